@@ -1,0 +1,65 @@
+"""Exceptions raised by ngcontact.
+
+Every error a user can cause names the offending key path, the value given and
+what would have been allowed, so that a scene file can be fixed from the
+message alone.
+"""
+from __future__ import annotations
+
+
+class _Missing:
+    """Stands for a key that is absent from the scene."""
+
+    def __repr__(self) -> str:
+        return "<missing>"
+
+
+MISSING = _Missing()
+
+
+class NgcontactError(Exception):
+    """Base class of all errors raised by the package."""
+
+
+class SceneError(NgcontactError):
+    """An invalid scene: ``path = value: what is allowed``.
+
+    Parameters
+    ----------
+    path
+        Dotted key path in the scene, e.g. ``materials.bone.nu``.
+    value
+        The offending value (``repr`` goes into the message).
+    allowed
+        What would have been accepted.
+    """
+
+    def __init__(self, path: str, value, allowed: str):
+        self.path = path
+        self.value = value
+        self.allowed = allowed
+        super().__init__(f"{path} = {_show(value)}: {allowed}")
+
+
+class ConvergenceError(NgcontactError):
+    """A nonlinear solve that did not converge; carries its iteration history."""
+
+    def __init__(self, message: str, history: dict):
+        self.history = history
+        super().__init__(message)
+
+
+class OutputError(NgcontactError):
+    """The output directory cannot be written."""
+
+
+def _show(value) -> str:
+    if isinstance(value, str):
+        return repr(value)
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, (list, tuple)) and len(value) > 8:
+        return f"[{', '.join(_show(v) for v in value[:8])}, ...] ({len(value)} entries)"
+    if isinstance(value, dict):
+        return "{" + ", ".join(sorted(value)) + "}"
+    return repr(value)

@@ -1,0 +1,132 @@
+"""Periodic two-body cells in 2D with Netgen's ``geom2d``.
+
+The interface between ``rough`` (below) and ``counter`` (above) is a chain of
+segments from ``(0, y0)`` to ``(period, y0)``: straight lines and rational
+quadratic splines (``spline3``, exact circular arcs), so that curved
+interfaces get curved high-order elements.  The lateral edges ``x = 0`` and
+``x = period`` are identified (``copy=`` in geom2d), the far faces are
+``bottom`` (``y = -h_rough``) and ``top`` (``y = h_counter``).
+
+A segment list may also mark parts of the interface as free surfaces
+bounding a void: a void is a closed region between two chains (the rough
+profile below, the counter's face above) and belongs to neither body.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ngsolve as ng
+from netgen.geom2d import SplineGeometry
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One piece of the interface: ``kind`` is ``"line"`` or ``"spline3"``.
+
+    ``points`` are 2 (line) or 3 (spline3: start, control, end) coordinates;
+    ``label`` is ``"contact"`` or ``"free"``.
+    """
+
+    kind: str
+    points: tuple
+    label: str = "contact"
+
+
+@dataclass(frozen=True)
+class Cell:
+    """A meshed periodic cell and its geometric data (no physics)."""
+
+    mesh: ng.Mesh
+    dim: int
+    period: tuple          # period in each tangential direction
+    h_rough: float         # depth of the rough body below y = 0
+    h_counter: float       # height of the counter body above y = 0
+
+    @property
+    def area(self) -> float:
+        """``|T|``: projected area (3D) or length (2D) of one cell."""
+        a = 1.0
+        for p in self.period:
+            a *= p
+        return a
+
+
+def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
+                   maxh: float, interface_maxh: float | None = None, order: int = 1,
+                   voids=()) -> Cell:
+    """Mesh a 2D periodic cell whose bodies meet along ``segments``.
+
+    Parameters
+    ----------
+    segments
+        Interface chain from ``x = 0`` to ``x = period``, left to right, each a
+        :class:`Segment`; the chain must start and end at the same height.
+        The rough body lies below, the counter body above.
+    period
+        Cell length ``|T|``.
+    h_rough, h_counter
+        Far faces at ``y = -h_rough`` and ``y = h_counter``.
+    maxh, interface_maxh
+        Mesh sizes in the bodies and on the interface.
+    order
+        Geometry order of the curved elements.
+    voids
+        Closed chains of :class:`Segment` (counter-clockwise) cut from the
+        ``counter`` region: each void's boundary is labelled by its segments
+        (``free`` or ``contact``).  A void's chain replaces the part of the
+        interface it covers, which must then be omitted from ``segments``.
+    """
+    pts = [tuple(map(float, p)) for s in segments for p in s.points]
+    y0, y1 = segments[0].points[0][1], segments[-1].points[-1][1]
+    if abs(segments[0].points[0][0]) > 1e-14 or abs(segments[-1].points[-1][0] - period) > 1e-12 * period:
+        raise ValueError("the interface chain must run from x = 0 to x = period")
+    if abs(y0 - y1) > 1e-12 * max(1.0, abs(y0)):
+        raise ValueError(f"the interface is not periodic: y(0) = {y0} but y(period) = {y1}")
+    lo = min(p[1] for p in pts)
+    hi = max(p[1] for p in pts)
+    if not (-h_rough < lo and hi < h_counter):
+        raise ValueError(f"the interface spans y in [{lo}, {hi}]: it must lie strictly between "
+                         f"-h_rough = {-h_rough} and h_counter = {h_counter}")
+    hint = interface_maxh or maxh
+    geo = SplineGeometry()
+    cache = {}
+
+    def point(p):
+        key = (round(p[0], 14), round(p[1], 14))
+        if key not in cache:
+            cache[key] = geo.AppendPoint(*p)
+        return cache[key]
+
+    ROUGH, COUNTER = 1, 2
+    bl, br = point((0.0, -h_rough)), point((period, -h_rough))
+    tl, tr = point((0.0, h_counter)), point((period, h_counter))
+    il, ir = point((0.0, y0)), point((period, y0))
+    geo.Append(["line", bl, br], leftdomain=ROUGH, rightdomain=0, bc="bottom")
+    right = geo.Append(["line", br, ir], leftdomain=ROUGH, rightdomain=0, bc="periodic")
+    geo.Append(["line", bl, il], leftdomain=0, rightdomain=ROUGH, bc="periodic", copy=right)
+    right = geo.Append(["line", ir, tr], leftdomain=COUNTER, rightdomain=0, bc="periodic")
+    geo.Append(["line", il, tl], leftdomain=0, rightdomain=COUNTER, bc="periodic", copy=right)
+    geo.Append(["line", tr, tl], leftdomain=COUNTER, rightdomain=0, bc="top")
+    # interface, left to right: rough (below) is on the right-hand side
+    for s in segments:
+        ids = [point(p) for p in s.points]
+        geo.Append([s.kind, *ids], leftdomain=COUNTER, rightdomain=ROUGH, bc=s.label, maxh=hint)
+    for chain in voids:
+        for s in chain:
+            ids = [point(p) for p in s.points]
+            geo.Append([s.kind, *ids], leftdomain=0, rightdomain=COUNTER, bc=s.label, maxh=hint)
+    geo.SetMaterial(ROUGH, "rough")
+    geo.SetMaterial(COUNTER, "counter")
+    mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh))
+    if order > 1:
+        mesh.Curve(order)
+    return Cell(mesh=mesh, dim=2, period=(float(period),), h_rough=float(h_rough),
+                h_counter=float(h_counter))
+
+
+def flat_cell(period: float = 1.0, h_rough: float = 1.0, h_counter: float = 1.0, *,
+              maxh: float, interface_maxh: float | None = None, order: int = 1) -> Cell:
+    """Two bodies bonded along the flat line ``y = 0`` (the small-slope model)."""
+    seg = Segment("line", ((0.0, 0.0), (period, 0.0)))
+    return interface_cell([seg], period, h_rough, h_counter, maxh=maxh,
+                          interface_maxh=interface_maxh, order=order)

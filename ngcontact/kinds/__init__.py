@@ -1,0 +1,2 @@
+"""Scene descriptions, one module per problem kind; importing registers them."""
+from . import manufactured  # noqa: F401

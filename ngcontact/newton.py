@@ -1,0 +1,157 @@
+"""Energy minimization by Newton's method with a backtracking line search.
+
+Contact and elasticity are written as one energy ``Pi(u)`` (NGSolve
+``Variation`` terms), so the residual ``r(u) = Pi'(u)`` and the tangent
+``K(u) = Pi''(u)`` come from NGSolve's linearization. One step solves
+``K(u) du = r(u)`` and sets ``u <- u - alpha du`` with the largest
+``alpha = 1, 1/2, 1/4, ...`` that satisfies the Armijo condition
+
+    Pi(u - alpha du) <= Pi(u) - c alpha (du . r(u)),   c = 1e-4,
+
+and yields finite numbers.  The iteration stops when the residual (free
+dofs) has fallen below ``rtol`` times the first residual, or below ``atol``.
+A quadratic energy is minimized by a single linear solve.
+
+On failure a :class:`~ngcontact.errors.ConvergenceError` carries the history:
+residual norms, energies, step lengths.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import ngsolve as ng
+
+from .errors import ConvergenceError
+
+log = logging.getLogger(__name__)
+
+ARMIJO = 1e-4
+MIN_STEP = 2.0 ** -30
+
+
+@dataclass
+class NewtonHistory:
+    """What happened during a solve (JSON-ready lists of floats)."""
+
+    residuals: list = field(default_factory=list)
+    energies: list = field(default_factory=list)
+    steps: list = field(default_factory=list)
+    converged: bool = False
+    linear: bool = False
+
+    @property
+    def iterations(self) -> int:
+        return len(self.steps)
+
+    def as_dict(self) -> dict:
+        return {"iterations": self.iterations, "converged": self.converged,
+                "linear_solve_only": self.linear,
+                "residuals": list(self.residuals), "energies": list(self.energies),
+                "step_lengths": list(self.steps)}
+
+
+def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
+             rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 50,
+             inverse: str = "sparsecholesky", quadratic: bool = False,
+             callback=None) -> NewtonHistory:
+    """Minimize the energy of ``form`` starting from ``gfu`` (updated in place).
+
+    Parameters
+    ----------
+    form
+        BilinearForm made of ``Variation`` energy terms.
+    gfu
+        Start value; Dirichlet values must already be set in it.
+    freedofs
+        BitArray of the unknowns (default: the space's free dofs).
+    rtol, atol
+        Stop when ``|r| <= max(rtol * |r_0|, atol)``.
+    max_iter
+        Largest number of Newton steps.
+    inverse
+        Sparse direct solver for the tangent.
+    quadratic
+        The energy is quadratic: one linear solve, no iteration.
+    callback
+        Called as ``callback(iteration, gfu)`` after each accepted step.
+    """
+    if freedofs is None:
+        freedofs = gfu.space.FreeDofs()
+    hist = NewtonHistory(linear=quadratic)
+    fixed = fixed_mask(freedofs)
+    res = gfu.vec.CreateVector()
+    du = gfu.vec.CreateVector()
+    trial = gfu.vec.CreateVector()
+
+    def residual(vec) -> float:
+        form.Apply(vec, res)
+        _mask(res, fixed)
+        return math.sqrt(max(ng.InnerProduct(res, res), 0.0))
+
+    energy = form.Energy(gfu.vec)
+    rnorm = residual(gfu.vec)
+    hist.energies.append(energy)
+    hist.residuals.append(rnorm)
+    if not (math.isfinite(energy) and math.isfinite(rnorm)):
+        raise ConvergenceError("the start value gives a non-finite energy or residual", hist.as_dict())
+    r0 = rnorm
+    if rnorm <= atol or rnorm == 0.0:
+        hist.converged = True
+        return hist
+    for it in range(1, (1 if quadratic else max_iter) + 1):
+        form.AssembleLinearization(gfu.vec)
+        inv = form.mat.Inverse(freedofs, inverse=inverse)
+        du.data = inv * res
+        slope = ng.InnerProduct(du, res)
+        if not math.isfinite(slope):
+            raise ConvergenceError(f"Newton step {it}: the tangent solve gave non-finite values", hist.as_dict())
+        alpha = 1.0
+        while True:
+            trial.data = gfu.vec - alpha * du
+            e_new = form.Energy(trial)
+            finite = math.isfinite(e_new)
+            if quadratic and finite:
+                break
+            if finite and e_new <= energy - ARMIJO * alpha * slope + 1e-14 * abs(energy):
+                break
+            alpha *= 0.5
+            if alpha < MIN_STEP:
+                hist.steps.append(0.0)
+                raise ConvergenceError(
+                    f"Newton step {it}: line search found no decrease of the energy "
+                    f"(residual {rnorm:.3e}); the tangent may be wrong or the problem unbounded",
+                    hist.as_dict())
+        gfu.vec.data = trial
+        energy = e_new
+        rnorm = residual(gfu.vec)
+        hist.steps.append(alpha)
+        hist.energies.append(energy)
+        hist.residuals.append(rnorm)
+        log.debug("newton %d: |r| = %.3e, energy = %.6e, alpha = %g", it, rnorm, energy, alpha)
+        if callback is not None:
+            callback(it, gfu)
+        if not math.isfinite(rnorm):
+            raise ConvergenceError(f"Newton step {it}: non-finite residual", hist.as_dict())
+        if rnorm <= max(rtol * r0, atol):
+            hist.converged = True
+            return hist
+    if quadratic:
+        hist.converged = True
+        return hist
+    raise ConvergenceError(
+        f"Newton did not converge in {max_iter} steps: residual {rnorm:.3e} "
+        f"> {max(rtol * r0, atol):.3e} (rtol {rtol:g} x first residual {r0:.3e})",
+        hist.as_dict())
+
+
+def fixed_mask(freedofs):
+    """Boolean NumPy array, True where a dof is not free."""
+    import numpy as np
+    return ~np.array([freedofs[i] for i in range(len(freedofs))], dtype=bool)
+
+
+def _mask(vec, fixed) -> None:
+    """Zero the entries of ``vec`` that are not free."""
+    vec.FV().NumPy()[fixed] = 0.0
