@@ -85,7 +85,7 @@ class SolverSpec:
     atol: float = param(0.0, doc="or below this absolute residual", units="N", check=at_least(0))
     max_iter: int = param(40, doc="largest number of Newton steps", check=at_least(1))
     inverse: str = param("sparsecholesky", doc="sparse direct solver",
-                         choices=("sparsecholesky", "umfpack", "pardiso"))
+                         choices=("sparsecholesky", "umfpack"))
 
 
 def materials_param(doc: str = "named materials; see [materials.NAME]"):

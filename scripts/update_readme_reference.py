@@ -1,0 +1,67 @@
+"""Regenerate the scene-file reference in README.md from the scene schema.
+
+The tables between the markers ``<!-- scene-reference:begin -->`` and
+``<!-- scene-reference:end -->`` are written from the same field metadata that
+validates scenes, so documentation and validation cannot drift apart.
+``tests/test_readme.py`` fails when the README is out of date.
+
+Usage: python scripts/update_readme_reference.py [--check]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from ngcontact.scene import KINDS, _ensure_kinds
+from ngcontact.schema import describe
+
+BEGIN = "<!-- scene-reference:begin -->"
+END = "<!-- scene-reference:end -->"
+README = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "README.md")
+
+
+def reference() -> str:
+    """Markdown tables, one per scene kind."""
+    _ensure_kinds()
+    out = []
+    for name in sorted(KINDS):
+        cls = KINDS[name].scene
+        doc = (cls.__module__ and sys.modules[cls.__module__].__doc__ or "").strip().splitlines()
+        out.append(f"### kind = \"{name}\"\n")
+        if doc:
+            out.append(doc[0].split(": ", 1)[-1] + "\n")
+        out.append("| key | type | default | units | allowed | meaning |")
+        out.append("|---|---|---|---|---|---|")
+        for row in describe(cls):
+            cells = [f"`{row['key']}`", row["type"], row["default"], row["units"] or "-",
+                     row["allowed"], row["doc"]]
+            out.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+        out.append("")
+    return "\n".join(out)
+
+
+def updated(text: str) -> str:
+    if BEGIN not in text or END not in text:
+        raise SystemExit(f"README.md lacks the markers {BEGIN} ... {END}")
+    head, rest = text.split(BEGIN, 1)
+    _, tail = rest.split(END, 1)
+    return f"{head}{BEGIN}\n{reference()}\n{END}{tail}"
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--check", action="store_true", help="exit 1 if README.md is out of date")
+    args = p.parse_args()
+    with open(README) as fh:
+        text = fh.read()
+    new = updated(text)
+    if args.check:
+        return 0 if new == text else 1
+    with open(README, "w") as fh:
+        fh.write(new)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
