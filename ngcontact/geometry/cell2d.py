@@ -9,7 +9,11 @@ interfaces get curved high-order elements.  The lateral edges ``x = 0`` and
 
 A segment list may also mark parts of the interface as free surfaces
 bounding a void: a void is a closed region between two chains (the rough
-profile below, the counter's face above) and belongs to neither body.
+profile below, the counter's face above) and belongs to neither body.  Each
+segment names the domain on either side of its direction of travel
+(``right`` / ``left``: ``"rough"``, ``"counter"`` or ``"void"``), so a void
+may border both bodies (the summit arrangement of
+:mod:`ngcontact.geometry.profiles`).
 """
 from __future__ import annotations
 
@@ -19,17 +23,25 @@ import ngsolve as ng
 from netgen.geom2d import SplineGeometry
 
 
+_DOMAINS = {"void": 0, "rough": 1, "counter": 2}
+
+
 @dataclass(frozen=True)
 class Segment:
     """One piece of the interface: ``kind`` is ``"line"`` or ``"spline3"``.
 
     ``points`` are 2 (line) or 3 (spline3: start, control, end) coordinates;
-    ``label`` is ``"contact"`` or ``"free"``.
+    ``label`` is ``"contact"`` or ``"free"``; ``right`` and ``left`` are the
+    domains on the right- and left-hand side of the direction of travel
+    (``"rough"``, ``"counter"`` or ``"void"``).  The defaults suit a chain
+    run from ``x = 0`` to ``x = period``: ``rough`` below, ``counter`` above.
     """
 
     kind: str
     points: tuple
     label: str = "contact"
+    right: str = "rough"
+    left: str = "counter"
 
 
 @dataclass(frozen=True)
@@ -59,9 +71,11 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
     Parameters
     ----------
     segments
-        Interface chain from ``x = 0`` to ``x = period``, left to right, each a
-        :class:`Segment`; the chain must start and end at the same height.
-        The rough body lies below, the counter body above.
+        Interface segments, each a :class:`Segment`, forming the boundary
+        between the bodies (and any voids) from ``x = 0`` to ``x = period``;
+        exactly one point lies on each lateral edge and both at the same
+        height.  With the default sides the rough body lies below and the
+        counter body above.
     period
         Cell length ``|T|``.
     h_rough, h_counter
@@ -77,11 +91,22 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
         interface it covers, which must then be omitted from ``segments``.
     """
     pts = [tuple(map(float, p)) for s in segments for p in s.points]
-    y0, y1 = segments[0].points[0][1], segments[-1].points[-1][1]
-    if abs(segments[0].points[0][0]) > 1e-14 or abs(segments[-1].points[-1][0] - period) > 1e-12 * period:
-        raise ValueError("the interface chain must run from x = 0 to x = period")
+    ends = [tuple(map(float, p)) for s in segments for p in (s.points[0], s.points[-1])]
+    tol = 1e-12 * period
+    left_pts = {round(p[1], 12): p[1] for p in ends if abs(p[0]) <= tol}
+    right_pts = {round(p[1], 12): p[1] for p in ends if abs(p[0] - period) <= tol}
+    if len(left_pts) != 1 or len(right_pts) != 1:
+        raise ValueError("the interface must run from x = 0 to x = period, meeting each "
+                         f"lateral edge at exactly one point; it meets x = 0 at y in "
+                         f"{sorted(left_pts.values())} and x = period at y in "
+                         f"{sorted(right_pts.values())}")
+    (y0,), (y1,) = left_pts.values(), right_pts.values()
     if abs(y0 - y1) > 1e-12 * max(1.0, abs(y0)):
         raise ValueError(f"the interface is not periodic: y(0) = {y0} but y(period) = {y1}")
+    for s in segments:
+        for side in (s.right, s.left):
+            if side not in _DOMAINS:
+                raise ValueError(f"segment side = {side!r}: must be one of {', '.join(_DOMAINS)}")
     lo = min(p[1] for p in pts)
     hi = max(p[1] for p in pts)
     if not (-h_rough < lo and hi < h_counter):
@@ -97,7 +122,7 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
             cache[key] = geo.AppendPoint(*p)
         return cache[key]
 
-    ROUGH, COUNTER = 1, 2
+    ROUGH, COUNTER = _DOMAINS["rough"], _DOMAINS["counter"]
     bl, br = point((0.0, -h_rough)), point((period, -h_rough))
     tl, tr = point((0.0, h_counter)), point((period, h_counter))
     il, ir = point((0.0, y0)), point((period, y0))
@@ -107,10 +132,11 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
     right = geo.Append(["line", ir, tr], leftdomain=COUNTER, rightdomain=0, bc="periodic")
     geo.Append(["line", il, tl], leftdomain=0, rightdomain=COUNTER, bc="periodic", copy=right)
     geo.Append(["line", tr, tl], leftdomain=COUNTER, rightdomain=0, bc="top")
-    # interface, left to right: rough (below) is on the right-hand side
+    # interface: by default run left to right, rough (below) on the right-hand side
     for s in segments:
         ids = [point(p) for p in s.points]
-        geo.Append([s.kind, *ids], leftdomain=COUNTER, rightdomain=ROUGH, bc=s.label, maxh=hint)
+        geo.Append([s.kind, *ids], leftdomain=_DOMAINS[s.left], rightdomain=_DOMAINS[s.right],
+                   bc=s.label, maxh=hint)
     for chain in voids:
         for s in chain:
             ids = [point(p) for p in s.points]
