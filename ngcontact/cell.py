@@ -1,0 +1,612 @@
+"""The micro (cell) contact problem in the interface layer (paper Sec. 3.4).
+
+A periodic cell holds two elastic bodies, ``rough`` below and ``counter``
+above, meeting along the potential contact surface ``S_C`` (mesh naming
+contract of :mod:`ngcontact.geometry`).  The cell problem (paper eqs. 49-51,
+variational form 57 and 65) is solved for the periodic displacement
+fluctuation of each body as the minimum of
+
+    Pi(u_r, u_c, U) = sum_B int_B 1/2 (eps(u_B) + E) : C_B : (eps(u_B) + E) dx
+                      + int_{S_C} psi(J) ds  -  |T| tbar . U
+
+with
+
+* ``u_r`` the fluctuation of ``rough``, periodic, zero on ``bottom``;
+* ``u_c + U`` the displacement of ``counter``: a periodic fluctuation ``u_c``
+  vanishing on ``top`` plus a rigid translation ``U`` of the far face (one
+  ``NumberSpace`` per component);
+* ``J = u_r - u_c - U`` the jump (the affine macro part ``E x`` is the same on
+  both sides and does not jump), ``psi`` the interface energy of
+  :mod:`ngcontact.contact` (penalty, gap, friction as asked for);
+* ``E`` an optional in-plane macro strain (2D: ``e_xx``; 3D: ``e_xx, e_yy,
+  e_xy``);
+* per component ``i`` of the mesh axes (``x, y`` in 2D, ``x, y, z`` in 3D; the
+  last one is the macro normal ``n0``) either a prescribed mean traction
+  ``tbar_i`` on the counter's far face (normal pressure ``p = -tbar_n >= 0``,
+  compression positive) or a prescribed jump across the layer
+  ``Delta_i = (u_bottom - u_top)_i = -U_i`` (``Delta_n > 0`` closes).
+
+Start of a solve.  The tangent is singular in ``U_n`` while nothing is in
+contact, so the first load of a sweep starts from a *closed* predictor: the
+counter is pushed down by the largest gap plus ``p/k_n`` so that every
+quadrature point on ``S_C`` is in contact; the line search then opens the
+surface where it must.  Later loads continue from the previous solution.
+When friction is absent and ``S_C`` is flat, a tangential translation of the
+counter costs no energy: it is then fixed at 0 (any value solves the problem)
+and a nonzero shear is rejected (a frictionless flat interface carries
+none).
+
+Coulomb friction is a fixed point of Tresca problems, ``G_k = mu p_{k-1}``
+(see :mod:`ngcontact.contact`); it stops when
+``max |p_k - p_{k-1}| <= coulomb_rtol * max p_k`` at the quadrature points
+of ``S_C``.
+
+Effective stiffness (beyond the paper, DESIGN Sec. 3): with ``S`` the Schur
+complement of the tangent on ``U`` divided by ``|T|`` (the tangent of the
+mean traction with respect to the far faces' relative displacement) and
+``S_b`` the same for the cell with the interface bonded, the interface's
+compliance is ``S^-1 - S_b^-1`` and the effective stiffness its inverse,
+``K_eff = S_b (S_b - S)^-1 S``.
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+import ngsolve as ng
+import numpy as np
+
+from . import contact as _contact
+from . import elasticity as _el
+from . import materials as _mat
+from .errors import ConvergenceError
+from .newton import minimize
+
+log = logging.getLogger(__name__)
+
+
+# ------------------------------------------------------------ descriptions
+@dataclass(frozen=True)
+class Friction:
+    """Friction law: ``"tresca"`` with threshold ``G`` or ``"coulomb"`` with ``mu``; Huber width ``w``."""
+
+    law: str
+    w: float
+    G: float | None = None
+    mu: float | None = None
+
+    def __post_init__(self):
+        if self.law not in ("tresca", "coulomb"):
+            raise ValueError(f"friction law {self.law!r}: must be 'tresca' or 'coulomb'")
+        if not self.w > 0:
+            raise ValueError(f"friction width w = {self.w!r}: must be > 0")
+        if self.law == "tresca" and (self.G is None or self.G < 0):
+            raise ValueError(f"Tresca threshold G = {self.G!r}: must be >= 0")
+        if self.law == "coulomb" and (self.mu is None or self.mu < 0):
+            raise ValueError(f"Coulomb coefficient mu = {self.mu!r}: must be >= 0")
+
+
+@dataclass(frozen=True)
+class CellLoad:
+    """One load state of the cell, per mesh axis (the last axis is ``n0``).
+
+    ``traction[i]`` is the prescribed mean traction on the counter's far face
+    or ``None`` where ``jump[i]`` (far-face jump, rough minus counter) is
+    prescribed instead; ``macro_strain`` holds the in-plane macro strain
+    (2D ``(e_xx,)``, 3D ``(e_xx, e_yy, e_xy)``) or is empty.
+    """
+
+    traction: tuple
+    jump: tuple
+    macro_strain: tuple = ()
+
+
+def cell_load(dim: int, *, pressure=None, normal_jump=None, shear=None,
+              tangential_jump=None, macro_strain=None) -> CellLoad:
+    """Build a :class:`CellLoad` from the quantities of the interface.
+
+    Parameters
+    ----------
+    dim
+        Spatial dimension of the cell (2 or 3).
+    pressure
+        Mean normal pressure transmitted across the layer (compression
+        positive); give this or ``normal_jump``.
+    normal_jump
+        Prescribed normal jump of the far faces (positive closes the layer).
+    shear
+        Mean tangential traction on the counter's far face, one value per
+        tangential axis (``None`` entries: the jump is prescribed); default 0.
+    tangential_jump
+        Prescribed tangential far-face jump per tangential axis, or ``None``.
+    macro_strain
+        In-plane macro strain, 2D ``(e_xx,)``, 3D ``(e_xx, e_yy, e_xy)``.
+    """
+    nt = dim - 1
+    if (pressure is None) == (normal_jump is None):
+        raise ValueError("give exactly one of pressure and normal_jump")
+    shear = tuple(shear) if shear is not None else (None,) * nt
+    tj = tuple(tangential_jump) if tangential_jump is not None else (None,) * nt
+    if len(shear) != nt or len(tj) != nt:
+        raise ValueError(f"shear and tangential_jump need {nt} entries in {dim}D")
+    traction, jump = [], []
+    for s, j in zip(shear, tj):
+        if s is not None and j is not None:
+            raise ValueError("a tangential component takes a shear or a jump, not both")
+        traction.append(None if j is not None else float(s or 0.0))
+        jump.append(None if j is None else float(j))
+    traction.append(None if pressure is None else -float(pressure))
+    jump.append(None if normal_jump is None else float(normal_jump))
+    ms = tuple(float(v) for v in (macro_strain or ()))
+    if ms and len(ms) != (1 if dim == 2 else 3):
+        raise ValueError(f"macro_strain needs {1 if dim == 2 else 3} entries in {dim}D")
+    return CellLoad(traction=tuple(traction), jump=tuple(jump), macro_strain=ms)
+
+
+@dataclass(frozen=True)
+class CellModel:
+    """Physics of a cell problem (no mesh).
+
+    Attributes
+    ----------
+    rough, counter
+        Elastic laws of the two bodies.
+    k_n
+        Penalty stiffness [stress/length].
+    gap
+        Initial gap as a CoefficientFunction of the coordinates, or ``None``.
+    friction
+        :class:`Friction` or ``None`` (frictionless).
+    order
+        Polynomial order of the displacements.
+    macro_strain
+        Assemble the macro strain term.
+    interpolate_gap
+        Replace the gap by its interpolant of the displacement order on ``S_C``.
+    contact_bonus_order
+        Extra integration order on ``S_C`` (the penalty has a kink).
+    coulomb_rtol, coulomb_max_iter
+        Stopping rule of the Coulomb fixed point.
+    """
+
+    rough: _mat.ElasticLaw
+    counter: _mat.ElasticLaw
+    k_n: float
+    gap: object = None
+    friction: Friction | None = None
+    order: int = 2
+    macro_strain: bool = False
+    interpolate_gap: bool = True
+    contact_bonus_order: int = 12
+    coulomb_rtol: float = 1e-8
+    coulomb_max_iter: int = 40
+
+
+@dataclass
+class CellSolution:
+    """Results of one load (plain numbers and arrays)."""
+
+    load: CellLoad
+    results: dict
+    surface: dict
+    newton: list = field(default_factory=list)
+    coulomb_iterations: int = 0
+
+    @property
+    def iterations(self) -> int:
+        return sum(h["iterations"] for h in self.newton)
+
+
+# ------------------------------------------------------------------ model
+def contact_normal(mesh, dim: int):
+    """Unit micro normal on ``contact``, oriented from ``rough`` into ``counter``.
+
+    Uses :func:`ngcontact.homogenize.contact_normal` when that module provides
+    it; otherwise NGSolve's boundary normal, whose orientation is consistent
+    along the interface chain of a cell, with its sign fixed so that it has a
+    positive mean component along ``n0``.
+    """
+    try:
+        from .homogenize import contact_normal as _hn  # provided by the homogenize module
+    except ImportError:
+        _hn = None
+    if _hn is not None:
+        return _hn(mesh)
+    raw = ng.specialcf.normal(dim)
+    s = ng.Integrate(raw[dim - 1], mesh, definedon=mesh.Boundaries("contact"), order=4)
+    if s == 0:
+        raise ValueError("cannot orient the contact normal: it has no mean component along n0")
+    return raw if s > 0 else -raw
+
+
+class CellProblem:
+    """A cell problem built on a meshed cell; solve loads with :meth:`sweep`.
+
+    Parameters
+    ----------
+    cell
+        A :class:`ngcontact.geometry.cell2d.Cell` (or 3D analogue) obeying the
+        naming contract.
+    model
+        :class:`CellModel`.
+    rtol, atol, max_iter, inverse
+        Newton settings (see :func:`ngcontact.newton.minimize`).
+    normal
+        Micro normal on ``contact``; default :func:`contact_normal`.
+    """
+
+    def __init__(self, cell, model: CellModel, *, rtol: float = 1e-10, atol: float = 0.0,
+                 max_iter: int = 40, inverse: str = "sparsecholesky", normal=None):
+        self.cell, self.model = cell, model
+        self.mesh = mesh = cell.mesh
+        self.dim = dim = cell.dim
+        self.setting = "3d" if dim == 3 else "plane_strain"
+        self.rtol, self.atol, self.max_iter, self.inverse = rtol, atol, max_iter, inverse
+        self.area = cell.area
+        self.n = normal if normal is not None else contact_normal(mesh, dim)
+        Vr = _el.body_space(mesh, "rough", model.order, dirichlet="bottom", periodic=True)
+        Vc = _el.body_space(mesh, "counter", model.order, dirichlet="top", periodic=True)
+        # U lives only where it enters (S_C and the far face): a NumberSpace on
+        # every element would couple all dofs and slow the factorization 5x
+        N = ng.NumberSpace(mesh, definedon=mesh.Boundaries("contact|top"))
+        self.X = ng.FESpace([Vr, Vc] + [N] * dim)
+        self.gap = self._discrete_gap()
+        self.gfu = ng.GridFunction(self.X)
+        self.u_dofs = [self.X.Range(2 + i).start for i in range(dim)]
+        self.traction = [ng.Parameter(0.0) for _ in range(dim)]
+        nE = 1 if dim == 2 else 3
+        self.strain_params = [ng.Parameter(0.0) for _ in range(nE)]
+        self.tangential_free = self._tangential_determinate()
+        self._bonded = None
+        self._previous = None
+        trial = self.X.TrialFunction()
+        ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
+        self.form = self._energy(ur, uc, U, trial)
+        # the state as CoefficientFunctions (for results and tests)
+        comps = self.gfu.components
+        self.U = ng.CF(tuple(comps[2:]))
+        self.J = comps[0] - comps[1] - self.U
+        self.pressure = _contact.pressure(self.J, self.n, model.k_n, self.gap)
+        self.penetration = _contact.penetration(self.J, self.n, self.gap)
+        self.slip = _contact.tangential_slip(self.J, self.n)
+
+    # -------------------------------------------------------------- energy
+    def _discrete_gap(self):
+        """The gap interpolated into polynomials of the displacement order on ``S_C``.
+
+        The penetration ``J_n - g_h`` is then a polynomial on each boundary
+        element, so its sign (the contact set) is not polluted by the
+        interpolation error of a transcendental gap against polynomial
+        displacements, which for a stiff penalty exceeds the penetration.
+        """
+        g = self.model.gap
+        if g is None or not self.model.interpolate_gap:
+            return g
+        mesh = self.mesh
+        Vg = ng.H1(mesh, order=self.model.order, definedon=mesh.Boundaries("contact"))
+        gh = ng.GridFunction(Vg)
+        gh.Set(g, definedon=mesh.Boundaries("contact"))
+        return gh
+
+    def _macro_strain_cf(self):
+        e = self.strain_params
+        if self.dim == 2:
+            return ng.CF((e[0], 0, 0, 0, 0, 0, 0, 0, 0), dims=(3, 3))
+        return ng.CF((e[0], e[2], 0, e[2], e[1], 0, 0, 0, 0), dims=(3, 3))
+
+    def body_strain(self, u):
+        """Total strain of a body: fluctuation plus the macro strain (if assembled)."""
+        eps = _el.strain(u, self.setting)
+        return eps + self._macro_strain_cf() if self.model.macro_strain else eps
+
+    def _energy(self, ur, uc, U, trial):
+        m, mesh = self.model, self.mesh
+        form = ng.BilinearForm(self.X, symmetric=True)
+        for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
+            eps = self.body_strain(u)
+            form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
+                                 * ng.dx(definedon=mesh.Materials(name)))
+        J = ur - uc - U
+        friction = threshold = w = None
+        if m.friction is not None:
+            friction, w = m.friction.law, m.friction.w
+            if friction == "tresca":
+                threshold = m.friction.G
+            else:
+                self._previous = ng.GridFunction(self.X)
+                pc = self._previous.components
+                J_prev = pc[0] - pc[1] - ng.CF(tuple(pc[2:]))
+                threshold = _contact.coulomb_threshold(J_prev, self.n, m.k_n, m.friction.mu, self.gap)
+        psi = _contact.interface_energy(J, self.n, k_n=m.k_n, gap=self.gap, friction=friction,
+                                        w=w, threshold=threshold)
+        form += ng.Variation(psi * ng.ds("contact", bonus_intorder=m.contact_bonus_order))
+        t = ng.CF(tuple(self.traction))
+        form += ng.Variation(-ng.InnerProduct(t, U) * ng.ds("top"))
+        return form
+
+    def _tangential_determinate(self) -> bool:
+        """False when ``U_t`` costs no energy: frictionless and a flat ``S_C``."""
+        if self.model.friction is not None:
+            return True
+        mesh, n, d = self.mesh, self.n, self.dim
+        nt2 = ng.InnerProduct(n, n) - n[d - 1] * n[d - 1]
+        tilt = ng.Integrate(nt2, mesh, definedon=mesh.Boundaries("contact"), order=2 * self.model.order + 2)
+        size = ng.Integrate(ng.CF(1.0), mesh, definedon=mesh.Boundaries("contact"))
+        return tilt > 1e-12 * size
+
+    @property
+    def ndof(self) -> int:
+        return self.X.ndof
+
+    # --------------------------------------------------------------- solve
+    def _freedofs(self, load: CellLoad):
+        free = ng.BitArray(self.X.FreeDofs())
+        for i, d in enumerate(self.u_dofs):
+            if load.jump[i] is not None or (i < self.dim - 1 and not self.tangential_free):
+                free.Clear(d)
+        return free
+
+    def _apply_load(self, load: CellLoad, first: bool):
+        d = self.dim
+        if not self.tangential_free:
+            for i in range(d - 1):
+                if load.traction[i] not in (None, 0.0) or load.jump[i] not in (None, 0.0):
+                    raise ValueError(
+                        "a frictionless flat contact surface carries no shear and fixes no "
+                        "tangential jump: give shear = 0 or add friction")
+        if load.macro_strain and not self.model.macro_strain:
+            raise ValueError("this cell problem was built without the macro strain term")
+        for i, p in enumerate(self.strain_params):
+            p.Set(load.macro_strain[i] if load.macro_strain else 0.0)
+        vec = self.gfu.vec
+        for i in range(d):
+            t = load.traction[i]
+            self.traction[i].Set(0.0 if t is None else t)
+            if load.jump[i] is not None:
+                vec[self.u_dofs[i]] = -load.jump[i]
+            elif i < d - 1 and not self.tangential_free:
+                vec[self.u_dofs[i]] = 0.0
+        if first and load.jump[d - 1] is None:
+            p = -load.traction[d - 1]
+            if not p > 0:
+                raise ValueError(f"normal pressure {p!r}: must be > 0 (a free layer has no unique "
+                                 "rigid position); prescribe a normal jump instead")
+            vec[self.u_dofs[d - 1]] = -(self.max_gap() + p / self.model.k_n)
+
+    def max_gap(self) -> float:
+        """Largest initial gap at the quadrature points of ``S_C`` (0 without gap)."""
+        if self.gap is None:
+            return 0.0
+        vals = self.sample_surface({"g": self.gap})["g"]
+        return float(max(vals.max(), 0.0))
+
+    def solve(self, load: CellLoad, first: bool = False) -> CellSolution:
+        """Solve one load, starting from the current state (continuation)."""
+        self._apply_load(load, first)
+        free = self._freedofs(load)
+        histories = []
+        fp = 0
+        if self.model.friction is not None and self.model.friction.law == "coulomb":
+            p_old = self.sample_surface({"p": self.pressure})["p"]
+            atol = self.atol
+            for fp in range(1, self.model.coulomb_max_iter + 1):
+                self._previous.vec.data = self.gfu.vec
+                h = self._newton(free, atol)
+                histories.append(h)
+                if fp == 1:
+                    atol = max(self.atol, self.rtol * h["residuals"][0])
+                p_new = self.sample_surface({"p": self.pressure})["p"]
+                change = float(np.max(np.abs(p_new - p_old))) if p_new.size else 0.0
+                scale = float(np.max(np.abs(p_new))) if p_new.size else 0.0
+                log.info("coulomb fixed point %d: max |dp| = %.3e (max p %.3e)", fp, change, scale)
+                if change <= self.model.coulomb_rtol * max(scale, 1e-300):
+                    break
+                p_old = p_new
+            else:
+                raise ConvergenceError(
+                    f"Coulomb fixed point did not converge in {self.model.coulomb_max_iter} "
+                    f"iterations: max pressure change {change:.3e} > "
+                    f"{self.model.coulomb_rtol:g} x max pressure {scale:.3e}",
+                    {"newton": histories})
+        else:
+            histories.append(self._newton(free, self.atol))
+        results = self.measure(load)
+        surface = self.surface_distribution()
+        return CellSolution(load=load, results=results, surface=surface, newton=histories,
+                            coulomb_iterations=fp)
+
+    def _newton(self, free, atol) -> dict:
+        h = minimize(self.form, self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
+                     max_iter=self.max_iter, inverse=self.inverse)
+        return h.as_dict()
+
+    def sweep(self, loads) -> list:
+        """Solve a list of loads in order, each from the previous solution."""
+        self.gfu.vec[:] = 0.0
+        out = []
+        for k, load in enumerate(loads):
+            sol = self.solve(load, first=(k == 0))
+            log.info("load %d: %d Newton steps, contact fraction %.6f", k, sol.iterations,
+                     sol.results["contact_fraction"])
+            out.append(sol)
+        return out
+
+    # ------------------------------------------------------------- results
+    def _contact_integral(self, cf, order=None):
+        o = order if order is not None else 4 * self.model.order + 24
+        return ng.Integrate(cf, self.mesh, definedon=self.mesh.Boundaries("contact"), order=o)
+
+    def contact_fraction(self) -> float:
+        """Measure of ``{J_n - g >= 0}`` on ``S_C`` divided by ``|T|``."""
+        ind = ng.IfPos(-self.penetration, 0.0, 1.0)
+        return float(self._contact_integral(ind)) / self.area
+
+    def mean_traction(self, load: CellLoad) -> np.ndarray:
+        """Mean traction on the counter's far face per axis (prescribed or reaction)."""
+        res = self.gfu.vec.CreateVector()
+        self.form.Apply(self.gfu.vec, res)
+        out = np.empty(self.dim)
+        for i, d in enumerate(self.u_dofs):
+            if load.traction[i] is not None and (i == self.dim - 1 or self.tangential_free):
+                out[i] = load.traction[i]
+            else:  # the load term of a controlled component is zero: residual = reaction
+                out[i] = res[d] / self.area
+        return out
+
+    def mean_jump(self) -> np.ndarray:
+        """Projected mean of the jump on ``S_C``: ``(1/|T|) int J |n.n0| ds``."""
+        w = ng.IfPos(self.n[self.dim - 1], self.n[self.dim - 1], -self.n[self.dim - 1])
+        return np.array(self._contact_integral(self.J * w, order=2 * self.model.order + 4)) / self.area
+
+    def measure(self, load: CellLoad) -> dict:
+        """Scalar results of the current state (see module docstring)."""
+        d = self.dim
+        t = self.mean_traction(load)
+        jbar = self.mean_jump()
+        Uv = np.array([self.gfu.vec[k] for k in self.u_dofs])
+        res = {
+            "contact_fraction": self.contact_fraction(),
+            "mean_pressure": float(self._contact_integral(self.pressure)) / self.area,
+            "mean_traction": t.tolist(),
+            "transmitted_pressure": float(-t[d - 1]),
+            "mean_jump": jbar.tolist(),
+            "mean_closure": float(jbar[d - 1]),
+            "far_face_jump": (-Uv).tolist(),
+            "max_penetration": float(self.sample_surface({"pen": self.penetration})["pen"].max()),
+        }
+        res.update(self.stress_maxima())
+        res["effective_stiffness"] = self.effective_stiffness()
+        return res
+
+    def sample_surface(self, fields: dict, order: int | None = None) -> dict:
+        """Values of CoefficientFunctions at the quadrature points of ``S_C``.
+
+        Evaluated on the boundary elements of ``contact`` themselves, so the
+        traces of each body are unambiguous.  Returns arrays, with the
+        coordinates under ``"x"``, ``"y"`` (and ``"z"``).
+        """
+        mesh = self.mesh
+        o = order if order is not None else 2 * self.model.order + 2
+        S = ng.comp.IntegrationRuleSpaceSurface(mesh, order=o, definedon=mesh.Boundaries("contact"))
+        names = ["x", "y", "z"][: self.dim] + list(fields)
+        cfs = [ng.x, ng.y, ng.z][: self.dim] + [fields[k] for k in fields]
+        flat = []
+        for cf in cfs:
+            flat.extend(cf[i] for i in range(cf.dim)) if cf.dim > 1 else flat.append(cf)
+        gf = ng.GridFunction(S ** len(flat)) if len(flat) > 1 else ng.GridFunction(S)
+        gf.Set(ng.CF(tuple(flat)) if len(flat) > 1 else flat[0], definedon=mesh.Boundaries("contact"))
+        arr = gf.vec.FV().NumPy().reshape(len(flat), -1)
+        out, k = {}, 0
+        for name, cf in zip(names, cfs):
+            out[name] = arr[k:k + cf.dim].copy() if cf.dim > 1 else arr[k].copy()
+            k += cf.dim
+        return out
+
+    def surface_distribution(self) -> dict:
+        """Pressure and slip at the quadrature points of ``S_C`` (2D: sorted by ``x``)."""
+        s = self.sample_surface({"pressure": self.pressure,
+                                 "slip": _contact.slip_magnitude(self.J, self.n),
+                                 "closure": _contact.normal_closure(self.J, self.n)})
+        if self.dim == 2:
+            idx = np.argsort(s["x"], kind="stable")
+            s = {k: v[..., idx] for k, v in s.items()}
+        return s
+
+    def stress_maxima(self) -> dict:
+        """Largest von Mises and Tresca stress in each body and where (element points)."""
+        out = {}
+        mesh, m = self.mesh, self.model
+        comps = self.gfu.components
+        for name, law, u in (("rough", m.rough, comps[0]), ("counter", m.counter, comps[1])):
+            R = ng.comp.IntegrationRuleSpace(mesh, order=max(m.order, 1),
+                                             definedon=mesh.Materials(name))
+            sig = law.stress(self.body_strain(u))
+            coords = [ng.x, ng.y, ng.z][: self.dim]
+            flat = [sig[i, j] for i in range(3) for j in range(3)] + coords + [ng.CF(1.0)]
+            gf = ng.GridFunction(R ** len(flat))
+            gf.Set(ng.CF(tuple(flat)), definedon=mesh.Materials(name))
+            arr = gf.vec.FV().NumPy().reshape(len(flat), -1)
+            inside = arr[-1] > 0.5
+            S = arr[:9, inside].T.reshape(-1, 3, 3)
+            X = arr[9:9 + self.dim, inside].T
+            vm = _mat.von_mises(S)
+            tr = _mat.tresca(S)
+            i, j = int(np.argmax(vm)), int(np.argmax(tr))
+            out[f"max_von_mises_{name}"] = {"value": float(vm[i]), "location": X[i].tolist()}
+            out[f"max_tresca_{name}"] = {"value": float(tr[j]), "location": X[j].tolist()}
+        return out
+
+    # --------------------------------------------------- effective stiffness
+    def _schur_on_U(self, form, X, u_dofs, state_vec):
+        """Schur complement of the tangent of ``form`` on the dofs ``u_dofs``."""
+        form.AssembleLinearization(state_vec)
+        K = form.mat
+        free = ng.BitArray(X.FreeDofs())
+        for d in u_dofs:
+            free.Clear(d)
+        inv = K.Inverse(free, inverse=self.inverse)
+        n = len(u_dofs)
+        S = np.zeros((n, n))
+        e, y, x, z = (state_vec.CreateVector() for _ in range(4))
+        for j, dj in enumerate(u_dofs):
+            e[:] = 0.0
+            e[dj] = 1.0
+            y.data = K * e
+            x.data = inv * y
+            z.data = K * x
+            for i, di in enumerate(u_dofs):
+                S[i, j] = y[di] - z[di]
+        return 0.5 * (S + S.T)
+
+    def bonded_stiffness(self) -> np.ndarray:
+        """``S_b``: stiffness of the same cell with the interface bonded (per ``|T|``)."""
+        if self._bonded is None:
+            mesh, m, d = self.mesh, self.model, self.dim
+            V = ng.Periodic(ng.VectorH1(mesh, order=m.order, dirichlet="bottom|top"))
+            N = ng.NumberSpace(mesh)
+            Xb = ng.FESpace([V] + [N] * d)
+            tr = Xb.TrialFunction()
+            u, U = tr[0], tr[1:]
+            H = self.cell.h_rough + self.cell.h_counter
+            # lifting U psi(y), psi = (y + h_rough)/H: strain sym(U (x) grad psi)
+            cols = [[0] * 3 for _ in range(3)]
+            for i in range(d):
+                a = U[i] / H
+                if i == d - 1:
+                    cols[i][i] = a
+                else:
+                    cols[i][d - 1] = cols[d - 1][i] = 0.5 * a
+            epsU = ng.CF(tuple(cols[i][j] for i in range(3) for j in range(3)), dims=(3, 3))
+            fb = ng.BilinearForm(Xb, symmetric=True)
+            for name, law in (("rough", m.rough), ("counter", m.counter)):
+                eps = _el.strain(u, self.setting) + epsU
+                fb += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
+                                   * ng.dx(definedon=mesh.Materials(name)))
+            g = ng.GridFunction(Xb)
+            dofs = [Xb.Range(1 + i).start for i in range(d)]
+            self._bonded = self._schur_on_U(fb, Xb, dofs, g.vec) / self.area
+        return self._bonded
+
+    def tangent_stiffness(self) -> np.ndarray:
+        """``S``: tangent of the mean far-face traction w.r.t. the far-face jump (per ``|T|``)."""
+        return self._schur_on_U(self.form, self.X, self.u_dofs, self.gfu.vec) / self.area
+
+    def effective_stiffness(self) -> dict:
+        """Interface stiffness with asperity compliance: ``(S^-1 - S_b^-1)^-1``.
+
+        Restricted to the components that are determinate (all but the
+        tangential ones of a frictionless flat interface).
+        """
+        keep = [i for i in range(self.dim) if i == self.dim - 1 or self.tangential_free]
+        names = (["t0"] if self.dim == 2 else ["t1", "t2"]) + ["n0"]
+        S = self.tangent_stiffness()[np.ix_(keep, keep)]
+        Sb = self.bonded_stiffness()[np.ix_(keep, keep)]
+        K = Sb @ np.linalg.solve(Sb - S, S)
+        return {"components": [names[i] for i in keep], "matrix": (0.5 * (K + K.T)).tolist(),
+                "total": S.tolist(), "bonded": Sb.tolist()}
+
+
+def solve_cell(cell, model: CellModel, loads, **newton) -> list:
+    """Build the cell problem and solve the sweep ``loads``; see :class:`CellProblem`."""
+    return CellProblem(cell, model, **newton).sweep(loads)
+
