@@ -45,7 +45,17 @@ def _check_setting(setting: str) -> None:
 def strain(u, setting: str):
     """3x3 small-strain tensor of the displacement ``u`` (trial, test or grid function)."""
     _check_setting(setting)
-    G = ng.Grad(u)
+    return strain_of_gradient(ng.Grad(u), u, setting)
+
+
+def strain_of_gradient(G, u, setting: str):
+    """3x3 strain tensor from a displacement gradient ``G`` (dim x dim) and ``u``.
+
+    The same embedding as :func:`strain`, for fields whose gradient is known
+    otherwise, e.g. a symbolic ``CoefficientFunction`` differentiated with
+    ``.Diff``; ``u`` enters only through the hoop strain ``u_r / r``.
+    """
+    _check_setting(setting)
     if setting == "3d":
         return ng.Sym(G)
     hoop = u[0] / ng.x if setting == "axisymmetric" else 0

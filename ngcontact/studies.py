@@ -1,0 +1,118 @@
+"""Convergence studies: refinement runners and observed rates.
+
+An a-priori estimate ``e(h) ~ C h^q`` makes ``log e`` affine in ``log h``;
+the observed rate ``q`` is the least-squares slope of ``log e`` against
+``log h`` over at least three levels (a two-point slope hides a level that
+is not yet asymptotic).  For order-``p`` Lagrange elements and a smooth
+solution the expected rates are ``p + 1`` in L2 and ``p`` in the H1
+seminorm.
+
+A *level* is any callable ``level(order, refinements) -> dict`` that returns
+at least ``ndof``, ``l2`` and ``h1``; the runners add the setting, order,
+mesh size and wall time and return one row (a dict) per level.  Rows are
+plain data, ready for CSV tables, reports and plots.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from typing import Callable, Sequence
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+ROW_KEYS = ("setting", "order", "level", "h", "ndof", "l2", "h1", "seconds")
+
+
+def fit_rate(h: Sequence[float], error: Sequence[float]) -> float:
+    """Least-squares slope of ``log error`` against ``log h``.
+
+    Parameters
+    ----------
+    h, error
+        Mesh sizes and errors of at least three levels, all > 0.
+
+    Raises
+    ------
+    ValueError
+        Fewer than three levels, or a non-positive value.
+    """
+    h = np.asarray(h, dtype=float)
+    e = np.asarray(error, dtype=float)
+    if h.shape != e.shape or h.ndim != 1:
+        raise ValueError(f"h and error must be 1-d of equal length, got {h.shape} and {e.shape}")
+    if len(h) < 3:
+        raise ValueError(f"{len(h)} levels: a rate needs at least 3")
+    if not (np.all(h > 0) and np.all(e > 0) and np.all(np.isfinite(e))):
+        raise ValueError("mesh sizes and errors must be finite and > 0")
+    return float(np.polyfit(np.log(h), np.log(e), 1)[0])
+
+
+def expected_rates(order: int) -> dict:
+    """``{"l2": p + 1, "h1": p}`` for elements of order ``p``."""
+    return {"l2": float(order + 1), "h1": float(order)}
+
+
+def h_refinement(level: Callable[[int, int], dict], *, setting: str, orders: Sequence[int],
+                 maxh: float, refinements: Sequence[int]) -> list[dict]:
+    """Rows for every order and every refinement level (h-refinement).
+
+    Parameters
+    ----------
+    level
+        ``level(order, refinements) -> {"ndof", "l2", "h1", ...}``.
+    setting
+        Label copied into each row.
+    orders
+        Polynomial orders.
+    maxh
+        Size of the generated mesh; level ``k`` has ``h = maxh / 2**k``.
+    refinements
+        Numbers of uniform refinements, one per level.
+    """
+    rows = []
+    for p in orders:
+        for k in refinements:
+            rows.append(_timed_row(level, setting, p, k, maxh))
+    return rows
+
+
+def p_refinement(level: Callable[[int, int], dict], *, setting: str, orders: Sequence[int],
+                 maxh: float, refinement: int) -> list[dict]:
+    """Rows for increasing order on one fixed mesh (p-refinement)."""
+    return [_timed_row(level, setting, p, refinement, maxh) for p in orders]
+
+
+def _timed_row(level, setting, order, k, maxh) -> dict:
+    t0 = time.perf_counter()
+    out = dict(level(order, k))
+    seconds = time.perf_counter() - t0
+    row = {"setting": setting, "order": int(order), "level": int(k), "h": maxh / 2 ** k,
+           "ndof": int(out.pop("ndof")), "l2": float(out.pop("l2")), "h1": float(out.pop("h1")),
+           "seconds": seconds}
+    row.update(out)
+    log.info("%s p=%d h=%.4g: ndof %d, L2 %.3e, H1 %.3e (%.2f s)", setting, order, row["h"],
+             row["ndof"], row["l2"], row["h1"], seconds)
+    return row
+
+
+def rates_by_order(rows: Sequence[dict]) -> dict:
+    """Observed ``{order: {"l2": rate, "h1": rate}}`` from h-refinement rows.
+
+    Orders with fewer than three levels are left out.
+    """
+    out = {}
+    for p in sorted({r["order"] for r in rows}):
+        sel = sorted((r for r in rows if r["order"] == p), key=lambda r: -r["h"])
+        if len(sel) < 3:
+            continue
+        h = [r["h"] for r in sel]
+        out[p] = {"l2": fit_rate(h, [r["l2"] for r in sel]),
+                  "h1": fit_rate(h, [r["h1"] for r in sel])}
+    return out
+
+
+def table(rows: Sequence[dict], keys: Sequence[str] = ROW_KEYS) -> tuple[list, list]:
+    """``(header, rows as lists)`` for a CSV file."""
+    return list(keys), [[r[k] for k in keys] for r in rows]
