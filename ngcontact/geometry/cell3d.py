@@ -1,0 +1,200 @@
+"""Periodic two-body cells in 3D with Netgen's constructive solid geometry.
+
+The cell is ``[0, P] x [0, P] x [-h_rough, h_counter]``; the macro normal
+``n0`` is ``+e_z`` and the summits of the roughness lie at ``z = 0``.  The
+faces ``x = 0, P`` and ``y = 0, P`` are identified periodically
+(``CSGeometry.PeriodicSurfaces``).
+
+Shapes
+------
+* :func:`flat_cell3d` -- the plane interface ``z = 0``;
+* :func:`square_hills_cell` -- the implant coating of paper Fig. 6: one
+  square hill of side ``a`` and height ``t`` centred in the cell, its plane
+  summit at ``z = 0``, on a base whose top lies at ``z = -t``.  With
+  ``arrangement="summit"`` the counter body fills ``z > 0`` and touches only
+  the summit (paper Example 26: ``|S_C_real| = a^2``); with ``"conforming"``
+  it fills everything around the hill as well.
+
+Faces are named after meshing from the domains on either side of each face
+(Netgen's face descriptors): a face between ``rough`` and ``counter`` is
+``contact``; a face between a body and a void inside the cell is ``free``.
+
+Free-form surfaces
+------------------
+CSG composes solids from primitives with closed-form surfaces and cannot
+express a bisinusoid or a sampled height map.  For those, this module gives
+the small-slope model instead: the flat cell (:func:`flat_cell3d`) plus the
+initial gap ``g(x, y) >= 0`` between the summit plane and the rough surface
+(:func:`bisinusoid_gap`, :func:`height_map_gap`).  A resolved free-form cell
+with Netgen's OCC kernel was not attempted within this module.
+"""
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+import ngsolve as ng
+from netgen.csg import CSGeometry, OrthoBrick, Plane, Pnt, Vec
+
+from ..errors import SceneError
+from .cell2d import Cell
+
+log = logging.getLogger(__name__)
+
+ARRANGEMENTS = ("conforming", "summit")
+_KEEP = ("periodic", "top", "bottom")
+
+
+def _positive(key, value):
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        raise SceneError(key, value, "must be a finite number > 0")
+    return float(value)
+
+
+def _box_planes(P, h_rough, h_counter):
+    """Lateral, bottom and top half-spaces of the cell."""
+    xm = Plane(Pnt(0, 0, 0), Vec(-1, 0, 0)).bc("periodic")
+    xp = Plane(Pnt(P, 0, 0), Vec(1, 0, 0)).bc("periodic")
+    ym = Plane(Pnt(0, 0, 0), Vec(0, -1, 0)).bc("periodic")
+    yp = Plane(Pnt(0, P, 0), Vec(0, 1, 0)).bc("periodic")
+    bottom = Plane(Pnt(0, 0, -h_rough), Vec(0, 0, -1)).bc("bottom")
+    top = Plane(Pnt(0, 0, h_counter), Vec(0, 0, 1)).bc("top")
+    return (xm, xp, ym, yp), bottom, top
+
+
+def _mesh(geo, maxh: float, P: float, h_rough: float, h_counter: float) -> Cell:
+    ngmesh = geo.GenerateMesh(maxh=maxh)
+    _name_faces(ngmesh)
+    mesh = ng.Mesh(ngmesh)
+    log.debug("3D cell: %d elements, boundaries %s", mesh.ne, sorted(set(mesh.GetBoundaries())))
+    return Cell(mesh=mesh, dim=3, period=(P, P), h_rough=float(h_rough),
+                h_counter=float(h_counter))
+
+
+def _name_faces(ngmesh) -> None:
+    """Name interface faces ``contact`` / ``free`` from the domains on their two sides."""
+    rough = counter = None
+    for i in range(1, ngmesh.GetNDomains() + 1):
+        name = ngmesh.GetMaterial(i)
+        if name == "rough":
+            rough = i
+        elif name == "counter":
+            counter = i
+    wanted = {}
+    for i in range(1, ngmesh.GetNFaceDescriptors() + 1):
+        fd = ngmesh.FaceDescriptor(i)
+        if fd.bcname in _KEEP:
+            continue
+        name = "contact" if {fd.domin, fd.domout} == {rough, counter} else "free"
+        if wanted.setdefault(fd.bc, name) != name:
+            raise RuntimeError(f"Netgen gave one boundary number {fd.bc} to contact and free faces")
+    for bc, name in wanted.items():
+        ngmesh.SetBCName(bc - 1, name)
+
+
+def flat_cell3d(period: float = 1.0, h_rough: float = 1.0, h_counter: float = 1.0, *,
+                maxh: float, interface_maxh: float | None = None) -> Cell:
+    """Two bodies bonded along the plane ``z = 0`` of a periodic ``period x period`` cell.
+
+    Parameters
+    ----------
+    period
+        Cell side ``P`` in ``x`` and ``y`` (``|T| = P^2``).
+    h_rough, h_counter
+        Far faces ``bottom`` at ``z = -h_rough`` and ``top`` at ``z = h_counter``.
+    maxh, interface_maxh
+        Mesh sizes in the bodies and on the interface.
+    """
+    P = _positive("period", period)
+    hr, hc = _positive("h_rough", h_rough), _positive("h_counter", h_counter)
+    lat, bottom, top = _box_planes(P, hr, hc)
+    xm, xp, ym, yp = lat
+    plane = Plane(Pnt(0, 0, 0), Vec(0, 0, 1)).bc("contact").maxh(interface_maxh or maxh)
+    box = xm * xp * ym * yp
+    geo = CSGeometry()
+    geo.Add((box * bottom * plane).mat("rough"))
+    geo.Add((box * top - plane).mat("counter"))
+    geo.PeriodicSurfaces(xm, xp)
+    geo.PeriodicSurfaces(ym, yp)
+    return _mesh(geo, maxh, P, hr, hc)
+
+
+def square_hills_cell(side: float, height: float, *, period: float = 1.0,
+                      arrangement: str = "summit", h_rough: float, h_counter: float,
+                      maxh: float, interface_maxh: float | None = None) -> Cell:
+    """The implant-coating cell of paper Fig. 6: one square hill with a plane summit.
+
+    Parameters
+    ----------
+    side
+        Hill side ``a < period``; the hill is centred in the cell.
+    height
+        Hill height ``t < h_rough``; summit at ``z = 0``, base top at ``z = -t``.
+    period
+        Cell side ``P``.
+    arrangement
+        ``"summit"`` (counter body flat on the summits, voids around the hill,
+        ``contact`` = the summit square) or ``"conforming"`` (the counter body
+        fills the space around the hill, ``contact`` = the whole rough surface).
+    h_rough, h_counter
+        Far faces at ``z = -h_rough`` and ``z = h_counter``.
+    maxh, interface_maxh
+        Mesh sizes in the bodies and on the rough surface.
+    """
+    P = _positive("period", period)
+    a, t = _positive("profile.side", side), _positive("profile.height", height)
+    hr, hc = _positive("h_rough", h_rough), _positive("h_counter", h_counter)
+    if arrangement not in ARRANGEMENTS:
+        raise SceneError("arrangement", arrangement, f"must be one of {', '.join(ARRANGEMENTS)}")
+    if not a < P:
+        raise SceneError("profile.side", side, f"must be < period = {P} (hills must not touch)")
+    if not t < hr:
+        raise SceneError("profile.height", height, f"must be < h_rough = {hr} "
+                         "(the hill base must lie inside the rough body)")
+    hi = interface_maxh or maxh
+    lat, bottom, top = _box_planes(P, hr, hc)
+    xm, xp, ym, yp = lat
+    box = xm * xp * ym * yp
+    c0, c1 = 0.5 * (P - a), 0.5 * (P + a)
+    base_top = Plane(Pnt(0, 0, -t), Vec(0, 0, 1)).bc("interface").maxh(hi)
+    hill = OrthoBrick(Pnt(c0, c0, -0.5 * (t + hr)), Pnt(c1, c1, 0.0)).bc("interface").maxh(hi)
+    rough = box * bottom * base_top + hill
+    if arrangement == "summit":
+        summit = Plane(Pnt(0, 0, 0), Vec(0, 0, -1)).bc("interface").maxh(hi)
+        counter = box * top * summit
+    else:
+        counter = box * top - base_top - hill
+    geo = CSGeometry()
+    geo.Add(rough.mat("rough"))
+    geo.Add(counter.mat("counter"))
+    geo.PeriodicSurfaces(xm, xp)
+    geo.PeriodicSurfaces(ym, yp)
+    return _mesh(geo, maxh, P, hr, hc)
+
+
+# ----------------------------------------------------- small-slope models
+def bisinusoid_gap(amplitude: float, period: float = 1.0):
+    """Initial gap of the bisinusoid ``z = A (cos(2 pi x/P) + cos(2 pi y/P) - 2)`` below its summit.
+
+    Small-slope model on :func:`flat_cell3d`: ``g(x, y) = A (2 - cos(2 pi x/P)
+    - cos(2 pi y/P)) >= 0``, zero at the summit ``(0, 0)``.
+    """
+    A, P = _positive("profile.amplitude", amplitude), _positive("period", period)
+    k = 2 * math.pi / P
+    return A * (2 - ng.cos(k * ng.x) - ng.cos(k * ng.y))
+
+
+def height_map_gap(heights, period: float = 1.0):
+    """Initial gap ``max(H) - H(x, y)`` of a periodic height map, bilinear between samples.
+
+    Small-slope model on :func:`flat_cell3d`.  ``heights[i, j]`` is the
+    height at ``x = j P / (n_x - 1)``, ``y = i P / (n_y - 1)``: the last row
+    and column repeat the first (see
+    :func:`ngcontact.geometry.tabulated.read_height_map`, which validates
+    such arrays).
+    """
+    P = _positive("period", period)
+    H = np.asarray(heights, dtype=float)
+    g = np.ascontiguousarray(H.max() - H)
+    return ng.VoxelCoefficient((0.0, 0.0), (P, P), g, linear=True)
