@@ -198,25 +198,14 @@ class CellSolution:
 
 
 # ------------------------------------------------------------------ model
-def contact_normal(mesh, dim: int):
-    """Unit micro normal on ``contact``, oriented from ``rough`` into ``counter``.
+def contact_normal(cell):
+    """Unit micro normal on ``contact``, from ``rough`` into ``counter``.
 
-    Uses :func:`ngcontact.homogenize.contact_normal` when that module provides
-    it; otherwise NGSolve's boundary normal, whose orientation is consistent
-    along the interface chain of a cell, with its sign fixed so that it has a
-    positive mean component along ``n0``.
+    Delegates to :func:`ngcontact.homogenize.contact_normal` (sign fixed per
+    boundary element by the side of its ``rough`` neighbour).
     """
-    try:
-        from .homogenize import contact_normal as _hn  # provided by the homogenize module
-    except ImportError:
-        _hn = None
-    if _hn is not None:
-        return _hn(mesh)
-    raw = ng.specialcf.normal(dim)
-    s = ng.Integrate(raw[dim - 1], mesh, definedon=mesh.Boundaries("contact"), order=4)
-    if s == 0:
-        raise ValueError("cannot orient the contact normal: it has no mean component along n0")
-    return raw if s > 0 else -raw
+    from .homogenize import contact_normal as _normal
+    return _normal(cell)
 
 
 class CellProblem:
@@ -243,7 +232,7 @@ class CellProblem:
         self.setting = "3d" if dim == 3 else "plane_strain"
         self.rtol, self.atol, self.max_iter, self.inverse = rtol, atol, max_iter, inverse
         self.area = cell.area
-        self.n = normal if normal is not None else contact_normal(mesh, dim)
+        self.n = normal if normal is not None else contact_normal(cell)
         Vr = _el.body_space(mesh, "rough", model.order, dirichlet="bottom", periodic=True)
         Vc = _el.body_space(mesh, "counter", model.order, dirichlet="top", periodic=True)
         # U lives only where it enters (S_C and the far face): a NumberSpace on
@@ -476,7 +465,23 @@ class CellProblem:
         }
         res.update(self.stress_maxima())
         res["effective_stiffness"] = self.effective_stiffness()
+        res["coefficients"] = self.real_contact_coefficients()
         return res
+
+    def friction_threshold(self):
+        """``G`` on ``S_C`` of the current state (``mu p`` for Coulomb), or ``None``."""
+        f = self.model.friction
+        if f is None:
+            return None
+        return f.G if f.law == "tresca" else f.mu * self.pressure
+
+    def real_contact_coefficients(self) -> dict:
+        """Paper eqs. 34, 42-43 on the real contact set ``{J_n - g >= 0}`` of the current state."""
+        from .homogenize import coefficients
+        ind = ng.IfPos(-self.penetration, 0.0, 1.0)
+        c = coefficients(self.cell, kn=self.model.k_n, gap=self.gap, G=self.friction_threshold(),
+                         weight=ind, normal=self.n, intorder=4 * self.model.order + 24)
+        return c.as_dict()
 
     def sample_surface(self, fields: dict, order: int | None = None) -> dict:
         """Values of CoefficientFunctions at the quadrature points of ``S_C``.
