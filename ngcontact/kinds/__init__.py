@@ -1,2 +1,3 @@
 """Scene descriptions, one module per problem kind; importing registers them."""
 from . import manufactured  # noqa: F401
+from . import cell  # noqa: F401

@@ -1,0 +1,149 @@
+"""Driver of the ``cell`` kind: mesh the cell, solve the load sweep, collect results.
+
+Results (``report.json`` ``results``): ``whole_surface`` coefficients of the
+whole contact surface (paper eqs. 34, 42-43, purely geometric), and per load
+``contact_fraction``, ``mean_pressure`` (compression positive),
+``mean_traction``, ``mean_jump``, ``mean_closure``, ``coefficients`` on the
+real contact set, ``effective_stiffness`` and the largest von Mises / Tresca
+stress per body with its location (see :mod:`ngcontact.cell`).
+"""
+from __future__ import annotations
+
+import logging
+import math
+
+import ngsolve as ng
+
+from ..cell import CellModel, CellProblem, Friction
+from ..homogenize import coefficients
+from ..kinds.cell import loads
+from ..report import Outcome, VtkField
+
+log = logging.getLogger(__name__)
+
+
+def build_cell(scene, maxh=None, interface_maxh=None, order=None):
+    """Mesh the cell of ``scene.geometry`` (mesh sizes may be overridden)."""
+    g, d = scene.geometry, scene.discretization
+    maxh = maxh or d.maxh
+    ih = interface_maxh or d.interface_maxh
+    order = order or d.order
+    if g.profile in ("flat3d", "square_hills"):
+        from ..geometry import cell3d
+        if g.profile == "flat3d":
+            return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih)
+        return cell3d.square_hills_cell(g.width, g.depth, period=g.period, arrangement=g.arrangement,
+                                        h_rough=g.h_rough, h_counter=g.h_counter, maxh=maxh,
+                                        interface_maxh=ih)
+    from ..geometry import profiles as pr
+    if g.profile == "flat":
+        prof = pr.flat(g.period)
+    elif g.profile == "rectangular":
+        prof = pr.rectangular_valley(g.width, g.depth, g.period)
+    elif g.profile == "triangular":
+        prof = pr.triangular_valley(g.angles[0], g.angles[1], g.width, g.period)
+    elif g.profile == "semicircular":
+        prof = pr.semicircular_valley(g.radius, g.period)
+    else:
+        prof = pr.sinusoid(g.amplitude, g.period)
+    return pr.profile_cell(prof, arrangement=g.arrangement, h_rough=g.h_rough, h_counter=g.h_counter,
+                           maxh=maxh, interface_maxh=ih, order=order)
+
+
+def gap_cf(scene):
+    """The initial gap of ``scene.contact.gap`` as a CoefficientFunction, or ``None``."""
+    gs, P = scene.contact.gap, scene.geometry.period
+    if gs.kind == "none":
+        return None
+    if gs.kind == "constant":
+        return ng.CF(gs.value)
+    if gs.kind == "sinusoid":
+        return 2 * gs.h * ng.sin(math.pi * ng.x / P) ** 2
+    return gs.h * (2 - ng.cos(2 * math.pi * ng.x / P) - ng.cos(2 * math.pi * ng.y / P))
+
+
+def model_of(scene) -> CellModel:
+    c = scene.contact
+    fr = None
+    if c.friction == "tresca":
+        fr = Friction("tresca", w=c.w, G=c.G)
+    elif c.friction == "coulomb":
+        fr = Friction("coulomb", w=c.w, mu=c.mu)
+    ms = scene.load is not None and scene.load.macro_strain is not None
+    return CellModel(rough=scene.materials[scene.bodies.rough].law(),
+                     counter=scene.materials[scene.bodies.counter].law(),
+                     k_n=c.k_n, gap=gap_cf(scene), friction=fr, order=scene.discretization.order,
+                     macro_strain=ms)
+
+
+def run(scene, clock) -> Outcome:
+    """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.report`)."""
+    with clock.stage("mesh"):
+        cell = build_cell(scene)
+    c = scene.contact
+    G = c.G if c.friction == "tresca" else None
+    with clock.stage("whole-surface coefficients"):
+        whole = coefficients(cell, kn=c.k_n, gap=gap_cf(scene), G=G).as_dict()
+    results = {"whole_surface": whole}
+    if c.geometric_only:
+        return Outcome(results=results, ndof=0)
+    with clock.stage("setup"):
+        s = scene.solver
+        P = CellProblem(cell, model_of(scene), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
+                        inverse=s.inverse)
+    with clock.stage("solve"):
+        sols = P.sweep(loads(scene))
+    per_load, tables, newton = [], {}, []
+    for k, sol in enumerate(sols):
+        entry = dict(sol.results)
+        entry["newton_iterations"] = sol.iterations
+        entry["coulomb_iterations"] = sol.coulomb_iterations
+        per_load.append(entry)
+        newton.append(sol.newton)
+        sf = sol.surface
+        coords = [k for k in ("x", "y", "z") if k in sf]
+        tables[f"surface_load{k}"] = (coords + ["pressure", "slip", "closure"],
+                                      list(zip(*[sf[n] for n in coords + ["pressure", "slip", "closure"]])))
+    results["loads"] = per_load
+    solver = {"iterations": sum(x.iterations for x in sols),
+              "converged": True, "per_load": newton}
+    comps = P.gfu.components
+    vtk = {"cell": VtkField(mesh=cell.mesh, fields={"u_rough": comps[0], "u_counter": comps[1]},
+                            subdivision=1)}
+    plots = {}
+    if cell.dim == 2:
+        plots["surface"] = lambda path, sols=sols: _plot_surface(path, sols)
+    if len(sols) > 1:
+        plots["contact_curve"] = lambda path, sols=sols: _plot_curve(path, sols)
+    return Outcome(results=results, ndof=P.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
+
+
+def _plot_surface(path, sols):
+    import matplotlib.pyplot as plt
+    fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(6, 5))
+    for k, sol in enumerate(sols):
+        sf = sol.surface
+        a1.plot(sf["x"], sf["pressure"], label=f"load {k}")
+        a2.plot(sf["x"], sf["slip"])
+    a1.set_ylabel("pressure (compression +)")
+    a2.set_ylabel("|slip|")
+    a2.set_xlabel("x")
+    a1.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _plot_curve(path, sols):
+    import matplotlib.pyplot as plt
+    p = [s.results["transmitted_pressure"] for s in sols]
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(8, 3.5))
+    a1.plot(p, [s.results["contact_fraction"] for s in sols], "o-")
+    a1.set_xlabel("mean pressure")
+    a1.set_ylabel("contact fraction")
+    a2.plot(p, [s.results["mean_closure"] for s in sols], "o-")
+    a2.set_xlabel("mean pressure")
+    a2.set_ylabel("mean closure")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

@@ -1,0 +1,242 @@
+"""Scene kind ``cell``: the micro contact problem of one periodic cell.
+
+Sections: ``[geometry]`` (profile and arrangement, mapped onto the builders
+of :mod:`ngcontact.geometry.profiles` and :mod:`ngcontact.geometry.cell3d`),
+``[contact]`` (penalty ``k_n``, initial gap, friction law), ``[load]``
+(pressure or normal jump, shear or tangential jump, macro strain; lists are
+sweeps), ``[bodies]`` (material names), ``[discretization]``, ``[solver]``.
+With ``contact.geometric_only = true`` only the coefficients of the whole
+contact surface (paper eq. 34, 42-43) are computed and no contact problem is
+solved.  Solved by :mod:`ngcontact.drivers.cell`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import MISSING, SceneError
+from ..scene import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
+                     check_material_names, register)
+from ..schema import at_least, nonempty, nonnegative, open_interval, param, positive
+
+PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid")
+PROFILES_3D = ("flat3d", "square_hills")
+GAPS = ("none", "constant", "sinusoid", "bisinusoid")
+FRICTION = ("none", "tresca", "coulomb")
+
+
+@dataclass(frozen=True, kw_only=True)
+class CellGeometry:
+    """The periodic cell (mesh naming contract of ngcontact.geometry)."""
+
+    profile: str = param(doc="roughness profile", choices=PROFILES_2D + PROFILES_3D)
+    arrangement: str = param("conforming", doc="counter body fills the valleys (conforming) or "
+                             "touches the summits only (summit)", choices=("conforming", "summit"))
+    period: float = param(1.0, doc="cell period |T| (per tangential direction)", units="m",
+                          check=positive())
+    h_rough: float = param(1.0, doc="depth of the rough body below the summits", units="m",
+                           check=positive())
+    h_counter: float = param(1.0, doc="height of the counter body above the summits", units="m",
+                             check=positive())
+    width: float | None = param(None, doc="valley width (rectangular; triangular: omit for a "
+                                "sawtooth spanning the period); hill side (square_hills)",
+                                units="m", check=positive())
+    depth: float | None = param(None, doc="valley depth (rectangular); hill height (square_hills)",
+                                units="m", check=positive())
+    radius: float | None = param(None, doc="valley radius (semicircular)", units="m", check=positive())
+    angles: tuple[float, float] | None = param(None, doc="face angles to S_0 (triangular)",
+                                               units="deg", check=open_interval(0, 90))
+    amplitude: float | None = param(None, doc="profile amplitude (sinusoid)", units="m",
+                                    check=positive())
+
+    _USES = {"flat": (), "flat3d": (), "rectangular": ("width", "depth"),
+             "triangular": ("angles",), "semicircular": ("radius",), "sinusoid": ("amplitude",),
+             "square_hills": ("width", "depth")}
+    _OPTIONAL = {"triangular": ("width",)}
+
+    @property
+    def dim(self) -> int:
+        return 3 if self.profile in PROFILES_3D else 2
+
+    def check(self, path: str) -> None:
+        need = self._USES[self.profile]
+        allowed = need + self._OPTIONAL.get(self.profile, ())
+        for key in ("width", "depth", "radius", "angles", "amplitude"):
+            value = getattr(self, key)
+            if key in need and value is None:
+                raise SceneError(f"{path}.{key}", MISSING, f"required for profile = {self.profile!r}")
+            if key not in allowed and value is not None:
+                raise SceneError(f"{path}.{key}", value,
+                                 f"not used by profile = {self.profile!r}; remove it")
+
+
+@dataclass(frozen=True, kw_only=True)
+class GapSpec:
+    """Initial gap g >= 0 on the contact surface."""
+
+    kind: str = param("none", doc="none, constant, sinusoid 2h sin^2(pi x/P), bisinusoid "
+                      "h (2 - cos(2 pi x/P) - cos(2 pi y/P))",
+                      choices=GAPS)
+    value: float | None = param(None, doc="constant gap", units="m", check=nonnegative())
+    h: float | None = param(None, doc="gap amplitude h (sinusoid: g in [0, 2h]; bisinusoid: [0, 2h])",
+                            units="m", check=positive())
+
+    def check(self, path: str) -> None:
+        need = {"none": (), "constant": ("value",), "sinusoid": ("h",),
+                "bisinusoid": ("h",)}[self.kind]
+        for key in ("value", "h"):
+            v = getattr(self, key)
+            if key in need and v is None:
+                raise SceneError(f"{path}.{key}", MISSING, f"required for kind = {self.kind!r}")
+            if key not in need and v is not None:
+                raise SceneError(f"{path}.{key}", v, f"not used by kind = {self.kind!r}; remove it")
+
+
+@dataclass(frozen=True, kw_only=True)
+class ContactSpec:
+    """Penalty contact and friction on S_C."""
+
+    k_n: float = param(doc="penalty (Winkler) stiffness k_n", units="Pa/m", check=positive())
+    gap: GapSpec = param(GapSpec(), doc="initial gap")
+    friction: str = param("none", doc="friction law", choices=FRICTION)
+    G: float | None = param(None, doc="Tresca threshold", units="Pa", check=nonnegative())
+    mu: float | None = param(None, doc="Coulomb coefficient", check=nonnegative())
+    w: float | None = param(None, doc="Huber width (stick zone of the slip)", units="m",
+                            check=positive())
+    geometric_only: bool = param(False, doc="only the coefficients of the whole contact surface; "
+                                 "solve no contact problem")
+
+    def check(self, path: str) -> None:
+        need = {"none": (), "tresca": ("G", "w"), "coulomb": ("mu", "w")}[self.friction]
+        for key in ("G", "mu", "w"):
+            v = getattr(self, key)
+            if key in need and v is None:
+                raise SceneError(f"{path}.{key}", MISSING, f"required for friction = {self.friction!r}")
+            if key not in need and v is not None:
+                raise SceneError(f"{path}.{key}", v,
+                                 f"not used by friction = {self.friction!r}; remove it")
+
+
+@dataclass(frozen=True, kw_only=True)
+class LoadSpec:
+    """Mean load of the cell; lists of equal length (or length 1) make a sweep."""
+
+    pressure: tuple[float, ...] | None = param(None, doc="mean normal pressure, compression positive",
+                                               units="Pa", check=positive())
+    normal_jump: tuple[float, ...] | None = param(None, doc="prescribed far-face normal jump "
+                                                  "(rough minus counter, positive closes)", units="m")
+    shear: tuple[float, ...] | None = param(None, doc="mean shear on the counter's far face along "
+                                            "x (2D) or x then y per load (3D: 2 entries per load)",
+                                            units="Pa")
+    tangential_jump: tuple[float, ...] | None = param(None, doc="prescribed far-face tangential jump "
+                                                      "(same layout as shear)", units="m")
+    macro_strain: tuple[float, ...] | None = param(None, doc="in-plane macro strain: 2D (e_xx), "
+                                                   "3D (e_xx, e_yy, e_xy), one set per sweep", units="")
+
+    def check(self, path: str) -> None:
+        if (self.pressure is None) == (self.normal_jump is None):
+            raise SceneError(f"{path}.pressure", self.pressure,
+                             "give exactly one of pressure and normal_jump")
+        if self.shear is not None and self.tangential_jump is not None:
+            raise SceneError(f"{path}.shear", self.shear, "give shear or tangential_jump, not both")
+        for key in ("pressure", "normal_jump", "shear", "tangential_jump"):
+            v = getattr(self, key)
+            if v is not None and len(v) == 0:
+                raise SceneError(f"{path}.{key}", v, "must not be empty")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Bodies:
+    """Materials of the two bodies."""
+
+    rough: str = param(doc="material of the rough body (below)")
+    counter: str = param(doc="material of the counter body (above)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class CellScene:
+    kind: str = param(doc="problem type", choices=("cell",))
+    title: str = param("", doc="free text shown in the report")
+    materials: dict[str, MaterialSpec] = param(doc="named materials", check=nonempty())
+    bodies: Bodies = param(doc="materials of the bodies")
+    geometry: CellGeometry = param(doc="the periodic cell")
+    contact: ContactSpec = param(doc="contact law")
+    load: LoadSpec | None = param(None, doc="mean load (omit with contact.geometric_only)")
+    discretization: Discretization = param(Discretization(), doc="mesh and order")
+    solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
+    base_dir: str = base_dir_field()
+
+    def check(self, path: str) -> None:
+        check_material_names(self.materials, {"rough": self.bodies.rough,
+                                              "counter": self.bodies.counter}, "bodies")
+        for name in (self.bodies.rough, self.bodies.counter):
+            if self.materials[name].C is not None:
+                raise SceneError(f"materials.{name}.C", "...", "cell scenes take isotropic E, nu")
+        dim = self.geometry.dim
+        g = self.contact.gap.kind
+        if g == "sinusoid" and dim != 2 or g == "bisinusoid" and dim != 3:
+            raise SceneError("contact.gap.kind", g, f"not available for a {dim}D cell")
+        if self.contact.geometric_only:
+            if self.load is not None:
+                raise SceneError("load", "...", "not used with contact.geometric_only = true; remove it")
+            return
+        if self.load is None:
+            raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
+        try:
+            loads(self)
+        except ValueError as exc:
+            raise SceneError("load", "...", str(exc)) from None
+
+
+def loads(scene: CellScene) -> list:
+    """The sweep of :class:`ngcontact.cell.CellLoad` described by ``scene.load``."""
+    from ..cell import cell_load
+    L, dim = scene.load, scene.geometry.dim
+    nt = dim - 1
+    normal = L.pressure if L.pressure is not None else L.normal_jump
+    tang = L.shear if L.shear is not None else L.tangential_jump
+    tang_sets = None
+    if tang is not None:
+        if len(tang) % nt:
+            raise ValueError(f"shear / tangential_jump need {nt} entries per load")
+        tang_sets = [tuple(tang[i:i + nt]) for i in range(0, len(tang), nt)]
+    n = max(len(normal), len(tang_sets or [()]))
+    for name, seq in (("normal", normal), ("tangential", tang_sets or [None])):
+        if len(seq) not in (1, n):
+            raise ValueError(f"the {name} load has {len(seq)} entries; sweeps need equal lengths or 1")
+    ms = L.macro_strain
+    if ms is not None and len(ms) != (1 if dim == 2 else 3):
+        raise ValueError(f"macro_strain needs {1 if dim == 2 else 3} entries in {dim}D")
+    out = []
+    for k in range(n):
+        nv = normal[k if len(normal) > 1 else 0]
+        tv = tang_sets[k if len(tang_sets) > 1 else 0] if tang_sets else None
+        out.append(cell_load(dim,
+                             pressure=nv if L.pressure is not None else None,
+                             normal_jump=nv if L.normal_jump is not None else None,
+                             shear=tv if L.shear is not None else None,
+                             tangential_jump=tv if L.tangential_jump is not None else None,
+                             macro_strain=ms))
+    return out
+
+
+def effects(scene: CellScene) -> tuple[str, ...]:
+    """The terms assembled (geometric_only: only the surface integrals)."""
+    if scene.contact.geometric_only:
+        return ("contact_surface_coefficients",)
+    out = ["elasticity", "normal_contact"]
+    if scene.contact.gap.kind != "none":
+        out.append("gap")
+    if scene.contact.friction != "none":
+        out.append(f"{scene.contact.friction}_friction")
+    L = scene.load
+    out.append("pressure_load" if L.pressure is not None else "prescribed_normal_jump")
+    if L.shear is not None and any(v != 0 for v in L.shear):
+        out.append("shear_load")
+    if L.tangential_jump is not None:
+        out.append("prescribed_tangential_jump")
+    if L.macro_strain is not None and any(v != 0 for v in L.macro_strain):
+        out.append("macro_strain")
+    return tuple(out)
+
+
+register("cell", CellScene, "ngcontact.drivers.cell:run", effects)
