@@ -1,0 +1,172 @@
+"""The ``ngcontact`` command: check, run, exit codes, messages and atomic output."""
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from ngcontact import cli
+from ngcontact.errors import ConvergenceError
+
+REQUIRED_KEYS = {"schema", "kind", "scene", "effects", "ndof", "timings", "solver", "results"}
+
+SMALL_SCENE = """\
+kind = "manufactured"
+title = "small plane-strain check"
+
+[materials.steel]
+E = 210e9
+nu = 0.3
+
+[manufactured]
+setting = "plane_strain"
+body = "steel"
+orders = [1, 2]
+maxh = 0.5
+levels = 3
+"""
+
+
+@pytest.fixture
+def scene_file(tmp_path):
+    path = tmp_path / "small.toml"
+    path.write_text(SMALL_SCENE)
+    return path
+
+
+def invalid_scene(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(SMALL_SCENE.replace("nu = 0.3", "nu = 0.5"))
+    return path
+
+
+def leftovers(directory):
+    return [n for n in os.listdir(directory) if n.startswith(".ngcontact-")]
+
+
+def assert_finite(obj, path="report"):
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            assert_finite(v, f"{path}.{k}")
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj):
+            assert_finite(v, f"{path}[{i}]")
+    elif isinstance(obj, float):
+        assert math.isfinite(obj), path
+
+
+def reject_constant(name):
+    raise ValueError(f"non-finite constant {name} in report.json")
+
+
+def test_check_accepts_a_valid_scene(scene_file, capsys):
+    assert cli.main(["check", str(scene_file)]) == 0
+    out = capsys.readouterr().out
+    assert "valid manufactured scene" in out and "elasticity" in out
+
+
+def test_shipped_scenes_are_valid(capsys):
+    root = os.path.join(os.path.dirname(__file__), os.pardir, "geometries")
+    for name in ("verify_elasticity", "verify_axisymmetric", "verify_3d", "verify_periodic_cell"):
+        assert cli.main(["check", os.path.join(root, f"{name}.toml")]) == 0, name
+    capsys.readouterr()
+
+
+def test_run_writes_a_complete_report(scene_file, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert cli.main(["run", str(scene_file), "--out", str(out), "--quiet"]) == 0
+    with open(out / "report.json") as fh:
+        report = json.load(fh, parse_constant=reject_constant)
+    assert REQUIRED_KEYS <= set(report)
+    assert_finite(report)
+    assert report["kind"] == "manufactured"
+    assert report["scene"]["manufactured"]["orders"] == [1, 2]
+    assert report["effects"] == ["elasticity"]
+    assert report["ndof"] == max(r["ndof"] for r in report["results"]["rows"]) > 0
+    assert report["timings"]["total"] > 0
+    solver = report["solver"]
+    assert solver["converged"] and solver["linear_solve_only"] and solver["iterations"] == 6
+    assert max(solver["residuals"]) < 1e-10
+    results = report["results"]
+    assert len(results["rows"]) == 6
+    assert set(results["rates"]) == {"1", "2"}
+    assert results["expected_rates"]["2"] == {"l2": 3.0, "h1": 2.0}
+    assert results["verified"] is True
+    for name in report["files"]:
+        assert (out / name).stat().st_size > 0, name
+    assert {"convergence.csv", "rates.csv", "convergence.png", "finest.vtu"} <= set(report["files"])
+    header = (out / "convergence.csv").read_text().splitlines()[0]
+    assert header.startswith("setting,order,level,h,ndof,l2,h1,seconds")
+    assert leftovers(tmp_path) == []
+
+
+def test_invalid_scene_exits_2_with_one_line(tmp_path, capsys):
+    bad = invalid_scene(tmp_path)
+    for command in (["check", str(bad)], ["run", str(bad), "--out", str(tmp_path / "out")]):
+        assert cli.main(command) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1, err
+        assert "materials.steel.nu = 0.5: must lie in (-1, 0.5)" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_unwritable_output_exits_2(scene_file, tmp_path, capsys):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a directory")
+    for out in (blocker, blocker / "sub"):
+        assert cli.main(["run", str(scene_file), "--out", str(out), "--quiet"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "--out" in err, err
+    assert blocker.read_text() == "not a directory"
+
+
+def test_solver_failure_exits_3_and_leaves_nothing(scene_file, tmp_path, monkeypatch, capsys):
+    from ngcontact.drivers import manufactured as driver
+
+    def failing(scene, clock):
+        raise ConvergenceError("Newton did not converge in 3 steps", {"iterations": 3})
+
+    monkeypatch.setattr(driver, "run", failing)
+    out = tmp_path / "out"
+    assert cli.main(["run", str(scene_file), "--out", str(out), "--quiet"]) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "did not converge" in err
+    assert not out.exists() and leftovers(tmp_path) == []
+
+
+def test_inaccurate_linear_solve_exits_3_and_keeps_old_output(scene_file, tmp_path, monkeypatch, capsys):
+    """The driver's own residual check: with a zero tolerance no solve is accurate enough."""
+    from ngcontact.drivers import manufactured as driver
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "previous.txt").write_text("earlier run")
+    monkeypatch.setattr(driver, "LINEAR_RTOL", 0.0)
+    assert cli.main(["run", str(scene_file), "--out", str(out), "--quiet"]) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "relative residual" in err
+    assert os.listdir(out) == ["previous.txt"] and leftovers(tmp_path) == []
+
+
+def console_script():
+    found = shutil.which("ngcontact", path=os.path.dirname(sys.executable))
+    assert found, "the console script ngcontact is not installed beside the interpreter"
+    return found
+
+
+def test_console_script(scene_file, tmp_path):
+    exe = console_script()
+    version = subprocess.run([exe, "--version"], capture_output=True, text=True)
+    assert version.returncode == 0 and version.stdout.startswith("ngcontact ")
+    out = tmp_path / "out"
+    done = subprocess.run([exe, "run", str(scene_file), "--out", str(out)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "order 2, level 3" in done.stderr  # progress lines
+    assert (out / "report.json").is_file()
+    bad = subprocess.run([exe, "check", str(invalid_scene(tmp_path))], capture_output=True, text=True)
+    assert bad.returncode == 2
+    assert bad.stderr.count("\n") == 1 and "materials.steel.nu = 0.5" in bad.stderr
