@@ -393,16 +393,20 @@ def level_runner(setting: str, laws: dict, maxh: float, *, inverse: str = "spars
     """A ``level(order, refinements) -> dict`` for :mod:`ngcontact.studies`.
 
     Each call builds the problem on the mesh refined ``refinements`` times,
-    solves it with order ``order`` and returns ``ndof``, ``l2``, ``h1`` and
-    the solve's ``relative_residual``.  When ``keep`` is a dict, the last
+    solves it with order ``order`` and returns ``ndof``, ``l2``, ``h1``, the
+    solve's ``relative_residual`` and ``solve_seconds`` (wall time of mesh,
+    assembly and solve, without the error evaluation).  When ``keep`` is a dict, the last
     problem and solution are stored in it under ``"problem"`` and
     ``"solution"`` (e.g. to write the finest one).
     """
     def level(order: int, refinements: int) -> dict:
+        t0 = time.perf_counter()
         prob = problem(setting, laws, maxh, refinements=refinements, order=order)
         sol = solve(prob, order, inverse=inverse)
+        solve_seconds = time.perf_counter() - t0
         l2, h1 = errors(prob, sol.gfu)
         if keep is not None:
             keep["problem"], keep["solution"] = prob, sol
-        return {"ndof": sol.ndof, "l2": l2, "h1": h1, "relative_residual": sol.relative_residual}
+        return {"ndof": sol.ndof, "l2": l2, "h1": h1, "relative_residual": sol.relative_residual,
+                "solve_seconds": solve_seconds}
     return level

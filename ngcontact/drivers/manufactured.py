@@ -75,7 +75,7 @@ def run(scene, clock) -> Outcome:
                                       "error_norm": ng.Norm(error)})}
     return Outcome(results=results, ndof=max(r["ndof"] for r in rows),
                    solver=_solver_info(rows, scene, converged=True),
-                   tables={"convergence": studies.table(rows, studies.ROW_KEYS + ("relative_residual",)),
+                   tables={"convergence": studies.table(rows, studies.ROW_KEYS + ("solve_seconds", "relative_residual")),
                            "rates": _rates_table(rates, expected)},
                    vtk=vtk, plots={"convergence": lambda path: plot_convergence(rows, rates, path)})
 
