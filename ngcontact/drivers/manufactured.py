@@ -23,6 +23,7 @@ from ..report import Outcome, VtkField
 log = logging.getLogger(__name__)
 
 LINEAR_RTOL = 1e-8
+TABLE_KEYS = studies.ROW_KEYS + ("solve_seconds", "relative_residual")
 
 
 def laws_of(scene) -> dict:
@@ -75,7 +76,7 @@ def run(scene, clock) -> Outcome:
                                       "error_norm": ng.Norm(error)})}
     return Outcome(results=results, ndof=max(r["ndof"] for r in rows),
                    solver=_solver_info(rows, scene, converged=True),
-                   tables={"convergence": studies.table(rows, studies.ROW_KEYS + ("solve_seconds", "relative_residual")),
+                   tables={"convergence": studies.table(rows, TABLE_KEYS),
                            "rates": _rates_table(rates, expected)},
                    vtk=vtk, plots={"convergence": lambda path: plot_convergence(rows, rates, path)})
 
