@@ -52,6 +52,7 @@ from netgen.csg import unit_cube
 from netgen.geom2d import SplineGeometry, unit_square
 
 from . import elasticity
+from .errors import ConvergenceError
 from .geometry.cell2d import Segment, interface_cell
 from .materials import ElasticLaw
 from .newton import fixed_mask
@@ -322,13 +323,19 @@ def solve(prob: Problem, order: int, *, inverse: str = "sparsecholesky",
 
     The load integrals use ``bonus_intorder`` extra quadrature orders, so that
     quadrature does not pollute the rates (and is exact for polynomial data).
+
+    Raises
+    ------
+    ConvergenceError
+        The sparse direct solver ``inverse`` failed (e.g. is not installed).
     """
     t0 = time.perf_counter()
     mesh, setting = prob.mesh, prob.setting
     V = space(prob, order)
     u, v = V.TnT()
     w = elasticity.weight(setting)
-    a = ng.BilinearForm(V, symmetric=True, symmetric_storage=True)
+    # only the Cholesky factorization reads a matrix stored as one triangle
+    a = ng.BilinearForm(V, symmetric=True, symmetric_storage=(inverse == "sparsecholesky"))
     f = ng.LinearForm(V)
     for region, law in prob.laws.items():
         on = mesh.Materials(region)
@@ -352,7 +359,12 @@ def solve(prob: Problem, order: int, *, inverse: str = "sparsecholesky",
     free = V.FreeDofs()
     res = f.vec.CreateVector()
     res.data = f.vec - a.mat * gfu.vec
-    gfu.vec.data += a.mat.Inverse(free, inverse=inverse) * res
+    try:
+        inv = a.mat.Inverse(free, inverse=inverse)
+    except RuntimeError as exc:
+        raise ConvergenceError(f"linear solver {inverse!r} failed: {exc}",
+                               {"linear_solve_only": True, "converged": False}) from exc
+    gfu.vec.data += inv * res
     res.data = f.vec - a.mat * gfu.vec
     fixed = fixed_mask(free)
     r = res.FV().NumPy().copy()
