@@ -60,3 +60,13 @@ def test_umfpack_is_exact_too():
     """UMFPACK reads the full matrix (the Cholesky path stores one triangle)."""
     l2, h1 = relative_errors("axisymmetric", 2, 2, inverse="umfpack")
     assert l2 < 1e-11 and h1 < 1e-10, (l2, h1)
+
+
+@pytest.mark.parametrize("setting", ["plane_strain", "3d"])
+def test_navier_form_equals_the_divergence_of_the_stress(setting):
+    prob = manufactured.problem(setting, {"body": LAW}, 1.0 if setting == "3d" else 0.4)
+    navier = manufactured.navier_body_force(LAW, prob.exact, setting)
+    generic = manufactured.stress_divergence_body_force(LAW, prob.exact, setting)
+    diff = ng.Integrate(ng.InnerProduct(navier - generic, navier - generic), prob.mesh, order=6)
+    size = ng.Integrate(ng.InnerProduct(generic, generic), prob.mesh, order=6)
+    assert diff <= 1e-24 * size and size > 1.0
