@@ -27,10 +27,24 @@ with
   ``Delta_i = (u_bottom - u_top)_i = -U_i`` (``Delta_n > 0`` closes).
 
 Start of a solve.  The tangent is singular in ``U_n`` while nothing is in
-contact, so the first load of a sweep starts from a *closed* predictor: the
-counter is pushed down by the largest gap plus ``p/k_n`` so that every
-quadrature point on ``S_C`` is in contact; the line search then opens the
-surface where it must.  Later loads continue from the previous solution.
+contact, and Newton's active-set updates converge slowly (each step halves
+the distance of a contact edge) when they start with the whole surface
+closed.  The first load of a sweep therefore starts from the *rigid
+predictor*: fluctuations zero and the counter translated by the normal
+approach ``d`` that minimizes the energy over rigid normal translations
+alone, i.e. the root of
+
+    R(d) = int_{S_C} k_n [d n.n0 - g]_+ (n.n0) ds - p |T| = 0
+
+(the penalty layer alone carries the pressure; a Winkler foundation of
+stiffness ``k_n``).  Because ``k_n`` is much stiffer than the bodies, this
+under-estimates the contact set, and Newton approaches the contact edges
+from the open side, where each step moves them most of the way.  The step
+length is the minimizer of the (convex) energy along the Newton direction
+(``line_search="exact"`` of :func:`ngcontact.newton.minimize`, Armijo test
+kept as a guard); ``start="closed"`` restores the earlier start (counter
+pushed down by the largest gap plus ``p/k_n``).  Later loads continue from
+the previous solution.
 When friction is absent and ``S_C`` is flat, a tangential translation of the
 counter costs no energy: it is then fixed at 0 (any value solves the problem)
 and a nonzero shear is rejected (a frictionless flat interface carries
@@ -222,10 +236,23 @@ class CellProblem:
         Newton settings (see :func:`ngcontact.newton.minimize`).
     normal
         Micro normal on ``contact``; default :func:`contact_normal`.
+    line_search
+        ``"exact"`` (default: energy minimized along the Newton direction)
+        or ``"armijo"`` (backtracking only).
+    start
+        Start of the first load under a prescribed pressure: ``"rigid"``
+        (default, the rigid predictor of the module docstring) or
+        ``"closed"`` (every point of ``S_C`` pushed into contact).
     """
 
     def __init__(self, cell, model: CellModel, *, rtol: float = 1e-10, atol: float = 0.0,
-                 max_iter: int = 40, inverse: str = "sparsecholesky", normal=None):
+                 max_iter: int = 40, inverse: str = "sparsecholesky", normal=None,
+                 line_search: str = "exact", start: str = "rigid"):
+        if line_search not in ("exact", "armijo"):
+            raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
+        if start not in ("rigid", "closed"):
+            raise ValueError(f"start = {start!r}: must be 'rigid' or 'closed'")
+        self.line_search, self.start = line_search, start
         self.cell, self.model = cell, model
         self.mesh = mesh = cell.mesh
         self.dim = dim = cell.dim
@@ -290,7 +317,7 @@ class CellProblem:
 
     def _energy(self, ur, uc, U, trial):
         m, mesh = self.model, self.mesh
-        form = ng.BilinearForm(self.X, symmetric=True)
+        form = ng.BilinearForm(self.X, symmetric=True, symmetric_storage=True)
         for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
             eps = self.body_strain(u)
             form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
@@ -360,7 +387,68 @@ class CellProblem:
             if not p > 0:
                 raise ValueError(f"normal pressure {p!r}: must be > 0 (a free layer has no unique "
                                  "rigid position); prescribe a normal jump instead")
-            vec[self.u_dofs[d - 1]] = -(self.max_gap() + p / self.model.k_n)
+            if self.start == "closed":
+                vec[self.u_dofs[d - 1]] = -(self.max_gap() + p / self.model.k_n)
+            else:
+                vec[:] = 0.0
+                for i in range(d):
+                    if load.jump[i] is not None:
+                        vec[self.u_dofs[i]] = -load.jump[i]
+                vec[self.u_dofs[d - 1]] = -self.rigid_approach(p)
+
+    def _contact_order(self) -> int:
+        """Integration order of the contact energy (that of the ``Variation`` term)."""
+        return 2 * self.model.order + self.model.contact_bonus_order
+
+    def rigid_approach(self, p: float) -> float:
+        """Normal approach ``d`` of the rigid predictor: root of ``R(d)`` (module docstring).
+
+        ``R`` is nondecreasing and piecewise linear in ``d`` at the
+        quadrature points of the contact energy; the root is bracketed by
+        doubling and found by the Illinois variant of regula falsi.  The
+        predicted state has at least one quadrature point in contact, so
+        the first tangent is regular in ``U_n``.
+        """
+        k_n, area = self.model.k_n, self.area
+        n0 = self.n[self.dim - 1]
+        dpar = ng.Parameter(0.0)
+        pen = dpar * n0 if self.gap is None else dpar * n0 - self.gap
+        force = k_n * _contact.positive_part(pen) * n0
+        order = self._contact_order()
+
+        def R(dv):
+            dpar.Set(dv)
+            return float(self._contact_integral(force, order=order)) - p * area
+
+        lo, flo = 0.0, R(0.0)
+        scale = self.max_gap() + p / k_n
+        if flo >= 0.0:            # interference: already pressed at d = 0
+            hi, fhi = lo, flo
+            lo = -scale
+            while (flo := R(lo)) >= 0.0:
+                lo *= 2.0
+        else:
+            hi = scale
+            while (fhi := R(hi)) <= 0.0:
+                lo, flo, hi = hi, fhi, 2.0 * hi
+        side, d = 0, hi
+        for _ in range(200):
+            d = (lo * fhi - hi * flo) / (fhi - flo)
+            fd = R(d)
+            if abs(fd) <= 1e-12 * p * area or hi - lo <= 1e-14 * abs(hi):
+                break
+            if fd < 0.0:
+                lo, flo = d, fd
+                if side == -1:
+                    fhi *= 0.5
+                side = -1
+            else:
+                hi, fhi = d, fd
+                if side == 1:
+                    flo *= 0.5
+                side = 1
+        log.debug("rigid predictor: approach %.6e for pressure %.6e", d, p)
+        return d
 
     def max_gap(self) -> float:
         """Largest initial gap at the quadrature points of ``S_C`` (0 without gap)."""
@@ -406,7 +494,7 @@ class CellProblem:
 
     def _newton(self, free, atol) -> dict:
         h = minimize(self.form, self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
-                     max_iter=self.max_iter, inverse=self.inverse)
+                     max_iter=self.max_iter, inverse=self.inverse, line_search=self.line_search)
         return h.as_dict()
 
     def sweep(self, loads) -> list:

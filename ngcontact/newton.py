@@ -12,6 +12,19 @@ and yields finite numbers.  The iteration stops when the residual (free
 dofs) has fallen below ``rtol`` times the first residual, or below ``atol``.
 A quadratic energy is minimized by a single linear solve.
 
+With ``line_search="exact"`` (for convex energies such as penalty contact)
+the step length minimizes the energy along the Newton direction instead:
+``phi(alpha) = Pi(u - alpha du)`` is convex, so its slope
+``phi'(alpha) = -du . r(u - alpha du)`` is nondecreasing, and its root is
+bracketed (``alpha`` doubled up to ``max_step`` while ``phi' < 0``) and
+located by the Illinois variant of regula falsi until
+``|phi'(alpha)| <= 1e-3 |phi'(0)|``.  For a piecewise quadratic energy
+(penalty contact) ``phi'`` is piecewise linear and a few residual
+evaluations suffice.  Steps longer than 1 matter at a contact edge, where
+the fixed-active-set Newton step typically covers only about half of the
+distance to the solution.  The accepted step must still pass the Armijo
+test above; otherwise the backtracking search decides.
+
 On failure a :class:`~ngcontact.errors.ConvergenceError` carries the history:
 residual norms, energies, step lengths.
 """
@@ -55,7 +68,7 @@ class NewtonHistory:
 def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
              rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 50,
              inverse: str = "sparsecholesky", quadratic: bool = False,
-             callback=None) -> NewtonHistory:
+             callback=None, line_search: str = "armijo", max_step: float = 8.0) -> NewtonHistory:
     """Minimize the energy of ``form`` starting from ``gfu`` (updated in place).
 
     Parameters
@@ -76,7 +89,17 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         The energy is quadratic: one linear solve, no iteration.
     callback
         Called as ``callback(iteration, gfu)`` after each accepted step.
+    line_search
+        ``"armijo"`` (backtracking from ``alpha = 1``) or ``"exact"`` (root of
+        the slope along the direction, for convex energies; see the module
+        docstring).
+    max_step
+        Largest step length tried by the exact line search.
     """
+    if line_search not in ("armijo", "exact"):
+        raise ValueError(f"line_search = {line_search!r}: must be 'armijo' or 'exact'")
+    if not max_step >= 1.0:
+        raise ValueError(f"max_step = {max_step!r}: must be >= 1")
     if freedofs is None:
         freedofs = gfu.space.FreeDofs()
     hist = NewtonHistory(linear=quadratic)
@@ -108,6 +131,8 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         if not math.isfinite(slope):
             raise ConvergenceError(f"Newton step {it}: the tangent solve gave non-finite values", hist.as_dict())
         alpha = 1.0
+        if line_search == "exact" and not quadratic:
+            alpha = _exact_step(form, gfu.vec, du, slope, fixed, trial, res, max_step)
         while True:
             trial.data = gfu.vec - alpha * du
             e_new = form.Energy(trial)
@@ -144,6 +169,58 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         f"Newton did not converge in {max_iter} steps: residual {rnorm:.3e} "
         f"> {max(rtol * r0, atol):.3e} (rtol {rtol:g} x first residual {r0:.3e})",
         hist.as_dict())
+
+
+def _exact_step(form, u, du, slope0, fixed, trial, work, max_step) -> float:
+    """Minimizer of ``phi(alpha) = Pi(u - alpha du)`` for a convex energy.
+
+    ``slope0 = du . r(u) > 0`` is ``-phi'(0)``.  Returns 1 where the slope
+    cannot be evaluated (non-finite values); the caller's Armijo test then
+    guards the step.  ``work`` is overwritten.
+    """
+    def dphi(a):
+        trial.data = u - a * du
+        form.Apply(trial, work)
+        _mask(work, fixed)
+        return -ng.InnerProduct(du, work)
+
+    tol = 1e-3 * slope0
+    lo, flo = 0.0, -slope0
+    hi, fhi = 1.0, dphi(1.0)
+    if not math.isfinite(fhi):
+        return 1.0
+    if abs(fhi) <= tol:
+        return 1.0
+    while fhi < 0.0 and hi < max_step:
+        lo, flo = hi, fhi
+        hi = min(2.0 * hi, max_step)
+        fhi = dphi(hi)
+        if not math.isfinite(fhi):
+            return lo
+        if abs(fhi) <= tol:
+            return hi
+    if fhi < 0.0:
+        return hi
+    side = 0
+    a = hi
+    for _ in range(30):
+        a = (lo * fhi - hi * flo) / (fhi - flo)
+        fa = dphi(a)
+        if not math.isfinite(fa):
+            return 1.0
+        if abs(fa) <= tol:
+            break
+        if fa < 0.0:
+            lo, flo = a, fa
+            if side == -1:
+                fhi *= 0.5
+            side = -1
+        else:
+            hi, fhi = a, fa
+            if side == 1:
+                flo *= 0.5
+            side = 1
+    return a
 
 
 def fixed_mask(freedofs):
