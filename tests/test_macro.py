@@ -1,0 +1,235 @@
+"""The macro problem: Lame press fit, patch test, friction, equilibrium, axisymmetric vs 3D."""
+import math
+
+import numpy as np
+import ngsolve as ng
+import pytest
+
+from ngcontact import interface_law as il
+from ngcontact import macro as M
+from ngcontact.geometry import macro as gm
+from ngcontact.materials import isotropic
+
+# ----------------------------------------------------------- Lame press fit
+A, B, C = 0.5, 1.0, 2.0          # bore, interface, mantle radii
+E_IN, NU_IN, E_OUT, NU_OUT = 200.0, 0.3, 70.0, 0.25
+K_N = 300.0                       # interface stiffness, stress / length
+DELTA = 1e-3                      # radial interference
+
+
+def lame_pressure(a, b, c, Ei, nui, Eo, nuo, k, delta):
+    """Contact pressure of a press fit of two tubes through a compliant interface (plane strain).
+
+    Plane strain, ``u_r = A r + B / r`` and ``sigma_rr = 2 (lam + mu) A - 2 mu B / r^2``
+    in each tube.  The outer tube ``b < r < c`` with ``sigma_rr(b) = -p``,
+    ``sigma_rr(c) = 0`` moves its bore outward by
+
+        u_o = p * b (1 + nu_o) ((1 - 2 nu_o) b^2 + c^2) / (E_o (c^2 - b^2)) = p * C_o,
+
+    the inner tube ``a < r < b`` with ``sigma_rr(a) = 0``, ``sigma_rr(b) = -p``
+    moves its mantle inward by
+
+        -u_i = p * b (1 + nu_i) ((1 - 2 nu_i) b^2 + a^2) / (E_i (b^2 - a^2)) = p * C_i.
+
+    The interface carries ``p = k (J_n - g)`` with the jump ``J_n = u_i - u_o``
+    (inner = rough, ``n0 = e_r``) and the gap ``g = -delta``, so
+    ``p / k = delta - p C_i - p C_o``: the compliances add in series,
+
+        p = delta / (1/k + C_i + C_o).
+    """
+    Ci = b * (1 + nui) * ((1 - 2 * nui) * b ** 2 + a ** 2) / (Ei * (b ** 2 - a ** 2))
+    Co = b * (1 + nuo) * ((1 - 2 * nuo) * b ** 2 + c ** 2) / (Eo * (c ** 2 - b ** 2))
+    return delta / (1.0 / k + Ci + Co)
+
+
+def _press_fit(setting, law):
+    if setting == "axisymmetric":
+        g = gm.coaxial_axisymmetric(A, B, C, 0.5, maxh=0.25)
+        sup = (M.Support(label="bottom", components=("z",)), M.Support(label="top", components=("z",)))
+    else:
+        g = gm.coaxial_plane_strain(A, B, C, maxh=0.3, order=3)
+        sup = (M.Support(label="sym_x", components=("x",)), M.Support(label="sym_y", components=("y",)))
+    prob = M.MacroProblem(mesh=g.mesh, setting=setting, rough="inner", counter="outer",
+                          materials={"inner": isotropic(E_IN, NU_IN), "outer": isotropic(E_OUT, NU_OUT)},
+                          law=law, gap=-DELTA, supports=sup, order=3)
+    return M.solve(prob)
+
+
+@pytest.mark.parametrize("setting", ["plane_strain", "axisymmetric"])
+def test_press_fit_matches_lame_with_interface_compliance_in_series(setting):
+    """Long coaxial tubes (axisymmetric: u_z = 0 at both ends, i.e. plane strain)."""
+    sol = _press_fit(setting, il.InterfaceLaw(normal=il.LinearLaw(kn=K_N)))
+    assert sol.history["quadratic"] and sol.history["newton_iterations"] == 1
+    prof = M.interface_profile(sol)
+    p_exact = lame_pressure(A, B, C, E_IN, NU_IN, E_OUT, NU_OUT, K_N, DELTA)
+    err = np.abs(prof["pressure"] / p_exact - 1).max()
+    assert err < 5e-3, f"{setting}: pressure off Lame's by {err:.2e}"
+    # the finite interface stiffness matters: rigid-interface Lame is clearly different
+    p_rigid = lame_pressure(A, B, C, E_IN, NU_IN, E_OUT, NU_OUT, 1e12, DELTA)
+    assert abs(p_rigid / p_exact - 1) > 0.05
+    assert set(prof["status"]) == {"slip"}  # no tangential stiffness, no friction
+    np.testing.assert_allclose(prof["jump_n"] + DELTA, prof["pressure"] / K_N, rtol=1e-10)
+
+
+def test_press_fit_unilateral_bundle_law_gives_the_same_pressure():
+    """A closed one-direction bundle is the linear law: same Lame pressure, Newton converges."""
+    law = il.InterfaceLaw(normal=il.BundleLaw(weights=(K_N,), directions=((1.0, 0.0),)))
+    sol = _press_fit("axisymmetric", law)
+    prof = M.interface_profile(sol)
+    p_exact = lame_pressure(A, B, C, E_IN, NU_IN, E_OUT, NU_OUT, K_N, DELTA)
+    assert np.abs(prof["pressure"] / p_exact - 1).max() < 5e-3
+    assert sol.history["converged"] and not sol.history["quadratic"]
+
+
+# ------------------------------------------------------------ patch test
+@pytest.mark.parametrize("normal", [il.LinearLaw(kn=5e11, kt=2e11),
+                                    il.BundleLaw(weights=(5e11,), directions=((1.0, 0.0),))])
+def test_uniform_compression_transmits_a_uniform_pressure_exactly(normal):
+    """Block on a base, rollers on the sides, pressure P on top: p = P, J_n = P / k_n everywhere.
+
+    The block (rough) lies above the base, so ``n0 = -e_y`` must be found on the
+    internal interface for the closure to come out positive.
+    """
+    g = gm.block_on_plane(0.1, 0.03, 0.02, maxh=0.012)
+    P = 2e6
+    prob = M.MacroProblem(
+        mesh=g.mesh, setting="plane_strain", rough="block", counter="base",
+        materials={"block": isotropic(10e9, 0.3), "base": isotropic(70e9, 0.2)},
+        law=il.InterfaceLaw(normal=normal), order=1,
+        supports=(M.Support(label="bottom", components=("y",)),
+                  M.Support(label="block_sides", components=("x",)),
+                  M.Support(label="base_sides", components=("x",))),
+        loads=(M.Load(label="top", pressure=P),))
+    sol = M.solve(prob)
+    prof = M.interface_profile(sol, points_per_element=4)
+    np.testing.assert_allclose(prof["pressure"], P, rtol=1e-10)
+    np.testing.assert_allclose(prof["jump_n"], P / 5e11, rtol=1e-9)
+    np.testing.assert_allclose(prof["shear"], 0.0, atol=1e-9 * P)
+    n0 = np.asarray(sol.frame[0](g.mesh.MapToAllElements(ng.IntegrationRule([(0.5,)], [1.0]),
+                                                         g.mesh.Boundaries("interface"))))
+    np.testing.assert_allclose(n0.reshape(-1, 2), np.tile([0.0, -1.0], (len(n0), 1)), atol=1e-14)
+    R = M.resultant(sol)
+    assert abs(R["y"] + P * 0.1) < 1e-9 * P * 0.1 and abs(R["x"]) < 1e-9 * P * 0.1
+
+
+# -------------------------------------------------------------- friction
+L_BLOCK, H_BLOCK = 0.1, 0.01
+N_PRESS, MU, WIDTH = 1e6, 0.3, 1e-7
+
+
+def _block(top_support=(), shear=0.0):
+    g = gm.block_on_plane(L_BLOCK, H_BLOCK, 0.02, maxh=0.01)
+    law = il.InterfaceLaw(normal=il.LinearLaw(kn=1e12), friction=il.Friction(mu=MU, width=WIDTH))
+    prob = M.MacroProblem(
+        mesh=g.mesh, setting="plane_strain", rough="block", counter="base",
+        materials={"block": isotropic(10e9, 0.3), "base": isotropic(10e9, 0.3)}, law=law, order=2,
+        supports=(M.Support(label="bottom"),) + tuple(top_support),
+        loads=(M.Load(label="top", pressure=N_PRESS, traction=(shear, 0.0)),))
+    return M.solve(prob, fixed_point_tol=1e-9)
+
+
+def test_block_under_small_shear_sticks_with_slip_below_the_width():
+    """T = 0.5 mu N: every point sticks, |J_t| <= w, the interface carries exactly T and N."""
+    T = 0.5 * MU * N_PRESS
+    sol = _block(shear=T)
+    prof = M.interface_profile(sol)
+    assert set(prof["status"]) == {"stick"}
+    assert np.abs(prof["jump_t"]).max() <= WIDTH
+    assert np.all(np.abs(prof["shear"]) < MU * prof["pressure"])
+    R = M.resultant(sol)
+    assert abs(R["x"] - T * L_BLOCK) < 1e-8 * T * L_BLOCK
+    assert abs(R["y"] + N_PRESS * L_BLOCK) < 1e-8 * N_PRESS * L_BLOCK
+    assert sol.history["fixed_point_iterations"] >= 1
+
+
+def test_block_dragged_beyond_the_limit_slides_with_reaction_mu_N():
+    """Top dragged by 500 w (T would exceed mu N): everything slips, tangential reaction = mu N."""
+    drag = (M.Support(label="top", components=("x",), displacement=(500 * WIDTH,)),)
+    sol = _block(top_support=drag)
+    prof = M.interface_profile(sol)
+    assert set(prof["status"]) == {"slip"}
+    R = M.resultant(sol)
+    assert abs(R["y"] + N_PRESS * L_BLOCK) < 1e-8 * N_PRESS * L_BLOCK
+    assert abs(R["x"] - MU * N_PRESS * L_BLOCK) < 1e-6 * MU * N_PRESS * L_BLOCK, R
+    np.testing.assert_allclose(np.abs(prof["shear"]), MU * prof["pressure"], rtol=1e-5,
+                               atol=1e-6 * MU * N_PRESS)
+
+
+# ------------------------------------------------ femur: equilibrium, labels
+def test_femur_stem_interface_carries_the_applied_load():
+    """The stem is held only by the interface: its axial resultant equals the load on the top."""
+    d = gm.FemurStemDims()
+    g = gm.femur_stem(d, maxh=0.008, interface_maxh=0.004)
+    law = il.InterfaceLaw(normal=il.BundleLaw(weights=(3.2e10,), directions=((1.0, 0.0),)),
+                          friction=il.Friction(mu=0.3, width=1e-6))
+    gap = M.piecewise_linear(ng.y, [(d.z_tip, 2e-5), (d.z_corner, -5e-5)])
+    prob = M.MacroProblem(mesh=g.mesh, setting="axisymmetric", rough="stem", counter="bone",
+                          materials={"stem": isotropic(100e9, 0.3), "bone": isotropic(9e9, 0.27)},
+                          law=law, gap=gap, order=2,
+                          supports=(M.Support(label="base"), M.Support(label="axis", components=("r",))),
+                          loads=(M.Load(label="stem_top", pressure=1e6),))
+    sol = M.solve(prob)
+    F = 1e6 * math.pi * d.r_stem ** 2
+    R = M.resultant(sol)
+    assert abs(R["z"] + F) < 1e-6 * F, (R, F)
+    prof = M.interface_profile(sol)
+    assert prof["s"][0] == 0 and np.all(np.diff(prof["s"]) >= 0)
+    assert abs(prof["z"][0] - d.z_bone_top) < 1e-12 and abs(prof["z"][-1] - d.z_tip) < 1e-12
+    length = (d.z_bone_top - d.z_corner) + math.hypot(d.r_stem - d.r_tip, d.z_corner - d.z_tip)
+    assert abs(prof["s"][-1] - length) < 1e-12
+    assert np.all(prof["pressure"] >= 0)
+    # detachment points separate open from closed samples
+    for pt in M.detachments(prof):
+        assert d.z_tip <= pt["z"] <= d.z_bone_top
+    fields = M.stress_fields(sol)
+    ext = M.field_extrema(sol, fields)
+    assert all(np.isfinite(v["max"]["value"]) for v in ext.values())
+
+
+def test_unknown_boundary_label_is_rejected_with_the_existing_ones():
+    g = gm.block_on_plane(1.0, 0.2, 0.2, maxh=0.2)
+    prob = M.MacroProblem(mesh=g.mesh, setting="plane_strain", rough="block", counter="base",
+                          materials={"block": isotropic(1.0, 0.3), "base": isotropic(1.0, 0.3)},
+                          law=il.InterfaceLaw(normal=il.LinearLaw(kn=1.0)),
+                          supports=(M.Support(label="floor"),))
+    with pytest.raises(ValueError, match="floor.*bottom"):
+        M.solve(prob)
+
+
+# ------------------------------------------------------- axisymmetric vs 3D
+@pytest.mark.slow
+def test_axisymmetric_equals_3d_for_a_rotationally_symmetric_problem():
+    """Press-fitted tubes, clamped at their bases, pressed on their tops.
+
+    The tubes differ in stiffness, so the interface carries shear as well as
+    the press-fit pressure.  Compared: ``int p w ds``, ``int p z w ds`` and
+    ``int J_t^2 w ds`` over the interface; the 3D model is a quarter with
+    symmetry planes (integrals x 4).
+    """
+    a, b, c, h = 0.5, 1.0, 1.6, 1.0
+    law = il.InterfaceLaw(normal=il.LinearLaw(kn=300.0, kt=100.0))
+    mats = {"inner": isotropic(200.0, 0.3), "outer": isotropic(70.0, 0.25)}
+    top = (M.Load(label="top", pressure=1.0),)
+
+    def integrals(sol, factor):
+        p = il.pressure(law.normal, sol.local_jump, -DELTA)
+        axi = sol.problem.setting == "axisymmetric"
+        w = factor * (2 * math.pi * ng.x if axi else ng.CF(1.0))
+        z = ng.y if axi else ng.z
+        on = sol.problem.mesh.Boundaries("interface")
+        return np.array([ng.Integrate(f * w, sol.problem.mesh, ng.BND, definedon=on)
+                         for f in (p, p * z, sol.local_jump[1] ** 2)])
+
+    g2 = gm.coaxial_axisymmetric(a, b, c, h, maxh=0.05)
+    sol2 = M.solve(M.MacroProblem(mesh=g2.mesh, setting="axisymmetric", rough="inner", counter="outer",
+                                  materials=mats, law=law, gap=-DELTA, order=3,
+                                  supports=(M.Support(label="bottom"),), loads=top))
+    g3 = gm.coaxial_3d(a, b, c, h, maxh=0.22, order=2)
+    sol3 = M.solve(M.MacroProblem(mesh=g3.mesh, setting="3d", rough="inner", counter="outer",
+                                  materials=mats, law=law, gap=-DELTA, order=2,
+                                  supports=(M.Support(label="bottom"),
+                                            M.Support(label="sym_x", components=("x",)),
+                                            M.Support(label="sym_y", components=("y",))), loads=top))
+    I2, I3 = integrals(sol2, 1.0), integrals(sol3, 4.0)
+    rel = np.abs(I3 / I2 - 1)
+    assert rel.max() < 0.01, (I2, I3, rel)
