@@ -15,9 +15,12 @@ import math
 import ngsolve as ng
 
 from ..cell import CellModel, CellProblem, Friction
+import numpy as np
+
 from ..homogenize import coefficients
-from ..kinds.cell import loads
+from ..kinds.cell import GAP_PROFILES, loads
 from ..report import Outcome, VtkField
+from ..scene import resolve
 
 log = logging.getLogger(__name__)
 
@@ -28,9 +31,9 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
     maxh = maxh or d.maxh
     ih = interface_maxh or d.interface_maxh
     order = order or d.order
-    if g.profile in ("flat3d", "square_hills"):
+    if g.dim == 3:
         from ..geometry import cell3d
-        if g.profile == "flat3d":
+        if g.profile != "square_hills":  # flat, or a small-slope profile carried by the gap
             return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih)
         return cell3d.square_hills_cell(g.width, g.depth, period=g.period, arrangement=g.arrangement,
                                         h_rough=g.h_rough, h_counter=g.h_counter, maxh=maxh,
@@ -44,6 +47,9 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
         prof = pr.triangular_valley(g.angles[0], g.angles[1], g.width, g.period)
     elif g.profile == "semicircular":
         prof = pr.semicircular_valley(g.radius, g.period)
+    elif g.profile == "tabulated":
+        from ..geometry.tabulated import read_profile_csv
+        prof = read_profile_csv(resolve(scene, g.file), path="geometry.file")
     else:
         prof = pr.sinusoid(g.amplitude, g.period)
     return pr.profile_cell(prof, arrangement=g.arrangement, h_rough=g.h_rough, h_counter=g.h_counter,
@@ -51,7 +57,30 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
 
 
 def gap_cf(scene):
-    """The initial gap of ``scene.contact.gap`` as a CoefficientFunction, or ``None``."""
+    """The initial gap as a CoefficientFunction, or ``None`` when there is none.
+
+    The sum of the explicit gap ``scene.contact.gap`` and, for the 3D
+    small-slope profiles (bisinusoid, height map), the height below the
+    highest summit.
+    """
+    terms = [t for t in (_profile_gap(scene), _explicit_gap(scene)) if t is not None]
+    if not terms:
+        return None
+    return terms[0] if len(terms) == 1 else terms[0] + terms[1]
+
+
+def _profile_gap(scene):
+    g = scene.geometry
+    if g.profile not in GAP_PROFILES:
+        return None
+    from ..geometry import cell3d
+    if g.profile == "bisinusoid":
+        return cell3d.bisinusoid_gap(g.amplitude, g.period)
+    from ..geometry.tabulated import read_height_map
+    return cell3d.height_map_gap(read_height_map(resolve(scene, g.file), path="geometry.file"), g.period)
+
+
+def _explicit_gap(scene):
     gs, P = scene.contact.gap, scene.geometry.period
     if gs.kind == "none":
         return None
@@ -59,7 +88,27 @@ def gap_cf(scene):
         return ng.CF(gs.value)
     if gs.kind == "sinusoid":
         return 2 * gs.h * ng.sin(math.pi * ng.x / P) ** 2
-    return gs.h * (2 - ng.cos(2 * math.pi * ng.x / P) - ng.cos(2 * math.pi * ng.y / P))
+    if gs.kind == "bisinusoid":
+        return gs.h * (2 - ng.cos(2 * math.pi * ng.x / P) - ng.cos(2 * math.pi * ng.y / P))
+    from ..geometry import tabulated
+    if scene.geometry.dim == 2:
+        x, g = tabulated.read_gap_csv(resolve(scene, gs.file), path="contact.gap.file")
+        return periodic_table_1d(x, g, P)
+    g = tabulated.read_gap_map(resolve(scene, gs.file), path="contact.gap.file")
+    return ng.VoxelCoefficient((0.0, 0.0), (P, P), np.ascontiguousarray(g), linear=True)
+
+
+def periodic_table_1d(x, g, period: float, samples: int = 4096):
+    """Piecewise-linear interpolant of the samples ``(x_i, g_i)`` as a function of ``x``.
+
+    Resampled on a uniform grid of ``samples`` intervals (exact for the
+    polyline up to the resampling of its kinks) and carried by a 2D voxel
+    coefficient that is constant in ``y``.
+    """
+    xs = np.linspace(0.0, period, samples + 1)
+    row = np.interp(xs, x, g)
+    data = np.ascontiguousarray(np.vstack([row, row]))
+    return ng.VoxelCoefficient((0.0, -1e3), (period, 1e3), data, linear=True)
 
 
 def model_of(scene) -> CellModel:

@@ -108,3 +108,39 @@ def _numeric(text: str) -> bool:
     except ValueError:
         return False
     return True
+
+
+def read_gap_csv(file, *, path: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Read a periodic initial gap ``g(x) >= 0`` from a CSV file with columns ``x, g``.
+
+    The same layout and checks as :func:`read_profile_csv` (one period from
+    ``x = 0``, strictly increasing, ``g(0) = g(P)``), and every ``g >= 0``.
+
+    Returns
+    -------
+    (x, g)
+        NumPy arrays of the samples.
+    """
+    where = path or str(file)
+    prof = read_profile_csv(file, path=where)
+    pts = [p.start for p in prof.pieces] + [prof.pieces[-1].end]
+    x = np.array([p[0] for p in pts], dtype=float)
+    g = np.array([p[1] for p in pts], dtype=float)
+    _check_nonnegative(g, where)
+    return x, g
+
+
+def read_gap_map(file, *, path: str | None = None) -> np.ndarray:
+    """Read a periodic initial-gap map ``g[i, j] >= 0`` from a ``.npy`` file (layout of :func:`read_height_map`)."""
+    where = path or str(file)
+    g = read_height_map(file, path=where)
+    _check_nonnegative(g, where)
+    return g
+
+
+def _check_nonnegative(g: np.ndarray, where: str) -> None:
+    bad = np.argwhere(np.asarray(g) < 0)
+    if len(bad):
+        idx = tuple(int(i) for i in bad[0])
+        raise SceneError(f"{where}[{', '.join(map(str, idx))}]", float(np.asarray(g)[idx]),
+                         "a gap must be >= 0")

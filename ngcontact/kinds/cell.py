@@ -18,9 +18,12 @@ from ..scene import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names, register)
 from ..schema import at_least, nonempty, nonnegative, open_interval, param, positive
 
-PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid")
-PROFILES_3D = ("flat3d", "square_hills")
-GAPS = ("none", "constant", "sinusoid", "bisinusoid")
+PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
+PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map")
+#: 3D profiles represented by the small-slope model: a flat mesh interface
+#: whose initial gap is the height below the highest summit.
+GAP_PROFILES = ("bisinusoid", "height_map")
+GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 FRICTION = ("none", "tresca", "coulomb")
 
 
@@ -45,12 +48,16 @@ class CellGeometry:
     radius: float | None = param(None, doc="valley radius (semicircular)", units="m", check=positive())
     angles: tuple[float, float] | None = param(None, doc="face angles to S_0 (triangular)",
                                                units="deg", check=open_interval(0, 90))
-    amplitude: float | None = param(None, doc="profile amplitude (sinusoid)", units="m",
+    amplitude: float | None = param(None, doc="profile amplitude (sinusoid, bisinusoid)", units="m",
                                     check=positive())
+    file: str | None = param(None, doc="tabulated profile: CSV with columns x, y over one period "
+                             "(2D); height map: .npy array whose last row/column repeat the first "
+                             "(3D, small-slope model); relative to the scene file")
 
     _USES = {"flat": (), "flat3d": (), "rectangular": ("width", "depth"),
              "triangular": ("angles",), "semicircular": ("radius",), "sinusoid": ("amplitude",),
-             "square_hills": ("width", "depth")}
+             "square_hills": ("width", "depth"), "tabulated": ("file",),
+             "bisinusoid": ("amplitude",), "height_map": ("file",)}
     _OPTIONAL = {"triangular": ("width",)}
 
     @property
@@ -60,7 +67,11 @@ class CellGeometry:
     def check(self, path: str) -> None:
         need = self._USES[self.profile]
         allowed = need + self._OPTIONAL.get(self.profile, ())
-        for key in ("width", "depth", "radius", "angles", "amplitude"):
+        if self.profile in GAP_PROFILES and self.arrangement != "summit":
+            raise SceneError(f"{path}.arrangement", self.arrangement,
+                             f"profile = {self.profile!r} is modelled as a flat counter face touching "
+                             "the summits (small-slope model): set arrangement = 'summit'")
+        for key in ("width", "depth", "radius", "angles", "amplitude", "file"):
             value = getattr(self, key)
             if key in need and value is None:
                 raise SceneError(f"{path}.{key}", MISSING, f"required for profile = {self.profile!r}")
@@ -74,16 +85,19 @@ class GapSpec:
     """Initial gap g >= 0 on the contact surface."""
 
     kind: str = param("none", doc="none, constant, sinusoid 2h sin^2(pi x/P), bisinusoid "
-                      "h (2 - cos(2 pi x/P) - cos(2 pi y/P))",
+                      "h (2 - cos(2 pi x/P) - cos(2 pi y/P)), tabulated (file)",
                       choices=GAPS)
     value: float | None = param(None, doc="constant gap", units="m", check=nonnegative())
-    h: float | None = param(None, doc="gap amplitude h (sinusoid: g in [0, 2h]; bisinusoid: [0, 2h])",
+    h: float | None = param(None, doc="gap amplitude h (sinusoid: g in [0, 2h]; bisinusoid: [0, 4h])",
                             units="m", check=positive())
+    file: str | None = param(None, doc="tabulated gap: CSV with columns x, g over one period (2D) "
+                             "or .npy array g[i, j] at x = j P/(n_x - 1), y = i P/(n_y - 1) whose last "
+                             "row/column repeat the first (3D); g >= 0; relative to the scene file")
 
     def check(self, path: str) -> None:
         need = {"none": (), "constant": ("value",), "sinusoid": ("h",),
-                "bisinusoid": ("h",)}[self.kind]
-        for key in ("value", "h"):
+                "bisinusoid": ("h",), "tabulated": ("file",)}[self.kind]
+        for key in ("value", "h", "file"):
             v = getattr(self, key)
             if key in need and v is None:
                 raise SceneError(f"{path}.{key}", MISSING, f"required for kind = {self.kind!r}")
@@ -165,6 +179,35 @@ class CellScene:
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     base_dir: str = base_dir_field()
 
+    def check_files(self) -> None:
+        """Read and validate the tabulated profile / height map / gap named by the scene."""
+        from ..geometry import tabulated
+        from ..scene import resolve
+        g = self.geometry
+        if g.file is not None:
+            where = f"geometry.file ({g.file})"
+            if g.profile == "tabulated":
+                prof = tabulated.read_profile_csv(resolve(self, g.file), path=where)
+                if abs(prof.period - g.period) > 1e-12 * g.period:
+                    raise SceneError("geometry.period", g.period,
+                                     f"must equal the period of the tabulated profile ({prof.period!r})")
+                lo, hi = prof.bounds
+                if hi - lo >= min(g.h_rough, g.h_counter):
+                    raise SceneError("geometry.file", g.file, f"the profile height {hi - lo!r} must stay "
+                                     "below h_rough and h_counter")
+            else:
+                tabulated.read_height_map(resolve(self, g.file), path=where)
+        gs = self.contact.gap
+        if gs.file is not None:
+            where = f"contact.gap.file ({gs.file})"
+            if self.geometry.dim == 2:
+                x, _ = tabulated.read_gap_csv(resolve(self, gs.file), path=where)
+                if abs(x[-1] - g.period) > 1e-12 * g.period:
+                    raise SceneError("contact.gap.file", gs.file,
+                                     f"must span one period {g.period!r} (it ends at x = {x[-1]!r})")
+            else:
+                tabulated.read_gap_map(resolve(self, gs.file), path=where)
+
     def check(self, path: str) -> None:
         check_material_names(self.materials, {"rough": self.bodies.rough,
                                               "counter": self.bodies.counter}, "bodies")
@@ -224,7 +267,7 @@ def effects(scene: CellScene) -> tuple[str, ...]:
     if scene.contact.geometric_only:
         return ("contact_surface_coefficients",)
     out = ["elasticity", "normal_contact"]
-    if scene.contact.gap.kind != "none":
+    if scene.contact.gap.kind != "none" or scene.geometry.profile in GAP_PROFILES:
         out.append("gap")
     if scene.contact.friction != "none":
         out.append(f"{scene.contact.friction}_friction")
