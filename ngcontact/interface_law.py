@@ -103,7 +103,8 @@ class BundleLaw:
         ``w_q`` [stress / length], > 0.
     directions
         Unit micro normals ``n_q`` in the local frame ``(n0, t0)`` or
-        ``(n0, t1, t2)``.
+        ``(n0, t1, t2)``; a 3D cell's normals under a 2D macro frame are
+        their projections on ``(n0, t1)`` (the hoop jump is zero).
     gaps
         Micro gaps ``g_q`` [length] (default zeros).
     """
@@ -119,8 +120,9 @@ class BundleLaw:
             raise ValueError("weights must be a non-empty list of numbers > 0")
         if d.shape[0] != len(w) or d.ndim != 2 or d.shape[1] not in (2, 3):
             raise ValueError(f"directions must be {len(w)} vectors of 2 or 3 components")
-        if not np.allclose(np.linalg.norm(d, axis=1), 1.0, atol=1e-9):
-            raise ValueError("directions must be unit vectors")
+        norms = np.linalg.norm(d, axis=1)
+        if np.any(norms <= 0) or np.any(norms > 1 + 1e-9):
+            raise ValueError("directions must be unit vectors (or their projections on a 2D frame)")
         if self.gaps and len(self.gaps) != len(w):
             raise ValueError(f"gaps must have {len(w)} entries (one per direction)")
 

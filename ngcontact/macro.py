@@ -454,15 +454,18 @@ def resultant(sol: MacroSolution) -> dict:
     ``R = int_S0 tau w ds`` with the global traction ``tau = sum_k tau_k e_k``.
     Axisymmetric: only the axial component ``z`` (per full revolution; the
     radial tractions cancel around the circumference).  Plane strain: per unit
-    thickness.
+    thickness.  Integrated with the quadrature of the assembly (order ``2p``),
+    so ``R`` is the discrete reaction and balances the applied loads to
+    solver tolerance (the kinks of unilateral laws make other quadratures
+    differ slightly).
     """
     p = sol.problem
     tau = interface_tractions(sol)
     glob = sum((t * e for t, e in zip(tau, sol.frame)), ng.CF((0,) * p.mesh.dim))
     w = elasticity.weight(p.setting)
     comps = COMPONENTS[p.setting]
-    vals = [ng.Integrate(glob[i] * w, p.mesh, ng.BND, definedon=p.mesh.Boundaries(p.interface))
-            for i in range(p.mesh.dim)]
+    vals = [ng.Integrate(glob[i] * w, p.mesh, ng.BND, definedon=p.mesh.Boundaries(p.interface),
+                         order=2 * p.order) for i in range(p.mesh.dim)]
     if p.setting == "axisymmetric":
         return {"z": float(vals[1])}
     return {c: float(v) for c, v in zip(comps, vals)}

@@ -1,0 +1,250 @@
+"""Scene kind ``macro``: two elastic bodies joined by a homogenized interface law.
+
+The macro problem of paper eqs. 44-48 / 69-71 (see :mod:`ngcontact.macro`)
+on one of the built-in geometries: the axisymmetric femur with a press-fitted
+hip stem (paper Sec. 4.2-4.3), two coaxial tubes (Lame press fit; plane
+strain, axisymmetric or 3D) or a block on a base (friction).  The interface
+law comes from explicit numbers (``linear`` K0, ``bundle`` of directions,
+``tabulated`` normal law) or from a ``cell`` scene named by
+``interface.cell`` (its direction bundle, computed on the fly and cached on
+disk; see :mod:`ngcontact.cell_law`), with homogenized friction on top.
+Lengths in metres, stresses in pascals, interface stiffnesses in Pa/m.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from ..errors import MISSING, SceneError
+from ..geometry.macro import FemurStemDims
+from ..scene import (Discretization, MaterialSpec, SolverSpec, base_dir_field, check_material_names,
+                     register)
+from ..schema import at_least, nonempty, nonnegative, param, positive
+
+SHAPES = ("femur_stem", "coaxial", "block")
+SETTINGS = {"femur_stem": ("axisymmetric",), "coaxial": ("plane_strain", "axisymmetric", "3d"),
+            "block": ("plane_strain",)}
+DIMENSIONS = {"femur_stem": tuple(f.name for f in dataclasses.fields(FemurStemDims)),
+              "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base")}
+REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base")}
+REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block": ("block", "base")}
+LAWS = ("linear", "bundle", "tabulated")
+
+
+@dataclass(frozen=True, kw_only=True)
+class MacroGeometrySpec:
+    """Which macro geometry, in which setting, with which dimensions."""
+
+    shape: str = param(doc="femur_stem (regions stem = rough, bone = counter), coaxial (inner = rough, "
+                       "outer = counter) or block (block = rough on base = counter)", choices=SHAPES)
+    setting: str = param("axisymmetric", doc="plane_strain, axisymmetric (r, z) or 3d",
+                         choices=("plane_strain", "axisymmetric", "3d"))
+    dimensions: dict[str, float] | None = param(
+        None, doc="femur_stem: r_stem, r_tip, r_bone, z_tip, z_corner, z_bone_top, z_stem_top (defaults "
+        "exist); coaxial: a, b, c (radii), height (axisymmetric/3d); block: length, h_block, h_base",
+        units="m", allowed="a table of numbers > 0")
+
+    def check(self, path: str) -> None:
+        allowed = SETTINGS[self.shape]
+        if self.setting not in allowed:
+            raise SceneError(f"{path}.setting", self.setting,
+                             f"shape {self.shape!r} takes setting " + " or ".join(repr(s) for s in allowed))
+        dims = self.dimensions or {}
+        for key in dims:
+            if not dims[key] > 0:
+                raise SceneError(f"{path}.dimensions.{key}", dims[key], "must be > 0")
+            if key not in DIMENSIONS[self.shape]:
+                raise SceneError(f"{path}.dimensions.{key}", dims[key],
+                                 f"unknown dimension of {self.shape!r}; known: " + ", ".join(DIMENSIONS[self.shape]))
+        need = REQUIRED[self.shape] + (("height",) if self.shape == "coaxial" and self.setting != "plane_strain"
+                                       else ())
+        for key in need:
+            if key not in dims:
+                raise SceneError(f"{path}.dimensions.{key}", MISSING, f"required for shape {self.shape!r}")
+        if self.shape == "coaxial" and not dims["a"] < dims["b"] < dims["c"]:
+            raise SceneError(f"{path}.dimensions", dims, "need a < b < c")
+        if self.shape == "femur_stem":
+            try:
+                FemurStemDims(**dims).check()
+            except ValueError as exc:
+                raise SceneError(f"{path}.dimensions", dims, str(exc)) from None
+
+
+@dataclass(frozen=True, kw_only=True)
+class BodiesSpec:
+    """Materials of the two bodies."""
+
+    rough: str = param(doc="material of the rough body, paper D (femur_stem: the stem, whose coating is rough)")
+    counter: str = param(doc="material of the counter body, paper Omega (femur_stem: the bone)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class InterfaceSpec:
+    """The homogenized interface law on S_0 and the initial gap."""
+
+    law: str = param("bundle", doc="linear (K0, bilateral), bundle (unilateral weighted directions; the "
+                     "default, also from a cell) or tabulated (pressure against closure)", choices=LAWS)
+    cell: str | None = param(None, doc="cell scene file (relative to this scene): the law is its direction "
+                             "bundle (law = linear: its K0); then omit the explicit numbers")
+    cell_length_unit: float = param(1.0, doc="length of one unit of the cell scene (scales its gaps)",
+                                    units="m", check=positive())
+    kn: float | None = param(None, doc="k_n0 of the linear law", units="Pa/m", check=positive())
+    kt: float = param(0.0, doc="k_t0 (linear law; tabulated: tangential stiffness)", units="Pa/m",
+                      check=nonnegative())
+    knt: float = param(0.0, doc="k_nt0 of the linear law", units="Pa/m")
+    gap_force: tuple[float, float] = param((0.0, 0.0), doc="(g_n0, g_t0) of eq. 34 (linear law)", units="Pa")
+    weights: tuple[float, ...] | None = param(None, doc="bundle weights w_q", units="Pa/m", check=positive())
+    directions: tuple[tuple[float, ...], ...] | None = param(
+        None, doc="bundle directions n_q in the local frame (n0, t0) or (n0, t1, t2)",
+        allowed="one unit vector per weight")
+    gaps: tuple[float, ...] | None = param(None, doc="bundle micro gaps g_q", units="m")
+    closure: tuple[float, ...] | None = param(None, doc="tabulated closures c_i, increasing", units="m")
+    pressure: tuple[float, ...] | None = param(None, doc="tabulated pressures p_i, from 0, non-decreasing",
+                                               units="Pa")
+    gap: float = param(0.0, doc="uniform macro normal gap g0 (negative: interference, press fit)", units="m")
+    gap_table: tuple[tuple[float, float], ...] | None = param(
+        None, doc="piecewise linear gap [[coordinate, g0], ...] along gap_coordinate (replaces gap)",
+        units="m", allowed="pairs with increasing coordinate")
+    gap_coordinate: str = param("y", doc="coordinate of gap_table (r = x, z = y in axisymmetry)",
+                                choices=("x", "y", "z", "r"))
+    mu: float = param(0.0, doc="homogenized Coulomb coefficient mu0 (fixed point on the pressure)",
+                      check=nonnegative())
+    threshold: float = param(0.0, doc="Tresca threshold G0", units="Pa", check=nonnegative())
+    huber_width: float = param(1e-6, doc="Huber width w: largest slip of a sticking point", units="m",
+                               check=positive())
+
+    def check(self, path: str) -> None:
+        explicit = {"kn": self.kn, "weights": self.weights, "directions": self.directions, "gaps": self.gaps,
+                    "closure": self.closure, "pressure": self.pressure}
+        if self.cell is not None:
+            for key, value in explicit.items():
+                if value is not None:
+                    raise SceneError(f"{path}.{key}", value, "not used with interface.cell; remove it")
+            if self.law == "tabulated":
+                raise SceneError(f"{path}.law", self.law, "a cell gives law = 'bundle' or 'linear'")
+            return
+        need = {"linear": ("kn",), "bundle": ("weights", "directions"), "tabulated": ("closure", "pressure")}
+        for key in need[self.law]:
+            if explicit[key] is None:
+                raise SceneError(f"{path}.{key}", MISSING, f"required for law = {self.law!r} (or name a cell)")
+        for key, value in explicit.items():
+            if value is not None and key not in need[self.law] + (("gaps",) if self.law == "bundle" else ()):
+                raise SceneError(f"{path}.{key}", value, f"not used by law = {self.law!r}; remove it")
+        try:
+            self.normal_law()
+        except ValueError as exc:
+            raise SceneError(f"{path}", self.law, str(exc)) from None
+        if self.gap_table is not None:
+            xs = [q[0] for q in self.gap_table]
+            if any(b <= a for a, b in zip(xs, xs[1:])):
+                raise SceneError(f"{path}.gap_table", self.gap_table, "coordinates must increase strictly")
+            if self.gap != 0.0:
+                raise SceneError(f"{path}.gap", self.gap, "give either gap or gap_table")
+
+    def normal_law(self):
+        """The normal law from the explicit numbers (``None`` with a cell)."""
+        from .. import interface_law as il
+        if self.cell is not None:
+            return None
+        if self.law == "linear":
+            return il.LinearLaw(kn=self.kn, kt=self.kt, knt=self.knt, gap_force=self.gap_force)
+        if self.law == "bundle":
+            return il.BundleLaw(weights=self.weights, directions=self.directions, gaps=self.gaps or ())
+        return il.TabulatedLaw(closure=self.closure, pressure=self.pressure, kt=self.kt)
+
+    def friction(self):
+        from .. import interface_law as il
+        if self.mu == 0.0 and self.threshold == 0.0:
+            return None
+        return il.Friction(mu=self.mu, threshold=self.threshold, width=self.huber_width)
+
+
+@dataclass(frozen=True, kw_only=True)
+class SupportSpec:
+    """Prescribed displacement components on a boundary."""
+
+    boundary: str = param(doc="boundary label of the geometry")
+    components: tuple[str, ...] = param((), doc="components fixed (x, y, z; r, z in axisymmetry); empty: all")
+    displacement: tuple[float, ...] = param((), doc="prescribed values, one per component (default 0)",
+                                            units="m")
+
+
+@dataclass(frozen=True, kw_only=True)
+class LoadSpec:
+    """Surface load on a boundary."""
+
+    boundary: str = param(doc="boundary label of the geometry")
+    pressure: float = param(0.0, doc="normal pressure, positive pushes into the body", units="Pa")
+    traction: tuple[float, ...] = param((), doc="traction vector (global components)", units="Pa")
+
+
+@dataclass(frozen=True, kw_only=True)
+class OutputSpec:
+    """Sampling of the results."""
+
+    points_per_element: int = param(5, doc="samples per interface element in the profile", check=at_least(2))
+    vtk_subdivision: int = param(1, doc="subdivision of the VTK output", check=at_least(0))
+    coulomb_tol: float = param(1e-6, doc="Coulomb fixed point: relative change of the pressure to stop at",
+                               check=positive())
+
+
+@dataclass(frozen=True, kw_only=True)
+class MacroScene:
+    kind: str = param(doc="problem type", choices=("macro",))
+    title: str = param("", doc="free text shown in the report")
+    materials: dict[str, MaterialSpec] = param(doc="named materials", check=nonempty())
+    bodies: BodiesSpec = param(doc="materials of the bodies")
+    geometry: MacroGeometrySpec = param(doc="the macro geometry")
+    interface: InterfaceSpec = param(doc="interface law on S_0")
+    supports: tuple[SupportSpec, ...] = param(doc="[[supports]]: Dirichlet conditions", check=nonempty())
+    loads: tuple[LoadSpec, ...] = param((), doc="[[loads]]: surface loads")
+    discretization: Discretization = param(Discretization(), doc="mesh and order")
+    solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
+    output: OutputSpec = param(OutputSpec(), doc="result sampling")
+    base_dir: str = base_dir_field()
+
+    def check(self, path: str) -> None:
+        check_material_names(self.materials, {"rough": self.bodies.rough, "counter": self.bodies.counter},
+                             "bodies")
+        from ..macro import COMPONENTS
+        comps = COMPONENTS[self.geometry.setting]
+        for i, s in enumerate(self.supports):
+            for c in s.components:
+                if c not in comps:
+                    raise SceneError(f"supports[{i}].components", c, "must be one of " + ", ".join(comps))
+            if s.displacement and len(s.displacement) != len(s.components or comps):
+                raise SceneError(f"supports[{i}].displacement", s.displacement,
+                                 f"one value per component ({len(s.components or comps)})")
+        dim = 3 if self.geometry.setting == "3d" else 2
+        for i, load in enumerate(self.loads):
+            if load.traction and len(load.traction) != dim:
+                raise SceneError(f"loads[{i}].traction", load.traction, f"must have {dim} components")
+        if self.interface.gap_coordinate == "z" and dim == 2 and self.geometry.setting != "axisymmetric":
+            raise SceneError("interface.gap_coordinate", "z", "plane strain has coordinates x, y")
+
+    def check_files(self) -> None:
+        if self.interface.cell is not None:
+            import os
+            from ..scene import resolve
+            if not os.path.isfile(resolve(self, self.interface.cell)):
+                raise SceneError("interface.cell", self.interface.cell, "no such cell scene file")
+
+
+def effects(scene: MacroScene) -> tuple[str, ...]:
+    """The terms assembled."""
+    i = scene.interface
+    out = ["elasticity", f"interface_{i.law}" + ("_from_cell" if i.cell else "")]
+    if i.gap != 0.0 or i.gap_table is not None:
+        out.append("initial_gap")
+    if i.mu > 0:
+        out.append("coulomb_friction")
+    if i.threshold > 0:
+        out.append("tresca_friction")
+    if any(load.pressure or load.traction for load in scene.loads):
+        out.append("surface_loads")
+    if any(any(s.displacement) for s in scene.supports):
+        out.append("prescribed_displacement")
+    return tuple(out)
+
+
+register("macro", MacroScene, "ngcontact.drivers.macro:run", effects)
