@@ -513,10 +513,71 @@ class CellProblem:
         o = order if order is not None else 4 * self.model.order + 24
         return ng.Integrate(cf, self.mesh, definedon=self.mesh.Boundaries("contact"), order=o)
 
-    def contact_fraction(self) -> float:
-        """Measure of ``{J_n - g >= 0}`` on ``S_C`` divided by ``|T|``."""
-        ind = ng.IfPos(-self.penetration, 0.0, 1.0)
-        return float(self._contact_integral(ind)) / self.area
+    def contact_fraction(self, method: str = "auto") -> float:
+        """Measure of the real contact set ``{J_n - g >= 0}`` on ``S_C`` divided by ``|T|``.
+
+        Parameters
+        ----------
+        method
+            ``"roots"`` (2D): on each boundary element the penetration
+            ``J_n - g_h`` is a polynomial of the reference coordinate ``t``
+            (degree ``order`` on straight elements with the interpolated
+            gap); it is interpolated at ``order + 3`` Gauss points, its real
+            roots in ``[0, 1]`` split the element, and the length
+            ``int |dx/dt| dt`` of the pieces where it is nonnegative is
+            summed.  The contact edge is thus located inside the element
+            instead of at the nearest quadrature point.
+            ``"quadrature"``: integral of the indicator at high order (3D,
+            where the zero set is a curve on each face).  ``"auto"``: roots
+            in 2D, quadrature in 3D.
+        """
+        if method == "auto":
+            method = "roots" if self.dim == 2 else "quadrature"
+        if method == "quadrature":
+            ind = ng.IfPos(-self.penetration, 0.0, 1.0)
+            return float(self._contact_integral(ind)) / self.area
+        if method != "roots" or self.dim != 2:
+            raise ValueError(f"method = {method!r}: must be 'auto', 'quadrature' or (2D) 'roots'")
+        return self._contact_length_by_roots() / self.area
+
+    def _contact_length_by_roots(self) -> float:
+        P = np.polynomial.polynomial
+        m = self.model.order + 3
+        ir = ng.IntegrationRule(ng.SEGM, 2 * m - 1)
+        t = np.array([q[0] for q in ir.points])
+        mesh = self.mesh
+        pts = mesh.MapToAllElements(ir, mesh.Boundaries("contact"))
+        vals = np.asarray(ng.CF((self.penetration, ng.x, ng.y))(pts)).reshape(-1, m, 3)
+        # monomial coefficients in t of penetration, x and y, per element
+        coef = np.linalg.solve(P.polyvander(t, m - 1), vals.transpose(1, 0, 2).reshape(m, -1))
+        coef = coef.reshape(m, -1, 3)
+        tg, wg = np.polynomial.legendre.leggauss(m + 2)
+        total = 0.0
+        for e in range(vals.shape[0]):
+            c_pen, c_x, c_y = coef[:, e, 0], coef[:, e, 1], coef[:, e, 2]
+            pen = vals[e, :, 0]
+            if np.all(pen > 0) or np.all(pen < 0):
+                r = P.polyroots(c_pen) if np.any(c_pen[1:]) else np.empty(0)
+                r = r[np.abs(r.imag) <= 1e-10].real
+                if not np.any((r > 0.0) & (r < 1.0)):
+                    if pen[0] > 0:
+                        total += self._arc(c_x, c_y, 0.0, 1.0, tg, wg)
+                    continue
+            r = P.polyroots(c_pen) if np.any(c_pen[1:]) else np.empty(0)
+            r = np.sort(r[(np.abs(r.imag) <= 1e-10) & (r.real > 0.0) & (r.real < 1.0)].real)
+            cuts = np.concatenate(([0.0], r, [1.0]))
+            for a, b in zip(cuts[:-1], cuts[1:]):
+                if b > a and P.polyval(0.5 * (a + b), c_pen) >= 0.0:
+                    total += self._arc(c_x, c_y, a, b, tg, wg)
+        return total
+
+    @staticmethod
+    def _arc(c_x, c_y, a, b, tg, wg) -> float:
+        """Length of the curve ``(x(t), y(t))`` (monomial coefficients) for ``t`` in ``[a, b]``."""
+        P = np.polynomial.polynomial
+        s = 0.5 * (b - a) * tg + 0.5 * (a + b)
+        dx, dy = P.polyval(s, P.polyder(c_x)), P.polyval(s, P.polyder(c_y))
+        return float(0.5 * (b - a) * np.sum(wg * np.hypot(dx, dy)))
 
     def mean_traction(self, load: CellLoad) -> np.ndarray:
         """Mean traction on the counter's far face per axis (prescribed or reaction)."""
