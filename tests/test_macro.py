@@ -199,122 +199,50 @@ def test_unknown_boundary_label_is_rejected_with_the_existing_ones():
 # ------------------------------------------------------- axisymmetric vs 3D
 @pytest.mark.slow
 def test_axisymmetric_equals_3d_for_a_rotationally_symmetric_problem():
-    """Press-fitted tubes, clamped at their bases, pressed on their tops.
+    """Press-fitted tubes, clamped at their bases, pressed on their tops: (r, z) model vs 3D quarter.
 
     The tubes differ in stiffness, so the interface carries shear as well as
-    the press-fit pressure.  Compared: ``int p w ds``, ``int p z w ds`` and
-    ``int J_t^2 w ds`` over the interface; the 3D model is a quarter with
-    symmetry planes (integrals x 4).
+    the press-fit pressure.  Compared (3D quarter x 4): ``int p w ds`` and
+    ``int |J_t|^2 w ds`` on the interface, the axial displacement integrated
+    over the top faces and the radial one over the mantle.  The pressure is
+    ``k (J_n + delta)`` with ``|J_n|`` about 0.8 ``delta``, so its error is
+    the displacement error amplified about five times; it gets a looser bound.
+    The 3D discrepancy must shrink under refinement (it is discretization error).
     """
     a, b, c, h = 0.5, 1.0, 1.6, 1.0
     law = il.InterfaceLaw(normal=il.LinearLaw(kn=300.0, kt=100.0))
     mats = {"inner": isotropic(200.0, 0.3), "outer": isotropic(70.0, 0.25)}
-    top = (M.Load(label="top", pressure=1.0),)
+    top = (M.Load(label="top", pressure=0.1),)
 
     def integrals(sol, factor):
-        p = il.pressure(law.normal, sol.local_jump, -DELTA)
         axi = sol.problem.setting == "axisymmetric"
+        mesh = sol.problem.mesh
         w = factor * (2 * math.pi * ng.x if axi else ng.CF(1.0))
-        z = ng.y if axi else ng.z
-        on = sol.problem.mesh.Boundaries("interface")
-        return np.array([ng.Integrate(f * w, sol.problem.mesh, ng.BND, definedon=on)
-                         for f in (p, p * z, sol.local_jump[1] ** 2)])
+        p = il.pressure(law.normal, sol.local_jump, -DELTA)
+        jt2 = sum(t * t for t in sol.local_jump[1:])
+        uz = sol.u_rough[1] if axi else sol.u_rough[2]
+        r = ng.x if axi else ng.sqrt(ng.x ** 2 + ng.y ** 2)
+        ur = sol.u_counter[0] if axi else (sol.u_counter[0] * ng.x + sol.u_counter[1] * ng.y) / r
+        on = mesh.Boundaries
+        return np.array([ng.Integrate(p * w, mesh, ng.BND, definedon=on("interface")),
+                         ng.Integrate(jt2 * w, mesh, ng.BND, definedon=on("interface")),
+                         ng.Integrate(uz * w, mesh, ng.BND, definedon=on("top")),
+                         ng.Integrate(ur * w, mesh, ng.BND, definedon=on("mantle"))])
 
     g2 = gm.coaxial_axisymmetric(a, b, c, h, maxh=0.05)
     sol2 = M.solve(M.MacroProblem(mesh=g2.mesh, setting="axisymmetric", rough="inner", counter="outer",
                                   materials=mats, law=law, gap=-DELTA, order=3,
                                   supports=(M.Support(label="bottom"),), loads=top))
-    g3 = gm.coaxial_3d(a, b, c, h, maxh=0.22, order=2)
-    sol3 = M.solve(M.MacroProblem(mesh=g3.mesh, setting="3d", rough="inner", counter="outer",
-                                  materials=mats, law=law, gap=-DELTA, order=2,
-                                  supports=(M.Support(label="bottom"),
-                                            M.Support(label="sym_x", components=("x",)),
-                                            M.Support(label="sym_y", components=("y",))), loads=top))
-    I2, I3 = integrals(sol2, 1.0), integrals(sol3, 4.0)
-    rel = np.abs(I3 / I2 - 1)
-    assert rel.max() < 0.01, (I2, I3, rel)
-
-
-# ------------------------------------------------------------ scenes, driver
-ROOT = __import__("os").path.dirname(__import__("os").path.dirname(__import__("os").path.abspath(__file__)))
-
-
-def test_femur_stem_scene_runs_end_to_end(tmp_path):
-    """The README's main job: report keys, equilibrium, a detachment on the cone, files written."""
-    import json
-    import os
-    from ngcontact.cli import main
-    out = tmp_path / "femur"
-    assert main(["run", os.path.join(ROOT, "geometries", "femur_stem.toml"), "--out", str(out), "--quiet"]) == 0
-    rep = json.loads((out / "report.json").read_text())
-    res = rep["results"]
-    dims = res["dimensions"]
-    F = 1e6 * math.pi * dims["r_stem"] ** 2
-    assert abs(res["resultant"]["z"] + F) < 1e-6 * F
-    prof = res["interface"]
-    assert set(prof) == {"s", "r", "z", "pressure", "shear", "jump_n", "jump_t", "status"}
-    assert len({len(v) for v in prof.values()}) == 1
-    assert set(prof["status"]) <= {"open", "stick", "slip"} and "open" in prof["status"]
-    assert min(prof["pressure"]) >= 0.0
-    peak = res["maxima"]["pressure"]
-    assert peak["pressure"] == max(prof["pressure"])
-    # the over-reamed distal canal opens: the stem detaches on the cone, below mid-cone
-    assert res["detachment"]
-    for pt in res["detachment"]:
-        assert dims["z_tip"] < pt["z"] < dims["z_corner"]
-    assert res["maxima"]["von_mises"]["max"]["value"] > 0
-    for name in ("interface.csv", "interface.png", "stress.png", "stress.vtu"):
-        assert (out / name).is_file(), name
-    assert rep["solver"]["converged"]
-
-
-def test_scene_with_an_unknown_boundary_names_the_existing_ones():
-    import os
-    from ngcontact import scene as scene_mod
-    from ngcontact.drivers.macro import build_geometry, problem_of
-    from ngcontact.errors import SceneError
-    sc = scene_mod.load(os.path.join(ROOT, "geometries", "femur_stem.toml"))
-    bad = __import__("dataclasses").replace(sc.supports[0], boundary="floor")
-    sc = __import__("dataclasses").replace(sc, supports=(bad,) + sc.supports[1:])
-    with pytest.raises(SceneError, match=r"supports\[0\]\.boundary = 'floor'.*base.*interface"):
-        problem_of(sc, build_geometry(sc, maxh=0.02))
-
-
-def test_law_from_a_cell_is_its_bundle_with_the_cells_K0_and_is_cached(tmp_path, monkeypatch):
-    """Sawtooth cell (Example 27): bundle K0 = closed form; the second call reads the cache."""
-    import os
-    from ngcontact import cell_law
-    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
-    path = os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml")
-    law, info = cell_law.law_from_cell(path, dim=2)
-    assert not info["cached"] and len(os.listdir(tmp_path)) == 1
-    b1, b2 = math.radians(30), math.radians(60)
-    a2 = 1.0 / (math.sin(b2) / math.sin(b1) * math.cos(b1) + math.cos(b2))   # face lengths of one period
-    a1 = a2 * math.sin(b2) / math.sin(b1)
-    kn = 1e12
-    expected = kn * np.array([[a1 * math.cos(b1) ** 2 + a2 * math.cos(b2) ** 2,
-                               a1 * math.cos(b1) * math.sin(b1) - a2 * math.cos(b2) * math.sin(b2)],
-                              [0, a1 * math.sin(b1) ** 2 + a2 * math.sin(b2) ** 2]])
-    expected[1, 0] = expected[0, 1]
-    np.testing.assert_allclose(np.abs(law.matrix()), np.abs(expected), rtol=1e-10)
-    assert abs(law.matrix()[0, 1]) > 0.1 * kn   # the asymmetric valley couples n0 and t0
-    law2, info2 = cell_law.law_from_cell(path, dim=2)
-    assert info2["cached"] and law2 == law
-    lin, _ = cell_law.law_from_cell(path, dim=2, linear=True)
-    assert isinstance(lin, il.LinearLaw) and abs(lin.kn - expected[0, 0]) < 1e-10 * kn
-
-
-def test_block_on_a_sawtooth_cell_scene_transmits_the_load(tmp_path, monkeypatch):
-    """Macro scene taking its law from a cell: equilibrium and a closed interface."""
-    import os
-    from ngcontact import scene as scene_mod
-    from ngcontact.drivers.macro import run
-    from ngcontact.report import Clock
-    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
-    sc = scene_mod.load(os.path.join(ROOT, "geometries", "macro", "block_on_sawtooth.toml"))
-    out = run(sc, Clock())
-    L = sc.geometry.dimensions["length"]
-    R = out.results["resultant"]
-    assert abs(R["x"] - 2e6 * L) < 1e-8 * 2e6 * L and abs(R["y"] + 10e6 * L) < 1e-8 * 10e6 * L
-    assert "open" not in out.results["interface"]["status"]
-    assert out.results["law"]["directions"] == 2
+    I2 = integrals(sol2, 1.0)
+    errors = []
+    for maxh in (0.3, 0.2):
+        g3 = gm.coaxial_3d(a, b, c, h, maxh=maxh, order=3)
+        sol3 = M.solve(M.MacroProblem(mesh=g3.mesh, setting="3d", rough="inner", counter="outer",
+                                      materials=mats, law=law, gap=-DELTA, order=3,
+                                      supports=(M.Support(label="bottom"),
+                                                M.Support(label="sym_x", components=("x",)),
+                                                M.Support(label="sym_y", components=("y",))), loads=top))
+        errors.append(np.abs(integrals(sol3, 4.0) / I2 - 1))
+    coarse, fine = errors
+    assert fine[0] < 0.025 and fine[1] < 0.015 and fine[2] < 0.005 and fine[3] < 0.005, fine
+    assert fine[0] < coarse[0] and fine[2] < coarse[2] and fine[3] < coarse[3], (coarse, fine)
