@@ -82,10 +82,13 @@ def test_press_fit_unilateral_bundle_law_gives_the_same_pressure():
 
 
 # ------------------------------------------------------------ patch test
-@pytest.mark.parametrize("normal", [il.LinearLaw(kn=5e11, kt=2e11),
-                                    il.BundleLaw(weights=(5e11,), directions=((1.0, 0.0),))])
-def test_uniform_compression_transmits_a_uniform_pressure_exactly(normal):
-    """Block on a base, rollers on the sides, pressure P on top: p = P, J_n = P / k_n everywhere.
+@pytest.mark.parametrize("normal,closure", [
+    (il.LinearLaw(kn=5e11, kt=2e11), 2e6 / 5e11),
+    (il.BundleLaw(weights=(5e11,), directions=((1.0, 0.0),)), 2e6 / 5e11),
+    # table: 1 MPa at 2 um, then 1 MPa/um; P = 2 MPa is reached at 3 um
+    (il.TabulatedLaw(closure=(0.0, 2e-6, 5e-6), pressure=(0.0, 1e6, 4e6)), 3e-6)])
+def test_uniform_compression_transmits_a_uniform_pressure_exactly(normal, closure):
+    """Block on a base, rollers on the sides, pressure P on top: p = P and the law's closure everywhere.
 
     The block (rough) lies above the base, so ``n0 = -e_y`` must be found on the
     internal interface for the closure to come out positive.
@@ -103,7 +106,7 @@ def test_uniform_compression_transmits_a_uniform_pressure_exactly(normal):
     sol = M.solve(prob)
     prof = M.interface_profile(sol, points_per_element=4)
     np.testing.assert_allclose(prof["pressure"], P, rtol=1e-10)
-    np.testing.assert_allclose(prof["jump_n"], P / 5e11, rtol=1e-9)
+    np.testing.assert_allclose(prof["jump_n"], closure, rtol=1e-9)
     np.testing.assert_allclose(prof["shear"], 0.0, atol=1e-9 * P)
     n0 = np.asarray(sol.frame[0](g.mesh.MapToAllElements(ng.IntegrationRule([(0.5,)], [1.0]),
                                                          g.mesh.Boundaries("interface"))))
