@@ -116,3 +116,63 @@ def test_frictionless_flat_cell_rejects_shear(cell):
     P = CellProblem(cell, CellModel(rough=LAW, counter=LAW, k_n=1e3, order=1))
     with pytest.raises(ValueError, match="shear"):
         P.sweep([cell_load(2, pressure=0.01, shear=(0.001,))])
+
+
+def test_macro_strain_gives_laminate_stresses():
+    """Two materials stacked along y, macro strain ``e_xx`` and pressure ``p``.
+
+    The interface is flat and closed, nothing varies along x, so each layer
+    is a homogeneous plane-strain state with ``eps_xx = e_xx``,
+    ``eps_xy = 0``, ``eps_zz = 0`` and ``sigma_yy = -p``.  From
+    ``lambda (eps_xx + eps_yy) + 2 mu eps_yy = -p``:
+
+        eps_yy   = -(lambda e_xx + p) / (lambda + 2 mu)
+        sigma_xx = E/(1 - nu^2) e_xx - nu/(1 - nu) p
+        sigma_zz = nu E/(1 - nu^2) e_xx - nu/(1 - nu) p   (= nu (sigma_xx + sigma_yy))
+
+    per layer with its own ``E, nu``: the stress jumps across the interface
+    while ``sigma_yy`` is continuous.  Quadratic elements hold the linear
+    displacements exactly.
+    """
+    from ngcontact.materials import isotropic as iso
+    mats = {"rough": (1.0, 0.3), "counter": (3.0, 0.2)}
+    exx, p = 1e-3, 2e-3
+    c = flat_cell(maxh=0.3, order=1)
+    model = CellModel(rough=iso(*mats["rough"]), counter=iso(*mats["counter"]), k_n=1e3, order=2,
+                      macro_strain=True)
+    P = CellProblem(c, model)
+    (sol,) = P.sweep([cell_load(2, pressure=p, macro_strain=(exx,))])
+    comps = P.gfu.components
+    for k, (name, y) in enumerate((("rough", -0.4), ("counter", 0.6))):
+        E, nu = mats[name]
+        law = model.rough if name == "rough" else model.counter
+        sig = law.stress(P.body_strain(comps[k]))
+        got = np.array(sig(c.mesh(0.37, y))).reshape(3, 3)
+        want = np.zeros((3, 3))
+        want[0, 0] = E / (1 - nu ** 2) * exx - nu / (1 - nu) * p
+        want[1, 1] = -p
+        want[2, 2] = nu * E / (1 - nu ** 2) * exx - nu / (1 - nu) * p
+        assert np.max(np.abs(got - want)) <= 1e-9 * np.max(np.abs(want)), f"{name}: {got} vs {want}"
+    assert sol.results["contact_fraction"] == pytest.approx(1.0, abs=1e-12)
+
+
+def test_predictor_and_exact_line_search_cut_newton_steps():
+    """First load of a Westergaard-type sweep: the rigid predictor needs fewer steps.
+
+    Both starts must reach the same solution; the old start (everything
+    closed, backtracking only) creeps towards the contact edge.
+    """
+    h = 0.01
+    pstar = np.pi * h / (2 * (1 - 0.3 ** 2))
+    c = flat_cell(maxh=0.3, interface_maxh=0.02, order=2)
+    gap = 2 * h * ng.sin(np.pi * ng.x) ** 2
+    out = {}
+    for key, kw in (("new", {}), ("old", {"start": "closed", "line_search": "armijo"})):
+        P = CellProblem(c, CellModel(rough=LAW, counter=LAW, k_n=1e3, gap=gap, order=2), **kw)
+        P._apply_load(cell_load(2, pressure=0.1 * pstar), first=True)
+        hist = P._newton(P._freedofs(cell_load(2, pressure=0.1 * pstar)), 0.0)
+        out[key] = (hist["iterations"], P.contact_fraction(), P.gfu.vec.FV().NumPy().copy())
+    assert out["new"][0] <= 10
+    assert out["new"][0] < out["old"][0]
+    assert out["new"][1] == pytest.approx(out["old"][1], rel=1e-10)
+    assert np.allclose(out["new"][2], out["old"][2], rtol=0, atol=1e-9 * np.max(np.abs(out["old"][2])))
