@@ -457,8 +457,14 @@ class CellProblem:
         vals = self.sample_surface({"g": self.gap})["g"]
         return float(max(vals.max(), 0.0))
 
-    def solve(self, load: CellLoad, first: bool = False) -> CellSolution:
-        """Solve one load, starting from the current state (continuation)."""
+    def solve(self, load: CellLoad, first: bool = False, measure: bool = True) -> CellSolution:
+        """Solve one load, starting from the current state (continuation).
+
+        With ``measure=False`` only ``contact_fraction`` and
+        ``mean_pressure`` are evaluated (no stresses, coefficients or
+        stiffness Schur complements) and ``surface`` is empty: for timing
+        studies of the solve itself.
+        """
         self._apply_load(load, first)
         free = self._freedofs(load)
         histories = []
@@ -487,8 +493,13 @@ class CellProblem:
                     {"newton": histories})
         else:
             histories.append(self._newton(free, self.atol))
-        results = self.measure(load)
-        surface = self.surface_distribution()
+        if measure:
+            results = self.measure(load)
+            surface = self.surface_distribution()
+        else:
+            results = {"contact_fraction": self.contact_fraction(),
+                       "mean_pressure": float(self._contact_integral(self.pressure)) / self.area}
+            surface = {}
         return CellSolution(load=load, results=results, surface=surface, newton=histories,
                             coulomb_iterations=fp)
 
