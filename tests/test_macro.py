@@ -249,3 +249,100 @@ def test_axisymmetric_equals_3d_for_a_rotationally_symmetric_problem():
     coarse, fine = errors
     assert fine[0] < 0.025 and fine[1] < 0.015 and fine[2] < 0.005 and fine[3] < 0.005, fine
     assert fine[0] < coarse[0] and fine[2] < coarse[2] and fine[3] < coarse[3], (coarse, fine)
+
+
+def test_axisymmetric_order_one_on_the_axis_is_refused():
+    """Order 1 would evaluate u_r / r on the axis (edge-midpoint quadrature): a clear error instead of NaN."""
+    d = gm.FemurStemDims()
+    g = gm.femur_stem(d, maxh=0.02)
+    prob = M.MacroProblem(mesh=g.mesh, setting="axisymmetric", rough="stem", counter="bone",
+                          materials={"stem": isotropic(100e9, 0.3), "bone": isotropic(9e9, 0.27)},
+                          law=il.InterfaceLaw(normal=il.LinearLaw(kn=3.2e10)), order=1,
+                          supports=(M.Support(label="base"),))
+    with pytest.raises(ValueError, match="order >= 2"):
+        M.solve(prob)
+
+
+# ------------------------------------------------------------ scenes, driver
+ROOT = __import__("os").path.dirname(__import__("os").path.dirname(__import__("os").path.abspath(__file__)))
+
+
+def test_femur_stem_scene_runs_end_to_end(tmp_path):
+    """The README's main job: report keys, equilibrium, a detachment on the cone, files written."""
+    import json
+    import os
+    from ngcontact.cli import main
+    out = tmp_path / "femur"
+    assert main(["run", os.path.join(ROOT, "geometries", "femur_stem.toml"), "--out", str(out), "--quiet"]) == 0
+    rep = json.loads((out / "report.json").read_text())
+    res = rep["results"]
+    dims = res["dimensions"]
+    F = 1e6 * math.pi * dims["r_stem"] ** 2
+    assert abs(res["resultant"]["z"] + F) < 1e-6 * F
+    prof = res["interface"]
+    assert set(prof) == {"s", "r", "z", "pressure", "shear", "jump_n", "jump_t", "status"}
+    assert len({len(v) for v in prof.values()}) == 1
+    assert set(prof["status"]) <= {"open", "stick", "slip"} and "open" in prof["status"]
+    assert min(prof["pressure"]) >= 0.0
+    peak = res["maxima"]["pressure"]
+    assert peak["pressure"] == max(prof["pressure"])
+    # the over-reamed distal canal opens: the stem detaches on the cone, below mid-cone
+    assert res["detachment"]
+    for pt in res["detachment"]:
+        assert dims["z_tip"] < pt["z"] < dims["z_corner"]
+    assert res["maxima"]["von_mises"]["max"]["value"] > 0
+    for name in ("interface.csv", "interface.png", "stress.png", "stress.vtu"):
+        assert (out / name).is_file(), name
+    assert rep["solver"]["converged"]
+
+
+def test_scene_with_an_unknown_boundary_names_the_existing_ones():
+    import os
+    from ngcontact import scene as scene_mod
+    from ngcontact.drivers.macro import build_geometry, problem_of
+    from ngcontact.errors import SceneError
+    sc = scene_mod.load(os.path.join(ROOT, "geometries", "femur_stem.toml"))
+    bad = __import__("dataclasses").replace(sc.supports[0], boundary="floor")
+    sc = __import__("dataclasses").replace(sc, supports=(bad,) + sc.supports[1:])
+    with pytest.raises(SceneError, match=r"supports\[0\]\.boundary = 'floor'.*base.*interface"):
+        problem_of(sc, build_geometry(sc, maxh=0.02))
+
+
+def test_law_from_a_cell_is_its_bundle_with_the_cells_K0_and_is_cached(tmp_path, monkeypatch):
+    """Sawtooth cell (Example 27): bundle K0 = closed form; the second call reads the cache."""
+    import os
+    from ngcontact import cell_law
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
+    path = os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml")
+    law, info = cell_law.law_from_cell(path, dim=2)
+    assert not info["cached"] and len(os.listdir(tmp_path)) == 1
+    b1, b2 = math.radians(30), math.radians(60)
+    a2 = 1.0 / (math.sin(b2) / math.sin(b1) * math.cos(b1) + math.cos(b2))   # face lengths of one period
+    a1 = a2 * math.sin(b2) / math.sin(b1)
+    kn = 1e12
+    expected = kn * np.array([[a1 * math.cos(b1) ** 2 + a2 * math.cos(b2) ** 2,
+                               a1 * math.cos(b1) * math.sin(b1) - a2 * math.cos(b2) * math.sin(b2)],
+                              [0, a1 * math.sin(b1) ** 2 + a2 * math.sin(b2) ** 2]])
+    expected[1, 0] = expected[0, 1]
+    np.testing.assert_allclose(np.abs(law.matrix()), np.abs(expected), rtol=1e-10)
+    assert abs(law.matrix()[0, 1]) > 0.1 * kn   # the asymmetric valley couples n0 and t0
+    law2, info2 = cell_law.law_from_cell(path, dim=2)
+    assert info2["cached"] and law2 == law
+    lin, _ = cell_law.law_from_cell(path, dim=2, linear=True)
+    assert isinstance(lin, il.LinearLaw) and abs(lin.kn - expected[0, 0]) < 1e-10 * kn
+
+
+def test_block_on_a_sawtooth_cell_scene_transmits_the_load(tmp_path, monkeypatch):
+    """Macro scene taking its law from a cell: equilibrium and a closed interface."""
+    import os
+    from ngcontact import scene as scene_mod
+    from ngcontact.drivers.macro import run
+    from ngcontact.report import Clock
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
+    sc = scene_mod.load(os.path.join(ROOT, "geometries", "macro", "block_on_sawtooth.toml"))
+    out = run(sc, Clock())
+    L = sc.geometry.dimensions["length"]
+    R = out.results["resultant"]
+    assert abs(R["x"] - 2e6 * L) < 1e-8 * 2e6 * L and abs(R["y"] + 10e6 * L) < 1e-8 * 10e6 * L
+    assert "open" not in out.results["interface"]["status"]
+    assert out.results["law"]["directions"] == 2
