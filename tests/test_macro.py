@@ -346,3 +346,20 @@ def test_block_on_a_sawtooth_cell_scene_transmits_the_load(tmp_path, monkeypatch
     assert abs(R["x"] - 2e6 * L) < 1e-8 * 2e6 * L and abs(R["y"] + 10e6 * L) < 1e-8 * 10e6 * L
     assert "open" not in out.results["interface"]["status"]
     assert out.results["law"]["directions"] == 2
+
+
+def test_femur_law_from_the_hip_cell_is_the_papers_32_GPa(tmp_path, monkeypatch):
+    """The hip cell (square hills, a = 0.4, k_n = 200 GPa) gives k_n0 = 32 GPa (eq. 36) and the
+    femur solved with the cell's bundle equals the one with the explicit number."""
+    import os
+    from ngcontact import scene as scene_mod
+    from ngcontact.drivers.macro import build_geometry, problem_of, solve_scene
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
+    pressures = []
+    for path in (("femur_stem.toml",), ("macro", "femur_stem_from_cell.toml")):
+        sc = scene_mod.load(os.path.join(ROOT, "geometries", *path))
+        geo = build_geometry(sc, maxh=0.008, interface_maxh=0.004)
+        prob, info = problem_of(sc, geo, order=2)
+        np.testing.assert_allclose(info["full_contact_K0"], [[32e9, 0.0], [0.0, 0.0]], rtol=1e-12, atol=1e-3)
+        pressures.append(M.interface_profile(solve_scene(sc, prob))["pressure"])
+    np.testing.assert_allclose(pressures[1], pressures[0], rtol=1e-9, atol=1e-9 * pressures[0].max())
