@@ -204,7 +204,7 @@ def plot_fields(path: str, sol: M.MacroSolution, fields: dict) -> None:
             vals[n].append(np.asarray(fields[n](mips)).ravel())
     x, y = np.concatenate(xs) * 1e3, np.concatenate(ys) * 1e3
     tri = Triangulation(x, y, np.arange(len(x)).reshape(-1, 3))
-    fig, axes = plt.subplots(1, 4, figsize=(16, 6))
+    fig, axes = plt.subplots(1, 4, figsize=(11, 7))
     for ax, n in zip(axes, names):
         v = np.concatenate(vals[n])
         scale, unit = (1.0, "-") if n == "von_mises_strain" else (1e-6, "MPa")
