@@ -58,9 +58,10 @@ of ``S_C``.
 Effective stiffness (beyond the paper, DESIGN Sec. 3): with ``S`` the Schur
 complement of the tangent on ``U`` divided by ``|T|`` (the tangent of the
 mean traction with respect to the far faces' relative displacement) and
-``S_b`` the same for the cell with the interface bonded, the interface's
-compliance is ``S^-1 - S_b^-1`` and the effective stiffness its inverse,
-``K_eff = S_b (S_b - S)^-1 S``.
+``S_0`` the same for the flat bonded laminate of the same thickness
+(analytic, :meth:`CellProblem.reference_stiffness`), the interface's
+compliance is ``S^-1 - S_0^-1`` (penalty layer plus asperities) and the
+effective stiffness its inverse.
 """
 from __future__ import annotations
 
@@ -273,7 +274,6 @@ class CellProblem:
         nE = 1 if dim == 2 else 3
         self.strain_params = [ng.Parameter(0.0) for _ in range(nE)]
         self.tangential_free = self._tangential_determinate()
-        self._bonded = None
         self._previous = None
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
@@ -317,7 +317,9 @@ class CellProblem:
 
     def _energy(self, ur, uc, U, trial):
         m, mesh = self.model, self.mesh
-        form = ng.BilinearForm(self.X, symmetric=True, symmetric_storage=True)
+        # UMFPACK reads only one triangle of a symmetric-storage matrix: full storage for it
+        form = ng.BilinearForm(self.X, symmetric=True,
+                               symmetric_storage=self.inverse == "sparsecholesky")
         for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
             eps = self.body_strain(u)
             form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
@@ -723,52 +725,68 @@ class CellProblem:
                 S[i, j] = y[di] - z[di]
         return 0.5 * (S + S.T)
 
-    def bonded_stiffness(self) -> np.ndarray:
-        """``S_b``: stiffness of the same cell with the interface bonded (per ``|T|``)."""
-        if self._bonded is None:
-            mesh, m, d = self.mesh, self.model, self.dim
-            V = ng.Periodic(ng.VectorH1(mesh, order=m.order, dirichlet="bottom|top"))
-            N = ng.NumberSpace(mesh)
-            Xb = ng.FESpace([V] + [N] * d)
-            tr = Xb.TrialFunction()
-            u, U = tr[0], tr[1:]
-            H = self.cell.h_rough + self.cell.h_counter
-            # lifting U psi(y), psi = (y + h_rough)/H: strain sym(U (x) grad psi)
-            cols = [[0] * 3 for _ in range(3)]
-            for i in range(d):
-                a = U[i] / H
-                if i == d - 1:
-                    cols[i][i] = a
-                else:
-                    cols[i][d - 1] = cols[d - 1][i] = 0.5 * a
-            epsU = ng.CF(tuple(cols[i][j] for i in range(3) for j in range(3)), dims=(3, 3))
-            fb = ng.BilinearForm(Xb, symmetric=True)
-            for name, law in (("rough", m.rough), ("counter", m.counter)):
-                eps = _el.strain(u, self.setting) + epsU
-                fb += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
-                                   * ng.dx(definedon=mesh.Materials(name)))
-            g = ng.GridFunction(Xb)
-            dofs = [Xb.Range(1 + i).start for i in range(d)]
-            self._bonded = self._schur_on_U(fb, Xb, dofs, g.vec) / self.area
-        return self._bonded
+    def reference_stiffness(self) -> np.ndarray:
+        """``S_0``: far-face stiffness of the flat bonded laminate of the same thickness.
+
+        Both bodies, each with its own law, stacked flat with the interface in
+        the summit plane (``rough`` below it over ``h_rough``, ``counter``
+        above over ``h_counter``) and bonded.  Under a mean traction each
+        layer is in a uniform state ``eps = sym(a (x) n0)`` with
+        ``t = A a``, ``A_ik = C_ijkl n0_j n0_l`` (the acoustic tensor), so
+        the far-face jump is ``sum_L h_L A_L^-1 t`` and
+
+            S_0 = (h_rough A_rough^-1 + h_counter A_counter^-1)^-1,
+
+        in the components ``(t0[, t1], n0)`` (per ``|T|``).
+        """
+        d = self.dim
+        idx = list(range(d))  # mesh axes; n0 is the last one
+        C = 0.0
+        for law, h in ((self.model.rough, self.cell.h_rough), (self.model.counter, self.cell.h_counter)):
+            A = _acoustic_tensor(law, normal_axis=d - 1)[np.ix_(idx, idx)]
+            C = C + h * np.linalg.inv(A)
+        return np.linalg.inv(C)
 
     def tangent_stiffness(self) -> np.ndarray:
         """``S``: tangent of the mean far-face traction w.r.t. the far-face jump (per ``|T|``)."""
         return self._schur_on_U(self.form, self.X, self.u_dofs, self.gfu.vec) / self.area
 
     def effective_stiffness(self) -> dict:
-        """Interface stiffness with asperity compliance: ``(S^-1 - S_b^-1)^-1``.
+        """Interface stiffness with asperity compliance: ``(S^-1 - S_0^-1)^-1``.
 
-        Restricted to the components that are determinate (all but the
-        tangential ones of a frictionless flat interface).
+        ``S`` is the tangent far-face stiffness of the cell, ``S_0`` that of
+        the flat bonded laminate (:meth:`reference_stiffness`); their
+        compliance difference is the interface's share: penalty layer plus
+        the compliance of the asperities (constriction), which stays finite
+        as ``k_n -> infinity`` (DESIGN Sec. 3).  Restricted to the components
+        that are determinate (all but the tangential ones of a frictionless
+        flat interface).  ``matrix`` is ``None`` when the interface
+        compliance is singular (e.g. a component the interface does not
+        resist beyond the bulk).
         """
         keep = [i for i in range(self.dim) if i == self.dim - 1 or self.tangential_free]
         names = (["t0"] if self.dim == 2 else ["t1", "t2"]) + ["n0"]
         S = self.tangent_stiffness()[np.ix_(keep, keep)]
-        Sb = self.bonded_stiffness()[np.ix_(keep, keep)]
-        K = Sb @ np.linalg.solve(Sb - S, S)
-        return {"components": [names[i] for i in keep], "matrix": (0.5 * (K + K.T)).tolist(),
-                "total": S.tolist(), "bonded": Sb.tolist()}
+        S0 = self.reference_stiffness()[np.ix_(keep, keep)]
+        compliance = np.linalg.inv(S) - np.linalg.inv(S0)
+        compliance = 0.5 * (compliance + compliance.T)
+        if np.linalg.cond(compliance) > 1e12:
+            K = None
+        else:
+            K = np.linalg.inv(compliance)
+            K = (0.5 * (K + K.T)).tolist()
+        return {"components": [names[i] for i in keep], "matrix": K,
+                "compliance": compliance.tolist(), "total": S.tolist(), "reference": S0.tolist()}
+
+
+def _acoustic_tensor(law, normal_axis: int) -> np.ndarray:
+    """``A_ik = C_ijkl n_j n_l`` for ``n = e_normal_axis`` (3x3, from the Voigt matrix)."""
+    C = law.matrix
+    voigt = {}
+    for k, (i, j) in enumerate(_mat.VOIGT_PAIRS):
+        voigt[i, j] = voigt[j, i] = k
+    m = normal_axis
+    return np.array([[C[voigt[i, m], voigt[k, m]] for k in range(3)] for i in range(3)])
 
 
 def solve_cell(cell, model: CellModel, loads, **newton) -> list:

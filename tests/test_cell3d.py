@@ -69,3 +69,27 @@ def test_pressure_balances_the_load(hip):
     assert sol.results["mean_pressure"] == pytest.approx(PRESSURE, rel=1e-8)
     assert sol.results["transmitted_pressure"] == pytest.approx(PRESSURE, rel=1e-12)
     assert sol.iterations <= 10
+
+
+def test_effective_stiffness_stays_finite_as_kn_grows():
+    """Interface compliance = penalty part ~ 1/k_n + asperity part (finite as k_n -> oo).
+
+    The reference is the flat bonded laminate, so the hills' own compliance
+    remains when the penalty goes to infinity (DESIGN Sec. 3): the compliance
+    decrements shrink tenfold per decade of ``k_n`` and the stiffness
+    converges to a finite value.
+    """
+    cell = square_hills_cell(0.4, 0.2, period=1.0, arrangement="summit", h_rough=0.5,
+                             h_counter=0.5, maxh=0.25)
+    law = isotropic(110e9, 0.3)
+    comp = []
+    for kn in (2e12, 2e13, 2e14):
+        P = CellProblem(cell, CellModel(rough=law, counter=law, k_n=kn, order=2))
+        (sol,) = P.sweep([cell_load(3, pressure=PRESSURE)])
+        comp.append(sol.results["effective_stiffness"]["compliance"][0][0])
+    d1, d2 = comp[0] - comp[1], comp[1] - comp[2]
+    assert d1 > 0 and d2 > 0
+    assert d1 / d2 == pytest.approx(10.0, rel=0.1), f"decrement ratio {d1 / d2:.3f}, expected ~10"
+    asperity = comp[2] - d2 / 9.0          # geometric-series limit k_n -> infinity
+    assert asperity > 0.5 * comp[2], "the asperity compliance must dominate at k_n = 2e14"
+    assert 1.0 / asperity < 2 * (1.0 / comp[2])
