@@ -58,9 +58,22 @@ def strain_of_gradient(G, u, setting: str):
     _check_setting(setting)
     if setting == "3d":
         return ng.Sym(G)
-    hoop = u[0] / ng.x if setting == "axisymmetric" else 0
+    hoop = u[0] / radius() if setting == "axisymmetric" else 0
     exy = 0.5 * (G[0, 1] + G[1, 0])
     return ng.CF((G[0, 0], exy, 0, exy, G[1, 1], 0, 0, 0, hoop), dims=(3, 3))
+
+
+#: Floor of the radius in the hoop strain ``u_r / r``.  Quadrature rules may
+#: sample points on the axis (e.g. edge midpoints at order 2), where ``u_r = 0``
+#: makes ``u_r / r`` a 0/0.  With ``r`` floored there, ``u_r / r = 0`` and, the
+#: measure weight ``2 pi r`` being 0, every derivative of the energy stays
+#: finite (``1/R_FLOOR^2`` is still representable).
+R_FLOOR = 1e-100
+
+
+def radius():
+    """``r = x`` floored at :data:`R_FLOOR` (points exactly on the axis)."""
+    return ng.IfPos(ng.x - R_FLOOR, ng.x, R_FLOOR)
 
 
 def weight(setting: str):
