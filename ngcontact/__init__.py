@@ -13,5 +13,6 @@ except PackageNotFoundError:  # running from a source tree
 
 from .errors import ConvergenceError, NgcontactError, SceneError  # noqa: E402
 from .scene import load  # noqa: E402
+from .runner import solve  # noqa: E402
 
-__all__ = ["ConvergenceError", "NgcontactError", "SceneError", "load", "__version__"]
+__all__ = ["ConvergenceError", "NgcontactError", "SceneError", "load", "solve", "__version__"]

@@ -10,7 +10,6 @@ failure; every failure prints one line on stderr and leaves no output behind.
 from __future__ import annotations
 
 import argparse
-import importlib
 import logging
 import os
 import sys
@@ -67,7 +66,8 @@ def _check(path: str) -> int:
 
 
 def _run(path: str, out: str | None, quiet: bool) -> int:
-    from .report import Clock, build_report, ensure_writable, write_outputs
+    from .report import ensure_writable, write_outputs
+    from .runner import solve
 
     try:
         sc = scene_mod.load(path)
@@ -79,14 +79,8 @@ def _run(path: str, out: str | None, quiet: bool) -> int:
     except OutputError as exc:
         return _fail(EXIT_SCENE, str(exc))
     progress = None if quiet else (lambda line: print(line, file=sys.stderr, flush=True))
-    clock = Clock(progress)
-    module, func = scene_mod.KINDS[sc.kind].runner.split(":")
-    runner = getattr(importlib.import_module(module), func)
     try:
-        outcome = runner(sc, clock)
-        report = build_report(kind=sc.kind, title=getattr(sc, "title", ""),
-                              scene=scene_mod.as_dict(sc), effects=scene_mod.effects(sc),
-                              outcome=outcome, timings=clock.total(), version=__version__)
+        report, outcome = solve(sc, progress)
         write_outputs(out, report, outcome)
     except SceneError as exc:
         return _fail(EXIT_SCENE, f"{path}: {exc}")

@@ -1,0 +1,56 @@
+"""Every shipped scene is valid, and runs end to end to a report of finite numbers.
+
+Validation is in the default tier; the full runs (the shipped settings, some
+of them 3D) are in the slow tier, which CI runs after the default one.
+"""
+import glob
+import json
+import math
+import os
+
+import pytest
+
+from ngcontact import cli, scene
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCENES = sorted(glob.glob(os.path.join(ROOT, "geometries", "**", "*.toml"), recursive=True))
+IDS = [os.path.relpath(p, os.path.join(ROOT, "geometries")) for p in SCENES]
+
+
+def test_scenes_are_shipped():
+    assert len(SCENES) >= 10
+
+
+@pytest.mark.parametrize("path", SCENES, ids=IDS)
+def test_scene_is_valid_and_names_its_effects(path):
+    sc = scene.load(path)
+    effects = scene.effects(sc)
+    assert effects, f"{path}: a scene must call for at least one effect"
+    assert len(set(effects)) == len(effects)
+
+
+def _numbers(obj, where="report"):
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            yield from _numbers(v, f"{where}.{k}")
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj):
+            yield from _numbers(v, f"{where}[{i}]")
+    elif isinstance(obj, float):
+        yield where, obj
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", SCENES, ids=IDS)
+def test_scene_runs_to_a_finite_report(path, tmp_path, monkeypatch):
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))
+    out = tmp_path / "out"
+    assert cli.main(["run", path, "--out", str(out), "--quiet"]) == 0
+    rep = json.loads((out / "report.json").read_text())
+    sc = scene.load(path)
+    assert rep["kind"] == sc.kind
+    assert rep["effects"] == list(scene.effects(sc))
+    bad = [w for w, x in _numbers(rep) if not math.isfinite(x)]
+    assert not bad, f"non-finite numbers at {bad[:5]}"
+    for name in rep["files"]:
+        assert (out / name).is_file(), f"{name} listed but not written"
