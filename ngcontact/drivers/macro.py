@@ -153,6 +153,14 @@ def run(scene, clock) -> Outcome:
         results["maxima"] = maxima
     vtk = {"stress": VtkField(mesh=geo.mesh, fields=dict(fields, u_rough=sol.u_rough, u_counter=sol.u_counter),
                               subdivision=scene.output.vtk_subdivision)}
+    if scene.strength is not None:
+        from .strength import evaluate
+        with clock.stage("strength check"):
+            st = evaluate(scene, sol)
+        results["strength"] = st["results"]
+        tables["strength_map"] = st["table"]
+        vtk["worst_cell"] = st["vtk"]
+        plots.update(st["plots"])
     newton = sol.history["newton"]
     solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],
               "linear_solve_only": sol.history["quadratic"],

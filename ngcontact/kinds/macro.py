@@ -9,6 +9,19 @@ law comes from explicit numbers (``linear`` K0, ``bundle`` of directions,
 ``interface.cell`` (its direction bundle, computed on the fly and cached on
 disk; see :mod:`ngcontact.cell_law`), with homogenized friction on top.
 Lengths in metres, stresses in pascals, interface stiffnesses in Pa/m.
+
+Two optional sections extend the macro solve (this kind rather than new kinds,
+because both act on a macro solution and share its geometry, law and output):
+
+* ``[two_scale]``: the coupling loop of paper Sec. 3.5
+  (:mod:`ngcontact.twoscale`): the scene's interface law is the start (the
+  assumed contact set), and the cell named there, solved at the macro
+  pressure of every interface point (through an adaptive table in the
+  pressure), supplies coefficients that vary along the interface until the
+  macro normal stress stops changing;
+* ``[strength]``: micro stresses in the layer and the check of paper eq. 78
+  (:mod:`ngcontact.strength`) against ``materials.NAME.sigma_u`` of both
+  bodies.
 """
 from __future__ import annotations
 
@@ -189,6 +202,43 @@ class OutputSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class StrengthSpec:
+    """Micro-stress recovery in the interface layer and the strength check (paper eqs. 74-78)."""
+
+    cell: str = param(doc="cell scene (kind cell) of the layer, relative to this scene; its [load] is "
+                      "not used (the macro state loads it); its bodies are this scene's rough and counter")
+    criterion: str = param("von_mises", doc="equivalent stress of eq. 77", choices=("von_mises", "tresca"))
+    recovery: str = param("linear", doc="linear: unit-load correctors with the contact set fixed (the "
+                          "cell's points without gap), superposed at every interface point (eq. 75); "
+                          "nonlinear: in addition the contact cell problem solved at the macro state of "
+                          "the nonlinear_points interface points with the largest linear estimate",
+                          choices=("linear", "nonlinear"))
+    nonlinear_points: int = param(3, doc="interface points re-solved with the contact cell problem "
+                                  "(recovery = nonlinear)", check=at_least(1))
+    tangential_stiffness: float | None = param(
+        None, doc="k_t on the contact set in the linear recovery (sticking summits carry the shear); "
+        "default: the cell's k_n when the macro law has friction, else 0 (no shear carried)",
+        units="Pa/m", check=nonnegative())
+
+
+@dataclass(frozen=True, kw_only=True)
+class TwoScaleSpec:
+    """The two-scale coupling loop (paper Sec. 3.5)."""
+
+    cell: str = param(doc="cell scene (kind cell) solved at the macro pressures, relative to this scene; "
+                      "lengths in cell_length_unit, its [load] is not used")
+    cell_length_unit: float = param(1.0, doc="length of one unit of the cell scene (scales its gap terms)",
+                                    units="m", check=positive())
+    tol: float = param(doc="stop when max |sigma_n(k) - sigma_n(k-1)| over the interface points is below",
+                       units="Pa", check=positive())
+    max_iter: int = param(20, doc="largest number of coefficient updates", check=at_least(1))
+    table_tol: float = param(0.01, doc="interpolation tolerance of the cell table: the contact fraction "
+                             "and g_n0 / max g_n0 at interval midpoints", check=positive())
+    table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
+                             "(below it the coefficients are held constant)", check=positive())
+
+
+@dataclass(frozen=True, kw_only=True)
 class MacroScene:
     kind: str = param(doc="problem type", choices=("macro",))
     title: str = param("", doc="free text shown in the report")
@@ -201,6 +251,8 @@ class MacroScene:
     discretization: Discretization = param(Discretization(), doc="mesh and order")
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     output: OutputSpec = param(OutputSpec(), doc="result sampling")
+    two_scale: TwoScaleSpec | None = param(None, doc="[two_scale]: coupling loop with a cell (Sec. 3.5)")
+    strength: StrengthSpec | None = param(None, doc="[strength]: micro stresses and the check of eq. 78")
     base_dir: str = base_dir_field()
 
     def check(self, path: str) -> None:
@@ -221,13 +273,26 @@ class MacroScene:
                 raise SceneError(f"loads[{i}].traction", load.traction, f"must have {dim} components")
         if self.interface.gap_coordinate == "z" and dim == 2 and self.geometry.setting != "axisymmetric":
             raise SceneError("interface.gap_coordinate", "z", "plane strain has coordinates x, y")
+        for key in ("strength", "two_scale"):
+            if getattr(self, key) is not None and dim == 3:
+                raise SceneError(f"{key}", "...", "available for plane strain and axisymmetric macro problems")
+        if self.strength is not None:
+            for role in ("rough", "counter"):
+                name = getattr(self.bodies, role)
+                if self.materials[name].sigma_u is None:
+                    raise SceneError(f"materials.{name}.sigma_u", MISSING,
+                                     f"the ultimate stress of the {role} body is required by [strength]; "
+                                     "a number > 0 [Pa]")
 
     def check_files(self) -> None:
-        if self.interface.cell is not None:
-            import os
-            from ..scene import resolve
-            if not os.path.isfile(resolve(self, self.interface.cell)):
-                raise SceneError("interface.cell", self.interface.cell, "no such cell scene file")
+        import os
+        from ..scene import resolve
+        files = (("interface.cell", self.interface.cell),
+                 ("strength.cell", self.strength.cell if self.strength else None),
+                 ("two_scale.cell", self.two_scale.cell if self.two_scale else None))
+        for key, rel in files:
+            if rel is not None and not os.path.isfile(resolve(self, rel)):
+                raise SceneError(key, rel, "no such cell scene file")
 
 
 def effects(scene: MacroScene) -> tuple[str, ...]:
@@ -244,6 +309,10 @@ def effects(scene: MacroScene) -> tuple[str, ...]:
         out.append("surface_loads")
     if any(any(s.displacement) for s in scene.supports):
         out.append("prescribed_displacement")
+    if scene.two_scale is not None:
+        out.append("two_scale_coupling")
+    if scene.strength is not None:
+        out.append("strength_check")
     return tuple(out)
 
 
