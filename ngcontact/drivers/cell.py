@@ -18,7 +18,7 @@ from ..cell import CellModel, CellProblem, Friction
 import numpy as np
 
 from ..homogenize import coefficients
-from ..kinds.cell import GAP_PROFILES, loads
+from ..kinds.cell import GAP_PROFILES, loads, small_slope
 from ..report import Outcome, VtkField
 from ..scene import resolve
 
@@ -33,6 +33,15 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
     order = order or d.order
     if g.dim == 3:
         from ..geometry import cell3d
+        if g.profile in GAP_PROFILES and not small_slope(g):
+            if g.profile == "bisinusoid":
+                heights = cell3d.bisinusoid_heights(g.amplitude, g.period)
+            else:
+                from ..geometry.tabulated import read_height_map
+                heights = read_height_map(resolve(scene, g.file), path="geometry.file")
+            return cell3d.surface_cell(heights, period=g.period, h_rough=g.h_rough,
+                                       h_counter=g.h_counter, maxh=maxh, interface_maxh=ih,
+                                       order=order)
         if g.profile != "square_hills":  # flat, or a small-slope profile carried by the gap
             return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih)
         return cell3d.square_hills_cell(g.width, g.depth, period=g.period, arrangement=g.arrangement,
@@ -71,7 +80,7 @@ def gap_cf(scene):
 
 def _profile_gap(scene):
     g = scene.geometry
-    if g.profile not in GAP_PROFILES:
+    if not small_slope(g):
         return None
     from ..geometry import cell3d
     if g.profile == "bisinusoid":

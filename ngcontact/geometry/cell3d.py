@@ -22,11 +22,16 @@ Faces are named after meshing from the domains on either side of each face
 Free-form surfaces
 ------------------
 CSG composes solids from primitives with closed-form surfaces and cannot
-express a bisinusoid or a sampled height map.  For those, this module gives
-the small-slope model instead: the flat cell (:func:`flat_cell3d`) plus the
-initial gap ``g(x, y) >= 0`` between the summit plane and the rough surface
-(:func:`bisinusoid_gap`, :func:`height_map_gap`).  A resolved free-form cell
-with Netgen's OCC kernel was not attempted within this module.
+express a bisinusoid or a sampled height map.  For those two shapes -- and
+only those -- the cell is built with Netgen's OCC kernel instead
+(:func:`surface_cell`): a B-spline surface interpolating the heights on a
+periodic grid splits the box into the two bodies (``Glue``), the conforming
+arrangement (the counter body fills the valleys, the whole surface is
+``contact``), with the lateral faces identified periodically.  The summit
+arrangement of a free-form surface is represented by the small-slope model:
+the flat cell (:func:`flat_cell3d`) plus the initial gap ``g(x, y) >= 0``
+between the summit plane and the rough surface (:func:`bisinusoid_gap`,
+:func:`height_map_gap`).
 """
 from __future__ import annotations
 
@@ -171,6 +176,92 @@ def square_hills_cell(side: float, height: float, *, period: float = 1.0,
     geo.PeriodicSurfaces(xm, xp)
     geo.PeriodicSurfaces(ym, yp)
     return _mesh(geo, maxh, P, hr, hc)
+
+
+# ------------------------------------------------ free-form surfaces (OCC)
+def bisinusoid_heights(amplitude: float, period: float = 1.0, samples: int = 33) -> np.ndarray:
+    """Heights ``A (cos(2 pi x/P) + cos(2 pi y/P) - 2)`` on a ``samples x samples`` periodic grid.
+
+    Same layout as a height map: ``H[i, j]`` at ``x = j P/(n - 1)``,
+    ``y = i P/(n - 1)``; the last row and column repeat the first.
+    """
+    A, P = _positive("geometry.amplitude", amplitude), _positive("geometry.period", period)
+    t = np.linspace(0.0, P, int(samples))
+    X, Y = np.meshgrid(t, t)
+    k = 2 * math.pi / P
+    return A * (np.cos(k * X) + np.cos(k * Y) - 2.0)
+
+
+def surface_cell(heights, *, period: float = 1.0, h_rough: float, h_counter: float,
+                 maxh: float, interface_maxh: float | None = None, order: int = 1) -> Cell:
+    """Conforming cell whose bodies meet along a periodic free-form surface (OCC).
+
+    Parameters
+    ----------
+    heights
+        ``H[i, j]``, the height at ``x = j P/(n_x - 1)``, ``y = i P/(n_y - 1)``
+        with the last row and column repeating the first (validated by
+        :func:`ngcontact.geometry.tabulated.check_height_map`).  The surface is
+        shifted so that its highest summit lies at ``z = 0``.
+    period
+        ``P``, the cell period in ``x`` and ``y``.
+    h_rough, h_counter
+        The far faces lie at ``z = -h_rough`` and ``z = h_counter``; the
+        surface must stay strictly between them.
+    maxh, interface_maxh
+        Mesh sizes in the bodies and on the surface.
+    order
+        Geometry order of the curved elements.
+
+    Notes
+    -----
+    The surface is the B-spline interpolating the grid points
+    (``netgen.occ.SplineSurfaceInterpolation``).  Its boundary curves on
+    ``x = 0`` and ``x = P`` interpolate identical data and therefore coincide
+    after the shift by ``P``, which makes the periodic identification of the
+    lateral faces exact.
+    """
+    import netgen.occ as occ
+    from .tabulated import check_height_map
+
+    P = _positive("geometry.period", period)
+    hr, hc = _positive("geometry.h_rough", h_rough), _positive("geometry.h_counter", h_counter)
+    H = check_height_map(heights, path="geometry.heights")
+    H = H - H.max()
+    if -H.min() >= hr:
+        raise SceneError("geometry.h_rough", hr, f"must exceed the roughness depth {float(-H.min())!r}")
+    ny, nx = H.shape
+    xs, ys = np.linspace(0.0, P, nx), np.linspace(0.0, P, ny)
+    X, Y = np.meshgrid(xs, ys)
+    # first surface parameter along x, second along y
+    pts = np.ascontiguousarray(np.stack([X.T, Y.T, H.T], axis=-1))
+    surface = occ.SplineSurfaceInterpolation(pts)
+    if interface_maxh:
+        surface.maxh = _positive("discretization.interface_maxh", interface_maxh)
+    box = occ.Box(occ.Pnt(0, 0, -hr), occ.Pnt(P, P, hc))
+    box.faces.Min(occ.X).Identify(box.faces.Max(occ.X), "periodic_x", occ.IdentificationType.PERIODIC)
+    box.faces.Min(occ.Y).Identify(box.faces.Max(occ.Y), "periodic_y", occ.IdentificationType.PERIODIC)
+    shape = occ.Glue([box, surface])
+    solids = sorted(shape.solids, key=lambda sol: sol.center.z)
+    if len(solids) != 2:
+        raise ValueError(f"the surface split the cell into {len(solids)} solids, expected 2")
+    solids[0].mat("rough")
+    solids[1].mat("counter")
+    for f in shape.faces:
+        c = f.center
+        if abs(c.z + hr) < 1e-9 * max(1.0, hr):
+            f.name = "bottom"
+        elif abs(c.z - hc) < 1e-9 * max(1.0, hc):
+            f.name = "top"
+        elif min(abs(c.x), abs(c.x - P), abs(c.y), abs(c.y - P)) < 1e-12 * max(1.0, P):
+            f.name = "periodic"
+        else:
+            f.name = "contact"
+    mesh = ng.Mesh(occ.OCCGeometry(shape).GenerateMesh(maxh=_positive("discretization.maxh", maxh)))
+    if order > 1:
+        mesh.Curve(order)
+    log.debug("OCC surface cell: %d elements", mesh.ne)
+    return Cell(mesh=mesh, dim=3, period=(P, P), h_rough=hr, h_counter=hc)
 
 
 # ----------------------------------------------------- small-slope models

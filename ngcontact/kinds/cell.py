@@ -20,8 +20,10 @@ from ..schema import at_least, nonempty, nonnegative, open_interval, param, posi
 
 PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
 PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map")
-#: 3D profiles represented by the small-slope model: a flat mesh interface
-#: whose initial gap is the height below the highest summit.
+#: 3D free-form profiles: meshed as the real surface with Netgen's OCC kernel
+#: in the conforming arrangement; in the summit arrangement represented by the
+#: small-slope model (a flat interface whose initial gap is the height below
+#: the highest summit).
 GAP_PROFILES = ("bisinusoid", "height_map")
 GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 FRICTION = ("none", "tresca", "coulomb")
@@ -33,7 +35,9 @@ class CellGeometry:
 
     profile: str = param(doc="roughness profile", choices=PROFILES_2D + PROFILES_3D)
     arrangement: str = param("conforming", doc="counter body fills the valleys (conforming) or "
-                             "touches the summits only (summit)", choices=("conforming", "summit"))
+                             "touches the summits only (summit; for bisinusoid and height_map the "
+                             "small-slope model: a flat interface with the heights as initial gap)",
+                             choices=("conforming", "summit"))
     period: float = param(1.0, doc="cell period |T| (per tangential direction)", units="m",
                           check=positive())
     h_rough: float = param(1.0, doc="depth of the rough body below the summits", units="m",
@@ -67,10 +71,6 @@ class CellGeometry:
     def check(self, path: str) -> None:
         need = self._USES[self.profile]
         allowed = need + self._OPTIONAL.get(self.profile, ())
-        if self.profile in GAP_PROFILES and self.arrangement != "summit":
-            raise SceneError(f"{path}.arrangement", self.arrangement,
-                             f"profile = {self.profile!r} is modelled as a flat counter face touching "
-                             "the summits (small-slope model): set arrangement = 'summit'")
         for key in ("width", "depth", "radius", "angles", "amplitude", "file"):
             value = getattr(self, key)
             if key in need and value is None:
@@ -230,6 +230,11 @@ class CellScene:
             raise SceneError("load", "...", str(exc)) from None
 
 
+def small_slope(geometry: CellGeometry) -> bool:
+    """A free-form 3D profile in the summit arrangement: flat interface plus gap."""
+    return geometry.profile in GAP_PROFILES and geometry.arrangement == "summit"
+
+
 def loads(scene: CellScene) -> list:
     """The sweep of :class:`ngcontact.cell.CellLoad` described by ``scene.load``."""
     from ..cell import cell_load
@@ -267,7 +272,7 @@ def effects(scene: CellScene) -> tuple[str, ...]:
     if scene.contact.geometric_only:
         return ("contact_surface_coefficients",)
     out = ["elasticity", "normal_contact"]
-    if scene.contact.gap.kind != "none" or scene.geometry.profile in GAP_PROFILES:
+    if scene.contact.gap.kind != "none" or small_slope(scene.geometry):
         out.append("gap")
     if scene.contact.friction != "none":
         out.append(f"{scene.contact.friction}_friction")
