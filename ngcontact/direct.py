@@ -164,13 +164,28 @@ class DirectSolution:
 
 # ------------------------------------------------------------------ model
 def _spaces(problem: DirectProblem):
+    """Compound space of the two bodies with the Dirichlet flags of the supports.
+
+    Labels fixed in every component use ``dirichlet``, the others the
+    component-wise flags; ``Periodic`` keeps only the former (NGSolve drops
+    component-wise flags when it wraps the space), so a periodic problem
+    accepts only supports that fix every component.
+    """
     mesh = problem.mesh
     comps = COMPONENTS[problem.setting]
-    fixed = {c: [] for c in comps}
+    full, partial = [], {c: [] for c in comps}
     for s in problem.supports:
-        for c in (s.components or comps):
-            fixed[c].append(s.label)
-    kw = {f"dirichlet{'xyz'[i]}": "|".join(fixed[c]) for i, c in enumerate(comps) if fixed[c]}
+        if not s.components or set(s.components) == set(comps):
+            full.append(s.label)
+        else:
+            if problem.periodic:
+                raise ValueError(f"support on {s.label!r}: a periodic problem takes supports that fix "
+                                 "every component")
+            for c in s.components:
+                partial[c].append(s.label)
+    kw = {f"dirichlet{'xyz'[i]}": "|".join(partial[c] + full) for i, c in enumerate(comps) if partial[c]}
+    if full:
+        kw["dirichlet"] = "|".join(full)
     spaces = []
     for name in ("rough", "counter"):
         V = ng.VectorH1(mesh, order=problem.order, definedon=mesh.Materials(name), **kw)
