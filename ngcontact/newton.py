@@ -8,7 +8,8 @@ Contact and elasticity are written as one energy ``Pi(u)`` (NGSolve
 
     Pi(u - alpha du) <= Pi(u) - c alpha (du . r(u)),   c = 1e-4,
 
-and yields finite numbers.  The iteration stops when the residual (free
+and yields a finite energy and a finite residual (otherwise the step is
+halved: NaN or Inf never enter the iterate).  The iteration stops when the residual (free
 dofs) has fallen below ``rtol`` times the first residual, or below ``atol``.
 A quadratic energy is minimized by a single linear solve.
 
@@ -137,10 +138,12 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
             trial.data = gfu.vec - alpha * du
             e_new = form.Energy(trial)
             finite = math.isfinite(e_new)
-            if quadratic and finite:
-                break
-            if finite and e_new <= energy - ARMIJO * alpha * slope + 1e-14 * abs(energy):
-                break
+            accept = finite and (quadratic or e_new <= energy - ARMIJO * alpha * slope + 1e-14 * abs(energy))
+            if accept:
+                r_new = residual(trial)        # a finite energy can still have a non-finite gradient
+                if math.isfinite(r_new):
+                    break
+                log.debug("newton %d: non-finite residual at alpha = %g, backtracking", it, alpha)
             alpha *= 0.5
             if alpha < MIN_STEP:
                 hist.steps.append(0.0)
@@ -149,16 +152,13 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
                     f"(residual {rnorm:.3e}); the tangent may be wrong or the problem unbounded",
                     hist.as_dict())
         gfu.vec.data = trial
-        energy = e_new
-        rnorm = residual(gfu.vec)
+        energy, rnorm = e_new, r_new
         hist.steps.append(alpha)
         hist.energies.append(energy)
         hist.residuals.append(rnorm)
         log.debug("newton %d: |r| = %.3e, energy = %.6e, alpha = %g", it, rnorm, energy, alpha)
         if callback is not None:
             callback(it, gfu)
-        if not math.isfinite(rnorm):
-            raise ConvergenceError(f"Newton step {it}: non-finite residual", hist.as_dict())
         if rnorm <= max(rtol * r0, atol):
             hist.converged = True
             return hist
