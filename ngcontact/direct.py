@@ -420,15 +420,17 @@ def probe(mesh, u, points) -> np.ndarray:
     return np.array([np.asarray(u(mesh(float(x), float(y)))).ravel() for x, y in pts])
 
 
-def contact_force(sol: DirectSolution, x_range=None) -> np.ndarray:
+def contact_force(sol: DirectSolution, x_range=None, part=None) -> np.ndarray:
     """Force the counter body receives through ``S_C^eps`` (or its part with ``x`` in ``x_range``).
 
     ``int p n w ds`` with the pressure ``p`` (compression positive) and the
     micro normal ``n`` from rough into counter (friction not included).
+    ``part``: an indicator CoefficientFunction of the part instead of
+    ``x_range``.
     """
     p = sol.problem
     mesh = p.mesh
-    ind = ng.CF(1.0)
+    ind = ng.CF(1.0) if part is None else part
     if x_range is not None:
         ind = ng.IfPos(ng.x - x_range[0], 1.0, 0.0) * ng.IfPos(x_range[1] - ng.x, 1.0, 0.0)
     w = elasticity.weight(p.setting)
