@@ -2,7 +2,11 @@
 
 ``ngcontact run SCENE [--out DIR]`` solves a scene and writes ``report.json``,
 CSV tables, VTK files for ParaView and PNG plots into ``DIR`` (default
-``results/<scene name>``); ``ngcontact check SCENE`` only validates it.
+``results/<scene name>``); ``ngcontact check SCENE`` only validates it;
+``ngcontact study epsilon SCENE [--periods N ...] [--out DIR]`` runs the
+epsilon study of a ``direct`` scene (:mod:`ngcontact.epsilon_study`) and
+writes ``report.json``, ``epsilon.csv`` and ``epsilon.png`` into ``DIR``
+(default ``results/<scene name>_epsilon``).
 
 Exit status: 0 success, 2 invalid scene or output directory, 3 solver
 failure; every failure prints one line on stderr and leaves no output behind.
@@ -37,6 +41,14 @@ def _parser() -> argparse.ArgumentParser:
     chk = sub.add_parser("check", help="validate a scene file without solving",
                          description="Validate a scene file and list the effects it calls for.")
     chk.add_argument("scene", help="scene file (TOML)")
+    st = sub.add_parser("study", help="run a study of a scene (epsilon: resolved against homogenized)",
+                        description="Epsilon study of a 'direct' scene: resolved runs against the homogenized "
+                                    "laws; write DIR/report.json, DIR/epsilon.csv and DIR/epsilon.png.")
+    st.add_argument("study", choices=("epsilon",), help="which study")
+    st.add_argument("scene", help="scene file (TOML) of kind 'direct' with a [study] section")
+    st.add_argument("--periods", type=int, nargs="+", metavar="N", help="numbers of periods (default: the scene's)")
+    st.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon)")
+    st.add_argument("--quiet", action="store_true", help="no progress lines")
     return p
 
 
@@ -48,6 +60,8 @@ def main(argv=None) -> int:
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
     if args.command == "check":
         return _check(args.scene)
+    if args.command == "study":
+        return _study(args.scene, args.periods, args.out, quiet=args.quiet)
     return _run(args.scene, args.out, quiet=args.quiet)
 
 
@@ -81,6 +95,41 @@ def _run(path: str, out: str | None, quiet: bool) -> int:
     progress = None if quiet else (lambda line: print(line, file=sys.stderr, flush=True))
     try:
         report, outcome = solve(sc, progress)
+        write_outputs(out, report, outcome)
+    except SceneError as exc:
+        return _fail(EXIT_SCENE, f"{path}: {exc}")
+    except OutputError as exc:
+        return _fail(EXIT_SCENE, str(exc))
+    except ConvergenceError as exc:
+        return _fail(EXIT_SOLVER, f"{path}: solver failed: {exc}")
+    except (NgcontactError, ValueError) as exc:
+        return _fail(EXIT_SOLVER, f"{path}: {exc}")
+    if progress:
+        progress(f"wrote {os.path.join(out, 'report.json')}")
+    return EXIT_OK
+
+
+def _study(path: str, periods, out: str | None, quiet: bool) -> int:
+    """``ngcontact study epsilon``: the same code as ``scripts/epsilon_study.py``."""
+    from .epsilon_study import epsilon_report
+    from .report import Clock, ensure_writable, write_outputs
+
+    try:
+        sc = scene_mod.load(path)
+        if sc.kind != "direct" or sc.study is None:
+            raise SceneError("kind", sc.kind, "the epsilon study needs a 'direct' scene with a [study] section")
+    except SceneError as exc:
+        return _fail(EXIT_SCENE, f"{path}: {exc}")
+    if periods is not None and any(n < 1 for n in periods):
+        return _fail(EXIT_SCENE, f"--periods {periods}: every N must be >= 1")
+    out = out or os.path.join("results", os.path.splitext(os.path.basename(path))[0] + "_epsilon")
+    try:
+        ensure_writable(out)
+    except OutputError as exc:
+        return _fail(EXIT_SCENE, str(exc))
+    progress = None if quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+    try:
+        report, outcome = epsilon_report(sc, periods, Clock(progress))
         write_outputs(out, report, outcome)
     except SceneError as exc:
         return _fail(EXIT_SCENE, f"{path}: {exc}")

@@ -400,3 +400,25 @@ def plot(path: str, rows: list, laws=LAWS) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def epsilon_report(scene, periods=None, clock=None) -> tuple[dict, object]:
+    """The study as a report dictionary and its outcome (``ngcontact study epsilon``); no file I/O.
+
+    Raises
+    ------
+    SceneError
+        The scene is not a ``direct`` scene with a ``[study]`` section, or
+        its band leaves no points for the field error.
+    """
+    from . import __version__
+    from . import scene as scene_mod
+    from .report import Clock, build_report
+    if scene.kind != "direct" or getattr(scene, "study", None) is None:
+        raise SceneError("kind", scene.kind, "the epsilon study needs a 'direct' scene with a [study] section")
+    clock = clock or Clock(None)
+    outcome = run_study(scene, periods, clock=clock)
+    report = build_report(kind="direct-epsilon-study", title=scene.title, scene=scene_mod.as_dict(scene),
+                          effects=scene_mod.effects(scene), outcome=outcome, timings=clock.total(),
+                          version=__version__)
+    return report, outcome

@@ -8,6 +8,8 @@ whole-surface and the effective-stiffness laws are solved and compared (see
 ``DIR/epsilon.csv`` and ``DIR/epsilon.png`` (error and cost against eps).
 
 Usage: python scripts/epsilon_study.py SCENE [--periods 4 8 16 32] [--out DIR]
+(the same study as ``ngcontact study epsilon SCENE``, which writes the same
+files; this script also prints the table)
 
 Exit status as ``ngcontact run``: 0 success, 2 invalid scene or output
 directory, 3 solver failure.
@@ -18,12 +20,11 @@ import argparse
 import os
 import sys
 
-from ngcontact import __version__
 from ngcontact import scene as scene_mod
 from ngcontact.cli import EXIT_OK, EXIT_SCENE, EXIT_SOLVER
-from ngcontact.epsilon_study import run_study
+from ngcontact.epsilon_study import epsilon_report
 from ngcontact.errors import ConvergenceError, NgcontactError, OutputError, SceneError
-from ngcontact.report import Clock, build_report, ensure_writable, write_outputs
+from ngcontact.report import Clock, ensure_writable, write_outputs
 
 
 def main(argv=None) -> int:
@@ -48,10 +49,7 @@ def main(argv=None) -> int:
         return EXIT_SCENE
     clock = Clock(None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True)))
     try:
-        outcome = run_study(sc, args.periods, clock=clock)
-        report = build_report(kind="direct-epsilon-study", title=sc.title, scene=scene_mod.as_dict(sc),
-                              effects=scene_mod.effects(sc), outcome=outcome, timings=clock.total(),
-                              version=__version__)
+        report, outcome = epsilon_report(sc, args.periods, clock)
         write_outputs(out, report, outcome)
     except (SceneError, OutputError) as exc:
         print(f"epsilon_study: error: {exc}", file=sys.stderr)

@@ -184,3 +184,26 @@ def test_femur_bundle_and_effective_laws_converge_on_finer_levels():
             assert rates[law][key] >= 0.8, (law, key, rates[law])
     assert rows[-1]["bundle_field"] < 0.01, rows[-1]
     assert res["below_1_percent"]["bundle"]["field"] is not None
+
+
+# -------------------------------------------------------------- command line
+def test_cli_study_epsilon_writes_the_study_and_uses_the_exit_codes(tmp_path, capsys):
+    import json
+
+    from ngcontact.cli import EXIT_OK, EXIT_SCENE, main
+    out = tmp_path / "eps"
+    assert main(["study", "epsilon", FEMUR, "--periods", "4", "8", "16", "--out", str(out), "--quiet"]) == EXIT_OK
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["kind"] == "direct-epsilon-study"
+    assert [r["N"] for r in rep["results"]["rows"]] == [4, 8, 16]
+    assert set(rep["results"]["rates"]) == {"bundle", "linear", "effective"}
+    assert (out / "epsilon.csv").exists() and (out / "epsilon.png").stat().st_size > 0
+    # not a direct scene: exit 2, nothing written
+    cell = os.path.join(ROOT, "geometries", "direct", "stem_grooves_cell.toml")
+    assert main(["study", "epsilon", cell, "--out", str(tmp_path / "no"), "--quiet"]) == EXIT_SCENE
+    assert not (tmp_path / "no").exists()
+    # output path is a file: exit 2
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert main(["study", "epsilon", FEMUR, "--out", str(blocker), "--quiet"]) == EXIT_SCENE
+    assert "error" in capsys.readouterr().err
