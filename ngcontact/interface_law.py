@@ -40,6 +40,15 @@ Laws (frozen dataclasses; the energies are built by :func:`energy`):
     ramps ``p(c) = sum_i s_i [c - c_i]_+`` (``s_i`` the slope increments), so
     its energy, the integral of the table, is ``sum_i s_i/2 [c - c_i]_+^2``.
     A linear tangential stiffness ``k_t`` may be added.
+:class:`FieldLaw`
+    Unilateral Winkler law whose coefficients vary along ``S_0`` (the
+    coupling loop of paper Sec. 3.5): ``k_n0(x)`` and ``g_n0(x)`` of eq. 34
+    on the real contact set of the cell at the point ``x``::
+
+        W(a) = k_n0(x)/2 [a_n - g0 - c(x)]_+^2,     c(x) = g_n0(x) / k_n0(x),
+
+    i.e. ``p = [k_n0 (a_n - g0) - g_n0]_+``; ``k_n0`` and ``c`` are
+    CoefficientFunctions (fields on the interface).
 :class:`Friction`
     Homogenized friction on top of any of them (paper eqs. 38-44): threshold
     ``G = mu0 [p]_+ + G0`` and energy ``G huber(|a_t|, w)`` with
@@ -227,7 +236,30 @@ class Friction:
         return self.mu > 0
 
 
-NormalLaw = LinearLaw | BundleLaw | TabulatedLaw
+@dataclass(frozen=True, kw_only=True)
+class FieldLaw:
+    """Unilateral normal law with coefficient fields along ``S_0`` (module docstring).
+
+    Attributes
+    ----------
+    kn
+        ``k_n0(x)`` [stress / length], a CoefficientFunction > 0 on ``S_0``.
+    offset
+        ``c(x) = g_n0(x) / k_n0(x)`` [length], a CoefficientFunction.
+    stiffness
+        An upper bound of ``k_n0`` (a number; scales the start of the solve).
+    """
+
+    kn: object
+    offset: object
+    stiffness: float
+
+    def __post_init__(self):
+        if not self.stiffness > 0:
+            raise ValueError(f"stiffness = {self.stiffness!r}: must be > 0")
+
+
+NormalLaw = LinearLaw | BundleLaw | TabulatedLaw | FieldLaw
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -335,6 +367,8 @@ def normal_energy(law: NormalLaw, a, g0=0.0, closed: bool = False):
         if law.kt > 0:
             W = W + 0.5 * law.kt * sum(ai * ai for ai in a[1:])
         return W
+    if isinstance(law, FieldLaw):
+        return 0.5 * law.kn * ramp(a[0] - g0 - law.offset) ** 2
     raise TypeError(f"unknown interface law {type(law).__name__}")
 
 
@@ -360,6 +394,8 @@ def normal_traction(law: NormalLaw, a, g0=0.0) -> list:
         c = a[0] - g0
         p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
         return [p] + [law.kt * ai for ai in a[1:]]
+    if isinstance(law, FieldLaw):
+        return [law.kn * _ramp(a[0] - g0 - law.offset)] + [0.0 * ai for ai in a[1:]]
     raise TypeError(f"unknown interface law {type(law).__name__}")
 
 

@@ -515,8 +515,11 @@ def _status(sol: MacroSolution, press, jt) -> list:
     if law.friction is not None:
         closed = np.where(np.abs(jt) <= law.friction.width, "stick", "slip")
     else:
-        K = law.normal.matrix(2) if not isinstance(law.normal, il.TabulatedLaw) else None
-        kt = law.normal.kt if K is None else K[1, 1]
+        if isinstance(law.normal, il.FieldLaw):
+            kt = 0.0
+        else:
+            K = law.normal.matrix(2) if not isinstance(law.normal, il.TabulatedLaw) else None
+            kt = law.normal.kt if K is None else K[1, 1]
         closed = np.full(len(press), "stick" if kt > 0 else "slip")
     return [("open" if pv <= 0 else str(c)) for pv, c in zip(press, closed)]
 

@@ -127,8 +127,13 @@ def run(scene, clock) -> Outcome:
         geo = build_geometry(scene)
     with clock.stage("interface law"):
         problem, law_info = problem_of(scene, geo)
+    two_scale = None
     with clock.stage("solve"):
-        sol = solve_scene(scene, problem)
+        if scene.two_scale is None:
+            sol = solve_scene(scene, problem)
+        else:
+            from .two_scale import couple
+            sol, two_scale = couple(scene, problem, lambda prob: solve_scene(scene, prob))
     with clock.stage("post-processing"):
         fields = M.stress_fields(sol)
         extrema = M.field_extrema(sol, fields)
@@ -151,6 +156,11 @@ def run(scene, clock) -> Outcome:
             plots["interface"] = lambda path, prof=prof, setting=problem.setting: plot_interface(path, prof, setting)
             plots["stress"] = lambda path, sol=sol, fields=fields: plot_fields(path, sol, fields)
         results["maxima"] = maxima
+        if two_scale is not None:
+            results["two_scale"] = two_scale
+            if "interface" in results:
+                results["interface"]["contact_fraction"] = np.asarray(two_scale["interface_coefficients"]
+                                                                     ["contact_fraction"])
     vtk = {"stress": VtkField(mesh=geo.mesh, fields=dict(fields, u_rough=sol.u_rough, u_counter=sol.u_counter),
                               subdivision=scene.output.vtk_subdivision)}
     if scene.strength is not None:

@@ -1,0 +1,115 @@
+"""The two-scale coupling loop (paper Sec. 3.5) and its tabulated cell response."""
+import math
+
+import numpy as np
+import pytest
+
+from ngcontact import interface_law as il
+from ngcontact import macro as M
+from ngcontact import twoscale as T
+from ngcontact.cell import CellModel, CellProblem
+from ngcontact.geometry import cell2d, profiles as pr
+from ngcontact.geometry import macro as gm
+from ngcontact.materials import isotropic
+
+import ngsolve as ng
+
+K_N = 600.0  # micro penalty; plane summits over half the period give k_n0 = 300
+
+
+def _summit_cell():
+    prof = pr.rectangular_valley(0.5, 0.2, 1.0)
+    cell = pr.profile_cell(prof, arrangement="summit", h_rough=0.6, h_counter=0.6, maxh=0.2,
+                           interface_maxh=0.1, order=2)
+    return CellProblem(cell, CellModel(rough=isotropic(200.0, 0.3), counter=isotropic(70.0, 0.25),
+                                       k_n=K_N, order=2))
+
+
+def _press_fit(law):
+    g = gm.coaxial_plane_strain(0.5, 1.0, 2.0, maxh=0.3, order=3)
+    sup = (M.Support(label="sym_x", components=("x",)), M.Support(label="sym_y", components=("y",)))
+    return M.MacroProblem(mesh=g.mesh, setting="plane_strain", rough="inner", counter="outer",
+                          materials={"inner": isotropic(200.0, 0.3), "outer": isotropic(70.0, 0.25)},
+                          law=law, gap=-1e-3, supports=sup, order=3)
+
+
+def test_fixed_contact_set_stops_after_one_update_and_reproduces_the_one_shot_solution():
+    """Plane summits in compression: the contact set is the plateaus at every pressure."""
+    P = _summit_cell()
+    one_shot_law = il.InterfaceLaw(normal=il.BundleLaw(weights=(0.5 * K_N,), directions=((1.0, 0.0),)))
+    problem = _press_fit(one_shot_law)
+    one_shot = M.interface_profile(M.solve(problem))["pressure"]
+    assert one_shot.min() > 0  # all in compression
+    table = T.CellTable(lambda p: T.cell_response(P, p), tol=1e-3)
+    out = T.couple(problem, table, tol=1e-6 * one_shot.max(), max_iter=5)
+    assert out.converged and len(out.history) == 2, out.history   # start + one update
+    assert np.allclose(table.as_dict()["contact_fraction"], 0.5, atol=1e-9)
+    assert np.allclose(table.as_dict()["k_n0"], 0.5 * K_N, rtol=1e-9)
+    assert np.max(np.abs(table.as_dict()["g_n0"])) < 1e-8 * one_shot.max()
+    p = M.interface_profile(out.solution)["pressure"]
+    assert np.max(np.abs(p - one_shot)) < 1e-8 * one_shot.max()
+
+
+def _westergaard_cell():
+    cell = pr.profile_cell(pr.flat(1.0), h_rough=1.0, h_counter=1.0, maxh=0.25, interface_maxh=0.01, order=2)
+    gap = 2 * 0.01 * ng.sin(math.pi * ng.x) ** 2
+    return CellProblem(cell, CellModel(rough=isotropic(1.0, 0.3), counter=isotropic(1.0, 0.3), k_n=1e3,
+                                       gap=gap, order=2))
+
+
+def test_tabulated_response_is_within_its_tolerance_of_direct_solves_at_random_pressures():
+    P = _westergaard_cell()
+    p_star = math.pi * 0.5 / (1 - 0.3 ** 2) * 0.01
+    tol = 0.02
+    table = T.CellTable(lambda p: T.cell_response(P, p), tol=tol)
+    table.cover(0.05 * p_star, 0.8 * p_star)
+    assert table.error_estimate <= tol
+    d = table.as_dict()
+    f = np.array(d["contact_fraction"])
+    assert np.all(np.diff(f) > 0)  # the real contact area grows with the pressure
+    scale = {"contact_fraction": f.max(), "g_n0": max(np.max(np.abs(d["g_n0"])), max(d["pressure"]))}
+    solves = table.solves
+    rng = np.random.default_rng(7)
+    for p in rng.uniform(0.05 * p_star, 0.8 * p_star, 4):
+        direct = T.cell_response(P, p)
+        interp = table(p)
+        for key, s in scale.items():
+            err = abs(float(interp[key]) - direct[key]) / s
+            assert err <= tol, f"{key} at p = {p:.3e}: relative error {err:.3e} > {tol}"
+    assert table.solves == solves  # evaluating the table solves no cell problem
+
+
+def test_table_grows_only_where_the_range_is_extended():
+    calls = []
+
+    def response(p):
+        calls.append(p)
+        return {"contact_fraction": math.sqrt(p), "k_n0": math.sqrt(p), "g_n0": p ** 1.5}
+
+    table = T.CellTable(response, tol=1e-3)
+    table.cover(0.01, 1.0)
+    n = len(calls)
+    table.cover(0.02, 0.9)
+    assert len(calls) == n
+    table.cover(0.01, 2.0)
+    assert len(calls) > n and max(calls) == 2.0
+    x = np.linspace(0.01, 2.0, 101)
+    exact = np.sqrt(x)
+    assert np.max(np.abs(table(x)["contact_fraction"] - exact)) / exact.max() <= 1e-3
+
+
+@pytest.mark.slow
+def test_loop_converges_on_the_shipped_scene_with_falling_changes():
+    from ngcontact.drivers import macro as D
+    from ngcontact.report import Clock
+    from ngcontact.scene import effects, load
+    scene = load("geometries/femur_stem_two_scale.toml")
+    assert "two_scale_coupling" in effects(scene)
+    out = D.run(scene, Clock())
+    ts = out.results["two_scale"]
+    changes = [h["max_change"] for h in ts["history"][1:]]
+    assert ts["converged"] and changes[-1] < scene.two_scale.tol
+    assert all(b < a for a, b in zip(changes, changes[1:])), changes
+    assert ts["table"]["error_estimate"] <= scene.two_scale.table_tol
+    f = np.asarray(ts["interface_coefficients"]["contact_fraction"])
+    assert f.max() > 2 * f[f > 0].min()  # the real contact area varies along the interface
