@@ -187,8 +187,14 @@ def field_law(sol: M.MacroSolution, table: CellTable, pressure) -> il.FieldLaw:
     P = table.pressures
     kn = np.array([table.values[q]["k_n0"] for q in P])
     off = np.array([table.values[q]["g_n0"] for q in P]) / kn
-    return il.FieldLaw(kn=M.piecewise_linear(pgf, list(zip(P, kn))),
-                       offset=M.piecewise_linear(pgf, list(zip(P, off))), stiffness=float(kn.max()))
+    # interpolated into the same space, so the macro assembly evaluates two plain fields
+    # instead of the table's sum of ramps at every quadrature point
+    fields = []
+    for values in (kn, off):
+        gf = ng.GridFunction(V)
+        gf.Set(M.piecewise_linear(pgf, list(zip(P, values))), definedon=on)
+        fields.append(gf)
+    return il.FieldLaw(kn=fields[0], offset=fields[1], stiffness=float(kn.max()))
 
 
 def interface_pressure(sol: M.MacroSolution):
