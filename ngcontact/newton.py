@@ -131,6 +131,11 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         slope = ng.InnerProduct(du, res)
         if not math.isfinite(slope):
             raise ConvergenceError(f"Newton step {it}: the tangent solve gave non-finite values", hist.as_dict())
+        if slope <= 0.0:
+            raise ConvergenceError(
+                f"Newton step {it}: the tangent gives no descent direction (du . r = {slope:.3e}); "
+                "the tangent is singular or indefinite, e.g. a load the interface cannot carry",
+                hist.as_dict())
         alpha = 1.0
         if line_search == "exact" and not quadratic:
             alpha = _exact_step(form, gfu.vec, du, slope, fixed, trial, res, max_step)
@@ -204,6 +209,8 @@ def _exact_step(form, u, du, slope0, fixed, trial, work, max_step) -> float:
     side = 0
     a = hi
     for _ in range(30):
+        if not fhi > flo:      # the bracket collapsed numerically
+            break
         a = (lo * fhi - hi * flo) / (fhi - flo)
         fa = dphi(a)
         if not math.isfinite(fa):

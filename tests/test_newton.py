@@ -1,0 +1,62 @@
+"""Newton with line search: NaN/Inf never enter the iterate; failures carry their history."""
+import math
+
+import ngsolve as ng
+import pytest
+from netgen.geom2d import unit_square
+
+from ngcontact.errors import ConvergenceError
+from ngcontact.newton import minimize
+
+
+@pytest.fixture(scope="module")
+def scalar():
+    """One global unknown u (NumberSpace) on the unit square: energies are functions of u."""
+    mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.5))
+    return ng.NumberSpace(mesh)
+
+
+def energy_form(space, density):
+    u = space.TrialFunction()
+    form = ng.BilinearForm(space, symmetric=True)
+    form += ng.Variation(density(u) * ng.dx)
+    return form
+
+
+def test_steps_into_nan_are_backtracked(scalar):
+    """E(u) = -3u - log(1 - u): the full Newton step from 0 lands at u = 2 (log of a negative)."""
+    form = energy_form(scalar, lambda u: -3 * u - ng.log(1 - u))
+    gfu = ng.GridFunction(scalar)
+    hist = minimize(form, gfu, rtol=1e-12)
+    assert hist.converged
+    assert gfu.vec[0] == pytest.approx(2.0 / 3.0, rel=1e-10)
+    assert hist.steps[0] == 0.25          # 1 -> u = 2 (NaN), 1/2 -> u = 1 (inf), 1/4 accepted
+    assert all(math.isfinite(e) for e in hist.energies)
+
+
+def test_no_descent_direction_fails_with_history(scalar):
+    """A concave energy has a negative tangent: no Newton descent direction exists."""
+    form = energy_form(scalar, lambda u: -(u - 1) ** 2)
+    gfu = ng.GridFunction(scalar)
+    with pytest.raises(ConvergenceError, match="no descent direction") as info:
+        minimize(form, gfu)
+    hist = info.value.history
+    assert hist["converged"] is False and len(hist["residuals"]) == 1
+
+
+def test_non_convergence_reports_history(scalar):
+    """|u|^1.5 has a singular tangent at its minimum; 2 steps cannot reach 1e-14."""
+    form = energy_form(scalar, lambda u: ng.sqrt(u * u + 1e-12) ** 3 + 0.1 * u)
+    gfu = ng.GridFunction(scalar)
+    gfu.vec[0] = 1.0
+    with pytest.raises(ConvergenceError, match="did not converge in 2 steps") as info:
+        minimize(form, gfu, rtol=1e-14, max_iter=2)
+    assert len(info.value.history["residuals"]) == 3
+
+
+def test_quadratic_energy_takes_one_linear_solve(scalar):
+    form = energy_form(scalar, lambda u: 0.5 * 4.0 * u * u - 2.0 * u)
+    gfu = ng.GridFunction(scalar)
+    hist = minimize(form, gfu, quadratic=True)
+    assert hist.converged and hist.iterations == 1 and hist.linear
+    assert gfu.vec[0] == pytest.approx(0.5, rel=1e-12)
