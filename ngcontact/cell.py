@@ -679,23 +679,32 @@ class CellProblem:
             s = {k: v[..., idx] for k, v in s.items()}
         return s
 
-    def stress_maxima(self) -> dict:
-        """Largest von Mises and Tresca stress in each body and where (element points)."""
+    def body_stresses(self) -> dict:
+        """Stress tensors of the current state at the element integration points of each body.
+
+        Returns ``{body: {"stress": (n, 3, 3), "points": (n, dim)}}``.  The
+        points are those of the order-``2p`` rule mapped to every element of
+        the body, so none lies on the interface (where point evaluation could
+        pick the other body's element).
+        """
         out = {}
         mesh, m = self.mesh, self.model
         comps = self.gfu.components
+        shape = ng.TET if self.dim == 3 else ng.TRIG
+        rule = ng.IntegrationRule(shape, 2 * max(m.order, 1))
         for name, law, u in (("rough", m.rough, comps[0]), ("counter", m.counter, comps[1])):
-            R = ng.comp.IntegrationRuleSpace(mesh, order=max(m.order, 1),
-                                             definedon=mesh.Materials(name))
             sig = law.stress(self.body_strain(u))
-            coords = [ng.x, ng.y, ng.z][: self.dim]
-            flat = [sig[i, j] for i in range(3) for j in range(3)] + coords + [ng.CF(1.0)]
-            gf = ng.GridFunction(R ** len(flat))
-            gf.Set(ng.CF(tuple(flat)), definedon=mesh.Materials(name))
-            arr = gf.vec.FV().NumPy().reshape(len(flat), -1)
-            inside = arr[-1] > 0.5
-            S = arr[:9, inside].T.reshape(-1, 3, 3)
-            X = arr[9:9 + self.dim, inside].T
+            coords = (ng.x, ng.y, ng.z)[: self.dim]
+            cf = ng.CF(tuple(sig[i, j] for i in range(3) for j in range(3)) + coords)
+            vals = np.asarray(cf(mesh.MapToAllElements(rule, mesh.Materials(name))))
+            out[name] = {"stress": vals[:, :9].reshape(-1, 3, 3).copy(), "points": vals[:, 9:].copy()}
+        return out
+
+    def stress_maxima(self) -> dict:
+        """Largest von Mises and Tresca stress in each body and where (element points)."""
+        out = {}
+        for name, sample in self.body_stresses().items():
+            S, X = sample["stress"], sample["points"]
             vm = _mat.von_mises(S)
             tr = _mat.tresca(S)
             i, j = int(np.argmax(vm)), int(np.argmax(tr))

@@ -51,7 +51,7 @@ import numpy as np
 
 from . import elasticity
 from . import interface_law as il
-from .materials import ElasticLaw, von_mises
+from .materials import von_mises
 from .newton import minimize
 
 log = logging.getLogger(__name__)

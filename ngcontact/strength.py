@@ -80,24 +80,10 @@ def _set_load(problem, l) -> None:
 def sample_stresses(problem) -> dict:
     """Stress tensors of the current state of ``problem`` per body at element points.
 
-    Returns ``{body: {"points": (n, dim), "stress": (n, 3, 3)}}``; the points
-    are those of an ``IntegrationRuleSpace`` of the displacement order.
+    Returns ``{body: {"points": (n, dim), "stress": (n, 3, 3)}}``
+    (:meth:`ngcontact.cell.CellProblem.body_stresses`).
     """
-    out = {}
-    mesh, m = problem.mesh, problem.model
-    comps = problem.gfu.components
-    for name, law, u in (("rough", m.rough, comps[0]), ("counter", m.counter, comps[1])):
-        R = ng.comp.IntegrationRuleSpace(mesh, order=max(m.order, 1), definedon=mesh.Materials(name))
-        sig = law.stress(problem.body_strain(u))
-        coords = [ng.x, ng.y, ng.z][: problem.dim]
-        flat = [sig[i, j] for i in range(3) for j in range(3)] + coords + [ng.CF(1.0)]
-        gf = ng.GridFunction(R ** len(flat))
-        gf.Set(ng.CF(tuple(flat)), definedon=mesh.Materials(name))
-        arr = gf.vec.FV().NumPy().reshape(len(flat), -1)
-        inside = arr[-1] > 0.5
-        out[name] = {"stress": arr[:9, inside].T.reshape(-1, 3, 3).copy(),
-                     "points": arr[9:9 + problem.dim, inside].T.copy()}
-    return out
+    return problem.body_stresses()
 
 
 # ------------------------------------------------------------ correctors

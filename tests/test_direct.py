@@ -8,7 +8,6 @@
   of about eps on ``block_rect_valleys.toml`` and beats the whole-surface
   linear law there (DESIGN Sec. 3).
 """
-import dataclasses
 import json
 import os
 import subprocess

@@ -8,7 +8,7 @@ from ngcontact import interface_law as il
 from ngcontact import macro as M
 from ngcontact import twoscale as T
 from ngcontact.cell import CellModel, CellProblem
-from ngcontact.geometry import cell2d, profiles as pr
+from ngcontact.geometry import profiles as pr
 from ngcontact.geometry import macro as gm
 from ngcontact.materials import isotropic
 

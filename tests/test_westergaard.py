@@ -15,7 +15,6 @@ import math
 import os
 
 import ngsolve as ng
-import numpy as np
 import pytest
 
 from ngcontact import scene as scene_mod

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from ..errors import MISSING, SceneError
 from ..scene import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names, register)
-from ..schema import at_least, nonempty, nonnegative, open_interval, param, positive
+from ..schema import nonempty, nonnegative, open_interval, param, positive
 
 PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
 PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map")
