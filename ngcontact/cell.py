@@ -75,7 +75,7 @@ from . import contact as _contact
 from . import elasticity as _el
 from . import materials as _mat
 from .errors import ConvergenceError
-from .newton import minimize
+from .newton import illinois_root, minimize
 
 log = logging.getLogger(__name__)
 
@@ -433,22 +433,8 @@ class CellProblem:
             hi = scale
             while (fhi := R(hi)) <= 0.0:
                 lo, flo, hi = hi, fhi, 2.0 * hi
-        side, d = 0, hi
-        for _ in range(200):
-            d = (lo * fhi - hi * flo) / (fhi - flo)
-            fd = R(d)
-            if abs(fd) <= 1e-12 * p * area or hi - lo <= 1e-14 * abs(hi):
-                break
-            if fd < 0.0:
-                lo, flo = d, fd
-                if side == -1:
-                    fhi *= 0.5
-                side = -1
-            else:
-                hi, fhi = d, fd
-                if side == 1:
-                    flo *= 0.5
-                side = 1
+        d = illinois_root(R, lo, flo, hi, fhi, ftol=1e-12 * p * area, xtol=1e-14 * abs(hi),
+                          max_iter=200)
         log.debug("rigid predictor: approach %.6e for pressure %.6e", d, p)
         return d
 

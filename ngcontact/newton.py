@@ -206,16 +206,29 @@ def _exact_step(form, u, du, slope0, fixed, trial, work, max_step) -> float:
             return hi
     if fhi < 0.0:
         return hi
-    side = 0
-    a = hi
-    for _ in range(30):
-        if not fhi > flo:      # the bracket collapsed numerically
+    a = illinois_root(dphi, lo, flo, hi, fhi, ftol=tol, max_iter=30)
+    return a if math.isfinite(a) else 1.0
+
+
+def illinois_root(f, lo: float, flo: float, hi: float, fhi: float, *, ftol: float,
+                  xtol: float = 0.0, max_iter: int = 100) -> float:
+    """Root of a nondecreasing ``f`` bracketed by ``f(lo) = flo < 0 < fhi = f(hi)``.
+
+    The Illinois variant of regula falsi: secant steps within the bracket,
+    halving the retained end's value when the same end is kept twice, which
+    restores superlinear convergence.  Stops when ``|f| <= ftol``, the
+    bracket is shorter than ``xtol`` or has collapsed numerically; returns
+    ``nan`` when ``f`` is not finite at an iterate.
+    """
+    side, a = 0, hi
+    for _ in range(max_iter):
+        if not fhi > flo:          # the bracket collapsed numerically
             break
         a = (lo * fhi - hi * flo) / (fhi - flo)
-        fa = dphi(a)
+        fa = f(a)
         if not math.isfinite(fa):
-            return 1.0
-        if abs(fa) <= tol:
+            return math.nan
+        if abs(fa) <= ftol or hi - lo <= xtol:
             break
         if fa < 0.0:
             lo, flo = a, fa
