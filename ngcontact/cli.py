@@ -80,56 +80,50 @@ def _check(path: str) -> int:
 
 
 def _run(path: str, out: str | None, quiet: bool) -> int:
-    from .report import ensure_writable, write_outputs
     from .runner import solve
 
-    try:
-        sc = scene_mod.load(path)
-    except SceneError as exc:
-        return _fail(EXIT_SCENE, f"{path}: {exc}")
-    out = out or os.path.join("results", os.path.splitext(os.path.basename(path))[0])
-    try:
-        ensure_writable(out)
-    except OutputError as exc:
-        return _fail(EXIT_SCENE, str(exc))
-    progress = None if quiet else (lambda line: print(line, file=sys.stderr, flush=True))
-    try:
-        report, outcome = solve(sc, progress)
-        write_outputs(out, report, outcome)
-    except SceneError as exc:
-        return _fail(EXIT_SCENE, f"{path}: {exc}")
-    except OutputError as exc:
-        return _fail(EXIT_SCENE, str(exc))
-    except ConvergenceError as exc:
-        return _fail(EXIT_SOLVER, f"{path}: solver failed: {exc}")
-    except (NgcontactError, ValueError) as exc:
-        return _fail(EXIT_SOLVER, f"{path}: {exc}")
-    if progress:
-        progress(f"wrote {os.path.join(out, 'report.json')}")
-    return EXIT_OK
+    return _execute(path, out, quiet, solve, suffix="")
 
 
 def _study(path: str, periods, out: str | None, quiet: bool) -> int:
     """``ngcontact study epsilon``: the same code as ``scripts/epsilon_study.py``."""
     from .epsilon_study import epsilon_report
-    from .report import Clock, ensure_writable, write_outputs
+    from .report import Clock
+
+    def require_study(sc):
+        if sc.kind != "direct" or sc.study is None:
+            raise SceneError("kind", sc.kind, "the epsilon study needs a 'direct' scene with a [study] section")
+
+    def compute(sc, progress):
+        return epsilon_report(sc, periods, Clock(progress))
+
+    if periods is not None and any(n < 1 for n in periods):
+        return _fail(EXIT_SCENE, f"--periods {periods}: every N must be >= 1")
+    return _execute(path, out, quiet, compute, suffix="_epsilon", validate=require_study)
+
+
+def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, validate=None) -> int:
+    """Load, check the output directory, ``compute(scene, progress)``, write atomically.
+
+    Maps every failure to its exit status with a one-line message: invalid
+    scene or output directory 2, solver failure 3.
+    """
+    from .report import ensure_writable, write_outputs
 
     try:
         sc = scene_mod.load(path)
-        if sc.kind != "direct" or sc.study is None:
-            raise SceneError("kind", sc.kind, "the epsilon study needs a 'direct' scene with a [study] section")
+        if validate is not None:
+            validate(sc)
     except SceneError as exc:
         return _fail(EXIT_SCENE, f"{path}: {exc}")
-    if periods is not None and any(n < 1 for n in periods):
-        return _fail(EXIT_SCENE, f"--periods {periods}: every N must be >= 1")
-    out = out or os.path.join("results", os.path.splitext(os.path.basename(path))[0] + "_epsilon")
+    out = out or os.path.join("results", os.path.splitext(os.path.basename(path))[0] + suffix)
     try:
         ensure_writable(out)
     except OutputError as exc:
         return _fail(EXIT_SCENE, str(exc))
     progress = None if quiet else (lambda line: print(line, file=sys.stderr, flush=True))
     try:
-        report, outcome = epsilon_report(sc, periods, Clock(progress))
+        report, outcome = compute(sc, progress)
         write_outputs(out, report, outcome)
     except SceneError as exc:
         return _fail(EXIT_SCENE, f"{path}: {exc}")
