@@ -76,3 +76,32 @@ def test_strength_check_without_ultimate_stress_is_a_scene_error(tmp_path):
     with pytest.raises(SceneError) as exc:
         from_dict(data, base_dir=base)
     assert exc.value.path == "materials.bone.sigma_u"
+
+
+def test_nonlinear_recovery_agrees_with_the_correctors_where_the_contact_set_is_fixed():
+    """``recovery = "nonlinear"`` re-solves the contact cell at the worst interface points.
+
+    With the hip cell's plane summits pressed (the contact set cannot change)
+    and no tangential transfer (``tangential_stiffness = 0``: the frictionless
+    summit cell carries no shear, which is then dropped), the nonlinear solves
+    must reproduce the superposed correctors (eq. 75) at those points.
+    """
+    import tomllib
+
+    from ngcontact.drivers.macro import build_geometry, problem_of, solve_scene
+    from ngcontact.drivers.strength import evaluate
+
+    with open("geometries/femur_stem.toml", "rb") as fh:
+        data = tomllib.load(fh)
+    data["strength"].update(recovery="nonlinear", tangential_stiffness=0.0, nonlinear_points=3)
+    scene = from_dict(data, base_dir=str(load("geometries/femur_stem.toml").base_dir))
+    problem, _ = problem_of(scene, build_geometry(scene))
+    sol = solve_scene(scene, problem)
+    res = evaluate(scene, sol)["results"]
+    solved = res["nonlinear"]
+    assert len(solved) == 3
+    for entry in solved:
+        assert entry["contact_fraction"] == pytest.approx(0.16, rel=1e-8)
+        for b, v in entry["bodies"].items():
+            assert v["nonlinear"] == pytest.approx(v["linear"], rel=1e-7), (b, entry["index"])
+    assert res["recovery"] == "nonlinear" and res["safety_factor"] > 0
