@@ -58,8 +58,10 @@ def _show(value) -> str:
         return repr(value)
     if isinstance(value, float):
         return repr(value)
-    if isinstance(value, (list, tuple)) and len(value) > 8:
-        return f"[{', '.join(_show(v) for v in value[:8])}, ...] ({len(value)} entries)"
+    if isinstance(value, (list, tuple)):  # as the scene writes it: a TOML array
+        if len(value) > 8:
+            return f"[{', '.join(_show(v) for v in value[:8])}, ...] ({len(value)} entries)"
+        return f"[{', '.join(_show(v) for v in value)}]"
     if isinstance(value, dict):
         return "{" + ", ".join(sorted(value)) + "}"
     return repr(value)

@@ -174,10 +174,11 @@ def _convert(tp, value, key):
     if origin in (Union, types.UnionType):
         if value is None and type(None) in args:
             return None
+        options = [a for a in args if a is not type(None)]
+        if len(options) == 1:  # an optional value: keep the inner key path (e.g. load.pressure[1])
+            return _convert(options[0], value, key)
         errors = []
-        for a in args:
-            if a is type(None):
-                continue
+        for a in options:
             try:
                 return _convert(a, value, key)
             except SceneError as exc:

@@ -18,7 +18,7 @@ from ..cell import CellModel, CellProblem, Friction
 import numpy as np
 
 from ..homogenize import coefficients
-from ..kinds.cell import GAP_PROFILES, loads, small_slope
+from ..kinds.cell import GAP_PROFILES, loads, profile_2d, small_slope
 from ..report import Outcome, VtkField
 from ..scene import resolve
 
@@ -48,19 +48,11 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
                                         h_rough=g.h_rough, h_counter=g.h_counter, maxh=maxh,
                                         interface_maxh=ih)
     from ..geometry import profiles as pr
-    if g.profile == "flat":
-        prof = pr.flat(g.period)
-    elif g.profile == "rectangular":
-        prof = pr.rectangular_valley(g.width, g.depth, g.period)
-    elif g.profile == "triangular":
-        prof = pr.triangular_valley(g.angles[0], g.angles[1], g.width, g.period)
-    elif g.profile == "semicircular":
-        prof = pr.semicircular_valley(g.radius, g.period)
-    elif g.profile == "tabulated":
+    if g.profile == "tabulated":
         from ..geometry.tabulated import read_profile_csv
         prof = read_profile_csv(resolve(scene, g.file), path="geometry.file")
     else:
-        prof = pr.sinusoid(g.amplitude, g.period)
+        prof = profile_2d(g)
     return pr.profile_cell(prof, arrangement=g.arrangement, h_rough=g.h_rough, h_counter=g.h_counter,
                            maxh=maxh, interface_maxh=ih, order=order)
 

@@ -78,6 +78,49 @@ class CellGeometry:
             if key not in allowed and value is not None:
                 raise SceneError(f"{path}.{key}", value,
                                  f"not used by profile = {self.profile!r}; remove it")
+        if self.profile == "square_hills":
+            if not self.width < self.period:
+                raise SceneError(f"{path}.width", self.width,
+                                 f"must be < period = {self.period!r} (hills must not touch)")
+            if not self.depth < self.h_rough:
+                raise SceneError(f"{path}.depth", self.depth, f"must be < h_rough = {self.h_rough!r} "
+                                 "(the hill base must lie inside the rough body)")
+        if self.dim == 2 and self.profile != "tabulated":  # tabulated: checked when its file is read
+            try:
+                bounds = profile_2d(self).bounds
+            except SceneError as exc:  # the builders name their own arguments (profile.width, ...)
+                key = _BUILDER_KEYS.get(exc.path, exc.path.replace("profile.", ""))
+                raise SceneError(f"{path}.{key}", exc.value, exc.allowed) from None
+            check_profile_heights(self, bounds, path)
+
+
+_BUILDER_KEYS = {"profile.angle_left": "angles", "profile.angle_right": "angles"}
+
+
+def profile_2d(g: CellGeometry):
+    """The :class:`~ngcontact.geometry.profiles.Profile` of a parametric 2D geometry section."""
+    from ..geometry import profiles as pr
+    if g.profile == "flat":
+        return pr.flat(g.period)
+    if g.profile == "rectangular":
+        return pr.rectangular_valley(g.width, g.depth, g.period)
+    if g.profile == "triangular":
+        return pr.triangular_valley(g.angles[0], g.angles[1], g.width, g.period)
+    if g.profile == "semicircular":
+        return pr.semicircular_valley(g.radius, g.period)
+    if g.profile == "sinusoid":
+        return pr.sinusoid(g.amplitude, g.period)
+    raise ValueError(f"profile {g.profile!r} is not a parametric 2D profile")
+
+
+def check_profile_heights(g: CellGeometry, bounds: tuple, path: str = "geometry") -> None:
+    """The profile ``(y_min, y_max)`` must lie strictly between the far faces of the cell."""
+    lo, hi = bounds
+    if not lo > -g.h_rough:
+        raise SceneError(f"{path}.h_rough", g.h_rough, f"must exceed the profile depth {-lo!r} "
+                         "(the roughness must lie inside the rough body)")
+    if not hi < g.h_counter:
+        raise SceneError(f"{path}.h_counter", g.h_counter, f"must exceed the profile height {hi!r}")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -224,10 +267,7 @@ class CellScene:
             return
         if self.load is None:
             raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
-        try:
-            loads(self)
-        except ValueError as exc:
-            raise SceneError("load", "...", str(exc)) from None
+        loads(self)
 
 
 def small_slope(geometry: CellGeometry) -> bool:
@@ -240,20 +280,22 @@ def loads(scene: CellScene) -> list:
     from ..cell import cell_load
     L, dim = scene.load, scene.geometry.dim
     nt = dim - 1
-    normal = L.pressure if L.pressure is not None else L.normal_jump
-    tang = L.shear if L.shear is not None else L.tangential_jump
+    nkey = "pressure" if L.pressure is not None else "normal_jump"
+    tkey = "shear" if L.shear is not None else "tangential_jump"
+    normal = getattr(L, nkey)
+    tang = getattr(L, tkey)
     tang_sets = None
     if tang is not None:
         if len(tang) % nt:
-            raise ValueError(f"shear / tangential_jump need {nt} entries per load")
+            raise SceneError(f"load.{tkey}", tang, f"needs {nt} entries per load in a {dim}D cell")
         tang_sets = [tuple(tang[i:i + nt]) for i in range(0, len(tang), nt)]
     n = max(len(normal), len(tang_sets or [()]))
-    for name, seq in (("normal", normal), ("tangential", tang_sets or [None])):
-        if len(seq) not in (1, n):
-            raise ValueError(f"the {name} load has {len(seq)} entries; sweeps need equal lengths or 1")
+    if tang_sets is not None and 1 < len(normal) != len(tang_sets) > 1:
+        raise SceneError(f"load.{tkey}", tang, f"makes {len(tang_sets)} loads but load.{nkey} has "
+                         f"{len(normal)}; sweeps need equal lengths or length 1")
     ms = L.macro_strain
     if ms is not None and len(ms) != (1 if dim == 2 else 3):
-        raise ValueError(f"macro_strain needs {1 if dim == 2 else 3} entries in {dim}D")
+        raise SceneError("load.macro_strain", ms, f"needs {1 if dim == 2 else 3} entries in a {dim}D cell")
     out = []
     for k in range(n):
         nv = normal[k if len(normal) > 1 else 0]

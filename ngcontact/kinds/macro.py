@@ -42,6 +42,16 @@ DIMENSIONS = {"femur_stem": tuple(f.name for f in dataclasses.fields(FemurStemDi
 REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base")}
 REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block": ("block", "base")}
 LAWS = ("linear", "bundle", "tabulated")
+#: Boundary labels of the meshed geometries (:mod:`ngcontact.geometry.macro`) by (shape, setting),
+#: so that supports and loads are checked without meshing.
+BOUNDARIES = {
+    ("femur_stem", "axisymmetric"): ("axis", "base", "bone_outer", "bone_top", "canal", "interface",
+                                     "stem_side", "stem_tip", "stem_top"),
+    ("coaxial", "plane_strain"): ("bore", "interface", "mantle", "sym_x", "sym_y"),
+    ("coaxial", "axisymmetric"): ("bore", "bottom", "interface", "mantle", "top"),
+    ("coaxial", "3d"): ("bore", "bottom", "interface", "mantle", "sym_x", "sym_y", "top"),
+    ("block", "plane_strain"): ("base_sides", "block_sides", "bottom", "interface", "top"),
+}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -260,6 +270,13 @@ class MacroScene:
                              "bodies")
         from ..macro import COMPONENTS
         comps = COMPONENTS[self.geometry.setting]
+        shape, setting = self.geometry.shape, self.geometry.setting
+        labels = BOUNDARIES[shape, setting]
+        for what, items in (("supports", self.supports), ("loads", self.loads)):
+            for i, item in enumerate(items):
+                if item.boundary not in labels:
+                    raise SceneError(f"{what}[{i}].boundary", item.boundary,
+                                     f"no such boundary in {shape!r} ({setting}); labels are " + ", ".join(labels))
         for i, s in enumerate(self.supports):
             for c in s.components:
                 if c not in comps:
@@ -285,14 +302,32 @@ class MacroScene:
                                      "a number > 0 [Pa]")
 
     def check_files(self) -> None:
+        """Every named cell scene exists, is valid and is of kind ``cell``.
+
+        The cells of ``[strength]`` and ``[two_scale]`` are solved, so they
+        also need a contact model (not ``contact.geometric_only``).  A fault
+        inside a cell scene is reported under the key naming it, e.g.
+        ``interface.cell = 'hip.toml': invalid cell scene: materials.bone.nu = ...``.
+        """
         import os
-        from ..scene import resolve
-        files = (("interface.cell", self.interface.cell),
-                 ("strength.cell", self.strength.cell if self.strength else None),
-                 ("two_scale.cell", self.two_scale.cell if self.two_scale else None))
-        for key, rel in files:
-            if rel is not None and not os.path.isfile(resolve(self, rel)):
+        from ..scene import load, resolve
+        files = (("interface.cell", self.interface.cell, False),
+                 ("strength.cell", self.strength.cell if self.strength else None, True),
+                 ("two_scale.cell", self.two_scale.cell if self.two_scale else None, True))
+        for key, rel, solved in files:
+            if rel is None:
+                continue
+            if not os.path.isfile(resolve(self, rel)):
                 raise SceneError(key, rel, "no such cell scene file")
+            try:
+                cell = load(resolve(self, rel))
+            except SceneError as exc:
+                raise SceneError(key, rel, f"invalid cell scene: {exc}") from None
+            if cell.kind != "cell":
+                raise SceneError(key, rel, f"invalid cell scene: must be of kind 'cell', not {cell.kind!r}")
+            if solved and cell.contact.geometric_only:
+                raise SceneError(key, rel, "invalid cell scene: contact.geometric_only = true, but this "
+                                 "section solves the cell, so it needs a contact model and a [load] section")
 
 
 def effects(scene: MacroScene) -> tuple[str, ...]:

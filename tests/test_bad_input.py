@@ -1,0 +1,464 @@
+"""Bad input: every case ends with exit status 2, one line on stderr, nothing written.
+
+Each case is a small scene written into ``tmp_path`` (derived from a flat
+cell, a macro block or a shipped scene) and run through the real command
+line, ``ngcontact run SCENE --out DIR`` (and ``check`` where the case is
+about the scene alone).  The message is checked exactly, or by an exact
+prefix where its tail lists many keys; it always has the form
+``path = value: what is allowed``.
+"""
+import os
+
+import numpy as np
+import pytest
+
+from ngcontact import cli
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CELLS = os.path.join(ROOT, "geometries", "cells")
+
+CELL = """\
+kind = "cell"
+
+[materials.solid]
+E = 1.0
+nu = 0.3
+
+[bodies]
+rough = "solid"
+counter = "solid"
+
+[geometry]
+profile = "flat"
+
+[contact]
+k_n = 1.0e3
+{contact}
+
+[load]
+pressure = [0.01]
+
+[discretization]
+order = 1
+maxh = 0.5
+
+[solver]
+rtol = 1e-10
+"""
+
+MACRO = """\
+kind = "macro"
+
+[materials.steel]
+E = 210e9
+nu = 0.3
+
+[bodies]
+rough = "steel"
+counter = "steel"
+
+[geometry]
+shape = "block"
+setting = "plane_strain"
+
+[geometry.dimensions]
+length = 0.02
+h_block = 0.005
+h_base = 0.005
+
+[interface]
+law = "linear"
+kn = 1e12
+kt = 1e11
+
+[[supports]]
+boundary = "bottom"
+
+[[loads]]
+boundary = "top"
+pressure = 10e6
+
+[discretization]
+order = 1
+maxh = 0.01
+"""
+
+
+def edit(text: str, *pairs) -> str:
+    """``text`` with each ``(old, new)`` substituted once; ``old`` must occur."""
+    for old, new in pairs:
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    return text
+
+
+def run_bad(tmp_path, capsys, text, expected, *, prefix=False, commands=("run", "check"), files=None):
+    """Write ``text`` as a scene, run it, and check exit 2, the one-line message and no output."""
+    work = tmp_path / "work"
+    work.mkdir(exist_ok=True)
+    for name, content in (files or {}).items():
+        target = work / name
+        if isinstance(content, np.ndarray):
+            np.save(target, content)
+        else:
+            target.write_text(content)
+    scene = work / "scene.toml"
+    scene.write_text(text)
+    before = sorted(os.listdir(tmp_path)), sorted(os.listdir(work))
+    out = tmp_path / "out"
+    for command in commands:
+        argv = ["run", str(scene), "--out", str(out), "--quiet"] if command == "run" else ["check", str(scene)]
+        assert cli.main(argv) == 2, command
+        captured = capsys.readouterr()
+        err = captured.err
+        assert err.endswith("\n") and err.count("\n") == 1, err
+        message = err.rstrip("\n")
+        want = f"ngcontact: error: {scene}: {expected}"
+        if prefix:
+            assert message.startswith(want), message
+        else:
+            assert message == want, message
+        assert not out.exists()
+        assert (sorted(os.listdir(tmp_path)), sorted(os.listdir(work))) == before
+
+
+# ------------------------------------------------------------- materials
+@pytest.mark.parametrize("E, shown", [("0.0", "0.0"), ("-2.0e9", "-2000000000.0")])
+def test_young_modulus_must_be_positive(tmp_path, capsys, E, shown):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("E = 1.0", f"E = {E}")),
+            f"materials.solid.E = {shown}: must be > 0")
+
+
+@pytest.mark.parametrize("nu", ["0.5", "-1.0", "0.7"])
+def test_poisson_ratio_must_lie_in_the_open_interval(tmp_path, capsys, nu):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("nu = 0.3", f"nu = {nu}")),
+            f"materials.solid.nu = {float(nu)!r}: must lie in (-1, 0.5)")
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf"])
+def test_non_finite_material_constant(tmp_path, capsys, value):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("E = 1.0", f"E = {value}")),
+            f"materials.solid.E = {float(value)!r}: must be a finite number")
+
+
+def test_non_finite_entry_of_a_load_sweep_names_its_index(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("pressure = [0.01]", "pressure = [0.01, nan]")),
+            "load.pressure[1] = nan: must be a finite number")
+
+
+def test_non_finite_macro_traction(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(MACRO, ("pressure = 10e6", "pressure = 10e6\ntraction = [inf, 0.0]")),
+            "loads[0].traction[0] = inf: must be a finite number")
+
+
+def test_a_string_where_a_number_is_asked(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("E = 1.0", 'E = "stiff"')),
+            "materials.solid.E = 'stiff': must be a number")
+
+
+def test_a_body_names_an_undefined_material(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ('counter = "solid"', 'counter = "steel"')),
+            "bodies.counter = 'steel': must name a material defined under [materials]: solid")
+
+
+# --------------------------------------------------------- contact laws
+def test_negative_penalty(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("k_n = 1.0e3", "k_n = -1.0e3")),
+            "contact.k_n = -1000.0: must be > 0")
+
+
+def test_negative_coulomb_coefficient(tmp_path, capsys):
+    text = CELL.format(contact='friction = "coulomb"\nmu = -0.2\nw = 1e-6')
+    run_bad(tmp_path, capsys, text, "contact.mu = -0.2: must be >= 0")
+
+
+def test_negative_tresca_threshold(tmp_path, capsys):
+    text = CELL.format(contact='friction = "tresca"\nG = -1.0\nw = 1e-6')
+    run_bad(tmp_path, capsys, text, "contact.G = -1.0: must be >= 0")
+
+
+@pytest.mark.parametrize("w", ["0.0", "-1e-6"])
+def test_regularization_width_must_be_positive(tmp_path, capsys, w):
+    text = CELL.format(contact=f'friction = "tresca"\nG = 1.0\nw = {w}')
+    run_bad(tmp_path, capsys, text, f"contact.w = {float(w)!r}: must be > 0")
+
+
+def test_negative_macro_threshold_and_huber_width(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(MACRO, ("kt = 1e11", "kt = 1e11\nthreshold = -1e6")),
+            "interface.threshold = -1000000.0: must be >= 0")
+    run_bad(tmp_path, capsys, edit(MACRO, ("kt = 1e11", "kt = 1e11\nhuber_width = 0.0")),
+            "interface.huber_width = 0.0: must be > 0")
+
+
+def test_coefficient_not_used_by_tresca(tmp_path, capsys):
+    text = CELL.format(contact='friction = "tresca"\nG = 1.0\nmu = 0.3\nw = 1e-6')
+    run_bad(tmp_path, capsys, text, "contact.mu = 0.3: not used by friction = 'tresca'; remove it")
+
+
+def test_threshold_not_used_by_coulomb(tmp_path, capsys):
+    text = CELL.format(contact='friction = "coulomb"\nG = 1.0\nmu = 0.3\nw = 1e-6')
+    run_bad(tmp_path, capsys, text, "contact.G = 1.0: not used by friction = 'coulomb'; remove it")
+
+
+def test_width_without_friction(tmp_path, capsys):
+    run_bad(tmp_path, capsys, CELL.format(contact="w = 1e-6"),
+            "contact.w = 1e-06: not used by friction = 'none'; remove it")
+
+
+def test_macro_law_parameter_not_used(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(MACRO, ("kt = 1e11", "kt = 1e11\nweights = [1e12]")),
+            "interface.weights = [1000000000000.0]: not used by law = 'linear'; remove it")
+
+
+# -------------------------------------------------------------- profiles
+def test_profile_key_the_profile_does_not_use(tmp_path, capsys):
+    text = edit(CELL.format(contact=""), ('profile = "flat"', 'profile = "sinusoid"\namplitude = 0.05\nradius = 0.1'))
+    run_bad(tmp_path, capsys, text, "geometry.radius = 0.1: not used by profile = 'sinusoid'; remove it")
+
+
+def test_profile_key_missing(tmp_path, capsys):
+    text = edit(CELL.format(contact=""), ('profile = "flat"', 'profile = "semicircular"'))
+    run_bad(tmp_path, capsys, text, "geometry.radius = <missing>: required for profile = 'semicircular'")
+
+
+def test_sinusoid_amplitude_reaching_the_cell_height(tmp_path, capsys):
+    # valley depth 2 A = 0.6 = h_rough: the roughness would cut the rough body through
+    text = edit(CELL.format(contact=""),
+                ('profile = "flat"', 'profile = "sinusoid"\namplitude = 0.3\nh_rough = 0.6'))
+    run_bad(tmp_path, capsys, text,
+            "geometry.h_rough = 0.6: must exceed the profile depth 0.6 (the roughness must lie inside "
+            "the rough body)")
+
+
+def test_rectangular_valley_as_wide_as_the_period(tmp_path, capsys):
+    text = edit(CELL.format(contact=""),
+                ('profile = "flat"', 'profile = "rectangular"\nwidth = 1.0\ndepth = 0.2'))
+    run_bad(tmp_path, capsys, text, "geometry.width = 1.0: must be < period = 1.0 (plateaus must remain)")
+
+
+def test_triangular_face_angle_of_90_degrees(tmp_path, capsys):
+    text = edit(CELL.format(contact=""), ('profile = "flat"', 'profile = "triangular"\nangles = [30.0, 90.0]'))
+    run_bad(tmp_path, capsys, text, "geometry.angles = [30.0, 90.0]: must lie in (0, 90)", prefix=True)
+
+
+TAB = edit(CELL.format(contact=""), ('profile = "flat"', 'profile = "tabulated"\nfile = "p.csv"\nh_rough = 0.6'))
+
+
+def test_tabulated_profile_that_is_not_periodic(tmp_path, capsys):
+    run_bad(tmp_path, capsys, TAB,
+            "geometry.file (p.csv)[last row].y = -0.02: the profile must be periodic: "
+            "y(period) must equal y(0) = 0.0 within 1e-09",
+            files={"p.csv": "x,y\n0,0\n0.5,-0.1\n1.0,-0.02\n"})
+
+
+def test_tabulated_profile_with_a_non_finite_value(tmp_path, capsys):
+    run_bad(tmp_path, capsys, TAB, "geometry.file (p.csv)[row 1] = [0.5, nan]: x and y must be finite numbers",
+            files={"p.csv": "x,y\n0,0\n0.5,nan\n1.0,0\n"})
+
+
+def test_tabulated_profile_with_three_columns(tmp_path, capsys):
+    run_bad(tmp_path, capsys, TAB,
+            "geometry.file (p.csv)[row 1] = ['0.5', '-0.1', '7']: each row must have exactly two columns x, y",
+            files={"p.csv": "x,y\n0,0\n0.5,-0.1,7\n1.0,0\n"})
+
+
+def test_tabulated_profile_deeper_than_the_rough_body(tmp_path, capsys):
+    run_bad(tmp_path, capsys, TAB,
+            "geometry.file = 'p.csv': the profile height 0.7 must stay below h_rough and h_counter",
+            files={"p.csv": "x,y\n0,0\n0.5,-0.7\n1.0,0\n"})
+
+
+def test_missing_profile_file(tmp_path, capsys):
+    where = tmp_path / "work" / "p.csv"
+    run_bad(tmp_path, capsys, TAB,
+            f"geometry.file (p.csv) = '{where}': must be a readable CSV file (No such file or directory)")
+
+
+HMAP = edit(CELL.format(contact=""),
+            ('profile = "flat"', 'profile = "height_map"\nfile = "h.npy"\narrangement = "summit"'),
+            ("maxh = 0.5", "maxh = 0.5\ninterface_maxh = 0.25"))
+
+
+def test_height_map_of_the_wrong_shape(tmp_path, capsys):
+    run_bad(tmp_path, capsys, HMAP,
+            "geometry.file (h.npy) = 'array of shape (5,)': must be a 2D array with at least 3 samples per "
+            "direction (last row/column repeating the first)", files={"h.npy": np.zeros(5)})
+
+
+def test_height_map_with_a_non_finite_value(tmp_path, capsys):
+    H = np.zeros((4, 4))
+    H[1, 2] = np.inf
+    run_bad(tmp_path, capsys, HMAP, "geometry.file (h.npy)[1, 2] = inf: heights must be finite",
+            files={"h.npy": H})
+
+
+def test_height_map_that_is_not_periodic(tmp_path, capsys):
+    H = np.zeros((4, 4))
+    H[-1, 1] = 0.01
+    run_bad(tmp_path, capsys, HMAP,
+            "geometry.file (h.npy)[last row] = 0.01: the map must be periodic: the last row must repeat "
+            "the first (entry 1: 0.0) within 1e-09", files={"h.npy": H})
+
+
+# ------------------------------------------------------------------ keys
+def test_unknown_top_level_section(tmp_path, capsys):
+    text = CELL.format(contact="").replace("[solver]", "[solvr]")
+    run_bad(tmp_path, capsys, text, "solvr = {rtol}: unknown key; allowed keys here are bodies, contact, "
+            "discretization, geometry, kind, load, materials, solver, title")
+
+
+def test_misspelled_key_in_a_section(tmp_path, capsys):
+    text = edit(CELL.format(contact=""), ("rtol = 1e-10", "r_tol = 1e-10"))
+    run_bad(tmp_path, capsys, text, "solver.r_tol = 1e-10: unknown key; allowed keys here are atol, inverse, "
+            "max_iter, rtol")
+
+
+def test_misspelled_material_constant(tmp_path, capsys):
+    text = edit(CELL.format(contact=""), ("nu = 0.3", "Nu = 0.3"))
+    run_bad(tmp_path, capsys, text, "materials.solid.Nu = 0.3: unknown key; allowed keys here are C, E, nu, sigma_u")
+
+
+def test_misspelled_key_of_an_array_of_tables(tmp_path, capsys):
+    text = edit(MACRO, ('boundary = "bottom"', 'boundry = "bottom"'))
+    run_bad(tmp_path, capsys, text,
+            "supports[0].boundry = 'bottom': unknown key; allowed keys here are boundary, components, displacement")
+
+
+def test_unknown_kind(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ('kind = "cell"', 'kind = "cells"')),
+            "kind = 'cells': must be one of 'cell', 'direct', 'macro', 'manufactured'")
+
+
+def test_scene_that_is_not_toml(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("E = 1.0", "E = 1.0 GPa")),
+            f"<scene file> = '{tmp_path / 'work' / 'scene.toml'}': not valid TOML", prefix=True)
+
+
+def test_missing_scene_file(tmp_path, capsys):
+    missing = tmp_path / "nowhere.toml"
+    for argv in (["run", str(missing), "--out", str(tmp_path / "out")], ["check", str(missing)]):
+        assert cli.main(argv) == 2
+        assert capsys.readouterr().err == (f"ngcontact: error: {missing}: <scene file> = '{missing}': "
+                                           "no such file\n")
+    assert os.listdir(tmp_path) == []
+
+
+# ------------------------------------------------------- labels and files
+def test_macro_support_on_a_boundary_that_does_not_exist(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(MACRO, ('boundary = "bottom"', 'boundary = "floor"')),
+            "supports[0].boundary = 'floor': no such boundary in 'block' (plane_strain); labels are "
+            "base_sides, block_sides, bottom, interface, top")
+
+
+def test_macro_load_on_a_boundary_that_does_not_exist(tmp_path, capsys):
+    text = MACRO.replace('shape = "block"\nsetting = "plane_strain"', 'shape = "coaxial"\nsetting = "plane_strain"')
+    text = edit(text, ("length = 0.02\nh_block = 0.005\nh_base = 0.005", "a = 0.01\nb = 0.02\nc = 0.03"),
+                ('boundary = "bottom"', 'boundary = "sym_x"\ncomponents = ["x"]'),
+                ('boundary = "top"', 'boundary = "top"'))
+    run_bad(tmp_path, capsys, text, "loads[0].boundary = 'top': no such boundary in 'coaxial' (plane_strain); "
+            "labels are bore, interface, mantle, sym_x, sym_y")
+
+
+def test_missing_cell_scene_of_a_macro_scene(tmp_path, capsys):
+    text = edit(MACRO, ('law = "linear"\nkn = 1e12\nkt = 1e11', 'cell = "no_cell.toml"'))
+    run_bad(tmp_path, capsys, text, "interface.cell = 'no_cell.toml': no such cell scene file")
+
+
+def test_macro_scene_whose_cell_scene_is_invalid(tmp_path, capsys):
+    bad_cell = open(os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml")).read()
+    bad_cell = edit(bad_cell, ("nu = 0.3", "nu = 0.6"))
+    text = edit(MACRO, ('law = "linear"\nkn = 1e12\nkt = 1e11', 'cell = "cell.toml"'))
+    run_bad(tmp_path, capsys, text,
+            "interface.cell = 'cell.toml': invalid cell scene: materials.steel.nu = 0.6: must lie in (-1, 0.5)",
+            files={"cell.toml": bad_cell})
+
+
+def test_two_scale_cell_of_another_kind(tmp_path, capsys):
+    text = MACRO + '\n[two_scale]\ncell = "other.toml"\ntol = 1e3\n'
+    run_bad(tmp_path, capsys, text, "two_scale.cell = 'other.toml': invalid cell scene: must be of kind 'cell', "
+            "not 'macro'", files={"other.toml": MACRO})
+
+
+def test_unwritable_output_directory(tmp_path, capsys):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(CELL.format(contact=""))
+    blocker = tmp_path / "plain_file"
+    blocker.write_text("keep me")
+    for out in (blocker, blocker / "below"):
+        assert cli.main(["run", str(scene), "--out", str(out), "--quiet"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1
+        if out == blocker:
+            assert err == f"ngcontact: error: --out {out}: exists and is not a directory\n"
+        else:
+            assert err == f"ngcontact: error: --out {out}: cannot write in {blocker}\n"
+    assert sorted(os.listdir(tmp_path)) == ["plain_file", "scene.toml"]
+    assert blocker.read_text() == "keep me"
+
+
+# --------------------------------------------------- numerics settings
+def test_polynomial_order_below_one(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("order = 1", "order = 0")),
+            "discretization.order = 0: must be >= 1")
+
+
+def test_boolean_is_not_an_order(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("order = 1", "order = true")),
+            "discretization.order = True: must be an integer")
+
+
+@pytest.mark.parametrize("key, value, allowed", [("rtol", "0.0", "must be > 0"), ("rtol", "-1e-8", "must be > 0"),
+                                                ("max_iter", "0", "must be >= 1"), ("atol", "-1.0", "must be >= 0")])
+def test_solver_tolerances_and_limits(tmp_path, capsys, key, value, allowed):
+    text = edit(CELL.format(contact=""), ("rtol = 1e-10", f"{key} = {value}"))
+    shown = value if key == "max_iter" else repr(float(value))
+    run_bad(tmp_path, capsys, text, f"solver.{key} = {shown}: {allowed}")
+
+
+def test_non_positive_mesh_size(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("maxh = 0.5", "maxh = 0.0")),
+            "discretization.maxh = 0.0: must be > 0")
+
+
+def test_two_scale_tolerance_and_iteration_limit(tmp_path, capsys):
+    cell_text = open(os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml")).read()
+    base = MACRO + '\n[two_scale]\ncell = "cell.toml"\ntol = 1e3\n'
+    run_bad(tmp_path, capsys, edit(base, ("tol = 1e3", "tol = 0.0")), "two_scale.tol = 0.0: must be > 0",
+            files={"cell.toml": cell_text})
+    run_bad(tmp_path, capsys, edit(base, ("tol = 1e3", "tol = 1e3\nmax_iter = 0")),
+            "two_scale.max_iter = 0: must be >= 1", files={"cell.toml": cell_text})
+
+
+def test_strength_check_without_ultimate_stress(tmp_path, capsys):
+    cell_text = open(os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml")).read()
+    text = MACRO + '\n[strength]\ncell = "cell.toml"\n'
+    run_bad(tmp_path, capsys, text,
+            "materials.steel.sigma_u = <missing>: the ultimate stress of the rough body is required by "
+            "[strength]; a number > 0 [Pa]", files={"cell.toml": cell_text})
+
+
+def test_load_sweeps_of_unequal_length(tmp_path, capsys):
+    text = edit(CELL.format(contact=""), ("pressure = [0.01]", "pressure = [0.01, 0.02]\nshear = [0.0, 0.1, 0.2]"))
+    run_bad(tmp_path, capsys, text,
+            "load.shear = [0.0, 0.1, 0.2]: makes 3 loads but load.pressure has 2; sweeps need equal lengths "
+            "or length 1")
+
+
+def test_both_pressure_and_normal_jump(tmp_path, capsys):
+    text = edit(CELL.format(contact=""), ("pressure = [0.01]", "pressure = [0.01]\nnormal_jump = [0.001]"))
+    run_bad(tmp_path, capsys, text, "load.pressure = [0.01]: give exactly one of pressure and normal_jump")
+
+
+def test_boundary_table_matches_the_meshed_geometries():
+    """The labels checked without meshing are exactly those the meshers create."""
+    from ngcontact.geometry import macro as gm
+    from ngcontact.kinds.macro import BOUNDARIES
+    from ngcontact.macro import boundary_labels
+    built = {("femur_stem", "axisymmetric"): gm.femur_stem(maxh=0.02),
+             ("coaxial", "plane_strain"): gm.coaxial_plane_strain(1.0, 2.0, 3.0, maxh=1.0),
+             ("coaxial", "axisymmetric"): gm.coaxial_axisymmetric(1.0, 2.0, 3.0, 1.0, maxh=1.0),
+             ("coaxial", "3d"): gm.coaxial_3d(1.0, 2.0, 3.0, 1.0, maxh=1.0),
+             ("block", "plane_strain"): gm.block_on_plane(2.0, 1.0, 1.0, maxh=1.0)}
+    assert set(built) == set(BOUNDARIES)
+    for key, geometry in built.items():
+        assert tuple(sorted(boundary_labels(geometry.mesh))) == BOUNDARIES[key], key
