@@ -462,3 +462,11 @@ def test_boundary_table_matches_the_meshed_geometries():
     assert set(built) == set(BOUNDARIES)
     for key, geometry in built.items():
         assert tuple(sorted(boundary_labels(geometry.mesh))) == BOUNDARIES[key], key
+
+
+@pytest.mark.parametrize("key", ["shear", "tangential_jump"])
+def test_shear_on_a_frictionless_flat_interface(tmp_path, capsys, key):
+    """Found here: this was a ValueError from the solver (exit 3) after meshing."""
+    text = edit(CELL.format(contact=""), ("pressure = [0.01]", f"pressure = [0.01]\n{key} = [0.0, 0.001]"))
+    run_bad(tmp_path, capsys, text, f"load.{key} = [0.0, 0.001]: a frictionless flat contact surface carries "
+            "no shear and fixes no tangential jump: give 0 or set contact.friction")

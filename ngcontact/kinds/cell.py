@@ -268,6 +268,13 @@ class CellScene:
         if self.load is None:
             raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
         loads(self)
+        flat = self.geometry.profile in ("flat", "flat3d") or small_slope(self.geometry)
+        if flat and self.contact.friction == "none":
+            for key in ("shear", "tangential_jump"):
+                v = getattr(self.load, key)
+                if v is not None and any(x != 0.0 for x in v):
+                    raise SceneError(f"load.{key}", v, "a frictionless flat contact surface carries no "
+                                     "shear and fixes no tangential jump: give 0 or set contact.friction")
 
 
 def small_slope(geometry: CellGeometry) -> bool:
