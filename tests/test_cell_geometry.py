@@ -217,3 +217,17 @@ def test_bad_profile_parameters_are_rejected():
                         h_rough=1, h_counter=1, maxh=0.3)
     with pytest.raises(SceneError, match="arrangement.*conforming, summit"):
         pr.interface_segments(pr.flat(), "glued")
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_mesh_size_as_large_as_the_period_still_gives_a_solvable_cell(dim):
+    """Regression: maxh >= period / 2 let one element touch both periodic sides, and the
+    assembly of the identified space failed ('illegal dnums').  The size is now capped."""
+    from ngcontact.cell import CellModel, CellProblem, cell_load
+    from ngcontact.geometry.cell2d import flat_cell
+    from ngcontact.materials import isotropic
+    cell = flat_cell(maxh=1.0) if dim == 2 else flat_cell3d(maxh=1.0)
+    law = isotropic(1.0, 0.3)
+    P = CellProblem(cell, CellModel(rough=law, counter=law, k_n=1e3, order=1))
+    sol = P.solve(cell_load(dim, pressure=0.01), first=True)
+    assert sol.results["mean_pressure"] == pytest.approx(0.01, rel=1e-9)

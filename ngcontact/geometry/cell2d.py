@@ -17,10 +17,28 @@ may border both bodies (the summit arrangement of
 """
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 
 import ngsolve as ng
 from netgen.geom2d import SplineGeometry
+
+log = logging.getLogger(__name__)
+
+#: Fewest elements across one period: an element reaching from one periodic
+#: side to the other would carry a dof twice after the identification (NGSolve
+#: refuses to assemble it), and Netgen's ``maxh`` is only a target size.
+MIN_ELEMENTS_PER_PERIOD = 3
+
+
+def periodic_maxh(maxh: float, period: float) -> float:
+    """``maxh`` capped at ``period / MIN_ELEMENTS_PER_PERIOD`` (logged when capped)."""
+    cap = period / MIN_ELEMENTS_PER_PERIOD
+    if maxh > cap:
+        log.info("mesh size %g capped at period / %d = %g for the periodic identification",
+                 maxh, MIN_ELEMENTS_PER_PERIOD, cap)
+        return cap
+    return maxh
 
 
 _DOMAINS = {"void": 0, "rough": 1, "counter": 2}
@@ -112,7 +130,8 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
     if not (-h_rough < lo and hi < h_counter):
         raise ValueError(f"the interface spans y in [{lo}, {hi}]: it must lie strictly between "
                          f"-h_rough = {-h_rough} and h_counter = {h_counter}")
-    hint = interface_maxh or maxh
+    maxh = periodic_maxh(maxh, period)
+    hint = periodic_maxh(interface_maxh or maxh, period)
     geo = SplineGeometry()
     cache = {}
 

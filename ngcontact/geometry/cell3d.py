@@ -43,7 +43,7 @@ import ngsolve as ng
 from netgen.csg import CSGeometry, OrthoBrick, Plane, Pnt, Vec
 
 from ..errors import SceneError
-from .cell2d import Cell
+from .cell2d import Cell, periodic_maxh
 
 log = logging.getLogger(__name__)
 
@@ -69,7 +69,7 @@ def _box_planes(P, h_rough, h_counter):
 
 
 def _mesh(geo, maxh: float, P: float, h_rough: float, h_counter: float) -> Cell:
-    ngmesh = geo.GenerateMesh(maxh=maxh)
+    ngmesh = geo.GenerateMesh(maxh=periodic_maxh(maxh, P))
     _name_faces(ngmesh)
     mesh = ng.Mesh(ngmesh)
     log.debug("3D cell: %d elements, boundaries %s", mesh.ne, sorted(set(mesh.GetBoundaries())))
@@ -115,7 +115,7 @@ def flat_cell3d(period: float = 1.0, h_rough: float = 1.0, h_counter: float = 1.
     hr, hc = _positive("h_rough", h_rough), _positive("h_counter", h_counter)
     lat, bottom, top = _box_planes(P, hr, hc)
     xm, xp, ym, yp = lat
-    plane = Plane(Pnt(0, 0, 0), Vec(0, 0, 1)).bc("contact").maxh(interface_maxh or maxh)
+    plane = Plane(Pnt(0, 0, 0), Vec(0, 0, 1)).bc("contact").maxh(periodic_maxh(interface_maxh or maxh, P))
     box = xm * xp * ym * yp
     geo = CSGeometry()
     geo.Add((box * bottom * plane).mat("rough"))
@@ -157,7 +157,7 @@ def square_hills_cell(side: float, height: float, *, period: float = 1.0,
     if not t < hr:
         raise SceneError("profile.height", height, f"must be < h_rough = {hr} "
                          "(the hill base must lie inside the rough body)")
-    hi = interface_maxh or maxh
+    hi = periodic_maxh(interface_maxh or maxh, P)
     lat, bottom, top = _box_planes(P, hr, hc)
     xm, xp, ym, yp = lat
     box = xm * xp * ym * yp
@@ -237,7 +237,7 @@ def surface_cell(heights, *, period: float = 1.0, h_rough: float, h_counter: flo
     pts = np.ascontiguousarray(np.stack([X.T, Y.T, H.T], axis=-1))
     surface = occ.SplineSurfaceInterpolation(pts)
     if interface_maxh:
-        surface.maxh = _positive("discretization.interface_maxh", interface_maxh)
+        surface.maxh = periodic_maxh(_positive("discretization.interface_maxh", interface_maxh), P)
     box = occ.Box(occ.Pnt(0, 0, -hr), occ.Pnt(P, P, hc))
     box.faces.Min(occ.X).Identify(box.faces.Max(occ.X), "periodic_x", occ.IdentificationType.PERIODIC)
     box.faces.Min(occ.Y).Identify(box.faces.Max(occ.Y), "periodic_y", occ.IdentificationType.PERIODIC)
@@ -257,7 +257,7 @@ def surface_cell(heights, *, period: float = 1.0, h_rough: float, h_counter: flo
             f.name = "periodic"
         else:
             f.name = "contact"
-    mesh = ng.Mesh(occ.OCCGeometry(shape).GenerateMesh(maxh=_positive("discretization.maxh", maxh)))
+    mesh = ng.Mesh(occ.OCCGeometry(shape).GenerateMesh(maxh=periodic_maxh(_positive("discretization.maxh", maxh), P)))
     if order > 1:
         mesh.Curve(order)
     log.debug("OCC surface cell: %d elements", mesh.ne)
