@@ -155,6 +155,10 @@ def write_outputs(out_dir: str, report: dict, outcome: Outcome) -> str:
             json.dump(report, fh, indent=2, allow_nan=False)
             fh.write("\n")
         _replace_dir(tmp, out_dir)
+    except OSError as exc:  # e.g. a full disk: an output problem, reported as such
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise OutputError(f"--out {out_dir}: writing failed ({exc}); the previous output, if any, "
+                          "is unchanged") from exc
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
