@@ -757,21 +757,27 @@ class CellProblem:
         that are determinate (all but the tangential ones of a frictionless
         flat interface).  ``matrix`` is ``None`` when the interface
         compliance is singular (e.g. a component the interface does not
-        resist beyond the bulk).
+        resist beyond the bulk).  An open interface transmits nothing
+        (``S`` singular): its stiffness is the limit
+        ``S (I - S_0^-1 S)^-1 = 0`` and ``compliance`` is ``None``.
         """
         keep = [i for i in range(self.dim) if i == self.dim - 1 or self.tangential_free]
         names = (["t0"] if self.dim == 2 else ["t1", "t2"]) + ["n0"]
         S = self.tangent_stiffness()[np.ix_(keep, keep)]
         S0 = self.reference_stiffness()[np.ix_(keep, keep)]
-        compliance = np.linalg.inv(S) - np.linalg.inv(S0)
-        compliance = 0.5 * (compliance + compliance.T)
-        if np.linalg.cond(compliance) > 1e12:
-            K = None
+        if np.linalg.cond(S) > 1e12 * np.linalg.cond(S0):  # (partly) open: S^-1 does not exist
+            compliance = None
+            A = np.eye(len(keep)) - np.linalg.solve(S0, S)
+            K = None if np.linalg.cond(A) > 1e12 else S @ np.linalg.inv(A)
         else:
-            K = np.linalg.inv(compliance)
+            compliance = np.linalg.inv(S) - np.linalg.inv(S0)
+            compliance = 0.5 * (compliance + compliance.T)
+            K = None if np.linalg.cond(compliance) > 1e12 else np.linalg.inv(compliance)
+        if K is not None:
             K = (0.5 * (K + K.T)).tolist()
         return {"components": [names[i] for i in keep], "matrix": K,
-                "compliance": compliance.tolist(), "total": S.tolist(), "reference": S0.tolist()}
+                "compliance": None if compliance is None else compliance.tolist(),
+                "total": S.tolist(), "reference": S0.tolist()}
 
 
 def _acoustic_tensor(law, normal_axis: int) -> np.ndarray:

@@ -10,7 +10,12 @@ Contact and elasticity are written as one energy ``Pi(u)`` (NGSolve
 
 and yields a finite energy and a finite residual (otherwise the step is
 halved: NaN or Inf never enter the iterate).  The iteration stops when the residual (free
-dofs) has fallen below ``rtol`` times the first residual, or below ``atol``.
+dofs) has fallen below ``rtol`` times the first residual, or below ``atol``, or
+below its round-off floor ``ROUNDOFF eps || |K| |u| ||``: the size at which
+the residual, a sum of terms as large as ``|K_ij| |u_j|``, can no longer be
+evaluated.  Stiff terms (a Huber width of 1e-12, a penalty touching with zero
+force) put that floor above ``rtol`` times the first residual; without it
+Newton would wander in the round-off until ``max_iter``.
 A quadratic energy is minimized by a single linear solve.
 
 With ``line_search="exact"`` (for convex energies such as penalty contact)
@@ -43,6 +48,7 @@ log = logging.getLogger(__name__)
 
 ARMIJO = 1e-4
 MIN_STEP = 2.0 ** -30
+ROUNDOFF = 10.0
 
 
 @dataclass
@@ -126,6 +132,10 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         return hist
     for it in range(1, (1 if quadratic else max_iter) + 1):
         form.AssembleLinearization(gfu.vec)
+        if not quadratic and rnorm <= roundoff_floor(form.mat, gfu.vec, fixed):
+            log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
+            hist.converged = True
+            return hist
         inv = form.mat.Inverse(freedofs, inverse=inverse)
         du.data = inv * res
         slope = ng.InnerProduct(du, res)
@@ -241,6 +251,26 @@ def illinois_root(f, lo: float, flo: float, hi: float, fhi: float, *, ftol: floa
                 flo *= 0.5
             side = 1
     return a
+
+
+def roundoff_floor(mat, vec, fixed) -> float:
+    """``ROUNDOFF eps || |K| |u| ||`` over the free dofs: the residual's round-off level.
+
+    ``K`` may be stored as its lower triangle (symmetric storage).
+    """
+    import numpy as np
+    vals, cols, ptr = mat.CSR()
+    vals, cols, ptr = np.asarray(vals), np.asarray(cols, dtype=np.int64), np.asarray(ptr, dtype=np.int64)
+    u = np.abs(vec.FV().NumPy())
+    n = len(u)
+    rows = np.repeat(np.arange(n), np.diff(ptr))
+    a = np.abs(vals)
+    m = np.bincount(rows, weights=a * u[cols], minlength=n)
+    if type(mat).__name__.startswith("SparseMatrixSymmetric"):
+        off = rows != cols
+        m += np.bincount(cols[off], weights=a[off] * u[rows[off]], minlength=n)
+    m[fixed] = 0.0
+    return ROUNDOFF * np.finfo(float).eps * float(np.sqrt(np.dot(m, m)))
 
 
 def fixed_mask(freedofs):
