@@ -30,8 +30,11 @@ def _parser() -> argparse.ArgumentParser:
         prog="ngcontact",
         description="Contact of elastic bodies with periodically rough interfaces, "
                     "by two-scale homogenization (NGSolve).",
-        epilog="Exit status: 0 success, 2 invalid scene or output directory, 3 solver failure.")
+        epilog="Exit status: 0 success, 2 invalid scene or output directory, 3 solver failure "
+               "(and any unexpected error).")
     p.add_argument("--version", action="version", version=f"ngcontact {__version__}")
+    p.add_argument("--debug", action="store_true",
+                   help="show the traceback of an unexpected error (and debug log lines)")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     run = sub.add_parser("run", help="solve a scene and write report.json, VTK, CSV and PNG",
                          description="Solve a scene; write DIR/report.json, VTK files, CSV tables and PNG plots.")
@@ -57,12 +60,18 @@ def main(argv=None) -> int:
     if args.command is None:
         _parser().print_help()
         return EXIT_SCENE
-    logging.basicConfig(level=logging.WARNING, format="%(message)s")
-    if args.command == "check":
-        return _check(args.scene)
-    if args.command == "study":
-        return _study(args.scene, args.periods, args.out, quiet=args.quiet)
-    return _run(args.scene, args.out, quiet=args.quiet)
+    logging.basicConfig(level=logging.DEBUG if args.debug else logging.WARNING, format="%(message)s")
+    try:
+        if args.command == "check":
+            return _check(args.scene)
+        if args.command == "study":
+            return _study(args.scene, args.periods, args.out, quiet=args.quiet)
+        return _run(args.scene, args.out, quiet=args.quiet)
+    except Exception as exc:  # an unexpected failure still ends in one line and exit 3
+        if args.debug:
+            raise
+        return _fail(EXIT_SOLVER, f"{args.scene}: unexpected error ({type(exc).__name__}): {exc}; "
+                                  "rerun with --debug for the traceback")
 
 
 def _fail(code: int, message: str) -> int:

@@ -170,3 +170,22 @@ def test_console_script(scene_file, tmp_path):
     bad = subprocess.run([exe, "check", str(invalid_scene(tmp_path))], capture_output=True, text=True)
     assert bad.returncode == 2
     assert bad.stderr.count("\n") == 1 and "materials.steel.nu = 0.5" in bad.stderr
+
+
+def test_unexpected_error_is_one_line_exit_3_and_no_output(tmp_path, monkeypatch, capsys):
+    """A failure nobody anticipated (here: inside the driver) still ends in one line, exit 3."""
+    import ngcontact.drivers.manufactured as drv
+
+    def boom(scene, clock):
+        raise RuntimeError("mesher exploded")
+
+    monkeypatch.setattr(drv, "run", boom)
+    out = tmp_path / "out"
+    scene_path = os.path.join(os.path.dirname(__file__), os.pardir, "geometries", "verify_elasticity.toml")
+    assert cli.main(["run", scene_path, "--out", str(out)]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert err[0].endswith("unexpected error (RuntimeError): mesher exploded; rerun with --debug for the traceback")
+    assert not out.exists()
+    with pytest.raises(RuntimeError, match="mesher exploded"):
+        cli.main(["--debug", "run", scene_path, "--out", str(out)])
