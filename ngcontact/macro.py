@@ -163,11 +163,6 @@ def check_problem(problem: MacroProblem) -> None:
             raise ValueError(f"{role} = {name!r}: no such region; regions are {', '.join(sorted(regions))}")
     if problem.interface not in labels:
         raise ValueError(f"interface = {problem.interface!r}: no such boundary; labels are {', '.join(labels)}")
-    if problem.setting == "axisymmetric" and problem.order < 2:
-        if any(abs(v.point[0]) < 1e-14 for v in mesh.vertices):
-            # the degree-2 triangle rule samples edge midpoints, where u_r / r is 0/0 on the axis
-            raise ValueError("order = 1 with elements on the axis r = 0: the hoop strain u_r / r is "
-                             "evaluated on the axis; use order >= 2")
     comps = COMPONENTS[problem.setting]
     for item in tuple(problem.supports) + tuple(problem.loads):
         if item.label not in labels:

@@ -210,3 +210,39 @@ def test_3d_cell_with_a_periodic_height_map():
         # the measured mean of k_n [J_n - g]_+ on a coarse 3D interface mesh: within 3 % (observed 1.6 %)
         assert sol.results["mean_pressure"] == pytest.approx(q, rel=0.03)
     assert 0.0 < sols[0].results["contact_fraction"] < sols[1].results["contact_fraction"] <= 1.0
+
+
+@pytest.mark.parametrize("order", [1, 2, 3])
+@pytest.mark.parametrize("law", ["linear", "bundle"])
+def test_contact_across_the_symmetry_axis(order, law):
+    """Axisymmetric: a cylinder pressed on a disc, the interface runs from r = 0 outwards.
+
+    With ``u_r = 0`` on the sides the state is confined compression: the
+    pressure ``P`` crosses the interface uniformly, right up to the axis, and
+    the closure is ``P / k_n``.  Quadrature points on the axis (where ``u_r / r``
+    is 0/0) must not spoil it at any order.
+    """
+    from ngcontact import interface_law as il
+    from ngcontact import macro as M
+    from ngcontact.geometry import macro as gm
+
+    kn, P = 5e11, 2e6
+    normal = (il.LinearLaw(kn=kn, kt=2e11) if law == "linear"
+              else il.BundleLaw(weights=(kn,), directions=((1.0, 0.0),)))
+    g = gm.block_on_plane(0.02, 0.03, 0.02, maxh=0.004)
+    prob = M.MacroProblem(
+        mesh=g.mesh, setting="axisymmetric", rough="block", counter="base",
+        materials={"block": isotropic(100e9, 0.3), "base": isotropic(9e9, 0.27)},
+        law=il.InterfaceLaw(normal=normal), order=order,
+        supports=(M.Support(label="bottom", components=("z",)),
+                  M.Support(label="block_sides", components=("r",)),
+                  M.Support(label="base_sides", components=("r",))),
+        loads=(M.Load(label="top", pressure=P),))
+    sol = M.solve(prob)
+    assert np.isfinite(sol.gfu.vec.FV().NumPy()).all()
+    prof = M.interface_profile(sol, points_per_element=4)
+    assert min(prof["r"]) < 1e-3 * 0.02, "the profile must reach the axis"
+    np.testing.assert_allclose(prof["pressure"], P, rtol=1e-9)
+    np.testing.assert_allclose(prof["jump_n"], P / kn, rtol=1e-8)
+    R = M.resultant(sol)
+    assert R["z"] == pytest.approx(-P * math.pi * 0.02 ** 2, rel=1e-9)

@@ -251,18 +251,6 @@ def test_axisymmetric_equals_3d_for_a_rotationally_symmetric_problem():
     assert fine[0] < coarse[0] and fine[2] < coarse[2] and fine[3] < coarse[3], (coarse, fine)
 
 
-def test_axisymmetric_order_one_on_the_axis_is_refused():
-    """Order 1 would evaluate u_r / r on the axis (edge-midpoint quadrature): a clear error instead of NaN."""
-    d = gm.FemurStemDims()
-    g = gm.femur_stem(d, maxh=0.02)
-    prob = M.MacroProblem(mesh=g.mesh, setting="axisymmetric", rough="stem", counter="bone",
-                          materials={"stem": isotropic(100e9, 0.3), "bone": isotropic(9e9, 0.27)},
-                          law=il.InterfaceLaw(normal=il.LinearLaw(kn=3.2e10)), order=1,
-                          supports=(M.Support(label="base"),))
-    with pytest.raises(ValueError, match="order >= 2"):
-        M.solve(prob)
-
-
 # ------------------------------------------------------------ scenes, driver
 ROOT = __import__("os").path.dirname(__import__("os").path.dirname(__import__("os").path.abspath(__file__)))
 
