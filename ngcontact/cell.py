@@ -284,6 +284,7 @@ class CellProblem:
         self.J = comps[0] - comps[1] - self.U
         self.pressure = _contact.pressure(self.J, self.n, model.k_n, self.gap)
         self.penetration = _contact.penetration(self.J, self.n, self.gap)
+        self._active_points = None
         self.slip = _contact.tangential_slip(self.J, self.n)
 
     # -------------------------------------------------------------- energy
@@ -493,8 +494,18 @@ class CellProblem:
 
     def _newton(self, free, atol) -> dict:
         h = minimize(self.form, self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
-                     max_iter=self.max_iter, inverse=self.inverse, line_search=self.line_search)
+                     max_iter=self.max_iter, inverse=self.inverse, line_search=self.line_search,
+                     active_set=self.active_set)
         return h.as_dict()
+
+    def active_set(self, gfu=None) -> bytes:
+        """Signature of the contact state: which quadrature points of ``S_C`` penetrate."""
+        if self._active_points is None:
+            shape = ng.TRIG if self.dim == 3 else ng.SEGM
+            rule = ng.IntegrationRule(shape, 2 * self.model.order)
+            self._active_points = self.mesh.MapToAllElements(rule, self.mesh.Boundaries("contact"))
+        pen = np.asarray(self.penetration(self._active_points)).ravel()
+        return np.packbits(pen > 0.0).tobytes()
 
     def sweep(self, loads) -> list:
         """Solve a list of loads in order, each from the previous solution."""

@@ -60,6 +60,7 @@ class NewtonHistory:
     steps: list = field(default_factory=list)
     converged: bool = False
     linear: bool = False
+    active_set_sizes: list = field(default_factory=list)
 
     @property
     def iterations(self) -> int:
@@ -69,13 +70,48 @@ class NewtonHistory:
         return {"iterations": self.iterations, "converged": self.converged,
                 "linear_solve_only": self.linear,
                 "residuals": list(self.residuals), "energies": list(self.energies),
-                "step_lengths": list(self.steps)}
+                "step_lengths": list(self.steps), "active_set_sizes": list(self.active_set_sizes)}
+
+
+class ActiveSetCycle:
+    """Detects an active set that flips back and forth while the residual stagnates.
+
+    Feed it the signature of the active set (any hashable, e.g. the sign
+    pattern of the penetration at the contact quadrature points) and the
+    residual after every Newton step.  A signature that recurs after other
+    ones, for the ``repeats``-th time, while the residual has not fallen
+    below ``progress`` times its value at the signature's previous
+    occurrence, is a cycle: Newton would only go round it until its
+    iteration limit.
+    """
+
+    def __init__(self, repeats: int = 2, progress: float = 0.5):
+        self.repeats, self.progress = repeats, progress
+        self.seen: dict = {}      # signature -> (last step, residual there, recurrences)
+        self.previous = None
+
+    def step(self, it: int, signature, residual: float) -> str | None:
+        """Record step ``it``; return a description of the cycle, or ``None``."""
+        message = None
+        if signature in self.seen and signature != self.previous:
+            last, r_last, count = self.seen[signature]
+            stagnant = residual > self.progress * r_last
+            count = count + 1 if stagnant else 0
+            if count >= self.repeats:
+                message = (f"the active set of step {last} recurred at step {it} (period {it - last}, "
+                           f"{count} recurrences) while the residual stagnated ({r_last:.3e} -> {residual:.3e})")
+            self.seen[signature] = (it, residual, count)
+        else:
+            self.seen[signature] = (it, residual, 0)
+        self.previous = signature
+        return message
 
 
 def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
              rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 50,
              inverse: str = "sparsecholesky", quadratic: bool = False,
-             callback=None, line_search: str = "armijo", max_step: float = 8.0) -> NewtonHistory:
+             callback=None, line_search: str = "armijo", max_step: float = 8.0,
+             active_set=None) -> NewtonHistory:
     """Minimize the energy of ``form`` starting from ``gfu`` (updated in place).
 
     Parameters
@@ -102,6 +138,11 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         docstring).
     max_step
         Largest step length tried by the exact line search.
+    active_set
+        Optional ``active_set(gfu) -> hashable`` signature of the contact
+        state; an active set that cycles while the residual stagnates raises
+        :class:`~ngcontact.errors.ConvergenceError` at once
+        (:class:`ActiveSetCycle`) instead of iterating to ``max_iter``.
     """
     if line_search not in ("armijo", "exact"):
         raise ValueError(f"line_search = {line_search!r}: must be 'armijo' or 'exact'")
@@ -110,6 +151,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
     if freedofs is None:
         freedofs = gfu.space.FreeDofs()
     hist = NewtonHistory(linear=quadratic)
+    cycle = ActiveSetCycle() if active_set is not None else None
     fixed = fixed_mask(freedofs)
     res = gfu.vec.CreateVector()
     du = gfu.vec.CreateVector()
@@ -174,6 +216,12 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         log.debug("newton %d: |r| = %.3e, energy = %.6e, alpha = %g", it, rnorm, energy, alpha)
         if callback is not None:
             callback(it, gfu)
+        if cycle is not None:
+            sig = active_set(gfu)
+            hist.active_set_sizes.append(_size(sig))
+            found = cycle.step(it, sig, rnorm)
+            if found is not None and not rnorm <= max(rtol * r0, atol):
+                raise ConvergenceError(f"Newton step {it}: {found}", hist.as_dict())
         if rnorm <= max(rtol * r0, atol):
             hist.converged = True
             return hist
@@ -271,6 +319,16 @@ def roundoff_floor(mat, vec, fixed) -> float:
         m += np.bincount(cols[off], weights=a[off] * u[rows[off]], minlength=n)
     m[fixed] = 0.0
     return ROUNDOFF * np.finfo(float).eps * float(np.sqrt(np.dot(m, m)))
+
+
+def _size(signature) -> int:
+    """Number of active entries: set bits of a ``bytes`` signature, true entries of a sequence, or -1."""
+    if isinstance(signature, (bytes, bytearray)):
+        return sum(bin(b).count("1") for b in signature)
+    try:
+        return int(sum(bool(b) for b in signature))
+    except TypeError:
+        return -1
 
 
 def fixed_mask(freedofs):

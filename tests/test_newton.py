@@ -60,3 +60,43 @@ def test_quadratic_energy_takes_one_linear_solve(scalar):
     hist = minimize(form, gfu, quadratic=True)
     assert hist.converged and hist.iterations == 1 and hist.linear
     assert gfu.vec[0] == pytest.approx(0.5, rel=1e-12)
+
+
+def test_cycle_detector_flags_a_flip_flop_with_a_stagnating_residual():
+    from ngcontact.newton import ActiveSetCycle
+    d = ActiveSetCycle()
+    seq = ["A", "B", "A", "B", "A"]
+    msgs = [d.step(k + 1, s, 1.0) for k, s in enumerate(seq)]
+    assert msgs[:4] == [None, None, None, None]
+    assert msgs[4] == ("the active set of step 3 recurred at step 5 (period 2, 2 recurrences) "
+                       "while the residual stagnated (1.000e+00 -> 1.000e+00)")
+
+
+def test_cycle_detector_ignores_progress_and_new_states():
+    from ngcontact.newton import ActiveSetCycle
+    d = ActiveSetCycle()
+    # the same flip-flop, but the residual falls tenfold per step: a converging iteration
+    assert all(d.step(k + 1, s, 10.0 ** -k) is None for k, s in enumerate("ABABABAB"))
+    d = ActiveSetCycle()
+    assert all(d.step(k + 1, s, 1.0) is None for k, s in enumerate("ABCDEFGH"))
+    d = ActiveSetCycle()   # staying in one state is no cycle
+    assert all(d.step(k + 1, "A", 1.0) is None for k in range(8))
+
+
+def test_cell_newton_records_the_active_set_and_finds_no_false_cycle():
+    import math as m
+
+    from ngcontact.cell import CellModel, CellProblem, cell_load
+    from ngcontact.geometry.cell2d import flat_cell
+    from ngcontact.materials import isotropic
+
+    law = isotropic(1.0, 0.3)
+    c = flat_cell(maxh=0.2, interface_maxh=0.02, order=1)
+    gap = 0.02 * ng.sin(m.pi * ng.x) ** 2
+    P = CellProblem(c, CellModel(rough=law, counter=law, k_n=1e3, order=2, gap=gap))
+    (sol,) = P.sweep([cell_load(2, pressure=0.002)])
+    last = sol.newton[-1]                       # one history per Newton solve of this load
+    sizes = last["active_set_sizes"]
+    assert len(sizes) == last["iterations"] and sizes[-1] > 0
+    total = len(P.active_set()) * 8
+    assert 0 < sizes[-1] < total      # partial contact: some points in, some out
