@@ -72,15 +72,6 @@ class Support:
 
 
 @dataclass(frozen=True, kw_only=True)
-class Load:
-    """Surface load: ``pressure`` (positive pushes into the body) plus ``traction``."""
-
-    label: str
-    pressure: float = 0.0
-    traction: tuple = ()
-
-
-@dataclass(frozen=True, kw_only=True)
 class Friction:
     """Micro friction: ``"tresca"`` (threshold ``G``) or ``"coulomb"`` (``mu``), Huber width ``w``."""
 

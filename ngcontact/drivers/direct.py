@@ -33,25 +33,16 @@ import numpy as np
 from .. import direct as D
 from ..geometry import profiles as pr
 from ..geometry import resolved as rg
+from ..kinds.cell import profile_2d
+from ..macro import Load
 from ..report import Outcome, VtkField
 
 log = logging.getLogger(__name__)
 
 
 def profile_of(cell_scene) -> pr.Profile:
-    """The roughness profile of a 2D ``cell`` scene."""
-    g = cell_scene.geometry
-    if g.profile == "flat":
-        return pr.flat(g.period)
-    if g.profile == "rectangular":
-        return pr.rectangular_valley(g.width, g.depth, g.period)
-    if g.profile == "triangular":
-        return pr.triangular_valley(g.angles[0], g.angles[1], g.width, g.period)
-    if g.profile == "semicircular":
-        return pr.semicircular_valley(g.radius, g.period)
-    if g.profile == "sinusoid":
-        return pr.sinusoid(g.amplitude, g.period)
-    raise ValueError(f"profile {g.profile!r} cannot be resolved")
+    """The roughness profile of a 2D ``cell`` scene (parametric profiles only)."""
+    return profile_2d(cell_scene.geometry)
 
 
 def micro_law(cell_scene) -> dict:
@@ -81,7 +72,7 @@ def supports_of(scene) -> tuple:
 
 
 def loads_of(scene) -> tuple:
-    return tuple(D.Load(label=lo.boundary, pressure=lo.pressure, traction=lo.traction) for lo in scene.loads)
+    return tuple(Load(label=lo.boundary, pressure=lo.pressure, traction=lo.traction) for lo in scene.loads)
 
 
 def interface_length(scene) -> float:
