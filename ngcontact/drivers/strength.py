@@ -150,25 +150,42 @@ def plot_map(path, states, smap, sigma_u) -> None:
 
 
 def plot_cell(path, stress, criterion, dim) -> None:
-    """Equivalent stress in the worst cell (paper Fig. 8): 2D map or 3D point cloud."""
+    """Equivalent stress in the worst cell (paper Fig. 8).
+
+    2D: the map over the cell.  3D: two sections through the point of the
+    largest equivalent stress, the vertical plane ``y = y_max`` (x-z) and the
+    horizontal plane ``z = z_max`` (x-y), each from the sample points within
+    a thin slab around the plane.
+    """
     import matplotlib.pyplot as plt
     pts = np.concatenate([stress[b]["points"] for b in S.BODIES])
     eq = np.concatenate([S.equivalent(stress[b]["stress"], criterion) for b in S.BODIES]) / 1e6
-    fig = plt.figure(figsize=(7, 5.5))
+    label = f"{criterion.replace('_', ' ')} [MPa]"
+    k = int(np.argmax(eq))
     if dim == 2:
-        ax = fig.add_subplot(111)
+        fig, ax = plt.subplots(figsize=(7, 5.5))
         sc = ax.scatter(pts[:, 0], pts[:, 1], c=eq, s=4, cmap="viridis")
+        ax.plot(*pts[k, :2], "r+", ms=14, mew=2)
         ax.set_aspect("equal")
         ax.set_xlabel("x (t0)")
         ax.set_ylabel("y (n0)")
+        fig.colorbar(sc, ax=ax, shrink=0.8, label=label)
+        ax.set_title(f"worst cell: max {eq[k]:.3g} MPa (+)")
     else:
-        ax = fig.add_subplot(111, projection="3d")
-        sc = ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], c=eq, s=2, cmap="viridis")
-        ax.set_xlabel("x (t0)")
-        ax.set_ylabel("y (hoop)")
-        ax.set_zlabel("z (n0)")
-    fig.colorbar(sc, ax=ax, shrink=0.8, label=f"{criterion.replace('_', ' ')} [MPa]")
-    ax.set_title("worst cell")
-    fig.tight_layout()
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
+        span = np.ptp(pts, axis=0)
+        for ax, (normal, a, b, names) in zip(axes, ((1, 0, 2, ("x (t0)", "z (n0)")),
+                                                    (2, 0, 1, ("x (t0)", "y (hoop)")))):
+            slab = np.abs(pts[:, normal] - pts[k, normal]) <= 0.03 * span[normal]
+            sc = ax.scatter(pts[slab, a], pts[slab, b], c=eq[slab], s=6, cmap="viridis",
+                            vmin=eq.min(), vmax=eq.max())
+            ax.plot(pts[k, a], pts[k, b], "r+", ms=14, mew=2)
+            ax.set_aspect("equal")
+            ax.set_xlabel(names[0])
+            ax.set_ylabel(names[1])
+            which = "y" if normal == 1 else "z"
+            ax.set_title(f"section {which} = {pts[k, normal]:.3g}")
+        fig.colorbar(sc, ax=axes, shrink=0.85, label=label)
+        fig.suptitle(f"worst cell: max {eq[k]:.3g} MPa (+)")
     fig.savefig(path, dpi=110)
     plt.close(fig)
