@@ -3,8 +3,11 @@
 Runs the ``cell`` driver on each scene through the command line
 (``ngcontact run SCENE --out DIR``, one process per scene, so every scene
 pays its own imports and meshing) and reads ``report.json``: Newton steps
-per load (``results.loads[k].newton_iterations``), the number of dofs, the
-solve stage and the total wall time.  Scenes of other kinds and purely
+per load (``results.loads[k].newton_iterations``, summed over the Coulomb
+fixed-point passes), the largest number of steps of any single Newton solve
+and the number of Newton solves (``solver.per_load``: more than one per load
+under Coulomb friction), the number of dofs, the solve stage and the total
+wall time.  Scenes of other kinds and purely
 geometric scenes (``contact.geometric_only``) are listed with zero loads.
 Writes ``cell_scenes_benchmark.csv`` into the output directory (default
 ``results/cell_scenes_benchmark``) and prints the table.
@@ -24,8 +27,8 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-KEYS = ("scene", "status", "ndof", "loads", "newton_per_load", "max_newton", "solve_seconds",
-        "total_seconds", "wall_seconds")
+KEYS = ("scene", "status", "ndof", "loads", "newton_per_load", "max_newton", "max_per_solve",
+        "newton_solves", "solve_seconds", "total_seconds", "wall_seconds")
 
 
 def bench(path: str, out_root: str) -> dict:
@@ -36,7 +39,8 @@ def bench(path: str, out_root: str) -> dict:
                           capture_output=True, text=True)
     wall = time.perf_counter() - t0
     row = {"scene": name, "status": "ok" if proc.returncode == 0 else f"exit {proc.returncode}",
-           "ndof": 0, "loads": 0, "newton_per_load": "", "max_newton": 0, "solve_seconds": 0.0,
+           "ndof": 0, "loads": 0, "newton_per_load": "", "max_newton": 0, "max_per_solve": 0,
+           "newton_solves": 0, "solve_seconds": 0.0,
            "total_seconds": 0.0, "wall_seconds": wall}
     report = os.path.join(out, "report.json")
     if proc.returncode != 0 or not os.path.exists(report):
@@ -46,8 +50,10 @@ def bench(path: str, out_root: str) -> dict:
         rep = json.load(fh)
     loads = rep.get("results", {}).get("loads", [])
     its = [int(entry.get("newton_iterations", 0)) for entry in loads]
+    solves = [h["iterations"] for per in rep.get("solver", {}).get("per_load", []) for h in per]
     t = rep.get("timings", {})
-    row.update(ndof=rep.get("ndof", 0), loads=len(its), newton_per_load=" ".join(map(str, its)),
+    row.update(max_per_solve=max(solves) if solves else 0, newton_solves=len(solves),
+               ndof=rep.get("ndof", 0), loads=len(its), newton_per_load=" ".join(map(str, its)),
                max_newton=max(its) if its else 0, solve_seconds=t.get("solve", 0.0),
                total_seconds=t.get("total", 0.0))
     return row
@@ -65,11 +71,13 @@ def main(argv=None) -> int:
         w = csv.writer(fh)
         w.writerow(KEYS)
         w.writerows([[r[k] for k in KEYS] for r in rows])
-    head = f"{'scene':24s} {'status':10s} {'ndof':>7s} {'loads':>5s} {'max it':>6s} {'solve s':>8s} {'total s':>8s}  per-load"
+    head = (f"{'scene':24s} {'status':10s} {'ndof':>7s} {'loads':>5s} {'max it':>6s} {'max/solve':>9s} "
+            f"{'solves':>6s} {'solve s':>8s} {'total s':>8s}  per-load")
     sys.stdout.write(head + "\n" + "-" * len(head) + "\n")
     for r in rows:
         sys.stdout.write(f"{r['scene']:24s} {r['status'][:10]:10s} {r['ndof']:7d} {r['loads']:5d} "
-                         f"{r['max_newton']:6d} {r['solve_seconds']:8.2f} {r['total_seconds']:8.2f}  "
+                         f"{r['max_newton']:6d} {r['max_per_solve']:9d} {r['newton_solves']:6d} "
+                         f"{r['solve_seconds']:8.2f} {r['total_seconds']:8.2f}  "
                          f"{r['newton_per_load']}\n")
     bad = [r for r in rows if r["status"] != "ok"]
     for r in bad:
