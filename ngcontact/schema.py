@@ -112,6 +112,23 @@ def _all(value, pred) -> bool:
     return pred(value)
 
 
+def check_selected(obj, path: str, selector: str, keys, need, optional=()) -> None:
+    """Keys that a choice (``selector``, e.g. ``friction``) requires or does not use.
+
+    For each of ``keys`` in order: absent but in ``need`` is an error
+    ``path.key = <missing>: required for selector = 'value'``; present but in
+    neither ``need`` nor ``optional`` is ``path.key = value: not used by
+    selector = 'value'; remove it``.
+    """
+    choice = getattr(obj, selector)
+    for key in keys:
+        value = getattr(obj, key)
+        if key in need and value is None:
+            raise SceneError(f"{path}.{key}", MISSING, f"required for {selector} = {choice!r}")
+        if key not in need and key not in optional and value is not None:
+            raise SceneError(f"{path}.{key}", value, f"not used by {selector} = {choice!r}; remove it")
+
+
 # ------------------------------------------------------------------ build
 def build(cls, data: Any, path: str = ""):
     """Validate the TOML table ``data`` into an instance of dataclass ``cls``.

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from ..errors import MISSING, SceneError
 from ..scene import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names, register)
-from ..schema import nonempty, nonnegative, open_interval, param, positive
+from ..schema import check_selected, nonempty, nonnegative, open_interval, param, positive
 
 PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
 PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map")
@@ -69,15 +69,8 @@ class CellGeometry:
         return 3 if self.profile in PROFILES_3D else 2
 
     def check(self, path: str) -> None:
-        need = self._USES[self.profile]
-        allowed = need + self._OPTIONAL.get(self.profile, ())
-        for key in ("width", "depth", "radius", "angles", "amplitude", "file"):
-            value = getattr(self, key)
-            if key in need and value is None:
-                raise SceneError(f"{path}.{key}", MISSING, f"required for profile = {self.profile!r}")
-            if key not in allowed and value is not None:
-                raise SceneError(f"{path}.{key}", value,
-                                 f"not used by profile = {self.profile!r}; remove it")
+        check_selected(self, path, "profile", ("width", "depth", "radius", "angles", "amplitude", "file"),
+                       self._USES[self.profile], self._OPTIONAL.get(self.profile, ()))
         if self.profile == "square_hills":
             if not self.width < self.period:
                 raise SceneError(f"{path}.width", self.width,
@@ -140,12 +133,7 @@ class GapSpec:
     def check(self, path: str) -> None:
         need = {"none": (), "constant": ("value",), "sinusoid": ("h",),
                 "bisinusoid": ("h",), "tabulated": ("file",)}[self.kind]
-        for key in ("value", "h", "file"):
-            v = getattr(self, key)
-            if key in need and v is None:
-                raise SceneError(f"{path}.{key}", MISSING, f"required for kind = {self.kind!r}")
-            if key not in need and v is not None:
-                raise SceneError(f"{path}.{key}", v, f"not used by kind = {self.kind!r}; remove it")
+        check_selected(self, path, "kind", ("value", "h", "file"), need)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -164,13 +152,7 @@ class ContactSpec:
 
     def check(self, path: str) -> None:
         need = {"none": (), "tresca": ("G", "w"), "coulomb": ("mu", "w")}[self.friction]
-        for key in ("G", "mu", "w"):
-            v = getattr(self, key)
-            if key in need and v is None:
-                raise SceneError(f"{path}.{key}", MISSING, f"required for friction = {self.friction!r}")
-            if key not in need and v is not None:
-                raise SceneError(f"{path}.{key}", v,
-                                 f"not used by friction = {self.friction!r}; remove it")
+        check_selected(self, path, "friction", ("G", "mu", "w"), need)
 
 
 @dataclass(frozen=True, kw_only=True)
