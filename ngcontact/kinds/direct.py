@@ -34,8 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import MISSING, SceneError
 from ..geometry.macro import FemurStemDims
+from .macro import check_dimensions
 from ..scene import MaterialSpec, SolverSpec, base_dir_field, check_material_names, register
 from ..schema import at_least, nonempty, param, positive
 
@@ -76,7 +77,7 @@ class DirectGeometry:
         if self.shape == "blocks":
             for key in ("length", "h_rough", "h_counter"):
                 if getattr(self, key) is None:
-                    raise SceneError(f"{path}.{key}", None, "required for shape 'blocks'")
+                    raise SceneError(f"{path}.{key}", MISSING, "required for shape 'blocks'")
             if self.dimensions is not None:
                 raise SceneError(f"{path}.dimensions", self.dimensions, "only for shape 'femur_stem'")
             return
@@ -85,17 +86,7 @@ class DirectGeometry:
         for key in ("length", "h_rough", "h_counter"):
             if getattr(self, key) is not None:
                 raise SceneError(f"{path}.{key}", getattr(self, key), "only for shape 'blocks'")
-        dims = self.dimensions or {}
-        for key in dims:
-            if key not in DIMENSIONS:
-                raise SceneError(f"{path}.dimensions.{key}", dims[key], f"one of {', '.join(DIMENSIONS)}")
-        for key in DIMENSIONS:
-            if key not in dims:
-                raise SceneError(f"{path}.dimensions.{key}", None, "required for shape 'femur_stem'")
-        try:
-            FemurStemDims(**dims).check()
-        except ValueError as exc:
-            raise SceneError(f"{path}.dimensions", dims, str(exc)) from None
+        check_dimensions(self.dimensions or {}, f"{path}.dimensions", "femur_stem", DIMENSIONS)
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -40,6 +40,28 @@ SETTINGS = {"femur_stem": ("axisymmetric",), "coaxial": ("plane_strain", "axisym
 DIMENSIONS = {"femur_stem": tuple(f.name for f in dataclasses.fields(FemurStemDims)),
               "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base")}
 REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base")}
+def check_dimensions(dims: dict, path: str, shape: str, required) -> None:
+    """A ``dimensions`` table: positive, known for ``shape``, the ``required`` ones present.
+
+    For ``femur_stem`` the completed dimensions must also describe a valid
+    femur and stem (:meth:`ngcontact.geometry.macro.FemurStemDims.check`).
+    """
+    for key in dims:
+        if not dims[key] > 0:
+            raise SceneError(f"{path}.{key}", dims[key], "must be > 0")
+        if key not in DIMENSIONS[shape]:
+            raise SceneError(f"{path}.{key}", dims[key],
+                             f"unknown dimension of {shape!r}; known: " + ", ".join(DIMENSIONS[shape]))
+    for key in required:
+        if key not in dims:
+            raise SceneError(f"{path}.{key}", MISSING, f"required for shape {shape!r}")
+    if shape == "femur_stem":
+        try:
+            FemurStemDims(**dims).check()
+        except ValueError as exc:
+            raise SceneError(path, dims, str(exc)) from None
+
+
 REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block": ("block", "base")}
 LAWS = ("linear", "bundle", "tabulated")
 #: Boundary labels of the meshed geometries (:mod:`ngcontact.geometry.macro`) by (shape, setting),
@@ -73,24 +95,11 @@ class MacroGeometrySpec:
             raise SceneError(f"{path}.setting", self.setting,
                              f"shape {self.shape!r} takes setting " + " or ".join(repr(s) for s in allowed))
         dims = self.dimensions or {}
-        for key in dims:
-            if not dims[key] > 0:
-                raise SceneError(f"{path}.dimensions.{key}", dims[key], "must be > 0")
-            if key not in DIMENSIONS[self.shape]:
-                raise SceneError(f"{path}.dimensions.{key}", dims[key],
-                                 f"unknown dimension of {self.shape!r}; known: " + ", ".join(DIMENSIONS[self.shape]))
         need = REQUIRED[self.shape] + (("height",) if self.shape == "coaxial" and self.setting != "plane_strain"
                                        else ())
-        for key in need:
-            if key not in dims:
-                raise SceneError(f"{path}.dimensions.{key}", MISSING, f"required for shape {self.shape!r}")
+        check_dimensions(dims, f"{path}.dimensions", self.shape, need)
         if self.shape == "coaxial" and not dims["a"] < dims["b"] < dims["c"]:
             raise SceneError(f"{path}.dimensions", dims, "need a < b < c")
-        if self.shape == "femur_stem":
-            try:
-                FemurStemDims(**dims).check()
-            except ValueError as exc:
-                raise SceneError(f"{path}.dimensions", dims, str(exc)) from None
 
 
 @dataclass(frozen=True, kw_only=True)
