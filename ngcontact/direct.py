@@ -46,7 +46,7 @@ from . import contact as _contact
 from . import elasticity
 from . import interface_law as il
 from .errors import ConvergenceError
-from .macro import interface_normal
+from .macro import add_load_potential, interface_normal
 from .newton import minimize
 
 log = logging.getLogger(__name__)
@@ -240,14 +240,7 @@ def _form(problem: DirectProblem, fes, n, *, threshold=None, surrogate: bool = F
                                         friction=None if fr is None else fr.law,
                                         w=None if fr is None else fr.w, threshold=threshold)
     form += ng.Variation(psi * w * ng.ds(definedon=mesh.Boundaries(problem.contact)))
-    normal = ng.specialcf.normal(mesh.dim)
-    for load in problem.loads:
-        t = -float(load.pressure) * normal
-        if load.traction:
-            t = t + ng.CF(tuple(float(c) for c in load.traction))
-        work = ng.InnerProduct(t, ur.Trace()) + ng.InnerProduct(t, uc.Trace())
-        form += ng.Variation(-work * w * ng.ds(definedon=mesh.Boundaries(load.label)))
-    return form
+    return add_load_potential(form, mesh, problem.loads, (ur, uc), w)
 
 
 def _check(problem: DirectProblem) -> None:

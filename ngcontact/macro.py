@@ -266,14 +266,24 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
     else:
         W = il.energy(law, a, g0, G)
     form += ng.Variation(W * w * ng.ds(definedon=mesh.Boundaries(problem.interface)))
-    dim = mesh.dim
-    n = ng.specialcf.normal(dim)
-    for load in problem.loads:
+    return add_load_potential(form, mesh, problem.loads, (ur, uc), w)
+
+
+def add_load_potential(form, mesh, loads, displacements, weight):
+    """Add ``-int t . u w ds`` of every surface load to a ``Variation`` form.
+
+    ``t = -p n + traction`` with ``n`` the outer normal of the loaded
+    boundary (a pressure ``p > 0`` pushes into the body).  Each body's
+    displacement is defined on its own region only, so summing over
+    ``displacements`` picks the body that owns the boundary.
+    """
+    n = ng.specialcf.normal(mesh.dim)
+    for load in loads:
         t = -float(load.pressure) * n
         if load.traction:
             t = t + ng.CF(tuple(float(c) for c in load.traction))
-        work = ng.InnerProduct(t, ur.Trace()) + ng.InnerProduct(t, uc.Trace())
-        form += ng.Variation(-work * w * ng.ds(definedon=mesh.Boundaries(load.label)))
+        work = sum(ng.InnerProduct(t, u.Trace()) for u in displacements)
+        form += ng.Variation(-work * weight * ng.ds(definedon=mesh.Boundaries(load.label)))
     return form
 
 
