@@ -298,19 +298,21 @@ def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS) -> dict:
     return row
 
 
+def per_error(rows: list, laws, summary) -> dict:
+    """``{law: {error: summary(column)}}`` over the error columns present in ``rows``."""
+    return {name: {key: summary(f"{name}_{key}") for key in ERRORS if f"{name}_{key}" in rows[0]}
+            for name in laws}
+
+
 def rates(rows: list, laws=LAWS) -> dict:
     """Fitted rate in ``eps`` of every error of every law (``None`` where an error is 0)."""
     eps = [r["eps"] for r in rows]
-    out = {}
-    for name in laws:
-        out[name] = {}
-        for key in ERRORS:
-            col = f"{name}_{key}"
-            if col not in rows[0]:
-                continue
-            vals = [r[col] for r in rows]
-            out[name][key] = fit_rate(eps, vals) if min(vals) > 0 else None
-    return out
+
+    def rate(col):
+        vals = [r[col] for r in rows]
+        return fit_rate(eps, vals) if min(vals) > 0 else None
+
+    return per_error(rows, laws, rate)
 
 
 def threshold_eps(rows: list, laws=LAWS, tol: float = 0.01) -> dict:
@@ -319,21 +321,13 @@ def threshold_eps(rows: list, laws=LAWS, tol: float = 0.01) -> dict:
     ``None`` where no level qualifies; otherwise ``{"eps", "N", "cost_ratio"}``
     with the cost ratio resolved / homogenized (bundle) wall time at that level.
     """
-    out = {}
-    for name in laws:
-        out[name] = {}
-        for key in ERRORS:
-            col = f"{name}_{key}"
-            if col not in rows[0]:
-                continue
-            hit = None
-            for r in sorted(rows, key=lambda r: -r["eps"]):
-                if all(q[col] < tol for q in rows if q["eps"] <= r["eps"]):
-                    hit = {"eps": r["eps"], "N": r["N"],
-                           "cost_ratio": r["time_resolved"] / r["time_homogenized"]}
-                    break
-            out[name][key] = hit
-    return out
+    def first_below(col):
+        for r in sorted(rows, key=lambda r: -r["eps"]):
+            if all(q[col] < tol for q in rows if q["eps"] <= r["eps"]):
+                return {"eps": r["eps"], "N": r["N"], "cost_ratio": r["time_resolved"] / r["time_homogenized"]}
+        return None
+
+    return per_error(rows, laws, first_below)
 
 
 def run_study(scene, periods=None, *, laws=LAWS, clock=None) -> Outcome:
