@@ -11,8 +11,8 @@ try:
 except PackageNotFoundError:  # running from a source tree
     __version__ = "0.1.0"
 
-from .errors import ConvergenceError, NgcontactError, SceneError  # noqa: E402
-from .scene import load  # noqa: E402
-from .runner import solve  # noqa: E402
+from ngcontact.errors import ConvergenceError, NgcontactError, SceneError  # noqa: E402
+from ngcontact.scene.loader import load  # noqa: E402
+from ngcontact.runner import solve  # noqa: E402
 
 __all__ = ["ConvergenceError", "NgcontactError", "SceneError", "load", "solve", "__version__"]

@@ -4,7 +4,7 @@
 CSV tables, VTK files for ParaView and PNG plots into ``DIR`` (default
 ``results/<scene name>``); ``ngcontact check SCENE`` only validates it;
 ``ngcontact study epsilon SCENE [--periods N ...] [--out DIR]`` runs the
-epsilon study of a ``direct`` scene (:mod:`ngcontact.epsilon_study`) and
+epsilon study of a ``direct`` scene (:mod:`ngcontact.verification.epsilon_study`) and
 writes ``report.json``, ``epsilon.csv`` and ``epsilon.png`` into ``DIR``
 (default ``results/<scene name>_epsilon``).
 
@@ -18,9 +18,9 @@ import logging
 import os
 import sys
 
-from . import __version__
-from . import scene as scene_mod
-from .errors import ConvergenceError, NgcontactError, OutputError, SceneError
+from ngcontact import __version__
+from ngcontact.scene import loader as scene_mod
+from ngcontact.errors import ConvergenceError, NgcontactError, OutputError, SceneError
 
 EXIT_OK, EXIT_SCENE, EXIT_SOLVER = 0, 2, 3
 
@@ -89,15 +89,15 @@ def _check(path: str) -> int:
 
 
 def _run(path: str, out: str | None, quiet: bool) -> int:
-    from .runner import solve
+    from ngcontact.runner import solve
 
     return _execute(path, out, quiet, solve, suffix="")
 
 
 def _study(path: str, periods, out: str | None, quiet: bool) -> int:
     """``ngcontact study epsilon``: the same code as ``scripts/epsilon_study.py``."""
-    from .epsilon_study import epsilon_report
-    from .report import Clock
+    from ngcontact.verification.epsilon_study import epsilon_report
+    from ngcontact.output.report import Clock
 
     def require_study(sc):
         if sc.kind != "direct" or sc.study is None:
@@ -117,7 +117,7 @@ def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, v
     Maps every failure to its exit status with a one-line message: invalid
     scene or output directory 2, solver failure 3.
     """
-    from .report import ensure_writable, write_outputs
+    from ngcontact.output.report import ensure_writable, write_outputs
 
     try:
         sc = scene_mod.load(path)

@@ -6,18 +6,28 @@ The one code path behind ``ngcontact run`` and the Python API::
 
 ``report`` is the JSON-ready dictionary (see the README's report reference);
 ``outcome`` keeps the NGSolve objects (meshes, fields) for further work.
-Nothing is written to disk; :func:`ngcontact.report.write_outputs` does that.
+Nothing is written to disk; :func:`ngcontact.output.report.write_outputs` does that.
 """
 from __future__ import annotations
 
 import importlib
+from typing import Callable
 
-from . import __version__
-from . import scene as scene_mod
-from .report import Clock, Outcome, build_report
+from ngcontact import __version__
+from ngcontact.output.report import Clock, Outcome, build_report
+from ngcontact.scene import loader
+
+#: kind -> the driver module whose ``run(scene, clock)`` solves it; imported
+#: on first use, so that ``ngcontact check`` stays light.
+DRIVERS = {
+    "manufactured": "ngcontact.drivers.run_manufactured",
+    "cell": "ngcontact.drivers.run_cell",
+    "macro": "ngcontact.drivers.run_macro",
+    "direct": "ngcontact.drivers.run_resolved",
+}
 
 
-def solve(scene, progress=None) -> tuple[dict, Outcome]:
+def solve(scene, progress: Callable[[str], None] | None = None) -> tuple[dict, Outcome]:
     """Solve ``scene`` (a validated scene or a path to a scene file).
 
     Parameters
@@ -32,11 +42,10 @@ def solve(scene, progress=None) -> tuple[dict, Outcome]:
     (report, outcome)
     """
     if not hasattr(scene, "kind"):
-        scene = scene_mod.load(scene)
+        scene = loader.load(scene)
     clock = Clock(progress)
-    module, func = scene_mod.KINDS[scene.kind].runner.split(":")
-    outcome = getattr(importlib.import_module(module), func)(scene, clock)
+    outcome = importlib.import_module(DRIVERS[scene.kind]).run(scene, clock)
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
-                          scene=scene_mod.as_dict(scene), effects=scene_mod.effects(scene),
+                          scene=loader.as_dict(scene), effects=loader.effects(scene),
                           outcome=outcome, timings=clock.total(), version=__version__)
     return report, outcome

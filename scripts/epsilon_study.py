@@ -3,7 +3,7 @@
 For each number of periods N (the scene's ``[study] periods`` or ``--periods``)
 the resolved problem and the homogenized problems with the bundle, the linear
 whole-surface and the effective-stiffness laws are solved and compared (see
-:mod:`ngcontact.epsilon_study`).  Writes, atomically, ``DIR/report.json``
+:mod:`ngcontact.verification.epsilon_study`).  Writes, atomically, ``DIR/report.json``
 (``results.rows``, ``results.rates``, ``results.below_1_percent``),
 ``DIR/epsilon.csv`` and ``DIR/epsilon.png`` (error and cost against eps).
 
@@ -20,11 +20,11 @@ import argparse
 import os
 import sys
 
-from ngcontact import scene as scene_mod
+from ngcontact.scene import loader as scene_mod
 from ngcontact.cli import EXIT_OK, EXIT_SCENE, EXIT_SOLVER
-from ngcontact.epsilon_study import epsilon_report
+from ngcontact.verification.epsilon_study import epsilon_report
 from ngcontact.errors import ConvergenceError, NgcontactError, OutputError, SceneError
-from ngcontact.report import Clock, ensure_writable, write_outputs
+from ngcontact.output.report import Clock, ensure_writable, write_outputs
 
 
 def main(argv=None) -> int:

@@ -13,8 +13,8 @@ import argparse
 import os
 import sys
 
-from ngcontact.scene import KINDS, _ensure_kinds
-from ngcontact.schema import describe
+from ngcontact.scene.kinds import KINDS
+from ngcontact.scene.schema import describe
 
 BEGIN = "<!-- scene-reference:begin -->"
 END = "<!-- scene-reference:end -->"
@@ -23,7 +23,6 @@ README = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "RE
 
 def reference() -> str:
     """Markdown tables, one per scene kind."""
-    _ensure_kinds()
     out = []
     for name in sorted(KINDS):
         cls = KINDS[name].scene

@@ -30,12 +30,12 @@ import time
 
 import ngsolve as ng
 
-from ngcontact.cell import CellModel, CellProblem, cell_load
+from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
 from ngcontact.geometry import profiles
 from ngcontact.geometry.cell2d import flat_cell
-from ngcontact.homogenize import coefficients
-from ngcontact.materials import isotropic
-from ngcontact.report import write_csv
+from ngcontact.cell.coefficients import coefficients
+from ngcontact.fem.materials import isotropic
+from ngcontact.output.report import write_csv
 
 log = logging.getLogger("work_precision_cell")
 

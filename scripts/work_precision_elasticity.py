@@ -1,7 +1,7 @@
 """What accuracy costs in time: work-precision of the manufactured elasticity problem.
 
 For the manufactured plane-strain and axisymmetric problems of
-:mod:`ngcontact.manufactured` it measures the L2 and H1-seminorm errors
+:mod:`ngcontact.verification.manufactured` it measures the L2 and H1-seminorm errors
 against the wall time of one solve (mesh, assembly, sparse direct solve;
 the error evaluation is not counted) under
 
@@ -21,9 +21,10 @@ import argparse
 import logging
 import os
 
-from ngcontact import manufactured, studies
-from ngcontact.materials import isotropic
-from ngcontact.report import write_csv
+from ngcontact.verification import manufactured
+from ngcontact.verification import rates as studies
+from ngcontact.fem.materials import isotropic
+from ngcontact.output.report import write_csv
 
 log = logging.getLogger("work_precision_elasticity")
 

@@ -23,9 +23,9 @@ import time
 
 import numpy as np
 
-from ngcontact import macro as M
-from ngcontact import scene as scene_mod
-from ngcontact.drivers.macro import build_geometry, problem_of, solve_scene
+from ngcontact.macro import macro_problem as M
+from ngcontact.scene import loader as scene_mod
+from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 log = logging.getLogger("work_precision_femur")

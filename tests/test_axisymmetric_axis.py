@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from netgen.geom2d import SplineGeometry
 
-from ngcontact import elasticity as el
-from ngcontact.materials import isotropic
+from ngcontact.fem import elasticity as el
+from ngcontact.fem.materials import isotropic
 
 E, NU, Q = 2.0, 0.3, 1.0
 

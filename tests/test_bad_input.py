@@ -451,9 +451,9 @@ def test_both_pressure_and_normal_jump(tmp_path, capsys):
 
 def test_boundary_table_matches_the_meshed_geometries():
     """The labels checked without meshing are exactly those the meshers create."""
-    from ngcontact.geometry import macro as gm
-    from ngcontact.kinds.macro import BOUNDARIES
-    from ngcontact.macro import boundary_labels
+    from ngcontact.geometry import bodies as gm
+    from ngcontact.scene.macro_scene import BOUNDARIES
+    from ngcontact.macro.macro_problem import boundary_labels
     built = {("femur_stem", "axisymmetric"): gm.femur_stem(maxh=0.02),
              ("coaxial", "plane_strain"): gm.coaxial_plane_strain(1.0, 2.0, 3.0, maxh=1.0),
              ("coaxial", "axisymmetric"): gm.coaxial_axisymmetric(1.0, 2.0, 3.0, 1.0, maxh=1.0),

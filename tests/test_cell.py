@@ -7,10 +7,10 @@ import ngsolve as ng
 import numpy as np
 import pytest
 
-from ngcontact.cell import CellModel, CellProblem, Friction, cell_load
+from ngcontact.cell.cell_problem import CellModel, CellProblem, Friction, cell_load
 from ngcontact.errors import ConvergenceError
 from ngcontact.geometry.cell2d import flat_cell
-from ngcontact.materials import isotropic
+from ngcontact.fem.materials import isotropic
 
 LAW = isotropic(1.0, 0.3)
 
@@ -134,7 +134,7 @@ def test_macro_strain_gives_laminate_stresses():
     while ``sigma_yy`` is continuous.  Quadratic elements hold the linear
     displacements exactly.
     """
-    from ngcontact.materials import isotropic as iso
+    from ngcontact.fem.materials import isotropic as iso
     mats = {"rough": (1.0, 0.3), "counter": (3.0, 0.2)}
     exx, p = 1e-3, 2e-3
     c = flat_cell(maxh=0.3, order=1)

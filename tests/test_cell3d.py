@@ -26,9 +26,9 @@ import math
 import numpy as np
 import pytest
 
-from ngcontact.cell import CellModel, CellProblem, cell_load
+from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
 from ngcontact.geometry.cell3d import square_hills_cell
-from ngcontact.materials import isotropic
+from ngcontact.fem.materials import isotropic
 
 K_N = 200e9
 PRESSURE = 10e6

@@ -14,7 +14,7 @@ import pytest
 
 from ngcontact.geometry.cell3d import bisinusoid_heights, surface_cell
 from ngcontact.geometry.tabulated import read_height_map
-from ngcontact.homogenize import coefficients, contact_normal
+from ngcontact.cell.coefficients import coefficients, contact_normal
 
 A = 0.05
 

@@ -124,7 +124,7 @@ def test_unwritable_output_exits_2(scene_file, tmp_path, capsys):
 
 
 def test_solver_failure_exits_3_and_leaves_nothing(scene_file, tmp_path, monkeypatch, capsys):
-    from ngcontact.drivers import manufactured as driver
+    from ngcontact.drivers import run_manufactured as driver
 
     def failing(scene, clock):
         raise ConvergenceError("Newton did not converge in 3 steps", {"iterations": 3})
@@ -139,7 +139,7 @@ def test_solver_failure_exits_3_and_leaves_nothing(scene_file, tmp_path, monkeyp
 
 def test_inaccurate_linear_solve_exits_3_and_keeps_old_output(scene_file, tmp_path, monkeypatch, capsys):
     """The driver's own residual check: with a zero tolerance no solve is accurate enough."""
-    from ngcontact.drivers import manufactured as driver
+    from ngcontact.drivers import run_manufactured as driver
 
     out = tmp_path / "out"
     out.mkdir()
@@ -174,7 +174,7 @@ def test_console_script(scene_file, tmp_path):
 
 def test_unexpected_error_is_one_line_exit_3_and_no_output(tmp_path, monkeypatch, capsys):
     """A failure nobody anticipated (here: inside the driver) still ends in one line, exit 3."""
-    import ngcontact.drivers.manufactured as drv
+    import ngcontact.drivers.run_manufactured as drv
 
     def boom(scene, clock):
         raise RuntimeError("mesher exploded")

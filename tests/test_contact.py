@@ -1,7 +1,7 @@
 """Consistency of the interface energies: energy -> residual -> tangent.
 
 Central differences of the total cell energy (elasticity plus the contact
-terms of :mod:`ngcontact.contact`) along a random direction must match the
+terms of :mod:`ngcontact.laws.penalty`) along a random direction must match the
 residual NGSolve derives, and central differences of the residual must match
 the tangent, at states away from the kinks of ``[.]_+`` and of the Huber
 function.
@@ -10,10 +10,10 @@ import ngsolve as ng
 import numpy as np
 import pytest
 
-from ngcontact import contact
-from ngcontact.cell import CellModel, CellProblem, Friction
+from ngcontact.laws import penalty as contact
+from ngcontact.cell.cell_problem import CellModel, CellProblem, Friction
 from ngcontact.geometry.cell2d import flat_cell
-from ngcontact.materials import isotropic
+from ngcontact.fem.materials import isotropic
 
 LAW = isotropic(1.0, 0.3)
 W = 1e-3

@@ -2,7 +2,7 @@
 
 * A periodic strip of N resolved periods under a prescribed far-face jump is
   the cell problem N times over: same mean traction and contact fraction as
-  :mod:`ngcontact.cell` (a check of both codes: orientation of the micro
+  :mod:`ngcontact.cell.cell_problem` (a check of both codes: orientation of the micro
   normal over many periods, periodic spaces, reactions).
 * The homogenized bundle law converges to the resolved solution at a rate
   of about eps on ``block_rect_valleys.toml`` and beats the whole-surface
@@ -17,14 +17,14 @@ import ngsolve as ng
 import numpy as np
 import pytest
 
-from ngcontact import direct as D
-from ngcontact import materials as mat
-from ngcontact import scene as scene_mod
-from ngcontact.cell import CellModel, CellProblem, cell_load
-from ngcontact.epsilon_study import run_study
+from ngcontact.resolved import resolved_problem as D
+from ngcontact.fem import materials as mat
+from ngcontact.scene import loader as scene_mod
+from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
+from ngcontact.verification.epsilon_study import run_study
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
-from ngcontact.geometry.resolved import flat_blocks, resolved_blocks
+from ngcontact.geometry.resolved_bodies import flat_blocks, resolved_blocks
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BLOCK = os.path.join(ROOT, "geometries", "direct", "block_rect_valleys.toml")

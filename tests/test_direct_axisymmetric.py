@@ -20,16 +20,16 @@ import ngsolve as ng
 import numpy as np
 import pytest
 
-from ngcontact import direct as D
-from ngcontact import materials as mat
-from ngcontact import scene as scene_mod
-from ngcontact.drivers import direct as drv
-from ngcontact.epsilon_study import run_study
+from ngcontact.resolved import resolved_problem as D
+from ngcontact.fem import materials as mat
+from ngcontact.scene import loader as scene_mod
+from ngcontact.drivers import run_resolved as drv
+from ngcontact.verification.epsilon_study import run_study
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
-from ngcontact.geometry.macro import FemurStemDims
-from ngcontact.geometry.resolved import femur_stem, resolved_blocks, split_periods
-from ngcontact.report import Clock
+from ngcontact.geometry.bodies import FemurStemDims
+from ngcontact.geometry.resolved_bodies import femur_stem, resolved_blocks, split_periods
+from ngcontact.output.report import Clock
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FEMUR = os.path.join(ROOT, "geometries", "direct", "femur_stem_grooves.toml")

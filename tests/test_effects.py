@@ -138,8 +138,8 @@ def test_macro_linear_law_is_one_linear_solve_and_no_friction_term(tmp_path):
 def test_failures_after_the_solve_leave_the_previous_output_and_no_partial_files(tmp_path, monkeypatch, capsys):
     """Atomic output through the command line: a non-finite result found after the solve
     (exit 3) and a write that fails halfway (exit 2) both leave the earlier run intact."""
-    from ngcontact import report as report_mod
-    from ngcontact.cell import CellProblem
+    from ngcontact.output import report as report_mod
+    from ngcontact.cell.cell_problem import CellProblem
 
     scene = tmp_path / "cell.toml"
     scene.write_text(CELL.format(friction=""))

@@ -8,8 +8,9 @@ orders 1 and 2 (3D: order 1); higher orders are marked slow.
 import numpy as np
 import pytest
 
-from ngcontact import manufactured, studies
-from ngcontact.materials import anisotropic, isotropic
+from ngcontact.verification import manufactured
+from ngcontact.verification import rates as studies
+from ngcontact.fem.materials import anisotropic, isotropic
 
 TOLERANCE = 0.25
 

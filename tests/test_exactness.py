@@ -9,8 +9,8 @@ import numpy as np
 import ngsolve as ng
 import pytest
 
-from ngcontact import manufactured
-from ngcontact.materials import anisotropic, isotropic
+from ngcontact.verification import manufactured
+from ngcontact.fem.materials import anisotropic, isotropic
 
 LAW = isotropic(3.0, 0.3)
 

@@ -20,11 +20,11 @@ import numpy as np
 import pytest
 
 import ngcontact
-from ngcontact.cell import CellModel, CellProblem, Friction, cell_load
+from ngcontact.cell.cell_problem import CellModel, CellProblem, Friction, cell_load
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.cell2d import flat_cell
-from ngcontact.homogenize import coefficients
-from ngcontact.materials import isotropic
+from ngcontact.cell.coefficients import coefficients
+from ngcontact.fem.materials import isotropic
 
 pytestmark = [pytest.mark.slow, pytest.mark.hard]
 
@@ -199,7 +199,7 @@ def test_3d_cell_with_a_periodic_height_map():
     """The shipped height map (small-slope model), two pressures: at most 20 Newton steps,
     finite, equilibrium, contact grows with the pressure."""
     scene = ngcontact.load(os.path.join(ROOT, "geometries", "cells", "height_map.toml"))
-    from ngcontact.drivers.cell import build_cell, model_of
+    from ngcontact.drivers.run_cell import build_cell, model_of
     cell = build_cell(scene)
     P = CellProblem(cell, model_of(scene))
     sols = P.sweep([cell_load(3, pressure=q) for q in (0.002, 0.01)])
@@ -222,9 +222,9 @@ def test_contact_across_the_symmetry_axis(order, law):
     the closure is ``P / k_n``.  Quadrature points on the axis (where ``u_r / r``
     is 0/0) must not spoil it at any order.
     """
-    from ngcontact import interface_law as il
-    from ngcontact import macro as M
-    from ngcontact.geometry import macro as gm
+    from ngcontact.laws import homogenized as il
+    from ngcontact.macro import macro_problem as M
+    from ngcontact.geometry import bodies as gm
 
     kn, P = 5e11, 2e6
     normal = (il.LinearLaw(kn=kn, kt=2e11) if law == "linear"

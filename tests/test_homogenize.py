@@ -7,7 +7,7 @@ import pytest
 
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.cell3d import square_hills_cell
-from ngcontact.homogenize import coefficients, contact_normal, direction_bundle
+from ngcontact.cell.coefficients import coefficients, contact_normal, direction_bundle
 
 
 def _cell(profile, arrangement="conforming", order=4, h=0.1):

@@ -7,7 +7,7 @@ gives the same numbers.
 import numpy as np
 import pytest
 
-from ngcontact import interface_law as il
+from ngcontact.laws import homogenized as il
 
 RNG = np.random.default_rng(7)
 

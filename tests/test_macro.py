@@ -5,10 +5,10 @@ import numpy as np
 import ngsolve as ng
 import pytest
 
-from ngcontact import interface_law as il
-from ngcontact import macro as M
-from ngcontact.geometry import macro as gm
-from ngcontact.materials import isotropic
+from ngcontact.laws import homogenized as il
+from ngcontact.macro import macro_problem as M
+from ngcontact.geometry import bodies as gm
+from ngcontact.fem.materials import isotropic
 
 # ----------------------------------------------------------- Lame press fit
 A, B, C = 0.5, 1.0, 2.0          # bore, interface, mantle radii
@@ -286,8 +286,8 @@ def test_femur_stem_scene_runs_end_to_end(tmp_path):
 
 def test_scene_with_an_unknown_boundary_names_the_existing_ones():
     import os
-    from ngcontact import scene as scene_mod
-    from ngcontact.drivers.macro import build_geometry, problem_of
+    from ngcontact.scene import loader as scene_mod
+    from ngcontact.drivers.run_macro import build_geometry, problem_of
     from ngcontact.errors import SceneError
     sc = scene_mod.load(os.path.join(ROOT, "geometries", "femur_stem.toml"))
     bad = __import__("dataclasses").replace(sc.supports[0], boundary="floor")
@@ -299,7 +299,7 @@ def test_scene_with_an_unknown_boundary_names_the_existing_ones():
 def test_law_from_a_cell_is_its_bundle_with_the_cells_K0_and_is_cached(tmp_path, monkeypatch):
     """Sawtooth cell (Example 27): bundle K0 = closed form; the second call reads the cache."""
     import os
-    from ngcontact import cell_law
+    from ngcontact.coupling import cell_law
     monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
     path = os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml")
     law, info = cell_law.law_from_cell(path, dim=2)
@@ -323,9 +323,9 @@ def test_law_from_a_cell_is_its_bundle_with_the_cells_K0_and_is_cached(tmp_path,
 def test_block_on_a_sawtooth_cell_scene_transmits_the_load(tmp_path, monkeypatch):
     """Macro scene taking its law from a cell: equilibrium and a closed interface."""
     import os
-    from ngcontact import scene as scene_mod
-    from ngcontact.drivers.macro import run
-    from ngcontact.report import Clock
+    from ngcontact.scene import loader as scene_mod
+    from ngcontact.drivers.run_macro import run
+    from ngcontact.output.report import Clock
     monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
     sc = scene_mod.load(os.path.join(ROOT, "geometries", "macro", "block_on_sawtooth.toml"))
     out = run(sc, Clock())
@@ -340,8 +340,8 @@ def test_femur_law_from_the_hip_cell_is_the_papers_32_GPa(tmp_path, monkeypatch)
     """The hip cell (square hills, a = 0.4, k_n = 200 GPa) gives k_n0 = 32 GPa (eq. 36) and the
     femur solved with the cell's bundle equals the one with the explicit number."""
     import os
-    from ngcontact import scene as scene_mod
-    from ngcontact.drivers.macro import build_geometry, problem_of, solve_scene
+    from ngcontact.scene import loader as scene_mod
+    from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
     monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
     pressures = []
     for path in (("femur_stem.toml",), ("macro", "femur_stem_from_cell.toml")):

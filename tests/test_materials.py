@@ -4,8 +4,8 @@ import ngsolve as ng
 import pytest
 from netgen.geom2d import SplineGeometry
 
-from ngcontact import elasticity
-from ngcontact.materials import (anisotropic, isotropic, plane_strain_modulus, principal_stresses,
+from ngcontact.fem import elasticity
+from ngcontact.fem.materials import (anisotropic, isotropic, plane_strain_modulus, principal_stresses,
                                  tresca, von_mises)
 
 E, NU = 200.0, 0.25

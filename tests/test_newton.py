@@ -6,7 +6,7 @@ import pytest
 from netgen.geom2d import unit_square
 
 from ngcontact.errors import ConvergenceError
-from ngcontact.newton import minimize
+from ngcontact.solvers.newton import minimize
 
 
 @pytest.fixture(scope="module")
@@ -63,7 +63,7 @@ def test_quadratic_energy_takes_one_linear_solve(scalar):
 
 
 def test_cycle_detector_flags_a_flip_flop_with_a_stagnating_residual():
-    from ngcontact.newton import ActiveSetCycle
+    from ngcontact.solvers.newton import ActiveSetCycle
     d = ActiveSetCycle()
     seq = ["A", "B", "A", "B", "A"]
     msgs = [d.step(k + 1, s, 1.0) for k, s in enumerate(seq)]
@@ -73,7 +73,7 @@ def test_cycle_detector_flags_a_flip_flop_with_a_stagnating_residual():
 
 
 def test_cycle_detector_ignores_progress_and_new_states():
-    from ngcontact.newton import ActiveSetCycle
+    from ngcontact.solvers.newton import ActiveSetCycle
     d = ActiveSetCycle()
     # the same flip-flop, but the residual falls tenfold per step: a converging iteration
     assert all(d.step(k + 1, s, 10.0 ** -k) is None for k, s in enumerate("ABABABAB"))
@@ -86,9 +86,9 @@ def test_cycle_detector_ignores_progress_and_new_states():
 def test_cell_newton_records_the_active_set_and_finds_no_false_cycle():
     import math as m
 
-    from ngcontact.cell import CellModel, CellProblem, cell_load
+    from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
     from ngcontact.geometry.cell2d import flat_cell
-    from ngcontact.materials import isotropic
+    from ngcontact.fem.materials import isotropic
 
     law = isotropic(1.0, 0.3)
     c = flat_cell(maxh=0.2, interface_maxh=0.02, order=1)

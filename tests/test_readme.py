@@ -28,7 +28,7 @@ def test_exactly_two_setup_commands_and_ci_runs_the_test_one():
 
 
 def test_main_job_scene_exists_and_is_valid():
-    from ngcontact import scene
+    from ngcontact.scene import loader as scene
     main_job = setup_commands()[0]
     path = re.search(r"ngcontact run (\S+)", main_job).group(1)
     scene.load(os.path.join(ROOT, path))

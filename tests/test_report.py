@@ -6,7 +6,7 @@ import os
 import numpy as np
 import pytest
 
-from ngcontact.report import Clock, Outcome, build_report, ensure_writable, to_plain, write_outputs
+from ngcontact.output.report import Clock, Outcome, build_report, ensure_writable, to_plain, write_outputs
 from ngcontact.errors import OutputError
 
 

@@ -10,7 +10,8 @@ import os
 
 import pytest
 
-from ngcontact import cli, scene
+from ngcontact import cli
+from ngcontact.scene import loader as scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES = sorted(glob.glob(os.path.join(ROOT, "geometries", "**", "*.toml"), recursive=True))

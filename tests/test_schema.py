@@ -1,7 +1,7 @@
 """Scene validation: messages name the key path, the value and what is allowed."""
 import pytest
 
-from ngcontact import scene
+from ngcontact.scene import loader as scene
 from ngcontact.errors import SceneError
 
 

@@ -2,12 +2,12 @@
 import numpy as np
 import pytest
 
-from ngcontact import strength as S
-from ngcontact.cell import CellModel, CellProblem, Friction
+from ngcontact.coupling import strength as S
+from ngcontact.cell.cell_problem import CellModel, CellProblem, Friction
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
-from ngcontact.materials import isotropic, tresca, von_mises
-from ngcontact.scene import from_dict, load
+from ngcontact.fem.materials import isotropic, tresca, von_mises
+from ngcontact.scene.loader import from_dict, load
 
 K_N = 50.0
 
@@ -88,8 +88,8 @@ def test_nonlinear_recovery_agrees_with_the_correctors_where_the_contact_set_is_
     """
     import tomllib
 
-    from ngcontact.drivers.macro import build_geometry, problem_of, solve_scene
-    from ngcontact.drivers.strength import evaluate
+    from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
+    from ngcontact.drivers.run_strength import evaluate
 
     with open("geometries/femur_stem.toml", "rb") as fh:
         data = tomllib.load(fh)

@@ -4,13 +4,13 @@ import math
 import numpy as np
 import pytest
 
-from ngcontact import interface_law as il
-from ngcontact import macro as M
-from ngcontact import twoscale as T
-from ngcontact.cell import CellModel, CellProblem
+from ngcontact.laws import homogenized as il
+from ngcontact.macro import macro_problem as M
+from ngcontact.coupling import two_scale as T
+from ngcontact.cell.cell_problem import CellModel, CellProblem
 from ngcontact.geometry import profiles as pr
-from ngcontact.geometry import macro as gm
-from ngcontact.materials import isotropic
+from ngcontact.geometry import bodies as gm
+from ngcontact.fem.materials import isotropic
 
 import ngsolve as ng
 
@@ -100,9 +100,9 @@ def test_table_grows_only_where_the_range_is_extended():
 
 @pytest.mark.slow
 def test_loop_converges_on_the_shipped_scene_with_falling_changes():
-    from ngcontact.drivers import macro as D
-    from ngcontact.report import Clock
-    from ngcontact.scene import effects, load
+    from ngcontact.drivers import run_macro as D
+    from ngcontact.output.report import Clock
+    from ngcontact.scene.loader import effects, load
     scene = load("geometries/femur_stem_two_scale.toml")
     assert "two_scale_coupling" in effects(scene)
     out = D.run(scene, Clock())

@@ -17,12 +17,12 @@ import os
 import ngsolve as ng
 import pytest
 
-from ngcontact import scene as scene_mod
-from ngcontact.cell import CellModel, CellProblem, cell_load
-from ngcontact.drivers.cell import build_cell, model_of
+from ngcontact.scene import loader as scene_mod
+from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
+from ngcontact.drivers.run_cell import build_cell, model_of
 from ngcontact.geometry.cell2d import flat_cell
-from ngcontact.kinds.cell import loads
-from ngcontact.materials import isotropic
+from ngcontact.scene.cell_scene import loads
+from ngcontact.fem.materials import isotropic
 
 SCENE = os.path.join(os.path.dirname(__file__), "..", "geometries", "cells", "westergaard.toml")
 

@@ -42,8 +42,8 @@ import numpy as np
 import ngsolve as ng
 from netgen.csg import CSGeometry, OrthoBrick, Plane, Pnt, Vec
 
-from ..errors import SceneError
-from .cell2d import Cell, periodic_maxh
+from ngcontact.errors import SceneError
+from ngcontact.geometry.cell2d import Cell, periodic_maxh
 
 log = logging.getLogger(__name__)
 
@@ -222,7 +222,7 @@ def surface_cell(heights, *, period: float = 1.0, h_rough: float, h_counter: flo
     lateral faces exact.
     """
     import netgen.occ as occ
-    from .tabulated import check_height_map
+    from ngcontact.geometry.tabulated import check_height_map
 
     P = _positive("geometry.period", period)
     hr, hc = _positive("geometry.h_rough", h_rough), _positive("geometry.h_counter", h_counter)

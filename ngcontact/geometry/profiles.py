@@ -40,8 +40,8 @@ import logging
 import math
 from dataclasses import dataclass, replace
 
-from ..errors import SceneError
-from .cell2d import Cell, Segment, interface_cell
+from ngcontact.errors import SceneError
+from ngcontact.geometry.cell2d import Cell, Segment, interface_cell
 
 log = logging.getLogger(__name__)
 

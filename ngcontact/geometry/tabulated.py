@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError
-from .profiles import Profile, tabulated
+from ngcontact.errors import SceneError
+from ngcontact.geometry.profiles import Profile, tabulated
 
 PERIODIC_TOL = 1e-9
 

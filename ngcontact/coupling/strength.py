@@ -1,0 +1,357 @@
+"""Micro stresses in the interface layer and the strength check (paper eqs. 74-78).
+
+Linear recovery (paper eqs. 72-75).  With the real contact set ``S_act`` of
+the cell held fixed, the cell problem of :mod:`ngcontact.cell.cell_problem` becomes
+quadratic: the penalty acts on ``S_act`` in both directions,
+
+    Pi_lin(u) = sum_B int_B 1/2 (eps(u_B) + E) : C_B : (eps(u_B) + E) dx
+                + int_{S_act} k_n/2 (J.n - g)^2 + k_t/2 |J_t|^2 ds - |T| tbar . U,
+
+(``k_t`` a tangential stiffness on ``S_act``: 0 for frictionless contact,
+else the stick stiffness that lets the summits carry shear).  Its solution is
+affine in the load vector ``l = (tau_1[, tau_2], p, E_1, ...)`` made of the
+mean shear on the counter's far face, the mean pressure ``p = -tbar_n``
+(compression positive) and the in-plane macro strain components, so the
+micro stress is the superposition
+
+    sigma(xi; l) = sigma_g(xi) + sum_k l_k Sigma_k(xi),                  (75)
+
+``sigma_g`` the stress of the gap alone (zero load) and ``Sigma_k`` the
+stress of the unit-load correctors: unit tractions play the part of the
+paper's unit macro jumps ``Theta_p`` (a traction and a jump determine each
+other through the fixed-contact-set stiffness) and unit strains that of
+``N_pq``.  One factorization serves every corrector.
+
+Nonlinear recovery: the contact cell problem itself
+(:class:`ngcontact.cell.CellProblem`) solved at the macro state.
+
+Strength (eqs. 76-78): the equivalent stress ``sigma_eq`` (von Mises
+``sqrt(3/2 s:s)`` or Tresca ``max |sigma_k - sigma_l|``, eq. 77,
+:mod:`ngcontact.fem.materials`) is maximized over the cell (``xi``) and over the
+macro interface points (``x``); each body is checked against its own
+ultimate stress ``sigma_u`` and the safety factor is
+``min_B sigma_u,B / max sigma_eq,B`` (eq. 78 holds when it exceeds 1).
+
+Macro state at an interface point: the local traction ``(p, tau)`` of the
+homogenized law (compression positive, ``tau`` along ``t0``) and the strain
+of the layer tangential to ``S_0``, the mean of the two bodies' strains next
+to the point.  The cell's axes are ``(t0, n0)`` in 2D and ``(t0, hoop, n0)``
+in 3D, so the cell loads are ``tau_x = -tau`` (the counter's far face carries
+the opposite of what the rough body transmits), ``p``, ``E_xx = e_t0t0``
+and in 3D ``E_yy = e_hoop`` (axisymmetry; 0 in plane strain), ``E_xy = 0``.
+A 2D cell takes ``E_xx`` only (it is in plane strain across the hoop
+direction).
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import ngsolve as ng
+import numpy as np
+
+from ngcontact.laws import penalty as _contact
+from ngcontact.fem import materials as _mat
+
+log = logging.getLogger(__name__)
+
+CRITERIA = ("von_mises", "tresca")
+BODIES = ("rough", "counter")
+
+
+# ------------------------------------------------------------ load vectors
+def load_names(dim: int) -> tuple:
+    """Names of the load components ``l_k`` of a ``dim``-D cell (see module docstring)."""
+    if dim == 2:
+        return ("shear_x", "pressure", "E_xx")
+    return ("shear_x", "shear_y", "pressure", "E_xx", "E_yy", "E_xy")
+
+
+def _set_load(problem, l) -> None:
+    """Put the load vector ``l`` into the traction and strain parameters of ``problem``."""
+    d = problem.dim
+    for i in range(d - 1):
+        problem.traction[i].Set(float(l[i]))
+    problem.traction[d - 1].Set(-float(l[d - 1]))
+    for k, par in enumerate(problem.strain_params):
+        par.Set(float(l[d + k]))
+
+
+def sample_stresses(problem) -> dict:
+    """Stress tensors of the current state of ``problem`` per body at element points.
+
+    Returns ``{body: {"points": (n, dim), "stress": (n, 3, 3)}}``
+    (:meth:`ngcontact.cell.CellProblem.body_stresses`).
+    """
+    return problem.body_stresses()
+
+
+# ------------------------------------------------------------ correctors
+@dataclass
+class Correctors:
+    """Stress of the gap state and of the unit-load correctors, per body.
+
+    Attributes
+    ----------
+    names
+        Load component names (:func:`load_names`).
+    points
+        ``{body: (n, dim)}`` sample points.
+    base
+        ``{body: (n, 3, 3)}`` stress at zero load (the gap alone).
+    unit
+        ``{body: (K, n, 3, 3)}`` stress of the unit load ``k``.
+    states
+        Displacement vectors: the gap state, then the unit-load correctors
+        (differences to the gap state).
+    """
+
+    names: tuple
+    points: dict
+    base: dict
+    unit: dict
+    states: list | None = None
+
+    def state(self, load):
+        """Displacement vector of the superposed state (``states[0]`` the gap state)."""
+        v = self.states[0].CreateVector()
+        v.data = self.states[0]
+        for lk, sk in zip(np.asarray(load, float), self.states[1:]):
+            if lk != 0.0:
+                v.data += float(lk) * sk
+        return v
+
+    def stress(self, load) -> dict:
+        """Superposed stress ``sigma_g + sum_k l_k Sigma_k`` (eq. 75) per body."""
+        l = np.asarray(load, float)
+        return {b: self.base[b] + np.einsum("k,knij->nij", l, self.unit[b]) for b in self.base}
+
+
+def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float = 0.0) -> Correctors:
+    """Unit-load correctors of the cell with a fixed contact set (module docstring).
+
+    Parameters
+    ----------
+    problem
+        A :class:`ngcontact.cell.CellProblem` built with ``macro_strain=True``
+        (its spaces, normal, gap and parameters are reused; its state is
+        overwritten).
+    contact_set
+        Indicator (CoefficientFunction, 1 in contact) of ``S_act`` on ``S_C``;
+        default the whole contact surface.
+    tangential_stiffness
+        ``k_t`` on ``S_act`` [stress/length]; 0 leaves the tangential jump
+        free (a flat frictionless surface then carries no shear).
+
+    Raises
+    ------
+    ValueError
+        The cell problem lacks the macro strain term.
+    """
+    m = problem.model
+    if not m.macro_strain:
+        raise ValueError("linear correctors need a cell problem built with macro_strain = True")
+    X, mesh, d = problem.X, problem.mesh, problem.dim
+    trial = X.TrialFunction()
+    ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
+    form = ng.BilinearForm(X, symmetric=True)
+    for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
+        eps = problem.body_strain(u)
+        form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps) * ng.dx(definedon=mesh.Materials(name)))
+    J = ur - uc - U
+    chi = ng.CF(1.0) if contact_set is None else contact_set
+    pen = _contact.penetration(J, problem.n, problem.gap)
+    psi = 0.5 * m.k_n * chi * pen * pen
+    if tangential_stiffness > 0:
+        Jt = _contact.tangential_slip(J, problem.n)
+        psi = psi + 0.5 * tangential_stiffness * chi * ng.InnerProduct(Jt, Jt)
+    form += ng.Variation(psi * ng.ds("contact", bonus_intorder=m.contact_bonus_order))
+    form += ng.Variation(-ng.InnerProduct(ng.CF(tuple(problem.traction)), U) * ng.ds("top"))
+    free = ng.BitArray(X.FreeDofs())
+    shear_free = tangential_stiffness > 0 or problem.tangential_free
+    if not shear_free:
+        for i in range(d - 1):
+            free.Clear(problem.u_dofs[i])
+    names = load_names(d)
+    zero = problem.gfu.vec.CreateVector()
+    zero[:] = 0.0
+    _set_load(problem, np.zeros(len(names)))
+    form.AssembleLinearization(zero)
+    inv = form.mat.Inverse(free, inverse=problem.inverse)
+    res = zero.CreateVector()
+
+    vectors = []
+
+    def state(l):
+        _set_load(problem, l)
+        form.Apply(zero, res)
+        problem.gfu.vec.data = -(inv * res)
+        v = zero.CreateVector()
+        v.data = problem.gfu.vec
+        vectors.append(v)
+        return sample_stresses(problem)
+
+    base = state(np.zeros(len(names)))
+    unit = {b: [] for b in BODIES}
+    for k in range(len(names)):
+        if not shear_free and k < d - 1:
+            for b in BODIES:  # a free tangential jump carries no shear: zero corrector
+                unit[b].append(np.zeros_like(base[b]["stress"]))
+            v = zero.CreateVector()
+            v[:] = 0.0
+            vectors.append(v)
+            continue
+        e = np.zeros(len(names))
+        e[k] = 1.0
+        s = state(e)
+        vectors[-1].data -= vectors[0]
+        for b in BODIES:
+            unit[b].append(s[b]["stress"] - base[b]["stress"])
+    _set_load(problem, np.zeros(len(names)))
+    log.info("linear correctors: %d unit loads, one factorization", len(names))
+    return Correctors(names=names, points={b: base[b]["points"] for b in BODIES},
+                      base={b: base[b]["stress"] for b in BODIES},
+                      unit={b: np.array(unit[b]) for b in BODIES}, states=vectors)
+
+
+def nonlinear_stress(problem, load_vector) -> tuple[dict, object]:
+    """The contact cell problem solved at the load vector (rigid-predictor start).
+
+    Returns the sampled stresses per body (:func:`sample_stresses`) and the
+    :class:`ngcontact.cell.CellSolution`.  A flat frictionless cell carries
+    no shear: its shear components must be 0.
+    """
+    from ngcontact.cell.cell_problem import cell_load
+    d = problem.dim
+    l = np.asarray(load_vector, float)
+    shear = tuple(float(v) for v in l[:d - 1])
+    ms = tuple(float(v) for v in l[d:]) if problem.model.macro_strain else None
+    sol = problem.solve(cell_load(d, pressure=float(l[d - 1]), shear=shear, macro_strain=ms),
+                        first=True, measure=False)
+    return sample_stresses(problem), sol
+
+
+# ------------------------------------------------------------ criteria
+def equivalent(stress: np.ndarray, criterion: str) -> np.ndarray:
+    """``sigma_eq`` of eq. 77 for an array of 3x3 tensors."""
+    if criterion == "von_mises":
+        return _mat.von_mises(stress)
+    if criterion == "tresca":
+        return _mat.tresca(stress)
+    raise ValueError(f"criterion = {criterion!r}: must be one of {', '.join(CRITERIA)}")
+
+
+@dataclass
+class StrengthMap:
+    """Largest ``sigma_eq`` over the cell at each macro point, per body.
+
+    ``values[body]`` has one entry per macro point, ``cell_point[body]`` the
+    cell point (cell coordinates) where it is reached.
+    """
+
+    criterion: str
+    values: dict
+    cell_point: dict
+
+
+def strength_map(correctors: Correctors, loads: np.ndarray, criterion: str = "von_mises") -> StrengthMap:
+    """Superpose the correctors at every row of ``loads`` and take the cell maxima."""
+    loads = np.atleast_2d(np.asarray(loads, float))
+    values, where = {}, {}
+    for b in correctors.base:
+        v = np.empty(len(loads))
+        w = np.empty((len(loads), correctors.points[b].shape[1]))
+        for i, l in enumerate(loads):
+            s = correctors.base[b] + np.einsum("k,knij->nij", l, correctors.unit[b])
+            eq = equivalent(s, criterion)
+            k = int(np.argmax(eq))
+            v[i], w[i] = eq[k], correctors.points[b][k]
+        values[b], where[b] = v, w
+    return StrengthMap(criterion=criterion, values=values, cell_point=where)
+
+
+def check(smap: StrengthMap, sigma_u: dict, macro_points: np.ndarray) -> dict:
+    """The check of eq. 78 per body and overall.
+
+    Parameters
+    ----------
+    smap
+        :func:`strength_map` result.
+    sigma_u
+        ``{body: ultimate stress}``.
+    macro_points
+        ``(m, dim)`` coordinates of the macro interface points (rows of the loads).
+
+    Returns
+    -------
+    dict
+        Per body ``max_sigma_eq``, ``sigma_u``, ``safety_factor``, the
+        ``macro_point`` (index and coordinates) and ``cell_point``; overall
+        ``safety_factor`` (the smallest), ``critical_body`` and ``holds``
+        (``safety_factor > 1``).
+    """
+    out = {"criterion": smap.criterion, "bodies": {}}
+    for b, vals in smap.values.items():
+        k = int(np.argmax(vals))
+        out["bodies"][b] = {"max_sigma_eq": float(vals[k]), "sigma_u": float(sigma_u[b]),
+                            "safety_factor": float(sigma_u[b] / vals[k]) if vals[k] > 0 else None,
+                            "macro_point": {"index": k, "coordinates": np.asarray(macro_points[k]).tolist()},
+                            "cell_point": smap.cell_point[b][k].tolist()}
+    finite = {b: e["safety_factor"] for b, e in out["bodies"].items() if e["safety_factor"] is not None}
+    crit = min(finite, key=finite.get)
+    out["critical_body"] = crit
+    out["safety_factor"] = finite[crit]
+    out["holds"] = bool(finite[crit] > 1.0)
+    return out
+
+
+# ------------------------------------------------------------ macro state
+def interface_states(sol, points_per_element: int = 5, offset: float = 1e-4) -> dict:
+    """Macro state at points along ``S_0`` (2D and axisymmetric macro problems).
+
+    Returns the interface profile of :func:`ngcontact.macro.interface_profile`
+    (``s``, coordinates, ``pressure``, ``shear``, ...) plus ``e_t`` (strain
+    along ``t0``) and ``e_hoop`` (axisymmetric hoop strain, else 0), each the
+    mean of the two bodies' strains at points moved by ``offset`` times the
+    mesh's extent off the interface, and slightly towards the element centre.
+    """
+    from ngcontact.macro import macro_problem as M
+    prof = M.interface_profile(sol, points_per_element)
+    k = max(2, int(points_per_element))
+    names = M.COMPONENTS[sol.problem.setting]
+    xy = np.column_stack([prof[names[0]], prof[names[1]]])
+    mesh = sol.problem.mesh
+    pts = np.array([v.point for v in mesh.vertices])
+    delta = offset * float(np.max(pts.max(axis=0) - pts.min(axis=0)))
+    eps_cf = M.strain(sol)
+    e_t = np.zeros(len(xy))
+    e_h = np.zeros(len(xy))
+    for e0 in range(0, len(xy), k):
+        seg = xy[e0:e0 + k]
+        t = seg[-1] - seg[0]
+        t = t / np.linalg.norm(t)
+        nperp = np.array([-t[1], t[0]])
+        mid = seg.mean(axis=0)
+        for j, q in enumerate(seg):
+            q = q + 1e-3 * (mid - q)
+            vals = []
+            for side in (1.0, -1.0):
+                p = q + side * delta * nperp
+                E = np.asarray(eps_cf(mesh(float(p[0]), float(p[1])))).reshape(3, 3)
+                vals.append(E)
+            E = 0.5 * (vals[0] + vals[1])
+            e_t[e0 + j] = t @ E[:2, :2] @ t
+            e_h[e0 + j] = E[2, 2] if sol.problem.setting == "axisymmetric" else 0.0
+    out = dict(prof)
+    out["e_t"], out["e_hoop"] = e_t, e_h
+    return out
+
+
+def cell_loads(states: dict, dim: int) -> np.ndarray:
+    """Load vectors of a ``dim``-D cell (rows) from :func:`interface_states`."""
+    p = np.asarray(states["pressure"], float)
+    tau = np.asarray(states["shear"], float)
+    if dim == 2:
+        return np.column_stack([-tau, p, states["e_t"]])
+    z = np.zeros_like(p)
+    return np.column_stack([-tau, z, p, states["e_t"], states["e_hoop"], z])

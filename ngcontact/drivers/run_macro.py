@@ -1,0 +1,238 @@
+"""Driver of the ``macro`` kind: geometry -> macro problem -> solve -> results.
+
+Returns an :class:`~ngcontact.report.Outcome` (no file I/O here; a law from a
+cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its cache).
+
+``results``:
+
+* ``interface``: arrays along the interface (2D / axisymmetric): ``s`` arc
+  length from the end with the largest ``z`` (``y``) [m], ``r, z`` (or
+  ``x, y``) [m], ``pressure`` [Pa, compression positive], ``shear`` [Pa,
+  traction along ``t0``], ``jump_n`` [m, ``J . n0``, positive closes],
+  ``jump_t`` [m, ``J . t0``], ``status`` (``open`` / ``stick`` / ``slip``);
+* ``resultant``: force through the interface from the rough to the counter
+  body [N; axisymmetric: axial, per full revolution; plane strain: per metre];
+* ``maxima``: peak pressure and largest |shear| with their location, the
+  largest and smallest stress components, von Mises stress and strain with
+  location and body;
+* ``detachment``: points where the interface changes between open and closed;
+* ``law``, ``dimensions``, ``newton_iterations``, ``coulomb_iterations``.
+"""
+from __future__ import annotations
+
+import logging
+from collections import Counter
+
+import numpy as np
+import ngsolve as ng
+
+from ngcontact.drivers.build import body_laws, elastic_law
+from ngcontact.laws import homogenized as il
+from ngcontact.macro import macro_problem as M
+from ngcontact.errors import SceneError
+from ngcontact.geometry import bodies as gm
+from ngcontact.scene.macro_scene import REGIONS
+from ngcontact.output.report import Outcome, VtkField
+from ngcontact.scene.sections import resolve
+
+log = logging.getLogger(__name__)
+
+
+def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None) -> gm.MacroGeometry:
+    """Mesh the geometry of ``scene`` (sizes and order may be overridden)."""
+    g, d = scene.geometry, scene.discretization
+    maxh = maxh or d.maxh
+    ih = interface_maxh or d.interface_maxh or maxh
+    order = order or d.order
+    dims = dict(g.dimensions or {})
+    if g.shape == "femur_stem":
+        return gm.femur_stem(gm.FemurStemDims(**dims), maxh=maxh, interface_maxh=ih)
+    if g.shape == "block":
+        return gm.block_on_plane(dims["length"], dims["h_block"], dims["h_base"], maxh=maxh)
+    if g.setting == "plane_strain":
+        return gm.coaxial_plane_strain(dims["a"], dims["b"], dims["c"], maxh=maxh, order=order)
+    if g.setting == "axisymmetric":
+        return gm.coaxial_axisymmetric(dims["a"], dims["b"], dims["c"], dims["height"], maxh=maxh)
+    return gm.coaxial_3d(dims["a"], dims["b"], dims["c"], dims["height"], maxh=maxh, order=order)
+
+
+def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
+    """The interface law of ``scene`` and a description of it for the report."""
+    spec = scene.interface
+    if spec.cell is not None:
+        from ngcontact.coupling.cell_law import law_from_cell
+        normal, info = law_from_cell(resolve(scene, spec.cell), dim=dim, linear=spec.law == "linear",
+                                     length_unit=spec.cell_length_unit)
+    else:
+        normal = spec.normal_law()
+        info = {"source": "explicit numbers"}
+        if isinstance(normal, il.BundleLaw) and len(normal.directions[0]) != dim:
+            raise SceneError("interface.directions", normal.directions,
+                             f"need {dim} components per direction in this setting")
+    info = {"type": scene.interface.law, **info, "full_contact_K0": _K0(normal, dim)}
+    return il.InterfaceLaw(normal=normal, friction=spec.friction()), info
+
+
+def _K0(normal, dim):
+    if isinstance(normal, il.TabulatedLaw):
+        return None
+    return np.asarray(normal.matrix(dim)).tolist()
+
+
+def gap_of(scene):
+    """The macro normal gap ``g0``: a number or a piecewise linear CoefficientFunction."""
+    spec = scene.interface
+    if spec.gap_table is None:
+        return spec.gap
+    coord = {"x": ng.x, "r": ng.x, "y": ng.y, "z": ng.z}[spec.gap_coordinate]
+    if spec.gap_coordinate == "z" and scene.geometry.setting == "axisymmetric":
+        coord = ng.y
+    return M.piecewise_linear(coord, spec.gap_table)
+
+
+def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.MacroProblem, dict]:
+    """The :class:`~ngcontact.macro.MacroProblem` of ``scene`` on ``geometry``.
+
+    Raises
+    ------
+    SceneError
+        A boundary label the geometry does not have (the message lists those it has).
+    """
+    labels = M.boundary_labels(geometry.mesh)
+    for what, items in (("supports", scene.supports), ("loads", scene.loads)):
+        for i, item in enumerate(items):
+            if item.boundary not in labels:
+                raise SceneError(f"{what}[{i}].boundary", item.boundary,
+                                 f"no such boundary in {scene.geometry.shape!r}; labels are " + ", ".join(labels))
+    law, info = interface_law_of(scene, geometry.mesh.dim)
+    rough, counter = REGIONS[scene.geometry.shape]
+    mats = body_laws(scene, {rough: scene.bodies.rough, counter: scene.bodies.counter})
+    problem = M.MacroProblem(
+        mesh=geometry.mesh, setting=scene.geometry.setting, rough=rough, counter=counter, materials=mats,
+        law=law, gap=gap_of(scene), order=order or scene.discretization.order,
+        supports=tuple(M.Support(label=s.boundary, components=s.components, displacement=s.displacement)
+                       for s in scene.supports),
+        loads=tuple(M.Load(label=lo.boundary, pressure=lo.pressure, traction=lo.traction) for lo in scene.loads))
+    return problem, info
+
+
+def solve_scene(scene, problem: M.MacroProblem) -> M.MacroSolution:
+    s = scene.solver
+    return M.solve(problem, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
+                   fixed_point_tol=scene.output.coulomb_tol)
+
+
+def run(scene, clock) -> Outcome:
+    """Solve a ``macro`` scene; no file I/O (see :mod:`ngcontact.output.report`)."""
+    with clock.stage("mesh"):
+        geo = build_geometry(scene)
+    with clock.stage("interface law"):
+        problem, law_info = problem_of(scene, geo)
+    two_scale = None
+    with clock.stage("solve"):
+        if scene.two_scale is None:
+            sol = solve_scene(scene, problem)
+        else:
+            from ngcontact.drivers.run_two_scale import couple
+            sol, two_scale = couple(scene, problem, lambda prob: solve_scene(scene, prob))
+    with clock.stage("post-processing"):
+        fields = M.stress_fields(sol)
+        extrema = M.field_extrema(sol, fields)
+        results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
+                   "dimensions": geo.dims, "law": law_info, "resultant": M.resultant(sol),
+                   "newton_iterations": sol.history["newton_iterations"],
+                   "coulomb_iterations": sol.history["fixed_point_iterations"]}
+        maxima = {name: ext for name, ext in extrema.items()}
+        tables, plots = {}, {}
+        if geo.mesh.dim == 2:
+            prof = M.interface_profile(sol, scene.output.points_per_element)
+            results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in prof.items()}
+            results["status_counts"] = dict(Counter(prof["status"]))
+            maxima["pressure"] = M.peak_pressure(prof)
+            k = int(np.argmax(np.abs(prof["shear"])))
+            maxima["shear"] = {key: (v[k] if key == "status" else float(v[k])) for key, v in prof.items()}
+            results["detachment"] = M.detachments(prof)
+            header = list(prof)
+            tables["interface"] = (header, list(zip(*[prof[h] for h in header])))
+            plots["interface"] = lambda path, prof=prof, setting=problem.setting: plot_interface(path, prof, setting)
+            plots["stress"] = lambda path, sol=sol, fields=fields: plot_fields(path, sol, fields)
+        results["maxima"] = maxima
+        if two_scale is not None:
+            results["two_scale"] = two_scale
+            if "interface" in results:
+                results["interface"]["contact_fraction"] = np.asarray(two_scale["interface_coefficients"]
+                                                                     ["contact_fraction"])
+    vtk = {"stress": VtkField(mesh=geo.mesh, fields=dict(fields, u_rough=sol.u_rough, u_counter=sol.u_counter),
+                              subdivision=scene.output.vtk_subdivision)}
+    if scene.strength is not None:
+        from ngcontact.drivers.run_strength import evaluate
+        with clock.stage("strength check"):
+            st = evaluate(scene, sol)
+        results["strength"] = st["results"]
+        tables["strength_map"] = st["table"]
+        vtk["worst_cell"] = st["vtk"]
+        plots.update(st["plots"])
+    newton = sol.history["newton"]
+    solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],
+              "linear_solve_only": sol.history["quadratic"],
+              "coulomb_fixed_point_changes": sol.history["fixed_point_changes"], "solves": newton}
+    return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
+
+
+# ------------------------------------------------------------------ plots
+def plot_interface(path: str, prof: dict, setting: str) -> None:
+    """Pressure, shear, jumps and status along the interface."""
+    import matplotlib.pyplot as plt
+    s = np.asarray(prof["s"]) * 1e3
+    fig, ax = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    ax[0].plot(s, np.asarray(prof["pressure"]) / 1e6, label="pressure p (compression > 0)")
+    ax[0].plot(s, np.asarray(prof["shear"]) / 1e6, label="shear (along t0)")
+    ax[0].set_ylabel("MPa")
+    ax[0].legend()
+    ax[1].plot(s, np.asarray(prof["jump_n"]) * 1e6, label="J . n0 (closure)")
+    ax[1].plot(s, np.asarray(prof["jump_t"]) * 1e6, label="J . t0 (slip)")
+    ax[1].set_ylabel("um")
+    ax[1].legend()
+    colors = {"open": 0, "stick": 1, "slip": 2}
+    ax[2].scatter(s, [colors[x] for x in prof["status"]], s=4)
+    ax[2].set_yticks([0, 1, 2], ["open", "stick", "slip"])
+    ax[2].set_xlabel("arc length s along the interface [mm] (from the top end)")
+    for a in ax:
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_fields(path: str, sol: M.MacroSolution, fields: dict) -> None:
+    """Four panels of paper Fig. 10: radial / axial stress, von Mises stress and strain."""
+    import matplotlib.pyplot as plt
+    from matplotlib.tri import Triangulation
+    p = sol.problem
+    mesh = p.mesh
+    names = [n for n in fields if n in ("sigma_r", "sigma_xx")][:1] + \
+            [n for n in fields if n in ("sigma_z", "sigma_yy")][:1] + ["von_mises", "von_mises_strain"]
+    rule = ng.IntegrationRule([(1e-3, 1e-3), (1 - 2e-3, 1e-3), (1e-3, 1 - 2e-3)], [0.0] * 3)
+    xs, ys, vals = [], [], {n: [] for n in names}
+    for region in (p.rough, p.counter):
+        mips = mesh.MapToAllElements(rule, mesh.Materials(region))
+        xy = np.asarray(ng.CF((ng.x, ng.y))(mips)).reshape(-1, 2)
+        xs.append(xy[:, 0])
+        ys.append(xy[:, 1])
+        for n in names:
+            vals[n].append(np.asarray(fields[n](mips)).ravel())
+    x, y = np.concatenate(xs) * 1e3, np.concatenate(ys) * 1e3
+    tri = Triangulation(x, y, np.arange(len(x)).reshape(-1, 3))
+    fig, axes = plt.subplots(1, 4, figsize=(11, 7))
+    for ax, n in zip(axes, names):
+        v = np.concatenate(vals[n])
+        scale, unit = (1.0, "-") if n == "von_mises_strain" else (1e-6, "MPa")
+        tc = ax.tripcolor(tri, v * scale, shading="gouraud", cmap="viridis")
+        fig.colorbar(tc, ax=ax, shrink=0.8, label=unit)
+        ax.set_title(n.replace("_", " "))
+        ax.set_aspect("equal")
+        ax.set_xlabel("r [mm]" if p.setting == "axisymmetric" else "x [mm]")
+    axes[0].set_ylabel("z [mm]" if p.setting == "axisymmetric" else "y [mm]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

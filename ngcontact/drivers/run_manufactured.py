@@ -1,0 +1,118 @@
+"""Driver of the ``manufactured`` kind: convergence rates of the elasticity solver.
+
+For every order ``p`` and level ``k = 1..levels`` it solves the manufactured
+problem of :mod:`ngcontact.verification.manufactured` on the mesh refined ``k`` times and
+measures the L2 and H1-seminorm errors; :mod:`ngcontact.verification.rates` fits the
+observed rates (expected ``p + 1`` and ``p``).  Each level is one linear
+solve (assembled ``BilinearForm``/``LinearForm``, sparse direct factorization);
+its relative residual ``|f - A u| / |f|`` on the free dofs is the solver
+history.  A residual above :data:`LINEAR_RTOL` means the factorization failed
+(e.g. a singular matrix) and raises :class:`~ngcontact.errors.ConvergenceError`.
+"""
+from __future__ import annotations
+
+import logging
+import math
+
+import ngsolve as ng
+
+from ngcontact.verification import manufactured
+from ngcontact.verification import rates as studies
+from ngcontact.drivers.build import body_laws
+from ngcontact.errors import ConvergenceError
+from ngcontact.output.report import Outcome, VtkField
+
+log = logging.getLogger(__name__)
+
+LINEAR_RTOL = 1e-8
+TABLE_KEYS = studies.ROW_KEYS + ("solve_seconds", "relative_residual")
+
+
+def laws_of(scene) -> dict:
+    """Region name -> elastic law for the scene's setting."""
+    m = scene.manufactured
+    if m.setting == "periodic_cell":
+        return body_laws(scene, {"rough": m.body, "counter": m.second_body})
+    return body_laws(scene, {"body": m.body})
+
+
+def run(scene, clock) -> Outcome:
+    """Solve every (order, level), fit rates and collect tables, plots and VTK."""
+    m = scene.manufactured
+    finest: dict = {}
+    level = manufactured.level_runner(m.setting, laws_of(scene), m.maxh,
+                                      inverse=scene.solver.inverse, keep=finest)
+    rows = []
+    for p in m.orders:
+        for k in range(1, m.levels + 1):
+            with clock.stage(f"order {p}, level {k}"):
+                rows.extend(studies.h_refinement(level, setting=m.setting, orders=(p,), maxh=m.maxh,
+                                                 refinements=(k,)))
+            residual = rows[-1]["relative_residual"]
+            if not residual <= LINEAR_RTOL:
+                raise ConvergenceError(
+                    f"linear solve for order {p}, level {k}: relative residual {residual:.3e} "
+                    f"> {LINEAR_RTOL:g}", _solver_info(rows, scene, converged=False))
+    rates = studies.rates_by_order(rows)
+    expected = {p: studies.expected_rates(p) for p in rates}
+    deviation = max(abs(rates[p][n] - expected[p][n]) for p in rates for n in ("l2", "h1"))
+    verified = deviation <= m.rate_tolerance
+    if not verified:
+        log.warning("observed rates deviate by up to %.2f from the expected ones", deviation)
+    results = {
+        "setting": m.setting,
+        "solution": "smooth manufactured displacement (see ngcontact.manufactured.smooth_field)",
+        "errors": "l2 = |u_h - u*|_L2, h1 = |grad(u_h - u*)|_L2 (axisymmetric: weighted by 2 pi r, "
+                  "with the hoop term)",
+        "rows": rows,
+        "rates": {str(p): r for p, r in rates.items()},
+        "expected_rates": {str(p): r for p, r in expected.items()},
+        "max_rate_deviation": deviation,
+        "rate_tolerance": m.rate_tolerance,
+        "verified": verified,
+    }
+    prob, sol = finest["problem"], finest["solution"]
+    error = sol.gfu - prob.exact
+    vtk = {"finest": VtkField(mesh=prob.mesh, subdivision=min(max(m.orders) - 1, 2),
+                              fields={"displacement": sol.gfu, "exact": prob.exact, "error": error,
+                                      "error_norm": ng.Norm(error)})}
+    return Outcome(results=results, ndof=max(r["ndof"] for r in rows),
+                   solver=_solver_info(rows, scene, converged=True),
+                   tables={"convergence": studies.table(rows, TABLE_KEYS),
+                           "rates": _rates_table(rates, expected)},
+                   vtk=vtk, plots={"convergence": lambda path: plot_convergence(rows, rates, path)})
+
+
+def _solver_info(rows, scene, converged: bool) -> dict:
+    return {"type": "linear", "method": f"direct ({scene.solver.inverse})",
+            "linear_solve_only": True, "iterations": len(rows), "converged": converged,
+            "residuals": [r["relative_residual"] for r in rows],
+            "residual_measure": "|f - A u| / |f| on the free dofs, one entry per linear solve"}
+
+
+def _rates_table(rates: dict, expected: dict):
+    header = ["order", "l2_rate", "l2_expected", "h1_rate", "h1_expected"]
+    return header, [[p, r["l2"], expected[p]["l2"], r["h1"], expected[p]["h1"]] for p, r in rates.items()]
+
+
+def plot_convergence(rows, rates: dict, path: str) -> None:
+    """Log-log plot of the L2 and H1 errors against ``h``, one line per order."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
+    for ax, norm, label in zip(axes, ("l2", "h1"), ("L2 error", "H1-seminorm error")):
+        for p in sorted({r["order"] for r in rows}):
+            sel = sorted((r for r in rows if r["order"] == p), key=lambda r: r["h"])
+            h = [r["h"] for r in sel]
+            e = [r[norm] for r in sel]
+            rate = rates.get(p, {}).get(norm, math.nan)
+            ax.loglog(h, e, "o-", label=f"p = {p} (rate {rate:.2f})")
+        ax.set_xlabel("h")
+        ax.set_ylabel(label)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"manufactured solution, setting {rows[0]['setting']}")
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

@@ -1,0 +1,220 @@
+"""Driver of the ``direct`` kind: resolved geometry -> resolved contact problem -> results.
+
+Returns an :class:`~ngcontact.report.Outcome`; no file I/O.
+
+``results``:
+
+* ``periods`` ``N`` and ``eps`` [m], the resolved period (femur: the
+  interface arc length over ``N``; ``segments`` lists ``[N_i, eps_i]`` of
+  the cylinder and the cone);
+* ``reactions``: per supported boundary the force the body exerts on the
+  support in the fixed components [N per metre of thickness; axisymmetric:
+  N per revolution, axial component only] and, in plane strain, its moment
+  about the boundary's mid-point [N m / m]
+  (:func:`ngcontact.direct.boundary_reaction`);
+* ``contact_force``: force the counter body receives through the resolved
+  surface [N/m; axisymmetric: ``int p n 2 pi r ds``, whose ``r`` entry is
+  the integral of the radial line load, not a net force], from the micro
+  pressure (compression positive);
+* ``contact_fraction``: length of the closed part of ``S_C^eps`` per unit
+  length of the macro interface (it exceeds 1 where valley walls are
+  closed: the whole surface of a rectangular valley profile is
+  ``1 + 2 depth / period``);
+* ``probes``: displacements [m] at the study's probe points, if any;
+* ``newton_iterations``, ``ndof``.
+"""
+from __future__ import annotations
+
+import logging
+
+import ngsolve as ng
+import numpy as np
+
+from ngcontact.drivers.build import body_laws, elastic_law
+from ngcontact.resolved import resolved_problem as D
+from ngcontact.geometry import profiles as pr
+from ngcontact.geometry import resolved_bodies as rg
+from ngcontact.scene.cell_scene import profile_2d
+from ngcontact.macro.macro_problem import Load
+from ngcontact.output.report import Outcome, VtkField
+
+log = logging.getLogger(__name__)
+
+
+def profile_of(cell_scene) -> pr.Profile:
+    """The roughness profile of a 2D ``cell`` scene (parametric profiles only)."""
+    return profile_2d(cell_scene.geometry)
+
+
+def micro_law(cell_scene) -> dict:
+    """``k_n``, ``gap`` and ``friction`` of the cell as keyword arguments of :class:`DirectProblem`."""
+    c = cell_scene.contact
+    gap = c.gap.value if c.gap.kind == "constant" else None
+    fr = None
+    if c.friction == "tresca":
+        fr = D.Friction(law="tresca", w=c.w, G=c.G)
+    elif c.friction == "coulomb":
+        fr = D.Friction(law="coulomb", w=c.w, mu=c.mu)
+    return {"k_n": c.k_n, "gap": gap, "friction": fr}
+
+
+def materials_of(scene) -> dict:
+    return body_laws(scene, {"rough": scene.bodies.rough, "counter": scene.bodies.counter})
+
+
+#: Boundaries along which ``x`` (``r``) varies; a support's slope is taken along ``x`` there, else ``y``.
+HORIZONTAL = ("top", "bottom", "base", "stem_top", "stem_tip", "bone_top")
+
+
+def supports_of(scene) -> tuple:
+    return tuple(D.Support(label=s.boundary, components=s.components, value=s.displacement, slope=s.slope,
+                           along="x" if s.boundary in HORIZONTAL else "y") for s in scene.supports)
+
+
+def loads_of(scene) -> tuple:
+    return tuple(Load(label=lo.boundary, pressure=lo.pressure, traction=lo.traction) for lo in scene.loads)
+
+
+def interface_length(scene) -> float:
+    """Arc length of the macro interface ``S_0`` (block width; femur: cone plus cylinder)."""
+    g = scene.geometry
+    if g.shape == "femur_stem":
+        return float(sum(np.hypot(b[0] - a[0], b[1] - a[1]) for a, b in rg.femur_stem_interface(g.femur_dims())))
+    return float(g.length)
+
+
+def eps_of(scene, periods: int) -> float:
+    """Resolved period ``eps = (interface length) / N``."""
+    return interface_length(scene) / periods
+
+
+def build_resolved(scene, periods: int | None = None, periodic: bool = False):
+    """Mesh the bodies of ``scene`` with ``periods`` resolved periods (default: the scene's)."""
+    g, d = scene.geometry, scene.discretization
+    N = periods or g.periods
+    eps = eps_of(scene, N)
+    prof = profile_of(scene.cell_scene)
+    if g.shape == "femur_stem":
+        if periodic:
+            raise ValueError("the femur has no periodic variant")
+        return rg.femur_stem(g.femur_dims(), prof, N, maxh=d.maxh, interface_maxh=eps / d.elements_per_period,
+                             order=d.order, grading=d.grading)
+    return rg.resolved_blocks(prof, N, g.length, g.h_rough, g.h_counter, maxh=d.maxh,
+                              interface_maxh=eps / d.elements_per_period, order=d.order, periodic=periodic,
+                              grading=d.grading, x0=g.x0)
+
+
+def build_flat(scene, interface_maxh: float):
+    """The same bodies with the flat macro interface ``S_0`` (boundary ``interface``)."""
+    g, d = scene.geometry, scene.discretization
+    if g.shape == "femur_stem":
+        return rg.femur_stem(g.femur_dims(), None, 0, maxh=d.maxh, interface_maxh=interface_maxh,
+                             grading=d.grading)
+    return rg.flat_blocks(g.length, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=interface_maxh,
+                          grading=d.grading, x0=g.x0)
+
+
+def body_of(scene, points) -> np.ndarray:
+    """Body of each point with the flat interface: 0 rough, 1 counter, -1 outside."""
+    g = scene.geometry
+    pts = np.asarray(points, float).reshape(-1, 2)
+    if g.shape == "femur_stem":
+        return rg.femur_stem_body(g.femur_dims(), pts)
+    inside = (pts[:, 0] > g.x0) & (pts[:, 0] < g.x0 + g.length) & (pts[:, 1] > -g.h_rough) & \
+        (pts[:, 1] < g.h_counter)
+    return np.where(inside, np.where(pts[:, 1] < 0, 0, 1), -1)
+
+
+def interface_distance(scene, points) -> np.ndarray:
+    """Distance of each point from the flat macro interface ``S_0``."""
+    g = scene.geometry
+    pts = np.asarray(points, float).reshape(-1, 2)
+    if g.shape == "femur_stem":
+        return rg.distance_to_polyline(rg.femur_stem_interface(g.femur_dims()), pts)
+    return np.abs(pts[:, 1])
+
+
+def interface_part(scene):
+    """Indicator (CoefficientFunction) of the interface part whose transmitted force the study compares.
+
+    Blocks: the left half ``x < x0 + L/2``.  Femur: the cylindrical part
+    ``z > z_corner`` (its share of the axial load against the cone's).
+    """
+    g = scene.geometry
+    if g.shape == "femur_stem":
+        return ng.IfPos(ng.y - g.femur_dims().z_corner, 1.0, 0.0)
+    return ng.IfPos(g.x0 + 0.5 * g.length - ng.x, 1.0, 0.0)
+
+
+def problem_of(scene, geometry, *, law=None) -> D.DirectProblem:
+    """The resolved problem (``law=None``) or its homogenized counterpart on a flat geometry."""
+    kw = micro_law(scene.cell_scene)
+    return D.DirectProblem(mesh=geometry.mesh, materials=materials_of(scene), setting=scene.geometry.setting,
+                           supports=supports_of(scene), loads=loads_of(scene), order=scene.discretization.order,
+                           contact=geometry.interface, law=law, **kw)
+
+
+def solve_scene(scene, problem) -> D.DirectSolution:
+    s = scene.solver
+    return D.solve(problem, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse)
+
+
+def reactions(scene, sol) -> dict:
+    """Reaction force and moment of every supported boundary (see :func:`ngcontact.direct.boundary_reaction`).
+
+    Only the fixed components are kept (a free component's "reaction" is
+    the residual, zero); in axisymmetry the radial one is dropped (its net
+    force over a revolution vanishes) and there is no moment, so e.g. the
+    femur's ``axis`` support (``r`` fixed) has no entry.
+    """
+    p = sol.problem
+    mesh = p.mesh
+    comps = D.COMPONENTS[p.setting]
+    out = {}
+    for s in scene.supports:
+        label = s.boundary
+        keep = [c for c in (s.components or comps) if not (p.setting == "axisymmetric" and c == "r")]
+        if p.setting == "plane_strain" and not s.components:
+            keep.append("moment")
+        if not keep:
+            continue
+        xs = [mesh[v].point for el in mesh.Elements(ng.BND) if el.mat == label for v in el.vertices]
+        about = tuple(0.5 * (np.min(xs, axis=0) + np.max(xs, axis=0)))
+        total = None
+        for region, u in (("rough", sol.u_rough), ("counter", sol.u_counter)):
+            r = D.boundary_reaction(mesh, p.setting, p.materials[region], u, region, label, p.order, about=about)
+            total = r if total is None else {k: total[k] + r[k] for k in r}
+        out[label] = {k: total[k] for k in keep}
+    return out
+
+
+def probes(scene, sol) -> list:
+    """Displacements at the study's probe points, each from the body it lies in (:func:`body_of`)."""
+    mesh = sol.problem.mesh
+    out = []
+    for x, y in (scene.study.probes if scene.study else ()):
+        u = sol.u_rough if body_of(scene, [(x, y)])[0] == 0 else sol.u_counter
+        out.append(D.probe(mesh, u, [(x, y)])[0].tolist())
+    return out
+
+
+def run(scene, clock) -> Outcome:
+    """Solve a ``direct`` scene; no file I/O (see :mod:`ngcontact.output.report`)."""
+    with clock.stage("mesh"):
+        geo = build_resolved(scene)
+    with clock.stage("solve"):
+        sol = solve_scene(scene, problem_of(scene, geo))
+    with clock.stage("post-processing"):
+        results = {"periods": geo.periods, "eps": geo.eps, "setting": scene.geometry.setting,
+                   "shape": scene.geometry.shape, "segments": [list(sg) for sg in geo.segments],
+                   "reactions": reactions(scene, sol),
+                   "contact_force": D.contact_force(sol).tolist(),
+                   "contact_fraction": D.contact_fraction(sol, geo.length),
+                   "probes": probes(scene, sol),
+                   "newton_iterations": sol.history["newton_iterations"],
+                   "elements": geo.mesh.ne}
+    vtk = {"resolved": VtkField(mesh=geo.mesh, fields={"u_rough": sol.u_rough, "u_counter": sol.u_counter},
+                                subdivision=1)}
+    solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],
+              "solves": sol.history["newton"]}
+    return Outcome(results=results, ndof=sol.ndof, solver=solver, vtk=vtk)

@@ -1,0 +1,125 @@
+"""Linear elasticity on NGSolve in plane strain, axisymmetry and 3D.
+
+The equilibrium problem ``div sigma = f``, ``sigma = C : eps(u)`` (paper
+eqs. 1 and 46) is written as the minimum of the stored energy
+
+    Pi(u) = sum over bodies B of  int_B  1/2 sigma(u) : eps(u)  w dx  - (loads),
+
+with the measure weight ``w = 1`` (plane strain, 3D; per unit thickness in
+plane strain) or ``w = 2 pi r`` (axisymmetric, per full revolution).
+
+All settings use the 3x3 strain tensor:
+
+* plane strain, coordinates ``(x, y)``: ``eps = [[e_xx, e_xy, 0], [e_xy, e_yy, 0], [0, 0, 0]]``;
+* axisymmetric, coordinates ``(r, z)`` = mesh ``(x, y)``, displacement
+  ``(u_r, u_z)``: as plane strain plus the hoop strain ``eps_tt = u_r / r``;
+* 3D: the symmetric gradient.
+
+Several bodies, each with its own law, each get their own ``VectorH1``
+defined on their region only (``definedon``), so that displacements may jump
+across an interface between them; on periodic meshes each space is wrapped
+in ``Periodic``.
+"""
+from __future__ import annotations
+
+from math import pi
+
+import ngsolve as ng
+
+from ngcontact.fem.materials import ElasticLaw
+
+SETTINGS = ("plane_strain", "axisymmetric", "3d")
+
+
+def dimension(setting: str) -> int:
+    """Spatial dimension of the mesh for ``setting``."""
+    _check_setting(setting)
+    return 3 if setting == "3d" else 2
+
+
+def _check_setting(setting: str) -> None:
+    if setting not in SETTINGS:
+        raise ValueError(f"setting = {setting!r}: must be one of {', '.join(SETTINGS)}")
+
+
+def strain(u, setting: str):
+    """3x3 small-strain tensor of the displacement ``u`` (trial, test or grid function)."""
+    _check_setting(setting)
+    return strain_of_gradient(ng.Grad(u), u, setting)
+
+
+def strain_of_gradient(G, u, setting: str):
+    """3x3 strain tensor from a displacement gradient ``G`` (dim x dim) and ``u``.
+
+    The same embedding as :func:`strain`, for fields whose gradient is known
+    otherwise, e.g. a symbolic ``CoefficientFunction`` differentiated with
+    ``.Diff``; ``u`` enters only through the hoop strain ``u_r / r``.
+    """
+    _check_setting(setting)
+    if setting == "3d":
+        return ng.Sym(G)
+    hoop = u[0] / radius() if setting == "axisymmetric" else 0
+    exy = 0.5 * (G[0, 1] + G[1, 0])
+    return ng.CF((G[0, 0], exy, 0, exy, G[1, 1], 0, 0, 0, hoop), dims=(3, 3))
+
+
+#: Floor of the radius in the hoop strain ``u_r / r``.  Quadrature rules may
+#: sample points on the axis (e.g. edge midpoints at order 2), where ``u_r = 0``
+#: makes ``u_r / r`` a 0/0.  With ``r`` floored there, ``u_r / r = 0`` and, the
+#: measure weight ``2 pi r`` being 0, every derivative of the energy stays
+#: finite (``1/R_FLOOR^2`` is still representable).
+R_FLOOR = 1e-100
+
+
+def radius():
+    """``r = x`` floored at :data:`R_FLOOR` (points exactly on the axis)."""
+    return ng.IfPos(ng.x - R_FLOOR, ng.x, R_FLOOR)
+
+
+def weight(setting: str):
+    """Measure weight: ``2 pi r`` in axisymmetry, else 1."""
+    _check_setting(setting)
+    return 2 * pi * ng.x if setting == "axisymmetric" else ng.CF(1.0)
+
+
+def stress(law: ElasticLaw, u, setting: str):
+    """3x3 stress tensor ``C : eps(u)``."""
+    return law.stress(strain(u, setting))
+
+
+def energy_density(law: ElasticLaw, u, setting: str):
+    """Stored energy density ``1/2 sigma : eps`` (without the measure weight)."""
+    eps = strain(u, setting)
+    return 0.5 * ng.InnerProduct(law.stress(eps), eps)
+
+
+def bilinear_integrand(law: ElasticLaw, u, v, setting: str):
+    """``sigma(u) : eps(v) w``, the integrand of the elastic bilinear form."""
+    return ng.InnerProduct(stress(law, u, setting), strain(v, setting)) * weight(setting)
+
+
+def body_space(mesh, body: str, order: int, dirichlet: str = "", periodic: bool = False):
+    """``VectorH1`` of order ``order`` on region ``body`` (optionally periodic)."""
+    if order < 1:
+        raise ValueError(f"order = {order!r}: must be >= 1")
+    V = ng.VectorH1(mesh, order=order, definedon=mesh.Materials(body), dirichlet=dirichlet)
+    return ng.Periodic(V) if periodic else V
+
+
+def add_elastic_energy(form: ng.BilinearForm, mesh, bodies: dict, displacements: dict, setting: str):
+    """Add ``int_B 1/2 sigma:eps w dx`` of every body to a ``Variation`` form.
+
+    Parameters
+    ----------
+    form
+        The (symmetric) ``BilinearForm`` collecting the total energy.
+    bodies
+        ``name -> ElasticLaw``.
+    displacements
+        ``name -> trial function`` of that body's space.
+    """
+    w = weight(setting)
+    for name, law in bodies.items():
+        u = displacements[name]
+        form += ng.Variation(energy_density(law, u, setting) * w * ng.dx(definedon=mesh.Materials(name)))
+    return form

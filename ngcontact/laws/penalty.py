@@ -1,0 +1,155 @@
+"""Interface energies of penalty contact with Huber-regularized friction.
+
+All densities are NGSolve CoefficientFunctions of the displacement jump
+
+    J = u_rough - u_counter        on S_C,
+
+with the micro normal ``n`` pointing from ``rough`` into ``counter`` (so a
+closure ``J_n = J.n > 0`` means the bodies move towards each other) and an
+initial gap ``g >= 0``.  The total interface energy added to the elastic
+energy of the bodies is the integral over ``S_C`` of
+
+* normal penalty (paper eqs. 7 and 9, Winkler stiffness ``k_n = b/delta``)::
+
+      psi_n(J) = (k_n / 2) [J_n - g]_+^2,       p = k_n [J_n - g]_+ >= 0,
+
+  ``p`` is the contact pressure, compression positive;
+
+* Tresca friction, regularized by the Huber function (paper eqs. 9 and 16)::
+
+      psi_t(J) = G huber(|J_t|, w),   J_t = J - J_n n,
+      huber(s, w) = s^2 / (2 w)  (s <= w),   s - w/2  (s > w),
+
+  whose derivative is the friction traction ``G J_t / max(|J_t|, w)``
+  (paper eq. 17): a tangential spring ``G/w`` while ``|J_t| <= w`` (stick),
+  the threshold ``G`` beyond (slip).  The quadratic branch is written with
+  ``J_t . J_t`` and the linear branch takes the root of
+  ``max(J_t . J_t, w^2)``, so neither branch has a singular derivative, not
+  even at ``J_t = 0``;
+
+* Coulomb friction ``G = mu p``.  Coulomb friction has no potential, so it
+  is solved as a fixed point of Tresca problems (see :mod:`ngcontact.cell.cell_problem`):
+  the threshold is ``mu`` times the pressure of the *previous* iterate,
+  evaluated exactly at the quadrature points from a frozen copy of that
+  iterate (:func:`coulomb_threshold`), and the iteration stops when the
+  pressure changes by less than a tolerance relative to its maximum.
+
+Only the terms a problem asks for are added: a frictionless problem
+assembles no friction term, a problem without gap no gap.
+"""
+from __future__ import annotations
+
+import ngsolve as ng
+
+
+def positive_part(s):
+    """``[s]_+ = max(s, 0)``.
+
+    At the kink ``s = 0`` the generalized derivative is taken from the
+    active side (slope 1), so that Newton sees the stiffness of surfaces that
+    touch exactly without overlap (e.g. the flanks of a conforming valley).
+    """
+    return ng.IfPos(-s, 0.0, s)
+
+
+def normal_closure(J, n):
+    """``J_n = J . n``: closure of the interface (positive when closing)."""
+    return ng.InnerProduct(J, n)
+
+
+def penetration(J, n, gap=None):
+    """``J_n - g``: positive where the bodies overlap (in contact)."""
+    Jn = normal_closure(J, n)
+    return Jn if gap is None else Jn - gap
+
+
+def pressure(J, n, k_n, gap=None):
+    """Contact pressure ``p = k_n [J_n - g]_+ >= 0`` (compression positive)."""
+    return k_n * positive_part(penetration(J, n, gap))
+
+
+def normal_energy(J, n, k_n, gap=None):
+    """Penalty energy density ``(k_n/2) [J_n - g]_+^2`` (paper eq. 9)."""
+    d = positive_part(penetration(J, n, gap))
+    return 0.5 * k_n * d * d
+
+
+def tangential_slip(J, n):
+    """``J_t = J - (J.n) n``, the tangential part of the jump."""
+    return J - normal_closure(J, n) * n
+
+
+def huber_of_square(s2, w):
+    """``huber(sqrt(s2), w)`` written without a singular derivative.
+
+    Parameters
+    ----------
+    s2
+        The squared argument ``s^2 >= 0`` (a CoefficientFunction).
+    w
+        Width of the quadratic zone, ``w > 0``.
+    """
+    w2 = w * w
+    far = ng.sqrt(ng.IfPos(s2 - w2, s2, w2)) - 0.5 * w
+    return ng.IfPos(s2 - w2, far, s2 / (2.0 * w))
+
+
+def huber(s, w):
+    """``huber(s, w)`` of a nonnegative scalar ``s`` (for plots and checks)."""
+    return huber_of_square(s * s, w)
+
+
+def tresca_energy(J, n, G, w):
+    """Regularized Tresca energy density ``G huber(|J_t|, w)`` (paper eqs. 9, 16)."""
+    Jt = tangential_slip(J, n)
+    return G * huber_of_square(ng.InnerProduct(Jt, Jt), w)
+
+
+def slip_magnitude(J, n):
+    """``|J_t|``."""
+    Jt = tangential_slip(J, n)
+    return ng.sqrt(ng.InnerProduct(Jt, Jt))
+
+
+def friction_traction(J, n, G, w):
+    """Tangential traction on the counter body, ``G J_t / max(|J_t|, w)`` (paper eq. 17)."""
+    Jt = tangential_slip(J, n)
+    s2 = ng.InnerProduct(Jt, Jt)
+    return G * Jt / ng.sqrt(ng.IfPos(s2 - w * w, s2, w * w))
+
+
+def coulomb_threshold(J_previous, n, k_n, mu, gap=None):
+    """Coulomb threshold ``G = mu p`` from the pressure of a frozen previous state.
+
+    ``J_previous`` must be built from GridFunctions that are not the unknown
+    (a copy of the previous iterate), so that ``G`` is data for the Tresca
+    problem of the next fixed-point step.
+    """
+    return mu * pressure(J_previous, n, k_n, gap)
+
+
+def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=None):
+    """Total interface energy density of the terms asked for.
+
+    Parameters
+    ----------
+    J
+        Jump ``u_rough - u_counter`` (trial function expression).
+    n
+        Micro normal, from ``rough`` into ``counter``.
+    k_n
+        Penalty stiffness [stress/length].
+    gap
+        Initial gap ``g`` or ``None`` (no gap term).
+    friction
+        ``None`` (frictionless), ``"tresca"`` or ``"coulomb"``; both friction
+        laws use ``threshold`` (``G``, or ``mu p_previous``) and ``w``.
+    """
+    energy = normal_energy(J, n, k_n, gap)
+    if friction is None:
+        return energy
+    if friction not in ("tresca", "coulomb"):
+        raise ValueError(f"friction = {friction!r}: must be None, 'tresca' or 'coulomb'")
+    if w is None or threshold is None:
+        raise ValueError("friction needs a width w and a threshold")
+    return energy + tresca_energy(J, n, threshold, w)

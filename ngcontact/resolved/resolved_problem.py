@@ -1,0 +1,432 @@
+"""The resolved (direct) contact problem of two bodies with a rough interface.
+
+The micro problem that the homogenized model approximates (paper Sec. 3.3,
+the problem whose limit Prop. 29 identifies): the roughness of period
+``eps`` is resolved in the mesh and the micro contact law of the cell acts
+on the whole resolved surface ``S_C^eps``.  Minimizes
+
+    Pi(u) = sum_B int_B 1/2 sigma(u_B) : eps(u_B) w dx
+            + int_{S_C^eps} psi(J) w ds  -  int_GammaN t . u w ds
+
+with each body ``B`` its own ``VectorH1`` on its region (``definedon``), the
+jump ``J = u_rough - u_counter`` on ``S_C^eps``, the micro normal ``n``
+pointing from ``rough`` into ``counter`` (sign fixed element by element by
+:func:`ngcontact.macro.interface_normal`), the measure weight ``w`` (``2 pi r``
+in axisymmetry) and the interface energy density of
+:mod:`ngcontact.laws.penalty` (paper eqs. 7, 9, 16)::
+
+    psi(J) = (k_n / 2) [J.n - g]_+^2  (+ G huber(|J_t|, w_h)  with friction).
+
+Dirichlet data fix displacement components on labelled boundaries (the
+values may vary linearly along the boundary: a tilt); pressures and
+tractions load others.  The energy is convex: it is minimized by Newton's
+method with the exact line search of :func:`ngcontact.newton.minimize`,
+started from the solution of the quadratic surrogate with every point of
+``S_C^eps`` closed (so that no body floats at the first step).  Coulomb
+friction ``G = mu p`` is a fixed point on the pressure of the previous
+solution, stopped when ``max |p_k - p_{k-1}| <= coulomb_rtol max p_k`` at
+the quadrature points of ``S_C^eps``.
+
+Post-processing shared with the homogenized solutions (so both are measured
+alike): :func:`boundary_reaction` (consistent reaction force and moment on a
+Dirichlet boundary from the elastic energy of the body that carries it),
+:func:`probe` (displacement at points), and on the resolved surface
+:func:`contact_force` (the force the counter body receives through a part
+of the interface) and :func:`contact_fraction`.
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+import ngsolve as ng
+import numpy as np
+
+from ngcontact.laws import penalty as _contact
+from ngcontact.fem import elasticity
+from ngcontact.laws import homogenized as il
+from ngcontact.errors import ConvergenceError
+from ngcontact.macro.macro_problem import add_load_potential, interface_normal
+from ngcontact.solvers.newton import minimize
+
+log = logging.getLogger(__name__)
+
+COMPONENTS = {"plane_strain": ("x", "y"), "axisymmetric": ("r", "z")}
+
+
+@dataclass(frozen=True, kw_only=True)
+class Support:
+    """Prescribed displacement components on a boundary.
+
+    ``value[i]`` is prescribed for ``components[i]`` (all components when
+    empty), plus ``slope[i] * (s - s_mid)`` where ``s`` is the coordinate
+    along ``along`` (``"x"`` or ``"y"``) and ``s_mid`` the mid-point of the
+    boundary in that coordinate: a linear variation (a tilt of a face).
+    """
+
+    label: str
+    components: tuple = ()
+    value: tuple = ()
+    slope: tuple = ()
+    along: str = "x"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Friction:
+    """Micro friction: ``"tresca"`` (threshold ``G``) or ``"coulomb"`` (``mu``), Huber width ``w``."""
+
+    law: str
+    w: float
+    G: float = 0.0
+    mu: float = 0.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class DirectProblem:
+    """A resolved contact problem (no solution inside).
+
+    Attributes
+    ----------
+    mesh
+        Mesh with regions ``rough`` and ``counter`` and the resolved surface ``contact``.
+    setting
+        ``plane_strain`` or ``axisymmetric``.
+    materials
+        ``{"rough": ElasticLaw, "counter": ElasticLaw}``.
+    k_n
+        Micro penalty stiffness [stress / length].
+    gap
+        Initial micro gap ``g >= 0`` (number or CoefficientFunction) or ``None``.
+    friction
+        :class:`Friction` or ``None`` (frictionless).
+    supports, loads
+        Boundary conditions.
+    order
+        Polynomial order of the displacement.
+    periodic
+        The lateral faces are identified (``Periodic`` spaces).
+    coulomb_rtol, coulomb_max_iter
+        Stopping rule of the Coulomb fixed point.
+    law
+        ``None`` (the micro law above on the resolved surface) or a
+        homogenized :class:`~ngcontact.interface_law.InterfaceLaw` (without
+        Coulomb friction): then ``contact`` names the flat macro interface
+        ``S_0``, ``n`` is its normal ``n0``, the energy density is
+        ``W(a)`` of the local jump ``a = (J.n0, J.t0)`` and ``k_n``,
+        ``gap`` and ``friction`` are not used.  Both models are thus solved
+        with the same spaces, boundary conditions, start and Newton method.
+    contact
+        Label of the interface boundary.
+    """
+
+    mesh: object
+    materials: dict
+    k_n: float
+    setting: str = "plane_strain"
+    gap: object = None
+    friction: Friction | None = None
+    supports: tuple = ()
+    loads: tuple = ()
+    order: int = 2
+    periodic: bool = False
+    contact: str = "contact"
+    coulomb_rtol: float = 1e-8
+    coulomb_max_iter: int = 40
+    law: object = None
+
+
+@dataclass
+class DirectSolution:
+    """Result of :func:`solve`: the state as NGSolve objects, plus the solver history."""
+
+    problem: DirectProblem
+    gfu: ng.GridFunction
+    u_rough: object
+    u_counter: object
+    normal: object
+    jump: object
+    pressure: object
+    history: dict = field(default_factory=dict)
+
+    @property
+    def ndof(self) -> int:
+        return int(sum(self.gfu.space.FreeDofs()))
+
+
+# ------------------------------------------------------------------ model
+def _spaces(problem: DirectProblem):
+    """Compound space of the two bodies with the Dirichlet flags of the supports.
+
+    Labels fixed in every component use ``dirichlet``, the others the
+    component-wise flags; ``Periodic`` keeps only the former (NGSolve drops
+    component-wise flags when it wraps the space), so a periodic problem
+    accepts only supports that fix every component.
+    """
+    mesh = problem.mesh
+    comps = COMPONENTS[problem.setting]
+    full, partial = [], {c: [] for c in comps}
+    for s in problem.supports:
+        if not s.components or set(s.components) == set(comps):
+            full.append(s.label)
+        else:
+            if problem.periodic:
+                raise ValueError(f"support on {s.label!r}: a periodic problem takes supports that fix "
+                                 "every component")
+            for c in s.components:
+                partial[c].append(s.label)
+    kw = {f"dirichlet{'xyz'[i]}": "|".join(partial[c] + full) for i, c in enumerate(comps) if partial[c]}
+    if full:
+        kw["dirichlet"] = "|".join(full)
+    spaces = []
+    for name in ("rough", "counter"):
+        V = ng.VectorH1(mesh, order=problem.order, definedon=mesh.Materials(name), **kw)
+        spaces.append(ng.Periodic(V) if problem.periodic else V)
+    return ng.FESpace(spaces)
+
+
+def _boundary_mid(mesh, label: str, axis: int) -> float:
+    """Mid-point of a boundary's extent along a coordinate axis."""
+    coords = [mesh[v].point[axis] for el in mesh.Elements(ng.BND) if el.mat == label for v in el.vertices]
+    return 0.5 * (min(coords) + max(coords))
+
+
+def _set_dirichlet(problem: DirectProblem, gfu) -> None:
+    mesh = problem.mesh
+    comps = COMPONENTS[problem.setting]
+    for s in problem.supports:
+        listed = s.components or comps
+        value = tuple(s.value) or (0.0,) * len(listed)
+        slope = tuple(s.slope) or (0.0,) * len(listed)
+        if not any(value) and not any(slope):
+            continue
+        axis = 0 if s.along == "x" else 1
+        coord = (ng.x, ng.y)[axis] - _boundary_mid(mesh, s.label, axis)
+        vec = ng.CF(tuple(float(value[listed.index(c)]) + float(slope[listed.index(c)]) * coord
+                          if c in listed else 0.0 for c in comps))
+        for gf in gfu.components:
+            gf.Set(vec, definedon=mesh.Boundaries(s.label))
+
+
+def _form(problem: DirectProblem, fes, n, *, threshold=None, surrogate: bool = False):
+    """The energy as a symmetric ``BilinearForm`` of ``Variation`` terms.
+
+    ``surrogate``: the quadratic start energy, every point of ``S_C`` closed
+    (no positive part) and, under friction, the slip held by a spring ``k_n``.
+    """
+    mesh, setting = problem.mesh, problem.setting
+    w = elasticity.weight(setting)
+    ur, uc = fes.TrialFunction()
+    form = ng.BilinearForm(fes, symmetric=True)
+    elasticity.add_elastic_energy(form, mesh, {"rough": problem.materials["rough"],
+                                               "counter": problem.materials["counter"]},
+                                  {"rough": ur, "counter": uc}, setting)
+    J = ur.Trace() - uc.Trace()
+    k_n = problem.k_n
+    fr = problem.friction
+    if problem.law is not None:
+        a = [ng.InnerProduct(J, e) for e in il.local_frame(n, mesh.dim)]
+        if surrogate:
+            psi = il.normal_energy(problem.law.normal, a, 0.0, closed=True)
+        else:
+            psi = il.energy(problem.law, a, 0.0, threshold)
+    elif surrogate:
+        d = _contact.penetration(J, n, problem.gap)
+        psi = 0.5 * k_n * d * d
+        if fr is not None:
+            Jt = _contact.tangential_slip(J, n)
+            psi = psi + 0.5 * k_n * ng.InnerProduct(Jt, Jt)
+    else:
+        psi = _contact.interface_energy(J, n, k_n=k_n, gap=problem.gap,
+                                        friction=None if fr is None else fr.law,
+                                        w=None if fr is None else fr.w, threshold=threshold)
+    form += ng.Variation(psi * w * ng.ds(definedon=mesh.Boundaries(problem.contact)))
+    return add_load_potential(form, mesh, problem.loads, (ur, uc), w)
+
+
+def _check(problem: DirectProblem) -> None:
+    mesh = problem.mesh
+    labels = set(mesh.GetBoundaries())
+    if problem.setting not in COMPONENTS:
+        raise ValueError(f"setting = {problem.setting!r}: must be one of {', '.join(COMPONENTS)}")
+    if problem.contact not in labels:
+        raise ValueError(f"the mesh has no boundary {problem.contact!r}")
+    for item in tuple(problem.supports) + tuple(problem.loads):
+        if item.label not in labels:
+            raise ValueError(f"boundary {item.label!r} does not exist; labels are "
+                             + ", ".join(sorted(labels - {""})))
+    if not problem.k_n > 0:
+        raise ValueError(f"k_n = {problem.k_n!r}: must be > 0")
+    law = problem.law
+    if law is not None and law.friction is not None and law.friction.coulomb:
+        raise ValueError("a homogenized law with Coulomb friction is solved by ngcontact.macro.solve")
+
+
+def solve(problem: DirectProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
+          inverse: str = "sparsecholesky") -> DirectSolution:
+    """Solve the resolved contact problem (or its homogenized counterpart, ``problem.law``).
+
+    Parameters
+    ----------
+    problem
+        The description.
+    rtol, atol, max_iter, inverse
+        Newton settings (:func:`ngcontact.newton.minimize`); every Newton
+        solve after the quadratic start stops at ``rtol`` times the first
+        residual of that start.
+
+    Raises
+    ------
+    ValueError
+        Unknown boundary labels or an invalid setting.
+    ConvergenceError
+        Newton or the Coulomb fixed point failed.
+    """
+    _check(problem)
+    mesh = problem.mesh
+    fes = _spaces(problem)
+    gfu = ng.GridFunction(fes)
+    _set_dirichlet(problem, gfu)
+    n = interface_normal(mesh, "rough", problem.contact)
+    newton = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
+    history = {"newton": [], "coulomb_changes": []}
+    start = _form(problem, fes, n, surrogate=True)
+    history["newton"].append(minimize(start, gfu, quadratic=True, **newton).as_dict())
+    newton["atol"] = max(atol, rtol * history["newton"][0]["residuals"][0])
+    ur, uc = gfu.components
+    J = ur - uc
+    fr = problem.friction
+    if problem.law is not None:
+        a = [ng.InnerProduct(J, e) for e in il.local_frame(n, mesh.dim)]
+        pressure = il.pressure(problem.law.normal, a)
+        G = None if problem.law.friction is None else ng.CF(problem.law.friction.threshold)
+        form = _form(problem, fes, n, threshold=G)
+        history["newton"].append(minimize(form, gfu, line_search="exact", **newton).as_dict())
+    elif fr is not None and fr.law == "coulomb":
+        pressure = _contact.pressure(J, n, problem.k_n, problem.gap)
+        _coulomb(problem, fes, gfu, n, pressure, newton, history)
+    else:
+        pressure = _contact.pressure(J, n, problem.k_n, problem.gap)
+        G = ng.CF(fr.G) if fr is not None else None
+        form = _form(problem, fes, n, threshold=G)
+        history["newton"].append(minimize(form, gfu, line_search="exact", **newton).as_dict())
+    history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
+    history["converged"] = all(h["converged"] for h in history["newton"])
+    return DirectSolution(problem=problem, gfu=gfu, u_rough=ur, u_counter=uc, normal=n, jump=J,
+                          pressure=pressure, history=history)
+
+
+def _coulomb(problem, fes, gfu, n, pressure, newton, history) -> None:
+    """Coulomb friction: Tresca solves with ``G = mu p`` of the previous solution, to a fixed point."""
+    mesh, fr = problem.mesh, problem.friction
+    old = ng.GridFunction(fes)
+    J_old = old.components[0] - old.components[1]
+    G = _contact.coulomb_threshold(J_old, n, problem.k_n, fr.mu, problem.gap)
+    form = _form(problem, fes, n, threshold=G)
+    p_old = _sample_contact(mesh, problem.contact, pressure, problem.order)
+    for it in range(1, problem.coulomb_max_iter + 1):
+        old.vec.data = gfu.vec
+        history["newton"].append(minimize(form, gfu, line_search="exact", **newton).as_dict())
+        p_new = _sample_contact(mesh, problem.contact, pressure, problem.order)
+        change = float(np.max(np.abs(p_new - p_old)))
+        scale = float(np.max(np.abs(p_new)))
+        history["coulomb_changes"].append(change)
+        log.info("coulomb fixed point %d: max |dp| = %.3e (max p %.3e)", it, change, scale)
+        if change <= problem.coulomb_rtol * max(scale, 1e-300):
+            return
+        p_old = p_new
+    raise ConvergenceError(f"Coulomb fixed point: pressure still changes by {change:.3e} after "
+                           f"{problem.coulomb_max_iter} passes", history)
+
+
+def _sample_contact(mesh, label, cf, order) -> np.ndarray:
+    S = ng.comp.IntegrationRuleSpaceSurface(mesh, order=2 * order + 2, definedon=mesh.Boundaries(label))
+    gf = ng.GridFunction(S)
+    gf.Set(cf, definedon=mesh.Boundaries(label))
+    return gf.vec.FV().NumPy().copy()
+
+
+# -------------------------------------------------------- post-processing
+def boundary_reaction(mesh, setting: str, law, u, region: str, label: str, order: int,
+                      about=(0.0, 0.0)) -> dict:
+    """Reaction force and moment that a Dirichlet boundary exerts on its body.
+
+    The consistent reaction: the derivative of the body's elastic energy in
+    the direction of a test field ``v`` equal to ``e_i`` (force component
+    ``i``) or to the rigid rotation about ``about`` (moment, plane strain)
+    on the dofs of ``label`` and zero on all other dofs.  At an equilibrium
+    state with no load on the boundary's neighbours this is the force the
+    support transmits; the sign is that of the force the body *exerts on
+    the support* (e.g. positive ``y`` when the body presses upwards).
+
+    Parameters
+    ----------
+    mesh, setting
+        Mesh and setting.
+    law
+        The body's :class:`~ngcontact.materials.ElasticLaw`.
+    u
+        The body's displacement (GridFunction or component).
+    region, label
+        The body's region and the boundary.
+    order
+        Order of the test field (that of ``u``).
+    about
+        Centre of the moment (plane strain).
+
+    Returns
+    -------
+    dict
+        Force components by name (``x, y`` or ``r, z``; axisymmetric: per
+        full revolution, ``r`` omitted) and ``moment`` (plane strain).
+    """
+    comps = COMPONENTS[setting]
+    V = ng.VectorH1(mesh, order=order, definedon=mesh.Materials(region))
+    v = ng.GridFunction(V)
+    sigma = elasticity.stress(law, u, setting)
+    w = elasticity.weight(setting)
+    fields = {c: ng.CF(tuple(1.0 if j == i else 0.0 for j in range(2))) for i, c in enumerate(comps)}
+    if setting == "plane_strain":
+        fields["moment"] = ng.CF((-(ng.y - about[1]), ng.x - about[0]))
+    else:
+        fields.pop("r")
+    out = {}
+    for name, cf in fields.items():
+        v.vec[:] = 0.0
+        v.Set(cf, definedon=mesh.Boundaries(label))
+        work = ng.InnerProduct(sigma, elasticity.strain(v, setting)) * w
+        out[name] = -float(ng.Integrate(work, mesh, definedon=mesh.Materials(region)))
+    return out
+
+
+def probe(mesh, u, points) -> np.ndarray:
+    """Displacement ``u`` at ``points`` (an array ``(m, 2)``), one row per point."""
+    pts = np.asarray(points, float).reshape(-1, 2)
+    return np.array([np.asarray(u(mesh(float(x), float(y)))).ravel() for x, y in pts])
+
+
+def contact_force(sol: DirectSolution, x_range=None, part=None) -> np.ndarray:
+    """Force the counter body receives through ``S_C^eps`` (or its part with ``x`` in ``x_range``).
+
+    ``int p n w ds`` with the pressure ``p`` (compression positive) and the
+    micro normal ``n`` from rough into counter (friction not included).
+    ``part``: an indicator CoefficientFunction of the part instead of
+    ``x_range``.
+    """
+    p = sol.problem
+    mesh = p.mesh
+    ind = ng.CF(1.0) if part is None else part
+    if x_range is not None:
+        ind = ng.IfPos(ng.x - x_range[0], 1.0, 0.0) * ng.IfPos(x_range[1] - ng.x, 1.0, 0.0)
+    w = elasticity.weight(p.setting)
+    vals = ng.Integrate(sol.pressure * sol.normal * ind * w, mesh, ng.BND,
+                        definedon=mesh.Boundaries(p.contact), order=2 * p.order + 6)
+    return np.asarray(vals, float).ravel()
+
+
+def contact_fraction(sol: DirectSolution, length: float) -> float:
+    """Measure of ``{J.n - g >= 0}`` on ``S_C^eps`` (high-order quadrature) per unit macro length."""
+    p = sol.problem
+    pen = _contact.penetration(sol.jump, sol.normal, p.gap)
+    ind = ng.IfPos(-pen, 0.0, 1.0)
+    return float(ng.Integrate(ind, p.mesh, ng.BND, definedon=p.mesh.Boundaries(p.contact),
+                              order=4 * p.order + 24)) / length

@@ -1,0 +1,320 @@
+"""Scene kind ``cell``: the micro contact problem of one periodic cell.
+
+Sections: ``[geometry]`` (profile and arrangement, mapped onto the builders
+of :mod:`ngcontact.geometry.profiles` and :mod:`ngcontact.geometry.cell3d`),
+``[contact]`` (penalty ``k_n``, initial gap, friction law), ``[load]``
+(pressure or normal jump, shear or tangential jump, macro strain; lists are
+sweeps), ``[bodies]`` (material names), ``[discretization]``, ``[solver]``.
+With ``contact.geometric_only = true`` only the coefficients of the whole
+contact surface (paper eq. 34, 42-43) are computed and no contact problem is
+solved.  Solved by :mod:`ngcontact.drivers.run_cell`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ngcontact.errors import MISSING, SceneError
+from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
+                     check_material_names)
+from ngcontact.scene.schema import check_selected, nonempty, nonnegative, open_interval, param, positive
+
+PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
+PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map")
+#: 3D free-form profiles: meshed as the real surface with Netgen's OCC kernel
+#: in the conforming arrangement; in the summit arrangement represented by the
+#: small-slope model (a flat interface whose initial gap is the height below
+#: the highest summit).
+GAP_PROFILES = ("bisinusoid", "height_map")
+GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
+FRICTION = ("none", "tresca", "coulomb")
+
+
+@dataclass(frozen=True, kw_only=True)
+class CellGeometry:
+    """The periodic cell (mesh naming contract of ngcontact.geometry)."""
+
+    profile: str = param(doc="roughness profile", choices=PROFILES_2D + PROFILES_3D)
+    arrangement: str = param("conforming", doc="counter body fills the valleys (conforming) or "
+                             "touches the summits only (summit; for bisinusoid and height_map the "
+                             "small-slope model: a flat interface with the heights as initial gap)",
+                             choices=("conforming", "summit"))
+    period: float = param(1.0, doc="cell period |T| (per tangential direction)", units="m",
+                          check=positive())
+    h_rough: float = param(1.0, doc="depth of the rough body below the summits", units="m",
+                           check=positive())
+    h_counter: float = param(1.0, doc="height of the counter body above the summits", units="m",
+                             check=positive())
+    width: float | None = param(None, doc="valley width (rectangular; triangular: omit for a "
+                                "sawtooth spanning the period); hill side (square_hills)",
+                                units="m", check=positive())
+    depth: float | None = param(None, doc="valley depth (rectangular); hill height (square_hills)",
+                                units="m", check=positive())
+    radius: float | None = param(None, doc="valley radius (semicircular)", units="m", check=positive())
+    angles: tuple[float, float] | None = param(None, doc="face angles to S_0 (triangular)",
+                                               units="deg", check=open_interval(0, 90))
+    amplitude: float | None = param(None, doc="profile amplitude (sinusoid, bisinusoid)", units="m",
+                                    check=positive())
+    file: str | None = param(None, doc="tabulated profile: CSV with columns x, y over one period "
+                             "(2D); height map: .npy array whose last row/column repeat the first "
+                             "(3D, small-slope model); relative to the scene file")
+
+    _USES = {"flat": (), "flat3d": (), "rectangular": ("width", "depth"),
+             "triangular": ("angles",), "semicircular": ("radius",), "sinusoid": ("amplitude",),
+             "square_hills": ("width", "depth"), "tabulated": ("file",),
+             "bisinusoid": ("amplitude",), "height_map": ("file",)}
+    _OPTIONAL = {"triangular": ("width",)}
+
+    @property
+    def dim(self) -> int:
+        return 3 if self.profile in PROFILES_3D else 2
+
+    def check(self, path: str) -> None:
+        check_selected(self, path, "profile", ("width", "depth", "radius", "angles", "amplitude", "file"),
+                       self._USES[self.profile], self._OPTIONAL.get(self.profile, ()))
+        if self.profile == "square_hills":
+            if not self.width < self.period:
+                raise SceneError(f"{path}.width", self.width,
+                                 f"must be < period = {self.period!r} (hills must not touch)")
+            if not self.depth < self.h_rough:
+                raise SceneError(f"{path}.depth", self.depth, f"must be < h_rough = {self.h_rough!r} "
+                                 "(the hill base must lie inside the rough body)")
+        if self.dim == 2 and self.profile != "tabulated":  # tabulated: checked when its file is read
+            try:
+                bounds = profile_2d(self).bounds
+            except SceneError as exc:  # the builders name their own arguments (profile.width, ...)
+                key = _BUILDER_KEYS.get(exc.path, exc.path.replace("profile.", ""))
+                raise SceneError(f"{path}.{key}", exc.value, exc.allowed) from None
+            check_profile_heights(self, bounds, path)
+
+
+_BUILDER_KEYS = {"profile.angle_left": "angles", "profile.angle_right": "angles"}
+
+
+def profile_2d(g: CellGeometry):
+    """The :class:`~ngcontact.geometry.profiles.Profile` of a parametric 2D geometry section."""
+    from ngcontact.geometry import profiles as pr
+    if g.profile == "flat":
+        return pr.flat(g.period)
+    if g.profile == "rectangular":
+        return pr.rectangular_valley(g.width, g.depth, g.period)
+    if g.profile == "triangular":
+        return pr.triangular_valley(g.angles[0], g.angles[1], g.width, g.period)
+    if g.profile == "semicircular":
+        return pr.semicircular_valley(g.radius, g.period)
+    if g.profile == "sinusoid":
+        return pr.sinusoid(g.amplitude, g.period)
+    raise ValueError(f"profile {g.profile!r} is not a parametric 2D profile")
+
+
+def check_profile_heights(g: CellGeometry, bounds: tuple, path: str = "geometry") -> None:
+    """The profile ``(y_min, y_max)`` must lie strictly between the far faces of the cell."""
+    lo, hi = bounds
+    if not lo > -g.h_rough:
+        raise SceneError(f"{path}.h_rough", g.h_rough, f"must exceed the profile depth {-lo!r} "
+                         "(the roughness must lie inside the rough body)")
+    if not hi < g.h_counter:
+        raise SceneError(f"{path}.h_counter", g.h_counter, f"must exceed the profile height {hi!r}")
+
+
+@dataclass(frozen=True, kw_only=True)
+class GapSpec:
+    """Initial gap g >= 0 on the contact surface."""
+
+    kind: str = param("none", doc="none, constant, sinusoid 2h sin^2(pi x/P), bisinusoid "
+                      "h (2 - cos(2 pi x/P) - cos(2 pi y/P)), tabulated (file)",
+                      choices=GAPS)
+    value: float | None = param(None, doc="constant gap", units="m", check=nonnegative())
+    h: float | None = param(None, doc="gap amplitude h (sinusoid: g in [0, 2h]; bisinusoid: [0, 4h])",
+                            units="m", check=positive())
+    file: str | None = param(None, doc="tabulated gap: CSV with columns x, g over one period (2D) "
+                             "or .npy array g[i, j] at x = j P/(n_x - 1), y = i P/(n_y - 1) whose last "
+                             "row/column repeat the first (3D); g >= 0; relative to the scene file")
+
+    def check(self, path: str) -> None:
+        need = {"none": (), "constant": ("value",), "sinusoid": ("h",),
+                "bisinusoid": ("h",), "tabulated": ("file",)}[self.kind]
+        check_selected(self, path, "kind", ("value", "h", "file"), need)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ContactSpec:
+    """Penalty contact and friction on S_C."""
+
+    k_n: float = param(doc="penalty (Winkler) stiffness k_n", units="Pa/m", check=positive())
+    gap: GapSpec = param(GapSpec(), doc="initial gap")
+    friction: str = param("none", doc="friction law", choices=FRICTION)
+    G: float | None = param(None, doc="Tresca threshold", units="Pa", check=nonnegative())
+    mu: float | None = param(None, doc="Coulomb coefficient", check=nonnegative())
+    w: float | None = param(None, doc="Huber width (stick zone of the slip)", units="m",
+                            check=positive())
+    geometric_only: bool = param(False, doc="only the coefficients of the whole contact surface; "
+                                 "solve no contact problem")
+
+    def check(self, path: str) -> None:
+        need = {"none": (), "tresca": ("G", "w"), "coulomb": ("mu", "w")}[self.friction]
+        check_selected(self, path, "friction", ("G", "mu", "w"), need)
+
+
+@dataclass(frozen=True, kw_only=True)
+class LoadSpec:
+    """Mean load of the cell; lists of equal length (or length 1) make a sweep."""
+
+    pressure: tuple[float, ...] | None = param(None, doc="mean normal pressure, compression positive",
+                                               units="Pa", check=positive())
+    normal_jump: tuple[float, ...] | None = param(None, doc="prescribed far-face normal jump "
+                                                  "(rough minus counter, positive closes)", units="m")
+    shear: tuple[float, ...] | None = param(None, doc="mean shear on the counter's far face along "
+                                            "x (2D) or x then y per load (3D: 2 entries per load)",
+                                            units="Pa")
+    tangential_jump: tuple[float, ...] | None = param(None, doc="prescribed far-face tangential jump "
+                                                      "(same layout as shear)", units="m")
+    macro_strain: tuple[float, ...] | None = param(None, doc="in-plane macro strain: 2D (e_xx), "
+                                                   "3D (e_xx, e_yy, e_xy), one set per sweep", units="")
+
+    def check(self, path: str) -> None:
+        if (self.pressure is None) == (self.normal_jump is None):
+            raise SceneError(f"{path}.pressure", self.pressure,
+                             "give exactly one of pressure and normal_jump")
+        if self.shear is not None and self.tangential_jump is not None:
+            raise SceneError(f"{path}.shear", self.shear, "give shear or tangential_jump, not both")
+        for key in ("pressure", "normal_jump", "shear", "tangential_jump"):
+            v = getattr(self, key)
+            if v is not None and len(v) == 0:
+                raise SceneError(f"{path}.{key}", v, "must not be empty")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Bodies:
+    """Materials of the two bodies."""
+
+    rough: str = param(doc="material of the rough body (below)")
+    counter: str = param(doc="material of the counter body (above)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class CellScene:
+    kind: str = param(doc="problem type", choices=("cell",))
+    title: str = param("", doc="free text shown in the report")
+    materials: dict[str, MaterialSpec] = param(doc="named materials", check=nonempty())
+    bodies: Bodies = param(doc="materials of the bodies")
+    geometry: CellGeometry = param(doc="the periodic cell")
+    contact: ContactSpec = param(doc="contact law")
+    load: LoadSpec | None = param(None, doc="mean load (omit with contact.geometric_only)")
+    discretization: Discretization = param(Discretization(), doc="mesh and order")
+    solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
+    base_dir: str = base_dir_field()
+
+    def check_files(self) -> None:
+        """Read and validate the tabulated profile / height map / gap named by the scene."""
+        from ngcontact.geometry import tabulated
+        from ngcontact.scene.sections import resolve
+        g = self.geometry
+        if g.file is not None:
+            where = f"geometry.file ({g.file})"
+            if g.profile == "tabulated":
+                prof = tabulated.read_profile_csv(resolve(self, g.file), path=where)
+                if abs(prof.period - g.period) > 1e-12 * g.period:
+                    raise SceneError("geometry.period", g.period,
+                                     f"must equal the period of the tabulated profile ({prof.period!r})")
+                lo, hi = prof.bounds
+                if hi - lo >= min(g.h_rough, g.h_counter):
+                    raise SceneError("geometry.file", g.file, f"the profile height {hi - lo!r} must stay "
+                                     "below h_rough and h_counter")
+            else:
+                tabulated.read_height_map(resolve(self, g.file), path=where)
+        gs = self.contact.gap
+        if gs.file is not None:
+            where = f"contact.gap.file ({gs.file})"
+            if self.geometry.dim == 2:
+                x, _ = tabulated.read_gap_csv(resolve(self, gs.file), path=where)
+                if abs(x[-1] - g.period) > 1e-12 * g.period:
+                    raise SceneError("contact.gap.file", gs.file,
+                                     f"must span one period {g.period!r} (it ends at x = {x[-1]!r})")
+            else:
+                tabulated.read_gap_map(resolve(self, gs.file), path=where)
+
+    def check(self, path: str) -> None:
+        check_material_names(self.materials, {"rough": self.bodies.rough,
+                                              "counter": self.bodies.counter}, "bodies")
+        for name in (self.bodies.rough, self.bodies.counter):
+            if self.materials[name].C is not None:
+                raise SceneError(f"materials.{name}.C", "...", "cell scenes take isotropic E, nu")
+        dim = self.geometry.dim
+        g = self.contact.gap.kind
+        if g == "sinusoid" and dim != 2 or g == "bisinusoid" and dim != 3:
+            raise SceneError("contact.gap.kind", g, f"not available for a {dim}D cell")
+        if self.contact.geometric_only:
+            if self.load is not None:
+                raise SceneError("load", "...", "not used with contact.geometric_only = true; remove it")
+            return
+        if self.load is None:
+            raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
+        loads(self)
+        flat = self.geometry.profile in ("flat", "flat3d") or small_slope(self.geometry)
+        if flat and self.contact.friction == "none":
+            for key in ("shear", "tangential_jump"):
+                v = getattr(self.load, key)
+                if v is not None and any(x != 0.0 for x in v):
+                    raise SceneError(f"load.{key}", v, "a frictionless flat contact surface carries no "
+                                     "shear and fixes no tangential jump: give 0 or set contact.friction")
+
+
+def small_slope(geometry: CellGeometry) -> bool:
+    """A free-form 3D profile in the summit arrangement: flat interface plus gap."""
+    return geometry.profile in GAP_PROFILES and geometry.arrangement == "summit"
+
+
+def loads(scene: CellScene) -> list:
+    """The sweep of :class:`ngcontact.cell.CellLoad` described by ``scene.load``."""
+    from ngcontact.cell.cell_problem import cell_load
+    L, dim = scene.load, scene.geometry.dim
+    nt = dim - 1
+    nkey = "pressure" if L.pressure is not None else "normal_jump"
+    tkey = "shear" if L.shear is not None else "tangential_jump"
+    normal = getattr(L, nkey)
+    tang = getattr(L, tkey)
+    tang_sets = None
+    if tang is not None:
+        if len(tang) % nt:
+            raise SceneError(f"load.{tkey}", tang, f"needs {nt} entries per load in a {dim}D cell")
+        tang_sets = [tuple(tang[i:i + nt]) for i in range(0, len(tang), nt)]
+    n = max(len(normal), len(tang_sets or [()]))
+    if tang_sets is not None and 1 < len(normal) != len(tang_sets) > 1:
+        raise SceneError(f"load.{tkey}", tang, f"makes {len(tang_sets)} loads but load.{nkey} has "
+                         f"{len(normal)}; sweeps need equal lengths or length 1")
+    ms = L.macro_strain
+    if ms is not None and len(ms) != (1 if dim == 2 else 3):
+        raise SceneError("load.macro_strain", ms, f"needs {1 if dim == 2 else 3} entries in a {dim}D cell")
+    out = []
+    for k in range(n):
+        nv = normal[k if len(normal) > 1 else 0]
+        tv = tang_sets[k if len(tang_sets) > 1 else 0] if tang_sets else None
+        out.append(cell_load(dim,
+                             pressure=nv if L.pressure is not None else None,
+                             normal_jump=nv if L.normal_jump is not None else None,
+                             shear=tv if L.shear is not None else None,
+                             tangential_jump=tv if L.tangential_jump is not None else None,
+                             macro_strain=ms))
+    return out
+
+
+def effects(scene: CellScene) -> tuple[str, ...]:
+    """The terms assembled (geometric_only: only the surface integrals)."""
+    if scene.contact.geometric_only:
+        return ("contact_surface_coefficients",)
+    out = ["elasticity", "normal_contact"]
+    if scene.contact.gap.kind != "none" or small_slope(scene.geometry):
+        out.append("gap")
+    if scene.contact.friction != "none":
+        out.append(f"{scene.contact.friction}_friction")
+    L = scene.load
+    out.append("pressure_load" if L.pressure is not None else "prescribed_normal_jump")
+    if L.shear is not None and any(v != 0 for v in L.shear):
+        out.append("shear_load")
+    if L.tangential_jump is not None:
+        out.append("prescribed_tangential_jump")
+    if L.macro_strain is not None and any(v != 0 for v in L.macro_strain):
+        out.append("macro_strain")
+    return tuple(out)
+
+

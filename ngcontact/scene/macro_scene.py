@@ -1,0 +1,363 @@
+"""Scene kind ``macro``: two elastic bodies joined by a homogenized interface law.
+
+The macro problem of paper eqs. 44-48 / 69-71 (see :mod:`ngcontact.macro.macro_problem`)
+on one of the built-in geometries: the axisymmetric femur with a press-fitted
+hip stem (paper Sec. 4.2-4.3), two coaxial tubes (Lame press fit; plane
+strain, axisymmetric or 3D) or a block on a base (friction).  The interface
+law comes from explicit numbers (``linear`` K0, ``bundle`` of directions,
+``tabulated`` normal law) or from a ``cell`` scene named by
+``interface.cell`` (its direction bundle, computed on the fly and cached on
+disk; see :mod:`ngcontact.coupling.cell_law`), with homogenized friction on top.
+Lengths in metres, stresses in pascals, interface stiffnesses in Pa/m.
+
+Two optional sections extend the macro solve (this kind rather than new kinds,
+because both act on a macro solution and share its geometry, law and output):
+
+* ``[two_scale]``: the coupling loop of paper Sec. 3.5
+  (:mod:`ngcontact.coupling.two_scale`): the scene's interface law is the start (the
+  assumed contact set), and the cell named there, solved at the macro
+  pressure of every interface point (through an adaptive table in the
+  pressure), supplies coefficients that vary along the interface until the
+  macro normal stress stops changing;
+* ``[strength]``: micro stresses in the layer and the check of paper eq. 78
+  (:mod:`ngcontact.coupling.strength`) against ``materials.NAME.sigma_u`` of both
+  bodies.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from ngcontact.errors import MISSING, SceneError
+from ngcontact.geometry.bodies import FemurStemDims
+from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field, check_material_names,
+                     )
+from ngcontact.scene.schema import at_least, nonempty, nonnegative, param, positive
+
+SHAPES = ("femur_stem", "coaxial", "block")
+SETTINGS = {"femur_stem": ("axisymmetric",), "coaxial": ("plane_strain", "axisymmetric", "3d"),
+            "block": ("plane_strain",)}
+DIMENSIONS = {"femur_stem": tuple(f.name for f in dataclasses.fields(FemurStemDims)),
+              "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base")}
+REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base")}
+def check_dimensions(dims: dict, path: str, shape: str, required) -> None:
+    """A ``dimensions`` table: positive, known for ``shape``, the ``required`` ones present.
+
+    For ``femur_stem`` the completed dimensions must also describe a valid
+    femur and stem (:meth:`ngcontact.geometry.macro.FemurStemDims.check`).
+    """
+    for key in dims:
+        if not dims[key] > 0:
+            raise SceneError(f"{path}.{key}", dims[key], "must be > 0")
+        if key not in DIMENSIONS[shape]:
+            raise SceneError(f"{path}.{key}", dims[key],
+                             f"unknown dimension of {shape!r}; known: " + ", ".join(DIMENSIONS[shape]))
+    for key in required:
+        if key not in dims:
+            raise SceneError(f"{path}.{key}", MISSING, f"required for shape {shape!r}")
+    if shape == "femur_stem":
+        try:
+            FemurStemDims(**dims).check()
+        except ValueError as exc:
+            raise SceneError(path, dims, str(exc)) from None
+
+
+REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block": ("block", "base")}
+LAWS = ("linear", "bundle", "tabulated")
+#: Boundary labels of the meshed geometries (:mod:`ngcontact.geometry.bodies`) by (shape, setting),
+#: so that supports and loads are checked without meshing.
+BOUNDARIES = {
+    ("femur_stem", "axisymmetric"): ("axis", "base", "bone_outer", "bone_top", "canal", "interface",
+                                     "stem_side", "stem_tip", "stem_top"),
+    ("coaxial", "plane_strain"): ("bore", "interface", "mantle", "sym_x", "sym_y"),
+    ("coaxial", "axisymmetric"): ("bore", "bottom", "interface", "mantle", "top"),
+    ("coaxial", "3d"): ("bore", "bottom", "interface", "mantle", "sym_x", "sym_y", "top"),
+    ("block", "plane_strain"): ("base_sides", "block_sides", "bottom", "interface", "top"),
+}
+
+
+@dataclass(frozen=True, kw_only=True)
+class MacroGeometrySpec:
+    """Which macro geometry, in which setting, with which dimensions."""
+
+    shape: str = param(doc="femur_stem (regions stem = rough, bone = counter), coaxial (inner = rough, "
+                       "outer = counter) or block (block = rough on base = counter)", choices=SHAPES)
+    setting: str = param("axisymmetric", doc="plane_strain, axisymmetric (r, z) or 3d",
+                         choices=("plane_strain", "axisymmetric", "3d"))
+    dimensions: dict[str, float] | None = param(
+        None, doc="femur_stem: r_stem, r_tip, r_bone, z_tip, z_corner, z_bone_top, z_stem_top (defaults "
+        "exist); coaxial: a, b, c (radii), height (axisymmetric/3d); block: length, h_block, h_base",
+        units="m", allowed="a table of numbers > 0")
+
+    def check(self, path: str) -> None:
+        allowed = SETTINGS[self.shape]
+        if self.setting not in allowed:
+            raise SceneError(f"{path}.setting", self.setting,
+                             f"shape {self.shape!r} takes setting " + " or ".join(repr(s) for s in allowed))
+        dims = self.dimensions or {}
+        need = REQUIRED[self.shape] + (("height",) if self.shape == "coaxial" and self.setting != "plane_strain"
+                                       else ())
+        check_dimensions(dims, f"{path}.dimensions", self.shape, need)
+        if self.shape == "coaxial" and not dims["a"] < dims["b"] < dims["c"]:
+            raise SceneError(f"{path}.dimensions", dims, "need a < b < c")
+
+
+@dataclass(frozen=True, kw_only=True)
+class BodiesSpec:
+    """Materials of the two bodies."""
+
+    rough: str = param(doc="material of the rough body, paper D (femur_stem: the stem, whose coating is rough)")
+    counter: str = param(doc="material of the counter body, paper Omega (femur_stem: the bone)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class InterfaceSpec:
+    """The homogenized interface law on S_0 and the initial gap."""
+
+    law: str = param("bundle", doc="linear (K0, bilateral), bundle (unilateral weighted directions; the "
+                     "default, also from a cell) or tabulated (pressure against closure)", choices=LAWS)
+    cell: str | None = param(None, doc="cell scene file (relative to this scene): the law is its direction "
+                             "bundle (law = linear: its K0); then omit the explicit numbers")
+    cell_length_unit: float = param(1.0, doc="length of one unit of the cell scene (scales its gaps)",
+                                    units="m", check=positive())
+    kn: float | None = param(None, doc="k_n0 of the linear law", units="Pa/m", check=positive())
+    kt: float = param(0.0, doc="k_t0 (linear law; tabulated: tangential stiffness)", units="Pa/m",
+                      check=nonnegative())
+    knt: float = param(0.0, doc="k_nt0 of the linear law", units="Pa/m")
+    gap_force: tuple[float, float] = param((0.0, 0.0), doc="(g_n0, g_t0) of eq. 34 (linear law)", units="Pa")
+    weights: tuple[float, ...] | None = param(None, doc="bundle weights w_q", units="Pa/m", check=positive())
+    directions: tuple[tuple[float, ...], ...] | None = param(
+        None, doc="bundle directions n_q in the local frame (n0, t0) or (n0, t1, t2)",
+        allowed="one unit vector per weight")
+    gaps: tuple[float, ...] | None = param(None, doc="bundle micro gaps g_q", units="m")
+    closure: tuple[float, ...] | None = param(None, doc="tabulated closures c_i, increasing", units="m")
+    pressure: tuple[float, ...] | None = param(None, doc="tabulated pressures p_i, from 0, non-decreasing",
+                                               units="Pa")
+    gap: float = param(0.0, doc="uniform macro normal gap g0 (negative: interference, press fit)", units="m")
+    gap_table: tuple[tuple[float, float], ...] | None = param(
+        None, doc="piecewise linear gap [[coordinate, g0], ...] along gap_coordinate (replaces gap)",
+        units="m", allowed="pairs with increasing coordinate")
+    gap_coordinate: str = param("y", doc="coordinate of gap_table (r = x, z = y in axisymmetry)",
+                                choices=("x", "y", "z", "r"))
+    mu: float = param(0.0, doc="homogenized Coulomb coefficient mu0 (fixed point on the pressure)",
+                      check=nonnegative())
+    threshold: float = param(0.0, doc="Tresca threshold G0", units="Pa", check=nonnegative())
+    huber_width: float = param(1e-6, doc="Huber width w: largest slip of a sticking point", units="m",
+                               check=positive())
+
+    def check(self, path: str) -> None:
+        explicit = {"kn": self.kn, "weights": self.weights, "directions": self.directions, "gaps": self.gaps,
+                    "closure": self.closure, "pressure": self.pressure}
+        if self.cell is not None:
+            for key, value in explicit.items():
+                if value is not None:
+                    raise SceneError(f"{path}.{key}", value, "not used with interface.cell; remove it")
+            if self.law == "tabulated":
+                raise SceneError(f"{path}.law", self.law, "a cell gives law = 'bundle' or 'linear'")
+            return
+        need = {"linear": ("kn",), "bundle": ("weights", "directions"), "tabulated": ("closure", "pressure")}
+        for key in need[self.law]:
+            if explicit[key] is None:
+                raise SceneError(f"{path}.{key}", MISSING, f"required for law = {self.law!r} (or name a cell)")
+        for key, value in explicit.items():
+            if value is not None and key not in need[self.law] + (("gaps",) if self.law == "bundle" else ()):
+                raise SceneError(f"{path}.{key}", value, f"not used by law = {self.law!r}; remove it")
+        try:
+            self.normal_law()
+        except ValueError as exc:
+            raise SceneError(f"{path}", self.law, str(exc)) from None
+        if self.gap_table is not None:
+            xs = [q[0] for q in self.gap_table]
+            if any(b <= a for a, b in zip(xs, xs[1:])):
+                raise SceneError(f"{path}.gap_table", self.gap_table, "coordinates must increase strictly")
+            if self.gap != 0.0:
+                raise SceneError(f"{path}.gap", self.gap, "give either gap or gap_table")
+
+    def normal_law(self):
+        """The normal law from the explicit numbers (``None`` with a cell)."""
+        from ngcontact.laws import homogenized as il
+        if self.cell is not None:
+            return None
+        if self.law == "linear":
+            return il.LinearLaw(kn=self.kn, kt=self.kt, knt=self.knt, gap_force=self.gap_force)
+        if self.law == "bundle":
+            return il.BundleLaw(weights=self.weights, directions=self.directions, gaps=self.gaps or ())
+        return il.TabulatedLaw(closure=self.closure, pressure=self.pressure, kt=self.kt)
+
+    def friction(self):
+        from ngcontact.laws import homogenized as il
+        if self.mu == 0.0 and self.threshold == 0.0:
+            return None
+        return il.Friction(mu=self.mu, threshold=self.threshold, width=self.huber_width)
+
+
+@dataclass(frozen=True, kw_only=True)
+class SupportSpec:
+    """Prescribed displacement components on a boundary."""
+
+    boundary: str = param(doc="boundary label of the geometry")
+    components: tuple[str, ...] = param((), doc="components fixed (x, y, z; r, z in axisymmetry); empty: all")
+    displacement: tuple[float, ...] = param((), doc="prescribed values, one per component (default 0)",
+                                            units="m")
+
+
+@dataclass(frozen=True, kw_only=True)
+class LoadSpec:
+    """Surface load on a boundary."""
+
+    boundary: str = param(doc="boundary label of the geometry")
+    pressure: float = param(0.0, doc="normal pressure, positive pushes into the body", units="Pa")
+    traction: tuple[float, ...] = param((), doc="traction vector (global components)", units="Pa")
+
+
+@dataclass(frozen=True, kw_only=True)
+class OutputSpec:
+    """Sampling of the results."""
+
+    points_per_element: int = param(5, doc="samples per interface element in the profile", check=at_least(2))
+    vtk_subdivision: int = param(1, doc="subdivision of the VTK output", check=at_least(0))
+    coulomb_tol: float = param(1e-6, doc="Coulomb fixed point: relative change of the pressure to stop at",
+                               check=positive())
+
+
+@dataclass(frozen=True, kw_only=True)
+class StrengthSpec:
+    """Micro-stress recovery in the interface layer and the strength check (paper eqs. 74-78)."""
+
+    cell: str = param(doc="cell scene (kind cell) of the layer, relative to this scene; its [load] is "
+                      "not used (the macro state loads it); its bodies are this scene's rough and counter")
+    criterion: str = param("von_mises", doc="equivalent stress of eq. 77", choices=("von_mises", "tresca"))
+    recovery: str = param("linear", doc="linear: unit-load correctors with the contact set fixed (the "
+                          "cell's points without gap), superposed at every interface point (eq. 75); "
+                          "nonlinear: in addition the contact cell problem solved at the macro state of "
+                          "the nonlinear_points interface points with the largest linear estimate",
+                          choices=("linear", "nonlinear"))
+    nonlinear_points: int = param(3, doc="interface points re-solved with the contact cell problem "
+                                  "(recovery = nonlinear)", check=at_least(1))
+    tangential_stiffness: float | None = param(
+        None, doc="k_t on the contact set in the linear recovery (sticking summits carry the shear); "
+        "default: the cell's k_n when the macro law has friction, else 0 (no shear carried)",
+        units="Pa/m", check=nonnegative())
+
+
+@dataclass(frozen=True, kw_only=True)
+class TwoScaleSpec:
+    """The two-scale coupling loop (paper Sec. 3.5)."""
+
+    cell: str = param(doc="cell scene (kind cell) solved at the macro pressures, relative to this scene; "
+                      "lengths in cell_length_unit, its [load] is not used")
+    cell_length_unit: float = param(1.0, doc="length of one unit of the cell scene (scales its gap terms)",
+                                    units="m", check=positive())
+    tol: float = param(doc="stop when max |sigma_n(k) - sigma_n(k-1)| over the interface points is below",
+                       units="Pa", check=positive())
+    max_iter: int = param(20, doc="largest number of coefficient updates", check=at_least(1))
+    table_tol: float = param(0.01, doc="interpolation tolerance of the cell table: the contact fraction "
+                             "and g_n0 / max g_n0 at interval midpoints", check=positive())
+    table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
+                             "(below it the coefficients are held constant)", check=positive())
+
+
+@dataclass(frozen=True, kw_only=True)
+class MacroScene:
+    kind: str = param(doc="problem type", choices=("macro",))
+    title: str = param("", doc="free text shown in the report")
+    materials: dict[str, MaterialSpec] = param(doc="named materials", check=nonempty())
+    bodies: BodiesSpec = param(doc="materials of the bodies")
+    geometry: MacroGeometrySpec = param(doc="the macro geometry")
+    interface: InterfaceSpec = param(doc="interface law on S_0")
+    supports: tuple[SupportSpec, ...] = param(doc="[[supports]]: Dirichlet conditions", check=nonempty())
+    loads: tuple[LoadSpec, ...] = param((), doc="[[loads]]: surface loads")
+    discretization: Discretization = param(Discretization(), doc="mesh and order")
+    solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
+    output: OutputSpec = param(OutputSpec(), doc="result sampling")
+    two_scale: TwoScaleSpec | None = param(None, doc="[two_scale]: coupling loop with a cell (Sec. 3.5)")
+    strength: StrengthSpec | None = param(None, doc="[strength]: micro stresses and the check of eq. 78")
+    base_dir: str = base_dir_field()
+
+    def check(self, path: str) -> None:
+        check_material_names(self.materials, {"rough": self.bodies.rough, "counter": self.bodies.counter},
+                             "bodies")
+        from ngcontact.macro.macro_problem import COMPONENTS
+        comps = COMPONENTS[self.geometry.setting]
+        shape, setting = self.geometry.shape, self.geometry.setting
+        labels = BOUNDARIES[shape, setting]
+        for what, items in (("supports", self.supports), ("loads", self.loads)):
+            for i, item in enumerate(items):
+                if item.boundary not in labels:
+                    raise SceneError(f"{what}[{i}].boundary", item.boundary,
+                                     f"no such boundary in {shape!r} ({setting}); labels are " + ", ".join(labels))
+        for i, s in enumerate(self.supports):
+            for c in s.components:
+                if c not in comps:
+                    raise SceneError(f"supports[{i}].components", c, "must be one of " + ", ".join(comps))
+            if s.displacement and len(s.displacement) != len(s.components or comps):
+                raise SceneError(f"supports[{i}].displacement", s.displacement,
+                                 f"one value per component ({len(s.components or comps)})")
+        dim = 3 if self.geometry.setting == "3d" else 2
+        for i, load in enumerate(self.loads):
+            if load.traction and len(load.traction) != dim:
+                raise SceneError(f"loads[{i}].traction", load.traction, f"must have {dim} components")
+        if self.interface.gap_coordinate == "z" and dim == 2 and self.geometry.setting != "axisymmetric":
+            raise SceneError("interface.gap_coordinate", "z", "plane strain has coordinates x, y")
+        for key in ("strength", "two_scale"):
+            if getattr(self, key) is not None and dim == 3:
+                raise SceneError(f"{key}", "...", "available for plane strain and axisymmetric macro problems")
+        if self.strength is not None:
+            for role in ("rough", "counter"):
+                name = getattr(self.bodies, role)
+                if self.materials[name].sigma_u is None:
+                    raise SceneError(f"materials.{name}.sigma_u", MISSING,
+                                     f"the ultimate stress of the {role} body is required by [strength]; "
+                                     "a number > 0 [Pa]")
+
+    def check_files(self) -> None:
+        """Every named cell scene exists, is valid and is of kind ``cell``.
+
+        The cells of ``[strength]`` and ``[two_scale]`` are solved, so they
+        also need a contact model (not ``contact.geometric_only``).  A fault
+        inside a cell scene is reported under the key naming it, e.g.
+        ``interface.cell = 'hip.toml': invalid cell scene: materials.bone.nu = ...``.
+        """
+        import os
+        from ngcontact.scene.loader import load
+        from ngcontact.scene.sections import resolve
+        files = (("interface.cell", self.interface.cell, False),
+                 ("strength.cell", self.strength.cell if self.strength else None, True),
+                 ("two_scale.cell", self.two_scale.cell if self.two_scale else None, True))
+        for key, rel, solved in files:
+            if rel is None:
+                continue
+            if not os.path.isfile(resolve(self, rel)):
+                raise SceneError(key, rel, "no such cell scene file")
+            try:
+                cell = load(resolve(self, rel))
+            except SceneError as exc:
+                raise SceneError(key, rel, f"invalid cell scene: {exc}") from None
+            if cell.kind != "cell":
+                raise SceneError(key, rel, f"invalid cell scene: must be of kind 'cell', not {cell.kind!r}")
+            if solved and cell.contact.geometric_only:
+                raise SceneError(key, rel, "invalid cell scene: contact.geometric_only = true, but this "
+                                 "section solves the cell, so it needs a contact model and a [load] section")
+
+
+def effects(scene: MacroScene) -> tuple[str, ...]:
+    """The terms assembled."""
+    i = scene.interface
+    out = ["elasticity", f"interface_{i.law}" + ("_from_cell" if i.cell else "")]
+    if i.gap != 0.0 or i.gap_table is not None:
+        out.append("initial_gap")
+    if i.mu > 0:
+        out.append("coulomb_friction")
+    if i.threshold > 0:
+        out.append("tresca_friction")
+    if any(load.pressure or load.traction for load in scene.loads):
+        out.append("surface_loads")
+    if any(any(s.displacement) for s in scene.supports):
+        out.append("prescribed_displacement")
+    if scene.two_scale is not None:
+        out.append("two_scale_coupling")
+    if scene.strength is not None:
+        out.append("strength_check")
+    return tuple(out)
+
+

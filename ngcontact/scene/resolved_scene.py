@@ -1,0 +1,262 @@
+"""Scene kind ``direct``: two bodies whose interface resolves N periods of a cell's roughness.
+
+The resolved micro problem of paper Sec. 3.3 (see :mod:`ngcontact.resolved.resolved_problem`):
+the profile and the micro contact law (penalty ``k_n``, constant gap,
+friction) come from a ``cell`` scene named by ``geometry.cell``; its
+roughness is repeated ``geometry.periods`` times along the interface and
+scaled to the period ``eps = (interface length) / periods``.
+
+Shapes (``geometry.shape``, see :mod:`ngcontact.geometry.resolved_bodies`):
+
+``blocks``
+    Rough block below, counter block above, ``x0 <= x <= x0 + length``;
+    boundaries ``bottom``, ``top``, ``rough_sides``, ``counter_sides``.
+    Plane strain, or axisymmetric (``x`` = ``r``: an annular disk whose face
+    carries concentric ring grooves).
+``femur_stem``
+    The axisymmetric femur with a hip stem of the ``macro`` kind
+    (``geometry.dimensions`` as there), the stem rough: circumferential
+    grooves along the whole interface, cone and cylinder; boundaries
+    ``axis``, ``stem_top``, ``stem_side``, ``stem_tip``, ``bone_top``,
+    ``bone_outer``, ``canal``, ``base``.
+
+In axisymmetry the components are ``(r, z)`` and forces are per full
+revolution.  The resolved surface is the boundary ``contact``.  The
+optional ``[study]`` section sets up the epsilon study
+(``scripts/epsilon_study.py``) that compares the resolved runs with the
+homogenized laws of the same cell on the same bodies with a flat interface.
+Lengths in metres, stresses in pascals, stiffnesses in Pa/m.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from ngcontact.errors import MISSING, SceneError
+from ngcontact.geometry.bodies import FemurStemDims
+from ngcontact.scene.macro_scene import check_dimensions
+from ngcontact.scene.sections import MaterialSpec, SolverSpec, base_dir_field, check_material_names
+from ngcontact.scene.schema import at_least, nonempty, param, positive
+
+SHAPES = ("blocks", "femur_stem")
+BOUNDARIES = {"blocks": ("bottom", "top", "rough_sides", "counter_sides"),
+              "femur_stem": ("axis", "stem_top", "stem_side", "stem_tip", "bone_top", "bone_outer", "canal",
+                             "base")}
+COMPONENTS = {"plane_strain": ("x", "y"), "axisymmetric": ("r", "z")}
+DIMENSIONS = tuple(f.name for f in dataclasses.fields(FemurStemDims))
+
+
+@dataclass(frozen=True, kw_only=True)
+class DirectGeometry:
+    """The bodies and the resolved roughness."""
+
+    cell: str = param(doc="cell scene (relative to this scene) whose profile and contact law are resolved")
+    periods: int = param(doc="number N of periods resolved along the interface", check=at_least(1))
+    shape: str = param("blocks", doc="two blocks, or the axisymmetric femur with a hip stem", choices=SHAPES)
+    setting: str = param("plane_strain", doc="plane strain (x, y) or axisymmetric (r, z; per revolution)",
+                         choices=tuple(COMPONENTS))
+    length: float | None = param(None, doc="blocks: width L (eps = L / N)", units="m", check=positive())
+    h_rough: float | None = param(None, doc="blocks: height of the rough block below the summits", units="m",
+                                  check=positive())
+    h_counter: float | None = param(None, doc="blocks: height of the counter block above the summits",
+                                    units="m", check=positive())
+    x0: float = param(0.0, doc="blocks: x (axisymmetric: radius r) of the left faces", units="m",
+                      allowed=">= 0")
+    dimensions: dict[str, float] | None = param(
+        None, doc="femur_stem: dimensions as in the macro kind (eps = interface arc length / N)", units="m",
+        allowed=f"all of {', '.join(DIMENSIONS)}")
+
+    def femur_dims(self) -> FemurStemDims:
+        return FemurStemDims(**(self.dimensions or {}))
+
+    def check(self, path: str) -> None:
+        if self.x0 < 0:
+            raise SceneError(f"{path}.x0", self.x0, ">= 0")
+        if self.shape == "blocks":
+            for key in ("length", "h_rough", "h_counter"):
+                if getattr(self, key) is None:
+                    raise SceneError(f"{path}.{key}", MISSING, "required for shape 'blocks'")
+            if self.dimensions is not None:
+                raise SceneError(f"{path}.dimensions", self.dimensions, "only for shape 'femur_stem'")
+            return
+        if self.setting != "axisymmetric":
+            raise SceneError(f"{path}.setting", self.setting, "shape 'femur_stem' is axisymmetric")
+        for key in ("length", "h_rough", "h_counter"):
+            if getattr(self, key) is not None:
+                raise SceneError(f"{path}.{key}", getattr(self, key), "only for shape 'blocks'")
+        check_dimensions(self.dimensions or {}, f"{path}.dimensions", "femur_stem", DIMENSIONS)
+
+
+@dataclass(frozen=True, kw_only=True)
+class DirectBodies:
+    """Materials of the two bodies."""
+
+    rough: str = param(doc="material of the rough body (blocks: the one below; femur: the stem)")
+    counter: str = param(doc="material of the counter body (blocks: the one above; femur: the bone)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class DirectSupport:
+    """Prescribed displacement components on a boundary, constant or linear along it (a tilt)."""
+
+    boundary: str = param(doc="a boundary of the shape", allowed="blocks: " + ", ".join(BOUNDARIES["blocks"])
+                          + "; femur_stem: " + ", ".join(BOUNDARIES["femur_stem"]))
+    components: tuple[str, ...] = param((), doc="components fixed (x, y or r, z); empty: all")
+    displacement: tuple[float, ...] = param((), doc="value at the boundary's mid-point, one per component "
+                                            "(default 0)", units="m")
+    slope: tuple[float, ...] = param((), doc="change of each prescribed component per metre along the "
+                                     "boundary: along x (r) on horizontal boundaries, y (z) on vertical ones "
+                                     "(default 0)", units="m/m")
+
+
+@dataclass(frozen=True, kw_only=True)
+class DirectLoad:
+    """Surface load on a boundary."""
+
+    boundary: str = param(doc="a boundary of the shape (as for supports)")
+    pressure: float = param(0.0, doc="normal pressure, positive pushes into the body", units="Pa")
+    traction: tuple[float, float] = param((0.0, 0.0), doc="traction vector (x, y) or (r, z)", units="Pa")
+
+
+@dataclass(frozen=True, kw_only=True)
+class DirectMesh:
+    """Mesh graded towards the resolved interface."""
+
+    order: int = param(2, doc="polynomial order of the displacement", check=at_least(1))
+    maxh: float = param(doc="mesh size in the far field", units="m", check=positive())
+    elements_per_period: float = param(8.0, doc="interface mesh size is eps / elements_per_period",
+                                       check=positive())
+    grading: float = param(0.3, doc="Netgen grading factor (growth of the elements away from the interface)",
+                           check=positive())
+
+
+@dataclass(frozen=True, kw_only=True)
+class StudySpec:
+    """Epsilon study: resolved runs against the homogenized laws."""
+
+    periods: tuple[int, ...] = param((4, 8, 16), doc="N of each level (at least 3 for a rate)",
+                                     check=at_least(1))
+    band: float = param(3.0, doc="half-width of the band around the interface excluded from the field "
+                        "error (and from the probes), in periods eps", check=positive())
+    interface_maxh: float = param(doc="mesh size along the flat interface of the homogenized runs",
+                                  units="m", check=positive())
+    probes: tuple[tuple[float, float], ...] = param(
+        (), doc="points (x, y) or (r, z) away from the layer where displacements are compared", units="m",
+        allowed="pairs of numbers inside a body, outside the band of the coarsest level")
+    grid: tuple[int, int] = param((100, 50), doc="sampling grid of the field error: (nx, ny) per block, "
+                                  "or (nr, nz) over the femur's bounding box", check=at_least(4))
+
+
+@dataclass(frozen=True, kw_only=True)
+class DirectScene:
+    kind: str = param(doc="problem type", choices=("direct",))
+    title: str = param("", doc="free text shown in the report")
+    materials: dict[str, MaterialSpec] = param(doc="named materials", check=nonempty())
+    bodies: DirectBodies = param(doc="materials of the blocks")
+    geometry: DirectGeometry = param(doc="blocks and resolved roughness")
+    supports: tuple[DirectSupport, ...] = param(doc="[[supports]]: Dirichlet conditions", check=nonempty())
+    loads: tuple[DirectLoad, ...] = param((), doc="[[loads]]: surface loads")
+    discretization: DirectMesh = param(doc="mesh and order")
+    solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
+    study: StudySpec | None = param(None, doc="epsilon study (scripts/epsilon_study.py)")
+    base_dir: str = base_dir_field()
+
+    def check(self, path: str) -> None:
+        check_material_names(self.materials, {"rough": self.bodies.rough, "counter": self.bodies.counter},
+                             "bodies")
+        for name in (self.bodies.rough, self.bodies.counter):
+            if self.materials[name].C is not None:
+                raise SceneError(f"materials.{name}.C", "...", "direct scenes take isotropic E, nu")
+        g = self.geometry
+        labels, comps = BOUNDARIES[g.shape], COMPONENTS[g.setting]
+        for key, items in (("supports", self.supports), ("loads", self.loads)):
+            for i, item in enumerate(items):
+                if item.boundary not in labels:
+                    raise SceneError(f"{key}[{i}].boundary", item.boundary,
+                                     f"one of {', '.join(labels)} (shape {g.shape!r})")
+        for i, s in enumerate(self.supports):
+            for c in s.components:
+                if c not in comps:
+                    raise SceneError(f"supports[{i}].components", c, f"must be one of {', '.join(comps)}")
+            n = len(s.components or comps)
+            for key in ("displacement", "slope"):
+                v = getattr(s, key)
+                if v and len(v) != n:
+                    raise SceneError(f"supports[{i}].{key}", v, f"one value per component ({n})")
+        st = self.study
+        if st is not None:
+            if len(st.periods) < 3 or any(b <= a for a, b in zip(st.periods, st.periods[1:])):
+                raise SceneError("study.periods", st.periods, "at least 3 increasing numbers of periods")
+            if g.shape == "femur_stem":
+                self._check_femur_study()
+                return
+            for i, (x, y) in enumerate(st.probes):
+                if not (g.x0 < x < g.x0 + g.length and -g.h_rough < y < g.h_counter):
+                    raise SceneError(f"study.probes[{i}]", (x, y), "must lie inside the blocks")
+                if abs(y) <= st.band * g.length / st.periods[0]:
+                    raise SceneError(f"study.probes[{i}]", (x, y), "must lie outside the band of the "
+                                     "coarsest level (|y| > band * length / periods[0])")
+            if st.band * g.length / st.periods[0] >= min(g.h_rough, g.h_counter):
+                raise SceneError("study.band", st.band, "the band of the coarsest level must stay inside "
+                                 "both blocks")
+
+    def _check_femur_study(self) -> None:
+        """Probes inside a body and outside the band of the coarsest level; the band leaves points."""
+        from ngcontact.geometry.resolved_bodies import distance_to_polyline, femur_stem_body, femur_stem_interface
+        st, dims = self.study, self.geometry.femur_dims()
+        segs = femur_stem_interface(dims)
+        band = st.band * sum(float(np.hypot(b[0] - a[0], b[1] - a[1])) for a, b in segs) / st.periods[0]
+        for i, pt in enumerate(st.probes):
+            if femur_stem_body(dims, [pt])[0] < 0:
+                raise SceneError(f"study.probes[{i}]", pt, "must lie inside the stem or the bone")
+            if distance_to_polyline(segs, [pt])[0] <= band:
+                raise SceneError(f"study.probes[{i}]", pt, f"must lie farther than band * eps = {band:.4g} m "
+                                 "(coarsest level) from the interface")
+        r = np.linspace(0.0, dims.r_bone, 41)
+        z = np.linspace(0.0, dims.z_stem_top, 41)
+        pts = np.column_stack([a.ravel() for a in np.meshgrid(r, z)])
+        keep = (femur_stem_body(dims, pts) >= 0) & (distance_to_polyline(segs, pts) > band)
+        if not np.any(keep):
+            raise SceneError("study.band", st.band, "the band of the coarsest level covers both bodies; "
+                             "take a smaller band or more periods")
+
+    def check_files(self) -> None:
+        """The named cell scene must be a valid 2D conforming ``cell`` scene this kind can resolve."""
+        from ngcontact.scene.loader import load
+        from ngcontact.scene.sections import resolve
+        path = resolve(self, self.geometry.cell)
+        try:
+            cell = load(path)
+        except SceneError as exc:
+            raise SceneError("geometry.cell", self.geometry.cell, f"invalid cell scene: {exc}") from None
+        if cell.kind != "cell":
+            raise SceneError("geometry.cell", self.geometry.cell, f"names a {cell.kind!r} scene; need 'cell'")
+        g = cell.geometry
+        if g.dim != 2 or g.arrangement != "conforming" or g.profile == "tabulated":
+            raise SceneError("geometry.cell", self.geometry.cell,
+                             "need a 2D conforming cell with an analytic profile (flat, rectangular, "
+                             "triangular, semicircular, sinusoid)")
+        if cell.contact.gap.kind not in ("none", "constant"):
+            raise SceneError("geometry.cell", self.geometry.cell,
+                             f"gap kind {cell.contact.gap.kind!r} is not resolved; use none or constant")
+        object.__setattr__(self, "cell_scene", cell)
+
+
+def effects(scene: DirectScene) -> tuple[str, ...]:
+    """The terms assembled."""
+    out = ["elasticity", "resolved_normal_contact"]
+    cell = getattr(scene, "cell_scene", None)
+    if cell is not None:
+        if cell.contact.gap.kind != "none":
+            out.append("gap")
+        if cell.contact.friction != "none":
+            out.append(f"{cell.contact.friction}_friction")
+    if any(load.pressure or any(load.traction) for load in scene.loads):
+        out.append("surface_loads")
+    if any(any(s.displacement) or any(s.slope) for s in scene.supports):
+        out.append("prescribed_displacement")
+    return tuple(out)
+
+

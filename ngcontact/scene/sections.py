@@ -1,0 +1,88 @@
+"""Sections shared by every scene kind.
+
+* ``[materials.NAME]``: ``E`` and ``nu`` (isotropic) or ``C`` (6x6 Voigt
+  matrix), optional ultimate stress ``sigma_u``;
+* ``[discretization]``: polynomial order and mesh size;
+* ``[solver]``: Newton tolerances and limits.
+
+Descriptions only: the drivers turn them into model objects
+(:func:`ngcontact.drivers.build.elastic_law`).
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+from ngcontact.errors import MISSING, SceneError
+from ngcontact.fem import materials as _materials
+from ngcontact.scene.schema import at_least, open_interval, param, positive
+
+
+@dataclass(frozen=True, kw_only=True)
+class MaterialSpec:
+    """Elastic material: isotropic ``(E, nu)`` or anisotropic ``C``."""
+
+    E: float | None = param(None, doc="Young's modulus (isotropic)", units="Pa", check=positive())
+    nu: float | None = param(None, doc="Poisson's ratio (isotropic)", check=open_interval(-1, 0.5))
+    C: tuple[tuple[float, ...], ...] | None = param(
+        None, doc="6x6 Voigt stiffness matrix, order 11,22,33,23,13,12 with engineering shear strains",
+        units="Pa", allowed="6 rows of 6 numbers, symmetric positive definite")
+    sigma_u: float | None = param(None, doc="ultimate stress for the strength check", units="Pa",
+                                  check=positive())
+
+    def check(self, path: str) -> None:
+        iso = self.E is not None or self.nu is not None
+        if iso and self.C is not None:
+            raise SceneError(path + ".C", self.C, "give either E and nu or C, not both")
+        if self.C is None:
+            if self.E is None:
+                raise SceneError(path + ".E", MISSING, "required (or give C); a number > 0")
+            if self.nu is None:
+                raise SceneError(path + ".nu", MISSING, "required (or give C); a number in (-1, 0.5)")
+            return
+        try:
+            _materials.anisotropic(self.C)
+        except ValueError as exc:
+            raise SceneError(path + ".C", self.C, str(exc).replace("C ", "", 1)) from None
+
+@dataclass(frozen=True, kw_only=True)
+class Discretization:
+    """Finite element discretization."""
+
+    order: int = param(2, doc="polynomial order of the displacement", check=at_least(1))
+    maxh: float = param(0.1, doc="global mesh size", units="m", check=positive())
+    interface_maxh: float | None = param(None, doc="mesh size on the interface (default: maxh)",
+                                         units="m", check=positive())
+
+
+@dataclass(frozen=True, kw_only=True)
+class SolverSpec:
+    """Newton solver settings."""
+
+    rtol: float = param(1e-10, doc="stop when the residual falls below rtol x the first residual",
+                        check=positive())
+    atol: float = param(0.0, doc="or below this absolute residual", units="N", check=at_least(0))
+    max_iter: int = param(40, doc="largest number of Newton steps", check=at_least(1))
+    inverse: str = param("sparsecholesky", doc="sparse direct solver",
+                         choices=("sparsecholesky", "umfpack"))
+
+
+def check_material_names(materials: dict, names: dict, path: str) -> None:
+    """Every ``key -> material name`` in ``names`` must exist in ``materials``."""
+    for key, name in names.items():
+        if name not in materials:
+            raise SceneError(f"{path}.{key}" if path else key, name,
+                             "must name a material defined under [materials]: "
+                             + ", ".join(sorted(materials)))
+
+
+
+
+def base_dir_field():
+    """The scene file's folder: set by the loader, not read from the file."""
+    return field(default=".", init=False, repr=False, compare=False)
+
+
+def resolve(scene, relpath: str) -> str:
+    """Absolute path of a file named in a scene (relative to the scene file)."""
+    return os.path.normpath(os.path.join(getattr(scene, "base_dir", "."), relpath))

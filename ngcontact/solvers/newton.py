@@ -1,0 +1,342 @@
+"""Energy minimization by Newton's method with a backtracking line search.
+
+Contact and elasticity are written as one energy ``Pi(u)`` (NGSolve
+``Variation`` terms), so the residual ``r(u) = Pi'(u)`` and the tangent
+``K(u) = Pi''(u)`` come from NGSolve's linearization. One step solves
+``K(u) du = r(u)`` and sets ``u <- u - alpha du`` with the largest
+``alpha = 1, 1/2, 1/4, ...`` that satisfies the Armijo condition
+
+    Pi(u - alpha du) <= Pi(u) - c alpha (du . r(u)),   c = 1e-4,
+
+and yields a finite energy and a finite residual (otherwise the step is
+halved: NaN or Inf never enter the iterate).  The iteration stops when the residual (free
+dofs) has fallen below ``rtol`` times the first residual, or below ``atol``, or
+below its round-off floor ``ROUNDOFF eps || |K| |u| ||``: the size at which
+the residual, a sum of terms as large as ``|K_ij| |u_j|``, can no longer be
+evaluated.  Stiff terms (a Huber width of 1e-12, a penalty touching with zero
+force) put that floor above ``rtol`` times the first residual; without it
+Newton would wander in the round-off until ``max_iter``.
+A quadratic energy is minimized by a single linear solve.
+
+With ``line_search="exact"`` (for convex energies such as penalty contact)
+the step length minimizes the energy along the Newton direction instead:
+``phi(alpha) = Pi(u - alpha du)`` is convex, so its slope
+``phi'(alpha) = -du . r(u - alpha du)`` is nondecreasing, and its root is
+bracketed (``alpha`` doubled up to ``max_step`` while ``phi' < 0``) and
+located by the Illinois variant of regula falsi until
+``|phi'(alpha)| <= 1e-3 |phi'(0)|``.  For a piecewise quadratic energy
+(penalty contact) ``phi'`` is piecewise linear and a few residual
+evaluations suffice.  Steps longer than 1 matter at a contact edge, where
+the fixed-active-set Newton step typically covers only about half of the
+distance to the solution.  The accepted step must still pass the Armijo
+test above; otherwise the backtracking search decides.
+
+On failure a :class:`~ngcontact.errors.ConvergenceError` carries the history:
+residual norms, energies, step lengths.
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+
+import ngsolve as ng
+
+from ngcontact.errors import ConvergenceError
+
+log = logging.getLogger(__name__)
+
+ARMIJO = 1e-4
+MIN_STEP = 2.0 ** -30
+ROUNDOFF = 10.0
+
+
+@dataclass
+class NewtonHistory:
+    """What happened during a solve (JSON-ready lists of floats)."""
+
+    residuals: list = field(default_factory=list)
+    energies: list = field(default_factory=list)
+    steps: list = field(default_factory=list)
+    converged: bool = False
+    linear: bool = False
+    active_set_sizes: list = field(default_factory=list)
+
+    @property
+    def iterations(self) -> int:
+        return len(self.steps)
+
+    def as_dict(self) -> dict:
+        return {"iterations": self.iterations, "converged": self.converged,
+                "linear_solve_only": self.linear,
+                "residuals": list(self.residuals), "energies": list(self.energies),
+                "step_lengths": list(self.steps), "active_set_sizes": list(self.active_set_sizes)}
+
+
+class ActiveSetCycle:
+    """Detects an active set that flips back and forth while the residual stagnates.
+
+    Feed it the signature of the active set (any hashable, e.g. the sign
+    pattern of the penetration at the contact quadrature points) and the
+    residual after every Newton step.  A signature that recurs after other
+    ones, for the ``repeats``-th time, while the residual has not fallen
+    below ``progress`` times its value at the signature's previous
+    occurrence, is a cycle: Newton would only go round it until its
+    iteration limit.
+    """
+
+    def __init__(self, repeats: int = 2, progress: float = 0.5):
+        self.repeats, self.progress = repeats, progress
+        self.seen: dict = {}      # signature -> (last step, residual there, recurrences)
+        self.previous = None
+
+    def step(self, it: int, signature, residual: float) -> str | None:
+        """Record step ``it``; return a description of the cycle, or ``None``."""
+        message = None
+        if signature in self.seen and signature != self.previous:
+            last, r_last, count = self.seen[signature]
+            stagnant = residual > self.progress * r_last
+            count = count + 1 if stagnant else 0
+            if count >= self.repeats:
+                message = (f"the active set of step {last} recurred at step {it} (period {it - last}, "
+                           f"{count} recurrences) while the residual stagnated ({r_last:.3e} -> {residual:.3e})")
+            self.seen[signature] = (it, residual, count)
+        else:
+            self.seen[signature] = (it, residual, 0)
+        self.previous = signature
+        return message
+
+
+def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
+             rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 50,
+             inverse: str = "sparsecholesky", quadratic: bool = False,
+             callback=None, line_search: str = "armijo", max_step: float = 8.0,
+             active_set=None) -> NewtonHistory:
+    """Minimize the energy of ``form`` starting from ``gfu`` (updated in place).
+
+    Parameters
+    ----------
+    form
+        BilinearForm made of ``Variation`` energy terms.
+    gfu
+        Start value; Dirichlet values must already be set in it.
+    freedofs
+        BitArray of the unknowns (default: the space's free dofs).
+    rtol, atol
+        Stop when ``|r| <= max(rtol * |r_0|, atol)``.
+    max_iter
+        Largest number of Newton steps.
+    inverse
+        Sparse direct solver for the tangent.
+    quadratic
+        The energy is quadratic: one linear solve, no iteration.
+    callback
+        Called as ``callback(iteration, gfu)`` after each accepted step.
+    line_search
+        ``"armijo"`` (backtracking from ``alpha = 1``) or ``"exact"`` (root of
+        the slope along the direction, for convex energies; see the module
+        docstring).
+    max_step
+        Largest step length tried by the exact line search.
+    active_set
+        Optional ``active_set(gfu) -> hashable`` signature of the contact
+        state; an active set that cycles while the residual stagnates raises
+        :class:`~ngcontact.errors.ConvergenceError` at once
+        (:class:`ActiveSetCycle`) instead of iterating to ``max_iter``.
+    """
+    if line_search not in ("armijo", "exact"):
+        raise ValueError(f"line_search = {line_search!r}: must be 'armijo' or 'exact'")
+    if not max_step >= 1.0:
+        raise ValueError(f"max_step = {max_step!r}: must be >= 1")
+    if freedofs is None:
+        freedofs = gfu.space.FreeDofs()
+    hist = NewtonHistory(linear=quadratic)
+    cycle = ActiveSetCycle() if active_set is not None else None
+    fixed = fixed_mask(freedofs)
+    res = gfu.vec.CreateVector()
+    du = gfu.vec.CreateVector()
+    trial = gfu.vec.CreateVector()
+
+    def residual(vec) -> float:
+        form.Apply(vec, res)
+        _mask(res, fixed)
+        return math.sqrt(max(ng.InnerProduct(res, res), 0.0))
+
+    energy = form.Energy(gfu.vec)
+    rnorm = residual(gfu.vec)
+    hist.energies.append(energy)
+    hist.residuals.append(rnorm)
+    if not (math.isfinite(energy) and math.isfinite(rnorm)):
+        raise ConvergenceError("the start value gives a non-finite energy or residual", hist.as_dict())
+    r0 = rnorm
+    if rnorm <= atol or rnorm == 0.0:
+        hist.converged = True
+        return hist
+    for it in range(1, (1 if quadratic else max_iter) + 1):
+        form.AssembleLinearization(gfu.vec)
+        if not quadratic and rnorm <= roundoff_floor(form.mat, gfu.vec, fixed):
+            log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
+            hist.converged = True
+            return hist
+        inv = form.mat.Inverse(freedofs, inverse=inverse)
+        du.data = inv * res
+        slope = ng.InnerProduct(du, res)
+        if not math.isfinite(slope):
+            raise ConvergenceError(f"Newton step {it}: the tangent solve gave non-finite values", hist.as_dict())
+        if slope <= 0.0:
+            raise ConvergenceError(
+                f"Newton step {it}: the tangent gives no descent direction (du . r = {slope:.3e}); "
+                "the tangent is singular or indefinite, e.g. a load the interface cannot carry",
+                hist.as_dict())
+        alpha = 1.0
+        if line_search == "exact" and not quadratic:
+            alpha = _exact_step(form, gfu.vec, du, slope, fixed, trial, res, max_step)
+        while True:
+            trial.data = gfu.vec - alpha * du
+            e_new = form.Energy(trial)
+            finite = math.isfinite(e_new)
+            accept = finite and (quadratic or e_new <= energy - ARMIJO * alpha * slope + 1e-14 * abs(energy))
+            if accept:
+                r_new = residual(trial)        # a finite energy can still have a non-finite gradient
+                if math.isfinite(r_new):
+                    break
+                log.debug("newton %d: non-finite residual at alpha = %g, backtracking", it, alpha)
+            alpha *= 0.5
+            if alpha < MIN_STEP:
+                hist.steps.append(0.0)
+                raise ConvergenceError(
+                    f"Newton step {it}: line search found no decrease of the energy "
+                    f"(residual {rnorm:.3e}); the tangent may be wrong or the problem unbounded",
+                    hist.as_dict())
+        gfu.vec.data = trial
+        energy, rnorm = e_new, r_new
+        hist.steps.append(alpha)
+        hist.energies.append(energy)
+        hist.residuals.append(rnorm)
+        log.debug("newton %d: |r| = %.3e, energy = %.6e, alpha = %g", it, rnorm, energy, alpha)
+        if callback is not None:
+            callback(it, gfu)
+        if cycle is not None:
+            sig = active_set(gfu)
+            hist.active_set_sizes.append(_size(sig))
+            found = cycle.step(it, sig, rnorm)
+            if found is not None and not rnorm <= max(rtol * r0, atol):
+                raise ConvergenceError(f"Newton step {it}: {found}", hist.as_dict())
+        if rnorm <= max(rtol * r0, atol):
+            hist.converged = True
+            return hist
+    if quadratic:
+        hist.converged = True
+        return hist
+    raise ConvergenceError(
+        f"Newton did not converge in {max_iter} steps: residual {rnorm:.3e} "
+        f"> {max(rtol * r0, atol):.3e} (rtol {rtol:g} x first residual {r0:.3e})",
+        hist.as_dict())
+
+
+def _exact_step(form, u, du, slope0, fixed, trial, work, max_step) -> float:
+    """Minimizer of ``phi(alpha) = Pi(u - alpha du)`` for a convex energy.
+
+    ``slope0 = du . r(u) > 0`` is ``-phi'(0)``.  Returns 1 where the slope
+    cannot be evaluated (non-finite values); the caller's Armijo test then
+    guards the step.  ``work`` is overwritten.
+    """
+    def dphi(a):
+        trial.data = u - a * du
+        form.Apply(trial, work)
+        _mask(work, fixed)
+        return -ng.InnerProduct(du, work)
+
+    tol = 1e-3 * slope0
+    lo, flo = 0.0, -slope0
+    hi, fhi = 1.0, dphi(1.0)
+    if not math.isfinite(fhi):
+        return 1.0
+    if abs(fhi) <= tol:
+        return 1.0
+    while fhi < 0.0 and hi < max_step:
+        lo, flo = hi, fhi
+        hi = min(2.0 * hi, max_step)
+        fhi = dphi(hi)
+        if not math.isfinite(fhi):
+            return lo
+        if abs(fhi) <= tol:
+            return hi
+    if fhi < 0.0:
+        return hi
+    a = illinois_root(dphi, lo, flo, hi, fhi, ftol=tol, max_iter=30)
+    return a if math.isfinite(a) else 1.0
+
+
+def illinois_root(f, lo: float, flo: float, hi: float, fhi: float, *, ftol: float,
+                  xtol: float = 0.0, max_iter: int = 100) -> float:
+    """Root of a nondecreasing ``f`` bracketed by ``f(lo) = flo < 0 < fhi = f(hi)``.
+
+    The Illinois variant of regula falsi: secant steps within the bracket,
+    halving the retained end's value when the same end is kept twice, which
+    restores superlinear convergence.  Stops when ``|f| <= ftol``, the
+    bracket is shorter than ``xtol`` or has collapsed numerically; returns
+    ``nan`` when ``f`` is not finite at an iterate.
+    """
+    side, a = 0, hi
+    for _ in range(max_iter):
+        if not fhi > flo:          # the bracket collapsed numerically
+            break
+        a = (lo * fhi - hi * flo) / (fhi - flo)
+        fa = f(a)
+        if not math.isfinite(fa):
+            return math.nan
+        if abs(fa) <= ftol or hi - lo <= xtol:
+            break
+        if fa < 0.0:
+            lo, flo = a, fa
+            if side == -1:
+                fhi *= 0.5
+            side = -1
+        else:
+            hi, fhi = a, fa
+            if side == 1:
+                flo *= 0.5
+            side = 1
+    return a
+
+
+def roundoff_floor(mat, vec, fixed) -> float:
+    """``ROUNDOFF eps || |K| |u| ||`` over the free dofs: the residual's round-off level.
+
+    ``K`` may be stored as its lower triangle (symmetric storage).
+    """
+    import numpy as np
+    vals, cols, ptr = mat.CSR()
+    vals, cols, ptr = np.asarray(vals), np.asarray(cols, dtype=np.int64), np.asarray(ptr, dtype=np.int64)
+    u = np.abs(vec.FV().NumPy())
+    n = len(u)
+    rows = np.repeat(np.arange(n), np.diff(ptr))
+    a = np.abs(vals)
+    m = np.bincount(rows, weights=a * u[cols], minlength=n)
+    if type(mat).__name__.startswith("SparseMatrixSymmetric"):
+        off = rows != cols
+        m += np.bincount(cols[off], weights=a[off] * u[rows[off]], minlength=n)
+    m[fixed] = 0.0
+    return ROUNDOFF * np.finfo(float).eps * float(np.sqrt(np.dot(m, m)))
+
+
+def _size(signature) -> int:
+    """Number of active entries: set bits of a ``bytes`` signature, true entries of a sequence, or -1."""
+    if isinstance(signature, (bytes, bytearray)):
+        return sum(bin(b).count("1") for b in signature)
+    try:
+        return int(sum(bool(b) for b in signature))
+    except TypeError:
+        return -1
+
+
+def fixed_mask(freedofs):
+    """Boolean NumPy array, True where a dof is not free."""
+    import numpy as np
+    return ~np.array([freedofs[i] for i in range(len(freedofs))], dtype=bool)
+
+
+def _mask(vec, fixed) -> None:
+    """Zero the entries of ``vec`` that are not free."""
+    vec.FV().NumPy()[fixed] = 0.0

@@ -1,0 +1,449 @@
+"""Manufactured solutions for the elasticity operator.
+
+A chosen smooth displacement ``u*`` is made the exact solution of
+
+    -div sigma(u*) = f        in every body B,    sigma = C_B : eps(u*)   (paper eq. 1)
+               u   = u*       on the Dirichlet part,
+        sigma(u*) n = t       on the Neumann part,
+    [sigma(u*)] n  = j        on a bonded interface between two materials,
+
+by computing the data from ``u*`` symbolically (NGSolve ``CoefficientFunction``
+``.Diff``).  The weak form is the one of :mod:`ngcontact.fem.elasticity`
+(paper eq. 46 without contact):
+
+    sum_B int_B sigma(u) : eps(v) w dx
+        = sum_B int_B f . v w dx + int_N t . v w ds + int_I j . v w ds,
+
+with the weight ``w = 1`` (plane strain, 3D) or ``2 pi r`` (axisymmetric).
+In the axisymmetric setting, coordinates ``(r, z)`` are the mesh ``(x, y)``
+and
+
+    f_r = -(d_r s_rr + d_z s_rz + (s_rr - s_tt) / r),
+    f_z = -(d_r s_rz + d_z s_zz + s_rz / r);
+
+the axis ``r = 0`` carries ``u_r = 0`` only (the weight makes every other
+boundary term vanish there), and ``u*`` is regular at the axis (``u_r`` odd,
+``u_z`` even in ``r``).
+
+On the interface ``I`` with normal ``n`` pointing from ``rough`` (below) into
+``counter`` (above), ``j = (sigma_rough(u*) - sigma_counter(u*)) n``: with
+different materials the traction of a smooth ``u*`` jumps there.
+
+The two bonded bodies of the periodic cell share one conforming, periodic
+``VectorH1`` with a piecewise constant law: "bonded" means continuous
+displacement, which a single H1 space imposes exactly, so the observed error
+is the discretization error alone (a tie by penalty or multipliers would add
+its own consistency error).
+
+Errors: ``|u_h - u*|_L2`` and the H1 seminorm ``|grad(u_h - u*)|_L2``, both
+with the measure weight; in axisymmetry the seminorm includes the hoop term
+``(e_r / r)^2``.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass
+
+import ngsolve as ng
+import numpy as np
+from netgen.csg import unit_cube
+from netgen.geom2d import SplineGeometry, unit_square
+
+from ngcontact.fem import elasticity
+from ngcontact.errors import ConvergenceError
+from ngcontact.geometry.cell2d import Segment, interface_cell
+from ngcontact.fem.materials import ElasticLaw
+from ngcontact.solvers.newton import fixed_mask
+
+log = logging.getLogger(__name__)
+
+SETTINGS = ("plane_strain", "axisymmetric", "3d", "periodic_cell")
+SOLUTIONS = ("smooth", "polynomial")
+CELL_PERIOD = 1.0
+CELL_DEPTH = 0.5
+INTERFACE = "contact"
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A manufactured boundary value problem on a mesh (no discretization yet).
+
+    Attributes
+    ----------
+    setting
+        ``"plane_strain"``, ``"axisymmetric"`` or ``"3d"`` (the elasticity
+        setting; the periodic cell is plane strain).
+    mesh
+        The mesh.
+    laws
+        ``region name -> ElasticLaw``.
+    exact
+        ``u*`` as a vector ``CoefficientFunction``.
+    dirichlet
+        Boundaries where every component of ``u*`` is imposed (``|``-joined).
+    dirichlet_x
+        Boundaries where only the first component is imposed (the axis).
+    neumann
+        Boundaries loaded by the traction ``sigma(u*) n``.
+    interface
+        Internal boundary loaded by the traction jump, or ``""``.
+    periodic
+        The space is periodic (identified boundaries of the mesh).
+    """
+
+    setting: str
+    mesh: ng.Mesh
+    laws: dict
+    exact: ng.CoefficientFunction
+    dirichlet: str
+    dirichlet_x: str = ""
+    neumann: str = ""
+    interface: str = ""
+    periodic: bool = False
+
+
+@dataclass
+class Solution:
+    """A discrete solution and what it cost."""
+
+    gfu: ng.GridFunction
+    ndof: int
+    relative_residual: float
+    seconds: float
+
+
+# ------------------------------------------------------------ calculus
+def coordinates(dim: int) -> tuple:
+    """The coordinate functions ``(x, y[, z])``."""
+    return (ng.x, ng.y, ng.z)[:dim]
+
+
+def gradient(u: ng.CoefficientFunction, dim: int) -> ng.CoefficientFunction:
+    """``(du_i / dx_j)`` of a vector ``CoefficientFunction``, symbolically."""
+    X = coordinates(dim)
+    return ng.CF(tuple(u[i].Diff(X[j]) for i in range(dim) for j in range(dim)), dims=(dim, dim))
+
+
+def exact_stress(law: ElasticLaw, u: ng.CoefficientFunction, setting: str) -> ng.CoefficientFunction:
+    """3x3 stress ``C : eps(u)`` of a symbolic displacement ``u``."""
+    dim = elasticity.dimension(setting)
+    return law.stress(elasticity.strain_of_gradient(gradient(u, dim), u, setting))
+
+
+def body_force(law: ElasticLaw, u: ng.CoefficientFunction, setting: str) -> ng.CoefficientFunction:
+    """``f = -div sigma(u)`` (cylindrical divergence in the axisymmetric setting).
+
+    For an isotropic law in plane strain or 3D the Navier form
+    ``f = -(mu lap u + (lam + mu) grad div u)`` is used: the same field,
+    with a several times smaller expression tree (faster quadrature).
+    """
+    if law.lame is not None and setting in ("plane_strain", "3d"):
+        return navier_body_force(law, u, setting)
+    return stress_divergence_body_force(law, u, setting)
+
+
+def stress_divergence_body_force(law: ElasticLaw, u: ng.CoefficientFunction,
+                                 setting: str) -> ng.CoefficientFunction:
+    """``f = -div sigma(u)`` by differentiating the stress, for any law and setting."""
+    dim = elasticity.dimension(setting)
+    s = exact_stress(law, u, setting)
+    X = coordinates(dim)
+    div = [sum(s[i, j].Diff(X[j]) for j in range(dim)) for i in range(dim)]
+    if setting == "axisymmetric":
+        div[0] = div[0] + (s[0, 0] - s[2, 2]) / ng.x
+        div[1] = div[1] + s[0, 1] / ng.x
+    return ng.CF(tuple(-d for d in div)).Compile()
+
+
+def navier_body_force(law: ElasticLaw, u: ng.CoefficientFunction, setting: str) -> ng.CoefficientFunction:
+    """``f = -(mu lap u + (lam + mu) grad div u)`` for an isotropic law (plane strain, 3D)."""
+    if law.lame is None or setting not in ("plane_strain", "3d"):
+        raise ValueError("the Navier form needs an isotropic law in plane strain or 3D")
+    lam, mu = law.lame
+    dim = elasticity.dimension(setting)
+    X = coordinates(dim)
+    div_u = sum(u[j].Diff(X[j]) for j in range(dim))
+    return ng.CF(tuple(-(mu * sum(u[i].Diff(X[j]).Diff(X[j]) for j in range(dim))
+                         + (lam + mu) * div_u.Diff(X[i])) for i in range(dim))).Compile()
+
+
+def traction(law: ElasticLaw, u: ng.CoefficientFunction, setting: str, normal) -> ng.CoefficientFunction:
+    """``sigma(u) n`` for the in-plane (2D) or full (3D) normal ``n``."""
+    dim = elasticity.dimension(setting)
+    s = exact_stress(law, u, setting)
+    return ng.CF(tuple(sum(s[i, j] * normal[j] for j in range(dim)) for i in range(dim))).Compile()
+
+
+# ------------------------------------------------------------ exact fields
+def smooth_field(setting: str) -> ng.CoefficientFunction:
+    """A smooth, non-polynomial ``u*`` for rate studies.
+
+    Axisymmetric: ``u_r`` odd and ``u_z`` even in ``r`` (regular at the axis).
+    Periodic cell: ``1``-periodic in ``x``.
+    """
+    x, y, z = ng.x, ng.y, ng.z
+    if setting == "plane_strain":
+        return ng.CF((ng.sin(2 * x + y) * ng.cos(0.5 * y), ng.cos(x - 1.5 * y) * ng.exp(0.5 * x)))
+    if setting == "axisymmetric":
+        r = x
+        return ng.CF((ng.sin(2 * r) * ng.cos(1.5 * y + 0.3), ng.cos(2 * r) * ng.sin(y) + r * r * y))
+    if setting == "3d":
+        return ng.CF((ng.sin(x + 2 * y) * ng.cos(z), ng.cos(2 * x - z) * ng.sin(y),
+                      ng.exp(0.5 * x) * ng.sin(y + z)))
+    if setting == "periodic_cell":
+        k = 2 * math.pi / CELL_PERIOD
+        return ng.CF((ng.sin(k * x) * ng.cos(2 * y) + 0.5 * y,
+                      ng.cos(k * x) * ng.sin(3 * y) + 0.3 * ng.sin(k * x + y)))
+    raise ValueError(f"setting = {setting!r}: must be one of {', '.join(SETTINGS)}")
+
+
+def polynomial_field(setting: str, degree: int, seed: int = 1) -> ng.CoefficientFunction:
+    """A generic polynomial ``u*`` of total degree ``degree`` (exactness tests).
+
+    Coefficients are fixed pseudo-random numbers.  Axisymmetric:
+    ``u_r = r q(r, z)`` with ``deg q = degree - 1`` and ``u_z`` without a term
+    linear in ``r``, so that the weak form of ``u*`` has polynomial integrands.
+    """
+    if degree < 1:
+        raise ValueError(f"degree = {degree!r}: must be >= 1")
+    if setting == "periodic_cell":
+        raise ValueError("a polynomial cannot be periodic; use setting 'plane_strain'")
+    dim = elasticity.dimension(setting)
+    rng = np.random.default_rng(seed)
+    X = coordinates(dim)
+
+    def poly(deg, skip=lambda powers: False):
+        total = ng.CF(0.0)
+        for powers in np.ndindex(*(deg + 1,) * dim):
+            if sum(powers) > deg or skip(powers):
+                continue
+            term = ng.CF(float(rng.uniform(-1.0, 1.0)))
+            for c, k in zip(X, powers):
+                if k:
+                    term = term * c ** int(k)
+            total = total + term
+        return total
+
+    if setting == "axisymmetric":
+        u_r = ng.x * poly(degree - 1) if degree > 1 else ng.x * float(rng.uniform(-1.0, 1.0))
+        u_z = poly(degree, skip=lambda powers: powers[0] == 1)
+        return ng.CF((u_r, u_z))
+    return ng.CF(tuple(poly(degree) for _ in range(dim)))
+
+
+# ------------------------------------------------------------ domains
+def bump_segments(period: float = CELL_PERIOD) -> list:
+    """Flat - circular arc bump - flat interface chain (arc of 90 degrees)."""
+    a, b, m = 0.25 * period, 0.75 * period, 0.5 * period
+    return [Segment("line", ((0.0, 0.0), (a, 0.0))),
+            Segment("spline3", ((a, 0.0), (m, 0.25 * period), (b, 0.0))),
+            Segment("line", ((b, 0.0), (period, 0.0)))]
+
+
+def _axis_rectangle(maxh: float) -> ng.Mesh:
+    geo = SplineGeometry()
+    geo.AddRectangle((0.0, 0.0), (1.0, 1.0), bcs=("bottom", "outer", "top", "axis"))
+    return ng.Mesh(geo.GenerateMesh(maxh=maxh))
+
+
+def _refine(mesh: ng.Mesh, times: int) -> ng.Mesh:
+    """Refine ``mesh`` uniformly ``times`` times (new boundary points lie on the geometry)."""
+    if times < 0:
+        raise ValueError(f"refinements = {times!r}: must be >= 0")
+    for _ in range(times):
+        mesh.Refine()
+    return mesh
+
+
+def problem(setting: str, laws: dict, maxh: float, *, refinements: int = 0, order: int = 1,
+            solution: str = "smooth", degree: int | None = None) -> Problem:
+    """The manufactured problem of ``setting`` on a mesh of size ``maxh``.
+
+    The mesh is generated with ``maxh`` and then refined uniformly
+    ``refinements`` times (each halving ``h``), so that a sequence of levels
+    is nested and its mesh sizes have exactly the ratio 2.
+
+    Parameters
+    ----------
+    setting
+        ``plane_strain`` (unit square, Dirichlet on left and bottom, traction
+        on right and top), ``axisymmetric`` (``(r, z)`` in the unit square,
+        axis ``r = 0`` with ``u_r = 0``, Dirichlet at ``z = 0, 1``, traction
+        at ``r = 1``), ``3d`` (unit cube, Dirichlet on three faces, traction
+        on the others) or ``periodic_cell`` (two bodies bonded along a
+        circular-arc bump, periodic in ``x``, Dirichlet on bottom and top).
+    laws
+        ``{"body": law}``; the periodic cell needs ``{"rough": law,
+        "counter": law}``.
+    maxh
+        Mesh size of the generated (coarsest) mesh.
+    refinements
+        Number of uniform refinements of that mesh.
+    order
+        Geometry order of curved boundaries (periodic cell).
+    solution
+        ``"smooth"`` or ``"polynomial"`` (then ``degree`` is required).
+    """
+    if solution not in SOLUTIONS:
+        raise ValueError(f"solution = {solution!r}: must be one of {', '.join(SOLUTIONS)}")
+    if solution == "polynomial":
+        if degree is None:
+            raise ValueError("solution = 'polynomial' needs a degree")
+        exact = polynomial_field(setting, degree)
+    else:
+        exact = smooth_field(setting)
+    if setting == "periodic_cell":
+        missing = {"rough", "counter"} - set(laws)
+        if missing:
+            raise ValueError(f"laws lacks {sorted(missing)}: the periodic cell needs 'rough' and 'counter'")
+        cell = interface_cell(bump_segments(), CELL_PERIOD, CELL_DEPTH, CELL_DEPTH, maxh=maxh)
+        _refine(cell.mesh, refinements)
+        if order > 1:
+            cell.mesh.Curve(order)
+        return Problem("plane_strain", cell.mesh, {k: laws[k] for k in ("rough", "counter")}, exact,
+                       dirichlet="bottom|top", interface=INTERFACE, periodic=True)
+    law = laws["body"]
+    if setting == "plane_strain":
+        mesh = _refine(ng.Mesh(unit_square.GenerateMesh(maxh=maxh)), refinements)
+        return Problem(setting, mesh, {mesh.GetMaterials()[0]: law}, exact,
+                       dirichlet="left|bottom", neumann="right|top")
+    if setting == "axisymmetric":
+        mesh = _refine(_axis_rectangle(maxh), refinements)
+        return Problem(setting, mesh, {mesh.GetMaterials()[0]: law}, exact,
+                       dirichlet="bottom|top", dirichlet_x="axis", neumann="outer")
+    if setting == "3d":
+        mesh = _refine(ng.Mesh(unit_cube.GenerateMesh(maxh=maxh)), refinements)
+        return Problem(setting, mesh, {mesh.GetMaterials()[0]: law}, exact,
+                       dirichlet="left|bottom|back", neumann="right|top|front")
+    raise ValueError(f"setting = {setting!r}: must be one of {', '.join(SETTINGS)}")
+
+
+# ------------------------------------------------------------ solve
+def space(prob: Problem, order: int):
+    """Order-``order`` ``VectorH1`` over the whole mesh, periodic if asked."""
+    if order < 1:
+        raise ValueError(f"order = {order!r}: must be >= 1")
+    V = ng.VectorH1(prob.mesh, order=order, dirichlet=prob.dirichlet, dirichletx=prob.dirichlet_x)
+    return ng.Periodic(V) if prob.periodic else V
+
+
+def interface_normal(prob: Problem) -> ng.CoefficientFunction:
+    """Unit normal on ``prob.interface`` pointing from ``rough`` into ``counter``.
+
+    The interface is a graph over ``x`` with ``counter`` above, so the right
+    normal has ``int n_y ds = period > 0``; the mesh's own orientation is
+    flipped when it disagrees.
+    """
+    dim = prob.mesh.dim
+    n = ng.specialcf.normal(dim)
+    ny = ng.Integrate(n[dim - 1], prob.mesh, ng.BND, definedon=prob.mesh.Boundaries(prob.interface))
+    return n if ny > 0 else -n
+
+
+def solve(prob: Problem, order: int, *, inverse: str = "sparsecholesky",
+          bonus_intorder: int = 2) -> Solution:
+    """Assemble and solve the linear problem of ``prob`` with elements of order ``order``.
+
+    The load integrals use ``bonus_intorder`` extra quadrature orders, so that
+    quadrature does not pollute the rates (and is exact for polynomial data).
+
+    Raises
+    ------
+    ConvergenceError
+        The sparse direct solver ``inverse`` failed (e.g. is not installed).
+    """
+    t0 = time.perf_counter()
+    mesh, setting = prob.mesh, prob.setting
+    V = space(prob, order)
+    u, v = V.TnT()
+    w = elasticity.weight(setting)
+    # only the Cholesky factorization reads a matrix stored as one triangle
+    a = ng.BilinearForm(V, symmetric=True, symmetric_storage=(inverse == "sparsecholesky"))
+    f = ng.LinearForm(V)
+    for region, law in prob.laws.items():
+        on = mesh.Materials(region)
+        a += elasticity.bilinear_integrand(law, u, v, setting) * ng.dx(definedon=on, bonus_intorder=2)
+        f += ng.InnerProduct(body_force(law, prob.exact, setting), v) * w * ng.dx(
+            definedon=on, bonus_intorder=bonus_intorder)
+    if prob.neumann:
+        (law,) = prob.laws.values()
+        t = traction(law, prob.exact, setting, ng.specialcf.normal(mesh.dim))
+        f += ng.InnerProduct(t, v) * w * ng.ds(prob.neumann, bonus_intorder=bonus_intorder)
+    if prob.interface:
+        n = interface_normal(prob)
+        jump = (traction(prob.laws["rough"], prob.exact, setting, n)
+                - traction(prob.laws["counter"], prob.exact, setting, n))
+        f += ng.InnerProduct(jump, v) * w * ng.ds(prob.interface, bonus_intorder=bonus_intorder)
+    a.Assemble()
+    f.Assemble()
+    gfu = ng.GridFunction(V)
+    boundaries = "|".join(b for b in (prob.dirichlet, prob.dirichlet_x) if b)
+    gfu.Set(prob.exact, ng.BND, definedon=mesh.Boundaries(boundaries))
+    free = V.FreeDofs()
+    res = f.vec.CreateVector()
+    res.data = f.vec - a.mat * gfu.vec
+    try:
+        inv = a.mat.Inverse(free, inverse=inverse)
+    except RuntimeError as exc:
+        raise ConvergenceError(f"linear solver {inverse!r} failed: {exc}",
+                               {"linear_solve_only": True, "converged": False}) from exc
+    gfu.vec.data += inv * res
+    res.data = f.vec - a.mat * gfu.vec
+    fixed = fixed_mask(free)
+    r = res.FV().NumPy().copy()
+    load = f.vec.FV().NumPy().copy()
+    r[fixed] = 0.0
+    load[fixed] = 0.0
+    scale = max(float(np.linalg.norm(load)), np.finfo(float).tiny)
+    rel = float(np.linalg.norm(r)) / scale
+    seconds = time.perf_counter() - t0
+    log.debug("%s order %d: %d dofs, relative residual %.2e, %.3f s", setting, order, V.ndof, rel, seconds)
+    return Solution(gfu=gfu, ndof=int(sum(free)), relative_residual=rel, seconds=seconds)
+
+
+def errors(prob: Problem, gfu: ng.GridFunction, bonus_intorder: int = 4) -> tuple[float, float]:
+    """``(L2 error, H1-seminorm error)`` of ``gfu`` against ``prob.exact`` (weighted)."""
+    mesh, setting = prob.mesh, prob.setting
+    dim = mesh.dim
+    w = elasticity.weight(setting)
+    e = gfu - prob.exact
+    de = ng.Grad(gfu) - gradient(prob.exact, dim)
+    grad2 = ng.InnerProduct(de, de)
+    if setting == "axisymmetric":
+        grad2 = grad2 + (e[0] / ng.x) ** 2
+    order = 2 * gfu.space.globalorder + bonus_intorder
+    l2 = ng.Integrate(ng.InnerProduct(e, e) * w, mesh, order=order)
+    h1 = ng.Integrate(grad2 * w, mesh, order=order)
+    return math.sqrt(max(l2, 0.0)), math.sqrt(max(h1, 0.0))
+
+
+def mesh_size(mesh: ng.Mesh) -> float:
+    """Mean element size ``(|Omega| / #elements)^(1/d)``."""
+    volume = ng.Integrate(ng.CF(1.0), mesh)
+    return (volume / mesh.ne) ** (1.0 / mesh.dim)
+
+
+def level_runner(setting: str, laws: dict, maxh: float, *, inverse: str = "sparsecholesky",
+                 keep: dict | None = None):
+    """A ``level(order, refinements) -> dict`` for :mod:`ngcontact.verification.rates`.
+
+    Each call builds the problem on the mesh refined ``refinements`` times,
+    solves it with order ``order`` and returns ``ndof``, ``l2``, ``h1``, the
+    solve's ``relative_residual`` and ``solve_seconds`` (wall time of mesh,
+    assembly and solve, without the error evaluation).  When ``keep`` is a dict, the last
+    problem and solution are stored in it under ``"problem"`` and
+    ``"solution"`` (e.g. to write the finest one).
+    """
+    def level(order: int, refinements: int) -> dict:
+        t0 = time.perf_counter()
+        prob = problem(setting, laws, maxh, refinements=refinements, order=order)
+        sol = solve(prob, order, inverse=inverse)
+        solve_seconds = time.perf_counter() - t0
+        l2, h1 = errors(prob, sol.gfu)
+        if keep is not None:
+            keep["problem"], keep["solution"] = prob, sol
+        return {"ndof": sol.ndof, "l2": l2, "h1": h1, "relative_residual": sol.relative_residual,
+                "solve_seconds": solve_seconds}
+    return level
