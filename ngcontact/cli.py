@@ -4,7 +4,7 @@
 CSV tables, VTK files for ParaView and PNG plots into ``DIR`` (default
 ``results/<scene name>``); ``ngcontact check SCENE`` only validates it;
 ``ngcontact study epsilon SCENE [--periods N ...] [--out DIR]`` runs the
-epsilon study of a ``direct`` scene (:mod:`ngcontact.verification.epsilon_study`) and
+epsilon study of a ``direct`` scene (:func:`ngcontact.runner.study_epsilon`) and
 writes ``report.json``, ``epsilon.csv`` and ``epsilon.png`` into ``DIR``
 (default ``results/<scene name>_epsilon``).
 
@@ -96,15 +96,14 @@ def _run(path: str, out: str | None, quiet: bool) -> int:
 
 def _study(path: str, periods, out: str | None, quiet: bool) -> int:
     """``ngcontact study epsilon``: the same code as ``scripts/epsilon_study.py``."""
-    from ngcontact.verification.epsilon_study import epsilon_report
-    from ngcontact.output.report import Clock
+    from ngcontact.runner import study_epsilon
 
     def require_study(sc):
         if sc.kind != "direct" or sc.study is None:
             raise SceneError("kind", sc.kind, "the epsilon study needs a 'direct' scene with a [study] section")
 
     def compute(sc, progress):
-        return epsilon_report(sc, periods, Clock(progress))
+        return study_epsilon(sc, periods, progress)
 
     if periods is not None and any(n < 1 for n in periods):
         return _fail(EXIT_SCENE, f"--periods {periods}: every N must be >= 1")

@@ -14,6 +14,7 @@ import importlib
 from typing import Callable
 
 from ngcontact import __version__
+from ngcontact.errors import SceneError
 from ngcontact.output.report import Clock, Outcome, build_report
 from ngcontact.scene import loader
 
@@ -48,4 +49,31 @@ def solve(scene, progress: Callable[[str], None] | None = None) -> tuple[dict, O
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),
                           outcome=outcome, timings=clock.total(), version=__version__)
+    return report, outcome
+
+
+def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = None) -> tuple[dict, Outcome]:
+    """The epsilon study of a ``direct`` scene with a ``[study]`` section, as a report; no file I/O.
+
+    The resolved rough interface at ``N`` periods against the homogenized
+    laws (:mod:`ngcontact.drivers.study_epsilon`); the command
+    ``ngcontact study epsilon`` and ``scripts/epsilon_study.py`` call this.
+
+    Raises
+    ------
+    SceneError
+        The scene is not a ``direct`` scene with a ``[study]`` section, or
+        its band leaves no points for the field error.
+    """
+    from ngcontact.drivers.study_epsilon import run_study
+
+    if not hasattr(scene, "kind"):
+        scene = loader.load(scene)
+    if scene.kind != "direct" or getattr(scene, "study", None) is None:
+        raise SceneError("kind", scene.kind, "the epsilon study needs a 'direct' scene with a [study] section")
+    clock = Clock(progress)
+    outcome = run_study(scene, periods, clock=clock)
+    report = build_report(kind="direct-epsilon-study", title=scene.title, scene=loader.as_dict(scene),
+                          effects=loader.effects(scene), outcome=outcome, timings=clock.total(),
+                          version=__version__)
     return report, outcome

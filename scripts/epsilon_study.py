@@ -3,13 +3,12 @@
 For each number of periods N (the scene's ``[study] periods`` or ``--periods``)
 the resolved problem and the homogenized problems with the bundle, the linear
 whole-surface and the effective-stiffness laws are solved and compared (see
-:mod:`ngcontact.verification.epsilon_study`).  Writes, atomically, ``DIR/report.json``
+:func:`ngcontact.runner.study_epsilon`).  Writes, atomically, ``DIR/report.json``
 (``results.rows``, ``results.rates``, ``results.below_1_percent``),
 ``DIR/epsilon.csv`` and ``DIR/epsilon.png`` (error and cost against eps).
 
 Usage: python scripts/epsilon_study.py SCENE [--periods 4 8 16 32] [--out DIR]
-(the same study as ``ngcontact study epsilon SCENE``, which writes the same
-files; this script also prints the table)
+(runs ``ngcontact study epsilon SCENE`` and prints its table)
 
 Exit status as ``ngcontact run``: 0 success, 2 invalid scene or output
 directory, 3 solver failure.
@@ -17,14 +16,12 @@ directory, 3 solver failure.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 
-from ngcontact.scene import loader as scene_mod
-from ngcontact.cli import EXIT_OK, EXIT_SCENE, EXIT_SOLVER
-from ngcontact.verification.epsilon_study import epsilon_report
-from ngcontact.errors import ConvergenceError, NgcontactError, OutputError, SceneError
-from ngcontact.output.report import Clock, ensure_writable, write_outputs
+from ngcontact.cli import EXIT_OK
+from ngcontact.cli import main as cli_main
 
 
 def main(argv=None) -> int:
@@ -34,36 +31,20 @@ def main(argv=None) -> int:
     p.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     args = p.parse_args(argv)
-    try:
-        sc = scene_mod.load(args.scene)
-        if sc.kind != "direct" or sc.study is None:
-            raise SceneError("kind", sc.kind, "the epsilon study needs a 'direct' scene with a [study] section")
-    except SceneError as exc:
-        print(f"epsilon_study: error: {args.scene}: {exc}", file=sys.stderr)
-        return EXIT_SCENE
     out = args.out or os.path.join("results", os.path.splitext(os.path.basename(args.scene))[0] + "_epsilon")
-    try:
-        ensure_writable(out)
-    except OutputError as exc:
-        print(f"epsilon_study: error: {exc}", file=sys.stderr)
-        return EXIT_SCENE
-    clock = Clock(None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True)))
-    try:
-        report, outcome = epsilon_report(sc, args.periods, clock)
-        write_outputs(out, report, outcome)
-    except (SceneError, OutputError) as exc:
-        print(f"epsilon_study: error: {exc}", file=sys.stderr)
-        return EXIT_SCENE
-    except (ConvergenceError, NgcontactError, ValueError) as exc:
-        print(f"epsilon_study: error: {args.scene}: {exc}", file=sys.stderr)
-        return EXIT_SOLVER
-    rows = outcome.results["rows"]
+    code = cli_main(["study", "epsilon", args.scene, "--out", out]
+                    + (["--periods", *map(str, args.periods)] if args.periods else [])
+                    + (["--quiet"] if args.quiet else []))
+    if code != EXIT_OK:
+        return code
+    with open(os.path.join(out, "report.json"), encoding="utf-8") as fh:
+        rows = json.load(fh)["results"]["rows"]
+    laws = ("bundle", "linear", "effective")
     print(f"{'N':>4} {'eps':>9} {'t_res':>7} {'t_hom':>7} " + " ".join(
-        f"{law + '_' + key:>18}" for law in ("bundle", "linear", "effective") for key in ("field", "reaction")))
+        f"{law + '_' + key:>18}" for law in laws for key in ("field", "reaction")))
     for r in rows:
         print(f"{r['N']:>4} {r['eps']:9.4g} {r['time_resolved']:7.2f} {r['time_homogenized']:7.2f} " + " ".join(
-            f"{r[law + '_' + key]:18.3e}" for law in ("bundle", "linear", "effective") for key in ("field", "reaction")))
-    print(f"wrote {os.path.join(out, 'report.json')}")
+            f"{r[law + '_' + key]:18.3e}" for law in laws for key in ("field", "reaction")))
     return EXIT_OK
 
 

@@ -21,7 +21,7 @@ from ngcontact.resolved import resolved_problem as D
 from ngcontact.fem import materials as mat
 from ngcontact.scene import loader as scene_mod
 from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
-from ngcontact.verification.epsilon_study import run_study
+from ngcontact.drivers.study_epsilon import run_study
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.resolved_bodies import flat_blocks, resolved_blocks

@@ -24,7 +24,7 @@ from ngcontact.resolved import resolved_problem as D
 from ngcontact.fem import materials as mat
 from ngcontact.scene import loader as scene_mod
 from ngcontact.drivers import run_resolved as drv
-from ngcontact.verification.epsilon_study import run_study
+from ngcontact.drivers.study_epsilon import run_study
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.bodies import FemurStemDims

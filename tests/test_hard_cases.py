@@ -199,7 +199,7 @@ def test_3d_cell_with_a_periodic_height_map():
     """The shipped height map (small-slope model), two pressures: at most 20 Newton steps,
     finite, equilibrium, contact grows with the pressure."""
     scene = ngcontact.load(os.path.join(ROOT, "geometries", "cells", "height_map.toml"))
-    from ngcontact.drivers.run_cell import build_cell, model_of
+    from ngcontact.drivers.build import build_cell, model_of
     cell = build_cell(scene)
     P = CellProblem(cell, model_of(scene))
     sols = P.sweep([cell_load(3, pressure=q) for q in (0.002, 0.01)])

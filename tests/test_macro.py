@@ -299,7 +299,7 @@ def test_scene_with_an_unknown_boundary_names_the_existing_ones():
 def test_law_from_a_cell_is_its_bundle_with_the_cells_K0_and_is_cached(tmp_path, monkeypatch):
     """Sawtooth cell (Example 27): bundle K0 = closed form; the second call reads the cache."""
     import os
-    from ngcontact.coupling import cell_law
+    from ngcontact.drivers import build as cell_law
     monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
     path = os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml")
     law, info = cell_law.law_from_cell(path, dim=2)

@@ -19,9 +19,9 @@ import pytest
 
 from ngcontact.scene import loader as scene_mod
 from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
-from ngcontact.drivers.run_cell import build_cell, model_of
+from ngcontact.drivers.build import build_cell, model_of
 from ngcontact.geometry.cell2d import flat_cell
-from ngcontact.scene.cell_scene import loads
+from ngcontact.drivers.build import cell_loads as loads
 from ngcontact.fem.materials import isotropic
 
 SCENE = os.path.join(os.path.dirname(__file__), "..", "geometries", "cells", "westergaard.toml")

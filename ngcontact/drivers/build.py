@@ -6,8 +6,24 @@ driver calls these instead of building its own copies.
 """
 from __future__ import annotations
 
+import hashlib
+import json
+import math
+import os
+
+import ngsolve as ng
+import numpy as np
+
+from ngcontact.cell.cell_problem import CellLoad, CellModel, Friction, cell_load
+from ngcontact.cell.coefficients import direction_bundle
+from ngcontact.coupling import cell_law
+from ngcontact.errors import SceneError
 from ngcontact.fem import materials
-from ngcontact.scene.sections import MaterialSpec
+from ngcontact.fem.interpolants import periodic_table_1d
+from ngcontact.laws import homogenized as il
+from ngcontact.scene.cell_scene import GAP_PROFILES, CellScene, load_states, profile_2d, small_slope
+from ngcontact.scene.loader import as_dict, load
+from ngcontact.scene.sections import MaterialSpec, resolve
 
 
 def elastic_law(spec: MaterialSpec) -> materials.ElasticLaw:
@@ -21,3 +37,160 @@ def elastic_law(spec: MaterialSpec) -> materials.ElasticLaw:
 def body_laws(scene, names: dict[str, str]) -> dict[str, materials.ElasticLaw]:
     """``{body: law}`` for ``{body: material name}`` of ``scene.materials``."""
     return {body: elastic_law(scene.materials[name]) for body, name in names.items()}
+
+
+def interface_normal_law(spec) -> il.NormalLaw | None:
+    """The homogenized normal law of an ``[interface]`` section's numbers (``None`` with a cell)."""
+    if spec.cell is not None:
+        return None
+    return il.normal_law(spec.law, kn=spec.kn, kt=spec.kt, knt=spec.knt, gap_force=spec.gap_force,
+                         weights=spec.weights, directions=spec.directions, gaps=spec.gaps,
+                         closure=spec.closure, pressure=spec.pressure)
+
+
+def interface_friction(spec) -> il.Friction | None:
+    """Homogenized friction of an ``[interface]`` section (``None`` without mu and threshold)."""
+    if spec.mu == 0.0 and spec.threshold == 0.0:
+        return None
+    return il.Friction(mu=spec.mu, threshold=spec.threshold, width=spec.huber_width)
+
+
+def cell_loads(scene: CellScene) -> list[CellLoad]:
+    """The sweep of cell loads a cell scene's ``[load]`` section describes."""
+    return [cell_load(scene.geometry.dim, **state) for state in load_states(scene)]
+
+
+def cell_key(cell_scene) -> str:
+    """SHA-256 of the validated cell scene and the data files it names."""
+    h = hashlib.sha256()
+    h.update(cell_law.CACHE_VERSION.encode())
+    h.update(json.dumps(as_dict(cell_scene), sort_keys=True, default=str).encode())
+    for rel in (getattr(cell_scene.geometry, "file", None), getattr(cell_scene.contact.gap, "file", None)):
+        if rel:
+            with open(resolve(cell_scene, rel), "rb") as fh:
+                h.update(fh.read())
+    return h.hexdigest()
+
+
+def law_from_cell(path: str, *, dim: int, linear: bool = False, length_unit: float = 1.0,
+                  cache_dir: str | None = None):
+    """Normal law from the cell scene file ``path`` and a description for the report.
+
+    Parameters
+    ----------
+    path
+        A scene file of kind ``cell``.
+    dim
+        Dimension of the macro frame (2 for plane strain and axisymmetry).
+    linear
+        Return its linearization :class:`~ngcontact.laws.homogenized.LinearLaw`
+        (``K0`` and the gap forces of eq. 34) instead of the bundle.
+    length_unit, cache_dir
+        See :mod:`ngcontact.coupling.cell_law`.
+    """
+    cell_scene = load(path)
+    if cell_scene.kind != "cell":
+        raise SceneError("interface.cell", path, f"names a {cell_scene.kind!r} scene; a 'cell' scene is needed")
+    def compute() -> dict:
+        b = direction_bundle(build_cell(cell_scene), kn=cell_scene.contact.k_n, gap=gap_cf(cell_scene))
+        return {"w": b.w, "n": b.n, "g": b.g}
+
+    arrays, cached = cell_law.cached_bundle_arrays(cell_key(cell_scene), compute, cache_dir)
+    law = cell_law.bundle_law(arrays, dim=dim, length_unit=length_unit)
+    K = law.matrix()
+    info = {"cell_scene": os.path.abspath(path), "cached": cached, "directions": len(law.weights),
+            "K0": K.tolist(), "key": cell_key(cell_scene)}
+    if linear:
+        if dim == 3:
+            raise SceneError("interface.law", "linear", "a linear law from a cell is available in 2D and "
+                             "axisymmetry; use the bundle in 3D")
+        law = il.linearized(law)
+    return law, info
+
+
+def build_cell(scene, maxh=None, interface_maxh=None, order=None):
+    """Mesh the cell of ``scene.geometry`` (mesh sizes may be overridden)."""
+    g, d = scene.geometry, scene.discretization
+    maxh = maxh or d.maxh
+    ih = interface_maxh or d.interface_maxh
+    order = order or d.order
+    if g.dim == 3:
+        from ngcontact.geometry import cell3d
+        if g.profile in GAP_PROFILES and not small_slope(g):
+            if g.profile == "bisinusoid":
+                heights = cell3d.bisinusoid_heights(g.amplitude, g.period)
+            else:
+                from ngcontact.geometry.tabulated import read_height_map
+                heights = read_height_map(resolve(scene, g.file), path="geometry.file")
+            return cell3d.surface_cell(heights, period=g.period, h_rough=g.h_rough,
+                                       h_counter=g.h_counter, maxh=maxh, interface_maxh=ih,
+                                       order=order)
+        if g.profile != "square_hills":  # flat, or a small-slope profile carried by the gap
+            return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih)
+        return cell3d.square_hills_cell(g.width, g.depth, period=g.period, arrangement=g.arrangement,
+                                        h_rough=g.h_rough, h_counter=g.h_counter, maxh=maxh,
+                                        interface_maxh=ih)
+    from ngcontact.geometry import profiles as pr
+    if g.profile == "tabulated":
+        from ngcontact.geometry.tabulated import read_profile_csv
+        prof = read_profile_csv(resolve(scene, g.file), path="geometry.file")
+    else:
+        prof = profile_2d(g)
+    return pr.profile_cell(prof, arrangement=g.arrangement, h_rough=g.h_rough, h_counter=g.h_counter,
+                           maxh=maxh, interface_maxh=ih, order=order)
+
+
+def gap_cf(scene):
+    """The initial gap as a CoefficientFunction, or ``None`` when there is none.
+
+    The sum of the explicit gap ``scene.contact.gap`` and, for the 3D
+    small-slope profiles (bisinusoid, height map), the height below the
+    highest summit.
+    """
+    terms = [t for t in (_profile_gap(scene), _explicit_gap(scene)) if t is not None]
+    if not terms:
+        return None
+    return terms[0] if len(terms) == 1 else terms[0] + terms[1]
+
+
+def _profile_gap(scene):
+    g = scene.geometry
+    if not small_slope(g):
+        return None
+    from ngcontact.geometry import cell3d
+    if g.profile == "bisinusoid":
+        return cell3d.bisinusoid_gap(g.amplitude, g.period)
+    from ngcontact.geometry.tabulated import read_height_map
+    return cell3d.height_map_gap(read_height_map(resolve(scene, g.file), path="geometry.file"), g.period)
+
+
+def _explicit_gap(scene):
+    gs, P = scene.contact.gap, scene.geometry.period
+    if gs.kind == "none":
+        return None
+    if gs.kind == "constant":
+        return ng.CF(gs.value)
+    if gs.kind == "sinusoid":
+        return 2 * gs.h * ng.sin(math.pi * ng.x / P) ** 2
+    if gs.kind == "bisinusoid":
+        return gs.h * (2 - ng.cos(2 * math.pi * ng.x / P) - ng.cos(2 * math.pi * ng.y / P))
+    from ngcontact.geometry import tabulated
+    if scene.geometry.dim == 2:
+        x, g = tabulated.read_gap_csv(resolve(scene, gs.file), path="contact.gap.file")
+        return periodic_table_1d(x, g, P)
+    g = tabulated.read_gap_map(resolve(scene, gs.file), path="contact.gap.file")
+    return ng.VoxelCoefficient((0.0, 0.0), (P, P), np.ascontiguousarray(g), linear=True)
+
+
+def model_of(scene) -> CellModel:
+    c = scene.contact
+    fr = None
+    if c.friction == "tresca":
+        fr = Friction("tresca", w=c.w, G=c.G)
+    elif c.friction == "coulomb":
+        fr = Friction("coulomb", w=c.w, mu=c.mu)
+    ms = scene.load is not None and scene.load.macro_strain is not None
+    return CellModel(rough=elastic_law(scene.materials[scene.bodies.rough]),
+                     counter=elastic_law(scene.materials[scene.bodies.counter]),
+                     k_n=c.k_n, gap=gap_cf(scene), friction=fr, order=scene.discretization.order,
+                     macro_strain=ms)

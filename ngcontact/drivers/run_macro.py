@@ -26,7 +26,7 @@ from collections import Counter
 import numpy as np
 import ngsolve as ng
 
-from ngcontact.drivers.build import body_laws, elastic_law
+from ngcontact.drivers.build import body_laws, interface_friction, interface_normal_law, law_from_cell
 from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
 from ngcontact.errors import SceneError
@@ -60,17 +60,16 @@ def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
     """The interface law of ``scene`` and a description of it for the report."""
     spec = scene.interface
     if spec.cell is not None:
-        from ngcontact.coupling.cell_law import law_from_cell
         normal, info = law_from_cell(resolve(scene, spec.cell), dim=dim, linear=spec.law == "linear",
                                      length_unit=spec.cell_length_unit)
     else:
-        normal = spec.normal_law()
+        normal = interface_normal_law(spec)
         info = {"source": "explicit numbers"}
         if isinstance(normal, il.BundleLaw) and len(normal.directions[0]) != dim:
             raise SceneError("interface.directions", normal.directions,
                              f"need {dim} components per direction in this setting")
     info = {"type": scene.interface.law, **info, "full_contact_K0": _K0(normal, dim)}
-    return il.InterfaceLaw(normal=normal, friction=spec.friction()), info
+    return il.InterfaceLaw(normal=normal, friction=interface_friction(spec)), info
 
 
 def _K0(normal, dim):

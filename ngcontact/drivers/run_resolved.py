@@ -30,7 +30,7 @@ import logging
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.drivers.build import body_laws, elastic_law
+from ngcontact.drivers.build import body_laws
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry import resolved_bodies as rg

@@ -33,7 +33,7 @@ log = logging.getLogger(__name__)
 
 def cell_problem_of(cell_path: str, *, key: str):
     """Cell scene -> :class:`CellProblem` with the macro strain term (for recovery)."""
-    from ngcontact.drivers.run_cell import build_cell, model_of
+    from ngcontact.drivers.build import build_cell, model_of
     cs = load(cell_path)
     if cs.kind != "cell":
         raise SceneError(key, cell_path, f"names a {cs.kind!r} scene; a 'cell' scene is needed")

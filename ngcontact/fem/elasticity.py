@@ -29,6 +29,8 @@ import ngsolve as ng
 from ngcontact.fem.materials import ElasticLaw
 
 SETTINGS = ("plane_strain", "axisymmetric", "3d")
+#: displacement components per setting, in the order of the mesh axes
+COMPONENTS = {"plane_strain": ("x", "y"), "axisymmetric": ("r", "z"), "3d": ("x", "y", "z")}
 
 
 def dimension(setting: str) -> int:

@@ -275,6 +275,22 @@ class InterfaceLaw:
         return isinstance(self.normal, LinearLaw) and self.friction is None
 
 
+def normal_law(law: str, *, kn=None, kt: float = 0.0, knt: float = 0.0, gap_force=(0.0, 0.0),
+               weights=None, directions=None, gaps=None, closure=None, pressure=None) -> NormalLaw:
+    """The normal law ``law`` ("linear", "bundle" or "tabulated") from its numbers.
+
+    Raises ``ValueError`` (from the law's own checks) when the numbers are
+    not admissible; unused numbers are ignored.
+    """
+    if law == "linear":
+        return LinearLaw(kn=kn, kt=kt, knt=knt, gap_force=tuple(gap_force))
+    if law == "bundle":
+        return BundleLaw(weights=weights, directions=directions, gaps=gaps or ())
+    if law == "tabulated":
+        return TabulatedLaw(closure=closure, pressure=pressure, kt=kt)
+    raise ValueError(f"law {law!r}: must be 'linear', 'bundle' or 'tabulated'")
+
+
 def linearized(law: BundleLaw) -> LinearLaw:
     """The linear law a bundle equals when every direction is closed.
 

@@ -50,13 +50,13 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.fem import elasticity
+from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.laws import homogenized as il
 from ngcontact.fem.materials import von_mises
 from ngcontact.solvers.newton import minimize
 
 log = logging.getLogger(__name__)
 
-COMPONENTS = {"plane_strain": ("x", "y"), "axisymmetric": ("r", "z"), "3d": ("x", "y", "z")}
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -204,7 +204,7 @@ class CellScene:
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     base_dir: str = base_dir_field()
 
-    def check_files(self) -> None:
+    def check_files(self, load) -> None:
         """Read and validate the tabulated profile / height map / gap named by the scene."""
         from ngcontact.geometry import tabulated
         from ngcontact.scene.sections import resolve
@@ -249,7 +249,7 @@ class CellScene:
             return
         if self.load is None:
             raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
-        loads(self)
+        load_states(self)
         flat = self.geometry.profile in ("flat", "flat3d") or small_slope(self.geometry)
         if flat and self.contact.friction == "none":
             for key in ("shear", "tangential_jump"):
@@ -264,9 +264,13 @@ def small_slope(geometry: CellGeometry) -> bool:
     return geometry.profile in GAP_PROFILES and geometry.arrangement == "summit"
 
 
-def loads(scene: CellScene) -> list:
-    """The sweep of :class:`ngcontact.cell.CellLoad` described by ``scene.load``."""
-    from ngcontact.cell.cell_problem import cell_load
+def load_states(scene: CellScene) -> list[dict]:
+    """The sweep ``scene.load`` describes, one keyword dict per load state.
+
+    Keys ``pressure`` / ``normal_jump``, ``shear`` / ``tangential_jump`` and
+    ``macro_strain`` as :func:`ngcontact.drivers.build.cell_loads` hands them
+    to the cell problem; checks that the lists pair up.
+    """
     L, dim = scene.load, scene.geometry.dim
     nt = dim - 1
     nkey = "pressure" if L.pressure is not None else "normal_jump"
@@ -289,12 +293,11 @@ def loads(scene: CellScene) -> list:
     for k in range(n):
         nv = normal[k if len(normal) > 1 else 0]
         tv = tang_sets[k if len(tang_sets) > 1 else 0] if tang_sets else None
-        out.append(cell_load(dim,
-                             pressure=nv if L.pressure is not None else None,
-                             normal_jump=nv if L.normal_jump is not None else None,
-                             shear=tv if L.shear is not None else None,
-                             tangential_jump=tv if L.tangential_jump is not None else None,
-                             macro_strain=ms))
+        out.append(dict(pressure=nv if L.pressure is not None else None,
+                        normal_jump=nv if L.normal_jump is not None else None,
+                        shear=tv if L.shear is not None else None,
+                        tangential_jump=tv if L.tangential_jump is not None else None,
+                        macro_strain=ms))
     return out
 
 

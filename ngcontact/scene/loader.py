@@ -52,8 +52,8 @@ def from_dict(data: dict, base_dir: str = "."):
     scene = build(KINDS[kind].scene, data)
     object.__setattr__(scene, "base_dir", base_dir)
     check_files = getattr(scene, "check_files", None)
-    if callable(check_files):
-        check_files()
+    if callable(check_files):  # nested scenes (a macro scene's cell) load through this loader
+        check_files(load)
     return scene
 
 

@@ -29,6 +29,8 @@ import dataclasses
 from dataclasses import dataclass
 
 from ngcontact.errors import MISSING, SceneError
+from ngcontact.fem.elasticity import COMPONENTS
+from ngcontact.laws import homogenized as il
 from ngcontact.geometry.bodies import FemurStemDims
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field, check_material_names,
                      )
@@ -162,8 +164,10 @@ class InterfaceSpec:
         for key, value in explicit.items():
             if value is not None and key not in need[self.law] + (("gaps",) if self.law == "bundle" else ()):
                 raise SceneError(f"{path}.{key}", value, f"not used by law = {self.law!r}; remove it")
-        try:
-            self.normal_law()
+        try:  # the law's own admissibility rule; the driver builds the law it solves with
+            il.normal_law(self.law, kn=self.kn, kt=self.kt, knt=self.knt, gap_force=self.gap_force,
+                          weights=self.weights, directions=self.directions, gaps=self.gaps,
+                          closure=self.closure, pressure=self.pressure)
         except ValueError as exc:
             raise SceneError(f"{path}", self.law, str(exc)) from None
         if self.gap_table is not None:
@@ -172,23 +176,6 @@ class InterfaceSpec:
                 raise SceneError(f"{path}.gap_table", self.gap_table, "coordinates must increase strictly")
             if self.gap != 0.0:
                 raise SceneError(f"{path}.gap", self.gap, "give either gap or gap_table")
-
-    def normal_law(self):
-        """The normal law from the explicit numbers (``None`` with a cell)."""
-        from ngcontact.laws import homogenized as il
-        if self.cell is not None:
-            return None
-        if self.law == "linear":
-            return il.LinearLaw(kn=self.kn, kt=self.kt, knt=self.knt, gap_force=self.gap_force)
-        if self.law == "bundle":
-            return il.BundleLaw(weights=self.weights, directions=self.directions, gaps=self.gaps or ())
-        return il.TabulatedLaw(closure=self.closure, pressure=self.pressure, kt=self.kt)
-
-    def friction(self):
-        from ngcontact.laws import homogenized as il
-        if self.mu == 0.0 and self.threshold == 0.0:
-            return None
-        return il.Friction(mu=self.mu, threshold=self.threshold, width=self.huber_width)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -277,7 +264,6 @@ class MacroScene:
     def check(self, path: str) -> None:
         check_material_names(self.materials, {"rough": self.bodies.rough, "counter": self.bodies.counter},
                              "bodies")
-        from ngcontact.macro.macro_problem import COMPONENTS
         comps = COMPONENTS[self.geometry.setting]
         shape, setting = self.geometry.shape, self.geometry.setting
         labels = BOUNDARIES[shape, setting]
@@ -310,7 +296,7 @@ class MacroScene:
                                      f"the ultimate stress of the {role} body is required by [strength]; "
                                      "a number > 0 [Pa]")
 
-    def check_files(self) -> None:
+    def check_files(self, load) -> None:
         """Every named cell scene exists, is valid and is of kind ``cell``.
 
         The cells of ``[strength]`` and ``[two_scale]`` are solved, so they
@@ -319,7 +305,6 @@ class MacroScene:
         ``interface.cell = 'hip.toml': invalid cell scene: materials.bone.nu = ...``.
         """
         import os
-        from ngcontact.scene.loader import load
         from ngcontact.scene.sections import resolve
         files = (("interface.cell", self.interface.cell, False),
                  ("strength.cell", self.strength.cell if self.strength else None, True),

@@ -222,9 +222,8 @@ class DirectScene:
             raise SceneError("study.band", st.band, "the band of the coarsest level covers both bodies; "
                              "take a smaller band or more periods")
 
-    def check_files(self) -> None:
+    def check_files(self, load) -> None:
         """The named cell scene must be a valid 2D conforming ``cell`` scene this kind can resolve."""
-        from ngcontact.scene.loader import load
         from ngcontact.scene.sections import resolve
         path = resolve(self, self.geometry.cell)
         try:

@@ -57,6 +57,7 @@ from ngcontact.fem import elasticity
 from ngcontact.laws import homogenized as il
 from ngcontact.coupling.cell_law import bundle_law
 from ngcontact.drivers import run_resolved as drv
+from ngcontact.output import plots
 from ngcontact.geometry.profiles import profile_cell
 from ngcontact.errors import SceneError
 from ngcontact.geometry.resolved_bodies import scaled_profile
@@ -366,53 +367,4 @@ def run_study(scene, periods=None, *, laws=LAWS, clock=None) -> Outcome:
     table = (header, [[r[k] for k in header] for r in rows])
     return Outcome(results=results, ndof=max(r["ndof_resolved"] for r in rows),
                    tables={"epsilon": table},
-                   plots={"epsilon": lambda path, rows=rows, laws=laws: plot(path, rows, laws)})
-
-
-def plot(path: str, rows: list, laws=LAWS) -> None:
-    """Error against ``eps`` (field and reaction) and cost against ``eps``."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    eps = np.array([r["eps"] for r in rows])
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
-    for name, color in zip(laws, ("C0", "C1", "C2")):
-        ax[0].loglog(eps, [r[f"{name}_field"] for r in rows], "o-", color=color, label=f"{name}: field")
-        ax[0].loglog(eps, [r[f"{name}_reaction"] for r in rows], "s--", color=color, label=f"{name}: reaction")
-    ax[0].loglog(eps, eps / eps[0] * rows[0]["bundle_field"], "k:", label="slope 1")
-    ax[0].axhline(0.01, color="gray", lw=0.8)
-    ax[0].set_xlabel("eps [m]")
-    ax[0].set_ylabel("relative error against the resolved solution")
-    ax[0].legend(fontsize=7)
-    ax[1].loglog(eps, [r["time_resolved"] for r in rows], "o-", label="resolved")
-    ax[1].loglog(eps, [r["time_homogenized"] for r in rows], "s-", label="homogenized (bundle)")
-    ax[1].set_xlabel("eps [m]")
-    ax[1].set_ylabel("wall time [s]")
-    ax[1].legend(fontsize=8)
-    for a in ax:
-        a.grid(alpha=0.3, which="both")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def epsilon_report(scene, periods=None, clock=None) -> tuple[dict, object]:
-    """The study as a report dictionary and its outcome (``ngcontact study epsilon``); no file I/O.
-
-    Raises
-    ------
-    SceneError
-        The scene is not a ``direct`` scene with a ``[study]`` section, or
-        its band leaves no points for the field error.
-    """
-    from ngcontact import __version__
-    from ngcontact.scene import loader as scene_mod
-    from ngcontact.output.report import Clock, build_report
-    if scene.kind != "direct" or getattr(scene, "study", None) is None:
-        raise SceneError("kind", scene.kind, "the epsilon study needs a 'direct' scene with a [study] section")
-    clock = clock or Clock(None)
-    outcome = run_study(scene, periods, clock=clock)
-    report = build_report(kind="direct-epsilon-study", title=scene.title, scene=scene_mod.as_dict(scene),
-                          effects=scene_mod.effects(scene), outcome=outcome, timings=clock.total(),
-                          version=__version__)
-    return report, outcome
+                   plots={"epsilon": lambda path, rows=rows, laws=laws: plots.epsilon_study(path, rows, laws)})
