@@ -147,7 +147,7 @@ def test_block_under_small_shear_sticks_with_slip_below_the_width():
 
 def test_block_dragged_beyond_the_limit_slides_with_reaction_mu_N():
     """Top dragged by 500 w (T would exceed mu N): everything slips, tangential reaction = mu N."""
-    drag = (M.Support(label="top", components=("x",), displacement=(500 * WIDTH,)),)
+    drag = (M.Support(label="top", components=("x",), value=(500 * WIDTH,)),)
     sol = _block(top_support=drag)
     prof = M.interface_profile(sol)
     assert set(prof["status"]) == {"slip"}

@@ -109,7 +109,7 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
     problem = M.MacroProblem(
         mesh=geometry.mesh, setting=scene.geometry.setting, rough=rough, counter=counter, materials=mats,
         law=law, gap=gap_of(scene), order=order or scene.discretization.order,
-        supports=tuple(M.Support(label=s.boundary, components=s.components, displacement=s.displacement)
+        supports=tuple(M.Support(label=s.boundary, components=s.components, value=s.displacement)
                        for s in scene.supports),
         loads=tuple(M.Load(label=lo.boundary, pressure=lo.pressure, traction=lo.traction) for lo in scene.loads))
     return problem, info

@@ -50,41 +50,15 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.fem import elasticity
+from ngcontact.fem import two_body
 from ngcontact.fem.elasticity import COMPONENTS
+from ngcontact.fem.two_body import Load, Support, boundary_labels, interface_normal  # noqa: F401  (public names of the macro problem)
 from ngcontact.laws import homogenized as il
 from ngcontact.fem.materials import von_mises
 from ngcontact.solvers.newton import minimize
 
 log = logging.getLogger(__name__)
 
-
-
-@dataclass(frozen=True, kw_only=True)
-class Support:
-    """Prescribed displacement components on a boundary.
-
-    Attributes
-    ----------
-    label
-        Boundary label.
-    components
-        Names from ``COMPONENTS[setting]`` (``("r",)`` on an axis); empty: all.
-    displacement
-        Prescribed values, one per listed component (default zeros).
-    """
-
-    label: str
-    components: tuple = ()
-    displacement: tuple = ()
-
-
-@dataclass(frozen=True, kw_only=True)
-class Load:
-    """Surface load on a boundary: ``pressure`` (positive pushes inward) plus ``traction``."""
-
-    label: str
-    pressure: float = 0.0
-    traction: tuple = ()
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -147,93 +121,13 @@ class MacroSolution:
 
 
 # ------------------------------------------------------------- checks
-def boundary_labels(mesh) -> list:
-    """Boundary labels present in ``mesh`` (sorted)."""
-    return sorted(set(mesh.GetBoundaries()) - {""})
-
-
 def check_problem(problem: MacroProblem) -> None:
     """Reject labels, regions and components that do not exist (ValueError naming them)."""
-    mesh = problem.mesh
-    labels = boundary_labels(mesh)
-    regions = set(mesh.GetMaterials())
-    for role in ("rough", "counter"):
-        name = getattr(problem, role)
-        if name not in regions:
-            raise ValueError(f"{role} = {name!r}: no such region; regions are {', '.join(sorted(regions))}")
-    if problem.interface not in labels:
-        raise ValueError(f"interface = {problem.interface!r}: no such boundary; labels are {', '.join(labels)}")
-    comps = COMPONENTS[problem.setting]
-    for item in tuple(problem.supports) + tuple(problem.loads):
-        if item.label not in labels:
-            raise ValueError(f"boundary {item.label!r} does not exist; labels are {', '.join(labels)}")
-    for s in problem.supports:
-        bad = [c for c in s.components if c not in comps]
-        if bad:
-            raise ValueError(f"support on {s.label!r}: component {bad[0]!r}; allowed {', '.join(comps)}")
-        if s.displacement and len(s.displacement) != len(s.components or comps):
-            raise ValueError(f"support on {s.label!r}: give one displacement per component")
-
-
-# ------------------------------------------------------------- frame
-def interface_normal(mesh, rough: str, label: str = "interface"):
-    """Unit normal ``n0`` on ``label``, pointing out of the region ``rough``.
-
-    The mesh normal ``specialcf.normal`` of each boundary element is flipped
-    where it points towards the adjacent ``rough`` element's centroid; the
-    signs live in a piecewise constant ``SurfaceL2`` function.
-    """
-    dim = mesh.dim
-    region = mesh.Boundaries(label)
-    mid_rule = ng.IntegrationRule([(1 / 3, 1 / 3)] if dim == 3 else [(0.5,)], [1.0])
-    mips = mesh.MapToAllElements(mid_rule, region)
-    xyz = ng.CF((ng.x, ng.y, ng.z)[:dim])
-    mids = np.asarray(xyz(mips)).reshape(-1, dim)
-    normals = np.asarray(ng.specialcf.normal(dim)(mips)).reshape(-1, dim)
-    space = ng.SurfaceL2(mesh, order=0, definedon=region)
-    sign = ng.GridFunction(space)
-    values = sign.vec.FV().NumPy()
-    elements = [el for el in mesh.Elements(ng.BND) if el.mat == label]
-    if len(elements) != len(mids):
-        raise RuntimeError("interface elements and mapped points do not match")
-    for k, el in enumerate(elements):
-        facet = el.faces[0] if dim == 3 else el.edges[0]
-        vols = [mesh[e] for e in mesh[facet].elements]
-        side = [v for v in vols if v.mat == rough]
-        if len(side) != 1 or len(vols) != 2:
-            raise ValueError(f"interface element {k} does not separate {rough!r} from another region")
-        centroid = np.mean([mesh[v].point for v in side[0].vertices], axis=0)[:dim]
-        away = mids[k] - centroid
-        values[space.GetDofNrs(el)[0]] = 1.0 if np.dot(normals[k], away) > 0 else -1.0
-    n = ng.specialcf.normal(dim)
-    return sign * n
+    two_body.check_labels(problem.mesh, problem.setting, problem.interface, problem.supports, problem.loads,
+                          regions=(("rough", problem.rough), ("counter", problem.counter)))
 
 
 # ------------------------------------------------------------- model
-def _spaces(problem: MacroProblem):
-    mesh = problem.mesh
-    comps = COMPONENTS[problem.setting]
-    fixed = {c: [] for c in comps}
-    for s in problem.supports:
-        for c in (s.components or comps):
-            fixed[c].append(s.label)
-    kw = {f"dirichlet{'xyz'[i]}": "|".join(fixed[c]) for i, c in enumerate(comps) if fixed[c]}
-    spaces = [ng.VectorH1(mesh, order=problem.order, definedon=mesh.Materials(name), **kw)
-              for name in (problem.rough, problem.counter)]
-    return ng.FESpace(spaces)
-
-
-def _set_dirichlet(problem: MacroProblem, gfu) -> None:
-    comps = COMPONENTS[problem.setting]
-    for s in problem.supports:
-        if not s.displacement or not any(s.displacement):
-            continue
-        listed = s.components or comps
-        vec = ng.CF(tuple(float(s.displacement[listed.index(c)]) if c in listed else 0.0 for c in comps))
-        for gf in gfu.components:
-            gf.Set(vec, definedon=problem.mesh.Boundaries(s.label))
-
-
 def _local(frame, J) -> list:
     return [ng.InnerProduct(J, e) for e in frame]
 
@@ -266,25 +160,7 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
     else:
         W = il.energy(law, a, g0, G)
     form += ng.Variation(W * w * ng.ds(definedon=mesh.Boundaries(problem.interface)))
-    return add_load_potential(form, mesh, problem.loads, (ur, uc), w)
-
-
-def add_load_potential(form, mesh, loads, displacements, weight):
-    """Add ``-int t . u w ds`` of every surface load to a ``Variation`` form.
-
-    ``t = -p n + traction`` with ``n`` the outer normal of the loaded
-    boundary (a pressure ``p > 0`` pushes into the body).  Each body's
-    displacement is defined on its own region only, so summing over
-    ``displacements`` picks the body that owns the boundary.
-    """
-    n = ng.specialcf.normal(mesh.dim)
-    for load in loads:
-        t = -float(load.pressure) * n
-        if load.traction:
-            t = t + ng.CF(tuple(float(c) for c in load.traction))
-        work = sum(ng.InnerProduct(t, u.Trace()) for u in displacements)
-        form += ng.Variation(-work * weight * ng.ds(definedon=mesh.Boundaries(load.label)))
-    return form
+    return two_body.add_load_potential(form, mesh, problem.loads, (ur, uc), w)
 
 
 def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
@@ -313,10 +189,11 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
 
     check_problem(problem)
     mesh = problem.mesh
-    fes = _spaces(problem)
+    fes = two_body.spaces(mesh, problem.setting, (problem.rough, problem.counter), problem.supports,
+                          problem.order)
     gfu = ng.GridFunction(fes)
-    _set_dirichlet(problem, gfu)
-    n0 = interface_normal(mesh, problem.rough, problem.interface)
+    two_body.set_dirichlet(mesh, problem.setting, problem.supports, gfu)
+    n0 = two_body.interface_normal(mesh, problem.rough, problem.interface)
     frame = il.local_frame(n0, mesh.dim)
     law = problem.law
     newton = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)

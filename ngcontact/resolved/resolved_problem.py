@@ -46,29 +46,14 @@ from ngcontact.laws import penalty as _contact
 from ngcontact.fem import elasticity
 from ngcontact.laws import homogenized as il
 from ngcontact.errors import ConvergenceError
-from ngcontact.macro.macro_problem import add_load_potential, interface_normal
+from ngcontact.fem import two_body
+from ngcontact.fem.elasticity import COMPONENTS
+from ngcontact.fem.two_body import Load, Support, interface_normal  # noqa: F401  (public names of the resolved problem)
 from ngcontact.solvers.newton import minimize
 
 log = logging.getLogger(__name__)
 
-COMPONENTS = {"plane_strain": ("x", "y"), "axisymmetric": ("r", "z")}
-
-
-@dataclass(frozen=True, kw_only=True)
-class Support:
-    """Prescribed displacement components on a boundary.
-
-    ``value[i]`` is prescribed for ``components[i]`` (all components when
-    empty), plus ``slope[i] * (s - s_mid)`` where ``s`` is the coordinate
-    along ``along`` (``"x"`` or ``"y"``) and ``s_mid`` the mid-point of the
-    boundary in that coordinate: a linear variation (a tilt of a face).
-    """
-
-    label: str
-    components: tuple = ()
-    value: tuple = ()
-    slope: tuple = ()
-    along: str = "x"
+SETTINGS = ("plane_strain", "axisymmetric")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -154,59 +139,6 @@ class DirectSolution:
 
 
 # ------------------------------------------------------------------ model
-def _spaces(problem: DirectProblem):
-    """Compound space of the two bodies with the Dirichlet flags of the supports.
-
-    Labels fixed in every component use ``dirichlet``, the others the
-    component-wise flags; ``Periodic`` keeps only the former (NGSolve drops
-    component-wise flags when it wraps the space), so a periodic problem
-    accepts only supports that fix every component.
-    """
-    mesh = problem.mesh
-    comps = COMPONENTS[problem.setting]
-    full, partial = [], {c: [] for c in comps}
-    for s in problem.supports:
-        if not s.components or set(s.components) == set(comps):
-            full.append(s.label)
-        else:
-            if problem.periodic:
-                raise ValueError(f"support on {s.label!r}: a periodic problem takes supports that fix "
-                                 "every component")
-            for c in s.components:
-                partial[c].append(s.label)
-    kw = {f"dirichlet{'xyz'[i]}": "|".join(partial[c] + full) for i, c in enumerate(comps) if partial[c]}
-    if full:
-        kw["dirichlet"] = "|".join(full)
-    spaces = []
-    for name in ("rough", "counter"):
-        V = ng.VectorH1(mesh, order=problem.order, definedon=mesh.Materials(name), **kw)
-        spaces.append(ng.Periodic(V) if problem.periodic else V)
-    return ng.FESpace(spaces)
-
-
-def _boundary_mid(mesh, label: str, axis: int) -> float:
-    """Mid-point of a boundary's extent along a coordinate axis."""
-    coords = [mesh[v].point[axis] for el in mesh.Elements(ng.BND) if el.mat == label for v in el.vertices]
-    return 0.5 * (min(coords) + max(coords))
-
-
-def _set_dirichlet(problem: DirectProblem, gfu) -> None:
-    mesh = problem.mesh
-    comps = COMPONENTS[problem.setting]
-    for s in problem.supports:
-        listed = s.components or comps
-        value = tuple(s.value) or (0.0,) * len(listed)
-        slope = tuple(s.slope) or (0.0,) * len(listed)
-        if not any(value) and not any(slope):
-            continue
-        axis = 0 if s.along == "x" else 1
-        coord = (ng.x, ng.y)[axis] - _boundary_mid(mesh, s.label, axis)
-        vec = ng.CF(tuple(float(value[listed.index(c)]) + float(slope[listed.index(c)]) * coord
-                          if c in listed else 0.0 for c in comps))
-        for gf in gfu.components:
-            gf.Set(vec, definedon=mesh.Boundaries(s.label))
-
-
 def _form(problem: DirectProblem, fes, n, *, threshold=None, surrogate: bool = False):
     """The energy as a symmetric ``BilinearForm`` of ``Variation`` terms.
 
@@ -240,14 +172,14 @@ def _form(problem: DirectProblem, fes, n, *, threshold=None, surrogate: bool = F
                                         friction=None if fr is None else fr.law,
                                         w=None if fr is None else fr.w, threshold=threshold)
     form += ng.Variation(psi * w * ng.ds(definedon=mesh.Boundaries(problem.contact)))
-    return add_load_potential(form, mesh, problem.loads, (ur, uc), w)
+    return two_body.add_load_potential(form, mesh, problem.loads, (ur, uc), w)
 
 
 def _check(problem: DirectProblem) -> None:
     mesh = problem.mesh
     labels = set(mesh.GetBoundaries())
-    if problem.setting not in COMPONENTS:
-        raise ValueError(f"setting = {problem.setting!r}: must be one of {', '.join(COMPONENTS)}")
+    if problem.setting not in SETTINGS:
+        raise ValueError(f"setting = {problem.setting!r}: must be one of {', '.join(SETTINGS)}")
     if problem.contact not in labels:
         raise ValueError(f"the mesh has no boundary {problem.contact!r}")
     for item in tuple(problem.supports) + tuple(problem.loads):
@@ -283,10 +215,11 @@ def solve(problem: DirectProblem, *, rtol: float = 1e-10, atol: float = 0.0, max
     """
     _check(problem)
     mesh = problem.mesh
-    fes = _spaces(problem)
+    fes = two_body.spaces(mesh, problem.setting, ("rough", "counter"), problem.supports, problem.order,
+                          periodic=problem.periodic)
     gfu = ng.GridFunction(fes)
-    _set_dirichlet(problem, gfu)
-    n = interface_normal(mesh, "rough", problem.contact)
+    two_body.set_dirichlet(mesh, problem.setting, problem.supports, gfu)
+    n = two_body.interface_normal(mesh, "rough", problem.contact)
     newton = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
     history = {"newton": [], "coulomb_changes": []}
     start = _form(problem, fes, n, surrogate=True)
