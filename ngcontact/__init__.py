@@ -11,8 +11,8 @@ try:
 except PackageNotFoundError:  # running from a source tree
     __version__ = "0.1.0"
 
-from ngcontact.errors import ConvergenceError, NgcontactError, SceneError  # noqa: E402
+from ngcontact.errors import ConvergenceError, ModelError, NgcontactError, SceneError  # noqa: E402
 from ngcontact.scene.loader import load  # noqa: E402
 from ngcontact.runner import solve  # noqa: E402
 
-__all__ = ["ConvergenceError", "NgcontactError", "SceneError", "load", "solve", "__version__"]
+__all__ = ["ConvergenceError", "ModelError", "NgcontactError", "SceneError", "load", "solve", "__version__"]

@@ -20,7 +20,7 @@ import sys
 
 from ngcontact import __version__
 from ngcontact.scene import loader as scene_mod
-from ngcontact.errors import ConvergenceError, NgcontactError, OutputError, SceneError
+from ngcontact.errors import ConvergenceError, ModelError, NgcontactError, OutputError, SceneError
 
 EXIT_OK, EXIT_SCENE, EXIT_SOLVER = 0, 2, 3
 
@@ -135,6 +135,8 @@ def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, v
         write_outputs(out, report, outcome)
     except SceneError as exc:
         return _fail(EXIT_SCENE, f"{path}: {exc}")
+    except ModelError as exc:
+        return _fail(EXIT_SCENE, f"{path}: inadmissible model input: {exc}")
     except OutputError as exc:
         return _fail(EXIT_SCENE, str(exc))
     except ConvergenceError as exc:

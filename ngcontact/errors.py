@@ -49,6 +49,16 @@ class ConvergenceError(NgcontactError):
         super().__init__(message)
 
 
+class ModelError(NgcontactError, ValueError):
+    """Physically inadmissible input met by the model code (not a solver failure).
+
+    Raised by the numerics (materials, laws, problems) with the name of the
+    quantity, its value and what is allowed; a ``ValueError`` as well, so
+    that the scene layer can translate it into a :class:`SceneError` with
+    the key path.  The command line maps it to exit status 2.
+    """
+
+
 class OutputError(NgcontactError):
     """The output directory cannot be written."""
 

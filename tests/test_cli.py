@@ -189,3 +189,19 @@ def test_unexpected_error_is_one_line_exit_3_and_no_output(tmp_path, monkeypatch
     assert not out.exists()
     with pytest.raises(RuntimeError, match="mesher exploded"):
         cli.main(["--debug", "run", scene_path, "--out", str(out)])
+
+
+def test_inadmissible_model_input_exits_2_with_the_quantity(scene_file, tmp_path, monkeypatch, capsys):
+    """A ModelError from the numerics is bad input (exit 2, one line naming the quantity), not a solver failure."""
+    from ngcontact.drivers import run_manufactured as driver
+    from ngcontact.fem.materials import isotropic
+
+    def inadmissible(scene, clock):
+        isotropic(E=-1.0, nu=0.3)
+
+    monkeypatch.setattr(driver, "run", inadmissible)
+    out = tmp_path / "out"
+    assert cli.main(["run", str(scene_file), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].endswith("inadmissible model input: E = -1.0: must be > 0"), err
+    assert not out.exists()

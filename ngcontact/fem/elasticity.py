@@ -27,6 +27,7 @@ from math import pi
 import ngsolve as ng
 
 from ngcontact.fem.materials import ElasticLaw
+from ngcontact.errors import ModelError
 
 SETTINGS = ("plane_strain", "axisymmetric", "3d")
 #: displacement components per setting, in the order of the mesh axes
@@ -41,7 +42,7 @@ def dimension(setting: str) -> int:
 
 def _check_setting(setting: str) -> None:
     if setting not in SETTINGS:
-        raise ValueError(f"setting = {setting!r}: must be one of {', '.join(SETTINGS)}")
+        raise ModelError(f"setting = {setting!r}: must be one of {', '.join(SETTINGS)}")
 
 
 def strain(u, setting: str):
@@ -103,7 +104,7 @@ def bilinear_integrand(law: ElasticLaw, u, v, setting: str):
 def body_space(mesh, body: str, order: int, dirichlet: str = "", periodic: bool = False):
     """``VectorH1`` of order ``order`` on region ``body`` (optionally periodic)."""
     if order < 1:
-        raise ValueError(f"order = {order!r}: must be >= 1")
+        raise ModelError(f"order = {order!r}: must be >= 1")
     V = ng.VectorH1(mesh, order=order, definedon=mesh.Materials(body), dirichlet=dirichlet)
     return ng.Periodic(V) if periodic else V
 

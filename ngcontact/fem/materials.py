@@ -19,6 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from ngcontact.errors import ModelError
 
 VOIGT_PAIRS = ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))
 
@@ -54,9 +55,9 @@ class ElasticLaw:
 def isotropic(E: float, nu: float) -> ElasticLaw:
     """Isotropic law from Young's modulus ``E > 0`` and ``-1 < nu < 0.5``."""
     if not E > 0:
-        raise ValueError(f"E = {E!r}: must be > 0")
+        raise ModelError(f"E = {E!r}: must be > 0")
     if not -1.0 < nu < 0.5:
-        raise ValueError(f"nu = {nu!r}: must lie in (-1, 0.5)")
+        raise ModelError(f"nu = {nu!r}: must lie in (-1, 0.5)")
     lam = E * nu / ((1 + nu) * (1 - 2 * nu))
     mu = E / (2 * (1 + nu))
     C = np.zeros((6, 6))
@@ -70,13 +71,13 @@ def anisotropic(C) -> ElasticLaw:
     """General law from a 6x6 Voigt matrix; must be symmetric positive definite."""
     C = np.asarray(C, dtype=float)
     if C.shape != (6, 6):
-        raise ValueError(f"C has shape {C.shape}: must be 6x6")
+        raise ModelError(f"C has shape {C.shape}: must be 6x6")
     if not np.all(np.isfinite(C)):
-        raise ValueError("C must hold finite numbers")
+        raise ModelError("C must hold finite numbers")
     if not np.allclose(C, C.T, rtol=1e-12, atol=1e-12 * np.abs(C).max()):
-        raise ValueError("C must be symmetric")
+        raise ModelError("C must be symmetric")
     if np.linalg.eigvalsh(C).min() <= 0:
-        raise ValueError("C must be positive definite")
+        raise ModelError("C must be positive definite")
     return ElasticLaw(voigt=_freeze(C))
 
 

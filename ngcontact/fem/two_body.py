@@ -27,6 +27,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.fem.elasticity import COMPONENTS
+from ngcontact.errors import ModelError
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -67,19 +68,19 @@ def check_labels(mesh, setting: str, interface: str, supports, loads, regions=()
     present = set(mesh.GetMaterials())
     for role, name in regions:
         if name not in present:
-            raise ValueError(f"{role} = {name!r}: no such region; regions are {', '.join(sorted(present))}")
+            raise ModelError(f"{role} = {name!r}: no such region; regions are {', '.join(sorted(present))}")
     if interface not in labels:
-        raise ValueError(f"interface = {interface!r}: no such boundary; labels are {', '.join(labels)}")
+        raise ModelError(f"interface = {interface!r}: no such boundary; labels are {', '.join(labels)}")
     comps = COMPONENTS[setting]
     for item in tuple(supports) + tuple(loads):
         if item.label not in labels:
-            raise ValueError(f"boundary {item.label!r} does not exist; labels are {', '.join(labels)}")
+            raise ModelError(f"boundary {item.label!r} does not exist; labels are {', '.join(labels)}")
     for s in supports:
         bad = [c for c in s.components if c not in comps]
         if bad:
-            raise ValueError(f"support on {s.label!r}: component {bad[0]!r}; allowed {', '.join(comps)}")
+            raise ModelError(f"support on {s.label!r}: component {bad[0]!r}; allowed {', '.join(comps)}")
         if s.value and len(s.value) != len(s.components or comps):
-            raise ValueError(f"support on {s.label!r}: give one displacement per component")
+            raise ModelError(f"support on {s.label!r}: give one displacement per component")
 
 
 def spaces(mesh, setting: str, regions: tuple[str, str], supports, order: int, periodic: bool = False):
@@ -97,7 +98,7 @@ def spaces(mesh, setting: str, regions: tuple[str, str], supports, order: int, p
             full.append(s.label)
         else:
             if periodic:
-                raise ValueError(f"support on {s.label!r}: a periodic problem takes supports that fix "
+                raise ModelError(f"support on {s.label!r}: a periodic problem takes supports that fix "
                                  "every component")
             for c in s.components:
                 partial[c].append(s.label)
@@ -180,7 +181,7 @@ def interface_normal(mesh, rough: str, label: str = "interface"):
         vols = [mesh[e] for e in mesh[facet].elements]
         side = [v for v in vols if v.mat == rough]
         if len(side) != 1 or len(vols) != 2:
-            raise ValueError(f"interface element {k} does not separate {rough!r} from another region")
+            raise ModelError(f"interface element {k} does not separate {rough!r} from another region")
         centroid = np.mean([mesh[v].point for v in side[0].vertices], axis=0)[:dim]
         away = mids[k] - centroid
         values[space.GetDofNrs(el)[0]] = 1.0 if np.dot(normals[k], away) > 0 else -1.0

@@ -66,6 +66,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from ngcontact.errors import ModelError
 
 
 # ------------------------------------------------------------------ laws
@@ -88,7 +89,7 @@ class LinearLaw:
 
     def __post_init__(self):
         if not self.kn > 0 or self.kt < 0 or self.kn * self.kt < self.knt ** 2:
-            raise ValueError(f"K0 = [[{self.kn}, {self.knt}], [{self.knt}, {self.kt}]]: "
+            raise ModelError(f"K0 = [[{self.kn}, {self.knt}], [{self.knt}, {self.kt}]]: "
                              "must be positive semidefinite with k_n0 > 0")
 
     def matrix(self, dim: int) -> np.ndarray:
@@ -126,14 +127,14 @@ class BundleLaw:
         w = np.asarray(self.weights, float)
         d = np.asarray(self.directions, float)
         if w.ndim != 1 or len(w) == 0 or np.any(w <= 0):
-            raise ValueError("weights must be a non-empty list of numbers > 0")
+            raise ModelError("weights must be a non-empty list of numbers > 0")
         if d.shape[0] != len(w) or d.ndim != 2 or d.shape[1] not in (2, 3):
-            raise ValueError(f"directions must be {len(w)} vectors of 2 or 3 components")
+            raise ModelError(f"directions must be {len(w)} vectors of 2 or 3 components")
         norms = np.linalg.norm(d, axis=1)
         if np.any(norms <= 0) or np.any(norms > 1 + 1e-9):
-            raise ValueError("directions must be unit vectors (or their projections on a 2D frame)")
+            raise ModelError("directions must be unit vectors (or their projections on a 2D frame)")
         if self.gaps and len(self.gaps) != len(w):
-            raise ValueError(f"gaps must have {len(w)} entries (one per direction)")
+            raise ModelError(f"gaps must have {len(w)} entries (one per direction)")
 
     @property
     def g(self) -> np.ndarray:
@@ -182,17 +183,17 @@ class TabulatedLaw:
         c = np.asarray(self.closure, float)
         p = np.asarray(self.pressure, float)
         if c.ndim != 1 or len(c) < 2 or len(p) != len(c):
-            raise ValueError("closure and pressure must be lists of the same length >= 2")
+            raise ModelError("closure and pressure must be lists of the same length >= 2")
         if np.any(np.diff(c) <= 0):
-            raise ValueError("closure must be strictly increasing")
+            raise ModelError("closure must be strictly increasing")
         if np.any(np.diff(p) < 0):
-            raise ValueError("pressure must be non-decreasing (a monotone law has a convex energy)")
+            raise ModelError("pressure must be non-decreasing (a monotone law has a convex energy)")
         if p[0] != 0.0:
-            raise ValueError("the first pressure must be 0 (contact starts there)")
+            raise ModelError("the first pressure must be 0 (contact starts there)")
         if np.all(p == 0):
-            raise ValueError("the table carries no pressure")
+            raise ModelError("the table carries no pressure")
         if self.kt < 0:
-            raise ValueError("kt must be >= 0")
+            raise ModelError("kt must be >= 0")
 
     def ramps(self) -> tuple[np.ndarray, np.ndarray]:
         """Kinks ``c_i`` and slope increments ``s_i`` of ``p(c) = sum s_i [c - c_i]_+``."""
@@ -229,7 +230,7 @@ class Friction:
 
     def __post_init__(self):
         if self.mu < 0 or self.threshold < 0 or not self.width > 0:
-            raise ValueError("need mu >= 0, threshold >= 0, width > 0")
+            raise ModelError("need mu >= 0, threshold >= 0, width > 0")
 
     @property
     def coulomb(self) -> bool:
@@ -256,7 +257,7 @@ class FieldLaw:
 
     def __post_init__(self):
         if not self.stiffness > 0:
-            raise ValueError(f"stiffness = {self.stiffness!r}: must be > 0")
+            raise ModelError(f"stiffness = {self.stiffness!r}: must be > 0")
 
 
 NormalLaw = LinearLaw | BundleLaw | TabulatedLaw | FieldLaw
@@ -288,7 +289,7 @@ def normal_law(law: str, *, kn=None, kt: float = 0.0, knt: float = 0.0, gap_forc
         return BundleLaw(weights=weights, directions=directions, gaps=gaps or ())
     if law == "tabulated":
         return TabulatedLaw(closure=closure, pressure=pressure, kt=kt)
-    raise ValueError(f"law {law!r}: must be 'linear', 'bundle' or 'tabulated'")
+    raise ModelError(f"law {law!r}: must be 'linear', 'bundle' or 'tabulated'")
 
 
 def linearized(law: BundleLaw) -> LinearLaw:
@@ -301,7 +302,7 @@ def linearized(law: BundleLaw) -> LinearLaw:
     gf = np.einsum("q,q,qi->i", np.asarray(law.weights, float), law.g, np.asarray(law.directions, float))
     if K.shape[0] == 3 and (abs(K[1, 1] - K[2, 2]) > 1e-12 * K[0, 0] or abs(K[0, 2]) > 1e-12 * K[0, 0]
                             or abs(K[1, 2]) > 1e-12 * K[0, 0]):
-        raise ValueError("a 3D bundle is linearized to a LinearLaw only if transversely isotropic")
+        raise ModelError("a 3D bundle is linearized to a LinearLaw only if transversely isotropic")
     return LinearLaw(kn=float(K[0, 0]), kt=float(K[1, 1]), knt=float(K[0, 1]),
                      gap_force=(float(gf[0]), float(gf[1])))
 
@@ -468,7 +469,7 @@ def _dot(n, a):
 
 def _check_dim(law: BundleLaw, dim: int) -> None:
     if len(law.directions[0]) != dim:
-        raise ValueError(f"the bundle's directions have {len(law.directions[0])} components, "
+        raise ModelError(f"the bundle's directions have {len(law.directions[0])} components, "
                          f"the interface frame {dim}")
 
 

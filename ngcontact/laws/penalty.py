@@ -40,6 +40,7 @@ assembles no friction term, a problem without gap no gap.
 from __future__ import annotations
 
 import ngsolve as ng
+from ngcontact.errors import ModelError
 
 
 def positive_part(s):
@@ -149,7 +150,7 @@ def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=No
     if friction is None:
         return energy
     if friction not in ("tresca", "coulomb"):
-        raise ValueError(f"friction = {friction!r}: must be None, 'tresca' or 'coulomb'")
+        raise ModelError(f"friction = {friction!r}: must be None, 'tresca' or 'coulomb'")
     if w is None or threshold is None:
-        raise ValueError("friction needs a width w and a threshold")
+        raise ModelError("friction needs a width w and a threshold")
     return energy + tresca_energy(J, n, threshold, w)

@@ -56,6 +56,7 @@ from ngcontact.fem.two_body import Load, Support, boundary_labels, interface_nor
 from ngcontact.laws import homogenized as il
 from ngcontact.fem.materials import von_mises
 from ngcontact.solvers.newton import minimize
+from ngcontact.errors import ModelError
 
 log = logging.getLogger(__name__)
 
@@ -373,7 +374,7 @@ def interface_profile(sol: MacroSolution, points_per_element: int = 5) -> dict:
     p = sol.problem
     mesh = p.mesh
     if mesh.dim != 2:
-        raise ValueError("an interface profile needs a 2D or axisymmetric mesh")
+        raise ModelError("an interface profile needs a 2D or axisymmetric mesh")
     k = max(2, int(points_per_element))
     rule = ng.IntegrationRule([(t,) for t in np.linspace(0.0, 1.0, k)], [0.0] * k)
     mips = mesh.MapToAllElements(rule, mesh.Boundaries(p.interface))
@@ -476,7 +477,7 @@ def piecewise_linear(coordinate, points):
     if len(xs) == 1:
         return ng.CF(float(ys[0]))
     if np.any(np.diff(xs) <= 0):
-        raise ValueError("the abscissae of a piecewise linear table must increase strictly")
+        raise ModelError("the abscissae of a piecewise linear table must increase strictly")
     slopes = np.diff(ys) / np.diff(xs)
     incr = np.diff(np.concatenate([[0.0], slopes, [0.0]]))
     f = ng.CF(float(ys[0]))

@@ -50,6 +50,7 @@ from ngcontact.fem import two_body
 from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.fem.two_body import Load, Support, interface_normal  # noqa: F401  (public names of the resolved problem)
 from ngcontact.solvers.newton import minimize
+from ngcontact.errors import ModelError
 
 log = logging.getLogger(__name__)
 
@@ -179,18 +180,18 @@ def _check(problem: DirectProblem) -> None:
     mesh = problem.mesh
     labels = set(mesh.GetBoundaries())
     if problem.setting not in SETTINGS:
-        raise ValueError(f"setting = {problem.setting!r}: must be one of {', '.join(SETTINGS)}")
+        raise ModelError(f"setting = {problem.setting!r}: must be one of {', '.join(SETTINGS)}")
     if problem.contact not in labels:
-        raise ValueError(f"the mesh has no boundary {problem.contact!r}")
+        raise ModelError(f"the mesh has no boundary {problem.contact!r}")
     for item in tuple(problem.supports) + tuple(problem.loads):
         if item.label not in labels:
-            raise ValueError(f"boundary {item.label!r} does not exist; labels are "
+            raise ModelError(f"boundary {item.label!r} does not exist; labels are "
                              + ", ".join(sorted(labels - {""})))
     if not problem.k_n > 0:
-        raise ValueError(f"k_n = {problem.k_n!r}: must be > 0")
+        raise ModelError(f"k_n = {problem.k_n!r}: must be > 0")
     law = problem.law
     if law is not None and law.friction is not None and law.friction.coulomb:
-        raise ValueError("a homogenized law with Coulomb friction is solved by ngcontact.macro.solve")
+        raise ModelError("a homogenized law with Coulomb friction is solved by ngcontact.macro.solve")
 
 
 def solve(problem: DirectProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
