@@ -84,12 +84,19 @@ Penalty bar against a wall
     bar and layer are springs in series,
 
         F = (d - g0) / (L/(E A) + 1/(k A))    for d > g0, else 0.
+
+Inadmissible arguments (a modulus <= 0, Poisson's ratio outside (-1, 0.5),
+radii out of order, a negative pressure) raise
+:class:`ngcontact.errors.ModelError` naming the argument, its value and what
+is allowed.
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
+
+from ngcontact.errors import ModelError
 
 __all__ = [
     "e_star",
@@ -111,17 +118,17 @@ __all__ = [
 
 def _positive(name: str, value: float) -> None:
     if not value > 0:
-        raise ValueError(f"{name} = {value!r}: must be > 0")
+        raise ModelError(f"{name} = {value!r}: must be > 0")
 
 
 def _nonnegative(name: str, value: float) -> None:
     if not value >= 0:
-        raise ValueError(f"{name} = {value!r}: must be >= 0")
+        raise ModelError(f"{name} = {value!r}: must be >= 0")
 
 
 def _poisson(name: str, value: float) -> None:
     if not -1.0 < value < 0.5:
-        raise ValueError(f"{name} = {value!r}: must lie in (-1, 0.5)")
+        raise ModelError(f"{name} = {value!r}: must lie in (-1, 0.5)")
 
 
 def _out(value):
@@ -153,7 +160,7 @@ def e_star(E1: float, nu1: float, E2: float | None = None, nu2: float | None = N
     if E2 is not None and not math.isinf(E2):
         _positive("E2", E2)
         if nu2 is None:
-            raise ValueError("nu2 = None: give Poisson's ratio of the second body with E2 (or E2 = None: rigid)")
+            raise ModelError("nu2 = None: give Poisson's ratio of the second body with E2 (or E2 = None: rigid)")
         _poisson("nu2", nu2)
         compliance += (1.0 - nu2 ** 2) / E2
     return 1.0 / compliance
@@ -356,7 +363,7 @@ def lame_radial_displacement(r, r_in: float, r_out: float, E: float, nu: float,
     """
     _nonnegative("r_in", r_in)
     if not r_out > r_in:
-        raise ValueError(f"r_out = {r_out!r}: must be > r_in = {r_in!r}")
+        raise ModelError(f"r_out = {r_out!r}: must be > r_in = {r_in!r}")
     _positive("E", E)
     _poisson("nu", nu)
     r = np.asarray(r, dtype=float)
@@ -394,7 +401,7 @@ def lame_press_fit_pressure(a: float, b: float, c: float, E_in: float, nu_in: fl
         of the two rings (:func:`lame_radial_displacement`).
     """
     if not 0 <= a < b < c:
-        raise ValueError(f"(a, b, c) = {(a, b, c)!r}: need 0 <= a < b < c")
+        raise ModelError(f"(a, b, c) = {(a, b, c)!r}: need 0 <= a < b < c")
     _positive("k_n", k_n)
     if interference <= 0:
         return 0.0
@@ -469,7 +476,7 @@ def laminate_stiffness(h1: float, E1: float, nu1: float, h2: float, E2: float, n
     _positive("k_n", k_n)
     _positive("k_t", k_t)
     if dim not in (2, 3):
-        raise ValueError(f"dim = {dim!r}: must be 2 or 3")
+        raise ModelError(f"dim = {dim!r}: must be 2 or 3")
     k_normal = 1.0 / (h1 / p_wave_modulus(E1, nu1) + h2 / p_wave_modulus(E2, nu2) + 1.0 / k_n)
     k_shear = 1.0 / (h1 / shear_modulus(E1, nu1) + h2 / shear_modulus(E2, nu2) + 1.0 / k_t)
     return np.diag([k_normal] + [k_shear] * (dim - 1))
