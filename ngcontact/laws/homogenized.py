@@ -67,6 +67,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from ngcontact.errors import ModelError
+from ngcontact.laws.huber import huber_of_square, huber_slope, is_numeric
 
 
 # ------------------------------------------------------------------ laws
@@ -308,40 +309,12 @@ def linearized(law: BundleLaw) -> LinearLaw:
 
 
 # -------------------------------------------------------------- backend
-def _is_numeric(*xs) -> bool:
-    return all(isinstance(x, (int, float, np.ndarray, np.floating, np.integer)) for x in xs)
-
-
 def _ramp(x):
     """``[x]_+``."""
-    if _is_numeric(x):
+    if is_numeric(x):
         return np.maximum(x, 0.0)
     import ngsolve as ng
     return ng.IfPos(x, x, 0.0)
-
-
-def _ifpos(c, a, b):
-    if _is_numeric(c, a, b):
-        return np.where(np.asarray(c) > 0, a, b)
-    import ngsolve as ng
-    return ng.IfPos(c, a, b)
-
-
-def _sqrt(x):
-    if _is_numeric(x):
-        return np.sqrt(x)
-    import ngsolve as ng
-    return ng.sqrt(x)
-
-
-def huber(s2, w):
-    """``huber(s, w)`` of ``s = sqrt(s2)``, written without ``sqrt`` near 0."""
-    return _ifpos(s2 - w * w, _sqrt(_ifpos(s2 - w * w, s2, w * w)) - w / 2, s2 / (2 * w))
-
-
-def huber_slope(s2, w):
-    """``huber'(s) / s``: tangential traction per unit slip vector."""
-    return _ifpos(s2 - w * w, 1.0 / _sqrt(_ifpos(s2 - w * w, s2, w * w)), 1.0 / w)
 
 
 # ----------------------------------------------------------- energies
@@ -423,7 +396,7 @@ def pressure(law: NormalLaw, a, g0=0.0):
 
 def friction_energy(friction: Friction, a, G):
     """``G huber(|a_t|, w)`` with the threshold field ``G`` given."""
-    return G * huber(_tangential_norm2(a), friction.width)
+    return G * huber_of_square(_tangential_norm2(a), friction.width)
 
 
 def friction_traction(friction: Friction, a, G) -> list:

@@ -40,6 +40,8 @@ assembles no friction term, a problem without gap no gap.
 from __future__ import annotations
 
 import ngsolve as ng
+
+from ngcontact.laws.huber import huber, huber_of_square  # noqa: F401  (huber: part of the micro law's API)
 from ngcontact.errors import ModelError
 
 
@@ -78,26 +80,6 @@ def normal_energy(J, n, k_n, gap=None):
 def tangential_slip(J, n):
     """``J_t = J - (J.n) n``, the tangential part of the jump."""
     return J - normal_closure(J, n) * n
-
-
-def huber_of_square(s2, w):
-    """``huber(sqrt(s2), w)`` written without a singular derivative.
-
-    Parameters
-    ----------
-    s2
-        The squared argument ``s^2 >= 0`` (a CoefficientFunction).
-    w
-        Width of the quadratic zone, ``w > 0``.
-    """
-    w2 = w * w
-    far = ng.sqrt(ng.IfPos(s2 - w2, s2, w2)) - 0.5 * w
-    return ng.IfPos(s2 - w2, far, s2 / (2.0 * w))
-
-
-def huber(s, w):
-    """``huber(s, w)`` of a nonnegative scalar ``s`` (for plots and checks)."""
-    return huber_of_square(s * s, w)
 
 
 def tresca_energy(J, n, G, w):
