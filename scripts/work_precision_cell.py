@@ -36,6 +36,7 @@ from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.fem.materials import isotropic
 from ngcontact.output.report import write_csv
+from ngcontact.verification.oracles import e_star, westergaard_contact_fraction, westergaard_p_star
 
 log = logging.getLogger("work_precision_cell")
 
@@ -52,8 +53,8 @@ KEYS = ("quantity", "study", "k_n", "order", "interface_maxh", "ndof", "value", 
 
 def westergaard(order: int, ih: float, kn: float) -> dict:
     """One Westergaard solve at ``p/p* = RATIO``; error of the contact fraction."""
-    pstar = math.pi * H_GAP / (2 * (1 - NU ** 2))
-    exact = 2 * math.asin(math.sqrt(RATIO)) / math.pi
+    pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H_GAP, 1.0)
+    exact = westergaard_contact_fraction(RATIO * pstar, pstar)
     t0 = time.perf_counter()
     cell = flat_cell(maxh=0.3, interface_maxh=ih, order=order)
     law = isotropic(1.0, NU)
