@@ -1,7 +1,7 @@
 """Interface law of a macro problem taken from a cell's contact surface, cached on disk.
 
-The cell's contact surface ``S_C`` becomes the unilateral direction bundle of
-DESIGN Sec. 3 (paper eqs. 31-33) through
+The cell's contact surface ``S_C`` becomes the unilateral direction bundle
+(paper eqs. 31-33) through
 :func:`ngcontact.homogenize.direction_bundle`: one direction per quadrature
 point, with weight ``w_q = k_n ds_q / |T|``, micro normal ``n_q`` in the
 cell's macro basis (``n0 = e_y, t0 = e_x``; 3D ``n0 = e_z, t1 = e_x,

@@ -4,7 +4,7 @@ A driver returns an :class:`Outcome` (plain data plus deferred writers); the
 functions here write it.  Writing is atomic: everything goes into a hidden
 temporary directory beside the target, which replaces the target only once
 every file is written, so a failed run leaves no partial output.  Reports
-never contain NaN or infinity: :func:`check_finite` rejects them before any
+never contain NaN or infinity: :func:`to_plain` rejects them before any
 file is written.
 
 Report keys (schema ``ngcontact-report/1``): ``schema``, ``version``,
@@ -49,7 +49,6 @@ class Outcome:
     results: dict
     ndof: int = 0
     solver: dict = field(default_factory=dict)
-    timings: dict = field(default_factory=dict)
     tables: dict = field(default_factory=dict)   # name -> (header, rows)
     vtk: dict = field(default_factory=dict)      # name -> VtkField
     plots: dict = field(default_factory=dict)    # name -> callable(path)
@@ -101,7 +100,6 @@ def to_plain(obj, path: str = "results"):
     raise TypeError(f"cannot write {type(obj).__name__} at {path} to JSON")
 
 
-check_finite = to_plain
 
 
 def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcome,

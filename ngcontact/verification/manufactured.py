@@ -419,12 +419,6 @@ def errors(prob: Problem, gfu: ng.GridFunction, bonus_intorder: int = 4) -> tupl
     return math.sqrt(max(l2, 0.0)), math.sqrt(max(h1, 0.0))
 
 
-def mesh_size(mesh: ng.Mesh) -> float:
-    """Mean element size ``(|Omega| / #elements)^(1/d)``."""
-    volume = ng.Integrate(ng.CF(1.0), mesh)
-    return (volume / mesh.ne) ** (1.0 / mesh.dim)
-
-
 def level_runner(setting: str, laws: dict, maxh: float, *, inverse: str = "sparsecholesky",
                  keep: dict | None = None):
     """A ``level(order, refinements) -> dict`` for :mod:`ngcontact.verification.rates`.
