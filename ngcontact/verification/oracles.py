@@ -2,7 +2,7 @@
 
 Pure NumPy: nothing here meshes or solves.  Lengths, stresses and stiffnesses
 are in any consistent set of units; pressures are **compression positive**,
-as in every report of the package (compression positive, ``1/E* = sum (1 - nu_i^2)/E_i``).
+as in every report of the package.
 
 Plane-strain contact modulus
     Two elastic bodies pressed together respond like one body of modulus
