@@ -10,15 +10,13 @@ stress per body with its location (see :mod:`ngcontact.cell.cell_problem`).
 from __future__ import annotations
 
 import logging
-import math
 
-import ngsolve as ng
 
 from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, model_of
 from ngcontact.cell.cell_problem import CellProblem
-import numpy as np
 
 from ngcontact.cell.coefficients import coefficients
+from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 
 log = logging.getLogger(__name__)
@@ -60,38 +58,11 @@ def run(scene, clock) -> Outcome:
                             subdivision=1)}
     plots = {}
     if cell.dim == 2:
-        plots["surface"] = lambda path, sols=sols: _plot_surface(path, sols)
+        surfaces = [{k: sol.surface[k] for k in ("x", "pressure", "slip")} for sol in sols]
+        plots["surface"] = lambda path, sf=surfaces: figures.cell_surface(path, sf)
     if len(sols) > 1:
-        plots["contact_curve"] = lambda path, sols=sols: _plot_curve(path, sols)
+        curve = {k: [s.results[k] for s in sols] for k in ("transmitted_pressure", "contact_fraction",
+                                                            "mean_closure")}
+        plots["contact_curve"] = lambda path, c=curve: figures.cell_contact_curve(
+            path, c["transmitted_pressure"], c["contact_fraction"], c["mean_closure"])
     return Outcome(results=results, ndof=P.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
-
-
-def _plot_surface(path, sols):
-    import matplotlib.pyplot as plt
-    fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(6, 5))
-    for k, sol in enumerate(sols):
-        sf = sol.surface
-        a1.plot(sf["x"], sf["pressure"], label=f"load {k}")
-        a2.plot(sf["x"], sf["slip"])
-    a1.set_ylabel("pressure (compression +)")
-    a2.set_ylabel("|slip|")
-    a2.set_xlabel("x")
-    a1.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def _plot_curve(path, sols):
-    import matplotlib.pyplot as plt
-    p = [s.results["transmitted_pressure"] for s in sols]
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(8, 3.5))
-    a1.plot(p, [s.results["contact_fraction"] for s in sols], "o-")
-    a1.set_xlabel("mean pressure")
-    a1.set_ylabel("contact fraction")
-    a2.plot(p, [s.results["mean_closure"] for s in sols], "o-")
-    a2.set_xlabel("mean pressure")
-    a2.set_ylabel("mean closure")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)

@@ -32,6 +32,7 @@ from ngcontact.macro import macro_problem as M
 from ngcontact.errors import SceneError
 from ngcontact.geometry import bodies as gm
 from ngcontact.scene.macro_scene import REGIONS
+from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 from ngcontact.scene.sections import resolve
 
@@ -153,8 +154,9 @@ def run(scene, clock) -> Outcome:
             results["detachment"] = M.detachments(prof)
             header = list(prof)
             tables["interface"] = (header, list(zip(*[prof[h] for h in header])))
-            plots["interface"] = lambda path, prof=prof, setting=problem.setting: plot_interface(path, prof, setting)
-            plots["stress"] = lambda path, sol=sol, fields=fields: plot_fields(path, sol, fields)
+            plots["interface"] = lambda path, prof=prof: figures.macro_interface(path, prof)
+            samples = field_samples(sol, fields)
+            plots["stress"] = lambda path, d=samples: figures.macro_fields(path, **d)
         results["maxima"] = maxima
         if two_scale is not None:
             results["two_scale"] = two_scale
@@ -178,35 +180,11 @@ def run(scene, clock) -> Outcome:
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
 
 
-# ------------------------------------------------------------------ plots
-def plot_interface(path: str, prof: dict, setting: str) -> None:
-    """Pressure, shear, jumps and status along the interface."""
-    import matplotlib.pyplot as plt
-    s = np.asarray(prof["s"]) * 1e3
-    fig, ax = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
-    ax[0].plot(s, np.asarray(prof["pressure"]) / 1e6, label="pressure p (compression > 0)")
-    ax[0].plot(s, np.asarray(prof["shear"]) / 1e6, label="shear (along t0)")
-    ax[0].set_ylabel("MPa")
-    ax[0].legend()
-    ax[1].plot(s, np.asarray(prof["jump_n"]) * 1e6, label="J . n0 (closure)")
-    ax[1].plot(s, np.asarray(prof["jump_t"]) * 1e6, label="J . t0 (slip)")
-    ax[1].set_ylabel("um")
-    ax[1].legend()
-    colors = {"open": 0, "stick": 1, "slip": 2}
-    ax[2].scatter(s, [colors[x] for x in prof["status"]], s=4)
-    ax[2].set_yticks([0, 1, 2], ["open", "stick", "slip"])
-    ax[2].set_xlabel("arc length s along the interface [mm] (from the top end)")
-    for a in ax:
-        a.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def plot_fields(path: str, sol: M.MacroSolution, fields: dict) -> None:
-    """Four panels of paper Fig. 10: radial / axial stress, von Mises stress and strain."""
-    import matplotlib.pyplot as plt
-    from matplotlib.tri import Triangulation
+# ------------------------------------------------------------------ plot data
+def field_samples(sol: M.MacroSolution, fields: dict) -> dict:
+    """Arrays for :func:`ngcontact.output.plots.macro_fields`: the stress fields at
+    three points near the vertices of every element of both bodies (one
+    triangle per element, so each body's colouring stays its own)."""
     p = sol.problem
     mesh = p.mesh
     names = [n for n in fields if n in ("sigma_r", "sigma_xx")][:1] + \
@@ -220,18 +198,7 @@ def plot_fields(path: str, sol: M.MacroSolution, fields: dict) -> None:
         ys.append(xy[:, 1])
         for n in names:
             vals[n].append(np.asarray(fields[n](mips)).ravel())
-    x, y = np.concatenate(xs) * 1e3, np.concatenate(ys) * 1e3
-    tri = Triangulation(x, y, np.arange(len(x)).reshape(-1, 3))
-    fig, axes = plt.subplots(1, 4, figsize=(11, 7))
-    for ax, n in zip(axes, names):
-        v = np.concatenate(vals[n])
-        scale, unit = (1.0, "-") if n == "von_mises_strain" else (1e-6, "MPa")
-        tc = ax.tripcolor(tri, v * scale, shading="gouraud", cmap="viridis")
-        fig.colorbar(tc, ax=ax, shrink=0.8, label=unit)
-        ax.set_title(n.replace("_", " "))
-        ax.set_aspect("equal")
-        ax.set_xlabel("r [mm]" if p.setting == "axisymmetric" else "x [mm]")
-    axes[0].set_ylabel("z [mm]" if p.setting == "axisymmetric" else "y [mm]")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    x, y = np.concatenate(xs), np.concatenate(ys)
+    return {"x": x, "y": y, "triangles": np.arange(len(x)).reshape(-1, 3),
+            "values": {n: np.concatenate(v) for n, v in vals.items()},
+            "axisymmetric": p.setting == "axisymmetric"}

@@ -12,7 +12,6 @@ history.  A residual above :data:`LINEAR_RTOL` means the factorization failed
 from __future__ import annotations
 
 import logging
-import math
 
 import ngsolve as ng
 
@@ -20,6 +19,7 @@ from ngcontact.verification import manufactured
 from ngcontact.verification import rates as studies
 from ngcontact.drivers.build import body_laws
 from ngcontact.errors import ConvergenceError
+from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 
 log = logging.getLogger(__name__)
@@ -80,7 +80,7 @@ def run(scene, clock) -> Outcome:
                    solver=_solver_info(rows, scene, converged=True),
                    tables={"convergence": studies.table(rows, TABLE_KEYS),
                            "rates": _rates_table(rates, expected)},
-                   vtk=vtk, plots={"convergence": lambda path: plot_convergence(rows, rates, path)})
+                   vtk=vtk, plots={"convergence": lambda path: figures.convergence(path, rows, rates)})
 
 
 def _solver_info(rows, scene, converged: bool) -> dict:
@@ -93,26 +93,3 @@ def _solver_info(rows, scene, converged: bool) -> dict:
 def _rates_table(rates: dict, expected: dict):
     header = ["order", "l2_rate", "l2_expected", "h1_rate", "h1_expected"]
     return header, [[p, r["l2"], expected[p]["l2"], r["h1"], expected[p]["h1"]] for p, r in rates.items()]
-
-
-def plot_convergence(rows, rates: dict, path: str) -> None:
-    """Log-log plot of the L2 and H1 errors against ``h``, one line per order."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
-    for ax, norm, label in zip(axes, ("l2", "h1"), ("L2 error", "H1-seminorm error")):
-        for p in sorted({r["order"] for r in rows}):
-            sel = sorted((r for r in rows if r["order"] == p), key=lambda r: r["h"])
-            h = [r["h"] for r in sel]
-            e = [r[norm] for r in sel]
-            rate = rates.get(p, {}).get(norm, math.nan)
-            ax.loglog(h, e, "o-", label=f"p = {p} (rate {rate:.2f})")
-        ax.set_xlabel("h")
-        ax.set_ylabel(label)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.suptitle(f"manufactured solution, setting {rows[0]['setting']}")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)

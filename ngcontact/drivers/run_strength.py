@@ -25,6 +25,7 @@ from ngcontact.coupling import strength as S
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.errors import SceneError
 from ngcontact.output.report import VtkField
+from ngcontact.output import plots as figures
 from ngcontact.scene.loader import load
 from ngcontact.scene.sections import resolve
 
@@ -122,71 +123,13 @@ def evaluate(scene, sol) -> dict:
                                                          states["e_hoop"]] + [smap.values[b] for b in S.BODIES]
     table = (header, list(zip(*cols)))
     sig_u = {b: res["bodies"][b]["sigma_u"] for b in S.BODIES}
-    plots = {"strength_map": lambda p, st=states, sm=smap, su=sig_u: plot_map(p, st, sm, su),
-             "worst_cell": lambda p, ws=worst_stress, c=spec.criterion, d=P.dim: plot_cell(p, ws, c, d)}
+    map_data = {"s": np.asarray(states["s"]), "values": {b: smap.values[b] for b in S.BODIES},
+                "sigma_u": sig_u, "criterion": smap.criterion,
+                "pressure": np.asarray(states["pressure"]), "shear": np.asarray(states["shear"])}
+    cell_data = {"points": np.concatenate([worst_stress[b]["points"] for b in S.BODIES]),
+                 "eq": np.concatenate([S.equivalent(worst_stress[b]["stress"], spec.criterion)
+                                       for b in S.BODIES]),
+                 "criterion": spec.criterion, "dim": P.dim}
+    plots = {"strength_map": lambda p, d=map_data: figures.strength_map(p, **d),
+             "worst_cell": lambda p, d=cell_data: figures.worst_cell(p, **d)}
     return {"results": res, "table": table, "vtk": vtk, "plots": plots}
-
-
-def plot_map(path, states, smap, sigma_u) -> None:
-    """Largest micro ``sigma_eq`` along the interface per body, against ``sigma_u``."""
-    import matplotlib.pyplot as plt
-    s = np.asarray(states["s"]) * 1e3
-    fig, ax = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
-    for b, c in zip(S.BODIES, ("C0", "C1")):
-        ax[0].plot(s, smap.values[b] / 1e6, color=c, label=f"max over the cell, {b}")
-        ax[0].axhline(sigma_u[b] / 1e6, color=c, ls="--", label=f"sigma_u {b}")
-    ax[0].set_ylabel(f"{smap.criterion.replace('_', ' ')} [MPa]")
-    ax[0].set_yscale("log")
-    ax[0].legend(fontsize=7)
-    ax[1].plot(s, np.asarray(states["pressure"]) / 1e6, label="macro pressure p")
-    ax[1].plot(s, np.asarray(states["shear"]) / 1e6, label="macro shear")
-    ax[1].set_ylabel("MPa")
-    ax[1].set_xlabel("arc length s along the interface [mm] (from the top end)")
-    ax[1].legend(fontsize=7)
-    for a in ax:
-        a.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def plot_cell(path, stress, criterion, dim) -> None:
-    """Equivalent stress in the worst cell (paper Fig. 8).
-
-    2D: the map over the cell.  3D: two sections through the point of the
-    largest equivalent stress, the vertical plane ``y = y_max`` (x-z) and the
-    horizontal plane ``z = z_max`` (x-y), each from the sample points within
-    a thin slab around the plane.
-    """
-    import matplotlib.pyplot as plt
-    pts = np.concatenate([stress[b]["points"] for b in S.BODIES])
-    eq = np.concatenate([S.equivalent(stress[b]["stress"], criterion) for b in S.BODIES]) / 1e6
-    label = f"{criterion.replace('_', ' ')} [MPa]"
-    k = int(np.argmax(eq))
-    if dim == 2:
-        fig, ax = plt.subplots(figsize=(7, 5.5))
-        sc = ax.scatter(pts[:, 0], pts[:, 1], c=eq, s=4, cmap="viridis")
-        ax.plot(*pts[k, :2], "r+", ms=14, mew=2)
-        ax.set_aspect("equal")
-        ax.set_xlabel("x (t0)")
-        ax.set_ylabel("y (n0)")
-        fig.colorbar(sc, ax=ax, shrink=0.8, label=label)
-        ax.set_title(f"worst cell: max {eq[k]:.3g} MPa (+)")
-    else:
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
-        span = np.ptp(pts, axis=0)
-        for ax, (normal, a, b, names) in zip(axes, ((1, 0, 2, ("x (t0)", "z (n0)")),
-                                                    (2, 0, 1, ("x (t0)", "y (hoop)")))):
-            slab = np.abs(pts[:, normal] - pts[k, normal]) <= 0.03 * span[normal]
-            sc = ax.scatter(pts[slab, a], pts[slab, b], c=eq[slab], s=6, cmap="viridis",
-                            vmin=eq.min(), vmax=eq.max())
-            ax.plot(pts[k, a], pts[k, b], "r+", ms=14, mew=2)
-            ax.set_aspect("equal")
-            ax.set_xlabel(names[0])
-            ax.set_ylabel(names[1])
-            which = "y" if normal == 1 else "z"
-            ax.set_title(f"section {which} = {pts[k, normal]:.3g}")
-        fig.colorbar(sc, ax=axes, shrink=0.85, label=label)
-        fig.suptitle(f"worst cell: max {eq[k]:.3g} MPa (+)")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)

@@ -6,6 +6,8 @@ call these functions with the numbers they computed, and the writer of
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -39,4 +41,188 @@ def epsilon_study(path: str, rows: list, laws) -> None:
         a.grid(alpha=0.3, which="both")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+# ------------------------------------------------------------------ cell
+def cell_surface(path: str, surfaces: list) -> None:
+    """Contact pressure and slip along the cell's contact surface, one line per load.
+
+    ``surfaces``: one dict per load with arrays ``x``, ``pressure``, ``slip``.
+    """
+    plt = _pyplot()
+    fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(6, 5))
+    for k, sf in enumerate(surfaces):
+        a1.plot(sf["x"], sf["pressure"], label=f"load {k}")
+        a2.plot(sf["x"], sf["slip"])
+    a1.set_ylabel("pressure (compression +)")
+    a2.set_ylabel("|slip|")
+    a2.set_xlabel("x")
+    a1.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def cell_contact_curve(path: str, pressure, contact_fraction, mean_closure) -> None:
+    """Contact fraction and mean closure against the transmitted mean pressure."""
+    plt = _pyplot()
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(8, 3.5))
+    a1.plot(pressure, contact_fraction, "o-")
+    a1.set_xlabel("mean pressure")
+    a1.set_ylabel("contact fraction")
+    a2.plot(pressure, mean_closure, "o-")
+    a2.set_xlabel("mean pressure")
+    a2.set_ylabel("mean closure")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+# ------------------------------------------------------------------ macro
+def macro_interface(path: str, prof: dict) -> None:
+    """Pressure, shear, jumps and status along the interface.
+
+    ``prof``: arrays ``s``, ``pressure``, ``shear``, ``jump_n``, ``jump_t``
+    and a list ``status`` of ``"open"``, ``"stick"``, ``"slip"``.
+    """
+    plt = _pyplot()
+    s = np.asarray(prof["s"]) * 1e3
+    fig, ax = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
+    ax[0].plot(s, np.asarray(prof["pressure"]) / 1e6, label="pressure p (compression > 0)")
+    ax[0].plot(s, np.asarray(prof["shear"]) / 1e6, label="shear (along t0)")
+    ax[0].set_ylabel("MPa")
+    ax[0].legend()
+    ax[1].plot(s, np.asarray(prof["jump_n"]) * 1e6, label="J . n0 (closure)")
+    ax[1].plot(s, np.asarray(prof["jump_t"]) * 1e6, label="J . t0 (slip)")
+    ax[1].set_ylabel("um")
+    ax[1].legend()
+    colors = {"open": 0, "stick": 1, "slip": 2}
+    ax[2].scatter(s, [colors[x] for x in prof["status"]], s=4)
+    ax[2].set_yticks([0, 1, 2], ["open", "stick", "slip"])
+    ax[2].set_xlabel("arc length s along the interface [mm] (from the top end)")
+    for a in ax:
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def macro_fields(path: str, x, y, triangles, values: dict, axisymmetric: bool) -> None:
+    """Four panels of paper Fig. 10: radial / axial stress, von Mises stress and strain.
+
+    ``x, y``: point coordinates [m]; ``triangles``: ``(n, 3)`` indices into
+    them; ``values``: field name -> values at the points (stresses in Pa).
+    """
+    plt = _pyplot()
+    from matplotlib.tri import Triangulation
+    tri = Triangulation(np.asarray(x) * 1e3, np.asarray(y) * 1e3, np.asarray(triangles))
+    fig, axes = plt.subplots(1, 4, figsize=(11, 7))
+    for ax, (n, v) in zip(axes, values.items()):
+        scale, unit = (1.0, "-") if n == "von_mises_strain" else (1e-6, "MPa")
+        tc = ax.tripcolor(tri, np.asarray(v) * scale, shading="gouraud", cmap="viridis")
+        fig.colorbar(tc, ax=ax, shrink=0.8, label=unit)
+        ax.set_title(n.replace("_", " "))
+        ax.set_aspect("equal")
+        ax.set_xlabel("r [mm]" if axisymmetric else "x [mm]")
+    axes[0].set_ylabel("z [mm]" if axisymmetric else "y [mm]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+# ------------------------------------------------------------------ manufactured solution
+def convergence(path: str, rows: list, rates: dict) -> None:
+    """Log-log plot of the L2 and H1 errors against ``h``, one line per order.
+
+    ``rows``: dicts with ``order``, ``h``, ``l2``, ``h1``, ``setting``;
+    ``rates``: order -> ``{"l2": rate, "h1": rate}``.
+    """
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
+    for ax, norm, label in zip(axes, ("l2", "h1"), ("L2 error", "H1-seminorm error")):
+        for p in sorted({r["order"] for r in rows}):
+            sel = sorted((r for r in rows if r["order"] == p), key=lambda r: r["h"])
+            h = [r["h"] for r in sel]
+            e = [r[norm] for r in sel]
+            rate = rates.get(p, {}).get(norm, math.nan)
+            ax.loglog(h, e, "o-", label=f"p = {p} (rate {rate:.2f})")
+        ax.set_xlabel("h")
+        ax.set_ylabel(label)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"manufactured solution, setting {rows[0]['setting']}")
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+# ------------------------------------------------------------------ strength check
+def strength_map(path: str, s, values: dict, sigma_u: dict, criterion: str, pressure, shear) -> None:
+    """Largest micro ``sigma_eq`` along the interface per body, against ``sigma_u``.
+
+    ``s``: arc length [m]; ``values``: body -> largest equivalent stress over
+    the cell at each ``s`` [Pa]; ``sigma_u``: body -> strength [Pa];
+    ``pressure``, ``shear``: the macro tractions at ``s`` [Pa].
+    """
+    plt = _pyplot()
+    s = np.asarray(s) * 1e3
+    fig, ax = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    for (b, v), c in zip(values.items(), ("C0", "C1")):
+        ax[0].plot(s, np.asarray(v) / 1e6, color=c, label=f"max over the cell, {b}")
+        ax[0].axhline(sigma_u[b] / 1e6, color=c, ls="--", label=f"sigma_u {b}")
+    ax[0].set_ylabel(f"{criterion.replace('_', ' ')} [MPa]")
+    ax[0].set_yscale("log")
+    ax[0].legend(fontsize=7)
+    ax[1].plot(s, np.asarray(pressure) / 1e6, label="macro pressure p")
+    ax[1].plot(s, np.asarray(shear) / 1e6, label="macro shear")
+    ax[1].set_ylabel("MPa")
+    ax[1].set_xlabel("arc length s along the interface [mm] (from the top end)")
+    ax[1].legend(fontsize=7)
+    for a in ax:
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def worst_cell(path: str, points, eq, criterion: str, dim: int) -> None:
+    """Equivalent stress in the worst cell (paper Fig. 8).
+
+    ``points``: ``(n, dim)`` sample points of the cell; ``eq``: the
+    equivalent stress there [Pa].  2D: the map over the cell.  3D: two
+    sections through the point of the largest equivalent stress, the vertical
+    plane ``y = y_max`` (x-z) and the horizontal plane ``z = z_max`` (x-y),
+    each from the sample points within a thin slab around the plane.
+    """
+    plt = _pyplot()
+    pts = np.asarray(points)
+    eq = np.asarray(eq) / 1e6
+    label = f"{criterion.replace('_', ' ')} [MPa]"
+    k = int(np.argmax(eq))
+    if dim == 2:
+        fig, ax = plt.subplots(figsize=(7, 5.5))
+        sc = ax.scatter(pts[:, 0], pts[:, 1], c=eq, s=4, cmap="viridis")
+        ax.plot(*pts[k, :2], "r+", ms=14, mew=2)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (t0)")
+        ax.set_ylabel("y (n0)")
+        fig.colorbar(sc, ax=ax, shrink=0.8, label=label)
+        ax.set_title(f"worst cell: max {eq[k]:.3g} MPa (+)")
+    else:
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
+        span = np.ptp(pts, axis=0)
+        for ax, (normal, a, b, names) in zip(axes, ((1, 0, 2, ("x (t0)", "z (n0)")),
+                                                    (2, 0, 1, ("x (t0)", "y (hoop)")))):
+            slab = np.abs(pts[:, normal] - pts[k, normal]) <= 0.03 * span[normal]
+            sc = ax.scatter(pts[slab, a], pts[slab, b], c=eq[slab], s=6, cmap="viridis",
+                            vmin=eq.min(), vmax=eq.max())
+            ax.plot(pts[k, a], pts[k, b], "r+", ms=14, mew=2)
+            ax.set_aspect("equal")
+            ax.set_xlabel(names[0])
+            ax.set_ylabel(names[1])
+            which = "y" if normal == 1 else "z"
+            ax.set_title(f"section {which} = {pts[k, normal]:.3g}")
+        fig.colorbar(sc, ax=axes, shrink=0.85, label=label)
+        fig.suptitle(f"worst cell: max {eq[k]:.3g} MPa (+)")
+    fig.savefig(path, dpi=110)
     plt.close(fig)
