@@ -30,7 +30,8 @@ import time
 
 import ngsolve as ng
 
-from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.cell_problem import CellModel, CellProblem
 from ngcontact.geometry import profiles
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.cell.coefficients import coefficients

@@ -26,7 +26,9 @@ import math
 import numpy as np
 import pytest
 
-from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.measures import sample_surface
 from ngcontact.geometry.cell3d import square_hills_cell
 from ngcontact.fem.materials import isotropic
 
@@ -60,7 +62,7 @@ def test_effective_stiffness_finite_and_below_kn0(hip):
     assert math.isfinite(keff) and keff > 0
     assert keff < kn0, f"effective stiffness {keff:.4e} not below k_n0 = {kn0:.4e}"
     # the pressure is not uniform over the summit (the reason for the strict inequality)
-    p = P.sample_surface({"p": P.pressure})["p"]
+    p = sample_surface(P, {"p": P.pressure})["p"]
     assert np.ptp(p) > 1e-3 * PRESSURE / 0.16
 
 

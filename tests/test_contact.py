@@ -12,6 +12,7 @@ import pytest
 
 from ngcontact.laws import penalty as contact
 from ngcontact.cell.cell_problem import CellModel, CellProblem, Friction
+from ngcontact.cell.measures import sample_surface
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.fem.materials import isotropic
 
@@ -76,8 +77,8 @@ def test_coulomb_consistency(slip):
     P = _problem(Friction("coulomb", w=W, mu=0.3))
     rng = np.random.default_rng(3)
     _set_state(P, slip, rng)
-    P._previous.vec.data = P.gfu.vec   # frozen pressure of the previous iterate: positive
-    p_prev = P.sample_surface({"p": P.pressure})["p"]
+    P.coulomb_previous.vec.data = P.gfu.vec   # frozen pressure of the previous iterate: positive
+    p_prev = sample_surface(P, {"p": P.pressure})["p"]
     assert p_prev.min() > 0
     _check(P, rng, slip)
 

@@ -20,7 +20,8 @@ import pytest
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.fem import materials as mat
 from ngcontact.scene import loader as scene_mod
-from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.cell_problem import CellModel, CellProblem
 from ngcontact.drivers.study_epsilon import run_study
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr

@@ -86,7 +86,8 @@ def test_cycle_detector_ignores_progress_and_new_states():
 def test_cell_newton_records_the_active_set_and_finds_no_false_cycle():
     import math as m
 
-    from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
+    from ngcontact.cell.cell_load import cell_load
+    from ngcontact.cell.cell_problem import CellModel, CellProblem
     from ngcontact.geometry.cell2d import flat_cell
     from ngcontact.fem.materials import isotropic
 

@@ -23,7 +23,7 @@ other through the fixed-contact-set stiffness) and unit strains that of
 ``N_pq``.  One factorization serves every corrector.
 
 Nonlinear recovery: the contact cell problem itself
-(:class:`ngcontact.cell.CellProblem`) solved at the macro state.
+(:class:`ngcontact.cell.cell_problem.CellProblem`) solved at the macro state.
 
 Strength (eqs. 76-78): the equivalent stress ``sigma_eq`` (von Mises
 ``sqrt(3/2 s:s)`` or Tresca ``max |sigma_k - sigma_l|``, eq. 77,
@@ -50,8 +50,11 @@ from dataclasses import dataclass
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.laws import penalty as _contact
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.measures import body_stresses
 from ngcontact.fem import materials as _mat
+from ngcontact.laws import penalty as _contact
+from ngcontact.errors import ModelError
 
 log = logging.getLogger(__name__)
 
@@ -67,8 +70,12 @@ def load_names(dim: int) -> tuple:
     return ("shear_x", "shear_y", "pressure", "E_xx", "E_yy", "E_xy")
 
 
-def _set_load(problem, l) -> None:
-    """Put the load vector ``l`` into the traction and strain parameters of ``problem``."""
+def apply_load_vector(problem, l) -> None:
+    """Put the load vector ``l`` (:func:`load_names`) into the traction and strain parameters of ``problem``.
+
+    Only the parameters of the energy are set; the state ``problem.gfu`` is
+    left as it is (see :meth:`Correctors.state`).
+    """
     d = problem.dim
     for i in range(d - 1):
         problem.traction[i].Set(float(l[i]))
@@ -81,9 +88,9 @@ def sample_stresses(problem) -> dict:
     """Stress tensors of the current state of ``problem`` per body at element points.
 
     Returns ``{body: {"points": (n, dim), "stress": (n, 3, 3)}}``
-    (:meth:`ngcontact.cell.CellProblem.body_stresses`).
+    (:func:`ngcontact.cell.measures.body_stresses`).
     """
-    return problem.body_stresses()
+    return body_stresses(problem)
 
 
 # ------------------------------------------------------------ correctors
@@ -133,7 +140,7 @@ def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float 
     Parameters
     ----------
     problem
-        A :class:`ngcontact.cell.CellProblem` built with ``macro_strain=True``
+        A :class:`ngcontact.cell.cell_problem.CellProblem` built with ``macro_strain=True``
         (its spaces, normal, gap and parameters are reused; its state is
         overwritten).
     contact_set
@@ -150,7 +157,7 @@ def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float 
     """
     m = problem.model
     if not m.macro_strain:
-        raise ValueError("linear correctors need a cell problem built with macro_strain = True")
+        raise ModelError("linear correctors need a cell problem built with macro_strain = True")
     X, mesh, d = problem.X, problem.mesh, problem.dim
     trial = X.TrialFunction()
     ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
@@ -175,7 +182,7 @@ def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float 
     names = load_names(d)
     zero = problem.gfu.vec.CreateVector()
     zero[:] = 0.0
-    _set_load(problem, np.zeros(len(names)))
+    apply_load_vector(problem, np.zeros(len(names)))
     form.AssembleLinearization(zero)
     inv = form.mat.Inverse(free, inverse=problem.inverse)
     res = zero.CreateVector()
@@ -183,7 +190,7 @@ def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float 
     vectors = []
 
     def state(l):
-        _set_load(problem, l)
+        apply_load_vector(problem, l)
         form.Apply(zero, res)
         problem.gfu.vec.data = -(inv * res)
         v = zero.CreateVector()
@@ -207,7 +214,7 @@ def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float 
         vectors[-1].data -= vectors[0]
         for b in BODIES:
             unit[b].append(s[b]["stress"] - base[b]["stress"])
-    _set_load(problem, np.zeros(len(names)))
+    apply_load_vector(problem, np.zeros(len(names)))
     log.info("linear correctors: %d unit loads, one factorization", len(names))
     return Correctors(names=names, points={b: base[b]["points"] for b in BODIES},
                       base={b: base[b]["stress"] for b in BODIES},
@@ -218,10 +225,9 @@ def nonlinear_stress(problem, load_vector) -> tuple[dict, object]:
     """The contact cell problem solved at the load vector (rigid-predictor start).
 
     Returns the sampled stresses per body (:func:`sample_stresses`) and the
-    :class:`ngcontact.cell.CellSolution`.  A flat frictionless cell carries
+    :class:`ngcontact.cell.cell_problem.CellSolution`.  A flat frictionless cell carries
     no shear: its shear components must be 0.
     """
-    from ngcontact.cell.cell_problem import cell_load
     d = problem.dim
     l = np.asarray(load_vector, float)
     shear = tuple(float(v) for v in l[:d - 1])
@@ -238,7 +244,7 @@ def equivalent(stress: np.ndarray, criterion: str) -> np.ndarray:
         return _mat.von_mises(stress)
     if criterion == "tresca":
         return _mat.tresca(stress)
-    raise ValueError(f"criterion = {criterion!r}: must be one of {', '.join(CRITERIA)}")
+    raise ModelError(f"criterion = {criterion!r}: must be one of {', '.join(CRITERIA)}")
 
 
 @dataclass

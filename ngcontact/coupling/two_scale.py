@@ -46,9 +46,17 @@ from dataclasses import dataclass, field
 import ngsolve as ng
 import numpy as np
 
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.measures import (
+    contact_fraction,
+    contact_integral,
+    mean_jump,
+    real_contact_coefficients,
+)
+from ngcontact.errors import ConvergenceError
 from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
-from ngcontact.errors import ConvergenceError
+from ngcontact.errors import ModelError
 
 log = logging.getLogger(__name__)
 
@@ -56,7 +64,7 @@ log = logging.getLogger(__name__)
 def cell_response(problem, pressure: float, length_unit: float = 1.0) -> dict:
     """Contact fraction, ``k_n0`` and ``g_n0`` of the cell at a mean pressure.
 
-    ``problem`` is a :class:`ngcontact.cell.CellProblem`, solved from the
+    ``problem`` is a :class:`ngcontact.cell.cell_problem.CellProblem`, solved from the
     rigid predictor.  ``k_n0`` is eq. 34 on the real contact set: ``k_n``
     times the contact fraction (located by the roots of the penetration in
     2D) on a flat cell, else the quadrature integral of the indicator.
@@ -72,16 +80,15 @@ def cell_response(problem, pressure: float, length_unit: float = 1.0) -> dict:
     Lengths are scaled by ``length_unit`` (metres per cell length unit);
     ``k_n0`` is a length ratio times ``k_n``.
     """
-    from ngcontact.cell.cell_problem import cell_load
     problem.solve(cell_load(problem.dim, pressure=float(pressure)), first=True, measure=False)
-    fraction = float(problem.contact_fraction())
+    fraction = float(contact_fraction(problem))
     if not problem.tangential_free:  # flat and frictionless: n = n0 on all of S_C
         kn0 = problem.model.k_n * fraction
     else:
-        kn0 = float(problem.real_contact_coefficients()["k_n"])
+        kn0 = float(real_contact_coefficients(problem)["k_n"])
     n0 = problem.n[problem.dim - 1]
-    projected = float(problem._contact_integral(ng.IfPos(n0, n0, -n0), order=2 * problem.model.order + 4))
-    jbar = float(problem.mean_jump()[problem.dim - 1]) * problem.area / projected * length_unit
+    projected = float(contact_integral(problem, ng.IfPos(n0, n0, -n0), order=2 * problem.model.order + 4))
+    jbar = float(mean_jump(problem)[problem.dim - 1]) * problem.area / projected * length_unit
     return {"contact_fraction": fraction, "k_n0": kn0, "g_n0": kn0 * jbar - float(pressure)}
 
 
@@ -142,7 +149,7 @@ class CellTable:
     def cover(self, lo: float, hi: float, start_nodes: int = 5) -> None:
         """Make the table span ``[lo, hi]`` (``0 < lo < hi``) within the tolerance."""
         if not 0 < lo < hi:
-            raise ValueError(f"table range [{lo!r}, {hi!r}]: need 0 < lo < hi")
+            raise ModelError(f"table range [{lo!r}, {hi!r}]: need 0 < lo < hi")
         if not self.values:
             nodes = np.geomspace(lo, hi, start_nodes)
         else:

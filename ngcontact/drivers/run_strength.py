@@ -18,14 +18,15 @@ from __future__ import annotations
 import dataclasses
 import logging
 
-import numpy as np
 import ngsolve as ng
+import numpy as np
 
-from ngcontact.coupling import strength as S
 from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.cell.predictor import max_gap
+from ngcontact.coupling import strength as S
 from ngcontact.errors import SceneError
-from ngcontact.output.report import VtkField
 from ngcontact.output import plots as figures
+from ngcontact.output.report import VtkField
 from ngcontact.scene.loader import load
 from ngcontact.scene.sections import resolve
 
@@ -59,7 +60,7 @@ def evaluate(scene, sol) -> dict:
     kt = spec.tangential_stiffness
     if kt is None:
         kt = cs.contact.k_n if law.friction is not None else 0.0
-    chi = None if P.gap is None else ng.IfPos(P.gap - 1e-14 * max(P.max_gap(), 1e-300), 0.0, 1.0)
+    chi = None if P.gap is None else ng.IfPos(P.gap - 1e-14 * max(max_gap(P), 1e-300), 0.0, 1.0)
     corr = S.linear_correctors(P, contact_set=chi, tangential_stiffness=kt)
     states = S.interface_states(sol, scene.output.points_per_element)
     loads = S.cell_loads(states, P.dim)
@@ -103,7 +104,7 @@ def evaluate(scene, sol) -> dict:
         worst_stress, _ = S.nonlinear_stress(P, worst_load)
     else:
         P.gfu.vec.data = corr.state(worst_load)
-        S._set_load(P, worst_load)
+        S.apply_load_vector(P, worst_load)
         worst_stress = {b: {"stress": corr.stress(worst_load)[b], "points": corr.points[b]} for b in S.BODIES}
     m = P.model
     comps = P.gfu.components

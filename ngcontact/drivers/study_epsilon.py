@@ -97,7 +97,8 @@ def effective_law(scene, eps: float, mean_traction) -> tuple[il.LinearLaw, dict]
         ``(tau_n, tau_t)``: mean traction the rough body transmits to the
         counter body on ``S_0`` (compression positive), the cell's load.
     """
-    from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
+    from ngcontact.cell.cell_load import cell_load
+    from ngcontact.cell.cell_problem import CellModel, CellProblem
     cell_scene = scene.cell_scene
     g, d = cell_scene.geometry, cell_scene.discretization
     s = eps / g.period

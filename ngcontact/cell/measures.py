@@ -1,0 +1,252 @@
+"""Measurements of a solved cell problem: contact set, mean tractions and jumps, stresses.
+
+Functions of a :class:`~ngcontact.cell.cell_problem.CellProblem` in its
+current state (the cell problem of paper eqs. 49-51, 57, 65, with the jump
+``J = u_r - u_c - U`` across ``S_C``, the micro normal ``n``, the gap ``g``
+and the penalty pressure ``p = k_n [J.n - g]_+`` of eq. 65).  ``|T|`` is the
+area of the cell's period.
+
+* Real contact set ``S_C_real = {J.n - g >= 0}`` (the set of paper Sec. 3.2.2
+  over which eq. 34 integrates) and its measure per period,
+  ``contact_fraction = |S_C_real| / |T|`` (:func:`contact_fraction`; in 2D
+  the contact edges are located between quadrature points by the roots of
+  the penetration polynomial on each boundary element);
+* ``mean_pressure = (1/|T|) int_{S_C} p ds`` (:func:`mean_pressure`);
+* the mean traction on the counter's far face, prescribed or the reaction
+  (the residual of the energy on ``U``), :func:`mean_traction`;
+* the projected mean jump ``Jbar = (1/|T|) int_{S_C} J |n.n0| ds``
+  (:func:`mean_jump`);
+* the homogenized coefficients of eqs. 34, 42-43 on ``S_C_real``
+  (:func:`real_contact_coefficients`, computed by
+  :mod:`ngcontact.cell.coefficients`);
+* the stress ``sigma_B = C_B : (eps(u_B) + E)`` of each body at element
+  points and its largest von Mises and Tresca values (the equivalent
+  stresses of eq. 77, :mod:`ngcontact.fem.materials`), :func:`body_stresses`,
+  :func:`stress_maxima`;
+* the effective stiffness of the interface (beyond the paper,
+  :mod:`ngcontact.cell.stiffness`).
+
+:func:`measure` collects them into the results of one load.
+"""
+from __future__ import annotations
+
+import ngsolve as ng
+import numpy as np
+
+from ngcontact.cell.cell_load import CellLoad
+from ngcontact.cell.coefficients import coefficients
+from ngcontact.cell.stiffness import effective_stiffness
+from ngcontact.fem import materials as _mat
+from ngcontact.laws import penalty as _contact
+
+
+# ------------------------------------------------------------ the contact surface
+def contact_integral(problem, cf, order=None):
+    """``int_{S_C} cf ds`` at integration order ``order`` (default ``4 p + 24``)."""
+    o = order if order is not None else 4 * problem.model.order + 24
+    return ng.Integrate(cf, problem.mesh, definedon=problem.mesh.Boundaries("contact"), order=o)
+
+
+def contact_fraction(problem, method: str = "auto") -> float:
+    """Measure of the real contact set ``{J_n - g >= 0}`` on ``S_C`` divided by ``|T|``.
+
+    Parameters
+    ----------
+    method
+        ``"roots"`` (2D): on each boundary element the penetration
+        ``J_n - g_h`` is a polynomial of the reference coordinate ``t``
+        (degree ``order`` on straight elements with the interpolated
+        gap); it is interpolated at ``order + 3`` Gauss points, its real
+        roots in ``[0, 1]`` split the element, and the length
+        ``int |dx/dt| dt`` of the pieces where it is nonnegative is
+        summed.  The contact edge is thus located inside the element
+        instead of at the nearest quadrature point.
+        ``"quadrature"``: integral of the indicator at high order (3D,
+        where the zero set is a curve on each face).  ``"auto"``: roots
+        in 2D, quadrature in 3D.
+    """
+    if method == "auto":
+        method = "roots" if problem.dim == 2 else "quadrature"
+    if method == "quadrature":
+        ind = ng.IfPos(-problem.penetration, 0.0, 1.0)
+        return float(contact_integral(problem, ind)) / problem.area
+    if method != "roots" or problem.dim != 2:
+        raise ValueError(f"method = {method!r}: must be 'auto', 'quadrature' or (2D) 'roots'")
+    return _contact_length_by_roots(problem) / problem.area
+
+
+def _contact_length_by_roots(problem) -> float:
+    P = np.polynomial.polynomial
+    m = problem.model.order + 3
+    ir = ng.IntegrationRule(ng.SEGM, 2 * m - 1)
+    t = np.array([q[0] for q in ir.points])
+    mesh = problem.mesh
+    pts = mesh.MapToAllElements(ir, mesh.Boundaries("contact"))
+    vals = np.asarray(ng.CF((problem.penetration, ng.x, ng.y))(pts)).reshape(-1, m, 3)
+    # monomial coefficients in t of penetration, x and y, per element
+    coef = np.linalg.solve(P.polyvander(t, m - 1), vals.transpose(1, 0, 2).reshape(m, -1))
+    coef = coef.reshape(m, -1, 3)
+    tg, wg = np.polynomial.legendre.leggauss(m + 2)
+    total = 0.0
+    for e in range(vals.shape[0]):
+        c_pen, c_x, c_y = coef[:, e, 0], coef[:, e, 1], coef[:, e, 2]
+        pen = vals[e, :, 0]
+        if np.all(pen > 0) or np.all(pen < 0):
+            r = P.polyroots(c_pen) if np.any(c_pen[1:]) else np.empty(0)
+            r = r[np.abs(r.imag) <= 1e-10].real
+            if not np.any((r > 0.0) & (r < 1.0)):
+                if pen[0] > 0:
+                    total += _arc(c_x, c_y, 0.0, 1.0, tg, wg)
+                continue
+        r = P.polyroots(c_pen) if np.any(c_pen[1:]) else np.empty(0)
+        r = np.sort(r[(np.abs(r.imag) <= 1e-10) & (r.real > 0.0) & (r.real < 1.0)].real)
+        cuts = np.concatenate(([0.0], r, [1.0]))
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            if b > a and P.polyval(0.5 * (a + b), c_pen) >= 0.0:
+                total += _arc(c_x, c_y, a, b, tg, wg)
+    return total
+
+
+def _arc(c_x, c_y, a, b, tg, wg) -> float:
+    """Length of the curve ``(x(t), y(t))`` (monomial coefficients) for ``t`` in ``[a, b]``."""
+    P = np.polynomial.polynomial
+    s = 0.5 * (b - a) * tg + 0.5 * (a + b)
+    dx, dy = P.polyval(s, P.polyder(c_x)), P.polyval(s, P.polyder(c_y))
+    return float(0.5 * (b - a) * np.sum(wg * np.hypot(dx, dy)))
+
+
+def mean_pressure(problem) -> float:
+    """``(1/|T|) int_{S_C} p ds`` with the penalty pressure ``p = k_n [J.n - g]_+``."""
+    return float(contact_integral(problem, problem.pressure)) / problem.area
+
+
+# ------------------------------------------------------------ means over the period
+def mean_traction(problem, load: CellLoad) -> np.ndarray:
+    """Mean traction on the counter's far face per axis (prescribed or reaction)."""
+    res = problem.gfu.vec.CreateVector()
+    problem.form.Apply(problem.gfu.vec, res)
+    out = np.empty(problem.dim)
+    for i, d in enumerate(problem.u_dofs):
+        if load.traction[i] is not None and (i == problem.dim - 1 or problem.tangential_free):
+            out[i] = load.traction[i]
+        else:  # the load term of a controlled component is zero: residual = reaction
+            out[i] = res[d] / problem.area
+    return out
+
+
+def mean_jump(problem) -> np.ndarray:
+    """Projected mean of the jump on ``S_C``: ``(1/|T|) int J |n.n0| ds``."""
+    n, d = problem.n, problem.dim
+    w = ng.IfPos(n[d - 1], n[d - 1], -n[d - 1])
+    return np.array(contact_integral(problem, problem.J * w, order=2 * problem.model.order + 4)) / problem.area
+
+
+def friction_threshold(problem):
+    """``G`` on ``S_C`` of the current state (``mu p`` for Coulomb), or ``None``."""
+    f = problem.model.friction
+    if f is None:
+        return None
+    return f.G if f.law == "tresca" else f.mu * problem.pressure
+
+
+def real_contact_coefficients(problem) -> dict:
+    """Paper eqs. 34, 42-43 on the real contact set ``{J_n - g >= 0}`` of the current state."""
+    ind = ng.IfPos(-problem.penetration, 0.0, 1.0)
+    c = coefficients(problem.cell, kn=problem.model.k_n, gap=problem.gap, G=friction_threshold(problem),
+                     weight=ind, normal=problem.n, intorder=4 * problem.model.order + 24)
+    return c.as_dict()
+
+
+# ------------------------------------------------------------ samples
+def sample_surface(problem, fields: dict, order: int | None = None) -> dict:
+    """Values of CoefficientFunctions at the quadrature points of ``S_C``.
+
+    Evaluated on the boundary elements of ``contact`` themselves, so the
+    traces of each body are unambiguous.  Returns arrays, with the
+    coordinates under ``"x"``, ``"y"`` (and ``"z"``).
+    """
+    mesh = problem.mesh
+    o = order if order is not None else 2 * problem.model.order + 2
+    S = ng.comp.IntegrationRuleSpaceSurface(mesh, order=o, definedon=mesh.Boundaries("contact"))
+    names = ["x", "y", "z"][: problem.dim] + list(fields)
+    cfs = [ng.x, ng.y, ng.z][: problem.dim] + [fields[k] for k in fields]
+    flat = []
+    for cf in cfs:
+        flat.extend(cf[i] for i in range(cf.dim)) if cf.dim > 1 else flat.append(cf)
+    gf = ng.GridFunction(S ** len(flat)) if len(flat) > 1 else ng.GridFunction(S)
+    gf.Set(ng.CF(tuple(flat)) if len(flat) > 1 else flat[0], definedon=mesh.Boundaries("contact"))
+    arr = gf.vec.FV().NumPy().reshape(len(flat), -1)
+    out, k = {}, 0
+    for name, cf in zip(names, cfs):
+        out[name] = arr[k:k + cf.dim].copy() if cf.dim > 1 else arr[k].copy()
+        k += cf.dim
+    return out
+
+
+def surface_distribution(problem) -> dict:
+    """Pressure and slip at the quadrature points of ``S_C`` (2D: sorted by ``x``)."""
+    s = sample_surface(problem, {"pressure": problem.pressure,
+                                 "slip": _contact.slip_magnitude(problem.J, problem.n),
+                                 "closure": _contact.normal_closure(problem.J, problem.n)})
+    if problem.dim == 2:
+        idx = np.argsort(s["x"], kind="stable")
+        s = {k: v[..., idx] for k, v in s.items()}
+    return s
+
+
+def body_stresses(problem) -> dict:
+    """Stress tensors of the current state at the element integration points of each body.
+
+    Returns ``{body: {"stress": (n, 3, 3), "points": (n, dim)}}``.  The
+    points are those of the order-``2p`` rule mapped to every element of
+    the body, so none lies on the interface (where point evaluation could
+    pick the other body's element).
+    """
+    out = {}
+    mesh, m = problem.mesh, problem.model
+    comps = problem.gfu.components
+    shape = ng.TET if problem.dim == 3 else ng.TRIG
+    rule = ng.IntegrationRule(shape, 2 * max(m.order, 1))
+    for name, law, u in (("rough", m.rough, comps[0]), ("counter", m.counter, comps[1])):
+        sig = law.stress(problem.body_strain(u))
+        coords = (ng.x, ng.y, ng.z)[: problem.dim]
+        cf = ng.CF(tuple(sig[i, j] for i in range(3) for j in range(3)) + coords)
+        vals = np.asarray(cf(mesh.MapToAllElements(rule, mesh.Materials(name))))
+        out[name] = {"stress": vals[:, :9].reshape(-1, 3, 3).copy(), "points": vals[:, 9:].copy()}
+    return out
+
+
+def stress_maxima(problem) -> dict:
+    """Largest von Mises and Tresca stress in each body and where (element points)."""
+    out = {}
+    for name, sample in body_stresses(problem).items():
+        S, X = sample["stress"], sample["points"]
+        vm = _mat.von_mises(S)
+        tr = _mat.tresca(S)
+        i, j = int(np.argmax(vm)), int(np.argmax(tr))
+        out[f"max_von_mises_{name}"] = {"value": float(vm[i]), "location": X[i].tolist()}
+        out[f"max_tresca_{name}"] = {"value": float(tr[j]), "location": X[j].tolist()}
+    return out
+
+
+# ------------------------------------------------------------ results of a load
+def measure(problem, load: CellLoad) -> dict:
+    """Scalar results of the current state (module docstring)."""
+    d = problem.dim
+    t = mean_traction(problem, load)
+    jbar = mean_jump(problem)
+    Uv = np.array([problem.gfu.vec[k] for k in problem.u_dofs])
+    res = {
+        "contact_fraction": contact_fraction(problem),
+        "mean_pressure": mean_pressure(problem),
+        "mean_traction": t.tolist(),
+        "transmitted_pressure": float(-t[d - 1]),
+        "mean_jump": jbar.tolist(),
+        "mean_closure": float(jbar[d - 1]),
+        "far_face_jump": (-Uv).tolist(),
+        "max_penetration": float(sample_surface(problem, {"pen": problem.penetration})["pen"].max()),
+    }
+    res.update(stress_maxima(problem))
+    res["effective_stiffness"] = effective_stiffness(problem)
+    res["coefficients"] = real_contact_coefficients(problem)
+    return res

@@ -1,0 +1,131 @@
+"""Far-face and effective stiffness of the interface layer (beyond the paper).
+
+The paper homogenizes the contact layer into the stiffnesses of eq. 34,
+integrals of the penalty ``k_n`` over the real contact set; they grow
+without bound with ``k_n`` and leave out the compliance of the asperities
+themselves.  This module measures the stiffness the solved cell problem
+(paper eqs. 49-51, 57, 65; :mod:`ngcontact.cell.cell_problem`) really has:
+
+* ``S``: the tangent of the mean far-face traction with respect to the
+  far-face jump, per ``|T|`` — the Schur complement of the tangent of the
+  cell energy on the far-face translation ``U`` (:func:`schur_complement`,
+  :func:`tangent_stiffness`);
+* ``S_0``: the same for the flat bonded laminate of the same thickness,
+  analytic (:func:`reference_stiffness`): each layer in a uniform state
+  ``eps = sym(a (x) n0)`` with ``t = A a`` and the acoustic tensor
+  ``A_ik = C_ijkl n0_j n0_l``, so
+
+      S_0 = (h_rough A_rough^-1 + h_counter A_counter^-1)^-1;
+
+* the interface's compliance ``S^-1 - S_0^-1`` (penalty layer plus the
+  constriction of the asperities, finite as ``k_n -> infinity``) and the
+  effective stiffness, its inverse (:func:`effective_stiffness`).
+"""
+from __future__ import annotations
+
+import ngsolve as ng
+import numpy as np
+
+from ngcontact.fem import materials as _mat
+
+
+def schur_complement(form, X, dofs, state_vec, inverse: str) -> np.ndarray:
+    """Schur complement of the tangent of ``form`` at ``state_vec`` on the dofs ``dofs``.
+
+    The tangent ``K`` is factorized (direct solver ``inverse``) on the free
+    dofs of ``X`` without ``dofs``; the result ``K_UU - K_UI K_II^-1 K_IU``
+    is symmetrized.
+    """
+    form.AssembleLinearization(state_vec)
+    K = form.mat
+    free = ng.BitArray(X.FreeDofs())
+    for d in dofs:
+        free.Clear(d)
+    inv = K.Inverse(free, inverse=inverse)
+    n = len(dofs)
+    S = np.zeros((n, n))
+    e, y, x, z = (state_vec.CreateVector() for _ in range(4))
+    for j, dj in enumerate(dofs):
+        e[:] = 0.0
+        e[dj] = 1.0
+        y.data = K * e
+        x.data = inv * y
+        z.data = K * x
+        for i, di in enumerate(dofs):
+            S[i, j] = y[di] - z[di]
+    return 0.5 * (S + S.T)
+
+
+def reference_stiffness(problem) -> np.ndarray:
+    """``S_0``: far-face stiffness of the flat bonded laminate of the same thickness.
+
+    Both bodies, each with its own law, stacked flat with the interface in
+    the summit plane (``rough`` below it over ``h_rough``, ``counter``
+    above over ``h_counter``) and bonded.  Under a mean traction each
+    layer is in a uniform state ``eps = sym(a (x) n0)`` with
+    ``t = A a``, ``A_ik = C_ijkl n0_j n0_l`` (the acoustic tensor), so
+    the far-face jump is ``sum_L h_L A_L^-1 t`` and
+
+        S_0 = (h_rough A_rough^-1 + h_counter A_counter^-1)^-1,
+
+    in the components ``(t0[, t1], n0)`` (per ``|T|``).
+    """
+    d = problem.dim
+    idx = list(range(d))  # mesh axes; n0 is the last one
+    C = 0.0
+    for law, h in ((problem.model.rough, problem.cell.h_rough),
+                   (problem.model.counter, problem.cell.h_counter)):
+        A = _acoustic_tensor(law, normal_axis=d - 1)[np.ix_(idx, idx)]
+        C = C + h * np.linalg.inv(A)
+    return np.linalg.inv(C)
+
+
+def tangent_stiffness(problem) -> np.ndarray:
+    """``S``: tangent of the mean far-face traction w.r.t. the far-face jump (per ``|T|``)."""
+    return schur_complement(problem.form, problem.X, problem.u_dofs, problem.gfu.vec,
+                            problem.inverse) / problem.area
+
+
+def effective_stiffness(problem) -> dict:
+    """Interface stiffness with asperity compliance: ``(S^-1 - S_0^-1)^-1``.
+
+    ``S`` is the tangent far-face stiffness of the cell, ``S_0`` that of
+    the flat bonded laminate (:func:`reference_stiffness`); their
+    compliance difference is the interface's share: penalty layer plus
+    the compliance of the asperities (constriction), which stays finite
+    as ``k_n -> infinity`` (module docstring).  Restricted to the components
+    that are determinate (all but the tangential ones of a frictionless
+    flat interface).  ``matrix`` is ``None`` when the interface
+    compliance is singular (e.g. a component the interface does not
+    resist beyond the bulk).  An open interface transmits nothing
+    (``S`` singular): its stiffness is the limit
+    ``S (I - S_0^-1 S)^-1 = 0`` and ``compliance`` is ``None``.
+    """
+    dim = problem.dim
+    keep = [i for i in range(dim) if i == dim - 1 or problem.tangential_free]
+    names = (["t0"] if dim == 2 else ["t1", "t2"]) + ["n0"]
+    S = tangent_stiffness(problem)[np.ix_(keep, keep)]
+    S0 = reference_stiffness(problem)[np.ix_(keep, keep)]
+    if np.linalg.cond(S) > 1e12 * np.linalg.cond(S0):  # (partly) open: S^-1 does not exist
+        compliance = None
+        A = np.eye(len(keep)) - np.linalg.solve(S0, S)
+        K = None if np.linalg.cond(A) > 1e12 else S @ np.linalg.inv(A)
+    else:
+        compliance = np.linalg.inv(S) - np.linalg.inv(S0)
+        compliance = 0.5 * (compliance + compliance.T)
+        K = None if np.linalg.cond(compliance) > 1e12 else np.linalg.inv(compliance)
+    if K is not None:
+        K = (0.5 * (K + K.T)).tolist()
+    return {"components": [names[i] for i in keep], "matrix": K,
+            "compliance": None if compliance is None else compliance.tolist(),
+            "total": S.tolist(), "reference": S0.tolist()}
+
+
+def _acoustic_tensor(law, normal_axis: int) -> np.ndarray:
+    """``A_ik = C_ijkl n_j n_l`` for ``n = e_normal_axis`` (3x3, from the Voigt matrix)."""
+    C = law.matrix
+    voigt = {}
+    for k, (i, j) in enumerate(_mat.VOIGT_PAIRS):
+        voigt[i, j] = voigt[j, i] = k
+    m = normal_axis
+    return np.array([[C[voigt[i, m], voigt[k, m]] for k in range(3)] for i in range(3)])
