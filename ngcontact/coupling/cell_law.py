@@ -29,7 +29,7 @@ from __future__ import annotations
 import logging
 import os
 import tempfile
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -57,7 +57,9 @@ def cached_bundle_arrays(key: str, compute: Callable[[], dict], cache_dir: str |
         with np.load(path) as data:
             log.info("cell bundle from cache %s", path)
             return {k: np.array(data[k]) for k in ("w", "n", "g")}, True
-    arrays = {k: np.asarray(v, float) for k, v in compute().items()}
+    # Any values: np.savez's stub would otherwise match the arrays against
+    # its keyword-only allow_pickle: bool
+    arrays: dict[str, Any] = {k: np.asarray(v, float) for k, v in compute().items()}
     os.makedirs(cache_dir, exist_ok=True)
     fd, tmp = tempfile.mkstemp(suffix=".npz", dir=cache_dir)
     os.close(fd)

@@ -92,7 +92,8 @@ def spaces(mesh, setting: str, regions: tuple[str, str], supports, order: int, p
     accepts only supports that fix every component.
     """
     comps = COMPONENTS[setting]
-    full, partial = [], {c: [] for c in comps}
+    full: list[str] = []
+    partial: dict[str, list[str]] = {c: [] for c in comps}
     for s in supports:
         if not s.components or set(s.components) == set(comps):
             full.append(s.label)

@@ -86,7 +86,7 @@ def _name_faces(ngmesh) -> None:
             rough = i
         elif name == "counter":
             counter = i
-    wanted = {}
+    wanted: dict[int, str] = {}
     for i in range(1, ngmesh.GetNFaceDescriptors() + 1):
         fd = ngmesh.FaceDescriptor(i)
         if fd.bcname in _KEEP:

@@ -83,7 +83,7 @@ class ResolvedGeometry:
     length: float
     h_rough: float = 0.0
     h_counter: float = 0.0
-    segments: tuple = ()
+    segments: tuple[tuple[int, float], ...] = ()
     x0: float = 0.0
 
 
@@ -94,7 +94,7 @@ def scaled_profile(profile: Profile, eps: float) -> Profile:
     def sc(p):
         return (p[0] * s, p[1] * s)
 
-    pieces = []
+    pieces: list[Line | Arc | Curve] = []
     for p in profile.pieces:
         if isinstance(p, Line):
             pieces.append(Line(sc(p.start), sc(p.end)))
@@ -238,7 +238,7 @@ def femur_stem_interface(dims) -> list:
     return [(top, corner), (corner, tip)]
 
 
-def split_periods(lengths, periods: int) -> tuple:
+def split_periods(lengths, periods: int) -> tuple[tuple[int, float], ...]:
     """``N_i = max(1, round(L_i / eps))`` whole periods per segment, ``eps = sum(L_i) / periods``.
 
     Returns ``((N_1, eps_1), ...)`` with ``eps_i = L_i / N_i``.
@@ -246,7 +246,7 @@ def split_periods(lengths, periods: int) -> tuple:
     if not (isinstance(periods, int) and periods >= 1):
         raise ValueError(f"periods = {periods!r}: must be an integer >= 1")
     eps = float(sum(lengths)) / periods
-    out = []
+    out: list[tuple[int, float]] = []
     for L in lengths:
         n = max(1, int(round(L / eps)))
         out.append((n, L / n))
@@ -307,6 +307,7 @@ def femur_stem(dims, profile: Profile | None, periods: int, *, maxh: float, inte
     d = dims
     segs = femur_stem_interface(d)
     lengths = [math.dist(a, b) for a, b in segs]
+    split: tuple[tuple[int, float], ...]
     if profile is None:
         split = ()
         chain = [("line", (a, b)) for a, b in segs]

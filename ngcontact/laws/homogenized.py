@@ -64,10 +64,14 @@ CoefficientFunctions alike.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from ngcontact.errors import ModelError
 from ngcontact.laws.huber import huber_of_square, huber_slope, is_numeric
+
+if TYPE_CHECKING:
+    import ngsolve as ng
 
 
 # ------------------------------------------------------------------ laws
@@ -252,8 +256,8 @@ class FieldLaw:
         An upper bound of ``k_n0`` (a number; scales the start of the solve).
     """
 
-    kn: object
-    offset: object
+    kn: ng.CoefficientFunction
+    offset: ng.CoefficientFunction
     stiffness: float
 
     def __post_init__(self):

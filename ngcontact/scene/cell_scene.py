@@ -72,6 +72,7 @@ class CellGeometry:
         check_selected(self, path, "profile", ("width", "depth", "radius", "angles", "amplitude", "file"),
                        self._USES[self.profile], self._OPTIONAL.get(self.profile, ()))
         if self.profile == "square_hills":
+            assert self.width is not None and self.depth is not None  # required: check_selected
             if not self.width < self.period:
                 raise SceneError(f"{path}.width", self.width,
                                  f"must be < period = {self.period!r} (hills must not touch)")
@@ -95,13 +96,18 @@ def profile_2d(g: CellGeometry):
     from ngcontact.geometry import profiles as pr
     if g.profile == "flat":
         return pr.flat(g.period)
+    # the keys a profile uses are required by CellGeometry.check (check_selected)
     if g.profile == "rectangular":
+        assert g.width is not None and g.depth is not None
         return pr.rectangular_valley(g.width, g.depth, g.period)
     if g.profile == "triangular":
+        assert g.angles is not None
         return pr.triangular_valley(g.angles[0], g.angles[1], g.width, g.period)
     if g.profile == "semicircular":
+        assert g.radius is not None
         return pr.semicircular_valley(g.radius, g.period)
     if g.profile == "sinusoid":
+        assert g.amplitude is not None
         return pr.sinusoid(g.amplitude, g.period)
     raise ValueError(f"profile {g.profile!r} is not a parametric 2D profile")
 
@@ -272,6 +278,7 @@ def load_states(scene: CellScene) -> list[dict]:
     to the cell problem; checks that the lists pair up.
     """
     L, dim = scene.load, scene.geometry.dim
+    assert L is not None  # required unless contact.geometric_only (CellScene.check)
     nt = dim - 1
     nkey = "pressure" if L.pressure is not None else "normal_jump"
     tkey = "shear" if L.shear is not None else "tangential_jump"
@@ -311,6 +318,7 @@ def effects(scene: CellScene) -> tuple[str, ...]:
     if scene.contact.friction != "none":
         out.append(f"{scene.contact.friction}_friction")
     L = scene.load
+    assert L is not None  # required unless contact.geometric_only (CellScene.check)
     out.append("pressure_load" if L.pressure is not None else "prescribed_normal_jump")
     if L.shear is not None and any(v != 0 for v in L.shear):
         out.append("shear_load")

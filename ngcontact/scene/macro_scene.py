@@ -267,7 +267,9 @@ class MacroScene:
         comps = COMPONENTS[self.geometry.setting]
         shape, setting = self.geometry.shape, self.geometry.setting
         labels = BOUNDARIES[shape, setting]
-        for what, items in (("supports", self.supports), ("loads", self.loads)):
+        groups: tuple[tuple[str, tuple[SupportSpec | LoadSpec, ...]], ...] = (
+            ("supports", self.supports), ("loads", self.loads))
+        for what, items in groups:
             for i, item in enumerate(items):
                 if item.boundary not in labels:
                     raise SceneError(f"{what}[{i}].boundary", item.boundary,

@@ -171,7 +171,9 @@ class DirectScene:
                 raise SceneError(f"materials.{name}.C", "...", "direct scenes take isotropic E, nu")
         g = self.geometry
         labels, comps = BOUNDARIES[g.shape], COMPONENTS[g.setting]
-        for key, items in (("supports", self.supports), ("loads", self.loads)):
+        groups: tuple[tuple[str, tuple[DirectSupport | DirectLoad, ...]], ...] = (
+            ("supports", self.supports), ("loads", self.loads))
+        for key, items in groups:
             for i, item in enumerate(items):
                 if item.boundary not in labels:
                     raise SceneError(f"{key}[{i}].boundary", item.boundary,
@@ -192,6 +194,8 @@ class DirectScene:
             if g.shape == "femur_stem":
                 self._check_femur_study()
                 return
+            # required for shape 'blocks' (DirectGeometry.check, run when the section was built)
+            assert g.length is not None and g.h_rough is not None and g.h_counter is not None
             for i, (x, y) in enumerate(st.probes):
                 if not (g.x0 < x < g.x0 + g.length and -g.h_rough < y < g.h_counter):
                     raise SceneError(f"study.probes[{i}]", (x, y), "must lie inside the blocks")
@@ -206,6 +210,7 @@ class DirectScene:
         """Probes inside a body and outside the band of the coarsest level; the band leaves points."""
         from ngcontact.geometry.resolved_bodies import distance_to_polyline, femur_stem_body, femur_stem_interface
         st, dims = self.study, self.geometry.femur_dims()
+        assert st is not None  # called from check only when the study is given
         segs = femur_stem_interface(dims)
         band = st.band * sum(float(np.hypot(b[0] - a[0], b[1] - a[1])) for a, b in segs) / st.periods[0]
         for i, pt in enumerate(st.probes):

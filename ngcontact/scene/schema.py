@@ -63,7 +63,9 @@ def param(default=dataclasses.MISSING, *, doc: str, units: str = "",
 def _named(text: str, fn: Callable[[Any], bool]) -> Check:
     def check(value):
         return None if fn(value) else text
-    check.text = text
+    # the description is kept as a function attribute, read back with
+    # getattr(check, "text", "") by all_of and describe
+    setattr(check, "text", text)
     return check
 
 
@@ -102,7 +104,7 @@ def all_of(*checks: Check) -> Check:
             if msg:
                 return msg
         return None
-    check.text = "; ".join(getattr(c, "text", "") for c in checks)
+    setattr(check, "text", "; ".join(getattr(c, "text", "") for c in checks))
     return check
 
 

@@ -38,15 +38,15 @@ def fit_rate(h: Sequence[float], error: Sequence[float]) -> float:
     ValueError
         Fewer than three levels, or a non-positive value.
     """
-    h = np.asarray(h, dtype=float)
+    hh = np.asarray(h, dtype=float)
     e = np.asarray(error, dtype=float)
-    if h.shape != e.shape or h.ndim != 1:
-        raise ValueError(f"h and error must be 1-d of equal length, got {h.shape} and {e.shape}")
-    if len(h) < 3:
-        raise ValueError(f"{len(h)} levels: a rate needs at least 3")
-    if not (np.all(h > 0) and np.all(e > 0) and np.all(np.isfinite(e))):
+    if hh.shape != e.shape or hh.ndim != 1:
+        raise ValueError(f"h and error must be 1-d of equal length, got {hh.shape} and {e.shape}")
+    if len(hh) < 3:
+        raise ValueError(f"{len(hh)} levels: a rate needs at least 3")
+    if not (np.all(hh > 0) and np.all(e > 0) and np.all(np.isfinite(e))):
         raise ValueError("mesh sizes and errors must be finite and > 0")
-    return float(np.polyfit(np.log(h), np.log(e), 1)[0])
+    return float(np.polyfit(np.log(hh), np.log(e), 1)[0])
 
 
 def expected_rates(order: int) -> dict:
