@@ -77,7 +77,7 @@ def test_effective_stiffness_stays_finite_as_kn_grows():
     """Interface compliance = penalty part ~ 1/k_n + asperity part (finite as k_n -> oo).
 
     The reference is the flat bonded laminate, so the hills' own compliance
-    remains when the penalty goes to infinity (DESIGN Sec. 3): the compliance
+    remains when the penalty goes to infinity (effective stiffness, :mod:`ngcontact.cell.stiffness`): the compliance
     decrements shrink tenfold per decade of ``k_n`` and the stiffness
     converges to a finite value.
     """

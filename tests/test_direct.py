@@ -6,7 +6,7 @@
   normal over many periods, periodic spaces, reactions).
 * The homogenized bundle law converges to the resolved solution at a rate
   of about eps on ``block_rect_valleys.toml`` and beats the whole-surface
-  linear law there (DESIGN Sec. 3).
+  linear law there (paper eqs. 31-34).
 """
 import json
 import os

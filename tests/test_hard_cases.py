@@ -8,7 +8,7 @@ A tier of its own (marker ``hard``), kept out of the default tier (marker
   ``p (h_r / M_r + h_c / M_c + 1 / k_n)`` with the P-wave modulus
   ``M = E (1 - nu) / ((1 + nu)(1 - 2 nu))``, and the contact pressure is
   ``k_n`` times the penetration everywhere (patch test);
-* Westergaard's sinusoid (DESIGN Sec. 8) for partial contact;
+* Westergaard's sinusoid (:mod:`ngcontact.verification.oracles`) for partial contact;
 * the identity ``k_n0 + k_t0 = k_n |S_C| / |T|`` (trace of eq. 34) for the
   whole-surface coefficients of any profile.
 """

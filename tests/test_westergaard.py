@@ -1,9 +1,9 @@
-"""Westergaard's periodic sinusoidal contact (DESIGN Sec. 8).
+"""Westergaard's periodic sinusoidal contact (oracle: :mod:`ngcontact.verification.oracles`).
 
 Two tiers: the default tier solves the same problem on a coarser, higher-order
 cell built here (order 3, interface mesh 0.01, about 15k dofs, a few seconds);
 the slow tier solves the shipped scene (order 2, interface mesh 0.005).  Both
-assert the tolerances of issue 3.
+assert the tolerances stated with each test.
 
 Gap ``2h sin^2(pi x)``, ``p* = pi E* h``; partial contact of half-width ``a``
 with ``p = p* sin^2(pi a)`` and pressure

@@ -21,7 +21,7 @@ bound gives the weights ``|(I - n n^T) e_p|`` (in 2D ``|beta_2|`` for ``G_n``
 and ``|beta_1|`` for ``G_t``, the paper's ``|alpha|``).
 
 The same integrals, left unsummed over the quadrature points of ``S_C``, are
-the *direction bundle* of the macro interface law (DESIGN Sec. 3):
+the *direction bundle* of the macro interface law (paper eqs. 31-33):
 :func:`direction_bundle`.
 
 Orientation of the normal: Netgen orients a boundary element's normal from

@@ -13,7 +13,7 @@ or the axisymmetric femur with a stem) with a flat interface, with
 * ``linear``: its linearization with the whole surface in contact,
   ``K0 = sum_q w_q n_q n_q^T`` (paper eq. 34), independent of ``eps``;
 * ``effective``: the linear law whose matrix is the effective stiffness of
-  the cell scaled to the period ``eps`` (DESIGN Sec. 3, "Beyond the
+  the cell scaled to the period ``eps`` (:mod:`ngcontact.cell.stiffness`, "Beyond the
   paper": the tangent of the mean traction with respect to the interface's
   share of the far faces' relative displacement, including the compliance
   of the asperities), evaluated by a cell solve at the mean interface
