@@ -104,7 +104,7 @@ def law_from_cell(path: str, *, dim: int, linear: bool = False, length_unit: flo
         if dim == 3:
             raise SceneError("interface.law", "linear", "a linear law from a cell is available in 2D and "
                              "axisymmetry; use the bundle in 3D")
-        law = il.linearized(law)
+        return il.linearized(law), info
     return law, info
 
 

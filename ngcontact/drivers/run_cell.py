@@ -10,6 +10,7 @@ stress per body with its location (see :mod:`ngcontact.cell.cell_problem`).
 from __future__ import annotations
 
 import logging
+from typing import Any
 
 
 from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, model_of
@@ -30,7 +31,7 @@ def run(scene, clock) -> Outcome:
     G = c.G if c.friction == "tresca" else None
     with clock.stage("whole-surface coefficients"):
         whole = coefficients(cell, kn=c.k_n, gap=gap_cf(scene), G=G).as_dict()
-    results = {"whole_surface": whole}
+    results: dict[str, Any] = {"whole_surface": whole}
     if c.geometric_only:
         return Outcome(results=results, ndof=0)
     with clock.stage("setup"):

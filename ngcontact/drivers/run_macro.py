@@ -190,7 +190,9 @@ def field_samples(sol: M.MacroSolution, fields: dict) -> dict:
     names = [n for n in fields if n in ("sigma_r", "sigma_xx")][:1] + \
             [n for n in fields if n in ("sigma_z", "sigma_yy")][:1] + ["von_mises", "von_mises_strain"]
     rule = ng.IntegrationRule([(1e-3, 1e-3), (1 - 2e-3, 1e-3), (1e-3, 1 - 2e-3)], [0.0] * 3)
-    xs, ys, vals = [], [], {n: [] for n in names}
+    xs: list[np.ndarray] = []
+    ys: list[np.ndarray] = []
+    vals: dict[str, list[np.ndarray]] = {n: [] for n in names}
     for region in (p.rough, p.counter):
         mips = mesh.MapToAllElements(rule, mesh.Materials(region))
         xy = np.asarray(ng.CF((ng.x, ng.y))(mips)).reshape(-1, 2)

@@ -184,6 +184,7 @@ def reactions(scene, sol) -> dict:
         for region, u in (("rough", sol.u_rough), ("counter", sol.u_counter)):
             r = D.boundary_reaction(mesh, p.setting, p.materials[region], u, region, label, p.order, about=about)
             total = r if total is None else {k: total[k] + r[k] for k in r}
+        assert total is not None  # set by the loop over both bodies
         out[label] = {k: total[k] for k in keep}
     return out
 

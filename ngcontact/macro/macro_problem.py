@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import ngsolve as ng
 import numpy as np
@@ -54,7 +55,7 @@ from ngcontact.fem import two_body
 from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.fem.two_body import Load, Support, boundary_labels, interface_normal  # noqa: F401  (public names of the macro problem)
 from ngcontact.laws import homogenized as il
-from ngcontact.fem.materials import von_mises
+from ngcontact.fem.materials import ElasticLaw, von_mises
 from ngcontact.solvers.newton import minimize
 from ngcontact.errors import ModelError
 
@@ -89,15 +90,15 @@ class MacroProblem:
         Label of the interface boundary ``S_0``.
     """
 
-    mesh: object
+    mesh: ng.Mesh
     setting: str
     rough: str
     counter: str
-    materials: dict
+    materials: dict[str, ElasticLaw]
     law: il.InterfaceLaw
-    gap: object = 0.0
-    supports: tuple = ()
-    loads: tuple = ()
+    gap: float | ng.CoefficientFunction = 0.0
+    supports: tuple[Support, ...] = ()
+    loads: tuple[Load, ...] = ()
     order: int = 2
     interface: str = "interface"
 
@@ -108,13 +109,13 @@ class MacroSolution:
 
     problem: MacroProblem
     gfu: ng.GridFunction
-    u_rough: object
-    u_counter: object
+    u_rough: ng.GridFunction
+    u_counter: ng.GridFunction
     frame: list
     local_jump: list
-    threshold: object
-    history: dict = field(default_factory=dict)
-    previous: object = None  # the solution the friction threshold was evaluated at
+    threshold: ng.CoefficientFunction | None
+    history: dict[str, Any] = field(default_factory=dict)
+    previous: ng.GridFunction | None = None  # the solution the friction threshold was evaluated at
 
     @property
     def ndof(self) -> int:
@@ -197,8 +198,8 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     n0 = two_body.interface_normal(mesh, problem.rough, problem.interface)
     frame = il.local_frame(n0, mesh.dim)
     law = problem.law
-    newton = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
-    history = {"newton": [], "fixed_point_changes": []}
+    newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
+    history: dict[str, Any] = {"newton": [], "fixed_point_changes": []}
     g0 = _gap_cf(problem.gap)
     old = ng.GridFunction(fes)
     a_old = _local(frame, old.components[0] - old.components[1])
@@ -298,6 +299,7 @@ def _sample_rule(dim: int, inset: float = 1e-3):
     """Points at the vertices (moved ``inset`` inwards, off the axis ``r = 0``
     where the hoop strain ``u_r / r`` is 0/0), edge midpoints and centroid."""
     e = inset
+    pts: list[tuple[float, ...]]
     if dim == 2:
         pts = [(e, e), (1 - 2 * e, e), (e, 1 - 2 * e), (0.5, e), (0.5 - e, 0.5 - e), (e, 0.5), (1 / 3, 1 / 3)]
     else:
@@ -315,7 +317,7 @@ def field_extrema(sol: MacroSolution, fields: dict) -> dict:
     mesh = p.mesh
     rule = _sample_rule(mesh.dim)
     coords = ng.CF((ng.x, ng.y, ng.z)[:mesh.dim])
-    out = {name: {} for name in fields}
+    out: dict[str, dict[str, dict[str, Any]]] = {name: {} for name in fields}
     for region in (p.rough, p.counter):
         mips = mesh.MapToAllElements(rule, mesh.Materials(region))
         xyz = np.asarray(coords(mips)).reshape(-1, mesh.dim)
@@ -400,9 +402,10 @@ def _status(sol: MacroSolution, press, jt) -> list:
     else:
         if isinstance(law.normal, il.FieldLaw):
             kt = 0.0
+        elif isinstance(law.normal, il.TabulatedLaw):
+            kt = law.normal.kt
         else:
-            K = law.normal.matrix(2) if not isinstance(law.normal, il.TabulatedLaw) else None
-            kt = law.normal.kt if K is None else K[1, 1]
+            kt = law.normal.matrix(2)[1, 1]
         closed = np.full(len(press), "stick" if kt > 0 else "slip")
     return [("open" if pv <= 0 else str(c)) for pv, c in zip(press, closed)]
 
@@ -412,7 +415,7 @@ def _chain(starts, ends) -> list:
     def key(p):
         return (round(float(p[0]), 12), round(float(p[1]), 12))
 
-    at = {}
+    at: dict[tuple[float, float], list[int]] = {}
     for e, (a, b) in enumerate(zip(starts, ends)):
         at.setdefault(key(a), []).append(e)
         at.setdefault(key(b), []).append(e)

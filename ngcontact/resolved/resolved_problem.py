@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
+from typing import Any
 
 import ngsolve as ng
 import numpy as np
@@ -48,6 +49,7 @@ from ngcontact.laws import homogenized as il
 from ngcontact.errors import ConvergenceError
 from ngcontact.fem import two_body
 from ngcontact.fem.elasticity import COMPONENTS
+from ngcontact.fem.materials import ElasticLaw
 from ngcontact.fem.two_body import Load, Support, interface_normal  # noqa: F401  (public names of the resolved problem)
 from ngcontact.solvers.newton import minimize
 from ngcontact.errors import ModelError
@@ -105,20 +107,20 @@ class DirectProblem:
         Label of the interface boundary.
     """
 
-    mesh: object
-    materials: dict
+    mesh: ng.Mesh
+    materials: dict[str, ElasticLaw]
     k_n: float
     setting: str = "plane_strain"
-    gap: object = None
+    gap: float | ng.CoefficientFunction | None = None
     friction: Friction | None = None
-    supports: tuple = ()
-    loads: tuple = ()
+    supports: tuple[Support, ...] = ()
+    loads: tuple[Load, ...] = ()
     order: int = 2
     periodic: bool = False
     contact: str = "contact"
     coulomb_rtol: float = 1e-8
     coulomb_max_iter: int = 40
-    law: object = None
+    law: il.InterfaceLaw | None = None
 
 
 @dataclass
@@ -127,12 +129,12 @@ class DirectSolution:
 
     problem: DirectProblem
     gfu: ng.GridFunction
-    u_rough: object
-    u_counter: object
-    normal: object
-    jump: object
-    pressure: object
-    history: dict = field(default_factory=dict)
+    u_rough: ng.GridFunction
+    u_counter: ng.GridFunction
+    normal: ng.CoefficientFunction
+    jump: ng.CoefficientFunction
+    pressure: ng.CoefficientFunction
+    history: dict[str, Any] = field(default_factory=dict)
 
     @property
     def ndof(self) -> int:
@@ -221,8 +223,8 @@ def solve(problem: DirectProblem, *, rtol: float = 1e-10, atol: float = 0.0, max
     gfu = ng.GridFunction(fes)
     two_body.set_dirichlet(mesh, problem.setting, problem.supports, gfu)
     n = two_body.interface_normal(mesh, "rough", problem.contact)
-    newton = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
-    history = {"newton": [], "coulomb_changes": []}
+    newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
+    history: dict[str, Any] = {"newton": [], "coulomb_changes": []}
     start = _form(problem, fes, n, surrogate=True)
     history["newton"].append(minimize(start, gfu, quadratic=True, **newton).as_dict())
     newton["atol"] = max(atol, rtol * history["newton"][0]["residuals"][0])
