@@ -97,7 +97,9 @@ def test_shifted_profile_is_the_same_surface(name, fraction):
     moved = pr.shifted(profile, fraction)
     assert moved.pieces[0].start[0] == pytest.approx(0.0, abs=1e-14)
     assert moved.pieces[-1].end[0] == pytest.approx(moved.period, abs=1e-14)
-    length = lambda p: sum(_piece_length(q) for q in p.pieces)
+    def length(p):
+        return sum(_piece_length(q) for q in p.pieces)
+
     assert length(moved) == pytest.approx(length(profile), rel=1e-12)
     assert moved.bounds == pytest.approx(profile.bounds, abs=1e-14)
     # the first point of the moved chain is the original surface at x = fraction * period
