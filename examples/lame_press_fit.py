@@ -29,7 +29,7 @@ import numpy as np
 
 import ngcontact
 from ngcontact.scene.loader import from_dict
-from ngcontact.verification.oracles import lame_press_fit_pressure
+from ngcontact.verification.lame import lame_press_fit_pressure
 
 A, B, C = 0.010, 0.020, 0.040          # shaft bore, interface, hub outer radius [m]
 STEEL, BRONZE = (210e9, 0.30), (110e9, 0.34)   # (E [Pa], nu)

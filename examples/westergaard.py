@@ -21,7 +21,7 @@ paper's cell problem with a flat interface carrying the sinusoid as its
 initial gap (the small-slope model the formula assumes), a stiff penalty
 ``k_n = 1e3 E`` and five loads ``p/p*`` from 0.05 to 1.2.  The example reads
 the scene with ``ngcontact.load`` to compute ``p*`` from its own numbers
-(:mod:`ngcontact.verification.oracles`), solves it with ``ngcontact.solve``
+(:mod:`ngcontact.verification.westergaard`), solves it with ``ngcontact.solve``
 and prints the contact fraction of every load next to Westergaard's.  The
 key number is the fraction at ``p = p*/2`` (exactly 1/2); the finite penalty
 lets the bodies overlap slightly and widens the patches by about 0.1-0.3 %.
@@ -31,7 +31,8 @@ Run from the repository's top directory (scene paths are relative to it)::
     python examples/westergaard.py
 """
 import ngcontact
-from ngcontact.verification.oracles import e_star, westergaard_contact_fraction, westergaard_p_star
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
 SCENE = "geometries/cells/westergaard.toml"
 

@@ -1,6 +1,6 @@
 """What accuracy costs in time for the cell problem: two work-precision studies.
 
-1. Westergaard contact fraction (:mod:`ngcontact.verification.oracles`): flat cell, gap
+1. Westergaard contact fraction (:mod:`ngcontact.verification.westergaard`): flat cell, gap
    ``2h sin^2(pi x)`` with ``h = 0.01``, ``E = 1``, ``nu = 0.3``, one load
    ``p/p* = 0.2`` (exact fraction ``(2/pi) asin(sqrt(0.2))``).  The error
    contains the penalty error (``O(1/k_n)``) as well as the discretization
@@ -37,7 +37,8 @@ from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.fem.materials import isotropic
 from ngcontact.output.report import write_csv
-from ngcontact.verification.oracles import e_star, westergaard_contact_fraction, westergaard_p_star
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
 log = logging.getLogger("work_precision_cell")
 

@@ -14,7 +14,8 @@ from ngcontact.cell.stiffness import reference_stiffness
 from ngcontact.errors import ConvergenceError
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.fem.materials import isotropic
-from ngcontact.verification.oracles import e_star, westergaard_p_star
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_p_star
 
 LAW = isotropic(1.0, 0.3)
 

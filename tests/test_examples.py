@@ -3,10 +3,11 @@
 Each example is imported from its file (``examples/`` is not a package) and
 its ``main()`` called from the repository's top directory, as the examples'
 docstrings say to run them.  Its key number is checked against the analytic
-oracle where there is one (:mod:`ngcontact.verification.oracles`), else
-against the value recorded when the example was written; every tolerance
-says why it is what it is.  The shipped two-scale scene takes 10-20 s and is
-in the slow tier, like its other end-to-end test (tests/test_twoscale.py).
+oracle where there is one (:mod:`ngcontact.verification.westergaard`,
+:mod:`ngcontact.verification.lame`), else against the value recorded when
+the example was written; every tolerance says why it is what it is.  The
+shipped two-scale scene takes 10-20 s and is in the slow tier, like its
+other end-to-end test (tests/test_twoscale.py).
 """
 import ast
 import importlib.util
@@ -15,7 +16,8 @@ import textwrap
 
 import pytest
 
-from ngcontact.verification import oracles
+from ngcontact.verification.lame import lame_press_fit_pressure
+from ngcontact.verification.westergaard import westergaard_contact_fraction
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXAMPLES = os.path.join(ROOT, "examples")
@@ -75,7 +77,7 @@ def test_cell_under_shear_loses_tangential_stiffness(run):
 
 def test_westergaard_contact_fraction_at_half_the_full_contact_pressure(run):
     fraction, _ = run("westergaard.py")
-    exact = oracles.westergaard_contact_fraction(0.5, 1.0)     # = 1/2
+    exact = westergaard_contact_fraction(0.5, 1.0)     # = 1/2
     # 0.5 %: the scene's penalty k_n = 1e3 E lets the bodies overlap and widens the
     # patches by 0.1-0.3 % (observed +0.08 % at p*/2); the tolerance of tests/test_westergaard.py.
     assert fraction == pytest.approx(exact, rel=5e-3)
@@ -85,11 +87,11 @@ def test_lame_press_fit_mean_pressure(run):
     p, _ = run("lame_press_fit.py")
     lame = _load("lame_press_fit.py")
     args = (lame.A, lame.B, lame.C, *lame.STEEL, *lame.BRONZE, lame.DELTA)
-    exact = oracles.lame_press_fit_pressure(*args, k_n=lame.K_N)
+    exact = lame_press_fit_pressure(*args, k_n=lame.K_N)
     # Order-4 curved elements meet Lame to ~3e-6 (observed); 2e-3 leaves the mesher room and is
     # still 100 times below what the interface compliance changes (next assertion).
     assert p == pytest.approx(exact, rel=2e-3)
-    assert p < 0.9 * oracles.lame_press_fit_pressure(*args)
+    assert p < 0.9 * lame_press_fit_pressure(*args)
 
 
 def test_femur_strength_safety_factor(run):

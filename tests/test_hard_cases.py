@@ -8,7 +8,7 @@ A tier of its own (marker ``hard``), kept out of the default tier (marker
   ``p (h_r / M_r + h_c / M_c + 1 / k_n)`` with the P-wave modulus
   ``M = E (1 - nu) / ((1 + nu)(1 - 2 nu))``, and the contact pressure is
   ``k_n`` times the penetration everywhere (patch test);
-* Westergaard's sinusoid (:mod:`ngcontact.verification.oracles`) for partial contact;
+* Westergaard's sinusoid (:mod:`ngcontact.verification.westergaard`) for partial contact;
 * the identity ``k_n0 + k_t0 = k_n |S_C| / |T|`` (trace of eq. 34) for the
   whole-surface coefficients of any profile.
 """
@@ -26,7 +26,8 @@ from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.fem.materials import isotropic
-from ngcontact.verification.oracles import e_star, westergaard_contact_fraction, westergaard_p_star
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
 pytestmark = [pytest.mark.slow, pytest.mark.hard]
 

@@ -11,7 +11,8 @@ from ngcontact.cell.cell_problem import CellModel, CellProblem
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry import bodies as gm
 from ngcontact.fem.materials import isotropic
-from ngcontact.verification.oracles import e_star, westergaard_p_star
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_p_star
 
 import ngsolve as ng
 

@@ -1,4 +1,4 @@
-"""Westergaard's periodic sinusoidal contact (oracle: :mod:`ngcontact.verification.oracles`).
+"""Westergaard's periodic sinusoidal contact (oracle: :mod:`ngcontact.verification.westergaard`).
 
 Two tiers: the default tier solves the same problem on a coarser, higher-order
 cell built here (order 3, interface mesh 0.01, about 15k dofs, a few seconds);
@@ -25,7 +25,8 @@ from ngcontact.drivers.build import build_cell, model_of
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.drivers.build import cell_loads as loads
 from ngcontact.fem.materials import isotropic
-from ngcontact.verification.oracles import e_star, westergaard_contact_fraction, westergaard_p_star
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
 SCENE = os.path.join(os.path.dirname(__file__), "..", "geometries", "cells", "westergaard.toml")
 
