@@ -1,16 +1,18 @@
-"""Homogenized interface laws on the macro interface ``S_0`` as energy densities.
+"""Homogenized interface laws on the macro interface ``S_0``: the law values.
 
-A law is a function of the macro jump ``J = u_rough - u_counter`` written in
-the interface's local frame, ``a = (a_n, a_t)`` with ``a_n = J . n0`` and
-``a_t = J . t0`` in 2D and axisymmetry, ``a = (J . n0, J . t1, J . t2)`` in
-3D (:func:`local_frame`; ``n0`` points from ``rough`` into ``counter``, so
-``a_n > 0`` closes the interface).  The macro normal gap ``g0`` (length,
-``g0 < 0`` is an initial interference, i.e. a press fit) shifts the law along
-``n0``.  The traction ``tau = dW/da`` is what the rough body transmits to the
-counter body; its normal component is the contact pressure ``p = tau_n``
-(compression positive), its tangential part the shear.
+A law (paper eqs. 31-34, 38-44, 69-71) is an energy density ``W(a)`` of the
+macro jump ``J = u_rough - u_counter`` written in the interface's local
+frame, ``a = (a_n, a_t)`` with ``a_n = J . n0`` and ``a_t = J . t0`` in 2D
+and axisymmetry, ``a = (J . n0, J . t1, J . t2)`` in 3D
+(:mod:`ngcontact.laws.local_frame`; ``n0`` points from ``rough`` into
+``counter``, so ``a_n > 0`` closes the interface).  The macro normal gap
+``g0`` (length, ``g0 < 0`` is an initial interference, i.e. a press fit)
+shifts the law along ``n0``.  The traction ``tau = dW/da`` is what the rough
+body transmits to the counter body; its normal component is the contact
+pressure ``p = tau_n`` (compression positive), its tangential part the shear.
 
-Laws (frozen dataclasses; the energies are built by :func:`energy`):
+Laws (frozen dataclasses, values only; their energy ``W(a)`` and traction
+``tau = dW/da`` are evaluated by :mod:`ngcontact.laws.interface_energy`):
 
 :class:`LinearLaw`
     Anisotropic Winkler law of paper eqs. 34 and 69-71 with the matrix
@@ -56,10 +58,8 @@ Laws (frozen dataclasses; the energies are built by :func:`energy`):
     sticking interface slips at most ``w``.  Coulomb's ``G = mu0 p`` is not
     the derivative of an energy; :mod:`ngcontact.macro.macro_problem` treats it by a fixed
     point on the pressure (``G`` frozen at the previous solution's ``p``), see
-    there.  The energy here takes ``G`` as given.
-
-All functions work on NumPy arrays (for tests and tables) and on NGSolve
-CoefficientFunctions alike.
+    there.  The friction energy of
+    :mod:`ngcontact.laws.interface_energy` takes ``G`` as given.
 """
 from __future__ import annotations
 
@@ -68,7 +68,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from ngcontact.errors import ModelError
-from ngcontact.laws.huber import huber_of_square, huber_slope, is_numeric
 
 if TYPE_CHECKING:
     import ngsolve as ng
@@ -310,168 +309,3 @@ def linearized(law: BundleLaw) -> LinearLaw:
         raise ModelError("a 3D bundle is linearized to a LinearLaw only if transversely isotropic")
     return LinearLaw(kn=float(K[0, 0]), kt=float(K[1, 1]), knt=float(K[0, 1]),
                      gap_force=(float(gf[0]), float(gf[1])))
-
-
-# -------------------------------------------------------------- backend
-def _ramp(x):
-    """``[x]_+``."""
-    if is_numeric(x):
-        return np.maximum(x, 0.0)
-    import ngsolve as ng
-    return ng.IfPos(x, x, 0.0)
-
-
-# ----------------------------------------------------------- energies
-def normal_energy(law: NormalLaw, a, g0=0.0, closed: bool = False):
-    """Energy density of the normal (and elastic tangential) law at local jump ``a``.
-
-    Parameters
-    ----------
-    law
-        :class:`LinearLaw`, :class:`BundleLaw` or :class:`TabulatedLaw`.
-    a
-        Local jump components ``(a_n, a_t)`` or ``(a_n, a_t1, a_t2)``.
-    g0
-        Macro normal gap (number or CoefficientFunction); ``< 0`` interference.
-    closed
-        Replace the law by its quadratic "all closed" surrogate: every bundle
-        direction active, the table's first segment extended both ways (a
-        start value for Newton that holds every body in place).
-    """
-    dim = len(a)
-    ramp = (lambda x: x) if closed else _ramp
-    if isinstance(law, LinearLaw):
-        K = law.matrix(dim)
-        e = [a[0] - g0] + list(a[1:])
-        W = 0.5 * sum(K[i, j] * e[i] * e[j] for i in range(dim) for j in range(dim) if K[i, j] != 0)
-        return W - law.gap_force[0] * a[0] - law.gap_force[1] * a[1]
-    if isinstance(law, BundleLaw):
-        _check_dim(law, dim)
-        W = 0
-        for w, n, g in zip(law.weights, law.directions, law.g):
-            W = W + 0.5 * w * ramp(_dot(n, a) - g - n[0] * g0) ** 2
-        return W
-    if isinstance(law, TabulatedLaw):
-        kinks, slopes = law.ramps()
-        c = a[0] - g0
-        if closed:
-            first = next(k for k, s in enumerate(slopes) if s != 0)
-            kinks, slopes = kinks[first:first + 1], slopes[first:first + 1]
-        W = sum(0.5 * s * ramp(c - ci) ** 2 for ci, s in zip(kinks, slopes) if s != 0)
-        if law.kt > 0:
-            W = W + 0.5 * law.kt * sum(ai * ai for ai in a[1:])
-        return W
-    if isinstance(law, FieldLaw):
-        return 0.5 * law.kn * ramp(a[0] - g0 - law.offset) ** 2
-    raise TypeError(f"unknown interface law {type(law).__name__}")
-
-
-def normal_traction(law: NormalLaw, a, g0=0.0) -> list:
-    """``dW/da`` of :func:`normal_energy`: local traction components."""
-    dim = len(a)
-    if isinstance(law, LinearLaw):
-        K = law.matrix(dim)
-        e = [a[0] - g0] + list(a[1:])
-        tau = [sum(K[i, j] * e[j] for j in range(dim) if K[i, j] != 0) for i in range(dim)]
-        tau[0] = tau[0] - law.gap_force[0]
-        tau[1] = tau[1] - law.gap_force[1]
-        return tau
-    if isinstance(law, BundleLaw):
-        _check_dim(law, dim)
-        tau = [0] * dim
-        for w, n, g in zip(law.weights, law.directions, law.g):
-            f = w * _ramp(_dot(n, a) - g - n[0] * g0)
-            tau = [tau[i] + f * n[i] for i in range(dim)]
-        return tau
-    if isinstance(law, TabulatedLaw):
-        kinks, slopes = law.ramps()
-        c = a[0] - g0
-        p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
-        return [p] + [law.kt * ai for ai in a[1:]]
-    if isinstance(law, FieldLaw):
-        return [law.kn * _ramp(a[0] - g0 - law.offset)] + [0.0 * ai for ai in a[1:]]
-    raise TypeError(f"unknown interface law {type(law).__name__}")
-
-
-def pressure(law: NormalLaw, a, g0=0.0):
-    """Contact pressure ``p = tau_n`` (compression positive)."""
-    return normal_traction(law, a, g0)[0]
-
-
-def friction_energy(friction: Friction, a, G):
-    """``G huber(|a_t|, w)`` with the threshold field ``G`` given."""
-    return G * huber_of_square(_tangential_norm2(a), friction.width)
-
-
-def friction_traction(friction: Friction, a, G) -> list:
-    """``d/da`` of :func:`friction_energy` (``G`` frozen)."""
-    f = G * huber_slope(_tangential_norm2(a), friction.width)
-    return [0.0 * a[0]] + [f * ai for ai in a[1:]]
-
-
-def threshold(friction: Friction, p):
-    """``G = mu [p]_+ + G0`` for a pressure ``p``."""
-    return friction.mu * _ramp(p) + friction.threshold
-
-
-def energy(law: InterfaceLaw, a, g0=0.0, G=None):
-    """Total interface energy density; ``G`` is the friction threshold field
-    (default: ``threshold(friction, 0)``, i.e. ``G0`` only)."""
-    W = normal_energy(law.normal, a, g0)
-    if law.friction is not None:
-        if G is None:
-            G = law.friction.threshold
-        W = W + friction_energy(law.friction, a, G)
-    return W
-
-
-def traction(law: InterfaceLaw, a, g0=0.0, G=None) -> list:
-    """Local traction ``dW/da`` of :func:`energy` (same ``G``)."""
-    tau = normal_traction(law.normal, a, g0)
-    if law.friction is not None:
-        if G is None:
-            G = law.friction.threshold
-        ft = friction_traction(law.friction, a, G)
-        tau = [t + f for t, f in zip(tau, ft)]
-    return tau
-
-
-def _tangential_norm2(a):
-    return sum(ai * ai for ai in a[1:])
-
-
-def _dot(n, a):
-    return sum(float(ni) * ai for ni, ai in zip(n, a) if ni != 0)
-
-
-def _check_dim(law: BundleLaw, dim: int) -> None:
-    if len(law.directions[0]) != dim:
-        raise ModelError(f"the bundle's directions have {len(law.directions[0])} components, "
-                         f"the interface frame {dim}")
-
-
-# --------------------------------------------------------------- frame
-def local_frame(n0, dim: int, reference=(1.0, 0.0, 0.0)) -> list:
-    """Local basis ``[n0, t0]`` (2D) or ``[n0, t1, t2]`` (3D) as CoefficientFunctions.
-
-    2D and axisymmetric: ``t0 = (n0_y, -n0_x)``, i.e. ``n0`` turned clockwise,
-    so that ``n0 = e_y`` gives ``t0 = e_x`` as in the cells; on the stem's
-    cylinder (``n0 = e_r``) ``t0 = -e_z``.  3D: ``t1`` is the unit
-    projection of ``reference`` on the tangent plane (``e_y`` where
-    ``reference`` is nearly normal), ``t2 = n0 x t1``.
-    """
-    import ngsolve as ng
-    if dim == 2:
-        return [n0, ng.CF((n0[1], -n0[0]))]
-    r1 = ng.CF(tuple(float(c) for c in reference))
-    alt = np.cross(reference, (0.0, 0.0, 1.0))
-    if np.linalg.norm(alt) < 0.5:
-        alt = np.cross(reference, (0.0, 1.0, 0.0))
-    r2 = ng.CF(tuple(float(c) for c in alt / np.linalg.norm(alt)))
-    p1 = r1 - ng.InnerProduct(r1, n0) * n0
-    p2 = r2 - ng.InnerProduct(r2, n0) * n0
-    use1 = ng.InnerProduct(p1, p1) - 0.25
-    t = ng.IfPos(use1, 1, 0) * p1 + ng.IfPos(use1, 0, 1) * p2
-    t1 = t / ng.sqrt(ng.InnerProduct(t, t))
-    t2 = ng.Cross(n0, t1)
-    return [n0, t1, t2]

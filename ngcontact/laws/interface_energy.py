@@ -1,0 +1,205 @@
+"""The interface energy ``W(a)`` of a homogenized law and its gradient, the traction.
+
+Evaluates the laws of :mod:`ngcontact.laws.homogenized` at the local jump
+``a = (a_n, a_t)`` (2D, axisymmetry) or ``(a_n, a_t1, a_t2)`` (3D) of
+:mod:`ngcontact.laws.local_frame`, with the macro normal gap ``g0``, ``e_n``
+the first local axis and ``[x]_+ = max(x, 0)`` (:func:`_ramp`).  The traction
+``tau = dW/da`` is what the rough body transmits to the counter body, its
+normal component the contact pressure ``p = tau_n`` (compression positive).
+
+Normal (and elastic tangential) laws, :func:`normal_energy` and
+:func:`normal_traction`:
+
+``LinearLaw`` (paper eqs. 34 and 69-71)::
+
+    W(a) = 1/2 (a - g0 e_n) . K0 (a - g0 e_n) - g0_vec . a
+    tau  = K0 (a - g0 e_n) - g0_vec
+
+``BundleLaw`` (paper eqs. 31-33; ``tau_n`` and ``tau_t`` are the
+homogenized stresses of eqs. 32 and 33 with the integral over ``S_C``
+replaced by the weighted directions)::
+
+    W(a) = sum_q w_q/2 [n_q . a - g_q - beta1_q g0]_+^2,    beta1_q = n_q . e_n
+    tau  = sum_q w_q   [n_q . a - g_q - beta1_q g0]_+ n_q
+
+``TabulatedLaw`` (closure ``c = a_n - g0``, kinks ``c_i``, slope increments ``s_i``)::
+
+    W(a) = sum_i s_i/2 [c - c_i]_+^2 + k_t/2 |a_t|^2
+    tau  = (sum_i s_i [c - c_i]_+,  k_t a_t)
+
+``FieldLaw`` (eq. 34 on the real contact set of the cell at ``x``, Sec. 3.5)::
+
+    W(a) = k_n0(x)/2 [a_n - g0 - c(x)]_+^2
+    tau  = (k_n0(x) [a_n - g0 - c(x)]_+,  0)
+
+With ``closed=True`` :func:`normal_energy` is the quadratic "all closed"
+surrogate (a start value for Newton): every ramp ``[x]_+`` replaced by ``x``,
+and a table reduced to its first segment of nonzero slope, extended both ways.
+
+Friction (paper eqs. 38-44; the Huber function of eq. 16,
+:mod:`ngcontact.laws.huber`), :func:`threshold`, :func:`friction_energy`
+and :func:`friction_traction`::
+
+    G     = mu0 [p]_+ + G0                          (eqs. 42-43)
+    W_f(a) = G huber(|a_t|, w)
+    tau_f  = (0,  G a_t / max(|a_t|, w))            (G held fixed)
+
+Total (the interface integrand of eq. 44), :func:`energy` and
+:func:`traction`: ``W = W_normal + W_f`` and ``tau = tau_normal + tau_f``,
+with ``G = G0`` unless a threshold field is given.
+
+All functions work on NumPy arrays (for tests and tables) and on NGSolve
+CoefficientFunctions alike.
+"""
+from __future__ import annotations
+
+import numpy as np
+from ngcontact.errors import ModelError
+from ngcontact.laws.homogenized import (
+    BundleLaw,
+    FieldLaw,
+    Friction,
+    InterfaceLaw,
+    LinearLaw,
+    NormalLaw,
+    TabulatedLaw,
+)
+from ngcontact.laws.huber import huber_of_square, huber_slope, is_numeric
+
+
+# -------------------------------------------------------------- backend
+def _ramp(x):
+    """``[x]_+``."""
+    if is_numeric(x):
+        return np.maximum(x, 0.0)
+    import ngsolve as ng
+    return ng.IfPos(x, x, 0.0)
+
+
+# ----------------------------------------------------------- energies
+def normal_energy(law: NormalLaw, a, g0=0.0, closed: bool = False):
+    """Energy density of the normal (and elastic tangential) law at local jump ``a``.
+
+    Parameters
+    ----------
+    law
+        :class:`LinearLaw`, :class:`BundleLaw` or :class:`TabulatedLaw`.
+    a
+        Local jump components ``(a_n, a_t)`` or ``(a_n, a_t1, a_t2)``.
+    g0
+        Macro normal gap (number or CoefficientFunction); ``< 0`` interference.
+    closed
+        Replace the law by its quadratic "all closed" surrogate: every bundle
+        direction active, the table's first segment extended both ways (a
+        start value for Newton that holds every body in place).
+    """
+    dim = len(a)
+    ramp = (lambda x: x) if closed else _ramp
+    if isinstance(law, LinearLaw):
+        K = law.matrix(dim)
+        e = [a[0] - g0] + list(a[1:])
+        W = 0.5 * sum(K[i, j] * e[i] * e[j] for i in range(dim) for j in range(dim) if K[i, j] != 0)
+        return W - law.gap_force[0] * a[0] - law.gap_force[1] * a[1]
+    if isinstance(law, BundleLaw):
+        _check_dim(law, dim)
+        W = 0
+        for w, n, g in zip(law.weights, law.directions, law.g):
+            W = W + 0.5 * w * ramp(_dot(n, a) - g - n[0] * g0) ** 2
+        return W
+    if isinstance(law, TabulatedLaw):
+        kinks, slopes = law.ramps()
+        c = a[0] - g0
+        if closed:
+            first = next(k for k, s in enumerate(slopes) if s != 0)
+            kinks, slopes = kinks[first:first + 1], slopes[first:first + 1]
+        W = sum(0.5 * s * ramp(c - ci) ** 2 for ci, s in zip(kinks, slopes) if s != 0)
+        if law.kt > 0:
+            W = W + 0.5 * law.kt * sum(ai * ai for ai in a[1:])
+        return W
+    if isinstance(law, FieldLaw):
+        return 0.5 * law.kn * ramp(a[0] - g0 - law.offset) ** 2
+    raise TypeError(f"unknown interface law {type(law).__name__}")
+
+
+def normal_traction(law: NormalLaw, a, g0=0.0) -> list:
+    """``dW/da`` of :func:`normal_energy`: local traction components."""
+    dim = len(a)
+    if isinstance(law, LinearLaw):
+        K = law.matrix(dim)
+        e = [a[0] - g0] + list(a[1:])
+        tau = [sum(K[i, j] * e[j] for j in range(dim) if K[i, j] != 0) for i in range(dim)]
+        tau[0] = tau[0] - law.gap_force[0]
+        tau[1] = tau[1] - law.gap_force[1]
+        return tau
+    if isinstance(law, BundleLaw):
+        _check_dim(law, dim)
+        tau = [0] * dim
+        for w, n, g in zip(law.weights, law.directions, law.g):
+            f = w * _ramp(_dot(n, a) - g - n[0] * g0)
+            tau = [tau[i] + f * n[i] for i in range(dim)]
+        return tau
+    if isinstance(law, TabulatedLaw):
+        kinks, slopes = law.ramps()
+        c = a[0] - g0
+        p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
+        return [p] + [law.kt * ai for ai in a[1:]]
+    if isinstance(law, FieldLaw):
+        return [law.kn * _ramp(a[0] - g0 - law.offset)] + [0.0 * ai for ai in a[1:]]
+    raise TypeError(f"unknown interface law {type(law).__name__}")
+
+
+def pressure(law: NormalLaw, a, g0=0.0):
+    """Contact pressure ``p = tau_n`` (compression positive)."""
+    return normal_traction(law, a, g0)[0]
+
+
+def friction_energy(friction: Friction, a, G):
+    """``G huber(|a_t|, w)`` with the threshold field ``G`` given."""
+    return G * huber_of_square(_tangential_norm2(a), friction.width)
+
+
+def friction_traction(friction: Friction, a, G) -> list:
+    """``d/da`` of :func:`friction_energy` (``G`` frozen)."""
+    f = G * huber_slope(_tangential_norm2(a), friction.width)
+    return [0.0 * a[0]] + [f * ai for ai in a[1:]]
+
+
+def threshold(friction: Friction, p):
+    """``G = mu [p]_+ + G0`` for a pressure ``p``."""
+    return friction.mu * _ramp(p) + friction.threshold
+
+
+def energy(law: InterfaceLaw, a, g0=0.0, G=None):
+    """Total interface energy density; ``G`` is the friction threshold field
+    (default: ``threshold(friction, 0)``, i.e. ``G0`` only)."""
+    W = normal_energy(law.normal, a, g0)
+    if law.friction is not None:
+        if G is None:
+            G = law.friction.threshold
+        W = W + friction_energy(law.friction, a, G)
+    return W
+
+
+def traction(law: InterfaceLaw, a, g0=0.0, G=None) -> list:
+    """Local traction ``dW/da`` of :func:`energy` (same ``G``)."""
+    tau = normal_traction(law.normal, a, g0)
+    if law.friction is not None:
+        if G is None:
+            G = law.friction.threshold
+        ft = friction_traction(law.friction, a, G)
+        tau = [t + f for t, f in zip(tau, ft)]
+    return tau
+
+
+def _tangential_norm2(a):
+    return sum(ai * ai for ai in a[1:])
+
+
+def _dot(n, a):
+    return sum(float(ni) * ai for ni, ai in zip(n, a) if ni != 0)
+
+
+def _check_dim(law: BundleLaw, dim: int) -> None:
+    if len(law.directions[0]) != dim:
+        raise ModelError(f"the bundle's directions have {len(law.directions[0])} components, "
+                         f"the interface frame {dim}")
