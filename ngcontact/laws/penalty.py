@@ -39,10 +39,38 @@ assembles no friction term, a problem without gap no gap.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import ngsolve as ng
 
 from ngcontact.laws.huber import huber, huber_of_square  # noqa: F401  (huber: part of the micro law's API)
 from ngcontact.errors import ModelError
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Micro friction: ``"tresca"`` with threshold ``G`` or ``"coulomb"`` with ``mu`` (``G = mu p``); Huber width ``w``.
+
+    The one description of friction on ``S_C`` for the cell and the resolved
+    problems (paper eqs. 9, 16-17); the homogenized law has its own
+    (:class:`ngcontact.laws.homogenized.Friction`, eqs. 42-43).
+    """
+
+    law: str
+    w: float
+    G: float | None = None
+    mu: float | None = None
+
+    def __post_init__(self):
+        if self.law not in ("tresca", "coulomb"):
+            raise ModelError(f"friction law {self.law!r}: must be 'tresca' or 'coulomb'")
+        if not self.w > 0:
+            raise ModelError(f"friction width w = {self.w!r}: must be > 0")
+        if self.law == "tresca" and (self.G is None or self.G < 0):
+            raise ModelError(f"Tresca threshold G = {self.G!r}: must be >= 0")
+        if self.law == "coulomb" and (self.mu is None or self.mu < 0):
+            raise ModelError(f"Coulomb coefficient mu = {self.mu!r}: must be >= 0")
+
 
 
 def positive_part(s):
