@@ -54,21 +54,23 @@ def record(out: Path, only: list[str]) -> int:
     return 0
 
 
-def _walk(a, b, path: str, rtol: float, atol: float, diffs: list[str]) -> None:
+def _walk(a, b, path: str, rtol: float, atol: float, diffs: list[str], ignore: tuple[str, ...] = ()) -> None:
     if isinstance(a, dict) and isinstance(b, dict):
         for key in sorted(set(a) | set(b)):
             if key in IGNORED_KEYS or key.endswith("_seconds") or key.startswith("time_"):
                 continue
+            if f"{path}.{key}" in ignore:
+                continue
             if key not in a or key not in b:
                 diffs.append(f"{path}.{key}: only on {'after' if key in b else 'before'} side")
                 continue
-            _walk(a[key], b[key], f"{path}.{key}", rtol, atol, diffs)
+            _walk(a[key], b[key], f"{path}.{key}", rtol, atol, diffs, ignore)
     elif isinstance(a, list) and isinstance(b, list):
         if len(a) != len(b):
             diffs.append(f"{path}: length {len(a)} != {len(b)}")
             return
         for i, (x, y) in enumerate(zip(a, b)):
-            _walk(x, y, f"{path}[{i}]", rtol, atol, diffs)
+            _walk(x, y, f"{path}[{i}]", rtol, atol, diffs, ignore)
     elif isinstance(a, (int, float)) and isinstance(b, (int, float)) and not isinstance(a, bool):
         if math.isnan(a) and math.isnan(b):
             return
@@ -78,7 +80,7 @@ def _walk(a, b, path: str, rtol: float, atol: float, diffs: list[str]) -> None:
         diffs.append(f"{path}: {a!r} != {b!r}")
 
 
-def compare(before: Path, after: Path, rtol: float, atol: float) -> int:
+def compare(before: Path, after: Path, rtol: float, atol: float, ignore: tuple[str, ...] = ()) -> int:
     names = sorted({p.name for p in before.glob("*.json")} | {p.name for p in after.glob("*.json")})
     bad = 0
     for name in names:
@@ -88,7 +90,7 @@ def compare(before: Path, after: Path, rtol: float, atol: float) -> int:
             bad += 1
             continue
         diffs: list[str] = []
-        _walk(json.loads(pa.read_text()), json.loads(pb.read_text()), "", rtol, atol, diffs)
+        _walk(json.loads(pa.read_text()), json.loads(pb.read_text()), "", rtol, atol, diffs, ignore)
         print(f"{name}: {'same' if not diffs else f'{len(diffs)} differences'}")
         for line in diffs[:20]:
             print("   ", line)
@@ -108,10 +110,12 @@ def main(argv=None) -> int:
     c.add_argument("after", type=Path)
     c.add_argument("--rtol", type=float, default=1e-10)
     c.add_argument("--atol", type=float, default=1e-300)
+    c.add_argument("--ignore", nargs="*", default=[], metavar="PATH",
+                   help="key paths left out, as printed (e.g. .scene.solver.coulomb_rtol for a key a change added)")
     args = ap.parse_args(argv)
     if args.cmd == "record":
         return record(args.out, args.only)
-    return compare(args.before, args.after, args.rtol, args.atol)
+    return compare(args.before, args.after, args.rtol, args.atol, tuple(args.ignore))
 
 
 if __name__ == "__main__":

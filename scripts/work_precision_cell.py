@@ -6,7 +6,7 @@
    contains the penalty error (``O(1/k_n)``) as well as the discretization
    error; both ``k_n`` values of ``KN_VALUES`` are run.  Time: mesh, setup
    and the Newton solve (rigid predictor, exact line search), without the
-   post-processing of :meth:`ngcontact.cell.CellProblem.measure`.
+   post-processing of :meth:`ngcontact.cell.cell_problem.CellProblem.measure`.
 2. Example 27 ``k_t0`` of the semicircular valley (radius 0.3, unit period,
    conforming, ``k_n = 1``): exact ``a pi / 2``; purely geometric (paper
    eq. 34), time = meshing + surface integral.

@@ -2,7 +2,7 @@
 
 Solves ``geometries/femur_stem.toml`` under h-refinement (mesh sizes halved,
 orders 2 and 3) and p-refinement (orders 2 to 5 on the scene's mesh; order 1 is
-refused on a mesh touching the axis, see :func:`ngcontact.macro.check_problem`), and
+refused on a mesh touching the axis, see :func:`ngcontact.macro.macro_problem.check_problem`), and
 compares the peak contact pressure along the interface and the peak von
 Mises stress with those of a reference solution (order 5 on the finest
 mesh).  Each run is timed from meshing to post-processing (wall clock,

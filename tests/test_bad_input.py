@@ -309,8 +309,8 @@ def test_unknown_top_level_section(tmp_path, capsys):
 
 def test_misspelled_key_in_a_section(tmp_path, capsys):
     text = edit(CELL.format(contact=""), ("rtol = 1e-10", "r_tol = 1e-10"))
-    run_bad(tmp_path, capsys, text, "solver.r_tol = 1e-10: unknown key; allowed keys here are atol, inverse, "
-            "max_iter, rtol")
+    run_bad(tmp_path, capsys, text, "solver.r_tol = 1e-10: unknown key; allowed keys here are atol, "
+            "coulomb_max_iter, coulomb_rtol, inverse, max_iter, rtol")
 
 
 def test_misspelled_material_constant(tmp_path, capsys):
@@ -452,9 +452,10 @@ def test_both_pressure_and_normal_jump(tmp_path, capsys):
 def test_boundary_table_matches_the_meshed_geometries():
     """The labels checked without meshing are exactly those the meshers create."""
     from ngcontact.geometry import bodies as gm
+    from ngcontact.geometry.femur import FemurStemDims, femur_stem
     from ngcontact.scene.macro_scene import BOUNDARIES
     from ngcontact.macro.macro_problem import boundary_labels
-    built = {("femur_stem", "axisymmetric"): gm.femur_stem(maxh=0.02),
+    built = {("femur_stem", "axisymmetric"): femur_stem(FemurStemDims(), maxh=0.02),
              ("coaxial", "plane_strain"): gm.coaxial_plane_strain(1.0, 2.0, 3.0, maxh=1.0),
              ("coaxial", "axisymmetric"): gm.coaxial_axisymmetric(1.0, 2.0, 3.0, 1.0, maxh=1.0),
              ("coaxial", "3d"): gm.coaxial_3d(1.0, 2.0, 3.0, 1.0, maxh=1.0),

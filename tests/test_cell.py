@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem, Friction
+from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.laws.penalty import Friction
 from ngcontact.cell.measures import contact_fraction
 from ngcontact.cell.stiffness import reference_stiffness
 from ngcontact.errors import ConvergenceError

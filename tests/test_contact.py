@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from ngcontact.laws import penalty as contact
-from ngcontact.cell.cell_problem import CellModel, CellProblem, Friction
+from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.laws.penalty import Friction
 from ngcontact.cell.measures import sample_surface
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.fem.materials import isotropic

@@ -27,12 +27,15 @@ from ngcontact.drivers import run_resolved as drv
 from ngcontact.drivers.study_epsilon import run_study
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
-from ngcontact.geometry.bodies import FemurStemDims
-from ngcontact.geometry.resolved_bodies import femur_stem, resolved_blocks, split_periods
+from ngcontact.geometry.femur import FemurStemDims, femur_stem, split_periods
+from ngcontact.geometry.resolved_bodies import resolved_blocks
 from ngcontact.output.report import Clock
+from ngcontact.fem.reaction import boundary_reaction
+from ngcontact.fem.sampling import probe
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FEMUR = os.path.join(ROOT, "geometries", "direct", "femur_stem_grooves.toml")
+REGIONS = ("rough", "counter")  # the direct kind's region names
 DIMS = FemurStemDims(r_stem=0.011, r_tip=0.005, r_bone=0.016, z_tip=0.05, z_corner=0.13, z_bone_top=0.18,
                      z_stem_top=0.20)
 GROOVE = pr.rectangular_valley(0.5, 0.1, 1.0)
@@ -53,7 +56,7 @@ def test_split_periods_gives_whole_periods_close_to_eps():
 
 def test_femur_grooves_follow_the_interface():
     N = 8
-    g = femur_stem(DIMS, GROOVE, N, maxh=0.004, interface_maxh=(CYL + CONE) / N / 8, order=2)
+    g = femur_stem(DIMS, GROOVE, N, maxh=0.004, interface_maxh=(CYL + CONE) / N / 8, order=2, regions=REGIONS)
     mesh = g.mesh
     assert set(mesh.GetBoundaries()) == {"contact", "axis", "stem_top", "stem_side", "stem_tip", "bone_top",
                                          "bone_outer", "canal", "base"}
@@ -62,7 +65,7 @@ def test_femur_grooves_follow_the_interface():
     walls = sum(n * 2 * 0.1 * e for n, e in g.segments)
     assert length == pytest.approx(CYL + CONE + walls, rel=1e-10)
     # the stem keeps its volume minus the grooves: the flat geometry has the macro volume
-    flat = femur_stem(DIMS, None, 0, maxh=0.004, interface_maxh=0.002)
+    flat = femur_stem(DIMS, None, 0, maxh=0.004, interface_maxh=0.002, regions=REGIONS)
     vol_flat = ng.Integrate(2 * math.pi * ng.x, flat.mesh, definedon=flat.mesh.Materials("rough"))
     cone = math.pi / 3 * 0.08 * (0.005 ** 2 + 0.005 * 0.011 + 0.011 ** 2)
     assert vol_flat == pytest.approx(cone + math.pi * 0.011 ** 2 * 0.07, rel=1e-10)
@@ -81,14 +84,14 @@ def test_femur_grooves_follow_the_interface():
 
 
 def test_femur_mesh_grows_like_the_number_of_grooves():
-    ne = [femur_stem(DIMS, GROOVE, N, maxh=0.004, interface_maxh=(CYL + CONE) / N / 8).mesh.ne
+    ne = [femur_stem(DIMS, GROOVE, N, maxh=0.004, interface_maxh=(CYL + CONE) / N / 8, regions=REGIONS).mesh.ne
           for N in (16, 32, 64)]
     assert ne[1] / ne[0] < 2.6 and ne[2] / ne[1] < 2.6, ne
 
 
 def test_grooves_reaching_the_axis_are_rejected():
     with pytest.raises(ValueError, match="axis"):
-        femur_stem(DIMS, pr.rectangular_valley(0.5, 0.45, 1.0), 2, maxh=0.004, interface_maxh=0.004)
+        femur_stem(DIMS, pr.rectangular_valley(0.5, 0.45, 1.0), 2, maxh=0.004, interface_maxh=0.004, regions=REGIONS)
 
 
 # ----------------------------------------------- axisymmetric periodic strip
@@ -101,11 +104,11 @@ def _strip(setting, x0, N=2):
                            supports=(D.Support(label="bottom"), D.Support(label="top", value=(-dt, -dn))))
     sol = D.solve(prob)
     assert sol.history["converged"]
-    R = D.boundary_reaction(g.mesh, setting, MATS["counter"], sol.u_counter, "counter", "top", 2)
+    R = boundary_reaction(g.mesh, setting, MATS["counter"], sol.u_counter, "counter", "top", 2)
     area = N if setting == "plane_strain" else math.pi * ((x0 + N) ** 2 - x0 ** 2)
     traction = R["y" if setting == "plane_strain" else "z"] / area
     pts = [(x0 + 0.5, 0.5), (x0 + 1.3, -0.5), (x0 + 0.8, 0.2)]
-    u = np.array([D.probe(g.mesh, sol.u_counter if y > 0 else sol.u_rough, [(x, y)])[0] for x, y in pts])
+    u = np.array([probe(g.mesh, sol.u_counter if y > 0 else sol.u_rough, [(x, y)])[0] for x, y in pts])
     force = D.contact_force(sol)
     return traction, u, force, R
 

@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 
 from ngcontact.laws import homogenized as il
+from ngcontact.laws import interface_energy as ie
+from ngcontact.laws.local_frame import local_frame
 
 RNG = np.random.default_rng(7)
 
@@ -41,12 +43,12 @@ def test_traction_is_the_derivative_of_the_energy(name):
         a = RNG.normal(scale=0.4, size=2)
         g0 = RNG.normal(scale=0.05)
         G = 0.8
-        tau = np.array([float(t) for t in il.traction(law, list(a), g0, G)])
+        tau = np.array([float(t) for t in ie.traction(law, list(a), g0, G)])
         fd = []
         for i in range(2):
             e = np.zeros(2)
             e[i] = h
-            fd.append((il.energy(law, list(a + e), g0, G) - il.energy(law, list(a - e), g0, G)) / (2 * h))
+            fd.append((ie.energy(law, list(a + e), g0, G) - ie.energy(law, list(a - e), g0, G)) / (2 * h))
         np.testing.assert_allclose(tau, np.array(fd, float), rtol=1e-6, atol=1e-8,
                                    err_msg=f"{name}: traction vs energy at a = {a}")
 
@@ -62,19 +64,19 @@ def test_bundle_equals_linearized_law_when_every_direction_is_closed(dim):
         a[0] = 5.0                      # deep closure: every direction is pressed
         g0 = -0.1 * RNG.uniform()
         assert min(np.dot(n, a) - g - n[0] * g0 for n, g in zip(bundle.directions, bundle.g)) > 0
-        tau = np.array([float(t) for t in il.normal_traction(bundle, list(a), g0)])
+        tau = np.array([float(t) for t in ie.normal_traction(bundle, list(a), g0)])
         e = a - g0 * np.eye(dim)[0]
         expected = K @ e - gf
         np.testing.assert_allclose(tau, expected, rtol=1e-13, atol=1e-13 * np.abs(expected).max())
         # energies agree up to the constant of the gaps
-        W = il.normal_energy(bundle, list(a), g0)
+        W = ie.normal_energy(bundle, list(a), g0)
         Wlin = 0.5 * e @ K @ e - gf @ e + 0.5 * np.sum(np.array(bundle.weights) * bundle.g ** 2)
         assert abs(W - Wlin) <= 1e-12 * abs(W)
     if dim == 2:
         lin = il.linearized(bundle)
         a = [5.0, 0.03]
-        np.testing.assert_allclose([float(t) for t in il.normal_traction(lin, a, -0.02)],
-                                   [float(t) for t in il.normal_traction(bundle, a, -0.02)], rtol=1e-13)
+        np.testing.assert_allclose([float(t) for t in ie.normal_traction(lin, a, -0.02)],
+                                   [float(t) for t in ie.normal_traction(bundle, a, -0.02)], rtol=1e-13)
 
 
 def test_bundle_opens_direction_by_direction():
@@ -85,7 +87,7 @@ def test_bundle_opens_direction_by_direction():
     # a pure tangential jump closes the directions with n . t0 > 0 and opens the others
     a = np.array([0.0, 0.1])
     closed = [np.dot(n, a) > 0 for n in d]
-    tau = np.array([float(t) for t in il.normal_traction(bundle, list(a))])
+    tau = np.array([float(t) for t in ie.normal_traction(bundle, list(a))])
     expected = sum(wq * np.outer(n, n) @ a for wq, n, c in zip(w, np.array(d), closed) if c)
     np.testing.assert_allclose(tau, expected, rtol=1e-14)
     assert 0 < sum(closed) < len(d)
@@ -105,15 +107,15 @@ def test_tabulated_law_interpolates_the_table_and_integrates_it():
     p = (0.0, 1e4, 5e4, 6e4)
     law = il.TabulatedLaw(closure=c, pressure=p)
     for ci, pi in zip(c, p):
-        assert abs(il.pressure(law, [ci, 0.0]) - pi) <= 1e-9 * max(p)
-    assert il.pressure(law, [-1e-6, 0.0]) == 0.0
+        assert abs(ie.pressure(law, [ci, 0.0]) - pi) <= 1e-9 * max(p)
+    assert ie.pressure(law, [-1e-6, 0.0]) == 0.0
     slope = (p[-1] - p[-2]) / (c[-1] - c[-2])
-    assert abs(il.pressure(law, [8e-6, 0.0]) - (p[-1] + slope * 2e-6)) <= 1e-9 * max(p)
+    assert abs(ie.pressure(law, [8e-6, 0.0]) - (p[-1] + slope * 2e-6)) <= 1e-9 * max(p)
     # energy at c_last equals the trapezoidal integral of the table (exact for a polyline)
-    W = il.normal_energy(law, [c[-1], 0.0])
+    W = ie.normal_energy(law, [c[-1], 0.0])
     assert abs(W - np.trapezoid(p, c)) <= 1e-12 * W
     # a gap shifts the law: g0 = -1e-6 means contact already at c = -1e-6
-    assert abs(il.pressure(law, [0.0, 0.0], g0=-1e-6) - p[1]) <= 1e-9 * max(p)
+    assert abs(ie.pressure(law, [0.0, 0.0], g0=-1e-6) - p[1]) <= 1e-9 * max(p)
 
 
 @pytest.mark.parametrize("bad", [dict(closure=(0.0, 1.0), pressure=(1.0, 2.0)),
@@ -129,12 +131,12 @@ def test_friction_sticks_within_the_width_and_slides_at_the_threshold():
     fr = il.Friction(mu=0.3, width=1e-3)
     G = 2.0
     for s in (1e-4, 5e-4, 9.99e-4):
-        t = il.friction_traction(fr, [0.0, s], G)[1]
+        t = ie.friction_traction(fr, [0.0, s], G)[1]
         assert abs(t - G * s / fr.width) <= 1e-12 * G
     for s in (1.001e-3, 0.1, -0.1):
-        t = il.friction_traction(fr, [0.0, s], G)[1]
+        t = ie.friction_traction(fr, [0.0, s], G)[1]
         assert abs(abs(t) - G) <= 1e-12 * G and np.sign(t) == np.sign(s)
-    assert il.threshold(fr, -5.0) == 0.0 and abs(il.threshold(fr, 10.0) - 3.0) < 1e-15
+    assert ie.threshold(fr, -5.0) == 0.0 and abs(ie.threshold(fr, 10.0) - 3.0) < 1e-15
 
 
 def test_coefficient_function_path_matches_numpy():
@@ -145,10 +147,10 @@ def test_coefficient_function_path_matches_numpy():
     mip = mesh(0.3, 0.3)
     for name, law in LAWS.items():
         a = [0.13, -0.07]
-        W = il.energy(law, [ng.CF(a[0]), ng.CF(a[1])], ng.CF(-0.02), ng.CF(0.8))(mip)
-        t = [tc(mip) for tc in il.traction(law, [ng.CF(a[0]), ng.CF(a[1])], ng.CF(-0.02), ng.CF(0.8))]
-        assert abs(W - il.energy(law, a, -0.02, 0.8)) <= 1e-12 * max(1.0, abs(W)), name
-        np.testing.assert_allclose(t, [float(x) for x in il.traction(law, a, -0.02, 0.8)], rtol=1e-12,
+        W = ie.energy(law, [ng.CF(a[0]), ng.CF(a[1])], ng.CF(-0.02), ng.CF(0.8))(mip)
+        t = [tc(mip) for tc in ie.traction(law, [ng.CF(a[0]), ng.CF(a[1])], ng.CF(-0.02), ng.CF(0.8))]
+        assert abs(W - ie.energy(law, a, -0.02, 0.8)) <= 1e-12 * max(1.0, abs(W)), name
+        np.testing.assert_allclose(t, [float(x) for x in ie.traction(law, a, -0.02, 0.8)], rtol=1e-12,
                                    atol=1e-14, err_msg=name)
 
 
@@ -157,16 +159,16 @@ def test_local_frame_turns_with_the_normal():
     import ngsolve as ng
     from netgen.geom2d import unit_square
     mesh = ng.Mesh(unit_square.GenerateMesh(maxh=1.0))
-    n0, t0 = il.local_frame(ng.CF((0.0, 1.0)), 2)
+    n0, t0 = local_frame(ng.CF((0.0, 1.0)), 2)
     np.testing.assert_allclose(t0(mesh(0.5, 0.5)), (1.0, 0.0))
     ang = 0.4
-    n0, t0 = il.local_frame(ng.CF((np.cos(ang), np.sin(ang))), 2)
+    n0, t0 = local_frame(ng.CF((np.cos(ang), np.sin(ang))), 2)
     np.testing.assert_allclose(t0(mesh(0.5, 0.5)), (np.sin(ang), -np.cos(ang)), atol=1e-15)
     mesh3 = mesh  # the frame is pointwise: a 3-vector CF evaluates anywhere
     for n in [(0, 0, 1.0), (1.0, 0, 0), (0.6, 0.0, 0.8), (0.48, 0.6, 0.64)]:
-        frame = il.local_frame(ng.CF(n), 3)
+        frame = local_frame(ng.CF(n), 3)
         E = np.array([np.asarray(e(mesh3(0.5, 0.5))) for e in frame])
         np.testing.assert_allclose(E @ E.T, np.eye(3), atol=1e-14)
         assert abs(np.linalg.det(E) - 1.0) < 1e-14
-    E = np.array([np.asarray(e(mesh3(0.5, 0.5))) for e in il.local_frame(ng.CF((0, 0, 1.0)), 3)])
+    E = np.array([np.asarray(e(mesh3(0.5, 0.5))) for e in local_frame(ng.CF((0, 0, 1.0)), 3)])
     np.testing.assert_allclose(E, np.eye(3)[[2, 0, 1]], atol=1e-15)

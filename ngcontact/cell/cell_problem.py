@@ -53,36 +53,18 @@ from ngcontact.cell import measures
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.predictor import set_start
-from ngcontact.errors import ConvergenceError
 from ngcontact.fem import elasticity as _el
 from ngcontact.fem import materials as _mat
 from ngcontact.laws import penalty as _contact
+from ngcontact.laws.penalty import Friction
+from ngcontact.solvers.coulomb import coulomb_fixed_point
 from ngcontact.solvers.newton import minimize
+from ngcontact.fem.quadrature import sampling_order
 
 log = logging.getLogger(__name__)
 
 
 # ------------------------------------------------------------ descriptions
-@dataclass(frozen=True)
-class Friction:
-    """Friction law: ``"tresca"`` with threshold ``G`` or ``"coulomb"`` with ``mu``; Huber width ``w``."""
-
-    law: str
-    w: float
-    G: float | None = None
-    mu: float | None = None
-
-    def __post_init__(self):
-        if self.law not in ("tresca", "coulomb"):
-            raise ValueError(f"friction law {self.law!r}: must be 'tresca' or 'coulomb'")
-        if not self.w > 0:
-            raise ValueError(f"friction width w = {self.w!r}: must be > 0")
-        if self.law == "tresca" and (self.G is None or self.G < 0):
-            raise ValueError(f"Tresca threshold G = {self.G!r}: must be >= 0")
-        if self.law == "coulomb" and (self.mu is None or self.mu < 0):
-            raise ValueError(f"Coulomb coefficient mu = {self.mu!r}: must be >= 0")
-
-
 @dataclass(frozen=True)
 class CellModel:
     """Physics of a cell problem (no mesh).
@@ -304,30 +286,27 @@ class CellProblem:
         """
         self._apply_load(load, first)
         free = self._freedofs(load)
-        histories = []
+        histories: list[dict] = []
         fp = 0
         if self.model.friction is not None and self.model.friction.law == "coulomb":
-            p_old = measures.sample_surface(self, {"p": self.pressure})["p"]
-            atol = self.atol
-            for fp in range(1, self.model.coulomb_max_iter + 1):
+            first_residual: list[float] = []
+
+            def freeze() -> None:
                 self.coulomb_previous.vec.data = self.gfu.vec
+
+            def tresca_solve() -> dict:
+                # later passes stop at rtol times the first pass's initial residual
+                atol = max(self.atol, self.rtol * first_residual[0]) if first_residual else self.atol
                 h = self._newton(free, atol)
-                histories.append(h)
-                if fp == 1:
-                    atol = max(self.atol, self.rtol * h["residuals"][0])
-                p_new = measures.sample_surface(self, {"p": self.pressure})["p"]
-                change = float(np.max(np.abs(p_new - p_old))) if p_new.size else 0.0
-                scale = float(np.max(np.abs(p_new))) if p_new.size else 0.0
-                log.info("coulomb fixed point %d: max |dp| = %.3e (max p %.3e)", fp, change, scale)
-                if change <= self.model.coulomb_rtol * max(scale, 1e-300):
-                    break
-                p_old = p_new
-            else:
-                raise ConvergenceError(
-                    f"Coulomb fixed point did not converge in {self.model.coulomb_max_iter} "
-                    f"iterations: max pressure change {change:.3e} > "
-                    f"{self.model.coulomb_rtol:g} x max pressure {scale:.3e}",
-                    {"newton": histories})
+                if not first_residual:
+                    first_residual.append(h["residuals"][0])
+                return h
+
+            fixed = coulomb_fixed_point(
+                freeze, tresca_solve,
+                lambda: measures.sample_surface(self, {"p": self.pressure})["p"],
+                rtol=self.model.coulomb_rtol, max_iter=self.model.coulomb_max_iter)
+            histories, fp = fixed["newton"], fixed["coulomb_iterations"]
         else:
             histories.append(self._newton(free, self.atol))
         if measure:
@@ -395,6 +374,6 @@ def _tangential_determinate(mesh, n, d: int, model: CellModel) -> bool:
     if model.friction is not None:
         return True
     nt2 = ng.InnerProduct(n, n) - n[d - 1] * n[d - 1]
-    tilt = ng.Integrate(nt2, mesh, definedon=mesh.Boundaries("contact"), order=2 * model.order + 2)
+    tilt = ng.Integrate(nt2, mesh, definedon=mesh.Boundaries("contact"), order=sampling_order(model.order))
     size = ng.Integrate(ng.CF(1.0), mesh, definedon=mesh.Boundaries("contact"))
     return tilt > 1e-12 * size

@@ -37,13 +37,15 @@ from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.cell.stiffness import effective_stiffness
 from ngcontact.fem import materials as _mat
+from ngcontact.fem.quadrature import kink_order, sampling_order, smooth_order
+from ngcontact.fem.sampling import boundary_samples
 from ngcontact.laws import penalty as _contact
 
 
 # ------------------------------------------------------------ the contact surface
 def contact_integral(problem, cf, order=None):
-    """``int_{S_C} cf ds`` at integration order ``order`` (default ``4 p + 24``)."""
-    o = order if order is not None else 4 * problem.model.order + 24
+    """``int_{S_C} cf ds`` at integration order ``order`` (default :func:`~ngcontact.fem.quadrature.kink_order`)."""
+    o = order if order is not None else kink_order(problem.model.order)
     return ng.Integrate(cf, problem.mesh, definedon=problem.mesh.Boundaries("contact"), order=o)
 
 
@@ -138,7 +140,7 @@ def mean_jump(problem) -> np.ndarray:
     """Projected mean of the jump on ``S_C``: ``(1/|T|) int J |n.n0| ds``."""
     n, d = problem.n, problem.dim
     w = ng.IfPos(n[d - 1], n[d - 1], -n[d - 1])
-    return np.array(contact_integral(problem, problem.J * w, order=2 * problem.model.order + 4)) / problem.area
+    return np.array(contact_integral(problem, problem.J * w, order=smooth_order(problem.model.order))) / problem.area
 
 
 def friction_threshold(problem):
@@ -153,7 +155,7 @@ def real_contact_coefficients(problem) -> dict:
     """Paper eqs. 34, 42-43 on the real contact set ``{J_n - g >= 0}`` of the current state."""
     ind = ng.IfPos(-problem.penetration, 0.0, 1.0)
     c = coefficients(problem.cell, kn=problem.model.k_n, gap=problem.gap, G=friction_threshold(problem),
-                     weight=ind, normal=problem.n, intorder=4 * problem.model.order + 24)
+                     weight=ind, normal=problem.n, intorder=kink_order(problem.model.order))
     return c.as_dict()
 
 
@@ -165,22 +167,9 @@ def sample_surface(problem, fields: dict, order: int | None = None) -> dict:
     traces of each body are unambiguous.  Returns arrays, with the
     coordinates under ``"x"``, ``"y"`` (and ``"z"``).
     """
-    mesh = problem.mesh
-    o = order if order is not None else 2 * problem.model.order + 2
-    S = ng.comp.IntegrationRuleSpaceSurface(mesh, order=o, definedon=mesh.Boundaries("contact"))
-    names = ["x", "y", "z"][: problem.dim] + list(fields)
-    cfs = [ng.x, ng.y, ng.z][: problem.dim] + [fields[k] for k in fields]
-    flat = []
-    for cf in cfs:
-        flat.extend(cf[i] for i in range(cf.dim)) if cf.dim > 1 else flat.append(cf)
-    gf = ng.GridFunction(S ** len(flat)) if len(flat) > 1 else ng.GridFunction(S)
-    gf.Set(ng.CF(tuple(flat)) if len(flat) > 1 else flat[0], definedon=mesh.Boundaries("contact"))
-    arr = gf.vec.FV().NumPy().reshape(len(flat), -1)
-    out, k = {}, 0
-    for name, cf in zip(names, cfs):
-        out[name] = arr[k:k + cf.dim].copy() if cf.dim > 1 else arr[k].copy()
-        k += cf.dim
-    return out
+    o = order if order is not None else sampling_order(problem.model.order)
+    coords = {name: c for name, c in zip(("x", "y", "z")[: problem.dim], (ng.x, ng.y, ng.z))}
+    return boundary_samples(problem.mesh, "contact", {**coords, **fields}, o)
 
 
 def surface_distribution(problem) -> dict:

@@ -2,7 +2,7 @@
 
 The cell's contact surface ``S_C`` becomes the unilateral direction bundle
 (paper eqs. 31-33) through
-:func:`ngcontact.homogenize.direction_bundle`: one direction per quadrature
+:func:`ngcontact.cell.coefficients.direction_bundle`: one direction per quadrature
 point, with weight ``w_q = k_n ds_q / |T|``, micro normal ``n_q`` in the
 cell's macro basis (``n0 = e_y, t0 = e_x``; 3D ``n0 = e_z, t1 = e_x,
 t2 = e_y``) and initial gap ``g_q``.  No cell contact problem is solved: the
@@ -74,7 +74,7 @@ def cached_bundle_arrays(key: str, compute: Callable[[], dict], cache_dir: str |
 
 
 def bundle_law(arrays: dict, *, dim: int, length_unit: float = 1.0) -> il.BundleLaw:
-    """The :class:`~ngcontact.interface_law.BundleLaw` of the arrays for a macro frame of ``dim``.
+    """The :class:`~ngcontact.laws.homogenized.BundleLaw` of the arrays for a macro frame of ``dim``.
 
     Directions whose projection vanishes (pure ``t2`` normals) carry no
     stiffness in that frame and are left out; equal directions and gaps merge.

@@ -45,7 +45,9 @@ direction).
 from __future__ import annotations
 
 import logging
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import ngsolve as ng
 import numpy as np
@@ -56,21 +58,30 @@ from ngcontact.fem import materials as _mat
 from ngcontact.laws import penalty as _contact
 from ngcontact.errors import ModelError
 
+if TYPE_CHECKING:
+    from ngcontact.cell.cell_problem import CellProblem, CellSolution
+    from ngcontact.macro.macro_problem import MacroSolution
+
 log = logging.getLogger(__name__)
+
+#: a load vector ``l`` (:func:`load_names`)
+LoadVector = Sequence[float] | np.ndarray
+#: ``{body: {"points": (n, dim), "stress": (n, 3, 3)}}``
+BodySamples = dict[str, dict[str, np.ndarray]]
 
 CRITERIA = ("von_mises", "tresca")
 BODIES = ("rough", "counter")
 
 
 # ------------------------------------------------------------ load vectors
-def load_names(dim: int) -> tuple:
+def load_names(dim: int) -> tuple[str, ...]:
     """Names of the load components ``l_k`` of a ``dim``-D cell (see module docstring)."""
     if dim == 2:
         return ("shear_x", "pressure", "E_xx")
     return ("shear_x", "shear_y", "pressure", "E_xx", "E_yy", "E_xy")
 
 
-def apply_load_vector(problem, l) -> None:
+def apply_load_vector(problem: CellProblem, l: LoadVector) -> None:
     """Put the load vector ``l`` (:func:`load_names`) into the traction and strain parameters of ``problem``.
 
     Only the parameters of the energy are set; the state ``problem.gfu`` is
@@ -84,7 +95,7 @@ def apply_load_vector(problem, l) -> None:
         par.Set(float(l[d + k]))
 
 
-def sample_stresses(problem) -> dict:
+def sample_stresses(problem: CellProblem) -> BodySamples:
     """Stress tensors of the current state of ``problem`` per body at element points.
 
     Returns ``{body: {"points": (n, dim), "stress": (n, 3, 3)}}``
@@ -113,14 +124,16 @@ class Correctors:
         (differences to the gap state).
     """
 
-    names: tuple
-    points: dict
-    base: dict
-    unit: dict
-    states: list | None = None
+    names: tuple[str, ...]
+    points: dict[str, np.ndarray]
+    base: dict[str, np.ndarray]
+    unit: dict[str, np.ndarray]
+    states: list[ng.BaseVector] | None = None
 
-    def state(self, load):
+    def state(self, load: LoadVector) -> ng.BaseVector:
         """Displacement vector of the superposed state (``states[0]`` the gap state)."""
+        # set: linear_correctors, the only constructor of Correctors, always passes its states
+        assert self.states is not None
         v = self.states[0].CreateVector()
         v.data = self.states[0]
         for lk, sk in zip(np.asarray(load, float), self.states[1:]):
@@ -128,13 +141,14 @@ class Correctors:
                 v.data += float(lk) * sk
         return v
 
-    def stress(self, load) -> dict:
+    def stress(self, load: LoadVector) -> dict[str, np.ndarray]:
         """Superposed stress ``sigma_g + sum_k l_k Sigma_k`` (eq. 75) per body."""
         l = np.asarray(load, float)
         return {b: self.base[b] + np.einsum("k,knij->nij", l, self.unit[b]) for b in self.base}
 
 
-def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float = 0.0) -> Correctors:
+def linear_correctors(problem: CellProblem, *, contact_set: ng.CoefficientFunction | None = None,
+                      tangential_stiffness: float = 0.0) -> Correctors:
     """Unit-load correctors of the cell with a fixed contact set (module docstring).
 
     Parameters
@@ -187,9 +201,9 @@ def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float 
     inv = form.mat.Inverse(free, inverse=problem.inverse)
     res = zero.CreateVector()
 
-    vectors = []
+    vectors: list[ng.BaseVector] = []
 
-    def state(l):
+    def state(l: np.ndarray) -> BodySamples:
         apply_load_vector(problem, l)
         form.Apply(zero, res)
         problem.gfu.vec.data = -(inv * res)
@@ -199,7 +213,7 @@ def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float 
         return sample_stresses(problem)
 
     base = state(np.zeros(len(names)))
-    unit = {b: [] for b in BODIES}
+    unit: dict[str, list[np.ndarray]] = {b: [] for b in BODIES}
     for k in range(len(names)):
         if not shear_free and k < d - 1:
             for b in BODIES:  # a free tangential jump carries no shear: zero corrector
@@ -221,7 +235,7 @@ def linear_correctors(problem, *, contact_set=None, tangential_stiffness: float 
                       unit={b: np.array(unit[b]) for b in BODIES}, states=vectors)
 
 
-def nonlinear_stress(problem, load_vector) -> tuple[dict, object]:
+def nonlinear_stress(problem: CellProblem, load_vector: LoadVector) -> tuple[BodySamples, CellSolution]:
     """The contact cell problem solved at the load vector (rigid-predictor start).
 
     Returns the sampled stresses per body (:func:`sample_stresses`) and the
@@ -256,14 +270,15 @@ class StrengthMap:
     """
 
     criterion: str
-    values: dict
-    cell_point: dict
+    values: dict[str, np.ndarray]
+    cell_point: dict[str, np.ndarray]
 
 
 def strength_map(correctors: Correctors, loads: np.ndarray, criterion: str = "von_mises") -> StrengthMap:
     """Superpose the correctors at every row of ``loads`` and take the cell maxima."""
     loads = np.atleast_2d(np.asarray(loads, float))
-    values, where = {}, {}
+    values: dict[str, np.ndarray] = {}
+    where: dict[str, np.ndarray] = {}
     for b in correctors.base:
         v = np.empty(len(loads))
         w = np.empty((len(loads), correctors.points[b].shape[1]))
@@ -276,7 +291,7 @@ def strength_map(correctors: Correctors, loads: np.ndarray, criterion: str = "vo
     return StrengthMap(criterion=criterion, values=values, cell_point=where)
 
 
-def check(smap: StrengthMap, sigma_u: dict, macro_points: np.ndarray) -> dict:
+def check(smap: StrengthMap, sigma_u: Mapping[str, float], macro_points: np.ndarray) -> dict[str, Any]:
     """The check of eq. 78 per body and overall.
 
     Parameters
@@ -296,15 +311,16 @@ def check(smap: StrengthMap, sigma_u: dict, macro_points: np.ndarray) -> dict:
         ``safety_factor`` (the smallest), ``critical_body`` and ``holds``
         (``safety_factor > 1``).
     """
-    out = {"criterion": smap.criterion, "bodies": {}}
+    bodies: dict[str, dict[str, Any]] = {}
+    out: dict[str, Any] = {"criterion": smap.criterion, "bodies": bodies}
     for b, vals in smap.values.items():
         k = int(np.argmax(vals))
-        out["bodies"][b] = {"max_sigma_eq": float(vals[k]), "sigma_u": float(sigma_u[b]),
-                            "safety_factor": float(sigma_u[b] / vals[k]) if vals[k] > 0 else None,
-                            "macro_point": {"index": k, "coordinates": np.asarray(macro_points[k]).tolist()},
-                            "cell_point": smap.cell_point[b][k].tolist()}
-    finite = {b: e["safety_factor"] for b, e in out["bodies"].items() if e["safety_factor"] is not None}
-    crit = min(finite, key=finite.get)
+        bodies[b] = {"max_sigma_eq": float(vals[k]), "sigma_u": float(sigma_u[b]),
+                     "safety_factor": float(sigma_u[b] / vals[k]) if vals[k] > 0 else None,
+                     "macro_point": {"index": k, "coordinates": np.asarray(macro_points[k]).tolist()},
+                     "cell_point": smap.cell_point[b][k].tolist()}
+    finite: dict[str, float] = {b: e["safety_factor"] for b, e in bodies.items() if e["safety_factor"] is not None}
+    crit = min(finite, key=finite.__getitem__)
     out["critical_body"] = crit
     out["safety_factor"] = finite[crit]
     out["holds"] = bool(finite[crit] > 1.0)
@@ -312,10 +328,11 @@ def check(smap: StrengthMap, sigma_u: dict, macro_points: np.ndarray) -> dict:
 
 
 # ------------------------------------------------------------ macro state
-def interface_states(sol, points_per_element: int = 5, offset: float = 1e-4) -> dict:
+def interface_states(sol: MacroSolution, points_per_element: int = 5,
+                     offset: float = 1e-4) -> dict[str, np.ndarray | list[str]]:
     """Macro state at points along ``S_0`` (2D and axisymmetric macro problems).
 
-    Returns the interface profile of :func:`ngcontact.macro.interface_profile`
+    Returns the interface profile of :func:`ngcontact.macro.macro_problem.interface_profile`
     (``s``, coordinates, ``pressure``, ``shear``, ...) plus ``e_t`` (strain
     along ``t0``) and ``e_hoop`` (axisymmetric hoop strain, else 0), each the
     mean of the two bodies' strains at points moved by ``offset`` times the
@@ -353,7 +370,7 @@ def interface_states(sol, points_per_element: int = 5, offset: float = 1e-4) -> 
     return out
 
 
-def cell_loads(states: dict, dim: int) -> np.ndarray:
+def cell_loads(states: Mapping[str, np.ndarray | list[str]], dim: int) -> np.ndarray:
     """Load vectors of a ``dim``-D cell (rows) from :func:`interface_states`."""
     p = np.asarray(states["pressure"], float)
     tau = np.asarray(states["shear"], float)

@@ -14,7 +14,7 @@ Loop (steps i-vi of Sec. 3.5):
 
    (``g_n0`` in the form of :func:`cell_response`);
 2. the macro problem is solved again with the unilateral law whose
-   coefficients vary along the interface (:class:`ngcontact.interface_law.FieldLaw`,
+   coefficients vary along the interface (:class:`ngcontact.laws.homogenized.FieldLaw`,
    ``p = [k_n0(x) (a_n - g0) - g_n0(x)]_+`` with ``k_n0(x) = k_n0(p_k(x))``);
 3. repeat from 1 until ``max_x |sigma_n^(k)(x) - sigma_n^(k-1)(x)| < tol``
    at the sampling points of the interface profile, or stop with a
@@ -41,12 +41,14 @@ needs higher (or lower) pressures.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.measures import (
     contact_fraction,
     contact_integral,
@@ -57,11 +59,17 @@ from ngcontact.errors import ConvergenceError
 from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
 from ngcontact.errors import ModelError
+from ngcontact.fem.quadrature import smooth_order
 
 log = logging.getLogger(__name__)
 
+#: ``{"contact_fraction", "k_n0", "g_n0"}`` of the cell at one pressure
+Response = dict[str, float]
+#: one entry of the coupling history: iteration and cell-solve counts, pressures, Newton iterations
+HistoryEntry = dict[str, int | float | None]
 
-def cell_response(problem, pressure: float, length_unit: float = 1.0) -> dict:
+
+def cell_response(problem: CellProblem, pressure: float, length_unit: float = 1.0) -> Response:
     """Contact fraction, ``k_n0`` and ``g_n0`` of the cell at a mean pressure.
 
     ``problem`` is a :class:`ngcontact.cell.cell_problem.CellProblem`, solved from the
@@ -87,7 +95,7 @@ def cell_response(problem, pressure: float, length_unit: float = 1.0) -> dict:
     else:
         kn0 = float(real_contact_coefficients(problem)["k_n"])
     n0 = problem.n[problem.dim - 1]
-    projected = float(contact_integral(problem, ng.IfPos(n0, n0, -n0), order=2 * problem.model.order + 4))
+    projected = float(contact_integral(problem, ng.IfPos(n0, n0, -n0), order=smooth_order(problem.model.order)))
     jbar = float(mean_jump(problem)[problem.dim - 1]) * problem.area / projected * length_unit
     return {"contact_fraction": fraction, "k_n0": kn0, "g_n0": kn0 * jbar - float(pressure)}
 
@@ -106,10 +114,10 @@ class CellTable:
         Largest number of cell solves before giving up.
     """
 
-    response: object
+    response: Callable[[float], Response]
     tol: float
     max_solves: int = 400
-    values: dict = field(default_factory=dict)
+    values: dict[float, Response] = field(default_factory=dict)
     error_estimate: float = 0.0
 
     @property
@@ -120,7 +128,7 @@ class CellTable:
     def pressures(self) -> np.ndarray:
         return np.array(sorted(self.values))
 
-    def _value(self, p: float) -> dict:
+    def _value(self, p: float) -> Response:
         if p not in self.values:
             if len(self.values) >= self.max_solves:
                 raise ConvergenceError(f"cell table: more than {self.max_solves} cell solves for "
@@ -154,12 +162,12 @@ class CellTable:
             nodes = np.geomspace(lo, hi, start_nodes)
         else:
             p = self.pressures
-            nodes = list(p)
+            grown = list(p)
             if lo < p[0]:
-                nodes = list(np.geomspace(lo, p[0], start_nodes)[:-1]) + nodes
+                grown = list(np.geomspace(lo, p[0], start_nodes)[:-1]) + grown
             if hi > p[-1]:
-                nodes = nodes + list(np.geomspace(p[-1], hi, start_nodes)[1:])
-            nodes = np.array(nodes)
+                grown = grown + list(np.geomspace(p[-1], hi, start_nodes)[1:])
+            nodes = np.array(grown)
         old = set(self.values)
         for a, b in zip(nodes[:-1], nodes[1:]):
             if a in old and b in old:
@@ -168,22 +176,22 @@ class CellTable:
         log.info("cell table: %d solves over [%.3e, %.3e], error estimate %.2e", self.solves,
                  self.pressures[0], self.pressures[-1], self.error_estimate)
 
-    def __call__(self, p) -> dict:
+    def __call__(self, p: float | np.ndarray) -> dict[str, np.ndarray | np.float64]:
         """Interpolated response at pressures ``p`` (held constant outside the table)."""
         P = self.pressures
-        out = {}
+        out: dict[str, np.ndarray | np.float64] = {}
         for key in ("contact_fraction", "k_n0", "g_n0"):
             out[key] = np.interp(p, P, [self.values[q][key] for q in P])
         return out
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, list[float] | int | float]:
         P = self.pressures
         return {"pressure": P.tolist(), "cell_solves": self.solves, "tolerance": self.tol,
                 "error_estimate": self.error_estimate,
                 **{key: [self.values[q][key] for q in P] for key in ("contact_fraction", "k_n0", "g_n0")}}
 
 
-def field_law(sol: M.MacroSolution, table: CellTable, pressure) -> il.FieldLaw:
+def field_law(sol: M.MacroSolution, table: CellTable, pressure: ng.CoefficientFunction) -> il.FieldLaw:
     """The law of step 2: the table composed with the projected pressure field on ``S_0``."""
     p = sol.problem
     mesh = p.mesh
@@ -204,7 +212,7 @@ def field_law(sol: M.MacroSolution, table: CellTable, pressure) -> il.FieldLaw:
     return il.FieldLaw(kn=fields[0], offset=fields[1], stiffness=float(kn.max()))
 
 
-def interface_pressure(sol: M.MacroSolution):
+def interface_pressure(sol: M.MacroSolution) -> ng.CoefficientFunction:
     """The macro normal stress ``p`` on ``S_0`` as a CoefficientFunction."""
     return M.interface_tractions(sol)[0]
 
@@ -215,14 +223,14 @@ class CouplingResult:
 
     solution: M.MacroSolution
     table: CellTable
-    history: list
+    history: list[HistoryEntry]
     converged: bool
     macro_solves: int
 
 
 def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: int = 20,
            table_min: float = 1e-3, headroom: float = 1.25, points_per_element: int = 5,
-           solve=M.solve) -> CouplingResult:
+           solve: Callable[[M.MacroProblem], M.MacroSolution] = M.solve) -> CouplingResult:
     """Run the coupling loop (module docstring).
 
     Parameters
@@ -252,8 +260,8 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
     """
     sol = solve(problem)
     p_old = M.interface_profile(sol, points_per_element)["pressure"]
-    history = [{"iteration": 0, "max_pressure": float(p_old.max()), "max_change": None,
-                "cell_solves": 0, "newton_iterations": sol.history["newton_iterations"]}]
+    history: list[HistoryEntry] = [{"iteration": 0, "max_pressure": float(p_old.max()), "max_change": None,
+                                     "cell_solves": 0, "newton_iterations": sol.history["newton_iterations"]}]
     friction = problem.law.friction
     for k in range(1, max_iter + 1):
         p_hi = float(p_old.max())

@@ -14,13 +14,14 @@ import os
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.cell_problem import CellLoad, CellModel, Friction, cell_load
+from ngcontact.cell.cell_problem import CellLoad, CellModel, cell_load
 from ngcontact.cell.coefficients import direction_bundle
 from ngcontact.coupling import cell_law
 from ngcontact.errors import SceneError
 from ngcontact.fem import materials
 from ngcontact.fem.interpolants import periodic_table_1d
 from ngcontact.laws import homogenized as il
+from ngcontact.laws.penalty import Friction
 from ngcontact.scene.cell_scene import GAP_PROFILES, CellScene, load_states, profile_2d, small_slope
 from ngcontact.scene.loader import as_dict, load
 from ngcontact.scene.sections import MaterialSpec, resolve
@@ -182,15 +183,20 @@ def _explicit_gap(scene):
     return ng.VoxelCoefficient((0.0, 0.0), (P, P), np.ascontiguousarray(g), linear=True)
 
 
+def micro_friction(contact) -> Friction | None:
+    """The micro friction of a cell scene's ``[contact]`` section (``None`` without friction)."""
+    if contact.friction == "tresca":
+        return Friction("tresca", w=contact.w, G=contact.G)
+    if contact.friction == "coulomb":
+        return Friction("coulomb", w=contact.w, mu=contact.mu)
+    return None
+
+
 def model_of(scene) -> CellModel:
     c = scene.contact
-    fr = None
-    if c.friction == "tresca":
-        fr = Friction("tresca", w=c.w, G=c.G)
-    elif c.friction == "coulomb":
-        fr = Friction("coulomb", w=c.w, mu=c.mu)
     ms = scene.load is not None and scene.load.macro_strain is not None
     return CellModel(rough=elastic_law(scene.materials[scene.bodies.rough]),
                      counter=elastic_law(scene.materials[scene.bodies.counter]),
-                     k_n=c.k_n, gap=gap_cf(scene), friction=fr, order=scene.discretization.order,
-                     macro_strain=ms)
+                     k_n=c.k_n, gap=gap_cf(scene), friction=micro_friction(c), order=scene.discretization.order,
+                     macro_strain=ms, coulomb_rtol=scene.solver.coulomb_rtol,
+                     coulomb_max_iter=scene.solver.coulomb_max_iter)

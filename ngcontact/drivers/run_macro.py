@@ -1,6 +1,6 @@
 """Driver of the ``macro`` kind: geometry -> macro problem -> solve -> results.
 
-Returns an :class:`~ngcontact.report.Outcome` (no file I/O here; a law from a
+Returns an :class:`~ngcontact.output.report.Outcome` (no file I/O here; a law from a
 cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its cache).
 
 ``results``:
@@ -35,6 +35,7 @@ from ngcontact.scene.macro_scene import REGIONS
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 from ngcontact.scene.sections import resolve
+from ngcontact.geometry.femur import BOUNDARIES, FemurStemDims, femur_stem
 
 log = logging.getLogger(__name__)
 
@@ -47,7 +48,9 @@ def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None) -> gm.M
     order = order or d.order
     dims = dict(g.dimensions or {})
     if g.shape == "femur_stem":
-        return gm.femur_stem(gm.FemurStemDims(**dims), maxh=maxh, interface_maxh=ih)
+        femur = femur_stem(FemurStemDims(**dims), maxh=maxh, interface_maxh=ih)
+        return gm.MacroGeometry(mesh=femur.mesh, rough="stem", counter="bone", dims=dict(vars(FemurStemDims(**dims))),
+                                boundaries={"interface": "stem-bone interface S_0 (cone and cylinder)", **BOUNDARIES})
     if g.shape == "block":
         return gm.block_on_plane(dims["length"], dims["h_block"], dims["h_base"], maxh=maxh)
     if g.setting == "plane_strain":
@@ -91,7 +94,7 @@ def gap_of(scene):
 
 
 def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.MacroProblem, dict]:
-    """The :class:`~ngcontact.macro.MacroProblem` of ``scene`` on ``geometry``.
+    """The :class:`~ngcontact.macro.macro_problem.MacroProblem` of ``scene`` on ``geometry``.
 
     Raises
     ------
@@ -119,7 +122,7 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
 def solve_scene(scene, problem: M.MacroProblem) -> M.MacroSolution:
     s = scene.solver
     return M.solve(problem, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
-                   fixed_point_tol=scene.output.coulomb_tol)
+                   coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter)
 
 
 def run(scene, clock) -> Outcome:
@@ -141,7 +144,7 @@ def run(scene, clock) -> Outcome:
         results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
                    "dimensions": geo.dims, "law": law_info, "resultant": M.resultant(sol),
                    "newton_iterations": sol.history["newton_iterations"],
-                   "coulomb_iterations": sol.history["fixed_point_iterations"]}
+                   "coulomb_iterations": sol.history["coulomb_iterations"]}
         maxima = {name: ext for name, ext in extrema.items()}
         tables, plots = {}, {}
         if geo.mesh.dim == 2:
@@ -176,7 +179,7 @@ def run(scene, clock) -> Outcome:
     newton = sol.history["newton"]
     solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],
               "linear_solve_only": sol.history["quadratic"],
-              "coulomb_fixed_point_changes": sol.history["fixed_point_changes"], "solves": newton}
+              "coulomb_changes": sol.history["coulomb_changes"], "solves": newton}
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
 
 

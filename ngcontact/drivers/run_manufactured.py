@@ -61,7 +61,7 @@ def run(scene, clock) -> Outcome:
         log.warning("observed rates deviate by up to %.2f from the expected ones", deviation)
     results = {
         "setting": m.setting,
-        "solution": "smooth manufactured displacement (see ngcontact.manufactured.smooth_field)",
+        "solution": "smooth manufactured displacement (see ngcontact.verification.manufactured.smooth_field)",
         "errors": "l2 = |u_h - u*|_L2, h1 = |grad(u_h - u*)|_L2 (axisymmetric: weighted by 2 pi r, "
                   "with the hoop term)",
         "rows": rows,

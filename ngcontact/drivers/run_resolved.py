@@ -1,6 +1,6 @@
 """Driver of the ``direct`` kind: resolved geometry -> resolved contact problem -> results.
 
-Returns an :class:`~ngcontact.report.Outcome`; no file I/O.
+Returns an :class:`~ngcontact.output.report.Outcome`; no file I/O.
 
 ``results``:
 
@@ -11,7 +11,7 @@ Returns an :class:`~ngcontact.report.Outcome`; no file I/O.
   support in the fixed components [N per metre of thickness; axisymmetric:
   N per revolution, axial component only] and, in plane strain, its moment
   about the boundary's mid-point [N m / m]
-  (:func:`ngcontact.direct.boundary_reaction`);
+  (:func:`ngcontact.fem.reaction.boundary_reaction`);
 * ``contact_force``: force the counter body receives through the resolved
   surface [N/m; axisymmetric: ``int p n 2 pi r ds``, whose ``r`` entry is
   the integral of the radial line load, not a net force], from the micro
@@ -30,13 +30,17 @@ import logging
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.drivers.build import body_laws
+from ngcontact.drivers.build import body_laws, micro_friction
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.geometry import profiles as pr
+from ngcontact.geometry import femur
 from ngcontact.geometry import resolved_bodies as rg
 from ngcontact.scene.cell_scene import profile_2d
 from ngcontact.macro.macro_problem import Load
 from ngcontact.output.report import Outcome, VtkField
+from ngcontact.fem.elasticity import COMPONENTS
+from ngcontact.fem.reaction import boundary_reaction
+from ngcontact.fem.sampling import probe
 
 log = logging.getLogger(__name__)
 
@@ -50,17 +54,15 @@ def micro_law(cell_scene) -> dict:
     """``k_n``, ``gap`` and ``friction`` of the cell as keyword arguments of :class:`DirectProblem`."""
     c = cell_scene.contact
     gap = c.gap.value if c.gap.kind == "constant" else None
-    fr = None
-    if c.friction == "tresca":
-        fr = D.Friction(law="tresca", w=c.w, G=c.G)
-    elif c.friction == "coulomb":
-        fr = D.Friction(law="coulomb", w=c.w, mu=c.mu)
-    return {"k_n": c.k_n, "gap": gap, "friction": fr}
+    return {"k_n": c.k_n, "gap": gap, "friction": micro_friction(c)}
 
 
 def materials_of(scene) -> dict:
     return body_laws(scene, {"rough": scene.bodies.rough, "counter": scene.bodies.counter})
 
+
+#: Region names of the two bodies in the ``direct`` kind (the femur's too).
+REGIONS = ("rough", "counter")
 
 #: Boundaries along which ``x`` (``r``) varies; a support's slope is taken along ``x`` there, else ``y``.
 HORIZONTAL = ("top", "bottom", "base", "stem_top", "stem_tip", "bone_top")
@@ -79,7 +81,7 @@ def interface_length(scene) -> float:
     """Arc length of the macro interface ``S_0`` (block width; femur: cone plus cylinder)."""
     g = scene.geometry
     if g.shape == "femur_stem":
-        return float(sum(np.hypot(b[0] - a[0], b[1] - a[1]) for a, b in rg.femur_stem_interface(g.femur_dims())))
+        return float(sum(np.hypot(b[0] - a[0], b[1] - a[1]) for a, b in femur.femur_stem_interface(g.femur_dims())))
     return float(g.length)
 
 
@@ -97,8 +99,8 @@ def build_resolved(scene, periods: int | None = None, periodic: bool = False):
     if g.shape == "femur_stem":
         if periodic:
             raise ValueError("the femur has no periodic variant")
-        return rg.femur_stem(g.femur_dims(), prof, N, maxh=d.maxh, interface_maxh=eps / d.elements_per_period,
-                             order=d.order, grading=d.grading)
+        return femur.femur_stem(g.femur_dims(), prof, N, maxh=d.maxh, interface_maxh=eps / d.elements_per_period,
+                                order=d.order, grading=d.grading, regions=REGIONS)
     return rg.resolved_blocks(prof, N, g.length, g.h_rough, g.h_counter, maxh=d.maxh,
                               interface_maxh=eps / d.elements_per_period, order=d.order, periodic=periodic,
                               grading=d.grading, x0=g.x0)
@@ -108,8 +110,8 @@ def build_flat(scene, interface_maxh: float):
     """The same bodies with the flat macro interface ``S_0`` (boundary ``interface``)."""
     g, d = scene.geometry, scene.discretization
     if g.shape == "femur_stem":
-        return rg.femur_stem(g.femur_dims(), None, 0, maxh=d.maxh, interface_maxh=interface_maxh,
-                             grading=d.grading)
+        return femur.femur_stem(g.femur_dims(), None, 0, maxh=d.maxh, interface_maxh=interface_maxh,
+                                grading=d.grading, regions=REGIONS)
     return rg.flat_blocks(g.length, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=interface_maxh,
                           grading=d.grading, x0=g.x0)
 
@@ -119,7 +121,7 @@ def body_of(scene, points) -> np.ndarray:
     g = scene.geometry
     pts = np.asarray(points, float).reshape(-1, 2)
     if g.shape == "femur_stem":
-        return rg.femur_stem_body(g.femur_dims(), pts)
+        return femur.femur_stem_body(g.femur_dims(), pts)
     inside = (pts[:, 0] > g.x0) & (pts[:, 0] < g.x0 + g.length) & (pts[:, 1] > -g.h_rough) & \
         (pts[:, 1] < g.h_counter)
     return np.where(inside, np.where(pts[:, 1] < 0, 0, 1), -1)
@@ -130,7 +132,7 @@ def interface_distance(scene, points) -> np.ndarray:
     g = scene.geometry
     pts = np.asarray(points, float).reshape(-1, 2)
     if g.shape == "femur_stem":
-        return rg.distance_to_polyline(rg.femur_stem_interface(g.femur_dims()), pts)
+        return femur.distance_to_polyline(femur.femur_stem_interface(g.femur_dims()), pts)
     return np.abs(pts[:, 1])
 
 
@@ -146,12 +148,14 @@ def interface_part(scene):
     return ng.IfPos(g.x0 + 0.5 * g.length - ng.x, 1.0, 0.0)
 
 
-def problem_of(scene, geometry, *, law=None) -> D.DirectProblem:
-    """The resolved problem (``law=None``) or its homogenized counterpart on a flat geometry."""
+def problem_of(scene, geometry) -> D.DirectProblem:
+    """The resolved problem of ``scene`` on ``geometry``."""
     kw = micro_law(scene.cell_scene)
     return D.DirectProblem(mesh=geometry.mesh, materials=materials_of(scene), setting=scene.geometry.setting,
                            supports=supports_of(scene), loads=loads_of(scene), order=scene.discretization.order,
-                           contact=geometry.interface, law=law, **kw)
+                           contact=geometry.interface,
+                           coulomb_rtol=scene.solver.coulomb_rtol,
+                           coulomb_max_iter=scene.solver.coulomb_max_iter, **kw)
 
 
 def solve_scene(scene, problem) -> D.DirectSolution:
@@ -160,7 +164,7 @@ def solve_scene(scene, problem) -> D.DirectSolution:
 
 
 def reactions(scene, sol) -> dict:
-    """Reaction force and moment of every supported boundary (see :func:`ngcontact.direct.boundary_reaction`).
+    """Reaction force and moment of every supported boundary (see :func:`ngcontact.fem.reaction.boundary_reaction`).
 
     Only the fixed components are kept (a free component's "reaction" is
     the residual, zero); in axisymmetry the radial one is dropped (its net
@@ -169,7 +173,7 @@ def reactions(scene, sol) -> dict:
     """
     p = sol.problem
     mesh = p.mesh
-    comps = D.COMPONENTS[p.setting]
+    comps = COMPONENTS[p.setting]
     out = {}
     for s in scene.supports:
         label = s.boundary
@@ -182,7 +186,7 @@ def reactions(scene, sol) -> dict:
         about = tuple(0.5 * (np.min(xs, axis=0) + np.max(xs, axis=0)))
         total = None
         for region, u in (("rough", sol.u_rough), ("counter", sol.u_counter)):
-            r = D.boundary_reaction(mesh, p.setting, p.materials[region], u, region, label, p.order, about=about)
+            r = boundary_reaction(mesh, p.setting, p.materials[region], u, region, label, p.order, about=about)
             total = r if total is None else {k: total[k] + r[k] for k in r}
         assert total is not None  # set by the loop over both bodies
         out[label] = {k: total[k] for k in keep}
@@ -195,7 +199,7 @@ def probes(scene, sol) -> list:
     out = []
     for x, y in (scene.study.probes if scene.study else ()):
         u = sol.u_rough if body_of(scene, [(x, y)])[0] == 0 else sol.u_counter
-        out.append(D.probe(mesh, u, [(x, y)])[0].tolist())
+        out.append(probe(mesh, u, [(x, y)])[0].tolist())
     return out
 
 

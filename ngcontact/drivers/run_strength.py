@@ -1,7 +1,7 @@
 """Driver part of ``[strength]`` (macro kind): macro state -> cell stresses -> check of eq. 78.
 
 No file I/O: returns results, a table, a VTK field and plot callables for
-the caller's :class:`~ngcontact.report.Outcome`.  See
+the caller's :class:`~ngcontact.output.report.Outcome`.  See
 :mod:`ngcontact.coupling.strength` for the mathematics.
 
 ``results["strength"]``: ``criterion``, ``recovery``, ``safety_factor``
@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+from collections.abc import Callable
+from typing import Any, TypedDict
 
 import ngsolve as ng
 import numpy as np
@@ -25,15 +27,27 @@ from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.predictor import max_gap
 from ngcontact.coupling import strength as S
 from ngcontact.errors import SceneError
+from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.output import plots as figures
 from ngcontact.output.report import VtkField
+from ngcontact.scene.cell_scene import CellScene
 from ngcontact.scene.loader import load
+from ngcontact.scene.macro_scene import MacroScene
 from ngcontact.scene.sections import resolve
 
 log = logging.getLogger(__name__)
 
 
-def cell_problem_of(cell_path: str, *, key: str):
+class StrengthEvaluation(TypedDict):
+    """What :func:`evaluate` returns for the caller's :class:`~ngcontact.output.report.Outcome`."""
+
+    results: dict[str, Any]  # results["strength"] (module docstring)
+    table: tuple[list[str], list[tuple[Any, ...]]]  # (header, rows) of the strength map
+    vtk: VtkField  # the worst cell
+    plots: dict[str, Callable[..., None]]  # name -> plot, called as plot(path)
+
+
+def cell_problem_of(cell_path: str, *, key: str) -> tuple[CellScene, CellProblem]:
     """Cell scene -> :class:`CellProblem` with the macro strain term (for recovery)."""
     from ngcontact.drivers.build import build_cell, model_of
     cs = load(cell_path)
@@ -48,12 +62,14 @@ def cell_problem_of(cell_path: str, *, key: str):
     return cs, CellProblem(cell, model, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse)
 
 
-def evaluate(scene, sol) -> dict:
+def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     """Strength check of ``scene.strength`` on the macro solution ``sol``.
 
     Returns ``{"results", "table", "vtk", "plots"}``.
     """
     spec = scene.strength
+    # set: the caller (drivers.run_macro) evaluates only scenes with a [strength] section
+    assert spec is not None
     path = resolve(scene, spec.cell)
     cs, P = cell_problem_of(path, key="strength.cell")
     law = sol.problem.law
@@ -70,19 +86,19 @@ def evaluate(scene, sol) -> dict:
     smap = S.strength_map(corr, loads, spec.criterion)
     names = [k for k in ("r", "z", "x", "y") if k in states]
     coords = np.column_stack([states[k] for k in names])
-    extra = {}
+    extra: dict[str, list[dict[str, Any]]] = {}
     if spec.recovery == "nonlinear":
         worst = np.maximum(smap.values["rough"], smap.values["counter"])
         picks = [int(i) for i in np.argsort(-worst)[:spec.nonlinear_points]]
-        solved = []
+        solved: list[dict[str, Any]] = []
         for i in picks:
             try:
                 st, csol = S.nonlinear_stress(P, loads[i])
             except ValueError as exc:
                 raise SceneError("strength.recovery", "nonlinear", f"the cell cannot be solved at the macro "
                                  f"state of interface point {i}: {exc}") from None
-            entry = {"index": i, "s": float(states["s"][i]), "load": loads[i].tolist(),
-                     "contact_fraction": csol.results["contact_fraction"], "bodies": {}}
+            entry: dict[str, Any] = {"index": i, "s": float(states["s"][i]), "load": loads[i].tolist(),
+                                     "contact_fraction": csol.results["contact_fraction"], "bodies": {}}
             for b in S.BODIES:
                 eq = S.equivalent(st[b]["stress"], spec.criterion)
                 k = int(np.argmax(eq))
@@ -91,8 +107,11 @@ def evaluate(scene, sol) -> dict:
                 smap.cell_point[b][i] = st[b]["points"][k]
             solved.append(entry)
         extra["nonlinear"] = solved
-    res = S.check(smap, {"rough": scene.materials[scene.bodies.rough].sigma_u,
-                         "counter": scene.materials[scene.bodies.counter].sigma_u}, coords)
+    sigma_u_rough = scene.materials[scene.bodies.rough].sigma_u
+    sigma_u_counter = scene.materials[scene.bodies.counter].sigma_u
+    # set: MacroScene.check requires sigma_u of both bodies when [strength] is present
+    assert sigma_u_rough is not None and sigma_u_counter is not None
+    res = S.check(smap, {"rough": sigma_u_rough, "counter": sigma_u_counter}, coords)
     for b, e in res["bodies"].items():
         e["macro_point"]["s"] = float(states["s"][e["macro_point"]["index"]])
         e["macro_point"]["names"] = names
@@ -124,13 +143,14 @@ def evaluate(scene, sol) -> dict:
                                                          states["e_hoop"]] + [smap.values[b] for b in S.BODIES]
     table = (header, list(zip(*cols)))
     sig_u = {b: res["bodies"][b]["sigma_u"] for b in S.BODIES}
-    map_data = {"s": np.asarray(states["s"]), "values": {b: smap.values[b] for b in S.BODIES},
-                "sigma_u": sig_u, "criterion": smap.criterion,
-                "pressure": np.asarray(states["pressure"]), "shear": np.asarray(states["shear"])}
-    cell_data = {"points": np.concatenate([worst_stress[b]["points"] for b in S.BODIES]),
-                 "eq": np.concatenate([S.equivalent(worst_stress[b]["stress"], spec.criterion)
-                                       for b in S.BODIES]),
-                 "criterion": spec.criterion, "dim": P.dim}
-    plots = {"strength_map": lambda p, d=map_data: figures.strength_map(p, **d),
-             "worst_cell": lambda p, d=cell_data: figures.worst_cell(p, **d)}
+    map_data: dict[str, Any] = {"s": np.asarray(states["s"]), "values": {b: smap.values[b] for b in S.BODIES},
+                                "sigma_u": sig_u, "criterion": smap.criterion,
+                                "pressure": np.asarray(states["pressure"]), "shear": np.asarray(states["shear"])}
+    cell_data: dict[str, Any] = {"points": np.concatenate([worst_stress[b]["points"] for b in S.BODIES]),
+                                 "eq": np.concatenate([S.equivalent(worst_stress[b]["stress"], spec.criterion)
+                                                       for b in S.BODIES]),
+                                 "criterion": spec.criterion, "dim": P.dim}
+    plots: dict[str, Callable[..., None]] = {
+        "strength_map": lambda p, d=map_data: figures.strength_map(p, **d),
+        "worst_cell": lambda p, d=cell_data: figures.worst_cell(p, **d)}
     return {"results": res, "table": table, "vtk": vtk, "plots": plots}

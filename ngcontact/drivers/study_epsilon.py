@@ -9,7 +9,7 @@ arc length of ``S_0``) this module solves the resolved problem of a
 or the axisymmetric femur with a stem) with a flat interface, with
 
 * ``bundle``: the unilateral direction bundle of the cell (paper eqs. 31-33,
-  :func:`ngcontact.homogenize.direction_bundle`), independent of ``eps``;
+  :func:`ngcontact.cell.coefficients.direction_bundle`), independent of ``eps``;
 * ``linear``: its linearization with the whole surface in contact,
   ``K0 = sum_q w_q n_q n_q^T`` (paper eq. 34), independent of ``eps``;
 * ``effective``: the linear law whose matrix is the effective stiffness of
@@ -42,12 +42,13 @@ Errors of each law against the resolved solution ``u^eps``:
   through the cone).
 
 The observed rate of each law is the least-squares slope of ``log error``
-against ``log eps`` (:func:`ngcontact.studies.fit_rate`).
+against ``log eps`` (:func:`ngcontact.verification.rates.fit_rate`).
 """
 from __future__ import annotations
 
 import logging
 import time
+from typing import Any
 
 import ngsolve as ng
 import numpy as np
@@ -55,6 +56,7 @@ import numpy as np
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.fem import elasticity
 from ngcontact.laws import homogenized as il
+from ngcontact.macro import macro_problem as M
 from ngcontact.coupling.cell_law import bundle_law
 from ngcontact.drivers import run_resolved as drv
 from ngcontact.output import plots
@@ -64,6 +66,7 @@ from ngcontact.geometry.resolved_bodies import scaled_profile
 from ngcontact.cell.coefficients import direction_bundle
 from ngcontact.output.report import Outcome
 from ngcontact.verification.rates import fit_rate
+from ngcontact.fem.quadrature import resultant_order
 
 log = logging.getLogger(__name__)
 
@@ -107,14 +110,8 @@ def effective_law(scene, eps: float, mean_traction) -> tuple[il.LinearLaw, dict]
                         h_counter=s * g.h_counter, maxh=s * d.maxh,
                         interface_maxh=s * (d.interface_maxh or d.maxh), order=d.order)
     mats = drv.materials_of(scene)
-    fr = None
-    f = kw["friction"]
-    if f is not None:
-        from ngcontact.cell.cell_problem import Friction
-        fr = Friction(f.law, w=f.w, G=f.G if f.law == "tresca" else None,
-                      mu=f.mu if f.law == "coulomb" else None)
     model = CellModel(rough=mats["rough"], counter=mats["counter"], k_n=kw["k_n"],
-                      gap=None if kw["gap"] is None else ng.CF(kw["gap"]), friction=fr,
+                      gap=None if kw["gap"] is None else ng.CF(kw["gap"]), friction=kw["friction"],
                       order=scene.discretization.order)
     tau_n, tau_t = (float(v) for v in mean_traction)
     if not tau_n > 0:
@@ -132,45 +129,56 @@ def effective_law(scene, eps: float, mean_traction) -> tuple[il.LinearLaw, dict]
     return law, info
 
 
-def mean_interface_traction(sol: D.DirectSolution, length: float | None = None) -> np.ndarray:
+def homogenized_problem(scene, flat, law: il.InterfaceLaw) -> M.MacroProblem:
+    """The macro problem on the flat bodies of ``scene`` with the homogenized ``law`` on ``S_0``.
+
+    The same materials, supports, loads and order as the resolved problem;
+    no macro gap (the cell's own gap terms are in the law).
+    """
+    return M.MacroProblem(mesh=flat.mesh, setting=scene.geometry.setting, rough="rough", counter="counter",
+                          materials=drv.materials_of(scene), law=law, supports=drv.supports_of(scene),
+                          loads=drv.loads_of(scene), order=scene.discretization.order, interface=flat.interface)
+
+
+def solve_homogenized(scene, flat, law: il.InterfaceLaw) -> M.MacroSolution:
+    """:func:`ngcontact.macro.macro_problem.solve` with the scene's solver settings."""
+    s = scene.solver
+    return M.solve(homogenized_problem(scene, flat, law), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
+                   inverse=s.inverse, coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter)
+
+
+def mean_interface_traction(sol: M.MacroSolution) -> np.ndarray:
     """``int_S0 tau w ds / int_S0 w ds`` in the local frame ``(n0, t0)`` of a homogenized solution.
 
-    ``w`` is the measure weight (``2 pi r`` in axisymmetry).  ``length`` is
-    not used (the denominator is integrated); kept for existing callers.
+    ``w`` is the measure weight (``2 pi r`` in axisymmetry).
     """
     p = sol.problem
     mesh = p.mesh
     w = elasticity.weight(p.setting)
-    frame = il.local_frame(sol.normal, 2)
-    a = [ng.InnerProduct(sol.jump, e) for e in frame]
-    tau = il.traction(p.law, a)
-    area = ng.Integrate(w, mesh, ng.BND, definedon=mesh.Boundaries(p.contact))
-    vals = [ng.Integrate(t * w, mesh, ng.BND, definedon=mesh.Boundaries(p.contact)) for t in tau]
+    on_s0 = mesh.Boundaries(p.interface)
+    area = ng.Integrate(w, mesh, ng.BND, definedon=on_s0)
+    vals = [ng.Integrate(t * w, mesh, ng.BND, definedon=on_s0) for t in M.interface_tractions(sol)]
     return np.asarray(vals, float) / area
 
 
 # -------------------------------------------------------------- measures
-def interface_force(sol: D.DirectSolution, x_range=None, part=None) -> np.ndarray:
+def interface_force(sol: D.DirectSolution | M.MacroSolution, part=None) -> np.ndarray:
     """Force the counter receives through a part of the interface (resolved or flat).
 
-    ``int tau w ds`` over the part given by ``x_range`` (``x`` in it) or by
-    the indicator CoefficientFunction ``part`` (default: all of it);
-    ``w = 2 pi r`` in axisymmetry.
+    ``int tau w ds`` over the part given by the indicator CoefficientFunction
+    ``part`` (default: all of it); ``w = 2 pi r`` in axisymmetry.  Resolved:
+    the micro pressure along the micro normal on ``S_C^eps``; homogenized:
+    the law's traction in the frame of ``S_0``.
     """
+    if isinstance(sol, D.DirectSolution):
+        return D.contact_force(sol, part=part)
     p = sol.problem
-    if p.law is None:
-        return D.contact_force(sol, x_range, part=part)
     mesh = p.mesh
-    frame = il.local_frame(sol.normal, 2)
-    a = [ng.InnerProduct(sol.jump, e) for e in frame]
-    tau = il.traction(p.law, a)
-    glob = tau[0] * frame[0] + tau[1] * frame[1]
+    glob = sum((t * e for t, e in zip(M.interface_tractions(sol), sol.frame)), ng.CF((0.0, 0.0)))
     ind = ng.CF(1.0) if part is None else part
-    if x_range is not None:
-        ind = ng.IfPos(ng.x - x_range[0], 1.0, 0.0) * ng.IfPos(x_range[1] - ng.x, 1.0, 0.0)
     w = elasticity.weight(p.setting)
-    return np.asarray(ng.Integrate(glob * ind * w, mesh, ng.BND, definedon=mesh.Boundaries(p.contact),
-                                   order=2 * p.order + 6), float).ravel()
+    return np.asarray(ng.Integrate(glob * ind * w, mesh, ng.BND, definedon=mesh.Boundaries(p.interface),
+                                   order=resultant_order(p.order)), float).ravel()
 
 
 def sample_grid(scene, band: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -203,7 +211,7 @@ def sample_grid(scene, band: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return pts, wts, drv.body_of(scene, pts)
 
 
-def displacement_at(sol: D.DirectSolution, points: np.ndarray, body=None) -> np.ndarray:
+def displacement_at(sol: D.DirectSolution | M.MacroSolution, points: np.ndarray, body=None) -> np.ndarray:
     """Displacement at ``points``, shape ``(m, 2)``.
 
     ``body``: per point 0 (rough) or 1 (counter); default: rough below ``y = 0``.
@@ -219,7 +227,7 @@ def displacement_at(sol: D.DirectSolution, points: np.ndarray, body=None) -> np.
     return out
 
 
-def measures(scene, sol: D.DirectSolution, points: np.ndarray, body=None) -> dict:
+def measures(scene, sol: D.DirectSolution | M.MacroSolution, points: np.ndarray, body=None) -> dict:
     """The quantities of interest of one solution (resolved or homogenized).
 
     In axisymmetry the interface force keeps its axial component only (the
@@ -272,21 +280,24 @@ def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS) -> dict:
     ref_sol = drv.solve_scene(scene, drv.problem_of(scene, geo))
     time_resolved = time.perf_counter() - t0
     ref = measures(scene, ref_sol, points, body)
-    row = {"N": N, "eps": eps, "ndof_resolved": ref_sol.ndof, "time_resolved": time_resolved,
+    row: dict[str, Any] = {"N": N, "eps": eps, "ndof_resolved": ref_sol.ndof, "time_resolved": time_resolved,
            "contact_fraction_resolved": D.contact_fraction(ref_sol, length)}
     t0 = time.perf_counter()
     flat = drv.build_flat(scene, st.interface_maxh)
     t_mesh = time.perf_counter() - t0
-    homogenized = {"bundle": bundle, "linear": il.linearized(bundle)}
-    bundle_sol = None
+    homogenized: dict[str, il.NormalLaw] = {"bundle": bundle, "linear": il.linearized(bundle)}
+    bundle_sol: M.MacroSolution | None = None
     for name in laws:
         t0 = time.perf_counter()
+        normal: il.NormalLaw
         if name == "effective":
+            if bundle_sol is None:
+                raise ValueError("the effective law is evaluated at the bundle solution: list 'bundle' before it")
             normal, info = effective_law(scene, eps, mean_interface_traction(bundle_sol))
             row["effective_law"] = info
         else:
             normal = homogenized[name]
-        sol = drv.solve_scene(scene, drv.problem_of(scene, flat, law=il.InterfaceLaw(normal=normal)))
+        sol = solve_homogenized(scene, flat, il.InterfaceLaw(normal=normal))
         seconds = time.perf_counter() - t0 + t_mesh
         if name == "bundle":
             bundle_sol = sol
@@ -335,7 +346,7 @@ def threshold_eps(rows: list, laws=LAWS, tol: float = 0.01) -> dict:
 def run_study(scene, periods=None, *, laws=LAWS, clock=None) -> Outcome:
     """The epsilon study of a ``direct`` scene with a ``[study]`` section; no file I/O.
 
-    Returns an :class:`~ngcontact.report.Outcome` with ``results.rows`` (one
+    Returns an :class:`~ngcontact.output.report.Outcome` with ``results.rows`` (one
     per ``N``), ``results.rates`` (per law and error), ``results.below_1_percent``
     (per law and error, the ``eps`` from which on the error stays below 1 %
     and the cost ratio there), a CSV table ``epsilon`` and a plot ``epsilon``.

@@ -12,10 +12,8 @@ is *not* part of the contract; :mod:`ngcontact.macro.macro_problem` determines `
 
 Builders
 --------
-:func:`femur_stem`
-    Axisymmetric hip stem in a femur, coordinates ``(r, z)`` = mesh
-    ``(x, y)``; regions ``stem`` (rough: the porous implant coating is on the
-    stem) and ``bone`` (counter).
+(The axisymmetric femur with a hip stem, flat or grooved, has its own
+builder: :func:`ngcontact.geometry.femur.femur_stem`.)
 :func:`coaxial_plane_strain`, :func:`coaxial_axisymmetric`
     Two long coaxial tubes (inner ``inner`` = rough, outer ``outer`` =
     counter) for Lame's press fit: a quarter annulus in plane strain, an
@@ -57,106 +55,6 @@ class MacroGeometry:
     counter: str
     boundaries: dict
     dims: dict
-
-
-@dataclass(frozen=True, kw_only=True)
-class FemurStemDims:
-    """Dimensions of the axisymmetric femur with a hip stem, in metres.
-
-    The femur is a hollow cylinder (outer radius ``r_bone``) from its clamped
-    base ``z = 0`` up to ``z_bone_top``.  The stem is a solid cylinder of
-    radius ``r_stem`` from its top ``z_stem_top`` down to ``z_corner``, below
-    which a conical frustum narrows to ``r_tip`` at ``z_tip``.  The canal
-    follows the stem (the interface) and continues below the tip as an empty
-    canal of radius ``r_tip`` down to the base.
-    """
-
-    r_stem: float = 0.011
-    r_tip: float = 0.005
-    r_bone: float = 0.016
-    z_tip: float = 0.04
-    z_corner: float = 0.12
-    z_bone_top: float = 0.17
-    z_stem_top: float = 0.19
-
-    def check(self) -> None:
-        if not 0 < self.r_tip <= self.r_stem < self.r_bone:
-            raise ValueError("need 0 < r_tip <= r_stem < r_bone")
-        if not 0 < self.z_tip < self.z_corner < self.z_bone_top < self.z_stem_top:
-            raise ValueError("need 0 < z_tip < z_corner < z_bone_top < z_stem_top")
-
-
-def femur_stem(dims: FemurStemDims = FemurStemDims(), *, maxh: float, interface_maxh: float | None = None,
-               corner_maxh: float | None = None, order: int = 1) -> MacroGeometry:
-    """Mesh the axisymmetric femur (``bone``) with a hip stem (``stem``) in ``(r, z)``.
-
-    Parameters
-    ----------
-    dims
-        The dimensions, see :class:`FemurStemDims`.
-    maxh, interface_maxh
-        Mesh size in the bodies and along the interface.
-    corner_maxh
-        Mesh size at the points where the interface ends or turns (stem tip,
-        cone-cylinder corner, bone top); default ``interface_maxh``.
-    order
-        Geometry order (the boundaries are straight, so 1 suffices).
-
-    Boundaries: ``interface`` (stem-bone), ``axis`` (``r = 0``),
-    ``stem_top`` (loaded face), ``stem_side`` (stem above the bone),
-    ``stem_tip`` (bottom face of the stem), ``bone_top``, ``bone_outer``,
-    ``canal`` (empty canal below the tip), ``base`` (clamped).
-    """
-    dims.check()
-    d = dims
-    hint = interface_maxh or maxh
-    hcorner = corner_maxh or hint
-    geo = SplineGeometry()
-    pts = {}
-
-    def p(name, x, y, h=None):
-        pts[name] = geo.AppendPoint(x, y, maxh=h) if h else geo.AppendPoint(x, y)
-
-    p("axis_tip", 0.0, d.z_tip)
-    p("axis_top", 0.0, d.z_stem_top)
-    p("tip", d.r_tip, d.z_tip, hcorner)
-    p("corner", d.r_stem, d.z_corner, hcorner)
-    p("bone_top_in", d.r_stem, d.z_bone_top, hcorner)
-    p("stem_top_out", d.r_stem, d.z_stem_top)
-    p("base_in", d.r_tip, 0.0)
-    p("base_out", d.r_bone, 0.0)
-    p("bone_top_out", d.r_bone, d.z_bone_top)
-
-    def seg(a, b, left, right, bc, h=None):
-        kw = {"maxh": h} if h else {}
-        geo.Append(["line", pts[a], pts[b]], leftdomain=left, rightdomain=right, bc=bc, **kw)
-
-    STEM, BONE = ROUGH, COUNTER
-    seg("axis_tip", "tip", STEM, 0, "stem_tip")
-    seg("tip", "corner", STEM, BONE, "interface", hint)
-    seg("corner", "bone_top_in", STEM, BONE, "interface", hint)
-    seg("bone_top_in", "stem_top_out", STEM, 0, "stem_side")
-    seg("stem_top_out", "axis_top", STEM, 0, "stem_top")
-    seg("axis_top", "axis_tip", STEM, 0, "axis")
-    seg("base_in", "base_out", BONE, 0, "base")
-    seg("base_out", "bone_top_out", BONE, 0, "bone_outer")
-    seg("bone_top_out", "bone_top_in", BONE, 0, "bone_top")
-    seg("tip", "base_in", BONE, 0, "canal")
-    geo.SetMaterial(STEM, "stem")
-    geo.SetMaterial(BONE, "bone")
-    mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh))
-    if order > 1:
-        mesh.Curve(order)
-    return MacroGeometry(mesh=mesh, rough="stem", counter="bone", dims=dict(vars(d)), boundaries={
-        "interface": "stem-bone interface S_0 (cone and cylinder)",
-        "axis": "symmetry axis r = 0 of the stem",
-        "stem_top": "top face of the stem (loaded)",
-        "stem_side": "stem surface above the bone",
-        "stem_tip": "bottom face of the stem",
-        "bone_top": "top face of the bone",
-        "bone_outer": "outer surface of the femur",
-        "canal": "empty canal below the stem tip",
-        "base": "base of the femur (clamped)"})
 
 
 def coaxial_axisymmetric(a: float, b: float, c: float, height: float, *, maxh: float,

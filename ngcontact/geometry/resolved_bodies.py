@@ -24,28 +24,15 @@ cells, for comparison with the cell problem).  The blocks may be shifted to
 ``x0 <= x <= x0 + L`` (in axisymmetry ``x`` is the radius ``r``: an annular
 disk whose face carries concentric ring grooves).
 
-:func:`femur_stem` lays the profile along the stem-bone interface of the
-axisymmetric femur of :func:`ngcontact.geometry.macro.femur_stem` (the
-cone from the stem tip to the cone-cylinder corner and the cylinder up to
-the top of the bone): circumferential grooves in the stem, filled by the
-bone.  Along a straight interface segment from ``a`` to ``b`` with unit
-tangent ``t`` and the unit normal ``n`` on its left (pointing into the
-counter body), a profile point ``(s, y)`` of a period starting at arc length
-``s_k`` maps to ``a + (s_k + s) t + y n``: a rigid motion, so lines stay
-lines and the rational ``spline3`` arcs stay exact.  Each segment ``i`` of
-arc length ``L_i`` gets ``N_i = max(1, round(L_i / eps))`` whole periods,
-``eps = (sum L_i) / N``, so its own period ``eps_i = L_i / N_i`` is within
-a factor ``[2/3, 2]`` of ``eps`` (equal to it when ``L_i`` is a multiple).
-The profile starts and ends a period at the summit height ``y = 0``, so the
-chains of the two segments meet at the corner.
+The femur with a grooved stem is built by
+:func:`ngcontact.geometry.femur.femur_stem`, which lays the same
+:func:`profile_chain` along the stem-bone interface.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-import math
 
-import numpy as np
 import ngsolve as ng
 from netgen.geom2d import SplineGeometry
 
@@ -107,7 +94,7 @@ def scaled_profile(profile: Profile, eps: float) -> Profile:
     return Profile(profile.name, eps, tuple(pieces))
 
 
-def _chain(profile: Profile, periods: int, eps: float) -> list:
+def profile_chain(profile: Profile, periods: int, eps: float) -> list:
     """Interface segments of ``periods`` scaled copies, left to right."""
     one = interface_segments(scaled_profile(profile, eps), "conforming")
     out = []
@@ -155,7 +142,7 @@ def resolved_blocks(profile: Profile, periods: int, length: float, h_rough: floa
     if not (-h_rough < s * lo and s * hi < h_counter):
         raise ValueError(f"the scaled roughness spans y in [{s * lo}, {s * hi}]: it must lie inside "
                          f"(-h_rough, h_counter) = ({-h_rough}, {h_counter})")
-    chain = [(kind, tuple((p[0] + x0, p[1]) for p in pts)) for kind, pts in _chain(profile, periods, eps)]
+    chain = [(kind, tuple((p[0] + x0, p[1]) for p in pts)) for kind, pts in profile_chain(profile, periods, eps)]
     geo = SplineGeometry()
     cache = {}
     tol = 1e-12 * length
@@ -222,163 +209,3 @@ def flat_blocks(length: float, h_rough: float, h_counter: float, *, maxh: float,
     mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh, grading=grading))
     return ResolvedGeometry(mesh=mesh, interface="interface", periods=0, eps=length, length=length,
                             h_rough=h_rough, h_counter=h_counter, x0=x0)
-
-
-# ------------------------------------------------------------ femur and stem
-def femur_stem_interface(dims) -> list:
-    """The straight segments of the stem-bone interface, from the bone top down to the stem tip.
-
-    Returns ``[(a, b), ...]`` in ``(r, z)``: the cylinder from
-    ``(r_stem, z_bone_top)`` to the corner ``(r_stem, z_corner)``, then the
-    cone down to the tip ``(r_tip, z_tip)``.  Travelled in this order, the
-    left-hand normal points out of the stem into the bone.
-    """
-    d = dims
-    top, corner, tip = (d.r_stem, d.z_bone_top), (d.r_stem, d.z_corner), (d.r_tip, d.z_tip)
-    return [(top, corner), (corner, tip)]
-
-
-def split_periods(lengths, periods: int) -> tuple[tuple[int, float], ...]:
-    """``N_i = max(1, round(L_i / eps))`` whole periods per segment, ``eps = sum(L_i) / periods``.
-
-    Returns ``((N_1, eps_1), ...)`` with ``eps_i = L_i / N_i``.
-    """
-    if not (isinstance(periods, int) and periods >= 1):
-        raise ValueError(f"periods = {periods!r}: must be an integer >= 1")
-    eps = float(sum(lengths)) / periods
-    out: list[tuple[int, float]] = []
-    for L in lengths:
-        n = max(1, int(round(L / eps)))
-        out.append((n, L / n))
-    return tuple(out)
-
-
-def _chain_along(profile: Profile, a, b, periods: int) -> list:
-    """``periods`` scaled copies of ``profile`` along the segment ``a -> b``, normal on the left."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    L = float(np.linalg.norm(b - a))
-    t = (b - a) / L
-    n = np.array([-t[1], t[0]])
-    eps = L / periods
-    out = []
-    for kind, pts in _chain(profile, periods, eps):
-        out.append((kind, tuple(tuple(a + p[0] * t + p[1] * n) for p in pts)))
-    return out
-
-
-def femur_stem(dims, profile: Profile | None, periods: int, *, maxh: float, interface_maxh: float,
-               order: int = 1, grading: float = 0.3) -> ResolvedGeometry:
-    """The axisymmetric femur with a hip stem whose interface carries resolved circumferential grooves.
-
-    The outline, regions (``rough`` = the stem, ``counter`` = the bone) and
-    boundary labels are those of :func:`ngcontact.geometry.macro.femur_stem`
-    (``axis``, ``stem_top``, ``stem_side``, ``stem_tip``, ``bone_top``,
-    ``bone_outer``, ``canal``, ``base``), coordinates ``(r, z)`` = mesh
-    ``(x, y)``; the region names follow the ``direct`` kind.
-
-    Parameters
-    ----------
-    dims
-        :class:`ngcontact.geometry.macro.FemurStemDims`.
-    profile
-        One period of the roughness (summits at ``y = 0``, valleys into the
-        stem), or ``None`` for the flat macro interface ``S_0`` (boundary
-        ``interface``).
-    periods
-        Total number ``N`` of periods along the interface (cone and
-        cylinder, split by :func:`split_periods`); ignored when flat.
-    maxh, interface_maxh
-        Mesh size in the bodies and along the interface (for the resolved
-        interface: a fraction of ``eps``; the grading keeps the element
-        count growing like ``N``).
-    order
-        Geometry order (curved elements on arcs of the profile).
-    grading
-        Netgen's grading factor.
-
-    Raises
-    ------
-    ValueError
-        Invalid dimensions or sizes, or grooves so deep that they reach the axis.
-    """
-    dims.check()
-    if min(maxh, interface_maxh) <= 0:
-        raise ValueError("mesh sizes must be > 0")
-    d = dims
-    segs = femur_stem_interface(d)
-    lengths = [math.dist(a, b) for a, b in segs]
-    split: tuple[tuple[int, float], ...]
-    if profile is None:
-        split = ()
-        chain = [("line", (a, b)) for a, b in segs]
-        label, eps = "interface", float(sum(lengths))
-    else:
-        split = split_periods(lengths, periods)
-        chain = []
-        for (a, b), (n, _) in zip(segs, split):
-            chain += _chain_along(profile, a, b, n)
-        label, eps = "contact", float(sum(lengths)) / periods
-        r_min = min(p[0] for _, pts in chain for p in pts)
-        if not r_min > 0:
-            raise ValueError(f"periods = {periods}: the grooves (depth {profile.depth * eps / profile.period:.4g} m) "
-                             f"reach the axis (r = {r_min:.4g} m); use more periods or a shallower profile")
-    geo = SplineGeometry()
-    cache = {}
-    tol = 1e-12 * d.z_stem_top
-
-    def point(p, h=None):
-        key = (round(p[0] / tol), round(p[1] / tol))
-        if key not in cache:
-            cache[key] = geo.AppendPoint(*p, maxh=h) if h else geo.AppendPoint(*p)
-        return cache[key]
-
-    STEM, BONE = ROUGH, COUNTER
-    for p in ((d.r_tip, d.z_tip), (d.r_stem, d.z_corner), (d.r_stem, d.z_bone_top)):
-        point(p, interface_maxh)
-
-    def seg(a, b, left, right, bc):
-        geo.Append(["line", point(a), point(b)], leftdomain=left, rightdomain=right, bc=bc)
-
-    seg((0.0, d.z_tip), (d.r_tip, d.z_tip), STEM, 0, "stem_tip")
-    seg((d.r_stem, d.z_bone_top), (d.r_stem, d.z_stem_top), STEM, 0, "stem_side")
-    seg((d.r_stem, d.z_stem_top), (0.0, d.z_stem_top), STEM, 0, "stem_top")
-    seg((0.0, d.z_stem_top), (0.0, d.z_tip), STEM, 0, "axis")
-    seg((d.r_tip, 0.0), (d.r_bone, 0.0), BONE, 0, "base")
-    seg((d.r_bone, 0.0), (d.r_bone, d.z_bone_top), BONE, 0, "bone_outer")
-    seg((d.r_bone, d.z_bone_top), (d.r_stem, d.z_bone_top), BONE, 0, "bone_top")
-    seg((d.r_tip, d.z_tip), (d.r_tip, 0.0), BONE, 0, "canal")
-    # travelled from the bone top down: the bone (counter) on the left, the stem on the right
-    for kind, pts in chain:
-        geo.Append([kind, *[point(p) for p in pts]], leftdomain=BONE, rightdomain=STEM, bc=label,
-                   maxh=interface_maxh)
-    geo.SetMaterial(STEM, "rough")
-    geo.SetMaterial(BONE, "counter")
-    mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh, grading=grading))
-    if order > 1:
-        mesh.Curve(order)
-    return ResolvedGeometry(mesh=mesh, interface=label, periods=0 if profile is None else periods, eps=eps,
-                            length=float(sum(lengths)), segments=split)
-
-
-def femur_stem_body(dims, points) -> np.ndarray:
-    """Which body each point ``(r, z)`` lies in with the flat interface: 0 stem, 1 bone, -1 outside."""
-    d = dims
-    pts = np.asarray(points, float).reshape(-1, 2)
-    r, z = pts[:, 0], pts[:, 1]
-    slope = (d.r_stem - d.r_tip) / (d.z_corner - d.z_tip)
-    r_int = np.where(z < d.z_tip, d.r_tip, np.where(z < d.z_corner, d.r_tip + slope * (z - d.z_tip), d.r_stem))
-    stem = (z > d.z_tip) & (z < d.z_stem_top) & (r >= 0) & (r < r_int)
-    bone = (z > 0) & (z < d.z_bone_top) & (r > r_int) & (r < d.r_bone)
-    return np.where(stem, 0, np.where(bone, 1, -1))
-
-
-def distance_to_polyline(segments, points) -> np.ndarray:
-    """Euclidean distance of each point to the union of the segments ``[(a, b), ...]``."""
-    pts = np.asarray(points, float).reshape(-1, 2)
-    out = np.full(len(pts), np.inf)
-    for a, b in segments:
-        a, b = np.asarray(a, float), np.asarray(b, float)
-        ab = b - a
-        t = np.clip((pts - a) @ ab / (ab @ ab), 0.0, 1.0)
-        out = np.minimum(out, np.linalg.norm(pts - (a + t[:, None] * ab), axis=1))
-    return out

@@ -22,16 +22,16 @@ Solution strategy:
 
 * linear law, no friction: the energy is quadratic, one linear solve;
 * bundle / tabulated laws, or a Tresca threshold ``G0`` only: Newton with
-  line search (:func:`ngcontact.newton.minimize`);
+  line search (:func:`ngcontact.solvers.newton.minimize`);
 * every nonlinear law starts from one linear solve of its quadratic
   surrogate: the normal law with every direction closed and, under friction,
   the tangential jump bonded by a spring as stiff as the normal law (so no
   body floats at the first Newton step);
 * Coulomb friction ``G = mu0 [p]_+ + G0``: a fixed point on the pressure.
   It starts from that bonded state, then repeats Newton solves
-  with ``G`` evaluated at the previous solution's pressure until the
-  pressure changes by less than ``fixed_point_tol`` (relative L2 norm on
-  ``S_0``); each pass stops at ``rtol`` times the first residual of the
+  with ``G`` evaluated at the previous solution's pressure
+  (:func:`ngcontact.solvers.coulomb.coulomb_fixed_point`, whose stopping
+  rule is that of every scale); each pass stops at ``rtol`` times the first residual of the
   bonded start.  The fixed point converges to a solution of the regularized
   Coulomb problem; no energy of the coupled problem exists, so no coupled
   Newton is attempted.
@@ -55,7 +55,12 @@ from ngcontact.fem import two_body
 from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.fem.two_body import Load, Support, boundary_labels, interface_normal  # noqa: F401  (public names of the macro problem)
 from ngcontact.laws import homogenized as il
+from ngcontact.laws import interface_energy as ie
+from ngcontact.laws.local_frame import local_frame
 from ngcontact.fem.materials import ElasticLaw, von_mises
+from ngcontact.fem.quadrature import energy_order, sampling_order
+from ngcontact.fem.sampling import boundary_values
+from ngcontact.solvers.coulomb import coulomb_fixed_point
 from ngcontact.solvers.newton import minimize
 from ngcontact.errors import ModelError
 
@@ -156,18 +161,18 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
     g0 = _gap_cf(problem.gap)
     law = problem.law
     if start_stiffness is not None:
-        W = il.normal_energy(law.normal, a, g0, closed=True)
+        W = ie.normal_energy(law.normal, a, g0, closed=True)
         if law.friction is not None:
             W = W + 0.5 * start_stiffness * sum(t * t for t in a[1:])
     else:
-        W = il.energy(law, a, g0, G)
+        W = ie.energy(law, a, g0, G)
     form += ng.Variation(W * w * ng.ds(definedon=mesh.Boundaries(problem.interface)))
     return two_body.add_load_potential(form, mesh, problem.loads, (ur, uc), w)
 
 
 def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
-          inverse: str = "sparsecholesky", fixed_point_tol: float = 1e-6,
-          max_fixed_point: int = 40) -> MacroSolution:
+          inverse: str = "sparsecholesky", coulomb_rtol: float = 1e-8,
+          coulomb_max_iter: int = 40) -> MacroSolution:
     """Solve the macro problem.
 
     Parameters
@@ -175,10 +180,10 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     problem
         The description.
     rtol, atol, max_iter, inverse
-        Newton settings (:func:`ngcontact.newton.minimize`).
-    fixed_point_tol, max_fixed_point
-        Coulomb fixed point on the pressure: relative change of ``p`` in
-        ``L2(S_0)`` at which to stop, and the largest number of passes.
+        Newton settings (:func:`ngcontact.solvers.newton.minimize`).
+    coulomb_rtol, coulomb_max_iter
+        Stopping rule of the Coulomb fixed point
+        (:func:`ngcontact.solvers.coulomb.coulomb_fixed_point`).
 
     Raises
     ------
@@ -187,7 +192,6 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     ConvergenceError
         Newton or the fixed point failed.
     """
-    from ngcontact.errors import ConvergenceError
 
     check_problem(problem)
     mesh = problem.mesh
@@ -196,10 +200,10 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     gfu = ng.GridFunction(fes)
     two_body.set_dirichlet(mesh, problem.setting, problem.supports, gfu)
     n0 = two_body.interface_normal(mesh, problem.rough, problem.interface)
-    frame = il.local_frame(n0, mesh.dim)
+    frame = local_frame(n0, mesh.dim)
     law = problem.law
     newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
-    history: dict[str, Any] = {"newton": [], "fixed_point_changes": []}
+    history: dict[str, Any] = {"newton": [], "coulomb_changes": [], "coulomb_iterations": 0}
     g0 = _gap_cf(problem.gap)
     old = ng.GridFunction(fes)
     a_old = _local(frame, old.components[0] - old.components[1])
@@ -212,33 +216,26 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
         history["newton"].append(minimize(start, gfu, quadratic=True, **newton).as_dict())
         newton["atol"] = max(atol, rtol * history["newton"][0]["residuals"][0])
     if law.friction is not None and law.friction.coulomb:
-        G = il.threshold(law.friction, il.pressure(law.normal, a_old, g0))
+        G = ie.threshold(law.friction, ie.pressure(law.normal, a_old, g0))
         form = _form(problem, fes, frame, G=G)
-        wt = elasticity.weight(problem.setting)
-        on_s0 = mesh.Boundaries(problem.interface)
-        a_new = _local(frame, gfu.components[0] - gfu.components[1])
-        p_new = il.pressure(law.normal, a_new, g0)
-        p_prev = il.pressure(law.normal, a_old, g0)
-        for it in range(1, max_fixed_point + 1):
+        p_now = ie.pressure(law.normal, _local(frame, gfu.components[0] - gfu.components[1]), g0)
+
+        def freeze() -> None:
             old.vec.data = gfu.vec
-            history["newton"].append(minimize(form, gfu, **newton).as_dict())
-            diff = ng.Integrate((p_new - p_prev) ** 2 * wt, mesh, ng.BND, definedon=on_s0)
-            norm = ng.Integrate(p_new ** 2 * wt, mesh, ng.BND, definedon=on_s0)
-            change = float(np.sqrt(max(diff, 0.0) / norm)) if norm > 0 else 0.0
-            history["fixed_point_changes"].append(change)
-            log.info("Coulomb fixed point %d: relative pressure change %.3e", it, change)
-            if change <= fixed_point_tol:
-                break
-        else:
-            raise ConvergenceError(f"Coulomb fixed point: pressure still changes by {change:.3e} "
-                                   f"> {fixed_point_tol:g} after {max_fixed_point} passes", history)
+
+        fixed = coulomb_fixed_point(
+            freeze, lambda: minimize(form, gfu, **newton).as_dict(),
+            lambda: boundary_values(mesh, problem.interface, p_now, sampling_order(problem.order)),
+            rtol=coulomb_rtol, max_iter=coulomb_max_iter)
+        history["newton"].extend(fixed["newton"])
+        history["coulomb_changes"] = fixed["coulomb_changes"]
+        history["coulomb_iterations"] = fixed["coulomb_iterations"]
     else:
         if law.friction is not None:
             G = ng.CF(law.friction.threshold)
         form = _form(problem, fes, frame, G=G)
         history["newton"].append(minimize(form, gfu, quadratic=law.quadratic, **newton).as_dict())
     history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
-    history["fixed_point_iterations"] = len(history["fixed_point_changes"])
     history["converged"] = all(h["converged"] for h in history["newton"])
     history["quadratic"] = law.quadratic
     ur, uc = gfu.components
@@ -335,7 +332,7 @@ def field_extrema(sol: MacroSolution, fields: dict) -> dict:
 def interface_tractions(sol: MacroSolution) -> list:
     """Local traction components ``dW/da`` on ``S_0`` at the solution."""
     p = sol.problem
-    return il.traction(p.law, sol.local_jump, _gap_cf(p.gap), sol.threshold)
+    return ie.traction(p.law, sol.local_jump, _gap_cf(p.gap), sol.threshold)
 
 
 def resultant(sol: MacroSolution) -> dict:
@@ -355,7 +352,7 @@ def resultant(sol: MacroSolution) -> dict:
     w = elasticity.weight(p.setting)
     comps = COMPONENTS[p.setting]
     vals = [ng.Integrate(glob[i] * w, p.mesh, ng.BND, definedon=p.mesh.Boundaries(p.interface),
-                         order=2 * p.order) for i in range(p.mesh.dim)]
+                         order=energy_order(p.order)) for i in range(p.mesh.dim)]
     if p.setting == "axisymmetric":
         return {"z": float(vals[1])}
     return {c: float(v) for c, v in zip(comps, vals)}

@@ -11,7 +11,7 @@ on the whole resolved surface ``S_C^eps``.  Minimizes
 with each body ``B`` its own ``VectorH1`` on its region (``definedon``), the
 jump ``J = u_rough - u_counter`` on ``S_C^eps``, the micro normal ``n``
 pointing from ``rough`` into ``counter`` (sign fixed element by element by
-:func:`ngcontact.macro.interface_normal`), the measure weight ``w`` (``2 pi r``
+:func:`ngcontact.fem.two_body.interface_normal`), the measure weight ``w`` (``2 pi r``
 in axisymmetry) and the interface energy density of
 :mod:`ngcontact.laws.penalty` (paper eqs. 7, 9, 16)::
 
@@ -20,19 +20,18 @@ in axisymmetry) and the interface energy density of
 Dirichlet data fix displacement components on labelled boundaries (the
 values may vary linearly along the boundary: a tilt); pressures and
 tractions load others.  The energy is convex: it is minimized by Newton's
-method with the exact line search of :func:`ngcontact.newton.minimize`,
+method with the exact line search of :func:`ngcontact.solvers.newton.minimize`,
 started from the solution of the quadratic surrogate with every point of
 ``S_C^eps`` closed (so that no body floats at the first step).  Coulomb
 friction ``G = mu p`` is a fixed point on the pressure of the previous
 solution, stopped when ``max |p_k - p_{k-1}| <= coulomb_rtol max p_k`` at
 the quadrature points of ``S_C^eps``.
 
-Post-processing shared with the homogenized solutions (so both are measured
-alike): :func:`boundary_reaction` (consistent reaction force and moment on a
-Dirichlet boundary from the elastic energy of the body that carries it),
-:func:`probe` (displacement at points), and on the resolved surface
-:func:`contact_force` (the force the counter body receives through a part
-of the interface) and :func:`contact_fraction`.
+Measures on the resolved surface: :func:`contact_force` (the force the
+counter body receives through a part of the interface) and
+:func:`contact_fraction`.  Reactions and probes, which the resolved and the
+homogenized solutions share, are in :mod:`ngcontact.fem.reaction` and
+:mod:`ngcontact.fem.sampling`.
 """
 from __future__ import annotations
 
@@ -45,28 +44,19 @@ import numpy as np
 
 from ngcontact.laws import penalty as _contact
 from ngcontact.fem import elasticity
-from ngcontact.laws import homogenized as il
-from ngcontact.errors import ConvergenceError
 from ngcontact.fem import two_body
-from ngcontact.fem.elasticity import COMPONENTS
+from ngcontact.laws.penalty import Friction
+from ngcontact.fem.quadrature import kink_order, resultant_order, sampling_order
+from ngcontact.fem.sampling import boundary_values
 from ngcontact.fem.materials import ElasticLaw
 from ngcontact.fem.two_body import Load, Support, interface_normal  # noqa: F401  (public names of the resolved problem)
+from ngcontact.solvers.coulomb import coulomb_fixed_point
 from ngcontact.solvers.newton import minimize
 from ngcontact.errors import ModelError
 
 log = logging.getLogger(__name__)
 
 SETTINGS = ("plane_strain", "axisymmetric")
-
-
-@dataclass(frozen=True, kw_only=True)
-class Friction:
-    """Micro friction: ``"tresca"`` (threshold ``G``) or ``"coulomb"`` (``mu``), Huber width ``w``."""
-
-    law: str
-    w: float
-    G: float = 0.0
-    mu: float = 0.0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -95,14 +85,6 @@ class DirectProblem:
         The lateral faces are identified (``Periodic`` spaces).
     coulomb_rtol, coulomb_max_iter
         Stopping rule of the Coulomb fixed point.
-    law
-        ``None`` (the micro law above on the resolved surface) or a
-        homogenized :class:`~ngcontact.interface_law.InterfaceLaw` (without
-        Coulomb friction): then ``contact`` names the flat macro interface
-        ``S_0``, ``n`` is its normal ``n0``, the energy density is
-        ``W(a)`` of the local jump ``a = (J.n0, J.t0)`` and ``k_n``,
-        ``gap`` and ``friction`` are not used.  Both models are thus solved
-        with the same spaces, boundary conditions, start and Newton method.
     contact
         Label of the interface boundary.
     """
@@ -120,7 +102,6 @@ class DirectProblem:
     contact: str = "contact"
     coulomb_rtol: float = 1e-8
     coulomb_max_iter: int = 40
-    law: il.InterfaceLaw | None = None
 
 
 @dataclass
@@ -158,13 +139,7 @@ def _form(problem: DirectProblem, fes, n, *, threshold=None, surrogate: bool = F
     J = ur.Trace() - uc.Trace()
     k_n = problem.k_n
     fr = problem.friction
-    if problem.law is not None:
-        a = [ng.InnerProduct(J, e) for e in il.local_frame(n, mesh.dim)]
-        if surrogate:
-            psi = il.normal_energy(problem.law.normal, a, 0.0, closed=True)
-        else:
-            psi = il.energy(problem.law, a, 0.0, threshold)
-    elif surrogate:
+    if surrogate:
         d = _contact.penetration(J, n, problem.gap)
         psi = 0.5 * k_n * d * d
         if fr is not None:
@@ -191,21 +166,18 @@ def _check(problem: DirectProblem) -> None:
                              + ", ".join(sorted(labels - {""})))
     if not problem.k_n > 0:
         raise ModelError(f"k_n = {problem.k_n!r}: must be > 0")
-    law = problem.law
-    if law is not None and law.friction is not None and law.friction.coulomb:
-        raise ModelError("a homogenized law with Coulomb friction is solved by ngcontact.macro.solve")
 
 
 def solve(problem: DirectProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
           inverse: str = "sparsecholesky") -> DirectSolution:
-    """Solve the resolved contact problem (or its homogenized counterpart, ``problem.law``).
+    """Solve the resolved contact problem.
 
     Parameters
     ----------
     problem
         The description.
     rtol, atol, max_iter, inverse
-        Newton settings (:func:`ngcontact.newton.minimize`); every Newton
+        Newton settings (:func:`ngcontact.solvers.newton.minimize`); every Newton
         solve after the quadratic start stops at ``rtol`` times the first
         residual of that start.
 
@@ -224,20 +196,14 @@ def solve(problem: DirectProblem, *, rtol: float = 1e-10, atol: float = 0.0, max
     two_body.set_dirichlet(mesh, problem.setting, problem.supports, gfu)
     n = two_body.interface_normal(mesh, "rough", problem.contact)
     newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
-    history: dict[str, Any] = {"newton": [], "coulomb_changes": []}
+    history: dict[str, Any] = {"newton": [], "coulomb_changes": [], "coulomb_iterations": 0}
     start = _form(problem, fes, n, surrogate=True)
     history["newton"].append(minimize(start, gfu, quadratic=True, **newton).as_dict())
     newton["atol"] = max(atol, rtol * history["newton"][0]["residuals"][0])
     ur, uc = gfu.components
     J = ur - uc
     fr = problem.friction
-    if problem.law is not None:
-        a = [ng.InnerProduct(J, e) for e in il.local_frame(n, mesh.dim)]
-        pressure = il.pressure(problem.law.normal, a)
-        G = None if problem.law.friction is None else ng.CF(problem.law.friction.threshold)
-        form = _form(problem, fes, n, threshold=G)
-        history["newton"].append(minimize(form, gfu, line_search="exact", **newton).as_dict())
-    elif fr is not None and fr.law == "coulomb":
+    if fr is not None and fr.law == "coulomb":
         pressure = _contact.pressure(J, n, problem.k_n, problem.gap)
         _coulomb(problem, fes, gfu, n, pressure, newton, history)
     else:
@@ -258,88 +224,20 @@ def _coulomb(problem, fes, gfu, n, pressure, newton, history) -> None:
     J_old = old.components[0] - old.components[1]
     G = _contact.coulomb_threshold(J_old, n, problem.k_n, fr.mu, problem.gap)
     form = _form(problem, fes, n, threshold=G)
-    p_old = _sample_contact(mesh, problem.contact, pressure, problem.order)
-    for it in range(1, problem.coulomb_max_iter + 1):
+
+    def freeze() -> None:
         old.vec.data = gfu.vec
-        history["newton"].append(minimize(form, gfu, line_search="exact", **newton).as_dict())
-        p_new = _sample_contact(mesh, problem.contact, pressure, problem.order)
-        change = float(np.max(np.abs(p_new - p_old)))
-        scale = float(np.max(np.abs(p_new)))
-        history["coulomb_changes"].append(change)
-        log.info("coulomb fixed point %d: max |dp| = %.3e (max p %.3e)", it, change, scale)
-        if change <= problem.coulomb_rtol * max(scale, 1e-300):
-            return
-        p_old = p_new
-    raise ConvergenceError(f"Coulomb fixed point: pressure still changes by {change:.3e} after "
-                           f"{problem.coulomb_max_iter} passes", history)
 
-
-def _sample_contact(mesh, label, cf, order) -> np.ndarray:
-    S = ng.comp.IntegrationRuleSpaceSurface(mesh, order=2 * order + 2, definedon=mesh.Boundaries(label))
-    gf = ng.GridFunction(S)
-    gf.Set(cf, definedon=mesh.Boundaries(label))
-    return gf.vec.FV().NumPy().copy()
+    fixed = coulomb_fixed_point(
+        freeze, lambda: minimize(form, gfu, line_search="exact", **newton).as_dict(),
+        lambda: boundary_values(mesh, problem.contact, pressure, sampling_order(problem.order)),
+        rtol=problem.coulomb_rtol, max_iter=problem.coulomb_max_iter)
+    history["newton"].extend(fixed["newton"])
+    history["coulomb_changes"] = fixed["coulomb_changes"]
+    history["coulomb_iterations"] = fixed["coulomb_iterations"]
 
 
 # -------------------------------------------------------- post-processing
-def boundary_reaction(mesh, setting: str, law, u, region: str, label: str, order: int,
-                      about=(0.0, 0.0)) -> dict:
-    """Reaction force and moment that a Dirichlet boundary exerts on its body.
-
-    The consistent reaction: the derivative of the body's elastic energy in
-    the direction of a test field ``v`` equal to ``e_i`` (force component
-    ``i``) or to the rigid rotation about ``about`` (moment, plane strain)
-    on the dofs of ``label`` and zero on all other dofs.  At an equilibrium
-    state with no load on the boundary's neighbours this is the force the
-    support transmits; the sign is that of the force the body *exerts on
-    the support* (e.g. positive ``y`` when the body presses upwards).
-
-    Parameters
-    ----------
-    mesh, setting
-        Mesh and setting.
-    law
-        The body's :class:`~ngcontact.materials.ElasticLaw`.
-    u
-        The body's displacement (GridFunction or component).
-    region, label
-        The body's region and the boundary.
-    order
-        Order of the test field (that of ``u``).
-    about
-        Centre of the moment (plane strain).
-
-    Returns
-    -------
-    dict
-        Force components by name (``x, y`` or ``r, z``; axisymmetric: per
-        full revolution, ``r`` omitted) and ``moment`` (plane strain).
-    """
-    comps = COMPONENTS[setting]
-    V = ng.VectorH1(mesh, order=order, definedon=mesh.Materials(region))
-    v = ng.GridFunction(V)
-    sigma = elasticity.stress(law, u, setting)
-    w = elasticity.weight(setting)
-    fields = {c: ng.CF(tuple(1.0 if j == i else 0.0 for j in range(2))) for i, c in enumerate(comps)}
-    if setting == "plane_strain":
-        fields["moment"] = ng.CF((-(ng.y - about[1]), ng.x - about[0]))
-    else:
-        fields.pop("r")
-    out = {}
-    for name, cf in fields.items():
-        v.vec[:] = 0.0
-        v.Set(cf, definedon=mesh.Boundaries(label))
-        work = ng.InnerProduct(sigma, elasticity.strain(v, setting)) * w
-        out[name] = -float(ng.Integrate(work, mesh, definedon=mesh.Materials(region)))
-    return out
-
-
-def probe(mesh, u, points) -> np.ndarray:
-    """Displacement ``u`` at ``points`` (an array ``(m, 2)``), one row per point."""
-    pts = np.asarray(points, float).reshape(-1, 2)
-    return np.array([np.asarray(u(mesh(float(x), float(y)))).ravel() for x, y in pts])
-
-
 def contact_force(sol: DirectSolution, x_range=None, part=None) -> np.ndarray:
     """Force the counter body receives through ``S_C^eps`` (or its part with ``x`` in ``x_range``).
 
@@ -355,7 +253,7 @@ def contact_force(sol: DirectSolution, x_range=None, part=None) -> np.ndarray:
         ind = ng.IfPos(ng.x - x_range[0], 1.0, 0.0) * ng.IfPos(x_range[1] - ng.x, 1.0, 0.0)
     w = elasticity.weight(p.setting)
     vals = ng.Integrate(sol.pressure * sol.normal * ind * w, mesh, ng.BND,
-                        definedon=mesh.Boundaries(p.contact), order=2 * p.order + 6)
+                        definedon=mesh.Boundaries(p.contact), order=resultant_order(p.order))
     return np.asarray(vals, float).ravel()
 
 
@@ -365,4 +263,4 @@ def contact_fraction(sol: DirectSolution, length: float) -> float:
     pen = _contact.penetration(sol.jump, sol.normal, p.gap)
     ind = ng.IfPos(-pen, 0.0, 1.0)
     return float(ng.Integrate(ind, p.mesh, ng.BND, definedon=p.mesh.Boundaries(p.contact),
-                              order=4 * p.order + 24)) / length
+                              order=kink_order(p.order))) / length

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.laws import homogenized as il
-from ngcontact.geometry.bodies import FemurStemDims
+from ngcontact.geometry.femur import FemurStemDims
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field, check_material_names,
                      )
 from ngcontact.scene.schema import at_least, nonempty, nonnegative, param, positive
@@ -46,7 +46,7 @@ def check_dimensions(dims: dict, path: str, shape: str, required) -> None:
     """A ``dimensions`` table: positive, known for ``shape``, the ``required`` ones present.
 
     For ``femur_stem`` the completed dimensions must also describe a valid
-    femur and stem (:meth:`ngcontact.geometry.macro.FemurStemDims.check`).
+    femur and stem (:class:`ngcontact.geometry.femur.FemurStemDims`).
     """
     for key in dims:
         if not dims[key] > 0:
@@ -203,8 +203,6 @@ class OutputSpec:
 
     points_per_element: int = param(5, doc="samples per interface element in the profile", check=at_least(2))
     vtk_subdivision: int = param(1, doc="subdivision of the VTK output", check=at_least(0))
-    coulomb_tol: float = param(1e-6, doc="Coulomb fixed point: relative change of the pressure to stop at",
-                               check=positive())
 
 
 @dataclass(frozen=True, kw_only=True)

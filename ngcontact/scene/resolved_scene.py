@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ngcontact.errors import MISSING, SceneError
-from ngcontact.geometry.bodies import FemurStemDims
+from ngcontact.geometry.femur import FemurStemDims
 from ngcontact.scene.macro_scene import check_dimensions
 from ngcontact.scene.sections import MaterialSpec, SolverSpec, base_dir_field, check_material_names
 from ngcontact.scene.schema import at_least, nonempty, param, positive
@@ -208,7 +208,7 @@ class DirectScene:
 
     def _check_femur_study(self) -> None:
         """Probes inside a body and outside the band of the coarsest level; the band leaves points."""
-        from ngcontact.geometry.resolved_bodies import distance_to_polyline, femur_stem_body, femur_stem_interface
+        from ngcontact.geometry.femur import distance_to_polyline, femur_stem_body, femur_stem_interface
         st, dims = self.study, self.geometry.femur_dims()
         assert st is not None  # called from check only when the study is given
         segs = femur_stem_interface(dims)

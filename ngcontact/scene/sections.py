@@ -57,7 +57,7 @@ class Discretization:
 
 @dataclass(frozen=True, kw_only=True)
 class SolverSpec:
-    """Newton solver settings."""
+    """Newton solver settings and the stopping rule of the Coulomb fixed point."""
 
     rtol: float = param(1e-10, doc="stop when the residual falls below rtol x the first residual",
                         check=positive())
@@ -65,6 +65,9 @@ class SolverSpec:
     max_iter: int = param(40, doc="largest number of Newton steps", check=at_least(1))
     inverse: str = param("sparsecholesky", doc="sparse direct solver",
                          choices=("sparsecholesky", "umfpack"))
+    coulomb_rtol: float = param(1e-8, doc="Coulomb fixed point: stop when max |p_k - p_k-1| <= coulomb_rtol x "
+                                "max p_k on the contact surface", check=positive())
+    coulomb_max_iter: int = param(40, doc="Coulomb fixed point: largest number of Tresca passes", check=at_least(1))
 
 
 def check_material_names(materials: dict, names: dict, path: str) -> None:
