@@ -7,7 +7,7 @@ oracle where there is one (:mod:`ngcontact.verification.westergaard`,
 :mod:`ngcontact.verification.lame`), else against the value recorded when
 the example was written; every tolerance says why it is what it is.  The
 shipped two-scale scene takes 10-20 s and is in the slow tier, like its
-other end-to-end test (tests/test_twoscale.py).
+other end-to-end test (tests/coupling/test_twoscale.py).
 """
 import ast
 import importlib.util
@@ -61,7 +61,7 @@ def test_every_example_has_a_docstring_a_main_and_is_tested():
 def test_ex27_rectangular_valley_tangential_stiffness(run):
     k_t0, _ = run("ex27_coefficients.py")
     # The faces are straight: the surface integral of eq. 34 is exact up to quadrature
-    # round-off (tests/test_homogenize.py holds the same coefficients to 1e-8).
+    # round-off (tests/cell/test_homogenize.py holds the same coefficients to 1e-8).
     assert k_t0 == pytest.approx(2 * 0.3, rel=1e-8)
 
 
@@ -79,7 +79,7 @@ def test_westergaard_contact_fraction_at_half_the_full_contact_pressure(run):
     fraction, _ = run("westergaard.py")
     exact = westergaard_contact_fraction(0.5, 1.0)     # = 1/2
     # 0.5 %: the scene's penalty k_n = 1e3 E lets the bodies overlap and widens the
-    # patches by 0.1-0.3 % (observed +0.08 % at p*/2); the tolerance of tests/test_westergaard.py.
+    # patches by 0.1-0.3 % (observed +0.08 % at p*/2); the tolerance of tests/cell/test_westergaard.py.
     assert fraction == pytest.approx(exact, rel=5e-3)
 
 

@@ -42,6 +42,7 @@ import numpy as np
 import ngsolve as ng
 
 from ngcontact.geometry.cell2d import Cell
+from ngcontact.fem.two_body import interface_normal
 
 log = logging.getLogger(__name__)
 
@@ -50,44 +51,13 @@ log = logging.getLogger(__name__)
 def contact_normal(cell: Cell):
     """Unit normal on ``contact`` pointing from ``rough`` into ``counter``.
 
-    Returns
-    -------
-    CoefficientFunction
-        ``s * specialcf.normal(dim)`` with ``s = +-1`` a piecewise constant
-        (``SurfaceL2`` of order 0 on ``contact``) fixed per boundary element
-        by the side on which its ``rough`` neighbour lies.  Valid on the
-        ``contact`` boundary only.
+    The one oriented normal of the package,
+    :func:`ngcontact.fem.two_body.interface_normal`, on the cell's contact
+    surface; valid on the ``contact`` boundary only.
     """
-    mesh, dim = cell.mesh, cell.dim
-    region = mesh.Boundaries("contact")
-    space = ng.SurfaceL2(mesh, order=0, definedon=region)
-    sign = ng.GridFunction(space)
-    normal = ng.specialcf.normal(dim)
-    position = ng.CF((ng.x, ng.y, ng.z)[:dim])
-    centre_bnd = (1.0 / dim,) * (dim - 1)
-    centre_vol = (1.0 / (dim + 1),) * dim
-    nfacet = 0
-    for el in mesh.Elements(ng.BND):
-        if el.mat != "contact":
-            continue
-        facet = el.edges[0] if dim == 2 else el.faces[0]
-        rough = [e for e in mesh[facet].elements if mesh[e].mat == "rough"]
-        if len(rough) != 1:
-            raise ValueError(f"contact element {el.nr} has {len(rough)} rough neighbours; "
-                             "contact must separate rough from counter")
-        trafo_f = mesh.GetTrafo(ng.ElementId(el))   # keep alive while its points are used
-        mip = trafo_f(*centre_bnd)
-        x_f = np.array(position(mip)).ravel()
-        n_f = np.array(normal(mip)).ravel()
-        trafo_r = mesh.GetTrafo(rough[0])
-        x_r = np.array(position(trafo_r(*centre_vol))).ravel()
-        s = 1.0 if float(n_f @ (x_f - x_r)) > 0 else -1.0
-        for d in space.GetDofNrs(ng.ElementId(el)):
-            sign.vec[d] = s
-        nfacet += 1
-    if nfacet == 0:
+    if "contact" not in cell.mesh.GetBoundaries():
         raise ValueError("the cell has no 'contact' boundary")
-    return sign * normal
+    return interface_normal(cell.mesh, "rough", "contact")
 
 
 def macro_basis(dim: int) -> np.ndarray:

@@ -56,6 +56,7 @@ from ngcontact.errors import ConvergenceError
 from ngcontact.geometry.cell2d import Segment, interface_cell
 from ngcontact.fem.materials import ElasticLaw
 from ngcontact.solvers.newton import fixed_mask
+from ngcontact.fem import two_body
 
 log = logging.getLogger(__name__)
 
@@ -330,16 +331,9 @@ def space(prob: Problem, order: int):
 
 
 def interface_normal(prob: Problem) -> ng.CoefficientFunction:
-    """Unit normal on ``prob.interface`` pointing from ``rough`` into ``counter``.
-
-    The interface is a graph over ``x`` with ``counter`` above, so the right
-    normal has ``int n_y ds = period > 0``; the mesh's own orientation is
-    flipped when it disagrees.
-    """
-    dim = prob.mesh.dim
-    n = ng.specialcf.normal(dim)
-    ny = ng.Integrate(n[dim - 1], prob.mesh, ng.BND, definedon=prob.mesh.Boundaries(prob.interface))
-    return n if ny > 0 else -n
+    """Unit normal on ``prob.interface`` pointing from ``rough`` into ``counter``
+    (:func:`ngcontact.fem.two_body.interface_normal`)."""
+    return two_body.interface_normal(prob.mesh, "rough", prob.interface)
 
 
 def solve(prob: Problem, order: int, *, inverse: str = "sparsecholesky",

@@ -14,7 +14,7 @@ import pytest
 
 from ngcontact import cli
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CELLS = os.path.join(ROOT, "geometries", "cells")
 
 CELL = """\

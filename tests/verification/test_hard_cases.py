@@ -32,7 +32,7 @@ from ngcontact.verification.westergaard import westergaard_contact_fraction, wes
 
 pytestmark = [pytest.mark.slow, pytest.mark.hard]
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def p_wave(E, nu):

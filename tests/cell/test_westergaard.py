@@ -28,7 +28,7 @@ from ngcontact.fem.materials import isotropic
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
-SCENE = os.path.join(os.path.dirname(__file__), "..", "geometries", "cells", "westergaard.toml")
+SCENE = os.path.join(os.path.dirname(__file__), "..", "..", "geometries", "cells", "westergaard.toml")
 
 
 RATIOS = (0.05, 0.2, 0.5, 0.8, 1.2)

@@ -254,7 +254,7 @@ def test_axisymmetric_equals_3d_for_a_rotationally_symmetric_problem():
 
 
 # ------------------------------------------------------------ scenes, driver
-ROOT = __import__("os").path.dirname(__import__("os").path.dirname(__import__("os").path.abspath(__file__)))
+ROOT = __import__("os").path.dirname(__import__("os").path.dirname(__import__("os").path.dirname(__import__("os").path.abspath(__file__))))
 
 
 def test_femur_stem_scene_runs_end_to_end(tmp_path):

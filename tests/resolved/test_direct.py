@@ -28,7 +28,7 @@ from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.resolved_bodies import flat_blocks, resolved_blocks
 from ngcontact.fem.reaction import boundary_reaction
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BLOCK = os.path.join(ROOT, "geometries", "direct", "block_rect_valleys.toml")
 MATS = {"rough": mat.isotropic(210e9, 0.3), "counter": mat.isotropic(70e9, 0.33)}
 KN = 1e11

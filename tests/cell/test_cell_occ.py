@@ -66,7 +66,7 @@ def test_lateral_faces_identified_by_the_period(cell):
 
 def test_height_map_surface_builds_and_respects_the_cell_height(tmp_path):
     import os
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    here = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     H = read_height_map(os.path.join(here, "geometries", "cells", "data", "height_map_example.npy"))
     c = surface_cell(H, h_rough=0.6, h_counter=0.6, maxh=0.4, interface_maxh=0.2)
     assert "contact" in c.mesh.GetBoundaries()

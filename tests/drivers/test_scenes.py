@@ -13,7 +13,7 @@ import pytest
 from ngcontact import cli
 from ngcontact.scene import loader as scene
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENES = sorted(glob.glob(os.path.join(ROOT, "geometries", "**", "*.toml"), recursive=True))
 IDS = [os.path.relpath(p, os.path.join(ROOT, "geometries")) for p in SCENES]
 

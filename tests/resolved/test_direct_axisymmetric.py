@@ -33,7 +33,7 @@ from ngcontact.output.report import Clock
 from ngcontact.fem.reaction import boundary_reaction
 from ngcontact.fem.sampling import probe
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FEMUR = os.path.join(ROOT, "geometries", "direct", "femur_stem_grooves.toml")
 REGIONS = ("rough", "counter")  # the direct kind's region names
 DIMS = FemurStemDims(r_stem=0.011, r_tip=0.005, r_bone=0.016, z_tip=0.05, z_corner=0.13, z_bone_top=0.18,

@@ -10,7 +10,7 @@ from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.cell3d import (flat_cell3d, height_map_gap, square_hills_cell)
 from ngcontact.geometry.tabulated import check_height_map, read_height_map, read_profile_csv
 
-DATA = __import__("pathlib").Path(__file__).resolve().parents[1] / "geometries" / "cells" / "data"
+DATA = __import__("pathlib").Path(__file__).resolve().parents[2] / "geometries" / "cells" / "data"
 
 PROFILES = {
     "flat": lambda: pr.flat(),
