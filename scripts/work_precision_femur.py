@@ -23,7 +23,8 @@ import time
 
 import numpy as np
 
-from ngcontact.macro import macro_problem as M
+
+from ngcontact.macro import macro_measures as MM
 from ngcontact.scene import loader as scene_mod
 from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
 
@@ -37,9 +38,9 @@ def peaks(sc, maxh: float, interface_maxh: float, order: int) -> dict:
     geo = build_geometry(sc, maxh=maxh, interface_maxh=interface_maxh)
     problem, _ = problem_of(sc, geo, order=order)
     sol = solve_scene(sc, problem)
-    prof = M.interface_profile(sol, points_per_element=sc.output.points_per_element)
-    fields = M.stress_fields(sol)
-    vm = M.field_extrema(sol, {"von_mises": fields["von_mises"]})["von_mises"]["max"]
+    prof = MM.interface_profile(sol, points_per_element=sc.output.points_per_element)
+    fields = MM.stress_fields(sol)
+    vm = MM.field_extrema(sol, {"von_mises": fields["von_mises"]})["von_mises"]["max"]
     seconds = time.perf_counter() - t0
     k = int(np.argmax(prof["pressure"]))
     return {"maxh": maxh, "interface_maxh": interface_maxh, "order": order, "ndof": sol.ndof,

@@ -338,15 +338,16 @@ def interface_states(sol: MacroSolution, points_per_element: int = 5,
     mean of the two bodies' strains at points moved by ``offset`` times the
     mesh's extent off the interface, and slightly towards the element centre.
     """
-    from ngcontact.macro import macro_problem as M
-    prof = M.interface_profile(sol, points_per_element)
+    from ngcontact.fem.elasticity import COMPONENTS
+    from ngcontact.macro import macro_measures as MM
+    prof = MM.interface_profile(sol, points_per_element)
     k = max(2, int(points_per_element))
-    names = M.COMPONENTS[sol.problem.setting]
+    names = COMPONENTS[sol.problem.setting]
     xy = np.column_stack([prof[names[0]], prof[names[1]]])
     mesh = sol.problem.mesh
     pts = np.array([v.point for v in mesh.vertices])
     delta = offset * float(np.max(pts.max(axis=0) - pts.min(axis=0)))
-    eps_cf = M.strain(sol)
+    eps_cf = MM.strain(sol)
     e_t = np.zeros(len(xy))
     e_h = np.zeros(len(xy))
     for e0 in range(0, len(xy), k):

@@ -57,7 +57,9 @@ from ngcontact.cell.measures import (
 )
 from ngcontact.errors import ConvergenceError
 from ngcontact.laws import homogenized as il
+from ngcontact.fem.interpolants import piecewise_linear
 from ngcontact.macro import macro_problem as M
+from ngcontact.macro import macro_measures as MM
 from ngcontact.errors import ModelError
 from ngcontact.fem.quadrature import smooth_order
 
@@ -207,14 +209,14 @@ def field_law(sol: M.MacroSolution, table: CellTable, pressure: ng.CoefficientFu
     fields = []
     for values in (kn, off):
         gf = ng.GridFunction(V)
-        gf.Set(M.piecewise_linear(pgf, list(zip(P, values))), definedon=on)
+        gf.Set(piecewise_linear(pgf, list(zip(P, values))), definedon=on)
         fields.append(gf)
     return il.FieldLaw(kn=fields[0], offset=fields[1], stiffness=float(kn.max()))
 
 
 def interface_pressure(sol: M.MacroSolution) -> ng.CoefficientFunction:
     """The macro normal stress ``p`` on ``S_0`` as a CoefficientFunction."""
-    return M.interface_tractions(sol)[0]
+    return MM.interface_tractions(sol)[0]
 
 
 @dataclass
@@ -259,7 +261,7 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         No convergence within ``max_iter`` updates (carries the history).
     """
     sol = solve(problem)
-    p_old = M.interface_profile(sol, points_per_element)["pressure"]
+    p_old = MM.interface_profile(sol, points_per_element)["pressure"]
     history: list[HistoryEntry] = [{"iteration": 0, "max_pressure": float(p_old.max()), "max_change": None,
                                      "cell_solves": 0, "newton_iterations": sol.history["newton_iterations"]}]
     friction = problem.law.friction
@@ -272,7 +274,7 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
             table.cover(table_min * p_hi, headroom * p_hi)
         law = il.InterfaceLaw(normal=field_law(sol, table, interface_pressure(sol)), friction=friction)
         sol = solve(M.replace_law(problem, law))
-        p_new = M.interface_profile(sol, points_per_element)["pressure"]
+        p_new = MM.interface_profile(sol, points_per_element)["pressure"]
         change = float(np.max(np.abs(p_new - p_old)))
         history.append({"iteration": k, "max_pressure": float(p_new.max()), "max_change": change,
                         "cell_solves": table.solves, "newton_iterations": sol.history["newton_iterations"]})

@@ -28,7 +28,9 @@ import ngsolve as ng
 
 from ngcontact.drivers.build import body_laws, interface_friction, interface_normal_law, law_from_cell
 from ngcontact.laws import homogenized as il
+from ngcontact.fem.interpolants import piecewise_linear
 from ngcontact.macro import macro_problem as M
+from ngcontact.macro import macro_measures as MM
 from ngcontact.errors import SceneError
 from ngcontact.geometry import bodies as gm
 from ngcontact.scene.macro_scene import REGIONS
@@ -90,7 +92,7 @@ def gap_of(scene):
     coord = {"x": ng.x, "r": ng.x, "y": ng.y, "z": ng.z}[spec.gap_coordinate]
     if spec.gap_coordinate == "z" and scene.geometry.setting == "axisymmetric":
         coord = ng.y
-    return M.piecewise_linear(coord, spec.gap_table)
+    return piecewise_linear(coord, spec.gap_table)
 
 
 def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.MacroProblem, dict]:
@@ -139,22 +141,22 @@ def run(scene, clock) -> Outcome:
             from ngcontact.drivers.run_two_scale import couple
             sol, two_scale = couple(scene, problem, lambda prob: solve_scene(scene, prob))
     with clock.stage("post-processing"):
-        fields = M.stress_fields(sol)
-        extrema = M.field_extrema(sol, fields)
+        fields = MM.stress_fields(sol)
+        extrema = MM.field_extrema(sol, fields)
         results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
-                   "dimensions": geo.dims, "law": law_info, "resultant": M.resultant(sol),
+                   "dimensions": geo.dims, "law": law_info, "resultant": MM.resultant(sol),
                    "newton_iterations": sol.history["newton_iterations"],
                    "coulomb_iterations": sol.history["coulomb_iterations"]}
         maxima = {name: ext for name, ext in extrema.items()}
         tables, plots = {}, {}
         if geo.mesh.dim == 2:
-            prof = M.interface_profile(sol, scene.output.points_per_element)
+            prof = MM.interface_profile(sol, scene.output.points_per_element)
             results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in prof.items()}
             results["status_counts"] = dict(Counter(prof["status"]))
-            maxima["pressure"] = M.peak_pressure(prof)
+            maxima["pressure"] = MM.peak_pressure(prof)
             k = int(np.argmax(np.abs(prof["shear"])))
             maxima["shear"] = {key: (v[k] if key == "status" else float(v[k])) for key, v in prof.items()}
-            results["detachment"] = M.detachments(prof)
+            results["detachment"] = MM.detachments(prof)
             header = list(prof)
             tables["interface"] = (header, list(zip(*[prof[h] for h in header])))
             plots["interface"] = lambda path, prof=prof: figures.macro_interface(path, prof)

@@ -57,6 +57,7 @@ from ngcontact.resolved import resolved_problem as D
 from ngcontact.fem import elasticity
 from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
+from ngcontact.macro import macro_measures as MM
 from ngcontact.coupling.cell_law import bundle_law
 from ngcontact.drivers import run_resolved as drv
 from ngcontact.output import plots
@@ -157,7 +158,7 @@ def mean_interface_traction(sol: M.MacroSolution) -> np.ndarray:
     w = elasticity.weight(p.setting)
     on_s0 = mesh.Boundaries(p.interface)
     area = ng.Integrate(w, mesh, ng.BND, definedon=on_s0)
-    vals = [ng.Integrate(t * w, mesh, ng.BND, definedon=on_s0) for t in M.interface_tractions(sol)]
+    vals = [ng.Integrate(t * w, mesh, ng.BND, definedon=on_s0) for t in MM.interface_tractions(sol)]
     return np.asarray(vals, float) / area
 
 
@@ -174,7 +175,7 @@ def interface_force(sol: D.DirectSolution | M.MacroSolution, part=None) -> np.nd
         return D.contact_force(sol, part=part)
     p = sol.problem
     mesh = p.mesh
-    glob = sum((t * e for t, e in zip(M.interface_tractions(sol), sol.frame)), ng.CF((0.0, 0.0)))
+    glob = sum((t * e for t, e in zip(MM.interface_tractions(sol), sol.frame)), ng.CF((0.0, 0.0)))
     ind = ng.CF(1.0) if part is None else part
     w = elasticity.weight(p.setting)
     return np.asarray(ng.Integrate(glob * ind * w, mesh, ng.BND, definedon=mesh.Boundaries(p.interface),

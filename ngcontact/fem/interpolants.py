@@ -1,12 +1,17 @@
 """Interpolants of sampled data as NGSolve coefficient functions.
 
 Tabulated gaps and profiles come as samples ``(x_i, g_i)``; the finite
-element forms need them as functions of the mesh coordinates.
+element forms need them as functions of the mesh coordinates.  A periodic
+table (:func:`periodic_table_1d`, the cell's gap and profile) is resampled
+on a voxel grid; an open one (:func:`piecewise_linear`, the macro gap table
+and the two-scale coefficient fields) is written exactly as a sum of ramps.
 """
 from __future__ import annotations
 
 import ngsolve as ng
 import numpy as np
+
+from ngcontact.errors import ModelError
 
 
 def periodic_table_1d(x, g, period: float, samples: int = 4096):
@@ -20,3 +25,24 @@ def periodic_table_1d(x, g, period: float, samples: int = 4096):
     row = np.interp(xs, x, g)
     data = np.ascontiguousarray(np.vstack([row, row]))
     return ng.VoxelCoefficient((0.0, -1e3), (period, 1e3), data, linear=True)
+
+
+def piecewise_linear(coordinate, points):
+    """CoefficientFunction interpolating ``points = [(x_i, y_i)]`` linearly in ``coordinate``.
+
+    Constant ``y_0`` before ``x_0`` and ``y_last`` after the last point;
+    written as ``y_0 + sum_i d_i [x - x_i]_+`` with the slope increments ``d_i``.
+    """
+    xs = np.array([q[0] for q in points], float)
+    ys = np.array([q[1] for q in points], float)
+    if len(xs) == 1:
+        return ng.CF(float(ys[0]))
+    if np.any(np.diff(xs) <= 0):
+        raise ModelError("the abscissae of a piecewise linear table must increase strictly")
+    slopes = np.diff(ys) / np.diff(xs)
+    incr = np.diff(np.concatenate([[0.0], slopes, [0.0]]))
+    f = ng.CF(float(ys[0]))
+    for xi, d in zip(xs, incr):
+        if d != 0:
+            f = f + float(d) * ng.IfPos(coordinate - float(xi), coordinate - float(xi), 0.0)
+    return f

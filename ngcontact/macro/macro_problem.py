@@ -36,10 +36,8 @@ Solution strategy:
   Coulomb problem; no energy of the coupled problem exists, so no coupled
   Newton is attempted.
 
-Post-processing: stress fields (radial / axial / hoop in axisymmetry), von
-Mises stress and strain, their extrema with locations, the profile along the
-interface (arc length, pressure, shear, jumps, status open / stick / slip),
-the force transmitted through the interface and the detachment points.
+Post-processing (stress fields, extrema, the interface profile and
+resultant, detachment points) is in :mod:`ngcontact.macro.macro_measures`.
 """
 from __future__ import annotations
 
@@ -48,21 +46,18 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import ngsolve as ng
-import numpy as np
 
 from ngcontact.fem import elasticity
 from ngcontact.fem import two_body
-from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.fem.two_body import Load, Support, boundary_labels, interface_normal  # noqa: F401  (public names of the macro problem)
 from ngcontact.laws import homogenized as il
 from ngcontact.laws import interface_energy as ie
 from ngcontact.laws.local_frame import local_frame
-from ngcontact.fem.materials import ElasticLaw, von_mises
-from ngcontact.fem.quadrature import energy_order, sampling_order
+from ngcontact.fem.materials import ElasticLaw
+from ngcontact.fem.quadrature import sampling_order
 from ngcontact.fem.sampling import boundary_values
 from ngcontact.solvers.coulomb import coulomb_fixed_point
 from ngcontact.solvers.newton import minimize
-from ngcontact.errors import ModelError
 
 log = logging.getLogger(__name__)
 
@@ -139,7 +134,7 @@ def _local(frame, J) -> list:
     return [ng.InnerProduct(J, e) for e in frame]
 
 
-def _gap_cf(gap):
+def gap_cf(gap):
     return ng.CF(float(gap)) if isinstance(gap, (int, float)) else gap
 
 
@@ -158,7 +153,7 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
                                                problem.counter: problem.materials[problem.counter]},
                                   {problem.rough: ur, problem.counter: uc}, setting)
     a = _local(frame, ur.Trace() - uc.Trace())
-    g0 = _gap_cf(problem.gap)
+    g0 = gap_cf(problem.gap)
     law = problem.law
     if start_stiffness is not None:
         W = ie.normal_energy(law.normal, a, g0, closed=True)
@@ -204,7 +199,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     law = problem.law
     newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
     history: dict[str, Any] = {"newton": [], "coulomb_changes": [], "coulomb_iterations": 0}
-    g0 = _gap_cf(problem.gap)
+    g0 = gap_cf(problem.gap)
     old = ng.GridFunction(fes)
     a_old = _local(frame, old.components[0] - old.components[1])
     G = None
@@ -245,243 +240,6 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
 
 
 # ----------------------------------------------------- post-processing
-def _by_region(sol: MacroSolution, fn):
-    p = sol.problem
-    return p.mesh.MaterialCF({p.rough: fn(sol.u_rough, p.materials[p.rough]),
-                              p.counter: fn(sol.u_counter, p.materials[p.counter])})
-
-
-def stress(sol: MacroSolution):
-    """3x3 stress tensor field (both bodies)."""
-    s = sol.problem.setting
-    return _by_region(sol, lambda u, law: elasticity.stress(law, u, s))
-
-
-def strain(sol: MacroSolution):
-    """3x3 strain tensor field (both bodies)."""
-    s = sol.problem.setting
-    return _by_region(sol, lambda u, law: elasticity.strain(u, s))
-
-
-def von_mises_strain(eps):
-    """Equivalent strain ``sqrt(2/3 e:e)``, ``e`` the deviatoric strain."""
-    e = eps - ng.Trace(eps) / 3.0 * ng.Id(3)
-    return ng.sqrt(2.0 / 3.0 * ng.InnerProduct(e, e))
-
-
-def stress_fields(sol: MacroSolution) -> dict:
-    """Named scalar fields: stress components, von Mises stress and strain.
-
-    Axisymmetric: ``sigma_r``, ``sigma_z``, ``sigma_hoop``, ``sigma_rz``;
-    plane strain: ``sigma_xx``, ``sigma_yy``, ``sigma_zz``, ``sigma_xy``;
-    3D: the six Cartesian components.  Always ``von_mises`` (stress) and
-    ``von_mises_strain``.
-    """
-    sig = stress(sol)
-    setting = sol.problem.setting
-    if setting == "axisymmetric":
-        out = {"sigma_r": sig[0, 0], "sigma_z": sig[1, 1], "sigma_hoop": sig[2, 2], "sigma_rz": sig[0, 1]}
-    elif setting == "plane_strain":
-        out = {"sigma_xx": sig[0, 0], "sigma_yy": sig[1, 1], "sigma_zz": sig[2, 2], "sigma_xy": sig[0, 1]}
-    else:
-        out = {f"sigma_{a}{b}": sig[i, j] for i, j, a, b in
-               ((0, 0, "x", "x"), (1, 1, "y", "y"), (2, 2, "z", "z"), (1, 2, "y", "z"),
-                (0, 2, "x", "z"), (0, 1, "x", "y"))}
-    out["von_mises"] = von_mises(sig)
-    out["von_mises_strain"] = von_mises_strain(strain(sol))
-    return out
-
-
-def _sample_rule(dim: int, inset: float = 1e-3):
-    """Points at the vertices (moved ``inset`` inwards, off the axis ``r = 0``
-    where the hoop strain ``u_r / r`` is 0/0), edge midpoints and centroid."""
-    e = inset
-    pts: list[tuple[float, ...]]
-    if dim == 2:
-        pts = [(e, e), (1 - 2 * e, e), (e, 1 - 2 * e), (0.5, e), (0.5 - e, 0.5 - e), (e, 0.5), (1 / 3, 1 / 3)]
-    else:
-        pts = [(e, e, e), (1 - 3 * e, e, e), (e, 1 - 3 * e, e), (e, e, 1 - 3 * e), (0.25, 0.25, 0.25)]
-    return ng.IntegrationRule(pts, [0.0] * len(pts))
-
-
-def field_extrema(sol: MacroSolution, fields: dict) -> dict:
-    """Largest and smallest value of each field with its location and body.
-
-    Sampled next to the vertices, at edge midpoints and centroids of every
-    element, on each body's side separately (the fields jump across ``S_0``).
-    """
-    p = sol.problem
-    mesh = p.mesh
-    rule = _sample_rule(mesh.dim)
-    coords = ng.CF((ng.x, ng.y, ng.z)[:mesh.dim])
-    out: dict[str, dict[str, dict[str, Any]]] = {name: {} for name in fields}
-    for region in (p.rough, p.counter):
-        mips = mesh.MapToAllElements(rule, mesh.Materials(region))
-        xyz = np.asarray(coords(mips)).reshape(-1, mesh.dim)
-        for name, cf in fields.items():
-            vals = np.asarray(cf(mips)).ravel()
-            for key, k in (("max", int(np.argmax(vals))), ("min", int(np.argmin(vals)))):
-                best = out[name].get(key)
-                better = best is None or (vals[k] > best["value"] if key == "max" else vals[k] < best["value"])
-                if better:
-                    out[name][key] = {"value": float(vals[k]), "location": [float(c) for c in xyz[k]],
-                                      "body": region}
-    return out
-
-
-def interface_tractions(sol: MacroSolution) -> list:
-    """Local traction components ``dW/da`` on ``S_0`` at the solution."""
-    p = sol.problem
-    return ie.traction(p.law, sol.local_jump, _gap_cf(p.gap), sol.threshold)
-
-
-def resultant(sol: MacroSolution) -> dict:
-    """Force transmitted through ``S_0`` from the rough to the counter body.
-
-    ``R = int_S0 tau w ds`` with the global traction ``tau = sum_k tau_k e_k``.
-    Axisymmetric: only the axial component ``z`` (per full revolution; the
-    radial tractions cancel around the circumference).  Plane strain: per unit
-    thickness.  Integrated with the quadrature of the assembly (order ``2p``),
-    so ``R`` is the discrete reaction and balances the applied loads to
-    solver tolerance (the kinks of unilateral laws make other quadratures
-    differ slightly).
-    """
-    p = sol.problem
-    tau = interface_tractions(sol)
-    glob = sum((t * e for t, e in zip(tau, sol.frame)), ng.CF((0,) * p.mesh.dim))
-    w = elasticity.weight(p.setting)
-    comps = COMPONENTS[p.setting]
-    vals = [ng.Integrate(glob[i] * w, p.mesh, ng.BND, definedon=p.mesh.Boundaries(p.interface),
-                         order=energy_order(p.order)) for i in range(p.mesh.dim)]
-    if p.setting == "axisymmetric":
-        return {"z": float(vals[1])}
-    return {c: float(v) for c, v in zip(comps, vals)}
-
-
-def interface_profile(sol: MacroSolution, points_per_element: int = 5) -> dict:
-    """Values along the interface curve (2D and axisymmetric only).
-
-    Returns arrays ``s`` (arc length from the end with the largest ``y``, or
-    ``z``), the coordinates (``r, z`` or ``x, y``), ``pressure`` (compression
-    positive), ``shear`` (traction along ``t0``), ``jump_n`` (``J . n0``,
-    positive closes), ``jump_t`` (``J . t0``) and ``status``: ``open`` where
-    ``p <= 0`` (for a bilateral linear law: tension), else ``stick`` / ``slip``
-    (with friction: ``|J_t|`` within / beyond the Huber width; without: by
-    whether the law has a tangential stiffness).  Element end points appear
-    once per element, so values that jump at a kink of ``n0`` show both sides.
-    """
-    p = sol.problem
-    mesh = p.mesh
-    if mesh.dim != 2:
-        raise ModelError("an interface profile needs a 2D or axisymmetric mesh")
-    k = max(2, int(points_per_element))
-    rule = ng.IntegrationRule([(t,) for t in np.linspace(0.0, 1.0, k)], [0.0] * k)
-    mips = mesh.MapToAllElements(rule, mesh.Boundaries(p.interface))
-    tau = interface_tractions(sol)
-    a = sol.local_jump
-    cf = ng.CF((ng.x, ng.y, tau[0], tau[1], a[0], a[1]))
-    vals = np.asarray(cf(mips)).reshape(-1, k, 6)
-    order = _chain(vals[:, 0, :2], vals[:, -1, :2])
-    rows = np.concatenate([vals[e, ::-1] if flip else vals[e] for e, flip in order])
-    steps = np.hypot(np.diff(rows[:, 0]), np.diff(rows[:, 1]))
-    s = np.concatenate([[0.0], np.cumsum(steps)])
-    press, shear, jn, jt = rows[:, 2], rows[:, 3], rows[:, 4], rows[:, 5]
-    status = _status(sol, press, jt)
-    names = COMPONENTS[p.setting]
-    return {"s": s, names[0]: rows[:, 0], names[1]: rows[:, 1], "pressure": press, "shear": shear,
-            "jump_n": jn, "jump_t": jt, "status": status}
-
-
-def _status(sol: MacroSolution, press, jt) -> list:
-    law = sol.problem.law
-    if law.friction is not None:
-        closed = np.where(np.abs(jt) <= law.friction.width, "stick", "slip")
-    else:
-        if isinstance(law.normal, il.FieldLaw):
-            kt = 0.0
-        elif isinstance(law.normal, il.TabulatedLaw):
-            kt = law.normal.kt
-        else:
-            kt = law.normal.matrix(2)[1, 1]
-        closed = np.full(len(press), "stick" if kt > 0 else "slip")
-    return [("open" if pv <= 0 else str(c)) for pv, c in zip(press, closed)]
-
-
-def _chain(starts, ends) -> list:
-    """Order segments into chains: list of ``(element, reversed)``."""
-    def key(p):
-        return (round(float(p[0]), 12), round(float(p[1]), 12))
-
-    at: dict[tuple[float, float], list[int]] = {}
-    for e, (a, b) in enumerate(zip(starts, ends)):
-        at.setdefault(key(a), []).append(e)
-        at.setdefault(key(b), []).append(e)
-    left = set(range(len(starts)))
-    order = []
-    while left:
-        ends_ = [pt for pt, es in at.items() if len([e for e in es if e in left]) == 1]
-        pool = ends_ or [key(starts[e]) for e in left]
-        cur = max(pool, key=lambda q: (q[1], -q[0]))
-        while True:
-            nxt = [e for e in at.get(cur, []) if e in left]
-            if not nxt:
-                break
-            e = nxt[0]
-            left.discard(e)
-            flip = key(starts[e]) != cur
-            order.append((e, flip))
-            cur = key(starts[e]) if flip else key(ends[e])
-    return order
-
-
-def detachments(profile: dict) -> list:
-    """Points along the interface where the status changes between open and closed.
-
-    The location is interpolated linearly where the pressure changes sign
-    (or halfway between the two samples when it does not).
-    """
-    names = [k for k in profile if k not in ("s", "pressure", "shear", "jump_n", "jump_t", "status")]
-    s, p, st = profile["s"], profile["pressure"], profile["status"]
-    out = []
-    for i in range(len(s) - 1):
-        if (st[i] == "open") == (st[i + 1] == "open"):
-            continue
-        theta = p[i] / (p[i] - p[i + 1]) if p[i] * p[i + 1] < 0 else 0.5
-        point = {"s": float(s[i] + theta * (s[i + 1] - s[i]))}
-        for c in names:
-            point[c] = float(profile[c][i] + theta * (profile[c][i + 1] - profile[c][i]))
-        point["opens_towards_larger_s"] = st[i + 1] == "open"
-        out.append(point)
-    return out
-
-
-def peak_pressure(profile: dict) -> dict:
-    """Largest contact pressure along the interface with its location."""
-    k = int(np.argmax(profile["pressure"]))
-    return {key: (float(profile[key][k]) if key != "status" else profile[key][k]) for key in profile}
-
-
 def replace_law(problem: MacroProblem, law: il.InterfaceLaw) -> MacroProblem:
     """The same problem with another interface law."""
     return replace(problem, law=law)
-
-
-def piecewise_linear(coordinate, points):
-    """CoefficientFunction interpolating ``points = [(x_i, y_i)]`` linearly in ``coordinate``.
-
-    Constant ``y_0`` before ``x_0`` and ``y_last`` after the last point;
-    written as ``y_0 + sum_i d_i [x - x_i]_+`` with the slope increments ``d_i``.
-    """
-    xs = np.array([q[0] for q in points], float)
-    ys = np.array([q[1] for q in points], float)
-    if len(xs) == 1:
-        return ng.CF(float(ys[0]))
-    if np.any(np.diff(xs) <= 0):
-        raise ModelError("the abscissae of a piecewise linear table must increase strictly")
-    slopes = np.diff(ys) / np.diff(xs)
-    incr = np.diff(np.concatenate([[0.0], slopes, [0.0]]))
-    f = ng.CF(float(ys[0]))
-    for xi, d in zip(xs, incr):
-        if d != 0:
-            f = f + float(d) * ng.IfPos(coordinate - float(xi), coordinate - float(xi), 0.0)
-    return f

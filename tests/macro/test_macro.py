@@ -7,7 +7,9 @@ import pytest
 
 from ngcontact.laws import homogenized as il
 from ngcontact.laws import interface_energy as ie
+from ngcontact.fem.interpolants import piecewise_linear
 from ngcontact.macro import macro_problem as M
+from ngcontact.macro import macro_measures as MM
 from ngcontact.geometry import bodies as gm
 from ngcontact.fem.materials import isotropic
 from ngcontact.geometry.femur import FemurStemDims, femur_stem
@@ -62,7 +64,7 @@ def test_press_fit_matches_lame_with_interface_compliance_in_series(setting):
     """Long coaxial tubes (axisymmetric: u_z = 0 at both ends, i.e. plane strain)."""
     sol = _press_fit(setting, il.InterfaceLaw(normal=il.LinearLaw(kn=K_N)))
     assert sol.history["quadratic"] and sol.history["newton_iterations"] == 1
-    prof = M.interface_profile(sol)
+    prof = MM.interface_profile(sol)
     p_exact = lame_pressure(A, B, C, E_IN, NU_IN, E_OUT, NU_OUT, K_N, DELTA)
     err = np.abs(prof["pressure"] / p_exact - 1).max()
     assert err < 5e-3, f"{setting}: pressure off Lame's by {err:.2e}"
@@ -77,7 +79,7 @@ def test_press_fit_unilateral_bundle_law_gives_the_same_pressure():
     """A closed one-direction bundle is the linear law: same Lame pressure, Newton converges."""
     law = il.InterfaceLaw(normal=il.BundleLaw(weights=(K_N,), directions=((1.0, 0.0),)))
     sol = _press_fit("axisymmetric", law)
-    prof = M.interface_profile(sol)
+    prof = MM.interface_profile(sol)
     p_exact = lame_pressure(A, B, C, E_IN, NU_IN, E_OUT, NU_OUT, K_N, DELTA)
     assert np.abs(prof["pressure"] / p_exact - 1).max() < 5e-3
     assert sol.history["converged"] and not sol.history["quadratic"]
@@ -106,14 +108,14 @@ def test_uniform_compression_transmits_a_uniform_pressure_exactly(normal, closur
                   M.Support(label="base_sides", components=("x",))),
         loads=(M.Load(label="top", pressure=P),))
     sol = M.solve(prob)
-    prof = M.interface_profile(sol, points_per_element=4)
+    prof = MM.interface_profile(sol, points_per_element=4)
     np.testing.assert_allclose(prof["pressure"], P, rtol=1e-10)
     np.testing.assert_allclose(prof["jump_n"], closure, rtol=1e-9)
     np.testing.assert_allclose(prof["shear"], 0.0, atol=1e-9 * P)
     n0 = np.asarray(sol.frame[0](g.mesh.MapToAllElements(ng.IntegrationRule([(0.5,)], [1.0]),
                                                          g.mesh.Boundaries("interface"))))
     np.testing.assert_allclose(n0.reshape(-1, 2), np.tile([0.0, -1.0], (len(n0), 1)), atol=1e-14)
-    R = M.resultant(sol)
+    R = MM.resultant(sol)
     assert abs(R["y"] + P * 0.1) < 1e-9 * P * 0.1 and abs(R["x"]) < 1e-9 * P * 0.1
 
 
@@ -137,11 +139,11 @@ def test_block_under_small_shear_sticks_with_slip_below_the_width():
     """T = 0.5 mu N: every point sticks, |J_t| <= w, the interface carries exactly T and N."""
     T = 0.5 * MU * N_PRESS
     sol = _block(shear=T)
-    prof = M.interface_profile(sol)
+    prof = MM.interface_profile(sol)
     assert set(prof["status"]) == {"stick"}
     assert np.abs(prof["jump_t"]).max() <= WIDTH
     assert np.all(np.abs(prof["shear"]) < MU * prof["pressure"])
-    R = M.resultant(sol)
+    R = MM.resultant(sol)
     assert abs(R["x"] - T * L_BLOCK) < 1e-8 * T * L_BLOCK
     assert abs(R["y"] + N_PRESS * L_BLOCK) < 1e-8 * N_PRESS * L_BLOCK
     assert sol.history["coulomb_iterations"] >= 1
@@ -151,9 +153,9 @@ def test_block_dragged_beyond_the_limit_slides_with_reaction_mu_N():
     """Top dragged by 500 w (T would exceed mu N): everything slips, tangential reaction = mu N."""
     drag = (M.Support(label="top", components=("x",), value=(500 * WIDTH,)),)
     sol = _block(top_support=drag)
-    prof = M.interface_profile(sol)
+    prof = MM.interface_profile(sol)
     assert set(prof["status"]) == {"slip"}
-    R = M.resultant(sol)
+    R = MM.resultant(sol)
     assert abs(R["y"] + N_PRESS * L_BLOCK) < 1e-8 * N_PRESS * L_BLOCK
     assert abs(R["x"] - MU * N_PRESS * L_BLOCK) < 1e-6 * MU * N_PRESS * L_BLOCK, R
     np.testing.assert_allclose(np.abs(prof["shear"]), MU * prof["pressure"], rtol=1e-5,
@@ -167,7 +169,7 @@ def test_femur_stem_interface_carries_the_applied_load():
     g = femur_stem(d, maxh=0.008, interface_maxh=0.004)
     law = il.InterfaceLaw(normal=il.BundleLaw(weights=(3.2e10,), directions=((1.0, 0.0),)),
                           friction=il.Friction(mu=0.3, width=1e-6))
-    gap = M.piecewise_linear(ng.y, [(d.z_tip, 2e-5), (d.z_corner, -5e-5)])
+    gap = piecewise_linear(ng.y, [(d.z_tip, 2e-5), (d.z_corner, -5e-5)])
     prob = M.MacroProblem(mesh=g.mesh, setting="axisymmetric", rough="stem", counter="bone",
                           materials={"stem": isotropic(100e9, 0.3), "bone": isotropic(9e9, 0.27)},
                           law=law, gap=gap, order=2,
@@ -175,19 +177,19 @@ def test_femur_stem_interface_carries_the_applied_load():
                           loads=(M.Load(label="stem_top", pressure=1e6),))
     sol = M.solve(prob)
     F = 1e6 * math.pi * d.r_stem ** 2
-    R = M.resultant(sol)
+    R = MM.resultant(sol)
     assert abs(R["z"] + F) < 1e-6 * F, (R, F)
-    prof = M.interface_profile(sol)
+    prof = MM.interface_profile(sol)
     assert prof["s"][0] == 0 and np.all(np.diff(prof["s"]) >= 0)
     assert abs(prof["z"][0] - d.z_bone_top) < 1e-12 and abs(prof["z"][-1] - d.z_tip) < 1e-12
     length = (d.z_bone_top - d.z_corner) + math.hypot(d.r_stem - d.r_tip, d.z_corner - d.z_tip)
     assert abs(prof["s"][-1] - length) < 1e-12
     assert np.all(prof["pressure"] >= 0)
     # detachment points separate open from closed samples
-    for pt in M.detachments(prof):
+    for pt in MM.detachments(prof):
         assert d.z_tip <= pt["z"] <= d.z_bone_top
-    fields = M.stress_fields(sol)
-    ext = M.field_extrema(sol, fields)
+    fields = MM.stress_fields(sol)
+    ext = MM.field_extrema(sol, fields)
     assert all(np.isfinite(v["max"]["value"]) for v in ext.values())
 
 
@@ -351,5 +353,5 @@ def test_femur_law_from_the_hip_cell_is_the_papers_32_GPa(tmp_path, monkeypatch)
         geo = build_geometry(sc, maxh=0.008, interface_maxh=0.004)
         prob, info = problem_of(sc, geo, order=2)
         np.testing.assert_allclose(info["full_contact_K0"], [[32e9, 0.0], [0.0, 0.0]], rtol=1e-12, atol=1e-3)
-        pressures.append(M.interface_profile(solve_scene(sc, prob))["pressure"])
+        pressures.append(MM.interface_profile(solve_scene(sc, prob))["pressure"])
     np.testing.assert_allclose(pressures[1], pressures[0], rtol=1e-9, atol=1e-9 * pressures[0].max())
