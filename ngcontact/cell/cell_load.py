@@ -35,9 +35,9 @@ class CellLoad:
     (2D ``(e_xx,)``, 3D ``(e_xx, e_yy, e_xy)``) or is empty.
     """
 
-    traction: tuple
-    jump: tuple
-    macro_strain: tuple = ()
+    traction: tuple[float | None, ...]
+    jump: tuple[float | None, ...]
+    macro_strain: tuple[float, ...] = ()
 
 
 def cell_load(dim: int, *, pressure=None, normal_jump=None, shear=None,

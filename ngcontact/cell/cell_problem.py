@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
+from typing import Any
 
 import ngsolve as ng
 import numpy as np
@@ -94,7 +95,7 @@ class CellModel:
     rough: _mat.ElasticLaw
     counter: _mat.ElasticLaw
     k_n: float
-    gap: object = None
+    gap: ng.CoefficientFunction | None = None
     friction: Friction | None = None
     order: int = 2
     macro_strain: bool = False
@@ -109,9 +110,9 @@ class CellSolution:
     """Results of one load (plain numbers and arrays)."""
 
     load: CellLoad
-    results: dict
-    surface: dict
-    newton: list = field(default_factory=list)
+    results: dict[str, Any]
+    surface: dict[str, np.ndarray]
+    newton: list[dict[str, Any]] = field(default_factory=list)
     coulomb_iterations: int = 0
 
     @property
@@ -184,7 +185,7 @@ class CellProblem:
         nE = 1 if dim == 2 else 3
         self.strain_params = [ng.Parameter(0.0) for _ in range(nE)]
         self.tangential_free = _tangential_determinate(mesh, self.n, dim, model)
-        self.coulomb_previous = None
+        self.coulomb_previous: ng.GridFunction | None = None
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
         self.form = self._energy(ur, uc, U, trial)
@@ -269,8 +270,9 @@ class CellProblem:
         for i in range(d):
             t = load.traction[i]
             self.traction[i].Set(0.0 if t is None else t)
-            if load.jump[i] is not None:
-                vec[self.u_dofs[i]] = -load.jump[i]
+            jump = load.jump[i]
+            if jump is not None:
+                vec[self.u_dofs[i]] = -jump
             elif i < d - 1 and not self.tangential_free:
                 vec[self.u_dofs[i]] = 0.0
         if first and load.jump[d - 1] is None:
@@ -290,9 +292,11 @@ class CellProblem:
         fp = 0
         if self.model.friction is not None and self.model.friction.law == "coulomb":
             first_residual: list[float] = []
+            previous = self.coulomb_previous
+            assert previous is not None  # built with the Coulomb form in __init__
 
             def freeze() -> None:
-                self.coulomb_previous.vec.data = self.gfu.vec
+                previous.vec.data = self.gfu.vec
 
             def tresca_solve() -> dict:
                 # later passes stop at rtol times the first pass's initial residual

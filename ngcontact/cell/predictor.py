@@ -106,6 +106,7 @@ def set_start(problem, load: CellLoad) -> None:
     else:
         vec[:] = 0.0
         for i in range(d):
-            if load.jump[i] is not None:
-                vec[u_dofs[i]] = -load.jump[i]
+            jump = load.jump[i]
+            if jump is not None:
+                vec[u_dofs[i]] = -jump
         vec[u_dofs[d - 1]] = -rigid_approach(problem, p)

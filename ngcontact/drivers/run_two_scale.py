@@ -17,6 +17,7 @@ import logging
 import numpy as np
 
 from ngcontact.coupling import two_scale as T
+from ngcontact.macro.macro_measures import interface_profile
 from ngcontact.scene.sections import resolve
 
 log = logging.getLogger(__name__)
@@ -31,7 +32,7 @@ def couple(scene, problem, solve):
     table = T.CellTable(lambda p: T.cell_response(P, p, spec.cell_length_unit), tol=spec.table_tol)
     out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
                    points_per_element=scene.output.points_per_element, solve=solve)
-    p = T.M.interface_profile(out.solution, scene.output.points_per_element)["pressure"]
+    p = interface_profile(out.solution, scene.output.points_per_element)["pressure"]
     coef = table(np.asarray(p))
     res = {"converged": out.converged, "iterations": len(out.history) - 1, "macro_solves": out.macro_solves,
            "cell_solves": table.solves, "tolerance": spec.tol, "history": out.history,

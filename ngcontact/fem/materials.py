@@ -37,8 +37,8 @@ class ElasticLaw:
         path assembles a cheaper expression.
     """
 
-    voigt: tuple
-    lame: tuple | None = None
+    voigt: tuple[tuple[float, ...], ...]
+    lame: tuple[float, float] | None = None
 
     @property
     def matrix(self) -> np.ndarray:

@@ -42,9 +42,9 @@ class Support:
     """
 
     label: str
-    components: tuple = ()
-    value: tuple = ()
-    slope: tuple = ()
+    components: tuple[str, ...] = ()
+    value: tuple[float, ...] = ()
+    slope: tuple[float, ...] = ()
     along: str = "x"
 
 
@@ -54,7 +54,7 @@ class Load:
 
     label: str
     pressure: float = 0.0
-    traction: tuple = ()
+    traction: tuple[float, ...] = ()
 
 
 def boundary_labels(mesh) -> list:

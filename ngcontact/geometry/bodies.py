@@ -53,8 +53,8 @@ class MacroGeometry:
     mesh: ng.Mesh
     rough: str
     counter: str
-    boundaries: dict
-    dims: dict
+    boundaries: dict[str, str]
+    dims: dict[str, float]
 
 
 def coaxial_axisymmetric(a: float, b: float, c: float, height: float, *, maxh: float,

@@ -56,7 +56,7 @@ class Segment:
     """
 
     kind: str
-    points: tuple
+    points: tuple[tuple[float, float], ...]
     label: str = "contact"
     right: str = "rough"
     left: str = "counter"
@@ -68,7 +68,7 @@ class Cell:
 
     mesh: ng.Mesh
     dim: int
-    period: tuple          # period in each tangential direction
+    period: tuple[float, ...]          # period in each tangential direction
     h_rough: float         # depth of the rough body below y = 0
     h_counter: float       # height of the counter body above y = 0
 

@@ -53,8 +53,8 @@ ARRANGEMENTS = ("conforming", "summit")
 class Line:
     """Straight piece from ``start`` to ``end``."""
 
-    start: tuple
-    end: tuple
+    start: tuple[float, float]
+    end: tuple[float, float]
 
     def segments(self) -> list:
         return [Segment("line", (self.start, self.end))]
@@ -78,7 +78,7 @@ class Arc:
     ``x`` is monotone along it.
     """
 
-    center: tuple
+    center: tuple[float, float]
     radius: float
     t0: float
     t1: float
@@ -118,9 +118,9 @@ class Arc:
 class Curve:
     """Rational quadratic piece ``start``, ``control``, ``end`` (a smooth approximant)."""
 
-    start: tuple
-    control: tuple
-    end: tuple
+    start: tuple[float, float]
+    control: tuple[float, float]
+    end: tuple[float, float]
 
     def segments(self) -> list:
         return [Segment("spline3", (self.start, self.control, self.end))]
@@ -144,7 +144,7 @@ class Profile:
 
     name: str
     period: float
-    pieces: tuple
+    pieces: tuple[Line | Arc | Curve, ...]
 
     @property
     def depth(self) -> float:

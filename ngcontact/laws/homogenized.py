@@ -89,7 +89,7 @@ class LinearLaw:
     kn: float
     kt: float = 0.0
     knt: float = 0.0
-    gap_force: tuple = (0.0, 0.0)
+    gap_force: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self):
         if not self.kn > 0 or self.kt < 0 or self.kn * self.kt < self.knt ** 2:
@@ -123,9 +123,9 @@ class BundleLaw:
         Micro gaps ``g_q`` [length] (default zeros).
     """
 
-    weights: tuple
-    directions: tuple
-    gaps: tuple = ()
+    weights: tuple[float, ...]
+    directions: tuple[tuple[float, ...], ...]
+    gaps: tuple[float, ...] = ()
 
     def __post_init__(self):
         w = np.asarray(self.weights, float)
@@ -179,8 +179,8 @@ class TabulatedLaw:
         Linear tangential stiffness [stress / length].
     """
 
-    closure: tuple
-    pressure: tuple
+    closure: tuple[float, ...]
+    pressure: tuple[float, ...]
     kt: float = 0.0
 
     def __post_init__(self):

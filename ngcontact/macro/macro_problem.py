@@ -111,8 +111,8 @@ class MacroSolution:
     gfu: ng.GridFunction
     u_rough: ng.GridFunction
     u_counter: ng.GridFunction
-    frame: list
-    local_jump: list
+    frame: list[ng.CoefficientFunction]
+    local_jump: list[ng.CoefficientFunction]
     threshold: ng.CoefficientFunction | None
     history: dict[str, Any] = field(default_factory=dict)
     previous: ng.GridFunction | None = None  # the solution the friction threshold was evaluated at

@@ -24,11 +24,14 @@ import tempfile
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
 from ngcontact.errors import OutputError
+
+if TYPE_CHECKING:
+    import ngsolve as ng
 
 SCHEMA = "ngcontact-report/1"
 
@@ -37,8 +40,8 @@ SCHEMA = "ngcontact-report/1"
 class VtkField:
     """Fields on a mesh to write as one ``.vtu`` file."""
 
-    mesh: object
-    fields: dict  # name -> CoefficientFunction
+    mesh: ng.Mesh
+    fields: dict[str, ng.CoefficientFunction]
     subdivision: int = 1
 
 
@@ -46,12 +49,12 @@ class VtkField:
 class Outcome:
     """What a driver computed, ready to be written."""
 
-    results: dict
+    results: dict[str, Any]
     ndof: int = 0
-    solver: dict = field(default_factory=dict)
-    tables: dict = field(default_factory=dict)   # name -> (header, rows)
-    vtk: dict = field(default_factory=dict)      # name -> VtkField
-    plots: dict = field(default_factory=dict)    # name -> callable(path)
+    solver: dict[str, Any] = field(default_factory=dict)
+    tables: dict[str, tuple[list[str], list]] = field(default_factory=dict)
+    vtk: dict[str, VtkField] = field(default_factory=dict)
+    plots: dict[str, Callable[..., None]] = field(default_factory=dict)
 
 
 class Clock:

@@ -55,12 +55,12 @@ ROUNDOFF = 10.0
 class NewtonHistory:
     """What happened during a solve (JSON-ready lists of floats)."""
 
-    residuals: list = field(default_factory=list)
-    energies: list = field(default_factory=list)
-    steps: list = field(default_factory=list)
+    residuals: list[float] = field(default_factory=list)
+    energies: list[float] = field(default_factory=list)
+    steps: list[float] = field(default_factory=list)
     converged: bool = False
     linear: bool = False
-    active_set_sizes: list = field(default_factory=list)
+    active_set_sizes: list[int] = field(default_factory=list)
 
     @property
     def iterations(self) -> int:

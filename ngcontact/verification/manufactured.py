@@ -96,7 +96,7 @@ class Problem:
 
     setting: str
     mesh: ng.Mesh
-    laws: dict
+    laws: dict[str, ElasticLaw]
     exact: ng.CoefficientFunction
     dirichlet: str
     dirichlet_x: str = ""
