@@ -59,6 +59,23 @@ class ModelError(NgcontactError, ValueError):
     """
 
 
+class GeometryError(ModelError):
+    """An inadmissible geometry argument: ``name = value: what is allowed``.
+
+    Raised by :mod:`ngcontact.geometry` with its own argument names (a
+    profile's ``width``, a data file's name); the scene layer translates it
+    into a :class:`SceneError` with the scene's key path, and a caller
+    outside a scene sees the argument name.  A :class:`ModelError`, so the
+    command line maps it to exit status 2.
+    """
+
+    def __init__(self, name: str, value, allowed: str):
+        self.name = name
+        self.value = value
+        self.allowed = allowed
+        super().__init__(f"{name} = {_show(value)}: {allowed}")
+
+
 class OutputError(NgcontactError):
     """The output directory cannot be written."""
 

@@ -158,3 +158,26 @@ def test_no_two_modules_share_a_base_name():
             names.setdefault(pkg.name, []).append(str(pkg.relative_to(PACKAGE)) + "/")
     shared = {k: v for k, v in names.items() if len(v) > 1 and k != "__pycache__"}
     assert not shared, f"modules sharing a base name: {shared}"
+
+
+def _raised_names(source: str) -> set[str]:
+    """Names of the exception classes a module raises (``raise Name(...)``)."""
+    out = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Raise) and isinstance(node.exc, ast.Call) and isinstance(node.exc.func, ast.Name):
+            out.add(node.exc.func.id)
+    return out
+
+
+def test_only_the_scene_layer_and_its_translator_raise_scene_errors():
+    """Key paths of a scene belong to the scene layer and to the one scene -> objects translator
+    (drivers/, which checks what needs a mesh, such as boundary labels); geometry and the numerics
+    raise their own errors with argument names (GeometryError, ModelError), translated above them."""
+    offenders = sorted(str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob("*.py")
+                       if p.relative_to(PACKAGE).parts[0] not in ("scene", "drivers", "cli.py", "runner.py")
+                       and "SceneError" in _raised_names(p.read_text(encoding="utf-8")))
+    assert not offenders, f"raise SceneError below the scene layer: {offenders}"
+
+
+def test_the_scene_error_check_sees_a_raise():
+    assert _raised_names("def f():\n    raise SceneError('a', 1, 'b')\n") == {"SceneError"}

@@ -42,7 +42,7 @@ import numpy as np
 import ngsolve as ng
 from netgen.csg import CSGeometry, OrthoBrick, Plane, Pnt, Vec
 
-from ngcontact.errors import SceneError
+from ngcontact.errors import GeometryError
 from ngcontact.geometry.cell2d import Cell, periodic_maxh
 
 log = logging.getLogger(__name__)
@@ -53,7 +53,7 @@ _KEEP = ("periodic", "top", "bottom")
 
 def _positive(key, value):
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-        raise SceneError(key, value, "must be a finite number > 0")
+        raise GeometryError(key, value, "must be a finite number > 0")
     return float(value)
 
 
@@ -148,14 +148,14 @@ def square_hills_cell(side: float, height: float, *, period: float = 1.0,
         Mesh sizes in the bodies and on the rough surface.
     """
     P = _positive("period", period)
-    a, t = _positive("profile.side", side), _positive("profile.height", height)
+    a, t = _positive("side", side), _positive("height", height)
     hr, hc = _positive("h_rough", h_rough), _positive("h_counter", h_counter)
     if arrangement not in ARRANGEMENTS:
-        raise SceneError("arrangement", arrangement, f"must be one of {', '.join(ARRANGEMENTS)}")
+        raise GeometryError("arrangement", arrangement, f"must be one of {', '.join(ARRANGEMENTS)}")
     if not a < P:
-        raise SceneError("profile.side", side, f"must be < period = {P} (hills must not touch)")
+        raise GeometryError("side", side, f"must be < period = {P} (hills must not touch)")
     if not t < hr:
-        raise SceneError("profile.height", height, f"must be < h_rough = {hr} "
+        raise GeometryError("height", height, f"must be < h_rough = {hr} "
                          "(the hill base must lie inside the rough body)")
     hi = periodic_maxh(interface_maxh or maxh, P)
     lat, bottom, top = _box_planes(P, hr, hc)
@@ -225,11 +225,11 @@ def surface_cell(heights, *, period: float = 1.0, h_rough: float, h_counter: flo
     from ngcontact.geometry.tabulated import check_height_map
 
     P = _positive("geometry.period", period)
-    hr, hc = _positive("geometry.h_rough", h_rough), _positive("geometry.h_counter", h_counter)
+    hr, hc = _positive("h_rough", h_rough), _positive("geometry.h_counter", h_counter)
     H = check_height_map(heights, path="geometry.heights")
     H = H - H.max()
     if -H.min() >= hr:
-        raise SceneError("geometry.h_rough", hr, f"must exceed the roughness depth {float(-H.min())!r}")
+        raise GeometryError("h_rough", hr, f"must exceed the roughness depth {float(-H.min())!r}")
     ny, nx = H.shape
     xs, ys = np.linspace(0.0, P, nx), np.linspace(0.0, P, ny)
     X, Y = np.meshgrid(xs, ys)
@@ -271,7 +271,7 @@ def bisinusoid_gap(amplitude: float, period: float = 1.0):
     Small-slope model on :func:`flat_cell3d`: ``g(x, y) = A (2 - cos(2 pi x/P)
     - cos(2 pi y/P)) >= 0``, zero at the summit ``(0, 0)``.
     """
-    A, P = _positive("profile.amplitude", amplitude), _positive("period", period)
+    A, P = _positive("amplitude", amplitude), _positive("period", period)
     k = 2 * math.pi / P
     return A * (2 - ng.cos(k * ng.x) - ng.cos(k * ng.y))
 

@@ -40,7 +40,7 @@ import logging
 import math
 from dataclasses import dataclass, replace
 
-from ngcontact.errors import SceneError
+from ngcontact.errors import GeometryError
 from ngcontact.geometry.cell2d import Cell, Segment, interface_cell
 
 log = logging.getLogger(__name__)
@@ -129,7 +129,7 @@ class Curve:
         return Curve(_move(self.start, dx), _move(self.control, dx), _move(self.end, dx))
 
     def split(self, x: float) -> tuple:
-        raise SceneError("profile.shift", x, "a sampled curve can only be shifted by a multiple "
+        raise GeometryError("shift", x, "a sampled curve can only be shifted by a multiple "
                          "of its sampling step (the cut must fall on a node)")
 
 
@@ -169,13 +169,13 @@ class Profile:
 
 def _check_positive(key: str, value: float) -> float:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-        raise SceneError(key, value, "must be a finite number > 0")
+        raise GeometryError(key, value, "must be a finite number > 0")
     return float(value)
 
 
 def flat(period: float = 1.0) -> Profile:
     """The flat profile ``y = 0``."""
-    P = _check_positive("profile.period", period)
+    P = _check_positive("period", period)
     return Profile("flat", P, (Line((0.0, 0.0), (P, 0.0)),))
 
 
@@ -185,11 +185,11 @@ def rectangular_valley(width: float, depth: float, period: float = 1.0) -> Profi
     Faces: plateaus of total length ``period - width`` and the valley bottom
     (parallel to ``S_0``), two walls of length ``depth`` (normal to ``S_0``).
     """
-    P = _check_positive("profile.period", period)
-    w = _check_positive("profile.width", width)
-    d = _check_positive("profile.depth", depth)
+    P = _check_positive("period", period)
+    w = _check_positive("width", width)
+    d = _check_positive("depth", depth)
     if not w < P:
-        raise SceneError("profile.width", width, f"must be < period = {P} (plateaus must remain)")
+        raise GeometryError("width", width, f"must be < period = {P} (plateaus must remain)")
     x0, x1 = 0.5 * (P - w), 0.5 * (P + w)
     pts = [(0.0, 0.0), (x0, 0.0), (x0, -d), (x1, -d), (x1, 0.0), (P, 0.0)]
     return Profile("rectangular_valley", P, _polyline(pts))
@@ -210,13 +210,13 @@ def triangular_valley(angle_left: float, angle_right: float, width: float | None
     period
         Period ``P``.
     """
-    P = _check_positive("profile.period", period)
-    for key, a in (("profile.angle_left", angle_left), ("profile.angle_right", angle_right)):
+    P = _check_positive("period", period)
+    for key, a in (("angle_left", angle_left), ("angle_right", angle_right)):
         if not (isinstance(a, (int, float)) and math.isfinite(a) and 0 < a < 90):
-            raise SceneError(key, a, "must be an angle in degrees in (0, 90)")
-    w = P if width is None else _check_positive("profile.width", width)
+            raise GeometryError(key, a, "must be an angle in degrees in (0, 90)")
+    w = P if width is None else _check_positive("width", width)
     if w > P:
-        raise SceneError("profile.width", width, f"must be <= period = {P}")
+        raise GeometryError("width", width, f"must be <= period = {P}")
     b1, b2 = math.radians(angle_left), math.radians(angle_right)
     d = w / (1.0 / math.tan(b1) + 1.0 / math.tan(b2))
     x0 = 0.5 * (P - w)
@@ -228,10 +228,10 @@ def triangular_valley(angle_left: float, angle_right: float, width: float | None
 
 def semicircular_valley(radius: float, period: float = 1.0) -> Profile:
     """A semicircular valley of ``radius`` centred in the period (two exact quarter arcs)."""
-    P = _check_positive("profile.period", period)
-    a = _check_positive("profile.radius", radius)
+    P = _check_positive("period", period)
+    a = _check_positive("radius", radius)
     if not 2 * a < P:
-        raise SceneError("profile.radius", radius, f"must be < period / 2 = {P / 2}")
+        raise GeometryError("radius", radius, f"must be < period / 2 = {P / 2}")
     c = (0.5 * P, 0.0)
     pieces = (Line((0.0, 0.0), (c[0] - a, 0.0)),
               Arc(c, a, math.pi, 1.5 * math.pi), Arc(c, a, 1.5 * math.pi, 2 * math.pi),
@@ -248,10 +248,10 @@ def sinusoid(amplitude: float, period: float = 1.0, pieces: int = 16) -> Profile
     approximant, not the exact sinusoid; the geometric error decreases like
     ``(period / pieces)^3``.
     """
-    P = _check_positive("profile.period", period)
-    A = _check_positive("profile.amplitude", amplitude)
+    P = _check_positive("period", period)
+    A = _check_positive("amplitude", amplitude)
     if not (isinstance(pieces, int) and pieces >= 4 and pieces % 2 == 0):
-        raise SceneError("profile.pieces", pieces, "must be an even integer >= 4")
+        raise GeometryError("pieces", pieces, "must be an even integer >= 4")
     k = 2 * math.pi / P
     xs = [P * i / pieces for i in range(pieces + 1)]
     out = []
@@ -277,20 +277,20 @@ def tabulated(x, y, *, path: str = "profile") -> Profile:
     """
     xs, ys = list(map(float, x)), list(map(float, y))
     if len(xs) != len(ys) or len(xs) < 3:
-        raise SceneError(path, len(xs), "needs columns x and y of equal length with at least 3 points")
+        raise GeometryError(path, len(xs), "needs columns x and y of equal length with at least 3 points")
     for i, (a, b) in enumerate(zip(xs, ys)):
         if not (math.isfinite(a) and math.isfinite(b)):
-            raise SceneError(f"{path}[row {i}]", (a, b), "x and y must be finite numbers")
+            raise GeometryError(f"{path}[row {i}]", (a, b), "x and y must be finite numbers")
     if xs[0] != 0.0:
-        raise SceneError(f"{path}[row 0].x", xs[0], "the profile must start at x = 0")
+        raise GeometryError(f"{path}[row 0].x", xs[0], "the profile must start at x = 0")
     for i in range(1, len(xs)):
         if not xs[i] > xs[i - 1]:
-            raise SceneError(f"{path}[row {i}].x", xs[i],
+            raise GeometryError(f"{path}[row {i}].x", xs[i],
                              f"x must increase strictly (previous x = {xs[i - 1]!r})")
     P = xs[-1]
     tol = 1e-9 * max(P, max(ys) - min(ys))
     if abs(ys[0] - ys[-1]) > tol:
-        raise SceneError(f"{path}[last row].y", ys[-1],
+        raise GeometryError(f"{path}[last row].y", ys[-1],
                          f"the profile must be periodic: y(period) must equal y(0) = {ys[0]!r} "
                          f"within {tol:.3g}")
     ys[-1] = ys[0]
@@ -331,7 +331,7 @@ def shifted(profile: Profile, fraction: float) -> Profile:
     for p in profile.pieces:
         x0, x1 = p.start[0], p.end[0]
         if abs(x1 - x0) <= tol and abs(x0 - s) <= tol:
-            raise SceneError("profile.shift", fraction, "the cut must not fall on a vertical face")
+            raise GeometryError("shift", fraction, "the cut must not fall on a vertical face")
         if x1 <= s + tol:
             tail.append(p.translated(P - s))
         elif x0 >= s - tol:
@@ -369,19 +369,19 @@ def interface_segments(profile: Profile, arrangement: str = "conforming") -> lis
     See the module docstring for the arrangements.
     """
     if arrangement not in ARRANGEMENTS:
-        raise SceneError("arrangement", arrangement, f"must be one of {', '.join(ARRANGEMENTS)}")
+        raise GeometryError("arrangement", arrangement, f"must be one of {', '.join(ARRANGEMENTS)}")
     if arrangement == "conforming":
         return [s for p in profile.pieces for s in p.segments()]
     lo, top = profile.bounds
     tol = 1e-12 * max(profile.period, top - lo)
     plateau = [_is_plateau(p, top, tol) for p in profile.pieces]
     if not any(plateau):
-        raise SceneError("arrangement", arrangement,
+        raise GeometryError("arrangement", arrangement,
                          f"the {profile.name} profile has no plane summit plateau to carry contact; "
                          "use 'conforming', or a flat interface with a gap function "
                          "(the small-slope model of rounded summits)")
     if not (plateau[0] and plateau[-1]):
-        raise SceneError("arrangement", arrangement,
+        raise GeometryError("arrangement", arrangement,
                          "in the summit arrangement the lateral edges must cut a summit plateau; "
                          "shift the profile so that x = 0 lies on a plateau")
     out, run_start = [], None
@@ -425,10 +425,10 @@ def profile_cell(profile: Profile, *, arrangement: str = "conforming", h_rough: 
     _check_positive("h_rough", h_rough)
     _check_positive("h_counter", h_counter)
     if not lo > -h_rough:
-        raise SceneError("h_rough", h_rough, f"must exceed the profile depth {-lo!r} "
+        raise GeometryError("h_rough", h_rough, f"must exceed the profile depth {-lo!r} "
                          "(the roughness must lie inside the rough body)")
     if not hi < h_counter:
-        raise SceneError("h_counter", h_counter, f"must exceed the profile height {hi!r}")
+        raise GeometryError("h_counter", h_counter, f"must exceed the profile height {hi!r}")
     segments = interface_segments(profile, arrangement)
     log.debug("profile cell %s (%s): %d interface segments", profile.name, arrangement, len(segments))
     return interface_cell(segments, profile.period, h_rough, h_counter, maxh=maxh,

@@ -10,7 +10,7 @@ column repeat the first** (``H[-1, :] = H[0, :]``, ``H[:, -1] = H[:, 0]``), whic
 makes the periodicity checkable.  Used as the initial gap of the small-slope
 model (:func:`ngcontact.geometry.cell3d.height_map_gap`).
 
-All checks raise :class:`~ngcontact.errors.SceneError` naming the file, the
+All checks raise :class:`~ngcontact.errors.GeometryError` naming the file, the
 offending entry and what is allowed.
 """
 from __future__ import annotations
@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ngcontact.errors import SceneError
+from ngcontact.errors import GeometryError
 from ngcontact.geometry.profiles import Profile, tabulated
 
 PERIODIC_TOL = 1e-9
@@ -45,19 +45,19 @@ def read_profile_csv(file, *, path: str | None = None) -> Profile:
     try:
         text = file.read_text()
     except OSError as err:
-        raise SceneError(where, str(file), f"must be a readable CSV file ({err.strerror})") from None
+        raise GeometryError(where, str(file), f"must be a readable CSV file ({err.strerror})") from None
     rows = [r for r in csv.reader(text.splitlines()) if r and any(c.strip() for c in r)]
     if rows and not _numeric(rows[0][0]):
         rows = rows[1:]                      # header
     xs, ys = [], []
     for i, row in enumerate(rows):
         if len(row) != 2:
-            raise SceneError(f"{where}[row {i}]", row, "each row must have exactly two columns x, y")
+            raise GeometryError(f"{where}[row {i}]", row, "each row must have exactly two columns x, y")
         try:
             xs.append(float(row[0]))
             ys.append(float(row[1]))
         except ValueError:
-            raise SceneError(f"{where}[row {i}]", row, "x and y must be numbers") from None
+            raise GeometryError(f"{where}[row {i}]", row, "x and y must be numbers") from None
     return tabulated(xs, ys, path=where)
 
 
@@ -74,7 +74,7 @@ def read_height_map(file, *, path: str | None = None) -> np.ndarray:
     try:
         H = np.load(file, allow_pickle=False)
     except (OSError, ValueError) as err:
-        raise SceneError(where, str(file), f"must be a readable .npy array ({err})") from None
+        raise GeometryError(where, str(file), f"must be a readable .npy array ({err})") from None
     return check_height_map(H, path=where)
 
 
@@ -82,21 +82,21 @@ def check_height_map(H, *, path: str = "height_map") -> np.ndarray:
     """Validate a height-map array: 2D, finite, periodic with repeated last row/column."""
     H = np.asarray(H)
     if H.ndim != 2 or min(H.shape) < 3:
-        raise SceneError(path, f"array of shape {H.shape}", "must be a 2D array with at least 3 "
+        raise GeometryError(path, f"array of shape {H.shape}", "must be a 2D array with at least 3 "
                          "samples per direction (last row/column repeating the first)")
     if not np.issubdtype(H.dtype, np.number) or np.iscomplexobj(H):
-        raise SceneError(path, f"array of dtype {H.dtype}", "must hold real numbers")
+        raise GeometryError(path, f"array of dtype {H.dtype}", "must hold real numbers")
     H = H.astype(float)
     bad = np.argwhere(~np.isfinite(H))
     if len(bad):
         i, j = bad[0]
-        raise SceneError(f"{path}[{i}, {j}]", float(H[i, j]), "heights must be finite")
+        raise GeometryError(f"{path}[{i}, {j}]", float(H[i, j]), "heights must be finite")
     tol = PERIODIC_TOL * max(1.0, float(np.ptp(H)))
     for axis, name in ((0, "row"), (1, "column")):
         first, last = np.take(H, 0, axis=axis), np.take(H, -1, axis=axis)
         k = int(np.argmax(np.abs(first - last)))
         if abs(first[k] - last[k]) > tol:
-            raise SceneError(f"{path}[last {name}]", float(last[k]),
+            raise GeometryError(f"{path}[last {name}]", float(last[k]),
                              f"the map must be periodic: the last {name} must repeat the first "
                              f"(entry {k}: {float(first[k])!r}) within {tol:.3g}")
     return H
@@ -142,5 +142,5 @@ def _check_nonnegative(g: np.ndarray, where: str) -> None:
     bad = np.argwhere(np.asarray(g) < 0)
     if len(bad):
         idx = tuple(int(i) for i in bad[0])
-        raise SceneError(f"{where}[{', '.join(map(str, idx))}]", float(np.asarray(g)[idx]),
+        raise GeometryError(f"{where}[{', '.join(map(str, idx))}]", float(np.asarray(g)[idx]),
                          "a gap must be >= 0")

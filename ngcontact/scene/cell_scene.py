@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ngcontact.errors import MISSING, SceneError
+from ngcontact.errors import MISSING, GeometryError, SceneError
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names)
 from ngcontact.scene.schema import check_selected, nonempty, nonnegative, open_interval, param, positive
@@ -82,13 +82,13 @@ class CellGeometry:
         if self.dim == 2 and self.profile != "tabulated":  # tabulated: checked when its file is read
             try:
                 bounds = profile_2d(self).bounds
-            except SceneError as exc:  # the builders name their own arguments (profile.width, ...)
-                key = _BUILDER_KEYS.get(exc.path, exc.path.replace("profile.", ""))
+            except GeometryError as exc:  # the builders name their own arguments (width, angle_left, ...)
+                key = _BUILDER_KEYS.get(exc.name, exc.name)
                 raise SceneError(f"{path}.{key}", exc.value, exc.allowed) from None
             check_profile_heights(self, bounds, path)
 
 
-_BUILDER_KEYS = {"profile.angle_left": "angles", "profile.angle_right": "angles"}
+_BUILDER_KEYS = {"angle_left": "angles", "angle_right": "angles"}
 
 
 def profile_2d(g: CellGeometry):
@@ -211,7 +211,18 @@ class CellScene:
     base_dir: str = base_dir_field()
 
     def check_files(self, load) -> None:
-        """Read and validate the tabulated profile / height map / gap named by the scene."""
+        """Read and validate the tabulated profile / height map / gap named by the scene.
+
+        The readers name the entry under the scene's key path they are given
+        (``where``), so their :class:`GeometryError` becomes a
+        :class:`SceneError` with the same words.
+        """
+        try:
+            self._check_files()
+        except GeometryError as exc:
+            raise SceneError(exc.name, exc.value, exc.allowed) from None
+
+    def _check_files(self) -> None:
         from ngcontact.geometry import tabulated
         from ngcontact.scene.sections import resolve
         g = self.geometry

@@ -70,6 +70,6 @@ def test_height_map_surface_builds_and_respects_the_cell_height(tmp_path):
     H = read_height_map(os.path.join(here, "geometries", "cells", "data", "height_map_example.npy"))
     c = surface_cell(H, h_rough=0.6, h_counter=0.6, maxh=0.4, interface_maxh=0.2)
     assert "contact" in c.mesh.GetBoundaries()
-    from ngcontact.errors import SceneError
-    with pytest.raises(SceneError, match="geometry.h_rough"):
+    from ngcontact.errors import GeometryError
+    with pytest.raises(GeometryError, match="^h_rough = "):
         surface_cell(H * 1e3, h_rough=0.6, h_counter=0.6, maxh=0.4)

@@ -5,7 +5,7 @@ import numpy as np
 import ngsolve as ng
 import pytest
 
-from ngcontact.errors import SceneError
+from ngcontact.errors import GeometryError
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.cell3d import (flat_cell3d, height_map_gap, square_hills_cell)
 from ngcontact.geometry.tabulated import check_height_map, read_height_map, read_profile_csv
@@ -47,7 +47,7 @@ def _length(mesh, bc):
 def test_2d_cells_follow_the_naming_contract(name, arrangement):
     profile = PROFILES[name]()
     if arrangement == "summit" and name in NO_PLATEAU:
-        with pytest.raises(SceneError, match="no plane summit plateau"):
+        with pytest.raises(GeometryError, match="no plane summit plateau"):
             pr.profile_cell(profile, arrangement=arrangement, h_rough=1, h_counter=1, maxh=0.3)
         return
     cell = pr.profile_cell(profile, arrangement=arrangement, h_rough=1.0, h_counter=0.5,
@@ -178,16 +178,16 @@ def _csv(tmp_path, text):
     ("x,y\n0,0\n1,0\n", "at least 3 points"),
 ])
 def test_bad_csv_profiles_are_rejected(tmp_path, text, match):
-    with pytest.raises(SceneError, match=match) as err:
+    with pytest.raises(GeometryError, match=match) as err:
         read_profile_csv(_csv(tmp_path, text))
     assert "p.csv" in str(err.value)
 
 
 def test_profile_reaching_the_cell_height_is_rejected():
     profile = pr.rectangular_valley(0.4, 0.3)
-    with pytest.raises(SceneError, match="h_rough.*must exceed the profile depth"):
+    with pytest.raises(GeometryError, match="h_rough.*must exceed the profile depth"):
         pr.profile_cell(profile, h_rough=0.3, h_counter=1, maxh=0.3)
-    with pytest.raises(SceneError, match="profile.height.*must be < h_rough"):
+    with pytest.raises(GeometryError, match="^height.*must be < h_rough"):
         square_hills_cell(0.4, 0.5, h_rough=0.5, h_counter=0.5, maxh=0.3)
 
 
@@ -201,23 +201,23 @@ def test_profile_reaching_the_cell_height_is_rejected():
 def test_bad_height_maps_are_rejected(tmp_path, array, match):
     f = tmp_path / "h.npy"
     np.save(f, array)
-    with pytest.raises(SceneError, match=match):
+    with pytest.raises(GeometryError, match=match):
         read_height_map(f)
-    with pytest.raises(SceneError, match=match):
+    with pytest.raises(GeometryError, match=match):
         check_height_map(array)
 
 
 def test_bad_profile_parameters_are_rejected():
-    with pytest.raises(SceneError, match="profile.width.*must be < period"):
+    with pytest.raises(GeometryError, match="^width.*must be < period"):
         pr.rectangular_valley(1.2, 0.3)
-    with pytest.raises(SceneError, match="profile.angle_left.*\\(0, 90\\)"):
+    with pytest.raises(GeometryError, match="^angle_left.*\\(0, 90\\)"):
         pr.triangular_valley(95, 30)
-    with pytest.raises(SceneError, match="profile.radius.*period / 2"):
+    with pytest.raises(GeometryError, match="^radius.*period / 2"):
         pr.semicircular_valley(0.6)
-    with pytest.raises(SceneError, match="arrangement.*lateral edges must cut a summit plateau"):
+    with pytest.raises(GeometryError, match="arrangement.*lateral edges must cut a summit plateau"):
         pr.profile_cell(pr.shifted(pr.rectangular_valley(0.4, 0.3), 0.5), arrangement="summit",
                         h_rough=1, h_counter=1, maxh=0.3)
-    with pytest.raises(SceneError, match="arrangement.*conforming, summit"):
+    with pytest.raises(GeometryError, match="arrangement.*conforming, summit"):
         pr.interface_segments(pr.flat(), "glued")
 
 
