@@ -9,20 +9,51 @@ writes ``report.json``, ``epsilon.csv`` and ``epsilon.png`` into ``DIR``
 (default ``results/<scene name>_epsilon``).
 
 Exit status: 0 success, 2 invalid scene or output directory, 3 solver
-failure; every failure prints one line on stderr and leaves no output behind.
+failure, 130 interrupted (SIGINT), 143 terminated (SIGTERM); every failure
+prints one line on stderr and leaves the output directory as it was
+(:mod:`ngcontact.output.writer`: only the package's own files are ever
+written or replaced).
 """
 from __future__ import annotations
 
 import argparse
 import logging
 import os
+import signal
 import sys
+import threading
 
 from ngcontact import __version__
 from ngcontact.scene import loader as scene_mod
 from ngcontact.errors import ConvergenceError, ModelError, NgcontactError, OutputError, SceneError
 
 EXIT_OK, EXIT_SCENE, EXIT_SOLVER = 0, 2, 3
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
+
+
+class Terminated(BaseException):
+    """SIGTERM, raised where the program stands so that every ``finally`` cleans up."""
+
+
+#: Signals received by this run.  An exception raised by the handler can be
+#: lost inside a compiled library that swallows errors of Python callbacks,
+#: so the record is checked again at every stage and before any file is
+#: written: an interrupted run never writes.
+_RECEIVED: list[int] = []
+
+
+def _interruption(signum: int) -> BaseException:
+    return KeyboardInterrupt() if signum == signal.SIGINT else Terminated()
+
+
+def _on_signal(signum, frame):
+    _RECEIVED.append(signum)
+    raise _interruption(signum)
+
+
+def _check_signals() -> None:
+    if _RECEIVED:
+        raise _interruption(_RECEIVED[0])
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -61,17 +92,30 @@ def main(argv=None) -> int:
         _parser().print_help()
         return EXIT_SCENE
     logging.basicConfig(level=logging.DEBUG if args.debug else logging.WARNING, format="%(message)s")
+    _RECEIVED.clear()
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            if signal.getsignal(sig) is not signal.SIG_IGN:  # an ignored signal stays ignored (nohup, &)
+                previous[sig] = signal.signal(sig, _on_signal)
     try:
         if args.command == "check":
             return _check(args.scene)
         if args.command == "study":
             return _study(args.scene, args.periods, args.out, quiet=args.quiet)
         return _run(args.scene, args.out, quiet=args.quiet)
+    except KeyboardInterrupt:
+        return _fail(EXIT_INTERRUPTED, f"{args.scene}: interrupted; the output directory is as it was")
+    except Terminated:
+        return _fail(EXIT_TERMINATED, f"{args.scene}: terminated; the output directory is as it was")
     except Exception as exc:  # an unexpected failure still ends in one line and exit 3
         if args.debug:
             raise
         return _fail(EXIT_SOLVER, f"{args.scene}: unexpected error ({type(exc).__name__}): {exc}; "
                                   "rerun with --debug for the traceback")
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 def _fail(code: int, message: str) -> int:
@@ -116,23 +160,29 @@ def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, v
     Maps every failure to its exit status with a one-line message: invalid
     scene or output directory 2, solver failure 3.
     """
-    from ngcontact.output.report import ensure_writable, write_outputs
+    from ngcontact.output.writer import check_output_dir, write_outputs
 
     try:
         sc = scene_mod.load(path)
         if validate is not None:
             validate(sc)
+        inputs = scene_mod.inputs(sc, path)
     except SceneError as exc:
         return _fail(EXIT_SCENE, f"{path}: {exc}")
     out = out or os.path.join("results", os.path.splitext(os.path.basename(path))[0] + suffix)
     try:
-        ensure_writable(out)
+        check_output_dir(out, inputs)
     except OutputError as exc:
         return _fail(EXIT_SCENE, str(exc))
-    progress = None if quiet else (lambda line: print(line, file=sys.stderr, flush=True))
+    def progress(line: str) -> None:  # called at every stage
+        _check_signals()
+        if not quiet:
+            print(line, file=sys.stderr, flush=True)
+
     try:
         report, outcome = compute(sc, progress)
-        write_outputs(out, report, outcome)
+        _check_signals()
+        write_outputs(out, report, outcome, inputs)
     except SceneError as exc:
         return _fail(EXIT_SCENE, f"{path}: {exc}")
     except ModelError as exc:
@@ -143,8 +193,8 @@ def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, v
         return _fail(EXIT_SOLVER, f"{path}: solver failed: {exc}")
     except (NgcontactError, ValueError) as exc:
         return _fail(EXIT_SOLVER, f"{path}: {exc}")
-    if progress:
-        progress(f"wrote {os.path.join(out, 'report.json')}")
+    if not quiet:
+        print(f"wrote {os.path.join(out, 'report.json')}", file=sys.stderr, flush=True)
     return EXIT_OK
 
 

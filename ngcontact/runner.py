@@ -6,7 +6,7 @@ The one code path behind ``ngcontact run`` and the Python API::
 
 ``report`` is the JSON-ready dictionary (see the README's report reference);
 ``outcome`` keeps the NGSolve objects (meshes, fields) for further work.
-Nothing is written to disk; :func:`ngcontact.output.report.write_outputs` does that.
+Nothing is written to disk; :func:`ngcontact.output.writer.write_outputs` does that.
 """
 from __future__ import annotations
 

@@ -36,7 +36,7 @@ from ngcontact.geometry import profiles
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.fem.materials import isotropic
-from ngcontact.output.report import write_csv
+from ngcontact.output.writer import write_csv
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 

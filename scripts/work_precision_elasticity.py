@@ -24,7 +24,7 @@ import os
 from ngcontact.verification import manufactured
 from ngcontact.verification import rates as studies
 from ngcontact.fem.materials import isotropic
-from ngcontact.output.report import write_csv
+from ngcontact.output.writer import write_csv
 
 log = logging.getLogger("work_precision_elasticity")
 

@@ -1,11 +1,10 @@
 """Run outcome and its output: ``report.json``, CSV tables, VTK files, PNG plots.
 
-A driver returns an :class:`Outcome` (plain data plus deferred writers); the
-functions here write it.  Writing is atomic: everything goes into a hidden
-temporary directory beside the target, which replaces the target only once
-every file is written, so a failed run leaves no partial output.  Reports
-never contain NaN or infinity: :func:`to_plain` rejects them before any
-file is written.
+A driver returns an :class:`Outcome` (plain data plus deferred writers);
+:func:`build_report` makes the report of it and
+:mod:`ngcontact.output.writer` writes both into the output directory.
+Reports never contain NaN or infinity: :func:`to_plain` rejects them before
+any file is written.
 
 Report keys (schema ``ngcontact-report/1``): ``schema``, ``version``,
 ``kind``, ``title``, ``scene`` (the validated scene echoed), ``effects`` (the
@@ -15,12 +14,7 @@ terms assembled), ``ndof``, ``timings`` (seconds per stage and ``total``),
 """
 from __future__ import annotations
 
-import csv
-import json
 import math
-import os
-import shutil
-import tempfile
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -28,7 +22,6 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from ngcontact.errors import OutputError
 
 if TYPE_CHECKING:
     import ngsolve as ng
@@ -123,71 +116,3 @@ def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcom
                         + [f"{n}.png" for n in outcome.plots]),
     }
     return to_plain(report, "report")
-
-
-def ensure_writable(out_dir: str) -> None:
-    """Fail early when ``out_dir`` cannot be created or replaced."""
-    out_dir = os.path.abspath(out_dir)
-    parent = os.path.dirname(out_dir)
-    probe = parent
-    while not os.path.exists(probe):
-        probe = os.path.dirname(probe)
-    if os.path.exists(out_dir) and not os.path.isdir(out_dir):
-        raise OutputError(f"--out {out_dir}: exists and is not a directory")
-    if not os.path.isdir(probe) or not os.access(probe, os.W_OK | os.X_OK):
-        raise OutputError(f"--out {out_dir}: cannot write in {probe}")
-
-
-def write_outputs(out_dir: str, report: dict, outcome: Outcome) -> str:
-    """Write report, tables, VTK and plots atomically into ``out_dir``."""
-    out_dir = os.path.abspath(out_dir)
-    parent = os.path.dirname(out_dir)
-    ensure_writable(out_dir)
-    os.makedirs(parent, exist_ok=True)
-    tmp = tempfile.mkdtemp(prefix=".ngcontact-partial-", dir=parent)
-    try:
-        for name, (header, rows) in outcome.tables.items():
-            write_csv(os.path.join(tmp, f"{name}.csv"), header, rows)
-        for name, item in outcome.vtk.items():
-            write_vtk(os.path.join(tmp, name), item)
-        for name, draw in outcome.plots.items():
-            draw(os.path.join(tmp, f"{name}.png"))
-        with open(os.path.join(tmp, "report.json"), "w") as fh:
-            json.dump(report, fh, indent=2, allow_nan=False)
-            fh.write("\n")
-        _replace_dir(tmp, out_dir)
-    except OSError as exc:  # e.g. a full disk: an output problem, reported as such
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise OutputError(f"--out {out_dir}: writing failed ({exc}); the previous output, if any, "
-                          "is unchanged") from exc
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return out_dir
-
-
-def _replace_dir(src: str, dst: str) -> None:
-    if os.path.exists(dst):
-        old = tempfile.mkdtemp(prefix=".ngcontact-old-", dir=os.path.dirname(dst))
-        os.rmdir(old)
-        os.rename(dst, old)
-        os.rename(src, dst)
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        os.rename(src, dst)
-
-
-def write_csv(path: str, header, rows) -> None:
-    rows = to_plain([list(r) for r in rows], os.path.basename(path))
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        w.writerows(rows)
-
-
-def write_vtk(path_noext: str, item: VtkField) -> None:
-    import ngsolve as ng
-    names = list(item.fields)
-    ng.VTKOutput(ma=item.mesh, coefs=[item.fields[n] for n in names], names=names,
-                 filename=path_noext, subdivision=item.subdivision, legacy=False).Do()
-    # VTKOutput appends ".vtu"; nothing else to do.

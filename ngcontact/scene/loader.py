@@ -21,7 +21,15 @@ try:  # Python >= 3.11
 except ModuleNotFoundError:  # pragma: no cover - exercised on 3.10 only
     import tomli as tomllib
 
-__all__ = ["load", "from_dict", "effects", "as_dict", "resolve"]
+__all__ = ["load", "from_dict", "effects", "as_dict", "resolve", "inputs"]
+
+#: Real paths of the scene files being loaded, outermost first: a scene that
+#: names itself, directly or through others, as a cell is refused by name.
+_LOADING: list[str] = []
+
+#: Keys whose string value names a file the scene reads (``cell``: a scene).
+FILE_KEYS = ("file",)
+SCENE_KEYS = ("cell",)
 
 
 def load(path: str | os.PathLike):
@@ -35,12 +43,21 @@ def load(path: str | os.PathLike):
     path = os.fspath(path)
     if not os.path.isfile(path):
         raise SceneError("<scene file>", path, "no such file")
+    real = os.path.realpath(path)
+    if real in _LOADING:
+        chain = " -> ".join(os.path.basename(p) for p in _LOADING[_LOADING.index(real):] + [real])
+        raise SceneError("<scene file>", path, f"names itself as a scene to load ({chain}); a cell scene "
+                         "must not refer back to the scene that uses it")
     try:
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError("<scene file>", path, f"not valid TOML ({exc})") from None
-    return from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
+    _LOADING.append(real)
+    try:
+        return from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
+    finally:
+        _LOADING.pop()
 
 
 def from_dict(data: dict, base_dir: str = "."):
@@ -55,6 +72,35 @@ def from_dict(data: dict, base_dir: str = "."):
     if callable(check_files):  # nested scenes (a macro scene's cell) load through this loader
         check_files(load)
     return scene
+
+
+def inputs(scene, path: str | None = None) -> list[str]:
+    """The files a validated scene reads: its own file (``path``), its data files and nested scenes.
+
+    Every string under a key named ``file`` is a data file and every string
+    under ``cell`` a scene, whose own inputs count too (paths relative to
+    the scene that names them).
+    """
+    out = [os.path.abspath(path)] if path else []
+
+    def walk(node, base):
+        if isinstance(node, dict):
+            for key, value in node.items():
+                if isinstance(value, str) and key in FILE_KEYS:
+                    out.append(resolve(base, value))
+                elif isinstance(value, str) and key in SCENE_KEYS:
+                    nested = resolve(base, value)
+                    if nested not in out:
+                        out.append(nested)
+                        out.extend(p for p in inputs(load(nested)) if p not in out)
+                else:
+                    walk(value, base)
+        elif isinstance(node, (list, tuple)):
+            for value in node:
+                walk(value, base)
+
+    walk(as_dict(scene), scene)
+    return out
 
 
 def effects(scene) -> tuple[str, ...]:

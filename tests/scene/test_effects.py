@@ -138,7 +138,7 @@ def test_macro_linear_law_is_one_linear_solve_and_no_friction_term(tmp_path):
 def test_failures_after_the_solve_leave_the_previous_output_and_no_partial_files(tmp_path, monkeypatch, capsys):
     """Atomic output through the command line: a non-finite result found after the solve
     (exit 3) and a write that fails halfway (exit 2) both leave the earlier run intact."""
-    from ngcontact.output import report as report_mod
+    from ngcontact.output import writer as writer_mod
     from ngcontact.cell.cell_problem import CellProblem
 
     scene = tmp_path / "cell.toml"
@@ -166,7 +166,7 @@ def test_failures_after_the_solve_leave_the_previous_output_and_no_partial_files
     def full_disk(path, item):  # the CSV tables are already in the temporary directory
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(report_mod, "write_vtk", full_disk)
+    monkeypatch.setattr(writer_mod, "write_vtk", full_disk)
     assert cli.main(["run", str(scene), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err
     assert err == (f"ngcontact: error: --out {out}: writing failed ([Errno 28] No space left on device); "

@@ -1,0 +1,234 @@
+"""Writing a run's files into the user's output directory without harming anything else in it.
+
+The contract, for ``ngcontact run SCENE --out DIR`` and every study:
+
+* Only the package's own files are written: ``report.json``, the CSV
+  tables, the VTK files and the PNG plots of the outcome, and the manifest
+  ``.ngcontact-manifest.json`` that lists them.  ``DIR`` is created when
+  missing (with the user's umask); an existing ``DIR`` keeps its mode, its
+  owner and every file the package did not write.  A symbolic link ``DIR``
+  is followed, never replaced.
+* A rerun replaces the files the manifest of the previous run lists (and
+  removes those of them the new run does not write); a file of the same
+  name that no manifest lists is the user's, and the run is refused before
+  anything is written.
+* ``DIR`` must not contain the scene or any file the scene reads (the
+  directory ``.``, a parent, a data folder): refused before any work.
+* Atomic as a whole: every file is first written into a staging directory
+  ``.ngcontact-partial-<pid>-<random>`` beside or inside ``DIR``, on the
+  same file system; the files are then moved into place by renames, with
+  SIGINT and SIGTERM held back, and the manifest last.  A failure or an
+  interruption before that leaves ``DIR`` as it was and removes the staging
+  directory; one left behind by a killed run (its process no longer exists)
+  is removed by the next run that stages there.
+
+Errors are :class:`~ngcontact.errors.OutputError` with one line naming
+``--out`` and the reason.
+"""
+from __future__ import annotations
+
+import csv
+import glob
+import json
+import os
+import shutil
+import signal
+import tempfile
+from contextlib import contextmanager
+from typing import TYPE_CHECKING, Iterable
+
+from ngcontact.errors import OutputError
+from ngcontact.output.report import Outcome, to_plain
+
+if TYPE_CHECKING:
+    from ngcontact.output.report import VtkField
+
+MANIFEST = ".ngcontact-manifest.json"
+STAGING_PREFIX = ".ngcontact-partial-"
+
+
+# ---------------------------------------------------------------- the files
+def write_csv(path: str, header, rows) -> None:
+    """One CSV table: a header row, then the rows (finite numbers only)."""
+    rows = to_plain([list(r) for r in rows], os.path.basename(path))
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        w.writerows(rows)
+
+
+def write_vtk(path_noext: str, item: VtkField) -> None:
+    """One ``.vtu`` file of the fields of ``item`` (NGSolve appends the extension)."""
+    import ngsolve as ng
+    names = list(item.fields)
+    ng.VTKOutput(ma=item.mesh, coefs=[item.fields[n] for n in names], names=names,
+                 filename=path_noext, subdivision=item.subdivision, legacy=False).Do()
+
+
+def file_names(outcome: Outcome) -> list[str]:
+    """The names of the files an outcome writes besides ``report.json``."""
+    return sorted([f"{n}.csv" for n in outcome.tables] + [f"{n}.vtu" for n in outcome.vtk]
+                  + [f"{n}.png" for n in outcome.plots])
+
+
+# ---------------------------------------------------------------- the checks
+def _inside(path: str, directory: str) -> bool:
+    try:
+        return os.path.commonpath([path, directory]) == directory
+    except ValueError:  # different drives
+        return False
+
+
+def _existing_ancestor(path: str) -> str:
+    probe = path
+    while not os.path.exists(probe):
+        probe = os.path.dirname(probe)
+    return probe
+
+
+def own_files(out_dir: str) -> set[str] | None:
+    """The files the package's manifest in ``out_dir`` lists; ``None`` when there is no manifest.
+
+    Raises
+    ------
+    OutputError
+        A file of the manifest's name that is not a manifest of this package.
+    """
+    path = os.path.join(out_dir, MANIFEST)
+    if not os.path.lexists(path):
+        return None
+    try:
+        with open(path, encoding="utf-8") as fh:
+            data = json.load(fh)
+    except (OSError, ValueError):
+        data = None
+    files = data.get("files") if isinstance(data, dict) and data.get("written_by") == "ngcontact" else None
+    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
+        raise OutputError(f"--out {out_dir}: {MANIFEST} exists and is not a manifest of ngcontact; "
+                          "move it or choose another directory")
+    # a manifest names plain files of this directory only
+    return {f for f in files if f == os.path.basename(f) and f not in ("", ".", "..", MANIFEST)}
+
+
+def check_output_dir(out_dir: str, inputs: Iterable[str] = (), names: Iterable[str] = ("report.json",)) -> str:
+    """Refuse, before any work, an output directory the run may not write; returns its real path.
+
+    Parameters
+    ----------
+    out_dir
+        The ``--out`` directory (need not exist).
+    inputs
+        The scene file and every file it reads.
+    names
+        File names the run will write; one that exists and is not the
+        package's (no manifest lists it) is refused.
+    """
+    real = os.path.realpath(os.path.abspath(out_dir))
+    if os.path.exists(real) and not os.path.isdir(real):
+        raise OutputError(f"--out {out_dir}: exists and is not a directory")
+    for p in inputs:
+        if _inside(os.path.realpath(os.path.abspath(p)), real):
+            raise OutputError(f"--out {out_dir}: contains {p}, which the scene reads; choose a directory "
+                              "that holds no input (the default is results/<scene name>)")
+    probe = _existing_ancestor(real)
+    if not os.path.isdir(probe) or not os.access(probe, os.W_OK | os.X_OK):
+        raise OutputError(f"--out {out_dir}: cannot write in {probe}")
+    if os.path.isdir(real):
+        ours = own_files(real) or set()
+        for name in names:
+            if name not in ours and os.path.lexists(os.path.join(real, name)):
+                raise OutputError(f"--out {out_dir}: {name} exists and was not written by ngcontact; "
+                                  "move it or choose another directory")
+    return real
+
+
+# ---------------------------------------------------------------- staging
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def remove_stale_staging(directory: str) -> list[str]:
+    """Remove staging directories of runs whose process no longer exists; returns their paths."""
+    removed = []
+    for path in glob.glob(os.path.join(directory, STAGING_PREFIX + "*")):
+        rest = os.path.basename(path)[len(STAGING_PREFIX):]
+        pid = rest.split("-", 1)[0]
+        if pid.isdigit() and os.path.isdir(path) and not os.path.islink(path) and not _alive(int(pid)):
+            shutil.rmtree(path, ignore_errors=True)
+            removed.append(path)
+    return removed
+
+
+@contextmanager
+def _signals_held():
+    """Hold SIGINT and SIGTERM back (they arrive after the block) where the platform allows."""
+    held = {signal.SIGINT, signal.SIGTERM}
+    try:
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    except (AttributeError, ValueError, OSError):  # no POSIX signal masks here
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _move(src: str, dst: str) -> None:
+    try:
+        os.replace(src, dst)
+    except OSError:  # another file system below a mount point inside DIR
+        shutil.copy2(src, dst + ".ngcontact-tmp")
+        os.replace(dst + ".ngcontact-tmp", dst)
+
+
+# ---------------------------------------------------------------- the write
+def write_outputs(out_dir: str, report: dict, outcome: Outcome, inputs: Iterable[str] = ()) -> str:
+    """Write ``report.json`` and the outcome's files into ``out_dir`` under the contract of this module.
+
+    Returns the directory's real path.
+    """
+    names = file_names(outcome) + ["report.json"]
+    real = check_output_dir(out_dir, inputs, names)
+    stage_in = real if os.path.isdir(real) else _existing_ancestor(real)
+    remove_stale_staging(stage_in)
+    try:
+        tmp = tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=stage_in)
+    except OSError as exc:
+        raise OutputError(f"--out {out_dir}: cannot write in {stage_in} ({exc.strerror})") from None
+    try:
+        for name, (header, rows) in outcome.tables.items():
+            write_csv(os.path.join(tmp, f"{name}.csv"), header, rows)
+        for name, item in outcome.vtk.items():
+            write_vtk(os.path.join(tmp, name), item)
+        for name, draw in outcome.plots.items():
+            draw(os.path.join(tmp, f"{name}.png"))
+        with open(os.path.join(tmp, "report.json"), "w") as fh:
+            json.dump(report, fh, indent=2, allow_nan=False)
+            fh.write("\n")
+        manifest = {"written_by": "ngcontact", "version": report.get("version"), "files": sorted(names)}
+        with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as fh:
+            json.dump(manifest, fh, indent=1)
+            fh.write("\n")
+        with _signals_held():
+            old = (own_files(real) or set()) if os.path.isdir(real) else set()
+            os.makedirs(real, exist_ok=True)
+            for name in names:
+                _move(os.path.join(tmp, name), os.path.join(real, name))
+            for name in sorted(old - set(names)):
+                target = os.path.join(real, name)
+                if os.path.isfile(target) or os.path.islink(target):
+                    os.remove(target)
+            _move(os.path.join(tmp, MANIFEST), os.path.join(real, MANIFEST))
+    except OSError as exc:  # e.g. a full disk: an output problem, reported as such
+        raise OutputError(f"--out {out_dir}: writing failed ({exc}); the previous output, if any, "
+                          "is unchanged") from exc
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return real
