@@ -30,7 +30,7 @@ import ngcontact
 
 def main() -> float:
     """Solve the femur scene; return the strength safety factor of its coating layer."""
-    # Solve a scene file as `ngcontact run` does (nothing is written to disk).
+    # Solve a scene file as `ngcontact run` does, without writing output files.
     report, outcome = ngcontact.solve("geometries/femur_stem.toml")
     print(report["effects"])                      # the physical terms that were assembled
 

@@ -17,6 +17,7 @@ written or replaced).
 from __future__ import annotations
 
 import argparse
+from contextlib import contextmanager
 import logging
 import os
 import signal
@@ -118,6 +119,26 @@ def main(argv=None) -> int:
             signal.signal(sig, handler)
 
 
+@contextmanager
+def _native_output_silenced(active: bool):
+    """With ``--quiet``: the compiled libraries' own lines on file descriptor 1 (Netgen's
+    ``identify surfaces ...``) go to the null device while the scene is solved."""
+    if not active:
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 1)
+    os.close(null)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def _fail(code: int, message: str) -> int:
     print(f"ngcontact: error: {message}", file=sys.stderr)
     return code
@@ -180,7 +201,8 @@ def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, v
             print(line, file=sys.stderr, flush=True)
 
     try:
-        report, outcome = compute(sc, progress)
+        with _native_output_silenced(quiet):
+            report, outcome = compute(sc, progress)
         _check_signals()
         write_outputs(out, report, outcome, inputs)
     except SceneError as exc:

@@ -205,3 +205,13 @@ def test_inadmissible_model_input_exits_2_with_the_quantity(scene_file, tmp_path
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].endswith("inadmissible model input: E = -1.0: must be > 0"), err
     assert not out.exists()
+
+
+def test_quiet_prints_nothing_not_even_the_mesher_s_own_lines(tmp_path):
+    """Was: --quiet still printed Netgen's 'identify surfaces' lines of a periodic 3D cell."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    done = subprocess.run([sys.executable, "-m", "ngcontact.cli", "run",
+                           os.path.join(root, "geometries", "cells", "hip_hills.toml"),
+                           "--out", str(tmp_path / "out"), "--quiet"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "" and done.stderr == "", (done.stdout, done.stderr)

@@ -22,13 +22,23 @@ The arrays are cached in ``cache_dir`` (default ``$NGCONTACT_CACHE`` or
 ``~/.cache/ngcontact``) under a key that names the cell; the driver
 (:func:`ngcontact.drivers.build.law_from_cell`) takes the SHA-256 of the
 validated cell scene and of the files it names, so an edited cell scene is
-recomputed.
+recomputed.  Each entry ``<key>.npz`` also holds its own description: the
+cache format, the package version that wrote it, the key and the SHA-256 of
+the three arrays.  An entry that cannot be read, was written by another
+version or format, names another key, fails its checksum or holds arrays of
+the wrong shape or non-finite values is discarded with one warning and
+recomputed; a cache that cannot be written costs only the caching (one
+warning).  Entries are read without pickles.
 """
 from __future__ import annotations
 
+import hashlib
+import json
 import logging
 import os
 import tempfile
+import zipfile
+from importlib.metadata import PackageNotFoundError, version
 from typing import Any, Callable
 
 import numpy as np
@@ -37,7 +47,46 @@ from ngcontact.laws import homogenized as il
 
 log = logging.getLogger(__name__)
 
-CACHE_VERSION = "bundle-1"
+CACHE_VERSION = "bundle-2"
+ARRAYS = ("w", "n", "g")
+
+
+def _package_version() -> str:
+    try:
+        return version("ngcontact")
+    except PackageNotFoundError:  # a source tree that is not installed
+        return "unknown"
+
+
+def _digest(arrays: dict) -> str:
+    h = hashlib.sha256()
+    for k in ARRAYS:
+        a = np.ascontiguousarray(arrays[k], dtype=float)
+        h.update(k.encode() + str(a.shape).encode() + a.tobytes())
+    return h.hexdigest()
+
+
+def _read_entry(path: str, key: str) -> dict:
+    """The arrays of a cache entry; raises ``ValueError`` naming what is wrong with it."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {k: np.array(data[k], dtype=float) for k in ARRAYS}
+            meta = json.loads(str(data["meta"]))
+    except (OSError, KeyError, ValueError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+        raise ValueError(f"unreadable ({type(exc).__name__}: {exc})") from None
+    if not isinstance(meta, dict):
+        raise ValueError("no description")
+    for name, want in (("format", CACHE_VERSION), ("version", _package_version()), ("key", key)):
+        if meta.get(name) != want:
+            raise ValueError(f"{name} {meta.get(name)!r}, expected {want!r}")
+    w, n, g = arrays["w"], arrays["n"], arrays["g"]
+    if not (w.ndim == 1 and g.shape == w.shape and n.ndim == 2 and n.shape[0] == w.size and n.shape[1] in (2, 3)):
+        raise ValueError(f"arrays of shapes {w.shape}, {n.shape}, {g.shape}")
+    if not all(np.all(np.isfinite(a)) for a in (w, n, g)):
+        raise ValueError("non-finite values")
+    if meta.get("sha256") != _digest(arrays):
+        raise ValueError("checksum mismatch (the entry was changed after it was written)")
+    return arrays
 
 
 def cache_dir_default() -> str:
@@ -54,22 +103,30 @@ def cached_bundle_arrays(key: str, compute: Callable[[], dict], cache_dir: str |
     cache_dir = cache_dir or cache_dir_default()
     path = os.path.join(cache_dir, f"{key}.npz")
     if os.path.isfile(path):
-        with np.load(path) as data:
+        try:
+            found = _read_entry(path, key)
             log.info("cell bundle from cache %s", path)
-            return {k: np.array(data[k]) for k in ("w", "n", "g")}, True
+            return found, True
+        except ValueError as exc:
+            log.warning("ngcontact: discarding the cache entry %s (%s); recomputing it", path, exc)
     # Any values: np.savez's stub would otherwise match the arrays against
     # its keyword-only allow_pickle: bool
     arrays: dict[str, Any] = {k: np.asarray(v, float) for k, v in compute().items()}
-    os.makedirs(cache_dir, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".npz", dir=cache_dir)
-    os.close(fd)
+    meta = {"format": CACHE_VERSION, "version": _package_version(), "key": key, "sha256": _digest(arrays)}
+    tmp = None
     try:
-        np.savez(tmp, **arrays)
+        os.makedirs(cache_dir, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(suffix=".npz", dir=cache_dir)
+        os.close(fd)
+        np.savez(tmp, meta=np.array(json.dumps(meta)), **arrays)
         os.replace(tmp, path)
+        log.info("cell bundle computed and cached in %s", path)
+    except OSError as exc:
+        log.warning("ngcontact: the cell-law cache %s cannot be written (%s); the law is recomputed on every "
+                    "run (set NGCONTACT_CACHE to a writable directory)", cache_dir, exc.strerror or exc)
     finally:
-        if os.path.exists(tmp):
+        if tmp is not None and os.path.exists(tmp):
             os.remove(tmp)
-    log.info("cell bundle computed and cached in %s", path)
     return arrays, False
 
 

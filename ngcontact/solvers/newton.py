@@ -15,8 +15,18 @@ below its round-off floor ``ROUNDOFF eps || |K| |u| ||``: the size at which
 the residual, a sum of terms as large as ``|K_ij| |u_j|``, can no longer be
 evaluated.  Stiff terms (a Huber width of 1e-12, a penalty touching with zero
 force) put that floor above ``rtol`` times the first residual; without it
-Newton would wander in the round-off until ``max_iter``.
-A quadratic energy is minimized by a single linear solve.
+Newton would wander in the round-off until ``max_iter``.  The floor grows with
+``|u|``, so it counts only while the residual has not grown above the first
+one (``FLOOR_PROGRESS`` times it): a runaway iterate, whose residual grows
+with it, fails instead of passing as converged.  (Equilibrium checks of the
+results catch what a residual at its floor cannot show, e.g.
+:func:`ngcontact.cell.measures.equilibrium_error`.)
+
+A quadratic energy is minimized by a linear solve, refined with the same
+factorization while the residual is above the tolerance (at most
+``REFINE_STEPS`` times); a residual still above ``max(rtol |r_0|, atol)`` and
+above its round-off floor is a singular or ill-posed system (e.g. a
+rigid-body mode the supports leave free) and raises, never "converged".
 
 With ``line_search="exact"`` (for convex energies such as penalty contact)
 the step length minimizes the energy along the Newton direction instead:
@@ -49,6 +59,8 @@ log = logging.getLogger(__name__)
 ARMIJO = 1e-4
 MIN_STEP = 2.0 ** -30
 ROUNDOFF = 10.0
+FLOOR_PROGRESS = 1.0
+REFINE_STEPS = 2
 
 
 @dataclass
@@ -172,9 +184,11 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
     if rnorm <= atol or rnorm == 0.0:
         hist.converged = True
         return hist
-    for it in range(1, (1 if quadratic else max_iter) + 1):
+    if quadratic:
+        return _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rtol, atol, fixed)
+    for it in range(1, max_iter + 1):
         form.AssembleLinearization(gfu.vec)
-        if not quadratic and rnorm <= roundoff_floor(form.mat, gfu.vec, fixed):
+        if rnorm <= FLOOR_PROGRESS * r0 and rnorm <= roundoff_floor(form.mat, gfu.vec, fixed):
             log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             return hist
@@ -189,13 +203,13 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
                 "the tangent is singular or indefinite, e.g. a load the interface cannot carry",
                 hist.as_dict())
         alpha = 1.0
-        if line_search == "exact" and not quadratic:
+        if line_search == "exact":
             alpha = _exact_step(form, gfu.vec, du, slope, fixed, trial, res, max_step)
         while True:
             trial.data = gfu.vec - alpha * du
             e_new = form.Energy(trial)
             finite = math.isfinite(e_new)
-            accept = finite and (quadratic or e_new <= energy - ARMIJO * alpha * slope + 1e-14 * abs(energy))
+            accept = finite and e_new <= energy - ARMIJO * alpha * slope + 1e-14 * abs(energy)
             if accept:
                 r_new = residual(trial)        # a finite energy can still have a non-finite gradient
                 if math.isfinite(r_new):
@@ -225,13 +239,42 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         if rnorm <= max(rtol * r0, atol):
             hist.converged = True
             return hist
-    if quadratic:
-        hist.converged = True
-        return hist
     raise ConvergenceError(
         f"Newton did not converge in {max_iter} steps: residual {rnorm:.3e} "
         f"> {max(rtol * r0, atol):.3e} (rtol {rtol:g} x first residual {r0:.3e})",
         hist.as_dict())
+
+
+def _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rtol, atol, fixed) -> NewtonHistory:
+    """A quadratic energy: ``u <- u - K^{-1} r(u)``, refined with the same factorization, and checked.
+
+    ``res`` holds ``r(u)`` on entry.  Raises when the residual stays above
+    ``max(rtol r_0, atol)`` and above its round-off floor.
+    """
+    form.AssembleLinearization(gfu.vec)
+    inv = form.mat.Inverse(freedofs, inverse=inverse)
+    target = max(rtol * r0, atol)
+    rnorm = r0
+    for step in range(1 + REFINE_STEPS):
+        du.data = inv * res
+        gfu.vec.data -= du
+        rnorm = residual(gfu.vec)          # leaves r(u) in res for the next refinement
+        energy = form.Energy(gfu.vec)
+        hist.steps.append(1.0)
+        hist.residuals.append(rnorm)
+        hist.energies.append(energy)
+        if not (math.isfinite(rnorm) and math.isfinite(energy)):
+            raise ConvergenceError("the linear solve gave non-finite values: the system is singular "
+                                   "(e.g. a rigid-body mode that no support removes)", hist.as_dict())
+        if rnorm <= target:
+            break
+    if rnorm <= target or rnorm <= roundoff_floor(form.mat, gfu.vec, fixed) and rnorm <= FLOOR_PROGRESS * r0:
+        hist.converged = True
+        return hist
+    raise ConvergenceError(
+        f"the linear solve left the residual at {rnorm:.3e} > {target:.3e} (first residual {r0:.3e}) after "
+        f"{REFINE_STEPS} refinements: the system is singular or ill-posed, e.g. a rigid-body mode that no "
+        "support removes, or a stiffness far beyond the others", hist.as_dict())
 
 
 def _exact_step(form, u, du, slope0, fixed, trial, work, max_step) -> float:

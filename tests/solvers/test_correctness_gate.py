@@ -1,0 +1,104 @@
+"""A wrong answer is never reported as converged.
+
+Each case was reported with exit 0 and ``converged: true`` before the gate:
+Newton's quadratic path did not check its residual, and its round-off stop
+grew with ``|u|`` so that a runaway iterate passed it.  Each now ends with
+one line on stderr, a non-zero exit and no output.
+"""
+import os
+
+import pytest
+
+from ngcontact import cli
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+BLOCK = """\
+kind = "macro"
+title = "block on a base"
+[materials.steel]
+E = 210e9
+nu = 0.3
+[bodies]
+rough = "steel"
+counter = "steel"
+[geometry]
+shape = "block"
+setting = "plane_strain"
+[geometry.dimensions]
+length = 0.02
+h_block = 0.005
+h_base = 0.005
+[interface]
+{law}
+[[supports]]
+boundary = "bottom"
+{components}
+[[loads]]
+boundary = "top"
+pressure = {pressure}
+[discretization]
+order = 2
+maxh = 0.0025
+"""
+
+
+def run(tmp_path, capsys, text):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(text)
+    out = tmp_path / "out"
+    code = cli.main(["run", str(scene), "--out", str(out), "--quiet"])
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err
+    assert not out.exists(), "a failed run writes nothing"
+    return code, err
+
+
+def test_a_base_held_only_in_x_is_singular_not_converged(tmp_path, capsys):
+    """Was: residual rose from 1.07e5 to 2.21e5, 'converged', 15.26 MPa peak under 10 MPa applied."""
+    code, err = run(tmp_path, capsys, BLOCK.format(law='law = "linear"\nkn = 1e12\nkt = 1e11',
+                                                   components='components = ["x"]', pressure="10e6"))
+    assert code == 3
+    assert "the linear solve left the residual at" in err and "rigid-body mode that no support removes" in err
+
+
+@pytest.mark.parametrize("weights, pressure", [("1e12", "-10e6"), ("1e-300", "10e6")])
+def test_a_body_the_interface_cannot_hold_fails(tmp_path, capsys, weights, pressure):
+    """Was: pull-off with a normal-only law (jumps of 4.6e9 m) and k_n = 1e-300 (2.2e9 m), 'converged'."""
+    law = f'law = "bundle"\ndirections = [[1.0, 0.0]]\nweights = [{weights}]'
+    code, err = run(tmp_path, capsys, BLOCK.format(law=law, components="", pressure=pressure))
+    assert code == 3 and "solver failed" in err, err
+
+
+@pytest.mark.parametrize("k_n", ["1.0e16", "1.0e30"])
+def test_a_penalty_far_beyond_the_material_fails_instead_of_breaking_equilibrium(tmp_path, capsys, k_n):
+    """Was: a flat cell (E = 1, p = 0.01) with k_n = 1e16 reported a mean contact pressure of 0.0163
+    while transmitting 0.01 (63 % equilibrium error); with 1e30 a far-face jump of 1e-31."""
+    text = open(os.path.join(ROOT, "geometries", "cells", "flat_patch.toml")).read()
+    assert "k_n = 1.0e3" in text
+    code, err = run(tmp_path, capsys, text.replace("k_n = 1.0e3", f"k_n = {k_n}"))
+    assert code == 3 and "solver failed" in err, err
+
+
+def test_the_cell_equilibrium_check_holds_for_a_solution_and_catches_a_state_that_is_not_one():
+    """The interface force balances the far-face traction to round-off at a solution; a disturbed
+    state is refused by the measurement with the figures."""
+    import ngcontact
+    from ngcontact.cell import measures
+    from ngcontact.errors import ConvergenceError
+
+    report, outcome = ngcontact.solve(os.path.join(ROOT, "geometries", "cells", "flat_patch.toml"))
+    assert all(load["equilibrium_error"] < 1e-10 for load in report["results"]["loads"])
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.cell.cell_problem import CellProblem
+
+    scene = ngcontact.load(os.path.join(ROOT, "geometries", "cells", "flat_patch.toml"))
+    problem = CellProblem(build_cell(scene), model_of(scene))
+    load = cell_loads(scene)[0]
+    problem.solve(load, measure=False)
+    t = measures.mean_traction(problem, load)
+    assert measures.equilibrium_error(problem, t) < 1e-10
+    problem.gfu.vec.data *= 1.5          # 50 % more penetration: the interface now pushes harder
+    assert measures.equilibrium_error(problem, t) > 0.1
+    with pytest.raises(ConvergenceError, match="not in equilibrium"):
+        measures.measure(problem, load)
