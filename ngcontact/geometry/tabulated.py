@@ -25,8 +25,29 @@ from ngcontact.geometry.profiles import Profile, tabulated
 
 PERIODIC_TOL = 1e-9
 
+#: Largest data file read (a FIFO, a device or a huge file would hang or exhaust memory).
+MAX_DATA_BYTES = 64 * 2 ** 20
+#: Largest number of rows of a tabulated profile, whose every row becomes a segment of the mesh's
+#: geometry (a gap table is interpolated, not meshed, and may be longer).
+MAX_PROFILE_ROWS = 4096
 
-def read_profile_csv(file, *, path: str | None = None) -> Profile:
+
+def check_data_file(file, where: str, what: str = "file") -> None:
+    """A data file must be a regular file of at most :data:`MAX_DATA_BYTES` (checked before reading)."""
+    import os
+    import stat
+    try:
+        st = os.stat(file)
+    except OSError as err:
+        raise GeometryError(where, str(file), f"must be a readable {what} ({err.strerror})") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise GeometryError(where, str(file), "must be a regular file (not a directory, FIFO or device)")
+    if st.st_size > MAX_DATA_BYTES:
+        raise GeometryError(where, str(file), f"is {st.st_size} bytes; data files are limited to "
+                            f"{MAX_DATA_BYTES // 2 ** 20} MiB")
+
+
+def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MAX_PROFILE_ROWS) -> Profile:
     """Read and validate a periodic profile from a CSV file with columns ``x, y``.
 
     Parameters
@@ -35,6 +56,8 @@ def read_profile_csv(file, *, path: str | None = None) -> Profile:
         Path of the CSV file.
     path
         Name used in error messages (default: the file name).
+    max_rows
+        Largest number of data rows (``None``: no limit but the file size).
 
     Returns
     -------
@@ -42,13 +65,19 @@ def read_profile_csv(file, *, path: str | None = None) -> Profile:
     """
     file = Path(file)
     where = path or str(file)
+    check_data_file(file, where, "CSV file")
     try:
-        text = file.read_text()
+        text = file.read_text(encoding="utf-8")
     except OSError as err:
         raise GeometryError(where, str(file), f"must be a readable CSV file ({err.strerror})") from None
+    except UnicodeDecodeError:
+        raise GeometryError(where, str(file), "must be a text (UTF-8) CSV file with columns x, y") from None
     rows = [r for r in csv.reader(text.splitlines()) if r and any(c.strip() for c in r)]
     if rows and not _numeric(rows[0][0]):
         rows = rows[1:]                      # header
+    if max_rows is not None and len(rows) > max_rows:
+        raise GeometryError(where, str(file), f"has {len(rows)} rows; a tabulated profile takes at most "
+                            f"{max_rows} (each row is a segment of the mesh's geometry): resample it")
     xs, ys = [], []
     for i, row in enumerate(rows):
         if len(row) != 2:
@@ -71,10 +100,14 @@ def read_height_map(file, *, path: str | None = None) -> np.ndarray:
     """
     file = Path(file)
     where = path or str(file)
+    check_data_file(file, where, ".npy array")
     try:
         H = np.load(file, allow_pickle=False)
-    except (OSError, ValueError) as err:
-        raise GeometryError(where, str(file), f"must be a readable .npy array ({err})") from None
+    except (OSError, ValueError, EOFError) as err:
+        raise GeometryError(where, str(file), f"must be a readable .npy array ({err or type(err).__name__})") from None
+    if not isinstance(H, np.ndarray):  # an .npz archive
+        H.close()
+        raise GeometryError(where, str(file), "must be a single .npy array, not an .npz archive")
     return check_height_map(H, path=where)
 
 
@@ -122,7 +155,7 @@ def read_gap_csv(file, *, path: str | None = None) -> tuple[np.ndarray, np.ndarr
         NumPy arrays of the samples.
     """
     where = path or str(file)
-    prof = read_profile_csv(file, path=where)
+    prof = read_profile_csv(file, path=where, max_rows=None)
     pts = [p.start for p in prof.pieces] + [prof.pieces[-1].end]
     x = np.array([p[0] for p in pts], dtype=float)
     g = np.array([p[1] for p in pts], dtype=float)

@@ -471,3 +471,50 @@ def test_shear_on_a_frictionless_flat_interface(tmp_path, capsys, key):
     text = edit(CELL.format(contact=""), ("pressure = [0.01]", f"pressure = [0.01]\n{key} = [0.0, 0.001]"))
     run_bad(tmp_path, capsys, text, f"load.{key} = [0.0, 0.001]: a frictionless flat contact surface carries "
             "no shear and fixes no tangential jump: give 0 or set contact.friction")
+
+
+# ------------------------------------------------------------- hostile data files
+def test_a_fifo_as_profile_file_is_refused_without_reading_it(tmp_path, capsys):
+    """Was: a FIFO as profile or height map hung 'run' and 'check' alike."""
+    work = tmp_path / "work"
+    work.mkdir()
+    os.mkfifo(work / "p.csv")
+    run_bad(tmp_path, capsys, TAB, f"geometry.file (p.csv) = '{work / 'p.csv'}': must be a regular file "
+            "(not a directory, FIFO or device)")
+
+
+@pytest.mark.parametrize("device", ["/dev/zero", "/dev/urandom"])
+def test_a_device_as_height_map_is_refused_without_reading_it(tmp_path, capsys, device):
+    """Was: /dev/zero or /dev/urandom as a data file was read until memory ran out."""
+    run_bad(tmp_path, capsys, HMAP.replace('file = "h.npy"', f'file = "{device}"'),
+            f"geometry.file ({device}) = '{device}': must be a regular file (not a directory, FIFO or device)")
+
+
+def test_a_profile_of_a_hundred_thousand_rows_is_refused_before_meshing(tmp_path, capsys):
+    """Was: a 1e5-row CSV profile hung the mesher."""
+    rows = "".join(f"{i / 100000!r},0.0\n" for i in range(100001))
+    run_bad(tmp_path, capsys, TAB, "geometry.file (p.csv) = '{}': has 100001 rows; a tabulated profile takes at "
+            "most 4096 (each row is a segment of the mesh's geometry): resample it".format(tmp_path / "work" / "p.csv"),
+            files={"p.csv": "x,y\n" + rows})
+
+
+def test_a_utf16_profile_is_bad_input_not_a_solver_failure(tmp_path, capsys):
+    """Was: exit 3 for a UTF-16 (or binary) CSV."""
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "p.csv").write_bytes("x,y\n0,0\n0.5,-0.1\n1,0\n".encode("utf-16"))
+    run_bad(tmp_path, capsys, TAB, f"geometry.file (p.csv) = '{work / 'p.csv'}': must be a text (UTF-8) CSV "
+            "file with columns x, y")
+
+
+def test_an_empty_npy_and_an_npz_archive_are_bad_input(tmp_path, capsys):
+    """Was: exit 3 for an empty .npy."""
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "h.npy").write_bytes(b"")
+    run_bad(tmp_path, capsys, HMAP, f"geometry.file (h.npy) = '{work / 'h.npy'}': must be a readable .npy array "
+            "(No data left in file)")
+    np.savez(work / "a.npz", h=np.zeros((3, 3)))
+    os.replace(work / "a.npz", work / "h.npy")
+    run_bad(tmp_path, capsys, HMAP, f"geometry.file (h.npy) = '{work / 'h.npy'}': must be a single .npy array, "
+            "not an .npz archive")
