@@ -266,6 +266,7 @@ class CellScene:
             return
         if self.load is None:
             raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
+        check_penalty_ratio(self)
         load_states(self)
         flat = self.geometry.profile in ("flat", "flat3d") or small_slope(self.geometry)
         if flat and self.contact.friction == "none":
@@ -274,6 +275,24 @@ class CellScene:
                 if v is not None and any(x != 0.0 for x in v):
                     raise SceneError(f"load.{key}", v, "a frictionless flat contact surface carries no "
                                      "shear and fixes no tangential jump: give 0 or set contact.friction")
+
+
+#: Largest admissible ``k_n h / E``: beyond it the tangent of the penalty term outweighs the bodies'
+#: by more than double precision can resolve, and the residual cannot be evaluated (k_n = 1e16 on a
+#: cell with E = 1 reported a pressure 63 % off equilibrium as converged).
+MAX_PENALTY_RATIO = 1e10
+
+
+def check_penalty_ratio(scene: CellScene) -> None:
+    """``k_n h / E`` of the cell, ``h`` its interface mesh size and ``E`` the softer body's modulus."""
+    d, c = scene.discretization, scene.contact
+    h = d.interface_maxh or d.maxh
+    E = min(scene.materials[name].E or 0.0 for name in (scene.bodies.rough, scene.bodies.counter))
+    ratio = c.k_n * h / E if E > 0 else 0.0
+    if ratio > MAX_PENALTY_RATIO:
+        raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
+                         f"E = {E:g} the softer body's modulus) must stay below {MAX_PENALTY_RATIO:g}: the "
+                         "penalty would outweigh the bodies beyond what double precision resolves; lower k_n")
 
 
 def small_slope(geometry: CellGeometry) -> bool:

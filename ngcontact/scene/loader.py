@@ -53,6 +53,10 @@ def load(path: str | os.PathLike):
             data = tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError("<scene file>", path, f"not valid TOML ({exc})") from None
+    except RecursionError:
+        raise SceneError("<scene file>", path, "nests arrays or tables too deeply to be a scene") from None
+    except UnicodeDecodeError:
+        raise SceneError("<scene file>", path, "must be UTF-8 text (TOML)") from None
     _LOADING.append(real)
     try:
         return from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
@@ -63,7 +67,7 @@ def load(path: str | os.PathLike):
 def from_dict(data: dict, base_dir: str = "."):
     """Validate an already parsed scene table."""
     kind = data.get("kind")
-    if kind not in KINDS:
+    if not isinstance(kind, str) or kind not in KINDS:
         raise SceneError("kind", kind if kind is not None else MISSING,
                          "must be one of " + ", ".join(repr(k) for k in sorted(KINDS)))
     scene = build(KINDS[kind].scene, data)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.scene.sections import (MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names)
-from ngcontact.scene.schema import all_of, at_least, nonempty, param, positive
+from ngcontact.scene.schema import MAX_LEVELS, MAX_ORDER, all_of, closed_interval, nonempty, param, positive
 
 SETTINGS = ("plane_strain", "axisymmetric", "3d", "periodic_cell")
 
@@ -35,10 +35,11 @@ class ManufacturedSection:
     body: str = param(doc="material of the body (periodic_cell: of the lower body)")
     second_body: str | None = param(None, doc="material of the upper body (periodic_cell only)")
     orders: tuple[int, ...] = param((1, 2, 3), doc="polynomial orders to run",
-                                    check=all_of(nonempty(), at_least(1)))
+                                    check=all_of(nonempty(), closed_interval(1, MAX_ORDER)))
     maxh: float = param(0.25, doc="mesh size given to the mesher; level k is that mesh refined "
                         "uniformly k times, h = maxh / 2^k", units="m", check=positive())
-    levels: int = param(3, doc="number of levels k = 1..levels in the rate fit", check=at_least(3))
+    levels: int = param(3, doc="number of levels k = 1..levels in the rate fit",
+                        check=closed_interval(3, MAX_LEVELS))
     rate_tolerance: float = param(0.25, doc="largest admissible |observed - expected| rate for "
                                   "results.verified", check=positive())
 

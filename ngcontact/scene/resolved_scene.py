@@ -38,7 +38,7 @@ from ngcontact.errors import MISSING, SceneError
 from ngcontact.geometry.femur import FemurStemDims
 from ngcontact.scene.macro_scene import check_dimensions
 from ngcontact.scene.sections import MaterialSpec, SolverSpec, base_dir_field, check_material_names
-from ngcontact.scene.schema import at_least, nonempty, param, positive
+from ngcontact.scene.schema import MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty, param, positive
 
 SHAPES = ("blocks", "femur_stem")
 BOUNDARIES = {"blocks": ("bottom", "top", "rough_sides", "counter_sides"),
@@ -53,7 +53,8 @@ class DirectGeometry:
     """The bodies and the resolved roughness."""
 
     cell: str = param(doc="cell scene (relative to this scene) whose profile and contact law are resolved")
-    periods: int = param(doc="number N of periods resolved along the interface", check=at_least(1))
+    periods: int = param(doc="number N of periods resolved along the interface",
+                         check=closed_interval(1, MAX_PERIODS))
     shape: str = param("blocks", doc="two blocks, or the axisymmetric femur with a hip stem", choices=SHAPES)
     setting: str = param("plane_strain", doc="plane strain (x, y) or axisymmetric (r, z; per revolution)",
                          choices=tuple(COMPONENTS))
@@ -124,7 +125,7 @@ class DirectLoad:
 class DirectMesh:
     """Mesh graded towards the resolved interface."""
 
-    order: int = param(2, doc="polynomial order of the displacement", check=at_least(1))
+    order: int = param(2, doc="polynomial order of the displacement", check=closed_interval(1, MAX_ORDER))
     maxh: float = param(doc="mesh size in the far field", units="m", check=positive())
     elements_per_period: float = param(8.0, doc="interface mesh size is eps / elements_per_period",
                                        check=positive())
@@ -137,7 +138,7 @@ class StudySpec:
     """Epsilon study: resolved runs against the homogenized laws."""
 
     periods: tuple[int, ...] = param((4, 8, 16), doc="N of each level (at least 3 for a rate)",
-                                     check=at_least(1))
+                                     check=closed_interval(1, MAX_PERIODS))
     band: float = param(3.0, doc="half-width of the band around the interface excluded from the field "
                         "error (and from the probes), in periods eps", check=positive())
     interface_maxh: float = param(doc="mesh size along the flat interface of the homogenized runs",

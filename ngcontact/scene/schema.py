@@ -60,6 +60,14 @@ def param(default=dataclasses.MISSING, *, doc: str, units: str = "",
 
 
 # ----------------------------------------------------------------- checks
+#: Largest polynomial order: beyond it a single element has thousands of dofs and the
+#: quadrature tables of the compiled library run out (order 100 ended in std::bad_alloc).
+MAX_ORDER = 10
+#: Largest number of resolved periods and of uniform refinement levels (more hung the mesher).
+MAX_PERIODS = 1024
+MAX_LEVELS = 8
+
+
 def _named(text: str, fn: Callable[[Any], bool]) -> Check:
     def check(value):
         return None if fn(value) else text

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.fem import materials as _materials
-from ngcontact.scene.schema import at_least, open_interval, param, positive
+from ngcontact.scene.schema import MAX_ORDER, at_least, closed_interval, open_interval, param, positive
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -49,7 +49,7 @@ class MaterialSpec:
 class Discretization:
     """Finite element discretization."""
 
-    order: int = param(2, doc="polynomial order of the displacement", check=at_least(1))
+    order: int = param(2, doc="polynomial order of the displacement", check=closed_interval(1, MAX_ORDER))
     maxh: float = param(0.1, doc="global mesh size", units="m", check=positive())
     interface_maxh: float | None = param(None, doc="mesh size on the interface (default: maxh)",
                                          units="m", check=positive())

@@ -399,7 +399,7 @@ def test_unwritable_output_directory(tmp_path, capsys):
 # --------------------------------------------------- numerics settings
 def test_polynomial_order_below_one(tmp_path, capsys):
     run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("order = 1", "order = 0")),
-            "discretization.order = 0: must be >= 1")
+            "discretization.order = 0: must lie in [1, 10]")
 
 
 def test_boolean_is_not_an_order(tmp_path, capsys):
@@ -518,3 +518,46 @@ def test_an_empty_npy_and_an_npz_archive_are_bad_input(tmp_path, capsys):
     os.replace(work / "a.npz", work / "h.npy")
     run_bad(tmp_path, capsys, HMAP, f"geometry.file (h.npy) = '{work / 'h.npy'}': must be a single .npy array, "
             "not an .npz archive")
+
+
+# ------------------------------------------------------------- values beyond what can run
+def test_kind_that_is_not_a_string(tmp_path, capsys):
+    """Was: exit 3 with 'unhashable type: list'."""
+    run_bad(tmp_path, capsys, CELL.format(contact="").replace('kind = "cell"', 'kind = ["cell"]'),
+            "kind = ['cell']: must be one of 'cell', 'direct', 'macro', 'manufactured'")
+
+
+def test_a_scene_nested_too_deeply(tmp_path, capsys):
+    """Was: RecursionError (exit 3)."""
+    scene = tmp_path / "work" / "scene.toml"
+    run_bad(tmp_path, capsys, 'kind = "cell"\nx = ' + "[" * 2000 + "]" * 2000 + "\n",
+            f"<scene file> = '{scene}': nests arrays or tables too deeply to be a scene")
+
+
+def test_a_utf16_scene(tmp_path, capsys):
+    """Was: exit 3 for a UTF-16 scene file."""
+    work = tmp_path / "work"
+    work.mkdir()
+    scene = work / "scene.toml"
+    scene.write_bytes(CELL.format(contact="").encode("utf-16"))
+    out = tmp_path / "out"
+    for argv in (["check", str(scene)], ["run", str(scene), "--out", str(out), "--quiet"]):
+        assert cli.main(argv) == 2
+        assert capsys.readouterr().err == (f"ngcontact: error: {scene}: <scene file> = '{scene}': "
+                                           "must be UTF-8 text (TOML)\n")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("order", ["100", "2147483648"])
+def test_an_order_beyond_what_can_be_assembled(tmp_path, capsys, order):
+    """Was: std::bad_alloc (order 100) and four pybind11 lines (order 2147483648), exit 3."""
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("order = 1", f"order = {order}")),
+            f"discretization.order = {order}: must lie in [1, 10]")
+
+
+def test_a_penalty_that_double_precision_cannot_resolve(tmp_path, capsys):
+    """Was: numpy overflow warnings, then a solver failure (k_n = 1e308)."""
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("k_n = 1.0e3", "k_n = 1e308")),
+            "contact.k_n = 1e+308: k_n h / E = 5e+307 (h = 0.5 the interface mesh size, E = 1 the softer "
+            "body's modulus) must stay below 1e+10: the penalty would outweigh the bodies beyond what double "
+            "precision resolves; lower k_n")
