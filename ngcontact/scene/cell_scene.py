@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from ngcontact.errors import MISSING, GeometryError, SceneError
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names)
+from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import check_selected, nonempty, nonnegative, open_interval, param, positive
 
 PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
@@ -260,6 +261,7 @@ class CellScene:
         g = self.contact.gap.kind
         if g == "sinusoid" and dim != 2 or g == "bisinusoid" and dim != 3:
             raise SceneError("contact.gap.kind", g, f"not available for a {dim}D cell")
+        self.check_size()
         if self.contact.geometric_only:
             if self.load is not None:
                 raise SceneError("load", "...", "not used with contact.geometric_only = true; remove it")
@@ -275,6 +277,24 @@ class CellScene:
                 if v is not None and any(x != 0.0 for x in v):
                     raise SceneError(f"load.{key}", v, "a frictionless flat contact surface carries no "
                                      "shear and fixes no tangential jump: give 0 or set contact.friction")
+
+    def check_size(self) -> None:
+        """The element estimate of :mod:`ngcontact.scene.mesh_size` against ``max_elements``."""
+        g, d = self.geometry, self.discretization
+        P, dim = g.period, g.dim
+        width = min(P, g.h_rough, g.h_counter)
+        n = mesh_size.estimate(dim, P ** (dim - 1) * (g.h_rough + g.h_counter), d.maxh, width=width,
+                               interface=P ** (dim - 1), h_interface=d.interface_maxh)
+        tall = max(g.h_rough, g.h_counter) / P
+        hint = (f" (the bodies are {tall:.3g} periods high; the cell's boundary layer decays within a few "
+                "periods, so h_rough and h_counter of 0.5 to 5 periods suffice)") if tall > 20 else ""
+        if hint:
+            key, value = "geometry.period", P
+        elif d.interface_maxh is not None and d.interface_maxh < d.maxh:
+            key, value = "discretization.interface_maxh", d.interface_maxh
+        else:
+            key, value = "discretization.maxh", d.maxh
+        mesh_size.refuse_beyond(n, d.max_elements, key, value, hint=hint)
 
 
 #: Largest admissible ``k_n h / E``: beyond it the tangent of the penalty term outweighs the bodies'

@@ -34,6 +34,7 @@ from ngcontact.laws import homogenized as il
 from ngcontact.geometry.femur import FemurStemDims
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field, check_material_names,
                      )
+from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import at_least, nonempty, nonnegative, param, positive
 
 SHAPES = ("femur_stem", "coaxial", "block")
@@ -242,6 +243,24 @@ class TwoScaleSpec:
                              "(below it the coefficients are held constant)", check=positive())
 
 
+def macro_extent(shape: str, setting: str, dims: dict) -> tuple[int, float, float, float]:
+    """``(dim, area or volume, interface length or area, smallest width)`` of a macro geometry."""
+    import math
+    if shape == "femur_stem":
+        d = FemurStemDims(**dims)
+        return 2, d.r_bone * d.z_stem_top, d.z_bone_top - d.z_tip, d.r_bone - d.r_stem
+    if shape == "block":
+        return 2, dims["length"] * (dims["h_block"] + dims["h_base"]), dims["length"], \
+            min(dims["h_block"], dims["h_base"])
+    a, b, c = dims["a"], dims["b"], dims["c"]
+    width = min(b - a, c - b)
+    if setting == "plane_strain":
+        return 2, math.pi / 4 * (c * c - a * a), math.pi / 2 * b, width
+    if setting == "axisymmetric":
+        return 2, (c - a) * dims["height"], dims["height"], width
+    return 3, math.pi / 4 * (c * c - a * a) * dims["height"], math.pi / 2 * b * dims["height"], width
+
+
 @dataclass(frozen=True, kw_only=True)
 class MacroScene:
     kind: str = param(doc="problem type", choices=("macro",))
@@ -259,9 +278,19 @@ class MacroScene:
     strength: StrengthSpec | None = param(None, doc="[strength]: micro stresses and the check of eq. 78")
     base_dir: str = base_dir_field()
 
+    def check_size(self) -> None:
+        """The element estimate of :mod:`ngcontact.scene.mesh_size` against ``max_elements``."""
+        g, d = self.geometry, self.discretization
+        dim, volume, interface, width = macro_extent(g.shape, g.setting, dict(g.dimensions or {}))
+        n = mesh_size.estimate(dim, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
+        if d.interface_maxh is not None and d.interface_maxh < d.maxh:
+            mesh_size.refuse_beyond(n, d.max_elements, "discretization.interface_maxh", d.interface_maxh)
+        mesh_size.refuse_beyond(n, d.max_elements, "discretization.maxh", d.maxh)
+
     def check(self, path: str) -> None:
         check_material_names(self.materials, {"rough": self.bodies.rough, "counter": self.bodies.counter},
                              "bodies")
+        self.check_size()
         comps = COMPONENTS[self.geometry.setting]
         shape, setting = self.geometry.shape, self.geometry.setting
         labels = BOUNDARIES[shape, setting]

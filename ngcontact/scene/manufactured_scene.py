@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.scene.sections import (MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names)
+from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import MAX_LEVELS, MAX_ORDER, all_of, closed_interval, nonempty, param, positive
 
 SETTINGS = ("plane_strain", "axisymmetric", "3d", "periodic_cell")
@@ -40,6 +41,8 @@ class ManufacturedSection:
                         "uniformly k times, h = maxh / 2^k", units="m", check=positive())
     levels: int = param(3, doc="number of levels k = 1..levels in the rate fit",
                         check=closed_interval(3, MAX_LEVELS))
+    max_elements: int = param(mesh_size.MAX_ELEMENTS, doc="refuse a study whose finest mesh is estimated to "
+                              "have more elements", check=closed_interval(1, 10 ** 9))
     rate_tolerance: float = param(0.25, doc="largest admissible |observed - expected| rate for "
                                   "results.verified", check=positive())
 
@@ -66,6 +69,10 @@ class ManufacturedScene:
             raise SceneError("manufactured.second_body", m.second_body,
                              f"not used by setting = {m.setting!r}; remove it")
         check_material_names(self.materials, names, "manufactured")
+        dim = 3 if m.setting == "3d" else 2
+        finest = mesh_size.estimate(dim, 1.0, m.maxh) * (2 ** dim) ** m.levels   # unit domains, refined
+        mesh_size.refuse_beyond(finest, m.max_elements, "manufactured.levels", m.levels, path="manufactured",
+                                hint=" (each level multiplies the elements by 2^dim)")
 
 
 def effects(scene: ManufacturedScene) -> tuple[str, ...]:

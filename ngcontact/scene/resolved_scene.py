@@ -38,6 +38,7 @@ from ngcontact.errors import MISSING, SceneError
 from ngcontact.geometry.femur import FemurStemDims
 from ngcontact.scene.macro_scene import check_dimensions
 from ngcontact.scene.sections import MaterialSpec, SolverSpec, base_dir_field, check_material_names
+from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty, param, positive
 
 SHAPES = ("blocks", "femur_stem")
@@ -131,6 +132,8 @@ class DirectMesh:
                                        check=positive())
     grading: float = param(0.3, doc="Netgen grading factor (growth of the elements away from the interface)",
                            check=positive())
+    max_elements: int = param(mesh_size.MAX_ELEMENTS, doc="refuse a scene whose finest mesh is estimated to "
+                              "have more elements (a guard against sizes that hang the mesher)", check=at_least(1))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -188,6 +191,7 @@ class DirectScene:
                 v = getattr(s, key)
                 if v and len(v) != n:
                     raise SceneError(f"supports[{i}].{key}", v, f"one value per component ({n})")
+        self.check_size()
         st = self.study
         if st is not None:
             if len(st.periods) < 3 or any(b <= a for a, b in zip(st.periods, st.periods[1:])):
@@ -206,6 +210,24 @@ class DirectScene:
             if st.band * g.length / st.periods[0] >= min(g.h_rough, g.h_counter):
                 raise SceneError("study.band", st.band, "the band of the coarsest level must stay inside "
                                  "both blocks")
+
+    def check_size(self) -> None:
+        """The element estimate of :mod:`ngcontact.scene.mesh_size` at the finest level, against ``max_elements``."""
+        g, d = self.geometry, self.discretization
+        N = max((g.periods,) + (tuple(self.study.periods) if self.study else ()))
+        if g.shape == "femur_stem":
+            f = g.femur_dims()
+            area, length, width = f.r_bone * f.z_stem_top, f.z_bone_top - f.z_tip, f.r_bone - f.r_stem
+            length += float(np.hypot(f.r_stem - f.r_tip, f.z_corner - f.z_tip)) - (f.z_corner - f.z_tip)
+        else:
+            assert g.length is not None and g.h_rough is not None and g.h_counter is not None  # required (check)
+            area, length, width = g.length * (g.h_rough + g.h_counter), g.length, min(g.h_rough, g.h_counter)
+        n = mesh_size.estimate(2, area, d.maxh, width=width, interface=length,
+                               h_interface=length / N / d.elements_per_period)
+        key, value = ("study.periods", N) if self.study and N > g.periods else ("geometry.periods", g.periods)
+        mesh_size.refuse_beyond(n, d.max_elements, key, value,
+                                hint=" (fewer periods, or fewer discretization.elements_per_period)")
+        mesh_size.refuse_beyond(n, d.max_elements, "discretization.maxh", d.maxh)
 
     def _check_femur_study(self) -> None:
         """Probes inside a body and outside the band of the coarsest level; the band leaves points."""

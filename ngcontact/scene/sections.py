@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.fem import materials as _materials
+from ngcontact.scene.mesh_size import MAX_ELEMENTS
 from ngcontact.scene.schema import MAX_ORDER, at_least, closed_interval, open_interval, param, positive
 
 
@@ -53,6 +54,8 @@ class Discretization:
     maxh: float = param(0.1, doc="global mesh size", units="m", check=positive())
     interface_maxh: float | None = param(None, doc="mesh size on the interface (default: maxh)",
                                          units="m", check=positive())
+    max_elements: int = param(MAX_ELEMENTS, doc="refuse a scene whose mesh is estimated to have more elements "
+                              "(a guard against sizes that hang the mesher)", check=at_least(1))
 
 
 @dataclass(frozen=True, kw_only=True)

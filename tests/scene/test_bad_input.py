@@ -561,3 +561,48 @@ def test_a_penalty_that_double_precision_cannot_resolve(tmp_path, capsys):
             "contact.k_n = 1e+308: k_n h / E = 5e+307 (h = 0.5 the interface mesh size, E = 1 the softer "
             "body's modulus) must stay below 1e+10: the penalty would outweigh the bodies beyond what double "
             "precision resolves; lower k_n")
+
+
+# ------------------------------------------------------------- sizes that would hang the mesher
+def test_a_period_of_a_tenth_of_a_millimetre_in_a_cell_of_default_height(tmp_path, capsys):
+    """Was: the likeliest real case (0.1 mm grooves, heights left at 1) hung the mesher."""
+    text = edit(CELL.format(contact=""), ('profile = "flat"', 'profile = "flat"\nperiod = 1e-4'))
+    run_bad(tmp_path, capsys, text, "geometry.period = 0.0001: the mesh would have about 4.1e+05 elements, more "
+            "than discretization.max_elements = 300000; coarsen it (the bodies are 1e+04 periods high; the cell's "
+            "boundary layer decays within a few periods, so h_rough and h_counter of 0.5 to 5 periods suffice), "
+            "or raise discretization.max_elements if the machine can take it")
+
+
+def test_a_tiny_mesh_size(tmp_path, capsys):
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("maxh = 0.5", "maxh = 0.001")),
+            "discretization.maxh = 0.001: the mesh would have about 4.6e+06 elements, more than "
+            "discretization.max_elements = 300000; coarsen it, or raise discretization.max_elements if the "
+            "machine can take it")
+
+
+def test_twenty_verification_levels(tmp_path, capsys):
+    """Was: 20 levels of uniform refinement hung (now at most 8, and the finest mesh is estimated)."""
+    text = open(os.path.join(ROOT, "geometries", "verify_3d.toml")).read()
+    run_bad(tmp_path, capsys, edit(text, ("levels = 3", "levels = 20")),
+            "manufactured.levels = 20: must lie in [3, 8]")
+    run_bad(tmp_path, capsys, edit(text, ("levels = 3", "levels = 6")),
+            "manufactured.levels = 6: the mesh would have about", prefix=True)
+
+
+def test_the_element_estimate_follows_the_shipped_meshes():
+    """The guard's estimate stays within a factor of three of the real element count of every shipped cell."""
+    import glob
+
+    import ngcontact
+    from ngcontact.drivers.build import build_cell
+    from ngcontact.scene import mesh_size
+
+    for path in sorted(glob.glob(os.path.join(CELLS, "*.toml"))):
+        sc = ngcontact.load(path)
+        g, d = sc.geometry, sc.discretization
+        P = g.period
+        n = mesh_size.estimate(g.dim, P ** (g.dim - 1) * (g.h_rough + g.h_counter), d.maxh,
+                               width=min(P, g.h_rough, g.h_counter), interface=P ** (g.dim - 1),
+                               h_interface=d.interface_maxh)
+        actual = build_cell(sc).mesh.ne
+        assert actual / 3 <= n <= 3 * actual, (os.path.basename(path), n, actual)

@@ -31,7 +31,7 @@ def test_valid_scene_round_trips():
     (lambda d: d["materials"]["steel"].update(E=True), "materials.steel.E = True: must be a number"),
     (lambda d: d.update(kind="celll"), "kind = 'celll': must be one of"),
     (lambda d: d["manufactured"].update(ordres=[1]),
-     "manufactured.ordres = [1]: unknown key; allowed keys here are body, levels, maxh, orders, rate_tolerance, second_body, setting"),
+     "manufactured.ordres = [1]: unknown key; allowed keys here are body, levels, max_elements, maxh, orders, rate_tolerance, second_body, setting"),
     (lambda d: d["manufactured"].update(orders=[0, 1]), "manufactured.orders = [0, 1]: must lie in [1, 10]"),
     (lambda d: d["manufactured"].update(body="bone"),
      "manufactured.body = 'bone': must name a material defined under [materials]: steel"),
