@@ -170,8 +170,10 @@ def _study(path: str, periods, out: str | None, quiet: bool) -> int:
     def compute(sc, progress):
         return study_epsilon(sc, periods, progress)
 
-    if periods is not None and any(n < 1 for n in periods):
-        return _fail(EXIT_SCENE, f"--periods {periods}: every N must be >= 1")
+    if periods is not None and (len(periods) < 3 or any(n < 1 for n in periods)
+                                or any(b <= a for a, b in zip(periods, periods[1:]))):
+        return _fail(EXIT_SCENE, f"--periods {' '.join(map(str, periods))}: at least 3 increasing numbers "
+                                 "N >= 1 (a rate needs three distinct levels)")
     return _execute(path, out, quiet, compute, suffix="_epsilon", validate=require_study)
 
 
@@ -215,6 +217,12 @@ def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, v
         return _fail(EXIT_SOLVER, f"{path}: solver failed: {exc}")
     except (NgcontactError, ValueError) as exc:
         return _fail(EXIT_SOLVER, f"{path}: {exc}")
+    except Exception as exc:
+        if type(exc).__name__ == "NgException" and "meshing" in str(exc).lower():
+            return _fail(EXIT_SCENE, f"{path}: the mesher failed on this geometry ({exc}); a feature is "
+                                     "too small or too thin for discretization.maxh / interface_maxh: "
+                                     "change the geometry's sizes or the mesh sizes")
+        raise
     if not quiet:
         print(f"wrote {os.path.join(out, 'report.json')}", file=sys.stderr, flush=True)
     return EXIT_OK

@@ -153,6 +153,11 @@ class Profile:
         return hi - lo
 
     @property
+    def smallest_feature(self) -> float:
+        """The shortest chord of its pieces: the smallest length the mesher must resolve."""
+        return min(math.dist(p.start, p.end) for p in self.pieces)
+
+    @property
     def bounds(self) -> tuple:
         """``(y_min, y_max)`` of the chain (arcs included exactly)."""
         ys = []

@@ -82,11 +82,13 @@ class CellGeometry:
                                  "(the hill base must lie inside the rough body)")
         if self.dim == 2 and self.profile != "tabulated":  # tabulated: checked when its file is read
             try:
-                bounds = profile_2d(self).bounds
+                profile = profile_2d(self)
             except GeometryError as exc:  # the builders name their own arguments (width, angle_left, ...)
                 key = _BUILDER_KEYS.get(exc.name, exc.name)
                 raise SceneError(f"{path}.{key}", exc.value, exc.allowed) from None
-            check_profile_heights(self, bounds, path)
+            check_profile_heights(self, profile.bounds, path)
+            check_features(profile, f"{path}.{PROFILE_KEYS.get(self.profile, 'period')}",
+                           getattr(self, PROFILE_KEYS.get(self.profile, "period")))
 
 
 _BUILDER_KEYS = {"angle_left": "angles", "angle_right": "angles"}
@@ -111,6 +113,21 @@ def profile_2d(g: CellGeometry):
         assert g.amplitude is not None
         return pr.sinusoid(g.amplitude, g.period)
     raise ValueError(f"profile {g.profile!r} is not a parametric 2D profile")
+
+
+#: The parameter of each parametric 2D profile that sets its smallest feature.
+PROFILE_KEYS = {"rectangular": "width", "triangular": "width", "semicircular": "radius", "sinusoid": "amplitude"}
+#: Smallest feature of a profile, relative to its period, that the mesher resolves (a semicircle of
+#: radius 0.4999999 leaves plateaus of 2e-7 and one of radius 1e-9 an arc of 1e-9: 'meshing failed').
+MIN_FEATURE = 1e-4
+
+
+def check_features(profile, key: str, value) -> None:
+    """Every piece of the profile must be at least :data:`MIN_FEATURE` periods long."""
+    small = profile.smallest_feature
+    if not small >= MIN_FEATURE * profile.period:
+        raise SceneError(key, value, f"leaves a piece of the profile {small:.3g} long, below {MIN_FEATURE:g} of "
+                         f"the period {profile.period:g}, which the mesher cannot resolve")
 
 
 def check_profile_heights(g: CellGeometry, bounds: tuple, path: str = "geometry") -> None:
@@ -238,6 +255,8 @@ class CellScene:
                 if hi - lo >= min(g.h_rough, g.h_counter):
                     raise SceneError("geometry.file", g.file, f"the profile height {hi - lo!r} must stay "
                                      "below h_rough and h_counter")
+                check_profile_heights(g, (lo, hi))     # what the mesher checks, as 'run' meets it
+                check_features(prof, "geometry.file", g.file)
             else:
                 tabulated.read_height_map(resolve(self, g.file), path=where)
         gs = self.contact.gap

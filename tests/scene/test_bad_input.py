@@ -606,3 +606,30 @@ def test_the_element_estimate_follows_the_shipped_meshes():
                                h_interface=d.interface_maxh)
         actual = build_cell(sc).mesh.ne
         assert actual / 3 <= n <= 3 * actual, (os.path.basename(path), n, actual)
+
+
+def test_a_semicircle_that_leaves_no_plateau_or_no_arc(tmp_path, capsys):
+    """Was: 'NgException: meshing failed' (exit 3) for radius 0.4999999 or 1e-9."""
+    text = open(os.path.join(CELLS, "ex27_semicircular.toml")).read()
+    run_bad(tmp_path, capsys, edit(text, ("radius = 0.3", "radius = 0.4999999")),
+            "geometry.radius = 0.4999999: leaves a piece of the profile 1e-07 long, below 0.0001 of the period 1, "
+            "which the mesher cannot resolve")
+    run_bad(tmp_path, capsys, edit(text, ("radius = 0.3", "radius = 1e-9")),
+            "geometry.radius = 1e-09: leaves a piece of the profile 1.41e-09 long, below 0.0001 of the period 1, "
+            "which the mesher cannot resolve")
+
+
+def test_a_tabulated_profile_above_the_counter_body_is_refused_by_check_too(tmp_path, capsys):
+    """Was: 'check' accepted a tabulated profile above h_counter that 'run' then refused."""
+    run_bad(tmp_path, capsys, TAB, "geometry.h_counter = 1.0: must exceed the profile height 1.2",
+            files={"p.csv": "x,y\n0,1.0\n0.5,1.2\n1.0,1.0\n"})
+
+
+@pytest.mark.parametrize("periods", [["3", "3", "3"], ["8", "4", "16"], ["4", "8"]])
+def test_epsilon_study_levels_that_give_no_rate(tmp_path, capsys, periods):
+    """Was: --periods 3 3 3 ran and reported meaningless rates."""
+    scene = os.path.join(ROOT, "geometries", "direct", "block_rect_valleys.toml")
+    assert cli.main(["study", "epsilon", scene, "--periods", *periods, "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    assert capsys.readouterr().err == (f"ngcontact: error: --periods {' '.join(periods)}: at least 3 increasing "
+                                       "numbers N >= 1 (a rate needs three distinct levels)\n")
+    assert not (tmp_path / "o").exists()
