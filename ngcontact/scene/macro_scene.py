@@ -32,10 +32,10 @@ from ngcontact.errors import MISSING, SceneError
 from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.laws import homogenized as il
 from ngcontact.geometry.femur import FemurStemDims
-from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field, check_material_names,
-                     )
+from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
+                                      check_material_names, check_supports_once)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import at_least, nonempty, nonnegative, param, positive
+from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
 
 SHAPES = ("femur_stem", "coaxial", "block")
 SETTINGS = {"femur_stem": ("axisymmetric",), "coaxial": ("plane_strain", "axisymmetric", "3d"),
@@ -240,7 +240,7 @@ class TwoScaleSpec:
     table_tol: float = param(0.01, doc="interpolation tolerance of the cell table: the contact fraction "
                              "and g_n0 / max g_n0 at interval midpoints", check=positive())
     table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
-                             "(below it the coefficients are held constant)", check=positive())
+                             "(below it the coefficients are held constant)", check=open_interval(0, 1))
 
 
 def macro_extent(shape: str, setting: str, dims: dict) -> tuple[int, float, float, float]:
@@ -308,6 +308,7 @@ class MacroScene:
             if s.displacement and len(s.displacement) != len(s.components or comps):
                 raise SceneError(f"supports[{i}].displacement", s.displacement,
                                  f"one value per component ({len(s.components or comps)})")
+        check_supports_once(self.supports, comps)
         dim = 3 if self.geometry.setting == "3d" else 2
         for i, load in enumerate(self.loads):
             if load.traction and len(load.traction) != dim:

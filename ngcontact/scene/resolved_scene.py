@@ -37,7 +37,7 @@ import numpy as np
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.geometry.femur import FemurStemDims
 from ngcontact.scene.macro_scene import check_dimensions
-from ngcontact.scene.sections import MaterialSpec, SolverSpec, base_dir_field, check_material_names
+from ngcontact.scene.sections import MaterialSpec, check_supports_once, SolverSpec, base_dir_field, check_material_names
 from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty, param, positive
 
@@ -191,6 +191,7 @@ class DirectScene:
                 v = getattr(s, key)
                 if v and len(v) != n:
                     raise SceneError(f"supports[{i}].{key}", v, f"one value per component ({n})")
+        check_supports_once(self.supports, comps)
         self.check_size()
         st = self.study
         if st is not None:

@@ -92,3 +92,19 @@ def base_dir_field():
 def resolve(scene, relpath: str) -> str:
     """Absolute path of a file named in a scene (relative to the scene file)."""
     return os.path.normpath(os.path.join(getattr(scene, "base_dir", "."), relpath))
+
+
+def check_supports_once(supports, comps) -> None:
+    """Each component of a boundary is fixed by one ``[[supports]]`` entry only.
+
+    A second entry for the same boundary and component was silently
+    ignored; which value holds is then a guess, so the scene is refused.
+    """
+    seen: dict[tuple[str, str], int] = {}
+    for i, s in enumerate(supports):
+        for c in (s.components or comps):
+            j = seen.setdefault((s.boundary, c), i)
+            if j != i:
+                raise SceneError(f"supports[{i}]", s.boundary, f"fixes component {c!r} of boundary "
+                                 f"{s.boundary!r}, which supports[{j}] fixes already; give each component "
+                                 "of a boundary once")

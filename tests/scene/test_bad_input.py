@@ -633,3 +633,22 @@ def test_epsilon_study_levels_that_give_no_rate(tmp_path, capsys, periods):
     assert capsys.readouterr().err == (f"ngcontact: error: --periods {' '.join(periods)}: at least 3 increasing "
                                        "numbers N >= 1 (a rate needs three distinct levels)\n")
     assert not (tmp_path / "o").exists()
+
+
+def test_a_support_that_contradicts_another_on_the_same_boundary(tmp_path, capsys):
+    """Was: the second [[supports]] entry of a boundary was silently ignored."""
+    text = edit(MACRO, ('[[supports]]\nboundary = "bottom"\n',
+                        '[[supports]]\nboundary = "bottom"\n\n[[supports]]\nboundary = "bottom"\n'
+                        'components = ["y"]\ndisplacement = [1e-5]\n'))
+    run_bad(tmp_path, capsys, text, "supports[1] = 'bottom': fixes component 'y' of boundary 'bottom', which "
+            "supports[0] fixes already; give each component of a boundary once")
+
+
+def test_a_two_scale_table_minimum_outside_its_range_names_the_key(tmp_path, capsys):
+    """Was: 'inadmissible model input: table range [2.6e13, 3.25e7]' without the key."""
+    text = open(os.path.join(ROOT, "geometries", "femur_stem_two_scale.toml")).read()
+    work = tmp_path / "work"
+    work.mkdir()
+    os.symlink(os.path.join(ROOT, "geometries", "cells"), work / "cells")
+    run_bad(tmp_path, capsys, edit(text, ("table_min = 1e-3", "table_min = 1e6")),
+            "two_scale.table_min = 1000000.0: must lie in (0, 1)")
