@@ -37,6 +37,17 @@ def reference() -> str:
                      row["allowed"], row["doc"]]
             out.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
         out.append("")
+        docs = getattr(sys.modules[cls.__module__], "BOUNDARY_DOCS", None)
+        if docs:
+            out.append(f"Boundary labels of kind `{name}` (for `[[supports]]` and `[[loads]]`; a support without "
+                       "`components` fixes all of them):\n")
+            out.append("| geometry | label | what it is |")
+            out.append("|---|---|---|")
+            for key, labels in docs.items():
+                where = " / ".join(key) if isinstance(key, tuple) else key
+                for label, text in labels.items():
+                    out.append(f"| {where} | `{label}` | {text} |")
+            out.append("")
     return "\n".join(out)
 
 

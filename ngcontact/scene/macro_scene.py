@@ -69,14 +69,62 @@ REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block
 LAWS = ("linear", "bundle", "tabulated")
 #: Boundary labels of the meshed geometries (:mod:`ngcontact.geometry.bodies`) by (shape, setting),
 #: so that supports and loads are checked without meshing.
-BOUNDARIES = {
-    ("femur_stem", "axisymmetric"): ("axis", "base", "bone_outer", "bone_top", "canal", "interface",
-                                     "stem_side", "stem_tip", "stem_top"),
-    ("coaxial", "plane_strain"): ("bore", "interface", "mantle", "sym_x", "sym_y"),
-    ("coaxial", "axisymmetric"): ("bore", "bottom", "interface", "mantle", "top"),
-    ("coaxial", "3d"): ("bore", "bottom", "interface", "mantle", "sym_x", "sym_y", "top"),
-    ("block", "plane_strain"): ("base_sides", "block_sides", "bottom", "interface", "top"),
+FEMUR_BOUNDARIES = {
+    "interface": "stem-bone interface S_0 (cone and cylinder); carries the law",
+    "axis": "symmetry axis r = 0 of the stem: fix r there (components = [\"r\"])",
+    "stem_top": "top face of the stem (where the joint load acts)",
+    "stem_side": "stem surface above the bone",
+    "stem_tip": "bottom face of the stem",
+    "bone_top": "top face of the bone",
+    "bone_outer": "outer surface of the femur",
+    "canal": "empty canal below the stem tip",
+    "base": "base of the femur (clamp it)",
 }
+_COAXIAL = {"interface": "r = b between the tubes; carries the law", "bore": "inner surface r = a of the inner "
+            "tube (a > 0: the inner body is a tube)", "mantle": "outer surface r = c of the outer tube"}
+_QUARTER = {"sym_x": "the cut on the plane x = 0, a symmetry plane: fix x there (components = [\"x\"])",
+            "sym_y": "the cut on the plane y = 0, a symmetry plane: fix y there (components = [\"y\"])"}
+_ENDS = {"bottom": "end face z = 0 of both tubes", "top": "end face z = height of both tubes"}
+#: Boundary labels of each (shape, setting) with what each is and what its supports mean.
+BOUNDARY_DOCS: dict[tuple[str, str], dict[str, str]] = {
+    ("femur_stem", "axisymmetric"): FEMUR_BOUNDARIES,
+    ("coaxial", "plane_strain"): {**_COAXIAL, **_QUARTER},
+    ("coaxial", "axisymmetric"): {**_COAXIAL, **_ENDS},
+    ("coaxial", "3d"): {**_COAXIAL, **_QUARTER, **_ENDS},
+    ("block", "plane_strain"): {
+        "interface": "y = 0 between block and base; carries the law",
+        "top": "top face of the block (the rough body, above the interface here; in the direct kind the rough "
+               "block lies below)",
+        "block_sides": "left and right faces of the block", "bottom": "bottom face of the base (the counter body)",
+        "base_sides": "left and right faces of the base"},
+}
+BOUNDARIES = {key: tuple(sorted(labels)) for key, labels in BOUNDARY_DOCS.items()}
+#: A symmetry plane and the one component its support fixes.
+SYMMETRY_PLANES = {"sym_x": "x", "sym_y": "y"}
+
+
+def check_support_meaning(supports, comps: tuple[str, ...], setting: str) -> None:
+    """A symmetry plane fixes its normal component only, and every translation is fixed somewhere.
+
+    Swapping the components of the two symmetry supports of a quarter ran
+    without complaint and gave a mean pressure 10 % off; a base held only
+    in x left the bodies free to translate in y (a singular system).  In
+    axisymmetry the radial translation is no rigid motion (the axis or the
+    rings hold it), so only z must be fixed.
+    """
+    for i, s in enumerate(supports):
+        normal = SYMMETRY_PLANES.get(s.boundary)
+        if normal is not None and tuple(s.components) != (normal,):
+            raise SceneError(f"supports[{i}].components", list(s.components) or list(comps),
+                             f"{s.boundary!r} is the symmetry plane {normal} = 0: fix only its normal component "
+                             f"[{normal!r}] there")
+    fixed = {c for s in supports for c in (s.components or comps)}
+    needed = ("z",) if setting == "axisymmetric" else comps
+    for c in needed:
+        if c not in fixed:
+            raise SceneError("supports", [s.boundary for s in supports], f"no support fixes component {c!r}: "
+                             f"the bodies could translate freely in {c} (a singular system); fix {c} on some "
+                             "boundary")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -309,6 +357,7 @@ class MacroScene:
                 raise SceneError(f"supports[{i}].displacement", s.displacement,
                                  f"one value per component ({len(s.components or comps)})")
         check_supports_once(self.supports, comps)
+        check_support_meaning(self.supports, comps, self.geometry.setting)
         dim = 3 if self.geometry.setting == "3d" else 2
         for i, load in enumerate(self.loads):
             if load.traction and len(load.traction) != dim:

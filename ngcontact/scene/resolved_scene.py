@@ -36,15 +36,21 @@ import numpy as np
 
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.geometry.femur import FemurStemDims
-from ngcontact.scene.macro_scene import check_dimensions
+from ngcontact.scene.macro_scene import FEMUR_BOUNDARIES, check_dimensions, check_support_meaning
 from ngcontact.scene.sections import MaterialSpec, check_supports_once, SolverSpec, base_dir_field, check_material_names
 from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty, param, positive
 
 SHAPES = ("blocks", "femur_stem")
-BOUNDARIES = {"blocks": ("bottom", "top", "rough_sides", "counter_sides"),
-              "femur_stem": ("axis", "stem_top", "stem_side", "stem_tip", "bone_top", "bone_outer", "canal",
-                             "base")}
+#: Boundary labels of each shape with what each is (the resolved surface is ``contact``).
+BOUNDARY_DOCS: dict[str, dict[str, str]] = {
+    "blocks": {"bottom": "bottom face of the rough block (below the interface here; in the macro kind's block "
+                         "the rough body is on top)",
+               "top": "top face of the counter block", "rough_sides": "left and right faces of the rough block",
+               "counter_sides": "left and right faces of the counter block"},
+    "femur_stem": {k: v for k, v in FEMUR_BOUNDARIES.items() if k != "interface"},
+}
+BOUNDARIES = {shape: tuple(labels) for shape, labels in BOUNDARY_DOCS.items()}
 COMPONENTS = {"plane_strain": ("x", "y"), "axisymmetric": ("r", "z")}
 DIMENSIONS = tuple(f.name for f in dataclasses.fields(FemurStemDims))
 
@@ -192,6 +198,7 @@ class DirectScene:
                 if v and len(v) != n:
                     raise SceneError(f"supports[{i}].{key}", v, f"one value per component ({n})")
         check_supports_once(self.supports, comps)
+        check_support_meaning(self.supports, comps, g.setting)
         self.check_size()
         st = self.study
         if st is not None:

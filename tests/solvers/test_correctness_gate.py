@@ -54,12 +54,30 @@ def run(tmp_path, capsys, text):
     return code, err
 
 
-def test_a_base_held_only_in_x_is_singular_not_converged(tmp_path, capsys):
-    """Was: residual rose from 1.07e5 to 2.21e5, 'converged', 15.26 MPa peak under 10 MPa applied."""
-    code, err = run(tmp_path, capsys, BLOCK.format(law='law = "linear"\nkn = 1e12\nkt = 1e11',
-                                                   components='components = ["x"]', pressure="10e6"))
-    assert code == 3
-    assert "the linear solve left the residual at" in err and "rigid-body mode that no support removes" in err
+def test_a_base_held_only_in_x_is_refused_and_its_singular_solve_fails(tmp_path, capsys):
+    """Was: residual rose from 1.07e5 to 2.21e5, 'converged', 15.26 MPa peak under 10 MPa applied.
+
+    The scene is refused before the solve (no support fixes y); the same problem built through the
+    API, past the scene's check, fails in the solver instead of converging."""
+    from dataclasses import replace
+
+    import ngcontact
+    from ngcontact.drivers.run_macro import build_geometry, problem_of
+    from ngcontact.errors import ConvergenceError
+    from ngcontact.fem.two_body import Support
+    from ngcontact.macro import macro_problem as M
+
+    law = 'law = "linear"\nkn = 1e12\nkt = 1e11'
+    code, err = run(tmp_path, capsys, BLOCK.format(law=law, components='components = ["x"]', pressure="10e6"))
+    assert code == 2 and "no support fixes component 'y'" in err, err
+    scene_path = tmp_path / "held.toml"
+    scene_path.write_text(BLOCK.format(law=law, components="", pressure="10e6"))
+    scene = ngcontact.load(str(scene_path))
+    problem, _ = problem_of(scene, build_geometry(scene))
+    loose = replace(problem, supports=(Support(label="bottom", components=("x",)),))
+    with pytest.raises(ConvergenceError, match="rigid-body mode that no support removes"):
+        M.solve(loose)
+    assert M.solve(problem).history["converged"]
 
 
 @pytest.mark.parametrize("weights, pressure", [("1e12", "-10e6"), ("1e-300", "10e6")])
