@@ -273,31 +273,37 @@ def sinusoid(amplitude: float, period: float = 1.0, pieces: int = 16) -> Profile
     return Profile("sinusoid", P, tuple(out))
 
 
-def tabulated(x, y, *, path: str = "profile") -> Profile:
+def tabulated(x, y, *, path: str = "profile", lines=None, value: str = "y", what: str = "profile") -> Profile:
     """The periodic polyline through the points ``(x_i, y_i)``, ``x_0 = 0``, ``x_last = period``.
 
     Validated here: finite values, ``x`` strictly increasing from 0,
     ``y(0) = y(period)`` within ``1e-9`` of the larger of the period and the
-    peak-to-valley height.  ``path`` names the source in error messages.
+    peak-to-valley height.  ``path`` names the source in error messages,
+    ``lines`` the line of each point in its file (messages say ``[line n]``;
+    without it ``[row i]``, counted from 0), ``value`` and ``what`` the
+    names of the second column and of the function.
     """
     xs, ys = list(map(float, x)), list(map(float, y))
+
+    def at(i: int) -> str:
+        return f"{path}[line {lines[i]}]" if lines is not None else f"{path}[row {i}]"
+
     if len(xs) != len(ys) or len(xs) < 3:
-        raise GeometryError(path, len(xs), "needs columns x and y of equal length with at least 3 points")
+        raise GeometryError(path, len(xs), f"needs columns x and {value} of equal length with at least 3 points")
     for i, (a, b) in enumerate(zip(xs, ys)):
         if not (math.isfinite(a) and math.isfinite(b)):
-            raise GeometryError(f"{path}[row {i}]", (a, b), "x and y must be finite numbers")
+            raise GeometryError(at(i), (a, b), f"x and {value} must be finite numbers")
     if xs[0] != 0.0:
-        raise GeometryError(f"{path}[row 0].x", xs[0], "the profile must start at x = 0")
+        raise GeometryError(f"{at(0)}.x", xs[0], f"the {what} must start at x = 0")
     for i in range(1, len(xs)):
         if not xs[i] > xs[i - 1]:
-            raise GeometryError(f"{path}[row {i}].x", xs[i],
-                             f"x must increase strictly (previous x = {xs[i - 1]!r})")
+            raise GeometryError(f"{at(i)}.x", xs[i], f"x must increase strictly (previous x = {xs[i - 1]!r})")
     P = xs[-1]
     tol = 1e-9 * max(P, max(ys) - min(ys))
     if abs(ys[0] - ys[-1]) > tol:
-        raise GeometryError(f"{path}[last row].y", ys[-1],
-                         f"the profile must be periodic: y(period) must equal y(0) = {ys[0]!r} "
-                         f"within {tol:.3g}")
+        raise GeometryError(f"{at(len(ys) - 1)}.{value}", ys[-1],
+                            f"the {what} must be periodic: the last row is x = period and repeats the first, "
+                            f"{value}(period) = {value}(0) = {ys[0]!r} within {tol:.3g}")
     ys[-1] = ys[0]
     return Profile("tabulated", P, _polyline(list(zip(xs, ys))))
 

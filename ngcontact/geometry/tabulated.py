@@ -47,7 +47,8 @@ def check_data_file(file, where: str, what: str = "file") -> None:
                             f"{MAX_DATA_BYTES // 2 ** 20} MiB")
 
 
-def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MAX_PROFILE_ROWS) -> Profile:
+def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MAX_PROFILE_ROWS,
+                     value: str = "y", what: str = "profile") -> Profile:
     """Read and validate a periodic profile from a CSV file with columns ``x, y``.
 
     Parameters
@@ -58,6 +59,11 @@ def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MA
         Name used in error messages (default: the file name).
     max_rows
         Largest number of data rows (``None``: no limit but the file size).
+    value, what
+        Name of the second column and of the tabulated function in messages.
+
+    Messages name a row by its line in the file (the header is line 1) and
+    never repeat the file's content.
 
     Returns
     -------
@@ -71,23 +77,24 @@ def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MA
     except OSError as err:
         raise GeometryError(where, str(file), f"must be a readable CSV file ({err.strerror})") from None
     except UnicodeDecodeError:
-        raise GeometryError(where, str(file), "must be a text (UTF-8) CSV file with columns x, y") from None
-    rows = [r for r in csv.reader(text.splitlines()) if r and any(c.strip() for c in r)]
-    if rows and not _numeric(rows[0][0]):
-        rows = rows[1:]                      # header
-    if max_rows is not None and len(rows) > max_rows:
-        raise GeometryError(where, str(file), f"has {len(rows)} rows; a tabulated profile takes at most "
+        raise GeometryError(where, str(file), f"must be a text (UTF-8) CSV file with columns x, {value}") from None
+    numbered = [(k + 1, r) for k, r in enumerate(csv.reader(text.splitlines())) if r and any(c.strip() for c in r)]
+    if numbered and not _numeric(numbered[0][1][0]):
+        numbered = numbered[1:]                      # header
+    if max_rows is not None and len(numbered) > max_rows:
+        raise GeometryError(where, str(file), f"has {len(numbered)} rows; a tabulated {what} takes at most "
                             f"{max_rows} (each row is a segment of the mesh's geometry): resample it")
     xs, ys = [], []
-    for i, row in enumerate(rows):
+    for line, row in numbered:
         if len(row) != 2:
-            raise GeometryError(f"{where}[row {i}]", row, "each row must have exactly two columns x, y")
+            raise GeometryError(f"{where}[line {line}]", f"{len(row)} column{'' if len(row) == 1 else 's'}",
+                                f"each row must have exactly two columns x, {value}")
         try:
             xs.append(float(row[0]))
             ys.append(float(row[1]))
         except ValueError:
-            raise GeometryError(f"{where}[row {i}]", row, "x and y must be numbers") from None
-    return tabulated(xs, ys, path=where)
+            raise GeometryError(f"{where}[line {line}]", "not two numbers", f"x and {value} must be numbers") from None
+    return tabulated(xs, ys, path=where, lines=[line for line, _ in numbered], value=value, what=what)
 
 
 def read_height_map(file, *, path: str | None = None) -> np.ndarray:
@@ -155,7 +162,7 @@ def read_gap_csv(file, *, path: str | None = None) -> tuple[np.ndarray, np.ndarr
         NumPy arrays of the samples.
     """
     where = path or str(file)
-    prof = read_profile_csv(file, path=where, max_rows=None)
+    prof = read_profile_csv(file, path=where, max_rows=None, value="g", what="gap")
     pts = [p.start for p in prof.pieces] + [prof.pieces[-1].end]
     x = np.array([p[0] for p in pts], dtype=float)
     g = np.array([p[1] for p in pts], dtype=float)

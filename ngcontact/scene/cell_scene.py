@@ -55,9 +55,11 @@ class CellGeometry:
                                                units="deg", check=open_interval(0, 90))
     amplitude: float | None = param(None, doc="profile amplitude (sinusoid, bisinusoid)", units="m",
                                     check=positive())
-    file: str | None = param(None, doc="tabulated profile: CSV with columns x, y over one period "
-                             "(2D); height map: .npy array whose last row/column repeat the first "
-                             "(3D, small-slope model); relative to the scene file")
+    file: str | None = param(None, doc="tabulated profile: CSV with columns x, y in the scene's length unit, "
+                             "an optional header line, x strictly increasing from 0 to the period, the last row "
+                             "(x = period) repeating the first y, at most 4096 rows (2D); height map: .npy array "
+                             "whose last row/column repeat the first (3D, small-slope model); a regular file of at "
+                             "most 64 MiB, relative to the scene file")
 
     _USES = {"flat": (), "flat3d": (), "rectangular": ("width", "depth"),
              "triangular": ("angles",), "semicircular": ("radius",), "sinusoid": ("amplitude",),
@@ -150,9 +152,11 @@ class GapSpec:
     value: float | None = param(None, doc="constant gap", units="m", check=nonnegative())
     h: float | None = param(None, doc="gap amplitude h (sinusoid: g in [0, 2h]; bisinusoid: [0, 4h])",
                             units="m", check=positive())
-    file: str | None = param(None, doc="tabulated gap: CSV with columns x, g over one period (2D) "
-                             "or .npy array g[i, j] at x = j P/(n_x - 1), y = i P/(n_y - 1) whose last "
-                             "row/column repeat the first (3D); g >= 0; relative to the scene file")
+    file: str | None = param(None, doc="tabulated gap: CSV with columns x, g in the scene's length unit, an "
+                             "optional header line, x strictly increasing from 0 to the period, the last row "
+                             "(x = period) repeating the first g (2D), or .npy array g[i, j] at x = j P/(n_x - 1), "
+                             "y = i P/(n_y - 1) whose last row/column repeat the first (3D); g >= 0; a regular "
+                             "file of at most 64 MiB, relative to the scene file")
 
     def check(self, path: str) -> None:
         need = {"none": (), "constant": ("value",), "sinusoid": ("h",),

@@ -246,19 +246,19 @@ TAB = edit(CELL.format(contact=""), ('profile = "flat"', 'profile = "tabulated"\
 
 def test_tabulated_profile_that_is_not_periodic(tmp_path, capsys):
     run_bad(tmp_path, capsys, TAB,
-            "geometry.file (p.csv)[last row].y = -0.02: the profile must be periodic: "
-            "y(period) must equal y(0) = 0.0 within 1e-09",
+            "geometry.file (p.csv)[line 4].y = -0.02: the profile must be periodic: the last row is x = period "
+            "and repeats the first, y(period) = y(0) = 0.0 within 1e-09",
             files={"p.csv": "x,y\n0,0\n0.5,-0.1\n1.0,-0.02\n"})
 
 
 def test_tabulated_profile_with_a_non_finite_value(tmp_path, capsys):
-    run_bad(tmp_path, capsys, TAB, "geometry.file (p.csv)[row 1] = [0.5, nan]: x and y must be finite numbers",
+    run_bad(tmp_path, capsys, TAB, "geometry.file (p.csv)[line 3] = [0.5, nan]: x and y must be finite numbers",
             files={"p.csv": "x,y\n0,0\n0.5,nan\n1.0,0\n"})
 
 
 def test_tabulated_profile_with_three_columns(tmp_path, capsys):
     run_bad(tmp_path, capsys, TAB,
-            "geometry.file (p.csv)[row 1] = ['0.5', '-0.1', '7']: each row must have exactly two columns x, y",
+            "geometry.file (p.csv)[line 3] = '3 columns': each row must have exactly two columns x, y",
             files={"p.csv": "x,y\n0,0\n0.5,-0.1,7\n1.0,0\n"})
 
 
@@ -714,3 +714,23 @@ def test_the_coaxial_quarter_with_its_symmetry_supports_runs(tmp_path, capsys):
     scene.write_text(COAXIAL)
     assert cli.main(["check", str(scene)]) == 0
     capsys.readouterr()
+
+
+GAPTAB = CELL.format(contact='gap = { kind = "tabulated", file = "g.csv" }')
+
+
+def test_a_gap_table_that_does_not_close_the_period_speaks_of_the_gap(tmp_path, capsys):
+    """Was: a gap file's message spoke of 'y' and 'profile', and the closing row was documented nowhere."""
+    run_bad(tmp_path, capsys, GAPTAB,
+            "contact.gap.file (g.csv)[line 4].g = 0.002: the gap must be periodic: the last row is x = period "
+            "and repeats the first, g(period) = g(0) = 0.001 within 1e-09",
+            files={"g.csv": "x,g\n0,0.001\n0.5,0.0\n1.0,0.002\n"})
+
+
+def test_messages_name_lines_and_never_repeat_a_file_s_content(tmp_path, capsys):
+    """Was: a message echoed a line of an arbitrary file (a root-only one, run as root) and counted rows
+    from 0 after the header."""
+    run_bad(tmp_path, capsys, TAB, "geometry.file (p.csv)[line 3] = 'not two numbers': x and y must be numbers",
+            files={"p.csv": "x,y\n0,0\nroot,secret-hash\n1,0\n"})
+    run_bad(tmp_path, capsys, TAB, "geometry.file (p.csv)[line 3] = '1 column': each row must have exactly two "
+            "columns x, y", files={"p.csv": "x,y\n0,0\nroot:x:0:0:root:/root:/bin/bash\n1,0\n"})
