@@ -84,6 +84,48 @@ def _K0(normal, dim):
     return np.asarray(normal.matrix(dim)).tolist()
 
 
+#: Largest equivalent strain for which the linear (small-strain) elasticity of the model is meaningful.
+SMALL_STRAIN = 0.05
+
+
+def small_strain_warnings(strain: float) -> list[str]:
+    """A warning (logged and reported) when the largest von Mises strain leaves the small-strain range.
+
+    Loads far beyond a joint's gave strains of ~7000 without a word: the
+    linear model still solves, but its answer is no longer physical.
+    """
+    if not strain > SMALL_STRAIN:
+        return []
+    text = (f"the largest von Mises strain {strain:.3g} exceeds {SMALL_STRAIN:g}: linear (small-strain) "
+            "elasticity does not hold there, so stresses and displacements are not physical; check the loads, "
+            "gaps and units")
+    log.warning("ngcontact: warning: %s", text)
+    return [text]
+
+
+def check_gap_table_covers(scene, mesh) -> None:
+    """``interface.gap_table`` must span the interface along its coordinate.
+
+    Outside its rows the piecewise linear gap would be held at the end
+    values, silently; a table that stops short of the interface is refused.
+    """
+    spec = scene.interface
+    if spec.gap_table is None:
+        return
+    axis = {"x": 0, "r": 0, "y": 1, "z": 2}[spec.gap_coordinate]
+    if spec.gap_coordinate == "z" and scene.geometry.setting == "axisymmetric":
+        axis = 1
+    coords = [mesh[v].point[axis] for el in mesh.Elements(ng.BND) if el.mat == "interface" for v in el.vertices]
+    lo, hi = min(coords), max(coords)
+    first, last = spec.gap_table[0][0], spec.gap_table[-1][0]
+    tol = 1e-9 * max(abs(hi - lo), abs(last - first), 1e-300)
+    if first > lo + tol or last < hi - tol:
+        raise SceneError("interface.gap_table", [list(r) for r in spec.gap_table],
+                         f"covers {spec.gap_coordinate} in [{first:g}, {last:g}], but the interface spans "
+                         f"[{lo:g}, {hi:g}]; give rows that cover it (outside them the gap would be held "
+                         "at the end values)")
+
+
 def gap_of(scene):
     """The macro normal gap ``g0``: a number or a piecewise linear CoefficientFunction."""
     spec = scene.interface
@@ -109,6 +151,7 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
             if item.boundary not in labels:
                 raise SceneError(f"{what}[{i}].boundary", item.boundary,
                                  f"no such boundary in {scene.geometry.shape!r}; labels are " + ", ".join(labels))
+    check_gap_table_covers(scene, geometry.mesh)
     law, info = interface_law_of(scene, geometry.mesh.dim)
     rough, counter = REGIONS[scene.geometry.shape]
     mats = body_laws(scene, {rough: scene.bodies.rough, counter: scene.bodies.counter})
@@ -163,6 +206,7 @@ def run(scene, clock) -> Outcome:
             samples = field_samples(sol, fields)
             plots["stress"] = lambda path, d=samples: figures.macro_fields(path, **d)
         results["maxima"] = maxima
+        results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
         if two_scale is not None:
             results["two_scale"] = two_scale
             if "interface" in results:

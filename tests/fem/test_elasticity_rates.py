@@ -122,3 +122,23 @@ def test_interface_normal_points_from_rough_into_counter():
     # the flat parts of the interface (|x - 1/2| > 1/4) have n = +e_y
     flat = ng.IfPos(ng.x - 0.75, 1.0, 0.0) + ng.IfPos(0.25 - ng.x, 1.0, 0.0)
     assert ng.Integrate(flat * n[1], prob.mesh, ng.BND, definedon=bnd) == pytest.approx(0.5, rel=1e-10)
+
+
+def test_an_order_at_round_off_is_exact_not_a_failed_rate(tmp_path):
+    """Was: order 8 reproduces the smooth field to ~1e-13 on every level, the fitted 'rate' of the
+    round-off is -0.2, and the report said verified: false."""
+    import json
+    import os
+
+    from ngcontact import cli
+
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    text = open(os.path.join(root, "geometries", "verify_elasticity.toml")).read()
+    assert "orders = [1, 2, 3]" in text
+    scene = tmp_path / "scene.toml"
+    scene.write_text(text.replace("orders = [1, 2, 3]", "orders = [1, 8]"))
+    assert cli.main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    res = json.loads((tmp_path / "out" / "report.json").read_text())["results"]
+    assert res["orders_at_roundoff"] == [8] and list(res["rates"]) == ["1"]
+    assert res["verified"] and abs(res["rates"]["1"]["l2"] - 2.0) < 0.05
+    assert all(r["l2"] < res["roundoff_error_floor"]["l2"] for r in res["rows"] if r["order"] == 8)

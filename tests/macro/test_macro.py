@@ -355,3 +355,52 @@ def test_femur_law_from_the_hip_cell_is_the_papers_32_GPa(tmp_path, monkeypatch)
         np.testing.assert_allclose(info["full_contact_K0"], [[32e9, 0.0], [0.0, 0.0]], rtol=1e-12, atol=1e-3)
         pressures.append(MM.interface_profile(solve_scene(sc, prob))["pressure"])
     np.testing.assert_allclose(pressures[1], pressures[0], rtol=1e-9, atol=1e-9 * pressures[0].max())
+
+
+def test_strains_beyond_small_strain_elasticity_are_reported_with_a_warning(tmp_path, caplog):
+    """Was: strains of ~7000 reported without a word.  A block under 1e14 Pa: solved, warned, exit 0;
+    under 10 MPa: no warning."""
+    import json
+    import os
+
+    from ngcontact import cli
+
+    text = """kind = "macro"
+[materials.steel]
+E = 210e9
+nu = 0.3
+[bodies]
+rough = "steel"
+counter = "steel"
+[geometry]
+shape = "block"
+setting = "plane_strain"
+[geometry.dimensions]
+length = 0.02
+h_block = 0.005
+h_base = 0.005
+[interface]
+law = "linear"
+kn = 1e12
+kt = 1e11
+[[supports]]
+boundary = "bottom"
+[[loads]]
+boundary = "top"
+pressure = {p}
+[discretization]
+order = 2
+maxh = 0.0025
+"""
+    for p, warned in (("1e14", True), ("10e6", False)):
+        scene = tmp_path / f"block_{p}.toml"
+        scene.write_text(text.replace("{p}", p))
+        out = tmp_path / f"out_{p}"
+        caplog.clear()
+        assert cli.main(["run", str(scene), "--out", str(out), "--quiet"]) == 0
+        warnings = json.loads((out / "report.json").read_text())["results"]["warnings"]
+        logged = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+        assert bool(warnings) == warned and any("exceeds 0.05" in m for m in logged) == warned, logged
+        if warned:
+            assert "linear (small-strain) elasticity does not hold" in warnings[0]
+    assert os.path.exists(tmp_path / "out_10e6" / "report.json")

@@ -734,3 +734,16 @@ def test_messages_name_lines_and_never_repeat_a_file_s_content(tmp_path, capsys)
             files={"p.csv": "x,y\n0,0\nroot,secret-hash\n1,0\n"})
     run_bad(tmp_path, capsys, TAB, "geometry.file (p.csv)[line 3] = '1 column': each row must have exactly two "
             "columns x, y", files={"p.csv": "x,y\n0,0\nroot:x:0:0:root:/root:/bin/bash\n1,0\n"})
+
+
+def test_a_gap_table_that_stops_short_of_the_interface(tmp_path, capsys):
+    """Was: outside its rows the gap was silently held at the end values."""
+    text = open(os.path.join(ROOT, "geometries", "femur_stem.toml")).read()
+    work = tmp_path / "work"
+    work.mkdir()
+    os.symlink(os.path.join(ROOT, "geometries", "cells"), work / "cells")
+    old = "gap_table = [[0.05, 20e-6], [0.09, 0.0], [0.13, -50e-6], [0.18, -50e-6]]"
+    run_bad(tmp_path, capsys, edit(text, (old, "gap_table = [[0.07, 20e-6], [0.09, 0.0], [0.13, -50e-6]]")),
+            "interface.gap_table = [[0.07, 2e-05], [0.09, 0.0], [0.13, -5e-05]]: covers z in [0.07, 0.13], but the "
+            "interface spans [0.05, 0.18]; give rows that cover it (outside them the gap would be held at the end "
+            "values)", commands=("run",))
