@@ -305,6 +305,8 @@ class CellScene:
         """The element estimate of :mod:`ngcontact.scene.mesh_size` against ``max_elements``."""
         g, d = self.geometry, self.discretization
         P, dim = g.period, g.dim
+        mesh_size.check_lengths({"geometry.period": P, "geometry.h_rough": g.h_rough, "geometry.h_counter": g.h_counter,
+                                 "discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         width = min(P, g.h_rough, g.h_counter)
         n = mesh_size.estimate(dim, P ** (dim - 1) * (g.h_rough + g.h_counter), d.maxh, width=width,
                                interface=P ** (dim - 1), h_interface=d.interface_maxh)

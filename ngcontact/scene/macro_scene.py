@@ -329,6 +329,8 @@ class MacroScene:
     def check_size(self) -> None:
         """The element estimate of :mod:`ngcontact.scene.mesh_size` against ``max_elements``."""
         g, d = self.geometry, self.discretization
+        mesh_size.check_lengths({f"geometry.dimensions.{k}": v for k, v in (g.dimensions or {}).items()}
+                                | {"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         dim, volume, interface, width = macro_extent(g.shape, g.setting, dict(g.dimensions or {}))
         n = mesh_size.estimate(dim, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
         if d.interface_maxh is not None and d.interface_maxh < d.maxh:

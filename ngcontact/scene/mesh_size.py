@@ -39,6 +39,19 @@ def estimate(dim: int, volume: float, h: float, *, width: float | None = None, i
     return 6.0 * volume / h_e ** 3 + 12.0 * interface / h_i ** 2 * layers
 
 
+#: Lengths the mesher handles: a cell scaled down to 1e-15 crashed it (segmentation fault).
+LENGTH_RANGE = (1e-9, 1e9)
+
+
+def check_lengths(lengths: dict) -> None:
+    """Every ``{key: length}`` (``None`` skipped) within :data:`LENGTH_RANGE`."""
+    lo, hi = LENGTH_RANGE
+    for key, value in lengths.items():
+        if value is not None and not lo <= value <= hi:
+            raise SceneError(key, value, f"must lie in [{lo:g}, {hi:g}]: choose a length unit (e.g. mm or um) "
+                             "in which the geometry's sizes fall in that range")
+
+
 def refuse_beyond(n: float, max_elements: int, size_key: str, size: float, *, path: str = "discretization",
                   hint: str = "") -> None:
     """Raise :class:`SceneError` naming ``size_key`` when the estimate ``n`` exceeds ``max_elements``."""

@@ -747,3 +747,12 @@ def test_a_gap_table_that_stops_short_of_the_interface(tmp_path, capsys):
             "interface.gap_table = [[0.07, 2e-05], [0.09, 0.0], [0.13, -5e-05]]: covers z in [0.07, 0.13], but the "
             "interface spans [0.05, 0.18]; give rows that cover it (outside them the gap would be held at the end "
             "values)", commands=("run",))
+
+
+@pytest.mark.parametrize("length", ["1e-15", "1e100"])
+def test_a_cell_scaled_beyond_the_mesher_s_lengths(tmp_path, capsys, length):
+    """Was: a segmentation fault (exit -11, no message) for a cell scaled to 1e-15, a hang or a crash at 1e100."""
+    text = edit(CELL.format(contact=""), ('profile = "flat"', f'profile = "flat"\nperiod = {length}\nh_rough = {length}\n'
+                                          f'h_counter = {length}'), ("maxh = 0.5", f"maxh = {length}"))
+    run_bad(tmp_path, capsys, text, f"geometry.period = {float(length)!r}: must lie in [1e-09, 1e+09]: choose a "
+            "length unit (e.g. mm or um) in which the geometry's sizes fall in that range")
