@@ -5,6 +5,7 @@ Used to prove that a refactoring changed no result::
     python scripts/compare_reports.py record before/      # on the old commit
     python scripts/compare_reports.py record after/       # on the new one
     python scripts/compare_reports.py compare before/ after/ --rtol 1e-10
+    python scripts/compare_reports.py summary before/ after/   # largest difference per report
 
 ``record`` solves every scene under ``geometries/`` (the epsilon study's
 scenes as plain runs) and writes ``<dir>/<scene path with / -> __>.json``;
@@ -99,6 +100,51 @@ def compare(before: Path, after: Path, rtol: float, atol: float, ignore: tuple[s
     return 1 if bad else 0
 
 
+def _numbers(obj, path: str, out: dict, scale: float = 0.0) -> None:
+    """``{path: (value, scale)}``; a number in a list is measured against the list's largest magnitude."""
+    if isinstance(obj, dict):
+        for key, value in obj.items():
+            if key in IGNORED_KEYS or key.endswith("_seconds") or key.startswith("time_"):
+                continue
+            _numbers(value, f"{path}.{key}", out)
+    elif isinstance(obj, list):
+        flat = [abs(v) for v in obj if isinstance(v, (int, float)) and not isinstance(v, bool)]
+        for i, value in enumerate(obj):
+            _numbers(value, f"{path}[{i}]", out, max(flat, default=0.0))
+    elif isinstance(obj, (int, float)) and not isinstance(obj, bool):
+        out[path] = (float(obj), scale)
+
+
+def summary(before: Path, after: Path, skip: tuple[str, ...]) -> int:
+    """Per report: the largest relative difference of any number both sides hold, and where.
+
+    Paths containing any of ``skip`` (e.g. ``.solver``: residual histories at
+    round-off) are left out; a number in a list is measured against the
+    largest magnitude in that list (a round-off zero beside 1e-2 is no 100 %
+    difference); a number that is zero on both sides is equal.
+    """
+    for pa in sorted(before.glob("*.json")):
+        pb = after / pa.name
+        if not pb.exists():
+            print(f"{pa.name}: missing on the after side")
+            continue
+        na: dict = {}
+        nb: dict = {}
+        _numbers(json.loads(pa.read_text()), "", na)
+        _numbers(json.loads(pb.read_text()), "", nb)
+        worst, where = 0.0, ""
+        for key in sorted(set(na) & set(nb)):
+            if any(s in key for s in skip):
+                continue
+            (a, sa), (b, sb) = na[key], nb[key]
+            scale = max(abs(a), abs(b), sa, sb)
+            d = abs(a - b) / scale if scale > 0 else 0.0
+            if d > worst:
+                worst, where = d, key
+        print(f"{pa.name:45s} max relative difference {worst:.1e} {where}")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -112,7 +158,15 @@ def main(argv=None) -> int:
     c.add_argument("--atol", type=float, default=1e-300)
     c.add_argument("--ignore", nargs="*", default=[], metavar="PATH",
                    help="key paths left out, as printed (e.g. .scene.solver.coulomb_rtol for a key a change added)")
+    m = sub.add_parser("summary", help="the largest relative difference per report")
+    m.add_argument("before", type=Path)
+    m.add_argument("after", type=Path)
+    m.add_argument("--skip", nargs="*", default=[".solver", "newton", "residual", "coulomb_iterations", "elements",
+                                                 "ndof"],
+                   help="substrings of key paths to leave out (default: solver histories)")
     args = ap.parse_args(argv)
+    if args.cmd == "summary":
+        return summary(args.before, args.after, tuple(args.skip))
     if args.cmd == "record":
         return record(args.out, args.only)
     return compare(args.before, args.after, args.rtol, args.atol, tuple(args.ignore))

@@ -16,9 +16,11 @@ the residual, a sum of terms as large as ``|K_ij| |u_j|``, can no longer be
 evaluated.  Stiff terms (a Huber width of 1e-12, a penalty touching with zero
 force) put that floor above ``rtol`` times the first residual; without it
 Newton would wander in the round-off until ``max_iter``.  The floor grows with
-``|u|``, so it counts only while the residual has not grown above the first
-one (``FLOOR_PROGRESS`` times it): a runaway iterate, whose residual grows
-with it, fails instead of passing as converged.  (Equilibrium checks of the
+``|u|``: a runaway iterate (a body that floats off under an unbalanced load,
+a singular system) drags it up to its own, unchanged residual.  So the floor
+counts only where it explains the residual at a sane iterate: the residual
+must also lie below ``FLOOR_GROWTH`` times the floor of the start value, or
+below ``FLOOR_PROGRESS`` times the first residual.  (Equilibrium checks of the
 results catch what a residual at its floor cannot show, e.g.
 :func:`ngcontact.cell.measures.equilibrium_error`.)
 
@@ -59,7 +61,8 @@ log = logging.getLogger(__name__)
 ARMIJO = 1e-4
 MIN_STEP = 2.0 ** -30
 ROUNDOFF = 10.0
-FLOOR_PROGRESS = 1.0
+FLOOR_PROGRESS = 1e-6
+FLOOR_GROWTH = 1e3
 REFINE_STEPS = 2
 
 
@@ -186,9 +189,12 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         return hist
     if quadratic:
         return _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rtol, atol, fixed)
+    floor0 = None
     for it in range(1, max_iter + 1):
         form.AssembleLinearization(gfu.vec)
-        if rnorm <= FLOOR_PROGRESS * r0 and rnorm <= roundoff_floor(form.mat, gfu.vec, fixed):
+        floor = roundoff_floor(form.mat, gfu.vec, fixed)
+        floor0 = floor if floor0 is None else floor0
+        if rnorm <= floor and rnorm <= max(FLOOR_PROGRESS * r0, FLOOR_GROWTH * floor0):
             log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             return hist
@@ -254,6 +260,7 @@ def _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rto
     form.AssembleLinearization(gfu.vec)
     inv = form.mat.Inverse(freedofs, inverse=inverse)
     target = max(rtol * r0, atol)
+    sane = max(FLOOR_PROGRESS * r0, FLOOR_GROWTH * roundoff_floor(form.mat, gfu.vec, fixed))
     rnorm = r0
     for step in range(1 + REFINE_STEPS):
         du.data = inv * res
@@ -268,7 +275,7 @@ def _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rto
                                    "(e.g. a rigid-body mode that no support removes)", hist.as_dict())
         if rnorm <= target:
             break
-    if rnorm <= target or rnorm <= roundoff_floor(form.mat, gfu.vec, fixed) and rnorm <= FLOOR_PROGRESS * r0:
+    if rnorm <= target or rnorm <= roundoff_floor(form.mat, gfu.vec, fixed) and rnorm <= sane:
         hist.converged = True
         return hist
     raise ConvergenceError(

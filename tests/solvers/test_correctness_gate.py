@@ -80,9 +80,11 @@ def test_a_base_held_only_in_x_is_refused_and_its_singular_solve_fails(tmp_path,
     assert M.solve(problem).history["converged"]
 
 
-@pytest.mark.parametrize("weights, pressure", [("1e12", "-10e6"), ("1e-300", "10e6")])
+@pytest.mark.parametrize("weights, pressure", [("1e12", "-10e6"), ("1e-300", "10e6"),
+                                               ("1e12", "-10e6\ntraction = [2e6, 0.0]")])
 def test_a_body_the_interface_cannot_hold_fails(tmp_path, capsys, weights, pressure):
-    """Was: pull-off with a normal-only law (jumps of 4.6e9 m) and k_n = 1e-300 (2.2e9 m), 'converged'."""
+    """Was: pull-off with a normal-only law (jumps of 4.6e9 m) and k_n = 1e-300 (2.2e9 m), 'converged';
+    with a shear traction too, a slip of 2.9e8 m and a zero resultant under the applied load, exit 0."""
     law = f'law = "bundle"\ndirections = [[1.0, 0.0]]\nweights = [{weights}]'
     code, err = run(tmp_path, capsys, BLOCK.format(law=law, components="", pressure=pressure))
     assert code == 3 and "solver failed" in err, err
