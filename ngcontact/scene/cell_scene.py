@@ -326,6 +326,9 @@ class CellScene:
 #: by more than double precision can resolve, and the residual cannot be evaluated (k_n = 1e16 on a
 #: cell with E = 1 reported a pressure 63 % off equilibrium as converged).
 MAX_PENALTY_RATIO = 1e10
+#: Smallest admissible ``k_n h / E``: below it the interface is so much softer than the bodies that the jump
+#: dwarfs their deformation (k_n = 1e-300 gave a far-face jump of 1e298 under a pressure of 0.01).
+MIN_PENALTY_RATIO = 1e-8
 
 
 def check_penalty_ratio(scene: CellScene) -> None:
@@ -334,6 +337,10 @@ def check_penalty_ratio(scene: CellScene) -> None:
     h = d.interface_maxh or d.maxh
     E = min(scene.materials[name].E or 0.0 for name in (scene.bodies.rough, scene.bodies.counter))
     ratio = c.k_n * h / E if E > 0 else 0.0
+    if 0 < ratio < MIN_PENALTY_RATIO:
+        raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
+                         f"E = {E:g} the softer body's modulus) must be at least {MIN_PENALTY_RATIO:g}: the "
+                         "interface would hold nothing and the jump would dwarf the bodies; raise k_n")
     if ratio > MAX_PENALTY_RATIO:
         raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
                          f"E = {E:g} the softer body's modulus) must stay below {MAX_PENALTY_RATIO:g}: the "

@@ -756,3 +756,11 @@ def test_a_cell_scaled_beyond_the_mesher_s_lengths(tmp_path, capsys, length):
                                           f'h_counter = {length}'), ("maxh = 0.5", f"maxh = {length}"))
     run_bad(tmp_path, capsys, text, f"geometry.period = {float(length)!r}: must lie in [1e-09, 1e+09]: choose a "
             "length unit (e.g. mm or um) in which the geometry's sizes fall in that range")
+
+
+def test_a_penalty_so_soft_that_the_interface_holds_nothing(tmp_path, capsys):
+    """Was: k_n = 1e-300 on a flat cell 'converged' to a far-face jump of 1e298."""
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ("k_n = 1.0e3", "k_n = 1e-300")),
+            "contact.k_n = 1e-300: k_n h / E = 5e-301 (h = 0.5 the interface mesh size, E = 1 the softer body's "
+            "modulus) must be at least 1e-08: the interface would hold nothing and the jump would dwarf the "
+            "bodies; raise k_n")
