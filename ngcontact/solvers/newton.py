@@ -18,9 +18,10 @@ force) put that floor above ``rtol`` times the first residual; without it
 Newton would wander in the round-off until ``max_iter``.  The floor grows with
 ``|u|``: a runaway iterate (a body that floats off under an unbalanced load,
 a singular system) drags it up to its own, unchanged residual.  So the floor
-counts only where it explains the residual at a sane iterate: the residual
-must also lie below ``FLOOR_GROWTH`` times the floor of the start value, or
-below ``FLOOR_PROGRESS`` times the first residual.  (Equilibrium checks of the
+counts only after real progress: the residual has fallen below
+``FLOOR_PROGRESS`` times the first one, or the first one was itself at the
+round-off of the start value (within ``FLOOR_GROWTH`` times its floor: a
+start that already was the solution).  (Equilibrium checks of the
 results catch what a residual at its floor cannot show, e.g.
 :func:`ngcontact.cell.measures.equilibrium_error`.)
 
@@ -61,7 +62,7 @@ log = logging.getLogger(__name__)
 ARMIJO = 1e-4
 MIN_STEP = 2.0 ** -30
 ROUNDOFF = 10.0
-FLOOR_PROGRESS = 1e-6
+FLOOR_PROGRESS = 1e-3
 FLOOR_GROWTH = 1e3
 REFINE_STEPS = 2
 
@@ -194,7 +195,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         form.AssembleLinearization(gfu.vec)
         floor = roundoff_floor(form.mat, gfu.vec, fixed)
         floor0 = floor if floor0 is None else floor0
-        if rnorm <= floor and rnorm <= max(FLOOR_PROGRESS * r0, FLOOR_GROWTH * floor0):
+        if rnorm <= floor and (rnorm <= FLOOR_PROGRESS * r0 or r0 <= FLOOR_GROWTH * floor0):
             log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             return hist
@@ -260,7 +261,7 @@ def _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rto
     form.AssembleLinearization(gfu.vec)
     inv = form.mat.Inverse(freedofs, inverse=inverse)
     target = max(rtol * r0, atol)
-    sane = max(FLOOR_PROGRESS * r0, FLOOR_GROWTH * roundoff_floor(form.mat, gfu.vec, fixed))
+    at_start = r0 <= FLOOR_GROWTH * roundoff_floor(form.mat, gfu.vec, fixed)
     rnorm = r0
     for step in range(1 + REFINE_STEPS):
         du.data = inv * res
@@ -275,7 +276,8 @@ def _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rto
                                    "(e.g. a rigid-body mode that no support removes)", hist.as_dict())
         if rnorm <= target:
             break
-    if rnorm <= target or rnorm <= roundoff_floor(form.mat, gfu.vec, fixed) and rnorm <= sane:
+    if rnorm <= target or rnorm <= roundoff_floor(form.mat, gfu.vec, fixed) and (rnorm <= FLOOR_PROGRESS * r0
+                                                                                 or at_start):
         hist.converged = True
         return hist
     raise ConvergenceError(

@@ -365,33 +365,9 @@ def test_strains_beyond_small_strain_elasticity_are_reported_with_a_warning(tmp_
 
     from ngcontact import cli
 
-    text = """kind = "macro"
-[materials.steel]
-E = 210e9
-nu = 0.3
-[bodies]
-rough = "steel"
-counter = "steel"
-[geometry]
-shape = "block"
-setting = "plane_strain"
-[geometry.dimensions]
-length = 0.02
-h_block = 0.005
-h_base = 0.005
-[interface]
-law = "linear"
-kn = 1e12
-kt = 1e11
-[[supports]]
-boundary = "bottom"
-[[loads]]
-boundary = "top"
-pressure = {p}
-[discretization]
-order = 2
-maxh = 0.0025
-"""
+    text = open(os.path.join(ROOT, "geometries", "macro", "block_on_sawtooth.toml")).read()
+    text = text.replace('cell = "sawtooth_cell.toml"', 'law = "linear"\nkn = 1e12\nkt = 1e11').replace(
+        "cell_length_unit = 1e-4", "").replace("pressure = 10e6", "pressure = {p}")
     for p, warned in (("1e14", True), ("10e6", False)):
         scene = tmp_path / f"block_{p}.toml"
         scene.write_text(text.replace("{p}", p))

@@ -18,53 +18,13 @@ from ngcontact.errors import OutputError
 from ngcontact.output.report import Outcome, build_report
 from ngcontact.output.writer import MANIFEST, STAGING_PREFIX, check_output_dir, remove_stale_staging, write_outputs
 
-SMALL_SCENE = """\
-kind = "manufactured"
-title = "small plane-strain check"
-
-[materials.steel]
-E = 210e9
-nu = 0.3
-
-[manufactured]
-setting = "plane_strain"
-body = "steel"
-orders = [1]
-maxh = 0.5
-levels = 3
-"""
-
-#: a cell scene that takes some seconds: long enough to be interrupted while it solves
-SLOW_SCENE = """\
-kind = "cell"
-title = "Westergaard cell, fine enough to be interrupted while it solves"
-
-[materials.solid]
-E = 1.0
-nu = 0.3
-
-[bodies]
-rough = "solid"
-counter = "solid"
-
-[geometry]
-profile = "flat"
-period = 1.0
-h_rough = 1.0
-h_counter = 1.0
-
-[contact]
-k_n = 1.0e3
-gap = { kind = "sinusoid", h = 0.01 }
-
-[load]
-pressure = [0.000863075, 0.0034523, 0.00863075, 0.0138092, 0.0207138]
-
-[discretization]
-order = 2
-maxh = 0.2
-interface_maxh = 0.005
-"""
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+GEOMETRIES = os.path.join(ROOT, "geometries")
+#: the smallest shipped scene: a manufactured plane-strain check, orders 1 only
+SMALL_SCENE = open(os.path.join(GEOMETRIES, "verify_elasticity.toml")).read().replace(
+    "orders = [1, 2, 3]", "orders = [1]")
+#: a cell that takes some seconds: long enough to be interrupted while it solves
+SLOW_SCENE = open(os.path.join(GEOMETRIES, "cells", "westergaard.toml")).read()
 
 
 def report_for(outcome):
@@ -234,8 +194,7 @@ def test_out_dot_keeps_the_scene_and_every_file(scene_dir, monkeypatch, capsys, 
 
 def test_a_data_folder_the_scene_reads_is_refused(tmp_path, capsys):
     """Defect: --out data deleted the CSV the scene reads."""
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    cells = os.path.join(root, "geometries", "cells")
+    cells = os.path.join(GEOMETRIES, "cells")
     data = os.path.join(cells, "data")
     before = sorted(os.listdir(data))
     assert cli.main(["run", os.path.join(cells, "tabulated_gap.toml"), "--out", data, "--quiet"]) == 2
@@ -293,8 +252,7 @@ def test_an_interrupted_run_leaves_a_previous_output_directory_byte_identical(tm
 
 def test_a_scene_that_names_itself_as_its_cell_is_refused_with_the_chain(tmp_path, capsys):
     """Defect: a scene naming itself as its cell, or A -> B -> A, ended in RecursionError (exit 3)."""
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    text = open(os.path.join(root, "geometries", "macro", "femur_stem_from_cell.toml")).read()
+    text = open(os.path.join(GEOMETRIES, "macro", "femur_stem_from_cell.toml")).read()
     assert 'cell = "hip_cell.toml"' in text
     a, b = tmp_path / "a.toml", tmp_path / "b.toml"
     a.write_text(text.replace('cell = "hip_cell.toml"', 'cell = "b.toml"'))

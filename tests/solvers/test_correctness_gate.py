@@ -13,34 +13,18 @@ from ngcontact import cli
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-BLOCK = """\
-kind = "macro"
-title = "block on a base"
-[materials.steel]
-E = 210e9
-nu = 0.3
-[bodies]
-rough = "steel"
-counter = "steel"
-[geometry]
-shape = "block"
-setting = "plane_strain"
-[geometry.dimensions]
-length = 0.02
-h_block = 0.005
-h_base = 0.005
-[interface]
-{law}
-[[supports]]
-boundary = "bottom"
-{components}
-[[loads]]
-boundary = "top"
-pressure = {pressure}
-[discretization]
-order = 2
-maxh = 0.0025
-"""
+SHIPPED_BLOCK = open(os.path.join(ROOT, "geometries", "macro", "block_on_sawtooth.toml")).read()
+
+
+def block(*, law: str, components: str, pressure: str) -> str:
+    """The shipped block on a base with another interface law, base supports and top load."""
+    text = SHIPPED_BLOCK
+    for old, new in (('cell = "sawtooth_cell.toml"', law), ("cell_length_unit = 1e-4", ""),
+                     ('boundary = "bottom"', f'boundary = "bottom"\n{components}'),
+                     ("pressure = 10e6\ntraction = [2e6, 0.0]", f"pressure = {pressure}")):
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    return text
 
 
 def run(tmp_path, capsys, text):
@@ -68,10 +52,10 @@ def test_a_base_held_only_in_x_is_refused_and_its_singular_solve_fails(tmp_path,
     from ngcontact.macro import macro_problem as M
 
     law = 'law = "linear"\nkn = 1e12\nkt = 1e11'
-    code, err = run(tmp_path, capsys, BLOCK.format(law=law, components='components = ["x"]', pressure="10e6"))
+    code, err = run(tmp_path, capsys, block(law=law, components='components = ["x"]', pressure="10e6"))
     assert code == 2 and "no support fixes component 'y'" in err, err
     scene_path = tmp_path / "held.toml"
-    scene_path.write_text(BLOCK.format(law=law, components="", pressure="10e6"))
+    scene_path.write_text(block(law=law, components="", pressure="10e6"))
     scene = ngcontact.load(str(scene_path))
     problem, _ = problem_of(scene, build_geometry(scene))
     loose = replace(problem, supports=(Support(label="bottom", components=("x",)),))
@@ -86,7 +70,7 @@ def test_a_body_the_interface_cannot_hold_fails(tmp_path, capsys, weights, press
     """Was: pull-off with a normal-only law (jumps of 4.6e9 m) and k_n = 1e-300 (2.2e9 m), 'converged';
     with a shear traction too, a slip of 2.9e8 m and a zero resultant under the applied load, exit 0."""
     law = f'law = "bundle"\ndirections = [[1.0, 0.0]]\nweights = [{weights}]'
-    code, err = run(tmp_path, capsys, BLOCK.format(law=law, components="", pressure=pressure))
+    code, err = run(tmp_path, capsys, block(law=law, components="", pressure=pressure))
     assert code == 3 and "solver failed" in err, err
 
 
