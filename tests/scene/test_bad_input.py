@@ -654,43 +654,13 @@ def test_a_two_scale_table_minimum_outside_its_range_names_the_key(tmp_path, cap
             "two_scale.table_min = 1000000.0: must lie in (0, 1)")
 
 
-COAXIAL = """\
-kind = "macro"
-
-[materials.steel]
-E = 210e9
-nu = 0.3
-
-[bodies]
-rough = "steel"
-counter = "steel"
-
-[geometry]
-shape = "coaxial"
-setting = "plane_strain"
-
-[geometry.dimensions]
-a = 0.01
-b = 0.02
-c = 0.03
-
-[interface]
-law = "linear"
-kn = 1e13
-gap = -1e-5
-
-[[supports]]
-boundary = "sym_x"
-components = ["x"]
-
-[[supports]]
-boundary = "sym_y"
-components = ["y"]
-
-[discretization]
-order = 2
-maxh = 0.004
-"""
+COAXIAL = edit(MACRO, ('shape = "block"', 'shape = "coaxial"'),
+               ("length = 0.02\nh_block = 0.005\nh_base = 0.005", "a = 0.01\nb = 0.02\nc = 0.03"),
+               ("kt = 1e11", "gap = -1e-5"),
+               ('[[supports]]\nboundary = "bottom"\n', '[[supports]]\nboundary = "sym_x"\ncomponents = ["x"]\n\n'
+                '[[supports]]\nboundary = "sym_y"\ncomponents = ["y"]\n'),
+               ('[[loads]]\nboundary = "top"\npressure = 10e6\n', ""),
+               ("maxh = 0.01", "maxh = 0.004"))
 
 
 def test_swapped_symmetry_supports_are_refused(tmp_path, capsys):
