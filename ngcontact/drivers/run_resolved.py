@@ -81,7 +81,7 @@ def interface_length(scene) -> float:
     """Arc length of the macro interface ``S_0`` (block width; femur: cone plus cylinder)."""
     g = scene.geometry
     if g.shape == "femur_stem":
-        return float(sum(np.hypot(b[0] - a[0], b[1] - a[1]) for a, b in femur.femur_stem_interface(g.femur_dims())))
+        return femur.femur_interface_length(g.femur_dims())
     return float(g.length)
 
 

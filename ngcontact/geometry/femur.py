@@ -114,6 +114,11 @@ def femur_stem_interface(dims) -> list:
     return [(top, corner), (corner, tip)]
 
 
+def femur_interface_length(dims) -> float:
+    """Arc length of the stem-bone interface: the cylinder and the cone of :func:`femur_stem_interface`."""
+    return float(sum(math.dist(a, b) for a, b in femur_stem_interface(dims)))
+
+
 def split_periods(lengths, periods: int) -> tuple[tuple[int, float], ...]:
     """``N_i = max(1, round(L_i / eps))`` whole periods per segment, ``eps = sum(L_i) / periods``.
 

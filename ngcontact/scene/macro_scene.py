@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.laws import homogenized as il
-from ngcontact.geometry.femur import FemurStemDims
+from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
 from ngcontact.scene import mesh_size
@@ -296,7 +296,7 @@ def macro_extent(shape: str, setting: str, dims: dict) -> tuple[int, float, floa
     import math
     if shape == "femur_stem":
         d = FemurStemDims(**dims)
-        return 2, d.r_bone * d.z_stem_top, d.z_bone_top - d.z_tip, d.r_bone - d.r_stem
+        return 2, d.r_bone * d.z_stem_top, femur_interface_length(d), d.r_bone - d.r_stem
     if shape == "block":
         return 2, dims["length"] * (dims["h_block"] + dims["h_base"]), dims["length"], \
             min(dims["h_block"], dims["h_base"])

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ngcontact.errors import MISSING, SceneError
-from ngcontact.geometry.femur import FemurStemDims
+from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
 from ngcontact.scene.macro_scene import FEMUR_BOUNDARIES, check_dimensions, check_support_meaning
 from ngcontact.scene.sections import MaterialSpec, check_supports_once, SolverSpec, base_dir_field, check_material_names
 from ngcontact.scene import mesh_size
@@ -225,8 +225,7 @@ class DirectScene:
         N = max((g.periods,) + (tuple(self.study.periods) if self.study else ()))
         if g.shape == "femur_stem":
             f = g.femur_dims()
-            area, length, width = f.r_bone * f.z_stem_top, f.z_bone_top - f.z_tip, f.r_bone - f.r_stem
-            length += float(np.hypot(f.r_stem - f.r_tip, f.z_corner - f.z_tip)) - (f.z_corner - f.z_tip)
+            area, length, width = f.r_bone * f.z_stem_top, femur_interface_length(f), f.r_bone - f.r_stem
         else:
             assert g.length is not None and g.h_rough is not None and g.h_counter is not None  # required (check)
             area, length, width = g.length * (g.h_rough + g.h_counter), g.length, min(g.h_rough, g.h_counter)
@@ -243,7 +242,7 @@ class DirectScene:
         st, dims = self.study, self.geometry.femur_dims()
         assert st is not None  # called from check only when the study is given
         segs = femur_stem_interface(dims)
-        band = st.band * sum(float(np.hypot(b[0] - a[0], b[1] - a[1])) for a, b in segs) / st.periods[0]
+        band = st.band * femur_interface_length(dims) / st.periods[0]
         for i, pt in enumerate(st.probes):
             if femur_stem_body(dims, [pt])[0] < 0:
                 raise SceneError(f"study.probes[{i}]", pt, "must lie inside the stem or the bone")
