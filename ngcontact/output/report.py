@@ -98,6 +98,12 @@ def to_plain(obj, path: str = "results"):
 
 
 
+def file_names(outcome: Outcome) -> list[str]:
+    """The names of the files an outcome writes besides ``report.json`` (the report's ``files``)."""
+    return sorted([f"{n}.csv" for n in outcome.tables] + [f"{n}.vtu" for n in outcome.vtk]
+                  + [f"{n}.png" for n in outcome.plots])
+
+
 def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcome,
                  timings: dict, version: str) -> dict:
     """Assemble the report dictionary (validated: finite numbers only)."""
@@ -112,7 +118,6 @@ def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcom
         "timings": timings,
         "solver": outcome.solver,
         "results": outcome.results,
-        "files": sorted([f"{n}.csv" for n in outcome.tables] + [f"{n}.vtu" for n in outcome.vtk]
-                        + [f"{n}.png" for n in outcome.plots]),
+        "files": file_names(outcome),
     }
     return to_plain(report, "report")

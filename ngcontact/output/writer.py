@@ -28,6 +28,7 @@ Errors are :class:`~ngcontact.errors.OutputError` with one line naming
 from __future__ import annotations
 
 import csv
+import errno
 import glob
 import json
 import os
@@ -38,7 +39,7 @@ from contextlib import contextmanager
 from typing import TYPE_CHECKING, Iterable
 
 from ngcontact.errors import OutputError
-from ngcontact.output.report import Outcome, to_plain
+from ngcontact.output.report import Outcome, file_names, to_plain
 
 if TYPE_CHECKING:
     from ngcontact.output.report import VtkField
@@ -63,12 +64,6 @@ def write_vtk(path_noext: str, item: VtkField) -> None:
     names = list(item.fields)
     ng.VTKOutput(ma=item.mesh, coefs=[item.fields[n] for n in names], names=names,
                  filename=path_noext, subdivision=item.subdivision, legacy=False).Do()
-
-
-def file_names(outcome: Outcome) -> list[str]:
-    """The names of the files an outcome writes besides ``report.json``."""
-    return sorted([f"{n}.csv" for n in outcome.tables] + [f"{n}.vtu" for n in outcome.vtk]
-                  + [f"{n}.png" for n in outcome.plots])
 
 
 # ---------------------------------------------------------------- the checks
@@ -144,12 +139,13 @@ def check_output_dir(out_dir: str, inputs: Iterable[str] = (), names: Iterable[s
 
 # ---------------------------------------------------------------- staging
 def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists (one of another user counts)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except PermissionError:  # another user's process
-        return True
+    except PermissionError:
+        pass
     return True
 
 
@@ -183,7 +179,10 @@ def _signals_held():
 def _move(src: str, dst: str) -> None:
     try:
         os.replace(src, dst)
-    except OSError:  # another file system below a mount point inside DIR
+    except OSError as exc:
+        if exc.errno != errno.EXDEV:
+            raise
+        # the staging directory lies on another file system (DIR was created below a mount point)
         shutil.copy2(src, dst + ".ngcontact-tmp")
         os.replace(dst + ".ngcontact-tmp", dst)
 

@@ -313,12 +313,7 @@ class CellScene:
         tall = max(g.h_rough, g.h_counter) / P
         hint = (f" (the bodies are {tall:.3g} periods high; the cell's boundary layer decays within a few "
                 "periods, so h_rough and h_counter of 0.5 to 5 periods suffice)") if tall > 20 else ""
-        if hint:
-            key, value = "geometry.period", P
-        elif d.interface_maxh is not None and d.interface_maxh < d.maxh:
-            key, value = "discretization.interface_maxh", d.interface_maxh
-        else:
-            key, value = "discretization.maxh", d.maxh
+        key, value = ("geometry.period", P) if hint else mesh_size.finest_size(d)
         mesh_size.refuse_beyond(n, d.max_elements, key, value, hint=hint)
 
 

@@ -333,9 +333,7 @@ class MacroScene:
                                 | {"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         dim, volume, interface, width = macro_extent(g.shape, g.setting, dict(g.dimensions or {}))
         n = mesh_size.estimate(dim, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
-        if d.interface_maxh is not None and d.interface_maxh < d.maxh:
-            mesh_size.refuse_beyond(n, d.max_elements, "discretization.interface_maxh", d.interface_maxh)
-        mesh_size.refuse_beyond(n, d.max_elements, "discretization.maxh", d.maxh)
+        mesh_size.refuse_beyond(n, d.max_elements, *mesh_size.finest_size(d))
 
     def check(self, path: str) -> None:
         check_material_names(self.materials, {"rough": self.bodies.rough, "counter": self.bodies.counter},

@@ -52,6 +52,14 @@ def check_lengths(lengths: dict) -> None:
                              "in which the geometry's sizes fall in that range")
 
 
+def finest_size(discretization) -> tuple[str, float]:
+    """``(key, value)`` of the finer of ``maxh`` and ``interface_maxh``: the size a refusal names."""
+    d = discretization
+    if d.interface_maxh is not None and d.interface_maxh < d.maxh:
+        return "discretization.interface_maxh", d.interface_maxh
+    return "discretization.maxh", d.maxh
+
+
 def refuse_beyond(n: float, max_elements: int, size_key: str, size: float, *, path: str = "discretization",
                   hint: str = "") -> None:
     """Raise :class:`SceneError` naming ``size_key`` when the estimate ``n`` exceeds ``max_elements``."""

@@ -234,7 +234,6 @@ class DirectScene:
         key, value = ("study.periods", N) if self.study and N > g.periods else ("geometry.periods", g.periods)
         mesh_size.refuse_beyond(n, d.max_elements, key, value,
                                 hint=" (fewer periods, or fewer discretization.elements_per_period)")
-        mesh_size.refuse_beyond(n, d.max_elements, "discretization.maxh", d.maxh)
 
     def _check_femur_study(self) -> None:
         """Probes inside a body and outside the band of the coarsest level; the band leaves points."""

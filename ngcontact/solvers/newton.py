@@ -195,7 +195,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         form.AssembleLinearization(gfu.vec)
         floor = roundoff_floor(form.mat, gfu.vec, fixed)
         floor0 = floor if floor0 is None else floor0
-        if rnorm <= floor and (rnorm <= FLOOR_PROGRESS * r0 or r0 <= FLOOR_GROWTH * floor0):
+        if _at_floor(rnorm, floor, r0, floor0):
             log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             return hist
@@ -252,6 +252,11 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         hist.as_dict())
 
 
+def _at_floor(rnorm: float, floor: float, r0: float, floor0: float) -> bool:
+    """The residual is at its round-off ``floor`` after real progress, or the start was (module docstring)."""
+    return rnorm <= floor and (rnorm <= FLOOR_PROGRESS * r0 or r0 <= FLOOR_GROWTH * floor0)
+
+
 def _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rtol, atol, fixed) -> NewtonHistory:
     """A quadratic energy: ``u <- u - K^{-1} r(u)``, refined with the same factorization, and checked.
 
@@ -261,9 +266,9 @@ def _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rto
     form.AssembleLinearization(gfu.vec)
     inv = form.mat.Inverse(freedofs, inverse=inverse)
     target = max(rtol * r0, atol)
-    at_start = r0 <= FLOOR_GROWTH * roundoff_floor(form.mat, gfu.vec, fixed)
+    floor0 = roundoff_floor(form.mat, gfu.vec, fixed)
     rnorm = r0
-    for step in range(1 + REFINE_STEPS):
+    for _ in range(1 + REFINE_STEPS):
         du.data = inv * res
         gfu.vec.data -= du
         rnorm = residual(gfu.vec)          # leaves r(u) in res for the next refinement
@@ -276,8 +281,7 @@ def _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rto
                                    "(e.g. a rigid-body mode that no support removes)", hist.as_dict())
         if rnorm <= target:
             break
-    if rnorm <= target or rnorm <= roundoff_floor(form.mat, gfu.vec, fixed) and (rnorm <= FLOOR_PROGRESS * r0
-                                                                                 or at_start):
+    if rnorm <= target or _at_floor(rnorm, roundoff_floor(form.mat, gfu.vec, fixed), r0, floor0):
         hist.converged = True
         return hist
     raise ConvergenceError(
