@@ -279,6 +279,22 @@ class InterfaceLaw:
         """True when the energy is quadratic (one linear solve suffices)."""
         return isinstance(self.normal, LinearLaw) and self.friction is None
 
+    @property
+    def holds_tangentially(self) -> bool:
+        """True when a closed interface resists a tangential jump.
+
+        Friction does (the Huber-regularized stick, eq. 34's tangential
+        slope), and so does an elastic tangential stiffness ``k_t0 > 0`` of a
+        linear, bundle or tabulated law; a field law is normal only.
+        """
+        if self.friction is not None:
+            return True
+        if isinstance(self.normal, FieldLaw):
+            return False
+        if isinstance(self.normal, TabulatedLaw):
+            return self.normal.kt > 0
+        return bool(self.normal.matrix(2)[1, 1] > 0)
+
 
 def normal_law(law: str, *, kn=None, kt: float = 0.0, knt: float = 0.0, gap_force=(0.0, 0.0),
                weights=None, directions=None, gaps=None, closure=None, pressure=None) -> NormalLaw:

@@ -42,12 +42,12 @@ def test_a_base_held_only_in_x_is_refused_and_its_singular_solve_fails(tmp_path,
     """Was: residual rose from 1.07e5 to 2.21e5, 'converged', 15.26 MPa peak under 10 MPa applied.
 
     The scene is refused before the solve (no support fixes y); the same problem built through the
-    API, past the scene's check, fails in the solver instead of converging."""
+    API, past the scene's check, is refused by the problem's rigid-motion check before any solve."""
     from dataclasses import replace
 
     import ngcontact
     from ngcontact.drivers.run_macro import build_geometry, problem_of
-    from ngcontact.errors import ConvergenceError
+    from ngcontact.errors import ModelError
     from ngcontact.fem.two_body import Support
     from ngcontact.macro import macro_problem as M
 
@@ -59,19 +59,32 @@ def test_a_base_held_only_in_x_is_refused_and_its_singular_solve_fails(tmp_path,
     scene = ngcontact.load(str(scene_path))
     problem, _ = problem_of(scene, build_geometry(scene))
     loose = replace(problem, supports=(Support(label="bottom", components=("x",)),))
-    with pytest.raises(ConvergenceError, match="rigid-body mode that no support removes"):
+    with pytest.raises(ModelError, match="leave a rigid-body motion free: .*translation in y"):
         M.solve(loose)
     assert M.solve(problem).history["converged"]
 
 
-@pytest.mark.parametrize("weights, pressure", [("1e12", "-10e6"), ("1e-300", "10e6"),
-                                               ("1e12", "-10e6\ntraction = [2e6, 0.0]")])
+HELD_SIDEWAYS = '\n\n[[supports]]\nboundary = "block_sides"\ncomponents = ["x"]\n'
+
+
+@pytest.mark.parametrize("weights, pressure", [("1e12", "-10e6"), ("1e-300", "10e6")])
 def test_a_body_the_interface_cannot_hold_fails(tmp_path, capsys, weights, pressure):
-    """Was: pull-off with a normal-only law (jumps of 4.6e9 m) and k_n = 1e-300 (2.2e9 m), 'converged';
-    with a shear traction too, a slip of 2.9e8 m and a zero resultant under the applied load, exit 0."""
+    """Was: pull-off with a normal-only law (jumps of 4.6e9 m) and k_n = 1e-300 (2.2e9 m), 'converged'.
+
+    The block's sides are held in x, so only the normal direction is left to the law."""
     law = f'law = "bundle"\ndirections = [[1.0, 0.0]]\nweights = [{weights}]'
-    code, err = run(tmp_path, capsys, block(law=law, components="", pressure=pressure))
+    code, err = run(tmp_path, capsys, block(law=law, components="", pressure=pressure) + HELD_SIDEWAYS)
     assert code == 3 and "solver failed" in err, err
+
+
+def test_a_shear_load_on_a_normal_only_law_is_refused_before_the_solve(tmp_path, capsys):
+    """Was: with a shear traction too, a slip of 2.9e8 m and a zero resultant under the applied load, exit 0.
+
+    A normal-only law holds nothing tangentially: the block's x translation is free, named before any solve."""
+    law = 'law = "bundle"\ndirections = [[1.0, 0.0]]\nweights = [1e12]'
+    code, err = run(tmp_path, capsys, block(law=law, components="", pressure="-10e6\ntraction = [2e6, 0.0]"))
+    assert code == 2 and err.endswith("leave a rigid-body motion free: body 'block': translation in x; the "
+                                      "system would be singular: fix more components or boundaries\n"), err
 
 
 @pytest.mark.parametrize("k_n", ["1.0e16", "1.0e30"])
