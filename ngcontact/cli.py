@@ -145,10 +145,15 @@ def _fail(code: int, message: str) -> int:
 
 
 def _check(path: str) -> int:
+    """Load and validate; for kinds whose driver has ``check_model``, mesh and check the model too."""
+    from ngcontact.runner import check
+
     try:
         sc = scene_mod.load(path)
-    except SceneError as exc:
-        return _fail(EXIT_SCENE, f"{path}: {exc}")
+        with _native_output_silenced(True):
+            check(sc)
+    except Exception as exc:
+        return _classified(path, exc)
     print(f"{path}: valid {sc.kind} scene; effects: {', '.join(scene_mod.effects(sc)) or 'none'}")
     return EXIT_OK
 
@@ -175,6 +180,29 @@ def _study(path: str, periods, out: str | None, quiet: bool) -> int:
         return _fail(EXIT_SCENE, f"--periods {' '.join(map(str, periods))}: at least 3 increasing numbers "
                                  "N >= 1 (a rate needs three distinct levels)")
     return _execute(path, out, quiet, compute, suffix="_epsilon", validate=require_study)
+
+
+def _classified(path: str, exc: Exception) -> int:
+    """Exit code and one line for an exception of a run: 2 for input, 3 for a solver failure.
+
+    Anything unforeseen is raised again (a traceback is a bug to fix, not an
+    answer to hide).
+    """
+    if isinstance(exc, SceneError):
+        return _fail(EXIT_SCENE, f"{path}: {exc}")
+    if isinstance(exc, ModelError):
+        return _fail(EXIT_SCENE, f"{path}: inadmissible model input: {exc}")
+    if isinstance(exc, OutputError):
+        return _fail(EXIT_SCENE, str(exc))
+    if isinstance(exc, ConvergenceError):
+        return _fail(EXIT_SOLVER, f"{path}: solver failed: {exc}")
+    if isinstance(exc, (NgcontactError, ValueError)):
+        return _fail(EXIT_SOLVER, f"{path}: {exc}")
+    if type(exc).__name__ == "NgException" and "meshing" in str(exc).lower():
+        return _fail(EXIT_SCENE, f"{path}: the mesher failed on this geometry ({exc}); a feature is "
+                                 "too small or too thin for discretization.maxh / interface_maxh: "
+                                 "change the geometry's sizes or the mesh sizes")
+    raise exc
 
 
 def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, validate=None) -> int:
@@ -207,22 +235,8 @@ def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, v
             report, outcome = compute(sc, progress)
         _check_signals()
         write_outputs(out, report, outcome, inputs)
-    except SceneError as exc:
-        return _fail(EXIT_SCENE, f"{path}: {exc}")
-    except ModelError as exc:
-        return _fail(EXIT_SCENE, f"{path}: inadmissible model input: {exc}")
-    except OutputError as exc:
-        return _fail(EXIT_SCENE, str(exc))
-    except ConvergenceError as exc:
-        return _fail(EXIT_SOLVER, f"{path}: solver failed: {exc}")
-    except (NgcontactError, ValueError) as exc:
-        return _fail(EXIT_SOLVER, f"{path}: {exc}")
     except Exception as exc:
-        if type(exc).__name__ == "NgException" and "meshing" in str(exc).lower():
-            return _fail(EXIT_SCENE, f"{path}: the mesher failed on this geometry ({exc}); a feature is "
-                                     "too small or too thin for discretization.maxh / interface_maxh: "
-                                     "change the geometry's sizes or the mesh sizes")
-        raise
+        return _classified(path, exc)
     if not quiet:
         print(f"wrote {os.path.join(out, 'report.json')}", file=sys.stderr, flush=True)
     return EXIT_OK

@@ -28,6 +28,21 @@ DRIVERS = {
 }
 
 
+def check(scene) -> None:
+    """Every check ``run`` makes before its solve, without solving.
+
+    The scene is validated when loaded; kinds whose driver defines
+    ``check_model(scene)`` (the macro kind: boundary labels of the meshed
+    shape, the gap table's coverage, rigid motions the supports leave free)
+    are meshed and checked too.  Raises what ``run`` would raise.
+    """
+    if not hasattr(scene, "kind"):
+        scene = loader.load(scene)
+    check_model = getattr(importlib.import_module(DRIVERS[scene.kind]), "check_model", None)
+    if check_model is not None:
+        check_model(scene)
+
+
 def solve(scene, progress: Callable[[str], None] | None = None) -> tuple[dict, Outcome]:
     """Solve ``scene`` (a validated scene or a path to a scene file).
 

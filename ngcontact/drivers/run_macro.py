@@ -31,13 +31,15 @@ from ngcontact.laws import homogenized as il
 from ngcontact.fem.interpolants import piecewise_linear
 from ngcontact.macro import macro_problem as M
 from ngcontact.macro import macro_measures as MM
-from ngcontact.errors import SceneError
+from ngcontact.errors import ConvergenceError, SceneError
 from ngcontact.geometry import bodies as gm
 from ngcontact.scene.macro_scene import REGIONS
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 from ngcontact.scene.sections import resolve
 from ngcontact.geometry.femur import BOUNDARIES, FemurStemDims, femur_stem
+
+from ngcontact.fem.rigid_modes import check_rigid_modes
 
 log = logging.getLogger(__name__)
 
@@ -137,6 +139,41 @@ def gap_of(scene):
     return piecewise_linear(coord, spec.gap_table)
 
 
+def check_boundaries(scene, mesh) -> None:
+    """Every support and load names a boundary of the meshed shape, and the gap table covers the interface."""
+    labels = M.boundary_labels(mesh)
+    for what, items in (("supports", scene.supports), ("loads", scene.loads)):
+        for i, item in enumerate(items):
+            if item.boundary not in labels:
+                raise SceneError(f"{what}[{i}].boundary", item.boundary,
+                                 f"no such boundary in {scene.geometry.shape!r}; labels are " + ", ".join(labels))
+    check_gap_table_covers(scene, mesh)
+
+
+def check_model(scene) -> None:
+    """What ``run`` checks before the solve, without solving (``ngcontact check``).
+
+    Meshes the shape, checks its boundary labels and the gap table's
+    coverage, and refuses supports that leave a rigid motion free.  A law
+    taken from a cell is not computed here: it is assumed to hold
+    tangentially (a cell has a tangential stiffness), and ``run`` repeats
+    the rigid-motion check with the computed law.
+    """
+    geo = build_geometry(scene)
+    check_boundaries(scene, geo.mesh)
+    spec = scene.interface
+    if spec.cell is not None:
+        tangential = True
+    else:
+        normal = interface_normal_law(spec)
+        assert normal is not None  # an explicit law (no cell) always has its numbers
+        tangential = il.InterfaceLaw(normal=normal, friction=interface_friction(spec)).holds_tangentially
+    rough, counter = REGIONS[scene.geometry.shape]
+    check_rigid_modes(geo.mesh, scene.geometry.setting, (rough, counter),
+                      tuple(M.Support(label=s.boundary, components=s.components) for s in scene.supports),
+                      "interface", tangential)
+
+
 def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.MacroProblem, dict]:
     """The :class:`~ngcontact.macro.macro_problem.MacroProblem` of ``scene`` on ``geometry``.
 
@@ -145,13 +182,7 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
     SceneError
         A boundary label the geometry does not have (the message lists those it has).
     """
-    labels = M.boundary_labels(geometry.mesh)
-    for what, items in (("supports", scene.supports), ("loads", scene.loads)):
-        for i, item in enumerate(items):
-            if item.boundary not in labels:
-                raise SceneError(f"{what}[{i}].boundary", item.boundary,
-                                 f"no such boundary in {scene.geometry.shape!r}; labels are " + ", ".join(labels))
-    check_gap_table_covers(scene, geometry.mesh)
+    check_boundaries(scene, geometry.mesh)
     law, info = interface_law_of(scene, geometry.mesh.dim)
     rough, counter = REGIONS[scene.geometry.shape]
     mats = body_laws(scene, {rough: scene.bodies.rough, counter: scene.bodies.counter})
@@ -170,6 +201,26 @@ def solve_scene(scene, problem: M.MacroProblem) -> M.MacroSolution:
                    coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter)
 
 
+def checked_equilibrium(sol: M.MacroSolution) -> dict:
+    """:func:`ngcontact.macro.macro_measures.equilibrium`, refused beyond its tolerance.
+
+    Raises
+    ------
+    ConvergenceError
+        A body's forces do not balance: the figures of the worst one.
+    """
+    eq = MM.equilibrium(sol)
+    if not eq["error"] <= eq["tolerance"]:
+        body, comp, f = max(((b, c, f) for b, fc in eq["bodies"].items() for c, f in fc.items()),
+                            key=lambda t: abs(t[2]["imbalance"]))
+        raise ConvergenceError(
+            f"the solution is not in equilibrium: body {body!r} in {comp}: applied {f['applied']:.6g}, "
+            f"interface {f['interface']:.6g}, supports {f['supports']:.6g} leave {f['imbalance']:.3g} "
+            f"({eq['error']:.2g} of the largest force {eq['scale']:.6g}, allowed {eq['tolerance']:g}); "
+            "tighten solver.rtol or check the supports and the law's stiffness", sol.history)
+    return eq
+
+
 def run(scene, clock) -> Outcome:
     """Solve a ``macro`` scene; no file I/O (see :mod:`ngcontact.output.report`)."""
     with clock.stage("mesh"):
@@ -184,12 +235,13 @@ def run(scene, clock) -> Outcome:
             from ngcontact.drivers.run_two_scale import couple
             sol, two_scale = couple(scene, problem, lambda prob: solve_scene(scene, prob))
     with clock.stage("post-processing"):
+        balance = checked_equilibrium(sol)
         fields = MM.stress_fields(sol)
         extrema = MM.field_extrema(sol, fields)
         results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
                    "dimensions": geo.dims, "law": law_info, "resultant": MM.resultant(sol),
                    "newton_iterations": sol.history["newton_iterations"],
-                   "coulomb_iterations": sol.history["coulomb_iterations"]}
+                   "coulomb_iterations": sol.history["coulomb_iterations"], "equilibrium": balance}
         maxima = {name: ext for name, ext in extrema.items()}
         tables, plots = {}, {}
         if geo.mesh.dim == 2:

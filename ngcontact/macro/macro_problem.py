@@ -58,6 +58,7 @@ from ngcontact.fem.quadrature import sampling_order
 from ngcontact.fem.sampling import boundary_values
 from ngcontact.solvers.coulomb import coulomb_fixed_point
 from ngcontact.solvers.newton import minimize
+from ngcontact.fem.rigid_modes import check_rigid_modes
 
 log = logging.getLogger(__name__)
 
@@ -124,9 +125,15 @@ class MacroSolution:
 
 # ------------------------------------------------------------- checks
 def check_problem(problem: MacroProblem) -> None:
-    """Reject labels, regions and components that do not exist (ValueError naming them)."""
+    """Reject labels, regions and components that do not exist, and supports that leave a rigid motion.
+
+    Raises :class:`ModelError` naming the label, the component or the free
+    motion (:func:`ngcontact.fem.rigid_modes.check_rigid_modes`).
+    """
     two_body.check_labels(problem.mesh, problem.setting, problem.interface, problem.supports, problem.loads,
                           regions=(("rough", problem.rough), ("counter", problem.counter)))
+    check_rigid_modes(problem.mesh, problem.setting, (problem.rough, problem.counter), problem.supports,
+                      problem.interface, problem.law.holds_tangentially)
 
 
 # ------------------------------------------------------------- model
@@ -240,6 +247,19 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
 
 
 # ----------------------------------------------------- post-processing
+def energy_form(sol: MacroSolution):
+    """The energy whose minimizer ``sol`` is (the friction threshold frozen at ``sol.previous``)."""
+    return _form(sol.problem, sol.gfu.space, sol.frame, G=sol.threshold)
+
+
+def load_form(sol: MacroSolution):
+    """The load potential ``-int t . u w ds`` alone: its gradient is ``-l``, the applied loads."""
+    p = sol.problem
+    fes = sol.gfu.space
+    form = ng.BilinearForm(fes, symmetric=True)
+    return two_body.add_load_potential(form, p.mesh, p.loads, fes.TrialFunction(), elasticity.weight(p.setting))
+
+
 def replace_law(problem: MacroProblem, law: il.InterfaceLaw) -> MacroProblem:
     """The same problem with another interface law."""
     return replace(problem, law=law)

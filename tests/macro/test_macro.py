@@ -380,3 +380,25 @@ def test_strains_beyond_small_strain_elasticity_are_reported_with_a_warning(tmp_
         if warned:
             assert "linear (small-strain) elasticity does not hold" in warnings[0]
     assert os.path.exists(tmp_path / "out_10e6" / "report.json")
+
+
+def test_every_body_balances_and_an_unconverged_state_is_refused_with_the_figures():
+    """Each body's applied, interface and support forces cancel at the solution; a perturbed state fails."""
+    from ngcontact.drivers.run_macro import checked_equilibrium
+    from ngcontact.errors import ConvergenceError
+
+    T = 0.5 * MU * N_PRESS
+    sol = _block(shear=T)
+    eq = checked_equilibrium(sol)
+    assert eq["error"] < 1e-9
+    block, base = eq["bodies"]["block"], eq["bodies"]["base"]
+    assert block["y"]["applied"] == pytest.approx(-N_PRESS * L_BLOCK, rel=1e-10)
+    assert block["x"]["applied"] == pytest.approx(T * L_BLOCK, rel=1e-10)
+    assert block["y"]["interface"] == pytest.approx(N_PRESS * L_BLOCK, rel=1e-8)
+    assert base["y"]["supports"] == pytest.approx(-base["y"]["interface"], rel=1e-8)
+    assert block["x"]["supports"] == 0.0
+    free = np.array(list(sol.gfu.space.FreeDofs()), dtype=bool)
+    u = np.asarray(sol.gfu.vec)
+    u[free] *= 1.01
+    with pytest.raises(ConvergenceError, match=r"not in equilibrium: body '(block|base)' in [xy]: applied "):
+        checked_equilibrium(sol)

@@ -734,3 +734,24 @@ def test_a_penalty_so_soft_that_the_interface_holds_nothing(tmp_path, capsys):
             "contact.k_n = 1e-300: k_n h / E = 5e-301 (h = 0.5 the interface mesh size, E = 1 the softer body's "
             "modulus) must be at least 1e-08: the interface would hold nothing and the jump would dwarf the "
             "bodies; raise k_n")
+
+
+def test_a_rotation_that_no_support_removes_is_named(tmp_path, capsys):
+    """A frictionless ring held only by its mantle (every translation fixed) could still rotate in its bore."""
+    text = edit(COAXIAL, ('[[supports]]\nboundary = "sym_x"\ncomponents = ["x"]\n\n'
+                          '[[supports]]\nboundary = "sym_y"\ncomponents = ["y"]\n',
+                          '[[supports]]\nboundary = "mantle"\n'), ("order = 1", "order = 2"))
+    run_bad(tmp_path, capsys, text, "inadmissible model input: the supports (mantle ['x', 'y']) leave a "
+            "rigid-body motion free: body 'inner': rotation in the x-y plane; the system would be singular: "
+            "fix more components or boundaries")
+
+
+def test_the_same_ring_with_a_tangential_stiffness_is_held(tmp_path, capsys):
+    """The negative case above is not vacuous: k_t0 > 0 ties the ring to the mantle."""
+    text = edit(COAXIAL, ('[[supports]]\nboundary = "sym_x"\ncomponents = ["x"]\n\n'
+                          '[[supports]]\nboundary = "sym_y"\ncomponents = ["y"]\n',
+                          '[[supports]]\nboundary = "mantle"\n'), ("gap = -1e-5", "gap = -1e-5\nkt = 1e11"),
+                ("order = 1", "order = 2"))
+    scene = tmp_path / "ring.toml"
+    scene.write_text(text)
+    assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
