@@ -90,6 +90,19 @@ def contact_fraction(problem, method: str = "auto") -> float:
 
 
 def _contact_length_by_roots(problem) -> float:
+    return float(sum(length for _, _, on, length in contact_pieces(problem) if on))
+
+
+def contact_pieces(problem) -> list[tuple[float, float, bool, float]]:
+    """The boundary elements of ``S_C`` (2D) cut at the roots of the penetration polynomial.
+
+    Returns ``(x_start, x_end, in_contact, length)`` per piece: the
+    abscissae of its ends (in the element's direction), whether the
+    penetration ``J_n - g_h`` is nonnegative on it, and its arc length.
+    The penetration is interpolated at ``order + 3`` Gauss points of each
+    element (exact for the polynomial it is on straight elements with the
+    interpolated gap) and its real roots in ``(0, 1)`` cut the element.
+    """
     P = np.polynomial.polynomial
     m = problem.model.order + 3
     ir = ng.IntegrationRule(ng.SEGM, 2 * m - 1)
@@ -101,24 +114,17 @@ def _contact_length_by_roots(problem) -> float:
     coef = np.linalg.solve(P.polyvander(t, m - 1), vals.transpose(1, 0, 2).reshape(m, -1))
     coef = coef.reshape(m, -1, 3)
     tg, wg = np.polynomial.legendre.leggauss(m + 2)
-    total = 0.0
+    out: list[tuple[float, float, bool, float]] = []
     for e in range(vals.shape[0]):
         c_pen, c_x, c_y = coef[:, e, 0], coef[:, e, 1], coef[:, e, 2]
-        pen = vals[e, :, 0]
-        if np.all(pen > 0) or np.all(pen < 0):
-            r = P.polyroots(c_pen) if np.any(c_pen[1:]) else np.empty(0)
-            r = r[np.abs(r.imag) <= 1e-10].real
-            if not np.any((r > 0.0) & (r < 1.0)):
-                if pen[0] > 0:
-                    total += _arc(c_x, c_y, 0.0, 1.0, tg, wg)
-                continue
         r = P.polyroots(c_pen) if np.any(c_pen[1:]) else np.empty(0)
         r = np.sort(r[(np.abs(r.imag) <= 1e-10) & (r.real > 0.0) & (r.real < 1.0)].real)
         cuts = np.concatenate(([0.0], r, [1.0]))
         for a, b in zip(cuts[:-1], cuts[1:]):
-            if b > a and P.polyval(0.5 * (a + b), c_pen) >= 0.0:
-                total += _arc(c_x, c_y, a, b, tg, wg)
-    return total
+            if b > a:
+                on = bool(P.polyval(0.5 * (a + b), c_pen) >= 0.0)
+                out.append((float(P.polyval(a, c_x)), float(P.polyval(b, c_x)), on, _arc(c_x, c_y, a, b, tg, wg)))
+    return out
 
 
 def _arc(c_x, c_y, a, b, tg, wg) -> float:
