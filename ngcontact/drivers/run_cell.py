@@ -6,21 +6,47 @@ whole contact surface (paper eqs. 34, 42-43, purely geometric), and per load
 ``mean_traction``, ``mean_jump``, ``mean_closure``, ``coefficients`` on the
 real contact set, ``effective_stiffness`` and the largest von Mises / Tresca
 stress per body with its location (see :mod:`ngcontact.cell.cell_problem`).
+With ``discretization.tolerance`` each load is solved on its own mesh,
+graded towards its contact edges (:mod:`ngcontact.cell.edge_grading`), and
+its entry adds ``error_estimate`` and ``mesh_history``.
 """
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 from typing import Any
 
 
 from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, model_of
 from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.cell.edge_grading import GradedSolve, solve_to_tolerance
+from ngcontact.geometry.cell2d import flat_cell
 
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 
 log = logging.getLogger(__name__)
+
+
+def solve_graded(scene, loads) -> list[GradedSolve]:
+    """Each load on its own mesh, graded towards its contact edges until ``discretization.tolerance`` is met."""
+    g, d, s = scene.geometry, scene.discretization, scene.solver
+    model = model_of(scene)
+    h0 = d.interface_maxh or d.maxh
+
+    def make_problem(vertices, order):
+        cell = flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
+                         vertices=vertices)
+        return CellProblem(cell, replace(model, order=order), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
+                           inverse=s.inverse)
+
+    out = []
+    for k, load in enumerate(loads):
+        out.append(solve_to_tolerance(make_problem, load, d.tolerance, h0, g.period, d.order))
+        log.info("load %d: contact fraction %.10g after %d grading steps", k,
+                 out[-1].solution.results["contact_fraction"], len(out[-1].history) - 1)
+    return out
 
 
 def run(scene, clock) -> Outcome:
@@ -38,11 +64,21 @@ def run(scene, clock) -> Outcome:
         s = scene.solver
         P = CellProblem(cell, model_of(scene), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
                         inverse=s.inverse)
+    graded: list[GradedSolve] = []
     with clock.stage("solve"):
-        sols = P.sweep(cell_loads(scene))
+        if scene.discretization.tolerance is None:
+            sols = P.sweep(cell_loads(scene))
+        else:
+            graded = solve_graded(scene, cell_loads(scene))
+            sols = [g.solution for g in graded]
+            P = graded[-1].problem
+            cell = P.cell
     per_load, tables, newton = [], {}, []
     for k, sol in enumerate(sols):
         entry = dict(sol.results)
+        if graded:
+            entry["error_estimate"] = graded[k].estimate
+            entry["mesh_history"] = graded[k].history
         entry["newton_iterations"] = sol.iterations
         entry["coulomb_iterations"] = sol.coulomb_iterations
         per_load.append(entry)

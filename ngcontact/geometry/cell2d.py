@@ -170,8 +170,15 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
 
 
 def flat_cell(period: float = 1.0, h_rough: float = 1.0, h_counter: float = 1.0, *,
-              maxh: float, interface_maxh: float | None = None, order: int = 1) -> Cell:
-    """Two bodies bonded along the flat line ``y = 0`` (the small-slope model)."""
-    seg = Segment("line", ((0.0, 0.0), (period, 0.0)))
-    return interface_cell([seg], period, h_rough, h_counter, maxh=maxh,
+              maxh: float, interface_maxh: float | None = None, order: int = 1, vertices=()) -> Cell:
+    """Two bodies bonded along the flat line ``y = 0`` (the small-slope model).
+
+    ``vertices``: abscissae in ``(0, period)`` that become mesh vertices of
+    the interface (a mesh graded towards the contact edges,
+    :mod:`ngcontact.cell.edge_grading`).
+    """
+    tol = 1e-12 * period
+    xs = [0.0] + sorted({float(v) for v in vertices if tol < v < period - tol}) + [float(period)]
+    segs = [Segment("line", ((a, 0.0), (b, 0.0))) for a, b in zip(xs[:-1], xs[1:])]
+    return interface_cell(segs, period, h_rough, h_counter, maxh=maxh,
                           interface_maxh=interface_maxh, order=order)

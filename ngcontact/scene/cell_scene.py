@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
-from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
+from ngcontact.scene.sections import (CellDiscretization, MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names)
 from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import check_selected, nonempty, nonnegative, open_interval, param, positive
@@ -228,7 +228,7 @@ class CellScene:
     geometry: CellGeometry = param(doc="the periodic cell")
     contact: ContactSpec = param(doc="contact law")
     load: LoadSpec | None = param(None, doc="mean load (omit with contact.geometric_only)")
-    discretization: Discretization = param(Discretization(), doc="mesh and order")
+    discretization: CellDiscretization = param(CellDiscretization(), doc="mesh and order")
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     base_dir: str = base_dir_field()
 
@@ -292,6 +292,16 @@ class CellScene:
         if self.load is None:
             raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
         check_penalty_ratio(self)
+        if self.discretization.tolerance is not None and not (dim == 2 and self.geometry.profile == "flat"):
+            raise SceneError("discretization.tolerance", self.discretization.tolerance,
+                             "refinement towards the contact edges needs a 2D cell with geometry.profile = "
+                             f"'flat' (the small-slope model), not a {dim}D {self.geometry.profile!r} cell; remove "
+                             "the key and refine interface_maxh or order by hand")
+        if self.discretization.tolerance is not None and self.contact.friction != "none":
+            raise SceneError("discretization.tolerance", self.discretization.tolerance,
+                             "refinement towards the contact edges solves every load afresh on its own mesh, "
+                             "which a frictional load path does not allow; remove the key or set "
+                             "contact.friction = 'none'")
         load_states(self)
         flat = self.geometry.profile in ("flat", "flat3d") or small_slope(self.geometry)
         if flat and self.contact.friction == "none":

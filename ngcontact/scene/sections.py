@@ -59,6 +59,17 @@ class Discretization:
 
 
 @dataclass(frozen=True, kw_only=True)
+class CellDiscretization(Discretization):
+    """Finite element discretization of a cell, with accuracy on request."""
+
+    tolerance: float | None = param(
+        None, doc="refine the interface mesh towards the contact edges until the estimated error of the contact "
+        "fraction (absolute) and of the mean closure (relative) is at most this (2D cells with a flat "
+        "interface; the report gives the estimate and the mesh history per load); default: the fixed mesh",
+        check=open_interval(0, 1))
+
+
+@dataclass(frozen=True, kw_only=True)
 class SolverSpec:
     """Newton solver settings and the stopping rule of the Coulomb fixed point."""
 

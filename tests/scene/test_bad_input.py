@@ -755,3 +755,21 @@ def test_the_same_ring_with_a_tangential_stiffness_is_held(tmp_path, capsys):
     scene = tmp_path / "ring.toml"
     scene.write_text(text)
     assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("edits, expected", [
+    ((('profile = "flat"', 'profile = "sinusoid"\namplitude = 0.1'),),
+     "discretization.tolerance = 0.0001: refinement towards the contact edges needs a 2D cell with "
+     "geometry.profile = 'flat' (the small-slope model), not a 2D 'sinusoid' cell; remove the key and refine "
+     "interface_maxh or order by hand"),
+    ((("k_n = 1.0e3", 'k_n = 1.0e3\nfriction = "tresca"\nG = 0.001\nw = 1e-4'),),
+     "discretization.tolerance = 0.0001: refinement towards the contact edges solves every load afresh on its "
+     "own mesh, which a frictional load path does not allow; remove the key or set contact.friction = 'none'"),
+    ((("maxh = 0.5", "maxh = 0.5\ntolerance = 2.0"),),
+     "discretization.tolerance = 2.0: must lie in (0, 1)"),
+])
+def test_a_tolerance_where_edge_grading_does_not_apply_is_refused(tmp_path, capsys, edits, expected):
+    text = CELL.format(contact='gap = { kind = "sinusoid", h = 0.01 }')
+    if "tolerance = 2.0" not in str(edits):
+        text = text.replace("maxh = 0.5", "maxh = 0.5\ntolerance = 1e-4")
+    run_bad(tmp_path, capsys, edit(text, *edits), expected)

@@ -1,0 +1,72 @@
+"""Meshes graded towards the contact edges until a tolerance is met (ngcontact.cell.edge_grading).
+
+Westergaard's sinusoid (DESIGN Sec. 8) is the oracle: its contact half-width
+``a`` with ``sin^2(pi a) = p/p*`` is known in closed form.
+"""
+import math
+from dataclasses import replace
+
+import ngsolve as ng
+import numpy as np
+import pytest
+
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.edge_grading import contact_edges, graded_vertices, solve_to_tolerance
+from ngcontact.fem.materials import isotropic
+from ngcontact.geometry.cell2d import flat_cell
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
+
+H, NU, RATIO = 0.01, 0.3, 0.2
+PSTAR = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H, 1.0)
+EXACT = westergaard_contact_fraction(RATIO * PSTAR, PSTAR)
+LAW = isotropic(1.0, NU)
+MODEL = CellModel(rough=LAW, counter=LAW, k_n=1e4, gap=2 * H * ng.sin(math.pi * ng.x) ** 2, order=2)
+
+
+def make_problem(vertices, order):
+    cell = flat_cell(1.0, 2.0, 2.0, maxh=0.3, interface_maxh=0.02, order=order, vertices=vertices)
+    return CellProblem(cell, replace(MODEL, order=order), max_iter=60)
+
+
+def test_graded_vertices_crowd_geometrically_towards_each_edge_and_wrap_periodically():
+    v = graded_vertices([0.5, 0.999], 0.02, 3, 1.0)
+    assert 0.5 in v and 0.999 in v
+    for d in (0.005, 0.00125, 0.0003125):
+        assert any(abs(x - (0.5 - d)) < 1e-15 for x in v) and any(abs(x - (0.5 + d)) < 1e-15 for x in v)
+    assert any(abs(x - (0.999 + 0.005 - 1.0)) < 1e-12 for x in v)  # wrapped past the period
+    assert v == sorted(v) and all(0.0 < x < 1.0 for x in v)
+
+
+def test_the_edges_of_a_uniform_solve_lie_within_an_element_of_westergaards():
+    P = make_problem([], 2)
+    P.solve(cell_load(2, pressure=RATIO * PSTAR), first=True)
+    edges = np.sort(contact_edges(P))
+    a = 0.5 * EXACT  # the patch is centred on x = 0 (the gap's zero), its edges at a and 1 - a
+    assert len(edges) == 2
+    assert abs(edges[0] - a) < 0.02 and abs(edges[1] - (1.0 - a)) < 0.02
+
+
+def test_grading_converges_monotonically_and_the_estimate_bounds_the_error():
+    g = solve_to_tolerance(make_problem, cell_load(2, pressure=RATIO * PSTAR), 1e-3, 0.02, 1.0, 2)
+    errors = [abs(h["contact_fraction"] - EXACT) for h in g.history if h["order"] == 2]
+    assert len(errors) >= 3
+    assert all(b < a for a, b in zip(errors, errors[1:])), errors  # each level better than the last
+    assert errors[0] > 3e-3 and errors[-1] < 1e-4  # from the uniform mesh's error to far below the tolerance
+    final = g.solution.results["contact_fraction"]
+    assert g.estimate["contact_fraction"] <= 1e-3 and g.estimate["mean_closure"] <= 1e-3
+    assert abs(final - EXACT) <= g.estimate["contact_fraction"]
+    assert g.history[-1]["order"] == 3  # the answer is the one-order-higher check
+    smallest = [h["smallest_element"] for h in g.history if h["order"] == 2]
+    assert all(b < a for a, b in zip(smallest, smallest[1:]))
+
+
+def test_a_tolerance_out_of_reach_fails_with_the_figures(monkeypatch):
+    from ngcontact.cell import edge_grading
+    from ngcontact.errors import ConvergenceError
+
+    monkeypatch.setattr(edge_grading, "MAX_STEPS", 1)  # the budget, shortened: the rule is the same
+    with pytest.raises(ConvergenceError, match=r"discretization.tolerance = 1e-12 not reached after .* the "
+                                                r"contact fraction still changes by"):
+        solve_to_tolerance(make_problem, cell_load(2, pressure=RATIO * PSTAR), 1e-12, 0.02, 1.0, 1)
