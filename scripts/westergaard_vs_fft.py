@@ -50,10 +50,9 @@ import ngsolve as ng
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_problem import CellModel, CellProblem
-from ngcontact.cell.edge_grading import solve_to_tolerance
+from ngcontact.cell.edge_grading import graded_flat_cell, solve_to_tolerance
 from ngcontact.errors import ConvergenceError
 from ngcontact.fem.materials import isotropic
-from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.output.writer import write_csv
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import (westergaard_contact_fraction, westergaard_p_star,
@@ -92,7 +91,7 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None) -> di
     model = CellModel(rough=law, counter=law, k_n=kn, gap=2 * H_GAP * ng.sin(math.pi * ng.x) ** 2, order=order)
 
     def make_problem(vertices, p):
-        cell = flat_cell(1.0, DEPTH, DEPTH, maxh=0.3, interface_maxh=ih, order=p, vertices=vertices)
+        cell = graded_flat_cell(1.0, DEPTH, DEPTH, maxh=0.3, interface_maxh=ih, order=p, vertices=vertices)
         return CellProblem(cell, replace(model, order=p), max_iter=100)
 
     t0 = time.perf_counter()

@@ -19,8 +19,7 @@ from typing import Any
 
 from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, model_of
 from ngcontact.cell.cell_problem import CellProblem
-from ngcontact.cell.edge_grading import GradedSolve, solve_to_tolerance
-from ngcontact.geometry.cell2d import flat_cell
+from ngcontact.cell.edge_grading import GradedSolve, graded_flat_cell, solve_to_tolerance
 
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.output import plots as figures
@@ -36,8 +35,8 @@ def solve_graded(scene, loads) -> list[GradedSolve]:
     h0 = d.interface_maxh or d.maxh
 
     def make_problem(vertices, order):
-        cell = flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
-                         vertices=vertices)
+        cell = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
+                                vertices=vertices)
         return CellProblem(cell, replace(model, order=order), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
                            inverse=s.inverse)
 

@@ -83,7 +83,7 @@ class Cell:
 
 def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
                    maxh: float, interface_maxh: float | None = None, order: int = 1,
-                   voids=()) -> Cell:
+                   voids=(), grading: float = 0.3) -> Cell:
     """Mesh a 2D periodic cell whose bodies meet along ``segments``.
 
     Parameters
@@ -107,6 +107,9 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
         ``counter`` region: each void's boundary is labelled by its segments
         (``free`` or ``contact``).  A void's chain replaces the part of the
         interface it covers, which must then be omitted from ``segments``.
+    grading
+        Netgen's mesh grading: how fast elements may grow away from small
+        ones (larger grows faster).
     """
     pts = [tuple(map(float, p)) for s in segments for p in s.points]
     ends = [tuple(map(float, p)) for s in segments for p in (s.points[0], s.points[-1])]
@@ -162,7 +165,7 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
             geo.Append([s.kind, *ids], leftdomain=0, rightdomain=COUNTER, bc=s.label, maxh=hint)
     geo.SetMaterial(ROUGH, "rough")
     geo.SetMaterial(COUNTER, "counter")
-    mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh))
+    mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh, grading=grading))
     if order > 1:
         mesh.Curve(order)
     return Cell(mesh=mesh, dim=2, period=(float(period),), h_rough=float(h_rough),
@@ -170,15 +173,17 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
 
 
 def flat_cell(period: float = 1.0, h_rough: float = 1.0, h_counter: float = 1.0, *,
-              maxh: float, interface_maxh: float | None = None, order: int = 1, vertices=()) -> Cell:
+              maxh: float, interface_maxh: float | None = None, order: int = 1, vertices=(),
+              grading: float = 0.3) -> Cell:
     """Two bodies bonded along the flat line ``y = 0`` (the small-slope model).
 
     ``vertices``: abscissae in ``(0, period)`` that become mesh vertices of
     the interface (a mesh graded towards the contact edges,
-    :mod:`ngcontact.cell.edge_grading`).
+    :mod:`ngcontact.cell.edge_grading`); ``grading`` as in
+    :func:`interface_cell`.
     """
     tol = 1e-12 * period
     xs = [0.0] + sorted({float(v) for v in vertices if tol < v < period - tol}) + [float(period)]
     segs = [Segment("line", ((a, 0.0), (b, 0.0))) for a, b in zip(xs[:-1], xs[1:])]
     return interface_cell(segs, period, h_rough, h_counter, maxh=maxh,
-                          interface_maxh=interface_maxh, order=order)
+                          interface_maxh=interface_maxh, order=order, grading=grading)
