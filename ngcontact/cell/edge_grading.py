@@ -179,6 +179,7 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
     previous = None
     step = raises = 0
     last: list[Any] = []
+    graded: dict[str, Any] | None = None  # the last level-against-level comparison checked by an order raise
 
     def run(vertices: list[float], p: int, level: int):
         problem = make_problem(vertices, p)
@@ -233,8 +234,9 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
         else:
             vertices = graded_vertices(edges, h0, step * LEVELS_PER_STEP, period)
         problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP)
+    worst = graded["fraction_change"] if graded is not None else entry["fraction_change"]
     raise ConvergenceError(
         f"discretization.tolerance = {tolerance:g} not reached after {step} grading steps and {raises} order raises "
-        f"(smallest element {entry['smallest_element']:.3g}, order {entry['order']}): the contact fraction still "
-        f"changes by {entry['fraction_change']:.3g} and the mean closure by {entry['closure_change']:.3g}; loosen "
-        "the tolerance or raise the order", {})
+        f"(smallest element {entry['smallest_element']:.3g}, order {entry['order']}): the contact fraction changes "
+        f"by {worst:.3g} between the last two grading levels and by {entry['fraction_change']:.3g} with the last "
+        f"order, the mean closure by {entry['closure_change']:.3g}; loosen the tolerance or raise the order", {})
