@@ -200,10 +200,14 @@ def plot(rows: list[dict], path: str) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for ax, key, title in zip(axes, ("worst_fraction_error", "worst_pressure_error"),
                               ("contact fraction", "pressure (relative L2)")):
-        for solver, style in (("ngcontact", "o-"), ("tamaas", "s--")):
-            sel = [r for r in rows if r["solver"] == solver]
+        series = (("ngcontact, fixed meshes", "o-",
+                   lambda r: r["solver"] == "ngcontact" and "graded" not in r["setting"]),
+                  ("ngcontact, graded to a tolerance", "D-", lambda r: "graded" in r["setting"]),
+                  ("tamaas (FFT)", "s--", lambda r: r["solver"] == "tamaas"))
+        for label, style, take in series:
+            sel = [r for r in rows if take(r)]
             if sel:
-                ax.loglog([r["seconds"] for r in sel], [max(r[key], 1e-16) for r in sel], style, label=solver)
+                ax.loglog([r["seconds"] for r in sel], [max(r[key], 1e-16) for r in sel], style, label=label)
         ax.set_xlabel("wall time, four loads [s]")
         ax.set_ylabel("worst relative error over the four loads")
         ax.set_title(f"Westergaard: {title}")
