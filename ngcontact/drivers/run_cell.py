@@ -78,7 +78,9 @@ def run(scene, clock) -> Outcome:
         if graded:
             entry["error_estimate"] = graded[k].estimate
             entry["mesh_history"] = graded[k].history
-        entry["newton_iterations"] = sol.iterations
+        # graded: the Newton steps of every level the load was solved on, not only the last
+        entry["newton_iterations"] = (sum(h["newton_iterations"] for h in graded[k].history) if graded
+                                      else sol.iterations)
         entry["coulomb_iterations"] = sol.coulomb_iterations
         per_load.append(entry)
         newton.append(sol.newton)
