@@ -44,7 +44,9 @@ from typing import Any, Callable
 import numpy as np
 import ngsolve as ng
 
+from ngcontact.cell.measures import contact_pieces
 from ngcontact.errors import ConvergenceError
+from ngcontact.geometry.cell2d import flat_cell
 
 log = logging.getLogger(__name__)
 
@@ -72,8 +74,6 @@ def contact_edges(problem) -> np.ndarray:
     where the state changes between consecutive pieces along ``x``
     (periodically), inside an element or at a vertex.
     """
-    from ngcontact.cell.measures import contact_pieces
-
     pieces = sorted((min(a, b), max(a, b), on) for a, b, on, _ in contact_pieces(problem))
     if not pieces:
         return np.empty(0)
@@ -87,8 +87,8 @@ class GradedSolve:
 
     problem: Any
     solution: Any
+    estimate_from: tuple[dict[str, Any], dict[str, Any]]  # the level and the order comparison that met it
     history: list[dict[str, Any]] = field(default_factory=list)
-    estimate_from: tuple[dict[str, Any], dict[str, Any]] = ()  # type: ignore[assignment]
 
     @property
     def estimate(self) -> dict[str, float]:
@@ -116,8 +116,6 @@ def graded_vertices(edges, h0: float, levels: int, period: float) -> list[float]
 def graded_flat_cell(period: float, h_rough: float, h_counter: float, *, maxh: float, interface_maxh: float,
                      order: int, vertices):
     """The flat 2D cell with these interface vertices (Netgen's default grading without any)."""
-    from ngcontact.geometry.cell2d import flat_cell
-
     return flat_cell(period, h_rough, h_counter, maxh=maxh, interface_maxh=interface_maxh, order=order,
                      vertices=vertices, grading=MESH_GRADING if len(vertices) else 0.3)
 
