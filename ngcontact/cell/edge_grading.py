@@ -146,11 +146,11 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
                        period: float, order: int) -> GradedSolve:
     """Solve ``load`` on meshes graded towards the contact edges until the estimate meets ``tolerance``.
 
-    Once two grading levels agree to the tolerance, the finer level is
-    solved again at ``order + 1`` (the bulk, away from the edges, is smooth:
-    raising the order is the cheap refinement there); the estimate is the
-    larger of the two changes.  If the order changes the answer by more than
-    the tolerance, the grading continues at the raised order.
+    The loop of the module docstring: grading levels until the contact
+    fraction settles, then one order more on the same mesh; the estimate is
+    the larger of the two changes.  If the order changes the answer by more
+    than the tolerance, the grading continues at the raised order (at the
+    finest grading, the order is raised again).
 
     Parameters
     ----------
@@ -174,30 +174,28 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
     """
     history: list[dict[str, Any]] = []
     vertices: list[float] = []
-    previous = None
     step = raises = 0
-    last: list[Any] = []
     graded: dict[str, Any] | None = None  # the last level-against-level comparison checked by an order raise
 
-    def run(vertices: list[float], p: int, level: int):
+    def run(vertices: list[float], p: int, level: int, before=None):
+        """Solve on a new mesh, from ``before = (problem, entry)`` when given; record the changes against it."""
         problem = make_problem(vertices, p)
-        if history:
-            carry_over(last[0], problem)
-        sol = problem.solve(load, first=not history)
-        last[:] = [problem]
+        if before is not None:
+            carry_over(before[0], problem)
+        sol = problem.solve(load, first=before is None)
         edges = contact_edges(problem)
         ends = _interface_elements(problem.mesh)
+        f, c = sol.results["contact_fraction"], sol.results["mean_closure"]
         entry = {"level": level, "order": p, "ndof": problem.ndof, "edges": [float(e) for e in edges],
-                 "smallest_element": float(np.min(ends[:, 1] - ends[:, 0])),
-                 "contact_fraction": sol.results["contact_fraction"], "mean_closure": sol.results["mean_closure"],
-                 "newton_iterations": sol.iterations, "fraction_change": None, "closure_change": None}
-        if previous is not None:
-            f0, c0 = previous
-            entry["fraction_change"] = abs(entry["contact_fraction"] - f0)
-            entry["closure_change"] = abs(entry["mean_closure"] - c0) / max(abs(entry["mean_closure"]), 1e-300)
+                 "smallest_element": float(np.min(ends[:, 1] - ends[:, 0])), "contact_fraction": f,
+                 "mean_closure": c, "newton_iterations": sol.iterations, "fraction_change": None,
+                 "closure_change": None}
+        if before is not None:
+            entry["fraction_change"] = abs(f - before[1]["contact_fraction"])
+            entry["closure_change"] = abs(c - before[1]["mean_closure"]) / max(abs(c), 1e-300)
         history.append(entry)
         log.info("grading level %d, order %d: %d dofs, contact fraction %.10g, change %s", level, p,
-                 problem.ndof, entry["contact_fraction"], entry["fraction_change"])
+                 problem.ndof, f, entry["fraction_change"])
         return problem, sol, edges, entry
 
     def met(entry) -> bool:
@@ -213,10 +211,9 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
             # answer and raises remain
             graded = entry
             while raises < MAX_ORDER_RAISES + 1:
-                previous = (entry["contact_fraction"], entry["mean_closure"])
                 order += 1
                 raises += 1
-                problem, sol, edges, entry = run(vertices, order, entry["level"])
+                problem, sol, edges, entry = run(vertices, order, entry["level"], (problem, entry))
                 if graded["fraction_change"] <= tolerance and met(entry):
                     return GradedSolve(problem=problem, solution=sol, history=history,
                                        estimate_from=(graded, entry))
@@ -225,13 +222,12 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
         if step == MAX_STEPS or raises > MAX_ORDER_RAISES:
             break
         step += 1
-        previous = (entry["contact_fraction"], entry["mean_closure"])
         if len(edges) == 0:  # full (or no) contact: no edge to grade towards; halve the interface mesh instead
             n = int(round(period / h0)) * 2 ** step
             vertices = [period * (i + 0.5) / n for i in range(n)]
         else:
             vertices = graded_vertices(edges, h0, step * LEVELS_PER_STEP, period)
-        problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP)
+        problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP, (problem, entry))
     worst = graded["fraction_change"] if graded is not None else entry["fraction_change"]
     raise ConvergenceError(
         f"discretization.tolerance = {tolerance:g} not reached after {step} grading steps and {raises} order raises "

@@ -161,17 +161,15 @@ def check_model(scene) -> None:
     """
     geo = build_geometry(scene)
     check_boundaries(scene, geo.mesh)
-    spec = scene.interface
-    if spec.cell is not None:
-        tangential = True
-    else:
-        normal = interface_normal_law(spec)
-        assert normal is not None  # an explicit law (no cell) always has its numbers
-        tangential = il.InterfaceLaw(normal=normal, friction=interface_friction(spec)).holds_tangentially
-    rough, counter = REGIONS[scene.geometry.shape]
-    check_rigid_modes(geo.mesh, scene.geometry.setting, (rough, counter),
-                      tuple(M.Support(label=s.boundary, components=s.components) for s in scene.supports),
+    tangential = scene.interface.cell is not None or interface_law_of(scene, geo.mesh.dim)[0].holds_tangentially
+    check_rigid_modes(geo.mesh, scene.geometry.setting, REGIONS[scene.geometry.shape], supports_of(scene),
                       "interface", tangential)
+
+
+def supports_of(scene) -> tuple[M.Support, ...]:
+    """The scene's ``[[supports]]`` as the problem's supports."""
+    return tuple(M.Support(label=s.boundary, components=s.components, value=s.displacement)
+                 for s in scene.supports)
 
 
 def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.MacroProblem, dict]:
@@ -189,8 +187,7 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
     problem = M.MacroProblem(
         mesh=geometry.mesh, setting=scene.geometry.setting, rough=rough, counter=counter, materials=mats,
         law=law, gap=gap_of(scene), order=order or scene.discretization.order,
-        supports=tuple(M.Support(label=s.boundary, components=s.components, value=s.displacement)
-                       for s in scene.supports),
+        supports=supports_of(scene),
         loads=tuple(M.Load(label=lo.boundary, pressure=lo.pressure, traction=lo.traction) for lo in scene.loads))
     return problem, info
 
