@@ -22,7 +22,8 @@ from ngcontact.fem import materials
 from ngcontact.fem.interpolants import periodic_table_1d
 from ngcontact.laws import homogenized as il
 from ngcontact.laws.penalty import Friction
-from ngcontact.scene.cell_scene import GAP_PROFILES, CellScene, load_states, profile_2d, small_slope
+from ngcontact.cell.spectral_cell import Layer, SpectralCell
+from ngcontact.scene.cell_scene import GAP_PROFILES, CellScene, load_states, profile_2d, small_slope, spectral_grid
 from ngcontact.scene.loader import as_dict, load
 from ngcontact.scene.sections import MaterialSpec, resolve
 
@@ -154,6 +155,57 @@ def gap_cf(scene):
     return terms[0] if len(terms) == 1 else terms[0] + terms[1]
 
 
+def spectral_cell(scene: CellScene) -> SpectralCell:
+    """The spectral cell (:mod:`ngcontact.cell.spectral_cell`) of a small-slope cell scene."""
+    g, c, s = scene.geometry, scene.contact, scene.solver
+    shape = None
+    if small_slope(g) and g.profile == "height_map":
+        from ngcontact.geometry.tabulated import read_height_map
+        assert g.file is not None  # required by the profile (CellGeometry.check)
+        shape = read_height_map(resolve(scene, g.file), path="geometry.file").shape
+    grid = spectral_grid(scene, shape)
+
+    def layer(name, h):
+        m = scene.materials[name]
+        return Layer(E=m.E, nu=m.nu, h=h)
+    return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
+                        counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid), k_n=c.k_n,
+                        enforcement=c.enforcement, tol=s.rtol, max_iter=s.cg_max_iter)
+
+
+def gap_samples(scene, grid: int) -> np.ndarray:
+    """The initial gap of :func:`gap_cf` at the points of a uniform grid of ``grid`` points per period.
+
+    Shape ``(grid,)`` at ``x_j = j P / grid`` (2D) or ``(grid, grid)`` at
+    ``(x_j, y_i)`` (3D); height maps and tabulated gaps are interpolated
+    as the FE cell interpolates them (piecewise linear, bilinear).
+    """
+    from ngcontact.geometry import cell3d, tabulated
+    g = scene.geometry
+    P, dim = g.period, g.dim
+    s = P * np.arange(grid) / grid
+    xy = (s, np.zeros(1)) if dim == 2 else (s[None, :], s[:, None])
+    shape = (grid,) * (dim - 1)
+    out = np.zeros(shape)
+    if small_slope(g):
+        if g.profile == "bisinusoid":
+            out += cell3d.bisinusoid_gap(g.amplitude, P, xy=xy)
+        else:
+            H = tabulated.read_height_map(resolve(scene, g.file), path="geometry.file")
+            out += cell3d.bilinear_samples(H.max() - H, P, grid)
+    gs = scene.contact.gap
+    if gs.kind == "tabulated":
+        if dim == 2:
+            x, gv = tabulated.read_gap_csv(resolve(scene, gs.file), path="contact.gap.file")
+            out += np.interp(s, x, gv)
+        else:
+            out += cell3d.bilinear_samples(tabulated.read_gap_map(resolve(scene, gs.file), path="contact.gap.file"),
+                                           P, grid)
+    elif gs.kind != "none":
+        out += np.broadcast_to(_explicit_gap(scene, xy), shape)
+    return out
+
+
 def _profile_gap(scene):
     g = scene.geometry
     if not small_slope(g):
@@ -165,16 +217,18 @@ def _profile_gap(scene):
     return cell3d.height_map_gap(read_height_map(resolve(scene, g.file), path="geometry.file"), g.period)
 
 
-def _explicit_gap(scene):
+def _explicit_gap(scene, xy=None):
+    """The ``[contact.gap]`` section's formula: a CoefficientFunction, or with ``xy = (x, y)`` its values."""
     gs, P = scene.contact.gap, scene.geometry.period
+    x, y, m = (ng.x, ng.y, ng) if xy is None else (xy[0], xy[1], np)
     if gs.kind == "none":
         return None
     if gs.kind == "constant":
-        return ng.CF(gs.value)
+        return ng.CF(gs.value) if xy is None else gs.value + 0.0 * x
     if gs.kind == "sinusoid":
-        return 2 * gs.h * ng.sin(math.pi * ng.x / P) ** 2
+        return 2 * gs.h * m.sin(math.pi * x / P) ** 2
     if gs.kind == "bisinusoid":
-        return gs.h * (2 - ng.cos(2 * math.pi * ng.x / P) - ng.cos(2 * math.pi * ng.y / P))
+        return gs.h * (2 - m.cos(2 * math.pi * x / P) - m.cos(2 * math.pi * y / P))
     from ngcontact.geometry import tabulated
     if scene.geometry.dim == 2:
         x, g = tabulated.read_gap_csv(resolve(scene, gs.file), path="contact.gap.file")

@@ -8,7 +8,11 @@ real contact set, ``effective_stiffness`` and the largest von Mises / Tresca
 stress per body with its location (see :mod:`ngcontact.cell.cell_problem`).
 With ``discretization.tolerance`` each load is solved on its own mesh,
 graded towards its contact edges (:mod:`ngcontact.cell.edge_grading`), and
-its entry adds ``error_estimate`` and ``mesh_history``.
+its entry adds ``error_estimate`` and ``mesh_history``.  With
+``discretization.method = "spectral"`` the small-slope cell is solved on a
+grid (:mod:`ngcontact.cell.spectral_cell`, :func:`run_spectral`): the same
+per-load keys (no body stresses: the layers' interiors are not sampled), the
+grid fields as ``.npy`` and ``results.method`` stating the grid.
 """
 from __future__ import annotations
 
@@ -16,8 +20,10 @@ import logging
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
 
-from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, model_of
+
+from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, model_of, spectral_cell
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.edge_grading import GradedSolve, graded_flat_cell, solve_to_tolerance
 
@@ -48,8 +54,55 @@ def solve_graded(scene, loads) -> list[GradedSolve]:
     return out
 
 
+def run_spectral(scene, clock) -> Outcome:
+    """Solve a small-slope ``cell`` scene with the spectral cell."""
+    with clock.stage("grid"):
+        cell = spectral_cell(scene)
+    results: dict[str, Any] = {"method": {"name": "spectral", "grid": cell.grid, "points": cell.points,
+                                          "enforcement": cell.enforcement, "solver": "constrained_cg",
+                                          "tolerance": cell.tol},
+                               "whole_surface": cell.coefficients(np.ones(cell.shape, bool)).as_dict()}
+    if scene.contact.geometric_only:
+        return Outcome(results=results, ndof=cell.points)
+    with clock.stage("solve"):
+        sols = cell.sweep(cell_loads(scene))
+    per_load, tables, arrays = [], {}, {}
+    for k, sol in enumerate(sols):
+        entry = dict(sol.results)
+        entry["iterations"] = sol.iterations
+        per_load.append(entry)
+        for name in ("pressure", "gap"):
+            arrays[f"{name}_load{k}"] = sol.fields[name]
+        if cell.dim == 2:
+            x = cell.period * np.arange(cell.grid) / cell.grid
+            tables[f"surface_load{k}"] = (["x", "pressure", "gap", "closure"], list(zip(
+                x, sol.fields["pressure"], sol.fields["gap"], sol.fields["closure"])))
+        log.info("load %d: %d constrained CG steps, contact fraction %.8f", k, sol.iterations,
+                 sol.results["contact_fraction"])
+    results["loads"] = per_load
+    solver = {"iterations": sum(s.iterations for s in sols), "converged": True,
+              "per_load": [{"method": "constrained_cg", "iterations": s.iterations,
+                            "residuals": s.residuals} for s in sols]}
+    plots: dict[str, Any] = {}
+    if cell.dim == 2:
+        xs = cell.period * np.arange(cell.grid) / cell.grid
+        surfaces = [{"x": xs, "pressure": s.fields["pressure"], "slip": np.zeros(cell.grid)} for s in sols]
+        plots["surface"] = lambda path, sf=surfaces: figures.cell_surface(path, sf)
+    else:
+        maps = [s.fields["pressure"] for s in sols]
+        plots["pressure_map"] = lambda path, m=maps: figures.pressure_map(path, m, cell.period)
+    if len(sols) > 1:
+        curve = {k: [s.results[k] for s in sols] for k in ("transmitted_pressure", "contact_fraction",
+                                                            "mean_closure")}
+        plots["contact_curve"] = lambda path, c=curve: figures.cell_contact_curve(
+            path, c["transmitted_pressure"], c["contact_fraction"], c["mean_closure"])
+    return Outcome(results=results, ndof=cell.points, solver=solver, tables=tables, plots=plots, arrays=arrays)
+
+
 def run(scene, clock) -> Outcome:
     """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`)."""
+    if scene.discretization.method == "spectral":
+        return run_spectral(scene, clock)
     with clock.stage("mesh"):
         cell = build_cell(scene)
     c = scene.contact

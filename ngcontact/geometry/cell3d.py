@@ -265,15 +265,17 @@ def surface_cell(heights, *, period: float = 1.0, h_rough: float, h_counter: flo
 
 
 # ----------------------------------------------------- small-slope models
-def bisinusoid_gap(amplitude: float, period: float = 1.0):
+def bisinusoid_gap(amplitude: float, period: float = 1.0, xy=None):
     """Initial gap of the bisinusoid ``z = A (cos(2 pi x/P) + cos(2 pi y/P) - 2)`` below its summit.
 
     Small-slope model on :func:`flat_cell3d`: ``g(x, y) = A (2 - cos(2 pi x/P)
-    - cos(2 pi y/P)) >= 0``, zero at the summit ``(0, 0)``.
+    - cos(2 pi y/P)) >= 0``, zero at the summit ``(0, 0)``.  A
+    CoefficientFunction, or with ``xy = (x, y)`` (arrays) its values there.
     """
     A, P = _positive("amplitude", amplitude), _positive("period", period)
     k = 2 * math.pi / P
-    return A * (2 - ng.cos(k * ng.x) - ng.cos(k * ng.y))
+    x, y, m = (ng.x, ng.y, ng) if xy is None else (xy[0], xy[1], np)
+    return A * (2 - m.cos(k * x) - m.cos(k * y))
 
 
 def height_map_gap(heights, period: float = 1.0):
@@ -289,3 +291,26 @@ def height_map_gap(heights, period: float = 1.0):
     H = np.asarray(heights, dtype=float)
     g = np.ascontiguousarray(H.max() - H)
     return ng.VoxelCoefficient((0.0, 0.0), (P, P), g, linear=True)
+
+
+def bilinear_samples(values, period: float, grid: int) -> np.ndarray:
+    """A periodic map (layout of :func:`height_map_gap`) at the points ``(j, i) P / grid`` of a uniform grid.
+
+    Bilinear between the map's samples, as the voxel coefficient the FE cell
+    uses; returns shape ``(grid, grid)`` indexed ``[i (y), j (x)]``.
+    """
+    V = np.asarray(values, dtype=float)
+    ny, nx = V.shape[0] - 1, V.shape[1] - 1
+    if ny == nx == grid:
+        return V[:-1, :-1].copy()
+    s = np.arange(grid) / grid
+
+    def weights(n):
+        t = s * n
+        i = np.minimum(np.floor(t).astype(int), n - 1)
+        return i, t - i
+    iy, wy = weights(ny)
+    ix, wx = weights(nx)
+    lo = V[iy][:, ix] * (1 - wx) + V[iy][:, ix + 1] * wx
+    hi = V[iy + 1][:, ix] * (1 - wx) + V[iy + 1][:, ix + 1] * wx
+    return lo * (1 - wy)[:, None] + hi * wy[:, None]

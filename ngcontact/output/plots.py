@@ -79,6 +79,22 @@ def cell_contact_curve(path: str, pressure, contact_fraction, mean_closure) -> N
     plt.close(fig)
 
 
+def pressure_map(path: str, pressures: list, period: float) -> None:
+    """Contact pressure over one period of a 3D cell, one panel per load (in contact: nonzero)."""
+    plt = _pyplot()
+    n = len(pressures)
+    fig, axes = plt.subplots(1, n, figsize=(3.6 * n + 0.6, 3.4), squeeze=False)
+    for k, (ax, p) in enumerate(zip(axes[0], pressures)):
+        im = ax.imshow(p, origin="lower", extent=(0, period, 0, period), cmap="viridis")
+        ax.set_title(f"load {k}: contact {float((p > 0).mean()):.3f}", fontsize=8)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        fig.colorbar(im, ax=ax, shrink=0.8, label="pressure")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 # ------------------------------------------------------------------ macro
 def macro_interface(path: str, prof: dict) -> None:
     """Pressure, shear, jumps and status along the interface.

@@ -6,6 +6,9 @@ A driver returns an :class:`Outcome` (plain data plus deferred writers);
 Reports never contain NaN or infinity: :func:`to_plain` rejects them before
 any file is written.
 
+Grid fields (the spectral cell's pressure and gap) are written as ``.npy``
+arrays.
+
 Report keys (schema ``ngcontact-report/1``): ``schema``, ``version``,
 ``kind``, ``title``, ``scene`` (the validated scene echoed), ``effects`` (the
 terms assembled), ``ndof``, ``timings`` (seconds per stage and ``total``),
@@ -48,6 +51,7 @@ class Outcome:
     tables: dict[str, tuple[list[str], list]] = field(default_factory=dict)
     vtk: dict[str, VtkField] = field(default_factory=dict)
     plots: dict[str, Callable[..., None]] = field(default_factory=dict)
+    arrays: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 class Clock:
@@ -101,7 +105,7 @@ def to_plain(obj, path: str = "results"):
 def file_names(outcome: Outcome) -> list[str]:
     """The names of the files an outcome writes besides ``report.json`` (the report's ``files``)."""
     return sorted([f"{n}.csv" for n in outcome.tables] + [f"{n}.vtu" for n in outcome.vtk]
-                  + [f"{n}.png" for n in outcome.plots])
+                  + [f"{n}.png" for n in outcome.plots] + [f"{n}.npy" for n in outcome.arrays])
 
 
 def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcome,

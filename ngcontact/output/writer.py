@@ -38,6 +38,8 @@ import tempfile
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Iterable
 
+import numpy as np
+
 from ngcontact.errors import OutputError
 from ngcontact.output.report import Outcome, file_names, to_plain
 
@@ -208,6 +210,8 @@ def write_outputs(out_dir: str, report: dict, outcome: Outcome, inputs: Iterable
             write_vtk(os.path.join(tmp, name), item)
         for name, draw in outcome.plots.items():
             draw(os.path.join(tmp, f"{name}.png"))
+        for name, array in outcome.arrays.items():
+            np.save(os.path.join(tmp, f"{name}.npy"), array, allow_pickle=False)
         with open(os.path.join(tmp, "report.json"), "w") as fh:
             json.dump(report, fh, indent=2, allow_nan=False)
             fh.write("\n")

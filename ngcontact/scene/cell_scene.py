@@ -28,6 +28,7 @@ PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map")
 GAP_PROFILES = ("bisinusoid", "height_map")
 GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 FRICTION = ("none", "tresca", "coulomb")
+ENFORCEMENTS = ("penalty", "exact")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -168,7 +169,11 @@ class GapSpec:
 class ContactSpec:
     """Penalty contact and friction on S_C."""
 
-    k_n: float = param(doc="penalty (Winkler) stiffness k_n", units="Pa/m", check=positive())
+    k_n: float = param(doc="penalty (Winkler) stiffness k_n (with enforcement = 'exact' only the scale of the "
+                       "eq. 34 coefficients in the report)", units="Pa/m", check=positive())
+    enforcement: str = param("penalty", doc="penalty: the paper's Winkler layer p = k_n [J.n - g]_+ (eq. 65); "
+                             "exact: non-penetration, the rigid limit k_n -> infinity (discretization.method = "
+                             "'spectral')", choices=ENFORCEMENTS)
     gap: GapSpec = param(GapSpec(), doc="initial gap")
     friction: str = param("none", doc="friction law", choices=FRICTION)
     G: float | None = param(None, doc="Tresca threshold", units="Pa", check=nonnegative())
@@ -291,7 +296,14 @@ class CellScene:
             return
         if self.load is None:
             raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
-        check_penalty_ratio(self)
+        if self.discretization.method == "spectral":
+            check_spectral(self)
+        else:
+            if self.contact.enforcement == "exact":
+                raise SceneError("contact.enforcement", "exact", "exact non-penetration is solved by the spectral "
+                                 "cell (discretization.method = 'spectral', small-slope cells); the FE cell "
+                                 "enforces contact by the penalty: set enforcement = 'penalty'")
+            check_penalty_ratio(self)
         if self.discretization.tolerance is not None and not (dim == 2 and self.geometry.profile == "flat"):
             raise SceneError("discretization.tolerance", self.discretization.tolerance,
                              "refinement towards the contact edges needs a 2D cell with geometry.profile = "
@@ -314,6 +326,8 @@ class CellScene:
     def check_size(self) -> None:
         """The element estimate of :mod:`ngcontact.scene.mesh_size` against ``max_elements``."""
         g, d = self.geometry, self.discretization
+        if d.method == "spectral":
+            return          # no mesh: the grid is bounded by its own check
         P, dim = g.period, g.dim
         mesh_size.check_lengths({"geometry.period": P, "geometry.h_rough": g.h_rough, "geometry.h_counter": g.h_counter,
                                  "discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
@@ -350,6 +364,44 @@ def check_penalty_ratio(scene: CellScene) -> None:
         raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
                          f"E = {E:g} the softer body's modulus) must stay below {MAX_PENALTY_RATIO:g}: the "
                          "penalty would outweigh the bodies beyond what double precision resolves; lower k_n")
+
+
+#: Largest number of spectral grid points of a cell (2D: points, 3D: points squared).
+MAX_SPECTRAL_POINTS = 2 ** 24
+
+
+def spectral_grid(scene: CellScene, heights_shape: tuple[int, ...] | None = None) -> int:
+    """Points per period and direction of a spectral cell: ``discretization.grid`` or the default."""
+    if scene.discretization.grid is not None:
+        return scene.discretization.grid
+    if heights_shape is not None:      # the map's own grid (made even)
+        n = max(heights_shape) - 1
+        return n + n % 2
+    return 1024 if scene.geometry.dim == 2 else 256
+
+
+def check_spectral(scene: CellScene) -> None:
+    """A spectral cell needs the small-slope model and a frictionless normal load."""
+    g, c, d = scene.geometry, scene.contact, scene.discretization
+    if not (g.profile in ("flat", "flat3d") or small_slope(g)):
+        raise SceneError("discretization.method", "spectral", "solves the small-slope cell: a flat interface with "
+                         "the roughness in the initial gap (geometry.profile = 'flat' or 'flat3d', or 'bisinusoid' / "
+                         f"'height_map' with arrangement = 'summit'), not geometry.profile = {g.profile!r} in the "
+                         f"{g.arrangement!r} arrangement; use method = 'fe'")
+    if c.friction != "none":
+        raise SceneError("contact.friction", c.friction, "the spectral cell solves frictionless contact so far; set "
+                         "friction = 'none' or discretization.method = 'fe'")
+    if d.tolerance is not None:
+        raise SceneError("discretization.tolerance", d.tolerance, "refines an FE mesh; the spectral cell's accuracy "
+                         "is set by discretization.grid: remove the key")
+    if d.grid is not None and d.grid % 2:
+        raise SceneError("discretization.grid", d.grid, "must be even (the FFT's Nyquist mode is real)")
+    n = d.grid if d.grid is not None else (1024 if g.dim == 2 else 256)
+    points = n ** (g.dim - 1)
+    if points > MAX_SPECTRAL_POINTS:
+        raise SceneError("discretization.grid", n, f"makes {points} grid points, more than {MAX_SPECTRAL_POINTS} "
+                         f"(about {MAX_SPECTRAL_POINTS * 200 // 2 ** 30} GB of fields); at most "
+                         f"{int(MAX_SPECTRAL_POINTS ** (1 / (g.dim - 1)))} in {g.dim}D")
 
 
 def small_slope(geometry: CellGeometry) -> bool:
@@ -399,7 +451,7 @@ def effects(scene: CellScene) -> tuple[str, ...]:
     """The terms assembled (geometric_only: only the surface integrals)."""
     if scene.contact.geometric_only:
         return ("contact_surface_coefficients",)
-    out = ["elasticity", "normal_contact"]
+    out = ["elasticity", "exact_normal_contact" if scene.contact.enforcement == "exact" else "normal_contact"]
     if scene.contact.gap.kind != "none" or small_slope(scene.geometry):
         out.append("gap")
     if scene.contact.friction != "none":

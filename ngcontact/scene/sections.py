@@ -58,6 +58,10 @@ class Discretization:
                               "(a guard against sizes that hang the mesher)", check=at_least(1))
 
 
+#: Largest spectral grid per direction (2D; in 3D the number of points bounds it, see scene.cell_scene).
+MAX_GRID = 2 ** 24
+
+
 @dataclass(frozen=True, kw_only=True)
 class CellDiscretization(Discretization):
     """Finite element discretization of a cell, with accuracy on request."""
@@ -67,18 +71,26 @@ class CellDiscretization(Discretization):
         "fraction (absolute) and of the mean closure (relative) is at most this (2D cells with a flat "
         "interface; the report gives the estimate and the mesh history per load); default: the fixed mesh",
         check=open_interval(0, 1))
+    method: str = param("fe", doc="fe: finite elements on a mesh of the cell; spectral: the small-slope cell "
+                        "(flat interface, the roughness in the initial gap) as two periodic layers solved with "
+                        "FFTs on a uniform grid of the interface", choices=("fe", "spectral"))
+    grid: int | None = param(None, doc="spectral: grid points per period and direction (default: a height "
+                             "map's own grid, else 1024 in 2D and 256 in 3D)", check=closed_interval(8, MAX_GRID))
 
 
 @dataclass(frozen=True, kw_only=True)
 class SolverSpec:
     """Newton solver settings and the stopping rule of the Coulomb fixed point."""
 
-    rtol: float = param(1e-10, doc="stop when the residual falls below rtol x the first residual",
-                        check=positive())
+    rtol: float = param(1e-10, doc="stop when the residual falls below rtol x the first residual (spectral "
+                        "cell: when the complementarity residual falls below rtol x the gap's peak-to-valley "
+                        "height)", check=positive())
     atol: float = param(0.0, doc="or below this absolute residual", units="N", check=at_least(0))
     max_iter: int = param(40, doc="largest number of Newton steps", check=at_least(1))
     inverse: str = param("sparsecholesky", doc="sparse direct solver",
                          choices=("sparsecholesky", "umfpack"))
+    cg_max_iter: int = param(10000, doc="spectral cell: largest number of constrained CG steps per load",
+                             check=at_least(1))
     coulomb_rtol: float = param(1e-8, doc="Coulomb fixed point: stop when max |p_k - p_k-1| <= coulomb_rtol x "
                                 "max p_k on the contact surface", check=positive())
     coulomb_max_iter: int = param(40, doc="Coulomb fixed point: largest number of Tresca passes", check=at_least(1))

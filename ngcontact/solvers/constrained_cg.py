@@ -1,0 +1,179 @@
+"""Constrained conjugate gradients for a unilateral contact problem on a grid.
+
+The problem (the discrete form of the rigid-limit cell problem, paper eq. 57
+with the small-slope contact condition, or of its penalty form eq. 65):
+find pressures ``p_i >= 0`` on the points of a grid minimizing
+
+    f(p) = 1/2 <p, A p> + <p, b>        (optionally with mean(p) = pbar),
+
+``A`` symmetric positive (semi)definite and applied as a function (an FFT
+convolution for the spectral cell), ``b`` the initial gap.  Its optimality
+conditions are the contact conditions: with the gap ``gamma = A p + b - c``
+(``c`` the multiplier of the mean constraint, 0 without it)
+
+    p >= 0,   gamma >= 0,   p gamma = 0.
+
+Method (Polonsky & Keer, Wear 231 (1999) 206-219).  Conjugate gradients on
+the current contact set ``{p > 0}``, the search direction made
+mean-free over the set when the mean pressure is prescribed; after each
+step the pressures are clipped at 0, points outside the set whose gap is
+negative are put back in contact with a steepest-descent step (and the
+conjugacy restarted), and the mean is rescaled to ``pbar``.  Chosen over a
+semismooth Newton with the FFT-applied operator because each step costs two
+operator applications and no inner linear solve, it needs no
+regularization of the complementarity, and it converges to the exact
+contact set of the grid (the active set settles in a few dozen steps, then
+it is plain CG on an SPD system).
+
+Stopping rule: the complementarity residual, relative to the scale ``gscale``
+of the gap,
+
+    r = max( max_{p>0} |gamma|, max_{p=0} max(-gamma, 0) ) / gscale <= tol.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ngcontact.errors import ConvergenceError
+
+
+@dataclass
+class ConstrainedResult:
+    """Solution of :func:`constrained_cg`: pressure, gap, multiplier, history."""
+
+    p: np.ndarray
+    gap: np.ndarray
+    shift: float
+    iterations: int
+    residuals: list[float]
+
+
+def inner(a: np.ndarray, b: np.ndarray) -> float:
+    """``sum a b`` without BLAS: OpenBLAS' threads, spinning against another busy process, made a dot
+    product of 16k numbers take 8 ms instead of 30 us."""
+    return float(np.multiply(a, b).sum())
+
+
+def _residual(p, g, shift, gscale) -> float:
+    gamma = g - shift
+    on = p > 0
+    r_on = float(np.max(np.abs(gamma[on]))) if on.any() else 0.0
+    r_off = float(np.max(-gamma[~on], initial=0.0))
+    return max(r_on, r_off) / gscale
+
+
+def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *, pbar: float | None,
+                   tol: float, max_iter: int, gscale: float, p0: np.ndarray | None = None) -> ConstrainedResult:
+    """Minimize ``1/2 <p, A p> + <p, b>`` over ``p >= 0`` (module docstring).
+
+    Parameters
+    ----------
+    apply_A
+        ``p -> A p`` (same shape as ``b``).
+    b
+        Initial gap on the grid.
+    pbar
+        Prescribed mean pressure (> 0), or ``None``: no mean constraint
+        (``A`` must then be positive definite, e.g. include the uniform
+        mode, and ``b`` carries the prescribed approach).
+    tol, max_iter
+        Stopping rule (module docstring) and the largest number of steps.
+    gscale
+        Scale of the gap for the residual (e.g. its peak-to-valley height).
+    p0
+        Start (e.g. the previous load's pressure); default: uniform ``pbar``,
+        or, without a mean constraint, the pressure that closes every
+        penetrating point under the diagonal of ``A``.
+
+    Raises
+    ------
+    ConvergenceError
+        When the residual is still above ``tol`` after ``max_iter`` steps.
+    """
+    if pbar is not None and not pbar > 0:
+        raise ValueError(f"pbar = {pbar!r}: a prescribed mean pressure must be > 0")
+    if not gscale > 0:
+        raise ValueError(f"gscale = {gscale!r}: must be > 0")
+    n = b.size
+    if p0 is not None and np.any(p0 > 0):
+        p = np.maximum(p0, 0.0).astype(float)
+    elif pbar is not None:
+        p = np.full(b.shape, float(pbar))
+    else:
+        e = np.zeros(b.shape)
+        e.flat[0] = 1.0
+        diag = float(apply_A(e).flat[0])
+        p = np.maximum(-b, 0.0) / diag
+    if pbar is not None:
+        p *= pbar / p.mean()
+    t = np.zeros(b.shape)
+    g_old = 1.0
+    conjugate = False
+    residuals: list[float] = []
+    shift = 0.0
+    g = apply_A(p) + b
+    for it in range(1, max_iter + 1):
+        on = p > 0
+        if not on.any():       # nothing pressed (approach below every summit): the open solution
+            residuals.append(_residual(p, g, 0.0, gscale))
+            return ConstrainedResult(p=p, gap=g, shift=0.0, iterations=it - 1, residuals=residuals)
+        shift = float(g[on].mean()) if pbar is not None else 0.0
+        gs = np.where(on, g - shift, 0.0)
+        G = inner(gs, gs)
+        t = np.where(on, gs + (G / g_old) * t if conjugate else gs, 0.0)
+        g_old = G
+        r = apply_A(t)
+        if pbar is not None:
+            r = r - r[on].mean()
+        rt = inner(np.where(on, r, 0.0), t)
+        if rt <= 0:
+            residuals.append(_residual(p, g, shift, gscale))
+            break
+        tau = inner(gs, t) / rt
+        p = np.maximum(p - tau * t, 0.0)
+        back = (p == 0.0) & (g - shift < 0.0)
+        conjugate = not back.any()
+        if not conjugate:
+            p[back] -= tau * (g[back] - shift)
+        if pbar is not None:
+            p *= pbar / p.mean()
+        g = apply_A(p) + b
+        on = p > 0
+        shift = float(g[on].mean()) if (pbar is not None and on.any()) else 0.0
+        res = _residual(p, g, shift, gscale)
+        residuals.append(res)
+        if res <= tol:
+            return ConstrainedResult(p=p, gap=g - shift, shift=shift, iterations=it, residuals=residuals)
+    raise ConvergenceError(
+        f"constrained CG: the complementarity residual {residuals[-1]:.3g} of the gap scale is above the "
+        f"tolerance {tol:g} after {len(residuals)} steps (grid of {n} points)", {"residuals": residuals[-5:]})
+
+
+def masked_cg(apply_A: Callable[[np.ndarray], np.ndarray], active: np.ndarray, rhs: np.ndarray, *,
+              rtol: float = 1e-10, max_iter: int = 10000) -> tuple[np.ndarray, int]:
+    """Solve ``(A x)_i = rhs_i`` for ``i`` in ``active`` with ``x = 0`` outside, by conjugate gradients.
+
+    ``A`` restricted to a set is symmetric positive definite whenever ``A`` is
+    positive definite on vectors supported there (the linearization of the
+    contact problem at a fixed contact set).  Returns ``(x, iterations)``.
+    """
+    mask = active.astype(float)
+    x = np.zeros(rhs.shape)
+    r = rhs * mask
+    d = r.copy()
+    rr = inner(r, r)
+    stop = rtol * rtol * rr
+    for it in range(1, max_iter + 1):
+        if rr <= stop:
+            return x, it - 1
+        Ad = apply_A(d) * mask
+        alpha = rr / inner(d, Ad)
+        x += alpha * d
+        r -= alpha * Ad
+        rr, rr_old = inner(r, r), rr
+        d = r + (rr / rr_old) * d
+    raise ConvergenceError(f"masked CG: residual {np.sqrt(rr / inner(rhs * mask, rhs * mask)):.3g} above "
+                           f"{rtol:g} after {max_iter} steps", {})

@@ -1,0 +1,275 @@
+"""The spectral small-slope cell: layer compliance, constrained CG, Westergaard, FE agreement, scenes."""
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+
+from ngcontact import cli
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.layer_compliance import antiplane_compliance, layer_matrix, plane_compliances
+from ngcontact.cell.spectral_cell import Layer, SpectralCell, wave_numbers
+from ngcontact.errors import ConvergenceError
+from ngcontact.solvers.constrained_cg import constrained_cg, masked_cg
+from ngcontact.verification.layer_fe import layer_fe_compliance
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import (westergaard_contact_fraction, westergaard_p_star,
+                                                westergaard_pressure)
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+CELLS = os.path.join(ROOT, "geometries", "cells")
+
+
+# ------------------------------------------------------------------ layer compliance
+@pytest.mark.parametrize("k, h, E, nu", [(1.0, 1.0, 2.3, 0.27), (6.28, 0.3, 1.0, 0.3), (30.0, 1.0, 5.0, 0.45),
+                                         (0.05, 1.0, 1.0, -0.2), (2 * math.pi, 0.6, 210e9, 0.3)])
+def test_closed_form_compliance_equals_the_finite_elements_through_the_thickness(k, h, E, nu):
+    nn, ll, ln = plane_compliances(k, E, nu, h)
+    aa = antiplane_compliance(k, E, nu, h)
+    fe = layer_fe_compliance(k, E, nu, h)
+    for name, value in (("nn", nn), ("ll", ll), ("ln", ln), ("aa", aa)):
+        assert abs(fe[name] - float(value)) <= 1e-10 * abs(float(value)), (name, fe[name], float(value))
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3, 0.49])
+def test_thick_layer_is_the_half_space_and_thin_layer_the_uniaxial_strain_column(nu):
+    E, k = 3.0, 2.0
+    nn, ll, ln = plane_compliances(k, E, nu, 40.0 / k)
+    mu = E / (2 * (1 + nu))
+    assert float(nn) == pytest.approx(2 * (1 - nu ** 2) / (E * k), rel=1e-14)
+    assert float(ll) == pytest.approx(2 * (1 - nu ** 2) / (E * k), rel=1e-14)
+    assert float(ln) == pytest.approx(-(1 - 2 * nu) / (2 * mu * k), rel=1e-13, abs=1e-300)
+    h = 1e-6          # k h = 2e-6: the O((k h)^2) correction, large near nu = 1/2, is below 1e-9
+    M = 2 * mu * (1 - nu) / (1 - 2 * nu)
+    nn0, ll0, _ = plane_compliances(k, E, nu, h)
+    assert float(nn0) == pytest.approx(h / M, rel=1e-7)
+    assert float(ll0) == pytest.approx(h / mu, rel=1e-7)
+    assert plane_compliances(0.0, E, nu, h)[0] == pytest.approx(h / M, rel=1e-15)   # the zero mode
+
+
+def test_layer_matrix_is_hermitian_positive_and_the_counter_mirrors_the_coupling():
+    rng = np.random.default_rng(1)
+    kv = rng.normal(size=(50, 2)) * 7
+    C = layer_matrix(kv, 2.0, 0.3, 0.4)
+    Cu = layer_matrix(kv, 2.0, 0.3, 0.4, above=True)
+    assert np.allclose(C, np.conj(np.swapaxes(C, -1, -2)), rtol=0, atol=1e-14)
+    assert np.all(np.linalg.eigvalsh(C) > 0)
+    R = np.diag([1.0, 1.0, -1.0])
+    assert np.allclose(Cu, R @ C @ R, rtol=0, atol=1e-15)
+    # isotropy in the plane: rotating k rotates C
+    c, s = math.cos(0.7), math.sin(0.7)
+    Q = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+    Ck = layer_matrix(kv @ Q[:2, :2].T, 2.0, 0.3, 0.4)
+    assert np.allclose(Ck, Q @ C @ Q.T, rtol=0, atol=1e-14)
+
+
+# ------------------------------------------------------------------ constrained CG
+def _operator(N, E=1.0, nu=0.3, h=1.0):
+    cell = SpectralCell(dim=2, period=1.0, grid=N, rough=Layer(E, nu, h), counter=Layer(E, nu, h),
+                        gap=np.zeros(N), k_n=1.0)
+    return cell, cell._interface_compliance(uniform=True)
+
+
+def test_the_operator_is_symmetric_positive_and_the_energy_gradient_is_its_residual():
+    cell, A = _operator(64)
+    rng = np.random.default_rng(3)
+    x, y, b = rng.normal(size=(3, 64))
+    assert np.dot(x, A(y)) == pytest.approx(np.dot(A(x), y), rel=1e-13)
+    assert np.dot(x, A(x)) > 0
+
+    def f(p):
+        return 0.5 * np.dot(p, A(p)) + np.dot(p, b)
+    grad = A(x) + b
+    for i in (0, 17, 40):
+        e = np.zeros(64)
+        e[i] = 1e-4
+        fd = (f(x + e) - f(x - e)) / 2e-4
+        assert fd == pytest.approx(grad[i], rel=1e-7)
+
+
+def test_constrained_cg_meets_the_contact_conditions_and_refuses_a_hopeless_budget():
+    cell, A = _operator(256)
+    x = np.arange(256) / 256
+    g0 = 0.02 * np.sin(np.pi * x) ** 2
+    res = constrained_cg(cell._interface_compliance(uniform=False), g0, pbar=5e-3, tol=1e-12, max_iter=1000,
+                         gscale=0.02)
+    assert res.p.min() >= 0 and res.p.mean() == pytest.approx(5e-3, rel=1e-14)
+    on = res.p > 0
+    assert np.max(np.abs(res.gap[on])) <= 1e-12 * 0.02 and res.gap[~on].min() >= -1e-12 * 0.02
+    with pytest.raises(ConvergenceError, match="constrained CG"):
+        constrained_cg(cell._interface_compliance(uniform=False), g0, pbar=5e-3, tol=1e-14, max_iter=3,
+                       gscale=0.02)
+    # the linearization at the contact set: C restricted to it is SPD, masked CG solves it
+    sol, its = masked_cg(cell._interface_compliance(uniform=False), on, np.ones(256), rtol=1e-12)
+    r = cell._interface_compliance(uniform=False)(sol)
+    assert np.allclose(r[on], 1.0, atol=1e-10) and np.all(sol[~on] == 0) and its > 0
+
+
+# ------------------------------------------------------------------ Westergaard
+E_, NU, H = 1.0, 0.3, 0.01
+P_STAR = westergaard_p_star(e_star(E_, NU) / 2, H, 1.0)
+LOADS = (0.05, 0.2, 0.5, 0.8)
+
+
+def _westergaard(N, thickness, enforcement="exact", k_n=1e3):
+    x = np.arange(N) / N
+    cell = SpectralCell(dim=2, period=1.0, grid=N, rough=Layer(E_, NU, thickness), counter=Layer(E_, NU, thickness),
+                        gap=2 * H * np.sin(np.pi * x) ** 2, k_n=k_n, enforcement=enforcement)
+    return cell, [cell.solve(cell_load(2, pressure=r * P_STAR)) for r in LOADS]
+
+
+def _fraction_error(sols):
+    return max(abs(s.results["contact_fraction"] - westergaard_contact_fraction(r * P_STAR, P_STAR))
+               / westergaard_contact_fraction(r * P_STAR, P_STAR) for r, s in zip(LOADS, sols))
+
+
+def test_westergaard_contact_fraction_converges_at_more_than_first_order_in_the_grid():
+    errors = [_fraction_error(_westergaard(N, thickness=20.0)[1]) for N in (256, 1024, 4096)]
+    rates = [math.log(errors[i] / errors[i + 1]) / math.log(4) for i in range(2)]
+    assert errors[-1] <= 1e-4, errors
+    assert min(rates) >= 1.2, (errors, rates)
+
+
+def test_westergaard_pressure_field_and_closure():
+    cell, sols = _westergaard(4096, thickness=20.0)
+    x = np.arange(4096) / 4096
+    x = np.where(x > 0.5, x - 1, x)
+    for r, s in zip(LOADS, sols):
+        exact = westergaard_pressure(x, r * P_STAR, P_STAR, 1.0)
+        assert np.linalg.norm(s.fields["pressure"] - exact) / np.linalg.norm(exact) <= 5e-4
+        assert s.results["mean_pressure"] == pytest.approx(r * P_STAR, rel=1e-13)
+        assert s.results["max_penetration"] <= 1e-9 * 2 * H
+
+
+@pytest.mark.slow
+def test_westergaard_on_a_fine_grid():
+    assert _fraction_error(_westergaard(65536, thickness=20.0)[1]) <= 2e-5
+
+
+def test_penalty_converges_to_exact_contact_like_one_over_k_n():
+    _, exact = _westergaard(2048, thickness=1.0)
+    errs = []
+    for k_n in (1e2, 1e3, 1e4):
+        _, pen = _westergaard(2048, thickness=1.0, enforcement="penalty", k_n=k_n)
+        errs.append(max(abs(p.results["mean_closure"] - e.results["mean_closure"]) / e.results["mean_closure"]
+                        for p, e in zip(pen, exact)))
+    rates = [math.log10(errs[i] / errs[i + 1]) for i in range(2)]
+    assert all(0.9 <= r <= 1.1 for r in rates), (errs, rates)
+
+
+@pytest.mark.parametrize("ratio", [1.0, 10.0, 100.0])
+def test_frictionless_answer_depends_on_the_materials_only_through_the_compliance(ratio):
+    """Thick layers: dissimilar bodies E1, E2 = ratio E1 and identical bodies of the same E* agree."""
+    N, nu = 1024, 0.3
+    x = np.arange(N) / N
+    g0 = 2 * H * np.sin(np.pi * x) ** 2
+    E1, E2 = 1.0, ratio
+    # identical bodies with 2 / E_eq = 1 / E1 + 1 / E2 (same nu): the same summed compliance
+    E_eq = 2.0 / (1.0 / E1 + 1.0 / E2)
+    load = cell_load(2, pressure=0.3 * westergaard_p_star(e_star(E1, nu) * e_star(E2, nu)
+                                                          / (e_star(E1, nu) + e_star(E2, nu)), H, 1.0))
+    a = SpectralCell(dim=2, period=1.0, grid=N, rough=Layer(E1, nu, 30.0), counter=Layer(E2, nu, 30.0),
+                     gap=g0, k_n=1.0).solve(load)
+    b = SpectralCell(dim=2, period=1.0, grid=N, rough=Layer(E_eq, nu, 30.0), counter=Layer(E_eq, nu, 30.0),
+                     gap=g0, k_n=1.0).solve(load)
+    assert a.results["contact_fraction"] == pytest.approx(b.results["contact_fraction"], rel=1e-10)
+    assert np.allclose(a.fields["pressure"], b.fields["pressure"], rtol=0, atol=1e-10 * load.traction[-1] ** 2 + 1e-14)
+    frac = westergaard_contact_fraction(0.3 * P_STAR, P_STAR)
+    assert a.results["contact_fraction"] == pytest.approx(frac, rel=2e-3)
+
+
+# ------------------------------------------------------------------ against the FE cell
+def _run(tmp_path, scene_text, name):
+    path = tmp_path / f"{name}.toml"
+    path.write_text(scene_text)
+    out = tmp_path / name
+    assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 0
+    return json.loads((out / "report.json").read_text()), out
+
+
+SCENE = """\
+kind = "cell"
+[materials.solid]
+E = 1.0
+nu = 0.3
+[bodies]
+rough = "solid"
+counter = "solid"
+[geometry]
+profile = "flat"
+h_rough = 1.0
+h_counter = 1.0
+[contact]
+k_n = 1.0e3
+gap = {{ kind = "sinusoid", h = 0.01 }}
+[load]
+pressure = [0.0034523, 0.00863075]
+[discretization]
+{disc}
+"""
+
+
+def test_a_small_fe_cell_and_the_spectral_cell_of_the_same_scene_agree(tmp_path):
+    fe, _ = _run(tmp_path, SCENE.format(disc="order = 2\nmaxh = 0.25\ninterface_maxh = 0.005"), "fe")
+    sp, out = _run(tmp_path, SCENE.format(disc='method = "spectral"\ngrid = 2048'), "spectral")
+    assert sp["results"]["method"]["name"] == "spectral" and sp["results"]["method"]["grid"] == 2048
+    for a, b in zip(fe["results"]["loads"], sp["results"]["loads"]):
+        assert b["mean_closure"] == pytest.approx(a["mean_closure"], rel=2e-3)
+        assert b["far_face_jump"][-1] == pytest.approx(a["far_face_jump"][-1], rel=2e-3)
+        assert b["contact_fraction"] == pytest.approx(a["contact_fraction"], rel=1e-2)
+        assert b["effective_stiffness"]["total"][0][0] == pytest.approx(a["effective_stiffness"]["total"][0][0],
+                                                                         rel=5e-3)
+        assert b["iterations"] > 0
+    p = np.load(out / "pressure_load1.npy")
+    assert p.shape == (2048,) and p.mean() == pytest.approx(0.00863075, rel=1e-12)
+    assert {"surface.png", "contact_curve.png", "gap_load0.npy"} <= set(os.listdir(out))
+
+
+def test_bisinusoid_spectral_cell_converges_in_the_grid_and_writes_a_pressure_map(tmp_path):
+    text = open(os.path.join(CELLS, "bisinusoid.toml")).read()
+    text = text.replace("[discretization]\norder = 2\nmaxh = 0.4\ninterface_maxh = 0.12",
+                        '[discretization]\nmethod = "spectral"\ngrid = {grid}')
+    closure, fraction = [], []
+    for grid in (64, 128, 256):
+        rep, out = _run(tmp_path, text.replace("{grid}", str(grid)), f"bis{grid}")
+        load = rep["results"]["loads"][0]
+        closure.append(load["mean_closure"])
+        fraction.append(load["contact_fraction"])
+    assert abs(closure[2] - closure[1]) <= 0.2 * abs(closure[1] - closure[0])    # faster than the grid step
+    assert abs(fraction[2] - fraction[1]) <= 1.0 / 128                             # pixel counting: O(1/N)
+    assert (out / "pressure_map.png").stat().st_size > 0
+    assert np.load(out / "pressure_load0.npy").shape == (256, 256)
+
+
+# ------------------------------------------------------------------ scenes the spectral cell refuses
+@pytest.mark.parametrize("edit, message", [
+    (('profile = "flat"', 'profile = "sinusoid"\namplitude = 0.05'),
+     "discretization.method = 'spectral': solves the small-slope cell"),
+    (("k_n = 1.0e3", 'k_n = 1.0e3\nfriction = "tresca"\nG = 0.001\nw = 1e-6'),
+     "contact.friction = 'tresca': the spectral cell solves frictionless contact so far"),
+    (("grid = 2048", "grid = 2047"), "discretization.grid = 2047: must be even"),
+    (("grid = 2048", "grid = 2048\ntolerance = 1e-4"), "discretization.tolerance = 0.0001: refines an FE mesh"),
+])
+def test_scenes_the_spectral_cell_refuses(tmp_path, capsys, edit, message):
+    text = SCENE.format(disc='method = "spectral"\ngrid = 2048').replace(*edit)
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_exact_enforcement_needs_the_spectral_cell(tmp_path, capsys):
+    text = SCENE.format(disc="order = 1\nmaxh = 0.5").replace("k_n = 1.0e3", 'k_n = 1.0e3\nenforcement = "exact"')
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    assert cli.main(["check", str(path)]) == 2
+    assert "contact.enforcement = 'exact': exact non-penetration is solved by the spectral cell" in \
+        capsys.readouterr().err
+
+
+def test_wave_numbers_cover_the_half_spectrum():
+    k = wave_numbers(3, 8, 2.0)
+    assert k.shape == (8, 5) and k[0, 0] == 0 and k[0, 1] == pytest.approx(math.pi)
+    assert k[4, 4] == pytest.approx(math.hypot(4 * math.pi, 4 * math.pi))
