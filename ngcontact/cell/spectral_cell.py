@@ -25,12 +25,23 @@ interpolant of the pressure loads the layers), and the contact problem is
 solved by constrained conjugate gradients
 (:mod:`ngcontact.solvers.constrained_cg`).
 
+Friction (Tresca, or Coulomb as a fixed point of Tresca problems with
+``G = mu p``, paper eqs. 16-17) needs the tangential traction ``q`` too: the
+jump is ``J = -K t - U`` with ``t = (q, p)`` and ``K`` the layers' full
+3 x 3 (2D: 2 x 2) compliance, whose normal/tangential coupling vanishes for
+identical layers only.  The cell is then the convex problem in tractions of
+:mod:`ngcontact.solvers.projected_gradient` (``|q| <= G``, ``p >= 0``),
+solved by accelerated proximal gradients; with ``"penalty"`` the friction
+is the FE cell's Huber-regularized one (width ``w``), with ``"exact"`` it is
+exact.  As in the FE cell, the Tresca threshold holds on the whole surface.
+
 Results use the names of the FE cell (:mod:`ngcontact.cell.measures`):
 ``contact_fraction`` (the share of grid points in contact; in 2D the
 contact edges located between grid points, below), ``mean_pressure``,
 ``mean_closure`` (the mean of ``J_n``), ``far_face_jump``,
 ``effective_stiffness`` (``d pbar / d Delta_interface`` at the current
-contact set, the FE cell's ``(S^-1 - S_0^-1)^-1``) and the coefficients of
+contact set, the FE cell's ``(S^-1 - S_0^-1)^-1``; its normal component
+only, also with friction) and the coefficients of
 eq. 34 on the real contact set.
 
 Contact edges in 2D: beyond an edge at ``a`` the gap of a smooth contact
@@ -52,12 +63,23 @@ import scipy.fft as sfft
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.coefficients import Coefficients
-from ngcontact.cell.layer_compliance import normal_compliance
+from ngcontact.cell.layer_compliance import layer_matrix, normal_compliance
+from ngcontact.geometry.random_surface import wave_vectors
+from ngcontact.laws.penalty import Friction
 from ngcontact.solvers.constrained_cg import constrained_cg, masked_cg
+from ngcontact.solvers.coulomb import coulomb_fixed_point
+from ngcontact.solvers.projected_gradient import fista, prox_friction, prox_pressure
 
 log = logging.getLogger(__name__)
 
 ENFORCEMENTS = ("penalty", "exact")
+
+
+def cell_load_normal(load: CellLoad) -> CellLoad:
+    """The normal part of a load (the tangential components free of traction)."""
+    d = len(load.traction)
+    return CellLoad(traction=(0.0,) * (d - 1) + (load.traction[-1],), jump=(None,) * (d - 1) + (load.jump[-1],),
+                    macro_strain=load.macro_strain)
 
 
 @dataclass(frozen=True)
@@ -91,11 +113,8 @@ class SpectralSolution:
 
 def wave_numbers(dim: int, grid: int, period: float) -> np.ndarray:
     """``|k|`` on the half spectrum of ``scipy.fft.rfftn`` for a grid of ``grid`` points per period."""
-    k1 = 2 * np.pi * sfft.rfftfreq(grid, d=period / grid)
-    if dim == 2:
-        return k1
-    k0 = 2 * np.pi * sfft.fftfreq(grid, d=period / grid)
-    return np.sqrt(k0[:, None] ** 2 + k1[None, :] ** 2)
+    return np.broadcast_to(wave_vectors(dim, grid, period)[1], (grid // 2 + 1,) if dim == 2
+                           else (grid, grid // 2 + 1)).copy()
 
 
 class SpectralCell:
@@ -120,11 +139,16 @@ class SpectralCell:
     tol, max_iter
         Stopping rule of the constrained CG: complementarity residual
         relative to the peak-to-valley height of the gap.
+    friction, coulomb_rtol, coulomb_max_iter
+        :class:`~ngcontact.laws.penalty.Friction` (Tresca or Coulomb; its
+        Huber width with ``"penalty"``, exact friction with ``"exact"``) and
+        the stopping rule of the Coulomb fixed point; ``None``: frictionless.
     """
 
     def __init__(self, *, dim: int, period: float, grid: int, rough: Layer, counter: Layer,
                  gap: np.ndarray, k_n: float, enforcement: str = "exact", tol: float = 1e-12,
-                 max_iter: int = 2000):
+                 max_iter: int = 2000, friction: Friction | None = None, coulomb_rtol: float = 1e-8,
+                 coulomb_max_iter: int = 40):
         if dim not in (2, 3):
             raise ValueError(f"dim = {dim!r}: must be 2 or 3")
         if enforcement not in ENFORCEMENTS:
@@ -139,6 +163,7 @@ class SpectralCell:
         self.rough, self.counter = rough, counter
         self.g0, self.k_n, self.enforcement = g0, float(k_n), enforcement
         self.tol, self.max_iter = tol, max_iter
+        self.friction, self.coulomb_rtol, self.coulomb_max_iter = friction, coulomb_rtol, coulomb_max_iter
         k = wave_numbers(dim, grid, period)
         self.symbol = (normal_compliance(k, rough.E, rough.nu, rough.h)
                        + normal_compliance(k, counter.E, counter.nu, counter.h))
@@ -180,17 +205,56 @@ class SpectralCell:
     def solve(self, load: CellLoad, start: np.ndarray | None = None) -> SpectralSolution:
         """Solve one load (pressure or far-face approach prescribed), from ``start`` if given."""
         d = self.dim
-        for i in range(d - 1):
-            if load.traction[i] not in (None, 0.0) or load.jump[i] not in (None, 0.0):
-                raise ValueError("a frictionless flat contact surface carries no shear and fixes no tangential "
-                                 "jump: the spectral cell takes shear = 0")
+        if self.friction is None:
+            for i in range(d - 1):
+                if load.traction[i] not in (None, 0.0) or load.jump[i] not in (None, 0.0):
+                    raise ValueError("a frictionless flat contact surface carries no shear and fixes no "
+                                     "tangential jump: the spectral cell takes shear = 0")
+        tn = load.traction[d - 1]
+        if tn is not None and not -tn > 0:
+            raise ValueError(f"pressure = {-tn!r}: the spectral cell needs a compressive mean pressure > 0")
+        state = self._normal(load, start) if self.friction is None else self._frictional(load, start)
+        p, q = state["p"], state["q"]
+        pbar = float(p.mean())
+        qbar = [float(c.mean()) for c in q]
+        closure = state["closure"]                    # J_n
+        elastic_gap = self.g0 - closure
+        slip = np.sqrt(np.sum(state["slip"] ** 2, axis=0))
+        mean_closure = float(closure.mean())
+        fraction = self.contact_fraction(p, np.maximum(elastic_gap, 0.0) if self.friction is None else elastic_gap)
+        results: dict[str, Any] = {
+            "contact_fraction": fraction,
+            "contact_fraction_grid": float(np.count_nonzero(p > 0)) / self.points,
+            "mean_pressure": pbar,
+            "mean_traction": [-v for v in qbar] + [-pbar],
+            "transmitted_pressure": pbar,
+            "equilibrium_error": abs(pbar - (-tn)) / (-tn) if tn is not None else 0.0,
+            "mean_jump": [float(c.mean()) for c in state["slip"]] + [mean_closure],
+            "mean_closure": mean_closure,
+            "far_face_jump": list(state["far_face_jump"]),
+            "max_penetration": float(max(0.0, np.max(-elastic_gap))),
+            "max_pressure": float(p.max()),
+        }
+        if self.friction is not None:
+            results["max_slip"] = float(slip.max())
+            results["slip_fraction"] = float(np.count_nonzero(state["slipping"])) / self.points
+            results["coulomb_iterations"] = state.get("coulomb_iterations", 0)
+        results["effective_stiffness"] = self.effective_stiffness(p > 0)
+        results["coefficients"] = self.coefficients(p > 0).as_dict()
+        fields = {"pressure": p, "gap": np.maximum(elastic_gap, 0.0), "closure": closure}
+        if self.friction is not None:
+            fields.update(shear=q, slip=state["slip"])
+        log.info("spectral cell: %d iterations, contact fraction %.8f", state["iterations"], fraction)
+        return SpectralSolution(load=load, results=results, fields=fields, iterations=state["iterations"],
+                                residuals=state["residuals"])
+
+    def _normal(self, load: CellLoad, start) -> dict:
+        """Frictionless: the pressure by constrained CG (module docstring)."""
+        d = self.dim
         poisson = self.poisson_shift(load.macro_strain)
         tn, jn = load.traction[d - 1], load.jump[d - 1]
         if tn is not None:
-            pbar = -tn
-            if not pbar > 0:
-                raise ValueError(f"pressure = {pbar!r}: the spectral cell needs a compressive mean pressure > 0")
-            res = constrained_cg(self._interface_compliance(uniform=False), self.g0, pbar=pbar,
+            res = constrained_cg(self._interface_compliance(uniform=False), self.g0, pbar=-tn,
                                  tol=self.tol, max_iter=self.max_iter, gscale=self.gscale, p0=start)
         else:
             assert jn is not None
@@ -198,32 +262,144 @@ class SpectralCell:
             res = constrained_cg(self._interface_compliance(uniform=True), self.g0 - (jn - poisson), pbar=None,
                                  tol=self.tol, max_iter=self.max_iter, gscale=self.gscale, p0=start)
         p = res.p
-        pbar = float(p.mean())
         winkler = p / self.k_n if self.enforcement == "penalty" else 0.0
-        elastic_gap = res.gap - winkler               # g0 - J_n
-        closure = self.g0 - elastic_gap               # J_n
-        mean_closure = float(closure.mean())
-        approach = mean_closure + self.c0 * pbar + poisson
-        fraction = self.contact_fraction(p, elastic_gap)
-        results: dict[str, Any] = {
-            "contact_fraction": fraction,
-            "contact_fraction_grid": float(np.count_nonzero(p > 0)) / self.points,
-            "mean_pressure": pbar,
-            "mean_traction": [0.0] * (d - 1) + [-pbar],
-            "transmitted_pressure": pbar,
-            "equilibrium_error": abs(pbar - (-tn)) / (-tn) if tn is not None else 0.0,
-            "mean_jump": [0.0] * (d - 1) + [mean_closure],
-            "mean_closure": mean_closure,
-            "far_face_jump": [0.0] * (d - 1) + [approach],
-            "max_penetration": float(max(0.0, np.max(-elastic_gap))),
-            "max_pressure": float(p.max()),
-        }
-        results["effective_stiffness"] = self.effective_stiffness(p > 0)
-        results["coefficients"] = self.coefficients(p > 0).as_dict()
-        fields = {"pressure": p, "gap": np.maximum(elastic_gap, 0.0), "closure": closure}
-        log.info("spectral cell: %d constrained CG steps, contact fraction %.8f", res.iterations, fraction)
-        return SpectralSolution(load=load, results=results, fields=fields, iterations=res.iterations,
-                                residuals=res.residuals)
+        closure = self.g0 - (res.gap - winkler)
+        approach = float(closure.mean()) + self.c0 * float(p.mean()) + poisson
+        return {"p": p, "q": np.zeros((d - 1,) + self.shape), "closure": closure,
+                "slip": np.zeros((d - 1,) + self.shape), "far_face_jump": [0.0] * (d - 1) + [approach],
+                "iterations": res.iterations, "residuals": res.residuals}
+
+    # ------------------------------------------------------------ friction
+    def traction_operator(self, uniform: tuple[bool, ...]):
+        """``(t -> K t, L, K0)``: the full compliance ``K = C_rough + C_counter`` on stacked tractions.
+
+        ``t`` has the components ``(q_x[, q_y], p)`` of the traction the
+        rough body exerts on the counter; the jump is ``J = -K t - U``.
+        ``uniform[c]``: keep the uniform mode of component ``c`` (its mean is
+        free); without it the mean is prescribed and the mode is dropped.
+        The coupling is zeroed on the Nyquist rows, where ``k`` and ``-k``
+        are the same mode.  ``L`` is the largest eigenvalue of ``K`` and
+        ``K0`` the diagonal of the uniform mode (the layers' uniaxial-strain
+        and shear compliances).
+        """
+        d = self.dim
+        n = self.grid
+        k1 = 2 * np.pi * sfft.rfftfreq(n, d=self.period / n)
+        if d == 2:
+            kv = k1[:, None]
+            nyq = np.arange(k1.size) == n // 2
+        else:
+            k0 = 2 * np.pi * sfft.fftfreq(n, d=self.period / n)
+            kv = np.stack(np.broadcast_arrays(k1[None, :], k0[:, None]), axis=-1)
+            nyq = (np.arange(n)[:, None] == n // 2) | (np.arange(k1.size)[None, :] == n // 2)
+        K = (layer_matrix(kv, self.rough.E, self.rough.nu, self.rough.h)
+             + layer_matrix(kv, self.counter.E, self.counter.nu, self.counter.h, above=True))
+        K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
+        K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
+        K0 = np.real(np.diagonal(K.reshape(-1, d, d)[0])).copy()
+        zero = (0,) * (d - 1)
+        for c in range(d):
+            if not uniform[c]:
+                K[zero + (c, c)] = 0.0
+        L = float(np.max(np.linalg.eigvalsh(K)))
+        Km = np.moveaxis(K, (-2, -1), (0, 1)).copy()       # (d, d, *kshape)
+        axes = tuple(range(1, d))
+
+        def apply(t):
+            T = sfft.rfftn(t, axes=axes, workers=-1)
+            U = np.einsum("ab...,b...->a...", Km, T)
+            return sfft.irfftn(U, s=self.shape, axes=axes, workers=-1)
+        return apply, L, K0
+
+    def _frictional(self, load: CellLoad, start) -> dict:
+        """Tresca (or a Coulomb fixed point of Tresca problems) by FISTA in tractions."""
+        d, f = self.dim, self.friction
+        assert f is not None
+        poisson = self.poisson_shift(load.macro_strain)
+        prescribed_mean = [load.traction[c] is not None for c in range(d)]
+        apply, L, K0 = self.traction_operator(tuple(not m for m in prescribed_mean))
+        b = np.zeros((d,) + self.shape)
+        b[d - 1] = self.g0
+        jumps = [0.0 if j is None else float(j) for j in load.jump]
+        tractions = [0.0 if t is None else float(t) for t in load.traction]
+        for c in range(d):
+            if load.jump[c] is not None:
+                b[c] -= jumps[c] - (poisson if c == d - 1 else 0.0)
+        mean_p = -tractions[d - 1] if prescribed_mean[d - 1] else None
+        mean_q = np.array([-tractions[c] for c in range(d - 1)]) if all(prescribed_mean[:d - 1]) else None
+        if any(prescribed_mean[:d - 1]) and mean_q is None:
+            raise ValueError("the spectral cell takes either the shear or the tangential jump in every direction")
+        exact = self.enforcement == "exact"
+        damp_p = 1.0 if exact else 1.0 + 1.0 / (L * self.k_n)
+        frictionless = self._normal(cell_load_normal(load), start)
+        t0 = np.zeros((d,) + self.shape)
+        t0[d - 1] = frictionless["p"]
+        if mean_q is not None:
+            t0[:d - 1] = mean_q.reshape((d - 1,) + (1,) * (d - 1))
+        scale = self.gscale
+
+        def grad(t):
+            return apply(t) + b
+
+        def solve_tresca(G: np.ndarray, t_start: np.ndarray):
+            damp_q = np.ones(self.shape) if exact else 1.0 + f.w / (L * np.maximum(G, 1e-300))
+
+            def prox(v, shifts):
+                sp, sq = shifts if shifts else (0.0, None)
+                p, sp = prox_pressure(v[d - 1], damp_p, mean_p, sp)
+                q, sq = prox_friction(v[:d - 1], G, damp_q, mean_q, sq)
+                return np.concatenate([q, p[None]]), (sp, sq)
+            return fista(grad, prox, t_start, L, tol=self.tol, scale=scale, max_iter=self.max_iter)
+
+        history: list = []
+        if f.law == "tresca":
+            assert f.G is not None  # required by Friction for Tresca
+            res = solve_tresca(f.G * np.ones(self.shape), t0)
+            history.append(res)
+            passes = 0
+        else:
+            current = {"t": t0}
+            previous = {"p": t0[d - 1].copy()}
+
+            def freeze():
+                previous["p"] = current["t"][d - 1].copy()
+
+            def tresca_solve():
+                r = solve_tresca((f.mu or 0.0) * previous["p"], current["t"])
+                current["t"] = r.t
+                history.append(r)
+                return {"iterations": r.iterations}
+
+            fixed = coulomb_fixed_point(freeze, tresca_solve, lambda: current["t"][d - 1].ravel(),
+                                        rtol=self.coulomb_rtol, max_iter=self.coulomb_max_iter)
+            passes = fixed["coulomb_iterations"]
+            res = history[-1]
+        t = res.t
+        sp, sq = res.shifts
+        Kt = apply(t)
+        # the effective linear term of the reduced problem is b + L * shift on the mean-constrained components
+        eff = b.copy()
+        if mean_p is not None:
+            eff[d - 1] += L * sp
+        if mean_q is not None:
+            eff[:d - 1] += L * np.asarray(sq).reshape((d - 1,) + (1,) * (d - 1))
+        # -J = K_full t - Delta = K t + (b_eff - g0 e_n): on a component of prescribed mean the dropped uniform
+        # mode K0 mean(t) and Delta = K0 mean(t) - L shift cancel
+        minus_J = Kt + eff - np.where(np.arange(d) == d - 1, 1.0, 0.0).reshape((d,) + (1,) * (d - 1)) * self.g0
+        Delta = np.zeros(d)
+        for c in range(d):
+            if prescribed_mean[c]:
+                Delta[c] = K0[c] * float(t[c].mean()) - L * (sp if c == d - 1 else np.asarray(sq)[c])
+            else:
+                Delta[c] = jumps[c] - (poisson if c == d - 1 else 0.0)
+        Delta[d - 1] += poisson
+        J = -minus_J
+        G_last = (f.G or 0.0) * np.ones(self.shape) if f.law == "tresca" else (f.mu or 0.0) * t[d - 1]
+        qn = np.sqrt(np.sum(t[:d - 1] ** 2, axis=0))
+        slipping = (qn >= G_last * (1 - 1e-9)) & (G_last > 0)
+        return {"p": t[d - 1], "q": t[:d - 1], "closure": J[d - 1], "slip": J[:d - 1], "slipping": slipping,
+                "far_face_jump": Delta.tolist(), "iterations": sum(r.iterations for r in history),
+                "residuals": [x for r in history for x in r.residuals], "coulomb_iterations": passes}
 
     def sweep(self, loads) -> list[SpectralSolution]:
         """Solve loads in order, each starting from the previous pressure."""

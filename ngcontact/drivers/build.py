@@ -122,8 +122,7 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
             if g.profile == "bisinusoid":
                 heights = cell3d.bisinusoid_heights(g.amplitude, g.period)
             else:
-                from ngcontact.geometry.tabulated import read_height_map
-                heights = read_height_map(resolve(scene, g.file), path="geometry.file")
+                heights = height_map(scene)
             return cell3d.surface_cell(heights, period=g.period, h_rough=g.h_rough,
                                        h_counter=g.h_counter, maxh=maxh, interface_maxh=ih,
                                        order=order)
@@ -158,11 +157,7 @@ def gap_cf(scene):
 def spectral_cell(scene: CellScene) -> SpectralCell:
     """The spectral cell (:mod:`ngcontact.cell.spectral_cell`) of a small-slope cell scene."""
     g, c, s = scene.geometry, scene.contact, scene.solver
-    shape = None
-    if small_slope(g) and g.profile == "height_map":
-        from ngcontact.geometry.tabulated import read_height_map
-        assert g.file is not None  # required by the profile (CellGeometry.check)
-        shape = read_height_map(resolve(scene, g.file), path="geometry.file").shape
+    shape = height_map(scene).shape if g.profile in ("height_map", "self_affine") else None
     grid = spectral_grid(scene, shape)
 
     def layer(name, h):
@@ -170,7 +165,8 @@ def spectral_cell(scene: CellScene) -> SpectralCell:
         return Layer(E=m.E, nu=m.nu, h=h)
     return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
                         counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid), k_n=c.k_n,
-                        enforcement=c.enforcement, tol=s.rtol, max_iter=s.cg_max_iter)
+                        enforcement=c.enforcement, tol=s.rtol, max_iter=s.cg_max_iter, friction=micro_friction(c),
+                        coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter)
 
 
 def gap_samples(scene, grid: int) -> np.ndarray:
@@ -191,7 +187,7 @@ def gap_samples(scene, grid: int) -> np.ndarray:
         if g.profile == "bisinusoid":
             out += cell3d.bisinusoid_gap(g.amplitude, P, xy=xy)
         else:
-            H = tabulated.read_height_map(resolve(scene, g.file), path="geometry.file")
+            H = height_map(scene)
             out += cell3d.bilinear_samples(H.max() - H, P, grid)
     gs = scene.contact.gap
     if gs.kind == "tabulated":
@@ -213,8 +209,26 @@ def _profile_gap(scene):
     from ngcontact.geometry import cell3d
     if g.profile == "bisinusoid":
         return cell3d.bisinusoid_gap(g.amplitude, g.period)
-    from ngcontact.geometry.tabulated import read_height_map
-    return cell3d.height_map_gap(read_height_map(resolve(scene, g.file), path="geometry.file"), g.period)
+    return cell3d.height_map_gap(height_map(scene), g.period)
+
+
+def height_map(scene) -> np.ndarray:
+    """The heights of a ``height_map`` (read from its file) or ``self_affine`` (drawn from its spectrum) profile.
+
+    In the file layout: the last row and column repeat the first.
+    """
+    g = scene.geometry
+    if g.profile == "height_map":
+        from ngcontact.geometry.tabulated import read_height_map
+        assert g.file is not None  # required by the profile (CellGeometry.check)
+        return read_height_map(resolve(scene, g.file), path="geometry.file")
+    if g.profile != "self_affine":
+        raise ValueError(f"geometry.profile = {g.profile!r} has no height map")
+    from ngcontact.geometry.random_surface import as_height_map, self_affine
+    sp = g.spectrum
+    assert sp is not None  # required by the profile (CellGeometry.check)
+    return as_height_map(self_affine(dim=3, grid=sp.grid, period=g.period, hurst=sp.hurst, rms_height=sp.rms_height,
+                                     rms_slope=sp.rms_slope, rolloff=sp.rolloff, cutoff=sp.cutoff, seed=sp.seed))
 
 
 def _explicit_gap(scene, xy=None):

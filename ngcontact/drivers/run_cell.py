@@ -71,8 +71,9 @@ def run_spectral(scene, clock) -> Outcome:
         entry = dict(sol.results)
         entry["iterations"] = sol.iterations
         per_load.append(entry)
-        for name in ("pressure", "gap"):
-            arrays[f"{name}_load{k}"] = sol.fields[name]
+        for name in ("pressure", "gap", "shear", "slip"):
+            if name in sol.fields:
+                arrays[f"{name}_load{k}"] = sol.fields[name]
         if cell.dim == 2:
             x = cell.period * np.arange(cell.grid) / cell.grid
             tables[f"surface_load{k}"] = (["x", "pressure", "gap", "closure"], list(zip(

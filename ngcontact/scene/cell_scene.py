@@ -17,18 +17,44 @@ from ngcontact.errors import MISSING, GeometryError, SceneError
 from ngcontact.scene.sections import (CellDiscretization, MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import check_selected, nonempty, nonnegative, open_interval, param, positive
+from ngcontact.scene.schema import (at_least, check_selected, closed_interval, nonempty, nonnegative, open_interval,
+                                    param, positive)
 
 PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
-PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map")
+PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map", "self_affine")
 #: 3D free-form profiles: meshed as the real surface with Netgen's OCC kernel
 #: in the conforming arrangement; in the summit arrangement represented by the
 #: small-slope model (a flat interface whose initial gap is the height below
 #: the highest summit).
-GAP_PROFILES = ("bisinusoid", "height_map")
+GAP_PROFILES = ("bisinusoid", "height_map", "self_affine")
 GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 FRICTION = ("none", "tresca", "coulomb")
 ENFORCEMENTS = ("penalty", "exact")
+
+
+@dataclass(frozen=True, kw_only=True)
+class SpectrumSpec:
+    """A random periodic self-affine surface (:mod:`ngcontact.geometry.random_surface`)."""
+
+    hurst: float = param(doc="Hurst exponent H: power spectrum C(q) ~ q^(-2(1+H)) between roll-off and cut-off",
+                         check=open_interval(0, 1))
+    rms_height: float | None = param(None, doc="root-mean-square height (give this or rms_slope)", units="m",
+                                     check=positive())
+    rms_slope: float | None = param(None, doc="root-mean-square slope (give this or rms_height)", check=positive())
+    rolloff: float | None = param(None, doc="roll-off wavelength: the spectrum is flat for longer ones (default: "
+                                  "the period)", units="m", check=positive())
+    cutoff: float | None = param(None, doc="shortest wavelength (default: 4 grid steps)", units="m",
+                                 check=positive())
+    grid: int = param(256, doc="points per period and direction the surface is drawn on (even)",
+                      check=closed_interval(8, 4096))
+    seed: int = param(0, doc="seed of the random generator (the same seed draws the same surface)",
+                      check=at_least(0))
+
+    def check(self, path: str) -> None:
+        if (self.rms_height is None) == (self.rms_slope is None):
+            raise SceneError(f"{path}.rms_height", self.rms_height, "give exactly one of rms_height and rms_slope")
+        if self.grid % 2:
+            raise SceneError(f"{path}.grid", self.grid, "must be even")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -61,11 +87,12 @@ class CellGeometry:
                              "(x = period) repeating the first y, at most 4096 rows (2D); height map: .npy array "
                              "whose last row/column repeat the first (3D, small-slope model); a regular file of at "
                              "most 64 MiB, relative to the scene file")
+    spectrum: SpectrumSpec | None = param(None, doc="self_affine: the power spectrum and seed of the random surface")
 
     _USES = {"flat": (), "flat3d": (), "rectangular": ("width", "depth"),
              "triangular": ("angles",), "semicircular": ("radius",), "sinusoid": ("amplitude",),
              "square_hills": ("width", "depth"), "tabulated": ("file",),
-             "bisinusoid": ("amplitude",), "height_map": ("file",)}
+             "bisinusoid": ("amplitude",), "height_map": ("file",), "self_affine": ("spectrum",)}
     _OPTIONAL = {"triangular": ("width",)}
 
     @property
@@ -73,7 +100,7 @@ class CellGeometry:
         return 3 if self.profile in PROFILES_3D else 2
 
     def check(self, path: str) -> None:
-        check_selected(self, path, "profile", ("width", "depth", "radius", "angles", "amplitude", "file"),
+        check_selected(self, path, "profile", ("width", "depth", "radius", "angles", "amplitude", "file", "spectrum"),
                        self._USES[self.profile], self._OPTIONAL.get(self.profile, ()))
         if self.profile == "square_hills":
             assert self.width is not None and self.depth is not None  # required: check_selected
@@ -171,9 +198,10 @@ class ContactSpec:
 
     k_n: float = param(doc="penalty (Winkler) stiffness k_n (with enforcement = 'exact' only the scale of the "
                        "eq. 34 coefficients in the report)", units="Pa/m", check=positive())
-    enforcement: str = param("penalty", doc="penalty: the paper's Winkler layer p = k_n [J.n - g]_+ (eq. 65); "
-                             "exact: non-penetration, the rigid limit k_n -> infinity (discretization.method = "
-                             "'spectral')", choices=ENFORCEMENTS)
+    enforcement: str = param("penalty", doc="penalty: the paper's Winkler layer p = k_n [J.n - g]_+ (eq. 65) "
+                             "and Huber-regularized friction; exact: non-penetration, the rigid limit k_n -> infinity, "
+                             "and exact friction (w unused; discretization.method = 'spectral')",
+                             choices=ENFORCEMENTS)
     gap: GapSpec = param(GapSpec(), doc="initial gap")
     friction: str = param("none", doc="friction law", choices=FRICTION)
     G: float | None = param(None, doc="Tresca threshold", units="Pa", check=nonnegative())
@@ -381,16 +409,13 @@ def spectral_grid(scene: CellScene, heights_shape: tuple[int, ...] | None = None
 
 
 def check_spectral(scene: CellScene) -> None:
-    """A spectral cell needs the small-slope model and a frictionless normal load."""
-    g, c, d = scene.geometry, scene.contact, scene.discretization
+    """A spectral cell needs the small-slope model, and a grid it can hold."""
+    g, d = scene.geometry, scene.discretization
     if not (g.profile in ("flat", "flat3d") or small_slope(g)):
         raise SceneError("discretization.method", "spectral", "solves the small-slope cell: a flat interface with "
-                         "the roughness in the initial gap (geometry.profile = 'flat' or 'flat3d', or 'bisinusoid' / "
-                         f"'height_map' with arrangement = 'summit'), not geometry.profile = {g.profile!r} in the "
-                         f"{g.arrangement!r} arrangement; use method = 'fe'")
-    if c.friction != "none":
-        raise SceneError("contact.friction", c.friction, "the spectral cell solves frictionless contact so far; set "
-                         "friction = 'none' or discretization.method = 'fe'")
+                         "the roughness in the initial gap (geometry.profile = 'flat' or 'flat3d', or 'bisinusoid', "
+                         "'height_map' or 'self_affine' with arrangement = 'summit'), not geometry.profile = "
+                         f"{g.profile!r} in the {g.arrangement!r} arrangement; use method = 'fe'")
     if d.tolerance is not None:
         raise SceneError("discretization.tolerance", d.tolerance, "refines an FE mesh; the spectral cell's accuracy "
                          "is set by discretization.grid: remove the key")

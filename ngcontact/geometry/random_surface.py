@@ -1,0 +1,117 @@
+"""Random periodic self-affine surfaces from a power spectrum.
+
+A self-affine rough surface of Hurst exponent ``H`` (0 < H < 1) has the
+isotropic power spectral density
+
+    C(q) = C0                      for q_l <= q < q_r   (roll-off),
+    C(q) = C0 (q / q_r)^(-2(1+H))  for q_r <= q <= q_s,
+    C(q) = 0                       otherwise,
+
+(3D height maps; a 2D profile takes the exponent ``-(1+2H)``), with the
+wave numbers ``q = 2 pi / wavelength``: ``q_l`` the longest wavelength kept
+(the period by default), ``q_r`` the roll-off and ``q_s`` the shortest
+(the small cut-off).  The generator draws each Fourier coefficient as a
+complex Gaussian of variance ``C(|q|)`` (the surface of Persson et al.,
+J. Phys.: Condens. Matter 17 (2005) R1, Sec. 4, filtered white noise), makes
+the field real by an inverse real FFT, removes its mean, and scales it to
+the requested root-mean-square height or slope (the slope as the RMS of the
+spectral gradient, exact for the trigonometric interpolant).  A seed makes
+it reproducible.
+
+The result is periodic and sampled at ``x_j = j P / N``; :func:`as_height_map`
+appends the repeated last row and column of the height-map file layout
+(:func:`ngcontact.geometry.tabulated.read_height_map`).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.fft as sfft
+
+from ngcontact.errors import GeometryError
+
+
+def wave_vectors(dim: int, n: int, period: float):
+    """Wave vectors of the half spectrum of ``scipy.fft.rfftn`` on ``n`` points per period.
+
+    Returns ``(components, |k|)``: 2D ``((k_x,), |k_x|)``, shape ``(n//2+1,)``;
+    3D ``((k_x, k_y), |k|)`` broadcasting to ``(n, n//2+1)`` (rows ``y``).
+    """
+    k1 = 2 * math.pi * sfft.rfftfreq(n, d=period / n)
+    if dim == 2:
+        return (k1,), np.abs(k1)
+    k0 = 2 * math.pi * sfft.fftfreq(n, d=period / n)
+    kx, ky = k1[None, :], k0[:, None]
+    return (kx, ky), np.sqrt(kx ** 2 + ky ** 2)
+
+
+def self_affine(*, dim: int = 3, grid: int = 256, period: float = 1.0, hurst: float = 0.8,
+                rms_height: float | None = None, rms_slope: float | None = None,
+                rolloff: float | None = None, cutoff: float | None = None, longest: float | None = None,
+                seed: int = 0) -> np.ndarray:
+    """A random periodic self-affine surface (module docstring).
+
+    Parameters
+    ----------
+    dim
+        3: a height map of shape ``(grid, grid)`` indexed ``[y, x]``; 2: a
+        profile of shape ``(grid,)``.
+    grid, period
+        Points per period and direction, and the period.
+    hurst
+        Hurst exponent, in (0, 1).
+    rms_height, rms_slope
+        Exactly one: the RMS height or the RMS slope of the result.
+    rolloff, cutoff, longest
+        Wavelengths ``2 pi / q_r``, ``2 pi / q_s`` and ``2 pi / q_l``
+        (defaults: the period, four grid steps, the period).
+    seed
+        Seed of NumPy's default generator.
+    """
+    if dim not in (2, 3):
+        raise GeometryError("dim", dim, "must be 2 (profile) or 3 (height map)")
+    if not (isinstance(grid, (int, np.integer)) and grid >= 8 and grid % 2 == 0):
+        raise GeometryError("grid", grid, "must be an even integer >= 8")
+    if not 0 < hurst < 1:
+        raise GeometryError("hurst", hurst, "must lie in (0, 1)")
+    if (rms_height is None) == (rms_slope is None):
+        raise GeometryError("rms_height", rms_height, "give exactly one of rms_height and rms_slope")
+    target = rms_height if rms_height is not None else rms_slope
+    if not (target is not None and target > 0 and math.isfinite(target)):
+        raise GeometryError("rms_height" if rms_height is not None else "rms_slope", target, "must be > 0")
+    step = period / grid
+    longest = period if longest is None else longest
+    rolloff = longest if rolloff is None else rolloff
+    cutoff = 4 * step if cutoff is None else cutoff
+    if not (2 * step <= cutoff < rolloff <= longest <= period):
+        raise GeometryError("cutoff", cutoff, f"need 2 grid steps ({2 * step:g}) <= cutoff < rolloff ({rolloff:g}) "
+                            f"<= longest ({longest:g}) <= period ({period:g})")
+    q_l, q_r, q_s = (2 * math.pi / w for w in (longest, rolloff, cutoff))
+    ks, q = wave_vectors(dim, grid, period)
+    exponent = -2 * (1 + hurst) if dim == 3 else -(1 + 2 * hurst)
+    eps = 1e-9 * q_s
+    band = (q >= q_l - eps) & (q <= q_s + eps)
+    psd = np.where(q < q_r, 1.0, (np.maximum(q, q_r) / q_r) ** exponent) * band
+    rng = np.random.default_rng(seed)
+    coeff = np.sqrt(psd) * (rng.standard_normal(q.shape) + 1j * rng.standard_normal(q.shape))
+    shape = (grid,) * (dim - 1)
+    coeff.flat[0] = 0.0
+    z = sfft.irfftn(coeff, s=shape)
+    if not np.any(z):
+        raise GeometryError("cutoff", cutoff, "leaves no wave number between longest and cutoff on this grid")
+    if rms_height is not None:
+        scale = target / float(np.sqrt(np.mean(z ** 2)))
+    else:
+        zh = sfft.rfftn(z)
+        grads = [sfft.irfftn(1j * k * zh, s=shape) for k in ks]
+        scale = target / float(np.sqrt(np.mean(sum(g ** 2 for g in grads))))
+    return z * scale
+
+
+def as_height_map(z: np.ndarray) -> np.ndarray:
+    """The periodic samples ``z`` with the first row and column repeated at the end (the file layout)."""
+    z = np.asarray(z, dtype=float)
+    if z.ndim == 1:
+        return np.append(z, z[0])
+    return np.pad(z, ((0, 1), (0, 1)), mode="wrap")

@@ -1,0 +1,159 @@
+"""Accelerated proximal gradients for the frictional contact problem in tractions.
+
+The frictional small-slope cell (paper eqs. 57 and 65 with Tresca friction,
+eqs. 16-17, posed in the interface tractions, the dual of the displacement
+form) is the convex problem
+
+    min_t  1/2 <t, K t> + <t, b> + sum_i h_i(t_i)
+    s.t.   mean(t_c) = m_c   for the components c whose mean is prescribed,
+
+``t = (q, p)`` the tangential and normal traction at the grid points, ``K``
+symmetric positive semidefinite (applied as a function), and the separable
+``h_i``: for the pressure ``p_i >= 0`` (plus ``p_i^2 / (2 k_n)`` for the
+penalty layer), for the friction traction ``|q_i| <= G_i`` (plus
+``w |q_i|^2 / (2 G_i)``, the conjugate of the Huber-regularized friction
+energy ``G huber(|J_t|, w)``).  Without ``w`` and ``1/k_n`` the contact and the
+friction are exact.
+
+Method: FISTA (Beck & Teboulle, SIAM J. Imaging Sci. 2 (2009) 183-202) with
+the adaptive restart of O'Donoghue & Candes (Found. Comput. Math. 15 (2015)
+715-732), step ``1/L`` with ``L`` the largest eigenvalue of ``K``.  The
+proximal step of ``h`` under the mean constraints is separable up to one
+shift per component, found by Newton's method on the mean
+(:func:`prox_pressure`, :func:`prox_friction`).  Stopping rule: the
+fixed-point residual ``|t - prox(t - grad / L)| L`` (a displacement: the
+violation of the contact and friction conditions) below ``tol`` times
+``scale``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ngcontact.errors import ConvergenceError
+
+
+def _decreasing_root(f: Callable[[float], tuple[float, float]], lo: float, hi: float, x0: float,
+                     tol: float) -> float:
+    """The root of a decreasing, piecewise smooth ``f`` in ``[lo, hi]`` (``f(lo) >= 0 >= f(hi)``).
+
+    Newton's method from ``x0``, kept inside the bracket by bisection
+    whenever a step leaves it; ``f`` returns its value and slope.
+    """
+    x = min(max(x0, lo), hi)
+    for _ in range(200):
+        v, slope = f(x)
+        if abs(v) <= tol:
+            return x
+        if v > 0:
+            lo = x
+        else:
+            hi = x
+        step = x - v / slope if slope < 0 else None
+        x = step if step is not None and lo < step < hi else 0.5 * (lo + hi)
+        if hi - lo <= 1e-15 * max(abs(lo), abs(hi), 1e-300):
+            return x
+    return x
+
+
+def prox_pressure(v: np.ndarray, damping: float, mean: float | None, shift0: float = 0.0) -> tuple[np.ndarray, float]:
+    """``p = max(v - s, 0) / damping`` with ``s`` such that ``mean(p) = mean`` (``s = 0`` without it)."""
+    if mean is None:
+        return np.maximum(v / damping, 0.0), 0.0
+    if not mean > 0:
+        raise ConvergenceError(f"the mean pressure {mean!r} must be > 0", {})
+
+    def f(x):
+        d = v - x
+        return float(np.maximum(d, 0.0).mean()) / damping - mean, -np.count_nonzero(d > 0) / (v.size * damping)
+    x = _decreasing_root(f, float(v.min()) - damping * mean, float(v.max()), shift0, 1e-14 * mean)
+    return np.maximum(v - x, 0.0) / damping, x
+
+
+def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray, mean: np.ndarray | None,
+                  shift0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``q_i = clip_{|q| <= G_i}((v_i - s) / d_i)`` with ``s`` such that ``mean(q) = mean``.
+
+    ``v``: shape ``(c, ...)`` with ``c`` tangential components; ``radius``
+    the thresholds ``G_i``, ``damping`` the factors ``d_i``.  The shift is
+    found one component at a time (each mean is decreasing in its own
+    shift), sweeping until both hold.
+    """
+    c = v.shape[0]
+
+    def clip(s):
+        z = (v - s.reshape((c,) + (1,) * (v.ndim - 1))) / damping
+        norm = np.sqrt(np.sum(z * z, axis=0))
+        over = norm > radius
+        return z * np.where(over, radius / np.where(over, norm, 1.0), 1.0), z, norm, over
+
+    s = np.zeros(c) if (mean is None or shift0 is None) else np.asarray(shift0, float).copy()
+    if mean is None:
+        return clip(np.zeros(c))[0], s
+    capacity = float(radius.mean())
+    target = np.asarray(mean, float)
+    if float(np.linalg.norm(target)) >= capacity:
+        raise ConvergenceError(f"a mean shear of {float(np.linalg.norm(target)):.6g} exceeds the friction the "
+                               f"interface can carry, {capacity:.6g} (the mean friction threshold): the interface "
+                               "cannot carry this load", {})
+    tol = 1e-13 * max(capacity, 1e-300)
+    reach = float(np.max(np.abs(v))) + float(np.max(radius * damping))
+    for _ in range(100):
+        for a in range(c):
+            def f(x, a=a):
+                s[a] = x
+                q, z, norm, over = clip(s)
+                # d q_a / d s_a = -(1/d) (1 inside the disc; (G/|z|)(1 - z_a^2/|z|^2) on its rim)
+                rim = np.where(over, radius / np.where(over, norm, 1.0)
+                               * (1.0 - z[a] ** 2 / np.where(over, norm * norm, 1.0)), 1.0)
+                return float(q[a].mean()) - target[a], -float(np.mean(rim / damping)) - 1e-300
+            s[a] = _decreasing_root(f, -reach, reach, float(s[a]), tol)
+        q = clip(s)[0]
+        if all(abs(float(q[a].mean()) - target[a]) <= 10 * tol for a in range(c)):
+            return q, s
+    raise ConvergenceError(f"the shift that makes the mean shear {target.tolist()} did not converge", {})
+
+
+@dataclass
+class ProximalResult:
+    t: np.ndarray
+    shifts: tuple
+    iterations: int
+    residuals: list[float]
+
+
+def fista(grad: Callable[[np.ndarray], np.ndarray], prox: Callable[[np.ndarray, tuple], tuple], t0: np.ndarray,
+          L: float, *, tol: float, scale: float, max_iter: int) -> ProximalResult:
+    """FISTA with adaptive restart (module docstring).
+
+    ``grad(t)`` is the gradient of the smooth part; ``prox(v, shifts)``
+    returns ``(t, shifts)``, the proximal point of ``v`` for the step ``1/L``
+    (warm-started shifts in, the new shifts out).
+    """
+    t = t0.copy()
+    y = t.copy()
+    theta = 1.0
+    shifts: tuple = ()
+    t_new, shifts = prox(t - grad(t) / L, shifts)
+    residuals: list[float] = []
+    for it in range(1, max_iter + 1):
+        g = grad(y)
+        t_new, shifts = prox(y - g / L, shifts)
+        # restart when the step goes against the momentum
+        if float(np.sum((t_new - t) * (y - t_new))) > 0:
+            theta = 1.0
+        theta_new = 0.5 * (1 + np.sqrt(1 + 4 * theta * theta))
+        y = t_new + ((theta - 1) / theta_new) * (t_new - t)
+        theta = theta_new
+        res = float(np.max(np.abs(t_new - prox(t_new - grad(t_new) / L, shifts)[0]))) * L / scale if it % 10 == 0 \
+            else None
+        t = t_new
+        if res is not None:
+            residuals.append(res)
+            if res <= tol:
+                return ProximalResult(t=t, shifts=shifts, iterations=it, residuals=residuals)
+    last = f"{residuals[-1]:.3g}" if residuals else "not yet measured"
+    raise ConvergenceError(f"accelerated proximal gradient: the residual ({last}, relative to the gap scale) is "
+                           f"above {tol:g} after {max_iter} steps", {"residuals": residuals[-5:]})

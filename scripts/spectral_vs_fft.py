@@ -1,0 +1,238 @@
+"""The spectral small-slope cell beside an FFT half-space solver and beside the FE cell.
+
+Three measurements, one run, one CSV and one PNG:
+
+1. **Half-space limit against Tamaas** (the ``bench`` extra; skipped with a
+   message without it).  A random self-affine surface (Hurst exponent 0.8,
+   RMS slope 0.1, roll-off at a quarter period, cut-off at 1/64 of the
+   period; :func:`ngcontact.geometry.random_surface.self_affine`, seed 7),
+   drawn once on the finest grid and sampled on every coarser one (its
+   spectrum ends below their Nyquist wave number, so it is the same surface),
+   pressed by one mean pressure.  This package: two identical layers 50
+   periods thick (``E = 1``, ``nu = 0.3``: a half-space pair of
+   ``E* = E / (2 (1 - nu^2))``), exact contact.  Tamaas: its
+   Polonsky-Keer-Rey solver on one half-space of the same ``E*`` against
+   the rigid surface.  Both with the same tolerance on the same grid from
+   128^2 to 1024^2: contact fraction (share of grid points in contact),
+   relative L2 difference of the pressure fields, iterations and wall time.
+2. **FE cell against the spectral cell** on the shipped bisinusoid
+   (``geometries/cells/bisinusoid.toml``: finite layers 0.6 thick, the
+   penalty of the scene): the FE cell over a ladder of interface mesh sizes
+   and the spectral cell at 512^2, contact fraction, mean closure and the
+   far-face stiffness; the gap between them closes under FE refinement.
+3. **A 1024^2 cell of dissimilar finite layers** (``E = 1, 3``,
+   ``nu = 0.3, 0.25``, 0.5 and 0.3 thick) on the same surface: wall time and
+   peak memory of the whole process (run in a child process).
+
+Usage::
+
+    python scripts/spectral_vs_fft.py [OUT_DIR] [--quick] [--fe-sizes 0.12 0.08 0.06]
+
+Writes ``spectral_vs_fft.csv`` and ``spectral_vs_fft.png`` into ``OUT_DIR``
+(default ``results/spectral_vs_fft``) and logs the tables.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import resource
+import subprocess
+import sys
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.spectral_cell import Layer, SpectralCell
+from ngcontact.geometry.random_surface import self_affine
+from ngcontact.output.writer import write_csv
+
+log = logging.getLogger("spectral_vs_fft")
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+E, NU, THICK = 1.0, 0.3, 50.0
+E_STAR = E / (2 * (1 - NU ** 2))
+SLOPE, HURST, SEED = 0.1, 0.8, 7
+PRESSURE = 0.05 * E_STAR * SLOPE          # about 10 % contact (Persson: fraction ~ 2 p / (E* slope))
+GRIDS, FINEST = (128, 256, 512, 1024), 1024
+TOL = 1e-10
+KEYS = ("part", "solver", "setting", "grid_or_ndof", "contact_fraction", "pressure_l2_difference", "mean_closure",
+        "stiffness", "iterations", "seconds", "peak_memory_gb")
+
+
+def surface(n: int) -> np.ndarray:
+    """The benchmark surface on an ``n x n`` grid (sampled from the finest grid)."""
+    z = self_affine(dim=3, grid=FINEST, hurst=HURST, rms_slope=SLOPE, rolloff=0.25, cutoff=1 / 64, seed=SEED)
+    step = FINEST // n
+    return z[::step, ::step]
+
+
+def ours(z: np.ndarray, rough=None, counter=None) -> tuple[dict, np.ndarray]:
+    n = z.shape[0]
+    t0 = time.perf_counter()
+    cell = SpectralCell(dim=3, period=1.0, grid=n, rough=rough or Layer(E, NU, THICK),
+                        counter=counter or Layer(E, NU, THICK), gap=z.max() - z, k_n=1.0, enforcement="exact",
+                        tol=TOL)
+    sol = cell.solve(cell_load(3, pressure=PRESSURE))
+    secs = time.perf_counter() - t0
+    r = sol.results
+    return ({"solver": "ngcontact spectral", "grid_or_ndof": n, "contact_fraction": r["contact_fraction"],
+             "mean_closure": r["mean_closure"], "stiffness": r["effective_stiffness"]["total"][0][0],
+             "iterations": sol.iterations, "seconds": secs}, sol.fields["pressure"])
+
+
+def tamaas_available() -> bool:
+    try:
+        import tamaas  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def tamaas(z: np.ndarray) -> tuple[dict, np.ndarray]:
+    import tamaas as tm
+    tm.set_log_level(tm.LogLevel.error)
+    n = z.shape[0]
+    t0 = time.perf_counter()
+    model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, 1.0], [n, n])
+    model.E, model.nu = E_STAR, 0.0          # one half-space of E / (1 - nu^2) = E* against a rigid surface
+    solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(z), TOL)
+    solver.max_iter = 100000
+    solver.solve(PRESSURE)
+    p = np.array(model.traction).reshape(n, n)
+    secs = time.perf_counter() - t0
+    return ({"solver": "tamaas", "grid_or_ndof": n, "contact_fraction": float(np.mean(p > 0)),
+             "iterations": "", "seconds": secs}, p)
+
+
+def half_space(quick: bool) -> list[dict]:
+    rows = []
+    have = tamaas_available()
+    if not have:
+        log.warning("Tamaas is not installed (pip install '.[bench]'): the FFT peer is skipped")
+    for n in (GRIDS[:2] if quick else GRIDS):
+        z = surface(n)
+        a, pa = ours(z)
+        a.update(part="half_space", setting=f"{n}^2, exact, tol {TOL:g}")
+        rows.append(a)
+        if have:
+            b, pb = tamaas(z)
+            diff = float(np.linalg.norm(pa - pb) / np.linalg.norm(pb))
+            b.update(part="half_space", setting=f"{n}^2, tol {TOL:g}", pressure_l2_difference=diff)
+            a["pressure_l2_difference"] = diff
+            rows.append(b)
+            log.info("%4d^2: fraction ours %.6f tamaas %.6f (diff %.1e), pressure L2 diff %.1e, time ours %.2f s "
+                     "(%d CG steps) tamaas %.2f s", n, a["contact_fraction"], b["contact_fraction"],
+                     abs(a["contact_fraction"] - b["contact_fraction"]), diff, a["seconds"], a["iterations"],
+                     b["seconds"])
+        else:
+            log.info("%4d^2: fraction ours %.6f, %.2f s (%d CG steps)", n, a["contact_fraction"], a["seconds"],
+                     a["iterations"])
+    return rows
+
+
+def fe_against_spectral(sizes, quick: bool) -> list[dict]:
+    from ngcontact.drivers import run_cell
+    from ngcontact.output.report import Clock
+    from ngcontact.scene.loader import load
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    rows = []
+    settings = [("spectral", replace(scene.discretization, method="spectral", grid=128 if quick else 512))]
+    settings += [("fe", replace(scene.discretization, interface_maxh=h)) for h in sizes]
+    for kind, disc in settings:
+        sc = replace(scene, discretization=disc)
+        object.__setattr__(sc, "base_dir", scene.base_dir)
+        t0 = time.perf_counter()
+        out = run_cell.run(sc, Clock())
+        secs = time.perf_counter() - t0
+        load0 = out.results["loads"][0]
+        rows.append({"part": "bisinusoid", "solver": f"ngcontact {kind}",
+                     "setting": f"grid {disc.grid}" if kind == "spectral" else f"order {disc.order}, interface_maxh "
+                     f"{disc.interface_maxh}", "grid_or_ndof": out.ndof, "contact_fraction": load0["contact_fraction"],
+                     "mean_closure": load0["mean_closure"], "stiffness": load0["effective_stiffness"]["total"][-1][-1],
+                     "iterations": out.solver["iterations"], "seconds": secs})
+        log.info("bisinusoid %-40s ndof %8d: fraction %.5f closure %.8f stiffness %.5f (%.1f s)", rows[-1]["setting"],
+                 out.ndof, load0["contact_fraction"], load0["mean_closure"], rows[-1]["stiffness"], secs)
+    return rows
+
+
+def dissimilar_child() -> None:
+    """Part 3 in this (child) process: print its row as JSON."""
+    z = surface(FINEST)
+    row, _ = ours(z, rough=Layer(1.0, 0.3, 0.5), counter=Layer(3.0, 0.25, 0.3))
+    row.update(part="dissimilar", setting="1024^2, E 1 / 3, h 0.5 / 0.3, exact",
+               peak_memory_gb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20)
+    print(json.dumps(row))
+
+
+def dissimilar() -> list[dict]:
+    out = subprocess.run([sys.executable, os.path.abspath(__file__), "--dissimilar-child"], check=True,
+                         capture_output=True, text=True)
+    row = json.loads(out.stdout.strip().splitlines()[-1])
+    log.info("dissimilar finite layers 1024^2: %.2f s, %d CG steps, peak memory %.2f GB, fraction %.5f",
+             row["seconds"], row["iterations"], row["peak_memory_gb"], row["contact_fraction"])
+    return [row]
+
+
+def plot(rows: list[dict], path: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4))
+    hs = [r for r in rows if r["part"] == "half_space"]
+    for solver, style in (("ngcontact spectral", "o-"), ("tamaas", "s--")):
+        sel = [r for r in hs if r["solver"] == solver]
+        if sel:
+            axes[0].semilogx([r["grid_or_ndof"] for r in sel], [r["contact_fraction"] for r in sel], style,
+                             label=solver, base=2)
+            axes[1].loglog([r["grid_or_ndof"] for r in sel], [r["seconds"] for r in sel], style, label=solver,
+                           base=2)
+    axes[0].set(xlabel="grid points per direction", ylabel="contact fraction", title="half-space limit: fraction")
+    axes[1].set(xlabel="grid points per direction", ylabel="wall time [s]", title="half-space limit: time")
+    bis = [r for r in rows if r["part"] == "bisinusoid"]
+    fe = [r for r in bis if r["solver"] == "ngcontact fe"]
+    sp = [r for r in bis if r["solver"] == "ngcontact spectral"]
+    if fe:
+        axes[2].semilogx([r["grid_or_ndof"] for r in fe], [r["contact_fraction"] for r in fe], "o-", label="FE cell")
+    for r in sp:
+        axes[2].axhline(r["contact_fraction"], color="k", ls="--", label=f"spectral, {r['setting']}")
+    axes[2].set(xlabel="FE dofs", ylabel="contact fraction", title="bisinusoid: FE against spectral")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", nargs="?", default=os.path.join("results", "spectral_vs_fft"), help="output directory")
+    ap.add_argument("--quick", action="store_true", help="small grids and one FE size (a smoke run)")
+    ap.add_argument("--fe-sizes", type=float, nargs="*", default=None,
+                    help="FE interface mesh sizes of part 2 (default 0.12 0.08 0.06)")
+    ap.add_argument("--dissimilar-child", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.dissimilar_child:
+        dissimilar_child()
+        return 0
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    for quiet in ("ngcontact.cell.spectral_cell", "ngcontact.solvers.newton", "ngcontact.drivers.run_cell",
+                  "ngcontact.cell.cell_problem"):
+        logging.getLogger(quiet).setLevel(logging.WARNING)
+    sizes = args.fe_sizes if args.fe_sizes is not None else ([0.12] if args.quick else [0.12, 0.08, 0.06])
+    rows = half_space(args.quick) + fe_against_spectral(sizes, args.quick)
+    if not args.quick:
+        rows += dissimilar()
+    os.makedirs(args.out, exist_ok=True)
+    write_csv(os.path.join(args.out, "spectral_vs_fft.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
+    plot(rows, os.path.join(args.out, "spectral_vs_fft.png"))
+    log.info("wrote %s", os.path.join(args.out, "spectral_vs_fft.csv"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
