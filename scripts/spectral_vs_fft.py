@@ -21,8 +21,10 @@ Three measurements, one run, one CSV and one PNG:
    and the spectral cell at 512^2, contact fraction, mean closure and the
    far-face stiffness; the gap between them closes under FE refinement.
 3. **A 1024^2 cell of dissimilar finite layers** (``E = 1, 3``,
-   ``nu = 0.3, 0.25``, 0.5 and 0.3 thick) on the same surface: wall time and
-   peak memory of the whole process (run in a child process).
+   ``nu = 0.3, 0.25``, 0.5 and 0.3 thick) on the same surface, frictionless
+   and with exact Coulomb friction (``mu = 0.5``) under a mean shear of 0.2
+   times the pressure: wall time and peak memory of the whole process (each
+   run in a child process).
 
 Usage::
 
@@ -57,6 +59,7 @@ E, NU, THICK = 1.0, 0.3, 50.0
 E_STAR = E / (2 * (1 - NU ** 2))
 SLOPE, HURST, SEED = 0.1, 0.8, 7
 PRESSURE = 0.05 * E_STAR * SLOPE          # about 10 % contact (Persson: fraction ~ 2 p / (E* slope))
+MU, SHEAR = 0.5, 0.2                      # part 3 with friction: Coulomb mu, mean shear / mean pressure
 GRIDS, FINEST = (128, 256, 512, 1024), 1024
 TOL = 1e-10
 KEYS = ("part", "solver", "setting", "grid_or_ndof", "contact_fraction", "pressure_l2_difference", "mean_closure",
@@ -70,13 +73,13 @@ def surface(n: int) -> np.ndarray:
     return z[::step, ::step]
 
 
-def ours(z: np.ndarray, rough=None, counter=None) -> tuple[dict, np.ndarray]:
+def ours(z: np.ndarray, rough=None, counter=None, friction=None, shear=None) -> tuple[dict, np.ndarray]:
     n = z.shape[0]
     t0 = time.perf_counter()
     cell = SpectralCell(dim=3, period=1.0, grid=n, rough=rough or Layer(E, NU, THICK),
                         counter=counter or Layer(E, NU, THICK), gap=z.max() - z, k_n=1.0, enforcement="exact",
-                        tol=TOL)
-    sol = cell.solve(cell_load(3, pressure=PRESSURE))
+                        tol=TOL, friction=friction, max_iter=100000)
+    sol = cell.solve(cell_load(3, pressure=PRESSURE, shear=shear))
     secs = time.perf_counter() - t0
     r = sol.results
     return ({"solver": "ngcontact spectral", "grid_or_ndof": n, "contact_fraction": r["contact_fraction"],
@@ -159,22 +162,28 @@ def fe_against_spectral(sizes, quick: bool) -> list[dict]:
     return rows
 
 
-def dissimilar_child() -> None:
+def dissimilar_child(friction: bool) -> None:
     """Part 3 in this (child) process: print its row as JSON."""
+    from ngcontact.laws.penalty import Friction
     z = surface(FINEST)
-    row, _ = ours(z, rough=Layer(1.0, 0.3, 0.5), counter=Layer(3.0, 0.25, 0.3))
-    row.update(part="dissimilar", setting="1024^2, E 1 / 3, h 0.5 / 0.3, exact",
+    fr = Friction("coulomb", w=1e-6, mu=MU) if friction else None
+    row, _ = ours(z, rough=Layer(1.0, 0.3, 0.5), counter=Layer(3.0, 0.25, 0.3), friction=fr,
+                  shear=(SHEAR * PRESSURE, 0.0) if friction else None)
+    row.update(part="dissimilar", setting="1024^2, E 1 / 3, h 0.5 / 0.3, exact" + (
+               f", Coulomb mu {MU}, shear {SHEAR} p" if friction else ", frictionless"),
                peak_memory_gb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2 ** 20)
     print(json.dumps(row))
 
 
 def dissimilar() -> list[dict]:
-    out = subprocess.run([sys.executable, os.path.abspath(__file__), "--dissimilar-child"], check=True,
-                         capture_output=True, text=True)
-    row = json.loads(out.stdout.strip().splitlines()[-1])
-    log.info("dissimilar finite layers 1024^2: %.2f s, %d CG steps, peak memory %.2f GB, fraction %.5f",
-             row["seconds"], row["iterations"], row["peak_memory_gb"], row["contact_fraction"])
-    return [row]
+    rows = []
+    for flag in ("--dissimilar-child", "--dissimilar-friction-child"):
+        out = subprocess.run([sys.executable, os.path.abspath(__file__), flag], check=True, capture_output=True,
+                             text=True)
+        rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
+        log.info("%s: %.2f s, %d iterations, peak memory %.2f GB, fraction %.5f", rows[-1]["setting"],
+                 rows[-1]["seconds"], rows[-1]["iterations"], rows[-1]["peak_memory_gb"], rows[-1]["contact_fraction"])
+    return rows
 
 
 def plot(rows: list[dict], path: str) -> None:
@@ -215,9 +224,10 @@ def main(argv=None) -> int:
     ap.add_argument("--fe-sizes", type=float, nargs="*", default=None,
                     help="FE interface mesh sizes of part 2 (default 0.12 0.08 0.06)")
     ap.add_argument("--dissimilar-child", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--dissimilar-friction-child", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    if args.dissimilar_child:
-        dissimilar_child()
+    if args.dissimilar_child or args.dissimilar_friction_child:
+        dissimilar_child(friction=args.dissimilar_friction_child)
         return 0
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     for quiet in ("ngcontact.cell.spectral_cell", "ngcontact.solvers.newton", "ngcontact.drivers.run_cell",

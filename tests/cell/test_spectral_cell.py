@@ -398,3 +398,42 @@ def test_3d_shear_is_isotropic_on_the_bisinusoid():
     assert abs(ja[1]) <= 1e-7 * abs(ja[0]) and abs(jb[0]) <= 1e-7 * abs(jb[1])
     assert np.allclose(a.fields["pressure"], b.fields["pressure"].T, rtol=0, atol=1e-12 * 0.008)
     assert a.results["mean_traction"] == pytest.approx([0.002, 0.0, -0.008], abs=1e-15)
+
+
+def test_full_traction_operator_is_symmetric_and_its_energy_gradient_consistent():
+    N = 32
+    cell = SpectralCell(dim=3, period=1.0, grid=N, rough=Layer(1, 0.3, 0.6), counter=Layer(4, 0.2, 0.3),
+                        gap=np.zeros((N, N)), k_n=1.0)
+    apply, L, K0 = cell.traction_operator((True, False, True))
+    rng = np.random.default_rng(0)
+    x, y = rng.normal(size=(2, 3, N, N))
+    assert np.sum(x * apply(y)) == pytest.approx(np.sum(apply(x) * y), rel=1e-12)
+    assert 0 < np.sum(x * apply(x)) <= L * np.sum(x * x) * (1 + 1e-12)
+    b = rng.normal(size=(3, N, N))
+
+    def energy(t):
+        return 0.5 * np.sum(t * apply(t)) + np.sum(t * b)
+    grad = apply(x) + b
+    for idx in ((0, 3, 4), (1, 10, 2), (2, 31, 0)):
+        e = np.zeros_like(x)
+        e[idx] = 1e-5
+        assert (energy(x + e) - energy(x - e)) / 2e-5 == pytest.approx(grad[idx], rel=1e-7)
+    # the uniform modes: the layers' uniaxial-strain and shear compliances in series
+    mu_r, mu_c = 1 / (2 * 1.3), 4 / (2 * 1.2)
+    assert K0[0] == pytest.approx(0.6 / mu_r + 0.3 / mu_c, rel=1e-12)
+    assert K0[2] == pytest.approx(0.6 / Layer(1, 0.3, 0.6).M + 0.3 / Layer(4, 0.2, 0.3).M, rel=1e-12)
+
+
+def test_macro_strain_shifts_the_far_face_approach_as_in_the_fe_cell(tmp_path):
+    def scene(disc):
+        return SCENE.format(disc=disc).replace("pressure = [0.0034523, 0.00863075]",
+                                               "pressure = [0.00863075]\nmacro_strain = [0.002]")
+    fe, _ = _run(tmp_path, scene("order = 2\nmaxh = 0.25\ninterface_maxh = 0.01"), "fe")
+    sp, _ = _run(tmp_path, scene('method = "spectral"\ngrid = 2048'), "sp")
+    plain, _ = _run(tmp_path, SCENE.format(disc='method = "spectral"\ngrid = 2048'), "plain")
+    a, b = fe["results"]["loads"][0], sp["results"]["loads"][0]
+    assert b["far_face_jump"][-1] == pytest.approx(a["far_face_jump"][-1], rel=2e-3)
+    # the contact problem itself does not see an in-plane strain of flat layers: same closure, shifted approach
+    c = plain["results"]["loads"][1]
+    assert b["mean_closure"] == pytest.approx(c["mean_closure"], rel=1e-12)
+    assert b["far_face_jump"][-1] - c["far_face_jump"][-1] == pytest.approx(2 * 1.0 * (0.3 / 0.7) * 0.002, rel=1e-10)
