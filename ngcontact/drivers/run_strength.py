@@ -56,6 +56,10 @@ def cell_problem_of(cell_path: str, *, key: str) -> tuple[CellScene, CellProblem
     if cs.contact.geometric_only:
         raise SceneError(key, cell_path, "the cell scene has contact.geometric_only = true; the recovery "
                          "solves the cell, so it needs a contact model and a [load] section")
+    if cs.discretization.method != "fe":
+        raise SceneError(key, cell_path, f"the cell scene is solved by discretization.method = "
+                         f"{cs.discretization.method!r}; the strength recovery and the two-scale loop need the body "
+                         "stresses and the macro strain term of the FE cell: use a cell scene with method = 'fe'")
     cell = build_cell(cs)
     model = dataclasses.replace(model_of(cs), macro_strain=True)
     s = cs.solver
