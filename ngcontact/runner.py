@@ -11,6 +11,8 @@ Nothing is written to disk; :func:`ngcontact.output.writer.write_outputs` does t
 from __future__ import annotations
 
 import importlib
+import os
+from contextlib import contextmanager
 from typing import Callable
 
 from ngcontact import __version__
@@ -26,6 +28,40 @@ DRIVERS = {
     "macro": "ngcontact.drivers.run_macro",
     "direct": "ngcontact.drivers.run_resolved",
 }
+
+
+#: Environment variable with the number of threads NGSolve's task manager runs with (default: every core
+#: this process may use).
+THREADS_ENV = "NGCONTACT_THREADS"
+
+
+def thread_count() -> int:
+    """Threads of a run: ``NGCONTACT_THREADS`` or the cores available to this process."""
+    raw = os.environ.get(THREADS_ENV)
+    if raw is None:
+        return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    try:
+        n = int(raw)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise SceneError(f"environment variable {THREADS_ENV}", raw, "the number of threads: an integer >= 1")
+    return n
+
+
+@contextmanager
+def threads(n: int):
+    """Assembly and solves inside NGSolve's task manager with ``n`` threads (NGSolve runs on one core otherwise).
+
+    One thread runs without the task manager: with it a 3D cell took 37 s instead of 26 s here.
+    """
+    if n == 1:
+        yield
+        return
+    import ngsolve as ng
+    ng.SetNumThreads(n)
+    with ng.TaskManager():
+        yield
 
 
 def check(scene) -> None:
@@ -59,11 +95,13 @@ def solve(scene, progress: Callable[[str], None] | None = None) -> tuple[dict, O
     """
     if not hasattr(scene, "kind"):
         scene = loader.load(scene)
+    n = thread_count()
     clock = Clock(progress)
-    outcome = importlib.import_module(DRIVERS[scene.kind]).run(scene, clock)
+    with threads(n):
+        outcome = importlib.import_module(DRIVERS[scene.kind]).run(scene, clock)
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),
-                          outcome=outcome, timings=clock.total(), version=__version__)
+                          outcome=outcome, timings=clock.total(), version=__version__, threads=n)
     return report, outcome
 
 
@@ -86,9 +124,11 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
         scene = loader.load(scene)
     if scene.kind != "direct" or getattr(scene, "study", None) is None:
         raise SceneError("kind", scene.kind, "the epsilon study needs a 'direct' scene with a [study] section")
+    n = thread_count()
     clock = Clock(progress)
-    outcome = run_study(scene, periods, clock=clock)
+    with threads(n):
+        outcome = run_study(scene, periods, clock=clock)
     report = build_report(kind="direct-epsilon-study", title=scene.title, scene=loader.as_dict(scene),
                           effects=loader.effects(scene), outcome=outcome, timings=clock.total(),
-                          version=__version__)
+                          version=__version__, threads=n)
     return report, outcome

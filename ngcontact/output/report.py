@@ -12,6 +12,7 @@ arrays.
 Report keys (schema ``ngcontact-report/1``): ``schema``, ``version``,
 ``kind``, ``title``, ``scene`` (the validated scene echoed), ``effects`` (the
 terms assembled), ``ndof``, ``timings`` (seconds per stage and ``total``),
+``threads`` (of NGSolve's task manager),
 ``solver`` (iterations, residual history, converged), ``results``
 (kind-specific), ``files`` (what was written beside the report).
 """
@@ -109,7 +110,7 @@ def file_names(outcome: Outcome) -> list[str]:
 
 
 def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcome,
-                 timings: dict, version: str) -> dict:
+                 timings: dict, version: str, threads: int = 1) -> dict:
     """Assemble the report dictionary (validated: finite numbers only)."""
     report = {
         "schema": SCHEMA,
@@ -120,6 +121,7 @@ def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcom
         "effects": list(effects),
         "ndof": int(outcome.ndof),
         "timings": timings,
+        "threads": int(threads),
         "solver": outcome.solver,
         "results": outcome.results,
         "files": file_names(outcome),
