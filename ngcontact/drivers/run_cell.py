@@ -54,6 +54,15 @@ def solve_graded(scene, loads) -> list[GradedSolve]:
     return out
 
 
+def contact_curve_plot(sols) -> dict:
+    """``{"contact_curve": draw}`` for a sweep of more than one load (either cell's solutions), else empty."""
+    if len(sols) < 2:
+        return {}
+    curve = {k: [s.results[k] for s in sols] for k in ("transmitted_pressure", "contact_fraction", "mean_closure")}
+    return {"contact_curve": lambda path: figures.cell_contact_curve(
+        path, curve["transmitted_pressure"], curve["contact_fraction"], curve["mean_closure"])}
+
+
 def run_spectral(scene, clock) -> Outcome:
     """Solve a small-slope ``cell`` scene with the spectral cell."""
     with clock.stage("grid"):
@@ -92,11 +101,7 @@ def run_spectral(scene, clock) -> Outcome:
     else:
         maps = [s.fields["pressure"] for s in sols]
         plots["pressure_map"] = lambda path, m=maps: figures.pressure_map(path, m, cell.period)
-    if len(sols) > 1:
-        curve = {k: [s.results[k] for s in sols] for k in ("transmitted_pressure", "contact_fraction",
-                                                            "mean_closure")}
-        plots["contact_curve"] = lambda path, c=curve: figures.cell_contact_curve(
-            path, c["transmitted_pressure"], c["contact_fraction"], c["mean_closure"])
+    plots.update(contact_curve_plot(sols))
     return Outcome(results=results, ndof=cell.points, solver=solver, tables=tables, plots=plots, arrays=arrays)
 
 
@@ -152,9 +157,5 @@ def run(scene, clock) -> Outcome:
     if cell.dim == 2:
         surfaces = [{k: sol.surface[k] for k in ("x", "pressure", "slip")} for sol in sols]
         plots["surface"] = lambda path, sf=surfaces: figures.cell_surface(path, sf)
-    if len(sols) > 1:
-        curve = {k: [s.results[k] for s in sols] for k in ("transmitted_pressure", "contact_fraction",
-                                                            "mean_closure")}
-        plots["contact_curve"] = lambda path, c=curve: figures.cell_contact_curve(
-            path, c["transmitted_pressure"], c["contact_fraction"], c["mean_closure"])
+    plots.update(contact_curve_plot(sols))
     return Outcome(results=results, ndof=P.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
