@@ -99,6 +99,10 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray, mean: 
                                f"interface can carry, {capacity:.6g} (the mean friction threshold): the interface "
                                "cannot carry this load", {})
     tol = 1e-13 * max(capacity, 1e-300)
+    if c > 1:                   # Newton on all shifts at once, from the warm start; one sweep at a time below if not
+        joint = _joint_shift(clip, s, target, radius, damping, tol)
+        if joint is not None:
+            return clip(joint)[0], joint
     reach = float(np.max(np.abs(v))) + float(np.max(radius * damping))
     for _ in range(100):
         for a in range(c):
@@ -114,6 +118,39 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray, mean: 
         if all(abs(float(q[a].mean()) - target[a]) <= 10 * tol for a in range(c)):
             return q, s
     raise ConvergenceError(f"the shift that makes the mean shear {target.tolist()} did not converge", {})
+
+
+def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping, tol: float) -> np.ndarray | None:
+    """Newton's method for all the shifts of :func:`prox_friction` at once (``None`` if it stalls)."""
+    c = len(s0)
+    s = s0.copy()
+    for _ in range(20):
+        q, z, norm, over = clip(s)
+        r = np.array([float(q[a].mean()) for a in range(c)]) - target
+        if float(np.max(np.abs(r))) <= tol:
+            return s
+        # d mean(q_a) / d s_b = -mean((1/d) (delta_ab inside; (G/|z|)(delta_ab - z_a z_b / |z|^2) on the rim))
+        inv = np.where(over, radius / np.where(over, norm, 1.0), 1.0) / damping
+        unit = np.where(over, 1.0 / np.where(over, norm * norm, 1.0), 0.0)
+        jac = np.empty((c, c))
+        for a in range(c):
+            for b in range(c):
+                jac[a, b] = -float(np.mean(inv * ((1.0 if a == b else 0.0) - unit * z[a] * z[b])))
+        try:
+            step = np.linalg.solve(jac, r)
+        except np.linalg.LinAlgError:
+            return None
+        t = 1.0
+        while t > 1e-4:
+            trial = s - t * step
+            qt = clip(trial)[0]
+            if float(np.max(np.abs([float(qt[a].mean()) - target[a] for a in range(c)]))) < float(np.max(np.abs(r))):
+                s = trial
+                break
+            t *= 0.5
+        else:
+            return None
+    return None
 
 
 @dataclass
