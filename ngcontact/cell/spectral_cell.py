@@ -142,16 +142,15 @@ class SpectralCell:
     tol, max_iter
         Stopping rule of the constrained CG: complementarity residual
         relative to the peak-to-valley height of the gap.
-    friction, coulomb_rtol, coulomb_max_iter
+    friction
         :class:`~ngcontact.laws.penalty.Friction` (Tresca or Coulomb; its
-        Huber width with ``"penalty"``, exact friction with ``"exact"``) and
-        the stopping rule of the Coulomb fixed point; ``None``: frictionless.
+        Huber width with ``"penalty"``, exact friction with ``"exact"``);
+        ``None``: frictionless.
     """
 
     def __init__(self, *, dim: int, period: float, grid: int, rough: Layer, counter: Layer,
                  gap: np.ndarray, k_n: float, enforcement: str = "exact", tol: float = 1e-12,
-                 max_iter: int = 2000, friction: Friction | None = None, coulomb_rtol: float = 1e-8,
-                 coulomb_max_iter: int = 40):
+                 max_iter: int = 2000, friction: Friction | None = None):
         if dim not in (2, 3):
             raise ValueError(f"dim = {dim!r}: must be 2 or 3")
         if enforcement not in ENFORCEMENTS:
@@ -166,7 +165,7 @@ class SpectralCell:
         self.rough, self.counter = rough, counter
         self.g0, self.k_n, self.enforcement = g0, float(k_n), enforcement
         self.tol, self.max_iter = tol, max_iter
-        self.friction, self.coulomb_rtol, self.coulomb_max_iter = friction, coulomb_rtol, coulomb_max_iter
+        self.friction = friction
         k = wave_numbers(dim, grid, period)
         self.symbol = (normal_compliance(k, rough.E, rough.nu, rough.h)
                        + normal_compliance(k, counter.E, counter.nu, counter.h))
@@ -224,7 +223,7 @@ class SpectralCell:
         elastic_gap = self.g0 - closure
         slip = np.sqrt(np.sum(state["slip"] ** 2, axis=0))
         mean_closure = float(closure.mean())
-        fraction = self.contact_fraction(p, np.maximum(elastic_gap, 0.0) if self.friction is None else elastic_gap)
+        fraction = self.contact_fraction(p, elastic_gap)
         results: dict[str, Any] = {
             "contact_fraction": fraction,
             "contact_fraction_grid": float(np.count_nonzero(p > 0)) / self.points,
@@ -241,7 +240,6 @@ class SpectralCell:
         if self.friction is not None:
             results["max_slip"] = float(slip.max())
             results["slip_fraction"] = float(np.count_nonzero(state["slipping"])) / self.points
-            results["coulomb_iterations"] = state.get("coulomb_iterations", 0)
         results["effective_stiffness"] = self.effective_stiffness(p > 0)
         results["coefficients"] = self.coefficients(p > 0, state.get("threshold")).as_dict()
         fields = {"pressure": p, "gap": np.maximum(elastic_gap, 0.0), "closure": closure}
@@ -353,8 +351,6 @@ class SpectralCell:
             q, sq = prox_friction(v[:d - 1], G, damp_q, mean_q, sq)
             return np.concatenate([q, p[None]]), (sp, sq)
         res = fista(grad, prox, t0, L, tol=self.tol, scale=scale, max_iter=self.max_iter)
-        history = [res]
-        passes = 0
         t = res.t
         sp, sq = res.shifts
         Kt = apply(t)
@@ -380,8 +376,7 @@ class SpectralCell:
         slipping = (qn >= G_last * (1 - 1e-9)) & (G_last > 0)
         return {"p": t[d - 1], "q": t[:d - 1], "closure": J[d - 1], "slip": J[:d - 1], "slipping": slipping,
                 "threshold": G_last,
-                "far_face_jump": Delta.tolist(), "iterations": sum(r.iterations for r in history),
-                "residuals": [x for r in history for x in r.residuals], "coulomb_iterations": passes}
+                "far_face_jump": Delta.tolist(), "iterations": res.iterations, "residuals": res.residuals}
 
     def sweep(self, loads) -> list[SpectralSolution]:
         """Solve loads in order, each starting from the previous pressure."""

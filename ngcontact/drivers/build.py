@@ -165,8 +165,7 @@ def spectral_cell(scene: CellScene) -> SpectralCell:
         return Layer(E=m.E, nu=m.nu, h=h)
     return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
                         counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid), k_n=c.k_n,
-                        enforcement=c.enforcement, tol=s.rtol, max_iter=s.cg_max_iter, friction=micro_friction(c),
-                        coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter)
+                        enforcement=c.enforcement, tol=s.rtol, max_iter=s.cg_max_iter, friction=micro_friction(c))
 
 
 def gap_samples(scene, grid: int) -> np.ndarray:

@@ -421,7 +421,7 @@ def check_spectral(scene: CellScene) -> None:
                          "is set by discretization.grid: remove the key")
     if d.grid is not None and d.grid % 2:
         raise SceneError("discretization.grid", d.grid, "must be even (the FFT's Nyquist mode is real)")
-    n = d.grid if d.grid is not None else (1024 if g.dim == 2 else 256)
+    n = spectral_grid(scene)           # a height map's own grid is bounded by its file size (64 MiB)
     points = n ** (g.dim - 1)
     if points > MAX_SPECTRAL_POINTS:
         raise SceneError("discretization.grid", n, f"makes {points} grid points, more than {MAX_SPECTRAL_POINTS} "

@@ -89,7 +89,8 @@ class SolverSpec:
     max_iter: int = param(40, doc="largest number of Newton steps", check=at_least(1))
     inverse: str = param("sparsecholesky", doc="sparse direct solver",
                          choices=("sparsecholesky", "umfpack"))
-    cg_max_iter: int = param(10000, doc="spectral cell: largest number of constrained CG steps per load",
+    cg_max_iter: int = param(10000, doc="spectral cell: largest number of constrained CG (frictionless) or "
+                             "accelerated proximal gradient (friction) steps per load",
                              check=at_least(1))
     coulomb_rtol: float = param(1e-8, doc="Coulomb fixed point: stop when max |p_k - p_k-1| <= coulomb_rtol x "
                                 "max p_k on the contact surface", check=positive())
