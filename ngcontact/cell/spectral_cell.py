@@ -166,6 +166,7 @@ class SpectralCell:
         self.g0, self.k_n, self.enforcement = g0, float(k_n), enforcement
         self.tol, self.max_iter = tol, max_iter
         self.friction = friction
+        self._operators: dict[tuple[bool, ...], Any] = {}
         k = wave_numbers(dim, grid, period)
         self.symbol = (normal_compliance(k, rough.E, rough.nu, rough.h)
                        + normal_compliance(k, counter.E, counter.nu, counter.h))
@@ -272,6 +273,12 @@ class SpectralCell:
 
     # ------------------------------------------------------------ friction
     def traction_operator(self, uniform: tuple[bool, ...]):
+        """The cached :meth:`build_traction_operator` (a sweep's loads share it)."""
+        if uniform not in self._operators:
+            self._operators[uniform] = self.build_traction_operator(uniform)
+        return self._operators[uniform]
+
+    def build_traction_operator(self, uniform: tuple[bool, ...]):
         """``(t -> K t, L, K0)``: the full compliance ``K = C_rough + C_counter`` on stacked tractions.
 
         ``t`` has the components ``(q_x[, q_y], p)`` of the traction the

@@ -157,19 +157,22 @@ def gap_cf(scene):
 def spectral_cell(scene: CellScene) -> SpectralCell:
     """The spectral cell (:mod:`ngcontact.cell.spectral_cell`) of a small-slope cell scene."""
     g, c, s = scene.geometry, scene.contact, scene.solver
-    shape = height_map(scene).shape if g.profile in ("height_map", "self_affine") else None
-    grid = spectral_grid(scene, shape)
+    heights = height_map(scene) if small_slope(g) and g.profile != "bisinusoid" else None
+    grid = spectral_grid(scene, None if heights is None else heights.shape)
 
     def layer(name, h):
         m = scene.materials[name]
         return Layer(E=m.E, nu=m.nu, h=h)
     return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
-                        counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid), k_n=c.k_n,
+                        counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid, heights),
+                        k_n=c.k_n,
                         enforcement=c.enforcement, tol=s.rtol, max_iter=s.cg_max_iter, friction=micro_friction(c))
 
 
-def gap_samples(scene, grid: int) -> np.ndarray:
+def gap_samples(scene, grid: int, heights: np.ndarray | None = None) -> np.ndarray:
     """The initial gap of :func:`gap_cf` at the points of a uniform grid of ``grid`` points per period.
+
+    ``heights``: the profile's height map when the caller has it already (:func:`height_map`).
 
     Shape ``(grid,)`` at ``x_j = j P / grid`` (2D) or ``(grid, grid)`` at
     ``(x_j, y_i)`` (3D); height maps and tabulated gaps are interpolated
@@ -186,7 +189,7 @@ def gap_samples(scene, grid: int) -> np.ndarray:
         if g.profile == "bisinusoid":
             out += cell3d.bisinusoid_gap(g.amplitude, P, xy=xy)
         else:
-            H = height_map(scene)
+            H = height_map(scene) if heights is None else heights
             out += cell3d.bilinear_samples(H.max() - H, P, grid)
     gs = scene.contact.gap
     if gs.kind == "tabulated":
