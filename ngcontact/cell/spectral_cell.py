@@ -25,36 +25,8 @@ interpolant of the pressure loads the layers), and the contact problem is
 solved by constrained conjugate gradients
 (:mod:`ngcontact.solvers.constrained_cg`).
 
-Friction (Tresca, or Coulomb with the threshold ``G = mu p``, paper eqs.
-16-17) needs the tangential traction ``q`` too: the
-jump is ``J = -K t - U`` with ``t = (q, p)`` and ``K`` the layers' full
-3 x 3 (2D: 2 x 2) compliance, whose normal/tangential coupling vanishes for
-identical layers only.  The cell is then the convex problem in tractions of
-:mod:`ngcontact.solvers.projected_gradient` (``|q| <= G``, ``p >= 0``),
-solved by accelerated proximal gradients.  Coulomb friction has no such
-potential; its threshold is taken from the pressure of the same proximal
-step, so that a fixed point of the iteration meets Coulomb's conditions
-with its own pressure (no outer fixed point of Tresca problems, which cost
-six passes of 300 to 400 steps each on a 256^2 cell).  With ``"penalty"`` the friction
-is the FE cell's Huber-regularized one (width ``w``), with ``"exact"`` it is
-exact.  As in the FE cell, the Tresca threshold holds on the whole surface.
-
-Results use the names of the FE cell (:mod:`ngcontact.cell.measures`):
-``contact_fraction`` (the share of grid points in contact; in 2D the
-contact edges located between grid points, below), ``mean_pressure``,
-``mean_closure`` (the mean of ``J_n``), ``far_face_jump``,
-``effective_stiffness`` (``d pbar / d Delta_interface`` at the current
-contact set, the FE cell's ``(S^-1 - S_0^-1)^-1``; its normal component
-only, also with friction) and the coefficients of
-eq. 34 on the real contact set.
-
-Contact edges in 2D: beyond an edge at ``a`` the gap of a smooth contact
-grows like ``(x - a)^(3/2)``, so ``gap^(2/3)`` is linear in ``x``; each edge
-is placed where the line through ``gap^(2/3)`` at the first two open points
-meets zero, within the grid step before the first open point (tried against
-Westergaard: the other side's ``p^2``, linear for a ``sqrt`` edge, is biased
-by the collocation error of the pressure at the last contact points, 2e-5
-of the fraction at 65,536 points where the gap gives 1e-5).
+Friction: :mod:`ngcontact.cell.spectral_friction`; results of a load:
+:mod:`ngcontact.cell.spectral_measures`.
 """
 from __future__ import annotations
 
@@ -65,24 +37,17 @@ from typing import Any
 import numpy as np
 import scipy.fft as sfft
 
+from ngcontact.cell import spectral_measures as measures
 from ngcontact.cell.cell_load import CellLoad
-from ngcontact.cell.coefficients import Coefficients
-from ngcontact.cell.layer_compliance import layer_matrix, normal_compliance
+from ngcontact.cell.layer_compliance import normal_compliance
+from ngcontact.cell.spectral_friction import solve_frictional, traction_operator
 from ngcontact.geometry.random_surface import wave_vectors
 from ngcontact.laws.penalty import Friction
-from ngcontact.solvers.constrained_cg import constrained_cg, masked_cg
-from ngcontact.solvers.projected_gradient import fista, prox_friction, prox_pressure
+from ngcontact.solvers.constrained_cg import constrained_cg
 
 log = logging.getLogger(__name__)
 
 ENFORCEMENTS = ("penalty", "exact")
-
-
-def cell_load_normal(load: CellLoad) -> CellLoad:
-    """The normal part of a load (the tangential components free of traction)."""
-    d = len(load.traction)
-    return CellLoad(traction=(0.0,) * (d - 1) + (load.traction[-1],), jump=(None,) * (d - 1) + (load.jump[-1],),
-                    macro_strain=load.macro_strain)
 
 
 @dataclass(frozen=True)
@@ -186,7 +151,7 @@ class SpectralCell:
         """``IFFT(symbol FFT(p))`` on the grid (all cores)."""
         return sfft.irfftn(symbol * sfft.rfftn(p, workers=-1), s=self.shape, workers=-1)
 
-    def _interface_compliance(self, uniform: bool):
+    def interface_compliance(self, uniform: bool):
         """``p -> C p (+ p / k_n)``, with or without the uniform mode of ``C``."""
         sym = self.symbol if uniform else self.fluctuation
         winkler = 1.0 / self.k_n if self.enforcement == "penalty" else 0.0
@@ -216,7 +181,7 @@ class SpectralCell:
         tn = load.traction[d - 1]
         if tn is not None and not -tn > 0:
             raise ValueError(f"pressure = {-tn!r}: the spectral cell needs a compressive mean pressure > 0")
-        state = self._normal(load, start) if self.friction is None else self._frictional(load, start)
+        state = self.solve_normal(load, start) if self.friction is None else solve_frictional(self, load, start)
         p, q = state["p"], state["q"]
         pbar = float(p.mean())
         qbar = [float(c.mean()) for c in q]
@@ -224,7 +189,7 @@ class SpectralCell:
         elastic_gap = self.g0 - closure
         slip = np.sqrt(np.sum(state["slip"] ** 2, axis=0))
         mean_closure = float(closure.mean())
-        fraction = self.contact_fraction(p, elastic_gap)
+        fraction = measures.contact_fraction(self, p, elastic_gap)
         results: dict[str, Any] = {
             "contact_fraction": fraction,
             "contact_fraction_grid": float(np.count_nonzero(p > 0)) / self.points,
@@ -241,8 +206,8 @@ class SpectralCell:
         if self.friction is not None:
             results["max_slip"] = float(slip.max())
             results["slip_fraction"] = float(np.count_nonzero(state["slipping"])) / self.points
-        results["effective_stiffness"] = self.effective_stiffness(p > 0)
-        results["coefficients"] = self.coefficients(p > 0, state.get("threshold")).as_dict()
+        results["effective_stiffness"] = measures.effective_stiffness(self, p > 0)
+        results["coefficients"] = measures.coefficients(self, p > 0, state.get("threshold")).as_dict()
         fields = {"pressure": p, "gap": np.maximum(elastic_gap, 0.0), "closure": closure}
         if self.friction is not None:
             fields.update(shear=q, slip=state["slip"])
@@ -250,18 +215,18 @@ class SpectralCell:
         return SpectralSolution(load=load, results=results, fields=fields, iterations=state["iterations"],
                                 residuals=state["residuals"])
 
-    def _normal(self, load: CellLoad, start) -> dict:
+    def solve_normal(self, load: CellLoad, start) -> dict:
         """Frictionless: the pressure by constrained CG (module docstring)."""
         d = self.dim
         poisson = self.poisson_shift(load.macro_strain)
         tn, jn = load.traction[d - 1], load.jump[d - 1]
         if tn is not None:
-            res = constrained_cg(self._interface_compliance(uniform=False), self.g0, pbar=-tn,
+            res = constrained_cg(self.interface_compliance(uniform=False), self.g0, pbar=-tn,
                                  tol=self.tol, max_iter=self.max_iter, gscale=self.gscale, p0=start)
         else:
             assert jn is not None
             # gamma = g0 - Delta + C p (+ p/k_n), uniform mode included: b = g0 - Delta_interface
-            res = constrained_cg(self._interface_compliance(uniform=True), self.g0 - (jn - poisson), pbar=None,
+            res = constrained_cg(self.interface_compliance(uniform=True), self.g0 - (jn - poisson), pbar=None,
                                  tol=self.tol, max_iter=self.max_iter, gscale=self.gscale, p0=start)
         p = res.p
         winkler = p / self.k_n if self.enforcement == "penalty" else 0.0
@@ -273,117 +238,10 @@ class SpectralCell:
 
     # ------------------------------------------------------------ friction
     def traction_operator(self, uniform: tuple[bool, ...]):
-        """The cached :meth:`build_traction_operator` (a sweep's loads share it)."""
+        """:func:`ngcontact.cell.spectral_friction.traction_operator`, built once per kind of load of a sweep."""
         if uniform not in self._operators:
-            self._operators[uniform] = self.build_traction_operator(uniform)
+            self._operators[uniform] = traction_operator(self, uniform)
         return self._operators[uniform]
-
-    def build_traction_operator(self, uniform: tuple[bool, ...]):
-        """``(t -> K t, L, K0)``: the full compliance ``K = C_rough + C_counter`` on stacked tractions.
-
-        ``t`` has the components ``(q_x[, q_y], p)`` of the traction the
-        rough body exerts on the counter; the jump is ``J = -K t - U``.
-        ``uniform[c]``: keep the uniform mode of component ``c`` (its mean is
-        free); without it the mean is prescribed and the mode is dropped.
-        The coupling is zeroed on the Nyquist rows, where ``k`` and ``-k``
-        are the same mode.  ``L`` is the largest eigenvalue of ``K`` and
-        ``K0`` the diagonal of the uniform mode (the layers' uniaxial-strain
-        and shear compliances).
-        """
-        d = self.dim
-        n = self.grid
-        k1 = 2 * np.pi * sfft.rfftfreq(n, d=self.period / n)
-        if d == 2:
-            kv = k1[:, None]
-            nyq = np.arange(k1.size) == n // 2
-        else:
-            k0 = 2 * np.pi * sfft.fftfreq(n, d=self.period / n)
-            kv = np.stack(np.broadcast_arrays(k1[None, :], k0[:, None]), axis=-1)
-            nyq = (np.arange(n)[:, None] == n // 2) | (np.arange(k1.size)[None, :] == n // 2)
-        K = (layer_matrix(kv, self.rough.E, self.rough.nu, self.rough.h)
-             + layer_matrix(kv, self.counter.E, self.counter.nu, self.counter.h, above=True))
-        K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
-        K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
-        K0 = np.real(np.diagonal(K.reshape(-1, d, d)[0])).copy()
-        zero = (0,) * (d - 1)
-        for c in range(d):
-            if not uniform[c]:
-                K[zero + (c, c)] = 0.0
-        L = float(np.max(np.linalg.eigvalsh(K)))
-        Km = np.moveaxis(K, (-2, -1), (0, 1)).copy()       # (d, d, *kshape)
-        axes = tuple(range(1, d))
-
-        def apply(t):
-            T = sfft.rfftn(t, axes=axes, workers=-1)
-            U = np.einsum("ab...,b...->a...", Km, T)
-            return sfft.irfftn(U, s=self.shape, axes=axes, workers=-1)
-        return apply, L, K0
-
-    def _frictional(self, load: CellLoad, start) -> dict:
-        """Tresca (or a Coulomb fixed point of Tresca problems) by FISTA in tractions."""
-        d, f = self.dim, self.friction
-        assert f is not None
-        poisson = self.poisson_shift(load.macro_strain)
-        prescribed_mean = [load.traction[c] is not None for c in range(d)]
-        apply, L, K0 = self.traction_operator(tuple(not m for m in prescribed_mean))
-        b = np.zeros((d,) + self.shape)
-        b[d - 1] = self.g0
-        jumps = [0.0 if j is None else float(j) for j in load.jump]
-        tractions = [0.0 if t is None else float(t) for t in load.traction]
-        for c in range(d):
-            if load.jump[c] is not None:
-                b[c] -= jumps[c] - (poisson if c == d - 1 else 0.0)
-        mean_p = -tractions[d - 1] if prescribed_mean[d - 1] else None
-        mean_q = np.array([-tractions[c] for c in range(d - 1)]) if all(prescribed_mean[:d - 1]) else None
-        if any(prescribed_mean[:d - 1]) and mean_q is None:
-            raise ValueError("the spectral cell takes either the shear or the tangential jump in every direction")
-        exact = self.enforcement == "exact"
-        damp_p = 1.0 if exact else 1.0 + 1.0 / (L * self.k_n)
-        frictionless = self._normal(cell_load_normal(load), start)
-        t0 = np.zeros((d,) + self.shape)
-        t0[d - 1] = frictionless["p"]
-        if mean_q is not None:
-            t0[:d - 1] = mean_q.reshape((d - 1,) + (1,) * (d - 1))
-        scale = self.gscale
-
-        def grad(t):
-            return apply(t) + b
-
-        def prox(v, shifts):
-            sp, sq = shifts if shifts else (0.0, None)
-            p, sp = prox_pressure(v[d - 1], damp_p, mean_p, sp)
-            # Tresca: the fixed threshold; Coulomb: mu times the pressure of this very step
-            G = (f.G or 0.0) * np.ones(self.shape) if f.law == "tresca" else (f.mu or 0.0) * p
-            damp_q = 1.0 if exact else 1.0 + f.w / (L * np.maximum(G, 1e-300))
-            q, sq = prox_friction(v[:d - 1], G, damp_q, mean_q, sq)
-            return np.concatenate([q, p[None]]), (sp, sq)
-        res = fista(grad, prox, t0, L, tol=self.tol, scale=scale, max_iter=self.max_iter)
-        t = res.t
-        sp, sq = res.shifts
-        Kt = apply(t)
-        # the effective linear term of the reduced problem is b + L * shift on the mean-constrained components
-        eff = b.copy()
-        if mean_p is not None:
-            eff[d - 1] += L * sp
-        if mean_q is not None:
-            eff[:d - 1] += L * np.asarray(sq).reshape((d - 1,) + (1,) * (d - 1))
-        # -J = K_full t - Delta = K t + (b_eff - g0 e_n): on a component of prescribed mean the dropped uniform
-        # mode K0 mean(t) and Delta = K0 mean(t) - L shift cancel
-        minus_J = Kt + eff - np.where(np.arange(d) == d - 1, 1.0, 0.0).reshape((d,) + (1,) * (d - 1)) * self.g0
-        Delta = np.zeros(d)
-        for c in range(d):
-            if prescribed_mean[c]:
-                Delta[c] = K0[c] * float(t[c].mean()) - L * (sp if c == d - 1 else np.asarray(sq)[c])
-            else:
-                Delta[c] = jumps[c] - (poisson if c == d - 1 else 0.0)
-        Delta[d - 1] += poisson
-        J = -minus_J
-        G_last = (f.G or 0.0) * np.ones(self.shape) if f.law == "tresca" else (f.mu or 0.0) * t[d - 1]
-        qn = np.sqrt(np.sum(t[:d - 1] ** 2, axis=0))
-        slipping = (qn >= G_last * (1 - 1e-9)) & (G_last > 0)
-        return {"p": t[d - 1], "q": t[:d - 1], "closure": J[d - 1], "slip": J[:d - 1], "slipping": slipping,
-                "threshold": G_last,
-                "far_face_jump": Delta.tolist(), "iterations": res.iterations, "residuals": res.residuals}
 
     def sweep(self, loads) -> list[SpectralSolution]:
         """Solve loads in order, each starting from the previous pressure."""
@@ -392,66 +250,3 @@ class SpectralCell:
             start = out[-1].fields["pressure"] if out and load.traction[-1] is not None else None
             out.append(self.solve(load, start=start))
         return out
-
-    # -------------------------------------------------------------- measures
-    def contact_fraction(self, p: np.ndarray, gap: np.ndarray) -> float:
-        """Contact area per period: grid points in 3D; in 2D edges between points (module docstring)."""
-        on = p > 0
-        if self.dim == 3 or on.all() or not on.any():
-            return float(np.count_nonzero(on)) / self.points
-        n = self.grid
-        length = float(np.count_nonzero(on))
-        root = np.maximum(gap, 0.0) ** (2.0 / 3.0)       # linear in the distance from a smooth contact edge
-        for step in (1, -1):                            # edges on the right, then on the left of a patch
-            last = on & ~np.roll(on, -step)             # in contact, the next point (in this direction) is not
-            for i in np.flatnonzero(last):
-                first, second = (i + step) % n, (i + 2 * step) % n
-                a, b = root[first], root[second]
-                # the edge lies where the line through the first two open points' root meets zero
-                open_share = a / (b - a) if (b > a and not on[second]) else 0.5
-                length += 1.0 - min(max(open_share, 0.0), 1.0) - 0.5
-        return length / n
-
-    def effective_stiffness(self, active: np.ndarray) -> dict:
-        """``K = d pbar / d Delta_interface`` on the contact set ``active`` (the FE cell's names).
-
-        At a fixed contact set a unit interface approach needs the pressure
-        ``p'`` with ``(C p' + p'/k_n) = 1`` on the set and 0 elsewhere
-        (uniform mode of ``C`` excluded: it is the bulk's share), so
-        ``K = mean(p')``; the far-face stiffness adds the layers in series,
-        ``S = (1/K + c0)^-1``, and the reference ``S_0 = 1/c0``.
-        """
-        idx = np.flatnonzero(active.ravel())
-        S0 = 1.0 / self.c0
-        if idx.size == 0:
-            return {"components": ["n0"], "matrix": [[0.0]], "compliance": None, "total": [[0.0]],
-                    "reference": [[S0]]}
-        # the fluctuation operator is singular on the full surface (constants): in full contact K is infinite
-        if idx.size == self.points and self.enforcement == "exact":
-            return {"components": ["n0"], "matrix": None, "compliance": [[0.0]], "total": [[S0]],
-                    "reference": [[S0]]}
-        x, _ = masked_cg(self._interface_compliance(uniform=False), active, np.ones(self.shape))
-        K = float(x.sum()) / self.points
-        S = 1.0 / (1.0 / K + self.c0)
-        return {"components": ["n0"], "matrix": [[K]], "compliance": [[1.0 / K]], "total": [[S]],
-                "reference": [[S0]]}
-
-    def coefficients(self, active: np.ndarray, threshold: np.ndarray | None = None) -> Coefficients:
-        """Eqs. 34, 42-43 on the real contact set of a flat interface (``n = n0`` everywhere).
-
-        ``K0 = k_n |S_real| / |T|`` on ``n0`` only, ``g_n = k_n mean(1_real g0)``,
-        and the friction threshold ``G_t = mean(1_real G)`` per tangential
-        direction (``G`` the Tresca threshold or ``mu p``), ``G_n = 0``.
-        """
-        frac = float(np.count_nonzero(active)) / self.points
-        kn0 = self.k_n * frac
-        g_n = self.k_n * float(np.where(active, self.g0, 0.0).sum()) / self.points
-        G_t = float(np.where(active, threshold, 0.0).sum()) / self.points if threshold is not None else 0.0
-        nt = self.dim - 1
-        K0 = np.zeros((self.dim, self.dim))
-        K0[0, 0] = kn0
-
-        def tangential(v):
-            return v if nt == 1 else (v, v)
-        return Coefficients(k_n=kn0, k_t=tangential(0.0), k_nt=tangential(0.0), g_n=g_n, g_t=tangential(0.0),
-                            mu=tangential(0.0), G_n=0.0, G_t=tangential(G_t), K0=K0, contact_fraction=frac)

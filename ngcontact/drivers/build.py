@@ -23,7 +23,8 @@ from ngcontact.fem.interpolants import periodic_table_1d
 from ngcontact.laws import homogenized as il
 from ngcontact.laws.penalty import Friction
 from ngcontact.cell.spectral_cell import Layer, SpectralCell
-from ngcontact.scene.cell_scene import GAP_PROFILES, CellScene, load_states, profile_2d, small_slope, spectral_grid
+from ngcontact.scene.cell_geometry import GAP_PROFILES, profile_2d, small_slope
+from ngcontact.scene.cell_scene import CellScene, load_states, spectral_grid
 from ngcontact.scene.loader import as_dict, load
 from ngcontact.scene.sections import MaterialSpec, resolve
 

@@ -27,6 +27,7 @@ from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, model_of, sp
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.edge_grading import GradedSolve, graded_flat_cell, solve_to_tolerance
 
+from ngcontact.cell import spectral_measures
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
@@ -67,10 +68,13 @@ def run_spectral(scene, clock) -> Outcome:
     """Solve a small-slope ``cell`` scene with the spectral cell."""
     with clock.stage("grid"):
         cell = spectral_cell(scene)
+    whole = spectral_measures.coefficients(cell, np.ones(cell.shape, bool)).as_dict()
     results: dict[str, Any] = {"method": {"name": "spectral", "grid": cell.grid, "points": cell.points,
-                                          "enforcement": cell.enforcement, "solver": "constrained_cg",
+                                          "enforcement": cell.enforcement,
+                                          "solver": "constrained_cg" if cell.friction is None
+                                          else "accelerated_proximal_gradient",
                                           "tolerance": cell.tol},
-                               "whole_surface": cell.coefficients(np.ones(cell.shape, bool)).as_dict()}
+                               "whole_surface": whole}
     if scene.contact.geometric_only:
         return Outcome(results=results, ndof=cell.points)
     with clock.stage("solve"):

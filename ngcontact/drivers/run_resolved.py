@@ -35,7 +35,7 @@ from ngcontact.resolved import resolved_problem as D
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry import femur
 from ngcontact.geometry import resolved_bodies as rg
-from ngcontact.scene.cell_scene import profile_2d
+from ngcontact.scene.cell_geometry import profile_2d
 from ngcontact.macro.macro_problem import Load
 from ngcontact.output.report import Outcome, VtkField
 from ngcontact.fem.elasticity import COMPONENTS

@@ -1,7 +1,7 @@
 """Scene kind ``cell``: the micro contact problem of one periodic cell.
 
-Sections: ``[geometry]`` (profile and arrangement, mapped onto the builders
-of :mod:`ngcontact.geometry.profiles` and :mod:`ngcontact.geometry.cell3d`),
+Sections: ``[geometry]`` (profile and arrangement,
+:mod:`ngcontact.scene.cell_geometry`),
 ``[contact]`` (penalty ``k_n``, initial gap, friction law), ``[load]``
 (pressure or normal jump, shear or tangential jump, macro strain; lists are
 sweeps), ``[bodies]`` (material names), ``[discretization]``, ``[solver]``.
@@ -14,160 +14,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
+from ngcontact.scene.cell_geometry import CellGeometry, check_features, check_profile_heights, small_slope
 from ngcontact.scene.sections import (CellDiscretization, MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import (at_least, check_selected, closed_interval, nonempty, nonnegative, open_interval,
-                                    param, positive)
+from ngcontact.scene.schema import check_selected, nonempty, nonnegative, param, positive
 
-PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
-PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map", "self_affine")
-#: 3D free-form profiles: meshed as the real surface with Netgen's OCC kernel
-#: in the conforming arrangement; in the summit arrangement represented by the
-#: small-slope model (a flat interface whose initial gap is the height below
-#: the highest summit).
-GAP_PROFILES = ("bisinusoid", "height_map", "self_affine")
 GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 FRICTION = ("none", "tresca", "coulomb")
 ENFORCEMENTS = ("penalty", "exact")
-
-
-@dataclass(frozen=True, kw_only=True)
-class SpectrumSpec:
-    """A random periodic self-affine surface (:mod:`ngcontact.geometry.random_surface`)."""
-
-    hurst: float = param(doc="Hurst exponent H: power spectrum C(q) ~ q^(-2(1+H)) between roll-off and cut-off",
-                         check=open_interval(0, 1))
-    rms_height: float | None = param(None, doc="root-mean-square height (give this or rms_slope)", units="m",
-                                     check=positive())
-    rms_slope: float | None = param(None, doc="root-mean-square slope (give this or rms_height)", check=positive())
-    rolloff: float | None = param(None, doc="roll-off wavelength: the spectrum is flat for longer ones (default: "
-                                  "the period)", units="m", check=positive())
-    cutoff: float | None = param(None, doc="shortest wavelength (default: 4 grid steps)", units="m",
-                                 check=positive())
-    grid: int = param(256, doc="points per period and direction the surface is drawn on (even)",
-                      check=closed_interval(8, 4096))
-    seed: int = param(0, doc="seed of the random generator (the same seed draws the same surface)",
-                      check=at_least(0))
-
-    def check(self, path: str) -> None:
-        if (self.rms_height is None) == (self.rms_slope is None):
-            raise SceneError(f"{path}.rms_height", self.rms_height, "give exactly one of rms_height and rms_slope")
-        if self.grid % 2:
-            raise SceneError(f"{path}.grid", self.grid, "must be even")
-
-
-@dataclass(frozen=True, kw_only=True)
-class CellGeometry:
-    """The periodic cell (mesh naming contract of ngcontact.geometry)."""
-
-    profile: str = param(doc="roughness profile", choices=PROFILES_2D + PROFILES_3D)
-    arrangement: str = param("conforming", doc="counter body fills the valleys (conforming) or "
-                             "touches the summits only (summit; for bisinusoid and height_map the "
-                             "small-slope model: a flat interface with the heights as initial gap)",
-                             choices=("conforming", "summit"))
-    period: float = param(1.0, doc="cell period |T| (per tangential direction)", units="m",
-                          check=positive())
-    h_rough: float = param(1.0, doc="depth of the rough body below the summits", units="m",
-                           check=positive())
-    h_counter: float = param(1.0, doc="height of the counter body above the summits", units="m",
-                             check=positive())
-    width: float | None = param(None, doc="valley width (rectangular; triangular: omit for a "
-                                "sawtooth spanning the period); hill side (square_hills)",
-                                units="m", check=positive())
-    depth: float | None = param(None, doc="valley depth (rectangular); hill height (square_hills)",
-                                units="m", check=positive())
-    radius: float | None = param(None, doc="valley radius (semicircular)", units="m", check=positive())
-    angles: tuple[float, float] | None = param(None, doc="face angles to S_0 (triangular)",
-                                               units="deg", check=open_interval(0, 90))
-    amplitude: float | None = param(None, doc="profile amplitude (sinusoid, bisinusoid)", units="m",
-                                    check=positive())
-    file: str | None = param(None, doc="tabulated profile: CSV with columns x, y in the scene's length unit, "
-                             "an optional header line, x strictly increasing from 0 to the period, the last row "
-                             "(x = period) repeating the first y, at most 4096 rows (2D); height map: .npy array "
-                             "whose last row/column repeat the first (3D, small-slope model); a regular file of at "
-                             "most 64 MiB, relative to the scene file")
-    spectrum: SpectrumSpec | None = param(None, doc="self_affine: the power spectrum and seed of the random surface")
-
-    _USES = {"flat": (), "flat3d": (), "rectangular": ("width", "depth"),
-             "triangular": ("angles",), "semicircular": ("radius",), "sinusoid": ("amplitude",),
-             "square_hills": ("width", "depth"), "tabulated": ("file",),
-             "bisinusoid": ("amplitude",), "height_map": ("file",), "self_affine": ("spectrum",)}
-    _OPTIONAL = {"triangular": ("width",)}
-
-    @property
-    def dim(self) -> int:
-        return 3 if self.profile in PROFILES_3D else 2
-
-    def check(self, path: str) -> None:
-        check_selected(self, path, "profile", ("width", "depth", "radius", "angles", "amplitude", "file", "spectrum"),
-                       self._USES[self.profile], self._OPTIONAL.get(self.profile, ()))
-        if self.profile == "square_hills":
-            assert self.width is not None and self.depth is not None  # required: check_selected
-            if not self.width < self.period:
-                raise SceneError(f"{path}.width", self.width,
-                                 f"must be < period = {self.period!r} (hills must not touch)")
-            if not self.depth < self.h_rough:
-                raise SceneError(f"{path}.depth", self.depth, f"must be < h_rough = {self.h_rough!r} "
-                                 "(the hill base must lie inside the rough body)")
-        if self.dim == 2 and self.profile != "tabulated":  # tabulated: checked when its file is read
-            try:
-                profile = profile_2d(self)
-            except GeometryError as exc:  # the builders name their own arguments (width, angle_left, ...)
-                key = _BUILDER_KEYS.get(exc.name, exc.name)
-                raise SceneError(f"{path}.{key}", exc.value, exc.allowed) from None
-            check_profile_heights(self, profile.bounds, path)
-            check_features(profile, f"{path}.{PROFILE_KEYS.get(self.profile, 'period')}",
-                           getattr(self, PROFILE_KEYS.get(self.profile, "period")))
-
-
-_BUILDER_KEYS = {"angle_left": "angles", "angle_right": "angles"}
-
-
-def profile_2d(g: CellGeometry):
-    """The :class:`~ngcontact.geometry.profiles.Profile` of a parametric 2D geometry section."""
-    from ngcontact.geometry import profiles as pr
-    if g.profile == "flat":
-        return pr.flat(g.period)
-    # the keys a profile uses are required by CellGeometry.check (check_selected)
-    if g.profile == "rectangular":
-        assert g.width is not None and g.depth is not None
-        return pr.rectangular_valley(g.width, g.depth, g.period)
-    if g.profile == "triangular":
-        assert g.angles is not None
-        return pr.triangular_valley(g.angles[0], g.angles[1], g.width, g.period)
-    if g.profile == "semicircular":
-        assert g.radius is not None
-        return pr.semicircular_valley(g.radius, g.period)
-    if g.profile == "sinusoid":
-        assert g.amplitude is not None
-        return pr.sinusoid(g.amplitude, g.period)
-    raise ValueError(f"profile {g.profile!r} is not a parametric 2D profile")
-
-
-#: The parameter of each parametric 2D profile that sets its smallest feature.
-PROFILE_KEYS = {"rectangular": "width", "triangular": "width", "semicircular": "radius", "sinusoid": "amplitude"}
-#: Smallest feature of a profile, relative to its period, that the mesher resolves (a semicircle of
-#: radius 0.4999999 leaves plateaus of 2e-7 and one of radius 1e-9 an arc of 1e-9: 'meshing failed').
-MIN_FEATURE = 1e-4
-
-
-def check_features(profile, key: str, value) -> None:
-    """Every piece of the profile must be at least :data:`MIN_FEATURE` periods long."""
-    small = profile.smallest_feature
-    if not small >= MIN_FEATURE * profile.period:
-        raise SceneError(key, value, f"leaves a piece of the profile {small:.3g} long, below {MIN_FEATURE:g} of "
-                         f"the period {profile.period:g}, which the mesher cannot resolve")
-
-
-def check_profile_heights(g: CellGeometry, bounds: tuple, path: str = "geometry") -> None:
-    """The profile ``(y_min, y_max)`` must lie strictly between the far faces of the cell."""
-    lo, hi = bounds
-    if not lo > -g.h_rough:
-        raise SceneError(f"{path}.h_rough", g.h_rough, f"must exceed the profile depth {-lo!r} "
-                         "(the roughness must lie inside the rough body)")
-    if not hi < g.h_counter:
-        raise SceneError(f"{path}.h_counter", g.h_counter, f"must exceed the profile height {hi!r}")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -427,11 +282,6 @@ def check_spectral(scene: CellScene) -> None:
         raise SceneError("discretization.grid", n, f"makes {points} grid points, more than {MAX_SPECTRAL_POINTS} "
                          f"(about {MAX_SPECTRAL_POINTS * 200 // 2 ** 30} GB of fields); at most "
                          f"{int(MAX_SPECTRAL_POINTS ** (1 / (g.dim - 1)))} in {g.dim}D")
-
-
-def small_slope(geometry: CellGeometry) -> bool:
-    """A free-form 3D profile in the summit arrangement: flat interface plus gap."""
-    return geometry.profile in GAP_PROFILES and geometry.arrangement == "summit"
 
 
 def load_states(scene: CellScene) -> list[dict]:

@@ -58,7 +58,7 @@ class Discretization:
                               "(a guard against sizes that hang the mesher)", check=at_least(1))
 
 
-#: Largest spectral grid per direction (2D; in 3D the number of points bounds it, see scene.cell_scene).
+#: Largest spectral grid per direction (2D; in 3D the number of points bounds it, see scene.cell_scene.check_spectral).
 MAX_GRID = 2 ** 24
 
 

@@ -68,7 +68,7 @@ def test_layer_matrix_is_hermitian_positive_and_the_counter_mirrors_the_coupling
 def _operator(N, E=1.0, nu=0.3, h=1.0):
     cell = SpectralCell(dim=2, period=1.0, grid=N, rough=Layer(E, nu, h), counter=Layer(E, nu, h),
                         gap=np.zeros(N), k_n=1.0)
-    return cell, cell._interface_compliance(uniform=True)
+    return cell, cell.interface_compliance(uniform=True)
 
 
 def test_the_operator_is_symmetric_positive_and_the_energy_gradient_is_its_residual():
@@ -92,17 +92,17 @@ def test_constrained_cg_meets_the_contact_conditions_and_refuses_a_hopeless_budg
     cell, A = _operator(256)
     x = np.arange(256) / 256
     g0 = 0.02 * np.sin(np.pi * x) ** 2
-    res = constrained_cg(cell._interface_compliance(uniform=False), g0, pbar=5e-3, tol=1e-12, max_iter=1000,
+    res = constrained_cg(cell.interface_compliance(uniform=False), g0, pbar=5e-3, tol=1e-12, max_iter=1000,
                          gscale=0.02)
     assert res.p.min() >= 0 and res.p.mean() == pytest.approx(5e-3, rel=1e-14)
     on = res.p > 0
     assert np.max(np.abs(res.gap[on])) <= 1e-12 * 0.02 and res.gap[~on].min() >= -1e-12 * 0.02
     with pytest.raises(ConvergenceError, match="constrained CG"):
-        constrained_cg(cell._interface_compliance(uniform=False), g0, pbar=5e-3, tol=1e-14, max_iter=3,
+        constrained_cg(cell.interface_compliance(uniform=False), g0, pbar=5e-3, tol=1e-14, max_iter=3,
                        gscale=0.02)
     # the linearization at the contact set: C restricted to it is SPD, masked CG solves it
-    sol, its = masked_cg(cell._interface_compliance(uniform=False), on, np.ones(256), rtol=1e-12)
-    r = cell._interface_compliance(uniform=False)(sol)
+    sol, its = masked_cg(cell.interface_compliance(uniform=False), on, np.ones(256), rtol=1e-12)
+    r = cell.interface_compliance(uniform=False)(sol)
     assert np.allclose(r[on], 1.0, atol=1e-10) and np.all(sol[~on] == 0) and its > 0
 
 
