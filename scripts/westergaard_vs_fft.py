@@ -14,7 +14,9 @@ cores), and two errors are recorded against the closed form:
 This package, spectral: the small-slope cell of two layers ``DEPTH`` thick
 solved on a grid with FFTs and exact contact
 (:mod:`ngcontact.cell.spectral_cell`), from ``N = 2^10`` to ``2^16`` points,
-the contact edges placed between grid points.
+the contact edges placed between grid points; and the same refined from
+``N = 2^10`` to the tolerances 1e-4, 1e-5, 1e-6
+(``geometries/cells/westergaard_exact.toml``), every level timed.
 
 This package, FE: the FE cell of :class:`ngcontact.cell.cell_problem.CellProblem`
 (bodies 2 periods deep, so that their finite depth changes the half-space
@@ -57,6 +59,7 @@ from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_problem import CellModel, CellProblem
 from ngcontact.cell.edge_grading import graded_flat_cell, solve_to_tolerance
 from ngcontact.cell.spectral_cell import Layer, SpectralCell
+from ngcontact.cell.spectral_refinement import sweep_to_tolerance
 from ngcontact.errors import ConvergenceError
 from ngcontact.fem.materials import isotropic
 from ngcontact.output.writer import write_csv
@@ -76,6 +79,8 @@ QUICK_LADDER = (LADDER[0], LADDER[4])
 FFT_START, FFT_TARGET, FFT_BUDGET = 2 ** 10, 1e-5, 60.0
 #: grids of the spectral cell (exact contact, layers DEPTH thick)
 SPECTRAL_GRIDS = tuple(2 ** k for k in range(10, 17))
+#: tolerances of the spectral cell refined from the first grid (discretization.tolerance)
+SPECTRAL_TOLERANCES = (1e-4, 1e-5, 1e-6)
 KEYS = ("solver", "setting", "ndof", "worst_fraction_error", "worst_pressure_error", "seconds",
         "iterations_per_load")
 
@@ -132,15 +137,15 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None) -> di
             "iterations_per_load": " ".join(str(s) for s in steps)}
 
 
-def spectral(n: int) -> dict:
-    """The four loads on the spectral cell of ``n`` grid points (exact contact); errors and wall time."""
-    pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H_GAP, 1.0)
-    t0 = time.perf_counter()
+def _westergaard_cell(n: int) -> SpectralCell:
     x = np.arange(n) / n
-    cell = SpectralCell(dim=2, period=1.0, grid=n, rough=Layer(1.0, NU, DEPTH), counter=Layer(1.0, NU, DEPTH),
+    return SpectralCell(dim=2, period=1.0, grid=n, rough=Layer(1.0, NU, DEPTH), counter=Layer(1.0, NU, DEPTH),
                         gap=2 * H_GAP * np.sin(np.pi * x) ** 2, k_n=1.0, enforcement="exact")
-    sols = cell.sweep([cell_load(2, pressure=r * pstar) for r in RATIOS])
-    secs = time.perf_counter() - t0
+
+
+def _spectral_errors(n: int, sols, pstar: float) -> tuple[float, float]:
+    """Worst relative fraction and pressure errors of a spectral sweep on ``n`` points."""
+    x = np.arange(n) / n
     xc = np.where(x > 0.5, x - 1.0, x)
     ferr = perr = 0.0
     for r, sol in zip(RATIOS, sols):
@@ -148,9 +153,39 @@ def spectral(n: int) -> dict:
         ferr = max(ferr, abs(sol.results["contact_fraction"] - exact_f) / exact_f)
         pe = westergaard_pressure(xc, r * pstar, pstar, 1.0)
         perr = max(perr, float(np.linalg.norm(sol.fields["pressure"] - pe) / np.linalg.norm(pe)))
+    return ferr, perr
+
+
+def spectral(n: int) -> dict:
+    """The four loads on the spectral cell of ``n`` grid points (exact contact); errors and wall time."""
+    pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H_GAP, 1.0)
+    t0 = time.perf_counter()
+    cell = _westergaard_cell(n)
+    sols = cell.sweep([cell_load(2, pressure=r * pstar) for r in RATIOS])
+    secs = time.perf_counter() - t0
+    ferr, perr = _spectral_errors(n, sols, pstar)
     return {"solver": "ngcontact spectral", "setting": f"N = {n}, exact", "ndof": n, "worst_fraction_error": ferr,
             "worst_pressure_error": perr, "seconds": secs,
             "iterations_per_load": " ".join(str(s.iterations) for s in sols)}
+
+
+def spectral_to_tolerance(tolerance: float) -> dict:
+    """The four loads on the spectral cell refined from ``N = 2^10`` until the estimate meets ``tolerance``.
+
+    The scene ``geometries/cells/westergaard_exact.toml`` at ``tolerance = 1e-6``
+    (:mod:`ngcontact.cell.spectral_refinement`); the time includes every level.
+    """
+    pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H_GAP, 1.0)
+    t0 = time.perf_counter()
+    refined = sweep_to_tolerance(_westergaard_cell, [cell_load(2, pressure=r * pstar) for r in RATIOS], tolerance,
+                                 SPECTRAL_GRIDS[0], 2, 2 ** 24)
+    secs = time.perf_counter() - t0
+    n = refined.cell.grid
+    ferr, perr = _spectral_errors(n, refined.solutions, pstar)
+    grids = " -> ".join(str(h["grid"]) for h in refined.history)
+    return {"solver": "ngcontact spectral", "setting": f"to tolerance {tolerance:g} (N = {grids}), exact",
+            "ndof": n, "worst_fraction_error": ferr, "worst_pressure_error": perr, "seconds": secs,
+            "iterations_per_load": " ".join(str(s.iterations) for s in refined.solutions)}
 
 
 def tamaas_available() -> bool:
@@ -198,6 +233,9 @@ def run(quick: bool = False) -> list[dict]:
         log.info("%s", _fmt(rows[-1]))
     for n in SPECTRAL_GRIDS[:2] if quick else SPECTRAL_GRIDS:
         rows.append(spectral(n))
+        log.info("%s", _fmt(rows[-1]))
+    for tol in SPECTRAL_TOLERANCES[:1] if quick else SPECTRAL_TOLERANCES:
+        rows.append(spectral_to_tolerance(tol))
         log.info("%s", _fmt(rows[-1]))
     if not tamaas_available():
         log.warning("Tamaas is not installed (pip install '.[bench]'): the FFT peer is skipped")

@@ -155,11 +155,15 @@ def gap_cf(scene):
     return terms[0] if len(terms) == 1 else terms[0] + terms[1]
 
 
-def spectral_cell(scene: CellScene) -> SpectralCell:
-    """The spectral cell (:mod:`ngcontact.cell.spectral_cell`) of a small-slope cell scene."""
+def spectral_cell(scene: CellScene, grid: int | None = None) -> SpectralCell:
+    """The spectral cell (:mod:`ngcontact.cell.spectral_cell`) of a small-slope cell scene.
+
+    ``grid``: points per direction instead of the scene's (a gap given by a formula).
+    """
     g, c, s = scene.geometry, scene.contact, scene.solver
     heights = height_map(scene) if small_slope(g) and g.profile != "bisinusoid" else None
-    grid = spectral_grid(scene, None if heights is None else heights.shape)
+    if grid is None:
+        grid = spectral_grid(scene, None if heights is None else heights.shape)
 
     def layer(name, h):
         m = scene.materials[name]

@@ -12,7 +12,10 @@ its entry adds ``error_estimate`` and ``mesh_history``.  With
 ``discretization.method = "spectral"`` the small-slope cell is solved on a
 grid (:mod:`ngcontact.cell.spectral_cell`, :func:`run_spectral`): the same
 per-load keys (no body stresses: the layers' interiors are not sampled), the
-grid fields as ``.npy`` and ``results.method`` stating the grid.
+grid fields as ``.npy`` and ``results.method`` stating the grid; with a
+tolerance the grid is refined (:mod:`ngcontact.cell.spectral_refinement`),
+each load adds ``error_estimate`` and ``results.method.refinement`` holds the
+levels.
 """
 from __future__ import annotations
 
@@ -28,6 +31,8 @@ from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.edge_grading import GradedSolve, graded_flat_cell, solve_to_tolerance
 
 from ngcontact.cell import spectral_measures
+from ngcontact.cell.spectral_refinement import sweep_to_tolerance
+from ngcontact.scene.cell_scene import MAX_SPECTRAL_POINTS
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
@@ -69,6 +74,7 @@ def run_spectral(scene, clock) -> Outcome:
     with clock.stage("grid"):
         cell = spectral_cell(scene)
     whole = spectral_measures.coefficients(cell, np.ones(cell.shape, bool)).as_dict()
+    tolerance = scene.discretization.tolerance
     results: dict[str, Any] = {"method": {"name": "spectral", "grid": cell.grid, "points": cell.points,
                                           "enforcement": cell.enforcement,
                                           "solver": "constrained_cg" if cell.friction is None
@@ -77,12 +83,23 @@ def run_spectral(scene, clock) -> Outcome:
                                "whole_surface": whole}
     if scene.contact.geometric_only:
         return Outcome(results=results, ndof=cell.points)
+    estimates: list[dict[str, float] | None] = []
     with clock.stage("solve"):
-        sols = cell.sweep(cell_loads(scene))
+        if tolerance is None:
+            sols = cell.sweep(cell_loads(scene))
+            estimates = [None] * len(sols)
+        else:
+            refined = sweep_to_tolerance(lambda n: spectral_cell(scene, grid=n), cell_loads(scene), tolerance,
+                                         cell.grid, cell.dim, MAX_SPECTRAL_POINTS)
+            cell, sols = refined.cell, refined.solutions
+            estimates = list(refined.estimates)
+            results["method"].update(grid=cell.grid, points=cell.points, refinement=refined.history)
     per_load, tables, arrays = [], {}, {}
     for k, sol in enumerate(sols):
         entry = dict(sol.results)
         entry["iterations"] = sol.iterations
+        if estimates[k] is not None:
+            entry["error_estimate"] = estimates[k]
         per_load.append(entry)
         for name in ("pressure", "gap", "shear", "slip"):
             if name in sol.fields:

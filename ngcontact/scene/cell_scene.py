@@ -187,12 +187,13 @@ class CellScene:
                                  "cell (discretization.method = 'spectral', small-slope cells); the FE cell "
                                  "enforces contact by the penalty: set enforcement = 'penalty'")
             check_penalty_ratio(self)
-        if self.discretization.tolerance is not None and not (dim == 2 and self.geometry.profile == "flat"):
+        fe_tolerance = self.discretization.method == "fe" and self.discretization.tolerance is not None
+        if fe_tolerance and not (dim == 2 and self.geometry.profile == "flat"):
             raise SceneError("discretization.tolerance", self.discretization.tolerance,
                              "refinement towards the contact edges needs a 2D cell with geometry.profile = "
                              f"'flat' (the small-slope model), not a {dim}D {self.geometry.profile!r} cell; remove "
                              "the key and refine interface_maxh or order by hand")
-        if self.discretization.tolerance is not None and self.contact.friction != "none":
+        if fe_tolerance and self.contact.friction != "none":
             raise SceneError("discretization.tolerance", self.discretization.tolerance,
                              "refinement towards the contact edges solves every load afresh on its own mesh, "
                              "which a frictional load path does not allow; remove the key or set "
@@ -271,9 +272,10 @@ def check_spectral(scene: CellScene) -> None:
                          "the roughness in the initial gap (geometry.profile = 'flat' or 'flat3d', or 'bisinusoid', "
                          "'height_map' or 'self_affine' with arrangement = 'summit'), not geometry.profile = "
                          f"{g.profile!r} in the {g.arrangement!r} arrangement; use method = 'fe'")
-    if d.tolerance is not None:
-        raise SceneError("discretization.tolerance", d.tolerance, "refines an FE mesh; the spectral cell's accuracy "
-                         "is set by discretization.grid: remove the key")
+    if d.tolerance is not None and g.profile in ("height_map", "self_affine"):
+        raise SceneError("discretization.tolerance", d.tolerance, "refines the grid of a gap given by a formula; "
+                         f"a {g.profile!r} profile's heights exist on their own grid only: remove the key and "
+                         "set discretization.grid")
     if d.grid is not None and d.grid % 2:
         raise SceneError("discretization.grid", d.grid, "must be even (the FFT's Nyquist mode is real)")
     n = spectral_grid(scene)           # a height map's own grid is bounded by its file size (64 MiB)

@@ -67,9 +67,11 @@ class CellDiscretization(Discretization):
     """Finite element discretization of a cell, with accuracy on request."""
 
     tolerance: float | None = param(
-        None, doc="refine the interface mesh towards the contact edges until the estimated error of the contact "
-        "fraction (absolute) and of the mean closure (relative) is at most this (2D cells with a flat "
-        "interface; the report gives the estimate and the mesh history per load); default: the fixed mesh",
+        None, doc="refine until the estimated error of the contact fraction (absolute) and of the mean closure "
+        "(relative) is at most this: method 'fe' grades the interface mesh towards the contact edges (2D cells "
+        "with a flat interface), method 'spectral' multiplies the grid's points by 4 from discretization.grid "
+        "(gaps given by a formula); the report gives the estimate per load and the mesh or grid history; "
+        "default: the fixed mesh or grid",
         check=open_interval(0, 1))
     method: str = param("fe", doc="fe: finite elements on a mesh of the cell; spectral: the small-slope cell "
                         "(flat interface, the roughness in the initial gap) as two periodic layers solved with "

@@ -1,0 +1,109 @@
+"""The spectral cell refined to a tolerance: estimate, history, the answer within it, refusals."""
+import json
+
+import numpy as np
+import pytest
+
+from ngcontact import cli
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.spectral_cell import Layer, SpectralCell
+from ngcontact.cell.spectral_refinement import next_grid, sweep_to_tolerance
+from ngcontact.errors import ConvergenceError
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
+
+NU, H = 0.3, 0.01
+P_STAR = westergaard_p_star(e_star(1.0, NU) / 2, H, 1.0)
+LOADS = (0.05, 0.5)
+
+
+def _make(n):
+    x = np.arange(n) / n
+    return SpectralCell(dim=2, period=1.0, grid=n, rough=Layer(1.0, NU, 2.0), counter=Layer(1.0, NU, 2.0),
+                        gap=2 * H * np.sin(np.pi * x) ** 2, k_n=1.0, enforcement="exact")
+
+
+def test_the_refined_sweep_meets_its_tolerance_and_the_estimate_bounds_the_true_error():
+    loads = [cell_load(2, pressure=r * P_STAR) for r in LOADS]
+    refined = sweep_to_tolerance(_make, loads, 1e-5, 256, 2, 2 ** 20)
+    assert refined.estimate <= 1e-5
+    assert [h["grid"] for h in refined.history] == [256 * 4 ** k for k in range(len(refined.history))]
+    assert len(refined.history) >= 2 and "estimate" not in refined.history[0]
+    for r, sol, est in zip(LOADS, refined.solutions, refined.estimates):
+        exact = westergaard_contact_fraction(r * P_STAR, P_STAR)
+        assert abs(sol.results["contact_fraction"] - exact) <= est["contact_fraction"] + 1e-12
+        assert abs(sol.results["contact_fraction"] - exact) <= 1e-5
+    # the estimate of a level is the change from the level before it
+    last, before = refined.history[-1], refined.history[-2]
+    change = max(abs(a - b) for a, b in zip(last["contact_fraction"], before["contact_fraction"]))
+    assert change <= refined.estimate
+
+
+def test_a_tolerance_beyond_the_largest_grid_raises_with_the_history():
+    loads = [cell_load(2, pressure=0.05 * P_STAR)]
+    with pytest.raises(ConvergenceError, match="tolerance = 1e-12 not met") as err:
+        sweep_to_tolerance(_make, loads, 1e-12, 256, 2, 4096)
+    assert [h["grid"] for h in err.value.history["levels"]] == [256, 1024, 4096]
+
+
+def test_next_grid_multiplies_the_points_by_four():
+    assert next_grid(1024, 2) == 4096 and next_grid(128, 3) == 256
+
+
+SCENE = """\
+kind = "cell"
+[materials.solid]
+E = 1.0
+nu = 0.3
+[bodies]
+rough = "solid"
+counter = "solid"
+[geometry]
+profile = "flat"
+h_rough = 2.0
+h_counter = 2.0
+[contact]
+k_n = 1.0e3
+enforcement = "exact"
+gap = { kind = "sinusoid", h = 0.01 }
+[load]
+pressure = [0.0034523]
+[discretization]
+method = "spectral"
+grid = 256
+tolerance = 1e-5
+"""
+
+
+def test_a_spectral_scene_with_a_tolerance_reports_the_estimate_and_the_grids(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(SCENE)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    rep = json.loads((tmp_path / "o" / "report.json").read_text())
+    method, load = rep["results"]["method"], rep["results"]["loads"][0]
+    assert method["grid"] == method["refinement"][-1]["grid"] > 256
+    assert max(load["error_estimate"].values()) <= 1e-5
+    exact = westergaard_contact_fraction(0.0034523, P_STAR)
+    assert load["contact_fraction"] == pytest.approx(exact, abs=1e-5)
+
+
+def test_a_self_affine_map_takes_no_tolerance(tmp_path, capsys):
+    from pathlib import Path
+    text = (Path(__file__).parents[2] / "geometries" / "cells" / "self_affine_spectral.toml").read_text()
+    path = tmp_path / "s.toml"
+    path.write_text(text + "tolerance = 1e-4\n")
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    assert "discretization.tolerance = 0.0001: refines the grid of a gap given by a formula" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.slow
+def test_the_shipped_exact_westergaard_scene_meets_one_in_a_million(tmp_path):
+    from pathlib import Path
+    scene = Path(__file__).parents[2] / "geometries" / "cells" / "westergaard_exact.toml"
+    assert cli.main(["run", str(scene), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    rep = json.loads((tmp_path / "o" / "report.json").read_text())
+    for r, load in zip((0.05, 0.2, 0.5, 0.8), rep["results"]["loads"]):
+        exact = westergaard_contact_fraction(r * P_STAR, P_STAR)
+        assert abs(load["contact_fraction"] - exact) <= 1e-6 * exact
+        assert max(load["error_estimate"].values()) <= 1e-6
