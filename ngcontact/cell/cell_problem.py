@@ -37,6 +37,16 @@ and a nonzero shear is rejected.  Coulomb friction is a fixed point of
 Tresca problems, ``G_k = mu p_{k-1}`` (:mod:`ngcontact.laws.penalty`), until
 ``max |p_k - p_{k-1}| <= coulomb_rtol * max p_k`` on ``S_C``.
 
+Exact non-penetration (``CellModel.enforcement = "exact"``, 2D, frictionless;
+the rigid limit ``k_n -> infinity`` of the Winkler layer): the normal
+energy is the augmented Lagrangian
+``(1/(2 k_n)) ([lambda + k_n (J.n - g)]_+^2 - lambda^2)``, integrated with the
+Gauss-Lobatto rule of ``p + 1`` points per segment of ``S_C`` so that the
+constraints sit at the nodes of the trace space, with a multiplier
+``lambda`` per point held fixed in each Newton solve and updated by Uzawa's
+iteration (:mod:`ngcontact.cell.contact_multiplier`); the pressure of the
+results is the multiplier, and ``k_n`` only sets the speed.
+
 Results of a load: :mod:`ngcontact.cell.measures` (contact fraction, means,
 stresses, eq. 34 on the real contact set); effective stiffness (beyond the
 paper): :mod:`ngcontact.cell.stiffness`.
@@ -51,6 +61,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell import measures
+from ngcontact.cell.contact_multiplier import ContactMultiplier, solve_exact
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.predictor import rigid_continuation, set_start, tangential_load
@@ -58,6 +69,7 @@ from ngcontact.fem import elasticity as _el
 from ngcontact.fem import materials as _mat
 from ngcontact.laws import penalty as _contact
 from ngcontact.laws.penalty import Friction
+from ngcontact.errors import ModelError
 from ngcontact.solvers.coulomb import MIXING_DEPTH, coulomb_fixed_point
 from ngcontact.solvers.newton import minimize
 from ngcontact.fem.quadrature import sampling_order
@@ -75,7 +87,8 @@ class CellModel:
     rough, counter
         Elastic laws of the two bodies.
     k_n
-        Penalty stiffness [stress/length].
+        Penalty stiffness [stress/length]; with ``enforcement = "exact"``
+        the augmentation parameter of the augmented Lagrangian.
     gap
         Initial gap as a CoefficientFunction of the coordinates, or ``None``.
     friction
@@ -90,6 +103,11 @@ class CellModel:
         Extra integration order on ``S_C`` (the penalty has a kink).
     coulomb_rtol, coulomb_max_iter
         Stopping rule of the Coulomb fixed point.
+    enforcement
+        ``"penalty"`` (the Winkler layer of eq. 65) or ``"exact"``
+        (non-penetration by an augmented Lagrangian, module docstring).
+    uzawa_rtol, uzawa_max_iter
+        Stopping rule of Uzawa's iteration (:mod:`ngcontact.solvers.uzawa`).
     """
 
     rough: _mat.ElasticLaw
@@ -103,6 +121,9 @@ class CellModel:
     contact_bonus_order: int = 12
     coulomb_rtol: float = 1e-8
     coulomb_max_iter: int = 40
+    enforcement: str = "penalty"
+    uzawa_rtol: float = 1e-10
+    uzawa_max_iter: int = 60
 
 
 @dataclass
@@ -150,7 +171,14 @@ class CellProblem:
     traction, strain_params
         ``Parameter`` objects of ``tbar`` and ``E`` in ``Pi``.
     n, gap, J, pressure, penetration, slip
-        Micro normal, (interpolated) gap and CoefficientFunctions of the state.
+        Micro normal, (interpolated) gap and CoefficientFunctions of the state
+        (exact enforcement: ``pressure`` is the multiplier, meaningful at
+        the Lobatto points of ``multiplier`` only).
+    multiplier
+        :class:`~ngcontact.cell.contact_multiplier.ContactMultiplier` (exact
+        enforcement) or ``None``.
+    augmented_pressure
+        Exact enforcement: ``[lambda + k_n (J.n - g)]_+`` of the state.
     tangential_free
         Whether ``U_t`` is determinate (friction or a curved ``S_C``).
     coulomb_previous
@@ -164,6 +192,17 @@ class CellProblem:
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
         if start not in ("rigid", "closed"):
             raise ValueError(f"start = {start!r}: must be 'rigid' or 'closed'")
+        if model.enforcement not in ("penalty", "exact"):
+            raise ModelError(f"enforcement = {model.enforcement!r}: must be 'penalty' or 'exact'")
+        if not (model.uzawa_rtol > 0 and model.uzawa_max_iter >= 1):
+            raise ModelError(f"uzawa_rtol = {model.uzawa_rtol!r}, uzawa_max_iter = {model.uzawa_max_iter!r}: "
+                             "must be > 0 and >= 1")
+        if model.enforcement == "exact" and cell.dim != 2:
+            raise ModelError(f"enforcement = 'exact' in a {cell.dim}D cell: the FE cell enforces exact contact "
+                             "in 2D only (node-to-node on segments); use 'penalty' or the spectral cell")
+        if model.enforcement == "exact" and model.friction is not None:
+            raise ModelError(f"enforcement = 'exact' with {model.friction.law} friction: the FE cell enforces exact "
+                             "contact without friction only; use 'penalty' or the spectral cell")
         self.line_search, self.start = line_search, start
         self.cell, self.model = cell, model
         self.mesh = mesh = cell.mesh
@@ -178,7 +217,9 @@ class CellProblem:
         # every element would couple all dofs and slow the factorization 5x
         N = ng.NumberSpace(mesh, definedon=mesh.Boundaries("contact|top"))
         self.X = ng.FESpace([Vr, Vc] + [N] * dim)
-        self.gap = _discrete_gap(mesh, model)
+        # exact: the gap itself at the Lobatto nodes (an interpolant on S_C, not periodic, would give the
+        # two copies of a periodic vertex different gaps: contradictory constraints on one node)
+        self.gap = model.gap if model.enforcement == "exact" else _discrete_gap(mesh, model)
         self.gfu = ng.GridFunction(self.X)
         self.u_dofs = [self.X.Range(2 + i).start for i in range(dim)]
         self.traction = [ng.Parameter(0.0) for _ in range(dim)]
@@ -186,6 +227,10 @@ class CellProblem:
         self.strain_params = [ng.Parameter(0.0) for _ in range(nE)]
         self.tangential_free = _tangential_determinate(mesh, self.n, dim, model)
         self.coulomb_previous: ng.GridFunction | None = None
+        self.multiplier = (ContactMultiplier(mesh, model.order)
+                           if model.enforcement == "exact" else None)
+        # exact: the augmentation k_n as a Parameter (the constrained tangent extrapolates in it)
+        self.augmentation = ng.Parameter(model.k_n)
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
         self.form = self._energy(ur, uc, U, trial)
@@ -193,7 +238,13 @@ class CellProblem:
         comps = self.gfu.components
         self.U = ng.CF(tuple(comps[2:]))
         self.J = comps[0] - comps[1] - self.U
-        self.pressure = _contact.pressure(self.J, self.n, model.k_n, self.gap)
+        if self.multiplier is None:
+            self.pressure = _contact.pressure(self.J, self.n, model.k_n, self.gap)
+            self.augmented_pressure = None
+        else:
+            self.pressure = self.multiplier.value
+            self.augmented_pressure = _contact.augmented_pressure(self.J, self.n, self.augmentation,
+                                                                  self.multiplier.value, self.gap)
         self.penetration = _contact.penetration(self.J, self.n, self.gap)
         self._active_points = None
         self.slip = _contact.tangential_slip(self.J, self.n)
@@ -220,6 +271,7 @@ class CellProblem:
             form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
                                  * ng.dx(definedon=mesh.Materials(name)))
         J = ur - uc - U
+        lam = None if self.multiplier is None else self.multiplier.value
         friction = threshold = w = None
         if m.friction is not None:
             friction, w = m.friction.law, m.friction.w
@@ -230,9 +282,12 @@ class CellProblem:
                 pc = self.coulomb_previous.components
                 J_prev = pc[0] - pc[1] - ng.CF(tuple(pc[2:]))
                 threshold = _contact.coulomb_threshold(J_prev, self.n, m.k_n, m.friction.mu, self.gap)
-        psi = _contact.interface_energy(J, self.n, k_n=m.k_n, gap=self.gap, friction=friction,
-                                        w=w, threshold=threshold)
-        form += ng.Variation(psi * ng.ds("contact", bonus_intorder=m.contact_bonus_order))
+        k = m.k_n if lam is None else self.augmentation
+        psi = _contact.interface_energy(J, self.n, k_n=k, gap=self.gap, friction=friction,
+                                        w=w, threshold=threshold, multiplier=lam)
+        ds = (ng.ds("contact", bonus_intorder=m.contact_bonus_order) if self.multiplier is None
+              else self.multiplier.ds)
+        form += ng.Variation(psi * ds)
         t = ng.CF(tuple(self.traction))
         form += ng.Variation(-ng.InnerProduct(t, U) * ng.ds("top"))
         return form
@@ -332,13 +387,25 @@ class CellProblem:
                             coulomb_iterations=fp)
 
     def _newton(self, free, atol) -> dict:
+        if self.multiplier is not None:
+            return solve_exact(self, lambda a: self._newton_once(free, a), atol)
+        return self._newton_once(free, atol)
+
+    def _newton_once(self, free, atol) -> dict:
         h = minimize(self.form, self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
                      max_iter=self.max_iter, inverse=self.inverse, line_search=self.line_search,
                      active_set=self.active_set)
         return h.as_dict()
 
     def active_set(self, gfu=None) -> bytes:
-        """Signature of the contact state: which quadrature points of ``S_C`` penetrate."""
+        """Signature of the contact state: which quadrature points of ``S_C`` penetrate.
+
+        Exact enforcement: where the augmented pressure is positive, at the
+        multiplier's points.
+        """
+        if self.multiplier is not None:
+            aug = self.multiplier.at_points(self.multiplier.value + self.augmentation * self.penetration)
+            return np.packbits(aug > 0.0).tobytes()
         if self._active_points is None:
             shape = ng.TRIG if self.dim == 3 else ng.SEGM
             rule = ng.IntegrationRule(shape, 2 * self.model.order)

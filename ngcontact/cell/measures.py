@@ -37,6 +37,15 @@ area of the cell's period.
 * the effective stiffness of the interface (beyond the paper,
   :mod:`ngcontact.cell.stiffness`).
 
+Exact enforcement (2D, :mod:`ngcontact.cell.contact_multiplier`): the
+pressure is the multiplier ``lambda``, given at the Gauss-Lobatto points of
+the contact energy, so its integrals use that rule (the discrete interface
+force) and its samples are taken at those points; the real contact set is
+built from the closed nodes and the edges between them
+(:func:`ngcontact.cell.contact_multiplier.contact_cuts`), not from the sign
+of the penetration, which is zero to round-off at the nodes and the
+interpolation error of the closure between them.
+
 :func:`measure` collects them into the results of one load.
 """
 from __future__ import annotations
@@ -47,6 +56,7 @@ import numpy as np
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.errors import ConvergenceError
 from ngcontact.cell.coefficients import coefficients
+from ngcontact.cell.contact_multiplier import contact_cuts
 from ngcontact.cell.stiffness import effective_stiffness
 from ngcontact.fem import materials as _mat
 from ngcontact.fem.quadrature import kink_order, sampling_order, smooth_order
@@ -77,8 +87,12 @@ def contact_fraction(problem, method: str = "auto") -> float:
         instead of at the nearest quadrature point.
         ``"quadrature"``: integral of the indicator at high order (3D,
         where the zero set is a curve on each face).  ``"auto"``: roots
-        in 2D, quadrature in 3D.
+        in 2D, quadrature in 3D.  With exact enforcement the pieces of
+        :func:`contact_pieces` are those of the closed nodes (module
+        docstring), whatever the method.
     """
+    if problem.multiplier is not None:
+        return _contact_length_by_roots(problem) / problem.area
     if method == "auto":
         method = "roots" if problem.dim == 2 else "quadrature"
     if method == "quadrature":
@@ -102,6 +116,8 @@ def contact_pieces(problem) -> list[tuple[float, float, bool, float]]:
     The penetration is interpolated at ``order + 3`` Gauss points of each
     element (exact for the polynomial it is on straight elements with the
     interpolated gap) and its real roots in ``(0, 1)`` cut the element.
+    Exact enforcement: the cuts and states of
+    :func:`ngcontact.cell.contact_multiplier.contact_cuts` instead.
     """
     P = np.polynomial.polynomial
     m = problem.model.order + 3
@@ -114,15 +130,19 @@ def contact_pieces(problem) -> list[tuple[float, float, bool, float]]:
     coef = np.linalg.solve(P.polyvander(t, m - 1), vals.transpose(1, 0, 2).reshape(m, -1))
     coef = coef.reshape(m, -1, 3)
     tg, wg = np.polynomial.legendre.leggauss(m + 2)
+    exact = contact_cuts(problem) if problem.multiplier is not None else None
     out: list[tuple[float, float, bool, float]] = []
     for e in range(vals.shape[0]):
         c_pen, c_x, c_y = coef[:, e, 0], coef[:, e, 1], coef[:, e, 2]
-        r = P.polyroots(c_pen) if np.any(c_pen[1:]) else np.empty(0)
-        r = np.sort(r[(np.abs(r.imag) <= 1e-10) & (r.real > 0.0) & (r.real < 1.0)].real)
-        cuts = np.concatenate(([0.0], r, [1.0]))
-        for a, b in zip(cuts[:-1], cuts[1:]):
+        if exact is not None:
+            cuts, states = exact[e]
+        else:
+            r = P.polyroots(c_pen) if np.any(c_pen[1:]) else np.empty(0)
+            r = np.sort(r[(np.abs(r.imag) <= 1e-10) & (r.real > 0.0) & (r.real < 1.0)].real)
+            cuts = np.concatenate(([0.0], r, [1.0]))
+            states = [bool(P.polyval(0.5 * (a + b), c_pen) >= 0.0) for a, b in zip(cuts[:-1], cuts[1:])]
+        for a, b, on in zip(cuts[:-1], cuts[1:], states):
             if b > a:
-                on = bool(P.polyval(0.5 * (a + b), c_pen) >= 0.0)
                 out.append((float(P.polyval(a, c_x)), float(P.polyval(b, c_x)), on, _arc(c_x, c_y, a, b, tg, wg)))
     return out
 
@@ -136,7 +156,9 @@ def _arc(c_x, c_y, a, b, tg, wg) -> float:
 
 
 def mean_pressure(problem) -> float:
-    """``(1/|T|) int_{S_C} p ds`` with the penalty pressure ``p = k_n [J.n - g]_+``."""
+    """``(1/|T|) int_{S_C} p ds`` with the penalty pressure ``p = k_n [J.n - g]_+`` (exact: the multiplier)."""
+    if problem.multiplier is not None:
+        return float(problem.multiplier.integrate(problem.pressure)) / problem.area
     return float(contact_integral(problem, problem.pressure)) / problem.area
 
 
@@ -170,9 +192,12 @@ def interface_traction(problem):
 def equilibrium_error(problem, far_face_traction: np.ndarray) -> float:
     """``|F + t| / max(|t|, A)`` of the module docstring (0 when nothing is transmitted)."""
     tr = interface_traction(problem)
-    o = problem.contact_order     # the rule the energy is assembled with: F is then the discrete force
-    F = np.array(contact_integral(problem, tr, order=o), float).ravel() / problem.area
-    A = float(contact_integral(problem, ng.sqrt(ng.InnerProduct(tr, tr)), order=o)) / problem.area
+    def energy_rule(cf):          # the rule the energy is assembled with: F is then the discrete force
+        if problem.multiplier is not None:
+            return problem.multiplier.integrate(cf)
+        return contact_integral(problem, cf, order=problem.contact_order)
+    F = np.array(energy_rule(tr), float).ravel() / problem.area
+    A = float(energy_rule(ng.sqrt(ng.InnerProduct(tr, tr)))) / problem.area
     t = np.asarray(far_face_traction, float)
     scale = max(float(np.linalg.norm(t)), A)
     return float(np.linalg.norm(F + t)) / scale if scale > 0 else 0.0
@@ -194,8 +219,13 @@ def friction_threshold(problem):
 
 
 def real_contact_coefficients(problem) -> dict:
-    """Paper eqs. 34, 42-43 on the real contact set ``{J_n - g >= 0}`` of the current state."""
-    ind = ng.IfPos(-problem.penetration, 0.0, 1.0)
+    """Paper eqs. 34, 42-43 on the real contact set ``{J_n - g >= 0}`` of the current state.
+
+    Exact enforcement: where the multiplier's interpolant is positive
+    (``k_n`` only scales ``K0`` and ``g``; in the rigid limit they diverge).
+    """
+    ind = ng.IfPos(-problem.penetration, 0.0, 1.0) if problem.multiplier is None else \
+        ng.IfPos(problem.pressure, 1.0, 0.0)
     c = coefficients(problem.cell, kn=problem.model.k_n, gap=problem.gap, G=friction_threshold(problem),
                      weight=ind, normal=problem.n, intorder=kink_order(problem.model.order))
     return c.as_dict()
@@ -207,10 +237,14 @@ def sample_surface(problem, fields: dict, order: int | None = None) -> dict:
 
     Evaluated on the boundary elements of ``contact`` themselves, so the
     traces of each body are unambiguous.  Returns arrays, with the
-    coordinates under ``"x"``, ``"y"`` (and ``"z"``).
+    coordinates under ``"x"``, ``"y"`` (and ``"z"``).  The default points:
+    :func:`~ngcontact.fem.quadrature.sampling_order`, with exact
+    enforcement the multiplier's Lobatto points (a shared vertex once).
     """
-    o = order if order is not None else sampling_order(problem.model.order)
     coords = {name: c for name, c in zip(("x", "y", "z")[: problem.dim], (ng.x, ng.y, ng.z))}
+    if order is None and problem.multiplier is not None:
+        return problem.multiplier.samples({**coords, **fields})
+    o = order if order is not None else sampling_order(problem.model.order)
     return boundary_samples(problem.mesh, "contact", {**coords, **fields}, o)
 
 
@@ -285,6 +319,10 @@ def measure(problem, load: CellLoad) -> dict:
         "far_face_jump": (-Uv).tolist(),
         "max_penetration": float(sample_surface(problem, {"pen": problem.penetration})["pen"].max()),
     }
+    if problem.multiplier is not None:   # between the multiplier's points (module docstring)
+        o = sampling_order(problem.model.order)
+        res["max_penetration_between_points"] = float(
+            sample_surface(problem, {"pen": problem.penetration}, order=o)["pen"].max())
     res.update(stress_maxima(problem))
     res["effective_stiffness"] = effective_stiffness(problem)
     res["coefficients"] = real_contact_coefficients(problem)

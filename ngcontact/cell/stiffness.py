@@ -20,6 +20,14 @@ themselves.  This module measures the stiffness the solved cell problem
 * the interface's compliance ``S^-1 - S_0^-1`` (penalty layer plus the
   constriction of the asperities, finite as ``k_n -> infinity``) and the
   effective stiffness, its inverse (:func:`effective_stiffness`).
+
+Exact enforcement (:mod:`ngcontact.cell.contact_multiplier`): ``S`` is the
+tangent with the contact set held closed, the limit ``k -> infinity`` of
+the augmented energy's tangent, in which the loaded points are springs of
+stiffness ``k`` (the augmentation).  ``S(k)`` is smooth in ``1/k`` at a
+fixed contact set, so it is extrapolated from ``k, 2k, 4k`` to ``1/k = 0``
+(Richardson, error ``O(k^-3)``) instead of evaluated at a stiffness that
+would spoil the factorization.
 """
 from __future__ import annotations
 
@@ -81,9 +89,24 @@ def reference_stiffness(problem) -> np.ndarray:
 
 
 def tangent_stiffness(problem) -> np.ndarray:
-    """``S``: tangent of the mean far-face traction w.r.t. the far-face jump (per ``|T|``)."""
-    return schur_complement(problem.form, problem.X, problem.u_dofs, problem.gfu.vec,
-                            problem.inverse) / problem.area
+    """``S``: tangent of the mean far-face traction w.r.t. the far-face jump (per ``|T|``).
+
+    Exact enforcement: extrapolated to ``k -> infinity`` (module docstring).
+    """
+    def at_current_k() -> np.ndarray:
+        return schur_complement(problem.form, problem.X, problem.u_dofs, problem.gfu.vec,
+                                problem.inverse) / problem.area
+    if problem.multiplier is None:
+        return at_current_k()
+    k = problem.augmentation.Get()
+    S = []
+    try:
+        for scale in (1.0, 2.0, 4.0):
+            problem.augmentation.Set(scale * k)
+            S.append(at_current_k())
+    finally:
+        problem.augmentation.Set(k)
+    return (8.0 * S[2] - 6.0 * S[1] + S[0]) / 3.0
 
 
 def effective_stiffness(problem) -> dict:

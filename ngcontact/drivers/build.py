@@ -274,4 +274,4 @@ def model_of(scene) -> CellModel:
                      counter=elastic_law(scene.materials[scene.bodies.counter]),
                      k_n=c.k_n, gap=gap_cf(scene), friction=micro_friction(c), order=scene.discretization.order,
                      macro_strain=ms, coulomb_rtol=scene.solver.coulomb_rtol,
-                     coulomb_max_iter=scene.solver.coulomb_max_iter)
+                     coulomb_max_iter=scene.solver.coulomb_max_iter, enforcement=c.enforcement)

@@ -34,6 +34,21 @@ energy of the bodies is the integral over ``S_C`` of
   iterate (:func:`coulomb_threshold`), and the iteration stops when the
   pressure changes by less than a tolerance relative to its maximum.
 
+* exact non-penetration by an augmented Lagrangian (the rigid limit
+  ``k_n -> infinity`` of the Winkler layer; not in the paper, DESIGN 7a):
+  with a multiplier ``lambda >= 0`` held fixed, the normal energy is::
+
+      psi_n(J; lambda) = (1 / (2 k)) ([lambda + k (J_n - g)]_+^2 - lambda^2),
+      p = [lambda + k (J_n - g)]_+,
+
+  ``k`` the augmentation parameter (the scene's ``k_n``).  At ``lambda = 0``
+  it is the penalty above; its minimizer in ``J`` for fixed ``lambda`` is
+  followed by the Uzawa update ``lambda <- p``, whose fixed points are the
+  complementarity conditions ``J_n - g <= 0``, ``lambda >= 0``,
+  ``lambda (J_n - g) = 0`` whatever ``k`` is (:func:`augmented_pressure`,
+  :mod:`ngcontact.cell.contact_multiplier`).  The constant ``-lambda^2/(2k)``
+  only makes the energy vanish where the surfaces are open.
+
 Only the terms a problem asks for are added: a frictionless problem
 assembles no friction term, a problem without gap no gap.
 """
@@ -105,6 +120,21 @@ def normal_energy(J, n, k_n, gap=None):
     return 0.5 * k_n * d * d
 
 
+def augmented_pressure(J, n, k, multiplier, gap=None):
+    """Augmented-Lagrangian pressure ``p = [lambda + k (J_n - g)]_+ >= 0`` (module docstring)."""
+    return positive_part(multiplier + k * penetration(J, n, gap))
+
+
+def augmented_normal_energy(J, n, k, multiplier, gap=None):
+    """``(1/(2k)) ([lambda + k (J_n - g)]_+^2 - lambda^2)`` for a fixed multiplier ``lambda``.
+
+    Its derivative in ``J`` is ``p n`` with :func:`augmented_pressure`; with
+    ``lambda = 0`` it is :func:`normal_energy`.
+    """
+    a = positive_part(multiplier + k * penetration(J, n, gap))
+    return (0.5 / k) * (a * a - multiplier * multiplier)
+
+
 def tangential_slip(J, n):
     """``J_t = J - (J.n) n``, the tangential part of the jump."""
     return J - normal_closure(J, n) * n
@@ -139,7 +169,7 @@ def coulomb_threshold(J_previous, n, k_n, mu, gap=None):
     return mu * pressure(J_previous, n, k_n, gap)
 
 
-def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=None):
+def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=None, multiplier=None):
     """Total interface energy density of the terms asked for.
 
     Parameters
@@ -155,8 +185,15 @@ def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=No
     friction
         ``None`` (frictionless), ``"tresca"`` or ``"coulomb"``; both friction
         laws use ``threshold`` (``G``, or ``mu p_previous``) and ``w``.
+    multiplier
+        ``None``: the penalty :func:`normal_energy`; a contact multiplier
+        ``lambda`` (held fixed): the augmented energy
+        :func:`augmented_normal_energy` with ``k = k_n``.
     """
-    energy = normal_energy(J, n, k_n, gap)
+    if multiplier is None:
+        energy = normal_energy(J, n, k_n, gap)
+    else:
+        energy = augmented_normal_energy(J, n, k_n, multiplier, gap)
     if friction is None:
         return energy
     if friction not in ("tresca", "coulomb"):

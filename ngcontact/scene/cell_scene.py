@@ -54,8 +54,10 @@ class ContactSpec:
     k_n: float = param(doc="penalty (Winkler) stiffness k_n (with enforcement = 'exact' only the scale of the "
                        "eq. 34 coefficients in the report)", units="Pa/m", check=positive())
     enforcement: str = param("penalty", doc="penalty: the paper's Winkler layer p = k_n [J.n - g]_+ (eq. 65) "
-                             "and Huber-regularized friction; exact: non-penetration, the rigid limit k_n -> infinity, "
-                             "and exact friction (w unused; discretization.method = 'spectral')",
+                             "and Huber-regularized friction; exact: non-penetration, the rigid limit k_n -> infinity: "
+                             "spectral cell with exact friction (w unused), or 2D frictionless FE cell, node-to-node "
+                             "at the Gauss-Lobatto points by an augmented Lagrangian with Uzawa updates (k_n is its "
+                             "augmentation: the speed, not the answer)",
                              choices=ENFORCEMENTS)
     gap: GapSpec = param(GapSpec(), doc="initial gap")
     friction: str = param("none", doc="friction law", choices=FRICTION)
@@ -183,9 +185,7 @@ class CellScene:
             check_spectral(self)
         else:
             if self.contact.enforcement == "exact":
-                raise SceneError("contact.enforcement", "exact", "exact non-penetration is solved by the spectral "
-                                 "cell (discretization.method = 'spectral', small-slope cells); the FE cell "
-                                 "enforces contact by the penalty: set enforcement = 'penalty'")
+                check_fe_exact(self)
             check_penalty_ratio(self)
         fe_tolerance = self.discretization.method == "fe" and self.discretization.tolerance is not None
         if fe_tolerance and not (dim == 2 and self.geometry.profile == "flat"):
@@ -248,6 +248,18 @@ def check_penalty_ratio(scene: CellScene) -> None:
         raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
                          f"E = {E:g} the softer body's modulus) must stay below {MAX_PENALTY_RATIO:g}: the "
                          "penalty would outweigh the bodies beyond what double precision resolves; lower k_n")
+
+
+def check_fe_exact(scene: CellScene) -> None:
+    """Exact non-penetration on the FE cell: built for 2D frictionless cells (node-to-node on segments)."""
+    if scene.geometry.dim != 2:
+        raise SceneError("contact.enforcement", "exact", f"the FE cell enforces exact contact in 2D only, not in a "
+                         f"{scene.geometry.dim}D cell: set enforcement = 'penalty', or discretization.method = "
+                         "'spectral' for a small-slope cell")
+    if scene.contact.friction != "none":
+        raise SceneError("contact.enforcement", "exact", "the FE cell enforces exact contact without friction only, "
+                         f"not with contact.friction = {scene.contact.friction!r}: set enforcement = 'penalty', "
+                         "friction = 'none', or discretization.method = 'spectral' for a small-slope cell")
 
 
 #: Largest number of spectral grid points of a cell (2D: points, 3D: points squared).

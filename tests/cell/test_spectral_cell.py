@@ -269,15 +269,6 @@ def test_scenes_the_spectral_cell_refuses(tmp_path, capsys, edit, message):
     assert not (tmp_path / "o").exists()
 
 
-def test_exact_enforcement_needs_the_spectral_cell(tmp_path, capsys):
-    text = SCENE.format(disc="order = 1\nmaxh = 0.5").replace("k_n = 1.0e3", 'k_n = 1.0e3\nenforcement = "exact"')
-    path = tmp_path / "s.toml"
-    path.write_text(text)
-    assert cli.main(["check", str(path)]) == 2
-    assert "contact.enforcement = 'exact': exact non-penetration is solved by the spectral cell" in \
-        capsys.readouterr().err
-
-
 def test_wave_numbers_cover_the_half_spectrum():
     k = wave_numbers(3, 8, 2.0)
     assert k.shape == (8, 5) and k[0, 0] == 0 and k[0, 1] == pytest.approx(math.pi)

@@ -1,0 +1,84 @@
+"""Uzawa's iteration for an augmented Lagrangian, written once for any constraint.
+
+Exact non-penetration ``J_n - g <= 0`` (the rigid limit of the paper's
+Winkler layer, eqs. 7, 9 and 65 with ``k_n -> infinity``; DESIGN 7a) is the
+saddle point of the elastic energy and the multiplier term.  With the
+augmented energy of :func:`ngcontact.laws.penalty.augmented_normal_energy`
+Uzawa's iteration alternates
+
+    u_{j+1}      = argmin_u  Pi(u; lambda_j)                  (a Newton solve)
+    lambda_{j+1} = [lambda_j + k (J_n(u_{j+1}) - g)]_+        (pointwise)
+
+and stops at the first ``j`` with
+
+    max (J_n - g)_+                       <=  rtol * L   (admissibility)
+    max |lambda_{j+1} - lambda_j| / k     <=  rtol * L   (stationarity)
+
+over the points the multiplier lives on (the second over those that carry
+load, ``lambda_{j+1} > 0``, where ``|d lambda| / k = |J_n - g|`` is the gap
+left open under load: complementarity), ``L`` a characteristic length of
+the state (the caller's).  The change is measured in lengths, not relative
+to ``lambda``: ``k`` times a penetration at the round-off of the
+displacements can be a relative change of ``1e-5``.  A fixed point satisfies the complementarity
+conditions ``lambda >= 0``, ``J_n - g <= 0``, ``lambda (J_n - g) = 0`` and
+the equilibrium of the multiplier pressure, for every ``k > 0``: ``k`` sets
+only the speed (the error in ``lambda`` contracts roughly by
+``1 / (1 + k c)`` per pass, ``c`` the compliance of the mode, so ``k`` of
+the order of ``E/h`` and above takes a few passes).  Each pass's Newton
+solve starts from the previous one's state.
+"""
+from __future__ import annotations
+
+import logging
+from typing import Any, Callable
+
+from ngcontact.errors import ConvergenceError
+
+log = logging.getLogger(__name__)
+
+
+def uzawa(solve: Callable[[int], dict], update: Callable[[], dict[str, float]], *, rtol: float,
+          max_iter: int) -> dict[str, Any]:
+    """Alternate ``solve`` (primal, multiplier fixed) and ``update`` (multiplier) until both tests hold.
+
+    Parameters
+    ----------
+    solve
+        ``solve(j)`` minimizes the augmented energy with the multiplier of
+        pass ``j`` (1-based) held fixed and returns its Newton history.
+    update
+        Updates the multiplier from the current state and returns the two
+        measures of the module docstring, ``{"penetration": max (J_n - g)_+ / L,
+        "change": max |d lambda| / (k L)}`` (and optionally
+        ``"relative_change"``, kept in the history).
+    rtol, max_iter
+        Stopping rule of the module docstring; largest number of passes.
+
+    Returns
+    -------
+    dict
+        ``newton`` (the passes' histories), ``penetrations``, ``changes``,
+        ``relative_changes``, ``uzawa_iterations``.
+
+    Raises
+    ------
+    ConvergenceError
+        After ``max_iter`` passes, with the history.
+    """
+    history: dict[str, Any] = {"newton": [], "penetrations": [], "changes": [], "relative_changes": [],
+                               "uzawa_iterations": 0}
+    pen = change = float("inf")
+    for j in range(1, max_iter + 1):
+        history["newton"].append(solve(j))
+        measures = update()
+        pen, change = measures["penetration"], measures["change"]
+        history["penetrations"].append(pen)
+        history["changes"].append(change)
+        history["relative_changes"].append(measures.get("relative_change", change))
+        history["uzawa_iterations"] = j
+        log.debug("uzawa %d: penetration %.3e, multiplier change %.3e (relative)", j, pen, change)
+        if pen <= rtol and change <= rtol:
+            return history
+    raise ConvergenceError(f"Uzawa's iteration did not converge in {max_iter} passes: relative penetration "
+                           f"{pen:.3e} and multiplier change {change:.3e}, allowed {rtol:g}; raise the "
+                           "augmentation k_n (towards E/h and above) or the pass limit", history)

@@ -1,0 +1,213 @@
+"""Exact non-penetration on the 2D FE cell: node-to-node constraints, augmented Lagrangian, Uzawa.
+
+Requirements, one sentence each:
+
+* the Gauss-Lobatto rule has ``p + 1`` points including both ends and
+  integrates degree ``2p - 1`` exactly;
+* the multiplier field reads back the point values it was given;
+* the augmented energy's derivative is the augmented pressure along ``n``
+  (central differences), and at ``lambda = 0`` it is the penalty energy;
+* the solution does not depend on the augmentation ``k_n``: contact
+  fraction and mean closure agree to 1e-8 for ``k_n = 1e2`` and ``1e4`` times
+  ``E/h``;
+* the solution is admissible and balanced: no penetration at the nodes
+  beyond the Uzawa tolerance, a nonnegative multiplier whose mean is the
+  applied pressure, equilibrium to round-off;
+* it agrees with Westergaard within the discretization error, which falls
+  as the interface mesh is refined (slow tier), also on meshes graded to a
+  tolerance (slow tier);
+* what is not built is refused with the key, the value and what is allowed.
+"""
+import json
+import math
+from types import SimpleNamespace
+
+import ngsolve as ng
+import numpy as np
+import pytest
+
+from ngcontact import cli
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.contact_multiplier import ContactMultiplier, lobatto_rule
+from ngcontact.errors import ModelError
+from ngcontact.fem.materials import isotropic
+from ngcontact.geometry.cell2d import flat_cell
+from ngcontact.laws import penalty
+from ngcontact.laws.penalty import Friction
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
+
+H, NU = 0.01, 0.3
+PSTAR = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H, 1.0)
+
+
+def _problem(ih, order, k_factor, **kw):
+    cell = flat_cell(maxh=0.3, interface_maxh=ih, order=order)
+    law = isotropic(1.0, NU)
+    model = CellModel(rough=law, counter=law, k_n=k_factor / ih, gap=2 * H * ng.sin(math.pi * ng.x) ** 2,
+                      order=order, enforcement="exact", **kw)
+    return CellProblem(cell, model)
+
+
+def _sweep(P, ratios, measure=True):
+    return [P.solve(cell_load(2, pressure=r * PSTAR), first=(k == 0), measure=measure)
+            for k, r in enumerate(ratios)]
+
+
+@pytest.mark.parametrize("p", [1, 2, 3, 4])
+def test_lobatto_rule_has_the_ends_and_its_degree(p):
+    rule = lobatto_rule(p)
+    t = np.array([q[0] for q in rule.points])
+    w = np.array(rule.weights)
+    assert len(t) == p + 1 and t[0] == 0.0 and t[-1] == 1.0
+    for k in range(2 * p):
+        assert np.dot(w, t ** k) == pytest.approx(1.0 / (k + 1), rel=1e-13), k
+    assert abs(np.dot(w, t ** (2 * p)) - 1.0 / (2 * p + 1)) > 1e-6   # and not one degree more
+
+
+def test_the_multiplier_field_reads_back_its_point_values():
+    cell = flat_cell(maxh=0.5, interface_maxh=0.1, order=3)
+    m = ContactMultiplier(cell.mesh, 3)
+    v = np.random.default_rng(1).random(len(m.point_values()))
+    m.set_point_values(v)
+    assert np.allclose(m.at_points(m.value), v, rtol=0, atol=1e-13)
+    assert float(m.integrate(ng.x ** 5)) == pytest.approx(1.0 / 6.0, rel=1e-13)
+
+
+def test_augmented_energy_derivative_is_the_augmented_pressure():
+    mesh = ng.Mesh(ng.unit_square.GenerateMesh(maxh=0.5))
+    n = ng.CF((0.6, 0.8))
+    k, lam, g = 7.0, 0.3, 0.05
+    for J0 in ((0.1, 0.02), (0.01, -0.05), (-0.2, -0.1)):
+        J = ng.CF(J0)
+        dE = []
+        for i in range(2):
+            e = [0.0, 0.0]
+            e[i] = 1e-6
+            up = penalty.augmented_normal_energy(J + ng.CF(tuple(e)), n, k, lam, g)
+            dn = penalty.augmented_normal_energy(J - ng.CF(tuple(e)), n, k, lam, g)
+            dE.append((up - dn)(mesh(0.5, 0.5)) / 2e-6)
+        p = penalty.augmented_pressure(J, n, k, lam, g)(mesh(0.5, 0.5))
+        assert dE == pytest.approx([p * 0.6, p * 0.8], rel=1e-7, abs=1e-9)
+        at_zero = penalty.augmented_normal_energy(J, n, k, 0.0, g)(mesh(0.5, 0.5))
+        assert at_zero == pytest.approx(penalty.normal_energy(J, n, k, g)(mesh(0.5, 0.5)), abs=1e-15)
+
+
+@pytest.fixture(scope="module")
+def two_augmentations():
+    """Order 2, interface mesh 0.02, p/p* = 0.2 and 0.8, k_n = 1e2 and 1e4 E/h."""
+    return {f: _sweep(_problem(0.02, 2, f), (0.2, 0.8)) for f in (1e2, 1e4)}
+
+
+def test_the_solution_does_not_depend_on_the_augmentation(two_augmentations):
+    soft, stiff = two_augmentations[1e2], two_augmentations[1e4]
+    for a, b in zip(soft, stiff):
+        for key in ("contact_fraction", "mean_closure"):
+            assert b.results[key] == pytest.approx(a.results[key], rel=1e-8, abs=1e-12), key
+        # the closed-set tangent, extrapolated to k -> infinity (stiffness module)
+        assert b.results["effective_stiffness"]["matrix"][-1][-1] == pytest.approx(
+            a.results["effective_stiffness"]["matrix"][-1][-1], rel=1e-4)
+
+
+def test_the_solution_is_admissible_and_balanced(two_augmentations):
+    for sol in two_augmentations[1e2]:
+        r = sol.results
+        assert r["max_penetration"] <= 1e-10 * 2 * H
+        assert r["mean_pressure"] == pytest.approx(r["transmitted_pressure"], rel=1e-9)
+        assert r["equilibrium_error"] <= 1e-9
+        assert min(sol.surface["pressure"]) >= 0.0 and max(sol.surface["pressure"]) > 0.0
+        h = sol.newton[-1]
+        assert 1 <= h["uzawa_iterations"] <= 6 and h["uzawa_penetrations"][-1] <= 1e-10
+
+
+def test_contact_fraction_near_westergaard(two_augmentations):
+    # measured: -1.2e-2 and -3.2e-3 at this coarse mesh (order 2, 50 interface elements)
+    for r, sol in zip((0.2, 0.8), two_augmentations[1e2]):
+        exact = westergaard_contact_fraction(r, 1.0)
+        assert sol.results["contact_fraction"] == pytest.approx(exact, rel=0.02)
+
+
+@pytest.mark.slow  # ~40 s: three interface meshes at order 3
+def test_contact_fraction_converges_to_westergaard_under_refinement():
+    ratios = (0.2, 0.5, 0.8)
+    errors = []
+    for ih in (0.02, 0.01, 0.005):
+        sols = _sweep(_problem(ih, 3, 1e3), ratios, measure=False)
+        errors.append([abs(s.results["contact_fraction"] / westergaard_contact_fraction(r, 1.0) - 1)
+                       for r, s in zip(ratios, sols)])
+    # measured: 4.7e-3, 3.1e-3, 2.3e-3 -> 1.5e-3, 9.9e-4, 4.2e-4 -> 1.1e-3, 6.9e-4, 4.2e-5
+    for j, r in enumerate(ratios):
+        e = [row[j] for row in errors]
+        assert e[0] > e[1] > e[2], (r, e)
+    assert max(errors[-1]) <= 1.5e-3, errors
+
+
+def test_exact_enforcement_is_refused_where_it_is_not_built(tmp_path, capsys):
+    law = isotropic(1.0, NU)
+    cell = flat_cell(maxh=0.5, interface_maxh=0.25, order=1)
+    with pytest.raises(ModelError, match="enforcement = 'magic'"):
+        CellProblem(cell, CellModel(rough=law, counter=law, k_n=1.0, enforcement="magic"))
+    with pytest.raises(ModelError, match="enforcement = 'exact' in a 3D cell: .* 2D only"):
+        CellProblem(SimpleNamespace(dim=3), CellModel(rough=law, counter=law, k_n=1.0, enforcement="exact"))
+    with pytest.raises(ModelError, match="without friction only"):
+        CellProblem(cell, CellModel(rough=law, counter=law, k_n=1.0, enforcement="exact",
+                                    friction=Friction(law="tresca", G=1e-3, w=1e-6)))
+    text = SCENE.replace('friction = "none"', 'friction = "tresca"\nG = 1e-3\nw = 1e-6')
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    assert cli.main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "contact.enforcement = 'exact'" in err and "without friction only" in err
+
+
+SCENE = """\
+kind = "cell"
+[materials.solid]
+E = 1.0
+nu = 0.3
+[bodies]
+rough = "solid"
+counter = "solid"
+[geometry]
+profile = "flat"
+h_rough = 1.0
+h_counter = 1.0
+[contact]
+k_n = 1.0e4
+enforcement = "exact"
+friction = "none"
+gap = { kind = "sinusoid", h = 0.01 }
+[load]
+pressure = [0.0034523]
+[discretization]
+order = 2
+maxh = 0.3
+interface_maxh = 0.02
+"""
+
+
+def test_an_exact_fe_scene_runs_end_to_end(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(SCENE)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    report = json.loads((tmp_path / "o" / "report.json").read_text())
+    (load,) = report["results"]["loads"]
+    assert load["mean_pressure"] == pytest.approx(0.0034523, rel=1e-9)
+    assert load["contact_fraction"] == pytest.approx(westergaard_contact_fraction(0.0034523 / PSTAR, 1.0), rel=0.02)
+
+
+@pytest.mark.slow  # ~40 s: two loads graded towards their edges to a tolerance of 1e-3
+def test_graded_refinement_meets_its_tolerance_with_exact_contact(tmp_path):
+    # measured with tolerance 1e-4 (four loads, 2.3 min): estimates 2e-5 to 7e-5, errors 7e-7 to 3.4e-6
+    text = SCENE.replace("k_n = 1.0e4", "k_n = 1.0e5").replace("h_rough = 1.0", "h_rough = 2.0") \
+        .replace("h_counter = 1.0", "h_counter = 2.0").replace("pressure = [0.0034523]", "pressure = [0.0034523, 0.0138092]") \
+        .replace("order = 2", "order = 3") + "tolerance = 1e-3\n"
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    loads = json.loads((tmp_path / "o" / "report.json").read_text())["results"]["loads"]
+    for load in loads:
+        exact = westergaard_contact_fraction(load["transmitted_pressure"] / PSTAR, 1.0)
+        assert load["error_estimate"]["contact_fraction"] <= 1e-3
+        assert abs(load["contact_fraction"] - exact) <= 1e-3, (load["contact_fraction"], exact)
