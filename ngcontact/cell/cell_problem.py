@@ -59,6 +59,7 @@ from ngcontact.fem import materials as _mat
 from ngcontact.laws import penalty as _contact
 from ngcontact.laws.penalty import Friction
 from ngcontact.solvers.coulomb import coulomb_fixed_point
+from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
 from ngcontact.fem.quadrature import sampling_order
 
@@ -138,6 +139,9 @@ class CellProblem:
     line_search
         ``"exact"`` (default: energy minimized along the Newton direction)
         or ``"armijo"`` (backtracking only).
+    linear
+        Tangent solves (:class:`~ngcontact.solvers.linear_solver.LinearSolver`);
+        default: direct with ``inverse``.
     start
         Start of the first load under a prescribed pressure: ``"rigid"``
         (default, the rigid predictor of :mod:`ngcontact.cell.predictor`) or
@@ -159,7 +163,7 @@ class CellProblem:
 
     def __init__(self, cell, model: CellModel, *, rtol: float = 1e-10, atol: float = 0.0,
                  max_iter: int = 40, inverse: str = "sparsecholesky", normal=None,
-                 line_search: str = "exact", start: str = "rigid"):
+                 line_search: str = "exact", start: str = "rigid", linear: LinearSolver | None = None):
         if line_search not in ("exact", "armijo"):
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
         if start not in ("rigid", "closed"):
@@ -170,6 +174,7 @@ class CellProblem:
         self.dim = dim = cell.dim
         self.setting = "3d" if dim == 3 else "plane_strain"
         self.rtol, self.atol, self.max_iter, self.inverse = rtol, atol, max_iter, inverse
+        self.linear = linear if linear is not None else LinearSolver("direct", inverse=inverse)
         self.area = cell.area
         self.n = normal if normal is not None else contact_normal(cell)
         Vr = _el.body_space(mesh, "rough", model.order, dirichlet="bottom", periodic=True)
@@ -178,6 +183,7 @@ class CellProblem:
         # every element would couple all dofs and slow the factorization 5x
         N = ng.NumberSpace(mesh, definedon=mesh.Boundaries("contact|top"))
         self.X = ng.FESpace([Vr, Vc] + [N] * dim)
+        _el.surface_wirebasket(self.X, mesh, "contact")
         self.gap = _discrete_gap(mesh, model)
         self.gfu = ng.GridFunction(self.X)
         self.u_dofs = [self.X.Range(2 + i).start for i in range(dim)]
@@ -325,7 +331,7 @@ class CellProblem:
 
     def _newton(self, free, atol) -> dict:
         h = minimize(self.form, self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
-                     max_iter=self.max_iter, inverse=self.inverse, line_search=self.line_search,
+                     max_iter=self.max_iter, linear=self.linear, line_search=self.line_search,
                      active_set=self.active_set)
         return h.as_dict()
 
