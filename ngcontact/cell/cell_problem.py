@@ -53,12 +53,12 @@ import numpy as np
 from ngcontact.cell import measures
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
 from ngcontact.cell.coefficients import contact_normal
-from ngcontact.cell.predictor import set_start
+from ngcontact.cell.predictor import rigid_continuation, set_start, tangential_load
 from ngcontact.fem import elasticity as _el
 from ngcontact.fem import materials as _mat
 from ngcontact.laws import penalty as _contact
 from ngcontact.laws.penalty import Friction
-from ngcontact.solvers.coulomb import coulomb_fixed_point
+from ngcontact.solvers.coulomb import MIXING_DEPTH, coulomb_fixed_point
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
 from ngcontact.fem.quadrature import sampling_order
@@ -292,9 +292,12 @@ class CellProblem:
         stiffness Schur complements) and ``surface`` is empty: for timing
         studies of the solve itself.
         """
+        before = tangential_load(self)
         self._apply_load(load, first)
         free = self._freedofs(load)
-        histories: list[dict] = []
+        # a later load with a tangential change: the rigid continuation (predictor module); its steps count
+        predicted = None if first else rigid_continuation(self, free, before)
+        histories: list[dict] = [] if predicted is None else [predicted]
         fp = 0
         if self.model.friction is not None and self.model.friction.law == "coulomb":
             first_residual: list[float] = []
@@ -303,6 +306,9 @@ class CellProblem:
 
             def freeze() -> None:
                 previous.vec.data = self.gfu.vec
+
+            def put(x) -> None:
+                self.gfu.vec.FV().NumPy()[:] = x
 
             def tresca_solve() -> dict:
                 # later passes stop at rtol times the first pass's initial residual
@@ -315,8 +321,10 @@ class CellProblem:
             fixed = coulomb_fixed_point(
                 freeze, tresca_solve,
                 lambda: measures.sample_surface(self, {"p": self.pressure})["p"],
-                rtol=self.model.coulomb_rtol, max_iter=self.model.coulomb_max_iter)
-            histories, fp = fixed["newton"], fixed["coulomb_iterations"]
+                rtol=self.model.coulomb_rtol, max_iter=self.model.coulomb_max_iter,
+                state=(lambda: self.gfu.vec.FV().NumPy().copy(), put),
+                depth=MIXING_DEPTH if getattr(self, "multiplier", None) is None else 0)
+            histories, fp = histories + fixed["newton"], fixed["coulomb_iterations"]
         else:
             histories.append(self._newton(free, self.atol))
         if measure:
