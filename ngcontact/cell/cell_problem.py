@@ -71,6 +71,7 @@ from ngcontact.laws import penalty as _contact
 from ngcontact.laws.penalty import Friction
 from ngcontact.errors import ModelError
 from ngcontact.solvers.coulomb import MIXING_DEPTH, coulomb_fixed_point
+from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
 from ngcontact.fem.quadrature import sampling_order
 
@@ -159,6 +160,9 @@ class CellProblem:
     line_search
         ``"exact"`` (default: energy minimized along the Newton direction)
         or ``"armijo"`` (backtracking only).
+    linear
+        Tangent solves (:class:`~ngcontact.solvers.linear_solver.LinearSolver`);
+        default: direct with ``inverse``.
     start
         Start of the first load under a prescribed pressure: ``"rigid"``
         (default, the rigid predictor of :mod:`ngcontact.cell.predictor`) or
@@ -187,7 +191,7 @@ class CellProblem:
 
     def __init__(self, cell, model: CellModel, *, rtol: float = 1e-10, atol: float = 0.0,
                  max_iter: int = 40, inverse: str = "sparsecholesky", normal=None,
-                 line_search: str = "exact", start: str = "rigid"):
+                 line_search: str = "exact", start: str = "rigid", linear: LinearSolver | None = None):
         if line_search not in ("exact", "armijo"):
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
         if start not in ("rigid", "closed"):
@@ -209,6 +213,7 @@ class CellProblem:
         self.dim = dim = cell.dim
         self.setting = "3d" if dim == 3 else "plane_strain"
         self.rtol, self.atol, self.max_iter, self.inverse = rtol, atol, max_iter, inverse
+        self.linear = linear if linear is not None else LinearSolver("direct", inverse=inverse)
         self.area = cell.area
         self.n = normal if normal is not None else contact_normal(cell)
         Vr = _el.body_space(mesh, "rough", model.order, dirichlet="bottom", periodic=True)
@@ -217,6 +222,7 @@ class CellProblem:
         # every element would couple all dofs and slow the factorization 5x
         N = ng.NumberSpace(mesh, definedon=mesh.Boundaries("contact|top"))
         self.X = ng.FESpace([Vr, Vc] + [N] * dim)
+        _el.surface_wirebasket(self.X, mesh, "contact")
         # exact: the gap itself at the Lobatto nodes (an interpolant on S_C, not periodic, would give the
         # two copies of a periodic vertex different gaps: contradictory constraints on one node)
         self.gap = model.gap if model.enforcement == "exact" else _discrete_gap(mesh, model)
@@ -393,7 +399,7 @@ class CellProblem:
 
     def _newton_once(self, free, atol) -> dict:
         h = minimize(self.form, self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
-                     max_iter=self.max_iter, inverse=self.inverse, line_search=self.line_search,
+                     max_iter=self.max_iter, linear=self.linear, line_search=self.line_search,
                      active_set=self.active_set)
         return h.as_dict()
 

@@ -22,6 +22,7 @@ from ngcontact.fem import materials
 from ngcontact.fem.interpolants import periodic_table_1d
 from ngcontact.laws import homogenized as il
 from ngcontact.laws.penalty import Friction
+from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.cell.spectral_cell import Layer, SpectralCell
 from ngcontact.scene.cell_geometry import GAP_PROFILES, profile_2d, small_slope
 from ngcontact.scene.cell_scene import CellScene, load_states, spectral_grid
@@ -153,6 +154,12 @@ def gap_cf(scene):
     if not terms:
         return None
     return terms[0] if len(terms) == 1 else terms[0] + terms[1]
+
+
+def linear_solver(scene) -> LinearSolver:
+    """The tangent solves of a scene's Newton iterations: ``solver.linear``, ``iterative_from``, ``inverse``."""
+    s = scene.solver
+    return LinearSolver(policy=s.linear, inverse=s.inverse, threshold=s.iterative_from)
 
 
 def spectral_cell(scene: CellScene, grid: int | None = None) -> SpectralCell:

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 
-from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, model_of, spectral_cell
+from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, linear_solver, model_of, spectral_cell
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.edge_grading import GradedSolve, graded_flat_cell, solve_to_tolerance
 
@@ -50,7 +50,7 @@ def solve_graded(scene, loads) -> list[GradedSolve]:
         cell = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
                                 vertices=vertices)
         return CellProblem(cell, replace(model, order=order), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
-                           inverse=s.inverse)
+                           inverse=s.inverse, linear=linear_solver(scene))
 
     out = []
     for k, load in enumerate(loads):
@@ -142,7 +142,7 @@ def run(scene, clock) -> Outcome:
     with clock.stage("setup"):
         s = scene.solver
         P = CellProblem(cell, model_of(scene), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
-                        inverse=s.inverse)
+                        inverse=s.inverse, linear=linear_solver(scene))
     graded: list[GradedSolve] = []
     with clock.stage("solve"):
         if scene.discretization.tolerance is None:
@@ -170,7 +170,7 @@ def run(scene, clock) -> Outcome:
                                       list(zip(*[sf[n] for n in coords + ["pressure", "slip", "closure"]])))
     results["loads"] = per_load
     solver = {"iterations": sum(x.iterations for x in sols),
-              "converged": True, "per_load": newton}
+              "converged": True, "per_load": newton, "linear": P.linear.summary()}
     comps = P.gfu.components
     vtk = {"cell": VtkField(mesh=cell.mesh, fields={"u_rough": comps[0], "u_counter": comps[1]},
                             subdivision=1)}

@@ -26,7 +26,7 @@ from collections import Counter
 import numpy as np
 import ngsolve as ng
 
-from ngcontact.drivers.build import body_laws, interface_friction, interface_normal_law, law_from_cell
+from ngcontact.drivers.build import body_laws, interface_friction, interface_normal_law, law_from_cell, linear_solver
 from ngcontact.laws import homogenized as il
 from ngcontact.fem.interpolants import piecewise_linear
 from ngcontact.macro import macro_problem as M
@@ -195,7 +195,7 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
 def solve_scene(scene, problem: M.MacroProblem) -> M.MacroSolution:
     s = scene.solver
     return M.solve(problem, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
-                   coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter)
+                   coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter, linear=linear_solver(scene))
 
 
 def checked_equilibrium(sol: M.MacroSolution) -> dict:
@@ -274,7 +274,8 @@ def run(scene, clock) -> Outcome:
     newton = sol.history["newton"]
     solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],
               "linear_solve_only": sol.history["quadratic"],
-              "coulomb_changes": sol.history["coulomb_changes"], "solves": newton}
+              "coulomb_changes": sol.history["coulomb_changes"], "solves": newton,
+              "linear": sol.history["linear"]}
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
 
 

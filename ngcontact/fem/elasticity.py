@@ -106,7 +106,36 @@ def body_space(mesh, body: str, order: int, dirichlet: str = "", periodic: bool 
     if order < 1:
         raise ModelError(f"order = {order!r}: must be >= 1")
     V = ng.VectorH1(mesh, order=order, definedon=mesh.Materials(body), dirichlet=dirichlet)
-    return ng.Periodic(V) if periodic else V
+    V = ng.Periodic(V) if periodic else V
+    vertex_wirebasket(V, mesh)
+    return V
+
+
+def surface_wirebasket(V, mesh, boundaries: str) -> None:
+    """Put every dof of the boundary elements on ``boundaries`` on BDDC's wirebasket.
+
+    BDDC eliminates each element's interface dofs with that element's own
+    matrix; a contact term on a boundary element couples the two bodies'
+    traces alone and is singular (zero where the contact is open), so its
+    dofs must stay in the coarse problem."""
+    wirebasket = ng.COUPLING_TYPE.WIREBASKET_DOF
+    region = mesh.Boundaries(boundaries)
+    for el in mesh.Elements(ng.BND):
+        if region.Mask()[el.index]:
+            for d in V.GetDofNrs(el):
+                if d >= 0:
+                    V.SetCouplingType(d, wirebasket)
+
+
+def vertex_wirebasket(V, mesh) -> None:
+    """Put only the vertex dofs of ``V`` on BDDC's wirebasket (its coarse problem): the edge dofs of
+    order >= 2 become interface dofs, as ``wb_withedges=False`` does for ``H1``
+    (:mod:`ngcontact.solvers.linear_solver`).  Sparse direct solves ignore coupling types."""
+    interface = ng.COUPLING_TYPE.INTERFACE_DOF
+    for edge in mesh.edges:
+        for d in V.GetDofNrs(edge):
+            if d >= 0:
+                V.SetCouplingType(d, interface)
 
 
 def add_elastic_energy(form: ng.BilinearForm, mesh, bodies: dict, displacements: dict, setting: str):

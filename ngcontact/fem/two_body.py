@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.fem.elasticity import COMPONENTS
+from ngcontact.fem.elasticity import COMPONENTS, vertex_wirebasket
 from ngcontact.errors import ModelError
 
 
@@ -109,7 +109,9 @@ def spaces(mesh, setting: str, regions: tuple[str, str], supports, order: int, p
     spaces = []
     for name in regions:
         V = ng.VectorH1(mesh, order=order, definedon=mesh.Materials(name), **kw)
-        spaces.append(ng.Periodic(V) if periodic else V)
+        V = ng.Periodic(V) if periodic else V
+        vertex_wirebasket(V, mesh)
+        spaces.append(V)
     return ng.FESpace(spaces)
 
 

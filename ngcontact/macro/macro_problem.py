@@ -57,6 +57,7 @@ from ngcontact.fem.materials import ElasticLaw
 from ngcontact.fem.quadrature import sampling_order
 from ngcontact.fem.sampling import boundary_values
 from ngcontact.solvers.coulomb import coulomb_fixed_point
+from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
 from ngcontact.fem.rigid_modes import check_rigid_modes
 
@@ -174,7 +175,7 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
 
 def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
           inverse: str = "sparsecholesky", coulomb_rtol: float = 1e-8,
-          coulomb_max_iter: int = 40) -> MacroSolution:
+          coulomb_max_iter: int = 40, linear: LinearSolver | None = None) -> MacroSolution:
     """Solve the macro problem.
 
     Parameters
@@ -186,6 +187,9 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     coulomb_rtol, coulomb_max_iter
         Stopping rule of the Coulomb fixed point
         (:func:`ngcontact.solvers.coulomb.coulomb_fixed_point`).
+    linear
+        Tangent solves (:class:`~ngcontact.solvers.linear_solver.LinearSolver`);
+        default: direct with ``inverse``.  Its record goes to the history.
 
     Raises
     ------
@@ -199,12 +203,14 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     mesh = problem.mesh
     fes = two_body.spaces(mesh, problem.setting, (problem.rough, problem.counter), problem.supports,
                           problem.order)
+    elasticity.surface_wirebasket(fes, mesh, problem.interface)
     gfu = ng.GridFunction(fes)
     two_body.set_dirichlet(mesh, problem.setting, problem.supports, gfu)
     n0 = two_body.interface_normal(mesh, problem.rough, problem.interface)
     frame = local_frame(n0, mesh.dim)
     law = problem.law
-    newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, inverse=inverse)
+    linear = linear if linear is not None else LinearSolver("direct", inverse=inverse)
+    newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, linear=linear)
     history: dict[str, Any] = {"newton": [], "coulomb_changes": [], "coulomb_iterations": 0}
     g0 = gap_cf(problem.gap)
     old = ng.GridFunction(fes)
@@ -240,6 +246,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
     history["converged"] = all(h["converged"] for h in history["newton"])
     history["quadratic"] = law.quadratic
+    history["linear"] = linear.summary()
     ur, uc = gfu.components
     sol = MacroSolution(problem=problem, gfu=gfu, u_rough=ur, u_counter=uc, frame=frame,
                         local_jump=_local(frame, ur - uc), threshold=G, history=history, previous=old)

@@ -56,6 +56,7 @@ from dataclasses import dataclass, field
 import ngsolve as ng
 
 from ngcontact.errors import ConvergenceError
+from ngcontact.solvers.linear_solver import LinearSolver
 
 log = logging.getLogger(__name__)
 
@@ -127,7 +128,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
              rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 50,
              inverse: str = "sparsecholesky", quadratic: bool = False,
              callback=None, line_search: str = "armijo", max_step: float = 8.0,
-             active_set=None) -> NewtonHistory:
+             active_set=None, linear: LinearSolver | None = None) -> NewtonHistory:
     """Minimize the energy of ``form`` starting from ``gfu`` (updated in place).
 
     Parameters
@@ -143,7 +144,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
     max_iter
         Largest number of Newton steps.
     inverse
-        Sparse direct solver for the tangent.
+        Sparse direct solver for the tangent (when no ``linear`` is given).
     quadratic
         The energy is quadratic: one linear solve, no iteration.
     callback
@@ -159,6 +160,10 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         state; an active set that cycles while the residual stagnates raises
         :class:`~ngcontact.errors.ConvergenceError` at once
         (:class:`ActiveSetCycle`) instead of iterating to ``max_iter``.
+    linear
+        The tangent solves (:class:`~ngcontact.solvers.linear_solver.LinearSolver`:
+        direct, BDDC-preconditioned CG, or by size), which also records
+        them; default: direct with ``inverse``.
     """
     if line_search not in ("armijo", "exact"):
         raise ValueError(f"line_search = {line_search!r}: must be 'armijo' or 'exact'")
@@ -166,6 +171,9 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         raise ValueError(f"max_step = {max_step!r}: must be >= 1")
     if freedofs is None:
         freedofs = gfu.space.FreeDofs()
+    if linear is None:
+        linear = LinearSolver("direct", inverse=inverse)
+    linear.register(form, freedofs)
     hist = NewtonHistory(linear=quadratic)
     cycle = ActiveSetCycle() if active_set is not None else None
     fixed = fixed_mask(freedofs)
@@ -189,7 +197,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         hist.converged = True
         return hist
     if quadratic:
-        return _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rtol, atol, fixed)
+        return _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol, atol, fixed)
     floor0 = None
     for it in range(1, max_iter + 1):
         form.AssembleLinearization(gfu.vec)
@@ -199,8 +207,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
             log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             return hist
-        inv = form.mat.Inverse(freedofs, inverse=inverse)
-        du.data = inv * res
+        linear.prepare(form, freedofs).apply(res, du)
         slope = ng.InnerProduct(du, res)
         if not math.isfinite(slope):
             raise ConvergenceError(f"Newton step {it}: the tangent solve gave non-finite values", hist.as_dict())
@@ -257,19 +264,19 @@ def _at_floor(rnorm: float, floor: float, r0: float, floor0: float) -> bool:
     return rnorm <= floor and (rnorm <= FLOOR_PROGRESS * r0 or r0 <= FLOOR_GROWTH * floor0)
 
 
-def _linear_solve(form, gfu, freedofs, inverse, residual, res, du, hist, r0, rtol, atol, fixed) -> NewtonHistory:
+def _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol, atol, fixed) -> NewtonHistory:
     """A quadratic energy: ``u <- u - K^{-1} r(u)``, refined with the same factorization, and checked.
 
     ``res`` holds ``r(u)`` on entry.  Raises when the residual stays above
     ``max(rtol r_0, atol)`` and above its round-off floor.
     """
     form.AssembleLinearization(gfu.vec)
-    inv = form.mat.Inverse(freedofs, inverse=inverse)
+    inv = linear.prepare(form, freedofs)
     target = max(rtol * r0, atol)
     floor0 = roundoff_floor(form.mat, gfu.vec, fixed)
     rnorm = r0
     for _ in range(1 + REFINE_STEPS):
-        du.data = inv * res
+        inv.apply(res, du)
         gfu.vec.data -= du
         rnorm = residual(gfu.vec)          # leaves r(u) in res for the next refinement
         energy = form.Energy(gfu.vec)

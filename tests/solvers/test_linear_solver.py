@@ -1,0 +1,103 @@
+"""Tangent solves: BDDC-preconditioned CG against the sparse factorization, and the policy by size."""
+import json
+import math
+import os
+
+import ngsolve as ng
+import numpy as np
+import pytest
+
+from ngcontact import cli
+from ngcontact.fem.materials import isotropic
+from ngcontact.geometry import bodies as gm
+from ngcontact.laws import homogenized as il
+from ngcontact.laws import interface_energy as ie
+from ngcontact.macro import macro_problem as M
+from ngcontact.solvers.linear_solver import LinearSolver, match_free_dofs
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def _press_fit_3d(policy, law):
+    g = gm.coaxial_3d(0.5, 1.0, 1.6, 1.0, maxh=0.35, order=2)
+    linear = LinearSolver(policy)
+    sol = M.solve(M.MacroProblem(mesh=g.mesh, setting="3d", rough="inner", counter="outer",
+                                 materials={"inner": isotropic(200.0, 0.3), "outer": isotropic(70.0, 0.25)},
+                                 law=law, gap=-1e-3, order=2,
+                                 supports=(M.Support(label="bottom"), M.Support(label="sym_x", components=("x",)),
+                                           M.Support(label="sym_y", components=("y",))),
+                                 loads=(M.Load(label="top", pressure=0.1),)), linear=linear)
+    mesh = sol.problem.mesh
+    p = ie.pressure(law.normal, sol.local_jump, 1e-3)
+    force = ng.Integrate(p, mesh, ng.BND, definedon=mesh.Boundaries("interface"))
+    return sol, force, linear
+
+
+@pytest.mark.parametrize("law", [il.InterfaceLaw(normal=il.LinearLaw(kn=300.0, kt=100.0)),
+                                 il.InterfaceLaw(normal=il.TabulatedLaw(closure=(0.0, 5e-4, 2e-3),
+                                                                        pressure=(0.0, 0.05, 0.5), kt=100.0))],
+                         ids=["linear law", "tabulated law (Newton)"])
+def test_iterative_and_direct_agree_on_a_3d_press_fit(law):
+    sol_d, f_d, lin_d = _press_fit_3d("direct", law)
+    sol_i, f_i, lin_i = _press_fit_3d("iterative", law)
+    assert lin_d.summary()["method"].startswith("direct") and lin_i.summary()["method"] == "cg+bddc"
+    assert all(0 < k < 500 for k in lin_i.iterations)
+    du = sol_i.gfu.vec.FV().NumPy() - sol_d.gfu.vec.FV().NumPy()
+    assert np.linalg.norm(du) <= 1e-8 * np.linalg.norm(sol_d.gfu.vec.FV().NumPy())
+    assert f_i == pytest.approx(f_d, rel=1e-8)
+
+
+def test_a_3d_cell_solved_iteratively_equals_the_direct_solve():
+    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.scene.loader import load
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    out = {}
+    for policy in ("direct", "iterative"):
+        cell = build_cell(scene, maxh=0.6, interface_maxh=0.25)
+        P = CellProblem(cell, model_of(scene), linear=LinearSolver(policy))
+        sol = P.solve(cell_loads(scene)[0], first=True, measure=False)
+        out[policy] = (sol.results, P.gfu.vec.FV().NumPy().copy(), P.linear)
+    (a, ua, _), (b, ub, lin) = out["direct"], out["iterative"]
+    assert lin.summary()["method"] == "cg+bddc" and len(lin.iterations) == lin.solves > 0
+    assert b["contact_fraction"] == pytest.approx(a["contact_fraction"], rel=1e-9)
+    assert np.linalg.norm(ub - ua) <= 1e-7 * np.linalg.norm(ua)
+
+
+CELL = os.path.join(ROOT, "geometries", "cells", "sinusoid.toml")
+
+
+def _cell_report(tmp_path, name, solver):
+    text = open(CELL).read().replace("shear = [0.0, 0.001, 0.002, 0.003]", "shear = [0.0, 0.001]")
+    text = text.replace("[solver]\n", "[solver]\n" + solver)
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / name), "--quiet"]) == 0
+    return json.loads((tmp_path / name / "report.json").read_text())
+
+
+def test_the_policy_goes_iterative_above_its_threshold_and_the_report_says_so(tmp_path):
+    below = _cell_report(tmp_path, "below", 'linear = "auto"\n')
+    above = _cell_report(tmp_path, "above", 'linear = "auto"\niterative_from = 1000\n')
+    assert below["solver"]["linear"]["method"] == "direct (sparsecholesky)"
+    lin = above["solver"]["linear"]
+    assert lin["policy"] == "auto" and lin["method"] == "cg+bddc" and lin["threshold"] == 1000
+    assert len(lin["cg_iterations"]) == lin["solves"] > 0
+    for a, b in zip(below["results"]["loads"], above["results"]["loads"]):
+        assert b["contact_fraction"] == pytest.approx(a["contact_fraction"], rel=1e-8)
+        assert b["mean_closure"] == pytest.approx(a["mean_closure"], rel=1e-7)
+
+
+def test_the_space_takes_the_free_dofs_of_the_solve():
+    mesh = ng.Mesh(ng.unit_square.GenerateMesh(maxh=0.5))
+    V = ng.H1(mesh, order=1, dirichlet="left")
+    free = ng.BitArray(V.FreeDofs())
+    free.Clear(int(np.flatnonzero([free[i] for i in range(len(free))])[0]))
+    match_free_dofs(V, free)
+    assert [V.FreeDofs()[i] for i in range(V.ndof)] == [free[i] for i in range(V.ndof)]
+
+
+def test_an_unknown_policy_is_refused():
+    with pytest.raises(ValueError, match="policy = 'cg'"):
+        LinearSolver("cg")
+    assert math.isfinite(LinearSolver("auto").threshold)
