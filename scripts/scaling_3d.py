@@ -1,0 +1,257 @@
+"""3D at scale: cost against size of a 3D cell and a 3D macro problem, direct and iterative; the bisinusoid aim.
+
+Three measurements, one run, one CSV and one PNG:
+
+1. **3D cell** (``geometries/cells/bisinusoid.toml``: order 2, the scene's
+   pressure), refining ``interface_maxh``: the Newton solve of one load with
+   ``solver.linear = "direct"`` (sparse Cholesky; up to ``--direct-max``
+   dofs) and ``"iterative"`` (BDDC-preconditioned CG,
+   :mod:`ngcontact.solvers.linear_solver`).
+2. **3D macro press fit** (two coaxial tubes, a quarter, interference 1e-3,
+   a tabulated nonlinear normal law so that Newton iterates, 0.1 on the top),
+   refining ``maxh`` at order 2, the same two solvers.
+3. **Bisinusoid aim** (gap ``A (2 - cos 2 pi x - cos 2 pi y)``, ``A = 0.005``,
+   two half-spaces ``E = 1, nu = 0.3``, mean pressures giving about 20 % and
+   60 % contact): the spectral cell from 64^2 to 512^2 against Tamaas at
+   1024^2 (the ``bench`` extra; skipped with a message without it): contact
+   fraction against wall time.
+
+Every solve of parts 1 and 2 runs in its own child process, so that its peak
+memory (``VmHWM``) is its own.  Reported per solve: dofs, wall time of the
+setup and solve (not the meshing), Newton steps, CG iterations, peak memory,
+contact fraction; per solver the exponent ``b`` of ``time ~ dofs^b`` fitted
+over the sizes.
+
+Usage::
+
+    python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000]
+
+Writes ``scaling_3d.csv`` and ``scaling_3d.png`` into ``OUT_DIR`` (default
+``results/scaling_3d``) and logs the tables and the fitted exponents.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+from ngcontact.output.writer import write_csv
+
+log = logging.getLogger("scaling_3d")
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CELL_SIZES = (0.12, 0.08, 0.06, 0.045, 0.035)
+MACRO_SIZES = (0.3, 0.2, 0.14, 0.1, 0.075)
+QUICK_CELL, QUICK_MACRO = (0.16, 0.12), (0.35, 0.3)
+AMPLITUDE, PRESSURES = 0.005, (0.00185, 0.0065)
+SPECTRAL_GRIDS, TAMAAS_GRID = (64, 128, 256, 512), 1024
+KEYS = ("part", "solver", "size", "ndof", "seconds", "newton_steps", "cg_iterations", "peak_memory_gb",
+        "contact_fraction", "pressure")
+
+
+def peak_memory_gb() -> float:
+    """This process's peak resident memory (``VmHWM``)."""
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 2 ** 20
+    return float("nan")
+
+
+def cell_child(size: float, policy: str) -> dict:
+    import ngsolve as ng
+    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.scene.loader import load
+    from ngcontact.solvers.linear_solver import LinearSolver
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    cell = build_cell(scene, interface_maxh=size)
+    with ng.TaskManager():
+        t0 = time.perf_counter()
+        P = CellProblem(cell, model_of(scene), linear=LinearSolver(policy))
+        sol = P.solve(cell_loads(scene)[0], first=True, measure=False)
+        secs = time.perf_counter() - t0
+    return {"part": "cell", "solver": policy, "size": size, "ndof": P.ndof, "seconds": secs,
+            "newton_steps": sol.iterations, "cg_iterations": sum(P.linear.iterations),
+            "contact_fraction": sol.results["contact_fraction"], "pressure": sol.results["mean_pressure"]}
+
+
+def macro_child(size: float, policy: str) -> dict:
+    import ngsolve as ng
+    from ngcontact.fem.materials import isotropic
+    from ngcontact.geometry import bodies as gm
+    from ngcontact.laws import homogenized as il
+    from ngcontact.macro import macro_problem as M
+    from ngcontact.solvers.linear_solver import LinearSolver
+    g = gm.coaxial_3d(0.5, 1.0, 1.6, 1.0, maxh=size, order=2)
+    law = il.InterfaceLaw(normal=il.TabulatedLaw(closure=(0.0, 5e-4, 2e-3), pressure=(0.0, 0.05, 0.5), kt=100.0))
+    linear = LinearSolver(policy)
+    with ng.TaskManager():
+        t0 = time.perf_counter()
+        sol = M.solve(M.MacroProblem(mesh=g.mesh, setting="3d", rough="inner", counter="outer",
+                                     materials={"inner": isotropic(200.0, 0.3), "outer": isotropic(70.0, 0.25)},
+                                     law=law, gap=-1e-3, order=2,
+                                     supports=(M.Support(label="bottom"), M.Support(label="sym_x", components=("x",)),
+                                               M.Support(label="sym_y", components=("y",))),
+                                     loads=(M.Load(label="top", pressure=0.1),)), linear=linear)
+        secs = time.perf_counter() - t0
+    return {"part": "macro", "solver": policy, "size": size, "ndof": sol.gfu.space.ndof, "seconds": secs,
+            "newton_steps": sol.history["newton_iterations"], "cg_iterations": sum(linear.iterations),
+            "contact_fraction": "", "pressure": ""}
+
+
+def child(argv: list[str]) -> None:
+    part, size, policy = argv[0], float(argv[1]), argv[2]
+    row = (cell_child if part == "cell" else macro_child)(size, policy)
+    row["peak_memory_gb"] = peak_memory_gb()
+    print(json.dumps(row))
+
+
+def run_child(part: str, size: float, policy: str) -> dict | None:
+    out = subprocess.run([sys.executable, os.path.abspath(__file__), "--child", part, str(size), policy],
+                         capture_output=True, text=True)
+    if out.returncode != 0:
+        log.warning("%s %s at size %g failed: %s", part, policy, size, out.stderr.strip().splitlines()[-1:])
+        return None
+    row = json.loads(out.stdout.strip().splitlines()[-1])
+    log.info("%-5s %-9s size %-6g ndof %8d: %7.1f s, %3d Newton, %5d CG, %.2f GB", part, policy, size, row["ndof"],
+             row["seconds"], row["newton_steps"], row["cg_iterations"], row["peak_memory_gb"])
+    return row
+
+
+def fe_parts(quick: bool, direct_max: int) -> list[dict]:
+    rows = []
+    ladders = (("cell", QUICK_CELL if quick else CELL_SIZES), ("macro", QUICK_MACRO if quick else MACRO_SIZES))
+    for part, sizes in ladders:
+        direct_on = True
+        for size in sizes:
+            for policy in ("iterative", "direct"):
+                if policy == "direct" and not direct_on:
+                    continue
+                row = run_child(part, size, policy)
+                if row is None:
+                    continue
+                rows.append(row)
+                if policy == "direct" and row["ndof"] > direct_max:
+                    direct_on = False
+    return rows
+
+
+def spectral_aim(quick: bool) -> list[dict]:
+    from ngcontact.cell.cell_load import cell_load
+    from ngcontact.cell.spectral_cell import Layer, SpectralCell
+    from ngcontact.geometry.cell3d import bisinusoid_gap
+    rows = []
+
+    def gap(n):
+        s = np.arange(n) / n
+        return bisinusoid_gap(AMPLITUDE, 1.0, xy=(s[None, :], s[:, None]))
+
+    for n in SPECTRAL_GRIDS[:2] if quick else SPECTRAL_GRIDS:
+        for p in PRESSURES:
+            t0 = time.perf_counter()
+            cell = SpectralCell(dim=3, period=1.0, grid=n, rough=Layer(1.0, 0.3, 50.0), counter=Layer(1.0, 0.3, 50.0),
+                                gap=gap(n), k_n=1.0, enforcement="exact")
+            sol = cell.solve(cell_load(3, pressure=p))
+            rows.append({"part": "bisinusoid", "solver": "ngcontact spectral", "size": n, "ndof": n * n,
+                         "seconds": time.perf_counter() - t0, "newton_steps": "", "cg_iterations": sol.iterations,
+                         "peak_memory_gb": "", "contact_fraction": sol.results["contact_fraction"], "pressure": p})
+    try:
+        import tamaas as tm
+    except ImportError:
+        log.warning("Tamaas is not installed (pip install '.[bench]'): the FFT peer is skipped")
+        return rows
+    tm.set_log_level(tm.LogLevel.error)
+    n = 256 if quick else TAMAAS_GRID
+    for p in PRESSURES:
+        t0 = time.perf_counter()
+        model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, 1.0], [n, n])
+        model.E, model.nu = 1.0 / (2 * (1 - 0.3 ** 2)), 0.0      # one half-space of the pair's E*
+        solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(-gap(n)), 1e-12)
+        solver.max_iter = 100000
+        solver.solve(p)
+        tr = np.array(model.traction).reshape(n, n)
+        rows.append({"part": "bisinusoid", "solver": "tamaas", "size": n, "ndof": n * n,
+                     "seconds": time.perf_counter() - t0, "newton_steps": "", "cg_iterations": "",
+                     "peak_memory_gb": "", "contact_fraction": float(np.mean(tr > 0)), "pressure": p})
+    return rows
+
+
+def exponent(rows: list[dict], part: str, solver: str) -> float | None:
+    sel = [r for r in rows if r["part"] == part and r["solver"] == solver]
+    if len(sel) < 2:
+        return None
+    b, _ = np.polyfit(np.log([r["ndof"] for r in sel]), np.log([r["seconds"] for r in sel]), 1)
+    return float(b)
+
+
+def plot(rows: list[dict], path: str) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
+    for ax, part in zip(axes[:2], ("cell", "macro")):
+        for solver, style in (("iterative", "o-"), ("direct", "s--")):
+            sel = [r for r in rows if r["part"] == part and r["solver"] == solver]
+            if sel:
+                b = exponent(rows, part, solver)
+                ax.loglog([r["ndof"] for r in sel], [r["seconds"] for r in sel], style,
+                          label=f"{solver} (time ~ N^{b:.2f})" if b is not None else solver)
+        ax.set_xlabel("dofs")
+        ax.set_ylabel("wall time, setup and solve [s]")
+        ax.set_title("3D cell (bisinusoid)" if part == "cell" else "3D macro press fit")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+    ax = axes[2]
+    for p in PRESSURES:
+        ref = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "tamaas" and r["pressure"] == p]
+        sel = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "ngcontact spectral"
+               and r["pressure"] == p]
+        if ref and sel:
+            f0 = ref[0]["contact_fraction"]
+            ax.loglog([r["seconds"] for r in sel], [max(abs(r["contact_fraction"] / f0 - 1), 1e-8) for r in sel],
+                      "^-", label=f"spectral, p = {p:g} (Tamaas {TAMAAS_GRID}^2: {f0:.4f})")
+    ax.axhline(5e-3, color="k", lw=0.8, ls=":", label="0.5 %")
+    ax.set_xlabel("wall time [s]")
+    ax.set_ylabel("contact fraction, relative to Tamaas 1024^2")
+    ax.set_title("bisinusoid, 20 % and 60 % contact")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv and argv[0] == "--child":
+        child(argv[1:])
+        return 0
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", nargs="?", default=os.path.join("results", "scaling_3d"), help="output directory")
+    ap.add_argument("--quick", action="store_true", help="two small sizes of each part (a smoke run)")
+    ap.add_argument("--direct-max", type=int, default=45000,
+                    help="no direct solves beyond the first size above this many dofs")
+    args = ap.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    rows = fe_parts(args.quick, args.direct_max) + spectral_aim(args.quick)
+    os.makedirs(args.out, exist_ok=True)
+    write_csv(os.path.join(args.out, "scaling_3d.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
+    plot(rows, os.path.join(args.out, "scaling_3d.png"))
+    for part in ("cell", "macro"):
+        for solver in ("iterative", "direct"):
+            b = exponent(rows, part, solver)
+            if b is not None:
+                log.info("%s, %s: time ~ dofs^%.2f", part, solver, b)
+    log.info("wrote %s", os.path.join(args.out, "scaling_3d.csv"))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
