@@ -37,7 +37,7 @@ and a nonzero shear is rejected.  Coulomb friction is a fixed point of
 Tresca problems, ``G_k = mu p_{k-1}`` (:mod:`ngcontact.laws.penalty`), until
 ``max |p_k - p_{k-1}| <= coulomb_rtol * max p_k`` on ``S_C``.
 
-Exact non-penetration (``CellModel.enforcement = "exact"``, 2D, frictionless;
+Exact non-penetration (``CellModel.enforcement = "exact"``, 2D;
 the rigid limit ``k_n -> infinity`` of the Winkler layer): the normal
 energy is the augmented Lagrangian
 ``(1/(2 k_n)) ([lambda + k_n (J.n - g)]_+^2 - lambda^2)``, integrated with the
@@ -45,7 +45,11 @@ Gauss-Lobatto rule of ``p + 1`` points per segment of ``S_C`` so that the
 constraints sit at the nodes of the trace space, with a multiplier
 ``lambda`` per point held fixed in each Newton solve and updated by Uzawa's
 iteration (:mod:`ngcontact.cell.contact_multiplier`); the pressure of the
-results is the multiplier, and ``k_n`` only sets the speed.
+results is the multiplier, and ``k_n`` only sets the speed.  Tresca
+friction adds its energy at the same points.  Coulomb friction takes the
+threshold ``mu lambda`` from the multiplier held fixed in each Newton solve
+(a Tresca problem), so Uzawa's iteration is the Coulomb fixed point too: it
+stops when neither the multiplier nor, with it, the threshold changes.
 
 Results of a load: :mod:`ngcontact.cell.measures` (contact fraction, means,
 stresses, eq. 34 on the real contact set); effective stiffness (beyond the
@@ -54,8 +58,6 @@ paper): :mod:`ngcontact.cell.stiffness`.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
-from typing import Any
 
 import ngsolve as ng
 import numpy as np
@@ -63,12 +65,11 @@ import numpy as np
 from ngcontact.cell import measures
 from ngcontact.cell.contact_multiplier import ContactMultiplier, solve_exact
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
+from ngcontact.cell.cell_model import CellModel, CellSolution
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.predictor import rigid_continuation, set_start, tangential_load
 from ngcontact.fem import elasticity as _el
-from ngcontact.fem import materials as _mat
 from ngcontact.laws import penalty as _contact
-from ngcontact.laws.penalty import Friction
 from ngcontact.errors import ModelError
 from ngcontact.solvers.coulomb import MIXING_DEPTH, coulomb_fixed_point
 from ngcontact.solvers.linear_solver import LinearSolver
@@ -76,70 +77,6 @@ from ngcontact.solvers.newton import minimize
 from ngcontact.fem.quadrature import sampling_order
 
 log = logging.getLogger(__name__)
-
-
-# ------------------------------------------------------------ descriptions
-@dataclass(frozen=True)
-class CellModel:
-    """Physics of a cell problem (no mesh).
-
-    Attributes
-    ----------
-    rough, counter
-        Elastic laws of the two bodies.
-    k_n
-        Penalty stiffness [stress/length]; with ``enforcement = "exact"``
-        the augmentation parameter of the augmented Lagrangian.
-    gap
-        Initial gap as a CoefficientFunction of the coordinates, or ``None``.
-    friction
-        :class:`Friction` or ``None`` (frictionless).
-    order
-        Polynomial order of the displacements.
-    macro_strain
-        Assemble the macro strain term.
-    interpolate_gap
-        Replace the gap by its interpolant of the displacement order on ``S_C``.
-    contact_bonus_order
-        Extra integration order on ``S_C`` (the penalty has a kink).
-    coulomb_rtol, coulomb_max_iter
-        Stopping rule of the Coulomb fixed point.
-    enforcement
-        ``"penalty"`` (the Winkler layer of eq. 65) or ``"exact"``
-        (non-penetration by an augmented Lagrangian, module docstring).
-    uzawa_rtol, uzawa_max_iter
-        Stopping rule of Uzawa's iteration (:mod:`ngcontact.solvers.uzawa`).
-    """
-
-    rough: _mat.ElasticLaw
-    counter: _mat.ElasticLaw
-    k_n: float
-    gap: ng.CoefficientFunction | None = None
-    friction: Friction | None = None
-    order: int = 2
-    macro_strain: bool = False
-    interpolate_gap: bool = True
-    contact_bonus_order: int = 12
-    coulomb_rtol: float = 1e-8
-    coulomb_max_iter: int = 40
-    enforcement: str = "penalty"
-    uzawa_rtol: float = 1e-10
-    uzawa_max_iter: int = 60
-
-
-@dataclass
-class CellSolution:
-    """Results of one load (plain numbers and arrays)."""
-
-    load: CellLoad
-    results: dict[str, Any]
-    surface: dict[str, np.ndarray]
-    newton: list[dict[str, Any]] = field(default_factory=list)
-    coulomb_iterations: int = 0
-
-    @property
-    def iterations(self) -> int:
-        return sum(h["iterations"] for h in self.newton)
 
 
 class CellProblem:
@@ -196,17 +133,9 @@ class CellProblem:
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
         if start not in ("rigid", "closed"):
             raise ValueError(f"start = {start!r}: must be 'rigid' or 'closed'")
-        if model.enforcement not in ("penalty", "exact"):
-            raise ModelError(f"enforcement = {model.enforcement!r}: must be 'penalty' or 'exact'")
-        if not (model.uzawa_rtol > 0 and model.uzawa_max_iter >= 1):
-            raise ModelError(f"uzawa_rtol = {model.uzawa_rtol!r}, uzawa_max_iter = {model.uzawa_max_iter!r}: "
-                             "must be > 0 and >= 1")
         if model.enforcement == "exact" and cell.dim != 2:
             raise ModelError(f"enforcement = 'exact' in a {cell.dim}D cell: the FE cell enforces exact contact "
                              "in 2D only (node-to-node on segments); use 'penalty' or the spectral cell")
-        if model.enforcement == "exact" and model.friction is not None:
-            raise ModelError(f"enforcement = 'exact' with {model.friction.law} friction: the FE cell enforces exact "
-                             "contact without friction only; use 'penalty' or the spectral cell")
         self.line_search, self.start = line_search, start
         self.cell, self.model = cell, model
         self.mesh = mesh = cell.mesh
@@ -283,6 +212,10 @@ class CellProblem:
             friction, w = m.friction.law, m.friction.w
             if friction == "tresca":
                 threshold = m.friction.G
+            elif lam is not None:
+                # exact: mu lambda of the multiplier Uzawa holds fixed in this Newton solve, so
+                # Uzawa's iteration is the Coulomb fixed point as well (module docstring)
+                threshold = m.friction.mu * lam
             else:
                 self.coulomb_previous = ng.GridFunction(self.X)
                 pc = self.coulomb_previous.components
@@ -349,12 +282,14 @@ class CellProblem:
         """
         before = tangential_load(self)
         self._apply_load(load, first)
+        if first and self.multiplier is not None and self.model.friction is not None:
+            start_multiplier(self, load)
         free = self._freedofs(load)
         # a later load with a tangential change: the rigid continuation (predictor module); its steps count
         predicted = None if first else rigid_continuation(self, free, before)
         histories: list[dict] = [] if predicted is None else [predicted]
         fp = 0
-        if self.model.friction is not None and self.model.friction.law == "coulomb":
+        if self.coulomb_previous is not None:
             first_residual: list[float] = []
             previous = self.coulomb_previous
             assert previous is not None  # built with the Coulomb form in __init__
@@ -378,7 +313,7 @@ class CellProblem:
                 lambda: measures.sample_surface(self, {"p": self.pressure})["p"],
                 rtol=self.model.coulomb_rtol, max_iter=self.model.coulomb_max_iter,
                 state=(lambda: self.gfu.vec.FV().NumPy().copy(), put),
-                depth=MIXING_DEPTH if getattr(self, "multiplier", None) is None else 0)
+                depth=MIXING_DEPTH)
             histories, fp = histories + fixed["newton"], fixed["coulomb_iterations"]
         else:
             histories.append(self._newton(free, self.atol))
@@ -433,6 +368,27 @@ class CellProblem:
     def measure(self, load: CellLoad) -> dict:
         """Results of the current state: :func:`ngcontact.cell.measures.measure`."""
         return measures.measure(self, load)
+
+
+def start_multiplier(problem: CellProblem, load: CellLoad) -> None:
+    """Uzawa's start under friction: the start state's contact pattern carrying the load's pressure.
+
+    With ``lambda = 0`` the Coulomb threshold ``mu lambda`` would leave the
+    tangential translation without stiffness.  The start state's augmented
+    pressure ``k_n [J_n - g]_+`` gives where the contact is; it is scaled to
+    the prescribed mean pressure, since the start state (the rigid predictor)
+    penetrates by what the bodies would yield, far more than ``p / k_n``, and
+    a multiplier that large opens the whole surface in the first solve.
+    """
+    m = problem.multiplier
+    assert m is not None  # exact enforcement
+    lam = np.maximum(m.at_points(problem.augmented_pressure), 0.0)
+    tn = load.traction[problem.dim - 1]
+    if tn is not None and lam.any():
+        m.set_point_values(lam)
+        carried = m.integrate(m.value)
+        lam *= -tn * problem.area / carried
+    m.set_point_values(lam)
 
 
 # ------------------------------------------------------------ discretization

@@ -55,9 +55,10 @@ class ContactSpec:
                        "eq. 34 coefficients in the report)", units="Pa/m", check=positive())
     enforcement: str = param("penalty", doc="penalty: the paper's Winkler layer p = k_n [J.n - g]_+ (eq. 65) "
                              "and Huber-regularized friction; exact: non-penetration, the rigid limit k_n -> infinity: "
-                             "spectral cell with exact friction (w unused), or 2D frictionless FE cell, node-to-node "
-                             "at the Gauss-Lobatto points by an augmented Lagrangian with Uzawa updates (k_n is its "
-                             "augmentation: the speed, not the answer)",
+                             "spectral cell with exact friction (w unused), or 2D FE cell, node-to-node at the "
+                             "Gauss-Lobatto points by an augmented Lagrangian with Uzawa updates (k_n is its "
+                             "augmentation: the speed, not the answer; friction Huber-regularized with w, the "
+                             "Coulomb threshold mu times the multiplier)",
                              choices=ENFORCEMENTS)
     gap: GapSpec = param(GapSpec(), doc="initial gap")
     friction: str = param("none", doc="friction law", choices=FRICTION)
@@ -251,15 +252,11 @@ def check_penalty_ratio(scene: CellScene) -> None:
 
 
 def check_fe_exact(scene: CellScene) -> None:
-    """Exact non-penetration on the FE cell: built for 2D frictionless cells (node-to-node on segments)."""
+    """Exact non-penetration on the FE cell: built for 2D cells (node-to-node on segments)."""
     if scene.geometry.dim != 2:
         raise SceneError("contact.enforcement", "exact", f"the FE cell enforces exact contact in 2D only, not in a "
                          f"{scene.geometry.dim}D cell: set enforcement = 'penalty', or discretization.method = "
                          "'spectral' for a small-slope cell")
-    if scene.contact.friction != "none":
-        raise SceneError("contact.enforcement", "exact", "the FE cell enforces exact contact without friction only, "
-                         f"not with contact.friction = {scene.contact.friction!r}: set enforcement = 'penalty', "
-                         "friction = 'none', or discretization.method = 'spectral' for a small-slope cell")
 
 
 #: Largest number of spectral grid points of a cell (2D: points, 3D: points squared).

@@ -150,15 +150,47 @@ def test_exact_enforcement_is_refused_where_it_is_not_built(tmp_path, capsys):
         CellProblem(cell, CellModel(rough=law, counter=law, k_n=1.0, enforcement="magic"))
     with pytest.raises(ModelError, match="enforcement = 'exact' in a 3D cell: .* 2D only"):
         CellProblem(SimpleNamespace(dim=3), CellModel(rough=law, counter=law, k_n=1.0, enforcement="exact"))
-    with pytest.raises(ModelError, match="without friction only"):
-        CellProblem(cell, CellModel(rough=law, counter=law, k_n=1.0, enforcement="exact",
-                                    friction=Friction(law="tresca", G=1e-3, w=1e-6)))
-    text = SCENE.replace('friction = "none"', 'friction = "tresca"\nG = 1e-3\nw = 1e-6')
+    text = SCENE.replace('profile = "flat"', 'profile = "flat3d"').replace(
+        'gap = { kind = "sinusoid", h = 0.01 }', 'gap = { kind = "constant", value = 0.0 }')
     path = tmp_path / "s.toml"
     path.write_text(text)
     assert cli.main(["check", str(path)]) == 2
     err = capsys.readouterr().err
-    assert "contact.enforcement = 'exact'" in err and "without friction only" in err
+    assert "contact.enforcement = 'exact'" in err and "2D only" in err
+
+
+@pytest.mark.parametrize("friction", [Friction(law="tresca", G=0.4 * 0.5 * PSTAR, w=1e-8),
+                                      Friction(law="coulomb", mu=0.4, w=1e-8)], ids=["tresca", "coulomb"])
+def test_friction_with_exact_contact_is_independent_of_k_n_and_admissible(friction):
+    """Pressure 0.5 p*, then a shear of 0.2 times it (Coulomb: partial slip at the contact edges)."""
+    p, q = 0.5 * PSTAR, 0.1 * PSTAR
+    out = {}
+    for k_factor in (1e2, 1e4):
+        P = _problem(0.05, 2, k_factor, friction=friction)
+        P.solve(cell_load(2, pressure=p), first=True)
+        sol = P.solve(cell_load(2, pressure=p, shear=(q,)))
+        out[k_factor] = (sol.results, P)
+    (a, _), (b, P) = out[1e2], out[1e4]
+    for key in ("contact_fraction", "mean_closure"):
+        assert b[key] == pytest.approx(a[key], rel=1e-7), key
+    assert b["mean_jump"][0] == pytest.approx(a["mean_jump"][0], rel=1e-6)
+    assert abs(b["mean_traction"][0]) == pytest.approx(q, rel=1e-8)
+    # at the nodes: |tau| <= G (Tresca) or mu lambda (Coulomb), and the multiplier is the pressure
+    m = P.multiplier
+    lam = m.point_values()
+    tau = m.at_points(_tangential_traction(P))
+    bound = friction.G if friction.law == "tresca" else friction.mu * lam
+    assert np.all(tau <= bound + 1e-9 * PSTAR)
+    if friction.law == "coulomb":                        # partial slip at the contact edges, stick inside
+        assert np.any((lam > 0) & (tau >= bound - 1e-9 * PSTAR))
+        assert np.any(tau < 0.9 * bound)
+
+
+def _tangential_traction(P):
+    """``|G J_t / max(|J_t|, w)|`` of the state, ``G`` the Tresca threshold or ``mu lambda``."""
+    f = P.model.friction
+    G = f.G if f.law == "tresca" else f.mu * P.multiplier.value
+    return ng.Norm(penalty.friction_traction(P.J, P.n, G, f.w))
 
 
 SCENE = """\
