@@ -47,7 +47,7 @@ log = logging.getLogger("scaling_3d")
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CELL_SIZES = (0.12, 0.08, 0.06, 0.045, 0.035)
-MACRO_SIZES = (0.3, 0.2, 0.14, 0.1, 0.075)
+MACRO_SIZES = (0.3, 0.2, 0.14, 0.1, 0.075, 0.043)
 QUICK_CELL, QUICK_MACRO = (0.16, 0.12), (0.35, 0.3)
 AMPLITUDE, PRESSURES = 0.005, (0.00185, 0.0065)
 SPECTRAL_GRIDS, TAMAAS_GRID = (64, 128, 256, 512), 1024
@@ -173,7 +173,7 @@ def spectral_aim(quick: bool) -> list[dict]:
         t0 = time.perf_counter()
         model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, 1.0], [n, n])
         model.E, model.nu = 1.0 / (2 * (1 - 0.3 ** 2)), 0.0      # one half-space of the pair's E*
-        solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(-gap(n)), 1e-12)
+        solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(-gap(n)), 1e-10)
         solver.max_iter = 100000
         solver.solve(p)
         tr = np.array(model.traction).reshape(n, n)

@@ -93,10 +93,12 @@ class SolverSpec:
                          choices=("sparsecholesky", "umfpack"))
     linear: str = param("auto", doc="Newton's tangent solves (FE cells and macro problems): direct (the "
                         "sparse direct solver of 'inverse'), iterative (conjugate gradients preconditioned by "
-                        "BDDC with a vertex wirebasket), auto (iterative from iterative_from free dofs on); the report "
+                        "BDDC with a vertex wirebasket), auto (3D problems iterative from iterative_from free dofs on, "
+                        "2D direct); the report "
                         "states the choice and the CG iterations", choices=("direct", "iterative", "auto"))
-    iterative_from: int = param(60000, doc="free dofs from which linear = 'auto' solves iteratively (about where "
-                                "BDDC-CG overtakes the sparse factorization in 3D at order 2)", check=at_least(1))
+    iterative_from: int = param(20000, doc="free dofs from which linear = 'auto' solves a 3D problem iteratively "
+                                "(about where BDDC-CG overtakes the sparse factorization at order 2)",
+                                check=at_least(1))
     cg_max_iter: int = param(10000, doc="spectral cell: largest number of constrained CG (frictionless) or "
                              "accelerated proximal gradient (friction) steps per load",
                              check=at_least(1))

@@ -17,16 +17,21 @@ definite on the free dofs.  Two ways:
   ``wb_withedges=False``, so the coarse problem holds the vertex dofs only
   (and the far-face translations, ``NumberSpace`` dofs, which BDDC keeps on
   the wirebasket).  Its setup costs about one assembly, its iterations grow
-  like ``log(p)^2`` and mildly with the mesh; measured on a 3D box of order
-  2: 58 iterations at 64k dofs, 87 at 120k, setup and solve together 2x
-  cheaper than the factorization at 120k and cheaper beyond.  The
+  like ``log(p)^2`` and mildly with the mesh (measured below).  The
   preconditioner is registered with the energy form and rebuilt from each
   step's tangent by the assembly itself.  CG stops at
   ``|r_k| <= rtol |r_0|`` in the preconditioned norm (``rtol = 1e-10``
   by default: Newton's own tolerance, so the steps are as exact as the
   factorization's for the stopping rules downstream).
-* ``"auto"``: iterative from ``threshold`` free dofs on (default
-  ``AUTO_THRESHOLD``, about the crossover measured above), direct below.
+* ``"auto"``: in 3D iterative from ``threshold`` free dofs on (default
+  ``AUTO_THRESHOLD``), direct below; in 2D direct.  Measured with
+  ``scripts/scaling_3d.py`` (2 cores): the 3D bisinusoid cell solves in
+  2.0 s iteratively against 2.5 s directly at 8k dofs, 18.9 s against
+  53.5 s at 39k, 35 s against 126 s at 64k (time ~ N^1.4 against N^1.9); a
+  3D press fit of two tubes 1.5 s against 1.1 s at 15k dofs, 4.9 s against
+  6.9 s at 43k, 13.3 s against 34.9 s at 96k.  In 2D the factorization
+  stays far ahead: a 142k-dof order-3 cell took 51 s directly and over
+  8 minutes with BDDC-CG.
 
 BDDC reads the free dofs from the space; a solve whose free dofs differ
 from the space's (prescribed far-face translations of a cell) sets the
@@ -44,8 +49,8 @@ import ngsolve as ng
 from ngcontact.errors import ConvergenceError
 
 POLICIES = ("direct", "iterative", "auto")
-#: free dofs from which "auto" solves iteratively (BDDC-CG against sparse Cholesky, 3D order 2)
-AUTO_THRESHOLD = 60_000
+#: free dofs from which "auto" solves 3D problems iteratively (BDDC-CG against sparse Cholesky, order 2)
+AUTO_THRESHOLD = 20_000
 
 
 @dataclass
@@ -77,10 +82,10 @@ class LinearSolver:
         if self.policy not in POLICIES:
             raise ValueError(f"policy = {self.policy!r}: must be one of {POLICIES}")
 
-    def method(self, freedofs) -> str:
-        """``"direct"`` or ``"iterative"`` for a system with these free dofs."""
+    def method(self, freedofs, dim: int = 3) -> str:
+        """``"direct"`` or ``"iterative"`` for a system with these free dofs on a mesh of dimension ``dim``."""
         if self.policy == "auto":
-            return "iterative" if freedofs.NumSet() >= self.threshold else "direct"
+            return "iterative" if dim == 3 and freedofs.NumSet() >= self.threshold else "direct"
         return self.policy
 
     def register(self, form: ng.BilinearForm, freedofs) -> None:
@@ -90,7 +95,7 @@ class LinearSolver:
         form (``AssembleLinearization`` included), on the space's free dofs,
         which are set to ``freedofs`` here.
         """
-        if self.method(freedofs) != "iterative":
+        if self.method(freedofs, form.space.mesh.dim) != "iterative":
             return
         match_free_dofs(form.space, freedofs)
         if id(form) not in self._pre:
@@ -98,7 +103,7 @@ class LinearSolver:
 
     def prepare(self, form: ng.BilinearForm, freedofs) -> "TangentSolve":
         """The solve with the current (assembled) ``form.mat`` on ``freedofs``: ``apply(rhs, out)``."""
-        if self.method(freedofs) == "direct":
+        if self.method(freedofs, form.space.mesh.dim) == "direct":
             return TangentSolve(self, form.mat.Inverse(freedofs, inverse=self.inverse), counted=False)
         pre = self._pre.get(id(form))
         if pre is None:

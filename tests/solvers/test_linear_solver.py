@@ -64,14 +64,13 @@ def test_a_3d_cell_solved_iteratively_equals_the_direct_solve():
     assert np.linalg.norm(ub - ua) <= 1e-7 * np.linalg.norm(ua)
 
 
-CELL = os.path.join(ROOT, "geometries", "cells", "sinusoid.toml")
+CELL = os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml")
 
 
 def _cell_report(tmp_path, name, solver):
-    text = open(CELL).read().replace("shear = [0.0, 0.001, 0.002, 0.003]", "shear = [0.0, 0.001]")
-    text = text.replace("[solver]\n", "[solver]\n" + solver)
+    text = open(CELL).read().replace("maxh = 0.4\ninterface_maxh = 0.12", "maxh = 0.6\ninterface_maxh = 0.25")
     path = tmp_path / f"{name}.toml"
-    path.write_text(text)
+    path.write_text(text + "\n[solver]\n" + solver)
     assert cli.main(["run", str(path), "--out", str(tmp_path / name), "--quiet"]) == 0
     return json.loads((tmp_path / name / "report.json").read_text())
 
@@ -86,6 +85,13 @@ def test_the_policy_goes_iterative_above_its_threshold_and_the_report_says_so(tm
     for a, b in zip(below["results"]["loads"], above["results"]["loads"]):
         assert b["contact_fraction"] == pytest.approx(a["contact_fraction"], rel=1e-8)
         assert b["mean_closure"] == pytest.approx(a["mean_closure"], rel=1e-7)
+
+
+def test_auto_solves_2d_problems_directly():
+    mesh = ng.Mesh(ng.unit_square.GenerateMesh(maxh=0.5))
+    free = ng.H1(mesh, order=1).FreeDofs()
+    assert LinearSolver("auto", threshold=1).method(free, dim=2) == "direct"
+    assert LinearSolver("auto", threshold=1).method(free, dim=3) == "iterative"
 
 
 def test_the_space_takes_the_free_dofs_of_the_solve():
