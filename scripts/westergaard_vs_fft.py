@@ -22,9 +22,11 @@ This package, FE: the FE cell of :class:`ngcontact.cell.cell_problem.CellProblem
 (bodies 2 periods deep, so that their finite depth changes the half-space
 answer by less than 1e-10) over a ladder of orders, interface mesh sizes and
 penalties, on fixed meshes and on meshes graded towards the contact edges to
-a tolerance (``discretization.tolerance``); the contact fraction is the
+a tolerance (``discretization.tolerance``), with the penalty and with exact
+contact (``contact.enforcement = "exact"``: node-to-node, the pressure the
+multiplier); the contact fraction is the
 package's own measure and the pressure is the penalty pressure at the
-contact term's quadrature.  The penalty is part of the package's model (the
+contact term's quadrature (exact: the multiplier's interpolant).  The penalty is part of the package's model (the
 paper's Winkler layer): its own shift of the answer is in the error.
 
 The peer: Tamaas (the ``bench`` extra, ``pip install ".[bench]"``), the
@@ -71,11 +73,14 @@ log = logging.getLogger("westergaard_vs_fft")
 
 H_GAP, NU, DEPTH = 0.01, 0.3, 2.0
 RATIOS = (0.05, 0.2, 0.5, 0.8)
-#: (order, interface_maxh, k_n / E, tolerance or None) of this package's ladder: fixed meshes, then
-#: meshes graded towards the contact edges to a tolerance
-LADDER = ((2, 0.02, 1e3, None), (3, 0.01, 1e3, None), (3, 0.005, 1e3, None), (4, 0.005, 1e4, None),
-          (2, 0.02, 1e4, 1e-3), (3, 0.02, 1e6, 1e-3), (3, 0.02, 1e6, 1e-4), (3, 0.02, 1e6, 3e-5))
-QUICK_LADDER = (LADDER[0], LADDER[4])
+#: (order, interface_maxh, k_n / E, tolerance or None, enforcement) of this package's ladder: fixed
+#: meshes, then meshes graded towards the contact edges to a tolerance; the penalty, then exact contact
+#: (k_n its augmentation)
+LADDER = ((2, 0.02, 1e3, None, "penalty"), (3, 0.01, 1e3, None, "penalty"), (3, 0.005, 1e3, None, "penalty"),
+          (4, 0.005, 1e4, None, "penalty"), (2, 0.02, 1e4, 1e-3, "penalty"), (3, 0.02, 1e6, 1e-3, "penalty"),
+          (3, 0.02, 1e6, 1e-4, "penalty"), (3, 0.02, 1e6, 3e-5, "penalty"),
+          (3, 0.01, 1e5, None, "exact"), (3, 0.005, 1e5, None, "exact"), (3, 0.02, 1e5, 1e-4, "exact"))
+QUICK_LADDER = (LADDER[0], LADDER[4], LADDER[8])
 FFT_START, FFT_TARGET, FFT_BUDGET = 2 ** 10, 1e-5, 60.0
 #: grids of the spectral cell (exact contact, layers DEPTH thick)
 SPECTRAL_GRIDS = tuple(2 ** k for k in range(10, 17))
@@ -92,7 +97,7 @@ def _exact_pressure_cf(p: float, pstar: float):
     return 2.0 * p * ng.sqrt(ng.cos(math.pi * ng.x) ** 2) * ng.sqrt(ng.IfPos(sa - s, sa - s, 0.0)) / sa
 
 
-def ours(order: int, ih: float, kn: float, tolerance: float | None = None) -> dict:
+def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enforcement: str = "penalty") -> dict:
     """The four loads on FE cells; errors and wall time.
 
     Without ``tolerance``: one mesh, the loads continued from one another.
@@ -101,7 +106,8 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None) -> di
     """
     pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H_GAP, 1.0)
     law = isotropic(1.0, NU)
-    model = CellModel(rough=law, counter=law, k_n=kn, gap=2 * H_GAP * ng.sin(math.pi * ng.x) ** 2, order=order)
+    model = CellModel(rough=law, counter=law, k_n=kn, gap=2 * H_GAP * ng.sin(math.pi * ng.x) ** 2, order=order,
+                      enforcement=enforcement)
 
     def make_problem(vertices, p):
         cell = graded_flat_cell(1.0, DEPTH, DEPTH, maxh=0.3, interface_maxh=ih, order=p, vertices=vertices)
@@ -132,7 +138,8 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None) -> di
     setting = f"order {order}, interface_maxh {ih:g}, k_n {kn:g} E"
     if tolerance is not None:
         setting += f", graded to tolerance {tolerance:g}"
-    return {"solver": "ngcontact", "setting": setting, "ndof": ndof, "worst_fraction_error": ferr,
+    return {"solver": "ngcontact" if enforcement == "penalty" else "ngcontact exact", "setting": setting,
+            "ndof": ndof, "worst_fraction_error": ferr,
             "worst_pressure_error": max(pressures), "seconds": secs,
             "iterations_per_load": " ".join(str(s) for s in steps)}
 
@@ -224,9 +231,9 @@ def fft(n: int) -> dict:
 
 def run(quick: bool = False) -> list[dict]:
     rows = []
-    for order, ih, kn, tol in (QUICK_LADDER if quick else LADDER):
+    for order, ih, kn, tol, enforcement in (QUICK_LADDER if quick else LADDER):
         try:
-            rows.append(ours(order, ih, kn, tol))
+            rows.append(ours(order, ih, kn, tol, enforcement))
         except ConvergenceError as exc:  # a tolerance out of reach is a figure too, not a crash
             log.warning("ngcontact order %d, k_n %g, tolerance %s: %s", order, kn, tol, exc)
             continue
@@ -272,7 +279,9 @@ def plot(rows: list[dict], path: str) -> None:
                               ("contact fraction", "pressure (relative L2)")):
         series = (("ngcontact, fixed meshes", "o-",
                    lambda r: r["solver"] == "ngcontact" and "graded" not in r["setting"]),
-                  ("ngcontact, graded to a tolerance", "D-", lambda r: "graded" in r["setting"]),
+                  ("ngcontact, graded to a tolerance", "D-",
+                   lambda r: r["solver"] == "ngcontact" and "graded" in r["setting"]),
+                  ("ngcontact, FE exact contact", "v-", lambda r: r["solver"] == "ngcontact exact"),
                   ("ngcontact, spectral cell (exact)", "^-", lambda r: r["solver"] == "ngcontact spectral"),
                   ("tamaas (FFT)", "s--", lambda r: r["solver"] == "tamaas"))
         for label, style, take in series:
@@ -303,7 +312,8 @@ def main(argv=None) -> int:
     write_csv(os.path.join(args.out, "westergaard_vs_fft.csv"), list(KEYS), [[r[k] for k in KEYS] for r in rows])
     plot(rows, os.path.join(args.out, "westergaard_vs_fft.png"))
     for target in (1e-4, 1e-5, 1e-6):
-        times = {name: time_at(rows, name, target) for name in ("ngcontact", "ngcontact spectral", "tamaas")}
+        times = {name: time_at(rows, name, target)
+                 for name in ("ngcontact", "ngcontact exact", "ngcontact spectral", "tamaas")}
         log.info("time to a worst fraction error <= %g: %s", target, ", ".join(
             f"{name} {t:.2f} s" if t is not None else f"{name} not reached" for name, t in times.items()))
     log.info("wrote %s", os.path.join(args.out, "westergaard_vs_fft.csv"))
