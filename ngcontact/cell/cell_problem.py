@@ -66,6 +66,7 @@ from ngcontact.cell import measures
 from ngcontact.cell.contact_multiplier import ContactMultiplier, solve_exact
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
 from ngcontact.cell.cell_model import CellModel, CellSolution
+from ngcontact.cell.cell_energy import cell_energy, macro_strain_cf
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.predictor import rigid_continuation, set_start, tangential_load
 from ngcontact.fem import elasticity as _el
@@ -161,14 +162,13 @@ class CellProblem:
         nE = 1 if dim == 2 else 3
         self.strain_params = [ng.Parameter(0.0) for _ in range(nE)]
         self.tangential_free = _tangential_determinate(mesh, self.n, dim, model)
-        self.coulomb_previous: ng.GridFunction | None = None
         self.multiplier = (ContactMultiplier(mesh, model.order)
                            if model.enforcement == "exact" else None)
         # exact: the augmentation k_n as a Parameter (the constrained tangent extrapolates in it)
         self.augmentation = ng.Parameter(model.k_n)
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
-        self.form = self._energy(ur, uc, U, trial)
+        self.form, self.coulomb_previous = cell_energy(self, ur, uc, U)
         # the state as CoefficientFunctions (for results and tests)
         comps = self.gfu.components
         self.U = ng.CF(tuple(comps[2:]))
@@ -185,51 +185,10 @@ class CellProblem:
         self.slip = _contact.tangential_slip(self.J, self.n)
 
     # -------------------------------------------------------------- energy
-    def _macro_strain_cf(self):
-        e = self.strain_params
-        if self.dim == 2:
-            return ng.CF((e[0], 0, 0, 0, 0, 0, 0, 0, 0), dims=(3, 3))
-        return ng.CF((e[0], e[2], 0, e[2], e[1], 0, 0, 0, 0), dims=(3, 3))
-
     def body_strain(self, u):
         """Total strain of a body: fluctuation plus the macro strain (if assembled)."""
         eps = _el.strain(u, self.setting)
-        return eps + self._macro_strain_cf() if self.model.macro_strain else eps
-
-    def _energy(self, ur, uc, U, trial):
-        m, mesh = self.model, self.mesh
-        # UMFPACK reads only one triangle of a symmetric-storage matrix: full storage for it
-        form = ng.BilinearForm(self.X, symmetric=True,
-                               symmetric_storage=self.inverse == "sparsecholesky")
-        for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
-            eps = self.body_strain(u)
-            form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
-                                 * ng.dx(definedon=mesh.Materials(name)))
-        J = ur - uc - U
-        lam = None if self.multiplier is None else self.multiplier.value
-        friction = threshold = w = None
-        if m.friction is not None:
-            friction, w = m.friction.law, m.friction.w
-            if friction == "tresca":
-                threshold = m.friction.G
-            elif lam is not None:
-                # exact: mu lambda of the multiplier Uzawa holds fixed in this Newton solve, so
-                # Uzawa's iteration is the Coulomb fixed point as well (module docstring)
-                threshold = m.friction.mu * lam
-            else:
-                self.coulomb_previous = ng.GridFunction(self.X)
-                pc = self.coulomb_previous.components
-                J_prev = pc[0] - pc[1] - ng.CF(tuple(pc[2:]))
-                threshold = _contact.coulomb_threshold(J_prev, self.n, m.k_n, m.friction.mu, self.gap)
-        k = m.k_n if lam is None else self.augmentation
-        psi = _contact.interface_energy(J, self.n, k_n=k, gap=self.gap, friction=friction,
-                                        w=w, threshold=threshold, multiplier=lam)
-        ds = (ng.ds("contact", bonus_intorder=m.contact_bonus_order) if self.multiplier is None
-              else self.multiplier.ds)
-        form += ng.Variation(psi * ds)
-        t = ng.CF(tuple(self.traction))
-        form += ng.Variation(-ng.InnerProduct(t, U) * ng.ds("top"))
-        return form
+        return eps + macro_strain_cf(self.strain_params, self.dim) if self.model.macro_strain else eps
 
     @property
     def ndof(self) -> int:

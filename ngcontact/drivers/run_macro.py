@@ -254,6 +254,17 @@ def run(scene, clock) -> Outcome:
             plots["interface"] = lambda path, prof=prof: figures.macro_interface(path, prof)
             samples = field_samples(sol, fields)
             plots["stress"] = lambda path, d=samples: figures.macro_fields(path, **d)
+        else:
+            surf = MM.interface_surface(sol)
+            results["contact_area"] = surf.pop("contact_area")
+            results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in surf.items()}
+            results["status_counts"] = dict(Counter(surf["status"]))
+            for key in ("pressure", "shear"):
+                k = int(np.argmax(surf[key]))
+                maxima[key] = {name: (v[k] if name == "status" else float(v[k])) for name, v in surf.items()}
+            header = list(surf)
+            tables["interface"] = (header, list(zip(*[surf[h] for h in header])))
+            plots["interface"] = lambda path, sf=surf: figures.macro_interface_3d(path, sf)
         results["maxima"] = maxima
         results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
         if two_scale is not None:

@@ -8,7 +8,8 @@ are compression positive.
 
 Stress fields (radial / axial / hoop in axisymmetry), von Mises stress and
 strain, their extrema with locations, the profile along the interface (arc
-length, pressure, shear, jumps, status open / stick / slip), the force
+length, pressure, shear, jumps, status open / stick / slip; in 3D the same
+on the interface surface), the force
 transmitted through the interface and the detachment points.
 """
 from __future__ import annotations
@@ -235,6 +236,40 @@ def interface_profile(sol: MacroSolution, points_per_element: int = 5) -> dict:
     names = COMPONENTS[p.setting]
     return {"s": s, names[0]: rows[:, 0], names[1]: rows[:, 1], "pressure": press, "shear": shear,
             "jump_n": jn, "jump_t": jt, "status": status}
+
+
+def interface_surface(sol: MacroSolution) -> dict:
+    """Values on the interface surface of a 3D solution, the counterpart of :func:`interface_profile`.
+
+    Sampled on each boundary triangle of ``S_0`` at its three vertices, its
+    edge midpoints and its centroid (a shared vertex once per triangle).
+    Returns arrays ``x, y, z``, ``pressure`` (compression positive),
+    ``shear_1``, ``shear_2`` (tractions along the local tangents ``t1, t2``
+    of :mod:`ngcontact.laws.local_frame`), ``shear`` (their magnitude),
+    ``jump_n``, ``jump_t1``, ``jump_t2``, and ``status`` as in the profile,
+    and ``contact_area``: the area of ``S_0`` where ``p > 0`` over its whole
+    area, integrated with the energy's quadrature.
+    """
+    p = sol.problem
+    mesh = p.mesh
+    if mesh.dim != 3:
+        raise ModelError("an interface surface needs a 3D mesh")
+    pts = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (0.0, 0.5), (1 / 3, 1 / 3)]
+    rule = ng.IntegrationRule(pts, [0.0] * len(pts))
+    mips = mesh.MapToAllElements(rule, mesh.Boundaries(p.interface))
+    tau = interface_tractions(sol)
+    a = sol.local_jump
+    cf = ng.CF((ng.x, ng.y, ng.z, tau[0], tau[1], tau[2], a[0], a[1], a[2]))
+    v = np.asarray(cf(mips)).reshape(-1, 9)
+    shear = np.hypot(v[:, 4], v[:, 5])
+    slip = np.hypot(v[:, 7], v[:, 8])
+    on = mesh.Boundaries(p.interface)
+    order = energy_order(p.order)
+    area = ng.Integrate(ng.CF(1.0), mesh, ng.BND, definedon=on)
+    pressed = ng.Integrate(ng.IfPos(tau[0], 1.0, 0.0), mesh, ng.BND, definedon=on, order=order)
+    return {"x": v[:, 0], "y": v[:, 1], "z": v[:, 2], "pressure": v[:, 3], "shear_1": v[:, 4],
+            "shear_2": v[:, 5], "shear": shear, "jump_n": v[:, 6], "jump_t1": v[:, 7], "jump_t2": v[:, 8],
+            "status": _status(sol, v[:, 3], slip), "contact_area": float(pressed / area)}
 
 
 def _status(sol: MacroSolution, press, jt) -> list:

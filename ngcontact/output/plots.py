@@ -124,6 +124,35 @@ def macro_interface(path: str, prof: dict) -> None:
     plt.close(fig)
 
 
+def macro_interface_3d(path: str, surf: dict) -> None:
+    """Pressure and shear on a 3D interface surface, seen from two sides, and the status.
+
+    ``surf``: arrays ``x, y, z``, ``pressure``, ``shear`` and a list ``status``
+    (:func:`ngcontact.macro.macro_measures.interface_surface`).
+    """
+    plt = _pyplot()
+    fig = plt.figure(figsize=(13, 4.2))
+    x, y, z = (np.asarray(surf[c]) * 1e3 for c in ("x", "y", "z"))
+    for i, (key, label) in enumerate((("pressure", "pressure p [MPa]"), ("shear", "|shear| [MPa]"))):
+        ax = fig.add_subplot(1, 3, i + 1, projection="3d")
+        sc = ax.scatter(x, y, z, c=np.asarray(surf[key]) / 1e6, s=3, cmap="viridis")
+        fig.colorbar(sc, ax=ax, shrink=0.7, label=label)
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+        ax.set_zlabel("z [mm]")
+    ax = fig.add_subplot(1, 3, 3, projection="3d")
+    colors = {"open": "tab:gray", "stick": "tab:blue", "slip": "tab:red"}
+    for st, c in colors.items():
+        sel = np.array([s == st for s in surf["status"]])
+        if sel.any():
+            ax.scatter(x[sel], y[sel], z[sel], s=3, c=c, label=st)
+    ax.legend()
+    ax.set_title("status")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def macro_fields(path: str, x, y, triangles, values: dict, axisymmetric: bool) -> None:
     """Four panels of paper Fig. 10: radial / axial stress, von Mises stress and strain.
 

@@ -1,0 +1,104 @@
+"""A 3D macro scene reports its interface surface as a 2D scene reports its interface profile."""
+import json
+
+import numpy as np
+import pytest
+
+from ngcontact import cli
+
+SCENE = """\
+kind = "macro"
+title = "3D press fit of two tubes, a quarter"
+
+[materials.steel]
+E = 210e9
+nu = 0.3
+
+[materials.bone]
+E = 17e9
+nu = 0.3
+
+[bodies]
+rough = "steel"
+counter = "bone"
+
+[geometry]
+shape = "coaxial"
+setting = "3d"
+
+[geometry.dimensions]
+a = 0.004
+b = 0.008
+c = 0.014
+height = 0.01
+
+[interface]
+law = "linear"
+kn = 1e13
+kt = 1e12
+gap = -2e-6
+
+[[supports]]
+boundary = "bottom"
+
+[[supports]]
+boundary = "sym_x"
+components = ["x"]
+
+[[supports]]
+boundary = "sym_y"
+components = ["y"]
+
+[[loads]]
+boundary = "top"
+pressure = 5e6
+
+[discretization]
+order = 2
+maxh = 0.004
+"""
+
+
+def test_a_3d_macro_scene_reports_its_interface_surface(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(SCENE)
+    out = tmp_path / "o"
+    assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 0
+    rep = json.loads((out / "report.json").read_text())
+    res = rep["results"]
+    surf = res["interface"]
+    assert {"x", "y", "z", "pressure", "shear", "shear_1", "shear_2", "jump_n", "jump_t1", "jump_t2",
+            "status"} <= set(surf)
+    r = np.hypot(surf["x"], surf["y"])
+    assert np.allclose(r, 0.008, rtol=1e-3)                        # the samples lie on the interface r = b
+    p = np.asarray(surf["pressure"])
+    assert np.all(np.isfinite(p)) and p.max() > 0
+    assert 0.0 < res["contact_area"] <= 1.0
+    assert sum(res["status_counts"].values()) == len(p)
+    assert res["maxima"]["pressure"]["pressure"] == pytest.approx(p.max())
+    # the integrated area agrees with the share of samples in contact (the ends of the fit open)
+    assert res["contact_area"] == pytest.approx(np.mean(p > 0), abs=0.05)
+    assert (out / "interface.csv").stat().st_size > 0 and (out / "interface.png").stat().st_size > 0
+    # the same press fit in axisymmetry: the mean pressure over the middle of the fit (away from the ends,
+    # where the pressure is singular) agrees within the discretization error, which falls under refinement
+    axi = SCENE.replace('setting = "3d"', 'setting = "axisymmetric"').replace(
+        '[[supports]]\nboundary = "sym_x"\ncomponents = ["x"]\n\n[[supports]]\nboundary = "sym_y"\n'
+        'components = ["y"]\n\n', "")
+    prof = _interface(tmp_path, "axi", axi)
+    order = np.argsort(prof["z"])
+    band = np.linspace(0.002, 0.008, 601)
+    p_axi = np.interp(band, np.asarray(prof["z"])[order], np.asarray(prof["pressure"])[order]).mean()
+    errors = []
+    for maxh in ("0.004", "0.0028"):
+        s3 = _interface(tmp_path, f"h{maxh}", SCENE.replace("maxh = 0.004", f"maxh = {maxh}"))
+        z, p3 = np.asarray(s3["z"]), np.asarray(s3["pressure"])
+        mid = (z > 0.002) & (z < 0.008)
+        errors.append(abs(p3[mid].mean() / p_axi - 1))
+    assert errors[1] < errors[0] and errors[1] < 0.04, errors
+
+
+def _interface(tmp_path, name, text):
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / name), "--quiet"]) == 0
+    return json.loads((tmp_path / name / "report.json").read_text())["results"]["interface"]
