@@ -13,10 +13,14 @@ definite on the free dofs.  Two ways:
   8 s at 8k dofs, 508 s at 83k dofs for a solve of 11 Newton steps).
 * ``"iterative"``: conjugate gradients preconditioned by NGSolve's BDDC
   (balancing domain decomposition by constraints, one subdomain per element)
-  with a vertex-only wirebasket: the spaces are built with
-  ``wb_withedges=False``, so the coarse problem holds the vertex dofs only
-  (and the far-face translations, ``NumberSpace`` dofs, which BDDC keeps on
-  the wirebasket).  Its setup costs about one assembly, its iterations grow
+  with a vertex-only wirebasket: the body spaces mark their edge dofs as
+  interface dofs (:func:`ngcontact.fem.elasticity.vertex_wirebasket`, what
+  ``wb_withedges=False`` does for ``H1``), so the coarse problem holds the
+  vertex dofs, the far-face translations (``NumberSpace`` dofs) and the dofs
+  of the contact surface (:func:`ngcontact.fem.elasticity.surface_wirebasket`:
+  a contact boundary element's own matrix is singular, and BDDC eliminates
+  each element's interface dofs with it).  Its setup costs about one
+  assembly, its iterations grow
   like ``log(p)^2`` and mildly with the mesh (measured below).  The
   preconditioner is registered with the energy form and rebuilt from each
   step's tangent by the assembly itself.  CG stops at
@@ -26,10 +30,10 @@ definite on the free dofs.  Two ways:
 * ``"auto"``: in 3D iterative from ``threshold`` free dofs on (default
   ``AUTO_THRESHOLD``), direct below; in 2D direct.  Measured with
   ``scripts/scaling_3d.py`` (2 cores): the 3D bisinusoid cell solves in
-  2.0 s iteratively against 2.5 s directly at 8k dofs, 18.9 s against
-  53.5 s at 39k, 35 s against 126 s at 64k (time ~ N^1.4 against N^1.9); a
-  3D press fit of two tubes 1.5 s against 1.1 s at 15k dofs, 4.9 s against
-  6.9 s at 43k, 13.3 s against 34.9 s at 96k.  In 2D the factorization
+  2.1 s iteratively against 2.6 s directly at 8k dofs, 20 s against 54 s
+  at 39k, 34 s against 145 s at 64k (time ~ N^1.4 against N^1.9); a 3D
+  press fit of two tubes 2.1 s against 1.3 s at 15k dofs, 7.0 s against
+  8.3 s at 43k, 15 s against 43 s at 96k, 114 s at 525k.  In 2D the factorization
   stays far ahead: a 142k-dof order-3 cell took 51 s directly and over
   8 minutes with BDDC-CG.
 
