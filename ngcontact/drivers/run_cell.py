@@ -89,8 +89,9 @@ def run_spectral(scene, clock) -> Outcome:
             sols = cell.sweep(cell_loads(scene))
             estimates = [None] * len(sols)
         else:
-            refined = sweep_to_tolerance(lambda n: spectral_cell(scene, grid=n), cell_loads(scene), tolerance,
-                                         cell.grid, cell.dim, MAX_SPECTRAL_POINTS)
+            first = cell                   # the first level is the scene's own grid: built already
+            refined = sweep_to_tolerance(lambda n: first if n == first.grid else spectral_cell(scene, grid=n),
+                                         cell_loads(scene), tolerance, cell.grid, cell.dim, MAX_SPECTRAL_POINTS)
             cell, sols = refined.cell, refined.solutions
             estimates = list(refined.estimates)
             results["method"].update(grid=cell.grid, points=cell.points, refinement=refined.history)

@@ -119,9 +119,9 @@ def surface_wirebasket(V, mesh, boundaries: str) -> None:
     traces alone and is singular (zero where the contact is open), so its
     dofs must stay in the coarse problem."""
     wirebasket = ng.COUPLING_TYPE.WIREBASKET_DOF
-    region = mesh.Boundaries(boundaries)
+    mask = mesh.Boundaries(boundaries).Mask()
     for el in mesh.Elements(ng.BND):
-        if region.Mask()[el.index]:
+        if mask[el.index]:
             for d in V.GetDofNrs(el):
                 if d >= 0:
                     V.SetCouplingType(d, wirebasket)
