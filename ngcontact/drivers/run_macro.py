@@ -195,7 +195,8 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
 def solve_scene(scene, problem: M.MacroProblem) -> M.MacroSolution:
     s = scene.solver
     return M.solve(problem, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
-                   coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter, linear=linear_solver(scene))
+                   coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter, linear=linear_solver(scene),
+                   coulomb=s.coulomb)
 
 
 def checked_equilibrium(sol: M.MacroSolution) -> dict:
@@ -285,7 +286,7 @@ def run(scene, clock) -> Outcome:
     newton = sol.history["newton"]
     solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],
               "linear_solve_only": sol.history["quadratic"],
-              "coulomb_changes": sol.history["coulomb_changes"], "solves": newton,
+              "coulomb": sol.history["coulomb"], "coulomb_changes": sol.history["coulomb_changes"], "solves": newton,
               "linear": sol.history["linear"]}
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
 

@@ -145,7 +145,8 @@ def solve_homogenized(scene, flat, law: il.InterfaceLaw) -> M.MacroSolution:
     """:func:`ngcontact.macro.macro_problem.solve` with the scene's solver settings."""
     s = scene.solver
     return M.solve(homogenized_problem(scene, flat, law), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
-                   inverse=s.inverse, coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter)
+                   inverse=s.inverse, coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter,
+                   coulomb=s.coulomb)
 
 
 def mean_interface_traction(sol: M.MacroSolution) -> np.ndarray:

@@ -25,16 +25,27 @@ Solution strategy:
   line search (:func:`ngcontact.solvers.newton.minimize`);
 * every nonlinear law starts from one linear solve of its quadratic
   surrogate: the normal law with every direction closed and, under friction,
-  the tangential jump bonded by a spring as stiff as the normal law (so no
-  body floats at the first Newton step);
-* Coulomb friction ``G = mu0 [p]_+ + G0``: a fixed point on the pressure.
-  It starts from that bonded state, then repeats Newton solves
+  the tangential jump bonded by a spring as stiff as the normal law where
+  the bodies would float without it (:func:`start_stiffness`), so that no
+  body floats at the first Newton step;
+* Coulomb friction ``G = mu0 [p]_+ + G0`` (``coulomb = "newton"``, the
+  default): Newton on the coupled equations, whose friction threshold is
+  the current pressure's (no energy exists; the residual is the gradient of
+  the frictionless energy plus the friction's virtual work, and its
+  Jacobian is not symmetric: :mod:`ngcontact.solvers.semismooth_newton`).
+  Where Newton fails from the start value, continuation in the Huber width
+  (:mod:`ngcontact.solvers.continuation`) from the largest slip of the
+  start value down to the scene's width.  Measured on the femur / hip-stem
+  scene and 23 variants of it (loads 0.1 to 30 MPa, interference 1 to
+  200 um, line-to-line, clearances 1 to 50 um, mu 0.1 to 1, widths 1e-5 to
+  1e-8 m, orders 2 to 4): all converge, 2 to 26 Newton steps, equilibrium
+  to 1e-11 or better; the fixed point below cycled on five of them;
+* ``coulomb = "fixed_point"`` (the paper's Sec. 2): repeated Newton solves
   with ``G`` evaluated at the previous solution's pressure
   (:func:`ngcontact.solvers.coulomb.coulomb_fixed_point`, whose stopping
-  rule is that of every scale); each pass stops at ``rtol`` times the first residual of the
-  bonded start.  The fixed point converges to a solution of the regularized
-  Coulomb problem; no energy of the coupled problem exists, so no coupled
-  Newton is attempted.
+  rule is that of every scale); each pass stops at ``rtol`` times the first
+  residual of the start.  Same solution where both converge (1e-9 on the
+  femur scene).
 
 Post-processing (stress fields, extrema, the interface profile and
 resultant, detachment points) is in :mod:`ngcontact.macro.macro_measures`.
@@ -59,7 +70,10 @@ from ngcontact.fem.sampling import boundary_values
 from ngcontact.solvers.coulomb import coulomb_fixed_point
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
-from ngcontact.fem.rigid_modes import check_rigid_modes
+from ngcontact.fem.rigid_modes import check_rigid_modes, free_rigid_modes
+from ngcontact.solvers.continuation import INTERMEDIATE_RTOL, ladder
+from ngcontact.solvers.semismooth_newton import solve_equations
+from ngcontact.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
 
@@ -146,36 +160,53 @@ def gap_cf(gap):
     return ng.CF(float(gap)) if isinstance(gap, (int, float)) else gap
 
 
-def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float | None = None):
+def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float | None = None,
+          coupled: bool = False):
     """Energy of the macro problem as a symmetric ``BilinearForm`` of ``Variation`` terms.
 
     With ``start_stiffness`` the interface energy is the quadratic start
     surrogate: the normal law with everything closed plus, when the law has
-    friction, a tangential spring of that stiffness (tangentially bonded).
+    friction, a tangential spring of that stiffness (tangentially bonded);
+    ``start_stiffness = 0`` leaves the tangential jump free.
+
+    With ``coupled`` (Coulomb friction) the form is the residual of the
+    coupled equations instead (:mod:`ngcontact.solvers.semismooth_newton`):
+    the energy without friction plus the virtual work of the friction
+    traction whose threshold ``G = mu [p(u)]_+ + G0`` is the current
+    pressure's; not symmetric.
     """
     mesh, setting = problem.mesh, problem.setting
     w = elasticity.weight(setting)
     ur, uc = fes.TrialFunction()
-    form = ng.BilinearForm(fes, symmetric=True)
+    form = ng.BilinearForm(fes, symmetric=not coupled)
     elasticity.add_elastic_energy(form, mesh, {problem.rough: problem.materials[problem.rough],
                                                problem.counter: problem.materials[problem.counter]},
                                   {problem.rough: ur, problem.counter: uc}, setting)
     a = _local(frame, ur.Trace() - uc.Trace())
     g0 = gap_cf(problem.gap)
     law = problem.law
+    ds = ng.ds(definedon=mesh.Boundaries(problem.interface))
     if start_stiffness is not None:
         W = ie.normal_energy(law.normal, a, g0, closed=True)
-        if law.friction is not None:
+        if law.friction is not None and start_stiffness > 0:
             W = W + 0.5 * start_stiffness * sum(t * t for t in a[1:])
+    elif coupled and law.friction is not None:
+        W = ie.normal_energy(law.normal, a, g0)
+        G = ie.threshold(law.friction, ie.pressure(law.normal, a, g0))
+        vr, vc = fes.TestFunction()
+        b = _local(frame, vr.Trace() - vc.Trace())
+        work = sum(f * bi for f, bi in zip(ie.friction_traction(law.friction, a, G)[1:], b[1:]))
+        form += work * w * ds
     else:
         W = ie.energy(law, a, g0, G)
-    form += ng.Variation(W * w * ng.ds(definedon=mesh.Boundaries(problem.interface)))
+    form += ng.Variation(W * w * ds)
     return two_body.add_load_potential(form, mesh, problem.loads, (ur, uc), w)
 
 
 def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
           inverse: str = "sparsecholesky", coulomb_rtol: float = 1e-8,
-          coulomb_max_iter: int = 40, linear: LinearSolver | None = None) -> MacroSolution:
+          coulomb_max_iter: int = 40, linear: LinearSolver | None = None,
+          coulomb: str = "newton") -> MacroSolution:
     """Solve the macro problem.
 
     Parameters
@@ -184,6 +215,10 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
         The description.
     rtol, atol, max_iter, inverse
         Newton settings (:func:`ngcontact.solvers.newton.minimize`).
+    coulomb
+        Coulomb friction: ``"newton"`` (the coupled equations,
+        :func:`ngcontact.solvers.semismooth_newton.solve_equations`) or
+        ``"fixed_point"`` (Tresca passes, paper Sec. 2).
     coulomb_rtol, coulomb_max_iter
         Stopping rule of the Coulomb fixed point
         (:func:`ngcontact.solvers.coulomb.coulomb_fixed_point`).
@@ -211,19 +246,26 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     law = problem.law
     linear = linear if linear is not None else LinearSolver("direct", inverse=inverse)
     newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, linear=linear)
-    history: dict[str, Any] = {"newton": [], "coulomb_changes": [], "coulomb_iterations": 0}
+    history: dict[str, Any] = {"newton": [], "coulomb": None, "coulomb_changes": [], "coulomb_iterations": 0}
     g0 = gap_cf(problem.gap)
     old = ng.GridFunction(fes)
     a_old = _local(frame, old.components[0] - old.components[1])
     G = None
     if not law.quadratic:
-        # quadratic start: all closed (and tangentially bonded under friction),
+        # quadratic start: all closed (and tangentially bonded under friction where needed),
         # so that no body floats at the first Newton step; later solves stop at
         # rtol times the first residual of the whole problem, not of their own
-        start = _form(problem, fes, frame, start_stiffness=law.normal.stiffness)
+        start = _form(problem, fes, frame, start_stiffness=start_stiffness(problem))
         history["newton"].append(minimize(start, gfu, quadratic=True, **newton).as_dict())
         newton["atol"] = max(atol, rtol * history["newton"][0]["residuals"][0])
-    if law.friction is not None and law.friction.coulomb:
+    if law.friction is not None and law.friction.coulomb and coulomb == "newton":
+        coupled = _coupled_newton(problem, fes, frame, gfu, newton)
+        history["newton"].extend(coupled["newton"])
+        history["coulomb"] = {"method": "coupled Newton", "widths": coupled["widths"]}
+        old.vec.data = gfu.vec
+        G = ie.threshold(law.friction, ie.pressure(law.normal, a_old, g0))
+    elif law.friction is not None and law.friction.coulomb:
+        history["coulomb"] = {"method": "fixed point"}
         G = ie.threshold(law.friction, ie.pressure(law.normal, a_old, g0))
         form = _form(problem, fes, frame, G=G)
         p_now = ie.pressure(law.normal, _local(frame, gfu.components[0] - gfu.components[1]), g0)
@@ -251,6 +293,74 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     sol = MacroSolution(problem=problem, gfu=gfu, u_rough=ur, u_counter=uc, frame=frame,
                         local_jump=_local(frame, ur - uc), threshold=G, history=history, previous=old)
     return sol
+
+
+def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dict:
+    """Coulomb friction by Newton on the coupled equations, with continuation in the Huber width on failure.
+
+    First Newton from the start value at the scene's width ``w``; where it
+    fails, from the same start value down the ladder of
+    :func:`ngcontact.solvers.continuation.ladder`, which begins at the
+    largest tangential jump of the start value (at least ``10 w``): there
+    every point sticks in the Huber sense.  Returns ``newton`` (the
+    histories) and ``widths`` (the ladder's rungs; empty when none was
+    needed).
+    """
+    law, mesh, friction = problem.law, problem.mesh, problem.law.friction
+    assert friction is not None
+    start = gfu.vec.CreateVector()
+    start.data = gfu.vec
+    try:
+        return {"newton": [solve_equations(_form(problem, fes, frame, coupled=True), gfu, **newton).as_dict()],
+                "widths": []}
+    except ConvergenceError as err:
+        log.info("coupled Newton at the scene's Huber width failed (%s); continuation in the width", err)
+        gfu.vec.data = start
+    a = _local(frame, gfu.components[0] - gfu.components[1])
+    slips = boundary_values(mesh, problem.interface, ng.sqrt(sum(t * t for t in a[1:])), sampling_order(problem.order))
+    width = friction.width
+
+    def solve_at(w: float, last: bool) -> dict:
+        at = replace(problem, law=replace(law, friction=replace(friction, width=w)))
+        opts = newton if last else {**newton, "rtol": INTERMEDIATE_RTOL, "atol": 0.0}
+        return solve_equations(_form(at, fes, frame, coupled=True), gfu, **opts).as_dict()
+
+    def save():
+        copy = gfu.vec.CreateVector()
+        copy.data = gfu.vec
+        return copy
+
+    def restore(copy) -> None:
+        gfu.vec.data = copy
+
+    try:
+        rungs = ladder(solve_at, save, restore, start=max(float(slips.max(initial=0.0)), 10 * width), target=width)
+    except ConvergenceError as err:
+        raise ConvergenceError(f"Coulomb friction (solver.coulomb = 'newton'): {err}. A tangential load larger "
+                               "than friction (mu times the pressure) can carry has no equilibrium: a body would "
+                               "slide without bound; if the load can be carried, try solver.coulomb = "
+                               "'fixed_point'", err.history) from err
+    return {"newton": [r["history"] for r in rungs], "widths": [r["width"] for r in rungs]}
+
+
+def start_stiffness(problem: MacroProblem) -> float:
+    """Tangential spring of the quadratic start: none where the normal law alone holds the bodies.
+
+    Under friction the start bonds the tangential jump with a spring as
+    stiff as the normal law only when the bodies would otherwise float
+    (:func:`ngcontact.fem.rigid_modes.free_rigid_modes` with the normal tie
+    only: a block sheared on a plane).  Where the normal law holds them (a
+    tapered stem in its bore) the start leaves the tangential jump free:
+    a bonded start would hold a stem with a clearance above its seat,
+    every point open, and the first Newton step of the real law would
+    find nothing that carries the load.
+    """
+    law = problem.law
+    if law.friction is None:
+        return 0.0
+    free = free_rigid_modes(problem.mesh, problem.setting, (problem.rough, problem.counter), problem.supports,
+                            problem.interface, holds_tangentially=False)
+    return law.normal.stiffness if free else 0.0
 
 
 # ----------------------------------------------------- post-processing

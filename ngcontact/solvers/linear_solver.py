@@ -80,6 +80,7 @@ class LinearSolver:
     max_iter: int = 2000
     iterations: list[int] = field(default_factory=list)
     solves: int = 0
+    methods: set = field(default_factory=set)
     _pre: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
@@ -105,26 +106,34 @@ class LinearSolver:
         if id(form) not in self._pre:
             self._pre[id(form)] = ng.Preconditioner(form, "bddc")
 
-    def prepare(self, form: ng.BilinearForm, freedofs) -> "TangentSolve":
-        """The solve with the current (assembled) ``form.mat`` on ``freedofs``: ``apply(rhs, out)``."""
+    def prepare(self, form: ng.BilinearForm, freedofs, *, symmetric: bool = True) -> "TangentSolve":
+        """The solve with the current (assembled) ``form.mat`` on ``freedofs``: ``apply(rhs, out)``.
+
+        A non-symmetric tangent (``symmetric=False``: Coulomb friction's
+        coupled equations) is factorized by UMFPACK, or solved by GMRES with
+        the same BDDC preconditioner.
+        """
         if self.method(freedofs, form.space.mesh.dim) == "direct":
-            return TangentSolve(self, form.mat.Inverse(freedofs, inverse=self.inverse), counted=False)
+            inverse = self.inverse if symmetric or self.inverse != "sparsecholesky" else "umfpack"
+            self.methods.add(f"direct ({inverse})")
+            return TangentSolve(self, form.mat.Inverse(freedofs, inverse=inverse), counted=False)
         pre = self._pre.get(id(form))
         if pre is None:
             raise RuntimeError("LinearSolver.register(form) must come before the form's first assembly")
-        from ngsolve.krylovspace import CGSolver
-        return TangentSolve(self, CGSolver(form.mat, pre.mat, tol=self.rtol, maxiter=self.max_iter,
-                                           printrates=False), counted=True)
+        from ngsolve.krylovspace import CGSolver, GMResSolver
+        krylov = CGSolver if symmetric else GMResSolver
+        self.methods.add("cg+bddc" if symmetric else "gmres+bddc")
+        return TangentSolve(self, krylov(form.mat, pre.mat, tol=self.rtol, maxiter=self.max_iter,
+                                         printrates=False), counted=True)
 
     def summary(self) -> dict:
         """What was done, JSON-ready."""
         out: dict = {"policy": self.policy, "solves": self.solves}
         if self.policy == "auto":
             out["threshold"] = self.threshold
+        out["method"] = ", ".join(sorted(self.methods)) or f"direct ({self.inverse})"
         if self.iterations:
-            out.update(method="cg+bddc", cg_iterations=list(self.iterations), cg_rtol=self.rtol)
-        else:
-            out["method"] = f"direct ({self.inverse})"
+            out.update(cg_iterations=list(self.iterations), cg_rtol=self.rtol)
         return out
 
 

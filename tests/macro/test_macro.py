@@ -5,6 +5,7 @@ import numpy as np
 import ngsolve as ng
 import pytest
 
+from ngcontact.errors import ConvergenceError
 from ngcontact.laws import homogenized as il
 from ngcontact.laws import interface_energy as ie
 from ngcontact.fem.interpolants import piecewise_linear
@@ -124,7 +125,7 @@ L_BLOCK, H_BLOCK = 0.1, 0.01
 N_PRESS, MU, WIDTH = 1e6, 0.3, 1e-7
 
 
-def _block(top_support=(), shear=0.0):
+def _block(top_support=(), shear=0.0, coulomb="newton"):
     g = gm.block_on_plane(L_BLOCK, H_BLOCK, 0.02, maxh=0.01)
     law = il.InterfaceLaw(normal=il.LinearLaw(kn=1e12), friction=il.Friction(mu=MU, width=WIDTH))
     prob = M.MacroProblem(
@@ -132,13 +133,17 @@ def _block(top_support=(), shear=0.0):
         materials={"block": isotropic(10e9, 0.3), "base": isotropic(10e9, 0.3)}, law=law, order=2,
         supports=(M.Support(label="bottom"),) + tuple(top_support),
         loads=(M.Load(label="top", pressure=N_PRESS, traction=(shear, 0.0)),))
-    return M.solve(prob, coulomb_rtol=1e-9)
+    return M.solve(prob, coulomb_rtol=1e-9, coulomb=coulomb)
 
 
-def test_block_under_small_shear_sticks_with_slip_below_the_width():
+COULOMB = pytest.mark.parametrize("coulomb", ["newton", "fixed_point"])
+
+
+@COULOMB
+def test_block_under_small_shear_sticks_with_slip_below_the_width(coulomb):
     """T = 0.5 mu N: every point sticks, |J_t| <= w, the interface carries exactly T and N."""
     T = 0.5 * MU * N_PRESS
-    sol = _block(shear=T)
+    sol = _block(shear=T, coulomb=coulomb)
     prof = MM.interface_profile(sol)
     assert set(prof["status"]) == {"stick"}
     assert np.abs(prof["jump_t"]).max() <= WIDTH
@@ -146,13 +151,14 @@ def test_block_under_small_shear_sticks_with_slip_below_the_width():
     R = MM.resultant(sol)
     assert abs(R["x"] - T * L_BLOCK) < 1e-8 * T * L_BLOCK
     assert abs(R["y"] + N_PRESS * L_BLOCK) < 1e-8 * N_PRESS * L_BLOCK
-    assert sol.history["coulomb_iterations"] >= 1
+    assert (sol.history["coulomb_iterations"] >= 1) == (coulomb == "fixed_point")
 
 
-def test_block_dragged_beyond_the_limit_slides_with_reaction_mu_N():
+@COULOMB
+def test_block_dragged_beyond_the_limit_slides_with_reaction_mu_N(coulomb):
     """Top dragged by 500 w (T would exceed mu N): everything slips, tangential reaction = mu N."""
     drag = (M.Support(label="top", components=("x",), value=(500 * WIDTH,)),)
-    sol = _block(top_support=drag)
+    sol = _block(top_support=drag, coulomb=coulomb)
     prof = MM.interface_profile(sol)
     assert set(prof["status"]) == {"slip"}
     R = MM.resultant(sol)
@@ -162,7 +168,39 @@ def test_block_dragged_beyond_the_limit_slides_with_reaction_mu_N():
                                atol=1e-6 * MU * N_PRESS)
 
 
+def test_block_sheared_beyond_what_friction_carries_is_refused_with_the_reason():
+    """T = 2 mu N under a load (no drag): no equilibrium exists, and the message says why."""
+    with pytest.raises(ConvergenceError, match="A tangential load larger than friction"):
+        _block(shear=2 * MU * N_PRESS)
+
+
 # ------------------------------------------------ femur: equilibrium, labels
+def _femur(gap_table, pressure=1e6, mu=0.3, maxh=0.008, order=2, coulomb="newton"):
+    d = FemurStemDims()
+    g = femur_stem(d, maxh=maxh, interface_maxh=maxh / 2)
+    law = il.InterfaceLaw(normal=il.BundleLaw(weights=(3.2e10,), directions=((1.0, 0.0),)),
+                          friction=il.Friction(mu=mu, width=1e-6))
+    prob = M.MacroProblem(mesh=g.mesh, setting="axisymmetric", rough="stem", counter="bone",
+                          materials={"stem": isotropic(100e9, 0.3), "bone": isotropic(9e9, 0.27)},
+                          law=law, gap=piecewise_linear(ng.y, gap_table), order=order,
+                          supports=(M.Support(label="base"), M.Support(label="axis", components=("r",))),
+                          loads=(M.Load(label="stem_top", pressure=pressure),))
+    return d, M.solve(prob, coulomb=coulomb, coulomb_rtol=1e-10)
+
+
+def test_femur_coupled_newton_and_fixed_point_reach_the_same_coulomb_solution():
+    """Where both converge, both solve the same regularized Coulomb problem: same interface, 1e-7."""
+    table = [(0.05, 2e-5), (0.13, -5e-5)]
+    _, a = _femur(table, coulomb="newton")
+    _, b = _femur(table, coulomb="fixed_point")
+    pa, pb = MM.interface_profile(a), MM.interface_profile(b)
+    for key in ("pressure", "shear", "jump_n", "jump_t"):
+        scale = np.max(np.abs(pb[key]))
+        assert np.max(np.abs(pa[key] - pb[key])) <= 1e-7 * scale, key
+    assert list(pa["status"]) == list(pb["status"]) and {"stick", "slip"} <= set(pa["status"])
+    assert a.history["coulomb"]["method"] == "coupled Newton" and b.history["coulomb_iterations"] > 1
+
+
 def test_femur_stem_interface_carries_the_applied_load():
     """The stem is held only by the interface: its axial resultant equals the load on the top."""
     d = FemurStemDims()

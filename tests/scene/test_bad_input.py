@@ -310,7 +310,7 @@ def test_unknown_top_level_section(tmp_path, capsys):
 def test_misspelled_key_in_a_section(tmp_path, capsys):
     text = edit(CELL.format(contact=""), ("rtol = 1e-10", "r_tol = 1e-10"))
     run_bad(tmp_path, capsys, text, "solver.r_tol = 1e-10: unknown key; allowed keys here are atol, cg_max_iter, "
-            "coulomb_max_iter, coulomb_rtol, inverse, iterative_from, linear, max_iter, rtol")
+            "coulomb, coulomb_max_iter, coulomb_rtol, inverse, iterative_from, linear, max_iter, rtol")
 
 
 def test_misspelled_material_constant(tmp_path, capsys):

@@ -132,7 +132,8 @@ def test_macro_linear_law_is_one_linear_solve_and_no_friction_term(tmp_path):
     friction = report_of(tmp_path, "friction", MACRO.format(law='law = "linear"\nkn = 1e13\nkt = 1e12\nmu = 0.3'))
     assert "coulomb_friction" in friction["effects"]
     assert friction["solver"]["linear_solve_only"] is False
-    assert len(friction["solver"]["coulomb_changes"]) >= 1
+    assert friction["solver"]["coulomb"]["method"] == "coupled Newton"
+    assert friction["solver"]["coulomb_changes"] == [] and linear["solver"]["coulomb"] is None
 
 
 def test_failures_after_the_solve_leave_the_previous_output_and_no_partial_files(tmp_path, monkeypatch, capsys):
