@@ -72,6 +72,11 @@ HIGHLIGHTS: dict[str, list[tuple[str, str, str]]] = {
         ("contact force", "results.contact_force", "N"),
         ("Newton iterations", "results.newton_iterations", ""),
     ],
+    "direct-epsilon-study": [
+        (f"{law} law: {err} error < 1 % from eps", f"results.below_1_percent.{law}.{err}.eps", "m")
+        for law in ("bundle", "linear", "effective") for err in ("field", "reaction")
+    ] + [(f"{law} law: rate of the field error in eps", f"results.rates.{law}.field", "")
+         for law in ("bundle", "linear", "effective")],
 }
 #: per-load columns of a cell's law table (the pressure-closure curve and its contact set)
 LOAD_COLUMNS = ("mean_pressure", "transmitted_pressure", "max_pressure", "contact_fraction", "mean_closure",
@@ -158,8 +163,10 @@ def key_figures(report: dict) -> list[tuple[str, str]]:
     """(label, formatted value) of the figures an engineer looks at first, kind-specific ones first."""
     items = []
     shown = set()
+    per_metre = _get(report, "results.setting") == "plane_strain"   # forces of a plane-strain run are per metre
     for label, path, unit in HIGHLIGHTS.get(report.get("kind", ""), []):
         value = _get(report, path)
+        unit = "N/m" if unit == "N" and per_metre else unit
         if value is not None and value != []:
             items.append((label, fmt(value, unit)))
             shown.add(path.split(".")[1] if path.startswith("results.") else path)
@@ -172,12 +179,10 @@ def key_figures(report: dict) -> list[tuple[str, str]]:
         if key not in shown and _is_scalar(value) and not (isinstance(value, str) and len(value) > 60):
             items.append((key.replace("_", " "), fmt(value)))
     solver = report.get("solver") or {}
-    items += [("unknowns (ndof)", fmt(report.get("ndof"))),
-              ("solver iterations", fmt(solver.get("iterations"))),
-              ("solver converged", fmt(solver.get("converged"))),
-              ("wall time", fmt((report.get("timings") or {}).get("total"), "s")),
-              ("threads", fmt(report.get("threads")))]
-    return items
+    generic = [("unknowns (ndof)", report.get("ndof"), ""), ("solver iterations", solver.get("iterations"), ""),
+               ("solver converged", solver.get("converged"), ""),
+               ("wall time", (report.get("timings") or {}).get("total"), "s"), ("threads", report.get("threads"), "")]
+    return items + [(label, fmt(value, unit)) for label, value, unit in generic if value is not None]
 
 
 def html_table(header: list[str], rows: list[list[str]], cls: str = "") -> str:
@@ -198,12 +203,17 @@ def _rows_table(items: list[dict], columns=None) -> str:
     return html_table(["#"] + keys, [[str(i)] + [fmt(it.get(k)) for k in keys] for i, it in enumerate(items)])
 
 
-def law_table(report: dict) -> str:
-    """A cell's loads as one table: its pressure-closure curve and contact set per load."""
+def kind_tables(report: dict) -> str:
+    """Tables of the key figures: a cell's law per load (pressure-closure curve, contact set), a two-scale history."""
     loads = _get(report, "results.loads")
-    if report.get("kind") != "cell" or not isinstance(loads, list) or not loads:
-        return ""
-    return "<h3>Law per load</h3>" + _rows_table(loads, LOAD_COLUMNS)
+    history = _get(report, "results.two_scale.history")
+    parts = []
+    if report.get("kind") == "cell" and isinstance(loads, list) and loads:
+        parts.append("<h3>Law per load</h3>" + _rows_table(loads, LOAD_COLUMNS))
+    if isinstance(history, list) and history:
+        parts.append("<h3>Two-scale iterations (max_change: largest pressure change over the interface)</h3>"
+                     + _rows_table(history))
+    return "".join(parts)
 
 
 def nested(value, depth: int = 0) -> str:
@@ -351,7 +361,7 @@ def render(report: dict, directory: str, names: list[str]) -> str:
         f'{_e(report.get("schema", ""))} \u00b7 <a href="report.json">report.json</a></p>',
         f"<p>Effects: {effects or '(none)'}</p>",
         "".join(f'<p class="warn">{_e(w)}</p>' for w in warnings if isinstance(w, str)),
-        "<h2>Key figures</h2>", _cards(key_figures(report)), law_table(report),
+        "<h2>Key figures</h2>", _cards(key_figures(report)), kind_tables(report),
     ]
     if pngs:
         parts += ["<h2>Figures</h2>"] + [figure(directory, n) for n in pngs]
