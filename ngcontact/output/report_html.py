@@ -107,14 +107,15 @@ def fmt(x, unit: str = "") -> str:
         return "\u2013"
     if isinstance(x, bool):
         return "yes" if x else "no"
-    if isinstance(x, int):
-        return f"{x} {unit}".strip()
-    if isinstance(x, float):
+    if isinstance(x, int) and not unit:
+        return str(x)
+    if isinstance(x, (int, float)):
+        x = float(x)
         if not math.isfinite(x):
             raise ValueError(f"report.html: non-finite number {x}")
         if unit and x != 0.0:
             for scale, prefix in _PREFIXES:
-                if abs(x) >= scale * 0.9999995 or scale == 1e-9:
+                if abs(x) >= scale * 0.9999995:
                     return f"{x / scale:.4g} {prefix}{unit}"
         return f"{x:.5g} {unit}".strip()
     if isinstance(x, list):
@@ -243,6 +244,8 @@ def nested(value, depth: int = 0) -> str:
         for v in value:
             counts[v] = counts.get(v, 0) + 1
         return _e(f"{len(value)} entries: " + ", ".join(f"{k} \u00d7 {n}" for k, n in counts.items()))
+    if all(isinstance(v, list) for v in value) and len(value) > MAX_INLINE:
+        return _e(f"{len(value)} entries of {min(map(len, value))} to {max(map(len, value))} values")
     if all(_is_scalar(v) for v in value) or all(isinstance(v, list) and len(v) <= MAX_INLINE for v in value):
         return _e(fmt(value))
     return "<ol start=0>" + "".join(f"<li>{nested(v, depth + 1)}</li>" for v in value) + "</ol>"

@@ -36,6 +36,7 @@ def visible_text(page: str) -> str:
 
 def run(tmp_path, monkeypatch, scene_path):
     monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("NGCONTACT_THREADS", "1")   # the page is the subject here: one core of the shared two
     out = tmp_path / "out"
     assert cli.main(["run", str(scene_path), "--out", str(out), "--quiet"]) == 0
     return out, json.loads((out / "report.json").read_text()), (out / "report.html").read_text(encoding="utf-8")
