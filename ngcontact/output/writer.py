@@ -2,7 +2,9 @@
 
 The contract, for ``ngcontact run SCENE --out DIR`` and every study:
 
-* Only the package's own files are written: ``report.json``, the CSV
+* Only the package's own files are written: ``report.json``, its page
+  ``report.html`` (:mod:`ngcontact.output.report_html`: the report, the
+  PNGs embedded and the CSV tables, one self-contained file), the CSV
   tables, the VTK files and the PNG plots of the outcome, and the manifest
   ``.ngcontact-manifest.json`` that lists them.  ``DIR`` is created when
   missing (with the user's umask); an existing ``DIR`` keeps its mode, its
@@ -42,11 +44,14 @@ import numpy as np
 
 from ngcontact.errors import OutputError
 from ngcontact.output.report import Outcome, file_names, to_plain
+from ngcontact.output.report_html import write_html
 
 if TYPE_CHECKING:
     from ngcontact.output.report import VtkField
 
 MANIFEST = ".ngcontact-manifest.json"
+#: the files every run writes besides those of its outcome
+REPORT_FILES = ("report.json", "report.html")
 STAGING_PREFIX = ".ngcontact-partial-"
 
 
@@ -107,7 +112,7 @@ def own_files(out_dir: str) -> set[str] | None:
     return {f for f in files if f == os.path.basename(f) and f not in ("", ".", "..", MANIFEST)}
 
 
-def check_output_dir(out_dir: str, inputs: Iterable[str] = (), names: Iterable[str] = ("report.json",)) -> str:
+def check_output_dir(out_dir: str, inputs: Iterable[str] = (), names: Iterable[str] = REPORT_FILES) -> str:
     """Refuse, before any work, an output directory the run may not write; returns its real path.
 
     Parameters
@@ -191,11 +196,12 @@ def _move(src: str, dst: str) -> None:
 
 # ---------------------------------------------------------------- the write
 def write_outputs(out_dir: str, report: dict, outcome: Outcome, inputs: Iterable[str] = ()) -> str:
-    """Write ``report.json`` and the outcome's files into ``out_dir`` under the contract of this module.
+    """Write ``report.json``, ``report.html`` and the outcome's files into ``out_dir`` under the contract of this
+    module.
 
     Returns the directory's real path.
     """
-    names = file_names(outcome) + ["report.json"]
+    names = file_names(outcome) + list(REPORT_FILES)
     real = check_output_dir(out_dir, inputs, names)
     stage_in = real if os.path.isdir(real) else _existing_ancestor(real)
     remove_stale_staging(stage_in)
@@ -215,6 +221,7 @@ def write_outputs(out_dir: str, report: dict, outcome: Outcome, inputs: Iterable
         with open(os.path.join(tmp, "report.json"), "w") as fh:
             json.dump(report, fh, indent=2, allow_nan=False)
             fh.write("\n")
+        write_html(os.path.join(tmp, "report.html"), report, tmp, file_names(outcome))
         manifest = {"written_by": "ngcontact", "version": report.get("version"), "files": sorted(names)}
         with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as fh:
             json.dump(manifest, fh, indent=1)

@@ -3,10 +3,12 @@
 Validation is in the default tier; the full runs (the shipped settings, some
 of them 3D) are in the slow tier, which CI runs after the default one.
 """
+import base64
 import glob
 import json
 import math
 import os
+import re
 
 import pytest
 
@@ -55,3 +57,9 @@ def test_scene_runs_to_a_finite_report(path, tmp_path, monkeypatch):
     assert not bad, f"non-finite numbers at {bad[:5]}"
     for name in rep["files"]:
         assert (out / name).is_file(), f"{name} listed but not written"
+    # the page beside the report: every PNG embedded, no non-finite number in its text
+    page = (out / "report.html").read_text(encoding="utf-8")
+    embedded = {base64.b64decode(m) for m in re.findall(r"data:image/png;base64,([A-Za-z0-9+/=]+)", page)}
+    assert all((out / n).read_bytes() in embedded for n in rep["files"] if n.endswith(".png"))
+    text = re.sub(r"data:image/png;base64,[A-Za-z0-9+/=]+", "", page)
+    assert not re.search(r"\b(nan|inf|infinity)\b", text, re.IGNORECASE)

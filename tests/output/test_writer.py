@@ -64,11 +64,11 @@ def test_outputs_are_written_together_with_a_manifest_of_them(tmp_path):
     out = tmp_path / "run"
     outcome = outcome_with(2.0)
     write_outputs(str(out), report_for(outcome), outcome)
-    assert sorted(os.listdir(out)) == sorted([MANIFEST, "curve.csv", "figure.png", "report.json"])
+    assert sorted(os.listdir(out)) == sorted([MANIFEST, "curve.csv", "figure.png", "report.html", "report.json"])
     rep = json.loads((out / "report.json").read_text())
     assert rep["results"] == {"value": 2.0} and rep["files"] == ["curve.csv", "figure.png"]
     manifest = json.loads((out / MANIFEST).read_text())
-    assert manifest["written_by"] == "ngcontact" and manifest["files"] == ["curve.csv", "figure.png", "report.json"]
+    assert manifest["written_by"] == "ngcontact" and manifest["files"] == ["curve.csv", "figure.png", "report.html", "report.json"]
     assert os.listdir(tmp_path) == ["run"], "no staging directory may remain"
 
 
