@@ -39,9 +39,14 @@ def header(law: ExportedLaw, comment: str, code: str) -> list[str]:
     return [f"{comment} {line}" for line in lines]
 
 
+def number(v: float) -> str:
+    """A number in at most 20 characters (ccx reads fields of 20) with 13 significant digits (relative 5e-14)."""
+    return f"{v:.12e}"
+
+
 def table_rows(law: ExportedLaw) -> list[str]:
-    """``pressure, overclosure`` data lines (17 significant digits: the nodes are reproduced exactly)."""
-    return [f"{p:.17g}, {c + law.gap:.17g}" for c, p in zip(law.closure, law.pressure)]
+    """``pressure, overclosure`` data lines (13 significant digits)."""
+    return [f"{number(p)}, {number(c + law.gap)}" for c, p in zip(law.closure, law.pressure)]
 
 
 def text(law: ExportedLaw) -> str:
@@ -55,9 +60,9 @@ def text(law: ExportedLaw) -> str:
         gamma = law.mu * p_ref / law.stick_slope
         lines += [f"** elastic slip gamma = mu0 p_ref / k_t0 with p_ref = {p_ref:.6g} Pa: the stick stiffness "
                   "mu0 p / gamma equals k_t0 at p = p_ref only (Abaqus scales it with the pressure)",
-                  f"*FRICTION, ELASTIC SLIP={gamma:.17g}", f"{law.mu:.17g}"]
+                  f"*FRICTION, ELASTIC SLIP={number(gamma)}", number(law.mu)]
     elif law.mu > 0:
-        lines += [f"*FRICTION, ELASTIC SLIP={1e-3 * (law.closure[-1] - law.closure[0]):.17g}", f"{law.mu:.17g}"]
+        lines += [f"*FRICTION, ELASTIC SLIP={number(1e-3 * (law.closure[-1] - law.closure[0]))}", number(law.mu)]
     else:
         lines.append("** no *FRICTION: the friction coefficient is 0 (give one with --mu to carry the stick slope)")
     return "\n".join(lines) + "\n"
