@@ -101,7 +101,7 @@ def exported_law(path: str, *, length_unit: float = 1.0, p_max: float | None = N
                              "give the table's largest pressure (--max-pressure, Pa)")
     closure, pressure = lt.table(kinks, slopes, p_max=p_max, tolerance=tolerance)
     if mu is not None:
-        mu0, mu_source = mu, "given (--mu)"
+        mu0, mu_source = mu, "given"
     elif scene_mu > 0:
         mu0, mu_source = scene_mu, "the macro scene's interface.mu"
     elif K0 is not None:
