@@ -64,8 +64,9 @@ def compare(cell: str, workdir: str, blocks: Blocks, *, length_unit: float, mu: 
             table_tol: float = 1e-4, maxh: float | None = None, order: int = 2) -> dict:
     """Export, solve both ways and return ``{"rows": [(quantity, unit, ngcontact, ccx, rel. diff)], ...}``.
 
-    Also ``seconds`` (``ngcontact``, ``ccx``), ``ccx`` (its results), ``law``
-    and ``stick`` (the largest ``|tau| / (mu0 p)`` of ccx's contact nodes).
+    Also ``seconds`` (``ngcontact``, ``ccx``), ``ccx`` (its results), ``law``,
+    ``stick`` (the largest ``|tau| / (mu0 p)`` of ccx's contact nodes) and
+    ``profile`` (this package's interface samples ``x``, ``pressure``, ``shear``).
     """
     law_dir = os.path.join(workdir, "law")
     opts = {"length_unit": length_unit, "p_max": p_max, "tolerance": table_tol, "mu": mu}
@@ -104,4 +105,5 @@ def compare(cell: str, workdir: str, blocks: Blocks, *, length_unit: float, mu: 
     closed = cx["pressure"] > 0
     stick = float(np.max(np.abs(cx["shear"][closed]) / (mu * cx["pressure"][closed]))) if mu > 0 else 0.0
     return {"rows": rows, "seconds": {"ngcontact": ours_s, "ccx": cx["seconds"]}, "ccx": cx, "law": law,
-            "stick": stick, "json": path, "ccx_law": ccx_law, "ndof": sol.ndof}
+            "stick": stick, "json": path, "ccx_law": ccx_law, "ndof": sol.ndof,
+            "profile": {"x": x, "pressure": p, "shear": tau}}
