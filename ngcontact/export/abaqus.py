@@ -62,7 +62,8 @@ def text(law: ExportedLaw) -> str:
                   "mu0 p / gamma equals k_t0 at p = p_ref only (Abaqus scales it with the pressure)",
                   f"*FRICTION, ELASTIC SLIP={number(gamma)}", number(law.mu)]
     elif law.mu > 0:
-        lines += [f"*FRICTION, ELASTIC SLIP={number(1e-3 * (law.closure[-1] - law.closure[0]))}", number(law.mu)]
+        lines += ["** the law has no tangential stiffness (k_t0 = 0): elastic slip 1e-3 of the table's closure range",
+                  f"*FRICTION, ELASTIC SLIP={number(1e-3 * (law.closure[-1] - law.closure[0]))}", number(law.mu)]
     else:
         lines.append("** no *FRICTION: the friction coefficient is 0 (give one with --mu to carry the stick slope)")
     return "\n".join(lines) + "\n"

@@ -216,3 +216,23 @@ def test_greedy_thinning_keeps_the_ends_and_meets_the_tolerance():
     keep = lt.thinned(c, p, 1e-3)
     assert keep[0] == 0 and keep[-1] == 100 and 2 < len(keep) < 101
     assert np.max(np.abs(np.interp(c, c[keep], p[keep]) - p)) <= 1e-3
+
+
+@pytest.mark.parametrize("law, numbers", [
+    ("linear", "kn = 2e10\nkt = 5e9\n"),
+    ("tabulated", "closure = [1e-6, 2e-6, 5e-6]\npressure = [0.0, 1e6, 2e7]\nkt = 5e9\n"),
+])
+def test_explicit_laws_export_their_curve(tmp_path, law, numbers):
+    text = open(SAWTOOTH_BLOCK).read()
+    text = re.sub(r"^cell = .*$", f'law = "{law}"\n{numbers}', text, flags=re.M)
+    text = re.sub(r"^cell_length_unit.*$", "", text, flags=re.M)
+    path = tmp_path / "m.toml"
+    path.write_text(text)
+    exp = exported_law(str(path), p_max=5e7, tolerance=0.0)
+    assert exp.stick_slope == 5e9
+    if law == "linear":
+        assert exp.k_n0 == 2e10 and any("bilateral" in n for n in exp.notes)
+        assert np.allclose(exp.pressure, 2e10 * exp.closure, rtol=1e-14, atol=1e-6)
+    else:
+        assert np.allclose(np.interp([1e-6, 2e-6, 5e-6], exp.closure, exp.pressure), [0.0, 1e6, 2e7], rtol=1e-13)
+        assert exp.k_n0 == pytest.approx((2e7 - 1e6) / 3e-6, rel=1e-12)  # extrapolated with the last slope
