@@ -1,4 +1,4 @@
-"""CalculiX (ccx) solves two blocks with the exported law and agrees with this package within 1 %.
+"""CalculiX (ccx) solves two blocks and a press fit with the exported law and agrees with this package within 1 %.
 
 Requirement: the law exported for ccx (pressure-overclosure table, friction with the stick slope), used by a
 real ccx run on the two blocks of ``ngcontact.export.calculix_model`` pressed and sheared, gives the reaction
@@ -36,3 +36,17 @@ def test_ccx_agrees_with_the_macro_solve_within_one_percent(tmp_path, monkeypatc
     bad = [f"{name}: ngcontact {a:.6g}, ccx {b:.6g} ({d:.2%})" for name, _, a, b, d in r["rows"] if not d < 0.01]
     assert not bad, "ccx and ngcontact differ by more than 1 %:\n" + "\n".join(bad)
     assert all(np.isfinite([a, b]).all() for _, _, a, b, _ in r["rows"])
+
+
+def test_ccx_press_fit_agrees_within_one_percent(tmp_path, monkeypatch):
+    """Plane-strain press fit: the interference is the exported law's gap g0 (the table shifted by it)."""
+    from ngcontact.export.calculix_check import compare_press_fit
+    from ngcontact.export.calculix_model import PressFit
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))
+    fit = PressFit(a=0.01, b=0.02, c=0.03, E=210e9, nu=0.3, n_theta=20, n_inner=5, n_outer=5)
+    r = compare_press_fit(CELL, str(tmp_path), fit, length_unit=1e-4, gap=-3e-6, p_max=1e8)
+    assert r["law"].gap == -3e-6
+    p = r["ccx"]["pressure"]
+    assert p.min() > 0 and p.max() < r["law"].full_contact_pressure(), "inside the law's nonlinear range"
+    bad = [f"{name}: ngcontact {a:.6g}, ccx {b:.6g} ({d:.2%})" for name, _, a, b, d in r["rows"] if not d < 0.01]
+    assert not bad, "ccx and ngcontact differ by more than 1 %:\n" + "\n".join(bad)
