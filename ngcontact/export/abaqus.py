@@ -29,7 +29,8 @@ def header(law: ExportedLaw, comment: str, code: str) -> list[str]:
              f"source: {s['kind']} scene {s['scene']} (SHA-256 {s['scene_sha256']})"]
     if "cell_sha256" in s:
         lines.append(f"cell content hash {s['cell_sha256']}, cell length unit {s.get('length_unit', 1.0):g} m")
-    lines += [f"normal law: p(c) = sum_i s_i [c - c_i]_+ with {len(law.kinks)} kinks; k_n0 = {law.k_n0:.10g} Pa/m "
+    kinks = f"{len(law.kinks)} kink" + ("s" if len(law.kinks) != 1 else "")
+    lines += [f"normal law: p(c) = sum_i s_i [c - c_i]_+ with {kinks}; k_n0 = {law.k_n0:.10g} Pa/m "
               f"beyond the last kink (p >= {law.full_contact_pressure():.6g} Pa)",
               f"table: {len(law.closure)} nodes, exact at the nodes, within {law.tolerance:g} * p_max between; "
               f"pressure range 0 .. {law.p_max:.6g} Pa, closure {law.closure[0]:.6g} .. {law.closure[-1]:.6g} m",

@@ -74,6 +74,8 @@ def exported_law(path: str, *, length_unit: float = 1.0, p_max: float | None = N
         raise ModelError(f"--mu {mu!r}: must be >= 0")
     if not length_unit > 0:
         raise ModelError(f"--length-unit {length_unit!r}: metres per cell unit, must be > 0")
+    if not 0 <= tolerance < 1:
+        raise ModelError(f"--table-tol {tolerance!r}: a fraction of the table's largest pressure, in [0, 1)")
     if p_max is not None and not p_max > 0:
         raise ModelError(f"--max-pressure {p_max!r}: the table's largest pressure [Pa], must be > 0")
     scene = loader.load(path)

@@ -142,7 +142,8 @@ def test_json_round_trip_gives_the_same_macro_result(tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["--format", "nastran"], "--format nastran: unknown format"),
     (["--format", "json", "--max-pressure", "-1"], "--max-pressure -1.0"),
-    (["--format", "json", "--table-tol", "1.5"], "tolerance = 1.5"),
+    (["--format", "json", "--table-tol", "1.5"], "--table-tol 1.5: a fraction of the table's largest pressure"),
+    (["--format", "json", "--length-unit", "0"], "--length-unit 0.0: metres per cell unit"),
 ])
 def test_bad_options_are_refused_and_nothing_is_written(tmp_path, capsys, args, message):
     out = tmp_path / "out"
@@ -170,6 +171,9 @@ def test_a_users_file_in_out_is_never_overwritten(tmp_path, capsys):
                      "--max-pressure", "1e8"]) == 2
     assert "interface_law.json exists and was not written by ngcontact" in capsys.readouterr().err
     assert mine.read_text() == "mine" and sorted(p.name for p in out.iterdir()) == ["interface_law.json"]
+    # a directory holding the scene is refused as by `run --out`
+    assert cli.main(["export", GAP_CELL, "--format", "json", "--out", os.path.dirname(GAP_CELL)]) == 2
+    assert "which the scene reads" in capsys.readouterr().err
     # a second export into a package directory keeps the first one's file
     other = tmp_path / "other"
     for fmt in ("json", "abaqus"):
