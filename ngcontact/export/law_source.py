@@ -52,6 +52,8 @@ def _normal_law(scene, path: str, length_unit: float):
     if "sha256" in info:
         source["law_file_sha256"] = info["sha256"]
     source["law"] = spec.law_file_form if spec.law == "file" else spec.law
+    if spec.mu > 0:
+        source["huber_width"] = spec.huber_width
     scale = max([0.0] + [abs(lo.pressure) for lo in scene.loads]
                 + [float(np.linalg.norm(lo.traction)) for lo in scene.loads if lo.traction])
     return (law.normal, spec.gap if spec.gap_table is None else 0.0, spec.threshold, spec.mu,
@@ -113,6 +115,9 @@ def exported_law(path: str, *, length_unit: float = 1.0, p_max: float | None = N
     stick = float(np.mean(np.diag(K0)[1:])) if K0 is not None else float(normal.kt)
     notes = lt.not_carried(None if bundle is None else bundle["directions"], K0, threshold=threshold,
                            gap_table=gap_table, bilateral=isinstance(normal, il.LinearLaw))
+    if "huber_width" in source:
+        notes += (f"the macro scene's friction regularization (Huber width w = {source['huber_width']:g} m: a "
+                  "sticking point slips at most w) is not exported; the stick slope is the law's k_t0",)
     return lt.ExportedLaw(kinks=np.asarray(kinks, float), slopes=np.asarray(slopes, float), closure=closure,
                           pressure=pressure, tolerance=tolerance, K0=K0, bundle=bundle, mu=mu0, mu_source=mu_source,
                           stick_slope=stick, gap=float(g0), source=source, notes=notes,
