@@ -117,26 +117,31 @@ def _solve(path):
     return solve(loader.load(path))[0]["results"]
 
 
-def test_json_round_trip_gives_the_same_macro_result(tmp_path):
+@pytest.mark.parametrize("source", ["macro", "cell"])
+def test_json_round_trip_gives_the_same_macro_result(tmp_path, source):
+    """Exported from the macro scene (sawtooth cell, no gaps) or from a cell with gaps (its length unit
+    scaling them), read back by a macro scene: the same macro solution to 1e-12."""
+    cell = os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml") if source == "macro" else GAP_CELL
+    original = tmp_path / "original.toml"
+    text = open(SAWTOOTH_BLOCK).read().replace("maxh = 0.0025", "maxh = 0.005")
+    original.write_text(re.sub(r"^cell = .*$", f'cell = "{cell}"', text, flags=re.M))
     out = tmp_path / "law"
-    assert cli.main(["export", SAWTOOTH_BLOCK, "--format", "json", "--out", str(out), "--max-pressure", "1e8"]) == 0
+    scene = str(original) if source == "macro" else GAP_CELL
+    assert cli.main(["export", scene, "--format", "json", "--out", str(out), "--max-pressure", "1e8",
+                     "--length-unit", "1e-4"]) == 0
     data = json.loads((out / "interface_law.json").read_text())
     assert data["units"]["weights"] == "Pa/m" and len(data["source"]["cell_sha256"]) == 64
-    text = open(SAWTOOTH_BLOCK).read()
-    text = re.sub(r"^cell = .*$", f'law = "file"\nlaw_file = "{out / "interface_law.json"}"', text, flags=re.M)
-    text = re.sub(r"^cell_length_unit.*$", "", text, flags=re.M)
-    text = text.replace("maxh = 0.0025", "maxh = 0.005")
-    original = tmp_path / "original.toml"
-    original.write_text(open(SAWTOOTH_BLOCK).read().replace("maxh = 0.0025", "maxh = 0.005").replace(
-        '"sawtooth_cell.toml"', repr(os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml")).replace("'", '"')))
     back = tmp_path / "from_file.toml"
-    back.write_text(text)
+    text = re.sub(r"^cell = .*$", f'law = "file"\nlaw_file = "{out / "interface_law.json"}"', text, flags=re.M)
+    back.write_text(re.sub(r"^cell_length_unit.*$", "", text, flags=re.M))
     assert loader.effects(loader.load(str(back)))[1] == "interface_bundle_from_file"
     a, b = _solve(str(original)), _solve(str(back))
     for key in ("pressure", "shear", "jump_n", "jump_t"):
         x, y = np.asarray(a["interface"][key]), np.asarray(b["interface"][key])
         assert np.max(np.abs(x - y)) <= 1e-12 * np.max(np.abs(x)), key
     assert b["resultant"]["y"] == pytest.approx(a["resultant"]["y"], rel=1e-12)
+    if source == "cell":  # the gaps (up to 2h = 0.02 cell units) arrive in metres
+        assert max(data["bundle"]["gaps"]) == pytest.approx(0.02 * 1e-4, rel=1e-2)
 
 
 @pytest.mark.parametrize("args, message", [
