@@ -205,6 +205,12 @@ class InterfaceSpec:
     def check(self, path: str) -> None:
         explicit = {"kn": self.kn, "weights": self.weights, "directions": self.directions, "gaps": self.gaps,
                     "closure": self.closure, "pressure": self.pressure}
+        if self.gap_table is not None:
+            xs = [q[0] for q in self.gap_table]
+            if any(b <= a for a, b in zip(xs, xs[1:])):
+                raise SceneError(f"{path}.gap_table", self.gap_table, "coordinates must increase strictly")
+            if self.gap != 0.0:
+                raise SceneError(f"{path}.gap", self.gap, "give either gap or gap_table")
         if (self.law == "file") != (self.law_file is not None):
             raise SceneError(f"{path}.law_file", self.law_file or MISSING, "give law_file exactly when law = 'file'")
         if self.law == "file":
@@ -232,12 +238,6 @@ class InterfaceSpec:
                           closure=self.closure, pressure=self.pressure)
         except ValueError as exc:
             raise SceneError(f"{path}", self.law, str(exc)) from None
-        if self.gap_table is not None:
-            xs = [q[0] for q in self.gap_table]
-            if any(b <= a for a, b in zip(xs, xs[1:])):
-                raise SceneError(f"{path}.gap_table", self.gap_table, "coordinates must increase strictly")
-            if self.gap != 0.0:
-                raise SceneError(f"{path}.gap", self.gap, "give either gap or gap_table")
 
 
 @dataclass(frozen=True, kw_only=True)

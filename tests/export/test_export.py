@@ -245,3 +245,22 @@ def test_explicit_laws_export_their_curve(tmp_path, law, numbers):
     else:
         assert np.allclose(np.interp([1e-6, 2e-6, 5e-6], exp.closure, exp.pressure), [0.0, 1e6, 2e7], rtol=1e-13)
         assert exp.k_n0 == pytest.approx((2e7 - 1e6) / 3e-6, rel=1e-12)  # extrapolated with the last slope
+
+
+def test_a_law_file_scene_checks_its_gap_like_every_macro_scene(tmp_path):
+    """The gap checks hold whatever the law's source (they were skipped for a law from a cell or a file)."""
+    law = exported_law(GAP_CELL, length_unit=UNIT, p_max=P_MAX)
+    from ngcontact.export import json_law
+    (tmp_path / "law.json").write_text(json_law.text(law))
+    path = _macro_with_file(tmp_path, "law.json")
+    loader.load(path)  # valid as written
+    text = open(path).read().replace('law = "file"', 'law = "file"\ngap = -1e-6\ngap_table = [[0.0, 0.0], [1.0, 0.0]]')
+    (tmp_path / "both.toml").write_text(text)
+    with pytest.raises(SceneError, match="interface.gap.*give either gap or gap_table"):
+        loader.load(str(tmp_path / "both.toml"))
+    cell_scene = open(SAWTOOTH_BLOCK).read().replace("[interface]", "[interface]\ngap_table = [[1.0, 0.0], [0.0, 0.0]]")
+    cell_scene = cell_scene.replace('"sawtooth_cell.toml"',
+                                    '"' + os.path.join(ROOT, "geometries", "macro", "sawtooth_cell.toml") + '"')
+    (tmp_path / "cell.toml").write_text(cell_scene)
+    with pytest.raises(SceneError, match="interface.gap_table.*increase strictly"):
+        loader.load(str(tmp_path / "cell.toml"))
