@@ -264,3 +264,11 @@ def test_a_law_file_scene_checks_its_gap_like_every_macro_scene(tmp_path):
     (tmp_path / "cell.toml").write_text(cell_scene)
     with pytest.raises(SceneError, match="interface.gap_table.*increase strictly"):
         loader.load(str(tmp_path / "cell.toml"))
+
+
+def test_the_running_sum_curve_is_the_sum_of_ramps():
+    rng = np.random.default_rng(3)
+    kinks, slopes = rng.normal(size=400), rng.random(400)  # unsorted, negative kinks too
+    c = np.linspace(-4.0, 4.0, 3001)
+    direct = np.maximum(c[:, None] - kinks[None, :], 0.0) @ slopes
+    assert np.max(np.abs(lt.curve(kinks, slopes, c) - direct)) <= 1e-13 * direct.max()
