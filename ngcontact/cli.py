@@ -6,7 +6,10 @@ CSV tables, VTK files for ParaView and PNG plots into ``DIR`` (default
 ``ngcontact study epsilon SCENE [--periods N ...] [--out DIR]`` runs the
 epsilon study of a ``direct`` scene (:func:`ngcontact.runner.study_epsilon`) and
 writes ``report.json``, ``epsilon.csv`` and ``epsilon.png`` into ``DIR``
-(default ``results/<scene name>_epsilon``).
+(default ``results/<scene name>_epsilon``); ``ngcontact export SCENE --format
+abaqus|calculix|ansys|json [--out DIR]`` writes the interface law of a cell or
+macro scene for another FE code (:mod:`ngcontact.export.export_law`; default
+``results/<scene name>_export``), what the format cannot carry as a warning.
 
 Exit status: 0 success, 2 invalid scene or output directory, 3 solver
 failure, 130 interrupted (SIGINT), 143 terminated (SIGTERM); every failure
@@ -84,6 +87,21 @@ def _parser() -> argparse.ArgumentParser:
     st.add_argument("--periods", type=int, nargs="+", metavar="N", help="numbers of periods (default: the scene's)")
     st.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon)")
     st.add_argument("--quiet", action="store_true", help="no progress lines")
+    ex = sub.add_parser("export", help="write a cell's or macro scene's interface law for Abaqus, CalculiX, "
+                        "ANSYS or as JSON", description="Export the homogenized interface law of a cell scene (its "
+                        "direction bundle) or of a macro scene (the law its interface uses).")
+    ex.add_argument("scene", help="scene file (TOML) of kind cell or macro")
+    ex.add_argument("--format", required=True, metavar="FORMAT", help="abaqus, calculix, ansys or json")
+    ex.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_export)")
+    ex.add_argument("--length-unit", type=float, default=1.0, metavar="M",
+                    help="cell scene: metres per cell length unit (default 1)")
+    ex.add_argument("--max-pressure", type=float, metavar="PA", help="largest pressure of the table [Pa] "
+                    "(default: from the law's kinks, the scene's loads and interference)")
+    ex.add_argument("--table-tol", type=float, default=1e-3, metavar="T",
+                    help="largest departure of the table from the law between nodes, times the largest "
+                         "pressure (default 1e-3)")
+    ex.add_argument("--mu", type=float, metavar="MU", help="friction coefficient to write (default: the macro "
+                    "scene's interface.mu, else |k_nt0|/k_n0)")
     return p
 
 
@@ -102,6 +120,8 @@ def main(argv=None) -> int:
     try:
         if args.command == "check":
             return _check(args.scene)
+        if args.command == "export":
+            return _export(args)
         if args.command == "study":
             return _study(args.scene, args.periods, args.out, quiet=args.quiet)
         return _run(args.scene, args.out, quiet=args.quiet)
@@ -180,6 +200,28 @@ def _study(path: str, periods, out: str | None, quiet: bool) -> int:
         return _fail(EXIT_SCENE, f"--periods {' '.join(map(str, periods))}: at least 3 increasing numbers "
                                  "N >= 1 (a rate needs three distinct levels)")
     return _execute(path, out, quiet, compute, suffix="_epsilon", validate=require_study)
+
+
+def _export(args) -> int:
+    """``ngcontact export``: check format, scene and ``--out`` first; write one file; warn what is lost."""
+    from ngcontact.export.export_law import FORMATS, check, export, warnings
+
+    if args.format not in FORMATS:
+        return _fail(EXIT_SCENE, f"--format {args.format}: unknown format; one of " + ", ".join(FORMATS))
+    out = args.out or os.path.join("results", os.path.splitext(os.path.basename(args.scene))[0] + "_export")
+    try:
+        if not os.path.isfile(args.scene):
+            raise SceneError("SCENE", args.scene, "an existing scene file")
+        check(args.scene, args.format, out)
+        with _native_output_silenced(True):
+            path, law = export(args.scene, args.format, out, length_unit=args.length_unit,
+                               p_max=args.max_pressure, tolerance=args.table_tol, mu=args.mu)
+    except Exception as exc:
+        return _classified(args.scene, exc)
+    for note in warnings(law, args.format):
+        print(f"ngcontact: warning: {args.format} cannot carry: {note}", file=sys.stderr)
+    print(f"wrote {path}", file=sys.stderr)
+    return EXIT_OK
 
 
 def _classified(path: str, exc: Exception) -> int:

@@ -112,6 +112,30 @@ def law_from_cell(path: str, *, dim: int, linear: bool = False, length_unit: flo
     return law, info
 
 
+def law_from_file(path: str, form: str, *, dim: int) -> tuple[il.NormalLaw, dict]:
+    """Normal law of form ``form`` from a law file of ``ngcontact export --format json`` and its description.
+
+    A bundle of a 3D cell under a 2D macro frame is projected as in
+    :func:`ngcontact.coupling.cell_law.bundle_law`.
+    """
+    from ngcontact.scene import law_file
+    contents = law_file.read(path)
+    try:
+        law = law_file.normal_law_of(contents, form)
+    except ValueError as exc:
+        raise SceneError("interface.law_file_form", form, str(exc)) from None
+    if isinstance(law, il.BundleLaw):
+        n = len(law.directions[0])
+        if n < dim:
+            raise SceneError("interface.law_file", path, f"its bundle has {n} components per direction; "
+                             f"this setting needs {dim}")
+        if n > dim:
+            law = cell_law.bundle_law({"w": law.weights, "n": law.directions, "g": law.g}, dim=dim)
+    with open(path, "rb") as fh:
+        digest = hashlib.sha256(fh.read()).hexdigest()
+    return law, {"law_file": os.path.abspath(path), "form": form, "sha256": digest}
+
+
 def build_cell(scene, maxh=None, interface_maxh=None, order=None):
     """Mesh the cell of ``scene.geometry`` (mesh sizes may be overridden)."""
     g, d = scene.geometry, scene.discretization

@@ -26,7 +26,8 @@ from collections import Counter
 import numpy as np
 import ngsolve as ng
 
-from ngcontact.drivers.build import body_laws, interface_friction, interface_normal_law, law_from_cell, linear_solver
+from ngcontact.drivers.build import (body_laws, interface_friction, interface_normal_law, law_from_cell, law_from_file,
+                                     linear_solver)
 from ngcontact.laws import homogenized as il
 from ngcontact.fem.interpolants import piecewise_linear
 from ngcontact.macro import macro_problem as M
@@ -67,7 +68,10 @@ def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None) -> gm.M
 def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
     """The interface law of ``scene`` and a description of it for the report."""
     spec = scene.interface
-    if spec.cell is not None:
+    normal: il.NormalLaw | None
+    if spec.law == "file":
+        normal, info = law_from_file(resolve(scene, spec.law_file), spec.law_file_form, dim=dim)
+    elif spec.cell is not None:
         normal, info = law_from_cell(resolve(scene, spec.cell), dim=dim, linear=spec.law == "linear",
                                      length_unit=spec.cell_length_unit)
     else:
@@ -76,6 +80,7 @@ def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
         if isinstance(normal, il.BundleLaw) and len(normal.directions[0]) != dim:
             raise SceneError("interface.directions", normal.directions,
                              f"need {dim} components per direction in this setting")
+    assert normal is not None  # only a scene with a cell has no explicit law, and that branch is above
     info = {"type": scene.interface.law, **info, "full_contact_K0": _K0(normal, dim)}
     return il.InterfaceLaw(normal=normal, friction=interface_friction(spec)), info
 

@@ -195,13 +195,12 @@ def _move(src: str, dst: str) -> None:
 
 
 # ---------------------------------------------------------------- the write
-def write_outputs(out_dir: str, report: dict, outcome: Outcome, inputs: Iterable[str] = ()) -> str:
-    """Write ``report.json``, ``report.html`` and the outcome's files into ``out_dir`` under the contract of this
-    module.
+def _staged(out_dir: str, names: list[str], inputs: Iterable[str], fill, version, *, keep_previous: bool) -> str:
+    """Stage ``fill(tmp)``'s files, then move ``names`` and the manifest into place (the module's contract).
 
-    Returns the directory's real path.
+    ``keep_previous``: the manifest also lists the files of earlier runs
+    (none is removed); otherwise those the new run does not write are removed.
     """
-    names = file_names(outcome) + list(REPORT_FILES)
     real = check_output_dir(out_dir, inputs, names)
     stage_in = real if os.path.isdir(real) else _existing_ancestor(real)
     remove_stale_staging(stage_in)
@@ -210,6 +209,39 @@ def write_outputs(out_dir: str, report: dict, outcome: Outcome, inputs: Iterable
     except OSError as exc:
         raise OutputError(f"--out {out_dir}: cannot write in {stage_in} ({exc.strerror})") from None
     try:
+        fill(tmp)
+        with _signals_held():
+            old = (own_files(real) or set()) if os.path.isdir(real) else set()
+            listed = sorted(set(names) | ({n for n in old if os.path.lexists(os.path.join(real, n))}
+                                          if keep_previous else set()))
+            with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as fh:
+                json.dump({"written_by": "ngcontact", "version": version, "files": listed}, fh, indent=1)
+                fh.write("\n")
+            os.makedirs(real, exist_ok=True)
+            for name in names:
+                _move(os.path.join(tmp, name), os.path.join(real, name))
+            for name in sorted(old - set(listed)):
+                target = os.path.join(real, name)
+                if os.path.isfile(target) or os.path.islink(target):
+                    os.remove(target)
+            _move(os.path.join(tmp, MANIFEST), os.path.join(real, MANIFEST))
+    except OSError as exc:  # e.g. a full disk: an output problem, reported as such
+        raise OutputError(f"--out {out_dir}: writing failed ({exc}); the previous output, if any, "
+                          "is unchanged") from exc
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return real
+
+
+def write_outputs(out_dir: str, report: dict, outcome: Outcome, inputs: Iterable[str] = ()) -> str:
+    """Write ``report.json``, ``report.html`` and the outcome's files into ``out_dir`` under the contract of this
+    module.
+
+    Returns the directory's real path.
+    """
+    names = file_names(outcome) + list(REPORT_FILES)
+
+    def fill(tmp: str) -> None:
         for name, (header, rows) in outcome.tables.items():
             write_csv(os.path.join(tmp, f"{name}.csv"), header, rows)
         for name, item in outcome.vtk.items():
@@ -222,23 +254,19 @@ def write_outputs(out_dir: str, report: dict, outcome: Outcome, inputs: Iterable
             json.dump(report, fh, indent=2, allow_nan=False)
             fh.write("\n")
         write_html(os.path.join(tmp, "report.html"), report, tmp, file_names(outcome))
-        manifest = {"written_by": "ngcontact", "version": report.get("version"), "files": sorted(names)}
-        with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as fh:
-            json.dump(manifest, fh, indent=1)
-            fh.write("\n")
-        with _signals_held():
-            old = (own_files(real) or set()) if os.path.isdir(real) else set()
-            os.makedirs(real, exist_ok=True)
-            for name in names:
-                _move(os.path.join(tmp, name), os.path.join(real, name))
-            for name in sorted(old - set(names)):
-                target = os.path.join(real, name)
-                if os.path.isfile(target) or os.path.islink(target):
-                    os.remove(target)
-            _move(os.path.join(tmp, MANIFEST), os.path.join(real, MANIFEST))
-    except OSError as exc:  # e.g. a full disk: an output problem, reported as such
-        raise OutputError(f"--out {out_dir}: writing failed ({exc}); the previous output, if any, "
-                          "is unchanged") from exc
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-    return real
+
+    return _staged(out_dir, names, inputs, fill, report.get("version"), keep_previous=False)
+
+
+def write_text_files(out_dir: str, files: dict[str, str], inputs: Iterable[str] = (), *, version=None) -> str:
+    """Write text files ``{name: content}`` into ``out_dir`` under the contract of this module.
+
+    Unlike :func:`write_outputs`, the files of earlier runs stay (an export
+    adds its file beside a run's report).  Returns the directory's real path.
+    """
+    def fill(tmp: str) -> None:
+        for name, content in files.items():
+            with open(os.path.join(tmp, name), "w", encoding="utf-8") as fh:
+                fh.write(content)
+
+    return _staged(out_dir, sorted(files), inputs, fill, version, keep_previous=True)

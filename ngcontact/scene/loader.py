@@ -28,7 +28,7 @@ __all__ = ["load", "from_dict", "effects", "as_dict", "resolve", "inputs"]
 _LOADING: list[str] = []
 
 #: Keys whose string value names a file the scene reads (``cell``: a scene).
-FILE_KEYS = ("file",)
+FILE_KEYS = ("file", "law_file")
 SCENE_KEYS = ("cell",)
 
 

@@ -66,7 +66,7 @@ def check_dimensions(dims: dict, path: str, shape: str, required) -> None:
 
 
 REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block": ("block", "base")}
-LAWS = ("linear", "bundle", "tabulated")
+LAWS = ("linear", "bundle", "tabulated", "file")
 #: Boundary labels of the meshed geometries (:mod:`ngcontact.geometry.bodies`) by (shape, setting),
 #: so that supports and loads are checked without meshing.
 FEMUR_BOUNDARIES = {
@@ -166,7 +166,13 @@ class InterfaceSpec:
     """The homogenized interface law on S_0 and the initial gap."""
 
     law: str = param("bundle", doc="linear (K0, bilateral), bundle (unilateral weighted directions; the "
-                     "default, also from a cell) or tabulated (pressure against closure)", choices=LAWS)
+                     "default, also from a cell), tabulated (pressure against closure) or file (a law file of "
+                     "`ngcontact export --format json`, see law_file)", choices=LAWS)
+    law_file: str | None = param(None, doc="law = file: the JSON law file, relative to this scene (SI units; "
+                                 "cell_length_unit is not applied)")
+    law_file_form: str = param("bundle", doc="law = file: which of the file's laws: bundle (exact), tabulated "
+                               "(its pressure-closure table, tangential stiffness = its stick slope) or linear (K0)",
+                               choices=("bundle", "tabulated", "linear"))
     cell: str | None = param(None, doc="cell scene file (relative to this scene): the law is its direction "
                              "bundle (law = linear: its K0); then omit the explicit numbers")
     cell_length_unit: float = param(1.0, doc="length of one unit of the cell scene (scales its gaps)",
@@ -199,6 +205,19 @@ class InterfaceSpec:
     def check(self, path: str) -> None:
         explicit = {"kn": self.kn, "weights": self.weights, "directions": self.directions, "gaps": self.gaps,
                     "closure": self.closure, "pressure": self.pressure}
+        if self.gap_table is not None:
+            xs = [q[0] for q in self.gap_table]
+            if any(b <= a for a, b in zip(xs, xs[1:])):
+                raise SceneError(f"{path}.gap_table", self.gap_table, "coordinates must increase strictly")
+            if self.gap != 0.0:
+                raise SceneError(f"{path}.gap", self.gap, "give either gap or gap_table")
+        if (self.law == "file") != (self.law_file is not None):
+            raise SceneError(f"{path}.law_file", self.law_file or MISSING, "give law_file exactly when law = 'file'")
+        if self.law == "file":
+            for key, value in dict(explicit, cell=self.cell).items():
+                if value is not None:
+                    raise SceneError(f"{path}.{key}", value, "not used with law = 'file'; remove it")
+            return
         if self.cell is not None:
             for key, value in explicit.items():
                 if value is not None:
@@ -219,12 +238,6 @@ class InterfaceSpec:
                           closure=self.closure, pressure=self.pressure)
         except ValueError as exc:
             raise SceneError(f"{path}", self.law, str(exc)) from None
-        if self.gap_table is not None:
-            xs = [q[0] for q in self.gap_table]
-            if any(b <= a for a, b in zip(xs, xs[1:])):
-                raise SceneError(f"{path}.gap_table", self.gap_table, "coordinates must increase strictly")
-            if self.gap != 0.0:
-                raise SceneError(f"{path}.gap", self.gap, "give either gap or gap_table")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -385,6 +398,13 @@ class MacroScene:
         """
         import os
         from ngcontact.scene.sections import resolve
+        if self.interface.law_file is not None:
+            from ngcontact.scene import law_file
+            contents = law_file.read(resolve(self, self.interface.law_file))
+            try:
+                law_file.normal_law_of(contents, self.interface.law_file_form)
+            except ValueError as exc:
+                raise SceneError("interface.law_file_form", self.interface.law_file_form, str(exc)) from None
         files = (("interface.cell", self.interface.cell, False),
                  ("strength.cell", self.strength.cell if self.strength else None, True),
                  ("two_scale.cell", self.two_scale.cell if self.two_scale else None, True))
@@ -407,7 +427,8 @@ class MacroScene:
 def effects(scene: MacroScene) -> tuple[str, ...]:
     """The terms assembled."""
     i = scene.interface
-    out = ["elasticity", f"interface_{i.law}" + ("_from_cell" if i.cell else "")]
+    out = ["elasticity", f"interface_{i.law_file_form}_from_file" if i.law == "file"
+           else f"interface_{i.law}" + ("_from_cell" if i.cell else "")]
     if i.gap != 0.0 or i.gap_table is not None:
         out.append("initial_gap")
     if i.mu > 0:

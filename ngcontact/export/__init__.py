@@ -1,0 +1,1 @@
+"""Export of a homogenized interface law to commercial FE codes (Abaqus, CalculiX, ANSYS) and to JSON."""
