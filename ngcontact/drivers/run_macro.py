@@ -39,6 +39,7 @@ from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 from ngcontact.scene.sections import resolve
 from ngcontact.geometry.femur import BOUNDARIES, FemurStemDims, femur_stem
+from ngcontact.geometry.femur3d import femur_stem_3d
 
 from ngcontact.fem.rigid_modes import check_rigid_modes
 
@@ -53,6 +54,13 @@ def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None) -> gm.M
     order = order or d.order
     dims = dict(g.dimensions or {})
     if g.shape == "femur_stem":
+        if g.setting == "3d":
+            femur = femur_stem_3d(FemurStemDims(**dims), maxh=maxh, interface_maxh=ih, order=order)
+            labels = {k: v for k, v in BOUNDARIES.items() if k != "axis"}
+            return gm.MacroGeometry(mesh=femur.mesh, rough="stem", counter="bone",
+                                    dims=dict(vars(FemurStemDims(**dims))),
+                                    boundaries={"interface": "stem-bone interface S_0 (cone and cylinder)",
+                                                **labels, "sym_x": "x = 0", "sym_y": "y = 0"})
         femur = femur_stem(FemurStemDims(**dims), maxh=maxh, interface_maxh=ih)
         return gm.MacroGeometry(mesh=femur.mesh, rough="stem", counter="bone", dims=dict(vars(FemurStemDims(**dims))),
                                 boundaries={"interface": "stem-bone interface S_0 (cone and cylinder)", **BOUNDARIES})

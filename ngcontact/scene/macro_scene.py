@@ -38,7 +38,7 @@ from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
 
 SHAPES = ("femur_stem", "coaxial", "block")
-SETTINGS = {"femur_stem": ("axisymmetric",), "coaxial": ("plane_strain", "axisymmetric", "3d"),
+SETTINGS = {"femur_stem": ("axisymmetric", "3d"), "coaxial": ("plane_strain", "axisymmetric", "3d"),
             "block": ("plane_strain",)}
 DIMENSIONS = {"femur_stem": tuple(f.name for f in dataclasses.fields(FemurStemDims)),
               "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base")}
@@ -88,6 +88,9 @@ _ENDS = {"bottom": "end face z = 0 of both tubes", "top": "end face z = height o
 #: Boundary labels of each (shape, setting) with what each is and what its supports mean.
 BOUNDARY_DOCS: dict[tuple[str, str], dict[str, str]] = {
     ("femur_stem", "axisymmetric"): FEMUR_BOUNDARIES,
+    ("femur_stem", "3d"): {**{k: v for k, v in FEMUR_BOUNDARIES.items() if k != "axis"}, **_QUARTER,
+                           "stem_inner": "internal faces of the stem where its cone and cylinders meet (no "
+                                         "support or load belongs there)"},
     ("coaxial", "plane_strain"): {**_COAXIAL, **_QUARTER},
     ("coaxial", "axisymmetric"): {**_COAXIAL, **_ENDS},
     ("coaxial", "3d"): {**_COAXIAL, **_QUARTER, **_ENDS},
@@ -309,6 +312,9 @@ def macro_extent(shape: str, setting: str, dims: dict) -> tuple[int, float, floa
     import math
     if shape == "femur_stem":
         d = FemurStemDims(**dims)
+        if setting == "3d":
+            return 3, math.pi / 4 * d.r_bone ** 2 * d.z_stem_top, math.pi / 2 * d.r_stem * femur_interface_length(d), \
+                d.r_bone - d.r_stem
         return 2, d.r_bone * d.z_stem_top, femur_interface_length(d), d.r_bone - d.r_stem
     if shape == "block":
         return 2, dims["length"] * (dims["h_block"] + dims["h_base"]), dims["length"], \

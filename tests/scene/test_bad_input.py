@@ -455,7 +455,9 @@ def test_boundary_table_matches_the_meshed_geometries():
     from ngcontact.geometry.femur import FemurStemDims, femur_stem
     from ngcontact.scene.macro_scene import BOUNDARIES
     from ngcontact.macro.macro_problem import boundary_labels
+    from ngcontact.geometry.femur3d import femur_stem_3d
     built = {("femur_stem", "axisymmetric"): femur_stem(FemurStemDims(), maxh=0.02),
+             ("femur_stem", "3d"): femur_stem_3d(FemurStemDims(), maxh=0.03, order=1),
              ("coaxial", "plane_strain"): gm.coaxial_plane_strain(1.0, 2.0, 3.0, maxh=1.0),
              ("coaxial", "axisymmetric"): gm.coaxial_axisymmetric(1.0, 2.0, 3.0, 1.0, maxh=1.0),
              ("coaxial", "3d"): gm.coaxial_3d(1.0, 2.0, 3.0, 1.0, maxh=1.0),
