@@ -26,7 +26,8 @@ from collections import Counter
 import numpy as np
 import ngsolve as ng
 
-from ngcontact.drivers.build import body_laws, interface_friction, interface_normal_law, law_from_cell, linear_solver
+from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
+                                     law_from_cell, linear_solver)
 from ngcontact.laws import homogenized as il
 from ngcontact.fem.interpolants import piecewise_linear
 from ngcontact.macro import macro_problem as M
@@ -67,9 +68,10 @@ def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None) -> gm.M
 def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
     """The interface law of ``scene`` and a description of it for the report."""
     spec = scene.interface
+    overrides = spec.cell_overrides()
     if spec.cell is not None:
         normal, info = law_from_cell(resolve(scene, spec.cell), dim=dim, linear=spec.law == "linear",
-                                     length_unit=spec.cell_length_unit)
+                                     length_unit=spec.cell_length_unit, overrides=overrides)
     else:
         normal = interface_normal_law(spec)
         info = {"source": "explicit numbers"}
@@ -77,7 +79,17 @@ def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
             raise SceneError("interface.directions", normal.directions,
                              f"need {dim} components per direction in this setting")
     info = {"type": scene.interface.law, **info, "full_contact_K0": _K0(normal, dim)}
-    return il.InterfaceLaw(normal=normal, friction=interface_friction(spec)), info
+    friction: il.Friction | None
+    if spec.friction == "from_cell":
+        cell = spec.cell if spec.cell is not None else scene.two_scale.cell
+        friction, info["friction"] = friction_from_cell(resolve(scene, cell), width=spec.huber_width,
+                                                        overrides=overrides)
+    else:
+        friction = interface_friction(spec)
+        info["friction"] = {"source": "scene", "mu0": spec.mu, "G0": spec.threshold, "huber_width": spec.huber_width}
+    if overrides:
+        info["cell_overrides"] = overrides
+    return il.InterfaceLaw(normal=normal, friction=friction), info
 
 
 def _K0(normal, dim):
@@ -192,10 +204,12 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
     return problem, info
 
 
-def solve_scene(scene, problem: M.MacroProblem) -> M.MacroSolution:
+def solve_scene(scene, problem: M.MacroProblem, start=None) -> M.MacroSolution:
+    """:func:`ngcontact.macro.macro_problem.solve` with the scene's solver settings (``start``: warm start)."""
     s = scene.solver
     return M.solve(problem, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
-                   coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter, linear=linear_solver(scene))
+                   coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter, linear=linear_solver(scene),
+                   start=start)
 
 
 def checked_equilibrium(sol: M.MacroSolution) -> dict:
@@ -230,7 +244,7 @@ def run(scene, clock) -> Outcome:
             sol = solve_scene(scene, problem)
         else:
             from ngcontact.drivers.run_two_scale import couple
-            sol, two_scale = couple(scene, problem, lambda prob: solve_scene(scene, prob))
+            sol, two_scale = couple(scene, problem, lambda prob, start: solve_scene(scene, prob, start))
     with clock.stage("post-processing"):
         balance = checked_equilibrium(sol)
         fields = MM.stress_fields(sol)
