@@ -242,9 +242,12 @@ def response_law(table: CellTable) -> il.TabulatedLaw:
         response is not monotone, e.g. a cell solve that did not converge).
     """
     P = table.pressures
-    if len(P) < 2:
-        raise ModelError("cell table: need at least two pressures for a law")
     c = np.array([table.values[q]["closure"] for q in P])
+    # nodes closer than round-off to their neighbour carry no information and spoil the slopes
+    keep = np.concatenate([[True], np.abs(np.diff(c)) > 1e-9 * np.max(np.abs(c))])
+    P, c = P[keep], c[keep]
+    if len(P) < 2:
+        raise ModelError("cell table: need at least two distinct pressures for a law")
     if np.any(np.diff(c) <= 0):
         k = int(np.argmin(np.diff(c)))
         raise ModelError(f"cell table: the closure does not increase with the pressure between p = {P[k]:.6g} "

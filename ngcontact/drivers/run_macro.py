@@ -293,6 +293,8 @@ def run(scene, clock) -> Outcome:
         with clock.stage("strength check"):
             st = evaluate(scene, sol)
         results["strength"] = st["results"]
+        if two_scale is not None:
+            results["two_scale"]["summary"] = two_scale_summary(two_scale, st["results"])
         tables["strength_map"] = st["table"]
         vtk["worst_cell"] = st["vtk"]
         plots.update(st["plots"])
@@ -302,6 +304,18 @@ def run(scene, clock) -> Outcome:
               "coulomb_changes": sol.history["coulomb_changes"], "solves": newton,
               "linear": sol.history["linear"]}
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
+
+
+def two_scale_summary(two_scale: dict, strength: dict) -> dict:
+    """The two-scale loop and the strength check of its converged state in one place."""
+    return {"iterations": two_scale["iterations"], "macro_solves": two_scale["macro_solves"],
+            "cell_solves": two_scale["cell_solves"], "table_from_cache": two_scale["cache"]["table_from_cache"],
+            "table_error_estimate": two_scale["table"]["error_estimate"],
+            "newton_per_solve": two_scale["newton_per_solve"],
+            "max_change": [h["max_change"] for h in two_scale["history"][1:]],
+            "safety_factor": strength["safety_factor"], "critical_body": strength["critical_body"],
+            "critical_points": {b: {"macro_point": e["macro_point"], "cell_point": e.get("cell_point"),
+                                    "max_sigma_eq": e["max_sigma_eq"]} for b, e in strength["bodies"].items()}}
 
 
 # ------------------------------------------------------------------ plot data

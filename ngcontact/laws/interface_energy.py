@@ -27,9 +27,9 @@ replaced by the weighted directions)::
     W(a) = sum_i s_i/2 [c - c_i]_+^2 + k_t/2 |a_t|^2
     tau  = (sum_i s_i [c - c_i]_+,  k_t a_t)
 
-(on CoefficientFunctions the same piecewise linear ``p(c)`` and its integral
-are NGSolve B-splines of order 2: one table lookup per quadrature point
-instead of one ramp per kink; the two-scale law has dozens of kinks)
+(on CoefficientFunctions the energy is the same function written as an
+NGSolve B-spline, one table lookup per quadrature point instead of one ramp
+per kink; the two-scale law has dozens of kinks)
 
 With ``closed=True`` :func:`normal_energy` is the quadratic "all closed"
 surrogate (a start value for Newton): every ramp ``[x]_+`` replaced by ``x``,
@@ -77,14 +77,14 @@ def _ramp(x):
 
 
 @functools.lru_cache(maxsize=16)
-def _spline(closure: tuple, pressure: tuple):
-    """``(p, W)`` of a table as NGSolve B-splines: ``p`` piecewise linear (0 below ``c_0``, the last
-    slope beyond ``c_last``), ``W`` its integral from ``c_0``; one table lookup per point instead of a
-    sum of ramps (the same function; tests/laws compare the two)."""
+def _energy_spline(closure: tuple, pressure: tuple):
+    """The integral ``W(c)`` of the piecewise linear ``p(c)`` of a table (0 below ``c_0``, the last slope
+    beyond ``c_last``) as an NGSolve B-spline of order 3: one table lookup per point instead of a sum of
+    ramps (the same function; tests/laws compare the two).  The order-2 spline of ``p`` itself has no
+    second derivatives in NGSolve, so the traction stays a sum of ramps."""
     import ngsolve as ng
     c = [float(x) for x in closure]
-    p = ng.BSpline(2, [c[0]] + c + [c[-1]], [float(x) for x in pressure])
-    return p, p.Integrate()
+    return ng.BSpline(2, [c[0]] + c + [c[-1]], [float(x) for x in pressure]).Integrate()
 
 
 # ----------------------------------------------------------- energies
@@ -120,7 +120,7 @@ def normal_energy(law: NormalLaw, a, g0=0.0, closed: bool = False):
     if isinstance(law, TabulatedLaw):
         c = a[0] - g0
         if not closed and not is_numeric(c):
-            W = _spline(law.closure, law.pressure)[1](c)
+            W = _energy_spline(law.closure, law.pressure)(c)
             return W + 0.5 * law.kt * sum(ai * ai for ai in a[1:]) if law.kt > 0 else W
         kinks, slopes = law.ramps()
         if closed:
@@ -151,12 +151,9 @@ def normal_traction(law: NormalLaw, a, g0=0.0) -> list:
             tau = [tau[i] + f * n[i] for i in range(dim)]
         return tau
     if isinstance(law, TabulatedLaw):
+        kinks, slopes = law.ramps()
         c = a[0] - g0
-        if is_numeric(c):
-            kinks, slopes = law.ramps()
-            p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
-        else:
-            p = _spline(law.closure, law.pressure)[0](c)
+        p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
         return [p] + [law.kt * ai for ai in a[1:]]
     raise TypeError(f"unknown interface law {type(law).__name__}")
 
