@@ -101,12 +101,13 @@ def store_table(key: str, table: T.CellTable, cache_dir: str | None = None) -> N
 
 def couple(scene, problem, solve,
            map_tasks: Callable[[Callable[[float], T.Response], Sequence[float]], list[T.Response]] = T.serial_map,
-           cache_dir: str | None = None):
+           cache_dir: str | None = None, warm: bool = True):
     """Run the loop of ``scene.two_scale`` from ``problem``; returns ``(solution, results)``.
 
     ``solve(problem, start)``: the macro solve (warm-started from the
     vector ``start`` when it is not None); ``map_tasks``: runs the cell
-    solves of one table level (:class:`~ngcontact.coupling.two_scale.CellTable`).
+    solves of one table level (:class:`~ngcontact.coupling.two_scale.CellTable`);
+    ``warm = False`` cold-starts every macro solve (for comparisons).
     """
     from ngcontact.drivers.build import cell_scene_of
     spec = scene.two_scale
@@ -117,7 +118,7 @@ def couple(scene, problem, solve,
     key = table_key(cell_scene, spec.cell_length_unit, spec.table_tol)
     table, from_cache = cached_table(key, task, spec.table_tol, map_tasks, cache_dir)
     out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
-                   points_per_element=scene.output.points_per_element, solve=solve)
+                   points_per_element=scene.output.points_per_element, solve=solve, warm=warm)
     if table.solves:
         store_table(key, table, cache_dir)
     p = interface_profile(out.solution, scene.output.points_per_element)["pressure"]

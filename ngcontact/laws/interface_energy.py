@@ -27,9 +27,9 @@ replaced by the weighted directions)::
     W(a) = sum_i s_i/2 [c - c_i]_+^2 + k_t/2 |a_t|^2
     tau  = (sum_i s_i [c - c_i]_+,  k_t a_t)
 
-(on CoefficientFunctions the energy is the same function written as an
-NGSolve B-spline, one table lookup per quadrature point instead of one ramp
-per kink; the two-scale law has dozens of kinks)
+(on CoefficientFunctions the same functions are NGSolve B-splines, one
+table lookup per quadrature point instead of one ramp per kink; the
+two-scale law has dozens of kinks)
 
 With ``closed=True`` :func:`normal_energy` is the quadratic "all closed"
 surrogate (a start value for Newton): every ramp ``[x]_+`` replaced by ``x``,
@@ -77,14 +77,23 @@ def _ramp(x):
 
 
 @functools.lru_cache(maxsize=16)
-def _energy_spline(closure: tuple, pressure: tuple):
-    """The integral ``W(c)`` of the piecewise linear ``p(c)`` of a table (0 below ``c_0``, the last slope
-    beyond ``c_last``) as an NGSolve B-spline of order 3: one table lookup per point instead of a sum of
-    ramps (the same function; tests/laws compare the two).  The order-2 spline of ``p`` itself has no
-    second derivatives in NGSolve, so the traction stays a sum of ramps."""
+def _splines(closure: tuple, pressure: tuple):
+    """``(p, W)`` of a table as NGSolve B-splines: one table lookup per point instead of a sum of ramps.
+
+    ``p(c)`` piecewise linear (0 below ``c_0``, the last slope beyond
+    ``c_last``) as a quadratic B-spline whose interior knots are doubled (so
+    it is only C0 there, and exactly the polyline: control values at the
+    table points and the segment midpoints); quadratic because NGSolve's
+    linear B-splines have no second derivatives, which a Newton tangent of
+    an energy holding ``p`` (the Coulomb threshold ``mu p``) needs.  ``W``
+    its integral from ``c_0``.  tests/laws compare both with the ramps.
+    """
     import ngsolve as ng
     c = [float(x) for x in closure]
-    return ng.BSpline(2, [c[0]] + c + [c[-1]], [float(x) for x in pressure]).Integrate()
+    p = [float(x) for x in pressure]
+    values = [v for a, b in zip(p[:-1], p[1:]) for v in (a, 0.5 * (a + b))] + [p[-1]]
+    knots = [c[0]] * 3 + [x for x in c[1:-1] for _ in (0, 1)] + [c[-1]] * 3
+    return ng.BSpline(3, knots, values), ng.BSpline(2, [c[0]] + c + [c[-1]], p).Integrate()
 
 
 # ----------------------------------------------------------- energies
@@ -120,7 +129,7 @@ def normal_energy(law: NormalLaw, a, g0=0.0, closed: bool = False):
     if isinstance(law, TabulatedLaw):
         c = a[0] - g0
         if not closed and not is_numeric(c):
-            W = _energy_spline(law.closure, law.pressure)(c)
+            W = _splines(law.closure, law.pressure)[1](c)
             return W + 0.5 * law.kt * sum(ai * ai for ai in a[1:]) if law.kt > 0 else W
         kinks, slopes = law.ramps()
         if closed:
@@ -151,9 +160,12 @@ def normal_traction(law: NormalLaw, a, g0=0.0) -> list:
             tau = [tau[i] + f * n[i] for i in range(dim)]
         return tau
     if isinstance(law, TabulatedLaw):
-        kinks, slopes = law.ramps()
         c = a[0] - g0
-        p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
+        if is_numeric(c):
+            kinks, slopes = law.ramps()
+            p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
+        else:
+            p = _splines(law.closure, law.pressure)[0](c)
         return [p] + [law.kt * ai for ai in a[1:]]
     raise TypeError(f"unknown interface law {type(law).__name__}")
 

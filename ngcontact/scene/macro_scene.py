@@ -15,10 +15,10 @@ because both act on a macro solution and share its geometry, law and output):
 
 * ``[two_scale]``: the coupling loop of paper Sec. 3.5
   (:mod:`ngcontact.coupling.two_scale`): the scene's interface law is the start (the
-  assumed contact set), and the cell named there, solved at the macro
-  pressure of every interface point (through an adaptive table in the
-  pressure), supplies coefficients that vary along the interface until the
-  macro normal stress stops changing;
+  assumed contact set), and the cell named there, tabulated adaptively in
+  the pressure over the macro pressures (cached on disk), supplies its own
+  response closure -> pressure as the interface law, until the table covers
+  the macro pressures and the macro normal stress stops changing;
 * ``[strength]``: micro stresses in the layer and the check of paper eq. 78
   (:mod:`ngcontact.coupling.strength`) against ``materials.NAME.sigma_u`` of both
   bodies.
@@ -304,11 +304,13 @@ class TwoScaleSpec:
                                     units="m", check=positive())
     tol: float = param(doc="stop when max |sigma_n(k) - sigma_n(k-1)| over the interface points is below",
                        units="Pa", check=positive())
-    max_iter: int = param(20, doc="largest number of coefficient updates", check=at_least(1))
+    max_iter: int = param(20, doc="largest number of law updates", check=at_least(1))
     table_tol: float = param(0.01, doc="interpolation tolerance of the cell table: the contact fraction "
-                             "and g_n0 / max g_n0 at interval midpoints", check=positive())
+                             "and the closure relative to their largest values at interval midpoints",
+                             check=positive())
     table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
-                             "(below it the coefficients are held constant)", check=open_interval(0, 1))
+                             "(below it the law follows the table's first secant down to p = 0)",
+                             check=open_interval(0, 1))
 
 
 def macro_extent(shape: str, setting: str, dims: dict) -> tuple[int, float, float, float]:

@@ -195,13 +195,17 @@ def test_cell_response_law_is_consistent_in_the_assembled_macro_problem():
     sup = (M.Support(label="sym_x", components=("x",)), M.Support(label="sym_y", components=("y",)))
     problem = M.MacroProblem(mesh=g.mesh, setting="plane_strain", rough="inner", counter="outer",
                              materials={"inner": isotropic(200.0, 0.3), "outer": isotropic(70.0, 0.25)},
-                             law=il.InterfaceLaw(normal=law, friction=il.Friction(threshold=0.05, width=1e-4)),
+                             law=il.InterfaceLaw(normal=law, friction=il.Friction(mu=0.3, threshold=0.05, width=1e-4)),
                              gap=-0.5e-3 * ng.x, supports=sup, order=2)
     fes = two_body.spaces(problem.mesh, problem.setting, (problem.rough, problem.counter), problem.supports, 2)
     frame = local_frame(two_body.interface_normal(problem.mesh, "inner", "interface"), 2)
-    form = M._form(problem, fes, frame, G=ng.CF(0.05))
     rng = np.random.default_rng(5)
     free = np.array(list(fes.FreeDofs()), dtype=bool)
+    old = ng.GridFunction(fes)      # a frozen Coulomb threshold mu p(old) + G0, as in the fixed point
+    old.vec.FV().NumPy()[free] = 1e-3 * rng.standard_normal(free.sum())
+    G = ie.threshold(problem.law.friction, ie.pressure(law, M._local(frame, old.components[0] - old.components[1]),
+                                                        -0.5e-3 * ng.x))
+    form = M._form(problem, fes, frame, G=G)
     u = ng.GridFunction(fes).vec
     for trial in range(3):
         u.FV().NumPy()[:] = 0.0
