@@ -37,6 +37,7 @@ from ngcontact.geometry import bodies as gm
 from ngcontact.scene.macro_scene import REGIONS
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
+from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
 from ngcontact.geometry.femur import BOUNDARIES, FemurStemDims, femur_stem
 
@@ -68,7 +69,7 @@ def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None) -> gm.M
 def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
     """The interface law of ``scene`` and a description of it for the report."""
     spec = scene.interface
-    overrides = spec.cell_overrides()
+    overrides = cell_links.overrides(spec)
     if spec.cell is not None:
         normal, info = law_from_cell(resolve(scene, spec.cell), dim=dim, linear=spec.law == "linear",
                                      length_unit=spec.cell_length_unit, overrides=overrides)

@@ -35,6 +35,7 @@ import numpy as np
 from ngcontact.coupling import cell_law
 from ngcontact.coupling import two_scale as T
 from ngcontact.macro.macro_measures import interface_profile
+from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
 
 log = logging.getLogger(__name__)
@@ -112,7 +113,7 @@ def couple(scene, problem, solve,
     from ngcontact.drivers.build import cell_scene_of
     spec = scene.two_scale
     path = resolve(scene, spec.cell)
-    overrides = scene.interface.cell_overrides()
+    overrides = cell_links.overrides(scene.interface)
     cell_scene = cell_scene_of(path, key="two_scale.cell", overrides=overrides)
     task = PressureSolve(path, spec.cell_length_unit, overrides)
     key = table_key(cell_scene, spec.cell_length_unit, spec.table_tol)

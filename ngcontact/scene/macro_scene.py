@@ -34,7 +34,7 @@ from ngcontact.laws import homogenized as il
 from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
-from ngcontact.scene import mesh_size
+from ngcontact.scene import cell_links, mesh_size
 from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
 
 SHAPES = ("femur_stem", "coaxial", "block")
@@ -195,26 +195,16 @@ class InterfaceSpec:
     threshold: float = param(0.0, doc="Tresca threshold G0", units="Pa", check=nonnegative())
     huber_width: float = param(1e-6, doc="Huber width w: largest slip of a sticking point", units="m",
                                check=positive())
-    friction: str = param("given", doc="given: mu and threshold above; from_cell: the homogenized friction of "
-                          "the cell the law comes from (interface.cell, else two_scale.cell), paper eqs. 42-43: "
-                          "mu0 from its Coulomb coefficient, G0 from its Tresca threshold",
+    friction: str = param("given", doc="given: mu and threshold above; from_cell: mu0 and G0 of eqs. 42-43 from "
+                          "the cell the law comes from (interface.cell, else two_scale.cell)",
                           choices=("given", "from_cell"))
-    cell_k_n: float | None = param(None, doc="override of the cell scene's contact.k_n (the cells the law "
-                                   "comes from: interface.cell and two_scale.cell)", units="Pa/m",
+    cell_k_n: float | None = param(None, doc="replaces contact.k_n of the cells the law comes from", units="Pa/m",
                                    check=positive())
-    cell_friction: str | None = param(None, doc="override of the cell scene's contact.friction (then give "
-                                      "cell_mu or cell_G, and cell_w)", choices=("none", "tresca", "coulomb"))
-    cell_mu: float | None = param(None, doc="override of the cell scene's contact.mu", check=nonnegative())
-    cell_G: float | None = param(None, doc="override of the cell scene's contact.G", units="Pa",
-                                 check=nonnegative())
-    cell_w: float | None = param(None, doc="override of the cell scene's contact.w (cell length units)",
-                                 check=positive())
-
-    def cell_overrides(self) -> dict:
-        """The ``[contact]`` keys of the cell scene this section overrides."""
-        keys = {"k_n": self.cell_k_n, "friction": self.cell_friction, "mu": self.cell_mu, "G": self.cell_G,
-                "w": self.cell_w}
-        return {k: v for k, v in keys.items() if v is not None}
+    cell_friction: str | None = param(None, doc="replaces their contact.friction (with cell_mu or cell_G, "
+                                      "and cell_w)", choices=("none", "tresca", "coulomb"))
+    cell_mu: float | None = param(None, doc="replaces their contact.mu", check=nonnegative())
+    cell_G: float | None = param(None, doc="replaces their contact.G", units="Pa", check=nonnegative())
+    cell_w: float | None = param(None, doc="replaces their contact.w (cell length units)", check=positive())
 
     def check(self, path: str) -> None:
         explicit = {"kn": self.kn, "weights": self.weights, "directions": self.directions, "gaps": self.gaps,
@@ -388,24 +378,7 @@ class MacroScene:
             raise SceneError("interface.gap_coordinate", "z", "plane strain has coordinates x, y")
         if self.strength is not None and dim == 3:
             raise SceneError("strength", "...", "available for plane strain and axisymmetric macro problems")
-        if self.two_scale is not None and dim == 3:
-            raise SceneError("two_scale", "...", "not available in 3D macro scenes: the loop reads the macro "
-                             "pressure from the 2D interface profile (macro_measures.interface_profile) and "
-                             "coupling.two_scale.couple does not yet read it from the 3D interface surface "
-                             "(macro_measures.interface_surface); the tabulated cell law itself works in 3D. Use "
-                             "geometry.setting = 'axisymmetric' or 'plane_strain'")
-        cell = self.interface.cell or (self.two_scale.cell if self.two_scale else None)
-        if cell is None:
-            for key, value in self.interface.cell_overrides().items():
-                raise SceneError(f"interface.cell_{key}", value, "overrides a cell's contact, but the scene "
-                                 "names no cell (interface.cell or two_scale.cell)")
-            if self.interface.friction == "from_cell":
-                raise SceneError("interface.friction", "from_cell", "needs a cell: interface.cell or "
-                                 "two_scale.cell")
-        if self.interface.friction == "from_cell" and (self.interface.mu or self.interface.threshold):
-            raise SceneError("interface.mu" if self.interface.mu else "interface.threshold",
-                             self.interface.mu or self.interface.threshold,
-                             "not used with interface.friction = 'from_cell' (the cell gives mu0 and G0); remove it")
+        cell_links.check(self.interface, self.two_scale, dim)
         if self.strength is not None:
             for role in ("rough", "counter"):
                 name = getattr(self.bodies, role)
@@ -421,15 +394,14 @@ class MacroScene:
         also need a contact model (not ``contact.geometric_only``).  A fault
         inside a cell scene is reported under the key naming it, e.g.
         ``interface.cell = 'hip.toml': invalid cell scene: materials.bone.nu = ...``.
-        ``load(path, overrides=None)`` reads a scene, with ``[contact]``
-        overrides (``interface.cell_*``) for the cells the law comes from.
+        ``load(path, overrides=None)``: overrides of the law's cells' ``[contact]``.
         """
         import os
         from ngcontact.scene.sections import resolve
         files = (("interface.cell", self.interface.cell, False),
                  ("strength.cell", self.strength.cell if self.strength else None, True),
                  ("two_scale.cell", self.two_scale.cell if self.two_scale else None, True))
-        overrides = self.interface.cell_overrides()
+        overrides = cell_links.overrides(self.interface)
         for key, rel, solved in files:
             if rel is None:
                 continue
@@ -447,11 +419,7 @@ class MacroScene:
                                      f"the cell {rel!r} with these overrides is invalid: {exc}") from None
             if cell.kind != "cell":
                 raise SceneError(key, rel, f"invalid cell scene: must be of kind 'cell', not {cell.kind!r}")
-            law_cell = "interface.cell" if self.interface.cell is not None else "two_scale.cell"
-            if self.interface.friction == "from_cell" and key == law_cell and cell.contact.friction == "none":
-                raise SceneError("interface.friction", "from_cell", f"the cell {rel!r} ({key}) has no friction "
-                                 "(contact.friction = 'none'); give it one with interface.cell_friction, or use "
-                                 "interface.friction = 'given'")
+            cell_links.check_friction_source(self.interface, key, rel, cell)
             if solved and cell.contact.geometric_only:
                 raise SceneError(key, rel, "invalid cell scene: contact.geometric_only = true, but this "
                                  "section solves the cell, so it needs a contact model and a [load] section")
