@@ -117,3 +117,8 @@ def test_loop_converges_on_the_shipped_scene_with_falling_changes():
     assert ts["table"]["error_estimate"] <= scene.two_scale.table_tol
     f = np.asarray(ts["interface_coefficients"]["contact_fraction"])
     assert f.max() > 2 * f[f > 0].min()  # the real contact area varies along the interface
+    # the strength check of the converged state, joined with the loop's figures
+    summary = ts["summary"]
+    assert summary["safety_factor"] == out.results["strength"]["safety_factor"] > 0
+    assert summary["cell_solves"] == ts["cell_solves"] and summary["table_error_estimate"] <= scene.two_scale.table_tol
+    assert set(summary["critical_points"]) == {"rough", "counter"}
