@@ -9,13 +9,16 @@ The scene ``geometries/femur_stem_two_scale.toml`` (the femur of
 
 1. start from an assumed contact set (10 % of each groove in contact),
 2. solve the macro problem with that law,
-3. at every interface point, take the macro normal stress as the load of the
-   groove cell and read off its real contact fraction and its coefficients
-   ``k_n0``, ``g_n0`` (a table in the pressure, refined adaptively, so that
-   the number of cell solves does not grow with the interface points),
-4. solve the macro problem again with coefficients varying along the
-   interface, and repeat until the macro normal stress changes by less than
-   ``tol`` (10 kPa) anywhere.
+3. take the macro normal stresses as the loads of the groove cell and
+   tabulate its response: real contact fraction and mean closure against
+   the pressure (refined adaptively, so that the number of cell solves does
+   not grow with the interface points; cached on disk, so a second run
+   solves no cell problem),
+4. solve the macro problem again, warm-started, with the cell's own
+   response ``p(closure)`` as the interface law at every point (the fixed
+   point of the paper's coefficient updates), and stop once the table
+   covers the macro pressures and the pressure changes by less than ``tol``
+   (10 kPa) anywhere.
 
 The report's ``two_scale`` entry holds the history.  The key number is the
 peak contact pressure of the converged coupled solution.
@@ -38,7 +41,7 @@ def main() -> float:
         change = "-" if step["max_change"] is None else f"{step['max_change'] / 1e3:.1f}"
         print(f" {step['iteration']:9d}   {step['max_pressure'] / 1e6:19.3f}   {change:>20}"
               f"   {step['cell_solves']:18d}")
-    print(f"converged: {loop['converged']} after {loop['iterations']} coefficient updates, "
+    print(f"converged: {loop['converged']} after {loop['iterations']} law updates, "
           f"{loop['macro_solves']} macro and {loop['cell_solves']} cell solves")
 
     # The real contact share of the grooves along the interface, from the cell table.

@@ -118,13 +118,15 @@ def test_export_law_normal_stiffness_is_the_sinusoids(run):
     assert "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=TABULAR" in out and "*FRICTION" in out
 
 
-@pytest.mark.slow  # the shipped two-scale scene: 7 macro and 39 cell solves, 10-20 s
+@pytest.mark.slow  # the shipped two-scale scene: 2 macro and about 23 cell solves (0 on a warm cache)
 def test_two_scale_converged_peak_pressure(run):
     peak, out = run("two_scale.py")
-    # Recorded from the shipped scene.  The loop stops once the pressure changes by less
-    # than 10 kPa anywhere, 4e-4 of the peak, so a reproduction that stops one update
-    # earlier or later under round-off stays within 1e-3.
-    assert peak == pytest.approx(25994878.3, rel=1e-3)
+    # Recorded from the shipped scene.  The macro law is the cell's tabulated response, so the
+    # converged state satisfies the cell relation at every interface point (the earlier
+    # coefficient loop's fixed point, 25.99 MPa, missed it by up to 1.6 MPa at the contact
+    # edge, where the pressure field was projected before the law was built); Newton rtol
+    # 1e-10 and the Coulomb fixed point leave round-off well below 1e-4.
+    assert peak == pytest.approx(25653797.9, rel=1e-4)
     assert "converged: True" in out
 
 

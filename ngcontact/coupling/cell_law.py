@@ -58,39 +58,87 @@ def _package_version() -> str:
         return "unknown"
 
 
-def _digest(arrays: dict) -> str:
+def _digest(arrays: dict, names=ARRAYS) -> str:
     h = hashlib.sha256()
-    for k in ARRAYS:
+    for k in names:
         a = np.ascontiguousarray(arrays[k], dtype=float)
         h.update(k.encode() + str(a.shape).encode() + a.tobytes())
     return h.hexdigest()
 
 
-def _read_entry(path: str, key: str) -> dict:
+def _bundle_shapes(arrays: dict) -> str | None:
+    w, n, g = arrays["w"], arrays["n"], arrays["g"]
+    if not (w.ndim == 1 and g.shape == w.shape and n.ndim == 2 and n.shape[0] == w.size and n.shape[1] in (2, 3)):
+        return f"arrays of shapes {w.shape}, {n.shape}, {g.shape}"
+    return None
+
+
+def _read_entry(path: str, key: str, names=ARRAYS, fmt: str = CACHE_VERSION,
+                shapes: Callable[[dict], str | None] = _bundle_shapes) -> dict:
     """The arrays of a cache entry; raises ``ValueError`` naming what is wrong with it."""
     try:
         with np.load(path, allow_pickle=False) as data:
-            arrays = {k: np.array(data[k], dtype=float) for k in ARRAYS}
+            arrays = {k: np.array(data[k], dtype=float) for k in names}
             meta = json.loads(str(data["meta"]))
     except (OSError, KeyError, ValueError, TypeError, EOFError, zipfile.BadZipFile) as exc:
         raise ValueError(f"unreadable ({type(exc).__name__}: {exc})") from None
     if not isinstance(meta, dict):
         raise ValueError("no description")
-    for name, want in (("format", CACHE_VERSION), ("version", _package_version()), ("key", key)):
+    for name, want in (("format", fmt), ("version", _package_version()), ("key", key)):
         if meta.get(name) != want:
             raise ValueError(f"{name} {meta.get(name)!r}, expected {want!r}")
-    w, n, g = arrays["w"], arrays["n"], arrays["g"]
-    if not (w.ndim == 1 and g.shape == w.shape and n.ndim == 2 and n.shape[0] == w.size and n.shape[1] in (2, 3)):
-        raise ValueError(f"arrays of shapes {w.shape}, {n.shape}, {g.shape}")
-    if not all(np.all(np.isfinite(a)) for a in (w, n, g)):
+    wrong = shapes(arrays)
+    if wrong:
+        raise ValueError(wrong)
+    if not all(np.all(np.isfinite(a)) for a in arrays.values()):
         raise ValueError("non-finite values")
-    if meta.get("sha256") != _digest(arrays):
+    if meta.get("sha256") != _digest(arrays, names):
         raise ValueError("checksum mismatch (the entry was changed after it was written)")
     return arrays
 
 
 def cache_dir_default() -> str:
     return os.environ.get("NGCONTACT_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "ngcontact")
+
+
+def read_cached(key: str, names=ARRAYS, fmt: str = CACHE_VERSION, cache_dir: str | None = None,
+                shapes: Callable[[dict], str | None] = _bundle_shapes) -> dict | None:
+    """The arrays ``names`` cached under ``key``, or ``None`` (a bad entry is discarded with one warning)."""
+    path = os.path.join(cache_dir or cache_dir_default(), f"{key}.npz")
+    if not os.path.isfile(path):
+        return None
+    try:
+        found = _read_entry(path, key, names, fmt, shapes)
+        log.info("cell data from cache %s", path)
+        return found
+    except ValueError as exc:
+        log.warning("ngcontact: discarding the cache entry %s (%s); recomputing it", path, exc)
+        return None
+
+
+def write_cached(key: str, arrays: dict, names=ARRAYS, fmt: str = CACHE_VERSION,
+                 cache_dir: str | None = None) -> None:
+    """Write ``arrays`` under ``key`` atomically; a cache that cannot be written costs one warning."""
+    cache_dir = cache_dir or cache_dir_default()
+    path = os.path.join(cache_dir, f"{key}.npz")
+    # Any values: np.savez's stub would otherwise match the arrays against
+    # its keyword-only allow_pickle: bool
+    data: dict[str, Any] = {k: np.asarray(arrays[k], float) for k in names}
+    meta = {"format": fmt, "version": _package_version(), "key": key, "sha256": _digest(data, names)}
+    tmp = None
+    try:
+        os.makedirs(cache_dir, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(suffix=".npz", dir=cache_dir)
+        os.close(fd)
+        np.savez(tmp, meta=np.array(json.dumps(meta)), **data)
+        os.replace(tmp, path)
+        log.info("cell data computed and cached in %s", path)
+    except OSError as exc:
+        log.warning("ngcontact: the cell-law cache %s cannot be written (%s); the law is recomputed on every "
+                    "run (set NGCONTACT_CACHE to a writable directory)", cache_dir, exc.strerror or exc)
+    finally:
+        if tmp is not None and os.path.exists(tmp):
+            os.remove(tmp)
 
 
 def cached_bundle_arrays(key: str, compute: Callable[[], dict], cache_dir: str | None = None
@@ -100,33 +148,11 @@ def cached_bundle_arrays(key: str, compute: Callable[[], dict], cache_dir: str |
     ``key`` names the cell (a digest of its description); ``compute()``
     returns the arrays when the cache has none for it.
     """
-    cache_dir = cache_dir or cache_dir_default()
-    path = os.path.join(cache_dir, f"{key}.npz")
-    if os.path.isfile(path):
-        try:
-            found = _read_entry(path, key)
-            log.info("cell bundle from cache %s", path)
-            return found, True
-        except ValueError as exc:
-            log.warning("ngcontact: discarding the cache entry %s (%s); recomputing it", path, exc)
-    # Any values: np.savez's stub would otherwise match the arrays against
-    # its keyword-only allow_pickle: bool
-    arrays: dict[str, Any] = {k: np.asarray(v, float) for k, v in compute().items()}
-    meta = {"format": CACHE_VERSION, "version": _package_version(), "key": key, "sha256": _digest(arrays)}
-    tmp = None
-    try:
-        os.makedirs(cache_dir, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(suffix=".npz", dir=cache_dir)
-        os.close(fd)
-        np.savez(tmp, meta=np.array(json.dumps(meta)), **arrays)
-        os.replace(tmp, path)
-        log.info("cell bundle computed and cached in %s", path)
-    except OSError as exc:
-        log.warning("ngcontact: the cell-law cache %s cannot be written (%s); the law is recomputed on every "
-                    "run (set NGCONTACT_CACHE to a writable directory)", cache_dir, exc.strerror or exc)
-    finally:
-        if tmp is not None and os.path.exists(tmp):
-            os.remove(tmp)
+    found = read_cached(key, cache_dir=cache_dir)
+    if found is not None:
+        return found, True
+    arrays = {k: np.asarray(v, float) for k, v in compute().items()}
+    write_cached(key, arrays, cache_dir=cache_dir)
     return arrays, False
 
 
@@ -142,3 +168,44 @@ def bundle_law(arrays: dict, *, dim: int, length_unit: float = 1.0) -> il.Bundle
     keep = (np.linalg.norm(n, axis=1) > 1e-12) & (w > 0)
     law = il.BundleLaw(weights=tuple(w[keep]), directions=tuple(map(tuple, n[keep])), gaps=tuple(g[keep]))
     return law.merged()
+
+
+def friction_from_bundle(arrays: dict, *, k_n: float, law: str, mu: float = 0.0, G: float = 0.0
+                         ) -> dict[str, float]:
+    """Homogenized friction ``mu0``, ``G0`` of a cell's contact surface (paper eqs. 42-43).
+
+    With the bundle's weights ``w_q = k_n ds_q / |T|`` and micro normals
+    ``n_q`` (first component ``beta_q = n_q . n0``), the threshold along a
+    macro tangent ``t`` is eq. 43 with the paper's ``|alpha|`` taken as
+    ``|(I - n_q n_q^T) t|`` (isotropic micro friction, see
+    :mod:`ngcontact.cell.coefficients`):
+
+    * micro Tresca threshold ``G``:
+      ``G0 = sum_q (w_q / k_n) G |(I - n_q n_q^T) t|`` [stress], ``mu0 = 0``;
+    * micro Coulomb coefficient ``mu``: the micro pressure of the closed
+      surface under a macro closure ``a_n`` is ``k_n beta_q a_n`` where
+      ``beta_q > 0``, so the threshold ``mu sum_q w_q beta_q |(I - n_q n_q^T) t| a_n``
+      over the macro pressure ``sum_q w_q beta_q^2 a_n`` gives
+
+          mu0 = mu sum_{beta_q > 0} w_q beta_q |(I - n_q n_q^T) t| / sum_{beta_q > 0} w_q beta_q^2,
+
+      ``G0 = 0`` (``mu0 = mu`` on a flat cell).
+
+    The whole contact surface counts (the bundle's directions open on
+    their own, the threshold does not).  With two macro tangents (a 3D
+    cell) the larger value is taken, the macro friction being isotropic.
+    Returns ``{"mu0", "G0"}``.
+    """
+    w = np.asarray(arrays["w"], float)
+    n = np.asarray(arrays["n"], float)
+    beta = n[:, 0]
+    proj = [np.sqrt(np.clip(1.0 - n[:, j] ** 2, 0.0, None)) for j in range(1, n.shape[1])]
+    if law == "tresca":
+        return {"mu0": 0.0, "G0": float(max(np.sum(w / k_n * G * p) for p in proj))}
+    if law == "coulomb":
+        up = beta > 0
+        den = float(np.sum(w[up] * beta[up] ** 2))
+        if not den > 0:
+            raise ValueError("the cell's contact surface has no direction facing the counter body")
+        return {"mu0": float(max(mu * np.sum(w[up] * beta[up] * p[up]) / den for p in proj)), "G0": 0.0}
+    raise ValueError(f"micro friction {law!r}: must be 'tresca' or 'coulomb'")

@@ -26,7 +26,7 @@ from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.cell.spectral_cell import Layer, SpectralCell
 from ngcontact.scene.cell_geometry import GAP_PROFILES, profile_2d, small_slope
 from ngcontact.scene.cell_scene import CellScene, load_states, spectral_grid
-from ngcontact.scene.loader import as_dict, load
+from ngcontact.scene.loader import as_dict, load_with_contact
 from ngcontact.scene.sections import MaterialSpec, resolve
 
 
@@ -76,8 +76,24 @@ def cell_key(cell_scene) -> str:
     return h.hexdigest()
 
 
+def cell_scene_of(path: str, *, key: str, overrides: dict | None = None) -> CellScene:
+    """The cell scene file ``path`` with ``[contact]`` overrides (:func:`~ngcontact.scene.loader.load_with_contact`)."""
+    cell_scene = load_with_contact(path, overrides)
+    if cell_scene.kind != "cell":
+        raise SceneError(key, path, f"names a {cell_scene.kind!r} scene; a 'cell' scene is needed")
+    return cell_scene
+
+
+def cell_bundle_arrays(cell_scene: CellScene, cache_dir: str | None = None) -> tuple[dict, bool]:
+    """``{"w", "n", "g"}`` of the cell's direction bundle (cached) and whether it came from the cache."""
+    def compute() -> dict:
+        b = direction_bundle(build_cell(cell_scene), kn=cell_scene.contact.k_n, gap=gap_cf(cell_scene))
+        return {"w": b.w, "n": b.n, "g": b.g}
+    return cell_law.cached_bundle_arrays(cell_key(cell_scene), compute, cache_dir)
+
+
 def law_from_cell(path: str, *, dim: int, linear: bool = False, length_unit: float = 1.0,
-                  cache_dir: str | None = None):
+                  cache_dir: str | None = None, overrides: dict | None = None):
     """Normal law from the cell scene file ``path`` and a description for the report.
 
     Parameters
@@ -91,19 +107,16 @@ def law_from_cell(path: str, *, dim: int, linear: bool = False, length_unit: flo
         (``K0`` and the gap forces of eq. 34) instead of the bundle.
     length_unit, cache_dir
         See :mod:`ngcontact.coupling.cell_law`.
+    overrides
+        Keys of the cell's ``[contact]`` section replaced (the macro scene's
+        ``interface.cell_*``).
     """
-    cell_scene = load(path)
-    if cell_scene.kind != "cell":
-        raise SceneError("interface.cell", path, f"names a {cell_scene.kind!r} scene; a 'cell' scene is needed")
-    def compute() -> dict:
-        b = direction_bundle(build_cell(cell_scene), kn=cell_scene.contact.k_n, gap=gap_cf(cell_scene))
-        return {"w": b.w, "n": b.n, "g": b.g}
-
-    arrays, cached = cell_law.cached_bundle_arrays(cell_key(cell_scene), compute, cache_dir)
+    cell_scene = cell_scene_of(path, key="interface.cell", overrides=overrides)
+    arrays, cached = cell_bundle_arrays(cell_scene, cache_dir)
     law = cell_law.bundle_law(arrays, dim=dim, length_unit=length_unit)
     K = law.matrix()
     info = {"cell_scene": os.path.abspath(path), "cached": cached, "directions": len(law.weights),
-            "K0": K.tolist(), "key": cell_key(cell_scene)}
+            "K0": K.tolist(), "key": cell_key(cell_scene), "cell_overrides": dict(overrides or {})}
     if linear:
         if dim == 3:
             raise SceneError("interface.law", "linear", "a linear law from a cell is available in 2D and "
@@ -134,6 +147,25 @@ def law_from_file(path: str, form: str, *, dim: int) -> tuple[il.NormalLaw, dict
     with open(path, "rb") as fh:
         digest = hashlib.sha256(fh.read()).hexdigest()
     return law, {"law_file": os.path.abspath(path), "form": form, "sha256": digest}
+
+
+def friction_from_cell(path: str, *, width: float, overrides: dict | None = None,
+                       cache_dir: str | None = None) -> tuple[il.Friction, dict]:
+    """The homogenized friction (paper eqs. 42-43) of the cell scene file ``path`` and its description.
+
+    ``width``: the macro Huber width.  See
+    :func:`ngcontact.coupling.cell_law.friction_from_bundle`.
+    """
+    cell_scene = cell_scene_of(path, key="interface.friction", overrides=overrides)
+    c = cell_scene.contact
+    if c.friction == "none":
+        raise SceneError("interface.friction", "from_cell", f"the cell {path!r} has no friction")
+    arrays, _ = cell_bundle_arrays(cell_scene, cache_dir)
+    values = cell_law.friction_from_bundle(arrays, k_n=c.k_n, law=c.friction, mu=c.mu or 0.0, G=c.G or 0.0)
+    info = {"source": "cell", "cell_scene": os.path.abspath(path), "micro_friction": c.friction,
+            "micro_mu": c.mu, "micro_G": c.G, "mu0": values["mu0"], "G0": values["G0"], "huber_width": width,
+            "equations": "paper eqs. 42-43", "cell_overrides": dict(overrides or {})}
+    return il.Friction(mu=values["mu0"], threshold=values["G0"], width=width), info
 
 
 def build_cell(scene, maxh=None, interface_maxh=None, order=None):

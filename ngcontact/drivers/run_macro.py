@@ -26,8 +26,8 @@ from collections import Counter
 import numpy as np
 import ngsolve as ng
 
-from ngcontact.drivers.build import (body_laws, interface_friction, interface_normal_law, law_from_cell, law_from_file,
-                                     linear_solver)
+from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
+                                     law_from_cell, law_from_file, linear_solver)
 from ngcontact.laws import homogenized as il
 from ngcontact.fem.interpolants import piecewise_linear
 from ngcontact.macro import macro_problem as M
@@ -37,6 +37,7 @@ from ngcontact.geometry import bodies as gm
 from ngcontact.scene.macro_scene import REGIONS
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
+from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
 from ngcontact.geometry.femur import BOUNDARIES, FemurStemDims, femur_stem
 from ngcontact.geometry.femur3d import femur_stem_3d
@@ -77,11 +78,12 @@ def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
     """The interface law of ``scene`` and a description of it for the report."""
     spec = scene.interface
     normal: il.NormalLaw | None
+    overrides = cell_links.overrides(spec)
     if spec.law == "file":
         normal, info = law_from_file(resolve(scene, spec.law_file), spec.law_file_form, dim=dim)
     elif spec.cell is not None:
         normal, info = law_from_cell(resolve(scene, spec.cell), dim=dim, linear=spec.law == "linear",
-                                     length_unit=spec.cell_length_unit)
+                                     length_unit=spec.cell_length_unit, overrides=overrides)
     else:
         normal = interface_normal_law(spec)
         info = {"source": "explicit numbers"}
@@ -90,7 +92,17 @@ def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
                              f"need {dim} components per direction in this setting")
     assert normal is not None  # only a scene with a cell has no explicit law, and that branch is above
     info = {"type": scene.interface.law, **info, "full_contact_K0": _K0(normal, dim)}
-    return il.InterfaceLaw(normal=normal, friction=interface_friction(spec)), info
+    friction: il.Friction | None
+    if spec.friction == "from_cell":
+        cell = spec.cell if spec.cell is not None else scene.two_scale.cell
+        friction, info["friction"] = friction_from_cell(resolve(scene, cell), width=spec.huber_width,
+                                                        overrides=overrides)
+    else:
+        friction = interface_friction(spec)
+        info["friction"] = {"source": "scene", "mu0": spec.mu, "G0": spec.threshold, "huber_width": spec.huber_width}
+    if overrides:
+        info["cell_overrides"] = overrides
+    return il.InterfaceLaw(normal=normal, friction=friction), info
 
 
 def _K0(normal, dim):
@@ -205,11 +217,12 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
     return problem, info
 
 
-def solve_scene(scene, problem: M.MacroProblem) -> M.MacroSolution:
+def solve_scene(scene, problem: M.MacroProblem, start=None) -> M.MacroSolution:
+    """:func:`ngcontact.macro.macro_problem.solve` with the scene's solver settings (``start``: warm start)."""
     s = scene.solver
     return M.solve(problem, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
                    coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter, linear=linear_solver(scene),
-                   coulomb=s.coulomb)
+                   coulomb=s.coulomb, start=start)
 
 
 def checked_equilibrium(sol: M.MacroSolution) -> dict:
@@ -244,7 +257,7 @@ def run(scene, clock) -> Outcome:
             sol = solve_scene(scene, problem)
         else:
             from ngcontact.drivers.run_two_scale import couple
-            sol, two_scale = couple(scene, problem, lambda prob: solve_scene(scene, prob))
+            sol, two_scale = couple(scene, problem, lambda prob, start: solve_scene(scene, prob, start))
     with clock.stage("post-processing"):
         balance = checked_equilibrium(sol)
         fields = MM.stress_fields(sol)
@@ -293,6 +306,8 @@ def run(scene, clock) -> Outcome:
         with clock.stage("strength check"):
             st = evaluate(scene, sol)
         results["strength"] = st["results"]
+        if two_scale is not None:
+            results["two_scale"]["summary"] = two_scale_summary(two_scale, st["results"])
         tables["strength_map"] = st["table"]
         vtk["worst_cell"] = st["vtk"]
         plots.update(st["plots"])
@@ -302,6 +317,18 @@ def run(scene, clock) -> Outcome:
               "coulomb": sol.history["coulomb"], "coulomb_changes": sol.history["coulomb_changes"], "solves": newton,
               "linear": sol.history["linear"]}
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
+
+
+def two_scale_summary(two_scale: dict, strength: dict) -> dict:
+    """The two-scale loop and the strength check of its converged state in one place."""
+    return {"iterations": two_scale["iterations"], "macro_solves": two_scale["macro_solves"],
+            "cell_solves": two_scale["cell_solves"], "table_from_cache": two_scale["cache"]["table_from_cache"],
+            "table_error_estimate": two_scale["table"]["error_estimate"],
+            "newton_per_solve": two_scale["newton_per_solve"],
+            "max_change": [h["max_change"] for h in two_scale["history"][1:]],
+            "safety_factor": strength["safety_factor"], "critical_body": strength["critical_body"],
+            "critical_points": {b: {"macro_point": e["macro_point"], "cell_point": e.get("cell_point"),
+                                    "max_sigma_eq": e["max_sigma_eq"]} for b, e in strength["bodies"].items()}}
 
 
 # ------------------------------------------------------------------ plot data

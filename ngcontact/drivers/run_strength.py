@@ -31,7 +31,7 @@ from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.output import plots as figures
 from ngcontact.output.report import VtkField
 from ngcontact.scene.cell_scene import CellScene
-from ngcontact.scene.loader import load
+from ngcontact.scene.loader import load_with_contact
 from ngcontact.scene.macro_scene import MacroScene
 from ngcontact.scene.sections import resolve
 
@@ -47,10 +47,10 @@ class StrengthEvaluation(TypedDict):
     plots: dict[str, Callable[..., None]]  # name -> plot, called as plot(path)
 
 
-def cell_problem_of(cell_path: str, *, key: str) -> tuple[CellScene, CellProblem]:
-    """Cell scene -> :class:`CellProblem` with the macro strain term (for recovery)."""
+def cell_problem_of(cell_path: str, *, key: str, overrides: dict | None = None) -> tuple[CellScene, CellProblem]:
+    """Cell scene (with ``[contact]`` overrides) -> :class:`CellProblem` with the macro strain term (for recovery)."""
     from ngcontact.drivers.build import build_cell, model_of
-    cs = load(cell_path)
+    cs = load_with_contact(cell_path, overrides)
     if cs.kind != "cell":
         raise SceneError(key, cell_path, f"names a {cs.kind!r} scene; a 'cell' scene is needed")
     if cs.contact.geometric_only:

@@ -41,16 +41,9 @@ Laws (frozen dataclasses, values only; their energy ``W(a)`` and traction
     below ``c_0``, extrapolated with the last slope; written as a sum of
     ramps ``p(c) = sum_i s_i [c - c_i]_+`` (``s_i`` the slope increments), so
     its energy, the integral of the table, is ``sum_i s_i/2 [c - c_i]_+^2``.
-    A linear tangential stiffness ``k_t`` may be added.
-:class:`FieldLaw`
-    Unilateral Winkler law whose coefficients vary along ``S_0`` (the
-    coupling loop of paper Sec. 3.5): ``k_n0(x)`` and ``g_n0(x)`` of eq. 34
-    on the real contact set of the cell at the point ``x``::
-
-        W(a) = k_n0(x)/2 [a_n - g0 - c(x)]_+^2,     c(x) = g_n0(x) / k_n0(x),
-
-    i.e. ``p = [k_n0 (a_n - g0) - g_n0]_+``; ``k_n0`` and ``c`` are
-    CoefficientFunctions (fields on the interface).
+    A linear tangential stiffness ``k_t`` may be added.  The two-scale loop
+    (paper Sec. 3.5, :mod:`ngcontact.coupling.two_scale`) hands the cell's
+    own response over as such a table: closure ``c(p)`` against pressure.
 :class:`Friction`
     Homogenized friction on top of any of them (paper eqs. 38-44): threshold
     ``G = mu0 [p]_+ + G0`` and energy ``G huber(|a_t|, w)`` with
@@ -64,13 +57,9 @@ Laws (frozen dataclasses, values only; their energy ``W(a)`` and traction
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
 import numpy as np
 from ngcontact.errors import ModelError
 
-if TYPE_CHECKING:
-    import ngsolve as ng
 
 
 # ------------------------------------------------------------------ laws
@@ -241,30 +230,7 @@ class Friction:
         return self.mu > 0
 
 
-@dataclass(frozen=True, kw_only=True)
-class FieldLaw:
-    """Unilateral normal law with coefficient fields along ``S_0`` (module docstring).
-
-    Attributes
-    ----------
-    kn
-        ``k_n0(x)`` [stress / length], a CoefficientFunction > 0 on ``S_0``.
-    offset
-        ``c(x) = g_n0(x) / k_n0(x)`` [length], a CoefficientFunction.
-    stiffness
-        An upper bound of ``k_n0`` (a number; scales the start of the solve).
-    """
-
-    kn: ng.CoefficientFunction
-    offset: ng.CoefficientFunction
-    stiffness: float
-
-    def __post_init__(self):
-        if not self.stiffness > 0:
-            raise ModelError(f"stiffness = {self.stiffness!r}: must be > 0")
-
-
-NormalLaw = LinearLaw | BundleLaw | TabulatedLaw | FieldLaw
+NormalLaw = LinearLaw | BundleLaw | TabulatedLaw
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -285,12 +251,10 @@ class InterfaceLaw:
 
         Friction does (the Huber-regularized stick, eq. 34's tangential
         slope), and so does an elastic tangential stiffness ``k_t0 > 0`` of a
-        linear, bundle or tabulated law; a field law is normal only.
+        linear, bundle or tabulated law.
         """
         if self.friction is not None:
             return True
-        if isinstance(self.normal, FieldLaw):
-            return False
         if isinstance(self.normal, TabulatedLaw):
             return self.normal.kt > 0
         return bool(self.normal.matrix(2)[1, 1] > 0)

@@ -27,10 +27,9 @@ replaced by the weighted directions)::
     W(a) = sum_i s_i/2 [c - c_i]_+^2 + k_t/2 |a_t|^2
     tau  = (sum_i s_i [c - c_i]_+,  k_t a_t)
 
-``FieldLaw`` (eq. 34 on the real contact set of the cell at ``x``, Sec. 3.5)::
-
-    W(a) = k_n0(x)/2 [a_n - g0 - c(x)]_+^2
-    tau  = (k_n0(x) [a_n - g0 - c(x)]_+,  0)
+(on CoefficientFunctions the same functions are NGSolve B-splines, one
+table lookup per quadrature point instead of one ramp per kink; the
+two-scale law has dozens of kinks)
 
 With ``closed=True`` :func:`normal_energy` is the quadratic "all closed"
 surrogate (a start value for Newton): every ramp ``[x]_+`` replaced by ``x``,
@@ -53,11 +52,12 @@ CoefficientFunctions alike.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from ngcontact.errors import ModelError
 from ngcontact.laws.homogenized import (
     BundleLaw,
-    FieldLaw,
     Friction,
     InterfaceLaw,
     LinearLaw,
@@ -74,6 +74,26 @@ def _ramp(x):
         return np.maximum(x, 0.0)
     import ngsolve as ng
     return ng.IfPos(x, x, 0.0)
+
+
+@functools.lru_cache(maxsize=16)
+def _splines(closure: tuple, pressure: tuple):
+    """``(p, W)`` of a table as NGSolve B-splines: one table lookup per point instead of a sum of ramps.
+
+    ``p(c)`` piecewise linear (0 below ``c_0``, the last slope beyond
+    ``c_last``) as a quadratic B-spline whose interior knots are doubled (so
+    it is only C0 there, and exactly the polyline: control values at the
+    table points and the segment midpoints); quadratic because NGSolve's
+    linear B-splines have no second derivatives, which a Newton tangent of
+    an energy holding ``p`` (the Coulomb threshold ``mu p``) needs.  ``W``
+    its integral from ``c_0``.  tests/laws compare both with the ramps.
+    """
+    import ngsolve as ng
+    c = [float(x) for x in closure]
+    p = [float(x) for x in pressure]
+    values = [v for a, b in zip(p[:-1], p[1:]) for v in (a, 0.5 * (a + b))] + [p[-1]]
+    knots = [c[0]] * 3 + [x for x in c[1:-1] for _ in (0, 1)] + [c[-1]] * 3
+    return ng.BSpline(3, knots, values), ng.BSpline(2, [c[0]] + c + [c[-1]], p).Integrate()
 
 
 # ----------------------------------------------------------- energies
@@ -107,8 +127,11 @@ def normal_energy(law: NormalLaw, a, g0=0.0, closed: bool = False):
             W = W + 0.5 * w * ramp(_dot(n, a) - g - n[0] * g0) ** 2
         return W
     if isinstance(law, TabulatedLaw):
-        kinks, slopes = law.ramps()
         c = a[0] - g0
+        if not closed and not is_numeric(c):
+            W = _splines(law.closure, law.pressure)[1](c)
+            return W + 0.5 * law.kt * sum(ai * ai for ai in a[1:]) if law.kt > 0 else W
+        kinks, slopes = law.ramps()
         if closed:
             first = next(k for k, s in enumerate(slopes) if s != 0)
             kinks, slopes = kinks[first:first + 1], slopes[first:first + 1]
@@ -116,8 +139,6 @@ def normal_energy(law: NormalLaw, a, g0=0.0, closed: bool = False):
         if law.kt > 0:
             W = W + 0.5 * law.kt * sum(ai * ai for ai in a[1:])
         return W
-    if isinstance(law, FieldLaw):
-        return 0.5 * law.kn * ramp(a[0] - g0 - law.offset) ** 2
     raise TypeError(f"unknown interface law {type(law).__name__}")
 
 
@@ -139,12 +160,13 @@ def normal_traction(law: NormalLaw, a, g0=0.0) -> list:
             tau = [tau[i] + f * n[i] for i in range(dim)]
         return tau
     if isinstance(law, TabulatedLaw):
-        kinks, slopes = law.ramps()
         c = a[0] - g0
-        p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
+        if is_numeric(c):
+            kinks, slopes = law.ramps()
+            p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
+        else:
+            p = _splines(law.closure, law.pressure)[0](c)
         return [p] + [law.kt * ai for ai in a[1:]]
-    if isinstance(law, FieldLaw):
-        return [law.kn * _ramp(a[0] - g0 - law.offset)] + [0.0 * ai for ai in a[1:]]
     raise TypeError(f"unknown interface law {type(law).__name__}")
 
 

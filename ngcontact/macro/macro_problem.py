@@ -57,7 +57,9 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import ngsolve as ng
+import numpy as np
 
+from ngcontact.errors import ConvergenceError, ModelError
 from ngcontact.fem import elasticity
 from ngcontact.fem import two_body
 from ngcontact.fem.two_body import Load, Support, boundary_labels, interface_normal  # noqa: F401  (public names of the macro problem)
@@ -73,7 +75,6 @@ from ngcontact.solvers.newton import minimize
 from ngcontact.fem.rigid_modes import check_rigid_modes, free_rigid_modes
 from ngcontact.solvers.continuation import INTERMEDIATE_RTOL, ladder
 from ngcontact.solvers.semismooth_newton import solve_equations
-from ngcontact.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
 
@@ -206,7 +207,7 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
 def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
           inverse: str = "sparsecholesky", coulomb_rtol: float = 1e-8,
           coulomb_max_iter: int = 40, linear: LinearSolver | None = None,
-          coulomb: str = "newton") -> MacroSolution:
+          coulomb: str = "newton", start: ng.BaseVector | None = None) -> MacroSolution:
     """Solve the macro problem.
 
     Parameters
@@ -225,6 +226,12 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     linear
         Tangent solves (:class:`~ngcontact.solvers.linear_solver.LinearSolver`);
         default: direct with ``inverse``.  Its record goes to the history.
+    start
+        Warm start: the solution vector of an earlier solve on the same mesh,
+        order and supports (e.g. the previous iterate of the two-scale loop).
+        Newton starts there instead of from the quadratic start and stops at
+        the same absolute residual a cold start would (``rtol`` times the
+        residual of the quadratic start at the undeformed state).
 
     Raises
     ------
@@ -255,9 +262,16 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
         # quadratic start: all closed (and tangentially bonded under friction where needed),
         # so that no body floats at the first Newton step; later solves stop at
         # rtol times the first residual of the whole problem, not of their own
-        start = _form(problem, fes, frame, start_stiffness=start_stiffness(problem))
-        history["newton"].append(minimize(start, gfu, quadratic=True, **newton).as_dict())
-        newton["atol"] = max(atol, rtol * history["newton"][0]["residuals"][0])
+        surrogate = _form(problem, fes, frame, start_stiffness=start_stiffness(problem))
+        if start is None:
+            history["newton"].append(minimize(surrogate, gfu, quadratic=True, **newton).as_dict())
+            newton["atol"] = max(atol, rtol * history["newton"][0]["residuals"][0])
+        else:
+            newton["atol"] = max(atol, rtol * _residual_norm(surrogate, gfu))
+            _warm(gfu, start)
+            history["warm_start"] = True
+    elif start is not None:
+        _warm(gfu, start)
     if law.friction is not None and law.friction.coulomb and coulomb == "newton":
         coupled = _coupled_newton(problem, fes, frame, gfu, newton)
         history["newton"].extend(coupled["newton"])
@@ -361,6 +375,23 @@ def start_stiffness(problem: MacroProblem) -> float:
     free = free_rigid_modes(problem.mesh, problem.setting, (problem.rough, problem.counter), problem.supports,
                             problem.interface, holds_tangentially=False)
     return law.normal.stiffness if free else 0.0
+
+
+def _residual_norm(form, gfu: ng.GridFunction) -> float:
+    """Norm of the free part of the residual of ``form`` at ``gfu`` (as Newton measures it)."""
+    r = gfu.vec.CreateVector()
+    form.Apply(gfu.vec, r)
+    free = np.array(list(gfu.space.FreeDofs()), dtype=bool)
+    return float(np.linalg.norm(r.FV().NumPy()[free]))
+
+
+def _warm(gfu: ng.GridFunction, start: ng.BaseVector) -> None:
+    """Copy the free values of ``start`` into ``gfu`` (its Dirichlet values stay)."""
+    if len(start) != len(gfu.vec):
+        raise ModelError(f"warm start: a vector of {len(start)} values for a space of {len(gfu.vec)} dofs "
+                         "(the start must come from the same mesh, order and supports)")
+    free = np.array(list(gfu.space.FreeDofs()), dtype=bool)
+    gfu.vec.FV().NumPy()[free] = np.asarray(start.FV().NumPy())[free]
 
 
 # ----------------------------------------------------- post-processing

@@ -21,7 +21,7 @@ try:  # Python >= 3.11
 except ModuleNotFoundError:  # pragma: no cover - exercised on 3.10 only
     import tomli as tomllib
 
-__all__ = ["load", "from_dict", "effects", "as_dict", "resolve", "inputs"]
+__all__ = ["load", "load_with_contact", "from_dict", "effects", "as_dict", "resolve", "inputs"]
 
 #: Real paths of the scene files being loaded, outermost first: a scene that
 #: names itself, directly or through others, as a cell is refused by name.
@@ -64,6 +64,31 @@ def load(path: str | os.PathLike):
         _LOADING.pop()
 
 
+def load_with_contact(path: str | os.PathLike, overrides: dict | None = None):
+    """:func:`load` a cell scene with some keys of its ``[contact]`` section replaced.
+
+    ``overrides`` maps ``[contact]`` keys (``k_n``, ``friction``, ``mu``,
+    ``G``, ``w``) to values; a new ``friction`` drops the cell's own ``mu``,
+    ``G`` and ``w`` unless they are overridden too.  The result is validated
+    as a whole (a fault names the cell key, e.g. ``contact.mu``).
+    """
+    if not overrides:
+        return load(path)
+    path = os.fspath(path)
+    base = load(path)   # the file itself must be a valid scene
+    if base.kind != "cell":
+        return base
+    with open(path, "rb") as fh:
+        data = tomllib.load(fh)
+    contact = dict(data.get("contact", {}))
+    if "friction" in overrides:
+        for key in ("mu", "G", "w"):
+            contact.pop(key, None)
+    contact.update(overrides)
+    data["contact"] = contact
+    return from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
+
+
 def from_dict(data: dict, base_dir: str = "."):
     """Validate an already parsed scene table."""
     kind = data.get("kind")
@@ -74,7 +99,7 @@ def from_dict(data: dict, base_dir: str = "."):
     object.__setattr__(scene, "base_dir", base_dir)
     check_files = getattr(scene, "check_files", None)
     if callable(check_files):  # nested scenes (a macro scene's cell) load through this loader
-        check_files(load)
+        check_files(load_with_contact)
     return scene
 
 

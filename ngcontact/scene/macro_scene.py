@@ -15,10 +15,10 @@ because both act on a macro solution and share its geometry, law and output):
 
 * ``[two_scale]``: the coupling loop of paper Sec. 3.5
   (:mod:`ngcontact.coupling.two_scale`): the scene's interface law is the start (the
-  assumed contact set), and the cell named there, solved at the macro
-  pressure of every interface point (through an adaptive table in the
-  pressure), supplies coefficients that vary along the interface until the
-  macro normal stress stops changing;
+  assumed contact set), and the cell named there, tabulated adaptively in
+  the pressure over the macro pressures (cached on disk), supplies its own
+  response closure -> pressure as the interface law, until the table covers
+  the macro pressures and the macro normal stress stops changing;
 * ``[strength]``: micro stresses in the layer and the check of paper eq. 78
   (:mod:`ngcontact.coupling.strength`) against ``materials.NAME.sigma_u`` of both
   bodies.
@@ -34,7 +34,7 @@ from ngcontact.laws import homogenized as il
 from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
-from ngcontact.scene import mesh_size
+from ngcontact.scene import cell_links, mesh_size
 from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
 
 SHAPES = ("femur_stem", "coaxial", "block")
@@ -204,6 +204,16 @@ class InterfaceSpec:
     threshold: float = param(0.0, doc="Tresca threshold G0", units="Pa", check=nonnegative())
     huber_width: float = param(1e-6, doc="Huber width w: largest slip of a sticking point", units="m",
                                check=positive())
+    friction: str = param("given", doc="given: mu and threshold above; from_cell: mu0 and G0 of eqs. 42-43 from "
+                          "the cell the law comes from (interface.cell, else two_scale.cell)",
+                          choices=("given", "from_cell"))
+    cell_k_n: float | None = param(None, doc="replaces contact.k_n of the cells the law comes from", units="Pa/m",
+                                   check=positive())
+    cell_friction: str | None = param(None, doc="replaces their contact.friction (with cell_mu or cell_G, "
+                                      "and cell_w)", choices=("none", "tresca", "coulomb"))
+    cell_mu: float | None = param(None, doc="replaces their contact.mu", check=nonnegative())
+    cell_G: float | None = param(None, doc="replaces their contact.G", units="Pa", check=nonnegative())
+    cell_w: float | None = param(None, doc="replaces their contact.w (cell length units)", check=positive())
 
     def check(self, path: str) -> None:
         explicit = {"kn": self.kn, "weights": self.weights, "directions": self.directions, "gaps": self.gaps,
@@ -300,11 +310,13 @@ class TwoScaleSpec:
                                     units="m", check=positive())
     tol: float = param(doc="stop when max |sigma_n(k) - sigma_n(k-1)| over the interface points is below",
                        units="Pa", check=positive())
-    max_iter: int = param(20, doc="largest number of coefficient updates", check=at_least(1))
+    max_iter: int = param(20, doc="largest number of law updates", check=at_least(1))
     table_tol: float = param(0.01, doc="interpolation tolerance of the cell table: the contact fraction "
-                             "and g_n0 / max g_n0 at interval midpoints", check=positive())
+                             "and the closure relative to their largest values at interval midpoints",
+                             check=positive())
     table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
-                             "(below it the coefficients are held constant)", check=open_interval(0, 1))
+                             "(below it the law follows the table's first secant down to p = 0)",
+                             check=open_interval(0, 1))
 
 
 def macro_extent(shape: str, setting: str, dims: dict) -> tuple[int, float, float, float]:
@@ -383,9 +395,9 @@ class MacroScene:
                 raise SceneError(f"loads[{i}].traction", load.traction, f"must have {dim} components")
         if self.interface.gap_coordinate == "z" and dim == 2 and self.geometry.setting != "axisymmetric":
             raise SceneError("interface.gap_coordinate", "z", "plane strain has coordinates x, y")
-        for key in ("strength", "two_scale"):
-            if getattr(self, key) is not None and dim == 3:
-                raise SceneError(f"{key}", "...", "available for plane strain and axisymmetric macro problems")
+        if self.strength is not None and dim == 3:
+            raise SceneError("strength", "...", "available for plane strain and axisymmetric macro problems")
+        cell_links.check(self.interface, self.two_scale, dim)
         if self.strength is not None:
             for role in ("rough", "counter"):
                 name = getattr(self.bodies, role)
@@ -401,6 +413,7 @@ class MacroScene:
         also need a contact model (not ``contact.geometric_only``).  A fault
         inside a cell scene is reported under the key naming it, e.g.
         ``interface.cell = 'hip.toml': invalid cell scene: materials.bone.nu = ...``.
+        ``load(path, overrides=None)``: overrides of the law's cells' ``[contact]``.
         """
         import os
         from ngcontact.scene.sections import resolve
@@ -414,6 +427,7 @@ class MacroScene:
         files = (("interface.cell", self.interface.cell, False),
                  ("strength.cell", self.strength.cell if self.strength else None, True),
                  ("two_scale.cell", self.two_scale.cell if self.two_scale else None, True))
+        overrides = cell_links.overrides(self.interface)
         for key, rel, solved in files:
             if rel is None:
                 continue
@@ -423,8 +437,15 @@ class MacroScene:
                 cell = load(resolve(self, rel))
             except SceneError as exc:
                 raise SceneError(key, rel, f"invalid cell scene: {exc}") from None
+            if overrides and key != "strength.cell" and cell.kind == "cell":
+                try:
+                    cell = load(resolve(self, rel), overrides)
+                except SceneError as exc:
+                    raise SceneError("interface.cell_" + next(iter(overrides)), overrides,
+                                     f"the cell {rel!r} with these overrides is invalid: {exc}") from None
             if cell.kind != "cell":
                 raise SceneError(key, rel, f"invalid cell scene: must be of kind 'cell', not {cell.kind!r}")
+            cell_links.check_friction_source(self.interface, key, rel, cell)
             if solved and cell.contact.geometric_only:
                 raise SceneError(key, rel, "invalid cell scene: contact.geometric_only = true, but this "
                                  "section solves the cell, so it needs a contact model and a [load] section")

@@ -45,7 +45,7 @@ def test_fixed_contact_set_stops_after_one_update_and_reproduces_the_one_shot_so
     assert one_shot.min() > 0  # all in compression
     table = T.CellTable(lambda p: T.cell_response(P, p), tol=1e-3)
     out = T.couple(problem, table, tol=1e-6 * one_shot.max(), max_iter=5)
-    assert out.converged and len(out.history) == 2, out.history   # start + one update
+    assert out.converged and out.macro_solves == 2, out.history   # start + one update
     assert np.allclose(table.as_dict()["contact_fraction"], 0.5, atol=1e-9)
     assert np.allclose(table.as_dict()["k_n0"], 0.5 * K_N, rtol=1e-9)
     assert np.max(np.abs(table.as_dict()["g_n0"])) < 1e-8 * one_shot.max()
@@ -70,7 +70,7 @@ def test_tabulated_response_is_within_its_tolerance_of_direct_solves_at_random_p
     d = table.as_dict()
     f = np.array(d["contact_fraction"])
     assert np.all(np.diff(f) > 0)  # the real contact area grows with the pressure
-    scale = {"contact_fraction": f.max(), "g_n0": max(np.max(np.abs(d["g_n0"])), max(d["pressure"]))}
+    scale = {"contact_fraction": f.max(), "closure": np.max(np.abs(d["closure"]))}
     solves = table.solves
     rng = np.random.default_rng(7)
     for p in rng.uniform(0.05 * p_star, 0.8 * p_star, 4):
@@ -87,7 +87,7 @@ def test_table_grows_only_where_the_range_is_extended():
 
     def response(p):
         calls.append(p)
-        return {"contact_fraction": math.sqrt(p), "k_n0": math.sqrt(p), "g_n0": p ** 1.5}
+        return {"contact_fraction": math.sqrt(p), "k_n0": math.sqrt(p), "g_n0": p ** 1.5, "closure": p ** 0.7}
 
     table = T.CellTable(response, tol=1e-3)
     table.cover(0.01, 1.0)
@@ -96,6 +96,7 @@ def test_table_grows_only_where_the_range_is_extended():
     assert len(calls) == n
     table.cover(0.01, 2.0)
     assert len(calls) > n and max(calls) == 2.0
+    assert table.solves == len(calls)
     x = np.linspace(0.01, 2.0, 101)
     exact = np.sqrt(x)
     assert np.max(np.abs(table(x)["contact_fraction"] - exact)) / exact.max() <= 1e-3
@@ -116,3 +117,8 @@ def test_loop_converges_on_the_shipped_scene_with_falling_changes():
     assert ts["table"]["error_estimate"] <= scene.two_scale.table_tol
     f = np.asarray(ts["interface_coefficients"]["contact_fraction"])
     assert f.max() > 2 * f[f > 0].min()  # the real contact area varies along the interface
+    # the strength check of the converged state, joined with the loop's figures
+    summary = ts["summary"]
+    assert summary["safety_factor"] == out.results["strength"]["safety_factor"] > 0
+    assert summary["cell_solves"] == ts["cell_solves"] and summary["table_error_estimate"] <= scene.two_scale.table_tol
+    assert set(summary["critical_points"]) == {"rough", "counter"}

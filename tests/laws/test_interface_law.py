@@ -24,6 +24,15 @@ def _bundle(dim=2, n=7, gaps=True):
     return il.BundleLaw(weights=tuple(w), directions=tuple(map(tuple, d)), gaps=tuple(g))
 
 
+def _cell_response_law():
+    """The two-scale law: a cell's response closure c(p) = 0.3 p^0.6 (a stiffening contact) tabulated."""
+    from ngcontact.coupling.two_scale import CellTable, response_law
+    table = CellTable(lambda p: {"contact_fraction": p ** 0.5, "k_n0": 1.0, "g_n0": 0.0, "closure": 0.3 * p ** 0.6},
+                      tol=1e-3)
+    table.cover(0.01, 3.0)
+    return response_law(table)
+
+
 LAWS = {
     "linear": il.InterfaceLaw(normal=il.LinearLaw(kn=3.0, kt=1.5, knt=0.7, gap_force=(0.2, -0.1))),
     "bundle": il.InterfaceLaw(normal=_bundle()),
@@ -31,6 +40,9 @@ LAWS = {
                                                          pressure=(0.0, 0.3, 1.0, 1.2), kt=0.4)),
     "bundle+friction": il.InterfaceLaw(normal=_bundle(), friction=il.Friction(mu=0.3, threshold=0.05,
                                                                               width=0.05)),
+    "cell_response": il.InterfaceLaw(normal=_cell_response_law()),
+    "cell_response+friction": il.InterfaceLaw(normal=_cell_response_law(),
+                                              friction=il.Friction(mu=0.3, threshold=0.05, width=0.05)),
 }
 
 
@@ -152,6 +164,71 @@ def test_coefficient_function_path_matches_numpy():
         assert abs(W - ie.energy(law, a, -0.02, 0.8)) <= 1e-12 * max(1.0, abs(W)), name
         np.testing.assert_allclose(t, [float(x) for x in ie.traction(law, a, -0.02, 0.8)], rtol=1e-12,
                                    atol=1e-14, err_msg=name)
+
+
+def test_tabulated_law_on_coefficient_functions_is_the_sum_of_ramps():
+    """The B-spline evaluation (CoefficientFunctions) equals the ramps (NumPy) at closures across the table."""
+    import ngsolve as ng
+    from netgen.geom2d import unit_square
+    mesh = ng.Mesh(unit_square.GenerateMesh(maxh=1.0))   # kept: a mesh point does not hold its mesh
+    mip = mesh(0.3, 0.3)
+    law = _cell_response_law()
+    for c in np.linspace(law.closure[0] - 0.1, law.closure[-1] + 0.2, 41):
+        W = ie.normal_energy(law, [ng.CF(c), ng.CF(0.0)])(mip)
+        p = ie.pressure(law, [ng.CF(c), ng.CF(0.0)])(mip)
+        want_W, want_p = ie.normal_energy(law, [c, 0.0]), ie.pressure(law, [c, 0.0])
+        assert abs(W - want_W) <= 1e-12 * max(1.0, want_W) and abs(p - want_p) <= 1e-12 * max(1.0, want_p), c
+
+
+def test_cell_response_law_is_consistent_in_the_assembled_macro_problem():
+    """Energy -> residual -> tangent of the macro problem with the two-scale law, by central differences to
+    1e-7, at random states where part of the interface is open."""
+    import ngsolve as ng
+    from ngcontact.fem import two_body
+    from ngcontact.geometry import bodies as gm
+    from ngcontact.macro import macro_problem as M
+    from ngcontact.fem.materials import isotropic
+    law = _cell_response_law()
+    scale = 1e-3 / law.closure[-1]   # closures of the table in mm
+    law = il.TabulatedLaw(closure=tuple(scale * c for c in law.closure), pressure=tuple(law.pressure))
+    g = gm.coaxial_plane_strain(0.5, 1.0, 2.0, maxh=0.4, order=2)
+    sup = (M.Support(label="sym_x", components=("x",)), M.Support(label="sym_y", components=("y",)))
+    problem = M.MacroProblem(mesh=g.mesh, setting="plane_strain", rough="inner", counter="outer",
+                             materials={"inner": isotropic(200.0, 0.3), "outer": isotropic(70.0, 0.25)},
+                             law=il.InterfaceLaw(normal=law, friction=il.Friction(mu=0.3, threshold=0.05, width=1e-4)),
+                             gap=-0.5e-3 * ng.x, supports=sup, order=2)
+    fes = two_body.spaces(problem.mesh, problem.setting, (problem.rough, problem.counter), problem.supports, 2)
+    frame = local_frame(two_body.interface_normal(problem.mesh, "inner", "interface"), 2)
+    rng = np.random.default_rng(5)
+    free = np.array(list(fes.FreeDofs()), dtype=bool)
+    old = ng.GridFunction(fes)      # a frozen Coulomb threshold mu p(old) + G0, as in the fixed point
+    old.vec.FV().NumPy()[free] = 1e-3 * rng.standard_normal(free.sum())
+    G = ie.threshold(problem.law.friction, ie.pressure(law, M._local(frame, old.components[0] - old.components[1]),
+                                                        -0.5e-3 * ng.x))
+    form = M._form(problem, fes, frame, G=G)
+    u = ng.GridFunction(fes).vec
+    for trial in range(3):
+        u.FV().NumPy()[:] = 0.0
+        u.FV().NumPy()[free] = 1e-3 * rng.standard_normal(free.sum())
+        v = u.CreateVector()
+        v.FV().NumPy()[:] = 0.0
+        v.FV().NumPy()[free] = rng.standard_normal(free.sum())
+        h = 1e-9
+        up, um, r, rp, rm, Kv = (u.CreateVector() for _ in range(6))
+        up.data = u + h * v
+        um.data = u - h * v
+        form.Apply(u, r)
+        dE = (form.Energy(up) - form.Energy(um)) / (2 * h)
+        rv = ng.InnerProduct(r, v)
+        assert abs(dE - rv) <= 1e-7 * abs(rv), f"energy vs residual: {dE} vs {rv}"
+        form.Apply(up, rp)
+        form.Apply(um, rm)
+        form.AssembleLinearization(u)
+        Kv.data = form.mat * v
+        fd = (rp.FV().NumPy() - rm.FV().NumPy())[free] / (2 * h)
+        kv = Kv.FV().NumPy()[free]
+        err = np.linalg.norm(fd - kv) / np.linalg.norm(kv)
+        assert err <= 1e-7, f"residual vs tangent: relative error {err:.2e}"
 
 
 def test_local_frame_turns_with_the_normal():
