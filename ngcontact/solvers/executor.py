@@ -36,6 +36,7 @@ import logging
 import os
 import threading
 import time
+import traceback
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
@@ -82,8 +83,23 @@ def run_member(fn: Callable[[Any], Any], item: Any, name: str, attempt: int, fau
         if fault.mode == "kill":
             os._exit(70)
         raise RuntimeError(f"injected fault (attempt {attempt + 1})")
-    with _ONE_AT_A_TIME:
-        return fn(item)
+    try:
+        with _ONE_AT_A_TIME:
+            return fn(item)
+    except Exception as exc:  # the package's errors take several arguments: they do not unpickle
+        raise MemberFailure(_reason(exc), traceback.format_exc()) from None
+
+
+class MemberFailure(Exception):
+    """A member's exception as it crosses from a worker: its type and first line, and the traceback."""
+
+    def __init__(self, reason: str, detail: str = ""):
+        super().__init__(reason, detail)
+        self.reason = reason
+        self.detail = detail
+
+    def __str__(self) -> str:
+        return self.reason
 
 
 #: One member at a time per process: Netgen's mesher keeps global state, and a Dask worker may run threads.
@@ -103,6 +119,8 @@ def _one_thread() -> None:
 
 
 def _reason(exc: BaseException) -> str:
+    if isinstance(exc, MemberFailure):
+        return exc.reason
     text = str(exc).strip().splitlines()
     return f"{type(exc).__name__}: {text[0] if text else ''}".rstrip(": ")
 
@@ -232,6 +250,7 @@ class LocalPool(Executor):
     @staticmethod
     def _failed(label, name, failures, k, exc) -> None:
         failures[k] += 1
+        log.debug("%s: %s: %s", label, name, getattr(exc, "detail", "") or _reason(exc))
         log.info("%s: %s failed (%s)%s", label, name, _reason(exc),
                     "; retrying" if failures[k] < ATTEMPTS else "")
         if failures[k] >= ATTEMPTS:
@@ -287,20 +306,28 @@ class DaskCluster(Executor):
     name = "dask"
 
     def __init__(self, address: str):
-        try:
-            from distributed import Client
-        except ImportError as exc:  # pragma: no cover - a dependency of the package
-            raise NgcontactError(f"scheduler {address!r}: dask.distributed is not installed") from exc
-        try:
-            self._client = Client(address, timeout=30, set_as_default=False)
-        except Exception as exc:
-            raise NgcontactError(f"scheduler {address!r}: cannot connect ({_reason(exc)})") from exc
         self.address = address
-        self.workers = max(1, sum(w.get("nthreads", 1) for w in self._client.scheduler_info()["workers"].values()))
+        self._client = None
+
+    @property
+    def client(self):
+        """The connection to the scheduler, made on first use."""
+        if self._client is None:
+            try:
+                from distributed import Client
+            except ImportError as exc:  # pragma: no cover - a dependency of the package
+                raise NgcontactError(f"scheduler {self.address!r}: dask.distributed is not installed") from exc
+            try:
+                self._client = Client(self.address, timeout=30, set_as_default=False)
+            except Exception as exc:
+                raise NgcontactError(f"scheduler {self.address!r}: cannot connect ({_reason(exc)})") from exc
+            info = self._client.scheduler_info()["workers"].values()
+            self.workers = max(1, sum(w.get("nthreads", 1) for w in info))
+        return self._client
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         from distributed import as_completed
-        client = self._client
+        client = self.client
         results: dict[int, Any] = {}
         failures = {k: 0 for k in range(len(items))}
         index: dict[Any, int] = {}
@@ -311,7 +338,7 @@ class DaskCluster(Executor):
             index[fut] = k
             return fut
 
-        futures = as_completed([submit(k) for k in range(len(items))])
+        futures = as_completed([submit(k) for k in range(len(items))], loop=client.loop)
         try:
             for fut in futures:
                 k = index.pop(fut)
@@ -329,7 +356,9 @@ class DaskCluster(Executor):
         return [results[k] for k in range(len(items))]
 
     def close(self) -> None:
-        self._client.close()
+        if self._client is not None:
+            self._client.close()
+            self._client = None
 
 
 def _dask_member(fn, item, name, attempt, fault):
