@@ -10,8 +10,8 @@ by the sample mean ``m = (1/M) sum x_i``, with the standard error
     m -+ t_{0.975, M-1} s / sqrt(M).
 
 The band narrows like ``M^(-1/2)``: :func:`shrinkage` evaluates the standard
-error on the nested ensembles of the first ``M_j`` members and fits its rate
-in ``M`` (least squares in log-log).  An ensemble whose members are
+error of the mean of ``m = M, M/2, M/4, ...`` members on disjoint
+sub-ensembles and fits its rate in ``m`` (least squares in log-log).  An ensemble whose members are
 identical has ``s = 0`` and a band of zero width.
 """
 from __future__ import annotations
@@ -54,21 +54,29 @@ def nested_sizes(M: int, smallest: int = 4) -> list[int]:
 
 
 def shrinkage(samples, sizes=None) -> dict:
-    """Standard error of the first ``M_j`` members for each size, and its fitted rate in ``M``.
+    """Standard error of the mean of ``m`` members for each size ``m``, and its fitted rate in ``m``.
 
-    ``samples`` shape ``(M, n)`` (``n`` loads).  The error of a size is the
-    mean over the loads of the standard error relative to the mean's
-    magnitude (loads with a zero mean are left out).  ``rate`` is ``None``
-    with fewer than two sizes or a zero error (identical members).
+    ``samples`` shape ``(M, n)`` (``n`` loads).  The members are split into
+    ``M // m`` disjoint sub-ensembles of ``m``; the variance of the mean of
+    ``m`` is estimated by the sub-ensembles' mean sample variance over
+    ``m`` (unbiased, and using every member at every size), and its square
+    root is taken relative to the magnitude of the whole ensemble's mean,
+    then averaged over the loads (loads with a zero mean are left out).
+    ``rate`` is the least-squares slope of its logarithm against ``log m``:
+    ``-1/2`` for independent members; ``None`` with fewer than two sizes or
+    a zero error (identical members).
     """
     x = np.asarray(samples, dtype=float).reshape(len(samples), -1)
-    sizes = nested_sizes(x.shape[0]) if sizes is None else list(sizes)
+    M = x.shape[0]
+    sizes = nested_sizes(M) if sizes is None else list(sizes)
+    scale = np.abs(x.mean(axis=0))
+    keep = scale > 0
     errors = []
     for m in sizes:
-        b = band(x[:m])
-        scale = np.abs(b["mean"])
-        keep = scale > 0
-        errors.append(float(np.mean(b["standard_error"][keep] / scale[keep])) if keep.any() else 0.0)
+        groups = x[:(M // m) * m].reshape(M // m, m, -1)
+        variance = np.mean([band(g)["std"] ** 2 for g in groups], axis=0)
+        se = np.sqrt(variance / m)
+        errors.append(float(np.mean(se[keep] / scale[keep])) if keep.any() else 0.0)
     rate = None
     if len(sizes) >= 2 and min(errors) > 0:
         rate = float(np.polyfit(np.log(sizes), np.log(errors), 1)[0])

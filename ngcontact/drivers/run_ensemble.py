@@ -12,8 +12,8 @@ effective stiffness, the mean closure and the transmitted pressure.
 Results: per load the mean of each quantity over the members and its 95 %
 confidence band (:mod:`ngcontact.cell.confidence_band`), every member's
 values, and the band's shrinkage with ``M`` (the relative standard error of
-the nested ensembles of the first ``M/2^j`` members and its fitted rate,
-``-1/2`` for independent members).  Tables ``ensemble.csv``,
+the mean of ``M, M/2, M/4, ...`` members on disjoint sub-ensembles and its
+fitted rate, ``-1/2`` for independent members).  Tables ``ensemble.csv``,
 ``ensemble_members.csv``, ``ensemble_shrinkage.csv``; plots
 ``ensemble_law.png`` (the law with its band) and ``ensemble_band.png``.
 """
@@ -25,6 +25,7 @@ import numpy as np
 
 from ngcontact.cell import confidence_band
 from ngcontact.drivers import run_cell
+from ngcontact.errors import ModelError
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Clock, Outcome
 from ngcontact.solvers import executor
@@ -49,6 +50,9 @@ def measured(entry: dict) -> dict[str, float]:
     """The ensemble's quantities of one load's results (:mod:`ngcontact.drivers.run_cell`)."""
     es = entry["effective_stiffness"]
     i = es["components"].index("n0")
+    if es["matrix"] is None:
+        raise ModelError("effective_stiffness = inf: a member in full contact under exact non-penetration has no "
+                         "finite interface stiffness to average; use contact.enforcement = 'penalty'")
     return {"contact_fraction": float(entry["contact_fraction"]), "k_n0": float(entry["coefficients"]["k_n"]),
             "effective_stiffness": float(es["matrix"][i][i]), "mean_closure": float(entry["mean_closure"]),
             "transmitted_pressure": float(entry["transmitted_pressure"])}

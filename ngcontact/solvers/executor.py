@@ -257,14 +257,22 @@ class LocalPool(Executor):
             raise BatchError(label, name, _reason(exc)) from exc
 
     def _running_on_dead_workers(self, names) -> set[str]:
-        """Members last started by worker processes that are gone (their start records, by process id)."""
+        """Members last started by worker processes that died by themselves (their start records, by pid).
+
+        The pool terminates the other workers when one dies (exit status
+        ``-SIGTERM``): their members are innocent and are not counted.
+        """
+        import signal
         last: dict[int, str] = {}
         assert self._started is not None
         while not self._started.empty():
             pid, name = self._started.get()
             last[pid] = name
-        alive = {p.pid for p in (self._pool._processes or {}).values() if p.is_alive()} if self._pool else set()
-        return {name for pid, name in last.items() if pid not in alive}
+        processes = dict(self._pool._processes or {}) if self._pool is not None else {}
+        for proc in processes.values():
+            proc.join(timeout=2)             # reap: a dead process may still look alive
+        died = {pid for pid, proc in processes.items() if proc.exitcode not in (None, -signal.SIGTERM)}
+        return {name for pid, name in last.items() if pid in died}
 
     def _discard(self) -> None:
         """Stop the workers now (a broken pool, an error, an interruption)."""
