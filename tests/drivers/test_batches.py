@@ -213,3 +213,13 @@ def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_
     while time.time() < deadline and any(w.is_running() and w.status() != psutil.STATUS_ZOMBIE for w in workers):
         time.sleep(0.2)
     assert not any(w.is_running() and w.status() != psutil.STATUS_ZOMBIE for w in workers)
+
+
+def test_independent_loads_are_refused_with_friction(tmp_path):
+    from ngcontact.errors import SceneError
+    from ngcontact.scene import loader
+    path = write(tmp_path, "friction.toml", FE_SWEEP.replace("k_n = 1.0e3", 'k_n = 1.0e3\nfriction = "tresca"\n'
+                                                             "G = 0.001\nw = 1e-4"))
+    with pytest.raises(SceneError, match=r"^load.independent = True: solves every load afresh, which a frictional "
+                                         "load path does not allow"):
+        loader.load(path)
