@@ -26,7 +26,16 @@ An interruption (``KeyboardInterrupt``, or any exception in the caller while
 it waits) stops the workers before it propagates.
 
 The batch a run uses is set once by the runner (:func:`use`) and read by
-the drivers (:func:`current`); without one, batches run serially.
+the code that has a batch (:func:`current`); without one, batches run
+serially.  Any room that may import ``solvers`` uses it the same way, e.g.
+the levels of a two-scale table in ``coupling/``::
+
+    rows = executor.current().map(solve_level, [(scene, level) for level in levels],
+                                  [f"level {k}" for k in range(len(levels))], label="table levels")
+
+with ``solve_level`` a module-level function of plain data.  A script that
+runs batches on local workers needs an ``if __name__ == "__main__":`` guard:
+the workers are spawned interpreters that import the main module.
 """
 from __future__ import annotations
 
@@ -80,7 +89,7 @@ def _fault() -> _Fault | None:
 def run_member(fn: Callable[[Any], Any], item: Any, name: str, attempt: int, fault: _Fault | None) -> Any:
     """One attempt of one member, in whichever process runs it (NGSolve on one thread there)."""
     if fault is not None and fault.member == name and attempt < fault.attempts:
-        if fault.mode == "kill":
+        if fault.mode == "kill" and _IN_WORKER:
             os._exit(70)
         raise RuntimeError(f"injected fault (attempt {attempt + 1})")
     try:
@@ -106,16 +115,21 @@ class MemberFailure(Exception):
 _ONE_AT_A_TIME = threading.Lock()
 
 
-def _one_thread() -> None:
-    """Worker start: NGSolve on one thread, SIGINT left to the submitting process (which stops the workers)."""
-    import signal
+#: True in a worker process (the test-only ``kill`` fault ends only a worker, never the submitting process).
+_IN_WORKER = False
+
+
+def _one_thread(ignore_sigint: bool) -> None:
+    """Worker start: NGSolve on one thread; a pool's workers leave SIGINT to the submitting process, which
+    stops them."""
+    global _IN_WORKER
+    _IN_WORKER = True
     os.environ["NGCONTACT_THREADS"] = "1"
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        import ngsolve
-        ngsolve.SetNumThreads(1)
-    except ImportError:  # pragma: no cover - ngsolve is a dependency
-        pass
+    if ignore_sigint:
+        import signal
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    import ngsolve
+    ngsolve.SetNumThreads(1)
 
 
 def _reason(exc: BaseException) -> str:
@@ -299,7 +313,7 @@ _STARTED = None
 def _worker_start(started) -> None:
     global _STARTED
     _STARTED = started
-    _one_thread()
+    _one_thread(ignore_sigint=True)
 
 
 def _pool_member(fn, item, name, attempt, fault):
@@ -370,15 +384,9 @@ class DaskCluster(Executor):
 
 
 def _dask_member(fn, item, name, attempt, fault):
-    if os.environ.get("NGCONTACT_THREADS") != "1":
-        _one_thread_keep_signals()
+    if not _IN_WORKER:
+        _one_thread(ignore_sigint=False)
     return run_member(fn, item, name, attempt, fault)
-
-
-def _one_thread_keep_signals() -> None:
-    os.environ["NGCONTACT_THREADS"] = "1"
-    import ngsolve
-    ngsolve.SetNumThreads(1)
 
 
 def make(workers: int | None = None, scheduler: str | None = None) -> Executor:

@@ -87,20 +87,37 @@ def ensemble(tmp_path, members=4, grid=32):
                  ENSEMBLE.format(members=members, grid=grid, cutoff=4.0 / grid))
 
 
-def assert_same(a, b, path="results"):
-    """Every number of ``a`` equals ``b``'s to 1e-12 (relative to the larger magnitude, at least 1)."""
+#: The FE cell's effective stiffness is a difference of compliances (the cell's minus the bonded
+#: laminate's): its cancellation turns rounding of the factorization into relative differences of about
+#: 1e-11 between processes of different history, so it is compared at this tolerance.
+CANCELLING = ("effective_stiffness", 1e-9)
+
+
+def differences(a, b, path="results", out=None):
+    """``(path, relative difference)`` of every number of ``a`` that differs from ``b``'s by more than 1e-12."""
+    out = [] if out is None else out
     if isinstance(a, dict):
         assert sorted(a) == sorted(b), path
         for k in a:
-            assert_same(a[k], b[k], f"{path}.{k}")
+            differences(a[k], b[k], f"{path}.{k}", out)
     elif isinstance(a, (list, tuple)):
         assert len(a) == len(b), path
         for i, (x, y) in enumerate(zip(a, b)):
-            assert_same(x, y, f"{path}[{i}]")
+            differences(x, y, f"{path}[{i}]", out)
     elif isinstance(a, float):
-        assert abs(a - b) <= 1e-12 * max(1.0, abs(a), abs(b)), (path, a, b)
+        rel = abs(a - b) / max(1.0, abs(a), abs(b))
+        if rel > 1e-12:
+            out.append((path, rel))
     else:
         assert a == b, path
+    return out
+
+
+def assert_same(a, b):
+    """Every number equal to 1e-12 (relative to the larger magnitude, at least 1), the cancelling one to 1e-9."""
+    key, tol = CANCELLING
+    bad = [(p, r) for p, r in differences(a, b) if not (key in p and r <= tol)]
+    assert not bad, bad
 
 
 def numbers(report):
@@ -124,14 +141,26 @@ def scenes(tmp_path_factory):
 
 
 class Serial(dict):
-    """The serial reports, solved on first use."""
+    """The serial reports, solved on first use in this process with one thread, as a worker solves.
+
+    (With NGSolve's task manager on several threads, assembled sums are added in another order: the
+    effective stiffness, a Schur complement, then differs by about 1e-11.)
+    """
 
     def __init__(self, paths):
         super().__init__()
         self.paths = paths
 
     def __missing__(self, name):
-        self[name] = solve(self.paths[name], workers=1)[0]
+        before = os.environ.get("NGCONTACT_THREADS")
+        os.environ["NGCONTACT_THREADS"] = "1"
+        try:
+            self[name] = solve(self.paths[name], workers=1)[0]
+        finally:
+            if before is None:
+                del os.environ["NGCONTACT_THREADS"]
+            else:
+                os.environ["NGCONTACT_THREADS"] = before
         return self[name]
 
 
