@@ -11,8 +11,13 @@ abaqus|calculix|ansys|json [--out DIR]`` writes the interface law of a cell or
 macro scene for another FE code (:mod:`ngcontact.export.export_law`; default
 ``results/<scene name>_export``), what the format cannot carry as a warning.
 
+Batches of independent solves (loads with ``load.independent``, ensemble
+members, study levels) run on ``--workers N`` local processes (default: one
+per core) or on the dask.distributed scheduler ``--scheduler ADDRESS``, with a
+progress bar on a terminal (plain lines otherwise, none with ``--quiet``).
+
 Exit status: 0 success, 2 invalid scene or output directory, 3 solver
-failure, 130 interrupted (SIGINT), 143 terminated (SIGTERM); every failure
+failure (also a member of a batch that failed twice), 130 interrupted (SIGINT), 143 terminated (SIGTERM); every failure
 prints one line on stderr and leaves the output directory as it was
 (:mod:`ngcontact.output.writer`: only the package's own files are ever
 written or replaced).
@@ -76,6 +81,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("scene", help="scene file (TOML)")
     run.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>)")
     run.add_argument("--quiet", action="store_true", help="no progress lines")
+    _compute_options(run)
     chk = sub.add_parser("check", help="validate a scene file without solving",
                          description="Validate a scene file and list the effects it calls for.")
     chk.add_argument("scene", help="scene file (TOML)")
@@ -87,6 +93,7 @@ def _parser() -> argparse.ArgumentParser:
     st.add_argument("--periods", type=int, nargs="+", metavar="N", help="numbers of periods (default: the scene's)")
     st.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon)")
     st.add_argument("--quiet", action="store_true", help="no progress lines")
+    _compute_options(st)
     ex = sub.add_parser("export", help="write a cell's or macro scene's interface law for Abaqus, CalculiX, "
                         "ANSYS or as JSON", description="Export the homogenized interface law of a cell scene (its "
                         "direction bundle) or of a macro scene (the law its interface uses).")
@@ -103,6 +110,26 @@ def _parser() -> argparse.ArgumentParser:
     ex.add_argument("--mu", type=float, metavar="MU", help="friction coefficient to write (default: the macro "
                     "scene's interface.mu, else |k_nt0|/k_n0)")
     return p
+
+
+def _workers(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: the number of worker processes, an integer >= 1")
+    return n
+
+
+def _compute_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--workers", type=_workers, metavar="N",
+                   help="local worker processes for independent solves (loads with load.independent, ensemble "
+                        "members, study levels), one NGSolve thread each (default: [compute] workers, else the "
+                        "number of cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run independent solves on the workers of this dask.distributed scheduler "
+                        "(e.g. tcp://10.0.0.5:8786) instead of local processes (default: [compute] scheduler)")
 
 
 def main(argv=None) -> int:
@@ -122,9 +149,10 @@ def main(argv=None) -> int:
             return _check(args.scene)
         if args.command == "export":
             return _export(args)
+        compute = {"workers": args.workers, "scheduler": args.scheduler}
         if args.command == "study":
-            return _study(args.scene, args.periods, args.out, quiet=args.quiet)
-        return _run(args.scene, args.out, quiet=args.quiet)
+            return _study(args.scene, args.periods, args.out, quiet=args.quiet, compute=compute)
+        return _run(args.scene, args.out, quiet=args.quiet, compute=compute)
     except KeyboardInterrupt:
         return _fail(EXIT_INTERRUPTED, f"{args.scene}: interrupted; the output directory is as it was")
     except Terminated:
@@ -178,13 +206,17 @@ def _check(path: str) -> int:
     return EXIT_OK
 
 
-def _run(path: str, out: str | None, quiet: bool) -> int:
+def _run(path: str, out: str | None, quiet: bool, compute: dict) -> int:
+    from ngcontact.output.progress_bar import BatchProgress
     from ngcontact.runner import solve
 
-    return _execute(path, out, quiet, solve, suffix="")
+    def compute_run(sc, progress):
+        return solve(sc, progress, batch_progress=BatchProgress(quiet), **compute)
+
+    return _execute(path, out, quiet, compute_run, suffix="")
 
 
-def _study(path: str, periods, out: str | None, quiet: bool) -> int:
+def _study(path: str, periods, out: str | None, quiet: bool, compute: dict) -> int:
     """``ngcontact study epsilon``: the same code as ``scripts/epsilon_study.py``."""
     from ngcontact.runner import study_epsilon
 
@@ -192,14 +224,16 @@ def _study(path: str, periods, out: str | None, quiet: bool) -> int:
         if sc.kind != "direct" or sc.study is None:
             raise SceneError("kind", sc.kind, "the epsilon study needs a 'direct' scene with a [study] section")
 
-    def compute(sc, progress):
-        return study_epsilon(sc, periods, progress)
+    from ngcontact.output.progress_bar import BatchProgress
+
+    def run_study(sc, progress):
+        return study_epsilon(sc, periods, progress, batch_progress=BatchProgress(quiet), **compute)
 
     if periods is not None and (len(periods) < 3 or any(n < 1 for n in periods)
                                 or any(b <= a for a, b in zip(periods, periods[1:]))):
         return _fail(EXIT_SCENE, f"--periods {' '.join(map(str, periods))}: at least 3 increasing numbers "
                                  "N >= 1 (a rate needs three distinct levels)")
-    return _execute(path, out, quiet, compute, suffix="_epsilon", validate=require_study)
+    return _execute(path, out, quiet, run_study, suffix="_epsilon", validate=require_study)
 
 
 def _export(args) -> int:

@@ -76,6 +76,19 @@ class GeometryError(ModelError):
         super().__init__(f"{name} = {_show(value)}: {allowed}")
 
 
+class BatchError(NgcontactError):
+    """A member of a batch of independent solves failed twice (its retry too): ``label: member: reason``.
+
+    The batch returns nothing; the command line maps it to exit status 3.
+    """
+
+    def __init__(self, label: str, member: str, reason: str):
+        self.label = label
+        self.member = member
+        self.reason = reason
+        super().__init__(f"{label}: {member} failed twice: {reason}")
+
+
 class OutputError(NgcontactError):
     """The output directory cannot be written."""
 

@@ -79,7 +79,15 @@ def check(scene) -> None:
         check_model(scene)
 
 
-def solve(scene, progress: Callable[[str], None] | None = None) -> tuple[dict, Outcome]:
+def driver(scene):
+    """The driver module of a scene: its kind's, or the ensemble driver for a cell scene with ``[ensemble]``."""
+    if scene.kind == "cell" and getattr(scene, "ensemble", None) is not None:
+        return importlib.import_module("ngcontact.drivers.run_ensemble")
+    return importlib.import_module(DRIVERS[scene.kind])
+
+
+def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int | None = None,
+          scheduler: str | None = None, batch_progress=None) -> tuple[dict, Outcome]:
     """Solve ``scene`` (a validated scene or a path to a scene file).
 
     Parameters
@@ -88,6 +96,13 @@ def solve(scene, progress: Callable[[str], None] | None = None) -> tuple[dict, O
         The result of :func:`ngcontact.load`, or a file path.
     progress
         Optional callable receiving one line per stage (e.g. ``print``).
+    workers, scheduler
+        Where batches of independent solves run (independent loads, ensemble
+        members): ``workers`` local processes (default: the scene's
+        ``[compute]``, else one per core), or the dask.distributed scheduler
+        at the address ``scheduler``.
+    batch_progress
+        Optional ``callable(label, finished, total)`` called as a batch advances.
 
     Returns
     -------
@@ -97,20 +112,25 @@ def solve(scene, progress: Callable[[str], None] | None = None) -> tuple[dict, O
         scene = loader.load(scene)
     n = thread_count()
     clock = Clock(progress)
-    with threads(n):
-        outcome = importlib.import_module(DRIVERS[scene.kind]).run(scene, clock)
+    module = driver(scene)
+    from ngcontact.drivers.build import batches
+    with threads(n), batches(scene, workers, scheduler, batch_progress):
+        outcome = module.run(scene, clock)
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),
                           outcome=outcome, timings=clock.total(), version=__version__, threads=n)
     return report, outcome
 
 
-def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = None) -> tuple[dict, Outcome]:
+def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = None, *, workers: int | None = None,
+                  scheduler: str | None = None, batch_progress=None) -> tuple[dict, Outcome]:
     """The epsilon study of a ``direct`` scene with a ``[study]`` section, as a report; no file I/O.
 
     The resolved rough interface at ``N`` periods against the homogenized
     laws (:mod:`ngcontact.drivers.study_epsilon`); the command
     ``ngcontact study epsilon`` and ``scripts/epsilon_study.py`` call this.
+    The levels are independent solves: ``workers``, ``scheduler`` and
+    ``batch_progress`` as in :func:`solve`.
 
     Raises
     ------
@@ -126,7 +146,8 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
         raise SceneError("kind", scene.kind, "the epsilon study needs a 'direct' scene with a [study] section")
     n = thread_count()
     clock = Clock(progress)
-    with threads(n):
+    from ngcontact.drivers.build import batches
+    with threads(n), batches(scene, workers, scheduler, batch_progress):
         outcome = run_study(scene, periods, clock=clock)
     report = build_report(kind="direct-epsilon-study", title=scene.title, scene=loader.as_dict(scene),
                           effects=loader.effects(scene), outcome=outcome, timings=clock.total(),

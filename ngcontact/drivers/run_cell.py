@@ -15,7 +15,9 @@ per-load keys (no body stresses: the layers' interiors are not sampled), the
 grid fields as ``.npy`` and ``results.method`` stating the grid; with a
 tolerance the grid is refined (:mod:`ngcontact.cell.spectral_refinement`),
 each load adds ``error_estimate`` and ``results.method.refinement`` holds the
-levels.
+levels.  With ``load.independent`` every load is solved from the unloaded
+cell as a member of a batch (:mod:`ngcontact.drivers.cell_members`), on the
+run's workers.
 """
 from __future__ import annotations
 
@@ -31,6 +33,7 @@ from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.edge_grading import GradedSolve, graded_flat_cell, solve_to_tolerance
 
 from ngcontact.cell import spectral_measures
+from ngcontact.drivers import cell_members
 from ngcontact.cell.spectral_refinement import sweep_to_tolerance
 from ngcontact.scene.cell_scene import MAX_SPECTRAL_POINTS
 from ngcontact.cell.coefficients import coefficients
@@ -85,7 +88,10 @@ def run_spectral(scene, clock) -> Outcome:
         return Outcome(results=results, ndof=cell.points)
     estimates: list[dict[str, float] | None] = []
     with clock.stage("solve"):
-        if tolerance is None:
+        if tolerance is None and scene.load.independent:
+            sols = cell_members.solve_spectral(scene)
+            estimates = [None] * len(sols)
+        elif tolerance is None:
             sols = cell.sweep(cell_loads(scene))
             estimates = [None] * len(sols)
         else:
@@ -146,7 +152,9 @@ def run(scene, clock) -> Outcome:
                         inverse=s.inverse, linear=linear_solver(scene))
     graded: list[GradedSolve] = []
     with clock.stage("solve"):
-        if scene.discretization.tolerance is None:
+        if scene.discretization.tolerance is None and scene.load.independent:
+            sols = cell_members.solve_fe(scene, P)
+        elif scene.discretization.tolerance is None:
             sols = P.sweep(cell_loads(scene))
         else:
             graded = solve_graded(scene, cell_loads(scene))

@@ -41,11 +41,16 @@ Errors of each law against the resolved solution ``u^eps``:
   force through the cylindrical part ``z > z_corner`` (the rest goes
   through the cone).
 
+The levels are independent solves: a batch (:mod:`ngcontact.solvers.executor`)
+spreads them over the run's workers, so the wall times of a level are
+measured while the other workers run too.
+
 The observed rate of each law is the least-squares slope of ``log error``
 against ``log eps`` (:func:`ngcontact.verification.rates.fit_rate`).
 """
 from __future__ import annotations
 
+import contextlib
 import logging
 import time
 from typing import Any
@@ -54,6 +59,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.resolved import resolved_problem as D
+from ngcontact.solvers import executor
 from ngcontact.fem import elasticity
 from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
@@ -313,6 +319,12 @@ def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS) -> dict:
     return row
 
 
+def level_member(job: tuple) -> dict:
+    """Member of the batch of levels (:mod:`ngcontact.solvers.executor`): ``(scene, N, bundle, laws)`` -> row."""
+    scene, N, bundle, laws = job
+    return level(scene, N, bundle, laws=laws)
+
+
 def per_error(rows: list, laws, summary) -> dict:
     """``{law: {error: summary(column)}}`` over the error columns present in ``rows``."""
     return {name: {key: summary(f"{name}_{key}") for key in ERRORS if f"{name}_{key}" in rows[0]}
@@ -360,13 +372,10 @@ def run_study(scene, periods=None, *, laws=LAWS, clock=None) -> Outcome:
         raise SceneError("study.band", scene.study.band, f"the band of N = {min(periods)} covers both "
                          "bodies: no points are left for the field error; take a smaller band or more periods")
     bundle = cell_bundle(scene)
-    rows = []
-    for N in periods:
-        if clock is not None:
-            with clock.stage(f"N = {N}"):
-                rows.append(level(scene, N, bundle, laws=laws))
-        else:
-            rows.append(level(scene, N, bundle, laws=laws))
+    jobs = [(scene, N, bundle, tuple(laws)) for N in periods]
+    names = [f"N = {N}" for N in periods]
+    with clock.stage("levels") if clock is not None else contextlib.nullcontext():
+        rows = executor.current().map(level_member, jobs, names, label="epsilon levels")
     results = {"rows": rows, "rates": rates(rows, laws) if len(rows) >= 3 else {},
                "below_1_percent": threshold_eps(rows, laws),
                "bundle": {"directions": len(bundle.weights), "K0": bundle.matrix().tolist()},

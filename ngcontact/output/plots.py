@@ -271,3 +271,47 @@ def worst_cell(path: str, points, eq, criterion: str, dim: int) -> None:
         fig.suptitle(f"worst cell: max {eq[k]:.3g} MPa (+)")
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def ensemble_law(path: str, pressure, bands: dict, labels: dict, members: int) -> None:
+    """An ensemble's law against the transmitted pressure: the mean of each quantity and its 95 % band."""
+    plt = _pyplot()
+    names = list(bands)
+    fig, ax = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.6))
+    order = np.argsort(pressure)
+    p = np.asarray(pressure)[order]
+    for a, name in zip(np.atleast_1d(ax), names):
+        b = {k: np.asarray(v)[order] for k, v in bands[name].items()}
+        a.fill_between(p, b["low"], b["high"], color="C0", alpha=0.3, label="95 % band of the mean")
+        a.plot(p, b["mean"], "o-", color="C0", label=f"mean of {members} members")
+        a.set_xscale("log")
+        a.set_xlabel("transmitted pressure")
+        a.set_title(labels.get(name, name), fontsize=9)
+        a.grid(True, which="both", alpha=0.3)
+    np.atleast_1d(ax)[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def ensemble_band(path: str, shrink: dict) -> None:
+    """Relative standard error of the ensemble mean against the number of members, with ``M^(-1/2)``."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(5, 4))
+    for name, s in shrink.items():
+        rate = s["rate"]
+        label = f"{name} (rate {rate:.2f})" if rate is not None else name
+        ax.loglog(s["members"], s["relative_standard_error"], "o-", label=label)
+    first = next(iter(shrink.values()))
+    M = np.asarray(first["members"], float)
+    e0 = max(max(s["relative_standard_error"]) for s in shrink.values()) or 1.0
+    ax.loglog(M, e0 * (M / M[0]) ** -0.5, "k:", label="M^(-1/2)")
+    ax.set_xticks(M, [str(int(m)) for m in M])
+    ax.minorticks_off()
+    ax.set_xlabel("members M")
+    ax.set_ylabel("standard error / |mean| (mean over loads)")
+    ax.legend(fontsize=7)
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

@@ -11,7 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ngcontact.errors import GeometryError, SceneError
-from ngcontact.scene.schema import (at_least, check_selected, closed_interval, open_interval, param, positive)
+from ngcontact.scene.schema import (at_least, check_selected, closed_interval, nonnegative, open_interval, param,
+                                    positive)
 
 
 PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
@@ -29,9 +30,10 @@ class SpectrumSpec:
 
     hurst: float = param(doc="Hurst exponent H: power spectrum C(q) ~ q^(-2(1+H)) between roll-off and cut-off",
                          check=open_interval(0, 1))
-    rms_height: float | None = param(None, doc="root-mean-square height (give this or rms_slope)", units="m",
-                                     check=positive())
-    rms_slope: float | None = param(None, doc="root-mean-square slope (give this or rms_height)", check=positive())
+    rms_height: float | None = param(None, doc="root-mean-square height (give this or rms_slope; 0: a flat surface)",
+                                     units="m", check=nonnegative())
+    rms_slope: float | None = param(None, doc="root-mean-square slope (give this or rms_height; 0: a flat surface)",
+                                    check=nonnegative())
     rolloff: float | None = param(None, doc="roll-off wavelength: the spectrum is flat for longer ones (default: "
                                   "the period)", units="m", check=positive())
     cutoff: float | None = param(None, doc="shortest wavelength (default: 4 grid steps)", units="m",

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
 from ngcontact.scene.cell_geometry import CellGeometry, check_features, check_profile_heights, small_slope
-from ngcontact.scene.sections import (CellDiscretization, MaterialSpec, SolverSpec, base_dir_field,
-                     check_material_names)
+from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
+                                     check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import check_selected, nonempty, nonnegative, param, positive
+from ngcontact.scene.schema import at_least, check_selected, nonempty, nonnegative, param, positive
 
 GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 FRICTION = ("none", "tresca", "coulomb")
@@ -89,6 +89,9 @@ class LoadSpec:
                                                       "(same layout as shear)", units="m")
     macro_strain: tuple[float, ...] | None = param(None, doc="in-plane macro strain: 2D (e_xx), "
                                                    "3D (e_xx, e_yy, e_xy), one set per sweep", units="")
+    independent: bool = param(False, doc="solve every load on its own from the unloaded cell (no continuation "
+                              "from the previous load), so that the loads run in parallel (see [compute]); "
+                              "frictionless contact only")
 
     def check(self, path: str) -> None:
         if (self.pressure is None) == (self.normal_jump is None):
@@ -100,6 +103,13 @@ class LoadSpec:
             v = getattr(self, key)
             if v is not None and len(v) == 0:
                 raise SceneError(f"{path}.{key}", v, "must not be empty")
+
+
+@dataclass(frozen=True, kw_only=True)
+class EnsembleSpec:
+    """M realizations of the random surface of ``geometry.spectrum``: seeds ``seed, seed + 1, ...``."""
+
+    members: int = param(doc="number of realizations M", check=at_least(2))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -121,6 +131,9 @@ class CellScene:
     load: LoadSpec | None = param(None, doc="mean load (omit with contact.geometric_only)")
     discretization: CellDiscretization = param(CellDiscretization(), doc="mesh and order")
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
+    ensemble: EnsembleSpec | None = param(None, doc="solve the loads on M realizations of the random surface "
+                                          "(geometry.profile = 'self_affine'); report the mean and the 95 % band")
+    compute: ComputeSpec = param(ComputeSpec(), doc="where independent solves run (loads, ensemble members)")
     base_dir: str = base_dir_field()
 
     def check_files(self, load) -> None:
@@ -200,6 +213,12 @@ class CellScene:
                              "which a frictional load path does not allow; remove the key or set "
                              "contact.friction = 'none'")
         load_states(self)
+        if self.load.independent and self.contact.friction != "none":
+            raise SceneError("load.independent", True, "solves every load afresh, which a frictional load path "
+                             "does not allow; remove the key or set contact.friction = 'none'")
+        if self.ensemble is not None and self.geometry.profile != "self_affine":
+            raise SceneError("ensemble", "...", "realizations of a random surface need geometry.profile = "
+                             f"'self_affine' (its spectrum and seed), not {self.geometry.profile!r}")
         flat = self.geometry.profile in ("flat", "flat3d") or small_slope(self.geometry)
         if flat and self.contact.friction == "none":
             for key in ("shear", "tangential_jump"):

@@ -37,7 +37,8 @@ import numpy as np
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
 from ngcontact.scene.macro_scene import FEMUR_BOUNDARIES, check_dimensions, check_support_meaning
-from ngcontact.scene.sections import MaterialSpec, check_supports_once, SolverSpec, base_dir_field, check_material_names
+from ngcontact.scene.sections import (ComputeSpec, MaterialSpec, check_supports_once, SolverSpec, base_dir_field,
+                                     check_material_names)
 from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty, param, positive
 
@@ -171,6 +172,7 @@ class DirectScene:
     discretization: DirectMesh = param(doc="mesh and order")
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     study: StudySpec | None = param(None, doc="epsilon study (scripts/epsilon_study.py)")
+    compute: ComputeSpec = param(ComputeSpec(), doc="where the epsilon study's levels run")
     base_dir: str = base_dir_field()
 
     def check(self, path: str) -> None:

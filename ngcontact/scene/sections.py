@@ -122,6 +122,21 @@ def check_material_names(materials: dict, names: dict, path: str) -> None:
 
 
 
+@dataclass(frozen=True, kw_only=True)
+class ComputeSpec:
+    """Where a batch of independent solves runs (:mod:`ngcontact.solvers.executor`); the command line's
+    ``--workers`` and ``--scheduler`` take precedence."""
+
+    scheduler: str | None = param(None, doc="address of a dask.distributed scheduler (e.g. 'tcp://10.0.0.5:8786') "
+                                  "whose workers solve the batch; default: a pool of local processes")
+    workers: int | None = param(None, doc="local worker processes, one NGSolve thread each (default: the cores)",
+                                check=at_least(1))
+
+    def check(self, path: str) -> None:
+        if self.scheduler is not None and not self.scheduler.strip():
+            raise SceneError(f"{path}.scheduler", self.scheduler, "an address such as 'tcp://host:8786', or omit it")
+
+
 def base_dir_field():
     """The scene file's folder: set by the loader, not read from the file."""
     return field(default=".", init=False, repr=False, compare=False)

@@ -129,8 +129,10 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
         if pbar is not None:
             r = r - r[on].mean()
         rt = inner(np.where(on, r, 0.0), t)
-        if rt <= 0:
+        if rt <= 0:            # no descent left: converged if complementary (a uniform start on a flat gap)
             residuals.append(_residual(p, g, shift, gscale))
+            if residuals[-1] <= tol:
+                return ConstrainedResult(p=p, gap=g - shift, shift=shift, iterations=it - 1, residuals=residuals)
             break
         tau = inner(gs, t) / rt
         p = np.maximum(p - tau * t, 0.0)

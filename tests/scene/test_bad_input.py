@@ -303,8 +303,8 @@ def test_height_map_that_is_not_periodic(tmp_path, capsys):
 # ------------------------------------------------------------------ keys
 def test_unknown_top_level_section(tmp_path, capsys):
     text = CELL.format(contact="").replace("[solver]", "[solvr]")
-    run_bad(tmp_path, capsys, text, "solvr = {rtol}: unknown key; allowed keys here are bodies, contact, "
-            "discretization, geometry, kind, load, materials, solver, title")
+    run_bad(tmp_path, capsys, text, "solvr = {rtol}: unknown key; allowed keys here are bodies, compute, contact, "
+            "discretization, ensemble, geometry, kind, load, materials, solver, title")
 
 
 def test_misspelled_key_in_a_section(tmp_path, capsys):

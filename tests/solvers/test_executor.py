@@ -1,0 +1,77 @@
+"""The executor of batches: results in order, a failing member retried once, a second failure named.
+
+Faults are injected through the test-only variable ``NGCONTACT_TEST_FAULT``
+(``MEMBER:ATTEMPTS:MODE``), read where the batch is submitted; the members
+are ``operator.neg`` so that a spawned worker needs nothing of the tests.
+"""
+import operator
+
+import pytest
+
+from ngcontact.errors import BatchError
+from ngcontact.solvers import executor
+
+ITEMS = [1.5, -2.0, 3.25, 7.0, -0.5]
+NAMES = [f"m{k}" for k in range(len(ITEMS))]
+EXPECTED = [-x for x in ITEMS]
+
+
+@pytest.fixture(scope="module")
+def pool():
+    p = executor.LocalPool(2)
+    yield p
+    p.close()
+
+
+def test_serial_runs_every_member_in_order_and_reports_progress():
+    seen = []
+    out = executor.Serial().map(operator.neg, ITEMS, NAMES, label="toy", progress=lambda *a: seen.append(a))
+    assert out == EXPECTED
+    assert seen == [("toy", k, len(ITEMS)) for k in range(len(ITEMS) + 1)]
+
+
+def test_names_must_be_distinct():
+    with pytest.raises(ValueError, match="one distinct name per member"):
+        executor.Serial().map(operator.neg, ITEMS, ["a"] * len(ITEMS))
+
+
+@pytest.mark.parametrize("make", [executor.Serial, lambda: None], ids=["serial", "pool"])
+def test_a_member_failing_once_is_retried_and_the_batch_completes(monkeypatch, pool, make):
+    monkeypatch.setenv(executor.FAULT_ENV, "m2:1:raise")
+    ex = make() or pool
+    assert ex.map(operator.neg, ITEMS, NAMES) == EXPECTED
+
+
+def test_a_killed_worker_is_replaced_and_its_member_retried(monkeypatch, pool):
+    monkeypatch.setenv(executor.FAULT_ENV, "m3:1:kill")
+    assert pool.map(operator.neg, ITEMS, NAMES, label="toy") == EXPECTED
+    monkeypatch.delenv(executor.FAULT_ENV)
+    assert pool.map(operator.neg, ITEMS, NAMES) == EXPECTED      # the pool works on afterwards
+
+
+@pytest.mark.parametrize("mode", ["raise", "kill"])
+def test_a_member_failing_twice_ends_the_batch_naming_it(monkeypatch, pool, mode):
+    monkeypatch.setenv(executor.FAULT_ENV, f"m1:2:{mode}")
+    with pytest.raises(BatchError) as info:
+        pool.map(operator.neg, ITEMS, NAMES, label="toy")
+    assert info.value.member == "m1"
+    reason = "its worker process died" if mode == "kill" else "injected fault (attempt 2)"
+    assert str(info.value) == f"toy: m1 failed twice: RuntimeError: {reason}"
+
+
+def test_a_serial_member_failing_twice_names_the_original_error(monkeypatch):
+    def bad(x):
+        raise ZeroDivisionError("no inverse of 0\nsecond line")
+    with pytest.raises(BatchError, match=r"^toy: m0 failed twice: ZeroDivisionError: no inverse of 0$"):
+        executor.Serial().map(bad, [0.0], ["m0"], label="toy")
+
+
+def test_make_chooses_serial_pool_or_cluster():
+    assert isinstance(executor.make(1), executor.Serial)
+    assert isinstance(executor.make(3), executor.LocalPool) and executor.make(3).workers == 3
+    dask = executor.make(2, "tcp://127.0.0.1:1")         # connects on first use only
+    assert isinstance(dask, executor.DaskCluster) and dask.address == "tcp://127.0.0.1:1"
+    assert executor.current().name == "serial"
+    with executor.use(executor.LocalPool(2)) as ex:
+        assert executor.current() is ex
+    assert executor.current().name == "serial"
