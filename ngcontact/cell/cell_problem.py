@@ -71,7 +71,7 @@ from ngcontact.cell.cell_model import CellModel, CellSolution
 from ngcontact.cell.cell_energy import cell_energy, macro_strain_cf
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
-from ngcontact.cell.predictor import rigid_continuation, set_start, tangential_load
+from ngcontact.cell.predictor import rigid_continuation, rigid_translation, set_start, tangential_load
 from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
 from ngcontact.errors import ModelError
@@ -255,8 +255,11 @@ class CellProblem:
         if first and self.multiplier is not None and self.model.friction is not None:
             start_multiplier(self, load)
         free = self._freedofs(load)
-        # a later load with a tangential change: the rigid continuation (predictor module); its steps count
-        predicted = None if first else rigid_continuation(self, free, before)
+        # a later load with a tangential change: frictionless, the rigid predictor for the whole traction;
+        # with friction (or where that has no minimizer), the rigid continuation, whose steps count
+        predicted = None
+        if not first and not (tangential_load(self) != before and rigid_translation(self, load, free)):
+            predicted = rigid_continuation(self, free, before)
         histories: list[dict] = [] if predicted is None else [predicted]
         fp = 0
         if self.coulomb_previous is not None:

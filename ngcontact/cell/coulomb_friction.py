@@ -82,7 +82,8 @@ def _coupled(problem, free) -> dict:
     return coupled_newton(problem.coulomb_residual, problem.form, problem.gfu, freeze=freeze,
                           pressure=lambda: _pressure(problem), freedofs=free, rtol=problem.rtol,
                           atol=problem.atol, max_iter=problem.max_iter, inverse=inverse,
-                          symmetric_inverse=problem.inverse, active_set=problem.active_set)
+                          symmetric_inverse=problem.inverse, active_set=problem.active_set,
+                          record=problem.linear)
 
 
 def _fixed_point(problem, free, newton_once) -> dict:

@@ -69,6 +69,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.errors import ConvergenceError
+from ngcontact.solvers.linear_solver import LinearSolver, TangentSolve
 from ngcontact.solvers.newton import (ARMIJO, MIN_STEP, ActiveSetCycle, NewtonHistory, at_floor, exact_step,
                                       fixed_mask, mask_fixed, roundoff_floor)
 
@@ -79,7 +80,7 @@ def coupled_newton(residual_form: ng.BilinearForm, energy_form: ng.BilinearForm,
                    freeze: Callable[[], None], pressure: Callable[[], np.ndarray], freedofs,
                    rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40, inverse: str = "umfpack",
                    symmetric_inverse: str = "sparsecholesky", max_step: float = 8.0,
-                   active_set=None) -> dict:
+                   active_set=None, record: LinearSolver | None = None) -> dict:
     """Solve ``R(u) = 0`` from ``gfu`` (updated in place) by the coupled Newton of the module docstring.
 
     Parameters
@@ -102,6 +103,9 @@ def coupled_newton(residual_form: ng.BilinearForm, energy_form: ng.BilinearForm,
         Largest step of the exact line search.
     active_set
         Optional ``active_set(gfu) -> hashable`` signature (cycle detection).
+    record
+        A :class:`~ngcontact.solvers.linear_solver.LinearSolver` whose
+        record of solves the LU solves join (the report's count).
 
     Returns
     -------
@@ -144,7 +148,11 @@ def coupled_newton(residual_form: ng.BilinearForm, energy_form: ng.BilinearForm,
             log.info("coulomb newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             break
-        du.data = residual_form.mat.Inverse(freedofs, inverse=inverse) * res
+        lu = residual_form.mat.Inverse(freedofs, inverse=inverse)
+        if record is None:
+            du.data = lu * res
+        else:
+            TangentSolve(record, lu, counted=False).apply(res, du)
         trial.data = gfu.vec - du
         r_full = residual(trial, r_trial)
         if math.isfinite(r_full) and r_full < rnorm:
@@ -152,7 +160,7 @@ def coupled_newton(residual_form: ng.BilinearForm, energy_form: ng.BilinearForm,
             gfu.vec.data = trial
         else:
             alpha = _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res,
-                                        symmetric_inverse, max_step)
+                                        symmetric_inverse, max_step, record)
             if alpha == 0.0:
                 hist.steps.append(0.0)
                 raise failed(f"Coulomb Newton step {it}: no decrease of the frozen Tresca energy "
@@ -187,7 +195,7 @@ def coupled_newton(residual_form: ng.BilinearForm, energy_form: ng.BilinearForm,
 
 
 def _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res, symmetric_inverse,
-                        max_step) -> float:
+                        max_step, record) -> float:
     """Step along ``du`` (or the Tresca direction) minimizing the frozen Tresca energy; updates ``gfu``.
 
     ``res`` holds ``R(u)`` = the frozen energy's gradient at ``u`` on entry
@@ -197,7 +205,11 @@ def _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res,
     slope = ng.InnerProduct(du, res)
     if not slope > 0.0:          # no descent of the frozen energy: the symmetric Tresca direction
         energy_form.AssembleLinearization(gfu.vec)
-        du.data = energy_form.mat.Inverse(freedofs, inverse=symmetric_inverse) * res
+        inv = energy_form.mat.Inverse(freedofs, inverse=symmetric_inverse)
+        if record is None:
+            du.data = inv * res
+        else:
+            TangentSolve(record, inv, counted=False).apply(res, du)
         slope = ng.InnerProduct(du, res)
         if not slope > 0.0:
             return 0.0
