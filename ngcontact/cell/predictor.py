@@ -59,14 +59,18 @@ is no better where the contact set moves across the cell (the shear turns
 the pressed flank): on the sinusoid sweep the Newton steps after the start
 are the same 6 and 4 as after the rigid continuation below, without the
 continuation's 3 and 3 steps (1, 2, 9, 7 -> 1, 1, 6, 4 per load), and on
-the 3D bisinusoid surface 4 + 9 -> 10.  With friction the Winkler model,
+the 3D bisinusoid surface 4 + 9 -> 10.  The gain is the continuation's
+steps, each an assembly of the cell's tangent; the predictor's own
+iterations, on ``dim`` unknowns with surface integrals only, are no
+Newton steps of the cell problem, like the first load's root.  With friction the Winkler model,
 which has none, would slide the counter over the flat parts of ``S_C``
 that friction holds (and Coulomb's law, without an energy, need not have
 one solution: the previous one is the start to keep): the rigid
 continuation.
 
-*Other later loads* (continuation from the previous load's solution): the rigid
-continuation.  Before the Newton solve, the energy is minimized over the
+*Later loads with a tangential change under friction*, or where the
+restart finds no regular minimizer (continuation from the previous load's
+solution): the rigid continuation.  Before the Newton solve, the energy is minimized over the
 far-face translations ``U_i`` that the load leaves free (a traction is
 prescribed), the fluctuations frozen at the previous solution:
 
@@ -76,7 +80,8 @@ a problem in ``dim`` unknowns (Newton on the same energy with only those
 dofs free; its tangent is the ``dim x dim`` block of ``Pi''`` in ``U``).  A
 load increment then first moves the counter as a rigid body on the deformed
 rough surface, which is where a shear load near the frictionless limit
-goes: on the sinusoid, the shear 0.002 -> 0.003 (``tau/p`` near the largest
+goes: on the sinusoid (measured before the restart took the frictionless
+loads), the shear 0.002 -> 0.003 (``tau/p`` near the largest
 slope 0.31) slides the counter a quarter period and lifts it, which Newton
 from the previous state reached in 21 steps, from the rigid continuation in
 4 (plus 3 steps of the ``dim``-unknown problem).  The continuation's steps
