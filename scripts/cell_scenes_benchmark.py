@@ -50,7 +50,9 @@ def bench(path: str, out_root: str) -> dict:
         rep = json.load(fh)
     loads = rep.get("results", {}).get("loads", [])
     its = [int(entry.get("newton_iterations", 0)) for entry in loads]
-    solves = [h["iterations"] for per in rep.get("solver", {}).get("per_load", []) for h in per]
+    # FE cells: a list of Newton histories per load; spectral cells: one solver record per load
+    solves = [h["iterations"] for per in rep.get("solver", {}).get("per_load", [])
+              for h in (per if isinstance(per, list) else [per])]
     t = rep.get("timings", {})
     row.update(max_per_solve=max(solves) if solves else 0, newton_solves=len(solves),
                ndof=rep.get("ndof", 0), loads=len(its), newton_per_load=" ".join(map(str, its)),

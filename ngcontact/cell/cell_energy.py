@@ -16,6 +16,14 @@ density ``psi`` (:func:`ngcontact.laws.penalty.interface_energy`):
   ``G = mu p`` of a frozen previous state (penalty: a copy of the state,
   returned for the fixed point to fill) or ``mu lambda`` of the multiplier
   (exact).
+
+Coulomb with the penalty, solved by the coupled Newton of
+:mod:`ngcontact.solvers.coulomb_newton` (:func:`coulomb_residual`): no
+energy exists, so the form is the residual itself, the same terms with the
+friction written as its traction ``mu p(J) J_t / max(|J_t|, w)`` tested
+with the jump of the test function, the threshold ``mu p(J)`` of the
+unknown state (``mu k_n [J.n - g]_+``), so that the linearization is the
+consistent, non-symmetric tangent.
 """
 from __future__ import annotations
 
@@ -31,15 +39,12 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
     GridFunction of the frozen previous state whose pressure sets the
     threshold (``None`` otherwise).
     """
-    m, mesh = problem.model, problem.mesh
+    m = problem.model
     previous = None
     # UMFPACK reads only one triangle of a symmetric-storage matrix: full storage for it
     form = ng.BilinearForm(problem.X, symmetric=True,
                            symmetric_storage=problem.inverse == "sparsecholesky")
-    for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
-        eps = problem.body_strain(u)
-        form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
-                             * ng.dx(definedon=mesh.Materials(name)))
+    _add_bodies(form, problem, ur, uc)
     J = ur - uc - U
     lam = None if problem.multiplier is None else problem.multiplier.value
     friction = threshold = w = None
@@ -62,9 +67,47 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
     ds = (ng.ds("contact", bonus_intorder=m.contact_bonus_order) if problem.multiplier is None
           else problem.multiplier.ds)
     form += ng.Variation(psi * ds)
+    _add_load(form, problem, U)
+    return form, previous
+
+
+def coulomb_residual(problem) -> ng.BilinearForm:
+    """The non-symmetric residual form of Coulomb friction with the penalty (module docstring).
+
+    Its ``Apply`` is the gradient of ``Pi`` with the threshold set to
+    ``mu p`` of the state itself, its linearization the consistent tangent.
+    """
+    m = problem.model
+    fr = m.friction
+    if fr is None or fr.law != "coulomb" or problem.multiplier is not None:
+        raise ValueError("the coupled Coulomb residual needs Coulomb friction with the penalty")
+    trial, test = problem.X.TrialFunction(), problem.X.TestFunction()
+    ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
+    form = ng.BilinearForm(problem.X, symmetric=False)
+    _add_bodies(form, problem, ur, uc)
+    J = ur - uc - U
+    dJ = test[0] - test[1] - ng.CF(tuple(test[2:]))
+    ds = ng.ds("contact", bonus_intorder=m.contact_bonus_order)
+    form += ng.Variation(_contact.normal_energy(J, problem.n, m.k_n, problem.gap) * ds)
+    G = _contact.coulomb_threshold(J, problem.n, m.k_n, fr.mu, problem.gap)
+    form += ng.InnerProduct(_contact.friction_traction(J, problem.n, G, fr.w), dJ) * ds
+    _add_load(form, problem, U)
+    return form
+
+
+def _add_bodies(form, problem, ur, uc) -> None:
+    """The bodies' elastic energies (with the macro strain when assembled)."""
+    m, mesh = problem.model, problem.mesh
+    for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
+        eps = problem.body_strain(u)
+        form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
+                             * ng.dx(definedon=mesh.Materials(name)))
+
+
+def _add_load(form, problem, U) -> None:
+    """The potential ``-|T| tbar . U`` of the far-face tractions."""
     t = ng.CF(tuple(problem.traction))
     form += ng.Variation(-ng.InnerProduct(t, U) * ng.ds("top"))
-    return form, previous
 
 
 def macro_strain_cf(params, dim: int):

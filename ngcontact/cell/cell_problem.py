@@ -33,9 +33,11 @@ step minimizing the convex energy along the Newton direction
 under a prescribed pressure starts from the rigid predictor of
 :mod:`ngcontact.cell.predictor`, later loads from the previous solution.  A
 frictionless flat ``S_C`` leaves ``U_t`` free of energy: it is fixed at 0
-and a nonzero shear is rejected.  Coulomb friction is a fixed point of
-Tresca problems, ``G_k = mu p_{k-1}`` (:mod:`ngcontact.laws.penalty`), until
-``max |p_k - p_{k-1}| <= coulomb_rtol * max p_k`` on ``S_C``.
+and a nonzero shear is rejected.  Coulomb friction: Newton on the
+coupled equations with the threshold ``mu p(u)`` differentiated (the
+consistent, non-symmetric tangent), or the fixed point of Tresca problems
+``G_k = mu p_{k-1}`` until ``max |p_k - p_{k-1}| <= coulomb_rtol * max p_k``
+on ``S_C``: the same solution (:mod:`ngcontact.cell.coulomb_friction`).
 
 Exact non-penetration (``CellModel.enforcement = "exact"``, 2D;
 the rigid limit ``k_n -> infinity`` of the Winkler layer): the normal
@@ -68,11 +70,11 @@ from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_loa
 from ngcontact.cell.cell_model import CellModel, CellSolution
 from ngcontact.cell.cell_energy import cell_energy, macro_strain_cf
 from ngcontact.cell.coefficients import contact_normal
-from ngcontact.cell.predictor import rigid_continuation, set_start, tangential_load
+from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
+from ngcontact.cell.predictor import rigid_continuation, rigid_translation, set_start, tangential_load
 from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
 from ngcontact.errors import ModelError
-from ngcontact.solvers.coulomb import MIXING_DEPTH, coulomb_fixed_point
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
 from ngcontact.fem.quadrature import sampling_order
@@ -105,6 +107,10 @@ class CellProblem:
         Start of the first load under a prescribed pressure: ``"rigid"``
         (default, the rigid predictor of :mod:`ngcontact.cell.predictor`) or
         ``"closed"`` (every point of ``S_C`` pushed into contact).
+    coulomb
+        Coulomb friction with the penalty: ``"newton"`` (default, the
+        coupled Newton) or ``"fixed_point"``
+        (:mod:`ngcontact.cell.coulomb_friction`).
 
     Attributes
     ----------
@@ -124,12 +130,16 @@ class CellProblem:
     tangential_free
         Whether ``U_t`` is determinate (friction or a curved ``S_C``).
     coulomb_previous
-        Coulomb: the previous fixed-point iterate (threshold ``mu p_{k-1}``).
+        Coulomb: the frozen state of the threshold ``mu p`` (the previous
+        fixed-point iterate, or the current Newton iterate for the line search).
     """
 
     def __init__(self, cell, model: CellModel, *, rtol: float = 1e-10, atol: float = 0.0,
                  max_iter: int = 40, inverse: str = "sparsecholesky", normal=None,
-                 line_search: str = "exact", start: str = "rigid", linear: LinearSolver | None = None):
+                 line_search: str = "exact", start: str = "rigid", linear: LinearSolver | None = None,
+                 coulomb: str = "newton"):
+        if coulomb not in METHODS:
+            raise ValueError(f"coulomb = {coulomb!r}: must be one of {METHODS}")
         if line_search not in ("exact", "armijo"):
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
         if start not in ("rigid", "closed"):
@@ -137,7 +147,8 @@ class CellProblem:
         if model.enforcement == "exact" and cell.dim != 2:
             raise ModelError(f"enforcement = 'exact' in a {cell.dim}D cell: the FE cell enforces exact contact "
                              "in 2D only (node-to-node on segments); use 'penalty' or the spectral cell")
-        self.line_search, self.start = line_search, start
+        self.line_search, self.start, self.coulomb = line_search, start, coulomb
+        self.coulomb_residual = None      # Coulomb, coupled Newton: the residual form, built on first use
         self.cell, self.model = cell, model
         self.mesh = mesh = cell.mesh
         self.dim = dim = cell.dim
@@ -244,36 +255,16 @@ class CellProblem:
         if first and self.multiplier is not None and self.model.friction is not None:
             start_multiplier(self, load)
         free = self._freedofs(load)
-        # a later load with a tangential change: the rigid continuation (predictor module); its steps count
-        predicted = None if first else rigid_continuation(self, free, before)
+        # a later load with a tangential change: frictionless, the rigid predictor for the whole traction;
+        # with friction (or where that has no minimizer), the rigid continuation, whose steps count
+        predicted = None
+        if not first and not (tangential_load(self) != before and rigid_translation(self, load, free)):
+            predicted = rigid_continuation(self, free, before)
         histories: list[dict] = [] if predicted is None else [predicted]
         fp = 0
         if self.coulomb_previous is not None:
-            first_residual: list[float] = []
-            previous = self.coulomb_previous
-            assert previous is not None  # built with the Coulomb form in __init__
-
-            def freeze() -> None:
-                previous.vec.data = self.gfu.vec
-
-            def put(x) -> None:
-                self.gfu.vec.FV().NumPy()[:] = x
-
-            def tresca_solve() -> dict:
-                # later passes stop at rtol times the first pass's initial residual
-                atol = max(self.atol, self.rtol * first_residual[0]) if first_residual else self.atol
-                h = self._newton(free, atol)
-                if not first_residual:
-                    first_residual.append(h["residuals"][0])
-                return h
-
-            fixed = coulomb_fixed_point(
-                freeze, tresca_solve,
-                lambda: measures.sample_surface(self, {"p": self.pressure})["p"],
-                rtol=self.model.coulomb_rtol, max_iter=self.model.coulomb_max_iter,
-                state=(lambda: self.gfu.vec.FV().NumPy().copy(), put),
-                depth=MIXING_DEPTH)
-            histories, fp = histories + fixed["newton"], fixed["coulomb_iterations"]
+            coulomb, fp = solve_coulomb(self, free, self._newton)
+            histories += coulomb
         else:
             histories.append(self._newton(free, self.atol))
         if measure:

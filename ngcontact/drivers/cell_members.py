@@ -27,7 +27,7 @@ def fe_problem(scene) -> CellProblem:
     """The FE cell problem of a cell scene (mesh, spaces, forms), before any load."""
     s = scene.solver
     return CellProblem(build_cell(scene), model_of(scene), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
-                       inverse=s.inverse, linear=linear_solver(scene))
+                       inverse=s.inverse, linear=linear_solver(scene), coulomb=s.coulomb)
 
 
 def fe_load(job: tuple) -> tuple[CellSolution, np.ndarray | None]:

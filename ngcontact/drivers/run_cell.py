@@ -53,7 +53,7 @@ def solve_graded(scene, loads) -> list[GradedSolve]:
         cell = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
                                 vertices=vertices)
         return CellProblem(cell, replace(model, order=order), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
-                           inverse=s.inverse, linear=linear_solver(scene))
+                           inverse=s.inverse, linear=linear_solver(scene), coulomb=s.coulomb)
 
     out = []
     for k, load in enumerate(loads):
@@ -149,7 +149,7 @@ def run(scene, clock) -> Outcome:
     with clock.stage("setup"):
         s = scene.solver
         P = CellProblem(cell, model_of(scene), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
-                        inverse=s.inverse, linear=linear_solver(scene))
+                        inverse=s.inverse, linear=linear_solver(scene), coulomb=s.coulomb)
     graded: list[GradedSolve] = []
     with clock.stage("solve"):
         if scene.discretization.tolerance is None and scene.load.independent:

@@ -102,11 +102,12 @@ class SolverSpec:
     cg_max_iter: int = param(10000, doc="spectral cell: largest number of constrained CG (frictionless) or "
                              "accelerated proximal gradient (friction) steps per load",
                              check=at_least(1))
-    coulomb: str = param("newton", doc="Coulomb friction in macro problems: newton (Newton on the coupled "
-                         "equations, the threshold mu p differentiated with the pressure; non-symmetric tangent) "
-                         "or fixed_point (Tresca passes with the threshold of the previous pressure, paper Sec. 2)",
-                         choices=("newton", "fixed_point"))
-    coulomb_rtol: float = param(1e-8, doc="Coulomb fixed point: stop when max |p_k - p_k-1| <= coulomb_rtol x "
+    coulomb: str = param("newton", doc="Coulomb friction (FE cells and macro problems): newton (Newton on the "
+                         "coupled equations, the threshold mu p differentiated with the pressure; non-symmetric "
+                         "tangent) or fixed_point (Tresca passes with the threshold of the previous pressure, paper "
+                         "Sec. 2)", choices=("newton", "fixed_point"))
+    coulomb_rtol: float = param(1e-8, doc="Coulomb fixed point (macro, resolved; a penalty cell's fallback, its "
+                                "Coulomb Newton stopping at rtol): stop when max |p_k - p_k-1| <= coulomb_rtol x "
                                 "max p_k on the contact surface", check=positive())
     coulomb_max_iter: int = param(40, doc="Coulomb fixed point: largest number of Tresca passes", check=at_least(1))
 

@@ -183,7 +183,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
 
     def residual(vec) -> float:
         form.Apply(vec, res)
-        _mask(res, fixed)
+        mask_fixed(res, fixed)
         return math.sqrt(max(ng.InnerProduct(res, res), 0.0))
 
     energy = form.Energy(gfu.vec)
@@ -203,7 +203,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         form.AssembleLinearization(gfu.vec)
         floor = roundoff_floor(form.mat, gfu.vec, fixed)
         floor0 = floor if floor0 is None else floor0
-        if _at_floor(rnorm, floor, r0, floor0):
+        if at_floor(rnorm, floor, r0, floor0):
             log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             return hist
@@ -218,7 +218,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
                 hist.as_dict())
         alpha = 1.0
         if line_search == "exact":
-            alpha = _exact_step(form, gfu.vec, du, slope, fixed, trial, res, max_step)
+            alpha = exact_step(form, gfu.vec, du, slope, fixed, trial, res, max_step)
         while True:
             trial.data = gfu.vec - alpha * du
             e_new = form.Energy(trial)
@@ -259,7 +259,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         hist.as_dict())
 
 
-def _at_floor(rnorm: float, floor: float, r0: float, floor0: float) -> bool:
+def at_floor(rnorm: float, floor: float, r0: float, floor0: float) -> bool:
     """The residual is at its round-off ``floor`` after real progress, or the start was (module docstring)."""
     return rnorm <= floor and (rnorm <= FLOOR_PROGRESS * r0 or r0 <= FLOOR_GROWTH * floor0)
 
@@ -288,7 +288,7 @@ def _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol
                                    "(e.g. a rigid-body mode that no support removes)", hist.as_dict())
         if rnorm <= target:
             break
-    if rnorm <= target or _at_floor(rnorm, roundoff_floor(form.mat, gfu.vec, fixed), r0, floor0):
+    if rnorm <= target or at_floor(rnorm, roundoff_floor(form.mat, gfu.vec, fixed), r0, floor0):
         hist.converged = True
         return hist
     raise ConvergenceError(
@@ -297,7 +297,7 @@ def _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol
         "support removes, or a stiffness far beyond the others", hist.as_dict())
 
 
-def _exact_step(form, u, du, slope0, fixed, trial, work, max_step) -> float:
+def exact_step(form, u, du, slope0, fixed, trial, work, max_step) -> float:
     """Minimizer of ``phi(alpha) = Pi(u - alpha du)`` for a convex energy.
 
     ``slope0 = du . r(u) > 0`` is ``-phi'(0)``.  Returns 1 where the slope
@@ -307,7 +307,7 @@ def _exact_step(form, u, du, slope0, fixed, trial, work, max_step) -> float:
     def dphi(a):
         trial.data = u - a * du
         form.Apply(trial, work)
-        _mask(work, fixed)
+        mask_fixed(work, fixed)
         return -ng.InnerProduct(du, work)
 
     tol = 1e-3 * slope0
@@ -400,6 +400,6 @@ def fixed_mask(freedofs):
     return ~np.array([freedofs[i] for i in range(len(freedofs))], dtype=bool)
 
 
-def _mask(vec, fixed) -> None:
+def mask_fixed(vec, fixed) -> None:
     """Zero the entries of ``vec`` that are not free."""
     vec.FV().NumPy()[fixed] = 0.0

@@ -38,7 +38,7 @@ import ngsolve as ng
 
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.linear_solver import LinearSolver
-from ngcontact.solvers.newton import ARMIJO, NewtonHistory, _at_floor, _mask, fixed_mask, roundoff_floor
+from ngcontact.solvers.newton import ARMIJO, NewtonHistory, at_floor, fixed_mask, mask_fixed, roundoff_floor
 
 log = logging.getLogger(__name__)
 
@@ -85,7 +85,7 @@ def solve_equations(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=Non
 
     def residual(vec) -> float:
         form.Apply(vec, res)
-        _mask(res, fixed)
+        mask_fixed(res, fixed)
         return math.sqrt(max(ng.InnerProduct(res, res), 0.0))
 
     rnorm = residual(gfu.vec)
@@ -101,7 +101,7 @@ def solve_equations(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=Non
         form.AssembleLinearization(gfu.vec)
         floor = roundoff_floor(form.mat, gfu.vec, fixed)
         floor0 = floor if floor0 is None else floor0
-        if _at_floor(rnorm, floor, r0, floor0):
+        if at_floor(rnorm, floor, r0, floor0):
             hist.converged = True
             return hist
         residual(gfu.vec)
