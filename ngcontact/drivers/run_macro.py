@@ -34,7 +34,7 @@ from ngcontact.macro import macro_problem as M
 from ngcontact.macro import macro_measures as MM
 from ngcontact.errors import ConvergenceError, SceneError
 from ngcontact.geometry import bodies as gm
-from ngcontact.scene.macro_scene import REGIONS
+from ngcontact.scene.macro_shapes import REGIONS
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 from ngcontact.scene import cell_links

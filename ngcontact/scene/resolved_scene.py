@@ -36,7 +36,7 @@ import numpy as np
 
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
-from ngcontact.scene.macro_scene import FEMUR_BOUNDARIES, check_dimensions, check_support_meaning
+from ngcontact.scene.macro_shapes import FEMUR_BOUNDARIES, check_dimensions, check_support_meaning
 from ngcontact.scene.sections import (ComputeSpec, MaterialSpec, check_supports_once, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size

@@ -453,7 +453,7 @@ def test_boundary_table_matches_the_meshed_geometries():
     """The labels checked without meshing are exactly those the meshers create."""
     from ngcontact.geometry import bodies as gm
     from ngcontact.geometry.femur import FemurStemDims, femur_stem
-    from ngcontact.scene.macro_scene import BOUNDARIES
+    from ngcontact.scene.macro_shapes import BOUNDARIES
     from ngcontact.macro.macro_problem import boundary_labels
     from ngcontact.geometry.femur3d import femur_stem_3d
     built = {("femur_stem", "axisymmetric"): femur_stem(FemurStemDims(), maxh=0.02),
