@@ -7,9 +7,13 @@ names, the cell length unit and the table tolerance, so a second run of the
 same scene solves no cell problem; an edited cell scene or data file gives
 another key.
 
-The cell solves of one table level go through ``map_tasks`` (serial by
-default): each task is a :class:`PressureSolve`, a picklable callable that
-builds its cell problem once per process.
+The cell solves of one table level go through ``map_tasks`` (default:
+:func:`executor_map`, one batch of the run's executor, ``--workers`` local
+processes or a Dask cluster): each task is a :class:`PressureSolve`, a
+picklable callable that builds its cell problem once per process.  Measured
+on ``femur_stem_two_scale.toml`` (cold cache, 23 cell solves, a loaded
+machine): solve stage 139 s with ``--workers 1``, 88 s with 2, the same
+safety factor to 15 digits.
 
 ``results["two_scale"]``: ``converged``, ``iterations`` (law updates),
 ``macro_solves``, ``cell_solves`` (cell problems solved in this run),
@@ -37,6 +41,7 @@ from ngcontact.coupling import two_scale as T
 from ngcontact.macro.macro_measures import interface_profile
 from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
+from ngcontact.solvers import executor
 
 log = logging.getLogger(__name__)
 
@@ -100,8 +105,14 @@ def store_table(key: str, table: T.CellTable, cache_dir: str | None = None) -> N
     cell_law.write_cached(key, arrays, TABLE_ARRAYS, TABLE_FORMAT, cache_dir)
 
 
+def executor_map(response: Callable[[float], T.Response], pressures: Sequence[float]) -> list[T.Response]:
+    """The cell solves of one table level as one batch of the run's executor (local processes or Dask)."""
+    return executor.current().map(response, list(pressures), [f"p = {p:.9g}" for p in pressures],
+                                  label="cell table level")
+
+
 def couple(scene, problem, solve,
-           map_tasks: Callable[[Callable[[float], T.Response], Sequence[float]], list[T.Response]] = T.serial_map,
+           map_tasks: Callable[[Callable[[float], T.Response], Sequence[float]], list[T.Response]] = executor_map,
            cache_dir: str | None = None, warm: bool = True):
     """Run the loop of ``scene.two_scale`` from ``problem``; returns ``(solution, results)``.
 

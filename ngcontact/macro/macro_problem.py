@@ -300,7 +300,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
         form = _form(problem, fes, frame, G=G)
         history["newton"].append(minimize(form, gfu, quadratic=law.quadratic, **newton).as_dict())
     history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
-    history["converged"] = all(h["converged"] for h in history["newton"])
+    history["converged"] = all(h["converged"] for h in history["newton"] if not h.get("failed"))
     history["quadratic"] = law.quadratic
     history["linear"] = linear.summary()
     ur, uc = gfu.components
@@ -317,8 +317,9 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
     :func:`ngcontact.solvers.continuation.ladder`, which begins at the
     largest tangential jump of the start value (at least ``10 w``): there
     every point sticks in the Huber sense.  Returns ``newton`` (the
-    histories) and ``widths`` (the ladder's rungs; empty when none was
-    needed).
+    histories, the failed first attempt's included and marked ``failed``:
+    its steps count) and ``widths`` (the ladder's rungs; empty when none
+    was needed).
     """
     law, mesh, friction = problem.law, problem.mesh, problem.law.friction
     assert friction is not None
@@ -330,6 +331,7 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
     except ConvergenceError as err:
         log.info("coupled Newton at the scene's Huber width failed (%s); continuation in the width", err)
         gfu.vec.data = start
+        failed = [{**err.history, "failed": True}] if isinstance(err.history, dict) else []
     a = _local(frame, gfu.components[0] - gfu.components[1])
     slips = boundary_values(mesh, problem.interface, ng.sqrt(sum(t * t for t in a[1:])), sampling_order(problem.order))
     width = friction.width
@@ -354,7 +356,7 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
                                "than friction (mu times the pressure) can carry has no equilibrium: a body would "
                                "slide without bound; if the load can be carried, try solver.coulomb = "
                                "'fixed_point'", err.history) from err
-    return {"newton": [r["history"] for r in rungs], "widths": [r["width"] for r in rungs]}
+    return {"newton": failed + [r["history"] for r in rungs], "widths": [r["width"] for r in rungs]}
 
 
 def start_stiffness(problem: MacroProblem) -> float:
