@@ -49,7 +49,8 @@ HIGHLIGHTS: dict[str, list[tuple[str, str, str]]] = {
         ("cell solves", "results.two_scale.cell_solves", ""),
         ("equilibrium error", "results.equilibrium.error", ""),
         ("Newton iterations", "results.newton_iterations", ""),
-        ("Coulomb passes", "results.coulomb_iterations", ""),
+        ("Coulomb friction solved by", "solver.coulomb.method", ""),
+        ("Coulomb passes (fixed point)", "results.coulomb_iterations", ""),
     ],
     "cell": [
         ("method", "results.method.name", ""),
