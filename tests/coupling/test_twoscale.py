@@ -122,3 +122,28 @@ def test_loop_converges_on_the_shipped_scene_with_falling_changes():
     assert summary["safety_factor"] == out.results["strength"]["safety_factor"] > 0
     assert summary["cell_solves"] == ts["cell_solves"] and summary["table_error_estimate"] <= scene.two_scale.table_tol
     assert set(summary["critical_points"]) == {"rough", "counter"}
+
+
+@pytest.mark.slow
+def test_warm_and_cold_starts_reach_the_same_two_scale_state(tmp_path):
+    """Every macro solve warm-started from the previous one, or each cold: the same converged interface (1e-8)."""
+    from ngcontact.drivers import run_macro as D
+    from ngcontact.drivers import run_two_scale as R
+    from ngcontact.scene.loader import load
+    scene = load("geometries/femur_stem_two_scale.toml")
+    geo = D.build_geometry(scene)
+    problem, _ = D.problem_of(scene, geo)
+    runs = {}
+    for warm in (True, False):
+        steps = []
+
+        def solve(prob, start):
+            sol = D.solve_scene(scene, prob, start)
+            steps.append((start is not None, sol.history["newton_iterations"]))
+            return sol
+        sol, res = R.couple(scene, problem, solve, map_tasks=T.serial_map, cache_dir=str(tmp_path), warm=warm)
+        runs[warm] = (MM.interface_profile(sol)["pressure"], steps)
+    (p_warm, s_warm), (p_cold, s_cold) = runs[True], runs[False]
+    assert np.max(np.abs(p_warm - p_cold)) <= 1e-8 * np.max(p_cold)
+    assert any(w for w, _ in s_warm) and not any(w for w, _ in s_cold)
+    assert sum(n for _, n in s_warm) < sum(n for _, n in s_cold)
