@@ -11,7 +11,7 @@ and the worst violation of the friction law (|tau| - mu p, over mu p_max).
 
 Writes ``OUT/femur_coulomb_variants.csv`` and ``.png``.  Usage::
 
-    python scripts/femur_coulomb_variants.py [--out DIR] [--only NAME ...]
+    python scripts/femur_coulomb_variants.py [--out DIR] [--only NAME ...] [--methods newton|fixed_point ...]
 """
 from __future__ import annotations
 
@@ -128,12 +128,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="results/femur_coulomb_variants")
     ap.add_argument("--only", nargs="*", default=None, help="variant names (default: all)")
+    ap.add_argument("--methods", nargs="*", default=list(METHODS), choices=METHODS, help="default: both")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.only or VARIANTS:
-            for method in METHODS:
+            for method in args.methods:
                 rows.append(run(name, method, tmp))
                 r = rows[-1]
                 print(f"{name:32s} {method:12s} {'ok' if r['converged'] else 'FAILED':7s} {r['seconds']:7.2f} s "

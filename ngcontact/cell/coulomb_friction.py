@@ -8,13 +8,15 @@ Pi_T(.; mu p(u))`` and conversely):
 
 * ``"newton"`` (default): Newton on ``R`` with the consistent,
   non-symmetric tangent (:func:`ngcontact.solvers.coulomb_newton.coupled_newton`,
-  form :func:`ngcontact.cell.cell_energy.coulomb_residual`), factorized by
-  LU.  Used where the tangent solves are direct
-  (:class:`~ngcontact.solvers.linear_solver.LinearSolver`); with BDDC-CG
-  (large 3D cells) the fixed point is used, CG needing a symmetric tangent.
-  Should the coupled Newton fail (an active set cycling, ``max_iter``), the
-  state is reset to its start and the fixed point solves the load; the
-  failed attempt's steps stay in the history and count.
+  form :func:`ngcontact.cell.cell_energy.coulomb_residual`), globalized by
+  the exact line search on the Tresca energy with the threshold frozen at
+  the iterate (:class:`~ngcontact.solvers.coulomb_newton.FrozenTresca`).
+  Its tangent solves follow the cell's
+  :class:`~ngcontact.solvers.linear_solver.LinearSolver`: LU directly,
+  GMRES with BDDC iteratively.  Should the coupled Newton fail (an active
+  set cycling, ``max_iter``, GMRES not converging), the state is reset to
+  its start and the fixed point solves the load; the failed attempt's
+  steps stay in the history and count.
 * ``"fixed_point"``: the Tresca passes of
   :func:`ngcontact.solvers.coulomb.coulomb_fixed_point` with Anderson
   mixing, each pass's threshold ``mu p`` of the previous pass (stopping
@@ -32,14 +34,12 @@ from ngcontact.cell import measures
 from ngcontact.cell.cell_energy import coulomb_residual
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.coulomb import MIXING_DEPTH, coulomb_fixed_point
-from ngcontact.solvers.coulomb_newton import coupled_newton
+from ngcontact.solvers.coulomb_newton import FrozenTresca, coupled_newton
 
 log = logging.getLogger(__name__)
 
 #: Iterations of the Coulomb threshold
 METHODS = ("newton", "fixed_point")
-#: LU solvers NGSolve offers for the non-symmetric tangent; anything else (Cholesky) gives way to UMFPACK
-LU_INVERSES = ("umfpack", "pardiso", "mumps")
 
 
 def solve_coulomb(problem, free, newton_once) -> tuple[list[dict], int]:
@@ -50,7 +50,7 @@ def solve_coulomb(problem, free, newton_once) -> tuple[list[dict], int]:
     Newton histories and the number of threshold updates (coupled steps or
     fixed-point passes).
     """
-    coupled = problem.coulomb == "newton" and problem.linear.method(free, problem.dim) == "direct"
+    coupled = problem.coulomb == "newton"
     histories: list[dict] = []
     if coupled:
         start = problem.gfu.vec.CreateVector()
@@ -78,12 +78,10 @@ def _coupled(problem, free) -> dict:
     def freeze() -> None:
         previous.vec.data = problem.gfu.vec
 
-    inverse = problem.inverse if problem.inverse in LU_INVERSES else "umfpack"
-    return coupled_newton(problem.coulomb_residual, problem.form, problem.gfu, freeze=freeze,
-                          pressure=lambda: _pressure(problem), freedofs=free, rtol=problem.rtol,
-                          atol=problem.atol, max_iter=problem.max_iter, inverse=inverse,
-                          symmetric_inverse=problem.inverse, active_set=problem.active_set,
-                          record=problem.linear)
+    return coupled_newton(problem.coulomb_residual, problem.gfu, freedofs=free, linear=problem.linear,
+                          frozen=FrozenTresca(problem.form, freeze), pressure=lambda: _pressure(problem),
+                          rtol=problem.rtol, atol=problem.atol, max_iter=problem.max_iter,
+                          active_set=problem.active_set)
 
 
 def _fixed_point(problem, free, newton_once) -> dict:

@@ -32,14 +32,19 @@ Solution strategy:
   default): Newton on the coupled equations, whose friction threshold is
   the current pressure's (no energy exists; the residual is the gradient of
   the frictionless energy plus the friction's virtual work, and its
-  Jacobian is not symmetric: :mod:`ngcontact.solvers.semismooth_newton`).
-  Where Newton fails from the start value, continuation in the Huber width
+  Jacobian is not symmetric: :mod:`ngcontact.solvers.coulomb_newton`,
+  the cell's Coulomb Newton too, with its line search on the Tresca energy
+  frozen at the iterate, :func:`frozen_tresca`).  Where Newton fails from
+  the start value, continuation in the Huber width
   (:mod:`ngcontact.solvers.continuation`) from the largest slip of the
   start value down to the scene's width.  Measured on the femur / hip-stem
-  scene and 23 variants of it (loads 0.1 to 30 MPa, interference 1 to
-  200 um, line-to-line, clearances 1 to 50 um, mu 0.1 to 1, widths 1e-5 to
-  1e-8 m, orders 2 to 4): all converge, 2 to 26 Newton steps, equilibrium
-  to 1e-11 or better; the fixed point below cycled on five of them;
+  scene and 23 variants of it (``scripts/femur_coulomb_variants.py``:
+  loads 0.1 to 30 MPa, interference 1 to 200 um, line-to-line, clearances
+  1 to 50 um, mu 0.1 to 1, widths 1e-5 to 1e-8 m, orders 2 to 4): all
+  converge, 2 to 20 Newton steps, none needing the continuation (with
+  backtracking on the residual instead of the frozen-energy search: 2 to 26
+  steps, five variants needing 4 to 6 rungs of it), equilibrium to 1e-11
+  or better; the fixed point below cycled on five of them;
 * ``coulomb = "fixed_point"`` (the paper's Sec. 2): repeated Newton solves
   with ``G`` evaluated at the previous solution's pressure
   (:func:`ngcontact.solvers.coulomb.coulomb_fixed_point`, whose stopping
@@ -74,7 +79,7 @@ from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
 from ngcontact.fem.rigid_modes import check_rigid_modes, free_rigid_modes
 from ngcontact.solvers.continuation import INTERMEDIATE_RTOL, ladder
-from ngcontact.solvers.semismooth_newton import solve_equations
+from ngcontact.solvers.coulomb_newton import FrozenTresca, coupled_newton
 
 log = logging.getLogger(__name__)
 
@@ -171,7 +176,7 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
     ``start_stiffness = 0`` leaves the tangential jump free.
 
     With ``coupled`` (Coulomb friction) the form is the residual of the
-    coupled equations instead (:mod:`ngcontact.solvers.semismooth_newton`):
+    coupled equations instead (:mod:`ngcontact.solvers.coulomb_newton`):
     the energy without friction plus the virtual work of the friction
     traction whose threshold ``G = mu [p(u)]_+ + G0`` is the current
     pressure's; not symmetric.
@@ -218,7 +223,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
         Newton settings (:func:`ngcontact.solvers.newton.minimize`).
     coulomb
         Coulomb friction: ``"newton"`` (the coupled equations,
-        :func:`ngcontact.solvers.semismooth_newton.solve_equations`) or
+        :func:`ngcontact.solvers.coulomb_newton.coupled_newton`) or
         ``"fixed_point"`` (Tresca passes, paper Sec. 2).
     coulomb_rtol, coulomb_max_iter
         Stopping rule of the Coulomb fixed point
@@ -326,7 +331,8 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
     start = gfu.vec.CreateVector()
     start.data = gfu.vec
     try:
-        return {"newton": [solve_equations(_form(problem, fes, frame, coupled=True), gfu, **newton).as_dict()],
+        return {"newton": [coupled_newton(_form(problem, fes, frame, coupled=True), gfu,
+                                          frozen=frozen_tresca(problem, fes, frame, gfu), **newton)],
                 "widths": []}
     except ConvergenceError as err:
         log.info("coupled Newton at the scene's Huber width failed (%s); continuation in the width", err)
@@ -339,7 +345,8 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
     def solve_at(w: float, last: bool) -> dict:
         at = replace(problem, law=replace(law, friction=replace(friction, width=w)))
         opts = newton if last else {**newton, "rtol": INTERMEDIATE_RTOL, "atol": 0.0}
-        return solve_equations(_form(at, fes, frame, coupled=True), gfu, **opts).as_dict()
+        return coupled_newton(_form(at, fes, frame, coupled=True), gfu, frozen=frozen_tresca(at, fes, frame, gfu),
+                              **opts)
 
     def save():
         copy = gfu.vec.CreateVector()
@@ -357,6 +364,24 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
                                "slide without bound; if the load can be carried, try solver.coulomb = "
                                "'fixed_point'", err.history) from err
     return {"newton": failed + [r["history"] for r in rungs], "widths": [r["width"] for r in rungs]}
+
+
+def frozen_tresca(problem: MacroProblem, fes, frame, gfu: ng.GridFunction) -> FrozenTresca:
+    """The Tresca energy whose threshold ``mu [p]_+ + G0`` is the pressure of a frozen copy of ``gfu``.
+
+    The coupled Newton's line search minimizes it along its step, frozen at
+    each iterate (:mod:`ngcontact.solvers.coulomb_newton`).
+    """
+    law = problem.law
+    assert law.friction is not None
+    old = ng.GridFunction(fes)
+    a_old = _local(frame, old.components[0] - old.components[1])
+    G = ie.threshold(law.friction, ie.pressure(law.normal, a_old, gap_cf(problem.gap)))
+
+    def freeze() -> None:
+        old.vec.data = gfu.vec
+
+    return FrozenTresca(_form(problem, fes, frame, G=G), freeze)
 
 
 def start_stiffness(problem: MacroProblem) -> float:

@@ -1,118 +1,160 @@
-"""Coulomb friction by one Newton iteration with the threshold differentiated (consistent tangent).
+"""Coulomb friction by Newton's method on the coupled equations (threshold differentiated, consistent tangent).
 
 Coulomb's law makes the friction threshold a function of the state,
-``G(u) = mu p(u)`` with ``p = k_n [J_n - g]_+`` (paper eqs. 16-17; the
-penalized contact of eq. 65), so the equations
+``G(u) = mu [p(u)]_+ + G0`` (paper eqs. 16-17; the penalized contact of
+eq. 65 on the cell, the homogenized law of eqs. 42-43 on the macro
+problem), so the equilibrium
 
-    R(u) = Pi_T'(u; G)|_{G = mu p(u)} = 0
+    R(u) = Pi_T'(u; G)|_{G = G(u)} = Pi_0'(u) + int_S tau_t(J(u); G(u)) . J_t(v) ds = 0
 
-are the stationarity of no energy: ``Pi_T(u; G)`` is the convex Tresca
-energy with a threshold field ``G`` held as data, and ``R`` its gradient
-with ``G`` then set to ``mu p(u)``.  The fixed point of
+is the stationarity of no energy: ``Pi_T(u; G)`` is the convex Tresca
+energy with a threshold field ``G`` held as data (``Pi_0`` everything but
+friction, ``tau_t`` the Huber-regularized friction traction of
+:func:`ngcontact.laws.interface_energy.friction_traction`), and ``R`` its
+gradient with ``G`` then set to ``G(u)``.  The fixed point of
 :mod:`ngcontact.solvers.coulomb` solves a Tresca problem per pass and
-converges linearly (the rectangular valley: 6, 17, 24 Newton steps summed
-over the passes of its three loads).  Here Newton is applied to ``R``
-itself: its Jacobian
+converges linearly (the rectangular valley cell: 6, 17, 24 Newton steps
+summed over the passes of its three loads).  Here Newton is applied to
+``R`` itself, with its generalized Jacobian
 
-    K_c(u) = Pi_T''(u; G(u)) + d/dG [Pi_T'(u; G)] . mu dp/du
+    K_c(u) = Pi_T''(u; G(u)) + d/dG [Pi_T'(u; G)] . dG/du
 
-adds to the symmetric Tresca tangent the coupling of the friction traction
-``G J_t / max(|J_t|, w)`` with the pressure, ``mu k_n (J_t / max(|J_t|, w))
-(x) n`` on the points in contact: a non-symmetric matrix, solved by a
-sparse LU factorization (UMFPACK).  ``[.]_+`` and the Huber branches are
-differentiated on their active side (a semismooth Newton, as for the
-penalty), which NGSolve's linearization of the residual form does.
+(NGSolve's linearization of the residual form): the symmetric Tresca
+tangent plus the coupling of the friction traction ``G J_t / max(|J_t|,
+w)`` with the pressure, ``mu k_n (J_t / max(|J_t|, w)) (x) n`` on the
+points in contact, a non-symmetric matrix.  ``[.]_+`` and the Huber
+branches are differentiated on their active side: a semismooth Newton
+(Qi and Sun, Math. Program. 58, 1993), locally superlinear once the
+contact, stick and slip sets have settled.  A zero of ``R`` is exactly a
+fixed point ``u = argmin Pi_T(.; G(u))``: the solution is the fixed
+point's.
 
-Choice (against substepping the load with a predictor, option (b) of issue
-12): the passes of the fixed point are slow because the *map* is a
-contraction with factor 0.2-0.3 even where every set has settled, not
-because the start is far; smaller load steps shrink each pass's work but
-not their number per step, while the consistent tangent converges
-quadratically once the contact, stick and slip sets have settled.  The
-solution is the same: a zero of ``R`` is exactly a fixed point
-``u = argmin Pi_T(.; mu p(u))``.
+Tangent solves go through a
+:class:`~ngcontact.solvers.linear_solver.LinearSolver` with
+``symmetric=False``: UMFPACK (or the policy's LU) directly, GMRES with
+BDDC iteratively; the symmetric Tresca direction below is solved by the
+policy's symmetric solve (Cholesky or CG with BDDC).
 
-Globalization.  ``R`` has no potential, so no energy decides the step.
-A step ``du = K_c^{-1} R(u)`` is taken in full when it lowers ``|R|``;
-otherwise the step length minimizes, along ``du``, the Tresca energy with
-the threshold frozen at the current iterate, ``Pi_T(.; mu p(u))`` (whose
-gradient at ``u`` is ``R(u)``: the frozen energy is a local model of the
-problem and its exact line search, :func:`ngcontact.solvers.newton.exact_step`,
-is the one the frictionless and Tresca cells use), guarded by Armijo's
-test on it.  Where ``du`` is no descent direction of that energy (a
-strong coupling) the symmetric Tresca direction ``Pi_T''^{-1} R`` is taken
-instead.  Measured on ``geometries/cells/rectangular_coulomb.toml``: 5, 6,
-11 steps for the three loads (the shear loads' rigid continuation
-counted); a pure full-step iteration cycles between two contact sets on
-the first load; a residual-norm backtracking search took 16 and 12 steps
-on the first and last loads; the symmetric Tresca steps until the sets
-settle, then coupled steps, 5, 6, 12.
+Globalization (``R`` has no potential, so no energy decides the step).
+The Newton step ``du = K_c^{-1} R(u)`` is taken in full when it lowers
+``|R|``.  Otherwise, one of two:
+
+* ``frozen`` given (:class:`FrozenTresca`: the Tresca energy with the
+  threshold read from a frozen copy of the state): the step length
+  minimizes, along ``du``, ``Pi_T(.; G(u))`` with ``G`` frozen at the
+  current iterate (whose gradient at ``u`` is ``R(u)``: a local model of
+  the problem; its exact line search,
+  :func:`ngcontact.solvers.newton.exact_step`, is the frictionless and
+  Tresca cells'), guarded by Armijo's test on it; where ``du`` is no
+  descent direction of that energy (strong coupling) the symmetric Tresca
+  direction ``Pi_T''^{-1} R`` is taken instead.
+* no ``frozen``: backtracking on the merit ``|R|``, the largest ``alpha =
+  1/2, 1/4, ...`` (down to ``2^-MAX_HALVINGS``) with ``|R(u - alpha du)|
+  <= (1 - c alpha) |R(u)|``, ``c = 1e-4``, else the step with the smallest
+  residual among those tried when it decreases ``|R|`` at all.
+
+Measured (``scripts/coulomb_newton_globalization.py``; both callers pass
+``frozen``).  The cell ``geometries/cells/rectangular_coulomb.toml``,
+Newton steps of its three loads (the shear loads' rigid continuation
+counted): frozen-energy search 5, 6, 11; residual backtracking 16, 7, 14;
+a pure full step cycles between two contact sets on the first load.  The
+femur / hip-stem scene and its 23 variants
+(``scripts/femur_coulomb_variants.py``): frozen-energy search 2 to 20
+steps (as shipped 8, load 3 MPa 10, width 1e-8 20), never needing the
+macro problem's width continuation; residual backtracking 2 to 26 (13,
+21, 26), five variants rescued by 4 to 6 rungs of continuation.
 
 Stopping rule: that of :func:`ngcontact.solvers.newton.minimize` on
 ``|R|`` (``rtol`` times the first residual, ``atol``, or the round-off
-floor after real progress), stricter than the fixed point's pressure
-change.  An active set that cycles while the residual stagnates
-(:class:`~ngcontact.solvers.newton.ActiveSetCycle`) or ``max_iter`` steps
-raise :class:`~ngcontact.errors.ConvergenceError` with the history; the
-caller may then fall back to the fixed point.  The history is a
-:class:`~ngcontact.solvers.newton.NewtonHistory` whose energies are the
-frozen Tresca energies of the iterates, plus the largest pressure change
-of each step (``coulomb_changes``).
+floor after real progress).  An active set that cycles while the residual
+stagnates (:class:`~ngcontact.solvers.newton.ActiveSetCycle`), no
+decrease along the step, or ``max_iter`` steps raise
+:class:`~ngcontact.errors.ConvergenceError` with the history; the caller
+may then fall back (the cell to the fixed point, the macro problem to
+continuation in the Huber width).
 """
 from __future__ import annotations
 
 import logging
 import math
+from dataclasses import dataclass
 from typing import Callable
 
 import ngsolve as ng
 import numpy as np
 
 from ngcontact.errors import ConvergenceError
-from ngcontact.solvers.linear_solver import LinearSolver, TangentSolve
+from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import (ARMIJO, MIN_STEP, ActiveSetCycle, NewtonHistory, at_floor, exact_step,
                                       fixed_mask, mask_fixed, roundoff_floor)
 
 log = logging.getLogger(__name__)
 
+#: largest number of step halvings of the residual line search
+MAX_HALVINGS = 12
+#: largest step of the exact line search on the frozen Tresca energy
+MAX_STEP = 8.0
 
-def coupled_newton(residual_form: ng.BilinearForm, energy_form: ng.BilinearForm, gfu: ng.GridFunction, *,
-                   freeze: Callable[[], None], pressure: Callable[[], np.ndarray], freedofs,
-                   rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40, inverse: str = "umfpack",
-                   symmetric_inverse: str = "sparsecholesky", max_step: float = 8.0,
-                   active_set=None, record: LinearSolver | None = None) -> dict:
-    """Solve ``R(u) = 0`` from ``gfu`` (updated in place) by the coupled Newton of the module docstring.
+
+@dataclass
+class FrozenTresca:
+    """The Tresca energy ``Pi_T(.; G)`` whose threshold ``G`` is read from a frozen copy of the state.
+
+    ``form``: symmetric ``BilinearForm`` of ``Variation`` terms;
+    ``freeze()``: copy the current state into the frozen one.
+    """
+
+    form: ng.BilinearForm
+    freeze: Callable[[], None]
+
+
+def coupled_newton(residual_form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
+                   linear: LinearSolver | None = None, frozen: FrozenTresca | None = None,
+                   pressure: Callable[[], np.ndarray] | None = None, rtol: float = 1e-10, atol: float = 0.0,
+                   max_iter: int = 40, max_step: float = MAX_STEP, active_set=None) -> dict:
+    """Solve ``R(u) = 0`` (``R = residual_form.Apply``) from ``gfu`` (updated in place); module docstring.
 
     Parameters
     ----------
     residual_form
-        Non-symmetric form whose ``Apply`` is ``R`` (the threshold a
-        function of the trial function) and whose linearization is ``K_c``.
-    energy_form
-        The Tresca energy ``Pi_T(.; G)`` with ``G`` read from a frozen copy
-        of the state, which ``freeze()`` sets to the current ``gfu``.
-    pressure
-        The contact pressure of the current state at the contact points.
+        Non-symmetric form whose ``Apply`` is ``R`` and whose linearization is ``K_c``.
+    gfu
+        Start value with the Dirichlet values set.
     freedofs
-        BitArray of the unknowns.
+        The unknowns (default: the space's free dofs).
+    linear
+        Tangent solves (default: direct, UMFPACK); its record counts them.
+    frozen
+        The frozen Tresca energy: its exact line search globalizes; without
+        it, backtracking on ``|R|``.
+    pressure
+        Optional: the contact pressure of the current state at the contact
+        points; its largest change per step goes to ``coulomb_changes``.
     rtol, atol, max_iter
         Stopping rule and step limit (:func:`ngcontact.solvers.newton.minimize`).
-    inverse, symmetric_inverse
-        Sparse direct solvers of ``K_c`` (LU) and of the Tresca tangent.
     max_step
         Largest step of the exact line search.
     active_set
         Optional ``active_set(gfu) -> hashable`` signature (cycle detection).
-    record
-        A :class:`~ngcontact.solvers.linear_solver.LinearSolver` whose
-        record of solves the LU solves join (the report's count).
 
     Returns
     -------
     dict
-        The history (:meth:`NewtonHistory.as_dict`) with ``"stage":
-        "coulomb_newton"`` and ``coulomb_changes``.
+        The history (:meth:`NewtonHistory.as_dict`: residual norms; the
+        frozen Tresca energies of the iterates when ``frozen`` is given)
+        with ``"stage": "coulomb_newton"`` and ``coulomb_changes``.
+
+    Raises
+    ------
+    ConvergenceError
+        No decrease along the step, a cycling active set, or ``max_iter`` steps.
     """
+    if freedofs is None:
+        freedofs = gfu.space.FreeDofs()
+    linear = linear if linear is not None else LinearSolver("direct", inverse="umfpack")
+    linear.register(residual_form, freedofs)
+    if frozen is not None:
+        linear.register(frozen.form, freedofs)
     hist = NewtonHistory()
     changes: list[float] = []
     cycle = ActiveSetCycle() if active_set is not None else None
@@ -129,14 +171,22 @@ def coupled_newton(residual_form: ng.BilinearForm, energy_form: ng.BilinearForm,
         mask_fixed(out, fixed)
         return math.sqrt(max(ng.InnerProduct(out, out), 0.0))
 
-    freeze()
-    rnorm = residual(gfu.vec)
-    energy = energy_form.Energy(gfu.vec)
-    hist.residuals.append(rnorm)
-    hist.energies.append(energy)
-    if not (math.isfinite(rnorm) and math.isfinite(energy)):
-        raise failed("the start value gives a non-finite energy or residual")
-    r0, floor0, p_old = rnorm, None, pressure()
+    def record_state() -> float:
+        """Freeze the threshold at ``gfu``, return ``|R(gfu)|`` (into ``res``); energy and pressure to the record."""
+        if frozen is not None:
+            frozen.freeze()
+        rnorm = residual(gfu.vec)
+        energy = frozen.form.Energy(gfu.vec) if frozen is not None else 0.0
+        hist.residuals.append(rnorm)
+        if frozen is not None:
+            hist.energies.append(energy)
+        if not (math.isfinite(rnorm) and math.isfinite(energy)):
+            raise failed(f"Coulomb Newton step {len(hist.steps)}: non-finite residual or energy")
+        return rnorm
+
+    rnorm = record_state()
+    r0, floor0 = rnorm, None
+    p_old = pressure() if pressure is not None else None
     for it in range(1, max_iter + 1):
         if rnorm <= max(rtol * r0, atol) or rnorm == 0.0:
             hist.converged = True
@@ -148,35 +198,27 @@ def coupled_newton(residual_form: ng.BilinearForm, energy_form: ng.BilinearForm,
             log.info("coulomb newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             break
-        lu = residual_form.mat.Inverse(freedofs, inverse=inverse)
-        if record is None:
-            du.data = lu * res
-        else:
-            TangentSolve(record, lu, counted=False).apply(res, du)
+        linear.prepare(residual_form, freedofs, symmetric=False).apply(res, du)
         trial.data = gfu.vec - du
         r_full = residual(trial, r_trial)
         if math.isfinite(r_full) and r_full < rnorm:
             alpha = 1.0
             gfu.vec.data = trial
+        elif frozen is not None:
+            alpha = _frozen_energy_step(frozen.form, gfu, du, freedofs, fixed, trial, work, res, linear, max_step)
         else:
-            alpha = _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res,
-                                        symmetric_inverse, max_step, record)
-            if alpha == 0.0:
-                hist.steps.append(0.0)
-                raise failed(f"Coulomb Newton step {it}: no decrease of the frozen Tresca energy "
-                             f"(residual {rnorm:.3e})")
-        freeze()
-        rnorm = residual(gfu.vec)
-        energy = energy_form.Energy(gfu.vec)
-        p_new = pressure()
-        changes.append(float(np.max(np.abs(p_new - p_old))) if p_new.size else 0.0)
-        p_old = p_new
+            alpha = _residual_step(gfu.vec, du, rnorm, trial, lambda v: residual(v, r_trial))
+        if alpha == 0.0:
+            hist.steps.append(0.0)
+            what = "the frozen Tresca energy" if frozen is not None else "the residual"
+            raise failed(f"Coulomb Newton step {it}: no decrease of {what} along the step (residual {rnorm:.3e})")
         hist.steps.append(alpha)
-        hist.residuals.append(rnorm)
-        hist.energies.append(energy)
+        rnorm = record_state()
+        if p_old is not None and pressure is not None:
+            p_new = pressure()
+            changes.append(float(np.max(np.abs(p_new - p_old))) if p_new.size else 0.0)
+            p_old = p_new
         log.debug("coulomb newton %d: |R| = %.3e, alpha = %g", it, rnorm, alpha)
-        if not (math.isfinite(rnorm) and math.isfinite(energy)):
-            raise failed(f"Coulomb Newton step {it}: non-finite residual or energy")
         if cycle is not None:
             sig = active_set(gfu)
             hist.active_set_sizes.append(int(sum(bin(b).count("1") for b in sig))
@@ -194,8 +236,7 @@ def coupled_newton(residual_form: ng.BilinearForm, energy_form: ng.BilinearForm,
     return out
 
 
-def _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res, symmetric_inverse,
-                        max_step, record) -> float:
+def _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res, linear, max_step) -> float:
     """Step along ``du`` (or the Tresca direction) minimizing the frozen Tresca energy; updates ``gfu``.
 
     ``res`` holds ``R(u)`` = the frozen energy's gradient at ``u`` on entry
@@ -205,11 +246,7 @@ def _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res,
     slope = ng.InnerProduct(du, res)
     if not slope > 0.0:          # no descent of the frozen energy: the symmetric Tresca direction
         energy_form.AssembleLinearization(gfu.vec)
-        inv = energy_form.mat.Inverse(freedofs, inverse=symmetric_inverse)
-        if record is None:
-            du.data = inv * res
-        else:
-            TangentSolve(record, inv, counted=False).apply(res, du)
+        linear.prepare(energy_form, freedofs, symmetric=True).apply(res, du)
         slope = ng.InnerProduct(du, res)
         if not slope > 0.0:
             return 0.0
@@ -223,3 +260,22 @@ def _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res,
             return alpha
         alpha *= 0.5
     return 0.0
+
+
+def _residual_step(u, du, rnorm: float, trial, residual) -> float:
+    """Backtracking on ``|R|`` from ``alpha = 1/2`` (module docstring); updates ``u``, 0 when nothing decreases it."""
+    best, r_best = 0.0, rnorm
+    alpha = 0.5
+    for _ in range(MAX_HALVINGS):
+        trial.data = u - alpha * du
+        r = residual(trial)
+        if math.isfinite(r):
+            if r <= (1.0 - ARMIJO * alpha) * rnorm:
+                best = alpha
+                break
+            if r < r_best:
+                best, r_best = alpha, r
+        alpha *= 0.5
+    if best > 0.0:
+        u.data -= best * du
+    return best

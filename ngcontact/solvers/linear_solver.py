@@ -53,6 +53,8 @@ import ngsolve as ng
 from ngcontact.errors import ConvergenceError
 
 POLICIES = ("direct", "iterative", "auto")
+#: LU solvers NGSolve offers for a non-symmetric tangent; any other ``inverse`` (Cholesky) gives way to UMFPACK
+LU_INVERSES = ("umfpack", "pardiso", "mumps")
 #: free dofs from which "auto" solves 3D problems iteratively (BDDC-CG against sparse Cholesky, order 2)
 AUTO_THRESHOLD = 20_000
 
@@ -110,11 +112,12 @@ class LinearSolver:
         """The solve with the current (assembled) ``form.mat`` on ``freedofs``: ``apply(rhs, out)``.
 
         A non-symmetric tangent (``symmetric=False``: Coulomb friction's
-        coupled equations) is factorized by UMFPACK, or solved by GMRES with
+        coupled equations) is factorized by the policy's ``inverse`` when it
+        is an LU (``LU_INVERSES``), else by UMFPACK, or solved by GMRES with
         the same BDDC preconditioner.
         """
         if self.method(freedofs, form.space.mesh.dim) == "direct":
-            inverse = self.inverse if symmetric or self.inverse != "sparsecholesky" else "umfpack"
+            inverse = self.inverse if symmetric or self.inverse in LU_INVERSES else "umfpack"
             self.methods.add(f"direct ({inverse})")
             return TangentSolve(self, form.mat.Inverse(freedofs, inverse=inverse), counted=False)
         pre = self._pre.get(id(form))

@@ -1,8 +1,10 @@
 """Coulomb friction on the cell: the coupled Newton against the fixed point.
 
-The coupled Newton's tangent is the derivative of its residual (central
-differences), it differs from the symmetric Tresca tangent where points
-slip, and it reaches the fixed point's solution in fewer Newton steps.
+The coupled Newton (:func:`ngcontact.solvers.coulomb_newton.coupled_newton`)'s
+tangent is the derivative of its residual (central differences), it differs
+from the symmetric Tresca tangent where points slip, it reaches the fixed
+point's solution in fewer Newton steps, and its tangent solves by GMRES with
+BDDC give the factorization's solution.
 """
 from pathlib import Path
 
@@ -13,6 +15,7 @@ import pytest
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.cell_energy import coulomb_residual
 from ngcontact.drivers.build import build_cell, cell_loads, model_of
+from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.scene import loader
 
 SCENE = Path(__file__).resolve().parents[2] / "geometries" / "cells" / "rectangular_coulomb.toml"
@@ -70,6 +73,20 @@ def test_coupled_newton_reaches_the_fixed_point_in_fewer_steps(valley):
     assert [s.newton[0].get("stage") for s in newton[1:]] == ["rigid_continuation"] * 2
     assert sum(s.iterations for s in newton) < sum(s.iterations for s in fixed)
     assert all(x.iterations <= y.iterations for x, y in zip(newton, fixed))
+
+
+def test_coupled_newton_solves_iteratively_with_the_factorization_s_answer(valley):
+    """solver.linear = 'iterative': the non-symmetric tangent by GMRES+BDDC, no fallback to the fixed point."""
+    P, direct = _sweep(valley, "newton")
+    cell, model, loads = valley
+    Q = CellProblem(cell, model, coulomb="newton", linear=LinearSolver("iterative", rtol=1e-12))
+    iterative = Q.sweep(loads)
+    a, b = Q.gfu.vec.FV().NumPy(), P.gfu.vec.FV().NumPy()
+    assert np.max(np.abs(a - b)) <= 1e-7 * np.max(np.abs(b))
+    for x, y in zip(iterative, direct):
+        assert [h.get("stage") for h in x.newton] == [h.get("stage") for h in y.newton]
+        assert x.iterations == y.iterations
+    assert "gmres+bddc" in Q.linear.summary()["method"]
 
 
 def test_unknown_coulomb_method_is_rejected(valley):

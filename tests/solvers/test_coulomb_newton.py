@@ -1,4 +1,8 @@
-"""Newton on equations without an energy: a non-symmetric, nonlinear problem with a known solution."""
+"""The coupled Newton on equations without an energy: a non-symmetric, nonlinear problem with a known solution.
+
+Without a frozen energy it globalizes by backtracking on the residual (its macro use); direct and GMRES+BDDC
+tangent solves agree.  Its Coulomb use with the frozen Tresca energy: tests/cell/test_coulomb_friction.py.
+"""
 import math
 
 import ngsolve as ng
@@ -8,7 +12,7 @@ from netgen.geom2d import unit_square
 
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.linear_solver import LinearSolver
-from ngcontact.solvers.semismooth_newton import solve_equations
+from ngcontact.solvers.coulomb_newton import coupled_newton
 
 EXACT = ng.sin(math.pi * ng.x) * ng.sin(math.pi * ng.y)
 BETA = ng.CF((3.0, 1.0))
@@ -33,13 +37,13 @@ def _convection_reaction(maxh=0.1, order=3):
 
 def test_converges_quadratically_to_the_manufactured_solution():
     mesh, form, gfu = _convection_reaction()
-    hist = solve_equations(form, gfu, rtol=1e-12)
-    assert hist.converged and hist.iterations <= 6
-    r = hist.residuals
+    hist = coupled_newton(form, gfu, rtol=1e-12)
+    assert hist["converged"] and hist["iterations"] <= 6
+    r = hist["residuals"]
     assert r[-1] <= 1e-12 * r[0]
     # quadratic: the last step squares the relative residual of the one before (up to a moderate factor)
     assert r[-1] / r[0] <= 1e3 * (r[-2] / r[0]) ** 2 or r[-1] <= 1e-14 * r[0]
-    assert all(s == 1.0 for s in hist.steps)
+    assert all(s == 1.0 for s in hist["step_lengths"])
     err = math.sqrt(ng.Integrate((gfu - EXACT) ** 2, mesh))
     assert err < 1e-4, err
 
@@ -47,9 +51,9 @@ def test_converges_quadratically_to_the_manufactured_solution():
 def test_gmres_with_bddc_gives_the_factorization_s_answer():
     _, form_d, u_d = _convection_reaction(maxh=0.15)
     _, form_i, u_i = _convection_reaction(maxh=0.15)
-    solve_equations(form_d, u_d, rtol=1e-12)
+    coupled_newton(form_d, u_d, rtol=1e-12)
     linear = LinearSolver("iterative", rtol=1e-12)
-    solve_equations(form_i, u_i, rtol=1e-12, linear=linear)
+    coupled_newton(form_i, u_i, rtol=1e-12, linear=linear)
     a, b = u_d.vec.FV().NumPy(), u_i.vec.FV().NumPy()
     assert np.max(np.abs(a - b)) <= 1e-9 * np.max(np.abs(a))
     summary = linear.summary()
@@ -65,6 +69,6 @@ def test_equations_without_a_root_end_in_an_error_with_the_history():
     form += ng.exp(u) * v * ng.dx
     gfu = ng.GridFunction(V)
     with pytest.raises(ConvergenceError, match="did not converge in 8 steps") as info:
-        solve_equations(form, gfu, max_iter=8)
+        coupled_newton(form, gfu, max_iter=8)
     res = info.value.history["residuals"]
     np.testing.assert_allclose(np.array(res[1:]) / np.array(res[:-1]), math.exp(-1), rtol=1e-8)
