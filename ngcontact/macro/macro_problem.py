@@ -44,7 +44,8 @@ Solution strategy:
   converge, 2 to 20 Newton steps, none needing the continuation (with
   backtracking on the residual instead of the frozen-energy search: 2 to 26
   steps, five variants needing 4 to 6 rungs of it), equilibrium to 1e-11
-  or better; the fixed point below cycled on five of them;
+  or better; the fixed point below, from the same start, failed on 11 of
+  them (a period-2 cycle, or a singular Tresca tangent);
 * ``coulomb = "fixed_point"`` (the paper's Sec. 2): repeated Newton solves
   with ``G`` evaluated at the previous solution's pressure
   (:func:`ngcontact.solvers.coulomb.coulomb_fixed_point`, whose stopping
