@@ -38,7 +38,7 @@ the macro solve; the loop only grows the table:
 2. if the table grew, the macro problem is solved again with
    :func:`response_law`, warm-started from the previous solution (on the
    femur with Coulomb friction by the coupled Newton: 4 Newton steps from
-   the start law's solution against 31 cold); its
+   the start law's solution against 22 cold); its
    change ``max_x |sigma_n^(k)(x) - sigma_n^(k-1)(x)|`` is recorded and the
    loop stops below ``tol``; if it did not grow, the law is the one just
    solved with, whose solution is unchanged: the loop stops (change 0,
@@ -315,7 +315,8 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
     sol = solve(problem, None)
     macro_solves, newton = 1, sol.history["newton_iterations"]
     if given:
-        # the cached table's law, warm from the scene's law (the femur: 14 + 4 Newton steps; 31 cold)
+        # the cached table's law, warm from the scene's law (the femur: 18 + 4 Newton steps, 22 cold;
+        # the scene's law is the more robust start: cold, the table's law once needed a continuation)
         problem = M.replace_law(problem, il.InterfaceLaw(normal=response_law(table), friction=problem.law.friction))
         sol = solve(problem, sol.gfu.vec if warm else None)
         macro_solves, newton = 2, newton + sol.history["newton_iterations"]
@@ -338,9 +339,10 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
                                   macro_solves=macro_solves)
         law = il.InterfaceLaw(normal=response_law(table), friction=problem.law.friction)
         # warm from the previous solution, also from the scene's start law: with Coulomb friction by
-        # the coupled Newton the femur's cell-law solve took 4 steps from the start law's solution
-        # against 31 cold (a failed attempt and a continuation in the Huber width); the Coulomb fixed
-        # point had taken 26 warm against 17 cold, its first pass frozen far from either solution
+        # the coupled Newton the femur's cell-law solve takes 4 steps from the start law's solution
+        # against 22 cold (31, with a failed attempt and a continuation in the Huber width, before its
+        # line search on the frozen Tresca energy); the Coulomb fixed point had taken 26 warm against
+        # 17 cold, its first pass frozen far from either solution
         start = sol.gfu.vec if warm else None
         sol = solve(M.replace_law(problem, law), start)
         macro_solves += 1
