@@ -312,19 +312,23 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         No convergence within ``max_iter`` updates (carries the history).
     """
     given = len(table.values) >= 2     # a table read from a cache: its response is the start law
-    sol = solve(problem, None)
-    macro_solves, newton = 1, sol.history["newton_iterations"]
+    macro_solves, newton, start = 0, 0, None
+    if warm or not given:
+        sol = solve(problem, None)
+        macro_solves, newton, start = 1, sol.history["newton_iterations"], sol.gfu.vec
     if given:
         # the cached table's law, warm from the scene's law (the femur: 18 + 4 Newton steps, 22 cold;
-        # the scene's law is the more robust start: cold, the table's law once needed a continuation)
+        # the scene's law is the more robust start: cold, the table's law once needed a continuation);
+        # without warm starts the scene's law is not solved at all
         problem = M.replace_law(problem, il.InterfaceLaw(normal=response_law(table), friction=problem.law.friction))
-        sol = solve(problem, sol.gfu.vec if warm else None)
-        macro_solves, newton = 2, newton + sol.history["newton_iterations"]
+        sol = solve(problem, start)
+        macro_solves, newton = macro_solves + 1, newton + sol.history["newton_iterations"]
     p_old = MM.interface_profile(sol, points_per_element)["pressure"]
     history: list[HistoryEntry] = [{"iteration": 0, "max_pressure": float(p_old.max()), "max_change": None,
                                      "cell_solves": 0, "newton_iterations": newton, "law_changed": True,
                                      "warm_start": given and warm,
-                                     "start_law": "cell table (after the scene's law)" if given else "scene"}]
+                                     "start_law": ("cell table (after the scene's law)" if warm else "cell table")
+                                     if given else "scene"}]
     change = float("inf")
     for k in range(1, max_iter + 1):
         p_hi = float(p_old.max())

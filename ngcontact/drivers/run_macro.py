@@ -34,7 +34,7 @@ from ngcontact.macro import macro_problem as M
 from ngcontact.macro import macro_measures as MM
 from ngcontact.errors import ConvergenceError, SceneError
 from ngcontact.geometry import bodies as gm
-from ngcontact.scene.macro_shapes import REGIONS
+from ngcontact.scene.macro_shapes import BOUNDARY_DOCS, REGIONS
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 from ngcontact.scene import cell_links
@@ -57,11 +57,9 @@ def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None) -> gm.M
     if g.shape == "femur_stem":
         if g.setting == "3d":
             femur = femur_stem_3d(FemurStemDims(**dims), maxh=maxh, interface_maxh=ih, order=order)
-            labels = {k: v for k, v in BOUNDARIES.items() if k != "axis"}
             return gm.MacroGeometry(mesh=femur.mesh, rough="stem", counter="bone",
                                     dims=dict(vars(FemurStemDims(**dims))),
-                                    boundaries={"interface": "stem-bone interface S_0 (cone and cylinder)",
-                                                **labels, "sym_x": "x = 0", "sym_y": "y = 0"})
+                                    boundaries=dict(BOUNDARY_DOCS[("femur_stem", "3d")]))
         femur = femur_stem(FemurStemDims(**dims), maxh=maxh, interface_maxh=ih)
         return gm.MacroGeometry(mesh=femur.mesh, rough="stem", counter="bone", dims=dict(vars(FemurStemDims(**dims))),
                                 boundaries={"interface": "stem-bone interface S_0 (cone and cylinder)", **BOUNDARIES})
