@@ -114,11 +114,12 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
     clock = Clock(progress)
     module = driver(scene)
     from ngcontact.drivers.build import batches
-    with threads(n), batches(scene, workers, scheduler, batch_progress):
+    with threads(n), batches(scene, workers, scheduler, batch_progress) as ex:
         outcome = module.run(scene, clock)
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),
-                          outcome=outcome, timings=clock.total(), version=__version__, threads=n)
+                          outcome=outcome, timings=clock.total(), version=__version__, threads=n,
+                          compute=ex.describe())
     return report, outcome
 
 
@@ -147,9 +148,9 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
     n = thread_count()
     clock = Clock(progress)
     from ngcontact.drivers.build import batches
-    with threads(n), batches(scene, workers, scheduler, batch_progress):
+    with threads(n), batches(scene, workers, scheduler, batch_progress) as ex:
         outcome = run_study(scene, periods, clock=clock)
     report = build_report(kind="direct-epsilon-study", title=scene.title, scene=loader.as_dict(scene),
                           effects=loader.effects(scene), outcome=outcome, timings=clock.total(),
-                          version=__version__, threads=n)
+                          version=__version__, threads=n, compute=ex.describe())
     return report, outcome

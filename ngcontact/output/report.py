@@ -12,7 +12,8 @@ arrays.
 Report keys (schema ``ngcontact-report/1``): ``schema``, ``version``,
 ``kind``, ``title``, ``scene`` (the validated scene echoed), ``effects`` (the
 terms assembled), ``ndof``, ``timings`` (seconds per stage and ``total``),
-``threads`` (of NGSolve's task manager),
+``threads`` (of NGSolve's task manager), ``compute`` (where batches of
+independent solves ran: executor, workers, scheduler, batches),
 ``solver`` (iterations, residual history, converged), ``results``
 (kind-specific), ``files`` (what was written beside the report).
 """
@@ -110,7 +111,7 @@ def file_names(outcome: Outcome) -> list[str]:
 
 
 def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcome,
-                 timings: dict, version: str, threads: int = 1) -> dict:
+                 timings: dict, version: str, threads: int = 1, compute: dict | None = None) -> dict:
     """Assemble the report dictionary (validated: finite numbers only)."""
     report = {
         "schema": SCHEMA,
@@ -122,6 +123,7 @@ def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcom
         "ndof": int(outcome.ndof),
         "timings": timings,
         "threads": int(threads),
+        "compute": compute if compute is not None else {"executor": "serial", "workers": 1, "batches": []},
         "solver": outcome.solver,
         "results": outcome.results,
         "files": file_names(outcome),

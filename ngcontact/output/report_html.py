@@ -184,7 +184,18 @@ def key_figures(report: dict) -> list[tuple[str, str]]:
     generic = [("unknowns (ndof)", report.get("ndof"), ""), ("solver iterations", solver.get("iterations"), ""),
                ("solver converged", solver.get("converged"), ""),
                ("wall time", (report.get("timings") or {}).get("total"), "s"), ("threads", report.get("threads"), "")]
-    return items + [(label, fmt(value, unit)) for label, value, unit in generic if value is not None]
+    return items + [(label, fmt(value, unit)) for label, value, unit in generic if value is not None] + compute_items(
+        report.get("compute"))
+
+
+def compute_items(compute: dict | None) -> list[tuple[str, str]]:
+    """Where the run's batches of independent solves ran (nothing when it had none)."""
+    if not compute or not compute.get("batches"):
+        return []
+    where = {"serial": "this process", "local": f"{compute['workers']} local worker processes",
+             "dask": f"{compute['workers']} Dask worker threads at {compute.get('scheduler', '?')}"}
+    batches = "; ".join(f"{b['label']}: {b['members']} in {fmt(b['seconds'], 's')}" for b in compute["batches"])
+    return [("batches ran on", where.get(compute["executor"], str(compute["executor"]))), ("batches", batches)]
 
 
 def html_table(header: list[str], rows: list[list[str]], cls: str = "") -> str:

@@ -155,7 +155,15 @@ class Executor:
         if progress is not None:
             progress(label, 0, len(items))
         fault = _fault()
-        return self._map(fn, list(items), list(names), label, progress, fault)
+        t0 = time.perf_counter()
+        out = self._map(fn, list(items), list(names), label, progress, fault)
+        self.record.append({"label": label, "members": len(items), "seconds": time.perf_counter() - t0})
+        return out
+
+    @property
+    def record(self) -> list[dict]:
+        """The batches this executor ran: label, number of members, wall seconds (in order)."""
+        return self.__dict__.setdefault("_record", [])
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         out = []
@@ -180,7 +188,14 @@ class Executor:
         """Release the workers (nothing to release here)."""
 
     def describe(self) -> dict:
-        return {"executor": self.name, "workers": self.workers}
+        """Where the batches ran, for the report: the executor, its workers (one NGSolve thread each, a
+        single member in this process), a cluster's scheduler address, and the batches it ran."""
+        out: dict[str, Any] = {"executor": self.name, "workers": self.workers}
+        address = getattr(self, "address", None)
+        if address is not None:
+            out["scheduler"] = address
+        out["batches"] = [dict(b) for b in self.record]
+        return out
 
 
 class Serial(Executor):

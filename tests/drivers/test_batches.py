@@ -169,6 +169,12 @@ def test_a_dask_cluster_gives_the_serial_numbers(cluster, scenes, name):
     paths, serial = scenes
     report, _ = solve(paths[name], scheduler=cluster)
     assert_same(numbers(report), numbers(serial[name]))
+    compute = report["compute"]
+    assert (compute["executor"], compute["scheduler"], compute["workers"]) == ("dask", cluster, 2)
+    members = 4 if name == "ensemble" else 3
+    assert [(b["label"], b["members"]) for b in compute["batches"]] == [
+        ("ensemble" if name == "ensemble" else "loads", members)]
+    assert serial[name]["compute"]["executor"] == "serial"
 
 
 @pytest.mark.slow
@@ -178,6 +184,7 @@ def test_two_local_workers_give_the_serial_numbers(scenes, name):
     seen = []
     report, _ = solve(paths[name], workers=2, batch_progress=lambda *a: seen.append(a))
     assert_same(numbers(report), numbers(serial[name]))
+    assert (report["compute"]["executor"], report["compute"]["workers"]) == ("local", 2)
     total = 4 if name == "ensemble" else 3
     assert [s[1:] for s in seen] == [(k, total) for k in range(total + 1)]
 

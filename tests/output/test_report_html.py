@@ -90,6 +90,18 @@ def test_key_figures_of_a_macro_report_are_formatted_with_units_and_the_title_is
     assert "<title>Stem &lt;b&gt;&quot;fit&quot;&lt;/b&gt; &amp; bone</title>" in page and "<b>\"fit\"" not in page
 
 
+def test_the_page_names_where_the_batches_ran_and_says_nothing_of_a_run_without_batches(tmp_path):
+    report = macro_report(tmp_path)
+    report["compute"] = {"executor": "dask", "workers": 4, "scheduler": "tcp://10.0.0.5:8786",
+                         "batches": [{"label": "loads", "members": 16, "seconds": 9.25}]}
+    cards = dict(re.findall(r'<div class="label">([^<]*)</div><div class="value figure-value">([^<]*)</div>',
+                            render(report, str(tmp_path), ["interface.png"])))
+    assert cards["batches ran on"] == "4 Dask worker threads at tcp://10.0.0.5:8786"
+    assert cards["batches"] == "loads: 16 in 9.25 s"
+    report["compute"] = {"executor": "local", "workers": 2, "batches": []}
+    assert "batches ran on" not in render(report, str(tmp_path), ["interface.png"])
+
+
 def test_a_non_finite_number_is_refused_and_a_failing_page_writes_nothing(tmp_path, monkeypatch):
     for bad in (float("nan"), float("inf")):
         with pytest.raises(ValueError, match="non-finite"):
