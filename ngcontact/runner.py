@@ -64,6 +64,35 @@ def threads(n: int):
         yield
 
 
+def batches(scene, workers: int | None = None, scheduler: str | None = None, progress=None):
+    """Context in which the run's batches of independent solves go to their executor.
+
+    The command line's ``workers`` / ``scheduler`` first, then the scene's
+    ``[compute]`` section; default: a pool of local processes, one per core
+    (:func:`ngcontact.solvers.executor.make`).  The workers are started at
+    once when the scene will have a batch (:func:`has_batches`), so that
+    their start overlaps with the run's own preparation; otherwise only if a
+    batch comes.
+    """
+    from ngcontact.solvers import executor
+    compute = getattr(scene, "compute", None)
+    if scheduler is None and workers is None and compute is not None:
+        scheduler, workers = compute.scheduler, compute.workers
+    ex = executor.make(workers, scheduler)
+    if has_batches(scene):
+        ex.start()
+    return executor.use(ex, progress)
+
+
+def has_batches(scene) -> bool:
+    """Whether solving ``scene`` runs a batch of independent solves: an ensemble, a cell's independent loads
+    (without refinement to a tolerance), or the levels of an epsilon study."""
+    if scene.kind == "cell":
+        independent = scene.load.independent and scene.discretization.tolerance is None
+        return getattr(scene, "ensemble", None) is not None or (independent and not scene.contact.geometric_only)
+    return scene.kind == "direct" and getattr(scene, "study", None) is not None
+
+
 def check(scene) -> None:
     """Every check ``run`` makes before its solve, without solving.
 
@@ -112,10 +141,8 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
         scene = loader.load(scene)
     n = thread_count()
     clock = Clock(progress)
-    module = driver(scene)
-    from ngcontact.drivers.build import batches
     with threads(n), batches(scene, workers, scheduler, batch_progress) as ex:
-        outcome = module.run(scene, clock)
+        outcome = driver(scene).run(scene, clock)
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),
                           outcome=outcome, timings=clock.total(), version=__version__, threads=n,
@@ -139,16 +166,14 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
         The scene is not a ``direct`` scene with a ``[study]`` section, or
         its band leaves no points for the field error.
     """
-    from ngcontact.drivers.study_epsilon import run_study
-
     if not hasattr(scene, "kind"):
         scene = loader.load(scene)
     if scene.kind != "direct" or getattr(scene, "study", None) is None:
         raise SceneError("kind", scene.kind, "the epsilon study needs a 'direct' scene with a [study] section")
     n = thread_count()
     clock = Clock(progress)
-    from ngcontact.drivers.build import batches
     with threads(n), batches(scene, workers, scheduler, batch_progress) as ex:
+        from ngcontact.drivers.study_epsilon import run_study
         outcome = run_study(scene, periods, clock=clock)
     report = build_report(kind="direct-epsilon-study", title=scene.title, scene=loader.as_dict(scene),
                           effects=loader.effects(scene), outcome=outcome, timings=clock.total(),

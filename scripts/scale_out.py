@@ -1,45 +1,52 @@
 """Scale-out of a batch of independent cell solves: 1 and 2 local workers and a Dask cluster.
 
 The batch: the 2D FE cell of a sinusoidal profile (conforming, order 2,
-``maxh = 0.08``, ``interface_maxh = 0.015``: about 1 s per solve here) under
-16 pressures with ``load.independent = true``, so each load is a member of
-the batch (:mod:`ngcontact.drivers.cell_members`) that meshes and solves its
-own cell.  Runs, each through the ``cell`` driver under the executor of
-:mod:`ngcontact.solvers.executor`:
+``maxh = 0.08``, ``interface_maxh = 0.015``: about 0.5 s per solve on a quiet
+machine here) under 16 pressures with ``load.independent = true``, so each
+load is a member of the batch (:mod:`ngcontact.drivers.cell_members`) that
+meshes and solves its own cell.  Each run is the command a user types,
+``ngcontact run SCENE --out DIR --quiet`` in a fresh interpreter, with
 
-* ``serial``: one worker, in this process;
-* ``local`` with 2 workers: cold (the pool is spawned for the run, as
-  ``ngcontact run --workers 2`` does: interpreters start and import NGSolve)
-  and warm (the same pool again);
-* ``dask``: a ``distributed.LocalCluster`` of 2 worker processes with one
-  thread each, cold (its workers import the package on the first task) and
-  warm.
+* ``--workers 1``: the serial executor, in the run's process (NGSolve's task
+  manager on every core, as a run without a batch);
+* ``--workers 2``: a local pool of two spawned workers, one NGSolve thread
+  each, started when the run begins (their interpreter start and imports
+  overlap with the run's own mesh and setup);
+* ``--scheduler ADDRESS``: a ``distributed.LocalCluster`` of 2 worker
+  processes with one thread each, started by this script before the runs (a
+  cluster outlives the runs it serves); its first run imports the package on
+  the workers (``dask cold``), the next finds it imported (``dask warm``).
 
-Reported: wall time, speedup over serial, the largest relative difference of
-any per-load result from the serial run, and the scheduler's overhead per
-task: the wall time of 200 no-op members (``operator.neg``) over their
-number, on 1 worker, as a percentage of the mean serial cell solve.  Writes
-``scale_out.csv`` and ``scale_out.png`` into the output directory (default
-``results/scale_out``).
+Each configuration runs ``REPEATS`` times; reported per run: the command's
+wall time, the batch's wall time (``report.json`` ``compute.batches``), the
+speedups of both over ``--workers 1`` (the first repeat of each against the
+first of ``--workers 1``, and so on), and the largest relative difference of
+any number in ``results.loads`` from the first ``--workers 1`` run (the
+effective stiffness, a difference of compliances that loses digits to
+cancellation, separately; its spread between two serial runs is reported
+too).  The scheduler's overhead per task: the wall time of 200 no-op members
+(``operator.neg``) over their number, on 1 worker, as a percentage of the
+mean serial cell solve.  Writes ``scale_out.csv`` and ``scale_out.png`` into
+the output directory (default ``results/scale_out``).
 
 Wall times on a shared machine are noisy: re-measure on a quiet one with::
 
-    PYTHONPATH=$PWD MPLBACKEND=Agg python scripts/scale_out.py results/scale_out
+    MPLBACKEND=Agg python scripts/scale_out.py results/scale_out
 """
 from __future__ import annotations
 
 import argparse
 import csv
+import json
 import operator
 import os
+import subprocess
+import sys
 import tempfile
 import time
 
 import numpy as np
 
-from ngcontact.drivers import run_cell
-from ngcontact.output.report import Clock
-from ngcontact.scene import loader
 from ngcontact.solvers import executor
 
 LOADS = np.geomspace(0.002, 0.02, 16)
@@ -67,22 +74,34 @@ order = 2
 maxh = 0.08
 interface_maxh = 0.015
 """
-KEYS = ("contact_fraction", "mean_closure", "mean_pressure", "transmitted_pressure")
 NOOP_TASKS = 200
+REPEATS = 2
 
 
-def solve(scene, ex) -> tuple[float, list[dict]]:
-    with executor.use(ex) as e:
-        t0 = time.perf_counter()
-        outcome = run_cell.run(scene, Clock())
-        wall = time.perf_counter() - t0
-        e.close()
-    return wall, outcome.results["loads"]
+def run(path: str, out: str, *flags: str) -> tuple[float, dict]:
+    """``ngcontact run path --out out --quiet flags`` in a fresh interpreter: (wall seconds, report)."""
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "ngcontact", "run", path, "--out", out, "--quiet", *flags], check=True)
+    wall = time.perf_counter() - t0
+    with open(os.path.join(out, "report.json")) as fh:
+        return wall, json.load(fh)
 
 
-def difference(a: list[dict], b: list[dict]) -> float:
-    """Largest relative difference of the per-load results ``KEYS``."""
-    return max(abs(x[k] - y[k]) / max(abs(x[k]), abs(y[k]), 1e-300) for x, y in zip(a, b) for k in KEYS)
+def numbers(value, path: str = "") -> dict[str, float]:
+    """Every float of a nested report value, by its path."""
+    if isinstance(value, dict):
+        return {k: v for key, item in value.items() for k, v in numbers(item, f"{path}.{key}").items()}
+    if isinstance(value, list):
+        return {k: v for i, item in enumerate(value) for k, v in numbers(item, f"{path}[{i}]").items()}
+    return {path: float(value)} if isinstance(value, float) else {}
+
+
+def difference(a: dict, b: dict, cancelling: bool) -> float:
+    """Largest relative difference (to the larger magnitude, at least 1) of the numbers of ``results.loads``,
+    with (``cancelling``) or without the effective stiffness."""
+    x, y = numbers(a["results"]["loads"]), numbers(b["results"]["loads"])
+    keys = [k for k in x if ("effective_stiffness" in k) == cancelling]
+    return max(abs(x[k] - y[k]) / max(1.0, abs(x[k]), abs(y[k])) for k in keys)
 
 
 def overhead(ex) -> float:
@@ -95,14 +114,9 @@ def overhead(ex) -> float:
     return (time.perf_counter() - t0) / NOOP_TASKS
 
 
-class Reusable(executor.Executor):
-    """An executor that :func:`executor.use` does not close (the warm runs reuse it)."""
-
-    def __init__(self, inner: executor.Executor):
-        self.inner, self.name, self.workers = inner, inner.name, inner.workers
-
-    def _map(self, fn, items, names, label, progress, fault):
-        return self.inner._map(fn, items, names, label, progress, fault)
+def batch_seconds(report: dict) -> float:
+    (batch,) = report["compute"]["batches"]
+    return batch["seconds"]
 
 
 def main() -> None:
@@ -110,78 +124,85 @@ def main() -> None:
     parser.add_argument("out", nargs="?", default=os.path.join("results", "scale_out"))
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
-    with tempfile.TemporaryDirectory() as tmp:
+    from distributed import LocalCluster
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp, LocalCluster(
+            n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster:
         path = os.path.join(tmp, "scale_out.toml")
         with open(path, "w") as fh:
             fh.write(SCENE.format(loads=", ".join(f"{p:.6g}" for p in LOADS)))
-        scene = loader.load(path)
-    rows = []
-    t_serial, ref = solve(scene, executor.Serial())
-    per_solve = t_serial / len(LOADS)
-    serial_overhead = overhead(executor.Serial())
-    rows.append(dict(run="serial", workers=1, wall=t_serial, speedup=1.0, max_rel_diff=0.0,
-                     overhead_per_task=serial_overhead))
-    print(f"serial: {t_serial:.2f} s ({per_solve:.2f} s per solve)", flush=True)
-
-    pool = executor.LocalPool(2)
-    for run in ("local cold", "local warm"):
-        wall, res = solve(scene, Reusable(pool))
-        rows.append(dict(run=run, workers=2, wall=wall, speedup=t_serial / wall, max_rel_diff=difference(ref, res),
-                         overhead_per_task=float("nan")))
-        print(f"{run}: {wall:.2f} s, speedup {t_serial / wall:.2f}", flush=True)
-    one = executor.LocalPool(1)
-    rows[-1]["overhead_per_task"] = overhead(one)
-    one.close()
-    pool.close()
-
-    from distributed import LocalCluster
-    with LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster:
-        dask = executor.DaskCluster(cluster.scheduler_address)
-        for run in ("dask cold", "dask warm"):
-            wall, res = solve(scene, Reusable(dask))
-            rows.append(dict(run=run, workers=2, wall=wall, speedup=t_serial / wall,
-                             max_rel_diff=difference(ref, res), overhead_per_task=float("nan")))
-            print(f"{run}: {wall:.2f} s, speedup {t_serial / wall:.2f}", flush=True)
-        dask.close()
-    with LocalCluster(n_workers=1, processes=True, threads_per_worker=1, dashboard_address=None) as cluster:
-        dask1 = executor.DaskCluster(cluster.scheduler_address)
-        rows[-1]["overhead_per_task"] = overhead(dask1)
-        dask1.close()
+        configs = [("workers 1", ("--workers", "1")), ("local 2", ("--workers", "2")),
+                   ("dask 2", ("--scheduler", cluster.scheduler_address))]
+        base: list[tuple[float, dict]] = []
+        for repeat in range(REPEATS):
+            for name, flags in configs:
+                wall, report = run(path, os.path.join(tmp, f"{name}_{repeat}".replace(" ", "_")), *flags)
+                if name == "workers 1":
+                    base.append((wall, report))
+                ref_wall, ref = base[repeat]
+                label = name if name != "dask 2" else ("dask cold" if repeat == 0 else "dask warm")
+                rows.append(dict(run=label, repeat=repeat, workers=report["compute"]["workers"],
+                                 executor=report["compute"]["executor"], wall=wall, batch=batch_seconds(report),
+                                 speedup=ref_wall / wall, batch_speedup=batch_seconds(ref) / batch_seconds(report),
+                                 max_rel_diff=difference(base[0][1], report, False),
+                                 effective_stiffness_rel_diff=difference(base[0][1], report, True)))
+                print(f"{label:>10} (repeat {repeat}): {wall:6.2f} s, batch {rows[-1]['batch']:6.2f} s, "
+                      f"speedup {rows[-1]['speedup']:.2f} (batch {rows[-1]['batch_speedup']:.2f})", flush=True)
+        per_solve = batch_seconds(base[0][1]) / len(LOADS)
+        with executor.use(executor.Serial()) as serial:
+            over = {"serial": overhead(serial)}
+        one = executor.LocalPool(1)
+        over["local"] = overhead(one)
+        one.close()
+        with LocalCluster(n_workers=1, processes=True, threads_per_worker=1, dashboard_address=None) as c1:
+            dask1 = executor.DaskCluster(c1.scheduler_address)
+            over["dask"] = overhead(dask1)
+            dask1.close()
     for r in rows:
+        r["overhead_per_task"] = over[r["executor"]]
         r["overhead_percent_of_solve"] = 100 * r["overhead_per_task"] / per_solve
     write(args.out, rows, per_solve)
 
 
 def write(out: str, rows: list[dict], per_solve: float) -> None:
-    keys = ["run", "workers", "wall", "speedup", "max_rel_diff", "overhead_per_task", "overhead_percent_of_solve"]
+    keys = ["run", "repeat", "executor", "workers", "wall", "batch", "speedup", "batch_speedup", "max_rel_diff",
+            "effective_stiffness_rel_diff", "overhead_per_task", "overhead_percent_of_solve"]
     with open(os.path.join(out, "scale_out.csv"), "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(keys)
         for r in rows:
-            w.writerow([r[k] if isinstance(r[k], str) or not np.isnan(r[k]) else "" for k in keys])
+            w.writerow([r[k] for k in keys])
     for r in rows:
-        over = "" if np.isnan(r["overhead_per_task"]) else (f"  overhead {1e3 * r['overhead_per_task']:.2f} ms/task "
-                                                            f"= {r['overhead_percent_of_solve']:.2f} % of a solve")
-        print(f"{r['run']:>11}: {r['wall']:7.2f} s  speedup {r['speedup']:.2f}  "
-              f"max rel diff {r['max_rel_diff']:.1e}{over}")
+        print(f"{r['run']:>10} #{r['repeat']}: command {r['wall']:6.2f} s (x{r['speedup']:.2f}), batch "
+              f"{r['batch']:6.2f} s (x{r['batch_speedup']:.2f}), max rel diff {r['max_rel_diff']:.1e}, "
+              f"effective stiffness {r['effective_stiffness_rel_diff']:.1e}, overhead "
+              f"{1e3 * r['overhead_per_task']:.2f} ms/task = {r['overhead_percent_of_solve']:.2f} % of a solve")
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    names = [r["run"] for r in rows]
-    ax[0].bar(names, [r["wall"] for r in rows], color=["C0", "C1", "C1", "C2", "C2"])
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    names = [f"{r['run']} #{r['repeat']}" for r in rows]
+    x = np.arange(len(rows))
+    colors = {"serial": "C0", "local": "C1", "dask": "C2"}
+    ax[0].bar(x - 0.2, [r["wall"] for r in rows], 0.4, color=[colors[r["executor"]] for r in rows],
+              label="whole command")
+    ax[0].bar(x + 0.2, [r["batch"] for r in rows], 0.4, color=[colors[r["executor"]] for r in rows], alpha=0.5,
+              hatch="//", label="batch of 16 solves")
     for i, r in enumerate(rows):
-        ax[0].text(i, r["wall"], f"x{r['speedup']:.2f}", ha="center", va="bottom", fontsize=8)
-    ax[0].set_ylabel("wall time of 16 cell solves [s]")
-    ax[0].set_title(f"speedup over serial ({per_solve:.2f} s per solve)", fontsize=9)
-    ax[0].tick_params(axis="x", rotation=30)
-    measured = [r for r in rows if not np.isnan(r["overhead_per_task"])]
-    ax[1].bar([r["run"].split()[0] for r in measured], [r["overhead_percent_of_solve"] for r in measured])
+        ax[0].text(i + 0.2, r["batch"], f"x{r['batch_speedup']:.2f}", ha="center", va="bottom", fontsize=7)
+    ax[0].set_xticks(x, names, rotation=30, ha="right", fontsize=8)
+    ax[0].set_ylabel("wall time [s]")
+    ax[0].set_title(f"16 independent cell solves ({per_solve:.2f} s each serially); batch speedup over "
+                    "--workers 1", fontsize=8)
+    ax[0].legend(fontsize=8)
+    execs = ["serial", "local", "dask"]
+    per = {r["executor"]: r["overhead_percent_of_solve"] for r in rows}
+    ax[1].bar(execs, [per[e] for e in execs], color=[colors[e] for e in execs])
     ax[1].axhline(5.0, color="k", ls=":", label="5 % of a solve")
     ax[1].set_yscale("log")
-    ax[1].set_ylabel("overhead per task [% of one cell solve]")
+    ax[1].set_ylabel("scheduler overhead per task [% of one cell solve]")
     ax[1].legend(fontsize=8)
-    fig.suptitle("scale-out on a shared 2-core machine (noisy: re-measure on a quiet one)", fontsize=9)
+    fig.suptitle("scale-out on a 2-core machine (wall times: re-measure on a quiet machine)", fontsize=9)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "scale_out.png"), dpi=120)
     plt.close(fig)

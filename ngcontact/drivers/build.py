@@ -22,26 +22,12 @@ from ngcontact.fem import materials
 from ngcontact.fem.interpolants import periodic_table_1d
 from ngcontact.laws import homogenized as il
 from ngcontact.laws.penalty import Friction
-from ngcontact.solvers import executor
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.cell.spectral_cell import Layer, SpectralCell
 from ngcontact.scene.cell_geometry import GAP_PROFILES, profile_2d, small_slope
 from ngcontact.scene.cell_scene import CellScene, load_states, spectral_grid
 from ngcontact.scene.loader import as_dict, load_with_contact
 from ngcontact.scene.sections import MaterialSpec, resolve
-
-
-def batches(scene, workers: int | None = None, scheduler: str | None = None, progress=None):
-    """Context in which the run's batches of independent solves go to their executor.
-
-    The command line's ``workers`` / ``scheduler`` first, then the scene's
-    ``[compute]`` section; default: a pool of local processes, one per core
-    (:func:`ngcontact.solvers.executor.make`; started only when a batch comes).
-    """
-    compute = getattr(scene, "compute", None)
-    if scheduler is None and workers is None and compute is not None:
-        scheduler, workers = compute.scheduler, compute.workers
-    return executor.use(executor.make(workers, scheduler), progress)
 
 
 def elastic_law(spec: MaterialSpec) -> materials.ElasticLaw:

@@ -184,6 +184,9 @@ class Executor:
                 progress(label, k + 1, len(items))
         return out
 
+    def start(self) -> None:
+        """Get the workers ready now, while this process prepares the batch (nothing to do here)."""
+
     def close(self) -> None:
         """Release the workers (nothing to release here)."""
 
@@ -222,6 +225,22 @@ class LocalPool(Executor):
         self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx, initializer=_worker_start,
                                          initargs=(self._started,))
         return self._pool
+
+    def start(self) -> None:
+        """Spawn every worker now and let it import the model code (NGSolve, the drivers' common imports).
+
+        A worker is a fresh interpreter: its start and imports take about a
+        second, which the batch would otherwise wait for.  Called when a run
+        knows it will have a batch, this overlaps with what the run does
+        before it (its own imports, the scene's meshes, a macro solve).  The
+        pool spawns one process per submitted task while none is idle, so one
+        warm-up task per worker starts them all.
+        """
+        if self._pool is not None:
+            return
+        pool = self._start()
+        for _ in range(self.workers):
+            pool.submit(_warm_up)
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         if len(items) == 1:
@@ -331,6 +350,16 @@ def _worker_start(started) -> None:
     _one_thread(ignore_sigint=True)
 
 
+#: What every member needs: imported by a worker while it waits for its first member.
+WARM_UP_MODULES = ("ngsolve", "ngcontact.drivers.build")
+
+
+def _warm_up() -> None:
+    import importlib
+    for module in WARM_UP_MODULES:
+        importlib.import_module(module)
+
+
 def _pool_member(fn, item, name, attempt, fault):
     if _STARTED is not None:
         _STARTED.put((os.getpid(), name))
@@ -361,6 +390,10 @@ class DaskCluster(Executor):
             info = self._client.scheduler_info()["workers"].values()
             self.workers = max(1, sum(w.get("nthreads", 1) for w in info))
         return self._client
+
+    def start(self) -> None:
+        """Connect to the scheduler now: an address that does not answer fails before any solve."""
+        self.client  # noqa: B018 - the property connects
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         from distributed import as_completed

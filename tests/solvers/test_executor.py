@@ -75,3 +75,29 @@ def test_make_chooses_serial_pool_or_cluster():
     with executor.use(executor.LocalPool(2)) as ex:
         assert executor.current() is ex
     assert executor.current().name == "serial"
+
+
+def test_a_started_pool_has_its_workers_running_before_the_first_batch_and_records_its_batches():
+    ex = executor.LocalPool(2)
+    try:
+        ex.start()
+        ex.start()                                           # a second start keeps the same workers
+        processes = list(ex._pool._processes.values())
+        assert len(processes) == 2 and all(p.is_alive() for p in processes)
+        assert ex.map(operator.neg, ITEMS, NAMES, label="toy") == EXPECTED
+        assert list(ex._pool._processes.values()) == processes   # the batch ran on the started workers
+        assert ex.describe()["executor"] == "local" and ex.describe()["workers"] == 2
+        assert [(b["label"], b["members"]) for b in ex.describe()["batches"]] == [("toy", len(ITEMS))]
+    finally:
+        ex.close()
+
+
+def test_runs_with_batches_start_their_workers_at_once_and_others_do_not():
+    from ngcontact.runner import has_batches
+    from ngcontact.scene import loader
+    import os
+    geometries = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(__file__))), "geometries")
+    with_batches = {"cells/self_affine_ensemble.toml"}
+    for name in ("femur_stem.toml", "femur_stem_two_scale.toml", "cells/sinusoid.toml",
+                 "cells/self_affine_ensemble.toml", "cells/westergaard_graded.toml"):
+        assert has_batches(loader.load(os.path.join(geometries, name))) == (name in with_batches), name
