@@ -86,7 +86,9 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
 
 def has_batches(scene) -> bool:
     """Whether solving ``scene`` runs a batch of independent solves: an ensemble, a cell's independent loads
-    (without refinement to a tolerance), or the levels of an epsilon study."""
+    (without refinement to a tolerance), the levels of a convergence study or of an epsilon study."""
+    if scene.kind == "manufactured":
+        return len(scene.manufactured.orders) * scene.manufactured.levels > 1
     if scene.kind == "cell":
         independent = scene.load.independent and scene.discretization.tolerance is None
         return getattr(scene, "ensemble", None) is not None or (independent and not scene.contact.geometric_only)

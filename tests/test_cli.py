@@ -165,7 +165,7 @@ def test_console_script(scene_file, tmp_path):
     done = subprocess.run([exe, "run", str(scene_file), "--out", str(out)],
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
-    assert "order 2, level 3" in done.stderr  # progress lines
+    assert "levels: 6/6 finished" in done.stderr  # progress lines of the batch of levels
     assert (out / "report.json").is_file()
     bad = subprocess.run([exe, "check", str(invalid_scene(tmp_path))], capture_output=True, text=True)
     assert bad.returncode == 2

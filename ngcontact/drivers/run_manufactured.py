@@ -14,7 +14,9 @@ from __future__ import annotations
 import logging
 
 import ngsolve as ng
+import numpy as np
 
+from ngcontact.solvers import executor
 from ngcontact.verification import manufactured
 from ngcontact.verification import rates as studies
 from ngcontact.drivers.build import body_laws
@@ -41,23 +43,37 @@ def laws_of(scene) -> dict:
     return body_laws(scene, {"body": m.body})
 
 
-def run(scene, clock) -> Outcome:
-    """Solve every (order, level), fit rates and collect tables, plots and VTK."""
+def level_member(job: tuple) -> tuple[dict, np.ndarray | None]:
+    """Member of the batch of levels: order ``p`` on the mesh refined ``k`` times, solved on its own.
+
+    Returns the level's row and, for the level the VTK output shows (``keep``), the solution vector.
+    """
+    scene, p, k, keep = job
     m = scene.manufactured
-    finest: dict = {}
-    level = manufactured.level_runner(m.setting, laws_of(scene), m.maxh,
-                                      inverse=scene.solver.inverse, keep=finest)
-    rows = []
-    for p in m.orders:
-        for k in range(1, m.levels + 1):
-            with clock.stage(f"order {p}, level {k}"):
-                rows.extend(studies.h_refinement(level, setting=m.setting, orders=(p,), maxh=m.maxh,
-                                                 refinements=(k,)))
-            residual = rows[-1]["relative_residual"]
-            if not residual <= LINEAR_RTOL:
-                raise ConvergenceError(
-                    f"linear solve for order {p}, level {k}: relative residual {residual:.3e} "
-                    f"> {LINEAR_RTOL:g}", _solver_info(rows, scene, converged=False))
+    kept: dict = {}
+    level = manufactured.level_runner(m.setting, laws_of(scene), m.maxh, inverse=scene.solver.inverse, keep=kept)
+    (row,) = studies.h_refinement(level, setting=m.setting, orders=(p,), maxh=m.maxh, refinements=(k,))
+    return row, (kept["solution"].gfu.vec.FV().NumPy().copy() if keep else None)
+
+
+def run(scene, clock) -> Outcome:
+    """Solve every (order, level), fit rates and collect tables, plots and VTK.
+
+    The levels are independent solves: one batch (:mod:`ngcontact.solvers.executor`), so they run on
+    the run's workers; the finest level of the highest order comes back as a vector for the VTK file.
+    """
+    m = scene.manufactured
+    jobs = [(scene, p, k, (p, k) == (m.orders[-1], m.levels)) for p in m.orders for k in range(1, m.levels + 1)]
+    with clock.stage("levels"):
+        out = executor.current().map(level_member, jobs, [f"order {p}, level {k}" for _, p, k, _ in jobs],
+                                     label="levels")
+    rows = [row for row, _ in out]
+    for (_, p, k, _), row in zip(jobs, rows):
+        residual = row["relative_residual"]
+        if not residual <= LINEAR_RTOL:
+            raise ConvergenceError(
+                f"linear solve for order {p}, level {k}: relative residual {residual:.3e} "
+                f"> {LINEAR_RTOL:g}", _solver_info(rows, scene, converged=False))
     # Levels whose error is at the round-off of the solve carry no rate: an order that reproduces the
     # smooth solution to round-off on every level is exact, not a failed rate.
     floor = {n: ROUNDOFF_ERROR * max(r[n] for r in rows) for n in ("l2", "h1")}
@@ -83,16 +99,29 @@ def run(scene, clock) -> Outcome:
         "rate_tolerance": m.rate_tolerance,
         "verified": verified,
     }
-    prob, sol = finest["problem"], finest["solution"]
-    error = sol.gfu - prob.exact
+    prob, gfu = finest_solution(scene, out[-1][1])
+    error = gfu - prob.exact
     vtk = {"finest": VtkField(mesh=prob.mesh, subdivision=min(max(m.orders) - 1, 2),
-                              fields={"displacement": sol.gfu, "exact": prob.exact, "error": error,
+                              fields={"displacement": gfu, "exact": prob.exact, "error": error,
                                       "error_norm": ng.Norm(error)})}
     return Outcome(results=results, ndof=max(r["ndof"] for r in rows),
                    solver=_solver_info(rows, scene, converged=True),
                    tables={"convergence": studies.table(rows, TABLE_KEYS),
                            "rates": _rates_table(rates, expected)},
                    vtk=vtk, plots={"convergence": lambda path: figures.convergence(path, rows, rates)})
+
+
+def finest_solution(scene, vec: np.ndarray | None) -> tuple[manufactured.Problem, ng.GridFunction]:
+    """The last level's problem rebuilt here (meshing is deterministic) with the member's solution vector."""
+    m = scene.manufactured
+    prob = manufactured.problem(m.setting, laws_of(scene), m.maxh, refinements=m.levels, order=m.orders[-1])
+    gfu = ng.GridFunction(manufactured.space(prob, m.orders[-1]))
+    values = gfu.vec.FV().NumPy()
+    if vec is None or len(vec) != len(values):
+        raise RuntimeError(f"the finest level came back with {0 if vec is None else len(vec)} dofs, its rebuilt "
+                           f"space has {len(values)}: the mesh was not rebuilt identically")
+    values[:] = vec
+    return prob, gfu
 
 
 def _solver_info(rows, scene, converged: bool) -> dict:
