@@ -12,13 +12,16 @@
    eq. 34), time = meshing + surface integral.
 
 Both under h-refinement (interface mesh halved at fixed order) and
-p-refinement (order raised on a fixed mesh).  Writes ``work_precision.csv``
+p-refinement (order raised on a fixed mesh).  The levels are independent
+solves: one batch on ``--workers N`` local processes (default 1); each is
+timed inside its worker on one NGSolve thread, so the figures do not depend
+on N, only the study's wall time does.  Writes ``work_precision.csv``
 and ``work_precision.png`` into the output directory (default
 ``results/work_precision_cell``) and logs the table.
 
 Usage::
 
-    python scripts/work_precision_cell.py [OUT_DIR]
+    python scripts/work_precision_cell.py [OUT_DIR] [--workers N]
 """
 from __future__ import annotations
 
@@ -37,6 +40,7 @@ from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.fem.materials import isotropic
 from ngcontact.output.writer import write_csv
+from ngcontact.solvers import executor
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
@@ -85,21 +89,25 @@ def semicircle_kt(order: int, ih: float) -> dict:
             "seconds": secs, "newton_iterations": 0}
 
 
-def run() -> list[dict]:
-    rows = []
+def level(job: tuple) -> dict:
+    """One level of either study as a member of a batch (:mod:`ngcontact.solvers.executor`)."""
+    study, quantity, args = job
+    return {"study": study, **(westergaard(*args) if quantity == "westergaard" else semicircle_kt(*args))}
+
+
+def run(workers: int = 1) -> list[dict]:
+    jobs = []
     for kn in KN_VALUES:
-        for ih in WG_H["interface_maxh"]:
-            rows.append({"study": "h", **westergaard(WG_H["order"], ih, kn)})
-            log.info("%s", _fmt(rows[-1]))
-        for order in WG_P["orders"]:
-            rows.append({"study": "p", **westergaard(order, WG_P["interface_maxh"], kn)})
-            log.info("%s", _fmt(rows[-1]))
-    for ih in SC_H["interface_maxh"]:
-        rows.append({"study": "h", **semicircle_kt(SC_H["order"], ih)})
-        log.info("%s", _fmt(rows[-1]))
-    for order in SC_P["orders"]:
-        rows.append({"study": "p", **semicircle_kt(order, SC_P["interface_maxh"])})
-        log.info("%s", _fmt(rows[-1]))
+        jobs += [("h", "westergaard", (WG_H["order"], ih, kn)) for ih in WG_H["interface_maxh"]]
+        jobs += [("p", "westergaard", (order, WG_P["interface_maxh"], kn)) for order in WG_P["orders"]]
+    jobs += [("h", "semicircle", (SC_H["order"], ih)) for ih in SC_H["interface_maxh"]]
+    jobs += [("p", "semicircle", (order, SC_P["interface_maxh"])) for order in SC_P["orders"]]
+    names = [f"{quantity} {study} {args}" for study, quantity, args in jobs]
+    with executor.use(executor.make(workers)) as ex:
+        ex.start()
+        rows = ex.map(level, jobs, names, label="work-precision levels")
+    for r in rows:
+        log.info("%s", _fmt(r))
     return rows
 
 
@@ -136,10 +144,11 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", nargs="?", default=os.path.join("results", "work_precision_cell"),
                     help="output directory")
+    ap.add_argument("--workers", type=int, default=1, help="local worker processes for the levels")
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     os.makedirs(args.out, exist_ok=True)
-    rows = run()
+    rows = run(args.workers)
     write_csv(os.path.join(args.out, "work_precision.csv"), KEYS, [[r[k] for k in KEYS] for r in rows])
     plot(rows, os.path.join(args.out, "work_precision.png"))
     log.info("wrote %s", args.out)

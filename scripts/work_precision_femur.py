@@ -6,12 +6,15 @@ refused on a mesh touching the axis, see :func:`ngcontact.macro.macro_problem.ch
 compares the peak contact pressure along the interface and the peak von
 Mises stress with those of a reference solution (order 5 on the finest
 mesh).  Each run is timed from meshing to post-processing (wall clock,
-including the Newton / Coulomb iterations).
+including the Newton / Coulomb iterations, on one NGSolve thread).  The
+discretizations are independent solves: one batch on ``--workers N`` local
+processes (default 1; each solve is timed inside its worker, on one thread,
+so the figures do not depend on N, only the study's wall time does).
 
 Writes ``OUT/work_precision_femur.csv`` and ``OUT/work_precision_femur.png``
 (relative error against seconds).  Usage::
 
-    python scripts/work_precision_femur.py [--out DIR] [--quick]
+    python scripts/work_precision_femur.py [--out DIR] [--quick] [--workers N]
 """
 from __future__ import annotations
 
@@ -27,6 +30,7 @@ import numpy as np
 from ngcontact.macro import macro_measures as MM
 from ngcontact.scene import loader as scene_mod
 from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
+from ngcontact.solvers import executor
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 log = logging.getLogger("work_precision_femur")
@@ -50,10 +54,17 @@ def peaks(sc, maxh: float, interface_maxh: float, order: int) -> dict:
             "peak_von_mises_z": vm["location"][1]}
 
 
+def member(job: tuple) -> dict:
+    """One discretization of the study as a member of a batch (:mod:`ngcontact.solvers.executor`)."""
+    sc, maxh, interface_maxh, order = job
+    return peaks(sc, maxh, interface_maxh, order)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "results", "work_precision_femur"))
     ap.add_argument("--quick", action="store_true", help="fewer levels (a smoke run)")
+    ap.add_argument("--workers", type=int, default=1, help="local worker processes for the discretizations")
     args = ap.parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     sc = scene_mod.load(os.path.join(ROOT, "geometries", "femur_stem.toml"))
@@ -67,11 +78,15 @@ def main() -> int:
     for order in ((2, 3, 4) if args.quick else (2, 3, 4, 5)):
         runs.append(("p", h0, hi0, order))
     fine = min(factors)
-    ref = peaks(sc, h0 * fine, hi0 * fine, 4 if args.quick else 5)
+    order_ref = 4 if args.quick else 5
+    jobs = [(sc, h0 * fine, hi0 * fine, order_ref)] + [(sc, maxh, ih, order) for _, maxh, ih, order in runs]
+    names = ["reference"] + [f"{study}: order {order}, maxh {maxh:.4g}" for study, maxh, _, order in runs]
+    with executor.use(executor.make(args.workers)) as ex:
+        ex.start()
+        ref, *solved = ex.map(member, jobs, names, label="discretizations")
     log.info("reference: %s", ref)
     rows = []
-    for study, maxh, ih, order in runs:
-        r = peaks(sc, maxh, ih, order)
+    for (study, maxh, ih, order), r in zip(runs, solved):
         r["study"] = study
         r["err_pressure"] = abs(r["peak_pressure"] / ref["peak_pressure"] - 1)
         r["err_von_mises"] = abs(r["peak_von_mises"] / ref["peak_von_mises"] - 1)

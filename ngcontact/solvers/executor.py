@@ -190,6 +190,10 @@ class Executor:
     def close(self) -> None:
         """Release the workers (nothing to release here)."""
 
+    def abort(self) -> None:
+        """Stop the workers at once (the run failed or was interrupted)."""
+        self.close()
+
     def describe(self) -> dict:
         """Where the batches ran, for the report: the executor, its workers (one NGSolve thread each, a
         single member in this process), a cluster's scheduler address, and the batches it ran."""
@@ -340,6 +344,9 @@ class LocalPool(Executor):
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
 
+    def abort(self) -> None:
+        self._discard()
+
 
 _STARTED = None
 
@@ -461,6 +468,9 @@ def use(executor: Executor, progress: Progress | None = None):
     token, ptoken = _CURRENT.set(executor), _PROGRESS.set(progress)
     try:
         yield executor
+    except BaseException:
+        executor.abort()                 # an error or Ctrl-C: stop the workers now, even idle or warming up
+        raise
     finally:
         _CURRENT.reset(token)
         _PROGRESS.reset(ptoken)

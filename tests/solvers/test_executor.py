@@ -101,3 +101,13 @@ def test_runs_with_batches_start_their_workers_at_once_and_others_do_not():
     for name in ("femur_stem.toml", "femur_stem_two_scale.toml", "cells/sinusoid.toml",
                  "cells/self_affine_ensemble.toml", "cells/westergaard_graded.toml"):
         assert has_batches(loader.load(os.path.join(geometries, name))) == (name in with_batches), name
+
+
+def test_a_run_that_fails_while_its_workers_start_stops_them_at_once():
+    ex = executor.LocalPool(2)
+    with pytest.raises(KeyboardInterrupt):
+        with executor.use(ex):
+            ex.start()
+            processes = list(ex._pool._processes.values())
+            raise KeyboardInterrupt
+    assert ex._pool is None and not any(p.is_alive() for p in processes)
