@@ -24,9 +24,13 @@ definite on the free dofs.  Two ways:
   like ``log(p)^2`` and mildly with the mesh (measured below).  The
   preconditioner is registered with the energy form and rebuilt from each
   step's tangent by the assembly itself.  CG stops at
-  ``|r_k| <= rtol |r_0|`` in the preconditioned norm (``rtol = 1e-10``
-  by default: Newton's own tolerance, so the steps are as exact as the
-  factorization's for the stopping rules downstream).
+  ``|r_k| <= eta |r_0|`` in the preconditioned norm: an inexact Newton
+  step, ``eta`` from the Newton residual's decrease (:func:`forcing_term`,
+  Eisenstat-Walker), never below ``rtol = 1e-10``; ``forcing = False``
+  solves every step to ``rtol``.  On the bisinusoid cell at 20.6k dofs
+  the forcing cut the CG iterations from 543 to 176 for one more Newton
+  step (9 against 8) and the solve from 62 s to 33 s (a loaded machine),
+  with the same contact fraction to 16 digits.
 * ``"auto"``: in 3D iterative from ``threshold`` free dofs on (default
   ``AUTO_THRESHOLD``), direct below; in 2D direct.  Measured with
   ``scripts/scaling_3d.py`` (2 cores): the 3D bisinusoid cell solves in
@@ -80,7 +84,9 @@ class LinearSolver:
     threshold: int = AUTO_THRESHOLD
     rtol: float = 1e-10
     max_iter: int = 2000
+    forcing: bool = True
     iterations: list[int] = field(default_factory=list)
+    tolerances: list[float] = field(default_factory=list)
     solves: int = 0
     methods: set = field(default_factory=set)
     _pre: dict = field(default_factory=dict, repr=False)
@@ -108,13 +114,16 @@ class LinearSolver:
         if id(form) not in self._pre:
             self._pre[id(form)] = ng.Preconditioner(form, "bddc")
 
-    def prepare(self, form: ng.BilinearForm, freedofs, *, symmetric: bool = True) -> "TangentSolve":
+    def prepare(self, form: ng.BilinearForm, freedofs, *, symmetric: bool = True,
+                forcing: float | None = None) -> "TangentSolve":
         """The solve with the current (assembled) ``form.mat`` on ``freedofs``: ``apply(rhs, out)``.
 
         A non-symmetric tangent (``symmetric=False``: Coulomb friction's
         coupled equations) is factorized by the policy's ``inverse`` when it
         is an LU (``LU_INVERSES``), else by UMFPACK, or solved by GMRES with
-        the same BDDC preconditioner.
+        the same BDDC preconditioner.  ``forcing``: the relative tolerance
+        of an inexact Newton step (:func:`forcing_term`) for CG, used when the
+        solver's ``forcing`` is on; never tighter than ``rtol``.
         """
         if self.method(freedofs, form.space.mesh.dim) == "direct":
             inverse = self.inverse if symmetric or self.inverse in LU_INVERSES else "umfpack"
@@ -126,7 +135,11 @@ class LinearSolver:
         from ngsolve.krylovspace import CGSolver, GMResSolver
         krylov = CGSolver if symmetric else GMResSolver
         self.methods.add("cg+bddc" if symmetric else "gmres+bddc")
-        return TangentSolve(self, krylov(form.mat, pre.mat, tol=self.rtol, maxiter=self.max_iter,
+        tol = self.rtol
+        if symmetric and self.forcing and forcing is not None:
+            tol = max(self.rtol, forcing)
+        self.tolerances.append(tol)
+        return TangentSolve(self, krylov(form.mat, pre.mat, tol=tol, maxiter=self.max_iter,
                                          printrates=False), counted=True)
 
     def summary(self) -> dict:
@@ -136,8 +149,42 @@ class LinearSolver:
             out["threshold"] = self.threshold
         out["method"] = ", ".join(sorted(self.methods)) or f"direct ({self.inverse})"
         if self.iterations:
-            out.update(cg_iterations=list(self.iterations), cg_rtol=self.rtol)
+            out.update(cg_iterations=list(self.iterations), cg_rtol=self.rtol,
+                       krylov_tolerances=list(self.tolerances), inexact_newton=self.forcing)
         return out
+
+
+#: Eisenstat-Walker (choice 2) constants of :func:`forcing_term`: ``eta = GAMMA (|r_k| / |r_k-1|)^2``,
+#: at most ``ETA_MAX``
+EW_GAMMA, ETA_MAX = 0.9, 1e-2
+
+
+def forcing_term(rnorm: float, previous: float | None, eta_previous: float | None, target: float) -> float:
+    """Relative tolerance of the Krylov solve of an inexact Newton step (Eisenstat and Walker, choice 2).
+
+    A Newton step needs its linear system solved only as far as the
+    nonlinear residual will fall: with ``|r_k|`` now and ``|r_k-1|`` before,
+
+        eta_k = GAMMA (|r_k| / |r_k-1|)^2,
+
+    kept above ``GAMMA eta_k-1^2`` when that is above 0.1 (no sudden
+    tightening), at most ``ETA_MAX`` (the first step and slow phases: two
+    digits), and at least ``target / (2 |r_k|)``, since the Newton loop
+    stops at ``|r| <= target`` (no over-solving of the last step).  Far
+    from the solution most CG iterations of a fixed ``rtol = 1e-10`` buy
+    digits the next Newton step discards; near it the quadratic decrease
+    makes ``eta`` small and the steps exact, so the Newton iteration stays
+    superlinear.
+    """
+    if previous is None or eta_previous is None or not previous > 0:
+        eta = ETA_MAX
+    else:
+        eta = EW_GAMMA * (rnorm / previous) ** 2
+        safeguard = EW_GAMMA * eta_previous ** 2
+        if safeguard > 0.1:
+            eta = max(eta, safeguard)
+    eta = min(eta, ETA_MAX)
+    return max(eta, 0.5 * target / rnorm) if rnorm > 0 else eta
 
 
 class TangentSolve:

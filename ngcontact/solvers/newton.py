@@ -56,7 +56,7 @@ from dataclasses import dataclass, field
 import ngsolve as ng
 
 from ngcontact.errors import ConvergenceError
-from ngcontact.solvers.linear_solver import LinearSolver
+from ngcontact.solvers.linear_solver import LinearSolver, forcing_term
 
 log = logging.getLogger(__name__)
 
@@ -199,6 +199,7 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
     if quadratic:
         return _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol, atol, fixed)
     floor0 = None
+    previous, eta = None, None
     for it in range(1, max_iter + 1):
         form.AssembleLinearization(gfu.vec)
         floor = roundoff_floor(form.mat, gfu.vec, fixed)
@@ -207,7 +208,9 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
             log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             return hist
-        linear.prepare(form, freedofs).apply(res, du)
+        eta = forcing_term(rnorm, previous, eta, max(rtol * r0, atol))
+        previous = rnorm
+        linear.prepare(form, freedofs, forcing=eta).apply(res, du)
         slope = ng.InnerProduct(du, res)
         if not math.isfinite(slope):
             raise ConvergenceError(f"Newton step {it}: the tangent solve gave non-finite values", hist.as_dict())

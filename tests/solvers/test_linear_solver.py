@@ -64,6 +64,35 @@ def test_a_3d_cell_solved_iteratively_equals_the_direct_solve():
     assert np.linalg.norm(ub - ua) <= 1e-7 * np.linalg.norm(ua)
 
 
+def test_inexact_newton_reaches_the_same_cell_state_with_fewer_cg_iterations():
+    """Eisenstat-Walker forcing against a fixed CG tolerance of 1e-10: the same state to Newton's tolerance."""
+    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.scene.loader import load
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    out = {}
+    for forcing in (False, True):
+        P = CellProblem(build_cell(scene, maxh=0.6, interface_maxh=0.2), model_of(scene),
+                        linear=LinearSolver("iterative", forcing=forcing))
+        sol = P.solve(cell_loads(scene)[0], first=True, measure=False)
+        out[forcing] = (sol, P.gfu.vec.FV().NumPy().copy(), P.linear)
+    (exact, u_exact, lin_exact), (inexact, u_inexact, lin_inexact) = out[False], out[True]
+    assert sum(lin_inexact.iterations) < 0.75 * sum(lin_exact.iterations)
+    assert max(lin_inexact.tolerances) <= 1e-2 and min(lin_exact.tolerances) == max(lin_exact.tolerances) == 1e-10
+    assert lin_inexact.summary()["inexact_newton"] and len(lin_inexact.summary()["krylov_tolerances"]) > 0
+    assert inexact.results["contact_fraction"] == pytest.approx(exact.results["contact_fraction"], rel=1e-9)
+    assert np.linalg.norm(u_inexact - u_exact) <= 1e-7 * np.linalg.norm(u_exact)
+    assert inexact.iterations <= exact.iterations + 2
+
+
+def test_the_forcing_term_follows_the_residual_and_never_over_solves():
+    from ngcontact.solvers.linear_solver import ETA_MAX, forcing_term
+    assert forcing_term(1.0, None, None, 1e-10) == ETA_MAX                  # first step: two digits
+    assert forcing_term(1e-3, 1.0, ETA_MAX, 1e-12) == pytest.approx(0.9e-6)  # quadratic phase: tight
+    assert forcing_term(0.9, 1.0, ETA_MAX, 1e-12) == ETA_MAX                # slow phase: capped
+    assert forcing_term(1e-9, 1e-5, 1e-3, 1e-10) == pytest.approx(0.05)     # the last step: to the target only
+
+
 CELL = os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml")
 
 
