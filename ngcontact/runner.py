@@ -64,35 +64,37 @@ def threads(n: int):
         yield
 
 
-def batches(scene, workers: int | None = None, scheduler: str | None = None, progress=None):
+def batches(scene, workers: int | None = None, scheduler: str | None = None, progress=None,
+            start: bool | None = None):
     """Context in which the run's batches of independent solves go to their executor.
 
     The command line's ``workers`` / ``scheduler`` first, then the scene's
     ``[compute]`` section; default: a pool of local processes, one per core
     (:func:`ngcontact.solvers.executor.make`).  The workers are started at
-    once when the scene will have a batch (:func:`has_batches`), so that
-    their start overlaps with the run's own preparation; otherwise only if a
-    batch comes.
+    once when the run will have a batch (``start``; default
+    :func:`has_batches`), so that their start overlaps with the run's own
+    preparation; otherwise only if a batch comes.
     """
     from ngcontact.solvers import executor
     compute = getattr(scene, "compute", None)
     if scheduler is None and workers is None and compute is not None:
         scheduler, workers = compute.scheduler, compute.workers
     ex = executor.make(workers, scheduler)
-    if has_batches(scene):
+    if has_batches(scene) if start is None else start:
         ex.start()
     return executor.use(ex, progress)
 
 
 def has_batches(scene) -> bool:
-    """Whether solving ``scene`` runs a batch of independent solves: an ensemble, a cell's independent loads
-    (without refinement to a tolerance), the levels of a convergence study or of an epsilon study."""
+    """Whether :func:`solve` runs a batch of independent solves for ``scene``: an ensemble, a cell's
+    independent loads (without refinement to a tolerance), the levels of a convergence study.  (The levels
+    of an epsilon study are a batch of :func:`study_epsilon`; ``solve`` of that scene is one resolved solve.)"""
     if scene.kind == "manufactured":
         return len(scene.manufactured.orders) * scene.manufactured.levels > 1
     if scene.kind == "cell":
         independent = scene.load.independent and scene.discretization.tolerance is None
         return getattr(scene, "ensemble", None) is not None or (independent and not scene.contact.geometric_only)
-    return scene.kind == "direct" and getattr(scene, "study", None) is not None
+    return False
 
 
 def check(scene) -> None:
@@ -174,7 +176,7 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
         raise SceneError("kind", scene.kind, "the epsilon study needs a 'direct' scene with a [study] section")
     n = thread_count()
     clock = Clock(progress)
-    with threads(n), batches(scene, workers, scheduler, batch_progress) as ex:
+    with threads(n), batches(scene, workers, scheduler, batch_progress, start=True) as ex:
         from ngcontact.drivers.study_epsilon import run_study
         outcome = run_study(scene, periods, clock=clock)
     report = build_report(kind="direct-epsilon-study", title=scene.title, scene=loader.as_dict(scene),

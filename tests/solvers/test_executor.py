@@ -97,9 +97,10 @@ def test_runs_with_batches_start_their_workers_at_once_and_others_do_not():
     from ngcontact.scene import loader
     import os
     geometries = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(__file__))), "geometries")
-    with_batches = {"cells/self_affine_ensemble.toml"}
+    with_batches = {"cells/self_affine_ensemble.toml", "verify_elasticity.toml"}
     for name in ("femur_stem.toml", "femur_stem_two_scale.toml", "cells/sinusoid.toml",
-                 "cells/self_affine_ensemble.toml", "cells/westergaard_graded.toml"):
+                 "cells/self_affine_ensemble.toml", "cells/westergaard_graded.toml",
+                 "direct/block_rect_valleys.toml", "verify_elasticity.toml"):
         assert has_batches(loader.load(os.path.join(geometries, name))) == (name in with_batches), name
 
 
