@@ -290,3 +290,23 @@ def test_the_levels_of_a_convergence_study_are_a_batch_and_two_workers_give_the_
     error = finest["error"]
     l2 = ng.sqrt(ng.Integrate(ng.InnerProduct(error, error), outcome.vtk["finest"].mesh, order=2 * 2 + 4))
     assert l2 == pytest.approx(report["results"]["rows"][-1]["l2"], rel=1e-8)
+
+
+def test_a_dask_cluster_fills_a_two_scale_cell_table_with_the_serial_numbers(cluster, tmp_path, monkeypatch):
+    """The table levels of the two-scale loop (paper Sec. 3.5) as batches on a real LocalCluster."""
+    from ngcontact.coupling import two_scale as T
+    from ngcontact.drivers import run_two_scale as R
+    from ngcontact.solvers import executor
+    monkeypatch.setenv("NGCONTACT_THREADS", "1")
+    path = write(tmp_path, "cell.toml", FE_SWEEP.replace("shear = [0.0, 0.001, 0.002]\n", "").replace(
+        "independent = true\n", ""))
+    tables = {}
+    for name, ex in (("serial", executor.Serial()), ("dask", executor.DaskCluster(cluster))):
+        with executor.use(ex):
+            table = T.CellTable(R.PressureSolve(path, 1.0), tol=0.02, map_tasks=R.executor_map)
+            assert table.cover(0.002, 0.02)
+            tables[name] = (table.as_dict(), ex.describe())
+    (serial, _), (dask, where) = tables["serial"], tables["dask"]
+    assert serial["cell_solves"] == dask["cell_solves"] >= 7            # five start nodes and a level of midpoints
+    assert [b["label"] for b in where["batches"]][:2] == ["cell table level"] * 2
+    assert_same(dask, serial)
