@@ -7,8 +7,10 @@ load is a member of the batch (:mod:`ngcontact.drivers.cell_members`) that
 meshes and solves its own cell.  Each run is the command a user types,
 ``ngcontact run SCENE --out DIR --quiet`` in a fresh interpreter, with
 
-* ``--workers 1``: the serial executor, in the run's process (NGSolve's task
-  manager on every core, as a run without a batch);
+* ``--workers 1`` with ``NGCONTACT_THREADS=1``: one worker on one thread, the
+  reference of the speedups (a worker of the pool runs one NGSolve thread);
+* ``--workers 1``: the serial executor in the run's process with NGSolve's
+  task manager on every core (what a run without a batch uses);
 * ``--workers 2``: a local pool of two spawned workers, one NGSolve thread
   each, started when the run begins (their interpreter start and imports
   overlap with the run's own mesh and setup);
@@ -19,9 +21,9 @@ meshes and solves its own cell.  Each run is the command a user types,
 
 Each configuration runs ``REPEATS`` times; reported per run: the command's
 wall time, the batch's wall time (``report.json`` ``compute.batches``), the
-speedups of both over ``--workers 1`` (the first repeat of each against the
-first of ``--workers 1``, and so on), and the largest relative difference of
-any number in ``results.loads`` from the first ``--workers 1`` run (the
+speedups of both over the one-thread ``--workers 1`` run of the same repeat,
+and the largest relative difference of any number in ``results.loads`` from
+the first one-thread run (the
 effective stiffness, a difference of compliances that loses digits to
 cancellation, separately; its spread between two serial runs is reported
 too).  The scheduler's overhead per task: the wall time of 200 no-op members
@@ -78,10 +80,14 @@ NOOP_TASKS = 200
 REPEATS = 2
 
 
-def run(path: str, out: str, *flags: str) -> tuple[float, dict]:
+def run(path: str, out: str, *flags: str, threads: int | None = None) -> tuple[float, dict]:
     """``ngcontact run path --out out --quiet flags`` in a fresh interpreter: (wall seconds, report)."""
+    env = dict(os.environ)
+    if threads is not None:
+        env["NGCONTACT_THREADS"] = str(threads)
     t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "ngcontact", "run", path, "--out", out, "--quiet", *flags], check=True)
+    subprocess.run([sys.executable, "-m", "ngcontact", "run", path, "--out", out, "--quiet", *flags], check=True,
+                   env=env)
     wall = time.perf_counter() - t0
     with open(os.path.join(out, "report.json")) as fh:
         return wall, json.load(fh)
@@ -131,13 +137,14 @@ def main() -> None:
         path = os.path.join(tmp, "scale_out.toml")
         with open(path, "w") as fh:
             fh.write(SCENE.format(loads=", ".join(f"{p:.6g}" for p in LOADS)))
-        configs = [("workers 1", ("--workers", "1")), ("local 2", ("--workers", "2")),
-                   ("dask 2", ("--scheduler", cluster.scheduler_address))]
+        configs = [("1 worker", ("--workers", "1"), 1), ("serial 2 threads", ("--workers", "1"), None),
+                   ("local 2", ("--workers", "2"), None), ("dask 2", ("--scheduler", cluster.scheduler_address), None)]
         base: list[tuple[float, dict]] = []
         for repeat in range(REPEATS):
-            for name, flags in configs:
-                wall, report = run(path, os.path.join(tmp, f"{name}_{repeat}".replace(" ", "_")), *flags)
-                if name == "workers 1":
+            for name, flags, threads in configs:
+                wall, report = run(path, os.path.join(tmp, f"{name}_{repeat}".replace(" ", "_")), *flags,
+                                   threads=threads)
+                if name == "1 worker":
                     base.append((wall, report))
                 ref_wall, ref = base[repeat]
                 label = name if name != "dask 2" else ("dask cold" if repeat == 0 else "dask warm")
@@ -192,8 +199,8 @@ def write(out: str, rows: list[dict], per_solve: float) -> None:
         ax[0].text(i + 0.2, r["batch"], f"x{r['batch_speedup']:.2f}", ha="center", va="bottom", fontsize=7)
     ax[0].set_xticks(x, names, rotation=30, ha="right", fontsize=8)
     ax[0].set_ylabel("wall time [s]")
-    ax[0].set_title(f"16 independent cell solves ({per_solve:.2f} s each serially); batch speedup over "
-                    "--workers 1", fontsize=8)
+    ax[0].set_title(f"16 independent cell solves ({per_solve:.2f} s each on one thread); batch speedup over "
+                    "one worker", fontsize=8)
     ax[0].legend(fontsize=8)
     execs = ["serial", "local", "dask"]
     per = {r["executor"]: r["overhead_percent_of_solve"] for r in rows}
