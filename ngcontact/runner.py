@@ -64,6 +64,11 @@ def threads(n: int):
         yield
 
 
+#: What the members of every batch import (the scene translator and through it the model code): a worker
+#: started early imports them while this process prepares its batch.
+WORKER_MODULES = ("ngsolve", "ngcontact.drivers.build")
+
+
 def batches(scene, workers: int | None = None, scheduler: str | None = None, progress=None,
             start: bool | None = None):
     """Context in which the run's batches of independent solves go to their executor.
@@ -81,7 +86,7 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
         scheduler, workers = compute.scheduler, compute.workers
     ex = executor.make(workers, scheduler)
     if has_batches(scene) if start is None else start:
-        ex.start()
+        ex.start(WORKER_MODULES)
     return executor.use(ex, progress)
 
 

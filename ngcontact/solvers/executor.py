@@ -184,8 +184,11 @@ class Executor:
                 progress(label, k + 1, len(items))
         return out
 
-    def start(self) -> None:
-        """Get the workers ready now, while this process prepares the batch (nothing to do here)."""
+    def start(self, modules: Sequence[str] = ()) -> None:
+        """Get the workers ready now, while this process prepares the batch (nothing to do here).
+
+        ``modules``: what the members will import, imported by each worker as it starts.
+        """
 
     def close(self) -> None:
         """Release the workers (nothing to release here)."""
@@ -230,8 +233,8 @@ class LocalPool(Executor):
                                          initargs=(self._started,))
         return self._pool
 
-    def start(self) -> None:
-        """Spawn every worker now and let it import the model code (NGSolve, the drivers' common imports).
+    def start(self, modules: Sequence[str] = ()) -> None:
+        """Spawn every worker now and let it import ``modules`` (what its members will need).
 
         A worker is a fresh interpreter: its start and imports take about a
         second, which the batch would otherwise wait for.  Called when a run
@@ -244,7 +247,7 @@ class LocalPool(Executor):
             return
         pool = self._start()
         for _ in range(self.workers):
-            pool.submit(_warm_up)
+            pool.submit(_warm_up, tuple(modules))
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         if len(items) == 1:
@@ -357,13 +360,9 @@ def _worker_start(started) -> None:
     _one_thread(ignore_sigint=True)
 
 
-#: What every member needs: imported by a worker while it waits for its first member.
-WARM_UP_MODULES = ("ngsolve", "ngcontact.drivers.build")
-
-
-def _warm_up() -> None:
+def _warm_up(modules: tuple[str, ...]) -> None:
     import importlib
-    for module in WARM_UP_MODULES:
+    for module in modules:
         importlib.import_module(module)
 
 
@@ -398,7 +397,7 @@ class DaskCluster(Executor):
             self.workers = max(1, sum(w.get("nthreads", 1) for w in info))
         return self._client
 
-    def start(self) -> None:
+    def start(self, modules: Sequence[str] = ()) -> None:
         """Connect to the scheduler now: an address that does not answer fails before any solve."""
         self.client  # noqa: B018 - the property connects
 
