@@ -24,7 +24,8 @@ over the sizes.
 
 Usage::
 
-    python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000]
+    python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral]
+                                 [--solvers iterative direct]
 
 Writes ``scaling_3d.csv`` and ``scaling_3d.png`` into ``OUT_DIR`` (default
 ``results/scaling_3d``) and logs the tables and the fitted exponents.
@@ -125,13 +126,15 @@ def run_child(part: str, size: float, policy: str) -> dict | None:
     return row
 
 
-def fe_parts(quick: bool, direct_max: int) -> list[dict]:
+def fe_parts(quick: bool, direct_max: int, parts=("cell", "macro"), solvers=("iterative", "direct")) -> list[dict]:
     rows = []
     ladders = (("cell", QUICK_CELL if quick else CELL_SIZES), ("macro", QUICK_MACRO if quick else MACRO_SIZES))
     for part, sizes in ladders:
+        if part not in parts:
+            continue
         direct_on = True
         for size in sizes:
-            for policy in ("iterative", "direct"):
+            for policy in solvers:
                 if policy == "direct" and not direct_on:
                     continue
                 row = run_child(part, size, policy)
@@ -238,9 +241,15 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="two small sizes of each part (a smoke run)")
     ap.add_argument("--direct-max", type=int, default=45000,
                     help="no direct solves beyond the first size above this many dofs")
+    ap.add_argument("--parts", nargs="+", choices=("cell", "macro", "spectral"), default=("cell", "macro", "spectral"),
+                    help="which of the three measurements to run (default: all)")
+    ap.add_argument("--solvers", nargs="+", choices=("iterative", "direct"), default=("iterative", "direct"),
+                    help="which linear solvers of parts 1 and 2 to run (default: both)")
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    rows = fe_parts(args.quick, args.direct_max) + spectral_aim(args.quick)
+    rows = fe_parts(args.quick, args.direct_max, args.parts, args.solvers)
+    if "spectral" in args.parts:
+        rows += spectral_aim(args.quick)
     os.makedirs(args.out, exist_ok=True)
     write_csv(os.path.join(args.out, "scaling_3d.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
     plot(rows, os.path.join(args.out, "scaling_3d.png"))
