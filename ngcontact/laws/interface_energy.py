@@ -58,11 +58,13 @@ import numpy as np
 from ngcontact.errors import ModelError
 from ngcontact.laws.homogenized import (
     BundleLaw,
+    CellShear,
     Friction,
     InterfaceLaw,
     LinearLaw,
     NormalLaw,
     TabulatedLaw,
+    Tangential,
 )
 from ngcontact.laws.huber import huber_of_square, huber_slope, is_numeric
 
@@ -175,20 +177,54 @@ def pressure(law: NormalLaw, a, g0=0.0):
     return normal_traction(law, a, g0)[0]
 
 
-def friction_energy(friction: Friction, a, G):
-    """``G huber(|a_t|, w)`` with the threshold field ``G`` given."""
+def friction_energy(friction: Tangential, a, G):
+    """``G huber(|a_t|, w)`` with the threshold field ``G`` given; for a :class:`CellShear`,
+    ``W_t(a; p)`` with the frozen pressure ``p = G`` (:func:`threshold`)."""
+    if isinstance(friction, CellShear):
+        _check_cell_shear(a)
+        return sum(phi * e for phi, e in _cell_shear_rows(friction, a[1], G, energy=True))
     return G * huber_of_square(_tangential_norm2(a), friction.width)
 
 
-def friction_traction(friction: Friction, a, G) -> list:
+def friction_traction(friction: Tangential, a, G) -> list:
     """``d/da`` of :func:`friction_energy` (``G`` frozen)."""
+    if isinstance(friction, CellShear):
+        _check_cell_shear(a)
+        return [0.0 * a[0], sum(phi * t for phi, t in _cell_shear_rows(friction, a[1], G, energy=False))]
     f = G * huber_slope(_tangential_norm2(a), friction.width)
     return [0.0 * a[0]] + [f * ai for ai in a[1:]]
 
 
-def threshold(friction: Friction, p):
-    """``G = mu [p]_+ + G0`` for a pressure ``p``."""
+def threshold(friction: Tangential, p):
+    """``G = mu [p]_+ + G0`` for a pressure ``p``; a :class:`CellShear` depends on ``p`` itself."""
+    if isinstance(friction, CellShear):
+        return p
     return friction.mu * _ramp(p) + friction.threshold
+
+
+def _cell_shear_rows(shear: CellShear, s, p, energy: bool):
+    """``(phi_i(p), E_i(s) or T_i(s))`` of the rows ``i >= 1`` of a :class:`CellShear` (row 0 is zero).
+
+    ``T_i(s) = sum_k e_k ([s - s_k]_+ - [-s - s_k]_+)`` (odd), ``E_i(s) =
+    sum_k e_k/2 ([s - s_k]_+^2 + [-s - s_k]_+^2)``; ``phi_i(p) = sum_k d_ik
+    [p - p_k]_+`` (zero at and below ``p_0 = 0`` for ``i >= 1``).
+    """
+    kinks, d = shear.hats()
+    for i in range(1, len(kinks)):
+        phi = sum(float(dk) * _ramp(p - float(pk)) for pk, dk in zip(kinks, d[i]) if dk != 0)
+        sk, ek = shear.ramps(i)
+        if energy:
+            f = sum(0.5 * float(e) * (_ramp(s - float(k)) ** 2 + _ramp(-s - float(k)) ** 2)
+                    for k, e in zip(sk, ek) if e != 0)
+        else:
+            f = sum(float(e) * (_ramp(s - float(k)) - _ramp(-s - float(k))) for k, e in zip(sk, ek) if e != 0)
+        yield phi, f
+
+
+def _check_cell_shear(a) -> None:
+    if len(a) != 2:
+        raise ModelError("a tabulated cell shear (CellShear) needs a 2D or axisymmetric interface frame "
+                         f"(one tangent); this frame has {len(a) - 1}")
 
 
 def energy(law: InterfaceLaw, a, g0=0.0, G=None):
@@ -197,7 +233,7 @@ def energy(law: InterfaceLaw, a, g0=0.0, G=None):
     W = normal_energy(law.normal, a, g0)
     if law.friction is not None:
         if G is None:
-            G = law.friction.threshold
+            G = threshold(law.friction, 0.0)
         W = W + friction_energy(law.friction, a, G)
     return W
 
@@ -207,7 +243,7 @@ def traction(law: InterfaceLaw, a, g0=0.0, G=None) -> list:
     tau = normal_traction(law.normal, a, g0)
     if law.friction is not None:
         if G is None:
-            G = law.friction.threshold
+            G = threshold(law.friction, 0.0)
         ft = friction_traction(law.friction, a, G)
         tau = [t + f for t, f in zip(tau, ft)]
     return tau

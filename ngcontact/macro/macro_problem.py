@@ -336,6 +336,8 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
                                           frozen=frozen_tresca(problem, fes, frame, gfu), **newton)],
                 "widths": []}
     except ConvergenceError as err:
+        if not isinstance(friction, il.Friction):   # a tabulated cell shear has no Huber width to continue in
+            raise
         log.info("coupled Newton at the scene's Huber width failed (%s); continuation in the width", err)
         gfu.vec.data = start
         failed = [{**err.history, "failed": True}] if isinstance(err.history, dict) else []
