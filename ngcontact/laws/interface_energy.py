@@ -59,7 +59,6 @@ from ngcontact.errors import ModelError
 from ngcontact.laws.homogenized import (
     BundleLaw,
     CellShear,
-    Friction,
     InterfaceLaw,
     LinearLaw,
     NormalLaw,

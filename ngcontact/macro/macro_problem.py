@@ -302,7 +302,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
         history["coulomb_iterations"] = fixed["coulomb_iterations"]
     else:
         if law.friction is not None:
-            G = ng.CF(law.friction.threshold)
+            G = ng.CF(ie.threshold(law.friction, 0.0))
         form = _form(problem, fes, frame, G=G)
         history["newton"].append(minimize(form, gfu, quadratic=law.quadratic, **newton).as_dict())
     history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
