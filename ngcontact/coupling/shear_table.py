@@ -157,8 +157,10 @@ class ShearTable:
 
     # ------------------------------------------------------------ one row
     def _plateaued(self, p: float) -> bool:
-        d, _, t = self.row(p)
-        return len(d) >= 3 and abs(t[-1] - t[-2]) <= self.tol * self._row_scale(p) and d[-1] >= 1.99 * d[-2]
+        """The row's shear changed by at most ``tol`` over the last doubling of the far-face jump."""
+        r = self.rows[p]
+        last = max(r)
+        return last > 0 and 0.5 * last in r and abs(r[last][1] - r[0.5 * last][1]) <= self.tol * self._row_scale(p)
 
     def _build(self, pressures: Sequence[float], s_hi: float) -> None:
         """Start, extend and refine the rows at ``pressures`` (all rows' solves of a level together)."""
