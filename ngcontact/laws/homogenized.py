@@ -53,6 +53,12 @@ Laws (frozen dataclasses, values only; their energy ``W(a)`` and traction
     point on the pressure (``G`` frozen at the previous solution's ``p``), see
     there.  The friction energy of
     :mod:`ngcontact.laws.interface_energy` takes ``G`` as given.
+:class:`CellShear`
+    In place of :class:`Friction`: the cell's own tangential response, rows
+    of shear against tangential jump tabulated at a set of pressures
+    (:mod:`ngcontact.coupling.shear_table`), interpolated linearly in both;
+    like Coulomb's threshold it depends on the current pressure, and its
+    energy is that of the frozen pressure.
 """
 from __future__ import annotations
 

@@ -43,6 +43,13 @@ and :func:`friction_traction`::
     W_f(a) = G huber(|a_t|, w)
     tau_f  = (0,  G a_t / max(|a_t|, w))            (G held fixed)
 
+The cell's tabulated shear :class:`CellShear` (rows ``T_i(s)`` at pressures
+``p_i``, hats ``phi_i`` in ``p``) in place of the Huber friction, with the
+frozen pressure ``p`` in the place of ``G``::
+
+    W_t(a; p) = sum_i phi_i(p) E_i(a_t),   E_i(s) = int_0^|s| T_i
+    tau_t     = sum_i phi_i(p) T_i(a_t)
+
 Total (the interface integrand of eq. 44), :func:`energy` and
 :func:`traction`: ``W = W_normal + W_f`` and ``tau = tau_normal + tau_f``,
 with ``G = G0`` unless a threshold field is given.
