@@ -23,11 +23,14 @@ Error control, as the pressure table's (:class:`ngcontact.coupling.two_scale.Cel
 
 * in the jump, per row: every interval of ``Delta`` is checked at its
   midpoint and halved while ``|tau_mid - T_row(s_mid)| / max_row |tau| >
-  tol``; the checked midpoints become nodes;
+  tol``; the checked midpoints become nodes; an interval whose ends carry
+  the same shear on a row whose shear never decreases is flat and not
+  checked (the sliding plateau);
 * in the pressure: every interval of pressures is checked by a row at its
   midpoint, halved while ``max_j |tau_mid,j - T(p_mid, s_mid,j)| /
-  max |tau| > tol`` (``T`` the interpolation of the two outer rows at the
-  middle row's jumps); the checked rows become rows.
+  max |tau| > tol`` (``T`` the law's interpolation of the two outer rows,
+  along the rays ``s / p = const``, at the middle row's jumps); the checked
+  rows become rows.
 
 The largest accepted discrepancies are the reported error estimates.  The
 rows cover the jumps ``[0, s_hi]`` asked for (the macro interface's, with
@@ -180,9 +183,11 @@ class ShearTable:
                      if not (a in old[p] and b in old[p])]
         while intervals:
             mids = [(p, 0.5 * (a + b)) for p, a, b in intervals]
-            self._solve(mids)
+            self._solve([pm for pm, (p, a, b) in zip(mids, intervals) if not self._flat(p, a, b)])
             nxt = []
             for (p, a, b), (_, m) in zip(intervals, mids):
+                if m not in self.rows[p]:     # a flat interval of a monotone row: not solved (see _flat)
+                    continue
                 r = self.rows[p]
                 (sa, ta), (sb, tb), (sm, tm) = r[a], r[b], r[m]
                 guess = ta + (tb - ta) * (sm - sa) / (sb - sa) if sb != sa else tb
@@ -192,6 +197,18 @@ class ShearTable:
                 else:
                     self.jump_error = max(self.jump_error, err)
             intervals = nxt
+
+    def _flat(self, p: float, a: float, b: float) -> bool:
+        """Both ends of ``[a, b]`` carry the same shear (to ``1e-3 tol``) and the row is monotone.
+
+        A shear that does not decrease with the far-face jump is constant
+        between two equal values, and the polyline is exact there: the
+        sliding plateau is not checked point by point.
+        """
+        _, _, t = self.row(p)
+        r = self.rows[p]
+        return bool(np.all(np.diff(t) >= -1e-9 * self._row_scale(p))) and \
+            abs(r[b][1] - r[a][1]) <= 1e-3 * self.tol * self._row_scale(p)
 
     def _check_odd(self, p: float) -> None:
         """Refuse a cell that transmits a shear at zero tangential jump (the rows are odd through 0)."""
@@ -203,22 +220,16 @@ class ShearTable:
                              "symmetric under t0 -> -t0")
 
     # ------------------------------------------------------------ cover
-    def _interp(self, p: float, s: np.ndarray) -> np.ndarray:
-        """Shear at jumps ``s >= 0`` of the pressure ``p`` interpolated between the rows (linear in p)."""
-        P = self.pressures
-        i = int(np.clip(np.searchsorted(P, p) - 1, 0, len(P) - 2))
-        lo, hi = P[i], P[i + 1]
-        f = float(np.clip((p - lo) / (hi - lo), 0.0, 1.0))
-        t_lo = np.interp(s, self.row(lo)[1], self.row(lo)[2])
-        t_hi = np.interp(s, self.row(hi)[1], self.row(hi)[2])
-        return (1 - f) * t_lo + f * t_hi
+    def along_ray(self, row: float, p: float, s: np.ndarray) -> np.ndarray:
+        """The row at ``row`` carried to the pressure ``p`` along ``s / p = const`` (as the law interpolates)."""
+        r = p / row
+        return r * np.interp(np.asarray(s) / r, self.row(row)[1], self.row(row)[2])
 
     def _triple_error(self, lo: float, m: float, hi: float) -> float:
         """Largest discrepancy of the row at ``m`` against the rows at ``lo`` and ``hi`` interpolated."""
         _, s, t = self.row(m)
         f = (m - lo) / (hi - lo)
-        guess = (1 - f) * np.interp(s, self.row(lo)[1], self.row(lo)[2]) + \
-            f * np.interp(s, self.row(hi)[1], self.row(hi)[2])
+        guess = (1 - f) * self.along_ray(lo, m, s) + f * self.along_ray(hi, m, s)
         return float(np.max(np.abs(t - guess))) / max(self._row_scale(p) for p in self.rows)
 
     def _refine_pressures(self, intervals: list[tuple[float, float]], s_hi: float) -> None:

@@ -245,11 +245,14 @@ class CellShear:
     ...`` (a polyline, odd in ``s``, held constant beyond the last jump: the
     cell slides there or the macro interface never went further); row 0 is
     zero (an open interface carries no shear).  Between rows the shear is
-    interpolated linearly in ``p`` (held at the last row above it)::
+    interpolated linearly in ``p`` along the rays ``s / p = const``, each
+    row stretched by ``r_i = p / p_i`` (so that a response homogeneous in
+    the load, as a Coulomb cell's nearly is, ``T(p, s) = p f(s / p)``, is
+    reproduced exactly; above the last row the shear grows with ``p`` that way)::
 
-        T(p, s)  = sum_i phi_i(p) T_i(s),        phi_i the piecewise-linear hats of the p_i
-        W_t(a; p) = sum_i phi_i(p) E_i(a_t),     E_i(s) = int_0^|s| T_i
-        tau_t    = dW_t/da_t = T(p, a_t)         (p frozen)
+        T(p, s)  = sum_i phi_i(p) r_i T_i(s / r_i),        phi_i the piecewise-linear hats of the p_i
+        W_t(a; p) = sum_i phi_i(p) r_i^2 E_i(a_t / r_i),   E_i(s) = int_0^|s| T_i
+        tau_t    = dW_t/da_t = T(p, a_t)                   (p frozen)
 
     Like Coulomb's threshold, the dependence on the pressure is not the
     derivative of an energy: energy, traction and tangent are consistent with

@@ -44,11 +44,12 @@ and :func:`friction_traction`::
     tau_f  = (0,  G a_t / max(|a_t|, w))            (G held fixed)
 
 The cell's tabulated shear :class:`CellShear` (rows ``T_i(s)`` at pressures
-``p_i``, hats ``phi_i`` in ``p``) in place of the Huber friction, with the
-frozen pressure ``p`` in the place of ``G``::
+``p_i``, hats ``phi_i`` in ``p``, each row stretched along the ray
+``s / p = const`` by ``r_i = p / p_i``) in place of the Huber friction, with
+the frozen pressure ``p`` in the place of ``G``::
 
-    W_t(a; p) = sum_i phi_i(p) E_i(a_t),   E_i(s) = int_0^|s| T_i
-    tau_t     = sum_i phi_i(p) T_i(a_t)
+    W_t(a; p) = sum_i phi_i(p) r_i^2 E_i(a_t / r_i),   E_i(s) = int_0^|s| T_i
+    tau_t     = sum_i phi_i(p) r_i   T_i(a_t / r_i)
 
 Total (the interface integrand of eq. 44), :func:`energy` and
 :func:`traction`: ``W = W_normal + W_f`` and ``tau = tau_normal + tau_f``,
@@ -72,7 +73,7 @@ from ngcontact.laws.homogenized import (
     TabulatedLaw,
     Tangential,
 )
-from ngcontact.laws.huber import huber_of_square, huber_slope, is_numeric
+from ngcontact.laws.huber import huber_of_square, huber_slope, if_positive, is_numeric
 
 
 # -------------------------------------------------------------- backend
@@ -209,22 +210,56 @@ def threshold(friction: Tangential, p):
 
 
 def _cell_shear_rows(shear: CellShear, s, p, energy: bool):
-    """``(phi_i(p), E_i(s) or T_i(s))`` of the rows ``i >= 1`` of a :class:`CellShear` (row 0 is zero).
+    """``(phi_i(p) r_i^k, E_i(s / r_i) or T_i(s / r_i))`` of the rows ``i >= 1`` of a :class:`CellShear`.
 
-    ``T_i(s) = sum_k e_k ([s - s_k]_+ - [-s - s_k]_+)`` (odd), ``E_i(s) =
-    sum_k e_k/2 ([s - s_k]_+^2 + [-s - s_k]_+^2)``; ``phi_i(p) = sum_k d_ik
-    [p - p_k]_+`` (zero at and below ``p_0 = 0`` for ``i >= 1``).
+    ``r_i = p / p_i`` (with ``p`` kept above ``1e-12 p_1``: for ``p <= 0``
+    every ``phi_i``, ``i >= 1``, is zero and row 0 is zero), ``k = 2`` for the
+    energy and 1 for the traction; ``T_i(x) = sum_k e_k ([x - s_k]_+ -
+    [-x - s_k]_+)`` (odd), ``E_i(x) = sum_k e_k/2 ([x - s_k]_+^2 + [-x -
+    s_k]_+^2)``; ``phi_i(p) = sum_k d_ik [p - p_k]_+``.
     """
     kinks, d = shear.hats()
+    floor = 1e-12 * float(kinks[1])
+    q = if_positive(p - floor, p, floor)
     for i in range(1, len(kinks)):
         phi = sum(float(dk) * _ramp(p - float(pk)) for pk, dk in zip(kinks, d[i]) if dk != 0)
+        r = q / float(kinks[i])
+        x = s / r
+        if not is_numeric(x):
+            T, E = _row_splines(tuple(shear.jumps[i]), tuple(shear.shears[i]))
+            yield (phi * r * r, E(x)) if energy else (phi * r, T(x))
+            continue
         sk, ek = shear.ramps(i)
         if energy:
-            f = sum(0.5 * float(e) * (_ramp(s - float(k)) ** 2 + _ramp(-s - float(k)) ** 2)
+            f = sum(0.5 * float(e) * (_ramp(x - float(k)) ** 2 + _ramp(-x - float(k)) ** 2)
                     for k, e in zip(sk, ek) if e != 0)
+            yield phi * r * r, f
         else:
-            f = sum(float(e) * (_ramp(s - float(k)) - _ramp(-s - float(k))) for k, e in zip(sk, ek) if e != 0)
-        yield phi, f
+            f = sum(float(e) * (_ramp(x - float(k)) - _ramp(-x - float(k))) for k, e in zip(sk, ek) if e != 0)
+            yield phi * r, f
+
+
+#: a row's spline is held constant out to this multiple of its last jump (the ramps: for ever)
+FAR = 1e6
+
+
+@functools.lru_cache(maxsize=256)
+def _row_splines(jumps: tuple, shears: tuple):
+    """``(T, E)`` of a :class:`CellShear` row as NGSolve B-splines (one lookup per point, not a ramp per kink).
+
+    ``T``: the odd polyline through ``(+-s_k, +-T_k)``, flat out to ``+-FAR
+    s_last``, by the table splines of :func:`_splines`; ``E(x) = E+(|x|)``
+    with ``E+`` the integral from 0 of its positive half (even, and C1 at 0
+    where ``T(0) = 0``; from 0, so no large constant cancels).
+    """
+    import ngsolve as ng
+    s, t = list(jumps), list(shears)
+    far = FAR * s[-1]
+    xs = [-far] + [-v for v in reversed(s[1:])] + s + [far]
+    ts = [-t[-1]] + [-v for v in reversed(t[1:])] + t + [t[-1]]
+    T = _splines(tuple(xs), tuple(ts))[0]
+    E_half = _splines(tuple(s + [far]), tuple(t + [t[-1]]))[1]
+    return T, lambda x: E_half(ng.IfPos(x, x, -x))
 
 
 def _check_cell_shear(a) -> None:

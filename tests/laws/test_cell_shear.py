@@ -25,13 +25,20 @@ def test_cell_shear_hits_its_rows_interpolates_in_pressure_and_is_odd():
         for s, t in zip(row_s, row_t):
             assert abs(ie.friction_traction(law, [0.0, s], p)[1] - t) <= 1e-12
             assert abs(ie.friction_traction(law, [0.0, -s], p)[1] + t) <= 1e-12
-    # halfway between the rows 1 and 2, at s = 1: the mean of the two rows' shears there
-    t1 = np.interp(1.0, law.jumps[1], law.shears[1])
-    t2 = np.interp(1.0, law.jumps[2], law.shears[2])
+    # halfway between the rows 1 and 2, at s = 1: the mean of the two rows carried along s / p = const
+    t1 = 1.5 * np.interp(1.0 / 1.5, law.jumps[1], law.shears[1])
+    t2 = 0.75 * np.interp(1.0 / 0.75, law.jumps[2], law.shears[2])
     assert abs(ie.friction_traction(law, [0.0, 1.0], 1.5)[1] - 0.5 * (t1 + t2)) <= 1e-12
-    # held beyond the last jump and above the last pressure; nothing at p <= 0
-    assert abs(ie.friction_traction(law, [0.0, 50.0], 9.0)[1] - law.shears[2][-1]) <= 1e-12
+    # held beyond the last jump, scaled with p above the last pressure; nothing at p <= 0
+    assert abs(ie.friction_traction(law, [0.0, 50.0], 9.0)[1] - 4.5 * law.shears[2][-1]) <= 1e-12
     assert ie.friction_traction(law, [0.0, 2.0], -1.0)[1] == 0.0
+    # a response homogeneous in the load, T(p, s) = p f(s / p), is reproduced between the rows
+    f = (0.0, 0.2, 0.5, 0.7)
+    x = (0.0, 0.1, 0.3, 1.0)
+    homog = il.CellShear(pressure=(0.0, 1.0, 3.0), jumps=((0.0, 1.0), x, tuple(3 * v for v in x)),
+                         shears=((0.0, 0.0), f, tuple(3 * v for v in f)))
+    for p, s in ((1.7, 0.25), (2.4, 1.9), (2.9, 0.05)):
+        assert abs(ie.friction_traction(homog, [0.0, s], p)[1] - p * np.interp(s / p, x, f)) <= 1e-12
     with pytest.raises(ModelError):
         ie.friction_traction(law, [0.0, 1.0, 0.0], 1.0)
 
@@ -114,3 +121,19 @@ def test_cell_shear_is_consistent_in_the_assembled_macro_problem():
         assert e_res <= 1e-7 and e_tan <= 1e-7, (e_res, e_tan)
         _, e_tan = _central_differences(coupled, u, v, free, energy=False)
         assert e_tan <= 1e-7, f"coupled residual vs tangent: {e_tan:.2e}"
+
+
+def test_the_coefficient_function_path_gives_the_numbers_of_the_numpy_path():
+    """The B-spline rows of the assembled law against the ramps, energy and traction, at mesh points."""
+    import ngsolve as ng
+    from netgen.geom2d import unit_square
+    mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.5))
+    law = shear_law()
+    s_cf, p_cf = 16.0 * (ng.x - 0.5), 3.0 * ng.y - 0.4      # jumps beyond both ends, pressures below 0 and above 2
+    W = ie.friction_energy(law, [0.0 * ng.x, s_cf], p_cf)
+    T = ie.friction_traction(law, [0.0 * ng.x, s_cf], p_cf)[1]
+    for x, y in ((0.1, 0.3), (0.45, 0.5), (0.52, 0.75), (0.9, 0.95), (0.7, 0.05)):
+        s, p = 16.0 * (x - 0.5), 3.0 * y - 0.4
+        mp = mesh(x, y)
+        assert abs(T(mp) - ie.friction_traction(law, [0.0, s], p)[1]) <= 1e-10, (x, y)
+        assert abs(W(mp) - ie.friction_energy(law, [0.0, s], p)) <= 1e-9 * max(1.0, abs(W(mp))), (x, y)
