@@ -174,7 +174,7 @@ def executor_map(response: Callable[[float], T.Response], pressures: Sequence[fl
 def shear_executor_map(response: Callable[[S.ShearLoad], S.ShearResponse], loads: Sequence[S.ShearLoad]
                        ) -> list[S.ShearResponse]:
     """The cell solves of one shear-table level as one batch of the run's executor."""
-    return executor.current().map(response, list(loads), [f"p = {p:.9g}, jump = {d:.9g}" for p, d in loads],
+    return executor.current().map(response, list(loads), [f"p = {p!r}, jump = {d!r}" for p, d in loads],
                                   label="shear table level")
 
 

@@ -102,3 +102,73 @@ def test_shear_keys_follow_the_cell_scene_and_differ_from_the_pressure_table(tmp
     assert key == R.shear_key(load(str(tmp_path / "c.toml")), 1.0, 0.01)
     assert key != R.table_key(scene, 1.0, 0.01) and key != R.shear_key(scene, 1.0, 0.02)
     assert key != R.shear_key(cell_scene_of(str(tmp_path / "c.toml"), key="k", overrides={"mu": 0.5}), 1.0, 0.01)
+
+
+def _synthetic_task(load):
+    return synthetic([])(load)
+
+
+def test_a_shear_level_is_one_batch_of_the_executor_and_the_task_pickles():
+    import os
+    import pickle
+
+    from ngcontact.solvers import executor
+    batches: list = []
+
+    class Recording(executor.Serial):
+        def map(self, fn, items, names, *, label="batch", progress=None):
+            batches.append((label, list(items), list(names)))
+            return super().map(fn, items, names, label=label, progress=progress)
+
+    with executor.use(Recording()):
+        table = S.ShearTable(_synthetic_task, tol=0.05, map_tasks=R.shear_executor_map)
+        table.cover(0.5, 1.0, 0.05)
+    assert batches and all(label == "shear table level" for label, _, _ in batches)
+    assert sum(len(items) for _, items, _ in batches) == table.solves - 1   # the symmetry probe is outside
+    cells = os.path.join(os.path.dirname(__file__), "..", "..", "geometries", "cells")
+    task = R.ShearSolve(os.path.join(cells, "rectangular_coulomb.toml"), 1.0, {"mu": 0.4})
+    again = pickle.loads(pickle.dumps(task))
+    assert again.path == task.path and again.overrides == {"mu": 0.4} and again._problem is None
+
+
+SAW = """kind = "cell"
+[materials.s]
+E = 1.0
+nu = 0.3
+[bodies]
+rough = "s"
+counter = "s"
+[geometry]
+profile = "triangular"
+period = 1.0
+h_rough = 1.0
+h_counter = 1.0
+angles = [20.0, 20.0]
+[contact]
+k_n = 1000.0
+friction = "coulomb"
+mu = 0.3
+w = 1e-5
+[load]
+pressure = [0.001]
+[discretization]
+order = 2
+maxh = 0.25
+interface_maxh = 0.1
+"""
+
+
+def test_a_sliding_sawtooth_cell_transmits_the_wedge_shear_with_the_signs_of_the_macro_law(tmp_path):
+    """Far beyond slip onset the cell's shear over its pressure is the rigid wedge's (tan b + mu) / (1 - mu
+    tan b); a positive far-face jump gives a positive interface jump and shear, a negative one the opposite,
+    and the interface takes less than the far faces (the bulk has its share)."""
+    import math
+    (tmp_path / "saw.toml").write_text(SAW)
+    task = R.ShearSolve(str(tmp_path / "saw.toml"), 1.0)
+    t = math.tan(math.radians(20.0))
+    wedge = (t + 0.3) / (1 - 0.3 * t)
+    for d in (0.05, -0.05):
+        r = task((1e-3, d))
+        assert r["shear"] / 1e-3 == pytest.approx(math.copysign(wedge, d), rel=1e-6), r
+        assert math.copysign(1.0, r["jump"]) == math.copysign(1.0, d) and 0 < abs(r["jump"]) < abs(d), r
+    assert abs(task((1e-3, 0.0))["shear"]) <= 1e-6 * 1e-3   # symmetric: none at zero jump (to the solver)
