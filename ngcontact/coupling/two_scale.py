@@ -368,12 +368,12 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         # without warm starts the scene's law is not solved at all
         problem = M.replace_law(problem, il.InterfaceLaw(normal=response_law(table),
                                                          friction=tangential_law(problem, shear)))
-        sol = solve(problem, start)
+        sol, start = _solve_warm_or_cold(solve, problem, start)
         macro_solves, newton = macro_solves + 1, newton + sol.history["newton_iterations"]
     p_old = MM.interface_profile(sol, points_per_element)["pressure"]
     history: list[HistoryEntry] = [{"iteration": 0, "max_pressure": float(p_old.max()), "max_change": None,
                                      "cell_solves": 0, "newton_iterations": newton, "law_changed": True,
-                                     "warm_start": given and warm,
+                                     "warm_start": given and start is not None,
                                      "start_law": ("cell table (after the scene's law)" if warm else "cell table")
                                      if given else "scene"}]
     change = float("inf")
