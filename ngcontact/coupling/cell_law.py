@@ -192,7 +192,15 @@ def friction_from_bundle(arrays: dict, *, k_n: float, law: str, mu: float = 0.0,
       ``G0 = 0`` (``mu0 = mu`` on a flat cell).
 
     The whole contact surface counts (the bundle's directions open on
-    their own, the threshold does not).  With two macro tangents (a 3D
+    their own, the threshold does not).  In 2D ``|(I - n_q n_q^T) t0| =
+    |beta_q|``, so ``mu0 = mu`` and ``G0 = G`` on every profile: the
+    roughness's own share of the macro friction is in the bundle's
+    directions (a bundle with ``mu0`` slides at ``tau / p = tan theta + mu``
+    on a sawtooth with faces at ``theta``, where the resolved interface
+    slides at the wedge's ``(tan theta + mu) / (1 - mu tan theta)``), and
+    the tabulated cell law of the two-scale loop, which has no such
+    directions, takes the cell's tabulated shear instead
+    (:mod:`ngcontact.coupling.shear_table`; ``scripts/sawtooth_shear.py``).  With two macro tangents (a 3D
     cell) the larger value is taken, the macro friction being isotropic.
     Returns ``{"mu0", "G0"}``.
     """

@@ -60,10 +60,17 @@ check) are independent; they go through the table's ``map_tasks`` callable
 which a process pool can be plugged.  The number of cell solves does not
 depend on the number of macro interface points.
 
-Scope: the table is over the pressure only.  A frictionless cell with a
-flat mean plane feels no shear; a frictional cell's response to the macro
-shear is not tabulated (the macro law carries the homogenized friction of
-:func:`ngcontact.coupling.cell_law.friction_from_bundle` instead).
+A frictionless cell with a flat mean plane feels no shear: its table is
+over the pressure only and the macro law keeps the friction it was given.
+A cell with micro friction also has a :class:`~ngcontact.coupling.shear_table.ShearTable`
+(``shear``): its rows, the shear against the tangential jump at a set of
+pressures, are made to cover the same pressures and the macro interface's
+tangential jumps (``headroom`` times the largest ``|a_t|``) at every
+update, and the macro law's tangential part is the table's
+:class:`~ngcontact.laws.homogenized.CellShear` instead of the given
+friction.  The loop then stops only where neither table grew (a change
+of the pressure below ``tol`` alone does not show that the last jumps are
+covered).
 """
 from __future__ import annotations
 
@@ -76,6 +83,7 @@ import numpy as np
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.coupling.shear_table import ShearTable
 from ngcontact.cell.measures import (
     contact_fraction,
     contact_integral,
@@ -269,6 +277,22 @@ class CouplingResult:
     history: list[HistoryEntry]
     converged: bool
     macro_solves: int
+    shear: ShearTable | None = None
+
+
+def tangential_law(problem: M.MacroProblem, shear: ShearTable | None) -> il.Tangential | None:
+    """The macro law's tangential part: the cell's tabulated shear when there is one, else the given friction."""
+    return shear.law() if shear is not None and shear.rows else problem.law.friction
+
+
+def _cover_shear(shear: ShearTable | None, sol: M.MacroSolution, lo: float, hi: float, headroom: float,
+                 points_per_element: int) -> bool:
+    """Extend the shear table to the pressures ``[lo, hi]`` and the macro interface's tangential jumps."""
+    if shear is None:
+        return False
+    jt = float(np.max(np.abs(MM.interface_profile(sol, points_per_element)["jump_t"])))
+    s_hi = headroom * jt if jt > 0 else (shear.covered_jump or 1e-12)
+    return shear.cover(lo, hi, s_hi)
 
 
 #: ``solve(problem, start)``: a macro solve, warm-started from the vector ``start`` when it is not None
@@ -279,9 +303,28 @@ def _default_solve(problem: M.MacroProblem, start=None) -> M.MacroSolution:
     return M.solve(problem, start=start)
 
 
+def _solve_warm_or_cold(solve: MacroSolve, problem: M.MacroProblem, start):
+    """``solve`` from ``start``; where a warm start fails, once more cold.
+
+    With the cell's tabulated shear, the first solve with the cell's law
+    from the start law's solution (a bundle law with ``mu0``, whose pressure
+    and slip differ widely) failed the coupled Newton's line search at its
+    first step on the sawtooth block, while the cold start converged in 10
+    steps.  Returns the solution and the start actually used.
+    """
+    if start is None:
+        return solve(problem, None), None
+    try:
+        return solve(problem, start), start
+    except ConvergenceError as err:
+        log.info("two-scale loop: the warm-started macro solve failed (%s); solving cold", err)
+        return solve(problem, None), None
+
+
 def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: int = 20,
            table_min: float = 1e-3, headroom: float = 1.25, points_per_element: int = 5,
-           solve: MacroSolve = _default_solve, warm: bool = True) -> CouplingResult:
+           solve: MacroSolve = _default_solve, warm: bool = True, shear: ShearTable | None = None
+           ) -> CouplingResult:
     """Run the coupling loop (module docstring).
 
     Parameters
@@ -305,13 +348,16 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         Macro solver ``(problem, start) -> MacroSolution``.
     warm
         Start every macro solve after the first from the previous solution.
+    shear
+        :class:`~ngcontact.coupling.shear_table.ShearTable` of a cell with
+        micro friction (filled as needed; module docstring), or ``None``.
 
     Raises
     ------
     ConvergenceError
         No convergence within ``max_iter`` updates (carries the history).
     """
-    given = len(table.values) >= 2     # a table read from a cache: its response is the start law
+    given = len(table.values) >= 2 and (shear is None or bool(shear.rows))   # read from a cache: the start law
     macro_solves, newton, start = 0, 0, None
     if warm or not given:
         sol = solve(problem, None)
@@ -320,13 +366,14 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         # the cached table's law, warm from the scene's law (the femur: 18 + 4 Newton steps, 22 cold;
         # the scene's law is the more robust start: cold, the table's law once needed a continuation);
         # without warm starts the scene's law is not solved at all
-        problem = M.replace_law(problem, il.InterfaceLaw(normal=response_law(table), friction=problem.law.friction))
-        sol = solve(problem, start)
+        problem = M.replace_law(problem, il.InterfaceLaw(normal=response_law(table),
+                                                         friction=tangential_law(problem, shear)))
+        sol, start = _solve_warm_or_cold(solve, problem, start)
         macro_solves, newton = macro_solves + 1, newton + sol.history["newton_iterations"]
     p_old = MM.interface_profile(sol, points_per_element)["pressure"]
     history: list[HistoryEntry] = [{"iteration": 0, "max_pressure": float(p_old.max()), "max_change": None,
                                      "cell_solves": 0, "newton_iterations": newton, "law_changed": True,
-                                     "warm_start": given and warm,
+                                     "warm_start": given and start is not None,
                                      "start_law": ("cell table (after the scene's law)" if warm else "cell table")
                                      if given else "scene"}]
     change = float("inf")
@@ -335,29 +382,32 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         if not p_hi > 0:
             raise ConvergenceError("two-scale loop: the macro interface carries no pressure", {"history": history})
         grew = table.cover(table_min * p_hi, headroom * p_hi)
+        grew = _cover_shear(shear, sol, table_min * p_hi, headroom * p_hi, headroom, points_per_element) or grew
         if not grew and (k > 1 or given):
-            history.append({"iteration": k, "max_pressure": p_hi, "max_change": 0.0, "cell_solves": table.solves,
+            history.append({"iteration": k, "max_pressure": p_hi, "max_change": 0.0,
+                            "cell_solves": table.solves + (shear.solves if shear is not None else 0),
                             "newton_iterations": 0, "law_changed": False, "warm_start": False})
             log.info("two-scale iteration %d: the table covers the pressures; the law is unchanged", k)
             return CouplingResult(solution=sol, table=table, history=history, converged=True,
-                                  macro_solves=macro_solves)
-        law = il.InterfaceLaw(normal=response_law(table), friction=problem.law.friction)
+                                  macro_solves=macro_solves, shear=shear)
+        law = il.InterfaceLaw(normal=response_law(table), friction=tangential_law(problem, shear))
         # warm from the previous solution, also from the scene's start law: with Coulomb friction by
         # the coupled Newton the femur's cell-law solve takes 4 steps from the start law's solution
         # against 22 cold (31, with a failed attempt and a continuation in the Huber width, before its
         # line search on the frozen Tresca energy); the Coulomb fixed point had taken 26 warm against
         # 17 cold, its first pass frozen far from either solution
         start = sol.gfu.vec if warm else None
-        sol = solve(M.replace_law(problem, law), start)
+        sol, start = _solve_warm_or_cold(solve, M.replace_law(problem, law), start)
         macro_solves += 1
         p_new = MM.interface_profile(sol, points_per_element)["pressure"]
         change = float(np.max(np.abs(p_new - p_old)))
         history.append({"iteration": k, "max_pressure": float(p_new.max()), "max_change": change,
-                        "cell_solves": table.solves, "newton_iterations": sol.history["newton_iterations"],
+                        "cell_solves": table.solves + (shear.solves if shear is not None else 0),
+                        "newton_iterations": sol.history["newton_iterations"],
                         "law_changed": True, "warm_start": start is not None})
         log.info("two-scale iteration %d: max |delta sigma_n| = %.3e (tol %.1e), %d cell solves",
                  k, change, tol, table.solves)
-        if change < tol:
+        if change < tol and shear is None:
             return CouplingResult(solution=sol, table=table, history=history, converged=True,
                                   macro_solves=macro_solves)
         p_old = p_new

@@ -15,6 +15,13 @@ on ``femur_stem_two_scale.toml`` (cold cache, 23 cell solves, a loaded
 machine): solve stage 139 s with ``--workers 1``, 88 s with 2, the same
 safety factor to 15 digits.
 
+A cell with micro friction under ``interface.friction = "from_cell"`` also
+gets its shear table (:mod:`ngcontact.coupling.shear_table`): the macro
+law's tangential part is then the cell's tabulated shear instead of the
+``mu0`` of eqs. 42-43 (which only starts the loop); its cell solves go
+through the same executor (:class:`ShearSolve` tasks) and it is cached the
+same way under its own key.
+
 ``results["two_scale"]``: ``converged``, ``iterations`` (law updates),
 ``macro_solves``, ``cell_solves`` (cell problems solved in this run),
 ``history`` (per iteration the largest macro pressure [Pa], ``max_change``
@@ -26,7 +33,11 @@ solve was warm-started), ``newton_per_solve``, ``tolerance`` [Pa],
 relative midpoint discrepancy accepted, ``nodes``), ``cache`` (key, whether
 the table came from it, its path), ``law`` (the macro law: the cell's
 tabulated response), ``cell`` (scene, ndof, overrides) and the coefficient
-profile along the interface (``contact_fraction``, ``k_n0``).
+profile along the interface (``contact_fraction``, ``k_n0``); with a shear
+table also ``shear_table`` (rows, nodes, cell solves, the error estimates
+in the jump and in the pressure, the rows themselves: far-face jump [cell
+units], interface jump [m], shear [Pa]) and its ``cache`` entry, and
+``cell_solves`` counts both tables' solves.
 """
 from __future__ import annotations
 
@@ -37,6 +48,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from ngcontact.coupling import cell_law
+from ngcontact.coupling import shear_table as S
 from ngcontact.coupling import two_scale as T
 from ngcontact.macro.macro_measures import interface_profile
 from ngcontact.scene import cell_links
@@ -67,6 +79,54 @@ class PressureSolve:
 
     def __call__(self, pressure: float) -> T.Response:
         return T.cell_response(self.problem(), pressure, self.length_unit)
+
+
+class ShearSolve(PressureSolve):
+    """``(p, Delta) -> cell shear response`` of one cell scene; picklable like :class:`PressureSolve`."""
+
+    def __call__(self, load) -> S.ShearResponse:  # type: ignore[override]
+        return S.cell_shear_response(self.problem(), load[0], load[1], self.length_unit)
+
+
+SHEAR_FORMAT = "cell-shear-table-1"
+SHEAR_ARRAYS = ("row_pressure", "far_face_jump", "jump", "shear", "errors", "checked")
+
+
+def shear_key(cell_scene, length_unit: float, tol: float) -> str:
+    """Cache key of a cell's shear table (another format than the pressure table's, same inputs)."""
+    from ngcontact.drivers.build import cell_key
+    return hashlib.sha256(f"{SHEAR_FORMAT}|{cell_key(cell_scene)}|{length_unit!r}|{tol!r}".encode()).hexdigest()
+
+
+def _shear_shapes(arrays: dict) -> str | None:
+    n = arrays["row_pressure"].shape
+    if len(n) != 1 or any(arrays[k].shape != n for k in ("far_face_jump", "jump", "shear")) or \
+            arrays["errors"].shape != (3,) or arrays["checked"].ndim != 2 or arrays["checked"].shape[1] != 3:
+        return "arrays of shapes " + ", ".join(str(arrays[k].shape) for k in SHEAR_ARRAYS)
+    return None
+
+
+def cached_shear(key: str, response, tol: float, length_unit: float, map_tasks, cache_dir: str | None = None
+                 ) -> tuple[S.ShearTable, bool]:
+    """A :class:`~ngcontact.coupling.shear_table.ShearTable` filled from the cache when it holds ``key``."""
+    found = cell_law.read_cached(key, SHEAR_ARRAYS, SHEAR_FORMAT, cache_dir, _shear_shapes)
+    table = S.ShearTable(response, tol=tol, length_unit=length_unit, map_tasks=map_tasks)
+    if found is None:
+        return table, False
+    for p, d, s, t in zip(*(found[k] for k in ("row_pressure", "far_face_jump", "jump", "shear"))):
+        table.rows.setdefault(float(p), {})[float(d)] = (float(s), float(t))
+    table.jump_error, table.pressure_error, table.covered_jump = (float(x) for x in found["errors"])
+    table.checked = [(float(a), float(b), float(c)) for a, b, c in found["checked"]]
+    return table, True
+
+
+def store_shear(key: str, table: S.ShearTable, cache_dir: str | None = None) -> None:
+    flat = [(p, d, s, t) for p in table.pressures for d, (s, t) in sorted(table.rows[p].items())]
+    cols = np.array(flat, float).reshape(-1, 4)
+    arrays = {"row_pressure": cols[:, 0], "far_face_jump": cols[:, 1], "jump": cols[:, 2], "shear": cols[:, 3],
+              "errors": np.array([table.jump_error, table.pressure_error, table.covered_jump]),
+              "checked": np.array(table.checked, float).reshape(-1, 3)}
+    cell_law.write_cached(key, arrays, SHEAR_ARRAYS, SHEAR_FORMAT, cache_dir)
 
 
 def table_key(cell_scene, length_unit: float, tol: float) -> str:
@@ -111,9 +171,16 @@ def executor_map(response: Callable[[float], T.Response], pressures: Sequence[fl
                                   label="cell table level")
 
 
+def shear_executor_map(response: Callable[[S.ShearLoad], S.ShearResponse], loads: Sequence[S.ShearLoad]
+                       ) -> list[S.ShearResponse]:
+    """The cell solves of one shear-table level as one batch of the run's executor."""
+    return executor.current().map(response, list(loads), [f"p = {p!r}, jump = {d!r}" for p, d in loads],
+                                  label="shear table level")
+
+
 def couple(scene, problem, solve,
            map_tasks: Callable[[Callable[[float], T.Response], Sequence[float]], list[T.Response]] = executor_map,
-           cache_dir: str | None = None, warm: bool = True):
+           cache_dir: str | None = None, warm: bool = True, shear_map=shear_executor_map):
     """Run the loop of ``scene.two_scale`` from ``problem``; returns ``(solution, results)``.
 
     ``solve(problem, start)``: the macro solve (warm-started from the
@@ -129,10 +196,17 @@ def couple(scene, problem, solve,
     task = PressureSolve(path, spec.cell_length_unit, overrides)
     key = table_key(cell_scene, spec.cell_length_unit, spec.table_tol)
     table, from_cache = cached_table(key, task, spec.table_tol, map_tasks, cache_dir)
+    shear, skey, shear_cached = None, None, False
+    if scene.interface.friction == "from_cell" and cell_scene.contact.friction != "none":
+        skey = shear_key(cell_scene, spec.cell_length_unit, spec.table_tol)
+        shear, shear_cached = cached_shear(skey, ShearSolve(path, spec.cell_length_unit, overrides), spec.table_tol,
+                                           spec.cell_length_unit, shear_map, cache_dir)
     out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
-                   points_per_element=scene.output.points_per_element, solve=solve, warm=warm)
+                   points_per_element=scene.output.points_per_element, solve=solve, warm=warm, shear=shear)
     if table.solves:
         store_table(key, table, cache_dir)
+    if shear is not None and shear.solves and skey is not None:
+        store_shear(skey, shear, cache_dir)
     p = interface_profile(out.solution, scene.output.points_per_element)["pressure"]
     coef = table(np.asarray(p))
     law = T.response_law(table)
@@ -147,4 +221,9 @@ def couple(scene, problem, solve,
            "cell": {"scene": path, "ndof": int(task.problem().ndof) if table.solves else None,
                     "overrides": overrides},
            "interface_coefficients": {"contact_fraction": coef["contact_fraction"], "k_n0": coef["k_n0"]}}
+    if shear is not None:
+        res["cell_solves"] += shear.solves
+        res["shear_table"] = shear.as_dict()
+        res["shear_table"]["cache"] = {"key": skey, "table_from_cache": shear_cached}
+        res["law"]["tangential"] = "tabulated cell shear T(p, a_t) (the cell's own friction)"
     return out.solution, res

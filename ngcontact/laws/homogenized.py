@@ -53,6 +53,12 @@ Laws (frozen dataclasses, values only; their energy ``W(a)`` and traction
     point on the pressure (``G`` frozen at the previous solution's ``p``), see
     there.  The friction energy of
     :mod:`ngcontact.laws.interface_energy` takes ``G`` as given.
+:class:`CellShear`
+    In place of :class:`Friction`: the cell's own tangential response, rows
+    of shear against tangential jump tabulated at a set of pressures
+    (:mod:`ngcontact.coupling.shear_table`), interpolated linearly in both;
+    like Coulomb's threshold it depends on the current pressure, and its
+    energy is that of the frozen pressure.
 """
 from __future__ import annotations
 
@@ -230,6 +236,84 @@ class Friction:
         return self.mu > 0
 
 
+@dataclass(frozen=True, kw_only=True)
+class CellShear:
+    """The cell's own tangential response, tabulated over pressure and tangential jump.
+
+    Rows ``i`` at pressures ``p_0 = 0 < p_1 < ...`` hold the cell's mean
+    shear ``T_i(s)`` at mean tangential interface jumps ``0 = s_i0 < s_i1 <
+    ...`` (a polyline, odd in ``s``, held constant beyond the last jump: the
+    cell slides there or the macro interface never went further); row 0 is
+    zero (an open interface carries no shear).  Between rows the shear is
+    interpolated linearly in ``p`` along the rays ``s / p = const``, each
+    row stretched by ``r_i = p / p_i`` (so that a response homogeneous in
+    the load, as a Coulomb cell's nearly is, ``T(p, s) = p f(s / p)``, is
+    reproduced exactly; above the last row the shear grows with ``p`` that way)::
+
+        T(p, s)  = sum_i phi_i(p) r_i T_i(s / r_i),        phi_i the piecewise-linear hats of the p_i
+        W_t(a; p) = sum_i phi_i(p) r_i^2 E_i(a_t / r_i),   E_i(s) = int_0^|s| T_i
+        tau_t    = dW_t/da_t = T(p, a_t)                   (p frozen)
+
+    Like Coulomb's threshold, the dependence on the pressure is not the
+    derivative of an energy: energy, traction and tangent are consistent with
+    ``p`` frozen, and the coupled Newton of the macro problem takes ``p`` at
+    the current state (:mod:`ngcontact.solvers.coulomb_newton`).  2D (and
+    axisymmetric) frames only: one tangential component.
+
+    Attributes
+    ----------
+    pressure
+        ``p_i`` [stress], strictly increasing, ``p_0 = 0``.
+    jumps
+        Per row the jumps ``s_ij`` [length], strictly increasing from 0.
+    shears
+        Per row the shears ``T_i(s_ij)`` [stress], 0 at ``s = 0``.
+    """
+
+    pressure: tuple[float, ...]
+    jumps: tuple[tuple[float, ...], ...]
+    shears: tuple[tuple[float, ...], ...]
+
+    def __post_init__(self):
+        p = np.asarray(self.pressure, float)
+        if p.ndim != 1 or len(p) < 2 or p[0] != 0.0 or np.any(np.diff(p) <= 0):
+            raise ModelError("pressure must be >= 2 strictly increasing values starting at 0")
+        if len(self.jumps) != len(p) or len(self.shears) != len(p):
+            raise ModelError(f"jumps and shears need one row per pressure ({len(p)})")
+        for i, (s, t) in enumerate(zip(self.jumps, self.shears)):
+            s, t = np.asarray(s, float), np.asarray(t, float)
+            if s.ndim != 1 or len(s) < 2 or len(t) != len(s) or s[0] != 0.0 or np.any(np.diff(s) <= 0):
+                raise ModelError(f"row {i}: jumps must be >= 2 strictly increasing values from 0, one shear each")
+            if t[0] != 0.0 or not np.all(np.isfinite(t)):
+                raise ModelError(f"row {i}: the shear must be finite and 0 at s = 0")
+
+    @property
+    def coulomb(self) -> bool:
+        """True: the shear depends on the current pressure (solved like Coulomb friction)."""
+        return True
+
+    @property
+    def width(self) -> float:
+        """The smallest tabulated nonzero jump: below it every row is in its first (sticking) segment."""
+        return float(min(s[1] for s in self.jumps))
+
+    def hats(self) -> tuple[np.ndarray, np.ndarray]:
+        """Kinks ``p_k`` and, per row ``i``, slope increments of ``phi_i(p) = phi_i(0) + sum_k d_ik [p - p_k]_+``."""
+        p = np.asarray(self.pressure, float)
+        eye = np.eye(len(p))
+        slopes = np.diff(eye, axis=1) / np.diff(p)                       # (rows, intervals)
+        slopes = np.concatenate([slopes, np.zeros((len(p), 1))], axis=1)  # held constant beyond p_last
+        return p, np.diff(np.concatenate([np.zeros((len(p), 1)), slopes], axis=1), axis=1)
+
+    def ramps(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """Kinks ``s_k`` and slope increments ``e_k`` of ``T_i(s) = sum_k e_k [s - s_k]_+`` for ``s >= 0``."""
+        s = np.asarray(self.jumps[i], float)
+        t = np.asarray(self.shears[i], float)
+        slopes = np.concatenate([np.diff(t) / np.diff(s), [0.0]])
+        return s, np.diff(np.concatenate([[0.0], slopes]))
+
+
+Tangential = Friction | CellShear
 NormalLaw = LinearLaw | BundleLaw | TabulatedLaw
 
 
@@ -238,7 +322,7 @@ class InterfaceLaw:
     """A normal (and elastic tangential) law, optionally with friction."""
 
     normal: NormalLaw
-    friction: Friction | None = None
+    friction: Tangential | None = None
 
     @property
     def quadratic(self) -> bool:

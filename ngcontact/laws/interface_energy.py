@@ -43,6 +43,14 @@ and :func:`friction_traction`::
     W_f(a) = G huber(|a_t|, w)
     tau_f  = (0,  G a_t / max(|a_t|, w))            (G held fixed)
 
+The cell's tabulated shear :class:`CellShear` (rows ``T_i(s)`` at pressures
+``p_i``, hats ``phi_i`` in ``p``, each row stretched along the ray
+``s / p = const`` by ``r_i = p / p_i``) in place of the Huber friction, with
+the frozen pressure ``p`` in the place of ``G``::
+
+    W_t(a; p) = sum_i phi_i(p) r_i^2 E_i(a_t / r_i),   E_i(s) = int_0^|s| T_i
+    tau_t     = sum_i phi_i(p) r_i   T_i(a_t / r_i)
+
 Total (the interface integrand of eq. 44), :func:`energy` and
 :func:`traction`: ``W = W_normal + W_f`` and ``tau = tau_normal + tau_f``,
 with ``G = G0`` unless a threshold field is given.
@@ -58,13 +66,14 @@ import numpy as np
 from ngcontact.errors import ModelError
 from ngcontact.laws.homogenized import (
     BundleLaw,
-    Friction,
+    CellShear,
     InterfaceLaw,
     LinearLaw,
     NormalLaw,
     TabulatedLaw,
+    Tangential,
 )
-from ngcontact.laws.huber import huber_of_square, huber_slope, is_numeric
+from ngcontact.laws.huber import huber_of_square, huber_slope, if_positive, is_numeric
 
 
 # -------------------------------------------------------------- backend
@@ -175,20 +184,88 @@ def pressure(law: NormalLaw, a, g0=0.0):
     return normal_traction(law, a, g0)[0]
 
 
-def friction_energy(friction: Friction, a, G):
-    """``G huber(|a_t|, w)`` with the threshold field ``G`` given."""
+def friction_energy(friction: Tangential, a, G):
+    """``G huber(|a_t|, w)`` with the threshold field ``G`` given; for a :class:`CellShear`,
+    ``W_t(a; p)`` with the frozen pressure ``p = G`` (:func:`threshold`)."""
+    if isinstance(friction, CellShear):
+        _check_cell_shear(a)
+        return sum(phi * e for phi, e in _cell_shear_rows(friction, a[1], G, energy=True))
     return G * huber_of_square(_tangential_norm2(a), friction.width)
 
 
-def friction_traction(friction: Friction, a, G) -> list:
+def friction_traction(friction: Tangential, a, G) -> list:
     """``d/da`` of :func:`friction_energy` (``G`` frozen)."""
+    if isinstance(friction, CellShear):
+        _check_cell_shear(a)
+        return [0.0 * a[0], sum(phi * t for phi, t in _cell_shear_rows(friction, a[1], G, energy=False))]
     f = G * huber_slope(_tangential_norm2(a), friction.width)
     return [0.0 * a[0]] + [f * ai for ai in a[1:]]
 
 
-def threshold(friction: Friction, p):
-    """``G = mu [p]_+ + G0`` for a pressure ``p``."""
+def threshold(friction: Tangential, p):
+    """``G = mu [p]_+ + G0`` for a pressure ``p``; a :class:`CellShear` depends on ``p`` itself."""
+    if isinstance(friction, CellShear):
+        return p
     return friction.mu * _ramp(p) + friction.threshold
+
+
+def _cell_shear_rows(shear: CellShear, s, p, energy: bool):
+    """``(phi_i(p) r_i^k, E_i(s / r_i) or T_i(s / r_i))`` of the rows ``i >= 1`` of a :class:`CellShear`.
+
+    ``r_i = p / p_i`` (with ``p`` kept above ``1e-12 p_1``: for ``p <= 0``
+    every ``phi_i``, ``i >= 1``, is zero and row 0 is zero), ``k = 2`` for the
+    energy and 1 for the traction; ``T_i(x) = sum_k e_k ([x - s_k]_+ -
+    [-x - s_k]_+)`` (odd), ``E_i(x) = sum_k e_k/2 ([x - s_k]_+^2 + [-x -
+    s_k]_+^2)``; ``phi_i(p) = sum_k d_ik [p - p_k]_+``.
+    """
+    kinks, d = shear.hats()
+    floor = 1e-12 * float(kinks[1])
+    q = if_positive(p - floor, p, floor)
+    for i in range(1, len(kinks)):
+        phi = sum(float(dk) * _ramp(p - float(pk)) for pk, dk in zip(kinks, d[i]) if dk != 0)
+        r = q / float(kinks[i])
+        x = s / r
+        if not is_numeric(x):
+            T, E = _row_splines(tuple(shear.jumps[i]), tuple(shear.shears[i]))
+            yield (phi * r * r, E(x)) if energy else (phi * r, T(x))
+            continue
+        sk, ek = shear.ramps(i)
+        if energy:
+            f = sum(0.5 * float(e) * (_ramp(x - float(k)) ** 2 + _ramp(-x - float(k)) ** 2)
+                    for k, e in zip(sk, ek) if e != 0)
+            yield phi * r * r, f
+        else:
+            f = sum(float(e) * (_ramp(x - float(k)) - _ramp(-x - float(k))) for k, e in zip(sk, ek) if e != 0)
+            yield phi * r, f
+
+
+#: a row's spline is held constant out to this multiple of its last jump (the ramps: for ever)
+FAR = 1e6
+
+
+@functools.lru_cache(maxsize=256)
+def _row_splines(jumps: tuple, shears: tuple):
+    """``(T, E)`` of a :class:`CellShear` row as NGSolve B-splines (one lookup per point, not a ramp per kink).
+
+    ``T``: the odd polyline through ``(+-s_k, +-T_k)``, flat out to ``+-FAR
+    s_last``, by the table splines of :func:`_splines`; ``E(x) = E+(|x|)``
+    with ``E+`` the integral from 0 of its positive half (even, and C1 at 0
+    where ``T(0) = 0``; from 0, so no large constant cancels).
+    """
+    import ngsolve as ng
+    s, t = list(jumps), list(shears)
+    far = FAR * s[-1]
+    xs = [-far] + [-v for v in reversed(s[1:])] + s + [far]
+    ts = [-t[-1]] + [-v for v in reversed(t[1:])] + t + [t[-1]]
+    T = _splines(tuple(xs), tuple(ts))[0]
+    E_half = _splines(tuple(s + [far]), tuple(t + [t[-1]]))[1]
+    return T, lambda x: E_half(ng.IfPos(x, x, -x))
+
+
+def _check_cell_shear(a) -> None:
+    if len(a) != 2:
+        raise ModelError("a tabulated cell shear (CellShear) needs a 2D or axisymmetric interface frame "
+                         f"(one tangent); this frame has {len(a) - 1}")
 
 
 def energy(law: InterfaceLaw, a, g0=0.0, G=None):
@@ -197,7 +274,7 @@ def energy(law: InterfaceLaw, a, g0=0.0, G=None):
     W = normal_energy(law.normal, a, g0)
     if law.friction is not None:
         if G is None:
-            G = law.friction.threshold
+            G = threshold(law.friction, 0.0)
         W = W + friction_energy(law.friction, a, G)
     return W
 
@@ -207,7 +284,7 @@ def traction(law: InterfaceLaw, a, g0=0.0, G=None) -> list:
     tau = normal_traction(law.normal, a, g0)
     if law.friction is not None:
         if G is None:
-            G = law.friction.threshold
+            G = threshold(law.friction, 0.0)
         ft = friction_traction(law.friction, a, G)
         tau = [t + f for t, f in zip(tau, ft)]
     return tau

@@ -302,7 +302,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
         history["coulomb_iterations"] = fixed["coulomb_iterations"]
     else:
         if law.friction is not None:
-            G = ng.CF(law.friction.threshold)
+            G = ng.CF(ie.threshold(law.friction, 0.0))
         form = _form(problem, fes, frame, G=G)
         history["newton"].append(minimize(form, gfu, quadratic=law.quadratic, **newton).as_dict())
     history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
@@ -336,6 +336,8 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
                                           frozen=frozen_tresca(problem, fes, frame, gfu), **newton)],
                 "widths": []}
     except ConvergenceError as err:
+        if not isinstance(friction, il.Friction):   # a tabulated cell shear has no Huber width to continue in
+            raise
         log.info("coupled Newton at the scene's Huber width failed (%s); continuation in the width", err)
         gfu.vec.data = start
         failed = [{**err.history, "failed": True}] if isinstance(err.history, dict) else []

@@ -116,7 +116,8 @@ class InterfaceSpec:
     huber_width: float = param(1e-6, doc="Huber width w: largest slip of a sticking point", units="m",
                                check=positive())
     friction: str = param("given", doc="given: mu and threshold above; from_cell: mu0 and G0 of eqs. 42-43 from "
-                          "the cell the law comes from (interface.cell, else two_scale.cell)",
+                          "the cell the law comes from (interface.cell, else two_scale.cell); with [two_scale] the "
+                          "loop then replaces them by the cell's tabulated shear over pressure and tangential jump",
                           choices=("given", "from_cell"))
     cell_k_n: float | None = param(None, doc="replaces contact.k_n of the cells the law comes from", units="Pa/m",
                                    check=positive())
