@@ -60,6 +60,16 @@ check) are independent; they go through the table's ``map_tasks`` callable
 which a process pool can be plugged.  The number of cell solves does not
 depend on the number of macro interface points.
 
+Interface samples: the change is measured at the points of
+:func:`ngcontact.macro.macro_measures.interface_samples`, along the
+interface curve in 2D and axisymmetry (``points_per_element`` per boundary
+element) and on the interface surface in 3D (vertices, edge midpoints and
+centroid of every boundary triangle).  The loop needs only the normal
+pressure ``p = -tau_n`` there, the normal component of the traction in the
+local frame ``(n0, t1, t2)`` (eqs. 69-71), so it runs unchanged in 3D: the
+macro tangential traction ``(tau_1, tau_2)`` does not load the table's cell
+(see Scope), and the table's law ``P`` acts along ``n0`` in every setting.
+
 Scope: the table is over the pressure only.  A frictionless cell with a
 flat mean plane feels no shear; a frictional cell's response to the macro
 shear is not tabulated (the macro law carries the homogenized friction of
@@ -300,7 +310,8 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
     headroom
         Upper end of the table as a multiple of the largest macro pressure.
     points_per_element
-        Sampling of the interface profile.
+        Sampling of the interface profile (2D and axisymmetric; a 3D
+        surface is sampled at fixed points per triangle).
     solve
         Macro solver ``(problem, start) -> MacroSolution``.
     warm
@@ -323,7 +334,7 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         problem = M.replace_law(problem, il.InterfaceLaw(normal=response_law(table), friction=problem.law.friction))
         sol = solve(problem, start)
         macro_solves, newton = macro_solves + 1, newton + sol.history["newton_iterations"]
-    p_old = MM.interface_profile(sol, points_per_element)["pressure"]
+    p_old = MM.interface_samples(sol, points_per_element)["pressure"]
     history: list[HistoryEntry] = [{"iteration": 0, "max_pressure": float(p_old.max()), "max_change": None,
                                      "cell_solves": 0, "newton_iterations": newton, "law_changed": True,
                                      "warm_start": given and warm,
@@ -350,7 +361,7 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         start = sol.gfu.vec if warm else None
         sol = solve(M.replace_law(problem, law), start)
         macro_solves += 1
-        p_new = MM.interface_profile(sol, points_per_element)["pressure"]
+        p_new = MM.interface_samples(sol, points_per_element)["pressure"]
         change = float(np.max(np.abs(p_new - p_old)))
         history.append({"iteration": k, "max_pressure": float(p_new.max()), "max_change": change,
                         "cell_solves": table.solves, "newton_iterations": sol.history["newton_iterations"],

@@ -10,6 +10,13 @@ cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its c
   ``x, y``) [m], ``pressure`` [Pa, compression positive], ``shear`` [Pa,
   traction along ``t0``], ``jump_n`` [m, ``J . n0``, positive closes],
   ``jump_t`` [m, ``J . t0``], ``status`` (``open`` / ``stick`` / ``slip``);
+  3D: the same on the interface surface (``x, y, z``, ``pressure``,
+  ``shear_1``, ``shear_2`` along the law's tangents ``t1, t2``, ``shear`` their
+  magnitude, ``jump_n``, ``jump_t1``, ``jump_t2``, ``status``) with
+  ``contact_area`` (share of ``S_0`` in contact), written as ``interface.csv``
+  and plotted on the surface (``interface.png``) and against the axial
+  position ``z`` (``interface_axial.png``); with ``[two_scale]`` also the
+  cell's ``contact_fraction`` at every sample;
 * ``resultant``: force through the interface from the rough to the counter
   body [N; axisymmetric: axial, per full revolution; plane strain: per metre];
 * ``maxima``: peak pressure and largest |shear| with their location, the
@@ -290,6 +297,7 @@ def run(scene, clock) -> Outcome:
             header = list(surf)
             tables["interface"] = (header, list(zip(*[surf[h] for h in header])))
             plots["interface"] = lambda path, sf=surf: figures.macro_interface_3d(path, sf)
+            plots["interface_axial"] = lambda path, sf=surf: figures.macro_interface_axial(path, sf)
         results["maxima"] = maxima
         results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
         if two_scale is not None:

@@ -285,9 +285,7 @@ class MacroScene:
                 raise SceneError(f"loads[{i}].traction", load.traction, f"must have {dim} components")
         if self.interface.gap_coordinate == "z" and dim == 2 and self.geometry.setting != "axisymmetric":
             raise SceneError("interface.gap_coordinate", "z", "plane strain has coordinates x, y")
-        if self.strength is not None and dim == 3:
-            raise SceneError("strength", "...", "available for plane strain and axisymmetric macro problems")
-        cell_links.check(self.interface, self.two_scale, dim)
+        cell_links.check(self.interface, self.two_scale)
         if self.strength is not None:
             for role in ("rough", "counter"):
                 name = getattr(self.bodies, role)
@@ -336,6 +334,11 @@ class MacroScene:
             if cell.kind != "cell":
                 raise SceneError(key, rel, f"invalid cell scene: must be of kind 'cell', not {cell.kind!r}")
             cell_links.check_friction_source(self.interface, key, rel, cell)
+            if key == "strength.cell" and self.geometry.setting == "3d" and cell.geometry.dim != 3:
+                raise SceneError(key, rel, f"a {cell.geometry.dim}D cell under a 3D macro scene: the macro "
+                                 "traction has two tangential components and the layer two in-plane strains, a "
+                                 "2D cell takes one of each; use a 3D cell (its x, y axes are the law's "
+                                 "tangents t1, t2)")
             if solved and cell.contact.geometric_only:
                 raise SceneError(key, rel, "invalid cell scene: contact.geometric_only = true, but this "
                                  "section solves the cell, so it needs a contact model and a [load] section")
