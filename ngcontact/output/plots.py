@@ -164,13 +164,13 @@ def macro_interface_axial(path: str, surf: dict) -> None:
     plt = _pyplot()
     z = np.asarray(surf["z"]) * 1e3
     angle = np.degrees(np.arctan2(np.asarray(surf["y"]), np.asarray(surf["x"])))
-    fig, ax = plt.subplots(4, 1, figsize=(8, 10), sharex=True)
+    fig, ax = plt.subplots(4, 1, figsize=(8, 10), sharex=True, constrained_layout=True)
     rows = (("pressure", 1e-6, "pressure p [MPa]\n(compression > 0)"), ("shear", 1e-6, "|shear| [MPa]"),
             ("jump_n", 1e6, "J . n0 [um]\n(closure)"))
     for a, (key, scale, label) in zip(ax, rows):
         sc = a.scatter(z, np.asarray(surf[key]) * scale, c=angle, s=3, cmap="twilight")
         a.set_ylabel(label)
-    fig.colorbar(sc, ax=ax[:3], shrink=0.8, label="angle about z [deg]")
+    fig.colorbar(sc, ax=ax, shrink=0.6, label="angle about z [deg]")
     colors = {"open": 0, "stick": 1, "slip": 2}
     ax[3].scatter(z, [colors[x] for x in surf["status"]], s=3)
     ax[3].set_yticks([0, 1, 2], ["open", "stick", "slip"])
