@@ -196,7 +196,8 @@ class StrengthSpec:
     """Micro-stress recovery in the interface layer and the strength check (paper eqs. 74-78)."""
 
     cell: str = param(doc="cell scene (kind cell) of the layer, relative to this scene; its [load] is "
-                      "not used (the macro state loads it); its bodies are this scene's rough and counter")
+                      "not used (the macro state loads it); its bodies are this scene's rough and counter; "
+                      "a 3D cell under a 3D macro scene (its x, y axes on the law's tangents t1, t2)")
     criterion: str = param("von_mises", doc="equivalent stress of eq. 77", choices=("von_mises", "tresca"))
     recovery: str = param("linear", doc="linear: unit-load correctors with the contact set fixed (the "
                           "cell's points without gap), superposed at every interface point (eq. 75); "
