@@ -164,7 +164,8 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     cell_data: dict[str, Any] = {"points": np.concatenate([worst_stress[b]["points"] for b in S.BODIES]),
                                  "eq": np.concatenate([S.equivalent(worst_stress[b]["stress"], spec.criterion)
                                                        for b in S.BODIES]),
-                                 "criterion": spec.criterion, "dim": P.dim}
+                                 "criterion": spec.criterion, "dim": P.dim,
+                                 "tangents": ("t0", "hoop") if "s" in states else ("t1", "t2")}
     plots: dict[str, Callable[..., None]] = {
         "strength_map": lambda p, d=map_data: figures.strength_map(p, **d),
         "worst_cell": lambda p, d=cell_data: figures.worst_cell(p, **d)}

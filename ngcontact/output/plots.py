@@ -263,7 +263,7 @@ def strength_map(path: str, s, values: dict, sigma_u: dict, criterion: str, pres
     plt.close(fig)
 
 
-def worst_cell(path: str, points, eq, criterion: str, dim: int) -> None:
+def worst_cell(path: str, points, eq, criterion: str, dim: int, tangents: tuple[str, str] = ("t0", "hoop")) -> None:
     """Equivalent stress in the worst cell (paper Fig. 8).
 
     ``points``: ``(n, dim)`` sample points of the cell; ``eq``: the
@@ -271,6 +271,8 @@ def worst_cell(path: str, points, eq, criterion: str, dim: int) -> None:
     sections through the point of the largest equivalent stress, the vertical
     plane ``y = y_max`` (x-z) and the horizontal plane ``z = z_max`` (x-y),
     each from the sample points within a thin slab around the plane.
+    ``tangents``: the macro directions of the cell's ``x, y`` axes (a 3D
+    cell under a 3D macro scene: ``t1, t2``).
     """
     plt = _pyplot()
     pts = np.asarray(points)
@@ -289,8 +291,8 @@ def worst_cell(path: str, points, eq, criterion: str, dim: int) -> None:
     else:
         fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
         span = np.ptp(pts, axis=0)
-        for ax, (normal, a, b, names) in zip(axes, ((1, 0, 2, ("x (t0)", "z (n0)")),
-                                                    (2, 0, 1, ("x (t0)", "y (hoop)")))):
+        tx, ty = (f"x ({tangents[0]})", f"y ({tangents[1]})")
+        for ax, (normal, a, b, names) in zip(axes, ((1, 0, 2, (tx, "z (n0)")), (2, 0, 1, (tx, ty)))):
             slab = np.abs(pts[:, normal] - pts[k, normal]) <= 0.03 * span[normal]
             sc = ax.scatter(pts[slab, a], pts[slab, b], c=eq[slab], s=6, cmap="viridis",
                             vmin=eq.min(), vmax=eq.max())
