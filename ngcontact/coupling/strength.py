@@ -32,15 +32,16 @@ macro interface points (``x``); each body is checked against its own
 ultimate stress ``sigma_u`` and the safety factor is
 ``min_B sigma_u,B / max sigma_eq,B`` (eq. 78 holds when it exceeds 1).
 
-Macro state at an interface point: the local traction ``(p, tau)`` of the
-homogenized law (compression positive, ``tau`` along ``t0``) and the strain
-of the layer tangential to ``S_0``, the mean of the two bodies' strains next
-to the point.  The cell's axes are ``(t0, n0)`` in 2D and ``(t0, hoop, n0)``
-in 3D, so the cell loads are ``tau_x = -tau`` (the counter's far face carries
-the opposite of what the rough body transmits), ``p``, ``E_xx = e_t0t0``
-and in 3D ``E_yy = e_hoop`` (axisymmetry; 0 in plane strain), ``E_xy = 0``.
-A 2D cell takes ``E_xx`` only (it is in plane strain across the hoop
-direction).
+Macro state at an interface point (:mod:`ngcontact.coupling.interface_state`):
+the local traction of the homogenized law (compression positive) and the
+strain of the layer tangential to ``S_0``, the mean of the two bodies'
+strains next to the point, put on the cell's axes.  2D and axisymmetric
+macro problems: the cell's axes are ``(t0, n0)`` (2D cell) or ``(t0, hoop,
+n0)`` (3D cell), loads ``shear_x = -tau``, ``p``, ``E_xx = e_t0t0`` and for
+a 3D cell ``E_yy = e_hoop``, ``E_xy = 0``.  3D macro problems: a 3D cell
+with axes ``(t1, t2, n0)`` of the law's frame, loads ``shear_x = -tau_1``,
+``shear_y = -tau_2``, ``p``, ``E_xx = e_t1t1``, ``E_yy = e_t2t2``,
+``E_xy = e_t1t2``.
 """
 from __future__ import annotations
 
@@ -60,7 +61,6 @@ from ngcontact.errors import ModelError
 
 if TYPE_CHECKING:
     from ngcontact.cell.cell_problem import CellProblem, CellSolution
-    from ngcontact.macro.macro_problem import MacroSolution
 
 log = logging.getLogger(__name__)
 
@@ -325,57 +325,3 @@ def check(smap: StrengthMap, sigma_u: Mapping[str, float], macro_points: np.ndar
     out["safety_factor"] = finite[crit]
     out["holds"] = bool(finite[crit] > 1.0)
     return out
-
-
-# ------------------------------------------------------------ macro state
-def interface_states(sol: MacroSolution, points_per_element: int = 5,
-                     offset: float = 1e-4) -> dict[str, np.ndarray | list[str]]:
-    """Macro state at points along ``S_0`` (2D and axisymmetric macro problems).
-
-    Returns the interface profile of :func:`ngcontact.macro.macro_problem.interface_profile`
-    (``s``, coordinates, ``pressure``, ``shear``, ...) plus ``e_t`` (strain
-    along ``t0``) and ``e_hoop`` (axisymmetric hoop strain, else 0), each the
-    mean of the two bodies' strains at points moved by ``offset`` times the
-    mesh's extent off the interface, and slightly towards the element centre.
-    """
-    from ngcontact.fem.elasticity import COMPONENTS
-    from ngcontact.macro import macro_measures as MM
-    prof = MM.interface_profile(sol, points_per_element)
-    k = max(2, int(points_per_element))
-    names = COMPONENTS[sol.problem.setting]
-    xy = np.column_stack([prof[names[0]], prof[names[1]]])
-    mesh = sol.problem.mesh
-    pts = np.array([v.point for v in mesh.vertices])
-    delta = offset * float(np.max(pts.max(axis=0) - pts.min(axis=0)))
-    eps_cf = MM.strain(sol)
-    e_t = np.zeros(len(xy))
-    e_h = np.zeros(len(xy))
-    for e0 in range(0, len(xy), k):
-        seg = xy[e0:e0 + k]
-        t = seg[-1] - seg[0]
-        t = t / np.linalg.norm(t)
-        nperp = np.array([-t[1], t[0]])
-        mid = seg.mean(axis=0)
-        for j, q in enumerate(seg):
-            q = q + 1e-3 * (mid - q)
-            vals = []
-            for side in (1.0, -1.0):
-                p = q + side * delta * nperp
-                E = np.asarray(eps_cf(mesh(float(p[0]), float(p[1])))).reshape(3, 3)
-                vals.append(E)
-            E = 0.5 * (vals[0] + vals[1])
-            e_t[e0 + j] = t @ E[:2, :2] @ t
-            e_h[e0 + j] = E[2, 2] if sol.problem.setting == "axisymmetric" else 0.0
-    out = dict(prof)
-    out["e_t"], out["e_hoop"] = e_t, e_h
-    return out
-
-
-def cell_loads(states: Mapping[str, np.ndarray | list[str]], dim: int) -> np.ndarray:
-    """Load vectors of a ``dim``-D cell (rows) from :func:`interface_states`."""
-    p = np.asarray(states["pressure"], float)
-    tau = np.asarray(states["shear"], float)
-    if dim == 2:
-        return np.column_stack([-tau, p, states["e_t"]])
-    z = np.zeros_like(p)
-    return np.column_stack([-tau, z, p, states["e_t"], states["e_hoop"], z])

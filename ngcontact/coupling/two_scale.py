@@ -60,16 +60,26 @@ check) are independent; they go through the table's ``map_tasks`` callable
 which a process pool can be plugged.  The number of cell solves does not
 depend on the number of macro interface points.
 
+Interface samples: the change is measured at the points of
+:func:`ngcontact.macro.macro_measures.interface_samples`, along the
+interface curve in 2D and axisymmetry (``points_per_element`` per boundary
+element) and on the interface surface in 3D (vertices, edge midpoints and
+centroid of every boundary triangle).  The pressure table needs only the
+normal pressure ``p = -tau_n`` there, the normal component of the traction
+in the local frame ``(n0, t1, t2)`` (eqs. 69-71), so it runs unchanged in
+3D: the table's law ``P`` acts along ``n0`` in every setting.
+
 A frictionless cell with a flat mean plane feels no shear: its table is
 over the pressure only and the macro law keeps the friction it was given.
 A cell with micro friction also has a :class:`~ngcontact.coupling.shear_table.ShearTable`
-(``shear``): its rows, the shear against the tangential jump at a set of
-pressures, are made to cover the same pressures and the macro interface's
-tangential jumps (``headroom`` times the largest ``|a_t|``) at every
-update, and the macro law's tangential part is the table's
+(``shear``; one tangent, so 2D and axisymmetric macro scenes only): its
+rows, the shear against the tangential jump at a set of pressures, are
+made to cover the same pressures and the macro interface's tangential
+jumps (``headroom`` times the largest ``|a_t|``) at every update, and the
+macro law's tangential part is the table's
 :class:`~ngcontact.laws.homogenized.CellShear` instead of the given
-friction.  The loop then stops only where neither table grew (a change
-of the pressure below ``tol`` alone does not show that the last jumps are
+friction.  The loop then stops only where neither table grew (a change of
+the pressure below ``tol`` alone does not show that the last jumps are
 covered).
 """
 from __future__ import annotations
@@ -343,7 +353,8 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
     headroom
         Upper end of the table as a multiple of the largest macro pressure.
     points_per_element
-        Sampling of the interface profile.
+        Sampling of the interface profile (2D and axisymmetric; a 3D
+        surface is sampled at fixed points per triangle).
     solve
         Macro solver ``(problem, start) -> MacroSolution``.
     warm
@@ -370,7 +381,7 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
                                                          friction=tangential_law(problem, shear)))
         sol, start = _solve_warm_or_cold(solve, problem, start)
         macro_solves, newton = macro_solves + 1, newton + sol.history["newton_iterations"]
-    p_old = MM.interface_profile(sol, points_per_element)["pressure"]
+    p_old = MM.interface_samples(sol, points_per_element)["pressure"]
     history: list[HistoryEntry] = [{"iteration": 0, "max_pressure": float(p_old.max()), "max_change": None,
                                      "cell_solves": 0, "newton_iterations": newton, "law_changed": True,
                                      "warm_start": given and start is not None,
@@ -399,7 +410,7 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         start = sol.gfu.vec if warm else None
         sol, start = _solve_warm_or_cold(solve, M.replace_law(problem, law), start)
         macro_solves += 1
-        p_new = MM.interface_profile(sol, points_per_element)["pressure"]
+        p_new = MM.interface_samples(sol, points_per_element)["pressure"]
         change = float(np.max(np.abs(p_new - p_old)))
         history.append({"iteration": k, "max_pressure": float(p_new.max()), "max_change": change,
                         "cell_solves": table.solves + (shear.solves if shear is not None else 0),

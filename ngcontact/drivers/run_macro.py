@@ -10,6 +10,14 @@ cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its c
   ``x, y``) [m], ``pressure`` [Pa, compression positive], ``shear`` [Pa,
   traction along ``t0``], ``jump_n`` [m, ``J . n0``, positive closes],
   ``jump_t`` [m, ``J . t0``], ``status`` (``open`` / ``stick`` / ``slip``);
+  3D: the same on the interface surface (``x, y, z``, ``pressure``,
+  ``shear_1``, ``shear_2`` along the law's tangents ``t1, t2``, ``shear`` their
+  magnitude, ``jump_n``, ``jump_t1``, ``jump_t2``, ``status``) with
+  ``contact_area`` (share of ``S_0`` in contact), written as ``interface.csv``
+  and plotted on the surface (``interface.png``) and against the axial
+  position ``z`` (``interface_axial.png``); with ``[two_scale]`` also the
+  cell's ``contact_fraction`` at every sample; the stress fields of 3D
+  quarters on their symmetry plane ``y = 0`` (``stress.png``, as in 2D);
 * ``resultant``: force through the interface from the rough to the counter
   body [N; axisymmetric: axial, per full revolution; plane strain: per metre];
 * ``maxima``: peak pressure and largest |shear| with their location, the
@@ -290,6 +298,10 @@ def run(scene, clock) -> Outcome:
             header = list(surf)
             tables["interface"] = (header, list(zip(*[surf[h] for h in header])))
             plots["interface"] = lambda path, sf=surf: figures.macro_interface_3d(path, sf)
+            plots["interface_axial"] = lambda path, sf=surf: figures.macro_interface_axial(path, sf)
+            if SECTION in M.boundary_labels(geo.mesh):
+                section = section_samples(sol, fields)
+                plots["stress"] = lambda path, d=section: figures.macro_fields(path, **d)
         results["maxima"] = maxima
         results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
         if two_scale is not None:
@@ -330,6 +342,35 @@ def two_scale_summary(two_scale: dict, strength: dict) -> dict:
 
 
 # ------------------------------------------------------------------ plot data
+#: the symmetry plane y = 0 of the 3D quarters: the (r, z) section of a body of revolution at angle 0
+SECTION = "sym_y"
+
+
+def section_samples(sol: M.MacroSolution, fields: dict) -> dict:
+    """Arrays for :func:`ngcontact.output.plots.macro_fields` from a 3D solution: the stress fields on
+    the symmetry plane ``y = 0`` (:data:`SECTION`), where ``x`` is the radius ``r``.
+
+    Three points near the vertices of every boundary triangle of the plane,
+    each evaluated in the body behind it (moved ``1e-6`` of the mesh's
+    extent to ``y > 0``, never on the plane itself), one plotted triangle per
+    boundary triangle, so each body keeps its colouring.  Fields:
+    ``sigma_xx`` (radial there), ``sigma_zz`` (axial), von Mises stress and strain.
+    """
+    p = sol.problem
+    mesh = p.mesh
+    names = ["sigma_xx", "sigma_zz", "von_mises", "von_mises_strain"]
+    rule = ng.IntegrationRule([(1e-3, 1e-3), (1 - 2e-3, 1e-3), (1e-3, 1 - 2e-3)], [0.0] * 3)
+    mips = mesh.MapToAllElements(rule, mesh.Boundaries(SECTION))
+    xyz = np.asarray(ng.CF((ng.x, ng.y, ng.z))(mips)).reshape(-1, 3)
+    pts = np.array([v.point for v in mesh.vertices])
+    xyz[:, 1] += 1e-6 * float(np.max(pts.max(axis=0) - pts.min(axis=0)))
+    inside = mesh(xyz[:, 0], xyz[:, 1], xyz[:, 2])
+    keep = (inside["nr"] >= 0).reshape(-1, 3).all(axis=1).repeat(3)
+    inside, xyz = inside[keep], xyz[keep]
+    return {"x": xyz[:, 0], "y": xyz[:, 2], "triangles": np.arange(len(xyz)).reshape(-1, 3),
+            "values": {n: np.asarray(fields[n](inside)).ravel() for n in names}, "axisymmetric": True}
+
+
 def field_samples(sol: M.MacroSolution, fields: dict) -> dict:
     """Arrays for :func:`ngcontact.output.plots.macro_fields`: the stress fields at
     three points near the vertices of every element of both bodies (one

@@ -7,11 +7,15 @@ the caller's :class:`~ngcontact.output.report.Outcome`.  See
 ``results["strength"]``: ``criterion``, ``recovery``, ``safety_factor``
 (``min_B sigma_u,B / max sigma_eq,B``), ``holds`` (eq. 78: safety factor
 > 1), ``critical_body``, per body ``max_sigma_eq`` [Pa], ``sigma_u`` [Pa],
-``safety_factor``, ``macro_point`` (index into the interface profile, its
-``s`` [m] and coordinates [m]) and ``cell_point`` (cell coordinates, cell
-units), ``cell`` (scene path, ``ndof``, contact fraction of the fixed
-contact set), ``tangential_stiffness`` and, with nonlinear recovery, the
-linear and nonlinear maxima at the re-solved points.
+``safety_factor``, ``macro_point`` (index into the interface samples: the
+profile in 2D and axisymmetry, with its ``s`` [m], the surface in 3D;
+coordinates [m]) and ``cell_point`` (cell coordinates, cell units),
+``cell`` (scene path, ``ndof``, contact fraction of the fixed contact set),
+``tangential_stiffness`` and, with nonlinear recovery, the linear and
+nonlinear maxima at the re-solved points.  The table
+``strength_map`` has one row per interface sample with its macro state (2D:
+``pressure, shear, e_t, e_hoop``; 3D: ``pressure, shear_1, shear_2, e_11,
+e_22, e_12`` in the law's frame, :mod:`ngcontact.coupling.interface_state`).
 """
 from __future__ import annotations
 
@@ -26,7 +30,8 @@ import numpy as np
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.predictor import max_gap
 from ngcontact.coupling import strength as S
-from ngcontact.errors import SceneError
+from ngcontact.coupling.interface_state import cell_loads, interface_states
+from ngcontact.errors import ModelError, SceneError
 from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.output import plots as figures
 from ngcontact.output.report import VtkField
@@ -82,13 +87,17 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
         kt = cs.contact.k_n if law.friction is not None else 0.0
     chi = None if P.gap is None else ng.IfPos(P.gap - 1e-14 * max(max_gap(P), 1e-300), 0.0, 1.0)
     corr = S.linear_correctors(P, contact_set=chi, tangential_stiffness=kt)
-    states = S.interface_states(sol, scene.output.points_per_element)
-    loads = S.cell_loads(states, P.dim)
+    states = interface_states(sol, scene.output.points_per_element)
+    try:
+        loads = cell_loads(states, P.dim)
+    except ModelError as exc:
+        raise SceneError("strength.cell", spec.cell, f"a {P.dim}D cell: {exc}") from None
     if kt == 0 and not P.tangential_free and np.any(loads[:, :P.dim - 1] != 0):
         log.warning("the cell carries no shear (flat, frictionless, k_t = 0): the macro shear is dropped")
         loads[:, :P.dim - 1] = 0.0
     smap = S.strength_map(corr, loads, spec.criterion)
-    names = [k for k in ("r", "z", "x", "y") if k in states]
+    names = ["r", "z"] if "r" in states else [k for k in ("x", "y", "z") if k in states]
+    along = "s" if "s" in states else "z"   # the abscissa of the map: arc length (2D) or the axis z (3D)
     coords = np.column_stack([states[k] for k in names])
     extra: dict[str, list[dict[str, Any]]] = {}
     if spec.recovery == "nonlinear":
@@ -101,7 +110,7 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
             except ValueError as exc:
                 raise SceneError("strength.recovery", "nonlinear", f"the cell cannot be solved at the macro "
                                  f"state of interface point {i}: {exc}") from None
-            entry: dict[str, Any] = {"index": i, "s": float(states["s"][i]), "load": loads[i].tolist(),
+            entry: dict[str, Any] = {"index": i, along: float(states[along][i]), "load": loads[i].tolist(),
                                      "contact_fraction": csol.results["contact_fraction"], "bodies": {}}
             for b in S.BODIES:
                 eq = S.equivalent(st[b]["stress"], spec.criterion)
@@ -117,7 +126,8 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     assert sigma_u_rough is not None and sigma_u_counter is not None
     res = S.check(smap, {"rough": sigma_u_rough, "counter": sigma_u_counter}, coords)
     for b, e in res["bodies"].items():
-        e["macro_point"]["s"] = float(states["s"][e["macro_point"]["index"]])
+        if "s" in states:
+            e["macro_point"]["s"] = float(states["s"][e["macro_point"]["index"]])
         e["macro_point"]["names"] = names
     crit = res["critical_body"]
     k = res["bodies"][crit]["macro_point"]["index"]
@@ -141,19 +151,21 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
                 "cell": {"scene": path, "ndof": int(P.ndof), "dim": P.dim,
                          "fixed_contact_set": "S_C without gap" if chi is not None else "all of S_C"}})
     res.update(extra)
-    header = ["s"] + names + ["pressure", "shear", "e_t", "e_hoop"] + \
-             [f"sigma_eq_{b}" for b in S.BODIES]
-    cols = [states["s"]] + [states[n] for n in names] + [states["pressure"], states["shear"], states["e_t"],
-                                                         states["e_hoop"]] + [smap.values[b] for b in S.BODIES]
+    state_keys = ["pressure", "shear", "e_t", "e_hoop"] if "s" in states else \
+        ["pressure", "shear_1", "shear_2", "e_11", "e_22", "e_12"]
+    header = (["s"] if "s" in states else []) + names + state_keys + [f"sigma_eq_{b}" for b in S.BODIES]
+    cols = [states[h] for h in header[:-2]] + [smap.values[b] for b in S.BODIES]
     table = (header, list(zip(*cols)))
     sig_u = {b: res["bodies"][b]["sigma_u"] for b in S.BODIES}
-    map_data: dict[str, Any] = {"s": np.asarray(states["s"]), "values": {b: smap.values[b] for b in S.BODIES},
+    map_data: dict[str, Any] = {"s": np.asarray(states[along]), "values": {b: smap.values[b] for b in S.BODIES},
                                 "sigma_u": sig_u, "criterion": smap.criterion,
-                                "pressure": np.asarray(states["pressure"]), "shear": np.asarray(states["shear"])}
+                                "pressure": np.asarray(states["pressure"]), "shear": np.asarray(states["shear"]),
+                                "xlabel": None if along == "s" else "axial position z of the interface point [mm]"}
     cell_data: dict[str, Any] = {"points": np.concatenate([worst_stress[b]["points"] for b in S.BODIES]),
                                  "eq": np.concatenate([S.equivalent(worst_stress[b]["stress"], spec.criterion)
                                                        for b in S.BODIES]),
-                                 "criterion": spec.criterion, "dim": P.dim}
+                                 "criterion": spec.criterion, "dim": P.dim,
+                                 "tangents": ("t0", "hoop") if "s" in states else ("t1", "t2")}
     plots: dict[str, Callable[..., None]] = {
         "strength_map": lambda p, d=map_data: figures.strength_map(p, **d),
         "worst_cell": lambda p, d=cell_data: figures.worst_cell(p, **d)}

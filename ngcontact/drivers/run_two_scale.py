@@ -32,8 +32,9 @@ solve was warm-started), ``newton_per_solve``, ``tolerance`` [Pa],
 [Pa], ``closure`` [m], ``tolerance``, ``error_estimate``: the largest
 relative midpoint discrepancy accepted, ``nodes``), ``cache`` (key, whether
 the table came from it, its path), ``law`` (the macro law: the cell's
-tabulated response), ``cell`` (scene, ndof, overrides) and the coefficient
-profile along the interface (``contact_fraction``, ``k_n0``); with a shear
+tabulated response), ``cell`` (scene, ndof, overrides) and the coefficients
+at the interface samples (``contact_fraction``, ``k_n0``; along the profile
+in 2D and axisymmetry, on the interface surface in 3D); with a shear
 table also ``shear_table`` (rows, nodes, cell solves, the error estimates
 in the jump and in the pressure, the rows themselves: far-face jump [cell
 units], interface jump [m], shear [Pa]) and its ``cache`` entry, and
@@ -50,7 +51,7 @@ import numpy as np
 from ngcontact.coupling import cell_law
 from ngcontact.coupling import shear_table as S
 from ngcontact.coupling import two_scale as T
-from ngcontact.macro.macro_measures import interface_profile
+from ngcontact.macro.macro_measures import interface_samples
 from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
 from ngcontact.solvers import executor
@@ -207,7 +208,7 @@ def couple(scene, problem, solve,
         store_table(key, table, cache_dir)
     if shear is not None and shear.solves and skey is not None:
         store_shear(skey, shear, cache_dir)
-    p = interface_profile(out.solution, scene.output.points_per_element)["pressure"]
+    p = interface_samples(out.solution, scene.output.points_per_element)["pressure"]
     coef = table(np.asarray(p))
     law = T.response_law(table)
     res = {"converged": out.converged, "iterations": len(out.history) - 1, "macro_solves": out.macro_solves,

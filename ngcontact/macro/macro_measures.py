@@ -252,11 +252,7 @@ def interface_surface(sol: MacroSolution) -> dict:
     """
     p = sol.problem
     mesh = p.mesh
-    if mesh.dim != 3:
-        raise ModelError("an interface surface needs a 3D mesh")
-    pts = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (0.0, 0.5), (1 / 3, 1 / 3)]
-    rule = ng.IntegrationRule(pts, [0.0] * len(pts))
-    mips = mesh.MapToAllElements(rule, mesh.Boundaries(p.interface))
+    mips = _surface_points(sol)
     tau = interface_tractions(sol)
     a = sol.local_jump
     cf = ng.CF((ng.x, ng.y, ng.z, tau[0], tau[1], tau[2], a[0], a[1], a[2]))
@@ -270,6 +266,43 @@ def interface_surface(sol: MacroSolution) -> dict:
     return {"x": v[:, 0], "y": v[:, 1], "z": v[:, 2], "pressure": v[:, 3], "shear_1": v[:, 4],
             "shear_2": v[:, 5], "shear": shear, "jump_n": v[:, 6], "jump_t1": v[:, 7], "jump_t2": v[:, 8],
             "status": _status(sol, v[:, 3], slip), "contact_area": float(pressed / area)}
+
+
+#: Sample points of :func:`interface_surface` in each boundary triangle: vertices, edge midpoints, centroid (last)
+SURFACE_POINTS = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (0.0, 0.5), (1 / 3, 1 / 3))
+
+
+def _surface_points(sol: MacroSolution):
+    """The mapped :data:`SURFACE_POINTS` of every boundary triangle of ``S_0`` (3D meshes only)."""
+    p = sol.problem
+    if p.mesh.dim != 3:
+        raise ModelError("an interface surface needs a 3D mesh")
+    rule = ng.IntegrationRule(list(SURFACE_POINTS), [0.0] * len(SURFACE_POINTS))
+    return p.mesh.MapToAllElements(rule, p.mesh.Boundaries(p.interface))
+
+
+def interface_surface_frame(sol: MacroSolution) -> np.ndarray:
+    """The local frame ``(n0, t1, t2)`` at the samples of :func:`interface_surface`, shape ``(n, 3, 3)``.
+
+    Row ``k`` of sample ``i`` is the ``k``-th basis vector of
+    :func:`ngcontact.laws.local_frame.local_frame` (the frame the law is
+    written in), evaluated on the interface's own boundary elements.
+    """
+    frame = ng.CF(tuple(sol.frame))
+    return np.asarray(frame(_surface_points(sol))).reshape(-1, 3, 3)
+
+
+def interface_samples(sol: MacroSolution, points_per_element: int = 5) -> dict:
+    """The interface samples of any macro solution: :func:`interface_profile` in 2D and axisymmetry,
+    :func:`interface_surface` in 3D (``points_per_element`` applies to the profile only).
+
+    Both carry ``pressure`` (compression positive) at the same points on
+    every call for the same mesh, which is what the two-scale loop compares
+    between its updates (:mod:`ngcontact.coupling.two_scale`).
+    """
+    if sol.problem.mesh.dim == 3:
+        return interface_surface(sol)
+    return interface_profile(sol, points_per_element)
 
 
 def _status(sol: MacroSolution, press, jt) -> list:

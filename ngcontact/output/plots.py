@@ -153,6 +153,34 @@ def macro_interface_3d(path: str, surf: dict) -> None:
     plt.close(fig)
 
 
+def macro_interface_axial(path: str, surf: dict) -> None:
+    """The 3D interface samples against the axial position ``z``: the counterpart of :func:`macro_interface`.
+
+    ``surf`` as in :func:`macro_interface_3d` plus ``jump_n``; every sample
+    is a point, coloured by its angle ``atan2(y, x)`` about the ``z`` axis
+    (on a surface of revolution the points of one height coincide when the
+    solution is axisymmetric, and their spread shows where it is not).
+    """
+    plt = _pyplot()
+    z = np.asarray(surf["z"]) * 1e3
+    angle = np.degrees(np.arctan2(np.asarray(surf["y"]), np.asarray(surf["x"])))
+    fig, ax = plt.subplots(4, 1, figsize=(8, 10), sharex=True, constrained_layout=True)
+    rows = (("pressure", 1e-6, "pressure p [MPa]\n(compression > 0)"), ("shear", 1e-6, "|shear| [MPa]"),
+            ("jump_n", 1e6, "J . n0 [um]\n(closure)"))
+    for a, (key, scale, label) in zip(ax, rows):
+        sc = a.scatter(z, np.asarray(surf[key]) * scale, c=angle, s=3, cmap="twilight")
+        a.set_ylabel(label)
+    fig.colorbar(sc, ax=ax, shrink=0.6, label="angle about z [deg]")
+    colors = {"open": 0, "stick": 1, "slip": 2}
+    ax[3].scatter(z, [colors[x] for x in surf["status"]], s=3)
+    ax[3].set_yticks([0, 1, 2], ["open", "stick", "slip"])
+    ax[3].set_xlabel("axial position z [mm]")
+    for a in ax:
+        a.grid(alpha=0.3)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def macro_fields(path: str, x, y, triangles, values: dict, axisymmetric: bool) -> None:
     """Four panels of paper Fig. 10: radial / axial stress, von Mises stress and strain.
 
@@ -202,26 +230,31 @@ def convergence(path: str, rows: list, rates: dict) -> None:
 
 
 # ------------------------------------------------------------------ strength check
-def strength_map(path: str, s, values: dict, sigma_u: dict, criterion: str, pressure, shear) -> None:
+def strength_map(path: str, s, values: dict, sigma_u: dict, criterion: str, pressure, shear,
+                 xlabel: str | None = None) -> None:
     """Largest micro ``sigma_eq`` along the interface per body, against ``sigma_u``.
 
-    ``s``: arc length [m]; ``values``: body -> largest equivalent stress over
-    the cell at each ``s`` [Pa]; ``sigma_u``: body -> strength [Pa];
-    ``pressure``, ``shear``: the macro tractions at ``s`` [Pa].
+    ``s``: arc length [m] (or, with ``xlabel``, another position along the
+    interface, e.g. the axial position of 3D samples); ``values``: body ->
+    largest equivalent stress over the cell at each ``s`` [Pa]; ``sigma_u``:
+    body -> strength [Pa]; ``pressure``, ``shear``: the macro tractions at
+    ``s`` [Pa] (3D: the magnitude of the shear).  Points, not lines, for
+    samples that do not form a curve.
     """
     plt = _pyplot()
     s = np.asarray(s) * 1e3
     fig, ax = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    style = {} if xlabel is None else {"ls": "none", "marker": ".", "ms": 2}
     for (b, v), c in zip(values.items(), ("C0", "C1")):
-        ax[0].plot(s, np.asarray(v) / 1e6, color=c, label=f"max over the cell, {b}")
+        ax[0].plot(s, np.asarray(v) / 1e6, color=c, label=f"max over the cell, {b}", **style)
         ax[0].axhline(sigma_u[b] / 1e6, color=c, ls="--", label=f"sigma_u {b}")
     ax[0].set_ylabel(f"{criterion.replace('_', ' ')} [MPa]")
     ax[0].set_yscale("log")
     ax[0].legend(fontsize=7)
-    ax[1].plot(s, np.asarray(pressure) / 1e6, label="macro pressure p")
-    ax[1].plot(s, np.asarray(shear) / 1e6, label="macro shear")
+    ax[1].plot(s, np.asarray(pressure) / 1e6, label="macro pressure p", **style)
+    ax[1].plot(s, np.asarray(shear) / 1e6, label="macro shear", **style)
     ax[1].set_ylabel("MPa")
-    ax[1].set_xlabel("arc length s along the interface [mm] (from the top end)")
+    ax[1].set_xlabel(xlabel or "arc length s along the interface [mm] (from the top end)")
     ax[1].legend(fontsize=7)
     for a in ax:
         a.grid(alpha=0.3)
@@ -230,7 +263,7 @@ def strength_map(path: str, s, values: dict, sigma_u: dict, criterion: str, pres
     plt.close(fig)
 
 
-def worst_cell(path: str, points, eq, criterion: str, dim: int) -> None:
+def worst_cell(path: str, points, eq, criterion: str, dim: int, tangents: tuple[str, str] = ("t0", "hoop")) -> None:
     """Equivalent stress in the worst cell (paper Fig. 8).
 
     ``points``: ``(n, dim)`` sample points of the cell; ``eq``: the
@@ -238,6 +271,8 @@ def worst_cell(path: str, points, eq, criterion: str, dim: int) -> None:
     sections through the point of the largest equivalent stress, the vertical
     plane ``y = y_max`` (x-z) and the horizontal plane ``z = z_max`` (x-y),
     each from the sample points within a thin slab around the plane.
+    ``tangents``: the macro directions of the cell's ``x, y`` axes (a 3D
+    cell under a 3D macro scene: ``t1, t2``).
     """
     plt = _pyplot()
     pts = np.asarray(points)
@@ -256,8 +291,8 @@ def worst_cell(path: str, points, eq, criterion: str, dim: int) -> None:
     else:
         fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
         span = np.ptp(pts, axis=0)
-        for ax, (normal, a, b, names) in zip(axes, ((1, 0, 2, ("x (t0)", "z (n0)")),
-                                                    (2, 0, 1, ("x (t0)", "y (hoop)")))):
+        tx, ty = (f"x ({tangents[0]})", f"y ({tangents[1]})")
+        for ax, (normal, a, b, names) in zip(axes, ((1, 0, 2, (tx, "z (n0)")), (2, 0, 1, (tx, ty)))):
             slab = np.abs(pts[:, normal] - pts[k, normal]) <= 0.03 * span[normal]
             sc = ax.scatter(pts[slab, a], pts[slab, b], c=eq[slab], s=6, cmap="viridis",
                             vmin=eq.min(), vmax=eq.max())

@@ -7,7 +7,8 @@ tabulated response, paper Sec. 3.5).  ``interface.cell_k_n``,
 that cell's ``[contact]`` section without copying the cell scene;
 ``interface.friction = "from_cell"`` takes the homogenized friction
 ``mu0``, ``G0`` (paper eqs. 42-43) from the same cell.  These checks need
-the interface section and the two-scale section together.
+the interface section and the two-scale section together.  Both work in
+every setting (in 3D the loop samples the interface surface).
 """
 from __future__ import annotations
 
@@ -21,14 +22,8 @@ def overrides(interface) -> dict:
     return {k: v for k, v in keys.items() if v is not None}
 
 
-def check(interface, two_scale, dim: int) -> None:
-    """Refuse a two-scale loop in 3D (naming what is missing) and cell keys without a cell."""
-    if two_scale is not None and dim == 3:
-        raise SceneError("two_scale", "...", "not available in 3D macro scenes: the loop reads the macro "
-                         "pressure from the 2D interface profile (macro_measures.interface_profile) and "
-                         "coupling.two_scale.couple does not yet read it from the 3D interface surface "
-                         "(macro_measures.interface_surface); the tabulated cell law itself works in 3D. Use "
-                         "geometry.setting = 'axisymmetric' or 'plane_strain'")
+def check(interface, two_scale) -> None:
+    """Refuse cell keys without a cell, and friction given twice."""
     cell = interface.cell or (two_scale.cell if two_scale is not None else None)
     if cell is None:
         for key, value in overrides(interface).items():

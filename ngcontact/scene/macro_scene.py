@@ -197,7 +197,8 @@ class StrengthSpec:
     """Micro-stress recovery in the interface layer and the strength check (paper eqs. 74-78)."""
 
     cell: str = param(doc="cell scene (kind cell) of the layer, relative to this scene; its [load] is "
-                      "not used (the macro state loads it); its bodies are this scene's rough and counter")
+                      "not used (the macro state loads it); its bodies are this scene's rough and counter; "
+                      "a 3D cell under a 3D macro scene (its x, y axes on the law's tangents t1, t2)")
     criterion: str = param("von_mises", doc="equivalent stress of eq. 77", choices=("von_mises", "tresca"))
     recovery: str = param("linear", doc="linear: unit-load correctors with the contact set fixed (the "
                           "cell's points without gap), superposed at every interface point (eq. 75); "
@@ -286,9 +287,7 @@ class MacroScene:
                 raise SceneError(f"loads[{i}].traction", load.traction, f"must have {dim} components")
         if self.interface.gap_coordinate == "z" and dim == 2 and self.geometry.setting != "axisymmetric":
             raise SceneError("interface.gap_coordinate", "z", "plane strain has coordinates x, y")
-        if self.strength is not None and dim == 3:
-            raise SceneError("strength", "...", "available for plane strain and axisymmetric macro problems")
-        cell_links.check(self.interface, self.two_scale, dim)
+        cell_links.check(self.interface, self.two_scale)
         if self.strength is not None:
             for role in ("rough", "counter"):
                 name = getattr(self.bodies, role)
@@ -337,6 +336,18 @@ class MacroScene:
             if cell.kind != "cell":
                 raise SceneError(key, rel, f"invalid cell scene: must be of kind 'cell', not {cell.kind!r}")
             cell_links.check_friction_source(self.interface, key, rel, cell)
+            if (key == "two_scale.cell" and self.geometry.setting == "3d" and self.interface.friction == "from_cell"
+                    and cell.contact.friction != "none"):
+                raise SceneError("interface.friction", "from_cell", f"with the frictional cell {rel!r} the two-scale "
+                                 "loop tabulates the cell's shear against one tangential jump "
+                                 "(coupling.shear_table), which a 3D macro interface with two tangents does not "
+                                 "have yet; use interface.friction = 'given' (mu, threshold) in 3D, or a 2D or "
+                                 "axisymmetric scene")
+            if key == "strength.cell" and self.geometry.setting == "3d" and cell.geometry.dim != 3:
+                raise SceneError(key, rel, f"a {cell.geometry.dim}D cell under a 3D macro scene: the macro "
+                                 "traction has two tangential components and the layer two in-plane strains, a "
+                                 "2D cell takes one of each; use a 3D cell (its x, y axes are the law's "
+                                 "tangents t1, t2)")
             if solved and cell.contact.geometric_only:
                 raise SceneError(key, rel, "invalid cell scene: contact.geometric_only = true, but this "
                                  "section solves the cell, so it needs a contact model and a [load] section")

@@ -164,7 +164,7 @@ def test_bad_friction_or_override_keys_are_refused_by_name(interface, key, words
     assert key in str(err.value) and words in str(err.value), str(err.value)
 
 
-def test_overrides_without_a_cell_and_two_scale_in_3d_are_refused_naming_the_missing_piece():
+def test_overrides_without_a_cell_are_refused_and_3d_takes_two_scale_and_a_3d_strength_cell_only():
     data = {"kind": "macro", "materials": {"steel": {"E": 210e9, "nu": 0.3}},
             "bodies": {"rough": "steel", "counter": "steel"},
             "geometry": {"shape": "coaxial", "setting": "axisymmetric",
@@ -177,6 +177,19 @@ def test_overrides_without_a_cell_and_two_scale_in_3d_are_refused_naming_the_mis
     data["geometry"]["setting"] = "3d"
     data["supports"] = [{"boundary": "bottom"}]
     data["two_scale"] = {"cell": os.path.join(CELLS, "stem_grooves.toml"), "tol": 1.0}
+    data["strength"] = {"cell": os.path.join(CELLS, "hip_hills.toml")}
+    data["materials"]["steel"]["sigma_u"] = 500e6
+    scene = from_dict(data)                       # the loop and the check with a 3D cell are accepted in 3D
+    assert scene.two_scale is not None and scene.strength is not None
+    # a 2D strength cell cannot take the two tangential tractions of a 3D interface: refused by name
+    data["strength"] = {"cell": os.path.join(CELLS, "stem_grooves.toml")}
     with pytest.raises(SceneError) as err:
         from_dict(data)
-    assert "two_scale" in str(err.value) and "interface_surface" in str(err.value), str(err.value)
+    assert "strength.cell" in str(err.value) and "2D cell under a 3D macro scene" in str(err.value), str(err.value)
+    # the cell's tabulated shear has one tangent: a frictional two-scale cell under from_cell is refused in 3D
+    data["strength"] = {"cell": os.path.join(CELLS, "hip_hills.toml")}
+    data["interface"] = {"law": "linear", "kn": 1e12, "friction": "from_cell", "cell_friction": "coulomb",
+                         "cell_mu": 0.3, "cell_w": 1e-7}
+    with pytest.raises(SceneError) as err:
+        from_dict(data)
+    assert "interface.friction" in str(err.value) and "one tangential jump" in str(err.value), str(err.value)

@@ -78,7 +78,10 @@ def test_a_3d_macro_scene_reports_its_interface_surface(tmp_path):
     assert res["maxima"]["pressure"]["pressure"] == pytest.approx(p.max())
     # the integrated area agrees with the share of samples in contact (the ends of the fit open)
     assert res["contact_area"] == pytest.approx(np.mean(p > 0), abs=0.05)
-    assert (out / "interface.csv").stat().st_size > 0 and (out / "interface.png").stat().st_size > 0
+    for name in ("interface.csv", "interface.png", "interface_axial.png", "stress.png"):
+        assert (out / name).stat().st_size > 0, name      # the profile against z and the y = 0 section too
+    header = (out / "interface.csv").read_text().splitlines()[0]
+    assert "pressure" in header and "shear_2" in header and "z" in header
     # the same press fit in axisymmetry: the mean pressure over the middle of the fit (away from the ends,
     # where the pressure is singular) agrees within the discretization error, which falls under refinement
     axi = SCENE.replace('setting = "3d"', 'setting = "axisymmetric"').replace(
