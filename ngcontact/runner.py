@@ -97,8 +97,11 @@ def has_batches(scene) -> bool:
     if scene.kind == "manufactured":
         return len(scene.manufactured.orders) * scene.manufactured.levels > 1
     if scene.kind == "cell":
-        independent = scene.load.independent and scene.discretization.tolerance is None
-        return getattr(scene, "ensemble", None) is not None or (independent and not scene.contact.geometric_only)
+        if getattr(scene, "ensemble", None) is not None:
+            return True
+        if scene.contact.geometric_only:  # no loads: one geometric solve
+            return False
+        return scene.load.independent and scene.discretization.tolerance is None
     return False
 
 

@@ -341,6 +341,9 @@ class LocalPool(Executor):
                 p.terminate()
         for p in processes:
             p.join(timeout=5)
+            if p.is_alive():  # a worker that does not stop on SIGTERM
+                p.kill()
+                p.join(timeout=5)
 
     def close(self) -> None:
         if self._pool is not None:
