@@ -44,7 +44,9 @@ from __future__ import annotations
 
 import hashlib
 import logging
+import threading
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -62,20 +64,52 @@ TABLE_FORMAT = "cell-table-1"
 TABLE_ARRAYS = ("pressure",) + T.KEYS + ("error_estimate",)
 
 
+#: cell problems built by unpickled tasks in this process (a worker), by task kind, content key and thread
+_BUILT: dict[tuple, Any] = {}
+#: how many of them a worker keeps (a long-lived Dask worker serves many runs)
+KEEP_BUILT = 4
+
+
 class PressureSolve:
-    """``p -> cell response`` of one cell scene; picklable (the cell problem is rebuilt per process)."""
+    """``p -> cell response`` of one cell scene; picklable (the cell problem is rebuilt per process).
+
+    A batch member arrives in a worker as a pickled copy of the task.  The
+    copies of one worker share the cell problem they build (its mesh, spaces
+    and forms), found by the content key of the cell scene (scene, contact
+    overrides, data files: :func:`~ngcontact.drivers.build.cell_key`) and the
+    worker thread: a worker builds the cell once per run, not once per
+    pressure, as the run's own process does with its one task.  Every
+    response is solved afresh from the rigid predictor (``first=True``), so a
+    shared problem gives the numbers of a fresh one.
+    """
 
     def __init__(self, path: str, length_unit: float, overrides: dict | None = None):
+        from ngcontact.drivers.build import cell_key, cell_scene_of
         self.path, self.length_unit, self.overrides = path, length_unit, dict(overrides or {})
+        self.key = cell_key(cell_scene_of(path, key="two_scale.cell", overrides=self.overrides))
         self._problem = None
+        self._shared = False
 
     def __getstate__(self):
-        return {"path": self.path, "length_unit": self.length_unit, "overrides": self.overrides, "_problem": None}
+        return {"path": self.path, "length_unit": self.length_unit, "overrides": self.overrides, "key": self.key,
+                "_problem": None, "_shared": False}
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._shared = True  # a copy in a worker: share the worker's cell problem
 
     def problem(self):
         if self._problem is None:
+            slot = (type(self).__name__, self.key, threading.get_ident())
+            if self._shared and slot in _BUILT:
+                self._problem = _BUILT[slot]
+                return self._problem
             from ngcontact.drivers.run_strength import cell_problem_of
             _, self._problem = cell_problem_of(self.path, key="two_scale.cell", overrides=self.overrides)
+            if self._shared:
+                while len(_BUILT) >= KEEP_BUILT:
+                    _BUILT.pop(next(iter(_BUILT)))
+                _BUILT[slot] = self._problem
         return self._problem
 
     def __call__(self, pressure: float) -> T.Response:

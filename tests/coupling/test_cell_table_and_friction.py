@@ -92,6 +92,24 @@ def test_the_pressure_solve_task_is_picklable():
     assert again.path == task.path and again.overrides == {"k_n": 1e15} and again._problem is None
 
 
+def test_copies_of_a_pressure_solve_in_one_worker_share_its_cell_problem_and_its_numbers(monkeypatch):
+    """Members of a table level arrive in a worker as pickled copies: they build the cell once (by the
+    cell scene's content key), and a shared problem answers as a fresh one does."""
+    import pickle
+    monkeypatch.setattr(R, "_BUILT", {})
+    path = os.path.join(CELLS, "stem_grooves.toml")
+    task = R.PressureSolve(path, 1.0)
+    first, second = (pickle.loads(pickle.dumps(task)) for _ in range(2))
+    other_cell = pickle.loads(pickle.dumps(R.PressureSolve(path, 1.0, {"k_n": 1e15})))
+    assert first.problem() is second.problem() and other_cell.problem() is not first.problem()
+    assert task.problem() is not first.problem()          # the submitting process keeps its own
+    pressures = (40.0, 5.0)
+    shared = [second(p) for p in pressures]               # the second after the first on one problem
+    fresh = [R.PressureSolve(path, 1.0)(p) for p in pressures[1:]]   # not a copy: builds its own cell
+    for key in T.KEYS:
+        assert shared[1][key] == pytest.approx(fresh[0][key], rel=1e-10, abs=1e-14), key
+
+
 def test_a_changed_cell_scene_or_data_file_gives_another_table_key(tmp_path):
     for name in ("tabulated_gap.toml",):
         shutil.copy(os.path.join(CELLS, name), tmp_path / name)
