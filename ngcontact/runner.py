@@ -78,7 +78,8 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
     (:func:`ngcontact.solvers.executor.make`).  The workers are started at
     once when the run will have a batch (``start``; default
     :func:`has_batches`), so that their start overlaps with the run's own
-    preparation; otherwise only if a batch comes.
+    preparation; otherwise only for a batch whose members take long enough to
+    repay the workers' start (:meth:`~ngcontact.solvers.executor.Executor.start_on_demand`).
     """
     from ngcontact.solvers import executor
     compute = getattr(scene, "compute", None)
@@ -87,6 +88,8 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
     ex = executor.make(workers, scheduler)
     if has_batches(scene) if start is None else start:
         ex.start(WORKER_MODULES)
+    else:  # batches may come (a two-scale table's levels): workers only where they repay their start
+        ex.start_on_demand()
     return executor.use(ex, progress)
 
 

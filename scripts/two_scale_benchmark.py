@@ -7,8 +7,11 @@ NGSolve's task manager on every core (as ``ngcontact run``):
 * ``fixed_law``: one macro solve with the scene's start law (``[two_scale]`` removed);
 * ``two_scale_cold``: the coupling loop with an empty cell-table cache, the cell solves of each
   table level one after the other in this process;
-* ``two_scale_cold_2_workers``: the same with the table levels on a local pool of two worker
-  processes (``ngcontact run``'s default on two cores), the pool's start counted;
+* ``two_scale_cold_2_workers``: the same with ``ngcontact run``'s default on two cores: a local
+  pool of two worker processes started on demand (a table level solves its first cell here and
+  starts the workers only if the rest repays their start; else the level runs here);
+* ``two_scale_cold_2_workers_started``: the table levels on a local pool of two workers started
+  as the run begins (their start overlaps with the first macro solve and is counted);
 * ``two_scale_warm``: the loop again with the table cached by a cold run;
 * ``cold_restarts``: the loop with a cold start of every macro solve (``warm = False``), empty cache.
 
@@ -43,18 +46,16 @@ KEYS = ("case", "repeat", "wall_seconds", "cpu_seconds", "macro_solves", "newton
         "peak_pressure_MPa")
 
 
-def measure(case: str, scene, cache_dir: str, warm: bool = True, workers: int = 1) -> dict:
+def measure(case: str, scene, cache_dir: str, warm: bool = True, workers: int = 1, started: bool = False) -> dict:
     from ngcontact import runner
     from ngcontact.drivers import run_macro as D
     from ngcontact.drivers import run_two_scale as R
     from ngcontact.macro import macro_measures as MM
-    from ngcontact.solvers import executor
     geo = D.build_geometry(scene)
     problem, _ = D.problem_of(scene, geo)
     with runner.threads(runner.thread_count()):
         t0, c0 = time.perf_counter(), time.process_time()
-        with executor.use(executor.make(workers)) as ex:
-            ex.start()
+        with runner.batches(scene, workers, start=True if started else None):  # as ngcontact run
             row = solve(scene, problem, cache_dir, warm, D, R)
         sol = row.pop("solution")
         row.update(case=case, wall_seconds=time.perf_counter() - t0, cpu_seconds=time.process_time() - c0,
@@ -96,6 +97,9 @@ def main(out: str) -> list[dict]:
             every.append(dict(measure("two_scale_warm", scene, cache), repeat=repeat))
         with tempfile.TemporaryDirectory() as cache:
             every.append(dict(measure("two_scale_cold_2_workers", scene, cache, workers=2), repeat=repeat))
+        with tempfile.TemporaryDirectory() as cache:
+            every.append(dict(measure("two_scale_cold_2_workers_started", scene, cache, workers=2, started=True),
+                              repeat=repeat))
         with tempfile.TemporaryDirectory() as cache:
             every.append(dict(measure("cold_restarts", scene, cache, warm=False), repeat=repeat))
     cases = list(dict.fromkeys(r["case"] for r in every))

@@ -135,3 +135,23 @@ def test_a_run_that_fails_while_its_workers_start_stops_them_at_once():
     while any(p.is_alive() for p in processes) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert not any(p.is_alive() for p in processes)
+
+
+@pytest.mark.parametrize("start_seconds, on_workers", [(1e9, False), (0.0, True)])
+def test_a_pool_started_on_demand_uses_its_workers_only_where_they_repay_their_start(
+        monkeypatch, start_seconds, on_workers):
+    """The first member runs here and times the batch; the rest go to the workers only if
+    ``rest * seconds * (1 - 1/workers)`` exceeds the workers' start (``START_SECONDS``)."""
+    monkeypatch.setattr(executor, "START_SECONDS", start_seconds)
+    ex = executor.LocalPool(2)
+    ex.start_on_demand()
+    seen = []
+    try:
+        out = ex.map(operator.neg, ITEMS, [f"m{k}" for k in range(len(ITEMS))], label="toy",
+                     progress=lambda label, k, n: seen.append((k, n)))
+        assert out == [-x for x in ITEMS]
+        assert (ex._pool is not None) == on_workers
+        assert seen[0] == (0, len(ITEMS)) and seen[-1] == (len(ITEMS), len(ITEMS))
+        assert [k for k, _ in seen] == sorted(k for k, _ in seen) and {n for _, n in seen} == {len(ITEMS)}
+    finally:
+        ex.close()
