@@ -131,11 +131,23 @@ def contact_pieces(problem) -> list[tuple[float, float, bool, float]]:
     coef = coef.reshape(m, -1, 3)
     tg, wg = np.polynomial.legendre.leggauss(m + 2)
     exact = contact_cuts(problem) if problem.multiplier is not None else None
+    # elements on which the penetration keeps one strict sign (all Bernstein coefficients on [0, 1] of
+    # that sign: the polynomial lies in their convex hull) are one piece: no roots to seek there
+    bern = _bernstein(m - 1) @ coef[:, :, 0]
+    whole = np.all(bern > 0.0, axis=0) | np.all(bern < 0.0, axis=0)
+    whole_on = bern[0] > 0.0
+    ends = np.stack((coef[0, :, 1], coef[:, :, 1].sum(axis=0)))       # x(0), x(1) per element
+    s = 0.5 * (tg + 1.0)
+    d_vander = P.polyvander(s, m - 1)[:, :-1] * np.arange(1, m)       # d/dt of the monomials, at s
+    whole_arc = 0.5 * (wg @ np.hypot(d_vander @ coef[1:, :, 1], d_vander @ coef[1:, :, 2]))
     out: list[tuple[float, float, bool, float]] = []
     for e in range(vals.shape[0]):
         c_pen, c_x, c_y = coef[:, e, 0], coef[:, e, 1], coef[:, e, 2]
         if exact is not None:
             cuts, states = exact[e]
+        elif whole[e]:
+            out.append((float(ends[0, e]), float(ends[1, e]), bool(whole_on[e]), float(whole_arc[e])))
+            continue
         else:
             r = P.polyroots(c_pen) if np.any(c_pen[1:]) else np.empty(0)
             r = np.sort(r[(np.abs(r.imag) <= 1e-10) & (r.real > 0.0) & (r.real < 1.0)].real)
@@ -145,6 +157,13 @@ def contact_pieces(problem) -> list[tuple[float, float, bool, float]]:
             if b > a:
                 out.append((float(P.polyval(a, c_x)), float(P.polyval(b, c_x)), on, _arc(c_x, c_y, a, b, tg, wg)))
     return out
+
+
+def _bernstein(n: int) -> np.ndarray:
+    """``B`` with ``B @ a`` the Bernstein coefficients on ``[0, 1]`` of the degree-``n`` polynomial of
+    monomial coefficients ``a``: ``b_k = sum_{j <= k} C(k, j) / C(n, j) a_j``."""
+    from math import comb
+    return np.array([[comb(k, j) / comb(n, j) if j <= k else 0.0 for j in range(n + 1)] for k in range(n + 1)])
 
 
 def _arc(c_x, c_y, a, b, tg, wg) -> float:

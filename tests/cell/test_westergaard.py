@@ -14,6 +14,7 @@ the contact fraction by about +0.1 to +0.3 % (the tolerance is 0.5 %).
 import math
 import os
 
+import numpy as np
 import ngsolve as ng
 import pytest
 
@@ -132,3 +133,19 @@ def test_mean_pressure_balances_the_load(solved):
     _check_balance(solved)
     for _, sol, _ in solved:
         assert sol.iterations <= 40
+
+
+def test_bernstein_coefficients_reproduce_the_polynomial_and_bound_it():
+    """The one-sign filter of ``contact_pieces``: on ``[0, 1]`` a polynomial equals
+    ``sum_k b_k C(n, k) t^k (1 - t)^(n - k)`` and so lies between its smallest and largest ``b_k``."""
+    from math import comb
+    from ngcontact.cell.measures import _bernstein
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 1.0, 41)
+    for n in (1, 2, 4, 6):
+        a = rng.normal(size=n + 1)
+        b = _bernstein(n) @ a
+        basis = np.array([comb(n, k) * t**k * (1 - t)**(n - k) for k in range(n + 1)])
+        values = np.polynomial.polynomial.polyval(t, a)
+        assert np.allclose(b @ basis, values, atol=1e-13)
+        assert np.all(values >= b.min() - 1e-13) and np.all(values <= b.max() + 1e-13)
