@@ -96,6 +96,18 @@ def pressure_map(path: str, pressures: list, period: float) -> None:
 
 
 # ------------------------------------------------------------------ macro
+
+STATUS_LEVELS = {"open": 0, "stick": 1, "slip": 2}
+
+
+def _status_panel(axes, ax, where, status, xlabel: str, size: float) -> None:
+    """The contact status (open, stick, slip) along the interface in ``ax``, the last panel of ``axes``."""
+    ax.scatter(where, [STATUS_LEVELS[x] for x in status], s=size)
+    ax.set_yticks(list(STATUS_LEVELS.values()), list(STATUS_LEVELS))
+    ax.set_xlabel(xlabel)
+    for a in axes:
+        a.grid(alpha=0.3)
+
 def macro_interface(path: str, prof: dict) -> None:
     """Pressure, shear, jumps and status along the interface.
 
@@ -113,12 +125,7 @@ def macro_interface(path: str, prof: dict) -> None:
     ax[1].plot(s, np.asarray(prof["jump_t"]) * 1e6, label="J . t0 (slip)")
     ax[1].set_ylabel("um")
     ax[1].legend()
-    colors = {"open": 0, "stick": 1, "slip": 2}
-    ax[2].scatter(s, [colors[x] for x in prof["status"]], s=4)
-    ax[2].set_yticks([0, 1, 2], ["open", "stick", "slip"])
-    ax[2].set_xlabel("arc length s along the interface [mm] (from the top end)")
-    for a in ax:
-        a.grid(alpha=0.3)
+    _status_panel(ax, ax[2], s, prof["status"], "arc length s along the interface [mm] (from the top end)", 4)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -171,12 +178,7 @@ def macro_interface_axial(path: str, surf: dict) -> None:
         sc = a.scatter(z, np.asarray(surf[key]) * scale, c=angle, s=3, cmap="twilight")
         a.set_ylabel(label)
     fig.colorbar(sc, ax=ax, shrink=0.6, label="angle about z [deg]")
-    colors = {"open": 0, "stick": 1, "slip": 2}
-    ax[3].scatter(z, [colors[x] for x in surf["status"]], s=3)
-    ax[3].set_yticks([0, 1, 2], ["open", "stick", "slip"])
-    ax[3].set_xlabel("axial position z [mm]")
-    for a in ax:
-        a.grid(alpha=0.3)
+    _status_panel(ax, ax[3], z, surf["status"], "axial position z [mm]", 3)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
