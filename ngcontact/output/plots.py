@@ -96,7 +96,6 @@ def pressure_map(path: str, pressures: list, period: float) -> None:
 
 
 # ------------------------------------------------------------------ macro
-
 STATUS_LEVELS = {"open": 0, "stick": 1, "slip": 2}
 
 
@@ -107,6 +106,7 @@ def _status_panel(axes, ax, where, status, xlabel: str, size: float) -> None:
     ax.set_xlabel(xlabel)
     for a in axes:
         a.grid(alpha=0.3)
+
 
 def macro_interface(path: str, prof: dict) -> None:
     """Pressure, shear, jumps and status along the interface.
