@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.fem.elasticity import COMPONENTS, vertex_wirebasket
+from ngcontact.fem.elasticity import COMPONENTS, vector_h1
 from ngcontact.errors import ModelError
 
 
@@ -108,10 +108,8 @@ def spaces(mesh, setting: str, regions: tuple[str, str], supports, order: int, p
         kw["dirichlet"] = "|".join(full)
     spaces = []
     for name in regions:
-        V = ng.VectorH1(mesh, order=order, definedon=mesh.Materials(name), **kw)
-        V = ng.Periodic(V) if periodic else V
-        vertex_wirebasket(V, mesh)
-        spaces.append(V)
+        V = vector_h1(mesh, order=order, definedon=mesh.Materials(name), **kw)
+        spaces.append(ng.Periodic(V) if periodic else V)
     return ng.FESpace(spaces)
 
 

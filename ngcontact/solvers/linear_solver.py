@@ -14,7 +14,7 @@ definite on the free dofs.  Two ways:
 * ``"iterative"``: conjugate gradients preconditioned by NGSolve's BDDC
   (balancing domain decomposition by constraints, one subdomain per element)
   with a vertex-only wirebasket: the body spaces mark their edge dofs as
-  interface dofs (:func:`ngcontact.fem.elasticity.vertex_wirebasket`, what
+  interface dofs (:func:`ngcontact.fem.elasticity.vector_h1`, what
   ``wb_withedges=False`` does for ``H1``), so the coarse problem holds the
   vertex dofs, the far-face translations (``NumberSpace`` dofs) and the dofs
   of the contact surface (:func:`ngcontact.fem.elasticity.surface_wirebasket`:
