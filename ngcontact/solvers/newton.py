@@ -373,16 +373,14 @@ def roundoff_floor(mat, vec, fixed) -> float:
     ``K`` may be stored as its lower triangle (symmetric storage).
     """
     import numpy as np
+    import scipy.sparse as sp
     vals, cols, ptr = mat.CSR()
-    vals, cols, ptr = np.asarray(vals), np.asarray(cols, dtype=np.int64), np.asarray(ptr, dtype=np.int64)
     u = np.abs(vec.FV().NumPy())
     n = len(u)
-    rows = np.repeat(np.arange(n), np.diff(ptr))
-    a = np.abs(vals)
-    m = np.bincount(rows, weights=a * u[cols], minlength=n)
-    if type(mat).__name__.startswith("SparseMatrixSymmetric"):
-        off = rows != cols
-        m += np.bincount(cols[off], weights=a[off] * u[rows[off]], minlength=n)
+    a = sp.csr_matrix((np.abs(np.asarray(vals)), np.asarray(cols), np.asarray(ptr)), shape=(n, n))
+    m = a @ u
+    if type(mat).__name__.startswith("SparseMatrixSymmetric"):   # the upper triangle is the lower's transpose
+        m += a.T @ u - a.diagonal() * u
     m[fixed] = 0.0
     return ROUNDOFF * np.finfo(float).eps * float(np.sqrt(np.dot(m, m)))
 

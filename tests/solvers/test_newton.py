@@ -101,3 +101,33 @@ def test_cell_newton_records_the_active_set_and_finds_no_false_cycle():
     assert len(sizes) == last["iterations"] and sizes[-1] > 0
     total = len(P.active_set()) * 8
     assert 0 < sizes[-1] < total      # partial contact: some points in, some out
+
+
+@pytest.mark.parametrize("symmetric_storage", [False, True])
+def test_the_roundoff_floor_is_eps_times_abs_k_times_abs_u_on_the_free_dofs(symmetric_storage):
+    """``ROUNDOFF eps || |K| |u| ||`` over the free dofs, from either storage of ``K`` (a dense check)."""
+    import numpy as np
+    from ngcontact.solvers.newton import ROUNDOFF, roundoff_floor
+    mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.25))
+    V = ng.VectorH1(mesh, order=2, dirichlet="bottom")
+    u, v = V.TnT()
+    a = ng.BilinearForm(V, symmetric=True, symmetric_storage=symmetric_storage)
+    a += (ng.InnerProduct(ng.Grad(u), ng.Grad(v)) - 0.3 * ng.InnerProduct(u, v)) * ng.dx
+    a.Assemble()
+    g = ng.GridFunction(V)
+    g.vec.FV().NumPy()[:] = np.random.default_rng(1).normal(size=V.ndof)
+    fixed = ~np.array([V.FreeDofs()[i] for i in range(V.ndof)])
+    dense = np.zeros((V.ndof, V.ndof))
+    e, col = g.vec.CreateVector(), g.vec.CreateVector()
+    full = ng.BilinearForm(V, symmetric=True)
+    full += (ng.InnerProduct(ng.Grad(u), ng.Grad(v)) - 0.3 * ng.InnerProduct(u, v)) * ng.dx
+    full.Assemble()
+    for j in range(V.ndof):
+        e[:] = 0.0
+        e[j] = 1.0
+        col.data = full.mat * e
+        dense[:, j] = col.FV().NumPy()
+    m = np.abs(dense) @ np.abs(g.vec.FV().NumPy())
+    m[fixed] = 0.0
+    expected = ROUNDOFF * np.finfo(float).eps * np.linalg.norm(m)
+    assert roundoff_floor(a.mat, g.vec, fixed) == pytest.approx(expected, rel=1e-12)
