@@ -10,7 +10,13 @@ definite on the free dofs.  Two ways:
 
 * ``"direct"``: a sparse Cholesky (or UMFPACK) factorization of ``K``.  Exact,
   but its cost grows like ``N^1.8`` in 3D (measured on the bisinusoid cell:
-  8 s at 8k dofs, 508 s at 83k dofs for a solve of 11 Newton steps).
+  8 s at 8k dofs, 508 s at 83k dofs for a solve of 11 Newton steps).  The
+  tangent of every step has the sparsity of the first (the form's matrix
+  is assembled in place), so while the free dofs stay the same the
+  factorization is only refreshed (``Update``: the fill-reducing ordering
+  and symbolic analysis are kept); on the 2D stem-grooves cell of 7.6k
+  dofs that is 10 ms against 22 ms for a fresh one, with the same
+  solution to round-off.
 * ``"iterative"``: conjugate gradients preconditioned by NGSolve's BDDC
   (balancing domain decomposition by constraints, one subdomain per element)
   with a vertex-only wirebasket: the body spaces mark their edge dofs as
@@ -59,6 +65,8 @@ from ngcontact.errors import ConvergenceError
 POLICIES = ("direct", "iterative", "auto")
 #: LU solvers NGSolve offers for a non-symmetric tangent; any other ``inverse`` (Cholesky) gives way to UMFPACK
 LU_INVERSES = ("umfpack", "pardiso", "mumps")
+#: factorizations whose ``Update()`` refactorizes a changed matrix of the same sparsity (tested)
+UPDATABLE = ("sparsecholesky", "umfpack")
 #: free dofs from which "auto" solves 3D problems iteratively (BDDC-CG against sparse Cholesky, order 2)
 AUTO_THRESHOLD = 20_000
 
@@ -90,6 +98,7 @@ class LinearSolver:
     solves: int = 0
     methods: set = field(default_factory=set)
     _pre: dict = field(default_factory=dict, repr=False)
+    _factors: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
         if self.policy not in POLICIES:
@@ -128,7 +137,7 @@ class LinearSolver:
         if self.method(freedofs, form.space.mesh.dim) == "direct":
             inverse = self.inverse if symmetric or self.inverse in LU_INVERSES else "umfpack"
             self.methods.add(f"direct ({inverse})")
-            return TangentSolve(self, form.mat.Inverse(freedofs, inverse=inverse), counted=False)
+            return TangentSolve(self, self._factorization(form, freedofs, inverse), counted=False)
         pre = self._pre.get(id(form))
         if pre is None:
             raise RuntimeError("LinearSolver.register(form) must come before the form's first assembly")
@@ -141,6 +150,19 @@ class LinearSolver:
         self.tolerances.append(tol)
         return TangentSolve(self, krylov(form.mat, pre.mat, tol=tol, maxiter=self.max_iter,
                                          printrates=False), counted=True)
+
+    def _factorization(self, form: ng.BilinearForm, freedofs, inverse: str):
+        """The factorization of ``form.mat`` on ``freedofs``: refreshed in place (``Update``) when the same
+        matrix (hence sparsity) and free dofs were factorized before by ``inverse``, else a fresh one."""
+        mat, free = form.mat, freedofs.__getstate__()
+        key = (id(form), inverse)
+        held = self._factors.get(key)
+        if held is not None and held[0] is mat and held[1] == free and inverse in UPDATABLE:
+            held[2].Update()
+            return held[2]
+        inv = mat.Inverse(freedofs, inverse=inverse)
+        self._factors[key] = (mat, free, inv)
+        return inv
 
     def summary(self) -> dict:
         """What was done, JSON-ready."""

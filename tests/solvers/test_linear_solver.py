@@ -136,3 +136,34 @@ def test_an_unknown_policy_is_refused():
     with pytest.raises(ValueError, match="policy = 'cg'"):
         LinearSolver("cg")
     assert math.isfinite(LinearSolver("auto").threshold)
+
+
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_a_direct_solve_of_the_same_matrix_and_free_dofs_refreshes_its_factorization(symmetric):
+    """Newton's tangents share one sparsity: the second factorization is the first one refreshed
+    (``Update``), and it solves the changed matrix as a fresh one does; other free dofs factorize afresh."""
+    from netgen.geom2d import unit_square
+    mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.2))
+    V = ng.H1(mesh, order=2, dirichlet="bottom")
+    u, v = V.TnT()
+    c = ng.Parameter(1.0)
+    form = ng.BilinearForm(V, symmetric=symmetric)
+    form += (ng.grad(u) * ng.grad(v) + c * u * v + (0.0 if symmetric else 0.3) * ng.grad(u)[0] * v) * ng.dx
+    solver = LinearSolver("direct")
+    form.Assemble()
+    first = solver.prepare(form, V.FreeDofs(), symmetric=symmetric).inverse
+    c.Set(40.0)
+    form.Assemble()
+    second = solver.prepare(form, V.FreeDofs(), symmetric=symmetric).inverse
+    assert second is first
+    x = ng.GridFunction(V).vec
+    x.FV().NumPy()[:] = np.random.default_rng(2).normal(size=V.ndof)
+    free = np.array([V.FreeDofs()[i] for i in range(V.ndof)])
+    x.FV().NumPy()[~free] = 0.0
+    rhs, y = x.CreateVector(), x.CreateVector()
+    rhs.data = form.mat * x
+    y.data = second * rhs
+    assert np.max(np.abs(y.FV().NumPy() - x.FV().NumPy())) < 1e-12
+    other = ng.BitArray(V.FreeDofs())
+    other.Clear(int(np.flatnonzero(free)[0]))
+    assert solver.prepare(form, other, symmetric=symmetric).inverse is not first
