@@ -19,8 +19,8 @@ Executors:
 * :class:`DaskCluster` - the workers of a ``dask.distributed`` scheduler at
   an address; Dask is the cluster engine, this module only submits.
 
-Failures: a member that raises (or whose worker process dies) is run once
-more; a second failure ends the batch with :class:`~ngcontact.errors.BatchError`
+Failures (the attempt itself: :mod:`ngcontact.solvers.batch_member`): a member that raises (or whose
+worker process dies) is run once more; a second failure ends the batch with :class:`~ngcontact.errors.BatchError`
 naming the member and the reason, and no result of the batch is returned.
 An interruption (``KeyboardInterrupt``, or any exception in the caller while
 it waits) stops the workers before it propagates.
@@ -43,100 +43,20 @@ import contextlib
 import contextvars
 import logging
 import os
-import threading
 import time
-import traceback
-from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
 from ngcontact.errors import BatchError, NgcontactError
+from ngcontact.solvers.batch_member import ATTEMPTS, fault_from_env, in_worker, one_thread, reason, run_member
 
 log = logging.getLogger(__name__)
 
 #: ``progress(label, finished, total)``, called at the start (0) and after every finished member.
 Progress = Callable[[str, int, int], None]
 
-#: Test-only fault injection, read in the submitting process: ``"MEMBER:ATTEMPTS:MODE"`` makes the member
-#: named ``MEMBER`` fail on its first ``ATTEMPTS`` attempts, by raising (``raise``) or by ending its worker
-#: process (``kill``).  Not a setting of the package: the tests of retries and failures use it.
-FAULT_ENV = "NGCONTACT_TEST_FAULT"
-
-#: The number of attempts of a member (the first and one retry).
-ATTEMPTS = 2
-
-
 def default_workers() -> int:
     """The cores this process may use."""
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-
-
-# ----------------------------------------------------------------- members
-@dataclass(frozen=True)
-class _Fault:
-    member: str
-    attempts: int
-    mode: str
-
-
-def _fault() -> _Fault | None:
-    raw = os.environ.get(FAULT_ENV)
-    if not raw:
-        return None
-    member, attempts, mode = raw.rsplit(":", 2)
-    return _Fault(member, int(attempts), mode)
-
-
-def run_member(fn: Callable[[Any], Any], item: Any, name: str, attempt: int, fault: _Fault | None) -> Any:
-    """One attempt of one member, in whichever process runs it (NGSolve on one thread there)."""
-    if fault is not None and fault.member == name and attempt < fault.attempts:
-        if fault.mode == "kill" and _IN_WORKER:
-            os._exit(70)
-        raise RuntimeError(f"injected fault (attempt {attempt + 1})")
-    try:
-        with _ONE_AT_A_TIME:
-            return fn(item)
-    except Exception as exc:  # the package's errors take several arguments: they do not unpickle
-        raise MemberFailure(_reason(exc), traceback.format_exc()) from None
-
-
-class MemberFailure(Exception):
-    """A member's exception as it crosses from a worker: its type and first line, and the traceback."""
-
-    def __init__(self, reason: str, detail: str = ""):
-        super().__init__(reason, detail)
-        self.reason = reason
-        self.detail = detail
-
-    def __str__(self) -> str:
-        return self.reason
-
-
-#: One member at a time per process: Netgen's mesher keeps global state, and a Dask worker may run threads.
-_ONE_AT_A_TIME = threading.Lock()
-
-
-#: True in a worker process (the test-only ``kill`` fault ends only a worker, never the submitting process).
-_IN_WORKER = False
-
-
-def _one_thread(ignore_sigint: bool) -> None:
-    """Worker start: NGSolve on one thread; a pool's workers leave SIGINT to the submitting process, which
-    stops them."""
-    global _IN_WORKER
-    _IN_WORKER = True
-    os.environ["NGCONTACT_THREADS"] = "1"
-    if ignore_sigint:
-        import signal
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-    import ngsolve
-    ngsolve.SetNumThreads(1)
-
-
-def _reason(exc: BaseException) -> str:
-    if isinstance(exc, MemberFailure):
-        return exc.reason
-    text = str(exc).strip().splitlines()
-    return f"{type(exc).__name__}: {text[0] if text else ''}".rstrip(": ")
 
 
 # --------------------------------------------------------------- executors
@@ -154,7 +74,7 @@ class Executor:
         progress = progress or _PROGRESS.get()
         if progress is not None:
             progress(label, 0, len(items))
-        fault = _fault()
+        fault = fault_from_env()
         t0 = time.perf_counter()
         out = self._map(fn, list(items), list(names), label, progress, fault)
         self.record.append({"label": label, "members": len(items), "seconds": time.perf_counter() - t0})
@@ -175,11 +95,11 @@ class Executor:
                     break
                 except Exception as exc:  # retried once, then reported
                     error = exc
-                    log.info("%s: %s failed (%s)%s", label, name, _reason(exc),
+                    log.info("%s: %s failed (%s)%s", label, name, reason(exc),
                                 "; retrying" if attempt + 1 < ATTEMPTS else "")
             else:
                 assert error is not None
-                raise BatchError(label, name, _reason(error)) from error
+                raise BatchError(label, name, reason(error)) from error
             if progress is not None:
                 progress(label, k + 1, len(items))
         return out
@@ -345,11 +265,11 @@ class LocalPool(Executor):
     @staticmethod
     def _failed(label, name, failures, k, exc) -> None:
         failures[k] += 1
-        log.debug("%s: %s: %s", label, name, getattr(exc, "detail", "") or _reason(exc))
-        log.info("%s: %s failed (%s)%s", label, name, _reason(exc),
+        log.debug("%s: %s: %s", label, name, getattr(exc, "detail", "") or reason(exc))
+        log.info("%s: %s failed (%s)%s", label, name, reason(exc),
                     "; retrying" if failures[k] < ATTEMPTS else "")
         if failures[k] >= ATTEMPTS:
-            raise BatchError(label, name, _reason(exc)) from exc
+            raise BatchError(label, name, reason(exc)) from exc
 
     def _running_on_dead_workers(self, names) -> set[str]:
         """Members last started by worker processes that died by themselves (their start records, by pid).
@@ -400,7 +320,7 @@ _STARTED = None
 def _worker_start(started) -> None:
     global _STARTED
     _STARTED = started
-    _one_thread(ignore_sigint=True)
+    one_thread(ignore_sigint=True)
 
 
 def _warm_up(modules: tuple[str, ...]) -> None:
@@ -435,7 +355,7 @@ class DaskCluster(Executor):
             try:
                 self._client = Client(self.address, timeout=30, set_as_default=False)
             except Exception as exc:
-                raise NgcontactError(f"scheduler {self.address!r}: cannot connect ({_reason(exc)})") from exc
+                raise NgcontactError(f"scheduler {self.address!r}: cannot connect ({reason(exc)})") from exc
             info = self._client.scheduler_info()["workers"].values()
             self.workers = max(1, sum(w.get("nthreads", 1) for w in info))
         return self._client
@@ -481,8 +401,8 @@ class DaskCluster(Executor):
 
 
 def _dask_member(fn, item, name, attempt, fault):
-    if not _IN_WORKER:
-        _one_thread(ignore_sigint=False)
+    if not in_worker():
+        one_thread(ignore_sigint=False)
     return run_member(fn, item, name, attempt, fault)
 
 

@@ -19,7 +19,7 @@ import pytest
 
 from ngcontact import cli
 from ngcontact.runner import solve
-from ngcontact.solvers.executor import FAULT_ENV
+from ngcontact.solvers.batch_member import FAULT_ENV
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 

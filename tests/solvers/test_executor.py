@@ -11,7 +11,7 @@ import time
 import pytest
 
 from ngcontact.errors import BatchError
-from ngcontact.solvers import executor
+from ngcontact.solvers import batch_member, executor
 
 ITEMS = [1.5, -2.0, 3.25, 7.0, -0.5]
 NAMES = [f"m{k}" for k in range(len(ITEMS))]
@@ -39,21 +39,21 @@ def test_names_must_be_distinct():
 
 @pytest.mark.parametrize("make", [executor.Serial, lambda: None], ids=["serial", "pool"])
 def test_a_member_failing_once_is_retried_and_the_batch_completes(monkeypatch, pool, make):
-    monkeypatch.setenv(executor.FAULT_ENV, "m2:1:raise")
+    monkeypatch.setenv(batch_member.FAULT_ENV, "m2:1:raise")
     ex = make() or pool
     assert ex.map(operator.neg, ITEMS, NAMES) == EXPECTED
 
 
 def test_a_killed_worker_is_replaced_and_its_member_retried(monkeypatch, pool):
-    monkeypatch.setenv(executor.FAULT_ENV, "m3:1:kill")
+    monkeypatch.setenv(batch_member.FAULT_ENV, "m3:1:kill")
     assert pool.map(operator.neg, ITEMS, NAMES, label="toy") == EXPECTED
-    monkeypatch.delenv(executor.FAULT_ENV)
+    monkeypatch.delenv(batch_member.FAULT_ENV)
     assert pool.map(operator.neg, ITEMS, NAMES) == EXPECTED      # the pool works on afterwards
 
 
 @pytest.mark.parametrize("mode", ["raise", "kill"])
 def test_a_member_failing_twice_ends_the_batch_naming_it(monkeypatch, pool, mode):
-    monkeypatch.setenv(executor.FAULT_ENV, f"m1:2:{mode}")
+    monkeypatch.setenv(batch_member.FAULT_ENV, f"m1:2:{mode}")
     with pytest.raises(BatchError) as info:
         pool.map(operator.neg, ITEMS, NAMES, label="toy")
     assert info.value.member == "m1"
