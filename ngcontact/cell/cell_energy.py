@@ -32,19 +32,25 @@ import ngsolve as ng
 from ngcontact.laws import penalty as _contact
 
 
-def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | None]:
+def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | None, tuple]:
     """The form of ``Pi`` for the trial functions ``(ur, uc, U)`` of ``problem``'s space.
 
-    Returns the form and, for Coulomb friction with the penalty, the
+    Returns the form, for Coulomb friction with the penalty the
     GridFunction of the frozen previous state whose pressure sets the
-    threshold (``None`` otherwise).
+    threshold (``None`` otherwise), and the forms of its two parts ``(Q,
+    Psi)``: the bodies with the load potential (quadratic) and the interface
+    energy, with the same terms (for :class:`ngcontact.solvers.split_energy.SplitEnergy`).
     """
     m = problem.model
     previous = None
-    # UMFPACK reads only one triangle of a symmetric-storage matrix: full storage for it
-    form = ng.BilinearForm(problem.X, symmetric=True,
-                           symmetric_storage=problem.inverse == "sparsecholesky")
-    _add_bodies(form, problem, ur, uc)
+
+    def new_form():
+        # UMFPACK reads only one triangle of a symmetric-storage matrix: full storage for it
+        return ng.BilinearForm(problem.X, symmetric=True, symmetric_storage=problem.inverse == "sparsecholesky")
+    form, quadratic, interface = new_form(), new_form(), new_form()
+    for term in _bodies(problem, ur, uc) + [_load(problem, U)]:
+        form += term
+        quadratic += term
     J = ur - uc - U
     lam = None if problem.multiplier is None else problem.multiplier.value
     friction = threshold = w = None
@@ -66,9 +72,10 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
                                     w=w, threshold=threshold, multiplier=lam)
     ds = (ng.ds("contact", bonus_intorder=m.contact_bonus_order) if problem.multiplier is None
           else problem.multiplier.ds)
-    form += ng.Variation(psi * ds)
-    _add_load(form, problem, U)
-    return form, previous
+    term = ng.Variation(psi * ds)
+    form += term
+    interface += term
+    return form, previous, (quadratic, interface)
 
 
 def coulomb_residual(problem) -> ng.BilinearForm:
@@ -84,30 +91,33 @@ def coulomb_residual(problem) -> ng.BilinearForm:
     trial, test = problem.X.TrialFunction(), problem.X.TestFunction()
     ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
     form = ng.BilinearForm(problem.X, symmetric=False)
-    _add_bodies(form, problem, ur, uc)
+    for term in _bodies(problem, ur, uc):
+        form += term
     J = ur - uc - U
     dJ = test[0] - test[1] - ng.CF(tuple(test[2:]))
     ds = ng.ds("contact", bonus_intorder=m.contact_bonus_order)
     form += ng.Variation(_contact.normal_energy(J, problem.n, m.k_n, problem.gap) * ds)
     G = _contact.coulomb_threshold(J, problem.n, m.k_n, fr.mu, problem.gap)
     form += ng.InnerProduct(_contact.friction_traction(J, problem.n, G, fr.w), dJ) * ds
-    _add_load(form, problem, U)
+    form += _load(problem, U)
     return form
 
 
-def _add_bodies(form, problem, ur, uc) -> None:
-    """The bodies' elastic energies (with the macro strain when assembled)."""
+def _bodies(problem, ur, uc) -> list:
+    """The bodies' elastic energies (with the macro strain when assembled), one term per body."""
     m, mesh = problem.model, problem.mesh
+    terms = []
     for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
         eps = problem.body_strain(u)
-        form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
-                             * ng.dx(definedon=mesh.Materials(name)))
+        terms.append(ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
+                                  * ng.dx(definedon=mesh.Materials(name))))
+    return terms
 
 
-def _add_load(form, problem, U) -> None:
+def _load(problem, U):
     """The potential ``-|T| tbar . U`` of the far-face tractions."""
     t = ng.CF(tuple(problem.traction))
-    form += ng.Variation(-ng.InnerProduct(t, U) * ng.ds("top"))
+    return ng.Variation(-ng.InnerProduct(t, U) * ng.ds("top"))
 
 
 def macro_strain_cf(params, dim: int):

@@ -77,6 +77,7 @@ from ngcontact.laws import penalty as _contact
 from ngcontact.errors import ModelError
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
+from ngcontact.solvers.split_energy import SplitEnergy
 from ngcontact.fem.quadrature import sampling_order
 
 log = logging.getLogger(__name__)
@@ -179,7 +180,8 @@ class CellProblem:
         self.augmentation = ng.Parameter(model.k_n)
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
-        self.form, self.coulomb_previous = cell_energy(self, ur, uc, U)
+        self.form, self.coulomb_previous, self._parts = cell_energy(self, ur, uc, U)
+        self._split = None
         # the state as CoefficientFunctions (for results and tests)
         comps = self.gfu.components
         self.U = ng.CF(tuple(comps[2:]))
@@ -282,8 +284,19 @@ class CellProblem:
             return solve_exact(self, lambda a: self._newton_once(free, a), atol)
         return self._newton_once(free, atol)
 
+    def energy(self, free):
+        """The energy Newton minimizes on ``free``: the whole form for iterative solves (BDDC is built by
+        its assembly), else the same energy split into the bodies' quadratic part, assembled once, and
+        the interface (:class:`~ngcontact.solvers.split_energy.SplitEnergy`)."""
+        if self.linear.method(free, self.dim) == "iterative":
+            return self.form
+        if self._split is None:
+            loads = self.traction + self.strain_params
+            self._split = SplitEnergy(self.form, *self._parts, key=lambda: tuple(p.Get() for p in loads))
+        return self._split
+
     def _newton_once(self, free, atol) -> dict:
-        h = minimize(self.form, self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
+        h = minimize(self.energy(free), self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
                      max_iter=self.max_iter, linear=self.linear, line_search=self.line_search,
                      active_set=self.active_set)
         return h.as_dict()

@@ -209,8 +209,11 @@ def max_gap(problem) -> float:
     """Largest initial gap at the quadrature points of ``S_C`` (0 without gap)."""
     if problem.gap is None:
         return 0.0
-    vals = sample_surface(problem, {"g": problem.gap})["g"]
-    return float(max(vals.max(), 0.0))
+    held = getattr(problem, "_max_gap", None)
+    if held is None or held[0] is not problem.gap:      # the gap of a problem is fixed: sampled once
+        held = (problem.gap, float(max(sample_surface(problem, {"g": problem.gap})["g"].max(), 0.0)))
+        problem._max_gap = held
+    return held[1]
 
 
 def set_start(problem, load: CellLoad) -> None:
@@ -360,7 +363,7 @@ def rigid_continuation(problem, free, before: tuple[float, ...] | None = None) -
     tangential traction or prescribed tangential jump changed is continued
     (a normal increment is carried by the bodies' compliance, which the
     rigid translation does not see).  Runs Newton
-    (:func:`ngcontact.solvers.newton.minimize`) on ``problem.form`` with
+    (:func:`ngcontact.solvers.newton.minimize`) on ``problem.energy`` with
     only those dofs free and the problem's tolerance and line search, and
     returns its history with ``"stage": "rigid_continuation"``, or ``None``
     (state unchanged) when the load was not continued or the frozen
@@ -379,7 +382,7 @@ def rigid_continuation(problem, free, before: tuple[float, ...] | None = None) -
     saved = problem.gfu.vec.CreateVector()
     saved.data = problem.gfu.vec
     try:
-        h = minimize(problem.form, problem.gfu, freedofs=rigid, rtol=problem.rtol, atol=problem.atol,
+        h = minimize(problem.energy(rigid), problem.gfu, freedofs=rigid, rtol=problem.rtol, atol=problem.atol,
                      max_iter=problem.max_iter, inverse=problem.inverse,
                      line_search=problem.line_search).as_dict()
     except ConvergenceError as err:

@@ -78,6 +78,7 @@ from ngcontact.fem.sampling import boundary_values
 from ngcontact.solvers.coulomb import coulomb_fixed_point
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
+from ngcontact.solvers.split_energy import SplitEnergy
 from ngcontact.fem.rigid_modes import check_rigid_modes, free_rigid_modes
 from ngcontact.solvers.continuation import INTERMEDIATE_RTOL, ladder
 from ngcontact.solvers.coulomb_newton import FrozenTresca, coupled_newton
@@ -168,7 +169,7 @@ def gap_cf(gap):
 
 
 def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float | None = None,
-          coupled: bool = False):
+          coupled: bool = False, split: bool = False):
     """Energy of the macro problem as a symmetric ``BilinearForm`` of ``Variation`` terms.
 
     With ``start_stiffness`` the interface energy is the quadratic start
@@ -181,14 +182,23 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
     the energy without friction plus the virtual work of the friction
     traction whose threshold ``G = mu [p(u)]_+ + G0`` is the current
     pressure's; not symmetric.
+
+    With ``split`` the form is a :class:`~ngcontact.solvers.split_energy.SplitEnergy`:
+    the same terms, the bodies and loads (quadratic) assembled once and only
+    the interface at each state (for direct tangent solves; BDDC needs the
+    whole form's assembly).
     """
     mesh, setting = problem.mesh, problem.setting
     w = elasticity.weight(setting)
     ur, uc = fes.TrialFunction()
     form = ng.BilinearForm(fes, symmetric=not coupled)
-    elasticity.add_elastic_energy(form, mesh, {problem.rough: problem.materials[problem.rough],
-                                               problem.counter: problem.materials[problem.counter]},
-                                  {problem.rough: ur, problem.counter: uc}, setting)
+    quadratic = ng.BilinearForm(fes, symmetric=not coupled)
+    interface = ng.BilinearForm(fes, symmetric=not coupled)
+    for f in (form, quadratic):
+        elasticity.add_elastic_energy(f, mesh, {problem.rough: problem.materials[problem.rough],
+                                                problem.counter: problem.materials[problem.counter]},
+                                      {problem.rough: ur, problem.counter: uc}, setting)
+        two_body.add_load_potential(f, mesh, problem.loads, (ur, uc), w)
     a = _local(frame, ur.Trace() - uc.Trace())
     g0 = gap_cf(problem.gap)
     law = problem.law
@@ -204,10 +214,13 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
         b = _local(frame, vr.Trace() - vc.Trace())
         work = sum(f * bi for f, bi in zip(ie.friction_traction(law.friction, a, G)[1:], b[1:]))
         form += work * w * ds
+        interface += work * w * ds
     else:
         W = ie.energy(law, a, g0, G)
-    form += ng.Variation(W * w * ds)
-    return two_body.add_load_potential(form, mesh, problem.loads, (ur, uc), w)
+    term = ng.Variation(W * w * ds)
+    form += term
+    interface += term
+    return SplitEnergy(form, quadratic, interface, key=lambda: None) if split else form
 
 
 def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
@@ -258,6 +271,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     frame = local_frame(n0, mesh.dim)
     law = problem.law
     linear = linear if linear is not None else LinearSolver("direct", inverse=inverse)
+    split = linear.method(fes.FreeDofs(), mesh.dim) == "direct"
     newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, linear=linear)
     history: dict[str, Any] = {"newton": [], "coulomb": None, "coulomb_changes": [], "coulomb_iterations": 0}
     g0 = gap_cf(problem.gap)
@@ -279,7 +293,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     elif start is not None:
         _warm(gfu, start)
     if law.friction is not None and law.friction.coulomb and coulomb == "newton":
-        coupled = _coupled_newton(problem, fes, frame, gfu, newton)
+        coupled = _coupled_newton(problem, fes, frame, gfu, newton, split)
         history["newton"].extend(coupled["newton"])
         history["coulomb"] = {"method": "coupled Newton", "widths": coupled["widths"]}
         old.vec.data = gfu.vec
@@ -287,7 +301,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     elif law.friction is not None and law.friction.coulomb:
         history["coulomb"] = {"method": "fixed point"}
         G = ie.threshold(law.friction, ie.pressure(law.normal, a_old, g0))
-        form = _form(problem, fes, frame, G=G)
+        form = _form(problem, fes, frame, G=G, split=split)
         p_now = ie.pressure(law.normal, _local(frame, gfu.components[0] - gfu.components[1]), g0)
 
         def freeze() -> None:
@@ -303,7 +317,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     else:
         if law.friction is not None:
             G = ng.CF(ie.threshold(law.friction, 0.0))
-        form = _form(problem, fes, frame, G=G)
+        form = _form(problem, fes, frame, G=G, split=split)
         history["newton"].append(minimize(form, gfu, quadratic=law.quadratic, **newton).as_dict())
     history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
     history["converged"] = all(h["converged"] for h in history["newton"] if not h.get("failed"))
@@ -315,7 +329,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     return sol
 
 
-def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dict:
+def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict, split: bool = False) -> dict:
     """Coulomb friction by Newton on the coupled equations, with continuation in the Huber width on failure.
 
     First Newton from the start value at the scene's width ``w``; where it
@@ -332,8 +346,8 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
     start = gfu.vec.CreateVector()
     start.data = gfu.vec
     try:
-        return {"newton": [coupled_newton(_form(problem, fes, frame, coupled=True), gfu,
-                                          frozen=frozen_tresca(problem, fes, frame, gfu), **newton)],
+        return {"newton": [coupled_newton(_form(problem, fes, frame, coupled=True, split=split), gfu,
+                                          frozen=frozen_tresca(problem, fes, frame, gfu, split), **newton)],
                 "widths": []}
     except ConvergenceError as err:
         if not isinstance(friction, il.Friction):   # a tabulated cell shear has no Huber width to continue in
@@ -348,8 +362,8 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
     def solve_at(w: float, last: bool) -> dict:
         at = replace(problem, law=replace(law, friction=replace(friction, width=w)))
         opts = newton if last else {**newton, "rtol": INTERMEDIATE_RTOL, "atol": 0.0}
-        return coupled_newton(_form(at, fes, frame, coupled=True), gfu, frozen=frozen_tresca(at, fes, frame, gfu),
-                              **opts)
+        return coupled_newton(_form(at, fes, frame, coupled=True, split=split), gfu,
+                              frozen=frozen_tresca(at, fes, frame, gfu, split), **opts)
 
     def save():
         copy = gfu.vec.CreateVector()
@@ -369,7 +383,7 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
     return {"newton": failed + [r["history"] for r in rungs], "widths": [r["width"] for r in rungs]}
 
 
-def frozen_tresca(problem: MacroProblem, fes, frame, gfu: ng.GridFunction) -> FrozenTresca:
+def frozen_tresca(problem: MacroProblem, fes, frame, gfu: ng.GridFunction, split: bool = False) -> FrozenTresca:
     """The Tresca energy whose threshold ``mu [p]_+ + G0`` is the pressure of a frozen copy of ``gfu``.
 
     The coupled Newton's line search minimizes it along its step, frozen at
@@ -384,7 +398,7 @@ def frozen_tresca(problem: MacroProblem, fes, frame, gfu: ng.GridFunction) -> Fr
     def freeze() -> None:
         old.vec.data = gfu.vec
 
-    return FrozenTresca(_form(problem, fes, frame, G=G), freeze)
+    return FrozenTresca(_form(problem, fes, frame, G=G, split=split), freeze)
 
 
 def start_stiffness(problem: MacroProblem) -> float:
