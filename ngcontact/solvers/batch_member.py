@@ -80,7 +80,7 @@ def in_worker() -> bool:
 
 
 def one_thread(ignore_sigint: bool) -> None:
-    """Worker start: NGSolve on one thread; a pool's workers leave SIGINT to the submitting process, which
+    """Worker start: NGSolve and BLAS on one thread; a pool's workers leave SIGINT to the submitting process, which
     stops them."""
     global _IN_WORKER
     _IN_WORKER = True
@@ -90,6 +90,8 @@ def one_thread(ignore_sigint: bool) -> None:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     import ngsolve
     ngsolve.SetNumThreads(1)
+    from threadpoolctl import threadpool_limits
+    threadpool_limits(limits=1)     # nor BLAS threads (runner.threads): for the rest of the worker's life
 
 
 def reason(exc: BaseException) -> str:
