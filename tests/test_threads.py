@@ -39,3 +39,22 @@ def test_a_bad_thread_count_is_refused_before_anything_is_written(tmp_path, monk
     err = capsys.readouterr().err
     assert f"environment variable NGCONTACT_THREADS = {value!r}: the number of threads: an integer >= 1" in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("n", [1, 2])
+def test_blas_runs_on_one_thread_inside_a_run_and_gets_its_threads_back(n):
+    """Inside ``runner.threads`` every BLAS library loaded (NGSolve's, NumPy's) is held at one thread, so
+    that its spinning threads do not share the cores with NGSolve's task manager; after, as before."""
+    import ngsolve  # noqa: F401  (loads NGSolve's BLAS)
+    import numpy  # noqa: F401
+    from threadpoolctl import threadpool_info
+    from ngcontact import runner
+    blas = [i for i in threadpool_info() if i["user_api"] == "blas"]
+    if not blas:
+        pytest.skip("no BLAS library with a thread pool is loaded")
+    before = {i["filepath"]: i["num_threads"] for i in blas}
+    with runner.threads(n):
+        inside = {i["filepath"]: i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"}
+    after = {i["filepath"]: i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"}
+    assert set(inside.values()) == {1}
+    assert after == before
