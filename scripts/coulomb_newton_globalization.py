@@ -33,7 +33,7 @@ from contextlib import contextmanager
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import ngsolve as ng  # noqa: E402
+from ngcontact import runner  # noqa: E402
 
 from ngcontact.cell import coulomb_friction  # noqa: E402
 from ngcontact.drivers.build import cell_loads  # noqa: E402
@@ -79,7 +79,7 @@ def run_cell() -> dict:
     problem = fe_problem(scene)
     t0 = time.perf_counter()
     try:
-        with ng.TaskManager():
+        with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
             sols = problem.sweep(cell_loads(scene))
     except ConvergenceError as err:
         return {"case": "cell rectangular_coulomb", "converged": False, "seconds": time.perf_counter() - t0,

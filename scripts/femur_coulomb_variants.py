@@ -25,7 +25,7 @@ import time
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import ngsolve as ng  # noqa: E402
+from ngcontact import runner  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ngcontact.drivers import run_macro as RM  # noqa: E402
@@ -87,7 +87,7 @@ def run(name: str, method: str, tmp: str) -> dict:
     row = {"variant": name, "method": method}
     t0 = time.perf_counter()
     try:
-        with ng.TaskManager():
+        with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
             sol = RM.solve_scene(scene, problem)
     except ConvergenceError as err:
         return {**row, "converged": False, "seconds": time.perf_counter() - t0, "failure": str(err)[:160]}

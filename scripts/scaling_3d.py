@@ -66,14 +66,14 @@ def peak_memory_gb() -> float:
 
 
 def cell_child(size: float, policy: str) -> dict:
-    import ngsolve as ng
+    from ngcontact import runner
     from ngcontact.cell.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of
     from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
     scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
     cell = build_cell(scene, interface_maxh=size)
-    with ng.TaskManager():
+    with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
         t0 = time.perf_counter()
         P = CellProblem(cell, model_of(scene), linear=LinearSolver(policy))
         sol = P.solve(cell_loads(scene)[0], first=True, measure=False)
@@ -84,7 +84,7 @@ def cell_child(size: float, policy: str) -> dict:
 
 
 def macro_child(size: float, policy: str) -> dict:
-    import ngsolve as ng
+    from ngcontact import runner
     from ngcontact.fem.materials import isotropic
     from ngcontact.geometry import bodies as gm
     from ngcontact.laws import homogenized as il
@@ -93,7 +93,7 @@ def macro_child(size: float, policy: str) -> dict:
     g = gm.coaxial_3d(0.5, 1.0, 1.6, 1.0, maxh=size, order=2)
     law = il.InterfaceLaw(normal=il.TabulatedLaw(closure=(0.0, 5e-4, 2e-3), pressure=(0.0, 0.05, 0.5), kt=100.0))
     linear = LinearSolver(policy)
-    with ng.TaskManager():
+    with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
         t0 = time.perf_counter()
         sol = M.solve(M.MacroProblem(mesh=g.mesh, setting="3d", rough="inner", counter="outer",
                                      materials={"inner": isotropic(200.0, 0.3), "outer": isotropic(70.0, 0.25)},

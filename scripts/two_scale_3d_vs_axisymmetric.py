@@ -56,6 +56,7 @@ def shared_response():
 
 def measure(case: str, name: str, sizes: dict, response) -> tuple[dict, dict]:
     import ngsolve as ng
+    from ngcontact import runner
     from ngcontact.coupling import two_scale as T
     from ngcontact.drivers import run_macro as RM
     from ngcontact.drivers.run_strength import evaluate
@@ -67,7 +68,7 @@ def measure(case: str, name: str, sizes: dict, response) -> tuple[dict, dict]:
     problem, _ = RM.problem_of(scene, RM.build_geometry(scene, **sizes), order=2)
     spec = scene.two_scale
     table = T.CellTable(response, tol=spec.table_tol)
-    with ng.TaskManager():
+    with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
         out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
                        solve=lambda prob, start: RM.solve_scene(scene, prob, start))
         st = evaluate(scene, out.solution)

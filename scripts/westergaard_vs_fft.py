@@ -56,6 +56,7 @@ from dataclasses import replace
 
 import numpy as np
 import ngsolve as ng
+from ngcontact import runner
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_problem import CellModel, CellProblem
@@ -115,7 +116,7 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enfor
 
     t0 = time.perf_counter()
     fractions, pressures, steps, ndof = [], [], [], 0
-    with ng.TaskManager():
+    with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
         P = make_problem([], order)
         for k, r in enumerate(RATIOS):
             load = cell_load(2, pressure=r * pstar)
