@@ -285,11 +285,8 @@ class CellProblem:
         return self._newton_once(free, atol)
 
     def energy(self, free):
-        """The energy Newton minimizes on ``free``: the whole form for iterative solves (BDDC is built by
-        its assembly), else the same energy split into the bodies' quadratic part, assembled once, and
-        the interface (:class:`~ngcontact.solvers.split_energy.SplitEnergy`)."""
-        if self.linear.method(free, self.dim) == "iterative":
-            return self.form
+        """The energy Newton minimizes on ``free``: the whole form split into the bodies' quadratic
+        part, assembled once, and the interface (:class:`~ngcontact.solvers.split_energy.SplitEnergy`)."""
         if self._split is None:
             loads = self.traction + self.strain_params
             self._split = SplitEnergy(self.form, *self._parts, key=lambda: tuple(p.Get() for p in loads))

@@ -185,8 +185,7 @@ def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float |
 
     With ``split`` the form is a :class:`~ngcontact.solvers.split_energy.SplitEnergy`:
     the same terms, the bodies and loads (quadratic) assembled once and only
-    the interface at each state (for direct tangent solves; BDDC needs the
-    whole form's assembly).
+    the interface at each state (what Newton's steps use).
     """
     mesh, setting = problem.mesh, problem.setting
     w = elasticity.weight(setting)
@@ -271,7 +270,6 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     frame = local_frame(n0, mesh.dim)
     law = problem.law
     linear = linear if linear is not None else LinearSolver("direct", inverse=inverse)
-    split = linear.method(fes.FreeDofs(), mesh.dim) == "direct"
     newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, linear=linear)
     history: dict[str, Any] = {"newton": [], "coulomb": None, "coulomb_changes": [], "coulomb_iterations": 0}
     g0 = gap_cf(problem.gap)
@@ -293,7 +291,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     elif start is not None:
         _warm(gfu, start)
     if law.friction is not None and law.friction.coulomb and coulomb == "newton":
-        coupled = _coupled_newton(problem, fes, frame, gfu, newton, split)
+        coupled = _coupled_newton(problem, fes, frame, gfu, newton)
         history["newton"].extend(coupled["newton"])
         history["coulomb"] = {"method": "coupled Newton", "widths": coupled["widths"]}
         old.vec.data = gfu.vec
@@ -301,7 +299,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     elif law.friction is not None and law.friction.coulomb:
         history["coulomb"] = {"method": "fixed point"}
         G = ie.threshold(law.friction, ie.pressure(law.normal, a_old, g0))
-        form = _form(problem, fes, frame, G=G, split=split)
+        form = _form(problem, fes, frame, G=G, split=True)
         p_now = ie.pressure(law.normal, _local(frame, gfu.components[0] - gfu.components[1]), g0)
 
         def freeze() -> None:
@@ -317,7 +315,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     else:
         if law.friction is not None:
             G = ng.CF(ie.threshold(law.friction, 0.0))
-        form = _form(problem, fes, frame, G=G, split=split)
+        form = _form(problem, fes, frame, G=G, split=not law.quadratic)     # a linear solve: one assembly anyway
         history["newton"].append(minimize(form, gfu, quadratic=law.quadratic, **newton).as_dict())
     history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
     history["converged"] = all(h["converged"] for h in history["newton"] if not h.get("failed"))
@@ -329,7 +327,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     return sol
 
 
-def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict, split: bool = False) -> dict:
+def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dict:
     """Coulomb friction by Newton on the coupled equations, with continuation in the Huber width on failure.
 
     First Newton from the start value at the scene's width ``w``; where it
@@ -346,8 +344,8 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict, split:
     start = gfu.vec.CreateVector()
     start.data = gfu.vec
     try:
-        return {"newton": [coupled_newton(_form(problem, fes, frame, coupled=True, split=split), gfu,
-                                          frozen=frozen_tresca(problem, fes, frame, gfu, split), **newton)],
+        return {"newton": [coupled_newton(_form(problem, fes, frame, coupled=True, split=True), gfu,
+                                          frozen=frozen_tresca(problem, fes, frame, gfu, split=True), **newton)],
                 "widths": []}
     except ConvergenceError as err:
         if not isinstance(friction, il.Friction):   # a tabulated cell shear has no Huber width to continue in
@@ -362,8 +360,8 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict, split:
     def solve_at(w: float, last: bool) -> dict:
         at = replace(problem, law=replace(law, friction=replace(friction, width=w)))
         opts = newton if last else {**newton, "rtol": INTERMEDIATE_RTOL, "atol": 0.0}
-        return coupled_newton(_form(at, fes, frame, coupled=True, split=split), gfu,
-                              frozen=frozen_tresca(at, fes, frame, gfu, split), **opts)
+        return coupled_newton(_form(at, fes, frame, coupled=True, split=True), gfu,
+                              frozen=frozen_tresca(at, fes, frame, gfu, split=True), **opts)
 
     def save():
         copy = gfu.vec.CreateVector()

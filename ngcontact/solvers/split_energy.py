@@ -31,11 +31,13 @@ and answers the questions Newton's method asks of a form
   in place at the next (``LinearSolver``).
 
 The same numbers as the whole form to round-off (tested), at a fraction of
-its cost: on the 2D stem-grooves cell (7.6k dofs) a residual is a sparse
-matrix-vector product (0.4 ms) instead of an element loop (5 ms).  The
-preconditioner of the iterative path (BDDC) is built from element matrices
-by the whole form's own assembly, so the iterative path keeps the whole
-form.
+its cost: on the femur's macro problem (7k dofs, 2D) a residual takes 1 ms
+instead of 5.4 ms, a tangent 4 ms instead of 30 ms.  The first tangent is
+the whole form's assembly (it allocates the matrix), and so is
+:meth:`SplitEnergy.rebuild`: a preconditioner registered with the whole form
+(BDDC, built from element matrices) is built there and kept by the later
+steps' tangents, until the linear solver finds it stale
+(:class:`ngcontact.solvers.linear_solver.LinearSolver`).
 """
 from __future__ import annotations
 
@@ -69,17 +71,18 @@ class SplitEnergy:
         self._state = ng.GridFunction(whole.space)      # owns the zero vector
         zero = self._zero = self._state.vec
         quadratic.AssembleLinearization(zero)       # Q'' is the same at every state
-        whole.AssembleLinearization(zero)           # allocates the matrix of every term's sparsity
         self.K = quadratic.mat
-        self._slots_K = _positions(whole.mat, self.K)
-        interface.AssembleLinearization(zero)
-        self._slots_psi = _positions(whole.mat, interface.mat)
-        self._K_whole = np.zeros(whole.mat.nze)
-        self._K_whole[self._slots_K] = self.K.AsVector().FV().NumPy()
+        # after the whole form's first assembly: where the interface's entries go, K in the whole storage
+        self._slots_psi: np.ndarray | None = None
+        self._K_whole: np.ndarray | None = None
         self._loads: object = _UNSET
         self._g = zero.CreateVector()
         self._c = 0.0
         self._work = zero.CreateVector()
+        self._at = zero.CreateVector()
+        #: whether the last :meth:`AssembleLinearization` assembled the whole form (and with it a
+        #: preconditioner registered with it) rather than only the interface
+        self.assembled_whole = False
 
     @property
     def mat(self):
@@ -109,11 +112,27 @@ class SplitEnergy:
         return quad + self.interface.Energy(vec)
 
     def AssembleLinearization(self, vec) -> None:  # noqa: N802
-        """``mat = K + Psi''(vec)``."""
+        """``mat = K + Psi''(vec)``: the first time by the whole form's assembly, which allocates its
+        matrix, then from ``K`` and the interface's assembly alone."""
+        self._at.data = vec
         self.interface.AssembleLinearization(vec)
+        if self._K_whole is None:
+            self.rebuild()
+            whole = self.whole.mat
+            self._slots_psi = _positions(whole, self.interface.mat)
+            self._K_whole = np.zeros(whole.nze)
+            self._K_whole[_positions(whole, self.K)] = self.K.AsVector().FV().NumPy()
+            return
         vals = self.whole.mat.AsVector().FV().NumPy()
         vals[:] = self._K_whole
         vals[self._slots_psi] += self.interface.mat.AsVector().FV().NumPy()
+        self.assembled_whole = False
+
+    def rebuild(self) -> None:
+        """Assemble the whole form at the state of the last :meth:`AssembleLinearization`: the same
+        tangent to round-off, and a preconditioner registered with the whole form (BDDC) built from it."""
+        self.whole.AssembleLinearization(self._at)
+        self.assembled_whole = True
 
 
 def _positions(whole, part) -> np.ndarray:

@@ -64,6 +64,28 @@ def test_a_3d_cell_solved_iteratively_equals_the_direct_solve():
     assert np.linalg.norm(ub - ua) <= 1e-7 * np.linalg.norm(ua)
 
 
+def test_a_kept_bddc_gives_the_state_of_one_rebuilt_at_every_step(monkeypatch):
+    """The split energy keeps BDDC across Newton steps (only CG's iterations may grow); rebuilt at every
+    step (growth limit 0) it gives the same cell state to Newton's tolerance, and the record says which."""
+    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.scene.loader import load
+    from ngcontact.solvers import linear_solver
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    out, default = {}, linear_solver.REBUILD_GROWTH
+    for growth in (default, 0.0):
+        monkeypatch.setattr(linear_solver, "REBUILD_GROWTH", growth)
+        P = CellProblem(build_cell(scene, maxh=0.6, interface_maxh=0.2), model_of(scene),
+                        linear=LinearSolver("iterative"))
+        sol = P.solve(cell_loads(scene)[0], first=True, measure=False)
+        out[growth] = (sol, P.gfu.vec.FV().NumPy().copy(), P.linear.summary())
+    (kept, u_kept, s_kept), (every, u_every, s_every) = out[default], out[0.0]
+    assert s_kept["bddc_kept"] >= 1
+    assert s_every["bddc_kept"] == 0 and s_every["bddc_rebuilt_for_growth"] == every.iterations - 1
+    assert kept.results["contact_fraction"] == pytest.approx(every.results["contact_fraction"], rel=1e-9)
+    assert np.linalg.norm(u_kept - u_every) <= 1e-7 * np.linalg.norm(u_every)
+
+
 def test_inexact_newton_reaches_the_same_cell_state_with_fewer_cg_iterations():
     """Eisenstat-Walker forcing against a fixed CG tolerance of 1e-10: the same state to Newton's tolerance."""
     from ngcontact.cell.cell_problem import CellProblem
