@@ -1,8 +1,9 @@
 """Scale-out of a batch of independent cell solves: 1 and 2 local workers and a Dask cluster.
 
 The batch: the 2D FE cell of a sinusoidal profile (conforming, order 2,
-``maxh = 0.08``, ``interface_maxh = 0.015``: about 0.5 s per solve on a quiet
-machine here) under 16 pressures with ``load.independent = true``, so each
+``maxh = 0.06``, ``interface_maxh = 0.01``: about 0.4 s per solve on a quiet
+machine here; the coarser cell of 0.5 s before the split energy of
+:mod:`ngcontact.solvers.split_energy` takes 0.25 s now) under 16 pressures with ``load.independent = true``, so each
 load is a member of the batch (:mod:`ngcontact.drivers.cell_members`) that
 meshes and solves its own cell.  Each run is the command a user types,
 ``ngcontact run SCENE --out DIR --quiet`` in a fresh interpreter, with
@@ -73,8 +74,8 @@ pressure = [{loads}]
 independent = true
 [discretization]
 order = 2
-maxh = 0.08
-interface_maxh = 0.015
+maxh = 0.06
+interface_maxh = 0.01
 """
 NOOP_TASKS = 200
 REPEATS = 2
