@@ -274,21 +274,63 @@ class StrengthMap:
     cell_point: dict[str, np.ndarray]
 
 
+#: stress entries superposed at once by :func:`strength_map` (macro points x cell points x 9): 16 MB
+CHUNK_ENTRIES = 2_000_000
+
+
 def strength_map(correctors: Correctors, loads: np.ndarray, criterion: str = "von_mises") -> StrengthMap:
-    """Superpose the correctors at every row of ``loads`` and take the cell maxima."""
+    """Superpose the correctors at every row of ``loads`` (eq. 75) and take the cell maxima of eq. 77.
+
+    The superposition of a block of rows is one matrix product ``loads @ unit``
+    (the unit stresses flattened), the blocks sized to ``CHUNK_ENTRIES``.  Von
+    Mises needs no superposed tensor: with ``s_0``, ``s_k`` the deviators of
+    the base and unit stresses at a cell point, ``sigma_eq^2 = 3/2 |s_0 + l_k
+    s_k|^2 = a + 2 b . l + l . C l`` with ``a = 3/2 s_0:s_0``, ``b_k = 3/2
+    s_0:s_k``, ``C_kl = 3/2 s_k:s_l`` computed once per cell point, so a block
+    costs two matrix products of ``K + K^2`` columns (``K`` load components)
+    instead of ``9 K`` and the deviators.
+    """
     loads = np.atleast_2d(np.asarray(loads, float))
+    if criterion not in CRITERIA:
+        raise ModelError(f"criterion = {criterion!r}: must be one of {', '.join(CRITERIA)}")
     values: dict[str, np.ndarray] = {}
     where: dict[str, np.ndarray] = {}
     for b in correctors.base:
+        base, unit, points = correctors.base[b], correctors.unit[b], correctors.points[b]
+        flat = unit.reshape(len(unit), -1)
+        if criterion == "von_mises":
+            quadratic = _von_mises_form(base, unit)
         v = np.empty(len(loads))
-        w = np.empty((len(loads), correctors.points[b].shape[1]))
-        for i, l in enumerate(loads):
-            s = correctors.base[b] + np.einsum("k,knij->nij", l, correctors.unit[b])
-            eq = equivalent(s, criterion)
-            k = int(np.argmax(eq))
-            v[i], w[i] = eq[k], correctors.points[b][k]
+        w = np.empty((len(loads), points.shape[1]))
+        rows = max(1, CHUNK_ENTRIES // max(base.size, 1))
+        for start in range(0, len(loads), rows):
+            block = loads[start:start + rows]
+            if criterion == "von_mises":
+                eq = np.sqrt(np.maximum(quadratic(block), 0.0))
+            else:
+                s = (base.reshape(1, -1) + block @ flat).reshape((len(block),) + base.shape)
+                eq = equivalent(s, criterion)
+            k = np.argmax(eq, axis=1)
+            v[start:start + len(block)] = eq[np.arange(len(block)), k]
+            w[start:start + len(block)] = points[k]
         values[b], where[b] = v, w
     return StrengthMap(criterion=criterion, values=values, cell_point=where)
+
+
+def _von_mises_form(base: np.ndarray, unit: np.ndarray):
+    """``block -> sigma_eq^2`` at every cell point for the load rows of ``block`` (:func:`strength_map`)."""
+    def deviator(t):
+        return (t - np.trace(t, axis1=-2, axis2=-1)[..., None, None] / 3.0 * np.eye(3)).reshape(t.shape[:-2] + (9,))
+    s0, sk = deviator(base), deviator(unit)                      # (n, 9), (K, n, 9)
+    a = 1.5 * np.einsum("nj,nj->n", s0, s0)
+    b = 1.5 * np.einsum("nj,knj->nk", s0, sk)
+    C = 1.5 * np.einsum("knj,lnj->nkl", sk, sk).reshape(len(s0), -1)
+    K = len(sk)
+
+    def form(block: np.ndarray) -> np.ndarray:
+        pairs = (block[:, :, None] * block[:, None, :]).reshape(len(block), K * K)
+        return a[None, :] + 2.0 * block @ b.T + pairs @ C.T
+    return form
 
 
 def check(smap: StrengthMap, sigma_u: Mapping[str, float], macro_points: np.ndarray) -> dict[str, Any]:

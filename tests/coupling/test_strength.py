@@ -48,15 +48,20 @@ def test_linear_correctors_superpose_to_the_direct_cell_solution(case):
     assert diff < 1e-8 * max(abs(c) for c in P.gfu.vec)
 
 
-def test_strength_map_and_check_locate_the_largest_equivalent_stress():
+@pytest.mark.parametrize("chunk", [None, 1])
+def test_strength_map_and_check_locate_the_largest_equivalent_stress(chunk, monkeypatch):
+    """Against the stress superposed load by load; also with one macro point per block (``chunk = 1``)."""
+    if chunk is not None:
+        monkeypatch.setattr(S, "CHUNK_ENTRIES", chunk)
     P = _summit_cell()
     C = S.linear_correctors(P)
     loads = np.array([[0.0, 0.01, 0.0], [0.0, 0.03, 0.001], [0.0, 0.02, -0.002]])
     for crit, fn in (("von_mises", von_mises), ("tresca", tresca)):
         smap = S.strength_map(C, loads, crit)
         for b in S.BODIES:
-            direct = [fn(C.stress(l)[b]).max() for l in loads]
-            assert np.allclose(smap.values[b], direct, rtol=1e-13)
+            direct = [fn(C.stress(l)[b]) for l in loads]
+            assert np.allclose(smap.values[b], [d.max() for d in direct], rtol=1e-13)
+            assert np.array_equal(smap.cell_point[b], [C.points[b][int(np.argmax(d))] for d in direct])
         res = S.check(smap, {"rough": 1.0, "counter": 0.02}, np.arange(6.0).reshape(3, 2))
         worst = {b: int(np.argmax(smap.values[b])) for b in S.BODIES}
         for b, su in (("rough", 1.0), ("counter", 0.02)):
