@@ -24,7 +24,8 @@ from ngcontact.laws import interface_energy as ie
 from ngcontact.fem.materials import von_mises
 from ngcontact.fem.quadrature import energy_order
 from ngcontact.errors import ModelError
-from ngcontact.macro.macro_problem import MacroSolution, energy_form, gap_cf, load_form
+from ngcontact.macro.macro_energy import energy_form, gap_cf, load_form
+from ngcontact.macro.macro_problem import MacroSolution
 
 #: Largest imbalance of a body's forces, relative to the largest force on
 #: either body or to the force the interface carries in magnitude, for a

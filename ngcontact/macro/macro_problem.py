@@ -78,10 +78,10 @@ from ngcontact.fem.sampling import boundary_values
 from ngcontact.solvers.coulomb import coulomb_fixed_point
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
-from ngcontact.solvers.split_energy import SplitEnergy
 from ngcontact.fem.rigid_modes import check_rigid_modes, free_rigid_modes
 from ngcontact.solvers.continuation import INTERMEDIATE_RTOL, ladder
-from ngcontact.solvers.coulomb_newton import FrozenTresca, coupled_newton
+from ngcontact.solvers.coulomb_newton import coupled_newton
+from ngcontact.macro.macro_energy import frozen_tresca, gap_cf, local_jump, macro_energy  # noqa: F401  (gap_cf: public)
 
 log = logging.getLogger(__name__)
 
@@ -159,69 +159,6 @@ def check_problem(problem: MacroProblem) -> None:
                       problem.interface, problem.law.holds_tangentially)
 
 
-# ------------------------------------------------------------- model
-def _local(frame, J) -> list:
-    return [ng.InnerProduct(J, e) for e in frame]
-
-
-def gap_cf(gap):
-    return ng.CF(float(gap)) if isinstance(gap, (int, float)) else gap
-
-
-def _form(problem: MacroProblem, fes, frame, *, G=None, start_stiffness: float | None = None,
-          coupled: bool = False, split: bool = False):
-    """Energy of the macro problem as a symmetric ``BilinearForm`` of ``Variation`` terms.
-
-    With ``start_stiffness`` the interface energy is the quadratic start
-    surrogate: the normal law with everything closed plus, when the law has
-    friction, a tangential spring of that stiffness (tangentially bonded);
-    ``start_stiffness = 0`` leaves the tangential jump free.
-
-    With ``coupled`` (Coulomb friction) the form is the residual of the
-    coupled equations instead (:mod:`ngcontact.solvers.coulomb_newton`):
-    the energy without friction plus the virtual work of the friction
-    traction whose threshold ``G = mu [p(u)]_+ + G0`` is the current
-    pressure's; not symmetric.
-
-    With ``split`` the form is a :class:`~ngcontact.solvers.split_energy.SplitEnergy`:
-    the same terms, the bodies and loads (quadratic) assembled once and only
-    the interface at each state (what Newton's steps use).
-    """
-    mesh, setting = problem.mesh, problem.setting
-    w = elasticity.weight(setting)
-    ur, uc = fes.TrialFunction()
-    form = ng.BilinearForm(fes, symmetric=not coupled)
-    quadratic = ng.BilinearForm(fes, symmetric=not coupled)
-    interface = ng.BilinearForm(fes, symmetric=not coupled)
-    for f in (form, quadratic):
-        elasticity.add_elastic_energy(f, mesh, {problem.rough: problem.materials[problem.rough],
-                                                problem.counter: problem.materials[problem.counter]},
-                                      {problem.rough: ur, problem.counter: uc}, setting)
-        two_body.add_load_potential(f, mesh, problem.loads, (ur, uc), w)
-    a = _local(frame, ur.Trace() - uc.Trace())
-    g0 = gap_cf(problem.gap)
-    law = problem.law
-    ds = ng.ds(definedon=mesh.Boundaries(problem.interface))
-    if start_stiffness is not None:
-        W = ie.normal_energy(law.normal, a, g0, closed=True)
-        if law.friction is not None and start_stiffness > 0:
-            W = W + 0.5 * start_stiffness * sum(t * t for t in a[1:])
-    elif coupled and law.friction is not None:
-        W = ie.normal_energy(law.normal, a, g0)
-        G = ie.threshold(law.friction, ie.pressure(law.normal, a, g0))
-        vr, vc = fes.TestFunction()
-        b = _local(frame, vr.Trace() - vc.Trace())
-        work = sum(f * bi for f, bi in zip(ie.friction_traction(law.friction, a, G)[1:], b[1:]))
-        form += work * w * ds
-        interface += work * w * ds
-    else:
-        W = ie.energy(law, a, g0, G)
-    term = ng.Variation(W * w * ds)
-    form += term
-    interface += term
-    return SplitEnergy(form, quadratic, interface, key=lambda: None) if split else form
-
-
 def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
           inverse: str = "sparsecholesky", coulomb_rtol: float = 1e-8,
           coulomb_max_iter: int = 40, linear: LinearSolver | None = None,
@@ -274,13 +211,13 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     history: dict[str, Any] = {"newton": [], "coulomb": None, "coulomb_changes": [], "coulomb_iterations": 0}
     g0 = gap_cf(problem.gap)
     old = ng.GridFunction(fes)
-    a_old = _local(frame, old.components[0] - old.components[1])
+    a_old = local_jump(frame, old.components[0] - old.components[1])
     G = None
     if not law.quadratic:
         # quadratic start: all closed (and tangentially bonded under friction where needed),
         # so that no body floats at the first Newton step; later solves stop at
         # rtol times the first residual of the whole problem, not of their own
-        surrogate = _form(problem, fes, frame, start_stiffness=start_stiffness(problem))
+        surrogate = macro_energy(problem, fes, frame, start_stiffness=start_stiffness(problem))
         if start is None:
             history["newton"].append(minimize(surrogate, gfu, quadratic=True, **newton).as_dict())
             newton["atol"] = max(atol, rtol * history["newton"][0]["residuals"][0])
@@ -299,8 +236,8 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     elif law.friction is not None and law.friction.coulomb:
         history["coulomb"] = {"method": "fixed point"}
         G = ie.threshold(law.friction, ie.pressure(law.normal, a_old, g0))
-        form = _form(problem, fes, frame, G=G, split=True)
-        p_now = ie.pressure(law.normal, _local(frame, gfu.components[0] - gfu.components[1]), g0)
+        form = macro_energy(problem, fes, frame, G=G, split=True)
+        p_now = ie.pressure(law.normal, local_jump(frame, gfu.components[0] - gfu.components[1]), g0)
 
         def freeze() -> None:
             old.vec.data = gfu.vec
@@ -315,7 +252,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     else:
         if law.friction is not None:
             G = ng.CF(ie.threshold(law.friction, 0.0))
-        form = _form(problem, fes, frame, G=G, split=not law.quadratic)     # a linear solve: one assembly anyway
+        form = macro_energy(problem, fes, frame, G=G, split=not law.quadratic)     # a linear solve: one assembly anyway
         history["newton"].append(minimize(form, gfu, quadratic=law.quadratic, **newton).as_dict())
     history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
     history["converged"] = all(h["converged"] for h in history["newton"] if not h.get("failed"))
@@ -323,7 +260,7 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
     history["linear"] = linear.summary()
     ur, uc = gfu.components
     sol = MacroSolution(problem=problem, gfu=gfu, u_rough=ur, u_counter=uc, frame=frame,
-                        local_jump=_local(frame, ur - uc), threshold=G, history=history, previous=old)
+                        local_jump=local_jump(frame, ur - uc), threshold=G, history=history, previous=old)
     return sol
 
 
@@ -344,7 +281,7 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
     start = gfu.vec.CreateVector()
     start.data = gfu.vec
     try:
-        return {"newton": [coupled_newton(_form(problem, fes, frame, coupled=True, split=True), gfu,
+        return {"newton": [coupled_newton(macro_energy(problem, fes, frame, coupled=True, split=True), gfu,
                                           frozen=frozen_tresca(problem, fes, frame, gfu, split=True), **newton)],
                 "widths": []}
     except ConvergenceError as err:
@@ -353,14 +290,14 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
         log.info("coupled Newton at the scene's Huber width failed (%s); continuation in the width", err)
         gfu.vec.data = start
         failed = [{**err.history, "failed": True}] if isinstance(err.history, dict) else []
-    a = _local(frame, gfu.components[0] - gfu.components[1])
+    a = local_jump(frame, gfu.components[0] - gfu.components[1])
     slips = boundary_values(mesh, problem.interface, ng.sqrt(sum(t * t for t in a[1:])), sampling_order(problem.order))
     width = friction.width
 
     def solve_at(w: float, last: bool) -> dict:
         at = replace(problem, law=replace(law, friction=replace(friction, width=w)))
         opts = newton if last else {**newton, "rtol": INTERMEDIATE_RTOL, "atol": 0.0}
-        return coupled_newton(_form(at, fes, frame, coupled=True, split=True), gfu,
+        return coupled_newton(macro_energy(at, fes, frame, coupled=True, split=True), gfu,
                               frozen=frozen_tresca(at, fes, frame, gfu, split=True), **opts)
 
     def save():
@@ -379,24 +316,6 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
                                "slide without bound; if the load can be carried, try solver.coulomb = "
                                "'fixed_point'", err.history) from err
     return {"newton": failed + [r["history"] for r in rungs], "widths": [r["width"] for r in rungs]}
-
-
-def frozen_tresca(problem: MacroProblem, fes, frame, gfu: ng.GridFunction, split: bool = False) -> FrozenTresca:
-    """The Tresca energy whose threshold ``mu [p]_+ + G0`` is the pressure of a frozen copy of ``gfu``.
-
-    The coupled Newton's line search minimizes it along its step, frozen at
-    each iterate (:mod:`ngcontact.solvers.coulomb_newton`).
-    """
-    law = problem.law
-    assert law.friction is not None
-    old = ng.GridFunction(fes)
-    a_old = _local(frame, old.components[0] - old.components[1])
-    G = ie.threshold(law.friction, ie.pressure(law.normal, a_old, gap_cf(problem.gap)))
-
-    def freeze() -> None:
-        old.vec.data = gfu.vec
-
-    return FrozenTresca(_form(problem, fes, frame, G=G, split=split), freeze)
 
 
 def start_stiffness(problem: MacroProblem) -> float:
@@ -434,20 +353,6 @@ def _warm(gfu: ng.GridFunction, start: ng.BaseVector) -> None:
                          "(the start must come from the same mesh, order and supports)")
     free = np.array(list(gfu.space.FreeDofs()), dtype=bool)
     gfu.vec.FV().NumPy()[free] = np.asarray(start.FV().NumPy())[free]
-
-
-# ----------------------------------------------------- post-processing
-def energy_form(sol: MacroSolution):
-    """The energy whose minimizer ``sol`` is (the friction threshold frozen at ``sol.previous``)."""
-    return _form(sol.problem, sol.gfu.space, sol.frame, G=sol.threshold)
-
-
-def load_form(sol: MacroSolution):
-    """The load potential ``-int t . u w ds`` alone: its gradient is ``-l``, the applied loads."""
-    p = sol.problem
-    fes = sol.gfu.space
-    form = ng.BilinearForm(fes, symmetric=True)
-    return two_body.add_load_potential(form, p.mesh, p.loads, fes.TrialFunction(), elasticity.weight(p.setting))
 
 
 def replace_law(problem: MacroProblem, law: il.InterfaceLaw) -> MacroProblem:

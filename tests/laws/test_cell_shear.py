@@ -93,6 +93,7 @@ def test_cell_shear_is_consistent_in_the_assembled_macro_problem():
     from ngcontact.fem.materials import isotropic
     from ngcontact.geometry import bodies as gm
     from ngcontact.laws.local_frame import local_frame
+    from ngcontact.macro import macro_energy as ME
     from ngcontact.macro import macro_problem as M
     normal = il.TabulatedLaw(closure=(-1e-4, 0.0, 2e-4, 5e-4), pressure=(0.0, 30.0, 100.0, 120.0))
     law = il.InterfaceLaw(normal=normal, friction=shear_law(scale=1e-4))
@@ -107,9 +108,9 @@ def test_cell_shear_is_consistent_in_the_assembled_macro_problem():
     free = np.array(list(fes.FreeDofs()), dtype=bool)
     old = ng.GridFunction(fes)
     old.vec.FV().NumPy()[free] = 2e-4 * rng.standard_normal(free.sum())
-    p_old = ie.pressure(normal, M._local(frame, old.components[0] - old.components[1]), -0.5e-4 * ng.x)
-    frozen = M._form(problem, fes, frame, G=ie.threshold(law.friction, p_old))
-    coupled = M._form(problem, fes, frame, coupled=True)
+    p_old = ie.pressure(normal, ME.local_jump(frame, old.components[0] - old.components[1]), -0.5e-4 * ng.x)
+    frozen = ME.macro_energy(problem, fes, frame, G=ie.threshold(law.friction, p_old))
+    coupled = ME.macro_energy(problem, fes, frame, coupled=True)
     u = ng.GridFunction(fes).vec
     for _ in range(3):
         u.FV().NumPy()[:] = 0.0

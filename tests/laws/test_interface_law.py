@@ -186,6 +186,7 @@ def test_cell_response_law_is_consistent_in_the_assembled_macro_problem():
     import ngsolve as ng
     from ngcontact.fem import two_body
     from ngcontact.geometry import bodies as gm
+    from ngcontact.macro import macro_energy as ME
     from ngcontact.macro import macro_problem as M
     from ngcontact.fem.materials import isotropic
     law = _cell_response_law()
@@ -203,9 +204,9 @@ def test_cell_response_law_is_consistent_in_the_assembled_macro_problem():
     free = np.array(list(fes.FreeDofs()), dtype=bool)
     old = ng.GridFunction(fes)      # a frozen Coulomb threshold mu p(old) + G0, as in the fixed point
     old.vec.FV().NumPy()[free] = 1e-3 * rng.standard_normal(free.sum())
-    G = ie.threshold(problem.law.friction, ie.pressure(law, M._local(frame, old.components[0] - old.components[1]),
+    G = ie.threshold(problem.law.friction, ie.pressure(law, ME.local_jump(frame, old.components[0] - old.components[1]),
                                                         -0.5e-3 * ng.x))
-    form = M._form(problem, fes, frame, G=G)
+    form = ME.macro_energy(problem, fes, frame, G=G)
     u = ng.GridFunction(fes).vec
     for trial in range(3):
         u.FV().NumPy()[:] = 0.0

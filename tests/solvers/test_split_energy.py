@@ -79,6 +79,7 @@ def test_macro_split_equals_the_whole_form(coupled):
     from ngcontact.geometry import bodies as gm
     from ngcontact.laws import homogenized as il
     from ngcontact.laws.local_frame import local_frame
+    from ngcontact.macro import macro_energy as ME
     from ngcontact.macro import macro_problem as M
     g = gm.block_on_plane(0.1, 0.03, 0.02, maxh=0.012)
     law = il.InterfaceLaw(normal=il.BundleLaw(weights=(5e11,), directions=((1.0, 0.0),)),
@@ -93,8 +94,8 @@ def test_macro_split_equals_the_whole_form(coupled):
     gfu = ng.GridFunction(fes)
     rng = np.random.default_rng(5)
     gfu.vec.FV().NumPy()[:] = 2e-6 * rng.standard_normal(len(gfu.vec))   # part open, part closed, slipping
-    whole = M._form(prob, fes, frame, coupled=coupled, G=None if coupled else ng.CF(1e5))
-    split = M._form(prob, fes, frame, coupled=coupled, G=None if coupled else ng.CF(1e5), split=True)
+    whole = ME.macro_energy(prob, fes, frame, coupled=coupled, G=None if coupled else ng.CF(1e5))
+    split = ME.macro_energy(prob, fes, frame, coupled=coupled, G=None if coupled else ng.CF(1e5), split=True)
     a, b = gfu.vec.CreateVector(), gfu.vec.CreateVector()
     whole.Apply(gfu.vec, a)
     split.Apply(gfu.vec, b)
