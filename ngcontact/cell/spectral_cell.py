@@ -35,7 +35,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.fft as sfft
 
 from ngcontact.cell import spectral_measures as measures
 from ngcontact.cell.cell_load import CellLoad
@@ -149,6 +148,7 @@ class SpectralCell:
 
     def convolve(self, p: np.ndarray, symbol: np.ndarray) -> np.ndarray:
         """``IFFT(symbol FFT(p))`` on the grid (all cores)."""
+        import scipy.fft as sfft  # on use: importing scipy.fft costs every process (and batch worker) 0.5 s at start
         return sfft.irfftn(symbol * sfft.rfftn(p, workers=-1), s=self.shape, workers=-1)
 
     def interface_compliance(self, uniform: bool):

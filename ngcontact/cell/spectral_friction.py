@@ -19,7 +19,6 @@ Functions of a :class:`~ngcontact.cell.spectral_cell.SpectralCell` ``cell``.
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft as sfft
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.layer_compliance import layer_matrix
@@ -45,6 +44,7 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
     ``K0`` the diagonal of the uniform mode (the layers' uniaxial-strain
     and shear compliances).
     """
+    import scipy.fft as sfft  # on use: importing scipy.fft costs every process (and batch worker) 0.5 s at start
     d = cell.dim
     n = cell.grid
     k1 = 2 * np.pi * sfft.rfftfreq(n, d=cell.period / n)
