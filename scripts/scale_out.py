@@ -15,6 +15,10 @@ meshes and solves its own cell.  Each run is the command a user types,
 * ``--workers 2``: a local pool of two spawned workers, one NGSolve thread
   each, started when the run begins (their interpreter start and imports
   overlap with the run's own mesh and setup);
+* two ``--workers 1`` one-thread runs at the same time (``2 runs at once``):
+  twice the work of one, so their throughput over one run's (twice its time
+  over theirs) is the ceiling of any two workers on this machine, whose
+  cores share caches and memory bandwidth;
 * ``--scheduler ADDRESS``: a ``distributed.LocalCluster`` of 2 worker
   processes with one thread each, started by this script before the runs (a
   cluster outlives the runs it serves); its first run imports the package on
@@ -94,6 +98,24 @@ def run(path: str, out: str, *flags: str, threads: int | None = None) -> tuple[f
         return wall, json.load(fh)
 
 
+def run_pair(path: str, outs: tuple[str, str]) -> tuple[float, list[dict]]:
+    """Two one-thread ``--workers 1`` runs of ``path`` at the same time, in two fresh interpreters: the wall
+    time until both end and their reports (what two independent processes get out of the machine)."""
+    env = dict(os.environ, NGCONTACT_THREADS="1")
+    t0 = time.perf_counter()
+    procs = [subprocess.Popen([sys.executable, "-m", "ngcontact", "run", path, "--out", out, "--quiet",
+                               "--workers", "1"], env=env) for out in outs]
+    for proc in procs:
+        if proc.wait() != 0:
+            raise RuntimeError(f"ngcontact run exited with {proc.returncode}")
+    wall = time.perf_counter() - t0
+    reports = []
+    for out in outs:
+        with open(os.path.join(out, "report.json")) as fh:
+            reports.append(json.load(fh))
+    return wall, reports
+
+
 def numbers(value, path: str = "") -> dict[str, float]:
     """Every float of a nested report value, by its path."""
     if isinstance(value, dict):
@@ -156,6 +178,18 @@ def main() -> None:
                                  effective_stiffness_rel_diff=difference(base[0][1], report, True)))
                 print(f"{label:>10} (repeat {repeat}): {wall:6.2f} s, batch {rows[-1]['batch']:6.2f} s, "
                       f"speedup {rows[-1]['speedup']:.2f} (batch {rows[-1]['batch_speedup']:.2f})", flush=True)
+            # the machine's ceiling: two independent one-thread runs at once do twice the work; their
+            # throughput over one run's is what any two workers can reach on this machine
+            wall, pair = run_pair(path, tuple(os.path.join(tmp, f"pair_{repeat}_{k}") for k in "ab"))
+            ref_wall, ref = base[repeat]
+            slowest = max(batch_seconds(r) for r in pair)
+            rows.append(dict(run="2 runs at once", repeat=repeat, workers=1, executor="serial", wall=wall,
+                             batch=slowest, speedup=2 * ref_wall / wall,
+                             batch_speedup=2 * batch_seconds(ref) / slowest,
+                             max_rel_diff=max(difference(base[0][1], r, False) for r in pair),
+                             effective_stiffness_rel_diff=max(difference(base[0][1], r, True) for r in pair)))
+            print(f"2 runs at once (repeat {repeat}): {wall:6.2f} s, batch {slowest:6.2f} s, throughput "
+                  f"{rows[-1]['speedup']:.2f} (batch {rows[-1]['batch_speedup']:.2f})", flush=True)
         per_solve = batch_seconds(base[0][1]) / len(LOADS)
         with executor.use(executor.Serial()) as serial:
             over = {"serial": overhead(serial)}
