@@ -71,7 +71,7 @@ from ngcontact.cell.cell_model import CellModel, CellSolution
 from ngcontact.cell.cell_energy import cell_energy, macro_strain_cf
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
-from ngcontact.cell.predictor import rigid_continuation, rigid_translation, set_start, tangential_load
+from ngcontact.cell.predictor import max_gap, rigid_continuation, rigid_translation, set_start, tangential_load
 from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
 from ngcontact.errors import ModelError
@@ -181,7 +181,8 @@ class CellProblem:
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
         self.form, self.coulomb_previous, self._parts = cell_energy(self, ur, uc, U)
-        self._split = None
+        self._split: SplitEnergy | None = None
+        self._largest_gap: float | None = None
         # the state as CoefficientFunctions (for results and tests)
         comps = self.gfu.components
         self.U = ng.CF(tuple(comps[2:]))
@@ -202,6 +203,13 @@ class CellProblem:
         """Total strain of a body: fluctuation plus the macro strain (if assembled)."""
         eps = _el.strain(u, self.setting)
         return eps + macro_strain_cf(self.strain_params, self.dim) if self.model.macro_strain else eps
+
+    def largest_gap(self) -> float:
+        """Largest initial gap on ``S_C`` (:func:`ngcontact.cell.predictor.max_gap`), sampled once: the gap
+        of a problem is fixed."""
+        if self._largest_gap is None:
+            self._largest_gap = max_gap(self)
+        return self._largest_gap
 
     @property
     def ndof(self) -> int:
@@ -284,16 +292,17 @@ class CellProblem:
             return solve_exact(self, lambda a: self._newton_once(free, a), atol)
         return self._newton_once(free, atol)
 
-    def energy(self, free):
-        """The energy Newton minimizes on ``free``: the whole form split into the bodies' quadratic
-        part, assembled once, and the interface (:class:`~ngcontact.solvers.split_energy.SplitEnergy`)."""
+    def energy(self) -> SplitEnergy:
+        """The energy Newton minimizes: the whole form split into the bodies' quadratic part, assembled
+        once, and the interface (:class:`~ngcontact.solvers.split_energy.SplitEnergy`)."""
         if self._split is None:
             loads = self.traction + self.strain_params
-            self._split = SplitEnergy(self.form, *self._parts, key=lambda: tuple(p.Get() for p in loads))
+            quadratic, interface = self._parts
+            self._split = SplitEnergy(self.form, quadratic, interface, key=lambda: tuple(p.Get() for p in loads))
         return self._split
 
     def _newton_once(self, free, atol) -> dict:
-        h = minimize(self.energy(free), self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
+        h = minimize(self.energy(), self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
                      max_iter=self.max_iter, linear=self.linear, line_search=self.line_search,
                      active_set=self.active_set)
         return h.as_dict()

@@ -189,7 +189,7 @@ def _winkler_root(problem, p: float, k_L: float) -> float:
         return float(contact_integral(problem, force, order=order)) - p * area
 
     lo, flo = 0.0, R(0.0)
-    scale = max_gap(problem) + p / k_L
+    scale = problem.largest_gap() + p / k_L
     if flo >= 0.0:            # interference: already pressed at d = 0
         hi, fhi = lo, flo
         lo = -scale
@@ -209,11 +209,7 @@ def max_gap(problem) -> float:
     """Largest initial gap at the quadrature points of ``S_C`` (0 without gap)."""
     if problem.gap is None:
         return 0.0
-    held = getattr(problem, "_max_gap", None)
-    if held is None or held[0] is not problem.gap:      # the gap of a problem is fixed: sampled once
-        held = (problem.gap, float(max(sample_surface(problem, {"g": problem.gap})["g"].max(), 0.0)))
-        problem._max_gap = held
-    return held[1]
+    return float(max(sample_surface(problem, {"g": problem.gap})["g"].max(), 0.0))
 
 
 def set_start(problem, load: CellLoad) -> None:
@@ -236,7 +232,7 @@ def set_start(problem, load: CellLoad) -> None:
         raise ValueError(f"normal pressure {p!r}: must be > 0 (a free layer has no unique "
                          "rigid position); prescribe a normal jump instead")
     if problem.start == "closed":
-        vec[u_dofs[d - 1]] = -(max_gap(problem) + p / problem.model.k_n)
+        vec[u_dofs[d - 1]] = -(problem.largest_gap() + p / problem.model.k_n)
     else:
         vec[:] = 0.0
         for i in range(d):
@@ -382,7 +378,7 @@ def rigid_continuation(problem, free, before: tuple[float, ...] | None = None) -
     saved = problem.gfu.vec.CreateVector()
     saved.data = problem.gfu.vec
     try:
-        h = minimize(problem.energy(rigid), problem.gfu, freedofs=rigid, rtol=problem.rtol, atol=problem.atol,
+        h = minimize(problem.energy(), problem.gfu, freedofs=rigid, rtol=problem.rtol, atol=problem.atol,
                      max_iter=problem.max_iter, inverse=problem.inverse,
                      line_search=problem.line_search).as_dict()
     except ConvergenceError as err:

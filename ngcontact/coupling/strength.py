@@ -297,9 +297,10 @@ def strength_map(correctors: Correctors, loads: np.ndarray, criterion: str = "vo
     where: dict[str, np.ndarray] = {}
     for b in correctors.base:
         base, unit, points = correctors.base[b], correctors.unit[b], correctors.points[b]
-        flat = unit.reshape(len(unit), -1)
         if criterion == "von_mises":
             quadratic = _von_mises_form(base, unit)
+        else:
+            flat = unit.reshape(len(unit), -1)
         v = np.empty(len(loads))
         w = np.empty((len(loads), points.shape[1]))
         rows = max(1, CHUNK_ENTRIES // max(base.size, 1))

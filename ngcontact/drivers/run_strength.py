@@ -28,7 +28,6 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell.cell_problem import CellProblem
-from ngcontact.cell.predictor import max_gap
 from ngcontact.coupling import strength as S
 from ngcontact.coupling.interface_state import cell_loads, interface_states
 from ngcontact.errors import ModelError, SceneError
@@ -85,7 +84,7 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     kt = spec.tangential_stiffness
     if kt is None:
         kt = cs.contact.k_n if law.friction is not None else 0.0
-    chi = None if P.gap is None else ng.IfPos(P.gap - 1e-14 * max(max_gap(P), 1e-300), 0.0, 1.0)
+    chi = None if P.gap is None else ng.IfPos(P.gap - 1e-14 * max(P.largest_gap(), 1e-300), 0.0, 1.0)
     corr = S.linear_correctors(P, contact_set=chi, tangential_stiffness=kt)
     states = interface_states(sol, scene.output.points_per_element)
     try:

@@ -58,9 +58,10 @@ def macro_energy(problem, fes, frame, *, G=None, start_stiffness: float | None =
     w = elasticity.weight(setting)
     ur, uc = fes.TrialFunction()
     form = ng.BilinearForm(fes, symmetric=not coupled)
-    quadratic = ng.BilinearForm(fes, symmetric=not coupled)
-    interface = ng.BilinearForm(fes, symmetric=not coupled)
-    for f in (form, quadratic):
+    # the split's parts (built only for it): the bodies and loads, and the interface
+    quadratic = ng.BilinearForm(fes, symmetric=not coupled) if split else None
+    interface = ng.BilinearForm(fes, symmetric=not coupled) if split else None
+    for f in (form, quadratic) if split else (form,):
         elasticity.add_elastic_energy(f, mesh, {problem.rough: problem.materials[problem.rough],
                                                 problem.counter: problem.materials[problem.counter]},
                                       {problem.rough: ur, problem.counter: uc}, setting)
@@ -80,13 +81,16 @@ def macro_energy(problem, fes, frame, *, G=None, start_stiffness: float | None =
         b = local_jump(frame, vr.Trace() - vc.Trace())
         work = sum(f * bi for f, bi in zip(ie.friction_traction(law.friction, a, G)[1:], b[1:]))
         form += work * w * ds
-        interface += work * w * ds
+        if split:
+            interface += work * w * ds
     else:
         W = ie.energy(law, a, g0, G)
     term = ng.Variation(W * w * ds)
     form += term
+    if not split:
+        return form
     interface += term
-    return SplitEnergy(form, quadratic, interface, key=lambda: None) if split else form
+    return SplitEnergy(form, quadratic, interface, key=lambda: None)
 
 
 def frozen_tresca(problem, fes, frame, gfu: ng.GridFunction, split: bool = False) -> FrozenTresca:

@@ -34,7 +34,7 @@ def test_split_energy_equals_the_whole_form(friction):
     rng = np.random.default_rng(3)
     vec = P.gfu.vec
     vec.FV().NumPy()[:] += 1e-3 * rng.standard_normal(len(vec)) * np.max(np.abs(vec.FV().NumPy()))
-    split = P.energy(P.X.FreeDofs())
+    split = P.energy()
     assert isinstance(split, SplitEnergy)
     split.AssembleLinearization(P.gfu.vec.CreateVector())   # (the whole form's at the first assembly only)
     whole = P.form
