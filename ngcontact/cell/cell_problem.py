@@ -39,12 +39,13 @@ consistent, non-symmetric tangent), or the fixed point of Tresca problems
 ``G_k = mu p_{k-1}`` until ``max |p_k - p_{k-1}| <= coulomb_rtol * max p_k``
 on ``S_C``: the same solution (:mod:`ngcontact.cell.coulomb_friction`).
 
-Exact non-penetration (``CellModel.enforcement = "exact"``, 2D;
+Exact non-penetration (``CellModel.enforcement = "exact"``, 2D and 3D;
 the rigid limit ``k_n -> infinity`` of the Winkler layer): the normal
 energy is the augmented Lagrangian
-``(1/(2 k_n)) ([lambda + k_n (J.n - g)]_+^2 - lambda^2)``, integrated with the
-Gauss-Lobatto rule of ``p + 1`` points per segment of ``S_C`` so that the
-constraints sit at the nodes of the trace space, with a multiplier
+``(1/(2 k_n)) ([lambda + k_n (J.n - g)]_+^2 - lambda^2)``, integrated with a
+nodal rule on ``S_C`` (Gauss-Lobatto on segments, the lattice nodes with
+their areas on triangles) so that the constraints sit at the nodes of the
+trace space, with a multiplier
 ``lambda`` per point held fixed in each Newton solve and updated by Uzawa's
 iteration (:mod:`ngcontact.cell.contact_multiplier`); the pressure of the
 results is the multiplier, and ``k_n`` only sets the speed.  Tresca
@@ -74,7 +75,6 @@ from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
 from ngcontact.cell.predictor import max_gap, rigid_continuation, rigid_translation, set_start, tangential_load
 from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
-from ngcontact.errors import ModelError
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
 from ngcontact.solvers.split_energy import SplitEnergy
@@ -145,9 +145,6 @@ class CellProblem:
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
         if start not in ("rigid", "closed"):
             raise ValueError(f"start = {start!r}: must be 'rigid' or 'closed'")
-        if model.enforcement == "exact" and cell.dim != 2:
-            raise ModelError(f"enforcement = 'exact' in a {cell.dim}D cell: the FE cell enforces exact contact "
-                             "in 2D only (node-to-node on segments); use 'penalty' or the spectral cell")
         self.line_search, self.start, self.coulomb = line_search, start, coulomb
         self.coulomb_residual = None      # Coulomb, coupled Newton: the residual form, built on first use
         self.cell, self.model = cell, model

@@ -1,4 +1,4 @@
-"""The contact multiplier of exact non-penetration on ``S_C``: node-to-node constraints (2D).
+"""The contact multiplier of exact non-penetration on ``S_C``: node-to-node constraints (2D and 3D).
 
 With ``contact.enforcement = "exact"`` the cell problem (paper eqs. 49-51,
 57 and 65, :mod:`ngcontact.cell.cell_problem`) keeps the bodies from
@@ -14,12 +14,19 @@ by Uzawa's iteration (:mod:`ngcontact.solvers.uzawa`),
 ``lambda <- [lambda + k (J_n - g)]_+``, ``k`` the scene's ``k_n`` (the
 augmentation: it sets the speed, not the answer).
 
-Where the constraints sit.  The contact energy is integrated with the
-Gauss-Lobatto rule of ``p + 1`` points on each boundary segment (order
+Where the constraints sit.  In 2D the contact energy is integrated with
+the Gauss-Lobatto rule of ``p + 1`` points on each boundary segment (order
 ``p`` displacements, :func:`lobatto_rule`): its points are the two
 vertices of the segment and ``p - 1`` interior points, ``p`` new points per
 element, as many as the trace of a continuous order-``p`` field has dofs.
-Non-penetration is imposed at these nodes only, and the multiplier has one
+In 3D (triangles on ``S_C``) no rule with positive weights has the
+``(p + 1)(p + 2)/2`` Lagrange nodes of a triangle as its points and the
+degree of Lobatto's, so the nodes ``(i/p, j/p)``, ``i + j <= p``, carry
+the nodal areas of the ``p^2`` sub-triangles of the lattice (each
+sub-triangle gives a third of its area to each of its vertices,
+:func:`triangle_nodal_rule`): positive weights, exact for linear
+functions, the lumped ("P1-iso-Pp") rule of the trace.  Either way,
+non-penetration is imposed at these nodes only, and the multiplier has one
 value ``lambda_q`` per point.  A fixed point of Uzawa's iteration is the
 discrete problem
 
@@ -33,18 +40,19 @@ with ``p + 1`` points per element, and the multiplier alternating between
 points with fewer), the nodes determine the trace: the discrete problem is
 a well-posed node-to-node contact problem.
 
-A vertex shared by two segments is a point of both rules: it carries two
-copies of the multiplier, one per segment.  The closure ``J_n - g`` is
+A vertex shared by two segments (in 3D: by the triangles around it, and
+likewise an edge's nodes) is a point of each of their rules: it carries one
+copy of the multiplier per element.  The closure ``J_n - g`` is
 continuous there (``J`` and the interpolated gap are, and so is ``n`` on a
 smooth ``S_C``, in particular the flat one), so both copies see the same
 penetration, start at 0 and receive the same update: they stay equal, and
-act as one nodal constraint with the weight ``w_left + w_right``.  Where
+act as one nodal constraint with the sum of the copies' weights.  Where
 the normal jumps (a kinked ``S_C``) the two copies constrain the two
 components of the jump along two different normals, still independent
 constraints on the node's two dofs.
 
-The multiplier as a field: the polynomial of degree ``p`` on each segment
-through its ``p + 1`` point values (a ``SurfaceL2`` GridFunction; the
+The multiplier as a field: the polynomial of degree ``p`` on each element
+through its point values (a ``SurfaceL2`` GridFunction; the
 Lobatto values determine it), so the energy reads it at the points
 exactly.  Between the points it is only an interpolant: integrals of the
 pressure use the Lobatto rule (:meth:`ContactMultiplier.integrate`, the
@@ -63,6 +71,17 @@ node beyond it, kept between ``x_c`` and ``x_o``.  This needs the nodes in
 order along ``S_C``: on a contact surface that is a graph over ``x``
 (``n_y > 0``), sorted by ``x``; elsewhere, or without a falling line, the
 edge is the midpoint of ``[x_c, x_o]``.
+
+In 3D (:func:`contact_area`) the same rule runs on each triangle's
+lattice: the contact edge crosses a lattice edge from a closed node ``c``
+to an open node ``o`` where the line through ``opening^(2/3)`` at ``o``
+and at the next lattice node ``2o - c`` beyond it (when that node is in
+the element and open, with a larger opening) vanishes, else at the
+midpoint; each sub-triangle contributes the part of it cut off on the
+closed side by the straight line through its two crossings (marching
+triangles).  The reference area is scaled by the element's area
+(exact for the flat triangles of a small-slope cell; on curved elements
+it neglects the variation of the area element across one element).
 """
 from __future__ import annotations
 
@@ -97,54 +116,95 @@ def lobatto_rule(order: int) -> ng.IntegrationRule:
     return ng.IntegrationRule([(0.5 * (si + 1.0),) for si in s], [0.5 * wi for wi in w])
 
 
+def triangle_lattice(order: int) -> tuple[np.ndarray, np.ndarray]:
+    """The nodes ``(i, j)``, ``i + j <= p``, of the order-``p`` lattice on a triangle and its ``p^2`` sub-triangles.
+
+    Returns ``(ij, tri)``: ``ij`` of shape ``(n, 2)`` (integers, the node
+    ``(i/p, j/p)`` of the reference triangle), ``tri`` of shape
+    ``(p^2, 3)``, indices into ``ij`` (the ``p(p+1)/2`` upward and
+    ``p(p-1)/2`` downward sub-triangles).
+    """
+    p = int(order)
+    if p < 1:
+        raise ValueError(f"order = {order!r}: a nodal rule needs order >= 1")
+    ij = np.array([(i, j) for j in range(p + 1) for i in range(p + 1 - j)], dtype=int)
+    index = {(int(i), int(j)): k for k, (i, j) in enumerate(ij)}
+    tri = [(index[i, j], index[i + 1, j], index[i, j + 1]) for j in range(p) for i in range(p - j)]
+    tri += [(index[i + 1, j], index[i + 1, j + 1], index[i, j + 1]) for j in range(p - 1) for i in range(p - 1 - j)]
+    return ij, np.array(tri, dtype=int)
+
+
+def triangle_nodal_rule(order: int) -> ng.IntegrationRule:
+    """The lattice nodes ``(i/p, j/p)`` of the reference triangle with their nodal areas (module docstring).
+
+    Each of the ``p^2`` sub-triangles (area ``1 / (2 p^2)``) gives a third
+    of its area to each of its vertices: corner nodes weigh
+    ``1 / (6 p^2)``, edge nodes three times and interior nodes six times
+    that; the weights sum to the reference area ``1/2`` and integrate
+    linear functions exactly.
+    """
+    ij, tri = triangle_lattice(order)
+    p = int(order)
+    w = np.zeros(len(ij))
+    np.add.at(w, tri.ravel(), 1.0 / (6.0 * p * p))
+    return ng.IntegrationRule([(i / p, j / p) for i, j in ij], [float(x) for x in w])
+
+
 class ContactMultiplier:
-    """``lambda`` at the Gauss-Lobatto points of the boundary ``label`` (2D meshes).
+    """``lambda`` at the nodes of the boundary ``label``: Gauss-Lobatto on segments (2D), lattice on triangles (3D).
 
     Parameters
     ----------
     mesh
-        The cell's mesh (2D: the contact boundary is made of segments).
+        The cell's mesh (2D: the contact boundary is made of segments; 3D:
+        of triangles).
     order
-        Displacement order ``p``: ``p + 1`` Lobatto points per segment.
+        Displacement order ``p``: ``p + 1`` Lobatto points per segment,
+        ``(p + 1)(p + 2)/2`` lattice nodes per triangle.
 
     Attributes
     ----------
     rule, ds
-        The Lobatto rule and the differential symbol of the contact energy
-        with it.
+        The nodal rule (:func:`lobatto_rule`, :func:`triangle_nodal_rule`)
+        and the differential symbol of the contact energy with it.
     value
         The multiplier (module docstring), 0 at the start.
     """
 
     def __init__(self, mesh: ng.Mesh, order: int, label: str = "contact"):
         self.mesh, self.label, self.order = mesh, label, int(order)
+        self.dim = mesh.dim
+        if self.dim not in (2, 3):
+            raise ValueError(f"mesh.dim = {self.dim!r}: a contact multiplier needs a 2D or 3D mesh")
         self.region = mesh.Boundaries(label)
-        self.rule = lobatto_rule(order)
-        self.ds = ng.ds(label, intrules={ng.SEGM: self.rule})
+        shape = ng.SEGM if self.dim == 2 else ng.TRIG
+        self.rule = lobatto_rule(order) if self.dim == 2 else triangle_nodal_rule(order)
+        self.ds = ng.ds(label, intrules={shape: self.rule})
         self.space = ng.SurfaceL2(mesh, order=self.order, definedon=self.region)
         self.value = ng.GridFunction(self.space)
         self.points = mesh.MapToAllElements(self.rule, self.region)
         self._values = np.zeros(len(self.points))      # lambda_q exactly (the field reads them back to round-off)
         npt = len(self.rule.points)
-        t = [q[0] for q in self.rule.points]
+        ref = [q[: self.dim - 1] for q in self.rule.points]
         elements = np.asarray(self.points["nr"]).reshape(-1, npt)[:, 0]
-        # per segment: its dofs and the inverse of (shape_j(t_q)), point values -> coefficients
+        self.elements = elements
+        # per element: its dofs and the inverse of (shape_j(x_q)), point values -> coefficients
         self._dofs = np.empty((len(elements), npt), dtype=int)
         self._inverse = np.empty((len(elements), npt, npt))
         for e, nr in enumerate(elements):
             ei = ng.ElementId(ng.BND, int(nr))
             fe = self.space.GetFE(ei)
-            V = np.array([np.asarray(fe.CalcShape(tq)) for tq in t])
+            V = np.array([np.asarray(fe.CalcShape(*xq)) for xq in ref])
             self._dofs[e] = np.asarray(self.space.GetDofNrs(ei))
             self._inverse[e] = np.linalg.inv(V)
 
     @property
     def weights(self) -> np.ndarray:
-        """Reference Lobatto weights, one per point of a segment."""
+        """Reference weights of the nodal rule, one per point of an element."""
         return np.array(self.rule.weights)
 
     def at_points(self, cf) -> np.ndarray:
-        """Values of the scalar ``cf`` at the points (segment by segment, ``p + 1`` each)."""
+        """Values of the scalar ``cf`` at the points (element by element, the rule's points each)."""
         return np.asarray(cf(self.points)).ravel()
 
     def point_values(self) -> np.ndarray:
@@ -152,27 +212,29 @@ class ContactMultiplier:
         return self._values.copy()
 
     def set_point_values(self, values: np.ndarray) -> None:
-        """``lambda_q = values``; :attr:`value` the degree-``p`` polynomial through them on each segment."""
+        """``lambda_q = values``; :attr:`value` the degree-``p`` polynomial through them on each element."""
         self._values[:] = values
         v = np.asarray(values, float).reshape(self._dofs.shape)
         coef = np.einsum("eij,ej->ei", self._inverse, v)
         self.value.vec.FV().NumPy()[self._dofs.ravel()] = coef.ravel()
 
     def integrate(self, cf):
-        """``sum_q w_q cf(x_q) |x'|`` over the segments: ``int_{S_C} cf ds`` with the energy's rule (per component)."""
+        """``sum_q w_q cf(x_q) |J_q|`` over the elements: ``int_{S_C} cf ds`` with the energy's rule (per component)."""
         if cf.dim > 1:
             return [ng.Integrate(cf[i] * self.ds, self.mesh) for i in range(cf.dim)]
         return ng.Integrate(cf * self.ds, self.mesh)
 
     def samples(self, fields: dict) -> dict[str, np.ndarray]:
         """``{name: values}`` of each field at the points, a shared vertex once; vectors as ``(dim, points)``."""
-        x, y = self.at_points(ng.x), self.at_points(ng.y)
-        scale = max(float(np.ptp(x)), float(np.ptp(y)), 1.0)
-        _, keep = np.unique(np.round(np.stack([x, y]) / scale, 10), axis=1, return_index=True)
+        xyz = np.stack([self.at_points(c) for c in (ng.x, ng.y, ng.z)[: self.dim]])
+        scale = max(float(np.ptp(xyz, axis=1).max()), 1.0)
+        _, keep = np.unique(np.round(xyz / scale, 10), axis=1, return_index=True)
         keep = np.sort(keep)
         out = {}
         for name, cf in fields.items():
-            if cf.dim > 1:
+            if cf is self.value:           # the multiplier itself: its point values as set, not read back
+                out[name] = self._values[keep].copy()
+            elif cf.dim > 1:
                 out[name] = np.stack([self.at_points(cf[i])[keep] for i in range(cf.dim)])
             else:
                 out[name] = self.at_points(cf)[keep]
@@ -250,6 +312,83 @@ def solve_exact(problem, newton: Callable[[float], dict], atol: float) -> dict[s
     return out
 
 
+def closed_nodes(problem) -> tuple[np.ndarray, np.ndarray]:
+    """Per point of the multiplier: closed (it carries load, or its opening is within the Uzawa tolerance
+    ``rtol L``), and the opening ``g - J_n``."""
+    m = problem.multiplier
+    opening = -m.at_points(problem.penetration)
+    closed = (m.point_values() > 0.0) | (opening <= problem.model.uzawa_rtol * characteristic_length(problem))
+    return closed, opening
+
+
+def contact_area(problem) -> float:
+    """Area of the real contact set on ``S_C`` (3D): closed nodes and the edges between them (module docstring)."""
+    closed, opening = closed_nodes(problem)
+    return lattice_area(problem.multiplier, closed, opening)
+
+
+def lattice_area(m: ContactMultiplier, closed: np.ndarray, opening: np.ndarray) -> float:
+    """Area of the closed part of ``S_C`` (3D) from the state of the nodes (module docstring).
+
+    ``closed`` and ``opening`` are given per point of ``m`` (element by
+    element).  On a lattice edge from a closed node ``c`` to an open node
+    ``o`` the contact edge crosses where ``opening^(2/3)``, extrapolated
+    from ``o`` and the next node ``2o - c`` beyond it, vanishes; without
+    that node (it lies outside the element, is closed or no more open),
+    where ``lambda^2`` (linear in the distance at a smooth edge, where the
+    pressure falls like a square root) extrapolated from ``c`` and the node
+    ``2c - o`` behind it vanishes; else at the midpoint.
+    """
+    ij, tri = triangle_lattice(m.order)
+    npt = len(ij)
+    closed, opening = closed.reshape(-1, npt), opening.reshape(-1, npt)
+    r = np.maximum(opening, 0.0) ** (2.0 / 3.0)
+    lam2 = m.point_values().reshape(-1, npt) ** 2
+    index = {(int(i), int(j)): k for k, (i, j) in enumerate(ij)}
+    # physical area of each element of S_C, in the order of the multiplier's points
+    areas = np.asarray(ng.Integrate(ng.CF(1.0), m.mesh, ng.BND, definedon=m.region, element_wise=True))
+    areas = areas[m.elements]
+
+    def beyond(a: int, b: int) -> int | None:
+        """The lattice node ``2b - a`` (the next one after ``b`` on the line from ``a``), if in the element."""
+        return index.get((2 * int(ij[b, 0]) - int(ij[a, 0]), 2 * int(ij[b, 1]) - int(ij[a, 1])))
+
+    def crossing(e: int, c: int, o: int) -> float:
+        """Fraction from closed node ``c`` to open node ``o`` at which the contact edge crosses."""
+        n2 = beyond(c, o)
+        if n2 is not None and not closed[e, n2] and r[e, n2] > r[e, o]:
+            return float(np.clip(1.0 - r[e, o] / (r[e, n2] - r[e, o]), 0.0, 1.0))
+        c2 = beyond(o, c)
+        if c2 is not None and closed[e, c2] and lam2[e, c2] > lam2[e, c]:
+            return float(np.clip(lam2[e, c] / (lam2[e, c2] - lam2[e, c]), 0.0, 1.0))
+        return 0.5
+
+    total = 0.0
+    for e in range(closed.shape[0]):
+        state = closed[e]
+        if state.all():
+            total += areas[e]
+            continue
+        if not state.any():
+            continue
+        part = 0.0
+        for a, b, c in tri:
+            on = state[[a, b, c]]
+            k = int(on.sum())
+            if k == 3:
+                part += 1.0
+            elif k == 1:          # one closed corner: the triangle of the two crossings from it
+                v = (a, b, c)[int(np.argmax(on))]
+                w1, w2 = [u for u in (a, b, c) if u != v]
+                part += crossing(e, v, w1) * crossing(e, v, w2)
+            elif k == 2:          # one open corner: all but the triangle of the two crossings towards it
+                v = (a, b, c)[int(np.argmin(on))]
+                w1, w2 = [u for u in (a, b, c) if u != v]
+                part += 1.0 - (1.0 - crossing(e, w1, v)) * (1.0 - crossing(e, w2, v))
+        total += part / len(tri) * areas[e]        # the p^2 sub-triangles share the element's area
+    return float(total)
+
+
 def contact_cuts(problem) -> list[tuple[np.ndarray, list[bool]]]:
     """Per segment of ``S_C`` (in the order of :attr:`ContactMultiplier.points`): ``(cuts, on)``.
 
@@ -262,9 +401,7 @@ def contact_cuts(problem) -> list[tuple[np.ndarray, list[bool]]]:
     m = problem.multiplier
     npt = len(m.rule.points)
     t = np.array([q[0] for q in m.rule.points])
-    lam = m.point_values()
-    opening = -m.at_points(problem.penetration)
-    closed = (lam > 0.0) | (opening <= problem.model.uzawa_rtol * characteristic_length(problem))
+    closed, opening = closed_nodes(problem)
     x = m.at_points(ng.x)
     graph = problem.dim == 2 and float(m.at_points(problem.n[1]).min(initial=1.0)) > 0.0
     # the nodes along S_C, a shared vertex once: sorted by x

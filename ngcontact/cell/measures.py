@@ -37,12 +37,14 @@ area of the cell's period.
 * the effective stiffness of the interface (beyond the paper,
   :mod:`ngcontact.cell.stiffness`).
 
-Exact enforcement (2D, :mod:`ngcontact.cell.contact_multiplier`): the
-pressure is the multiplier ``lambda``, given at the Gauss-Lobatto points of
-the contact energy, so its integrals use that rule (the discrete interface
-force) and its samples are taken at those points; the real contact set is
+Exact enforcement (:mod:`ngcontact.cell.contact_multiplier`): the
+pressure is the multiplier ``lambda``, given at the nodal points of the
+contact energy (Gauss-Lobatto in 2D, the triangle lattice in 3D), so its
+integrals use that rule (the discrete interface force) and its samples
+are taken at those points; the real contact set is
 built from the closed nodes and the edges between them
-(:func:`ngcontact.cell.contact_multiplier.contact_cuts`), not from the sign
+(:func:`ngcontact.cell.contact_multiplier.contact_cuts`, in 3D
+:func:`~ngcontact.cell.contact_multiplier.contact_area`), not from the sign
 of the penetration, which is zero to round-off at the nodes and the
 interpolation error of the closure between them.
 
@@ -56,7 +58,7 @@ import numpy as np
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.errors import ConvergenceError
 from ngcontact.cell.coefficients import coefficients
-from ngcontact.cell.contact_multiplier import contact_cuts
+from ngcontact.cell.contact_multiplier import contact_area, contact_cuts
 from ngcontact.cell.stiffness import effective_stiffness
 from ngcontact.fem import materials as _mat
 from ngcontact.fem.quadrature import kink_order, sampling_order, smooth_order
@@ -89,10 +91,12 @@ def contact_fraction(problem, method: str = "auto") -> float:
         where the zero set is a curve on each face).  ``"auto"``: roots
         in 2D, quadrature in 3D.  With exact enforcement the pieces of
         :func:`contact_pieces` are those of the closed nodes (module
-        docstring), whatever the method.
+        docstring; in 3D :func:`~ngcontact.cell.contact_multiplier.contact_area`),
+        whatever the method.
     """
     if problem.multiplier is not None:
-        return _contact_length_by_roots(problem) / problem.area
+        closed = _contact_length_by_roots(problem) if problem.dim == 2 else contact_area(problem)
+        return closed / problem.area
     if method == "auto":
         method = "roots" if problem.dim == 2 else "quadrature"
     if method == "quadrature":

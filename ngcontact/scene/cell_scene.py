@@ -29,7 +29,7 @@ ENFORCEMENTS = ("penalty", "exact")
 class GapSpec:
     """Initial gap g >= 0 on the contact surface."""
 
-    kind: str = param("none", doc="none, constant, sinusoid 2h sin^2(pi x/P), bisinusoid "
+    kind: str = param("none", doc="none, constant, sinusoid 2h sin^2(pi x/P) (2D; 3D: waves along x), bisinusoid "
                       "h (2 - cos(2 pi x/P) - cos(2 pi y/P)), tabulated (file)",
                       choices=GAPS)
     value: float | None = param(None, doc="constant gap", units="m", check=nonnegative())
@@ -55,8 +55,9 @@ class ContactSpec:
                        "eq. 34 coefficients in the report)", units="Pa/m", check=positive())
     enforcement: str = param("penalty", doc="penalty: the paper's Winkler layer p = k_n [J.n - g]_+ (eq. 65) "
                              "and Huber-regularized friction; exact: non-penetration, the rigid limit k_n -> infinity: "
-                             "spectral cell with exact friction (w unused), or 2D FE cell, node-to-node at the "
-                             "Gauss-Lobatto points by an augmented Lagrangian with Uzawa updates (k_n is its "
+                             "spectral cell with exact friction (w unused), or FE cell (2D and 3D), node-to-node at "
+                             "the nodes of the trace (Gauss-Lobatto on segments, the lattice on triangles) by an "
+                             "augmented Lagrangian with Uzawa updates (k_n is its "
                              "augmentation: the speed, not the answer; friction Huber-regularized with w, the "
                              "Coulomb threshold mu times the multiplier)",
                              choices=ENFORCEMENTS)
@@ -186,7 +187,7 @@ class CellScene:
                 raise SceneError(f"materials.{name}.C", "...", "cell scenes take isotropic E, nu")
         dim = self.geometry.dim
         g = self.contact.gap.kind
-        if g == "sinusoid" and dim != 2 or g == "bisinusoid" and dim != 3:
+        if g == "bisinusoid" and dim != 3:
             raise SceneError("contact.gap.kind", g, f"not available for a {dim}D cell")
         self.check_size()
         if self.contact.geometric_only:
@@ -198,8 +199,6 @@ class CellScene:
         if self.discretization.method == "spectral":
             check_spectral(self)
         else:
-            if self.contact.enforcement == "exact":
-                check_fe_exact(self)
             check_penalty_ratio(self)
         fe_tolerance = self.discretization.method == "fe" and self.discretization.tolerance is not None
         if fe_tolerance and not (dim == 2 and self.geometry.profile == "flat"):
@@ -268,14 +267,6 @@ def check_penalty_ratio(scene: CellScene) -> None:
         raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
                          f"E = {E:g} the softer body's modulus) must stay below {MAX_PENALTY_RATIO:g}: the "
                          "penalty would outweigh the bodies beyond what double precision resolves; lower k_n")
-
-
-def check_fe_exact(scene: CellScene) -> None:
-    """Exact non-penetration on the FE cell: built for 2D cells (node-to-node on segments)."""
-    if scene.geometry.dim != 2:
-        raise SceneError("contact.enforcement", "exact", f"the FE cell enforces exact contact in 2D only, not in a "
-                         f"{scene.geometry.dim}D cell: set enforcement = 'penalty', or discretization.method = "
-                         "'spectral' for a small-slope cell")
 
 
 #: Largest number of spectral grid points of a cell (2D: points, 3D: points squared).
