@@ -134,12 +134,24 @@ def carry_over(old, new) -> None:
     to the body's region, so that no point of one body reads the other's
     field across the interface) and the far-face translation is copied.
     Newton then starts next to the solution instead of at the rigid
-    predictor, with the active set nearly right.
+    predictor, with the active set nearly right.  With exact enforcement the
+    multiplier is carried too, interpolated linearly between the old nodes
+    along the flat ``S_C``: Uzawa's first pass then starts from the old
+    level's pressure instead of the penalty's (on the scene
+    ``westergaard_graded.toml`` run with exact enforcement, Newton steps
+    per load summed over the levels fell from 34-42 to 27-34).
     """
     for k, region in enumerate(("rough", "counter")):
         new.gfu.components[k].Set(old.gfu.components[k], definedon=new.mesh.Materials(region))
     for a, b in zip(old.u_dofs, new.u_dofs):
         new.gfu.vec[b] = old.gfu.vec[a]
+    if old.multiplier is not None and new.multiplier is not None:
+        # exact enforcement: the multiplier too, linear between the old nodes along the flat S_C (periodic in x)
+        x_old, lam = old.multiplier.at_points(ng.x), old.multiplier.point_values()
+        order = np.argsort(x_old, kind="stable")
+        period = float(old.cell.period[0])
+        new.multiplier.set_point_values(np.maximum(
+            np.interp(new.multiplier.at_points(ng.x), x_old[order], lam[order], period=period), 0.0))
 
 
 def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, tolerance: float, h0: float,
