@@ -39,12 +39,12 @@ consistent, non-symmetric tangent), or the fixed point of Tresca problems
 ``G_k = mu p_{k-1}`` until ``max |p_k - p_{k-1}| <= coulomb_rtol * max p_k``
 on ``S_C``: the same solution (:mod:`ngcontact.cell.coulomb_friction`).
 
-Exact non-penetration (``CellModel.enforcement = "exact"``, 2D and 3D;
+Exact non-penetration (``CellModel.enforcement = "exact"``, 2D, and 3D at order 1;
 the rigid limit ``k_n -> infinity`` of the Winkler layer): the normal
 energy is the augmented Lagrangian
 ``(1/(2 k_n)) ([lambda + k_n (J.n - g)]_+^2 - lambda^2)``, integrated with a
-nodal rule on ``S_C`` (Gauss-Lobatto on segments, the lattice nodes with
-their areas on triangles) so that the constraints sit at the nodes of the
+nodal rule on ``S_C`` (Gauss-Lobatto on segments, the vertices with their
+areas on order-1 triangles) so that the constraints sit at the nodes of the
 trace space, with a multiplier
 ``lambda`` per point held fixed in each Newton solve and updated by Uzawa's
 iteration (:mod:`ngcontact.cell.contact_multiplier`); the pressure of the
@@ -66,13 +66,14 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell import measures
-from ngcontact.cell.contact_multiplier import ContactMultiplier, solve_exact
+from ngcontact.cell.contact_multiplier import TRIANGLE_MAX_ORDER, ContactMultiplier, solve_exact
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
 from ngcontact.cell.cell_model import CellModel, CellSolution
 from ngcontact.cell.cell_energy import cell_energy, macro_strain_cf
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
 from ngcontact.cell.predictor import max_gap, rigid_continuation, rigid_translation, set_start, tangential_load
+from ngcontact.errors import ModelError
 from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
 from ngcontact.solvers.linear_solver import LinearSolver
@@ -145,6 +146,10 @@ class CellProblem:
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
         if start not in ("rigid", "closed"):
             raise ValueError(f"start = {start!r}: must be 'rigid' or 'closed'")
+        if model.enforcement == "exact" and cell.dim == 3 and model.order > TRIANGLE_MAX_ORDER:
+            raise ModelError(f"order = {model.order} with enforcement = 'exact' in a 3D cell: exact contact on "
+                             f"triangles is built for order <= {TRIANGLE_MAX_ORDER} (quadratic triangles leave corner "
+                             "nodes open inside the contact patch); use order 1, the penalty, or the spectral cell")
         self.line_search, self.start, self.coulomb = line_search, start, coulomb
         self.coulomb_residual = None      # Coulomb, coupled Newton: the residual form, built on first use
         self.cell, self.model = cell, model

@@ -39,7 +39,7 @@ area of the cell's period.
 
 Exact enforcement (:mod:`ngcontact.cell.contact_multiplier`): the
 pressure is the multiplier ``lambda``, given at the nodal points of the
-contact energy (Gauss-Lobatto in 2D, the triangle lattice in 3D), so its
+contact energy (Gauss-Lobatto in 2D, the vertices of the triangles in 3D), so its
 integrals use that rule (the discrete interface force) and its samples
 are taken at those points; the real contact set is
 built from the closed nodes and the edges between them

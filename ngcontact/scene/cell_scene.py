@@ -55,8 +55,9 @@ class ContactSpec:
                        "eq. 34 coefficients in the report)", units="Pa/m", check=positive())
     enforcement: str = param("penalty", doc="penalty: the paper's Winkler layer p = k_n [J.n - g]_+ (eq. 65) "
                              "and Huber-regularized friction; exact: non-penetration, the rigid limit k_n -> infinity: "
-                             "spectral cell with exact friction (w unused), or FE cell (2D and 3D), node-to-node at "
-                             "the nodes of the trace (Gauss-Lobatto on segments, the lattice on triangles) by an "
+                             "spectral cell with exact friction (w unused), or FE cell (2D; 3D at order 1), "
+                             "node-to-node at the nodes of the trace (Gauss-Lobatto on segments, vertices of "
+                             "triangles) by an "
                              "augmented Lagrangian with Uzawa updates (k_n is its "
                              "augmentation: the speed, not the answer; friction Huber-regularized with w, the "
                              "Coulomb threshold mu times the multiplier)",
@@ -200,6 +201,12 @@ class CellScene:
             check_spectral(self)
         else:
             check_penalty_ratio(self)
+        if self.discretization.method == "fe" and self.contact.enforcement == "exact" and dim == 3 \
+                and self.discretization.order > 1:
+            raise SceneError("discretization.order", self.discretization.order,
+                             "1 with contact.enforcement = 'exact' in a 3D FE cell (quadratic triangles leave corner "
+                             "nodes open inside the contact patch); or use the penalty, or discretization.method = "
+                             "'spectral' for a small-slope cell")
         fe_tolerance = self.discretization.method == "fe" and self.discretization.tolerance is not None
         if fe_tolerance and not (dim == 2 and self.geometry.profile == "flat"):
             raise SceneError("discretization.tolerance", self.discretization.tolerance,
