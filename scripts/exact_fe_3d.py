@@ -41,6 +41,9 @@ from dataclasses import replace
 
 from ngcontact.output.writer import write_csv
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from spectral_vs_fft import fe_against_spectral_panel, finish  # noqa: E402  (the sibling script draws both)
+
 log = logging.getLogger("exact_fe_3d")
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -134,19 +137,11 @@ def plot(rows: list[dict], path: str) -> None:
                 axes[0].loglog([r["ndof"] for r in sel], [abs(r["relative_error"]) for r in sel], style,
                                label=f"{method}, p/p* = {r0}")
     axes[0].set(xlabel="dofs", ylabel="|contact fraction / Westergaard - 1|", title="3D cell, Westergaard's waves")
-    fe = [r for r in rows if r["part"] == "bisinusoid" and r["method"] == "fe exact"]
-    sp = [r for r in rows if r["part"] == "bisinusoid" and r["method"] == "spectral exact"]
-    if fe:
-        axes[1].semilogx([r["ndof"] for r in fe], [r["contact_fraction"] for r in fe], "o-", label="FE cell, exact")
-    for r in sp:
-        axes[1].axhline(r["contact_fraction"], color="k", ls="--", label=f"spectral, exact, {r['setting']}")
-    axes[1].set(xlabel="FE dofs", ylabel="contact fraction", title="bisinusoid: FE exact against spectral exact")
-    for ax in axes:
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    bis = [r for r in rows if r["part"] == "bisinusoid"]
+    fe_against_spectral_panel(axes[1], [(r["ndof"], r["contact_fraction"]) for r in bis if r["method"] == "fe exact"],
+                              [(r["setting"], r["contact_fraction"]) for r in bis if r["method"] == "spectral exact"],
+                              " exact")
+    finish(fig, axes, path)
 
 
 def main(argv=None) -> int:

@@ -337,20 +337,14 @@ interface_maxh = 0.02
 """
 
 
-def test_an_exact_fe_scene_runs_end_to_end(tmp_path):
-    path = tmp_path / "s.toml"
-    path.write_text(SCENE)
-    assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
-    report = json.loads((tmp_path / "o" / "report.json").read_text())
-    (load,) = report["results"]["loads"]
-    assert load["mean_pressure"] == pytest.approx(0.0034523, rel=1e-9)
-    assert load["contact_fraction"] == pytest.approx(westergaard_contact_fraction(0.0034523 / PSTAR, 1.0), rel=0.02)
-
-
-def test_a_3d_exact_fe_scene_runs_end_to_end(tmp_path):
-    """A flat 3D cell with the sinusoid gap (waves along x), exact contact: the report's pressure, fraction, surface."""
-    text = SCENE.replace('profile = "flat"', 'profile = "flat3d"').replace("maxh = 0.3", "maxh = 0.4") \
-        .replace("interface_maxh = 0.02", "interface_maxh = 0.1").replace("order = 2", "order = 1")
+# measured -1.2 % (2D, order 2, interface mesh 0.02) and -5.0 % (3D, order 1, interface mesh 0.1, coarse bodies)
+@pytest.mark.parametrize("dim, tolerance", [(2, 0.02), (3, 0.08)])
+def test_an_exact_fe_scene_runs_end_to_end(tmp_path, dim, tolerance):
+    """Through the command line: the report's pressure, contact fraction and surface file (3D: a flat cell with
+    the sinusoid gap, waves along x)."""
+    text = SCENE if dim == 2 else SCENE.replace('profile = "flat"', 'profile = "flat3d"').replace(
+        "maxh = 0.3", "maxh = 0.4").replace("interface_maxh = 0.02", "interface_maxh = 0.1").replace(
+        "order = 2", "order = 1")
     path = tmp_path / "s.toml"
     path.write_text(text)
     assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
@@ -358,8 +352,8 @@ def test_a_3d_exact_fe_scene_runs_end_to_end(tmp_path):
     (load,) = report["results"]["loads"]
     assert load["mean_pressure"] == pytest.approx(0.0034523, rel=1e-9)
     assert load["max_penetration"] <= 1e-10
-    # measured -5.0 %: order 1 on 10 interface elements per period, coarse bodies
-    assert load["contact_fraction"] == pytest.approx(westergaard_contact_fraction(0.0034523 / PSTAR, 1.0), rel=0.08)
+    assert load["contact_fraction"] == pytest.approx(westergaard_contact_fraction(0.0034523 / PSTAR, 1.0),
+                                                     rel=tolerance)
     assert (tmp_path / "o" / "surface_load0.csv").exists()
 
 
