@@ -22,10 +22,15 @@ setup and solve (not the meshing), Newton steps, CG iterations, peak memory,
 contact fraction; per solver the exponent ``b`` of ``time ~ dofs^b`` fitted
 over the sizes.
 
+With ``--breakdown INTERFACE_MAXH`` it measures instead where one iterative
+cell solve spends its time (CG per iteration, one BDDC application, one
+product with the tangent, the size of BDDC's coarse problem) and writes
+``scaling_3d_breakdown.csv`` and ``.png``.
+
 Usage::
 
     python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral]
-                                 [--solvers iterative direct]
+                                 [--solvers iterative direct] [--breakdown INTERFACE_MAXH]
 
 Writes ``scaling_3d.csv`` and ``scaling_3d.png`` into ``OUT_DIR`` (default
 ``results/scaling_3d``) and logs the tables and the fitted exponents.
@@ -231,6 +236,76 @@ def plot(rows: list[dict], path: str) -> None:
     plt.close(fig)
 
 
+BREAKDOWN_KEYS = ("size", "ndof", "wirebasket_dofs", "wirebasket_contact_dofs", "cg_iterations", "cg_seconds",
+                  "ms_per_cg_iteration", "ms_per_matvec", "ms_per_bddc")
+
+
+def breakdown(size: float, out: str) -> dict:
+    """Where an iterative 3D cell solve spends its time: CG's cost per iteration against one product with the
+    tangent and one BDDC application, and the size of BDDC's coarse problem (its wirebasket dofs, and those of
+    them on the contact surface).  Writes ``scaling_3d_breakdown.csv`` and ``.png``."""
+    import ngsolve as ng
+    from ngcontact import runner
+    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.scene.loader import load
+    from ngcontact.solvers.linear_solver import LinearSolver
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    cell = build_cell(scene, interface_maxh=size)
+    with runner.threads(runner.thread_count()):
+        P = CellProblem(cell, model_of(scene), linear=LinearSolver("iterative"))
+        import ngsolve.krylovspace as K
+        spent = [0.0]
+        solve = K.CGSolver._SolveImpl
+
+        def timed(self, *a, **kw):
+            t0 = time.perf_counter()
+            try:
+                return solve(self, *a, **kw)
+            finally:
+                spent[0] += time.perf_counter() - t0
+        K.CGSolver._SolveImpl = timed
+        try:
+            P.solve(cell_loads(scene)[0], first=True, measure=False)
+        finally:
+            K.CGSolver._SolveImpl = solve
+        A = P.energy().whole.mat
+        pre = next(iter(P.linear._pre.values())).mat
+        x, y = A.CreateColVector(), A.CreateColVector()
+        x.SetRandom()
+        ms = {}
+        for name, op in (("matvec", A), ("bddc", pre)):
+            t0 = time.perf_counter()
+            for _ in range(20):
+                y.data = op * x
+            ms[name] = (time.perf_counter() - t0) / 20 * 1e3
+    wb = ng.COUPLING_TYPE.WIREBASKET_DOF
+    X = P.X
+    on_contact = {d for el in cell.mesh.Boundaries("contact").Elements() for d in X.GetDofNrs(el) if d >= 0}
+    its = sum(P.linear.iterations)
+    row = {"size": size, "ndof": X.ndof, "wirebasket_dofs": sum(X.CouplingType(d) == wb for d in range(X.ndof)),
+           "wirebasket_contact_dofs": sum(X.CouplingType(d) == wb for d in on_contact), "cg_iterations": its,
+           "cg_seconds": spent[0], "ms_per_cg_iteration": spent[0] / max(its, 1) * 1e3,
+           "ms_per_matvec": ms["matvec"], "ms_per_bddc": ms["bddc"]}
+    log.info("breakdown at interface_maxh %g: %s", size, ", ".join(f"{k} = {row[k]:.4g}" for k in BREAKDOWN_KEYS))
+    os.makedirs(out, exist_ok=True)
+    write_csv(os.path.join(out, "scaling_3d_breakdown.csv"), list(BREAKDOWN_KEYS), [[row[k] for k in BREAKDOWN_KEYS]])
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    names = ("ms_per_cg_iteration", "ms_per_bddc", "ms_per_matvec")
+    ax.bar(range(3), [row[k] for k in names])
+    ax.set_xticks(range(3), ["CG iteration", "BDDC application", "tangent product"])
+    ax.set_ylabel("ms")
+    ax.set_title(f"3D cell, {row['ndof']} dofs: coarse problem {row['wirebasket_dofs']} dofs "
+                 f"({row['wirebasket_contact_dofs']} on S_C)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "scaling_3d_breakdown.png"), dpi=120)
+    plt.close(fig)
+    return row
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv and argv[0] == "--child":
@@ -245,8 +320,13 @@ def main(argv=None) -> int:
                     help="which of the three measurements to run (default: all)")
     ap.add_argument("--solvers", nargs="+", choices=("iterative", "direct"), default=("iterative", "direct"),
                     help="which linear solvers of parts 1 and 2 to run (default: both)")
+    ap.add_argument("--breakdown", type=float, default=None, metavar="INTERFACE_MAXH",
+                    help="instead: where an iterative cell solve of this interface mesh size spends its time")
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
+    if args.breakdown is not None:
+        breakdown(args.breakdown, args.out)
+        return 0
     rows = fe_parts(args.quick, args.direct_max, args.parts, args.solvers)
     if "spectral" in args.parts:
         rows += spectral_aim(args.quick)
