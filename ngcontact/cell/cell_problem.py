@@ -264,8 +264,13 @@ class CellProblem:
         """
         before = tangential_load(self)
         self._apply_load(load, first)
-        if first and self.multiplier is not None and self.model.friction is not None:
-            start_multiplier(self, load)
+        if first and self.multiplier is not None:
+            # a first load starts afresh: a multiplier left by an earlier load (a table of independent cell
+            # solves) held against the rigid predictor's state could leave no point in contact, the bodies
+            # afloat and the tangent singular
+            self.multiplier.set_point_values(np.zeros(len(self.multiplier.point_values())))
+            if self.model.friction is not None:
+                start_multiplier(self, load)
         free = self._freedofs(load)
         # a later load with a tangential change: frictionless, the rigid predictor for the whole traction;
         # with friction (or where that has no minimizer), the rigid continuation, whose steps count

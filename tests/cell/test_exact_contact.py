@@ -151,6 +151,18 @@ def test_contact_fraction_converges_to_westergaard_under_refinement():
     assert max(errors[-1]) <= 1.5e-3, errors
 
 
+def test_a_first_load_starts_afresh_from_the_multiplier_of_an_earlier_one():
+    """``first=True`` after another load (the independent solves of a cell table) gives the first solve again;
+    the multiplier of p/p* = 0.8 held against the rigid predictor of 0.2 had left no point in contact (a singular
+    tangent at order 3)."""
+    P = _problem(0.02, 3, 1e2)
+    first = P.solve(cell_load(2, pressure=0.2 * PSTAR), first=True, measure=False)
+    P.solve(cell_load(2, pressure=0.8 * PSTAR), measure=False)
+    again = P.solve(cell_load(2, pressure=0.2 * PSTAR), first=True, measure=False)
+    for key in ("contact_fraction", "mean_pressure"):
+        assert again.results[key] == pytest.approx(first.results[key], rel=1e-10), key
+
+
 def test_an_unknown_enforcement_is_refused():
     law = isotropic(1.0, NU)
     cell = flat_cell(maxh=0.5, interface_maxh=0.25, order=1)
