@@ -269,6 +269,7 @@ class CellProblem:
             # solves) held against the rigid predictor's state could leave no point in contact, the bodies
             # afloat and the tangent singular
             self.multiplier.set_point_values(np.zeros(len(self.multiplier.point_values())))
+            self.augmentation.Set(self.model.k_n)         # as the scene gave it (Uzawa may have raised it)
             if self.model.friction is not None:
                 start_multiplier(self, load)
         free = self._freedofs(load)

@@ -94,6 +94,7 @@ own (exact for the flat triangles of a small-slope cell).
 from __future__ import annotations
 
 import logging
+import math
 from typing import Any, Callable
 
 import ngsolve as ng
@@ -270,6 +271,34 @@ def characteristic_length(problem) -> float:
     return J if J > 0 else 1.0
 
 
+#: factor by which a slow Uzawa pass raises the augmentation (:func:`ngcontact.solvers.uzawa.uzawa`)
+STIFFEN = 10.0
+#: ceiling of a raised augmentation, as ``k h / E`` (``h`` the smallest element of ``S_C``, ``E`` the
+#: softer body's modulus): 1e4 reaches the answer in 2 passes on Westergaard's cell with equilibrium to
+#: 2e-12, where 1e8 loses it to 3e-7
+MAX_AUGMENTATION_RATIO = 1e4
+
+
+def max_augmentation(problem) -> float:
+    """The ceiling of a raised augmentation: ``MAX_AUGMENTATION_RATIO E / h``; never below the scene's ``k_n``."""
+    m = problem.multiplier
+    sizes = np.asarray(ng.Integrate(ng.CF(1.0), m.mesh, ng.BND, definedon=m.region, element_wise=True))[m.elements]
+    h = float(sizes.min() if m.dim == 2 else np.sqrt(2.0 * sizes.min()))
+    return max(MAX_AUGMENTATION_RATIO * softer_modulus(problem.model) / h, problem.model.k_n)
+
+
+def softer_modulus(model) -> float:
+    """Young's modulus of the softer body (isotropic), else the smallest eigenvalue of its stiffness matrix."""
+    out = math.inf
+    for law in (model.rough, model.counter):
+        if law.lame is not None:
+            lam, mu = law.lame
+            out = min(out, mu * (3.0 * lam + 2.0 * mu) / (lam + mu))
+        else:
+            out = min(out, float(np.linalg.eigvalsh(law.matrix).min()))
+    return out
+
+
 def solve_exact(problem, newton: Callable[[float], dict], atol: float) -> dict[str, Any]:
     """Uzawa's iteration on ``problem`` (a cell problem built with ``enforcement = "exact"``).
 
@@ -277,7 +306,9 @@ def solve_exact(problem, newton: Callable[[float], dict], atol: float) -> dict[s
     multiplier and returns its history.  Returns one history in the format
     of :meth:`ngcontact.solvers.newton.NewtonHistory.as_dict`, the passes'
     lists concatenated, plus ``uzawa_iterations``, ``uzawa_penetrations``,
-    ``uzawa_changes``, ``uzawa_relative_changes`` and ``newton_per_pass``.
+    ``uzawa_changes``, ``uzawa_relative_changes``, ``newton_per_pass`` and
+    ``uzawa_stiffened`` (the passes after which a slow pass raised the
+    augmentation by ``STIFFEN``, up to :func:`max_augmentation`).
     """
     m, model = problem.multiplier, problem.model
 
@@ -288,13 +319,21 @@ def solve_exact(problem, newton: Callable[[float], dict], atol: float) -> dict[s
         return m.update(problem.augmented_pressure, problem.penetration, problem.augmentation.Get(),
                         characteristic_length(problem))
 
-    hist = uzawa(solve, update, rtol=model.uzawa_rtol, max_iter=model.uzawa_max_iter)
+    def stiffen() -> bool:
+        k, ceiling = problem.augmentation.Get(), max_augmentation(problem)
+        if STIFFEN * k > ceiling:
+            return False
+        problem.augmentation.Set(STIFFEN * k)
+        return True
+
+    hist = uzawa(solve, update, rtol=model.uzawa_rtol, max_iter=model.uzawa_max_iter, stiffen=stiffen)
     passes = hist["newton"]
     out: dict[str, Any] = {"iterations": sum(h["iterations"] for h in passes),
                            "converged": all(h["converged"] for h in passes), "linear_solve_only": False}
     for key in ("residuals", "energies", "step_lengths", "active_set_sizes"):
         out[key] = [v for h in passes for v in h[key]]
     out["uzawa_iterations"] = hist["uzawa_iterations"]
+    out["uzawa_stiffened"] = hist["stiffened"]
     out["uzawa_penetrations"] = hist["penetrations"]
     out["uzawa_changes"] = hist["changes"]
     out["uzawa_relative_changes"] = hist["relative_changes"]

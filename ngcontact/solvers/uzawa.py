@@ -26,6 +26,14 @@ only the speed (the error in ``lambda`` contracts roughly by
 ``1 / (1 + k c)`` per pass, ``c`` the compliance of the mode, so ``k`` of
 the order of ``E/h`` and above takes a few passes).  Each pass's Newton
 solve starts from the previous one's state.
+
+A soft augmentation converges slowly (``k = 0.01 E/h`` on Westergaard's
+cell: not within 500 passes).  Since ``k`` is not in the answer, a caller
+may pass ``stiffen``: whenever a pass fails to shrink the larger of the
+two measures to ``SLOW`` times its value after the previous pass,
+``stiffen()`` raises ``k`` (it returns ``False`` once it may not: a
+ceiling that keeps the Newton systems well conditioned) and the passes
+that did so are recorded.
 """
 from __future__ import annotations
 
@@ -36,9 +44,12 @@ from ngcontact.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
 
+#: a pass must shrink the larger of the two measures below this fraction of its previous value, or ``stiffen``
+SLOW = 0.5
+
 
 def uzawa(solve: Callable[[int], dict], update: Callable[[], dict[str, float]], *, rtol: float,
-          max_iter: int) -> dict[str, Any]:
+          max_iter: int, stiffen: Callable[[], bool] | None = None) -> dict[str, Any]:
     """Alternate ``solve`` (primal, multiplier fixed) and ``update`` (multiplier) until both tests hold.
 
     Parameters
@@ -53,12 +64,16 @@ def uzawa(solve: Callable[[int], dict], update: Callable[[], dict[str, float]], 
         ``"relative_change"``, kept in the history).
     rtol, max_iter
         Stopping rule of the module docstring; largest number of passes.
+    stiffen
+        Optional: raises the augmentation when a pass is slow (module
+        docstring); returns whether it did.
 
     Returns
     -------
     dict
         ``newton`` (the passes' histories), ``penetrations``, ``changes``,
-        ``relative_changes``, ``uzawa_iterations``.
+        ``relative_changes``, ``uzawa_iterations``, ``stiffened`` (the passes
+        after which the augmentation was raised).
 
     Raises
     ------
@@ -66,8 +81,8 @@ def uzawa(solve: Callable[[int], dict], update: Callable[[], dict[str, float]], 
         After ``max_iter`` passes, with the history.
     """
     history: dict[str, Any] = {"newton": [], "penetrations": [], "changes": [], "relative_changes": [],
-                               "uzawa_iterations": 0}
-    pen = change = float("inf")
+                               "uzawa_iterations": 0, "stiffened": []}
+    pen = change = previous = float("inf")
     for j in range(1, max_iter + 1):
         history["newton"].append(solve(j))
         measures = update()
@@ -79,6 +94,11 @@ def uzawa(solve: Callable[[int], dict], update: Callable[[], dict[str, float]], 
         log.debug("uzawa %d: penetration %.3e, multiplier change %.3e (relative)", j, pen, change)
         if pen <= rtol and change <= rtol:
             return history
+        worst = max(pen, change)
+        if stiffen is not None and worst > SLOW * previous and stiffen():
+            history["stiffened"].append(j)
+            log.debug("uzawa %d: slow pass, augmentation raised", j)
+        previous = worst
     raise ConvergenceError(f"Uzawa's iteration did not converge in {max_iter} passes: relative penetration "
                            f"{pen:.3e} and multiplier change {change:.3e}, allowed {rtol:g}; raise the "
                            "augmentation k_n (towards E/h and above) or the pass limit", history)

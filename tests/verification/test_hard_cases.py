@@ -82,7 +82,8 @@ def test_penalty_sweep_with_partial_contact_against_westergaard():
 
     Above ~1e4 E/h the penalty, enforced at every quadrature point of the P2 jump,
     locks the contact edge on this mesh (fraction 0.48 instead of 0.55 at 1e6 E/h);
-    that needs a finer interface mesh, not a stiffer solver.
+    that is the penalty model's own limit: exact enforcement has none
+    (:func:`test_exact_contact_sweep_gives_one_contact_set_for_every_k_n`).
     """
     E, nu, h, p = 1.0, 0.3, 0.01, 0.01
     law = isotropic(E, nu)
@@ -98,6 +99,35 @@ def test_penalty_sweep_with_partial_contact_against_westergaard():
         assert sol.results["mean_traction"][1] == pytest.approx(-p, rel=1e-9)
         assert sol.results["mean_pressure"] == pytest.approx(p, rel=1e-3), c
         assert sol.results["contact_fraction"] == pytest.approx(a_ref, rel=0.05), c
+
+
+def test_exact_contact_sweep_gives_one_contact_set_for_every_k_n():
+    """The cell above with exact enforcement, k_n (the augmentation) from 1e-2 to 1e8 E/h: one contact fraction to
+    1e-8 (measured 1.3e-9), 0.66 % from Westergaard on this mesh, admissible and balanced.  The softest
+    augmentations converge because Uzawa raises a slow one (18 passes at 1e-2 E/h, not converged in 500 without)."""
+    E, nu, h, p, ih = 1.0, 0.3, 0.01, 0.01, 0.02
+    law = isotropic(E, nu)
+    pstar = westergaard_p_star(e_star(E, nu, E, nu), h, 1.0)
+    cell = flat_cell(maxh=0.25, interface_maxh=ih)
+    gap = 2 * h * ng.sin(math.pi * ng.x) ** 2
+    fractions = []
+    for c in (1e-2, 1.0, 1e2, 1e4, 1e6, 1e8):
+        P = CellProblem(cell, CellModel(rough=law, counter=law, k_n=c * E / ih, order=2, gap=gap,
+                                        enforcement="exact"))
+        sol = P.sweep([cell_load(2, pressure=p)])[0]
+        assert all_finite(sol)
+        r, uz = sol.results, sol.newton[-1]
+        assert r["max_penetration"] <= 1e-10 * 2 * h, c
+        # measured <= 5e-13 up to 1e2 E/h, 2e-11 at 1e4, 3e-9 to 2.7e-7 at 1e6 and 1e8 (the round-off of an
+        # augmentation 1e8 times the bodies' stiffness, varying from run to run with the threads' summation order)
+        balance = 1e-10 if c <= 1e4 else 1e-6
+        assert r["equilibrium_error"] <= balance, c
+        assert r["mean_pressure"] == pytest.approx(p, rel=balance), c
+        assert uz["uzawa_iterations"] <= 30, (c, uz["uzawa_iterations"])
+        assert bool(uz["uzawa_stiffened"]) == (c < 1e2), (c, uz["uzawa_stiffened"])
+        fractions.append(r["contact_fraction"])
+    assert max(fractions) - min(fractions) <= 1e-8 * fractions[0], fractions
+    assert fractions[0] == pytest.approx(westergaard_contact_fraction(p, pstar), rel=0.01)
 
 
 @pytest.mark.parametrize("E_rough, E_counter, nu, order", [(1.0, 1e4, 0.3, 2), (1e4, 1.0, 0.3, 2),
