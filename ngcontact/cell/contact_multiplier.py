@@ -68,28 +68,9 @@ pressure use the Lobatto rule (:meth:`ContactMultiplier.integrate`, the
 discrete interface force) and samples are taken at the points
 (:meth:`ContactMultiplier.samples`).
 
-The real contact set (:func:`contact_cuts`): a node is closed where its
-multiplier carries load or its opening ``g - J_n`` is at most the Uzawa
-tolerance ``rtol L``.  Between two closed nodes the surfaces are in
-contact, between two open ones they are not; between a closed node ``x_c``
-and an open one ``x_o`` lies a contact edge.  Beyond a smooth edge ``a``
-the opening grows like ``(x - a)^(3/2)`` (the Westergaard and Hertz edge,
-DESIGN 8), so ``opening^(2/3)`` is nearly linear there: the edge is the
-root of the line through ``opening^(2/3)`` at ``x_o`` and the next open
-node beyond it, kept between ``x_c`` and ``x_o``.  This needs the nodes in
-order along ``S_C``: on a contact surface that is a graph over ``x``
-(``n_y > 0``), sorted by ``x``; elsewhere, or without a falling line, the
-edge is the midpoint of ``[x_c, x_o]``.
-
-In 3D (:func:`contact_area`) no open node beyond a crossing lies on the
-line through it on an unstructured surface mesh, so the edge is placed on
-each element edge from a closed vertex ``c`` to an open vertex ``o`` by the
-edge's asymptotics instead (:func:`edge_fraction`): the pressure
-``lambda_c`` inside and the opening at ``o`` outside fix where a
-square-root pressure and a ``3/2``-power gap of the same edge vanish.
-Each triangle contributes the part of it on the closed side of the
-straight lines through its crossings; the area of each triangle is its
-own (exact for the flat triangles of a small-slope cell).
+The real contact set the multiplier and the openings give (closed nodes
+and the contact edges between them) is measured in
+:mod:`ngcontact.cell.exact_contact_set`.
 """
 from __future__ import annotations
 
@@ -180,6 +161,7 @@ class ContactMultiplier:
         ref = [q[: self.dim - 1] for q in self.rule.points]
         elements = np.asarray(self.points["nr"]).reshape(-1, npt)[:, 0]
         self.elements = elements
+        self._areas: np.ndarray | None = None
         # per element: its dofs and the inverse of (shape_j(x_q)), point values -> coefficients
         self._dofs = np.empty((len(elements), npt), dtype=int)
         self._inverse = np.empty((len(elements), npt, npt))
@@ -189,6 +171,14 @@ class ContactMultiplier:
             V = np.array([np.asarray(fe.CalcShape(*xq)) for xq in ref])
             self._dofs[e] = np.asarray(self.space.GetDofNrs(ei))
             self._inverse[e] = np.linalg.inv(V)
+
+    @property
+    def element_areas(self) -> np.ndarray:
+        """Measure of each element of ``S_C`` (length in 2D, area in 3D), in the order of :attr:`points`."""
+        if self._areas is None:
+            every = ng.Integrate(ng.CF(1.0), self.mesh, ng.BND, definedon=self.region, element_wise=True)
+            self._areas = np.asarray(every)[self.elements]
+        return self._areas
 
     @property
     def weights(self) -> np.ndarray:
@@ -282,8 +272,8 @@ MAX_AUGMENTATION_RATIO = 1e4
 def max_augmentation(problem) -> float:
     """The ceiling of a raised augmentation: ``MAX_AUGMENTATION_RATIO E / h``; never below the scene's ``k_n``."""
     m = problem.multiplier
-    sizes = np.asarray(ng.Integrate(ng.CF(1.0), m.mesh, ng.BND, definedon=m.region, element_wise=True))[m.elements]
-    h = float(sizes.min() if m.dim == 2 else np.sqrt(2.0 * sizes.min()))
+    smallest = float(m.element_areas.min())
+    h = smallest if m.dim == 2 else math.sqrt(2.0 * smallest)
     return max(MAX_AUGMENTATION_RATIO * softer_modulus(problem.model) / h, problem.model.k_n)
 
 
@@ -339,149 +329,4 @@ def solve_exact(problem, newton: Callable[[float], dict], atol: float) -> dict[s
     out["uzawa_relative_changes"] = hist["relative_changes"]
     out["newton_per_pass"] = [h["iterations"] for h in passes]
     log.info("exact contact: %d Uzawa passes, %d Newton steps", hist["uzawa_iterations"], out["iterations"])
-    return out
-
-
-def closed_nodes(problem) -> tuple[np.ndarray, np.ndarray]:
-    """Per point of the multiplier: closed (it carries load, or its opening is within the Uzawa tolerance
-    ``rtol L``), and the opening ``g - J_n``."""
-    m = problem.multiplier
-    opening = -m.at_points(problem.penetration)
-    closed = (m.point_values() > 0.0) | (opening <= problem.model.uzawa_rtol * characteristic_length(problem))
-    return closed, opening
-
-
-def contact_area(problem) -> float:
-    """Area of the real contact set on ``S_C`` (3D): closed nodes and the edges between them (module docstring)."""
-    closed, opening = closed_nodes(problem)
-    return vertex_area(problem.multiplier, closed, opening, contact_modulus(problem.model))
-
-
-def contact_modulus(model) -> float | None:
-    """``E*`` of the two bodies, ``1/E* = (1 - nu_r)/(2 mu_r) + (1 - nu_c)/(2 mu_c)`` (isotropic), else ``None``."""
-    inverse = 0.0
-    for law in (model.rough, model.counter):
-        if law.lame is None:
-            return None
-        lam, mu = law.lame
-        nu = lam / (2.0 * (lam + mu))
-        inverse += (1.0 - nu) / (2.0 * mu)
-    return 1.0 / inverse
-
-
-def edge_fraction(lam_c, opening_o, length, estar) -> np.ndarray:
-    """Where a contact edge crosses a segment of ``length`` from a closed to an open node, as a fraction from the
-    closed one.
-
-    At a smooth edge the pressure grows like ``A sqrt(d)`` inside and the
-    gap like ``(4 A / (3 E*)) d^(3/2)`` outside (the 2D Hertz edge, DESIGN
-    Sec. 8; with ``E*`` of the two bodies).  With ``lambda_c`` at distance
-    ``t L`` inside and the opening ``g_o`` at ``(1 - t) L`` outside, ``A``
-    cancels: ``(1 - t)^(3/2) / t^(1/2) = 3 E* g_o / (4 lambda_c L)``, whose
-    left side falls from infinity to 0 on ``(0, 1)``: one root, found by
-    bisection.  A closed node that carries no load (closed by its opening
-    alone) puts the edge on it; without ``E*`` (anisotropic bodies) the
-    edge is at the midpoint.
-    """
-    lam_c, g_o, L = (np.asarray(v, float) for v in (lam_c, opening_o, length))
-    if estar is None:
-        return np.full(lam_c.shape, 0.5)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        R = np.where(lam_c > 0.0, 3.0 * estar * np.maximum(g_o, 0.0) / (4.0 * lam_c * L), np.inf)
-    lo, hi = np.zeros(R.shape), np.ones(R.shape)
-    for _ in range(60):
-        t = 0.5 * (lo + hi)
-        above = (1.0 - t) ** 1.5 > R * np.sqrt(t)
-        lo, hi = np.where(above, t, lo), np.where(above, hi, t)
-    return np.where(np.isinf(R), 0.0, 0.5 * (lo + hi))
-
-
-def vertex_area(m: ContactMultiplier, closed: np.ndarray, opening: np.ndarray, estar: float | None) -> float:
-    """Area of the closed part of ``S_C`` (3D, order-1 triangles) from the state of the vertices.
-
-    ``closed`` and ``opening`` are given per point of ``m`` (three per
-    triangle).  A contact edge crosses each element edge from a closed to
-    an open vertex at :func:`edge_fraction` of it; a triangle with one
-    closed vertex contributes the triangle cut off by the two crossings
-    from it, one with two closed vertices all but the triangle cut off
-    towards the open one, one with three all of it.
-    """
-    closed = np.asarray(closed, bool).reshape(-1, 3)
-    opening = np.asarray(opening, float).reshape(-1, 3)
-    lam = m.point_values().reshape(-1, 3)
-    xyz = np.stack([m.at_points(c).reshape(-1, 3) for c in (ng.x, ng.y, ng.z)], axis=-1)
-    # physical area of each element of S_C, in the order of the multiplier's points
-    areas = np.asarray(ng.Integrate(ng.CF(1.0), m.mesh, ng.BND, definedon=m.region, element_wise=True))[m.elements]
-    count = closed.sum(axis=1)
-    share = (count == 3).astype(float)
-    rows = np.arange(len(count))
-    for k in (1, 2):
-        e = rows[count == k]
-        if e.size == 0:
-            continue
-        # the odd vertex out: the closed one (k = 1) or the open one (k = 2), and the other two
-        v = np.argmax(closed[e], axis=1) if k == 1 else np.argmin(closed[e], axis=1)
-        w1, w2 = (v + 1) % 3, (v + 2) % 3
-        if k == 1:
-            c, o1, o2 = v, w1, w2
-            t = [edge_fraction(lam[e, c], opening[e, o], np.linalg.norm(xyz[e, o] - xyz[e, c], axis=1), estar)
-                 for o in (o1, o2)]
-            share[e] = t[0] * t[1]
-        else:
-            o = v
-            t = [edge_fraction(lam[e, c], opening[e, o], np.linalg.norm(xyz[e, o] - xyz[e, c], axis=1), estar)
-                 for c in (w1, w2)]
-            share[e] = 1.0 - (1.0 - t[0]) * (1.0 - t[1])
-    return float(np.dot(share, areas))
-
-
-def contact_cuts(problem) -> list[tuple[np.ndarray, list[bool]]]:
-    """Per segment of ``S_C`` (in the order of :attr:`ContactMultiplier.points`): ``(cuts, on)``.
-
-    ``cuts`` are reference coordinates ``0 = c_0 < ... < c_m = 1`` and
-    ``on[i]`` says whether ``[c_i, c_(i+1)]`` is in contact: the nodes and
-    the edges between them of the module docstring.  Within a segment the
-    abscissa is taken as affine in the reference coordinate (straight
-    segments) to place an edge.
-    """
-    m = problem.multiplier
-    npt = len(m.rule.points)
-    t = np.array([q[0] for q in m.rule.points])
-    closed, opening = closed_nodes(problem)
-    x = m.at_points(ng.x)
-    graph = problem.dim == 2 and float(m.at_points(problem.n[1]).min(initial=1.0)) > 0.0
-    # the nodes along S_C, a shared vertex once: sorted by x
-    scale = max(float(np.ptp(x)), 1.0)
-    X, node = np.unique(np.round(x / scale, 11), return_inverse=True)
-    X = X * scale
-    node_closed = np.zeros(len(X), bool)
-    np.logical_or.at(node_closed, node, closed)
-    node_opening = np.full(len(X), np.inf)
-    np.minimum.at(node_opening, node, np.maximum(opening, 0.0))
-    r = node_opening ** (2.0 / 3.0)
-    out = []
-    for e in range(len(x) // npt):
-        idx = node[e * npt:(e + 1) * npt]
-        cuts, on = [0.0], []
-        for q in range(npt - 1):
-            a, b = node_closed[idx[q]], node_closed[idx[q + 1]]
-            if a == b:
-                on.append(bool(a))
-                cuts.append(t[q + 1])
-                continue
-            c, o = (q, q + 1) if a else (q + 1, q)
-            f = 0.5                                   # the edge at this fraction from the closed node
-            if graph:
-                nc, no = idx[c], idx[o]
-                n2 = no + (no - nc)
-                if abs(no - nc) == 1 and 0 <= n2 < len(X) and not node_closed[n2] and r[n2] > r[no]:
-                    root = X[no] - r[no] * (X[n2] - X[no]) / (r[n2] - r[no])
-                    f = float(np.clip((root - X[nc]) / (X[no] - X[nc]), 0.0, 1.0))
-            tc = t[c] + f * (t[o] - t[c])
-            cuts.append(tc)
-            on.append(bool(a))
-            cuts.append(t[q + 1])
-            on.append(bool(b))
-        keep = [i for i in range(len(on)) if cuts[i + 1] > cuts[i]]
-        out.append((np.array([cuts[0]] + [cuts[i + 1] for i in keep]), [on[i] for i in keep]))
     return out

@@ -43,8 +43,8 @@ contact energy (Gauss-Lobatto in 2D, the vertices of the triangles in 3D), so it
 integrals use that rule (the discrete interface force) and its samples
 are taken at those points; the real contact set is
 built from the closed nodes and the edges between them
-(:func:`ngcontact.cell.contact_multiplier.contact_cuts`, in 3D
-:func:`~ngcontact.cell.contact_multiplier.contact_area`), not from the sign
+(:func:`ngcontact.cell.exact_contact_set.contact_cuts`, in 3D
+:func:`~ngcontact.cell.exact_contact_set.contact_area`), not from the sign
 of the penetration, which is zero to round-off at the nodes and the
 interpolation error of the closure between them.
 
@@ -58,7 +58,7 @@ import numpy as np
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.errors import ConvergenceError
 from ngcontact.cell.coefficients import coefficients
-from ngcontact.cell.contact_multiplier import contact_area, contact_cuts
+from ngcontact.cell.exact_contact_set import contact_area, contact_cuts
 from ngcontact.cell.stiffness import effective_stiffness
 from ngcontact.fem import materials as _mat
 from ngcontact.fem.quadrature import kink_order, sampling_order, smooth_order
@@ -91,7 +91,7 @@ def contact_fraction(problem, method: str = "auto") -> float:
         where the zero set is a curve on each face).  ``"auto"``: roots
         in 2D, quadrature in 3D.  With exact enforcement the pieces of
         :func:`contact_pieces` are those of the closed nodes (module
-        docstring; in 3D :func:`~ngcontact.cell.contact_multiplier.contact_area`),
+        docstring; in 3D :func:`~ngcontact.cell.exact_contact_set.contact_area`),
         whatever the method.
     """
     if problem.multiplier is not None:
@@ -121,7 +121,7 @@ def contact_pieces(problem) -> list[tuple[float, float, bool, float]]:
     element (exact for the polynomial it is on straight elements with the
     interpolated gap) and its real roots in ``(0, 1)`` cut the element.
     Exact enforcement: the cuts and states of
-    :func:`ngcontact.cell.contact_multiplier.contact_cuts` instead.
+    :func:`ngcontact.cell.exact_contact_set.contact_cuts` instead.
     """
     P = np.polynomial.polynomial
     m = problem.model.order + 3

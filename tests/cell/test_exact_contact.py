@@ -35,8 +35,8 @@ import pytest
 from ngcontact import cli
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_problem import CellModel, CellProblem
-from ngcontact.cell.contact_multiplier import (ContactMultiplier, edge_fraction, lobatto_rule, triangle_vertex_rule,
-                                               vertex_area)
+from ngcontact.cell.contact_multiplier import ContactMultiplier, lobatto_rule, triangle_vertex_rule
+from ngcontact.cell.exact_contact_set import edge_fraction, vertex_area
 from ngcontact.errors import ModelError
 from ngcontact.fem.materials import isotropic
 from ngcontact.geometry.cell2d import flat_cell
