@@ -11,9 +11,10 @@ The cell solves of one table level go through ``map_tasks`` (default:
 :func:`executor_map`, one batch of the run's executor, ``--workers`` local
 processes or a Dask cluster): each task is a :class:`PressureSolve`, a
 picklable callable that builds its cell problem once per process.  Measured
-on ``femur_stem_two_scale.toml`` (cold cache, 23 cell solves, a loaded
-machine): solve stage 139 s with ``--workers 1``, 88 s with 2, the same
-safety factor to 15 digits.
+on ``femur_stem_two_scale.toml`` (cold cache, 23 cell solves with the
+polyline table of that time, a loaded machine): solve stage 139 s with
+``--workers 1``, 88 s with 2, the same safety factor to 15 digits; the
+monotone cubic table needs 11 (``scripts/two_scale_benchmark.py``).
 
 A cell with micro friction under ``interface.friction = "from_cell"`` also
 gets its shear table (:mod:`ngcontact.coupling.shear_table`): the macro
@@ -60,7 +61,7 @@ from ngcontact.solvers import executor
 
 log = logging.getLogger(__name__)
 
-TABLE_FORMAT = "cell-table-1"
+TABLE_FORMAT = "cell-table-2"
 TABLE_ARRAYS = ("pressure",) + T.KEYS + ("error_estimate",)
 
 

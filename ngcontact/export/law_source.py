@@ -93,7 +93,7 @@ def exported_law(path: str, *, length_unit: float = 1.0, p_max: float | None = N
         kinks, slopes = np.array([normal.gap_force[0] / normal.kn]), np.array([normal.kn])
         K0 = normal.matrix(2)
         gap_force = np.asarray(normal.gap_force, float)
-    elif isinstance(normal, il.TabulatedLaw):
+    elif isinstance(normal, il.TabulatedLaw) and normal.interpolation == "linear":
         kinks, slopes = normal.ramps()
     else:  # pragma: no cover - a field law exists only inside the two-scale loop
         raise ModelError(f"a {type(normal).__name__} cannot be exported")

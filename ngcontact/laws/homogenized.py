@@ -41,9 +41,15 @@ Laws (frozen dataclasses, values only; their energy ``W(a)`` and traction
     below ``c_0``, extrapolated with the last slope; written as a sum of
     ramps ``p(c) = sum_i s_i [c - c_i]_+`` (``s_i`` the slope increments), so
     its energy, the integral of the table, is ``sum_i s_i/2 [c - c_i]_+^2``.
-    A linear tangential stiffness ``k_t`` may be added.  The two-scale loop
-    (paper Sec. 3.5, :mod:`ngcontact.coupling.two_scale`) hands the cell's
-    own response over as such a table: closure ``c(p)`` against pressure.
+    A linear tangential stiffness ``k_t`` may be added.  With
+    ``interpolation = "monotone_cubic"`` the nodes are joined instead by the
+    shape-preserving C1 cubic of :mod:`ngcontact.laws.monotone_cubic`
+    (Fritsch and Carlson): nondecreasing like the table, with a continuous
+    tangent at the nodes, zero below ``c_0``, continued with its last node
+    slope beyond ``c_last``; the energy is again the integral.  The
+    two-scale loop (paper Sec. 3.5, :mod:`ngcontact.coupling.two_scale`)
+    hands the cell's own response over as such a cubic table: closure
+    ``c(p)`` against pressure.
 :class:`Friction`
     Homogenized friction on top of any of them (paper eqs. 38-44): threshold
     ``G = mu0 [p]_+ + G0`` and energy ``G huber(|a_t|, w)`` with
@@ -65,6 +71,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import numpy as np
 from ngcontact.errors import ModelError
+from ngcontact.laws import monotone_cubic
 
 
 
@@ -160,6 +167,10 @@ class BundleLaw:
                          gaps=tuple(float(k[-1]) for k in keys))
 
 
+#: how a :class:`TabulatedLaw` joins its nodes
+INTERPOLATIONS = ("linear", "monotone_cubic")
+
+
 @dataclass(frozen=True, kw_only=True)
 class TabulatedLaw:
     """Monotone tabulated normal law ``p(c)`` with optional tangential stiffness.
@@ -172,11 +183,14 @@ class TabulatedLaw:
         ``p_i`` [stress], non-decreasing, ``p_0 = 0``.
     kt
         Linear tangential stiffness [stress / length].
+    interpolation
+        ``"linear"`` (the polyline) or ``"monotone_cubic"`` (module docstring).
     """
 
     closure: tuple[float, ...]
     pressure: tuple[float, ...]
     kt: float = 0.0
+    interpolation: str = "linear"
 
     def __post_init__(self):
         c = np.asarray(self.closure, float)
@@ -193,18 +207,28 @@ class TabulatedLaw:
             raise ModelError("the table carries no pressure")
         if self.kt < 0:
             raise ModelError("kt must be >= 0")
+        if self.interpolation not in INTERPOLATIONS:
+            raise ModelError(f"interpolation = {self.interpolation!r}: must be one of {', '.join(INTERPOLATIONS)}")
 
     def ramps(self) -> tuple[np.ndarray, np.ndarray]:
-        """Kinks ``c_i`` and slope increments ``s_i`` of ``p(c) = sum s_i [c - c_i]_+``."""
+        """Kinks ``c_i`` and slope increments ``s_i`` of the polyline ``p(c) = sum s_i [c - c_i]_+`` through
+        the table (the law itself when ``interpolation = "linear"``)."""
         c = np.asarray(self.closure, float)
         p = np.asarray(self.pressure, float)
         slopes = np.diff(p) / np.diff(c)
         return c[:-1], np.diff(np.concatenate([[0.0], slopes]))
 
+    def node_slopes(self) -> np.ndarray:
+        """``dp/dc`` at the nodes of the monotone cubic (:func:`ngcontact.laws.monotone_cubic.slopes`)."""
+        return monotone_cubic.slopes(self.closure, self.pressure)
+
     @property
     def stiffness(self) -> float:
+        """The largest slope ``dp/dc`` of the law."""
         c = np.asarray(self.closure, float)
         p = np.asarray(self.pressure, float)
+        if self.interpolation == "monotone_cubic":
+            return monotone_cubic.largest_slope(c, p, self.node_slopes())
         return float(np.max(np.diff(p) / np.diff(c)))
 
 

@@ -29,7 +29,11 @@ replaced by the weighted directions)::
 
 (on CoefficientFunctions the same functions are NGSolve B-splines, one
 table lookup per quadrature point instead of one ramp per kink; the
-two-scale law has dozens of kinks)
+two-scale law has dozens of kinks).  A ``"monotone_cubic"`` table: ``p(c)``
+the C1 cubic Hermite interpolant of :class:`~ngcontact.laws.homogenized.TabulatedLaw`
+and ``W(c) = int_{c_0}^c p`` (the formulas of :mod:`ngcontact.laws.monotone_cubic`;
+on CoefficientFunctions a cubic B-spline with triple knots, the Bezier form
+of each piece).
 
 With ``closed=True`` :func:`normal_energy` is the quadratic "all closed"
 surrogate (a start value for Newton): every ramp ``[x]_+`` replaced by ``x``,
@@ -73,6 +77,7 @@ from ngcontact.laws.homogenized import (
     TabulatedLaw,
     Tangential,
 )
+from ngcontact.laws import monotone_cubic
 from ngcontact.laws.huber import huber_of_square, huber_slope, if_positive, is_numeric
 
 
@@ -103,6 +108,55 @@ def _splines(closure: tuple, pressure: tuple):
     values = [v for a, b in zip(p[:-1], p[1:]) for v in (a, 0.5 * (a + b))] + [p[-1]]
     knots = [c[0]] * 3 + [x for x in c[1:-1] for _ in (0, 1)] + [c[-1]] * 3
     return ng.BSpline(3, knots, values), ng.BSpline(2, [c[0]] + c + [c[-1]], p).Integrate()
+
+
+def _table_splines(law: TabulatedLaw):
+    """``(p, W)`` of a table as B-splines, by its interpolation."""
+    if law.interpolation == "linear":
+        return _splines(law.closure, law.pressure)
+    return _cubic_splines(law.closure, law.pressure, tuple(law.node_slopes()))
+
+
+@functools.lru_cache(maxsize=16)
+def _cubic_splines(closure: tuple, pressure: tuple, slopes: tuple):
+    """``(p, W)`` of a monotone cubic table as NGSolve B-splines (module docstring).
+
+    ``p`` is a cubic B-spline with every interior knot tripled, so that its
+    control values are the Bezier points of each Hermite piece, ``p_i``,
+    ``p_i + h m_i / 3``, ``p_i+1 - h m_i+1 / 3``, ``p_i+1``: the Hermite
+    cubic exactly, 0 below ``c_0``.  A last straight piece of slope
+    ``m_last`` (as long as the table) makes the continuation beyond the last
+    node linear, like the polyline's.  ``W`` its integral from ``c_0``.
+    """
+    import ngsolve as ng
+    c = [float(x) for x in closure]
+    p = [float(x) for x in pressure]
+    m = [float(x) for x in slopes]
+    values = [p[0]]
+    for i in range(len(c) - 1):
+        h = c[i + 1] - c[i]
+        values += [p[i] + h * m[i] / 3.0, p[i + 1] - h * m[i + 1] / 3.0, p[i + 1]]
+    far = c[-1] - c[0]
+    values += [p[-1] + far * m[-1] / 3.0, p[-1] + 2.0 * far * m[-1] / 3.0, p[-1] + far * m[-1]]
+    knots = [c[0]] * 4 + [x for x in c[1:] for _ in range(3)] + [c[-1] + far] * 4
+    spline = ng.BSpline(4, knots, values)
+    return spline, spline.Integrate()
+
+
+def _cubic_table(law: TabulatedLaw, c, energy: bool):
+    """``p(c)`` or ``W(c)`` of a monotone cubic table at closures ``c`` (NumPy; :mod:`ngcontact.laws.monotone_cubic`),
+    0 below ``c_0`` and continued with the last node slope beyond ``c_last``."""
+    cn = np.asarray(law.closure, float)
+    pn = np.asarray(law.pressure, float)
+    m = law.node_slopes()
+    x = np.asarray(c, float)
+    d = x - cn[-1]
+    if energy:
+        inside = monotone_cubic.integral(cn, pn, m, x)
+        beyond = float(monotone_cubic.integral(cn, pn, m, cn[-1])) + pn[-1] * d + 0.5 * m[-1] * d * d
+    else:
+        inside, beyond = monotone_cubic.evaluate(cn, pn, m, x), pn[-1] + m[-1] * d
+    return np.where(x < cn[0], 0.0, np.where(x > cn[-1], beyond, inside))
 
 
 # ----------------------------------------------------------- energies
@@ -137,8 +191,8 @@ def normal_energy(law: NormalLaw, a, g0=0.0, closed: bool = False):
         return W
     if isinstance(law, TabulatedLaw):
         c = a[0] - g0
-        if not closed and not is_numeric(c):
-            W = _splines(law.closure, law.pressure)[1](c)
+        if not closed and (law.interpolation != "linear" or not is_numeric(c)):
+            W = _cubic_table(law, c, energy=True) if is_numeric(c) else _table_splines(law)[1](c)
             return W + 0.5 * law.kt * sum(ai * ai for ai in a[1:]) if law.kt > 0 else W
         kinks, slopes = law.ramps()
         if closed:
@@ -170,11 +224,13 @@ def normal_traction(law: NormalLaw, a, g0=0.0) -> list:
         return tau
     if isinstance(law, TabulatedLaw):
         c = a[0] - g0
-        if is_numeric(c):
+        if not is_numeric(c):
+            p = _table_splines(law)[0](c)
+        elif law.interpolation != "linear":
+            p = _cubic_table(law, c, energy=False)
+        else:
             kinks, slopes = law.ramps()
             p = sum(s * _ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
-        else:
-            p = _splines(law.closure, law.pressure)[0](c)
         return [p] + [law.kt * ai for ai in a[1:]]
     raise TypeError(f"unknown interface law {type(law).__name__}")
 

@@ -42,6 +42,30 @@ def counting_response(calls):
 START = il.BundleLaw(weights=(300.0,), directions=((1.0, 0.0),))
 
 
+@pytest.mark.parametrize("tol", [1e-2, 1e-3])
+def test_the_table_and_its_law_are_within_the_tolerance_between_the_nodes(tol):
+    """The checked interpolants (the monotone cubic in p of the fraction and the closure, and the macro
+    law P(c)) are within the tolerance of a smooth response at pressures between the nodes (the check
+    at the midpoints is an estimate: a kink of the response, e.g. where contact becomes complete, can
+    hide a larger error between them)."""
+    from ngcontact.laws import interface_energy as ie
+
+    def response(p):
+        return {"contact_fraction": math.sqrt(p / (p + 10.0)), "k_n0": 1.0, "g_n0": 0.0,
+                "closure": 1e-3 * (p / 10) ** 0.6}
+    table = T.CellTable(response, tol=tol)
+    table.cover(0.01, 20.0)
+    law = T.response_law(table)
+    assert law.interpolation == "monotone_cubic" and table.error_estimate <= tol
+    P = table.pressures
+    f_max, c_max = max(response(q)["contact_fraction"] for q in P), max(response(q)["closure"] for q in P)
+    for p in np.random.default_rng(3).uniform(P[0], P[-1], 200):
+        truth, at = response(p), table(p)
+        assert abs(float(at["contact_fraction"]) - truth["contact_fraction"]) <= tol * f_max
+        assert abs(float(at["closure"]) - truth["closure"]) <= tol * c_max
+        assert abs(float(ie.pressure(law, [truth["closure"], 0.0])) - p) <= tol * P[-1]
+
+
 def test_warm_and_cold_starts_reach_the_same_solution():
     table = T.CellTable(counting_response([]), tol=1e-3)
     table.cover(0.01, 20.0)

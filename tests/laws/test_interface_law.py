@@ -38,6 +38,9 @@ LAWS = {
     "bundle": il.InterfaceLaw(normal=_bundle()),
     "tabulated": il.InterfaceLaw(normal=il.TabulatedLaw(closure=(-0.1, 0.0, 0.2, 0.5),
                                                          pressure=(0.0, 0.3, 1.0, 1.2), kt=0.4)),
+    "tabulated_cubic": il.InterfaceLaw(normal=il.TabulatedLaw(closure=(-0.1, 0.0, 0.2, 0.5),
+                                                               pressure=(0.0, 0.3, 1.0, 1.2), kt=0.4,
+                                                               interpolation="monotone_cubic")),
     "bundle+friction": il.InterfaceLaw(normal=_bundle(), friction=il.Friction(mu=0.3, threshold=0.05,
                                                                               width=0.05)),
     "cell_response": il.InterfaceLaw(normal=_cell_response_law()),
@@ -130,6 +133,39 @@ def test_tabulated_law_interpolates_the_table_and_integrates_it():
     assert abs(ie.pressure(law, [0.0, 0.0], g0=-1e-6) - p[1]) <= 1e-9 * max(p)
 
 
+def test_monotone_cubic_table_interpolates_is_c1_and_continues_with_its_last_slope():
+    """The two-scale law's interpolation: through every node, zero before the first, W' = p, a
+    continuous tangent at the nodes (the polyline's jumps), the last node slope beyond the table."""
+    c = (0.0, 1e-6, 3e-6, 6e-6)
+    p = (0.0, 1e4, 5e4, 6e4)
+    law = il.TabulatedLaw(closure=c, pressure=p, interpolation="monotone_cubic")
+    poly = il.TabulatedLaw(closure=c, pressure=p)
+    for ci, pi in zip(c, p):
+        assert abs(ie.pressure(law, [ci, 0.0]) - pi) <= 1e-9 * max(p)
+    assert ie.pressure(law, [-1e-6, 0.0]) == 0.0
+    m = law.node_slopes()
+    assert abs(ie.pressure(law, [8e-6, 0.0]) - (p[-1] + m[-1] * 2e-6)) <= 1e-9 * max(p)
+    h = 1e-12
+    for ci in c[1:-1]:
+        jumps = []
+        for L in (law, poly):
+            left = (ie.pressure(L, [ci, 0.0]) - ie.pressure(L, [ci - h, 0.0])) / h
+            right = (ie.pressure(L, [ci + h, 0.0]) - ie.pressure(L, [ci, 0.0])) / h
+            jumps.append(abs(right - left) / law.stiffness)
+        assert jumps[0] < 1e-3 < jumps[1], jumps
+    x = np.linspace(-1e-6, 8e-6, 37)
+    W = np.array([float(ie.normal_energy(law, [xi, 0.0])) for xi in x])
+    fd = np.array([(ie.normal_energy(law, [xi + 1e-11, 0.0]) - ie.normal_energy(law, [xi - 1e-11, 0.0])) / 2e-11
+                   for xi in x])
+    np.testing.assert_allclose(fd, [float(ie.pressure(law, [xi, 0.0])) for xi in x], rtol=1e-5, atol=1e-6 * max(p))
+    assert W[0] == 0.0 and np.all(np.diff(W) >= 0)
+
+
+def test_an_unknown_table_interpolation_is_refused():
+    with pytest.raises(ValueError, match="interpolation = 'spline'"):
+        il.TabulatedLaw(closure=(0.0, 1.0), pressure=(0.0, 1.0), interpolation="spline")
+
+
 @pytest.mark.parametrize("bad", [dict(closure=(0.0, 1.0), pressure=(1.0, 2.0)),
                                  dict(closure=(0.0, 0.0, 1.0), pressure=(0.0, 1.0, 2.0)),
                                  dict(closure=(0.0, 1.0, 2.0), pressure=(0.0, 2.0, 1.0))])
@@ -166,14 +202,18 @@ def test_coefficient_function_path_matches_numpy():
                                    atol=1e-14, err_msg=name)
 
 
-def test_tabulated_law_on_coefficient_functions_is_the_sum_of_ramps():
-    """The B-spline evaluation (CoefficientFunctions) equals the ramps (NumPy) at closures across the table."""
+@pytest.mark.parametrize("interpolation", ["linear", "monotone_cubic"])
+def test_tabulated_law_on_coefficient_functions_matches_numpy(interpolation):
+    """The B-spline evaluation (CoefficientFunctions) equals the NumPy one (ramps of the polyline, the
+    Hermite formulas of the cubic) at closures across the table and beyond both ends."""
+    import dataclasses
     import ngsolve as ng
     from netgen.geom2d import unit_square
     mesh = ng.Mesh(unit_square.GenerateMesh(maxh=1.0))   # kept: a mesh point does not hold its mesh
     mip = mesh(0.3, 0.3)
-    law = _cell_response_law()
-    for c in np.linspace(law.closure[0] - 0.1, law.closure[-1] + 0.2, 41):
+    law = dataclasses.replace(_cell_response_law(), interpolation=interpolation)
+    span = law.closure[-1] - law.closure[0]
+    for c in np.linspace(law.closure[0] - 0.1, law.closure[-1] + 2.5 * span, 61):
         W = ie.normal_energy(law, [ng.CF(c), ng.CF(0.0)])(mip)
         p = ie.pressure(law, [ng.CF(c), ng.CF(0.0)])(mip)
         want_W, want_p = ie.normal_energy(law, [c, 0.0]), ie.pressure(law, [c, 0.0])
@@ -191,7 +231,8 @@ def test_cell_response_law_is_consistent_in_the_assembled_macro_problem():
     from ngcontact.fem.materials import isotropic
     law = _cell_response_law()
     scale = 1e-3 / law.closure[-1]   # closures of the table in mm
-    law = il.TabulatedLaw(closure=tuple(scale * c for c in law.closure), pressure=tuple(law.pressure))
+    law = il.TabulatedLaw(closure=tuple(scale * c for c in law.closure), pressure=tuple(law.pressure),
+                          interpolation=law.interpolation)
     g = gm.coaxial_plane_strain(0.5, 1.0, 2.0, maxh=0.4, order=2)
     sup = (M.Support(label="sym_x", components=("x",)), M.Support(label="sym_y", components=("y",)))
     problem = M.MacroProblem(mesh=g.mesh, setting="plane_strain", rough="inner", counter="outer",
