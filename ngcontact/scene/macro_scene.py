@@ -224,8 +224,9 @@ class TwoScaleSpec:
     tol: float = param(doc="stop when max |sigma_n(k) - sigma_n(k-1)| over the interface points is below",
                        units="Pa", check=positive())
     max_iter: int = param(20, doc="largest number of law updates", check=at_least(1))
-    table_tol: float = param(0.01, doc="interpolation tolerance of the cell table: the contact fraction "
-                             "and the closure relative to their largest values at interval midpoints",
+    table_tol: float = param(0.01, doc="interpolation tolerance of the cell table (monotone cubic): the "
+                             "contact fraction, the closure and the law's pressure relative to their "
+                             "largest values at interval midpoints",
                              check=positive())
     table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
                              "(below it the law follows the table's first secant down to p = 0)",
