@@ -297,7 +297,8 @@ def solve_exact(problem, newton: Callable[[float], dict], atol: float) -> dict[s
     of :meth:`ngcontact.solvers.newton.NewtonHistory.as_dict`, the passes'
     lists concatenated, plus ``uzawa_iterations``, ``uzawa_penetrations``,
     ``uzawa_changes``, ``uzawa_relative_changes``, ``newton_per_pass`` and
-    ``uzawa_stiffened`` (the passes after which a slow pass raised the
+    ``uzawa_at_floor`` (stopped at the round-off floor,
+    :func:`~ngcontact.solvers.uzawa.uzawa`), ``uzawa_stiffened`` (the passes after which a slow pass raised the
     augmentation by ``STIFFEN``, up to :func:`max_augmentation`).
     """
     m, model = problem.multiplier, problem.model
@@ -324,6 +325,7 @@ def solve_exact(problem, newton: Callable[[float], dict], atol: float) -> dict[s
         out[key] = [v for h in passes for v in h[key]]
     out["uzawa_iterations"] = hist["uzawa_iterations"]
     out["uzawa_stiffened"] = hist["stiffened"]
+    out["uzawa_at_floor"] = hist["at_floor"]
     out["uzawa_penetrations"] = hist["penetrations"]
     out["uzawa_changes"] = hist["changes"]
     out["uzawa_relative_changes"] = hist["relative_changes"]

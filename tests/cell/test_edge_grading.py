@@ -125,6 +125,26 @@ def test_the_shipped_graded_scene_meets_its_tolerance_against_westergaard():
         assert error / exact < 2e-5  # measured 8.9e-6 at worst
 
 
+@pytest.mark.slow  # about 15 s: the shipped scene's four loads, with exact contact
+def test_the_graded_scene_with_exact_contact_meets_its_tolerance_at_the_round_off_of_its_finest_meshes():
+    """Elements of 1e-6 of the period put Uzawa's measures at about 1e-10, their round-off: the passes stop
+    there (they had alternated between two states up to the pass limit) and every load meets its tolerance."""
+    import dataclasses
+    import os
+
+    import ngcontact
+
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "geometries", "cells", "westergaard_graded.toml")
+    sc = ngcontact.load(path)
+    sc = dataclasses.replace(sc, contact=dataclasses.replace(sc.contact, enforcement="exact", k_n=1e3))
+    report, _ = ngcontact.solve(sc)
+    pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H, 1.0)
+    for entry in report["results"]["loads"]:
+        exact = westergaard_contact_fraction(entry["transmitted_pressure"], pstar)
+        assert entry["error_estimate"]["contact_fraction"] <= sc.discretization.tolerance
+        assert abs(entry["contact_fraction"] - exact) <= entry["error_estimate"]["contact_fraction"]
+
+
 @pytest.mark.slow  # about 15 s: graded to 1e-5 up to order 5
 def test_hertz_half_width_in_a_wide_periodic_cell():
     """A cylinder gap ``(x - 1/2)^2 / (2R)`` pressed to Hertz half-width ``b = 0.02`` of the period.

@@ -67,3 +67,38 @@ def test_a_refusing_stiffen_changes_nothing():
     with pytest.raises(ConvergenceError):
         uzawa(solve, update, rtol=1e-12, max_iter=50, stiffen=lambda: calls.append(1) is not None)
     assert state["k"] == 1e-2 and len(calls) == 49
+
+
+def quantized_spring(k: float, step: float):
+    """The spring whose primal solve resolves ``u`` only to ``step`` (the round-off of a real solve): a
+    multiplier update that moves the exact ``u`` by less leaves the state as it was, in no Newton step."""
+    state, solve, update = spring(k)
+
+    def coarse_solve(j):
+        before = state["u"]
+        solve(j)
+        rounded = round(state["u"] / step) * step
+        if abs(rounded - before) < 0.5 * step:
+            state["u"] = before
+            return {"iterations": 0}
+        state["u"] = rounded
+        return {"iterations": 1}
+    return state, coarse_solve, update
+
+
+def test_passes_that_no_longer_move_the_state_stop_at_the_round_off_floor():
+    """A solve resolving u to 3e-13 G: the measures stall near it; the iteration stops there, converged at the
+    floor, within FLOOR_GROWTH times rtol, instead of cycling to the pass limit."""
+    state, solve, update = quantized_spring(1e3, 3e-13 * G)
+    hist = uzawa(solve, update, rtol=1e-13, max_iter=200)
+    assert hist["at_floor"] and hist["uzawa_iterations"] < 20
+    assert max(hist["penetrations"][-1], hist["changes"][-1]) <= 1e3 * 1e-13
+    assert state["u"] == pytest.approx(G, rel=1e-11)
+
+
+def test_a_stalled_pass_far_from_the_tolerance_is_no_convergence():
+    """A solve that cannot resolve u below 7e-7 G leaves measures far above FLOOR_GROWTH * rtol: failure."""
+    _, solve, update = quantized_spring(1e3, 7e-7 * G)
+    with pytest.raises(ConvergenceError, match="did not converge in 30 passes") as err:
+        uzawa(solve, update, rtol=1e-13, max_iter=30)
+    assert not err.value.history["at_floor"]
