@@ -33,7 +33,7 @@ solve was warm-started), ``newton_per_solve``, ``tolerance`` [Pa],
 [Pa], ``closure`` [m], ``tolerance``, ``error_estimate``: the largest
 relative midpoint discrepancy accepted, ``nodes``), ``cache`` (key, whether
 the table came from it, its path), ``law`` (the macro law: the cell's
-tabulated response), ``cell`` (scene, ndof, overrides) and the coefficients
+tabulated response and its interpolation, the monotone cubic), ``cell`` (scene, ndof, overrides) and the coefficients
 at the interface samples (``contact_fraction``, ``k_n0``; along the profile
 in 2D and axisymmetry, on the interface surface in 3D); with a shear
 table also ``shear_table`` (rows, nodes, cell solves, the error estimates
@@ -252,8 +252,8 @@ def couple(scene, problem, solve,
            "table": table.as_dict(),
            "cache": {"key": key, "table_from_cache": from_cache,
                      "directory": cache_dir or cell_law.cache_dir_default()},
-           "law": {"type": "tabulated cell response p(c)", "closure": list(law.closure),
-                   "pressure": list(law.pressure)},
+           "law": {"type": "tabulated cell response p(c)", "interpolation": law.interpolation,
+                   "closure": list(law.closure), "pressure": list(law.pressure)},
            "cell": {"scene": path, "ndof": int(task.problem().ndof) if table.solves else None,
                     "overrides": overrides},
            "interface_coefficients": {"contact_fraction": coef["contact_fraction"], "k_n0": coef["k_n0"]}}

@@ -115,6 +115,7 @@ def test_loop_converges_on_the_shipped_scene_with_falling_changes():
     assert ts["converged"] and changes[-1] < scene.two_scale.tol
     assert all(b < a for a, b in zip(changes, changes[1:])), changes
     assert ts["table"]["error_estimate"] <= scene.two_scale.table_tol
+    assert ts["law"]["interpolation"] == "monotone_cubic" and len(ts["law"]["closure"]) == ts["table"]["nodes"] + 1
     f = np.asarray(ts["interface_coefficients"]["contact_fraction"])
     assert f.max() > 2 * f[f > 0].min()  # the real contact area varies along the interface
     # the strength check of the converged state, joined with the loop's figures
