@@ -83,6 +83,7 @@ class SplitEnergy:
         #: whether the last :meth:`AssembleLinearization` assembled the whole form (and with it a
         #: preconditioner registered with it) rather than only the interface
         self.assembled_whole = False
+        self._renew = False
 
     @property
     def mat(self):
@@ -123,16 +124,25 @@ class SplitEnergy:
             self._K_whole = np.zeros(whole.nze)
             self._K_whole[_positions(whole, self.K)] = self.K.AsVector().FV().NumPy()
             return
+        if self._renew:
+            self.rebuild()
+            return
         vals = self.whole.mat.AsVector().FV().NumPy()
         vals[:] = self._K_whole
         vals[self._slots_psi] += self.interface.mat.AsVector().FV().NumPy()
         self.assembled_whole = False
+
+    def renew_preconditioner(self) -> None:
+        """The whole form was assembled elsewhere (e.g. on other free dofs, for a measurement): the next
+        tangent assembles it again, and with it a preconditioner registered with it."""
+        self._renew = True
 
     def rebuild(self) -> None:
         """Assemble the whole form at the state of the last :meth:`AssembleLinearization`: the same
         tangent to round-off, and a preconditioner registered with the whole form (BDDC) built from it."""
         self.whole.AssembleLinearization(self._at)
         self.assembled_whole = True
+        self._renew = False
 
 
 def _positions(whole, part) -> np.ndarray:
