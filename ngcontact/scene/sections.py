@@ -91,7 +91,8 @@ class SolverSpec:
     max_iter: int = param(40, doc="largest number of Newton steps", check=at_least(1))
     inverse: str = param("sparsecholesky", doc="sparse direct solver",
                          choices=("sparsecholesky", "umfpack"))
-    linear: str = param("auto", doc="Newton's tangent solves (FE cells and macro problems): direct (the "
+    linear: str = param("auto", doc="Newton's tangent solves (FE cells and macro problems) and the solves of "
+                        "a cell's effective stiffness: direct (the "
                         "sparse direct solver of 'inverse'), iterative (conjugate gradients preconditioned by "
                         "BDDC with a vertex wirebasket), auto (3D problems iterative from iterative_from free dofs on, "
                         "2D direct); the report "
