@@ -62,11 +62,12 @@ the shape-preserving C1 cubics of Fritsch and Carlson
 (:class:`~ngcontact.laws.homogenized.TabulatedLaw`): measured on the
 femur's stem-grooves cell (``table_tol`` 0.01, pressures 13 kPa to 32.5
 MPa) they meet the tolerance with 11 cell solves where the polyline that
-was used before needed 23, and the law they give has a continuous tangent.  The cell solves of one level of
-refinement (the start nodes, then the midpoints of all intervals still to
-check) are independent; they go through the table's ``map_tasks`` callable
-(``map_tasks(response, pressures) -> responses``, serial by default), into
-which a process pool can be plugged.  The number of cell solves does not
+was used before needed 23, and the law they give has a continuous tangent.
+The cell solves of one level of refinement (the start nodes, then the
+midpoints of all intervals still to check) are independent; they go
+through the table's ``map_tasks`` callable (``map_tasks(response,
+pressures) -> responses``, serial by default), into which a process pool
+can be plugged.  The number of cell solves does not
 depend on the number of macro interface points.
 
 Interface samples: the change is measured at the points of
