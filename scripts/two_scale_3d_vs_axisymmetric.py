@@ -42,12 +42,12 @@ CASES = (("3d", "femur_stem_3d_two_scale.toml", {}),
 
 def shared_response():
     """``p -> cell response`` of the groove cell, each pressure solved once."""
-    from ngcontact.coupling import two_scale as T
+    from ngcontact.coupling import pressure_table as PT
     from ngcontact.drivers.run_two_scale import PressureSolve
     solve = PressureSolve(os.path.join(GEOMETRIES, "cells", "stem_grooves.toml"), 1.0)
     known: dict[float, dict] = {}
 
-    def response(p: float) -> T.Response:
+    def response(p: float) -> PT.Response:
         if p not in known:
             known[p] = solve(p)
         return known[p]
@@ -57,6 +57,7 @@ def shared_response():
 def measure(case: str, name: str, sizes: dict, response) -> tuple[dict, dict]:
     import ngsolve as ng
     from ngcontact import runner
+    from ngcontact.coupling import pressure_table as PT
     from ngcontact.coupling import two_scale as T
     from ngcontact.drivers import run_macro as RM
     from ngcontact.drivers.run_strength import evaluate
@@ -67,7 +68,7 @@ def measure(case: str, name: str, sizes: dict, response) -> tuple[dict, dict]:
     scene = load(os.path.join(GEOMETRIES, name))
     problem, _ = RM.problem_of(scene, RM.build_geometry(scene, **sizes), order=2)
     spec = scene.two_scale
-    table = T.CellTable(response, tol=spec.table_tol)
+    table = PT.CellTable(response, tol=spec.table_tol)
     with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
         out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
                        solve=lambda prob, start: RM.solve_scene(scene, prob, start))

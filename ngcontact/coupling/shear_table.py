@@ -8,7 +8,7 @@ tangential interface jump
 
     s = int_{S_C} J.t0 |n.n0| ds / int_{S_C} |n.n0| ds,
 
-the tangential companion of the closure of :func:`ngcontact.coupling.two_scale.cell_response`
+the tangential companion of the closure of :func:`ngcontact.coupling.pressure_table.cell_response`
 (the far-face jump minus the share of the cell's bulk, which the macro
 bodies carry themselves).  For growing ``Delta`` the shear rises while
 parts of ``S_C`` stick and levels off when the whole surface slides: on a
@@ -19,7 +19,7 @@ not see.  :class:`ShearTable` tabulates rows ``s -> tau`` at pressures
 ``p_i`` and hands them to the macro problem as the law
 :class:`ngcontact.laws.homogenized.CellShear`.
 
-Error control, as the pressure table's (:class:`ngcontact.coupling.two_scale.CellTable`):
+Error control, as the pressure table's (:class:`ngcontact.coupling.pressure_table.CellTable`):
 
 * in the jump, per row: every interval of ``Delta`` is checked at its
   midpoint and halved while ``|tau_mid - T_row(s_mid)| / max_row |tau| >

@@ -6,7 +6,7 @@ set ``S_C(p)``, the coefficients of eq. 34 on it,
     k_n0(p) = (1/|T|) int_{S_C(p)} k_n (n.n0)^2 ds,      g_n0(p) = k_n0(p) c(p) - p,
 
 and a mean closure ``c(p)``: the projected mean normal jump on ``S_C``
-(:func:`cell_response`).  The law of step ii of Sec. 3.5 at an interface
+(:func:`~ngcontact.coupling.pressure_table.cell_response`).  The law of step ii of Sec. 3.5 at an interface
 point ``x`` whose previous macro pressure is ``p_k(x)`` is the Winkler law
 ``p = k_n0(p_k) (a_n - g0) - g_n0(p_k)``; at its fixed point ``p_{k+1} =
 p_k = p`` it reads ``a_n - g0 = c(p)``.  The loop is therefore the chord
@@ -19,7 +19,8 @@ state, so its energy, residual and tangent describe a different problem
 at every update.
 
 Here the macro law is ``P`` itself, the :class:`~ngcontact.laws.homogenized.TabulatedLaw`
-of the table's pairs ``(c_i, p_i)`` (:func:`response_law`):
+of the table's pairs ``(c_i, p_i)``
+(:func:`~ngcontact.coupling.pressure_table.response_law`):
 
     W(a) = int_{c_0}^{a_n - g0} P(s) ds,    tau_n = P(a_n - g0),    dtau_n/da_n = P'(a_n - g0),
 
@@ -47,28 +48,8 @@ the macro solve; the loop only grows the table:
 3. otherwise repeat from 1, or stop with a
    :class:`~ngcontact.errors.ConvergenceError` after ``max_iter`` updates.
 
-The table (:class:`CellTable`) is adaptive: every interval is checked at
-its midpoint against a cell solve and halved while
-
-    max(|f_mid - F(p_mid)| / max f, |c_mid - C(p_mid)| / max |c|, |p_mid - P(c_mid)| / max p) > table_tol
-
-(``f`` the contact fraction, ``c`` the closure; ``F`` and ``C`` their
-monotone cubic interpolants in ``p`` over the nodes before the check, what
-:meth:`CellTable.__call__` returns, and ``P`` the macro law
-:func:`response_law` of those nodes, the same interpolant in ``c``).  The
-checked midpoints become nodes too, so the largest accepted discrepancy is
-a conservative estimate of the interpolation error.  The interpolants are
-the shape-preserving C1 cubics of Fritsch and Carlson
-(:class:`~ngcontact.laws.homogenized.TabulatedLaw`): measured on the
-femur's stem-grooves cell (``table_tol`` 0.01, pressures 13 kPa to 32.5
-MPa) they meet the tolerance with 11 cell solves where the polyline that
-was used before needed 23, and the law they give has a continuous tangent.
-The cell solves of one level of refinement (the start nodes, then the
-midpoints of all intervals still to check) are independent; they go
-through the table's ``map_tasks`` callable (``map_tasks(response,
-pressures) -> responses``, serial by default), into which a process pool
-can be plugged.  The number of cell solves does not
-depend on the number of macro interface points.
+The table, its cell solves, its interpolation (a monotone C1 cubic) and
+its error control are :class:`~ngcontact.coupling.pressure_table.CellTable`.
 
 Interface samples: the change is measured at the points of
 :func:`ngcontact.macro.macro_measures.interface_samples`, along the
@@ -95,209 +76,23 @@ covered).
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.coupling.pressure_table import CellTable, response_law
 from ngcontact.coupling.shear_table import ShearTable
-from ngcontact.cell.measures import (
-    contact_fraction,
-    contact_integral,
-    mean_jump,
-    real_contact_coefficients,
-)
-from ngcontact.errors import ConvergenceError, ModelError
-from ngcontact.fem.quadrature import smooth_order
+from ngcontact.errors import ConvergenceError
 from ngcontact.laws import homogenized as il
-from ngcontact.laws import interface_energy as ie
-from ngcontact.laws import monotone_cubic
 from ngcontact.macro import macro_measures as MM
 from ngcontact.macro import macro_problem as M
 
 log = logging.getLogger(__name__)
 
-#: ``{"contact_fraction", "k_n0", "g_n0", "closure"}`` of the cell at one pressure
-Response = dict[str, float]
 #: one entry of the coupling history: iteration and cell-solve counts, pressures, Newton iterations
 HistoryEntry = dict[str, int | float | bool | str | None]
-KEYS = ("contact_fraction", "k_n0", "g_n0", "closure")
-#: the quantities whose interpolation error the table controls
-CHECKED = ("contact_fraction", "closure")
-#: a lower table end below the table is extended to this fraction of the requested one
-EXTEND_BELOW = 0.5
-#: relative amount by which a requested range may exceed the table without extending it (round-off of
-#: the macro pressures between runs)
-SLACK = 1e-6
-
-
-def serial_map(task: Callable[[float], Response], items: Sequence[float]) -> list[Response]:
-    """The default ``map_tasks``: the cell solves one after the other."""
-    return [task(x) for x in items]
-
-
-def cell_response(problem: CellProblem, pressure: float, length_unit: float = 1.0) -> Response:
-    """Contact fraction, ``k_n0``, ``g_n0`` and mean closure of the cell at a mean pressure.
-
-    ``problem`` is a :class:`ngcontact.cell.cell_problem.CellProblem`, solved from the
-    rigid predictor.  ``k_n0`` is eq. 34 on the real contact set: ``k_n``
-    times the contact fraction (located by the roots of the penetration in
-    2D) on a flat cell, else the quadrature integral of the indicator.  The
-    closure is the projected mean normal jump on ``S_C``,
-
-        c = int_{S_C} J_n |n.n0| ds / int_{S_C} |n.n0| ds,
-
-    which, unlike eq. 34's integral at quadrature points, does not jump when
-    a quadrature point enters contact; ``g_n0 = k_n0 c - p`` makes the
-    Winkler law pass through the cell's state.  Lengths are scaled by
-    ``length_unit`` (metres per cell length unit); ``k_n0`` is a length
-    ratio times ``k_n``.
-    """
-    problem.solve(cell_load(problem.dim, pressure=float(pressure)), first=True, measure=False)
-    fraction = float(contact_fraction(problem))
-    if not problem.tangential_free:  # flat and frictionless: n = n0 on all of S_C
-        kn0 = problem.model.k_n * fraction
-    else:
-        kn0 = float(real_contact_coefficients(problem)["k_n"])
-    n0 = problem.n[problem.dim - 1]
-    projected = float(contact_integral(problem, ng.IfPos(n0, n0, -n0), order=smooth_order(problem.model.order)))
-    closure = float(mean_jump(problem)[problem.dim - 1]) * problem.area / projected * length_unit
-    return {"contact_fraction": fraction, "k_n0": kn0, "g_n0": kn0 * closure - float(pressure),
-            "closure": closure}
-
-
-@dataclass
-class CellTable:
-    """Adaptive piecewise-linear table of a cell response in the pressure.
-
-    Parameters
-    ----------
-    response
-        Function ``p -> {"contact_fraction", "k_n0", "g_n0", "closure"}`` (a cell solve).
-    tol
-        Interpolation tolerance (module docstring).
-    max_solves
-        Largest number of cell solves of this table before giving up.
-    map_tasks
-        ``map_tasks(response, pressures) -> [response(p) for p in pressures]``:
-        runs the independent cell solves of one refinement level.
-    values
-        Responses known already (e.g. read from a cache): not solved again.
-    """
-
-    response: Callable[[float], Response]
-    tol: float
-    max_solves: int = 400
-    map_tasks: Callable[[Callable[[float], Response], Sequence[float]], list[Response]] = serial_map
-    values: dict[float, Response] = field(default_factory=dict)
-    error_estimate: float = 0.0
-    solves: int = 0   # cell problems solved by this table (not those it was given)
-
-    @property
-    def pressures(self) -> np.ndarray:
-        return np.array(sorted(self.values))
-
-    def _solve(self, pressures) -> None:
-        todo = sorted({float(p) for p in pressures} - set(self.values))
-        if not todo:
-            return
-        if self.solves + len(todo) > self.max_solves:
-            raise ConvergenceError(f"cell table: more than {self.max_solves} cell solves for "
-                                   f"tolerance {self.tol:g}", {"pressures": sorted(self.values)})
-        for p, value in zip(todo, self.map_tasks(self.response, todo)):
-            if not all(np.isfinite(value[k]) for k in KEYS):
-                raise ConvergenceError(f"cell table: non-finite cell response at p = {p:.6g}", dict(value))
-            self.values[p] = {k: float(value[k]) for k in KEYS}
-        self.solves += len(todo)
-
-    def _scale(self, key: str) -> float:
-        return max([abs(v[key]) for v in self.values.values()] + [1e-300])
-
-    def _refine(self, intervals: list[tuple[float, float]]) -> None:
-        """Check the intervals level by level (one batch of independent cell solves per level)."""
-        while intervals:
-            mids = [0.5 * (a + b) for a, b in intervals]
-            before = CellTable(self.response, self.tol, values=dict(self.values))  # the nodes before this level
-            law = response_law(before)
-            self._solve(mids)
-            p_scale = float(self.pressures[-1])
-            nxt = []
-            for (lo, hi), m in zip(intervals, mids):
-                vm, at = self.values[m], before(m)
-                err = max([abs(vm[k] - float(at[k])) / self._scale(k) for k in CHECKED]
-                          + [abs(m - float(ie.pressure(law, [vm["closure"], 0.0]))) / p_scale])
-                if err > self.tol and hi - lo > 1e-6 * hi:
-                    nxt += [(lo, m), (m, hi)]
-                else:
-                    self.error_estimate = max(self.error_estimate, err)
-            intervals = nxt
-
-    def cover(self, lo: float, hi: float, start_nodes: int = 5) -> bool:
-        """Make the table span ``[lo, hi]`` (``0 < lo < hi``) within the tolerance; True if it grew."""
-        if not 0 < lo < hi:
-            raise ModelError(f"table range [{lo!r}, {hi!r}]: need 0 < lo < hi")
-        if not self.values:
-            nodes = list(np.geomspace(EXTEND_BELOW * lo, hi, start_nodes))
-        else:
-            p = self.pressures
-            below, above = lo < p[0] * (1 - SLACK), hi > p[-1] * (1 + SLACK)
-            if not (below or above):
-                return False
-            nodes = list(p)
-            if below:
-                nodes = list(np.geomspace(EXTEND_BELOW * lo, p[0], start_nodes)[:-1]) + nodes
-            if above:
-                nodes = nodes + list(np.geomspace(p[-1], hi, start_nodes)[1:])
-        nodes = [float(q) for q in nodes]
-        old = set(self.values)
-        self._solve(nodes)
-        self._refine([(a, b) for a, b in zip(nodes[:-1], nodes[1:]) if not (a in old and b in old)])
-        log.info("cell table: %d nodes over [%.3e, %.3e] (%d cell solves), error estimate %.2e",
-                 len(self.values), self.pressures[0], self.pressures[-1], self.solves, self.error_estimate)
-        return True
-
-    def __call__(self, p: float | np.ndarray) -> dict[str, np.ndarray | np.float64]:
-        """Interpolated response at pressures ``p`` (held constant outside the table): the monotone cubic
-        of each quantity in ``p`` (module docstring)."""
-        P = self.pressures
-        out: dict[str, np.ndarray | np.float64] = {}
-        for key in KEYS:
-            v = [self.values[q][key] for q in P]
-            out[key] = monotone_cubic.evaluate(P, v, monotone_cubic.slopes(P, v), p)
-        return out
-
-    def as_dict(self) -> dict[str, list[float] | int | float]:
-        P = self.pressures
-        return {"pressure": P.tolist(), "cell_solves": self.solves, "nodes": len(P), "tolerance": self.tol,
-                "error_estimate": self.error_estimate, **{key: [self.values[q][key] for q in P] for key in KEYS}}
-
-
-def response_law(table: CellTable) -> il.TabulatedLaw:
-    """The cell's response ``p = P(c)`` as a tabulated normal law (module docstring).
-
-    Raises
-    ------
-    ModelError
-        The tabulated closure does not increase with the pressure (the cell
-        response is not monotone, e.g. a cell solve that did not converge).
-    """
-    P = table.pressures
-    c = np.array([table.values[q]["closure"] for q in P])
-    # nodes closer than round-off to their neighbour carry no information and spoil the slopes
-    keep = np.concatenate([[True], np.abs(np.diff(c)) > 1e-9 * np.max(np.abs(c))])
-    P, c = P[keep], c[keep]
-    if len(P) < 2:
-        raise ModelError("cell table: need at least two distinct pressures for a law")
-    if np.any(np.diff(c) <= 0):
-        k = int(np.argmin(np.diff(c)))
-        raise ModelError(f"cell table: the closure does not increase with the pressure between p = {P[k]:.6g} "
-                         f"and {P[k + 1]:.6g} ({c[k]:.6g} -> {c[k + 1]:.6g}); the cell response is not monotone")
-    c0 = c[0] - P[0] * (c[1] - c[0]) / (P[1] - P[0])   # first secant down to p = 0
-    return il.TabulatedLaw(closure=(float(c0), *map(float, c)), pressure=(0.0, *map(float, P)),
-                           interpolation="monotone_cubic")
 
 
 @dataclass

@@ -53,6 +53,7 @@ import numpy as np
 
 from ngcontact.coupling import cell_law
 from ngcontact.coupling import shear_table as S
+from ngcontact.coupling import pressure_table as PT
 from ngcontact.coupling import two_scale as T
 from ngcontact.macro.macro_measures import interface_samples
 from ngcontact.scene import cell_links
@@ -62,7 +63,7 @@ from ngcontact.solvers import executor
 log = logging.getLogger(__name__)
 
 TABLE_FORMAT = "cell-table-2"
-TABLE_ARRAYS = ("pressure",) + T.KEYS + ("error_estimate",)
+TABLE_ARRAYS = ("pressure",) + PT.KEYS + ("error_estimate",)
 
 
 #: cell problems built by unpickled tasks in this process (a worker), by task kind, content key and thread
@@ -113,8 +114,8 @@ class PressureSolve:
                 _BUILT[slot] = self._problem
         return self._problem
 
-    def __call__(self, pressure: float) -> T.Response:
-        return T.cell_response(self.problem(), pressure, self.length_unit)
+    def __call__(self, pressure: float) -> PT.Response:
+        return PT.cell_response(self.problem(), pressure, self.length_unit)
 
 
 class ShearSolve(PressureSolve):
@@ -175,33 +176,33 @@ def table_key(cell_scene, length_unit: float, tol: float) -> str:
 
 def _table_shapes(arrays: dict) -> str | None:
     n = arrays["pressure"].shape
-    if len(n) != 1 or n[0] < 2 or any(arrays[k].shape != n for k in T.KEYS) or arrays["error_estimate"].shape != (1,):
+    if len(n) != 1 or n[0] < 2 or any(arrays[k].shape != n for k in PT.KEYS) or arrays["error_estimate"].shape != (1,):
         return "arrays of shapes " + ", ".join(str(arrays[k].shape) for k in TABLE_ARRAYS)
     if np.any(np.diff(arrays["pressure"]) <= 0):
         return "pressures not increasing"
     return None
 
 
-def cached_table(key: str, response, tol: float, map_tasks, cache_dir: str | None = None) -> tuple[T.CellTable, bool]:
-    """A :class:`~ngcontact.coupling.two_scale.CellTable` filled from the cache when it holds ``key``."""
+def cached_table(key: str, response, tol: float, map_tasks, cache_dir: str | None = None) -> tuple[PT.CellTable, bool]:
+    """A :class:`~ngcontact.coupling.pressure_table.CellTable` filled from the cache when it holds ``key``."""
     found = cell_law.read_cached(key, TABLE_ARRAYS, TABLE_FORMAT, cache_dir, _table_shapes)
-    table = T.CellTable(response, tol=tol, map_tasks=map_tasks)
+    table = PT.CellTable(response, tol=tol, map_tasks=map_tasks)
     if found is None:
         return table, False
     for i, p in enumerate(found["pressure"]):
-        table.values[float(p)] = {k: float(found[k][i]) for k in T.KEYS}
+        table.values[float(p)] = {k: float(found[k][i]) for k in PT.KEYS}
     table.error_estimate = float(found["error_estimate"][0])
     return table, True
 
 
-def store_table(key: str, table: T.CellTable, cache_dir: str | None = None) -> None:
+def store_table(key: str, table: PT.CellTable, cache_dir: str | None = None) -> None:
     P = table.pressures
     arrays = {"pressure": P, "error_estimate": np.array([table.error_estimate]),
-              **{k: np.array([table.values[q][k] for q in P]) for k in T.KEYS}}
+              **{k: np.array([table.values[q][k] for q in P]) for k in PT.KEYS}}
     cell_law.write_cached(key, arrays, TABLE_ARRAYS, TABLE_FORMAT, cache_dir)
 
 
-def executor_map(response: Callable[[float], T.Response], pressures: Sequence[float]) -> list[T.Response]:
+def executor_map(response: Callable[[float], PT.Response], pressures: Sequence[float]) -> list[PT.Response]:
     """The cell solves of one table level as one batch of the run's executor (local processes or Dask)."""
     return executor.current().map(response, list(pressures), [f"p = {p:.9g}" for p in pressures],
                                   label="cell table level")
@@ -215,13 +216,13 @@ def shear_executor_map(response: Callable[[S.ShearLoad], S.ShearResponse], loads
 
 
 def couple(scene, problem, solve,
-           map_tasks: Callable[[Callable[[float], T.Response], Sequence[float]], list[T.Response]] = executor_map,
+           map_tasks: Callable[[Callable[[float], PT.Response], Sequence[float]], list[PT.Response]] = executor_map,
            cache_dir: str | None = None, warm: bool = True, shear_map=shear_executor_map):
     """Run the loop of ``scene.two_scale`` from ``problem``; returns ``(solution, results)``.
 
     ``solve(problem, start)``: the macro solve (warm-started from the
     vector ``start`` when it is not None); ``map_tasks``: runs the cell
-    solves of one table level (:class:`~ngcontact.coupling.two_scale.CellTable`);
+    solves of one table level (:class:`~ngcontact.coupling.pressure_table.CellTable`);
     ``warm = False`` cold-starts every macro solve (for comparisons).
     """
     from ngcontact.drivers.build import cell_scene_of
@@ -245,7 +246,7 @@ def couple(scene, problem, solve,
         store_shear(skey, shear, cache_dir)
     p = interface_samples(out.solution, scene.output.points_per_element)["pressure"]
     coef = table(np.asarray(p))
-    law = T.response_law(table)
+    law = PT.response_law(table)
     res = {"converged": out.converged, "iterations": len(out.history) - 1, "macro_solves": out.macro_solves,
            "cell_solves": table.solves, "tolerance": spec.tol, "history": out.history,
            "newton_per_solve": [h["newton_iterations"] for h in out.history if h["law_changed"]],

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from ngcontact.coupling import cell_law
+from ngcontact.coupling import pressure_table as PT
 from ngcontact.coupling import two_scale as T
 from ngcontact.drivers import run_two_scale as R
 from ngcontact.drivers.build import cell_scene_of
@@ -53,9 +54,9 @@ def test_the_table_and_its_law_are_within_the_tolerance_between_the_nodes(tol):
     def response(p):
         return {"contact_fraction": math.sqrt(p / (p + 10.0)), "k_n0": 1.0, "g_n0": 0.0,
                 "closure": 1e-3 * (p / 10) ** 0.6}
-    table = T.CellTable(response, tol=tol)
+    table = PT.CellTable(response, tol=tol)
     table.cover(0.01, 20.0)
-    law = T.response_law(table)
+    law = PT.response_law(table)
     assert law.interpolation == "monotone_cubic" and table.error_estimate <= tol
     P = table.pressures
     f_max, c_max = max(response(q)["contact_fraction"] for q in P), max(response(q)["closure"] for q in P)
@@ -67,9 +68,9 @@ def test_the_table_and_its_law_are_within_the_tolerance_between_the_nodes(tol):
 
 
 def test_warm_and_cold_starts_reach_the_same_solution():
-    table = T.CellTable(counting_response([]), tol=1e-3)
+    table = PT.CellTable(counting_response([]), tol=1e-3)
     table.cover(0.01, 20.0)
-    problem = M.replace_law(_press_fit(START), il.InterfaceLaw(normal=T.response_law(table)))
+    problem = M.replace_law(_press_fit(START), il.InterfaceLaw(normal=PT.response_law(table)))
     start = M.solve(_press_fit(START))
     cold = M.solve(problem)
     warm = M.solve(problem, start=start.gfu.vec)
@@ -84,7 +85,7 @@ def test_a_second_run_with_the_cached_table_solves_no_cell_problem_and_reproduce
     results = []
     for run in range(2):
         calls: list = []
-        table, cached = R.cached_table("k" * 64, counting_response(calls), 1e-3, T.serial_map, str(tmp_path))
+        table, cached = R.cached_table("k" * 64, counting_response(calls), 1e-3, PT.serial_map, str(tmp_path))
         out = T.couple(_press_fit(START), table, tol=1e-6, max_iter=6)
         if table.solves:
             R.store_table("k" * 64, table, str(tmp_path))
@@ -103,7 +104,7 @@ def test_table_cells_of_one_level_go_through_the_map_callable():
         return [task(x) for x in items]
 
     calls: list = []
-    table = T.CellTable(counting_response(calls), tol=1e-3, map_tasks=recording_map)
+    table = PT.CellTable(counting_response(calls), tol=1e-3, map_tasks=recording_map)
     table.cover(0.01, 20.0)
     assert sum(len(b) for b in batches) == len(calls) == table.solves
     assert len(batches[0]) == 5 and max(len(b) for b in batches[1:]) > 1, [len(b) for b in batches]
@@ -130,7 +131,7 @@ def test_copies_of_a_pressure_solve_in_one_worker_share_its_cell_problem_and_its
     pressures = (40.0, 5.0)
     shared = [second(p) for p in pressures]               # the second after the first on one problem
     fresh = [R.PressureSolve(path, 1.0)(p) for p in pressures[1:]]   # not a copy: builds its own cell
-    for key in T.KEYS:
+    for key in PT.KEYS:
         assert shared[1][key] == pytest.approx(fresh[0][key], rel=1e-10, abs=1e-14), key
 
 

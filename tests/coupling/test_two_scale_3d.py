@@ -34,6 +34,7 @@ import numpy as np
 import pytest
 
 from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.coupling import pressure_table as PT
 from ngcontact.coupling import two_scale as T
 from ngcontact.drivers import run_macro as RM
 from ngcontact.drivers.build import build_cell, model_of
@@ -56,11 +57,11 @@ def groove_response():
     s = cs.solver
     cell = CellProblem(build_cell(cs, interface_maxh=4e-6), model_of(cs), rtol=s.rtol, atol=s.atol,
                        max_iter=s.max_iter)
-    known: dict[float, T.Response] = {}
+    known: dict[float, PT.Response] = {}
 
-    def response(p: float) -> T.Response:
+    def response(p: float) -> PT.Response:
         if p not in known:
-            known[p] = T.cell_response(cell, p)
+            known[p] = PT.cell_response(cell, p)
         return known[p]
     return response
 
@@ -69,7 +70,7 @@ def _run(name, response, **sizes):
     scene = load(os.path.join(GEOMETRIES, name))
     problem, _ = RM.problem_of(scene, RM.build_geometry(scene, **sizes), order=2)
     spec = scene.two_scale
-    table = T.CellTable(response, tol=spec.table_tol)
+    table = PT.CellTable(response, tol=spec.table_tol)
     with ng.TaskManager():
         out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
                        solve=lambda prob, start: RM.solve_scene(scene, prob, start))

@@ -7,6 +7,7 @@ import pytest
 from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
 from ngcontact.macro import macro_measures as MM
+from ngcontact.coupling import pressure_table as PT
 from ngcontact.coupling import two_scale as T
 from ngcontact.cell.cell_problem import CellModel, CellProblem
 from ngcontact.geometry import profiles as pr
@@ -43,7 +44,7 @@ def test_fixed_contact_set_stops_after_one_update_and_reproduces_the_one_shot_so
     problem = _press_fit(one_shot_law)
     one_shot = MM.interface_profile(M.solve(problem))["pressure"]
     assert one_shot.min() > 0  # all in compression
-    table = T.CellTable(lambda p: T.cell_response(P, p), tol=1e-3)
+    table = PT.CellTable(lambda p: PT.cell_response(P, p), tol=1e-3)
     out = T.couple(problem, table, tol=1e-6 * one_shot.max(), max_iter=5)
     assert out.converged and out.macro_solves == 2, out.history   # start + one update
     assert np.allclose(table.as_dict()["contact_fraction"], 0.5, atol=1e-9)
@@ -64,7 +65,7 @@ def test_tabulated_response_is_within_its_tolerance_of_direct_solves_at_random_p
     P = _westergaard_cell()
     p_star = westergaard_p_star(e_star(1.0, 0.3, 1.0, 0.3), 0.01, 1.0)
     tol = 0.02
-    table = T.CellTable(lambda p: T.cell_response(P, p), tol=tol)
+    table = PT.CellTable(lambda p: PT.cell_response(P, p), tol=tol)
     table.cover(0.05 * p_star, 0.8 * p_star)
     assert table.error_estimate <= tol
     d = table.as_dict()
@@ -74,7 +75,7 @@ def test_tabulated_response_is_within_its_tolerance_of_direct_solves_at_random_p
     solves = table.solves
     rng = np.random.default_rng(7)
     for p in rng.uniform(0.05 * p_star, 0.8 * p_star, 4):
-        direct = T.cell_response(P, p)
+        direct = PT.cell_response(P, p)
         interp = table(p)
         for key, s in scale.items():
             err = abs(float(interp[key]) - direct[key]) / s
@@ -89,7 +90,7 @@ def test_table_grows_only_where_the_range_is_extended():
         calls.append(p)
         return {"contact_fraction": math.sqrt(p), "k_n0": math.sqrt(p), "g_n0": p ** 1.5, "closure": p ** 0.7}
 
-    table = T.CellTable(response, tol=1e-3)
+    table = PT.CellTable(response, tol=1e-3)
     table.cover(0.01, 1.0)
     n = len(calls)
     table.cover(0.02, 0.9)
@@ -143,7 +144,7 @@ def test_warm_and_cold_starts_reach_the_same_two_scale_state(tmp_path):
             steps.append((start is not None, sol.history["newton_iterations"]))
             return sol
         cache = tmp_path / ("warm" if warm else "cold")   # each run from an empty cache: the same loop
-        sol, res = R.couple(scene, problem, solve, map_tasks=T.serial_map, cache_dir=str(cache), warm=warm)
+        sol, res = R.couple(scene, problem, solve, map_tasks=PT.serial_map, cache_dir=str(cache), warm=warm)
         runs[warm] = (MM.interface_profile(sol)["pressure"], steps)
     (p_warm, s_warm), (p_cold, s_cold) = runs[True], runs[False]
     assert np.max(np.abs(p_warm - p_cold)) <= 1e-8 * np.max(p_cold)

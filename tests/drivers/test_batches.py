@@ -294,7 +294,7 @@ def test_the_levels_of_a_convergence_study_are_a_batch_and_two_workers_give_the_
 
 def test_a_dask_cluster_fills_a_two_scale_cell_table_with_the_serial_numbers(cluster, tmp_path, monkeypatch):
     """The table levels of the two-scale loop (paper Sec. 3.5) as batches on a real LocalCluster."""
-    from ngcontact.coupling import two_scale as T
+    from ngcontact.coupling import pressure_table as PT
     from ngcontact.drivers import run_two_scale as R
     from ngcontact.solvers import executor
     monkeypatch.setenv("NGCONTACT_THREADS", "1")
@@ -303,7 +303,7 @@ def test_a_dask_cluster_fills_a_two_scale_cell_table_with_the_serial_numbers(clu
     tables = {}
     for name, ex in (("serial", executor.Serial()), ("dask", executor.DaskCluster(cluster))):
         with executor.use(ex):
-            table = T.CellTable(R.PressureSolve(path, 1.0), tol=0.02, map_tasks=R.executor_map)
+            table = PT.CellTable(R.PressureSolve(path, 1.0), tol=0.02, map_tasks=R.executor_map)
             assert table.cover(0.002, 0.02)
             tables[name] = (table.as_dict(), ex.describe())
     (serial, _), (dask, where) = tables["serial"], tables["dask"]

@@ -26,7 +26,7 @@ def _bundle(dim=2, n=7, gaps=True):
 
 def _cell_response_law():
     """The two-scale law: a cell's response closure c(p) = 0.3 p^0.6 (a stiffening contact) tabulated."""
-    from ngcontact.coupling.two_scale import CellTable, response_law
+    from ngcontact.coupling.pressure_table import CellTable, response_law
     table = CellTable(lambda p: {"contact_fraction": p ** 0.5, "k_n0": 1.0, "g_n0": 0.0, "closure": 0.3 * p ** 0.6},
                       tol=1e-3)
     table.cover(0.01, 3.0)
