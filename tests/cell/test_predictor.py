@@ -135,10 +135,14 @@ def test_anderson_mixing_solves_an_affine_fixed_point():
 COULOMB_LEFT = ("the coupled Coulomb Newton takes 5, 6, 11 steps per load (fixed point: 6, 17, 24): on the last "
                 "shear load four contact edges (valley wall top and bottom, summit and floor corners) move a "
                 "quadrature point or two per step; substeps of 0.001 took 6, 6, 12, 9, 9")
+GRADED_LEFT = ("a load solved on 4 to 6 graded meshes: 42, 48, 57, 62 Newton steps summed over them, up to 28 on "
+               "one mesh (the first, p/p* = 0.8: under k_n = 1e6 E the exact line search takes steps of about 1 "
+               "and 0.1 in turn; from the spectral cell's pressure it took 11); with exact contact 47 to 56 summed")
 FE_SCENES = ["flat_patch", "westergaard", "tabulated_gap", "tabulated_profile", "stem_grooves", "hip_hills",
              "sinusoid", "bisinusoid", "height_map",
              "bisinusoid_surface",
-             pytest.param("rectangular_coulomb", marks=pytest.mark.xfail(reason=COULOMB_LEFT, strict=True))]
+             pytest.param("rectangular_coulomb", marks=pytest.mark.xfail(reason=COULOMB_LEFT, strict=True)),
+             pytest.param("westergaard_graded", marks=pytest.mark.xfail(reason=GRADED_LEFT, strict=True))]
 
 
 @pytest.mark.slow
