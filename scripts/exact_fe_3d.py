@@ -39,10 +39,9 @@ import sys
 import time
 from dataclasses import replace
 
-from ngcontact.output.writer import write_csv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from spectral_vs_fft import fe_against_spectral_panel, finish  # noqa: E402  (the sibling script draws both)
+from spectral_vs_fft import fe_against_spectral_panel, finish, start_logging, write_study  # noqa: E402  (the sibling script draws both)
 
 log = logging.getLogger("exact_fe_3d")
 
@@ -149,15 +148,9 @@ def main(argv=None) -> int:
     ap.add_argument("out", nargs="?", default=os.path.join("results", "exact_fe_3d"), help="output directory")
     ap.add_argument("--quick", action="store_true", help="the coarsest size of each part only (a smoke run)")
     args = ap.parse_args(argv)
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
-    for quiet in ("ngcontact.cell.spectral_cell", "ngcontact.solvers.newton", "ngcontact.drivers.run_cell",
-                  "ngcontact.cell.cell_problem", "ngcontact.cell.contact_multiplier"):
-        logging.getLogger(quiet).setLevel(logging.WARNING)
+    start_logging("ngcontact.cell.contact_multiplier")
     rows = waves(QUICK_WAVE if args.quick else WAVE_SIZES) + bisinusoid(QUICK_BIS if args.quick else BIS_SIZES)
-    os.makedirs(args.out, exist_ok=True)
-    write_csv(os.path.join(args.out, "exact_fe_3d.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
-    plot(rows, os.path.join(args.out, "exact_fe_3d.png"))
-    log.info("wrote %s", os.path.join(args.out, "exact_fe_3d.csv"))
+    write_study(args.out, "exact_fe_3d", KEYS, rows, plot)
     return 0
 
 

@@ -242,6 +242,25 @@ def finish(fig, axes, path: str) -> None:
     plt.close(fig)
 
 
+QUIET = ("ngcontact.cell.spectral_cell", "ngcontact.solvers.newton", "ngcontact.drivers.run_cell",
+         "ngcontact.cell.cell_problem")
+
+
+def start_logging(*more: str) -> None:
+    """The study's progress on the terminal; the solvers' own lines (``QUIET`` and ``more``) left out."""
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    for quiet in QUIET + more:
+        logging.getLogger(quiet).setLevel(logging.WARNING)
+
+
+def write_study(out: str, name: str, keys, rows: list[dict], draw) -> None:
+    """``OUT/NAME.csv`` (the columns ``keys``) and ``OUT/NAME.png`` (``draw(rows, path)``)."""
+    os.makedirs(out, exist_ok=True)
+    write_csv(os.path.join(out, f"{name}.csv"), list(keys), [[r.get(k, "") for k in keys] for r in rows])
+    draw(rows, os.path.join(out, f"{name}.png"))
+    log.info("wrote %s", os.path.join(out, f"{name}.csv"))
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", nargs="?", default=os.path.join("results", "spectral_vs_fft"), help="output directory")
@@ -254,18 +273,12 @@ def main(argv=None) -> int:
     if args.dissimilar_child or args.dissimilar_friction_child:
         dissimilar_child(friction=args.dissimilar_friction_child)
         return 0
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
-    for quiet in ("ngcontact.cell.spectral_cell", "ngcontact.solvers.newton", "ngcontact.drivers.run_cell",
-                  "ngcontact.cell.cell_problem"):
-        logging.getLogger(quiet).setLevel(logging.WARNING)
+    start_logging()
     sizes = args.fe_sizes if args.fe_sizes is not None else ([0.12] if args.quick else [0.12, 0.08, 0.06])
     rows = half_space(args.quick) + fe_against_spectral(sizes, args.quick)
     if not args.quick:
         rows += dissimilar()
-    os.makedirs(args.out, exist_ok=True)
-    write_csv(os.path.join(args.out, "spectral_vs_fft.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
-    plot(rows, os.path.join(args.out, "spectral_vs_fft.png"))
-    log.info("wrote %s", os.path.join(args.out, "spectral_vs_fft.csv"))
+    write_study(args.out, "spectral_vs_fft", KEYS, rows, plot)
     return 0
 
 

@@ -110,11 +110,11 @@ def uzawa(solve: Callable[[int], dict], update: Callable[[], dict[str, float]], 
         log.debug("uzawa %d: penetration %.3e, multiplier change %.3e (relative)", j, pen, change)
         if pen <= rtol and change <= rtol:
             return history
-        if j > 1 and history["newton"][-1].get("iterations", 1) == 0 and max(pen, change) <= FLOOR_GROWTH * rtol:
+        worst = max(pen, change)
+        if j > 1 and history["newton"][-1].get("iterations", 1) == 0 and worst <= FLOOR_GROWTH * rtol:
             history["at_floor"] = True
             log.debug("uzawa %d: the multiplier update no longer moves the state (round-off); converged", j)
             return history
-        worst = max(pen, change)
         if stiffen is not None and worst > SLOW * previous and stiffen():
             history["stiffened"].append(j)
             log.debug("uzawa %d: slow pass, augmentation raised", j)
