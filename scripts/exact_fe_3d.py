@@ -41,7 +41,8 @@ from dataclasses import replace
 
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from spectral_vs_fft import fe_against_spectral_panel, finish, start_logging, write_study  # noqa: E402  (the sibling script draws both)
+from spectral_vs_fft import (  # noqa: E402  (the sibling script draws both)
+    fe_against_spectral_panel, finish, run_variant, start_logging, write_study)
 
 log = logging.getLogger("exact_fe_3d")
 
@@ -93,21 +94,14 @@ def waves(sizes) -> list[dict]:
 
 
 def bisinusoid(sizes) -> list[dict]:
-    from ngcontact.drivers import run_cell
-    from ngcontact.output.report import Clock
     from ngcontact.scene.loader import load
     scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
-    exact = replace(scene, contact=replace(scene.contact, enforcement="exact"))
+    exact = replace(scene.contact, enforcement="exact")
     settings = [("spectral", replace(scene.discretization, method="spectral", grid=512))]
     settings += [("fe", replace(scene.discretization, order=1, maxh=2 * h, interface_maxh=h)) for h in sizes]
     rows = []
     for method, disc in settings:
-        sc = replace(exact, discretization=disc)
-        object.__setattr__(sc, "base_dir", scene.base_dir)
-        t0 = time.perf_counter()
-        out = run_cell.run(sc, Clock())
-        secs = time.perf_counter() - t0
-        load0 = out.results["loads"][0]
+        out, load0, secs = run_variant(scene, contact=exact, discretization=disc)
         newton = out.solver.get("iterations", "")
         rows.append({"part": "bisinusoid", "method": f"{method} exact",
                      "setting": f"grid {disc.grid}" if method == "spectral" else

@@ -139,21 +139,26 @@ def half_space(quick: bool) -> list[dict]:
     return rows
 
 
-def fe_against_spectral(sizes, quick: bool) -> list[dict]:
+def run_variant(scene, **changes):
+    """``ngcontact run`` of ``scene`` with its fields replaced (the scene's folder kept): ``(outcome, first
+    load's results, wall seconds)``."""
     from ngcontact.drivers import run_cell
     from ngcontact.output.report import Clock
+    sc = replace(scene, **changes)
+    object.__setattr__(sc, "base_dir", scene.base_dir)
+    t0 = time.perf_counter()
+    out = run_cell.run(sc, Clock())
+    return out, out.results["loads"][0], time.perf_counter() - t0
+
+
+def fe_against_spectral(sizes, quick: bool) -> list[dict]:
     from ngcontact.scene.loader import load
     scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
     rows = []
     settings = [("spectral", replace(scene.discretization, method="spectral", grid=128 if quick else 512))]
     settings += [("fe", replace(scene.discretization, interface_maxh=h)) for h in sizes]
     for kind, disc in settings:
-        sc = replace(scene, discretization=disc)
-        object.__setattr__(sc, "base_dir", scene.base_dir)
-        t0 = time.perf_counter()
-        out = run_cell.run(sc, Clock())
-        secs = time.perf_counter() - t0
-        load0 = out.results["loads"][0]
+        out, load0, secs = run_variant(scene, discretization=disc)
         rows.append({"part": "bisinusoid", "solver": f"ngcontact {kind}",
                      "setting": f"grid {disc.grid}" if kind == "spectral" else f"order {disc.order}, interface_maxh "
                      f"{disc.interface_maxh}", "grid_or_ndof": out.ndof, "contact_fraction": load0["contact_fraction"],
