@@ -28,6 +28,7 @@ from __future__ import annotations
 import csv
 import math
 import os
+from functools import partial
 import sys
 import tempfile
 import time
@@ -102,7 +103,7 @@ def macro_ratio(scene, cache: str):
     if scene.two_scale is None:
         sol = RM.solve_scene(scene, problem)
     else:
-        sol, res = R2.couple(scene, problem, lambda prob, start: RM.solve_scene(scene, prob, start),
+        sol, res = R2.couple(scene, problem, partial(RM.solve_scene, scene),
                              map_tasks=lambda f, xs: [f(x) for x in xs], cache_dir=cache,
                              shear_map=lambda f, xs: [f(x) for x in xs])
     rough = problem.rough

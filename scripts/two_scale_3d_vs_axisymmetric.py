@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import csv
 import os
+from functools import partial
 import sys
 import time
 
@@ -71,7 +72,7 @@ def measure(case: str, name: str, sizes: dict, response) -> tuple[dict, dict]:
     table = PT.CellTable(response, tol=spec.table_tol)
     with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
         out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
-                       solve=lambda prob, start: RM.solve_scene(scene, prob, start))
+                       solve=partial(RM.solve_scene, scene))
         st = evaluate(scene, out.solution)
     sol = out.solution
     mesh, three = sol.problem.mesh, sol.problem.setting == "3d"

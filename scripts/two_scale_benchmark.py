@@ -35,6 +35,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import os
+from functools import partial
 import tempfile
 import time
 
@@ -71,7 +72,7 @@ def solve(scene, problem, cache_dir, warm, D, R) -> dict:
         row = {"macro_solves": 1, "newton_per_solve": str(sol.history["newton_iterations"]), "cell_solves": 0,
                "updates": 0}
     else:
-        sol, res = R.couple(scene, problem, lambda prob, start: D.solve_scene(scene, prob, start),
+        sol, res = R.couple(scene, problem, partial(D.solve_scene, scene),
                             cache_dir=cache_dir, warm=warm)
         row = {"macro_solves": res["macro_solves"], "newton_per_solve": " ".join(map(str, res["newton_per_solve"])),
                "cell_solves": res["cell_solves"], "updates": res["iterations"]}

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import logging
 from collections import Counter
+from functools import partial
 
 import numpy as np
 import ngsolve as ng
@@ -223,10 +224,15 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
     return problem, info
 
 
-def solve_scene(scene, problem: M.MacroProblem, start=None) -> M.MacroSolution:
-    """:func:`ngcontact.macro.macro_problem.solve` with the scene's solver settings (``start``: warm start)."""
+def solve_scene(scene, problem: M.MacroProblem, start=None, rtol: float | None = None) -> M.MacroSolution:
+    """:func:`ngcontact.macro.macro_problem.solve` with the scene's solver settings.
+
+    ``start``: warm start; ``rtol``: a looser Newton tolerance than the
+    scene's, for a solve that only starts another (the scene's where it is
+    looser already).
+    """
     s = scene.solver
-    return M.solve(problem, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
+    return M.solve(problem, rtol=max(s.rtol, rtol or 0.0), atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
                    coulomb_rtol=s.coulomb_rtol, coulomb_max_iter=s.coulomb_max_iter, linear=linear_solver(scene),
                    coulomb=s.coulomb, start=start)
 
@@ -263,7 +269,7 @@ def run(scene, clock) -> Outcome:
             sol = solve_scene(scene, problem)
         else:
             from ngcontact.drivers.run_two_scale import couple
-            sol, two_scale = couple(scene, problem, lambda prob, start: solve_scene(scene, prob, start))
+            sol, two_scale = couple(scene, problem, partial(solve_scene, scene))
     with clock.stage("post-processing"):
         balance = checked_equilibrium(sol)
         fields = MM.stress_fields(sol)

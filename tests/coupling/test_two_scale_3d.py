@@ -28,6 +28,7 @@ Tolerances, each a discretization error:
   it was too costly here.
 """
 import os
+from functools import partial
 
 import ngsolve as ng
 import numpy as np
@@ -73,7 +74,7 @@ def _run(name, response, **sizes):
     table = PT.CellTable(response, tol=spec.table_tol)
     with ng.TaskManager():
         out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
-                       solve=lambda prob, start: RM.solve_scene(scene, prob, start))
+                       solve=partial(RM.solve_scene, scene))
         strength = evaluate(scene, out.solution)
     sol = out.solution
     mesh, law = sol.problem.mesh, sol.problem.law

@@ -139,8 +139,8 @@ def test_warm_and_cold_starts_reach_the_same_two_scale_state(tmp_path):
     for warm in (True, False):
         steps = []
 
-        def solve(prob, start):
-            sol = D.solve_scene(scene, prob, start)
+        def solve(prob, start, rtol=None):
+            sol = D.solve_scene(scene, prob, start, rtol)
             steps.append((start is not None, sol.history["newton_iterations"]))
             return sol
         cache = tmp_path / ("warm" if warm else "cold")   # each run from an empty cache: the same loop
