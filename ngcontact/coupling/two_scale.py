@@ -46,7 +46,7 @@ the macro solve; the loop only grows the table:
 2. if the table grew, the macro problem is solved again with
    :func:`response_law`, warm-started from the solution with the law it
    was given (on the femur with Coulomb friction by the coupled Newton: 4
-   Newton steps against 22 cold; always from that state, so that the answer
+   Newton steps against 20 cold; always from that state, so that the answer
    does not depend on the path by which the table grew); its
    change ``max_x |sigma_n^(k)(x) - sigma_n^(k-1)(x)|`` is recorded and the
    loop stops below ``tol``; if it did not grow, the law is the one just
@@ -216,7 +216,7 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         macro_solves, newton, start = 1, sol.history["newton_iterations"], sol.gfu.vec
         scene_law_solution = start
     if given:
-        # the cached table's law, warm from the scene's law (the femur: 18 + 4 Newton steps, 22 cold;
+        # the cached table's law, warm from the scene's law (the femur: 15 + 4 Newton steps, 20 cold;
         # the scene's law is the more robust start: cold, the table's law once needed a continuation);
         # without warm starts the scene's law is not solved at all
         problem = M.replace_law(problem, il.InterfaceLaw(normal=response_law(table),
@@ -246,7 +246,7 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
                                   macro_solves=macro_solves, shear=shear)
         law = il.InterfaceLaw(normal=response_law(table), friction=tangential_law(problem, shear))
         # warm from the scene's start law's solution: with Coulomb friction by the coupled Newton the
-        # femur's cell-law solve takes 4 steps from it against 22 cold (31, with a failed attempt and a
+        # femur's cell-law solve takes 4 steps from it against 20 cold (31, with a failed attempt and a
         # continuation in the Huber width, before its line search on the frozen Tresca energy); the
         # Coulomb fixed point had taken 26 warm against 17 cold, its first pass frozen far from either
         # solution.  Always from that one state, not from the last update's: the cell law's C1 cubic
