@@ -22,15 +22,13 @@ in ``Periodic``.
 """
 from __future__ import annotations
 
-import contextlib
-import os
-import sys
 from math import pi
 
 import ngsolve as ng
 
 from ngcontact.fem.materials import ElasticLaw
 from ngcontact.errors import ModelError
+from ngcontact.quiet import quiet
 
 SETTINGS = ("plane_strain", "axisymmetric", "3d")
 #: displacement components per setting, in the order of the mesh axes
@@ -137,22 +135,8 @@ def vector_h1(mesh, **flags) -> ng.FESpace:
     that line is kept off the user's terminal.  (Setting the types dof by
     dof in Python cost 12 % of a 3D cell solve of 39k dofs.)
     """
-    with _quiet_stderr():
+    with quiet("stderr"):
         return ng.VectorH1(mesh, wb_withedges=False, **flags)
-
-
-@contextlib.contextmanager
-def _quiet_stderr():
-    """Standard error closed at the descriptor level (where C++ writes) for the block."""
-    sys.stderr.flush()
-    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(null, 2)
-        yield
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-        os.close(null)
 
 
 def add_elastic_energy(form: ng.BilinearForm, mesh, bodies: dict, displacements: dict, setting: str):

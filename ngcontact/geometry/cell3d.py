@@ -44,6 +44,7 @@ from netgen.csg import CSGeometry, OrthoBrick, Plane, Pnt, Vec
 
 from ngcontact.errors import GeometryError
 from ngcontact.geometry.cell2d import Cell, periodic_maxh
+from ngcontact.quiet import quiet
 
 log = logging.getLogger(__name__)
 
@@ -66,6 +67,15 @@ def _box_planes(P, h_rough, h_counter):
     bottom = Plane(Pnt(0, 0, -h_rough), Vec(0, 0, -1)).bc("bottom")
     top = Plane(Pnt(0, 0, h_counter), Vec(0, 0, 1)).bc("top")
     return (xm, xp, ym, yp), bottom, top
+
+
+def _identify_periodic(geo, lateral) -> None:
+    """Identify the lateral planes ``x = 0, P`` and ``y = 0, P`` periodically (Netgen announces each
+    identification on C++'s standard output: kept off the terminal)."""
+    xm, xp, ym, yp = lateral
+    with quiet("stdout"):
+        geo.PeriodicSurfaces(xm, xp)
+        geo.PeriodicSurfaces(ym, yp)
 
 
 def _mesh(geo, maxh: float, P: float, h_rough: float, h_counter: float) -> Cell:
@@ -120,8 +130,7 @@ def flat_cell3d(period: float = 1.0, h_rough: float = 1.0, h_counter: float = 1.
     geo = CSGeometry()
     geo.Add((box * bottom * plane).mat("rough"))
     geo.Add((box * top - plane).mat("counter"))
-    geo.PeriodicSurfaces(xm, xp)
-    geo.PeriodicSurfaces(ym, yp)
+    _identify_periodic(geo, (xm, xp, ym, yp))
     return _mesh(geo, maxh, P, hr, hc)
 
 
@@ -173,8 +182,7 @@ def square_hills_cell(side: float, height: float, *, period: float = 1.0,
     geo = CSGeometry()
     geo.Add(rough.mat("rough"))
     geo.Add(counter.mat("counter"))
-    geo.PeriodicSurfaces(xm, xp)
-    geo.PeriodicSurfaces(ym, yp)
+    _identify_periodic(geo, (xm, xp, ym, yp))
     return _mesh(geo, maxh, P, hr, hc)
 
 
