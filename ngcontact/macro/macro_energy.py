@@ -58,10 +58,11 @@ def macro_energy(problem, fes, frame, *, G=None, start_stiffness: float | None =
     w = elasticity.weight(setting)
     ur, uc = fes.TrialFunction()
     form = ng.BilinearForm(fes, symmetric=not coupled)
-    # the split's parts (built only for it): the bodies and loads, and the interface
-    quadratic = ng.BilinearForm(fes, symmetric=not coupled) if split else None
+    # the split's parts (built only for it): the bodies and loads, assembled already when an earlier
+    # solve of the problem (another law: the two-scale loop) built them on this space, and the interface
+    quadratic, assembled = _bodies(problem, fes, symmetric=not coupled) if split else (None, False)
     interface = ng.BilinearForm(fes, symmetric=not coupled) if split else None
-    for f in (form, quadratic) if split else (form,):
+    for f in (form, quadratic) if split and not assembled else (form,):
         elasticity.add_elastic_energy(f, mesh, {problem.rough: problem.materials[problem.rough],
                                                 problem.counter: problem.materials[problem.counter]},
                                       {problem.rough: ur, problem.counter: uc}, setting)
@@ -90,7 +91,25 @@ def macro_energy(problem, fes, frame, *, G=None, start_stiffness: float | None =
     if not split:
         return form
     interface += term
-    return SplitEnergy(form, quadratic, interface, key=lambda: None)
+    split_form = SplitEnergy(form, quadratic, interface, key=lambda: None, assembled=assembled)
+    problem.parts[("bodies", not coupled)] = (fes, quadratic)     # assembled now
+    return split_form
+
+
+def _bodies(problem, fes, symmetric: bool) -> tuple[ng.BilinearForm, bool]:
+    """The form of the bodies and loads on ``fes`` in the given storage, and whether it is assembled.
+
+    Kept in ``problem.parts`` (shared by the problem's copies with other
+    laws, :func:`ngcontact.macro.macro_problem.replace_law`) for ``fes``, the
+    space of those parts: the bodies are linear, so every solve of the
+    problem, whatever its law, has the same stiffness ``K`` and load vector
+    (on the femur a second assembly of ``K`` would cost 12 ms of a 200 ms
+    solve with the cell's law, twice: symmetric and not).
+    """
+    held = problem.parts.get(("bodies", symmetric))
+    if held is not None and held[0] is fes:
+        return held[1], True
+    return ng.BilinearForm(fes, symmetric=symmetric), False
 
 
 def frozen_tresca(problem, fes, frame, gfu: ng.GridFunction, split: bool = False) -> FrozenTresca:

@@ -112,6 +112,13 @@ class MacroProblem:
         Polynomial order of the displacement.
     interface
         Label of the interface boundary ``S_0``.
+    parts
+        What a solve builds that does not depend on the interface law: the
+        space (with its wirebasket), the interface frame and the bodies'
+        assembled stiffness (:func:`ngcontact.macro.macro_energy.macro_energy`).
+        Built by the first solve; shared with the copies :func:`replace_law`
+        makes (the two-scale loop solves one problem with several laws), a
+        fresh one for any other copy.
     """
 
     mesh: ng.Mesh
@@ -125,6 +132,7 @@ class MacroProblem:
     loads: tuple[Load, ...] = ()
     order: int = 2
     interface: str = "interface"
+    parts: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
 
 @dataclass
@@ -198,13 +206,9 @@ def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_
 
     check_problem(problem)
     mesh = problem.mesh
-    fes = two_body.spaces(mesh, problem.setting, (problem.rough, problem.counter), problem.supports,
-                          problem.order)
-    elasticity.surface_wirebasket(fes, mesh, problem.interface)
+    fes, frame = space_and_frame(problem)
     gfu = ng.GridFunction(fes)
     two_body.set_dirichlet(mesh, problem.setting, problem.supports, gfu)
-    n0 = two_body.interface_normal(mesh, problem.rough, problem.interface)
-    frame = local_frame(n0, mesh.dim)
     law = problem.law
     linear = linear if linear is not None else LinearSolver("direct", inverse=inverse)
     newton: dict[str, Any] = dict(rtol=rtol, atol=atol, max_iter=max_iter, linear=linear)
@@ -356,5 +360,21 @@ def _warm(gfu: ng.GridFunction, start: ng.BaseVector) -> None:
 
 
 def replace_law(problem: MacroProblem, law: il.InterfaceLaw) -> MacroProblem:
-    """The same problem with another interface law."""
-    return replace(problem, law=law)
+    """The same problem with another interface law, sharing the law-independent ``parts`` of its solves."""
+    new = replace(problem, law=law)
+    object.__setattr__(new, "parts", problem.parts)
+    return new
+
+
+def space_and_frame(problem: MacroProblem):
+    """The displacement space of both bodies (the interface's dofs on BDDC's wirebasket) and the interface's
+    local frame ``(n0, t...)``: built once per problem and kept in its ``parts``."""
+    parts = problem.parts
+    if "space" not in parts:
+        mesh = problem.mesh
+        fes = two_body.spaces(mesh, problem.setting, (problem.rough, problem.counter), problem.supports,
+                              problem.order)
+        elasticity.surface_wirebasket(fes, mesh, problem.interface)
+        n0 = two_body.interface_normal(mesh, problem.rough, problem.interface)
+        parts["space"], parts["frame"] = fes, local_frame(n0, mesh.dim)
+    return parts["space"], parts["frame"]

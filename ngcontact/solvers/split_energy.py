@@ -63,14 +63,19 @@ class SplitEnergy:
         ``key() -> hashable``: the values of the parameters ``g`` and ``c``
         depend on (e.g. the load's ``Parameter`` values); ``K`` must not
         depend on them.
+    assembled
+        ``quadratic`` is assembled already (``K`` shared with another split
+        energy of the same bodies, e.g. with another interface law).
     """
 
-    def __init__(self, whole: ng.BilinearForm, quadratic: ng.BilinearForm, interface: ng.BilinearForm, key):
+    def __init__(self, whole: ng.BilinearForm, quadratic: ng.BilinearForm, interface: ng.BilinearForm, key,
+                 assembled: bool = False):
         self.whole, self.quadratic, self.interface, self.key = whole, quadratic, interface, key
         self.space = whole.space
         self._state = ng.GridFunction(whole.space)      # owns the zero vector
         zero = self._zero = self._state.vec
-        quadratic.AssembleLinearization(zero)       # Q'' is the same at every state
+        if not assembled:
+            quadratic.AssembleLinearization(zero)       # Q'' is the same at every state
         self.K = quadratic.mat
         # after the whole form's first assembly: where the interface's entries go, K in the whole storage
         self._slots_psi: np.ndarray | None = None

@@ -440,3 +440,29 @@ def test_every_body_balances_and_an_unconverged_state_is_refused_with_the_figure
     u[free] *= 1.01
     with pytest.raises(ConvergenceError, match=r"not in equilibrium: body '(block|base)' in [xy]: applied "):
         checked_equilibrium(sol)
+
+
+def test_a_copy_with_another_law_reuses_the_bodies_and_solves_as_a_fresh_problem():
+    """replace_law shares the law-independent parts (space, frame, assembled K): same solution to round-off."""
+    from dataclasses import replace
+    g = gm.block_on_plane(L_BLOCK, H_BLOCK, 0.02, maxh=0.01)
+    first = il.InterfaceLaw(normal=il.LinearLaw(kn=1e12), friction=il.Friction(mu=MU, width=WIDTH))
+    second = il.InterfaceLaw(normal=il.TabulatedLaw(closure=(0.0, 1e-6, 4e-6), pressure=(0.0, 2e5, 2e6),
+                                                    interpolation="monotone_cubic"),
+                             friction=il.Friction(mu=MU, width=WIDTH))
+    prob = M.MacroProblem(
+        mesh=g.mesh, setting="plane_strain", rough="block", counter="base",
+        materials={"block": isotropic(10e9, 0.3), "base": isotropic(10e9, 0.3)}, law=first, order=2,
+        supports=(M.Support(label="bottom"),), loads=(M.Load(label="top", pressure=N_PRESS, traction=(0.3 * MU * N_PRESS, 0.0)),))
+    a = M.solve(prob)
+    shared = M.replace_law(prob, second)
+    assert shared.parts is prob.parts and ("bodies", False) in prob.parts      # K of the coupled equations
+    K = prob.parts[("bodies", False)][1].mat
+    b = M.solve(shared, start=a.gfu.vec)
+    assert b.gfu.space is a.gfu.space and prob.parts[("bodies", False)][1].mat is K   # not assembled again
+    fresh = replace(prob, law=second)
+    assert fresh.parts == {} and fresh.parts is not prob.parts   # any other copy starts afresh
+    c = M.solve(fresh, start=a.gfu.vec)
+    pb, pc = MM.interface_profile(b), MM.interface_profile(c)
+    for key in ("pressure", "shear", "jump_n", "jump_t"):
+        assert np.max(np.abs(pb[key] - pc[key])) <= 1e-12 * np.max(np.abs(pc[key])), key
