@@ -145,7 +145,7 @@ class MacroSolve(Protocol):
 
 
 def _default_solve(problem: M.MacroProblem, start=None, rtol: float | None = None) -> M.MacroSolution:
-    return M.solve(problem, start=start, rtol=max(1e-10, rtol or 0.0))
+    return M.solve(problem, start=start, rtol=max(M.RTOL, rtol or 0.0))
 
 
 def _solve_warm_or_cold(solve: MacroSolve, problem: M.MacroProblem, start):

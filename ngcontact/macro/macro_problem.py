@@ -85,6 +85,8 @@ from ngcontact.macro.macro_energy import frozen_tresca, gap_cf, local_jump, macr
 
 log = logging.getLogger(__name__)
 
+#: Newton's default relative tolerance of a macro solve
+RTOL = 1e-10
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -167,7 +169,7 @@ def check_problem(problem: MacroProblem) -> None:
                       problem.interface, problem.law.holds_tangentially)
 
 
-def solve(problem: MacroProblem, *, rtol: float = 1e-10, atol: float = 0.0, max_iter: int = 40,
+def solve(problem: MacroProblem, *, rtol: float = RTOL, atol: float = 0.0, max_iter: int = 40,
           inverse: str = "sparsecholesky", coulomb_rtol: float = 1e-8,
           coulomb_max_iter: int = 40, linear: LinearSolver | None = None,
           coulomb: str = "newton", start: ng.BaseVector | None = None) -> MacroSolution:
