@@ -39,6 +39,7 @@ import numpy as np
 
 from ngcontact.fem import materials as _mat
 from ngcontact.solvers.linear_solver import LinearSolver, match_free_dofs
+from ngcontact.solvers.newton import fixed_mask, mask_fixed
 
 
 def schur_complement(form, X, dofs, state_vec, linear: LinearSolver) -> np.ndarray:
@@ -62,17 +63,17 @@ def schur_complement(form, X, dofs, state_vec, linear: LinearSolver) -> np.ndarr
         n = len(dofs)
         S = np.zeros((n, n))
         e, y, x, z = (state_vec.CreateVector() for _ in range(4))
-        mask = np.array(list(free), dtype=bool)
+        fixed = fixed_mask(free)
         for j, dj in enumerate(dofs):
             e[:] = 0.0
             e[dj] = 1.0
             y.data = K * e
             rhs = y.FV().NumPy().copy()
             x.data = y
-            x.FV().NumPy()[~mask] = 0.0                  # K_IU e_j
+            mask_fixed(x, fixed)                          # K_IU e_j
             z.data = inv * x
             x.data = z
-            x.FV().NumPy()[~mask] = 0.0
+            mask_fixed(x, fixed)
             z.data = K * x
             for i, di in enumerate(dofs):
                 S[i, j] = rhs[di] - z[di]
