@@ -13,7 +13,8 @@ The scene ``geometries/femur_stem_two_scale.toml`` (the femur of
    tabulate its response: real contact fraction and mean closure against
    the pressure (refined adaptively, so that the number of cell solves does
    not grow with the interface points; cached on disk, so a second run
-   solves no cell problem),
+   solves no cell problem; the scene solves this small-slope cell, a flat
+   interface with the grooves in its gap, by the spectral method),
 4. solve the macro problem again, warm-started, with the cell's own
    response ``p(closure)`` as the interface law at every point (the fixed
    point of the paper's coefficient updates), and stop once the table

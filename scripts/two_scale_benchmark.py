@@ -6,7 +6,10 @@ NGSolve's task manager on every core (as ``ngcontact run``):
 
 * ``fixed_law``: one macro solve with the scene's start law (``[two_scale]`` removed);
 * ``two_scale_cold``: the coupling loop with an empty cell-table cache, the cell solves of each
-  table level one after the other in this process;
+  table level one after the other in this process (the scene's ``two_scale.cell_method``:
+  the spectral small-slope cell on 1024 grid points);
+* ``two_scale_cold_fe_cell``: the same with ``two_scale.cell_method = "fe"`` (the groove
+  cell's finite elements, 7.6k dofs);
 * ``two_scale_cold_2_workers``: the same with ``ngcontact run``'s default on two cores: a local
   pool of two worker processes started on demand (a table level solves its first cell here and
   starts the workers only if the rest repays their start; else the level runs here);
@@ -90,6 +93,7 @@ def main(out: str, repeats: int = REPEATS) -> list[dict]:
         return new
     scene = variant(strength=None)
     fixed = variant(strength=None, two_scale=None)
+    fe_cell = variant(strength=None, two_scale=dataclasses.replace(shipped.two_scale, cell_method="fe"))
     measure("warm-up (not reported)", fixed, "")
     every = []
     for repeat in range(repeats):
@@ -97,6 +101,8 @@ def main(out: str, repeats: int = REPEATS) -> list[dict]:
         with tempfile.TemporaryDirectory() as cache:
             every.append(dict(measure("two_scale_cold", scene, cache), repeat=repeat))
             every.append(dict(measure("two_scale_warm", scene, cache), repeat=repeat))
+        with tempfile.TemporaryDirectory() as cache:
+            every.append(dict(measure("two_scale_cold_fe_cell", fe_cell, cache), repeat=repeat))
         with tempfile.TemporaryDirectory() as cache:
             every.append(dict(measure("two_scale_cold_2_workers", scene, cache, workers=2), repeat=repeat))
         with tempfile.TemporaryDirectory() as cache:

@@ -2,7 +2,8 @@
 
 The cell at a mean pressure ``p`` (compression positive) answers with its
 real contact fraction, the coefficients of eq. 34 on its real contact set
-and its mean closure ``c(p)`` (:func:`cell_response`); the two-scale loop
+and its mean closure ``c(p)`` (:func:`cell_response` for the FE cell,
+:func:`spectral_response` for the small-slope cell on a grid); the two-scale loop
 (:mod:`ngcontact.coupling.two_scale`, paper Sec. 3.5) reads them from a
 table over ``p`` and hands the macro problem the law ``p = P(c)``
 (:func:`response_law`).
@@ -41,6 +42,7 @@ import numpy as np
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.cell.spectral_cell import SpectralCell
 from ngcontact.cell.measures import (
     contact_fraction,
     contact_integral,
@@ -100,6 +102,27 @@ def cell_response(problem: CellProblem, pressure: float, length_unit: float = 1.
     closure = float(mean_jump(problem)[problem.dim - 1]) * problem.area / projected * length_unit
     return {"contact_fraction": fraction, "k_n0": kn0, "g_n0": kn0 * closure - float(pressure),
             "closure": closure}
+
+
+def spectral_response(cell: SpectralCell, pressure: float, length_unit: float = 1.0) -> Response:
+    """:func:`cell_response` of a small-slope cell solved on its grid (:mod:`ngcontact.cell.spectral_cell`).
+
+    The same model as the FE cell of a flat interface with the roughness in
+    the gap: both layers flat, ``n = n0`` on all of ``S_C``, so ``k_n0 =
+    k_n`` times the contact fraction (eq. 34 on the real contact set; the
+    fraction with its 2D edges located between grid points,
+    :func:`ngcontact.cell.spectral_measures.contact_fraction`) and the
+    closure is the mean normal jump ``c = mean(J_n)`` over the period.
+    Each pressure is solved from zero pressure, so a response does not
+    depend on the order of the solves.  Frictionless cells only (the
+    spectral cell carries no shear without friction; the loop's shear table
+    solves the FE cell).
+    """
+    sol = cell.solve(cell_load(cell.dim, pressure=float(pressure)))
+    fraction = float(sol.results["contact_fraction"])
+    kn0 = cell.k_n * fraction
+    closure = float(sol.results["mean_closure"]) * length_unit
+    return {"contact_fraction": fraction, "k_n0": kn0, "g_n0": kn0 * closure - float(pressure), "closure": closure}
 
 
 @dataclass

@@ -76,9 +76,10 @@ def cell_key(cell_scene) -> str:
     return h.hexdigest()
 
 
-def cell_scene_of(path: str, *, key: str, overrides: dict | None = None) -> CellScene:
-    """The cell scene file ``path`` with ``[contact]`` overrides (:func:`~ngcontact.scene.loader.load_with_contact`)."""
-    cell_scene = load_with_contact(path, overrides)
+def cell_scene_of(path: str, *, key: str, overrides: dict | None = None, method: str | None = None) -> CellScene:
+    """The cell scene file ``path`` with ``[contact]`` overrides and another ``discretization.method`` if given
+    (:func:`~ngcontact.scene.loader.load_with_contact`)."""
+    cell_scene = load_with_contact(path, overrides, method)
     if cell_scene.kind != "cell":
         raise SceneError(key, path, f"names a {cell_scene.kind!r} scene; a 'cell' scene is needed")
     return cell_scene

@@ -51,10 +51,12 @@ class StrengthEvaluation(TypedDict):
     plots: dict[str, Callable[..., None]]  # name -> plot, called as plot(path)
 
 
-def cell_problem_of(cell_path: str, *, key: str, overrides: dict | None = None) -> tuple[CellScene, CellProblem]:
-    """Cell scene (with ``[contact]`` overrides) -> :class:`CellProblem` with the macro strain term (for recovery)."""
+def cell_problem_of(cell_path: str, *, key: str, overrides: dict | None = None,
+                    method: str | None = None) -> tuple[CellScene, CellProblem]:
+    """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene) -> :class:`CellProblem`
+    with the macro strain term (for recovery)."""
     from ngcontact.drivers.build import build_cell, model_of
-    cs = load_with_contact(cell_path, overrides)
+    cs = load_with_contact(cell_path, overrides, method)
     if cs.kind != "cell":
         raise SceneError(key, cell_path, f"names a {cs.kind!r} scene; a 'cell' scene is needed")
     if cs.contact.geometric_only:
@@ -62,8 +64,8 @@ def cell_problem_of(cell_path: str, *, key: str, overrides: dict | None = None) 
                          "solves the cell, so it needs a contact model and a [load] section")
     if cs.discretization.method != "fe":
         raise SceneError(key, cell_path, f"the cell scene is solved by discretization.method = "
-                         f"{cs.discretization.method!r}; the strength recovery and the two-scale loop need the body "
-                         "stresses and the macro strain term of the FE cell: use a cell scene with method = 'fe'")
+                         f"{cs.discretization.method!r}; the strength recovery needs the body stresses and the macro "
+                         "strain term of the FE cell: use a cell scene with method = 'fe'")
     cell = build_cell(cs)
     model = dataclasses.replace(model_of(cs), macro_strain=True)
     s = cs.solver

@@ -33,7 +33,8 @@ solve was warm-started), ``newton_per_solve``, ``tolerance`` [Pa],
 [Pa], ``closure`` [m], ``tolerance``, ``error_estimate``: the largest
 relative midpoint discrepancy accepted, ``nodes``), ``cache`` (key, whether
 the table came from it, its path), ``law`` (the macro law: the cell's
-tabulated response and its interpolation, the monotone cubic), ``cell`` (scene, ndof, overrides) and the coefficients
+tabulated response and its interpolation, the monotone cubic), ``cell`` (scene, method, its ``ndof`` (FE) or
+``grid_points`` (spectral) when it was solved, overrides) and the coefficients
 at the interface samples (``contact_fraction``, ``k_n0``; along the profile
 in 2D and axisymmetry, on the interface surface in 3D); with a shear
 table also ``shear_table`` (rows, nodes, cell solves, the error estimates
@@ -83,18 +84,26 @@ class PressureSolve:
     pressure, as the run's own process does with its one task.  Every
     response is solved afresh from the rigid predictor (``first=True``), so a
     shared problem gives the numbers of a fresh one.
+
+    ``method``: ``"fe"`` or ``"spectral"`` instead of the cell scene's own
+    ``discretization.method`` (``two_scale.cell_method``).  A spectral cell
+    (:class:`~ngcontact.cell.spectral_cell.SpectralCell`) answers by
+    :func:`~ngcontact.coupling.pressure_table.spectral_response`, each
+    pressure from zero pressure.
     """
 
-    def __init__(self, path: str, length_unit: float, overrides: dict | None = None):
+    def __init__(self, path: str, length_unit: float, overrides: dict | None = None, method: str | None = None):
         from ngcontact.drivers.build import cell_key, cell_scene_of
         self.path, self.length_unit, self.overrides = path, length_unit, dict(overrides or {})
-        self.key = cell_key(cell_scene_of(path, key="two_scale.cell", overrides=self.overrides))
+        scene = cell_scene_of(path, key="two_scale.cell", overrides=self.overrides, method=method)
+        self.method = scene.discretization.method
+        self.key = cell_key(scene)
         self._problem = None
         self._shared = False
 
     def __getstate__(self):
         return {"path": self.path, "length_unit": self.length_unit, "overrides": self.overrides, "key": self.key,
-                "_problem": None, "_shared": False}
+                "method": self.method, "_problem": None, "_shared": False}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
@@ -106,8 +115,14 @@ class PressureSolve:
             if self._shared and slot in _BUILT:
                 self._problem = _BUILT[slot]
                 return self._problem
-            from ngcontact.drivers.run_strength import cell_problem_of
-            _, self._problem = cell_problem_of(self.path, key="two_scale.cell", overrides=self.overrides)
+            if self.method == "spectral":
+                from ngcontact.drivers.build import cell_scene_of, spectral_cell
+                self._problem = spectral_cell(cell_scene_of(self.path, key="two_scale.cell", overrides=self.overrides,
+                                                            method=self.method))
+            else:
+                from ngcontact.drivers.run_strength import cell_problem_of
+                _, self._problem = cell_problem_of(self.path, key="two_scale.cell", overrides=self.overrides,
+                                                   method=self.method)
             if self._shared:
                 while len(_BUILT) >= KEEP_BUILT:
                     _BUILT.pop(next(iter(_BUILT)))
@@ -115,7 +130,15 @@ class PressureSolve:
         return self._problem
 
     def __call__(self, pressure: float) -> PT.Response:
+        if self.method == "spectral":
+            return PT.spectral_response(self.problem(), pressure, self.length_unit)
         return PT.cell_response(self.problem(), pressure, self.length_unit)
+
+    def size(self) -> dict:
+        """The cell's discretization for the report: ``{"method", "ndof"}`` (FE) or ``{"method", "grid_points"}``."""
+        if self.method == "spectral":
+            return {"method": "spectral", "grid_points": int(self.problem().points)}
+        return {"method": "fe", "ndof": int(self.problem().ndof)}
 
 
 class ShearSolve(PressureSolve):
@@ -229,8 +252,8 @@ def couple(scene, problem, solve,
     spec = scene.two_scale
     path = resolve(scene, spec.cell)
     overrides = cell_links.overrides(scene.interface)
-    cell_scene = cell_scene_of(path, key="two_scale.cell", overrides=overrides)
-    task = PressureSolve(path, spec.cell_length_unit, overrides)
+    cell_scene = cell_scene_of(path, key="two_scale.cell", overrides=overrides, method=spec.cell_method)
+    task = PressureSolve(path, spec.cell_length_unit, overrides, spec.cell_method)
     key = table_key(cell_scene, spec.cell_length_unit, spec.table_tol)
     table, from_cache = cached_table(key, task, spec.table_tol, map_tasks, cache_dir)
     shear, skey, shear_cached = None, None, False
@@ -255,7 +278,7 @@ def couple(scene, problem, solve,
                      "directory": cache_dir or cell_law.cache_dir_default()},
            "law": {"type": "tabulated cell response p(c)", "interpolation": law.interpolation,
                    "closure": list(law.closure), "pressure": list(law.pressure)},
-           "cell": {"scene": path, "ndof": int(task.problem().ndof) if table.solves else None,
+           "cell": {"scene": path, "method": task.method, **(task.size() if table.solves else {}),
                     "overrides": overrides},
            "interface_coefficients": {"contact_fraction": coef["contact_fraction"], "k_n0": coef["k_n0"]}}
     if shear is not None:

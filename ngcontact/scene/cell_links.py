@@ -7,7 +7,9 @@ tabulated response, paper Sec. 3.5).  ``interface.cell_k_n``,
 that cell's ``[contact]`` section without copying the cell scene;
 ``interface.friction = "from_cell"`` takes the homogenized friction
 ``mu0``, ``G0`` (paper eqs. 42-43) from the same cell.  These checks need
-the interface section and the two-scale section together.  Both work in
+the interface section and the two-scale section together.  ``two_scale.cell_method``
+solves the loop's cell by another method than the cell scene's own (its
+pressure table by the spectral small-slope cell, say).  Both work in
 every setting (in 3D the loop samples the interface surface).
 """
 from __future__ import annotations
@@ -44,3 +46,14 @@ def check_friction_source(interface, key: str, rel: str, cell) -> None:
         raise SceneError("interface.friction", "from_cell", f"the cell {rel!r} ({key}) has no friction "
                          "(contact.friction = 'none'); give it one with interface.cell_friction, or use "
                          "interface.friction = 'given'")
+
+
+def check_spectral_loop(interface, two_scale, rel: str, cell) -> None:
+    """The loop solves a spectral cell (``discretization.method = "spectral"``) for its pressure table only:
+    the shear table of ``interface.friction = "from_cell"`` with a frictional cell needs the FE cell."""
+    if interface.friction == "from_cell" and cell.contact.friction != "none":
+        key, value = (("two_scale.cell_method", "spectral") if two_scale is not None and two_scale.cell_method
+                      else ("two_scale.cell", rel))
+        raise SceneError(key, value, "the loop solves a spectral cell for its pressure table only; the shear "
+                         "table of interface.friction = 'from_cell' with a frictional cell needs the FE cell: "
+                         "use two_scale.cell_method = 'fe', or interface.friction = 'given'")

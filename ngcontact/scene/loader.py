@@ -64,15 +64,17 @@ def load(path: str | os.PathLike):
         _LOADING.pop()
 
 
-def load_with_contact(path: str | os.PathLike, overrides: dict | None = None):
+def load_with_contact(path: str | os.PathLike, overrides: dict | None = None, method: str | None = None):
     """:func:`load` a cell scene with some keys of its ``[contact]`` section replaced.
 
     ``overrides`` maps ``[contact]`` keys (``k_n``, ``friction``, ``mu``,
     ``G``, ``w``) to values; a new ``friction`` drops the cell's own ``mu``,
-    ``G`` and ``w`` unless they are overridden too.  The result is validated
-    as a whole (a fault names the cell key, e.g. ``contact.mu``).
+    ``G`` and ``w`` unless they are overridden too.  ``method`` (``"fe"`` or
+    ``"spectral"``), when given, replaces ``discretization.method``.  The
+    result is validated as a whole (a fault names the cell key, e.g.
+    ``contact.mu``).
     """
-    if not overrides:
+    if not overrides and method is None:
         return load(path)
     path = os.fspath(path)
     base = load(path)   # the file itself must be a valid scene
@@ -81,11 +83,14 @@ def load_with_contact(path: str | os.PathLike, overrides: dict | None = None):
     with open(path, "rb") as fh:
         data = tomllib.load(fh)
     contact = dict(data.get("contact", {}))
+    overrides = overrides or {}
     if "friction" in overrides:
         for key in ("mu", "G", "w"):
             contact.pop(key, None)
     contact.update(overrides)
     data["contact"] = contact
+    if method is not None:
+        data["discretization"] = {**data.get("discretization", {}), "method": method}
     return from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
 
 

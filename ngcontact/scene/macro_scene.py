@@ -231,6 +231,10 @@ class TwoScaleSpec:
     table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
                              "(below it the law follows the table's first secant down to p = 0)",
                              check=open_interval(0, 1))
+    cell_method: str | None = param(None, doc="how the loop solves its cell: fe (finite elements) or spectral "
+                                    "(the small-slope cell on a grid, for a flat interface with the roughness in "
+                                    "the gap); default: the cell scene's discretization.method",
+                                    choices=("fe", "spectral"))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -334,6 +338,15 @@ class MacroScene:
                 except SceneError as exc:
                     raise SceneError("interface.cell_" + next(iter(overrides)), overrides,
                                      f"the cell {rel!r} with these overrides is invalid: {exc}") from None
+            method = self.two_scale.cell_method if key == "two_scale.cell" and self.two_scale else None
+            if method is not None and cell.kind == "cell":
+                try:
+                    cell = load(resolve(self, rel), overrides, method)
+                except SceneError as exc:
+                    raise SceneError("two_scale.cell_method", method,
+                                     f"the cell {rel!r} cannot be solved by this method: {exc}") from None
+            if key == "two_scale.cell" and cell.kind == "cell" and cell.discretization.method == "spectral":
+                cell_links.check_spectral_loop(self.interface, self.two_scale, rel, cell)
             if cell.kind != "cell":
                 raise SceneError(key, rel, f"invalid cell scene: must be of kind 'cell', not {cell.kind!r}")
             cell_links.check_friction_source(self.interface, key, rel, cell)

@@ -441,8 +441,8 @@ def test_macro_strain_shifts_the_far_face_approach_as_in_the_fe_cell(tmp_path):
     assert b["far_face_jump"][-1] - c["far_face_jump"][-1] == pytest.approx(2 * 1.0 * (0.3 / 0.7) * 0.002, rel=1e-10)
 
 
-def test_the_two_scale_loop_and_the_strength_recovery_refuse_a_spectral_cell():
+def test_the_strength_recovery_refuses_a_spectral_cell():
     from ngcontact.drivers.run_strength import cell_problem_of
     from ngcontact.errors import SceneError
-    with pytest.raises(SceneError, match="need the body stresses and the macro strain term of the FE cell"):
-        cell_problem_of(os.path.join(CELLS, "self_affine_spectral.toml"), key="two_scale.cell")
+    with pytest.raises(SceneError, match="needs the body stresses and the macro strain term of the FE cell"):
+        cell_problem_of(os.path.join(CELLS, "self_affine_spectral.toml"), key="strength.cell")

@@ -775,3 +775,27 @@ def test_a_tolerance_where_edge_grading_does_not_apply_is_refused(tmp_path, caps
     if "tolerance = 2.0" not in str(edits):
         text = text.replace("maxh = 0.5", "maxh = 0.5\ntolerance = 1e-4")
     run_bad(tmp_path, capsys, edit(text, *edits), expected)
+
+
+def _two_scale_scene(tmp_path, *pairs) -> str:
+    text = open(os.path.join(ROOT, "geometries", "femur_stem_two_scale.toml")).read()
+    work = tmp_path / "work"
+    work.mkdir(exist_ok=True)
+    if not (work / "cells").exists():
+        os.symlink(os.path.join(ROOT, "geometries", "cells"), work / "cells")
+    return edit(text, *pairs)
+
+
+def test_a_two_scale_cell_method_the_cell_cannot_take(tmp_path, capsys):
+    """The spectral cell needs a small-slope cell; the loop's shear table needs the FE cell."""
+    run_bad(tmp_path, capsys, _two_scale_scene(tmp_path, ('cell_method = "spectral"', 'cell_method = "bem"')),
+            "two_scale.cell_method = 'bem': must be one of 'fe', 'spectral'")
+    run_bad(tmp_path, capsys, _two_scale_scene(tmp_path, ('cell = "cells/stem_grooves.toml"',
+                                                          'cell = "cells/sinusoid.toml"')),
+            "two_scale.cell_method = 'spectral': the cell 'cells/sinusoid.toml' cannot be solved by this method: "
+            "discretization.method = 'spectral': solves the small-slope cell", prefix=True)
+    run_bad(tmp_path, capsys, _two_scale_scene(tmp_path, ("mu = 0.3            #", 'friction = "from_cell"\n'
+                                                          'cell_friction = "coulomb"\ncell_mu = 0.3\ncell_w = 1e-9\n#')),
+            "two_scale.cell_method = 'spectral': the loop solves a spectral cell for its pressure table only; the "
+            "shear table of interface.friction = 'from_cell' with a frictional cell needs the FE cell: use "
+            "two_scale.cell_method = 'fe', or interface.friction = 'given'")
