@@ -24,6 +24,10 @@ complement by the same linear-solver policy; stresses), Newton steps, CG
 iterations, peak memory (measurement included), contact fraction; per
 solver the exponent ``b`` of ``time ~ dofs^b`` fitted over the sizes.
 
+With ``--coarse INTERFACE_MAXH [--k-n K]`` it measures instead BDDC's coarse
+problem on the converged cell: the bubble term's ``gamma`` against the
+whole contact surface on the wirebasket (``scaling_3d_coarse.csv``, ``.png``).
+
 With ``--breakdown INTERFACE_MAXH`` it measures instead where one iterative
 cell solve spends its time (CG per iteration, one BDDC application, one
 product with the tangent, the size of BDDC's coarse problem) and writes
@@ -33,6 +37,7 @@ Usage::
 
     python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral]
                                  [--solvers iterative direct] [--breakdown INTERFACE_MAXH]
+                                 [--coarse INTERFACE_MAXH [--k-n K]]
 
 Writes ``scaling_3d.csv`` and ``scaling_3d.png`` into ``OUT_DIR`` (default
 ``results/scaling_3d``) and logs the tables and the fitted exponents.
@@ -317,6 +322,86 @@ def breakdown(size: float, out: str) -> dict:
     return row
 
 
+COARSE_KEYS = ("size", "ndof", "k_n", "coarse", "gamma", "wirebasket_dofs", "cg_iterations", "cg_seconds",
+               "ms_per_cg_iteration")
+COARSE_GAMMAS = (3e-5, 1.1e-4, 3e-4, 1e-3)
+
+
+def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
+    """BDDC's coarse problem on the converged 3D cell: the bubble term's ``gamma`` (the contact surface's
+    edge dofs as interface dofs, :func:`ngcontact.fem.elasticity.bubble_term`) against the whole contact
+    surface on the wirebasket.  Each preconditioner is built at the converged state and CG solves one
+    tangent system with a random right-hand side to 1e-8.  Writes ``scaling_3d_coarse.csv`` and ``.png``."""
+    from dataclasses import replace
+
+    import ngsolve as ng
+    from ngsolve.krylovspace import CGSolver
+    from ngcontact import runner
+    from ngcontact.cell.cell_energy import preconditioning_form
+    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.fem import elasticity
+    from ngcontact.scene.loader import load
+    from ngcontact.solvers.linear_solver import LinearSolver
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    model = model_of(scene) if k_n is None else replace(model_of(scene), k_n=k_n)
+    rows = []
+    with runner.threads(runner.thread_count()):
+        P = CellProblem(build_cell(scene, interface_maxh=size), model, linear=LinearSolver("iterative"))
+        P.solve(cell_loads(scene)[0], first=True, measure=False)
+        A = P.energy().mat
+        b = A.CreateColVector()
+        b.SetRandom()
+        free = P.X.FreeDofs()
+        b.FV().NumPy()[~np.array(free, dtype=bool)] = 0.0
+        WB = ng.COUPLING_TYPE.WIREBASKET_DOF
+        default = elasticity.BUBBLE_GAMMA
+
+        def measure(form, coarse, gamma):
+            pre = ng.Preconditioner(form, "bddc")
+            form.AssembleLinearization(P.gfu.vec)
+            x = A.CreateColVector()
+            cg = CGSolver(A, pre.mat, tol=1e-8, maxiter=5000, printrates=False)
+            t0 = time.perf_counter()
+            x.data = cg * b
+            secs = time.perf_counter() - t0
+            row = {"size": size, "ndof": P.X.ndof, "k_n": model.k_n, "coarse": coarse, "gamma": gamma,
+                   "wirebasket_dofs": sum(P.X.CouplingType(d) == WB for d in range(P.X.ndof)),
+                   "cg_iterations": cg.iterations, "cg_seconds": secs,
+                   "ms_per_cg_iteration": secs / max(cg.iterations, 1) * 1e3}
+            log.info("coarse %-20s gamma %-8s: %5d CG iterations, %.2f s, %.1f ms each, %d coarse dofs", coarse,
+                     gamma, row["cg_iterations"], secs, row["ms_per_cg_iteration"], row["wirebasket_dofs"])
+            rows.append(row)
+        try:
+            for gamma in COARSE_GAMMAS:
+                elasticity.BUBBLE_GAMMA = gamma
+                measure(preconditioning_form(P, P.form), "vertices + bubble term", gamma)
+        finally:
+            elasticity.BUBBLE_GAMMA = default
+        elasticity.surface_wirebasket(P.X, P.mesh, "contact")
+        measure(P.form, "contact surface", "")
+    os.makedirs(out, exist_ok=True)
+    write_csv(os.path.join(out, "scaling_3d_coarse.csv"), list(COARSE_KEYS), [[r[k] for k in COARSE_KEYS] for r in rows])
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 3.8))
+    bubble = [r for r in rows if r["gamma"] != ""]
+    ax.semilogx([r["gamma"] for r in bubble], [r["cg_seconds"] for r in bubble], "o-",
+                label=f"vertices + bubble term ({bubble[0]['wirebasket_dofs']} coarse dofs)")
+    ax.axhline(rows[-1]["cg_seconds"], color="k", ls="--",
+               label=f"contact surface on the wirebasket ({rows[-1]['wirebasket_dofs']} coarse dofs)")
+    ax.axvline(default, color="0.6", lw=0.8, ls=":", label=f"BUBBLE_GAMMA = {default:g}")
+    ax.set_xlabel("gamma")
+    ax.set_ylabel("CG solve to 1e-8 [s]")
+    ax.set_title(f"3D bisinusoid cell, {rows[0]['ndof']} dofs, k_n = {model.k_n:g}", fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "scaling_3d_coarse.png"), dpi=120)
+    plt.close(fig)
+    return rows
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv and argv[0] == "--child":
@@ -333,10 +418,17 @@ def main(argv=None) -> int:
                     help="which linear solvers of parts 1 and 2 to run (default: both)")
     ap.add_argument("--breakdown", type=float, default=None, metavar="INTERFACE_MAXH",
                     help="instead: where an iterative cell solve of this interface mesh size spends its time")
+    ap.add_argument("--coarse", type=float, default=None, metavar="INTERFACE_MAXH",
+                    help="instead: BDDC's coarse problem on the converged cell of this interface mesh size, the "
+                         "bubble term's gamma against the contact surface on the wirebasket")
+    ap.add_argument("--k-n", type=float, default=None, help="with --coarse: the penalty k_n (default the scene's)")
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     if args.breakdown is not None:
         breakdown(args.breakdown, args.out)
+        return 0
+    if args.coarse is not None:
+        coarse_study(args.coarse, args.out, args.k_n)
         return 0
     rows = fe_parts(args.quick, args.direct_max, args.parts, args.solvers)
     if "spectral" in args.parts:

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import ngsolve as ng
 
+from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
 
 
@@ -76,6 +77,22 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
     form += term
     interface += term
     return form, previous, (quadratic, interface)
+
+
+def preconditioning_form(problem, form: ng.BilinearForm) -> ng.BilinearForm:
+    """The form a BDDC preconditioner of ``form`` is built from: its terms plus each body's bubble term on
+    ``S_C`` (:func:`ngcontact.fem.elasticity.bubble_term`, with the body's longitudinal modulus and the contact
+    stiffness: ``k_n``, or the augmentation of exact enforcement), so that BDDC's coarse problem needs only
+    the vertex dofs of the contact surface.  Never assembled as the tangent."""
+    m = problem.model
+    pre = ng.BilinearForm(problem.X, symmetric=True, symmetric_storage=problem.inverse == "sparsecholesky")
+    for term in form.integrators:
+        pre += term
+    trial, test = problem.X.TnT()
+    k = m.k_n if problem.multiplier is None else problem.augmentation
+    for i, law in enumerate((m.rough, m.counter)):
+        pre += _el.bubble_term(trial[i], test[i], law.longitudinal_modulus, k, "contact")
+    return pre
 
 
 def coulomb_residual(problem) -> ng.BilinearForm:

@@ -69,7 +69,7 @@ from ngcontact.cell import measures
 from ngcontact.cell.contact_multiplier import TRIANGLE_MAX_ORDER, ContactMultiplier, solve_exact
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
 from ngcontact.cell.cell_model import CellModel, CellSolution
-from ngcontact.cell.cell_energy import cell_energy, macro_strain_cf
+from ngcontact.cell.cell_energy import cell_energy, macro_strain_cf, preconditioning_form
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
 from ngcontact.cell.predictor import max_gap, rigid_continuation, rigid_translation, set_start, tangential_load
@@ -166,7 +166,6 @@ class CellProblem:
         # every element would couple all dofs and slow the factorization 5x
         N = ng.NumberSpace(mesh, definedon=mesh.Boundaries("contact|top"))
         self.X = ng.FESpace([Vr, Vc] + [N] * dim)
-        _el.surface_wirebasket(self.X, mesh, "contact")
         # exact: the gap itself at the Lobatto nodes (an interpolant on S_C, not periodic, would give the
         # two copies of a periodic vertex different gaps: contradictory constraints on one node)
         self.gap = model.gap if model.enforcement == "exact" else _discrete_gap(mesh, model)
@@ -183,6 +182,13 @@ class CellProblem:
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
         self.form, self.coulomb_previous, self._parts = cell_energy(self, ur, uc, U)
+        # BDDC's coarse problem: the vertices, with the bubble term in a form of its own where the tangent is an
+        # energy's; Coulomb's coupled residual (penalty) is not, and keeps the contact surface on the wirebasket
+        self._preconditioning = None
+        if self.coulomb_previous is None:
+            self._preconditioning = preconditioning_form(self, self.form)
+        else:
+            _el.surface_wirebasket(self.X, mesh, "contact")
         self._split: SplitEnergy | None = None
         self._largest_gap: float | None = None
         # the state as CoefficientFunctions (for results and tests)
@@ -306,7 +312,8 @@ class CellProblem:
         if self._split is None:
             loads = self.traction + self.strain_params
             quadratic, interface = self._parts
-            self._split = SplitEnergy(self.form, quadratic, interface, key=lambda: tuple(p.Get() for p in loads))
+            self._split = SplitEnergy(self.form, quadratic, interface, key=lambda: tuple(p.Get() for p in loads),
+                                      preconditioning=self._preconditioning)
         return self._split
 
     def _newton_once(self, free, atol) -> dict:

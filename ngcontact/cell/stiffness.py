@@ -56,6 +56,8 @@ def schur_complement(form, X, dofs, state_vec, linear: LinearSolver) -> np.ndarr
     for d in dofs:
         free.Clear(d)
     linear.register(form, free)
+    if hasattr(form, "renew_preconditioner"):
+        form.renew_preconditioner()          # a split energy: its preconditioner is built anew on these free dofs
     try:
         form.AssembleLinearization(state_vec)
         K = form.mat
@@ -112,7 +114,7 @@ def tangent_stiffness(problem) -> np.ndarray:
     Exact enforcement: extrapolated to ``k -> infinity`` (module docstring).
     """
     def at_current_k() -> np.ndarray:
-        return schur_complement(problem.form, problem.X, problem.u_dofs, problem.gfu.vec,
+        return schur_complement(problem.energy(), problem.X, problem.u_dofs, problem.gfu.vec,
                                 problem.linear) / problem.area
     try:
         if problem.multiplier is None:
@@ -127,7 +129,7 @@ def tangent_stiffness(problem) -> np.ndarray:
             problem.augmentation.Set(k)
         return (8.0 * S[2] - 6.0 * S[1] + S[0]) / 3.0
     finally:
-        if problem.linear.preconditioned(problem.form):
+        if problem.linear.preconditioned(problem.energy()):
             # the whole form was assembled here, on other free dofs: the preconditioner kept by the
             # Newton solve of the next load must be built anew
             problem.energy().renew_preconditioner()

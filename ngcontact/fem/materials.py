@@ -44,6 +44,11 @@ class ElasticLaw:
     def matrix(self) -> np.ndarray:
         return np.array(self.voigt, dtype=float)
 
+    @property
+    def longitudinal_modulus(self) -> float:
+        """Mean of ``C_1111, C_2222, C_3333``: a stress per unit normal strain (``lam + 2 mu`` if isotropic)."""
+        return float(np.trace(self.matrix[:3, :3])) / 3.0
+
     def stress(self, eps):
         """Stress tensor for a 3x3 strain tensor (NGSolve CoefficientFunction or array)."""
         if self.lame is not None:

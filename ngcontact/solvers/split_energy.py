@@ -38,6 +38,14 @@ the whole form's assembly (it allocates the matrix), and so is
 (BDDC, built from element matrices) is built there and kept by the later
 steps' tangents, until the linear solver finds it stale
 (:class:`ngcontact.solvers.linear_solver.LinearSolver`).
+
+A split energy may carry a *preconditioning* form: the whole form's terms
+plus terms meant for the preconditioner alone (the contact surface's bubble
+term, :func:`ngcontact.fem.elasticity.bubble_term`).  Once a preconditioner
+is registered with it (:meth:`SplitEnergy.preconditioner_form`), a rebuild
+assembles that form, which builds the preconditioner, and writes the
+tangent ``K + Psi''`` into the whole form's matrix from its parts: the
+tangent never holds the extra terms.
 """
 from __future__ import annotations
 
@@ -66,11 +74,16 @@ class SplitEnergy:
     assembled
         ``quadratic`` is assembled already (``K`` shared with another split
         energy of the same bodies, e.g. with another interface law).
+    preconditioning
+        The form a preconditioner is built from instead of ``whole`` (module
+        docstring); ``None``: ``whole``.
     """
 
     def __init__(self, whole: ng.BilinearForm, quadratic: ng.BilinearForm, interface: ng.BilinearForm, key,
-                 assembled: bool = False):
+                 assembled: bool = False, preconditioning: ng.BilinearForm | None = None):
         self.whole, self.quadratic, self.interface, self.key = whole, quadratic, interface, key
+        self.preconditioning = preconditioning
+        self._precondition = False      # a preconditioner is registered with ``preconditioning``
         self.space = whole.space
         self._state = ng.GridFunction(whole.space)      # owns the zero vector
         zero = self._zero = self._state.vec
@@ -132,10 +145,22 @@ class SplitEnergy:
         if self._renew:
             self.rebuild()
             return
+        self._sum_parts()
+        self.assembled_whole = False
+
+    def _sum_parts(self) -> None:
+        """``whole.mat = K + Psi''`` from ``K`` and the interface's last assembly."""
         vals = self.whole.mat.AsVector().FV().NumPy()
         vals[:] = self._K_whole
         vals[self._slots_psi] += self.interface.mat.AsVector().FV().NumPy()
-        self.assembled_whole = False
+
+    def preconditioner_form(self) -> ng.BilinearForm:
+        """The form to register a preconditioner with: the preconditioning form if there is one (from then on
+        every rebuild assembles it), else the whole form."""
+        if self.preconditioning is None:
+            return self.whole
+        self._precondition = True
+        return self.preconditioning
 
     def renew_preconditioner(self) -> None:
         """The whole form was assembled elsewhere (e.g. on other free dofs, for a measurement): the next
@@ -144,8 +169,17 @@ class SplitEnergy:
 
     def rebuild(self) -> None:
         """Assemble the whole form at the state of the last :meth:`AssembleLinearization`: the same
-        tangent to round-off, and a preconditioner registered with the whole form (BDDC) built from it."""
-        self.whole.AssembleLinearization(self._at)
+        tangent to round-off, and a preconditioner registered with the whole form (BDDC) built from it.
+        With a registered preconditioning form: that form is assembled instead (building the
+        preconditioner), and the tangent is summed from its parts once the whole form's matrix exists."""
+        if not self._precondition:
+            self.whole.AssembleLinearization(self._at)
+        else:
+            self.preconditioning.AssembleLinearization(self._at)
+            if self._K_whole is None:
+                self.whole.AssembleLinearization(self._at)      # allocates the tangent's matrix
+            else:
+                self._sum_parts()
         self.assembled_whole = True
         self._renew = False
 

@@ -44,3 +44,30 @@ def test_the_contact_surface_dofs_join_the_wirebasket():
     assert on and all(V.CouplingType(d) == WB for d in on)
     off = {d for e in mesh.edges for d in V.GetDofNrs(e) if d >= 0} - on
     assert off and all(V.CouplingType(d) == IF for d in off)
+
+
+@pytest.mark.parametrize("stiffness", [1.0, 1e4])
+def test_the_bubble_term_acts_on_the_edge_bubbles_alone_and_is_definite_there(stiffness):
+    """On a flat face the surface Hessian vanishes on the (linear) vertex functions: the term leaves BDDC's
+    coarse problem alone and makes the face's edge block positive definite, for any contact stiffness."""
+    import numpy as np
+    import scipy.sparse as sp
+
+    from ngcontact.fem.elasticity import bubble_term
+    mesh = _mesh(3)
+    V = vector_h1(mesh, order=2, definedon=mesh.Materials("body"))
+    u, v = V.TnT()
+    form = ng.BilinearForm(V)
+    form += bubble_term(u, v, 1.3, stiffness, "bottom")
+    form.Assemble()
+    rows, cols, vals = form.mat.COO()
+    B = sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))), shape=(V.ndof, V.ndof))
+    vertex = sorted({d for vx in mesh.vertices for d in V.GetDofNrs(vx) if d >= 0})
+    face = mesh.Boundaries("bottom")
+    edges = sorted({d for el in face.Elements() for e in el.edges for d in V.GetDofNrs(e) if d >= 0})
+    assert abs(B[vertex, :]).max() <= 1e-12 * abs(B).max()
+    block = B[edges][:, edges].toarray()
+    eig = np.linalg.eigvalsh(0.5 * (block + block.T))
+    assert eig.min() > 1e-3 * eig.max() > 0
+    off = sorted(set(range(V.ndof)) - set(edges))
+    assert abs(B[off, :]).max() == 0.0
