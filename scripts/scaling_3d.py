@@ -381,7 +381,8 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
         elasticity.surface_wirebasket(P.X, P.mesh, "contact")
         measure(P.form, "contact surface", "")
     os.makedirs(out, exist_ok=True)
-    write_csv(os.path.join(out, "scaling_3d_coarse.csv"), list(COARSE_KEYS), [[r[k] for k in COARSE_KEYS] for r in rows])
+    write_csv(os.path.join(out, "scaling_3d_coarse.csv"), list(COARSE_KEYS),
+              [[r[k] for k in COARSE_KEYS] for r in rows])
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -172,7 +172,7 @@ class SplitEnergy:
         tangent to round-off, and a preconditioner registered with the whole form (BDDC) built from it.
         With a registered preconditioning form: that form is assembled instead (building the
         preconditioner), and the tangent is summed from its parts once the whole form's matrix exists."""
-        if not self._precondition:
+        if not self._precondition or self.preconditioning is None:
             self.whole.AssembleLinearization(self._at)
         else:
             self.preconditioning.AssembleLinearization(self._at)
