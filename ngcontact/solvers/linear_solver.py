@@ -242,8 +242,8 @@ class LinearSolver:
 MEASURE_RTOL = 1e-12
 
 #: Eisenstat-Walker (choice 2) constants of :func:`forcing_term`: ``eta = GAMMA (|r_k| / |r_k-1|)^2``,
-#: at most ``ETA_MAX``
-EW_GAMMA, ETA_MAX = 0.9, 1e-2
+#: at most ``ETA_MAX``, at least ``ETA_MIN``
+EW_GAMMA, ETA_MAX, ETA_MIN = 0.9, 1e-2, 1e-3
 
 
 def forcing_term(rnorm: float, previous: float | None, eta_previous: float | None, target: float) -> float:
@@ -256,8 +256,16 @@ def forcing_term(rnorm: float, previous: float | None, eta_previous: float | Non
 
     kept above ``GAMMA eta_k-1^2`` when that is above 0.1 (no sudden
     tightening), at most ``ETA_MAX`` (the first step and slow phases: two
-    digits), and at least ``target / (2 |r_k|)``, since the Newton loop
-    stops at ``|r| <= target`` (no over-solving of the last step).  Far
+    digits), at least ``ETA_MIN`` and at least ``target / (2 |r_k|)``,
+    since the Newton loop stops at ``|r| <= target`` (no over-solving of
+    the last step).  ``ETA_MIN``: after the first step of a contact
+    problem the residual has fallen by 1e-3 to 1e-4 (the bodies' linear
+    part is solved), and the formula then asks the next step for 7 digits,
+    while the step's own decrease is bounded by the moving contact set
+    (the residual rose after it, measured).  On the 3D bisinusoid cell
+    (8k, 38.8k, 94.6k dofs) the floor cut CG's iterations from 361, 483,
+    560 to 261, 379, 454 with the same Newton steps (8, 8, 10) and contact
+    fraction.  Far
     from the solution most CG iterations of a fixed ``rtol = 1e-10`` buy
     digits the next Newton step discards; near it the quadratic decrease
     makes ``eta`` small and the steps exact, so the Newton iteration stays
@@ -270,7 +278,7 @@ def forcing_term(rnorm: float, previous: float | None, eta_previous: float | Non
         safeguard = EW_GAMMA * eta_previous ** 2
         if safeguard > 0.1:
             eta = max(eta, safeguard)
-    eta = min(eta, ETA_MAX)
+    eta = max(min(eta, ETA_MAX), ETA_MIN)
     return max(eta, 0.5 * target / rnorm) if rnorm > 0 else eta
 
 

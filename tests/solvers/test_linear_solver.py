@@ -143,9 +143,10 @@ def test_inexact_newton_reaches_the_same_cell_state_with_fewer_cg_iterations():
 
 
 def test_the_forcing_term_follows_the_residual_and_never_over_solves():
-    from ngcontact.solvers.linear_solver import ETA_MAX, forcing_term
+    from ngcontact.solvers.linear_solver import ETA_MAX, ETA_MIN, forcing_term
     assert forcing_term(1.0, None, None, 1e-10) == ETA_MAX                  # first step: two digits
-    assert forcing_term(1e-3, 1.0, ETA_MAX, 1e-12) == pytest.approx(0.9e-6)  # quadratic phase: tight
+    assert forcing_term(0.1, 1.0, ETA_MAX, 1e-12) == pytest.approx(0.9e-2)  # faster decrease: tighter
+    assert forcing_term(1e-3, 1.0, ETA_MAX, 1e-12) == ETA_MIN               # quadratic phase: three digits
     assert forcing_term(0.9, 1.0, ETA_MAX, 1e-12) == ETA_MAX                # slow phase: capped
     assert forcing_term(1e-9, 1e-5, 1e-3, 1e-10) == pytest.approx(0.05)     # the last step: to the target only
 
