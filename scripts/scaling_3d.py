@@ -59,7 +59,7 @@ from ngcontact.output.writer import write_csv
 log = logging.getLogger("scaling_3d")
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CELL_SIZES = (0.12, 0.08, 0.06, 0.045, 0.035)
+CELL_SIZES = (0.12, 0.08, 0.06, 0.045, 0.035, 0.025, 0.016)
 MACRO_SIZES = (0.3, 0.2, 0.14, 0.1, 0.075, 0.041)
 QUICK_CELL, QUICK_MACRO = (0.16, 0.12), (0.35, 0.3)
 AMPLITUDE, PRESSURES = 0.005, (0.00185, 0.0065)
