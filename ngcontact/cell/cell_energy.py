@@ -79,12 +79,22 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
     return form, previous, (quadratic, interface)
 
 
-def preconditioning_form(problem, form: ng.BilinearForm) -> ng.BilinearForm:
+def preconditioning_form(problem, form: ng.BilinearForm) -> ng.BilinearForm | None:
     """The form a BDDC preconditioner of ``form`` is built from: its terms plus each body's bubble term on
     ``S_C`` (:func:`ngcontact.fem.elasticity.bubble_term`, with the body's longitudinal modulus and the contact
     stiffness: ``k_n``, or the augmentation of exact enforcement), so that BDDC's coarse problem needs only
-    the vertex dofs of the contact surface.  Never assembled as the tangent."""
+    the vertex dofs of the contact surface.  Never assembled as the tangent.
+
+    ``None`` where the whole form serves: at order 1 (every dof is a vertex's, no bubbles), and for
+    Coulomb friction with the penalty, whose coupled residual is not an energy's and keeps the contact
+    surface on BDDC's wirebasket (set here, on ``problem.X``).
+    """
     m = problem.model
+    if problem.coulomb_previous is not None:
+        _el.surface_wirebasket(problem.X, problem.mesh, "contact")
+        return None
+    if m.order < 2:
+        return None
     pre = ng.BilinearForm(problem.X, symmetric=True, symmetric_storage=problem.inverse == "sparsecholesky")
     for term in form.integrators:
         pre += term

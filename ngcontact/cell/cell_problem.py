@@ -182,14 +182,7 @@ class CellProblem:
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
         self.form, self.coulomb_previous, self._parts = cell_energy(self, ur, uc, U)
-        # BDDC's coarse problem: the vertices, with the bubble term in a form of its own where the tangent is an
-        # energy's; Coulomb's coupled residual (penalty) is not, and keeps the contact surface on the wirebasket.
-        # At order 1 every dof is a vertex's: no bubbles, the whole form serves
-        self._preconditioning = None
-        if self.coulomb_previous is None and model.order >= 2:
-            self._preconditioning = preconditioning_form(self, self.form)
-        elif self.coulomb_previous is not None:
-            _el.surface_wirebasket(self.X, mesh, "contact")
+        self._preconditioning = preconditioning_form(self, self.form)
         self._split: SplitEnergy | None = None
         self._largest_gap: float | None = None
         # the state as CoefficientFunctions (for results and tests)

@@ -43,7 +43,7 @@ from ngcontact.solvers.newton import fixed_mask, mask_fixed
 
 
 def schur_complement(form, X, dofs, state_vec, linear: LinearSolver) -> np.ndarray:
-    """Schur complement of the tangent of ``form`` at ``state_vec`` on the dofs ``dofs``.
+    """Schur complement of the tangent of the split energy ``form`` at ``state_vec`` on the dofs ``dofs``.
 
     ``K_II`` (the free dofs of ``X`` without ``dofs``) is inverted by the
     cell's linear-solver policy (:meth:`~ngcontact.solvers.linear_solver.LinearSolver.exact_inverse`:
@@ -56,8 +56,7 @@ def schur_complement(form, X, dofs, state_vec, linear: LinearSolver) -> np.ndarr
     for d in dofs:
         free.Clear(d)
     linear.register(form, free)
-    if hasattr(form, "renew_preconditioner"):
-        form.renew_preconditioner()          # a split energy: its preconditioner is built anew on these free dofs
+    form.renew_preconditioner()              # its preconditioner is built anew on these free dofs
     try:
         form.AssembleLinearization(state_vec)
         K = form.mat
