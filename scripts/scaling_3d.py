@@ -285,7 +285,7 @@ def breakdown(size: float, out: str) -> dict:
             P.solve(cell_loads(scene)[0], first=True, measure=False)
         finally:
             K.CGSolver._SolveImpl = solve
-        A = P.energy().whole.mat
+        A = P.energy().mat
         pre = next(iter(P.linear._pre.values())).mat
         x, y = A.CreateColVector(), A.CreateColVector()
         x.SetRandom()
@@ -358,7 +358,7 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
         default = elasticity.BUBBLE_GAMMA
 
         def measure(form, coarse, gamma):
-            pre = ng.Preconditioner(form, "bddc")
+            pre = ng.Preconditioner(getattr(form, "form", form), "bddc")
             form.AssembleLinearization(P.gfu.vec)
             x = A.CreateColVector()
             cg = CGSolver(A, pre.mat, tol=1e-8, maxiter=5000, printrates=False)
@@ -375,7 +375,7 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
         try:
             for gamma in COARSE_GAMMAS:
                 elasticity.BUBBLE_GAMMA = gamma
-                measure(preconditioning_form(P, P.form), "vertices + bubble term", gamma)
+                measure(preconditioning_form(P), "vertices + bubble term", gamma)
         finally:
             elasticity.BUBBLE_GAMMA = default
         elasticity.surface_wirebasket(P.X, P.mesh, "contact")

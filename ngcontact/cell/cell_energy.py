@@ -30,6 +30,7 @@ from __future__ import annotations
 import ngsolve as ng
 
 from ngcontact.fem import elasticity as _el
+from ngcontact.solvers.state_form import StateForm
 from ngcontact.laws import penalty as _contact
 
 
@@ -42,9 +43,6 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
     Psi)``: the bodies with the load potential (quadratic) and the interface
     energy, with the same terms (for :class:`ngcontact.solvers.split_energy.SplitEnergy`).
     """
-    m = problem.model
-    previous = None
-
     def new_form():
         # UMFPACK reads only one triangle of a symmetric-storage matrix: full storage for it
         return ng.BilinearForm(problem.X, symmetric=True, symmetric_storage=problem.inverse == "sparsecholesky")
@@ -53,37 +51,22 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
         form += term
         quadratic += term
     J = ur - uc - U
-    lam = None if problem.multiplier is None else problem.multiplier.value
-    friction = threshold = w = None
-    if m.friction is not None:
-        friction, w = m.friction.law, m.friction.w
-        if friction == "tresca":
-            threshold = m.friction.G
-        elif lam is not None:
-            # exact: mu lambda of the multiplier Uzawa holds fixed in this Newton solve, so
-            # Uzawa's iteration is the Coulomb fixed point as well (cell_problem's docstring)
-            threshold = m.friction.mu * lam
-        else:
-            previous = ng.GridFunction(problem.X)
-            pc = previous.components
-            J_prev = pc[0] - pc[1] - ng.CF(tuple(pc[2:]))
-            threshold = _contact.coulomb_threshold(J_prev, problem.n, m.k_n, m.friction.mu, problem.gap)
-    k = m.k_n if lam is None else problem.augmentation
-    psi = _contact.interface_energy(J, problem.n, k_n=k, gap=problem.gap, friction=friction,
-                                    w=w, threshold=threshold, multiplier=lam)
-    ds = (ng.ds("contact", bonus_intorder=m.contact_bonus_order) if problem.multiplier is None
-          else problem.multiplier.ds)
-    term = ng.Variation(psi * ds)
+    parameters, previous = _interface_parameters(problem)
+    psi = _contact.interface_energy(J, problem.n, **parameters)
+    term = ng.Variation(psi * _contact_measure(problem))
     form += term
     interface += term
     return form, previous, (quadratic, interface)
 
 
-def preconditioning_form(problem, form: ng.BilinearForm) -> ng.BilinearForm | None:
-    """The form a BDDC preconditioner of ``form`` is built from: its terms plus each body's bubble term on
-    ``S_C`` (:func:`ngcontact.fem.elasticity.bubble_term`, with the body's longitudinal modulus and the contact
+def preconditioning_form(problem) -> StateForm | None:
+    """The form a BDDC preconditioner of the cell's tangent is built from: the tangent itself, written as a
+    bilinear form of the state (the bodies' elasticity and :func:`ngcontact.laws.penalty.interface_stiffness`
+    of the same interface energy, with the same quadrature), plus each body's bubble term on ``S_C``
+    (:func:`ngcontact.fem.elasticity.bubble_term`, with the body's longitudinal modulus and the contact
     stiffness: ``k_n``, or the augmentation of exact enforcement), so that BDDC's coarse problem needs only
-    the vertex dofs of the contact surface.  Never assembled as the tangent.
+    the vertex dofs of the contact surface.  Never assembled as the tangent; assembled by ``Assemble``, at
+    half the cost of linearizing the ``Variation`` terms (:mod:`ngcontact.solvers.state_form`).
 
     ``None`` where the whole form serves: at order 1 (every dof is a vertex's, no bubbles), and for
     Coulomb friction with the penalty, whose coupled residual is not an energy's and keeps the contact
@@ -96,13 +79,25 @@ def preconditioning_form(problem, form: ng.BilinearForm) -> ng.BilinearForm | No
     if m.order < 2:
         return None
     pre = ng.BilinearForm(problem.X, symmetric=True, symmetric_storage=problem.inverse == "sparsecholesky")
-    for term in form.integrators:
-        pre += term
     trial, test = problem.X.TnT()
-    k = m.k_n if problem.multiplier is None else problem.augmentation
+    state = ng.GridFunction(problem.X)
+    for i, (name, law) in enumerate((("rough", m.rough), ("counter", m.counter))):
+        eps, eps_v = _el.strain(trial[i], problem.setting), _el.strain(test[i], problem.setting)
+        pre += ng.InnerProduct(law.stress(eps), eps_v) * ng.dx(definedon=problem.mesh.Materials(name))
+    s = state.components
+
+    def jump(u):
+        return u[0] - u[1] - ng.CF(tuple(u[2:]))
+    parameters, _ = _interface_parameters(problem)
+    pre += _contact.interface_stiffness(jump(s), problem.n, jump(trial), jump(test),
+                                        **parameters) * _contact_measure(problem)
     for i, law in enumerate((m.rough, m.counter)):
-        pre += _el.bubble_term(trial[i], test[i], law.longitudinal_modulus, k, "contact")
-    return pre
+        pre += _el.bubble_term(trial[i], test[i], law.longitudinal_modulus, parameters["k_n"], "contact")
+    # the load's potential is linear in U, its second variation zero; its face's elements couple U with the
+    # face's dofs all the same, so that this form's sparsity is the whole form's (SplitEnergy.rebuild)
+    U, V = ng.CF(tuple(trial[2:])), ng.CF(tuple(test[2:]))
+    pre += 0.0 * ng.InnerProduct(U, V) * ng.ds("top")
+    return StateForm(pre, state)
 
 
 def coulomb_residual(problem) -> ng.BilinearForm:
@@ -122,12 +117,43 @@ def coulomb_residual(problem) -> ng.BilinearForm:
         form += term
     J = ur - uc - U
     dJ = test[0] - test[1] - ng.CF(tuple(test[2:]))
-    ds = ng.ds("contact", bonus_intorder=m.contact_bonus_order)
+    ds = _contact_measure(problem)
     form += ng.Variation(_contact.normal_energy(J, problem.n, m.k_n, problem.gap) * ds)
     G = _contact.coulomb_threshold(J, problem.n, m.k_n, fr.mu, problem.gap)
     form += ng.InnerProduct(_contact.friction_traction(J, problem.n, G, fr.w), dJ) * ds
     form += _load(problem, U)
     return form
+
+
+def _interface_parameters(problem) -> tuple[dict, ng.GridFunction | None]:
+    """The keywords of the interface energy (:func:`ngcontact.laws.penalty.interface_energy`) and, for
+    Coulomb friction with the penalty, the frozen previous state whose pressure sets the threshold."""
+    m = problem.model
+    lam = None if problem.multiplier is None else problem.multiplier.value
+    friction = threshold = w = previous = None
+    if m.friction is not None:
+        friction, w = m.friction.law, m.friction.w
+        if friction == "tresca":
+            threshold = m.friction.G
+        elif lam is not None:
+            # exact: mu lambda of the multiplier Uzawa holds fixed in this Newton solve, so
+            # Uzawa's iteration is the Coulomb fixed point as well (cell_problem's docstring)
+            threshold = m.friction.mu * lam
+        else:
+            previous = ng.GridFunction(problem.X)
+            pc = previous.components
+            J_prev = pc[0] - pc[1] - ng.CF(tuple(pc[2:]))
+            threshold = _contact.coulomb_threshold(J_prev, problem.n, m.k_n, m.friction.mu, problem.gap)
+    k = m.k_n if lam is None else problem.augmentation
+    return dict(k_n=k, gap=problem.gap, friction=friction, w=w, threshold=threshold, multiplier=lam), previous
+
+
+def _contact_measure(problem):
+    """``ds`` on ``S_C``: with the contact bonus order (the penalty's kink), or exact enforcement's
+    Gauss-Lobatto nodes."""
+    if problem.multiplier is None:
+        return ng.ds("contact", bonus_intorder=problem.model.contact_bonus_order)
+    return problem.multiplier.ds
 
 
 def _bodies(problem, ur, uc) -> list:

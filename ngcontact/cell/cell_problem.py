@@ -182,7 +182,7 @@ class CellProblem:
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
         self.form, self.coulomb_previous, self._parts = cell_energy(self, ur, uc, U)
-        self._preconditioning = preconditioning_form(self, self.form)
+        self._preconditioning = preconditioning_form(self)
         self._split: SplitEnergy | None = None
         self._largest_gap: float | None = None
         # the state as CoefficientFunctions (for results and tests)

@@ -58,7 +58,7 @@ from dataclasses import dataclass
 
 import ngsolve as ng
 
-from ngcontact.laws.huber import huber, huber_of_square  # noqa: F401  (huber: part of the micro law's API)
+from ngcontact.laws.huber import huber, huber_of_square, huber_slope  # noqa: F401  (huber: the micro law's API)
 from ngcontact.errors import ModelError
 
 
@@ -201,3 +201,40 @@ def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=No
     if w is None or threshold is None:
         raise ModelError("friction needs a width w and a threshold")
     return energy + tresca_energy(J, n, threshold, w)
+
+
+def interface_stiffness(J, n, dJ, dJv, *, k_n, gap=None, friction=None, w=None, threshold=None, multiplier=None):
+    """The second variation of :func:`interface_energy` at the jump ``J``, bilinear in ``dJ`` and ``dJv``:
+
+        d2 psi(J)[dJ, dJv] = k H(s) (dJ.n)(dJv.n)
+                             + G ( P dJ . P dJv / m  -  [|J_t| > w] (J_t.dJ)(J_t.dJv) / |J_t|^3 ),
+
+    ``s = J_n - g`` (penalty, ``k = k_n``, eq. 9) or ``s = lambda + k (J_n - g)``
+    (augmented, the multiplier held fixed), ``H`` the derivative of ``[.]_+``
+    taken as :func:`positive_part` takes it (1 at ``s = 0``), ``P = I - n n``,
+    ``m = max(|J_t|, w)`` (the Huber function's two branches, eqs. 16-17, the
+    threshold ``G`` fixed as in :func:`interface_energy`).
+
+    The same numbers as NGSolve's linearization of the ``Variation`` of
+    :func:`interface_energy` (tested to round-off), as a *bilinear* density
+    of a state: a form built from it is assembled by ``Assemble``, which
+    costs half of the automatic second derivative (a BDDC preconditioner
+    rebuilt from it: :func:`ngcontact.cell.cell_energy.preconditioning_form`).
+    """
+    s = penetration(J, n, gap)
+    if multiplier is not None:
+        s = multiplier + k_n * s
+    stiffness = k_n * ng.IfPos(-s, 0.0, 1.0) * ng.InnerProduct(dJ, n) * ng.InnerProduct(dJv, n)
+    if friction is None:
+        return stiffness
+    if friction not in ("tresca", "coulomb"):
+        raise ModelError(f"friction = {friction!r}: must be None, 'tresca' or 'coulomb'")
+    if w is None or threshold is None:
+        raise ModelError("friction needs a width w and a threshold")
+    Jt = tangential_slip(J, n)
+    s2 = ng.InnerProduct(Jt, Jt)
+    slope = huber_slope(s2, w)
+    sliding = ng.IfPos(s2 - w * w, slope * slope * slope, 0.0)
+    tangential = (slope * ng.InnerProduct(tangential_slip(dJ, n), tangential_slip(dJv, n))
+                  - sliding * ng.InnerProduct(Jt, dJ) * ng.InnerProduct(Jt, dJv))
+    return stiffness + threshold * tangential

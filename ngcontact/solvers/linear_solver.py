@@ -313,7 +313,7 @@ def _key(form) -> int:
     """Which registered preconditioner serves ``form``: that of its preconditioning form, of its whole form (a
     split energy), or of the form itself."""
     pre = getattr(form, "preconditioning", None)
-    return id(pre if pre is not None else getattr(form, "whole", form))
+    return id(pre.form if pre is not None else getattr(form, "whole", form))
 
 
 def match_free_dofs(space, freedofs) -> None:

@@ -39,18 +39,22 @@ the whole form's assembly (it allocates the matrix), and so is
 steps' tangents, until the linear solver finds it stale
 (:class:`ngcontact.solvers.linear_solver.LinearSolver`).
 
-A split energy may carry a *preconditioning* form: the whole form's terms
-plus terms meant for the preconditioner alone (the contact surface's bubble
-term, :func:`ngcontact.fem.elasticity.bubble_term`).  Once a preconditioner
-is registered with it (:meth:`SplitEnergy.preconditioner_form`), a rebuild
-assembles that form, which builds the preconditioner, and writes the
-tangent ``K + Psi''`` into the whole form's matrix from its parts: the
-tangent never holds the extra terms.
+A split energy may carry a *preconditioning* form
+(:class:`ngcontact.solvers.state_form.StateForm`): the tangent written as a
+bilinear form of the state, plus terms meant for the preconditioner alone
+(the contact surface's bubble term,
+:func:`ngcontact.fem.elasticity.bubble_term`).  Once a preconditioner is
+registered with it (:meth:`SplitEnergy.preconditioner_form`), a rebuild
+assembles that form at the state, which builds the preconditioner, and
+writes the tangent ``K + Psi''`` into the whole form's matrix from its
+parts: the tangent never holds the extra terms.
 """
 from __future__ import annotations
 
 import ngsolve as ng
 import numpy as np
+
+from ngcontact.solvers.state_form import StateForm
 
 
 _UNSET = object()   # no load parameters seen yet
@@ -75,12 +79,12 @@ class SplitEnergy:
         ``quadratic`` is assembled already (``K`` shared with another split
         energy of the same bodies, e.g. with another interface law).
     preconditioning
-        The form a preconditioner is built from instead of ``whole`` (module
-        docstring); ``None``: ``whole``.
+        The form, linearized at a state, a preconditioner is built from instead
+        of ``whole`` (module docstring); ``None``: ``whole``.
     """
 
     def __init__(self, whole: ng.BilinearForm, quadratic: ng.BilinearForm, interface: ng.BilinearForm, key,
-                 assembled: bool = False, preconditioning: ng.BilinearForm | None = None):
+                 assembled: bool = False, preconditioning: StateForm | None = None):
         self.whole, self.quadratic, self.interface, self.key = whole, quadratic, interface, key
         self.preconditioning = preconditioning
         self._precondition = False      # a preconditioner is registered with ``preconditioning``
@@ -93,6 +97,7 @@ class SplitEnergy:
         # after the whole form's first assembly: where the interface's entries go, K in the whole storage
         self._slots_psi: np.ndarray | None = None
         self._K_whole: np.ndarray | None = None
+        self._matrix = None     # the tangent's own matrix, when the whole form is never assembled
         self._loads: object = _UNSET
         self._g = zero.CreateVector()
         self._c = 0.0
@@ -105,8 +110,9 @@ class SplitEnergy:
 
     @property
     def mat(self):
-        """The tangent ``K + Psi''`` of the last :meth:`AssembleLinearization` (the whole form's matrix)."""
-        return self.whole.mat
+        """The tangent ``K + Psi''`` of the last :meth:`AssembleLinearization`: the whole form's matrix, or a
+        matrix of the preconditioning form's sparsity (:meth:`rebuild`)."""
+        return self.whole.mat if self._matrix is None else self._matrix
 
     def _linear_part(self) -> None:
         loads = self.key()
@@ -132,15 +138,12 @@ class SplitEnergy:
 
     def AssembleLinearization(self, vec) -> None:  # noqa: N802
         """``mat = K + Psi''(vec)``: the first time by the whole form's assembly, which allocates its
-        matrix, then from ``K`` and the interface's assembly alone."""
+        matrix (or, with a registered preconditioning form, by that form's assembly, whose matrix has the
+        same sparsity), then from ``K`` and the interface's assembly alone."""
         self._at.data = vec
         self.interface.AssembleLinearization(vec)
         if self._K_whole is None:
             self.rebuild()
-            whole = self.whole.mat
-            self._slots_psi = _positions(whole, self.interface.mat)
-            self._K_whole = np.zeros(whole.nze)
-            self._K_whole[_positions(whole, self.K)] = self.K.AsVector().FV().NumPy()
             return
         if self._renew:
             self.rebuild()
@@ -150,7 +153,7 @@ class SplitEnergy:
 
     def _sum_parts(self) -> None:
         """``whole.mat = K + Psi''`` from ``K`` and the interface's last assembly."""
-        vals = self.whole.mat.AsVector().FV().NumPy()
+        vals = self.mat.AsVector().FV().NumPy()
         vals[:] = self._K_whole
         vals[self._slots_psi] += self.interface.mat.AsVector().FV().NumPy()
 
@@ -160,7 +163,7 @@ class SplitEnergy:
         if self.preconditioning is None:
             return self.whole
         self._precondition = True
-        return self.preconditioning
+        return self.preconditioning.form
 
     def renew_preconditioner(self) -> None:
         """The whole form was assembled elsewhere (e.g. on other free dofs, for a measurement): the next
@@ -171,17 +174,27 @@ class SplitEnergy:
         """Assemble the whole form at the state of the last :meth:`AssembleLinearization`: the same
         tangent to round-off, and a preconditioner registered with the whole form (BDDC) built from it.
         With a registered preconditioning form: that form is assembled instead (building the
-        preconditioner), and the tangent is summed from its parts once the whole form's matrix exists."""
+        preconditioner), and the tangent is summed from its parts into a matrix of that form's sparsity,
+        allocated at the first rebuild (the bodies and the contact surface couple the same dofs in both
+        forms, so the whole form, whose assembly costs as much again, is never assembled)."""
         if not self._precondition or self.preconditioning is None:
             self.whole.AssembleLinearization(self._at)
+            if self._K_whole is None:
+                self._locate(self.whole.mat)
         else:
             self.preconditioning.AssembleLinearization(self._at)
             if self._K_whole is None:
-                self.whole.AssembleLinearization(self._at)      # allocates the tangent's matrix
-            else:
-                self._sum_parts()
+                self._matrix = self.preconditioning.form.mat.CreateMatrix()
+                self._locate(self._matrix)
+            self._sum_parts()
         self.assembled_whole = True
         self._renew = False
+
+    def _locate(self, matrix) -> None:
+        """Where ``K``'s and the interface's entries sit in the tangent's ``matrix`` (once)."""
+        self._slots_psi = _positions(matrix, self.interface.mat)
+        self._K_whole = np.zeros(matrix.nze)
+        self._K_whole[_positions(matrix, self.K)] = self.K.AsVector().FV().NumPy()
 
 
 def _positions(whole, part) -> np.ndarray:

@@ -101,3 +101,38 @@ def test_no_friction_term_when_frictionless():
     assert e(mesh(0.5, 0.5)) == pytest.approx(0.5 * 2.0 * 0.1 ** 2, rel=1e-15)
     with pytest.raises(ValueError):
         contact.interface_energy(J, n, k_n=2.0, friction="tresca")
+
+
+@pytest.mark.parametrize("case", ["normal", "augmented", "tresca-stick", "tresca-slip", "augmented-tresca-slip"])
+def test_interface_stiffness_is_the_linearization_of_the_interface_energy(case):
+    """The written-out second variation (a bilinear form of the state, assembled by ``Assemble``) equals
+    NGSolve's linearization of the energy's ``Variation`` entry by entry, in stick and slip, with and
+    without a multiplier (the augmented energy), at a state where some points are open and some closed."""
+    friction = Friction("tresca", w=W, G=0.01) if "tresca" in case else None
+    P = _problem(friction)
+    slip = 5 * W if "slip" in case else 0.3 * W
+    _set_state(P, slip, np.random.default_rng(4))
+    counter = ng.GridFunction(P.X.components[1])       # lifted along half of the period: open points
+    counter.Set(ng.CF((0.0, 0.05 * ng.sin(2 * np.pi * ng.x))))
+    P.gfu.components[1].vec.data += counter.vec
+    keywords = dict(k_n=50.0, friction=None if friction is None else "tresca", w=W,
+                    threshold=None if friction is None else friction.G,
+                    multiplier=ng.CF(0.2) if "augmented" in case else None)
+    trial, test = P.X.TnT()
+    s = P.gfu.components
+
+    def jump(u):
+        return u[0] - u[1] - ng.CF(tuple(u[2:]))
+    ds = ng.ds("contact", bonus_intorder=4)
+    automatic = ng.BilinearForm(P.X, symmetric=True)
+    automatic += ng.Variation(contact.interface_energy(jump(trial), P.n, **keywords) * ds)
+    automatic.AssembleLinearization(P.gfu.vec)
+    written = ng.BilinearForm(P.X, symmetric=True)
+    written += contact.interface_stiffness(jump(s), P.n, jump(trial), jump(test), **keywords) * ds
+    written.Assemble()
+    a, b = automatic.mat.AsVector().FV().NumPy(), written.mat.AsVector().FV().NumPy()
+    assert np.max(np.abs(a)) > 1.0 and np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(a))
+    # both regimes of the case are present: closed and open points (and slipping ones in slip)
+    at = sample_surface(P, {"s": contact.penetration(jump(s), P.n), "t": contact.slip_magnitude(jump(s), P.n)})
+    assert at["s"].min() < 0 < at["s"].max()
+    assert (at["t"].min() > W) if "slip" in case else (at["t"].max() < W)
