@@ -151,6 +151,7 @@ class LocalPool(Executor):
         self.workers = workers
         self._pool = None
         self._started = None
+        self._processes: dict = {}      # every worker process of the current pool, by pid
         self.on_demand = False
 
     def _start(self):
@@ -158,6 +159,7 @@ class LocalPool(Executor):
         from concurrent.futures import ProcessPoolExecutor
         ctx = multiprocessing.get_context("spawn")
         self._started = ctx.SimpleQueue()
+        self._processes = {}
         self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx, initializer=_worker_start,
                                          initargs=(self._started,))
         return self._pool
@@ -221,6 +223,8 @@ class LocalPool(Executor):
 
         def submit(k):
             pending[pool.submit(_pool_member, fn, items[k], names[k], failures[k], fault)] = k
+            # the pool spawns its workers on submission and forgets them once one dies: keep them
+            self._processes.update(pool._processes or {})
 
         try:
             for k in range(len(items)):
@@ -283,10 +287,12 @@ class LocalPool(Executor):
         while not self._started.empty():
             pid, name = self._started.get()
             last[pid] = name
-        processes = dict(self._pool._processes or {}) if self._pool is not None else {}
+        processes = dict(self._processes)
+        if self._pool is not None:
+            processes.update(self._pool._processes or {})
         for proc in processes.values():
             proc.join(timeout=2)             # reap: a dead process may still look alive
-        died = {pid for pid, proc in processes.items() if proc.exitcode not in (None, -signal.SIGTERM)}
+        died = {pid for pid, proc in processes.items() if _exit_code(proc) not in (None, -signal.SIGTERM)}
         return {name for pid, name in last.items() if pid in died}
 
     def _discard(self) -> None:
@@ -315,6 +321,15 @@ class LocalPool(Executor):
 
 
 _STARTED = None
+
+
+def _exit_code(proc, seconds: float = 2.0):
+    """A joined worker's exit code.  The pool's own thread reaps its workers too: while it holds a dead
+    worker's status, ``exitcode`` reads ``None`` for a moment, so ``None`` is read again until ``seconds``."""
+    deadline = time.monotonic() + seconds
+    while proc.exitcode is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    return proc.exitcode
 
 
 def _worker_start(started) -> None:
