@@ -9,7 +9,10 @@ the residual and whose second derivative the tangent of Newton's method
 density ``psi`` (:func:`ngcontact.laws.penalty.interface_energy`):
 
 * penalty: ``k_n/2 [J.n - g]_+^2`` (eq. 65), integrated with the contact
-  bonus order (the penalty has a kink);
+  bonus order (the penalty has a kink); where the penetration is a
+  polynomial per element, Newton integrates it with that order on the
+  contact edge's elements only, to the same numbers
+  (:mod:`ngcontact.cell.contact_quadrature`);
 * exact: the augmented Lagrangian with the multiplier held fixed, at the
   Gauss-Lobatto nodes of :mod:`ngcontact.cell.contact_multiplier`;
 * friction ``G huber(|J_t|, w)`` (eqs. 57, 65): Tresca ``G``; Coulomb
@@ -43,10 +46,7 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
     Psi)``: the bodies with the load potential (quadratic) and the interface
     energy, with the same terms (for :class:`ngcontact.solvers.split_energy.SplitEnergy`).
     """
-    def new_form():
-        # UMFPACK reads only one triangle of a symmetric-storage matrix: full storage for it
-        return ng.BilinearForm(problem.X, symmetric=True, symmetric_storage=problem.inverse == "sparsecholesky")
-    form, quadratic, interface = new_form(), new_form(), new_form()
+    form, quadratic, interface = _new_form(problem), _new_form(problem), _new_form(problem)
     for term in _bodies(problem, ur, uc) + [_load(problem, U)]:
         form += term
         quadratic += term
@@ -59,14 +59,24 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
     return form, previous, (quadratic, interface)
 
 
-def preconditioning_form(problem) -> StateForm | None:
+def interface_tangent(problem, state: ng.GridFunction) -> StateForm:
+    """The interface's second variation ``Psi''`` at ``state``, written out as a bilinear form of the state
+    (:func:`ngcontact.laws.penalty.interface_stiffness` of the energy's own parameters and quadrature):
+    the same matrix as linearizing the energy's ``Variation`` term, assembled by ``Assemble`` in about
+    half its time (:mod:`ngcontact.solvers.state_form`; the split energy's tangent)."""
+    form = _new_form(problem)
+    form += _interface_stiffness(problem, state)
+    return StateForm(form, state)
+
+
+def preconditioning_form(problem, state: ng.GridFunction, quadrature=None) -> StateForm | None:
     """The form a BDDC preconditioner of the cell's tangent is built from: the tangent itself, written as a
-    bilinear form of the state (the bodies' elasticity and :func:`ngcontact.laws.penalty.interface_stiffness`
-    of the same interface energy, with the same quadrature), plus each body's bubble term on ``S_C``
-    (:func:`ngcontact.fem.elasticity.bubble_term`, with the body's longitudinal modulus and the contact
-    stiffness: ``k_n``, or the augmentation of exact enforcement), so that BDDC's coarse problem needs only
-    the vertex dofs of the contact surface.  Never assembled as the tangent; assembled by ``Assemble``, at
-    half the cost of linearizing the ``Variation`` terms (:mod:`ngcontact.solvers.state_form`).
+    bilinear form of ``state`` (the bodies' elasticity and :func:`interface_tangent`'s term), plus each
+    body's bubble term on ``S_C`` (:func:`ngcontact.fem.elasticity.bubble_term`, with the body's
+    longitudinal modulus and the contact stiffness: ``k_n``, or the augmentation of exact enforcement), so
+    that BDDC's coarse problem needs only the vertex dofs of the contact surface.  Never assembled as the
+    tangent.  ``quadrature``: the split contact quadrature
+    (:class:`ngcontact.cell.contact_quadrature.ContactQuadrature`) whose measures the interface term uses.
 
     ``None`` where the whole form serves: at order 1 (every dof is a vertex's, no bubbles), and for
     Coulomb friction with the penalty, whose coupled residual is not an energy's and keeps the contact
@@ -78,26 +88,43 @@ def preconditioning_form(problem) -> StateForm | None:
         return None
     if m.order < 2:
         return None
-    pre = ng.BilinearForm(problem.X, symmetric=True, symmetric_storage=problem.inverse == "sparsecholesky")
+    pre = _new_form(problem)
     trial, test = problem.X.TnT()
-    state = ng.GridFunction(problem.X)
     for i, (name, law) in enumerate((("rough", m.rough), ("counter", m.counter))):
         eps, eps_v = _el.strain(trial[i], problem.setting), _el.strain(test[i], problem.setting)
         pre += ng.InnerProduct(law.stress(eps), eps_v) * ng.dx(definedon=problem.mesh.Materials(name))
-    s = state.components
-
-    def jump(u):
-        return u[0] - u[1] - ng.CF(tuple(u[2:]))
-    parameters, _ = _interface_parameters(problem)
-    pre += _contact.interface_stiffness(jump(s), problem.n, jump(trial), jump(test),
-                                        **parameters) * _contact_measure(problem)
+    if quadrature is None:
+        pre += _interface_stiffness(problem, state)
+    else:
+        for term in quadrature.stiffness_terms(trial, test):
+            pre += term
+    k = m.k_n if problem.multiplier is None else problem.augmentation
     for i, law in enumerate((m.rough, m.counter)):
-        pre += _el.bubble_term(trial[i], test[i], law.longitudinal_modulus, parameters["k_n"], "contact")
+        pre += _el.bubble_term(trial[i], test[i], law.longitudinal_modulus, k, "contact")
     # the load's potential is linear in U, its second variation zero; its face's elements couple U with the
     # face's dofs all the same, so that this form's sparsity is the whole form's (SplitEnergy.rebuild)
-    U, V = ng.CF(tuple(trial[2:])), ng.CF(tuple(test[2:]))
-    pre += 0.0 * ng.InnerProduct(U, V) * ng.ds("top")
+    pre += 0.0 * ng.InnerProduct(_jump(trial)[1], _jump(test)[1]) * ng.ds("top")
     return StateForm(pre, state)
+
+
+def _interface_stiffness(problem, state):
+    """The integrand of ``Psi''(state)`` on ``S_C`` with its measure."""
+    trial, test = problem.X.TnT()
+    parameters, _ = _interface_parameters(problem, problem.coulomb_previous)
+    J = _jump(state.components)[0]
+    return (_contact.interface_stiffness(J, problem.n, _jump(trial)[0], _jump(test)[0], **parameters)
+            * _contact_measure(problem))
+
+
+def _jump(u) -> tuple:
+    """``(J, U)`` of the components ``(u_r, u_c, U...)``: the jump ``u_r - u_c - U`` and ``U``."""
+    U = ng.CF(tuple(u[2:]))
+    return u[0] - u[1] - U, U
+
+
+def _new_form(problem) -> ng.BilinearForm:
+    # UMFPACK reads only one triangle of a symmetric-storage matrix: full storage for it
+    return ng.BilinearForm(problem.X, symmetric=True, symmetric_storage=problem.inverse == "sparsecholesky")
 
 
 def coulomb_residual(problem) -> ng.BilinearForm:
@@ -125,12 +152,13 @@ def coulomb_residual(problem) -> ng.BilinearForm:
     return form
 
 
-def _interface_parameters(problem) -> tuple[dict, ng.GridFunction | None]:
+def _interface_parameters(problem, previous=None) -> tuple[dict, ng.GridFunction | None]:
     """The keywords of the interface energy (:func:`ngcontact.laws.penalty.interface_energy`) and, for
-    Coulomb friction with the penalty, the frozen previous state whose pressure sets the threshold."""
+    Coulomb friction with the penalty, the frozen previous state whose pressure sets the threshold
+    (``previous``, or a new GridFunction)."""
     m = problem.model
     lam = None if problem.multiplier is None else problem.multiplier.value
-    friction = threshold = w = previous = None
+    friction = threshold = w = None
     if m.friction is not None:
         friction, w = m.friction.law, m.friction.w
         if friction == "tresca":
@@ -140,7 +168,7 @@ def _interface_parameters(problem) -> tuple[dict, ng.GridFunction | None]:
             # Uzawa's iteration is the Coulomb fixed point as well (cell_problem's docstring)
             threshold = m.friction.mu * lam
         else:
-            previous = ng.GridFunction(problem.X)
+            previous = ng.GridFunction(problem.X) if previous is None else previous
             pc = previous.components
             J_prev = pc[0] - pc[1] - ng.CF(tuple(pc[2:]))
             threshold = _contact.coulomb_threshold(J_prev, problem.n, m.k_n, m.friction.mu, problem.gap)

@@ -69,7 +69,9 @@ from ngcontact.cell import measures
 from ngcontact.cell.contact_multiplier import TRIANGLE_MAX_ORDER, ContactMultiplier, solve_exact
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
 from ngcontact.cell.cell_model import CellModel, CellSolution
-from ngcontact.cell.cell_energy import cell_energy, macro_strain_cf, preconditioning_form
+from ngcontact.cell.cell_energy import cell_energy, interface_tangent, macro_strain_cf, preconditioning_form
+from ngcontact.cell.contact_quadrature import ContactQuadrature
+from ngcontact.cell.contact_quadrature import applies as quadrature_applies
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
 from ngcontact.cell.predictor import max_gap, rigid_continuation, rigid_translation, set_start, tangential_load
@@ -182,7 +184,11 @@ class CellProblem:
         trial = self.X.TrialFunction()
         ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
         self.form, self.coulomb_previous, self._parts = cell_energy(self, ur, uc, U)
-        self._preconditioning = preconditioning_form(self)
+        # the state the written-out tangent and the preconditioning form are assembled at
+        self._linearized_at = ng.GridFunction(self.X)
+        # the penalty's high quadrature on the contact edge's elements only, where that is exact
+        self._quadrature = ContactQuadrature(self, self._linearized_at) if quadrature_applies(self) else None
+        self._preconditioning = preconditioning_form(self, self._linearized_at, self._quadrature)
         self._split: SplitEnergy | None = None
         self._largest_gap: float | None = None
         # the state as CoefficientFunctions (for results and tests)
@@ -306,15 +312,29 @@ class CellProblem:
         if self._split is None:
             loads = self.traction + self.strain_params
             quadratic, interface = self._parts
+            tangent = None
+            if self._quadrature is not None:
+                interface = self._quadrature
+            else:
+                tangent = interface_tangent(self, self._linearized_at)
             self._split = SplitEnergy(self.form, quadratic, interface, key=lambda: tuple(p.Get() for p in loads),
-                                      preconditioning=self._preconditioning)
+                                      preconditioning=self._preconditioning, interface_tangent=tangent)
         return self._split
 
     def _newton_once(self, free, atol) -> dict:
+        if self._quadrature is not None:
+            self._quadrature.restart(self.gfu.vec)
         h = minimize(self.energy(), self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
                      max_iter=self.max_iter, linear=self.linear, line_search=self.line_search,
-                     active_set=self.active_set)
-        return h.as_dict()
+                     active_set=self.active_set).as_dict()
+        target = max(self.rtol * h["residuals"][0], atol)
+        # the split quadrature's high rule must hold every element the solution cuts: else on from there
+        while self._quadrature is not None and not self._quadrature.covers(self.gfu.vec):
+            more = minimize(self.energy(), self.gfu, freedofs=free, rtol=0.0, atol=target,
+                            max_iter=self.max_iter, linear=self.linear, line_search=self.line_search,
+                            active_set=self.active_set).as_dict()
+            h = _continued(h, more)
+        return h
 
     def active_set(self, gfu=None) -> bytes:
         """Signature of the contact state: which quadrature points of ``S_C`` penetrate.
@@ -370,6 +390,17 @@ def start_multiplier(problem: CellProblem, load: CellLoad) -> None:
 
 
 # ------------------------------------------------------------ discretization
+def _continued(first: dict, more: dict) -> dict:
+    """The history of a Newton solve continued from its end by ``more``."""
+    out = dict(more)
+    out["iterations"] = first["iterations"] + more["iterations"]
+    for key in ("residuals", "energies"):
+        out[key] = first[key] + more[key][1:]
+    for key in ("step_lengths", "active_set_sizes"):
+        out[key] = first.get(key, []) + more.get(key, [])
+    return out
+
+
 def _discrete_gap(mesh, model: CellModel):
     """The gap interpolated into polynomials of the displacement order on ``S_C``.
 

@@ -70,7 +70,9 @@ class SplitEnergy:
     quadratic
         The form of ``Q`` (same space and storage): the bodies and the load potentials.
     interface
-        The form of ``Psi`` (same space and storage).
+        The form of ``Psi`` (same space and storage), or an object answering the same
+        ``Apply``, ``Energy``, ``AssembleLinearization`` and ``mat`` (e.g.
+        :class:`ngcontact.cell.contact_quadrature.ContactQuadrature`).
     key
         ``key() -> hashable``: the values of the parameters ``g`` and ``c``
         depend on (e.g. the load's ``Parameter`` values); ``K`` must not
@@ -81,11 +83,18 @@ class SplitEnergy:
     preconditioning
         The form, linearized at a state, a preconditioner is built from instead
         of ``whole`` (module docstring); ``None``: ``whole``.
+    interface_tangent
+        ``Psi''`` written out as a form of the state (same matrix as the
+        linearization of ``interface``, faster to assemble); ``None``: the
+        linearization of ``interface``.
     """
 
     def __init__(self, whole: ng.BilinearForm, quadratic: ng.BilinearForm, interface: ng.BilinearForm, key,
-                 assembled: bool = False, preconditioning: StateForm | None = None):
+                 assembled: bool = False, preconditioning: StateForm | None = None,
+                 interface_tangent: StateForm | None = None):
         self.whole, self.quadratic, self.interface, self.key = whole, quadratic, interface, key
+        self._psi = interface if interface_tangent is None else interface_tangent
+        self._psi_form = interface if interface_tangent is None else interface_tangent.form
         self.preconditioning = preconditioning
         self._precondition = False      # a preconditioner is registered with ``preconditioning``
         self.space = whole.space
@@ -141,7 +150,7 @@ class SplitEnergy:
         matrix (or, with a registered preconditioning form, by that form's assembly, whose matrix has the
         same sparsity), then from ``K`` and the interface's assembly alone."""
         self._at.data = vec
-        self.interface.AssembleLinearization(vec)
+        self._psi.AssembleLinearization(vec)
         if self._K_whole is None:
             self.rebuild()
             return
@@ -155,7 +164,7 @@ class SplitEnergy:
         """``whole.mat = K + Psi''`` from ``K`` and the interface's last assembly."""
         vals = self.mat.AsVector().FV().NumPy()
         vals[:] = self._K_whole
-        vals[self._slots_psi] += self.interface.mat.AsVector().FV().NumPy()
+        vals[self._slots_psi] += self._psi_form.mat.AsVector().FV().NumPy()
 
     def preconditioner_form(self) -> ng.BilinearForm:
         """The form to register a preconditioner with: the preconditioning form if there is one (from then on
@@ -192,7 +201,7 @@ class SplitEnergy:
 
     def _locate(self, matrix) -> None:
         """Where ``K``'s and the interface's entries sit in the tangent's ``matrix`` (once)."""
-        self._slots_psi = _positions(matrix, self.interface.mat)
+        self._slots_psi = _positions(matrix, self._psi_form.mat)
         self._K_whole = np.zeros(matrix.nze)
         self._K_whole[_positions(matrix, self.K)] = self.K.AsVector().FV().NumPy()
 

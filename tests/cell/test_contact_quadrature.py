@@ -1,0 +1,93 @@
+"""The penalty's split quadrature on S_C (:mod:`ngcontact.cell.contact_quadrature`): the high rule on the
+contact edge's elements only, and the same energy, residual, tangent and solution as the high rule on all."""
+import os
+
+import numpy as np
+import pytest
+
+from ngcontact.cell import cell_problem as cp
+from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.cell.contact_quadrature import ContactQuadrature, applies
+from ngcontact.drivers.build import build_cell, cell_loads, model_of
+from ngcontact.scene.loader import load
+from ngcontact.solvers.linear_solver import LinearSolver
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCENE = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+
+
+def _problem(linear="direct"):
+    return CellProblem(build_cell(SCENE, maxh=0.6, interface_maxh=0.12), model_of(SCENE),
+                       linear=LinearSolver(linear))
+
+
+@pytest.fixture(scope="module")
+def solved():
+    P = _problem()
+    sol = P.solve(cell_loads(SCENE)[0], first=True, measure=False)
+    return P, sol
+
+
+def test_the_split_rule_gives_the_high_rule_s_energy_residual_and_tangent(solved):
+    """At a state with open, closed and cut elements: only the cut ones carry the high rule, and the
+    energy, residual and tangent equal the uniform high rule's (the Variation of the whole form's
+    interface term) to round-off; dropping the high rule on the cut elements changes them."""
+    P, _ = solved
+    Q = P._quadrature
+    assert isinstance(Q, ContactQuadrature)
+    u = P.gfu.vec
+    Q.restart(u)
+    cut = [e for e in Q.contact if Q.cut[int(e)]]
+    assert 0 < len(cut) < 0.5 * len(Q.contact)
+    uniform = P._parts[1]            # the interface's Variation, the high rule on every element
+    r_split, r_uniform = u.CreateVector(), u.CreateVector()
+
+    def compare():
+        Q.Apply(u, r_split)
+        uniform.Apply(u, r_uniform)
+        Q.AssembleLinearization(u)
+        uniform.AssembleLinearization(u)
+        a, b = r_split.FV().NumPy(), r_uniform.FV().NumPy()
+        tangent = np.max(np.abs(Q.mat.AsVector().FV().NumPy() - uniform.mat.AsVector().FV().NumPy()))
+        return (abs(Q.Energy(u) - uniform.Energy(u)) / abs(uniform.Energy(u)),
+                np.max(np.abs(a - b)) / np.max(np.abs(b)),
+                tangent / np.max(np.abs(uniform.mat.AsVector().FV().NumPy())))
+    assert max(compare()) <= 1e-12
+    for e in cut:                     # the low rule on the contact edge's elements too
+        Q.cut.Clear(int(e))
+        Q.smooth.Set(int(e))
+    Q.state.vec.data = u
+    Q.tangent.Assemble()
+    r = u.CreateVector()
+    Q.Apply(u, r)
+    assert np.max(np.abs(r.FV().NumPy() - r_uniform.FV().NumPy())) > 1e-6 * np.max(np.abs(r_uniform.FV().NumPy()))
+    Q.restart(u)
+
+
+def test_a_cell_solved_with_the_split_rule_is_the_one_solved_with_the_high_rule(solved, monkeypatch):
+    """The same solution and contact fraction as the uniform high rule, iteratively and directly."""
+    P, sol = solved
+    monkeypatch.setattr(cp, "quadrature_applies", lambda problem: False)
+    for linear in ("direct", "iterative"):
+        R = _problem(linear)
+        assert R._quadrature is None
+        ref = R.solve(cell_loads(SCENE)[0], first=True, measure=False)
+        assert sol.results["contact_fraction"] == pytest.approx(ref.results["contact_fraction"], rel=1e-9)
+        diff = np.linalg.norm(P.gfu.vec.FV().NumPy() - R.gfu.vec.FV().NumPy())
+        assert diff <= 1e-7 * np.linalg.norm(R.gfu.vec.FV().NumPy())
+
+
+def test_the_split_applies_only_where_the_penetration_is_a_polynomial_per_element():
+    """Frictionless penalty on straight elements with the gap interpolated: yes; friction, exact
+    enforcement or a curved mesh: the high rule everywhere."""
+    from dataclasses import replace
+
+    from ngcontact.laws.penalty import Friction
+    assert applies(_problem())
+    model = model_of(SCENE)
+    for changed in (replace(model, friction=Friction("tresca", w=1e-4, G=0.01)),
+                    replace(model, interpolate_gap=False)):
+        assert not applies(CellProblem(build_cell(SCENE, maxh=0.6, interface_maxh=0.25), changed))
+    curved = build_cell(SCENE, maxh=0.6, interface_maxh=0.25)
+    curved.mesh.Curve(2)
+    assert not applies(CellProblem(curved, model))
