@@ -194,13 +194,20 @@ def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=No
         energy = normal_energy(J, n, k_n, gap)
     else:
         energy = augmented_normal_energy(J, n, k_n, multiplier, gap)
-    if friction is None:
+    if not _has_friction(friction, w, threshold):
         return energy
+    return energy + tresca_energy(J, n, threshold, w)
+
+
+def _has_friction(friction, w, threshold) -> bool:
+    """Whether the interface terms include friction; raises on an unknown law or missing parameters."""
+    if friction is None:
+        return False
     if friction not in ("tresca", "coulomb"):
         raise ModelError(f"friction = {friction!r}: must be None, 'tresca' or 'coulomb'")
     if w is None or threshold is None:
         raise ModelError("friction needs a width w and a threshold")
-    return energy + tresca_energy(J, n, threshold, w)
+    return True
 
 
 def interface_stiffness(J, n, dJ, dJv, *, k_n, gap=None, friction=None, w=None, threshold=None, multiplier=None):
@@ -225,12 +232,8 @@ def interface_stiffness(J, n, dJ, dJv, *, k_n, gap=None, friction=None, w=None, 
     if multiplier is not None:
         s = multiplier + k_n * s
     stiffness = k_n * ng.IfPos(-s, 0.0, 1.0) * ng.InnerProduct(dJ, n) * ng.InnerProduct(dJv, n)
-    if friction is None:
+    if not _has_friction(friction, w, threshold):
         return stiffness
-    if friction not in ("tresca", "coulomb"):
-        raise ModelError(f"friction = {friction!r}: must be None, 'tresca' or 'coulomb'")
-    if w is None or threshold is None:
-        raise ModelError("friction needs a width w and a threshold")
     Jt = tangential_slip(J, n)
     s2 = ng.InnerProduct(Jt, Jt)
     slope = huber_slope(s2, w)
