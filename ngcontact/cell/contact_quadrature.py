@@ -117,15 +117,19 @@ class ContactQuadrature:
         self.cut.Clear()
         for e in self.contact:
             self.smooth.Set(int(e))
-        self.covers(vec)
+        self._add(vec)
 
     def covers(self, vec) -> bool:
         """Add the elements ``vec`` cuts to ``C``; whether ``C`` held them all already."""
+        return not self._add(vec)
+
+    def _add(self, vec) -> list[int]:
+        """Add the elements ``vec`` cuts to ``C``; those that were not in it."""
         new = [int(e) for e in self.cut_elements(vec) if not self.cut[int(e)]]
         for e in new:
             self.cut.Set(e)
             self.smooth.Clear(e)
-        return not new
+        return new
 
     def Energy(self, vec) -> float:  # noqa: N802 (NGSolve's name)
         self.state.vec.data = vec

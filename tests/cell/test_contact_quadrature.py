@@ -91,3 +91,34 @@ def test_the_split_applies_only_where_the_penetration_is_a_polynomial_per_elemen
     curved = build_cell(SCENE, maxh=0.6, interface_maxh=0.25)
     curved.mesh.Curve(2)
     assert not applies(CellProblem(curved, model))
+
+
+def test_a_state_that_cuts_new_elements_widens_the_high_rule_and_the_solve_goes_on(solved, monkeypatch):
+    """``covers`` adds the elements a moved contact edge cuts (and says it had to); a solve whose final
+    state was not covered continues Newton from there and reports the steps of both runs."""
+    P, _ = solved
+    Q = P._quadrature
+    u = P.gfu.vec
+    Q.restart(u)
+    before = {int(e) for e in Q.contact if Q.cut[int(e)]}
+    moved = u.CreateVector()
+    moved.data = u
+    moved[P.u_dofs[P.dim - 1]] -= 2e-3          # the counter face 2e-3 further away: the edge moves
+    assert not Q.covers(moved)
+    after = {int(e) for e in Q.contact if Q.cut[int(e)]}
+    assert before < after and Q.covers(moved)
+    assert all(not Q.smooth[e] for e in after)
+
+    R = _problem()
+    calls = []
+    real = ContactQuadrature.covers
+
+    def first_time_not(self, vec):      # the first check after a solve finds an element outside C
+        calls.append(1)
+        return real(self, vec) and len(calls) > 1
+    monkeypatch.setattr(ContactQuadrature, "covers", first_time_not)
+    sol = R.solve(cell_loads(SCENE)[0], first=True, measure=False)
+    assert len(calls) == 2 and all(h["converged"] for h in sol.newton)
+    assert sol.results["contact_fraction"] == pytest.approx(P.solve(cell_loads(SCENE)[0], first=True,
+                                                                    measure=False).results["contact_fraction"],
+                                                            rel=1e-9)
