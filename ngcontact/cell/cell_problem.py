@@ -334,6 +334,8 @@ class CellProblem:
                             max_iter=self.max_iter, linear=self.linear, line_search=self.line_search,
                             active_set=self.active_set).as_dict()
             h = _continued(h, more)
+        if self._quadrature is not None:
+            h["contact_quadrature"] = self._quadrature.summary()
         return h
 
     def active_set(self, gfu=None) -> bytes:

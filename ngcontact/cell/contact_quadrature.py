@@ -131,6 +131,11 @@ class ContactQuadrature:
             self.smooth.Clear(e)
         return new
 
+    def summary(self) -> dict:
+        """JSON-ready: how many of the contact elements carry the high rule now (``C``), and the rules' orders."""
+        return {"high_rule_elements": sum(1 for e in self.contact if self.cut[int(e)]),
+                "contact_elements": len(self.contact), "high_order": self._high, "low_order": self._low}
+
     def Energy(self, vec) -> float:  # noqa: N802 (NGSolve's name)
         self.state.vec.data = vec
         mesh = self.state.space.mesh
