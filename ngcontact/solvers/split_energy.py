@@ -201,27 +201,32 @@ class SplitEnergy:
 
     def _locate(self, matrix) -> None:
         """Where ``K``'s and the interface's entries sit in the tangent's ``matrix`` (once)."""
-        self._slots_psi = _positions(matrix, self._psi_form.mat)
+        keys = _keys(matrix)
+        self._slots_psi = _positions(matrix, self._psi_form.mat, keys)
         self._K_whole = np.zeros(matrix.nze)
-        self._K_whole[_positions(matrix, self.K)] = self.K.AsVector().FV().NumPy()
+        self._K_whole[_positions(matrix, self.K, keys)] = self.K.AsVector().FV().NumPy()
 
 
-def _positions(whole, part) -> np.ndarray:
+def _positions(whole, part, whole_keys: np.ndarray | None = None) -> np.ndarray:
     """Where each stored entry of the sparse matrix ``part`` sits among the stored entries of ``whole``.
 
     Both in NGSolve's CSR storage with sorted columns per row (the same
     storage, full or lower triangle); raises when ``part`` has an entry that
-    ``whole`` does not store.
+    ``whole`` does not store.  ``whole_keys``: :func:`_keys` of ``whole``, if at hand.
     """
-    def keys(mat):
-        _, cols, ptr = mat.CSR()
-        cols = np.asarray(cols).astype(np.int64)
-        ptr = np.asarray(ptr).astype(np.int64)
-        rows = np.repeat(np.arange(len(ptr) - 1, dtype=np.int64), np.diff(ptr))
-        return rows * mat.width + cols
-    big, small = keys(whole), keys(part)
+    big = _keys(whole) if whole_keys is None else whole_keys
+    small = _keys(part)
     at = np.searchsorted(big, small)
     if not (np.all(at < len(big)) and np.array_equal(big[np.minimum(at, len(big) - 1)], small)):
         raise ValueError("a term's matrix stores an entry the whole form's matrix does not: "
                          "the forms differ in space or storage")
     return at
+
+
+def _keys(mat) -> np.ndarray:
+    """``row * width + column`` of each stored entry, in storage order (ascending)."""
+    _, cols, ptr = mat.CSR()
+    cols = np.asarray(cols).astype(np.int64)
+    ptr = np.asarray(ptr).astype(np.int64)
+    rows = np.repeat(np.arange(len(ptr) - 1, dtype=np.int64), np.diff(ptr))
+    return rows * mat.width + cols
