@@ -91,19 +91,18 @@ def preconditioning_form(problem, state: ng.GridFunction, quadrature=None) -> St
     pre = _new_form(problem)
     trial, test = problem.X.TnT()
     for i, (name, law) in enumerate((("rough", m.rough), ("counter", m.counter))):
-        eps, eps_v = _el.strain(trial[i], problem.setting), _el.strain(test[i], problem.setting)
-        pre += ng.InnerProduct(law.stress(eps), eps_v) * ng.dx(definedon=problem.mesh.Materials(name))
+        pre += _el.bilinear_integrand(law, trial[i], test[i], problem.setting) * ng.dx(
+            definedon=problem.mesh.Materials(name))
     if quadrature is None:
         pre += _interface_stiffness(problem, state)
     else:
         for term in quadrature.stiffness_terms(trial, test):
             pre += term
-    k = m.k_n if problem.multiplier is None else problem.augmentation
     for i, law in enumerate((m.rough, m.counter)):
-        pre += _el.bubble_term(trial[i], test[i], law.longitudinal_modulus, k, "contact")
+        pre += _el.bubble_term(trial[i], test[i], law.longitudinal_modulus, _contact_stiffness(problem), "contact")
     # the load's potential is linear in U, its second variation zero; its face's elements couple U with the
     # face's dofs all the same, so that this form's sparsity is the whole form's (SplitEnergy.rebuild)
-    pre += 0.0 * ng.InnerProduct(_jump(trial)[1], _jump(test)[1]) * ng.ds("top")
+    pre += 0.0 * ng.InnerProduct(ng.CF(tuple(trial[2:])), ng.CF(tuple(test[2:]))) * ng.ds("top")
     return StateForm(pre, state)
 
 
@@ -111,15 +110,18 @@ def _interface_stiffness(problem, state):
     """The integrand of ``Psi''(state)`` on ``S_C`` with its measure."""
     trial, test = problem.X.TnT()
     parameters, _ = _interface_parameters(problem, problem.coulomb_previous)
-    J = _jump(state.components)[0]
-    return (_contact.interface_stiffness(J, problem.n, _jump(trial)[0], _jump(test)[0], **parameters)
+    return (_contact.interface_stiffness(jump(state.components), problem.n, jump(trial), jump(test), **parameters)
             * _contact_measure(problem))
 
 
-def _jump(u) -> tuple:
-    """``(J, U)`` of the components ``(u_r, u_c, U...)``: the jump ``u_r - u_c - U`` and ``U``."""
-    U = ng.CF(tuple(u[2:]))
-    return u[0] - u[1] - U, U
+def jump(u):
+    """``J = u_r - u_c - U`` of the components ``(u_r, u_c, U...)`` of trial or test functions or of a state."""
+    return u[0] - u[1] - ng.CF(tuple(u[2:]))
+
+
+def _contact_stiffness(problem):
+    """The contact stiffness of the interface energy: ``k_n``, or the augmentation of exact enforcement."""
+    return problem.model.k_n if problem.multiplier is None else problem.augmentation
 
 
 def _new_form(problem) -> ng.BilinearForm:
@@ -143,7 +145,7 @@ def coulomb_residual(problem) -> ng.BilinearForm:
     for term in _bodies(problem, ur, uc):
         form += term
     J = ur - uc - U
-    dJ = test[0] - test[1] - ng.CF(tuple(test[2:]))
+    dJ = jump(test)
     ds = _contact_measure(problem)
     form += ng.Variation(_contact.normal_energy(J, problem.n, m.k_n, problem.gap) * ds)
     G = _contact.coulomb_threshold(J, problem.n, m.k_n, fr.mu, problem.gap)
@@ -169,11 +171,11 @@ def _interface_parameters(problem, previous=None) -> tuple[dict, ng.GridFunction
             threshold = m.friction.mu * lam
         else:
             previous = ng.GridFunction(problem.X) if previous is None else previous
-            pc = previous.components
-            J_prev = pc[0] - pc[1] - ng.CF(tuple(pc[2:]))
-            threshold = _contact.coulomb_threshold(J_prev, problem.n, m.k_n, m.friction.mu, problem.gap)
-    k = m.k_n if lam is None else problem.augmentation
-    return dict(k_n=k, gap=problem.gap, friction=friction, w=w, threshold=threshold, multiplier=lam), previous
+            threshold = _contact.coulomb_threshold(jump(previous.components), problem.n, m.k_n, m.friction.mu,
+                                                   problem.gap)
+    parameters = dict(k_n=_contact_stiffness(problem), gap=problem.gap, friction=friction, w=w,
+                      threshold=threshold, multiplier=lam)
+    return parameters, previous
 
 
 def _contact_measure(problem):

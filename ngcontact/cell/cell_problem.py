@@ -322,21 +322,13 @@ class CellProblem:
         return self._split
 
     def _newton_once(self, free, atol) -> dict:
-        if self._quadrature is not None:
-            self._quadrature.restart(self.gfu.vec)
-        h = minimize(self.energy(), self.gfu, freedofs=free, rtol=self.rtol, atol=atol,
-                     max_iter=self.max_iter, linear=self.linear, line_search=self.line_search,
-                     active_set=self.active_set).as_dict()
-        target = max(self.rtol * h["residuals"][0], atol)
-        # the split quadrature's high rule must hold every element the solution cuts: else on from there
-        while self._quadrature is not None and not self._quadrature.covers(self.gfu.vec):
-            more = minimize(self.energy(), self.gfu, freedofs=free, rtol=0.0, atol=target,
+        def run(rtol, atol):
+            return minimize(self.energy(), self.gfu, freedofs=free, rtol=rtol, atol=atol,
                             max_iter=self.max_iter, linear=self.linear, line_search=self.line_search,
                             active_set=self.active_set).as_dict()
-            h = _continued(h, more)
-        if self._quadrature is not None:
-            h["contact_quadrature"] = self._quadrature.summary()
-        return h
+        if self._quadrature is None:
+            return run(self.rtol, atol)
+        return self._quadrature.newton(self.gfu.vec, run, self.rtol, atol)
 
     def active_set(self, gfu=None) -> bytes:
         """Signature of the contact state: which quadrature points of ``S_C`` penetrate.
@@ -392,17 +384,6 @@ def start_multiplier(problem: CellProblem, load: CellLoad) -> None:
 
 
 # ------------------------------------------------------------ discretization
-def _continued(first: dict, more: dict) -> dict:
-    """The history of a Newton solve continued from its end by ``more``."""
-    out = dict(more)
-    out["iterations"] = first["iterations"] + more["iterations"]
-    for key in ("residuals", "energies"):
-        out[key] = first[key] + more[key][1:]
-    for key in ("step_lengths", "active_set_sizes"):
-        out[key] = first.get(key, []) + more.get(key, [])
-    return out
-
-
 def _discrete_gap(mesh, model: CellModel):
     """The gap interpolated into polynomials of the displacement order on ``S_C``.
 

@@ -40,6 +40,7 @@ from __future__ import annotations
 import ngsolve as ng
 import numpy as np
 
+from ngcontact.cell.cell_energy import jump as _jump
 from ngcontact.laws import penalty as _contact
 
 #: relative tolerance of "every point in contact" and "every point open" on an element
@@ -152,7 +153,26 @@ class ContactQuadrature:
         self.state.vec.data = vec
         self.tangent.Assemble()
 
+    def newton(self, vec, run, rtol: float, atol: float) -> dict:
+        """A Newton solve from ``vec`` (updated in place by ``run(rtol, atol)``, which returns the history of
+        :func:`ngcontact.solvers.newton.minimize`) whose final state ``C`` covers: while it cuts an element
+        outside ``C``, Newton goes on from there to the first solve's residual target.  The history of all
+        runs, with :meth:`summary` under ``"contact_quadrature"``."""
+        self.restart(vec)
+        h = run(rtol, atol)
+        target = max(rtol * h["residuals"][0], atol)
+        while not self.covers(vec):
+            h = _continued(h, run(0.0, target))
+        h["contact_quadrature"] = self.summary()
+        return h
 
-def _jump(u):
-    """``u_r - u_c - U`` of the components ``(u_r, u_c, U...)``."""
-    return u[0] - u[1] - ng.CF(tuple(u[2:]))
+
+def _continued(first: dict, more: dict) -> dict:
+    """The history of a Newton solve continued from its end by ``more``."""
+    out = dict(more)
+    out["iterations"] = first["iterations"] + more["iterations"]
+    for key in ("residuals", "energies"):
+        out[key] = first[key] + more[key][1:]
+    for key in ("step_lengths", "active_set_sizes"):
+        out[key] = first.get(key, []) + more.get(key, [])
+    return out

@@ -93,8 +93,7 @@ class SplitEnergy:
                  assembled: bool = False, preconditioning: StateForm | None = None,
                  interface_tangent: StateForm | None = None):
         self.whole, self.quadratic, self.interface, self.key = whole, quadratic, interface, key
-        self._psi = interface if interface_tangent is None else interface_tangent
-        self._psi_form = interface if interface_tangent is None else interface_tangent.form
+        self._psi = interface if interface_tangent is None else interface_tangent      # assembles Psi''
         self.preconditioning = preconditioning
         self._precondition = False      # a preconditioner is registered with ``preconditioning``
         self.space = whole.space
@@ -164,7 +163,7 @@ class SplitEnergy:
         """``whole.mat = K + Psi''`` from ``K`` and the interface's last assembly."""
         vals = self.mat.AsVector().FV().NumPy()
         vals[:] = self._K_whole
-        vals[self._slots_psi] += self._psi_form.mat.AsVector().FV().NumPy()
+        vals[self._slots_psi] += self._psi.mat.AsVector().FV().NumPy()
 
     def preconditioner_form(self) -> ng.BilinearForm:
         """The form to register a preconditioner with: the preconditioning form if there is one (from then on
@@ -202,7 +201,7 @@ class SplitEnergy:
     def _locate(self, matrix) -> None:
         """Where ``K``'s and the interface's entries sit in the tangent's ``matrix`` (once)."""
         keys = _keys(matrix)
-        self._slots_psi = _positions(matrix, self._psi_form.mat, keys)
+        self._slots_psi = _positions(matrix, self._psi.mat, keys)
         self._K_whole = np.zeros(matrix.nze)
         self._K_whole[_positions(matrix, self.K, keys)] = self.K.AsVector().FV().NumPy()
 

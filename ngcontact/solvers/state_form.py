@@ -25,6 +25,11 @@ class StateForm:
     form: ng.BilinearForm
     state: ng.GridFunction
 
+    @property
+    def mat(self):
+        """The matrix of the last assembly."""
+        return self.form.mat
+
     def AssembleLinearization(self, vec) -> None:  # noqa: N802 (NGSolve's name)
         """Assemble ``form`` at the state ``vec`` (a preconditioner registered with it is built)."""
         self.state.vec.data = vec
