@@ -11,7 +11,7 @@ import time
 import pytest
 
 from ngcontact.errors import BatchError
-from ngcontact.solvers import batch_member, executor
+from ngcontact.solvers import batch_member, executor, local_pool
 
 ITEMS = [1.5, -2.0, 3.25, 7.0, -0.5]
 NAMES = [f"m{k}" for k in range(len(ITEMS))]
@@ -142,7 +142,7 @@ def test_a_pool_started_on_demand_uses_its_workers_only_where_they_repay_their_s
         monkeypatch, start_seconds, on_workers):
     """The first member runs here and times the batch; the rest go to the workers only if
     ``rest * seconds * (1 - 1/workers)`` exceeds the workers' start (``START_SECONDS``)."""
-    monkeypatch.setattr(executor, "START_SECONDS", start_seconds)
+    monkeypatch.setattr(local_pool, "START_SECONDS", start_seconds)
     ex = executor.LocalPool(2)
     ex.start_on_demand()
     seen = []

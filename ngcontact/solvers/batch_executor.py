@@ -1,0 +1,116 @@
+"""The executor of a batch of independent solves, and the serial one (:mod:`ngcontact.solvers.executor`).
+
+:class:`Executor` runs a batch member after member in this process, each
+attempt by :func:`ngcontact.solvers.batch_member.run_member`, a failing
+member once more; :class:`Serial` is that.  The local pool
+(:mod:`ngcontact.solvers.local_pool`) and the Dask cluster
+(:mod:`ngcontact.solvers.dask_cluster`) spread the same batch.
+"""
+from __future__ import annotations
+
+import contextvars
+import logging
+import os
+import time
+from typing import Any, Callable, Sequence
+
+from ngcontact.errors import BatchError
+from ngcontact.solvers.batch_member import ATTEMPTS, fault_from_env, reason, run_member
+
+log = logging.getLogger("ngcontact.solvers.executor")
+
+#: ``progress(label, finished, total)``, called at the start (0) and after every finished member.
+Progress = Callable[[str, int, int], None]
+
+#: the progress callback of the running batches (:func:`ngcontact.solvers.executor.use`)
+PROGRESS: contextvars.ContextVar[Progress | None] = contextvars.ContextVar("ngcontact_progress", default=None)
+
+
+def default_workers() -> int:
+    """The cores this process may use."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+# --------------------------------------------------------------- executors
+class Executor:
+    """Runs batches: :meth:`map` returns ``[fn(item) for item in items]`` in order."""
+
+    #: worker processes (or cores of the cluster) the batch is spread over
+    workers = 1
+    name = "serial"
+
+    def map(self, fn: Callable[[Any], Any], items: Sequence[Any], names: Sequence[str], *,
+            label: str = "batch", progress: Progress | None = None) -> list:
+        if len(items) != len(names) or len(set(names)) != len(names):
+            raise ValueError("a batch needs one distinct name per member")
+        progress = progress or PROGRESS.get()
+        if progress is not None:
+            progress(label, 0, len(items))
+        fault = fault_from_env()
+        t0 = time.perf_counter()
+        out = self._map(fn, list(items), list(names), label, progress, fault)
+        self.record.append({"label": label, "members": len(items), "seconds": time.perf_counter() - t0})
+        return out
+
+    @property
+    def record(self) -> list[dict]:
+        """The batches this executor ran: label, number of members, wall seconds (in order)."""
+        return self.__dict__.setdefault("_record", [])
+
+    def _map(self, fn, items, names, label, progress, fault) -> list:
+        out = []
+        for k, (item, name) in enumerate(zip(items, names)):
+            error: BaseException | None = None
+            for attempt in range(ATTEMPTS):
+                try:
+                    out.append(run_member(fn, item, name, attempt, fault))
+                    break
+                except Exception as exc:  # retried once, then reported
+                    error = exc
+                    log.info("%s: %s failed (%s)%s", label, name, reason(exc),
+                                "; retrying" if attempt + 1 < ATTEMPTS else "")
+            else:
+                assert error is not None
+                raise BatchError(label, name, reason(error)) from error
+            if progress is not None:
+                progress(label, k + 1, len(items))
+        return out
+
+    @staticmethod
+    def _failed(label, name, failures, k, exc) -> None:
+        failures[k] += 1
+        log.debug("%s: %s: %s", label, name, getattr(exc, "detail", "") or reason(exc))
+        log.info("%s: %s failed (%s)%s", label, name, reason(exc),
+                    "; retrying" if failures[k] < ATTEMPTS else "")
+        if failures[k] >= ATTEMPTS:
+            raise BatchError(label, name, reason(exc)) from exc
+
+    def start(self, modules: Sequence[str] = ()) -> None:
+        """Get the workers ready now, while this process prepares the batch (nothing to do here).
+
+        ``modules``: what the members will import, imported by each worker as it starts.
+        """
+
+    def start_on_demand(self) -> None:
+        """Start workers only for a batch that will repay their start (nothing to start here)."""
+
+    def close(self) -> None:
+        """Release the workers (nothing to release here)."""
+
+    def abort(self) -> None:
+        """Stop the workers at once (the run failed or was interrupted)."""
+        self.close()
+
+    def describe(self) -> dict:
+        """Where the batches ran, for the report: the executor, its workers (one NGSolve thread each, a
+        single member in this process), a cluster's scheduler address, and the batches it ran."""
+        out: dict[str, Any] = {"executor": self.name, "workers": self.workers}
+        address = getattr(self, "address", None)
+        if address is not None:
+            out["scheduler"] = address
+        out["batches"] = [dict(b) for b in self.record]
+        return out
+
+
+class Serial(Executor):
+    """Every member in this process, in order."""

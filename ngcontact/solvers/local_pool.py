@@ -1,0 +1,225 @@
+"""A pool of worker processes on this machine (:mod:`ngcontact.solvers.executor`).
+
+``spawn``: each worker is a fresh interpreter, never a fork of a process
+whose NGSolve task manager holds threads, limited to one NGSolve thread so
+that ``N`` workers use ``N`` cores.  A worker that dies counts a failure of
+the member it had started (its start record, by pid); the members of the
+workers the pool then stops are innocent.
+"""
+from __future__ import annotations
+
+import logging
+import os
+import time
+from typing import Any, Sequence
+
+from ngcontact.solvers.batch_executor import Executor
+from ngcontact.solvers.batch_member import one_thread, run_member
+
+log = logging.getLogger("ngcontact.solvers.executor")
+
+
+#: Wall seconds a local pool's workers take to start (fresh interpreters importing NGSolve and the package,
+#: all at once; measured 1.5 to 2.5 s for two on the 2-core machine here).
+START_SECONDS = 2.0
+
+
+class LocalPool(Executor):
+    """A pool of ``workers`` spawned worker processes on this machine (started on first use)."""
+
+    name = "local"
+
+    def __init__(self, workers: int):
+        if workers < 1:
+            raise ValueError(f"workers = {workers}: must be >= 1")
+        self.workers = workers
+        self._pool = None
+        self._started = None
+        self._processes: dict = {}      # every worker process of the current pool, by pid
+        self.on_demand = False
+
+    def _start(self):
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+        ctx = multiprocessing.get_context("spawn")
+        self._started = ctx.SimpleQueue()
+        self._processes = {}
+        self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx, initializer=_worker_start,
+                                         initargs=(self._started,))
+        return self._pool
+
+    def start(self, modules: Sequence[str] = ()) -> None:
+        """Spawn every worker now and let it import ``modules`` (what its members will need).
+
+        A worker is a fresh interpreter: its start and imports take about a
+        second, which the batch would otherwise wait for.  Called when a run
+        knows it will have a batch, this overlaps with what the run does
+        before it (its own imports, the scene's meshes, a macro solve).  The
+        pool spawns one process per submitted task while none is idle, so one
+        warm-up task per worker starts them all.
+        """
+        if self._pool is not None:
+            return
+        pool = self._start()
+        for _ in range(self.workers):
+            pool.submit(_warm_up, tuple(modules))
+
+    def start_on_demand(self) -> None:
+        """Until the workers are started, a batch solves its first member in this process and starts them
+        only if the rest will repay their start (:meth:`_worth_starting`); else the whole batch runs here.
+
+        For runs whose batches are few, small and unknown in advance (the
+        levels of a two-scale cell table: a handful of 0.2 s cell solves
+        each, none at all on a warm cache), where two fresh interpreters
+        importing NGSolve on a 2-core machine would cost more than they save.
+        """
+        self.on_demand = True
+
+    def _worth_starting(self, seconds: float, rest: int) -> bool:
+        """Whether ``rest`` more members of ``seconds`` each finish sooner on the workers, start included."""
+        return rest * seconds * (1.0 - 1.0 / self.workers) > START_SECONDS
+
+    def _map(self, fn, items, names, label, progress, fault) -> list:
+        if len(items) == 1:
+            return Executor._map(self, fn, items, names, label, progress, fault)
+        if self._pool is None and self.on_demand:
+            t0 = time.perf_counter()
+            first = Executor._map(self, fn, items[:1], names[:1], label, None, fault)
+            seconds = time.perf_counter() - t0
+            if progress is not None:
+                progress(label, 1, len(items))
+            shifted = None if progress is None else (lambda lb, k, n: progress(lb, k + 1, n + 1))
+            here = not self._worth_starting(seconds, len(items) - 1)
+            log.debug("%s: first member %.3g s; the other %d run %s", label, seconds, len(items) - 1,
+                      "in this process" if here else f"on {self.workers} workers")
+            rest = (Executor._map if here else LocalPool._pool_map)(self, fn, items[1:], names[1:], label,
+                                                                    shifted, fault)
+            return first + rest
+        return self._pool_map(fn, items, names, label, progress, fault)
+
+    def _pool_map(self, fn, items, names, label, progress, fault) -> list:
+        from concurrent.futures import FIRST_COMPLETED, wait
+        from concurrent.futures.process import BrokenProcessPool
+        results: dict[int, Any] = {}
+        failures = {k: 0 for k in range(len(items))}
+        pending: dict[Any, int] = {}
+        pool = self._pool or self._start()
+
+        def submit(k):
+            pending[pool.submit(_pool_member, fn, items[k], names[k], failures[k], fault)] = k
+            # the pool spawns its workers on submission and forgets them once one dies: keep them
+            self._processes.update(pool._processes or {})
+
+        try:
+            for k in range(len(items)):
+                submit(k)
+            while pending:
+                done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
+                broken = []
+                for fut in done:
+                    k = pending.pop(fut)
+                    try:
+                        results[k] = fut.result()
+                    except BrokenProcessPool:
+                        broken.append(k)
+                        continue
+                    except Exception as exc:
+                        self._failed(label, names[k], failures, k, exc)
+                        submit(k)
+                        continue
+                    if progress is not None:
+                        progress(label, len(results), len(items))
+                if broken:
+                    # a worker died: its member counts a failure; the members of the other workers are innocent
+                    lost = broken + [pending.pop(f) for f in list(pending)]
+                    culprits = self._running_on_dead_workers(names)
+                    for k in lost:
+                        # a worker that died before it started a member (it could not even start: a script
+                        # without an ``if __name__ == "__main__":`` guard) leaves no culprit: all count
+                        if names[k] in culprits or not culprits:
+                            self._failed(label, names[k], failures, k, RuntimeError(
+                                "its worker process died" if culprits else "the worker processes died before "
+                                "they started it (a script run with workers needs an "
+                                "'if __name__ == \"__main__\":' guard)"))
+                    self._discard()
+                    pool = self._start()
+                    for k in lost:
+                        submit(k)
+        except BaseException:
+            self._discard()
+            raise
+        return [results[k] for k in range(len(items))]
+
+    def _running_on_dead_workers(self, names) -> set[str]:
+        """Members last started by worker processes that died by themselves (their start records, by pid).
+
+        The pool terminates the other workers when one dies (exit status
+        ``-SIGTERM``): their members are innocent and are not counted.
+        """
+        import signal
+        last: dict[int, str] = {}
+        assert self._started is not None
+        while not self._started.empty():
+            pid, name = self._started.get()
+            last[pid] = name
+        processes = dict(self._processes)
+        if self._pool is not None:
+            processes.update(self._pool._processes or {})
+        for proc in processes.values():
+            proc.join(timeout=2)             # reap: a dead process may still look alive
+        died = {pid for pid, proc in processes.items() if _exit_code(proc) not in (None, -signal.SIGTERM)}
+        return {name for pid, name in last.items() if pid in died}
+
+    def _discard(self) -> None:
+        """Stop the workers now (a broken pool, an error, an interruption)."""
+        pool, self._pool = self._pool, None
+        if pool is None:
+            return
+        processes = list((pool._processes or {}).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        for p in processes:
+            if p.is_alive():
+                p.terminate()
+        for p in processes:
+            p.join(timeout=5)
+            if p.is_alive():  # a worker that does not stop on SIGTERM
+                p.kill()
+                p.join(timeout=5)
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
+
+    def abort(self) -> None:
+        self._discard()
+
+
+_STARTED = None
+
+
+def _exit_code(proc, seconds: float = 2.0):
+    """A joined worker's exit code.  The pool's own thread reaps its workers too: while it holds a dead
+    worker's status, ``exitcode`` reads ``None`` for a moment, so ``None`` is read again until ``seconds``."""
+    deadline = time.monotonic() + seconds
+    while proc.exitcode is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    return proc.exitcode
+
+
+def _worker_start(started) -> None:
+    global _STARTED
+    _STARTED = started
+    one_thread(ignore_sigint=True)
+
+
+def _warm_up(modules: tuple[str, ...]) -> None:
+    import importlib
+    for module in modules:
+        importlib.import_module(module)
+
+
+def _pool_member(fn, item, name, attempt, fault):
+    if _STARTED is not None:
+        _STARTED.put((os.getpid(), name))
+    return run_member(fn, item, name, attempt, fault)
