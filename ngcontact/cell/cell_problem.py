@@ -31,7 +31,10 @@ Solve.  Newton's method (:func:`ngcontact.solvers.newton.minimize`), the
 step minimizing the convex energy along the Newton direction
 (``line_search="exact"``, Armijo test kept as a guard).  The first load
 under a prescribed pressure starts from the rigid predictor of
-:mod:`ngcontact.cell.predictor`, later loads from the previous solution.  A
+:mod:`ngcontact.cell.predictor`, moved onto the contact set of the spectral
+twin where the cell has one (penalty, small slope:
+:mod:`ngcontact.cell.spectral_predictor`), later loads from the previous
+solution.  A
 frictionless flat ``S_C`` leaves ``U_t`` free of energy: it is fixed at 0
 and a nonzero shear is rejected.  Coulomb friction: Newton on the
 coupled equations with the threshold ``mu p(u)`` differentiated (the
@@ -75,6 +78,8 @@ from ngcontact.cell.contact_quadrature import applies as quadrature_applies
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
 from ngcontact.cell.predictor import max_gap, rigid_continuation, rigid_translation, set_start, tangential_load
+from ngcontact.cell.spectral_cell import SpectralCell
+from ngcontact.cell.spectral_predictor import spectral_start
 from ngcontact.errors import ModelError
 from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
@@ -108,9 +113,16 @@ class CellProblem:
         Tangent solves (:class:`~ngcontact.solvers.linear_solver.LinearSolver`);
         default: direct with ``inverse``.
     start
-        Start of the first load under a prescribed pressure: ``"rigid"``
-        (default, the rigid predictor of :mod:`ngcontact.cell.predictor`) or
-        ``"closed"`` (every point of ``S_C`` pushed into contact).
+        Start of the first load under a prescribed pressure: ``"spectral"``
+        (the default with a ``twin``: the rigid predictor moved onto the
+        twin's contact set, :mod:`ngcontact.cell.spectral_predictor`),
+        ``"rigid"`` (the default without: the rigid predictor of
+        :mod:`ngcontact.cell.predictor`) or ``"closed"`` (every point of
+        ``S_C`` pushed into contact).
+    twin
+        The spectral cell of the same small-slope cell
+        (:func:`ngcontact.drivers.build.predictor_twin`), penalty only; ``None``:
+        no spectral start.
     coulomb
         Coulomb friction with the penalty: ``"newton"`` (default, the
         coupled Newton) or ``"fixed_point"``
@@ -140,19 +152,24 @@ class CellProblem:
 
     def __init__(self, cell, model: CellModel, *, rtol: float = 1e-10, atol: float = 0.0,
                  max_iter: int = 40, inverse: str = "sparsecholesky", normal=None,
-                 line_search: str = "exact", start: str = "rigid", linear: LinearSolver | None = None,
-                 coulomb: str = "newton"):
+                 line_search: str = "exact", start: str | None = None, linear: LinearSolver | None = None,
+                 coulomb: str = "newton", twin: SpectralCell | None = None):
         if coulomb not in METHODS:
             raise ValueError(f"coulomb = {coulomb!r}: must be one of {METHODS}")
         if line_search not in ("exact", "armijo"):
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
-        if start not in ("rigid", "closed"):
-            raise ValueError(f"start = {start!r}: must be 'rigid' or 'closed'")
+        if start is None:
+            start = "rigid" if twin is None else "spectral"
+        if start not in ("rigid", "closed", "spectral"):
+            raise ValueError(f"start = {start!r}: must be 'rigid', 'closed' or 'spectral'")
+        if start == "spectral" and (twin is None or model.enforcement != "penalty"):
+            raise ValueError("start = 'spectral' needs the cell's spectral twin and the penalty "
+                             f"(twin {'given' if twin is not None else 'missing'}, enforcement {model.enforcement!r})")
         if model.enforcement == "exact" and cell.dim == 3 and model.order > TRIANGLE_MAX_ORDER:
             raise ModelError(f"order = {model.order} with enforcement = 'exact' in a 3D cell: exact contact on "
                              f"triangles is built for order <= {TRIANGLE_MAX_ORDER} (quadratic triangles leave corner "
                              "nodes open inside the contact patch); use order 1, the penalty, or the spectral cell")
-        self.line_search, self.start, self.coulomb = line_search, start, coulomb
+        self.line_search, self.start, self.coulomb, self.twin = line_search, start, coulomb, twin
         self.coulomb_residual = None      # Coulomb, coupled Newton: the residual form, built on first use
         self.cell, self.model = cell, model
         self.mesh = mesh = cell.mesh
@@ -279,6 +296,9 @@ class CellProblem:
             if self.model.friction is not None:
                 start_multiplier(self, load)
         free = self._freedofs(load)
+        started = None
+        if first and self.start == "spectral" and self.twin is not None and load.jump[self.dim - 1] is None:
+            started = spectral_start(self, load, self.twin)
         # a later load with a tangential change: frictionless, the rigid predictor for the whole traction;
         # with friction (or where that has no minimizer), the rigid continuation, whose steps count
         predicted = None
@@ -291,6 +311,8 @@ class CellProblem:
             histories += coulomb
         else:
             histories.append(self._newton(free, self.atol))
+        if started is not None:
+            histories[0]["start"] = started         # a first load: no rigid continuation before it
         if measure:
             results = self.measure(load)
             surface = measures.surface_distribution(self)

@@ -7,7 +7,10 @@ contact set of the start is far from the solution's: from the open side the
 tangent of a few penalty springs is soft, the step overshoots and the line
 search cuts it to a few per cent; from the closed side each step moves a
 contact edge only part of the way.  Two predictors put the start near the
-solution's contact set without any linear solve of the cell problem.
+solution's contact set without any linear solve of the cell problem.  A
+small-slope cell under the penalty has a third, run after the rigid one on
+a first load: its spectral twin's contact set
+(:mod:`ngcontact.cell.spectral_predictor`).
 
 *First load* under a prescribed pressure ``p``: the rigid predictor.  The
 fluctuations are zero and the counter is translated by the normal approach

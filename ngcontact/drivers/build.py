@@ -14,7 +14,7 @@ import os
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.cell_problem import CellLoad, CellModel, cell_load
+from ngcontact.cell.cell_problem import CellLoad, CellModel, CellProblem, cell_load
 from ngcontact.cell.coefficients import direction_bundle
 from ngcontact.coupling import cell_law
 from ngcontact.errors import SceneError
@@ -213,16 +213,28 @@ def gap_cf(scene):
     return terms[0] if len(terms) == 1 else terms[0] + terms[1]
 
 
+def cell_problem(scene: CellScene, cell=None, model: CellModel | None = None,
+                 interface_maxh: float | None = None) -> CellProblem:
+    """The FE cell problem of a cell scene: its mesh (``cell``, default :func:`build_cell`), its model
+    (default :func:`model_of`), the ``[solver]`` settings, and the spectral twin that starts its first loads
+    where it has one (:func:`predictor_twin`, grid from ``interface_maxh``, else the scene's)."""
+    s = scene.solver
+    return CellProblem(build_cell(scene) if cell is None else cell, model_of(scene) if model is None else model,
+                       rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
+                       linear=linear_solver(scene), coulomb=s.coulomb, twin=predictor_twin(scene, interface_maxh))
+
+
 def linear_solver(scene) -> LinearSolver:
     """The tangent solves of a scene's Newton iterations: ``solver.linear``, ``iterative_from``, ``inverse``."""
     s = scene.solver
     return LinearSolver(policy=s.linear, inverse=s.inverse, threshold=s.iterative_from)
 
 
-def spectral_cell(scene: CellScene, grid: int | None = None) -> SpectralCell:
+def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = True) -> SpectralCell:
     """The spectral cell (:mod:`ngcontact.cell.spectral_cell`) of a small-slope cell scene.
 
-    ``grid``: points per direction instead of the scene's (a gap given by a formula).
+    ``grid``: points per direction instead of the scene's (a gap given by a formula); ``friction = False``:
+    the cell without the scene's friction.
     """
     g, c, s = scene.geometry, scene.contact, scene.solver
     heights = height_map(scene) if small_slope(g) and g.profile != "bisinusoid" else None
@@ -235,7 +247,37 @@ def spectral_cell(scene: CellScene, grid: int | None = None) -> SpectralCell:
     return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
                         counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid, heights),
                         k_n=c.k_n,
-                        enforcement=c.enforcement, tol=s.rtol, max_iter=s.cg_max_iter, friction=micro_friction(c))
+                        enforcement=c.enforcement, tol=s.rtol, max_iter=s.cg_max_iter,
+                        friction=micro_friction(c) if friction else None)
+
+
+#: grid points of the spectral predictor's twin per interface element size (at least), and its bounds
+TWIN_POINTS_PER_ELEMENT = 4
+TWIN_GRID = {2: (64, 8192), 3: (64, 512)}
+
+
+def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> SpectralCell | None:
+    """The spectral twin whose contact set starts an FE cell's first loads
+    (:mod:`ngcontact.cell.spectral_predictor`), or ``None`` where there is none.
+
+    A twin exists for the penalty on a cell the spectral cell can solve (the small-slope model:
+    :func:`ngcontact.scene.cell_scene.check_spectral`), frictionless.  Its grid is the power of two
+    with ``TWIN_POINTS_PER_ELEMENT`` points per interface element size (``interface_maxh``, else the
+    scene's), within ``TWIN_GRID``; a height map keeps its own samples (interpolated as the FE cell
+    interpolates them).
+    """
+    from ngcontact.scene.cell_scene import check_spectral
+    if scene.contact.enforcement != "penalty":
+        return None
+    try:
+        check_spectral(scene)
+    except SceneError:
+        return None
+    g, d = scene.geometry, scene.discretization
+    h = interface_maxh or d.interface_maxh or d.maxh
+    low, high = TWIN_GRID[g.dim]
+    grid = int(min(max(2 ** math.ceil(math.log2(TWIN_POINTS_PER_ELEMENT * g.period / h)), low), high))
+    return spectral_cell(scene, grid=grid, friction=False)
 
 
 def gap_samples(scene, grid: int, heights: np.ndarray | None = None) -> np.ndarray:

@@ -19,15 +19,13 @@ import numpy as np
 from ngcontact.cell.cell_model import CellSolution
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.spectral_cell import SpectralSolution
-from ngcontact.drivers.build import build_cell, cell_loads, linear_solver, model_of, spectral_cell
+from ngcontact.drivers.build import cell_loads, cell_problem, spectral_cell
 from ngcontact.solvers import executor
 
 
 def fe_problem(scene) -> CellProblem:
     """The FE cell problem of a cell scene (mesh, spaces, forms), before any load."""
-    s = scene.solver
-    return CellProblem(build_cell(scene), model_of(scene), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
-                       inverse=s.inverse, linear=linear_solver(scene), coulomb=s.coulomb)
+    return cell_problem(scene)
 
 
 def fe_load(job: tuple) -> tuple[CellSolution, np.ndarray | None]:

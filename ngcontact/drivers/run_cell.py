@@ -28,8 +28,7 @@ from typing import Any
 import numpy as np
 
 
-from ngcontact.drivers.build import build_cell, cell_loads, gap_cf, linear_solver, model_of, spectral_cell
-from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.drivers.build import build_cell, cell_loads, cell_problem, gap_cf, model_of, spectral_cell
 from ngcontact.cell.edge_grading import GradedSolve, graded_flat_cell, solve_to_tolerance
 
 from ngcontact.cell import spectral_measures
@@ -45,15 +44,14 @@ log = logging.getLogger(__name__)
 
 def solve_graded(scene, loads) -> list[GradedSolve]:
     """Each load on its own mesh, graded towards its contact edges until ``discretization.tolerance`` is met."""
-    g, d, s = scene.geometry, scene.discretization, scene.solver
+    g, d = scene.geometry, scene.discretization
     model = model_of(scene)
     h0 = d.interface_maxh or d.maxh
 
     def make_problem(vertices, order):
         cell = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
                                 vertices=vertices)
-        return CellProblem(cell, replace(model, order=order), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
-                           inverse=s.inverse, linear=linear_solver(scene), coulomb=s.coulomb)
+        return cell_problem(scene, cell, replace(model, order=order), interface_maxh=h0)
 
     out = []
     for k, load in enumerate(loads):
@@ -147,9 +145,7 @@ def run(scene, clock) -> Outcome:
     if c.geometric_only:
         return Outcome(results=results, ndof=0)
     with clock.stage("setup"):
-        s = scene.solver
-        P = CellProblem(cell, model_of(scene), rtol=s.rtol, atol=s.atol, max_iter=s.max_iter,
-                        inverse=s.inverse, linear=linear_solver(scene), coulomb=s.coulomb)
+        P = cell_problem(scene, cell)
     graded: list[GradedSolve] = []
     with clock.stage("solve"):
         if scene.discretization.tolerance is None and scene.load.independent:

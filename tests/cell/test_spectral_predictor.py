@@ -1,0 +1,112 @@
+"""The spectral predictor (:mod:`ngcontact.cell.spectral_predictor`): a small-slope FE cell's first load starts
+on its spectral twin's contact set and reaches the rigid start's solution."""
+import os
+
+import ngsolve as ng
+import numpy as np
+import pytest
+
+from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.cell.measures import sample_surface
+from ngcontact.cell.spectral_predictor import grid_coefficient, spectral_start
+from ngcontact.drivers.build import TWIN_GRID, build_cell, cell_loads, model_of, predictor_twin
+from ngcontact.scene.loader import load
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def _scene(name):
+    return load(os.path.join(ROOT, "geometries", "cells", f"{name}.toml"))
+
+
+BISINUSOID = _scene("bisinusoid")
+
+
+def _problem(scene, start, interface_maxh=None):
+    return CellProblem(build_cell(scene, interface_maxh=interface_maxh), model_of(scene), start=start,
+                       twin=predictor_twin(scene, interface_maxh))
+
+
+def test_the_start_has_the_twin_s_contact_set():
+    """After the spectral start, the penetration on S_C is the twin's interpolated one: the same sign wherever
+    the twin's penetration is not within 5 % of its range of zero, and close to it everywhere."""
+    P = _problem(BISINUSOID, "spectral", 0.12)
+    twin = P.twin
+    load_ = cell_loads(BISINUSOID)[0]
+    P._apply_load(load_, first=True)              # the rigid predictor's state
+    record = spectral_start(P, load_, twin)
+    assert record["kind"] == "spectral" and record["grid"] == twin.grid == 64
+    s = sample_surface(P, {"s": P.penetration, "x": ng.x, "y": ng.y})
+    target = twin.solve(load_).fields["closure"] - twin.g0
+    # the twin's penetration, bilinear between its grid points, at the sampled points
+    N, period = twin.grid, twin.period
+    u, v = s["x"] / period * N, s["y"] / period * N
+    i0, j0 = np.floor(u).astype(int), np.floor(v).astype(int)
+    fu, fv = u - i0, v - j0
+
+    def at(i, j):
+        return target[j % N, i % N]
+    expected = ((1 - fu) * (1 - fv) * at(i0, j0) + fu * (1 - fv) * at(i0 + 1, j0)
+                + (1 - fu) * fv * at(i0, j0 + 1) + fu * fv * at(i0 + 1, j0 + 1))
+    opened = -expected.min()                   # the largest elastic gap
+    inside, outside, clear = expected > 0, expected < 0, expected < -0.05 * opened
+
+    def agreement(pen):
+        return np.mean(pen[inside] > 0), np.mean(pen[outside] < 0), np.mean(pen[clear] < 0)
+    closed_share, open_share, clear_share = agreement(s["s"])
+    assert closed_share >= 0.8 and open_share >= 0.95 and clear_share == 1.0
+    assert np.max(np.abs(s["s"] - expected)) <= 0.05 * opened
+    # the rigid start's penetration is a level set of the gap: further from the twin's contact set
+    R = _problem(BISINUSOID, "rigid", 0.12)
+    R._apply_load(load_, first=True)
+    rigid = agreement(sample_surface(R, {"s": R.penetration})["s"])
+    assert rigid[0] + rigid[1] < closed_share + open_share
+
+
+@pytest.mark.parametrize("name, interface_maxh", [("bisinusoid", 0.12), ("westergaard", None),
+                                                  ("tabulated_gap", None)])
+def test_the_spectral_start_reaches_the_rigid_start_s_solution(name, interface_maxh):
+    """Every load of a sweep solved afresh from either start: the same contact fraction, pressure and far-face
+    jump to the Newton tolerance; the spectral start records itself in the history and takes no more
+    Newton steps than the rigid start (3D and 2D cells)."""
+    scene = _scene(name)
+    rigid, spectral = _problem(scene, "rigid", interface_maxh), _problem(scene, "spectral", interface_maxh)
+    assert rigid.twin is not None and spectral.start == "spectral"
+    for load_ in cell_loads(scene):
+        a = rigid.solve(load_, first=True, measure=False)
+        b = spectral.solve(load_, first=True, measure=False)
+        assert b.results["contact_fraction"] == pytest.approx(a.results["contact_fraction"], rel=1e-9)
+        assert b.results["mean_pressure"] == pytest.approx(a.results["mean_pressure"], rel=1e-8)
+        ua, ub = (np.array([P.gfu.vec[i] for i in P.u_dofs]) for P in (rigid, spectral))
+        assert np.allclose(ub, ua, rtol=1e-8, atol=1e-12 * np.max(np.abs(ua)))
+        assert b.newton[0]["start"]["kind"] == "spectral" and "start" not in a.newton[0]
+        assert sum(h["iterations"] for h in b.newton) <= sum(h["iterations"] for h in a.newton)
+
+
+def test_grid_coefficient_is_the_periodic_bilinear_interpolant():
+    """At the grid points (the period's far end included, wrapped) the values, between them the mean of
+    the two neighbours, on a 3D cell's S_C."""
+    mesh = build_cell(BISINUSOID, interface_maxh=0.12).mesh
+    rng = np.random.default_rng(3)
+    N = 8
+    values = rng.standard_normal((N, N))
+    cf = grid_coefficient(mesh, values, 1.0)
+    for j, i in ((0, 0), (3, 5), (7, 7), (N, 2), (4, N)):
+        assert cf(mesh(i / N, j / N, 0.0)) == pytest.approx(values[j % N, i % N], abs=1e-12)
+    assert cf(mesh(2.5 / N, 1.0 / N, 0.0)) == pytest.approx(0.5 * (values[1, 2] + values[1, 3]), abs=1e-12)
+    assert cf(mesh(1.0 / N, 7.5 / N, 0.0)) == pytest.approx(0.5 * (values[7, 1] + values[0, 1]), abs=1e-12)
+
+
+def test_a_twin_only_where_the_spectral_cell_solves_the_same_problem():
+    """The penalty on a small-slope cell has a twin, its grid four points per interface element size (a
+    power of two, within the bounds); exact enforcement and a resolved rough surface have none; a spectral
+    start without a twin is refused."""
+    assert predictor_twin(BISINUSOID, 0.12).grid == 64
+    assert predictor_twin(BISINUSOID, 0.021).grid == 256
+    assert predictor_twin(BISINUSOID, 1e-4).grid == TWIN_GRID[3][1]
+    assert predictor_twin(BISINUSOID, 0.12).friction is None
+    assert predictor_twin(_scene("westergaard_exact")) is None
+    assert predictor_twin(_scene("sinusoid")) is None
+    assert predictor_twin(_scene("bisinusoid_surface")) is None
+    with pytest.raises(ValueError, match="twin"):
+        CellProblem(build_cell(BISINUSOID, interface_maxh=0.12), model_of(BISINUSOID), start="spectral")
