@@ -6,7 +6,9 @@ Three measurements, one run, one CSV and one PNG:
    pressure), refining ``interface_maxh``: the Newton solve of one load with
    ``solver.linear = "direct"`` (sparse Cholesky; up to ``--direct-max``
    dofs) and ``"iterative"`` (BDDC-preconditioned CG,
-   :mod:`ngcontact.solvers.linear_solver`).
+   :mod:`ngcontact.solvers.linear_solver`), started as ``ngcontact run``
+   starts it: on the contact set of the spectral twin
+   (:mod:`ngcontact.cell.spectral_predictor`), whose solve is timed with it.
 2. **3D macro press fit** (two coaxial tubes, a quarter, interference 1e-3,
    a tabulated nonlinear normal law so that Newton iterates, 0.1 on the top),
    refining ``maxh`` at order 2, the same two solvers.

@@ -221,7 +221,8 @@ def cell_problem(scene: CellScene, cell=None, model: CellModel | None = None,
     s = scene.solver
     return CellProblem(build_cell(scene) if cell is None else cell, model_of(scene) if model is None else model,
                        rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
-                       linear=linear_solver(scene), coulomb=s.coulomb, twin=predictor_twin(scene, interface_maxh))
+                       linear=linear_solver(scene), coulomb=s.coulomb, twin=predictor_twin(scene, interface_maxh),
+                       start=None if s.start == "auto" else s.start)
 
 
 def linear_solver(scene) -> LinearSolver:
@@ -261,17 +262,14 @@ def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> Spe
     (:mod:`ngcontact.cell.spectral_predictor`), or ``None`` where there is none.
 
     A twin exists for the penalty on a cell the spectral cell can solve (the small-slope model:
-    :func:`ngcontact.scene.cell_scene.check_spectral`), frictionless.  Its grid is the power of two
+    :func:`ngcontact.scene.cell_scene.has_twin`) unless ``solver.start`` asks for another start; it is
+    frictionless.  Its grid is the power of two
     with ``TWIN_POINTS_PER_ELEMENT`` points per interface element size (``interface_maxh``, else the
     scene's), within ``TWIN_GRID``; a height map keeps its own samples (interpolated as the FE cell
     interpolates them).
     """
-    from ngcontact.scene.cell_scene import check_spectral
-    if scene.contact.enforcement != "penalty":
-        return None
-    try:
-        check_spectral(scene)
-    except SceneError:
+    from ngcontact.scene.cell_scene import has_twin
+    if scene.solver.start in ("rigid", "closed") or not has_twin(scene):
         return None
     g, d = scene.geometry, scene.discretization
     h = interface_maxh or d.interface_maxh or d.maxh

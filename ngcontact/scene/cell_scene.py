@@ -207,6 +207,12 @@ class CellScene:
                              "1 with contact.enforcement = 'exact' in a 3D FE cell (quadratic triangles leave corner "
                              "nodes open inside the contact patch); or use the penalty, or discretization.method = "
                              "'spectral' for a small-slope cell")
+        if self.discretization.method == "fe" and self.solver.start == "spectral" and not has_twin(self):
+            raise SceneError("solver.start", "spectral", "starts from the spectral cell of the same small-slope cell: "
+                             "it needs contact.enforcement = 'penalty' and a flat interface (geometry.profile = "
+                             "'flat' or 'flat3d', or 'bisinusoid', 'height_map' or 'self_affine' with arrangement = "
+                             f"'summit'), not enforcement {self.contact.enforcement!r} on a {self.geometry.profile!r} "
+                             f"profile in the {self.geometry.arrangement!r} arrangement; use 'auto' or 'rigid'")
         fe_tolerance = self.discretization.method == "fe" and self.discretization.tolerance is not None
         if fe_tolerance and not (dim == 2 and self.geometry.profile == "flat"):
             raise SceneError("discretization.tolerance", self.discretization.tolerance,
@@ -225,8 +231,7 @@ class CellScene:
         if self.ensemble is not None and self.geometry.profile != "self_affine":
             raise SceneError("ensemble", "...", "realizations of a random surface need geometry.profile = "
                              f"'self_affine' (its spectrum and seed), not {self.geometry.profile!r}")
-        flat = self.geometry.profile in ("flat", "flat3d") or small_slope(self.geometry)
-        if flat and self.contact.friction == "none":
+        if flat_interface(self.geometry) and self.contact.friction == "none":
             for key in ("shear", "tangential_jump"):
                 v = getattr(self.load, key)
                 if v is not None and any(x != 0.0 for x in v):
@@ -290,10 +295,21 @@ def spectral_grid(scene: CellScene, heights_shape: tuple[int, ...] | None = None
     return 1024 if scene.geometry.dim == 2 else 256
 
 
+def flat_interface(geometry) -> bool:
+    """The small-slope model: a flat ``S_C`` with the roughness in the initial gap (what the spectral cell solves)."""
+    return geometry.profile in ("flat", "flat3d") or small_slope(geometry)
+
+
+def has_twin(scene: CellScene) -> bool:
+    """Whether an FE cell scene's first loads can start from its spectral twin
+    (:mod:`ngcontact.cell.spectral_predictor`): the penalty on a flat interface."""
+    return scene.contact.enforcement == "penalty" and flat_interface(scene.geometry)
+
+
 def check_spectral(scene: CellScene) -> None:
     """A spectral cell needs the small-slope model, and a grid it can hold."""
     g, d = scene.geometry, scene.discretization
-    if not (g.profile in ("flat", "flat3d") or small_slope(g)):
+    if not flat_interface(g):
         raise SceneError("discretization.method", "spectral", "solves the small-slope cell: a flat interface with "
                          "the roughness in the initial gap (geometry.profile = 'flat' or 'flat3d', or 'bisinusoid', "
                          "'height_map' or 'self_affine' with arrangement = 'summit'), not geometry.profile = "

@@ -1,6 +1,7 @@
 """The spectral predictor (:mod:`ngcontact.cell.spectral_predictor`): a small-slope FE cell's first load starts
 on its spectral twin's contact set and reaches the rigid start's solution."""
 import os
+from dataclasses import replace
 
 import ngsolve as ng
 import numpy as np
@@ -99,8 +100,8 @@ def test_grid_coefficient_is_the_periodic_bilinear_interpolant():
 
 def test_a_twin_only_where_the_spectral_cell_solves_the_same_problem():
     """The penalty on a small-slope cell has a twin, its grid four points per interface element size (a
-    power of two, within the bounds); exact enforcement and a resolved rough surface have none; a spectral
-    start without a twin is refused."""
+    power of two, within the bounds); exact enforcement, a resolved rough surface and a scene asking for
+    another start (``solver.start``) have none; a spectral start without a twin is refused."""
     assert predictor_twin(BISINUSOID, 0.12).grid == 64
     assert predictor_twin(BISINUSOID, 0.021).grid == 256
     assert predictor_twin(BISINUSOID, 1e-4).grid == TWIN_GRID[3][1]
@@ -108,5 +109,7 @@ def test_a_twin_only_where_the_spectral_cell_solves_the_same_problem():
     assert predictor_twin(_scene("westergaard_exact")) is None
     assert predictor_twin(_scene("sinusoid")) is None
     assert predictor_twin(_scene("bisinusoid_surface")) is None
+    for start in ("rigid", "closed"):        # the scene asks for another start
+        assert predictor_twin(replace(BISINUSOID, solver=replace(BISINUSOID.solver, start=start))) is None
     with pytest.raises(ValueError, match="twin"):
         CellProblem(build_cell(BISINUSOID, interface_maxh=0.12), model_of(BISINUSOID), start="spectral")

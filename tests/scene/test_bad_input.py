@@ -310,7 +310,7 @@ def test_unknown_top_level_section(tmp_path, capsys):
 def test_misspelled_key_in_a_section(tmp_path, capsys):
     text = edit(CELL.format(contact=""), ("rtol = 1e-10", "r_tol = 1e-10"))
     run_bad(tmp_path, capsys, text, "solver.r_tol = 1e-10: unknown key; allowed keys here are atol, cg_max_iter, "
-            "coulomb, coulomb_max_iter, coulomb_rtol, inverse, iterative_from, linear, max_iter, rtol")
+            "coulomb, coulomb_max_iter, coulomb_rtol, inverse, iterative_from, linear, max_iter, rtol, start")
 
 
 def test_misspelled_material_constant(tmp_path, capsys):
@@ -799,3 +799,17 @@ def test_a_two_scale_cell_method_the_cell_cannot_take(tmp_path, capsys):
             "two_scale.cell_method = 'spectral': the loop solves a spectral cell for its pressure table only; the "
             "shear table of interface.friction = 'from_cell' with a frictional cell needs the FE cell: use "
             "two_scale.cell_method = 'fe', or interface.friction = 'given'")
+
+
+def test_a_spectral_start_without_a_spectral_twin(tmp_path, capsys):
+    """The spectral predictor needs the penalty on a flat interface: a sinusoid profile has none."""
+    text = edit(CELL.format(contact=""), ('profile = "flat"', 'profile = "sinusoid"\namplitude = 0.05'),
+                ("rtol = 1e-10", 'rtol = 1e-10\nstart = "spectral"'))
+    run_bad(tmp_path, capsys, text,
+            "solver.start = 'spectral': starts from the spectral cell of the same small-slope cell: it needs "
+            "contact.enforcement = 'penalty' and a flat interface", prefix=True)
+
+
+def test_an_unknown_start(tmp_path, capsys):
+    text = edit(CELL.format(contact=""), ("rtol = 1e-10", 'rtol = 1e-10\nstart = "spectal"'))
+    run_bad(tmp_path, capsys, text, "solver.start = 'spectal': must be one of 'auto', 'spectral', 'rigid', 'closed'")
