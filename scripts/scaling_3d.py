@@ -268,13 +268,13 @@ def breakdown(size: float, out: str) -> dict:
     import ngsolve as ng
     from ngcontact import runner
     from ngcontact.cell.cell_problem import CellProblem
-    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
     from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
     scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
     cell = build_cell(scene, interface_maxh=size)
     with runner.threads(runner.thread_count()):
-        P = CellProblem(cell, model_of(scene), linear=LinearSolver("iterative"))
+        P = CellProblem(cell, model_of(scene), linear=LinearSolver("iterative"), twin=predictor_twin(scene, size))
         import ngsolve.krylovspace as K
         spent = [0.0]
         solve = K.CGSolver._SolveImpl
@@ -344,7 +344,7 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
     from ngcontact import runner
     from ngcontact.cell.cell_energy import preconditioning_form
     from ngcontact.cell.cell_problem import CellProblem
-    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
     from ngcontact.fem import elasticity
     from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
@@ -352,7 +352,8 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
     model = model_of(scene) if k_n is None else replace(model_of(scene), k_n=k_n)
     rows = []
     with runner.threads(runner.thread_count()):
-        P = CellProblem(build_cell(scene, interface_maxh=size), model, linear=LinearSolver("iterative"))
+        P = CellProblem(build_cell(scene, interface_maxh=size), model, linear=LinearSolver("iterative"),
+                        twin=predictor_twin(scene, size))
         P.solve(cell_loads(scene)[0], first=True, measure=False)
         A = P.energy().mat
         b = A.CreateColVector()

@@ -101,6 +101,11 @@ def _exact_pressure_cf(p: float, pstar: float):
 def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enforcement: str = "penalty") -> dict:
     """The four loads on FE cells; errors and wall time.
 
+    The first load starts from the rigid predictor, not from the spectral
+    predictor (``ngcontact run``'s start for this small-slope cell): its twin
+    is the spectral cell these rows are compared with, and the FE rows keep
+    their cost their own.
+
     Without ``tolerance``: one mesh, the loads continued from one another.
     With it: each load on its own meshes, graded towards its contact edges
     until the estimate meets the tolerance (:mod:`ngcontact.cell.edge_grading`).

@@ -79,7 +79,7 @@ from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
 from ngcontact.cell.predictor import max_gap, rigid_continuation, rigid_translation, set_start, tangential_load
 from ngcontact.cell.spectral_cell import SpectralCell
-from ngcontact.cell.spectral_predictor import spectral_start
+from ngcontact.cell.spectral_predictor import flat_level, spectral_start
 from ngcontact.errors import ModelError
 from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
@@ -169,6 +169,8 @@ class CellProblem:
             raise ModelError(f"order = {model.order} with enforcement = 'exact' in a 3D cell: exact contact on "
                              f"triangles is built for order <= {TRIANGLE_MAX_ORDER} (quadratic triangles leave corner "
                              "nodes open inside the contact patch); use order 1, the penalty, or the spectral cell")
+        if twin is not None:
+            flat_level(cell.mesh)           # a twin solves the small-slope cell: S_C must be flat
         self.line_search, self.start, self.coulomb, self.twin = line_search, start, coulomb, twin
         self.coulomb_residual = None      # Coulomb, coupled Newton: the residual form, built on first use
         self.cell, self.model = cell, model

@@ -46,9 +46,15 @@ taken as converged before a step.
 
 Applies to the penalty's first loads under a prescribed pressure on a
 small-slope cell (the twin is built by
-:func:`ngcontact.drivers.build.predictor_twin`); the twin is frictionless
-(a first load is a normal one) and takes the load's normal traction and
-macro strain.  Later loads continue from the previous solution as before
+:func:`ngcontact.drivers.build.predictor_twin`; :func:`flat_level` refuses
+a cell whose ``S_C`` is not flat).  The twin is frictionless and takes the
+first load's normal traction and macro strain: a first load's shear or
+tangential jump is left out, the start is the contact set of the normal
+load (a frictionless flat ``S_C`` carries no shear anyway; with friction
+Newton takes up the shear from there).  A twin that fails leaves the
+rigid start, recorded with the reason, and so does one whose contact set
+misses every point of ``S_C`` (a light load: the start would float).
+Later loads continue from the previous solution as before
 (:mod:`ngcontact.cell.predictor`), and so do the later meshes of a graded
 solve (:mod:`ngcontact.cell.edge_grading`: started afresh from the twin,
 the Westergaard graded sweep took 33-69 steps summed per load against
@@ -72,7 +78,9 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
+from ngcontact.cell.measures import sample_surface
 from ngcontact.cell.spectral_cell import SpectralCell
+from ngcontact.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
 
@@ -81,27 +89,59 @@ def spectral_start(problem, load: CellLoad, twin: SpectralCell) -> dict:
     """Move ``problem.gfu`` (at the rigid predictor's state) onto ``twin``'s contact set (module docstring).
 
     Returns the record of the start for the report: the twin's grid, its iterations and contact fraction.
+    A twin that fails (its solver does not converge), or whose contact set misses every point of ``S_C``
+    (a light load on a coarse mesh: the start would float, its tangent singular), leaves the rigid start,
+    and the record says why: it is a predictor, and the cell problem is solved from the rigid start as
+    before.
     """
     d = problem.dim
     normal = replace(load, traction=(0.0,) * (d - 1) + (load.traction[d - 1],), jump=(None,) * d)
-    sol = twin.solve(normal)
+    try:
+        sol = twin.solve(normal)
+    except (ConvergenceError, ValueError, FloatingPointError) as err:
+        log.warning("spectral predictor: the twin failed (%s); starting from the rigid predictor", err)
+        return {"kind": "rigid", "twin_failed": str(err)}
     target = grid_coefficient(problem.mesh, sol.fields["closure"] - twin.g0, twin.period)
     move = ng.GridFunction(problem.X)
     move.components[0].Set((target - problem.penetration) * problem.n, ng.BND,
                            definedon=problem.mesh.Boundaries("contact"))
     problem.gfu.components[0].vec.data += move.components[0].vec
+    if not np.any(sample_surface(problem, {"s": problem.penetration})["s"] > 0.0):
+        # the twin's contact patches fall between the mesh's points: a start without contact has no tangent
+        # in the far-face approach (the layer floats); the rigid predictor's start always carries the load
+        problem.gfu.components[0].vec.data -= move.components[0].vec
+        log.info("spectral predictor: the twin's contact set (fraction %.3g) misses every point of S_C; "
+                 "starting from the rigid predictor", sol.results["contact_fraction"])
+        return {"kind": "rigid", "twin_failed": f"the twin's contact set (fraction "
+                f"{sol.results['contact_fraction']:.3g}) misses every point of S_C"}
     log.info("spectral predictor: %d-point grid, contact fraction %.6f", twin.grid, sol.results["contact_fraction"])
     return {"kind": "spectral", "grid": twin.grid, "iterations": sol.iterations,
             "contact_fraction": float(sol.results["contact_fraction"])}
 
 
+def flat_level(mesh) -> float:
+    """The normal coordinate of a flat ``S_C`` (the last axis; the small-slope cell's interface).
+
+    Raises
+    ------
+    ValueError
+        ``S_C`` is not a plane normal to the last axis: no spectral twin solves this cell.
+    """
+    dim = mesh.dim
+    level = np.array([mesh[v].point[dim - 1] for el in mesh.Boundaries("contact").Elements() for v in el.vertices])
+    if level.size == 0:
+        raise ValueError("the cell has no contact surface S_C")
+    span = float(np.ptp(level))
+    if span > 1e-12 * max(1.0, float(np.max(np.abs(level)))):
+        raise ValueError(f"S_C spans {span:.3g} along the last axis: it is not flat, and a spectral twin solves "
+                         "the small-slope cell (a flat interface with the roughness in the gap) only")
+    return float(level.mean())
+
+
 def grid_coefficient(mesh, values: np.ndarray, period: float) -> ng.CoefficientFunction:
     """The periodic grid function ``values`` (at ``x_j = j P / N``, 3D indexed ``[y, x]``) on the flat
     ``S_C`` of ``mesh``, piecewise (bi)linear, constant across the interface's normal axis."""
-    dim = mesh.dim
-    normal_axis = np.array([mesh[v].point[dim - 1] for el in mesh.Boundaries("contact").Elements()
-                            for v in el.vertices[:1]])
-    z0 = float(normal_axis.mean())
+    dim, z0 = mesh.dim, flat_level(mesh)
     closed = np.pad(values, [(0, 1)] * values.ndim, mode="wrap")   # the period's far end, x = P
     start = (0.0,) * (dim - 1) + (z0 - 1.0,)
     end = (period,) * (dim - 1) + (z0 + 1.0,)

@@ -77,9 +77,9 @@ def serial_map(task: Callable[[float], Response], items: Sequence[float]) -> lis
 def cell_response(problem: CellProblem, pressure: float, length_unit: float = 1.0) -> Response:
     """Contact fraction, ``k_n0``, ``g_n0`` and mean closure of the cell at a mean pressure.
 
-    ``problem`` is a :class:`ngcontact.cell.cell_problem.CellProblem`, solved from the
-    rigid predictor.  ``k_n0`` is eq. 34 on the real contact set: ``k_n``
-    times the contact fraction (located by the roots of the penetration in
+    ``problem`` is a :class:`ngcontact.cell.cell_problem.CellProblem`, solved from a first
+    load's start (the rigid predictor, or the spectral one where the cell has a twin).  ``k_n0``
+    is eq. 34 on the real contact set: ``k_n`` times the contact fraction (located by the roots of the penetration in
     2D) on a flat cell, else the quadrature integral of the indicator.  The
     closure is the projected mean normal jump on ``S_C``,
 

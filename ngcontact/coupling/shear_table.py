@@ -95,7 +95,7 @@ def cell_shear_response(problem: CellProblem, pressure: float, jump: float, leng
     ``jump`` is the prescribed tangential far-face jump ``Delta`` (rough minus
     counter, cell length units); the returned ``jump`` is ``s`` in metres
     (times ``length_unit``), ``shear`` the mean shear [stress] the rough body
-    transmits to the counter along ``t0``.  Solved from the rigid predictor.
+    transmits to the counter along ``t0``.  Solved from a first load's start.
     """
     if problem.dim != 2:
         raise ModelError("the shear table needs a 2D cell (one tangent)")

@@ -231,11 +231,12 @@ def linear_solver(scene) -> LinearSolver:
     return LinearSolver(policy=s.linear, inverse=s.inverse, threshold=s.iterative_from)
 
 
-def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = True) -> SpectralCell:
+def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = True,
+                  tol: float | None = None) -> SpectralCell:
     """The spectral cell (:mod:`ngcontact.cell.spectral_cell`) of a small-slope cell scene.
 
     ``grid``: points per direction instead of the scene's (a gap given by a formula); ``friction = False``:
-    the cell without the scene's friction.
+    the cell without the scene's friction; ``tol``: its solver's tolerance instead of ``solver.rtol``.
     """
     g, c, s = scene.geometry, scene.contact, scene.solver
     heights = height_map(scene) if small_slope(g) and g.profile != "bisinusoid" else None
@@ -248,13 +249,15 @@ def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = Tr
     return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
                         counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid, heights),
                         k_n=c.k_n,
-                        enforcement=c.enforcement, tol=s.rtol, max_iter=s.cg_max_iter,
+                        enforcement=c.enforcement, tol=s.rtol if tol is None else tol, max_iter=s.cg_max_iter,
                         friction=micro_friction(c) if friction else None)
 
 
 #: grid points of the spectral predictor's twin per interface element size (at least), and its bounds
 TWIN_POINTS_PER_ELEMENT = 4
 TWIN_GRID = {2: (64, 8192), 3: (64, 512)}
+#: tolerance of the twin's solve: only its contact set is used, so it need not reach ``solver.rtol``
+TWIN_RTOL = 1e-8
 
 
 def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> SpectralCell | None:
@@ -263,10 +266,10 @@ def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> Spe
 
     A twin exists for the penalty on a cell the spectral cell can solve (the small-slope model:
     :func:`ngcontact.scene.cell_scene.has_twin`) unless ``solver.start`` asks for another start; it is
-    frictionless.  Its grid is the power of two
-    with ``TWIN_POINTS_PER_ELEMENT`` points per interface element size (``interface_maxh``, else the
-    scene's), within ``TWIN_GRID``; a height map keeps its own samples (interpolated as the FE cell
-    interpolates them).
+    frictionless and solves to ``TWIN_RTOL``.  Its grid is the power of two with
+    ``TWIN_POINTS_PER_ELEMENT`` points per interface element size (``interface_maxh``, else the scene's),
+    and no fewer than a height map's own samples, within ``TWIN_GRID`` (a map finer than the upper bound is
+    resampled bilinearly, as the FE cell interpolates it).
     """
     from ngcontact.scene.cell_scene import has_twin
     if scene.solver.start in ("rigid", "closed") or not has_twin(scene):
@@ -274,8 +277,10 @@ def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> Spe
     g, d = scene.geometry, scene.discretization
     h = interface_maxh or d.interface_maxh or d.maxh
     low, high = TWIN_GRID[g.dim]
-    grid = int(min(max(2 ** math.ceil(math.log2(TWIN_POINTS_PER_ELEMENT * g.period / h)), low), high))
-    return spectral_cell(scene, grid=grid, friction=False)
+    grid = 2 ** math.ceil(math.log2(TWIN_POINTS_PER_ELEMENT * g.period / h))
+    if small_slope(g) and g.profile != "bisinusoid":
+        grid = max(grid, spectral_grid(scene, height_map(scene).shape))
+    return spectral_cell(scene, grid=int(min(max(grid, low), high)), friction=False, tol=TWIN_RTOL)
 
 
 def gap_samples(scene, grid: int, heights: np.ndarray | None = None) -> np.ndarray:

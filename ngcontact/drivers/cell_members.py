@@ -4,7 +4,7 @@ A load sweep normally solves each load from the previous one's solution
 (continuation, :meth:`ngcontact.cell.cell_problem.CellProblem.sweep`): the
 loads are then a chain, and so is a frictional load path.  With
 ``load.independent = true`` every load starts from the unloaded cell (FE:
-the rigid predictor's start of a first load; spectral: no pressure), so the
+a first load's start, rigid or spectral; spectral cell: no pressure), so the
 answer of a load does not depend on the others and the loads of the sweep
 are a batch (:mod:`ngcontact.solvers.executor`) that runs on as many workers
 as there are.  A member receives the scene (a frozen description) and the

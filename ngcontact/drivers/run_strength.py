@@ -54,8 +54,9 @@ class StrengthEvaluation(TypedDict):
 def cell_problem_of(cell_path: str, *, key: str, overrides: dict | None = None,
                     method: str | None = None) -> tuple[CellScene, CellProblem]:
     """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene) -> :class:`CellProblem`
-    with the macro strain term (for recovery)."""
-    from ngcontact.drivers.build import build_cell, model_of
+    with the macro strain term (for recovery), the scene's ``[solver]`` settings and its first loads' start
+    (:func:`ngcontact.drivers.build.cell_problem`)."""
+    from ngcontact.drivers.build import cell_problem, model_of
     cs = load_with_contact(cell_path, overrides, method)
     if cs.kind != "cell":
         raise SceneError(key, cell_path, f"names a {cs.kind!r} scene; a 'cell' scene is needed")
@@ -66,10 +67,7 @@ def cell_problem_of(cell_path: str, *, key: str, overrides: dict | None = None,
         raise SceneError(key, cell_path, f"the cell scene is solved by discretization.method = "
                          f"{cs.discretization.method!r}; the strength recovery needs the body stresses and the macro "
                          "strain term of the FE cell: use a cell scene with method = 'fe'")
-    cell = build_cell(cs)
-    model = dataclasses.replace(model_of(cs), macro_strain=True)
-    s = cs.solver
-    return cs, CellProblem(cell, model, rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse)
+    return cs, cell_problem(cs, model=dataclasses.replace(model_of(cs), macro_strain=True))
 
 
 def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:

@@ -82,7 +82,7 @@ class PressureSolve:
     overrides, data files: :func:`~ngcontact.drivers.build.cell_key`) and the
     worker thread: a worker builds the cell once per run, not once per
     pressure, as the run's own process does with its one task.  Every
-    response is solved afresh from the rigid predictor (``first=True``), so a
+    response is solved afresh from a first load's start (``first=True``), so a
     shared problem gives the numbers of a fresh one.
 
     ``method``: ``"fe"`` or ``"spectral"`` instead of the cell scene's own

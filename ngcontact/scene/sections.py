@@ -100,7 +100,8 @@ class SolverSpec:
     iterative_from: int = param(20000, doc="free dofs from which linear = 'auto' solves a 3D problem iteratively "
                                 "(about where BDDC-CG overtakes the sparse factorization at order 2)",
                                 check=at_least(1))
-    start: str = param("auto", doc="start of an FE cell's first load under a prescribed pressure: spectral (the "
+    start: str = param("auto", doc="FE cell scenes (elsewhere no effect): start of a first load under a "
+                       "prescribed pressure: spectral (the "
                        "rigid predictor moved onto the contact set of the spectral cell of the same small-slope cell; "
                        "the penalty on a flat interface only), rigid (the counter translated rigidly to carry the "
                        "pressure on a Winkler layer), closed (every point pushed into contact), auto (spectral where "

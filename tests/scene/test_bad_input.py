@@ -813,3 +813,10 @@ def test_a_spectral_start_without_a_spectral_twin(tmp_path, capsys):
 def test_an_unknown_start(tmp_path, capsys):
     text = edit(CELL.format(contact=""), ("rtol = 1e-10", 'rtol = 1e-10\nstart = "spectal"'))
     run_bad(tmp_path, capsys, text, "solver.start = 'spectal': must be one of 'auto', 'spectral', 'rigid', 'closed'")
+
+
+def test_a_spectral_start_with_exact_enforcement(tmp_path, capsys):
+    """The spectral predictor moves the penalty's contact set: exact enforcement has no twin."""
+    text = edit(CELL.format(contact='enforcement = "exact"'), ("rtol = 1e-10", 'rtol = 1e-10\nstart = "spectral"'))
+    run_bad(tmp_path, capsys, text, "solver.start = 'spectral': starts from the spectral cell of the same "
+            "small-slope cell: it needs contact.enforcement = 'penalty'", prefix=True)
