@@ -48,11 +48,12 @@ definite on the free dofs.  Two ways:
   with the same contact fraction to 16 digits.
 * ``"auto"``: in 3D iterative from ``threshold`` free dofs on (default
   ``AUTO_THRESHOLD``), direct below; in 2D direct.  Measured with
-  ``scripts/scaling_3d.py`` (2 cores): the 3D bisinusoid cell solves in
-  2.1 s iteratively against 2.6 s directly at 8k dofs, 20 s against 54 s
-  at 39k, 34 s against 145 s at 64k (time ~ N^1.4 against N^1.9); a 3D
-  press fit of two tubes 2.1 s against 1.3 s at 15k dofs, 7.0 s against
-  8.3 s at 43k, 15 s against 43 s at 96k, 114 s at 525k.  In 2D the factorization
+  ``scripts/scaling_3d.py`` (2 cores, 2026-11-28): the 3D bisinusoid cell
+  solves in 0.58 s iteratively against 1.1 s directly at 8k dofs, 2.5 s
+  against 22.7 s at 39k, 3.7 s against 45 s at 64k, 25 s at 301k (time ~
+  N^1.13 from 8k to 451k against N^1.80 to 64k); a 3D press fit of two
+  tubes 1.2 s against 0.9 s at 15k dofs, 3.8 s against 5.3 s at 43k, 8.6 s
+  against 27.5 s at 96k, 59 s at 525k.  In 2D the factorization
   stays far ahead: a 142k-dof order-3 cell took 51 s directly and over
   8 minutes with BDDC-CG.
 
