@@ -54,8 +54,11 @@ load (a frictionless flat ``S_C`` carries no shear anyway; with friction
 Newton takes up the shear from there).  A twin that fails leaves the
 rigid start, recorded with the reason, and so does one whose contact set
 misses every point of ``S_C`` (a light load: the start would float).
-Later loads continue from the previous solution as before
-(:mod:`ngcontact.cell.predictor`), and so do the later meshes of a graded
+A frictionless sweep starts every pressure afresh from the twin
+(:meth:`~ngcontact.cell.cell_problem.CellProblem.sweep`: one minimizer, so
+the previous state need not be kept); a frictional one continues from the
+previous solution as before (:mod:`ngcontact.cell.predictor`), and so do the
+later meshes of a graded
 solve (:mod:`ngcontact.cell.edge_grading`: started afresh from the twin,
 the Westergaard graded sweep took 33-69 steps summed per load against
 39-46 carried over).  Measured, Newton steps per load from the rigid
@@ -66,8 +69,10 @@ or more (``python -m ngcontact.cli run <scene>`` and
 * bisinusoid cell, 8k dofs 7 -> 6; 94.6k dofs 10 -> 6 (13.2 s -> 6.4 s);
   301k dofs 11 -> 6 (62 s -> 26 s), equal to all 16 printed digits;
 * height map (64^2): 9 -> 6;
-* Westergaard sweep (2D): 5, 6, 8, 8, 1 -> 2, 2, 2, 2, 1;
-* tabulated gap (2D): 2, 4, 8 -> 1, 1, 4.
+* Westergaard sweep (2D), each load from a first load's start: 5, 6, 8, 8,
+  1 -> 2, 2, 2, 2, 1 (continued from the previous load, as the sweep did:
+  2, 5, 7, 7, 3);
+* tabulated gap (2D): 2, 4, 8 -> 1, 1, 4 (continued: 1, 5, 7).
 """
 from __future__ import annotations
 

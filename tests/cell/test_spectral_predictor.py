@@ -160,3 +160,18 @@ def test_a_twin_contact_set_between_the_mesh_points_leaves_the_rigid_start():
     assert sol.iterations == again.iterations
     for key in ("contact_fraction", "mean_pressure"):
         assert sol.results[key] == pytest.approx(again.results[key], rel=1e-12)
+
+
+def test_a_frictionless_sweep_starts_every_pressure_from_the_twin():
+    """A frictionless sweep with a twin solves each pressure afresh from the twin (one minimizer, so the
+    previous state need not be kept): the same contact fractions and pressures as the rigid start's
+    continuation, and every load's history records the spectral start."""
+    scene = _scene("westergaard")
+    loads = cell_loads(scene)
+    twin_sweep = cell_problem(scene).sweep(loads)
+    continued = cell_problem(replace(scene, solver=replace(scene.solver, start="rigid"))).sweep(loads)
+    for a, b in zip(continued, twin_sweep):
+        assert b.newton[0]["start"]["kind"] == "spectral"
+        for key in ("contact_fraction", "mean_pressure", "mean_closure"):
+            assert b.results[key] == pytest.approx(a.results[key], rel=1e-9, abs=1e-15)
+    assert sum(s.iterations for s in twin_sweep) < sum(s.iterations for s in continued)
