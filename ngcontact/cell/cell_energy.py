@@ -37,8 +37,8 @@ from ngcontact.solvers.state_form import StateForm
 from ngcontact.laws import penalty as _contact
 
 
-def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | None, tuple]:
-    """The form of ``Pi`` for the trial functions ``(ur, uc, U)`` of ``problem``'s space.
+def cell_energy(problem) -> tuple[ng.BilinearForm, ng.GridFunction | None, tuple]:
+    """The form of ``Pi`` for the trial functions ``(u_r, u_c, U)`` of ``problem``'s space.
 
     Returns the form, for Coulomb friction with the penalty the
     GridFunction of the frozen previous state whose pressure sets the
@@ -46,13 +46,13 @@ def cell_energy(problem, ur, uc, U) -> tuple[ng.BilinearForm, ng.GridFunction | 
     Psi)``: the bodies with the load potential (quadratic) and the interface
     energy, with the same terms (for :class:`ngcontact.solvers.split_energy.SplitEnergy`).
     """
+    trial = problem.X.TrialFunction()
     form, quadratic, interface = _new_form(problem), _new_form(problem), _new_form(problem)
-    for term in _bodies(problem, ur, uc) + [_load(problem, U)]:
+    for term in _bodies(problem, trial[0], trial[1]) + [_load(problem, trial)]:
         form += term
         quadratic += term
-    J = ur - uc - U
     parameters, previous = _interface_parameters(problem)
-    psi = _contact.interface_energy(J, problem.n, **parameters)
+    psi = _contact.interface_energy(jump(trial), problem.n, **parameters)
     term = ng.Variation(psi * _contact_measure(problem))
     form += term
     interface += term
@@ -140,17 +140,15 @@ def coulomb_residual(problem) -> ng.BilinearForm:
     if fr is None or fr.law != "coulomb" or problem.multiplier is not None:
         raise ValueError("the coupled Coulomb residual needs Coulomb friction with the penalty")
     trial, test = problem.X.TrialFunction(), problem.X.TestFunction()
-    ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
     form = ng.BilinearForm(problem.X, symmetric=False)
-    for term in _bodies(problem, ur, uc):
+    for term in _bodies(problem, trial[0], trial[1]):
         form += term
-    J = ur - uc - U
-    dJ = jump(test)
+    J, dJ = jump(trial), jump(test)
     ds = _contact_measure(problem)
     form += ng.Variation(_contact.normal_energy(J, problem.n, m.k_n, problem.gap) * ds)
     G = _contact.coulomb_threshold(J, problem.n, m.k_n, fr.mu, problem.gap)
     form += ng.InnerProduct(_contact.friction_traction(J, problem.n, G, fr.w), dJ) * ds
-    form += _load(problem, U)
+    form += _load(problem, trial)
     return form
 
 
@@ -197,10 +195,10 @@ def _bodies(problem, ur, uc) -> list:
     return terms
 
 
-def _load(problem, U):
-    """The potential ``-|T| tbar . U`` of the far-face tractions."""
+def _load(problem, trial):
+    """The potential ``-|T| tbar . U`` of the far-face tractions (``U``: the trial functions' last components)."""
     t = ng.CF(tuple(problem.traction))
-    return ng.Variation(-ng.InnerProduct(t, U) * ng.ds("top"))
+    return ng.Variation(-ng.InnerProduct(t, ng.CF(tuple(trial[2:]))) * ng.ds("top"))
 
 
 def macro_strain_cf(params, dim: int):

@@ -73,14 +73,14 @@ from ngcontact.cell import measures
 from ngcontact.cell.contact_multiplier import TRIANGLE_MAX_ORDER, ContactMultiplier, solve_exact
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
 from ngcontact.cell.cell_model import CellModel, CellSolution
-from ngcontact.cell.cell_energy import cell_energy, interface_tangent, macro_strain_cf, preconditioning_form
+from ngcontact.cell.cell_energy import cell_energy, interface_tangent, jump, macro_strain_cf, preconditioning_form
 from ngcontact.cell.contact_quadrature import ContactQuadrature
 from ngcontact.cell.contact_quadrature import applies as quadrature_applies
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
-from ngcontact.cell.predictor import max_gap, rigid_continuation, rigid_translation, set_start, tangential_load
+from ngcontact.cell.predictor import check_start, max_gap, start_load, starts_afresh, tangential_load
 from ngcontact.cell.spectral_cell import SpectralCell
-from ngcontact.cell.spectral_predictor import flat_level, spectral_start
+from ngcontact.cell.spectral_predictor import flat_level
 from ngcontact.errors import ModelError
 from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
@@ -159,13 +159,7 @@ class CellProblem:
             raise ValueError(f"coulomb = {coulomb!r}: must be one of {METHODS}")
         if line_search not in ("exact", "armijo"):
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
-        if start is None:
-            start = "rigid" if twin is None else "spectral"
-        if start not in ("rigid", "closed", "spectral"):
-            raise ValueError(f"start = {start!r}: must be 'rigid', 'closed' or 'spectral'")
-        if start == "spectral" and (twin is None or model.enforcement != "penalty"):
-            raise ValueError("start = 'spectral' needs the cell's spectral twin and the penalty "
-                             f"(twin {'given' if twin is not None else 'missing'}, enforcement {model.enforcement!r})")
+        start = check_start(start, twin, model.enforcement)
         if model.enforcement == "exact" and cell.dim == 3 and model.order > TRIANGLE_MAX_ORDER:
             raise ModelError(f"order = {model.order} with enforcement = 'exact' in a 3D cell: exact contact on "
                              f"triangles is built for order <= {TRIANGLE_MAX_ORDER} (quadratic triangles leave corner "
@@ -201,9 +195,7 @@ class CellProblem:
                            if model.enforcement == "exact" else None)
         # exact: the augmentation k_n as a Parameter (the constrained tangent extrapolates in it)
         self.augmentation = ng.Parameter(model.k_n)
-        trial = self.X.TrialFunction()
-        ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
-        self.form, self.coulomb_previous, self._parts = cell_energy(self, ur, uc, U)
+        self.form, self.coulomb_previous, self._parts = cell_energy(self)
         # the state the written-out tangent and the preconditioning form are assembled at
         self._linearized_at = ng.GridFunction(self.X)
         # the penalty's high quadrature on the contact edge's elements only, where that is exact
@@ -214,7 +206,7 @@ class CellProblem:
         # the state as CoefficientFunctions (for results and tests)
         comps = self.gfu.components
         self.U = ng.CF(tuple(comps[2:]))
-        self.J = comps[0] - comps[1] - self.U
+        self.J = jump(comps)
         if self.multiplier is None:
             self.pressure = _contact.pressure(self.J, self.n, model.k_n, self.gap)
             self.augmented_pressure = None
@@ -256,7 +248,7 @@ class CellProblem:
                 free.Clear(d)
         return free
 
-    def _apply_load(self, load: CellLoad, first: bool):
+    def _apply_load(self, load: CellLoad):
         d = self.dim
         if not self.tangential_free:
             for i in range(d - 1):
@@ -277,8 +269,6 @@ class CellProblem:
                 vec[self.u_dofs[i]] = -jump
             elif i < d - 1 and not self.tangential_free:
                 vec[self.u_dofs[i]] = 0.0
-        if first and load.jump[d - 1] is None:
-            set_start(self, load)
 
     def solve(self, load: CellLoad, first: bool = False, measure: bool = True) -> CellSolution:
         """Solve one load, starting from the current state (continuation).
@@ -289,24 +279,9 @@ class CellProblem:
         studies of the solve itself.
         """
         before = tangential_load(self)
-        self._apply_load(load, first)
-        if first and self.multiplier is not None:
-            # a first load starts afresh: a multiplier left by an earlier load (a table of independent cell
-            # solves) held against the rigid predictor's state could leave no point in contact, the bodies
-            # afloat and the tangent singular
-            self.multiplier.set_point_values(np.zeros(len(self.multiplier.point_values())))
-            self.augmentation.Set(self.model.k_n)         # as the scene gave it (Uzawa may have raised it)
-            if self.model.friction is not None:
-                start_multiplier(self, load)
+        self._apply_load(load)
         free = self._freedofs(load)
-        started = None
-        if first and self.start == "spectral" and self.twin is not None and load.jump[self.dim - 1] is None:
-            started = spectral_start(self, load, self.twin)
-        # a later load with a tangential change: frictionless, the rigid predictor for the whole traction;
-        # with friction (or where that has no minimizer), the rigid continuation, whose steps count
-        predicted = None
-        if not first and not (tangential_load(self) != before and rigid_translation(self, load, free)):
-            predicted = rigid_continuation(self, free, before)
+        started, predicted = start_load(self, load, free, first, before)
         histories: list[dict] = [] if predicted is None else [predicted]
         fp = 0
         if self.coulomb_previous is not None:
@@ -381,10 +356,9 @@ class CellProblem:
         1, 5, 7 and 1, 1, 4).
         """
         self.gfu.vec[:] = 0.0
-        afresh = self.start == "spectral" and self.twin is not None and self.model.friction is None
         out = []
         for k, load in enumerate(loads):
-            sol = self.solve(load, first=k == 0 or (afresh and load.jump[self.dim - 1] is None))
+            sol = self.solve(load, first=k == 0 or starts_afresh(self, load))
             log.info("load %d: %d Newton steps, contact fraction %.6f", k, sol.iterations,
                      sol.results["contact_fraction"])
             out.append(sol)
@@ -393,27 +367,6 @@ class CellProblem:
     def measure(self, load: CellLoad) -> dict:
         """Results of the current state: :func:`ngcontact.cell.measures.measure`."""
         return measures.measure(self, load)
-
-
-def start_multiplier(problem: CellProblem, load: CellLoad) -> None:
-    """Uzawa's start under friction: the start state's contact pattern carrying the load's pressure.
-
-    With ``lambda = 0`` the Coulomb threshold ``mu lambda`` would leave the
-    tangential translation without stiffness.  The start state's augmented
-    pressure ``k_n [J_n - g]_+`` gives where the contact is; it is scaled to
-    the prescribed mean pressure, since the start state (the rigid predictor)
-    penetrates by what the bodies would yield, far more than ``p / k_n``, and
-    a multiplier that large opens the whole surface in the first solve.
-    """
-    m = problem.multiplier
-    assert m is not None  # exact enforcement
-    lam = np.maximum(m.at_points(problem.augmented_pressure), 0.0)
-    tn = load.traction[problem.dim - 1]
-    if tn is not None and lam.any():
-        m.set_point_values(lam)
-        carried = m.integrate(m.value)
-        lam *= -tn * problem.area / carried
-    m.set_point_values(lam)
 
 
 # ------------------------------------------------------------ discretization

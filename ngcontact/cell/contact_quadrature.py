@@ -66,10 +66,8 @@ class ContactQuadrature:
         nbnd = mesh.GetNE(ng.BND)
         #: the elements integrated with the high rule (``C``) and the other contact elements
         self.cut, self.smooth = ng.BitArray(nbnd), ng.BitArray(nbnd)
-        self.cut.Clear()
         self.smooth.Clear()
-        for e in self.contact:
-            self.smooth.Set(int(e))
+        self._uncut()
         self._high = 2 * m.order + m.contact_bonus_order
         self._low = 2 * m.order
         self.measures = (ng.ds("contact", definedonelements=self.cut, bonus_intorder=m.contact_bonus_order),
@@ -115,10 +113,14 @@ class ContactQuadrature:
 
     def restart(self, vec) -> None:
         """``C``: the elements ``vec`` cuts (a new solve's start)."""
+        self._uncut()
+        self._add(vec)
+
+    def _uncut(self) -> None:
+        """``C`` empty: every contact element on the low rule."""
         self.cut.Clear()
         for e in self.contact:
             self.smooth.Set(int(e))
-        self._add(vec)
 
     def covers(self, vec) -> bool:
         """Add the elements ``vec`` cuts to ``C``; whether ``C`` held them all already."""
@@ -149,8 +151,7 @@ class ContactQuadrature:
 
     def AssembleLinearization(self, vec) -> None:  # noqa: N802
         """The tangent at ``vec``, with ``C`` the elements ``vec`` cuts."""
-        self.restart(vec)
-        self.state.vec.data = vec
+        self.restart(vec)                # leaves the state at ``vec``
         self.tangent.Assemble()
 
     def newton(self, vec, run, rtol: float, atol: float) -> dict:

@@ -109,6 +109,7 @@ import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.measures import contact_integral, sample_surface
+from ngcontact.cell.spectral_predictor import spectral_start
 from ngcontact.laws import penalty as _contact
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.newton import ARMIJO, illinois_root, minimize
@@ -344,6 +345,94 @@ def _winkler_translation(problem, U0, t, comps, k_L, max_iter: int = 50):
         if np.max(np.abs(alpha * step)) <= 1e-12 * max(np.max(np.abs(U)), 1e-300):
             return U
     return None
+
+
+#: the starts of a first load under a prescribed pressure (:func:`start_load`)
+STARTS = ("rigid", "closed", "spectral")
+
+
+def check_start(start: str | None, twin, enforcement: str) -> str:
+    """The start of a cell problem's first loads: ``start``, by default ``"spectral"`` with a spectral
+    ``twin`` and ``"rigid"`` without.
+
+    Raises
+    ------
+    ValueError
+        ``start`` is none of :data:`STARTS`, or ``"spectral"`` without a twin or with exact enforcement.
+    """
+    if start is None:
+        start = "rigid" if twin is None else "spectral"
+    if start not in STARTS:
+        raise ValueError(f"start = {start!r}: must be 'rigid', 'closed' or 'spectral'")
+    if start == "spectral" and (twin is None or enforcement != "penalty"):
+        raise ValueError("start = 'spectral' needs the cell's spectral twin and the penalty "
+                         f"(twin {'given' if twin is not None else 'missing'}, enforcement {enforcement!r})")
+    return start
+
+
+def starts_afresh(problem, load: CellLoad) -> bool:
+    """Whether a sweep solves ``load`` as a first load: a frictionless cell with a spectral twin, under a
+    prescribed pressure (its energy has one minimizer, and the twin's contact set is nearer the solution's
+    than the previous load's: :meth:`~ngcontact.cell.cell_problem.CellProblem.sweep`)."""
+    return problem.model.friction is None and _spectral(problem, load)
+
+
+def _spectral(problem, load: CellLoad) -> bool:
+    """Whether a first ``load`` starts on the spectral twin's contact set (a pressure prescribed)."""
+    return problem.start == "spectral" and problem.twin is not None and load.jump[problem.dim - 1] is None
+
+
+def start_load(problem, load: CellLoad, free, first: bool, before: tuple[float, ...]) -> tuple[dict | None,
+                                                                                             dict | None]:
+    """Put the start of ``load`` (its values applied) into ``problem.gfu`` (module docstring).
+
+    A first load under a prescribed pressure: the rigid or closed start (:func:`set_start`), moved onto the
+    spectral twin's contact set where the problem starts so
+    (:func:`ngcontact.cell.spectral_predictor.spectral_start`); with exact enforcement the multiplier starts
+    afresh (:func:`start_multiplier` under friction).  A later load whose tangential load changed
+    (``before``: :func:`tangential_load` of the previous one): frictionless, the rigid predictor for the
+    whole traction (:func:`rigid_translation`); with friction, or where that has no minimizer, the rigid
+    continuation, whose steps count.  ``free``: the load's free dofs.
+
+    Returns the spectral start's record and the rigid continuation's history (either ``None``).
+    """
+    if not first:
+        if tangential_load(problem) != before and rigid_translation(problem, load, free):
+            return None, None
+        return None, rigid_continuation(problem, free, before)
+    if load.jump[problem.dim - 1] is None:
+        set_start(problem, load)
+    if problem.multiplier is not None:
+        # a first load starts afresh: a multiplier left by an earlier load (a table of independent cell
+        # solves) held against the rigid predictor's state could leave no point in contact, the bodies
+        # afloat and the tangent singular
+        problem.multiplier.set_point_values(np.zeros(len(problem.multiplier.point_values())))
+        problem.augmentation.Set(problem.model.k_n)      # as the scene gave it (Uzawa may have raised it)
+        if problem.model.friction is not None:
+            start_multiplier(problem, load)
+    return (spectral_start(problem, load, problem.twin) if _spectral(problem, load) else None), None
+
+
+def start_multiplier(problem, load: CellLoad) -> None:
+    """Uzawa's start under friction: the start state's contact pattern carrying the load's pressure.
+
+    With ``lambda = 0`` the Coulomb threshold ``mu lambda`` would leave the
+    tangential translation without stiffness.  The start state's augmented
+    pressure ``k_n [J_n - g]_+`` gives where the contact is; it is scaled to
+    the prescribed mean pressure, since the start state (the rigid predictor)
+    penetrates by what the bodies would yield, far more than ``p / k_n``, and
+    a multiplier that large opens the whole surface in the first solve.
+    """
+    m = problem.multiplier
+    assert m is not None  # exact enforcement
+    lam = np.maximum(m.at_points(problem.augmented_pressure), 0.0)
+    tn = load.traction[problem.dim - 1]
+    if tn is not None and lam.any():
+        m.set_point_values(lam)
+        carried = m.integrate(m.value)
+        lam *= -tn * problem.area / carried
+    m.set_point_values(lam)
+
 
 
 def tangential_load(problem) -> tuple[float, ...]:

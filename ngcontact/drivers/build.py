@@ -232,14 +232,16 @@ def linear_solver(scene) -> LinearSolver:
 
 
 def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = True,
-                  tol: float | None = None) -> SpectralCell:
+                  tol: float | None = None, heights: np.ndarray | None = None) -> SpectralCell:
     """The spectral cell (:mod:`ngcontact.cell.spectral_cell`) of a small-slope cell scene.
 
     ``grid``: points per direction instead of the scene's (a gap given by a formula); ``friction = False``:
-    the cell without the scene's friction; ``tol``: its solver's tolerance instead of ``solver.rtol``.
+    the cell without the scene's friction; ``tol``: its solver's tolerance instead of ``solver.rtol``;
+    ``heights``: the profile's height map when the caller has it already (:func:`map_heights`).
     """
     g, c, s = scene.geometry, scene.contact, scene.solver
-    heights = height_map(scene) if small_slope(g) and g.profile != "bisinusoid" else None
+    if heights is None:
+        heights = map_heights(scene)
     if grid is None:
         grid = spectral_grid(scene, None if heights is None else heights.shape)
 
@@ -278,9 +280,18 @@ def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> Spe
     h = interface_maxh or d.interface_maxh or d.maxh
     low, high = TWIN_GRID[g.dim]
     grid = 2 ** math.ceil(math.log2(TWIN_POINTS_PER_ELEMENT * g.period / h))
-    if small_slope(g) and g.profile != "bisinusoid":
-        grid = max(grid, spectral_grid(scene, height_map(scene).shape))
-    return spectral_cell(scene, grid=int(min(max(grid, low), high)), friction=False, tol=TWIN_RTOL)
+    heights = map_heights(scene)
+    if heights is not None:
+        grid = max(grid, spectral_grid(scene, heights.shape))
+    return spectral_cell(scene, grid=int(min(max(grid, low), high)), friction=False, tol=TWIN_RTOL,
+                         heights=heights)
+
+
+def map_heights(scene: CellScene) -> np.ndarray | None:
+    """The height map of a small-slope cell whose gap comes from one (height map, self-affine surface), or
+    ``None`` (a gap given by a formula)."""
+    g = scene.geometry
+    return height_map(scene) if small_slope(g) and g.profile != "bisinusoid" else None
 
 
 def gap_samples(scene, grid: int, heights: np.ndarray | None = None) -> np.ndarray:

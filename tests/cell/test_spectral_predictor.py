@@ -9,6 +9,7 @@ import pytest
 
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.measures import sample_surface
+from ngcontact.cell.predictor import set_start
 from ngcontact.cell.spectral_predictor import grid_coefficient, spectral_start
 from ngcontact.drivers.build import TWIN_GRID, build_cell, cell_loads, cell_problem, model_of, predictor_twin
 from ngcontact.scene.loader import load
@@ -34,7 +35,8 @@ def test_the_start_has_the_twin_s_contact_set():
     P = _problem(BISINUSOID, "spectral", 0.12)
     twin = P.twin
     load_ = cell_loads(BISINUSOID)[0]
-    P._apply_load(load_, first=True)              # the rigid predictor's state
+    P._apply_load(load_)
+    set_start(P, load_)                           # the rigid predictor's state
     record = spectral_start(P, load_, twin)
     assert record["kind"] == "spectral" and record["grid"] == twin.grid == 64
     s = sample_surface(P, {"s": P.penetration, "x": ng.x, "y": ng.y})
@@ -59,7 +61,8 @@ def test_the_start_has_the_twin_s_contact_set():
     assert np.max(np.abs(s["s"] - expected)) <= 0.05 * opened
     # the rigid start's penetration is a level set of the gap: further from the twin's contact set
     R = _problem(BISINUSOID, "rigid", 0.12)
-    R._apply_load(load_, first=True)
+    R._apply_load(load_)
+    set_start(R, load_)
     rigid = agreement(sample_surface(R, {"s": R.penetration})["s"])
     assert rigid[0] + rigid[1] < closed_share + open_share
 
