@@ -27,7 +27,7 @@ The start.  The rigid predictor's state (fluctuations zero, the counter
 at the rigid approach), then the rough body's trace on ``S_C`` moved along
 the normal by ``s* - s`` (``s`` the penetration of that state), so that the
 start's penetration is the twin's, interpolated bilinearly from its grid
-(:func:`grid_coefficient`) and set into the trace's polynomials.  The
+(:func:`ngcontact.fem.interpolants.periodic_grid`) and set into the trace's polynomials.  The
 body's interior is left as it is: the state is not smooth, but only its
 active set enters the first Newton step.  The trace cannot follow the
 penetration's kink at the contact edge within an element, so the start's
@@ -86,6 +86,7 @@ from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.measures import sample_surface
 from ngcontact.cell.spectral_cell import SpectralCell
 from ngcontact.errors import ConvergenceError
+from ngcontact.fem.interpolants import periodic_grid
 
 log = logging.getLogger(__name__)
 
@@ -106,7 +107,7 @@ def spectral_start(problem, load: CellLoad, twin: SpectralCell) -> dict:
     except (ConvergenceError, ValueError, FloatingPointError) as err:
         log.warning("spectral predictor: the twin failed (%s); starting from the rigid predictor", err)
         return {"kind": "rigid", "twin_failed": str(err)}
-    target = grid_coefficient(problem.mesh, sol.fields["closure"] - twin.g0, twin.period)
+    target = periodic_grid(sol.fields["closure"] - twin.g0, twin.period)
     move = ng.GridFunction(problem.X)
     move.components[0].Set((target - problem.penetration) * problem.n, ng.BND,
                            definedon=problem.mesh.Boundaries("contact"))
@@ -141,13 +142,3 @@ def flat_level(mesh) -> float:
         raise ValueError(f"S_C spans {span:.3g} along the last axis: it is not flat, and a spectral twin solves "
                          "the small-slope cell (a flat interface with the roughness in the gap) only")
     return float(level.mean())
-
-
-def grid_coefficient(mesh, values: np.ndarray, period: float) -> ng.CoefficientFunction:
-    """The periodic grid function ``values`` (at ``x_j = j P / N``, 3D indexed ``[y, x]``) on the flat
-    ``S_C`` of ``mesh``, piecewise (bi)linear, constant across the interface's normal axis."""
-    dim, z0 = mesh.dim, flat_level(mesh)
-    closed = np.pad(values, [(0, 1)] * values.ndim, mode="wrap")   # the period's far end, x = P
-    start = (0.0,) * (dim - 1) + (z0 - 1.0,)
-    end = (period,) * (dim - 1) + (z0 + 1.0,)
-    return ng.VoxelCoefficient(start, end, np.stack([closed, closed]), linear=True)

@@ -3,7 +3,8 @@
 Tabulated gaps and profiles come as samples ``(x_i, g_i)``; the finite
 element forms need them as functions of the mesh coordinates.  A periodic
 table (:func:`periodic_table_1d`, the cell's gap and profile) is resampled
-on a voxel grid; an open one (:func:`piecewise_linear`, the macro gap table
+on a voxel grid; periodic samples on a uniform grid (:func:`periodic_grid`,
+a spectral cell's fields) are carried by one as they are; an open one (:func:`piecewise_linear`, the macro gap table
 and the two-scale coefficient fields) is written exactly as a sum of ramps.
 """
 from __future__ import annotations
@@ -22,9 +23,23 @@ def periodic_table_1d(x, g, period: float, samples: int = 4096):
     coefficient that is constant in ``y``.
     """
     xs = np.linspace(0.0, period, samples + 1)
-    row = np.interp(xs, x, g)
-    data = np.ascontiguousarray(np.vstack([row, row]))
-    return ng.VoxelCoefficient((0.0, -1e3), (period, 1e3), data, linear=True)
+    return _voxels(np.interp(xs, x, g), period)
+
+
+def periodic_grid(values, period: float):
+    """The periodic (bi)linear interpolant of samples at ``x_j = j P / N`` (2D arrays indexed ``[y, x]``,
+    ``y_i = i P / N``): of ``x`` (constant in ``y``) for a 1D array, of ``(x, y)`` (constant in ``z``) for a
+    2D one; the period's far end repeats the first samples."""
+    closed = np.pad(np.asarray(values, dtype=float), [(0, 1)] * np.ndim(values), mode="wrap")
+    return _voxels(closed, period)
+
+
+def _voxels(closed: np.ndarray, period: float):
+    """A voxel coefficient over ``[0, P]`` (or ``[0, P]^2``) from samples that include both ends."""
+    if closed.ndim == 1:
+        return ng.VoxelCoefficient((0.0, -1e3), (period, 1e3), np.ascontiguousarray(np.vstack([closed, closed])),
+                                   linear=True)
+    return ng.VoxelCoefficient((0.0, 0.0), (period, period), np.ascontiguousarray(closed), linear=True)
 
 
 def piecewise_linear(coordinate, points):

@@ -10,7 +10,8 @@ import pytest
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.measures import sample_surface
 from ngcontact.cell.predictor import set_start
-from ngcontact.cell.spectral_predictor import grid_coefficient, spectral_start
+from ngcontact.cell.spectral_predictor import spectral_start
+from ngcontact.fem.interpolants import periodic_grid
 from ngcontact.drivers.build import TWIN_GRID, build_cell, cell_loads, cell_problem, model_of, predictor_twin
 from ngcontact.scene.loader import load
 
@@ -88,14 +89,14 @@ def test_the_spectral_start_reaches_the_rigid_start_s_solution(name, interface_m
         assert sum(h["iterations"] for h in b.newton) <= sum(h["iterations"] for h in a.newton)
 
 
-def test_grid_coefficient_is_the_periodic_bilinear_interpolant():
+def test_periodic_grid_is_the_periodic_bilinear_interpolant():
     """At the grid points (the period's far end included, wrapped) the values, between them the mean of
     the two neighbours, on a 3D cell's S_C."""
     mesh = build_cell(BISINUSOID, interface_maxh=0.12).mesh
     rng = np.random.default_rng(3)
     N = 8
     values = rng.standard_normal((N, N))
-    cf = grid_coefficient(mesh, values, 1.0)
+    cf = periodic_grid(values, 1.0)
     for j, i in ((0, 0), (3, 5), (7, 7), (N, 2), (4, N)):
         assert cf(mesh(i / N, j / N, 0.0)) == pytest.approx(values[j % N, i % N], abs=1e-12)
     assert cf(mesh(2.5 / N, 1.0 / N, 0.0)) == pytest.approx(0.5 * (values[1, 2] + values[1, 3]), abs=1e-12)
