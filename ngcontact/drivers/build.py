@@ -214,14 +214,16 @@ def gap_cf(scene):
 
 
 def cell_problem(scene: CellScene, cell=None, model: CellModel | None = None,
-                 interface_maxh: float | None = None) -> CellProblem:
+                 twin: SpectralCell | None = None) -> CellProblem:
     """The FE cell problem of a cell scene: its mesh (``cell``, default :func:`build_cell`), its model
     (default :func:`model_of`), the ``[solver]`` settings, and the spectral twin that starts its first loads
-    where it has one (:func:`predictor_twin`, grid from ``interface_maxh``, else the scene's)."""
+    where it has one (``twin``, built by the caller for several meshes of one cell; default
+    :func:`predictor_twin` of the scene)."""
     s = scene.solver
     return CellProblem(build_cell(scene) if cell is None else cell, model_of(scene) if model is None else model,
                        rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
-                       linear=linear_solver(scene), coulomb=s.coulomb, twin=predictor_twin(scene, interface_maxh),
+                       linear=linear_solver(scene), coulomb=s.coulomb,
+                       twin=predictor_twin(scene) if twin is None else twin,
                        start=None if s.start == "auto" else s.start)
 
 

@@ -28,7 +28,8 @@ from typing import Any
 import numpy as np
 
 
-from ngcontact.drivers.build import build_cell, cell_loads, cell_problem, gap_cf, model_of, spectral_cell
+from ngcontact.drivers.build import (build_cell, cell_loads, cell_problem, gap_cf, model_of, predictor_twin,
+                                    spectral_cell)
 from ngcontact.cell.edge_grading import GradedSolve, graded_flat_cell, solve_to_tolerance
 
 from ngcontact.cell import spectral_measures
@@ -47,11 +48,12 @@ def solve_graded(scene, loads) -> list[GradedSolve]:
     g, d = scene.geometry, scene.discretization
     model = model_of(scene)
     h0 = d.interface_maxh or d.maxh
+    twin = predictor_twin(scene, h0)     # one for every mesh level (only a first level's start uses it)
 
     def make_problem(vertices, order):
         cell = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
                                 vertices=vertices)
-        return cell_problem(scene, cell, replace(model, order=order), interface_maxh=h0)
+        return cell_problem(scene, cell, replace(model, order=order), twin=twin)
 
     out = []
     for k, load in enumerate(loads):
