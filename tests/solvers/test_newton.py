@@ -107,7 +107,7 @@ def test_cell_newton_records_the_active_set_and_finds_no_false_cycle():
 def test_the_roundoff_floor_is_eps_times_abs_k_times_abs_u_on_the_free_dofs(symmetric_storage):
     """``ROUNDOFF eps || |K| |u| ||`` over the free dofs, from either storage of ``K`` (a dense check)."""
     import numpy as np
-    from ngcontact.solvers.newton import ROUNDOFF, roundoff_floor
+    from ngcontact.solvers.newton import ROUNDOFF, roundoff_floor, roundoff_floors
     mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.25))
     V = ng.VectorH1(mesh, order=2, dirichlet="bottom")
     u, v = V.TnT()
@@ -127,7 +127,42 @@ def test_the_roundoff_floor_is_eps_times_abs_k_times_abs_u_on_the_free_dofs(symm
         e[j] = 1.0
         col.data = full.mat * e
         dense[:, j] = col.FV().NumPy()
-    m = np.abs(dense) @ np.abs(g.vec.FV().NumPy())
+    absu = np.abs(g.vec.FV().NumPy())
+    m = np.abs(dense) @ absu
+    energy_expected = ROUNDOFF * np.finfo(float).eps * (0.7 + 0.5 * absu @ m)
     m[fixed] = 0.0
     expected = ROUNDOFF * np.finfo(float).eps * np.linalg.norm(m)
     assert roundoff_floor(a.mat, g.vec, fixed) == pytest.approx(expected, rel=1e-12)
+    assert roundoff_floors(a.mat, g.vec, fixed, -0.7) == pytest.approx((expected, energy_expected), rel=1e-12)
+
+
+@pytest.mark.parametrize("offset", [0.0, 3e2, 1e3, 3e4])
+def test_steps_below_the_energy_roundoff_are_judged_by_the_residual(offset):
+    """A smooth nonlinear field offset by a constant: near the solution the energy's change is below its round-off.
+
+    ``Pi = int |grad u|^2/2 + v^4/4 + v^2/2 - f v`` with ``v = u - offset``:
+    the offset leaves the problem unchanged but makes the energy a
+    difference of large terms.  Newton converges quadratically in 4 steps
+    whatever the offset; with Armijo's test on the energy alone it took 16
+    and 14 steps at offsets 3e2 and 1e3 (steps halved at random) and did not
+    converge in 30 at 3e4.
+    """
+    mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.1))
+    fes = ng.H1(mesh, order=2, dirichlet="left|right")
+    u = fes.TrialFunction()
+    v = u - offset
+    a = ng.BilinearForm(fes, symmetric=True)
+    a += ng.Variation((0.5 * ng.grad(u) * ng.grad(u) + 0.25 * v ** 4 + 0.5 * v * v - 10 * ng.sin(3 * ng.x) * v)
+                      * ng.dx)
+    g = ng.GridFunction(fes)
+    g.Set(ng.CF(offset))
+    h = minimize(a, g, rtol=1e-13, max_iter=30)
+    assert h.converged and h.iterations <= 5, (h.iterations, h.residuals)
+    g0 = ng.GridFunction(fes)
+    g0.Set(ng.CF(0.0))
+    a0 = ng.BilinearForm(fes, symmetric=True)
+    w = fes.TrialFunction()
+    a0 += ng.Variation((0.5 * ng.grad(w) * ng.grad(w) + 0.25 * w ** 4 + 0.5 * w * w - 10 * ng.sin(3 * ng.x) * w)
+                       * ng.dx)
+    minimize(a0, g0, rtol=1e-13)
+    assert ng.Integrate((g - offset - g0) ** 2, mesh) ** 0.5 <= 1e-8 * max(1.0, offset)
