@@ -89,6 +89,8 @@ class GradedSolve:
     solution: Any
     estimate_from: tuple[dict[str, Any], dict[str, Any]]  # the level and the order comparison that met it
     history: list[dict[str, Any]] = field(default_factory=list)
+    #: the Newton histories of every level's solve, in order, each with its ``"level"`` and ``"order"``
+    newton: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def estimate(self) -> dict[str, float]:
@@ -185,6 +187,7 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
         not reach the tolerance (the figures in the message).
     """
     history: list[dict[str, Any]] = []
+    newton: list[dict[str, Any]] = []
     vertices: list[float] = []
     step = raises = 0
     graded: dict[str, Any] | None = None  # the last level-against-level comparison checked by an order raise
@@ -206,6 +209,7 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
             entry["fraction_change"] = abs(f - before[1]["contact_fraction"])
             entry["closure_change"] = abs(c - before[1]["mean_closure"]) / max(abs(c), 1e-300)
         history.append(entry)
+        newton.extend(dict(h, level=level, order=p) for h in sol.newton)
         log.info("grading level %d, order %d: %d dofs, contact fraction %.10g, change %s", level, p,
                  problem.ndof, f, entry["fraction_change"])
         return problem, sol, edges, entry
@@ -228,7 +232,7 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
                 problem, sol, edges, entry = run(vertices, order, entry["level"], (problem, entry))
                 if graded["fraction_change"] <= tolerance and met(entry):
                     return GradedSolve(problem=problem, solution=sol, history=history,
-                                       estimate_from=(graded, entry))
+                                       estimate_from=(graded, entry), newton=newton)
                 if step < MAX_STEPS:
                     break
         if step == MAX_STEPS or raises > MAX_ORDER_RAISES:

@@ -170,13 +170,13 @@ def run(scene, clock) -> Outcome:
                                       else sol.iterations)
         entry["coulomb_iterations"] = sol.coulomb_iterations
         per_load.append(entry)
-        newton.append(sol.newton)
+        newton.append(graded[k].newton if graded else sol.newton)
         sf = sol.surface
         coords = [k for k in ("x", "y", "z") if k in sf]
         tables[f"surface_load{k}"] = (coords + ["pressure", "slip", "closure"],
                                       list(zip(*[sf[n] for n in coords + ["pressure", "slip", "closure"]])))
     results["loads"] = per_load
-    solver = {"iterations": sum(x.iterations for x in sols),
+    solver = {"iterations": sum(entry["newton_iterations"] for entry in per_load),
               "converged": True, "per_load": newton, "linear": P.linear.summary()}
     comps = P.gfu.components
     vtk = {"cell": VtkField(mesh=cell.mesh, fields={"u_rough": comps[0], "u_counter": comps[1]},

@@ -94,6 +94,10 @@ def test_grading_converges_monotonically_and_the_estimate_bounds_the_error():
     assert g.history[-1]["order"] > 2  # the answer is the one-order-higher check
     smallest = [h["smallest_element"] for h in g.history if h["order"] == 2]
     assert all(b < a for a, b in zip(smallest, smallest[1:]))
+    # the Newton histories of every level, each with its level and order, summing to the levels' counts
+    assert [(h["level"], h["order"]) for h in g.newton] == [(h["level"], h["order"]) for h in g.history]
+    assert sum(h["iterations"] for h in g.newton) == sum(h["newton_iterations"] for h in g.history)
+    assert g.newton[-1]["iterations"] == g.solution.iterations
 
 
 def test_a_tolerance_out_of_reach_fails_with_the_figures(monkeypatch):
@@ -123,6 +127,10 @@ def test_the_shipped_graded_scene_meets_its_tolerance_against_westergaard():
         assert entry["error_estimate"]["contact_fraction"] <= sc.discretization.tolerance
         assert error <= entry["error_estimate"]["contact_fraction"], (error, entry["error_estimate"])
         assert error / exact < 2e-5  # measured 8.9e-6 at worst
+    # the solver record holds every level's Newton solve, not only the finest's, and counts them all
+    per_load = report["solver"]["per_load"]
+    assert [len(solves) for solves in per_load] == [len(e["mesh_history"]) for e in report["results"]["loads"]]
+    assert report["solver"]["iterations"] == sum(e["newton_iterations"] for e in report["results"]["loads"])
 
 
 @pytest.mark.slow  # about 15 s: the shipped scene's four loads, with exact contact
