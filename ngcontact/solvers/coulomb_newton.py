@@ -85,8 +85,8 @@ import numpy as np
 
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.linear_solver import LinearSolver
-from ngcontact.solvers.newton import (ARMIJO, MIN_STEP, ActiveSetCycle, NewtonHistory, at_floor, exact_step,
-                                      fixed_mask, mask_fixed, roundoff_floor)
+from ngcontact.solvers.newton import (ARMIJO, MIN_STEP, ActiveSetCycle, NewtonHistory, armijo, at_floor,
+                                      exact_step, fixed_mask, mask_fixed, roundoff_floor)
 
 log = logging.getLogger(__name__)
 
@@ -255,7 +255,7 @@ def _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res,
     while alpha >= MIN_STEP:
         trial.data = gfu.vec - alpha * du
         e_new = energy_form.Energy(trial)
-        if math.isfinite(e_new) and e_new <= energy - ARMIJO * alpha * slope + 1e-14 * abs(energy):
+        if armijo(energy, e_new, alpha * slope):
             gfu.vec.data = trial
             return alpha
         alpha *= 0.5

@@ -20,21 +20,22 @@ of the current one is therefore judged by the residual instead, and accepted
 when ``|r(u - alpha du)| <= (1 - c alpha) |r(u)|``.  When no step length
 lowers either, the step's whole predicted decrease ``du . r`` is below the
 energy's round-off and the residual is within ``STAGNATION`` times its floor
-(below), the iterate is at round-off: converged.  The iteration stops when the residual (free
-dofs) has fallen below ``rtol`` times the first residual, or below ``atol``, or
-below its round-off floor ``ROUNDOFF eps || |K| |u| ||``: the size at which
-the residual, a sum of terms as large as ``|K_ij| |u_j|``, can no longer be
-evaluated.  Stiff terms (a Huber width of 1e-12, a penalty touching with zero
-force) put that floor above ``rtol`` times the first residual; without it
-Newton would wander in the round-off until ``max_iter``.  The floor grows with
-``|u|``: a runaway iterate (a body that floats off under an unbalanced load,
-a singular system) drags it up to its own, unchanged residual.  So the floor
-counts only after real progress: the residual has fallen below
-``FLOOR_PROGRESS`` times the first one, or the first one was itself at the
-round-off of the start value (within ``FLOOR_GROWTH`` times its floor: a
-start that already was the solution).  (Equilibrium checks of the
-results catch what a residual at its floor cannot show, e.g.
-:func:`ngcontact.cell.measures.equilibrium_error`.)
+(below), the iterate is at round-off: converged.
+
+The iteration stops when the residual (free dofs) has fallen below ``rtol``
+times the first residual, or below ``atol``, or below its round-off floor
+``ROUNDOFF eps || |K| |u| ||``: the size at which the residual, a sum of terms
+as large as ``|K_ij| |u_j|``, can no longer be evaluated. Stiff terms (a Huber
+width of 1e-12, a penalty touching with zero force) put that floor above
+``rtol`` times the first residual; without it Newton would wander in the
+round-off until ``max_iter``. The floor grows with ``|u|``: a runaway iterate
+(a body that floats off under an unbalanced load, a singular system) drags it
+up to its own, unchanged residual. So the floor counts only after real
+progress: the residual has fallen below ``FLOOR_PROGRESS`` times the first
+one, or the first one was itself at the round-off of the start value (within
+``FLOOR_GROWTH`` times its floor: a start that already was the solution).
+(Equilibrium checks of the results catch what a residual at its floor cannot
+show, e.g. :func:`ngcontact.cell.measures.equilibrium_error`.)
 
 A quadratic energy is minimized by a linear solve, refined with the same
 factorization while the residual is above the tolerance (at most
@@ -239,12 +240,13 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         while True:
             trial.data = gfu.vec - alpha * du
             e_new = form.Energy(trial)
-            r_new = math.nan
-            if sufficient_decrease(energy, e_new, alpha * slope, efloor):
+            decreased = armijo(energy, e_new, alpha * slope)
+            if decreased or within_roundoff(energy, e_new, efloor):
                 r_new = residual(trial)        # a finite energy can still have a non-finite gradient
-            if math.isfinite(r_new) and (e_new <= energy - ARMIJO * alpha * slope + 1e-14 * abs(energy)
-                                         or r_new <= (1.0 - ARMIJO * alpha) * rnorm):
-                break
+                if math.isfinite(r_new) and (decreased or r_new <= (1.0 - ARMIJO * alpha) * rnorm):
+                    break
+                if not math.isfinite(r_new):
+                    log.debug("newton %d: non-finite residual at alpha = %g, backtracking", it, alpha)
             alpha *= 0.5
             if alpha < MIN_STEP:
                 if at_roundoff(slope, efloor, rnorm, floor, r0):
@@ -280,11 +282,15 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         hist.as_dict())
 
 
-def sufficient_decrease(energy: float, e_new: float, decrease: float, efloor: float) -> bool:
-    """Armijo's test on the energy, ``Pi_new <= Pi - c decrease``, or a finite ``Pi_new`` within the energy's
-    round-off ``efloor`` of ``Pi`` (then the residual decides: module docstring)."""
-    return math.isfinite(e_new) and (e_new <= energy - ARMIJO * decrease + 1e-14 * abs(energy)
-                                     or e_new <= energy + efloor)
+def armijo(energy: float, e_new: float, decrease: float) -> bool:
+    """Armijo's test: ``Pi_new <= Pi - c decrease`` (``decrease = alpha du . r``), ``Pi_new`` finite."""
+    return math.isfinite(e_new) and e_new <= energy - ARMIJO * decrease + 1e-14 * abs(energy)
+
+
+def within_roundoff(energy: float, e_new: float, efloor: float) -> bool:
+    """``Pi_new`` finite and within the energy's round-off ``efloor`` above ``Pi``: the energy cannot tell the
+    step from no step, and the residual decides (module docstring)."""
+    return math.isfinite(e_new) and e_new <= energy + efloor
 
 
 def at_roundoff(slope: float, efloor: float, rnorm: float, floor: float, r0: float) -> bool:
