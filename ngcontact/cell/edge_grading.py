@@ -28,6 +28,24 @@ The edges are not known in advance, so meshing and solving alternate:
    of the coarser solution of each pair: an upper bound of the finer one's
    once the sequences contract); the answer reported is the finest.
 
+The first mesh from the spectral twin.  With the penalty, a flat cell has
+a spectral twin (:mod:`ngcontact.cell.spectral_predictor`): the same
+layers and ``k_n`` on a grid, solved with FFTs in a fraction of a second.
+Its contact edges, known to half its grid spacing
+(:func:`~ngcontact.cell.spectral_predictor.twin_edges`), replace step 1's
+uniform solve: the first mesh is graded towards them by as many levels as
+bring its smallest element down to the spacing (:func:`seed_levels`), and
+the loop goes on from there.  And every level, the order raise included,
+starts afresh from the twin's contact set instead of the previous level's
+state (a frictionless energy has one minimizer; the carried state has
+holes in its contact set where the interpolation between unrelated meshes
+shifts the tiny penetration ``p/k_n`` across zero).  On the shipped scene
+``westergaard_graded.toml`` (``k_n = 1e6 E``, tolerance 1e-4, the twin on
+8192 points), Newton steps summed over each load's meshes went from 39-48
+on 5-6 meshes (the first one uniform, the later ones carried over) to 13,
+10, 11, 10 on 3, and the solve from 10 s to 4 s, the errors against
+Westergaard the same (1e-6 to 5e-6).
+
 A full contact has no edge: the interface mesh is halved instead.  With the penalty enforcement the model *is* the
 Winkler layer ``k_n`` (paper eqs. 7, 9), whose own difference from rigid
 contact is not part of the estimate.
@@ -45,6 +63,7 @@ import numpy as np
 import ngsolve as ng
 
 from ngcontact.cell.measures import contact_pieces
+from ngcontact.cell.predictor import starts_afresh
 from ngcontact.errors import ConvergenceError
 from ngcontact.geometry.cell2d import flat_cell
 
@@ -156,8 +175,18 @@ def carry_over(old, new) -> None:
             np.interp(new.multiplier.at_points(ng.x), x_old[order], lam[order], period=period), 0.0))
 
 
+def seed_levels(h0: float, spacing: float) -> int:
+    """Grading levels of a first mesh seeded with edges known to ``spacing``: the fewest steps of
+    ``LEVELS_PER_STEP`` whose smallest element ``h0 r^L`` is no larger than ``spacing`` (finer elements would
+    crowd around the seed's error, not the edge), one step at least, and one step short of the last."""
+    levels = LEVELS_PER_STEP
+    while h0 * RATIO ** levels > spacing and levels < (MAX_STEPS - 1) * LEVELS_PER_STEP:
+        levels += LEVELS_PER_STEP
+    return levels
+
+
 def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, tolerance: float, h0: float,
-                       period: float, order: int) -> GradedSolve:
+                       period: float, order: int, seed: tuple[np.ndarray, float] | None = None) -> GradedSolve:
     """Solve ``load`` on meshes graded towards the contact edges until the estimate meets ``tolerance``.
 
     The loop of the module docstring: grading levels until the contact
@@ -179,6 +208,10 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
         The interface mesh size of level 0 (the first grading element).
     order
         The scene's polynomial order (the first levels').
+    seed
+        Contact edges known beforehand and their accuracy, ``(edges, spacing)``: the spectral twin's
+        (:func:`ngcontact.cell.spectral_predictor.twin_edges`).  The first mesh is then graded towards them
+        by :func:`seed_levels` levels instead of being the scene's uniform mesh.
 
     Raises
     ------
@@ -195,9 +228,10 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
     def run(vertices: list[float], p: int, level: int, before=None):
         """Solve on a new mesh, from ``before = (problem, entry)`` when given; record the changes against it."""
         problem = make_problem(vertices, p)
-        if before is not None:
+        fresh = before is None or starts_afresh(problem, load)
+        if not fresh:
             carry_over(before[0], problem)
-        sol = problem.solve(load, first=before is None)
+        sol = problem.solve(load, first=fresh)
         edges = contact_edges(problem)
         ends = _interface_elements(problem.mesh)
         f, c = sol.results["contact_fraction"], sol.results["mean_closure"]
@@ -218,7 +252,13 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
         return entry["fraction_change"] is not None and max(entry["fraction_change"],
                                                             entry["closure_change"]) <= tolerance
 
-    problem, sol, edges, entry = run(vertices, order, 0)
+    if seed is not None:
+        levels = seed_levels(h0, seed[1])
+        step = levels // LEVELS_PER_STEP
+        vertices = graded_vertices(seed[0], h0, levels, period)
+    problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP)
+    if seed is not None:
+        entry["seed"] = {"edges": [float(e) for e in seed[0]], "spacing": float(seed[1])}
     while True:
         change = entry["fraction_change"]
         if change is not None and (change <= tolerance or step == MAX_STEPS):

@@ -30,7 +30,9 @@ import numpy as np
 
 from ngcontact.drivers.build import (build_cell, cell_loads, cell_problem, gap_cf, model_of, predictor_twin,
                                     spectral_cell)
-from ngcontact.cell.edge_grading import GradedSolve, graded_flat_cell, solve_to_tolerance
+from ngcontact.cell.edge_grading import (LEVELS_PER_STEP, MAX_STEPS, RATIO, GradedSolve, graded_flat_cell,
+                                        solve_to_tolerance)
+from ngcontact.cell.spectral_predictor import twin_edges
 
 from ngcontact.cell import spectral_measures
 from ngcontact.drivers import cell_members
@@ -48,7 +50,9 @@ def solve_graded(scene, loads) -> list[GradedSolve]:
     g, d = scene.geometry, scene.discretization
     model = model_of(scene)
     h0 = d.interface_maxh or d.maxh
-    twin = predictor_twin(scene, h0)     # one for every mesh level (only a first level's start uses it)
+    # one twin for every load and level, as fine as the finest grading asks (within the grid's bound): it seeds
+    # each load's first mesh with its contact edges and starts every level (edge_grading's docstring)
+    twin = predictor_twin(scene, h0 * RATIO ** (MAX_STEPS * LEVELS_PER_STEP))
 
     def make_problem(vertices, order):
         cell = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
@@ -57,7 +61,8 @@ def solve_graded(scene, loads) -> list[GradedSolve]:
 
     out = []
     for k, load in enumerate(loads):
-        out.append(solve_to_tolerance(make_problem, load, d.tolerance, h0, g.period, d.order))
+        seed = twin_edges(twin, load) if twin is not None else None
+        out.append(solve_to_tolerance(make_problem, load, d.tolerance, h0, g.period, d.order, seed=seed))
         log.info("load %d: contact fraction %.10g after %d grading steps", k,
                  out[-1].solution.results["contact_fraction"], len(out[-1].history) - 1)
     return out

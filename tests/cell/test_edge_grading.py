@@ -110,6 +110,62 @@ def test_a_tolerance_out_of_reach_fails_with_the_figures(monkeypatch):
         solve_to_tolerance(make_problem, cell_load(2, pressure=RATIO * PSTAR), 1e-12, 0.02, 1.0, 1)
 
 
+def test_seed_levels_grade_down_to_the_seeds_spacing_and_leave_a_step():
+    from ngcontact.cell.edge_grading import LEVELS_PER_STEP, MAX_STEPS, RATIO, seed_levels
+    assert seed_levels(0.02, 1.0 / 8192) == 4                     # 0.02 / 4^4 = 7.8e-5 <= 1.2e-4 < 0.02 / 4^2
+    assert 0.02 * RATIO ** 4 <= 1.0 / 8192 < 0.02 * RATIO ** 2
+    assert seed_levels(0.02, 1.0) == LEVELS_PER_STEP              # one step at least
+    assert seed_levels(0.02, 1e-12) == (MAX_STEPS - 1) * LEVELS_PER_STEP   # one grading step left after it
+
+
+def _graded_scene(**solver):
+    import dataclasses
+    import os
+
+    import ngcontact
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "geometries", "cells", "westergaard_graded.toml")
+    sc = ngcontact.load(path)
+    return dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, **solver)) if solver else sc
+
+
+def test_the_twins_edges_lie_within_half_its_spacing_of_westergaards():
+    from ngcontact.cell.spectral_predictor import twin_edges
+    from ngcontact.drivers.build import cell_loads, predictor_twin
+    sc = _graded_scene()
+    twin = predictor_twin(sc, 1e-6)
+    pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H, 1.0)
+    for load in cell_loads(sc):
+        edges, spacing = twin_edges(twin, load)
+        assert spacing == 1.0 / twin.grid
+        a = 0.5 * westergaard_contact_fraction(-load.traction[-1], pstar)   # the patch is centred on x = 0
+        assert np.allclose(np.sort(edges), [a, 1.0 - a], rtol=0, atol=0.5 * spacing + 1e-6), (edges, a)
+    full = replace(cell_loads(sc)[0], traction=(0.0, -2 * pstar))       # beyond p*: full contact, no edge
+    assert twin_edges(twin, full) is None
+
+
+def test_a_load_graded_from_its_twins_edges_takes_fewer_meshes_and_steps_to_the_same_accuracy():
+    """The shipped scene's lightest load: seeded with the twin's edges and started from the twin at every level,
+    against the uniform first mesh and the carried states of a rigid start (no twin)."""
+    from ngcontact.cell.edge_grading import seed_levels
+    from ngcontact.drivers.build import cell_loads
+    from ngcontact.drivers.run_cell import solve_graded
+    sc = _graded_scene()
+    load = cell_loads(sc)[:1]
+    pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H, 1.0)
+    exact = westergaard_contact_fraction(-load[0].traction[-1], pstar)
+    seeded, = solve_graded(sc, load)
+    plain, = solve_graded(_graded_scene(start="rigid"), load)
+    first = seeded.history[0]
+    assert first["level"] == seed_levels(0.02, first["seed"]["spacing"]) > 0 and "seed" not in plain.history[0]
+    assert plain.history[0]["level"] == 0
+    for g in (seeded, plain):
+        assert g.estimate["contact_fraction"] <= sc.discretization.tolerance
+        assert abs(g.solution.results["contact_fraction"] - exact) <= g.estimate["contact_fraction"]
+    assert len(seeded.history) < len(plain.history)
+    steps = [sum(h["newton_iterations"] for h in g.history) for g in (seeded, plain)]
+    assert steps[0] < steps[1] / 2, steps                # measured 13 against 39
+
+
 @pytest.mark.slow  # about a minute: the shipped scene's four loads to a tolerance of 1e-4
 def test_the_shipped_graded_scene_meets_its_tolerance_against_westergaard():
     """Every load's contact fraction is within its estimate, and the estimate within the tolerance."""

@@ -135,15 +135,13 @@ def test_anderson_mixing_solves_an_affine_fixed_point():
 COULOMB_LEFT = ("the coupled Coulomb Newton takes 5, 6, 11 steps per load (fixed point: 6, 17, 24): on the last "
                 "shear load four contact edges (valley wall top and bottom, summit and floor corners) move a "
                 "quadrature point or two per step; substeps of 0.001 took 6, 6, 12, 9, 9")
-GRADED_LEFT = ("a load solved on 4 to 6 graded meshes: 39-42, 45-47, 45-52, 40-41 Newton steps summed over them "
-               "(runs differ in round-off), up to 15 on one mesh (a later one, started from the previous mesh's "
-               "solution, k_n = 1e6 E: on the first load's second mesh the start has 230 contact points against the "
-               "solution's 356, and the line search cuts the steps to 2e-4, 1e-3, 4e-3, ... while the active set "
-               "grows); the first mesh, from the spectral predictor, 7 to 9 (28 from the rigid one); every mesh from "
-               "the spectral predictor: 33, 69, 35, 46; the carried state with the old mesh's penetration put on the "
-               "new trace: 47, 57, 52, 43; the carried state solved once on the old contact set (no holes, 371 "
-               "points): 46, 56, 71, 62, the contact edge then zig-zagging a few points in and out per step with "
-               "step lengths 0.2 and 1.1-2.3 in turn")
+GRADED_LEFT = ("a load solved on 3 graded meshes, the first seeded with the spectral twin's edges (8192 points) and "
+               "every one started from the twin: 13, 10, 11, 10 Newton steps summed over them, 1 to 5 on one mesh "
+               "(before the seed: 39-48 on 5-6 meshes, up to 15 on one); after a first step to a relative "
+               "residual of about 1e-8 the rest open the contact edge's quadrature points one or two per step "
+               "(k_n = 1e6 E); tried for the start: the old mesh's state carried over (holes in its contact set), "
+               "the same solved once on the old contact set (46-71), a penetration lowered by half or 90 % of "
+               "the twin's inside the patch (90-134)")
 FE_SCENES = ["flat_patch", "westergaard", "tabulated_gap", "tabulated_profile", "stem_grooves", "hip_hills",
              "sinusoid", "bisinusoid", "height_map",
              "bisinusoid_surface",
