@@ -41,6 +41,18 @@ def test_graded_vertices_crowd_geometrically_towards_each_edge_and_wrap_periodic
     assert v == sorted(v) and all(0.0 < x < 1.0 for x in v)
 
 
+def test_graded_vertices_keep_half_the_finest_element_apart():
+    """Edges a few 1e-9 apart (a flickering sign at a contact edge) gave segments that short, on which Netgen's
+    mesher did not return; no two vertices may now be closer than half the finest element."""
+    h0, levels = 0.02, 8
+    gap = 0.5 * h0 * 0.25 ** levels
+    v = graded_vertices([0.2499481879, 0.2499481943, 0.2499694512, 0.75006270], h0, levels, 1.0)
+    assert min(np.diff(v)) >= gap and v[0] >= gap and v[-1] <= 1.0 - gap
+    assert any(abs(x - 0.2499481879) < 1e-15 for x in v)      # the first of a cluster is kept
+    cell = graded_flat_cell(1.0, 2.0, 2.0, maxh=0.3, interface_maxh=h0, order=1, vertices=v)
+    assert cell.mesh.ne > 0
+
+
 def test_the_edges_of_a_uniform_solve_lie_within_an_element_of_westergaards():
     cell = graded_flat_cell(1.0, 2.0, 2.0, maxh=0.3, interface_maxh=0.02, order=2, vertices=())
     P = CellProblem(cell, replace(MODEL, k_n=1e4), max_iter=60)  # the shipped scenes' penalty
