@@ -27,7 +27,11 @@ contact (``contact.enforcement = "exact"``: node-to-node, the pressure the
 multiplier); the contact fraction is the
 package's own measure and the pressure is the penalty pressure at the
 contact term's quadrature (exact: the multiplier's interpolant).  The penalty is part of the package's model (the
-paper's Winkler layer): its own shift of the answer is in the error.
+paper's Winkler layer): its own shift of the answer is in the error.  The
+graded penalty rows are run twice: on their own (the FE cost alone), and as
+``ngcontact run`` runs them, each load's first mesh seeded with the contact
+edges of the cell's spectral twin and every level started from the twin
+(:mod:`ngcontact.cell.edge_grading`; the twin's solves in the time).
 
 The peer: Tamaas (the ``bench`` extra, ``pip install ".[bench]"``), the
 Polonsky-Keer-Rey FFT solver on one elastic half-space against a rigid
@@ -62,6 +66,7 @@ from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_problem import CellModel, CellProblem
 from ngcontact.cell.edge_grading import graded_flat_cell, solve_to_tolerance
 from ngcontact.cell.spectral_cell import Layer, SpectralCell
+from ngcontact.cell.spectral_predictor import twin_edges
 from ngcontact.cell.spectral_refinement import sweep_to_tolerance
 from ngcontact.errors import ConvergenceError
 from ngcontact.fem.materials import isotropic
@@ -82,6 +87,11 @@ LADDER = ((2, 0.02, 1e3, None, "penalty"), (3, 0.01, 1e3, None, "penalty"), (3, 
           (3, 0.02, 1e6, 1e-4, "penalty"), (3, 0.02, 1e6, 3e-5, "penalty"),
           (3, 0.01, 1e5, None, "exact"), (3, 0.005, 1e5, None, "exact"), (3, 0.02, 1e5, 1e-4, "exact"))
 QUICK_LADDER = (LADDER[0], LADDER[4], LADDER[8])
+#: (order, interface_maxh, k_n / E, tolerance) of the graded penalty rows run as ``ngcontact run`` runs them: each
+#: load's first mesh seeded with the spectral twin's edges, every level started from the twin
+TWIN_LADDER = ((3, 0.02, 1e6, 1e-3), (3, 0.02, 1e6, 1e-4), (3, 0.02, 1e6, 3e-5))
+#: the twin's grid (``ngcontact.drivers.build.TWIN_GRID``'s bound for 2D cells, which a graded solve takes)
+TWIN_POINTS = 8192
 FFT_START, FFT_TARGET, FFT_BUDGET = 2 ** 10, 1e-5, 60.0
 #: grids of the spectral cell (exact contact, layers DEPTH thick)
 SPECTRAL_GRIDS = tuple(2 ** k for k in range(10, 17))
@@ -98,13 +108,17 @@ def _exact_pressure_cf(p: float, pstar: float):
     return 2.0 * p * ng.sqrt(ng.cos(math.pi * ng.x) ** 2) * ng.sqrt(ng.IfPos(sa - s, sa - s, 0.0)) / sa
 
 
-def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enforcement: str = "penalty") -> dict:
+def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enforcement: str = "penalty",
+         twin: bool = False) -> dict:
     """The four loads on FE cells; errors and wall time.
 
     The first load starts from the rigid predictor, not from the spectral
     predictor (``ngcontact run``'s start for this small-slope cell): its twin
     is the spectral cell these rows are compared with, and the FE rows keep
-    their cost their own.
+    their cost their own.  With ``twin`` (and a tolerance) the rows are
+    ``ngcontact run``'s: the penalty twin on ``TWIN_POINTS`` points seeds each
+    load's first graded mesh with its contact edges and starts every level
+    (:mod:`ngcontact.cell.edge_grading`), its solves in the time.
 
     Without ``tolerance``: one mesh, the loads continued from one another.
     With it: each load on its own meshes, graded towards its contact edges
@@ -115,11 +129,18 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enfor
     model = CellModel(rough=law, counter=law, k_n=kn, gap=2 * H_GAP * ng.sin(math.pi * ng.x) ** 2, order=order,
                       enforcement=enforcement)
 
+    t0 = time.perf_counter()
+    spectral_twin = None
+    if twin:
+        x = np.arange(TWIN_POINTS) / TWIN_POINTS
+        spectral_twin = SpectralCell(dim=2, period=1.0, grid=TWIN_POINTS, rough=Layer(1.0, NU, DEPTH),
+                                     counter=Layer(1.0, NU, DEPTH), gap=2 * H_GAP * np.sin(np.pi * x) ** 2, k_n=kn,
+                                     enforcement="penalty", tol=1e-8)
+
     def make_problem(vertices, p):
         cell = graded_flat_cell(1.0, DEPTH, DEPTH, maxh=0.3, interface_maxh=ih, order=p, vertices=vertices)
-        return CellProblem(cell, replace(model, order=p), max_iter=100)
+        return CellProblem(cell, replace(model, order=p), max_iter=100, twin=spectral_twin)
 
-    t0 = time.perf_counter()
     fractions, pressures, steps, ndof = [], [], [], 0
     with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
         P = make_problem([], order)
@@ -128,7 +149,8 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enfor
             if tolerance is None:
                 sol = P.solve(load, first=(k == 0), measure=False)
             else:
-                graded = solve_to_tolerance(make_problem, load, tolerance, ih, 1.0, order)
+                seed = twin_edges(spectral_twin, load) if spectral_twin is not None else None
+                graded = solve_to_tolerance(make_problem, load, tolerance, ih, 1.0, order, seed=seed)
                 P, sol = graded.problem, graded.solution
             fractions.append(sol.results["contact_fraction"])
             steps.append(sol.iterations if tolerance is None else sum(h["newton_iterations"] for h in graded.history))
@@ -144,6 +166,8 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enfor
     setting = f"order {order}, interface_maxh {ih:g}, k_n {kn:g} E"
     if tolerance is not None:
         setting += f", graded to tolerance {tolerance:g}"
+    if twin:
+        setting += ", seeded by the spectral twin"
     return {"solver": "ngcontact" if enforcement == "penalty" else "ngcontact exact", "setting": setting,
             "ndof": ndof, "worst_fraction_error": ferr,
             "worst_pressure_error": max(pressures), "seconds": secs,
@@ -244,6 +268,13 @@ def run(quick: bool = False) -> list[dict]:
             log.warning("ngcontact order %d, k_n %g, tolerance %s: %s", order, kn, tol, exc)
             continue
         log.info("%s", _fmt(rows[-1]))
+    for order, ih, kn, tol in TWIN_LADDER[:1] if quick else TWIN_LADDER:
+        try:
+            rows.append(ours(order, ih, kn, tol, twin=True))
+        except ConvergenceError as exc:
+            log.warning("ngcontact order %d, k_n %g, tolerance %s, seeded: %s", order, kn, tol, exc)
+            continue
+        log.info("%s", _fmt(rows[-1]))
     for n in SPECTRAL_GRIDS[:2] if quick else SPECTRAL_GRIDS:
         rows.append(spectral(n))
         log.info("%s", _fmt(rows[-1]))
@@ -286,7 +317,9 @@ def plot(rows: list[dict], path: str) -> None:
         series = (("ngcontact, fixed meshes", "o-",
                    lambda r: r["solver"] == "ngcontact" and "graded" not in r["setting"]),
                   ("ngcontact, graded to a tolerance", "D-",
-                   lambda r: r["solver"] == "ngcontact" and "graded" in r["setting"]),
+                   lambda r: r["solver"] == "ngcontact" and "graded" in r["setting"] and "twin" not in r["setting"]),
+                  ("ngcontact, graded, seeded by the spectral twin", "P-",
+                   lambda r: r["solver"] == "ngcontact" and "twin" in r["setting"]),
                   ("ngcontact, FE exact contact", "v-", lambda r: r["solver"] == "ngcontact exact"),
                   ("ngcontact, spectral cell (exact)", "^-", lambda r: r["solver"] == "ngcontact spectral"),
                   ("tamaas (FFT)", "s--", lambda r: r["solver"] == "tamaas"))
