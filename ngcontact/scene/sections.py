@@ -105,7 +105,9 @@ class SolverSpec:
                        "rigid predictor moved onto the contact set of the spectral cell of the same small-slope cell; "
                        "the penalty on a flat interface only), rigid (the counter translated rigidly to carry the "
                        "pressure on a Winkler layer), closed (every point pushed into contact), auto (spectral where "
-                       "the cell allows it, else rigid)", choices=("auto", "spectral", "rigid", "closed"))
+                       "the cell allows it, else rigid); with discretization.tolerance, spectral also grades each "
+                       "load's first mesh towards the spectral cell's contact edges and starts every mesh from it",
+                       choices=("auto", "spectral", "rigid", "closed"))
     cg_max_iter: int = param(10000, doc="spectral cell: largest number of constrained CG (frictionless) or "
                              "accelerated proximal gradient (friction) steps per load",
                              check=at_least(1))
