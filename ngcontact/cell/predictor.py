@@ -112,7 +112,8 @@ from ngcontact.cell.measures import contact_integral, sample_surface
 from ngcontact.cell.spectral_predictor import spectral_start
 from ngcontact.laws import penalty as _contact
 from ngcontact.errors import ConvergenceError
-from ngcontact.solvers.newton import ARMIJO, illinois_root, minimize
+from ngcontact.solvers.line_search import armijo, illinois_root
+from ngcontact.solvers.newton import minimize
 
 log = logging.getLogger(__name__)
 
@@ -336,7 +337,7 @@ def _winkler_translation(problem, U0, t, comps, k_L, max_iter: int = 50):
         alpha = 1.0
         while True:
             e_new = energy(U - alpha * step)
-            if e_new <= e - ARMIJO * alpha * slope + 1e-14 * abs(e):
+            if armijo(e, e_new, alpha * slope):
                 break
             alpha *= 0.5
             if alpha < 1e-10:

@@ -39,7 +39,7 @@ import numpy as np
 
 from ngcontact.fem import materials as _mat
 from ngcontact.solvers.linear_solver import LinearSolver, match_free_dofs
-from ngcontact.solvers.newton import fixed_mask, mask_fixed
+from ngcontact.solvers.free_dofs import fixed_mask, mask_fixed
 
 
 def schur_complement(form, X, dofs, state_vec, linear: LinearSolver) -> np.ndarray:

@@ -44,7 +44,7 @@ The Newton step ``du = K_c^{-1} R(u)`` is taken in full when it lowers
   minimizes, along ``du``, ``Pi_T(.; G(u))`` with ``G`` frozen at the
   current iterate (whose gradient at ``u`` is ``R(u)``: a local model of
   the problem; its exact line search,
-  :func:`ngcontact.solvers.newton.exact_step`, is the frictionless and
+  :func:`ngcontact.solvers.line_search.exact_step`, is the frictionless and
   Tresca cells'), guarded by Armijo's test on it; where ``du`` is no
   descent direction of that energy (strong coupling) the symmetric Tresca
   direction ``Pi_T''^{-1} R`` is taken instead.
@@ -85,8 +85,10 @@ import numpy as np
 
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.linear_solver import LinearSolver
-from ngcontact.solvers.newton import (ARMIJO, MIN_STEP, ActiveSetCycle, NewtonHistory, armijo, at_floor,
-                                      exact_step, fixed_mask, mask_fixed, roundoff_floor)
+from ngcontact.solvers.free_dofs import fixed_mask, mask_fixed
+from ngcontact.solvers.line_search import ARMIJO, MIN_STEP, armijo, exact_step
+from ngcontact.solvers.newton import ActiveSetCycle, NewtonHistory
+from ngcontact.solvers.roundoff import at_floor, roundoff_floors
 
 log = logging.getLogger(__name__)
 
@@ -192,7 +194,7 @@ def coupled_newton(residual_form: ng.BilinearForm, gfu: ng.GridFunction, *, free
             hist.converged = True
             break
         residual_form.AssembleLinearization(gfu.vec)
-        floor = roundoff_floor(residual_form.mat, gfu.vec, fixed)
+        floor = roundoff_floors(residual_form.mat, gfu.vec, fixed)[0]
         floor0 = floor if floor0 is None else floor0
         if at_floor(rnorm, floor, r0, floor0):
             log.info("coulomb newton %d: residual %.3e at its round-off floor; converged", it, rnorm)

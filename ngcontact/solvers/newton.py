@@ -1,60 +1,27 @@
-"""Energy minimization by Newton's method with a backtracking line search.
+"""Energy minimization by Newton's method with a line search.
 
 Contact and elasticity are written as one energy ``Pi(u)`` (NGSolve
 ``Variation`` terms), so the residual ``r(u) = Pi'(u)`` and the tangent
 ``K(u) = Pi''(u)`` come from NGSolve's linearization. One step solves
-``K(u) du = r(u)`` and sets ``u <- u - alpha du`` with the largest
-``alpha = 1, 1/2, 1/4, ...`` that satisfies the Armijo condition
+``K(u) du = r(u)`` and sets ``u <- u - alpha du`` with the step length of
+:mod:`ngcontact.solvers.line_search`: the largest ``alpha = 1, 1/2, 1/4,
+...`` that passes Armijo's test on the energy (a step the energy cannot
+resolve, by its round-off, judged by the residual instead), or with
+``line_search="exact"`` the minimizer of the energy along the direction,
+guarded by the same test.  NaN or Inf never enter the iterate.
 
-    Pi(u - alpha du) <= Pi(u) - c alpha (du . r(u)),   c = 1e-4,
-
-and yields a finite energy and a finite residual (otherwise the step is
-halved: NaN or Inf never enter the iterate).  The energy itself is known only
-to its round-off, ``ROUNDOFF eps (|Pi| + |u| |K| |u| / 2)`` (its stiff terms
-cancel: on the femur scene ``|Pi|`` is 4e-3 and ``|u| |K| |u| / 2`` 2.6e3).
-Near the solution a Newton step lowers the energy by about ``r . du / 2``,
-which falls below that round-off long before the residual reaches its own
-floor: the energy then cannot tell the step from no step, and Armijo's test
-rejects it at random.  A step whose energy is within the energy's round-off
-of the current one is therefore judged by the residual instead, and accepted
-when ``|r(u - alpha du)| <= (1 - c alpha) |r(u)|``.  When no step length
-lowers either, the step's whole predicted decrease ``du . r`` is below the
-energy's round-off and the residual is within ``STAGNATION`` times its floor
-(below), the iterate is at round-off: converged.
-
-The iteration stops when the residual (free dofs) has fallen below ``rtol``
-times the first residual, or below ``atol``, or below its round-off floor
-``ROUNDOFF eps || |K| |u| ||``: the size at which the residual, a sum of terms
-as large as ``|K_ij| |u_j|``, can no longer be evaluated. Stiff terms (a Huber
-width of 1e-12, a penalty touching with zero force) put that floor above
-``rtol`` times the first residual; without it Newton would wander in the
-round-off until ``max_iter``. The floor grows with ``|u|``: a runaway iterate
-(a body that floats off under an unbalanced load, a singular system) drags it
-up to its own, unchanged residual. So the floor counts only after real
-progress: the residual has fallen below ``FLOOR_PROGRESS`` times the first
-one, or the first one was itself at the round-off of the start value (within
-``FLOOR_GROWTH`` times its floor: a start that already was the solution).
-(Equilibrium checks of the results catch what a residual at its floor cannot
-show, e.g. :func:`ngcontact.cell.measures.equilibrium_error`.)
+The iteration stops when the residual (free dofs) has fallen below
+``rtol`` times the first residual, or below ``atol``, or below its
+round-off floor after real progress (:mod:`ngcontact.solvers.roundoff`).
+A step that lowers neither the energy nor the residual at any length is
+converged when the iterate is at round-off by the same module's rule, and
+fails otherwise.
 
 A quadratic energy is minimized by a linear solve, refined with the same
 factorization while the residual is above the tolerance (at most
 ``REFINE_STEPS`` times); a residual still above ``max(rtol |r_0|, atol)`` and
 above its round-off floor is a singular or ill-posed system (e.g. a
 rigid-body mode the supports leave free) and raises, never "converged".
-
-With ``line_search="exact"`` (for convex energies such as penalty contact)
-the step length minimizes the energy along the Newton direction instead:
-``phi(alpha) = Pi(u - alpha du)`` is convex, so its slope
-``phi'(alpha) = -du . r(u - alpha du)`` is nondecreasing, and its root is
-bracketed (``alpha`` doubled up to ``max_step`` while ``phi' < 0``) and
-located by the Illinois variant of regula falsi until
-``|phi'(alpha)| <= 1e-3 |phi'(0)|``.  For a piecewise quadratic energy
-(penalty contact) ``phi'`` is piecewise linear and a few residual
-evaluations suffice.  Steps longer than 1 matter at a contact edge, where
-the fixed-active-set Newton step typically covers only about half of the
-distance to the solution.  The accepted step must still pass the Armijo
-test above; otherwise the backtracking search decides.
 
 On failure a :class:`~ngcontact.errors.ConvergenceError` carries the history:
 residual norms, energies, step lengths.
@@ -68,19 +35,14 @@ from dataclasses import dataclass, field
 import ngsolve as ng
 
 from ngcontact.errors import ConvergenceError
+from ngcontact.solvers.free_dofs import fixed_mask, mask_fixed
+from ngcontact.solvers.line_search import ARMIJO, MIN_STEP, armijo, exact_step
 from ngcontact.solvers.linear_solver import LinearSolver, forcing_term
+from ngcontact.solvers.roundoff import at_floor, at_roundoff, roundoff_floors, within_roundoff
 
 log = logging.getLogger(__name__)
 
-ARMIJO = 1e-4
-MIN_STEP = 2.0 ** -30
-ROUNDOFF = 10.0
-FLOOR_PROGRESS = 1e-3
-FLOOR_GROWTH = 1e3
 REFINE_STEPS = 2
-#: a residual within this factor of its round-off floor estimate, with no decrease measurable along the Newton step,
-#: is at round-off (module docstring; the estimate was 2.1 times low on a smooth field offset by 3e4)
-STAGNATION = 100.0
 
 
 @dataclass
@@ -282,28 +244,6 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
         hist.as_dict())
 
 
-def armijo(energy: float, e_new: float, decrease: float) -> bool:
-    """Armijo's test: ``Pi_new <= Pi - c decrease`` (``decrease = alpha du . r``), ``Pi_new`` finite."""
-    return math.isfinite(e_new) and e_new <= energy - ARMIJO * decrease + 1e-14 * abs(energy)
-
-
-def within_roundoff(energy: float, e_new: float, efloor: float) -> bool:
-    """``Pi_new`` finite and within the energy's round-off ``efloor`` above ``Pi``: the energy cannot tell the
-    step from no step, and the residual decides (module docstring)."""
-    return math.isfinite(e_new) and e_new <= energy + efloor
-
-
-def at_roundoff(slope: float, efloor: float, rnorm: float, floor: float, r0: float) -> bool:
-    """No step length lowered the energy or the residual, the step's predicted decrease ``slope`` is below the
-    energy's round-off, and the residual is within ``STAGNATION`` times its floor after real progress."""
-    return slope <= efloor and rnorm <= STAGNATION * floor and rnorm <= FLOOR_PROGRESS * r0
-
-
-def at_floor(rnorm: float, floor: float, r0: float, floor0: float) -> bool:
-    """The residual is at its round-off ``floor`` after real progress, or the start was (module docstring)."""
-    return rnorm <= floor and (rnorm <= FLOOR_PROGRESS * r0 or r0 <= FLOOR_GROWTH * floor0)
-
-
 def _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol, atol, fixed) -> NewtonHistory:
     """A quadratic energy: ``u <- u - K^{-1} r(u)``, refined with the same factorization, and checked.
 
@@ -313,7 +253,7 @@ def _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol
     form.AssembleLinearization(gfu.vec)
     inv = linear.prepare(form, freedofs)
     target = max(rtol * r0, atol)
-    floor0 = roundoff_floor(form.mat, gfu.vec, fixed)
+    floor0 = roundoff_floors(form.mat, gfu.vec, fixed)[0]
     rnorm = r0
     for _ in range(1 + REFINE_STEPS):
         inv.apply(res, du)
@@ -328,108 +268,13 @@ def _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol
                                    "(e.g. a rigid-body mode that no support removes)", hist.as_dict())
         if rnorm <= target:
             break
-    if rnorm <= target or at_floor(rnorm, roundoff_floor(form.mat, gfu.vec, fixed), r0, floor0):
+    if rnorm <= target or at_floor(rnorm, roundoff_floors(form.mat, gfu.vec, fixed)[0], r0, floor0):
         hist.converged = True
         return hist
     raise ConvergenceError(
         f"the linear solve left the residual at {rnorm:.3e} > {target:.3e} (first residual {r0:.3e}) after "
         f"{REFINE_STEPS} refinements: the system is singular or ill-posed, e.g. a rigid-body mode that no "
         "support removes, or a stiffness far beyond the others", hist.as_dict())
-
-
-def exact_step(form, u, du, slope0, fixed, trial, work, max_step) -> float:
-    """Minimizer of ``phi(alpha) = Pi(u - alpha du)`` for a convex energy.
-
-    ``slope0 = du . r(u) > 0`` is ``-phi'(0)``.  Returns 1 where the slope
-    cannot be evaluated (non-finite values); the caller's Armijo test then
-    guards the step.  ``work`` is overwritten.
-    """
-    def dphi(a):
-        trial.data = u - a * du
-        form.Apply(trial, work)
-        mask_fixed(work, fixed)
-        return -ng.InnerProduct(du, work)
-
-    tol = 1e-3 * slope0
-    lo, flo = 0.0, -slope0
-    hi, fhi = 1.0, dphi(1.0)
-    if not math.isfinite(fhi):
-        return 1.0
-    if abs(fhi) <= tol:
-        return 1.0
-    while fhi < 0.0 and hi < max_step:
-        lo, flo = hi, fhi
-        hi = min(2.0 * hi, max_step)
-        fhi = dphi(hi)
-        if not math.isfinite(fhi):
-            return lo
-        if abs(fhi) <= tol:
-            return hi
-    if fhi < 0.0:
-        return hi
-    a = illinois_root(dphi, lo, flo, hi, fhi, ftol=tol, max_iter=30)
-    return a if math.isfinite(a) else 1.0
-
-
-def illinois_root(f, lo: float, flo: float, hi: float, fhi: float, *, ftol: float,
-                  xtol: float = 0.0, max_iter: int = 100) -> float:
-    """Root of a nondecreasing ``f`` bracketed by ``f(lo) = flo < 0 < fhi = f(hi)``.
-
-    The Illinois variant of regula falsi: secant steps within the bracket,
-    halving the retained end's value when the same end is kept twice, which
-    restores superlinear convergence.  Stops when ``|f| <= ftol``, the
-    bracket is shorter than ``xtol`` or has collapsed numerically; returns
-    ``nan`` when ``f`` is not finite at an iterate.
-    """
-    side, a = 0, hi
-    for _ in range(max_iter):
-        if not fhi > flo:          # the bracket collapsed numerically
-            break
-        a = (lo * fhi - hi * flo) / (fhi - flo)
-        fa = f(a)
-        if not math.isfinite(fa):
-            return math.nan
-        if abs(fa) <= ftol or hi - lo <= xtol:
-            break
-        if fa < 0.0:
-            lo, flo = a, fa
-            if side == -1:
-                fhi *= 0.5
-            side = -1
-        else:
-            hi, fhi = a, fa
-            if side == 1:
-                flo *= 0.5
-            side = 1
-    return a
-
-
-def roundoff_floor(mat, vec, fixed) -> float:
-    """``ROUNDOFF eps || |K| |u| ||`` over the free dofs: the residual's round-off level (:func:`roundoff_floors`)."""
-    return roundoff_floors(mat, vec, fixed, 0.0)[0]
-
-
-def roundoff_floors(mat, vec, fixed, energy: float) -> tuple[float, float]:
-    """The round-off levels of the residual and of the energy at ``u = vec``.
-
-    Residual: ``ROUNDOFF eps || |K| |u| ||`` over the free dofs.  Energy:
-    ``ROUNDOFF eps (|energy| + |u| . |K| |u| / 2)``, the size of the terms
-    whose sum it is.  ``K`` may be stored as its lower triangle (symmetric
-    storage).
-    """
-    import numpy as np
-    import scipy.sparse as sp
-    vals, cols, ptr = mat.CSR()
-    u = np.abs(vec.FV().NumPy())
-    n = len(u)
-    a = sp.csr_matrix((np.abs(np.asarray(vals)), np.asarray(cols), np.asarray(ptr)), shape=(n, n))
-    m = a @ u
-    if type(mat).__name__.startswith("SparseMatrixSymmetric"):   # the upper triangle is the lower's transpose
-        m += a.T @ u - a.diagonal() * u
-    eps = ROUNDOFF * np.finfo(float).eps
-    energy_floor = eps * (abs(energy) + 0.5 * float(np.dot(u, m)))
-    m[fixed] = 0.0
-    return eps * float(np.sqrt(np.dot(m, m))), energy_floor
 
 
 def _size(signature) -> int:
@@ -440,14 +285,3 @@ def _size(signature) -> int:
         return int(sum(bool(b) for b in signature))
     except TypeError:
         return -1
-
-
-def fixed_mask(freedofs):
-    """Boolean NumPy array, True where a dof is not free."""
-    import numpy as np
-    return ~np.array([freedofs[i] for i in range(len(freedofs))], dtype=bool)
-
-
-def mask_fixed(vec, fixed) -> None:
-    """Zero the entries of ``vec`` that are not free."""
-    vec.FV().NumPy()[fixed] = 0.0

@@ -39,7 +39,7 @@ Round-off ends the iteration too.  The measures cannot fall below the
 round-off of the displacements (``eps cond(K) |u| / L``), which a graded
 mesh (elements of 1e-6 of the period) lifts to about ``1e-10``: there a
 multiplier update changes the equilibrium by less than the round-off floor
-of the Newton residual (:func:`ngcontact.solvers.newton.at_floor`), the
+of the Newton residual (:func:`ngcontact.solvers.roundoff.at_floor`), the
 pass's Newton solve takes no step, the state and so the measures repeat,
 and the passes that follow only alternate between two states (measured:
 westergaard_graded with exact enforcement, 51 passes at 7e-11 / 1.5e-10
@@ -55,7 +55,7 @@ import logging
 from typing import Any, Callable
 
 from ngcontact.errors import ConvergenceError
-from ngcontact.solvers.newton import FLOOR_GROWTH
+from ngcontact.solvers.roundoff import FLOOR_GROWTH
 
 log = logging.getLogger(__name__)
 
