@@ -35,7 +35,7 @@ under a prescribed pressure starts from the rigid predictor of
 twin where the cell has one (penalty, small slope:
 :mod:`ngcontact.cell.spectral_predictor`), later loads from the previous
 solution (a frictionless sweep with a twin: each pressure afresh from the
-twin).  A
+twin; the rules: :mod:`ngcontact.cell.load_start`).  A
 frictionless flat ``S_C`` leaves ``U_t`` free of energy: it is fixed at 0
 and a nonzero shear is rejected.  Coulomb friction: Newton on the
 coupled equations with the threshold ``mu p(u)`` differentiated (the
@@ -78,7 +78,8 @@ from ngcontact.cell.contact_quadrature import ContactQuadrature
 from ngcontact.cell.contact_quadrature import applies as quadrature_applies
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
-from ngcontact.cell.predictor import check_start, max_gap, start_load, starts_afresh, tangential_load
+from ngcontact.cell.load_start import check_start, start_load, starts_afresh, tangential_load
+from ngcontact.cell.predictor import max_gap
 from ngcontact.cell.spectral_cell import SpectralCell
 from ngcontact.cell.spectral_predictor import flat_level
 from ngcontact.errors import ModelError

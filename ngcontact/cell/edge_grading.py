@@ -63,7 +63,7 @@ import numpy as np
 import ngsolve as ng
 
 from ngcontact.cell.measures import contact_pieces
-from ngcontact.cell.predictor import starts_afresh
+from ngcontact.cell.load_start import starts_afresh
 from ngcontact.errors import ConvergenceError
 from ngcontact.geometry.cell2d import flat_cell
 

@@ -1,4 +1,5 @@
-"""Start values of the cell problem: the rigid predictor (first and frictionless shear loads), the rigid continuation.
+"""The rigid predictor: start values of the cell problem from a Winkler model of rigid motions (first and
+frictionless shear loads).
 
 The Newton solve of the cell problem (paper eqs. 49-51 in the penalized
 variational form of eq. 65, :mod:`ngcontact.cell.cell_problem`) needs a
@@ -60,7 +61,8 @@ with the predicted patch as above.  The frictionless energy is convex with
 one minimizer, so the start may forget the previous state; a start from it
 is no better where the contact set moves across the cell (the shear turns
 the pressed flank): on the sinusoid sweep the Newton steps after the start
-are the same 6 and 4 as after the rigid continuation below, without the
+are the same 6 and 4 as after the rigid continuation
+(:func:`ngcontact.cell.load_start.rigid_continuation`), without the
 continuation's 3 and 3 steps (1, 2, 9, 7 -> 1, 1, 6, 4 per load), and on
 the 3D bisinusoid surface 4 + 9 -> 10.  The gain is the continuation's
 steps, each an assembly of the cell's tangent; the predictor's own
@@ -69,35 +71,8 @@ Newton steps of the cell problem, like the first load's root.  With friction the
 which has none, would slide the counter over the flat parts of ``S_C``
 that friction holds (and Coulomb's law, without an energy, need not have
 one solution: the previous one is the start to keep): the rigid
-continuation.
-
-*Later loads with a tangential change under friction*, or where the
-restart finds no regular minimizer (continuation from the previous load's
-solution): the rigid continuation.  Before the Newton solve, the energy is minimized over the
-far-face translations ``U_i`` that the load leaves free (a traction is
-prescribed), the fluctuations frozen at the previous solution:
-
-    U = argmin_U Pi(u_r, u_c, U)    (u_r, u_c fixed),
-
-a problem in ``dim`` unknowns (Newton on the same energy with only those
-dofs free; its tangent is the ``dim x dim`` block of ``Pi''`` in ``U``).  A
-load increment then first moves the counter as a rigid body on the deformed
-rough surface, which is where a shear load near the frictionless limit
-goes: on the sinusoid (measured before the restart took the frictionless
-loads), the shear 0.002 -> 0.003 (``tau/p`` near the largest
-slope 0.31) slides the counter a quarter period and lifts it, which Newton
-from the previous state reached in 21 steps, from the rigid continuation in
-4 (plus 3 steps of the ``dim``-unknown problem).  The continuation's steps
-are reported as a Newton history of their own (``"stage":
-"rigid_continuation"``) and count towards the load.  Where the frozen
-problem has no minimizer (the translation is free of energy, e.g. no
-contact) its Newton raises; the previous state is restored and the
-continuation is skipped.
-
-Secant or tangent extrapolation of the whole state from earlier loads was
-tried and gains little (sinusoid: 21 -> 21 and 17 steps): the state is not
-smooth in the load where the contact set changes, and the tangent predictor
-is the first Newton step itself.
+continuation (:mod:`ngcontact.cell.load_start`), which chooses among these
+starts for every load.
 """
 from __future__ import annotations
 
@@ -109,11 +84,8 @@ import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.measures import contact_integral, sample_surface
-from ngcontact.cell.spectral_predictor import spectral_start
 from ngcontact.laws import penalty as _contact
-from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.line_search import armijo, illinois_root
-from ngcontact.solvers.newton import minimize
 
 log = logging.getLogger(__name__)
 
@@ -346,139 +318,3 @@ def _winkler_translation(problem, U0, t, comps, k_L, max_iter: int = 50):
         if np.max(np.abs(alpha * step)) <= 1e-12 * max(np.max(np.abs(U)), 1e-300):
             return U
     return None
-
-
-#: the starts of a first load under a prescribed pressure (:func:`start_load`)
-STARTS = ("rigid", "closed", "spectral")
-
-
-def check_start(start: str | None, twin, enforcement: str) -> str:
-    """The start of a cell problem's first loads: ``start``, by default ``"spectral"`` with a spectral
-    ``twin`` and ``"rigid"`` without.
-
-    Raises
-    ------
-    ValueError
-        ``start`` is none of :data:`STARTS`, or ``"spectral"`` without a twin or with exact enforcement.
-    """
-    if start is None:
-        start = "rigid" if twin is None else "spectral"
-    if start not in STARTS:
-        raise ValueError(f"start = {start!r}: must be 'rigid', 'closed' or 'spectral'")
-    if start == "spectral" and (twin is None or enforcement != "penalty"):
-        raise ValueError("start = 'spectral' needs the cell's spectral twin and the penalty "
-                         f"(twin {'given' if twin is not None else 'missing'}, enforcement {enforcement!r})")
-    return start
-
-
-def starts_afresh(problem, load: CellLoad) -> bool:
-    """Whether a sweep solves ``load`` as a first load: a frictionless cell with a spectral twin, under a
-    prescribed pressure (its energy has one minimizer, and the twin's contact set is nearer the solution's
-    than the previous load's: :meth:`~ngcontact.cell.cell_problem.CellProblem.sweep`)."""
-    return problem.model.friction is None and _spectral(problem, load)
-
-
-def _spectral(problem, load: CellLoad) -> bool:
-    """Whether a first ``load`` starts on the spectral twin's contact set (a pressure prescribed)."""
-    return problem.start == "spectral" and problem.twin is not None and load.jump[problem.dim - 1] is None
-
-
-def start_load(problem, load: CellLoad, free, first: bool, before: tuple[float, ...]) -> tuple[dict | None,
-                                                                                             dict | None]:
-    """Put the start of ``load`` (its values applied) into ``problem.gfu`` (module docstring).
-
-    A first load under a prescribed pressure: the rigid or closed start (:func:`set_start`), moved onto the
-    spectral twin's contact set where the problem starts so
-    (:func:`ngcontact.cell.spectral_predictor.spectral_start`); with exact enforcement the multiplier starts
-    afresh (:func:`start_multiplier` under friction).  A later load whose tangential load changed
-    (``before``: :func:`tangential_load` of the previous one): frictionless, the rigid predictor for the
-    whole traction (:func:`rigid_translation`); with friction, or where that has no minimizer, the rigid
-    continuation, whose steps count.  ``free``: the load's free dofs.
-
-    Returns the spectral start's record and the rigid continuation's history (either ``None``).
-    """
-    if not first:
-        if tangential_load(problem) != before and rigid_translation(problem, load, free):
-            return None, None
-        return None, rigid_continuation(problem, free, before)
-    if load.jump[problem.dim - 1] is None:
-        set_start(problem, load)
-    if problem.multiplier is not None:
-        # a first load starts afresh: a multiplier left by an earlier load (a table of independent cell
-        # solves) held against the rigid predictor's state could leave no point in contact, the bodies
-        # afloat and the tangent singular
-        problem.multiplier.set_point_values(np.zeros(len(problem.multiplier.point_values())))
-        problem.augmentation.Set(problem.model.k_n)      # as the scene gave it (Uzawa may have raised it)
-        if problem.model.friction is not None:
-            start_multiplier(problem, load)
-    return (spectral_start(problem, load, problem.twin) if _spectral(problem, load) else None), None
-
-
-def start_multiplier(problem, load: CellLoad) -> None:
-    """Uzawa's start under friction: the start state's contact pattern carrying the load's pressure.
-
-    With ``lambda = 0`` the Coulomb threshold ``mu lambda`` would leave the
-    tangential translation without stiffness.  The start state's augmented
-    pressure ``k_n [J_n - g]_+`` gives where the contact is; it is scaled to
-    the prescribed mean pressure, since the start state (the rigid predictor)
-    penetrates by what the bodies would yield, far more than ``p / k_n``, and
-    a multiplier that large opens the whole surface in the first solve.
-    """
-    m = problem.multiplier
-    assert m is not None  # exact enforcement
-    lam = np.maximum(m.at_points(problem.augmented_pressure), 0.0)
-    tn = load.traction[problem.dim - 1]
-    if tn is not None and lam.any():
-        m.set_point_values(lam)
-        carried = m.integrate(m.value)
-        lam *= -tn * problem.area / carried
-    m.set_point_values(lam)
-
-
-
-def tangential_load(problem) -> tuple[float, ...]:
-    """The applied tangential far-face tractions and translations: compare before and after a load change."""
-    t = problem.dim - 1
-    return (tuple(problem.traction[i].Get() for i in range(t))
-            + tuple(problem.gfu.vec[problem.u_dofs[i]] for i in range(t)))
-
-
-def rigid_continuation(problem, free, before: tuple[float, ...] | None = None) -> dict | None:
-    """Minimize the energy over the free far-face translations, fluctuations frozen (module docstring).
-
-    ``free`` is the BitArray of the load's free dofs; the translations
-    ``U_i`` among them are the unknowns.  With ``before``
-    (:func:`tangential_load` of the previous load), only a load whose
-    tangential traction or prescribed tangential jump changed is continued
-    (a normal increment is carried by the bodies' compliance, which the
-    rigid translation does not see).  Runs Newton
-    (:func:`ngcontact.solvers.newton.minimize`) on ``problem.energy`` with
-    only those dofs free and the problem's tolerance and line search, and
-    returns its history with ``"stage": "rigid_continuation"``, or ``None``
-    (state unchanged) when the load was not continued or the frozen
-    problem has no minimizer.
-    """
-    if before is not None and tangential_load(problem) == before:
-        return None
-    ndof = len(free)
-    rigid = ng.BitArray(ndof)
-    rigid.Clear()
-    dofs = [i for i in problem.u_dofs if free[i]]
-    if not dofs:
-        return None
-    for i in dofs:
-        rigid.Set(i)
-    saved = problem.gfu.vec.CreateVector()
-    saved.data = problem.gfu.vec
-    try:
-        h = minimize(problem.energy(), problem.gfu, freedofs=rigid, rtol=problem.rtol, atol=problem.atol,
-                     max_iter=problem.max_iter, inverse=problem.inverse,
-                     line_search=problem.line_search).as_dict()
-    except ConvergenceError as err:
-        problem.gfu.vec.data = saved
-        log.info("rigid continuation skipped: %s", err)
-        return None
-    h["stage"] = "rigid_continuation"
-    log.debug("rigid continuation: %d steps, U = %s", h["iterations"],
-              [problem.gfu.vec[i] for i in problem.u_dofs])
-    return h

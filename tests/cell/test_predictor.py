@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import ngcontact.cell.predictor as predictor
+import ngcontact.cell.load_start as load_start
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_problem import CellModel, CellProblem
 from ngcontact.cell.predictor import layer_stiffness, rigid_approach
@@ -54,12 +54,12 @@ def test_rigid_continuation_same_answer_fewer_steps(monkeypatch):
     continuation from the previous state alone, in fewer Newton steps
     counting the continuation's own.
     """
-    monkeypatch.setattr(predictor, "rigid_translation", lambda *args: False)
+    monkeypatch.setattr(load_start, "rigid_translation", lambda *args: False)
     shears = (0.0, 0.002, 0.003)
     P, sols = _sinusoid_sweep(shears)
     with_rigid = P.gfu.vec.FV().NumPy().copy()
     assert [s.newton[0].get("stage") for s in sols[1:]] == ["rigid_continuation"] * 2
-    monkeypatch.setattr(predictor, "rigid_continuation", lambda *args: None)
+    monkeypatch.setattr(load_start, "rigid_continuation", lambda *args: None)
     Q, plain = _sinusoid_sweep(shears)
     without = Q.gfu.vec.FV().NumPy()
     assert np.max(np.abs(with_rigid - without)) <= 1e-8 * np.max(np.abs(without))
@@ -77,7 +77,7 @@ def test_frictionless_shear_restarts_from_the_rigid_predictor(monkeypatch):
     """
     shears = (0.0, 0.002, 0.003)
     calls = []
-    original = predictor.rigid_translation
+    original = load_start.rigid_translation
 
     def spy(problem, load, free):
         moved = original(problem, load, free)
@@ -86,12 +86,12 @@ def test_frictionless_shear_restarts_from_the_rigid_predictor(monkeypatch):
                                  np.max(np.abs(comps[1].vec.FV().NumPy())))))
         return moved
 
-    monkeypatch.setattr(predictor, "rigid_translation", spy)
+    monkeypatch.setattr(load_start, "rigid_translation", spy)
     P, restart = _sinusoid_sweep(shears)
     assert calls == [(True, 0.0), (True, 0.0)]
     assert all("stage" not in h for s in restart for h in s.newton)
     state = P.gfu.vec.FV().NumPy().copy()
-    monkeypatch.setattr(predictor, "rigid_translation", lambda *args: False)
+    monkeypatch.setattr(load_start, "rigid_translation", lambda *args: False)
     Q, continued = _sinusoid_sweep(shears)
     assert np.max(np.abs(state - Q.gfu.vec.FV().NumPy())) <= 1e-8 * np.max(np.abs(state))
     assert all(a.iterations < b.iterations for a, b in zip(restart[1:], continued[1:]))
