@@ -141,6 +141,7 @@ class SpectralCell:
         ptp = float(np.ptp(g0))
         self.gscale = ptp if ptp > 0 else 1.0
         self.area = self.period ** (dim - 1)
+        self._last: SpectralSolution | None = None
 
     @property
     def points(self) -> int:
@@ -171,7 +172,19 @@ class SpectralCell:
 
     # ----------------------------------------------------------------- solve
     def solve(self, load: CellLoad, start: np.ndarray | None = None) -> SpectralSolution:
-        """Solve one load (pressure or far-face approach prescribed), from ``start`` if given."""
+        """Solve one load (pressure or far-face approach prescribed), from ``start`` if given.
+
+        The last solution from no start is kept and returned again for the same load: a spectral twin is
+        asked for one load by the seed and every mesh of a graded solve (:mod:`ngcontact.cell.edge_grading`).
+        """
+        if start is None and self._last is not None and self._last.load == load:
+            return self._last
+        sol = self._solve(load, start)
+        if start is None:
+            self._last = sol
+        return sol
+
+    def _solve(self, load: CellLoad, start: np.ndarray | None) -> SpectralSolution:
         d = self.dim
         if self.friction is None:
             for i in range(d - 1):

@@ -85,7 +85,7 @@ import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.measures import sample_surface
-from ngcontact.cell.spectral_cell import SpectralCell
+from ngcontact.cell.spectral_cell import SpectralCell, SpectralSolution
 from ngcontact.errors import ConvergenceError
 from ngcontact.fem.interpolants import periodic_grid
 
@@ -101,11 +101,9 @@ def spectral_start(problem, load: CellLoad, twin: SpectralCell) -> dict:
     and the record says why: it is a predictor, and the cell problem is solved from the rigid start as
     before.
     """
-    try:
-        sol = twin.solve(normal_load(load))
-    except (ConvergenceError, ValueError, FloatingPointError) as err:
-        log.warning("spectral predictor: the twin failed (%s); starting from the rigid predictor", err)
-        return {"kind": "rigid", "twin_failed": str(err)}
+    sol = twin_solution(twin, load, "starting from the rigid predictor")
+    if isinstance(sol, str):
+        return {"kind": "rigid", "twin_failed": sol}
     target = periodic_grid(sol.fields["closure"] - twin.g0, twin.period)
     move = ng.GridFunction(problem.X)
     move.components[0].Set((target - problem.penetration) * problem.n, ng.BND,
@@ -124,6 +122,16 @@ def spectral_start(problem, load: CellLoad, twin: SpectralCell) -> dict:
             "contact_fraction": float(sol.results["contact_fraction"])}
 
 
+def twin_solution(twin: SpectralCell, load: CellLoad, fallback: str) -> SpectralSolution | str:
+    """The twin's solution of ``load``'s normal part, or, where its solver fails, the reason (logged with what
+    the caller does instead, ``fallback``)."""
+    try:
+        return twin.solve(normal_load(load))
+    except (ConvergenceError, ValueError, FloatingPointError) as err:
+        log.warning("spectral predictor: the twin failed (%s); %s", err, fallback)
+        return str(err)
+
+
 def normal_load(load: CellLoad) -> CellLoad:
     """The twin's load: ``load``'s normal traction and macro strain, without shear or prescribed jumps."""
     d = len(load.traction)
@@ -140,10 +148,8 @@ def twin_edges(twin: SpectralCell, load: CellLoad) -> tuple[np.ndarray, float] |
     """
     if twin.dim != 2:
         raise ValueError(f"twin.dim = {twin.dim}: contact edges are located on the 1D grid of a 2D cell")
-    try:
-        sol = twin.solve(normal_load(load))
-    except (ConvergenceError, ValueError, FloatingPointError) as err:
-        log.warning("spectral predictor: the twin failed (%s); the grading starts without its edges", err)
+    sol = twin_solution(twin, load, "the grading starts without its edges")
+    if isinstance(sol, str):
         return None
     on = sol.fields["pressure"] > 0.0
     spacing = twin.period / twin.grid

@@ -446,3 +446,21 @@ def test_the_strength_recovery_refuses_a_spectral_cell():
     from ngcontact.errors import SceneError
     with pytest.raises(SceneError, match="needs the body stresses and the macro strain term of the FE cell"):
         cell_problem_of(os.path.join(CELLS, "self_affine_spectral.toml"), key="strength.cell")
+
+
+def test_the_last_solution_from_no_start_is_returned_again_for_the_same_load():
+    """A twin is asked for one load by the seed and every mesh of a graded solve: solved once."""
+    n = 256
+    x = np.arange(n) / n
+    cell = SpectralCell(dim=2, period=1.0, grid=n, rough=Layer(1.0, 0.3, 2.0), counter=Layer(1.0, 0.3, 2.0),
+                        gap=0.02 * np.sin(np.pi * x) ** 2, k_n=1e6, enforcement="penalty", tol=1e-10)
+    a, b = cell_load(2, pressure=0.002), cell_load(2, pressure=0.004)
+    first = cell.solve(a)
+    assert cell.solve(a) is first
+    other = cell.solve(b)
+    assert other is not first and other.results["contact_fraction"] > first.results["contact_fraction"]
+    again = cell.solve(a)                                    # only the last load is kept: solved anew, same answer
+    assert again is not first and again.results["contact_fraction"] == pytest.approx(
+        first.results["contact_fraction"], rel=1e-12)
+    warm = cell.solve(a, start=first.fields["pressure"])     # a start given: always solved
+    assert warm is not again
