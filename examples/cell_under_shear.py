@@ -14,14 +14,14 @@ unilateral directions instead.
 This example uses the building blocks directly: a cell from a profile
 (:mod:`ngcontact.geometry.profiles`), its whole-surface coefficients
 (:mod:`ngcontact.cell.coefficients`), and the cell contact problem
-(:mod:`ngcontact.cell.cell_problem`: both bodies elastic, ``E = 1``,
+(:mod:`ngcontact.cell.fe.cell_problem`: both bodies elastic, ``E = 1``,
 penalty ``k_n = 1e3``, periodic sides) solved for two loads, a mean
 pressure alone and the same pressure with a shear of a fifth of it.  The key
 number is ``k_t0`` on the real contact set under shear, in units of ``k_n/|T|``.
 
     python examples/cell_under_shear.py
 """
-from ngcontact.cell.cell_problem import CellModel, CellProblem, cell_load
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem, cell_load
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.fem.materials import isotropic
 from ngcontact.geometry.profiles import profile_cell, rectangular_valley

@@ -35,7 +35,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from ngcontact import runner  # noqa: E402
 
-from ngcontact.cell import coulomb_friction  # noqa: E402
+from ngcontact.cell.fe import coulomb_friction  # noqa: E402
 from ngcontact.drivers.build import cell_loads  # noqa: E402
 from ngcontact.drivers.cell_members import fe_problem  # noqa: E402
 from ngcontact.errors import ConvergenceError  # noqa: E402

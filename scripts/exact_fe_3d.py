@@ -8,7 +8,7 @@ Two measurements, one run, one CSV and one PNG:
    Bodies 1 deep, ``E = 1``, ``nu = 0.3``, loads ``p/p* = 0.2, 0.8``,
    refining the interface mesh and with it the bodies' (``maxh`` twice the
    interface's: order-1 bodies kept coarse stall the error at 5-6 %): exact enforcement at order 1 (what is built
-   in 3D, ``ngcontact.cell.contact_multiplier``; augmentation
+   in 3D, ``ngcontact.cell.fe.contact_multiplier``; augmentation
    ``k_n = 100 E/h``) beside the penalty ``k_n = 1000 E/h`` at order 1, and
    at order 2 on the two coarser meshes (its contact set read from the
    penetration at quadrature points).  Reported: relative error of the
@@ -58,7 +58,7 @@ def waves(sizes) -> list[dict]:
     import ngsolve as ng
     from ngcontact import runner
     from ngcontact.cell.cell_load import cell_load
-    from ngcontact.cell.cell_problem import CellModel, CellProblem
+    from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
     from ngcontact.fem.materials import isotropic
     from ngcontact.geometry.cell3d import flat_cell3d
     from ngcontact.solvers.linear_solver import LinearSolver
@@ -142,7 +142,7 @@ def main(argv=None) -> int:
     ap.add_argument("out", nargs="?", default=os.path.join("results", "exact_fe_3d"), help="output directory")
     ap.add_argument("--quick", action="store_true", help="the coarsest size of each part only (a smoke run)")
     args = ap.parse_args(argv)
-    start_logging("ngcontact.cell.contact_multiplier")
+    start_logging("ngcontact.cell.fe.contact_multiplier")
     rows = waves(QUICK_WAVE if args.quick else WAVE_SIZES) + bisinusoid(QUICK_BIS if args.quick else BIS_SIZES)
     write_study(args.out, "exact_fe_3d", KEYS, rows, plot)
     return 0

@@ -8,7 +8,7 @@ Three measurements, one run, one CSV and one PNG:
    dofs) and ``"iterative"`` (BDDC-preconditioned CG,
    :mod:`ngcontact.solvers.linear_solver`), started as ``ngcontact run``
    starts it: on the contact set of the spectral twin
-   (:mod:`ngcontact.cell.spectral_predictor`), whose solve is timed with it.
+   (:mod:`ngcontact.cell.spectral_start`), whose solve is timed with it.
 2. **3D macro press fit** (two coaxial tubes, a quarter, interference 1e-3,
    a tabulated nonlinear normal law so that Newton iterates, 0.1 on the top),
    refining ``maxh`` at order 2, the same two solvers.
@@ -83,7 +83,7 @@ def peak_memory_gb() -> float:
 
 def cell_child(size: float, policy: str) -> dict:
     from ngcontact import runner
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
     from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
@@ -92,7 +92,7 @@ def cell_child(size: float, policy: str) -> dict:
     with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
         t0 = time.perf_counter()
         # as ngcontact run: the first load starts from the spectral twin's contact set
-        P = CellProblem(cell, model_of(scene), linear=LinearSolver(policy), twin=predictor_twin(scene, size))
+        P = CellProblem(cell, model_of(scene), linear=LinearSolver(policy), predictor=predictor_twin(scene, size))
         load = cell_loads(scene)[0]
         sol = P.solve(load, first=True, measure=False)
         secs = time.perf_counter() - t0
@@ -169,7 +169,7 @@ def fe_parts(quick: bool, direct_max: int, parts=("cell", "macro"), solvers=("it
 
 def spectral_aim(quick: bool) -> list[dict]:
     from ngcontact.cell.cell_load import cell_load
-    from ngcontact.cell.spectral_cell import Layer, SpectralCell
+    from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
     from ngcontact.geometry.cell3d import bisinusoid_gap
     rows = []
 
@@ -267,14 +267,14 @@ def breakdown(size: float, out: str) -> dict:
     them on the contact surface).  Writes ``scaling_3d_breakdown.csv`` and ``.png``."""
     import ngsolve as ng
     from ngcontact import runner
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
     from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
     scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
     cell = build_cell(scene, interface_maxh=size)
     with runner.threads(runner.thread_count()):
-        P = CellProblem(cell, model_of(scene), linear=LinearSolver("iterative"), twin=predictor_twin(scene, size))
+        P = CellProblem(cell, model_of(scene), linear=LinearSolver("iterative"), predictor=predictor_twin(scene, size))
         import ngsolve.krylovspace as K
         spent = [0.0]
         solve = K.CGSolver._SolveImpl
@@ -342,8 +342,8 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
     import ngsolve as ng
     from ngsolve.krylovspace import CGSolver
     from ngcontact import runner
-    from ngcontact.cell.cell_energy import preconditioning_form
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_energy import preconditioning_form
+    from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
     from ngcontact.fem import elasticity
     from ngcontact.scene.loader import load
@@ -353,7 +353,7 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
     rows = []
     with runner.threads(runner.thread_count()):
         P = CellProblem(build_cell(scene, interface_maxh=size), model, linear=LinearSolver("iterative"),
-                        twin=predictor_twin(scene, size))
+                        predictor=predictor_twin(scene, size))
         P.solve(cell_loads(scene)[0], first=True, measure=False)
         A = P.energy().mat
         b = A.CreateColVector()

@@ -49,7 +49,7 @@ from dataclasses import replace
 import numpy as np
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.spectral_cell import Layer, SpectralCell
+from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.geometry.random_surface import self_affine
 from ngcontact.output.writer import write_csv
 
@@ -247,8 +247,8 @@ def finish(fig, axes, path: str) -> None:
     plt.close(fig)
 
 
-QUIET = ("ngcontact.cell.spectral_cell", "ngcontact.solvers.newton", "ngcontact.drivers.run_cell",
-         "ngcontact.cell.cell_problem")
+QUIET = ("ngcontact.cell.spectral.layered_cell", "ngcontact.solvers.newton", "ngcontact.drivers.run_cell",
+         "ngcontact.cell.fe.cell_problem")
 
 
 def start_logging(*more: str) -> None:

@@ -13,12 +13,12 @@ cores), and two errors are recorded against the closed form:
 
 This package, spectral: the small-slope cell of two layers ``DEPTH`` thick
 solved on a grid with FFTs and exact contact
-(:mod:`ngcontact.cell.spectral_cell`), from ``N = 2^10`` to ``2^16`` points,
+(:mod:`ngcontact.cell.spectral.layered_cell`), from ``N = 2^10`` to ``2^16`` points,
 the contact edges placed between grid points; and the same refined from
 ``N = 2^10`` to the tolerances 1e-4, 1e-5, 1e-6
 (``geometries/cells/westergaard_exact.toml``), every level timed.
 
-This package, FE: the FE cell of :class:`ngcontact.cell.cell_problem.CellProblem`
+This package, FE: the FE cell of :class:`ngcontact.cell.fe.cell_problem.CellProblem`
 (bodies 2 periods deep, so that their finite depth changes the half-space
 answer by less than 1e-10) over a ladder of orders, interface mesh sizes and
 penalties, on fixed meshes and on meshes graded towards the contact edges to
@@ -31,7 +31,7 @@ paper's Winkler layer): its own shift of the answer is in the error.  The
 graded penalty rows are run twice: on their own (the FE cost alone), and as
 ``ngcontact run`` runs them, each load's first mesh seeded with the contact
 edges of the cell's spectral twin and every level started from the twin
-(:mod:`ngcontact.cell.edge_grading`; the twin's solves in the time).
+(:mod:`ngcontact.cell.fe.edge_grading`; the twin's solves in the time).
 
 The peer: Tamaas (the ``bench`` extra, ``pip install ".[bench]"``), the
 Polonsky-Keer-Rey FFT solver on one elastic half-space against a rigid
@@ -63,11 +63,11 @@ import ngsolve as ng
 from ngcontact import runner
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem
-from ngcontact.cell.edge_grading import graded_flat_cell, solve_to_tolerance
-from ngcontact.cell.spectral_cell import Layer, SpectralCell
-from ngcontact.cell.spectral_predictor import twin_edges
-from ngcontact.cell.spectral_refinement import sweep_to_tolerance
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.edge_grading import graded_flat_cell, solve_to_tolerance
+from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
+from ngcontact.cell.spectral_start import SpectralStart, twin_edges
+from ngcontact.cell.spectral.refinement import sweep_to_tolerance
 from ngcontact.errors import ConvergenceError
 from ngcontact.fem.materials import isotropic
 from ngcontact.output.writer import write_csv
@@ -118,11 +118,11 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enfor
     their cost their own.  With ``twin`` (and a tolerance) the rows are
     ``ngcontact run``'s: the penalty twin on ``TWIN_POINTS`` points seeds each
     load's first graded mesh with its contact edges and starts every level
-    (:mod:`ngcontact.cell.edge_grading`), its solves in the time.
+    (:mod:`ngcontact.cell.fe.edge_grading`), its solves in the time.
 
     Without ``tolerance``: one mesh, the loads continued from one another.
     With it: each load on its own meshes, graded towards its contact edges
-    until the estimate meets the tolerance (:mod:`ngcontact.cell.edge_grading`).
+    until the estimate meets the tolerance (:mod:`ngcontact.cell.fe.edge_grading`).
     """
     pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H_GAP, 1.0)
     law = isotropic(1.0, NU)
@@ -139,7 +139,8 @@ def ours(order: int, ih: float, kn: float, tolerance: float | None = None, enfor
 
     def make_problem(vertices, p):
         cell = graded_flat_cell(1.0, DEPTH, DEPTH, maxh=0.3, interface_maxh=ih, order=p, vertices=vertices)
-        return CellProblem(cell, replace(model, order=p), max_iter=100, twin=spectral_twin)
+        return CellProblem(cell, replace(model, order=p), max_iter=100,
+                           predictor=None if spectral_twin is None else SpectralStart(spectral_twin))
 
     fractions, pressures, steps, ndof = [], [], [], 0
     with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
@@ -210,7 +211,7 @@ def spectral_to_tolerance(tolerance: float) -> dict:
     """The four loads on the spectral cell refined from ``N = 2^10`` until the estimate meets ``tolerance``.
 
     The scene ``geometries/cells/westergaard_exact.toml`` at ``tolerance = 1e-6``
-    (:mod:`ngcontact.cell.spectral_refinement`); the time includes every level.
+    (:mod:`ngcontact.cell.spectral.refinement`); the time includes every level.
     """
     pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H_GAP, 1.0)
     t0 = time.perf_counter()
@@ -344,7 +345,7 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="two settings of each solver only (a smoke run)")
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    for quiet in ("ngcontact.cell.edge_grading", "ngcontact.solvers.newton"):
+    for quiet in ("ngcontact.cell.fe.edge_grading", "ngcontact.solvers.newton"):
         logging.getLogger(quiet).setLevel(logging.WARNING)
     rows = run(quick=args.quick)
     os.makedirs(args.out, exist_ok=True)

@@ -6,7 +6,7 @@
    contains the penalty error (``O(1/k_n)``) as well as the discretization
    error; both ``k_n`` values of ``KN_VALUES`` are run.  Time: mesh, setup
    and the Newton solve (rigid predictor, exact line search), without the
-   post-processing of :meth:`ngcontact.cell.cell_problem.CellProblem.measure`.
+   post-processing of :meth:`ngcontact.cell.fe.cell_problem.CellProblem.measure`.
 2. Example 27 ``k_t0`` of the semicircular valley (radius 0.3, unit period,
    conforming, ``k_n = 1``): exact ``a pi / 2``; purely geometric (paper
    eq. 34), time = meshing + surface integral.
@@ -34,7 +34,7 @@ import time
 import ngsolve as ng
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
 from ngcontact.geometry import profiles
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.cell.coefficients import coefficients

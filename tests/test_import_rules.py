@@ -120,10 +120,44 @@ def test_imports_point_downstream():
     assert not bad, "imports against the layer table:\n" + "\n".join(bad)
 
 
+#: inside ``cell``: the methods behind the cell protocol never know each other, and the protocol's own modules
+#: (the load, the solution, the protocol, eq. 34's coefficients) know neither; only the spectral start of an FE
+#: solve, a predictor passed in by the builder, joins the two
+CELL_PARTS: dict[str, set[str]] = {
+    "cell.fe": {"cell.fe", "cell.shared"},
+    "cell.spectral": {"cell.spectral", "cell.shared"},
+    "cell.shared": {"cell.shared"},
+    "cell.spectral_start": {"cell.fe", "cell.spectral", "cell.shared"},
+}
+
+
+def _cell_part(module: str) -> str | None:
+    parts = module.split(".")
+    if len(parts) < 3 or parts[1] != "cell":
+        return None
+    if parts[2] in ("fe", "spectral", "spectral_start"):
+        return "cell." + parts[2]
+    return "cell.shared"
+
+
+def test_the_cell_methods_do_not_know_each_other():
+    bad = []
+    for path in sorted((PACKAGE / "cell").rglob("*.py")):
+        src = _module_of(path)
+        part = _cell_part(src)
+        for line, dst in _imports(path):
+            target = _cell_part(dst)
+            if part is not None and target is not None and target not in CELL_PARTS[part]:
+                bad.append(f"{path.relative_to(PACKAGE.parent)}:{line}: {src} -> {dst}")
+    assert not bad, "imports across the cell's methods:\n" + "\n".join(bad)
+    assert _cell_part("ngcontact.cell.fe.cell_problem") == "cell.fe"
+    assert "cell.spectral" not in CELL_PARTS["cell.fe"]      # negative control of the table itself
+
+
 def test_the_check_sees_a_forbidden_import(tmp_path, monkeypatch):
     """Negative control: a cell module importing the macro problem is caught."""
-    assert not _allowed("ngcontact.cell.cell_problem", "ngcontact.macro.macro_problem")
-    assert not _allowed("ngcontact.macro.macro_problem", "ngcontact.cell.cell_problem")
+    assert not _allowed("ngcontact.cell.fe.cell_problem", "ngcontact.macro.macro_problem")
+    assert not _allowed("ngcontact.macro.macro_problem", "ngcontact.cell.fe.cell_problem")
     assert not _allowed("ngcontact.scene.loader", "ngcontact.drivers.build")
     assert _allowed("ngcontact.coupling.two_scale", "ngcontact.macro.macro_problem")
 

@@ -6,7 +6,7 @@ the cell through the contact conditions of eq. 50 and the far-field
 condition of eq. 51 (in the variational form, the last term of eq. 65,
 ``-sigma^0_ij int_{S_C} H(J.n - g) n_j (v_i - u_i) ds``); here it is applied
 as the mean traction it transmits across the layer, on the far face of
-``counter``, which moves rigidly by ``U`` (:mod:`ngcontact.cell.cell_problem`).
+``counter``, which moves rigidly by ``U`` (:mod:`ngcontact.cell.fe.cell_problem`).
 The macro strain ``du^0/dx`` is the volume term of eq. 63.  The load is, per
 mesh axis ``i`` (``x, y`` in 2D, ``x, y, z`` in 3D; the last one is the macro
 normal ``n0``), one of

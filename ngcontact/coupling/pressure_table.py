@@ -2,8 +2,8 @@
 
 The cell at a mean pressure ``p`` (compression positive) answers with its
 real contact fraction, the coefficients of eq. 34 on its real contact set
-and its mean closure ``c(p)`` (:func:`cell_response` for the FE cell,
-:func:`spectral_response` for the small-slope cell on a grid); the two-scale loop
+and its mean closure ``c(p)``, whichever method solves it
+(:meth:`ngcontact.cell.cell_solver.CellSolver.response`); the two-scale loop
 (:mod:`ngcontact.coupling.two_scale`, paper Sec. 3.5) reads them from a
 table over ``p`` and hands the macro problem the law ``p = P(c)``
 (:func:`response_law`).
@@ -37,29 +37,18 @@ import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellProblem
-from ngcontact.cell.spectral_cell import SpectralCell
-from ngcontact.cell.measures import (
-    contact_fraction,
-    contact_integral,
-    mean_jump,
-    real_contact_coefficients,
-)
+from ngcontact.cell.cell_solver import RESPONSE_KEYS, Response
 from ngcontact.errors import ConvergenceError, ModelError
-from ngcontact.fem.quadrature import smooth_order
 from ngcontact.laws import homogenized as il
 from ngcontact.laws import interface_energy as ie
 from ngcontact.laws import monotone_cubic
 
 log = logging.getLogger(__name__)
 
-#: ``{"contact_fraction", "k_n0", "g_n0", "closure"}`` of the cell at one pressure
-Response = dict[str, float]
-KEYS = ("contact_fraction", "k_n0", "g_n0", "closure")
+#: the keys of a response (:data:`ngcontact.cell.cell_solver.Response`)
+KEYS = RESPONSE_KEYS
 #: the quantities whose interpolation error the table controls
 CHECKED = ("contact_fraction", "closure")
 #: a lower table end below the table is extended to this fraction of the requested one
@@ -72,57 +61,6 @@ SLACK = 1e-6
 def serial_map(task: Callable[[float], Response], items: Sequence[float]) -> list[Response]:
     """The default ``map_tasks``: the cell solves one after the other."""
     return [task(x) for x in items]
-
-
-def cell_response(problem: CellProblem, pressure: float, length_unit: float = 1.0) -> Response:
-    """Contact fraction, ``k_n0``, ``g_n0`` and mean closure of the cell at a mean pressure.
-
-    ``problem`` is a :class:`ngcontact.cell.cell_problem.CellProblem`, solved from a first
-    load's start (the rigid predictor, or the spectral one where the cell has a twin).  ``k_n0``
-    is eq. 34 on the real contact set: ``k_n`` times the contact fraction (located by the roots of the penetration in
-    2D) on a flat cell, else the quadrature integral of the indicator.  The
-    closure is the projected mean normal jump on ``S_C``,
-
-        c = int_{S_C} J_n |n.n0| ds / int_{S_C} |n.n0| ds,
-
-    which, unlike eq. 34's integral at quadrature points, does not jump when
-    a quadrature point enters contact; ``g_n0 = k_n0 c - p`` makes the
-    Winkler law pass through the cell's state.  Lengths are scaled by
-    ``length_unit`` (metres per cell length unit); ``k_n0`` is a length
-    ratio times ``k_n``.
-    """
-    problem.solve(cell_load(problem.dim, pressure=float(pressure)), first=True, measure=False)
-    fraction = float(contact_fraction(problem))
-    if not problem.tangential_free:  # flat and frictionless: n = n0 on all of S_C
-        kn0 = problem.model.k_n * fraction
-    else:
-        kn0 = float(real_contact_coefficients(problem)["k_n"])
-    n0 = problem.n[problem.dim - 1]
-    projected = float(contact_integral(problem, ng.IfPos(n0, n0, -n0), order=smooth_order(problem.model.order)))
-    closure = float(mean_jump(problem)[problem.dim - 1]) * problem.area / projected * length_unit
-    return {"contact_fraction": fraction, "k_n0": kn0, "g_n0": kn0 * closure - float(pressure),
-            "closure": closure}
-
-
-def spectral_response(cell: SpectralCell, pressure: float, length_unit: float = 1.0) -> Response:
-    """:func:`cell_response` of a small-slope cell solved on its grid (:mod:`ngcontact.cell.spectral_cell`).
-
-    The same model as the FE cell of a flat interface with the roughness in
-    the gap: both layers flat, ``n = n0`` on all of ``S_C``, so ``k_n0 =
-    k_n`` times the contact fraction (eq. 34 on the real contact set; the
-    fraction with its 2D edges located between grid points,
-    :func:`ngcontact.cell.spectral_measures.contact_fraction`) and the
-    closure is the mean normal jump ``c = mean(J_n)`` over the period.
-    Each pressure is solved from zero pressure, so a response does not
-    depend on the order of the solves.  Frictionless cells only (the
-    spectral cell carries no shear without friction; the loop's shear table
-    solves the FE cell).
-    """
-    sol = cell.solve(cell_load(cell.dim, pressure=float(pressure)))
-    fraction = float(sol.results["contact_fraction"])
-    kn0 = cell.k_n * fraction
-    closure = float(sol.results["mean_closure"]) * length_unit
-    return {"contact_fraction": fraction, "k_n0": kn0, "g_n0": kn0 * closure - float(pressure), "closure": closure}
 
 
 @dataclass

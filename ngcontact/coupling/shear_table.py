@@ -8,7 +8,7 @@ tangential interface jump
 
     s = int_{S_C} J.t0 |n.n0| ds / int_{S_C} |n.n0| ds,
 
-the tangential companion of the closure of :func:`ngcontact.coupling.pressure_table.cell_response`
+the tangential companion of the closure of :meth:`ngcontact.cell.fe.fe_cell.FECell.response`
 (the far-face jump minus the share of the cell's bulk, which the macro
 bodies carry themselves).  For growing ``Delta`` the shear rises while
 parts of ``S_C`` stick and levels off when the whole surface slides: on a
@@ -65,8 +65,8 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellProblem
-from ngcontact.cell.measures import contact_integral, mean_jump, mean_traction
+from ngcontact.cell.fe.cell_problem import CellProblem
+from ngcontact.cell.fe.measures import contact_integral, mean_jump, mean_traction
 from ngcontact.errors import ConvergenceError, ModelError
 from ngcontact.fem.quadrature import smooth_order
 from ngcontact.laws import homogenized as il

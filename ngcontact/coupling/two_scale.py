@@ -6,7 +6,7 @@ set ``S_C(p)``, the coefficients of eq. 34 on it,
     k_n0(p) = (1/|T|) int_{S_C(p)} k_n (n.n0)^2 ds,      g_n0(p) = k_n0(p) c(p) - p,
 
 and a mean closure ``c(p)``: the projected mean normal jump on ``S_C``
-(:func:`~ngcontact.coupling.pressure_table.cell_response`).  The law of step ii of Sec. 3.5 at an interface
+(:meth:`~ngcontact.cell.cell_solver.CellSolver.response`).  The law of step ii of Sec. 3.5 at an interface
 point ``x`` whose previous macro pressure is ``p_k(x)`` is the Winkler law
 ``p = k_n0(p_k) (a_n - g0) - g_n0(p_k)``; at its fixed point ``p_{k+1} =
 p_k = p`` it reads ``a_n - g0 = c(p)``.  The loop is therefore the chord

@@ -6,6 +6,7 @@ driver calls these instead of building its own copies.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 import hashlib
 import json
 import math
@@ -14,8 +15,14 @@ import os
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.cell_problem import CellLoad, CellModel, CellProblem, cell_load
+from dataclasses import replace
+
+from ngcontact.cell.cell_solver import CellSolver
 from ngcontact.cell.coefficients import direction_bundle
+from ngcontact.cell.fe.cell_problem import CellLoad, CellModel, CellProblem, cell_load
+from ngcontact.cell.fe.edge_grading import LEVELS_PER_STEP, MAX_STEPS, RATIO, graded_flat_cell
+from ngcontact.cell.fe.fe_cell import FECell
+from ngcontact.cell.spectral.spectral_solver import SpectralCellSolver
 from ngcontact.coupling import cell_law
 from ngcontact.errors import SceneError
 from ngcontact.fem import materials
@@ -23,9 +30,10 @@ from ngcontact.fem.interpolants import periodic_table_1d
 from ngcontact.laws import homogenized as il
 from ngcontact.laws.penalty import Friction
 from ngcontact.solvers.linear_solver import LinearSolver
-from ngcontact.cell.spectral_cell import Layer, SpectralCell
+from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
+from ngcontact.cell.spectral_start import SpectralStart
 from ngcontact.scene.cell_geometry import GAP_PROFILES, profile_2d, small_slope
-from ngcontact.scene.cell_scene import CellScene, load_states, spectral_grid
+from ngcontact.scene.cell_scene import MAX_SPECTRAL_POINTS, CellScene, load_states, spectral_grid
 from ngcontact.scene.loader import as_dict, load_with_contact
 from ngcontact.scene.sections import MaterialSpec, resolve
 
@@ -213,18 +221,59 @@ def gap_cf(scene):
     return terms[0] if len(terms) == 1 else terms[0] + terms[1]
 
 
+def cell_solver(scene: CellScene) -> CellSolver:
+    """The cell of a cell scene behind the cell protocol (:mod:`ngcontact.cell.cell_solver`): its
+    ``discretization.method`` chooses the implementation (:data:`CELL_METHODS`)."""
+    return CELL_METHODS[scene.discretization.method](scene)
+
+
+def fe_cell(scene: CellScene) -> FECell:
+    """The FE cell of a scene: its mesh, its cell problem (built on the first solve) and, with
+    ``discretization.tolerance`` on a flat 2D cell, the graded meshes and the fine spectral predictor that
+    seeds them (:mod:`ngcontact.cell.fe.edge_grading`)."""
+    cell, model = build_cell(scene), model_of(scene)
+    c, d = scene.contact, scene.discretization
+    graded = h0 = predictor = None
+    if d.tolerance is not None:
+        g = scene.geometry
+        h0 = d.interface_maxh or d.maxh
+        # one twin for every load and level, as fine as the finest grading asks (within the grid's bound)
+        predictor = predictor_twin(scene, h0 * RATIO ** (MAX_STEPS * LEVELS_PER_STEP))
+
+        def graded(vertices, order):
+            mesh = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
+                                    vertices=vertices)
+            return cell_problem(scene, mesh, replace(model, order=order), predictor=predictor)
+    return FECell(cell, model, lambda: cell_problem(scene, cell, model),
+                  threshold=c.G if c.friction == "tresca" else None, graded=graded, h0=h0, predictor=predictor)
+
+
+def spectral_cell_solver(scene: CellScene) -> SpectralCellSolver:
+    """The spectral cell of a small-slope scene, with the recipe of its finer grids (refinement)."""
+    return SpectralCellSolver(spectral_cell(scene), make_cell=lambda n: spectral_cell(scene, grid=n),
+                              max_points=MAX_SPECTRAL_POINTS)
+
+
+#: the cell protocol's implementations by ``discretization.method``
+CELL_METHODS: dict[str, Callable[[CellScene], CellSolver]] = {"fe": fe_cell, "spectral": spectral_cell_solver}
+
+
+#: the FE cell problem's start of first loads for each ``solver.start`` of a scene (``None``: its default)
+FE_START = {"auto": None, "spectral": "predictor", "rigid": "rigid", "closed": "closed"}
+
+
 def cell_problem(scene: CellScene, cell=None, model: CellModel | None = None,
-                 twin: SpectralCell | None = None) -> CellProblem:
+                 predictor: SpectralStart | None = None) -> CellProblem:
     """The FE cell problem of a cell scene: its mesh (``cell``, default :func:`build_cell`), its model
-    (default :func:`model_of`), the ``[solver]`` settings, and the spectral twin that starts its first loads
-    where it has one (``twin``, built by the caller for several meshes of one cell; default
+    (default :func:`model_of`), the ``[solver]`` settings, and the spectral predictor that starts its first
+    loads where it has one (``predictor``, built by the caller for several meshes of one cell; default
     :func:`predictor_twin` of the scene)."""
     s = scene.solver
     return CellProblem(build_cell(scene) if cell is None else cell, model_of(scene) if model is None else model,
                        rtol=s.rtol, atol=s.atol, max_iter=s.max_iter, inverse=s.inverse,
                        linear=linear_solver(scene), coulomb=s.coulomb,
-                       twin=predictor_twin(scene) if twin is None else twin,
-                       start=None if s.start == "auto" else s.start)
+                       predictor=predictor_twin(scene) if predictor is None else predictor,
+                       start=FE_START[s.start])
 
 
 def linear_solver(scene) -> LinearSolver:
@@ -235,7 +284,7 @@ def linear_solver(scene) -> LinearSolver:
 
 def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = True,
                   tol: float | None = None, heights: np.ndarray | None = None) -> SpectralCell:
-    """The spectral cell (:mod:`ngcontact.cell.spectral_cell`) of a small-slope cell scene.
+    """The spectral cell (:mod:`ngcontact.cell.spectral.layered_cell`) of a small-slope cell scene.
 
     ``grid``: points per direction instead of the scene's (a gap given by a formula); ``friction = False``:
     the cell without the scene's friction; ``tol``: its solver's tolerance instead of ``solver.rtol``;
@@ -264,9 +313,9 @@ TWIN_GRID = {2: (64, 8192), 3: (64, 512)}
 TWIN_RTOL = 1e-8
 
 
-def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> SpectralCell | None:
-    """The spectral twin whose contact set starts an FE cell's first loads
-    (:mod:`ngcontact.cell.spectral_predictor`), or ``None`` where there is none.
+def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> SpectralStart | None:
+    """The predictor of an FE cell's first loads from its spectral twin's contact set
+    (:class:`ngcontact.cell.spectral_start.SpectralStart`), or ``None`` where there is none.
 
     A twin exists for the penalty on a cell the spectral cell can solve (the small-slope model:
     :func:`ngcontact.scene.cell_scene.has_twin`) unless ``solver.start`` asks for another start; it is
@@ -285,8 +334,8 @@ def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> Spe
     heights = map_heights(scene)
     if heights is not None:
         grid = max(grid, spectral_grid(scene, heights.shape))
-    return spectral_cell(scene, grid=int(min(max(grid, low), high)), friction=False, tol=TWIN_RTOL,
-                         heights=heights)
+    return SpectralStart(spectral_cell(scene, grid=int(min(max(grid, low), high)), friction=False,
+                                       tol=TWIN_RTOL, heights=heights))
 
 
 def map_heights(scene: CellScene) -> np.ndarray | None:

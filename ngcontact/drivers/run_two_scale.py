@@ -86,10 +86,10 @@ class PressureSolve:
     shared problem gives the numbers of a fresh one.
 
     ``method``: ``"fe"`` or ``"spectral"`` instead of the cell scene's own
-    ``discretization.method`` (``two_scale.cell_method``).  A spectral cell
-    (:class:`~ngcontact.cell.spectral_cell.SpectralCell`) answers by
-    :func:`~ngcontact.coupling.pressure_table.spectral_response`, each
-    pressure from zero pressure.
+    ``discretization.method`` (``two_scale.cell_method``).  The cell is
+    reached through the cell protocol
+    (:meth:`~ngcontact.cell.cell_solver.CellSolver.response`), each pressure
+    from a first load's start, whichever method solves it.
     """
 
     def __init__(self, path: str, length_unit: float, overrides: dict | None = None, method: str | None = None):
@@ -109,20 +109,20 @@ class PressureSolve:
         self.__dict__.update(state)
         self._shared = True  # a copy in a worker: share the worker's cell problem
 
+    def build(self):
+        """The cell this task solves: the scene's cell behind the cell protocol."""
+        from ngcontact.drivers.build import cell_scene_of, cell_solver
+        return cell_solver(cell_scene_of(self.path, key="two_scale.cell", overrides=self.overrides,
+                                         method=self.method))
+
     def problem(self):
+        """The cell of :meth:`build`, built once per process and worker thread."""
         if self._problem is None:
             slot = (type(self).__name__, self.key, threading.get_ident())
             if self._shared and slot in _BUILT:
                 self._problem = _BUILT[slot]
                 return self._problem
-            if self.method == "spectral":
-                from ngcontact.drivers.build import cell_scene_of, spectral_cell
-                self._problem = spectral_cell(cell_scene_of(self.path, key="two_scale.cell", overrides=self.overrides,
-                                                            method=self.method))
-            else:
-                from ngcontact.drivers.run_strength import cell_problem_of
-                _, self._problem = cell_problem_of(self.path, key="two_scale.cell", overrides=self.overrides,
-                                                   method=self.method)
+            self._problem = self.build()
             if self._shared:
                 while len(_BUILT) >= KEEP_BUILT:
                     _BUILT.pop(next(iter(_BUILT)))
@@ -130,19 +130,22 @@ class PressureSolve:
         return self._problem
 
     def __call__(self, pressure: float) -> PT.Response:
-        if self.method == "spectral":
-            return PT.spectral_response(self.problem(), pressure, self.length_unit)
-        return PT.cell_response(self.problem(), pressure, self.length_unit)
+        return self.problem().response(pressure, self.length_unit)
 
     def size(self) -> dict:
         """The cell's discretization for the report: ``{"method", "ndof"}`` (FE) or ``{"method", "grid_points"}``."""
-        if self.method == "spectral":
-            return {"method": "spectral", "grid_points": int(self.problem().points)}
-        return {"method": "fe", "ndof": int(self.problem().ndof)}
+        return self.problem().size()
 
 
 class ShearSolve(PressureSolve):
-    """``(p, Delta) -> cell shear response`` of one cell scene; picklable like :class:`PressureSolve`."""
+    """``(p, Delta) -> cell shear response`` of one cell scene; picklable like :class:`PressureSolve`.
+
+    The shear response is the FE cell's (its far-face jump under a shear load,
+    :func:`~ngcontact.coupling.shear_table.cell_shear_response`)."""
+
+    def build(self):
+        from ngcontact.drivers.run_strength import cell_problem_of
+        return cell_problem_of(self.path, key="two_scale.cell", overrides=self.overrides, method=self.method)[1]
 
     def __call__(self, load) -> S.ShearResponse:  # type: ignore[override]
         return S.cell_shear_response(self.problem(), load[0], load[1], self.length_unit)

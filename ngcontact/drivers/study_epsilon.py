@@ -13,7 +13,7 @@ or the axisymmetric femur with a stem) with a flat interface, with
 * ``linear``: its linearization with the whole surface in contact,
   ``K0 = sum_q w_q n_q n_q^T`` (paper eq. 34), independent of ``eps``;
 * ``effective``: the linear law whose matrix is the effective stiffness of
-  the cell scaled to the period ``eps`` (:mod:`ngcontact.cell.stiffness`, "Beyond the
+  the cell scaled to the period ``eps`` (:mod:`ngcontact.cell.fe.stiffness`, "Beyond the
   paper": the tangent of the mean traction with respect to the interface's
   share of the far faces' relative displacement, including the compliance
   of the asperities), evaluated by a cell solve at the mean interface
@@ -108,7 +108,7 @@ def effective_law(scene, eps: float, mean_traction) -> tuple[il.LinearLaw, dict]
         counter body on ``S_0`` (compression positive), the cell's load.
     """
     from ngcontact.cell.cell_load import cell_load
-    from ngcontact.cell.cell_problem import CellModel, CellProblem
+    from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
     cell_scene = scene.cell_scene
     g, d = cell_scene.geometry, cell_scene.discretization
     s = eps / g.period

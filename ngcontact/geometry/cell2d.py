@@ -179,7 +179,7 @@ def flat_cell(period: float = 1.0, h_rough: float = 1.0, h_counter: float = 1.0,
 
     ``vertices``: abscissae in ``(0, period)`` that become mesh vertices of
     the interface (a mesh graded towards the contact edges,
-    :mod:`ngcontact.cell.edge_grading`); ``grading`` as in
+    :mod:`ngcontact.cell.fe.edge_grading`); ``grading`` as in
     :func:`interface_cell`.
     """
     tol = 1e-12 * period

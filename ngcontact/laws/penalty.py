@@ -28,7 +28,7 @@ energy of the bodies is the integral over ``S_C`` of
   even at ``J_t = 0``;
 
 * Coulomb friction ``G = mu p``.  Coulomb friction has no potential, so it
-  is solved as a fixed point of Tresca problems (see :mod:`ngcontact.cell.cell_problem`):
+  is solved as a fixed point of Tresca problems (see :mod:`ngcontact.cell.fe.cell_problem`):
   the threshold is ``mu`` times the pressure of the *previous* iterate,
   evaluated exactly at the quadrature points from a frozen copy of that
   iterate (:func:`coulomb_threshold`), and the iteration stops when the
@@ -46,7 +46,7 @@ energy of the bodies is the integral over ``S_C`` of
   followed by the Uzawa update ``lambda <- p``, whose fixed points are the
   complementarity conditions ``J_n - g <= 0``, ``lambda >= 0``,
   ``lambda (J_n - g) = 0`` whatever ``k`` is (:func:`augmented_pressure`,
-  :mod:`ngcontact.cell.contact_multiplier`).  The constant ``-lambda^2/(2k)``
+  :mod:`ngcontact.cell.fe.contact_multiplier`).  The constant ``-lambda^2/(2k)``
   only makes the energy vanish where the surfaces are open.
 
 Only the terms a problem asks for are added: a frictionless problem
@@ -226,7 +226,7 @@ def interface_stiffness(J, n, dJ, dJv, *, k_n, gap=None, friction=None, w=None, 
     :func:`interface_energy` (tested to round-off), as a *bilinear* density
     of a state: a form built from it is assembled by ``Assemble``, which
     costs half of the automatic second derivative (a BDDC preconditioner
-    rebuilt from it: :func:`ngcontact.cell.cell_energy.preconditioning_form`).
+    rebuilt from it: :func:`ngcontact.cell.fe.cell_energy.preconditioning_form`).
     """
     s = penetration(J, n, gap)
     if multiplier is not None:

@@ -302,7 +302,7 @@ def flat_interface(geometry) -> bool:
 
 def has_twin(scene: CellScene) -> bool:
     """Whether an FE cell scene's first loads can start from its spectral twin
-    (:mod:`ngcontact.cell.spectral_predictor`): the penalty on a flat interface."""
+    (:mod:`ngcontact.cell.spectral_start`): the penalty on a flat interface."""
     return scene.contact.enforcement == "penalty" and flat_interface(scene.geometry)
 
 

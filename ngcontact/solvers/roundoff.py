@@ -13,7 +13,7 @@ progress: the residual has fallen below ``FLOOR_PROGRESS`` times the first
 one, or the first one was itself at the round-off of the start value (within
 ``FLOOR_GROWTH`` times its floor: a start that already was the solution).
 (Equilibrium checks of the results catch what a residual at its floor cannot
-show, e.g. :func:`ngcontact.cell.measures.equilibrium_error`.)
+show, e.g. :func:`ngcontact.cell.fe.measures.equilibrium_error`.)
 
 The energy itself is known only to its round-off, ``ROUNDOFF eps (|Pi| + |u| |K| |u| / 2)`` (its stiff terms
 cancel: on the femur scene ``|Pi|`` is 4e-3 and ``|u| |K| |u| / 2`` 2.6e3).

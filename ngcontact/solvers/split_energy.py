@@ -72,7 +72,7 @@ class SplitEnergy:
     interface
         The form of ``Psi`` (same space and storage), or an object answering the same
         ``Apply``, ``Energy``, ``AssembleLinearization`` and ``mat`` (e.g.
-        :class:`ngcontact.cell.contact_quadrature.ContactQuadrature`).
+        :class:`ngcontact.cell.fe.contact_quadrature.ContactQuadrature`).
     key
         ``key() -> hashable``: the values of the parameters ``g`` and ``c``
         depend on (e.g. the load's ``Parameter`` values); ``K`` must not

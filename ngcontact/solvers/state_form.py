@@ -7,7 +7,7 @@ form's coefficients read and calling ``Assemble``.  NGSolve linearizes a
 ``Variation`` by automatic differentiation at every quadrature point; a
 bilinear form of the same Hessian, written out, assembles in about half the
 time (a preconditioner rebuilt from it:
-:func:`ngcontact.cell.cell_energy.preconditioning_form`).  It answers the
+:func:`ngcontact.cell.fe.cell_energy.preconditioning_form`).  It answers the
 one question a split energy asks of a preconditioning form
 (:class:`ngcontact.solvers.split_energy.SplitEnergy`).
 """

@@ -1,4 +1,4 @@
-"""The layer compliance of :mod:`ngcontact.cell.layer_compliance`, solved by finite elements.
+"""The layer compliance of :mod:`ngcontact.cell.spectral.layer_compliance`, solved by finite elements.
 
 An independent check of the closed form: one Fourier mode of a layer
 ``-h < z < 0`` clamped at ``z = -h`` is a two-point boundary value problem

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
 from ngcontact.laws.penalty import Friction
-from ngcontact.cell.measures import contact_fraction
-from ngcontact.cell.stiffness import reference_stiffness
+from ngcontact.cell.fe.measures import contact_fraction
+from ngcontact.cell.fe.stiffness import reference_stiffness
 from ngcontact.errors import ConvergenceError
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.fem.materials import isotropic

@@ -27,8 +27,8 @@ import numpy as np
 import pytest
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem
-from ngcontact.cell.measures import sample_surface
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.measures import sample_surface
 from ngcontact.geometry.cell3d import square_hills_cell
 from ngcontact.fem.materials import isotropic
 
@@ -77,7 +77,7 @@ def test_effective_stiffness_stays_finite_as_kn_grows():
     """Interface compliance = penalty part ~ 1/k_n + asperity part (finite as k_n -> oo).
 
     The reference is the flat bonded laminate, so the hills' own compliance
-    remains when the penalty goes to infinity (effective stiffness, :mod:`ngcontact.cell.stiffness`): the compliance
+    remains when the penalty goes to infinity (effective stiffness, :mod:`ngcontact.cell.fe.stiffness`): the compliance
     decrements shrink tenfold per decade of ``k_n`` and the stiffness
     converges to a finite value.
     """

@@ -1,13 +1,13 @@
-"""The penalty's split quadrature on S_C (:mod:`ngcontact.cell.contact_quadrature`): the high rule on the
+"""The penalty's split quadrature on S_C (:mod:`ngcontact.cell.fe.contact_quadrature`): the high rule on the
 contact edge's elements only, and the same energy, residual, tangent and solution as the high rule on all."""
 import os
 
 import numpy as np
 import pytest
 
-from ngcontact.cell import cell_problem as cp
-from ngcontact.cell.cell_problem import CellProblem
-from ngcontact.cell.contact_quadrature import ContactQuadrature, applies
+from ngcontact.cell.fe import cell_problem as cp
+from ngcontact.cell.fe.cell_problem import CellProblem
+from ngcontact.cell.fe.contact_quadrature import ContactQuadrature, applies
 from ngcontact.drivers.build import build_cell, cell_loads, model_of
 from ngcontact.scene.loader import load
 from ngcontact.solvers.linear_solver import LinearSolver

@@ -12,8 +12,8 @@ import ngsolve as ng
 import numpy as np
 import pytest
 
-from ngcontact.cell.cell_problem import CellProblem
-from ngcontact.cell.cell_energy import coulomb_residual
+from ngcontact.cell.fe.cell_problem import CellProblem
+from ngcontact.cell.fe.cell_energy import coulomb_residual
 from ngcontact.drivers.build import build_cell, cell_loads, model_of
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.scene import loader

@@ -1,4 +1,4 @@
-"""Meshes graded towards the contact edges until a tolerance is met (ngcontact.cell.edge_grading).
+"""Meshes graded towards the contact edges until a tolerance is met (ngcontact.cell.fe.edge_grading).
 
 Westergaard's sinusoid (DESIGN Sec. 8) is the oracle: its contact half-width
 ``a`` with ``sin^2(pi a) = p/p*`` is known in closed form.  The penalty
@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem
-from ngcontact.cell.edge_grading import (carry_over, contact_edges, graded_flat_cell, graded_vertices,
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.edge_grading import (carry_over, contact_edges, graded_flat_cell, graded_vertices,
                                         solve_to_tolerance)
 from ngcontact.fem.materials import isotropic
 from ngcontact.verification.moduli import e_star
@@ -113,7 +113,7 @@ def test_grading_converges_monotonically_and_the_estimate_bounds_the_error():
 
 
 def test_a_tolerance_out_of_reach_fails_with_the_figures(monkeypatch):
-    from ngcontact.cell import edge_grading
+    from ngcontact.cell.fe import edge_grading
     from ngcontact.errors import ConvergenceError
 
     monkeypatch.setattr(edge_grading, "MAX_STEPS", 1)  # the budget, shortened: the rule is the same
@@ -123,7 +123,7 @@ def test_a_tolerance_out_of_reach_fails_with_the_figures(monkeypatch):
 
 
 def test_seed_levels_grade_down_to_the_seeds_spacing_and_leave_a_step():
-    from ngcontact.cell.edge_grading import LEVELS_PER_STEP, MAX_STEPS, RATIO, seed_levels
+    from ngcontact.cell.fe.edge_grading import LEVELS_PER_STEP, MAX_STEPS, RATIO, seed_levels
     assert seed_levels(0.02, 1.0 / 8192) == 4                     # 0.02 / 4^4 = 7.8e-5 <= 1.2e-4 < 0.02 / 4^2
     assert 0.02 * RATIO ** 4 <= 1.0 / 8192 < 0.02 * RATIO ** 2
     assert seed_levels(0.02, 1.0) == LEVELS_PER_STEP              # one step at least
@@ -141,10 +141,10 @@ def _graded_scene(**solver):
 
 
 def test_the_twins_edges_lie_within_half_its_spacing_of_westergaards():
-    from ngcontact.cell.spectral_predictor import twin_edges
+    from ngcontact.cell.spectral_start import twin_edges
     from ngcontact.drivers.build import cell_loads, predictor_twin
     sc = _graded_scene()
-    twin = predictor_twin(sc, 1e-6)
+    twin = predictor_twin(sc, 1e-6).twin
     pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H, 1.0)
     for load in cell_loads(sc):
         edges, spacing = twin_edges(twin, load)
@@ -158,23 +158,24 @@ def test_the_twins_edges_lie_within_half_its_spacing_of_westergaards():
 def test_a_load_graded_from_its_twins_edges_takes_fewer_meshes_and_steps_to_the_same_accuracy():
     """The shipped scene's lightest load: seeded with the twin's edges and started from the twin at every level,
     against the uniform first mesh and the carried states of a rigid start (no twin)."""
-    from ngcontact.cell.edge_grading import seed_levels
-    from ngcontact.drivers.build import cell_loads
-    from ngcontact.drivers.run_cell import solve_graded
+    from ngcontact.cell.fe.edge_grading import seed_levels
+    from ngcontact.drivers.build import cell_loads, fe_cell
     sc = _graded_scene()
     load = cell_loads(sc)[:1]
     pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H, 1.0)
     exact = westergaard_contact_fraction(-load[0].traction[-1], pstar)
-    seeded, = solve_graded(sc, load)
-    plain, = solve_graded(_graded_scene(start="rigid"), load)
-    first = seeded.history[0]
-    assert first["level"] == seed_levels(0.02, first["seed"]["spacing"]) > 0 and "seed" not in plain.history[0]
-    assert plain.history[0]["level"] == 0
+    tol = sc.discretization.tolerance
+    seeded = fe_cell(sc).refine_to(tol, load)
+    plain = fe_cell(_graded_scene(start="rigid")).refine_to(tol, load)
+    history = {name: g.per_load[0]["mesh_history"] for name, g in (("seeded", seeded), ("plain", plain))}
+    first = history["seeded"][0]
+    assert first["level"] == seed_levels(0.02, first["seed"]["spacing"]) > 0 and "seed" not in history["plain"][0]
+    assert history["plain"][0]["level"] == 0
     for g in (seeded, plain):
-        assert g.estimate["contact_fraction"] <= sc.discretization.tolerance
-        assert abs(g.solution.results["contact_fraction"] - exact) <= g.estimate["contact_fraction"]
-    assert len(seeded.history) < len(plain.history)
-    steps = [sum(h["newton_iterations"] for h in g.history) for g in (seeded, plain)]
+        assert g.estimates[0]["contact_fraction"] <= tol
+        assert abs(g.solutions[0].results["contact_fraction"] - exact) <= g.estimates[0]["contact_fraction"]
+    assert len(history["seeded"]) < len(history["plain"])
+    steps = [sum(h["newton_iterations"] for h in history[name]) for name in ("seeded", "plain")]
     assert steps[0] < steps[1] / 2, steps                # measured 13 against 39
 
 

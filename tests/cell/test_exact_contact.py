@@ -34,9 +34,9 @@ import pytest
 
 from ngcontact import cli
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem
-from ngcontact.cell.contact_multiplier import ContactMultiplier, lobatto_rule, triangle_vertex_rule
-from ngcontact.cell.exact_contact_set import edge_fraction, vertex_area
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.contact_multiplier import ContactMultiplier, lobatto_rule, triangle_vertex_rule
+from ngcontact.cell.fe.exact_contact_set import edge_fraction, vertex_area
 from ngcontact.errors import ModelError
 from ngcontact.fem.materials import isotropic
 from ngcontact.geometry.cell2d import flat_cell

@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import ngcontact.cell.load_start as load_start
+import ngcontact.cell.fe.load_start as load_start
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem
-from ngcontact.cell.predictor import layer_stiffness, rigid_approach
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.predictor import layer_stiffness, rigid_approach
 from ngcontact.drivers.build import build_cell, model_of
 from ngcontact.fem.materials import isotropic
 from ngcontact.geometry.cell2d import flat_cell

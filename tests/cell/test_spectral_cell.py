@@ -8,8 +8,8 @@ import pytest
 
 from ngcontact import cli
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.layer_compliance import antiplane_compliance, layer_matrix, plane_compliances
-from ngcontact.cell.spectral_cell import Layer, SpectralCell, wave_numbers
+from ngcontact.cell.spectral.layer_compliance import antiplane_compliance, layer_matrix, plane_compliances
+from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell, wave_numbers
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.constrained_cg import constrained_cg, masked_cg
 from ngcontact.verification.layer_fe import layer_fe_compliance
@@ -133,7 +133,7 @@ def test_westergaard_contact_fraction_converges_at_more_than_first_order_in_the_
 
 def test_the_edge_fitted_far_from_the_contact_beats_the_line_through_the_first_open_points(monkeypatch):
     """The quartic over the far window places the edges ten times better than the two-point line."""
-    from ngcontact.cell import spectral_measures
+    from ngcontact.cell.spectral import grid_measures as spectral_measures
     cell, sols = _westergaard(4096, thickness=20.0)
     fitted = _fraction_error(sols)
     monkeypatch.setattr(spectral_measures, "EDGE_MIN_POINTS", 10 ** 9)       # the line only

@@ -1,4 +1,4 @@
-"""The spectral predictor (:mod:`ngcontact.cell.spectral_predictor`): a small-slope FE cell's first load starts
+"""The spectral predictor (:mod:`ngcontact.cell.spectral_start`): a small-slope FE cell's first load starts
 on its spectral twin's contact set and reaches the rigid start's solution."""
 import os
 from dataclasses import replace
@@ -7,10 +7,10 @@ import ngsolve as ng
 import numpy as np
 import pytest
 
-from ngcontact.cell.cell_problem import CellProblem
-from ngcontact.cell.measures import sample_surface
-from ngcontact.cell.predictor import set_start
-from ngcontact.cell.spectral_predictor import spectral_start
+from ngcontact.cell.fe.cell_problem import CellProblem
+from ngcontact.cell.fe.measures import sample_surface
+from ngcontact.cell.fe.predictor import set_start
+from ngcontact.cell.spectral_start import spectral_start
 from ngcontact.fem.interpolants import periodic_grid
 from ngcontact.drivers.build import TWIN_GRID, build_cell, cell_loads, cell_problem, model_of, predictor_twin
 from ngcontact.scene.loader import load
@@ -27,14 +27,14 @@ BISINUSOID = _scene("bisinusoid")
 
 def _problem(scene, start, interface_maxh=None):
     return CellProblem(build_cell(scene, interface_maxh=interface_maxh), model_of(scene), start=start,
-                       twin=predictor_twin(scene, interface_maxh))
+                       predictor=predictor_twin(scene, interface_maxh))
 
 
 def test_the_start_has_the_twin_s_contact_set():
     """After the spectral start, the penetration on S_C is the twin's interpolated one: the same sign wherever
     the twin's penetration is not within 5 % of its range of zero, and close to it everywhere."""
-    P = _problem(BISINUSOID, "spectral", 0.12)
-    twin = P.twin
+    P = _problem(BISINUSOID, "predictor", 0.12)
+    twin = P.predictor.twin
     load_ = cell_loads(BISINUSOID)[0]
     P._apply_load(load_)
     set_start(P, load_)                           # the rigid predictor's state
@@ -76,8 +76,8 @@ def test_the_spectral_start_reaches_the_rigid_start_s_solution(name, interface_m
     Newton steps than the rigid start (3D and 2D cells; the height map is not symmetric in x and y, so a
     twin read transposed would start Newton on another contact set)."""
     scene = _scene(name)
-    rigid, spectral = _problem(scene, "rigid", interface_maxh), _problem(scene, "spectral", interface_maxh)
-    assert spectral.start == "spectral"
+    rigid, spectral = _problem(scene, "rigid", interface_maxh), _problem(scene, "predictor", interface_maxh)
+    assert spectral.start == "predictor"
     for load_ in cell_loads(scene):
         a = rigid.solve(load_, first=True, measure=False)
         b = spectral.solve(load_, first=True, measure=False)
@@ -107,36 +107,37 @@ def test_a_twin_only_where_the_spectral_cell_solves_the_same_problem():
     """The penalty on a small-slope cell has a twin, its grid four points per interface element size (a
     power of two, within the bounds); exact enforcement, a resolved rough surface and a scene asking for
     another start (``solver.start``) have none; a spectral start without a twin is refused."""
-    assert predictor_twin(BISINUSOID, 0.12).grid == 64
-    assert predictor_twin(BISINUSOID, 0.021).grid == 256
-    assert predictor_twin(BISINUSOID, 1e-4).grid == TWIN_GRID[3][1]
-    assert predictor_twin(BISINUSOID, 0.12).friction is None
+    assert predictor_twin(BISINUSOID, 0.12).twin.grid == 64
+    assert predictor_twin(BISINUSOID, 0.021).twin.grid == 256
+    assert predictor_twin(BISINUSOID, 1e-4).twin.grid == TWIN_GRID[3][1]
+    assert predictor_twin(BISINUSOID, 0.12).twin.friction is None
     assert predictor_twin(_scene("westergaard_exact")) is None
     assert predictor_twin(_scene("sinusoid")) is None
     assert predictor_twin(_scene("bisinusoid_surface")) is None
     for start in ("rigid", "closed"):        # the scene asks for another start
         assert predictor_twin(replace(BISINUSOID, solver=replace(BISINUSOID.solver, start=start))) is None
-    with pytest.raises(ValueError, match="twin"):
-        CellProblem(build_cell(BISINUSOID, interface_maxh=0.12), model_of(BISINUSOID), start="spectral")
+    with pytest.raises(ValueError, match="needs a predictor"):
+        CellProblem(build_cell(BISINUSOID, interface_maxh=0.12), model_of(BISINUSOID), start="predictor")
 
 
 def test_the_scene_s_start_reaches_the_cell_problem():
     """``solver.start`` through :func:`~ngcontact.drivers.build.cell_problem`: auto is the spectral start
     where the cell has a twin; rigid and closed build no twin."""
     cell = build_cell(BISINUSOID, interface_maxh=0.12)
-    for start, expected in (("auto", "spectral"), ("spectral", "spectral"), ("rigid", "rigid"), ("closed", "closed")):
+    for start, expected in (("auto", "predictor"), ("spectral", "predictor"), ("rigid", "rigid"),
+                            ("closed", "closed")):
         P = cell_problem(replace(BISINUSOID, solver=replace(BISINUSOID.solver, start=start)), cell)
-        assert P.start == expected and (P.twin is not None) == (expected == "spectral")
+        assert P.start == expected and (P.predictor is not None) == (expected == "predictor")
 
 
 def test_a_failing_twin_leaves_the_rigid_start():
     """A twin whose solver stops unconverged: the load is solved from the rigid predictor (the same solution),
     and the history says why."""
     twin = predictor_twin(BISINUSOID, 0.12)
-    twin.max_iter = 2
+    twin.twin.max_iter = 2
     cell = build_cell(BISINUSOID, interface_maxh=0.12)
     load_ = cell_loads(BISINUSOID)[0]
-    failed = CellProblem(cell, model_of(BISINUSOID), twin=twin).solve(load_, first=True, measure=False)
+    failed = CellProblem(cell, model_of(BISINUSOID), predictor=twin).solve(load_, first=True, measure=False)
     rigid = CellProblem(cell, model_of(BISINUSOID), start="rigid").solve(load_, first=True, measure=False)
     start = failed.newton[0]["start"]
     assert start["kind"] == "rigid" and "above the tolerance" in start["twin_failed"]
@@ -148,7 +149,7 @@ def test_a_twin_is_refused_for_a_curved_interface():
     """A twin solves the small-slope cell: a cell whose S_C is a resolved rough surface refuses one."""
     surface = _scene("bisinusoid_surface")
     with pytest.raises(ValueError, match="not flat"):
-        CellProblem(build_cell(surface), model_of(surface), twin=predictor_twin(BISINUSOID, 0.12))
+        CellProblem(build_cell(surface), model_of(surface), predictor=predictor_twin(BISINUSOID, 0.12))
 
 
 def test_a_twin_contact_set_between_the_mesh_points_leaves_the_rigid_start():

@@ -6,8 +6,8 @@ import pytest
 
 from ngcontact import cli
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.spectral_cell import Layer, SpectralCell
-from ngcontact.cell.spectral_refinement import next_grid, sweep_to_tolerance
+from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
+from ngcontact.cell.spectral.refinement import next_grid, sweep_to_tolerance
 from ngcontact.errors import ConvergenceError
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star

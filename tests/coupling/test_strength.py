@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from ngcontact.coupling import strength as S
-from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
 from ngcontact.laws.penalty import Friction
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr

@@ -34,7 +34,8 @@ import ngsolve as ng
 import numpy as np
 import pytest
 
-from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.cell.fe.cell_problem import CellProblem
+from ngcontact.cell.fe.fe_cell import FECell
 from ngcontact.coupling import pressure_table as PT
 from ngcontact.coupling import two_scale as T
 from ngcontact.drivers import run_macro as RM
@@ -62,7 +63,7 @@ def groove_response():
 
     def response(p: float) -> PT.Response:
         if p not in known:
-            known[p] = PT.cell_response(cell, p)
+            known[p] = FECell.of(cell).response(p)
         return known[p]
     return response
 

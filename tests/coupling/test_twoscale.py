@@ -9,7 +9,8 @@ from ngcontact.macro import macro_problem as M
 from ngcontact.macro import macro_measures as MM
 from ngcontact.coupling import pressure_table as PT
 from ngcontact.coupling import two_scale as T
-from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.fe_cell import FECell
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry import bodies as gm
 from ngcontact.fem.materials import isotropic
@@ -44,7 +45,7 @@ def test_fixed_contact_set_stops_after_one_update_and_reproduces_the_one_shot_so
     problem = _press_fit(one_shot_law)
     one_shot = MM.interface_profile(M.solve(problem))["pressure"]
     assert one_shot.min() > 0  # all in compression
-    table = PT.CellTable(lambda p: PT.cell_response(P, p), tol=1e-3)
+    table = PT.CellTable(lambda p: FECell.of(P).response(p), tol=1e-3)
     out = T.couple(problem, table, tol=1e-6 * one_shot.max(), max_iter=5)
     assert out.converged and out.macro_solves == 2, out.history   # start + one update
     assert np.allclose(table.as_dict()["contact_fraction"], 0.5, atol=1e-9)
@@ -65,7 +66,7 @@ def test_tabulated_response_is_within_its_tolerance_of_direct_solves_at_random_p
     P = _westergaard_cell()
     p_star = westergaard_p_star(e_star(1.0, 0.3, 1.0, 0.3), 0.01, 1.0)
     tol = 0.02
-    table = PT.CellTable(lambda p: PT.cell_response(P, p), tol=tol)
+    table = PT.CellTable(lambda p: FECell.of(P).response(p), tol=tol)
     table.cover(0.05 * p_star, 0.8 * p_star)
     assert table.error_estimate <= tol
     d = table.as_dict()
@@ -75,7 +76,7 @@ def test_tabulated_response_is_within_its_tolerance_of_direct_solves_at_random_p
     solves = table.solves
     rng = np.random.default_rng(7)
     for p in rng.uniform(0.05 * p_star, 0.8 * p_star, 4):
-        direct = PT.cell_response(P, p)
+        direct = FECell.of(P).response(p)
         interp = table(p)
         for key, s in scale.items():
             err = abs(float(interp[key]) - direct[key]) / s

@@ -226,7 +226,7 @@ def test_a_mesh_size_as_large_as_the_period_still_gives_a_solvable_cell(dim):
     """Regression: maxh >= period / 2 let one element touch both periodic sides, and the
     assembly of the identified space failed ('illegal dnums').  The size is now capped."""
     from ngcontact.cell.cell_load import cell_load
-    from ngcontact.cell.cell_problem import CellModel, CellProblem
+    from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
     from ngcontact.geometry.cell2d import flat_cell
     from ngcontact.fem.materials import isotropic
     cell = flat_cell(maxh=1.0) if dim == 2 else flat_cell3d(maxh=1.0)

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from ngcontact.laws import penalty as contact
-from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
 from ngcontact.laws.penalty import Friction
-from ngcontact.cell.measures import sample_surface
+from ngcontact.cell.fe.measures import sample_surface
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.fem.materials import isotropic
 

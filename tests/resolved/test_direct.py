@@ -2,7 +2,7 @@
 
 * A periodic strip of N resolved periods under a prescribed far-face jump is
   the cell problem N times over: same mean traction and contact fraction as
-  :mod:`ngcontact.cell.cell_problem` (a check of both codes: orientation of the micro
+  :mod:`ngcontact.cell.fe.cell_problem` (a check of both codes: orientation of the micro
   normal over many periods, periodic spaces, reactions).
 * The homogenized bundle law converges to the resolved solution at a rate
   of about eps on ``block_rect_valleys.toml`` and beats the whole-surface
@@ -21,7 +21,7 @@ from ngcontact.resolved import resolved_problem as D
 from ngcontact.fem import materials as mat
 from ngcontact.scene import loader as scene_mod
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
 from ngcontact.drivers.study_epsilon import run_study
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr

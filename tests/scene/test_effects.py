@@ -140,7 +140,7 @@ def test_failures_after_the_solve_leave_the_previous_output_and_no_partial_files
     """Atomic output through the command line: a non-finite result found after the solve
     (exit 3) and a write that fails halfway (exit 2) both leave the earlier run intact."""
     from ngcontact.output import writer as writer_mod
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_problem import CellProblem
 
     scene = tmp_path / "cell.toml"
     scene.write_text(CELL.format(friction=""))

@@ -119,13 +119,13 @@ def test_the_cell_equilibrium_check_holds_for_a_solution_and_catches_a_state_tha
     """The interface force balances the far-face traction to round-off at a solution; a disturbed
     state is refused by the measurement with the figures."""
     import ngcontact
-    from ngcontact.cell import measures
+    from ngcontact.cell.fe import measures
     from ngcontact.errors import ConvergenceError
 
     report, outcome = ngcontact.solve(os.path.join(ROOT, "geometries", "cells", "flat_patch.toml"))
     assert all(load["equilibrium_error"] < 1e-10 for load in report["results"]["loads"])
     from ngcontact.drivers.build import build_cell, cell_loads, model_of
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_problem import CellProblem
 
     scene = ngcontact.load(os.path.join(ROOT, "geometries", "cells", "flat_patch.toml"))
     problem = CellProblem(build_cell(scene), model_of(scene))

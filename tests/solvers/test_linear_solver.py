@@ -48,7 +48,7 @@ def test_iterative_and_direct_agree_on_a_3d_press_fit(law):
 
 
 def test_a_3d_cell_solved_iteratively_equals_the_direct_solve():
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of
     from ngcontact.scene.loader import load
     scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
@@ -73,7 +73,7 @@ def test_the_effective_stiffness_by_cg_equals_the_factorized_one_and_the_next_lo
     from dataclasses import replace
 
     from ngcontact.cell.cell_load import cell_load
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, model_of
     from ngcontact.scene.loader import load
     scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
@@ -96,7 +96,7 @@ def test_the_effective_stiffness_by_cg_equals_the_factorized_one_and_the_next_lo
 def test_a_kept_bddc_gives_the_state_of_one_rebuilt_at_every_step(monkeypatch):
     """The split energy keeps BDDC across Newton steps (only CG's iterations may grow); rebuilt at every
     step (growth limit 0) it gives the same cell state to Newton's tolerance, and the record says which."""
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of
     from ngcontact.scene.loader import load
     from ngcontact.solvers import linear_solver
@@ -117,7 +117,7 @@ def test_a_kept_bddc_gives_the_state_of_one_rebuilt_at_every_step(monkeypatch):
 
 def test_inexact_newton_reaches_the_same_cell_state_with_fewer_cg_iterations():
     """Eisenstat-Walker forcing against a fixed CG tolerance of 1e-10: the same state to Newton's tolerance."""
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.solvers.linear_solver import ETA_MAX
     from ngcontact.drivers.build import build_cell, cell_loads, model_of
     from ngcontact.scene.loader import load
@@ -234,7 +234,7 @@ def test_a_3d_cell_s_coarse_problem_holds_the_vertices_and_its_tangent_not_the_b
     is no energy, keeps the whole contact surface on the wirebasket."""
     from dataclasses import replace
 
-    from ngcontact.cell.cell_problem import CellProblem
+    from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.laws.penalty import Friction
     from ngcontact.drivers.build import build_cell, cell_loads, model_of
     from ngcontact.scene.loader import load

@@ -87,7 +87,7 @@ def test_cell_newton_records_the_active_set_and_finds_no_false_cycle():
     import math as m
 
     from ngcontact.cell.cell_load import cell_load
-    from ngcontact.cell.cell_problem import CellModel, CellProblem
+    from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
     from ngcontact.geometry.cell2d import flat_cell
     from ngcontact.fem.materials import isotropic
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.drivers.build import build_cell, model_of
 from ngcontact.laws.penalty import Friction
 from ngcontact.scene import loader

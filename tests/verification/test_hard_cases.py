@@ -21,7 +21,7 @@ import pytest
 
 import ngcontact
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.cell_problem import CellModel, CellProblem
+from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
 from ngcontact.laws.penalty import Friction
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.cell2d import flat_cell

@@ -1,7 +1,7 @@
 """The contact multiplier of exact non-penetration on ``S_C``: node-to-node constraints (2D and 3D).
 
 With ``contact.enforcement = "exact"`` the cell problem (paper eqs. 49-51,
-57 and 65, :mod:`ngcontact.cell.cell_problem`) keeps the bodies from
+57 and 65, :mod:`ngcontact.cell.fe.cell_problem`) keeps the bodies from
 overlapping instead of resisting the overlap with the Winkler layer
 ``k_n [J_n - g]_+`` of eq. 65, the rigid limit ``k_n -> infinity``
 (DESIGN 7a).  Its contact energy is the augmented Lagrangian of
@@ -70,7 +70,7 @@ discrete interface force) and samples are taken at the points
 
 The real contact set the multiplier and the openings give (closed nodes
 and the contact edges between them) is measured in
-:mod:`ngcontact.cell.exact_contact_set`.
+:mod:`ngcontact.cell.fe.exact_contact_set`.
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
-"""Results of a load of the spectral small-slope cell (:mod:`ngcontact.cell.spectral_cell`).
+"""Results of a load of the spectral small-slope cell (:mod:`ngcontact.cell.spectral.layered_cell`).
 
-Results use the names of the FE cell (:mod:`ngcontact.cell.measures`):
+Results use the names of the FE cell (:mod:`ngcontact.cell.fe.measures`):
 ``contact_fraction`` (the share of grid points in contact; in 2D the
 contact edges located between grid points, below), ``mean_pressure``,
 ``mean_closure`` (the mean of ``J_n``), ``far_face_jump``,
@@ -28,7 +28,7 @@ first two open points, kept within the step between them.
 (The other side's ``p^2``, linear for a ``sqrt`` edge, carries the
 collocation error itself: 2e-5 of the fraction at 65,536 points.)
 
-Functions of a :class:`~ngcontact.cell.spectral_cell.SpectralCell` ``cell``.
+Functions of a :class:`~ngcontact.cell.spectral.layered_cell.SpectralCell` ``cell``.
 """
 from __future__ import annotations
 

@@ -5,19 +5,16 @@
 rigid limit ``k_n -> infinity``): the two bodies' elastic laws, the
 interface's penalty ``k_n``, initial gap ``g`` and friction (eqs. 57, 65),
 the displacement order and the stopping rules of the fixed points around
-Newton's method.  :class:`CellSolution` holds the results of one load as
-plain numbers and arrays, and the Newton histories that produced them.
-:class:`~ngcontact.cell.cell_problem.CellProblem` discretizes and solves.
+Newton's method.  :class:`~ngcontact.cell.fe.cell_problem.CellProblem`
+discretizes and solves; a load's results are a
+:class:`~ngcontact.cell.cell_solution.CellSolution`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
 
 import ngsolve as ng
-import numpy as np
 
-from ngcontact.cell.cell_load import CellLoad
 from ngcontact.errors import ModelError
 from ngcontact.fem import materials as _mat
 from ngcontact.laws.penalty import Friction
@@ -51,7 +48,7 @@ class CellModel:
     enforcement
         ``"penalty"`` (the Winkler layer of eq. 65) or ``"exact"``
         (non-penetration by an augmented Lagrangian,
-        :mod:`ngcontact.cell.contact_multiplier`).
+        :mod:`ngcontact.cell.fe.contact_multiplier`).
     uzawa_rtol, uzawa_max_iter
         Stopping rule of Uzawa's iteration (:mod:`ngcontact.solvers.uzawa`).
     """
@@ -77,18 +74,3 @@ class CellModel:
         if not (self.uzawa_rtol > 0 and self.uzawa_max_iter >= 1):
             raise ModelError(f"uzawa_rtol = {self.uzawa_rtol!r}, uzawa_max_iter = {self.uzawa_max_iter!r}: "
                              "must be > 0 and >= 1")
-
-
-@dataclass
-class CellSolution:
-    """Results of one load (plain numbers and arrays)."""
-
-    load: CellLoad
-    results: dict[str, Any]
-    surface: dict[str, np.ndarray]
-    newton: list[dict[str, Any]] = field(default_factory=list)
-    coulomb_iterations: int = 0
-
-    @property
-    def iterations(self) -> int:
-        return sum(h["iterations"] for h in self.newton)

@@ -8,7 +8,7 @@ Pi_T(.; mu p(u))`` and conversely):
 
 * ``"newton"`` (default): Newton on ``R`` with the consistent,
   non-symmetric tangent (:func:`ngcontact.solvers.coulomb_newton.coupled_newton`,
-  form :func:`ngcontact.cell.cell_energy.coulomb_residual`), globalized by
+  form :func:`ngcontact.cell.fe.cell_energy.coulomb_residual`), globalized by
   the exact line search on the Tresca energy with the threshold frozen at
   the iterate (:class:`~ngcontact.solvers.coulomb_newton.FrozenTresca`).
   Its tangent solves follow the cell's
@@ -30,8 +30,8 @@ from __future__ import annotations
 
 import logging
 
-from ngcontact.cell import measures
-from ngcontact.cell.cell_energy import coulomb_residual
+from ngcontact.cell.fe import measures
+from ngcontact.cell.fe.cell_energy import coulomb_residual
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.coulomb import MIXING_DEPTH, coulomb_fixed_point
 from ngcontact.solvers.coulomb_newton import FrozenTresca, coupled_newton

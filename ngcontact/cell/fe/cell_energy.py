@@ -5,16 +5,16 @@
 
 as NGSolve ``Variation`` terms of one symmetric form, whose derivative is
 the residual and whose second derivative the tangent of Newton's method
-(:mod:`ngcontact.cell.cell_problem` names the unknowns).  The interface
+(:mod:`ngcontact.cell.fe.cell_problem` names the unknowns).  The interface
 density ``psi`` (:func:`ngcontact.laws.penalty.interface_energy`):
 
 * penalty: ``k_n/2 [J.n - g]_+^2`` (eq. 65), integrated with the contact
   bonus order (the penalty has a kink); where the penetration is a
   polynomial per element, Newton integrates it with that order on the
   contact edge's elements only, to the same numbers
-  (:mod:`ngcontact.cell.contact_quadrature`);
+  (:mod:`ngcontact.cell.fe.contact_quadrature`);
 * exact: the augmented Lagrangian with the multiplier held fixed, at the
-  Gauss-Lobatto nodes of :mod:`ngcontact.cell.contact_multiplier`;
+  Gauss-Lobatto nodes of :mod:`ngcontact.cell.fe.contact_multiplier`;
 * friction ``G huber(|J_t|, w)`` (eqs. 57, 65): Tresca ``G``; Coulomb
   ``G = mu p`` of a frozen previous state (penalty: a copy of the state,
   returned for the fixed point to fill) or ``mu lambda`` of the multiplier
@@ -76,7 +76,7 @@ def preconditioning_form(problem, state: ng.GridFunction, quadrature=None) -> St
     longitudinal modulus and the contact stiffness: ``k_n``, or the augmentation of exact enforcement), so
     that BDDC's coarse problem needs only the vertex dofs of the contact surface.  Never assembled as the
     tangent.  ``quadrature``: the split contact quadrature
-    (:class:`ngcontact.cell.contact_quadrature.ContactQuadrature`) whose measures the interface term uses.
+    (:class:`ngcontact.cell.fe.contact_quadrature.ContactQuadrature`) whose measures the interface term uses.
 
     ``None`` where the whole form serves: at order 1 (every dof is a vertex's, no bubbles), and for
     Coulomb friction with the penalty, whose coupled residual is not an energy's and keeps the contact

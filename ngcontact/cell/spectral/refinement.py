@@ -1,11 +1,11 @@
 """The spectral cell on finer and finer grids until a tolerance is met.
 
 The grid is the spectral cell's only discretization parameter
-(:mod:`ngcontact.cell.spectral_cell`): the collocated pressure and gap, and
+(:mod:`ngcontact.cell.spectral.layered_cell`): the collocated pressure and gap, and
 with them the contact set of eq. 57 and the coefficients of eq. 34 on it,
 converge as the grid step shrinks.  The error of the contact fraction falls
 like the grid step or faster (2D: the edges located between grid points,
-:mod:`ngcontact.cell.spectral_measures`; 3D: a count of grid points, one
+:mod:`ngcontact.cell.spectral.grid_measures`; 3D: a count of grid points, one
 layer of points at the contact edges), with a constant that depends on where
 the edges fall between points, so it does not fall smoothly enough for
 Richardson extrapolation.  Hence a comparison estimate on widely spaced

@@ -4,7 +4,7 @@ The paper homogenizes the contact layer into the stiffnesses of eq. 34,
 integrals of the penalty ``k_n`` over the real contact set; they grow
 without bound with ``k_n`` and leave out the compliance of the asperities
 themselves.  This module measures the stiffness the solved cell problem
-(paper eqs. 49-51, 57, 65; :mod:`ngcontact.cell.cell_problem`) really has:
+(paper eqs. 49-51, 57, 65; :mod:`ngcontact.cell.fe.cell_problem`) really has:
 
 * ``S``: the tangent of the mean far-face traction with respect to the
   far-face jump, per ``|T|`` — the Schur complement of the tangent of the
@@ -24,7 +24,7 @@ themselves.  This module measures the stiffness the solved cell problem
   constriction of the asperities, finite as ``k_n -> infinity``) and the
   effective stiffness, its inverse (:func:`effective_stiffness`).
 
-Exact enforcement (:mod:`ngcontact.cell.contact_multiplier`): ``S`` is the
+Exact enforcement (:mod:`ngcontact.cell.fe.contact_multiplier`): ``S`` is the
 tangent with the contact set held closed, the limit ``k -> infinity`` of
 the augmented energy's tangent, in which the loaded points are springs of
 stiffness ``k`` (the augmentation).  ``S(k)`` is smooth in ``1/k`` at a

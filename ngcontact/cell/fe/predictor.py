@@ -2,7 +2,7 @@
 frictionless shear loads).
 
 The Newton solve of the cell problem (paper eqs. 49-51 in the penalized
-variational form of eq. 65, :mod:`ngcontact.cell.cell_problem`) needs a
+variational form of eq. 65, :mod:`ngcontact.cell.fe.cell_problem`) needs a
 start for every load.  Newton's active-set updates are slow when the
 contact set of the start is far from the solution's: from the open side the
 tangent of a few penalty springs is soft, the step overshoots and the line
@@ -11,7 +11,7 @@ contact edge only part of the way.  Two predictors put the start near the
 solution's contact set without any linear solve of the cell problem.  A
 small-slope cell under the penalty has a third, run after the rigid one on
 a first load: its spectral twin's contact set
-(:mod:`ngcontact.cell.spectral_predictor`).
+(:mod:`ngcontact.cell.spectral_start`).
 
 *First load* under a prescribed pressure ``p``: the rigid predictor.  The
 fluctuations are zero and the counter is translated by the normal approach
@@ -44,7 +44,7 @@ patch, so ``l`` is taken as the predicted patch itself, ``l = P f^(1/(dim-1))``
 for the predicted contact fraction ``f``, iterated to consistency
 (:func:`rigid_approach`).  On the bisinusoid 12 -> 7 steps, the tabulated
 gap 4 -> 2, the Westergaard sweep's first load 5 -> 5.  ``start="closed"`` of
-:class:`~ngcontact.cell.cell_problem.CellProblem` restores the oldest start
+:class:`~ngcontact.cell.fe.cell_problem.CellProblem` restores the oldest start
 instead: the counter pushed down by the largest gap plus ``p/k_n``
 (:func:`max_gap`).
 
@@ -62,7 +62,7 @@ one minimizer, so the start may forget the previous state; a start from it
 is no better where the contact set moves across the cell (the shear turns
 the pressed flank): on the sinusoid sweep the Newton steps after the start
 are the same 6 and 4 as after the rigid continuation
-(:func:`ngcontact.cell.load_start.rigid_continuation`), without the
+(:func:`ngcontact.cell.fe.load_start.rigid_continuation`), without the
 continuation's 3 and 3 steps (1, 2, 9, 7 -> 1, 1, 6, 4 per load), and on
 the 3D bisinusoid surface 4 + 9 -> 10.  The gain is the continuation's
 steps, each an assembly of the cell's tangent; the predictor's own
@@ -71,7 +71,7 @@ Newton steps of the cell problem, like the first load's root.  With friction the
 which has none, would slide the counter over the flat parts of ``S_C``
 that friction holds (and Coulomb's law, without an energy, need not have
 one solution: the previous one is the start to keep): the rigid
-continuation (:mod:`ngcontact.cell.load_start`), which chooses among these
+continuation (:mod:`ngcontact.cell.fe.load_start`), which chooses among these
 starts for every load.
 """
 from __future__ import annotations
@@ -83,7 +83,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
-from ngcontact.cell.measures import contact_integral, sample_surface
+from ngcontact.cell.fe.measures import contact_integral, sample_surface
 from ngcontact.laws import penalty as _contact
 from ngcontact.solvers.line_search import armijo, illinois_root
 

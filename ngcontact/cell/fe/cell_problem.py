@@ -31,17 +31,17 @@ Solve.  Newton's method (:func:`ngcontact.solvers.newton.minimize`), the
 step minimizing the convex energy along the Newton direction
 (``line_search="exact"``, Armijo test kept as a guard).  The first load
 under a prescribed pressure starts from the rigid predictor of
-:mod:`ngcontact.cell.predictor`, moved onto the contact set of the spectral
+:mod:`ngcontact.cell.fe.predictor`, moved onto the contact set of the spectral
 twin where the cell has one (penalty, small slope:
-:mod:`ngcontact.cell.spectral_predictor`), later loads from the previous
+:mod:`ngcontact.cell.spectral_start`), later loads from the previous
 solution (a frictionless sweep with a twin: each pressure afresh from the
-twin; the rules: :mod:`ngcontact.cell.load_start`).  A
+twin; the rules: :mod:`ngcontact.cell.fe.load_start`).  A
 frictionless flat ``S_C`` leaves ``U_t`` free of energy: it is fixed at 0
 and a nonzero shear is rejected.  Coulomb friction: Newton on the
 coupled equations with the threshold ``mu p(u)`` differentiated (the
 consistent, non-symmetric tangent), or the fixed point of Tresca problems
 ``G_k = mu p_{k-1}`` until ``max |p_k - p_{k-1}| <= coulomb_rtol * max p_k``
-on ``S_C``: the same solution (:mod:`ngcontact.cell.coulomb_friction`).
+on ``S_C``: the same solution (:mod:`ngcontact.cell.fe.coulomb_friction`).
 
 Exact non-penetration (``CellModel.enforcement = "exact"``, 2D, and 3D at order 1;
 the rigid limit ``k_n -> infinity`` of the Winkler layer): the normal
@@ -51,16 +51,16 @@ nodal rule on ``S_C`` (Gauss-Lobatto on segments, the vertices with their
 areas on order-1 triangles) so that the constraints sit at the nodes of the
 trace space, with a multiplier
 ``lambda`` per point held fixed in each Newton solve and updated by Uzawa's
-iteration (:mod:`ngcontact.cell.contact_multiplier`); the pressure of the
+iteration (:mod:`ngcontact.cell.fe.contact_multiplier`); the pressure of the
 results is the multiplier, and ``k_n`` only sets the speed.  Tresca
 friction adds its energy at the same points.  Coulomb friction takes the
 threshold ``mu lambda`` from the multiplier held fixed in each Newton solve
 (a Tresca problem), so Uzawa's iteration is the Coulomb fixed point too: it
 stops when neither the multiplier nor, with it, the threshold changes.
 
-Results of a load: :mod:`ngcontact.cell.measures` (contact fraction, means,
+Results of a load: :mod:`ngcontact.cell.fe.measures` (contact fraction, means,
 stresses, eq. 34 on the real contact set); effective stiffness (beyond the
-paper): :mod:`ngcontact.cell.stiffness`.
+paper): :mod:`ngcontact.cell.fe.stiffness`.
 """
 from __future__ import annotations
 
@@ -69,19 +69,18 @@ import logging
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell import measures
-from ngcontact.cell.contact_multiplier import TRIANGLE_MAX_ORDER, ContactMultiplier, solve_exact
+from ngcontact.cell.fe import measures
+from ngcontact.cell.fe.contact_multiplier import TRIANGLE_MAX_ORDER, ContactMultiplier, solve_exact
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
-from ngcontact.cell.cell_model import CellModel, CellSolution
-from ngcontact.cell.cell_energy import cell_energy, interface_tangent, jump, macro_strain_cf, preconditioning_form
-from ngcontact.cell.contact_quadrature import ContactQuadrature
-from ngcontact.cell.contact_quadrature import applies as quadrature_applies
+from ngcontact.cell.cell_solution import CellSolution
+from ngcontact.cell.fe.cell_model import CellModel
+from ngcontact.cell.fe.cell_energy import cell_energy, interface_tangent, jump, macro_strain_cf, preconditioning_form
+from ngcontact.cell.fe.contact_quadrature import ContactQuadrature
+from ngcontact.cell.fe.contact_quadrature import applies as quadrature_applies
 from ngcontact.cell.coefficients import contact_normal
-from ngcontact.cell.coulomb_friction import METHODS, solve_coulomb
-from ngcontact.cell.load_start import check_start, start_load, starts_afresh, tangential_load
-from ngcontact.cell.predictor import max_gap
-from ngcontact.cell.spectral_cell import SpectralCell
-from ngcontact.cell.spectral_predictor import flat_level
+from ngcontact.cell.fe.coulomb_friction import METHODS, solve_coulomb
+from ngcontact.cell.fe.load_start import Predictor, check_start, start_load, starts_afresh, tangential_load
+from ngcontact.cell.fe.predictor import max_gap
 from ngcontact.errors import ModelError
 from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
@@ -115,20 +114,19 @@ class CellProblem:
         Tangent solves (:class:`~ngcontact.solvers.linear_solver.LinearSolver`);
         default: direct with ``inverse``.
     start
-        Start of the first load under a prescribed pressure: ``"spectral"``
-        (the default with a ``twin``: the rigid predictor moved onto the
-        twin's contact set, :mod:`ngcontact.cell.spectral_predictor`),
-        ``"rigid"`` (the default without: the rigid predictor of
-        :mod:`ngcontact.cell.predictor`) or ``"closed"`` (every point of
+        Start of the first load under a prescribed pressure: ``"predictor"``
+        (the default with a ``predictor``: the rigid predictor's state moved on
+        by it), ``"rigid"`` (the default without: the rigid predictor of
+        :mod:`ngcontact.cell.fe.predictor`) or ``"closed"`` (every point of
         ``S_C`` pushed into contact).
-    twin
-        The spectral cell of the same small-slope cell
-        (:func:`ngcontact.drivers.build.predictor_twin`), penalty only; ``None``:
-        no spectral start.
+    predictor
+        A :class:`~ngcontact.cell.fe.load_start.Predictor` of the first loads, penalty only (the
+        spectral twin's contact set, :class:`ngcontact.cell.spectral_start.SpectralStart`, made by
+        :func:`ngcontact.drivers.build.predictor_twin`); ``None``: none.
     coulomb
         Coulomb friction with the penalty: ``"newton"`` (default, the
         coupled Newton) or ``"fixed_point"``
-        (:mod:`ngcontact.cell.coulomb_friction`).
+        (:mod:`ngcontact.cell.fe.coulomb_friction`).
 
     Attributes
     ----------
@@ -141,7 +139,7 @@ class CellProblem:
         (exact enforcement: ``pressure`` is the multiplier, meaningful at
         the Lobatto points of ``multiplier`` only).
     multiplier
-        :class:`~ngcontact.cell.contact_multiplier.ContactMultiplier` (exact
+        :class:`~ngcontact.cell.fe.contact_multiplier.ContactMultiplier` (exact
         enforcement) or ``None``.
     augmented_pressure
         Exact enforcement: ``[lambda + k_n (J.n - g)]_+`` of the state.
@@ -155,19 +153,19 @@ class CellProblem:
     def __init__(self, cell, model: CellModel, *, rtol: float = 1e-10, atol: float = 0.0,
                  max_iter: int = 40, inverse: str = "sparsecholesky", normal=None,
                  line_search: str = "exact", start: str | None = None, linear: LinearSolver | None = None,
-                 coulomb: str = "newton", twin: SpectralCell | None = None):
+                 coulomb: str = "newton", predictor: Predictor | None = None):
         if coulomb not in METHODS:
             raise ValueError(f"coulomb = {coulomb!r}: must be one of {METHODS}")
         if line_search not in ("exact", "armijo"):
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
-        start = check_start(start, twin, model.enforcement)
+        start = check_start(start, predictor, model.enforcement)
         if model.enforcement == "exact" and cell.dim == 3 and model.order > TRIANGLE_MAX_ORDER:
             raise ModelError(f"order = {model.order} with enforcement = 'exact' in a 3D cell: exact contact on "
                              f"triangles is built for order <= {TRIANGLE_MAX_ORDER} (quadratic triangles leave corner "
                              "nodes open inside the contact patch); use order 1, the penalty, or the spectral cell")
-        if twin is not None:
-            flat_level(cell.mesh)           # a twin solves the small-slope cell: S_C must be flat
-        self.line_search, self.start, self.coulomb, self.twin = line_search, start, coulomb, twin
+        if predictor is not None:
+            predictor.check(cell.mesh)
+        self.line_search, self.start, self.coulomb, self.predictor = line_search, start, coulomb, predictor
         self.coulomb_residual = None      # Coulomb, coupled Newton: the residual form, built on first use
         self.cell, self.model = cell, model
         self.mesh = mesh = cell.mesh
@@ -226,7 +224,7 @@ class CellProblem:
         return eps + macro_strain_cf(self.strain_params, self.dim) if self.model.macro_strain else eps
 
     def largest_gap(self) -> float:
-        """Largest initial gap on ``S_C`` (:func:`ngcontact.cell.predictor.max_gap`), sampled once: the gap
+        """Largest initial gap on ``S_C`` (:func:`ngcontact.cell.fe.predictor.max_gap`), sampled once: the gap
         of a problem is fixed."""
         if self._largest_gap is None:
             self._largest_gap = max_gap(self)
@@ -366,7 +364,7 @@ class CellProblem:
         return out
 
     def measure(self, load: CellLoad) -> dict:
-        """Results of the current state: :func:`ngcontact.cell.measures.measure`."""
+        """Results of the current state: :func:`ngcontact.cell.fe.measures.measure`."""
         return measures.measure(self, load)
 
 

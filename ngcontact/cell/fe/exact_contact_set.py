@@ -2,7 +2,7 @@
 
 The cell problem with ``contact.enforcement = "exact"`` holds the
 multiplier ``lambda`` at the nodes of ``S_C``
-(:mod:`ngcontact.cell.contact_multiplier`); the contact fraction of its
+(:mod:`ngcontact.cell.fe.contact_multiplier`); the contact fraction of its
 results (paper Sec. 3.2.2, the real contact set of eq. 34) is measured here
 from the nodes, not from the sign of the penetration, which is zero to
 round-off at the closed nodes and only the interpolation error of the
@@ -36,7 +36,7 @@ from __future__ import annotations
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.contact_multiplier import ContactMultiplier, characteristic_length
+from ngcontact.cell.fe.contact_multiplier import ContactMultiplier, characteristic_length
 
 
 def closed_nodes(problem) -> tuple[np.ndarray, np.ndarray]:

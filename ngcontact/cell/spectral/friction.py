@@ -2,7 +2,7 @@
 
 Friction (Tresca, or Coulomb with the threshold ``G = mu p``, paper eqs.
 16-17) needs the tangential traction ``q`` beside the pressure of
-:mod:`ngcontact.cell.spectral_cell`: the jump is ``J = -K t - U`` with
+:mod:`ngcontact.cell.spectral.layered_cell`: the jump is ``J = -K t - U`` with
 ``t = (q, p)`` and ``K`` the layers' full 3 x 3 (2D: 2 x 2) compliance, whose normal/tangential coupling vanishes for
 identical layers only.  The cell is then the convex problem in tractions of
 :mod:`ngcontact.solvers.projected_gradient` (``|q| <= G``, ``p >= 0``),
@@ -14,14 +14,14 @@ six passes of 300 to 400 steps each on a 256^2 cell).  With ``"penalty"``
 the friction is the FE cell's Huber-regularized one (width ``w``), with ``"exact"`` it is
 exact.  As in the FE cell, the Tresca threshold holds on the whole surface.
 
-Functions of a :class:`~ngcontact.cell.spectral_cell.SpectralCell` ``cell``.
+Functions of a :class:`~ngcontact.cell.spectral.layered_cell.SpectralCell` ``cell``.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
-from ngcontact.cell.layer_compliance import layer_matrix
+from ngcontact.cell.spectral.layer_compliance import layer_matrix
 from ngcontact.solvers.projected_gradient import fista, prox_friction, prox_pressure
 
 

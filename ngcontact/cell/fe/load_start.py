@@ -1,23 +1,24 @@
 """The start of each load of the cell problem: which predictor starts it, and the rigid continuation.
 
 The Newton solve of the cell problem (paper eqs. 49-51 in the penalized
-variational form of eq. 65, :mod:`ngcontact.cell.cell_problem`) starts
+variational form of eq. 65, :mod:`ngcontact.cell.fe.cell_problem`) starts
 every load from a state :func:`start_load` puts in place:
 
 * a first load under a prescribed pressure: the rigid predictor's state
-  (:mod:`ngcontact.cell.predictor`: the counter translated to carry the
+  (:mod:`ngcontact.cell.fe.predictor`: the counter translated to carry the
   pressure on a Winkler layer), or every point closed (``"closed"``), moved
-  onto the spectral twin's contact set where the cell has one
-  (``"spectral"``, :mod:`ngcontact.cell.spectral_predictor`); with exact
+  on by the problem's :class:`Predictor` where it has one (``"predictor"``:
+  e.g. onto the spectral twin's contact set,
+  :class:`ngcontact.cell.spectral_start.SpectralStart`); with exact
   enforcement the multiplier starts afresh (:func:`start_multiplier` under
   friction);
 * a later frictionless load whose tangential load changed: the rigid
   predictor for the whole traction
-  (:func:`ngcontact.cell.predictor.rigid_translation`);
+  (:func:`ngcontact.cell.fe.predictor.rigid_translation`);
 * a later load with friction, or where that has no regular minimizer: the
   rigid continuation below.
 
-A frictionless cell with a spectral twin solves every load of a sweep, and
+A frictionless cell with a predictor solves every load of a sweep, and
 every mesh of a graded solve, as a first load (:func:`starts_afresh`).
 
 *Later loads with a tangential change under friction*, or where the
@@ -51,13 +52,13 @@ is the first Newton step itself.
 from __future__ import annotations
 
 import logging
+from typing import Protocol
 
 import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
-from ngcontact.cell.predictor import rigid_translation, set_start
-from ngcontact.cell.spectral_predictor import spectral_start
+from ngcontact.cell.fe.predictor import rigid_translation, set_start
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.newton import minimize
 
@@ -65,38 +66,59 @@ log = logging.getLogger(__name__)
 
 
 #: the starts of a first load under a prescribed pressure (:func:`start_load`)
-STARTS = ("rigid", "closed", "spectral")
+STARTS = ("rigid", "closed", "predictor")
 
 
-def check_start(start: str | None, twin, enforcement: str) -> str:
-    """The start of a cell problem's first loads: ``start``, by default ``"spectral"`` with a spectral
-    ``twin`` and ``"rigid"`` without.
+class Predictor(Protocol):
+    """A start of a first load under a prescribed pressure, better than the rigid predictor's.
+
+    Passed to the cell problem by its builder; the cell problem calls it after putting the rigid (or
+    closed) start in place.  :class:`ngcontact.cell.spectral_start.SpectralStart` is one: the contact set of
+    the cell's spectral twin.
+    """
+
+    def check(self, mesh) -> None:
+        """Raise ``ValueError`` where the predictor cannot serve a cell meshed so."""
+
+    def start(self, problem, load: CellLoad) -> dict:
+        """Move ``problem``'s state on from the rigid start; return the start's record for the report
+        (``{"kind": ...}``)."""
+
+    def edges(self, load: CellLoad) -> tuple[np.ndarray, float] | None:
+        """The contact edges of ``load`` as far as the predictor knows them (a 2D cell), and their accuracy,
+        or ``None``."""
+
+
+def check_start(start: str | None, predictor: Predictor | None, enforcement: str) -> str:
+    """The start of a cell problem's first loads: ``start``, by default ``"predictor"`` with a
+    ``predictor`` and ``"rigid"`` without.
 
     Raises
     ------
     ValueError
-        ``start`` is none of :data:`STARTS`, or ``"spectral"`` without a twin or with exact enforcement.
+        ``start`` is none of :data:`STARTS`, or ``"predictor"`` without a predictor or with exact enforcement.
     """
     if start is None:
-        start = "rigid" if twin is None else "spectral"
+        start = "rigid" if predictor is None else "predictor"
     if start not in STARTS:
-        raise ValueError(f"start = {start!r}: must be 'rigid', 'closed' or 'spectral'")
-    if start == "spectral" and (twin is None or enforcement != "penalty"):
-        raise ValueError("start = 'spectral' needs the cell's spectral twin and the penalty "
-                         f"(twin {'given' if twin is not None else 'missing'}, enforcement {enforcement!r})")
+        raise ValueError(f"start = {start!r}: must be 'rigid', 'closed' or 'predictor'")
+    if start == "predictor" and (predictor is None or enforcement != "penalty"):
+        raise ValueError("start = 'predictor' needs a predictor (the cell's spectral twin) and the penalty "
+                         f"(predictor {'given' if predictor is not None else 'missing'}, "
+                         f"enforcement {enforcement!r})")
     return start
 
 
 def starts_afresh(problem, load: CellLoad) -> bool:
-    """Whether a sweep solves ``load`` as a first load: a frictionless cell with a spectral twin, under a
-    prescribed pressure (its energy has one minimizer, and the twin's contact set is nearer the solution's
-    than the previous load's: :meth:`~ngcontact.cell.cell_problem.CellProblem.sweep`)."""
-    return problem.model.friction is None and _spectral(problem, load)
+    """Whether a sweep solves ``load`` as a first load: a frictionless cell with a predictor, under a
+    prescribed pressure (its energy has one minimizer, and the predicted contact set is nearer the
+    solution's than the previous load's: :meth:`~ngcontact.cell.fe.cell_problem.CellProblem.sweep`)."""
+    return problem.model.friction is None and _predicted(problem, load)
 
 
-def _spectral(problem, load: CellLoad) -> bool:
-    """Whether a first ``load`` starts on the spectral twin's contact set (a pressure prescribed)."""
-    return problem.start == "spectral" and problem.twin is not None and load.jump[problem.dim - 1] is None
+def _predicted(problem, load: CellLoad) -> bool:
+    """Whether a first ``load`` starts from the problem's predictor (a pressure prescribed)."""
+    return problem.start == "predictor" and problem.predictor is not None and load.jump[problem.dim - 1] is None
 
 
 def start_load(problem, load: CellLoad, free, first: bool, before: tuple[float, ...]) -> tuple[dict | None,
@@ -105,7 +127,7 @@ def start_load(problem, load: CellLoad, free, first: bool, before: tuple[float, 
 
     A first load under a prescribed pressure: the rigid or closed start (:func:`set_start`), moved onto the
     spectral twin's contact set where the problem starts so
-    (:func:`ngcontact.cell.spectral_predictor.spectral_start`); with exact enforcement the multiplier starts
+    (:func:`ngcontact.cell.spectral_start.spectral_start`); with exact enforcement the multiplier starts
     afresh (:func:`start_multiplier` under friction).  A later load whose tangential load changed
     (``before``: :func:`tangential_load` of the previous one): frictionless, the rigid predictor for the
     whole traction (:func:`rigid_translation`); with friction, or where that has no minimizer, the rigid
@@ -127,7 +149,7 @@ def start_load(problem, load: CellLoad, free, first: bool, before: tuple[float, 
         problem.augmentation.Set(problem.model.k_n)      # as the scene gave it (Uzawa may have raised it)
         if problem.model.friction is not None:
             start_multiplier(problem, load)
-    return (spectral_start(problem, load, problem.twin) if _spectral(problem, load) else None), None
+    return (problem.predictor.start(problem, load) if _predicted(problem, load) else None), None
 
 
 def start_multiplier(problem, load: CellLoad) -> None:

@@ -3,7 +3,7 @@
 A small-slope cell (a flat ``S_C`` whose roughness is the initial gap
 ``g0``, paper eqs. 49-51 in the penalized form of eq. 65) is also the
 problem the spectral cell solves on a grid with FFTs
-(:mod:`ngcontact.cell.spectral_cell`): the same two periodic layers, the
+(:mod:`ngcontact.cell.spectral.layered_cell`): the same two periodic layers, the
 same penalty ``k_n``.  Its solution costs a fraction of a second and
 gives, on its grid, the penetration of eq. 65 at the solution,
 
@@ -16,7 +16,7 @@ on a fixed active set ``A = {s > 0}`` it is the quadratic energy of the
 bodies with springs ``k_n`` on ``A``.  A Newton step from any state whose
 active set is ``A`` therefore lands on the minimizer of that quadratic
 energy, whatever the rest of the state; only the start's active set
-matters.  The rigid predictor (:mod:`ngcontact.cell.predictor`) can only
+matters.  The rigid predictor (:mod:`ngcontact.cell.fe.predictor`) can only
 offer a level set of the gap, which the elastic bodies then reshape, and
 Newton moves the contact edge over several steps (the 301k-dof bisinusoid
 cell: 11 steps, the active set overshooting from 90 % to 107 % of the
@@ -55,10 +55,10 @@ Newton takes up the shear from there).  A twin that fails leaves the
 rigid start, recorded with the reason, and so does one whose contact set
 misses every point of ``S_C`` (a light load: the start would float).
 A frictionless sweep starts every pressure afresh from the twin
-(:meth:`~ngcontact.cell.cell_problem.CellProblem.sweep`: one minimizer, so
+(:meth:`~ngcontact.cell.fe.cell_problem.CellProblem.sweep`: one minimizer, so
 the previous state need not be kept); a frictional one continues from the
-previous solution as before (:mod:`ngcontact.cell.predictor`).  A graded
-solve (:mod:`ngcontact.cell.edge_grading`) takes its first mesh's edges
+previous solution as before (:mod:`ngcontact.cell.fe.predictor`).  A graded
+solve (:mod:`ngcontact.cell.fe.edge_grading`) takes its first mesh's edges
 from the twin (:func:`twin_edges`) and starts every level afresh from it,
 the twin as fine as the grid allows: with a twin of 256 points, levels
 started afresh had taken 33-69 steps summed per load against 39-46 carried
@@ -84,12 +84,37 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
-from ngcontact.cell.measures import sample_surface
-from ngcontact.cell.spectral_cell import SpectralCell, SpectralSolution
+from ngcontact.cell.fe.measures import sample_surface
+from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
 from ngcontact.errors import ConvergenceError
 from ngcontact.fem.interpolants import periodic_grid
 
 log = logging.getLogger(__name__)
+
+
+class SpectralStart:
+    """The predictor of an FE cell's first loads: its spectral twin's contact set (module docstring).
+
+    An implementation of :class:`ngcontact.cell.fe.load_start.Predictor`, made by the builder
+    (:func:`ngcontact.drivers.build.predictor_twin`) and passed to the FE cell problem, which knows nothing
+    of the spectral cell.  ``twin`` is the frictionless spectral cell of the same small-slope cell.
+    """
+
+    def __init__(self, twin: SpectralCell):
+        self.twin = twin
+
+    def check(self, mesh) -> None:
+        """Refuse a mesh whose ``S_C`` is not flat: the twin solves the small-slope cell only
+        (:func:`flat_level`)."""
+        flat_level(mesh)
+
+    def start(self, problem, load: CellLoad) -> dict:
+        """Move ``problem``'s state onto the twin's contact set (:func:`spectral_start`); the start's record."""
+        return spectral_start(problem, load, self.twin)
+
+    def edges(self, load: CellLoad) -> tuple[np.ndarray, float] | None:
+        """The contact edges of the twin's solution of ``load`` and their accuracy (:func:`twin_edges`)."""
+        return twin_edges(self.twin, load)
 
 
 def spectral_start(problem, load: CellLoad, twin: SpectralCell) -> dict:
@@ -144,7 +169,7 @@ def twin_edges(twin: SpectralCell, load: CellLoad) -> tuple[np.ndarray, float] |
     An edge lies between two neighbouring grid points, one carrying pressure and one not; it is placed
     midway, within half a spacing of the twin's own edge.  ``None`` where the twin fails or its contact set
     has no edge (none, or all of the period): the caller grades without a seed
-    (:func:`ngcontact.cell.edge_grading.solve_to_tolerance`).
+    (:func:`ngcontact.cell.fe.edge_grading.solve_to_tolerance`).
     """
     if twin.dim != 2:
         raise ValueError(f"twin.dim = {twin.dim}: contact edges are located on the 1D grid of a 2D cell")

@@ -1,6 +1,6 @@
 """Measurements of a solved cell problem: contact set, mean tractions and jumps, stresses.
 
-Functions of a :class:`~ngcontact.cell.cell_problem.CellProblem` in its
+Functions of a :class:`~ngcontact.cell.fe.cell_problem.CellProblem` in its
 current state (the cell problem of paper eqs. 49-51, 57, 65, with the jump
 ``J = u_r - u_c - U`` across ``S_C``, the micro normal ``n``, the gap ``g``
 and the penalty pressure ``p = k_n [J.n - g]_+`` of eq. 65).  ``|T|`` is the
@@ -35,16 +35,16 @@ area of the cell's period.
   stresses of eq. 77, :mod:`ngcontact.fem.materials`), :func:`body_stresses`,
   :func:`stress_maxima`;
 * the effective stiffness of the interface (beyond the paper,
-  :mod:`ngcontact.cell.stiffness`).
+  :mod:`ngcontact.cell.fe.stiffness`).
 
-Exact enforcement (:mod:`ngcontact.cell.contact_multiplier`): the
+Exact enforcement (:mod:`ngcontact.cell.fe.contact_multiplier`): the
 pressure is the multiplier ``lambda``, given at the nodal points of the
 contact energy (Gauss-Lobatto in 2D, the vertices of the triangles in 3D), so its
 integrals use that rule (the discrete interface force) and its samples
 are taken at those points; the real contact set is
 built from the closed nodes and the edges between them
-(:func:`ngcontact.cell.exact_contact_set.contact_cuts`, in 3D
-:func:`~ngcontact.cell.exact_contact_set.contact_area`), not from the sign
+(:func:`ngcontact.cell.fe.exact_contact_set.contact_cuts`, in 3D
+:func:`~ngcontact.cell.fe.exact_contact_set.contact_area`), not from the sign
 of the penetration, which is zero to round-off at the nodes and the
 interpolation error of the closure between them.
 
@@ -58,8 +58,8 @@ import numpy as np
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.errors import ConvergenceError
 from ngcontact.cell.coefficients import coefficients
-from ngcontact.cell.exact_contact_set import contact_area, contact_cuts
-from ngcontact.cell.stiffness import effective_stiffness
+from ngcontact.cell.fe.exact_contact_set import contact_area, contact_cuts
+from ngcontact.cell.fe.stiffness import effective_stiffness
 from ngcontact.fem import materials as _mat
 from ngcontact.fem.quadrature import kink_order, sampling_order, smooth_order
 from ngcontact.fem.sampling import boundary_samples
@@ -91,7 +91,7 @@ def contact_fraction(problem, method: str = "auto") -> float:
         where the zero set is a curve on each face).  ``"auto"``: roots
         in 2D, quadrature in 3D.  With exact enforcement the pieces of
         :func:`contact_pieces` are those of the closed nodes (module
-        docstring; in 3D :func:`~ngcontact.cell.exact_contact_set.contact_area`),
+        docstring; in 3D :func:`~ngcontact.cell.fe.exact_contact_set.contact_area`),
         whatever the method.
     """
     if problem.multiplier is not None:
@@ -121,7 +121,7 @@ def contact_pieces(problem) -> list[tuple[float, float, bool, float]]:
     element (exact for the polynomial it is on straight elements with the
     interpolated gap) and its real roots in ``(0, 1)`` cut the element.
     Exact enforcement: the cuts and states of
-    :func:`ngcontact.cell.exact_contact_set.contact_cuts` instead.
+    :func:`ngcontact.cell.fe.exact_contact_set.contact_cuts` instead.
     """
     P = np.polynomial.polynomial
     m = problem.model.order + 3

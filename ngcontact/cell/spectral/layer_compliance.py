@@ -8,7 +8,7 @@ translations, so a surface traction ``t e^{i k.x}`` produces a surface
 displacement ``C(k) t e^{i k.x}``: one 3 x 3 (2D: 2 x 2) Hermitian matrix per
 wave vector.  This turns the cell problem of paper eqs. 49-51 (with the
 penalized contact condition eq. 65, or its rigid limit) into an interface
-problem on the grid of the height map (:mod:`ngcontact.cell.spectral_cell`).
+problem on the grid of the height map (:mod:`ngcontact.cell.spectral.layered_cell`).
 
 Derivation (plane strain in the plane of ``k``, ``t = |k| h``, shear modulus
 ``mu``, Poisson's ratio ``nu``, ``kappa = 3 - 4 nu``).  The Navier equations

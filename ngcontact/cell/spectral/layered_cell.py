@@ -6,7 +6,7 @@ the height below the highest summit) both bodies of the cell of paper eqs.
 translations.  A normal traction ``p`` on the interface (compression
 positive) then moves the two faces towards each other by ``C * p``, the
 convolution with the sum of the two layers' normal compliances
-(:mod:`ngcontact.cell.layer_compliance`), diagonal in Fourier space.
+(:mod:`ngcontact.cell.spectral.layer_compliance`), diagonal in Fourier space.
 Frictionless contact is the problem (eq. 57 in the small-slope form, with
 ``Delta`` the far-face approach and ``J_n`` the normal jump)
 
@@ -25,8 +25,8 @@ interpolant of the pressure loads the layers), and the contact problem is
 solved by constrained conjugate gradients
 (:mod:`ngcontact.solvers.constrained_cg`).
 
-Friction: :mod:`ngcontact.cell.spectral_friction`; results of a load:
-:mod:`ngcontact.cell.spectral_measures`.
+Friction: :mod:`ngcontact.cell.spectral.friction`; results of a load:
+:mod:`ngcontact.cell.spectral.grid_measures`.
 """
 from __future__ import annotations
 
@@ -36,10 +36,10 @@ from typing import Any
 
 import numpy as np
 
-from ngcontact.cell import spectral_measures as measures
+from ngcontact.cell.spectral import grid_measures as measures
 from ngcontact.cell.cell_load import CellLoad
-from ngcontact.cell.layer_compliance import normal_compliance
-from ngcontact.cell.spectral_friction import solve_frictional, traction_operator
+from ngcontact.cell.spectral.layer_compliance import normal_compliance
+from ngcontact.cell.spectral.friction import solve_frictional, traction_operator
 from ngcontact.geometry.random_surface import wave_vectors
 from ngcontact.laws.penalty import Friction
 from ngcontact.solvers.constrained_cg import constrained_cg
@@ -175,7 +175,7 @@ class SpectralCell:
         """Solve one load (pressure or far-face approach prescribed), from ``start`` if given.
 
         The last solution from no start is kept and returned again for the same load: a spectral twin is
-        asked for one load by the seed and every mesh of a graded solve (:mod:`ngcontact.cell.edge_grading`).
+        asked for one load by the seed and every mesh of a graded solve (:mod:`ngcontact.cell.fe.edge_grading`).
         """
         if start is None and self._last is not None and self._last.load == load:
             return self._last
@@ -251,7 +251,7 @@ class SpectralCell:
 
     # ------------------------------------------------------------ friction
     def traction_operator(self, uniform: tuple[bool, ...]):
-        """:func:`ngcontact.cell.spectral_friction.traction_operator`, built once per kind of load of a sweep."""
+        """:func:`ngcontact.cell.spectral.friction.traction_operator`, built once per kind of load of a sweep."""
         if uniform not in self._operators:
             self._operators[uniform] = traction_operator(self, uniform)
         return self._operators[uniform]

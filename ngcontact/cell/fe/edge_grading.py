@@ -29,10 +29,10 @@ The edges are not known in advance, so meshing and solving alternate:
    once the sequences contract); the answer reported is the finest.
 
 The first mesh from the spectral twin.  With the penalty, a flat cell has
-a spectral twin (:mod:`ngcontact.cell.spectral_predictor`): the same
+a spectral twin (:mod:`ngcontact.cell.spectral_start`): the same
 layers and ``k_n`` on a grid, solved with FFTs in a fraction of a second.
 Its contact edges, known to half its grid spacing
-(:func:`~ngcontact.cell.spectral_predictor.twin_edges`), replace step 1's
+(:func:`~ngcontact.cell.spectral_start.twin_edges`), replace step 1's
 uniform solve: the first mesh is graded towards them by as many levels as
 bring its smallest element down to the spacing (:func:`seed_levels`), and
 the loop goes on from there.  And every level, the order raise included,
@@ -62,8 +62,8 @@ from typing import Any, Callable
 import numpy as np
 import ngsolve as ng
 
-from ngcontact.cell.measures import contact_pieces
-from ngcontact.cell.load_start import starts_afresh
+from ngcontact.cell.fe.measures import contact_pieces
+from ngcontact.cell.fe.load_start import starts_afresh
 from ngcontact.errors import ConvergenceError
 from ngcontact.geometry.cell2d import flat_cell
 
@@ -89,7 +89,7 @@ def contact_edges(problem) -> np.ndarray:
     On each boundary element of ``S_C`` the penetration is a polynomial of
     the reference coordinate; its roots split the element into pieces in
     and out of contact (the construction of
-    :func:`ngcontact.cell.measures.contact_pieces`).  An edge is a point
+    :func:`ngcontact.cell.fe.measures.contact_pieces`).  An edge is a point
     where the state changes between consecutive pieces along ``x``
     (periodically), inside an element or at a vertex.
     """
@@ -191,6 +191,33 @@ def seed_levels(h0: float, spacing: float) -> int:
     return levels
 
 
+def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, before, history: list,
+                 newton: list):
+    """Solve ``load`` on a new mesh (grading ``level``, order ``p``), from ``before = (problem, entry)`` when
+    given (carried over unless the problem starts afresh); record the changes against it in ``history`` and
+    the Newton histories in ``newton``.  Returns the problem, the solution, its contact edges and its entry."""
+    problem = make_problem(vertices, p)
+    fresh = before is None or starts_afresh(problem, load)
+    if not fresh:
+        carry_over(before[0], problem)
+    sol = problem.solve(load, first=fresh)
+    edges = contact_edges(problem)
+    ends = _interface_elements(problem.mesh)
+    f, c = sol.results["contact_fraction"], sol.results["mean_closure"]
+    entry = {"level": level, "order": p, "ndof": problem.ndof, "edges": [float(e) for e in edges],
+             "smallest_element": float(np.min(ends[:, 1] - ends[:, 0])), "contact_fraction": f,
+             "mean_closure": c, "newton_iterations": sol.iterations, "fraction_change": None,
+             "closure_change": None}
+    if before is not None:
+        entry["fraction_change"] = abs(f - before[1]["contact_fraction"])
+        entry["closure_change"] = abs(c - before[1]["mean_closure"]) / max(abs(c), 1e-300)
+    history.append(entry)
+    newton.extend(dict(h, level=level, order=p) for h in sol.newton)
+    log.info("grading level %d, order %d: %d dofs, contact fraction %.10g, change %s", level, p,
+             problem.ndof, f, entry["fraction_change"])
+    return problem, sol, edges, entry
+
+
 def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, tolerance: float, h0: float,
                        period: float, order: int, seed: tuple[np.ndarray, float] | None = None) -> GradedSolve:
     """Solve ``load`` on meshes graded towards the contact edges until the estimate meets ``tolerance``.
@@ -216,7 +243,7 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
         The scene's polynomial order (the first levels').
     seed
         Contact edges known beforehand and their accuracy, ``(edges, spacing)``: the spectral twin's
-        (:func:`ngcontact.cell.spectral_predictor.twin_edges`).  The first mesh is then graded towards them
+        (:func:`ngcontact.cell.spectral_start.twin_edges`).  The first mesh is then graded towards them
         by :func:`seed_levels` levels instead of being the scene's uniform mesh.
 
     Raises
@@ -232,27 +259,7 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
     graded: dict[str, Any] | None = None  # the last level-against-level comparison checked by an order raise
 
     def run(vertices: list[float], p: int, level: int, before=None):
-        """Solve on a new mesh, from ``before = (problem, entry)`` when given; record the changes against it."""
-        problem = make_problem(vertices, p)
-        fresh = before is None or starts_afresh(problem, load)
-        if not fresh:
-            carry_over(before[0], problem)
-        sol = problem.solve(load, first=fresh)
-        edges = contact_edges(problem)
-        ends = _interface_elements(problem.mesh)
-        f, c = sol.results["contact_fraction"], sol.results["mean_closure"]
-        entry = {"level": level, "order": p, "ndof": problem.ndof, "edges": [float(e) for e in edges],
-                 "smallest_element": float(np.min(ends[:, 1] - ends[:, 0])), "contact_fraction": f,
-                 "mean_closure": c, "newton_iterations": sol.iterations, "fraction_change": None,
-                 "closure_change": None}
-        if before is not None:
-            entry["fraction_change"] = abs(f - before[1]["contact_fraction"])
-            entry["closure_change"] = abs(c - before[1]["mean_closure"]) / max(abs(c), 1e-300)
-        history.append(entry)
-        newton.extend(dict(h, level=level, order=p) for h in sol.newton)
-        log.info("grading level %d, order %d: %d dofs, contact fraction %.10g, change %s", level, p,
-                 problem.ndof, f, entry["fraction_change"])
-        return problem, sol, edges, entry
+        return _solve_level(make_problem, load, vertices, p, level, before, history, newton)
 
     def met(entry) -> bool:
         return entry["fraction_change"] is not None and max(entry["fraction_change"],

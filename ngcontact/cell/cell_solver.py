@@ -1,0 +1,121 @@
+"""The cell protocol: one question, the response of one periodic cell, answered by any method.
+
+Everything above :mod:`ngcontact.cell` (the drivers, the two-scale tables, the batch members) sees a cell
+only through :class:`CellSolver`.  Two methods implement it:
+
+* :class:`ngcontact.cell.fe.fe_cell.FECell`: finite elements on the meshed bodies (any profile; paper
+  eqs. 49-51, penalized as eq. 65 or with exact non-penetration), refined towards the contact edges;
+* :class:`ngcontact.cell.spectral.spectral_solver.SpectralCellSolver`: the small-slope cell on the grid
+  of its gap, with FFTs, refined by grid doubling.
+
+A third method is one sub-package implementing this protocol, plus its entry in the builder's choice
+(:func:`ngcontact.drivers.build.cell_solver`) and the scene's choice list
+(``discretization.method``).
+
+The response of a cell to a mean pressure ``p`` (compression positive), which the two-scale loop
+tabulates (paper Sec. 3.5; :mod:`ngcontact.coupling.pressure_table`), is the :data:`Response`: the real
+contact fraction, ``k_n0`` of eq. 34 on the real contact set, the mean closure ``c`` and the gap term
+``g_n0 = k_n0 c - p`` that makes the Winkler law pass through the cell's state.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from ngcontact.cell.cell_load import CellLoad
+from ngcontact.cell.cell_solution import CellSolution
+
+#: ``{"contact_fraction", "k_n0", "g_n0", "closure"}`` of the cell at one pressure
+Response = dict[str, float]
+#: the keys of a :data:`Response`
+RESPONSE_KEYS = ("contact_fraction", "k_n0", "g_n0", "closure")
+
+
+def response_of(fraction: float, kn0: float, closure: float, pressure: float) -> Response:
+    """The :data:`Response` of a cell state: its contact fraction, ``k_n0`` and mean closure at ``pressure``
+    (``g_n0 = k_n0 c - p``)."""
+    return {"contact_fraction": float(fraction), "k_n0": float(kn0), "g_n0": float(kn0 * closure - pressure),
+            "closure": float(closure)}
+
+
+@dataclass
+class Refinement:
+    """A load sweep solved to a requested accuracy.
+
+    Attributes
+    ----------
+    solutions
+        The finest level's solution of each load.
+    estimates
+        Per load, the estimated error of each controlled quantity (``contact_fraction`` absolute,
+        ``mean_closure`` relative).
+    per_load
+        Per load, what the report adds to the load's entry besides the estimate (an FE cell's
+        ``mesh_history`` and its Newton steps summed over the levels), possibly empty.
+    method
+        What the report adds to ``results.method`` (a spectral cell's finest grid and its levels),
+        possibly empty.
+    """
+
+    solutions: list[CellSolution]
+    estimates: list[dict[str, float]]
+    per_load: list[dict[str, Any]] = field(default_factory=list)
+    method: dict[str, Any] = field(default_factory=dict)
+    #: the histories of every level's solve per load (the report's ``solver.per_load``), where kept
+    histories: list[Any] = field(default_factory=list)
+
+
+class CellSolver(Protocol):
+    """A discretized cell that answers loads (module docstring)."""
+
+    #: the cell's dimension (2 or 3)
+    dim: int
+    #: the cell's period (the first tangential direction's)
+    period: float
+
+    def unknowns(self) -> int:
+        """The number of unknowns of the discretization (FE dofs, grid points)."""
+
+    def size(self) -> dict[str, Any]:
+        """The discretization for a report: ``{"method": ..., "ndof" or "grid_points": ...}``."""
+
+    def method_record(self) -> dict[str, Any] | None:
+        """What the report states under ``results.method`` (``None``: nothing)."""
+
+    def whole_surface(self) -> dict[str, Any]:
+        """The coefficients of the whole contact surface (paper eqs. 34, 42-43; no contact solve)."""
+
+    def solve(self, load: CellLoad, *, first: bool = True, measure: bool = True) -> CellSolution:
+        """Solve one load; ``first``: from a first load's start (else continued from the last state)."""
+
+    def sweep(self, loads: list[CellLoad]) -> list[CellSolution]:
+        """Solve the loads in order (each from the previous where the method continues)."""
+
+    def refine_to(self, tolerance: float, loads: list[CellLoad]) -> Refinement:
+        """Solve the loads on refined discretizations until the estimated error meets ``tolerance``.
+
+        Raises
+        ------
+        ConvergenceError
+            The tolerance is out of the method's reach (its largest discretization); the message says
+            how far it got.
+        """
+
+    def response(self, pressure: float, length_unit: float = 1.0) -> Response:
+        """The :data:`Response` at a mean pressure, solved from a first load's start; lengths scaled by
+        ``length_unit``."""
+
+    def load_entry(self, solution: CellSolution) -> dict[str, Any]:
+        """The report's entry of one load: its results and the method's iteration counts."""
+
+    def solver_record(self, solutions: list[CellSolution], refinement: Refinement | None = None) -> dict[str, Any]:
+        """The report's ``solver`` entry of a sweep: iterations, convergence, per-load records."""
+
+    def displacements(self) -> tuple[Any, dict[str, Any]] | None:
+        """The mesh and the bodies' displacement fields of the last state, where the method has them."""
+
+    def state(self) -> Any:
+        """The state after the last solve, as plain data (``None`` where the method keeps none)."""
+
+    def set_state(self, state: Any) -> None:
+        """Put a state of :meth:`state` (from a cell built identically, e.g. in a worker) in place."""

@@ -1,0 +1,125 @@
+"""The spectral cell behind the cell protocol (:class:`~ngcontact.cell.cell_solver.CellSolver`).
+
+:class:`SpectralCellSolver` holds a :class:`~ngcontact.cell.spectral.layered_cell.SpectralCell` and the
+recipe of the same cell on another grid: it answers loads (each from zero pressure: the small-slope
+problem has one solution whatever the path, for friction too since a load is solved in tractions at
+once), sweeps, refinement to a tolerance by grid growth
+(:mod:`ngcontact.cell.spectral.refinement`) and the pressure response of the two-scale table.
+
+Its response at a mean pressure ``p``: both layers are flat and ``n = n0`` on all of ``S_C``, so
+``k_n0 = k_n`` times the contact fraction (eq. 34 on the real contact set; the fraction with its 2D
+edges located between grid points, :func:`ngcontact.cell.spectral.grid_measures.contact_fraction`), and
+the closure is the mean normal jump ``c = mean(J_n)`` over the period.  Frictionless cells only: the
+spectral cell carries no shear without friction (the two-scale loop's shear table solves the FE cell).
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ngcontact.cell.cell_load import CellLoad, cell_load
+from ngcontact.cell.cell_solution import CellSolution
+from ngcontact.cell.cell_solver import Refinement, Response, response_of
+from ngcontact.cell.spectral import grid_measures
+from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
+from ngcontact.cell.spectral.refinement import sweep_to_tolerance
+
+#: the grid fields a solution hands on (the closure is in its surface distribution)
+FIELDS = ("pressure", "gap", "shear", "slip")
+
+
+class SpectralCellSolver:
+    """A spectral cell answering the cell protocol (module docstring).
+
+    Parameters
+    ----------
+    cell
+        The spectral cell on the scene's grid.
+    make_cell
+        ``n -> SpectralCell`` of the same cell on ``n`` points per direction (refinement).
+    max_points
+        The most grid points refinement may use.
+    """
+
+    def __init__(self, cell: SpectralCell, make_cell: Callable[[int], SpectralCell] | None = None,
+                 max_points: int | None = None):
+        self.cell = cell
+        self.dim = cell.dim
+        self.period = cell.period
+        self.make_cell, self.max_points = make_cell, max_points
+
+    # ------------------------------------------------------------ description
+    def unknowns(self) -> int:
+        return int(self.cell.points)
+
+    def size(self) -> dict[str, Any]:
+        return {"method": "spectral", "grid_points": self.unknowns()}
+
+    def method_record(self) -> dict[str, Any] | None:
+        c = self.cell
+        return {"name": "spectral", "grid": c.grid, "points": c.points, "enforcement": c.enforcement,
+                "solver": "constrained_cg" if c.friction is None else "accelerated_proximal_gradient",
+                "tolerance": c.tol}
+
+    def whole_surface(self) -> dict[str, Any]:
+        return grid_measures.coefficients(self.cell, np.ones(self.cell.shape, bool)).as_dict()
+
+    # ----------------------------------------------------------------- solves
+    def solution(self, sol: SpectralSolution) -> CellSolution:
+        """The protocol's solution of one of the spectral cell's own."""
+        surface: dict[str, np.ndarray] = {}
+        if self.cell.dim == 2:
+            c = self.cell
+            surface = {"x": c.period * np.arange(c.grid) / c.grid, "pressure": sol.fields["pressure"],
+                       "gap": sol.fields["gap"], "closure": sol.fields["closure"]}
+        history = {"method": "constrained_cg", "iterations": sol.iterations, "residuals": sol.residuals}
+        return CellSolution(load=sol.load, results=sol.results, surface=surface,
+                            fields={k: sol.fields[k] for k in FIELDS if k in sol.fields}, newton=[history])
+
+    def solve(self, load: CellLoad, *, first: bool = True, measure: bool = True) -> CellSolution:
+        return self.solution(self.cell.solve(load))
+
+    def sweep(self, loads: list[CellLoad]) -> list[CellSolution]:
+        return [self.solution(s) for s in self.cell.sweep(loads)]
+
+    def refine_to(self, tolerance: float, loads: list[CellLoad]) -> Refinement:
+        """Grids from the scene's up until the estimate meets ``tolerance``
+        (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`); the finest grid's cell becomes this
+        solver's."""
+        if self.make_cell is None or self.max_points is None:
+            raise ValueError("this spectral cell was built without the recipe of finer grids")
+        first, make = self.cell, self.make_cell
+        refined = sweep_to_tolerance(lambda n: first if n == first.grid else make(n), loads, tolerance,
+                                     first.grid, first.dim, self.max_points)
+        self.cell = refined.cell
+        return Refinement(solutions=[self.solution(s) for s in refined.solutions],
+                          estimates=list(refined.estimates),
+                          method={"grid": self.cell.grid, "points": self.cell.points,
+                                  "refinement": refined.history})
+
+    def response(self, pressure: float, length_unit: float = 1.0) -> Response:
+        """The response at ``pressure`` (module docstring), from zero pressure."""
+        sol = self.cell.solve(cell_load(self.cell.dim, pressure=float(pressure)))
+        fraction = float(sol.results["contact_fraction"])
+        closure = float(sol.results["mean_closure"]) * length_unit
+        return response_of(fraction, self.cell.k_n * fraction, closure, float(pressure))
+
+    # ------------------------------------------------------------------ report
+    def load_entry(self, solution: CellSolution) -> dict[str, Any]:
+        """The report's entry of one load: its results and constrained CG steps."""
+        return dict(solution.results, iterations=solution.iterations)
+
+    def solver_record(self, solutions: list[CellSolution], refinement: Refinement | None = None) -> dict[str, Any]:
+        return {"iterations": sum(s.iterations for s in solutions), "converged": True,
+                "per_load": [s.newton[0] for s in solutions]}
+
+    def displacements(self) -> tuple[Any, dict[str, Any]] | None:
+        return None            # the layers' interiors are not sampled
+
+    def state(self):
+        return None
+
+    def set_state(self, state) -> None:
+        return None
