@@ -1,7 +1,7 @@
 """Micro stresses in the interface layer and the strength check (paper eqs. 74-78).
 
 Linear recovery (paper eqs. 72-75).  With the real contact set ``S_act`` of
-the cell held fixed, the cell problem of :mod:`ngcontact.cell.cell_problem` becomes
+the cell held fixed, the cell problem of :mod:`ngcontact.cell.fe.cell_problem` becomes
 quadratic: the penalty acts on ``S_act`` in both directions,
 
     Pi_lin(u) = sum_B int_B 1/2 (eps(u_B) + E) : C_B : (eps(u_B) + E) dx
@@ -23,7 +23,7 @@ other through the fixed-contact-set stiffness) and unit strains that of
 ``N_pq``.  One factorization serves every corrector.
 
 Nonlinear recovery: the contact cell problem itself
-(:class:`ngcontact.cell.cell_problem.CellProblem`) solved at the macro state.
+(:class:`ngcontact.cell.fe.cell_problem.CellProblem`) solved at the macro state.
 
 Strength (eqs. 76-78): the equivalent stress ``sigma_eq`` (von Mises
 ``sqrt(3/2 s:s)`` or Tresca ``max |sigma_k - sigma_l|``, eq. 77,
@@ -54,13 +54,14 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell.cell_load import cell_load
-from ngcontact.cell.measures import body_stresses
+from ngcontact.cell.fe.measures import body_stresses
 from ngcontact.fem import materials as _mat
 from ngcontact.laws import penalty as _contact
 from ngcontact.errors import ModelError
 
 if TYPE_CHECKING:
-    from ngcontact.cell.cell_problem import CellProblem, CellSolution
+    from ngcontact.cell.cell_solution import CellSolution
+    from ngcontact.cell.fe.cell_problem import CellProblem
 
 log = logging.getLogger(__name__)
 
@@ -99,7 +100,7 @@ def sample_stresses(problem: CellProblem) -> BodySamples:
     """Stress tensors of the current state of ``problem`` per body at element points.
 
     Returns ``{body: {"points": (n, dim), "stress": (n, 3, 3)}}``
-    (:func:`ngcontact.cell.measures.body_stresses`).
+    (:func:`ngcontact.cell.fe.measures.body_stresses`).
     """
     return body_stresses(problem)
 
@@ -154,7 +155,7 @@ def linear_correctors(problem: CellProblem, *, contact_set: ng.CoefficientFuncti
     Parameters
     ----------
     problem
-        A :class:`ngcontact.cell.cell_problem.CellProblem` built with ``macro_strain=True``
+        A :class:`ngcontact.cell.fe.cell_problem.CellProblem` built with ``macro_strain=True``
         (its spaces, normal, gap and parameters are reused; its state is
         overwritten).
     contact_set
@@ -172,22 +173,8 @@ def linear_correctors(problem: CellProblem, *, contact_set: ng.CoefficientFuncti
     m = problem.model
     if not m.macro_strain:
         raise ModelError("linear correctors need a cell problem built with macro_strain = True")
-    X, mesh, d = problem.X, problem.mesh, problem.dim
-    trial = X.TrialFunction()
-    ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
-    form = ng.BilinearForm(X, symmetric=True)
-    for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
-        eps = problem.body_strain(u)
-        form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps) * ng.dx(definedon=mesh.Materials(name)))
-    J = ur - uc - U
-    chi = ng.CF(1.0) if contact_set is None else contact_set
-    pen = _contact.penetration(J, problem.n, problem.gap)
-    psi = 0.5 * m.k_n * chi * pen * pen
-    if tangential_stiffness > 0:
-        Jt = _contact.tangential_slip(J, problem.n)
-        psi = psi + 0.5 * tangential_stiffness * chi * ng.InnerProduct(Jt, Jt)
-    form += ng.Variation(psi * ng.ds("contact", bonus_intorder=m.contact_bonus_order))
-    form += ng.Variation(-ng.InnerProduct(ng.CF(tuple(problem.traction)), U) * ng.ds("top"))
+    X, d = problem.X, problem.dim
+    form = _fixed_set_form(problem, contact_set, tangential_stiffness)
     free = ng.BitArray(X.FreeDofs())
     shear_free = tangential_stiffness > 0 or problem.tangential_free
     if not shear_free:
@@ -235,11 +222,33 @@ def linear_correctors(problem: CellProblem, *, contact_set: ng.CoefficientFuncti
                       unit={b: np.array(unit[b]) for b in BODIES}, states=vectors)
 
 
+def _fixed_set_form(problem: CellProblem, contact_set, tangential_stiffness: float) -> ng.BilinearForm:
+    """The quadratic energy of the cell with a fixed contact set: the bodies (with the macro strain), the
+    penalty ``k_n/2 chi [J.n - g]^2`` and ``k_t/2 chi |J_t|^2`` on ``S_C``, the far-face load potential."""
+    m, mesh = problem.model, problem.mesh
+    trial = problem.X.TrialFunction()
+    ur, uc, U = trial[0], trial[1], ng.CF(tuple(trial[2:]))
+    form = ng.BilinearForm(problem.X, symmetric=True)
+    for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
+        eps = problem.body_strain(u)
+        form += ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps) * ng.dx(definedon=mesh.Materials(name)))
+    J = ur - uc - U
+    chi = ng.CF(1.0) if contact_set is None else contact_set
+    pen = _contact.penetration(J, problem.n, problem.gap)
+    psi = 0.5 * m.k_n * chi * pen * pen
+    if tangential_stiffness > 0:
+        Jt = _contact.tangential_slip(J, problem.n)
+        psi = psi + 0.5 * tangential_stiffness * chi * ng.InnerProduct(Jt, Jt)
+    form += ng.Variation(psi * ng.ds("contact", bonus_intorder=m.contact_bonus_order))
+    form += ng.Variation(-ng.InnerProduct(ng.CF(tuple(problem.traction)), U) * ng.ds("top"))
+    return form
+
+
 def nonlinear_stress(problem: CellProblem, load_vector: LoadVector) -> tuple[BodySamples, CellSolution]:
     """The contact cell problem solved at the load vector (rigid-predictor start).
 
     Returns the sampled stresses per body (:func:`sample_stresses`) and the
-    :class:`ngcontact.cell.cell_problem.CellSolution`.  A flat frictionless cell carries
+    :class:`ngcontact.cell.cell_solution.CellSolution`.  A flat frictionless cell carries
     no shear: its shear components must be 0.
     """
     d = problem.dim

@@ -27,7 +27,7 @@ from typing import Any, TypedDict
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.cell_problem import CellProblem
+from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.coupling import strength as S
 from ngcontact.coupling.interface_state import cell_loads, interface_states
 from ngcontact.errors import ModelError, SceneError
@@ -100,25 +100,7 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     coords = np.column_stack([states[k] for k in names])
     extra: dict[str, list[dict[str, Any]]] = {}
     if spec.recovery == "nonlinear":
-        worst = np.maximum(smap.values["rough"], smap.values["counter"])
-        picks = [int(i) for i in np.argsort(-worst)[:spec.nonlinear_points]]
-        solved: list[dict[str, Any]] = []
-        for i in picks:
-            try:
-                st, csol = S.nonlinear_stress(P, loads[i])
-            except ValueError as exc:
-                raise SceneError("strength.recovery", "nonlinear", f"the cell cannot be solved at the macro "
-                                 f"state of interface point {i}: {exc}") from None
-            entry: dict[str, Any] = {"index": i, along: float(states[along][i]), "load": loads[i].tolist(),
-                                     "contact_fraction": csol.results["contact_fraction"], "bodies": {}}
-            for b in S.BODIES:
-                eq = S.equivalent(st[b]["stress"], spec.criterion)
-                k = int(np.argmax(eq))
-                entry["bodies"][b] = {"linear": float(smap.values[b][i]), "nonlinear": float(eq[k])}
-                smap.values[b][i] = eq[k]
-                smap.cell_point[b][i] = st[b]["points"][k]
-            solved.append(entry)
-        extra["nonlinear"] = solved
+        extra["nonlinear"] = _nonlinear_recovery(P, smap, loads, states, along, spec)
     sigma_u_rough = scene.materials[scene.bodies.rough].sigma_u
     sigma_u_counter = scene.materials[scene.bodies.counter].sigma_u
     # set: MacroScene.check requires sigma_u of both bodies when [strength] is present
@@ -131,8 +113,45 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     crit = res["critical_body"]
     k = res["bodies"][crit]["macro_point"]["index"]
     worst_load = loads[k]
-    # the worst cell's state, for the VTK field and the figure
-    if spec.recovery == "nonlinear" and any(e["index"] == k for e in extra.get("nonlinear", [])):
+    worst_stress, vtk = _worst_cell(P, corr, worst_load, spec.recovery == "nonlinear"
+                                    and any(e["index"] == k for e in extra.get("nonlinear", [])))
+    res.update({"recovery": spec.recovery, "tangential_stiffness": float(kt), "load_names": list(corr.names),
+                "worst_cell_load": worst_load.tolist(),
+                "cell": {"scene": path, "ndof": int(P.ndof), "dim": P.dim,
+                         "fixed_contact_set": "S_C without gap" if chi is not None else "all of S_C"}})
+    res.update(extra)
+    table, plots = _table_and_plots(res, smap, states, names, along, worst_stress, spec.criterion, P.dim)
+    return {"results": res, "table": table, "vtk": vtk, "plots": plots}
+
+
+def _nonlinear_recovery(P, smap, loads, states, along: str, spec) -> list[dict[str, Any]]:
+    """The cell solved nonlinearly at the ``spec.nonlinear_points`` macro points of the largest linear
+    stress; their stresses replace the linear ones in ``smap`` (paper eqs. 76-78)."""
+    worst = np.maximum(smap.values["rough"], smap.values["counter"])
+    picks = [int(i) for i in np.argsort(-worst)[:spec.nonlinear_points]]
+    solved: list[dict[str, Any]] = []
+    for i in picks:
+        try:
+            st, csol = S.nonlinear_stress(P, loads[i])
+        except ValueError as exc:
+            raise SceneError("strength.recovery", "nonlinear", f"the cell cannot be solved at the macro "
+                             f"state of interface point {i}: {exc}") from None
+        entry: dict[str, Any] = {"index": i, along: float(states[along][i]), "load": loads[i].tolist(),
+                                 "contact_fraction": csol.results["contact_fraction"], "bodies": {}}
+        for b in S.BODIES:
+            eq = S.equivalent(st[b]["stress"], spec.criterion)
+            k = int(np.argmax(eq))
+            entry["bodies"][b] = {"linear": float(smap.values[b][i]), "nonlinear": float(eq[k])}
+            smap.values[b][i] = eq[k]
+            smap.cell_point[b][i] = st[b]["points"][k]
+        solved.append(entry)
+    return solved
+
+
+def _worst_cell(P, corr, worst_load, nonlinear: bool):
+    """The cell's state at the critical macro point (nonlinear where it was solved so), its stresses per
+    body and the VTK field of its von Mises stress and displacements."""
+    if nonlinear:
         worst_stress, _ = S.nonlinear_stress(P, worst_load)
     else:
         P.gfu.vec.data = corr.state(worst_load)
@@ -145,11 +164,11 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     from ngcontact.fem.materials import von_mises
     vtk = VtkField(mesh=P.mesh, fields={"von_mises": von_mises(sig), "u_rough": comps[0],
                                         "u_counter": comps[1]}, subdivision=1)
-    res.update({"recovery": spec.recovery, "tangential_stiffness": float(kt), "load_names": list(corr.names),
-                "worst_cell_load": worst_load.tolist(),
-                "cell": {"scene": path, "ndof": int(P.ndof), "dim": P.dim,
-                         "fixed_contact_set": "S_C without gap" if chi is not None else "all of S_C"}})
-    res.update(extra)
+    return worst_stress, vtk
+
+
+def _table_and_plots(res, smap, states, names, along: str, worst_stress, criterion: str, dim: int):
+    """The strength table along the interface and the two figures (the map, the worst cell)."""
     state_keys = ["pressure", "shear", "e_t", "e_hoop"] if "s" in states else \
         ["pressure", "shear_1", "shear_2", "e_11", "e_22", "e_12"]
     header = (["s"] if "s" in states else []) + names + state_keys + [f"sigma_eq_{b}" for b in S.BODIES]
@@ -161,11 +180,11 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
                                 "pressure": np.asarray(states["pressure"]), "shear": np.asarray(states["shear"]),
                                 "xlabel": None if along == "s" else "axial position z of the interface point [mm]"}
     cell_data: dict[str, Any] = {"points": np.concatenate([worst_stress[b]["points"] for b in S.BODIES]),
-                                 "eq": np.concatenate([S.equivalent(worst_stress[b]["stress"], spec.criterion)
+                                 "eq": np.concatenate([S.equivalent(worst_stress[b]["stress"], criterion)
                                                        for b in S.BODIES]),
-                                 "criterion": spec.criterion, "dim": P.dim,
+                                 "criterion": criterion, "dim": dim,
                                  "tangents": ("t0", "hoop") if "s" in states else ("t1", "t2")}
     plots: dict[str, Callable[..., None]] = {
         "strength_map": lambda p, d=map_data: figures.strength_map(p, **d),
         "worst_cell": lambda p, d=cell_data: figures.worst_cell(p, **d)}
-    return {"results": res, "table": table, "vtk": vtk, "plots": plots}
+    return table, plots

@@ -157,40 +157,15 @@ def coupled_newton(residual_form: ng.BilinearForm, gfu: ng.GridFunction, *, free
     linear.register(residual_form, freedofs)
     if frozen is not None:
         linear.register(frozen.form, freedofs)
-    hist = NewtonHistory()
-    changes: list[float] = []
+    rec = _Record(residual_form, gfu, fixed_mask(freedofs), frozen, pressure)
+    hist, fixed = rec.hist, rec.fixed
     cycle = ActiveSetCycle() if active_set is not None else None
-    fixed = fixed_mask(freedofs)
-    res, du, trial, work, r_trial = (gfu.vec.CreateVector() for _ in range(5))
-
-    def failed(message: str) -> ConvergenceError:
-        out = hist.as_dict()
-        out.update(stage="coulomb_newton", coulomb_changes=changes)
-        return ConvergenceError(message, out)
-
-    def residual(vec, out=res) -> float:
-        residual_form.Apply(vec, out)
-        mask_fixed(out, fixed)
-        return math.sqrt(max(ng.InnerProduct(out, out), 0.0))
-
-    def record_state() -> float:
-        """Freeze the threshold at ``gfu``, return ``|R(gfu)|`` (into ``res``); energy and pressure to the record."""
-        if frozen is not None:
-            frozen.freeze()
-        rnorm = residual(gfu.vec)
-        energy = frozen.form.Energy(gfu.vec) if frozen is not None else 0.0
-        hist.residuals.append(rnorm)
-        if frozen is not None:
-            hist.energies.append(energy)
-        if not (math.isfinite(rnorm) and math.isfinite(energy)):
-            raise failed(f"Coulomb Newton step {len(hist.steps)}: non-finite residual or energy")
-        return rnorm
-
-    rnorm = record_state()
+    du, trial, work, r_trial = (gfu.vec.CreateVector() for _ in range(4))
+    rnorm = rec.state()
     r0, floor0 = rnorm, None
-    p_old = pressure() if pressure is not None else None
+    target = max(rtol * r0, atol)
     for it in range(1, max_iter + 1):
-        if rnorm <= max(rtol * r0, atol) or rnorm == 0.0:
+        if rnorm <= target or rnorm == 0.0:
             hist.converged = True
             break
         residual_form.AssembleLinearization(gfu.vec)
@@ -200,42 +175,88 @@ def coupled_newton(residual_form: ng.BilinearForm, gfu: ng.GridFunction, *, free
             log.info("coulomb newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
             hist.converged = True
             break
-        linear.prepare(residual_form, freedofs, symmetric=False).apply(res, du)
+        linear.prepare(residual_form, freedofs, symmetric=False).apply(rec.res, du)
         trial.data = gfu.vec - du
-        r_full = residual(trial, r_trial)
+        r_full = rec.residual(trial, r_trial)
         if math.isfinite(r_full) and r_full < rnorm:
             alpha = 1.0
             gfu.vec.data = trial
         elif frozen is not None:
-            alpha = _frozen_energy_step(frozen.form, gfu, du, freedofs, fixed, trial, work, res, linear, max_step)
+            alpha = _frozen_energy_step(frozen.form, gfu, du, freedofs, fixed, trial, work, rec.res, linear,
+                                        max_step)
         else:
-            alpha = _residual_step(gfu.vec, du, rnorm, trial, lambda v: residual(v, r_trial))
+            alpha = _residual_step(gfu.vec, du, rnorm, trial, lambda v: rec.residual(v, r_trial))
         if alpha == 0.0:
             hist.steps.append(0.0)
             what = "the frozen Tresca energy" if frozen is not None else "the residual"
-            raise failed(f"Coulomb Newton step {it}: no decrease of {what} along the step (residual {rnorm:.3e})")
+            raise rec.failed(f"Coulomb Newton step {it}: no decrease of {what} along the step (residual {rnorm:.3e})")
         hist.steps.append(alpha)
-        rnorm = record_state()
-        if p_old is not None and pressure is not None:
-            p_new = pressure()
-            changes.append(float(np.max(np.abs(p_new - p_old))) if p_new.size else 0.0)
-            p_old = p_new
+        rnorm = rec.state()
         log.debug("coulomb newton %d: |R| = %.3e, alpha = %g", it, rnorm, alpha)
         if cycle is not None:
-            sig = active_set(gfu)
-            hist.active_set_sizes.append(int(sum(bin(b).count("1") for b in sig))
-                                         if isinstance(sig, (bytes, bytearray)) else -1)
-            found = cycle.step(it, sig, rnorm)
-            if found is not None and not rnorm <= max(rtol * r0, atol):
-                raise failed(f"Coulomb Newton step {it}: {found}")
+            found = cycle.step(it, rec.active_set(active_set), rnorm)
+            if found is not None and not rnorm <= target:
+                raise rec.failed(f"Coulomb Newton step {it}: {found}")
     else:
-        if not rnorm <= max(rtol * r0, atol):
-            raise failed(f"Coulomb Newton did not converge in {max_iter} steps: residual {rnorm:.3e} > "
-                         f"{max(rtol * r0, atol):.3e} (rtol {rtol:g} x first residual {r0:.3e})")
+        if not rnorm <= target:
+            raise rec.failed(f"Coulomb Newton did not converge in {max_iter} steps: residual {rnorm:.3e} > "
+                             f"{target:.3e} (rtol {rtol:g} x first residual {r0:.3e})")
         hist.converged = True
-    out = hist.as_dict()
-    out.update(stage="coulomb_newton", coulomb_changes=changes)
-    return out
+    return rec.as_dict()
+
+
+class _Record:
+    """The coupled Newton's iterates as recorded: residual norms, frozen energies, pressure changes."""
+
+    def __init__(self, residual_form, gfu, fixed, frozen: FrozenTresca | None, pressure):
+        self.residual_form, self.gfu, self.fixed = residual_form, gfu, fixed
+        self.frozen, self.pressure = frozen, pressure
+        self.hist = NewtonHistory()
+        self.changes: list[float] = []
+        self.res = gfu.vec.CreateVector()
+        self.p_old = None
+
+    def as_dict(self) -> dict:
+        out = self.hist.as_dict()
+        out.update(stage="coulomb_newton", coulomb_changes=self.changes)
+        return out
+
+    def failed(self, message: str) -> ConvergenceError:
+        return ConvergenceError(message, self.as_dict())
+
+    def residual(self, vec, out=None) -> float:
+        """``|R(vec)|`` on the free dofs, ``R(vec)`` left in ``out`` (default ``self.res``)."""
+        out = self.res if out is None else out
+        self.residual_form.Apply(vec, out)
+        mask_fixed(out, self.fixed)
+        return math.sqrt(max(ng.InnerProduct(out, out), 0.0))
+
+    def state(self) -> float:
+        """Freeze the threshold at the iterate, return ``|R|`` (into ``self.res``); the energy and the largest
+        pressure change since the last iterate go to the record."""
+        frozen = self.frozen
+        if frozen is not None:
+            frozen.freeze()
+        rnorm = self.residual(self.gfu.vec)
+        energy = frozen.form.Energy(self.gfu.vec) if frozen is not None else 0.0
+        self.hist.residuals.append(rnorm)
+        if frozen is not None:
+            self.hist.energies.append(energy)
+        if not (math.isfinite(rnorm) and math.isfinite(energy)):
+            raise self.failed(f"Coulomb Newton step {len(self.hist.steps)}: non-finite residual or energy")
+        if self.pressure is not None:
+            p_new = self.pressure()
+            if self.p_old is not None:
+                self.changes.append(float(np.max(np.abs(p_new - self.p_old))) if p_new.size else 0.0)
+            self.p_old = p_new
+        return rnorm
+
+    def active_set(self, signature_of):
+        """The iterate's active-set signature, its size recorded."""
+        sig = signature_of(self.gfu)
+        self.hist.active_set_sizes.append(int(sum(bin(b).count("1") for b in sig))
+                                          if isinstance(sig, (bytes, bytearray)) else -1)
+        return sig
 
 
 def _frozen_energy_step(energy_form, gfu, du, freedofs, fixed, trial, work, res, linear, max_step) -> float:

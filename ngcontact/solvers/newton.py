@@ -151,97 +151,139 @@ def minimize(form: ng.BilinearForm, gfu: ng.GridFunction, *, freedofs=None,
     if linear is None:
         linear = LinearSolver("direct", inverse=inverse)
     linear.register(form, freedofs)
-    hist = NewtonHistory(linear=quadratic)
-    cycle = ActiveSetCycle() if active_set is not None else None
-    fixed = fixed_mask(freedofs)
-    res = gfu.vec.CreateVector()
-    du = gfu.vec.CreateVector()
-    trial = gfu.vec.CreateVector()
-
-    def residual(vec) -> float:
-        form.Apply(vec, res)
-        mask_fixed(res, fixed)
-        return math.sqrt(max(ng.InnerProduct(res, res), 0.0))
-
-    energy = form.Energy(gfu.vec)
-    rnorm = residual(gfu.vec)
-    hist.energies.append(energy)
-    hist.residuals.append(rnorm)
-    if not (math.isfinite(energy) and math.isfinite(rnorm)):
-        raise ConvergenceError("the start value gives a non-finite energy or residual", hist.as_dict())
-    r0 = rnorm
-    if rnorm <= atol or rnorm == 0.0:
+    newton = _Iteration(form, gfu, freedofs, linear, NewtonHistory(linear=quadratic), line_search, max_step,
+                        target=lambda r0: max(rtol * r0, atol))
+    hist = newton.hist
+    if newton.rnorm <= atol or newton.rnorm == 0.0:
         hist.converged = True
         return hist
     if quadratic:
-        return _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol, atol, fixed)
-    floor0 = None
-    previous, eta = None, None
+        return _linear_solve(form, gfu, freedofs, linear, newton.residual, newton.res, newton.du, hist, newton.r0,
+                             rtol, atol, newton.fixed)
+    cycle = ActiveSetCycle() if active_set is not None else None
     for it in range(1, max_iter + 1):
-        form.AssembleLinearization(gfu.vec)
-        floor, efloor = roundoff_floors(form.mat, gfu.vec, fixed, energy)
-        floor0 = floor if floor0 is None else floor0
-        if at_floor(rnorm, floor, r0, floor0):
-            log.info("newton %d: residual %.3e at its round-off floor; converged", it, rnorm)
-            hist.converged = True
+        if newton.step(it):
             return hist
-        eta = forcing_term(rnorm, previous, eta, max(rtol * r0, atol))
-        previous = rnorm
-        linear.prepare(form, freedofs, forcing=eta).apply(res, du)
-        slope = ng.InnerProduct(du, res)
-        if not math.isfinite(slope):
-            raise ConvergenceError(f"Newton step {it}: the tangent solve gave non-finite values", hist.as_dict())
-        if slope <= 0.0:
-            raise ConvergenceError(
-                f"Newton step {it}: the tangent gives no descent direction (du . r = {slope:.3e}); "
-                "the tangent is singular or indefinite, e.g. a load the interface cannot carry",
-                hist.as_dict())
-        alpha = 1.0
-        if line_search == "exact":
-            alpha = exact_step(form, gfu.vec, du, slope, fixed, trial, res, max_step)
-        while True:
-            trial.data = gfu.vec - alpha * du
-            e_new = form.Energy(trial)
-            decreased = armijo(energy, e_new, alpha * slope)
-            if decreased or within_roundoff(energy, e_new, efloor):
-                r_new = residual(trial)        # a finite energy can still have a non-finite gradient
-                if math.isfinite(r_new) and (decreased or r_new <= (1.0 - ARMIJO * alpha) * rnorm):
-                    break
-                if not math.isfinite(r_new):
-                    log.debug("newton %d: non-finite residual at alpha = %g, backtracking", it, alpha)
-            alpha *= 0.5
-            if alpha < MIN_STEP:
-                if at_roundoff(slope, efloor, rnorm, floor, r0):
-                    log.info("newton %d: residual %.3e, no decrease measurable along the step; at round-off, "
-                             "converged", it, rnorm)
-                    hist.converged = True
-                    return hist
-                hist.steps.append(0.0)
-                raise ConvergenceError(
-                    f"Newton step {it}: line search found no decrease of the energy "
-                    f"(residual {rnorm:.3e}); the tangent may be wrong or the problem unbounded",
-                    hist.as_dict())
-        gfu.vec.data = trial
-        energy, rnorm = e_new, r_new
-        hist.steps.append(alpha)
-        hist.energies.append(energy)
-        hist.residuals.append(rnorm)
-        log.debug("newton %d: |r| = %.3e, energy = %.6e, alpha = %g", it, rnorm, energy, alpha)
         if callback is not None:
             callback(it, gfu)
         if cycle is not None:
             sig = active_set(gfu)
             hist.active_set_sizes.append(_size(sig))
-            found = cycle.step(it, sig, rnorm)
-            if found is not None and not rnorm <= max(rtol * r0, atol):
+            found = cycle.step(it, sig, newton.rnorm)
+            if found is not None and not newton.tolerance_met():
                 raise ConvergenceError(f"Newton step {it}: {found}", hist.as_dict())
-        if rnorm <= max(rtol * r0, atol):
+        if newton.tolerance_met():
             hist.converged = True
             return hist
     raise ConvergenceError(
-        f"Newton did not converge in {max_iter} steps: residual {rnorm:.3e} "
-        f"> {max(rtol * r0, atol):.3e} (rtol {rtol:g} x first residual {r0:.3e})",
+        f"Newton did not converge in {max_iter} steps: residual {newton.rnorm:.3e} "
+        f"> {newton.target(newton.r0):.3e} (rtol {rtol:g} x first residual {newton.r0:.3e})",
         hist.as_dict())
+
+
+class _Iteration:
+    """The state of one Newton minimization and its step; the stopping rules are its named tests.
+
+    Stopping rules, each a method: :meth:`tolerance_met` (``|r| <= max(rtol |r_0|, atol)``), the residual
+    at its round-off floor after real progress (:func:`~ngcontact.solvers.roundoff.at_floor`, in
+    :meth:`step`), a step along which no decrease is measurable at round-off
+    (:func:`~ngcontact.solvers.roundoff.at_roundoff`, in :meth:`step_length`); a cycling active set is
+    :class:`ActiveSetCycle`'s, in :func:`minimize`.
+    """
+
+    def __init__(self, form, gfu, freedofs, linear: LinearSolver, hist: NewtonHistory, line_search: str,
+                 max_step: float, target):
+        self.form, self.gfu, self.freedofs, self.linear, self.hist = form, gfu, freedofs, linear, hist
+        self.line_search, self.max_step, self.target = line_search, max_step, target
+        self.fixed = fixed_mask(freedofs)
+        self.res, self.du, self.trial = (gfu.vec.CreateVector() for _ in range(3))
+        self.energy = form.Energy(gfu.vec)
+        self.rnorm = self.residual(gfu.vec)
+        hist.energies.append(self.energy)
+        hist.residuals.append(self.rnorm)
+        if not (math.isfinite(self.energy) and math.isfinite(self.rnorm)):
+            raise ConvergenceError("the start value gives a non-finite energy or residual", hist.as_dict())
+        self.r0 = self.rnorm
+        self.floor0: float | None = None
+        self.previous: float | None = None
+        self.eta: float | None = None
+
+    def residual(self, vec) -> float:
+        """``|r(vec)|`` on the free dofs; leaves ``r(vec)`` in ``self.res``."""
+        self.form.Apply(vec, self.res)
+        mask_fixed(self.res, self.fixed)
+        return math.sqrt(max(ng.InnerProduct(self.res, self.res), 0.0))
+
+    def tolerance_met(self) -> bool:
+        """The residual is within the requested tolerance."""
+        return self.rnorm <= self.target(self.r0)
+
+    def direction(self, it: int) -> float:
+        """Solve ``K du = r`` into ``self.du`` (inexactly where the linear solver iterates); the slope
+        ``du . r``, checked to be a descent direction."""
+        self.eta = forcing_term(self.rnorm, self.previous, self.eta, self.target(self.r0))
+        self.previous = self.rnorm
+        self.linear.prepare(self.form, self.freedofs, forcing=self.eta).apply(self.res, self.du)
+        slope = ng.InnerProduct(self.du, self.res)
+        if not math.isfinite(slope):
+            raise ConvergenceError(f"Newton step {it}: the tangent solve gave non-finite values",
+                                   self.hist.as_dict())
+        if slope <= 0.0:
+            raise ConvergenceError(
+                f"Newton step {it}: the tangent gives no descent direction (du . r = {slope:.3e}); "
+                "the tangent is singular or indefinite, e.g. a load the interface cannot carry",
+                self.hist.as_dict())
+        return slope
+
+    def step_length(self, it: int, slope: float, floor: float, efloor: float) -> tuple[float, float, float] | None:
+        """The accepted step length along ``-du`` with the trial's energy and residual (the trial left in
+        ``self.trial``), or ``None`` where no decrease is measurable and the iterate is at round-off."""
+        alpha = 1.0
+        if self.line_search == "exact":
+            alpha = exact_step(self.form, self.gfu.vec, self.du, slope, self.fixed, self.trial, self.res,
+                               self.max_step)
+        while True:
+            self.trial.data = self.gfu.vec - alpha * self.du
+            e_new = self.form.Energy(self.trial)
+            decreased = armijo(self.energy, e_new, alpha * slope)
+            if decreased or within_roundoff(self.energy, e_new, efloor):
+                r_new = self.residual(self.trial)        # a finite energy can still have a non-finite gradient
+                if math.isfinite(r_new) and (decreased or r_new <= (1.0 - ARMIJO * alpha) * self.rnorm):
+                    return alpha, e_new, r_new
+                if not math.isfinite(r_new):
+                    log.debug("newton %d: non-finite residual at alpha = %g, backtracking", it, alpha)
+            alpha *= 0.5
+            if alpha < MIN_STEP:
+                if at_roundoff(slope, efloor, self.rnorm, floor, self.r0):
+                    log.info("newton %d: residual %.3e, no decrease measurable along the step; at round-off, "
+                             "converged", it, self.rnorm)
+                    return None
+                self.hist.steps.append(0.0)
+                raise ConvergenceError(
+                    f"Newton step {it}: line search found no decrease of the energy "
+                    f"(residual {self.rnorm:.3e}); the tangent may be wrong or the problem unbounded",
+                    self.hist.as_dict())
+
+    def step(self, it: int) -> bool:
+        """One Newton step; ``True`` where a round-off rule ends the iteration as converged."""
+        self.form.AssembleLinearization(self.gfu.vec)
+        floor, efloor = roundoff_floors(self.form.mat, self.gfu.vec, self.fixed, self.energy)
+        self.floor0 = floor if self.floor0 is None else self.floor0
+        if at_floor(self.rnorm, floor, self.r0, self.floor0):
+            log.info("newton %d: residual %.3e at its round-off floor; converged", it, self.rnorm)
+            self.hist.converged = True
+            return True
+        accepted = self.step_length(it, self.direction(it), floor, efloor)
+        if accepted is None:
+            self.hist.converged = True
+            return True
+        alpha, self.energy, self.rnorm = accepted
+        self.gfu.vec.data = self.trial
+        self.hist.steps.append(alpha)
+        self.hist.energies.append(self.energy)
+        self.hist.residuals.append(self.rnorm)
+        log.debug("newton %d: |r| = %.3e, energy = %.6e, alpha = %g", it, self.rnorm, self.energy, alpha)
+        return False
 
 
 def _linear_solve(form, gfu, freedofs, linear, residual, res, du, hist, r0, rtol, atol, fixed) -> NewtonHistory:
