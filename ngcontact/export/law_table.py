@@ -9,9 +9,10 @@ purely normal macro closure ``c`` (the jump ``a = c n0`` minus the macro gap
     beta_q = n_q . n0,   s_q = w_q beta_q^2,   c_q = g_q / beta_q,
 
 a convex piecewise linear curve with a kink at every ``c_q`` (directions with
-``beta_q <= 0`` never close under a normal closure and carry no pressure;
-each law gives its own curve,
-:meth:`~ngcontact.laws.law_protocol.NormalLaw.export_rows`).
+``beta_q <= 0`` never close under a normal closure and carry no pressure).
+Each law gives its curve itself
+(:meth:`~ngcontact.laws.law_protocol.NormalLaw.export_rows`; the bundle's:
+:meth:`~ngcontact.laws.homogenized.BundleLaw.closing_ramps`).
 Beyond its last kink the slope is ``k_n0 = sum_q s_q``, the normal entry of
 ``K0`` of eq. 34.  This curve is exact; the exported table is a subset of its
 kinks (and a last point at the largest pressure asked for) such that linear
