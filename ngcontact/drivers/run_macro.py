@@ -112,10 +112,9 @@ def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
     return il.InterfaceLaw(normal=normal, friction=friction), info
 
 
-def _K0(normal, dim):
-    if isinstance(normal, il.TabulatedLaw):
-        return None
-    return np.asarray(normal.matrix(dim)).tolist()
+def _K0(normal: il.NormalLaw, dim: int):
+    K0 = normal.full_contact_K0(dim)
+    return None if K0 is None else np.asarray(K0).tolist()
 
 
 #: Largest equivalent strain for which the linear (small-strain) elasticity of the model is meaningful.

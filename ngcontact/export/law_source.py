@@ -24,7 +24,6 @@ import numpy as np
 
 from ngcontact.errors import ModelError
 from ngcontact.export import law_table as lt
-from ngcontact.laws import homogenized as il
 from ngcontact.scene import loader
 
 
@@ -82,21 +81,8 @@ def exported_law(path: str, *, length_unit: float = 1.0, p_max: float | None = N
         raise ModelError(f"--max-pressure {p_max!r}: the table's largest pressure [Pa], must be > 0")
     scene = loader.load(path)
     normal, g0, threshold, scene_mu, gap_table, scale, source = _normal_law(scene, path, length_unit)
-    bundle, K0 = None, None
-    if isinstance(normal, il.BundleLaw):
-        w, n, g = np.asarray(normal.weights, float), np.asarray(normal.directions, float), normal.g
-        kinks, slopes = lt.bundle_ramps(w, n, g)
-        K0 = normal.matrix()
-        bundle = {"weights": w, "directions": n, "gaps": g}
-        gap_force = np.einsum("q,q,qi->i", w, g, n)
-    elif isinstance(normal, il.LinearLaw):
-        kinks, slopes = np.array([normal.gap_force[0] / normal.kn]), np.array([normal.kn])
-        K0 = normal.matrix(2)
-        gap_force = np.asarray(normal.gap_force, float)
-    elif isinstance(normal, il.TabulatedLaw) and normal.interpolation == "linear":
-        kinks, slopes = normal.ramps()
-    else:  # pragma: no cover - a field law exists only inside the two-scale loop
-        raise ModelError(f"a {type(normal).__name__} cannot be exported")
+    rows = normal.export_rows()
+    kinks, slopes, K0, bundle = rows.kinks, rows.slopes, rows.K0, rows.bundle
     if p_max is None:
         p_full = float(lt.curve(kinks, slopes, [np.max(kinks)])[0])
         p_max = max(2.0 * p_full, 10.0 * scale, 2.0 * float(np.sum(slopes)) * abs(g0))
@@ -112,13 +98,12 @@ def exported_law(path: str, *, length_unit: float = 1.0, p_max: float | None = N
         mu0, mu_source = float(np.linalg.norm(K0[0, 1:]) / K0[0, 0]), "|k_nt0| / k_n0 (paper, after eq. 34)"
     else:
         mu0, mu_source = 0.0, "none (a tabulated law has no k_nt0)"
-    stick = float(np.mean(np.diag(K0)[1:])) if K0 is not None else float(normal.kt)
     notes = lt.not_carried(None if bundle is None else bundle["directions"], K0, threshold=threshold,
-                           gap_table=gap_table, bilateral=isinstance(normal, il.LinearLaw))
+                           gap_table=gap_table, bilateral=rows.bilateral)
     if "huber_width" in source:
         notes += (f"the macro scene's friction regularization (Huber width w = {source['huber_width']:g} m: a "
                   "sticking point slips at most w) is not exported; the stick slope is the law's k_t0",)
     return lt.ExportedLaw(kinks=np.asarray(kinks, float), slopes=np.asarray(slopes, float), closure=closure,
                           pressure=pressure, tolerance=tolerance, K0=K0, bundle=bundle, mu=mu0, mu_source=mu_source,
-                          stick_slope=stick, gap=float(g0), source=source, notes=notes,
-                          gap_force=None if K0 is None else np.asarray(gap_force, float))
+                          stick_slope=rows.stick_slope, gap=float(g0), source=source, notes=notes,
+                          gap_force=None if K0 is None else np.asarray(rows.gap_force, float))

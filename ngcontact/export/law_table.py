@@ -10,6 +10,9 @@ purely normal macro closure ``c`` (the jump ``a = c n0`` minus the macro gap
 
 a convex piecewise linear curve with a kink at every ``c_q`` (directions with
 ``beta_q <= 0`` never close under a normal closure and carry no pressure).
+Each law gives its curve itself
+(:meth:`~ngcontact.laws.law_protocol.NormalLaw.export_rows`; the bundle's:
+:meth:`~ngcontact.laws.homogenized.BundleLaw.closing_ramps`).
 Beyond its last kink the slope is ``k_n0 = sum_q s_q``, the normal entry of
 ``K0`` of eq. 34.  This curve is exact; the exported table is a subset of its
 kinks (and a last point at the largest pressure asked for) such that linear
@@ -35,10 +38,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ngcontact.errors import ModelError
-
-#: Directions whose normal component is below this never close under a normal closure.
-CLOSING = 1e-12
-
 
 @dataclass(frozen=True)
 class ExportedLaw:
@@ -97,17 +96,6 @@ class ExportedLaw:
     def full_contact_pressure(self) -> float:
         """Pressure at the last kink: above it the curve is linear with slope ``k_n0``."""
         return float(curve(self.kinks, self.slopes, np.array([self.kinks.max()]))[0])
-
-
-def bundle_ramps(weights, directions, gaps) -> tuple[np.ndarray, np.ndarray]:
-    """Kinks ``c_q`` and slope increments ``s_q`` of a bundle's closing directions (module docstring)."""
-    w = np.asarray(weights, float)
-    beta = np.asarray(directions, float)[:, 0]
-    g = np.asarray(gaps, float)
-    closing = beta > CLOSING
-    if not np.any(closing):
-        raise ModelError("no direction of the bundle closes under a normal closure (all n_q . n0 <= 0)")
-    return g[closing] / beta[closing], w[closing] * beta[closing] ** 2
 
 
 def curve(kinks, slopes, c) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Homogenized interface laws on the macro interface ``S_0``: the law values.
+"""Homogenized interface laws on the macro interface ``S_0``: one class per law, its formulas with it.
 
 A law (paper eqs. 31-34, 38-44, 69-71) is an energy density ``W(a)`` of the
 macro jump ``J = u_rough - u_counter`` written in the interface's local
@@ -11,8 +11,11 @@ shifts the law along ``n0``.  The traction ``tau = dW/da`` is what the rough
 body transmits to the counter body; its normal component is the contact
 pressure ``p = tau_n`` (compression positive), its tangential part the shear.
 
-Laws (frozen dataclasses, values only; their energy ``W(a)`` and traction
-``tau = dW/da`` are evaluated by :mod:`ngcontact.laws.interface_energy`):
+Laws (frozen dataclasses), each a class of the protocol of
+:mod:`ngcontact.laws.law_protocol` carrying its own energy ``W(a)``,
+traction ``tau = dW/da`` and export rows (the normal laws: subclasses of
+:class:`NormalLaw`; the friction laws: of :class:`TangentialLaw`);
+:mod:`ngcontact.laws.interface_energy` adds them up:
 
 :class:`LinearLaw`
     Anisotropic Winkler law of paper eqs. 34 and 69-71 with the matrix
@@ -57,8 +60,7 @@ Laws (frozen dataclasses, values only; their energy ``W(a)`` and traction
     sticking interface slips at most ``w``.  Coulomb's ``G = mu0 p`` is not
     the derivative of an energy; :mod:`ngcontact.macro.macro_problem` treats it by a fixed
     point on the pressure (``G`` frozen at the previous solution's ``p``), see
-    there.  The friction energy of
-    :mod:`ngcontact.laws.interface_energy` takes ``G`` as given.
+    there.  The friction energy takes ``G`` as given.
 :class:`CellShear`
     In place of :class:`Friction`: the cell's own tangential response, rows
     of shear against tangential jump tabulated at a set of pressures
@@ -68,17 +70,28 @@ Laws (frozen dataclasses, values only; their energy ``W(a)`` and traction
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import numpy as np
 from ngcontact.errors import ModelError
 from ngcontact.laws import monotone_cubic
+from ngcontact.laws.huber import huber_of_square, huber_slope, if_positive, is_numeric
+from ngcontact.laws.law_evaluation import cubic_splines, dot, ramp, row_splines, table_splines, tangential_norm2
+from ngcontact.laws.law_protocol import ExportRows, NormalLaw, TangentialLaw
 
+__all__ = ["BundleLaw", "CellShear", "ExportRows", "Friction", "InterfaceLaw", "LinearLaw", "NormalLaw",
+           "TabulatedLaw", "Tangential", "TangentialLaw", "linearized", "normal_law"]
+
+#: Directions whose normal component is below this never close under a normal closure.
+CLOSING = 1e-12
 
 
 # ------------------------------------------------------------------ laws
 @dataclass(frozen=True, kw_only=True)
-class LinearLaw:
-    """Linear anisotropic Winkler law (paper eqs. 34, 69-71).
+class LinearLaw(NormalLaw):
+    """Linear anisotropic Winkler law (paper eqs. 34, 69-71)::
+
+        W(a) = 1/2 (a - g0 e_n) . K0 (a - g0 e_n) - g0_vec . a
+        tau  = K0 (a - g0 e_n) - g0_vec
 
     Attributes
     ----------
@@ -108,10 +121,49 @@ class LinearLaw:
     def stiffness(self) -> float:
         return self.kn
 
+    def energy(self, a, g0=0.0, closed: bool = False):
+        """``W(a) = 1/2 (a - g0 e_n) . K0 (a - g0 e_n) - g0_vec . a`` (eq. 34); quadratic, so ``closed`` is ``W``."""
+        dim = len(a)
+        K = self.matrix(dim)
+        e = [a[0] - g0] + list(a[1:])
+        W = 0.5 * sum(K[i, j] * e[i] * e[j] for i in range(dim) for j in range(dim) if K[i, j] != 0)
+        return W - self.gap_force[0] * a[0] - self.gap_force[1] * a[1]
+
+    def traction(self, a, g0=0.0) -> list:
+        """``tau = K0 (a - g0 e_n) - g0_vec``."""
+        dim = len(a)
+        K = self.matrix(dim)
+        e = [a[0] - g0] + list(a[1:])
+        tau = [sum(K[i, j] * e[j] for j in range(dim) if K[i, j] != 0) for i in range(dim)]
+        tau[0] = tau[0] - self.gap_force[0]
+        tau[1] = tau[1] - self.gap_force[1]
+        return tau
+
+    def full_contact_K0(self, dim: int) -> np.ndarray:
+        return self.matrix(dim)
+
+    @property
+    def quadratic(self) -> bool:
+        return True
+
+    def export_rows(self) -> ExportRows:
+        """The line ``p(c) = k_n0 c - g_n0 = k_n0 [c - g_n0 / k_n0]_+`` (bilateral: it goes on below its kink,
+        which a table does not carry), ``K0`` in 2D, stick slope ``k_t0``."""
+        K0 = self.matrix(2)
+        return ExportRows(kinks=np.array([self.gap_force[0] / self.kn]), slopes=np.array([self.kn]),
+                          stick_slope=float(np.mean(np.diag(K0)[1:])), K0=K0,
+                          gap_force=np.asarray(self.gap_force, float), bilateral=True)
+
 
 @dataclass(frozen=True, kw_only=True)
-class BundleLaw:
-    """Unilateral bundle of weighted micro directions (paper eqs. 31-33).
+class BundleLaw(NormalLaw):
+    """Unilateral bundle of weighted micro directions (paper eqs. 31-33)::
+
+        W(a) = sum_q w_q/2 [n_q . a - g_q - beta1_q g0]_+^2,    beta1_q = n_q . e_n
+        tau  = sum_q w_q   [n_q . a - g_q - beta1_q g0]_+ n_q
+
+    (``tau_n`` and ``tau_t`` are the homogenized stresses of eqs. 32 and 33
+    with the integral over ``S_C`` replaced by the weighted directions).
 
     Attributes
     ----------
@@ -155,6 +207,61 @@ class BundleLaw:
     def stiffness(self) -> float:
         return float(self.matrix()[0, 0])
 
+    def energy(self, a, g0=0.0, closed: bool = False):
+        """``W(a)`` of the class docstring; with ``closed`` every direction active (``[x]_+`` replaced by ``x``)."""
+        self._check_dim(len(a))
+        on = (lambda x: x) if closed else ramp
+        W = 0
+        for w, n, g in zip(self.weights, self.directions, self.g):
+            W = W + 0.5 * w * on(dot(n, a) - g - n[0] * g0) ** 2
+        return W
+
+    def traction(self, a, g0=0.0) -> list:
+        """``tau = sum_q w_q [n_q . a - g_q - beta1_q g0]_+ n_q``."""
+        dim = len(a)
+        self._check_dim(dim)
+        tau = [0] * dim
+        for w, n, g in zip(self.weights, self.directions, self.g):
+            f = w * ramp(dot(n, a) - g - n[0] * g0)
+            tau = [tau[i] + f * n[i] for i in range(dim)]
+        return tau
+
+    def full_contact_K0(self, dim: int) -> np.ndarray:
+        return self.matrix(dim)
+
+    def closing_ramps(self) -> tuple[np.ndarray, np.ndarray]:
+        """Kinks ``c_q`` and slope increments ``s_q`` of the pressure under a purely normal closure ``c``::
+
+            p(c) = sum_q w_q beta_q [beta_q c - g_q]_+ = sum_q s_q [c - c_q]_+,
+            beta_q = n_q . n0,   s_q = w_q beta_q^2,   c_q = g_q / beta_q,
+
+        a convex polyline whose last slope is ``k_n0 = sum_q s_q``, the normal
+        entry of ``K0`` (eq. 34); directions with ``beta_q <= CLOSING`` never
+        close under a normal closure and carry no pressure.
+        """
+        w = np.asarray(self.weights, float)
+        beta = np.asarray(self.directions, float)[:, 0]
+        g = np.asarray(self.g, float)
+        closing = beta > CLOSING
+        if not np.any(closing):
+            raise ModelError("no direction of the bundle closes under a normal closure (all n_q . n0 <= 0)")
+        return g[closing] / beta[closing], w[closing] * beta[closing] ** 2
+
+    def export_rows(self) -> ExportRows:
+        """:meth:`closing_ramps`, ``K0 = sum_q w_q n_q n_q^T`` and the gap forces ``sum_q w_q g_q n_q`` (eq. 34),
+        stick slope the mean tangential entry of ``K0``, the bundle itself."""
+        w, n, g = np.asarray(self.weights, float), np.asarray(self.directions, float), self.g
+        kinks, slopes = self.closing_ramps()
+        K0 = self.matrix()
+        return ExportRows(kinks=kinks, slopes=slopes, stick_slope=float(np.mean(np.diag(K0)[1:])), K0=K0,
+                          gap_force=np.einsum("q,q,qi->i", w, g, n),
+                          bundle={"weights": w, "directions": n, "gaps": g})
+
+    def _check_dim(self, dim: int) -> None:
+        if len(self.directions[0]) != dim:
+            raise ModelError(f"the bundle's directions have {len(self.directions[0])} components, "
+                             f"the interface frame {dim}")
+
     def merged(self, decimals: int = 12) -> "BundleLaw":
         """The same law with equal ``(n_q, g_q)`` merged (weights added)."""
         acc: dict = {}
@@ -172,8 +279,22 @@ INTERPOLATIONS = ("linear", "monotone_cubic")
 
 
 @dataclass(frozen=True, kw_only=True)
-class TabulatedLaw:
+class TabulatedLaw(NormalLaw):
     """Monotone tabulated normal law ``p(c)`` with optional tangential stiffness.
+
+    Closure ``c = a_n - g0``, kinks ``c_i``, slope increments ``s_i``::
+
+        W(a) = sum_i s_i/2 [c - c_i]_+^2 + k_t/2 |a_t|^2
+        tau  = (sum_i s_i [c - c_i]_+,  k_t a_t)
+
+    (on CoefficientFunctions the same functions are NGSolve B-splines, one
+    table lookup per quadrature point instead of one ramp per kink, see
+    :mod:`ngcontact.laws.law_evaluation`).  A ``"monotone_cubic"`` table:
+    ``p(c)`` the C1 cubic Hermite interpolant and ``W(c) = int_{c_0}^c p``
+    (the formulas of :mod:`ngcontact.laws.monotone_cubic`; on
+    CoefficientFunctions a cubic B-spline with triple knots, the Bezier form
+    of each piece).  The "all closed" surrogate is the table's first segment
+    of nonzero slope, extended both ways.
 
     Attributes
     ----------
@@ -231,10 +352,79 @@ class TabulatedLaw:
             return monotone_cubic.largest_slope(c, p, self.node_slopes())
         return float(np.max(np.diff(p) / np.diff(c)))
 
+    def energy(self, a, g0=0.0, closed: bool = False):
+        """``W(a)`` of the class docstring; with ``closed`` the first segment of nonzero slope, extended both ways."""
+        c = a[0] - g0
+        if not closed and (self.interpolation != "linear" or not is_numeric(c)):
+            W = self._cubic_table(c, energy=True) if is_numeric(c) else self._splines()[1](c)
+            return W + 0.5 * self.kt * sum(ai * ai for ai in a[1:]) if self.kt > 0 else W
+        on = (lambda x: x) if closed else ramp
+        kinks, slopes = self.ramps()
+        if closed:
+            first = next(k for k, s in enumerate(slopes) if s != 0)
+            kinks, slopes = kinks[first:first + 1], slopes[first:first + 1]
+        W = sum(0.5 * s * on(c - ci) ** 2 for ci, s in zip(kinks, slopes) if s != 0)
+        if self.kt > 0:
+            W = W + 0.5 * self.kt * sum(ai * ai for ai in a[1:])
+        return W
+
+    def traction(self, a, g0=0.0) -> list:
+        """``tau = (p(c), k_t a_t)``."""
+        c = a[0] - g0
+        if not is_numeric(c):
+            p = self._splines()[0](c)
+        elif self.interpolation != "linear":
+            p = self._cubic_table(c, energy=False)
+        else:
+            kinks, slopes = self.ramps()
+            p = sum(s * ramp(c - ci) for ci, s in zip(kinks, slopes) if s != 0)
+        return [p] + [self.kt * ai for ai in a[1:]]
+
+    @property
+    def holds_tangentially(self) -> bool:
+        return self.kt > 0
+
+    def export_rows(self) -> ExportRows:
+        """The polyline itself, :meth:`ramps` (a ``"monotone_cubic"`` table has no exact polyline: it is the
+        two-scale loop's own law and is not exported); stick slope ``k_t``, no ``K0``."""
+        if self.interpolation != "linear":
+            return super().export_rows()
+        kinks, slopes = self.ramps()
+        return ExportRows(kinks=kinks, slopes=slopes, stick_slope=float(self.kt))
+
+    def _splines(self):
+        """``(p, W)`` as B-splines, by the interpolation (:mod:`ngcontact.laws.law_evaluation`)."""
+        if self.interpolation == "linear":
+            return table_splines(self.closure, self.pressure)
+        return cubic_splines(self.closure, self.pressure, tuple(self.node_slopes()))
+
+    def _cubic_table(self, c, energy: bool):
+        """``p(c)`` or ``W(c)`` of a monotone cubic table at closures ``c`` (NumPy;
+        :mod:`ngcontact.laws.monotone_cubic`), 0 below ``c_0`` and continued with the last node slope beyond
+        ``c_last``."""
+        cn = np.asarray(self.closure, float)
+        pn = np.asarray(self.pressure, float)
+        m = self.node_slopes()
+        x = np.asarray(c, float)
+        d = x - cn[-1]
+        if energy:
+            inside = monotone_cubic.integral(cn, pn, m, x)
+            beyond = float(monotone_cubic.integral(cn, pn, m, cn[-1])) + pn[-1] * d + 0.5 * m[-1] * d * d
+        else:
+            inside, beyond = monotone_cubic.evaluate(cn, pn, m, x), pn[-1] + m[-1] * d
+        return np.where(x < cn[0], 0.0, np.where(x > cn[-1], beyond, inside))
+
 
 @dataclass(frozen=True, kw_only=True)
-class Friction:
+class Friction(TangentialLaw):
     """Homogenized friction: ``G = mu [p]_+ + threshold``, Huber width ``width``.
+
+    Paper eqs. 38-44 with the Huber function of eq. 16
+    (:mod:`ngcontact.laws.huber`)::
+
+        G      = mu0 [p]_+ + G0                          (eqs. 42-43)
+        W_f(a) = G huber(|a_t|, w)
+        tau_f  = (0,  G a_t / max(|a_t|, w))            (G held fixed)
 
     Attributes
     ----------
@@ -259,9 +449,29 @@ class Friction:
     def coulomb(self) -> bool:
         return self.mu > 0
 
+    @property
+    def huber_regularized(self) -> bool:
+        return True
+
+    def with_width(self, width: float) -> Friction:
+        return replace(self, width=width)
+
+    def threshold_at(self, p):
+        """``G = mu0 [p]_+ + G0``."""
+        return self.mu * ramp(p) + self.threshold
+
+    def energy(self, a, G):
+        """``W_f(a) = G huber(|a_t|, w)``."""
+        return G * huber_of_square(tangential_norm2(a), self.width)
+
+    def traction(self, a, G) -> list:
+        """``tau_f = (0, G a_t / max(|a_t|, w))``."""
+        f = G * huber_slope(tangential_norm2(a), self.width)
+        return [0.0 * a[0]] + [f * ai for ai in a[1:]]
+
 
 @dataclass(frozen=True, kw_only=True)
-class CellShear:
+class CellShear(TangentialLaw):
     """The cell's own tangential response, tabulated over pressure and tangential jump.
 
     Rows ``i`` at pressures ``p_0 = 0 < p_1 < ...`` hold the cell's mean
@@ -316,6 +526,20 @@ class CellShear:
         """True: the shear depends on the current pressure (solved like Coulomb friction)."""
         return True
 
+    def threshold_at(self, p):
+        """The pressure ``p`` itself: the rows are interpolated at it."""
+        return p
+
+    def energy(self, a, G):
+        """``W_t(a; p)`` of the class docstring with the frozen pressure ``p = G``."""
+        self._check_frame(a)
+        return sum(phi * e for phi, e in self._rows(a[1], G, energy=True))
+
+    def traction(self, a, G) -> list:
+        """``tau_t = T(p, a_t)`` with the frozen pressure ``p = G``; no normal component."""
+        self._check_frame(a)
+        return [0.0 * a[0], sum(phi * t for phi, t in self._rows(a[1], G, energy=False))]
+
     @property
     def width(self) -> float:
         """The smallest tabulated nonzero jump: below it every row is in its first (sticking) segment."""
@@ -336,9 +560,46 @@ class CellShear:
         slopes = np.concatenate([np.diff(t) / np.diff(s), [0.0]])
         return s, np.diff(np.concatenate([[0.0], slopes]))
 
+    def _rows(self, s, p, energy: bool):
+        """``(phi_i(p) r_i^k, E_i(s / r_i) or T_i(s / r_i))`` of the rows ``i >= 1``.
 
-Tangential = Friction | CellShear
-NormalLaw = LinearLaw | BundleLaw | TabulatedLaw
+        ``r_i = p / p_i`` (with ``p`` kept above ``1e-12 p_1``: for ``p <= 0``
+        every ``phi_i``, ``i >= 1``, is zero and row 0 is zero), ``k = 2`` for the
+        energy and 1 for the traction; ``T_i(x) = sum_k e_k ([x - s_k]_+ -
+        [-x - s_k]_+)`` (odd), ``E_i(x) = sum_k e_k/2 ([x - s_k]_+^2 + [-x -
+        s_k]_+^2)``; ``phi_i(p) = sum_k d_ik [p - p_k]_+``.  On
+        CoefficientFunctions ``T_i`` and ``E_i`` are B-splines
+        (:func:`ngcontact.laws.law_evaluation.row_splines`).
+        """
+        kinks, d = self.hats()
+        floor = 1e-12 * float(kinks[1])
+        q = if_positive(p - floor, p, floor)
+        for i in range(1, len(kinks)):
+            phi = sum(float(dk) * ramp(p - float(pk)) for pk, dk in zip(kinks, d[i]) if dk != 0)
+            r = q / float(kinks[i])
+            x = s / r
+            if not is_numeric(x):
+                T, E = row_splines(tuple(self.jumps[i]), tuple(self.shears[i]))
+                yield (phi * r * r, E(x)) if energy else (phi * r, T(x))
+                continue
+            sk, ek = self.ramps(i)
+            if energy:
+                f = sum(0.5 * float(e) * (ramp(x - float(k)) ** 2 + ramp(-x - float(k)) ** 2)
+                        for k, e in zip(sk, ek) if e != 0)
+                yield phi * r * r, f
+            else:
+                f = sum(float(e) * (ramp(x - float(k)) - ramp(-x - float(k))) for k, e in zip(sk, ek) if e != 0)
+                yield phi * r, f
+
+    @staticmethod
+    def _check_frame(a) -> None:
+        if len(a) != 2:
+            raise ModelError("a tabulated cell shear (CellShear) needs a 2D or axisymmetric interface frame "
+                             f"(one tangent); this frame has {len(a) - 1}")
+
+
+#: the friction laws (kept as the name the callers annotate with)
+Tangential = TangentialLaw
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -351,7 +612,7 @@ class InterfaceLaw:
     @property
     def quadratic(self) -> bool:
         """True when the energy is quadratic (one linear solve suffices)."""
-        return isinstance(self.normal, LinearLaw) and self.friction is None
+        return self.normal.quadratic and self.friction is None
 
     @property
     def holds_tangentially(self) -> bool:
@@ -363,9 +624,7 @@ class InterfaceLaw:
         """
         if self.friction is not None:
             return True
-        if isinstance(self.normal, TabulatedLaw):
-            return self.normal.kt > 0
-        return bool(self.normal.matrix(2)[1, 1] > 0)
+        return self.normal.holds_tangentially
 
 
 def normal_law(law: str, *, kn=None, kt: float = 0.0, knt: float = 0.0, gap_force=(0.0, 0.0),

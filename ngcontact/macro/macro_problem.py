@@ -291,7 +291,7 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
                                           frozen=frozen_tresca(problem, fes, frame, gfu, split=True), **newton)],
                 "widths": []}
     except ConvergenceError as err:
-        if not isinstance(friction, il.Friction):   # a tabulated cell shear has no Huber width to continue in
+        if not friction.huber_regularized:   # a tabulated cell shear has no Huber width to continue in
             raise
         log.info("coupled Newton at the scene's Huber width failed (%s); continuation in the width", err)
         gfu.vec.data = start
@@ -301,7 +301,7 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
     width = friction.width
 
     def solve_at(w: float, last: bool) -> dict:
-        at = replace(problem, law=replace(law, friction=replace(friction, width=w)))
+        at = replace(problem, law=replace(law, friction=friction.with_width(w)))
         opts = newton if last else {**newton, "rtol": INTERMEDIATE_RTOL, "atol": 0.0}
         return coupled_newton(macro_energy(at, fes, frame, coupled=True, split=True), gfu,
                               frozen=frozen_tresca(at, fes, frame, gfu, split=True), **opts)
