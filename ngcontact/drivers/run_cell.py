@@ -22,7 +22,9 @@ from __future__ import annotations
 import logging
 from typing import Any
 
+from ngcontact.cell import admissibility
 from ngcontact.cell.cell_solver import Refinement
+from ngcontact.errors import ConvergenceError
 from ngcontact.drivers import cell_members
 from ngcontact.drivers.build import cell_loads, cell_solver
 from ngcontact.output import plots as figures
@@ -51,6 +53,21 @@ def surface_plots(sols, dim: int, period: float) -> dict:
         maps = [s.fields["pressure"] for s in sols]
         plots["pressure_map"] = lambda path, m=maps: figures.pressure_map(path, m, period)
     return plots
+
+
+def accuracy_verdict(per_load: list[dict], tolerance: float | None) -> dict:
+    """The sweep's verdict (:mod:`ngcontact.cell.admissibility`): each failed check is one warning line;
+    a plainly wrong answer is no answer (exit 3)."""
+    verdict, failed = admissibility.verdict(per_load, tolerance)
+    wrong = [c for c in failed if c.plainly_wrong]
+    if wrong:
+        raise ConvergenceError(
+            f"the cell's answer contradicts its own load: {wrong[0].message()}; the interface is not resolved "
+            "(a contact patch narrower than the elements): refine the interface mesh, use contact.enforcement = "
+            "'exact', or discretization.method = 'spectral' for a small-slope cell", {"checks": verdict["checks"]})
+    for c in failed:
+        log.warning("accuracy not met: %s", c.message())
+    return verdict
 
 
 def run(scene, clock) -> Outcome:
@@ -90,6 +107,7 @@ def run(scene, clock) -> Outcome:
             arrays[f"{name}_load{k}"] = values
         log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
     results["loads"] = per_load
+    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance)
     vtk = {}
     displaced = cell.displacements()
     if displaced is not None:

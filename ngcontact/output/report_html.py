@@ -360,6 +360,16 @@ def csv_table(directory: str, name: str) -> str:
 
 
 # ------------------------------------------------------------------ the page
+def accuracy_warnings(report: dict) -> list[str]:
+    """One line per failed check of the report's accuracy verdict (``results.accuracy``), for the page's top."""
+    acc = _get(report, "results.accuracy") or {}
+    if not isinstance(acc, dict) or acc.get("met", True):
+        return []
+    return [f"Accuracy not met (tolerance {fmt(acc.get('tolerance'))}): load {c.get('load')}, {c.get('name')} = "
+            f"{fmt(c.get('value'))} > {fmt(c.get('limit'))}" for c in acc.get("checks", [])
+            if isinstance(c, dict) and not c.get("ok", True)]
+
+
 def render(report: dict, directory: str, names: list[str]) -> str:
     """The page of ``report``; ``names`` are the run's files in ``directory`` (PNGs embedded, CSVs tabulated)."""
     title = report.get("title") or "(untitled scene)"
@@ -367,7 +377,7 @@ def render(report: dict, directory: str, names: list[str]) -> str:
     pngs = sorted(n for n in names if n.endswith(".png"))
     csvs = sorted(n for n in names if n.endswith(".csv"))
     effects = "".join(f'<span class="chip">{_e(e)}</span>' for e in report.get("effects", []))
-    warnings = _get(report, "results.warnings") or []
+    warnings = list(_get(report, "results.warnings") or []) + accuracy_warnings(report)
     parts = [
         f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>{_e(title)}</title>'
         f"<style>{CSS}</style></head><body>",

@@ -226,6 +226,26 @@ def equilibrium_error(problem, far_face_traction: np.ndarray) -> float:
     return float(np.linalg.norm(F + t)) / scale if scale > 0 else 0.0
 
 
+def pressure_balance(problem, far_face_traction: np.ndarray) -> float:
+    """``|F_h + t| / max(|t|, A_h)``: the interface force integrated accurately (the kink rule, not the
+    energy's) against the far-face traction.
+
+    The energy's quadrature sees the penalty's pressure at its points only: a contact patch narrower than
+    those points' spacing penetrates between them unseen, the discrete force balances the load
+    (:func:`equilibrium_error`) and the pressure field does not.  Its accurate integral then misses the load
+    by the share of the pressure the energy did not see, which is what this measures (exact enforcement: the
+    multiplier's rule is the force's own, and the two coincide).
+    """
+    if problem.multiplier is not None:
+        return equilibrium_error(problem, far_face_traction)
+    tr = interface_traction(problem)
+    F = np.array(contact_integral(problem, tr), float).ravel() / problem.area
+    A = float(contact_integral(problem, ng.sqrt(ng.InnerProduct(tr, tr)))) / problem.area
+    t = np.asarray(far_face_traction, float)
+    scale = max(float(np.linalg.norm(t)), A)
+    return float(np.linalg.norm(F + t)) / scale if scale > 0 else 0.0
+
+
 def mean_jump(problem) -> np.ndarray:
     """Projected mean of the jump on ``S_C``: ``(1/|T|) int J |n.n0| ds``."""
     n, d = problem.n, problem.dim
@@ -337,6 +357,7 @@ def measure(problem, load: CellLoad) -> dict:
         "mean_traction": t.tolist(),
         "transmitted_pressure": float(-t[d - 1]),
         "equilibrium_error": imbalance,
+        "pressure_balance": pressure_balance(problem, t),
         "mean_jump": jbar.tolist(),
         "mean_closure": float(jbar[d - 1]),
         "far_face_jump": (-Uv).tolist(),

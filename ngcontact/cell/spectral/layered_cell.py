@@ -210,6 +210,8 @@ class SpectralCell:
             "mean_traction": [-v for v in qbar] + [-pbar],
             "transmitted_pressure": pbar,
             "equilibrium_error": abs(pbar - (-tn)) / (-tn) if tn is not None else 0.0,
+            # the grid's pressure is the field itself: its mean is the force the report integrates
+            "pressure_balance": abs(pbar - (-tn)) / (-tn) if tn is not None else 0.0,
             "mean_jump": [float(c.mean()) for c in state["slip"]] + [mean_closure],
             "mean_closure": mean_closure,
             "far_face_jump": list(state["far_face_jump"]),

@@ -1,0 +1,96 @@
+"""The verdict of a cell's answer (:mod:`ngcontact.cell.admissibility`): a converged solve whose pressure
+field misses its own load is not reported as met, and one that misses it by the load's size is no answer.
+
+The case: Westergaard's sinusoidal gap made 100 times deeper than the shipped scene's, on the same mesh.  The
+contact patch at the lightest load is then narrower than the interface elements, the energy's quadrature
+sees only part of it, and the accurately integrated pressure exceeds the load by a few per cent while the
+discrete balance holds to round-off.
+"""
+import json
+import os
+
+import pytest
+
+from ngcontact import cli
+from ngcontact.cell import admissibility
+from ngcontact.cell.admissibility import DEFAULT_TOLERANCE, PLAINLY_WRONG, verdict
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SHIPPED = os.path.join(ROOT, "geometries", "cells", "westergaard.toml")
+
+
+def _sinusoid(tmp_path, h: float):
+    text = open(SHIPPED, encoding="utf-8").read()
+    text = text.replace("gap = { kind = \"sinusoid\", h = 0.01 }", f"gap = {{ kind = \"sinusoid\", h = {h!r} }}")
+    text = "\n".join("pressure = [0.00863075]" if line.startswith("pressure = [") else line
+                     for line in text.splitlines())
+    path = tmp_path / f"sinusoid_{h:g}.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _run(tmp_path, path, capsys):
+    out = tmp_path / "out"
+    code = cli.main(["run", str(path), "--out", str(out), "--quiet"])
+    err = capsys.readouterr().err
+    report = json.loads((out / "report.json").read_text()) if (out / "report.json").exists() else None
+    return code, err, report
+
+
+def test_the_verdict_of_synthetic_results():
+    good = {"pressure_balance": 1e-6}
+    off = {"pressure_balance": 0.03}
+    v, failed = verdict([good, off], None)
+    assert v["tolerance"] == DEFAULT_TOLERANCE and v["tolerance_from"] == "default" and not v["met"]
+    assert [c.load for c in failed] == [1] and not failed[0].plainly_wrong
+    assert "load 1: pressure_balance = 0.03 exceeds 0.01" in failed[0].message()
+    v, failed = verdict([good, off], 0.05)
+    assert v["met"] and not failed and v["tolerance_from"] == "scene"
+    _, failed = verdict([{"pressure_balance": 19.0}], None)     # the pressure 20 times the load
+    assert failed[0].plainly_wrong and PLAINLY_WRONG < 19.0
+    assert verdict([{}], None)[0]["checks"] == []                # nothing to check: nothing claimed
+
+
+def test_a_resolved_patch_meets_the_default_accuracy(tmp_path, capsys):
+    code, err, report = _run(tmp_path, _sinusoid(tmp_path, 0.01), capsys)
+    assert code == 0
+    acc = report["results"]["accuracy"]
+    assert acc["met"] and acc["checks"][0]["value"] < 1e-3
+
+
+def test_a_patch_narrower_than_the_elements_is_not_reported_as_met(tmp_path, capsys, caplog):
+    """Before the verdict this run ended with exit 0 and nothing said; its pressure field carries 3 % more
+    than its load."""
+    code, err, report = _run(tmp_path, _sinusoid(tmp_path, 100.0), capsys)
+    assert code == 0
+    acc = report["results"]["accuracy"]
+    assert not acc["met"] and 0.01 < acc["checks"][0]["value"] < PLAINLY_WRONG
+    lines = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert sum(m.startswith("accuracy not met: load 0: pressure_balance") for m in lines) == 1, lines
+
+
+def test_an_answer_that_contradicts_its_load_is_no_answer(tmp_path, capsys, monkeypatch):
+    """The same run with the 'plainly wrong' limit below its imbalance: exit 3, one line, nothing written."""
+    monkeypatch.setattr(admissibility, "PLAINLY_WRONG", 0.02)
+    code, err, report = _run(tmp_path, _sinusoid(tmp_path, 100.0), capsys)
+    assert code == 3 and report is None and not (tmp_path / "out").exists()
+    assert "contradicts its own load" in err and "refine the interface mesh" in err
+
+
+@pytest.mark.parametrize("name", ["westergaard_spectral"])
+def test_the_spectral_cell_carries_the_same_verdict(tmp_path, capsys, name):
+    code, err, report = _run(tmp_path, os.path.join(ROOT, "geometries", "cells", f"{name}.toml"), capsys)
+    assert code == 0
+    acc = report["results"]["accuracy"]
+    assert acc["met"] and len(acc["checks"]) == len(report["results"]["loads"])
+
+
+def test_the_page_shows_a_missed_accuracy_at_its_top():
+    from ngcontact.output.report_html import render
+    report = {"title": "t", "results": {"accuracy": {"tolerance": 0.01, "met": False, "checks": [
+        {"load": 0, "name": "pressure_balance", "value": 0.03, "limit": 0.01, "ok": False}]}}}
+    page = render(report, ".", [])
+    top = page.split("<h2>")[0]
+    assert '<p class="warn">Accuracy not met (tolerance 0.01): load 0, pressure_balance = 0.03 &gt; 0.01</p>' in top
+    report["results"]["accuracy"]["met"] = True
+    assert "Accuracy not met" not in render(report, ".", [])
