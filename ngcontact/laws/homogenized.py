@@ -514,8 +514,8 @@ class CellShear(TangentialLaw):
             raise ModelError("pressure must be >= 2 strictly increasing values starting at 0")
         if len(self.jumps) != len(p) or len(self.shears) != len(p):
             raise ModelError(f"jumps and shears need one row per pressure ({len(p)})")
-        for i, (s, t) in enumerate(zip(self.jumps, self.shears)):
-            s, t = np.asarray(s, float), np.asarray(t, float)
+        for i, (row_s, row_t) in enumerate(zip(self.jumps, self.shears)):
+            s, t = np.asarray(row_s, float), np.asarray(row_t, float)
             if s.ndim != 1 or len(s) < 2 or len(t) != len(s) or s[0] != 0.0 or np.any(np.diff(s) <= 0):
                 raise ModelError(f"row {i}: jumps must be >= 2 strictly increasing values from 0, one shear each")
             if t[0] != 0.0 or not np.all(np.isfinite(t)):
