@@ -21,7 +21,7 @@ from ngcontact.errors import SceneError
 from ngcontact.fem import materials
 from ngcontact.fem.interpolants import periodic_table_1d
 from ngcontact.laws import homogenized as il
-from ngcontact.laws.penalty import Friction
+from ngcontact.laws.friction import FRICTION_LAWS, FrictionLaw
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.cell.spectral_cell import Layer, SpectralCell
 from ngcontact.scene.cell_geometry import GAP_PROFILES, profile_2d, small_slope
@@ -159,10 +159,11 @@ def friction_from_cell(path: str, *, width: float, overrides: dict | None = None
     """
     cell_scene = cell_scene_of(path, key="interface.friction", overrides=overrides)
     c = cell_scene.contact
-    if c.friction == "none":
+    micro = micro_friction(c)
+    if micro is None:
         raise SceneError("interface.friction", "from_cell", f"the cell {path!r} has no friction")
     arrays, _ = cell_bundle_arrays(cell_scene, cache_dir)
-    values = cell_law.friction_from_bundle(arrays, k_n=c.k_n, law=c.friction, mu=c.mu or 0.0, G=c.G or 0.0)
+    values = cell_law.friction_from_bundle(arrays, k_n=c.k_n, friction=micro)
     info = {"source": "cell", "cell_scene": os.path.abspath(path), "micro_friction": c.friction,
             "micro_mu": c.mu, "micro_G": c.G, "mu0": values["mu0"], "G0": values["G0"], "huber_width": width,
             "equations": "paper eqs. 42-43", "cell_overrides": dict(overrides or {})}
@@ -382,13 +383,16 @@ def _explicit_gap(scene, xy=None):
     return ng.VoxelCoefficient((0.0, 0.0), (P, P), np.ascontiguousarray(g), linear=True)
 
 
-def micro_friction(contact) -> Friction | None:
-    """The micro friction of a cell scene's ``[contact]`` section (``None`` without friction)."""
-    if contact.friction == "tresca":
-        return Friction("tresca", w=contact.w, G=contact.G)
-    if contact.friction == "coulomb":
-        return Friction("coulomb", w=contact.w, mu=contact.mu)
-    return None
+def micro_friction(contact) -> FrictionLaw | None:
+    """The micro friction of a cell scene's ``[contact]`` section (``None`` without friction).
+
+    The law's class from :data:`ngcontact.laws.friction.FRICTION_LAWS` by the scene's name, built from
+    the section's values of its ``parameters``.
+    """
+    if contact.friction == "none":
+        return None
+    law = FRICTION_LAWS[contact.friction]
+    return law(**{key: getattr(contact, key) for key in law.parameters})
 
 
 def model_of(scene) -> CellModel:

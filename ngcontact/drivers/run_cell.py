@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 
 
-from ngcontact.drivers.build import (build_cell, cell_loads, cell_problem, gap_cf, model_of, predictor_twin,
-                                    spectral_cell)
+from ngcontact.drivers.build import (build_cell, cell_loads, cell_problem, gap_cf, micro_friction, model_of,
+                                    predictor_twin, spectral_cell)
 from ngcontact.cell.edge_grading import (LEVELS_PER_STEP, MAX_STEPS, RATIO, GradedSolve, graded_flat_cell,
                                         solve_to_tolerance)
 from ngcontact.cell.spectral_predictor import twin_edges
@@ -145,7 +145,8 @@ def run(scene, clock) -> Outcome:
     with clock.stage("mesh"):
         cell = build_cell(scene)
     c = scene.contact
-    G = c.G if c.friction == "tresca" else None
+    friction = micro_friction(c)
+    G = None if friction is None or friction.couples_to_pressure else friction.threshold(None)
     with clock.stage("whole-surface coefficients"):
         whole = coefficients(cell, kn=c.k_n, gap=gap_cf(scene), G=G).as_dict()
     results: dict[str, Any] = {"whole_surface": whole}
