@@ -181,10 +181,10 @@ def peak_memory_gb() -> float:
 
 def dissimilar_child(friction: bool) -> None:
     """Part 3 in this (child) process: print its row as JSON."""
-    from ngcontact.laws.penalty import Friction
+    from ngcontact.laws.friction import Coulomb
     n = FRICTION_GRID if friction else FINEST
     z = surface(n)
-    fr = Friction("coulomb", w=1e-6, mu=MU) if friction else None
+    fr = Coulomb(w=1e-6, mu=MU) if friction else None
     row, _ = ours(z, rough=Layer(1.0, 0.3, 0.5), counter=Layer(3.0, 0.25, 0.3), friction=fr,
                   shear=(SHEAR * PRESSURE, 0.0) if friction else None)
     row.update(part="dissimilar", setting=f"{n}^2, E 1 / 3, h 0.5 / 0.3, exact" + (

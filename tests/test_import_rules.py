@@ -25,9 +25,10 @@ ALLOWED: dict[str, set[str]] = {
     # NGSolve's and Netgen's C++ output kept off the terminal, for the rooms that call them
     "quiet": set(),
     # validation at load time uses the values' own admissibility rules (an
-    # SPD Voigt matrix, a PSD K0, the component names of a setting); the
-    # objects the model solves with are built in drivers/build.py
-    "scene": {"errors", "geometry", "fem.materials", "fem.elasticity", "laws.homogenized"},
+    # SPD Voigt matrix, a PSD K0, the component names of a setting) and the
+    # friction laws' registry (their names and parameter keys); the objects
+    # the model solves with are built in drivers/build.py
+    "scene": {"errors", "geometry", "fem.materials", "fem.elasticity", "laws.homogenized", "laws.friction"},
     "geometry": {"errors", "quiet"},
     "fem": {"errors", "quiet"},
     "laws": {"errors"},

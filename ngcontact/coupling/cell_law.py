@@ -44,6 +44,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ngcontact.laws import homogenized as il
+from ngcontact.laws.friction import FrictionLaw
 
 log = logging.getLogger(__name__)
 
@@ -170,8 +171,7 @@ def bundle_law(arrays: dict, *, dim: int, length_unit: float = 1.0) -> il.Bundle
     return law.merged()
 
 
-def friction_from_bundle(arrays: dict, *, k_n: float, law: str, mu: float = 0.0, G: float = 0.0
-                         ) -> dict[str, float]:
+def friction_from_bundle(arrays: dict, *, k_n: float, friction: FrictionLaw) -> dict[str, float]:
     """Homogenized friction ``mu0``, ``G0`` of a cell's contact surface (paper eqs. 42-43).
 
     With the bundle's weights ``w_q = k_n ds_q / |T|`` and micro normals
@@ -202,18 +202,21 @@ def friction_from_bundle(arrays: dict, *, k_n: float, law: str, mu: float = 0.0,
     directions, takes the cell's tabulated shear instead
     (:mod:`ngcontact.coupling.shear_table`; ``scripts/sawtooth_shear.py``).  With two macro tangents (a 3D
     cell) the larger value is taken, the macro friction being isotropic.
-    Returns ``{"mu0", "G0"}``.
+    A micro law's threshold is taken in its affine parts ``G + mu p``
+    (:meth:`ngcontact.laws.friction.FrictionLaw.affine_parts`: ``G`` for
+    Tresca, ``mu`` for Coulomb); ``mu0`` is computed for a law that
+    couples to the pressure only.  Returns ``{"mu0", "G0"}``.
     """
     w = np.asarray(arrays["w"], float)
     n = np.asarray(arrays["n"], float)
     beta = n[:, 0]
     proj = [np.sqrt(np.clip(1.0 - n[:, j] ** 2, 0.0, None)) for j in range(1, n.shape[1])]
-    if law == "tresca":
-        return {"mu0": 0.0, "G0": float(max(np.sum(w / k_n * G * p) for p in proj))}
-    if law == "coulomb":
-        up = beta > 0
-        den = float(np.sum(w[up] * beta[up] ** 2))
-        if not den > 0:
-            raise ValueError("the cell's contact surface has no direction facing the counter body")
-        return {"mu0": float(max(mu * np.sum(w[up] * beta[up] * p[up]) / den for p in proj)), "G0": 0.0}
-    raise ValueError(f"micro friction {law!r}: must be 'tresca' or 'coulomb'")
+    G, mu = friction.affine_parts()
+    G0 = float(max(np.sum(w / k_n * G * p) for p in proj))
+    if not friction.couples_to_pressure:
+        return {"mu0": 0.0, "G0": G0}
+    up = beta > 0
+    den = float(np.sum(w[up] * beta[up] ** 2))
+    if not den > 0:
+        raise ValueError("the cell's contact surface has no direction facing the counter body")
+    return {"mu0": float(max(mu * np.sum(w[up] * beta[up] * p[up]) / den for p in proj)), "G0": G0}

@@ -28,7 +28,7 @@ from ngcontact.errors import SceneError
 from ngcontact.fem import materials
 from ngcontact.fem.interpolants import periodic_table_1d
 from ngcontact.laws import homogenized as il
-from ngcontact.laws.penalty import Friction
+from ngcontact.laws.friction import FRICTION_LAWS, FrictionLaw
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral_start import SpectralStart
@@ -167,10 +167,11 @@ def friction_from_cell(path: str, *, width: float, overrides: dict | None = None
     """
     cell_scene = cell_scene_of(path, key="interface.friction", overrides=overrides)
     c = cell_scene.contact
-    if c.friction == "none":
+    micro = micro_friction(c)
+    if micro is None:
         raise SceneError("interface.friction", "from_cell", f"the cell {path!r} has no friction")
     arrays, _ = cell_bundle_arrays(cell_scene, cache_dir)
-    values = cell_law.friction_from_bundle(arrays, k_n=c.k_n, law=c.friction, mu=c.mu or 0.0, G=c.G or 0.0)
+    values = cell_law.friction_from_bundle(arrays, k_n=c.k_n, friction=micro)
     info = {"source": "cell", "cell_scene": os.path.abspath(path), "micro_friction": c.friction,
             "micro_mu": c.mu, "micro_G": c.G, "mu0": values["mu0"], "G0": values["G0"], "huber_width": width,
             "equations": "paper eqs. 42-43", "cell_overrides": dict(overrides or {})}
@@ -232,7 +233,7 @@ def fe_cell(scene: CellScene) -> FECell:
     ``discretization.tolerance`` on a flat 2D cell, the graded meshes and the fine spectral predictor that
     seeds them (:mod:`ngcontact.cell.fe.edge_grading`)."""
     cell, model = build_cell(scene), model_of(scene)
-    c, d = scene.contact, scene.discretization
+    d = scene.discretization
     graded = h0 = predictor = None
     if d.tolerance is not None:
         g = scene.geometry
@@ -244,8 +245,10 @@ def fe_cell(scene: CellScene) -> FECell:
             mesh = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
                                     vertices=vertices)
             return cell_problem(scene, mesh, replace(model, order=order), predictor=predictor)
-    return FECell(cell, model, lambda: cell_problem(scene, cell, model),
-                  threshold=c.G if c.friction == "tresca" else None, graded=graded, h0=h0, predictor=predictor)
+    friction = model.friction            # the whole surface's eqs. 42-43 take a threshold fixed in advance
+    threshold = None if friction is None or friction.couples_to_pressure else friction.threshold(None)
+    return FECell(cell, model, lambda: cell_problem(scene, cell, model), threshold=threshold, graded=graded,
+                  h0=h0, predictor=predictor)
 
 
 def spectral_cell_solver(scene: CellScene) -> SpectralCellSolver:
@@ -431,13 +434,16 @@ def _explicit_gap(scene, xy=None):
     return ng.VoxelCoefficient((0.0, 0.0), (P, P), np.ascontiguousarray(g), linear=True)
 
 
-def micro_friction(contact) -> Friction | None:
-    """The micro friction of a cell scene's ``[contact]`` section (``None`` without friction)."""
-    if contact.friction == "tresca":
-        return Friction("tresca", w=contact.w, G=contact.G)
-    if contact.friction == "coulomb":
-        return Friction("coulomb", w=contact.w, mu=contact.mu)
-    return None
+def micro_friction(contact) -> FrictionLaw | None:
+    """The micro friction of a cell scene's ``[contact]`` section (``None`` without friction).
+
+    The law's class from :data:`ngcontact.laws.friction.FRICTION_LAWS` by the scene's name, built from
+    the section's values of its ``parameters``.
+    """
+    if contact.friction == "none":
+        return None
+    law = FRICTION_LAWS[contact.friction]
+    return law(**{key: getattr(contact, key) for key in law.parameters})
 
 
 def model_of(scene) -> CellModel:

@@ -31,8 +31,9 @@ energy of the bodies is the integral over ``S_C`` of
   is solved as a fixed point of Tresca problems (see :mod:`ngcontact.cell.fe.cell_problem`):
   the threshold is ``mu`` times the pressure of the *previous* iterate,
   evaluated exactly at the quadrature points from a frozen copy of that
-  iterate (:func:`coulomb_threshold`), and the iteration stops when the
-  pressure changes by less than a tolerance relative to its maximum.
+  iterate (:class:`ngcontact.laws.friction.Coulomb`), and the iteration
+  stops when the pressure changes by less than a tolerance relative to its
+  maximum.
 
 * exact non-penetration by an augmented Lagrangian (the rigid limit
   ``k_n -> infinity`` of the Winkler layer; not in the paper, DESIGN 7a):
@@ -50,42 +51,16 @@ energy of the bodies is the integral over ``S_C`` of
   only makes the energy vanish where the surfaces are open.
 
 Only the terms a problem asks for are added: a frictionless problem
-assembles no friction term, a problem without gap no gap.
+assembles no friction term, a problem without gap no gap.  The friction
+laws themselves (threshold, coupling to the pressure, which of these
+densities they use) are the classes of :mod:`ngcontact.laws.friction`.
 """
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import ngsolve as ng
 
 from ngcontact.laws.huber import huber, huber_of_square, huber_slope  # noqa: F401  (huber: the micro law's API)
 from ngcontact.errors import ModelError
-
-
-@dataclass(frozen=True)
-class Friction:
-    """Micro friction: ``"tresca"`` with threshold ``G`` or ``"coulomb"`` with ``mu`` (``G = mu p``); Huber width ``w``.
-
-    The one description of friction on ``S_C`` for the cell and the resolved
-    problems (paper eqs. 9, 16-17); the homogenized law has its own
-    (:class:`ngcontact.laws.homogenized.Friction`, eqs. 42-43).
-    """
-
-    law: str
-    w: float
-    G: float | None = None
-    mu: float | None = None
-
-    def __post_init__(self):
-        if self.law not in ("tresca", "coulomb"):
-            raise ModelError(f"friction law {self.law!r}: must be 'tresca' or 'coulomb'")
-        if not self.w > 0:
-            raise ModelError(f"friction width w = {self.w!r}: must be > 0")
-        if self.law == "tresca" and (self.G is None or self.G < 0):
-            raise ModelError(f"Tresca threshold G = {self.G!r}: must be >= 0")
-        if self.law == "coulomb" and (self.mu is None or self.mu < 0):
-            raise ModelError(f"Coulomb coefficient mu = {self.mu!r}: must be >= 0")
-
 
 
 def positive_part(s):
@@ -159,17 +134,7 @@ def friction_traction(J, n, G, w):
     return G * Jt / ng.sqrt(ng.IfPos(s2 - w * w, s2, w * w))
 
 
-def coulomb_threshold(J_previous, n, k_n, mu, gap=None):
-    """Coulomb threshold ``G = mu p`` from the pressure of a frozen previous state.
-
-    ``J_previous`` must be built from GridFunctions that are not the unknown
-    (a copy of the previous iterate), so that ``G`` is data for the Tresca
-    problem of the next fixed-point step.
-    """
-    return mu * pressure(J_previous, n, k_n, gap)
-
-
-def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=None, multiplier=None):
+def interface_energy(J, n, *, k_n, gap=None, friction=None, threshold=None, multiplier=None):
     """Total interface energy density of the terms asked for.
 
     Parameters
@@ -183,8 +148,10 @@ def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=No
     gap
         Initial gap ``g`` or ``None`` (no gap term).
     friction
-        ``None`` (frictionless), ``"tresca"`` or ``"coulomb"``; both friction
-        laws use ``threshold`` (``G``, or ``mu p_previous``) and ``w``.
+        ``None`` (frictionless) or a friction law
+        (:class:`ngcontact.laws.friction.FrictionLaw`), whose energy
+        ``G huber(|J_t|, w)`` takes ``threshold`` as ``G`` (its
+        ``threshold`` of a given pressure, e.g. ``mu p_previous``).
     multiplier
         ``None``: the penalty :func:`normal_energy`; a contact multiplier
         ``lambda`` (held fixed): the augmented energy
@@ -194,23 +161,21 @@ def interface_energy(J, n, *, k_n, gap=None, friction=None, w=None, threshold=No
         energy = normal_energy(J, n, k_n, gap)
     else:
         energy = augmented_normal_energy(J, n, k_n, multiplier, gap)
-    if not _has_friction(friction, w, threshold):
+    if not _has_friction(friction, threshold):
         return energy
-    return energy + tresca_energy(J, n, threshold, w)
+    return energy + friction.energy(J, n, threshold)
 
 
-def _has_friction(friction, w, threshold) -> bool:
-    """Whether the interface terms include friction; raises on an unknown law or missing parameters."""
+def _has_friction(friction, threshold) -> bool:
+    """Whether the interface terms include friction; raises on a friction law without a threshold."""
     if friction is None:
         return False
-    if friction not in ("tresca", "coulomb"):
-        raise ModelError(f"friction = {friction!r}: must be None, 'tresca' or 'coulomb'")
-    if w is None or threshold is None:
-        raise ModelError("friction needs a width w and a threshold")
+    if threshold is None:
+        raise ModelError(f"friction {friction.name!r} needs a threshold")
     return True
 
 
-def interface_stiffness(J, n, dJ, dJv, *, k_n, gap=None, friction=None, w=None, threshold=None, multiplier=None):
+def interface_stiffness(J, n, dJ, dJv, *, k_n, gap=None, friction=None, threshold=None, multiplier=None):
     """The second variation of :func:`interface_energy` at the jump ``J``, bilinear in ``dJ`` and ``dJv``:
 
         d2 psi(J)[dJ, dJv] = k H(s) (dJ.n)(dJv.n)
@@ -232,12 +197,23 @@ def interface_stiffness(J, n, dJ, dJv, *, k_n, gap=None, friction=None, w=None, 
     if multiplier is not None:
         s = multiplier + k_n * s
     stiffness = k_n * ng.IfPos(-s, 0.0, 1.0) * ng.InnerProduct(dJ, n) * ng.InnerProduct(dJv, n)
-    if not _has_friction(friction, w, threshold):
+    if not _has_friction(friction, threshold):
         return stiffness
+    return stiffness + friction.stiffness(J, n, dJ, dJv, threshold)
+
+
+def friction_stiffness(J, n, dJ, dJv, G, w):
+    """The second variation of :func:`tresca_energy` at ``J`` (``G`` fixed), bilinear in ``dJ`` and ``dJv``:
+
+        G ( P dJ . P dJv / m  -  [|J_t| > w] (J_t.dJ)(J_t.dJv) / |J_t|^3 ),
+
+    ``P = I - n n`` and ``m = max(|J_t|, w)`` (paper eqs. 16-17; the friction
+    part of :func:`interface_stiffness`).
+    """
     Jt = tangential_slip(J, n)
     s2 = ng.InnerProduct(Jt, Jt)
     slope = huber_slope(s2, w)
     sliding = ng.IfPos(s2 - w * w, slope * slope * slope, 0.0)
     tangential = (slope * ng.InnerProduct(tangential_slip(dJ, n), tangential_slip(dJv, n))
                   - sliding * ng.InnerProduct(Jt, dJ) * ng.InnerProduct(Jt, dJv))
-    return stiffness + threshold * tangential
+    return G * tangential

@@ -45,7 +45,7 @@ import numpy as np
 from ngcontact.laws import penalty as _contact
 from ngcontact.fem import elasticity
 from ngcontact.fem import two_body
-from ngcontact.laws.penalty import Friction
+from ngcontact.laws.friction import FrictionLaw
 from ngcontact.fem.quadrature import kink_order, resultant_order, sampling_order
 from ngcontact.fem.sampling import boundary_values
 from ngcontact.fem.materials import ElasticLaw
@@ -76,7 +76,7 @@ class DirectProblem:
     gap
         Initial micro gap ``g >= 0`` (number or CoefficientFunction) or ``None``.
     friction
-        :class:`Friction` or ``None`` (frictionless).
+        :class:`~ngcontact.laws.friction.FrictionLaw` or ``None`` (frictionless).
     supports, loads
         Boundary conditions.
     order
@@ -94,7 +94,7 @@ class DirectProblem:
     k_n: float
     setting: str = "plane_strain"
     gap: float | ng.CoefficientFunction | None = None
-    friction: Friction | None = None
+    friction: FrictionLaw | None = None
     supports: tuple[Support, ...] = ()
     loads: tuple[Load, ...] = ()
     order: int = 2
@@ -146,9 +146,7 @@ def _form(problem: DirectProblem, fes, n, *, threshold=None, surrogate: bool = F
             Jt = _contact.tangential_slip(J, n)
             psi = psi + 0.5 * k_n * ng.InnerProduct(Jt, Jt)
     else:
-        psi = _contact.interface_energy(J, n, k_n=k_n, gap=problem.gap,
-                                        friction=None if fr is None else fr.law,
-                                        w=None if fr is None else fr.w, threshold=threshold)
+        psi = _contact.interface_energy(J, n, k_n=k_n, gap=problem.gap, friction=fr, threshold=threshold)
     form += ng.Variation(psi * w * ng.ds(definedon=mesh.Boundaries(problem.contact)))
     return two_body.add_load_potential(form, mesh, problem.loads, (ur, uc), w)
 
@@ -203,12 +201,12 @@ def solve(problem: DirectProblem, *, rtol: float = 1e-10, atol: float = 0.0, max
     ur, uc = gfu.components
     J = ur - uc
     fr = problem.friction
-    if fr is not None and fr.law == "coulomb":
+    if fr is not None and fr.couples_to_pressure:
         pressure = _contact.pressure(J, n, problem.k_n, problem.gap)
         _coulomb(problem, fes, gfu, n, pressure, newton, history)
     else:
         pressure = _contact.pressure(J, n, problem.k_n, problem.gap)
-        G = ng.CF(fr.G) if fr is not None else None
+        G = ng.CF(fr.threshold(None)) if fr is not None else None
         form = _form(problem, fes, n, threshold=G)
         history["newton"].append(minimize(form, gfu, line_search="exact", **newton).as_dict())
     history["newton_iterations"] = int(sum(h["iterations"] for h in history["newton"]))
@@ -218,11 +216,12 @@ def solve(problem: DirectProblem, *, rtol: float = 1e-10, atol: float = 0.0, max
 
 
 def _coulomb(problem, fes, gfu, n, pressure, newton, history) -> None:
-    """Coulomb friction: Tresca solves with ``G = mu p`` of the previous solution, to a fixed point."""
+    """Friction coupled to the pressure (Coulomb): solves with the threshold (``G = mu p``) of the previous
+    solution's pressure, to a fixed point."""
     mesh, fr = problem.mesh, problem.friction
     old = ng.GridFunction(fes)
     J_old = old.components[0] - old.components[1]
-    G = _contact.coulomb_threshold(J_old, n, problem.k_n, fr.mu, problem.gap)
+    G = fr.threshold(_contact.pressure(J_old, n, problem.k_n, problem.gap))
     form = _form(problem, fes, n, threshold=G)
 
     def freeze() -> None:

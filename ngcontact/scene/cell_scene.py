@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
+from ngcontact.laws.friction import FRICTION_LAWS
 from ngcontact.scene.cell_geometry import CellGeometry, check_features, check_profile_heights, small_slope
 from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
                                      check_material_names)
@@ -21,7 +22,8 @@ from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import at_least, check_selected, nonempty, nonnegative, param, positive
 
 GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
-FRICTION = ("none", "tresca", "coulomb")
+#: "none" and the names of the micro friction laws (:data:`ngcontact.laws.friction.FRICTION_LAWS`)
+FRICTION = ("none", *FRICTION_LAWS)
 ENFORCEMENTS = ("penalty", "exact")
 
 
@@ -72,7 +74,7 @@ class ContactSpec:
                                  "solve no contact problem")
 
     def check(self, path: str) -> None:
-        need = {"none": (), "tresca": ("G", "w"), "coulomb": ("mu", "w")}[self.friction]
+        need = () if self.friction == "none" else FRICTION_LAWS[self.friction].parameters
         check_selected(self, path, "friction", ("G", "mu", "w"), need)
 
 

@@ -36,6 +36,7 @@ from ngcontact.scene.macro_shapes import BOUNDARY_DOCS  # noqa: F401  (the kind'
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
 from ngcontact.scene import cell_links, mesh_size
+from ngcontact.scene.cell_scene import FRICTION
 from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
 
 LAWS = ("linear", "bundle", "tabulated", "file")
@@ -122,7 +123,7 @@ class InterfaceSpec:
     cell_k_n: float | None = param(None, doc="replaces contact.k_n of the cells the law comes from", units="Pa/m",
                                    check=positive())
     cell_friction: str | None = param(None, doc="replaces their contact.friction (with cell_mu or cell_G, "
-                                      "and cell_w)", choices=("none", "tresca", "coulomb"))
+                                      "and cell_w)", choices=FRICTION)
     cell_mu: float | None = param(None, doc="replaces their contact.mu", check=nonnegative())
     cell_G: float | None = param(None, doc="replaces their contact.G", units="Pa", check=nonnegative())
     cell_w: float | None = param(None, doc="replaces their contact.w (cell length units)", check=positive())

@@ -9,7 +9,7 @@ import pytest
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
-from ngcontact.laws.penalty import Friction
+from ngcontact.laws.friction import Coulomb, Tresca
 from ngcontact.cell.fe.measures import contact_fraction
 from ngcontact.cell.fe.stiffness import reference_stiffness
 from ngcontact.errors import ConvergenceError
@@ -89,7 +89,7 @@ def _friction_problem(cell, friction):
 @pytest.mark.parametrize("law", ["tresca", "coulomb"])
 def test_friction_stick_below_threshold(cell, law):
     p, w = 0.01, 1e-3
-    fr = Friction("tresca", w=w, G=0.3 * p) if law == "tresca" else Friction("coulomb", w=w, mu=0.3)
+    fr = Tresca(w=w, G=0.3 * p) if law == "tresca" else Coulomb(w=w, mu=0.3)
     G = 0.3 * p
     P = _friction_problem(cell, fr)
     (sol,) = P.sweep([cell_load(2, pressure=p, shear=(0.5 * G,))])
@@ -102,7 +102,7 @@ def test_friction_stick_below_threshold(cell, law):
 @pytest.mark.parametrize("law", ["tresca", "coulomb"])
 def test_friction_slide_beyond_threshold(cell, law):
     p, w = 0.01, 1e-3
-    fr = Friction("tresca", w=w, G=0.3 * p) if law == "tresca" else Friction("coulomb", w=w, mu=0.3)
+    fr = Tresca(w=w, G=0.3 * p) if law == "tresca" else Coulomb(w=w, mu=0.3)
     G = 0.3 * p
     P = _friction_problem(cell, fr)
     (sol,) = P.sweep([cell_load(2, pressure=p, tangential_jump=(-20 * w,))])
@@ -113,7 +113,7 @@ def test_friction_slide_beyond_threshold(cell, law):
 
 def test_traction_beyond_threshold_has_no_equilibrium(cell):
     p, w = 0.01, 1e-3
-    P = _friction_problem(cell, Friction("tresca", w=w, G=0.3 * p))
+    P = _friction_problem(cell, Tresca(w=w, G=0.3 * p))
     with pytest.raises(ConvergenceError):
         P.sweep([cell_load(2, pressure=p, shear=(0.5 * p,))])
 

@@ -82,10 +82,10 @@ def test_the_split_applies_only_where_the_penetration_is_a_polynomial_per_elemen
     enforcement or a curved mesh: the high rule everywhere."""
     from dataclasses import replace
 
-    from ngcontact.laws.penalty import Friction
+    from ngcontact.laws.friction import Tresca
     assert applies(_problem())
     model = model_of(SCENE)
-    for changed in (replace(model, friction=Friction("tresca", w=1e-4, G=0.01)),
+    for changed in (replace(model, friction=Tresca(w=1e-4, G=0.01)),
                     replace(model, interpolate_gap=False)):
         assert not applies(CellProblem(build_cell(SCENE, maxh=0.6, interface_maxh=0.25), changed))
     curved = build_cell(SCENE, maxh=0.6, interface_maxh=0.25)

@@ -365,20 +365,20 @@ def test_tresca_with_a_vanishing_threshold_is_the_frictionless_cell():
     x = np.arange(N) / N
     kw = dict(dim=2, period=1.0, grid=N, rough=Layer(1, 0.3, 1), counter=Layer(2, 0.25, 0.7),
               gap=0.02 * np.sin(np.pi * x) ** 2, k_n=1e3, enforcement="exact", tol=1e-10, max_iter=50000)
-    from ngcontact.laws.penalty import Friction
+    from ngcontact.laws.friction import Tresca
     a = SpectralCell(**kw).solve(cell_load(2, pressure=0.008))
-    b = SpectralCell(friction=Friction("tresca", w=1e-5, G=1e-14), **kw).solve(cell_load(2, pressure=0.008, shear=(0.0,)))
+    b = SpectralCell(friction=Tresca(w=1e-5, G=1e-14), **kw).solve(cell_load(2, pressure=0.008, shear=(0.0,)))
     assert np.allclose(a.fields["pressure"], b.fields["pressure"], rtol=0, atol=1e-7 * 0.008)
     assert b.results["far_face_jump"][-1] == pytest.approx(a.results["far_face_jump"][-1], rel=1e-8)
     assert b.results["mean_closure"] == pytest.approx(a.results["mean_closure"], rel=1e-8)
 
 
 def test_a_shear_beyond_the_friction_capacity_is_refused():
-    from ngcontact.laws.penalty import Friction
+    from ngcontact.laws.friction import Tresca
     N = 128
     x = np.arange(N) / N
     cell = SpectralCell(dim=2, period=1.0, grid=N, rough=Layer(1, 0.3, 1), counter=Layer(1, 0.3, 1),
-                        gap=0.02 * np.sin(np.pi * x) ** 2, k_n=1e3, friction=Friction("tresca", w=1e-5, G=1e-3))
+                        gap=0.02 * np.sin(np.pi * x) ** 2, k_n=1e3, friction=Tresca(w=1e-5, G=1e-3))
     with pytest.raises(ConvergenceError, match="cannot carry this load"):
         cell.solve(cell_load(2, pressure=0.008, shear=(2e-3,)))
 
@@ -386,12 +386,12 @@ def test_a_shear_beyond_the_friction_capacity_is_refused():
 def test_3d_shear_is_isotropic_on_the_bisinusoid():
     """Shear along x and along y on the symmetric bisinusoid (Tresca): the same answer, axes swapped."""
     from ngcontact.geometry.cell3d import bisinusoid_gap
-    from ngcontact.laws.penalty import Friction
+    from ngcontact.laws.friction import Tresca
     N = 64
     s = np.arange(N) / N
     g0 = bisinusoid_gap(0.005, 1.0, xy=(s[None, :], s[:, None]))
     cell = SpectralCell(dim=3, period=1.0, grid=N, rough=Layer(1, 0.3, 0.6), counter=Layer(2, 0.2, 0.6), gap=g0,
-                        k_n=1e3, enforcement="exact", friction=Friction("tresca", w=1e-5, G=0.004), tol=1e-10,
+                        k_n=1e3, enforcement="exact", friction=Tresca(w=1e-5, G=0.004), tol=1e-10,
                         max_iter=50000)
     a = cell.solve(cell_load(3, pressure=0.008, shear=(0.002, 0.0)))
     b = cell.solve(cell_load(3, pressure=0.008, shear=(0.0, 0.002)))

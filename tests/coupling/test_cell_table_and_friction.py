@@ -16,6 +16,7 @@ from ngcontact.errors import SceneError
 from ngcontact.fem.materials import isotropic
 from ngcontact.geometry import bodies as gm
 from ngcontact.laws import homogenized as il
+from ngcontact.laws.friction import Coulomb, Tresca
 from ngcontact.macro import macro_measures as MM
 from ngcontact.macro import macro_problem as M
 from ngcontact.scene.loader import from_dict, load
@@ -160,12 +161,12 @@ def test_homogenized_friction_of_a_flat_and_a_sawtooth_surface():
     ang = np.radians([0.0, 30.0, -60.0])
     n = np.column_stack([np.cos(ang), np.sin(ang)])
     arrays = {"w": k_n * ds / np.cos(ang), "n": n}      # faces of projected lengths ds over |T| = 1
-    f = cell_law.friction_from_bundle(arrays, k_n=k_n, law="coulomb", mu=0.4)
+    f = cell_law.friction_from_bundle(arrays, k_n=k_n, friction=Coulomb(mu=0.4, w=1e-3))
     assert f == pytest.approx({"mu0": 0.4, "G0": 0.0}, rel=1e-12)
-    f = cell_law.friction_from_bundle(arrays, k_n=k_n, law="tresca", G=7.0)
+    f = cell_law.friction_from_bundle(arrays, k_n=k_n, friction=Tresca(G=7.0, w=1e-3))
     assert f == pytest.approx({"mu0": 0.0, "G0": 7.0}, rel=1e-12)
     away = {"w": np.array([k_n, k_n]), "n": np.array([[1.0, 0.0], [-0.6, 0.8]])}
-    f = cell_law.friction_from_bundle(away, k_n=k_n, law="coulomb", mu=0.4)
+    f = cell_law.friction_from_bundle(away, k_n=k_n, friction=Coulomb(mu=0.4, w=1e-3))
     assert f["mu0"] == pytest.approx(0.4, rel=1e-12)   # the facing-away direction carries no pressure
 
 

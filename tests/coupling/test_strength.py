@@ -4,7 +4,7 @@ import pytest
 
 from ngcontact.coupling import strength as S
 from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
-from ngcontact.laws.penalty import Friction
+from ngcontact.laws.friction import Tresca
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
 from ngcontact.fem.materials import isotropic, tresca, von_mises
@@ -29,7 +29,7 @@ def test_linear_correctors_superpose_to_the_direct_cell_solution(case):
     """Pressure, shear (stick) and macro strain: eq. 75 against the nonlinear cell solve."""
     if case == "stick":
         # Tresca in its stick zone is the tangential spring G/w on S_C
-        k_t, fr, load = 40.0, Friction("tresca", w=0.05, G=2.0), [0.004, 0.02, -0.003]
+        k_t, fr, load = 40.0, Tresca(w=0.05, G=2.0), [0.004, 0.02, -0.003]
     else:
         k_t, fr, load = 0.0, None, [0.0, 0.02, 0.003]
     P = _summit_cell(fr)

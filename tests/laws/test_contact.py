@@ -12,7 +12,7 @@ import pytest
 
 from ngcontact.laws import penalty as contact
 from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
-from ngcontact.laws.penalty import Friction
+from ngcontact.laws.friction import Coulomb, Tresca
 from ngcontact.cell.fe.measures import sample_surface
 from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.fem.materials import isotropic
@@ -70,12 +70,12 @@ def test_normal_penalty_consistency():
 
 @pytest.mark.parametrize("slip", [0.3 * W, 5 * W], ids=["stick", "slip"])
 def test_tresca_consistency(slip):
-    _check(_problem(Friction("tresca", w=W, G=0.01)), np.random.default_rng(2), slip=slip)
+    _check(_problem(Tresca(w=W, G=0.01)), np.random.default_rng(2), slip=slip)
 
 
 @pytest.mark.parametrize("slip", [0.3 * W, 5 * W], ids=["stick", "slip"])
 def test_coulomb_consistency(slip):
-    P = _problem(Friction("coulomb", w=W, mu=0.3))
+    P = _problem(Coulomb(w=W, mu=0.3))
     rng = np.random.default_rng(3)
     _set_state(P, slip, rng)
     P.coulomb_previous.vec.data = P.gfu.vec   # frozen pressure of the previous iterate: positive
@@ -100,7 +100,7 @@ def test_no_friction_term_when_frictionless():
     e = contact.interface_energy(J, n, k_n=2.0)
     assert e(mesh(0.5, 0.5)) == pytest.approx(0.5 * 2.0 * 0.1 ** 2, rel=1e-15)
     with pytest.raises(ValueError):
-        contact.interface_energy(J, n, k_n=2.0, friction="tresca")
+        contact.interface_energy(J, n, k_n=2.0, friction=Tresca(w=W, G=0.01))    # no threshold
 
 
 @pytest.mark.parametrize("case", ["normal", "augmented", "tresca-stick", "tresca-slip", "augmented-tresca-slip"])
@@ -108,15 +108,15 @@ def test_interface_stiffness_is_the_linearization_of_the_interface_energy(case):
     """The written-out second variation (a bilinear form of the state, assembled by ``Assemble``) equals
     NGSolve's linearization of the energy's ``Variation`` entry by entry, in stick and slip, with and
     without a multiplier (the augmented energy), at a state where some points are open and some closed."""
-    friction = Friction("tresca", w=W, G=0.01) if "tresca" in case else None
+    friction = Tresca(w=W, G=0.01) if "tresca" in case else None
     P = _problem(friction)
     slip = 5 * W if "slip" in case else 0.3 * W
     _set_state(P, slip, np.random.default_rng(4))
     counter = ng.GridFunction(P.X.components[1])       # lifted along half of the period: open points
     counter.Set(ng.CF((0.0, 0.05 * ng.sin(2 * np.pi * ng.x))))
     P.gfu.components[1].vec.data += counter.vec
-    keywords = dict(k_n=50.0, friction=None if friction is None else "tresca", w=W,
-                    threshold=None if friction is None else friction.G,
+    keywords = dict(k_n=50.0, friction=friction,
+                    threshold=None if friction is None else friction.threshold(None),
                     multiplier=ng.CF(0.2) if "augmented" in case else None)
     trial, test = P.X.TnT()
     s = P.gfu.components

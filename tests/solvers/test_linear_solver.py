@@ -235,7 +235,7 @@ def test_a_3d_cell_s_coarse_problem_holds_the_vertices_and_its_tangent_not_the_b
     from dataclasses import replace
 
     from ngcontact.cell.fe.cell_problem import CellProblem
-    from ngcontact.laws.penalty import Friction
+    from ngcontact.laws.friction import Coulomb
     from ngcontact.drivers.build import build_cell, cell_loads, model_of
     from ngcontact.scene.loader import load
     scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
@@ -252,7 +252,7 @@ def test_a_3d_cell_s_coarse_problem_holds_the_vertices_and_its_tangent_not_the_b
     whole = P.form.mat.AsVector().FV().NumPy()
     assert np.max(np.abs(tangent - whole)) <= 1e-12 * np.max(np.abs(whole))
 
-    coulomb = replace(model_of(scene), friction=Friction(law="coulomb", w=1e-4, mu=0.3))
+    coulomb = replace(model_of(scene), friction=Coulomb(w=1e-4, mu=0.3))
     Q = CellProblem(build_cell(scene, maxh=0.6, interface_maxh=0.25), coulomb, linear=LinearSolver("iterative"))
     edge_dofs = {d for el in Q.mesh.Boundaries("contact").Elements() for e in el.edges
                  for d in Q.X.GetDofNrs(e) if d >= 0}

@@ -11,7 +11,7 @@ import pytest
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.drivers.build import build_cell, model_of
-from ngcontact.laws.penalty import Friction
+from ngcontact.laws.friction import Tresca
 from ngcontact.scene import loader
 from ngcontact.solvers.split_energy import SplitEnergy, _positions
 
@@ -22,7 +22,7 @@ def _values(mat) -> np.ndarray:
     return mat.AsVector().FV().NumPy().copy()
 
 
-@pytest.mark.parametrize("friction", [None, Friction("tresca", w=1e-4, G=2e-3)])
+@pytest.mark.parametrize("friction", [None, Tresca(w=1e-4, G=2e-3)])
 def test_split_energy_equals_the_whole_form(friction):
     """Residual, energy and tangent of the split agree with the whole form at a random state, with part
     of the interface open and part closed, before and after the load's parameters change, without

@@ -15,7 +15,8 @@ density ``psi`` (:func:`ngcontact.laws.penalty.interface_energy`):
   (:mod:`ngcontact.cell.fe.contact_quadrature`);
 * exact: the augmented Lagrangian with the multiplier held fixed, at the
   Gauss-Lobatto nodes of :mod:`ngcontact.cell.fe.contact_multiplier`;
-* friction ``G huber(|J_t|, w)`` (eqs. 57, 65): Tresca ``G``; Coulomb
+* friction ``G huber(|J_t|, w)`` (eqs. 57, 65) with the threshold of the
+  law (:mod:`ngcontact.laws.friction`): Tresca ``G``; Coulomb
   ``G = mu p`` of a frozen previous state (penalty: a copy of the state,
   returned for the fixed point to fill) or ``mu lambda`` of the multiplier
   (exact).
@@ -137,8 +138,8 @@ def coulomb_residual(problem) -> ng.BilinearForm:
     """
     m = problem.model
     fr = m.friction
-    if fr is None or fr.law != "coulomb" or problem.multiplier is not None:
-        raise ValueError("the coupled Coulomb residual needs Coulomb friction with the penalty")
+    if fr is None or not fr.couples_to_pressure or problem.multiplier is not None:
+        raise ValueError("the coupled Coulomb residual needs friction coupled to the pressure with the penalty")
     trial, test = problem.X.TrialFunction(), problem.X.TestFunction()
     form = ng.BilinearForm(problem.X, symmetric=False)
     for term in _bodies(problem, trial[0], trial[1]):
@@ -146,8 +147,8 @@ def coulomb_residual(problem) -> ng.BilinearForm:
     J, dJ = jump(trial), jump(test)
     ds = _contact_measure(problem)
     form += ng.Variation(_contact.normal_energy(J, problem.n, m.k_n, problem.gap) * ds)
-    G = _contact.coulomb_threshold(J, problem.n, m.k_n, fr.mu, problem.gap)
-    form += ng.InnerProduct(_contact.friction_traction(J, problem.n, G, fr.w), dJ) * ds
+    G = fr.threshold(_contact.pressure(J, problem.n, m.k_n, problem.gap))
+    form += ng.InnerProduct(fr.traction(J, problem.n, G), dJ) * ds
     form += _load(problem, trial)
     return form
 
@@ -158,20 +159,19 @@ def _interface_parameters(problem, previous=None) -> tuple[dict, ng.GridFunction
     (``previous``, or a new GridFunction)."""
     m = problem.model
     lam = None if problem.multiplier is None else problem.multiplier.value
-    friction = threshold = w = None
-    if m.friction is not None:
-        friction, w = m.friction.law, m.friction.w
-        if friction == "tresca":
-            threshold = m.friction.G
+    friction, threshold = m.friction, None
+    if friction is not None:
+        if not friction.couples_to_pressure:
+            threshold = friction.threshold(None)
         elif lam is not None:
-            # exact: mu lambda of the multiplier Uzawa holds fixed in this Newton solve, so
+            # exact: the threshold of the multiplier Uzawa holds fixed in this Newton solve (mu lambda), so
             # Uzawa's iteration is the Coulomb fixed point as well (cell_problem's docstring)
-            threshold = m.friction.mu * lam
+            threshold = friction.threshold(lam)
         else:
             previous = ng.GridFunction(problem.X) if previous is None else previous
-            threshold = _contact.coulomb_threshold(jump(previous.components), problem.n, m.k_n, m.friction.mu,
-                                                   problem.gap)
-    parameters = dict(k_n=_contact_stiffness(problem), gap=problem.gap, friction=friction, w=w,
+            threshold = friction.threshold(_contact.pressure(jump(previous.components), problem.n, m.k_n,
+                                                             problem.gap))
+    parameters = dict(k_n=_contact_stiffness(problem), gap=problem.gap, friction=friction,
                       threshold=threshold, multiplier=lam)
     return parameters, previous
 

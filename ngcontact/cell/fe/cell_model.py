@@ -17,7 +17,7 @@ import ngsolve as ng
 
 from ngcontact.errors import ModelError
 from ngcontact.fem import materials as _mat
-from ngcontact.laws.penalty import Friction
+from ngcontact.laws.friction import FrictionLaw
 
 
 @dataclass(frozen=True)
@@ -34,7 +34,7 @@ class CellModel:
     gap
         Initial gap as a CoefficientFunction of the coordinates, or ``None``.
     friction
-        :class:`Friction` or ``None`` (frictionless).
+        :class:`~ngcontact.laws.friction.FrictionLaw` or ``None`` (frictionless).
     order
         Polynomial order of the displacements.
     macro_strain
@@ -57,7 +57,7 @@ class CellModel:
     counter: _mat.ElasticLaw
     k_n: float
     gap: ng.CoefficientFunction | None = None
-    friction: Friction | None = None
+    friction: FrictionLaw | None = None
     order: int = 2
     macro_strain: bool = False
     interpolate_gap: bool = True

@@ -208,7 +208,7 @@ def interface_traction(problem):
     t = problem.pressure * problem.n
     f = problem.model.friction
     if f is not None:
-        t = t + _contact.friction_traction(problem.J, problem.n, friction_threshold(problem), f.w)
+        t = t + f.traction(problem.J, problem.n, friction_threshold(problem))
     return t
 
 
@@ -258,7 +258,7 @@ def friction_threshold(problem):
     f = problem.model.friction
     if f is None:
         return None
-    return f.G if f.law == "tresca" else f.mu * problem.pressure
+    return f.threshold(problem.pressure)
 
 
 def real_contact_coefficients(problem) -> dict:

@@ -108,7 +108,7 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
         sp, sq = shifts if shifts else (0.0, None)
         p, sp = prox_pressure(v[d - 1], damp_p, mean_p, sp)
         # Tresca: the fixed threshold; Coulomb: mu times the pressure of this very step
-        G = (f.G or 0.0) * np.ones(cell.shape) if f.law == "tresca" else (f.mu or 0.0) * p
+        G = f.threshold(p) * np.ones(cell.shape)
         damp_q = 1.0 if exact else 1.0 + f.w / (L * np.maximum(G, 1e-300))
         q, sq = prox_friction(v[:d - 1], G, damp_q, mean_q, sq)
         return np.concatenate([q, p[None]]), (sp, sq)
@@ -133,7 +133,7 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
             Delta[c] = jumps[c] - (poisson if c == d - 1 else 0.0)
     Delta[d - 1] += poisson
     J = -minus_J
-    G_last = (f.G or 0.0) * np.ones(cell.shape) if f.law == "tresca" else (f.mu or 0.0) * t[d - 1]
+    G_last = f.threshold(t[d - 1]) * np.ones(cell.shape)
     qn = np.sqrt(np.sum(t[:d - 1] ** 2, axis=0))
     slipping = (qn >= G_last * (1 - 1e-9)) & (G_last > 0)
     return {"p": t[d - 1], "q": t[:d - 1], "closure": J[d - 1], "slip": J[:d - 1], "slipping": slipping,

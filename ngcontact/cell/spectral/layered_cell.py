@@ -41,7 +41,7 @@ from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.spectral.layer_compliance import normal_compliance
 from ngcontact.cell.spectral.friction import solve_frictional, traction_operator
 from ngcontact.geometry.random_surface import wave_vectors
-from ngcontact.laws.penalty import Friction
+from ngcontact.laws.friction import FrictionLaw
 from ngcontact.solvers.constrained_cg import constrained_cg
 
 log = logging.getLogger(__name__)
@@ -107,14 +107,14 @@ class SpectralCell:
         Stopping rule of the constrained CG: complementarity residual
         relative to the peak-to-valley height of the gap.
     friction
-        :class:`~ngcontact.laws.penalty.Friction` (Tresca or Coulomb; its
+        :class:`~ngcontact.laws.friction.FrictionLaw` (Tresca or Coulomb; its
         Huber width with ``"penalty"``, exact friction with ``"exact"``);
         ``None``: frictionless.
     """
 
     def __init__(self, *, dim: int, period: float, grid: int, rough: Layer, counter: Layer,
                  gap: np.ndarray, k_n: float, enforcement: str = "exact", tol: float = 1e-12,
-                 max_iter: int = 2000, friction: Friction | None = None):
+                 max_iter: int = 2000, friction: FrictionLaw | None = None):
         if dim not in (2, 3):
             raise ValueError(f"dim = {dim!r}: must be 2 or 3")
         if enforcement not in ENFORCEMENTS:
