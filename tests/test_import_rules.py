@@ -2,13 +2,16 @@
 
 The table is the one of the repository's architecture: descriptions
 (``scene``) and shapes (``geometry``) at the bottom, numerics (``fem``,
-``laws``, ``solvers``) above them, the three problems (``cell``, ``macro``,
-``resolved``) that never know each other, ``coupling`` where cell meets
-macro, ``verification`` above all numerics, ``drivers`` that translate
-scenes into objects, ``export`` (a scene's law for other FE codes) above
-them, and ``output``, ``runner``, ``cli`` (and ``python -m ngcontact``) on top.  The test
-reads the source with :mod:`ast` (nothing is imported), so a forbidden
-import inside a function counts as much as one at the top of a module.
+``laws``, ``solvers``) above them, ``parallel`` (batches of independent
+solves on worker processes or a Dask cluster; no numerics, and the only
+room that starts a pool) beside them, the three problems (``cell``,
+``macro``, ``resolved``) that never know each other, ``coupling`` where
+cell meets macro, ``verification`` above all numerics, ``drivers`` that
+translate scenes into objects, ``export`` (a scene's law for other FE
+codes) above them, and ``output``, ``runner``, ``cli`` (and ``python -m
+ngcontact``) on top.  The test reads the source with :mod:`ast` (nothing is
+imported), so a forbidden import inside a function counts as much as one at
+the top of a module.
 """
 from __future__ import annotations
 
@@ -32,15 +35,17 @@ ALLOWED: dict[str, set[str]] = {
     "fem": {"errors", "quiet"},
     "laws": {"errors"},
     "solvers": {"errors"},
+    # batches of independent solves: pools of worker processes and Dask clusters, nothing numeric
+    "parallel": {"errors"},
     "cell": PROBLEMS,
     "macro": PROBLEMS,
     "resolved": PROBLEMS,
-    "coupling": PROBLEMS | {"cell", "macro"},
+    "coupling": PROBLEMS | {"cell", "macro", "parallel"},
     "verification": PROBLEMS | {"cell", "macro", "resolved", "coupling"},
     "output": {"errors"},
-    "drivers": PROBLEMS | {"scene", "cell", "macro", "resolved", "coupling", "verification", "output"},
-    # the runner chooses where a run's batches go (solvers/executor.py) before a driver is imported
-    "runner": {"errors", "drivers", "scene", "output", "solvers", "__init__"},
+    "drivers": PROBLEMS | {"scene", "parallel", "cell", "macro", "resolved", "coupling", "verification", "output"},
+    # the runner chooses where a run's batches go (parallel/executor.py) before a driver is imported
+    "runner": {"errors", "drivers", "scene", "output", "parallel", "__init__"},
     # the exporters read a scene's law through the drivers, measure macro solutions (the ccx check) and
     # write through output's atomic writer
     "export": PROBLEMS | {"scene", "macro", "coupling", "drivers", "output", "__init__"},
@@ -118,6 +123,43 @@ def test_every_room_is_in_the_table():
 def test_imports_point_downstream():
     bad = _violations()
     assert not bad, "imports against the layer table:\n" + "\n".join(bad)
+
+
+#: the libraries that start pools of workers, and the package's own pools
+POOL_MODULES = ("multiprocessing", "concurrent.futures", "dask", "distributed")
+POOL_NAMES = {"LocalPool", "DaskCluster", "ProcessPoolExecutor", "ThreadPoolExecutor", "Pool", "Client"}
+
+
+def _pool_uses(source: str) -> set[str]:
+    """Pool libraries a module imports and pool classes it names (``executor.LocalPool`` counts too)."""
+    out = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names if a.name.startswith(POOL_MODULES)}
+        elif isinstance(node, ast.ImportFrom) and not node.level and (node.module or "").startswith(POOL_MODULES):
+            out.add(node.module or "")
+            out |= {a.name for a in node.names if a.name in POOL_NAMES}
+        elif isinstance(node, ast.Name) and node.id in POOL_NAMES:
+            out.add(node.id)
+        elif isinstance(node, ast.Attribute) and node.attr in POOL_NAMES:
+            out.add(node.attr)
+    return out
+
+
+def test_only_the_parallel_room_starts_a_pool():
+    """Worker processes and clusters are started in ``parallel/`` alone; the rest asks it for an executor."""
+    offenders = {str(p.relative_to(PACKAGE)): sorted(uses) for p in sorted(PACKAGE.rglob("*.py"))
+                 if p.relative_to(PACKAGE).parts[0] != "parallel"
+                 and (uses := _pool_uses(p.read_text(encoding="utf-8")))}
+    assert not offenders, f"pools outside parallel/: {offenders}"
+
+
+def test_the_pool_check_sees_a_pool():
+    assert _pool_uses("from concurrent.futures import ProcessPoolExecutor\n") == {"concurrent.futures",
+                                                                                   "ProcessPoolExecutor"}
+    assert _pool_uses("import multiprocessing\n") == {"multiprocessing"}
+    assert _pool_uses("ex = executor.LocalPool(2)\n") == {"LocalPool"}
+    assert _pool_uses("from ngcontact.parallel import executor\nexecutor.make(2)\n") == set()
 
 
 def test_the_check_sees_a_forbidden_import(tmp_path, monkeypatch):

@@ -6,7 +6,7 @@ loads are then a chain, and so is a frictional load path.  With
 ``load.independent = true`` every load starts from the unloaded cell (FE:
 a first load's start, rigid or spectral; spectral cell: no pressure), so the
 answer of a load does not depend on the others and the loads of the sweep
-are a batch (:mod:`ngcontact.solvers.executor`) that runs on as many workers
+are a batch (:mod:`ngcontact.parallel.executor`) that runs on as many workers
 as there are.  A member receives the scene (a frozen description) and the
 load's index, builds its own mesh or grid, and returns plain data: the
 load's solution (numbers and arrays) and, for the last load of an FE sweep,
@@ -20,7 +20,7 @@ from ngcontact.cell.cell_model import CellSolution
 from ngcontact.cell.cell_problem import CellProblem
 from ngcontact.cell.spectral_cell import SpectralSolution
 from ngcontact.drivers.build import cell_loads, cell_problem, spectral_cell
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
 
 
 def fe_problem(scene) -> CellProblem:

@@ -5,7 +5,7 @@ surface of ``geometry.spectrum`` drawn with the seed ``seed + m``
 (:mod:`ngcontact.geometry.random_surface`); it is solved over the scene's
 loads by the ``cell`` driver (:mod:`ngcontact.drivers.run_cell`, spectral or
 FE as the scene says), in a worker of the run's batch
-(:mod:`ngcontact.solvers.executor`), and returns per load the contact
+(:mod:`ngcontact.parallel.executor`), and returns per load the contact
 fraction, ``k_n0`` on the real contact set (paper eq. 34), the normal
 effective stiffness, the mean closure and the transmitted pressure.
 
@@ -28,7 +28,7 @@ from ngcontact.drivers import run_cell
 from ngcontact.errors import ModelError
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Clock, Outcome
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
 
 #: quantity -> its description in the report and the plots
 QUANTITIES = {
