@@ -15,7 +15,7 @@ import os
 from contextlib import contextmanager
 from typing import Callable
 
-from ngcontact import __version__
+from ngcontact._version import __version__
 from ngcontact.errors import SceneError
 from ngcontact.output.report import Clock, Outcome, build_report
 from ngcontact.scene import loader
