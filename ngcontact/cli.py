@@ -32,7 +32,7 @@ import signal
 import sys
 import threading
 
-from ngcontact import __version__
+from ngcontact._version import __version__
 from ngcontact.scene import loader as scene_mod
 from ngcontact.errors import ConvergenceError, ModelError, NgcontactError, OutputError, SceneError
 

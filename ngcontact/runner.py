@@ -15,7 +15,7 @@ import os
 from contextlib import contextmanager
 from typing import Callable
 
-from ngcontact import __version__
+from ngcontact._version import __version__
 from ngcontact.errors import SceneError
 from ngcontact.output.report import Clock, Outcome, build_report
 from ngcontact.scene import loader
@@ -80,13 +80,13 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
 
     The command line's ``workers`` / ``scheduler`` first, then the scene's
     ``[compute]`` section; default: a pool of local processes, one per core
-    (:func:`ngcontact.solvers.executor.make`).  The workers are started at
+    (:func:`ngcontact.parallel.executor.make`).  The workers are started at
     once when the run will have a batch (``start``; default
     :func:`has_batches`), so that their start overlaps with the run's own
     preparation; otherwise only for a batch whose members take long enough to
-    repay the workers' start (:meth:`~ngcontact.solvers.executor.Executor.start_on_demand`).
+    repay the workers' start (:meth:`~ngcontact.parallel.executor.Executor.start_on_demand`).
     """
-    from ngcontact.solvers import executor
+    from ngcontact.parallel import executor
     compute = getattr(scene, "compute", None)
     if scheduler is None and workers is None and compute is not None:
         scheduler, workers = compute.scheduler, compute.workers

@@ -54,7 +54,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ngcontact.export.calculix_check import compare, compare_press_fit  # noqa: E402
-from ngcontact.export.calculix_model import Blocks, PressFit, ccx_path  # noqa: E402
+from ngcontact.verification.calculix_model import Blocks, PressFit, ccx_path  # noqa: E402
 from ngcontact.output.writer import write_csv  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

@@ -54,7 +54,7 @@ import time
 
 import numpy as np
 
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
 
 LOADS = np.geomspace(0.002, 0.02, 16)
 SCENE = """kind = "cell"

@@ -40,7 +40,7 @@ from ngcontact.geometry.cell2d import flat_cell
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.fem.materials import isotropic
 from ngcontact.output.writer import write_csv
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
@@ -90,7 +90,7 @@ def semicircle_kt(order: int, ih: float) -> dict:
 
 
 def level(job: tuple) -> dict:
-    """One level of either study as a member of a batch (:mod:`ngcontact.solvers.executor`)."""
+    """One level of either study as a member of a batch (:mod:`ngcontact.parallel.executor`)."""
     study, quantity, args = job
     return {"study": study, **(westergaard(*args) if quantity == "westergaard" else semicircle_kt(*args))}
 

@@ -30,7 +30,7 @@ import numpy as np
 from ngcontact.macro import macro_measures as MM
 from ngcontact.scene import loader as scene_mod
 from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 log = logging.getLogger("work_precision_femur")
@@ -55,7 +55,7 @@ def peaks(sc, maxh: float, interface_maxh: float, order: int) -> dict:
 
 
 def member(job: tuple) -> dict:
-    """One discretization of the study as a member of a batch (:mod:`ngcontact.solvers.executor`)."""
+    """One discretization of the study as a member of a batch (:mod:`ngcontact.parallel.executor`)."""
     sc, maxh, interface_maxh, order = job
     return peaks(sc, maxh, interface_maxh, order)
 

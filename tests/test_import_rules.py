@@ -2,13 +2,21 @@
 
 The table is the one of the repository's architecture: descriptions
 (``scene``) and shapes (``geometry``) at the bottom, numerics (``fem``,
-``laws``, ``solvers``) above them, the three problems (``cell``, ``macro``,
-``resolved``) that never know each other, ``coupling`` where cell meets
-macro, ``verification`` above all numerics, ``drivers`` that translate
-scenes into objects, ``export`` (a scene's law for other FE codes) above
-them, and ``output``, ``runner``, ``cli`` (and ``python -m ngcontact``) on top.  The test
+``laws``, ``solvers``) above them, ``parallel`` (batches of independent
+solves on worker processes or a Dask cluster; no numerics, and the only
+room that starts a pool) beside them, the three problems (``cell``,
+``macro``, ``resolved``) that never know each other, ``coupling`` where
+cell meets macro, ``verification`` above all numerics, ``drivers`` that
+translate scenes into objects, ``export`` (a scene's law for other FE
+codes) above them, and ``output``, ``runner``, ``cli`` (and ``python -m
+ngcontact``) on top.  ``_version`` is a leaf that the package face
+(``ngcontact/__init__.py``) and the rooms that stamp reports and files
+import, so that nothing inside the package imports the face.  The test
 reads the source with :mod:`ast` (nothing is imported), so a forbidden
-import inside a function counts as much as one at the top of a module.
+import inside a function counts as much as one at the top of a module; on
+the same imports, module by module, the import graph has no cycle at all
+(no strongly connected component of two or more modules, the face
+included).
 """
 from __future__ import annotations
 
@@ -21,6 +29,8 @@ NUMERICS = {"errors", "fem", "laws", "solvers"}
 PROBLEMS = NUMERICS | {"geometry"}
 #: room -> rooms it may import (its own room is always allowed)
 ALLOWED: dict[str, set[str]] = {
+    # the package's version, a leaf: the face, the runner, the command line and the exporters stamp with it
+    "_version": set(),
     "errors": set(),
     # NGSolve's and Netgen's C++ output kept off the terminal, for the rooms that call them
     "quiet": set(),
@@ -33,20 +43,23 @@ ALLOWED: dict[str, set[str]] = {
     "fem": {"errors", "quiet"},
     "laws": {"errors"},
     "solvers": {"errors"},
+    # batches of independent solves: pools of worker processes and Dask clusters, nothing numeric
+    "parallel": {"errors"},
     "cell": PROBLEMS,
     "macro": PROBLEMS,
     "resolved": PROBLEMS,
-    "coupling": PROBLEMS | {"cell", "macro"},
+    "coupling": PROBLEMS | {"cell", "macro", "parallel"},
     "verification": PROBLEMS | {"cell", "macro", "resolved", "coupling"},
     "output": {"errors"},
-    "drivers": PROBLEMS | {"scene", "cell", "macro", "resolved", "coupling", "verification", "output"},
-    # the runner chooses where a run's batches go (solvers/executor.py) before a driver is imported
-    "runner": {"errors", "drivers", "scene", "output", "solvers", "__init__"},
-    # the exporters read a scene's law through the drivers, measure macro solutions (the ccx check) and
-    # write through output's atomic writer
-    "export": PROBLEMS | {"scene", "macro", "coupling", "drivers", "output", "__init__"},
-    "cli": {"errors", "runner", "scene", "output", "export", "__init__"},
-    "__init__": {"errors", "scene", "runner"},
+    "drivers": PROBLEMS | {"scene", "parallel", "cell", "macro", "resolved", "coupling", "verification", "output"},
+    # the runner chooses where a run's batches go (parallel/executor.py) before a driver is imported
+    "runner": {"_version", "errors", "drivers", "scene", "output", "parallel"},
+    # the exporters read a scene's law through the drivers and write through output's atomic writer; the ccx
+    # check solves its macro scene through the drivers and hands the solution to its harness in verification
+    "export": PROBLEMS | {"_version", "scene", "macro", "coupling", "verification", "drivers", "output"},
+    "cli": {"_version", "errors", "runner", "scene", "output", "export"},
+    # the package face: nothing inside the package imports it (its version is in _version)
+    "__init__": {"_version", "errors", "scene", "runner"},
     "__main__": {"cli"},
 }
 
@@ -105,7 +118,7 @@ def _violations() -> list[str]:
             if dst.split(".")[0] != "ngcontact":
                 continue
             if dst == "ngcontact" and _room(src) != "__init__":
-                dst = "ngcontact.__init__"  # e.g. `from ngcontact import __version__`
+                dst = "ngcontact.__init__"  # `from ngcontact import x`: the package face
             if not _allowed(src, dst):
                 out.append(f"{path.relative_to(PACKAGE.parent)}:{line}: {src} -> {dst}")
     return out
@@ -155,6 +168,43 @@ def test_the_cell_methods_do_not_know_each_other():
     assert "cell.spectral" not in CELL_PARTS["cell.fe"]      # negative control of the table itself
 
 
+#: the libraries that start pools of workers, and the package's own pools
+POOL_MODULES = ("multiprocessing", "concurrent.futures", "dask", "distributed")
+POOL_NAMES = {"LocalPool", "DaskCluster", "ProcessPoolExecutor", "ThreadPoolExecutor", "Pool", "Client"}
+
+
+def _pool_uses(source: str) -> set[str]:
+    """Pool libraries a module imports and pool classes it names (``executor.LocalPool`` counts too)."""
+    out = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names if a.name.startswith(POOL_MODULES)}
+        elif isinstance(node, ast.ImportFrom) and not node.level and (node.module or "").startswith(POOL_MODULES):
+            out.add(node.module or "")
+            out |= {a.name for a in node.names if a.name in POOL_NAMES}
+        elif isinstance(node, ast.Name) and node.id in POOL_NAMES:
+            out.add(node.id)
+        elif isinstance(node, ast.Attribute) and node.attr in POOL_NAMES:
+            out.add(node.attr)
+    return out
+
+
+def test_only_the_parallel_room_starts_a_pool():
+    """Worker processes and clusters are started in ``parallel/`` alone; the rest asks it for an executor."""
+    offenders = {str(p.relative_to(PACKAGE)): sorted(uses) for p in sorted(PACKAGE.rglob("*.py"))
+                 if p.relative_to(PACKAGE).parts[0] != "parallel"
+                 and (uses := _pool_uses(p.read_text(encoding="utf-8")))}
+    assert not offenders, f"pools outside parallel/: {offenders}"
+
+
+def test_the_pool_check_sees_a_pool():
+    assert _pool_uses("from concurrent.futures import ProcessPoolExecutor\n") == {"concurrent.futures",
+                                                                                   "ProcessPoolExecutor"}
+    assert _pool_uses("import multiprocessing\n") == {"multiprocessing"}
+    assert _pool_uses("ex = executor.LocalPool(2)\n") == {"LocalPool"}
+    assert _pool_uses("from ngcontact.parallel import executor\nexecutor.make(2)\n") == set()
+
+
 def test_the_check_sees_a_forbidden_import(tmp_path, monkeypatch):
     """Negative control: a cell module importing the macro problem is caught."""
     assert not _allowed("ngcontact.cell.fe.cell_problem", "ngcontact.macro.macro_problem")
@@ -163,32 +213,80 @@ def test_the_check_sees_a_forbidden_import(tmp_path, monkeypatch):
     assert _allowed("ngcontact.coupling.two_scale", "ngcontact.macro.macro_problem")
 
 
-def test_no_import_cycles():
+def _import_graph() -> dict[str, set[str]]:
+    """Module -> the package's modules it imports, the package face ``ngcontact`` included (``from ngcontact
+    import x`` imports the face, ``from ngcontact.a import b`` the module ``ngcontact.a.b`` or the package
+    ``ngcontact.a``).  Imports inside functions count; a package's ``__init__`` run before its modules does not
+    (it is no import written in the source)."""
     graph: dict[str, set[str]] = {}
     for path in PACKAGE.rglob("*.py"):
         src = _module_of(path)
-        graph.setdefault(src, set())
+        deps = graph.setdefault(src, set())
         for _, dst in _imports(path):
-            if dst.startswith("ngcontact.") and dst != src:
-                graph[src].add(dst if dst in graph or _is_module(dst) else dst.rsplit(".", 1)[0])
-    state: dict[str, int] = {}
-    cycles: list[list[str]] = []
-
-    def visit(node: str, stack: list[str]) -> None:
-        state[node] = 1
-        for nxt in sorted(graph.get(node, ())):
-            if nxt.endswith(".__init__"):
+            if dst != "ngcontact" and not dst.startswith("ngcontact."):
                 continue
-            if state.get(nxt) == 1:
-                cycles.append(stack[stack.index(nxt):] + [nxt] if nxt in stack else [node, nxt])
-            elif state.get(nxt) is None:
-                visit(nxt, stack + [nxt])
-        state[node] = 2
+            while dst != "ngcontact" and not _is_module(dst):   # a name inside a module: that module
+                dst = dst.rsplit(".", 1)[0]
+            if dst != src:
+                deps.add(dst)
+    return graph
 
-    for node in sorted(graph):
-        if state.get(node) is None:
-            visit(node, [node])
-    assert not cycles, "import cycles:\n" + "\n".join(" -> ".join(c) for c in cycles)
+
+def _strongly_connected(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of ``graph`` (Tarjan): a component of more than one module is a cycle."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    components: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            components.append(sorted(component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return components
+
+
+def test_no_import_cycles():
+    """No module reaches itself through the package's imports, the package face included."""
+    cycles = [c for c in _strongly_connected(_import_graph()) if len(c) > 1]
+    assert not cycles, "modules that import one another (strongly connected):\n" + "\n".join(
+        " <-> ".join(c) for c in cycles)
+
+
+def test_the_cycle_check_sees_a_cycle_through_the_package_face():
+    """Negative control: the runner importing the version from the face the face imports the runner from."""
+    graph = {"ngcontact": {"ngcontact.runner", "ngcontact.errors"}, "ngcontact.runner": {"ngcontact"},
+             "ngcontact.errors": set(), "ngcontact.a": {"ngcontact.b"}, "ngcontact.b": {"ngcontact.c"},
+             "ngcontact.c": {"ngcontact.a", "ngcontact.errors"}}
+    cycles = [c for c in _strongly_connected(graph) if len(c) > 1]
+    assert sorted(cycles) == [["ngcontact", "ngcontact.runner"], ["ngcontact.a", "ngcontact.b", "ngcontact.c"]]
+
+
+def test_the_version_is_a_leaf_that_the_face_and_the_runner_import():
+    graph = _import_graph()
+    assert ALLOWED["_version"] == set() and graph["ngcontact._version"] == set()
+    assert "ngcontact._version" in graph["ngcontact"] and "ngcontact._version" in graph["ngcontact.runner"]
+    assert not any("ngcontact" in deps for deps in graph.values()), "a module imports the package face"
 
 
 def test_no_two_modules_share_a_base_name():

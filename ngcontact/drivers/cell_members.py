@@ -5,7 +5,7 @@ A load sweep normally solves each load from the previous one's solution
 loads are then a chain, and so is a frictional load path.  With
 ``load.independent = true`` every load starts from the unloaded cell (a
 first load's start), so the answer of a load does not depend on the others
-and the loads of the sweep are a batch (:mod:`ngcontact.solvers.executor`)
+and the loads of the sweep are a batch (:mod:`ngcontact.parallel.executor`)
 that runs on as many workers as there are.  A member receives the scene (a
 frozen description), the load's index and whether to return its state; it
 builds its own cell through the cell protocol (whichever method the scene
@@ -20,7 +20,7 @@ from typing import Any
 from ngcontact.cell.cell_solution import CellSolution
 from ngcontact.cell.cell_solver import CellSolver
 from ngcontact.drivers.build import cell_loads, cell_solver
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
 
 
 def load_member(job: tuple) -> tuple[CellSolution, Any]:

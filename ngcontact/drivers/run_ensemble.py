@@ -5,12 +5,12 @@ surface of ``geometry.spectrum`` drawn with the seed ``seed + m``
 (:mod:`ngcontact.geometry.random_surface`); it is solved over the scene's
 loads by the ``cell`` driver (:mod:`ngcontact.drivers.run_cell`, spectral or
 FE as the scene says), in a worker of the run's batch
-(:mod:`ngcontact.solvers.executor`), and returns per load the contact
+(:mod:`ngcontact.parallel.executor`), and returns per load the contact
 fraction, ``k_n0`` on the real contact set (paper eq. 34), the normal
 effective stiffness, the mean closure and the transmitted pressure.
 
 Results: per load the mean of each quantity over the members and its 95 %
-confidence band (:mod:`ngcontact.cell.confidence_band`), every member's
+confidence band (:mod:`ngcontact.verification.confidence_band`), every member's
 values, and the band's shrinkage with ``M`` (the relative standard error of
 the mean of ``M, M/2, M/4, ...`` members on disjoint sub-ensembles and its
 fitted rate, ``-1/2`` for independent members).  Tables ``ensemble.csv``,
@@ -23,12 +23,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from ngcontact.cell import confidence_band
 from ngcontact.drivers import run_cell
 from ngcontact.errors import ModelError
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Clock, Outcome
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
+from ngcontact.verification import confidence_band
 
 #: quantity -> its description in the report and the plots
 QUANTITIES = {

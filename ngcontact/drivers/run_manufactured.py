@@ -16,7 +16,7 @@ import logging
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
 from ngcontact.verification import manufactured
 from ngcontact.verification import rates as studies
 from ngcontact.drivers.build import body_laws
@@ -59,7 +59,7 @@ def level_member(job: tuple) -> tuple[dict, np.ndarray | None]:
 def run(scene, clock) -> Outcome:
     """Solve every (order, level), fit rates and collect tables, plots and VTK.
 
-    The levels are independent solves: one batch (:mod:`ngcontact.solvers.executor`), so they run on
+    The levels are independent solves: one batch (:mod:`ngcontact.parallel.executor`), so they run on
     the run's workers; the finest level of the highest order comes back as a vector for the VTK file.
     """
     m = scene.manufactured

@@ -59,7 +59,7 @@ from ngcontact.coupling import two_scale as T
 from ngcontact.macro.macro_measures import interface_samples
 from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
 
 log = logging.getLogger(__name__)
 

@@ -41,7 +41,7 @@ Errors of each law against the resolved solution ``u^eps``:
   force through the cylindrical part ``z > z_corner`` (the rest goes
   through the cone).
 
-The levels are independent solves: a batch (:mod:`ngcontact.solvers.executor`)
+The levels are independent solves: a batch (:mod:`ngcontact.parallel.executor`)
 spreads them over the run's workers, so the wall times of a level are
 measured while the other workers run too.
 
@@ -59,7 +59,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.resolved import resolved_problem as D
-from ngcontact.solvers import executor
+from ngcontact.parallel import executor
 from ngcontact.fem import elasticity
 from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
@@ -320,7 +320,7 @@ def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS) -> dict:
 
 
 def level_member(job: tuple) -> dict:
-    """Member of the batch of levels (:mod:`ngcontact.solvers.executor`): ``(scene, N, bundle, laws)`` -> row."""
+    """Member of the batch of levels (:mod:`ngcontact.parallel.executor`): ``(scene, N, bundle, laws)`` -> row."""
     scene, N, bundle, laws = job
     return level(scene, N, bundle, laws=laws)
 

@@ -11,7 +11,7 @@ and exports in the directory.
 """
 from __future__ import annotations
 
-from ngcontact import __version__
+from ngcontact._version import __version__
 from ngcontact.errors import ModelError
 from ngcontact.export import abaqus, ansys, calculix, json_law
 from ngcontact.export.law_source import exported_law

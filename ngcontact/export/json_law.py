@@ -14,7 +14,7 @@ import json
 
 import numpy as np
 
-from ngcontact import __version__
+from ngcontact._version import __version__
 from ngcontact.export.law_table import ExportedLaw
 from ngcontact.scene.law_file import FORMAT, FORMAT_VERSION
 

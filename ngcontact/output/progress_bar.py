@@ -1,7 +1,7 @@
 """Progress of a batch of independent solves: one bar on a terminal, plain lines elsewhere.
 
 Called as ``progress(label, finished, total)`` by
-:mod:`ngcontact.solvers.executor` (``finished = 0`` when a batch starts).
+:mod:`ngcontact.parallel.executor` (``finished = 0`` when a batch starts).
 On a terminal a ``tqdm`` bar shows the finished count and the estimated
 time left; in a log file or a pipe a plain line per finished member says
 the same (``loads: 3/16 finished, about 12 s left``).  ``quiet`` silences it.

@@ -134,7 +134,7 @@ def check_material_names(materials: dict, names: dict, path: str) -> None:
 
 @dataclass(frozen=True, kw_only=True)
 class ComputeSpec:
-    """Where a batch of independent solves runs (:mod:`ngcontact.solvers.executor`); the command line's
+    """Where a batch of independent solves runs (:mod:`ngcontact.parallel.executor`); the command line's
     ``--workers`` and ``--scheduler`` take precedence."""
 
     scheduler: str | None = param(None, doc="address of a dask.distributed scheduler (e.g. 'tcp://10.0.0.5:8786') "

@@ -84,8 +84,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.errors import ConvergenceError
-from ngcontact.solvers.linear_solver import LinearSolver
-from ngcontact.solvers.free_dofs import fixed_mask, mask_fixed
+from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask, mask_fixed
 from ngcontact.solvers.line_search import ARMIJO, MIN_STEP, armijo, exact_step
 from ngcontact.solvers.newton import ActiveSetCycle, NewtonHistory
 from ngcontact.solvers.roundoff import at_floor, roundoff_floors

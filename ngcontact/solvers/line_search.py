@@ -30,7 +30,7 @@ import math
 
 import ngsolve as ng
 
-from ngcontact.solvers.free_dofs import mask_fixed
+from ngcontact.solvers.linear_solver import mask_fixed
 
 ARMIJO = 1e-4
 MIN_STEP = 2.0 ** -30

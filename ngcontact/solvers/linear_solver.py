@@ -59,7 +59,10 @@ definite on the free dofs.  Two ways:
 
 BDDC reads the free dofs from the space; a solve whose free dofs differ
 from the space's (prescribed far-face translations of a cell) sets the
-space's free dofs to them first (:func:`match_free_dofs`).
+space's free dofs to them first (:func:`match_free_dofs`).  The same free
+dofs as a NumPy mask (:func:`fixed_mask`, :func:`mask_fixed`) restrict the
+vectors of Newton's iterations and their step lengths to them without
+NGSolve's ``BitArray`` per entry.
 
 The solver keeps what it did for the report (:meth:`LinearSolver.summary`):
 the method chosen, the number of solves and CG iterations per solve.
@@ -70,6 +73,7 @@ import math
 from dataclasses import dataclass, field
 
 import ngsolve as ng
+import numpy as np
 
 from ngcontact.errors import ConvergenceError
 
@@ -326,3 +330,13 @@ def match_free_dofs(space, freedofs) -> None:
                 own.Set(i)
             else:
                 own.Clear(i)
+
+
+def fixed_mask(freedofs):
+    """Boolean NumPy array, True where a dof is not free."""
+    return ~np.array([freedofs[i] for i in range(len(freedofs))], dtype=bool)
+
+
+def mask_fixed(vec, fixed) -> None:
+    """Zero the entries of ``vec`` that are not free."""
+    vec.FV().NumPy()[fixed] = 0.0

@@ -35,9 +35,8 @@ from dataclasses import dataclass, field
 import ngsolve as ng
 
 from ngcontact.errors import ConvergenceError
-from ngcontact.solvers.free_dofs import fixed_mask, mask_fixed
 from ngcontact.solvers.line_search import ARMIJO, MIN_STEP, armijo, exact_step
-from ngcontact.solvers.linear_solver import LinearSolver, forcing_term
+from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask, forcing_term, mask_fixed
 from ngcontact.solvers.roundoff import at_floor, at_roundoff, roundoff_floors, within_roundoff
 
 log = logging.getLogger(__name__)

@@ -40,7 +40,7 @@ steps' tangents, until the linear solver finds it stale
 (:class:`ngcontact.solvers.linear_solver.LinearSolver`).
 
 A split energy may carry a *preconditioning* form
-(:class:`ngcontact.solvers.state_form.StateForm`): the tangent written as a
+(:class:`StateForm`): the tangent written as a
 bilinear form of the state, plus terms meant for the preconditioner alone
 (the contact surface's bubble term,
 :func:`ngcontact.fem.elasticity.bubble_term`).  Once a preconditioner is
@@ -51,10 +51,41 @@ parts: the tangent never holds the extra terms.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.solvers.state_form import StateForm
+
+@dataclass
+class StateForm:
+    """A bilinear form whose coefficients read a state: the linearization of an energy, written out.
+
+        a_u(du, v) = d2 Pi(u)[du, v],
+
+    assembled at a vector ``u`` by copying ``u`` into ``state``, the
+    GridFunction the coefficients of ``form`` (bilinear in trial and test
+    functions) read, and calling ``Assemble``.  NGSolve linearizes a
+    ``Variation`` by automatic differentiation at every quadrature point; a
+    bilinear form of the same Hessian, written out, assembles faster (a
+    preconditioner rebuilt from it:
+    :func:`ngcontact.cell.fe.cell_energy.preconditioning_form`).  It answers the
+    one question a split energy asks of its preconditioning form and of its
+    interface tangent (:class:`SplitEnergy`).
+    """
+
+    form: ng.BilinearForm
+    state: ng.GridFunction
+
+    @property
+    def mat(self):
+        """The matrix of the last assembly."""
+        return self.form.mat
+
+    def AssembleLinearization(self, vec) -> None:  # noqa: N802 (NGSolve's name)
+        """Assemble ``form`` at the state ``vec`` (a preconditioner registered with it is built)."""
+        self.state.vec.data = vec
+        self.form.Assemble()
 
 
 _UNSET = object()   # no load parameters seen yet

@@ -55,7 +55,7 @@ from ngcontact.fem import elasticity
 from ngcontact.errors import ConvergenceError
 from ngcontact.geometry.cell2d import Segment, interface_cell
 from ngcontact.fem.materials import ElasticLaw
-from ngcontact.solvers.free_dofs import fixed_mask
+from ngcontact.solvers.linear_solver import fixed_mask
 from ngcontact.fem import two_body
 
 log = logging.getLogger(__name__)

@@ -112,7 +112,7 @@ def test_a_shear_level_is_one_batch_of_the_executor_and_the_task_pickles():
     import os
     import pickle
 
-    from ngcontact.solvers import executor
+    from ngcontact.parallel import executor
     batches: list = []
 
     class Recording(executor.Serial):

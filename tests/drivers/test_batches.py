@@ -19,7 +19,7 @@ import pytest
 
 from ngcontact import cli
 from ngcontact.runner import solve
-from ngcontact.solvers.batch_member import FAULT_ENV
+from ngcontact.parallel.batch_member import FAULT_ENV
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -296,7 +296,7 @@ def test_a_dask_cluster_fills_a_two_scale_cell_table_with_the_serial_numbers(clu
     """The table levels of the two-scale loop (paper Sec. 3.5) as batches on a real LocalCluster."""
     from ngcontact.coupling import pressure_table as PT
     from ngcontact.drivers import run_two_scale as R
-    from ngcontact.solvers import executor
+    from ngcontact.parallel import executor
     monkeypatch.setenv("NGCONTACT_THREADS", "1")
     path = write(tmp_path, "cell.toml", FE_SWEEP.replace("shear = [0.0, 0.001, 0.002]\n", "").replace(
         "independent = true\n", ""))

@@ -8,10 +8,8 @@ import json
 
 import numpy as np
 import pytest
-from scipy import stats
 
 from ngcontact import cli
-from ngcontact.cell import confidence_band
 from ngcontact.errors import SceneError
 from ngcontact.runner import solve
 from ngcontact.scene import loader
@@ -44,17 +42,6 @@ def ensemble_scene(tmp_path, members=16, rms=0.1, profile="self_affine", enforce
     path = tmp_path / f"ensemble_{members}_{rms}.toml"
     path.write_text(SCENE.format(members=members, rms=rms, profile=profile, enforcement=enforcement))
     return str(path)
-
-
-def test_the_band_is_students_t_interval_of_the_mean():
-    rng = np.random.default_rng(1)
-    x = rng.normal(2.0, 0.3, size=(12, 3))
-    b = confidence_band.band(x)
-    low, high = stats.t.interval(0.95, 11, loc=x.mean(axis=0), scale=stats.sem(x, axis=0))
-    np.testing.assert_allclose(b["low"], low, rtol=1e-13)
-    np.testing.assert_allclose(b["high"], high, rtol=1e-13)
-    with pytest.raises(ValueError, match="at least 2 members"):
-        confidence_band.band(x[:1])
 
 
 def test_identical_members_have_a_zero_band(tmp_path):

@@ -1,7 +1,7 @@
 """CalculiX (ccx) solves two blocks and a press fit with the exported law and agrees with this package within 1 %.
 
 Requirement: the law exported for ccx (pressure-overclosure table, friction with the stick slope), used by a
-real ccx run on the two blocks of ``ngcontact.export.calculix_model`` pressed and sheared, gives the reaction
+real ccx run on the two blocks of ``ngcontact.verification.calculix_model`` pressed and sheared, gives the reaction
 forces and contact pressures of this package's macro solve of the same blocks with the same law read back from
 the exported JSON file, within 1 %.  The press lies inside the table's kinked (nonlinear) range and the
 interface sticks everywhere in ccx (its stick branch is then the linear law both codes share).  Skipped, with
@@ -12,7 +12,7 @@ import os
 import numpy as np
 import pytest
 
-from ngcontact.export.calculix_model import Blocks, ccx_path
+from ngcontact.verification.calculix_model import Blocks, ccx_path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CELL = os.path.join(ROOT, "geometries", "macro", "sinusoid_gap_cell.toml")
@@ -41,7 +41,7 @@ def test_ccx_agrees_with_the_macro_solve_within_one_percent(tmp_path, monkeypatc
 def test_ccx_press_fit_agrees_within_one_percent(tmp_path, monkeypatch):
     """Plane-strain press fit: the interference is the exported law's gap g0 (the table shifted by it)."""
     from ngcontact.export.calculix_check import compare_press_fit
-    from ngcontact.export.calculix_model import PressFit
+    from ngcontact.verification.calculix_model import PressFit
     monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))
     fit = PressFit(a=0.01, b=0.02, c=0.03, E=210e9, nu=0.3, n_theta=20, n_inner=5, n_outer=5)
     r = compare_press_fit(CELL, str(tmp_path), fit, length_unit=1e-4, gap=-3e-6, p_max=1e8)

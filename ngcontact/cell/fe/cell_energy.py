@@ -34,7 +34,7 @@ from __future__ import annotations
 import ngsolve as ng
 
 from ngcontact.fem import elasticity as _el
-from ngcontact.solvers.state_form import StateForm
+from ngcontact.solvers.split_energy import StateForm
 from ngcontact.laws import penalty as _contact
 
 
@@ -64,7 +64,7 @@ def interface_tangent(problem, state: ng.GridFunction) -> StateForm:
     """The interface's second variation ``Psi''`` at ``state``, written out as a bilinear form of the state
     (:func:`ngcontact.laws.penalty.interface_stiffness` of the energy's own parameters and quadrature):
     the same matrix as linearizing the energy's ``Variation`` term, assembled by ``Assemble`` in about
-    half its time (:mod:`ngcontact.solvers.state_form`; the split energy's tangent)."""
+    half its time (:class:`ngcontact.solvers.split_energy.StateForm`; the split energy's tangent)."""
     form = _new_form(problem)
     form += _interface_stiffness(problem, state)
     return StateForm(form, state)

@@ -38,8 +38,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.fem import materials as _mat
-from ngcontact.solvers.linear_solver import LinearSolver, match_free_dofs
-from ngcontact.solvers.free_dofs import fixed_mask, mask_fixed
+from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask, mask_fixed, match_free_dofs
 
 
 def schur_complement(form, X, dofs, state_vec, linear: LinearSolver) -> np.ndarray:

@@ -25,7 +25,7 @@ interpolant of the pressure loads the layers), and the contact problem is
 solved by constrained conjugate gradients
 (:mod:`ngcontact.solvers.constrained_cg`).
 
-Friction: :mod:`ngcontact.cell.spectral.friction`; results of a load:
+Friction: :mod:`ngcontact.cell.spectral.frictional_contact`; results of a load:
 :mod:`ngcontact.cell.spectral.grid_measures`.
 """
 from __future__ import annotations
@@ -39,7 +39,7 @@ import numpy as np
 from ngcontact.cell.spectral import grid_measures as measures
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.spectral.layer_compliance import normal_compliance
-from ngcontact.cell.spectral.friction import solve_frictional, traction_operator
+from ngcontact.cell.spectral.frictional_contact import solve_frictional, traction_operator
 from ngcontact.geometry.random_surface import wave_vectors
 from ngcontact.laws.friction import FrictionLaw
 from ngcontact.solvers.constrained_cg import constrained_cg
@@ -253,7 +253,8 @@ class SpectralCell:
 
     # ------------------------------------------------------------ friction
     def traction_operator(self, uniform: tuple[bool, ...]):
-        """:func:`ngcontact.cell.spectral.friction.traction_operator`, built once per kind of load of a sweep."""
+        """:func:`ngcontact.cell.spectral.frictional_contact.traction_operator`, built once per kind of load of a
+        sweep."""
         if uniform not in self._operators:
             self._operators[uniform] = traction_operator(self, uniform)
         return self._operators[uniform]

@@ -19,7 +19,7 @@ Executors:
 * :class:`DaskCluster` - the workers of a ``dask.distributed`` scheduler at
   an address; Dask is the cluster engine, this module only submits.
 
-Failures (the attempt itself: :mod:`ngcontact.solvers.batch_member`): a member that raises (or whose
+Failures (the attempt itself: :mod:`ngcontact.parallel.batch_member`): a member that raises (or whose
 worker process dies) is run once more; a second failure ends the batch with :class:`~ngcontact.errors.BatchError`
 naming the member and the reason, and no result of the batch is returned.
 An interruption (``KeyboardInterrupt``, or any exception in the caller while
@@ -27,7 +27,7 @@ it waits) stops the workers before it propagates.
 
 The batch a run uses is set once by the runner (:func:`use`) and read by
 the code that has a batch (:func:`current`); without one, batches run
-serially.  Any room that may import ``solvers`` uses it the same way, e.g.
+serially.  Any room that may import ``parallel`` uses it the same way, e.g.
 the levels of a two-scale table in ``coupling/``::
 
     rows = executor.current().map(solve_level, [(scene, level) for level in levels],
@@ -42,9 +42,9 @@ from __future__ import annotations
 import contextlib
 import contextvars
 
-from ngcontact.solvers.batch_executor import PROGRESS, Executor, Progress, Serial, default_workers
-from ngcontact.solvers.dask_cluster import DaskCluster
-from ngcontact.solvers.local_pool import LocalPool
+from ngcontact.parallel.batch_executor import PROGRESS, Executor, Progress, Serial, default_workers
+from ngcontact.parallel.dask_cluster import DaskCluster
+from ngcontact.parallel.local_pool import LocalPool
 
 __all__ = ["Executor", "Serial", "LocalPool", "DaskCluster", "Progress", "default_workers", "make", "current",
            "use"]

@@ -1,6 +1,6 @@
 """One member of a batch of independent solves, run in whichever process gets it.
 
-A member is one call ``fn(item)`` of a batch (:mod:`ngcontact.solvers.executor`).
+A member is one call ``fn(item)`` of a batch (:mod:`ngcontact.parallel.executor`).
 This module holds what every executor shares about running one: the
 attempt itself (:func:`run_member`: one member at a time per process,
 because Netgen's mesher keeps global state), the failure as it crosses from

@@ -1,4 +1,4 @@
-"""The workers of a ``dask.distributed`` scheduler (:mod:`ngcontact.solvers.executor`): Dask is the cluster
+"""The workers of a ``dask.distributed`` scheduler (:mod:`ngcontact.parallel.executor`): Dask is the cluster
 engine, this module only submits."""
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import time
 from typing import Any, Sequence
 
 from ngcontact.errors import NgcontactError
-from ngcontact.solvers.batch_executor import Executor
-from ngcontact.solvers.batch_member import in_worker, one_thread, reason, run_member
+from ngcontact.parallel.batch_executor import Executor
+from ngcontact.parallel.batch_member import in_worker, one_thread, reason, run_member
 
 
 class DaskCluster(Executor):

@@ -11,7 +11,7 @@ import time
 import pytest
 
 from ngcontact.errors import BatchError
-from ngcontact.solvers import batch_member, executor, local_pool
+from ngcontact.parallel import batch_member, executor, local_pool
 
 ITEMS = [1.5, -2.0, 3.25, 7.0, -0.5]
 NAMES = [f"m{k}" for k in range(len(ITEMS))]

@@ -1,10 +1,10 @@
-"""The executor of a batch of independent solves, and the serial one (:mod:`ngcontact.solvers.executor`).
+"""The executor of a batch of independent solves, and the serial one (:mod:`ngcontact.parallel.executor`).
 
 :class:`Executor` runs a batch member after member in this process, each
-attempt by :func:`ngcontact.solvers.batch_member.run_member`, a failing
+attempt by :func:`ngcontact.parallel.batch_member.run_member`, a failing
 member once more; :class:`Serial` is that.  The local pool
-(:mod:`ngcontact.solvers.local_pool`) and the Dask cluster
-(:mod:`ngcontact.solvers.dask_cluster`) spread the same batch.
+(:mod:`ngcontact.parallel.local_pool`) and the Dask cluster
+(:mod:`ngcontact.parallel.dask_cluster`) spread the same batch.
 """
 from __future__ import annotations
 
@@ -15,14 +15,14 @@ import time
 from typing import Any, Callable, Sequence
 
 from ngcontact.errors import BatchError
-from ngcontact.solvers.batch_member import ATTEMPTS, fault_from_env, reason, run_member
+from ngcontact.parallel.batch_member import ATTEMPTS, fault_from_env, reason, run_member
 
-log = logging.getLogger("ngcontact.solvers.executor")
+log = logging.getLogger("ngcontact.parallel.executor")
 
 #: ``progress(label, finished, total)``, called at the start (0) and after every finished member.
 Progress = Callable[[str, int, int], None]
 
-#: the progress callback of the running batches (:func:`ngcontact.solvers.executor.use`)
+#: the progress callback of the running batches (:func:`ngcontact.parallel.executor.use`)
 PROGRESS: contextvars.ContextVar[Progress | None] = contextvars.ContextVar("ngcontact_progress", default=None)
 
 

@@ -1,4 +1,4 @@
-"""A pool of worker processes on this machine (:mod:`ngcontact.solvers.executor`).
+"""A pool of worker processes on this machine (:mod:`ngcontact.parallel.executor`).
 
 ``spawn``: each worker is a fresh interpreter, never a fork of a process
 whose NGSolve task manager holds threads, limited to one NGSolve thread so
@@ -13,10 +13,10 @@ import os
 import time
 from typing import Any, Sequence
 
-from ngcontact.solvers.batch_executor import Executor
-from ngcontact.solvers.batch_member import one_thread, run_member
+from ngcontact.parallel.batch_executor import Executor
+from ngcontact.parallel.batch_member import one_thread, run_member
 
-log = logging.getLogger("ngcontact.solvers.executor")
+log = logging.getLogger("ngcontact.parallel.executor")
 
 
 #: Wall seconds a local pool's workers take to start (fresh interpreters importing NGSolve and the package,

@@ -1,4 +1,4 @@
-"""A CalculiX (ccx) model of two blocks meeting through an exported interface law: the client check.
+"""A CalculiX (ccx) model of two blocks meeting through an exported interface law: the ccx side of the client check.
 
 The macro ``block`` geometry of :func:`ngcontact.geometry.bodies.block_on_plane`
 (a block ``[0, L] x [0, h_block]`` on a base ``[0, L] x [-h_base, 0]``) in
