@@ -33,13 +33,14 @@ from __future__ import annotations
 
 import ngsolve as ng
 
+from ngcontact.cell.fe.discrete_cell import DiscreteCell
 from ngcontact.fem import elasticity as _el
 from ngcontact.solvers.split_energy import StateForm
 from ngcontact.laws import penalty as _contact
 
 
-def cell_energy(problem) -> tuple[ng.BilinearForm, ng.GridFunction | None, tuple]:
-    """The form of ``Pi`` for the trial functions ``(u_r, u_c, U)`` of ``problem``'s space.
+def cell_energy(cell: DiscreteCell) -> tuple[ng.BilinearForm, ng.GridFunction | None, tuple]:
+    """The form of ``Pi`` for the trial functions ``(u_r, u_c, U)`` of ``cell``'s space.
 
     Returns the form, for Coulomb friction with the penalty the
     GridFunction of the frozen previous state whose pressure sets the
@@ -47,72 +48,74 @@ def cell_energy(problem) -> tuple[ng.BilinearForm, ng.GridFunction | None, tuple
     Psi)``: the bodies with the load potential (quadratic) and the interface
     energy, with the same terms (for :class:`ngcontact.solvers.split_energy.SplitEnergy`).
     """
-    trial = problem.X.TrialFunction()
-    form, quadratic, interface = _new_form(problem), _new_form(problem), _new_form(problem)
-    for term in _bodies(problem, trial[0], trial[1]) + [_load(problem, trial)]:
+    trial = cell.X.TrialFunction()
+    form, quadratic, interface = _new_form(cell), _new_form(cell), _new_form(cell)
+    for term in _bodies(cell, trial[0], trial[1]) + [_load(cell, trial)]:
         form += term
         quadratic += term
-    parameters, previous = _interface_parameters(problem)
-    psi = _contact.interface_energy(jump(trial), problem.n, **parameters)
-    term = ng.Variation(psi * _contact_measure(problem))
+    parameters, previous = _interface_parameters(cell)
+    psi = _contact.interface_energy(jump(trial), cell.n, **parameters)
+    term = ng.Variation(psi * _contact_measure(cell))
     form += term
     interface += term
     return form, previous, (quadratic, interface)
 
 
-def interface_tangent(problem, state: ng.GridFunction) -> StateForm:
+def interface_tangent(cell: DiscreteCell, state: ng.GridFunction, previous: ng.GridFunction | None = None
+                      ) -> StateForm:
     """The interface's second variation ``Psi''`` at ``state``, written out as a bilinear form of the state
     (:func:`ngcontact.laws.penalty.interface_stiffness` of the energy's own parameters and quadrature):
     the same matrix as linearizing the energy's ``Variation`` term, assembled by ``Assemble`` in about
     half its time (:class:`ngcontact.solvers.split_energy.StateForm`; the split energy's tangent)."""
-    form = _new_form(problem)
-    form += _interface_stiffness(problem, state)
+    form = _new_form(cell)
+    form += _interface_stiffness(cell, state, previous)
     return StateForm(form, state)
 
 
-def preconditioning_form(problem, state: ng.GridFunction, quadrature=None) -> StateForm | None:
+def preconditioning_form(cell: DiscreteCell, state: ng.GridFunction, quadrature=None,
+                         previous: ng.GridFunction | None = None) -> StateForm | None:
     """The form a BDDC preconditioner of the cell's tangent is built from: the tangent itself, written as a
     bilinear form of ``state`` (the bodies' elasticity and :func:`interface_tangent`'s term), plus each
     body's bubble term on ``S_C`` (:func:`ngcontact.fem.elasticity.bubble_term`, with the body's
     longitudinal modulus and the contact stiffness: ``k_n``, or the augmentation of exact enforcement), so
-    that BDDC's coarse problem needs only the vertex dofs of the contact surface.  Never assembled as the
+    that BDDC's coarse cell needs only the vertex dofs of the contact surface.  Never assembled as the
     tangent.  ``quadrature``: the split contact quadrature
     (:class:`ngcontact.cell.fe.contact_quadrature.ContactQuadrature`) whose measures the interface term uses.
 
     ``None`` where the whole form serves: at order 1 (every dof is a vertex's, no bubbles), and for
     Coulomb friction with the penalty, whose coupled residual is not an energy's and keeps the contact
-    surface on BDDC's wirebasket (set here, on ``problem.X``).
+    surface on BDDC's wirebasket (set here, on ``cell.X``).
     """
-    m = problem.model
-    if problem.coulomb_previous is not None:
-        _el.surface_wirebasket(problem.X, problem.mesh, "contact")
+    m = cell.model
+    if previous is not None:
+        _el.surface_wirebasket(cell.X, cell.mesh, "contact")
         return None
     if m.order < 2:
         return None
-    pre = _new_form(problem)
-    trial, test = problem.X.TnT()
+    pre = _new_form(cell)
+    trial, test = cell.X.TnT()
     for i, (name, law) in enumerate((("rough", m.rough), ("counter", m.counter))):
-        pre += _el.bilinear_integrand(law, trial[i], test[i], problem.setting) * ng.dx(
-            definedon=problem.mesh.Materials(name))
+        pre += _el.bilinear_integrand(law, trial[i], test[i], cell.setting) * ng.dx(
+            definedon=cell.mesh.Materials(name))
     if quadrature is None:
-        pre += _interface_stiffness(problem, state)
+        pre += _interface_stiffness(cell, state, previous)
     else:
         for term in quadrature.stiffness_terms(trial, test):
             pre += term
     for i, law in enumerate((m.rough, m.counter)):
-        pre += _el.bubble_term(trial[i], test[i], law.longitudinal_modulus, _contact_stiffness(problem), "contact")
+        pre += _el.bubble_term(trial[i], test[i], law.longitudinal_modulus, _contact_stiffness(cell), "contact")
     # the load's potential is linear in U, its second variation zero; its face's elements couple U with the
     # face's dofs all the same, so that this form's sparsity is the whole form's (SplitEnergy.rebuild)
     pre += 0.0 * ng.InnerProduct(ng.CF(tuple(trial[2:])), ng.CF(tuple(test[2:]))) * ng.ds("top")
     return StateForm(pre, state)
 
 
-def _interface_stiffness(problem, state):
+def _interface_stiffness(cell: DiscreteCell, state, previous):
     """The integrand of ``Psi''(state)`` on ``S_C`` with its measure."""
-    trial, test = problem.X.TnT()
-    parameters, _ = _interface_parameters(problem, problem.coulomb_previous)
-    return (_contact.interface_stiffness(jump(state.components), problem.n, jump(trial), jump(test), **parameters)
-            * _contact_measure(problem))
+    trial, test = cell.X.TnT()
+    parameters, _ = _interface_parameters(cell, previous)
+    return (_contact.interface_stiffness(jump(state.components), cell.n, jump(trial), jump(test), **parameters)
+            * _contact_measure(cell))
 
 
 def jump(u):
@@ -120,45 +123,45 @@ def jump(u):
     return u[0] - u[1] - ng.CF(tuple(u[2:]))
 
 
-def _contact_stiffness(problem):
+def _contact_stiffness(cell: DiscreteCell):
     """The contact stiffness of the interface energy: ``k_n``, or the augmentation of exact enforcement."""
-    return problem.model.k_n if problem.multiplier is None else problem.augmentation
+    return cell.model.k_n if cell.multiplier is None else cell.augmentation
 
 
-def _new_form(problem) -> ng.BilinearForm:
+def _new_form(cell: DiscreteCell) -> ng.BilinearForm:
     # UMFPACK reads only one triangle of a symmetric-storage matrix: full storage for it
-    return ng.BilinearForm(problem.X, symmetric=True, symmetric_storage=problem.inverse == "sparsecholesky")
+    return ng.BilinearForm(cell.X, symmetric=True, symmetric_storage=cell.inverse == "sparsecholesky")
 
 
-def coulomb_residual(problem) -> ng.BilinearForm:
+def coulomb_residual(cell: DiscreteCell) -> ng.BilinearForm:
     """The non-symmetric residual form of Coulomb friction with the penalty (module docstring).
 
     Its ``Apply`` is the gradient of ``Pi`` with the threshold set to
     ``mu p`` of the state itself, its linearization the consistent tangent.
     """
-    m = problem.model
+    m = cell.model
     fr = m.friction
-    if fr is None or not fr.couples_to_pressure or problem.multiplier is not None:
+    if fr is None or not fr.couples_to_pressure or cell.multiplier is not None:
         raise ValueError("the coupled Coulomb residual needs friction coupled to the pressure with the penalty")
-    trial, test = problem.X.TrialFunction(), problem.X.TestFunction()
-    form = ng.BilinearForm(problem.X, symmetric=False)
-    for term in _bodies(problem, trial[0], trial[1]):
+    trial, test = cell.X.TrialFunction(), cell.X.TestFunction()
+    form = ng.BilinearForm(cell.X, symmetric=False)
+    for term in _bodies(cell, trial[0], trial[1]):
         form += term
     J, dJ = jump(trial), jump(test)
-    ds = _contact_measure(problem)
-    form += ng.Variation(_contact.normal_energy(J, problem.n, m.k_n, problem.gap) * ds)
-    G = fr.threshold(_contact.pressure(J, problem.n, m.k_n, problem.gap))
-    form += ng.InnerProduct(fr.traction(J, problem.n, G), dJ) * ds
-    form += _load(problem, trial)
+    ds = _contact_measure(cell)
+    form += ng.Variation(_contact.normal_energy(J, cell.n, m.k_n, cell.gap) * ds)
+    G = fr.threshold(_contact.pressure(J, cell.n, m.k_n, cell.gap))
+    form += ng.InnerProduct(fr.traction(J, cell.n, G), dJ) * ds
+    form += _load(cell, trial)
     return form
 
 
-def _interface_parameters(problem, previous=None) -> tuple[dict, ng.GridFunction | None]:
+def _interface_parameters(cell: DiscreteCell, previous=None) -> tuple[dict, ng.GridFunction | None]:
     """The keywords of the interface energy (:func:`ngcontact.laws.penalty.interface_energy`) and, for
     Coulomb friction with the penalty, the frozen previous state whose pressure sets the threshold
     (``previous``, or a new GridFunction)."""
-    m = problem.model
-    lam = None if problem.multiplier is None else problem.multiplier.value
+    m = cell.model
+    lam = None if cell.multiplier is None else cell.multiplier.value
     friction, threshold = m.friction, None
     if friction is not None:
         if not friction.couples_to_pressure:
@@ -168,45 +171,34 @@ def _interface_parameters(problem, previous=None) -> tuple[dict, ng.GridFunction
             # Uzawa's iteration is the Coulomb fixed point as well (cell_problem's docstring)
             threshold = friction.threshold(lam)
         else:
-            previous = ng.GridFunction(problem.X) if previous is None else previous
-            threshold = friction.threshold(_contact.pressure(jump(previous.components), problem.n, m.k_n,
-                                                             problem.gap))
-    parameters = dict(k_n=_contact_stiffness(problem), gap=problem.gap, friction=friction,
+            previous = ng.GridFunction(cell.X) if previous is None else previous
+            threshold = friction.threshold(_contact.pressure(jump(previous.components), cell.n, m.k_n,
+                                                             cell.gap))
+    parameters = dict(k_n=_contact_stiffness(cell), gap=cell.gap, friction=friction,
                       threshold=threshold, multiplier=lam)
     return parameters, previous
 
 
-def _contact_measure(problem):
+def _contact_measure(cell: DiscreteCell):
     """``ds`` on ``S_C``: with the contact bonus order (the penalty's kink), or exact enforcement's
     Gauss-Lobatto nodes."""
-    if problem.multiplier is None:
-        return ng.ds("contact", bonus_intorder=problem.model.contact_bonus_order)
-    return problem.multiplier.ds
+    if cell.multiplier is None:
+        return ng.ds("contact", bonus_intorder=cell.model.contact_bonus_order)
+    return cell.multiplier.ds
 
 
-def _bodies(problem, ur, uc) -> list:
+def _bodies(cell: DiscreteCell, ur, uc) -> list:
     """The bodies' elastic energies (with the macro strain when assembled), one term per body."""
-    m, mesh = problem.model, problem.mesh
+    m, mesh = cell.model, cell.mesh
     terms = []
     for name, law, u in (("rough", m.rough, ur), ("counter", m.counter, uc)):
-        eps = problem.body_strain(u)
+        eps = cell.body_strain(u)
         terms.append(ng.Variation(0.5 * ng.InnerProduct(law.stress(eps), eps)
                                   * ng.dx(definedon=mesh.Materials(name))))
     return terms
 
 
-def _load(problem, trial):
+def _load(cell: DiscreteCell, trial):
     """The potential ``-|T| tbar . U`` of the far-face tractions (``U``: the trial functions' last components)."""
-    t = ng.CF(tuple(problem.traction))
+    t = ng.CF(tuple(cell.traction))
     return ng.Variation(-ng.InnerProduct(t, ng.CF(tuple(trial[2:]))) * ng.ds("top"))
-
-
-def macro_strain_cf(params, dim: int):
-    """The in-plane macro strain ``E`` of eq. 63 as a 3x3 CoefficientFunction.
-
-    ``params``: 2D ``(e_xx,)``, 3D ``(e_xx, e_yy, e_xy)`` (``Parameter`` objects or numbers).
-    """
-    e = params
-    if dim == 2:
-        return ng.CF((e[0], 0, 0, 0, 0, 0, 0, 0, 0), dims=(3, 3))
-    return ng.CF((e[0], e[2], 0, e[2], e[1], 0, 0, 0, 0), dims=(3, 3))

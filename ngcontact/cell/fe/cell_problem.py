@@ -70,24 +70,22 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.cell.fe import measures
-from ngcontact.cell.fe.contact_multiplier import TRIANGLE_MAX_ORDER, ContactMultiplier, solve_exact
+from ngcontact.cell.fe.contact_multiplier import TRIANGLE_MAX_ORDER, solve_exact
 from ngcontact.cell.cell_load import CellLoad, cell_load  # noqa: F401 (cell_load: re-exported)
 from ngcontact.cell.cell_solution import CellSolution
 from ngcontact.cell.fe.cell_model import CellModel
-from ngcontact.cell.fe.cell_energy import cell_energy, interface_tangent, jump, macro_strain_cf, preconditioning_form
+from ngcontact.cell.fe.cell_energy import cell_energy, interface_tangent, jump, preconditioning_form
+from ngcontact.cell.fe.discrete_cell import discretize
 from ngcontact.cell.fe.contact_quadrature import ContactQuadrature
 from ngcontact.cell.fe.contact_quadrature import applies as quadrature_applies
-from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.fe.coulomb_friction import METHODS, solve_coulomb
 from ngcontact.cell.fe.load_start import Predictor, check_start, start_load, starts_afresh, tangential_load
 from ngcontact.cell.fe.predictor import max_gap
 from ngcontact.errors import ModelError
-from ngcontact.fem import elasticity as _el
 from ngcontact.laws import penalty as _contact
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.solvers.newton import minimize
 from ngcontact.solvers.split_energy import SplitEnergy
-from ngcontact.fem.quadrature import sampling_order
 
 log = logging.getLogger(__name__)
 
@@ -130,24 +128,16 @@ class CellProblem:
 
     Attributes
     ----------
-    X, gfu, form, u_dofs
-        Space ``(u_r, u_c, U)``, state, energy ``Pi`` and the dofs of ``U``.
-    traction, strain_params
-        ``Parameter`` objects of ``tbar`` and ``E`` in ``Pi``.
-    n, gap, J, pressure, penetration, slip
-        Micro normal, (interpolated) gap and CoefficientFunctions of the state
-        (exact enforcement: ``pressure`` is the multiplier, meaningful at
-        the Lobatto points of ``multiplier`` only).
-    multiplier
-        :class:`~ngcontact.cell.fe.contact_multiplier.ContactMultiplier` (exact
-        enforcement) or ``None``.
-    augmented_pressure
-        Exact enforcement: ``[lambda + k_n (J.n - g)]_+`` of the state.
-    tangential_free
-        Whether ``U_t`` is determinate (friction or a curved ``S_C``).
+    discrete
+        The :class:`~ngcontact.cell.fe.discrete_cell.DiscreteCell` (space, normal, gap, load parameters,
+        multiplier); its fields are also this object's attributes of the same names.
+    gfu, form
+        The state ``(u_r, u_c, U)`` and the energy ``Pi``.
+    J, pressure, penetration, slip, augmented_pressure
+        CoefficientFunctions of the state (exact enforcement: ``pressure`` is the multiplier, meaningful at
+        its points only; ``augmented_pressure`` is ``[lambda + k_n (J.n - g)]_+``, else ``None``).
     coulomb_previous
-        Coulomb: the frozen state of the threshold ``mu p`` (the previous
-        fixed-point iterate, or the current Newton iterate for the line search).
+        Coulomb with the penalty: the frozen state of the threshold ``mu p``.
     """
 
     def __init__(self, cell, model: CellModel, *, rtol: float = 1e-10, atol: float = 0.0,
@@ -167,39 +157,22 @@ class CellProblem:
             predictor.check(cell.mesh)
         self.line_search, self.start, self.coulomb, self.predictor = line_search, start, coulomb, predictor
         self.coulomb_residual = None      # Coulomb, coupled Newton: the residual form, built on first use
-        self.cell, self.model = cell, model
-        self.mesh = mesh = cell.mesh
-        self.dim = dim = cell.dim
-        self.setting = "3d" if dim == 3 else "plane_strain"
         self.rtol, self.atol, self.max_iter, self.inverse = rtol, atol, max_iter, inverse
         self.linear = linear if linear is not None else LinearSolver("direct", inverse=inverse)
-        self.area = cell.area
-        self.n = normal if normal is not None else contact_normal(cell)
-        Vr = _el.body_space(mesh, "rough", model.order, dirichlet="bottom", periodic=True)
-        Vc = _el.body_space(mesh, "counter", model.order, dirichlet="top", periodic=True)
-        # U lives only where it enters (S_C and the far face): a NumberSpace on
-        # every element would couple all dofs and slow the factorization 5x
-        N = ng.NumberSpace(mesh, definedon=mesh.Boundaries("contact|top"))
-        self.X = ng.FESpace([Vr, Vc] + [N] * dim)
-        # exact: the gap itself at the Lobatto nodes (an interpolant on S_C, not periodic, would give the
-        # two copies of a periodic vertex different gaps: contradictory constraints on one node)
-        self.gap = model.gap if model.enforcement == "exact" else _discrete_gap(mesh, model)
+        self.discrete = d = discretize(cell, model, normal=normal, inverse=inverse)
+        self.cell, self.model, self.mesh, self.dim, self.setting, self.area = cell, model, d.mesh, d.dim, \
+            d.setting, d.area
+        self.X, self.n, self.gap, self.u_dofs, self.tangential_free = d.X, d.n, d.gap, d.u_dofs, d.tangential_free
+        self.traction, self.strain_params, self.augmentation, self.multiplier = \
+            d.traction, d.strain_params, d.augmentation, d.multiplier
         self.gfu = ng.GridFunction(self.X)
-        self.u_dofs = [self.X.Range(2 + i).start for i in range(dim)]
-        self.traction = [ng.Parameter(0.0) for _ in range(dim)]
-        nE = 1 if dim == 2 else 3
-        self.strain_params = [ng.Parameter(0.0) for _ in range(nE)]
-        self.tangential_free = _tangential_determinate(mesh, self.n, dim, model)
-        self.multiplier = (ContactMultiplier(mesh, model.order)
-                           if model.enforcement == "exact" else None)
-        # exact: the augmentation k_n as a Parameter (the constrained tangent extrapolates in it)
-        self.augmentation = ng.Parameter(model.k_n)
-        self.form, self.coulomb_previous, self._parts = cell_energy(self)
+        self.form, self.coulomb_previous, self._parts = cell_energy(d)
         # the state the written-out tangent and the preconditioning form are assembled at
         self._linearized_at = ng.GridFunction(self.X)
         # the penalty's high quadrature on the contact edge's elements only, where that is exact
-        self._quadrature = ContactQuadrature(self, self._linearized_at) if quadrature_applies(self) else None
-        self._preconditioning = preconditioning_form(self, self._linearized_at, self._quadrature)
+        self._quadrature = ContactQuadrature(d, self._linearized_at) if quadrature_applies(d) else None
+        self._preconditioning = preconditioning_form(d, self._linearized_at, self._quadrature,
+                                                     self.coulomb_previous)
         self._split: SplitEnergy | None = None
         self._largest_gap: float | None = None
         # the state as CoefficientFunctions (for results and tests)
@@ -220,8 +193,7 @@ class CellProblem:
     # -------------------------------------------------------------- energy
     def body_strain(self, u):
         """Total strain of a body: fluctuation plus the macro strain (if assembled)."""
-        eps = _el.strain(u, self.setting)
-        return eps + macro_strain_cf(self.strain_params, self.dim) if self.model.macro_strain else eps
+        return self.discrete.body_strain(u)
 
     def largest_gap(self) -> float:
         """Largest initial gap on ``S_C`` (:func:`ngcontact.cell.fe.predictor.max_gap`), sampled once: the gap
@@ -237,7 +209,7 @@ class CellProblem:
     @property
     def contact_order(self) -> int:
         """Integration order of the contact energy (that of the ``Variation`` term)."""
-        return 2 * self.model.order + self.model.contact_bonus_order
+        return self.discrete.contact_order
 
     # --------------------------------------------------------------- solve
     def _freedofs(self, load: CellLoad):
@@ -315,7 +287,7 @@ class CellProblem:
             if self._quadrature is not None:
                 interface = self._quadrature
             else:
-                tangent = interface_tangent(self, self._linearized_at)
+                tangent = interface_tangent(self.discrete, self._linearized_at, self.coulomb_previous)
             self._split = SplitEnergy(self.form, quadratic, interface, key=lambda: tuple(p.Get() for p in loads),
                                       preconditioning=self._preconditioning, interface_tangent=tangent)
         return self._split
@@ -366,32 +338,3 @@ class CellProblem:
     def measure(self, load: CellLoad) -> dict:
         """Results of the current state: :func:`ngcontact.cell.fe.measures.measure`."""
         return measures.measure(self, load)
-
-
-# ------------------------------------------------------------ discretization
-def _discrete_gap(mesh, model: CellModel):
-    """The gap interpolated into polynomials of the displacement order on ``S_C``.
-
-    The penetration ``J_n - g_h`` is then a polynomial on each boundary
-    element, so its sign (the contact set) is not polluted by the
-    interpolation error of a transcendental gap against polynomial
-    displacements, which for a stiff penalty exceeds the penetration.
-    ``model.gap`` itself without gap or with ``interpolate_gap = False``.
-    """
-    g = model.gap
-    if g is None or not model.interpolate_gap:
-        return g
-    Vg = ng.H1(mesh, order=model.order, definedon=mesh.Boundaries("contact"))
-    gh = ng.GridFunction(Vg)
-    gh.Set(g, definedon=mesh.Boundaries("contact"))
-    return gh
-
-
-def _tangential_determinate(mesh, n, d: int, model: CellModel) -> bool:
-    """False when the far-face translation ``U_t`` costs no energy: frictionless and a flat ``S_C``."""
-    if model.friction is not None:
-        return True
-    nt2 = ng.InnerProduct(n, n) - n[d - 1] * n[d - 1]
-    tilt = ng.Integrate(nt2, mesh, definedon=mesh.Boundaries("contact"), order=sampling_order(model.order))
-    size = ng.Integrate(ng.CF(1.0), mesh, definedon=mesh.Boundaries("contact"))
-    return tilt > 1e-12 * size

@@ -7,7 +7,7 @@ The penalty energy of eq. 65 (frictionless),
 is integrated with ``contact_bonus_order`` extra orders because ``[.]_+``
 has a kink where the contact set ends.  On a straight surface element with
 the gap interpolated in the displacements' polynomials
-(:func:`ngcontact.cell.fe.cell_problem._discrete_gap`), ``s`` is a polynomial
+(:func:`ngcontact.cell.fe.discrete_cell.discrete_gap`), ``s`` is a polynomial
 of degree ``p`` (the order), so wherever an element's points are all in
 contact the integrand is the polynomial ``k_n/2 s^2`` of degree ``2p``, and
 wherever they are all open it is zero.  On such an element the order ``2p``
