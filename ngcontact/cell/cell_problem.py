@@ -180,7 +180,7 @@ class CellProblem:
         Vr = _el.body_space(mesh, "rough", model.order, dirichlet="bottom", periodic=True)
         Vc = _el.body_space(mesh, "counter", model.order, dirichlet="top", periodic=True)
         # U lives only where it enters (S_C and the far face): a NumberSpace on
-        # every element would couple all dofs and slow the factorization 5x
+        # every element would couple all dofs and make the factorization much slower
         N = ng.NumberSpace(mesh, definedon=mesh.Boundaries("contact|top"))
         self.X = ng.FESpace([Vr, Vc] + [N] * dim)
         # exact: the gap itself at the Lobatto nodes (an interpolant on S_C, not periodic, would give the
@@ -352,9 +352,8 @@ class CellProblem:
 
         A frictionless cell with a spectral twin starts every load under a prescribed pressure afresh from
         the twin's contact set instead: its energy is convex with one minimizer, so the start may forget the
-        previous state, and the twin's contact set is nearer the solution's than the previous load's (the
-        Westergaard sweep: 2, 5, 7, 7, 3 Newton steps continued, 2, 2, 2, 2, 1 afresh; the tabulated gap
-        1, 5, 7 and 1, 1, 4).
+        previous state, and the twin's contact set is nearer the solution's than the previous load's (fewer
+        Newton steps on the Westergaard sweep and the tabulated gap).
         """
         self.gfu.vec[:] = 0.0
         out = []

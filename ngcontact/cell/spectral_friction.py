@@ -9,8 +9,8 @@ identical layers only.  The cell is then the convex problem in tractions of
 solved by accelerated proximal gradients.  Coulomb friction has no such
 potential; its threshold is taken from the pressure of the same proximal
 step, so that a fixed point of the iteration meets Coulomb's conditions
-with its own pressure (no outer fixed point of Tresca problems, which cost
-six passes of 300 to 400 steps each on a 256^2 cell).  With ``"penalty"``
+with its own pressure (no outer fixed point of Tresca problems, each pass
+of which is a whole proximal-gradient solve).  With ``"penalty"``
 the friction is the FE cell's Huber-regularized one (width ``w``), with ``"exact"`` it is
 exact.  As in the FE cell, the Tresca threshold holds on the whole surface.
 
