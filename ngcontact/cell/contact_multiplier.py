@@ -263,8 +263,8 @@ def characteristic_length(problem) -> float:
 #: factor by which a slow Uzawa pass raises the augmentation (:func:`ngcontact.solvers.uzawa.uzawa`)
 STIFFEN = 10.0
 #: ceiling of a raised augmentation, as ``k h / E`` (``h`` the smallest element of ``S_C``, ``E`` the
-#: softer body's modulus): 1e4 reaches the answer in 2 passes on Westergaard's cell with equilibrium to
-#: 2e-12, where 1e8 loses it to 3e-7
+#: softer body's modulus): high enough that Uzawa ends in a couple of passes, low enough that the stiff
+#: term leaves the equilibrium at round-off (a far larger ratio costs it several digits)
 MAX_AUGMENTATION_RATIO = 1e4
 
 

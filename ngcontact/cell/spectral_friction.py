@@ -44,7 +44,7 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
     ``K0`` the diagonal of the uniform mode (the layers' uniaxial-strain
     and shear compliances).
     """
-    import scipy.fft as sfft  # on use: importing scipy.fft costs every process (and batch worker) 0.5 s at start
+    import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
     d = cell.dim
     n = cell.grid
     k1 = 2 * np.pi * sfft.rfftfreq(n, d=cell.period / n)

@@ -27,8 +27,8 @@ only the speed (the error in ``lambda`` contracts roughly by
 the order of ``E/h`` and above takes a few passes).  Each pass's Newton
 solve starts from the previous one's state.
 
-A soft augmentation converges slowly (``k = 0.01 E/h`` on Westergaard's
-cell: not within 500 passes).  Since ``k`` is not in the answer, a caller
+A soft augmentation converges slowly (``k`` well below ``E/h`` takes
+hundreds of passes).  Since ``k`` is not in the answer, a caller
 may pass ``stiffen``: whenever a pass fails to shrink the larger of the
 two measures to ``SLOW`` times its value after the previous pass,
 ``stiffen()`` raises ``k`` (it returns ``False`` once it may not: a
