@@ -13,7 +13,7 @@ and the text between them are kept byte for byte) with
 * a stamp line: the command that produced the figures, the git commit
   (``git rev-parse --short HEAD``, ``+dirty`` when tracked files outside the
   benchmark document differ from it), the machine (CPU model, core count,
-  total memory) and the date,
+  total memory, load average when published) and the date,
 * the script's note (what the columns mean, how to read them),
 * the CSV as a Markdown table (the chosen columns; numbers to ``DIGITS``
   significant digits),
@@ -106,7 +106,10 @@ def _read_field(path: str, key: str) -> str | None:
 
 
 def machine() -> str:
-    """CPU model, core count and total memory, from ``/proc`` where it exists."""
+    """CPU model, core count, total memory (from ``/proc`` where it exists) and the load average of the last minute.
+
+    The load tells a reader of a timing whether the machine was shared while it ran.
+    """
     import platform
     cpu = _read_field("/proc/cpuinfo", "model name") or platform.processor() or platform.machine() or "unknown CPU"
     cores = os.cpu_count() or 0
@@ -114,7 +117,8 @@ def machine() -> str:
     memory = "memory unknown"
     if mem and mem.split()[0].isdigit():
         memory = f"{int(mem.split()[0]) / 2 ** 20:.1f} GiB memory"
-    return f"{cpu}, {cores} cores, {memory}"
+    load = f", load average {os.getloadavg()[0]:.1f}" if hasattr(os, "getloadavg") else ""
+    return f"{cpu}, {cores} cores, {memory}{load}"
 
 
 def command_line(argv: Sequence[str] | None = None) -> str:
