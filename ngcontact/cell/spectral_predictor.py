@@ -58,8 +58,8 @@ the previous state need not be kept); a frictional one continues from the
 previous solution as before (:mod:`ngcontact.cell.predictor`).  A graded
 solve (:mod:`ngcontact.cell.edge_grading`) takes its first mesh's edges
 from the twin (:func:`twin_edges`) and starts every level afresh from it,
-the twin as fine as the grid allows: a coarse twin's edges are too far
-from the solution's to save the levels steps.  From the spectral start
+the twin as fine as the grid allows: a coarse twin's edges lie too far
+from the solution's for the fresh starts to save steps.  From the spectral start
 Newton takes fewer steps per load than from the rigid one on the
 bisinusoid cell (at every size), the height map, the Westergaard sweep and
 the tabulated gap, with the same contact fractions to round-off

@@ -20,7 +20,7 @@ log = logging.getLogger("ngcontact.solvers.executor")
 
 
 #: Wall seconds a local pool's workers take to start (fresh interpreters importing NGSolve and the package,
-#: all at once; the order of two workers starting together on a machine of two cores).
+#: all at once; an estimate for two workers starting together on two cores).
 START_SECONDS = 2.0
 
 
