@@ -53,10 +53,10 @@ def thread_count() -> int:
 def threads(n: int):
     """Assembly and solves inside NGSolve's task manager with ``n`` threads (NGSolve runs on one core otherwise).
 
-    One thread runs without the task manager: with it a 3D cell took 37 s instead of 26 s here.  The
+    One thread runs without the task manager: with it a 3D cell solve is markedly slower.  The
     BLAS libraries loaded (NGSolve's OpenBLAS under its direct solvers, NumPy's) run on one thread
     meanwhile: their own threads, which keep spinning after each call, would share the cores with
-    NGSolve's.  With both pools on 2 cores the femur's macro solve took 2.8 s; with one, 0.86 s.
+    NGSolve's, and a solve with both pools on the same cores runs several times slower.
     """
     from threadpoolctl import threadpool_limits
     with threadpool_limits(limits=1):

@@ -27,6 +27,9 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+
 KEYS = ("scene", "status", "ndof", "loads", "newton_per_load", "max_newton", "max_per_solve",
         "newton_solves", "solve_seconds", "total_seconds", "wall_seconds")
 
@@ -65,6 +68,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", nargs="?", default=os.path.join("results", "cell_scenes_benchmark"))
     ap.add_argument("--scenes", default=os.path.join(HERE, "..", "geometries", "cells"))
+    benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
     rows = [bench(p, args.out) for p in sorted(glob.glob(os.path.join(args.scenes, "*.toml")))]
@@ -84,6 +88,12 @@ def main(argv=None) -> int:
     bad = [r for r in rows if r["status"] != "ok"]
     for r in bad:
         sys.stdout.write(f"{r['scene']}: {r['status']}\n")
+    if args.publish:
+        benchmark_doc.publish("cell_scenes_benchmark", "Cell scenes: Newton steps and wall time",
+                              os.path.join(args.out, "cell_scenes_benchmark.csv"),
+                              note="Every scene of `geometries/cells/` run by `ngcontact run` in its own process: "
+                                   "Newton steps per load, the largest single Newton solve, the number of solves, "
+                                   "the solve stage's and the whole run's seconds.")
     return 0
 
 

@@ -26,6 +26,7 @@ import argparse
 import csv
 import importlib.util
 import os
+import sys
 import tempfile
 import time
 from contextlib import contextmanager
@@ -41,6 +42,9 @@ from ngcontact.drivers.cell_members import fe_problem  # noqa: E402
 from ngcontact.errors import ConvergenceError  # noqa: E402
 from ngcontact.macro import macro_problem  # noqa: E402
 from ngcontact.scene.loader import load  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CELL = os.path.join(ROOT, "geometries", "cells", "rectangular_coulomb.toml")
@@ -126,6 +130,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="results/coulomb_newton_globalization")
     ap.add_argument("--variants", nargs="*", default=list(DEFAULT_VARIANTS), help="femur variants")
+    benchmark_doc.add_flag(ap)
     args = ap.parse_args()
     variants = _variants_module()
     unknown = [v for v in args.variants if v not in variants.VARIANTS]
@@ -151,6 +156,14 @@ def main() -> None:
     os.replace(path + ".tmp", path)
     plot(rows, os.path.join(args.out, "coulomb_newton_globalization.png"))
     print("wrote", path)
+    if args.publish:
+        benchmark_doc.publish("coulomb_newton_globalization", "Coupled Coulomb Newton: the two globalizations",
+                              path, columns=FIELDS,
+                              note="The cell `geometries/cells/rectangular_coulomb.toml` (steps per load, the "
+                                   "shear loads' rigid continuation counted) and femur / hip-stem variants "
+                                   "solved with the frozen-energy line search (as shipped) and with residual "
+                                   "backtracking: converged, seconds, Newton steps, width-continuation rungs.",
+                              png=os.path.join(args.out, "coulomb_newton_globalization.png"))
 
 
 if __name__ == "__main__":

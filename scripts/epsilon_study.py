@@ -23,6 +23,9 @@ import sys
 from ngcontact.cli import EXIT_OK
 from ngcontact.cli import main as cli_main
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -30,6 +33,7 @@ def main(argv=None) -> int:
     p.add_argument("--periods", type=int, nargs="+", help="numbers of periods N (default: the scene's)")
     p.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
+    benchmark_doc.add_flag(p)
     args = p.parse_args(argv)
     out = args.out or os.path.join("results", os.path.splitext(os.path.basename(args.scene))[0] + "_epsilon")
     code = cli_main(["study", "epsilon", args.scene, "--out", out]
@@ -45,6 +49,14 @@ def main(argv=None) -> int:
     for r in rows:
         print(f"{r['N']:>4} {r['eps']:9.4g} {r['time_resolved']:7.2f} {r['time_homogenized']:7.2f} " + " ".join(
             f"{r[law + '_' + key]:18.3e}" for law in laws for key in ("field", "reaction")))
+    if args.publish:
+        name = os.path.splitext(os.path.basename(args.scene))[0]
+        benchmark_doc.publish(f"epsilon_{name}", f"Epsilon study of `{name}`: resolved against homogenized",
+                              os.path.join(out, "epsilon.csv"),
+                              note=f"`{args.scene}` with N periods (period eps): the resolved run against the "
+                                   "homogenized runs with the bundle, the linear whole-surface and the "
+                                   "effective-stiffness laws, their relative errors and seconds.",
+                              png=os.path.join(out, "epsilon.png"))
     return EXIT_OK
 
 

@@ -19,6 +19,7 @@ import argparse
 import csv
 import os
 import re
+import sys
 import tempfile
 import time
 
@@ -32,6 +33,9 @@ from ngcontact.drivers import run_macro as RM  # noqa: E402
 from ngcontact.errors import ConvergenceError  # noqa: E402
 from ngcontact.macro import macro_measures as MM  # noqa: E402
 from ngcontact.scene.loader import load  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FEMUR = os.path.join(ROOT, "geometries", "femur_stem.toml")
@@ -129,6 +133,7 @@ def main() -> None:
     ap.add_argument("--out", default="results/femur_coulomb_variants")
     ap.add_argument("--only", nargs="*", default=None, help="variant names (default: all)")
     ap.add_argument("--methods", nargs="*", default=list(METHODS), choices=METHODS, help="default: both")
+    benchmark_doc.add_flag(ap)
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     rows = []
@@ -145,6 +150,14 @@ def main() -> None:
         w.writerows({k: r.get(k, "") for k in FIELDS} for r in rows)
     plot(rows, os.path.join(args.out, "femur_coulomb_variants.png"))
     print("wrote", os.path.join(args.out, "femur_coulomb_variants.csv"))
+    if args.publish:
+        benchmark_doc.publish("femur_coulomb_variants", "Coulomb friction on femur / hip-stem variants",
+                              os.path.join(args.out, "femur_coulomb_variants.csv"), columns=FIELDS,
+                              note="Each variant changes one line of `geometries/femur_stem.toml` and is solved "
+                                   "by the coupled Newton (`newton`) and by the fixed point of Tresca passes "
+                                   "(`fixed_point`): converged, seconds of the solve, Newton steps, width-"
+                                   "continuation rungs, equilibrium error, worst friction-law violation.",
+                              png=os.path.join(args.out, "femur_coulomb_variants.png"))
 
 
 if __name__ == "__main__":

@@ -26,6 +26,9 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+
 ROOT = Path(__file__).resolve().parents[1]
 GEO = ROOT / "geometries"
 TIMEOUT = 120
@@ -167,6 +170,7 @@ def run_case(c: dict, base: Path) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, required=True)
+    benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     base = Path(tempfile.mkdtemp(prefix="ngcontact-hostile-"))
     try:
@@ -198,6 +202,15 @@ def main(argv=None) -> int:
     bad = [r["case"] for r in rows if not r["pass"]]
     print(f"{len(rows)} cases: " + ", ".join(f"{k} {v}" for k, v in kinds.items())
           + f"; handled well {len(rows) - len(bad)}" + (f"; not: {bad}" if bad else ""))
+    if args.publish:
+        benchmark_doc.publish("hostile_inputs", "Hostile inputs: what each run ends in", str(args.out / "hostile.csv"),
+                              columns=["case", "exit", "stderr_lines", "seconds", "user_files_intact", "converged",
+                                       "pass"],
+                              note="Each case is a shipped scene with one hostile edit (or a hostile file or "
+                                   "`--out` target) run by `ngcontact` in its own process; it passes when it ends "
+                                   "in exit 2 or 3 with one line, or in exit 0 with a converged report, and leaves "
+                                   "the user's files as they were. The message column of the CSV is left out here.",
+                              png=str(args.out / "hostile.png"))
     return 0
 
 

@@ -37,6 +37,7 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 from cell_scenes_benchmark import bench  # noqa: E402  (the sibling script runs one scene)
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
 
 AIM = 10
 KEYS = ("scene", "status", "loads", "newton_per_load", "max_newton", "mean_newton", "max_per_solve", "within_aim")
@@ -82,6 +83,7 @@ def main(argv=None) -> int:
     ap.add_argument("out", nargs="?", default=os.path.join("results", "newton_steps"))
     ap.add_argument("--scenes", default=os.path.join(HERE, "..", "geometries", "cells"))
     ap.add_argument("--only", nargs="*", default=None, help="scene names (without .toml) to run")
+    benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     paths = sorted(glob.glob(os.path.join(args.scenes, "*.toml")))
     if args.only:
@@ -107,6 +109,14 @@ def main(argv=None) -> int:
     plot(rows, os.path.join(args.out, "newton_steps.png"))
     over = [r["scene"] for r in rows if r["within_aim"] is False]
     sys.stdout.write(f"over the aim of {AIM}: {', '.join(over) if over else 'none'}\n")
+    if args.publish:
+        benchmark_doc.publish("newton_steps", f"Newton steps per load of the shipped cell scenes (aim: {AIM})",
+                              csv_path,
+                              note="Every tangent solve of a load counted (the rigid continuation's, every "
+                                   "Coulomb pass's or coupled step's, every graded level's); `max_per_solve` is "
+                                   "the largest single Newton solve. Spectral and purely geometric scenes take "
+                                   "no Newton step.",
+                              png=os.path.join(args.out, "newton_steps.png"))
     return 1 if any(r["status"] != "ok" for r in rows) else 0
 
 

@@ -58,6 +58,9 @@ import numpy as np
 
 from ngcontact.output.writer import write_csv
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+
 log = logging.getLogger("scaling_3d")
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -431,13 +434,31 @@ def main(argv=None) -> int:
                     help="instead: BDDC's coarse problem on the converged cell of this interface mesh size, the "
                          "bubble term's gamma against the contact surface on the wirebasket")
     ap.add_argument("--k-n", type=float, default=None, help="with --coarse: the penalty k_n (default the scene's)")
+    benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     if args.breakdown is not None:
         breakdown(args.breakdown, args.out)
+        if args.publish:
+            benchmark_doc.publish("scaling_3d_breakdown", "3D cell: where an iterative solve spends its time",
+                                  os.path.join(args.out, "scaling_3d_breakdown.csv"),
+                                  note="One BDDC-CG cell solve of the bisinusoid: CG iterations and seconds, "
+                                       "milliseconds per CG iteration, per BDDC application and per product with "
+                                       "the tangent; the size of BDDC's coarse problem (wirebasket dofs, those on "
+                                       "the contact surface).",
+                                  png=os.path.join(args.out, "scaling_3d_breakdown.png"))
         return 0
     if args.coarse is not None:
         coarse_study(args.coarse, args.out, args.k_n)
+        if args.publish:
+            benchmark_doc.publish("scaling_3d_coarse", "3D cell: BDDC's coarse problem, bubble term against "
+                                  "the contact surface on the wirebasket",
+                                  os.path.join(args.out, "scaling_3d_coarse.csv"),
+                                  note="CG to 1e-8 on the tangent of the converged bisinusoid cell with a random "
+                                       "right-hand side: the bubble term of `ngcontact.fem.elasticity.bubble_term` "
+                                       "for several `gamma` (the shipped one is `BUBBLE_GAMMA`), and the whole "
+                                       "contact surface on the wirebasket.",
+                                  png=os.path.join(args.out, "scaling_3d_coarse.png"))
         return 0
     rows = fe_parts(args.quick, args.direct_max, args.parts, args.solvers)
     if "spectral" in args.parts:
@@ -445,12 +466,24 @@ def main(argv=None) -> int:
     os.makedirs(args.out, exist_ok=True)
     write_csv(os.path.join(args.out, "scaling_3d.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
     plot(rows, os.path.join(args.out, "scaling_3d.png"))
+    fits = []
     for part in ("cell", "macro"):
         for solver in ("iterative", "direct"):
             b = exponent(rows, part, solver)
             if b is not None:
                 log.info("%s, %s: time ~ dofs^%.2f", part, solver, b)
+                fits.append(f"{part} {solver} `time ~ dofs^{b:.2f}`")
     log.info("wrote %s", os.path.join(args.out, "scaling_3d.csv"))
+    if args.publish:
+        benchmark_doc.publish("scaling_3d", "3D at scale: direct against iterative; the bisinusoid aim",
+                              os.path.join(args.out, "scaling_3d.csv"),
+                              note="Part `cell`: the 3D bisinusoid cell (order 2) refined, one load by sparse "
+                                   "Cholesky (`direct`) and BDDC-CG (`iterative`), started as `ngcontact run` "
+                                   "starts it; part `macro`: a 3D press fit of two tubes; part `spectral`: the "
+                                   "spectral cell against Tamaas (skipped without the `bench` extra). Seconds of "
+                                   "setup and solve, of the measurement after it, Newton steps, CG iterations, "
+                                   "peak memory. Fitted: " + ("; ".join(fits) if fits else "none") + ".",
+                              png=os.path.join(args.out, "scaling_3d.png"))
     return 0
 
 

@@ -53,6 +53,9 @@ from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.geometry.random_surface import self_affine
 from ngcontact.output.writer import write_csv
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+
 log = logging.getLogger("spectral_vs_fft")
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -274,6 +277,7 @@ def main(argv=None) -> int:
                     help="FE interface mesh sizes of part 2 (default 0.12 0.08 0.06)")
     ap.add_argument("--dissimilar-child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--dissimilar-friction-child", action="store_true", help=argparse.SUPPRESS)
+    benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     if args.dissimilar_child or args.dissimilar_friction_child:
         dissimilar_child(friction=args.dissimilar_friction_child)
@@ -284,6 +288,15 @@ def main(argv=None) -> int:
     if not args.quick:
         rows += dissimilar()
     write_study(args.out, "spectral_vs_fft", KEYS, rows, plot)
+    if args.publish:
+        benchmark_doc.publish("spectral_vs_fft", "The spectral cell beside an FFT half-space solver and the FE cell",
+                              os.path.join(args.out, "spectral_vs_fft.csv"),
+                              note="Part 1: a random self-affine surface on two thick layers against Tamaas' "
+                                   "half-space solver (skipped without the `bench` extra); part 2: the FE cell "
+                                   "against the spectral cell on the bisinusoid; part 3: dissimilar finite "
+                                   "layers, frictionless and with Coulomb friction. Contact fraction, pressure "
+                                   "difference, mean closure, stiffness, iterations, seconds, peak memory.",
+                              png=os.path.join(args.out, "spectral_vs_fft.png"))
     return 0
 
 

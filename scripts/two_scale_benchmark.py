@@ -31,7 +31,7 @@ machine are noisy: rerun on a quiet machine before quoting them.
 
 Usage::
 
-    python scripts/two_scale_benchmark.py [OUT_DIR] [--repeats N]
+    python scripts/two_scale_benchmark.py [OUT_DIR] [--repeats N] [--publish]
 """
 from __future__ import annotations
 
@@ -39,12 +39,16 @@ import csv
 import dataclasses
 import os
 from functools import partial
+import sys
 import tempfile
 import time
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+
 SCENE = os.path.join(HERE, "..", "geometries", "femur_stem_two_scale.toml")
 REPEATS = 2
 KEYS = ("case", "repeat", "wall_seconds", "cpu_seconds", "macro_solves", "newton_per_solve", "cell_solves", "updates",
@@ -149,5 +153,15 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description="cost of the two-scale femur against one fixed-law macro solve")
     ap.add_argument("out", nargs="?", default=os.path.join("results", "two_scale_benchmark"))
     ap.add_argument("--repeats", type=int, default=REPEATS, help="runs of every case; the fastest is reported")
+    benchmark_doc.add_flag(ap)
     args = ap.parse_args()
     main(args.out, args.repeats)
+    if args.publish:
+        benchmark_doc.publish("two_scale_benchmark", "Cost of the two-scale femur against one fixed-law macro solve",
+                              os.path.join(args.out, "two_scale_benchmark.csv"),
+                              note="`geometries/femur_stem_two_scale.toml` without its strength check, every case "
+                                   "in one process on every core: the fixed start law, the coupling loop cold "
+                                   "(spectral and FE cell, in this process and on two workers), warm from a cached "
+                                   "table, and with cold macro restarts. Every repeat is listed (`fastest` marks "
+                                   "each case's fastest); wall times on a shared machine vary between repeats.",
+                              png=os.path.join(args.out, "two_scale_benchmark.png"))

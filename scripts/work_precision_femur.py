@@ -22,6 +22,7 @@ import argparse
 import csv
 import logging
 import os
+import sys
 import time
 
 import numpy as np
@@ -31,6 +32,9 @@ from ngcontact.macro import macro_measures as MM
 from ngcontact.scene import loader as scene_mod
 from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
 from ngcontact.parallel import executor
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 log = logging.getLogger("work_precision_femur")
@@ -65,6 +69,7 @@ def main() -> int:
     ap.add_argument("--out", default=os.path.join(ROOT, "results", "work_precision_femur"))
     ap.add_argument("--quick", action="store_true", help="fewer levels (a smoke run)")
     ap.add_argument("--workers", type=int, default=1, help="local worker processes for the discretizations")
+    benchmark_doc.add_flag(ap)
     args = ap.parse_args()
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     sc = scene_mod.load(os.path.join(ROOT, "geometries", "femur_stem.toml"))
@@ -105,6 +110,16 @@ def main() -> int:
         w.writerow([dict(ref, study="reference", err_pressure=0.0, err_von_mises=0.0)[k] for k in keys])
     _plot(os.path.join(args.out, "work_precision_femur.png"), rows)
     log.info("wrote %s", args.out)
+    if args.publish:
+        benchmark_doc.publish("work_precision_femur", "Work-precision of the femur / hip-stem scene",
+                              os.path.join(args.out, "work_precision_femur.csv"),
+                              columns=["study", "order", "maxh", "interface_maxh", "ndof", "seconds", "newton",
+                                       "peak_pressure", "err_pressure", "peak_von_mises", "err_von_mises"],
+                              note="`geometries/femur_stem.toml` under h-refinement (orders 2 and 3) and "
+                                   "p-refinement on the scene's mesh: peak contact pressure and peak von Mises "
+                                   "stress, their relative errors against the reference (the last row), wall "
+                                   "seconds from meshing to post-processing on one NGSolve thread, Newton steps.",
+                              png=os.path.join(args.out, "work_precision_femur.png"))
     return 0
 
 

@@ -18,9 +18,9 @@ active set is ``A`` therefore lands on the minimizer of that quadratic
 energy, whatever the rest of the state; only the start's active set
 matters.  The rigid predictor (:mod:`ngcontact.cell.fe.predictor`) can only
 offer a level set of the gap, which the elastic bodies then reshape, and
-Newton moves the contact edge over several steps (the 301k-dof bisinusoid
-cell: 11 steps, the active set overshooting from 90 % to 107 % of the
-solution's and retreating over six of them).  The twin's contact set is
+Newton moves the contact edge over several steps (on the bisinusoid cell
+the active set overshoots the solution's and retreats over several
+of them).  The twin's contact set is
 the solution's up to the two discretizations.
 
 The start.  The rigid predictor's state (fluctuations zero, the counter
@@ -31,18 +31,16 @@ start's penetration is the twin's, interpolated bilinearly from its grid
 body's interior is left as it is: the state is not smooth, but only its
 active set enters the first Newton step.  The trace cannot follow the
 penetration's kink at the contact edge within an element, so the start's
-active set is the twin's but for a band along the edge (on the 8k-dof
-bisinusoid cell 85 % of the twin's contact points and 98 % of its open
-points).
+active set is the twin's but for a band along the edge.
 
 The Newton tolerance, ``|r| <= rtol |r_0|``, refers to the first residual,
-as from any start: the spectral start's is about 300 times smaller than
+as from any start: the spectral start's is much smaller than
 the rigid start's, so the answer is held to a tighter absolute tolerance
-(one Newton step more than the same absolute tolerance would take on the
-bisinusoid).  A tolerance referred to the rigid start's residual was tried
-and dropped: with a stiff penalty (``k_n h / E ~ 1e10``) that residual is
-the penalty force of the rigid start's misfit, and the spectral start was
-taken as converged before a step.
+(about one Newton step more than the same absolute tolerance would take).
+A tolerance referred to the rigid start's residual would not do: with a
+stiff penalty (``k_n h / E ~ 1e10``) that residual is
+the penalty force of the rigid start's misfit, and the spectral start would
+be taken as converged before a step.
 
 Applies to the penalty's first loads under a prescribed pressure on a
 small-slope cell (the twin is built by
@@ -60,20 +58,12 @@ the previous state need not be kept); a frictional one continues from the
 previous solution as before (:mod:`ngcontact.cell.fe.predictor`).  A graded
 solve (:mod:`ngcontact.cell.fe.edge_grading`) takes its first mesh's edges
 from the twin (:func:`twin_edges`) and starts every level afresh from it,
-the twin as fine as the grid allows: with a twin of 256 points, levels
-started afresh had taken 33-69 steps summed per load against 39-46 carried
-over; with 8192 points and the seeded first mesh, 10-13.  Measured, Newton steps per load from the rigid
-start and from the spectral one, the same contact fractions to 12 digits
-or more (``python -m ngcontact.cli run <scene>`` and
-``MPLBACKEND=Agg python scripts/scaling_3d.py OUT --parts cell``):
-
-* bisinusoid cell, 8k dofs 7 -> 6; 94.6k dofs 10 -> 6 (13.2 s -> 6.4 s);
-  301k dofs 11 -> 6 (62 s -> 26 s), equal to all 16 printed digits;
-* height map (64^2): 9 -> 6;
-* Westergaard sweep (2D), each load from a first load's start: 5, 6, 8, 8,
-  1 -> 2, 2, 2, 2, 1 (continued from the previous load, as the sweep did:
-  2, 5, 7, 7, 3);
-* tabulated gap (2D): 2, 4, 8 -> 1, 1, 4 (continued: 1, 5, 7).
+the twin as fine as the grid allows: a coarse twin's edges lie too far
+from the solution's for the fresh starts to save steps.  From the spectral start
+Newton takes fewer steps per load than from the rigid one on the
+bisinusoid cell (at every size), the height map, the Westergaard sweep and
+the tabulated gap, with the same contact fractions to round-off
+(docs/benchmarks.md, sections newton_steps and scaling_3d).
 """
 from __future__ import annotations
 

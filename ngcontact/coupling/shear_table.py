@@ -40,15 +40,14 @@ at most ``tol``; beyond the row the law holds the shear: the cell slides).
 The cell solves of one level (all rows' new nodes together) are independent
 and go through ``map_tasks``, like the pressure table's.
 
-Measured (``scripts/sawtooth_shear.py``: a symmetric sawtooth with faces at
-20 degrees, micro Coulomb ``mu = 0.3``, ``table_tol = 0.05``): 13 rows, 239
-nodes, 227 cell solves of about 0.1-0.3 s (and 19 of the pressure table),
-error estimates 0.050 in the jump and 0.031 in the pressure; the macro
-block's sliding ratio ``tau / p = 0.745357`` is the resolved one (N = 8,
-16, 32 periods) to 5e-11, where the hand-set ``mu`` gives 0.300 and the
-bundle with the ``mu0`` of eqs. 42-43 0.664.  With the rows interpolated at
-fixed ``s`` instead of along ``s / p`` the same tolerance took 19 rows and
-488 cell solves.
+On a symmetric sawtooth with micro Coulomb friction the macro block's
+sliding ratio ``tau / p`` from this table is the resolved one to many digits
+and the rigid wedge's ``(tan a + mu) / (1 - mu tan a)``, where the
+hand-set ``mu`` and the bundle with the ``mu0`` of eqs. 42-43 fall well
+short (``scripts/sawtooth_shear.py``: docs/benchmarks.md, section
+sawtooth_shear).  The rows are interpolated along ``s / p``, not at fixed
+``s``: the shear's kink moves with the pressure, so fixed ``s`` needs many
+more rows and cell solves for the same tolerance.
 
 Scope: the rows are odd in ``s`` through ``(0, 0)``, which holds for cells
 symmetric under ``t0 -> -t0``; a cell that transmits a shear at zero

@@ -35,9 +35,9 @@ the macro solve; the loop only grows the table:
    warm-started from that solution.  That first solve is never the answer:
    it starts the cell law's solve and sets the table's first range, so
    Newton stops it at ``START_RTOL`` (1e-4 of the first residual) instead of
-   the scene's ``rtol``.  On the femur that saves the scene law's last three
-   steps (15 instead of 18, where its contact and stick sets have long
-   settled), and the cell law's solve still takes 4 steps from there.  Both
+   the scene's ``rtol``.  That saves the scene law's last steps, taken where
+   its contact and stick sets have long settled, and the cell law's solve
+   takes as many steps from there as from the exact solution.  Both
    a first run and a cached one start that solve from the same state, so
    the cached run still reproduces the first to round-off;
 1. the table is made to cover ``[table_min p_max, headroom p_max]`` of the
@@ -45,8 +45,8 @@ the macro solve; the loop only grows the table:
    end, so that a slightly lower peak does not extend it again);
 2. if the table grew, the macro problem is solved again with
    :func:`response_law`, warm-started from the solution with the law it
-   was given (on the femur with Coulomb friction by the coupled Newton: 4
-   Newton steps against 20 cold; always from that state, so that the answer
+   was given (on the femur with Coulomb friction by the coupled Newton far
+   fewer Newton steps than cold; always from that state, so that the answer
    does not depend on the path by which the table grew); its
    change ``max_x |sigma_n^(k)(x) - sigma_n^(k-1)(x)|`` is recorded and the
    loop stops below ``tol``; if it did not grow, the law is the one just
@@ -130,8 +130,8 @@ def _cover_shear(shear: ShearTable | None, sol: M.MacroSolution, lo: float, hi: 
 
 
 #: the scene law's solve, when it only starts the cell law's, stops at this Newton ``rtol``
-#: (or the scene's, if looser): on the femur 15 Newton steps instead of 18, and the cell law's
-#: solve from there takes 4 steps as from the scene law's exact solution (module docstring, step 0)
+#: (or the scene's, if looser): it saves the scene law's last Newton steps, and the cell law's
+#: solve from there takes as many steps as from the scene law's exact solution (module docstring, step 0)
 START_RTOL = 1e-4
 
 
@@ -216,8 +216,8 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
         macro_solves, newton, start = 1, sol.history["newton_iterations"], sol.gfu.vec
         scene_law_solution = start
     if given:
-        # the cached table's law, warm from the scene's law (the femur: 15 + 4 Newton steps, 20 cold;
-        # the scene's law is the more robust start: cold, the table's law once needed a continuation);
+        # the cached table's law, warm from the scene's law (on the femur fewer Newton steps in all than cold;
+        # the scene's law is the more robust start: cold, the table's law can need a continuation);
         # without warm starts the scene's law is not solved at all
         problem = M.replace_law(problem, il.InterfaceLaw(normal=response_law(table),
                                                          friction=tangential_law(problem, shear)))
@@ -246,10 +246,9 @@ def couple(problem: M.MacroProblem, table: CellTable, *, tol: float, max_iter: i
                                   macro_solves=macro_solves, shear=shear)
         law = il.InterfaceLaw(normal=response_law(table), friction=tangential_law(problem, shear))
         # warm from the scene's start law's solution: with Coulomb friction by the coupled Newton the
-        # femur's cell-law solve takes 4 steps from it against 20 cold (31, with a failed attempt and a
-        # continuation in the Huber width, before its line search on the frozen Tresca energy); the
-        # Coulomb fixed point had taken 26 warm against 17 cold, its first pass frozen far from either
-        # solution.  Always from that one state, not from the last update's: the cell law's C1 cubic
+        # femur's cell-law solve takes far fewer steps from it than cold (the Coulomb fixed point would
+        # gain nothing: its first pass is frozen far from either solution).
+        # Always from that one state, not from the last update's: the cell law's C1 cubic
         # is solved to Newton's tolerance, not exactly like a polyline, so the answer would depend on
         # the path by which the table grew (a cached table reproduces its first run only so)
         start = scene_law_solution if warm else None

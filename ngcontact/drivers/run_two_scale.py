@@ -10,11 +10,10 @@ another key.
 The cell solves of one table level go through ``map_tasks`` (default:
 :func:`executor_map`, one batch of the run's executor, ``--workers`` local
 processes or a Dask cluster): each task is a :class:`PressureSolve`, a
-picklable callable that builds its cell problem once per process.  Measured
-on ``femur_stem_two_scale.toml`` (cold cache, 23 cell solves with the
-polyline table of that time, a loaded machine): solve stage 139 s with
-``--workers 1``, 88 s with 2, the same safety factor to 15 digits; the
-monotone cubic table needs 11 (``scripts/two_scale_benchmark.py``).
+picklable callable that builds its cell problem once per process.  The
+workers change no result (the same safety factor to round-off), only the
+wall time of a cold table (``scripts/two_scale_benchmark.py``:
+docs/benchmarks.md, section two_scale_benchmark).
 
 A cell with micro friction under ``interface.friction = "from_cell"`` also
 gets its shear table (:mod:`ngcontact.coupling.shear_table`): the macro

@@ -126,10 +126,10 @@ def surface_wirebasket(V, mesh, boundaries: str) -> None:
                 V.SetCouplingType(d, wirebasket)
 
 
-#: the factor ``gamma`` of :func:`bubble_term`, measured on the converged 3D bisinusoid cell of 38.8k dofs
-#: (``scripts/scaling_3d.py --coarse 0.06 --k-n K``, CG to 1e-8): with gamma = 3e-5, 1.1e-4, 3e-4, 1e-3 CG takes
-#: 85, 85, 87, 91 iterations at k_n = 10 (k_n h / E = 0.6), 122, 88, 96, 131 at 1e3, 92, 98, 127, 203 at 1e4,
-#: against 87 with the contact surface on the wirebasket, whose iterations cost 1.5x as much
+#: the factor ``gamma`` of :func:`bubble_term`, chosen on the converged 3D bisinusoid cell
+#: (``scripts/scaling_3d.py --coarse 0.06 --k-n K``, CG to 1e-8): there CG's iterations stay nearly
+#: independent of k_n and as few as with the contact surface on the wirebasket, whose iterations cost more;
+#: a larger gamma lets them grow with k_n, a smaller one with a stiff penalty
 BUBBLE_GAMMA = 1.1e-4
 
 
@@ -147,14 +147,14 @@ def bubble_term(u, v, modulus: float, stiffness, boundaries: str):
     matrix, and the contact term of a boundary element is singular on them
     (it couples the two traces through the normal jump alone).  Putting the
     whole contact surface on the wirebasket (:func:`surface_wirebasket`)
-    makes BDDC's coarse problem grow with the surface (28.7k of 94.6k dofs
-    on the 3D bisinusoid cell).  ``b`` instead makes each boundary element's
+    makes BDDC's coarse problem grow with the surface (a large part of a
+    3D cell's dofs).  ``b`` instead makes each boundary element's
     edge block definite while leaving the coarse problem alone: the vertex
     functions are linear on a flat triangle, so ``D2_S`` vanishes on them and
     ``b`` acts on the edge bubbles only (tested).  Its size, the geometric
     mean of a bubble's elastic stiffness ``M h`` and its contact stiffness
     ``k h^2`` (``D2_S`` of a bubble is ``1/h^2``), keeps the iterations
-    independent of ``k``; ``gamma`` is measured (``BUBBLE_GAMMA``).
+    independent of ``k``; ``gamma`` is calibrated (``BUBBLE_GAMMA``).
     """
     h = ng.specialcf.mesh_size
     coefficient = BUBBLE_GAMMA * ng.sqrt(modulus * stiffness * h ** 3) * h ** 2
@@ -171,7 +171,7 @@ def vector_h1(mesh, **flags) -> ng.FESpace:
     component, which honours it (the coupling types equal those set dof by
     dof, tested), but prints from C++ that the flag is not among its own:
     that line is kept off the user's terminal.  (Setting the types dof by
-    dof in Python cost 12 % of a 3D cell solve of 39k dofs.)
+    dof in Python would cost a noticeable share of a 3D cell solve.)
     """
     with quiet("stderr"):
         return ng.VectorH1(mesh, wb_withedges=False, **flags)

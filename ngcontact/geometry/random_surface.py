@@ -37,7 +37,7 @@ def wave_vectors(dim: int, n: int, period: float):
     Returns ``(components, |k|)``: 2D ``((k_x,), |k_x|)``, shape ``(n//2+1,)``;
     3D ``((k_x, k_y), |k|)`` broadcasting to ``(n, n//2+1)`` (rows ``y``).
     """
-    import scipy.fft as sfft  # on use: importing scipy.fft costs every process (and batch worker) 0.5 s at start
+    import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
     k1 = 2 * math.pi * sfft.rfftfreq(n, d=period / n)
     if dim == 2:
         return (k1,), np.abs(k1)
@@ -69,7 +69,7 @@ def self_affine(*, dim: int = 3, grid: int = 256, period: float = 1.0, hurst: fl
     seed
         Seed of NumPy's default generator.
     """
-    import scipy.fft as sfft  # on use: importing scipy.fft costs every process (and batch worker) 0.5 s at start
+    import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
     if dim not in (2, 3):
         raise GeometryError("dim", dim, "must be 2 (profile) or 3 (height map)")
     if not (isinstance(grid, (int, np.integer)) and grid >= 8 and grid % 2 == 0):

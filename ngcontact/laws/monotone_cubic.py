@@ -25,7 +25,7 @@ at most three times the end secant where the data turn.  Monotone data
 give a monotone interpolant, and there is no overshoot near a flat
 stretch.  These are the slopes of SciPy's ``PchipInterpolator`` (tested
 against it); written here because importing ``scipy.interpolate`` costs
-about 0.6 s, a fifth of a two-scale run.
+a good share of a short two-scale run's time.
 
 Used by the two-scale loop's cell table and its macro law (paper Sec. 3.5,
 :class:`~ngcontact.laws.homogenized.TabulatedLaw` with ``interpolation =

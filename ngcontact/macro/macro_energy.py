@@ -103,8 +103,8 @@ def _bodies(problem, fes, symmetric: bool) -> tuple[ng.BilinearForm, bool]:
     laws, :func:`ngcontact.macro.macro_problem.replace_law`) for ``fes``, the
     space of those parts: the bodies are linear, so every solve of the
     problem, whatever its law, has the same stiffness ``K`` and load vector
-    (on the femur a second assembly of ``K`` would cost 12 ms of a 200 ms
-    solve with the cell's law, twice: symmetric and not).
+    (a second assembly of ``K`` would add a good share to a macro solve
+    with the cell's law, twice: symmetric and not).
     """
     held = problem.parts.get(("bodies", symmetric))
     if held is not None and held[0] is fes:

@@ -37,15 +37,13 @@ Solution strategy:
   frozen at the iterate, :func:`frozen_tresca`).  Where Newton fails from
   the start value, continuation in the Huber width
   (:mod:`ngcontact.solvers.continuation`) from the largest slip of the
-  start value down to the scene's width.  Measured on the femur / hip-stem
-  scene and 23 variants of it (``scripts/femur_coulomb_variants.py``:
-  loads 0.1 to 30 MPa, interference 1 to 200 um, line-to-line, clearances
-  1 to 50 um, mu 0.1 to 1, widths 1e-5 to 1e-8 m, orders 2 to 4): all
-  converge, 2 to 20 Newton steps, none needing the continuation (with
-  backtracking on the residual instead of the frozen-energy search: 2 to 26
-  steps, five variants needing 4 to 6 rungs of it), equilibrium to 1e-11
-  or better; the fixed point below, from the same start, failed on 11 of
-  them (a period-2 cycle, or a singular Tresca tangent);
+  start value down to the scene's width.  On the femur / hip-stem scene
+  and its variants (``scripts/femur_coulomb_variants.py``: loads,
+  interferences, line-to-line, clearances, mu, widths, orders) Newton
+  converges without the continuation (backtracking on the residual instead
+  of the frozen-energy search needs it on some), where the fixed point
+  below, from the same start, fails on several (a period-2 cycle, or a
+  singular Tresca tangent): docs/benchmarks.md, section femur_coulomb_variants;
 * ``coulomb = "fixed_point"`` (the paper's Sec. 2): repeated Newton solves
   with ``G`` evaluated at the previous solution's pressure
   (:func:`ngcontact.solvers.coulomb.coulomb_fixed_point`, whose stopping

@@ -20,7 +20,7 @@ log = logging.getLogger("ngcontact.parallel.executor")
 
 
 #: Wall seconds a local pool's workers take to start (fresh interpreters importing NGSolve and the package,
-#: all at once; measured 1.5 to 2.5 s for two on the 2-core machine here).
+#: all at once; an estimate for two workers starting together on two cores).
 START_SECONDS = 2.0
 
 
@@ -69,9 +69,9 @@ class LocalPool(Executor):
         only if the rest will repay their start (:meth:`_worth_starting`); else the whole batch runs here.
 
         For runs whose batches are few, small and unknown in advance (the
-        levels of a two-scale cell table: a handful of 0.2 s cell solves
+        levels of a two-scale cell table: a handful of short cell solves
         each, none at all on a warm cache), where two fresh interpreters
-        importing NGSolve on a 2-core machine would cost more than they save.
+        importing NGSolve on a machine of few cores would cost more than they save.
         """
         self.on_demand = True
 

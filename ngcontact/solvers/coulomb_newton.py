@@ -13,8 +13,7 @@ friction, ``tau_t`` the Huber-regularized friction traction of
 :func:`ngcontact.laws.interface_energy.friction_traction`), and ``R`` its
 gradient with ``G`` then set to ``G(u)``.  The fixed point of
 :mod:`ngcontact.solvers.coulomb` solves a Tresca problem per pass and
-converges linearly (the rectangular valley cell: 6, 17, 24 Newton steps
-summed over the passes of its three loads).  Here Newton is applied to
+converges linearly, each pass a whole Newton solve.  Here Newton is applied to
 ``R`` itself, with its generalized Jacobian
 
     K_c(u) = Pi_T''(u; G(u)) + d/dG [Pi_T'(u; G)] . dG/du
@@ -53,16 +52,14 @@ The Newton step ``du = K_c^{-1} R(u)`` is taken in full when it lowers
   <= (1 - c alpha) |R(u)|``, ``c = 1e-4``, else the step with the smallest
   residual among those tried when it decreases ``|R|`` at all.
 
-Measured (``scripts/coulomb_newton_globalization.py``; both callers pass
-``frozen``).  The cell ``geometries/cells/rectangular_coulomb.toml``,
-Newton steps of its three loads (the shear loads' rigid continuation
-counted): frozen-energy search 5, 6, 11; residual backtracking 16, 7, 14;
-a pure full step cycles between two contact sets on the first load.  The
-femur / hip-stem scene and its 23 variants
-(``scripts/femur_coulomb_variants.py``): frozen-energy search 2 to 20
-steps (as shipped 8, load 3 MPa 10, width 1e-8 20), never needing the
-macro problem's width continuation; residual backtracking 2 to 26 (13,
-21, 26), five variants rescued by 4 to 6 rungs of continuation.
+Both callers pass ``frozen``: on the cell
+``geometries/cells/rectangular_coulomb.toml`` and on the femur / hip-stem
+scene and its variants (``scripts/femur_coulomb_variants.py``) the
+frozen-energy search takes fewer Newton steps than residual backtracking
+and never needs the macro problem's width continuation, which
+backtracking needs on some variants (``scripts/coulomb_newton_globalization.py``:
+docs/benchmarks.md, section coulomb_newton_globalization); a pure full
+step cycles between two contact sets on the cell.
 
 Stopping rule: that of :func:`ngcontact.solvers.newton.minimize` on
 ``|R|`` (``rtol`` times the first residual, ``atol``, or the round-off

@@ -9,14 +9,13 @@ the contact (and friction) terms on the interface, symmetric and positive
 definite on the free dofs.  Two ways:
 
 * ``"direct"``: a sparse Cholesky (or UMFPACK) factorization of ``K``.  Exact,
-  but its cost grows like ``N^1.8`` in 3D (measured on the bisinusoid cell:
-  8 s at 8k dofs, 508 s at 83k dofs for a solve of 11 Newton steps).  The
+  but in 3D its fill-in makes the cost grow much faster than ``N``
+  (docs/benchmarks.md, section scaling_3d).  The
   tangent of every step has the sparsity of the first (the form's matrix
   is assembled in place), so while the free dofs stay the same the
   factorization is only refreshed (``Update``: the fill-reducing ordering
-  and symbolic analysis are kept); on the 2D stem-grooves cell of 7.6k
-  dofs that is 10 ms against 22 ms for a fresh one, with the same
-  solution to round-off.
+  and symbolic analysis are kept), cheaper than a fresh one and with the
+  same solution to round-off.
 * ``"iterative"``: conjugate gradients preconditioned by NGSolve's BDDC
   (balancing domain decomposition by constraints, one subdomain per element)
   with a vertex-only wirebasket: the body spaces mark their edge dofs as
@@ -28,34 +27,29 @@ definite on the free dofs.  Two ways:
   with a preconditioning form (a cell: the tangent plus the bubble term,
   :func:`ngcontact.fem.elasticity.bubble_term`) has BDDC built from that
   form; any other form puts the contact surface's dofs on the wirebasket
-  (:func:`ngcontact.fem.elasticity.surface_wirebasket`; on the 94.6k-dof
-  bisinusoid cell 28.7k coarse dofs against 12.0k, 34 against 22 ms per CG
-  iteration, 25.3 against 22.0 s for the solve).  Its setup costs about one
+  (:func:`ngcontact.fem.elasticity.surface_wirebasket`: a larger coarse
+  problem, so dearer CG iterations).  Its setup costs about one
   assembly, its iterations grow
-  like ``log(p)^2`` and mildly with the mesh (measured below).  The
+  like ``log(p)^2`` and mildly with the mesh.  The
   preconditioner is registered with the energy form and built by its
   assembly; a split energy (:mod:`ngcontact.solvers.split_energy`: the bodies
   assembled once, the interface at each step) keeps it across Newton steps
   while CG's iterations per decade stay within ``REBUILD_GROWTH`` times
-  their rate after its build (the 38.8k-dof bisinusoid cell: 13.6 s rebuilt
-  at every step, 12.2 s kept, 288 against 508 CG iterations).  CG stops at
+  their rate after its build (a rebuild costs an assembly; a kept BDDC
+  costs CG iterations as the tangent drifts from its own).  CG stops at
   ``|r_k| <= eta |r_0|`` in the preconditioned norm: an inexact Newton
   step, ``eta`` from the Newton residual's decrease (:func:`forcing_term`,
   Eisenstat-Walker), never below ``rtol = 1e-10``; ``forcing = False``
-  solves every step to ``rtol``.  On the bisinusoid cell at 20.6k dofs
-  the forcing cut the CG iterations from 543 to 176 for one more Newton
-  step (9 against 8) and the solve from 62 s to 33 s (a loaded machine),
-  with the same contact fraction to 16 digits.
+  solves every step to ``rtol``.  The forcing saves many more CG
+  iterations than the Newton step it may add costs, and leaves the
+  contact fraction the same to round-off.
 * ``"auto"``: in 3D iterative from ``threshold`` free dofs on (default
-  ``AUTO_THRESHOLD``), direct below; in 2D direct.  Measured with
-  ``scripts/scaling_3d.py`` (2 cores, 2026-11-28): the 3D bisinusoid cell
-  solves in 0.58 s iteratively against 1.1 s directly at 8k dofs, 2.5 s
-  against 22.7 s at 39k, 3.7 s against 45 s at 64k, 25 s at 301k (time ~
-  N^1.13 from 8k to 451k against N^1.80 to 64k); a 3D press fit of two
-  tubes 1.2 s against 0.9 s at 15k dofs, 3.8 s against 5.3 s at 43k, 8.6 s
-  against 27.5 s at 96k, 59 s at 525k.  In 2D the factorization
-  stays far ahead: a 142k-dof order-3 cell took 51 s directly and over
-  8 minutes with BDDC-CG.
+  ``AUTO_THRESHOLD``), direct below; in 2D direct.  The threshold lies
+  where BDDC-CG overtakes the factorization on the 3D bisinusoid cell and
+  on a 3D press fit of two tubes, its time growing nearly like ``N``
+  against the factorization's much steeper growth; in 2D the
+  factorization stays far ahead (measured with ``scripts/scaling_3d.py``:
+  docs/benchmarks.md, section scaling_3d).
 
 BDDC reads the free dofs from the space; a solve whose free dofs differ
 from the space's (prescribed far-face translations of a cell) sets the
@@ -186,9 +180,9 @@ class LinearSolver:
         ``freedofs`` (:meth:`register` before the assembly).  Direct: a fresh
         factorization by the policy's ``inverse``; iterative: CG with the
         BDDC built by that assembly, so that a large 3D cell needs no
-        factorization of its whole matrix (on the bisinusoid cell of 94.6k
-        dofs the Cholesky factorization of the effective stiffness took 39 s
-        and 3.3 GB, as long as the cell's whole Newton solve).
+        factorization of its whole matrix (for a large 3D cell the factorization
+        of the effective stiffness would cost as much time as the cell's whole
+        Newton solve, and far more memory).
         """
         if self.method(freedofs, form.space.mesh.dim) == "direct":
             return form.mat.Inverse(freedofs, inverse=self.inverse)
@@ -267,10 +261,9 @@ def forcing_term(rnorm: float, previous: float | None, eta_previous: float | Non
     problem the residual has fallen by 1e-3 to 1e-4 (the bodies' linear
     part is solved), and the formula then asks the next step for 7 digits,
     while the step's own decrease is bounded by the moving contact set
-    (the residual rose after it, measured).  On the 3D bisinusoid cell
-    (8k, 38.8k, 94.6k dofs) the floor cut CG's iterations from 361, 483,
-    560 to 261, 379, 454 with the same Newton steps (8, 8, 10) and contact
-    fraction.  Far
+    (the residual can rise after it).  On the 3D bisinusoid cell the floor
+    saves CG iterations at every size with the same Newton steps and
+    contact fraction.  Far
     from the solution most CG iterations of a fixed ``rtol = 1e-10`` buy
     digits the next Newton step discards; near it each step still gains at
     least three digits (``ETA_MIN``), and the last one stops at the target.

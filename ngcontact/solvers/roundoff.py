@@ -38,7 +38,7 @@ ROUNDOFF = 10.0
 FLOOR_PROGRESS = 1e-3
 FLOOR_GROWTH = 1e3
 #: a residual within this factor of its round-off floor estimate, with no decrease measurable along the Newton step,
-#: is at round-off (module docstring; the estimate was 2.1 times low on a smooth field offset by 3e4)
+#: is at round-off (module docstring; the estimate can be a few times low, e.g. on a smooth field with a large offset)
 STAGNATION = 100.0
 
 

@@ -27,8 +27,8 @@ only the speed (the error in ``lambda`` contracts roughly by
 the order of ``E/h`` and above takes a few passes).  Each pass's Newton
 solve starts from the previous one's state.
 
-A soft augmentation converges slowly (``k = 0.01 E/h`` on Westergaard's
-cell: not within 500 passes).  Since ``k`` is not in the answer, a caller
+A soft augmentation converges slowly (``k`` well below ``E/h`` takes
+hundreds of passes).  Since ``k`` is not in the answer, a caller
 may pass ``stiffen``: whenever a pass fails to shrink the larger of the
 two measures to ``SLOW`` times its value after the previous pass,
 ``stiffen()`` raises ``k`` (it returns ``False`` once it may not: a
@@ -41,9 +41,9 @@ mesh (elements of 1e-6 of the period) lifts to about ``1e-10``: there a
 multiplier update changes the equilibrium by less than the round-off floor
 of the Newton residual (:func:`ngcontact.solvers.roundoff.at_floor`), the
 pass's Newton solve takes no step, the state and so the measures repeat,
-and the passes that follow only alternate between two states (measured:
-westergaard_graded with exact enforcement, 51 passes at 7e-11 / 1.5e-10
-against ``rtol = 1e-10`` before the pass limit).  A pass after the first
+and the passes that follow only alternate between two states until the
+pass limit (e.g. ``westergaard_graded.toml`` with exact enforcement, its
+measures stalling just above ``rtol = 1e-10``).  A pass after the first
 whose Newton solve took no step therefore stops the iteration, converged
 at the floor (``"at_floor"`` in the history), when both measures are within
 ``FLOOR_GROWTH`` (Newton's own allowance for a start at round-off) times

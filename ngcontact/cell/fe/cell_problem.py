@@ -322,9 +322,8 @@ class CellProblem:
 
         A frictionless cell with a spectral twin starts every load under a prescribed pressure afresh from
         the twin's contact set instead: its energy is convex with one minimizer, so the start may forget the
-        previous state, and the twin's contact set is nearer the solution's than the previous load's (the
-        Westergaard sweep: 2, 5, 7, 7, 3 Newton steps continued, 2, 2, 2, 2, 1 afresh; the tabulated gap
-        1, 5, 7 and 1, 1, 4).
+        previous state, and the twin's contact set is nearer the solution's than the previous load's (fewer
+        Newton steps on the Westergaard sweep and the tabulated gap).
         """
         self.gfu.vec[:] = 0.0
         out = []

@@ -28,12 +28,11 @@ the Lagrange nodes of a quadratic triangle as its points and the
 consistent nodal forces (a uniform pressure puts none on the corners of a
 quadratic triangle), and the lumped rule of the order-``p`` lattice (each
 of the ``p^2`` sub-triangles giving a third of its area to each of its
-vertices), tried in its place, left corner nodes hanging open inside the
-contact patch: on Westergaard's waves in a 3D cell at order 2, 22 to 34 %
-of the nodes inside the patch stayed open by up to 1.7e-5 (gap 0.02), the
-contact fraction came out 5.7 % low at interface mesh 0.07 after 0.42 %
-at 0.1, and the bisinusoid's fell away from the spectral cell's under
-refinement (0.651, 0.625 against 0.669).  At order 1 no node inside the
+vertices) leaves corner nodes hanging open inside the
+contact patch: on Westergaard's waves in a 3D cell at order 2 a good part
+of the nodes inside the patch stay open, the contact fraction comes out
+low and worsens under refinement, and the bisinusoid's falls away from
+the spectral cell's.  At order 1 no node inside the
 patch stays open.  Either way,
 non-penetration is imposed at these nodes only, and the multiplier has one
 value ``lambda_q`` per point.  A fixed point of Uzawa's iteration is the
@@ -264,8 +263,8 @@ def characteristic_length(problem) -> float:
 #: factor by which a slow Uzawa pass raises the augmentation (:func:`ngcontact.solvers.uzawa.uzawa`)
 STIFFEN = 10.0
 #: ceiling of a raised augmentation, as ``k h / E`` (``h`` the smallest element of ``S_C``, ``E`` the
-#: softer body's modulus): 1e4 reaches the answer in 2 passes on Westergaard's cell with equilibrium to
-#: 2e-12, where 1e8 loses it to 3e-7
+#: softer body's modulus): high enough that Uzawa ends in a couple of passes, low enough that the stiff
+#: term leaves the equilibrium at round-off (a far larger ratio costs it several digits)
 MAX_AUGMENTATION_RATIO = 1e4
 
 

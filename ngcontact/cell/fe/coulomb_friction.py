@@ -22,9 +22,10 @@ Pi_T(.; mu p(u))`` and conversely):
   mixing, each pass's threshold ``mu p`` of the previous pass (stopping
   rule ``coulomb_rtol`` on the pressure change).
 
-Newton steps per load on ``geometries/cells/rectangular_coulomb.toml``
-(three loads, the shear loads' rigid continuation counted): fixed point 6,
-17, 24; coupled Newton 5, 6, 11.
+On ``geometries/cells/rectangular_coulomb.toml`` the coupled Newton takes
+fewer Newton steps per load than the fixed point, each of whose passes
+is a whole Newton solve (its steps per load: docs/benchmarks.md, section
+coulomb_newton_globalization).
 """
 from __future__ import annotations
 

@@ -40,11 +40,9 @@ starts afresh from the twin's contact set instead of the previous level's
 state (a frictionless energy has one minimizer; the carried state has
 holes in its contact set where the interpolation between unrelated meshes
 shifts the tiny penetration ``p/k_n`` across zero).  On the shipped scene
-``westergaard_graded.toml`` (``k_n = 1e6 E``, tolerance 1e-4, the twin on
-8192 points), Newton steps summed over each load's meshes went from 39-48
-on 5-6 meshes (the first one uniform, the later ones carried over) to 13,
-10, 11, 10 on 3, and the solve from 10 s to 4 s, the errors against
-Westergaard the same (1e-6 to 5e-6).
+``westergaard_graded.toml`` the seeded first mesh saves levels and the
+fresh starts save Newton steps on each, the errors against
+Westergaard the same.
 
 A full contact has no edge: the interface mesh is halved instead.  With the penalty enforcement the model *is* the
 Winkler layer ``k_n`` (paper eqs. 7, 9), whose own difference from rigid
@@ -164,9 +162,9 @@ def carry_over(old, new) -> None:
     predictor, with the active set nearly right.  With exact enforcement the
     multiplier is carried too, interpolated linearly between the old nodes
     along the flat ``S_C``: Uzawa's first pass then starts from the old
-    level's pressure instead of the penalty's (on the scene
-    ``westergaard_graded.toml`` run with exact enforcement, Newton steps
-    per load summed over the levels fell from 34-42 to 27-34).
+    level's pressure instead of the penalty's (fewer Newton steps per load
+    summed over the levels, e.g. on ``westergaard_graded.toml`` run with
+    exact enforcement).
     """
     for k, region in enumerate(("rough", "counter")):
         new.gfu.components[k].Set(old.gfu.components[k], definedon=new.mesh.Materials(region))

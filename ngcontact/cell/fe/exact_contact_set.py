@@ -3,7 +3,7 @@
 The cell problem with ``contact.enforcement = "exact"`` holds the
 multiplier ``lambda`` at the nodes of ``S_C``
 (:mod:`ngcontact.cell.fe.contact_multiplier`); the contact fraction of its
-results (paper Sec. 3.2.2, the real contact set of eq. 34) is measured here
+results (paper Sec. 3.2.2, the real contact set of eq. 34) is read in this module
 from the nodes, not from the sign of the penetration, which is zero to
 round-off at the closed nodes and only the interpolation error of the
 closure between them.

@@ -33,19 +33,18 @@ a problem in ``dim`` unknowns (Newton on the same energy with only those
 dofs free; its tangent is the ``dim x dim`` block of ``Pi''`` in ``U``).  A
 load increment then first moves the counter as a rigid body on the deformed
 rough surface, which is where a shear load near the frictionless limit
-goes: on the sinusoid (measured before the restart took the frictionless
-loads), the shear 0.002 -> 0.003 (``tau/p`` near the largest
-slope 0.31) slides the counter a quarter period and lifts it, which Newton
-from the previous state reached in 21 steps, from the rigid continuation in
-4 (plus 3 steps of the ``dim``-unknown problem).  The continuation's steps
+goes: on the sinusoid a shear step with ``tau/p`` near the largest
+slope slides the counter a quarter period and lifts it, which Newton
+from the previous state reaches only after many steps, each moving the
+contact set a little, and from the rigid continuation in a few.  The continuation's steps
 are reported as a Newton history of their own (``"stage":
 "rigid_continuation"``) and count towards the load.  Where the frozen
 problem has no minimizer (the translation is free of energy, e.g. no
 contact) its Newton raises; the previous state is restored and the
 continuation is skipped.
 
-Secant or tangent extrapolation of the whole state from earlier loads was
-tried and gains little (sinusoid: 21 -> 21 and 17 steps): the state is not
+Secant or tangent extrapolation of the whole state from earlier loads
+gains little: the state is not
 smooth in the load where the contact set changes, and the tangent predictor
 is the first Newton step itself.
 """

@@ -26,8 +26,8 @@ Only the predicted contact set matters to Newton, and the start is best
 when that set is a little smaller than the solution's: from far on the open
 side the tangent of a few stiff springs is soft, the steps overshoot and the
 line search cuts them to a few per cent (the penalty alone, ``k_L = k_n``,
-the earlier predictor: 63 of 498 contact points on the small-slope
-bisinusoid, 12 steps with step lengths 0.06, 0.15, ...); from the closed
+predicts far too small a contact set on the small-slope bisinusoid, and
+Newton crawls from it in short steps); from the closed
 side each step moves an edge only part of the way.  The stiffness that sets
 the contact set is that of the pressure's variation over the cell, not of
 its mean (the mean compression moves all points alike and is absorbed in
@@ -42,8 +42,8 @@ With ``l = P`` (the period) this is exact at Westergaard's full contact,
 ``p* = pi E* h``; partial contact concentrates the pressure on a narrower
 patch, so ``l`` is taken as the predicted patch itself, ``l = P f^(1/(dim-1))``
 for the predicted contact fraction ``f``, iterated to consistency
-(:func:`rigid_approach`).  On the bisinusoid 12 -> 7 steps, the tabulated
-gap 4 -> 2, the Westergaard sweep's first load 5 -> 5.  ``start="closed"`` of
+(:func:`rigid_approach`): fewer Newton steps than the penalty alone on the
+bisinusoid and the tabulated gap, as many on Westergaard.  ``start="closed"`` of
 :class:`~ngcontact.cell.fe.cell_problem.CellProblem` restores the oldest start
 instead: the counter pushed down by the largest gap plus ``p/k_n``
 (:func:`max_gap`).
@@ -61,10 +61,10 @@ with the predicted patch as above.  The frictionless energy is convex with
 one minimizer, so the start may forget the previous state; a start from it
 is no better where the contact set moves across the cell (the shear turns
 the pressed flank): on the sinusoid sweep the Newton steps after the start
-are the same 6 and 4 as after the rigid continuation
+are as many as after the rigid continuation
 (:func:`ngcontact.cell.fe.load_start.rigid_continuation`), without the
-continuation's 3 and 3 steps (1, 2, 9, 7 -> 1, 1, 6, 4 per load), and on
-the 3D bisinusoid surface 4 + 9 -> 10.  The gain is the continuation's
+continuation's own steps, and on
+the 3D bisinusoid surface fewer in all.  The gain is the continuation's
 steps, each an assembly of the cell's tangent; the predictor's own
 iterations, on ``dim`` unknowns with surface integrals only, are no
 Newton steps of the cell problem, like the first load's root.  With friction the Winkler model,

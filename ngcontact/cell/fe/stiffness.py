@@ -10,9 +10,8 @@ themselves.  This module measures the stiffness the solved cell problem
   far-face jump, per ``|T|`` — the Schur complement of the tangent of the
   cell energy on the far-face translation ``U`` (:func:`schur_complement`,
   :func:`tangent_stiffness`), its inner solves by the cell's linear-solver
-  policy: a factorization, or for a large 3D cell CG with BDDC (on the
-  bisinusoid cell of 94.6k dofs a run of ``ngcontact`` took 97 s and 3.3 GB
-  with the factorization, 63 s and 0.69 GB with CG);
+  policy: a factorization, or for a large 3D cell CG with BDDC (faster
+  than the factorization there, in a fraction of its memory);
 * ``S_0``: the same for the flat bonded laminate of the same thickness,
   analytic (:func:`reference_stiffness`): each layer in a uniform state
   ``eps = sym(a (x) n0)`` with ``t = A a`` and the acoustic tensor

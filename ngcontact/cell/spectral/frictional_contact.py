@@ -9,8 +9,8 @@ identical layers only.  The cell is then the convex problem in tractions of
 solved by accelerated proximal gradients.  Coulomb friction has no such
 potential; its threshold is taken from the pressure of the same proximal
 step, so that a fixed point of the iteration meets Coulomb's conditions
-with its own pressure (no outer fixed point of Tresca problems, which cost
-six passes of 300 to 400 steps each on a 256^2 cell).  With ``"penalty"``
+with its own pressure (no outer fixed point of Tresca problems, each pass
+of which is a whole proximal-gradient solve).  With ``"penalty"``
 the friction is the FE cell's Huber-regularized one (width ``w``), with ``"exact"`` it is
 exact.  As in the FE cell, the Tresca threshold holds on the whole surface.
 
@@ -44,7 +44,7 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
     ``K0`` the diagonal of the uniform mode (the layers' uniaxial-strain
     and shear compliances).
     """
-    import scipy.fft as sfft  # on use: importing scipy.fft costs every process (and batch worker) 0.5 s at start
+    import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
     d = cell.dim
     n = cell.grid
     k1 = 2 * np.pi * sfft.rfftfreq(n, d=cell.period / n)

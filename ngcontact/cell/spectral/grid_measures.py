@@ -13,10 +13,10 @@ Contact edges in 2D: beyond an edge at ``a`` the gap of a smooth contact
 grows like ``(x - a)^(3/2)``, so ``r = gap^(2/3)`` is a smooth function of
 ``x`` with a simple root at ``a``.  The collocated pressure is in error at
 the last contact points, and that error perturbs the gap most at the first
-open points and less the farther away they lie (measured on Westergaard at
-1024 to 65,536 points: the root of the line through the first two open
-points is off by up to 0.05 grid steps, that of a quartic fitted to the
-points 10 to 90 steps away by at most 0.005).  So each edge is placed at
+open points and less the farther away they lie (on Westergaard's sinusoid
+the root of the line through the first two open points is off by a
+fraction of a grid step, that of a quartic fitted to points farther
+away by ten times less).  So each edge is placed at
 the root of the least-squares quartic of ``r`` over the window of open
 points ``EDGE_WINDOW`` (shortened, in proportion, to a quarter of the open
 run when the run is short: the gap must be smooth at the scale of the

@@ -149,7 +149,7 @@ class SpectralCell:
 
     def convolve(self, p: np.ndarray, symbol: np.ndarray) -> np.ndarray:
         """``IFFT(symbol FFT(p))`` on the grid (all cores)."""
-        import scipy.fft as sfft  # on use: importing scipy.fft costs every process (and batch worker) 0.5 s at start
+        import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
         return sfft.irfftn(symbol * sfft.rfftn(p, workers=-1), s=self.shape, workers=-1)
 
     def interface_compliance(self, uniform: bool):
