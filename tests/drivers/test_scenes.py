@@ -5,14 +5,12 @@ of them 3D) are in the slow tier, which CI runs after the default one.
 """
 import base64
 import glob
-import json
 import math
 import os
 import re
 
 import pytest
 
-from ngcontact import cli
 from ngcontact.scene import loader as scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -45,11 +43,10 @@ def _numbers(obj, where="report"):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("path", SCENES, ids=IDS)
-def test_scene_runs_to_a_finite_report(path, tmp_path, monkeypatch):
-    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))
-    out = tmp_path / "out"
-    assert cli.main(["run", path, "--out", str(out), "--quiet"]) == 0
-    rep = json.loads((out / "report.json").read_text())
+def test_scene_runs_to_a_finite_report(path, scene_run):
+    run = scene_run(path)  # `ngcontact run` in a fresh cache, shared with test_gold.py (conftest.py)
+    assert run.status == 0
+    out, rep = run.out, run.report
     sc = scene.load(path)
     assert rep["kind"] == sc.kind
     assert rep["effects"] == list(scene.effects(sc))
