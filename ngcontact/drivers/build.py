@@ -301,6 +301,8 @@ def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = Tr
 
     def layer(name, h):
         m = scene.materials[name]
+        # set: the scene layer requires isotropic E and nu of both bodies for the spectral cell
+        assert m.E is not None and m.nu is not None
         return Layer(E=m.E, nu=m.nu, h=h)
     return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
                         counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid, heights),

@@ -17,7 +17,7 @@ class DaskCluster(Executor):
 
     def __init__(self, address: str):
         self.address = address
-        self._client = None
+        self._client: Any = None      # the distributed Client, connected on first use
 
     @property
     def client(self):

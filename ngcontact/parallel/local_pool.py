@@ -33,8 +33,8 @@ class LocalPool(Executor):
         if workers < 1:
             raise ValueError(f"workers = {workers}: must be >= 1")
         self.workers = workers
-        self._pool = None
-        self._started = None
+        self._pool: Any = None        # the ProcessPoolExecutor, started on first use
+        self._started: Any = None     # the queue on which workers announce their start
         self._processes: dict = {}      # every worker process of the current pool, by pid
         self.on_demand = False
 

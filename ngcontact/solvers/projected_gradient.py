@@ -72,7 +72,7 @@ def prox_pressure(v: np.ndarray, damping: float, mean: float | None, shift0: flo
     return np.maximum(v - x, 0.0) / damping, x
 
 
-def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray, mean: np.ndarray | None,
+def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float, mean: np.ndarray | None,
                   shift0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``q_i = clip_{|q| <= G_i}((v_i - s) / d_i)`` with ``s`` such that ``mean(q) = mean``.
 

@@ -108,7 +108,7 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
         sp, sq = shifts if shifts else (0.0, None)
         p, sp = prox_pressure(v[d - 1], damp_p, mean_p, sp)
         # Tresca: the fixed threshold; Coulomb: mu times the pressure of this very step
-        G = f.threshold(p) * np.ones(cell.shape)
+        G = np.asarray(f.threshold(p) * np.ones(cell.shape), float)
         damp_q = 1.0 if exact else 1.0 + f.w / (L * np.maximum(G, 1e-300))
         q, sq = prox_friction(v[:d - 1], G, damp_q, mean_q, sq)
         return np.concatenate([q, p[None]]), (sp, sq)
