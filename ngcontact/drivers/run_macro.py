@@ -31,6 +31,7 @@ from __future__ import annotations
 import logging
 from collections import Counter
 from functools import partial
+from typing import Any
 
 import numpy as np
 import ngsolve as ng
@@ -278,35 +279,10 @@ def run(scene, clock) -> Outcome:
                    "newton_iterations": sol.history["newton_iterations"],
                    "coulomb_iterations": sol.history["coulomb_iterations"], "equilibrium": balance}
         maxima = {name: ext for name, ext in extrema.items()}
-        tables, plots = {}, {}
-        if geo.mesh.dim == 2:
-            prof = MM.interface_profile(sol, scene.output.points_per_element)
-            results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in prof.items()}
-            results["status_counts"] = dict(Counter(prof["status"]))
-            maxima["pressure"] = MM.peak_pressure(prof)
-            k = int(np.argmax(np.abs(prof["shear"])))
-            maxima["shear"] = {key: (v[k] if key == "status" else float(v[k])) for key, v in prof.items()}
-            results["detachment"] = MM.detachments(prof)
-            header = list(prof)
-            tables["interface"] = (header, list(zip(*[prof[h] for h in header])))
-            plots["interface"] = lambda path, prof=prof: figures.macro_interface(path, prof)
-            samples = field_samples(sol, fields)
-            plots["stress"] = lambda path, d=samples: figures.macro_fields(path, **d)
-        else:
-            surf = MM.interface_surface(sol)
-            results["contact_area"] = surf.pop("contact_area")
-            results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in surf.items()}
-            results["status_counts"] = dict(Counter(surf["status"]))
-            for key in ("pressure", "shear"):
-                k = int(np.argmax(surf[key]))
-                maxima[key] = {name: (v[k] if name == "status" else float(v[k])) for name, v in surf.items()}
-            header = list(surf)
-            tables["interface"] = (header, list(zip(*[surf[h] for h in header])))
-            plots["interface"] = lambda path, sf=surf: figures.macro_interface_3d(path, sf)
-            plots["interface_axial"] = lambda path, sf=surf: figures.macro_interface_axial(path, sf)
-            if SECTION in M.boundary_labels(geo.mesh):
-                section = section_samples(sol, fields)
-                plots["stress"] = lambda path, d=section: figures.macro_fields(path, **d)
+        tables: dict[str, Any] = {}
+        plots: dict[str, Any] = {}
+        interface = interface_2d if geo.mesh.dim == 2 else interface_3d
+        interface(sol, fields, scene, geo, results, maxima, tables, plots)
         results["maxima"] = maxima
         results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
         if two_scale is not None:
@@ -332,6 +308,42 @@ def run(scene, clock) -> Outcome:
               "coulomb": sol.history["coulomb"], "coulomb_changes": sol.history["coulomb_changes"], "solves": newton,
               "linear": sol.history["linear"]}
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
+
+
+def interface_2d(sol, fields, scene, geo, results, maxima, tables, plots) -> None:
+    """The interface of a 2D (plane strain, axisymmetric) solution along its arc: profile, status, peaks,
+    detachment, its table and figures."""
+    prof = MM.interface_profile(sol, scene.output.points_per_element)
+    results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in prof.items()}
+    results["status_counts"] = dict(Counter(prof["status"]))
+    maxima["pressure"] = MM.peak_pressure(prof)
+    k = int(np.argmax(np.abs(prof["shear"])))
+    maxima["shear"] = {key: (v[k] if key == "status" else float(v[k])) for key, v in prof.items()}
+    results["detachment"] = MM.detachments(prof)
+    header = list(prof)
+    tables["interface"] = (header, list(zip(*[prof[h] for h in header])))
+    plots["interface"] = lambda path, prof=prof: figures.macro_interface(path, prof)
+    samples = field_samples(sol, fields)
+    plots["stress"] = lambda path, d=samples: figures.macro_fields(path, **d)
+
+
+def interface_3d(sol, fields, scene, geo, results, maxima, tables, plots) -> None:
+    """The interface of a 3D solution over its surface: samples, contact area, status, peaks, its table and
+    figures (and the stress on the section plane where the mesh has one)."""
+    surf = MM.interface_surface(sol)
+    results["contact_area"] = surf.pop("contact_area")
+    results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in surf.items()}
+    results["status_counts"] = dict(Counter(surf["status"]))
+    for key in ("pressure", "shear"):
+        k = int(np.argmax(surf[key]))
+        maxima[key] = {name: (v[k] if name == "status" else float(v[k])) for name, v in surf.items()}
+    header = list(surf)
+    tables["interface"] = (header, list(zip(*[surf[h] for h in header])))
+    plots["interface"] = lambda path, sf=surf: figures.macro_interface_3d(path, sf)
+    plots["interface_axial"] = lambda path, sf=surf: figures.macro_interface_axial(path, sf)
+    if SECTION in M.boundary_labels(geo.mesh):
+        section = section_samples(sol, fields)
+        plots["stress"] = lambda path, d=section: figures.macro_fields(path, **d)
 
 
 def two_scale_summary(two_scale: dict, strength: dict) -> dict:
