@@ -20,7 +20,9 @@ parsed (:func:`check_options`: finite numbers in their ranges), and the
 law and its table before anything is rendered (:func:`check_law`: finite
 numbers, a positive slope ``k_n0``, table rows that stay distinct and
 strictly increasing as written); a violation is a
-:class:`~ngcontact.errors.ModelError` naming the option to change.
+:class:`~ngcontact.errors.ModelError` naming the option to change.  The
+cards name the scene by its file name and SHA-256 only, not by the
+directories it lies in.
 """
 from __future__ import annotations
 
@@ -71,7 +73,8 @@ def _sha256(path: str) -> str:
 def _normal_law(scene, path: str, length_unit: float):
     """``(normal law, macro gap, threshold, scene mu, gap table?, load scale, source)``."""
     from ngcontact.drivers.build import law_from_cell
-    source = {"scene": os.path.abspath(path), "kind": scene.kind, "scene_sha256": _sha256(path)}
+    # the file name only: a card must not carry the user's directory layout; the hash identifies the scene
+    source = {"scene": os.path.basename(path), "kind": scene.kind, "scene_sha256": _sha256(path)}
     if scene.kind == "cell":
         normal, info = law_from_cell(path, dim=scene.geometry.dim, length_unit=length_unit)
         loads = scene.load.pressure if scene.load is not None and scene.load.pressure else (0.0,)

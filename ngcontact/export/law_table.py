@@ -75,7 +75,7 @@ class ExportedLaw:
     gap
         Uniform macro gap ``g0`` [m] (negative: interference).
     source
-        Scene path, kind, SHA-256 of the scene (and its cell), length unit, the law's type.
+        Scene file name (no directories), kind, SHA-256 of the scene (and its cell), length unit, the law's type.
     notes
         What the formats with a contact card cannot carry (one sentence each).
     gap_force

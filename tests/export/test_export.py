@@ -340,6 +340,17 @@ def test_every_written_card_is_finite_with_strictly_increasing_rows(tmp_path, fm
             assert friction == [], "a friction coefficient of rounding noise is no friction coefficient"
 
 
+def test_the_card_names_the_scene_without_the_users_directories(tmp_path):
+    """Defect: the exported card recorded the scene's absolute path (the user's directory layout)."""
+    for fmt in ("abaqus", "calculix", "ansys", "json"):
+        out = tmp_path / fmt
+        assert cli.main(["export", GAP_CELL, "--format", fmt, "--out", str(out), "--length-unit", str(UNIT),
+                         "--max-pressure", "1e8"]) == 0
+        text = next(out.glob("interface_law*")).read_text()
+        assert os.path.dirname(GAP_CELL) not in text and ROOT not in text, fmt
+        assert os.path.basename(GAP_CELL) in text, fmt
+
+
 def test_a_law_without_tangential_stiffness_writes_no_zero_sticking_stiffness(tmp_path):
     """ANSYS reads FKT = 0 as its default factor, not as an absolute stiffness: no zero stiffness is written."""
     text = open(SAWTOOTH_BLOCK).read()
