@@ -9,7 +9,8 @@ The contract, for ``ngcontact run SCENE --out DIR`` and every study:
   ``.ngcontact-manifest.json`` that lists them.  ``DIR`` is created when
   missing (with the user's umask); an existing ``DIR`` keeps its mode, its
   owner and every file the package did not write.  A symbolic link ``DIR``
-  is followed, never replaced.
+  is followed, never replaced; a path whose links loop is refused before
+  any work.
 * A rerun replaces the files the manifest of the previous run lists (and
   removes those of them the new run does not write); a file of the same
   name that no manifest lists is the user's, and the run is refused before
@@ -88,6 +89,22 @@ def _existing_ancestor(path: str) -> str:
     return probe
 
 
+def _resolved(out_dir: str) -> str:
+    """The real path ``DIR`` stands for, its symbolic links followed; a loop among them is refused here,
+    before any work (it would fail only when the files are moved into place)."""
+    path = os.path.abspath(out_dir)
+    try:
+        os.path.realpath(path, strict=True)
+    except (FileNotFoundError, NotADirectoryError):  # the missing part is created; a file on the way is refused below
+        pass
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise OutputError(f"--out {out_dir}: a symbolic link on the path ({exc.filename}) leads into a loop; "
+                              "fix or remove the link, or choose another directory") from None
+        raise OutputError(f"--out {out_dir}: cannot be resolved ({exc.strerror}: {exc.filename})") from None
+    return os.path.realpath(path)
+
+
 def own_files(out_dir: str) -> set[str] | None:
     """The files the package's manifest in ``out_dir`` lists; ``None`` when there is no manifest.
 
@@ -125,7 +142,7 @@ def check_output_dir(out_dir: str, inputs: Iterable[str] = (), names: Iterable[s
         File names the run will write; one that exists and is not the
         package's (no manifest lists it) is refused.
     """
-    real = os.path.realpath(os.path.abspath(out_dir))
+    real = _resolved(out_dir)
     if os.path.exists(real) and not os.path.isdir(real):
         raise OutputError(f"--out {out_dir}: exists and is not a directory")
     for p in inputs:

@@ -157,6 +157,16 @@ def test_unwritable_output_is_refused_before_any_work(tmp_path):
         check_output_dir(str(blocker / "run"))
 
 
+@pytest.mark.parametrize("below", ["", "sub"])
+def test_an_output_path_through_a_symlink_loop_is_refused_before_any_work(tmp_path, below):
+    """Defect: --out a symbolic link loop passed the check, the whole solve ran, then "File exists"."""
+    (tmp_path / "a").symlink_to(tmp_path / "b")
+    (tmp_path / "b").symlink_to(tmp_path / "a")
+    out = tmp_path / "a" / below if below else tmp_path / "a"
+    with pytest.raises(OutputError, match=r"--out .*: a symbolic link on the path .*a\) leads into a loop"):
+        check_output_dir(str(out))
+
+
 def test_staging_left_by_a_killed_run_is_removed_by_the_next_and_a_live_one_is_kept(tmp_path):
     """Defect: SIGKILL left .ngcontact-partial-* folders forever."""
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
@@ -190,6 +200,22 @@ def test_out_dot_keeps_the_scene_and_every_file(scene_dir, monkeypatch, capsys, 
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "which the scene reads" in err, err
     assert snapshot(scene_dir.parent) == before
+
+
+def test_run_into_a_symlink_loop_exits_2_before_solving(scene_dir, monkeypatch, capsys):
+    """Defect: the solve ran to its end before --out (a symbolic link loop) failed with "File exists"."""
+    from ngcontact import runner
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("the solve ran although --out cannot be written")
+
+    monkeypatch.setattr(runner, "solve", no_solve)
+    (scene_dir / "loop").symlink_to(scene_dir / "loop")
+    before = snapshot(scene_dir)
+    assert cli.main(["run", str(scene_dir / "small.toml"), "--out", str(scene_dir / "loop"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--out" in err and "loop" in err, err
+    assert snapshot(scene_dir) == before
 
 
 def test_a_data_folder_the_scene_reads_is_refused(tmp_path, capsys):
