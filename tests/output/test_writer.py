@@ -4,6 +4,7 @@ Each test states one requirement of :mod:`ngcontact.output.writer` and the
 command line around it, with the defect it guards against.
 """
 import json
+import logging
 import os
 import signal
 import stat
@@ -100,6 +101,41 @@ def test_a_file_of_the_same_name_that_the_package_did_not_write_is_refused_untou
     with pytest.raises(OutputError, match="report.json exists and was not written by ngcontact"):
         write_outputs(str(out), report_for(outcome_with(1.0)), outcome_with(1.0))
     assert snapshot(out) == before
+
+
+def test_a_hand_edited_manifest_never_gets_a_users_file_deleted(tmp_path, caplog):
+    """Defect: a manifest edited to list thesis.tex got thesis.tex deleted by the next run.  Only names the
+    package writes are ever replaced or removed; any other entry is ignored with a warning and kept."""
+    out = tmp_path / "run"
+    first = outcome_with(1.0)
+    write_outputs(str(out), report_for(first), first)
+    (out / "thesis.tex").write_text("my thesis")
+    (out / "data.txt").write_text("mine")
+    (tmp_path / "outside.csv").write_text("mine too")
+    manifest = json.loads((out / MANIFEST).read_text())
+    manifest["files"] += ["thesis.tex", "data.txt", "../outside.csv", "sub/x.csv", ".."]
+    (out / MANIFEST).write_text(json.dumps(manifest))
+    with caplog.at_level(logging.WARNING, logger="ngcontact.output.writer"):
+        write_outputs(str(out), report_for(outcome_with(2.0)), outcome_with(2.0))
+    assert (out / "thesis.tex").read_text() == "my thesis" and (out / "data.txt").read_text() == "mine"
+    assert (tmp_path / "outside.csv").read_text() == "mine too"
+    warned = " ".join(r.getMessage() for r in caplog.records)
+    assert "thesis.tex" in warned and "data.txt" in warned and "ignored" in warned, warned
+    assert json.loads((out / MANIFEST).read_text())["files"] == ["curve.csv", "figure.png", "report.html",
+                                                                "report.json"]
+
+
+def test_the_package_writes_only_names_of_its_own_kind(tmp_path):
+    """What the package may delete is what it can write: a name outside that set is refused before writing."""
+    from ngcontact.output.writer import is_own_name, write_text_files
+    for name in ("report.json", "report.html", "curve.csv", "surface_load3.csv", "cell.vtu", "contact_curve.png",
+                 "pressure_load0.npy", "interface_law.json", "interface_law_calculix.inp", "interface_law_ansys.mac"):
+        assert is_own_name(name), name
+    for name in ("thesis.tex", "notes.txt", "Data.csv", "../report.json", "sub/report.json", "..", MANIFEST, ""):
+        assert not is_own_name(name), name
+    with pytest.raises(ValueError, match="thesis.tex"):
+        write_text_files(str(tmp_path / "out"), {"thesis.tex": "x"})
+    assert not (tmp_path / "out").exists()
 
 
 def test_a_foreign_file_named_like_the_manifest_is_refused(tmp_path):
