@@ -178,10 +178,11 @@ def check_law(law: lt.ExportedLaw, given: float | None = None, default: float = 
 
     Every number an exporter writes is finite, and the table's rows as
     written (``pressure, overclosure`` with 13 significant digits,
-    :func:`~ngcontact.export.law_table.number`) start at zero pressure and
-    increase strictly in both columns: two identical rows (a ``p_max`` below
-    the closures' resolution) or a non-monotone overclosure (a macro gap
-    that swamps the closures) are refused.
+    :func:`~ngcontact.export.law_table.number`) start at zero pressure, end
+    above it, have strictly increasing overclosures and non-decreasing
+    pressures (a tabulated law may have a plateau): two identical rows (a
+    ``p_max`` below the closures' resolution) or a non-monotone overclosure
+    (a macro gap that swamps the closures) are refused.
 
     ``given``: ``--max-pressure`` as given (``None``: the default, ``default``).
     """
@@ -193,7 +194,7 @@ def check_law(law: lt.ExportedLaw, given: float | None = None, default: float = 
             raise ModelError(f"{name} of the law is not finite; no card can carry it")
     d = np.array([float(lt.number(c + law.gap)) for c in law.closure])
     p = np.array([float(lt.number(v)) for v in law.pressure])
-    if len(d) >= 2 and p[0] == 0.0 and np.all(np.diff(d) > 0) and np.all(np.diff(p) > 0):
+    if len(d) >= 2 and p[0] == 0.0 and p[-1] > 0 and np.all(np.diff(d) > 0) and np.all(np.diff(p) >= 0):
         return
     span = f"overclosures {d[0]:.13g} .. {d[-1]:.13g} m, pressures 0 .. {law.p_max:.6g} Pa"
     if given is not None:

@@ -366,3 +366,16 @@ def test_a_law_without_tangential_stiffness_writes_no_zero_sticking_stiffness(tm
     fkt = re.search(r"^NGC_FKT = (\S+)", mac, re.M)
     assert fkt is None or float(fkt.group(1)) < 0, mac
     assert "RMODIF,NGC_REAL,12" not in mac or (fkt is not None and float(fkt.group(1)) < 0)
+
+
+def test_a_tabulated_plateau_is_admissible(tmp_path):
+    """Non-decreasing pressures (a plateau of a tabulated law) are a valid table; only overclosures must
+    increase strictly."""
+    text = open(SAWTOOTH_BLOCK).read()
+    text = re.sub(r"^cell = .*$", 'law = "tabulated"\nclosure = [1e-6, 2e-6, 3e-6, 5e-6]\n'
+                  'pressure = [0.0, 1e6, 1e6, 2e7]\nkt = 5e9\n', text, flags=re.M)
+    text = re.sub(r"^cell_length_unit.*$", "", text, flags=re.M)
+    path = tmp_path / "m.toml"
+    path.write_text(text)
+    exp = exported_law(str(path), p_max=5e7, tolerance=0.0)
+    assert np.all(np.diff(exp.closure) > 0) and list(exp.pressure[:3]) == [0.0, 1e6, 1e6]
