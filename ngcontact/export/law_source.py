@@ -18,8 +18,8 @@ curve from zero and no loads) needs ``p_max`` given.
 Every card written is admissible: the options are checked where they are
 parsed (:func:`check_options`: finite numbers in their ranges), and the
 law and its table before anything is rendered (:func:`check_law`: finite
-numbers, a positive slope ``k_n0``, table rows that stay distinct and
-strictly increasing as written); a violation is a
+numbers, a positive slope ``k_n0``, table rows that stay distinct as
+written, overclosures strictly increasing); a violation is a
 :class:`~ngcontact.errors.ModelError` naming the option to change.  The
 cards name the scene by its file name and SHA-256 only, not by the
 directories it lies in.
@@ -170,7 +170,7 @@ def _check_curve(kinks, slopes, g0: float, kind: str, length_unit: float) -> Non
     p_full = float(lt.curve(kinks, slopes, [np.max(kinks)])[0])
     if not (math.isfinite(p_full) and math.isfinite(k_n0 * float(np.max(np.abs(kinks))))):
         raise ModelError(f"the law's pressures overflow (closures up to {np.max(np.abs(kinks)):.3g} m at "
-                         f"k_n0 = {k_n0:.3g} Pa/m: {cause}); check the length unit")
+                         f"k_n0 = {k_n0:.3g} Pa/m: {cause})")
 
 
 def check_law(law: lt.ExportedLaw, given: float | None = None, default: float = 0.0) -> None:
@@ -191,6 +191,9 @@ def check_law(law: lt.ExportedLaw, given: float | None = None, default: float = 
     arrays = {"K0": law.K0, "the gap forces": law.gap_force, "the table": np.append(law.closure, law.pressure)}
     for name, value in list(scalars.items()) + list(arrays.items()):
         if value is not None and not np.all(np.isfinite(np.asarray(value, float))):
+            if name == "the table" and given is not None:
+                raise ModelError(f"--max-pressure {given!r}: the table's closures overflow; give a smaller one, "
+                                 f"e.g. the default {default:.6g} Pa (omit --max-pressure)")
             raise ModelError(f"{name} of the law is not finite; no card can carry it")
     d = np.array([float(lt.number(c + law.gap)) for c in law.closure])
     p = np.array([float(lt.number(v)) for v in law.pressure])
