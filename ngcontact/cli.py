@@ -101,13 +101,13 @@ def _parser() -> argparse.ArgumentParser:
     ex.add_argument("--format", required=True, metavar="FORMAT", help="abaqus, calculix, ansys or json")
     ex.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_export)")
     ex.add_argument("--length-unit", type=float, default=1.0, metavar="M",
-                    help="cell scene: metres per cell length unit (default 1)")
+                    help="cell scene: metres per cell length unit, in [1e-12, 1000] (default 1)")
     ex.add_argument("--max-pressure", type=float, metavar="PA", help="largest pressure of the table [Pa] "
-                    "(default: from the law's kinks, the scene's loads and interference)")
+                    "(> 0; default: from the law's kinks, the scene's loads and interference)")
     ex.add_argument("--table-tol", type=float, default=1e-3, metavar="T",
                     help="largest departure of the table from the law between nodes, times the largest "
                          "pressure (default 1e-3)")
-    ex.add_argument("--mu", type=float, metavar="MU", help="friction coefficient to write (default: the macro "
+    ex.add_argument("--mu", type=float, metavar="MU", help="friction coefficient to write, >= 0 (default: the macro "
                     "scene's interface.mu, else |k_nt0|/k_n0)")
     return p
 
@@ -239,9 +239,14 @@ def _study(path: str, periods, out: str | None, quiet: bool, compute: dict) -> i
 def _export(args) -> int:
     """``ngcontact export``: check format, scene and ``--out`` first; write one file; warn what is lost."""
     from ngcontact.export.export_law import FORMATS, check, export, warnings
+    from ngcontact.export.law_source import check_options
 
     if args.format not in FORMATS:
         return _fail(EXIT_SCENE, f"--format {args.format}: unknown format; one of " + ", ".join(FORMATS))
+    try:
+        check_options(length_unit=args.length_unit, p_max=args.max_pressure, tolerance=args.table_tol, mu=args.mu)
+    except ModelError as exc:
+        return _fail(EXIT_SCENE, str(exc))
     out = args.out or os.path.join("results", os.path.splitext(os.path.basename(args.scene))[0] + "_export")
     try:
         if not os.path.isfile(args.scene):

@@ -29,6 +29,14 @@ version or format, names another key, fails its checksum or holds arrays of
 the wrong shape or non-finite values is discarded with one warning and
 recomputed; a cache that cannot be written costs only the caching (one
 warning).  Entries are read without pickles.
+
+An entry is a regular file: anything else under its name (a directory, a
+symbolic link, a FIFO) is not the package's and is never removed or
+replaced: the entry goes to the second name ``<key>.1.npz`` (one warning,
+when it is written there), and later runs read it there without a word.
+Removing it would risk a user's data (a directory is not removed without
+looking into it), and skipping the cache would recompute and warn on every
+run.  With both names taken the law is not cached (one warning per run).
 """
 from __future__ import annotations
 
@@ -36,6 +44,7 @@ import hashlib
 import json
 import logging
 import os
+import stat
 import tempfile
 import zipfile
 from importlib.metadata import PackageNotFoundError, version
@@ -81,8 +90,12 @@ def _read_entry(path: str, key: str, names=ARRAYS, fmt: str = CACHE_VERSION,
         with np.load(path, allow_pickle=False) as data:
             arrays = {k: np.array(data[k], dtype=float) for k in names}
             meta = json.loads(str(data["meta"]))
-    except (OSError, KeyError, ValueError, TypeError, EOFError, zipfile.BadZipFile) as exc:
-        raise ValueError(f"unreadable ({type(exc).__name__}: {exc})") from None
+    except OSError as exc:
+        raise ValueError(f"unreadable ({exc.strerror or type(exc).__name__})") from None
+    except KeyError as exc:
+        raise ValueError(f"unreadable (no array {exc})") from None
+    except (ValueError, TypeError, EOFError, zipfile.BadZipFile):  # numpy's messages advise pickles: not quoted
+        raise ValueError("unreadable (not a NumPy .npz archive of this cache)") from None
     if not isinstance(meta, dict):
         raise ValueError("no description")
     for name, want in (("format", fmt), ("version", _package_version()), ("key", key)):
@@ -102,11 +115,33 @@ def cache_dir_default() -> str:
     return os.environ.get("NGCONTACT_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "ngcontact")
 
 
+def _entry_path(cache_dir: str, key: str) -> tuple[str | None, str | None]:
+    """``(path of key's entry, path skipped)``: the first of ``<key>.npz``, ``<key>.1.npz`` that is a regular
+    file or free, ``None`` when neither is; the first name when it holds something else (module docstring)."""
+    skipped = None
+    for name in (f"{key}.npz", f"{key}.1.npz"):
+        path = os.path.join(cache_dir, name)
+        try:
+            mode = os.lstat(path).st_mode
+        except OSError:  # free (or the cache directory is missing or unusable: reading finds nothing)
+            return path, skipped
+        if stat.S_ISREG(mode):
+            return path, skipped
+        skipped = skipped or path
+    return None, skipped
+
+
+def _kind(path: str) -> str:
+    mode = os.lstat(path).st_mode
+    return ("a directory" if stat.S_ISDIR(mode) else "a symbolic link" if stat.S_ISLNK(mode)
+            else "not a regular file")
+
+
 def read_cached(key: str, names=ARRAYS, fmt: str = CACHE_VERSION, cache_dir: str | None = None,
                 shapes: Callable[[dict], str | None] = _bundle_shapes) -> dict | None:
     """The arrays ``names`` cached under ``key``, or ``None`` (a bad entry is discarded with one warning)."""
-    path = os.path.join(cache_dir or cache_dir_default(), f"{key}.npz")
-    if not os.path.isfile(path):
+    path, _ = _entry_path(cache_dir or cache_dir_default(), key)
+    if path is None or not os.path.isfile(path):
         return None
     try:
         found = _read_entry(path, key, names, fmt, shapes)
@@ -121,7 +156,15 @@ def write_cached(key: str, arrays: dict, names=ARRAYS, fmt: str = CACHE_VERSION,
                  cache_dir: str | None = None) -> None:
     """Write ``arrays`` under ``key`` atomically; a cache that cannot be written costs one warning."""
     cache_dir = cache_dir or cache_dir_default()
-    path = os.path.join(cache_dir, f"{key}.npz")
+    path, skipped = _entry_path(cache_dir, key)
+    if path is None:
+        log.warning("ngcontact: the cell-law cache entry names %s and %s are taken by things that are not cache "
+                    "entries (left as they are); the law is recomputed on every run (move them away)",
+                    *(os.path.join(cache_dir, f"{key}{tail}") for tail in (".npz", ".1.npz")))
+        return
+    if skipped is not None:
+        log.warning("ngcontact: %s is %s, not a cache entry, and is left as it is; the entry is written to %s",
+                    skipped, _kind(skipped), os.path.basename(path))
     # Any values: np.savez's stub would otherwise match the arrays against
     # its keyword-only allow_pickle: bool
     data: dict[str, Any] = {k: np.asarray(arrays[k], float) for k in names}

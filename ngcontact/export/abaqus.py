@@ -17,7 +17,8 @@ largest pressure, and scales with ``p`` elsewhere (stated in the file).
 """
 from __future__ import annotations
 
-from ngcontact.export.law_table import ExportedLaw
+from ngcontact.errors import ModelError
+from ngcontact.export.law_table import ExportedLaw, number
 
 NAME = "NGCONTACT_LAW"
 
@@ -40,11 +41,6 @@ def header(law: ExportedLaw, comment: str, code: str) -> list[str]:
     return [f"{comment} {line}" for line in lines]
 
 
-def number(v: float) -> str:
-    """A number in at most 20 characters (ccx reads fields of 20) with 13 significant digits (relative 5e-14)."""
-    return f"{v:.12e}"
-
-
 def table_rows(law: ExportedLaw) -> list[str]:
     """``pressure, overclosure`` data lines (13 significant digits)."""
     return [f"{number(p)}, {number(c + law.gap)}" for c, p in zip(law.closure, law.pressure)]
@@ -59,6 +55,10 @@ def text(law: ExportedLaw) -> str:
     if law.mu > 0 and law.stick_slope > 0:
         p_ref = 0.5 * law.p_max
         gamma = law.mu * p_ref / law.stick_slope
+        if not (1e-300 < gamma < 1e300):
+            who = "--mu" if law.mu_source == "given" else f"mu0 (from {law.mu_source})"
+            raise ModelError(f"{who} {law.mu!r}: the elastic slip mu0 p_ref / k_t0 = {gamma:g} m it gives (p_ref = "
+                             f"{p_ref:.6g} Pa, k_t0 = {law.stick_slope:.6g} Pa/m) must be a positive finite number")
         lines += [f"** elastic slip gamma = mu0 p_ref / k_t0 with p_ref = {p_ref:.6g} Pa: the stick stiffness "
                   "mu0 p / gamma equals k_t0 at p = p_ref only (Abaqus scales it with the pressure)",
                   f"*FRICTION, ELASTIC SLIP={number(gamma)}", number(law.mu)]

@@ -7,7 +7,8 @@ the macro gap enters as the contact offset, real constant 10, ``CNOF``
 (positive closes: ``CNOF = -g0``).  Written:
 
     FKN = -k_n0    (the slope beyond the last kink: exact for p >= p_full)
-    FKT = -k_t0    (the stick slope, paper eqs. 34, 42-43)
+    FKT = -k_t0    (the stick slope, paper eqs. 34, 42-43; not written when k_t0 = 0:
+                    ANSYS would read 0 as its default factor)
     CNOF = -g0 - c_full + p_full / k_n0   (the straight line through the curve's last segment)
     MU = mu0       (MP,MU; TB,FRIC with TBDATA,1,mu0 in newer versions)
 
@@ -20,7 +21,7 @@ written).  The real-constant set and material numbers are parameters
 from __future__ import annotations
 
 from ngcontact.export.abaqus import header
-from ngcontact.export.law_table import ExportedLaw
+from ngcontact.export.law_table import ExportedLaw, number
 
 
 def offset(law: ExportedLaw) -> float:
@@ -36,10 +37,14 @@ def text(law: ExportedLaw) -> str:
               f"(up to the table's {law.p_max:.6g} Pa and beyond); below, the law is the table:",
               "!   pressure [Pa], closure [m]"] + [f"!   {p:.10g}, {c:.10g}" for c, p in zip(law.closure, law.pressure)]
     lines += ["NGC_REAL = 2   ! real-constant set of the contact pair: edit", "NGC_MAT = 2   ! its material: edit",
-              f"NGC_FKN = {-law.k_n0:.17g}   ! absolute normal stiffness [N/m^3] (negative: absolute)",
-              f"NGC_FKT = {-law.stick_slope:.17g}   ! absolute sticking stiffness [N/m^3]",
-              f"NGC_CNOF = {offset(law):.17g}   ! contact offset [m], positive closes",
-              f"NGC_MU = {law.mu:.17g}   ! friction coefficient ({law.mu_source})",
-              "R,NGC_REAL", "RMODIF,NGC_REAL,3,NGC_FKN", "RMODIF,NGC_REAL,10,NGC_CNOF",
-              "RMODIF,NGC_REAL,12,NGC_FKT", "MP,MU,NGC_MAT,NGC_MU"]
+              f"NGC_FKN = {number(-law.k_n0, '.17g')}   ! absolute normal stiffness [N/m^3] (negative: absolute)"]
+    if law.stick_slope > 0:
+        lines.append(f"NGC_FKT = {number(-law.stick_slope, '.17g')}   ! absolute sticking stiffness [N/m^3]")
+    lines += [f"NGC_CNOF = {number(offset(law), '.17g')}   ! contact offset [m], positive closes",
+              f"NGC_MU = {number(law.mu, '.17g')}   ! friction coefficient ({law.mu_source})",
+              "R,NGC_REAL", "RMODIF,NGC_REAL,3,NGC_FKN", "RMODIF,NGC_REAL,10,NGC_CNOF"]
+    # FKT = 0 would read as ANSYS's default factor, not as an absolute stiffness: no zero is written
+    lines += (["RMODIF,NGC_REAL,12,NGC_FKT"] if law.stick_slope > 0 else
+              ["! no FKT: the law has no tangential stiffness (k_t0 = 0); ANSYS takes its default sticking stiffness"])
+    lines.append("MP,MU,NGC_MAT,NGC_MU")
     return "\n".join(lines) + "\n"

@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ngcontact.export.abaqus import NAME, header, number, table_rows
-from ngcontact.export.law_table import ExportedLaw
+from ngcontact.export.abaqus import NAME, header, table_rows
+from ngcontact.export.law_table import ExportedLaw, number
 
 #: ccx moves table nodes closer than this apart (surfacebehaviors.f).
 CCX_MIN_SPACING = 1e-10

@@ -33,11 +33,24 @@ Units: closures and gaps in metres, pressures in pascals, stiffnesses in Pa/m
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ngcontact.errors import ModelError
+
+#: Entries of ``K0`` below this fraction of ``k_n0`` are rounding (``k_nt0`` of a symmetric cell): not carried,
+#: not a friction coefficient.
+ROUNDING = 1e-12
+
+
+def number(v: float, spec: str = ".12e") -> str:
+    """``v`` as a card writes it (default: at most 20 characters, as ccx reads them, with 13 significant digits,
+    relative 5e-14); a non-finite value is refused, so that no card carries ``inf`` or ``nan``."""
+    if not math.isfinite(v):
+        raise ModelError(f"a non-finite number ({v}) cannot be written into a card")
+    return format(v, spec)
 
 @dataclass(frozen=True)
 class ExportedLaw:
@@ -62,7 +75,7 @@ class ExportedLaw:
     gap
         Uniform macro gap ``g0`` [m] (negative: interference).
     source
-        Scene path, kind, SHA-256 of the scene (and its cell), length unit, the law's type.
+        Scene file name (no directories), kind, SHA-256 of the scene (and its cell), length unit, the law's type.
     notes
         What the formats with a contact card cannot carry (one sentence each).
     gap_force
@@ -186,7 +199,7 @@ def not_carried(directions, K0: np.ndarray | None, *, threshold: float = 0.0, ga
         return tuple(notes + (["the macro gap table (g0 varying along the interface) is not carried; the gap "
                                "written is 0"] if gap_table else []))
     kn = float(K0[0, 0])
-    if np.any(np.abs(K0[0, 1:]) > 1e-12 * kn):
+    if np.any(np.abs(K0[0, 1:]) > ROUNDING * kn):
         notes.append(f"k_nt0 = {', '.join(f'{v:.6g}' for v in K0[0, 1:])} Pa/m (normal-tangential coupling of "
                      "eq. 34: a normal closure also shears, a slip also presses) is not carried; only |k_nt0|/k_n0 "
                      "can enter as a friction coefficient")

@@ -9,11 +9,16 @@ The contract, for ``ngcontact run SCENE --out DIR`` and every study:
   ``.ngcontact-manifest.json`` that lists them.  ``DIR`` is created when
   missing (with the user's umask); an existing ``DIR`` keeps its mode, its
   owner and every file the package did not write.  A symbolic link ``DIR``
-  is followed, never replaced.
+  is followed, never replaced; a path whose links loop is refused before
+  any work.
 * A rerun replaces the files the manifest of the previous run lists (and
   removes those of them the new run does not write); a file of the same
   name that no manifest lists is the user's, and the run is refused before
   anything is written.
+* Only names of the kind the package writes (:func:`is_own_name`) are ever
+  written, replaced or removed: a manifest entry of any other name (one
+  edited in by hand: ``thesis.tex``, a path, ``..``) is ignored with a
+  warning, never deleted, and no longer listed.
 * ``DIR`` must not contain the scene or any file the scene reads (the
   directory ``.``, a parent, a data folder): refused before any work.
 * Atomic as a whole: every file is first written into a staging directory
@@ -33,7 +38,9 @@ import csv
 import errno
 import glob
 import json
+import logging
 import os
+import re
 import shutil
 import signal
 import tempfile
@@ -49,10 +56,23 @@ from ngcontact.output.report_html import write_html
 if TYPE_CHECKING:
     from ngcontact.output.report import VtkField
 
+log = logging.getLogger(__name__)
+
 MANIFEST = ".ngcontact-manifest.json"
 #: the files every run writes besides those of its outcome
 REPORT_FILES = ("report.json", "report.html")
 STAGING_PREFIX = ".ngcontact-partial-"
+#: Every file name the package writes into an output directory, and so the only names it ever replaces or
+#: removes: the reports, an outcome's tables, VTK files, plots and arrays (lower-case stems,
+#: :func:`ngcontact.output.report.file_names`) and the law files of ``ngcontact export``
+#: (:data:`ngcontact.export.export_law.FORMATS`).  The manifest is handled apart.
+OWN_NAMES = re.compile(r"report\.json|report\.html|[a-z][a-z0-9_]*\.(?:csv|vtu|png|npy)"
+                       r"|interface_law(?:_[a-z]+)?\.(?:inp|mac|json)")
+
+
+def is_own_name(name: str) -> bool:
+    """Whether ``name`` is a file name the package writes (:data:`OWN_NAMES`; no path, not the manifest)."""
+    return OWN_NAMES.fullmatch(name) is not None
 
 
 # ---------------------------------------------------------------- the files
@@ -88,8 +108,28 @@ def _existing_ancestor(path: str) -> str:
     return probe
 
 
-def own_files(out_dir: str) -> set[str] | None:
+def _resolved(out_dir: str) -> str:
+    """The real path ``DIR`` stands for, its symbolic links followed; a loop among them is refused here,
+    before any work (it would fail only when the files are moved into place)."""
+    path = os.path.abspath(out_dir)
+    try:
+        os.path.realpath(path, strict=True)
+    except (FileNotFoundError, NotADirectoryError):  # the missing part is created; a file on the way is refused below
+        pass
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise OutputError(f"--out {out_dir}: a symbolic link on the path ({exc.filename}) leads into a loop; "
+                              "fix or remove the link, or choose another directory") from None
+        raise OutputError(f"--out {out_dir}: cannot be resolved ({exc.strerror}: {exc.filename})") from None
+    return os.path.realpath(path)
+
+
+def own_files(out_dir: str, *, warn: bool = False) -> set[str] | None:
     """The files the package's manifest in ``out_dir`` lists; ``None`` when there is no manifest.
+
+    Entries that are not names the package writes (:func:`is_own_name`) are
+    left out (``warn``: with one warning line naming them): they are never
+    replaced or removed.
 
     Raises
     ------
@@ -108,8 +148,11 @@ def own_files(out_dir: str) -> set[str] | None:
     if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
         raise OutputError(f"--out {out_dir}: {MANIFEST} exists and is not a manifest of ngcontact; "
                           "move it or choose another directory")
-    # a manifest names plain files of this directory only
-    return {f for f in files if f == os.path.basename(f) and f not in ("", ".", "..", MANIFEST)}
+    foreign = sorted({f for f in files if not is_own_name(f)})
+    if warn and foreign:
+        log.warning("ngcontact: %s in %s lists %s, which ngcontact never writes; ignored (kept, not deleted, no "
+                    "longer listed)", MANIFEST, out_dir, ", ".join(map(repr, foreign)))
+    return {f for f in files if is_own_name(f)}
 
 
 def check_output_dir(out_dir: str, inputs: Iterable[str] = (), names: Iterable[str] = REPORT_FILES) -> str:
@@ -125,7 +168,7 @@ def check_output_dir(out_dir: str, inputs: Iterable[str] = (), names: Iterable[s
         File names the run will write; one that exists and is not the
         package's (no manifest lists it) is refused.
     """
-    real = os.path.realpath(os.path.abspath(out_dir))
+    real = _resolved(out_dir)
     if os.path.exists(real) and not os.path.isdir(real):
         raise OutputError(f"--out {out_dir}: exists and is not a directory")
     for p in inputs:
@@ -201,6 +244,9 @@ def _staged(out_dir: str, names: list[str], inputs: Iterable[str], fill, version
     ``keep_previous``: the manifest also lists the files of earlier runs
     (none is removed); otherwise those the new run does not write are removed.
     """
+    foreign = [n for n in names if not is_own_name(n)]
+    if foreign:  # a programming error: the package may delete what it writes, so it writes only its own names
+        raise ValueError(f"not a file name ngcontact writes: {', '.join(foreign)} (see writer.OWN_NAMES)")
     real = check_output_dir(out_dir, inputs, names)
     stage_in = real if os.path.isdir(real) else _existing_ancestor(real)
     remove_stale_staging(stage_in)
@@ -211,7 +257,7 @@ def _staged(out_dir: str, names: list[str], inputs: Iterable[str], fill, version
     try:
         fill(tmp)
         with _signals_held():
-            old = (own_files(real) or set()) if os.path.isdir(real) else set()
+            old = (own_files(real, warn=True) or set()) if os.path.isdir(real) else set()
             listed = sorted(set(names) | ({n for n in old if os.path.lexists(os.path.join(real, n))}
                                           if keep_previous else set()))
             with open(os.path.join(tmp, MANIFEST), "w", encoding="utf-8") as fh:

@@ -83,3 +83,42 @@ def test_a_cache_path_that_is_a_file_costs_only_the_caching(tmp_path, caplog):
     blocker.write_text("x")
     cached, calls, warnings = reread(blocker, caplog)
     assert not cached and calls == [1] and len(warnings) == 1 and "cannot be written" in warnings[0]
+
+
+def test_a_garbage_entry_is_called_unreadable_without_numpys_advice(tmp_path, caplog):
+    """Defect: the warning quoted numpy's "allow_pickle=True ... only if you trust the file" advice."""
+    path = fresh_entry(tmp_path)
+    path.write_bytes(b"\x80\x04garbage that looks like a pickle")
+    cached, calls, warnings = reread(tmp_path, caplog)
+    assert not cached and calls == [1] and len(warnings) == 1, warnings
+    assert "unreadable" in warnings[0] and "discarding the cache entry" in warnings[0], warnings
+    assert "pickle" not in warnings[0].lower() and "trust" not in warnings[0], warnings
+
+
+@pytest.mark.parametrize("kind", ["directory", "symlink", "fifo"])
+def test_an_entry_that_is_not_a_regular_file_is_left_alone_and_warned_about_once(tmp_path, caplog, kind):
+    """Defect: a cache entry that was a directory was never removed: every later run recomputed and warned.
+    The package writes regular files only; anything else under an entry's name is not its own: it is kept
+    as it is, the entry goes under a second name, and the next runs read that one without a word."""
+    path = tmp_path / f"{KEY}.npz"
+    target = tmp_path / "elsewhere.txt"
+    target.write_text("the user's")
+    if kind == "directory":
+        path.mkdir()
+        (path / "inside.txt").write_text("the user's")
+    elif kind == "symlink":
+        path.symlink_to(target)
+    else:
+        os.mkfifo(path)
+    cached, calls, warnings = reread(tmp_path, caplog)
+    assert not cached and calls == [1] and len(warnings) == 1, warnings
+    assert "not a cache entry" in warnings[0] and "left as it is" in warnings[0], warnings
+    caplog.clear()
+    for _ in range(2):
+        cached, calls, warnings = reread(tmp_path, caplog)
+        assert cached and calls == [] and warnings == [], warnings
+    assert target.read_text() == "the user's"
+    if kind == "directory":
+        assert (path / "inside.txt").read_text() == "the user's"
+    elif kind == "symlink":
+        assert path.is_symlink() and os.readlink(path) == str(target)

@@ -13,12 +13,13 @@ Requirements:
 import json
 import os
 import re
+import warnings as warnings_module
 
 import numpy as np
 import pytest
 
 from ngcontact import cli
-from ngcontact.errors import SceneError
+from ngcontact.errors import ModelError, SceneError
 from ngcontact.export import law_table as lt
 from ngcontact.export.law_source import exported_law
 from ngcontact.scene import loader
@@ -272,3 +273,109 @@ def test_the_running_sum_curve_is_the_sum_of_ramps():
     c = np.linspace(-4.0, 4.0, 3001)
     direct = np.maximum(c[:, None] - kinks[None, :], 0.0) @ slopes
     assert np.max(np.abs(lt.curve(kinks, slopes, c) - direct)) <= 1e-13 * direct.max()
+
+
+# ------------------------------------------------------------- every written card admissible
+@pytest.mark.parametrize("args, message", [
+    (["--mu", "inf"], "--mu inf: the friction coefficient, must be a finite number >= 0"),
+    (["--mu", "nan"], "--mu nan: the friction coefficient, must be a finite number >= 0"),
+    (["--max-pressure", "inf"], "--max-pressure inf: the table's largest pressure [Pa], must be a finite number > 0"),
+    (["--table-tol", "inf"], "--table-tol inf: a fraction of the table's largest pressure, must lie in [0, 1)"),
+    (["--length-unit", "inf"], "--length-unit inf: metres per cell unit, must be a finite number in [1e-12, 1000]"),
+    (["--length-unit", "1e300"], "--length-unit 1e+300: metres per cell unit, must be a finite number in"),
+    (["--length-unit", "1e-300"], "--length-unit 1e-300: metres per cell unit, must be a finite number in"),
+])
+def test_non_finite_or_out_of_range_options_are_refused_naming_the_option(tmp_path, capsys, args, message):
+    """Defect: --mu inf wrote '*FRICTION, ELASTIC SLIP=inf' and a line 'inf' (exit 0); --length-unit inf, 1e300,
+    1e-300 printed numpy warnings, then blamed --max-pressure."""
+    out = tmp_path / "out"
+    with warnings_module.catch_warnings(record=True) as caught:
+        warnings_module.simplefilter("always")
+        code = cli.main(["export", GAP_CELL, "--format", "abaqus", "--out", str(out), *args])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err, err
+    assert len(err.strip().splitlines()) == 1 and "--max-pressure" not in err.replace(message, "") or \
+        args[0] == "--max-pressure", err
+    assert not [w for w in caught if issubclass(w.category, RuntimeWarning)], [str(w.message) for w in caught]
+    assert not out.exists()
+
+
+def test_a_table_of_identical_rows_is_refused_naming_max_pressure(tmp_path, capsys):
+    """Defect: --max-pressure 1e-30 wrote two identical zero rows (exit 0)."""
+    out = tmp_path / "out"
+    assert cli.main(["export", GAP_CELL, "--format", "calculix", "--out", str(out), "--length-unit", str(UNIT),
+                     "--max-pressure", "1e-30"]) == 2
+    err = capsys.readouterr().err
+    assert "--max-pressure 1e-30: " in err and "too small" in err and "Pa" in err, err
+    assert not out.exists()
+    with pytest.raises(ModelError, match="--max-pressure 1e-30"):
+        exported_law(GAP_CELL, length_unit=UNIT, p_max=1e-30)
+
+
+def _numbers(text, comment):
+    """Every number on the lines of a card that are not comments."""
+    found = []
+    for line in text.splitlines():
+        if line.startswith(comment):
+            continue
+        found += re.findall(r"(?<![A-Za-z_])[-+]?(?:\d+\.?\d*(?:[eE][-+]?\d+)?|inf|nan)(?![A-Za-z_\d])",
+                            line.split("!")[0], flags=re.I)
+    return [float(v) for v in found]
+
+
+@pytest.mark.parametrize("fmt, comment", [("abaqus", "**"), ("calculix", "**"), ("ansys", "!")])
+@pytest.mark.parametrize("options", [["--max-pressure", "1e8"], ["--max-pressure", "1e8", "--mu", "0.3"], []])
+def test_every_written_card_is_finite_with_strictly_increasing_rows(tmp_path, fmt, comment, options):
+    out = tmp_path / "out"
+    assert cli.main(["export", GAP_CELL, "--format", fmt, "--out", str(out), "--length-unit", str(UNIT),
+                     *options]) == 0
+    text = next(out.glob("interface_law*")).read_text()
+    values = _numbers(text, comment)
+    assert values and all(np.isfinite(values)), [v for v in values if not np.isfinite(v)]
+    if fmt != "ansys":
+        rows = _rows(text)
+        assert rows[0, 0] == 0.0 and np.all(np.diff(rows[:, 0]) > 0) and np.all(np.diff(rows[:, 1]) > 0), rows
+        friction = [ln for ln in text.splitlines() if ln.startswith("*FRICTION")]
+        if "--mu" not in options:  # the cell is symmetric: its k_nt0 is rounding, its mu0 = |k_nt0|/k_n0 zero
+            assert friction == [], "a friction coefficient of rounding noise is no friction coefficient"
+
+
+def test_the_card_names_the_scene_without_the_users_directories(tmp_path):
+    """Defect: the exported card recorded the scene's absolute path (the user's directory layout)."""
+    for fmt in ("abaqus", "calculix", "ansys", "json"):
+        out = tmp_path / fmt
+        assert cli.main(["export", GAP_CELL, "--format", fmt, "--out", str(out), "--length-unit", str(UNIT),
+                         "--max-pressure", "1e8"]) == 0
+        text = next(out.glob("interface_law*")).read_text()
+        assert os.path.dirname(GAP_CELL) not in text and ROOT not in text, fmt
+        assert os.path.basename(GAP_CELL) in text, fmt
+
+
+def test_a_law_without_tangential_stiffness_writes_no_zero_sticking_stiffness(tmp_path):
+    """ANSYS reads FKT = 0 as its default factor, not as an absolute stiffness: no zero stiffness is written."""
+    text = open(SAWTOOTH_BLOCK).read()
+    text = re.sub(r"^cell = .*$", 'law = "tabulated"\nclosure = [1e-6, 2e-6, 5e-6]\npressure = [0.0, 1e6, 2e7]\n',
+                  text, flags=re.M)
+    text = re.sub(r"^cell_length_unit.*$", "", text, flags=re.M)
+    path = tmp_path / "m.toml"
+    path.write_text(text)
+    out = tmp_path / "out"
+    assert cli.main(["export", str(path), "--format", "ansys", "--out", str(out), "--max-pressure", "5e7",
+                     "--mu", "0.3"]) == 0
+    mac = (out / "interface_law_ansys.mac").read_text()
+    fkt = re.search(r"^NGC_FKT = (\S+)", mac, re.M)
+    assert fkt is None or float(fkt.group(1)) < 0, mac
+    assert "RMODIF,NGC_REAL,12" not in mac or (fkt is not None and float(fkt.group(1)) < 0)
+
+
+def test_a_tabulated_plateau_is_admissible(tmp_path):
+    """Non-decreasing pressures (a plateau of a tabulated law) are a valid table; only overclosures must
+    increase strictly."""
+    text = open(SAWTOOTH_BLOCK).read()
+    text = re.sub(r"^cell = .*$", 'law = "tabulated"\nclosure = [1e-6, 2e-6, 3e-6, 5e-6]\n'
+                  'pressure = [0.0, 1e6, 1e6, 2e7]\nkt = 5e9\n', text, flags=re.M)
+    text = re.sub(r"^cell_length_unit.*$", "", text, flags=re.M)
+    path = tmp_path / "m.toml"
+    path.write_text(text)
+    exp = exported_law(str(path), p_max=5e7, tolerance=0.0)
+    assert np.all(np.diff(exp.closure) > 0) and list(exp.pressure[:3]) == [0.0, 1e6, 1e6]

@@ -4,6 +4,7 @@ Each test states one requirement of :mod:`ngcontact.output.writer` and the
 command line around it, with the defect it guards against.
 """
 import json
+import logging
 import os
 import signal
 import stat
@@ -102,6 +103,41 @@ def test_a_file_of_the_same_name_that_the_package_did_not_write_is_refused_untou
     assert snapshot(out) == before
 
 
+def test_a_hand_edited_manifest_never_gets_a_users_file_deleted(tmp_path, caplog):
+    """Defect: a manifest edited to list thesis.tex got thesis.tex deleted by the next run.  Only names the
+    package writes are ever replaced or removed; any other entry is ignored with a warning and kept."""
+    out = tmp_path / "run"
+    first = outcome_with(1.0)
+    write_outputs(str(out), report_for(first), first)
+    (out / "thesis.tex").write_text("my thesis")
+    (out / "data.txt").write_text("mine")
+    (tmp_path / "outside.csv").write_text("mine too")
+    manifest = json.loads((out / MANIFEST).read_text())
+    manifest["files"] += ["thesis.tex", "data.txt", "../outside.csv", "sub/x.csv", ".."]
+    (out / MANIFEST).write_text(json.dumps(manifest))
+    with caplog.at_level(logging.WARNING, logger="ngcontact.output.writer"):
+        write_outputs(str(out), report_for(outcome_with(2.0)), outcome_with(2.0))
+    assert (out / "thesis.tex").read_text() == "my thesis" and (out / "data.txt").read_text() == "mine"
+    assert (tmp_path / "outside.csv").read_text() == "mine too"
+    warned = " ".join(r.getMessage() for r in caplog.records)
+    assert "thesis.tex" in warned and "data.txt" in warned and "ignored" in warned, warned
+    assert json.loads((out / MANIFEST).read_text())["files"] == ["curve.csv", "figure.png", "report.html",
+                                                                "report.json"]
+
+
+def test_the_package_writes_only_names_of_its_own_kind(tmp_path):
+    """What the package may delete is what it can write: a name outside that set is refused before writing."""
+    from ngcontact.output.writer import is_own_name, write_text_files
+    for name in ("report.json", "report.html", "curve.csv", "surface_load3.csv", "cell.vtu", "contact_curve.png",
+                 "pressure_load0.npy", "interface_law.json", "interface_law_calculix.inp", "interface_law_ansys.mac"):
+        assert is_own_name(name), name
+    for name in ("thesis.tex", "notes.txt", "Data.csv", "../report.json", "sub/report.json", "..", MANIFEST, ""):
+        assert not is_own_name(name), name
+    with pytest.raises(ValueError, match="thesis.tex"):
+        write_text_files(str(tmp_path / "out"), {"thesis.tex": "x"})
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_foreign_file_named_like_the_manifest_is_refused(tmp_path):
     out = tmp_path / "run"
     out.mkdir()
@@ -157,6 +193,16 @@ def test_unwritable_output_is_refused_before_any_work(tmp_path):
         check_output_dir(str(blocker / "run"))
 
 
+@pytest.mark.parametrize("below", ["", "sub"])
+def test_an_output_path_through_a_symlink_loop_is_refused_before_any_work(tmp_path, below):
+    """Defect: --out a symbolic link loop passed the check, the whole solve ran, then "File exists"."""
+    (tmp_path / "a").symlink_to(tmp_path / "b")
+    (tmp_path / "b").symlink_to(tmp_path / "a")
+    out = tmp_path / "a" / below if below else tmp_path / "a"
+    with pytest.raises(OutputError, match=r"--out .*: a symbolic link on the path .*a\) leads into a loop"):
+        check_output_dir(str(out))
+
+
 def test_staging_left_by_a_killed_run_is_removed_by_the_next_and_a_live_one_is_kept(tmp_path):
     """Defect: SIGKILL left .ngcontact-partial-* folders forever."""
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
@@ -190,6 +236,22 @@ def test_out_dot_keeps_the_scene_and_every_file(scene_dir, monkeypatch, capsys, 
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "which the scene reads" in err, err
     assert snapshot(scene_dir.parent) == before
+
+
+def test_run_into_a_symlink_loop_exits_2_before_solving(scene_dir, monkeypatch, capsys):
+    """Defect: the solve ran to its end before --out (a symbolic link loop) failed with "File exists"."""
+    from ngcontact import runner
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("the solve ran although --out cannot be written")
+
+    monkeypatch.setattr(runner, "solve", no_solve)
+    (scene_dir / "loop").symlink_to(scene_dir / "loop")
+    before = snapshot(scene_dir)
+    assert cli.main(["run", str(scene_dir / "small.toml"), "--out", str(scene_dir / "loop"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--out" in err and "loop" in err, err
+    assert snapshot(scene_dir) == before
 
 
 def test_a_data_folder_the_scene_reads_is_refused(tmp_path, capsys):
