@@ -37,6 +37,7 @@ import numpy as np
 
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.geometry.femur import FemurStemDims
+from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.geometry.resolved_shapes import RESOLVED_SHAPES, resolved_shape
 from ngcontact.scene.macro_shapes import FEMUR_BOUNDARIES, check_dimensions, check_support_meaning
 from ngcontact.scene.sections import (ComputeSpec, MaterialSpec, check_supports_once, SolverSpec, base_dir_field,
@@ -236,7 +237,7 @@ class DirectScene:
         if cell.kind != "cell":
             raise SceneError("geometry.cell", self.geometry.cell, f"names a {cell.kind!r} scene; need 'cell'")
         g = cell.geometry
-        if g.dim != 2 or g.arrangement != "conforming" or g.profile == "tabulated":
+        if g.arrangement != "conforming" or not PROFILES[g.profile].parametric:
             raise SceneError("geometry.cell", self.geometry.cell,
                              "need a 2D conforming cell with an analytic profile (flat, rectangular, "
                              "triangular, semicircular, sinusoid)")
