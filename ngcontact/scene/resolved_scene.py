@@ -6,7 +6,7 @@ friction) come from a ``cell`` scene named by ``geometry.cell``; its
 roughness is repeated ``geometry.periods`` times along the interface and
 scaled to the period ``eps = (interface length) / periods``.
 
-Shapes (``geometry.shape``, see :mod:`ngcontact.geometry.resolved_bodies`):
+Shapes (``geometry.shape``, see :mod:`ngcontact.geometry.resolved_shapes`):
 
 ``blocks``
     Rough block below, counter block above, ``x0 <= x <= x0 + length``;
