@@ -32,7 +32,8 @@ from ngcontact.laws.friction import FRICTION_LAWS, FrictionLaw
 from ngcontact.solvers.linear_solver import LinearSolver
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral_start import SpectralStart
-from ngcontact.scene.cell_geometry import GAP_PROFILES, profile_2d, small_slope
+from ngcontact.geometry.profile_registry import PROFILES
+from ngcontact.scene.cell_geometry import small_slope
 from ngcontact.scene.cell_scene import MAX_SPECTRAL_POINTS, CellScene, load_states, spectral_grid
 from ngcontact.scene.loader import as_dict, load_with_contact
 from ngcontact.scene.sections import MaterialSpec, resolve
@@ -184,27 +185,20 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
     maxh = maxh or d.maxh
     ih = interface_maxh or d.interface_maxh
     order = order or d.order
+    kind = PROFILES[g.profile]
+    file = resolve(scene, g.file) if kind.reads_file else None
     if g.dim == 3:
         from ngcontact.geometry import cell3d
-        if g.profile in GAP_PROFILES and not small_slope(g):
-            if g.profile == "bisinusoid":
-                heights = cell3d.bisinusoid_heights(g.amplitude, g.period)
-            else:
-                heights = height_map(scene)
-            return cell3d.surface_cell(heights, period=g.period, h_rough=g.h_rough,
+        if kind.heights is not None and not small_slope(g):    # a free-form surface, meshed as it is
+            return cell3d.surface_cell(kind.heights(g, file), period=g.period, h_rough=g.h_rough,
                                        h_counter=g.h_counter, maxh=maxh, interface_maxh=ih,
                                        order=order)
-        if g.profile != "square_hills":  # flat, or a small-slope profile carried by the gap
+        if kind.solid is None:  # flat, or a small-slope profile carried by the gap
             return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih)
-        return cell3d.square_hills_cell(g.width, g.depth, period=g.period, arrangement=g.arrangement,
-                                        h_rough=g.h_rough, h_counter=g.h_counter, maxh=maxh,
-                                        interface_maxh=ih)
+        return kind.solid(g, maxh=maxh, interface_maxh=ih)
     from ngcontact.geometry import profiles as pr
-    if g.profile == "tabulated":
-        from ngcontact.geometry.tabulated import read_profile_csv
-        prof = read_profile_csv(resolve(scene, g.file), path="geometry.file")
-    else:
-        prof = profile_2d(g)
+    assert kind.profile is not None  # every 2D profile has its builder
+    prof = kind.profile(g, file)
     return pr.profile_cell(prof, arrangement=g.arrangement, h_rough=g.h_rough, h_counter=g.h_counter,
                            maxh=maxh, interface_maxh=ih, order=order)
 
@@ -347,7 +341,7 @@ def map_heights(scene: CellScene) -> np.ndarray | None:
     """The height map of a small-slope cell whose gap comes from one (height map, self-affine surface), or
     ``None`` (a gap given by a formula)."""
     g = scene.geometry
-    return height_map(scene) if small_slope(g) and g.profile != "bisinusoid" else None
+    return height_map(scene) if small_slope(g) and PROFILES[g.profile].own_grid else None
 
 
 def gap_samples(scene, grid: int, heights: np.ndarray | None = None) -> np.ndarray:
@@ -367,8 +361,9 @@ def gap_samples(scene, grid: int, heights: np.ndarray | None = None) -> np.ndarr
     shape = (grid,) * (dim - 1)
     out = np.zeros(shape)
     if small_slope(g):
-        if g.profile == "bisinusoid":
-            out += cell3d.bisinusoid_gap(g.amplitude, P, xy=xy)
+        gap = PROFILES[g.profile].gap
+        if gap is not None:
+            out += gap(g, xy)
         else:
             H = height_map(scene) if heights is None else heights
             out += cell3d.bilinear_samples(H.max() - H, P, grid)
@@ -390,8 +385,9 @@ def _profile_gap(scene):
     if not small_slope(g):
         return None
     from ngcontact.geometry import cell3d
-    if g.profile == "bisinusoid":
-        return cell3d.bisinusoid_gap(g.amplitude, g.period)
+    gap = PROFILES[g.profile].gap
+    if gap is not None:
+        return gap(g, None)
     return cell3d.height_map_gap(height_map(scene), g.period)
 
 
@@ -401,19 +397,11 @@ def height_map(scene) -> np.ndarray:
     In the file layout: the last row and column repeat the first.
     """
     g = scene.geometry
-    if g.profile == "height_map":
-        from ngcontact.geometry.tabulated import read_height_map
-        assert g.file is not None  # required by the profile (CellGeometry.check)
-        return read_height_map(resolve(scene, g.file), path="geometry.file")
-    if g.profile != "self_affine":
+    kind = PROFILES[g.profile]
+    if not kind.own_grid or kind.heights is None:
         raise ValueError(f"geometry.profile = {g.profile!r} has no height map")
-    from ngcontact.geometry.random_surface import as_height_map, self_affine
-    sp = g.spectrum
-    assert sp is not None  # required by the profile (CellGeometry.check)
-    if (sp.rms_height if sp.rms_height is not None else sp.rms_slope) == 0.0:
-        return np.zeros((sp.grid + 1, sp.grid + 1))      # rms 0: the flat surface
-    return as_height_map(self_affine(dim=3, grid=sp.grid, period=g.period, hurst=sp.hurst, rms_height=sp.rms_height,
-                                     rms_slope=sp.rms_slope, rolloff=sp.rolloff, cutoff=sp.cutoff, seed=sp.seed))
+    # the keys a profile uses are required by CellGeometry.check (check_selected)
+    return kind.heights(g, resolve(scene, g.file) if kind.reads_file else None)
 
 
 def _explicit_gap(scene, xy=None):

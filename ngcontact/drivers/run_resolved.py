@@ -33,8 +33,7 @@ import numpy as np
 from ngcontact.drivers.build import body_laws, micro_friction
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.geometry import profiles as pr
-from ngcontact.geometry import femur
-from ngcontact.geometry import resolved_bodies as rg
+from ngcontact.geometry import resolved_shapes as rs
 from ngcontact.scene.cell_geometry import profile_2d
 from ngcontact.macro.macro_problem import Load
 from ngcontact.output.report import Outcome, VtkField
@@ -62,15 +61,19 @@ def materials_of(scene) -> dict:
 
 
 #: Region names of the two bodies in the ``direct`` kind (the femur's too).
-REGIONS = ("rough", "counter")
+REGIONS = rs.REGIONS
 
-#: Boundaries along which ``x`` (``r``) varies; a support's slope is taken along ``x`` there, else ``y``.
-HORIZONTAL = ("top", "bottom", "base", "stem_top", "stem_tip", "bone_top")
+
+def shape_of(scene) -> rs.ResolvedShape:
+    """The shape of the bodies (:mod:`ngcontact.geometry.resolved_shapes`) the scene's ``geometry`` names."""
+    return rs.resolved_shape(scene.geometry)
 
 
 def supports_of(scene) -> tuple:
+    """The supports; a support's slope runs along ``x`` on the shape's horizontal boundaries, else along ``y``."""
+    horizontal = shape_of(scene).horizontal
     return tuple(D.Support(label=s.boundary, components=s.components, value=s.displacement, slope=s.slope,
-                           along="x" if s.boundary in HORIZONTAL else "y") for s in scene.supports)
+                           along="x" if s.boundary in horizontal else "y") for s in scene.supports)
 
 
 def loads_of(scene) -> tuple:
@@ -79,61 +82,38 @@ def loads_of(scene) -> tuple:
 
 def interface_length(scene) -> float:
     """Arc length of the macro interface ``S_0`` (block width; femur: cone plus cylinder)."""
-    g = scene.geometry
-    if g.shape == "femur_stem":
-        return femur.femur_interface_length(g.femur_dims())
-    return float(g.length)
+    return shape_of(scene).interface_length()
 
 
 def eps_of(scene, periods: int) -> float:
     """Resolved period ``eps = (interface length) / N``."""
-    return interface_length(scene) / periods
+    return shape_of(scene).eps(periods)
 
 
 def build_resolved(scene, periods: int | None = None, periodic: bool = False):
     """Mesh the bodies of ``scene`` with ``periods`` resolved periods (default: the scene's)."""
-    g, d = scene.geometry, scene.discretization
-    N = periods or g.periods
-    eps = eps_of(scene, N)
-    prof = profile_of(scene.cell_scene)
-    if g.shape == "femur_stem":
-        if periodic:
-            raise ValueError("the femur has no periodic variant")
-        return femur.femur_stem(g.femur_dims(), prof, N, maxh=d.maxh, interface_maxh=eps / d.elements_per_period,
-                                order=d.order, grading=d.grading, regions=REGIONS)
-    return rg.resolved_blocks(prof, N, g.length, g.h_rough, g.h_counter, maxh=d.maxh,
-                              interface_maxh=eps / d.elements_per_period, order=d.order, periodic=periodic,
-                              grading=d.grading, x0=g.x0)
+    d = scene.discretization
+    shape = shape_of(scene)
+    N = periods or scene.geometry.periods
+    return shape.resolved(profile_of(scene.cell_scene), N, maxh=d.maxh,
+                          interface_maxh=shape.eps(N) / d.elements_per_period, order=d.order, grading=d.grading,
+                          periodic=periodic)
 
 
 def build_flat(scene, interface_maxh: float):
     """The same bodies with the flat macro interface ``S_0`` (boundary ``interface``)."""
-    g, d = scene.geometry, scene.discretization
-    if g.shape == "femur_stem":
-        return femur.femur_stem(g.femur_dims(), None, 0, maxh=d.maxh, interface_maxh=interface_maxh,
-                                grading=d.grading, regions=REGIONS)
-    return rg.flat_blocks(g.length, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=interface_maxh,
-                          grading=d.grading, x0=g.x0)
+    d = scene.discretization
+    return shape_of(scene).flat(maxh=d.maxh, interface_maxh=interface_maxh, grading=d.grading)
 
 
 def body_of(scene, points) -> np.ndarray:
     """Body of each point with the flat interface: 0 rough, 1 counter, -1 outside."""
-    g = scene.geometry
-    pts = np.asarray(points, float).reshape(-1, 2)
-    if g.shape == "femur_stem":
-        return femur.femur_stem_body(g.femur_dims(), pts)
-    inside = (pts[:, 0] > g.x0) & (pts[:, 0] < g.x0 + g.length) & (pts[:, 1] > -g.h_rough) & \
-        (pts[:, 1] < g.h_counter)
-    return np.where(inside, np.where(pts[:, 1] < 0, 0, 1), -1)
+    return shape_of(scene).body_of(points)
 
 
 def interface_distance(scene, points) -> np.ndarray:
     """Distance of each point from the flat macro interface ``S_0``."""
-    g = scene.geometry
-    pts = np.asarray(points, float).reshape(-1, 2)
-    if g.shape == "femur_stem":
-        return femur.distance_to_polyline(femur.femur_stem_interface(g.femur_dims()), pts)
-    return np.abs(pts[:, 1])
+    return shape_of(scene).interface_distance(points)
 
 
 def interface_part(scene):
@@ -142,10 +122,7 @@ def interface_part(scene):
     Blocks: the left half ``x < x0 + L/2``.  Femur: the cylindrical part
     ``z > z_corner`` (its share of the axial load against the cone's).
     """
-    g = scene.geometry
-    if g.shape == "femur_stem":
-        return ng.IfPos(ng.y - g.femur_dims().z_corner, 1.0, 0.0)
-    return ng.IfPos(g.x0 + 0.5 * g.length - ng.x, 1.0, 0.0)
+    return shape_of(scene).interface_part()
 
 
 def problem_of(scene, geometry) -> D.DirectProblem:

@@ -197,23 +197,8 @@ def sample_grid(scene, band: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     keeping the midpoints inside a body and farther than ``band`` from
     ``S_0``.  Axisymmetric weights carry the factor ``2 pi r``.
     """
-    g, (nx, ny) = scene.geometry, scene.study.grid
-    if g.shape == "femur_stem":
-        dims = g.femur_dims()
-        dr, dz = dims.r_bone / nx, dims.z_stem_top / ny
-        R, Z = np.meshgrid((np.arange(nx) + 0.5) * dr, (np.arange(ny) + 0.5) * dz)
-        cand = np.column_stack([R.ravel(), Z.ravel()])
-        keep = (drv.body_of(scene, cand) >= 0) & (drv.interface_distance(scene, cand) > band)
-        pts, wts = cand[keep], np.full(int(np.sum(keep)), dr * dz)
-    else:
-        xs = g.x0 + (np.arange(nx) + 0.5) * g.length / nx
-        pl, wl = [], []
-        for lo, hi in ((-g.h_rough, -band), (band, g.h_counter)):
-            ys = lo + (np.arange(ny) + 0.5) * (hi - lo) / ny
-            X, Y = np.meshgrid(xs, ys)
-            pl.append(np.column_stack([X.ravel(), Y.ravel()]))
-            wl.append(np.full(X.size, (g.length / nx) * (hi - lo) / ny))
-        pts, wts = np.concatenate(pl), np.concatenate(wl)
+    g = scene.geometry
+    pts, wts = drv.shape_of(scene).sample_grid(scene.study.grid, band)
     if g.setting == "axisymmetric":
         wts = wts * 2.0 * np.pi * pts[:, 0]
     return pts, wts, drv.body_of(scene, pts)

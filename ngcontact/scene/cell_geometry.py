@@ -1,7 +1,9 @@
 """The ``[geometry]`` section of a cell scene: the periodic cell's profile and arrangement.
 
 Mapped onto the builders of :mod:`ngcontact.geometry.profiles` (2D) and
-:mod:`ngcontact.geometry.cell3d` (3D); a self-affine random surface is drawn
+:mod:`ngcontact.geometry.cell3d` (3D) by the table of profiles
+:data:`ngcontact.geometry.profile_registry.PROFILES` (the keys each profile
+requires, its builder and what it is); a self-affine random surface is drawn
 by :mod:`ngcontact.geometry.random_surface` from its ``spectrum``.  The
 small-slope profiles (:func:`small_slope`) are a flat interface whose initial
 gap carries the roughness.
@@ -11,17 +13,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ngcontact.errors import GeometryError, SceneError
+from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.schema import (at_least, check_selected, closed_interval, nonnegative, open_interval, param,
                                     positive)
 
 
-PROFILES_2D = ("flat", "rectangular", "triangular", "semicircular", "sinusoid", "tabulated")
-PROFILES_3D = ("flat3d", "square_hills", "bisinusoid", "height_map", "self_affine")
+PROFILES_2D = tuple(name for name, kind in PROFILES.items() if kind.dim == 2)
+PROFILES_3D = tuple(name for name, kind in PROFILES.items() if kind.dim == 3)
 #: 3D free-form profiles: meshed as the real surface with Netgen's OCC kernel
 #: in the conforming arrangement; in the summit arrangement represented by the
 #: small-slope model (a flat interface whose initial gap is the height below
 #: the highest summit).
-GAP_PROFILES = ("bisinusoid", "height_map", "self_affine")
+GAP_PROFILES = tuple(name for name, kind in PROFILES.items() if kind.free_form)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -82,64 +85,40 @@ class CellGeometry:
                              "most 64 MiB, relative to the scene file")
     spectrum: SpectrumSpec | None = param(None, doc="self_affine: the power spectrum and seed of the random surface")
 
-    _USES = {"flat": (), "flat3d": (), "rectangular": ("width", "depth"),
-             "triangular": ("angles",), "semicircular": ("radius",), "sinusoid": ("amplitude",),
-             "square_hills": ("width", "depth"), "tabulated": ("file",),
-             "bisinusoid": ("amplitude",), "height_map": ("file",), "self_affine": ("spectrum",)}
-    _OPTIONAL = {"triangular": ("width",)}
-
     @property
     def dim(self) -> int:
-        return 3 if self.profile in PROFILES_3D else 2
+        return PROFILES[self.profile].dim
 
     def check(self, path: str) -> None:
+        kind = PROFILES[self.profile]
         check_selected(self, path, "profile", ("width", "depth", "radius", "angles", "amplitude", "file", "spectrum"),
-                       self._USES[self.profile], self._OPTIONAL.get(self.profile, ()))
-        if self.profile == "square_hills":
-            assert self.width is not None and self.depth is not None  # required: check_selected
-            if not self.width < self.period:
-                raise SceneError(f"{path}.width", self.width,
-                                 f"must be < period = {self.period!r} (hills must not touch)")
-            if not self.depth < self.h_rough:
-                raise SceneError(f"{path}.depth", self.depth, f"must be < h_rough = {self.h_rough!r} "
-                                 "(the hill base must lie inside the rough body)")
-        if self.dim == 2 and self.profile != "tabulated":  # tabulated: checked when its file is read
-            try:
-                profile = profile_2d(self)
-            except GeometryError as exc:  # the builders name their own arguments (width, angle_left, ...)
-                key = _BUILDER_KEYS.get(exc.name, exc.name)
-                raise SceneError(f"{path}.{key}", exc.value, exc.allowed) from None
+                       kind.keys, kind.optional)
+        try:
+            if kind.check is not None:
+                kind.check(self)
+            # a profile read from its file is checked when the file is read (CellScene.check_files)
+            profile = profile_2d(self) if kind.parametric else None
+        except GeometryError as exc:  # the builders name their own arguments (width, angle_left, ...)
+            key = _BUILDER_KEYS.get(exc.name, exc.name)
+            raise SceneError(f"{path}.{key}", exc.value, exc.allowed) from None
+        if profile is not None:
             check_profile_heights(self, profile.bounds, path)
-            check_features(profile, f"{path}.{PROFILE_KEYS.get(self.profile, 'period')}",
-                           getattr(self, PROFILE_KEYS.get(self.profile, "period")))
+            check_features(profile, f"{path}.{kind.feature}", getattr(self, kind.feature))
 
 
 _BUILDER_KEYS = {"angle_left": "angles", "angle_right": "angles"}
 
 
 def profile_2d(g: CellGeometry):
-    """The :class:`~ngcontact.geometry.profiles.Profile` of a parametric 2D geometry section."""
-    from ngcontact.geometry import profiles as pr
-    if g.profile == "flat":
-        return pr.flat(g.period)
-    # the keys a profile uses are required by CellGeometry.check (check_selected)
-    if g.profile == "rectangular":
-        assert g.width is not None and g.depth is not None
-        return pr.rectangular_valley(g.width, g.depth, g.period)
-    if g.profile == "triangular":
-        assert g.angles is not None
-        return pr.triangular_valley(g.angles[0], g.angles[1], g.width, g.period)
-    if g.profile == "semicircular":
-        assert g.radius is not None
-        return pr.semicircular_valley(g.radius, g.period)
-    if g.profile == "sinusoid":
-        assert g.amplitude is not None
-        return pr.sinusoid(g.amplitude, g.period)
-    raise ValueError(f"profile {g.profile!r} is not a parametric 2D profile")
+    """The :class:`~ngcontact.geometry.profiles.Profile` of a parametric 2D geometry section.
 
+    The keys a profile uses are required by :meth:`CellGeometry.check` (``check_selected``).
+    """
+    kind = PROFILES[g.profile]
+    if kind.profile is None or not kind.parametric:
+        raise ValueError(f"profile {g.profile!r} is not a parametric 2D profile")
+    return kind.profile(g, None)
 
-#: The parameter of each parametric 2D profile that sets its smallest feature.
-PROFILE_KEYS = {"rectangular": "width", "triangular": "width", "semicircular": "radius", "sinusoid": "amplitude"}
 #: Smallest feature of a profile, relative to its period, that the mesher resolves (a semicircle of
 #: radius 0.4999999 leaves plateaus of 2e-7 and one of radius 1e-9 an arc of 1e-9: 'meshing failed').
 MIN_FEATURE = 1e-4
@@ -165,4 +144,4 @@ def check_profile_heights(g: CellGeometry, bounds: tuple, path: str = "geometry"
 
 def small_slope(geometry: CellGeometry) -> bool:
     """A free-form 3D profile in the summit arrangement: flat interface plus gap."""
-    return geometry.profile in GAP_PROFILES and geometry.arrangement == "summit"
+    return PROFILES[geometry.profile].free_form and geometry.arrangement == "summit"

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
+from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.laws.friction import FRICTION_LAWS
 from ngcontact.scene.cell_geometry import CellGeometry, check_features, check_profile_heights, small_slope
 from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
@@ -158,7 +159,7 @@ class CellScene:
         g = self.geometry
         if g.file is not None:
             where = f"geometry.file ({g.file})"
-            if g.profile == "tabulated":
+            if g.dim == 2:      # a 2D profile's file is its CSV (tabulated), a 3D one's a height map
                 prof = tabulated.read_profile_csv(resolve(self, g.file), path=where)
                 if abs(prof.period - g.period) > 1e-12 * g.period:
                     raise SceneError("geometry.period", g.period,
@@ -216,7 +217,7 @@ class CellScene:
                              f"'summit'), not enforcement {self.contact.enforcement!r} on a {self.geometry.profile!r} "
                              f"profile in the {self.geometry.arrangement!r} arrangement; use 'auto' or 'rigid'")
         fe_tolerance = self.discretization.method == "fe" and self.discretization.tolerance is not None
-        if fe_tolerance and not (dim == 2 and self.geometry.profile == "flat"):
+        if fe_tolerance and not (dim == 2 and PROFILES[self.geometry.profile].flat):
             raise SceneError("discretization.tolerance", self.discretization.tolerance,
                              "refinement towards the contact edges needs a 2D cell with geometry.profile = "
                              f"'flat' (the small-slope model), not a {dim}D {self.geometry.profile!r} cell; remove "
@@ -230,7 +231,7 @@ class CellScene:
         if self.load.independent and self.contact.friction != "none":
             raise SceneError("load.independent", True, "solves every load afresh, which a frictional load path "
                              "does not allow; remove the key or set contact.friction = 'none'")
-        if self.ensemble is not None and self.geometry.profile != "self_affine":
+        if self.ensemble is not None and not PROFILES[self.geometry.profile].random:
             raise SceneError("ensemble", "...", "realizations of a random surface need geometry.profile = "
                              f"'self_affine' (its spectrum and seed), not {self.geometry.profile!r}")
         if flat_interface(self.geometry) and self.contact.friction == "none":
@@ -299,7 +300,7 @@ def spectral_grid(scene: CellScene, heights_shape: tuple[int, ...] | None = None
 
 def flat_interface(geometry) -> bool:
     """The small-slope model: a flat ``S_C`` with the roughness in the initial gap (what the spectral cell solves)."""
-    return geometry.profile in ("flat", "flat3d") or small_slope(geometry)
+    return PROFILES[geometry.profile].flat or small_slope(geometry)
 
 
 def has_twin(scene: CellScene) -> bool:
@@ -316,7 +317,7 @@ def check_spectral(scene: CellScene) -> None:
                          "the roughness in the initial gap (geometry.profile = 'flat' or 'flat3d', or 'bisinusoid', "
                          "'height_map' or 'self_affine' with arrangement = 'summit'), not geometry.profile = "
                          f"{g.profile!r} in the {g.arrangement!r} arrangement; use method = 'fe'")
-    if d.tolerance is not None and g.profile in ("height_map", "self_affine"):
+    if d.tolerance is not None and PROFILES[g.profile].own_grid:
         raise SceneError("discretization.tolerance", d.tolerance, "refines the grid of a gap given by a formula; "
                          f"a {g.profile!r} profile's heights exist on their own grid only: remove the key and "
                          "set discretization.grid")

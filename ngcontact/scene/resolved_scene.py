@@ -6,7 +6,7 @@ friction) come from a ``cell`` scene named by ``geometry.cell``; its
 roughness is repeated ``geometry.periods`` times along the interface and
 scaled to the period ``eps = (interface length) / periods``.
 
-Shapes (``geometry.shape``, see :mod:`ngcontact.geometry.resolved_bodies`):
+Shapes (``geometry.shape``, see :mod:`ngcontact.geometry.resolved_shapes`):
 
 ``blocks``
     Rough block below, counter block above, ``x0 <= x <= x0 + length``;
@@ -30,19 +30,24 @@ Lengths in metres, stresses in pascals, stiffnesses in Pa/m.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from ngcontact.errors import MISSING, SceneError
-from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
+from ngcontact.geometry.femur import FemurStemDims
+from ngcontact.geometry.profile_registry import PROFILES
+from ngcontact.geometry.resolved_shapes import RESOLVED_SHAPES, resolved_shape
 from ngcontact.scene.macro_shapes import FEMUR_BOUNDARIES, check_dimensions, check_support_meaning
 from ngcontact.scene.sections import (ComputeSpec, MaterialSpec, check_supports_once, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size
 from ngcontact.scene.schema import MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty, param, positive
 
-SHAPES = ("blocks", "femur_stem")
+#: The shapes (:data:`ngcontact.geometry.resolved_shapes.RESOLVED_SHAPES`: what each one is built and measured
+#: by); this module validates a scene against their settings, keys and boundary labels.
+SHAPES = tuple(RESOLVED_SHAPES)
 #: Boundary labels of each shape with what each is (the resolved surface is ``contact``).
 BOUNDARY_DOCS: dict[str, dict[str, str]] = {
     "blocks": {"bottom": "bottom face of the rough block (below the interface here; in the macro kind's block "
@@ -81,21 +86,22 @@ class DirectGeometry:
         return FemurStemDims(**(self.dimensions or {}))
 
     def check(self, path: str) -> None:
+        """The shape's setting, its required keys, no key of another shape; all femur dimensions."""
         if self.x0 < 0:
             raise SceneError(f"{path}.x0", self.x0, ">= 0")
-        if self.shape == "blocks":
-            for key in ("length", "h_rough", "h_counter"):
-                if getattr(self, key) is None:
-                    raise SceneError(f"{path}.{key}", MISSING, "required for shape 'blocks'")
-            if self.dimensions is not None:
-                raise SceneError(f"{path}.dimensions", self.dimensions, "only for shape 'femur_stem'")
-            return
-        if self.setting != "axisymmetric":
-            raise SceneError(f"{path}.setting", self.setting, "shape 'femur_stem' is axisymmetric")
-        for key in ("length", "h_rough", "h_counter"):
-            if getattr(self, key) is not None:
-                raise SceneError(f"{path}.{key}", getattr(self, key), "only for shape 'blocks'")
-        check_dimensions(self.dimensions or {}, f"{path}.dimensions", "femur_stem", DIMENSIONS)
+        shape = RESOLVED_SHAPES[self.shape]
+        if self.setting not in shape.settings:
+            raise SceneError(f"{path}.setting", self.setting,
+                             f"shape {shape.name!r} is " + " or ".join(shape.settings))
+        for key in shape.required:
+            if getattr(self, key) is None:
+                raise SceneError(f"{path}.{key}", MISSING, f"required for shape {shape.name!r}")
+        for other in RESOLVED_SHAPES.values():
+            for key in other.keys:
+                if key not in shape.keys and getattr(self, key) is not None:
+                    raise SceneError(f"{path}.{key}", getattr(self, key), f"only for shape {other.name!r}")
+        if "dimensions" in shape.keys:
+            check_dimensions(self.dimensions or {}, f"{path}.dimensions", shape.name, DIMENSIONS)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -110,8 +116,8 @@ class DirectBodies:
 class DirectSupport:
     """Prescribed displacement components on a boundary, constant or linear along it (a tilt)."""
 
-    boundary: str = param(doc="a boundary of the shape", allowed="blocks: " + ", ".join(BOUNDARIES["blocks"])
-                          + "; femur_stem: " + ", ".join(BOUNDARIES["femur_stem"]))
+    boundary: str = param(doc="a boundary of the shape",
+                          allowed="; ".join(f"{shape}: " + ", ".join(labels) for shape, labels in BOUNDARIES.items()))
     components: tuple[str, ...] = param((), doc="components fixed (x, y or r, z); empty: all")
     displacement: tuple[float, ...] = param((), doc="value at the boundary's mid-point, one per component "
                                             "(default 0)", units="m")
@@ -206,57 +212,19 @@ class DirectScene:
         if st is not None:
             if len(st.periods) < 3 or any(b <= a for a, b in zip(st.periods, st.periods[1:])):
                 raise SceneError("study.periods", st.periods, "at least 3 increasing numbers of periods")
-            if g.shape == "femur_stem":
-                self._check_femur_study()
-                return
-            # required for shape 'blocks' (DirectGeometry.check, run when the section was built)
-            assert g.length is not None and g.h_rough is not None and g.h_counter is not None
-            for i, (x, y) in enumerate(st.probes):
-                if not (g.x0 < x < g.x0 + g.length and -g.h_rough < y < g.h_counter):
-                    raise SceneError(f"study.probes[{i}]", (x, y), "must lie inside the blocks")
-                if abs(y) <= st.band * g.length / st.periods[0]:
-                    raise SceneError(f"study.probes[{i}]", (x, y), "must lie outside the band of the "
-                                     "coarsest level (|y| > band * length / periods[0])")
-            if st.band * g.length / st.periods[0] >= min(g.h_rough, g.h_counter):
-                raise SceneError("study.band", st.band, "the band of the coarsest level must stay inside "
-                                 "both blocks")
+            STUDY_CHECKS[g.shape](self)
 
     def check_size(self) -> None:
         """The element estimate of :mod:`ngcontact.scene.mesh_size` at the finest level, against ``max_elements``."""
         g, d = self.geometry, self.discretization
         N = max((g.periods,) + (tuple(self.study.periods) if self.study else ()))
-        if g.shape == "femur_stem":
-            f = g.femur_dims()
-            area, length, width = f.r_bone * f.z_stem_top, femur_interface_length(f), f.r_bone - f.r_stem
-        else:
-            assert g.length is not None and g.h_rough is not None and g.h_counter is not None  # required (check)
-            area, length, width = g.length * (g.h_rough + g.h_counter), g.length, min(g.h_rough, g.h_counter)
+        shape = resolved_shape(g)
+        (area, width), length = shape.extent(), shape.interface_length()
         n = mesh_size.estimate(2, area, d.maxh, width=width, interface=length,
                                h_interface=length / N / d.elements_per_period)
         key, value = ("study.periods", N) if self.study and N > g.periods else ("geometry.periods", g.periods)
         mesh_size.refuse_beyond(n, d.max_elements, key, value,
                                 hint=" (fewer periods, or fewer discretization.elements_per_period)")
-
-    def _check_femur_study(self) -> None:
-        """Probes inside a body and outside the band of the coarsest level; the band leaves points."""
-        from ngcontact.geometry.femur import distance_to_polyline, femur_stem_body, femur_stem_interface
-        st, dims = self.study, self.geometry.femur_dims()
-        assert st is not None  # called from check only when the study is given
-        segs = femur_stem_interface(dims)
-        band = st.band * femur_interface_length(dims) / st.periods[0]
-        for i, pt in enumerate(st.probes):
-            if femur_stem_body(dims, [pt])[0] < 0:
-                raise SceneError(f"study.probes[{i}]", pt, "must lie inside the stem or the bone")
-            if distance_to_polyline(segs, [pt])[0] <= band:
-                raise SceneError(f"study.probes[{i}]", pt, f"must lie farther than band * eps = {band:.4g} m "
-                                 "(coarsest level) from the interface")
-        r = np.linspace(0.0, dims.r_bone, 41)
-        z = np.linspace(0.0, dims.z_stem_top, 41)
-        pts = np.column_stack([a.ravel() for a in np.meshgrid(r, z)])
-        keep = (femur_stem_body(dims, pts) >= 0) & (distance_to_polyline(segs, pts) > band)
-        if not np.any(keep):
-            raise SceneError("study.band", st.band, "the band of the coarsest level covers both bodies; "
-                             "take a smaller band or more periods")
 
     def check_files(self, load) -> None:
         """The named cell scene must be a valid 2D conforming ``cell`` scene this kind can resolve."""
@@ -269,7 +237,7 @@ class DirectScene:
         if cell.kind != "cell":
             raise SceneError("geometry.cell", self.geometry.cell, f"names a {cell.kind!r} scene; need 'cell'")
         g = cell.geometry
-        if g.dim != 2 or g.arrangement != "conforming" or g.profile == "tabulated":
+        if g.arrangement != "conforming" or not PROFILES[g.profile].parametric:
             raise SceneError("geometry.cell", self.geometry.cell,
                              "need a 2D conforming cell with an analytic profile (flat, rectangular, "
                              "triangular, semicircular, sinusoid)")
@@ -277,6 +245,51 @@ class DirectScene:
             raise SceneError("geometry.cell", self.geometry.cell,
                              f"gap kind {cell.contact.gap.kind!r} is not resolved; use none or constant")
         object.__setattr__(self, "cell_scene", cell)
+
+
+def _check_blocks_study(scene: DirectScene) -> None:
+    """Probes inside the blocks and outside the band of the coarsest level; the band stays inside both blocks."""
+    st, g = scene.study, scene.geometry
+    assert st is not None  # called from check only when the study is given
+    # required for shape 'blocks' (DirectGeometry.check, run when the section was built)
+    assert g.length is not None and g.h_rough is not None and g.h_counter is not None
+    for i, (x, y) in enumerate(st.probes):
+        if not (g.x0 < x < g.x0 + g.length and -g.h_rough < y < g.h_counter):
+            raise SceneError(f"study.probes[{i}]", (x, y), "must lie inside the blocks")
+        if abs(y) <= st.band * g.length / st.periods[0]:
+            raise SceneError(f"study.probes[{i}]", (x, y), "must lie outside the band of the "
+                             "coarsest level (|y| > band * length / periods[0])")
+    if st.band * g.length / st.periods[0] >= min(g.h_rough, g.h_counter):
+        raise SceneError("study.band", st.band, "the band of the coarsest level must stay inside "
+                         "both blocks")
+
+
+def _check_femur_study(scene: DirectScene) -> None:
+    """Probes inside a body and outside the band of the coarsest level; the band leaves points."""
+    from ngcontact.geometry.femur import distance_to_polyline, femur_interface_length, femur_stem_body, \
+        femur_stem_interface
+    st, dims = scene.study, scene.geometry.femur_dims()
+    assert st is not None  # called from check only when the study is given
+    segs = femur_stem_interface(dims)
+    band = st.band * femur_interface_length(dims) / st.periods[0]
+    for i, pt in enumerate(st.probes):
+        if femur_stem_body(dims, [pt])[0] < 0:
+            raise SceneError(f"study.probes[{i}]", pt, "must lie inside the stem or the bone")
+        if distance_to_polyline(segs, [pt])[0] <= band:
+            raise SceneError(f"study.probes[{i}]", pt, f"must lie farther than band * eps = {band:.4g} m "
+                             "(coarsest level) from the interface")
+    r = np.linspace(0.0, dims.r_bone, 41)
+    z = np.linspace(0.0, dims.z_stem_top, 41)
+    pts = np.column_stack([a.ravel() for a in np.meshgrid(r, z)])
+    keep = (femur_stem_body(dims, pts) >= 0) & (distance_to_polyline(segs, pts) > band)
+    if not np.any(keep):
+        raise SceneError("study.band", st.band, "the band of the coarsest level covers both bodies; "
+                         "take a smaller band or more periods")
+
+
+#: Per shape, the checks of the ``[study]`` section against the bodies (with the wording of each shape).
+STUDY_CHECKS: dict[str, Callable[[DirectScene], None]] = {"blocks": _check_blocks_study,
+                                                           "femur_stem": _check_femur_study}
 
 
 def effects(scene: DirectScene) -> tuple[str, ...]:
