@@ -190,6 +190,9 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
         scene = loader.load(scene)
     if scene.kind != "direct" or getattr(scene, "study", None) is None:
         raise SceneError("kind", scene.kind, "the epsilon study needs a 'direct' scene with a [study] section")
+    if periods is not None:
+        from ngcontact.scene.resolved_scene import with_study_periods
+        scene = with_study_periods(scene, periods)
     n = thread_count()
     clock = Clock(progress)
     with threads(n), batches(scene, workers, scheduler, batch_progress, start=True) as ex:

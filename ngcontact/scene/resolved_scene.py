@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -308,3 +308,22 @@ def effects(scene: DirectScene) -> tuple[str, ...]:
     return tuple(out)
 
 
+def with_study_periods(scene: DirectScene, periods) -> DirectScene:
+    """The scene with its study's levels replaced (``ngcontact study epsilon --periods``), held to the
+    checks of the scene's own levels (a band of the coarsest level inside both bodies, probes outside it).
+
+    Raises
+    ------
+    SceneError
+        Naming ``study.periods`` (from ``--periods``), the levels and what the check demands.
+    """
+    if scene.study is None:
+        raise SceneError("study", None, "the epsilon study needs a [study] section")
+    levels = tuple(int(n) for n in periods)
+    new = replace(scene, study=replace(scene.study, periods=levels))
+    try:
+        STUDY_CHECKS[scene.geometry.shape](new)
+    except SceneError as err:
+        raise SceneError("study.periods (from --periods)", levels,
+                         f"with these levels {err.path} = {err.value!r} fails: {err.allowed}") from None
+    return new
