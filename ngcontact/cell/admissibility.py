@@ -9,14 +9,26 @@ problem of paper eqs. 49-51 demands of any solution:
   pressure against the load).  A mesh whose quadrature cannot see a contact patch satisfies its own
   discrete balance and misses this one by the share of the pressure it did not see.
 
+and, once per cell, what the model and its discretization assume:
+
+* **small slope**: a cell whose roughness is carried by the gap of a flat interface (the small-slope model,
+  both methods) neglects terms of relative order ``slope^2``: its rms slope is held to
+  ``sqrt(tolerance)`` (:func:`gap_slopes`);
+* **interface resolution**: an FE cell whose gap comes from a height map sees the map through its
+  interface elements; an element larger than the map's spacing smooths it away
+  (``interface_resolution = h / spacing <= 1``).
+
 A check beyond the scene's accuracy (``discretization.tolerance``, else :data:`DEFAULT_TOLERANCE`) marks
 the result as not meeting it; one beyond :data:`PLAINLY_WRONG` means the answer contradicts its own load
 and is not reported as one.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
+
+import numpy as np
 
 #: the accuracy a scene that states none is held to (relative)
 DEFAULT_TOLERANCE = 0.01
@@ -25,14 +37,18 @@ DEFAULT_TOLERANCE = 0.01
 PLAINLY_WRONG = 1.0
 #: the checks of each load: the results' key and what it measures
 CHECKS = {"pressure_balance": "the accurately integrated interface force against the far-face traction "
-                              "(relative)"}
+                              "(relative)",
+          "rms_slope": "the rms slope of the gap's roughness; the small-slope model neglects terms of order "
+                       "slope^2 (limit: sqrt(tolerance))",
+          "interface_resolution": "the interface element size over the height map's spacing (limit 1: the "
+                                  "map is resolved)"}
 
 
 @dataclass(frozen=True)
 class Check:
     """One check of one load: its value against its limit."""
 
-    load: int
+    load: int | None            # None: a check of the cell, not of one load
     name: str
     value: float
     limit: float
@@ -43,14 +59,15 @@ class Check:
 
     @property
     def plainly_wrong(self) -> bool:
-        return not self.value <= PLAINLY_WRONG
+        """Only a load's balance can contradict the answer; the cell's checks bound its accuracy."""
+        return self.load is not None and not self.value <= PLAINLY_WRONG
 
     def as_dict(self) -> dict[str, Any]:
         return dict(asdict(self), ok=self.ok, meaning=CHECKS[self.name])
 
     def message(self) -> str:
-        return (f"load {self.load}: {self.name} = {self.value:.3g} exceeds {self.limit:g} "
-                f"({CHECKS[self.name]})")
+        where = "the cell" if self.load is None else f"load {self.load}"
+        return f"{where}: {self.name} = {self.value:.3g} exceeds {self.limit:.3g} ({CHECKS[self.name]})"
 
 
 def load_checks(k: int, results: dict[str, Any], tolerance: float) -> list[Check]:
@@ -58,10 +75,29 @@ def load_checks(k: int, results: dict[str, Any], tolerance: float) -> list[Check
     return [Check(k, name, float(results[name]), tolerance) for name in CHECKS if name in results]
 
 
-def verdict(loads: list[dict[str, Any]], tolerance: float | None) -> tuple[dict[str, Any], list[Check]]:
-    """The report's verdict on a sweep's results (``{"tolerance", "met", "checks"}``) and its failed checks."""
+def gap_slopes(gap: np.ndarray, period: float) -> tuple[float, float]:
+    """The rms and the largest slope ``|grad g|`` of a periodic gap sampled on a uniform grid (2D: a line of
+    points, 3D: ``[y, x]``), by central differences."""
+    g = np.asarray(gap, float)
+    h = period / g.shape[-1]
+    parts = [(np.roll(g, -1, axis=a) - np.roll(g, 1, axis=a)) / (2 * h) for a in range(g.ndim)]
+    slope = np.sqrt(sum(p ** 2 for p in parts))
+    return float(np.sqrt(np.mean(slope ** 2))), float(slope.max())
+
+
+def cell_checks(facts: dict[str, float], tolerance: float | None) -> list[Check]:
+    """The checks of the cell itself from its ``facts`` (``rms_slope``, ``interface_resolution``)."""
+    tol = DEFAULT_TOLERANCE if tolerance is None else tolerance
+    limits = {"rms_slope": float(np.sqrt(tol)), "interface_resolution": 1.0}
+    return [Check(None, name, float(facts[name]), limits[name]) for name in limits if name in facts]
+
+
+def verdict(loads: list[dict[str, Any]], tolerance: float | None,
+            cell: Sequence[Check] = ()) -> tuple[dict[str, Any], list[Check]]:
+    """The report's verdict on a sweep's results (``{"tolerance", "met", "checks"}``) and its failed checks;
+    ``cell``: the checks of the cell itself (:func:`cell_checks`)."""
     limit = DEFAULT_TOLERANCE if tolerance is None else tolerance
-    checks = [c for k, results in enumerate(loads) for c in load_checks(k, results, limit)]
+    checks = list(cell) + [c for k, results in enumerate(loads) for c in load_checks(k, results, limit)]
     failed = [c for c in checks if not c.ok]
     return {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
             "met": not failed, "checks": [c.as_dict() for c in checks]}, failed

@@ -251,6 +251,26 @@ def spectral_cell_solver(scene: CellScene) -> SpectralCellSolver:
                               max_points=MAX_SPECTRAL_POINTS)
 
 
+def cell_facts(scene: CellScene) -> dict[str, float]:
+    """What a cell scene's model and discretization assume, as numbers for the accuracy verdict
+    (:func:`ngcontact.cell.admissibility.cell_checks`): the rms slope of a small-slope cell's gap (flat
+    interface, roughness in the gap; on the spectral grid of the scene), and for the FE cell of a height map
+    its interface element size over the map's spacing."""
+    from ngcontact.cell.admissibility import gap_slopes
+    from ngcontact.scene.cell_scene import flat_interface
+    g, d = scene.geometry, scene.discretization
+    facts: dict[str, float] = {}
+    if not flat_interface(g) or (scene.contact.gap.kind == "none" and not small_slope(g)):
+        return facts
+    heights = map_heights(scene)
+    grid = spectral_grid(scene, None if heights is None else heights.shape)
+    facts["rms_slope"] = gap_slopes(gap_samples(scene, grid, heights), g.period)[0]
+    if heights is not None and d.method == "fe":
+        spacing = g.period / (max(heights.shape) - 1)
+        facts["interface_resolution"] = float((d.interface_maxh or d.maxh) / spacing)
+    return facts
+
+
 #: the cell protocol's implementations by ``discretization.method``
 CELL_METHODS: dict[str, Callable[[CellScene], CellSolver]] = {"fe": fe_cell, "spectral": spectral_cell_solver}
 

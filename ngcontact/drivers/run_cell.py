@@ -26,7 +26,7 @@ from ngcontact.cell import admissibility
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.errors import ConvergenceError
 from ngcontact.drivers import cell_members
-from ngcontact.drivers.build import cell_loads, cell_solver
+from ngcontact.drivers.build import cell_facts, cell_loads, cell_solver
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 
@@ -55,10 +55,10 @@ def surface_plots(sols, dim: int, period: float) -> dict:
     return plots
 
 
-def accuracy_verdict(per_load: list[dict], tolerance: float | None) -> dict:
-    """The sweep's verdict (:mod:`ngcontact.cell.admissibility`): each failed check is one warning line;
-    a plainly wrong answer is no answer (exit 3)."""
-    verdict, failed = admissibility.verdict(per_load, tolerance)
+def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[str, float]) -> dict:
+    """The sweep's verdict (:mod:`ngcontact.cell.admissibility`) with the cell's own ``facts``: each failed
+    check is one warning line; a plainly wrong answer is no answer (exit 3)."""
+    verdict, failed = admissibility.verdict(per_load, tolerance, admissibility.cell_checks(facts, tolerance))
     wrong = [c for c in failed if c.plainly_wrong]
     if wrong:
         raise ConvergenceError(
@@ -66,14 +66,26 @@ def accuracy_verdict(per_load: list[dict], tolerance: float | None) -> dict:
             "(a contact patch narrower than the elements): refine the interface mesh, use contact.enforcement = "
             "'exact', or discretization.method = 'spectral' for a small-slope cell", {"checks": verdict["checks"]})
     for c in failed:
-        log.warning("accuracy not met: %s", c.message())
+        if c.load is not None:       # the cell's own checks were said before the solve
+            log.warning("accuracy not met: %s", c.message())
     return verdict
+
+
+def warn_before_solving(facts: dict[str, float], tolerance: float | None) -> None:
+    """What is known before the solve: a cell that cannot meet its accuracy says so at once."""
+    for c in admissibility.cell_checks(facts, tolerance):
+        if not c.ok:
+            hint = ("; use discretization.method = 'spectral', which solves on the map's own points, or a finer "
+                    "discretization.interface_maxh" if c.name == "interface_resolution" else "")
+            log.warning("accuracy not met, known before solving: %s%s", c.message(), hint)
 
 
 def run(scene, clock) -> Outcome:
     """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`)."""
     with clock.stage("setup"):
         cell = cell_solver(scene)
+        facts = cell_facts(scene)
+    warn_before_solving(facts, scene.discretization.tolerance)
     with clock.stage("whole-surface coefficients"):
         results: dict[str, Any] = {"whole_surface": cell.whole_surface()}
     method = cell.method_record()
@@ -107,7 +119,7 @@ def run(scene, clock) -> Outcome:
             arrays[f"{name}_load{k}"] = values
         log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
     results["loads"] = per_load
-    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance)
+    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts)
     vtk = {}
     displaced = cell.displacements()
     if displaced is not None:

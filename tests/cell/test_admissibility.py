@@ -94,3 +94,36 @@ def test_the_page_shows_a_missed_accuracy_at_its_top():
     assert '<p class="warn">Accuracy not met (tolerance 0.01): load 0, pressure_balance = 0.03 &gt; 0.01</p>' in top
     report["results"]["accuracy"]["met"] = True
     assert "Accuracy not met" not in render(report, ".", [])
+
+
+def test_the_slopes_of_westergaard_s_gap():
+    """``g = 2h sin^2(pi x)`` has ``g' = 2 pi h sin(2 pi x)``: rms ``sqrt(2) pi h``, largest ``2 pi h``."""
+    import numpy as np
+    from ngcontact.cell.admissibility import gap_slopes
+    h, n = 0.01, 512
+    x = np.arange(n) / n
+    rms, top = gap_slopes(2 * h * np.sin(np.pi * x) ** 2, 1.0)
+    assert abs(rms - np.sqrt(2) * np.pi * h) < 1e-4 * rms and abs(top - 2 * np.pi * h) < 1e-4 * top
+    xx, yy = np.meshgrid(x, x)                        # 3D: |grad g| of g(x) alone is the same
+    assert abs(gap_slopes(2 * h * np.sin(np.pi * xx) ** 2, 1.0)[0] - rms) < 1e-12
+
+
+def _height_map_scene(tmp_path, interface_maxh):
+    text = open(os.path.join(ROOT, "geometries", "cells", "height_map.toml"), encoding="utf-8").read()
+    text = text.replace("interface_maxh = 0.12", f"interface_maxh = {interface_maxh}")
+    text = text.replace('file = "data/height_map_example.npy"',
+                        f'file = "{os.path.join(ROOT, "geometries", "cells", "data", "height_map_example.npy")}"')
+    path = tmp_path / "map.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_an_fe_mesh_coarser_than_its_height_map_says_so_before_solving(tmp_path, capsys, caplog):
+    code, err, report = _run(tmp_path, _height_map_scene(tmp_path, 0.3), capsys)
+    assert code == 0
+    checks = {c["name"]: c for c in report["results"]["accuracy"]["checks"] if c["load"] is None}
+    assert checks["interface_resolution"]["value"] > 2 and not checks["interface_resolution"]["ok"]
+    assert not report["results"]["accuracy"]["met"]
+    lines = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    said = [m for m in lines if "known before solving: the cell: interface_resolution" in m]
+    assert len(said) == 1 and "discretization.method = 'spectral'" in said[0]
