@@ -235,8 +235,11 @@ class SpectralCell:
         tn, jn = load.traction[d - 1], load.jump[d - 1]
         uniform = tn is None
         # gamma = g0 - Delta + C p (+ p/k_n); a prescribed jump: uniform mode included, b = g0 - Delta_interface
-        b = self.g0 if tn is not None else self.g0 - (jn - poisson)
-        pbar = -tn if tn is not None else None
+        if tn is not None:
+            b, pbar = self.g0, -tn
+        else:
+            assert jn is not None
+            b, pbar = self.g0 - (jn - poisson), None
         res = self.full_contact(b, pbar)
         if res is None:
             res = constrained_cg(self.interface_compliance(uniform=uniform), b, pbar=pbar, tol=self.tol,
