@@ -220,3 +220,18 @@ def test_progress_lines_are_not_printed_with_quiet(tmp_path, monkeypatch, capsys
     monkeypatch.setattr(ccg, "PROGRESS_SECONDS", 0.0)
     rc, _ = _run(tmp_path, REFINED, quiet=True)
     assert rc == 0 and capsys.readouterr().err == ""
+
+
+def test_a_long_frictional_spectral_solve_prints_progress_lines(monkeypatch, caplog):
+    from ngcontact.geometry.cell3d import bisinusoid_gap
+    from ngcontact.laws.penalty import Friction
+    monkeypatch.setattr(ccg, "PROGRESS_SECONDS", 0.0)       # every solve counts as long
+    N = 32
+    s = np.arange(N) / N
+    cell = SpectralCell(dim=3, period=1.0, grid=N, rough=Layer(1, 0.3, 0.6), counter=Layer(2, 0.2, 0.6),
+                        gap=bisinusoid_gap(0.005, 1.0, xy=(s[None, :], s[:, None])), k_n=1e3, enforcement="exact",
+                        friction=Friction("tresca", w=1e-5, G=0.004), tol=1e-10, max_iter=50000)
+    with caplog.at_level(logging.INFO, logger="ngcontact.progress"):
+        sol = cell.solve(cell_load(3, pressure=0.008, shear=(0.002, 0.0)))
+    lines = [r.getMessage() for r in caplog.records if r.getMessage().startswith("accelerated proximal gradient: step")]
+    assert sol.iterations > 10 and len(lines) == sol.iterations // 10 - 1
