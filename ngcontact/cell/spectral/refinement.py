@@ -23,6 +23,12 @@ levels:
    level's.  A level beyond ``max_points`` raises
    :class:`~ngcontact.errors.ConvergenceError` with the history.
 
+The levels are known before the first solve (``grid`` times ``GROWTH^k``
+up to ``max_points``, :func:`levels`; the scene layer bounds
+``max_points`` by the cost of a solve,
+:func:`ngcontact.scene.cell_scene.spectral_cost`): the largest is stated
+first, and each level prints one progress line as it ends.
+
 Each level solves from scratch: nothing carries between grids but the
 comparison, so a frictional load path is simply solved again per level.
 """
@@ -111,7 +117,7 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
             entry["estimate"] = max(max(e.values()) for e in estimates)
         history.append(entry)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
-                 f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
+                      f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
         if estimates is not None and entry["estimate"] <= tolerance:
             return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history)
         previous = sols
