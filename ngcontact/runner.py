@@ -11,6 +11,7 @@ Nothing is written to disk; :func:`ngcontact.output.writer.write_outputs` does t
 from __future__ import annotations
 
 import importlib
+import logging
 import os
 from contextlib import contextmanager
 from typing import Callable
@@ -67,6 +68,38 @@ def threads(n: int):
         ng.SetNumThreads(n)
         with ng.TaskManager():
             yield
+
+
+#: The logger of the progress lines of long computations inside a stage (a spectral solve running longer
+#: than a few seconds, each level of a refinement): :func:`progress_lines` prints them as the stage lines.
+PROGRESS_LOGGER = "ngcontact.progress"
+
+
+class _ProgressHandler(logging.Handler):
+    def __init__(self, clock: Clock):
+        super().__init__(logging.INFO)
+        self.clock = clock
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.clock.note(record.getMessage())
+
+
+@contextmanager
+def progress_lines(clock: Clock):
+    """Within the block, INFO records of :data:`PROGRESS_LOGGER` are progress lines of ``clock`` (printed as
+    the stage lines are, so ``--quiet`` drops them too) and nothing else."""
+    logger = logging.getLogger(PROGRESS_LOGGER)
+    handler = _ProgressHandler(clock)
+    level, propagate = logger.level, logger.propagate
+    logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
+    logger.propagate = False
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(level)
+        logger.propagate = propagate
 
 
 #: What the members of every batch import (the scene translator and through it the model code): a worker
@@ -161,7 +194,7 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
         scene = loader.load(scene)
     n = thread_count()
     clock = Clock(progress)
-    with threads(n), batches(scene, workers, scheduler, batch_progress) as ex:
+    with threads(n), batches(scene, workers, scheduler, batch_progress) as ex, progress_lines(clock):
         outcome = driver(scene).run(scene, clock)
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),

@@ -138,12 +138,13 @@ def spectral_start(problem, load: CellLoad, twin: SpectralCell) -> dict:
 
 
 def twin_solution(twin: SpectralCell, load: CellLoad, fallback: str) -> SpectralSolution | str:
-    """The twin's solution of ``load``'s normal part, or, where its solver fails, the reason (logged with what
-    the caller does instead, ``fallback``)."""
+    """The twin's solution of ``load``'s normal part, or, where its solver fails, the reason (logged at INFO
+    with what the caller does instead, ``fallback``: a predictor's failure only costs Newton steps, the
+    answer is the same, so it is no warning to the user)."""
     try:
         return twin.solve(normal_load(load))
     except (ConvergenceError, ValueError, FloatingPointError) as err:
-        log.warning("spectral predictor: the twin failed (%s); %s", err, fallback)
+        log.info("spectral predictor: the twin failed (%s); %s", err, fallback)
         return str(err)
 
 

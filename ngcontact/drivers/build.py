@@ -248,7 +248,7 @@ def fe_cell(scene: CellScene) -> FECell:
 def spectral_cell_solver(scene: CellScene) -> SpectralCellSolver:
     """The spectral cell of a small-slope scene, with the recipe of its finer grids (refinement)."""
     return SpectralCellSolver(spectral_cell(scene), make_cell=lambda n: spectral_cell(scene, grid=n),
-                              max_points=MAX_SPECTRAL_POINTS)
+                              max_points=MAX_SPECTRAL_POINTS[scene.geometry.dim])
 
 
 def cell_facts(scene: CellScene) -> dict[str, float]:

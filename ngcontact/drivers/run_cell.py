@@ -4,7 +4,9 @@ Results (``report.json`` ``results``): ``whole_surface`` coefficients of the
 whole contact surface (paper eqs. 34, 42-43, purely geometric), and per load
 ``contact_fraction``, ``mean_pressure`` (compression positive),
 ``mean_traction``, ``mean_jump``, ``mean_closure``, ``coefficients`` on the
-real contact set, ``effective_stiffness`` and, where the method samples the
+real contact set, ``effective_stiffness``, ``far_face_strain`` (the far-face jump over the
+cell's height, warned beyond small strain: :mod:`ngcontact.cell.small_strain`)
+and, where the method samples the
 bodies, the largest von Mises / Tresca stress per body with its location.
 The cell is reached through the cell protocol only
 (:mod:`ngcontact.cell.cell_solver`; ``discretization.method`` chooses the
@@ -22,7 +24,7 @@ from __future__ import annotations
 import logging
 from typing import Any
 
-from ngcontact.cell import admissibility
+from ngcontact.cell import admissibility, small_strain
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.errors import ConvergenceError
 from ngcontact.drivers import cell_members
@@ -106,8 +108,10 @@ def run(scene, clock) -> Outcome:
         else:
             sols = cell.sweep(loads)
     per_load, tables, arrays = [], {}, {}
+    height = scene.geometry.h_rough + scene.geometry.h_counter
     for k, sol in enumerate(sols):
         entry = cell.load_entry(sol)
+        small_strain.check(entry, height, f"load {k}")
         if refinement is not None:
             entry["error_estimate"] = refinement.estimates[k]
             if refinement.per_load:

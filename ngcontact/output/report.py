@@ -74,6 +74,11 @@ class Clock:
         finally:
             self.timings[name] = self.timings.get(name, 0.0) + time.perf_counter() - t0
 
+    def note(self, line: str) -> None:
+        """A progress line inside a stage (a long solve's step, a refinement level), timed as the stage lines."""
+        if self._progress:
+            self._progress(f"[{time.perf_counter() - self._start:7.2f} s] {line}")
+
     def total(self) -> dict:
         out = dict(self.timings)
         out["total"] = time.perf_counter() - self._start

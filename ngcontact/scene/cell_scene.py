@@ -11,6 +11,7 @@ solved.  Solved by :mod:`ngcontact.drivers.run_cell`.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
@@ -20,7 +21,7 @@ from ngcontact.scene.cell_geometry import CellGeometry, check_features, check_pr
 from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import at_least, check_selected, nonempty, nonnegative, param, positive
+from ngcontact.scene.schema import check_selected, closed_interval, nonempty, nonnegative, param, positive
 
 GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 #: "none" and the names of the micro friction laws (:data:`ngcontact.laws.friction.FRICTION_LAWS`)
@@ -110,11 +111,18 @@ class LoadSpec:
                 raise SceneError(f"{path}.{key}", v, "must not be empty")
 
 
+#: Most realizations of an ensemble.  The 95 % band's half-width is ``t s / sqrt(M)`` (``s`` the members'
+#: standard deviation): at 10000 members it is 2 % of ``s``, and more members narrow it by less than the
+#: members' own spread shows; and every member is kept in the report (a row per member and load), which a
+#: billion members cannot be (a MemoryError after 45 s).
+MAX_MEMBERS = 10_000
+
+
 @dataclass(frozen=True, kw_only=True)
 class EnsembleSpec:
     """M realizations of the random surface of ``geometry.spectrum``: seeds ``seed, seed + 1, ...``."""
 
-    members: int = param(doc="number of realizations M", check=at_least(2))
+    members: int = param(doc="number of realizations M", check=closed_interval(2, MAX_MEMBERS))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -171,7 +179,9 @@ class CellScene:
                 check_profile_heights(g, (lo, hi))     # what the mesher checks, as 'run' meets it
                 check_features(prof, "geometry.file", g.file)
             else:
-                tabulated.read_height_map(resolve(self, g.file), path=where)
+                heights = tabulated.read_height_map(resolve(self, g.file), path=where)
+                if self.discretization.method == "spectral" and self.discretization.grid is None:
+                    check_spectral_size(g.dim, spectral_grid(self, heights.shape), "geometry.file", g.file)
         gs = self.contact.gap
         if gs.file is not None:
             where = f"contact.gap.file ({gs.file})"
@@ -268,24 +278,68 @@ MAX_PENALTY_RATIO = 1e10
 MIN_PENALTY_RATIO = 1e-8
 
 
-def check_penalty_ratio(scene: CellScene) -> None:
-    """``k_n h / E`` of the cell, ``h`` its interface mesh size and ``E`` the softer body's modulus."""
+def check_penalty_ratio(scene: CellScene, spacing: tuple[float, str] | None = None) -> None:
+    """``k_n h / E`` of the cell, ``h`` its interface mesh size and ``E`` the softer body's modulus.
+
+    ``spacing``: ``(h, what it is)`` instead of the mesh size, and the lower bound only: the spectral cell
+    (:func:`check_spectral`) with ``h`` its grid step.  Its penalty adds ``1/k_n`` to the layers' compliance,
+    diagonal in Fourier space, and a stiff ``k_n`` only approaches the exact limit it also solves: no
+    tangent outweighs another there, so the upper bound does not apply; a soft one makes the jump ``p/k_n``
+    dwarf the bodies' deformation as in the FE cell.
+    """
     d, c = scene.discretization, scene.contact
-    h = d.interface_maxh or d.maxh
+    h, what = spacing if spacing is not None else (d.interface_maxh or d.maxh, "the interface mesh size")
     E = min(scene.materials[name].E or 0.0 for name in (scene.bodies.rough, scene.bodies.counter))
     ratio = c.k_n * h / E if E > 0 else 0.0
     if 0 < ratio < MIN_PENALTY_RATIO:
-        raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
+        raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} {what}, "
                          f"E = {E:g} the softer body's modulus) must be at least {MIN_PENALTY_RATIO:g}: the "
                          "interface would hold nothing and the jump would dwarf the bodies; raise k_n")
-    if ratio > MAX_PENALTY_RATIO:
+    if spacing is None and ratio > MAX_PENALTY_RATIO:
         raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
                          f"E = {E:g} the softer body's modulus) must stay below {MAX_PENALTY_RATIO:g}: the "
                          "penalty would outweigh the bodies beyond what double precision resolves; lower k_n")
 
 
-#: Largest number of spectral grid points of a cell (2D: points, 3D: points squared).
-MAX_SPECTRAL_POINTS = 2 ** 24
+#: Bytes of a spectral solve per grid point: the constrained CG's fields, the FFTs' and the friction's
+#: buffers (about 25 arrays of doubles).
+SPECTRAL_BYTES_PER_POINT = 200
+#: Seconds of one constrained CG step per ``n log2 n`` (``n`` grid points): two real FFT pairs on one core.
+SPECTRAL_STEP_SECONDS = 2e-8
+#: Constrained CG steps per square root of the compliance's condition number (:func:`spectral_cost`).
+STEPS_PER_ROOT = 3.0
+#: Largest number of spectral grid points of a cell by dimension (2D: points, 3D: points squared): where the
+#: estimate of :func:`spectral_cost` reaches about a quarter of an hour per load (2D) or 1 GB (3D).
+MAX_SPECTRAL_POINTS = {2: 2 ** 20, 3: 2 ** 22}
+#: Largest ``discretization.tolerance`` of a spectral cell relative to ``solver.rtol``: two grids' answers,
+#: each only within ``rtol`` of the gap's scale, cannot show a smaller change.
+TOLERANCE_OVER_RTOL = 10.0
+
+
+def spectral_cost(dim: int, grid: int) -> tuple[float, float]:
+    """Memory (bytes) and time (seconds per load, the order of magnitude) of a spectral cell of ``grid`` points
+    per direction.
+
+    The layers' compliance falls like ``1/|k|``, so its condition number on the grid is the ratio of the
+    largest wave number to the smallest, ``kappa = N/2`` (2D) or ``N/sqrt(2)`` (3D), and conjugate gradients
+    take about ``STEPS_PER_ROOT sqrt(kappa)`` steps, each ``SPECTRAL_STEP_SECONDS n log2 n`` for ``n`` points.
+    A guard against sizes that run for hours, not a prediction.
+    """
+    points = float(grid) ** (dim - 1)
+    kappa = grid / 2.0 if dim == 2 else grid / math.sqrt(2.0)
+    steps = STEPS_PER_ROOT * math.sqrt(kappa)
+    return SPECTRAL_BYTES_PER_POINT * points, steps * SPECTRAL_STEP_SECONDS * points * math.log2(max(points, 2.0))
+
+
+def check_spectral_size(dim: int, grid: int, key: str = "discretization.grid", value=None) -> None:
+    """Refuse a spectral grid beyond :data:`MAX_SPECTRAL_POINTS`, with its estimated cost (:func:`spectral_cost`)."""
+    points, bound = grid ** (dim - 1), MAX_SPECTRAL_POINTS[dim]
+    if points > bound:
+        memory, seconds = spectral_cost(dim, grid)
+        raise SceneError(key, grid if value is None else value,
+                         f"makes {points} grid points, more than {bound}: about {memory / 2 ** 30:.2g} GB of fields "
+                         f"and of the order of {seconds:.2g} s per load; at most "
+                         f"{round(bound ** (1 / (dim - 1)))} points per direction in {dim}D")
 
 
 def spectral_grid(scene: CellScene, heights_shape: tuple[int, ...] | None = None) -> int:
@@ -323,12 +377,15 @@ def check_spectral(scene: CellScene) -> None:
                          "set discretization.grid")
     if d.grid is not None and d.grid % 2:
         raise SceneError("discretization.grid", d.grid, "must be even (the FFT's Nyquist mode is real)")
-    n = spectral_grid(scene)           # a height map's own grid is bounded by its file size (64 MiB)
-    points = n ** (g.dim - 1)
-    if points > MAX_SPECTRAL_POINTS:
-        raise SceneError("discretization.grid", n, f"makes {points} grid points, more than {MAX_SPECTRAL_POINTS} "
-                         f"(about {MAX_SPECTRAL_POINTS * 200 // 2 ** 30} GB of fields); at most "
-                         f"{int(MAX_SPECTRAL_POINTS ** (1 / (g.dim - 1)))} in {g.dim}D")
+    n = spectral_grid(scene)           # a height map's own grid: checked when the map is read (check_files)
+    check_spectral_size(g.dim, n)
+    if d.tolerance is not None and d.tolerance < TOLERANCE_OVER_RTOL * scene.solver.rtol:
+        raise SceneError("discretization.tolerance", d.tolerance,
+                         f"must be at least {TOLERANCE_OVER_RTOL:g} x solver.rtol = "
+                         f"{TOLERANCE_OVER_RTOL * scene.solver.rtol:g} (the grid's solutions are only that accurate, "
+                         "so no comparison of two grids can show less); loosen it or lower solver.rtol")
+    if scene.contact.enforcement == "penalty":
+        check_penalty_ratio(scene, (g.period / n, "the grid step"))
 
 
 def load_states(scene: CellScene) -> list[dict]:

@@ -28,16 +28,37 @@ it is plain CG on an SPD system).
 Stopping rule: the complementarity residual, relative to the scale ``gscale``
 of the gap,
 
-    r = max( max_{p>0} |gamma|, max_{p=0} max(-gamma, 0) ) / gscale <= tol.
+    r = max( max_{p>0} |gamma|, max_{p=0} max(-gamma, 0) ) / gscale <= tol,
+
+or, where the operator's norm ``|A|`` is given, the residual at its round-off
+``ROUNDOFF eps (|A| max|p| + max|b|) / gscale``: the gap is a sum of terms as
+large as ``(A p)_i`` and ``b_i``, and cannot be evaluated more accurately
+than that (a pressure far above the gap's scale, a gap of picometres under a
+load of the bodies' scale).  The rule is then invariant under a scaling of
+the gap or of the pressure alone.
+
+A solve that runs longer than ``PROGRESS_SECONDS`` logs its step and
+residual at INFO on the logger ``ngcontact.progress`` every
+``PROGRESS_SECONDS`` (the run's progress lines, :func:`ngcontact.runner.solve`).
 """
 from __future__ import annotations
 
+import logging
+import time
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
 from ngcontact.errors import ConvergenceError
+
+#: the run's progress lines (printed as its stage lines, :func:`ngcontact.runner.solve`)
+progress = logging.getLogger("ngcontact.progress")
+
+#: factor of ``eps (|A| max|p| + max|b|)`` at which the gap's residual is round-off (module docstring)
+ROUNDOFF = 10.0
+#: seconds of a solve after which, and between which, a progress line is logged
+PROGRESS_SECONDS = 5.0
 
 
 @dataclass
@@ -65,8 +86,18 @@ def _residual(p, g, shift, gscale) -> float:
     return max(r_on, r_off) / gscale
 
 
+def roundoff_floor(norm: float | None, p: np.ndarray, b: np.ndarray, gscale: float) -> float:
+    """The gap's round-off relative to ``gscale``: ``ROUNDOFF eps (|A| max|p| + max|b|) / gscale`` (module
+    docstring); 0 without the norm."""
+    if norm is None:
+        return 0.0
+    return ROUNDOFF * float(np.finfo(float).eps) * (norm * float(np.max(np.abs(p))) + float(np.max(np.abs(b)))) \
+        / gscale
+
+
 def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *, pbar: float | None,
-                   tol: float, max_iter: int, gscale: float, p0: np.ndarray | None = None) -> ConstrainedResult:
+                   tol: float, max_iter: int, gscale: float, p0: np.ndarray | None = None,
+                   norm: float | None = None) -> ConstrainedResult:
     """Minimize ``1/2 <p, A p> + <p, b>`` over ``p >= 0`` (module docstring).
 
     Parameters
@@ -87,6 +118,9 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
         Start (e.g. the previous load's pressure); default: uniform ``pbar``,
         or, without a mean constraint, the pressure that closes every
         penetrating point under the diagonal of ``A``.
+    norm
+        The largest eigenvalue of ``A`` (for a convolution: the largest value of its symbol), for the
+        round-off floor of the stopping rule (module docstring); ``None``: no floor.
 
     Raises
     ------
@@ -115,6 +149,7 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
     residuals: list[float] = []
     shift = 0.0
     g = apply_A(p) + b
+    started = reported = time.perf_counter()
     for it in range(1, max_iter + 1):
         on = p > 0
         if not on.any():       # nothing pressed (approach below every summit): the open solution
@@ -131,7 +166,7 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
         rt = inner(np.where(on, r, 0.0), t)
         if rt <= 0:            # no descent left: converged if complementary (a uniform start on a flat gap)
             residuals.append(_residual(p, g, shift, gscale))
-            if residuals[-1] <= tol:
+            if residuals[-1] <= max(tol, roundoff_floor(norm, p, b, gscale)):
                 return ConstrainedResult(p=p, gap=g - shift, shift=shift, iterations=it - 1, residuals=residuals)
             break
         tau = inner(gs, t) / rt
@@ -147,8 +182,13 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
         shift = float(g[on].mean()) if (pbar is not None and on.any()) else 0.0
         res = _residual(p, g, shift, gscale)
         residuals.append(res)
-        if res <= tol:
+        if res <= max(tol, roundoff_floor(norm, p, b, gscale)):
             return ConstrainedResult(p=p, gap=g - shift, shift=shift, iterations=it, residuals=residuals)
+        now = time.perf_counter()
+        if now - reported >= PROGRESS_SECONDS:
+            reported = now
+            progress.info("constrained CG: step %d of at most %d, residual %.3g (tolerance %g), grid of %d points, "
+                          "%.0f s", it, max_iter, res, tol, n, now - started)
     raise ConvergenceError(
         f"constrained CG: the complementarity residual {residuals[-1]:.3g} of the gap scale is above the "
         f"tolerance {tol:g} after {len(residuals)} steps (grid of {n} points)", {"residuals": residuals[-5:]})

@@ -23,16 +23,20 @@ shift per component, found by Newton's method on the mean
 (:func:`prox_pressure`, :func:`prox_friction`).  Stopping rule: the
 fixed-point residual ``|t - prox(t - grad / L)| L`` (a displacement: the
 violation of the contact and friction conditions) below ``tol`` times
-``scale``.
+``scale``.  A solve longer than ``PROGRESS_SECONDS`` logs its step and
+residual as a progress line, as constrained CG does
+(:mod:`ngcontact.solvers.constrained_cg`).
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
 from ngcontact.errors import ConvergenceError
+from ngcontact.solvers import constrained_cg as _cg
 
 
 def _decreasing_root(f: Callable[[float], tuple[float, float]], lo: float, hi: float, x0: float,
@@ -175,6 +179,7 @@ def fista(grad: Callable[[np.ndarray], np.ndarray], prox: Callable[[np.ndarray, 
     shifts: tuple = ()
     t_new, shifts = prox(t - grad(t) / L, shifts)
     residuals: list[float] = []
+    started = reported = time.perf_counter()
     for it in range(1, max_iter + 1):
         g = grad(y)
         t_new, shifts = prox(y - g / L, shifts)
@@ -191,6 +196,11 @@ def fista(grad: Callable[[np.ndarray], np.ndarray], prox: Callable[[np.ndarray, 
             residuals.append(res)
             if res <= tol:
                 return ProximalResult(t=t, shifts=shifts, iterations=it, residuals=residuals)
+            now = time.perf_counter()
+            if now - reported >= _cg.PROGRESS_SECONDS:
+                reported = now
+                _cg.progress.info("accelerated proximal gradient: step %d of at most %d, residual %.3g (tolerance %g), "
+                              "%.0f s", it, max_iter, res, tol, now - started)
     last = f"{residuals[-1]:.3g}" if residuals else "not yet measured"
     raise ConvergenceError(f"accelerated proximal gradient: the residual ({last}, relative to the gap scale) is "
                            f"above {tol:g} after {max_iter} steps", {"residuals": residuals[-5:]})

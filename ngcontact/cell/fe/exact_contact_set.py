@@ -9,14 +9,21 @@ round-off at the closed nodes and only the interpolation error of the
 closure between them.
 
 The real contact set (:func:`contact_cuts`): a node is closed where its
-multiplier carries load or its opening ``g - J_n`` is at most the Uzawa
-tolerance ``rtol L``.  Between two closed nodes the surfaces are in
+multiplier carries load, ``lambda > 0``.  A node that only touches (its
+opening ``g - J_n`` zero, its multiplier zero) transmits nothing and is
+not in contact: at zero load the contact set is empty, and a patch
+narrower than an element is one loaded node and its edges, not the
+elements around a touching node.  Between two closed nodes the surfaces are in
 contact, between two open ones they are not; between a closed node ``x_c``
 and an open one ``x_o`` lies a contact edge.  Beyond a smooth edge ``a``
 the opening grows like ``(x - a)^(3/2)`` (the Westergaard and Hertz edge,
 DESIGN 8), so ``opening^(2/3)`` is nearly linear there: the edge is the
 root of the line through ``opening^(2/3)`` at ``x_o`` and the next open
-node beyond it, kept between ``x_c`` and ``x_o``.  This needs the nodes in
+node beyond it, kept between ``x_c`` and ``x_o``.  A closed node whose
+neighbours are both open holds a patch narrower than the node spacing:
+the opening at the next nodes is the initial gap, not the edge's
+``3/2``-power, and the edge is placed by the pressure at the node and the
+opening beyond it instead (:func:`edge_fraction`, as in 3D).  This needs the nodes in
 order along ``S_C``: on a contact surface that is a graph over ``x``
 (``n_y > 0``), sorted by ``x``; elsewhere, or without a falling line, the
 edge is the midpoint of ``[x_c, x_o]``.
@@ -36,16 +43,15 @@ from __future__ import annotations
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.fe.contact_multiplier import ContactMultiplier, characteristic_length
+from ngcontact.cell.fe.contact_multiplier import ContactMultiplier
 
 
 def closed_nodes(problem) -> tuple[np.ndarray, np.ndarray]:
-    """Per point of the multiplier: closed (it carries load, or its opening is within the Uzawa tolerance
-    ``rtol L``), and the opening ``g - J_n``."""
+    """Per point of the multiplier: closed (it carries load, ``lambda > 0``; module docstring), and the
+    opening ``g - J_n``."""
     m = problem.multiplier
     opening = -m.at_points(problem.penetration)
-    closed = (m.point_values() > 0.0) | (opening <= problem.model.uzawa_rtol * characteristic_length(problem))
-    return closed, opening
+    return m.point_values() > 0.0, opening
 
 
 def contact_area(problem) -> float:
@@ -153,7 +159,10 @@ def contact_cuts(problem) -> list[tuple[np.ndarray, list[bool]]]:
     np.logical_or.at(node_closed, node, closed)
     node_opening = np.full(len(X), np.inf)
     np.minimum.at(node_opening, node, np.maximum(opening, 0.0))
+    node_lam = np.zeros(len(X))
+    np.maximum.at(node_lam, node, m.point_values())
     r = node_opening ** (2.0 / 3.0)
+    estar = contact_modulus(problem.model)
     out = []
     for e in range(len(x) // npt):
         idx = node[e * npt:(e + 1) * npt]
@@ -169,7 +178,10 @@ def contact_cuts(problem) -> list[tuple[np.ndarray, list[bool]]]:
             if graph:
                 nc, no = idx[c], idx[o]
                 n2 = no + (no - nc)
-                if abs(no - nc) == 1 and 0 <= n2 < len(X) and not node_closed[n2] and r[n2] > r[no]:
+                isolated = not any(node_closed[j] for j in (nc - 1, nc + 1) if 0 <= j < len(X))
+                if isolated and estar is not None and abs(no - nc) == 1:
+                    f = float(edge_fraction(node_lam[nc], node_opening[no], abs(X[no] - X[nc]), estar))
+                elif abs(no - nc) == 1 and 0 <= n2 < len(X) and not node_closed[n2] and r[n2] > r[no]:
                     root = X[no] - r[no] * (X[n2] - X[no]) / (r[n2] - r[no])
                     f = float(np.clip((root - X[nc]) / (X[no] - X[nc]), 0.0, 1.0))
             tc = t[c] + f * (t[o] - t[c])

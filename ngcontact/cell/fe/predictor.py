@@ -84,6 +84,7 @@ import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.fe.measures import contact_integral, sample_surface
+from ngcontact.errors import ConvergenceError
 from ngcontact.laws import penalty as _contact
 from ngcontact.solvers.line_search import armijo, illinois_root
 
@@ -166,20 +167,45 @@ def _winkler_root(problem, p: float, k_L: float) -> float:
         return float(contact_integral(problem, force, order=order)) - p * area
 
     lo, flo = 0.0, R(0.0)
-    scale = problem.largest_gap() + p / k_L
-    if flo >= 0.0:            # interference: already pressed at d = 0
+    if flo == 0.0:            # d = 0 carries the load (a zero load, or one below what R resolves, at touch)
+        return 0.0
+    # the first step: the gap's and the load's scale, at least the smallest normal number (a subnormal
+    # p / k_L, or 0, would never grow by doubling)
+    step = max(problem.largest_gap() + p / k_L, np.finfo(float).tiny)
+    if flo > 0.0:             # interference: already pressed at d = 0
         hi, fhi = lo, flo
-        lo = -scale
-        while (flo := R(lo)) >= 0.0:
-            lo *= 2.0
+        lo, flo, _, _ = _bracket(R, -step, lambda f: f > 0.0, p, (lo, flo))
+        if flo == 0.0:
+            return lo
     else:
-        hi = scale
-        while (fhi := R(hi)) <= 0.0:
-            lo, flo, hi = hi, fhi, 2.0 * hi
+        hi, fhi, lo, flo = _bracket(R, step, lambda f: f < 0.0, p, (lo, flo))
+        if fhi == 0.0:
+            return hi
     d = illinois_root(R, lo, flo, hi, fhi, ftol=1e-12 * p * area, xtol=1e-14 * abs(hi),
                       max_iter=200)
     log.debug("rigid predictor: approach %.6e for pressure %.6e", d, p)
     return d
+
+
+#: doublings of the bracket: from the smallest normal number to the largest, the whole exponent range
+MAX_DOUBLINGS = 2 * 1024
+
+
+def _bracket(R, d: float, same_side, p: float, start: tuple[float, float]) -> tuple[float, float, float, float]:
+    """``(d, R(d), e, R(e))``: ``d`` the first of ``d, 2d, 4d, ...`` where ``R`` has left the side of ``start``
+    (``same_side(R(d))`` false) or reached 0, a root; ``e`` the last point on the start's side (``start``
+    itself if none).  Bounded by :data:`MAX_DOUBLINGS`."""
+    last = start
+    for _ in range(MAX_DOUBLINGS):
+        f = R(d)
+        if not math.isfinite(f):
+            break
+        if not same_side(f):
+            return d, f, last[0], last[1]
+        last = (d, f)
+        d *= 2.0
+    raise ConvergenceError(f"rigid predictor: no approach carries the pressure {p!r} (R = {f!r} at d = {d!r} "
+                           f"after doubling the bracket); the contact surface may not face the load", {})
 
 
 def max_gap(problem) -> float:

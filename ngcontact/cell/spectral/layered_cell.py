@@ -42,7 +42,7 @@ from ngcontact.cell.spectral.layer_compliance import normal_compliance
 from ngcontact.cell.spectral.frictional_contact import solve_frictional, traction_operator
 from ngcontact.geometry.random_surface import wave_vectors
 from ngcontact.laws.friction import FrictionLaw
-from ngcontact.solvers.constrained_cg import constrained_cg
+from ngcontact.solvers.constrained_cg import ConstrainedResult, constrained_cg
 
 log = logging.getLogger(__name__)
 
@@ -235,14 +235,17 @@ class SpectralCell:
         d = self.dim
         poisson = self.poisson_shift(load.macro_strain)
         tn, jn = load.traction[d - 1], load.jump[d - 1]
+        uniform = tn is None
+        # gamma = g0 - Delta + C p (+ p/k_n); a prescribed jump: uniform mode included, b = g0 - Delta_interface
         if tn is not None:
-            res = constrained_cg(self.interface_compliance(uniform=False), self.g0, pbar=-tn,
-                                 tol=self.tol, max_iter=self.max_iter, gscale=self.gscale, p0=start)
+            b, pbar = self.g0, -tn
         else:
             assert jn is not None
-            # gamma = g0 - Delta + C p (+ p/k_n), uniform mode included: b = g0 - Delta_interface
-            res = constrained_cg(self.interface_compliance(uniform=True), self.g0 - (jn - poisson), pbar=None,
-                                 tol=self.tol, max_iter=self.max_iter, gscale=self.gscale, p0=start)
+            b, pbar = self.g0 - (jn - poisson), None
+        res = self.full_contact(b, pbar)
+        if res is None:
+            res = constrained_cg(self.interface_compliance(uniform=uniform), b, pbar=pbar, tol=self.tol,
+                                 max_iter=self.max_iter, gscale=self.gscale, p0=start, norm=self.norm(uniform))
         p = res.p
         winkler = p / self.k_n if self.enforcement == "penalty" else 0.0
         closure = self.g0 - (res.gap - winkler)
@@ -250,6 +253,42 @@ class SpectralCell:
         return {"p": p, "q": np.zeros((d - 1,) + self.shape), "closure": closure,
                 "slip": np.zeros((d - 1,) + self.shape), "far_face_jump": [0.0] * (d - 1) + [approach],
                 "iterations": res.iterations, "residuals": res.residuals}
+
+    def norm(self, uniform: bool) -> float:
+        """Largest eigenvalue of :meth:`interface_compliance`: the largest value of its symbol."""
+        sym = self.symbol if uniform else self.fluctuation
+        return float(np.max(sym)) + (1.0 / self.k_n if self.enforcement == "penalty" else 0.0)
+
+    def full_contact(self, b: np.ndarray, pbar: float | None) -> ConstrainedResult | None:
+        """The solution with every point closed, where it is admissible (``p >= 0``); else ``None``.
+
+        Closed everywhere, the gap ``A p + b - c`` vanishes (``A`` the interface compliance, ``c`` the
+        multiplier of a prescribed mean, 0 without it): in Fourier space ``p_k = -b_k / A_k`` for every mode
+        ``k != 0``, and ``p_0 = pbar`` under a prescribed mean pressure, ``-b_0 / A_0`` under a prescribed
+        approach (``A_0`` the uniform mode, ``c0`` plus the penalty's ``1/k_n``).  It is the solution of the
+        contact problem exactly when it is non-negative: the conditions of the module docstring hold with
+        ``gamma = 0``.  Answered directly, with no iteration: at a pressure far above the gap's scale
+        (``p`` of 1e6 on a gap of 1e-2 and ``E = 1``) the iteration would have to resolve a gap of round-off
+        size.  A prescribed approach below every summit needs no such answer: the iteration's start is
+        then already zero pressure (:func:`~ngcontact.solvers.constrained_cg.constrained_cg`).
+        """
+        import scipy.fft as sfft
+        winkler = 1.0 / self.k_n if self.enforcement == "penalty" else 0.0
+        sym = (self.fluctuation if pbar is not None else self.symbol) + winkler
+        bh = sfft.rfftn(b, workers=-1)
+        ph = np.zeros_like(bh)
+        nonzero = sym > 0
+        ph[nonzero] = -bh[nonzero] / sym[nonzero]
+        if pbar is not None:
+            ph.flat[0] = pbar * self.points
+        p = sfft.irfftn(ph, s=self.shape, workers=-1)
+        if pbar is not None:
+            p += pbar - float(p.mean())
+        if not (np.all(np.isfinite(p)) and p.min() >= 0.0):
+            return None
+        g = self.interface_compliance(uniform=pbar is None)(p) + b
+        shift = float(g.mean()) if pbar is not None else 0.0
+        return ConstrainedResult(p=p, gap=g - shift, shift=shift, iterations=0, residuals=[])
 
     # ------------------------------------------------------------ friction
     def traction_operator(self, uniform: tuple[bool, ...]):

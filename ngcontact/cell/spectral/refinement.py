@@ -23,6 +23,12 @@ levels:
    level's.  A level beyond ``max_points`` raises
    :class:`~ngcontact.errors.ConvergenceError` with the history.
 
+The levels are known before the first solve (``grid`` times ``GROWTH^k``
+up to ``max_points``, :func:`levels`; the scene layer bounds
+``max_points`` by the cost of a solve,
+:func:`ngcontact.scene.cell_scene.spectral_cost`): the largest is stated
+first, and each level prints one progress line as it ends.
+
 Each level solves from scratch: nothing carries between grids but the
 comparison, so a frictional load path is simply solved again per level.
 """
@@ -36,6 +42,8 @@ from typing import Any, Callable
 from ngcontact.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
+#: the run's progress lines (printed as its stage lines, :func:`ngcontact.runner.solve`)
+progress = logging.getLogger("ngcontact.progress")
 
 #: points of a level over those of the previous level
 GROWTH = 4
@@ -71,12 +79,27 @@ def level_change(coarse: list, fine: list) -> list[dict[str, float]]:
     return out
 
 
+def levels(grid: int, dim: int, max_points: int) -> list[int]:
+    """The grids refinement may use: ``grid`` and each next one while its points are at most ``max_points``."""
+    if grid ** (dim - 1) > max_points:
+        raise ValueError(f"the first grid of {grid} points per direction exceeds the {max_points} points of the "
+                         "largest")
+    out = [grid]
+    while next_grid(out[-1], dim) ** (dim - 1) <= max_points:
+        out.append(next_grid(out[-1], dim))
+    return out
+
+
 def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: float, grid: int, dim: int,
                        max_points: int) -> RefinedSweep:
     """Solve ``loads`` on grids from ``grid`` up until the estimate meets ``tolerance`` (module docstring).
 
-    ``make_cell(n)`` builds the spectral cell of ``n`` points per direction.
+    ``make_cell(n)`` builds the spectral cell of ``n`` points per direction.  The grids it may reach
+    (:func:`levels`) are known and stated before the first solve; each level logs one progress line.
     """
+    grids = levels(grid, dim, max_points)
+    progress.info("spectral refinement may reach grid %d (%d points) in %d levels from grid %d", grids[-1],
+                  grids[-1] ** (dim - 1), len(grids), grid)
     history: list[dict[str, Any]] = []
     previous = None
     n = grid
@@ -93,8 +116,8 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
         if estimates is not None:
             entry["estimate"] = max(max(e.values()) for e in estimates)
         history.append(entry)
-        log.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
-                 f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
+        progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
+                      f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
         if estimates is not None and entry["estimate"] <= tolerance:
             return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history)
         previous = sols
