@@ -1,8 +1,9 @@
 """Readers for tabulated roughness: a periodic profile (CSV) and a periodic height map (``.npy``).
 
-Profile CSV: two columns ``x, y`` (an optional header line is skipped), one
-period from ``x = 0`` to ``x = P`` with ``y(0) = y(P)``; the profile is the
-polyline through the points (:func:`ngcontact.geometry.profiles.tabulated`).
+Profile CSV: UTF-8 text (a byte-order mark is skipped), two columns ``x, y``
+(an optional header line is skipped), one period from ``x = 0`` to ``x = P``
+with ``y(0) = y(P)``; the profile is the polyline through the points
+(:func:`ngcontact.geometry.profiles.tabulated`).
 
 Height map ``.npy``: a 2D array ``H[i, j]`` of heights at ``x = j P / (n_x - 1)``,
 ``y = i P / (n_y - 1)`` over one period in each direction; the **last row and
@@ -73,7 +74,7 @@ def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MA
     where = path or str(file)
     check_data_file(file, where, "CSV file")
     try:
-        text = file.read_text(encoding="utf-8")
+        text = file.read_text(encoding="utf-8-sig")   # a byte-order mark is no part of the first row
     except OSError as err:
         raise GeometryError(where, str(file), f"must be a readable CSV file ({err.strerror})") from None
     except UnicodeDecodeError:

@@ -62,7 +62,7 @@ def read(path: str, key: str = "interface.law_file") -> dict:
     if os.path.getsize(path) > MAX_BYTES:
         raise SceneError(key, path, f"a law file of at most {MAX_BYTES // 2 ** 20} MiB")
     try:
-        with open(path, encoding="utf-8") as fh:
+        with open(path, encoding="utf-8-sig") as fh:   # a byte-order mark is skipped, as in scene files
             data = json.load(fh)
     except (OSError, UnicodeDecodeError, ValueError) as exc:
         raise SceneError(key, path, f"a readable JSON law file ({type(exc).__name__}: {exc})") from None

@@ -820,3 +820,26 @@ def test_a_spectral_start_with_exact_enforcement(tmp_path, capsys):
     text = edit(CELL.format(contact='enforcement = "exact"'), ("rtol = 1e-10", 'rtol = 1e-10\nstart = "spectral"'))
     run_bad(tmp_path, capsys, text, "solver.start = 'spectral': starts from the spectral cell of the same "
             "small-slope cell: it needs contact.enforcement = 'penalty'", prefix=True)
+
+
+# ------------------------------------------------------------- round three: inputs and messages
+
+
+def test_a_scene_with_a_utf8_byte_order_mark_is_read(tmp_path, capsys):
+    """Was: 'not valid TOML (line 1, column 1)' for a scene saved by an editor that writes a BOM."""
+    scene = tmp_path / "scene.toml"
+    scene.write_bytes(b"\xef\xbb\xbf" + CELL.format(contact="").encode())
+    assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+
+
+def test_a_profile_csv_with_a_byte_order_mark_and_no_header_keeps_its_first_row(tmp_path, capsys):
+    """Was: the BOM made the first row 'not numeric', so it was skipped as a header: the profile then
+    started at x = 0.5 and was refused."""
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "p.csv").write_bytes(b"\xef\xbb\xbf0,0\n0.5,-0.1\n1.0,0\n")
+    scene = work / "scene.toml"
+    scene.write_text(TAB)
+    assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
+    capsys.readouterr()
