@@ -239,13 +239,13 @@ def _study(path: str, periods, out: str | None, quiet: bool, compute: dict) -> i
 def _export(args) -> int:
     """``ngcontact export``: check format, scene and ``--out`` first; write one file; warn what is lost."""
     from ngcontact.export.export_law import FORMATS, check, export, warnings
+    from ngcontact.scene.sections import check_input_file
 
     if args.format not in FORMATS:
         return _fail(EXIT_SCENE, f"--format {args.format}: unknown format; one of " + ", ".join(FORMATS))
     out = args.out or os.path.join("results", os.path.splitext(os.path.basename(args.scene))[0] + "_export")
     try:
-        if not os.path.isfile(args.scene):
-            raise SceneError("SCENE", args.scene, "an existing scene file")
+        check_input_file("SCENE", args.scene, "scene file", missing="an existing scene file")
         check(args.scene, args.format, out)
         with _native_output_silenced(True):
             path, law = export(args.scene, args.format, out, length_unit=args.length_unit,

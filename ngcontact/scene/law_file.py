@@ -29,6 +29,7 @@ import os
 
 from ngcontact.errors import SceneError
 from ngcontact.laws import homogenized as il
+from ngcontact.scene.sections import check_input_file
 
 FORMAT = "ngcontact-interface-law"
 FORMAT_VERSION = 1
@@ -57,8 +58,8 @@ def read(path: str, key: str = "interface.law_file") -> dict:
         Under ``key`` (or ``key: field``) for a missing, unreadable, foreign
         or malformed file, or numbers the laws refuse.
     """
-    if not os.path.isfile(path):
-        raise SceneError(key, path, "no such law file (write one with `ngcontact export SCENE --format json`)")
+    check_input_file(key, path, "JSON law file",
+                     missing="no such law file (write one with `ngcontact export SCENE --format json`)")
     if os.path.getsize(path) > MAX_BYTES:
         raise SceneError(key, path, f"a law file of at most {MAX_BYTES // 2 ** 20} MiB")
     try:

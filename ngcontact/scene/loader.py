@@ -14,7 +14,7 @@ import os
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.scene.kinds import KINDS
 from ngcontact.scene.schema import build
-from ngcontact.scene.sections import resolve
+from ngcontact.scene.sections import check_input_file, resolve
 
 try:  # Python >= 3.11
     import tomllib
@@ -41,8 +41,7 @@ def load(path: str | os.PathLike):
         With the key path, the offending value and what is allowed.
     """
     path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise SceneError("<scene file>", path, "no such file")
+    check_input_file("<scene file>", path, "scene file", missing="no such file")
     real = os.path.realpath(path)
     if real in _LOADING:
         chain = " -> ".join(os.path.basename(p) for p in _LOADING[_LOADING.index(real):] + [real])

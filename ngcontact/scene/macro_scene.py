@@ -310,8 +310,7 @@ class MacroScene:
         ``interface.cell = 'hip.toml': invalid cell scene: materials.bone.nu = ...``.
         ``load(path, overrides=None)``: overrides of the law's cells' ``[contact]``.
         """
-        import os
-        from ngcontact.scene.sections import resolve
+        from ngcontact.scene.sections import check_input_file, resolve
         if self.interface.law_file is not None:
             from ngcontact.scene import law_file
             contents = law_file.read(resolve(self, self.interface.law_file))
@@ -326,8 +325,7 @@ class MacroScene:
         for key, rel, solved in files:
             if rel is None:
                 continue
-            if not os.path.isfile(resolve(self, rel)):
-                raise SceneError(key, rel, "no such cell scene file")
+            check_input_file(key, resolve(self, rel), "cell scene", shown=rel, missing="no such cell scene file")
             try:
                 cell = load(resolve(self, rel))
             except SceneError as exc:

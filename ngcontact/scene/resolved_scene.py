@@ -260,8 +260,10 @@ class DirectScene:
 
     def check_files(self, load) -> None:
         """The named cell scene must be a valid 2D conforming ``cell`` scene this kind can resolve."""
-        from ngcontact.scene.sections import resolve
+        from ngcontact.scene.sections import check_input_file, resolve
         path = resolve(self, self.geometry.cell)
+        check_input_file("geometry.cell", path, "cell scene", shown=self.geometry.cell,
+                         missing="no such cell scene file")
         try:
             cell = load(path)
         except SceneError as exc:

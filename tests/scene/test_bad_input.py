@@ -481,15 +481,15 @@ def test_a_fifo_as_profile_file_is_refused_without_reading_it(tmp_path, capsys):
     work = tmp_path / "work"
     work.mkdir()
     os.mkfifo(work / "p.csv")
-    run_bad(tmp_path, capsys, TAB, f"geometry.file (p.csv) = '{work / 'p.csv'}': must be a regular file "
-            "(not a directory, FIFO or device)")
+    run_bad(tmp_path, capsys, TAB, f"geometry.file (p.csv) = '{work / 'p.csv'}': is a FIFO; must be a regular file "
+            "(a CSV file)")
 
 
 @pytest.mark.parametrize("device", ["/dev/zero", "/dev/urandom"])
 def test_a_device_as_height_map_is_refused_without_reading_it(tmp_path, capsys, device):
     """Was: /dev/zero or /dev/urandom as a data file was read until memory ran out."""
     run_bad(tmp_path, capsys, HMAP.replace('file = "h.npy"', f'file = "{device}"'),
-            f"geometry.file ({device}) = '{device}': must be a regular file (not a directory, FIFO or device)")
+            f"geometry.file ({device}) = '{device}': is a character device; must be a regular file (a .npy array)")
 
 
 def test_a_profile_of_a_hundred_thousand_rows_is_refused_before_meshing(tmp_path, capsys):
@@ -843,3 +843,37 @@ def test_a_profile_csv_with_a_byte_order_mark_and_no_header_keeps_its_first_row(
     scene.write_text(TAB)
     assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
     capsys.readouterr()
+
+
+def test_a_scene_path_that_is_a_directory_or_a_device_says_what_it_is(tmp_path, capsys):
+    """Was: 'no such file' for a directory and for /dev/null."""
+    folder = tmp_path / "scene.toml"
+    folder.mkdir()
+    for path, kind in ((str(folder), "a directory"), ("/dev/null", "a character device")):
+        assert cli.main(["check", path]) == 2
+        assert capsys.readouterr().err == (f"ngcontact: error: {path}: <scene file> = '{path}': is {kind}; "
+                                           "must be a regular file (a scene file)\n")
+
+
+def test_a_cell_link_that_is_a_directory_says_what_it_is(tmp_path, capsys):
+    """Was: 'no such cell scene file' for a directory."""
+    (tmp_path / "work").mkdir()
+    (tmp_path / "work" / "cells").mkdir()
+    text = edit(MACRO, ('law = "linear"\nkn = 1e12\nkt = 1e11', 'cell = "cells"'))
+    run_bad(tmp_path, capsys, text, "interface.cell = 'cells': is a directory; must be a regular file (a cell scene)")
+
+
+def test_a_law_file_that_is_a_directory_says_what_it_is(tmp_path, capsys):
+    """Was: 'no such law file' for a directory."""
+    (tmp_path / "work").mkdir()
+    (tmp_path / "work" / "law.json").mkdir()
+    text = edit(MACRO, ('law = "linear"\nkn = 1e12\nkt = 1e11', 'law = "file"\nlaw_file = "law.json"'))
+    run_bad(tmp_path, capsys, text, f"interface.law_file = '{tmp_path / 'work' / 'law.json'}': is a directory; "
+            "must be a regular file (a JSON law file)")
+
+
+def test_a_data_file_that_is_a_directory_says_what_it_is(tmp_path, capsys):
+    (tmp_path / "work").mkdir()
+    (tmp_path / "work" / "p.csv").mkdir()
+    run_bad(tmp_path, capsys, TAB, f"geometry.file (p.csv) = '{tmp_path / 'work' / 'p.csv'}': is a directory; "
+            "must be a regular file (a CSV file)")
