@@ -13,7 +13,7 @@ import os
 
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.scene.kinds import KINDS
-from ngcontact.scene.schema import build
+from ngcontact.scene.schema import MAX_SCENE_BYTES, build
 from ngcontact.scene.sections import check_input_file, resolve
 
 try:  # Python >= 3.11
@@ -41,7 +41,7 @@ def load(path: str | os.PathLike):
         With the key path, the offending value and what is allowed.
     """
     path = os.fspath(path)
-    check_input_file("<scene file>", path, "scene file", missing="no such file")
+    check_input_file("<scene file>", path, "scene file", missing="no such file", max_bytes=MAX_SCENE_BYTES)
     real = os.path.realpath(path)
     if real in _LOADING:
         chain = " -> ".join(os.path.basename(p) for p in _LOADING[_LOADING.index(real):] + [real])

@@ -83,7 +83,7 @@ class InterfaceSpec:
                      "default, also from a cell), tabulated (pressure against closure) or file (a law file of "
                      "`ngcontact export --format json`, see law_file)", choices=LAWS)
     law_file: str | None = param(None, doc="law = file: the JSON law file, relative to this scene (SI units; "
-                                 "cell_length_unit is not applied)")
+                                 "cell_length_unit is not applied); a regular file of at most 64 MiB")
     law_file_form: str = param("bundle", doc="law = file: which of the file's laws: bundle (exact), tabulated "
                                "(its pressure-closure table, tangential stiffness = its stick slope) or linear (K0)",
                                choices=("bundle", "tabulated", "linear"))

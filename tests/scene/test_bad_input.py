@@ -877,3 +877,21 @@ def test_a_data_file_that_is_a_directory_says_what_it_is(tmp_path, capsys):
     (tmp_path / "work" / "p.csv").mkdir()
     run_bad(tmp_path, capsys, TAB, f"geometry.file (p.csv) = '{tmp_path / 'work' / 'p.csv'}': is a directory; "
             "must be a regular file (a CSV file)")
+
+
+def test_a_title_beyond_the_string_limit_is_refused_and_not_echoed(tmp_path, capsys):
+    """Was: a 50 MB title was accepted and copied into a 100 MB report.json."""
+    from ngcontact.scene.schema import MAX_STRING
+    title = "x" * (MAX_STRING + 1)
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ('kind = "cell"', f'kind = "cell"\ntitle = "{title}"')),
+            f"title = 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx...' ({MAX_STRING + 1} characters): must be at most "
+            f"{MAX_STRING} characters")
+
+
+def test_a_scene_file_beyond_the_size_limit_is_refused_before_parsing(tmp_path, capsys):
+    from ngcontact.scene.schema import MAX_SCENE_BYTES
+    text = CELL.format(contact="") + "# padding\n" * (MAX_SCENE_BYTES // 10 + 1)
+    scene = tmp_path / "work" / "scene.toml"
+    size = len(text.encode())
+    run_bad(tmp_path, capsys, text, f"<scene file> = '{scene}': is {size} bytes; a scene file is limited to "
+            f"{MAX_SCENE_BYTES // 2 ** 20} MiB")
