@@ -36,7 +36,7 @@ from ngcontact.scene.macro_shapes import BOUNDARY_DOCS  # noqa: F401  (the kind'
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
 from ngcontact.scene import cell_links, mesh_size
-from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
+from ngcontact.scene.schema import at_least, distinct, nonempty, nonnegative, open_interval, param, positive
 
 LAWS = ("linear", "bundle", "tabulated", "file")
 
@@ -170,7 +170,8 @@ class SupportSpec:
     """Prescribed displacement components on a boundary."""
 
     boundary: str = param(doc="boundary label of the geometry")
-    components: tuple[str, ...] = param((), doc="components fixed (x, y, z; r, z in axisymmetry); empty: all")
+    components: tuple[str, ...] = param((), doc="components fixed (x, y, z; r, z in axisymmetry); empty: all",
+                                        check=distinct())
     displacement: tuple[float, ...] = param((), doc="prescribed values, one per component (default 0)",
                                             units="m")
 

@@ -40,7 +40,8 @@ from ngcontact.scene.macro_shapes import FEMUR_BOUNDARIES, check_dimensions, che
 from ngcontact.scene.sections import (ComputeSpec, MaterialSpec, check_supports_once, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty, param, positive
+from ngcontact.scene.schema import (MAX_ORDER, MAX_PERIODS, at_least, closed_interval, distinct, nonempty, param,
+                                    positive)
 
 SHAPES = ("blocks", "femur_stem")
 #: Boundary labels of each shape with what each is (the resolved surface is ``contact``).
@@ -112,7 +113,7 @@ class DirectSupport:
 
     boundary: str = param(doc="a boundary of the shape", allowed="blocks: " + ", ".join(BOUNDARIES["blocks"])
                           + "; femur_stem: " + ", ".join(BOUNDARIES["femur_stem"]))
-    components: tuple[str, ...] = param((), doc="components fixed (x, y or r, z); empty: all")
+    components: tuple[str, ...] = param((), doc="components fixed (x, y or r, z); empty: all", check=distinct())
     displacement: tuple[float, ...] = param((), doc="value at the boundary's mid-point, one per component "
                                             "(default 0)", units="m")
     slope: tuple[float, ...] = param((), doc="change of each prescribed component per metre along the "

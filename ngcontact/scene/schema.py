@@ -111,6 +111,11 @@ def nonempty() -> Check:
     return _named("must not be empty", lambda v: len(v) > 0)
 
 
+def distinct() -> Check:
+    """Entries that name something (a component, an order) once each: a repeated one was dropped silently."""
+    return _named("must not repeat an entry", lambda v: len(set(v)) == len(v))
+
+
 def all_of(*checks: Check) -> Check:
     def check(value):
         for c in checks:

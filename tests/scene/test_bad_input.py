@@ -895,3 +895,11 @@ def test_a_scene_file_beyond_the_size_limit_is_refused_before_parsing(tmp_path, 
     size = len(text.encode())
     run_bad(tmp_path, capsys, text, f"<scene file> = '{scene}': is {size} bytes; a scene file is limited to "
             f"{MAX_SCENE_BYTES // 2 ** 20} MiB")
+
+
+def test_a_component_given_twice_is_refused(tmp_path, capsys):
+    """Was: components = ["x", "x", "y"] was accepted and one x value dropped."""
+    text = edit(MACRO, ('[[supports]]\nboundary = "bottom"\n',
+                        '[[supports]]\nboundary = "bottom"\ncomponents = ["x", "x", "y"]\n'
+                        'displacement = [0.0, 1e-6, 0.0]\n'))
+    run_bad(tmp_path, capsys, text, "supports[0].components = ['x', 'x', 'y']: must not repeat an entry")
