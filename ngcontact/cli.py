@@ -275,9 +275,9 @@ def _classified(path: str, exc: Exception) -> int:
     if isinstance(exc, (NgcontactError, ValueError)):
         return _fail(EXIT_SOLVER, f"{path}: {exc}")
     if type(exc).__name__ == "NgException" and "meshing" in str(exc).lower():
-        return _fail(EXIT_SCENE, f"{path}: the mesher failed on this geometry ({exc}); a feature is "
-                                 "too small or too thin for discretization.maxh / interface_maxh: "
-                                 "change the geometry's sizes or the mesh sizes")
+        return _fail(EXIT_SCENE, f"{path}: the mesher failed on this geometry ({exc}); the usual causes are a "
+                                 "feature smaller than discretization.maxh / interface_maxh, or these two sizes "
+                                 "far apart (a ratio near 100): change the geometry's sizes or the mesh sizes")
     raise exc
 
 

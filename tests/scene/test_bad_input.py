@@ -903,3 +903,14 @@ def test_a_component_given_twice_is_refused(tmp_path, capsys):
                         '[[supports]]\nboundary = "bottom"\ncomponents = ["x", "x", "y"]\n'
                         'displacement = [0.0, 1e-6, 0.0]\n'))
     run_bad(tmp_path, capsys, text, "supports[0].components = ['x', 'x', 'y']: must not repeat an entry")
+
+
+def test_a_mesher_failure_of_a_plain_cell_names_the_size_ratio(tmp_path, capsys):
+    """Was: 'a feature is too small or too thin' for a rectangular cell of height 1 at interface_maxh 0.002,
+    whose features are 0.3 and 0.4 long: Netgen's 2D mesher fails on size ratios near 100."""
+    text = open(os.path.join(CELLS, "ex27_rectangular.toml")).read()
+    run_bad(tmp_path, capsys, edit(text, ("interface_maxh = 0.05", "interface_maxh = 0.002")),
+            "inadmissible model input: discretization.interface_maxh = 0.002: Netgen's mesher failed (meshing "
+            "failed) on the cell meshed at maxh = 0.2 with the interface at 0.002: sizes 100 times apart, which its "
+            "grading does not bridge reliably (failures seen from about 90); keep maxh / interface_maxh below 50: "
+            "raise discretization.interface_maxh or lower discretization.maxh", commands=("run",))
