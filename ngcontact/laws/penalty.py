@@ -68,18 +68,20 @@ class Friction:
 
     The one description of friction on ``S_C`` for the cell and the resolved
     problems (paper eqs. 9, 16-17); the homogenized law has its own
-    (:class:`ngcontact.laws.homogenized.Friction`, eqs. 42-43).
+    (:class:`ngcontact.laws.homogenized.Friction`, eqs. 42-43).  ``w`` is
+    ``None`` for exact (unregularized) friction, which only the spectral cell
+    with exact enforcement solves; every regularized use needs ``w > 0``.
     """
 
     law: str
-    w: float
+    w: float | None
     G: float | None = None
     mu: float | None = None
 
     def __post_init__(self):
         if self.law not in ("tresca", "coulomb"):
             raise ModelError(f"friction law {self.law!r}: must be 'tresca' or 'coulomb'")
-        if not self.w > 0:
+        if self.w is not None and not self.w > 0:
             raise ModelError(f"friction width w = {self.w!r}: must be > 0")
         if self.law == "tresca" and (self.G is None or self.G < 0):
             raise ModelError(f"Tresca threshold G = {self.G!r}: must be >= 0")

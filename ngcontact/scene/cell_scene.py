@@ -66,14 +66,18 @@ class ContactSpec:
     friction: str = param("none", doc="friction law", choices=FRICTION)
     G: float | None = param(None, doc="Tresca threshold", units="Pa", check=nonnegative())
     mu: float | None = param(None, doc="Coulomb coefficient", check=nonnegative())
-    w: float | None = param(None, doc="Huber width (stick zone of the slip)", units="m",
-                            check=positive())
+    w: float | None = param(None, doc="Huber width (stick zone of the slip); required with friction, except by "
+                            "the spectral cell's exact friction (enforcement = 'exact', method = 'spectral'), "
+                            "which has none", units="m", check=positive())
     geometric_only: bool = param(False, doc="only the coefficients of the whole contact surface; "
                                  "solve no contact problem")
 
     def check(self, path: str) -> None:
         need = {"none": (), "tresca": ("G", "w"), "coulomb": ("mu", "w")}[self.friction]
-        check_selected(self, path, "friction", ("G", "mu", "w"), need)
+        # exact friction has no width: w is optional under exact enforcement (CellScene.check asks it of the FE cell)
+        exact = self.enforcement == "exact" and self.friction != "none"
+        check_selected(self, path, "friction", ("G", "mu", "w"), tuple(k for k in need if not (exact and k == "w")),
+                       optional=("w",) if exact else ())
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -197,6 +201,11 @@ class CellScene:
             return
         if self.load is None:
             raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
+        c = self.contact
+        if c.friction != "none" and c.w is None and self.discretization.method == "fe":
+            raise SceneError("contact.w", MISSING, f"required for friction = {c.friction!r} in an FE cell, which "
+                             "regularizes friction with the Huber width w under exact enforcement too (the spectral "
+                             "cell's exact friction needs none)")
         if self.discretization.method == "spectral":
             check_spectral(self)
         else:

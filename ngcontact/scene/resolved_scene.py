@@ -276,6 +276,10 @@ class DirectScene:
             raise SceneError("geometry.cell", self.geometry.cell,
                              "need a 2D conforming cell with an analytic profile (flat, rectangular, "
                              "triangular, semicircular, sinusoid)")
+        if cell.contact.friction != "none" and cell.contact.w is None:
+            raise SceneError("geometry.cell", self.geometry.cell, "its friction has no contact.w (the spectral cell's "
+                             "exact friction needs none); the resolved problem regularizes friction with the cell's "
+                             "Huber width w: give it one")
         if cell.contact.gap.kind not in ("none", "constant"):
             raise SceneError("geometry.cell", self.geometry.cell,
                              f"gap kind {cell.contact.gap.kind!r} is not resolved; use none or constant")

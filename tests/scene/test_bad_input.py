@@ -914,3 +914,19 @@ def test_a_mesher_failure_of_a_plain_cell_names_the_size_ratio(tmp_path, capsys)
             "failed) on the cell meshed at maxh = 0.2 with the interface at 0.002: sizes 100 times apart, which its "
             "grading does not bridge reliably (failures seen from about 90); keep maxh / interface_maxh below 50: "
             "raise discretization.interface_maxh or lower discretization.maxh", commands=("run",))
+
+
+def test_exact_coulomb_friction_of_the_spectral_cell_needs_no_huber_width(tmp_path, capsys):
+    """Was: 'contact.w = <missing>: required for friction = 'coulomb'' with exact friction, which has no width."""
+    text = edit(CELL.format(contact='enforcement = "exact"\nfriction = "coulomb"\nmu = 0.3\n'
+                            'gap = { kind = "sinusoid", h = 0.01 }'),
+                ("order = 1", 'method = "spectral"\ngrid = 64\norder = 1'))
+    scene = tmp_path / "spectral.toml"
+    scene.write_text(text)
+    assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
+    assert cli.main(["run", str(scene), "--out", str(tmp_path / "spectral"), "--quiet"]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+    # the FE cell regularizes friction with w under exact enforcement too: there it stays required
+    run_bad(tmp_path, capsys, text.replace('method = "spectral"\ngrid = 64\n', ""),
+            "contact.w = <missing>: required for friction = 'coulomb' in an FE cell, which regularizes friction "
+            "with the Huber width w under exact enforcement too (the spectral cell's exact friction needs none)")
