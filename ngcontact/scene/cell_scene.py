@@ -213,9 +213,9 @@ class CellScene:
         if self.discretization.method == "fe" and self.contact.enforcement == "exact" and dim == 3 \
                 and self.discretization.order > 1:
             raise SceneError("discretization.order", self.discretization.order,
-                             "1 with contact.enforcement = 'exact' in a 3D FE cell (quadratic triangles leave corner "
-                             "nodes open inside the contact patch); or use the penalty, or discretization.method = "
-                             "'spectral' for a small-slope cell")
+                             "must be 1 with contact.enforcement = 'exact' in a 3D FE cell (quadratic triangles leave "
+                             "corner nodes open inside the contact patch); or use the penalty, or "
+                             "discretization.method = 'spectral' for a small-slope cell")
         if self.discretization.method == "fe" and self.solver.start == "spectral" and not has_twin(self):
             raise SceneError("solver.start", "spectral", "starts from the spectral cell of the same small-slope cell: "
                              "it needs contact.enforcement = 'penalty' and a flat interface (geometry.profile = "
@@ -325,8 +325,10 @@ def check_spectral(scene: CellScene) -> None:
                          f"{g.profile!r} in the {g.arrangement!r} arrangement; use method = 'fe'")
     if d.tolerance is not None and g.profile in ("height_map", "self_affine"):
         raise SceneError("discretization.tolerance", d.tolerance, "refines the grid of a gap given by a formula; "
-                         f"a {g.profile!r} profile's heights exist on their own grid only: remove the key and "
-                         "set discretization.grid")
+                         f"a {g.profile!r} profile's heights are samples, which a finer grid interpolates bilinearly, "
+                         "so refining cannot estimate an error beyond them: remove the key and choose "
+                         "discretization.grid (default: the map's own grid; a finer one resolves contact patches "
+                         "between the samples)")
     if d.grid is not None and d.grid % 2:
         raise SceneError("discretization.grid", d.grid, "must be even (the FFT's Nyquist mode is real)")
     n = spectral_grid(scene)           # a height map's own grid is bounded by its file size (64 MiB)

@@ -110,7 +110,8 @@ class InterfaceSpec:
         units="m", allowed="pairs with increasing coordinate")
     gap_coordinate: str = param("y", doc="coordinate of gap_table (r = x, z = y in axisymmetry)",
                                 choices=("x", "y", "z", "r"))
-    mu: float = param(0.0, doc="homogenized Coulomb coefficient mu0 (fixed point on the pressure)",
+    mu: float = param(0.0, doc="homogenized Coulomb coefficient mu0: threshold mu0 p, solved as solver.coulomb "
+                      "says (default: Newton on the coupled equations; or the fixed point on the pressure)",
                       check=nonnegative())
     threshold: float = param(0.0, doc="Tresca threshold G0", units="Pa", check=nonnegative())
     huber_width: float = param(1e-6, doc="Huber width w: largest slip of a sticking point", units="m",
@@ -189,6 +190,9 @@ class LoadSpec:
 class OutputSpec:
     """Sampling of the results."""
 
+    #: removed keys -> what replaces them (:func:`~ngcontact.scene.schema.build` names it)
+    REMOVED = {"coulomb_tol": "solver.coulomb_rtol (the Coulomb fixed point stops when max |p_k - p_k-1| <= "
+                              "coulomb_rtol x max p_k)"}
     points_per_element: int = param(5, doc="samples per interface element in the profile", check=at_least(2))
     vtk_subdivision: int = param(1, doc="subdivision of the VTK output", check=at_least(0))
 

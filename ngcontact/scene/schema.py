@@ -6,7 +6,8 @@ with :func:`param`.  :func:`build` turns a parsed TOML table into such a
 dataclass and rejects, with a :class:`~ngcontact.errors.SceneError` naming the
 key path, the value and what is allowed,
 
-* unknown keys (the message lists the known ones),
+* unknown keys (the message lists the known ones; a key the section's
+  ``REMOVED`` table lists is named with what replaces it),
 * values of the wrong type (``bool`` is never a number, an ``int`` is accepted
   where a ``float`` is asked for),
 * NaN or infinite numbers anywhere (TOML admits ``nan`` and ``inf``),
@@ -170,6 +171,9 @@ def build(cls, data: Any, path: str = ""):
     unknown = sorted(set(data) - set(fields))
     if unknown:
         key = unknown[0]
+        successor = getattr(cls, "REMOVED", {}).get(key)
+        if successor is not None:
+            raise SceneError(_join(path, key), data[key], f"removed; use {successor}")
         raise SceneError(_join(path, key), data[key],
                          "unknown key; allowed keys here are " + ", ".join(sorted(fields)))
     values = {}

@@ -905,6 +905,15 @@ def test_a_component_given_twice_is_refused(tmp_path, capsys):
     run_bad(tmp_path, capsys, text, "supports[0].components = ['x', 'x', 'y']: must not repeat an entry")
 
 
+def test_the_bore_label_states_the_rule_the_dimensions_enforce(tmp_path, capsys):
+    """Was: 'a > 0: the inner body is a tube', as if a = 0 (a solid rod) were allowed; it is refused."""
+    from ngcontact.scene.macro_shapes import BOUNDARY_DOCS
+    for setting in ("plane_strain", "axisymmetric", "3d"):
+        assert "a must be > 0" in BOUNDARY_DOCS["coaxial", setting]["bore"]
+    run_bad(tmp_path, capsys, edit(COAXIAL, ("a = 0.01", "a = 0.0")),
+            "geometry.dimensions.a = 0.0: must be > 0", prefix=True)
+
+
 def test_a_mesher_failure_of_a_plain_cell_names_the_size_ratio(tmp_path, capsys):
     """Was: 'a feature is too small or too thin' for a rectangular cell of height 1 at interface_maxh 0.002,
     whose features are 0.3 and 0.4 long: Netgen's 2D mesher fails on size ratios near 100."""
@@ -914,6 +923,39 @@ def test_a_mesher_failure_of_a_plain_cell_names_the_size_ratio(tmp_path, capsys)
             "failed) on the cell meshed at maxh = 0.2 with the interface at 0.002: sizes 100 times apart, which its "
             "grading does not bridge reliably (failures seen from about 90); keep maxh / interface_maxh below 50: "
             "raise discretization.interface_maxh or lower discretization.maxh", commands=("run",))
+
+
+def test_the_macro_friction_coefficient_documents_the_default_coupled_newton():
+    """Was: interface.mu read 'fixed point on the pressure' while solver.coulomb defaults to the coupled Newton."""
+    import dataclasses
+    from ngcontact.scene.macro_scene import InterfaceSpec
+    from ngcontact.scene.sections import SolverSpec
+    doc = next(f for f in dataclasses.fields(InterfaceSpec) if f.name == "mu").metadata["doc"]
+    assert SolverSpec().coulomb == "newton" and "solver.coulomb" in doc and "Newton" in doc
+
+
+def test_the_order_of_an_exact_3d_fe_cell_says_what_it_must_be(tmp_path, capsys):
+    text = edit(CELL.format(contact='enforcement = "exact"'), ('profile = "flat"', 'profile = "flat3d"'),
+                ("order = 1", "order = 2"))
+    run_bad(tmp_path, capsys, text, "discretization.order = 2: must be 1 with contact.enforcement = 'exact' in a "
+            "3D FE cell", prefix=True)
+
+
+def test_a_removed_key_names_its_successor(tmp_path, capsys):
+    """Was: output.coulomb_tol (removed) gave 'unknown key' with no pointer to solver.coulomb_rtol."""
+    run_bad(tmp_path, capsys, MACRO + "\n[output]\ncoulomb_tol = 1e-6\n",
+            "output.coulomb_tol = 1e-06: removed; use solver.coulomb_rtol (the Coulomb fixed point stops when "
+            "max |p_k - p_k-1| <= coulomb_rtol x max p_k)")
+
+
+def test_a_height_map_tolerance_message_says_what_finer_grids_do(tmp_path, capsys):
+    """Was: 'heights exist on their own grid only', while finer grids are accepted (and interpolate them)."""
+    text = edit(HMAP, ("maxh = 0.5", 'method = "spectral"\ntolerance = 1e-3\nmaxh = 0.5'))
+    run_bad(tmp_path, capsys, text,
+            "discretization.tolerance = 0.001: refines the grid of a gap given by a formula; a 'height_map' "
+            "profile's heights are samples, which a finer grid interpolates bilinearly, so refining cannot estimate "
+            "an error beyond them: remove the key and choose discretization.grid (default: the map's own grid; a "
+            "finer one resolves contact patches between the samples)", files={"h.npy": np.zeros((5, 5))})
 
 
 def test_exact_coulomb_friction_of_the_spectral_cell_needs_no_huber_width(tmp_path, capsys):
