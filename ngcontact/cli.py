@@ -240,6 +240,7 @@ def _export(args) -> int:
     """``ngcontact export``: check format, scene and ``--out`` first; write one file; warn what is lost."""
     from ngcontact.export.export_law import FORMATS, check, export, warnings
     from ngcontact.export.law_source import check_options
+    from ngcontact.scene.sections import check_input_file
 
     if args.format not in FORMATS:
         return _fail(EXIT_SCENE, f"--format {args.format}: unknown format; one of " + ", ".join(FORMATS))
@@ -249,8 +250,7 @@ def _export(args) -> int:
         return _fail(EXIT_SCENE, str(exc))
     out = args.out or os.path.join("results", os.path.splitext(os.path.basename(args.scene))[0] + "_export")
     try:
-        if not os.path.isfile(args.scene):
-            raise SceneError("SCENE", args.scene, "an existing scene file")
+        check_input_file("SCENE", args.scene, "scene file", missing="an existing scene file")
         check(args.scene, args.format, out)
         with _native_output_silenced(True):
             path, law = export(args.scene, args.format, out, length_unit=args.length_unit,
@@ -280,9 +280,9 @@ def _classified(path: str, exc: Exception) -> int:
     if isinstance(exc, (NgcontactError, ValueError)):
         return _fail(EXIT_SOLVER, f"{path}: {exc}")
     if type(exc).__name__ == "NgException" and "meshing" in str(exc).lower():
-        return _fail(EXIT_SCENE, f"{path}: the mesher failed on this geometry ({exc}); a feature is "
-                                 "too small or too thin for discretization.maxh / interface_maxh: "
-                                 "change the geometry's sizes or the mesh sizes")
+        return _fail(EXIT_SCENE, f"{path}: the mesher failed on this geometry ({exc}); the usual causes are a "
+                                 "feature smaller than discretization.maxh / interface_maxh, or these two sizes "
+                                 "far apart (a ratio near 100): change the geometry's sizes or the mesh sizes")
     raise exc
 
 

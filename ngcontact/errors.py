@@ -93,8 +93,15 @@ class OutputError(NgcontactError):
     """The output directory cannot be written."""
 
 
+#: Strings longer than this are shown by their start and their length (a message is one line to read).
+SHOW_CHARACTERS = 256
+
+
 def _show(value) -> str:
     if isinstance(value, str):
+        if len(value) > SHOW_CHARACTERS:
+            head = repr(value[:40])
+            return f"{head[:-1]}...{head[-1]} ({len(value)} characters)"
         return repr(value)
     if isinstance(value, float):
         return repr(value)

@@ -13,8 +13,10 @@ import argparse
 import os
 import sys
 
+from ngcontact.geometry.tabulated import MAX_DATA_BYTES
+from ngcontact.scene import law_file
 from ngcontact.scene.kinds import KINDS
-from ngcontact.scene.schema import describe
+from ngcontact.scene.schema import MAX_SCENE_BYTES, MAX_STRING, describe
 
 BEGIN = "<!-- scene-reference:begin -->"
 END = "<!-- scene-reference:end -->"
@@ -22,8 +24,11 @@ README = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "RE
 
 
 def reference() -> str:
-    """Markdown tables, one per scene kind."""
-    out = []
+    """Markdown tables, one per scene kind, after the limits every scene obeys."""
+    out = [f"A scene file is UTF-8 text (a byte-order mark is skipped) of at most {MAX_SCENE_BYTES // 2 ** 20} MiB; "
+           f"every string and every table name in it has at most {MAX_STRING} characters; the data files it names "
+           f"(profiles, gaps, height maps: {MAX_DATA_BYTES // 2 ** 20} MiB; law files: "
+           f"{law_file.MAX_BYTES // 2 ** 20} MiB) and the cell scenes it names must be regular files.\n"]
     for name in sorted(KINDS):
         cls = KINDS[name].scene
         doc = (cls.__module__ and sys.modules[cls.__module__].__doc__ or "").strip().splitlines()

@@ -23,12 +23,41 @@ from dataclasses import dataclass
 import ngsolve as ng
 from netgen.geom2d import SplineGeometry
 
+from ngcontact.errors import GeometryError
+
 log = logging.getLogger(__name__)
 
 #: Fewest elements across one period: an element reaching from one periodic
 #: side to the other would carry a dof twice after the identification (NGSolve
 #: refuses to assemble it), and Netgen's ``maxh`` is only a target size.
 MIN_ELEMENTS_PER_PERIOD = 3
+
+
+#: Largest ratio of the mesh size to the interface mesh size a message calls safe: Netgen's 2D grading failed
+#: on a rectangular cell of height 1 at ratios 91 and 100 (and met 80 and 95), whatever the order.
+SAFE_SIZE_RATIO = 50
+
+
+def meshing_failure(exc: Exception, maxh: float, interface_maxh: float) -> GeometryError:
+    """The error for Netgen's ``meshing failed`` on a cell meshed at ``maxh`` with the interface at ``interface_maxh``.
+
+    Sizes :data:`SAFE_SIZE_RATIO` and more apart are named as the cause: the
+    grading between them is what fails (a plain rectangular cell of height 1
+    at interface_maxh = 0.002 has no feature below the mesh size).
+    Otherwise both sizes are named with the usual causes.
+    """
+    ratio = maxh / interface_maxh
+    if ratio >= SAFE_SIZE_RATIO:
+        return GeometryError("discretization.interface_maxh", interface_maxh,
+                             f"Netgen's mesher failed ({exc}) on the cell meshed at maxh = {maxh:g} with the "
+                             f"interface at {interface_maxh:g}: sizes {ratio:.3g} times apart, which its grading "
+                             "does not bridge reliably (failures seen from about 90); keep maxh / interface_maxh "
+                             f"below {SAFE_SIZE_RATIO}: raise discretization.interface_maxh or lower "
+                             "discretization.maxh")
+    return GeometryError("discretization.maxh", maxh,
+                         f"Netgen's mesher failed ({exc}) on the cell meshed at maxh = {maxh:g} with the interface "
+                         f"at {interface_maxh:g}: a feature of the geometry smaller than these sizes is the usual "
+                         "cause; change the geometry's sizes or the mesh sizes")
 
 
 def periodic_maxh(maxh: float, period: float) -> float:
@@ -165,7 +194,12 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
             geo.Append([s.kind, *ids], leftdomain=0, rightdomain=COUNTER, bc=s.label, maxh=hint)
     geo.SetMaterial(ROUGH, "rough")
     geo.SetMaterial(COUNTER, "counter")
-    mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh, grading=grading))
+    try:
+        mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh, grading=grading))
+    except Exception as exc:  # netgen's NgException, which its Python package does not export by a stable name
+        if type(exc).__name__ != "NgException" or "meshing" not in str(exc).lower():
+            raise
+        raise meshing_failure(exc, maxh, hint) from None
     if order > 1:
         mesh.Curve(order)
     return Cell(mesh=mesh, dim=2, period=(float(period),), h_rough=float(h_rough),

@@ -1,8 +1,9 @@
 """Readers for tabulated roughness: a periodic profile (CSV) and a periodic height map (``.npy``).
 
-Profile CSV: two columns ``x, y`` (an optional header line is skipped), one
-period from ``x = 0`` to ``x = P`` with ``y(0) = y(P)``; the profile is the
-polyline through the points (:func:`ngcontact.geometry.profiles.tabulated`).
+Profile CSV: UTF-8 text (a byte-order mark is skipped), two columns ``x, y``
+(an optional header line is skipped), one period from ``x = 0`` to ``x = P``
+with ``y(0) = y(P)``; the profile is the polyline through the points
+(:func:`ngcontact.geometry.profiles.tabulated`).
 
 Height map ``.npy``: a 2D array ``H[i, j]`` of heights at ``x = j P / (n_x - 1)``,
 ``y = i P / (n_y - 1)`` over one period in each direction; the **last row and
@@ -32,16 +33,32 @@ MAX_DATA_BYTES = 64 * 2 ** 20
 MAX_PROFILE_ROWS = 4096
 
 
+def file_kind(mode: int) -> str | None:
+    """What a path of ``os.stat`` mode ``mode`` is when it is not a regular file (``None`` when it is).
+
+    A directory, FIFO or device named as an input is said to be one: reading
+    it would fail, hang (a FIFO) or never end (``/dev/zero``).
+    """
+    import stat
+    if stat.S_ISREG(mode):
+        return None
+    for test, name in ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return "not a regular file"
+
+
 def check_data_file(file, where: str, what: str = "file") -> None:
     """A data file must be a regular file of at most :data:`MAX_DATA_BYTES` (checked before reading)."""
     import os
-    import stat
     try:
         st = os.stat(file)
     except OSError as err:
         raise GeometryError(where, str(file), f"must be a readable {what} ({err.strerror})") from None
-    if not stat.S_ISREG(st.st_mode):
-        raise GeometryError(where, str(file), "must be a regular file (not a directory, FIFO or device)")
+    kind = file_kind(st.st_mode)
+    if kind is not None:
+        raise GeometryError(where, str(file), f"is {kind}; must be a regular file (a {what})")
     if st.st_size > MAX_DATA_BYTES:
         raise GeometryError(where, str(file), f"is {st.st_size} bytes; data files are limited to "
                             f"{MAX_DATA_BYTES // 2 ** 20} MiB")
@@ -73,7 +90,7 @@ def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MA
     where = path or str(file)
     check_data_file(file, where, "CSV file")
     try:
-        text = file.read_text(encoding="utf-8")
+        text = file.read_text(encoding="utf-8-sig")   # a byte-order mark is no part of the first row
     except OSError as err:
         raise GeometryError(where, str(file), f"must be a readable CSV file ({err.strerror})") from None
     except UnicodeDecodeError:

@@ -41,9 +41,13 @@ from ngcontact.laws import penalty as _contact
 
 @dataclass(frozen=True, kw_only=True)
 class FrictionLaw(ABC):
-    """A micro friction law with Huber width ``w > 0``: its threshold and its energy (module docstring)."""
+    """A micro friction law with Huber width ``w > 0``: its threshold and its energy (module docstring).
 
-    w: float
+    ``w = None`` is exact (unregularized) friction, which only the spectral cell with exact enforcement
+    solves; every regularized use needs ``w > 0``.
+    """
+
+    w: float | None
     #: the law's name in scenes and reports
     name: ClassVar[str]
     #: the keys of the law's numbers (fields of the class and of the cell scene's ``[contact]``)
@@ -52,7 +56,7 @@ class FrictionLaw(ABC):
     couples_to_pressure: ClassVar[bool] = False
 
     def __post_init__(self) -> None:
-        if not self.w > 0:
+        if self.w is not None and not self.w > 0:
             raise ModelError(f"friction width w = {self.w!r}: must be > 0")
 
     @abstractmethod

@@ -63,6 +63,7 @@ HIGHLIGHTS: dict[str, list[tuple[str, str, str]]] = {
     ],
     "manufactured": [
         ("verified", "results.verified", ""),
+        ("verdict", "results.verdict", ""),
         ("largest rate deviation", "results.max_rate_deviation", ""),
         ("admissible deviation", "results.rate_tolerance", ""),
     ],

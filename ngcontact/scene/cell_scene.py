@@ -70,14 +70,18 @@ class ContactSpec:
     friction: str = param("none", doc="friction law", choices=FRICTION)
     G: float | None = param(None, doc="Tresca threshold", units="Pa", check=nonnegative())
     mu: float | None = param(None, doc="Coulomb coefficient", check=nonnegative())
-    w: float | None = param(None, doc="Huber width (stick zone of the slip)", units="m",
-                            check=positive())
+    w: float | None = param(None, doc="Huber width (stick zone of the slip); required with friction, except by "
+                            "the spectral cell's exact friction (enforcement = 'exact', method = 'spectral'), "
+                            "which has none", units="m", check=positive())
     geometric_only: bool = param(False, doc="only the coefficients of the whole contact surface; "
                                  "solve no contact problem")
 
     def check(self, path: str) -> None:
         need = () if self.friction == "none" else FRICTION_LAWS[self.friction].parameters
-        check_selected(self, path, "friction", ("G", "mu", "w"), need)
+        # exact friction has no width: w is optional under exact enforcement (CellScene.check asks it of the FE cell)
+        exact = self.enforcement == "exact" and self.friction != "none"
+        check_selected(self, path, "friction", ("G", "mu", "w"), tuple(k for k in need if not (exact and k == "w")),
+                       optional=("w",) if exact else ())
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -210,6 +214,11 @@ class CellScene:
             return
         if self.load is None:
             raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
+        c = self.contact
+        if c.friction != "none" and c.w is None and self.discretization.method == "fe":
+            raise SceneError("contact.w", MISSING, f"required for friction = {c.friction!r} in an FE cell, which "
+                             "regularizes friction with the Huber width w under exact enforcement too (the spectral "
+                             "cell's exact friction needs none)")
         if self.discretization.method == "spectral":
             check_spectral(self)
         else:
@@ -217,9 +226,9 @@ class CellScene:
         if self.discretization.method == "fe" and self.contact.enforcement == "exact" and dim == 3 \
                 and self.discretization.order > 1:
             raise SceneError("discretization.order", self.discretization.order,
-                             "1 with contact.enforcement = 'exact' in a 3D FE cell (quadratic triangles leave corner "
-                             "nodes open inside the contact patch); or use the penalty, or discretization.method = "
-                             "'spectral' for a small-slope cell")
+                             "must be 1 with contact.enforcement = 'exact' in a 3D FE cell (quadratic triangles leave "
+                             "corner nodes open inside the contact patch); or use the penalty, or "
+                             "discretization.method = 'spectral' for a small-slope cell")
         if self.discretization.method == "fe" and self.solver.start == "spectral" and not has_twin(self):
             raise SceneError("solver.start", "spectral", "starts from the spectral cell of the same small-slope cell: "
                              "it needs contact.enforcement = 'penalty' and a flat interface (geometry.profile = "
@@ -373,8 +382,10 @@ def check_spectral(scene: CellScene) -> None:
                          f"{g.profile!r} in the {g.arrangement!r} arrangement; use method = 'fe'")
     if d.tolerance is not None and PROFILES[g.profile].own_grid:
         raise SceneError("discretization.tolerance", d.tolerance, "refines the grid of a gap given by a formula; "
-                         f"a {g.profile!r} profile's heights exist on their own grid only: remove the key and "
-                         "set discretization.grid")
+                         f"a {g.profile!r} profile's heights are samples, which a finer grid interpolates bilinearly, "
+                         "so refining cannot estimate an error beyond them: remove the key and choose "
+                         "discretization.grid (default: the map's own grid; a finer one resolves contact patches "
+                         "between the samples)")
     if d.grid is not None and d.grid % 2:
         raise SceneError("discretization.grid", d.grid, "must be even (the FFT's Nyquist mode is real)")
     n = spectral_grid(scene)           # a height map's own grid: checked when the map is read (check_files)

@@ -25,10 +25,10 @@ from __future__ import annotations
 
 import json
 import math
-import os
 
 from ngcontact.errors import SceneError
 from ngcontact.laws import homogenized as il
+from ngcontact.scene.sections import check_input_file
 
 FORMAT = "ngcontact-interface-law"
 FORMAT_VERSION = 1
@@ -57,12 +57,10 @@ def read(path: str, key: str = "interface.law_file") -> dict:
         Under ``key`` (or ``key: field``) for a missing, unreadable, foreign
         or malformed file, or numbers the laws refuse.
     """
-    if not os.path.isfile(path):
-        raise SceneError(key, path, "no such law file (write one with `ngcontact export SCENE --format json`)")
-    if os.path.getsize(path) > MAX_BYTES:
-        raise SceneError(key, path, f"a law file of at most {MAX_BYTES // 2 ** 20} MiB")
+    check_input_file(key, path, "JSON law file", max_bytes=MAX_BYTES,
+                     missing="no such law file (write one with `ngcontact export SCENE --format json`)")
     try:
-        with open(path, encoding="utf-8") as fh:
+        with open(path, encoding="utf-8-sig") as fh:   # a byte-order mark is skipped, as in scene files
             data = json.load(fh)
     except (OSError, UnicodeDecodeError, ValueError) as exc:
         raise SceneError(key, path, f"a readable JSON law file ({type(exc).__name__}: {exc})") from None

@@ -13,8 +13,8 @@ import os
 
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.scene.kinds import KINDS
-from ngcontact.scene.schema import build
-from ngcontact.scene.sections import resolve
+from ngcontact.scene.schema import MAX_SCENE_BYTES, build
+from ngcontact.scene.sections import check_input_file, resolve
 
 try:  # Python >= 3.11
     import tomllib
@@ -41,22 +41,13 @@ def load(path: str | os.PathLike):
         With the key path, the offending value and what is allowed.
     """
     path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise SceneError("<scene file>", path, "no such file")
+    check_input_file("<scene file>", path, "scene file", missing="no such file", max_bytes=MAX_SCENE_BYTES)
     real = os.path.realpath(path)
     if real in _LOADING:
         chain = " -> ".join(os.path.basename(p) for p in _LOADING[_LOADING.index(real):] + [real])
         raise SceneError("<scene file>", path, f"names itself as a scene to load ({chain}); a cell scene "
                          "must not refer back to the scene that uses it")
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError("<scene file>", path, f"not valid TOML ({exc})") from None
-    except RecursionError:
-        raise SceneError("<scene file>", path, "nests arrays or tables too deeply to be a scene") from None
-    except UnicodeDecodeError:
-        raise SceneError("<scene file>", path, "must be UTF-8 text (TOML)") from None
+    data = _parsed(path)
     _LOADING.append(real)
     try:
         return from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
@@ -80,8 +71,7 @@ def load_with_contact(path: str | os.PathLike, overrides: dict | None = None, me
     base = load(path)   # the file itself must be a valid scene
     if base.kind != "cell":
         return base
-    with open(path, "rb") as fh:
-        data = tomllib.load(fh)
+    data = _parsed(path)
     contact = dict(data.get("contact", {}))
     overrides = overrides or {}
     if "friction" in overrides:
@@ -92,6 +82,24 @@ def load_with_contact(path: str | os.PathLike, overrides: dict | None = None, me
     if method is not None:
         data["discretization"] = {**data.get("discretization", {}), "method": method}
     return from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
+
+
+def _parsed(path: str) -> dict:
+    """The TOML table of the scene file ``path``.
+
+    A UTF-8 byte-order mark at the start is skipped: editors on Windows
+    write one, and TOML (UTF-8 without a mark) would refuse the file at
+    line 1, column 1 without naming the mark.
+    """
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.loads(fh.read().decode("utf-8-sig"))
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError("<scene file>", path, f"not valid TOML ({exc})") from None
+    except RecursionError:
+        raise SceneError("<scene file>", path, "nests arrays or tables too deeply to be a scene") from None
+    except UnicodeDecodeError:
+        raise SceneError("<scene file>", path, "must be UTF-8 text (TOML)") from None
 
 
 def from_dict(data: dict, base_dir: str = "."):

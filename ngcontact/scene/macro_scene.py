@@ -37,7 +37,7 @@ from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, 
                                       check_material_names, check_supports_once)
 from ngcontact.scene import cell_links, mesh_size
 from ngcontact.scene.cell_scene import FRICTION
-from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
+from ngcontact.scene.schema import at_least, distinct, nonempty, nonnegative, open_interval, param, positive
 
 LAWS = ("linear", "bundle", "tabulated", "file")
 
@@ -84,7 +84,7 @@ class InterfaceSpec:
                      "default, also from a cell), tabulated (pressure against closure) or file (a law file of "
                      "`ngcontact export --format json`, see law_file)", choices=LAWS)
     law_file: str | None = param(None, doc="law = file: the JSON law file, relative to this scene (SI units; "
-                                 "cell_length_unit is not applied)")
+                                 "cell_length_unit is not applied); a regular file of at most 64 MiB")
     law_file_form: str = param("bundle", doc="law = file: which of the file's laws: bundle (exact), tabulated "
                                "(its pressure-closure table, tangential stiffness = its stick slope) or linear (K0)",
                                choices=("bundle", "tabulated", "linear"))
@@ -111,7 +111,8 @@ class InterfaceSpec:
         units="m", allowed="pairs with increasing coordinate")
     gap_coordinate: str = param("y", doc="coordinate of gap_table (r = x, z = y in axisymmetry)",
                                 choices=("x", "y", "z", "r"))
-    mu: float = param(0.0, doc="homogenized Coulomb coefficient mu0 (fixed point on the pressure)",
+    mu: float = param(0.0, doc="homogenized Coulomb coefficient mu0: threshold mu0 p, solved as solver.coulomb "
+                      "says (default: Newton on the coupled equations; or the fixed point on the pressure)",
                       check=nonnegative())
     threshold: float = param(0.0, doc="Tresca threshold G0", units="Pa", check=nonnegative())
     huber_width: float = param(1e-6, doc="Huber width w: largest slip of a sticking point", units="m",
@@ -171,7 +172,8 @@ class SupportSpec:
     """Prescribed displacement components on a boundary."""
 
     boundary: str = param(doc="boundary label of the geometry")
-    components: tuple[str, ...] = param((), doc="components fixed (x, y, z; r, z in axisymmetry); empty: all")
+    components: tuple[str, ...] = param((), doc="components fixed (x, y, z; r, z in axisymmetry); empty: all",
+                                        check=distinct())
     displacement: tuple[float, ...] = param((), doc="prescribed values, one per component (default 0)",
                                             units="m")
 
@@ -189,6 +191,9 @@ class LoadSpec:
 class OutputSpec:
     """Sampling of the results."""
 
+    #: removed keys -> what replaces them (:func:`~ngcontact.scene.schema.build` names it)
+    REMOVED = {"coulomb_tol": "solver.coulomb_rtol (the Coulomb fixed point stops when max |p_k - p_k-1| <= "
+                              "coulomb_rtol x max p_k)"}
     points_per_element: int = param(5, doc="samples per interface element in the profile", check=at_least(2))
     vtk_subdivision: int = param(1, doc="subdivision of the VTK output", check=at_least(0))
 
@@ -311,8 +316,7 @@ class MacroScene:
         ``interface.cell = 'hip.toml': invalid cell scene: materials.bone.nu = ...``.
         ``load(path, overrides=None)``: overrides of the law's cells' ``[contact]``.
         """
-        import os
-        from ngcontact.scene.sections import resolve
+        from ngcontact.scene.sections import check_input_file, resolve
         if self.interface.law_file is not None:
             from ngcontact.scene import law_file
             contents = law_file.read(resolve(self, self.interface.law_file))
@@ -327,8 +331,7 @@ class MacroScene:
         for key, rel, solved in files:
             if rel is None:
                 continue
-            if not os.path.isfile(resolve(self, rel)):
-                raise SceneError(key, rel, "no such cell scene file")
+            check_input_file(key, resolve(self, rel), "cell scene", shown=rel, missing="no such cell scene file")
             try:
                 cell = load(resolve(self, rel))
             except SceneError as exc:

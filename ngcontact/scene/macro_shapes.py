@@ -58,7 +58,7 @@ FEMUR_BOUNDARIES = {
     "base": "base of the femur (clamp it)",
 }
 _COAXIAL = {"interface": "r = b between the tubes; carries the law", "bore": "inner surface r = a of the inner "
-            "tube (a > 0: the inner body is a tube)", "mantle": "outer surface r = c of the outer tube"}
+            "tube (a must be > 0: the inner body is always a tube)", "mantle": "outer surface r = c of the outer tube"}
 _QUARTER = {"sym_x": "the cut on the plane x = 0, a symmetry plane: fix x there (components = [\"x\"])",
             "sym_y": "the cut on the plane y = 0, a symmetry plane: fix y there (components = [\"y\"])"}
 _ENDS = {"bottom": "end face z = 0 of both tubes", "top": "end face z = height of both tubes"}

@@ -22,7 +22,7 @@ from ngcontact.errors import MISSING, SceneError
 from ngcontact.scene.sections import (MaterialSpec, SolverSpec, base_dir_field,
                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import MAX_LEVELS, MAX_ORDER, all_of, closed_interval, nonempty, param, positive
+from ngcontact.scene.schema import MAX_LEVELS, MAX_ORDER, all_of, closed_interval, distinct, nonempty, param, positive
 
 SETTINGS = ("plane_strain", "axisymmetric", "3d", "periodic_cell")
 
@@ -36,7 +36,7 @@ class ManufacturedSection:
     body: str = param(doc="material of the body (periodic_cell: of the lower body)")
     second_body: str | None = param(None, doc="material of the upper body (periodic_cell only)")
     orders: tuple[int, ...] = param((1, 2, 3), doc="polynomial orders to run",
-                                    check=all_of(nonempty(), closed_interval(1, MAX_ORDER)))
+                                    check=all_of(nonempty(), closed_interval(1, MAX_ORDER), distinct()))
     maxh: float = param(0.25, doc="mesh size given to the mesher; level k is that mesh refined "
                         "uniformly k times, h = maxh / 2^k", units="m", check=positive())
     levels: int = param(3, doc="number of levels k = 1..levels in the rate fit",

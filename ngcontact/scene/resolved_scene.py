@@ -43,7 +43,8 @@ from ngcontact.scene.macro_shapes import FEMUR_BOUNDARIES, check_dimensions, che
 from ngcontact.scene.sections import (ComputeSpec, MaterialSpec, check_supports_once, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty, param, positive
+from ngcontact.scene.schema import (MAX_ORDER, MAX_PERIODS, at_least, closed_interval, distinct, nonempty, param,
+                                    positive)
 
 #: The shapes (:data:`ngcontact.geometry.resolved_shapes.RESOLVED_SHAPES`: what each one is built and measured
 #: by); this module validates a scene against their settings, keys and boundary labels.
@@ -118,7 +119,7 @@ class DirectSupport:
 
     boundary: str = param(doc="a boundary of the shape",
                           allowed="; ".join(f"{shape}: " + ", ".join(labels) for shape, labels in BOUNDARIES.items()))
-    components: tuple[str, ...] = param((), doc="components fixed (x, y or r, z); empty: all")
+    components: tuple[str, ...] = param((), doc="components fixed (x, y or r, z); empty: all", check=distinct())
     displacement: tuple[float, ...] = param((), doc="value at the boundary's mid-point, one per component "
                                             "(default 0)", units="m")
     slope: tuple[float, ...] = param((), doc="change of each prescribed component per metre along the "
@@ -228,8 +229,10 @@ class DirectScene:
 
     def check_files(self, load) -> None:
         """The named cell scene must be a valid 2D conforming ``cell`` scene this kind can resolve."""
-        from ngcontact.scene.sections import resolve
+        from ngcontact.scene.sections import check_input_file, resolve
         path = resolve(self, self.geometry.cell)
+        check_input_file("geometry.cell", path, "cell scene", shown=self.geometry.cell,
+                         missing="no such cell scene file")
         try:
             cell = load(path)
         except SceneError as exc:
@@ -241,6 +244,10 @@ class DirectScene:
             raise SceneError("geometry.cell", self.geometry.cell,
                              "need a 2D conforming cell with an analytic profile (flat, rectangular, "
                              "triangular, semicircular, sinusoid)")
+        if cell.contact.friction != "none" and cell.contact.w is None:
+            raise SceneError("geometry.cell", self.geometry.cell, "its friction has no contact.w (the spectral cell's "
+                             "exact friction needs none); the resolved problem regularizes friction with the cell's "
+                             "Huber width w: give it one")
         if cell.contact.gap.kind not in ("none", "constant"):
             raise SceneError("geometry.cell", self.geometry.cell,
                              f"gap kind {cell.contact.gap.kind!r} is not resolved; use none or constant")

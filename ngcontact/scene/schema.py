@@ -6,11 +6,13 @@ with :func:`param`.  :func:`build` turns a parsed TOML table into such a
 dataclass and rejects, with a :class:`~ngcontact.errors.SceneError` naming the
 key path, the value and what is allowed,
 
-* unknown keys (the message lists the known ones),
+* unknown keys (the message lists the known ones; a key the section's
+  ``REMOVED`` table lists is named with what replaces it),
 * values of the wrong type (``bool`` is never a number, an ``int`` is accepted
   where a ``float`` is asked for),
 * NaN or infinite numbers anywhere (TOML admits ``nan`` and ``inf``),
-* values outside their range or set of choices.
+* values outside their range or set of choices,
+* strings (and names of tables) longer than :data:`MAX_STRING` characters.
 
 Cross-field rules live in a method ``check(self, path)`` of the dataclass,
 called after construction.  :func:`describe` walks the same metadata to write
@@ -66,6 +68,11 @@ MAX_ORDER = 10
 #: Largest number of resolved periods and of uniform refinement levels (more hung the mesher).
 MAX_PERIODS = 1024
 MAX_LEVELS = 8
+#: Longest string of a scene (a title, a file name, a label): the longest path Linux accepts (PATH_MAX);
+#: a string is copied into the reports, so an unbounded one made them as large as itself.
+MAX_STRING = 4096
+#: Largest scene file (bytes), checked before it is parsed; the shipped scenes are below 6 kB.
+MAX_SCENE_BYTES = 2 ** 20
 
 
 def _named(text: str, fn: Callable[[Any], bool]) -> Check:
@@ -103,6 +110,11 @@ def closed_interval(lo, hi) -> Check:
 
 def nonempty() -> Check:
     return _named("must not be empty", lambda v: len(v) > 0)
+
+
+def distinct() -> Check:
+    """Entries that name something (a component, an order) once each: a repeated one was dropped silently."""
+    return _named("must not repeat an entry", lambda v: len(set(v)) == len(v))
 
 
 def all_of(*checks: Check) -> Check:
@@ -159,6 +171,9 @@ def build(cls, data: Any, path: str = ""):
     unknown = sorted(set(data) - set(fields))
     if unknown:
         key = unknown[0]
+        successor = getattr(cls, "REMOVED", {}).get(key)
+        if successor is not None:
+            raise SceneError(_join(path, key), data[key], f"removed; use {successor}")
         raise SceneError(_join(path, key), data[key],
                          "unknown key; allowed keys here are " + ", ".join(sorted(fields)))
     values = {}
@@ -228,6 +243,8 @@ def _convert(tp, value, key):
     if tp is str:
         if not isinstance(value, str):
             raise SceneError(key, value, "must be a string")
+        if len(value) > MAX_STRING:
+            raise SceneError(key, value, f"must be at most {MAX_STRING} characters")
         return value
     if origin is tuple:
         if not isinstance(value, (list, tuple)):
@@ -240,6 +257,9 @@ def _convert(tp, value, key):
     if origin is dict:
         if not isinstance(value, dict):
             raise SceneError(key, value, "must be a table")
+        for k in value:
+            if len(k) > MAX_STRING:
+                raise SceneError(key, k, f"a name must be at most {MAX_STRING} characters")
         return {k: _convert(args[1], v, _join(key, k)) for k, v in value.items()}
     if dataclasses.is_dataclass(tp):
         return build(tp, value, key)
@@ -270,6 +290,8 @@ def _allowed_text(f, tp) -> str:
         return "one of " + ", ".join(repr(c) for c in meta["choices"])
     check = meta.get("check")
     text = getattr(check, "text", "") if check else ""
+    if _unwrap_optional(tp) is str and not text:
+        text = f"at most {MAX_STRING} characters"
     return f"{_type_name(tp)}" + (f", {text}" if text else "")
 
 

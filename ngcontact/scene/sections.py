@@ -157,6 +157,31 @@ def resolve(scene, relpath: str) -> str:
     return os.path.normpath(os.path.join(getattr(scene, "base_dir", "."), relpath))
 
 
+def check_input_file(key: str, path: str, what: str, *, shown=None, missing: str | None = None,
+                     max_bytes: int | None = None) -> None:
+    """The file ``path`` a scene reads under ``key`` must exist and be a regular file (checked before it is opened).
+
+    A missing file is ``missing`` (default ``no such <what>``); a directory,
+    FIFO or device is named as such (``is a directory; must be a regular
+    file (a <what>)``); a file larger than ``max_bytes`` is refused with its
+    size.  ``shown`` is the value the message quotes (default ``path``),
+    e.g. the path as the scene wrote it.
+    """
+    from ngcontact.geometry.tabulated import file_kind
+    shown = path if shown is None else shown
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise SceneError(key, shown, missing or f"no such {what}") from None
+    except OSError as err:
+        raise SceneError(key, shown, f"must be a readable {what} ({err.strerror})") from None
+    kind = file_kind(st.st_mode)
+    if kind is not None:
+        raise SceneError(key, shown, f"is {kind}; must be a regular file (a {what})")
+    if max_bytes is not None and st.st_size > max_bytes:
+        raise SceneError(key, shown, f"is {st.st_size} bytes; a {what} is limited to {max_bytes // 2 ** 20} MiB")
+
+
 def check_supports_once(supports, comps) -> None:
     """Each component of a boundary is fixed by one ``[[supports]]`` entry only.
 

@@ -413,6 +413,25 @@ def errors(prob: Problem, gfu: ng.GridFunction, bonus_intorder: int = 4) -> tupl
     return math.sqrt(max(l2, 0.0)), math.sqrt(max(h1, 0.0))
 
 
+def exact_norms(prob: Problem, intorder: int = 10) -> tuple[float, float]:
+    """``(L2 norm, H1 seminorm)`` of ``prob.exact`` itself, weighted as in :func:`errors`.
+
+    The scale against which an error is round-off: a discrete solution
+    cannot come closer to ``u*`` than a small multiple of the machine
+    precision times these norms.
+    """
+    mesh, setting = prob.mesh, prob.setting
+    w = elasticity.weight(setting)
+    u = prob.exact
+    du = gradient(u, mesh.dim)
+    grad2 = ng.InnerProduct(du, du)
+    if setting == "axisymmetric":
+        grad2 = grad2 + (u[0] / ng.x) ** 2
+    l2 = ng.Integrate(ng.InnerProduct(u, u) * w, mesh, order=intorder)
+    h1 = ng.Integrate(grad2 * w, mesh, order=intorder)
+    return math.sqrt(max(l2, 0.0)), math.sqrt(max(h1, 0.0))
+
+
 def level_runner(setting: str, laws: dict, maxh: float, *, inverse: str = "sparsecholesky",
                  keep: dict | None = None):
     """A ``level(order, refinements) -> dict`` for :mod:`ngcontact.verification.rates`.

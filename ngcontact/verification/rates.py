@@ -113,6 +113,57 @@ def rates_by_order(rows: Sequence[dict]) -> dict:
     return out
 
 
+#: Fewest levels a rate is fitted over (:func:`fit_rate`).
+MIN_LEVELS = 3
+
+
+def judge(rows: Sequence[dict], floor: dict, tolerance: float) -> dict:
+    """Observed rates over the levels above the round-off ``floor`` and the study's verdict.
+
+    A level whose ``l2`` or ``h1`` error is at or below ``floor[norm]`` is
+    round-off: it carries no rate.  Each order then falls into one class:
+
+    * no level above the floor: the order reproduces the solution to
+      round-off (exact); no rate, and no failure;
+    * one or two levels above it: too few for a rate (:data:`MIN_LEVELS`);
+      the order is neither verified nor failed, and the verdict says so;
+    * three or more: the least-squares rate over them, compared with the
+      expected ``p + 1`` (L2) and ``p`` (H1).
+
+    Returns ``rates`` and ``expected_rates`` (per rated order),
+    ``max_rate_deviation``, ``orders_at_roundoff``, ``orders_without_rate``
+    (order -> number of levels above the floor), ``verified`` (every fitted
+    rate within ``tolerance`` and at least one order rated or exact) and
+    ``verdict``, one sentence naming what was and was not judged.
+    """
+    orders = sorted({r["order"] for r in rows})
+    resolved = [r for r in rows if r["l2"] > floor["l2"] and r["h1"] > floor["h1"]]
+    rates = rates_by_order(resolved)
+    expected = {p: expected_rates(p) for p in rates}
+    levels = {p: sum(r["order"] == p for r in rows) for p in orders}
+    above = {p: sum(r["order"] == p for r in resolved) for p in orders}
+    at_roundoff = [p for p in orders if above[p] == 0]
+    without = {p: above[p] for p in orders if 0 < above[p] < MIN_LEVELS}
+    deviation = max((abs(rates[p][n] - expected[p][n]) for p in rates for n in ("l2", "h1")), default=0.0)
+    judged = bool(rates) or bool(at_roundoff)
+    notes = []
+    if rates:
+        notes.append(f"every fitted rate lies within {tolerance:g} of the expected one" if deviation <= tolerance
+                     else f"observed rates deviate by up to {deviation:.2f} from the expected ones (tolerance "
+                     f"{tolerance:g})")
+    if at_roundoff:
+        notes.append(f"order{'s' if len(at_roundoff) > 1 else ''} {', '.join(map(str, at_roundoff))} "
+                     f"reproduce{'' if len(at_roundoff) > 1 else 's'} the solution to round-off on every level "
+                     "(exact: no rate to fit)")
+    notes += [f"order {p}: {n} of {levels[p]} levels lie above the round-off floor, too few for a rate "
+              f"({MIN_LEVELS} needed): start from a coarser mesh or take more levels" for p, n in without.items()]
+    verdict = "; ".join(notes)
+    return {"rates": rates, "expected_rates": expected, "max_rate_deviation": deviation,
+            "orders_at_roundoff": at_roundoff, "orders_without_rate": without,
+            "verified": judged and deviation <= tolerance,
+            "verdict": verdict if judged else "no order could be judged: " + verdict}
+
+
 def table(rows: Sequence[dict], keys: Sequence[str] = ROW_KEYS) -> tuple[list, list]:
     """``(header, rows as lists)`` for a CSV file."""
     return list(keys), [[r[k] for k in keys] for r in rows]

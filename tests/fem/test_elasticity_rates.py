@@ -142,3 +142,44 @@ def test_an_order_at_round_off_is_exact_not_a_failed_rate(tmp_path):
     assert res["orders_at_roundoff"] == [8] and list(res["rates"]) == ["1"]
     assert res["verified"] and abs(res["rates"]["1"]["l2"] - 2.0) < 0.05
     assert all(r["l2"] < res["roundoff_error_floor"]["l2"] for r in res["rows"] if r["order"] == 8)
+
+
+def test_an_order_alone_at_round_off_is_exact_not_a_failed_rate(tmp_path):
+    """Was: orders = [10] alone (errors of 1e-14 on every level) reported verified: false with a 'rate' of -1.4:
+    the round-off floor was a fraction of the study's largest error, itself round-off."""
+    import json
+    import os
+
+    from ngcontact import cli
+
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    text = open(os.path.join(root, "geometries", "verify_elasticity.toml")).read()
+    scene = tmp_path / "scene.toml"
+    scene.write_text(text.replace("orders = [1, 2, 3]", "orders = [10]"))
+    assert cli.main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    res = json.loads((tmp_path / "out" / "report.json").read_text())["results"]
+    assert res["orders_at_roundoff"] == [10] and res["rates"] == {} and res["orders_without_rate"] == {}
+    assert res["verified"] is True and "round-off" in res["verdict"]
+    assert all(r["l2"] < res["roundoff_error_floor"]["l2"] for r in res["rows"])
+
+
+def _rows(order, l2, h1):
+    return [{"order": order, "level": k + 1, "h": 0.25 / 2 ** (k + 1), "l2": a, "h1": b}
+            for k, (a, b) in enumerate(zip(l2, h1))]
+
+
+def test_an_order_with_too_few_levels_above_round_off_says_so_instead_of_not_verified():
+    """An order whose finest level sits at round-off keeps two levels: too few for a rate.  That is said
+    (orders_without_rate, the verdict), it is no failed rate; with nothing else to judge the study is not
+    verified, and the verdict says why."""
+    h = np.array([0.125, 0.0625, 0.03125])
+    rows = (_rows(1, h ** 2, h) + _rows(5, [1e-9, 1e-11, 1e-13], [1e-7, 1e-9, 1e-13])
+            + _rows(10, [2e-14, 3e-14, 4e-14], [2e-13, 3e-13, 4e-13]))
+    floor = {"l2": 1e-12, "h1": 1e-12}
+    out = studies.judge(rows, floor, tolerance=0.25)
+    assert list(out["rates"]) == [1] and out["orders_at_roundoff"] == [10] and out["orders_without_rate"] == {5: 2}
+    assert out["verified"] is True
+    assert "order 5: 2 of 3 levels lie above the round-off floor, too few for a rate (3 needed)" in out["verdict"]
+    alone = studies.judge(_rows(5, [1e-9, 1e-11, 1e-13], [1e-7, 1e-9, 1e-13]), floor, tolerance=0.25)
+    assert alone["verified"] is False and alone["rates"] == {}
+    assert alone["verdict"].startswith("no order could be judged: order 5: 2 of 3 levels")

@@ -234,3 +234,18 @@ def test_a_mesh_size_as_large_as_the_period_still_gives_a_solvable_cell(dim):
     P = CellProblem(cell, CellModel(rough=law, counter=law, k_n=1e3, order=1))
     sol = P.solve(cell_load(dim, pressure=0.01), first=True)
     assert sol.results["mean_pressure"] == pytest.approx(0.01, rel=1e-9)
+
+
+def test_a_byte_order_mark_is_not_a_header(tmp_path):
+    """Was: a CSV saved with a UTF-8 BOM and no header lost its first row (the BOM made it 'not numeric')."""
+    from ngcontact.geometry.tabulated import read_gap_csv
+    for name, reader in (("p.csv", read_profile_csv), ("g.csv", read_gap_csv)):
+        f = tmp_path / name
+        f.write_bytes(b"\xef\xbb\xbf0,0.1\n0.5,0\n1,0.1\n")
+        points = reader(f)
+        x = [p.start[0] for p in points.pieces] if name == "p.csv" else list(points[0])
+        assert x[:2] == [0.0, 0.5], name
+        f.write_bytes(b"\xef\xbb\xbfx,y\n0,0.1\n0.5,0\n1,0.1\n")   # a header after the BOM is still a header
+        points = reader(f)
+        x = [p.start[0] for p in points.pieces] if name == "p.csv" else list(points[0])
+        assert x[:2] == [0.0, 0.5], name

@@ -481,15 +481,15 @@ def test_a_fifo_as_profile_file_is_refused_without_reading_it(tmp_path, capsys):
     work = tmp_path / "work"
     work.mkdir()
     os.mkfifo(work / "p.csv")
-    run_bad(tmp_path, capsys, TAB, f"geometry.file (p.csv) = '{work / 'p.csv'}': must be a regular file "
-            "(not a directory, FIFO or device)")
+    run_bad(tmp_path, capsys, TAB, f"geometry.file (p.csv) = '{work / 'p.csv'}': is a FIFO; must be a regular file "
+            "(a CSV file)")
 
 
 @pytest.mark.parametrize("device", ["/dev/zero", "/dev/urandom"])
 def test_a_device_as_height_map_is_refused_without_reading_it(tmp_path, capsys, device):
     """Was: /dev/zero or /dev/urandom as a data file was read until memory ran out."""
     run_bad(tmp_path, capsys, HMAP.replace('file = "h.npy"', f'file = "{device}"'),
-            f"geometry.file ({device}) = '{device}': must be a regular file (not a directory, FIFO or device)")
+            f"geometry.file ({device}) = '{device}': is a character device; must be a regular file (a .npy array)")
 
 
 def test_a_profile_of_a_hundred_thousand_rows_is_refused_before_meshing(tmp_path, capsys):
@@ -820,3 +820,155 @@ def test_a_spectral_start_with_exact_enforcement(tmp_path, capsys):
     text = edit(CELL.format(contact='enforcement = "exact"'), ("rtol = 1e-10", 'rtol = 1e-10\nstart = "spectral"'))
     run_bad(tmp_path, capsys, text, "solver.start = 'spectral': starts from the spectral cell of the same "
             "small-slope cell: it needs contact.enforcement = 'penalty'", prefix=True)
+
+
+# ------------------------------------------------------------- round three: inputs and messages
+
+
+def test_a_scene_with_a_utf8_byte_order_mark_is_read(tmp_path, capsys):
+    """Was: 'not valid TOML (line 1, column 1)' for a scene saved by an editor that writes a BOM."""
+    scene = tmp_path / "scene.toml"
+    scene.write_bytes(b"\xef\xbb\xbf" + CELL.format(contact="").encode())
+    assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+
+
+def test_a_profile_csv_with_a_byte_order_mark_and_no_header_keeps_its_first_row(tmp_path, capsys):
+    """Was: the BOM made the first row 'not numeric', so it was skipped as a header: the profile then
+    started at x = 0.5 and was refused."""
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "p.csv").write_bytes(b"\xef\xbb\xbf0,0\n0.5,-0.1\n1.0,0\n")
+    scene = work / "scene.toml"
+    scene.write_text(TAB)
+    assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+
+
+def test_a_scene_path_that_is_a_directory_or_a_device_says_what_it_is(tmp_path, capsys):
+    """Was: 'no such file' for a directory and for /dev/null."""
+    folder = tmp_path / "scene.toml"
+    folder.mkdir()
+    for path, kind in ((str(folder), "a directory"), ("/dev/null", "a character device")):
+        assert cli.main(["check", path]) == 2
+        assert capsys.readouterr().err == (f"ngcontact: error: {path}: <scene file> = '{path}': is {kind}; "
+                                           "must be a regular file (a scene file)\n")
+
+
+def test_a_cell_link_that_is_a_directory_says_what_it_is(tmp_path, capsys):
+    """Was: 'no such cell scene file' for a directory."""
+    (tmp_path / "work").mkdir()
+    (tmp_path / "work" / "cells").mkdir()
+    text = edit(MACRO, ('law = "linear"\nkn = 1e12\nkt = 1e11', 'cell = "cells"'))
+    run_bad(tmp_path, capsys, text, "interface.cell = 'cells': is a directory; must be a regular file (a cell scene)")
+
+
+def test_a_law_file_that_is_a_directory_says_what_it_is(tmp_path, capsys):
+    """Was: 'no such law file' for a directory."""
+    (tmp_path / "work").mkdir()
+    (tmp_path / "work" / "law.json").mkdir()
+    text = edit(MACRO, ('law = "linear"\nkn = 1e12\nkt = 1e11', 'law = "file"\nlaw_file = "law.json"'))
+    run_bad(tmp_path, capsys, text, f"interface.law_file = '{tmp_path / 'work' / 'law.json'}': is a directory; "
+            "must be a regular file (a JSON law file)")
+
+
+def test_a_data_file_that_is_a_directory_says_what_it_is(tmp_path, capsys):
+    (tmp_path / "work").mkdir()
+    (tmp_path / "work" / "p.csv").mkdir()
+    run_bad(tmp_path, capsys, TAB, f"geometry.file (p.csv) = '{tmp_path / 'work' / 'p.csv'}': is a directory; "
+            "must be a regular file (a CSV file)")
+
+
+def test_a_title_beyond_the_string_limit_is_refused_and_not_echoed(tmp_path, capsys):
+    """Was: a 50 MB title was accepted and copied into a 100 MB report.json."""
+    from ngcontact.scene.schema import MAX_STRING
+    title = "x" * (MAX_STRING + 1)
+    run_bad(tmp_path, capsys, edit(CELL.format(contact=""), ('kind = "cell"', f'kind = "cell"\ntitle = "{title}"')),
+            f"title = 'xxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxxx...' ({MAX_STRING + 1} characters): must be at most "
+            f"{MAX_STRING} characters")
+
+
+def test_a_scene_file_beyond_the_size_limit_is_refused_before_parsing(tmp_path, capsys):
+    from ngcontact.scene.schema import MAX_SCENE_BYTES
+    text = CELL.format(contact="") + "# padding\n" * (MAX_SCENE_BYTES // 10 + 1)
+    scene = tmp_path / "work" / "scene.toml"
+    size = len(text.encode())
+    run_bad(tmp_path, capsys, text, f"<scene file> = '{scene}': is {size} bytes; a scene file is limited to "
+            f"{MAX_SCENE_BYTES // 2 ** 20} MiB")
+
+
+def test_a_component_given_twice_is_refused(tmp_path, capsys):
+    """Was: components = ["x", "x", "y"] was accepted and one x value dropped."""
+    text = edit(MACRO, ('[[supports]]\nboundary = "bottom"\n',
+                        '[[supports]]\nboundary = "bottom"\ncomponents = ["x", "x", "y"]\n'
+                        'displacement = [0.0, 1e-6, 0.0]\n'))
+    run_bad(tmp_path, capsys, text, "supports[0].components = ['x', 'x', 'y']: must not repeat an entry")
+
+
+def test_the_bore_label_states_the_rule_the_dimensions_enforce(tmp_path, capsys):
+    """Was: 'a > 0: the inner body is a tube', as if a = 0 (a solid rod) were allowed; it is refused."""
+    from ngcontact.scene.macro_shapes import BOUNDARY_DOCS
+    for setting in ("plane_strain", "axisymmetric", "3d"):
+        assert "a must be > 0" in BOUNDARY_DOCS["coaxial", setting]["bore"]
+    run_bad(tmp_path, capsys, edit(COAXIAL, ("a = 0.01", "a = 0.0")),
+            "geometry.dimensions.a = 0.0: must be > 0", prefix=True)
+
+
+def test_a_mesher_failure_of_a_plain_cell_names_the_size_ratio(tmp_path, capsys):
+    """Was: 'a feature is too small or too thin' for a rectangular cell of height 1 at interface_maxh 0.002,
+    whose features are 0.3 and 0.4 long: Netgen's 2D mesher fails on size ratios near 100."""
+    text = open(os.path.join(CELLS, "ex27_rectangular.toml")).read()
+    run_bad(tmp_path, capsys, edit(text, ("interface_maxh = 0.05", "interface_maxh = 0.002")),
+            "inadmissible model input: discretization.interface_maxh = 0.002: Netgen's mesher failed (meshing "
+            "failed) on the cell meshed at maxh = 0.2 with the interface at 0.002: sizes 100 times apart, which its "
+            "grading does not bridge reliably (failures seen from about 90); keep maxh / interface_maxh below 50: "
+            "raise discretization.interface_maxh or lower discretization.maxh", commands=("run",))
+
+
+def test_the_macro_friction_coefficient_documents_the_default_coupled_newton():
+    """Was: interface.mu read 'fixed point on the pressure' while solver.coulomb defaults to the coupled Newton."""
+    import dataclasses
+    from ngcontact.scene.macro_scene import InterfaceSpec
+    from ngcontact.scene.sections import SolverSpec
+    doc = next(f for f in dataclasses.fields(InterfaceSpec) if f.name == "mu").metadata["doc"]
+    assert SolverSpec().coulomb == "newton" and "solver.coulomb" in doc and "Newton" in doc
+
+
+def test_the_order_of_an_exact_3d_fe_cell_says_what_it_must_be(tmp_path, capsys):
+    text = edit(CELL.format(contact='enforcement = "exact"'), ('profile = "flat"', 'profile = "flat3d"'),
+                ("order = 1", "order = 2"))
+    run_bad(tmp_path, capsys, text, "discretization.order = 2: must be 1 with contact.enforcement = 'exact' in a "
+            "3D FE cell", prefix=True)
+
+
+def test_a_removed_key_names_its_successor(tmp_path, capsys):
+    """Was: output.coulomb_tol (removed) gave 'unknown key' with no pointer to solver.coulomb_rtol."""
+    run_bad(tmp_path, capsys, MACRO + "\n[output]\ncoulomb_tol = 1e-6\n",
+            "output.coulomb_tol = 1e-06: removed; use solver.coulomb_rtol (the Coulomb fixed point stops when "
+            "max |p_k - p_k-1| <= coulomb_rtol x max p_k)")
+
+
+def test_a_height_map_tolerance_message_says_what_finer_grids_do(tmp_path, capsys):
+    """Was: 'heights exist on their own grid only', while finer grids are accepted (and interpolate them)."""
+    text = edit(HMAP, ("maxh = 0.5", 'method = "spectral"\ntolerance = 1e-3\nmaxh = 0.5'))
+    run_bad(tmp_path, capsys, text,
+            "discretization.tolerance = 0.001: refines the grid of a gap given by a formula; a 'height_map' "
+            "profile's heights are samples, which a finer grid interpolates bilinearly, so refining cannot estimate "
+            "an error beyond them: remove the key and choose discretization.grid (default: the map's own grid; a "
+            "finer one resolves contact patches between the samples)", files={"h.npy": np.zeros((5, 5))})
+
+
+def test_exact_coulomb_friction_of_the_spectral_cell_needs_no_huber_width(tmp_path, capsys):
+    """Was: 'contact.w = <missing>: required for friction = 'coulomb'' with exact friction, which has no width."""
+    text = edit(CELL.format(contact='enforcement = "exact"\nfriction = "coulomb"\nmu = 0.3\n'
+                            'gap = { kind = "sinusoid", h = 0.01 }'),
+                ("order = 1", 'method = "spectral"\ngrid = 64\norder = 1'))
+    scene = tmp_path / "spectral.toml"
+    scene.write_text(text)
+    assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
+    assert cli.main(["run", str(scene), "--out", str(tmp_path / "spectral"), "--quiet"]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+    # the FE cell regularizes friction with w under exact enforcement too: there it stays required
+    run_bad(tmp_path, capsys, text.replace('method = "spectral"\ngrid = 64\n', ""),
+            "contact.w = <missing>: required for friction = 'coulomb' in an FE cell, which regularizes friction "
+            "with the Huber width w under exact enforcement too (the spectral cell's exact friction needs none)")
