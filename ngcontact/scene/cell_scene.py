@@ -380,12 +380,6 @@ def check_spectral(scene: CellScene) -> None:
                          "the roughness in the initial gap (geometry.profile = 'flat' or 'flat3d', or 'bisinusoid', "
                          "'height_map' or 'self_affine' with arrangement = 'summit'), not geometry.profile = "
                          f"{g.profile!r} in the {g.arrangement!r} arrangement; use method = 'fe'")
-    if d.tolerance is not None and PROFILES[g.profile].own_grid:
-        raise SceneError("discretization.tolerance", d.tolerance, "refines the grid of a gap given by a formula; "
-                         f"a {g.profile!r} profile's heights are samples, which a finer grid interpolates bilinearly, "
-                         "so refining cannot estimate an error beyond them: remove the key and choose "
-                         "discretization.grid (default: the map's own grid; a finer one resolves contact patches "
-                         "between the samples)")
     if d.grid is not None and d.grid % 2:
         raise SceneError("discretization.grid", d.grid, "must be even (the FFT's Nyquist mode is real)")
     n = spectral_grid(scene)           # a height map's own grid: checked when the map is read (check_files)

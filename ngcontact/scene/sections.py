@@ -70,7 +70,8 @@ class CellDiscretization(Discretization):
         None, doc="refine until the estimated error of the contact fraction (absolute) and of the mean closure "
         "(relative) is at most this: method 'fe' grades the interface mesh towards the contact edges (2D cells "
         "with a flat interface), method 'spectral' multiplies the grid's points by 4 from discretization.grid "
-        "(gaps given by a formula); the report gives the estimate per load and the mesh or grid history; "
+        "(a height map's or random surface's samples are interpolated bilinearly, the surface the FE cell "
+        "meshes too); the report gives the estimate per load and the mesh or grid history; "
         "default: the fixed mesh or grid",
         check=open_interval(0, 1))
     method: str = param("fe", doc="fe: finite elements on a mesh of the cell; spectral: the small-slope cell "

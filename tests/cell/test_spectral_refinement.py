@@ -87,14 +87,25 @@ def test_a_spectral_scene_with_a_tolerance_reports_the_estimate_and_the_grids(tm
     assert load["contact_fraction"] == pytest.approx(exact, abs=1e-5)
 
 
-def test_a_self_affine_map_takes_no_tolerance(tmp_path, capsys):
+def test_a_sampled_map_is_refined_as_its_bilinear_interpolant(tmp_path):
+    """A self-affine map's heights are samples; the surface the cell solves is their bilinear interpolant (as the
+    FE cell meshes it), so a tolerance refines the grid beyond the samples and converges to that surface's
+    contact.  The refined answer is the direct solve on the final grid."""
     from pathlib import Path
     text = (Path(__file__).parents[2] / "geometries" / "cells" / "self_affine_spectral.toml").read_text()
-    path = tmp_path / "s.toml"
-    path.write_text(text + "tolerance = 1e-4\n")
-    assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 2
-    assert "discretization.tolerance = 0.0001: refines the grid of a gap given by a formula" in capsys.readouterr().err
-    assert not (tmp_path / "o").exists()
+    text = text.split("[discretization]")[0]
+    own = tmp_path / "own.toml"
+    own.write_text(text + "[discretization]\nmethod = \"spectral\"\ngrid = 64\ntolerance = 0.05\n")
+    assert cli.main(["run", str(own), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    rep = json.loads((tmp_path / "o" / "report.json").read_text())["results"]
+    grids = [level["grid"] for level in rep["method"]["refinement"]]
+    assert grids[0] == 64 and rep["method"]["grid"] == grids[-1] > 64
+    assert all(max(load["error_estimate"].values()) <= 0.05 for load in rep["loads"])
+    direct = tmp_path / "direct.toml"
+    direct.write_text(text + f"[discretization]\nmethod = \"spectral\"\ngrid = {grids[-1]}\n")
+    assert cli.main(["run", str(direct), "--out", str(tmp_path / "d"), "--quiet"]) == 0
+    again = json.loads((tmp_path / "d" / "report.json").read_text())["results"]
+    assert [load["contact_fraction"] for load in again["loads"]] == [load["contact_fraction"] for load in rep["loads"]]
 
 
 @pytest.mark.slow

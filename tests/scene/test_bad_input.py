@@ -948,16 +948,6 @@ def test_a_removed_key_names_its_successor(tmp_path, capsys):
             "max |p_k - p_k-1| <= coulomb_rtol x max p_k)")
 
 
-def test_a_height_map_tolerance_message_says_what_finer_grids_do(tmp_path, capsys):
-    """Was: 'heights exist on their own grid only', while finer grids are accepted (and interpolate them)."""
-    text = edit(HMAP, ("maxh = 0.5", 'method = "spectral"\ntolerance = 1e-3\nmaxh = 0.5'))
-    run_bad(tmp_path, capsys, text,
-            "discretization.tolerance = 0.001: refines the grid of a gap given by a formula; a 'height_map' "
-            "profile's heights are samples, which a finer grid interpolates bilinearly, so refining cannot estimate "
-            "an error beyond them: remove the key and choose discretization.grid (default: the map's own grid; a "
-            "finer one resolves contact patches between the samples)", files={"h.npy": np.zeros((5, 5))})
-
-
 def test_exact_coulomb_friction_of_the_spectral_cell_needs_no_huber_width(tmp_path, capsys):
     """Was: 'contact.w = <missing>: required for friction = 'coulomb'' with exact friction, which has no width."""
     text = edit(CELL.format(contact='enforcement = "exact"\nfriction = "coulomb"\nmu = 0.3\n'
