@@ -14,7 +14,7 @@ Each :class:`ProfileKind` says what the scene layer validates and what
   model in the summit arrangement (a flat interface whose initial gap is
   the height below the highest summit);
 * of a free-form surface, whether its gap has a formula (the bisinusoid) or
-  its heights exist on their own grid only (a file, a drawn random surface,
+  its heights are samples on a grid of their own (a file, a drawn random surface,
   which the spectral cell samples on that grid), and whether it is drawn
   from a spectrum with a seed (realizations of an ensemble).
 
@@ -78,7 +78,7 @@ class ProfileKind:
 
     @property
     def own_grid(self) -> bool:
-        """A free-form surface whose heights exist on their own grid only (no formula for its gap)."""
+        """A free-form surface whose heights are samples on a grid of their own (no formula for its gap)."""
         return self.free_form and self.gap is None
 
 
