@@ -12,8 +12,9 @@ problem of paper eqs. 49-51 demands of any solution:
 and, once per cell, what the model and its discretization assume:
 
 * **small slope**: a cell whose roughness is carried by the gap of a flat interface (the small-slope model,
-  both methods) neglects terms of relative order ``slope^2``: its rms slope is held to
-  ``sqrt(tolerance)`` (:func:`gap_slopes`);
+  both methods) neglects terms of relative order ``slope^2`` against the rough surface it stands for: its
+  rms slope is held to ``sqrt(DEFAULT_TOLERANCE) = 0.1`` (:func:`gap_slopes`).  This bounds the model, not
+  its discretization, so a scene's ``discretization.tolerance`` does not tighten it;
 * **interface resolution**: an FE cell whose gap comes from a height map sees the map through its
   interface elements; an element larger than the map's spacing smooths it away
   (``interface_resolution = h / spacing <= 1``).
@@ -39,7 +40,7 @@ PLAINLY_WRONG = 1.0
 CHECKS = {"pressure_balance": "the accurately integrated interface force against the far-face traction "
                               "(relative)",
           "rms_slope": "the rms slope of the gap's roughness; the small-slope model neglects terms of order "
-                       "slope^2 (limit: sqrt(tolerance))",
+                       "slope^2 (limit: sqrt(0.01))",
           "interface_resolution": "the interface element size over the height map's spacing (limit 1: the "
                                   "map is resolved)"}
 
@@ -85,19 +86,49 @@ def gap_slopes(gap: np.ndarray, period: float) -> tuple[float, float]:
     return float(np.sqrt(np.mean(slope ** 2))), float(slope.max())
 
 
-def cell_checks(facts: dict[str, float], tolerance: float | None) -> list[Check]:
+def cell_checks(facts: dict[str, float]) -> list[Check]:
     """The checks of the cell itself from its ``facts`` (``rms_slope``, ``interface_resolution``)."""
-    tol = DEFAULT_TOLERANCE if tolerance is None else tolerance
-    limits = {"rms_slope": float(np.sqrt(tol)), "interface_resolution": 1.0}
+    limits = {"rms_slope": float(np.sqrt(DEFAULT_TOLERANCE)), "interface_resolution": 1.0}
     return [Check(None, name, float(facts[name]), limits[name]) for name in limits if name in facts]
 
 
-def verdict(loads: list[dict[str, Any]], tolerance: float | None,
-            cell: Sequence[Check] = ()) -> tuple[dict[str, Any], list[Check]]:
-    """The report's verdict on a sweep's results (``{"tolerance", "met", "checks"}``) and its failed checks;
-    ``cell``: the checks of the cell itself (:func:`cell_checks`)."""
+#: the quantities whose discretization error a refinement estimates, and how the estimate measures it
+ESTIMATED = {"contact_fraction": "absolute", "mean_closure": "relative"}
+
+
+def quantities(loads: list[dict[str, Any]], estimates: Sequence[dict[str, float]], tolerance: float
+               ) -> list[dict[str, Any]]:
+    """Per load and estimated quantity: its value, the estimated error (absolute and relative) and whether it
+    meets ``tolerance`` in the measure the refinement controls (:data:`ESTIMATED`)."""
+    out = []
+    for k, (results, estimate) in enumerate(zip(loads, estimates)):
+        for name, measure in ESTIMATED.items():
+            if name not in estimate:
+                continue
+            value, e = float(results[name]), float(estimate[name])
+            absolute = e if measure == "absolute" else e * abs(value)
+            relative = e if measure == "relative" else (e / abs(value) if value != 0 else None)
+            out.append({"load": k, "name": name, "value": value, "error": absolute, "relative_error": relative,
+                        "controlled": measure, "met": e <= tolerance})
+    return out
+
+
+def verdict(loads: list[dict[str, Any]], tolerance: float | None, cell: Sequence[Check] = (),
+            estimates: Sequence[dict[str, float]] | None = None, how: str = ""
+            ) -> tuple[dict[str, Any], list[Check]]:
+    """The report's verdict on a sweep's results and its failed checks.
+
+    ``{"tolerance", "tolerance_from", "met", "checks", "estimated", "quantities", "how"}``: ``cell`` are the
+    checks of the cell itself (:func:`cell_checks`); ``estimates`` the refinement's per load (``None``: the
+    discretization was not refined, and its error is not estimated), made as ``how`` says.
+    """
     limit = DEFAULT_TOLERANCE if tolerance is None else tolerance
     checks = list(cell) + [c for k, results in enumerate(loads) for c in load_checks(k, results, limit)]
     failed = [c for c in checks if not c.ok]
-    return {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
-            "met": not failed, "checks": [c.as_dict() for c in checks]}, failed
+    estimated = quantities(loads, estimates, limit) if estimates is not None else []
+    out = {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
+           "met": not failed and all(q["met"] for q in estimated), "checks": [c.as_dict() for c in checks],
+           "estimated": estimates is not None, "quantities": estimated,
+           "how": how if estimates is not None else "not estimated: set discretization.tolerance to refine the "
+                                                      "discretization and estimate its error"}
+    return out, failed

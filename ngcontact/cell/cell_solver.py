@@ -63,6 +63,8 @@ class Refinement:
     method: dict[str, Any] = field(default_factory=dict)
     #: the histories of every level's solve per load (the report's ``solver.per_load``), where kept
     histories: list[Any] = field(default_factory=list)
+    #: how the estimates were made, in words for the report
+    how: str = ""
 
 
 class CellSolver(Protocol):

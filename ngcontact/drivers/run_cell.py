@@ -57,10 +57,15 @@ def surface_plots(sols, dim: int, period: float) -> dict:
     return plots
 
 
-def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[str, float]) -> dict:
-    """The sweep's verdict (:mod:`ngcontact.cell.admissibility`) with the cell's own ``facts``: each failed
-    check is one warning line; a plainly wrong answer is no answer (exit 3)."""
-    verdict, failed = admissibility.verdict(per_load, tolerance, admissibility.cell_checks(facts, tolerance))
+def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[str, float],
+                     refinement: Refinement | None = None) -> dict:
+    """The sweep's verdict (:mod:`ngcontact.cell.admissibility`) with the cell's own ``facts`` and the
+    refinement's estimates: each failed check is one warning line; a plainly wrong answer is no answer
+    (exit 3)."""
+    verdict, failed = admissibility.verdict(
+        per_load, tolerance, admissibility.cell_checks(facts),
+        estimates=None if refinement is None else refinement.estimates,
+        how="" if refinement is None else refinement.how)
     wrong = [c for c in failed if c.plainly_wrong]
     if wrong:
         raise ConvergenceError(
@@ -75,7 +80,7 @@ def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[
 
 def warn_before_solving(facts: dict[str, float], tolerance: float | None) -> None:
     """What is known before the solve: a cell that cannot meet its accuracy says so at once."""
-    for c in admissibility.cell_checks(facts, tolerance):
+    for c in admissibility.cell_checks(facts):
         if not c.ok:
             hint = ("; use discretization.method = 'spectral', which solves on the map's own points, or a finer "
                     "discretization.interface_maxh" if c.name == "interface_resolution" else "")
@@ -123,7 +128,7 @@ def run(scene, clock) -> Outcome:
             arrays[f"{name}_load{k}"] = values
         log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
     results["loads"] = per_load
-    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts)
+    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement)
     vtk = {}
     displaced = cell.displacements()
     if displaced is not None:

@@ -137,3 +137,16 @@ def test_an_fe_mesh_coarser_than_its_height_map_says_so_before_solving(tmp_path,
     lines = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
     said = [m for m in lines if "known before solving: the cell: interface_resolution" in m]
     assert len(said) == 1 and "discretization.method = 'spectral'" in said[0]
+
+
+def test_the_estimated_quantities_of_a_refinement():
+    from ngcontact.cell.admissibility import quantities
+    loads = [{"contact_fraction": 0.2, "mean_closure": -0.5}]
+    got = {q["name"]: q for q in quantities(loads, [{"contact_fraction": 0.004, "mean_closure": 0.02}], 0.01)}
+    assert got["contact_fraction"]["error"] == 0.004 and got["contact_fraction"]["relative_error"] == 0.02
+    assert got["contact_fraction"]["met"] and not got["mean_closure"]["met"]
+    assert got["mean_closure"]["error"] == 0.01 and got["mean_closure"]["relative_error"] == 0.02
+    v, failed = verdict(loads, 0.01, estimates=[{"contact_fraction": 0.004, "mean_closure": 0.02}], how="x")
+    assert not v["met"] and not failed and v["estimated"] and v["how"] == "x"      # no check failed: an estimate
+    v, _ = verdict(loads, None)
+    assert not v["estimated"] and v["quantities"] == [] and "not estimated" in v["how"]

@@ -123,7 +123,9 @@ class FECell:
                                      # the Newton steps of every level the load was solved on
                                      "newton_iterations": sum(h["newton_iterations"] for h in g.history)}
                                     for g in out],
-                          histories=[g.newton for g in out])
+                          histories=[g.newton for g in out],
+                          how="each load on meshes graded towards its contact edges, then one order more: the larger "
+                              "of the last grading change and the order's change")
 
     def response(self, pressure: float, length_unit: float = 1.0) -> Response:
         """The response at ``pressure`` (module docstring), from a first load's start."""
