@@ -78,7 +78,7 @@ def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[
     return verdict
 
 
-def warn_before_solving(facts: dict[str, float], tolerance: float | None) -> None:
+def warn_before_solving(facts: dict[str, float]) -> None:
     """What is known before the solve: a cell that cannot meet its accuracy says so at once."""
     for c in admissibility.cell_checks(facts):
         if not c.ok:
@@ -92,7 +92,7 @@ def run(scene, clock) -> Outcome:
     with clock.stage("setup"):
         cell = cell_solver(scene)
         facts = cell_facts(scene)
-    warn_before_solving(facts, scene.discretization.tolerance)
+    warn_before_solving(facts)
     with clock.stage("whole-surface coefficients"):
         results: dict[str, Any] = {"whole_surface": cell.whole_surface()}
     method = cell.method_record()
