@@ -275,6 +275,25 @@ def cell_facts(scene: CellScene) -> dict[str, float]:
 CELL_METHODS: dict[str, Callable[[CellScene], CellSolver]] = {"fe": fe_cell, "spectral": spectral_cell_solver}
 
 
+def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = None,
+                    method: str | None = None) -> tuple[CellScene, CellProblem]:
+    """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene) -> the FE
+    :class:`CellProblem` with the macro strain term, for what only the FE cell gives: the micro stresses of
+    the strength recovery (paper eqs. 74-78) and the shear response; the scene's ``[solver]`` settings and its
+    first loads' start (:func:`cell_problem`)."""
+    cs = load_with_contact(cell_path, overrides, method)
+    if cs.kind != "cell":
+        raise SceneError(key, cell_path, f"names a {cs.kind!r} scene; a 'cell' scene is needed")
+    if cs.contact.geometric_only:
+        raise SceneError(key, cell_path, "the cell scene has contact.geometric_only = true; the recovery "
+                         "solves the cell, so it needs a contact model and a [load] section")
+    if CELL_METHODS[cs.discretization.method] is not fe_cell:
+        raise SceneError(key, cell_path, f"the cell scene is solved by discretization.method = "
+                         f"{cs.discretization.method!r}; the strength recovery needs the body stresses and the macro "
+                         "strain term of the FE cell: use a cell scene with method = 'fe'")
+    return cs, cell_problem(cs, model=replace(model_of(cs), macro_strain=True))
+
+
 #: the FE cell problem's start of first loads for each ``solver.start`` of a scene (``None``: its default)
 FE_START = {"auto": None, "spectral": "predictor", "rigid": "rigid", "closed": "closed"}
 

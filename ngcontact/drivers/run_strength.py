@@ -19,7 +19,6 @@ e_22, e_12`` in the law's frame, :mod:`ngcontact.coupling.interface_state`).
 """
 from __future__ import annotations
 
-import dataclasses
 import logging
 from collections.abc import Callable
 from typing import Any, TypedDict
@@ -27,15 +26,13 @@ from typing import Any, TypedDict
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.coupling import strength as S
 from ngcontact.coupling.interface_state import cell_loads, interface_states
+from ngcontact.drivers.build import recovery_cell_problem
 from ngcontact.errors import ModelError, SceneError
 from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.output import plots as figures
 from ngcontact.output.report import VtkField
-from ngcontact.scene.cell_scene import CellScene
-from ngcontact.scene.loader import load_with_contact
 from ngcontact.scene.macro_scene import MacroScene
 from ngcontact.scene.sections import resolve
 
@@ -51,25 +48,6 @@ class StrengthEvaluation(TypedDict):
     plots: dict[str, Callable[..., None]]  # name -> plot, called as plot(path)
 
 
-def cell_problem_of(cell_path: str, *, key: str, overrides: dict | None = None,
-                    method: str | None = None) -> tuple[CellScene, CellProblem]:
-    """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene) -> :class:`CellProblem`
-    with the macro strain term (for recovery), the scene's ``[solver]`` settings and its first loads' start
-    (:func:`ngcontact.drivers.build.cell_problem`)."""
-    from ngcontact.drivers.build import cell_problem, model_of
-    cs = load_with_contact(cell_path, overrides, method)
-    if cs.kind != "cell":
-        raise SceneError(key, cell_path, f"names a {cs.kind!r} scene; a 'cell' scene is needed")
-    if cs.contact.geometric_only:
-        raise SceneError(key, cell_path, "the cell scene has contact.geometric_only = true; the recovery "
-                         "solves the cell, so it needs a contact model and a [load] section")
-    if cs.discretization.method != "fe":
-        raise SceneError(key, cell_path, f"the cell scene is solved by discretization.method = "
-                         f"{cs.discretization.method!r}; the strength recovery needs the body stresses and the macro "
-                         "strain term of the FE cell: use a cell scene with method = 'fe'")
-    return cs, cell_problem(cs, model=dataclasses.replace(model_of(cs), macro_strain=True))
-
-
 def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     """Strength check of ``scene.strength`` on the macro solution ``sol``.
 
@@ -79,7 +57,7 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     # set: the caller (drivers.run_macro) evaluates only scenes with a [strength] section
     assert spec is not None
     path = resolve(scene, spec.cell)
-    cs, P = cell_problem_of(path, key="strength.cell")
+    cs, P = recovery_cell_problem(path, key="strength.cell")
     law = sol.problem.law
     kt = spec.tangential_stiffness
     if kt is None:

@@ -143,8 +143,9 @@ class ShearSolve(PressureSolve):
     :func:`~ngcontact.coupling.shear_table.cell_shear_response`)."""
 
     def build(self):
-        from ngcontact.drivers.run_strength import cell_problem_of
-        return cell_problem_of(self.path, key="two_scale.cell", overrides=self.overrides, method=self.method)[1]
+        from ngcontact.drivers.build import recovery_cell_problem
+        return recovery_cell_problem(self.path, key="two_scale.cell", overrides=self.overrides,
+                                     method=self.method)[1]
 
     def __call__(self, load) -> S.ShearResponse:  # type: ignore[override]
         return S.cell_shear_response(self.problem(), load[0], load[1], self.length_unit)

@@ -442,10 +442,10 @@ def test_macro_strain_shifts_the_far_face_approach_as_in_the_fe_cell(tmp_path):
 
 
 def test_the_strength_recovery_refuses_a_spectral_cell():
-    from ngcontact.drivers.run_strength import cell_problem_of
+    from ngcontact.drivers.build import recovery_cell_problem
     from ngcontact.errors import SceneError
     with pytest.raises(SceneError, match="needs the body stresses and the macro strain term of the FE cell"):
-        cell_problem_of(os.path.join(CELLS, "self_affine_spectral.toml"), key="strength.cell")
+        recovery_cell_problem(os.path.join(CELLS, "self_affine_spectral.toml"), key="strength.cell")
 
 
 def test_the_last_solution_from_no_start_is_returned_again_for_the_same_load():
