@@ -328,6 +328,8 @@ def with_study_periods(scene: DirectScene, periods) -> DirectScene:
         raise SceneError("study", None, "the epsilon study needs a [study] section")
     levels = tuple(int(n) for n in periods)
     new = replace(scene, study=replace(scene.study, periods=levels))
+    if hasattr(scene, "cell_scene"):          # set by check when the scene was loaded (its linked cell)
+        object.__setattr__(new, "cell_scene", scene.cell_scene)
     try:
         STUDY_CHECKS[scene.geometry.shape](new)
     except SceneError as err:

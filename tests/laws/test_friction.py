@@ -91,11 +91,14 @@ def test_a_law_entered_in_the_registry_is_built_from_a_scene_section(monkeypatch
 @pytest.mark.parametrize("load", [{"shear": (0.5 * 0.3 * P,)}, {"tangential_jump": (-20 * W,)}],
                          ids=["stick", "slide"])
 def test_a_constant_threshold_law_gives_the_fe_cell_tresca_numbers(cell, load):
+    """The same numbers to round-off: two FE solves of one problem can differ in their last bits from run to
+    run, so the comparison allows 1e-12 of each quantity's size."""
     a = _solve(cell, F.Tresca(G=0.3 * P, w=W), **load)
     b = _solve(cell, Constant(G=0.3 * P, w=W), **load)
-    assert b.results["mean_traction"] == a.results["mean_traction"]
-    assert b.results["far_face_jump"] == a.results["far_face_jump"]
-    assert np.array_equal(b.surface["slip"], a.surface["slip"])
+    for key in ("mean_traction", "far_face_jump"):
+        assert np.allclose(b.results[key], a.results[key], rtol=1e-12, atol=1e-12 * np.max(np.abs(a.results[key])))
+    slip = a.surface["slip"]
+    assert np.allclose(b.surface["slip"], slip, rtol=1e-12, atol=1e-12 * np.max(np.abs(slip)))
 
 
 def test_a_law_coupled_to_the_pressure_runs_the_coupled_solve_and_slides_at_its_threshold(cell):
