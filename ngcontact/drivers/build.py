@@ -33,7 +33,8 @@ from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral_start import SpectralStart
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
-from ngcontact.scene.cell_scene import MAX_SPECTRAL_POINTS, CellScene, load_states, spectral_grid
+from ngcontact.scene.cell_scene import CellScene, load_states, spectral_grid
+from ngcontact.scene.spectral_grid import MAX_SPECTRAL_POINTS
 from ngcontact.scene.loader import as_dict, load_with_contact
 from ngcontact.scene.sections import MaterialSpec, resolve
 

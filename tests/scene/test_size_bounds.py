@@ -5,7 +5,8 @@ import os
 
 import pytest
 
-from ngcontact.scene.cell_scene import MAX_MEMBERS, MAX_SPECTRAL_POINTS, spectral_cost
+from ngcontact.scene.cell_scene import MAX_MEMBERS
+from ngcontact.scene.spectral_grid import MAX_SPECTRAL_POINTS, spectral_cost
 
 from test_bad_input import edit, run_bad
 

@@ -26,7 +26,7 @@ levels:
 The levels are known before the first solve (``grid`` times ``GROWTH^k``
 up to ``max_points``, :func:`levels`; the scene layer bounds
 ``max_points`` by the cost of a solve,
-:func:`ngcontact.scene.cell_scene.spectral_cost`): the largest is stated
+:func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest is stated
 first, and each level prints one progress line as it ends.
 
 Each level solves from scratch: nothing carries between grids but the
