@@ -2,28 +2,33 @@
 
 ``tests/drivers/test_scenes.py`` checks a run's report and files, ``tests/drivers/test_gold.py`` its
 headline numbers against the gold record: both ask :func:`scene_run` for the run of a scene, which
-solves it the first time (``ngcontact run SCENE --out DIR --quiet`` in this process, with
-``NGCONTACT_CACHE`` in a fresh directory of its own, so that every cell law is computed in the run)
-and hands out the same run afterwards.
+solves it the first time (``python -m ngcontact run SCENE --out DIR --quiet`` in a process of its own, as a
+user runs it, with ``NGCONTACT_CACHE`` in a fresh directory of its own, so that every cell law is computed in
+the run) and hands out the same run afterwards.  A process per scene keeps the scenes from sharing native
+state: a crash of one is that scene's failure, with its exit status and its stderr, not the session's end.
 """
 from __future__ import annotations
 
 import json
 import os
+import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
-from ngcontact import cli
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @dataclass(frozen=True)
 class SceneRun:
-    """A finished ``ngcontact run``: its exit status, output directory and ``report.json`` (``None`` unless 0)."""
+    """A finished ``ngcontact run``: its exit status, output directory, ``report.json`` (``None`` unless 0) and
+    what it wrote on stderr."""
     status: int
     out: Path
     report: dict | None
+    stderr: str = ""
 
 
 @pytest.fixture(scope="session")
@@ -36,11 +41,13 @@ def scene_run(tmp_path_factory):
         if key not in runs:
             base = tmp_path_factory.mktemp(Path(key).stem)
             out = base / "out"
-            with pytest.MonkeyPatch.context() as mp:
-                mp.setenv("NGCONTACT_CACHE", str(base / "cache"))
-                status = cli.main(["run", path, "--out", str(out), "--quiet"])
+            env = dict(os.environ, NGCONTACT_CACHE=str(base / "cache"),
+                       PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
+            done = subprocess.run([sys.executable, "-m", "ngcontact", "run", path, "--out", str(out), "--quiet"],
+                                  env=env, capture_output=True, text=True)
+            status = done.returncode
             report = json.loads((out / "report.json").read_text()) if status == 0 else None
-            runs[key] = SceneRun(status, out, report)
+            runs[key] = SceneRun(status, out, report, done.stderr)
         return runs[key]
 
     return run

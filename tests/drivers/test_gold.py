@@ -41,7 +41,7 @@ def test_every_shipped_scene_is_recorded():
 def test_scene_reproduces_its_gold(rel, scene_run):
     entry = GOLD[rel]
     run = scene_run(str(ROOT / rel))
-    assert run.status == 0, f"{rel}: ngcontact run ended with exit {run.status}"
+    assert run.status == 0, f"{rel}: ngcontact run ended with exit {run.status}: {run.stderr[-2000:]}"
     assert run.report["kind"] == entry["kind"]
     bad = R.compare(entry["keys"], R.extract(run.report))
     assert not bad, (f"{len(bad)} of {len(entry['keys'])} headline numbers moved beyond rtol {R.RTOL:g} "

@@ -45,7 +45,7 @@ def _numbers(obj, where="report"):
 @pytest.mark.parametrize("path", SCENES, ids=IDS)
 def test_scene_runs_to_a_finite_report(path, scene_run):
     run = scene_run(path)  # `ngcontact run` in a fresh cache, shared with test_gold.py (conftest.py)
-    assert run.status == 0
+    assert run.status == 0, run.stderr[-2000:]
     out, rep = run.out, run.report
     sc = scene.load(path)
     assert rep["kind"] == sc.kind
