@@ -89,7 +89,7 @@ def run(scene, clock) -> Outcome:
         log.warning("%s", judged["verdict"])
     results = {
         "setting": m.setting,
-        "solution": "smooth manufactured displacement (see ngcontact.verification.manufactured.smooth_field)",
+        "solution": "smooth manufactured displacement (see ngcontact.verification.exact_fields.smooth_field)",
         "errors": "l2 = |u_h - u*|_L2, h1 = |grad(u_h - u*)|_L2 (axisymmetric: weighted by 2 pi r, "
                   "with the hoop term)",
         "rows": rows,
