@@ -126,7 +126,7 @@ def _compute_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--workers", type=_workers, metavar="N",
                    help="local worker processes for independent solves (loads with load.independent, ensemble "
                         "members, study levels), one NGSolve thread each (default: [compute] workers, else the "
-                        "number of cores)")
+                        "number of cores); at most one per member of the batch and two per core")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run independent solves on the workers of this dask.distributed scheduler "
                         "(e.g. tcp://10.0.0.5:8786) instead of local processes (default: [compute] scheduler)")

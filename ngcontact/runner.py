@@ -11,6 +11,7 @@ Nothing is written to disk; :func:`ngcontact.output.writer.write_outputs` does t
 from __future__ import annotations
 
 import importlib
+import logging
 import os
 from contextlib import contextmanager
 from typing import Callable
@@ -75,12 +76,15 @@ WORKER_MODULES = ("ngsolve", "ngcontact.drivers.build")
 
 
 def batches(scene, workers: int | None = None, scheduler: str | None = None, progress=None,
-            start: bool | None = None):
+            start: bool | None = None, note: Callable[[str], None] | None = None, members: int | None = None):
     """Context in which the run's batches of independent solves go to their executor.
 
     The command line's ``workers`` / ``scheduler`` first, then the scene's
     ``[compute]`` section; default: a pool of local processes, one per core
-    (:func:`ngcontact.parallel.executor.make`).  The workers are started at
+    (:func:`ngcontact.parallel.executor.make`), never more than the batch
+    has members (``members``; default :func:`batch_members`) nor more than
+    twice the cores: a request above that is cut, with one line to ``note``
+    (else to the log).  The workers are started at
     once when the run will have a batch (``start``; default
     :func:`has_batches`), so that their start overlaps with the run's own
     preparation; otherwise only for a batch whose members take long enough to
@@ -90,7 +94,12 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
     compute = getattr(scene, "compute", None)
     if scheduler is None and workers is None and compute is not None:
         scheduler, workers = compute.scheduler, compute.workers
-    ex = executor.make(workers, scheduler)
+    members = batch_members(scene) if members is None else members
+    if not scheduler:
+        _, capped = executor.local_workers(workers, members)
+        if capped is not None:
+            (note or logging.getLogger("ngcontact.parallel.executor").info)(capped)
+    ex = executor.make(workers, scheduler, members)
     if has_batches(scene) if start is None else start:
         ex.start(WORKER_MODULES)
     else:  # batches may come (a two-scale table's levels): workers only where they repay their start
@@ -111,6 +120,20 @@ def has_batches(scene) -> bool:
             return False
         return scene.load.independent and scene.discretization.tolerance is None
     return False
+
+
+def batch_members(scene) -> int | None:
+    """The members of the batches :func:`solve` runs for ``scene`` where known before the solve (the loads
+    of a sweep of independent loads, the members of an ensemble, the levels of a convergence study); None
+    otherwise (a two-scale cell table's levels, known only as it fills)."""
+    if not has_batches(scene):
+        return None
+    if scene.kind == "manufactured":
+        return len(scene.manufactured.orders) * scene.manufactured.levels
+    if getattr(scene, "ensemble", None) is not None:
+        return scene.ensemble.members
+    from ngcontact.scene.cell_scene import load_states
+    return len(load_states(scene))
 
 
 def check(scene) -> None:
@@ -161,7 +184,7 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
         scene = loader.load(scene)
     n = thread_count()
     clock = Clock(progress)
-    with threads(n), batches(scene, workers, scheduler, batch_progress) as ex:
+    with threads(n), batches(scene, workers, scheduler, batch_progress, note=progress) as ex:
         outcome = driver(scene).run(scene, clock)
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),
@@ -192,7 +215,8 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
         raise SceneError("kind", scene.kind, "the epsilon study needs a 'direct' scene with a [study] section")
     n = thread_count()
     clock = Clock(progress)
-    with threads(n), batches(scene, workers, scheduler, batch_progress, start=True) as ex:
+    with threads(n), batches(scene, workers, scheduler, batch_progress, start=True, note=progress,
+                             members=len(periods or scene.study.periods)) as ex:
         from ngcontact.drivers.study_epsilon import run_study
         outcome = run_study(scene, periods, clock=clock)
     report = build_report(kind="direct-epsilon-study", title=scene.title, scene=loader.as_dict(scene),
