@@ -75,6 +75,7 @@ def threads(n: int):
 WORKER_MODULES = ("ngsolve", "ngcontact.drivers.build")
 
 
+@contextmanager
 def batches(scene, workers: int | None = None, scheduler: str | None = None, progress=None,
             start: bool | None = None, note: Callable[[str], None] | None = None, members: int | None = None):
     """Context in which the run's batches of independent solves go to their executor.
@@ -89,22 +90,42 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
     :func:`has_batches`), so that their start overlaps with the run's own
     preparation; otherwise only for a batch whose members take long enough to
     repay the workers' start (:meth:`~ngcontact.parallel.executor.Executor.start_on_demand`).
+    A scheduler address that is malformed, or where no scheduler answers (at
+    once, or at the first batch), is a :class:`SceneError` naming
+    ``scheduler`` or ``compute.scheduler``.
     """
     from ngcontact.parallel import executor
+    from ngcontact.parallel.dask_cluster import SchedulerError
     compute = getattr(scene, "compute", None)
+    key = "scheduler"
     if scheduler is None and workers is None and compute is not None:
         scheduler, workers = compute.scheduler, compute.workers
+        key = "compute.scheduler"
     members = batch_members(scene) if members is None else members
     if not scheduler:
         _, capped = executor.local_workers(workers, members)
         if capped is not None:
             (note or logging.getLogger("ngcontact.parallel.executor").info)(capped)
-    ex = executor.make(workers, scheduler, members)
-    if has_batches(scene) if start is None else start:
-        ex.start(WORKER_MODULES)
-    else:  # batches may come (a two-scale table's levels): workers only where they repay their start
-        ex.start_on_demand()
-    return executor.use(ex, progress)
+    try:
+        ex = executor.make(workers, scheduler, members)
+        if has_batches(scene) if start is None else start:
+            ex.start(WORKER_MODULES)
+        else:  # batches may come (a two-scale table's levels): workers only where they repay their start
+            ex.start_on_demand()
+        with executor.use(ex, progress):
+            yield ex
+    except SchedulerError as exc:
+        raise SceneError(key, exc.address, exc.allowed) from None
+
+
+def check_scheduler(address: str, key: str = "scheduler") -> None:
+    """Refuse a malformed dask.distributed scheduler address (:class:`SceneError` naming ``key``), by Dask's
+    own parsing (:func:`ngcontact.parallel.dask_cluster.check_address`); nothing is connected."""
+    from ngcontact.parallel.dask_cluster import SchedulerError, check_address
+    try:
+        check_address(address)
+    except SchedulerError as exc:
+        raise SceneError(key, address, exc.allowed) from None
 
 
 def has_batches(scene) -> bool:
@@ -139,13 +160,17 @@ def batch_members(scene) -> int | None:
 def check(scene) -> None:
     """Every check ``run`` makes before its solve, without solving.
 
-    The scene is validated when loaded; kinds whose driver defines
+    The scene is validated when loaded, its scheduler address (``compute.scheduler``) by its form (no
+    connection); kinds whose driver defines
     ``check_model(scene)`` (the macro kind: boundary labels of the meshed
     shape, the gap table's coverage, rigid motions the supports leave free)
     are meshed and checked too.  Raises what ``run`` would raise.
     """
     if not hasattr(scene, "kind"):
         scene = loader.load(scene)
+    compute = getattr(scene, "compute", None)
+    if compute is not None and compute.scheduler:
+        check_scheduler(compute.scheduler, "compute.scheduler")
     check_model = getattr(importlib.import_module(DRIVERS[scene.kind]), "check_model", None)
     if check_model is not None:
         check_model(scene)
