@@ -170,3 +170,32 @@ def test_the_next_pool_ends_the_orphans_of_an_earlier_run_by_their_records_and_n
             if p.poll() is None:
                 p.kill()
             p.wait()
+
+
+def test_workers_spawned_by_a_thread_that_ends_live_on_with_their_parent(tmp_path, monkeypatch):
+    """The kernel's death signal follows the *thread* that spawned a worker: a pool started by a thread
+    that then ends keeps its workers (they watch the parent's pid instead) and runs its batches."""
+    import operator
+    import threading
+
+    from ngcontact.parallel import local_pool
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
+    pool = local_pool.LocalPool(2)
+    try:
+        first = []
+
+        def starter():             # starts the workers and waits for a batch: they have started by its end
+            pool.start()
+            first.append(pool.map(operator.neg, [1.0, 2.0], ["a", "b"]))
+
+        thread = threading.Thread(target=starter)
+        thread.start()
+        thread.join()
+        assert first == [[-1.0, -2.0]]
+        workers = list(pool._pool._processes.values())
+        assert len(workers) == 2
+        time.sleep(0.5)            # a death signal, had it been asked for, is on its way
+        assert pool.map(operator.neg, [1.0, 2.0, 3.0, 4.0], ["a", "b", "c", "d"]) == [-1.0, -2.0, -3.0, -4.0]
+        assert list(pool._pool._processes.values()) == workers and all(w.is_alive() for w in workers)
+    finally:
+        pool.close()
