@@ -198,8 +198,9 @@ class LocalPool(Executor):
             self._forget(processes)
 
     def _forget(self, processes) -> None:
-        """The pool's workers have stopped: its record goes (kept while one runs on, for the next run to end)."""
-        if self._lifetime is not None and not any(p.is_alive() for p in processes):
+        """The pool's workers have stopped: its record goes (kept while one runs on, for the next run to end).
+        A worker reaped by the pool's own thread may read alive for a moment: its exit code is awaited."""
+        if self._lifetime is not None and all(_exit_code(p) is not None for p in processes):
             self._lifetime.remove()
 
     def abort(self) -> None:
