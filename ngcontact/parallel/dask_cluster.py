@@ -32,10 +32,13 @@ ADDRESS_FORMS = "tcp://HOST:PORT or HOST:PORT (also tls://, ws://, wss://, ucx:/
 
 def address_problem(address: str) -> str | None:
     """What is wrong with the form of a scheduler's ``address`` (Dask's own parsing), None if nothing."""
-    from distributed.comm.addressing import parse_address, parse_host_port
-    from distributed.comm.registry import backends
     if not isinstance(address, str) or not address.strip():
         return "empty"
+    try:
+        from distributed.comm.addressing import parse_address, parse_host_port
+        from distributed.comm.registry import backends
+    except ImportError:  # pragma: no cover - a dependency of the package; the connection names it missing
+        return None
     try:
         scheme, location = parse_address(address, strict=False)
     except ValueError as exc:
@@ -124,7 +127,8 @@ class DaskCluster(Executor):
         timeout = isinstance(exc, TimeoutError) or "Timed out" in str(exc)      # asyncio's is the builtin
         detail = "" if timeout else f" ({reason(exc)})"
         return SchedulerError(self.address, f"no dask.distributed scheduler answered there within "
-                          f"{CONNECT_SECONDS:g} s{detail}: start one there (dask scheduler) or correct the address")
+                              f"{CONNECT_SECONDS:g} s{detail}: start one there (dask scheduler) or correct "
+                              "the address")
 
     def start(self, modules: Sequence[str] = ()) -> None:
         """Connect to the scheduler now: an address that does not answer fails before any solve."""

@@ -53,7 +53,7 @@ __all__ = ["Executor", "Serial", "LocalPool", "DaskCluster", "Progress", "defaul
 #: busy while the workers compute; but a worker also waits (its start, its imports and meshing, the time
 #: between two members while the run's own process collects results), and a second worker per core fills
 #: those gaps.  Beyond two the workers only take turns on the cores, while each costs a fresh
-#: interpreter's start and its memory (NGSolve loaded: some 170 MB).
+#: interpreter's start and its memory (NGSolve loaded in each).
 MAX_WORKERS_PER_CORE = 2
 
 

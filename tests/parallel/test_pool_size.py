@@ -1,6 +1,6 @@
 """The number of local workers: never more than the batch has members, nor more than twice the cores.
 
-Every worker is a fresh interpreter (its start, and some 170 MB); past the
+Every worker is a fresh interpreter (its start, its memory); past the
 cores they only share them.  A request above the cap is cut to it, with one
 line saying so.  Nothing here starts a worker.
 """
