@@ -16,9 +16,11 @@ members, study levels) run on ``--workers N`` local processes (default: one
 per core) or on the dask.distributed scheduler ``--scheduler ADDRESS``, with a
 progress bar on a terminal (plain lines otherwise, none with ``--quiet``).
 
-Exit status: 0 success, 2 invalid scene or output directory, 3 solver
-failure (also a member of a batch that failed twice), 130 interrupted (SIGINT), 143 terminated (SIGTERM); every failure
-prints one line on stderr and leaves the output directory as it was
+Exit status: 0 success, 2 invalid scene or output directory (also a
+scheduler address that is malformed or where no scheduler answers: nothing
+was solved), 3 solver failure (also a member of a batch that failed twice),
+130 interrupted (SIGINT), 143 terminated (SIGTERM); every failure prints
+one line on stderr and leaves the output directory as it was
 (:mod:`ngcontact.output.writer`: only the package's own files are ever
 written or replaced).
 """
@@ -70,8 +72,8 @@ def _parser() -> argparse.ArgumentParser:
         prog="ngcontact",
         description="Contact of elastic bodies with periodically rough interfaces, "
                     "by two-scale homogenization (NGSolve).",
-        epilog="Exit status: 0 success, 2 invalid scene or output directory, 3 solver failure "
-               "(and any unexpected error).")
+        epilog="Exit status: 0 success, 2 invalid scene, output directory or scheduler address (or no "
+               "scheduler answers there), 3 solver failure (and any unexpected error).")
     p.add_argument("--version", action="version", version=f"ngcontact {__version__}")
     p.add_argument("--debug", action="store_true",
                    help="show the traceback of an unexpected error (and debug log lines)")
@@ -122,14 +124,25 @@ def _workers(text: str) -> int:
     return n
 
 
+def _scheduler(text: str) -> str:
+    """A scheduler address of a valid form (nothing is connected yet)."""
+    from ngcontact.runner import check_scheduler
+    try:
+        check_scheduler(text, "--scheduler")
+    except SceneError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: {exc.allowed}") from None
+    return text
+
+
 def _compute_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--workers", type=_workers, metavar="N",
                    help="local worker processes for independent solves (loads with load.independent, ensemble "
                         "members, study levels), one NGSolve thread each (default: [compute] workers, else the "
-                        "number of cores)")
-    p.add_argument("--scheduler", metavar="ADDRESS",
+                        "number of cores); at most one per member of the batch and two per core")
+    p.add_argument("--scheduler", metavar="ADDRESS", type=_scheduler,
                    help="run independent solves on the workers of this dask.distributed scheduler "
-                        "(e.g. tcp://10.0.0.5:8786) instead of local processes (default: [compute] scheduler)")
+                        "(tcp://HOST:PORT or HOST:PORT, e.g. tcp://10.0.0.5:8786) instead of local processes "
+                        "(default: [compute] scheduler)")
 
 
 def main(argv=None) -> int:
@@ -206,12 +219,24 @@ def _check(path: str) -> int:
     return EXIT_OK
 
 
+@contextmanager
+def _scheduler_named(compute: dict):
+    """The runner names its ``scheduler`` argument ``scheduler``: here it is ``--scheduler``."""
+    try:
+        yield
+    except SceneError as exc:
+        if exc.path == "scheduler" and compute.get("scheduler") is not None:
+            raise SceneError("--scheduler", exc.value, exc.allowed) from exc
+        raise
+
+
 def _run(path: str, out: str | None, quiet: bool, compute: dict) -> int:
     from ngcontact.output.progress_bar import BatchProgress
     from ngcontact.runner import solve
 
     def compute_run(sc, progress):
-        return solve(sc, progress, batch_progress=BatchProgress(quiet), **compute)
+        with _scheduler_named(compute):
+            return solve(sc, progress, batch_progress=BatchProgress(quiet), **compute)
 
     return _execute(path, out, quiet, compute_run, suffix="")
 
@@ -227,7 +252,8 @@ def _study(path: str, periods, out: str | None, quiet: bool, compute: dict) -> i
     from ngcontact.output.progress_bar import BatchProgress
 
     def run_study(sc, progress):
-        return study_epsilon(sc, periods, progress, batch_progress=BatchProgress(quiet), **compute)
+        with _scheduler_named(compute):
+            return study_epsilon(sc, periods, progress, batch_progress=BatchProgress(quiet), **compute)
 
     if periods is not None and (len(periods) < 3 or any(n < 1 for n in periods)
                                 or any(b <= a for a, b in zip(periods, periods[1:]))):

@@ -107,28 +107,57 @@ def progress_lines(clock: Clock):
 WORKER_MODULES = ("ngsolve", "ngcontact.drivers.build")
 
 
+@contextmanager
 def batches(scene, workers: int | None = None, scheduler: str | None = None, progress=None,
-            start: bool | None = None):
+            start: bool | None = None, note: Callable[[str], None] | None = None, members: int | None = None):
     """Context in which the run's batches of independent solves go to their executor.
 
     The command line's ``workers`` / ``scheduler`` first, then the scene's
     ``[compute]`` section; default: a pool of local processes, one per core
-    (:func:`ngcontact.parallel.executor.make`).  The workers are started at
+    (:func:`ngcontact.parallel.executor.make`), never more than the batch
+    has members (``members``; default :func:`batch_members`) nor more than
+    twice the cores: a request above that is cut, with one line to ``note``
+    (else to the log).  The workers are started at
     once when the run will have a batch (``start``; default
     :func:`has_batches`), so that their start overlaps with the run's own
     preparation; otherwise only for a batch whose members take long enough to
     repay the workers' start (:meth:`~ngcontact.parallel.executor.Executor.start_on_demand`).
+    A scheduler address that is malformed, or where no scheduler answers (at
+    once, or at the first batch), is a :class:`SceneError` naming
+    ``scheduler`` or ``compute.scheduler``.
     """
     from ngcontact.parallel import executor
+    from ngcontact.parallel.dask_cluster import SchedulerError
     compute = getattr(scene, "compute", None)
+    key = "scheduler"
     if scheduler is None and workers is None and compute is not None:
         scheduler, workers = compute.scheduler, compute.workers
-    ex = executor.make(workers, scheduler)
-    if has_batches(scene) if start is None else start:
-        ex.start(WORKER_MODULES)
-    else:  # batches may come (a two-scale table's levels): workers only where they repay their start
-        ex.start_on_demand()
-    return executor.use(ex, progress)
+        key = "compute.scheduler"
+    members = batch_members(scene) if members is None else members
+    if not scheduler:
+        _, capped = executor.local_workers(workers, members)
+        if capped is not None:
+            (note or logging.getLogger("ngcontact.parallel.executor").info)(capped)
+    try:
+        ex = executor.make(workers, scheduler, members)
+        if has_batches(scene) if start is None else start:
+            ex.start(WORKER_MODULES)
+        else:  # batches may come (a two-scale table's levels): workers only where they repay their start
+            ex.start_on_demand()
+        with executor.use(ex, progress):
+            yield ex
+    except SchedulerError as exc:
+        raise SceneError(key, exc.address, exc.allowed) from None
+
+
+def check_scheduler(address: str, key: str = "scheduler") -> None:
+    """Refuse a malformed dask.distributed scheduler address (:class:`SceneError` naming ``key``), by Dask's
+    own parsing (:func:`ngcontact.parallel.dask_cluster.check_address`); nothing is connected."""
+    from ngcontact.parallel.dask_cluster import SchedulerError, check_address
+    try:
+        check_address(address)
+    except SchedulerError as exc:
+        raise SceneError(key, address, exc.allowed) from None
 
 
 def has_batches(scene) -> bool:
@@ -146,16 +175,34 @@ def has_batches(scene) -> bool:
     return False
 
 
+def batch_members(scene) -> int | None:
+    """The members of the batches :func:`solve` runs for ``scene`` where known before the solve (the loads
+    of a sweep of independent loads, the members of an ensemble, the levels of a convergence study); None
+    otherwise (a two-scale cell table's levels, known only as it fills)."""
+    if not has_batches(scene):
+        return None
+    if scene.kind == "manufactured":
+        return len(scene.manufactured.orders) * scene.manufactured.levels
+    if getattr(scene, "ensemble", None) is not None:
+        return scene.ensemble.members
+    from ngcontact.scene.cell_scene import load_states
+    return len(load_states(scene))
+
+
 def check(scene) -> None:
     """Every check ``run`` makes before its solve, without solving.
 
-    The scene is validated when loaded; kinds whose driver defines
+    The scene is validated when loaded, its scheduler address (``compute.scheduler``) by its form (no
+    connection); kinds whose driver defines
     ``check_model(scene)`` (the macro kind: boundary labels of the meshed
     shape, the gap table's coverage, rigid motions the supports leave free)
     are meshed and checked too.  Raises what ``run`` would raise.
     """
     if not hasattr(scene, "kind"):
         scene = loader.load(scene)
+    compute = getattr(scene, "compute", None)
+    if compute is not None and compute.scheduler:
+        check_scheduler(compute.scheduler, "compute.scheduler")
     check_model = getattr(importlib.import_module(DRIVERS[scene.kind]), "check_model", None)
     if check_model is not None:
         check_model(scene)
@@ -194,7 +241,7 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
         scene = loader.load(scene)
     n = thread_count()
     clock = Clock(progress)
-    with threads(n), batches(scene, workers, scheduler, batch_progress) as ex, progress_lines(clock):
+    with threads(n), batches(scene, workers, scheduler, batch_progress, note=progress) as ex, progress_lines(clock):
         outcome = driver(scene).run(scene, clock)
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),
@@ -228,7 +275,8 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
         scene = with_study_periods(scene, periods)
     n = thread_count()
     clock = Clock(progress)
-    with threads(n), batches(scene, workers, scheduler, batch_progress, start=True) as ex:
+    with threads(n), batches(scene, workers, scheduler, batch_progress, start=True, note=progress,
+                             members=len(periods or scene.study.periods)) as ex:
         from ngcontact.drivers.study_epsilon import run_study
         outcome = run_study(scene, periods, clock=clock)
     report = build_report(kind="direct-epsilon-study", title=scene.title, scene=loader.as_dict(scene),

@@ -215,3 +215,32 @@ def test_quiet_prints_nothing_not_even_the_mesher_s_own_lines(tmp_path):
                            "--out", str(tmp_path / "out"), "--quiet"], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout == "" and done.stderr == "", (done.stdout, done.stderr)
+
+
+@pytest.mark.parametrize("address, problem", [("garbage", "missing port number"),
+                                              ("http://10.0.0.5:8786", "unknown scheme 'http'")])
+def test_a_malformed_scheduler_option_exits_2_at_once_naming_it_and_the_allowed_forms(scene_file, tmp_path,
+                                                                                       capsys, address, problem):
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as info:
+        cli.main(["run", str(scene_file), "--out", str(out), "--scheduler", address])
+    assert info.value.code == 2
+    last = capsys.readouterr().err.splitlines()[-1]
+    assert last == (f"ngcontact run: error: argument --scheduler: '{address}': {problem}; the address of a "
+                    "dask.distributed scheduler: tcp://HOST:PORT or HOST:PORT (also tls://, ws://, wss://, ucx:// "
+                    "HOST:PORT)")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+def test_a_malformed_compute_scheduler_exits_2_naming_the_key(tmp_path, capsys, command):
+    cell = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "geometries", "cells",
+                        "sinusoid.toml")
+    path = tmp_path / "sched.toml"
+    path.write_text(open(cell).read() + '\n[compute]\nscheduler = "garbage"\n')
+    out = tmp_path / "out"
+    assert cli.main([command, str(path)] + (["--out", str(out), "--quiet"] if command == "run" else [])) == 2
+    assert capsys.readouterr().err == (
+        f"ngcontact: error: {path}: compute.scheduler = 'garbage': missing port number; the address of a "
+        "dask.distributed scheduler: tcp://HOST:PORT or HOST:PORT (also tls://, ws://, wss://, ucx:// HOST:PORT)\n")
+    assert not out.exists()

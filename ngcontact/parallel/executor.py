@@ -47,14 +47,38 @@ from ngcontact.parallel.dask_cluster import DaskCluster
 from ngcontact.parallel.local_pool import LocalPool
 
 __all__ = ["Executor", "Serial", "LocalPool", "DaskCluster", "Progress", "default_workers", "make", "current",
-           "use"]
+           "use", "local_workers", "MAX_WORKERS_PER_CORE"]
+
+#: Local workers per core at most.  Each worker runs one NGSolve thread, so one per core keeps the cores
+#: busy while the workers compute; but a worker also waits (its start, its imports and meshing, the time
+#: between two members while the run's own process collects results), and a second worker per core fills
+#: those gaps.  Beyond two the workers only take turns on the cores, while each costs a fresh
+#: interpreter's start and its memory (NGSolve loaded in each).
+MAX_WORKERS_PER_CORE = 2
 
 
-def make(workers: int | None = None, scheduler: str | None = None) -> Executor:
-    """The executor a run asks for: a scheduler's cluster, else a local pool of ``workers`` (default: the cores)."""
+def local_workers(workers: int | None = None, members: int | None = None) -> tuple[int, str | None]:
+    """The local workers of a run: ``workers`` asked for (default: the cores), at most
+    :data:`MAX_WORKERS_PER_CORE` per core and one per member of its batch (``members``, where known); and
+    a line saying so when fewer than asked for are used (None otherwise)."""
+    cores = default_workers()
+    n = cores if workers is None else workers
+    if members is not None:
+        n = min(n, max(1, members))
+    n = min(n, MAX_WORKERS_PER_CORE * cores)
+    if workers is None or n == workers:
+        return n, None
+    why = (f"one per member of the batch ({members})" if n < MAX_WORKERS_PER_CORE * cores
+           else f"at most {MAX_WORKERS_PER_CORE} per core ({cores} core{'s' if cores > 1 else ''})")
+    return n, f"workers: {n} worker process{'es' if n > 1 else ''}, not the {workers} asked for: {why}"
+
+
+def make(workers: int | None = None, scheduler: str | None = None, members: int | None = None) -> Executor:
+    """The executor a run asks for: a scheduler's cluster, else a local pool of ``workers`` (default: the
+    cores; capped by :func:`local_workers`, ``members`` being the size of the run's batches where known)."""
     if scheduler:
         return DaskCluster(scheduler)
-    n = default_workers() if workers is None else workers
+    n, _ = local_workers(workers, members)
     return Serial() if n == 1 else LocalPool(n)
 
 

@@ -15,6 +15,7 @@ from typing import Any, Sequence
 
 from ngcontact.parallel.batch_executor import Executor
 from ngcontact.parallel.batch_member import one_thread, run_member
+from ngcontact.parallel import worker_lifetime
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
@@ -36,16 +37,18 @@ class LocalPool(Executor):
         self._pool: Any = None        # the ProcessPoolExecutor, started on first use
         self._started: Any = None     # the queue on which workers announce their start
         self._processes: dict = {}      # every worker process of the current pool, by pid
+        self._lifetime: worker_lifetime.Record | None = None   # the current pool's record of its workers
         self.on_demand = False
 
     def _start(self):
-        import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
-        ctx = multiprocessing.get_context("spawn")
+        worker_lifetime.end_orphans()
+        ctx = worker_lifetime.spawn_context()
         self._started = ctx.SimpleQueue()
         self._processes = {}
+        self._lifetime = worker_lifetime.Record()
         self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx, initializer=_worker_start,
-                                         initargs=(self._started,))
+                                         initargs=(self._started, os.getpid(), self._lifetime.path))
         return self._pool
 
     def start(self, modules: Sequence[str] = ()) -> None:
@@ -185,11 +188,20 @@ class LocalPool(Executor):
             if p.is_alive():  # a worker that does not stop on SIGTERM
                 p.kill()
                 p.join(timeout=5)
+        self._forget(processes)
 
     def close(self) -> None:
         if self._pool is not None:
+            processes = list((self._pool._processes or {}).values())
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
+            self._forget(processes)
+
+    def _forget(self, processes) -> None:
+        """The pool's workers have stopped: its record goes (kept while one runs on, for the next run to end).
+        A worker reaped by the pool's own thread may read alive for a moment: its exit code is awaited."""
+        if self._lifetime is not None and all(_exit_code(p) is not None for p in processes):
+            self._lifetime.remove()
 
     def abort(self) -> None:
         self._discard()
@@ -207,8 +219,9 @@ def _exit_code(proc, seconds: float = 2.0):
     return proc.exitcode
 
 
-def _worker_start(started) -> None:
+def _worker_start(started, parent: int, record: str | None) -> None:
     global _STARTED
+    worker_lifetime.die_with_parent(parent, record)
     _STARTED = started
     one_thread(ignore_sigint=True)
 
