@@ -110,6 +110,16 @@ class Cell:
         return a
 
 
+def _generate(geo, maxh: float, hint: float, grading: float) -> ng.Mesh:
+    """Netgen's mesh of the cell's geometry; a meshing failure names its likely cause (:func:`meshing_failure`)."""
+    try:
+        return ng.Mesh(geo.GenerateMesh(maxh=maxh, grading=grading))
+    except Exception as exc:  # netgen's NgException, which its Python package does not export by a stable name
+        if type(exc).__name__ != "NgException" or "meshing" not in str(exc).lower():
+            raise
+        raise meshing_failure(exc, maxh, hint) from None
+
+
 def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
                    maxh: float, interface_maxh: float | None = None, order: int = 1,
                    voids=(), grading: float = 0.3) -> Cell:
@@ -194,12 +204,7 @@ def interface_cell(segments, period: float, h_rough: float, h_counter: float, *,
             geo.Append([s.kind, *ids], leftdomain=0, rightdomain=COUNTER, bc=s.label, maxh=hint)
     geo.SetMaterial(ROUGH, "rough")
     geo.SetMaterial(COUNTER, "counter")
-    try:
-        mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh, grading=grading))
-    except Exception as exc:  # netgen's NgException, which its Python package does not export by a stable name
-        if type(exc).__name__ != "NgException" or "meshing" not in str(exc).lower():
-            raise
-        raise meshing_failure(exc, maxh, hint) from None
+    mesh = _generate(geo, maxh, hint, grading)
     if order > 1:
         mesh.Curve(order)
     return Cell(mesh=mesh, dim=2, period=(float(period),), h_rough=float(h_rough),

@@ -214,38 +214,10 @@ class CellScene:
             return
         if self.load is None:
             raise SceneError("load", MISSING, "required unless contact.geometric_only = true")
-        c = self.contact
-        if c.friction != "none" and c.w is None and self.discretization.method == "fe":
-            raise SceneError("contact.w", MISSING, f"required for friction = {c.friction!r} in an FE cell, which "
-                             "regularizes friction with the Huber width w under exact enforcement too (the spectral "
-                             "cell's exact friction needs none)")
         if self.discretization.method == "spectral":
             check_spectral(self)
         else:
-            check_penalty_ratio(self)
-        if self.discretization.method == "fe" and self.contact.enforcement == "exact" and dim == 3 \
-                and self.discretization.order > 1:
-            raise SceneError("discretization.order", self.discretization.order,
-                             "must be 1 with contact.enforcement = 'exact' in a 3D FE cell (quadratic triangles leave "
-                             "corner nodes open inside the contact patch); or use the penalty, or "
-                             "discretization.method = 'spectral' for a small-slope cell")
-        if self.discretization.method == "fe" and self.solver.start == "spectral" and not has_twin(self):
-            raise SceneError("solver.start", "spectral", "starts from the spectral cell of the same small-slope cell: "
-                             "it needs contact.enforcement = 'penalty' and a flat interface (geometry.profile = "
-                             "'flat' or 'flat3d', or 'bisinusoid', 'height_map' or 'self_affine' with arrangement = "
-                             f"'summit'), not enforcement {self.contact.enforcement!r} on a {self.geometry.profile!r} "
-                             f"profile in the {self.geometry.arrangement!r} arrangement; use 'auto' or 'rigid'")
-        fe_tolerance = self.discretization.method == "fe" and self.discretization.tolerance is not None
-        if fe_tolerance and not (dim == 2 and PROFILES[self.geometry.profile].flat):
-            raise SceneError("discretization.tolerance", self.discretization.tolerance,
-                             "refinement towards the contact edges needs a 2D cell with geometry.profile = "
-                             f"'flat' (the small-slope model), not a {dim}D {self.geometry.profile!r} cell; remove "
-                             "the key and refine interface_maxh or order by hand")
-        if fe_tolerance and self.contact.friction != "none":
-            raise SceneError("discretization.tolerance", self.discretization.tolerance,
-                             "refinement towards the contact edges solves every load afresh on its own mesh, "
-                             "which a frictional load path does not allow; remove the key or set "
-                             "contact.friction = 'none'")
+            check_fe(self)
         load_states(self)
         if self.load.independent and self.contact.friction != "none":
             raise SceneError("load.independent", True, "solves every load afresh, which a frictional load path "
@@ -329,6 +301,39 @@ def has_twin(scene: CellScene) -> bool:
     """Whether an FE cell scene's first loads can start from its spectral twin
     (:mod:`ngcontact.cell.spectral_start`): the penalty on a flat interface."""
     return scene.contact.enforcement == "penalty" and flat_interface(scene.geometry)
+
+
+def check_fe(scene: CellScene) -> None:
+    """What the FE cell needs of a scene: a Huber width with friction, an admissible penalty, order 1 for
+    exact contact in 3D, a flat interface for the spectral start, and a flat 2D frictionless cell for a
+    tolerance (graded meshes)."""
+    c, d, dim = scene.contact, scene.discretization, scene.geometry.dim
+    if c.friction != "none" and c.w is None:
+        raise SceneError("contact.w", MISSING, f"required for friction = {c.friction!r} in an FE cell, which "
+                         "regularizes friction with the Huber width w under exact enforcement too (the spectral "
+                         "cell's exact friction needs none)")
+    check_penalty_ratio(scene)
+    if c.enforcement == "exact" and dim == 3 and d.order > 1:
+        raise SceneError("discretization.order", d.order,
+                         "must be 1 with contact.enforcement = 'exact' in a 3D FE cell (quadratic triangles leave "
+                         "corner nodes open inside the contact patch); or use the penalty, or "
+                         "discretization.method = 'spectral' for a small-slope cell")
+    if scene.solver.start == "spectral" and not has_twin(scene):
+        raise SceneError("solver.start", "spectral", "starts from the spectral cell of the same small-slope cell: "
+                         "it needs contact.enforcement = 'penalty' and a flat interface (geometry.profile = "
+                         "'flat' or 'flat3d', or 'bisinusoid', 'height_map' or 'self_affine' with arrangement = "
+                         f"'summit'), not enforcement {c.enforcement!r} on a {scene.geometry.profile!r} "
+                         f"profile in the {scene.geometry.arrangement!r} arrangement; use 'auto' or 'rigid'")
+    if d.tolerance is not None and not (dim == 2 and PROFILES[scene.geometry.profile].flat):
+        raise SceneError("discretization.tolerance", d.tolerance,
+                         "refinement towards the contact edges needs a 2D cell with geometry.profile = "
+                         f"'flat' (the small-slope model), not a {dim}D {scene.geometry.profile!r} cell; remove "
+                         "the key and refine interface_maxh or order by hand")
+    if d.tolerance is not None and c.friction != "none":
+        raise SceneError("discretization.tolerance", d.tolerance,
+                         "refinement towards the contact edges solves every load afresh on its own mesh, "
+                         "which a frictional load path does not allow; remove the key or set "
+                         "contact.friction = 'none'")
 
 
 def check_spectral(scene: CellScene) -> None:

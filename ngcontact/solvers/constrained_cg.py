@@ -95,6 +95,23 @@ def roundoff_floor(norm: float | None, p: np.ndarray, b: np.ndarray, gscale: flo
         / gscale
 
 
+def _start(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, pbar: float | None,
+           p0: np.ndarray | None) -> np.ndarray:
+    """The start of :func:`constrained_cg` (its ``p0`` parameter), scaled to the mean ``pbar`` where given."""
+    if p0 is not None and np.any(p0 > 0):
+        p = np.maximum(p0, 0.0).astype(float)
+    elif pbar is not None:
+        p = np.full(b.shape, float(pbar))
+    else:
+        e = np.zeros(b.shape)
+        e.flat[0] = 1.0
+        diag = float(apply_A(e).flat[0])
+        p = np.maximum(-b, 0.0) / diag
+    if pbar is not None:
+        p *= pbar / p.mean()
+    return p
+
+
 def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *, pbar: float | None,
                    tol: float, max_iter: int, gscale: float, p0: np.ndarray | None = None,
                    norm: float | None = None) -> ConstrainedResult:
@@ -132,17 +149,7 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
     if not gscale > 0:
         raise ValueError(f"gscale = {gscale!r}: must be > 0")
     n = b.size
-    if p0 is not None and np.any(p0 > 0):
-        p = np.maximum(p0, 0.0).astype(float)
-    elif pbar is not None:
-        p = np.full(b.shape, float(pbar))
-    else:
-        e = np.zeros(b.shape)
-        e.flat[0] = 1.0
-        diag = float(apply_A(e).flat[0])
-        p = np.maximum(-b, 0.0) / diag
-    if pbar is not None:
-        p *= pbar / p.mean()
+    p = _start(apply_A, b, pbar, p0)
     t = np.zeros(b.shape)
     g_old = 1.0
     conjugate = False
