@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from ngcontact import cli
+from sinusoid_cell import sinusoid_cell
 from ngcontact.cell import spectral_start
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
@@ -22,27 +23,6 @@ from ngcontact.fem.materials import isotropic
 from ngcontact.geometry import profiles
 from ngcontact.solvers import constrained_cg as ccg
 
-SPECTRAL = """\
-kind = "cell"
-[materials.solid]
-E = 1.0
-nu = 0.3
-[bodies]
-rough = "solid"
-counter = "solid"
-[geometry]
-profile = "flat"
-h_rough = 1.0
-h_counter = 1.0
-[contact]
-k_n = {k_n}
-enforcement = "{enforcement}"
-gap = {{ kind = "sinusoid", h = 0.01 }}
-[load]
-pressure = [{pressure}]
-[discretization]
-{disc}
-"""
 
 
 def _run(tmp_path, text, name="s", quiet=True):
@@ -77,8 +57,8 @@ def _sinusoid_cell(N=256, enforcement="exact", k_n=1e3, h=0.01):
 # ------------------------------------------------------------------ spectral cell: trivial limits
 def test_full_contact_at_a_huge_pressure_is_answered_directly(tmp_path):
     """Was: exit 3 after 10000 CG steps (exact contact at pressure 1e6 on E = 1)."""
-    rc, rep = _run(tmp_path, SPECTRAL.format(k_n="1.0e3", enforcement="exact", pressure="1e6",
-                                             disc='method = "spectral"\ngrid = 256'))
+    rc, rep = _run(tmp_path, sinusoid_cell(k_n="1.0e3", enforcement="exact", pressure="1e6",
+                                             discretization='method = "spectral"\ngrid = 256'))
     assert rc == 0
     load = rep["results"]["loads"][0]
     assert load["contact_fraction"] == 1.0 and load["iterations"] == 0
@@ -127,7 +107,7 @@ def test_a_height_map_scaled_to_picometres_is_solved(tmp_path):
     heights = 1e-12 * rng.random((17, 17))
     heights[-1, :], heights[:, -1] = heights[0, :], heights[:, 0]
     np.save(tmp_path / "tiny.npy", heights)
-    text = SPECTRAL.format(k_n="1.0e3", enforcement="exact", pressure="0.005", disc='method = "spectral"')
+    text = sinusoid_cell(k_n="1.0e3", enforcement="exact", pressure="0.005", discretization='method = "spectral"')
     text = text.replace('profile = "flat"', 'profile = "height_map"\nfile = "tiny.npy"\narrangement = "summit"')
     text = text.replace('gap = { kind = "sinusoid", h = 0.01 }\n', "")
     rc, rep = _run(tmp_path, text)
@@ -164,8 +144,8 @@ def test_the_rigid_predictor_brackets_a_subnormal_and_a_zero_load(p):
 
 
 # ------------------------------------------------------------------ FE exact cell: the contact set
-EXACT = SPECTRAL.format(k_n="1.0e3", enforcement="exact", pressure="{pressure}",
-                        disc="order = 2\nmaxh = 0.25\ninterface_maxh = 0.05")
+EXACT = sinusoid_cell(k_n="1.0e3", enforcement="exact", pressure="{pressure}",
+                        discretization="order = 2\nmaxh = 0.25\ninterface_maxh = 0.05")
 
 
 def test_the_exact_cell_counts_no_touching_node_as_contact_at_zero_load(tmp_path):
@@ -188,7 +168,7 @@ def test_the_exact_cell_contact_fraction_vanishes_with_the_load(tmp_path):
 @pytest.mark.parametrize("disc", ['method = "spectral"\ngrid = 64', "order = 1\nmaxh = 0.5"])
 def test_a_far_face_jump_beyond_small_strain_is_warned_and_recorded(tmp_path, caplog, disc):
     """Was: a far-face jump of 14867 in a cell 2 high, without a word."""
-    text = SPECTRAL.format(k_n="1e-2", enforcement="penalty", pressure="1e-5, 0.2", disc=disc)
+    text = sinusoid_cell(k_n="1e-2", enforcement="penalty", pressure="1e-5, 0.2", discretization=disc)
     with caplog.at_level(logging.WARNING):
         rc, rep = _run(tmp_path, text)
     assert rc == 0
@@ -200,8 +180,8 @@ def test_a_far_face_jump_beyond_small_strain_is_warned_and_recorded(tmp_path, ca
 
 
 # ------------------------------------------------------------------ progress of long spectral solves
-REFINED = SPECTRAL.format(k_n="1.0e3", enforcement="exact", pressure="0.003",
-                          disc='method = "spectral"\ngrid = 64\ntolerance = 1e-3')
+REFINED = sinusoid_cell(k_n="1.0e3", enforcement="exact", pressure="0.003",
+                          discretization='method = "spectral"\ngrid = 64\ntolerance = 1e-3')
 
 
 def test_each_refinement_level_and_a_long_solve_print_a_progress_line(tmp_path, monkeypatch, capsys):

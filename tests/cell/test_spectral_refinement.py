@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from ngcontact import cli
+from sinusoid_cell import sinusoid_cell
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral.refinement import next_grid, sweep_to_tolerance
@@ -50,29 +51,8 @@ def test_next_grid_multiplies_the_points_by_four():
     assert next_grid(1024, 2) == 4096 and next_grid(128, 3) == 256
 
 
-SCENE = """\
-kind = "cell"
-[materials.solid]
-E = 1.0
-nu = 0.3
-[bodies]
-rough = "solid"
-counter = "solid"
-[geometry]
-profile = "flat"
-h_rough = 2.0
-h_counter = 2.0
-[contact]
-k_n = 1.0e3
-enforcement = "exact"
-gap = { kind = "sinusoid", h = 0.01 }
-[load]
-pressure = [0.0034523]
-[discretization]
-method = "spectral"
-grid = 256
-tolerance = 1e-5
-"""
+SCENE = sinusoid_cell(pressure="0.0034523", depth="2.0",
+                      discretization='method = "spectral"\ngrid = 256\ntolerance = 1e-5')
 
 
 def test_a_spectral_scene_with_a_tolerance_reports_the_estimate_and_the_grids(tmp_path):

@@ -8,33 +8,13 @@ import pytest
 from ngcontact.scene.cell_scene import MAX_MEMBERS
 from ngcontact.scene.spectral_grid import MAX_SPECTRAL_POINTS, spectral_cost
 
+from sinusoid_cell import sinusoid_cell
 from test_bad_input import edit, run_bad
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CELLS = os.path.join(ROOT, "geometries", "cells")
 
-SPECTRAL = """\
-kind = "cell"
-[materials.solid]
-E = 1.0
-nu = 0.3
-[bodies]
-rough = "solid"
-counter = "solid"
-[geometry]
-profile = "flat"
-h_rough = 1.0
-h_counter = 1.0
-[contact]
-k_n = 1.0e3
-enforcement = "exact"
-gap = { kind = "sinusoid", h = 0.01 }
-[load]
-pressure = [0.005]
-[discretization]
-method = "spectral"
-grid = 256
-"""
+SPECTRAL = sinusoid_cell()
 
 
 def test_a_billion_ensemble_members_are_refused(tmp_path, capsys):
