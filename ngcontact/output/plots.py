@@ -20,13 +20,17 @@ def _pyplot():
 
 
 def epsilon_study(path: str, rows: list, laws) -> None:
-    """Error against ``eps`` (field and reaction) and cost against ``eps``."""
+    """Error against ``eps`` (field and reaction; thin dotted: the field error's discretization estimate, where
+    the rows carry it) and cost against ``eps``."""
     plt = _pyplot()
     eps = np.array([r["eps"] for r in rows])
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
     for name, color in zip(laws, ("C0", "C1", "C2")):
         ax[0].loglog(eps, [r[f"{name}_field"] for r in rows], "o-", color=color, label=f"{name}: field")
         ax[0].loglog(eps, [r[f"{name}_reaction"] for r in rows], "s--", color=color, label=f"{name}: reaction")
+        if f"{name}_field_discretization" in rows[0]:
+            ax[0].loglog(eps, [r[f"{name}_field_discretization"] for r in rows], "x:", color=color, lw=0.8,
+                         label=f"{name}: field, discretization estimate")
     ax[0].loglog(eps, eps / eps[0] * rows[0]["bundle_field"], "k:", label="slope 1")
     ax[0].axhline(0.01, color="gray", lw=0.8)
     ax[0].set_xlabel("eps [m]")

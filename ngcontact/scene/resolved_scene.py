@@ -43,8 +43,8 @@ from ngcontact.scene.macro_shapes import FEMUR_BOUNDARIES, check_dimensions, che
 from ngcontact.scene.sections import (ComputeSpec, MaterialSpec, check_supports_once, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import (MAX_ORDER, MAX_PERIODS, at_least, closed_interval, distinct, nonempty, param,
-                                    positive)
+from ngcontact.scene.schema import (MAX_ORDER, MAX_PERIODS, at_least, closed_interval, distinct, nonempty,
+                                    open_interval, param, positive)
 
 #: The shapes (:data:`ngcontact.geometry.resolved_shapes.RESOLVED_SHAPES`: what each one is built and measured
 #: by); this module validates a scene against their settings, keys and boundary labels.
@@ -165,6 +165,13 @@ class StudySpec:
         allowed="pairs of numbers inside a body, outside the band of the coarsest level")
     grid: tuple[int, int] = param((100, 50), doc="sampling grid of the field error: (nx, ny) per block, "
                                   "or (nr, nz) over the femur's bounding box", check=at_least(4))
+    refinement: float = param(2.0, doc="each level is solved again with every mesh size divided by this factor "
+                              "(maxh, eps / elements_per_period, interface_maxh); the change of each error "
+                              "between the two estimates its discretization error", check=closed_interval(1.5, 8))
+    discretization_share: float = param(0.1, doc="the rates in eps are fitted on the levels whose discretization "
+                                        "estimate is at most this share of the error (the modelling error, not "
+                                        "the meshes'); fewer than three such levels: no rate, and the report "
+                                        "says why", check=open_interval(0, 1))
 
 
 @dataclass(frozen=True, kw_only=True)
