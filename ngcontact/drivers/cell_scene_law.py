@@ -26,7 +26,8 @@ from ngcontact.scene.macro_scene import InterfaceSpec
 #: the laws a cell gives: its bundle (eqs. 31-33) or the bundle's linearization (eq. 34)
 FORMS = ("bundle", "linear")
 #: the Huber width of friction from the cell, as a macro scene's ``interface.huber_width``
-HUBER_WIDTH = next(f.default for f in dataclasses.fields(InterfaceSpec) if f.name == "huber_width")
+HUBER_WIDTH = float(next(f.default for f in dataclasses.fields(InterfaceSpec)  # type: ignore[arg-type]
+                         if f.name == "huber_width"))
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -73,6 +73,19 @@ def _specs(items, cls, key: str, labels: list[str]) -> list:
     return specs
 
 
+def _check_components(supports, setting: str) -> None:
+    """Components of the setting, one displacement per component."""
+    comps = COMPONENTS[setting]
+    for i, s in enumerate(supports):
+        bad = [c for c in s.components if c not in comps]
+        if bad:
+            raise refuse(f"supports[{i}].components", list(s.components), f"components of {setting}: "
+                         + ", ".join(comps))
+        if s.displacement and len(s.displacement) != len(s.components or comps):
+            raise refuse(f"supports[{i}].displacement", list(s.displacement),
+                         f"one value per component ({len(s.components or comps)})")
+
+
 def _law_info(law: il.InterfaceLaw, dim: int) -> dict:
     """The report's description of the law (``results.law``), as a macro run's."""
     if isinstance(law, CellLaw):
@@ -130,6 +143,7 @@ def run(mesh, law, *, rough: str, counter: str, materials: dict, interface: str 
     elastic, materials_echo = _materials(materials, rough, counter)
     labels = boundary_labels(mesh)
     support_specs = _specs(supports, SupportSpec, "supports", labels)
+    _check_components(support_specs, setting)
     load_specs = _specs(loads, LoadSpec, "loads", labels)
     settings = SimpleNamespace(solver=schema.build(SolverSpec, solver or {}, "solver"),
                                output=schema.build(OutputSpec, output or {}, "output"))
