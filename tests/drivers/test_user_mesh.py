@@ -15,8 +15,8 @@ from netgen.occ import Compound, OCCGeometry, WorkPlane, Y
 
 import ngcontact
 from ngcontact.errors import ModelError, SceneError
-from ngcontact.geometry.bodies import block_on_plane, coaxial_axisymmetric
-from ngcontact.laws.homogenized import InterfaceLaw, LinearLaw
+from ngcontact.geometry.bodies import block_on_plane, coaxial_3d, coaxial_axisymmetric
+from ngcontact.laws.homogenized import BundleLaw, InterfaceLaw, LinearLaw
 from ngcontact.scene.loader import from_dict
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -177,3 +177,37 @@ def test_cell_law_of_a_loaded_scene_is_the_law_of_its_file():
     loaded = ngcontact.cell_law(ngcontact.load(CELL), setting="axisymmetric", length_unit=1e-4)
     assert loaded == by_file and isinstance(loaded, InterfaceLaw)
     assert loaded.coefficients == by_file.coefficients and len(by_file.coefficients["weights"]) == 2
+
+
+def test_cell_law_with_friction_from_the_cell_is_the_macro_scenes():
+    """Friction from a Coulomb cell (paper eqs. 42-43): in 2D ``mu0`` is the micro ``mu``, as a macro scene's
+    ``interface.friction = "from_cell"`` has it."""
+    from ngcontact.drivers.build import friction_from_cell
+    path = os.path.join(ROOT, "geometries", "cells", "rectangular_coulomb.toml")
+    law = ngcontact.cell_law(path, friction="from_cell")
+    scene_friction, _ = friction_from_cell(path, width=law.friction.width)
+    assert law.friction == scene_friction and law.friction.width == 1e-6
+    assert law.coefficients["mu0"] == pytest.approx(0.3, rel=1e-12) and law.coefficients["G0"] == 0.0
+
+
+@pytest.mark.slow  # a 3D quarter of two tubes solved twice: about 10 s on a loaded machine
+def test_solve_mesh_in_3d_as_the_coaxial_scene():
+    """The 3D frame (n0, t1, t2), a bundle law and an interference through both routes on the same mesh."""
+    a, b, c, height, maxh, delta = 0.01, 0.02, 0.04, 0.01, 0.01, 20e-6
+    supports = [{"boundary": "sym_x", "components": ["x"]}, {"boundary": "sym_y", "components": ["y"]},
+                {"boundary": "bottom", "components": ["z"]}, {"boundary": "top", "components": ["z"]}]
+    scene = from_dict({
+        "kind": "macro", "materials": {"steel": STEEL}, "bodies": {"rough": "steel", "counter": "steel"},
+        "geometry": {"shape": "coaxial", "setting": "3d", "dimensions": {"a": a, "b": b, "c": c, "height": height}},
+        "interface": {"law": "bundle", "weights": [1e13], "directions": [[1.0, 0.0, 0.0]], "gap": -delta},
+        "supports": supports, "discretization": {"maxh": maxh, "order": 2}})
+    by_scene, _ = ngcontact.solve(scene)
+    mesh = coaxial_3d(a, b, c, height, maxh=maxh, order=2).mesh
+    by_api, _ = ngcontact.solve_mesh(mesh, BundleLaw(weights=(1e13,), directions=((1.0, 0.0, 0.0),)), rough="inner",
+                                     counter="outer", materials={"inner": STEEL, "outer": STEEL}, gap=-delta,
+                                     supports=supports)
+    s, a_ = by_scene["results"], by_api["results"]
+    assert a_["maxima"]["pressure"]["pressure"] == pytest.approx(s["maxima"]["pressure"]["pressure"], rel=ROUND_OFF)
+    assert a_["contact_area"] == pytest.approx(s["contact_area"], rel=ROUND_OFF)
+    for comp in ("x", "y"):
+        assert a_["resultant"][comp] == pytest.approx(s["resultant"][comp], rel=ROUND_OFF)
