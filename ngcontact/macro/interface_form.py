@@ -140,6 +140,11 @@ class InterfaceForm:
         The measure weight ``w``.
     measure
         ``ds`` on the interface.
+    threshold
+        The friction threshold field ``G`` held fixed in the friction energy (paper eqs. 38-44); ``None``:
+        ``threshold(friction, 0) = G0``, the Tresca energy.  Coulomb's ``G = mu0 [p]_+ + G0`` is not the
+        derivative of an energy: freeze it at an earlier state (``ie.threshold(law.friction, p_old)``), as
+        the package's fixed point does, or let :func:`ngcontact.runner.solve_mesh` solve.
     """
 
     law: InterfaceLaw
@@ -148,11 +153,12 @@ class InterfaceForm:
     gap: ng.CoefficientFunction
     weight: ng.CoefficientFunction
     measure: ng.comp.DifferentialSymbol
+    threshold: ng.CoefficientFunction | None = None
 
     @property
     def density(self) -> ng.CoefficientFunction:
-        """``W(a) w``, the integrand (friction at its threshold ``G0``: the Tresca energy)."""
-        return ie.energy(self.law, self.jump, self.gap) * self.weight
+        """``W(a) w``, the integrand (the friction energy at the fixed ``threshold``)."""
+        return ie.energy(self.law, self.jump, self.gap, self.threshold) * self.weight
 
     @property
     def energy(self):
@@ -166,8 +172,8 @@ class InterfaceForm:
 
     @property
     def traction(self) -> list:
-        """``tau = dW/da`` in the local frame."""
-        return ie.traction(self.law, self.jump, self.gap)
+        """``tau = dW/da`` in the local frame (the same ``threshold``)."""
+        return ie.traction(self.law, self.jump, self.gap, self.threshold)
 
     @property
     def pressure(self) -> ng.CoefficientFunction:
@@ -176,7 +182,7 @@ class InterfaceForm:
 
 
 def interface_form(law, mesh, u_rough, u_counter, *, rough: str, counter: str, interface: str = "interface",
-                   setting: str | None = None, gap=0.0) -> InterfaceForm:
+                   setting: str | None = None, gap=0.0, threshold=None) -> InterfaceForm:
     """The interface term of ``law`` on the caller's mesh (paper eqs. 44, 69-71).
 
     Parameters
@@ -197,6 +203,8 @@ def interface_form(law, mesh, u_rough, u_counter, *, rough: str, counter: str, i
         ``plane_strain`` (2D default), ``axisymmetric`` (mesh ``(x, y)`` = ``(r, z)``) or ``3d``.
     gap
         The macro normal gap ``g0`` (number or CoefficientFunction); ``< 0`` an interference.
+    threshold
+        The friction threshold field ``G`` (see :class:`InterfaceForm`); default ``G0``.
 
     Raises
     ------
@@ -210,4 +218,4 @@ def interface_form(law, mesh, u_rough, u_counter, *, rough: str, counter: str, i
     frame = local_frame(interface_normal(mesh, rough, interface), mesh.dim)
     jump = local_jump(frame, _trace(u_rough) - _trace(u_counter))
     return InterfaceForm(law=law, frame=frame, jump=jump, gap=gap_cf(gap), weight=elasticity.weight(setting),
-                         measure=ng.ds(definedon=mesh.Boundaries(interface)))
+                         measure=ng.ds(definedon=mesh.Boundaries(interface)), threshold=threshold)

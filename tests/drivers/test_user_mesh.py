@@ -211,3 +211,19 @@ def test_solve_mesh_in_3d_as_the_coaxial_scene():
     assert a_["contact_area"] == pytest.approx(s["contact_area"], rel=ROUND_OFF)
     for comp in ("x", "y"):
         assert a_["resultant"][comp] == pytest.approx(s["resultant"][comp], rel=ROUND_OFF)
+
+
+def test_interface_form_friction_takes_the_threshold_given(block_mesh):
+    """A uniform slip ``s`` of the block beyond the Huber width ``w``: the friction energy is ``G (s - w/2) L``
+    (paper eqs. 38-44) with the threshold given, and zero at the law's own ``G0 = 0`` (Coulomb alone)."""
+    from ngcontact.laws.homogenized import Friction
+    mesh, s, w, G = block_mesh, 1e-4, 1e-6, 2e6
+    law = InterfaceLaw(normal=LinearLaw(kn=1e12), friction=Friction(mu=0.3, threshold=0.0, width=w))
+    fes = ng.VectorH1(mesh, definedon=mesh.Materials("block")) * ng.VectorH1(mesh, definedon=mesh.Materials("base"))
+    gfu = ng.GridFunction(fes)
+    gfu.components[0].Set(ng.CF((s, 0.0)))
+    for threshold, expected in ((ng.CF(G), G * (s - w / 2) * 0.02), (None, 0.0)):
+        form = ngcontact.interface_form(law, mesh, *gfu.components, rough="block", counter="base",
+                                        threshold=threshold)
+        assert ng.Integrate(form.energy, mesh) == pytest.approx(expected, rel=1e-12, abs=1e-12 * G * s * 0.02)
+    assert ng.Integrate(form.traction[1] * form.measure, mesh) == pytest.approx(0.0, abs=1e-12 * G)
