@@ -271,27 +271,13 @@ def run(scene, clock) -> Outcome:
             from ngcontact.drivers.run_two_scale import couple
             sol, two_scale = couple(scene, problem, partial(solve_scene, scene))
     with clock.stage("post-processing"):
-        balance = checked_equilibrium(sol)
-        fields = MM.stress_fields(sol)
-        extrema = MM.field_extrema(sol, fields)
-        results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
-                   "dimensions": geo.dims, "law": law_info, "resultant": MM.resultant(sol),
-                   "newton_iterations": sol.history["newton_iterations"],
-                   "coulomb_iterations": sol.history["coulomb_iterations"], "equilibrium": balance}
-        maxima = {name: ext for name, ext in extrema.items()}
-        tables: dict[str, Any] = {}
-        plots: dict[str, Any] = {}
-        interface = interface_2d if geo.mesh.dim == 2 else interface_3d
-        interface(sol, fields, scene, geo, results, maxima, tables, plots)
-        results["maxima"] = maxima
-        results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
+        outcome = measured(sol, geo, law_info, scene.output)
+        results = outcome.results
         if two_scale is not None:
             results["two_scale"] = two_scale
             if "interface" in results:
                 results["interface"]["contact_fraction"] = np.asarray(two_scale["interface_coefficients"]
                                                                      ["contact_fraction"])
-    vtk = {"stress": VtkField(mesh=geo.mesh, fields=dict(fields, u_rough=sol.u_rough, u_counter=sol.u_counter),
-                              subdivision=scene.output.vtk_subdivision)}
     if scene.strength is not None:
         from ngcontact.drivers.run_strength import evaluate
         with clock.stage("strength check"):
@@ -299,9 +285,39 @@ def run(scene, clock) -> Outcome:
         results["strength"] = st["results"]
         if two_scale is not None:
             results["two_scale"]["summary"] = two_scale_summary(two_scale, st["results"])
-        tables["strength_map"] = st["table"]
-        vtk["worst_cell"] = st["vtk"]
-        plots.update(st["plots"])
+        outcome.tables["strength_map"] = st["table"]
+        outcome.vtk["worst_cell"] = st["vtk"]
+        outcome.plots.update(st["plots"])
+    return outcome
+
+
+def measured(sol: M.MacroSolution, geo: gm.MacroGeometry, law_info: dict, output) -> Outcome:
+    """What a macro run reports of a solution on ``geo``: ``results`` (see the module's docstring; without
+    the two-scale and strength parts), the interface table, the figures, the VTK fields and the solver's
+    record.  ``output``: the scene's ``[output]`` section (samples per interface element, VTK subdivision).
+
+    Raises
+    ------
+    ConvergenceError
+        The solution is not in equilibrium (:func:`checked_equilibrium`).
+    """
+    balance = checked_equilibrium(sol)
+    fields = MM.stress_fields(sol)
+    extrema = MM.field_extrema(sol, fields)
+    problem = sol.problem
+    results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
+               "dimensions": geo.dims, "law": law_info, "resultant": MM.resultant(sol),
+               "newton_iterations": sol.history["newton_iterations"],
+               "coulomb_iterations": sol.history["coulomb_iterations"], "equilibrium": balance}
+    maxima = {name: ext for name, ext in extrema.items()}
+    tables: dict[str, Any] = {}
+    plots: dict[str, Any] = {}
+    interface = interface_2d if geo.mesh.dim == 2 else interface_3d
+    interface(sol, fields, output, geo, results, maxima, tables, plots)
+    results["maxima"] = maxima
+    results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
+    vtk = {"stress": VtkField(mesh=geo.mesh, fields=dict(fields, u_rough=sol.u_rough, u_counter=sol.u_counter),
+                              subdivision=output.vtk_subdivision)}
     newton = sol.history["newton"]
     solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],
               "linear_solve_only": sol.history["quadratic"],
@@ -310,10 +326,10 @@ def run(scene, clock) -> Outcome:
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
 
 
-def interface_2d(sol, fields, scene, geo, results, maxima, tables, plots) -> None:
+def interface_2d(sol, fields, output, geo, results, maxima, tables, plots) -> None:
     """The interface of a 2D (plane strain, axisymmetric) solution along its arc: profile, status, peaks,
-    detachment, its table and figures."""
-    prof = MM.interface_profile(sol, scene.output.points_per_element)
+    detachment, its table and figures (``output.points_per_element`` samples per element)."""
+    prof = MM.interface_profile(sol, output.points_per_element)
     results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in prof.items()}
     results["status_counts"] = dict(Counter(prof["status"]))
     maxima["pressure"] = MM.peak_pressure(prof)
@@ -327,7 +343,7 @@ def interface_2d(sol, fields, scene, geo, results, maxima, tables, plots) -> Non
     plots["stress"] = lambda path, d=samples: figures.macro_fields(path, **d)
 
 
-def interface_3d(sol, fields, scene, geo, results, maxima, tables, plots) -> None:
+def interface_3d(sol, fields, output, geo, results, maxima, tables, plots) -> None:
     """The interface of a 3D solution over its surface: samples, contact area, status, peaks, its table and
     figures (and the stress on the section plane where the mesh has one)."""
     surf = MM.interface_surface(sol)
