@@ -17,9 +17,14 @@ step, ``1/k_n``, the tolerance, or ``1/ndof`` for the order), and near the refer
 steep (the difference to the reference shrinks faster than the error itself), so it is an upper estimate
 of the rate; two levels only give a two-point slope, which the report says.
 
-**Target.** With a target ``T``, a level meets it when every headline quantity's error against the
-reference, and the error the level's own report estimates (where it has one; relative in the quantity's
-measure), is at most ``T``.  The reference levels cannot be judged against themselves and are not
+**Other knobs.** A level changes one knob; every other knob keeps the scene's setting and with it that
+knob's share of the error, which the scene's own level measures in that knob's ladder.  Errors add to first
+order, so a level's error in all its knobs is its error along its own knob plus the scene's own level's
+errors along the others (``error_other_knobs``).
+
+**Target.** With a target ``T``, a level meets it when, for every headline quantity, its error in all
+knobs, and the error the level's own report estimates (where it has one; in the quantity's measure), are at
+most ``T``.  The reference levels cannot be judged against themselves and are not
 candidates.  The cheapest level meeting ``T`` (by wall time) is written as a runnable scene
 (``recommended.toml``: the level's table, its file paths made absolute); else the report says that no
 level met it and how close the best came.
@@ -43,7 +48,7 @@ from ngcontact.scene.scene_text import dumps, with_absolute_paths
 log = logging.getLogger(__name__)
 
 CSV_HEADER = ["knob", "level", "setting", "reference", "own_scene", "seconds", "ndof", "quantity", "value",
-              "measure", "error", "estimated_error"]
+              "measure", "error", "error_other_knobs", "estimated_error"]
 
 
 def level_member(job: tuple) -> dict:
@@ -106,7 +111,18 @@ def level_rows(levels: list[Level], runs: dict[str, dict], own_key: str) -> list
                                     "error": None if r is None else error_of(name, entry["value"], r),
                                     "estimated_error": estimate_of(name, entry)}
             rows.append({**row, "seconds": run["seconds"], "ndof": run["ndof"], "quantities": quantities})
+    add_other_knobs(rows)
     return rows
+
+
+def add_other_knobs(rows: list[dict]) -> None:
+    """Set each quantity's ``error_other_knobs``: the scene's own level's errors in the other knobs' ladders
+    (see the module docstring; 0 where the scene's own level is not in a ladder)."""
+    own = {r["knob"]: r["quantities"] for r in rows if r["own_scene"] and "quantities" in r}
+    for r in rows:
+        for name, q in (r.get("quantities") or {}).items():
+            q["error_other_knobs"] = sum((qs.get(name) or {}).get("error") or 0.0
+                                         for knob, qs in own.items() if knob != r["knob"])
 
 
 def slope(x: list[float], e: list[float]) -> float | None:
@@ -117,8 +133,14 @@ def slope(x: list[float], e: list[float]) -> float | None:
     return float(np.polyfit(np.log([a for a, _ in pts]), np.log([b for _, b in pts]), 1)[0])
 
 
+#: an error at most this (in its measure) is round-off: the quantity does not depend on the knob (a resultant
+#: that equilibrium fixes), so it has no rate
+ROUNDOFF = 1e-9
+
+
 def rates(rows: list[dict]) -> dict[str, dict]:
-    """Per knob: its variable, the number of levels fitted and per quantity the observed rate."""
+    """Per knob: its variable, the number of levels fitted and per quantity the observed rate (None where the
+    errors sit at round-off, :data:`ROUNDOFF`, or fewer than two levels remain)."""
     variables = {k.name: k.variable for k in KNOBS}
     out = {}
     for knob in dict.fromkeys(r["knob"] for r in rows):
@@ -128,7 +150,7 @@ def rates(rows: list[dict]) -> dict[str, dict]:
         per = {}
         for name in names:
             pairs = [(xi, r["quantities"][name]["error"]) for xi, r in zip(x, fit)
-                     if (r["quantities"].get(name) or {}).get("error") is not None]
+                     if ((r["quantities"].get(name) or {}).get("error") or 0.0) > ROUNDOFF]
             per[name] = slope([p for p, _ in pairs], [e for _, e in pairs])
         out[knob] = {"variable": variables[knob], "levels_fitted": len(fit), "two_point": len(fit) == 2,
                      "rates": per}
@@ -136,8 +158,10 @@ def rates(rows: list[dict]) -> dict[str, dict]:
 
 
 def level_error(row: dict) -> float:
-    """The largest error of a level over its quantities: against the reference and as its report estimates."""
-    errors = [max(q["error"] or 0.0, q["estimated_error"] or 0.0) for q in row["quantities"].values()]
+    """The largest error of a level over its quantities: in all knobs (:func:`add_other_knobs`) and as its
+    report estimates."""
+    errors = [max((q["error"] or 0.0) + q["error_other_knobs"], q["estimated_error"] or 0.0)
+              for q in row["quantities"].values()]
     return max(errors) if errors else math.inf
 
 
@@ -175,11 +199,11 @@ def table(rows: list[dict]) -> tuple[list[str], list[list]]:
     for r in rows:
         head = [r["knob"], r["level"], r["setting"], int(r["reference"]), int(r["own_scene"])]
         if "quantities" not in r:
-            out.append(head + ["", "", f"failed: {r['failed']}", "", "", "", ""])
+            out.append(head + ["", "", f"failed: {r['failed']}", "", "", "", "", ""])
             continue
         for name, q in r["quantities"].items():
             out.append(head + [r["seconds"], r["ndof"], name, q["value"], q["measure"],
-                               "" if q["error"] is None else q["error"],
+                               "" if q["error"] is None else q["error"], q["error_other_knobs"],
                                "" if q["estimated_error"] is None else q["estimated_error"]])
     return CSV_HEADER, out
 
@@ -215,7 +239,8 @@ def run_study(scene, levels: list[Level], dropped: list[str], solve: Callable, *
     verdict, texts = recommendation(rows, levels, target, scene.base_dir, getattr(scene, "title", ""))
     results = {"reference": "each knob's finest level: a level's error is its difference to that level "
                             "(fractions absolute, other quantities relative), not the error of the finest "
-                            "level itself",
+                            "level itself; error_other_knobs adds the scene's own level's errors along the "
+                            "other knobs, which the level keeps",
                "ladder": {k: [lv.setting for lv in levels if lv.knob == k] for k in dict.fromkeys(
                    lv.knob for lv in levels)},
                "dropped": dropped, "levels": [{k: v for k, v in r.items() if k != "key"} for r in rows],

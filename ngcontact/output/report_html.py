@@ -351,7 +351,8 @@ def study_tables(report: dict) -> str:
     rows = []
     for r in levels:
         qs = r.get("quantities") or {}
-        worst = max((q.get("error") or 0.0 for q in qs.values()), default=None)
+        worst = max(((q.get("error") or 0.0) + (q.get("error_other_knobs") or 0.0) for q in qs.values()),
+                    default=None)
         rows.append([r.get("knob"), r.get("setting"), "reference" if r.get("reference") else
                      ("the scene" if r.get("own_scene") else ""), fmt(r.get("seconds"), "s"), fmt(r.get("ndof")),
                      r.get("failed") or fmt(worst)])
@@ -359,7 +360,7 @@ def study_tables(report: dict) -> str:
     rate_rows = [[k, v.get("variable"), name, fmt(rate)] for k, v in rates.items()
                  for name, rate in (v.get("rates") or {}).items()]
     return ("<h2>Accuracy study</h2><p>" + _e(_get(report, "results.reference") or "") + "</p>"
-            + html_table(["knob", "level", "", "wall time", "unknowns", "largest error"], rows)
+            + html_table(["knob", "level", "", "wall time", "unknowns", "largest error (all knobs)"], rows)
             + "<h3>Observed rates (error ~ x^rate)</h3>" + html_table(["knob", "x", "quantity", "rate"], rate_rows))
 
 
