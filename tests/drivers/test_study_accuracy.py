@@ -91,6 +91,28 @@ def test_the_femur_ladder_brackets_the_scene_and_refines_it_once():
     assert h[2].key == order[1].key      # the scene's own level, run once
 
 
+@pytest.mark.parametrize("scene, knobs", [
+    ("femur_stem_two_scale.toml", {"h": "discretization.maxh", "order": "discretization.order",
+                                   "tolerance": "two_scale.table_tol"}),
+    ("direct/block_rect_valleys.toml", {"h": "discretization.elements_per_period", "order": "discretization.order"}),
+    ("cells/westergaard_exact.toml", {"grid": "discretization.grid", "tolerance": "discretization.tolerance"}),
+])
+def test_each_kind_gets_the_knobs_it_has(scene, knobs):
+    path = ROOT / "geometries" / scene
+    levels, _ = ladder(loader.load(path), loader.parsed(path), 4)
+    assert {lv.knob: next(iter(k for k in lv.changes if k == knobs[lv.knob])) for lv in levels} == knobs
+
+
+def test_a_scene_written_as_toml_reads_back_the_same():
+    import glob
+    import tomllib
+    from ngcontact.scene.scene_text import dumps
+    for path in glob.glob(str(ROOT / "geometries" / "**" / "*.toml"), recursive=True):
+        with open(path, "rb") as fh:
+            data = tomllib.load(fh)
+        assert tomllib.loads(dumps(data, "a comment\non two lines")) == data, path
+
+
 def test_measures():
     assert measure("contact_fraction_load3") == "absolute" and measure("safety_factor") == "relative"
     assert error_of("safety_factor", 4.4, 4.0) == pytest.approx(0.1)
