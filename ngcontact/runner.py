@@ -319,7 +319,8 @@ def study_accuracy(path: str, levels: int | None = None, target: float | None = 
     ladder, dropped = rl.ladder(scene, loader.parsed(path), rl.DEFAULT_LEVELS if levels is None else levels)
     clock = Clock(progress)
     for knob in dict.fromkeys(lv.knob for lv in ladder):
-        clock.note(f"ladder {knob}: " + "; ".join(lv.setting for lv in ladder if lv.knob == knob))
+        clock.note(f"ladder {knob} (unknowns over the scene's): " + "; ".join(
+            lv.setting + ("" if lv.size is None else f" (~{lv.size:.2g})") for lv in ladder if lv.knob == knob))
     for line in dropped:
         clock.note(f"left out: {line}")
     distinct = len({lv.key for lv in ladder})

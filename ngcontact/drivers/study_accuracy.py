@@ -64,15 +64,18 @@ def level_member(job: tuple) -> dict:
 
 
 def run_levels(levels: list[Level], solve: Callable, clock=None) -> dict[str, dict]:
-    """Run every distinct level once, as one batch; ``{level key: member result}``."""
+    """Run every distinct level once, as one batch, the largest first (the batch's longest members start first,
+    and the first run of a process, which pays its warm-up, is the one that hides it best); ``{level key:
+    member result}``."""
     distinct: dict[str, Level] = {}
     for lv in levels:
         distinct.setdefault(lv.key, lv)
-    jobs = [(solve, lv.scene) for lv in distinct.values()]
-    names = [f"{lv.knob}: {lv.setting}" for lv in distinct.values()]
+    order = sorted(distinct, key=lambda k: -(distinct[k].size or 1.0))
+    jobs = [(solve, distinct[k].scene) for k in order]
+    names = [f"{distinct[k].knob}: {distinct[k].setting}" for k in order]
     with clock.stage("levels") if clock is not None else contextlib.nullcontext():
         runs = executor.current().map(level_member, jobs, names, label="accuracy levels")
-    return dict(zip(distinct, runs))
+    return dict(zip(order, runs))
 
 
 def error_of(name: str, value: float, ref: float) -> float:
@@ -99,7 +102,8 @@ def level_rows(levels: list[Level], runs: dict[str, dict], own_key: str) -> list
         for lv in mine:
             run = runs[lv.key]
             row: dict[str, Any] = {"knob": knob, "level": lv.index, "setting": lv.setting, "key": lv.key,
-                                   "parameter": lv.parameter, "reference": lv is ref, "own_scene": lv.key == own_key}
+                                   "parameter": lv.parameter, "size_estimate": lv.size, "reference": lv is ref,
+                                   "own_scene": lv.key == own_key}
             if "failed" in run:
                 rows.append({**row, "failed": run["failed"]})
                 continue

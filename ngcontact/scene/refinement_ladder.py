@@ -18,7 +18,10 @@ knob's keys replaced (all other keys as the user wrote them):
 
 Every ladder ends one level beyond the scene: its level ``n - 2`` is the user's own discretization
 (where the knob's range allows; an order ladder starts at the lowest admissible order), the levels
-below are coarser, its last is the finest and serves as the study's reference for that knob.  Each
+below are coarser, its last is the finest and serves as the study's reference for that knob.  So more
+levels only add coarser ones, and no level is larger than one refinement of the scene (``2^d`` its
+unknowns for ``h`` in ``d`` dimensions, ``((p + 1) / p)^d`` for the order, twice its grid points per
+direction): the study's size is bounded by the scene's own.  Each
 level is validated as the scene itself is (:func:`ngcontact.scene.loader.from_dict`): a level the
 scene's own checks refuse (a mesh beyond ``max_elements``, a grid beyond the spectral bound, a penalty
 outside its admissible ratio) is dropped with its reason, which bounds the study's size; a knob left
@@ -49,6 +52,7 @@ class Level:
     index: int
     changes: dict[str, Any]      # dotted key -> value of this level
     parameter: float | None      # the knob's variable at this level (None: the unknowns, known after the run)
+    size: float | None           # the level's unknowns over the scene's, estimated (None: not known beforehand)
     data: dict = field(repr=False, compare=False)
     scene: Any = field(repr=False, compare=False, default=None)
 
@@ -80,6 +84,17 @@ class Knob:
     def parameter(self, changes: dict[str, Any]) -> float | None:
         raise NotImplementedError
 
+    def size(self, scene, changes: dict[str, Any]) -> float | None:
+        """The level's unknowns over the scene's, estimated (None: the knob does not fix them)."""
+        return None
+
+
+def space_dim(scene) -> int:
+    """The dimension the unknowns fill: a cell's, 3 for a 3D macro scene, else 2."""
+    if scene.kind == "cell":
+        return scene.geometry.dim
+    return 3 if getattr(scene.geometry, "setting", "") == "3d" else 2
+
 
 def _steps(n: int) -> range:
     """Refinement steps relative to the scene: ``-(n - 2), ..., 0, 1``."""
@@ -108,6 +123,9 @@ class MeshSize(Knob):
     def parameter(self, changes):
         return changes["discretization.maxh"]
 
+    def size(self, scene, changes):
+        return (scene.discretization.maxh / changes["discretization.maxh"]) ** space_dim(scene)
+
 
 class Order(Knob):
     name, variable = "order", "1/ndof"
@@ -125,6 +143,10 @@ class Order(Knob):
     def parameter(self, changes):
         return None
 
+    def size(self, scene, changes):
+        """Lagrange elements of order ``q`` carry about ``q^d`` nodes each."""
+        return (changes["discretization.order"] / scene.discretization.order) ** space_dim(scene)
+
 
 class SpectralGrid(Knob):
     name, variable = "grid", "period / grid"
@@ -139,6 +161,9 @@ class SpectralGrid(Knob):
     def parameter(self, changes):
         return 1.0 / changes["discretization.grid"]
 
+    def size(self, scene, changes):
+        return (changes["discretization.grid"] / grid_of(scene)) ** (scene.geometry.dim - 1)
+
 
 class Penalty(Knob):
     name, variable = "k_n", "1/k_n"
@@ -151,6 +176,9 @@ class Penalty(Knob):
 
     def parameter(self, changes):
         return 1.0 / changes["contact.k_n"]
+
+    def size(self, scene, changes):
+        return 1.0
 
 
 class Tolerance(Knob):
@@ -229,9 +257,9 @@ def ladder(scene, data: dict, n: int) -> tuple[list[Level], list[str]]:
         mine = []
         for k, changes in enumerate(knob.values(scene, n)):
             level_data = with_keys(data, changes)
-            level = Level(knob.name, k, changes, knob.parameter(changes), level_data)
+            level = Level(knob.name, k, changes, knob.parameter(changes), knob.size(scene, changes), level_data)
             try:
-                level = Level(knob.name, k, changes, level.parameter, level_data,
+                level = Level(knob.name, k, changes, level.parameter, level.size, level_data,
                               loader.from_dict(level_data, base_dir=scene.base_dir))
             except SceneError as exc:
                 dropped.append(f"{knob.name} level {level.setting}: refused by the scene's checks ({exc})")
