@@ -92,27 +92,7 @@ def _parser() -> argparse.ArgumentParser:
     chk = sub.add_parser("check", help="validate a scene file without solving",
                          description="Validate a scene file and list the effects it calls for.")
     chk.add_argument("scene", help="scene file (TOML)")
-    st = sub.add_parser("study", help="run a study of a scene (epsilon: resolved against homogenized; accuracy: "
-                        "the work-precision diagram of the scene's discretization)",
-                        description="epsilon: a 'direct' scene's resolved runs against the homogenized laws; write "
-                                    "DIR/report.json, DIR/epsilon.csv and DIR/epsilon.png.  accuracy: a ladder over "
-                                    "the scene's discretization knobs (mesh size, order, spectral grid, penalty, "
-                                    "tolerance), each level a whole run; write DIR/report.json, "
-                                    "DIR/accuracy_study.csv, a PNG per headline quantity (error against wall time) "
-                                    "and, with --target met, DIR/recommended.toml.")
-    st.add_argument("study", choices=("epsilon", "accuracy"), help="which study")
-    st.add_argument("scene", help="scene file (TOML): epsilon, of kind 'direct' with a [study] section; accuracy, "
-                                  "of kind cell, macro or direct")
-    st.add_argument("--periods", type=int, nargs="+", metavar="N", help="epsilon: numbers of periods (default: the "
-                                                                        "scene's)")
-    st.add_argument("--target", type=float, metavar="T", help="accuracy: the relative error to meet, in (0, 1); "
-                    "the cheapest level meeting it is written as DIR/recommended.toml")
-    st.add_argument("--levels", type=int, metavar="N", help="accuracy: levels per knob, in [3, 6] (default 4: two "
-                    "coarser than the scene, the scene, one finer)")
-    st.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon or "
-                                                 "_accuracy)")
-    st.add_argument("--quiet", action="store_true", help="no progress lines")
-    _compute_options(st)
+    _study_parser(sub)
     ex = sub.add_parser("export", help="write a cell's or macro scene's interface law for Abaqus, CalculiX, "
                         "ANSYS or as JSON", description="Export the homogenized interface law of a cell scene (its "
                         "direction bundle) or of a macro scene (the law its interface uses).")
@@ -129,6 +109,32 @@ def _parser() -> argparse.ArgumentParser:
     ex.add_argument("--mu", type=float, metavar="MU", help="friction coefficient to write, >= 0 (default: the macro "
                     "scene's interface.mu, else |k_nt0|/k_n0)")
     return p
+
+
+def _study_parser(sub) -> None:
+    """The ``study`` command: epsilon and accuracy."""
+    st = sub.add_parser("study", help="run a study of a scene (epsilon: resolved against homogenized; accuracy: "
+                        "the work-precision diagram of the scene's discretization)",
+                        description="epsilon: a 'direct' scene's resolved runs against the homogenized laws; write "
+                                    "DIR/report.json, DIR/epsilon.csv and DIR/epsilon.png.  accuracy: a ladder over "
+                                    "the scene's discretization knobs (mesh size, order, spectral grid, penalty, "
+                                    "tolerance), each level a whole run; write DIR/report.json, "
+                                    "DIR/accuracy_study.csv, a PNG per headline quantity (error against wall time) "
+                                    "and, with --target met, DIR/recommended.toml.")
+    st.add_argument("study", choices=("epsilon", "accuracy"), help="which study")
+    st.add_argument("scene", help="scene file (TOML): epsilon, of kind 'direct' with a [study] section; accuracy, "
+                                  "of kind cell, macro or direct")
+    st.add_argument("--periods", type=int, nargs="+", metavar="N", help="epsilon: numbers of periods (default: the "
+                                                                        "scene's)")
+    st.add_argument("--target", type=float, metavar="T", help="accuracy: the error to meet, in (0, 1) (contact "
+                    "fractions absolute, other quantities relative); the cheapest level meeting it is written as "
+                    "DIR/recommended.toml")
+    st.add_argument("--levels", type=int, metavar="N", help="accuracy: levels per knob, in [3, 6] (default 4: two "
+                    "coarser than the scene, the scene, one finer)")
+    st.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon or "
+                                                 "_accuracy)")
+    st.add_argument("--quiet", action="store_true", help="no progress lines")
+    _compute_options(st)
 
 
 def _workers(text: str) -> int:
@@ -183,6 +189,8 @@ def main(argv=None) -> int:
         if args.command == "study" and args.study == "accuracy":
             return _study_accuracy(args, compute)
         if args.command == "study":
+            if args.target is not None or args.levels is not None:
+                return _fail(EXIT_SCENE, "--target, --levels: options of the accuracy study only")
             return _study(args.scene, args.periods, args.out, quiet=args.quiet, compute=compute)
         return _run(args.scene, args.out, quiet=args.quiet, compute=compute)
     except KeyboardInterrupt:
@@ -291,7 +299,8 @@ def _study_accuracy(args, compute: dict) -> int:
     if args.periods is not None:
         return _fail(EXIT_SCENE, "--periods: an option of the epsilon study only")
     if args.target is not None and not 0 < args.target < 1:
-        return _fail(EXIT_SCENE, f"--target {args.target:g}: a relative error in (0, 1), e.g. 0.01 for 1 %")
+        return _fail(EXIT_SCENE, f"--target {args.target:g}: an error in (0, 1) (contact fractions absolute, other "
+                                 "quantities relative), e.g. 0.01 for 1 %")
     if args.levels is not None and not 3 <= args.levels <= 6:
         return _fail(EXIT_SCENE, f"--levels {args.levels}: an integer in [3, 6] (levels per knob)")
 

@@ -303,7 +303,7 @@ def study_accuracy(path: str, levels: int | None = None, target: float | None = 
     The ladder (``levels`` per knob, default :data:`~ngcontact.scene.refinement_ladder.DEFAULT_LEVELS`) is
     stated to ``progress`` before anything runs; its levels are one batch of whole runs
     (:func:`level_report`), on ``workers`` / ``scheduler`` as in :func:`solve`.  ``target`` (a relative
-    error in ``(0, 1)``) asks for the cheapest level meeting it.
+    error in ``(0, 1)``, absolute for contact fractions, else relative) asks for the cheapest level meeting it.
 
     Raises
     ------
@@ -314,7 +314,8 @@ def study_accuracy(path: str, levels: int | None = None, target: float | None = 
     import json
     from ngcontact.scene import refinement_ladder as rl
     if target is not None and not 0 < target < 1:
-        raise SceneError("--target", target, "a relative error in (0, 1), e.g. 0.01 for 1 %")
+        raise SceneError("--target", target, "an error in (0, 1) (contact fractions absolute, other quantities "
+                         "relative), e.g. 0.01 for 1 %")
     scene = loader.load(path)
     ladder, dropped = rl.ladder(scene, loader.parsed(path), rl.DEFAULT_LEVELS if levels is None else levels)
     clock = Clock(progress)

@@ -181,19 +181,21 @@ def recommendation(rows: list[dict], levels: list[Level], target: float | None, 
         return {"target": target, "met": False,
                 "statement": f"no level of the study met the target {target:g}"
                              + ("" if best is None else f"; the closest, {best['knob']}: {best['setting']}, has "
-                                f"error {level_error(best):.3g}") + "; study a finer ladder (the scene refined, "
-                                "or --levels larger)"}, {}
+                                f"error {level_error(best):.3g}") + "; the finest levels are the references and "
+                                "cannot be judged against themselves: make a reference level the scene and study it "
+                                "again"}, {}
     best = meeting[0]
     level = next(lv for lv in levels if lv.key == best["key"])
     text = dumps(with_absolute_paths(level.data, base_dir),
                  f"{title or 'scene'}: the cheapest level of 'ngcontact study accuracy' meeting the target "
                  f"{target:g}\n({best['knob']}: {best['setting']}; error {level_error(best):.3g} against the "
-                 f"finest level of its ladder; {best['seconds']:.3g} s)")
+                 f"finest level of each knob's ladder; {best['seconds']:.3g} s)")
     return {"target": target, "met": True, "knob": best["knob"], "setting": best["setting"],
             "error": level_error(best), "seconds": best["seconds"], "ndof": best["ndof"],
             "file": "recommended.toml",
-            "statement": f"the cheapest level meeting {target:g}: {best['knob']}: {best['setting']} "
-                         f"(error {level_error(best):.3g}, {best['seconds']:.3g} s); written as recommended.toml"
+            "statement": f"the cheapest level meeting {target:g}: {best['knob']}: {best['setting']}"
+                         + (" (the scene as it is)" if best["own_scene"] else "")
+                         + f" (error {level_error(best):.3g}, {best['seconds']:.3g} s); written as recommended.toml"
             }, {"recommended.toml": text}
 
 
