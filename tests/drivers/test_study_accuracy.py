@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import os
 import sys
 import time
@@ -134,3 +135,43 @@ def test_the_femur_study_gives_rates_within_20_solves(tmp_path):
         rates = res["rates"][knob]["rates"]
         assert rates["safety_factor"] > 0.5 and rates["peak_pressure"] > 0
     assert wall < 20 * res["seconds_own_scene"], (wall, res["seconds_own_scene"])
+
+
+def _fake_solve(scene):
+    """A stand-in for a run: the 'quantity' converges like h^2 towards 1; k_n's share is 1/k_n."""
+    if scene["fail"]:
+        raise ValueError("the mesher gave up")
+    seconds = 1 / scene["h"] ** 2 + 1e-4 * scene["k_n"]
+    return {"kind": "direct", "ndof": int(1 / scene["h"] ** 2), "timings": {"total": seconds},
+            "results": {"contact_fraction": 0.5 + scene["h"] ** 2 + 1 / scene["k_n"], "contact_force": 2.0}}
+
+
+def test_failed_levels_references_other_knobs_and_the_target():
+    from ngcontact.drivers import study_accuracy as sa
+    from ngcontact.scene.refinement_ladder import Level
+
+    def level(knob, k, h, k_n, fail=False):
+        data = {"h": h, "k_n": k_n, "fail": fail}
+        return Level(knob, k, {"h": h} if knob == "h" else {"k_n": k_n}, h if knob == "h" else 1 / k_n, None,
+                     data, scene=None)
+
+    levels = [level("h", 0, 0.4, 1e3), level("h", 1, 0.2, 1e3), level("h", 2, 0.1, 1e3), level("h", 3, 0.05, 1e3,
+                                                                                              fail=True),
+              level("k_n", 0, 0.2, 1e1), level("k_n", 1, 0.2, 1e2), level("k_n", 2, 0.2, 1e3), level("k_n", 3, 0.2, 1e4)]
+    runs = {lv.key: sa.level_member((lambda s: _fake_solve(s), lv.data)) for lv in levels}
+    rows = sa.level_rows(levels, runs, own_key=levels[1].key)
+    h = [r for r in rows if r["knob"] == "h"]
+    assert "mesher gave up" in h[3]["failed"] and h[2]["reference"]          # the finest level that ran
+    assert h[1]["own_scene"] and h[1]["quantities"]["contact_fraction"]["error"] == pytest.approx(0.04 - 0.01)
+    # the h ladder's levels keep k_n = 1e3, whose error the scene's own level measures in the k_n ladder
+    assert h[0]["quantities"]["contact_fraction"]["error_other_knobs"] == pytest.approx(1e-3 - 1e-4)
+    # against the finest level the slope overestimates the rate 2 (the docstring's upper estimate)
+    assert sa.rates(rows)["h"]["rates"]["contact_fraction"] == pytest.approx(math.log2(0.15 / 0.03))
+    assert sa.rates(rows)["k_n"]["rates"]["contact_force"] is None       # the same on every level
+    # k_n = 100 at the scene's h: 0.0099 along k_n plus the scene's 0.03 along h; cheaper than the scene
+    verdict, texts = sa.recommendation(rows, levels, 0.05, ".", "t")
+    assert verdict["met"] and verdict["knob"] == "k_n" and verdict["setting"] == "k_n = 100"
+    assert verdict["error"] == pytest.approx(0.0099 + 0.03)
+    assert "recommended.toml" in texts
+    verdict, texts = sa.recommendation(rows, levels, 0.02, ".", "t")   # every level keeps 0.03 along h
+    assert not verdict["met"] and "no level" in verdict["statement"] and not texts
