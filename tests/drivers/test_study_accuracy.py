@@ -175,3 +175,18 @@ def test_failed_levels_references_other_knobs_and_the_target():
     assert "recommended.toml" in texts
     verdict, texts = sa.recommendation(rows, levels, 0.02, ".", "t")   # every level keeps 0.03 along h
     assert not verdict["met"] and "no level" in verdict["statement"] and not texts
+
+
+def test_the_reports_own_estimates_join_the_headline_quantities():
+    report = {"kind": "macro", "results": {
+        "maxima": {"pressure": {"pressure": 2.0e6}, "von_mises": {"max": {"value": 5.0e6}}},
+        "resultant": {"r": 3.0, "z": 4.0},
+        "accuracy": {"quantities": [{"name": "peak_pressure", "value": 2.0e6, "error": 2.0e4},
+                                    {"name": "tresca", "value": 4.0e6, "error": 4.0e3},
+                                    {"name": "contact_fraction", "load": 1, "value": 0.5, "error": None}]}}}
+    got = headline(report)
+    assert got["resultant"] == {"value": 5.0, "estimate": None}
+    assert got["peak_pressure"]["estimate"] == 2.0e4 and got["tresca"] == {"value": 4.0e6, "estimate": 4.0e3}
+    assert "safety_factor" not in got and "contact_fraction_load1" not in got    # no strength; no error given
+    from ngcontact.drivers.study_accuracy import estimate_of
+    assert estimate_of("peak_pressure", got["peak_pressure"]) == pytest.approx(0.01)
