@@ -349,3 +349,54 @@ def solve_mesh(mesh, law, *, rough: str, counter: str, materials: dict, interfac
     if out is not None:
         write_outputs(out, report, outcome)
     return report, outcome
+
+
+def level_report(scene) -> dict:
+    """A level of an accuracy study run as ``ngcontact run`` runs a scene, its batches in this process: the
+    report (module-level, so that a batch's worker can call it).  The kind's driver is imported first, so that
+    the level's wall time is its run's, not the import's."""
+    driver(scene)
+    report, _ = solve(scene, workers=1)
+    return report
+
+
+def study_accuracy(path: str, levels: int | None = None, target: float | None = None,
+                   progress: Callable[[str], None] | None = None, *, workers: int | None = None,
+                   scheduler: str | None = None, batch_progress=None) -> tuple[dict, Outcome]:
+    """The accuracy study of the scene file ``path`` (:mod:`ngcontact.drivers.study_accuracy`), as a report;
+    no file I/O.
+
+    The ladder (``levels`` per knob, default :data:`~ngcontact.scene.refinement_ladder.DEFAULT_LEVELS`) is
+    stated to ``progress`` before anything runs; its levels are one batch of whole runs
+    (:func:`level_report`), on ``workers`` / ``scheduler`` as in :func:`solve`.  ``target`` (a relative
+    error in ``(0, 1)``, absolute for contact fractions, else relative) asks for the cheapest level meeting it.
+
+    Raises
+    ------
+    SceneError
+        The scene is invalid or of a kind the study does not refine, ``levels`` or ``target`` is out of
+        range, or no knob of the scene gives enough admissible levels.
+    """
+    import json
+    from ngcontact.scene import refinement_ladder as rl
+    if target is not None and not 0 < target < 1:
+        raise SceneError("--target", target, "an error in (0, 1) (contact fractions absolute, other quantities "
+                         "relative), e.g. 0.01 for 1 %")
+    scene = loader.load(path)
+    ladder, dropped = rl.ladder(scene, loader.parsed(path), rl.DEFAULT_LEVELS if levels is None else levels)
+    clock = Clock(progress)
+    for knob in dict.fromkeys(lv.knob for lv in ladder):
+        clock.note(f"ladder {knob} (unknowns over the scene's): " + "; ".join(
+            lv.setting + ("" if lv.size is None else f" (~{lv.size:.2g})") for lv in ladder if lv.knob == knob))
+    for line in dropped:
+        clock.note(f"left out: {line}")
+    distinct = len({lv.key for lv in ladder})
+    clock.note(f"{distinct} distinct runs (the scene's own level is shared by its ladders)")
+    own_key = json.dumps(loader.as_dict(scene), sort_keys=True, default=str)
+    with batches(scene, workers, scheduler, batch_progress, start=True, note=progress, members=distinct) as ex:
+        from ngcontact.drivers.study_accuracy import run_study
+        outcome = run_study(scene, ladder, dropped, level_report, own_key=own_key, target=target, clock=clock)
+    report = build_report(kind="accuracy-study", title=getattr(scene, "title", ""), scene=loader.as_dict(scene),
+                          effects=loader.effects(scene), outcome=outcome, timings=clock.total(),
+                          version=__version__, threads=1, compute=ex.describe())
+    return report, outcome

@@ -356,3 +356,28 @@ def ensemble_band(path: str, shrink: dict) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def work_precision(path: str, quantity: str, measure: str, series: dict, target: float | None = None) -> None:
+    """Error of ``quantity`` against wall time, log-log, one line per knob (``series``: knob -> (seconds,
+    errors) of its levels; levels with a zero error are left out); the target as a horizontal line."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    drawn = False
+    for k, (knob, (seconds, errors)) in enumerate(series.items()):
+        pts = [(t, e) for t, e in zip(seconds, errors) if t > 0 and e > 0]
+        if pts:
+            ax.loglog([t for t, _ in pts], [e for _, e in pts], "o-", color=f"C{k}", label=knob)
+            drawn = True
+    if target is not None:
+        ax.axhline(target, color="gray", lw=0.8, ls="--", label=f"target {target:g}")
+    if not drawn:
+        ax.text(0.5, 0.5, "every level equals the reference", ha="center", transform=ax.transAxes)
+    ax.set_xlabel("wall time of the level [s]")
+    ax.set_ylabel(f"{measure} error against the finest level")
+    ax.set_title(quantity, fontsize=10)
+    if drawn or target is not None:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
