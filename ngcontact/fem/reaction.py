@@ -70,3 +70,35 @@ def boundary_reaction(mesh, setting: str, law, u, region: str, label: str, order
         work = ng.InnerProduct(sigma, elasticity.strain(v, setting)) * w
         out[name] = -float(ng.Integrate(work, mesh, definedon=mesh.Materials(region)))
     return out
+
+
+def support_reactions(mesh, setting: str, order: int, supports, bodies) -> dict:
+    """Reaction force (and, in plane strain, moment) of every supported boundary, summed over the bodies.
+
+    ``supports``: the problem's :class:`~ngcontact.fem.two_body.Support`
+    tuple; ``bodies``: ``(region, law, u)`` of each body.  Only the fixed
+    components are kept (a free component's "reaction" is the residual,
+    zero); in axisymmetry the radial one is dropped (its net force over a
+    revolution vanishes) and there is no moment; a support fixing every
+    component in plane strain also reports its moment about the boundary's
+    mid-point (:func:`boundary_reaction`).  A boundary fixed in no kept
+    component has no entry.
+    """
+    comps = COMPONENTS[setting]
+    out = {}
+    for s in supports:
+        label = s.label
+        keep = [c for c in (s.components or comps) if not (setting == "axisymmetric" and c == "r")]
+        if setting == "plane_strain" and not s.components:
+            keep.append("moment")
+        if not keep:
+            continue
+        xs = [mesh[v].point for el in mesh.Elements(ng.BND) if el.mat == label for v in el.vertices]
+        about = tuple(0.5 * (min(p[i] for p in xs) + max(p[i] for p in xs)) for i in range(mesh.dim))
+        total: dict | None = None
+        for region, law, u in bodies:
+            r = boundary_reaction(mesh, setting, law, u, region, label, order, about=about)
+            total = r if total is None else {k: total[k] + r[k] for k in r}
+        assert total is not None  # every problem has two bodies
+        out[label] = {k: total[k] for k in keep}
+    return out
