@@ -243,7 +243,7 @@ def reactions(sol: M.MacroSolution) -> dict:
     p = sol.problem
     return support_reactions(p.mesh, p.setting, p.order, p.supports,
                              ((p.rough, p.materials[p.rough], sol.u_rough),
-                              (p.counter, p.materials[p.counter], sol.u_counter)))
+                              (p.counter, p.materials[p.counter], sol.u_counter)), p.body_forces)
 
 
 def solve_scene(scene, problem: M.MacroProblem, start=None, rtol: float | None = None) -> M.MacroSolution:
