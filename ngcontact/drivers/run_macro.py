@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 import ngsolve as ng
 
-from ngcontact.drivers.supports import supports_on
+from ngcontact.drivers.mesh_supports import supports_on
 from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
                                      law_from_cell, law_from_file, linear_solver)
 from ngcontact.laws import homogenized as il
@@ -207,7 +207,7 @@ def check_model(scene) -> None:
 
 def supports_of(scene, mesh) -> tuple[M.Support, ...]:
     """The scene's ``[[supports]]`` on ``mesh`` as the problem's supports
-    (:func:`ngcontact.drivers.supports.supports_on`: symmetry planes and slopes read off the mesh)."""
+    (:func:`ngcontact.drivers.mesh_supports.supports_on`: symmetry planes and slopes read off the mesh)."""
     return supports_on(scene.supports, mesh, scene.geometry.setting)
 
 

@@ -30,7 +30,7 @@ import logging
 import numpy as np
 
 from ngcontact.drivers.build import body_laws, micro_friction
-from ngcontact.drivers.supports import supports_on
+from ngcontact.drivers.mesh_supports import supports_on
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry import resolved_shapes as rs
@@ -69,7 +69,7 @@ def shape_of(scene) -> rs.ResolvedShape:
 
 
 def supports_of(scene, mesh) -> tuple:
-    """The supports on ``mesh`` (:func:`ngcontact.drivers.supports.supports_on`); a support's slope runs
+    """The supports on ``mesh`` (:func:`ngcontact.drivers.mesh_supports.supports_on`); a support's slope runs
     along ``x`` on the shape's horizontal boundaries, else along ``y``."""
     horizontal = shape_of(scene).horizontal
     return supports_on(scene.supports, mesh, scene.geometry.setting,

@@ -11,7 +11,7 @@ from netgen.geom2d import SplineGeometry
 from ngcontact import cli
 from ngcontact.drivers import run_macro as RM
 from ngcontact.drivers import run_resolved as drv
-from ngcontact.drivers.supports import supports_on
+from ngcontact.drivers.mesh_supports import supports_on
 from ngcontact.fem import two_body
 from ngcontact.fem.materials import isotropic
 from ngcontact.laws import homogenized as il
