@@ -64,6 +64,30 @@ def test_the_affine_support_is_the_resolved_kinds_tilt_on_the_same_mesh():
     assert np.abs(fields[1] - fields[0]).max() <= 1e-12 * np.abs(fields[0]).max()
 
 
+def test_an_affine_support_in_3d_and_axisymmetry_prescribes_u0_plus_G_x():
+    """Every dof of the top face carries u0 + G x (the field is affine, so order 2 holds it exactly)."""
+    from ngcontact.geometry import bodies as gm
+    for geo, setting, u0, G in (
+            (gm.coaxial_3d(0.0, 1.0, 2.0, 1.0, maxh=0.6), "3d", (1e-4, -2e-4, 3e-4),
+             ((1e-4, 2e-4, 0.0), (0.0, -1e-4, 5e-5), (3e-4, 0.0, -2e-4))),
+            (gm.coaxial_axisymmetric(0.0, 1.0, 2.0, 1.0, maxh=0.3), "axisymmetric", (0.0, -1e-4),
+             ((0.0, 0.0), (2e-4, 0.0)))):
+        mesh = geo.mesh
+        support = supports_on((SupportSpec(boundary="top", u0=u0, G=G),), mesh, setting)
+        fes = two_body.spaces(mesh, setting, ("inner", "outer"), support, 2)
+        gfu = ng.GridFunction(fes)
+        two_body.set_dirichlet(mesh, setting, support, gfu)
+        pts = {v for el in mesh.Elements(ng.BND) if el.mat == "top" for v in el.vertices}
+        for v in pts:
+            x = np.array(mesh[v].point)
+            r = np.hypot(x[0], x[1] if setting == "3d" else 0.0)
+            if abs(r - 1.0) < 1e-9:
+                continue                  # on the interface: a point of both bodies
+            u = gfu.components[0 if r < 1.0 else 1]
+            got = np.array(u(mesh(*x)))
+            assert np.allclose(got, np.array(u0) + np.array(G) @ x, rtol=0, atol=1e-15), (x, got)
+
+
 # ---------------------------------------------------------------- symmetry
 def _blocks(x0: float, x1: float, left: str, maxh: float) -> ng.Mesh:
     """Block [x0, x1] x [0, 1] (rough) on a base [x0, x1] x [-1, 0]; the left faces labelled ``left``."""
