@@ -54,18 +54,19 @@ def boundary_reaction(mesh, setting: str, law, u, region: str, label: str, order
     Returns
     -------
     dict
-        Force components by name (``x, y`` or ``r, z``; axisymmetric: per
-        full revolution, ``r`` omitted) and ``moment`` (plane strain).
+        Force components by name (``x, y``, ``x, y, z`` or ``r, z``;
+        axisymmetric: per full revolution, ``r`` omitted) and ``moment``
+        (plane strain).
     """
     comps = COMPONENTS[setting]
     V = ng.VectorH1(mesh, order=order, definedon=mesh.Materials(region))
     v = ng.GridFunction(V)
     sigma = elasticity.stress(law, u, setting)
     w = elasticity.weight(setting)
-    fields = {c: ng.CF(tuple(1.0 if j == i else 0.0 for j in range(2))) for i, c in enumerate(comps)}
+    fields = {c: ng.CF(tuple(1.0 if j == i else 0.0 for j in range(mesh.dim))) for i, c in enumerate(comps)}
     if setting == "plane_strain":
         fields["moment"] = ng.CF((-(ng.y - about[1]), ng.x - about[0]))
-    else:
+    elif setting == "axisymmetric":
         fields.pop("r")
     out = {}
     for name, cf in fields.items():

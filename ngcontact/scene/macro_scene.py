@@ -8,6 +8,10 @@ law comes from explicit numbers (``linear`` K0, ``bundle`` of directions,
 ``tabulated`` normal law) or from a ``cell`` scene named by
 ``interface.cell`` (its direction bundle, computed on the fly and cached on
 disk; see :mod:`ngcontact.coupling.cell_law`), with homogenized friction on top.
+Supports are those of the ``direct`` kind (:mod:`ngcontact.scene.supports`:
+constant, tilted, affine ``u0 + G x``, symmetry planes), on any boundary
+label the mesh carries; ``[body_forces]`` loads each body with a constant
+force density.  A ``coaxial`` shape with ``a = 0`` has a solid inner shaft.
 Lengths in metres, stresses in pascals, interface stiffnesses in Pa/m.
 
 Two optional sections extend the macro solve (this kind rather than new kinds,
