@@ -336,6 +336,11 @@ def test_a_slope_in_3d_and_a_shaft_without_its_axis_are_refused(tmp_path, capsys
     assert capsys.readouterr().err.rstrip("\n").endswith(
         "a solid shaft (coaxial with a = 0) in axisymmetry needs u_r = 0 on its axis: add [[supports]] "
         "boundary = \"axis\", components = [\"r\"]")
+    path.write_text(SHAFT.format(setting="axisymmetric", supports=AXIS.replace("axis", "bore") + ENDS, maxh=0.002))
+    assert cli.main(["check", str(path)]) == 2
+    assert capsys.readouterr().err.rstrip("\n").endswith(
+        "supports[0].boundary = 'bore': no such boundary in 'coaxial' (axisymmetric); labels are axis, bottom, "
+        "interface, mantle, top")
 
 
 def test_a_symmetry_plane_on_a_curved_boundary_and_a_slope_on_a_slanted_one_are_refused(tmp_path):
