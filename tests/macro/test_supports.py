@@ -261,7 +261,7 @@ def test_the_base_of_a_shaft_in_its_tube_carries_their_weight(tmp_path, setting,
     w = 2 * np.pi * ng.x if setting == "axisymmetric" else ng.CF(1.0)
     volume = {r: ng.Integrate(w, mesh, definedon=mesh.Materials(r)) for r in ("inner", "outer")}
     weight = -7.7e4 * (volume["inner"] + 2 * volume["outer"])
-    # 3D: the curved elements' quadrature of the reaction is not the assembly's (4e-7 here)
+    # 3D: the curved elements' quadrature of the reaction is not the assembly's
     assert RM.reactions(sol)["bottom"]["z"] == pytest.approx(weight, rel=1e-9 if setting == "axisymmetric" else 2e-6)
 
 
