@@ -20,6 +20,11 @@ cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its c
   quarters on their symmetry plane ``y = 0`` (``stress.png``, as in 2D);
 * ``resultant``: force through the interface from the rough to the counter
   body [N; axisymmetric: axial, per full revolution; plane strain: per metre];
+* ``reactions``: per supported boundary the force the bodies exert on the
+  support in the fixed components (axisymmetric: axial only) and, in plane
+  strain for a support fixing every component, its moment about the
+  boundary's mid-point, as the ``direct`` kind reports them
+  (:func:`ngcontact.fem.reaction.support_reactions`);
 * ``maxima``: peak pressure and largest |shear| with their location, the
   largest and smallest stress components, von Mises stress and strain with
   location and body;
@@ -36,6 +41,7 @@ from typing import Any
 import numpy as np
 import ngsolve as ng
 
+from ngcontact.drivers.mesh_supports import supports_on
 from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
                                      law_from_cell, law_from_file, linear_solver)
 from ngcontact.laws import homogenized as il
@@ -53,6 +59,7 @@ from ngcontact.geometry.femur import BOUNDARIES, FemurStemDims, femur_stem
 from ngcontact.geometry.femur3d import femur_stem_3d
 
 from ngcontact.fem.rigid_modes import check_rigid_modes
+from ngcontact.fem.reaction import support_reactions
 
 log = logging.getLogger(__name__)
 
@@ -194,14 +201,21 @@ def check_model(scene) -> None:
     geo = build_geometry(scene)
     check_boundaries(scene, geo.mesh)
     tangential = scene.interface.cell is not None or interface_law_of(scene, geo.mesh.dim)[0].holds_tangentially
-    check_rigid_modes(geo.mesh, scene.geometry.setting, REGIONS[scene.geometry.shape], supports_of(scene),
+    check_rigid_modes(geo.mesh, scene.geometry.setting, REGIONS[scene.geometry.shape], supports_of(scene, geo.mesh),
                       "interface", tangential)
 
 
-def supports_of(scene) -> tuple[M.Support, ...]:
-    """The scene's ``[[supports]]`` as the problem's supports."""
-    return tuple(M.Support(label=s.boundary, components=s.components, value=s.displacement)
-                 for s in scene.supports)
+def supports_of(scene, mesh) -> tuple[M.Support, ...]:
+    """The scene's ``[[supports]]`` on ``mesh`` as the problem's supports
+    (:func:`ngcontact.drivers.mesh_supports.supports_on`: symmetry planes and slopes read off the mesh)."""
+    return supports_on(scene.supports, mesh, scene.geometry.setting)
+
+
+def body_forces_of(scene) -> dict[str, tuple[float, ...]]:
+    """The scene's ``[body_forces]`` by region."""
+    rough, counter = REGIONS[scene.geometry.shape]
+    f = scene.body_forces
+    return {region: tuple(v) for region, v in ((rough, f.rough), (counter, f.counter)) if any(v)}
 
 
 def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.MacroProblem, dict]:
@@ -219,9 +233,17 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
     problem = M.MacroProblem(
         mesh=geometry.mesh, setting=scene.geometry.setting, rough=rough, counter=counter, materials=mats,
         law=law, gap=gap_of(scene), order=order or scene.discretization.order,
-        supports=supports_of(scene),
+        supports=supports_of(scene, geometry.mesh), body_forces=body_forces_of(scene),
         loads=tuple(M.Load(label=lo.boundary, pressure=lo.pressure, traction=lo.traction) for lo in scene.loads))
     return problem, info
+
+
+def reactions(sol: M.MacroSolution) -> dict:
+    """Reaction force (and moment) of every supported boundary (:func:`ngcontact.fem.reaction.support_reactions`)."""
+    p = sol.problem
+    return support_reactions(p.mesh, p.setting, p.order, p.supports,
+                             ((p.rough, p.materials[p.rough], sol.u_rough),
+                              (p.counter, p.materials[p.counter], sol.u_counter)), p.body_forces)
 
 
 def solve_scene(scene, problem: M.MacroProblem, start=None, rtol: float | None = None) -> M.MacroSolution:
@@ -307,6 +329,7 @@ def measured(sol: M.MacroSolution, geo: gm.MacroGeometry, law_info: dict, output
     problem = sol.problem
     results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
                "dimensions": geo.dims, "law": law_info, "resultant": MM.resultant(sol),
+               "reactions": reactions(sol),
                "newton_iterations": sol.history["newton_iterations"],
                "coulomb_iterations": sol.history["coulomb_iterations"], "equilibrium": balance}
     maxima = {name: ext for name, ext in extrema.items()}

@@ -133,7 +133,7 @@ def homogenized_problem(scene, flat, law: il.InterfaceLaw) -> M.MacroProblem:
     no macro gap (the cell's own gap terms are in the law).
     """
     return M.MacroProblem(mesh=flat.mesh, setting=scene.geometry.setting, rough="rough", counter="counter",
-                          materials=drv.materials_of(scene), law=law, supports=drv.supports_of(scene),
+                          materials=drv.materials_of(scene), law=law, supports=drv.supports_of(scene, flat.mesh),
                           loads=drv.loads_of(scene), order=scene.discretization.order, interface=flat.interface)
 
 
