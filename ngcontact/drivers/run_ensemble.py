@@ -1,7 +1,8 @@
 """Driver of a cell scene with ``[ensemble]``: the law of a random surface class, not of one sample.
 
 Member ``m`` (``m = 0 .. M-1``) is the cell of the scene with the random
-surface of ``geometry.spectrum`` drawn with the seed ``seed + m``
+surface of ``geometry.spectrum`` (or of a measured file's spectrum, profile
+``measured_spectrum``) drawn with the seed ``seed + m``
 (:mod:`ngcontact.geometry.random_surface`); it is solved over the scene's
 loads by the ``cell`` driver (:mod:`ngcontact.drivers.run_cell`, spectral or
 FE as the scene says), in a worker of the run's batch
@@ -41,9 +42,8 @@ QUANTITIES = {
 
 
 def member_scene(scene, m: int):
-    """The cell scene of member ``m``: the spectrum's seed advanced by ``m``, no ensemble."""
-    g = scene.geometry
-    return replace(scene, ensemble=None, geometry=replace(g, spectrum=replace(g.spectrum, seed=g.spectrum.seed + m)))
+    """The cell scene of member ``m``: the random surface's seed advanced by ``m``, no ensemble."""
+    return replace(scene, ensemble=None, geometry=scene.geometry.reseeded(m))
 
 
 def measured(entry: dict) -> dict[str, float]:
@@ -63,7 +63,7 @@ def realization(job: tuple) -> dict:
     scene, m = job
     sc = member_scene(scene, m)
     outcome = run_cell.run(sc, Clock())
-    return {"seed": sc.geometry.spectrum.seed, "ndof": int(outcome.ndof),
+    return {"seed": sc.geometry.random_seed, "ndof": int(outcome.ndof),
             "loads": [measured(e) for e in outcome.results["loads"]]}
 
 
@@ -72,7 +72,7 @@ def run(scene, clock) -> Outcome:
     M = scene.ensemble.members
     with clock.stage(f"{M} members"):
         members = executor.current().map(realization, [(scene, m) for m in range(M)],
-                                         [f"member {m} (seed {scene.geometry.spectrum.seed + m})" for m in range(M)],
+                                         [f"member {m} (seed {scene.geometry.random_seed + m})" for m in range(M)],
                                          label="ensemble")
     n = len(members[0]["loads"])
     samples = {q: np.array([[mem["loads"][k][q] for k in range(n)] for mem in members]) for q in QUANTITIES}

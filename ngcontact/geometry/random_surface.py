@@ -116,3 +116,72 @@ def as_height_map(z: np.ndarray) -> np.ndarray:
     if z.ndim == 1:
         return np.append(z, z[0])
     return np.pad(z, ((0, 1), (0, 1)), mode="wrap")
+
+
+def _wave_numbers(shape: tuple[int, int], period: float) -> np.ndarray:
+    """``|k|`` of the half spectrum of ``scipy.fft.rfft2`` of a ``[y, x]`` map of period ``period``."""
+    import scipy.fft as sfft
+    ny, nx = shape
+    kx = 2 * math.pi * sfft.rfftfreq(nx, d=period / nx)
+    ky = 2 * math.pi * sfft.fftfreq(ny, d=period / ny)
+    return np.sqrt(kx[None, :] ** 2 + ky[:, None] ** 2)
+
+
+def spectral_slope(z: np.ndarray, period: float) -> float:
+    """The rms slope ``sqrt(<|grad z|^2>)`` of the trigonometric interpolant of periodic samples ``z[y, x]``."""
+    import scipy.fft as sfft
+    ny, nx = z.shape
+    zh = sfft.fft2(z)
+    kx = 2 * math.pi * sfft.fftfreq(nx, d=period / nx)[None, :]
+    ky = 2 * math.pi * sfft.fftfreq(ny, d=period / ny)[:, None]
+    return float(np.sqrt(np.sum((kx ** 2 + ky ** 2) * np.abs(zh) ** 2)) / z.size)
+
+
+def radial_psd(z: np.ndarray, period: float) -> tuple[np.ndarray, np.ndarray]:
+    """The radially averaged power spectral density of periodic samples ``z[y, x]`` (zero mean).
+
+    ``C(k) = P^2 |c_k|^2`` with ``c_k = FFT(z)_k / N`` the Fourier coefficients (``N`` points), so that
+    ``<z^2> = sum_k C(k) / P^2``; averaged over the wave vectors in rings ``|k| / (2 pi / P)`` rounded to
+    ``m = 1, 2, ...``.  Returns the rings' mean ``|k|`` and mean ``C``.
+    """
+    import scipy.fft as sfft
+    zh = sfft.fft2(z)
+    ny, nx = z.shape
+    kx = 2 * math.pi * sfft.fftfreq(nx, d=period / nx)[None, :]
+    ky = 2 * math.pi * sfft.fftfreq(ny, d=period / ny)[:, None]
+    k = np.sqrt(kx ** 2 + ky ** 2).ravel()
+    C = (period ** 2 * np.abs(zh) ** 2 / z.size ** 2).ravel()
+    ring = np.rint(k / (2 * math.pi / period)).astype(int)
+    count = np.bincount(ring)
+    keep = np.nonzero(count)[0]
+    keep = keep[keep > 0]
+    return (np.bincount(ring, weights=k)[keep] / count[keep], np.bincount(ring, weights=C)[keep] / count[keep])
+
+
+def from_psd(q: np.ndarray, C: np.ndarray, *, grid: int, period: float, rms_height: float,
+             seed: int = 0) -> np.ndarray:
+    """A random periodic surface ``[y, x]`` on ``grid x grid`` points with the isotropic spectrum ``C(q)``.
+
+    Each Fourier coefficient of wave number ``|k|`` is a complex Gaussian of variance ``C(|k|)``,
+    interpolated log-log between the given rings and zero outside ``[q_min, q_max]`` and at ``k = 0``
+    (the filtered white noise of :func:`self_affine` with a tabulated spectrum); the field is scaled to
+    ``rms_height`` as :func:`self_affine` scales to its target.  A seed makes it reproducible.
+    """
+    import scipy.fft as sfft
+    q, C = np.asarray(q, float), np.asarray(C, float)
+    ok = (q > 0) & (C > 0)
+    if ok.sum() < 2:
+        raise GeometryError("psd", int(ok.sum()), "a spectrum needs at least two rings of positive power")
+    q, C = q[ok], C[ok]
+    k = _wave_numbers((grid, grid), period)
+    inside = (k >= q[0] * (1 - 1e-9)) & (k <= q[-1] * (1 + 1e-9))
+    logC = np.interp(np.log(np.maximum(k, q[0])), np.log(q), np.log(C))
+    psd = np.where(inside, np.exp(logC), 0.0)
+    rng = np.random.default_rng(seed)
+    coeff = np.sqrt(psd / 2) * (rng.standard_normal(k.shape) + 1j * rng.standard_normal(k.shape))
+    z = sfft.irfft2(coeff, s=(grid, grid))
+    z -= z.mean()
+    rms = float(np.sqrt(np.mean(z ** 2)))
+    if rms == 0.0:
+        raise GeometryError("psd", "...", "draws a flat surface on this grid")
+    return z * (rms_height / rms)
