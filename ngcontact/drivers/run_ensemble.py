@@ -43,7 +43,9 @@ QUANTITIES = {
 
 def member_scene(scene, m: int):
     """The cell scene of member ``m``: the random surface's seed advanced by ``m``, no ensemble."""
-    return replace(scene, ensemble=None, geometry=scene.geometry.reseeded(m))
+    member = replace(scene, ensemble=None, geometry=scene.geometry.reseeded(m))
+    object.__setattr__(member, "base_dir", scene.base_dir)   # not a field of replace: a measured file's folder
+    return member
 
 
 def measured(entry: dict) -> dict[str, float]:

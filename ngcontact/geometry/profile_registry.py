@@ -124,16 +124,15 @@ def _height_map(g, file):
 
 
 def _measured_spectrum(g, file):
-    """A random surface with the radially averaged spectrum of the file's map, its rms height and grid
-    (:func:`ngcontact.geometry.random_surface.from_psd`), drawn with ``g.seed``."""
+    """A random surface with the radially averaged spectrum of the file's map, on its grid
+    (:func:`ngcontact.geometry.random_surface.from_psd`), drawn with ``g.seed``; a flat map draws flat."""
     from ngcontact.geometry.random_surface import as_height_map, from_psd, radial_psd
     H, period = file_map(g, file)
     z = H[:-1, :-1] - H[:-1, :-1].mean()
-    q, C = radial_psd(z, period)
-    rms = float(np.sqrt(np.mean(z ** 2)))
-    if rms == 0.0:
+    if not np.any(z):
         return np.zeros_like(H)
-    return as_height_map(from_psd(q, C, grid=max(z.shape), period=period, rms_height=rms, seed=g.seed or 0))
+    q, C = radial_psd(z, period)
+    return as_height_map(from_psd(q, C, grid=max(z.shape), period=period, seed=g.seed or 0))
 
 
 def _self_affine(g, file):

@@ -158,30 +158,35 @@ def radial_psd(z: np.ndarray, period: float) -> tuple[np.ndarray, np.ndarray]:
     return (np.bincount(ring, weights=k)[keep] / count[keep], np.bincount(ring, weights=C)[keep] / count[keep])
 
 
-def from_psd(q: np.ndarray, C: np.ndarray, *, grid: int, period: float, rms_height: float,
-             seed: int = 0) -> np.ndarray:
+def from_psd(q: np.ndarray, C: np.ndarray, *, grid: int, period: float, seed: int = 0) -> np.ndarray:
     """A random periodic surface ``[y, x]`` on ``grid x grid`` points with the isotropic spectrum ``C(q)``.
 
-    Each Fourier coefficient of wave number ``|k|`` is a complex Gaussian of variance ``C(|k|)``,
-    interpolated log-log between the given rings and zero outside ``[q_min, q_max]`` and at ``k = 0``
-    (the filtered white noise of :func:`self_affine` with a tabulated spectrum); the field is scaled to
-    ``rms_height`` as :func:`self_affine` scales to its target.  A seed makes it reproducible.
+    ``C`` in the normalization of :func:`radial_psd`, given on its rings ``m = rint(q / (2 pi / P))``: each
+    wave vector takes its ring's ``C`` (zero at ``k = 0``, in rings not given and beyond the last).  Each
+    Fourier coefficient ``Z_k`` of the forward FFT is a complex Gaussian of variance ``N^2 C / P^2`` (``N``
+    points; the filtered white noise of :func:`self_affine` with a tabulated spectrum), so that the expected
+    spectrum of the surface is ``C`` and its expected mean square height ``sum_k C / P^2``, that of the
+    surface ``C`` was measured on.  The surface is not scaled to one rms height: for a spectrum whose few
+    longest waves carry most of the power, scaling every draw to one rms would bias the expected spectrum
+    of the others.  A seed makes it reproducible.
     """
     import scipy.fft as sfft
     q, C = np.asarray(q, float), np.asarray(C, float)
     ok = (q > 0) & (C > 0)
-    if ok.sum() < 2:
-        raise GeometryError("psd", int(ok.sum()), "a spectrum needs at least two rings of positive power")
-    q, C = q[ok], C[ok]
-    k = _wave_numbers((grid, grid), period)
-    inside = (k >= q[0] * (1 - 1e-9)) & (k <= q[-1] * (1 + 1e-9))
-    logC = np.interp(np.log(np.maximum(k, q[0])), np.log(q), np.log(C))
-    psd = np.where(inside, np.exp(logC), 0.0)
+    if not ok.any():
+        raise GeometryError("psd", "...", "a spectrum needs a ring of positive power")
+    rings = np.rint(q[ok] / (2 * math.pi / period)).astype(int)
+    table = np.zeros(rings.max() + 2)
+    table[rings] = C[ok]
+    m = np.minimum(np.rint(_wave_numbers((grid, grid), period) / (2 * math.pi / period)).astype(int),
+                   len(table) - 1)
+    variance = table[m] * (grid ** 2 / period) ** 2
+    variance.flat[0] = 0.0
+    # the columns k_x = 0 and Nyquist hold a wave vector and its conjugate twin: irfft2 keeps their mean
+    # (half the variance), so they are drawn with twice it
+    variance[:, 0] *= 2.0
+    if grid % 2 == 0:
+        variance[:, -1] *= 2.0
     rng = np.random.default_rng(seed)
-    coeff = np.sqrt(psd / 2) * (rng.standard_normal(k.shape) + 1j * rng.standard_normal(k.shape))
-    z = sfft.irfft2(coeff, s=(grid, grid))
-    z -= z.mean()
-    rms = float(np.sqrt(np.mean(z ** 2)))
-    if rms == 0.0:
-        raise GeometryError("psd", "...", "draws a flat surface on this grid")
-    return z * (rms_height / rms)
+    coeff = np.sqrt(variance / 2) * (rng.standard_normal(m.shape) + 1j * rng.standard_normal(m.shape))
+    return sfft.irfft2(coeff, s=(grid, grid))

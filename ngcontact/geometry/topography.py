@@ -97,11 +97,11 @@ def _reader(file, where: str):
                             f"SUR, PLU, IBW, DI, plain-text matrix, ...): {err}") from None
 
 
-def _stated(file_value, scene_value, key: str, same) -> tuple[Any, str]:
+def _stated(file_value, scene_value, key: str, same, what: str) -> tuple[Any, str]:
     """The file's value, else the scene's; both given and different is refused."""
     if file_value is None:
         if scene_value is None:
-            raise GeometryError(key, MISSING, "required: the file does not state it")
+            raise GeometryError(key, MISSING, f"required: the file does not state {what}")
         return scene_value, "scene"
     if scene_value is not None and not same(file_value, scene_value):
         raise GeometryError(key, scene_value, f"the file states {file_value!r}; remove the key or give the same")
@@ -124,11 +124,13 @@ def read_scan(file, reading: Reading, where: str = "geometry.file") -> tuple[np.
         raise GeometryError(where, str(file), f"holds a {ch.dim}D scan; a cell's height map is a 2D scan")
     scene_unit = None if reading.units is None else {"um": "µm"}.get(reading.units, reading.units)
     unit, unit_from = _stated(ch.unit, scene_unit, "geometry.units",
-                              lambda a, b: math.isclose(_metres(a), _metres(b)))
+                              lambda a, b: math.isclose(_metres(a), _metres(b)),
+                              f"its length unit (one of {', '.join(UNITS)})")
     scale = _metres(unit)
     file_size = None if ch.physical_sizes is None or None in tuple(ch.physical_sizes) else tuple(ch.physical_sizes)
     size, size_from = _stated(file_size, reading.size, "geometry.size",
-                              lambda a, b: np.allclose(np.asarray(a, float), np.asarray(b, float), rtol=1e-9))
+                              lambda a, b: np.allclose(np.asarray(a, float), np.asarray(b, float), rtol=1e-9),
+                              "the scan's physical size: give [x, y] in geometry.units")
     topo = r.topography(channel_index=ch.index,
                         physical_sizes=None if size_from == "file" else tuple(size),
                         unit=None if unit_from == "file" else unit)

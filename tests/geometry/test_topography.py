@@ -1,0 +1,144 @@
+"""Measured topographies read as periodic height maps (ngcontact.geometry.topography).
+
+Requirement: a scan in an instrument's format becomes the map of the package's layout in metres, with
+what the file does not state taken from the scene (units, size) and refused when neither gives it; a
+non-periodic scan is made periodic only by a stated method (mirror, window), and the spectrum of a map
+feeds random surfaces like it.
+"""
+import sys
+
+import numpy as np
+import pytest
+
+from ngcontact.errors import GeometryError
+from ngcontact.geometry import random_surface, topography
+from ngcontact.geometry.topography import Reading, read_measured
+
+sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[1]))
+from x3p_file import write_x3p  # noqa: E402
+
+NEEDS = "reading measured topographies needs the optional extra ngcontact[topography] (SurfaceTopography)"
+P, N = 1e-4, 16
+
+
+def _surface(n=N, seed=1):
+    return random_surface.self_affine(grid=n, period=P, hurst=0.8, rms_slope=0.05, seed=seed)
+
+
+@pytest.fixture
+def st():
+    return pytest.importorskip("SurfaceTopography", reason=NEEDS)
+
+
+def test_a_periodic_x3p_gives_the_map_of_its_heights(tmp_path, st):
+    z = _surface()
+    write_x3p(tmp_path / "s.x3p", z, (P / N, P / N))
+    m = read_measured(tmp_path / "s.x3p", Reading(periodic=True))
+    assert m.period == pytest.approx(P, rel=1e-15)
+    np.testing.assert_array_equal(m.heights, random_surface.as_height_map(z))
+    r = m.record
+    assert (r["format"], r["unit"], r["unit_from"], r["size_from"]) == ("x3p", "m", "file", "file")
+    assert r["scan_grid"] == [N, N] and r["periodization"] is None and r["periodic_from"] == "scene"
+
+
+def test_orientation_rows_are_y(tmp_path, st):
+    """A map that varies along x only stays so: the file's x (CX, running fastest) is the layout's column."""
+    x = np.arange(N) / N
+    z = np.broadcast_to(1e-7 * np.sin(2 * np.pi * x), (N, N))
+    write_x3p(tmp_path / "x.x3p", z, (P / N, P / N))
+    H = read_measured(tmp_path / "x.x3p", Reading(periodic=True)).heights
+    assert np.ptp(H[:, 3]) == 0.0 and np.ptp(H[3, :]) > 0.0
+
+
+def test_a_nonperiodic_scan_is_refused_without_periodize(tmp_path, st):
+    write_x3p(tmp_path / "s.x3p", _surface(), (P / N, P / N))
+    with pytest.raises(GeometryError, match="geometry.periodize = <missing>: the scan in s.x3p is not periodic"):
+        read_measured(tmp_path / "s.x3p", Reading())
+
+
+def test_mirror_doubles_the_period_and_keeps_the_heights(tmp_path, st):
+    z = _surface()
+    write_x3p(tmp_path / "s.x3p", z, (P / N, P / N))
+    m = read_measured(tmp_path / "s.x3p", Reading(periodize="mirror"))
+    assert m.period == pytest.approx(2 * P) and m.heights.shape == (2 * N + 1, 2 * N + 1)
+    np.testing.assert_array_equal(m.heights[:N, :N], z)
+    np.testing.assert_array_equal(m.heights[:N, N:2 * N], z[:, ::-1])
+    assert m.record["periodization"] == {"method": "mirror"}
+
+
+def test_window_tapers_the_edges_to_the_mean_plane(tmp_path, st):
+    z = _surface() + 3e-7
+    write_x3p(tmp_path / "s.x3p", z, (P / N, P / N))
+    with pytest.raises(GeometryError, match="geometry.window_width = <missing>: required for periodize = 'window'"):
+        read_measured(tmp_path / "s.x3p", Reading(periodize="window"))
+    m = read_measured(tmp_path / "s.x3p", Reading(periodize="window", window_width=0.25))
+    w = topography.tukey(N, 0.25)
+    np.testing.assert_allclose(m.heights[:N, :N], (z - z.mean()) * np.outer(w, w), rtol=1e-12, atol=1e-22)
+    assert m.period == pytest.approx(P) and m.record["periodization"] == {"method": "window", "width": 0.25}
+    assert w[N // 2] == 1.0 and w[0] < 0.05
+
+
+def test_units_and_size_come_from_the_scene_where_the_file_has_none(tmp_path, st):
+    z = _surface()
+    np.savetxt(tmp_path / "s.txt", z * 1e6)                     # heights in micrometres, no size
+    with pytest.raises(GeometryError, match="geometry.units = <missing>: required: the file does not state its "
+                                            "length unit"):
+        read_measured(tmp_path / "s.txt", Reading(periodic=True))
+    with pytest.raises(GeometryError, match="geometry.size = <missing>: required"):
+        read_measured(tmp_path / "s.txt", Reading(periodic=True, units="um"))
+    m = read_measured(tmp_path / "s.txt", Reading(periodic=True, units="um", size=(P * 1e6, P * 1e6)))
+    assert m.period == pytest.approx(P, rel=1e-12)
+    np.testing.assert_allclose(m.heights, random_surface.as_height_map(z), rtol=1e-9, atol=1e-20)
+    assert (m.record["unit_from"], m.record["size_from"]) == ("scene", "scene")
+
+
+def test_a_unit_the_file_contradicts_is_refused(tmp_path, st):
+    write_x3p(tmp_path / "s.x3p", _surface(), (P / N, P / N))
+    with pytest.raises(GeometryError, match="geometry.units = 'µm': the file states 'm'"):
+        read_measured(tmp_path / "s.x3p", Reading(periodic=True, units="um"))
+
+
+def test_mean_plane_detrending_removes_a_tilt(tmp_path, st):
+    x = P * np.arange(N) / N
+    z = _surface()
+    write_x3p(tmp_path / "t.x3p", z + 1e-3 * x[None, :], (P / N, P / N))
+    flat = read_measured(tmp_path / "t.x3p", Reading(periodic=True, detrend="mean_plane")).heights
+    assert np.ptp(flat) < 2 * np.ptp(z)
+
+
+def test_a_scan_that_is_not_square_is_refused(tmp_path, st):
+    write_x3p(tmp_path / "r.x3p", _surface()[:8], (P / N, P / N))
+    with pytest.raises(GeometryError, match="the cell is square"):
+        read_measured(tmp_path / "r.x3p", Reading(periodic=True))
+
+
+def test_without_the_package_the_error_names_the_extra(tmp_path, monkeypatch):
+    (tmp_path / "s.x3p").write_bytes(b"PK")
+    monkeypatch.setitem(sys.modules, "SurfaceTopography", None)
+    with pytest.raises(GeometryError, match=r"pip install 'ngcontact\[topography\]'"):
+        read_measured(tmp_path / "s.x3p", Reading(periodic=True))
+
+
+def test_surfaces_drawn_with_a_measured_spectrum_share_it():
+    """Random surfaces from the radially averaged PSD of a map have, on average, its PSD and mean square."""
+    z = _surface(32)
+    q, C = random_surface.radial_psd(z, P)
+    draws = [random_surface.from_psd(q, C, grid=32, period=P, seed=s) for s in range(64)]
+    psds = np.array([random_surface.radial_psd(d, P)[1] for d in draws])
+    band = slice(0, 8)                                           # the rings of the spectrum's power
+    # each ring's C of one draw is a mean of 4 to 48 exponential variables: 64 draws average it within 30 %
+    np.testing.assert_allclose(psds.mean(axis=0)[band], C[band], rtol=0.3)
+    ms = np.mean([np.mean(d ** 2) for d in draws])
+    assert ms == pytest.approx(np.mean(z ** 2), rel=0.3)
+    assert not np.allclose(draws[0], draws[1])
+    np.testing.assert_array_equal(draws[3], random_surface.from_psd(q, C, grid=32, period=P, seed=3))
+
+
+def test_the_psd_sums_to_the_mean_square_height():
+    z = _surface(32)
+    zh = np.fft.fft2(z)
+    C = P ** 2 * np.abs(zh) ** 2 / z.size ** 2
+    assert np.sum(C) / P ** 2 == pytest.approx(np.mean(z ** 2), rel=1e-12)
+    q, Cr = random_surface.radial_psd(z, P)
+    assert np.rint(q[0] / (2 * np.pi / P)) == 1 and np.all(np.diff(q) > 0) and len(q) == len(Cr)
+    assert random_surface.spectral_slope(z, P) == pytest.approx(0.05, rel=1e-12)
