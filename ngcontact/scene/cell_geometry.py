@@ -4,7 +4,8 @@ Mapped onto the builders of :mod:`ngcontact.geometry.profiles` (2D) and
 :mod:`ngcontact.geometry.cell3d` (3D) by the table of profiles
 :data:`ngcontact.geometry.profile_registry.PROFILES` (the keys each profile
 requires, its builder and what it is); a self-affine random surface is drawn
-by :mod:`ngcontact.geometry.random_surface` from its ``spectrum``.  The
+by :mod:`ngcontact.geometry.random_surface` from its ``spectrum``; a height map is read from a ``.npy``
+file or from a measured topography (:mod:`ngcontact.geometry.topography`).  The
 small-slope profiles (:func:`small_slope`) are a flat interface whose initial
 gap carries the roughness.
 """
@@ -90,9 +91,9 @@ class CellGeometry:
     spectrum: SpectrumSpec | None = param(None, doc="self_affine: the power spectrum and seed of the random surface")
     units: str | None = param(None, doc="measured file: the length unit of its heights and size, where the file "
                               "states none (a different one than the file's is refused)", choices=tuple(UNITS))
-    size: tuple[float, float] | None = param(None, doc="measured file: the scan's physical size (x, y) in "
-                                             "geometry.units, where the file states none", units="units",
-                                             check=positive())
+    size: tuple[float, float] | None = param(None, doc="measured file: the scan's physical size (x, y) in its "
+                                             "length unit (the file's, else geometry.units), where the file "
+                                             "states none", check=positive())
     detrend: str | None = param(None, doc="measured file: remove nothing (none, the default), the least-squares "
                                 "plane (mean_plane: tilt) or quadratic (curvature: tilt and form)",
                                 choices=tuple(DETREND))

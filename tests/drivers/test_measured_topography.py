@@ -6,7 +6,6 @@ refused without ``periodize`` and accepted with one; missing units are refused n
 records the topography (file, format, units, size, detrending, periodization, rms height and slope, PSD,
 small-slope check) and plots its PSD; random surfaces with the measured spectrum form an ensemble.
 """
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -14,11 +13,10 @@ import pytest
 
 from ngcontact.errors import SceneError
 from ngcontact.geometry import random_surface
+from ngcontact.geometry.x3p import write_x3p
 from ngcontact.runner import solve
 from ngcontact.scene import loader
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from x3p_file import write_x3p  # noqa: E402
 
 NEEDS = "reading measured topographies needs the optional extra ngcontact[topography] (SurfaceTopography)"
 P, N = 1e-4, 32

@@ -12,10 +12,9 @@ import pytest
 
 from ngcontact.errors import GeometryError
 from ngcontact.geometry import random_surface, topography
+from ngcontact.geometry.x3p import write_x3p
 from ngcontact.geometry.topography import Reading, read_measured
 
-sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[1]))
-from x3p_file import write_x3p  # noqa: E402
 
 NEEDS = "reading measured topographies needs the optional extra ngcontact[topography] (SurfaceTopography)"
 P, N = 1e-4, 16

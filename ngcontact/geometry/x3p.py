@@ -1,4 +1,8 @@
-"""A minimal X3P file (ISO 25178-72 / ISO 5436-2) written by hand, for the tests of measured topographies.
+"""A minimal X3P file (ISO 25178-72 / ISO 5436-2): a height map written as an instrument would write its scan.
+
+Used by the tests of measured topographies (:mod:`ngcontact.geometry.topography`) and by the script that
+writes the shipped scan, so that both read the heights back through SurfaceTopography's reader, the
+route of a real instrument's file.
 
 The container is a zip of ``main.xml`` (the axes: ``CX``, ``CY`` incremental with their spacing in metres,
 ``CZ`` absolute heights in metres; the matrix dimensions and the link to the data) and the binary heights
@@ -25,11 +29,11 @@ MAIN_XML = """<?xml version="1.0" encoding="UTF-8"?>
   </Record1>
   <Record2>
     <Date>2026-01-01T00:00:00+00:00</Date>
-    <Instrument><Manufacturer>ngcontact tests</Manufacturer><Model>hand-written</Model><Serial>0</Serial>
+    <Instrument><Manufacturer>ngcontact</Manufacturer><Model>{model}</Model><Serial>0</Serial>
     <Version>1</Version></Instrument>
     <CalibrationDate>2026-01-01T00:00:00+00:00</CalibrationDate>
     <ProbingSystem><Type>NonContacting</Type><Identification>none</Identification></ProbingSystem>
-    <Comment>test topography</Comment>
+    <Comment>{comment}</Comment>
   </Record2>
   <Record3>
     <MatrixDimension><SizeX>{nx}</SizeX><SizeY>{ny}</SizeY><SizeZ>1</SizeZ></MatrixDimension>
@@ -41,14 +45,18 @@ MAIN_XML = """<?xml version="1.0" encoding="UTF-8"?>
 """
 
 
-def write_x3p(path, heights, spacing: tuple[float, float]) -> None:
-    """Write ``heights[y, x]`` (metres) on a grid of ``spacing = (dx, dy)`` metres as an X3P file."""
+def write_x3p(path, heights, spacing: tuple[float, float], *, model: str = "ngcontact.geometry.x3p",
+              comment: str = "height map") -> None:
+    """Write ``heights[y, x]`` (metres) on a grid of ``spacing = (dx, dy)`` metres as an X3P file (a fixed date:
+    the same heights give the same bytes)."""
+    from xml.sax.saxutils import escape
     h = np.ascontiguousarray(np.asarray(heights, dtype="<f8"))
     data = h.tobytes()
     ny, nx = h.shape
-    main = MAIN_XML.format(dx=float(spacing[0]), dy=float(spacing[1]), nx=nx, ny=ny,
-                           md5=hashlib.md5(data).hexdigest()).encode("utf-8")
+    main = MAIN_XML.format(dx=float(spacing[0]), dy=float(spacing[1]), nx=nx, ny=ny, model=escape(model),
+                           comment=escape(comment), md5=hashlib.md5(data).hexdigest()).encode("utf-8")
+    stamp = (2026, 1, 1, 0, 0, 0)
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("main.xml", main)
-        z.writestr("bindata/data.bin", data)
-        z.writestr("md5checksum.hex", f"{hashlib.md5(main).hexdigest()} *main.xml\n")
+        for name, content in (("main.xml", main), ("bindata/data.bin", data),
+                              ("md5checksum.hex", f"{hashlib.md5(main).hexdigest()} *main.xml\n".encode())):
+            z.writestr(zipfile.ZipInfo(name, date_time=stamp), content, compress_type=zipfile.ZIP_DEFLATED)
