@@ -2,7 +2,8 @@
 
 The instrument formats (X3P, DATX, OPD, SUR, PLU, IBW, DI, ... and plain-text matrices) are read by the
 optional SurfaceTopography package (``pip install 'ngcontact[topography]'``), with the units and physical
-size the file carries.  The scene states what the file does not (:class:`Reading`): the length unit and
+size the file carries; a file's suffix chooses the reader where one reader owns it (``.x3p`` is read as X3P
+or refused), else the content does.  The scene states what the file does not (:class:`Reading`): the length unit and
 the scan's physical size, the detrending and whether the scan is periodic.  The result is a height map in
 the package's layout (:func:`ngcontact.geometry.tabulated.read_height_map`: ``H[i, j]`` at
 ``y_i = i P / n_y``, ``x_j = j P / n_x``, the last row and column repeating the first) in metres, the
@@ -84,6 +85,9 @@ class MeasuredMap:
 
 
 def _reader(file, where: str):
+    """SurfaceTopography's reader of ``file`` and what its default channel states: ``(reader, channel, facts)``
+    with ``facts`` its ``dim``, ``unit``, ``physical_sizes`` (``None`` where the file states none) and
+    ``periodic``."""
     try:
         import SurfaceTopography as st
     except ImportError:
@@ -91,10 +95,33 @@ def _reader(file, where: str):
                             "needs the optional SurfaceTopography package: pip install "
                             f"'ngcontact[{EXTRA}]'") from None
     try:
-        return st.open_topography(str(file))
+        r = st.open_topography(str(file), format=_format_of(Path(file).suffix))
+        ch = r.default_channel
+        sizes = ch.physical_sizes
+        facts = {"dim": ch.dim, "unit": ch.unit, "periodic": bool(ch.is_periodic),
+                 "physical_sizes": None if sizes is None or None in tuple(sizes) else tuple(sizes)}
     except Exception as err:  # the package raises its own classes per format
         raise GeometryError(where, str(file), "must be a topography file SurfaceTopography reads (X3P, DATX, OPD, "
-                            f"SUR, PLU, IBW, DI, plain-text matrix, ...): {err}") from None
+                            f"SUR, PLU, IBW, DI, plain-text matrix, ...): {_one_line(err)}") from None
+    return r, ch, facts
+
+
+def _format_of(suffix: str) -> str | None:
+    """The one reader's format whose file extension ``suffix`` is (a ``.x3p`` is read as X3P only), or ``None``
+    (unknown or shared, as ``.dat``): detected from the content."""
+    from SurfaceTopography.IO import readers
+    ext = suffix.lower().lstrip(".")
+    owners = [r.format() for r in readers if ext in (getattr(r, "_file_extensions", None) or ())]
+    return owners[0] if len(owners) == 1 else None
+
+
+def _one_line(err: Exception, limit: int = 200) -> str:
+    """A reader's error in one line: its class and the first line of its text, cut at ``limit`` characters."""
+    if type(err).__name__ == "CannotDetectFileFormat":
+        return "no reader recognizes its format"
+    lines = [line.strip() for line in str(err).splitlines() if line.strip()]
+    text = f"{type(err).__name__}: {lines[0]}" if lines else type(err).__name__
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def _stated(file_value, scene_value, key: str, same, what: str) -> tuple[Any, str]:
@@ -118,22 +145,24 @@ def read_scan(file, reading: Reading, where: str = "geometry.file") -> tuple[np.
     what the file and the scene said (steps 1 and 2 of the module docstring)."""
     from ngcontact.geometry.tabulated import check_data_file
     check_data_file(file, where, "topography file")
-    r = _reader(file, where)
-    ch = r.default_channel
-    if ch.dim != 2:
-        raise GeometryError(where, str(file), f"holds a {ch.dim}D scan; a cell's height map is a 2D scan")
+    if Path(file).stat().st_size == 0:
+        raise GeometryError(where, str(file), "is empty; must be a topography file")
+    r, ch, facts = _reader(file, where)
+    if facts["dim"] != 2:
+        raise GeometryError(where, str(file), f"holds a {facts['dim']}D scan; a cell's height map is a 2D scan")
     scene_unit = None if reading.units is None else {"um": "µm"}.get(reading.units, reading.units)
-    unit, unit_from = _stated(ch.unit, scene_unit, "geometry.units",
+    unit, unit_from = _stated(facts["unit"], scene_unit, "geometry.units",
                               lambda a, b: math.isclose(_metres(a), _metres(b)),
                               f"its length unit (one of {', '.join(UNITS)})")
     scale = _metres(unit)
-    file_size = None if ch.physical_sizes is None or None in tuple(ch.physical_sizes) else tuple(ch.physical_sizes)
-    size, size_from = _stated(file_size, reading.size, "geometry.size",
+    size, size_from = _stated(facts["physical_sizes"], reading.size, "geometry.size",
                               lambda a, b: np.allclose(np.asarray(a, float), np.asarray(b, float), rtol=1e-9),
                               "the scan's physical size: give [x, y] in geometry.units")
-    topo = r.topography(channel_index=ch.index,
-                        physical_sizes=None if size_from == "file" else tuple(size),
-                        unit=None if unit_from == "file" else unit)
+    try:
+        topo = r.topography(channel_index=ch.index, physical_sizes=None if size_from == "file" else tuple(size),
+                            unit=None if unit_from == "file" else unit)
+    except Exception as err:  # a file whose header reads and whose data does not
+        raise GeometryError(where, str(file), f"has data SurfaceTopography cannot read: {_one_line(err)}") from None
     if not topo.is_uniform:
         raise GeometryError(where, str(file), "holds a nonuniform scan; a height map needs a uniform grid")
     if topo.has_undefined_data:
@@ -142,11 +171,13 @@ def read_scan(file, reading: Reading, where: str = "geometry.file") -> tuple[np.
     if mode is not None:
         topo = topo.detrend(detrend_mode=mode)
     h = np.asarray(topo.heights(), float).T * scale
-    periodic_file = bool(ch.is_periodic)
+    if min(h.shape) < 2:
+        raise GeometryError(where, str(file), f"holds {h.shape[1]} x {h.shape[0]} points; a height map needs at "
+                            "least 2 per direction")
     record = {"file": Path(file).name, "format": r.format(), "format_name": r.name(), "unit": unit,
               "unit_from": unit_from, "scan_size": [float(s) * scale for s in size], "size_from": size_from,
               "scan_grid": [int(n) for n in topo.nb_grid_pts], "detrend": reading.detrend or "none",
-              "periodic": reading.periodic if reading.periodic is not None else periodic_file,
+              "periodic": reading.periodic if reading.periodic is not None else facts["periodic"],
               "periodic_from": "scene" if reading.periodic is not None else "file"}
     return h, record
 

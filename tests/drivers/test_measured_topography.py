@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ngcontact import cli
 from ngcontact.errors import SceneError
 from ngcontact.geometry import random_surface
 from ngcontact.geometry.x3p import write_x3p
@@ -132,3 +133,10 @@ def test_surfaces_like_this_one_form_an_ensemble(scan):
     assert r["ensemble"]["seeds"] == [5, 6]
     members = [[e["contact_fraction"] for e in m] for m in r["members"]]
     assert members[0] != members[1] and all(0.0 < f < 1.0 for m in members for f in m)
+
+
+def test_the_command_line_refuses_a_scan_in_one_line_with_exit_2(scan, capsys):
+    path = scene(scan, "scan.x3p")
+    assert cli.main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "geometry.periodize = <missing>: the scan in scan.x3p is not periodic" in err

@@ -141,3 +141,23 @@ def test_the_psd_sums_to_the_mean_square_height():
     q, Cr = random_surface.radial_psd(z, P)
     assert np.rint(q[0] / (2 * np.pi / P)) == 1 and np.all(np.diff(q) > 0) and len(q) == len(Cr)
     assert random_surface.spectral_slope(z, P) == pytest.approx(0.05, rel=1e-12)
+
+
+@pytest.mark.parametrize("name, content, expected", [
+    pytest.param("empty.x3p", b"", "is empty; must be a topography file", id="empty"),
+    pytest.param("junk.x3p", bytes(range(256)) * 2, "must be a topography file SurfaceTopography reads .*: "
+                 "FileFormatMismatch: Stream is not a valid ZIP archive", id="x3p-not-zip"),
+    pytest.param("words.txt", b"hello world\nfoo\n", "CorruptFile: Could not find any topography data", id="words"),
+    pytest.param("noise.qqq", b"\x00\x01\x02", "no reader recognizes its format", id="unknown-suffix"),
+])
+def test_unreadable_files_are_refused_in_one_line(tmp_path, st, name, content, expected):
+    (tmp_path / name).write_bytes(content)
+    with pytest.raises(GeometryError, match=f"geometry.file = .*{expected}") as err:
+        read_measured(tmp_path / name, Reading(periodic=True, units="um", size=(1.0, 1.0)))
+    assert "\n" not in str(err.value)
+
+
+def test_a_scan_of_one_point_is_refused(tmp_path, st):
+    write_x3p(tmp_path / "one.x3p", np.ones((1, 1)), (1e-6, 1e-6))
+    with pytest.raises(GeometryError, match="holds 1 x 1 points; a height map needs at least 2 per direction"):
+        read_measured(tmp_path / "one.x3p", Reading(periodic=True))
