@@ -14,7 +14,8 @@ Steps, in this order:
 1. heights ``h(x, y)`` of the scan's ``n_x x n_y`` points, spacing ``L_x / n_x`` and ``L_y / n_y``
    (``L`` the physical size), converted to metres;
 2. detrending: ``none``; ``mean_plane``, the least-squares plane ``a + b x + c y`` removed (tilt);
-   ``curvature``, the least-squares quadratic removed (tilt and form);
+   ``curvature``, the least-squares quadratic removed (tilt and form); a periodic scan is not detrended
+   (neither a plane nor a quadratic is periodic: removing one would put a step at the cell's boundary);
 3. periodicity: a scan that is periodic (``periodic = true``, or the file says so) is used as it is, of
    period ``L``.  One that is not would put a step at the cell's boundary, a cliff that the periodic cell
    would press on; it is made periodic by a stated method (:data:`PERIODIZE`):
@@ -141,8 +142,8 @@ def _metres(unit: str) -> float:
 
 
 def read_scan(file, reading: Reading, where: str = "geometry.file") -> tuple[np.ndarray, dict[str, Any]]:
-    """The scan's detrended heights ``[y, x]`` in metres, its physical size ``(L_x, L_y)`` in metres and
-    what the file and the scene said (steps 1 and 2 of the module docstring)."""
+    """The scan's detrended heights ``[y, x]`` in metres and its record: what the file and the scene said,
+    its physical size ``scan_size`` in metres (steps 1 and 2 of the module docstring)."""
     from ngcontact.geometry.tabulated import check_data_file
     check_data_file(file, where, "topography file")
     if Path(file).stat().st_size == 0:
@@ -187,6 +188,10 @@ def read_measured(file, reading: Reading, where: str = "geometry.file") -> Measu
     h, record = read_scan(file, reading, where)
     Lx, Ly = record["scan_size"]
     if record["periodic"]:
+        if record["detrend"] != "none":
+            raise GeometryError("geometry.detrend", reading.detrend, "the scan is periodic: removing a plane or a "
+                                "quadratic would break its periodicity (a step at the cell's boundary); use 'none', "
+                                "or periodize a scan that is not periodic")
         if reading.periodize is not None:
             raise GeometryError("geometry.periodize", reading.periodize, "the scan is periodic (geometry.periodic); "
                                 "it needs no periodization: remove the key")

@@ -95,7 +95,8 @@ class CellGeometry:
                                              "length unit (the file's, else geometry.units), where the file "
                                              "states none", check=positive())
     detrend: str | None = param(None, doc="measured file: remove nothing (none, the default), the least-squares "
-                                "plane (mean_plane: tilt) or quadratic (curvature: tilt and form)",
+                                "plane (mean_plane: tilt) or quadratic (curvature: tilt and form); a periodic scan "
+                                "takes none",
                                 choices=tuple(DETREND))
     periodic: bool | None = param(None, doc="measured file: the scan is periodic (default: what the file says; "
                                   "instruments' files say not periodic)")

@@ -82,11 +82,11 @@ def test_x3p_gives_the_answers_of_the_same_heights_as_npy(scan):
 
 
 def test_the_report_records_the_topography(scan, tmp_path):
-    report, outcome = solve(str(scene(scan, "scan.x3p", 'periodic = true\ndetrend = "mean_plane"')), workers=1)
+    report, outcome = solve(str(scene(scan, "scan.x3p", 'periodic = true')), workers=1)
     t = report["results"]["topography"]
     assert (t["file"], t["format"], t["unit"], t["unit_from"]) == ("scan.x3p", "x3p", "m", "file")
     assert t["scan_size"] == pytest.approx([P, P]) and t["scan_grid"] == [N, N] and t["period"] == pytest.approx(P)
-    assert (t["detrend"], t["periodic"], t["periodization"], t["source"]) == ("mean_plane", True, None, "measured")
+    assert (t["detrend"], t["periodic"], t["periodization"], t["source"]) == ("none", True, None, "measured")
     assert 0.04 < t["rms_slope"] < 0.06 and t["rms_height"] > 0
     assert len(t["psd"]["q"]) == len(t["psd"]["C"]) > 10
     s = t["small_slope"]
@@ -103,9 +103,11 @@ def test_a_nonperiodic_scan_is_refused_without_periodize_and_accepted_with_one(s
     with pytest.raises(SceneError, match=r"geometry.period = 0.0001: must equal the period of the measured "
                                          r"topography 'scan.x3p': 0.0002"):
         loader.load(scene(scan, "scan.x3p", 'periodize = "mirror"'))
-    report, _ = solve(str(scene(scan, "scan.x3p", 'periodize = "mirror"', period=2 * P)), workers=1)
+    report, _ = solve(str(scene(scan, "scan.x3p", 'periodize = "mirror"\ndetrend = "mean_plane"', period=2 * P)),
+                      workers=1)
     t = report["results"]["topography"]
     assert t["periodization"] == {"method": "mirror"} and t["period"] == pytest.approx(2 * P)
+    assert (t["detrend"], t["periodic"], t["periodic_from"]) == ("mean_plane", False, "file")
     assert 0.0 < report["results"]["loads"][0]["contact_fraction"] < 1.0
     windowed = scene(scan, "scan.x3p", 'periodize = "window"\nwindow_width = 0.125')
     assert loader.load(windowed).geometry.window_width == 0.125
@@ -140,3 +142,8 @@ def test_the_command_line_refuses_a_scan_in_one_line_with_exit_2(scan, capsys):
     assert cli.main(["check", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "geometry.periodize = <missing>: the scan in scan.x3p is not periodic" in err
+
+
+def test_a_periodic_scan_is_not_detrended(scan):
+    with pytest.raises(SceneError, match=r"geometry.detrend = 'curvature': the scan is periodic: removing a plane"):
+        loader.load(scene(scan, "scan.x3p", 'periodic = true\ndetrend = "curvature"'))

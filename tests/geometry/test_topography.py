@@ -100,9 +100,12 @@ def test_a_unit_the_file_contradicts_is_refused(tmp_path, st):
 def test_mean_plane_detrending_removes_a_tilt(tmp_path, st):
     x = P * np.arange(N) / N
     z = _surface()
-    write_x3p(tmp_path / "t.x3p", z + 1e-3 * x[None, :], (P / N, P / N))
-    flat = read_measured(tmp_path / "t.x3p", Reading(periodic=True, detrend="mean_plane")).heights
-    assert np.ptp(flat) < 2 * np.ptp(z)
+    write_x3p(tmp_path / "t.x3p", z + 0.1 * x[None, :], (P / N, P / N))      # a tilt of 0.1: 10 um over the scan
+    flat = read_measured(tmp_path / "t.x3p", Reading(periodize="mirror", detrend="mean_plane")).heights
+    tilted = read_measured(tmp_path / "t.x3p", Reading(periodize="mirror")).heights
+    assert np.ptp(flat) < 2 * np.ptp(z) and np.ptp(tilted) > 0.09 * P
+    with pytest.raises(GeometryError, match="geometry.detrend = 'mean_plane': the scan is periodic"):
+        read_measured(tmp_path / "t.x3p", Reading(periodic=True, detrend="mean_plane"))
 
 
 def test_a_scan_that_is_not_square_is_refused(tmp_path, st):
