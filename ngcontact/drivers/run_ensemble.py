@@ -16,7 +16,9 @@ values, and the band's shrinkage with ``M`` (the relative standard error of
 the mean of ``M, M/2, M/4, ...`` members on disjoint sub-ensembles and its
 fitted rate, ``-1/2`` for independent members).  Tables ``ensemble.csv``,
 ``ensemble_members.csv``, ``ensemble_shrinkage.csv``; plots
-``ensemble_law.png`` (the law with its band) and ``ensemble_band.png``.
+``ensemble_law.png`` (the law with its band) and ``ensemble_band.png``.  Surfaces like a measured one
+(``measured_spectrum``) add the record ``topography`` of :func:`ngcontact.drivers.cell_gap.topography`
+and its ``psd.png``.
 """
 from __future__ import annotations
 
@@ -24,7 +26,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ngcontact.drivers import run_cell
+from ngcontact.drivers import cell_gap, run_cell
 from ngcontact.errors import ModelError
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Clock, Outcome
@@ -102,6 +104,11 @@ def run(scene, clock) -> Outcome:
     law = {q: {key: bands[q][key].tolist() for key in ("mean", "low", "high")} for q in QUANTITIES
            if q != "transmitted_pressure"}
     plots = {"ensemble_law": lambda path: figures.ensemble_law(path, pressure, law, QUANTITIES, M)}
+    topography = cell_gap.topography(scene)     # surfaces like a measured one: its record and spectrum
+    if topography is not None:
+        results["topography"] = topography
+        psd, title = topography["psd"], f"{topography['file']} ({topography['source']})"
+        plots["psd"] = lambda path: figures.topography_psd(path, psd, title)
     spread = {q: s for q, s in shrink.items() if s["rate"] is not None}
     if spread and len(sizes) >= 2:
         plots["ensemble_band"] = lambda path: figures.ensemble_band(path, spread)

@@ -129,10 +129,12 @@ def test_measured_keys_on_a_npy_map_are_refused(tmp_path):
 
 
 def test_surfaces_like_this_one_form_an_ensemble(scan):
-    report, _ = solve(str(scene(scan, "scan.x3p", "periodic = true\nseed = 5", profile="measured_spectrum",
-                                ensemble="[ensemble]\nmembers = 2\n")), workers=1)
+    report, outcome = solve(str(scene(scan, "scan.x3p", "periodic = true\nseed = 5", profile="measured_spectrum",
+                                      ensemble="[ensemble]\nmembers = 2\n")), workers=1)
     r = report["results"]
-    assert r["ensemble"]["seeds"] == [5, 6]
+    assert r["ensemble"]["seeds"] == [5, 6] and "psd" in outcome.plots
+    t = r["topography"]
+    assert t["source"] == "drawn with the measured spectrum, seed 5" and t["measured"]["rms_slope"] > 0
     members = [[e["contact_fraction"] for e in m] for m in r["members"]]
     assert members[0] != members[1] and all(0.0 < f < 1.0 for m in members for f in m)
 
