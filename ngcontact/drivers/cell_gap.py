@@ -118,3 +118,27 @@ def _explicit_gap(scene, xy=None):
         return periodic_table_1d(x, g, P)
     g = tabulated.read_gap_map(resolve(scene, gs.file), path="contact.gap.file")
     return ng.VoxelCoefficient((0.0, 0.0), (P, P), np.ascontiguousarray(g), linear=True)
+
+
+def topography(scene) -> dict | None:
+    """The report's record of a cell's measured topography (``geometry.file`` in an instrument's format), or
+    ``None``: what the file and the scene said (file, format, units, physical size, detrending,
+    periodization: :func:`ngcontact.geometry.topography.read_measured`) and the rms height, rms slope and
+    radially averaged PSD of the periodic map the cell uses (for ``measured_spectrum``, of the surface drawn
+    with the measured spectrum; ``source`` says which)."""
+    from ngcontact.geometry import topography as topo
+    from ngcontact.geometry.profile_registry import reading
+    g = scene.geometry
+    if g.file is None or g.dim != 3 or not topo.is_measured(g.file):
+        return None
+    measured = topo.read_measured(resolve(scene, g.file), reading(g))
+    record = dict(measured.record)
+    scan = topo.statistics(measured.heights, measured.period)
+    if PROFILES[g.profile].random:
+        record["measured"] = {k: scan[k] for k in ("rms_height", "rms_slope")}
+        record["source"] = f"drawn with the measured spectrum, seed {g.random_seed}"
+        record.update(topo.statistics(height_map(scene), measured.period))
+    else:
+        record["source"] = "measured"
+        record.update(scan)
+    return record

@@ -8,6 +8,9 @@ real contact set, ``effective_stiffness``, ``far_face_strain`` (the far-face jum
 cell's height, warned beyond small strain: :mod:`ngcontact.cell.small_strain`)
 and, where the method samples the
 bodies, the largest von Mises / Tresca stress per body with its location.
+A measured topography (``geometry.file`` in an instrument's format) adds its
+record ``topography`` (:func:`ngcontact.drivers.cell_gap.topography`, with
+the small-slope check of its rms slope) and the plot of its PSD ``psd.png``.
 The cell is reached through the cell protocol only
 (:mod:`ngcontact.cell.cell_solver`; ``discretization.method`` chooses the
 implementation in :func:`ngcontact.drivers.build.cell_solver`): the method
@@ -27,7 +30,7 @@ from typing import Any
 from ngcontact.cell import admissibility, small_strain
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.errors import ConvergenceError
-from ngcontact.drivers import cell_members
+from ngcontact.drivers import cell_gap, cell_members
 from ngcontact.drivers.build import cell_facts, cell_loads, cell_solver
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
@@ -98,6 +101,10 @@ def run(scene, clock) -> Outcome:
     method = cell.method_record()
     if method is not None:
         results = {"method": method, **results}
+    topography = cell_gap.topography(scene)
+    if topography is not None:     # its small-slope check is the cell's rms_slope check, on the spectral grid
+        checks = [c.as_dict() for c in admissibility.cell_checks(facts) if c.name == "rms_slope"]
+        results["topography"] = dict(topography, small_slope=checks[0] if checks else None)
     if scene.contact.geometric_only:
         return Outcome(results=results, ndof=0)
     loads = cell_loads(scene)
@@ -136,6 +143,8 @@ def run(scene, clock) -> Outcome:
         vtk["cell"] = VtkField(mesh=mesh, fields=fields, subdivision=1)
     plots = surface_plots(sols, cell.dim, cell.period)
     plots.update(contact_curve_plot(sols))
+    if topography is not None:
+        plots["psd"] = lambda path, t=topography: figures.topography_psd(path, t["psd"], f"{t['file']} ({t['source']})")
     return Outcome(results=results, ndof=cell.unknowns(),
                    solver=cell.solver_record(sols, refinement), tables=tables, vtk=vtk, plots=plots,
                    arrays=arrays)

@@ -1,7 +1,8 @@
 """Driver of a cell scene with ``[ensemble]``: the law of a random surface class, not of one sample.
 
 Member ``m`` (``m = 0 .. M-1``) is the cell of the scene with the random
-surface of ``geometry.spectrum`` drawn with the seed ``seed + m``
+surface of ``geometry.spectrum`` (or of a measured file's spectrum, profile
+``measured_spectrum``) drawn with the seed ``seed + m``
 (:mod:`ngcontact.geometry.random_surface`); it is solved over the scene's
 loads by the ``cell`` driver (:mod:`ngcontact.drivers.run_cell`, spectral or
 FE as the scene says), in a worker of the run's batch
@@ -15,7 +16,9 @@ values, and the band's shrinkage with ``M`` (the relative standard error of
 the mean of ``M, M/2, M/4, ...`` members on disjoint sub-ensembles and its
 fitted rate, ``-1/2`` for independent members).  Tables ``ensemble.csv``,
 ``ensemble_members.csv``, ``ensemble_shrinkage.csv``; plots
-``ensemble_law.png`` (the law with its band) and ``ensemble_band.png``.
+``ensemble_law.png`` (the law with its band) and ``ensemble_band.png``.  Surfaces like a measured one
+(``measured_spectrum``) add the record ``topography`` of :func:`ngcontact.drivers.cell_gap.topography`
+and its ``psd.png``.
 """
 from __future__ import annotations
 
@@ -23,7 +26,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ngcontact.drivers import run_cell
+from ngcontact.drivers import cell_gap, run_cell
 from ngcontact.errors import ModelError
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Clock, Outcome
@@ -41,9 +44,10 @@ QUANTITIES = {
 
 
 def member_scene(scene, m: int):
-    """The cell scene of member ``m``: the spectrum's seed advanced by ``m``, no ensemble."""
-    g = scene.geometry
-    return replace(scene, ensemble=None, geometry=replace(g, spectrum=replace(g.spectrum, seed=g.spectrum.seed + m)))
+    """The cell scene of member ``m``: the random surface's seed advanced by ``m``, no ensemble."""
+    member = replace(scene, ensemble=None, geometry=scene.geometry.reseeded(m))
+    object.__setattr__(member, "base_dir", scene.base_dir)   # not a field of replace: a measured file's folder
+    return member
 
 
 def measured(entry: dict) -> dict[str, float]:
@@ -63,7 +67,7 @@ def realization(job: tuple) -> dict:
     scene, m = job
     sc = member_scene(scene, m)
     outcome = run_cell.run(sc, Clock())
-    return {"seed": sc.geometry.spectrum.seed, "ndof": int(outcome.ndof),
+    return {"seed": sc.geometry.random_seed, "ndof": int(outcome.ndof),
             "loads": [measured(e) for e in outcome.results["loads"]]}
 
 
@@ -72,7 +76,7 @@ def run(scene, clock) -> Outcome:
     M = scene.ensemble.members
     with clock.stage(f"{M} members"):
         members = executor.current().map(realization, [(scene, m) for m in range(M)],
-                                         [f"member {m} (seed {scene.geometry.spectrum.seed + m})" for m in range(M)],
+                                         [f"member {m} (seed {scene.geometry.random_seed + m})" for m in range(M)],
                                          label="ensemble")
     n = len(members[0]["loads"])
     samples = {q: np.array([[mem["loads"][k][q] for k in range(n)] for mem in members]) for q in QUANTITIES}
@@ -100,6 +104,11 @@ def run(scene, clock) -> Outcome:
     law = {q: {key: bands[q][key].tolist() for key in ("mean", "low", "high")} for q in QUANTITIES
            if q != "transmitted_pressure"}
     plots = {"ensemble_law": lambda path: figures.ensemble_law(path, pressure, law, QUANTITIES, M)}
+    topography = cell_gap.topography(scene)     # surfaces like a measured one: its record and spectrum
+    if topography is not None:
+        results["topography"] = topography
+        psd, title = topography["psd"], f"{topography['file']} ({topography['source']})"
+        plots["psd"] = lambda path: figures.topography_psd(path, psd, title)
     spread = {q: s for q, s in shrink.items() if s["rate"] is not None}
     if spread and len(sizes) >= 2:
         plots["ensemble_band"] = lambda path: figures.ensemble_band(path, spread)

@@ -9,7 +9,7 @@ Each :class:`ProfileKind` says what the scene layer validates and what
   from the section's numbers or, for ``tabulated``, from its file;
 * a 3D profile's shape: flat (``flat3d``), a solid of its own builder
   (``square_hills``, paper Fig. 6), or a free-form surface (``bisinusoid``,
-  ``height_map``, ``self_affine``) given by its heights, meshed as the real
+  ``height_map``, ``self_affine``, ``measured_spectrum``) given by its heights, meshed as the real
   surface in the conforming arrangement and represented by the small-slope
   model in the summit arrangement (a flat interface whose initial gap is
   the height below the highest summit);
@@ -97,9 +97,42 @@ def _bisinusoid_gap(g, xy):
     return cell3d.bisinusoid_gap(g.amplitude, g.period, xy=xy)
 
 
-def _height_map(g, file):
+#: keys of a measured topography file (:mod:`ngcontact.geometry.topography`): what the scene states of it
+MEASURED_KEYS = ("units", "size", "detrend", "periodic", "periodize", "window_width")
+
+
+def reading(g):
+    """What the ``[geometry]`` section states of a measured file (:class:`~ngcontact.geometry.topography.Reading`)."""
+    from ngcontact.geometry.topography import Reading
+    return Reading(**{key: getattr(g, key, None) for key in MEASURED_KEYS})
+
+
+def file_map(g, file, where: str = "geometry.file") -> tuple[np.ndarray, float]:
+    """The height map of ``file`` in the package's layout and its period: a ``.npy`` map of the section's
+    period, or a measured topography made periodic (:func:`ngcontact.geometry.topography.read_measured`);
+    ``where`` names the file in messages."""
+    from ngcontact.geometry import topography
+    if topography.is_measured(file):
+        m = topography.read_measured(file, reading(g), where)
+        return m.heights, m.period
     from ngcontact.geometry.tabulated import read_height_map
-    return read_height_map(file, path="geometry.file")
+    return read_height_map(file, path=where), g.period
+
+
+def _height_map(g, file):
+    return file_map(g, file)[0]
+
+
+def _measured_spectrum(g, file):
+    """A random surface with the radially averaged spectrum of the file's map, on its grid
+    (:func:`ngcontact.geometry.random_surface.from_psd`), drawn with ``g.seed``; a flat map draws flat."""
+    from ngcontact.geometry.random_surface import as_height_map, from_psd, radial_psd
+    H, period = file_map(g, file)
+    z = H[:-1, :-1] - H[:-1, :-1].mean()
+    if not np.any(z):
+        return np.zeros_like(H)
+    q, C = radial_psd(z, period)
+    return as_height_map(from_psd(q, C, grid=max(z.shape), period=period, seed=g.seed or 0))
 
 
 def _self_affine(g, file):
@@ -141,7 +174,9 @@ _KINDS = (
     ProfileKind(name="flat3d", dim=3, flat=True),
     ProfileKind(name="square_hills", dim=3, keys=("width", "depth"), solid=_square_hills, check=_check_square_hills),
     ProfileKind(name="bisinusoid", dim=3, keys=("amplitude",), heights=_bisinusoid_heights, gap=_bisinusoid_gap),
-    ProfileKind(name="height_map", dim=3, keys=("file",), heights=_height_map),
+    ProfileKind(name="height_map", dim=3, keys=("file",), optional=MEASURED_KEYS, heights=_height_map),
+    ProfileKind(name="measured_spectrum", dim=3, keys=("file",), optional=MEASURED_KEYS + ("seed",),
+                heights=_measured_spectrum, random=True),
     ProfileKind(name="self_affine", dim=3, keys=("spectrum",), heights=_self_affine, random=True),
 )
 #: ``geometry.profile`` -> what that profile is and how it is built.

@@ -116,3 +116,77 @@ def as_height_map(z: np.ndarray) -> np.ndarray:
     if z.ndim == 1:
         return np.append(z, z[0])
     return np.pad(z, ((0, 1), (0, 1)), mode="wrap")
+
+
+def _wave_numbers(shape: tuple[int, int], period: float) -> np.ndarray:
+    """``|k|`` of the half spectrum of ``scipy.fft.rfft2`` of a ``[y, x]`` map of period ``period``."""
+    import scipy.fft as sfft
+    ny, nx = shape
+    kx = 2 * math.pi * sfft.rfftfreq(nx, d=period / nx)
+    ky = 2 * math.pi * sfft.fftfreq(ny, d=period / ny)
+    return np.sqrt(kx[None, :] ** 2 + ky[:, None] ** 2)
+
+
+def spectral_slope(z: np.ndarray, period: float) -> float:
+    """The rms slope ``sqrt(<|grad z|^2>)`` of the trigonometric interpolant of periodic samples ``z[y, x]``."""
+    import scipy.fft as sfft
+    ny, nx = z.shape
+    zh = sfft.fft2(z)
+    kx = 2 * math.pi * sfft.fftfreq(nx, d=period / nx)[None, :]
+    ky = 2 * math.pi * sfft.fftfreq(ny, d=period / ny)[:, None]
+    return float(np.sqrt(np.sum((kx ** 2 + ky ** 2) * np.abs(zh) ** 2)) / z.size)
+
+
+def radial_psd(z: np.ndarray, period: float) -> tuple[np.ndarray, np.ndarray]:
+    """The radially averaged power spectral density of periodic samples ``z[y, x]`` (zero mean).
+
+    ``C(k) = P^2 |c_k|^2`` with ``c_k = FFT(z)_k / N`` the Fourier coefficients (``N`` points), so that
+    ``<z^2> = sum_k C(k) / P^2``; averaged over the wave vectors in rings ``|k| / (2 pi / P)`` rounded to
+    ``m = 1, 2, ...``.  Returns the rings' mean ``|k|`` and mean ``C``.
+    """
+    import scipy.fft as sfft
+    zh = sfft.fft2(z)
+    ny, nx = z.shape
+    kx = 2 * math.pi * sfft.fftfreq(nx, d=period / nx)[None, :]
+    ky = 2 * math.pi * sfft.fftfreq(ny, d=period / ny)[:, None]
+    k = np.sqrt(kx ** 2 + ky ** 2).ravel()
+    C = (period ** 2 * np.abs(zh) ** 2 / z.size ** 2).ravel()
+    ring = np.rint(k / (2 * math.pi / period)).astype(int)
+    count = np.bincount(ring)
+    keep = np.nonzero(count)[0]
+    keep = keep[keep > 0]
+    return (np.bincount(ring, weights=k)[keep] / count[keep], np.bincount(ring, weights=C)[keep] / count[keep])
+
+
+def from_psd(q: np.ndarray, C: np.ndarray, *, grid: int, period: float, seed: int = 0) -> np.ndarray:
+    """A random periodic surface ``[y, x]`` on ``grid x grid`` points with the isotropic spectrum ``C(q)``.
+
+    ``C`` in the normalization of :func:`radial_psd`, given on its rings ``m = rint(q / (2 pi / P))``: each
+    wave vector takes its ring's ``C`` (zero at ``k = 0``, in rings not given and beyond the last).  Each
+    Fourier coefficient ``Z_k`` of the forward FFT is a complex Gaussian of variance ``N^2 C / P^2`` (``N``
+    points; the filtered white noise of :func:`self_affine` with a tabulated spectrum), so that the expected
+    spectrum of the surface is ``C`` and its expected mean square height ``sum_k C / P^2``, that of the
+    surface ``C`` was measured on.  The surface is not scaled to one rms height: for a spectrum whose few
+    longest waves carry most of the power, scaling every draw to one rms would bias the expected spectrum
+    of the others.  A seed makes it reproducible.
+    """
+    import scipy.fft as sfft
+    q, C = np.asarray(q, float), np.asarray(C, float)
+    ok = (q > 0) & (C > 0)
+    if not ok.any():
+        raise GeometryError("psd", "...", "a spectrum needs a ring of positive power")
+    rings = np.rint(q[ok] / (2 * math.pi / period)).astype(int)
+    table = np.zeros(rings.max() + 2)
+    table[rings] = C[ok]
+    m = np.minimum(np.rint(_wave_numbers((grid, grid), period) / (2 * math.pi / period)).astype(int),
+                   len(table) - 1)
+    variance = table[m] * (grid ** 2 / period) ** 2
+    variance.flat[0] = 0.0
+    # the columns k_x = 0 and Nyquist hold a wave vector and its conjugate twin: irfft2 keeps their mean
+    # (half the variance), so they are drawn with twice it
+    variance[:, 0] *= 2.0
+    if grid % 2 == 0:
+        variance[:, -1] *= 2.0
+    rng = np.random.default_rng(seed)
+    coeff = np.sqrt(variance / 2) * (rng.standard_normal(m.shape) + 1j * rng.standard_normal(m.shape))
+    return sfft.irfft2(coeff, s=(grid, grid))

@@ -381,3 +381,19 @@ def work_precision(path: str, quantity: str, measure: str, series: dict, target:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def topography_psd(path: str, psd: dict, title: str) -> None:
+    """The radially averaged power spectral density ``C(q)`` of a measured topography, log-log."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(5, 4))
+    q, C = np.asarray(psd["q"], float), np.asarray(psd["C"], float)
+    keep = (q > 0) & (C > 0)
+    ax.loglog(q[keep], C[keep], "o-", ms=3)
+    ax.set_xlabel("wave number q [1/m]")
+    ax.set_ylabel("C(q) [m^4]")
+    ax.set_title(title, fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

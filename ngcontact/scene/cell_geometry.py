@@ -4,18 +4,20 @@ Mapped onto the builders of :mod:`ngcontact.geometry.profiles` (2D) and
 :mod:`ngcontact.geometry.cell3d` (3D) by the table of profiles
 :data:`ngcontact.geometry.profile_registry.PROFILES` (the keys each profile
 requires, its builder and what it is); a self-affine random surface is drawn
-by :mod:`ngcontact.geometry.random_surface` from its ``spectrum``.  The
+by :mod:`ngcontact.geometry.random_surface` from its ``spectrum``; a height map is read from a ``.npy``
+file or from a measured topography (:mod:`ngcontact.geometry.topography`).  The
 small-slope profiles (:func:`small_slope`) are a flat interface whose initial
 gap carries the roughness.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ngcontact.errors import GeometryError, SceneError
-from ngcontact.geometry.profile_registry import PROFILES
+from ngcontact.geometry.profile_registry import MEASURED_KEYS, PROFILES
+from ngcontact.geometry.topography import DETREND, PERIODIZE, UNITS, is_measured
 from ngcontact.scene.schema import (at_least, check_selected, closed_interval, nonnegative, open_interval, param,
-                                    positive)
+                                    positive, left_open)
 
 
 PROFILES_2D = tuple(name for name, kind in PROFILES.items() if kind.dim == 2)
@@ -81,18 +83,65 @@ class CellGeometry:
     file: str | None = param(None, doc="tabulated profile: CSV with columns x, y in the scene's length unit, "
                              "an optional header line, x strictly increasing from 0 to the period, the last row "
                              "(x = period) repeating the first y, at most 4096 rows (2D); height map: .npy array "
-                             "whose last row/column repeat the first (3D, small-slope model); a regular file of at "
-                             "most 64 MiB, relative to the scene file")
+                             "whose last row/column repeat the first (3D, small-slope model), or a measured "
+                             "topography in an instrument's format (X3P, DATX, OPD, SUR, PLU, IBW, DI, plain-text "
+                             "matrix, ...; read by SurfaceTopography, pip install 'ngcontact[topography]'; its "
+                             "heights in metres and period = its physical size, twice it with periodize = "
+                             "'mirror'); a regular file of at most 64 MiB, relative to the scene file")
     spectrum: SpectrumSpec | None = param(None, doc="self_affine: the power spectrum and seed of the random surface")
+    units: str | None = param(None, doc="measured file: the length unit of its heights and size, where the file "
+                              "states none (a different one than the file's is refused)", choices=tuple(UNITS))
+    size: tuple[float, float] | None = param(None, doc="measured file: the scan's physical size (x, y) in its "
+                                             "length unit (the file's, else geometry.units), where the file "
+                                             "states none", check=positive())
+    detrend: str | None = param(None, doc="measured file: remove nothing (none, the default), the least-squares "
+                                "plane (mean_plane: tilt) or quadratic (curvature: tilt and form); a periodic scan "
+                                "takes none",
+                                choices=tuple(DETREND))
+    periodic: bool | None = param(None, doc="measured file: the scan is periodic (default: what the file says; "
+                                  "instruments' files say not periodic)")
+    periodize: str | None = param(None, doc="measured file that is not periodic (required for it): mirror (the "
+                                  "scan and its reflections, period twice its size) or window (tapered to the mean "
+                                  "plane within window_width of its edges, period its size)", choices=PERIODIZE)
+    window_width: float | None = param(None, doc="periodize = 'window': the fraction of the scan at each edge "
+                                       "that is tapered (cosine) to the mean plane", check=left_open(0, 0.5))
+    seed: int | None = param(None, doc="measured_spectrum: seed of the random surface drawn with the file's "
+                             "spectrum (default 0; an ensemble's members take seed, seed + 1, ...)",
+                             check=at_least(0))
 
     @property
     def dim(self) -> int:
         return PROFILES[self.profile].dim
 
+    @property
+    def random_seed(self) -> int | None:
+        """The seed of a random surface (``spectrum.seed``, else ``seed``), ``None`` for a given one."""
+        if not PROFILES[self.profile].random:
+            return None
+        return self.spectrum.seed if self.spectrum is not None else (self.seed or 0)
+
+    def reseeded(self, offset: int) -> CellGeometry:
+        """The same section with its random surface's seed advanced by ``offset``."""
+        seed = self.random_seed
+        if seed is None:
+            raise ValueError(f"geometry.profile = {self.profile!r} draws no random surface")
+        if self.spectrum is not None:
+            return replace(self, spectrum=replace(self.spectrum, seed=seed + offset))
+        return replace(self, seed=seed + offset)
+
     def check(self, path: str) -> None:
         kind = PROFILES[self.profile]
-        check_selected(self, path, "profile", ("width", "depth", "radius", "angles", "amplitude", "file", "spectrum"),
+        check_selected(self, path, "profile", ("width", "depth", "radius", "angles", "amplitude", "file", "spectrum",
+                                               *MEASURED_KEYS, "seed"),
                        kind.keys, kind.optional)
+        if self.file is not None and not is_measured(self.file):
+            for key in MEASURED_KEYS:
+                if getattr(self, key) is not None:
+                    raise SceneError(f"{path}.{key}", getattr(self, key), f"states what a measured topography file "
+                                     f"does not; {self.file!r} is a .npy height map in the package's layout: remove "
+                                     "it")
+        if self.window_width is not None and self.periodize != "window":
+            raise SceneError(f"{path}.window_width", self.window_width, "used by periodize = 'window' only; remove it")
         try:
             if kind.check is not None:
                 kind.check(self)

@@ -124,7 +124,8 @@ MAX_MEMBERS = 10_000
 
 @dataclass(frozen=True, kw_only=True)
 class EnsembleSpec:
-    """M realizations of the random surface of ``geometry.spectrum``: seeds ``seed, seed + 1, ...``."""
+    """M realizations of the random surface of ``geometry.spectrum`` (or ``geometry.seed``): seeds ``seed, seed + 1,
+    ...``."""
 
     members: int = param(doc="number of realizations M", check=closed_interval(2, MAX_MEMBERS))
 
@@ -149,12 +150,13 @@ class CellScene:
     discretization: CellDiscretization = param(CellDiscretization(), doc="mesh and order")
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     ensemble: EnsembleSpec | None = param(None, doc="solve the loads on M realizations of the random surface "
-                                          "(geometry.profile = 'self_affine'); report the mean and the 95 % band")
+                                          "(geometry.profile = 'self_affine' or 'measured_spectrum'); report the "
+                                          "mean and the 95 % band")
     compute: ComputeSpec = param(ComputeSpec(), doc="where independent solves run (loads, ensemble members)")
     base_dir: str = base_dir_field()
 
     def check_files(self, load) -> None:
-        """Read and validate the tabulated profile / height map / gap named by the scene.
+        """Read and validate the tabulated profile / height map / measured topography / gap named by the scene.
 
         The readers name the entry under the scene's key path they are given
         (``where``), so their :class:`GeometryError` becomes a
@@ -167,6 +169,7 @@ class CellScene:
 
     def _check_files(self) -> None:
         from ngcontact.geometry import tabulated
+        from ngcontact.geometry.profile_registry import file_map
         from ngcontact.scene.sections import resolve
         g = self.geometry
         if g.file is not None:
@@ -183,7 +186,11 @@ class CellScene:
                 check_profile_heights(g, (lo, hi))     # what the mesher checks, as 'run' meets it
                 check_features(prof, "geometry.file", g.file)
             else:
-                heights = tabulated.read_height_map(resolve(self, g.file), path=where)
+                heights, period = file_map(g, resolve(self, g.file), where)
+                if abs(period - g.period) > 1e-9 * period:
+                    raise SceneError("geometry.period", g.period, f"must equal the period of the measured "
+                                     f"topography {g.file!r}: {period!r} (its physical size in metres, twice it "
+                                     "with periodize = 'mirror')")
                 if self.discretization.method == "spectral" and self.discretization.grid is None:
                     check_spectral_size(g.dim, spectral_grid(self, heights.shape), "geometry.file", g.file)
         gs = self.contact.gap
@@ -224,7 +231,8 @@ class CellScene:
                              "does not allow; remove the key or set contact.friction = 'none'")
         if self.ensemble is not None and not PROFILES[self.geometry.profile].random:
             raise SceneError("ensemble", "...", "realizations of a random surface need geometry.profile = "
-                             f"'self_affine' (its spectrum and seed), not {self.geometry.profile!r}")
+                             "'self_affine' (its spectrum and seed) or 'measured_spectrum' (a measured file's "
+                             f"spectrum), not {self.geometry.profile!r}")
         if flat_interface(self.geometry) and self.contact.friction == "none":
             for key in ("shear", "tangential_jump"):
                 v = getattr(self.load, key)

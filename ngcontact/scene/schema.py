@@ -104,6 +104,10 @@ def half_open(lo, hi) -> Check:
     return _named(f"must lie in [{lo}, {hi})", lambda v: _all(v, lambda x: lo <= x < hi))
 
 
+def left_open(lo, hi) -> Check:
+    return _named(f"must lie in ({lo}, {hi}]", lambda v: _all(v, lambda x: lo < x <= hi))
+
+
 def closed_interval(lo, hi) -> Check:
     return _named(f"must lie in [{lo}, {hi}]", lambda v: _all(v, lambda x: lo <= x <= hi))
 
