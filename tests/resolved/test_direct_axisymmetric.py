@@ -24,6 +24,7 @@ from ngcontact.resolved import resolved_problem as D
 from ngcontact.fem import materials as mat
 from ngcontact.scene import loader as scene_mod
 from ngcontact.drivers import run_resolved as drv
+from ngcontact.coupling.homogenization_error import CONSTANTS
 from ngcontact.drivers.study_epsilon import run_study
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
@@ -179,6 +180,11 @@ def test_femur_bundle_error_falls_with_eps():
     # the rates rest on levels whose meshes are a small share of the error (the separation of the two errors)
     assert res["rate_levels"]["bundle"]["field"] == [4, 8, 16]
     assert all(r["bundle_field_discretization"] <= 0.1 * r["bundle_field"] for r in rows), rows
+    # the constant of the macro reports' modelling-error estimate E <= C eps / L bounds what the study measures
+    constant = CONSTANTS["bundle"][0]
+    for r in rows:
+        for key in ("field", "probe"):
+            assert r[f"bundle_{key}"] * r["N"] <= constant, (key, r["N"], r[f"bundle_{key}"] * r["N"], constant)
     # the base carries the whole load: its reaction error is round-off, and no rate is made of it
     assert rates["bundle"]["reaction"] is None
     assert res["refused"]["bundle"]["reaction"].startswith("the error is at round-off")
