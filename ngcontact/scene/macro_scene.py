@@ -32,7 +32,9 @@ from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.laws import homogenized as il
 from ngcontact.scene.macro_shapes import (BOUNDARIES, REQUIRED, SETTINGS, SHAPES, check_dimensions,
                                           check_support_meaning, macro_extent)
-from ngcontact.scene.macro_shapes import BOUNDARY_DOCS  # noqa: F401  (the kind's labels, read by the README reference)
+from ngcontact.scene.macro_shapes import BOUNDARY_DOCS as SHAPE_BOUNDARY_DOCS
+from ngcontact.scene.file_geometry import (FILE_BOUNDARY_DOCS, BodySpec, FaceSelectorSpec, check_file_geometry,
+                                           file_labels)
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
 from ngcontact.scene import cell_links, mesh_size
@@ -40,6 +42,8 @@ from ngcontact.scene.cell_scene import FRICTION
 from ngcontact.scene.schema import at_least, distinct, nonempty, nonnegative, open_interval, param, positive
 
 LAWS = ("linear", "bundle", "tabulated", "file")
+#: the kind's boundary labels by (shape, setting), read by the README reference
+BOUNDARY_DOCS = {**SHAPE_BOUNDARY_DOCS, ("file", "3d"): FILE_BOUNDARY_DOCS}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -47,15 +51,33 @@ class MacroGeometrySpec:
     """Which macro geometry, in which setting, with which dimensions."""
 
     shape: str = param(doc="femur_stem (regions stem = rough, bone = counter), coaxial (inner = rough, "
-                       "outer = counter) or block (block = rough on base = counter)", choices=SHAPES)
+                       "outer = counter), block (block = rough on base = counter) or file (two solids of a CAD "
+                       "file, see file)", choices=SHAPES)
     setting: str = param("axisymmetric", doc="plane_strain, axisymmetric (r, z) or 3d",
                          choices=("plane_strain", "axisymmetric", "3d"))
     dimensions: dict[str, float] | None = param(
         None, doc="femur_stem: r_stem, r_tip, r_bone, z_tip, z_corner, z_bone_top, z_stem_top (defaults "
         "exist); coaxial: a, b, c (radii), height (axisymmetric/3d); block: length, h_block, h_base",
         units="m", allowed="a table of numbers > 0")
+    file: str | None = param(None, doc="shape = file: the CAD file (STEP .step/.stp, IGES .iges/.igs, BREP "
+                             ".brep/.brp) of two solids, relative to this scene; where they touch is the "
+                             "interface; STEP and IGES are read in millimetres")
+    length_unit: float | None = param(None, doc="shape = file: metres per unit of the file as read (default "
+                                      "0.001 for STEP and IGES, which are read in millimetres; 1 for BREP)",
+                                      units="m", check=positive())
+    rough: BodySpec | None = param(None, doc="shape = file: the solid that is the rough body")
+    counter: BodySpec | None = param(None, doc="shape = file: the solid that is the counter body")
+    boundaries: dict[str, FaceSelectorSpec] | None = param(
+        None, doc="shape = file: boundary labels for [[supports]] and [[loads]], each the faces one selector "
+        "picks (`ngcontact check` lists the faces)")
 
     def check(self, path: str) -> None:
+        if self.shape == "file" or self.file is not None:
+            check_file_geometry(self, path)
+            return
+        for key in ("length_unit", "rough", "counter", "boundaries"):
+            if getattr(self, key) is not None:
+                raise SceneError(f"{path}.{key}", getattr(self, key), "only used with shape = 'file'; remove it")
         allowed = SETTINGS[self.shape]
         if self.setting not in allowed:
             raise SceneError(f"{path}.setting", self.setting,
@@ -263,6 +285,9 @@ class MacroScene:
     def check_size(self) -> None:
         """The element estimate of :mod:`ngcontact.scene.mesh_size` against ``max_elements``."""
         g, d = self.geometry, self.discretization
+        if g.shape == "file":   # the extent is known once the file is read (drivers/macro_geometry.py)
+            mesh_size.check_lengths({"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
+            return
         mesh_size.check_lengths({f"geometry.dimensions.{k}": v for k, v in (g.dimensions or {}).items()}
                                 | {"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         dim, volume, interface, width = macro_extent(g.shape, g.setting, dict(g.dimensions or {}))
@@ -275,12 +300,12 @@ class MacroScene:
         self.check_size()
         comps = COMPONENTS[self.geometry.setting]
         shape, setting = self.geometry.shape, self.geometry.setting
-        labels = BOUNDARIES[shape, setting]
+        labels = file_labels(self.geometry) if shape == "file" else BOUNDARIES[shape, setting]
         groups: tuple[tuple[str, tuple[SupportSpec | LoadSpec, ...]], ...] = (
             ("supports", self.supports), ("loads", self.loads))
         for what, items in groups:
             for i, item in enumerate(items):
-                if item.boundary not in labels:
+                if item.boundary not in labels and labels:
                     raise SceneError(f"{what}[{i}].boundary", item.boundary,
                                      f"no such boundary in {shape!r} ({setting}); labels are " + ", ".join(labels))
         for i, s in enumerate(self.supports):
@@ -317,6 +342,9 @@ class MacroScene:
         ``load(path, overrides=None)``: overrides of the law's cells' ``[contact]``.
         """
         from ngcontact.scene.sections import check_input_file, resolve
+        if self.geometry.file is not None:
+            check_input_file("geometry.file", resolve(self, self.geometry.file), "CAD file",
+                             shown=self.geometry.file, missing="no such CAD file")
         if self.interface.law_file is not None:
             from ngcontact.scene import law_file
             contents = law_file.read(resolve(self, self.interface.law_file))

@@ -15,12 +15,12 @@ import math
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
 
-SHAPES = ("femur_stem", "coaxial", "block")
+SHAPES = ("femur_stem", "coaxial", "block", "file")
 SETTINGS = {"femur_stem": ("axisymmetric", "3d"), "coaxial": ("plane_strain", "axisymmetric", "3d"),
-            "block": ("plane_strain",)}
+            "block": ("plane_strain",), "file": ("3d",)}
 DIMENSIONS = {"femur_stem": tuple(f.name for f in dataclasses.fields(FemurStemDims)),
-              "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base")}
-REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base")}
+              "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base"), "file": ()}
+REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base"), "file": ()}
 def check_dimensions(dims: dict, path: str, shape: str, required) -> None:
     """A ``dimensions`` table: positive, known for ``shape``, the ``required`` ones present.
 
@@ -43,7 +43,8 @@ def check_dimensions(dims: dict, path: str, shape: str, required) -> None:
             raise SceneError(path, dims, str(exc)) from None
 
 
-REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block": ("block", "base")}
+REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block": ("block", "base"),
+           "file": ("rough", "counter")}
 #: Boundary labels of the meshed geometries (:mod:`ngcontact.geometry.bodies`) by (shape, setting),
 #: so that supports and loads are checked without meshing.
 FEMUR_BOUNDARIES = {
