@@ -4,7 +4,8 @@
 the built-in femur with its hip stem (:mod:`ngcontact.geometry.femur`,
 :mod:`ngcontact.geometry.femur3d`), the coaxial tubes and the block on a base
 (:mod:`ngcontact.geometry.bodies`), and two solids of a CAD file
-(:mod:`ngcontact.geometry.cad_model`) whose faces the scene names by
+(:mod:`ngcontact.geometry.cad_model`) or two regions of a mesh file
+(:mod:`ngcontact.geometry.mesh_model`), whose faces the scene names by
 selectors (:mod:`ngcontact.geometry.face_selectors`).
 """
 from __future__ import annotations
@@ -16,6 +17,8 @@ from ngcontact.errors import GeometryError, SceneError
 from ngcontact.geometry import bodies as gm
 from ngcontact.geometry import cad_model as cad
 from ngcontact.geometry.face_selectors import label_faces, listing
+from ngcontact.geometry.mesh_model import MESH_SUFFIXES, read_mesh
+from ngcontact.geometry.model_faces import TwoBodyModel, body_index
 from ngcontact.geometry.femur import BOUNDARIES, FemurStemDims, femur_stem
 from ngcontact.geometry.femur3d import femur_stem_3d
 from ngcontact.scene import mesh_size
@@ -83,7 +86,7 @@ class Block:
 class FileModel:
     """A CAD file read and its selections made: the model, the two bodies, the face labels."""
 
-    model: cad.CadModel
+    model: TwoBodyModel
     rough: int
     counter: int
     labels: dict[int, str]
@@ -102,9 +105,10 @@ class FromFile:
 
     def _selected(self, scene) -> FileModel:
         g = scene.geometry
-        model = cad.read_cad(resolve(scene, g.file))
-        rough = cad.body_index(model, "geometry.rough", **vars(g.rough))
-        counter = cad.body_index(model, "geometry.counter", **vars(g.counter))
+        path = resolve(scene, g.file)
+        model = read_mesh(path) if path.lower().endswith(MESH_SUFFIXES) else cad.read_cad(path)
+        rough = body_index(model, "geometry.rough", **vars(g.rough))
+        counter = body_index(model, "geometry.counter", **vars(g.counter))
         if rough == counter:
             raise SceneError("geometry.counter", vars(g.counter), f"is body {rough}, the rough body too; the "
                              "bodies are\n" + model.bodies_listing())
@@ -121,11 +125,12 @@ class FromFile:
                                      "no such boundary in the file's model; labels are " + ", ".join(sorted(names))
                                      + "; name faces with geometry.boundaries.NAME; the faces are\n"
                                      + listing(model.faces, model.body_names(rough, counter)))
-        self._check_size(scene, model)
+        if model.meshed_here:
+            self._check_size(scene, model)
         return FileModel(model, rough, counter, labels)
 
     @staticmethod
-    def _check_size(scene, model: cad.CadModel) -> None:
+    def _check_size(scene, model: TwoBodyModel) -> None:
         """The element estimate of :mod:`ngcontact.scene.mesh_size` on the model's volume and interface."""
         d, unit = scene.discretization, file_length_unit(scene.geometry)
         volume = sum(model.volumes) * unit ** 3
@@ -136,9 +141,9 @@ class FromFile:
 
     def build(self, scene, sizes):
         chosen = self.selected(scene)
-        return cad.mesh_cad(chosen.model, chosen.rough, chosen.counter, chosen.labels,
-                            length_unit=file_length_unit(scene.geometry), maxh=sizes.maxh,
-                            interface_maxh=sizes.interface_maxh, order=sizes.order)
+        return chosen.model.mesh(chosen.rough, chosen.counter, chosen.labels,
+                                 length_unit=file_length_unit(scene.geometry), maxh=sizes.maxh,
+                                 interface_maxh=sizes.interface_maxh, order=sizes.order)
 
     def inventory(self, scene):
         chosen = self.selected(scene)

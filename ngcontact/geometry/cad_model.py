@@ -29,68 +29,33 @@ import ngsolve as ng
 
 from ngcontact.errors import GeometryError
 from ngcontact.geometry.bodies import MacroGeometry
-from ngcontact.geometry.model_faces import ModelFace, surface_form
+from ngcontact.geometry.model_faces import (MODEL_COUNTER, MODEL_ROUGH, MODEL_UNNAMED, ModelFace, TwoBodyModel,
+                                            surface_form)
 
 #: file suffixes read through OCC, and the length unit [m] of the coordinates as read
 CAD_SUFFIXES = {".step": 1e-3, ".stp": 1e-3, ".iges": 1e-3, ".igs": 1e-3, ".brep": None, ".brp": None}
-#: the region names of the two bodies in the mesh
-ROUGH, COUNTER = "rough", "counter"
-#: boundary label of faces no selector names and the file leaves unnamed
-UNNAMED = "free"
+ROUGH, COUNTER, UNNAMED = MODEL_ROUGH, MODEL_COUNTER, MODEL_UNNAMED
 #: relative tolerance (of the model's bounding-box diagonal) of recognising planes and cylinders
 FORM_TOLERANCE = 1e-5
 
 
 @dataclass
-class CadModel:
-    """The glued solids of a file and their distinct faces (in the units as read)."""
+class CadModel(TwoBodyModel):
+    """The glued solids of a CAD file and their distinct faces (in the units as read)."""
 
-    path: str
-    shape: Any
-    solids: list
-    occ_faces: list
-    faces: list[ModelFace]
-    solid_names: list[str | None]
-    size: float
-    volumes: list[float] = field(default_factory=list)
+    shape: Any = None
+    solids: list = field(default_factory=list)
+    occ_faces: list = field(default_factory=list)
 
-    @property
-    def tolerance(self) -> float:
-        """Default tolerance of the geometric selectors: ``1e-4`` of the bounding-box diagonal."""
-        return 1e-4 * self.size
+    def containing(self, point) -> list[int]:
+        from netgen.occ import Pnt, Vertex
 
-    def body_names(self, rough: int, counter: int) -> dict[int, str]:
-        return {rough: f"rough (body {rough})", counter: f"counter (body {counter})"}
+        return [i for i, s in enumerate(self.solids) if s.Distance(Vertex(Pnt(*point))) <= self.tolerance]
 
-    def bodies_listing(self) -> str:
-        return "\n".join(f"  body {i}: {repr(self.solid_names[i]) if self.solid_names[i] else '(no name)'}, "
-                         f"volume {v:.6g}"
-                         for i, v in enumerate(self.volumes))
-
-    def interface_faces(self) -> list[ModelFace]:
-        return [f for f in self.faces if len(f.bodies) == 2]
-
-
-def body_index(model: CadModel, key: str, *, name: str | None = None, index: int | None = None,
-               point: tuple[float, ...] | None = None) -> int:
-    """The body a scene means by its ``name`` in the file, its ``index`` or a ``point`` inside it."""
-    from netgen.occ import Pnt, Vertex
-
-    if name is not None:
-        found = [i for i, n in enumerate(model.solid_names) if n == name]
-        what: object = name
-    elif index is not None:
-        found = [index] if 0 <= index < len(model.solids) else []
-        what = index
-    else:
-        assert point is not None
-        found = [i for i, s in enumerate(model.solids)
-                 if s.Distance(Vertex(Pnt(*point))) <= model.tolerance]
-        what = list(point)
-    if len(found) != 1:
-        raise GeometryError(key, what, ("names no body" if not found else "lies in both bodies (on the interface)")
-                         + " of the model; the bodies are\n" + model.bodies_listing())
-    return found[0]
+    def mesh(self, rough: int, counter: int, labels: dict[int, str], *, length_unit: float, maxh: float,
+             interface_maxh: float, order: int) -> MacroGeometry:
+        return mesh_cad(self, rough, counter, labels, length_unit=length_unit, maxh=maxh,
+                        interface_maxh=interface_maxh, order=order)
 
 
 def _distinct(shapes) -> list:
@@ -111,12 +76,12 @@ def read_cad(path: str, key: str = "geometry.file") -> CadModel:
         raise GeometryError(key, path, f"not readable as CAD ({exc})") from None
     if len(solids) != 2:
         raise GeometryError(key, path, f"holds {len(solids)} solids; a macro model needs exactly two bodies "
-                         "(the rough and the counter body), each one solid")
+                            "(the rough and the counter body), each one solid")
     glued = Glue(solids)
     if len(glued.solids) != 2:
         raise GeometryError(key, path, "the two solids overlap (gluing them gives "
-                         f"{len(glued.solids)} solids); model them touching along the interface, with the "
-                         "interference as a negative interface.gap")
+                            f"{len(glued.solids)} solids); model them touching along the interface, with the "
+                            "interference as a negative interface.gap")
     parts = list(glued.solids)
     occ_faces = _distinct(glued.faces)
     lo, hi = (np.array(p) for p in glued.bounding_box)
@@ -132,8 +97,8 @@ def read_cad(path: str, key: str = "geometry.file") -> CadModel:
                      solid_names=[s.name for s in parts], size=size, volumes=[float(s.mass) for s in parts])
     if not model.interface_faces():
         raise GeometryError(key, path, "the two solids share no face: they must touch along the interface "
-                         "(the interference, if any, is a negative interface.gap); the bodies are\n"
-                         + model.bodies_listing())
+                            "(the interference, if any, is a negative interface.gap); the bodies are\n"
+                            + model.bodies_listing())
     return model
 
 

@@ -64,7 +64,7 @@ class ByIndex:
         for i in self.indices:
             if i not in known:
                 raise GeometryError(self.key, list(self.indices),
-                                 f"face {i} does not exist; the model has faces 0 to {len(faces) - 1}")
+                                    f"face {i} does not exist; the model has faces 0 to {len(faces) - 1}")
         return [f for f in faces if f.index in self.indices]
 
 
@@ -126,9 +126,9 @@ class NearestTo:
         best = np.flatnonzero(dist <= dist.min() + tol)
         if len(best) > 1:
             raise GeometryError(self.key, list(self.point),
-                             "ambiguous: faces " + ", ".join(str(faces[k].index) for k in best)
-                             + f" are all {dist.min():.6g} away (within the tolerance {tol:g}); move the point "
-                             "into the face you mean, or select by plane, cylinder or box\n" + listing(faces))
+                                "ambiguous: faces " + ", ".join(str(faces[k].index) for k in best)
+                                + f" are all {dist.min():.6g} away (within the tolerance {tol:g}); move the point "
+                                "into the face you mean, or select by plane, cylinder or box\n" + listing(faces))
         return [faces[int(best[0])]]
 
 
@@ -145,15 +145,15 @@ def label_faces(faces: list[ModelFace], selectors: dict[str, FaceSelector], tole
         picked = selector.pick(faces, tolerance)
         if not picked:
             raise GeometryError(selector.key, name, "matches no face of the model; the faces are\n"
-                             + listing(faces, body_names))
+                                + listing(faces, body_names))
         for f in picked:
             if len(f.bodies) > 1:
                 raise GeometryError(selector.key, name, f"matches face {f.index}, which both bodies share (the "
-                                 "interface, which carries the law and takes no support or load); the faces are\n"
-                                 + listing(faces, body_names))
+                                    "interface, which carries the law and takes no support or load); the faces are\n"
+                                    + listing(faces, body_names))
             if f.index in owner:
                 raise GeometryError(selector.key, name, f"ambiguous: face {f.index} is also selected as "
-                                 f"{owner[f.index]!r}; a face belongs to one boundary; the faces are\n"
-                                 + listing(faces, body_names))
+                                    f"{owner[f.index]!r}; a face belongs to one boundary; the faces are\n"
+                                    + listing(faces, body_names))
             owner[f.index] = name
     return owner

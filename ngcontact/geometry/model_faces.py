@@ -23,6 +23,7 @@ Lengths are in the file's own units throughout.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -168,3 +169,70 @@ def _segment_distance(p: np.ndarray, s: np.ndarray, t: np.ndarray) -> np.ndarray
     length2 = np.einsum("ij,ij->i", d, d)
     lam = np.clip(np.einsum("ij,ij->i", p - s, d) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
     return np.linalg.norm(p - (s + lam[:, None] * d), axis=1)
+
+
+#: the region names of the two bodies in a model's mesh, and the label of faces nothing names
+MODEL_ROUGH, MODEL_COUNTER, MODEL_UNNAMED = "rough", "counter", "free"
+
+
+@dataclass
+class TwoBodyModel:
+    """Two bodies read from a file and their faces, before meshing (in the file's units as read).
+
+    Subclasses (a CAD file, :mod:`ngcontact.geometry.cad_model`; a mesh
+    file, :mod:`ngcontact.geometry.mesh_model`) say which bodies contain a
+    point and produce the :class:`~ngcontact.geometry.bodies.MacroGeometry`.
+    """
+
+    path: str
+    faces: list[ModelFace]
+    solid_names: list[str | None]
+    volumes: list[float]
+    size: float
+    #: whether :meth:`mesh` meshes the model (with the scene's sizes) or uses a mesh the file holds
+    meshed_here: ClassVar[bool] = True
+
+    @property
+    def tolerance(self) -> float:
+        """Default tolerance of the geometric selectors: ``1e-4`` of the bounding-box diagonal."""
+        return 1e-4 * self.size
+
+    def body_names(self, rough: int, counter: int) -> dict[int, str]:
+        return {rough: f"rough (body {rough})", counter: f"counter (body {counter})"}
+
+    def bodies_listing(self) -> str:
+        return "\n".join(f"  body {i}: {repr(self.solid_names[i]) if self.solid_names[i] else '(no name)'}, "
+                         f"volume {v:.6g}" for i, v in enumerate(self.volumes))
+
+    def interface_faces(self) -> list[ModelFace]:
+        return [f for f in self.faces if len(f.bodies) == 2]
+
+    def containing(self, point) -> list[int]:
+        """The bodies ``point`` lies in (within the tolerance)."""
+        raise NotImplementedError
+
+    def mesh(self, rough: int, counter: int, labels: dict[int, str], *, length_unit: float, maxh: float,
+             interface_maxh: float, order: int):
+        """The :class:`~ngcontact.geometry.bodies.MacroGeometry` in metres: regions ``rough``, ``counter``,
+        boundary ``interface`` on the shared faces, ``labels`` (face index -> name) on the selected ones,
+        the file's names on the others, :data:`MODEL_UNNAMED` where it has none."""
+        raise NotImplementedError
+
+
+def body_index(model: TwoBodyModel, key: str, *, name: str | None = None, index: int | None = None,
+               point: tuple[float, ...] | None = None) -> int:
+    """The body a scene means by its ``name`` in the file, its ``index`` or a ``point`` inside it."""
+    from ngcontact.errors import GeometryError
+
+    what: object
+    if name is not None:
+        found, what = [i for i, n in enumerate(model.solid_names) if n == name], name
+    elif index is not None:
+        found, what = ([index] if 0 <= index < len(model.volumes) else []), index
+    else:
+        assert point is not None
+        found, what = model.containing(point), list(point)
+    if len(found) != 1:
+        raise GeometryError(key, what, ("names no body" if not found else "lies in both bodies (on the interface)")
+                            + " of the model; the bodies are\n" + model.bodies_listing())
+    return found[0]

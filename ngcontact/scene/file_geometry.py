@@ -32,7 +32,7 @@ def _unit_vector(v) -> str | None:
 class BodySpec:
     """Which solid of the file a body is: exactly one of name, index, point."""
 
-    name: str | None = param(None, doc="the solid's name in the file")
+    name: str | None = param(None, doc="the solid's name in the file (a mesh: its region's)")
     index: int | None = param(None, doc="the solid's index as `ngcontact check` lists it (0 or 1)")
     point: tuple[float, float, float] | None = param(None, doc="a point inside the solid", units="file units")
 
@@ -79,7 +79,8 @@ SELECTORS = ("name", "index", "plane", "cylinder", "box", "nearest")
 class FaceSelectorSpec:
     """Faces of the file's model: exactly one selector (the faces picked whole, every sample within tolerance)."""
 
-    name: str | None = param(None, doc="the faces the file names so (a STEP face name)")
+    name: str | None = param(None, doc="the faces the file names so (a STEP face name, a mesh's boundary "
+                             "region, a Gmsh physical surface)")
     index: tuple[int, ...] | None = param(None, doc="faces by their index in `ngcontact check`'s list")
     plane: PlaneSpec | None = param(None, doc="the faces lying on a plane")
     cylinder: CylinderSpec | None = param(None, doc="the faces lying on a cylinder")
@@ -116,15 +117,17 @@ class FaceSelectorSpec:
 def check_file_geometry(geometry, path: str) -> None:
     """The keys of ``shape = "file"``: the file, its unit, the two bodies, no dimensions, 3D."""
     from ngcontact.geometry.cad_model import CAD_SUFFIXES
+    from ngcontact.geometry.mesh_model import MESH_SUFFIXES
 
     if geometry.shape != "file":
         raise SceneError(f"{path}.file", geometry.file, "only used with shape = 'file'; remove it")
     if geometry.file is None:
         raise SceneError(f"{path}.file", MISSING, "required for shape = 'file': the CAD file of the two bodies")
     suffix = "." + geometry.file.rsplit(".", 1)[-1].lower() if "." in geometry.file else ""
-    if suffix not in CAD_SUFFIXES:
-        raise SceneError(f"{path}.file", geometry.file, "must end in one of " + ", ".join(CAD_SUFFIXES))
-    unit = CAD_SUFFIXES[suffix]
+    if suffix not in (*CAD_SUFFIXES, *MESH_SUFFIXES):
+        raise SceneError(f"{path}.file", geometry.file, "must end in one of " + ", ".join((*CAD_SUFFIXES,
+                                                                                            *MESH_SUFFIXES)))
+    unit = CAD_SUFFIXES.get(suffix)
     if unit is not None and geometry.length_unit not in (None, unit):
         raise SceneError(f"{path}.length_unit", geometry.length_unit,
                          f"a {suffix} file is read in millimetres whatever unit it declares (the reader "
@@ -148,7 +151,7 @@ def file_length_unit(geometry) -> float:
 
     if geometry.length_unit is not None:
         return geometry.length_unit
-    return CAD_SUFFIXES["." + geometry.file.rsplit(".", 1)[-1].lower()] or 1.0
+    return CAD_SUFFIXES.get("." + geometry.file.rsplit(".", 1)[-1].lower()) or 1.0
 
 
 def file_labels(geometry) -> tuple[str, ...]:

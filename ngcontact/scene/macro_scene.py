@@ -60,13 +60,15 @@ class MacroGeometrySpec:
         "exist); coaxial: a, b, c (radii), height (axisymmetric/3d); block: length, h_block, h_base",
         units="m", allowed="a table of numbers > 0")
     file: str | None = param(None, doc="shape = file: the CAD file (STEP .step/.stp, IGES .iges/.igs, BREP "
-                             ".brep/.brp) of two solids, relative to this scene; where they touch is the "
-                             "interface; STEP and IGES are read in millimetres")
+                             ".brep/.brp) of two solids, or the mesh (Netgen .vol, Gmsh .msh) of two regions of "
+                             "tetrahedra, relative to this scene; where the bodies touch is the interface; STEP "
+                             "and IGES are read in millimetres; a mesh is used as it is (maxh does not apply)")
     length_unit: float | None = param(None, doc="shape = file: metres per unit of the file as read (default "
-                                      "0.001 for STEP and IGES, which are read in millimetres; 1 for BREP)",
+                                      "0.001 for STEP and IGES, which are read in millimetres; 1 for BREP and "
+                                      "meshes)",
                                       units="m", check=positive())
-    rough: BodySpec | None = param(None, doc="shape = file: the solid that is the rough body")
-    counter: BodySpec | None = param(None, doc="shape = file: the solid that is the counter body")
+    rough: BodySpec | None = param(None, doc="shape = file: the solid (mesh region) that is the rough body")
+    counter: BodySpec | None = param(None, doc="shape = file: the solid (mesh region) that is the counter body")
     boundaries: dict[str, FaceSelectorSpec] | None = param(
         None, doc="shape = file: boundary labels for [[supports]] and [[loads]], each the faces one selector "
         "picks (`ngcontact check` lists the faces)")

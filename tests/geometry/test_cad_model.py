@@ -15,6 +15,7 @@ from ngcontact import cli
 from ngcontact.errors import GeometryError
 from ngcontact.geometry import cad_model as cad
 from ngcontact.geometry import face_selectors as fs
+from ngcontact.geometry.model_faces import body_index
 
 
 def write_block_on_base(path) -> None:
@@ -25,6 +26,29 @@ def write_block_on_base(path) -> None:
     block.faces.Max(Z).name = "top"
     block.name, base.name = "block", "base"
     Compound([block, base]).WriteStep(str(path))
+
+
+def write_block_on_base_meshes(folder) -> None:
+    """The same block on its base as a Netgen mesh (``bb.vol``) and a Gmsh mesh (``bb.msh``), in metres.
+
+    Netgen's Gmsh export writes no physical names, which Netgen's Gmsh reader
+    requires: they are added here (the face names and the region names).
+    """
+    from netgen.occ import Box, Glue, OCCGeometry, Pnt, Z
+
+    block = Box(Pnt(0, 0, 0), Pnt(2, 1, 1))
+    base = Box(Pnt(0, 0, -1), Pnt(2, 1, 0))
+    block.faces.Max(Z).name = "top"
+    block.mat("block")
+    base.mat("base")
+    m = OCCGeometry(Glue([block, base])).GenerateMesh(maxh=0.5)
+    m.Save(str(folder / "bb.vol"))
+    m.Export(str(folder / "raw.msh"), "Gmsh2 Format")
+    n = m.GetNFaceDescriptors()
+    names = ["$PhysicalNames", str(n + 2)] + [f'2 {k} "{m.FaceDescriptor(k).bcname}"' for k in range(1, n + 1)] \
+        + [f'3 {100000 + k} "{m.GetMaterial(k)}"' for k in (1, 2)] + ["$EndPhysicalNames", "$Nodes"]
+    text = (folder / "raw.msh").read_text().replace("$Nodes", "\n".join(names), 1)
+    (folder / "bb.msh").write_text(text)
 
 
 SCENE = """\
@@ -90,8 +114,8 @@ def test_a_step_file_is_read_back_with_its_bodies_interface_and_faces(step):
     assert np.allclose(shared.centroid, (1.0, 0.5, 0.0))
     assert [f.label for f in model.faces].count("top") == 1
     assert all(f.form.kind == "plane" for f in model.faces)
-    assert cad.body_index(model, "k", point=(1.0, 0.5, 0.5)) == 0
-    assert cad.body_index(model, "k", name="base") == 1
+    assert body_index(model, "k", point=(1.0, 0.5, 0.5)) == 0
+    assert body_index(model, "k", name="base") == 1
 
 
 def test_a_cylinder_is_recognised_by_its_axis_and_radius(tmp_path):
@@ -117,15 +141,38 @@ def test_check_lists_every_face_with_its_body_area_centroid_and_form(tmp_path, s
     assert "rough (body 0) and counter (body 1), area 2, centroid (1, 0.5, 0), plane, normal (0, 0, 1)" in out
 
 
+@pytest.mark.parametrize("name", ["bb.vol", "bb.msh"])
+def test_a_mesh_file_is_read_with_its_regions_interface_and_boundary_regions(tmp_path, name):
+    from ngcontact.geometry.mesh_model import read_mesh
+
+    write_block_on_base_meshes(tmp_path)
+    model = read_mesh(str(tmp_path / name))
+    assert model.solid_names == ["block", "base"] and model.volumes == pytest.approx([2.0, 2.0])
+    assert len(model.faces) == 11
+    (shared,) = model.interface_faces()
+    assert shared.bodies == (0, 1) and shared.area == pytest.approx(2.0)
+    assert shared.form.kind == "plane" and np.allclose(shared.form.normal, (0, 0, 1))
+    assert [f.label for f in model.faces].count("top") == 1
+    assert body_index(model, "k", point=(1.0, 0.5, -0.5)) == 1 and body_index(model, "k", name="block") == 0
+
+
 @pytest.mark.slow
-def test_uniform_pressure_is_transmitted_through_the_interface(tmp_path, step):
+@pytest.mark.parametrize("name,area", [("bb.step", 2e-6), ("bb.vol", 2.0), ("bb.msh", 2.0)])
+def test_uniform_pressure_is_transmitted_through_the_interface(tmp_path, step, name, area):
     """The whole chain (read, select, mesh in metres, solve): the block's top load crosses S_0 unchanged."""
+    write_block_on_base_meshes(tmp_path)
     out = tmp_path / "o"
-    assert cli.main(["run", scene_file(tmp_path), "--out", str(out), "--quiet"]) == 0
+    assert cli.main(["run", _with_file(tmp_path, name), "--out", str(out), "--quiet"]) == 0
     res = json.loads((out / "report.json").read_text())["results"]
     assert res["mean_pressure"] == pytest.approx(1e6, rel=1e-8)
-    assert res["resultant"]["z"] == pytest.approx(-1e6 * 2e-6, rel=1e-8)   # 2 mm^2 in m^2, pushed down
-    assert res["dimensions"] == {"length_unit": 0.001}
+    assert res["resultant"]["z"] == pytest.approx(-1e6 * area, rel=1e-8)   # pushed down
+    assert res["dimensions"] == {"length_unit": 0.001 if name == "bb.step" else 1.0}
+
+
+def _with_file(tmp_path, name) -> str:
+    path = tmp_path / "m.toml"
+    path.write_text(SCENE.format(extra="", loaded="top").replace('"bb.step"', f'"{name}"'))
+    return str(path)
 
 
 @pytest.mark.parametrize("extra,loaded,message", [
