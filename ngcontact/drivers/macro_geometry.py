@@ -106,7 +106,8 @@ class FromFile:
     def _selected(self, scene) -> FileModel:
         g = scene.geometry
         path = resolve(scene, g.file)
-        model = read_mesh(path) if path.lower().endswith(MESH_SUFFIXES) else cad.read_cad(path)
+        model = read_mesh(path) if path.lower().endswith(MESH_SUFFIXES) else \
+            cad.read_cad(path, dim=3 if g.setting == "3d" else 2)
         rough = body_index(model, "geometry.rough", **vars(g.rough))
         counter = body_index(model, "geometry.counter", **vars(g.counter))
         if rough == counter:
@@ -133,10 +134,11 @@ class FromFile:
     def _check_size(scene, model: TwoBodyModel) -> None:
         """The element estimate of :mod:`ngcontact.scene.mesh_size` on the model's volume and interface."""
         d, unit = scene.discretization, file_length_unit(scene.geometry)
-        volume = sum(model.volumes) * unit ** 3
-        interface = sum(f.area for f in model.interface_faces()) * unit ** 2
-        width = min(v ** (1 / 3) for v in model.volumes) * unit
-        n = mesh_size.estimate(3, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
+        dim = 3 if scene.geometry.setting == "3d" else 2
+        volume = sum(model.volumes) * unit ** dim
+        interface = sum(f.area for f in model.interface_faces()) * unit ** (dim - 1)
+        width = min(v ** (1 / dim) for v in model.volumes) * unit
+        n = mesh_size.estimate(dim, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
         mesh_size.refuse_beyond(n, d.max_elements, *mesh_size.finest_size(d))
 
     def build(self, scene, sizes):

@@ -8,6 +8,12 @@ there.  Those shared faces are the macro interface ``S_0`` (boundary
 two sides of ``S_0`` stay apart in the displacement spaces as for the
 built-in shapes (:mod:`ngcontact.geometry.bodies`).
 
+A planar model (plane strain; axisymmetry with ``x = r``, ``y = z``) is two
+faces in ``z = 0``, read with ``dim = 2``: the same holds one dimension
+lower, its "faces" are the boundary curves (edges), sampled along their
+parameter and recognised as lines or circular arcs
+(:func:`~ngcontact.geometry.model_faces.curve_form`).
+
 Every face is listed as a :class:`~ngcontact.geometry.model_faces.ModelFace`
 sampled by a coarse surface mesh of the glued model (Netgen numbers its face
 descriptors in the order of the shape's distinct faces, the order used here),
@@ -30,7 +36,7 @@ import ngsolve as ng
 from ngcontact.errors import GeometryError
 from ngcontact.geometry.bodies import MacroGeometry
 from ngcontact.geometry.model_faces import (MODEL_COUNTER, MODEL_ROUGH, MODEL_UNNAMED, ModelFace, TwoBodyModel,
-                                            surface_form)
+                                            curve_form, surface_form)
 
 #: file suffixes read through OCC, and the length unit [m] of the coordinates as read
 CAD_SUFFIXES = {".step": 1e-3, ".stp": 1e-3, ".iges": 1e-3, ".igs": 1e-3, ".brep": None, ".brp": None}
@@ -46,6 +52,11 @@ class CadModel(TwoBodyModel):
     shape: Any = None
     solids: list = field(default_factory=list)
     occ_faces: list = field(default_factory=list)
+    dim: int = 3
+
+    def bodies_listing(self) -> str:
+        text = super().bodies_listing()
+        return text.replace(", volume ", ", area ") if self.dim == 2 else text
 
     def containing(self, point) -> list[int]:
         from netgen.occ import Pnt, Vertex
@@ -66,40 +77,51 @@ def _distinct(shapes) -> list:
     return out
 
 
-def read_cad(path: str, key: str = "geometry.file") -> CadModel:
-    """Read, glue and list the two solids of ``path`` (module docstring)."""
+def read_cad(path: str, key: str = "geometry.file", dim: int = 3) -> CadModel:
+    """Read, glue and list the two bodies of ``path``: solids (``dim = 3``) or planar faces in ``z = 0``
+    (``dim = 2``, whose "faces" are then their edges; module docstring)."""
     from netgen.occ import Glue, OCCGeometry
 
+    what = "solids" if dim == 3 else "planar faces"
     try:
-        solids = list(OCCGeometry(path).shape.solids)
+        shape = OCCGeometry(path, dim=dim).shape
     except Exception as exc:  # the kernel's own message says what it could not read
         raise GeometryError(key, path, f"not readable as CAD ({exc})") from None
-    if len(solids) != 2:
-        raise GeometryError(key, path, f"holds {len(solids)} solids; a macro model needs exactly two bodies "
-                            "(the rough and the counter body), each one solid")
-    glued = Glue(solids)
-    if len(glued.solids) != 2:
-        raise GeometryError(key, path, "the two solids overlap (gluing them gives "
-                            f"{len(glued.solids)} solids); model them touching along the interface, with the "
-                            "interference as a negative interface.gap")
-    parts = list(glued.solids)
-    occ_faces = _distinct(glued.faces)
+    bodies = list(shape.solids if dim == 3 else shape.faces)
+    if len(bodies) != 2 or (dim == 2 and len(shape.solids) > 0):
+        raise GeometryError(key, path, f"holds {len(shape.solids)} solids and {len(shape.faces)} faces; a "
+                            f"{dim}D macro model needs exactly two {what} (the rough and the counter body)")
+    glued = Glue(bodies)
+    parts = list(glued.solids if dim == 3 else glued.faces)
+    if len(parts) != 2:
+        raise GeometryError(key, path, f"the two {what} overlap (gluing them gives {len(parts)}); model them "
+                            "touching along the interface, with the interference as a negative interface.gap")
+    entities = _distinct(glued.faces if dim == 3 else glued.edges)
     lo, hi = (np.array(p) for p in glued.bounding_box)
     size = float(np.linalg.norm(hi - lo))
-    triangles = _surface_triangles(glued, len(occ_faces), size)
+    samples = _surface_triangles(glued, len(entities), size) if dim == 3 else [_edge_samples(e) for e in entities]
     faces = []
-    for i, f in enumerate(occ_faces):
-        owners = tuple(k for k, s in enumerate(parts) if any(f == g for g in s.faces))
+    for i, f in enumerate(entities):
+        owners = tuple(k for k, s in enumerate(parts) if any(f == g for g in (s.faces if dim == 3 else s.edges)))
+        form = surface_form(samples[i], FORM_TOLERANCE * size) if dim == 3 else \
+            curve_form(samples[i], FORM_TOLERANCE * size)
         faces.append(ModelFace(index=i, label=f.name, bodies=owners, area=float(f.mass),
-                               centroid=tuple(float(c) for c in f.center), triangles=triangles[i],
-                               form=surface_form(triangles[i], FORM_TOLERANCE * size)))
-    model = CadModel(path=path, shape=glued, solids=parts, occ_faces=occ_faces, faces=faces,
+                               centroid=tuple(float(c) for c in f.center), triangles=samples[i], form=form,
+                               measure="area" if dim == 3 else "length"))
+    model = CadModel(path=path, shape=glued, solids=parts, occ_faces=entities, faces=faces, dim=dim,
                      solid_names=[s.name for s in parts], size=size, volumes=[float(s.mass) for s in parts])
     if not model.interface_faces():
-        raise GeometryError(key, path, "the two solids share no face: they must touch along the interface "
+        raise GeometryError(key, path, f"the two {what} share no boundary: they must touch along the interface "
                             "(the interference, if any, is a negative interface.gap); the bodies are\n"
                             + model.bodies_listing())
     return model
+
+
+def _edge_samples(edge, n: int = 16) -> np.ndarray:
+    """Points along ``edge`` as degenerate triangles ``(p_i, p_i+1, p_i+1)``, shape ``(n, 3, 3)``."""
+    t0, t1 = edge.parameter_interval
+    pts = np.array([tuple(edge.Value(t)) for t in np.linspace(t0, t1, n + 1)])
+    return np.stack([pts[:-1], pts[1:], pts[1:]], axis=1)
 
 
 def _surface_triangles(shape, n_faces: int, size: float) -> list[np.ndarray]:
@@ -123,7 +145,10 @@ def mesh_cad(model: CadModel, rough: int, counter: int, labels: dict[int, str], 
     from netgen.occ import OCCGeometry, Pnt
 
     for solid, name in ((model.solids[rough], ROUGH), (model.solids[counter], COUNTER)):
-        solid.mat(name)
+        if model.dim == 3:
+            solid.mat(name)
+        else:   # a planar face's name is its region's
+            solid.name = name
     for f, face in zip(model.occ_faces, model.faces):
         if len(face.bodies) == 2:
             f.name = "interface"
@@ -131,7 +156,7 @@ def mesh_cad(model: CadModel, rough: int, counter: int, labels: dict[int, str], 
         else:
             f.name = labels.get(face.index, face.label or UNNAMED)
     shape = model.shape.Scale(Pnt(0, 0, 0), length_unit) if length_unit != 1.0 else model.shape
-    mesh = ng.Mesh(OCCGeometry(shape).GenerateMesh(maxh=maxh))
+    mesh = ng.Mesh(OCCGeometry(shape, dim=model.dim).GenerateMesh(maxh=maxh))
     if order > 1:
         mesh.Curve(order)
     names = sorted(set(mesh.GetBoundaries()))

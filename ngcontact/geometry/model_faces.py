@@ -31,7 +31,8 @@ import numpy as np
 @dataclass(frozen=True)
 class SurfaceForm:
     """What a face is: ``kind`` ``plane`` (with ``normal``), ``cylinder`` (``point``, ``axis``, ``radius``)
-    or ``other``."""
+    or ``other``; of a planar model's boundary curve: ``line`` (``normal`` in the plane), ``arc``
+    (``point`` its centre, ``axis`` ``z``, ``radius``) or ``other curve``."""
 
     kind: str
     normal: tuple[float, ...] | None = None
@@ -40,11 +41,13 @@ class SurfaceForm:
     radius: float | None = None
 
     def describe(self) -> str:
-        if self.kind == "plane":
-            return "plane, normal " + _vec(self.normal)
+        if self.kind in ("plane", "line"):
+            return f"{self.kind}, normal " + _vec(self.normal)
         if self.kind == "cylinder":
             return f"cylinder, axis {_vec(self.axis)} through {_vec(self.point)}, radius {self.radius:.6g}"
-        return "other surface"
+        if self.kind == "arc":
+            return f"circular arc, centre {_vec(self.point)}, radius {self.radius:.6g}"
+        return "other " + ("curve" if self.kind == "other curve" else "surface")
 
 
 @dataclass(frozen=True)
@@ -54,7 +57,9 @@ class ModelFace:
     ``index``: its number in the model (0-based, as ``ngcontact check``
     lists it); ``label``: the name the file gives it, or None; ``bodies``:
     indices of the bodies it bounds (two for a face they share);
-    ``triangles``: samples of the surface, shape ``(n, 3, 3)``.
+    ``triangles``: samples of the surface, shape ``(n, 3, 3)`` (of a planar
+    model's boundary curve: segments as degenerate triangles, and ``area``
+    is its length, ``measure`` says which).
     """
 
     index: int
@@ -64,6 +69,7 @@ class ModelFace:
     centroid: tuple[float, ...]
     triangles: np.ndarray
     form: SurfaceForm
+    measure: str = "area"
 
     @property
     def points(self) -> np.ndarray:
@@ -76,7 +82,7 @@ class ModelFace:
     def describe(self, body_names: dict[int, str]) -> str:
         owner = " and ".join(body_names.get(b, f"body {b}") for b in self.bodies)
         name = f"{self.label!r}" if self.label else "(no name)"
-        return (f"face {self.index}: {name}, {owner}, area {self.area:.6g}, centroid {_vec(self.centroid)}, "
+        return (f"face {self.index}: {name}, {owner}, {self.measure} {self.area:.6g}, centroid {_vec(self.centroid)}, "
                 f"{self.form.describe()}")
 
 
@@ -105,6 +111,25 @@ def surface_form(triangles: np.ndarray, tolerance: float) -> SurfaceForm:
         if np.abs(_axis_distance(pts, p, d) - r).max() <= tolerance:
             return SurfaceForm("cylinder", point=tuple(p), axis=tuple(_unit(d)), radius=float(r))
     return SurfaceForm("other")
+
+
+def curve_form(segments: np.ndarray, tolerance: float) -> SurfaceForm:
+    """The form of a boundary curve in the plane ``z = 0`` sampled by ``segments``: a ``line`` when every
+    sample lies within the tolerance of the least-squares line, an ``arc`` when within it of the algebraic
+    circle fit ``u^2 + v^2 = a u + b v + c``, else ``other curve``."""
+    pts = segments.reshape(-1, 3)[:, :2]
+    centred = pts - pts.mean(axis=0)
+    normal = np.linalg.svd(centred, full_matrices=False)[2][-1]
+    if np.abs(centred @ normal).max() <= tolerance:
+        return SurfaceForm("line", normal=tuple(_unit(np.array([normal[0], normal[1], 0.0]))))
+    A = np.column_stack([pts, np.ones(len(pts))])
+    (a, b, c), *_ = np.linalg.lstsq(A, (pts ** 2).sum(axis=1), rcond=None)
+    centre = np.array([a / 2, b / 2])
+    r2 = c + centre @ centre
+    if r2 > 0 and np.abs(np.linalg.norm(pts - centre, axis=1) - np.sqrt(r2)).max() <= tolerance:
+        return SurfaceForm("arc", point=(float(centre[0]), float(centre[1]), 0.0), axis=(0.0, 0.0, 1.0),
+                           radius=float(np.sqrt(r2)))
+    return SurfaceForm("other curve")
 
 
 def _axis_distance(pts: np.ndarray, p: np.ndarray, d: np.ndarray) -> np.ndarray:
@@ -200,9 +225,12 @@ class TwoBodyModel:
     def body_names(self, rough: int, counter: int) -> dict[int, str]:
         return {rough: f"rough (body {rough})", counter: f"counter (body {counter})"}
 
+    #: what ``volumes`` measure (a planar model's bodies have areas)
+    body_measure: ClassVar[str] = "volume"
+
     def bodies_listing(self) -> str:
         return "\n".join(f"  body {i}: {repr(self.solid_names[i]) if self.solid_names[i] else '(no name)'}, "
-                         f"volume {v:.6g}" for i, v in enumerate(self.volumes))
+                         f"{self.body_measure} {v:.6g}" for i, v in enumerate(self.volumes))
 
     def interface_faces(self) -> list[ModelFace]:
         return [f for f in self.faces if len(f.bodies) == 2]

@@ -18,7 +18,7 @@ from ngcontact.scene.schema import positive, param
 
 #: Boundary labels of a file geometry, for the README reference.
 FILE_BOUNDARY_DOCS = {
-    "interface": "the faces the two bodies share (found by gluing the solids); carries the law",
+    "interface": "the faces (planar model: curves) the two bodies share, found by gluing them; carries the law",
     "NAME": "every table geometry.boundaries.NAME: the faces its selector picks",
     "(file names)": "the names the file gives faces no selector picks; the others are `free`",
 }
@@ -34,7 +34,8 @@ class BodySpec:
 
     name: str | None = param(None, doc="the solid's name in the file (a mesh: its region's)")
     index: int | None = param(None, doc="the solid's index as `ngcontact check` lists it (0 or 1)")
-    point: tuple[float, float, float] | None = param(None, doc="a point inside the solid", units="file units")
+    point: tuple[float, float, float] | None = param(None, doc="a point inside the solid (planar model: "
+                                                     "(x, y, 0) inside the face)", units="file units")
 
     def check(self, path: str) -> None:
         given = [k for k in ("name", "index", "point") if getattr(self, k) is not None]
@@ -115,7 +116,7 @@ class FaceSelectorSpec:
 
 
 def check_file_geometry(geometry, path: str) -> None:
-    """The keys of ``shape = "file"``: the file, its unit, the two bodies, no dimensions, 3D."""
+    """The keys of ``shape = "file"``: the file, its unit, the two bodies, no dimensions; a mesh in 3D."""
     from ngcontact.geometry.cad_model import CAD_SUFFIXES
     from ngcontact.geometry.mesh_model import MESH_SUFFIXES
 
@@ -132,8 +133,9 @@ def check_file_geometry(geometry, path: str) -> None:
         raise SceneError(f"{path}.length_unit", geometry.length_unit,
                          f"a {suffix} file is read in millimetres whatever unit it declares (the reader "
                          f"converts): the length unit is {unit:g}; omit it")
-    if geometry.setting != "3d":
-        raise SceneError(f"{path}.setting", geometry.setting, "shape 'file' takes setting '3d'")
+    if geometry.setting != "3d" and suffix not in CAD_SUFFIXES:
+        raise SceneError(f"{path}.setting", geometry.setting, "a mesh file takes setting '3d' (a planar model "
+                         "for plane strain or axisymmetry comes from a CAD file of two faces in z = 0)")
     if geometry.dimensions is not None:
         raise SceneError(f"{path}.dimensions", geometry.dimensions, "the file gives the dimensions; remove them")
     for key in ("rough", "counter"):

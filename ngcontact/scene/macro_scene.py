@@ -43,7 +43,7 @@ from ngcontact.scene.schema import at_least, distinct, nonempty, nonnegative, op
 
 LAWS = ("linear", "bundle", "tabulated", "file")
 #: the kind's boundary labels by (shape, setting), read by the README reference
-BOUNDARY_DOCS = {**SHAPE_BOUNDARY_DOCS, ("file", "3d"): FILE_BOUNDARY_DOCS}
+BOUNDARY_DOCS: dict = {**SHAPE_BOUNDARY_DOCS, "file": FILE_BOUNDARY_DOCS}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -60,7 +60,9 @@ class MacroGeometrySpec:
         "exist); coaxial: a, b, c (radii), height (axisymmetric/3d); block: length, h_block, h_base",
         units="m", allowed="a table of numbers > 0")
     file: str | None = param(None, doc="shape = file: the CAD file (STEP .step/.stp, IGES .iges/.igs, BREP "
-                             ".brep/.brp) of two solids, or the mesh (Netgen .vol, Gmsh .msh) of two regions of "
+                             ".brep/.brp) of two solids (3d) or two planar faces in z = 0 (plane_strain; "
+                             "axisymmetric with x = r, y = z; their boundary curves are the faces to select), "
+                             "or the mesh (Netgen .vol, Gmsh .msh) of two regions of "
                              "tetrahedra, relative to this scene; where the bodies touch is the interface; STEP "
                              "and IGES are read in millimetres; a mesh is used as it is (maxh does not apply)")
     length_unit: float | None = param(None, doc="shape = file: metres per unit of the file as read (default "

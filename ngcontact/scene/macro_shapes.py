@@ -17,7 +17,7 @@ from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
 
 SHAPES = ("femur_stem", "coaxial", "block", "file")
 SETTINGS = {"femur_stem": ("axisymmetric", "3d"), "coaxial": ("plane_strain", "axisymmetric", "3d"),
-            "block": ("plane_strain",), "file": ("3d",)}
+            "block": ("plane_strain",), "file": ("plane_strain", "axisymmetric", "3d")}
 DIMENSIONS = {"femur_stem": tuple(f.name for f in dataclasses.fields(FemurStemDims)),
               "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base"), "file": ()}
 REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base"), "file": ()}

@@ -225,10 +225,13 @@ def test_the_nearest_face_and_the_face_index_select_one_face(step):
      'counter = { index = 1 }', "geometry.rough = {index, name}: give exactly one of name, index, point"),
     ('shape = "file"\nsetting = "3d"\nfile = "bb.step"\nrough = { index = 0 }',
      "geometry.counter = <missing>: required for shape = 'file'"),
+    ('shape = "file"\nsetting = "plane_strain"\nfile = "bb.vol"\nrough = { index = 0 }\ncounter = { index = 1 }',
+     "geometry.setting = 'plane_strain': a mesh file takes setting '3d'"),
     ('shape = "file"\nsetting = "plane_strain"\nfile = "bb.step"\nrough = { index = 0 }\ncounter = { index = 1 }',
-     "geometry.setting = 'plane_strain': shape 'file' takes setting '3d'"),
+     "geometry.file = 'bb.step': holds 2 solids and 12 faces; a 2D macro model needs exactly two planar faces"),
 ])
 def test_file_geometry_keys_are_checked_when_the_scene_loads(tmp_path, step, capsys, geometry, message):
+    write_block_on_base_meshes(tmp_path)
     start = SCENE.index("[geometry]\n")
     text = SCENE.format(extra="", loaded="top")
     text = text[:start] + "[geometry]\n" + geometry + "\n\n" + text[text.index("[geometry.boundaries.bottom]"):]

@@ -58,3 +58,94 @@ def test_press_fit_from_step_matches_lame_another_step_and_the_builtin_shape(tmp
                         "dimensions": {"a": A, "b": B, "c": C, "height": 0.02}}
     builtin = mean_pressure(loader.from_dict(data, base_dir=os.path.dirname(SCENE)))
     assert abs(builtin / shipped - 1) < 1e-4, (builtin, shipped)
+
+
+PLANAR = """\
+kind = "macro"
+
+[materials.steel]
+E = 210e9
+nu = 0.3
+
+[materials.bronze]
+E = 110e9
+nu = 0.34
+
+[bodies]
+rough = "steel"
+counter = "bronze"
+
+[geometry]
+shape = "file"
+setting = "{setting}"
+file = "planar.step"
+rough = {{ point = [15.0, 1.0, 0.0] }}
+counter = {{ point = [50.0, 1.0, 0.0] }}
+{boundaries}
+[interface]
+law = "linear"
+kn = 5e12
+gap = -2e-5
+{supports}
+[discretization]
+order = 3
+maxh = 0.006
+"""
+ENDS = """
+[geometry.boundaries.bottom]
+plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
+
+[geometry.boundaries.top]
+plane = { point = [0.0, 20.0, 0.0], normal = [0.0, 1.0, 0.0] }
+"""
+QUARTER = """
+[geometry.boundaries.sym_x]
+plane = { point = [0.0, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }
+
+[geometry.boundaries.sym_y]
+plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
+
+[geometry.boundaries.mantle]
+cylinder = { point = [0.0, 0.0, 0.0], axis = [0.0, 0.0, 1.0], radius = 75.0 }
+"""
+
+
+def write_planar(path, setting: str) -> None:
+    """Two faces in ``z = 0``, in mm: the ``(r, z)`` rectangles of tube and hub (axisymmetric), or their quarter
+    annuli (plane strain)."""
+    from netgen.occ import Compound, WorkPlane
+
+    if setting == "axisymmetric":
+        tube = WorkPlane().MoveTo(5.0, 0.0).Rectangle(25.0, 20.0).Face()
+        hub = WorkPlane().MoveTo(30.0, 0.0).Rectangle(45.0, 20.0).Face()
+    else:
+        quarter = WorkPlane().Rectangle(100.0, 100.0).Face()
+
+        def disk(r):
+            return WorkPlane().Circle(r).Face()
+
+        tube, hub = (disk(30.0) - disk(5.0)) * quarter, (disk(75.0) - disk(30.0)) * quarter
+    Compound([hub, tube]).WriteStep(str(path))
+
+
+@pytest.mark.parametrize("setting", ["axisymmetric", "plane_strain"])
+def test_a_planar_step_model_gives_lames_pressure(tmp_path, setting):
+    """Two faces of a STEP file as a plane-strain quarter or an axisymmetric section (ends held in z)."""
+    from ngcontact.runner import check
+
+    write_planar(tmp_path / "planar.step", setting)
+    if setting == "axisymmetric":
+        boundaries, supports = ENDS, [("bottom", "z"), ("top", "z")]
+    else:
+        boundaries, supports = QUARTER, [("sym_x", "x"), ("sym_y", "y")]
+    text = PLANAR.format(setting=setting, boundaries=boundaries, supports="".join(
+        f'\n[[supports]]\nboundary = "{b}"\ncomponents = ["{c}"]\n' for b, c in supports))
+    (tmp_path / "s.toml").write_text(text)
+    scene = loader.load(tmp_path / "s.toml")
+    listing = "\n".join(check(scene))
+    assert "-> 'interface'" in listing and "length" in listing
+    if setting == "plane_strain":
+        assert "circular arc, centre (0, 0, 0), radius 30 -> 'interface'" in listing
+        assert "radius 75 -> 'mantle'" in listing
+    p = mean_pressure(scene)
+    assert abs(p / LAME - 1) < 1e-3, (p, LAME)
