@@ -153,10 +153,10 @@ class FromFile:
         unit = file_length_unit(scene.geometry)
         lines = [f"{scene.geometry.file}: 2 bodies, {len(m.faces)} faces (lengths in file units; "
                  f"1 unit = {unit:g} m)", m.bodies_listing(), "faces:"]
-        named = {f.index: f"-> {chosen.labels[f.index]!r}" if f.index in chosen.labels else
-                 "-> 'interface'" if len(f.bodies) == 2 else "" for f in m.faces}
+        named = {f.index: "interface" if len(f.bodies) == 2 else chosen.labels.get(f.index, f.label or cad.UNNAMED)
+                 for f in m.faces}
         for f in m.faces:
-            lines.append(f"  {f.describe(m.body_names(chosen.rough, chosen.counter))} {named[f.index]}".rstrip())
+            lines.append(f"  {f.describe(m.body_names(chosen.rough, chosen.counter))} -> {named[f.index]!r}")
         return lines
 
 
