@@ -154,9 +154,3 @@ def file_length_unit(geometry) -> float:
     if geometry.length_unit is not None:
         return geometry.length_unit
     return CAD_SUFFIXES.get("." + geometry.file.rsplit(".", 1)[-1].lower()) or 1.0
-
-
-def file_labels(geometry) -> tuple[str, ...]:
-    """Labels a support may name, known without reading the file: none (the names the file gives its faces
-    are checked against the file, before meshing; see ``drivers/macro_geometry.py``)."""
-    return ()

@@ -3,7 +3,9 @@
 The macro problem of paper eqs. 44-48 / 69-71 (see :mod:`ngcontact.macro.macro_problem`)
 on one of the built-in geometries: the axisymmetric femur with a press-fitted
 hip stem (paper Sec. 4.2-4.3), two coaxial tubes (Lame press fit; plane
-strain, axisymmetric or 3D) or a block on a base (friction).  The interface
+strain, axisymmetric or 3D) or a block on a base (friction); or on two
+bodies read from a CAD or mesh file (``geometry.shape = "file"``, keys in
+:mod:`ngcontact.scene.file_geometry`).  The interface
 law comes from explicit numbers (``linear`` K0, ``bundle`` of directions,
 ``tabulated`` normal law) or from a ``cell`` scene named by
 ``interface.cell`` (its direction bundle, computed on the fly and cached on
@@ -33,8 +35,7 @@ from ngcontact.laws import homogenized as il
 from ngcontact.scene.macro_shapes import (BOUNDARIES, REQUIRED, SETTINGS, SHAPES, check_dimensions,
                                           check_support_meaning, macro_extent)
 from ngcontact.scene.macro_shapes import BOUNDARY_DOCS as SHAPE_BOUNDARY_DOCS
-from ngcontact.scene.file_geometry import (FILE_BOUNDARY_DOCS, BodySpec, FaceSelectorSpec, check_file_geometry,
-                                           file_labels)
+from ngcontact.scene.file_geometry import FILE_BOUNDARY_DOCS, BodySpec, FaceSelectorSpec, check_file_geometry
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
 from ngcontact.scene import cell_links, mesh_size
@@ -304,12 +305,13 @@ class MacroScene:
         self.check_size()
         comps = COMPONENTS[self.geometry.setting]
         shape, setting = self.geometry.shape, self.geometry.setting
-        labels = file_labels(self.geometry) if shape == "file" else BOUNDARIES[shape, setting]
+        labels = () if shape == "file" else BOUNDARIES[shape, setting]
         groups: tuple[tuple[str, tuple[SupportSpec | LoadSpec, ...]], ...] = (
             ("supports", self.supports), ("loads", self.loads))
-        for what, items in groups:
+        # a file's labels (selected, or named in the file) are checked against the file, before meshing
+        for what, items in (groups if shape != "file" else ()):
             for i, item in enumerate(items):
-                if item.boundary not in labels and labels:
+                if item.boundary not in labels:
                     raise SceneError(f"{what}[{i}].boundary", item.boundary,
                                      f"no such boundary in {shape!r} ({setting}); labels are " + ", ".join(labels))
         for i, s in enumerate(self.supports):

@@ -3,7 +3,10 @@
 What a macro scene may name without meshing: the femur with its hip stem
 (:mod:`ngcontact.geometry.femur`, axisymmetric or a 3D quarter,
 :mod:`ngcontact.geometry.femur3d`), two coaxial tubes and a block on a base
-(:mod:`ngcontact.geometry.bodies`).  ``tests/scene/test_bad_input.py`` checks
+(:mod:`ngcontact.geometry.bodies`); ``file`` names two bodies read from a
+file, whose regions are ``rough`` and ``counter`` and whose labels the scene
+selects (:mod:`ngcontact.scene.file_geometry`), so it has no entry in the
+label tables here.  ``tests/scene/test_bad_input.py`` checks
 that the labels listed here are exactly those the meshers create; the scene
 layer validates supports and loads against them before any mesh exists.
 """
