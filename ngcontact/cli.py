@@ -6,7 +6,12 @@ CSV tables, VTK files for ParaView and PNG plots into ``DIR`` (default
 ``ngcontact study epsilon SCENE [--periods N ...] [--out DIR]`` runs the
 epsilon study of a ``direct`` scene (:func:`ngcontact.runner.study_epsilon`) and
 writes ``report.json``, ``epsilon.csv`` and ``epsilon.png`` into ``DIR``
-(default ``results/<scene name>_epsilon``); ``ngcontact export SCENE --format
+(default ``results/<scene name>_epsilon``); ``ngcontact study accuracy SCENE
+[--target T] [--levels N] [--out DIR]`` runs the accuracy study of a cell, macro or
+direct scene (:func:`ngcontact.runner.study_accuracy`: a ladder over its
+discretization knobs) and writes ``report.json``, ``accuracy_study.csv``, one
+``accuracy_<quantity>.png`` per headline quantity and, with a target met,
+``recommended.toml`` (default ``results/<scene name>_accuracy``); ``ngcontact export SCENE --format
 abaqus|calculix|ansys|json [--out DIR]`` writes the interface law of a cell or
 macro scene for another FE code (:mod:`ngcontact.export.export_law`; default
 ``results/<scene name>_export``), what the format cannot carry as a warning.
@@ -87,15 +92,7 @@ def _parser() -> argparse.ArgumentParser:
     chk = sub.add_parser("check", help="validate a scene file without solving",
                          description="Validate a scene file and list the effects it calls for.")
     chk.add_argument("scene", help="scene file (TOML)")
-    st = sub.add_parser("study", help="run a study of a scene (epsilon: resolved against homogenized)",
-                        description="Epsilon study of a 'direct' scene: resolved runs against the homogenized "
-                                    "laws; write DIR/report.json, DIR/epsilon.csv and DIR/epsilon.png.")
-    st.add_argument("study", choices=("epsilon",), help="which study")
-    st.add_argument("scene", help="scene file (TOML) of kind 'direct' with a [study] section")
-    st.add_argument("--periods", type=int, nargs="+", metavar="N", help="numbers of periods (default: the scene's)")
-    st.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon)")
-    st.add_argument("--quiet", action="store_true", help="no progress lines")
-    _compute_options(st)
+    _study_parser(sub)
     ex = sub.add_parser("export", help="write a cell's or macro scene's interface law for Abaqus, CalculiX, "
                         "ANSYS or as JSON", description="Export the homogenized interface law of a cell scene (its "
                         "direction bundle) or of a macro scene (the law its interface uses).")
@@ -112,6 +109,32 @@ def _parser() -> argparse.ArgumentParser:
     ex.add_argument("--mu", type=float, metavar="MU", help="friction coefficient to write, >= 0 (default: the macro "
                     "scene's interface.mu, else |k_nt0|/k_n0)")
     return p
+
+
+def _study_parser(sub) -> None:
+    """The ``study`` command: epsilon and accuracy."""
+    st = sub.add_parser("study", help="run a study of a scene (epsilon: resolved against homogenized; accuracy: "
+                        "the work-precision diagram of the scene's discretization)",
+                        description="epsilon: a 'direct' scene's resolved runs against the homogenized laws; write "
+                                    "DIR/report.json, DIR/epsilon.csv and DIR/epsilon.png.  accuracy: a ladder over "
+                                    "the scene's discretization knobs (mesh size, order, spectral grid, penalty, "
+                                    "tolerance), each level a whole run; write DIR/report.json, "
+                                    "DIR/accuracy_study.csv, a PNG per headline quantity (error against wall time) "
+                                    "and, with --target met, DIR/recommended.toml.")
+    st.add_argument("study", choices=("epsilon", "accuracy"), help="which study")
+    st.add_argument("scene", help="scene file (TOML): epsilon, of kind 'direct' with a [study] section; accuracy, "
+                                  "of kind cell, macro or direct")
+    st.add_argument("--periods", type=int, nargs="+", metavar="N", help="epsilon: numbers of periods (default: the "
+                                                                        "scene's)")
+    st.add_argument("--target", type=float, metavar="T", help="accuracy: the error to meet, in (0, 1) (contact "
+                    "fractions absolute, other quantities relative); the cheapest level meeting it is written as "
+                    "DIR/recommended.toml")
+    st.add_argument("--levels", type=int, metavar="N", help="accuracy: levels per knob, in [3, 6] (default 4: two "
+                    "coarser than the scene, the scene, one finer)")
+    st.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon or "
+                                                 "_accuracy)")
+    st.add_argument("--quiet", action="store_true", help="no progress lines")
+    _compute_options(st)
 
 
 def _workers(text: str) -> int:
@@ -163,7 +186,11 @@ def main(argv=None) -> int:
         if args.command == "export":
             return _export(args)
         compute = {"workers": args.workers, "scheduler": args.scheduler}
+        if args.command == "study" and args.study == "accuracy":
+            return _study_accuracy(args, compute)
         if args.command == "study":
+            if args.target is not None or args.levels is not None:
+                return _fail(EXIT_SCENE, "--target, --levels: options of the accuracy study only")
             return _study(args.scene, args.periods, args.out, quiet=args.quiet, compute=compute)
         return _run(args.scene, args.out, quiet=args.quiet, compute=compute)
     except KeyboardInterrupt:
@@ -262,6 +289,29 @@ def _study(path: str, periods, out: str | None, quiet: bool, compute: dict) -> i
         return _fail(EXIT_SCENE, f"--periods {' '.join(map(str, periods))}: at least 3 increasing numbers "
                                  "N >= 1 (a rate needs three distinct levels)")
     return _execute(path, out, quiet, run_study, suffix="_epsilon", validate=require_study)
+
+
+def _study_accuracy(args, compute: dict) -> int:
+    """``ngcontact study accuracy``: options checked first, then the scene and ``--out``; nothing is written
+    on a refusal."""
+    from ngcontact.output.progress_bar import BatchProgress
+    from ngcontact.runner import study_accuracy
+    from ngcontact.scene.refinement_ladder import check_study
+
+    if args.periods is not None:
+        return _fail(EXIT_SCENE, "--periods: an option of the epsilon study only")
+    if args.target is not None and not 0 < args.target < 1:
+        return _fail(EXIT_SCENE, f"--target {args.target:g}: an error in (0, 1) (contact fractions absolute, other "
+                                 "quantities relative), e.g. 0.01 for 1 %")
+    if args.levels is not None and not 3 <= args.levels <= 6:
+        return _fail(EXIT_SCENE, f"--levels {args.levels}: an integer in [3, 6] (levels per knob)")
+
+    def run_study(sc, progress):
+        with _scheduler_named(compute):
+            return study_accuracy(args.scene, args.levels, args.target, progress,
+                                  batch_progress=BatchProgress(args.quiet), **compute)
+
+    return _execute(args.scene, args.out, args.quiet, run_study, suffix="_accuracy", validate=check_study)
 
 
 def _export(args) -> int:

@@ -6,7 +6,8 @@ The one code path behind ``ngcontact run`` and the Python API::
 
 ``report`` is the JSON-ready dictionary (see the README's report reference);
 ``outcome`` keeps the NGSolve objects (meshes, fields) for further work.
-Nothing is written to disk; :func:`ngcontact.output.writer.write_outputs` does that.
+Nothing is written to disk; :func:`ngcontact.output.writer.write_outputs` does that
+(:func:`solve_mesh`, the macro problem on a mesh of the caller's, calls it when given a directory).
 """
 from __future__ import annotations
 
@@ -284,4 +285,120 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
     report = build_report(kind="direct-epsilon-study", title=scene.title, scene=loader.as_dict(scene),
                           effects=loader.effects(scene), outcome=outcome, timings=clock.total(),
                           version=__version__, threads=n, compute=ex.describe())
+    return report, outcome
+
+
+def solve_mesh(mesh, law, *, rough: str, counter: str, materials: dict, interface: str = "interface",
+               setting: str | None = None, supports=(), loads=(), gap=0.0, order: int = 2,
+               solver: dict | None = None, output: dict | None = None, title: str = "",
+               out: str | None = None, progress: Callable[[str], None] | None = None) -> tuple[dict, Outcome]:
+    """The macro problem on a mesh built in the caller's NGSolve script, reported as ``ngcontact run`` reports
+    a ``macro`` scene (:mod:`ngcontact.drivers.user_mesh`).
+
+    Parameters
+    ----------
+    mesh
+        An ``ngsolve.Mesh`` with the regions ``rough`` and ``counter`` and the internal boundary
+        ``interface`` between them, shared node for node (:mod:`ngcontact.macro.interface_form`).
+    law
+        An :class:`~ngcontact.laws.homogenized.InterfaceLaw` (e.g. :func:`ngcontact.cell_law`) or a normal
+        law alone.
+    rough, counter
+        Region names of the rough body (paper ``D``) and the counter body.
+    materials
+        ``{region: ElasticLaw or {"E": ..., "nu": ...} or {"C": ...}}`` for both regions.
+    interface
+        Boundary name of the interface ``S_0``.
+    setting
+        ``plane_strain`` (2D default), ``axisymmetric`` (mesh ``(x, y)`` = ``(r, z)``) or ``3d``.
+    supports, loads
+        Lists of tables as a macro scene's ``[[supports]]`` (``boundary``, ``components``,
+        ``displacement``) and ``[[loads]]`` (``boundary``, ``pressure``, ``traction``), on the mesh's
+        boundary names.
+    gap
+        Macro normal gap ``g0`` (number or CoefficientFunction; ``< 0`` an interference).
+    order
+        Polynomial order of the displacement.
+    solver, output
+        Keys of a macro scene's ``[solver]`` and ``[output]`` sections (defaults as there).
+    title
+        The report's title.
+    out
+        Output directory: ``report.json``, ``report.html`` and the run's tables, figures and VTK files
+        are written there, as ``ngcontact run --out`` writes them (checked before the solve).
+    progress
+        Optional callable receiving one line per stage.
+
+    Returns
+    -------
+    (report, outcome)
+        As :func:`solve`: the report (its ``results`` those of a macro run) and the outcome with the
+        NGSolve objects.
+    """
+    from ngcontact.drivers import user_mesh
+    from ngcontact.output.writer import check_output_dir, write_outputs
+    if out is not None:
+        check_output_dir(out)
+    n = thread_count()
+    clock = Clock(progress)
+    with threads(n), progress_lines(clock):
+        outcome, described, effects = user_mesh.run(
+            mesh, law, rough=rough, counter=counter, materials=materials, interface=interface, setting=setting,
+            supports=supports, loads=loads, gap=gap, order=order, solver=solver, output=output, title=title,
+            clock=clock)
+    report = build_report(kind="macro", title=title, scene=described, effects=effects, outcome=outcome,
+                          timings=clock.total(), version=__version__, threads=n)
+    if out is not None:
+        write_outputs(out, report, outcome)
+    return report, outcome
+
+
+def level_report(scene) -> dict:
+    """A level of an accuracy study run as ``ngcontact run`` runs a scene, its batches in this process: the
+    report (module-level, so that a batch's worker can call it).  The kind's driver is imported first, so that
+    the level's wall time is its run's, not the import's."""
+    driver(scene)
+    report, _ = solve(scene, workers=1)
+    return report
+
+
+def study_accuracy(path: str, levels: int | None = None, target: float | None = None,
+                   progress: Callable[[str], None] | None = None, *, workers: int | None = None,
+                   scheduler: str | None = None, batch_progress=None) -> tuple[dict, Outcome]:
+    """The accuracy study of the scene file ``path`` (:mod:`ngcontact.drivers.study_accuracy`), as a report;
+    no file I/O.
+
+    The ladder (``levels`` per knob, default :data:`~ngcontact.scene.refinement_ladder.DEFAULT_LEVELS`) is
+    stated to ``progress`` before anything runs; its levels are one batch of whole runs
+    (:func:`level_report`), on ``workers`` / ``scheduler`` as in :func:`solve`.  ``target`` (a relative
+    error in ``(0, 1)``, absolute for contact fractions, else relative) asks for the cheapest level meeting it.
+
+    Raises
+    ------
+    SceneError
+        The scene is invalid or of a kind the study does not refine, ``levels`` or ``target`` is out of
+        range, or no knob of the scene gives enough admissible levels.
+    """
+    import json
+    from ngcontact.scene import refinement_ladder as rl
+    if target is not None and not 0 < target < 1:
+        raise SceneError("--target", target, "an error in (0, 1) (contact fractions absolute, other quantities "
+                         "relative), e.g. 0.01 for 1 %")
+    scene = loader.load(path)
+    ladder, dropped = rl.ladder(scene, loader.parsed(path), rl.DEFAULT_LEVELS if levels is None else levels)
+    clock = Clock(progress)
+    for knob in dict.fromkeys(lv.knob for lv in ladder):
+        clock.note(f"ladder {knob} (unknowns over the scene's): " + "; ".join(
+            lv.setting + ("" if lv.size is None else f" (~{lv.size:.2g})") for lv in ladder if lv.knob == knob))
+    for line in dropped:
+        clock.note(f"left out: {line}")
+    distinct = len({lv.key for lv in ladder})
+    clock.note(f"{distinct} distinct runs (the scene's own level is shared by its ladders)")
+    own_key = json.dumps(loader.as_dict(scene), sort_keys=True, default=str)
+    with batches(scene, workers, scheduler, batch_progress, start=True, note=progress, members=distinct) as ex:
+        from ngcontact.drivers.study_accuracy import run_study
+        outcome = run_study(scene, ladder, dropped, level_report, own_key=own_key, target=target, clock=clock)
+    report = build_report(kind="accuracy-study", title=getattr(scene, "title", ""), scene=loader.as_dict(scene),
+                          effects=loader.effects(scene), outcome=outcome, timings=clock.total(),
+                          version=__version__, threads=1, compute=ex.describe())
     return report, outcome

@@ -50,7 +50,7 @@ def run(monkeypatch, tmp_path, capsys):
 
 def test_every_example_has_a_docstring_a_main_and_is_tested():
     names = sorted(n for n in os.listdir(EXAMPLES) if n.endswith(".py"))
-    assert 4 <= len(names) <= 7, names
+    assert 4 <= len(names) <= 8, names
     this = open(__file__, encoding="utf-8").read()
     for name in names:
         tree = ast.parse(open(os.path.join(EXAMPLES, name), encoding="utf-8").read())
@@ -131,10 +131,21 @@ def test_two_scale_converged_peak_pressure(run):
     assert "converged: True" in out
 
 
+def test_ngsolve_user_mesh_interface_force_is_the_load(run):
+    force, out = run("ngsolve_user_mesh.py")
+    own, api = force[1], force[0]
+    # Equilibrium of the block: the interface carries all of the top face's load, -p L = -2e5 N/m;
+    # Newton is converged to 1e-10 of the first residual, the quadrature is exact for the polynomials.
+    assert api == pytest.approx(-10e6 * 0.02, rel=1e-8)
+    # The same mesh, law and energy in the script's own forms and in solve_mesh: round-off apart.
+    assert own == pytest.approx(api, rel=1e-8)
+    assert "force through the interface, block on base: (40000, -200000)" in out
+
+
 # --------------------------------------------------------- README quick start
-def quick_start_of_readme() -> str:
+def quick_start_of_readme(title: str = "## Quick start (Python API)") -> str:
     with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as fh:
-        section = fh.read().split("## Quick start (Python API)", 1)[1].split("\n## ", 1)[0]
+        section = fh.read().split(title, 1)[1].split("\n## ", 1)[0]
     return section.split("```python\n", 1)[1].split("```", 1)[0].strip("\n")
 
 
@@ -161,3 +172,10 @@ def test_readme_quick_start_is_the_example():
     readme, example = quick_start_of_readme(), quick_start_of_example()
     assert readme == example, (f"the README's Quick start must be examples/{QUICK_START} (imports and the "
                                f"body of main()); it should read:\n{example}")
+
+
+def test_readme_section_on_your_own_ngsolve_script_is_the_example():
+    readme = quick_start_of_readme("## Using the law in your own NGSolve script")
+    example = quick_start_of_example("ngsolve_user_mesh.py")
+    assert readme == example, ("the README's section on your own NGSolve script must be "
+                               f"examples/ngsolve_user_mesh.py (imports and the body of main()); it should read:\n{example}")

@@ -21,6 +21,11 @@ cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its c
   quarters on their symmetry plane ``y = 0`` (``stress.png``, as in 2D);
 * ``resultant``: force through the interface from the rough to the counter
   body [N; axisymmetric: axial, per full revolution; plane strain: per metre];
+* ``reactions``: per supported boundary the force the bodies exert on the
+  support in the fixed components (axisymmetric: axial only) and, in plane
+  strain for a support fixing every component, its moment about the
+  boundary's mid-point, as the ``direct`` kind reports them
+  (:func:`ngcontact.fem.reaction.support_reactions`);
 * ``maxima``: peak pressure and largest |shear| with their location, the
   largest and smallest stress components, von Mises stress and strain with
   location and body;
@@ -37,6 +42,7 @@ from typing import Any
 import numpy as np
 import ngsolve as ng
 
+from ngcontact.drivers.mesh_supports import supports_on
 from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
                                      law_from_cell, law_from_file, linear_solver)
 from ngcontact.laws import homogenized as il
@@ -53,6 +59,7 @@ from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
 
 from ngcontact.fem.rigid_modes import check_rigid_modes
+from ngcontact.fem.reaction import support_reactions
 
 log = logging.getLogger(__name__)
 
@@ -171,15 +178,22 @@ def check_model(scene) -> list[str]:
     geo = build_geometry(scene)
     check_boundaries(scene, geo.mesh)
     tangential = scene.interface.cell is not None or interface_law_of(scene, geo.mesh.dim)[0].holds_tangentially
-    check_rigid_modes(geo.mesh, scene.geometry.setting, REGIONS[scene.geometry.shape], supports_of(scene),
+    check_rigid_modes(geo.mesh, scene.geometry.setting, REGIONS[scene.geometry.shape], supports_of(scene, geo.mesh),
                       "interface", tangential)
     return notes
 
 
-def supports_of(scene) -> tuple[M.Support, ...]:
-    """The scene's ``[[supports]]`` as the problem's supports."""
-    return tuple(M.Support(label=s.boundary, components=s.components, value=s.displacement)
-                 for s in scene.supports)
+def supports_of(scene, mesh) -> tuple[M.Support, ...]:
+    """The scene's ``[[supports]]`` on ``mesh`` as the problem's supports
+    (:func:`ngcontact.drivers.mesh_supports.supports_on`: symmetry planes and slopes read off the mesh)."""
+    return supports_on(scene.supports, mesh, scene.geometry.setting)
+
+
+def body_forces_of(scene) -> dict[str, tuple[float, ...]]:
+    """The scene's ``[body_forces]`` by region."""
+    rough, counter = REGIONS[scene.geometry.shape]
+    f = scene.body_forces
+    return {region: tuple(v) for region, v in ((rough, f.rough), (counter, f.counter)) if any(v)}
 
 
 def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.MacroProblem, dict]:
@@ -197,9 +211,17 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
     problem = M.MacroProblem(
         mesh=geometry.mesh, setting=scene.geometry.setting, rough=rough, counter=counter, materials=mats,
         law=law, gap=gap_of(scene), order=order or scene.discretization.order,
-        supports=supports_of(scene),
+        supports=supports_of(scene, geometry.mesh), body_forces=body_forces_of(scene),
         loads=tuple(M.Load(label=lo.boundary, pressure=lo.pressure, traction=lo.traction) for lo in scene.loads))
     return problem, info
+
+
+def reactions(sol: M.MacroSolution) -> dict:
+    """Reaction force (and moment) of every supported boundary (:func:`ngcontact.fem.reaction.support_reactions`)."""
+    p = sol.problem
+    return support_reactions(p.mesh, p.setting, p.order, p.supports,
+                             ((p.rough, p.materials[p.rough], sol.u_rough),
+                              (p.counter, p.materials[p.counter], sol.u_counter)), p.body_forces)
 
 
 def solve_scene(scene, problem: M.MacroProblem, start=None, rtol: float | None = None) -> M.MacroSolution:
@@ -249,27 +271,13 @@ def run(scene, clock) -> Outcome:
             from ngcontact.drivers.run_two_scale import couple
             sol, two_scale = couple(scene, problem, partial(solve_scene, scene))
     with clock.stage("post-processing"):
-        balance = checked_equilibrium(sol)
-        fields = MM.stress_fields(sol)
-        extrema = MM.field_extrema(sol, fields)
-        results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
-                   "dimensions": geo.dims, "law": law_info, "resultant": MM.resultant(sol),
-                   "newton_iterations": sol.history["newton_iterations"],
-                   "coulomb_iterations": sol.history["coulomb_iterations"], "equilibrium": balance}
-        maxima = {name: ext for name, ext in extrema.items()}
-        tables: dict[str, Any] = {}
-        plots: dict[str, Any] = {}
-        interface = interface_2d if geo.mesh.dim == 2 else interface_3d
-        interface(sol, fields, scene, geo, results, maxima, tables, plots)
-        results["maxima"] = maxima
-        results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
+        outcome = measured(sol, geo, law_info, scene.output)
+        results = outcome.results
         if two_scale is not None:
             results["two_scale"] = two_scale
             if "interface" in results:
                 results["interface"]["contact_fraction"] = np.asarray(two_scale["interface_coefficients"]
                                                                      ["contact_fraction"])
-    vtk = {"stress": VtkField(mesh=geo.mesh, fields=dict(fields, u_rough=sol.u_rough, u_counter=sol.u_counter),
-                              subdivision=scene.output.vtk_subdivision)}
     if scene.strength is not None:
         from ngcontact.drivers.run_strength import evaluate
         with clock.stage("strength check"):
@@ -277,9 +285,40 @@ def run(scene, clock) -> Outcome:
         results["strength"] = st["results"]
         if two_scale is not None:
             results["two_scale"]["summary"] = two_scale_summary(two_scale, st["results"])
-        tables["strength_map"] = st["table"]
-        vtk["worst_cell"] = st["vtk"]
-        plots.update(st["plots"])
+        outcome.tables["strength_map"] = st["table"]
+        outcome.vtk["worst_cell"] = st["vtk"]
+        outcome.plots.update(st["plots"])
+    return outcome
+
+
+def measured(sol: M.MacroSolution, geo: gm.MacroGeometry, law_info: dict, output) -> Outcome:
+    """What a macro run reports of a solution on ``geo``: ``results`` (see the module's docstring; without
+    the two-scale and strength parts), the interface table, the figures, the VTK fields and the solver's
+    record.  ``output``: the scene's ``[output]`` section (samples per interface element, VTK subdivision).
+
+    Raises
+    ------
+    ConvergenceError
+        The solution is not in equilibrium (:func:`checked_equilibrium`).
+    """
+    balance = checked_equilibrium(sol)
+    fields = MM.stress_fields(sol)
+    extrema = MM.field_extrema(sol, fields)
+    problem = sol.problem
+    results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
+               "dimensions": geo.dims, "law": law_info, "resultant": MM.resultant(sol),
+               "reactions": reactions(sol),
+               "newton_iterations": sol.history["newton_iterations"],
+               "coulomb_iterations": sol.history["coulomb_iterations"], "equilibrium": balance}
+    maxima = {name: ext for name, ext in extrema.items()}
+    tables: dict[str, Any] = {}
+    plots: dict[str, Any] = {}
+    interface = interface_2d if geo.mesh.dim == 2 else interface_3d
+    interface(sol, fields, output, geo, results, maxima, tables, plots)
+    results["maxima"] = maxima
+    results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
+    vtk = {"stress": VtkField(mesh=geo.mesh, fields=dict(fields, u_rough=sol.u_rough, u_counter=sol.u_counter),
+                              subdivision=output.vtk_subdivision)}
     newton = sol.history["newton"]
     solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],
               "linear_solve_only": sol.history["quadratic"],
@@ -288,10 +327,10 @@ def run(scene, clock) -> Outcome:
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
 
 
-def interface_2d(sol, fields, scene, geo, results, maxima, tables, plots) -> None:
+def interface_2d(sol, fields, output, geo, results, maxima, tables, plots) -> None:
     """The interface of a 2D (plane strain, axisymmetric) solution along its arc: profile, status, peaks,
-    detachment, its table and figures."""
-    prof = MM.interface_profile(sol, scene.output.points_per_element)
+    detachment, its table and figures (``output.points_per_element`` samples per element)."""
+    prof = MM.interface_profile(sol, output.points_per_element)
     results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in prof.items()}
     results["status_counts"] = dict(Counter(prof["status"]))
     maxima["pressure"] = MM.peak_pressure(prof)
@@ -305,7 +344,7 @@ def interface_2d(sol, fields, scene, geo, results, maxima, tables, plots) -> Non
     plots["stress"] = lambda path, d=samples: figures.macro_fields(path, **d)
 
 
-def interface_3d(sol, fields, scene, geo, results, maxima, tables, plots) -> None:
+def interface_3d(sol, fields, output, geo, results, maxima, tables, plots) -> None:
     """The interface of a 3D solution over its surface: samples, contact area, status, peaks, its table and
     figures (and the stress on the section plane where the mesh has one)."""
     surf = MM.interface_surface(sol)

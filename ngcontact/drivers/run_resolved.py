@@ -27,18 +27,17 @@ from __future__ import annotations
 
 import logging
 
-import ngsolve as ng
 import numpy as np
 
 from ngcontact.drivers.build import body_laws, micro_friction
+from ngcontact.drivers.mesh_supports import supports_on
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry import resolved_shapes as rs
 from ngcontact.scene.cell_geometry import profile_2d
 from ngcontact.macro.macro_problem import Load
 from ngcontact.output.report import Outcome, VtkField
-from ngcontact.fem.elasticity import COMPONENTS
-from ngcontact.fem.reaction import boundary_reaction
+from ngcontact.fem.reaction import support_reactions
 from ngcontact.fem.sampling import probe
 
 log = logging.getLogger(__name__)
@@ -69,11 +68,12 @@ def shape_of(scene) -> rs.ResolvedShape:
     return rs.resolved_shape(scene.geometry)
 
 
-def supports_of(scene) -> tuple:
-    """The supports; a support's slope runs along ``x`` on the shape's horizontal boundaries, else along ``y``."""
+def supports_of(scene, mesh) -> tuple:
+    """The supports on ``mesh`` (:func:`ngcontact.drivers.mesh_supports.supports_on`); a support's slope runs
+    along ``x`` on the shape's horizontal boundaries, else along ``y``."""
     horizontal = shape_of(scene).horizontal
-    return tuple(D.Support(label=s.boundary, components=s.components, value=s.displacement, slope=s.slope,
-                           along="x" if s.boundary in horizontal else "y") for s in scene.supports)
+    return supports_on(scene.supports, mesh, scene.geometry.setting,
+                       along=lambda label: "x" if label in horizontal else "y")
 
 
 def loads_of(scene) -> tuple:
@@ -129,7 +129,8 @@ def problem_of(scene, geometry) -> D.DirectProblem:
     """The resolved problem of ``scene`` on ``geometry``."""
     kw = micro_law(scene.cell_scene)
     return D.DirectProblem(mesh=geometry.mesh, materials=materials_of(scene), setting=scene.geometry.setting,
-                           supports=supports_of(scene), loads=loads_of(scene), order=scene.discretization.order,
+                           supports=supports_of(scene, geometry.mesh), loads=loads_of(scene),
+                           order=scene.discretization.order,
                            contact=geometry.interface,
                            coulomb_rtol=scene.solver.coulomb_rtol,
                            coulomb_max_iter=scene.solver.coulomb_max_iter, **kw)
@@ -141,33 +142,12 @@ def solve_scene(scene, problem) -> D.DirectSolution:
 
 
 def reactions(scene, sol) -> dict:
-    """Reaction force and moment of every supported boundary (see :func:`ngcontact.fem.reaction.boundary_reaction`).
-
-    Only the fixed components are kept (a free component's "reaction" is
-    the residual, zero); in axisymmetry the radial one is dropped (its net
-    force over a revolution vanishes) and there is no moment, so e.g. the
-    femur's ``axis`` support (``r`` fixed) has no entry.
-    """
+    """Reaction force and moment of every supported boundary
+    (:func:`ngcontact.fem.reaction.support_reactions`; resolved or homogenized solution)."""
     p = sol.problem
-    mesh = p.mesh
-    comps = COMPONENTS[p.setting]
-    out = {}
-    for s in scene.supports:
-        label = s.boundary
-        keep = [c for c in (s.components or comps) if not (p.setting == "axisymmetric" and c == "r")]
-        if p.setting == "plane_strain" and not s.components:
-            keep.append("moment")
-        if not keep:
-            continue
-        xs = [mesh[v].point for el in mesh.Elements(ng.BND) if el.mat == label for v in el.vertices]
-        about = tuple(0.5 * (np.min(xs, axis=0) + np.max(xs, axis=0)))
-        total = None
-        for region, u in (("rough", sol.u_rough), ("counter", sol.u_counter)):
-            r = boundary_reaction(mesh, p.setting, p.materials[region], u, region, label, p.order, about=about)
-            total = r if total is None else {k: total[k] + r[k] for k in r}
-        assert total is not None  # set by the loop over both bodies
-        out[label] = {k: total[k] for k in keep}
-    return out
+    return support_reactions(p.mesh, p.setting, p.order, p.supports,
+                             (("rough", p.materials["rough"], sol.u_rough),
+                              ("counter", p.materials["counter"], sol.u_counter)))
 
 
 def probes(scene, sol) -> list:

@@ -20,39 +20,29 @@ or the axisymmetric femur with a stem) with a flat interface, with
   traction of the bundle solution (pressure ``p = mean tau_n``, shear on the
   counter's far face ``-mean tau_t``); cell heights scale with ``eps``.
 
-Errors of each law against the resolved solution ``u^eps``:
-
-* ``field``: relative L2 error of the displacement outside the band of
-  half-width ``band * eps`` around ``S_0``, ``||u_h - u^eps|| / ||u^eps||``
-  (axisymmetric: with the weight ``2 pi r``), by the midpoint rule on a
-  uniform grid (blocks: of each block; femur: of the bounding box, points
-  in the bodies only), the same points for every law;
-* ``reaction``: ``|R_h - R^eps| / |R^eps|`` of the force vector (the fixed
-  components) on each supported boundary (maximum over the boundaries).
-  When the supports carry the whole load (the femur's base) equilibrium
-  fixes this number; it then only shows the discretization error;
-* ``moment``: relative error of the reaction moment (plane strain; maximum
-  over the boundaries);
-* ``probe``: largest ``|u_h - u^eps|`` at the probe points divided by the
-  largest ``|u^eps|`` there;
-* ``interface``: ``|F_h - F^eps| / |F^eps|`` of the force transmitted
-  through a part of the interface, an interface resultant that equilibrium
-  does not fix: blocks, the left half ``x < x0 + L/2``; femur, the axial
-  force through the cylindrical part ``z > z_corner`` (the rest goes
-  through the cone).
+Each level is solved twice, on the scene's discretization and on one refined by
+``study.refinement``; the errors of each law against the resolved solution
+(:mod:`ngcontact.drivers.modelling_error`: field, reaction, moment, probe,
+interface) are the refined pair's, and beside each the estimate of its
+discretization error, the change between the two pairs.
 
 The levels are independent solves: a batch (:mod:`ngcontact.parallel.executor`)
 spreads them over the run's workers, so the wall times of a level are
 measured while the other workers run too.
 
-The observed rate of each law is the least-squares slope of ``log error``
-against ``log eps`` (:func:`ngcontact.verification.rates.fit_rate`).
+The observed rate of each law and error is the least-squares slope of
+``log error`` against ``log eps`` (:func:`ngcontact.verification.rates.fit_rate`)
+over the levels whose discretization estimate is at most
+``study.discretization_share`` of the error: the modelling error, not the
+meshes.  With fewer than three such levels the study fits no rate and says why
+(``results.refused``).
 """
 from __future__ import annotations
 
 import contextlib
 import logging
 import time
+from dataclasses import replace
 from typing import Any
 
 import ngsolve as ng
@@ -65,6 +55,7 @@ from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
 from ngcontact.macro import macro_measures as MM
 from ngcontact.coupling.cell_law import bundle_law
+from ngcontact.drivers import modelling_error as E
 from ngcontact.drivers import run_resolved as drv
 from ngcontact.output import plots
 from ngcontact.geometry.profiles import profile_cell
@@ -73,12 +64,11 @@ from ngcontact.geometry.resolved_bodies import scaled_profile
 from ngcontact.cell.coefficients import direction_bundle
 from ngcontact.output.report import Outcome
 from ngcontact.verification.rates import fit_rate
-from ngcontact.fem.quadrature import resultant_order
 
 log = logging.getLogger(__name__)
 
 LAWS = ("bundle", "linear", "effective")
-ERRORS = ("field", "reaction", "moment", "probe", "interface")
+ERRORS = E.ERRORS
 
 
 # ------------------------------------------------------------------ laws
@@ -143,7 +133,7 @@ def homogenized_problem(scene, flat, law: il.InterfaceLaw) -> M.MacroProblem:
     no macro gap (the cell's own gap terms are in the law).
     """
     return M.MacroProblem(mesh=flat.mesh, setting=scene.geometry.setting, rough="rough", counter="counter",
-                          materials=drv.materials_of(scene), law=law, supports=drv.supports_of(scene),
+                          materials=drv.materials_of(scene), law=law, supports=drv.supports_of(scene, flat.mesh),
                           loads=drv.loads_of(scene), order=scene.discretization.order, interface=flat.interface)
 
 
@@ -169,114 +159,29 @@ def mean_interface_traction(sol: M.MacroSolution) -> np.ndarray:
     return np.asarray(vals, float) / area
 
 
-# -------------------------------------------------------------- measures
-def interface_force(sol: D.DirectSolution | M.MacroSolution, part=None) -> np.ndarray:
-    """Force the counter receives through a part of the interface (resolved or flat).
-
-    ``int tau w ds`` over the part given by the indicator CoefficientFunction
-    ``part`` (default: all of it); ``w = 2 pi r`` in axisymmetry.  Resolved:
-    the micro pressure along the micro normal on ``S_C^eps``; homogenized:
-    the law's traction in the frame of ``S_0``.
-    """
-    if isinstance(sol, D.DirectSolution):
-        return D.contact_force(sol, part=part)
-    p = sol.problem
-    mesh = p.mesh
-    glob = sum((t * e for t, e in zip(MM.interface_tractions(sol), sol.frame)), ng.CF((0.0, 0.0)))
-    ind = ng.CF(1.0) if part is None else part
-    w = elasticity.weight(p.setting)
-    return np.asarray(ng.Integrate(glob * ind * w, mesh, ng.BND, definedon=mesh.Boundaries(p.interface),
-                                   order=resultant_order(p.order)), float).ravel()
-
-
-def sample_grid(scene, band: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Midpoints, weights and bodies (0 rough, 1 counter) of a uniform grid outside the band.
-
-    Blocks: ``nx x ny`` cells in each block outside ``|y| <= band``.  Femur:
-    ``nr x nz`` cells over the bounding box ``[0, r_bone] x [0, z_stem_top]``,
-    keeping the midpoints inside a body and farther than ``band`` from
-    ``S_0``.  Axisymmetric weights carry the factor ``2 pi r``.
-    """
-    g = scene.geometry
-    pts, wts = drv.shape_of(scene).sample_grid(scene.study.grid, band)
-    if g.setting == "axisymmetric":
-        wts = wts * 2.0 * np.pi * pts[:, 0]
-    return pts, wts, drv.body_of(scene, pts)
-
-
-def displacement_at(sol: D.DirectSolution | M.MacroSolution, points: np.ndarray, body=None) -> np.ndarray:
-    """Displacement at ``points``, shape ``(m, 2)``.
-
-    ``body``: per point 0 (rough) or 1 (counter); default: rough below ``y = 0``.
-    """
-    mesh = sol.problem.mesh
-    if body is None:
-        body = np.where(points[:, 1] < 0, 0, 1)
-    out = np.empty((len(points), 2))
-    for mask, u in ((body == 0, sol.u_rough), (body == 1, sol.u_counter)):
-        if np.any(mask):
-            mp = mesh(points[mask, 0], points[mask, 1])
-            out[mask] = np.asarray(u(mp)).reshape(-1, 2)
-    return out
-
-
-def measures(scene, sol: D.DirectSolution | M.MacroSolution, points: np.ndarray, body=None) -> dict:
-    """The quantities of interest of one solution (resolved or homogenized).
-
-    In axisymmetry the interface force keeps its axial component only (the
-    radial entry integrates a line load that has no net resultant).
-    """
-    force = interface_force(sol, part=drv.interface_part(scene))
-    if scene.geometry.setting == "axisymmetric":
-        force = force[1:]
-    return {"reactions": drv.reactions(scene, sol),
-            "probes": np.asarray(drv.probes(scene, sol), float).reshape(-1, 2),
-            "interface": force,
-            "field": displacement_at(sol, points, body)}
-
-
-def errors(ref: dict, other: dict, weights: np.ndarray) -> dict:
-    """Relative errors of ``other`` against the resolved ``ref`` (see the module docstring)."""
-    diff = other["field"] - ref["field"]
-    field = np.sqrt(np.sum(weights[:, None] * diff ** 2) / np.sum(weights[:, None] * ref["field"] ** 2))
-    force, moment, has_moment = 0.0, 0.0, False
-    for label, r in ref["reactions"].items():
-        o = other["reactions"][label]
-        keys = [k for k in r if k != "moment"]
-        if keys:
-            fr = np.array([r[k] for k in keys])
-            fo = np.array([o[k] for k in keys])
-            force = max(force, float(np.linalg.norm(fo - fr) / np.linalg.norm(fr)))
-        if "moment" in r:
-            has_moment = True
-            moment = max(moment, abs(o["moment"] - r["moment"]) / abs(r["moment"]))
-    out = {"field": float(field), "reaction": force,
-           "interface": float(np.linalg.norm(other["interface"] - ref["interface"])
-                              / np.linalg.norm(ref["interface"]))}
-    if has_moment:
-        out["moment"] = float(moment)
-    if len(ref["probes"]):
-        out["probe"] = float(np.max(np.linalg.norm(other["probes"] - ref["probes"], axis=1))
-                             / np.max(np.linalg.norm(ref["probes"], axis=1)))
-    return out
-
-
 # ------------------------------------------------------------------ study
-def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS) -> dict:
-    """One level: the resolved run with ``N`` periods and the homogenized runs; a row of results."""
-    st = scene.study
-    eps = drv.eps_of(scene, N)
-    length = drv.interface_length(scene)
-    points, weights, body = sample_grid(scene, st.band * eps)
+def refined(scene, factor: float):
+    """``scene`` with every mesh size of the study divided by ``factor`` (the resolved far field and interface,
+    the homogenized interface); its linked cell stays."""
+    d, st = scene.discretization, scene.study
+    new = replace(scene, discretization=replace(d, maxh=d.maxh / factor,
+                                                elements_per_period=d.elements_per_period * factor),
+                  study=replace(st, interface_maxh=st.interface_maxh / factor))
+    object.__setattr__(new, "cell_scene", scene.cell_scene)
+    return new
+
+
+def solve_pair(scene, N: int, bundle: il.BundleLaw, laws, points, body) -> dict[str, Any]:
+    """The resolved run with ``N`` periods and the homogenized runs on one discretization: their measures
+    (:func:`ngcontact.drivers.modelling_error.measures`), unknowns, seconds and the effective law's record."""
     t0 = time.perf_counter()
     geo = drv.build_resolved(scene, N)
     ref_sol = drv.solve_scene(scene, drv.problem_of(scene, geo))
-    time_resolved = time.perf_counter() - t0
-    ref = measures(scene, ref_sol, points, body)
-    row: dict[str, Any] = {"N": N, "eps": eps, "ndof_resolved": ref_sol.ndof, "time_resolved": time_resolved,
-           "contact_fraction_resolved": D.contact_fraction(ref_sol, length)}
+    out: dict[str, Any] = {"resolved": E.measures(scene, ref_sol, points, body), "ndof_resolved": ref_sol.ndof,
+                           "time_resolved": time.perf_counter() - t0, "laws": {},
+                           "contact_fraction_resolved": D.contact_fraction(ref_sol, drv.interface_length(scene))}
     t0 = time.perf_counter()
-    flat = drv.build_flat(scene, st.interface_maxh)
+    flat = drv.build_flat(scene, scene.study.interface_maxh)
     t_mesh = time.perf_counter() - t0
     homogenized: dict[str, il.NormalLaw] = {"bundle": bundle, "linear": il.linearized(bundle)}
     bundle_sol: M.MacroSolution | None = None
@@ -286,21 +191,41 @@ def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS) -> dict:
         if name == "effective":
             if bundle_sol is None:
                 raise ValueError("the effective law is evaluated at the bundle solution: list 'bundle' before it")
-            normal, info = effective_law(scene, eps, mean_interface_traction(bundle_sol))
-            row["effective_law"] = info
+            traction = mean_interface_traction(bundle_sol)
+            normal, out["effective_law"] = effective_law(scene, drv.eps_of(scene, N), traction)
         else:
             normal = homogenized[name]
         sol = solve_homogenized(scene, flat, il.InterfaceLaw(normal=normal))
-        seconds = time.perf_counter() - t0 + t_mesh
+        out[f"time_{name}"] = time.perf_counter() - t0 + t_mesh
         if name == "bundle":
             bundle_sol = sol
-            row["time_homogenized"] = seconds
-            row["ndof_homogenized"] = sol.ndof
-        row[f"time_{name}"] = seconds
-        for key, value in errors(ref, measures(scene, sol, points, body), weights).items():
+            out["ndof_homogenized"] = sol.ndof
+        out["laws"][name] = E.measures(scene, sol, points, body)
+    return out
+
+
+def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS) -> dict:
+    """One level: the resolved and homogenized runs on the scene's discretization and on the refined one
+    (module docstring); a row with the refined pair's errors and each error's discretization estimate."""
+    st = scene.study
+    eps = drv.eps_of(scene, N)
+    points, weights, body = E.sample_grid(scene, st.band * eps)
+    coarse = solve_pair(scene, N, bundle, laws, points, body)
+    fine = solve_pair(refined(scene, st.refinement), N, bundle, laws, points, body)
+    row: dict[str, Any] = {"N": N, "eps": eps}
+    row.update({k: v for k, v in fine.items() if k not in ("resolved", "laws")})
+    row["time_homogenized"] = fine["time_bundle"] if "bundle" in laws else fine[f"time_{laws[0]}"]
+    row["time_discretization_check"] = sum(v for k, v in coarse.items() if k.startswith("time_"))
+    for name in laws:
+        model = E.errors(fine["resolved"], fine["laws"][name], weights)
+        check = E.discretization_errors(coarse["resolved"], coarse["laws"][name], fine["resolved"],
+                                        fine["laws"][name], weights)
+        for key, value in model.items():
             row[f"{name}_{key}"] = value
-    log.info("N = %d: resolved %.2f s (%d dofs), bundle field error %.3e, linear %.3e", N, time_resolved,
-             ref_sol.ndof, row.get("bundle_field", float("nan")), row.get("linear_field", float("nan")))
+            row[f"{name}_{key}_discretization"] = check[key]
+    log.info("N = %d: resolved %.2f s (%d dofs), bundle field error %.3e (discretization %.1e)", N,
+             row["time_resolved"], row["ndof_resolved"], row.get("bundle_field", float("nan")),
+             row.get("bundle_field_discretization", float("nan")))
     return row
 
 
@@ -316,15 +241,41 @@ def per_error(rows: list, laws, summary) -> dict:
             for name in laws}
 
 
-def rates(rows: list, laws=LAWS) -> dict:
-    """Fitted rate in ``eps`` of every error of every law (``None`` where an error is 0)."""
-    eps = [r["eps"] for r in rows]
+#: a relative error below this is round-off: the quantity is fixed by equilibrium (a support that carries the
+#: whole load), and it has no rate in eps
+ROUNDOFF = 1e-9
 
-    def rate(col):
-        vals = [r[col] for r in rows]
-        return fit_rate(eps, vals) if min(vals) > 0 else None
 
-    return per_error(rows, laws, rate)
+def refusal(rows: list, col: str, good: list, share: float) -> str:
+    """Why no rate of column ``col`` was fitted on ``rows`` of which ``good`` qualify."""
+    if all(r[col] < ROUNDOFF for r in rows):
+        return (f"the error is at round-off ({max(r[col] for r in rows):.1e} at most): the quantity is fixed by "
+                "equilibrium, nothing to fit")
+    bad = [r["N"] for r in rows if r not in good]
+    return (f"{len(good)} level(s) qualify: at N = {bad} the discretization estimate exceeds {share:g} of the "
+            "error; refine the scene's discretization or the study's interface_maxh")
+
+
+def rates(rows: list, laws=LAWS, share: float = 0.1) -> tuple[dict, dict, dict]:
+    """Fitted rate in ``eps`` of every error of every law over the levels whose discretization estimate is at
+    most ``share`` of the error (module docstring), at least three: ``(rates, levels, refused)``,
+    ``rates[law][error]`` the rate or ``None``, ``levels[law][error]`` the ``N`` it was fitted on,
+    ``refused[law][error]`` why no rate was fitted (only where none was)."""
+    fitted: dict[str, dict] = {name: {} for name in laws}
+    used: dict[str, dict] = {name: {} for name in laws}
+    refused: dict[str, dict] = {}
+    for name in laws:
+        for key in ERRORS:
+            col = f"{name}_{key}"
+            if col not in rows[0]:
+                continue
+            good = [r for r in rows if ROUNDOFF <= r[col] and r[f"{col}_discretization"] <= share * r[col]]
+            used[name][key] = [r["N"] for r in good]
+            fitted[name][key] = fit_rate([r["eps"] for r in good], [r[col] for r in good]) if len(good) >= 3 \
+                else None
+            if fitted[name][key] is None:
+                refused.setdefault(name, {})[key] = refusal(rows, col, good, share)
+    return fitted, used, refused
 
 
 def threshold_eps(rows: list, laws=LAWS, tol: float = 0.01) -> dict:
@@ -346,14 +297,16 @@ def run_study(scene, periods=None, *, laws=LAWS, clock=None) -> Outcome:
     """The epsilon study of a ``direct`` scene with a ``[study]`` section; no file I/O.
 
     Returns an :class:`~ngcontact.output.report.Outcome` with ``results.rows`` (one
-    per ``N``), ``results.rates`` (per law and error), ``results.below_1_percent``
+    per ``N``: each error and its discretization estimate), ``results.rates`` (per law
+    and error, over ``results.rate_levels``; ``results.refused`` says why a rate is
+    missing), ``results.below_1_percent``
     (per law and error, the ``eps`` from which on the error stays below 1 %
     and the cost ratio there), a CSV table ``epsilon`` and a plot ``epsilon``.
     """
     if scene.study is None:
         raise ValueError("the scene has no [study] section")
     periods = tuple(periods or scene.study.periods)
-    if len(sample_grid(scene, scene.study.band * drv.eps_of(scene, min(periods)))[0]) == 0:
+    if len(E.sample_grid(scene, scene.study.band * drv.eps_of(scene, min(periods)))[0]) == 0:
         raise SceneError("study.band", scene.study.band, f"the band of N = {min(periods)} covers both "
                          "bodies: no points are left for the field error; take a smaller band or more periods")
     bundle = cell_bundle(scene)
@@ -361,16 +314,16 @@ def run_study(scene, periods=None, *, laws=LAWS, clock=None) -> Outcome:
     names = [f"N = {N}" for N in periods]
     with clock.stage("levels") if clock is not None else contextlib.nullcontext():
         rows = executor.current().map(level_member, jobs, names, label="epsilon levels")
-    results = {"rows": rows, "rates": rates(rows, laws) if len(rows) >= 3 else {},
+    share = scene.study.discretization_share
+    fitted, used, refused = rates(rows, laws, share)
+    for name, keys in refused.items():
+        for key, why in keys.items():
+            log.warning("no rate of the %s law's %s error: %s", name, key, why)
+    results = {"rows": rows, "rates": fitted, "rate_levels": used, "refused": refused,
+               "discretization": {"refinement": scene.study.refinement, "share": share},
                "below_1_percent": threshold_eps(rows, laws),
                "bundle": {"directions": len(bundle.weights), "K0": bundle.matrix().tolist()},
-               "error_definitions": {k: v for k, v in zip(ERRORS, (
-                   "relative L2 displacement error outside the band of half-width band * eps around S_0",
-                   "largest relative error of a support's reaction force vector",
-                   "largest relative error of a support's reaction moment",
-                   "largest displacement error at the probes / largest resolved probe displacement",
-                   "relative error of the force through a part of the interface (blocks: x < x0 + L/2; "
-                   "femur: axial force through the cylinder z > z_corner)"))}}
+               "error_definitions": E.DEFINITIONS}
     header = [k for k in rows[0] if not isinstance(rows[0][k], dict)]
     table = (header, [[r[k] for k in header] for r in rows])
     return Outcome(results=results, ndof=max(r["ndof_resolved"] for r in rows),

@@ -21,7 +21,7 @@ from ngcontact.fem.elasticity import COMPONENTS
 
 
 def boundary_reaction(mesh, setting: str, law, u, region: str, label: str, order: int,
-                      about=(0.0, 0.0)) -> dict:
+                      about=(0.0, 0.0), force=()) -> dict:
     """Reaction force and moment that a Dirichlet boundary exerts on its body.
 
     The consistent reaction: the derivative of the body's elastic energy in
@@ -46,27 +46,68 @@ def boundary_reaction(mesh, setting: str, law, u, region: str, label: str, order
         Order of the test field (that of ``u``).
     about
         Centre of the moment (plane strain).
+    force
+        The body's constant force density, if any: its work on the test
+        field is a load on the boundary's neighbours, so the reaction is
+        ``R_i = - int_B (sigma(u) : eps(v_i) - f . v_i) w dx``.
 
     Returns
     -------
     dict
-        Force components by name (``x, y`` or ``r, z``; axisymmetric: per
-        full revolution, ``r`` omitted) and ``moment`` (plane strain).
+        Force components by name (``x, y``, ``x, y, z`` or ``r, z``;
+        axisymmetric: per full revolution, ``r`` omitted) and ``moment``
+        (plane strain).
     """
     comps = COMPONENTS[setting]
     V = ng.VectorH1(mesh, order=order, definedon=mesh.Materials(region))
     v = ng.GridFunction(V)
     sigma = elasticity.stress(law, u, setting)
     w = elasticity.weight(setting)
-    fields = {c: ng.CF(tuple(1.0 if j == i else 0.0 for j in range(2))) for i, c in enumerate(comps)}
+    fields = {c: ng.CF(tuple(1.0 if j == i else 0.0 for j in range(mesh.dim))) for i, c in enumerate(comps)}
     if setting == "plane_strain":
         fields["moment"] = ng.CF((-(ng.y - about[1]), ng.x - about[0]))
-    else:
+    elif setting == "axisymmetric":
         fields.pop("r")
     out = {}
     for name, cf in fields.items():
         v.vec[:] = 0.0
         v.Set(cf, definedon=mesh.Boundaries(label))
         work = ng.InnerProduct(sigma, elasticity.strain(v, setting)) * w
+        if any(force):
+            work = work - ng.InnerProduct(ng.CF(tuple(float(f) for f in force)), v) * w
         out[name] = -float(ng.Integrate(work, mesh, definedon=mesh.Materials(region)))
+    return out
+
+
+def support_reactions(mesh, setting: str, order: int, supports, bodies, forces=None) -> dict:
+    """Reaction force (and, in plane strain, moment) of every supported boundary, summed over the bodies.
+
+    ``supports``: the problem's :class:`~ngcontact.fem.two_body.Support`
+    tuple; ``bodies``: ``(region, law, u)`` of each body; ``forces``: region ->
+    constant body force (see :func:`boundary_reaction`).  Only the fixed
+    components are kept (a free component's "reaction" is the residual,
+    zero); in axisymmetry the radial one is dropped (its net force over a
+    revolution vanishes) and there is no moment; a support fixing every
+    component in plane strain also reports its moment about the boundary's
+    mid-point (:func:`boundary_reaction`).  A boundary fixed in no kept
+    component has no entry.
+    """
+    comps = COMPONENTS[setting]
+    out = {}
+    for s in supports:
+        label = s.label
+        keep = [c for c in (s.components or comps) if not (setting == "axisymmetric" and c == "r")]
+        if setting == "plane_strain" and not s.components:
+            keep.append("moment")
+        if not keep:
+            continue
+        xs = [mesh[v].point for el in mesh.Elements(ng.BND) if el.mat == label for v in el.vertices]
+        about = tuple(0.5 * (min(p[i] for p in xs) + max(p[i] for p in xs)) for i in range(mesh.dim))
+        total: dict | None = None
+        for region, law, u in bodies:
+            r = boundary_reaction(mesh, setting, law, u, region, label, order, about=about,
+                                  force=(forces or {}).get(region, ()))
+            total = r if total is None else {k: total[k] + r[k] for k in r}
+        assert total is not None  # every problem has two bodies
+        out[label] = {k: total[k] for k in keep}
     return out

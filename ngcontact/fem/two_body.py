@@ -6,11 +6,16 @@ body's displacement lives in its own ``VectorH1`` defined on its region
 jump ``J = u_rough - u_counter`` is the difference of the two traces.  This
 module holds what both problems set up the same way:
 
-* supports (:class:`Support`: prescribed components, optionally tilted) and
-  surface loads (:class:`Load`), with the Dirichlet flags of the compound
-  space (:func:`spaces`) and the prescribed values (:func:`set_dirichlet`);
+* supports (:class:`Support`: prescribed components, constant, tilted or a
+  general affine field ``u0 + G x``) and surface loads (:class:`Load`), with
+  the Dirichlet flags of the compound space (:func:`spaces`) and the
+  prescribed values (:func:`set_dirichlet`); a boundary's plane normal and
+  its direction of largest extent (:func:`plane_normal_axis`,
+  :func:`boundary_along`), which turn a symmetry plane and a slope into
+  components;
 * the load potential ``-int t . u w ds`` (:func:`add_load_potential`),
-  ``t = -p n + traction``;
+  ``t = -p n + traction``, and the body forces' ``-int f . u w dx``
+  (:func:`add_body_force_potential`);
 * the interface normal oriented from ``rough`` into the other body
   (:func:`interface_normal`), the paper's ``n`` on ``S_C`` and ``n0`` on
   ``S_0``;
@@ -39,6 +44,12 @@ class Support:
     default zeros), plus ``slope[i] * (s - s_mid)`` where ``s`` is the coordinate
     along ``along`` (``"x"``, ``"y"`` or ``"z"``) and ``s_mid`` the mid-point of the
     boundary in that coordinate: a linear variation (a tilt of a face).
+
+    With ``gradient`` (one row per listed component, one entry per
+    coordinate) the prescribed field is the general affine one
+    ``u_c(x) = value[c] + sum_j gradient[c][j] x_j`` in absolute
+    coordinates (``value`` is then ``u0``, the value at the origin) and
+    ``slope`` is not used.
     """
 
     label: str
@@ -46,6 +57,7 @@ class Support:
     value: tuple[float, ...] = ()
     slope: tuple[float, ...] = ()
     along: str = "x"
+    gradient: tuple[tuple[float, ...], ...] = ()
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -81,6 +93,10 @@ def check_labels(mesh, setting: str, interface: str, supports, loads, regions=()
             raise ModelError(f"support on {s.label!r}: component {bad[0]!r}; allowed {', '.join(comps)}")
         if s.value and len(s.value) != len(s.components or comps):
             raise ModelError(f"support on {s.label!r}: give one displacement per component")
+        if s.gradient and (len(s.gradient) != len(s.components or comps)
+                           or any(len(row) != mesh.dim for row in s.gradient)):
+            raise ModelError(f"support on {s.label!r}: the gradient needs one row per component, "
+                             f"{mesh.dim} entries each")
 
 
 def spaces(mesh, setting: str, regions: tuple[str, str], supports, order: int, periodic: bool = False):
@@ -119,24 +135,79 @@ def boundary_mid(mesh, label: str, axis: int) -> float:
     return 0.5 * (min(coords) + max(coords))
 
 
+def plane_normal_axis(mesh, label: str, tol: float = 1e-8) -> int | None:
+    """Index of the coordinate axis along which the boundary ``label``'s normal lies everywhere, or ``None``.
+
+    The normal at the mid-point of every boundary element must be ``+-e_k``
+    for one ``k`` (to ``tol``): the boundary is then made of planes (3D) or
+    straight lines (2D) normal to that axis, on which the normal
+    displacement is that one component.  A curved or slanted boundary gives
+    ``None``.
+    """
+    dim = mesh.dim
+    rule = ng.IntegrationRule([(1 / 3, 1 / 3)] if dim == 3 else [(0.5,)], [1.0])
+    normals = np.abs(np.asarray(ng.specialcf.normal(dim)(mesh.MapToAllElements(rule, mesh.Boundaries(label))))
+                     ).reshape(-1, dim)
+    if not len(normals):
+        return None
+    axes = [k for k in range(dim) if np.all(normals[:, k] >= 1.0 - tol)]
+    return axes[0] if axes else None
+
+
+def boundary_along(mesh, label: str, tol: float = 1e-8) -> str | None:
+    """The coordinate along a straight 2D boundary normal to an axis (``"x"`` on a horizontal one, ``"y"``
+    on a vertical one); ``None`` for a slanted or curved boundary and in 3D (a face has two directions)."""
+    axis = plane_normal_axis(mesh, label, tol) if mesh.dim == 2 else None
+    return None if axis is None else "xy"[1 - axis]
+
+
+def affine_field(mesh, support: Support, comps: tuple[str, ...]):
+    """The prescribed field of ``support`` in all ``comps`` (zero in the components it does not fix).
+
+    Constant ``value``; plus ``slope * (s - s_mid)`` along ``along``; or,
+    with a ``gradient``, ``u0 + G x`` (see :class:`Support`).
+    """
+    listed = support.components or comps
+    value = tuple(support.value) or (0.0,) * len(listed)
+    xyz = (ng.x, ng.y, ng.z)[:mesh.dim]
+    rows: list
+    if support.gradient:
+        rows = [float(value[k]) + sum(float(g) * x for g, x in zip(support.gradient[k], xyz))
+                for k in range(len(listed))]
+    elif any(support.slope):
+        axis = "xyz".index(support.along)
+        coord = xyz[axis] - boundary_mid(mesh, support.label, axis)
+        rows = [float(value[k]) + float(support.slope[k]) * coord for k in range(len(listed))]
+    else:
+        rows = [float(v) for v in value]
+    return ng.CF(tuple(rows[listed.index(c)] if c in listed else 0.0 for c in comps))
+
+
 def set_dirichlet(mesh, setting: str, supports, gfu) -> None:
-    """Prescribed support values (plus their tilt) into every body's component of ``gfu``."""
+    """Prescribed support values (constant, tilted or affine: :func:`affine_field`) into every body's
+    component of ``gfu``."""
     comps = COMPONENTS[setting]
     for s in supports:
-        listed = s.components or comps
-        value = tuple(s.value) or (0.0,) * len(listed)
-        slope = tuple(s.slope) or (0.0,) * len(listed)
-        if not any(value) and not any(slope):
+        if not any(s.value) and not any(s.slope) and not any(any(row) for row in s.gradient):
             continue
-        if any(slope):
-            axis = "xyz".index(s.along)
-            coord = (ng.x, ng.y, ng.z)[axis] - boundary_mid(mesh, s.label, axis)
-            vec = ng.CF(tuple(float(value[listed.index(c)]) + float(slope[listed.index(c)]) * coord
-                              if c in listed else 0.0 for c in comps))
-        else:
-            vec = ng.CF(tuple(float(value[listed.index(c)]) if c in listed else 0.0 for c in comps))
+        vec = affine_field(mesh, s, comps)
         for gf in gfu.components:
             gf.Set(vec, definedon=mesh.Boundaries(s.label))
+
+
+def add_body_force_potential(form, mesh, forces: dict, displacements: dict, weight):
+    """Add ``-int_B f_B . u_B w dx`` of every body's constant force density ``f_B`` to a ``Variation`` form.
+
+    ``forces``: region -> force per unit volume (global components; in
+    axisymmetry ``(f_r, f_z)``); ``displacements``: region -> that body's
+    trial function.
+    """
+    for region, f in forces.items():
+        if not any(f):
+            continue
+        work = ng.InnerProduct(ng.CF(tuple(float(c) for c in f)), displacements[region])
+        form += ng.Variation(-work * weight * ng.dx(definedon=mesh.Materials(region)))
+    return form
 
 
 def add_load_potential(form, mesh, loads, displacements, weight):

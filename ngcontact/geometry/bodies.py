@@ -17,7 +17,9 @@ builder: :func:`ngcontact.geometry.femur.femur_stem`.)
 :func:`coaxial_plane_strain`, :func:`coaxial_axisymmetric`
     Two long coaxial tubes (inner ``inner`` = rough, outer ``outer`` =
     counter) for Lame's press fit: a quarter annulus in plane strain, an
-    ``(r, z)`` strip in axisymmetry.
+    ``(r, z)`` strip in axisymmetry.  With inner radius ``a = 0`` the inner
+    body is a solid shaft: no ``bore``; in axisymmetry its edge on the axis
+    ``r = 0`` is the boundary ``axis``.
 :func:`block_on_plane`
     A block (rough) on a base (counter) of the same width, plane strain.
 :func:`coaxial_3d`
@@ -62,10 +64,12 @@ def coaxial_axisymmetric(a: float, b: float, c: float, height: float, *, maxh: f
     """Two coaxial tubes ``a < r < b`` (``inner``) and ``b < r < c`` (``outer``) in ``(r, z)``.
 
     Boundaries: ``interface`` (``r = b``), ``bore`` (``r = a``), ``mantle``
-    (``r = c``), ``bottom`` (``z = 0``), ``top`` (``z = height``).
+    (``r = c``), ``bottom`` (``z = 0``), ``top`` (``z = height``); with
+    ``a = 0`` (a solid shaft) ``axis`` (``r = 0``) instead of ``bore``.
     """
-    if not 0 < a < b < c or height <= 0:
-        raise ValueError("need 0 < a < b < c and height > 0")
+    if not 0 <= a < b < c or height <= 0:
+        raise ValueError("need 0 <= a < b < c and height > 0")
+    inside = "bore" if a > 0 else "axis"
     geo = SplineGeometry()
     P = [geo.AppendPoint(x, y) for x, y in ((a, 0), (b, 0), (c, 0), (c, height), (b, height), (a, height))]
     geo.Append(["line", P[0], P[1]], leftdomain=ROUGH, rightdomain=0, bc="bottom")
@@ -73,7 +77,7 @@ def coaxial_axisymmetric(a: float, b: float, c: float, height: float, *, maxh: f
     geo.Append(["line", P[2], P[3]], leftdomain=COUNTER, rightdomain=0, bc="mantle")
     geo.Append(["line", P[3], P[4]], leftdomain=COUNTER, rightdomain=0, bc="top")
     geo.Append(["line", P[4], P[5]], leftdomain=ROUGH, rightdomain=0, bc="top")
-    geo.Append(["line", P[5], P[0]], leftdomain=ROUGH, rightdomain=0, bc="bore")
+    geo.Append(["line", P[5], P[0]], leftdomain=ROUGH, rightdomain=0, bc=inside)
     geo.Append(["line", P[1], P[4]], leftdomain=ROUGH, rightdomain=COUNTER, bc="interface")
     geo.SetMaterial(ROUGH, "inner")
     geo.SetMaterial(COUNTER, "outer")
@@ -82,7 +86,7 @@ def coaxial_axisymmetric(a: float, b: float, c: float, height: float, *, maxh: f
         mesh.Curve(order)
     return MacroGeometry(mesh=mesh, rough="inner", counter="outer",
                          dims={"a": a, "b": b, "c": c, "height": height},
-                         boundaries={"interface": "r = b", "bore": "r = a", "mantle": "r = c",
+                         boundaries={"interface": "r = b", inside: f"r = {'a' if a > 0 else 0}", "mantle": "r = c",
                                      "bottom": "z = 0", "top": "z = height"})
 
 
@@ -91,33 +95,41 @@ def coaxial_plane_strain(a: float, b: float, c: float, *, maxh: float, order: in
 
     Circular arcs are exact rational splines; ``order`` curves the elements.
     Boundaries: ``interface`` (``r = b``), ``bore`` (``r = a``), ``mantle``
-    (``r = c``), ``sym_x`` (the face on ``x = 0``), ``sym_y`` (on ``y = 0``).
+    (``r = c``), ``sym_x`` (the face on ``x = 0``), ``sym_y`` (on ``y = 0``);
+    with ``a = 0`` the inner body is a quarter disk (no ``bore``).
     """
-    if not 0 < a < b < c:
-        raise ValueError("need 0 < a < b < c")
+    if not 0 <= a < b < c:
+        raise ValueError("need 0 <= a < b < c")
     geo = SplineGeometry()
 
     def pt(x, y):
         return geo.AppendPoint(x, y)
 
-    A0, B0, C0 = pt(a, 0), pt(b, 0), pt(c, 0)
-    A1, B1, C1 = pt(0, a), pt(0, b), pt(0, c)
-    Ac, Bc, Cc = pt(a, a), pt(b, b), pt(c, c)   # spline3 control points of the quarter arcs
+    B0, C0 = pt(b, 0), pt(c, 0)
+    B1, C1 = pt(0, b), pt(0, c)
+    Bc, Cc = pt(b, b), pt(c, c)   # spline3 control points of the quarter arcs
+    if a > 0:
+        A0, A1, Ac = pt(a, 0), pt(0, a), pt(a, a)
+    else:
+        A0 = A1 = pt(0, 0)
     geo.Append(["line", A0, B0], leftdomain=ROUGH, rightdomain=0, bc="sym_y")
     geo.Append(["line", B0, C0], leftdomain=COUNTER, rightdomain=0, bc="sym_y")
     geo.Append(["spline3", C0, Cc, C1], leftdomain=COUNTER, rightdomain=0, bc="mantle")
     geo.Append(["line", C1, B1], leftdomain=COUNTER, rightdomain=0, bc="sym_x")
     geo.Append(["line", B1, A1], leftdomain=ROUGH, rightdomain=0, bc="sym_x")
-    geo.Append(["spline3", A1, Ac, A0], leftdomain=ROUGH, rightdomain=0, bc="bore")
+    if a > 0:
+        geo.Append(["spline3", A1, Ac, A0], leftdomain=ROUGH, rightdomain=0, bc="bore")
     geo.Append(["spline3", B0, Bc, B1], leftdomain=ROUGH, rightdomain=COUNTER, bc="interface")
     geo.SetMaterial(ROUGH, "inner")
     geo.SetMaterial(COUNTER, "outer")
     mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh))
     if order > 1:
         mesh.Curve(order)
+    labels = {"interface": "r = b", "bore": "r = a", "mantle": "r = c", "sym_x": "x = 0", "sym_y": "y = 0"}
+    if a == 0:
+        del labels["bore"]
     return MacroGeometry(mesh=mesh, rough="inner", counter="outer", dims={"a": a, "b": b, "c": c},
-                         boundaries={"interface": "r = b", "bore": "r = a", "mantle": "r = c",
-                                     "sym_x": "x = 0", "sym_y": "y = 0"})
+                         boundaries=labels)
 
 
 def block_on_plane(length: float, h_block: float, h_base: float, *, maxh: float) -> MacroGeometry:
@@ -153,12 +165,13 @@ def coaxial_3d(a: float, b: float, c: float, height: float, *, maxh: float, orde
 
     Regions ``inner`` (rough, ``a < r < b``) and ``outer`` (counter,
     ``b < r < c``), ``0 < z < height``.  Boundaries: ``interface``, ``bore``,
-    ``mantle``, ``bottom``, ``top``, ``sym_x`` (``x = 0``), ``sym_y`` (``y = 0``).
+    ``mantle``, ``bottom``, ``top``, ``sym_x`` (``x = 0``), ``sym_y`` (``y = 0``);
+    with ``a = 0`` the inner body is a quarter of a solid shaft (no ``bore``).
     """
     from netgen.occ import Box, Cylinder, Glue, OCCGeometry, Pnt, X, Y, Z
 
-    if not 0 < a < b < c or height <= 0:
-        raise ValueError("need 0 < a < b < c and height > 0")
+    if not 0 <= a < b < c or height <= 0:
+        raise ValueError("need 0 <= a < b < c and height > 0")
     quarter = Box(Pnt(0, 0, 0), Pnt(c, c, height))
 
     def cylinder(r, name):
@@ -166,7 +179,7 @@ def coaxial_3d(a: float, b: float, c: float, height: float, *, maxh: float, orde
         cyl.faces.name = name
         return cyl
 
-    inner = (cylinder(b, "interface") - cylinder(a, "bore")) * quarter
+    inner = (cylinder(b, "interface") - cylinder(a, "bore") if a > 0 else cylinder(b, "interface")) * quarter
     outer = (cylinder(c, "mantle") - cylinder(b, "interface")) * quarter
     inner.mat("inner")
     outer.mat("outer")
@@ -181,6 +194,6 @@ def coaxial_3d(a: float, b: float, c: float, height: float, *, maxh: float, orde
         mesh.Curve(order)
     return MacroGeometry(mesh=mesh, rough="inner", counter="outer",
                          dims={"a": a, "b": b, "c": c, "height": height},
-                         boundaries={"interface": "r = b", "bore": "r = a", "mantle": "r = c",
+                         boundaries={"interface": "r = b", **({"bore": "r = a"} if a > 0 else {}), "mantle": "r = c",
                                      "bottom": "z = 0", "top": "z = height", "sym_x": "x = 0",
                                      "sym_y": "y = 0"})

@@ -1,7 +1,7 @@
 """The energy of the macro problem (paper eqs. 44, 46-48; the Winkler form 69-71) as NGSolve forms.
 
     Pi(u) = sum_B int_B 1/2 sigma(u_B) : eps(u_B) w dx
-            + int_S0 W(J) w ds  -  int_GammaN t . u w ds,
+            + int_S0 W(J) w ds  -  int_GammaN t . u w ds  -  sum_B int_B f_B . u_B w dx,
 
 the jump ``J = u_rough - u_counter`` in the interface's local frame, ``w``
 the measure weight (``2 pi r`` in axisymmetry); the variants the solution
@@ -67,6 +67,7 @@ def macro_energy(problem, fes, frame, *, G=None, start_stiffness: float | None =
                                                 problem.counter: problem.materials[problem.counter]},
                                       {problem.rough: ur, problem.counter: uc}, setting)
         two_body.add_load_potential(f, mesh, problem.loads, (ur, uc), w)
+        two_body.add_body_force_potential(f, mesh, problem.body_forces, {problem.rough: ur, problem.counter: uc}, w)
     a = local_jump(frame, ur.Trace() - uc.Trace())
     g0 = gap_cf(problem.gap)
     law = problem.law
@@ -136,8 +137,12 @@ def energy_form(sol):
 
 
 def load_form(sol):
-    """The load potential ``-int t . u w ds`` alone: its gradient is ``-l``, the applied loads."""
+    """The load potential ``-int t . u w ds - sum_B int_B f_B . u_B w dx`` alone: its gradient is ``-l``,
+    the applied loads (surface loads and body forces)."""
     p = sol.problem
     fes = sol.gfu.space
     form = ng.BilinearForm(fes, symmetric=True)
-    return two_body.add_load_potential(form, p.mesh, p.loads, fes.TrialFunction(), elasticity.weight(p.setting))
+    ur, uc = fes.TrialFunction()
+    w = elasticity.weight(p.setting)
+    two_body.add_load_potential(form, p.mesh, p.loads, (ur, uc), w)
+    return two_body.add_body_force_potential(form, p.mesh, p.body_forces, {p.rough: ur, p.counter: uc}, w)

@@ -167,7 +167,7 @@ def equilibrium(sol: MacroSolution) -> dict:
         applied_i + interface_i + supports_i = - sum_{free dofs} r_k v_k
 
     since the elastic energy does not change under a translation:
-    ``applied`` is the surface loads on ``B``, ``interface`` the force the
+    ``applied`` is the surface loads and body force on ``B``, ``interface`` the force the
     interface exerts on ``B``, ``supports`` the reactions of its Dirichlet
     dofs.  The imbalance vanishes at a converged solution; it is reported
     relative to the largest of these forces and of the interface force in

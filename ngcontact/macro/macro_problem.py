@@ -3,15 +3,16 @@
 Minimizes (paper eqs. 44 and 46-48; the Winkler form 69-71)
 
     Pi(u) = sum_B int_B 1/2 sigma(u_B) : eps(u_B) w dx
-            + int_S0 W(J) w ds  -  int_GammaN t . u w ds,
+            + int_S0 W(J) w ds  -  int_GammaN t . u w ds  -  sum_B int_B f_B . u_B w dx,
 
 with ``u_B`` the displacement of body ``B`` (each body its own ``VectorH1``
 on its region, so ``u`` jumps across ``S_0``), the jump
 ``J = u_rough - u_counter`` on ``S_0``, the interface energy ``W`` of
 :mod:`ngcontact.laws.homogenized` in the local frame ``(n0, t0)`` / ``(n0, t1,
 t2)`` and the measure weight ``w`` (``2 pi r`` in axisymmetry).  Dirichlet
-data fix chosen displacement components on labelled boundaries; tractions or
-pressures load others.
+data (constant, tilted or affine ``u0 + G x``) fix chosen displacement
+components on labelled boundaries; tractions or pressures load others, and a
+constant body force ``f_B`` may load each body.
 
 ``n0`` points from ``rough`` into ``counter``.  The mesh's normal on an
 internal boundary has an orientation set by the mesher, so
@@ -108,6 +109,10 @@ class MacroProblem:
         for an interference (press fit).
     supports, loads
         Boundary conditions.
+    body_forces
+        Constant force per unit volume of a body, region -> vector (global
+        components; ``(f_r, f_z)`` in axisymmetry): the potential
+        ``-int_B f . u w dx``.
     order
         Polynomial order of the displacement.
     interface
@@ -130,6 +135,7 @@ class MacroProblem:
     gap: float | ng.CoefficientFunction = 0.0
     supports: tuple[Support, ...] = ()
     loads: tuple[Load, ...] = ()
+    body_forces: dict[str, tuple[float, ...]] = field(default_factory=dict)
     order: int = 2
     interface: str = "interface"
     parts: dict = field(default_factory=dict, init=False, repr=False, compare=False)

@@ -20,13 +20,17 @@ def _pyplot():
 
 
 def epsilon_study(path: str, rows: list, laws) -> None:
-    """Error against ``eps`` (field and reaction) and cost against ``eps``."""
+    """Error against ``eps`` (field and reaction; thin dotted: the field error's discretization estimate, where
+    the rows carry it) and cost against ``eps``."""
     plt = _pyplot()
     eps = np.array([r["eps"] for r in rows])
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
     for name, color in zip(laws, ("C0", "C1", "C2")):
         ax[0].loglog(eps, [r[f"{name}_field"] for r in rows], "o-", color=color, label=f"{name}: field")
         ax[0].loglog(eps, [r[f"{name}_reaction"] for r in rows], "s--", color=color, label=f"{name}: reaction")
+        if f"{name}_field_discretization" in rows[0]:
+            ax[0].loglog(eps, [r[f"{name}_field_discretization"] for r in rows], "x:", color=color, lw=0.8,
+                         label=f"{name}: field, discretization estimate")
     ax[0].loglog(eps, eps / eps[0] * rows[0]["bundle_field"], "k:", label="slope 1")
     ax[0].axhline(0.01, color="gray", lw=0.8)
     ax[0].set_xlabel("eps [m]")
@@ -351,4 +355,29 @@ def ensemble_band(path: str, shrink: dict) -> None:
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def work_precision(path: str, quantity: str, measure: str, series: dict, target: float | None = None) -> None:
+    """Error of ``quantity`` against wall time, log-log, one line per knob (``series``: knob -> (seconds,
+    errors) of its levels; levels with a zero error are left out); the target as a horizontal line."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    drawn = False
+    for k, (knob, (seconds, errors)) in enumerate(series.items()):
+        pts = [(t, e) for t, e in zip(seconds, errors) if t > 0 and e > 0]
+        if pts:
+            ax.loglog([t for t, _ in pts], [e for _, e in pts], "o-", color=f"C{k}", label=knob)
+            drawn = True
+    if target is not None:
+        ax.axhline(target, color="gray", lw=0.8, ls="--", label=f"target {target:g}")
+    if not drawn:
+        ax.text(0.5, 0.5, "every level equals the reference", ha="center", transform=ax.transAxes)
+    ax.set_xlabel("wall time of the level [s]")
+    ax.set_ylabel(f"{measure} error against the finest level")
+    ax.set_title(quantity, fontsize=10)
+    if drawn or target is not None:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -54,6 +54,8 @@ class Outcome:
     vtk: dict[str, VtkField] = field(default_factory=dict)
     plots: dict[str, Callable[..., None]] = field(default_factory=dict)
     arrays: dict[str, np.ndarray] = field(default_factory=dict)
+    #: text files by full name (a scene written beside a study: ``recommended.toml``)
+    texts: dict[str, str] = field(default_factory=dict)
 
 
 class Clock:
@@ -112,7 +114,7 @@ def to_plain(obj, path: str = "results"):
 def file_names(outcome: Outcome) -> list[str]:
     """The names of the files an outcome writes besides ``report.json`` (the report's ``files``)."""
     return sorted([f"{n}.csv" for n in outcome.tables] + [f"{n}.vtu" for n in outcome.vtk]
-                  + [f"{n}.png" for n in outcome.plots] + [f"{n}.npy" for n in outcome.arrays])
+                  + [f"{n}.png" for n in outcome.plots] + [f"{n}.npy" for n in outcome.arrays] + list(outcome.texts))
 
 
 def build_report(*, kind: str, title: str, scene: dict, effects, outcome: Outcome,

@@ -79,6 +79,12 @@ HIGHLIGHTS: dict[str, list[tuple[str, str, str]]] = {
         for law in ("bundle", "linear", "effective") for err in ("field", "reaction")
     ] + [(f"{law} law: rate of the field error in eps", f"results.rates.{law}.field", "")
          for law in ("bundle", "linear", "effective")],
+    "accuracy-study": [
+        ("target", "results.target.statement", ""),
+        ("distinct runs", "results.distinct_runs", ""),
+        ("wall time of every level", "results.seconds_all_levels", "s"),
+        ("wall time of the scene's own level", "results.seconds_own_scene", "s"),
+    ],
 }
 #: per-load columns of a cell's law table (the pressure-closure curve and its contact set)
 LOAD_COLUMNS = ("mean_pressure", "transmitted_pressure", "max_pressure", "contact_fraction", "mean_closure",
@@ -224,6 +230,8 @@ def kind_tables(report: dict) -> str:
     parts = []
     if report.get("kind") == "cell" and isinstance(loads, list) and loads:
         parts.append("<h3>Law per load</h3>" + _rows_table(loads, LOAD_COLUMNS))
+    if report.get("kind") == "accuracy-study":
+        parts.append(study_tables(report))
     if isinstance(history, list) and history:
         parts.append("<h3>Two-scale iterations (max_change: largest pressure change over the interface)</h3>"
                      + _rows_table(history))
@@ -335,6 +343,25 @@ def solver_section(solver: dict) -> str:
         if isinstance(solver.get(key), list) and solver[key]:
             parts.append(f"<p><b>{_e(key)}</b>: {_e(fmt(solver[key]))}</p>")
     return "".join(parts)
+
+
+def study_tables(report: dict) -> str:
+    """An accuracy study's section: per level its largest error, time and unknowns; per knob its rates."""
+    levels = _get(report, "results.levels") or []
+    rows = []
+    for r in levels:
+        qs = r.get("quantities") or {}
+        worst = max(((q.get("error") or 0.0) + (q.get("error_other_knobs") or 0.0) for q in qs.values()),
+                    default=None)
+        rows.append([r.get("knob"), r.get("setting"), "reference" if r.get("reference") else
+                     ("the scene" if r.get("own_scene") else ""), fmt(r.get("seconds"), "s"), fmt(r.get("ndof")),
+                     r.get("failed") or fmt(worst)])
+    rates = _get(report, "results.rates") or {}
+    rate_rows = [[k, v.get("variable"), name, fmt(rate)] for k, v in rates.items()
+                 for name, rate in (v.get("rates") or {}).items()]
+    return ("<h2>Accuracy study</h2><p>" + _e(_get(report, "results.reference") or "") + "</p>"
+            + html_table(["knob", "level", "", "wall time", "unknowns", "largest error (all knobs)"], rows)
+            + "<h3>Observed rates (error ~ x^rate)</h3>" + html_table(["knob", "x", "quantity", "rate"], rate_rows))
 
 
 # ------------------------------------------------------------------ files

@@ -65,9 +65,10 @@ STAGING_PREFIX = ".ngcontact-partial-"
 #: Every file name the package writes into an output directory, and so the only names it ever replaces or
 #: removes: the reports, an outcome's tables, VTK files, plots and arrays (lower-case stems,
 #: :func:`ngcontact.output.report.file_names`) and the law files of ``ngcontact export``
-#: (:data:`ngcontact.export.export_law.FORMATS`).  The manifest is handled apart.
+#: (:data:`ngcontact.export.export_law.FORMATS`) and the scene an accuracy study recommends.  The manifest is
+#: handled apart.
 OWN_NAMES = re.compile(r"report\.json|report\.html|[a-z][a-z0-9_]*\.(?:csv|vtu|png|npy)"
-                       r"|interface_law(?:_[a-z]+)?\.(?:inp|mac|json)")
+                       r"|interface_law(?:_[a-z]+)?\.(?:inp|mac|json)|recommended\.toml")
 
 
 def is_own_name(name: str) -> bool:
@@ -296,6 +297,9 @@ def write_outputs(out_dir: str, report: dict, outcome: Outcome, inputs: Iterable
             draw(os.path.join(tmp, f"{name}.png"))
         for name, array in outcome.arrays.items():
             np.save(os.path.join(tmp, f"{name}.npy"), array, allow_pickle=False)
+        for name, text in outcome.texts.items():
+            with open(os.path.join(tmp, name), "w", encoding="utf-8") as fh:
+                fh.write(text)
         with open(os.path.join(tmp, "report.json"), "w") as fh:
             json.dump(report, fh, indent=2, allow_nan=False)
             fh.write("\n")

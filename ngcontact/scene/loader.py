@@ -21,7 +21,7 @@ try:  # Python >= 3.11
 except ModuleNotFoundError:  # pragma: no cover - exercised on 3.10 only
     import tomli as tomllib
 
-__all__ = ["load", "load_with_contact", "from_dict", "effects", "as_dict", "resolve", "inputs"]
+__all__ = ["load", "load_with_contact", "from_dict", "effects", "as_dict", "resolve", "inputs", "parsed"]
 
 #: Real paths of the scene files being loaded, outermost first: a scene that
 #: names itself, directly or through others, as a cell is refused by name.
@@ -82,6 +82,13 @@ def load_with_contact(path: str | os.PathLike, overrides: dict | None = None, me
     if method is not None:
         data["discretization"] = {**data.get("discretization", {}), "method": method}
     return from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
+
+
+def parsed(path: str | os.PathLike) -> dict:
+    """The TOML table of a scene file as written (no defaults filled in); :func:`load` validates it."""
+    path = os.fspath(path)
+    check_input_file("<scene file>", path, "scene file", missing="no such file", max_bytes=MAX_SCENE_BYTES)
+    return _parsed(path)
 
 
 def _parsed(path: str) -> dict:

@@ -10,6 +10,10 @@ law comes from explicit numbers (``linear`` K0, ``bundle`` of directions,
 ``tabulated`` normal law) or from a ``cell`` scene named by
 ``interface.cell`` (its direction bundle, computed on the fly and cached on
 disk; see :mod:`ngcontact.coupling.cell_law`), with homogenized friction on top.
+Supports are those of the ``direct`` kind (:mod:`ngcontact.scene.supports`:
+constant, tilted, affine ``u0 + G x``, symmetry planes), on any boundary
+label the mesh carries; ``[body_forces]`` loads each body with a constant
+force density.  A ``coaxial`` shape with ``a = 0`` has a solid inner shaft.
 Lengths in metres, stresses in pascals, interface stiffnesses in Pa/m.
 
 Two optional sections extend the macro solve (this kind rather than new kinds,
@@ -32,15 +36,16 @@ from dataclasses import dataclass
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.laws import homogenized as il
-from ngcontact.scene.macro_shapes import (BOUNDARIES, REQUIRED, SETTINGS, SHAPES, check_dimensions,
-                                          check_support_meaning, macro_extent)
+from ngcontact.scene.macro_shapes import (REQUIRED, SETTINGS, SHAPES, boundaries_of, check_dimensions,
+                                          check_shaft_axis, check_support_meaning, macro_extent)
 from ngcontact.scene.macro_shapes import BOUNDARY_DOCS as SHAPE_BOUNDARY_DOCS
 from ngcontact.scene.file_geometry import FILE_BOUNDARY_DOCS, BodySpec, FaceSelectorSpec, check_file_geometry
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
 from ngcontact.scene import cell_links, mesh_size
 from ngcontact.scene.cell_scene import FRICTION
-from ngcontact.scene.schema import at_least, distinct, nonempty, nonnegative, open_interval, param, positive
+from ngcontact.scene.supports import SupportSpec, check_values
+from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
 
 LAWS = ("linear", "bundle", "tabulated", "file")
 #: the kind's boundary labels by (shape, setting), read by the README reference
@@ -59,7 +64,7 @@ class MacroGeometrySpec:
     dimensions: dict[str, float] | None = param(
         None, doc="femur_stem: r_stem, r_tip, r_bone, z_tip, z_corner, z_bone_top, z_stem_top (defaults "
         "exist); coaxial: a, b, c (radii), height (axisymmetric/3d); block: length, h_block, h_base",
-        units="m", allowed="a table of numbers > 0")
+        units="m", allowed="a table of numbers > 0 (coaxial: a >= 0, a = 0 a solid inner shaft)")
     file: str | None = param(None, doc="shape = file: the CAD file (STEP .step/.stp, IGES .iges/.igs, BREP "
                              ".brep/.brp) of two solids (3d) or two planar faces in z = 0 (plane_strain; "
                              "axisymmetric with x = r, y = z; their boundary curves are the faces to select), "
@@ -195,23 +200,21 @@ class InterfaceSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
-class SupportSpec:
-    """Prescribed displacement components on a boundary."""
-
-    boundary: str = param(doc="boundary label of the geometry")
-    components: tuple[str, ...] = param((), doc="components fixed (x, y, z; r, z in axisymmetry); empty: all",
-                                        check=distinct())
-    displacement: tuple[float, ...] = param((), doc="prescribed values, one per component (default 0)",
-                                            units="m")
-
-
-@dataclass(frozen=True, kw_only=True)
 class LoadSpec:
     """Surface load on a boundary."""
 
     boundary: str = param(doc="boundary label of the geometry")
     pressure: float = param(0.0, doc="normal pressure, positive pushes into the body", units="Pa")
     traction: tuple[float, ...] = param((), doc="traction vector (global components)", units="Pa")
+
+
+@dataclass(frozen=True, kw_only=True)
+class BodyForceSpec:
+    """Constant body forces (force per unit volume, e.g. density times gravity), one vector per body."""
+
+    rough: tuple[float, ...] = param((), doc="force density on the rough body (x, y[, z]; r, z in axisymmetry)",
+                                     units="N/m^3")
+    counter: tuple[float, ...] = param((), doc="force density on the counter body", units="N/m^3")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -280,6 +283,7 @@ class MacroScene:
     interface: InterfaceSpec = param(doc="interface law on S_0")
     supports: tuple[SupportSpec, ...] = param(doc="[[supports]]: Dirichlet conditions", check=nonempty())
     loads: tuple[LoadSpec, ...] = param((), doc="[[loads]]: surface loads")
+    body_forces: BodyForceSpec = param(BodyForceSpec(), doc="[body_forces]: constant force densities")
     discretization: Discretization = param(Discretization(), doc="mesh and order")
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     output: OutputSpec = param(OutputSpec(), doc="result sampling")
@@ -293,7 +297,7 @@ class MacroScene:
         if g.shape == "file":   # the extent is known once the file is read (drivers/macro_geometry.py)
             mesh_size.check_lengths({"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
             return
-        mesh_size.check_lengths({f"geometry.dimensions.{k}": v for k, v in (g.dimensions or {}).items()}
+        mesh_size.check_lengths({f"geometry.dimensions.{k}": v for k, v in (g.dimensions or {}).items() if v != 0}
                                 | {"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         dim, volume, interface, width = macro_extent(g.shape, g.setting, dict(g.dimensions or {}))
         n = mesh_size.estimate(dim, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
@@ -305,7 +309,8 @@ class MacroScene:
         self.check_size()
         comps = COMPONENTS[self.geometry.setting]
         shape, setting = self.geometry.shape, self.geometry.setting
-        labels = () if shape == "file" else BOUNDARIES[shape, setting]
+        dims = dict(self.geometry.dimensions or {})
+        labels = () if shape == "file" else boundaries_of(shape, setting, dims)
         groups: tuple[tuple[str, tuple[SupportSpec | LoadSpec, ...]], ...] = (
             ("supports", self.supports), ("loads", self.loads))
         # a file's labels (selected, or named in the file) are checked against the file, before meshing
@@ -314,19 +319,18 @@ class MacroScene:
                 if item.boundary not in labels:
                     raise SceneError(f"{what}[{i}].boundary", item.boundary,
                                      f"no such boundary in {shape!r} ({setting}); labels are " + ", ".join(labels))
-        for i, s in enumerate(self.supports):
-            for c in s.components:
-                if c not in comps:
-                    raise SceneError(f"supports[{i}].components", c, "must be one of " + ", ".join(comps))
-            if s.displacement and len(s.displacement) != len(s.components or comps):
-                raise SceneError(f"supports[{i}].displacement", s.displacement,
-                                 f"one value per component ({len(s.components or comps)})")
+        check_values(self.supports, comps, setting)
         check_supports_once(self.supports, comps)
         check_support_meaning(self.supports, comps, self.geometry.setting)
+        check_shaft_axis(self.supports, shape, setting, dims)
         dim = 3 if self.geometry.setting == "3d" else 2
         for i, load in enumerate(self.loads):
             if load.traction and len(load.traction) != dim:
                 raise SceneError(f"loads[{i}].traction", load.traction, f"must have {dim} components")
+        for role in ("rough", "counter"):
+            f = getattr(self.body_forces, role)
+            if f and len(f) != dim:
+                raise SceneError(f"body_forces.{role}", f, f"one number per component ({', '.join(comps)})")
         if self.interface.gap_coordinate == "z" and dim == 2 and self.geometry.setting != "axisymmetric":
             raise SceneError("interface.gap_coordinate", "z", "plane strain has coordinates x, y")
         cell_links.check(self.interface, self.two_scale)
@@ -418,8 +422,10 @@ def effects(scene: MacroScene) -> tuple[str, ...]:
         out.append("tresca_friction")
     if any(load.pressure or load.traction for load in scene.loads):
         out.append("surface_loads")
-    if any(any(s.displacement) for s in scene.supports):
+    if any(any(s.displacement) or any(s.slope) or any(s.u0) or any(any(r) for r in s.G) for s in scene.supports):
         out.append("prescribed_displacement")
+    if any(scene.body_forces.rough) or any(scene.body_forces.counter):
+        out.append("body_forces")
     if scene.two_scale is not None:
         out.append("two_scale_coupling")
     if scene.strength is not None:

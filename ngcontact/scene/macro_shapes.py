@@ -24,14 +24,22 @@ SETTINGS = {"femur_stem": ("axisymmetric", "3d"), "coaxial": ("plane_strain", "a
 DIMENSIONS = {"femur_stem": tuple(f.name for f in dataclasses.fields(FemurStemDims)),
               "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base"), "file": ()}
 REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base"), "file": ()}
+#: dimensions that may be 0, with what that means
+MAY_BE_ZERO = {("coaxial", "a"): "must be >= 0 (a > 0: the inner body is a tube; a = 0: a solid shaft)"}
+
+
 def check_dimensions(dims: dict, path: str, shape: str, required) -> None:
-    """A ``dimensions`` table: positive, known for ``shape``, the ``required`` ones present.
+    """A ``dimensions`` table: positive (``coaxial``'s inner radius ``a`` may be 0: a solid shaft), known for
+    ``shape``, the ``required`` ones present.
 
     For ``femur_stem`` the completed dimensions must also describe a valid
     femur and stem (:class:`ngcontact.geometry.femur.FemurStemDims`).
     """
     for key in dims:
-        if not dims[key] > 0:
+        if (shape, key) in MAY_BE_ZERO:
+            if not dims[key] >= 0:
+                raise SceneError(f"{path}.{key}", dims[key], MAY_BE_ZERO[shape, key])
+        elif not dims[key] > 0:
             raise SceneError(f"{path}.{key}", dims[key], "must be > 0")
         if key not in DIMENSIONS[shape]:
             raise SceneError(f"{path}.{key}", dims[key],
@@ -62,7 +70,9 @@ FEMUR_BOUNDARIES = {
     "base": "base of the femur (clamp it)",
 }
 _COAXIAL = {"interface": "r = b between the tubes; carries the law", "bore": "inner surface r = a of the inner "
-            "tube (a must be > 0: the inner body is always a tube)", "mantle": "outer surface r = c of the outer tube"}
+            "tube (a > 0: the inner body is a tube; with a = 0 it is a solid shaft and has no bore; in "
+            "axisymmetry its edge r = 0 is then the boundary axis, where r must be fixed: components = [\"r\"])",
+            "mantle": "outer surface r = c of the outer tube"}
 _QUARTER = {"sym_x": "the cut on the plane x = 0, a symmetry plane: fix x there (components = [\"x\"])",
             "sym_y": "the cut on the plane y = 0, a symmetry plane: fix y there (components = [\"y\"])"}
 _ENDS = {"bottom": "end face z = 0 of both tubes", "top": "end face z = height of both tubes"}
@@ -83,12 +93,46 @@ BOUNDARY_DOCS: dict[tuple[str, str], dict[str, str]] = {
         "base_sides": "left and right faces of the base"},
 }
 BOUNDARIES = {key: tuple(sorted(labels)) for key, labels in BOUNDARY_DOCS.items()}
+#: the boundary of a solid coaxial shaft (a = 0) on the axis r = 0 in axisymmetry
+SHAFT_AXIS = "axis"
+
+
+def boundaries_of(shape: str, setting: str, dims: dict) -> tuple[str, ...]:
+    """The boundary labels the mesh of ``shape`` in ``setting`` with ``dims`` has.
+
+    Those of :data:`BOUNDARIES`, except a solid coaxial shaft (``a = 0``):
+    no ``bore``, and in axisymmetry its edge on the axis, ``axis``.
+    """
+    labels = BOUNDARIES[shape, setting]
+    if shape == "coaxial" and dims.get("a") == 0:
+        labels = tuple(sorted({*labels} - {"bore"} | ({SHAFT_AXIS} if setting == "axisymmetric" else set())))
+    return labels
+
+
+def check_shaft_axis(supports, shape: str, setting: str, dims: dict) -> None:
+    """An axisymmetric solid shaft has ``u_r = 0`` on its axis: a support on ``axis`` must fix ``r``.
+
+    The hoop strain ``u_r / r`` of the axisymmetric energy is finite at
+    ``r = 0`` only when ``u_r`` vanishes there.
+    """
+    if not (shape == "coaxial" and setting == "axisymmetric" and dims.get("a") == 0):
+        return
+    if not any(s.boundary == SHAFT_AXIS and (s.symmetry or not s.components or "r" in s.components)
+               and not any(s.displacement) and not s.affine() for s in supports):
+        raise SceneError("supports", [s.boundary for s in supports], "a solid shaft (coaxial with a = 0) in "
+                         "axisymmetry needs u_r = 0 on its axis: add [[supports]] boundary = \"axis\", "
+                         "components = [\"r\"]")
 #: A symmetry plane and the one component its support fixes.
 SYMMETRY_PLANES = {"sym_x": "x", "sym_y": "y"}
 
 
 def check_support_meaning(supports, comps: tuple[str, ...], setting: str) -> None:
     """A symmetry plane fixes its normal component only, and every translation is fixed somewhere.
+
+    A support with ``symmetry = true`` fixes its plane's normal component;
+    on a boundary whose plane is not known before meshing the translation
+    check is left to the rigid-motion check on the mesh
+    (:func:`ngcontact.fem.rigid_modes.check_rigid_modes`).
 
     Swapping the components of the two symmetry supports of a quarter ran
     without complaint and gave a mean pressure 10 % off; a base held only
@@ -98,11 +142,14 @@ def check_support_meaning(supports, comps: tuple[str, ...], setting: str) -> Non
     """
     for i, s in enumerate(supports):
         normal = SYMMETRY_PLANES.get(s.boundary)
-        if normal is not None and tuple(s.components) != (normal,):
+        if normal is not None and tuple(s.components) != (normal,) and not s.symmetry:
             raise SceneError(f"supports[{i}].components", list(s.components) or list(comps),
                              f"{s.boundary!r} is the symmetry plane {normal} = 0: fix only its normal component "
                              f"[{normal!r}] there")
-    fixed = {c for s in supports for c in (s.components or comps)}
+    if any(s.symmetry and s.boundary not in SYMMETRY_PLANES for s in supports):
+        return   # a plane's normal is known from the mesh only: the rigid-motion check of the solve has it
+    fixed = {c for s in supports
+             for c in ((SYMMETRY_PLANES[s.boundary],) if s.symmetry else (s.components or comps))}
     needed = ("z",) if setting == "axisymmetric" else comps
     for c in needed:
         if c not in fixed:

@@ -43,8 +43,9 @@ from ngcontact.scene.macro_shapes import FEMUR_BOUNDARIES, check_dimensions, che
 from ngcontact.scene.sections import (ComputeSpec, MaterialSpec, check_supports_once, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import (MAX_ORDER, MAX_PERIODS, at_least, closed_interval, distinct, nonempty, param,
-                                    positive)
+from ngcontact.scene.supports import SupportSpec, check_values
+from ngcontact.scene.schema import (MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty,
+                                    open_interval, param, positive)
 
 #: The shapes (:data:`ngcontact.geometry.resolved_shapes.RESOLVED_SHAPES`: what each one is built and measured
 #: by); this module validates a scene against their settings, keys and boundary labels.
@@ -114,20 +115,6 @@ class DirectBodies:
 
 
 @dataclass(frozen=True, kw_only=True)
-class DirectSupport:
-    """Prescribed displacement components on a boundary, constant or linear along it (a tilt)."""
-
-    boundary: str = param(doc="a boundary of the shape",
-                          allowed="; ".join(f"{shape}: " + ", ".join(labels) for shape, labels in BOUNDARIES.items()))
-    components: tuple[str, ...] = param((), doc="components fixed (x, y or r, z); empty: all", check=distinct())
-    displacement: tuple[float, ...] = param((), doc="value at the boundary's mid-point, one per component "
-                                            "(default 0)", units="m")
-    slope: tuple[float, ...] = param((), doc="change of each prescribed component per metre along the "
-                                     "boundary: along x (r) on horizontal boundaries, y (z) on vertical ones "
-                                     "(default 0)", units="m/m")
-
-
-@dataclass(frozen=True, kw_only=True)
 class DirectLoad:
     """Surface load on a boundary."""
 
@@ -165,6 +152,13 @@ class StudySpec:
         allowed="pairs of numbers inside a body, outside the band of the coarsest level")
     grid: tuple[int, int] = param((100, 50), doc="sampling grid of the field error: (nx, ny) per block, "
                                   "or (nr, nz) over the femur's bounding box", check=at_least(4))
+    refinement: float = param(2.0, doc="each level is solved again with every mesh size divided by this factor "
+                              "(maxh, eps / elements_per_period, interface_maxh); the change of each error "
+                              "between the two estimates its discretization error", check=closed_interval(1.5, 8))
+    discretization_share: float = param(0.1, doc="the rates in eps are fitted on the levels whose discretization "
+                                        "estimate is at most this share of the error (the modelling error, not "
+                                        "the meshes'); fewer than three such levels: no rate, and the report "
+                                        "says why", check=open_interval(0, 1))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -174,7 +168,7 @@ class DirectScene:
     materials: dict[str, MaterialSpec] = param(doc="named materials", check=nonempty())
     bodies: DirectBodies = param(doc="materials of the blocks")
     geometry: DirectGeometry = param(doc="blocks and resolved roughness")
-    supports: tuple[DirectSupport, ...] = param(doc="[[supports]]: Dirichlet conditions", check=nonempty())
+    supports: tuple[SupportSpec, ...] = param(doc="[[supports]]: Dirichlet conditions", check=nonempty())
     loads: tuple[DirectLoad, ...] = param((), doc="[[loads]]: surface loads")
     discretization: DirectMesh = param(doc="mesh and order")
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
@@ -190,22 +184,14 @@ class DirectScene:
                 raise SceneError(f"materials.{name}.C", "...", "direct scenes take isotropic E, nu")
         g = self.geometry
         labels, comps = BOUNDARIES[g.shape], COMPONENTS[g.setting]
-        groups: tuple[tuple[str, tuple[DirectSupport | DirectLoad, ...]], ...] = (
+        groups: tuple[tuple[str, tuple[SupportSpec | DirectLoad, ...]], ...] = (
             ("supports", self.supports), ("loads", self.loads))
         for key, items in groups:
             for i, item in enumerate(items):
                 if item.boundary not in labels:
                     raise SceneError(f"{key}[{i}].boundary", item.boundary,
                                      f"one of {', '.join(labels)} (shape {g.shape!r})")
-        for i, s in enumerate(self.supports):
-            for c in s.components:
-                if c not in comps:
-                    raise SceneError(f"supports[{i}].components", c, f"must be one of {', '.join(comps)}")
-            n = len(s.components or comps)
-            for key in ("displacement", "slope"):
-                v = getattr(s, key)
-                if v and len(v) != n:
-                    raise SceneError(f"supports[{i}].{key}", v, f"one value per component ({n})")
+        check_values(self.supports, comps, g.setting)
         check_supports_once(self.supports, comps)
         check_support_meaning(self.supports, comps, g.setting)
         self.check_size()
@@ -310,7 +296,7 @@ def effects(scene: DirectScene) -> tuple[str, ...]:
             out.append(f"{cell.contact.friction}_friction")
     if any(load.pressure or any(load.traction) for load in scene.loads):
         out.append("surface_loads")
-    if any(any(s.displacement) or any(s.slope) for s in scene.supports):
+    if any(any(s.displacement) or any(s.slope) or any(s.u0) or any(any(r) for r in s.G) for s in scene.supports):
         out.append("prescribed_displacement")
     return tuple(out)
 

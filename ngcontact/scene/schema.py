@@ -300,7 +300,8 @@ def describe(cls, path: str = "") -> list[dict]:
     """Rows (key, type, default, units, allowed, meaning) of a scene section.
 
     Nested dataclasses are expanded; ``dict[str, Section]`` fields appear as
-    ``path.NAME.key``.
+    ``path.NAME.key``; an array of tables (``tuple[Section, ...]``) has its
+    own row and its entries' keys as ``path[].key``.
     """
     rows = []
     hints = typing.get_type_hints(cls)
@@ -321,6 +322,9 @@ def describe(cls, path: str = "") -> list[dict]:
                      "units": f.metadata.get("units", ""),
                      "allowed": _allowed_text(f, tp),
                      "doc": f.metadata.get("doc", "")})
+        entries = typing.get_args(inner) if typing.get_origin(inner) is tuple else ()
+        if len(entries) == 2 and entries[1] is Ellipsis and dataclasses.is_dataclass(entries[0]):
+            rows.extend(describe(entries[0], key + "[]"))
     return rows
 
 

@@ -191,7 +191,7 @@ def check_supports_once(supports, comps) -> None:
     """
     seen: dict[tuple[str, str], int] = {}
     for i, s in enumerate(supports):
-        for c in (s.components or comps):
+        for c in (() if getattr(s, "symmetry", False) else (s.components or comps)):
             j = seen.setdefault((s.boundary, c), i)
             if j != i:
                 raise SceneError(f"supports[{i}]", s.boundary, f"fixes component {c!r} of boundary "

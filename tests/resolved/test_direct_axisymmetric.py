@@ -176,6 +176,12 @@ def test_femur_bundle_error_falls_with_eps():
         assert rows[-1][f"bundle_{key}"] < 0.2 * rows[-1][f"linear_{key}"], (key, rows[-1])
     assert rows[-1]["bundle_interface"] < rows[-1]["linear_interface"], rows[-1]
     assert "moment" not in rates["bundle"]       # axisymmetric reactions carry no moment
+    # the rates rest on levels whose meshes are a small share of the error (the separation of the two errors)
+    assert res["rate_levels"]["bundle"]["field"] == [4, 8, 16]
+    assert all(r["bundle_field_discretization"] <= 0.1 * r["bundle_field"] for r in rows), rows
+    # the base carries the whole load: its reaction error is round-off, and no rate is made of it
+    assert rates["bundle"]["reaction"] is None
+    assert res["refused"]["bundle"]["reaction"].startswith("the error is at round-off")
 
 
 @pytest.mark.slow

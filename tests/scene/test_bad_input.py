@@ -321,7 +321,8 @@ def test_misspelled_material_constant(tmp_path, capsys):
 def test_misspelled_key_of_an_array_of_tables(tmp_path, capsys):
     text = edit(MACRO, ('boundary = "bottom"', 'boundry = "bottom"'))
     run_bad(tmp_path, capsys, text,
-            "supports[0].boundry = 'bottom': unknown key; allowed keys here are boundary, components, displacement")
+            "supports[0].boundry = 'bottom': unknown key; allowed keys here are G, boundary, components, "
+            "displacement, slope, symmetry, u0")
 
 
 def test_unknown_kind(tmp_path, capsys):
@@ -906,12 +907,20 @@ def test_a_component_given_twice_is_refused(tmp_path, capsys):
 
 
 def test_the_bore_label_states_the_rule_the_dimensions_enforce(tmp_path, capsys):
-    """Was: 'a > 0: the inner body is a tube', as if a = 0 (a solid rod) were allowed; it is refused."""
+    """Was: 'a > 0: the inner body is a tube', as if a = 0 (a solid rod) were allowed, and a = 0 was refused.
+
+    Now a = 0 is a solid shaft (no bore) and the label says so; a < 0 is refused with the rule.
+    """
     from ngcontact.scene.macro_shapes import BOUNDARY_DOCS
     for setting in ("plane_strain", "axisymmetric", "3d"):
-        assert "a must be > 0" in BOUNDARY_DOCS["coaxial", setting]["bore"]
-    run_bad(tmp_path, capsys, edit(COAXIAL, ("a = 0.01", "a = 0.0")),
-            "geometry.dimensions.a = 0.0: must be > 0", prefix=True)
+        assert "with a = 0 it is a solid shaft and has no bore" in BOUNDARY_DOCS["coaxial", setting]["bore"]
+    run_bad(tmp_path, capsys, edit(COAXIAL, ("a = 0.01", "a = -0.01")),
+            "geometry.dimensions.a = -0.01: must be >= 0 (a > 0: the inner body is a tube; a = 0: a solid shaft)",
+            prefix=True)
+    scene = tmp_path / "shaft.toml"
+    scene.write_text(edit(COAXIAL, ("a = 0.01", "a = 0.0")))
+    assert cli.main(["check", str(scene)]) == 0
+    capsys.readouterr()
 
 
 def test_a_mesher_failure_of_a_plain_cell_names_the_size_ratio(tmp_path, capsys):

@@ -1,0 +1,116 @@
+"""The headline quantities of a run's report, and the errors the report estimates for them.
+
+What an engineer reads first of each kind, as ``{name: value}`` (plain numbers):
+
+* cell: per load ``k`` the contact fraction ``contact_fraction_load{k}``, the mean closure
+  ``mean_closure_load{k}`` and the normal effective stiffness ``effective_stiffness_load{k}`` (the
+  ``n0 n0`` entry of the tangent of the mean traction, :mod:`ngcontact.cell.fe.stiffness`); a cell
+  without loads: the whole-surface coefficients of paper eq. 34 (``whole_surface_k_n``, ...);
+* macro (also two-scale): the peak interface pressure ``peak_pressure``, the magnitude of the interface
+  resultant ``resultant``, the largest von Mises stress ``max_von_mises`` and, with ``[strength]``, the
+  safety factor of paper eq. 78 ``safety_factor``;
+* direct: the resolved contact fraction ``contact_fraction`` and the magnitude of the contact force
+  ``contact_force``.
+
+A report that estimates its own errors lists them in ``results.accuracy.quantities`` (per quantity its
+``name``, ``value``, absolute ``error`` and, for a load of a cell, ``load``): those quantities join the
+headline ones under the same names (``{name}_load{k}`` for a load), with their estimated absolute error.
+
+A fraction (contact fraction, contact area share) is compared in absolute terms, every other quantity
+relative to its value (:func:`measure`), as a cell's ``discretization.tolerance`` controls them.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+#: quantities compared in absolute terms (fractions in [0, 1]); every other one relative to its value
+ABSOLUTE = ("contact_fraction", "contact_area", "whole_surface_contact_fraction")
+
+
+def measure(name: str) -> str:
+    """``absolute`` for a fraction, else ``relative``."""
+    return "absolute" if name.startswith(ABSOLUTE) else "relative"
+
+
+def _number(x) -> float | None:
+    return float(x) if isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) else None
+
+
+def _get(tree, path: str):
+    for part in path.split("."):
+        if not isinstance(tree, dict):
+            return None
+        tree = tree.get(part)
+    return tree
+
+
+def _norm(value) -> float | None:
+    """A scalar, or the Euclidean norm of a list or of a dict of components."""
+    if isinstance(value, dict):
+        value = list(value.values())
+    if isinstance(value, list):
+        parts = [_number(v) for v in value]
+        return None if not parts or None in parts else math.sqrt(sum(v * v for v in parts))  # type: ignore
+    return _number(value)
+
+
+def _normal_stiffness(entry: dict) -> float | None:
+    eff = entry.get("effective_stiffness")
+    if not isinstance(eff, dict) or "n0" not in (eff.get("components") or []):
+        return None
+    k = eff["components"].index("n0")
+    return _number(eff["matrix"][k][k])
+
+
+def cell_quantities(results: dict) -> dict[str, float | None]:
+    loads = results.get("loads")
+    if not loads:
+        return {f"whole_surface_{k}": _number(v) for k, v in (results.get("whole_surface") or {}).items()}
+    out: dict[str, float | None] = {}
+    for k, entry in enumerate(loads):
+        out[f"contact_fraction_load{k}"] = _number(entry.get("contact_fraction"))
+        out[f"mean_closure_load{k}"] = _number(entry.get("mean_closure"))
+        out[f"effective_stiffness_load{k}"] = _normal_stiffness(entry)
+    return out
+
+
+def macro_quantities(results: dict) -> dict[str, float | None]:
+    return {"peak_pressure": _number(_get(results, "maxima.pressure.pressure")),
+            "resultant": _norm(results.get("resultant")),
+            "max_von_mises": _number(_get(results, "maxima.von_mises.max.value")),
+            "safety_factor": _number(_get(results, "strength.safety_factor"))}
+
+
+def direct_quantities(results: dict) -> dict[str, float | None]:
+    return {"contact_fraction": _number(results.get("contact_fraction")),
+            "contact_force": _norm(results.get("contact_force"))}
+
+
+QUANTITIES = {"cell": cell_quantities, "macro": macro_quantities, "direct": direct_quantities}
+
+
+def _name(entry: dict) -> str:
+    load = entry.get("load")
+    return str(entry["name"]) + ("" if load is None else f"_load{load}")
+
+
+def estimated(report: dict) -> list[dict[str, Any]]:
+    """The entries of ``results.accuracy.quantities`` that name a quantity and give a finite error."""
+    entries = _get(report, "results.accuracy.quantities") or []
+    return [e for e in entries if isinstance(e, dict) and isinstance(e.get("name"), str)
+            and _number(e.get("error")) is not None]
+
+
+def headline(report: dict) -> dict[str, dict[str, float | None]]:
+    """``{name: {"value", "estimate"}}`` of a report: its kind's headline quantities and those its accuracy
+    record estimates (``estimate``: the absolute error the report estimates, else None)."""
+    results = report.get("results") or {}
+    out = {name: {"value": v, "estimate": None}
+           for name, v in QUANTITIES[report["kind"]](results).items() if v is not None}
+    for entry in estimated(report):
+        name = _name(entry)
+        value = _number(entry.get("value"))
+        if name in out or value is not None:
+            out.setdefault(name, {"value": value, "estimate": None})["estimate"] = abs(float(entry["error"]))
+    return out

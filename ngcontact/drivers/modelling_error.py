@@ -1,0 +1,172 @@
+"""The modelling error of a homogenized solution against the resolved one, and how much of it is discretization.
+
+Paper Sec. 3.3 (Prop. 29): the resolved solution ``u^eps`` converges to the homogenized ``u^0`` as the
+period ``eps`` falls.  What a study measures is the difference of two *discrete* solutions,
+
+    e_h = Q(u^0_h) - Q(u^eps_h) = [Q(u^0) - Q(u^eps)] + [d^0_h - d^eps_h],
+
+the modelling error plus the difference of the two discretization errors ``d_h``.  Once the modelling
+error is small, the second bracket dominates and a rate fitted to ``|e_h|`` measures the meshes, not
+the model.  Each quantity ``Q`` (the :data:`ERRORS`) is therefore compared on two discretizations of
+the same level, the scene's and one refined by a factor ``r``; the change of the signed difference,
+
+    delta = |e_h - e_(h/r)|,
+
+estimates the discretization error of ``e_h``, and bounds that of ``e_(h/r)`` once both discretization
+errors contract by ``1/r`` or faster (order 2 elements away from corners contract by ``r^-2`` or
+faster; at the re-entrant corners of the resolved valleys by about ``r^-1``).  The modelling error
+reported is the refined pair's, with ``delta`` beside it (:func:`discretization_errors`): a vector
+quantity (the field, the reactions, the probes, the interface force) compares the vectors ``e``, so
+that the estimate is a norm of the change, not the change of a norm.
+
+Errors of a homogenized solution against the resolved solution ``u^eps`` (:func:`errors`):
+
+* ``field``: relative L2 error of the displacement outside the band of half-width ``band * eps``
+  around ``S_0``, ``||u_h - u^eps|| / ||u^eps||`` (axisymmetric: with the weight ``2 pi r``), by the
+  midpoint rule on a uniform grid (blocks: of each block; femur: of the bounding box, points in the
+  bodies only), the same points for every law and discretization;
+* ``reaction``: ``|R_h - R^eps| / |R^eps|`` of the force vector (the fixed components) on each
+  supported boundary (maximum over the boundaries).  When the supports carry the whole load (the
+  femur's base) equilibrium fixes this number; it then only shows the discretization error;
+* ``moment``: relative error of the reaction moment (plane strain; maximum over the boundaries);
+* ``probe``: largest ``|u_h - u^eps|`` at the probe points divided by the largest ``|u^eps|`` there;
+* ``interface``: ``|F_h - F^eps| / |F^eps|`` of the force transmitted through a part of the interface,
+  an interface resultant that equilibrium does not fix: blocks, the left half ``x < x0 + L/2``; femur,
+  the axial force through the cylindrical part ``z > z_corner`` (the rest goes through the cone).
+"""
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import ngsolve as ng
+import numpy as np
+
+from ngcontact.drivers import run_resolved as drv
+from ngcontact.fem import elasticity
+from ngcontact.fem.quadrature import resultant_order
+from ngcontact.macro import macro_measures as MM
+from ngcontact.macro import macro_problem as M
+from ngcontact.resolved import resolved_problem as D
+
+ERRORS = ("field", "reaction", "moment", "probe", "interface")
+#: what each error measures (the report's ``error_definitions``)
+DEFINITIONS = dict(zip(ERRORS, (
+    "relative L2 displacement error outside the band of half-width band * eps around S_0",
+    "largest relative error of a support's reaction force vector",
+    "largest relative error of a support's reaction moment",
+    "largest displacement error at the probes / largest resolved probe displacement",
+    "relative error of the force through a part of the interface (blocks: x < x0 + L/2; femur: axial force "
+    "through the cylinder z > z_corner)")))
+
+
+def interface_force(sol: D.DirectSolution | M.MacroSolution, part=None) -> np.ndarray:
+    """Force the counter receives through a part of the interface (resolved or flat).
+
+    ``int tau w ds`` over the part given by the indicator CoefficientFunction
+    ``part`` (default: all of it); ``w = 2 pi r`` in axisymmetry.  Resolved:
+    the micro pressure along the micro normal on ``S_C^eps``; homogenized:
+    the law's traction in the frame of ``S_0``.
+    """
+    if isinstance(sol, D.DirectSolution):
+        return D.contact_force(sol, part=part)
+    p = sol.problem
+    mesh = p.mesh
+    glob = sum((t * e for t, e in zip(MM.interface_tractions(sol), sol.frame)), ng.CF((0.0, 0.0)))
+    ind = ng.CF(1.0) if part is None else part
+    w = elasticity.weight(p.setting)
+    return np.asarray(ng.Integrate(glob * ind * w, mesh, ng.BND, definedon=mesh.Boundaries(p.interface),
+                                   order=resultant_order(p.order)), float).ravel()
+
+
+def sample_grid(scene, band: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Midpoints, weights and bodies (0 rough, 1 counter) of a uniform grid outside the band.
+
+    Blocks: ``nx x ny`` cells in each block outside ``|y| <= band``.  Femur:
+    ``nr x nz`` cells over the bounding box ``[0, r_bone] x [0, z_stem_top]``,
+    keeping the midpoints inside a body and farther than ``band`` from
+    ``S_0``.  Axisymmetric weights carry the factor ``2 pi r``.
+    """
+    g = scene.geometry
+    pts, wts = drv.shape_of(scene).sample_grid(scene.study.grid, band)
+    if g.setting == "axisymmetric":
+        wts = wts * 2.0 * np.pi * pts[:, 0]
+    return pts, wts, drv.body_of(scene, pts)
+
+
+def displacement_at(sol: D.DirectSolution | M.MacroSolution, points: np.ndarray, body=None) -> np.ndarray:
+    """Displacement at ``points``, shape ``(m, 2)``.
+
+    ``body``: per point 0 (rough) or 1 (counter); default: rough below ``y = 0``.
+    """
+    mesh = sol.problem.mesh
+    if body is None:
+        body = np.where(points[:, 1] < 0, 0, 1)
+    out = np.empty((len(points), 2))
+    for mask, u in ((body == 0, sol.u_rough), (body == 1, sol.u_counter)):
+        if np.any(mask):
+            mp = mesh(points[mask, 0], points[mask, 1])
+            out[mask] = np.asarray(u(mp)).reshape(-1, 2)
+    return out
+
+
+def measures(scene, sol: D.DirectSolution | M.MacroSolution, points: np.ndarray, body=None) -> dict:
+    """The quantities of interest of one solution (resolved or homogenized).
+
+    In axisymmetry the interface force keeps its axial component only (the
+    radial entry integrates a line load that has no net resultant).
+    """
+    force = interface_force(sol, part=drv.interface_part(scene))
+    if scene.geometry.setting == "axisymmetric":
+        force = force[1:]
+    return {"reactions": drv.reactions(scene, sol),
+            "probes": np.asarray(drv.probes(scene, sol), float).reshape(-1, 2),
+            "interface": force,
+            "field": displacement_at(sol, points, body)}
+
+
+def errors(ref: dict, other: dict, weights: np.ndarray) -> dict:
+    """Relative errors of ``other`` against the resolved ``ref`` (see the module docstring)."""
+    diff = other["field"] - ref["field"]
+    field = np.sqrt(np.sum(weights[:, None] * diff ** 2) / np.sum(weights[:, None] * ref["field"] ** 2))
+    force, moment, has_moment = 0.0, 0.0, False
+    for label, r in ref["reactions"].items():
+        o = other["reactions"][label]
+        keys = [k for k in r if k != "moment"]
+        if keys:
+            fr = np.array([r[k] for k in keys])
+            fo = np.array([o[k] for k in keys])
+            force = max(force, float(np.linalg.norm(fo - fr) / np.linalg.norm(fr)))
+        if "moment" in r:
+            has_moment = True
+            moment = max(moment, abs(o["moment"] - r["moment"]) / abs(r["moment"]))
+    out = {"field": float(field), "reaction": force,
+           "interface": float(np.linalg.norm(other["interface"] - ref["interface"])
+                              / np.linalg.norm(ref["interface"]))}
+    if has_moment:
+        out["moment"] = float(moment)
+    if len(ref["probes"]):
+        out["probe"] = float(np.max(np.linalg.norm(other["probes"] - ref["probes"], axis=1))
+                             / np.max(np.linalg.norm(ref["probes"], axis=1)))
+    return out
+
+
+def combine(fn: Callable[..., Any], *trees):
+    """``fn`` applied leaf by leaf to measures of the same structure (nested dicts of numbers and arrays)."""
+    first = trees[0]
+    if isinstance(first, dict):
+        return {k: combine(fn, *(t[k] for t in trees)) for k in first}
+    return fn(*(np.asarray(t, float) for t in trees))
+
+
+def discretization_errors(resolved: dict, homogenized: dict, resolved_fine: dict, homogenized_fine: dict,
+                          weights: np.ndarray) -> dict:
+    """The estimate ``delta = |e_h - e_(h/r)|`` of each error (module docstring), relative to the refined
+    resolved solution's size, as :func:`errors` measures it.
+
+    Each argument is :func:`measures` of one solution: the resolved and the homogenized one on the
+    scene's discretization, then both on the refined one.  ``errors(R, R + (e_h - e_(h/r)))`` is the
+    norm of the change of the signed difference in each error's own measure.
+    """
+    shifted = combine(lambda r, h, rf, hf: rf + (h - r) - (hf - rf), resolved, homogenized, resolved_fine,
+                      homogenized_fine)
+    return errors(resolved_fine, shifted, weights)

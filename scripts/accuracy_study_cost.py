@@ -1,0 +1,92 @@
+"""What the accuracy study of a scene costs beside one run of the scene, and what it finds.
+
+Runs ``ngcontact study accuracy SCENE`` into ``OUT/study`` and then ``ngcontact run SCENE`` into ``OUT/run``
+(each as a user runs it, in a process of its own, timed from start to exit), and writes
+``OUT/accuracy_study_cost.csv``: per level of the study its knob, setting, wall time, unknowns and the error
+of each headline quantity against its knob's finest level (``ngcontact.drivers.study_accuracy``), each
+knob's observed rates, then a row with the whole study's wall time and one with the single run's.  Issue 35
+aims at a study of the femur in less than 20 times one solve.
+
+    python scripts/accuracy_study_cost.py [SCENE] [--out OUT] [--levels N] [--figure QUANTITY] [--publish]
+
+Default scene ``geometries/femur_stem.toml``; ``--figure`` names the quantity whose work-precision plot
+the published section shows (default: the first).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+
+from ngcontact.output.writer import write_csv  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def timed(args: list[str]) -> float:
+    """Wall time of ``python -m ngcontact ARGS`` (which must succeed)."""
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "ngcontact", *args, "--quiet"], check=True)
+    return time.perf_counter() - t0
+
+
+def rows(results: dict, study_seconds: float, run_seconds: float) -> tuple[list[str], list[list]]:
+    """The table: one row per level, then the whole study and the single run."""
+    names = list(dict.fromkeys(n for lv in results["levels"] for n in (lv.get("quantities") or {})))
+    header = ["knob", "setting", "role", "seconds", "ndof"] + [f"error_{n}" for n in names]
+    out = []
+    for lv in results["levels"]:
+        role = "reference" if lv["reference"] else ("scene" if lv["own_scene"] else "")
+        qs = lv.get("quantities") or {}
+        out.append([lv["knob"], lv["setting"].replace("discretization.", ""), role or "-",
+                    lv.get("seconds", ""), lv.get("ndof", "")]
+                   + [(qs.get(n) or {}).get("error", "") for n in names])
+    for knob, fit in results["rates"].items():
+        out.append([knob, f"rate in {fit['variable']}", "rate", "", ""]
+                   + [fit["rates"].get(n) if fit["rates"].get(n) is not None else "" for n in names])
+    blank = [""] * len(names)
+    out.append(["whole study", f"{results['distinct_runs']} runs", "wall", study_seconds, ""] + blank)
+    out.append(["one run", "the scene", "wall", run_seconds, ""] + blank)
+    return header, out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("scene", nargs="?", default=os.path.join(ROOT, "geometries", "femur_stem.toml"))
+    ap.add_argument("--out", default=os.path.join("results", "accuracy_study_cost"))
+    ap.add_argument("--levels", type=int, default=4)
+    ap.add_argument("--figure", help="the quantity whose plot is published (default: the first)")
+    benchmark_doc.add_flag(ap)
+    args = ap.parse_args(argv)
+    study_dir, run_dir = os.path.join(args.out, "study"), os.path.join(args.out, "run")
+    study_seconds = timed(["study", "accuracy", args.scene, "--out", study_dir, "--levels", str(args.levels)])
+    run_seconds = timed(["run", args.scene, "--out", run_dir])
+    with open(os.path.join(study_dir, "report.json")) as fh:
+        results = json.load(fh)["results"]
+    header, table = rows(results, study_seconds, run_seconds)
+    csv_path = os.path.join(args.out, "accuracy_study_cost.csv")
+    write_csv(csv_path, header, table)
+    print(f"study {study_seconds:.1f} s, one run {run_seconds:.1f} s: {study_seconds / run_seconds:.2f} runs")
+    if args.publish:
+        figure = args.figure or header[5][len("error_"):]
+        stem = os.path.splitext(os.path.basename(args.scene))[0]
+        benchmark_doc.publish(f"accuracy_study_{stem}", f"Accuracy study of `{stem}`: errors, rates and cost",
+                              csv_path, png=os.path.join(study_dir, f"accuracy_{figure}.png"),
+                              note="`ngcontact study accuracy` on the scene (default 4 levels per knob: two "
+                              "coarser than the scene, the scene, one finer), then `ngcontact run` of the scene "
+                              "alone, each timed from start to exit on the same machine. Errors are against the "
+                              "finest level of each knob (relative; 0 for that level); the rows `rate` give each "
+                              "knob's observed rate (the slope of log error against log x over the other levels; "
+                              "empty where the error sits at round-off). Issue 35 aims at less than 20 runs of the "
+                              "scene for the whole study.")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
