@@ -239,9 +239,11 @@ def _check(path: str) -> int:
     try:
         sc = scene_mod.load(path)
         with _native_output_silenced(True):
-            check(sc)
+            notes = check(sc)
     except Exception as exc:
         return _classified(path, exc)
+    for line in notes:
+        print(line)
     print(f"{path}: valid {sc.kind} scene; effects: {', '.join(scene_mod.effects(sc)) or 'none'}")
     return EXIT_OK
 

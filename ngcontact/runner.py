@@ -190,8 +190,9 @@ def batch_members(scene) -> int | None:
     return len(load_states(scene))
 
 
-def check(scene) -> None:
-    """Every check ``run`` makes before its solve, without solving.
+def check(scene) -> list[str]:
+    """Every check ``run`` makes before its solve, without solving; returns what the model lists about
+    itself (the bodies and faces of a file geometry), else nothing.
 
     The scene is validated when loaded, its scheduler address (``compute.scheduler``) by its form (no
     connection); kinds whose driver defines
@@ -206,7 +207,8 @@ def check(scene) -> None:
         check_scheduler(compute.scheduler, "compute.scheduler")
     check_model = getattr(importlib.import_module(DRIVERS[scene.kind]), "check_model", None)
     if check_model is not None:
-        check_model(scene)
+        return list(check_model(scene) or [])
+    return []
 
 
 def driver(scene):

@@ -13,7 +13,8 @@ cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its c
   3D: the same on the interface surface (``x, y, z``, ``pressure``,
   ``shear_1``, ``shear_2`` along the law's tangents ``t1, t2``, ``shear`` their
   magnitude, ``jump_n``, ``jump_t1``, ``jump_t2``, ``status``) with
-  ``contact_area`` (share of ``S_0`` in contact), written as ``interface.csv``
+  ``contact_area`` (share of ``S_0`` in contact) and ``mean_pressure`` (the
+  pressure averaged over ``S_0``, Pa), written as ``interface.csv``
   and plotted on the surface (``interface.png``) and against the axial
   position ``z`` (``interface_axial.png``); with ``[two_scale]`` also the
   cell's ``contact_fraction`` at every sample; the stress fields of 3D
@@ -50,43 +51,17 @@ from ngcontact.macro import macro_problem as M
 from ngcontact.macro import macro_measures as MM
 from ngcontact.errors import ConvergenceError, SceneError
 from ngcontact.geometry import bodies as gm
-from ngcontact.scene.macro_shapes import BOUNDARY_DOCS, REGIONS
+from ngcontact.scene.macro_shapes import REGIONS
+from ngcontact.drivers.macro_geometry import MACRO_SHAPES, build_geometry
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
-from ngcontact.geometry.femur import BOUNDARIES, FemurStemDims, femur_stem
-from ngcontact.geometry.femur3d import femur_stem_3d
 
 from ngcontact.fem.rigid_modes import check_rigid_modes
 from ngcontact.fem.reaction import support_reactions
 
 log = logging.getLogger(__name__)
-
-
-def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None) -> gm.MacroGeometry:
-    """Mesh the geometry of ``scene`` (sizes and order may be overridden)."""
-    g, d = scene.geometry, scene.discretization
-    maxh = maxh or d.maxh
-    ih = interface_maxh or d.interface_maxh or maxh
-    order = order or d.order
-    dims = dict(g.dimensions or {})
-    if g.shape == "femur_stem":
-        if g.setting == "3d":
-            femur = femur_stem_3d(FemurStemDims(**dims), maxh=maxh, interface_maxh=ih, order=order)
-            return gm.MacroGeometry(mesh=femur.mesh, rough="stem", counter="bone",
-                                    dims=dict(vars(FemurStemDims(**dims))),
-                                    boundaries=dict(BOUNDARY_DOCS[("femur_stem", "3d")]))
-        femur = femur_stem(FemurStemDims(**dims), maxh=maxh, interface_maxh=ih)
-        return gm.MacroGeometry(mesh=femur.mesh, rough="stem", counter="bone", dims=dict(vars(FemurStemDims(**dims))),
-                                boundaries={"interface": "stem-bone interface S_0 (cone and cylinder)", **BOUNDARIES})
-    if g.shape == "block":
-        return gm.block_on_plane(dims["length"], dims["h_block"], dims["h_base"], maxh=maxh)
-    if g.setting == "plane_strain":
-        return gm.coaxial_plane_strain(dims["a"], dims["b"], dims["c"], maxh=maxh, order=order)
-    if g.setting == "axisymmetric":
-        return gm.coaxial_axisymmetric(dims["a"], dims["b"], dims["c"], dims["height"], maxh=maxh)
-    return gm.coaxial_3d(dims["a"], dims["b"], dims["c"], dims["height"], maxh=maxh, order=order)
 
 
 def interface_law_of(scene, dim: int) -> tuple[il.InterfaceLaw, dict]:
@@ -189,20 +164,23 @@ def check_boundaries(scene, mesh) -> None:
     check_gap_table_covers(scene, mesh)
 
 
-def check_model(scene) -> None:
+def check_model(scene) -> list[str]:
     """What ``run`` checks before the solve, without solving (``ngcontact check``).
 
     Meshes the shape, checks its boundary labels and the gap table's
     coverage, and refuses supports that leave a rigid motion free.  A law
     taken from a cell is not computed here: it is assumed to hold
     tangentially (a cell has a tangential stiffness), and ``run`` repeats
-    the rigid-motion check with the computed law.
+    the rigid-motion check with the computed law.  Returns the lines the
+    shape lists about itself (a file's bodies and faces), made before meshing.
     """
+    notes = MACRO_SHAPES[scene.geometry.shape].inventory(scene)
     geo = build_geometry(scene)
     check_boundaries(scene, geo.mesh)
     tangential = scene.interface.cell is not None or interface_law_of(scene, geo.mesh.dim)[0].holds_tangentially
     check_rigid_modes(geo.mesh, scene.geometry.setting, REGIONS[scene.geometry.shape], supports_of(scene, geo.mesh),
                       "interface", tangential)
+    return notes
 
 
 def supports_of(scene, mesh) -> tuple[M.Support, ...]:
@@ -371,6 +349,7 @@ def interface_3d(sol, fields, output, geo, results, maxima, tables, plots) -> No
     figures (and the stress on the section plane where the mesh has one)."""
     surf = MM.interface_surface(sol)
     results["contact_area"] = surf.pop("contact_area")
+    results["mean_pressure"] = MM.mean_pressure(sol)
     results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in surf.items()}
     results["status_counts"] = dict(Counter(surf["status"]))
     for key in ("pressure", "shear"):

@@ -146,6 +146,16 @@ def resultant(sol: MacroSolution) -> dict:
     return {c: float(v) for c, v in zip(comps, vals)}
 
 
+def mean_pressure(sol: MacroSolution) -> float:
+    """Mean interface pressure ``int_S0 tau_n ds / int_S0 ds`` (compression positive; axisymmetric:
+    weighted with ``r``), with the quadrature of :func:`resultant`."""
+    p = sol.problem
+    on = p.mesh.Boundaries(p.interface)
+    w = elasticity.weight(p.setting)
+    force = ng.Integrate(interface_tractions(sol)[0] * w, p.mesh, ng.BND, definedon=on, order=energy_order(p.order))
+    return float(force / ng.Integrate(w, p.mesh, ng.BND, definedon=on, order=energy_order(p.order)))
+
+
 def equilibrium(sol: MacroSolution) -> dict:
     """Each body's force balance at the solution, and its largest relative imbalance.
 

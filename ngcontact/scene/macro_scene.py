@@ -3,7 +3,9 @@
 The macro problem of paper eqs. 44-48 / 69-71 (see :mod:`ngcontact.macro.macro_problem`)
 on one of the built-in geometries: the axisymmetric femur with a press-fitted
 hip stem (paper Sec. 4.2-4.3), two coaxial tubes (Lame press fit; plane
-strain, axisymmetric or 3D) or a block on a base (friction).  The interface
+strain, axisymmetric or 3D) or a block on a base (friction); or on two
+bodies read from a CAD or mesh file (``geometry.shape = "file"``, keys in
+:mod:`ngcontact.scene.file_geometry`).  The interface
 law comes from explicit numbers (``linear`` K0, ``bundle`` of directions,
 ``tabulated`` normal law) or from a ``cell`` scene named by
 ``interface.cell`` (its direction bundle, computed on the fly and cached on
@@ -36,7 +38,8 @@ from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.laws import homogenized as il
 from ngcontact.scene.macro_shapes import (REQUIRED, SETTINGS, SHAPES, boundaries_of, check_dimensions,
                                           check_shaft_axis, check_support_meaning, macro_extent)
-from ngcontact.scene.macro_shapes import BOUNDARY_DOCS  # noqa: F401  (the kind's labels, read by the README reference)
+from ngcontact.scene.macro_shapes import BOUNDARY_DOCS as SHAPE_BOUNDARY_DOCS
+from ngcontact.scene.file_geometry import FILE_BOUNDARY_DOCS, BodySpec, FaceSelectorSpec, check_file_geometry
 from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
 from ngcontact.scene import cell_links, mesh_size
@@ -45,6 +48,8 @@ from ngcontact.scene.supports import SupportSpec, check_values
 from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
 
 LAWS = ("linear", "bundle", "tabulated", "file")
+#: the kind's boundary labels by (shape, setting), read by the README reference
+BOUNDARY_DOCS: dict = {**SHAPE_BOUNDARY_DOCS, "file": FILE_BOUNDARY_DOCS}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -52,15 +57,37 @@ class MacroGeometrySpec:
     """Which macro geometry, in which setting, with which dimensions."""
 
     shape: str = param(doc="femur_stem (regions stem = rough, bone = counter), coaxial (inner = rough, "
-                       "outer = counter) or block (block = rough on base = counter)", choices=SHAPES)
+                       "outer = counter), block (block = rough on base = counter) or file (two solids of a CAD "
+                       "file, see file)", choices=SHAPES)
     setting: str = param("axisymmetric", doc="plane_strain, axisymmetric (r, z) or 3d",
                          choices=("plane_strain", "axisymmetric", "3d"))
     dimensions: dict[str, float] | None = param(
         None, doc="femur_stem: r_stem, r_tip, r_bone, z_tip, z_corner, z_bone_top, z_stem_top (defaults "
         "exist); coaxial: a, b, c (radii), height (axisymmetric/3d); block: length, h_block, h_base",
         units="m", allowed="a table of numbers > 0 (coaxial: a >= 0, a = 0 a solid inner shaft)")
+    file: str | None = param(None, doc="shape = file: the CAD file (STEP .step/.stp, IGES .iges/.igs, BREP "
+                             ".brep/.brp) of two solids (3d) or two planar faces in z = 0 (plane_strain; "
+                             "axisymmetric with x = r, y = z; their boundary curves are the faces to select), "
+                             "or the mesh (Netgen .vol, Gmsh .msh) of two regions of "
+                             "tetrahedra, relative to this scene; where the bodies touch is the interface; STEP "
+                             "and IGES are read in millimetres; a mesh is used as it is (maxh does not apply)")
+    length_unit: float | None = param(None, doc="shape = file: metres per unit of the file as read (default "
+                                      "0.001 for STEP and IGES, which are read in millimetres; 1 for BREP and "
+                                      "meshes)",
+                                      units="m", check=positive())
+    rough: BodySpec | None = param(None, doc="shape = file: the solid (mesh region) that is the rough body")
+    counter: BodySpec | None = param(None, doc="shape = file: the solid (mesh region) that is the counter body")
+    boundaries: dict[str, FaceSelectorSpec] | None = param(
+        None, doc="shape = file: boundary labels for [[supports]] and [[loads]], each the faces one selector "
+        "picks (`ngcontact check` lists the faces)")
 
     def check(self, path: str) -> None:
+        if self.shape == "file" or self.file is not None:
+            check_file_geometry(self, path)
+            return
+        for key in ("length_unit", "rough", "counter", "boundaries"):
+            if getattr(self, key) is not None:
+                raise SceneError(f"{path}.{key}", getattr(self, key), "only used with shape = 'file'; remove it")
         allowed = SETTINGS[self.shape]
         if self.setting not in allowed:
             raise SceneError(f"{path}.setting", self.setting,
@@ -267,6 +294,9 @@ class MacroScene:
     def check_size(self) -> None:
         """The element estimate of :mod:`ngcontact.scene.mesh_size` against ``max_elements``."""
         g, d = self.geometry, self.discretization
+        if g.shape == "file":   # the extent is known once the file is read (drivers/macro_geometry.py)
+            mesh_size.check_lengths({"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
+            return
         mesh_size.check_lengths({f"geometry.dimensions.{k}": v for k, v in (g.dimensions or {}).items() if v != 0}
                                 | {"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         dim, volume, interface, width = macro_extent(g.shape, g.setting, dict(g.dimensions or {}))
@@ -280,10 +310,11 @@ class MacroScene:
         comps = COMPONENTS[self.geometry.setting]
         shape, setting = self.geometry.shape, self.geometry.setting
         dims = dict(self.geometry.dimensions or {})
-        labels = boundaries_of(shape, setting, dims)
+        labels = () if shape == "file" else boundaries_of(shape, setting, dims)
         groups: tuple[tuple[str, tuple[SupportSpec | LoadSpec, ...]], ...] = (
             ("supports", self.supports), ("loads", self.loads))
-        for what, items in groups:
+        # a file's labels (selected, or named in the file) are checked against the file, before meshing
+        for what, items in (groups if shape != "file" else ()):
             for i, item in enumerate(items):
                 if item.boundary not in labels:
                     raise SceneError(f"{what}[{i}].boundary", item.boundary,
@@ -321,6 +352,9 @@ class MacroScene:
         ``load(path, overrides=None)``: overrides of the law's cells' ``[contact]``.
         """
         from ngcontact.scene.sections import check_input_file, resolve
+        if self.geometry.file is not None:
+            check_input_file("geometry.file", resolve(self, self.geometry.file), "CAD file",
+                             shown=self.geometry.file, missing="no such CAD file")
         if self.interface.law_file is not None:
             from ngcontact.scene import law_file
             contents = law_file.read(resolve(self, self.interface.law_file))

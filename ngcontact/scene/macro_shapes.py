@@ -3,7 +3,10 @@
 What a macro scene may name without meshing: the femur with its hip stem
 (:mod:`ngcontact.geometry.femur`, axisymmetric or a 3D quarter,
 :mod:`ngcontact.geometry.femur3d`), two coaxial tubes and a block on a base
-(:mod:`ngcontact.geometry.bodies`).  ``tests/scene/test_bad_input.py`` checks
+(:mod:`ngcontact.geometry.bodies`); ``file`` names two bodies read from a
+file, whose regions are ``rough`` and ``counter`` and whose labels the scene
+selects (:mod:`ngcontact.scene.file_geometry`), so it has no entry in the
+label tables here.  ``tests/scene/test_bad_input.py`` checks
 that the labels listed here are exactly those the meshers create; the scene
 layer validates supports and loads against them before any mesh exists.
 """
@@ -15,12 +18,12 @@ import math
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.geometry.femur import FemurStemDims, femur_interface_length
 
-SHAPES = ("femur_stem", "coaxial", "block")
+SHAPES = ("femur_stem", "coaxial", "block", "file")
 SETTINGS = {"femur_stem": ("axisymmetric", "3d"), "coaxial": ("plane_strain", "axisymmetric", "3d"),
-            "block": ("plane_strain",)}
+            "block": ("plane_strain",), "file": ("plane_strain", "axisymmetric", "3d")}
 DIMENSIONS = {"femur_stem": tuple(f.name for f in dataclasses.fields(FemurStemDims)),
-              "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base")}
-REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base")}
+              "coaxial": ("a", "b", "c", "height"), "block": ("length", "h_block", "h_base"), "file": ()}
+REQUIRED = {"femur_stem": (), "coaxial": ("a", "b", "c"), "block": ("length", "h_block", "h_base"), "file": ()}
 #: dimensions that may be 0, with what that means
 MAY_BE_ZERO = {("coaxial", "a"): "must be >= 0 (a > 0: the inner body is a tube; a = 0: a solid shaft)"}
 
@@ -51,7 +54,8 @@ def check_dimensions(dims: dict, path: str, shape: str, required) -> None:
             raise SceneError(path, dims, str(exc)) from None
 
 
-REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block": ("block", "base")}
+REGIONS = {"femur_stem": ("stem", "bone"), "coaxial": ("inner", "outer"), "block": ("block", "base"),
+           "file": ("rough", "counter")}
 #: Boundary labels of the meshed geometries (:mod:`ngcontact.geometry.bodies`) by (shape, setting),
 #: so that supports and loads are checked without meshing.
 FEMUR_BOUNDARIES = {
