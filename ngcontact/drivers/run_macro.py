@@ -24,6 +24,8 @@ cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its c
   largest and smallest stress components, von Mises stress and strain with
   location and body;
 * ``detachment``: points where the interface changes between open and closed;
+* ``accuracy``: the headline quantities with their estimated discretization errors against
+  ``discretization.tolerance`` (:mod:`ngcontact.drivers.macro_accuracy`);
 * ``law``, ``dimensions``, ``newton_iterations``, ``coulomb_iterations``.
 """
 from __future__ import annotations
@@ -36,6 +38,7 @@ from typing import Any
 import numpy as np
 import ngsolve as ng
 
+from ngcontact.drivers.macro_accuracy import accuracy
 from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
                                      law_from_cell, law_from_file, linear_solver)
 from ngcontact.laws import homogenized as il
@@ -292,6 +295,7 @@ def run(scene, clock) -> Outcome:
                                                                      ["contact_fraction"])
     vtk = {"stress": VtkField(mesh=geo.mesh, fields=dict(fields, u_rough=sol.u_rough, u_counter=sol.u_counter),
                               subdivision=scene.output.vtk_subdivision)}
+    recovery = None
     if scene.strength is not None:
         from ngcontact.drivers.run_strength import evaluate
         with clock.stage("strength check"):
@@ -302,6 +306,10 @@ def run(scene, clock) -> Outcome:
         tables["strength_map"] = st["table"]
         vtk["worst_cell"] = st["vtk"]
         plots.update(st["plots"])
+        recovery = st["recovery"]
+    with clock.stage("discretization error"):
+        results["accuracy"] = accuracy(scene, sol, partial(solve_scene, scene), balance, two_scale,
+                                       recovery)
     newton = sol.history["newton"]
     solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],
               "linear_solve_only": sol.history["quadratic"],
