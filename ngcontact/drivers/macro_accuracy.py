@@ -43,11 +43,13 @@ def order_samples(scene, sol: MacroSolution, solve: Callable[[Any], MacroSolutio
                   safety_factor: Callable[[MacroSolution], float] | None = None) -> dict[int, dict[str, DE.Sample]]:
     """The headline quantities at the three orders of the ladder (``sol`` is the scene's order; the other
     two are solved by ``solve(problem)`` on the same mesh with the same law)."""
-    problem = sol.problem
+    problem, ppe = sol.problem, scene.output.points_per_element
+    own = DE.headlines(sol, ppe)
+    component = next(n for n in own if n.startswith("resultant_")).removeprefix("resultant_")
     out: dict[int, dict[str, DE.Sample]] = {}
     for q in DE.ladder(problem.order, MAX_ORDER):
         s = sol if q == problem.order else solve(replace(problem, order=q))
-        out[q] = DE.headlines(s, scene.output.points_per_element)
+        out[q] = own if s is sol else DE.headlines(s, ppe, component)
         if safety_factor is not None:
             out[q]["safety_factor"] = DE.Sample(safety_factor(s))
     return out
