@@ -91,7 +91,7 @@ def lame_rows() -> list[dict]:
                               law=il.InterfaceLaw(normal=il.LinearLaw(kn=K_N)), gap=-DELTA, supports=sup,
                               order=order)
         sol = M.solve(prob)
-        for e in MA.estimates(MA.order_samples(_Scene, sol, M.solve), sol):
+        for e in MA.estimates(MA.order_samples(_Scene, sol, lambda p, start: M.solve(p, start=start)), sol):
             key = "resultant" if e.name.startswith("resultant_") else e.name
             out.append(row("Lame press fit", order, e, exact[key]))
     return out
@@ -103,7 +103,7 @@ def femur_rows() -> list[dict]:
     sc = loader.load(os.path.join(ROOT, "geometries", "femur_stem.toml"))
     problem, _ = problem_of(sc, build_geometry(sc))
     sol = solve_scene(sc, problem)
-    found = MA.estimates(MA.order_samples(sc, sol, lambda p: solve_scene(sc, p)), sol)
+    found = MA.estimates(MA.order_samples(sc, sol, lambda p, start: solve_scene(sc, p, start)), sol)
     d = sc.discretization
     fine, _ = problem_of(sc, build_geometry(sc, maxh=d.maxh / 2, interface_maxh=d.interface_maxh / 2))
     component = next(e.name for e in found if e.name.startswith("resultant_")).removeprefix("resultant_")

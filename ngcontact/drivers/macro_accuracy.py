@@ -39,16 +39,20 @@ HOW = ("discretization error of each headline quantity from solves at the neighb
 CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its largest force"}
 
 
-def order_samples(scene, sol: MacroSolution, solve: Callable[[Any], MacroSolution],
+def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
                   safety_factor: Callable[[MacroSolution], float] | None = None) -> dict[int, dict[str, DE.Sample]]:
     """The headline quantities at the three orders of the ladder (``sol`` is the scene's order; the other
-    two are solved by ``solve(problem)`` on the same mesh with the same law)."""
+    two are solved by ``solve(problem, start)`` on the same mesh with the same law, from ``sol``)."""
     problem, ppe = sol.problem, scene.output.points_per_element
     own = DE.headlines(sol, ppe)
     component = next(n for n in own if n.startswith("resultant_")).removeprefix("resultant_")
     out: dict[int, dict[str, DE.Sample]] = {}
     for q in DE.ladder(problem.order, MAX_ORDER):
-        s = sol if q == problem.order else solve(replace(problem, order=q))
+        if q == problem.order:
+            s = sol
+        else:
+            other = replace(problem, order=q)
+            s = solve(other, DE.start_at_order(sol, other))
         out[q] = own if s is sol else DE.headlines(s, ppe, component)
         if safety_factor is not None:
             out[q]["safety_factor"] = DE.Sample(safety_factor(s))
@@ -112,10 +116,10 @@ def warning_line(accuracy: dict) -> str:
     return f"accuracy not met (tolerance {accuracy['tolerance']:.3g}): " + "; ".join(parts)
 
 
-def accuracy(scene, sol: MacroSolution, solve: Callable[[Any], MacroSolution], balance: dict,
+def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], balance: dict,
              two_scale: dict | None = None, recovery=None) -> dict[str, Any]:
     """``results.accuracy`` of the macro solution ``sol`` of ``scene``: the neighbouring orders solved by
-    ``solve(problem)``, the safety factor re-evaluated with the strength check's correctors ``recovery``."""
+    ``solve(problem, start)``, the safety factor re-evaluated with the strength check's correctors ``recovery``."""
     safety_factor = None
     if recovery is not None:
         from ngcontact.drivers.run_strength import linear_safety_factor

@@ -10,9 +10,10 @@ order).
 Why one order more on the same mesh, not one uniform refinement
     A uniform refinement multiplies the unknowns by 4 in 2D and by 8 in 3D; one order more by about
     ``((p + 2) / (p + 1))^2`` in 2D (1.7 at order 3) and ``((p + 2) / (p + 1))^3`` in 3D (3.4 at order 2),
-    and one order less costs less than the scene's own solve.  The mesh, its curved boundary and the
-    interface's sampling stay those of the reported solution, so the difference sees the polynomial
-    error alone.  On a solution that is smooth on each element the p-error falls geometrically,
+    and one order less costs less than the scene's own solve.  Each is solved from the reported solution
+    interpolated into its space (:func:`start_at_order`), so its Newton steps are few.  The mesh, its
+    curved boundary and the interface's sampling stay those of the reported solution, so the difference
+    sees the polynomial error alone.  On a solution that is smooth on each element the p-error falls geometrically,
     ``|e_{p+1}| ~ rho |e_p|`` (Babuska-Guo), and three orders measure ``rho``; a singular point (a
     re-entrant corner, a change of boundary condition along a straight edge) slows or stops that fall,
     which the same three orders detect (below).  A refinement would need three meshes (a 64-fold cost in
@@ -102,6 +103,20 @@ def ladder(order: int, max_order: int) -> tuple[int, int, int]:
     if order >= max_order:
         return (order - 2, order - 1, order)
     return (order - 1, order, order + 1)
+
+
+def start_at_order(sol: MacroSolution, problem) -> ng.BaseVector:
+    """``sol`` as a vector of ``problem``'s space (the same mesh, another order): the start of its solve.
+
+    Each body's displacement is interpolated into the space of the other order, exactly where that
+    order is higher (the spaces are nested on one mesh), so Newton starts next to the solution.
+    """
+    from ngcontact.macro.macro_problem import space_and_frame
+    fes, _ = space_and_frame(problem)
+    gfu = ng.GridFunction(fes)
+    for k, region in enumerate((problem.rough, problem.counter)):
+        gfu.components[k].Set(sol.gfu.components[k], definedon=problem.mesh.Materials(region))
+    return gfu.vec
 
 
 # ------------------------------------------------------------------ the quantities of one solution

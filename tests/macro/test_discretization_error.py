@@ -108,7 +108,7 @@ def _lame_estimates(order: int) -> list[DE.Estimate]:
     class Scene:  # what order_samples reads of a scene
         class output:
             points_per_element = 5
-    samples = MA.order_samples(Scene, sol, lambda problem: M.solve(problem))
+    samples = MA.order_samples(Scene, sol, lambda problem, start: M.solve(problem, start=start))
     return MA.estimates(samples, sol)
 
 
@@ -164,7 +164,7 @@ def test_the_clamped_corner_of_a_block_on_its_base_is_reported_as_a_singularity(
     sc = loader.load(str(path))
     problem, _ = problem_of(sc, build_geometry(sc))
     sol = solve_scene(sc, problem)
-    acc = MA.accuracy(sc, sol, lambda p: solve_scene(sc, p), checked_equilibrium(sol))
+    acc = MA.accuracy(sc, sol, lambda p, start: solve_scene(sc, p, start), checked_equilibrium(sol))
     q = {x["name"]: x for x in acc["quantities"]}
     assert not acc["met"]
     assert q["von_mises_base"]["error"] is None and "singularity" in q["von_mises_base"]["how"]
@@ -181,7 +181,7 @@ def test_effectivity_on_the_femur_against_a_refined_solution():
     sc = loader.load(os.path.join(ROOT, "geometries", "femur_stem.toml"))
     problem, _ = problem_of(sc, build_geometry(sc))
     sol = solve_scene(sc, problem)
-    found = {e.name: e for e in MA.estimates(MA.order_samples(sc, sol, lambda p: solve_scene(sc, p)), sol)}
+    found = {e.name: e for e in MA.estimates(MA.order_samples(sc, sol, lambda p, start: solve_scene(sc, p, start)), sol)}
     d = sc.discretization
     fine_geo = build_geometry(sc, maxh=d.maxh / 2, interface_maxh=d.interface_maxh / 2)
     fine_problem, _ = problem_of(sc, fine_geo)
