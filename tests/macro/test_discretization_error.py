@@ -191,3 +191,20 @@ def test_effectivity_on_the_femur_against_a_refined_solution():
         true = abs(e.value - reference[name].value)
         assert e.error is not None and math.isfinite(e.error)
         assert 1.0 <= e.error / true <= 10.0, f"{name}: effectivity {e.error / true:.3g} ({e.how})"
+
+
+@pytest.mark.slow
+def test_the_two_scale_femur_reports_its_loop_and_table_errors_beside_the_discretization():
+    from ngcontact.drivers import run_macro as D
+    from ngcontact.output.report import Clock
+    from ngcontact.scene import loader
+    scene = loader.load(os.path.join(ROOT, "geometries", "femur_stem_two_scale.toml"))
+    out = D.run(scene, Clock())
+    acc = out.results["accuracy"]
+    q = {x["name"]: x for x in acc["quantities"]}
+    ts = out.results["two_scale"]
+    assert q["two_scale_residual"]["value"] == ts["history"][-1]["max_change"] < scene.two_scale.tol
+    assert q["cell_table_interpolation"]["value"] == ts["table"]["error_estimate"] <= scene.two_scale.table_tol
+    assert q["safety_factor"]["error"] is not None and q["peak_pressure"]["error"] is not None
+    # the neighbouring orders are solved with the loop's converged law, not the scene's start law
+    assert q["peak_pressure"]["value"] == pytest.approx(out.results["maxima"]["pressure"]["pressure"])
