@@ -64,9 +64,10 @@ from typing import Any
 import ngsolve as ng
 import numpy as np
 
+from ngcontact.fem import elasticity
 from ngcontact.fem.materials import tresca, von_mises
 from ngcontact.macro import macro_measures as MM
-from ngcontact.macro.macro_problem import MacroSolution
+from ngcontact.macro.macro_problem import MacroProblem, MacroSolution, space_and_frame
 
 #: observed ratio of successive differences from which the quantity is taken as not converging
 NOT_CONVERGING = 1.0
@@ -105,13 +106,12 @@ def ladder(order: int, max_order: int) -> tuple[int, int, int]:
     return (order - 1, order, order + 1)
 
 
-def start_at_order(sol: MacroSolution, problem) -> ng.BaseVector:
+def start_at_order(sol: MacroSolution, problem: MacroProblem) -> ng.BaseVector:
     """``sol`` as a vector of ``problem``'s space (the same mesh, another order): the start of its solve.
 
     Each body's displacement is interpolated into the space of the other order, exactly where that
     order is higher (the spaces are nested on one mesh), so Newton starts next to the solution.
     """
-    from ngcontact.macro.macro_problem import space_and_frame
     fes, _ = space_and_frame(problem)
     gfu = ng.GridFunction(fes)
     for k, region in enumerate((problem.rough, problem.counter)):
@@ -164,7 +164,6 @@ def traction_magnitude(sol: MacroSolution) -> float:
     p = sol.problem
     tau = MM.interface_tractions(sol)
     size = ng.sqrt(sum(t * t for t in tau))
-    from ngcontact.fem import elasticity
     return float(ng.Integrate(size * elasticity.weight(p.setting), p.mesh, ng.BND,
                               definedon=p.mesh.Boundaries(p.interface), order=2 * p.order + 2))
 

@@ -177,16 +177,24 @@ def test_the_clamped_corner_of_a_block_on_its_base_is_reported_as_a_singularity(
 def test_effectivity_on_the_femur_against_a_refined_solution():
     """Reference: order 4 on the scene's mesh sizes halved (the quantities move by < 1e-4 from order 3 there)."""
     from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
+    from ngcontact.drivers.run_strength import linear_safety_factor, recovery_of
     from ngcontact.scene import loader
     sc = loader.load(os.path.join(ROOT, "geometries", "femur_stem.toml"))
     problem, _ = problem_of(sc, build_geometry(sc))
     sol = solve_scene(sc, problem)
-    found = {e.name: e for e in MA.estimates(MA.order_samples(sc, sol, lambda p, start: solve_scene(sc, p, start)), sol)}
+    recovery = recovery_of(sc, problem.law)
+
+    def safety_factor(s):
+        return linear_safety_factor(sc, s, recovery)
+    samples = MA.order_samples(sc, sol, lambda p, start: solve_scene(sc, p, start), safety_factor)
+    found = {e.name: e for e in MA.estimates(samples, sol)}
     d = sc.discretization
     fine_geo = build_geometry(sc, maxh=d.maxh / 2, interface_maxh=d.interface_maxh / 2)
     fine_problem, _ = problem_of(sc, fine_geo)
-    reference = DE.headlines(solve_scene(sc, replace(fine_problem, order=4)), sc.output.points_per_element)
-    for name in ("peak_pressure", "von_mises_bone", "tresca_bone"):
+    fine = solve_scene(sc, replace(fine_problem, order=4))
+    reference = DE.headlines(fine, sc.output.points_per_element)
+    reference["safety_factor"] = DE.Sample(safety_factor(fine))
+    for name in ("peak_pressure", "von_mises_bone", "tresca_bone", "safety_factor"):
         e = found[name]
         true = abs(e.value - reference[name].value)
         assert e.error is not None and math.isfinite(e.error)
