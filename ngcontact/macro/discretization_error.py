@@ -37,7 +37,10 @@ The estimate
 
         e_p = 1.5 max(g, min(m, 2 g)),    g = |d_hi| / (1 - rho),  m = sqrt(|d_lo d_hi|),
 
-    so between 1.5 and 3 times the geometric extrapolation; ``how`` says which rules.  A sharp
+    so between 1.5 and 3 times the geometric extrapolation; ``how`` says which rules.  Where the two
+    differences have opposite signs, the values oscillate about their limit, which lies between
+    ``Q_p`` and ``Q_{p+1}`` while the oscillation decays (``rho < 1``): then ``e_p = 1.5 |d_hi|`` (the
+    geometric sum would count an oscillation's swings as a drift).  A sharp
     extrapolation sits at an effectivity of 1 and falls below it as often as above: hence the factor.
     Its effectivity against the package's oracles (Lame's press fit with the interface compliance in
     series, a refined femur as reference) is tested in ``tests/macro/test_discretization_error.py`` and
@@ -277,11 +280,16 @@ def estimate(name: str, by_order: dict[int, Sample], order: int, corners: np.nda
                         how=f"{head}: the difference does not shrink with the order, so no error can be "
                             "extrapolated from it (not converging)")
     geometric, bracket = abs(d_hi) / (1.0 - rho), math.sqrt(abs(d_lo * d_hi))
-    raw = max(geometric, min(bracket, 2.0 * geometric))
+    if d_lo * d_hi < 0:
+        raw, rule = abs(d_hi), (f"the differences alternate in sign, so the limit lies between orders {mid} and "
+                                f"{hi}: {SAFETY:g} x |d_hi|")
+    elif geometric >= bracket:
+        raw, rule = geometric, f"{SAFETY:g} x the geometric extrapolation |d_hi| / (1 - ratio)"
+    else:
+        raw = min(bracket, 2.0 * geometric)
+        rule = (f"the differences fall unevenly: {SAFETY:g} x sqrt(|d_lo d_hi|) (at most twice the geometric "
+                f"extrapolation {geometric:.3g})")
     e_mid = SAFETY * raw
-    rule = (f"{SAFETY:g} x the geometric extrapolation |d_hi| / (1 - ratio)" if geometric >= bracket else
-            f"the differences fall unevenly: {SAFETY:g} x sqrt(|d_lo d_hi|) (at most twice the geometric "
-            f"extrapolation {geometric:.3g})")
     if order == lo:
         return Estimate(**base, error=SAFETY * (abs(d_lo) + raw),
                         how=f"{head}; {SAFETY:g} x (|d_lo| + the error of order {mid}), that by {rule}")
