@@ -157,10 +157,8 @@ def test_the_clamped_corner_of_a_block_on_its_base_is_reported_as_a_singularity(
     """The base's clamped bottom meets its free side at a right angle: the stress there has no limit."""
     from ngcontact.drivers.run_macro import build_geometry, checked_equilibrium, problem_of, solve_scene
     from ngcontact.scene import loader
-    text = open(os.path.join(ROOT, "geometries", "macro", "block_on_sawtooth.toml")).read()
-    text = text.replace('cell = "sawtooth_cell.toml"', 'law = "linear"\nkn = 1e13\nkt = 1e12')
     path = tmp_path / "block.toml"
-    path.write_text(text)
+    path.write_text(_block_text())
     sc = loader.load(str(path))
     problem, _ = problem_of(sc, build_geometry(sc))
     sol = solve_scene(sc, problem)
@@ -216,3 +214,22 @@ def test_the_two_scale_femur_reports_its_loop_and_table_errors_beside_the_discre
     assert q["safety_factor"]["error"] is not None and q["peak_pressure"]["error"] is not None
     # the neighbouring orders are solved with the loop's converged law, not the scene's start law
     assert q["peak_pressure"]["value"] == pytest.approx(out.results["maxima"]["pressure"]["pressure"])
+
+
+def _block_text(extra: str = "") -> str:
+    text = open(os.path.join(ROOT, "geometries", "macro", "block_on_sawtooth.toml")).read()
+    return text.replace('cell = "sawtooth_cell.toml"', 'law = "linear"\nkn = 1e13\nkt = 1e12').replace(
+        "maxh = 0.0025", "maxh = 0.0025\n" + extra)
+
+
+def test_a_macro_scene_states_its_tolerance_in_the_open_unit_interval(tmp_path):
+    from ngcontact.errors import SceneError
+    from ngcontact.scene import loader
+    path = tmp_path / "block.toml"
+    path.write_text(_block_text("tolerance = 0.2"))
+    assert loader.load(str(path)).discretization.tolerance == 0.2
+    path.write_text(_block_text())
+    assert loader.load(str(path)).discretization.tolerance is None
+    path.write_text(_block_text("tolerance = 0.0"))
+    with pytest.raises(SceneError, match="discretization.tolerance"):
+        loader.load(str(path))
