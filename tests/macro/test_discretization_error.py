@@ -173,7 +173,7 @@ def test_the_clamped_corner_of_a_block_on_its_base_is_reported_as_a_singularity(
 # ------------------------------------------------------------------ the femur against a refined reference
 @pytest.mark.slow
 def test_effectivity_on_the_femur_against_a_refined_solution():
-    """Reference: order 4 on the scene's mesh sizes halved (the quantities move by < 1e-4 from order 3 there)."""
+    """Reference: order 4 on the scene's mesh sizes halved; a stress maximum there over a dense lattice."""
     from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
     from ngcontact.drivers.run_strength import linear_safety_factor, recovery_of
     from ngcontact.scene import loader
@@ -192,9 +192,9 @@ def test_effectivity_on_the_femur_against_a_refined_solution():
     fine = solve_scene(sc, replace(fine_problem, order=4))
     reference = DE.headlines(fine, sc.output.points_per_element)
     reference["safety_factor"] = DE.Sample(safety_factor(fine))
-    for name in ("peak_pressure", "von_mises_bone", "tresca_bone", "safety_factor"):
+    for name in ("peak_pressure", "von_mises_bone", "tresca_bone", "von_mises_stem", "safety_factor"):
         e = found[name]
-        true = abs(e.value - reference[name].value)
+        true = abs(e.value - reference[name].value - reference[name].sampling)  # a maximum over a dense lattice
         assert e.error is not None and math.isfinite(e.error)
         assert 1.0 <= e.error / true <= 10.0, f"{name}: effectivity {e.error / true:.3g} ({e.how})"
 
