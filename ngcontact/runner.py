@@ -19,7 +19,7 @@ from typing import Callable
 
 from ngcontact._version import __version__
 from ngcontact.errors import SceneError
-from ngcontact.output.report import Clock, Outcome, build_report
+from ngcontact.output.report import Clock, Outcome, accuracy_line, build_report
 from ngcontact.scene import loader
 
 #: kind -> the driver module whose ``run(scene, clock)`` solves it; imported
@@ -246,6 +246,9 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
     clock = Clock(progress)
     with threads(n), batches(scene, workers, scheduler, batch_progress, note=progress) as ex, progress_lines(clock):
         outcome = driver(scene).run(scene, clock)
+    line = accuracy_line(outcome.results)
+    if line is not None:
+        clock.note(line)
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),
                           outcome=outcome, timings=clock.total(), version=__version__, threads=n,

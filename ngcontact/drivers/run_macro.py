@@ -30,6 +30,8 @@ cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its c
   largest and smallest stress components, von Mises stress and strain with
   location and body;
 * ``detachment``: points where the interface changes between open and closed;
+* ``accuracy``: the headline quantities with their estimated discretization errors against
+  ``discretization.tolerance`` (:mod:`ngcontact.drivers.macro_accuracy`);
 * ``law``, ``dimensions``, ``newton_iterations``, ``coulomb_iterations``.
 """
 from __future__ import annotations
@@ -43,6 +45,7 @@ import numpy as np
 import ngsolve as ng
 
 from ngcontact.drivers.mesh_supports import supports_on
+from ngcontact.drivers.macro_accuracy import accuracy
 from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
                                      law_from_cell, law_from_file, linear_solver)
 from ngcontact.laws import homogenized as il
@@ -278,6 +281,7 @@ def run(scene, clock) -> Outcome:
             if "interface" in results:
                 results["interface"]["contact_fraction"] = np.asarray(two_scale["interface_coefficients"]
                                                                      ["contact_fraction"])
+    recovery = None
     if scene.strength is not None:
         from ngcontact.drivers.run_strength import evaluate
         with clock.stage("strength check"):
@@ -288,6 +292,10 @@ def run(scene, clock) -> Outcome:
         outcome.tables["strength_map"] = st["table"]
         outcome.vtk["worst_cell"] = st["vtk"]
         outcome.plots.update(st["plots"])
+        recovery = st["recovery"]
+    with clock.stage("discretization error"):
+        results["accuracy"] = accuracy(scene, sol, partial(solve_scene, scene), results["equilibrium"], two_scale,
+                                       recovery)
     return outcome
 
 

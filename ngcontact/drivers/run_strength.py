@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, TypedDict
 
 import ngsolve as ng
@@ -46,32 +47,81 @@ class StrengthEvaluation(TypedDict):
     table: tuple[list[str], list[tuple[Any, ...]]]  # (header, rows) of the strength map
     vtk: VtkField  # the worst cell
     plots: dict[str, Callable[..., None]]  # name -> plot, called as plot(path)
+    recovery: "Recovery"  # the cell's correctors, for further evaluations on other macro solutions
 
 
-def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
-    """Strength check of ``scene.strength`` on the macro solution ``sol``.
+@dataclass(frozen=True)
+class Recovery:
+    """What the recovery of micro stresses needs of the cell, built once per law: the cell problem, its
+    tangential stiffness and the unit-load correctors (paper eq. 75)."""
 
-    Returns ``{"results", "table", "vtk", "plots"}``.
-    """
+    path: str
+    problem: Any                # the cell problem (drivers.build.recovery_cell_problem)
+    tangential_stiffness: float
+    fixed_set: bool             # the contact set is S_C without gap (else all of S_C)
+    correctors: S.Correctors
+
+
+def recovery_of(scene: MacroScene, law) -> Recovery:
+    """The cell of ``scene.strength`` and its correctors for the macro interface law ``law``."""
     spec = scene.strength
     # set: the caller (drivers.run_macro) evaluates only scenes with a [strength] section
     assert spec is not None
     path = resolve(scene, spec.cell)
     cs, P = recovery_cell_problem(path, key="strength.cell")
-    law = sol.problem.law
     kt = spec.tangential_stiffness
     if kt is None:
         kt = cs.contact.k_n if law.friction is not None else 0.0
     chi = None if P.gap is None else ng.IfPos(P.gap - 1e-14 * max(P.largest_gap(), 1e-300), 0.0, 1.0)
     corr = S.linear_correctors(P, contact_set=chi, tangential_stiffness=kt)
+    return Recovery(path, P, float(kt), chi is not None, corr)
+
+
+def _cell_loads(scene: MacroScene, sol: MacroSolution, rec: Recovery, warn: bool = True):
+    """The interface states of ``sol`` and the cell loads they give (the shear dropped where the cell
+    cannot carry it, said once: ``warn``)."""
+    spec, P = scene.strength, rec.problem
+    assert spec is not None
     states = interface_states(sol, scene.output.points_per_element)
     try:
         loads = cell_loads(states, P.dim)
     except ModelError as exc:
         raise SceneError("strength.cell", spec.cell, f"a {P.dim}D cell: {exc}") from None
-    if kt == 0 and not P.tangential_free and np.any(loads[:, :P.dim - 1] != 0):
-        log.warning("the cell carries no shear (flat, frictionless, k_t = 0): the macro shear is dropped")
+    if rec.tangential_stiffness == 0 and not P.tangential_free and np.any(loads[:, :P.dim - 1] != 0):
+        if warn:
+            log.warning("the cell carries no shear (flat, frictionless, k_t = 0): the macro shear is dropped")
         loads[:, :P.dim - 1] = 0.0
+    return states, loads
+
+
+def _sigma_u(scene: MacroScene) -> dict[str, float]:
+    sigma_u_rough = scene.materials[scene.bodies.rough].sigma_u
+    sigma_u_counter = scene.materials[scene.bodies.counter].sigma_u
+    # set: MacroScene.check requires sigma_u of both bodies when [strength] is present
+    assert sigma_u_rough is not None and sigma_u_counter is not None
+    return {"rough": sigma_u_rough, "counter": sigma_u_counter}
+
+
+def linear_safety_factor(scene: MacroScene, sol: MacroSolution, rec: Recovery) -> float:
+    """The safety factor of eq. 78 on ``sol`` by the linear recovery (eq. 75) with the correctors ``rec``."""
+    assert scene.strength is not None
+    states, loads = _cell_loads(scene, sol, rec, warn=False)
+    smap = S.strength_map(rec.correctors, loads, scene.strength.criterion)
+    names = ["r", "z"] if "r" in states else [k for k in ("x", "y", "z") if k in states]
+    return float(S.check(smap, _sigma_u(scene), np.column_stack([states[k] for k in names]))["safety_factor"])
+
+
+def evaluate(scene: MacroScene, sol: MacroSolution, rec: Recovery | None = None) -> StrengthEvaluation:
+    """Strength check of ``scene.strength`` on the macro solution ``sol`` (``rec``: correctors already
+    built for its law).
+
+    Returns ``{"results", "table", "vtk", "plots", "recovery"}``.
+    """
+    spec = scene.strength
+    assert spec is not None
+    rec = recovery_of(scene, sol.problem.law) if rec is None else rec
+    path, P, kt, corr = rec.path, rec.problem, rec.tangential_stiffness, rec.correctors
+    states, loads = _cell_loads(scene, sol, rec)
     smap = S.strength_map(corr, loads, spec.criterion)
     names = ["r", "z"] if "r" in states else [k for k in ("x", "y", "z") if k in states]
     along = "s" if "s" in states else "z"   # the abscissa of the map: arc length (2D) or the axis z (3D)
@@ -79,11 +129,7 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     extra: dict[str, list[dict[str, Any]]] = {}
     if spec.recovery == "nonlinear":
         extra["nonlinear"] = _nonlinear_recovery(P, smap, loads, states, along, spec)
-    sigma_u_rough = scene.materials[scene.bodies.rough].sigma_u
-    sigma_u_counter = scene.materials[scene.bodies.counter].sigma_u
-    # set: MacroScene.check requires sigma_u of both bodies when [strength] is present
-    assert sigma_u_rough is not None and sigma_u_counter is not None
-    res = S.check(smap, {"rough": sigma_u_rough, "counter": sigma_u_counter}, coords)
+    res = S.check(smap, _sigma_u(scene), coords)
     for b, e in res["bodies"].items():
         if "s" in states:
             e["macro_point"]["s"] = float(states["s"][e["macro_point"]["index"]])
@@ -96,10 +142,10 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     res.update({"recovery": spec.recovery, "tangential_stiffness": float(kt), "load_names": list(corr.names),
                 "worst_cell_load": worst_load.tolist(),
                 "cell": {"scene": path, "ndof": int(P.ndof), "dim": P.dim,
-                         "fixed_contact_set": "S_C without gap" if chi is not None else "all of S_C"}})
+                         "fixed_contact_set": "S_C without gap" if rec.fixed_set else "all of S_C"}})
     res.update(extra)
     table, plots = _table_and_plots(res, smap, states, names, along, worst_stress, spec.criterion, P.dim)
-    return {"results": res, "table": table, "vtk": vtk, "plots": plots}
+    return {"results": res, "table": table, "vtk": vtk, "plots": plots, "recovery": rec}
 
 
 def _nonlinear_recovery(P, smap, loads, states, along: str, spec) -> list[dict[str, Any]]:

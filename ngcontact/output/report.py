@@ -111,6 +111,24 @@ def to_plain(obj, path: str = "results"):
 
 
 
+def accuracy_line(results: dict) -> str | None:
+    """The accuracy verdict (``results.accuracy``) in one terminal line: met or not, and per quantity its
+    value and estimated relative error (the largest over the loads of a sweep, with that load's value)."""
+    acc = results.get("accuracy")
+    if not isinstance(acc, dict) or not acc.get("quantities"):
+        return None
+    worst: dict[str, dict] = {}
+    for q in acc["quantities"]:
+        seen = worst.get(q["name"])
+        rel = q.get("relative_error")
+        if seen is None or rel is None or (seen.get("relative_error") is not None and rel > seen["relative_error"]):
+            worst[q["name"]] = q
+    parts = [f"{n} {q['value']:.4g} " + ("(no estimate)" if q.get("relative_error") is None
+                                        else f"+/- {q['relative_error']:.2%}") for n, q in worst.items()]
+    verdict = "met" if acc.get("met") else "NOT met"
+    return f"accuracy {verdict} (tolerance {acc['tolerance']:.3g}): " + ", ".join(parts)
+
+
 def file_names(outcome: Outcome) -> list[str]:
     """The names of the files an outcome writes besides ``report.json`` (the report's ``files``)."""
     return sorted([f"{n}.csv" for n in outcome.tables] + [f"{n}.vtu" for n in outcome.vtk]

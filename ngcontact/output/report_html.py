@@ -393,9 +393,20 @@ def accuracy_warnings(report: dict) -> list[str]:
     acc = _get(report, "results.accuracy") or {}
     if not isinstance(acc, dict) or acc.get("met", True):
         return []
-    return [f"Accuracy not met (tolerance {fmt(acc.get('tolerance'))}): load {c.get('load')}, {c.get('name')} = "
-            f"{fmt(c.get('value'))} > {fmt(c.get('limit'))}" for c in acc.get("checks", [])
-            if isinstance(c, dict) and not c.get("ok", True)]
+    head = f"Accuracy not met (tolerance {fmt(acc.get('tolerance'))}): "
+    checks = [f"{head}load {c.get('load')}, {c.get('name')} = {fmt(c.get('value'))} > {fmt(c.get('limit'))}"
+              for c in acc.get("checks", []) if isinstance(c, dict) and not c.get("ok", True)]
+    return checks + [head + quantity_line(q) for q in acc.get("quantities", [])
+                     if isinstance(q, dict) and not q.get("met", True)]
+
+
+def quantity_line(q: dict) -> str:
+    """One estimated quantity of an accuracy verdict: its value and relative error, or why it has none."""
+    where = f"load {q['load']}, " if q.get("load") is not None else ""
+    rel = q.get("relative_error")
+    if rel is None:
+        return f"{where}{q.get('name')} = {fmt(q.get('value'))} has no error estimate: {q.get('how', '')}"
+    return f"{where}{q.get('name')} = {fmt(q.get('value'))}, estimated relative error {fmt(rel)}"
 
 
 def render(report: dict, directory: str, names: list[str]) -> str:

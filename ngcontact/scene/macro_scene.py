@@ -53,6 +53,19 @@ BOUNDARY_DOCS: dict = {**SHAPE_BOUNDARY_DOCS, "file": FILE_BOUNDARY_DOCS}
 
 
 @dataclass(frozen=True, kw_only=True)
+class MacroDiscretization(Discretization):
+    """Finite element discretization of a macro scene, and the accuracy its headline numbers are held to."""
+
+    tolerance: float | None = param(
+        None, doc="the relative accuracy the headline quantities (peak interface pressure, resultant, largest "
+        "von Mises and Tresca stress per body, safety factor; two-scale: the loop's residual and the cell "
+        "table's interpolation error) are held to: each is reported with its discretization error, estimated "
+        "from solves one order below and above on the same mesh, and results.accuracy.met says whether every "
+        "one is within; the mesh and order are not changed; default: 0.01",
+        check=open_interval(0, 1))
+
+
+@dataclass(frozen=True, kw_only=True)
 class MacroGeometrySpec:
     """Which macro geometry, in which setting, with which dimensions."""
 
@@ -284,7 +297,7 @@ class MacroScene:
     supports: tuple[SupportSpec, ...] = param(doc="[[supports]]: Dirichlet conditions", check=nonempty())
     loads: tuple[LoadSpec, ...] = param((), doc="[[loads]]: surface loads")
     body_forces: BodyForceSpec = param(BodyForceSpec(), doc="[body_forces]: constant force densities")
-    discretization: Discretization = param(Discretization(), doc="mesh and order")
+    discretization: MacroDiscretization = param(MacroDiscretization(), doc="mesh and order")
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     output: OutputSpec = param(OutputSpec(), doc="result sampling")
     two_scale: TwoScaleSpec | None = param(None, doc="[two_scale]: coupling loop with a cell (Sec. 3.5)")

@@ -1,0 +1,130 @@
+"""The accuracy verdict of a macro run (``results.accuracy``): every headline number with its error.
+
+The verdict has the format of the cell's (:func:`ngcontact.cell.admissibility.verdict`): ``tolerance``
+(the scene's ``discretization.tolerance``, else
+:data:`~ngcontact.cell.admissibility.DEFAULT_TOLERANCE`), ``tolerance_from``, ``met``, ``checks``,
+``estimated``, ``quantities`` (per quantity ``name, value, error, relative_error, met, how``) and ``how``.
+
+* the quantities of :func:`ngcontact.macro.discretization_error.headlines` (peak interface pressure,
+  the interface resultant, per body the largest von Mises and Tresca stress) and, with ``[strength]``,
+  the safety factor of eq. 78, each with its discretization error estimated from solves at the
+  neighbouring orders on the scene's mesh (:mod:`ngcontact.macro.discretization_error`; the safety
+  factor's by the linear recovery of eq. 75 on each order, whatever the scene's recovery);
+* with ``[two_scale]`` (the neighbouring orders solved with the loop's converged law) also the loop's
+  own residual, ``max |sigma_n(k) - sigma_n(k-1)|`` of its last step relative to the peak pressure, and
+  the cell table's interpolation error (relative, paper Sec. 3.5; :mod:`ngcontact.coupling.pressure_table`);
+* the check ``equilibrium`` (each body's forces balance, :func:`ngcontact.macro.macro_measures.equilibrium`).
+
+A quantity whose relative error exceeds the tolerance, or has none (not converging, a stress
+singularity), marks the verdict as not met and is said in one warning line.
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import replace
+from typing import Any, Callable
+
+from ngcontact.cell.admissibility import DEFAULT_TOLERANCE
+from ngcontact.macro import discretization_error as DE
+from ngcontact.macro.macro_problem import MacroSolution
+from ngcontact.scene.schema import MAX_ORDER
+
+log = logging.getLogger(__name__)
+
+#: how the verdict's errors are estimated (the report's ``accuracy.how``)
+HOW = ("discretization error of each headline quantity from solves at the neighbouring polynomial orders on "
+       "the scene's mesh (ngcontact.macro.discretization_error); the two-scale loop's residual and the cell "
+       "table's interpolation error as their own quantities")
+#: the meaning of the macro run's checks
+CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its largest force"}
+
+
+def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
+                  safety_factor: Callable[[MacroSolution], float] | None = None) -> dict[int, dict[str, DE.Sample]]:
+    """The headline quantities at the three orders of the ladder (``sol`` is the scene's order; the other
+    two are solved by ``solve(problem, start)`` on the same mesh with the same law, from ``sol``)."""
+    problem, ppe = sol.problem, scene.output.points_per_element
+    own = DE.headlines(sol, ppe)
+    component = next(n for n in own if n.startswith("resultant_")).removeprefix("resultant_")
+    out: dict[int, dict[str, DE.Sample]] = {}
+    for q in DE.ladder(problem.order, MAX_ORDER):
+        if q == problem.order:
+            s = sol
+        else:
+            other = replace(problem, order=q)
+            s = solve(other, DE.start_at_order(sol, other))
+        out[q] = own if s is sol else DE.headlines(s, ppe, component)
+        if safety_factor is not None:
+            out[q]["safety_factor"] = DE.Sample(safety_factor(s))
+    return out
+
+
+def estimates(samples: dict[int, dict[str, DE.Sample]], sol: MacroSolution) -> list[DE.Estimate]:
+    """Every headline quantity's :class:`~ngcontact.macro.discretization_error.Estimate` at the scene's order."""
+    mesh, order = sol.problem.mesh, sol.problem.order
+    corners, h = DE.corner_points(mesh), DE.shortest_boundary_edge(mesh)
+    return [DE.estimate(name, {q: s[name] for q, s in samples.items()}, order,
+                        corners if name.startswith(("von_mises", "tresca")) else None, h)
+            for name in samples[order]]
+
+
+def two_scale_quantities(two_scale: dict, tolerance: float) -> list[dict[str, Any]]:
+    """The loop's residual and the cell table's interpolation error as quantities of the verdict."""
+    last = two_scale["history"][-1]
+    change = float(last["max_change"] or 0.0)
+    peak = float(last["max_pressure"])
+    rel = change / peak if peak > 0 else 0.0
+    table = float(two_scale["table"]["error_estimate"])
+    return [{"name": "two_scale_residual", "value": change, "error": change, "relative_error": rel,
+             "controlled": "relative", "met": rel <= tolerance,
+             "how": "max |sigma_n(k) - sigma_n(k-1)| over the interface points at the loop's last step [Pa], "
+                    "relative to the peak pressure"},
+            {"name": "cell_table_interpolation", "value": table, "error": table, "relative_error": table,
+             "controlled": "relative", "met": table <= tolerance,
+             "how": "the monotone cubic's largest error at interval midpoints, relative to the tabulated "
+                    "quantities' largest values (two_scale.table_tol bounds it)"}]
+
+
+def verdict(found: list[DE.Estimate], tolerance: float | None, balance: dict,
+            two_scale: dict | None = None) -> dict[str, Any]:
+    """``results.accuracy`` of a macro run (module docstring); one warning line when it is not met."""
+    limit = DEFAULT_TOLERANCE if tolerance is None else tolerance
+    quantities = [e.quantity(limit) for e in found]
+    if two_scale is not None:
+        quantities += two_scale_quantities(two_scale, limit)
+    value, bound = float(balance["error"]), float(balance["tolerance"])
+    eq = {"load": None, "name": "equilibrium", "value": value, "limit": bound, "ok": value <= bound,
+          "meaning": CHECKS["equilibrium"]}
+    out: dict[str, Any] = {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
+           "met": eq["ok"] and all(q["met"] for q in quantities), "checks": [eq], "estimated": True,
+           "quantities": quantities, "how": HOW}
+    if not out["met"]:
+        log.warning("ngcontact: warning: %s", warning_line(out))
+    return out
+
+
+def warning_line(accuracy: dict) -> str:
+    """The unmet quantities of a verdict in one line."""
+    parts = []
+    for q in accuracy["quantities"]:
+        if q["met"]:
+            continue
+        rel = q["relative_error"]
+        parts.append(f"{q['name']} {q['value']:.4g} has no error estimate ({q['how'].split(': ')[-1]})"
+                     if rel is None else f"{q['name']} {q['value']:.4g} +/- {rel:.2%}")
+    parts += [f"{c['name']} {c['value']:.3g} > {c['limit']:.3g}" for c in accuracy["checks"] if not c["ok"]]
+    return f"accuracy not met (tolerance {accuracy['tolerance']:.3g}): " + "; ".join(parts)
+
+
+def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], balance: dict,
+             two_scale: dict | None = None, recovery=None) -> dict[str, Any]:
+    """``results.accuracy`` of the macro solution ``sol`` of ``scene``: the neighbouring orders solved by
+    ``solve(problem, start)``, the safety factor re-evaluated with the strength check's correctors ``recovery``."""
+    safety_factor = None
+    if recovery is not None:
+        from ngcontact.drivers.run_strength import linear_safety_factor
+
+        def safety_factor(s: MacroSolution) -> float:
+            return linear_safety_factor(scene, s, recovery)
+    samples = order_samples(scene, sol, solve, safety_factor)
+    return verdict(estimates(samples, sol), scene.discretization.tolerance, balance, two_scale)
