@@ -210,13 +210,14 @@ def cell_solver(scene: CellScene) -> CellSolver:
 
 
 def fe_cell(scene: CellScene) -> FECell:
-    """The FE cell of a scene: its mesh, its cell problem (built on the first solve) and, with
-    ``discretization.tolerance`` on a flat 2D cell, the graded meshes and the fine spectral predictor that
-    seeds them (:mod:`ngcontact.cell.fe.edge_grading`)."""
+    """The FE cell of a scene: its mesh, its cell problem (built on the first solve), its variants (another
+    order, interface size, enforcement or penalty: the error estimates and the penalty's share) and, on a
+    flat 2D frictionless cell, the graded meshes and the fine spectral predictor that seeds them
+    (:mod:`ngcontact.cell.fe.edge_grading`)."""
     cell, model = build_cell(scene), model_of(scene)
     d = scene.discretization
     graded = h0 = predictor = None
-    if d.tolerance is not None:
+    if gradable(scene):
         g = scene.geometry
         h0 = d.interface_maxh or d.maxh
         # one twin for every load and level, as fine as the finest grading asks (within the grid's bound)
@@ -229,13 +230,66 @@ def fe_cell(scene: CellScene) -> FECell:
     friction = model.friction            # the whole surface's eqs. 42-43 take a threshold fixed in advance
     threshold = None if friction is None or friction.couples_to_pressure else friction.threshold(None)
     return FECell(cell, model, lambda: cell_problem(scene, cell, model), threshold=threshold, graded=graded,
-                  h0=h0, predictor=predictor)
+                  h0=h0, predictor=predictor, variant=lambda **changes: fe_variant(scene, **changes),
+                  interface_maxh=d.interface_maxh or d.maxh, twin=share_twin(scene))
+
+
+#: the spectral twin's grid on which an FE cell's penalty share is measured: it resolves the contact edges
+SHARE_GRID = {2: 16384, 3: 256}
+
+
+def share_twin(scene: CellScene) -> Callable[[], SpectralCellSolver] | None:
+    """``() -> `` the spectral cell of an FE cell's small-slope model on :data:`SHARE_GRID` (the penalty's
+    share), where it has one: the penalty on a flat interface, frictionless, isotropic bodies."""
+    from ngcontact.scene.cell_scene import has_twin
+    isotropic = all(scene.materials[m].C is None for m in (scene.bodies.rough, scene.bodies.counter))
+    if not has_twin(scene) or scene.contact.friction != "none" or not isotropic:
+        return None
+    heights = map_heights(scene)
+    grid = max(SHARE_GRID[scene.geometry.dim], spectral_grid(scene, None if heights is None else heights.shape))
+    return lambda: spectral_variant(scene, grid)
+
+
+def gradable(scene: CellScene) -> bool:
+    """Whether an FE cell refines by meshes graded towards its contact edges: a flat 2D interface (the edges
+    are points on a line) and no friction (every load is solved afresh on its own mesh)."""
+    g = scene.geometry
+    return g.dim == 2 and PROFILES[g.profile].flat and scene.contact.friction == "none"
+
+
+#: the keys of a variant of a cell scene and their sections
+VARIED = {"order": "discretization", "interface_maxh": "discretization", "enforcement": "contact", "k_n": "contact"}
+
+
+def fe_variant(scene: CellScene, **changes) -> FECell | None:
+    """The FE cell of ``scene`` with the :data:`VARIED` keys changed, without its tolerance; ``None`` where
+    the scene's checks (:func:`~ngcontact.scene.cell_scene.check_fe`) refuse the change."""
+    from ngcontact.scene.cell_scene import check_fe
+    sections = {name: getattr(scene, name) for name in set(VARIED.values())}
+    for key, value in changes.items():
+        sections[VARIED[key]] = replace(sections[VARIED[key]], **{key: value})
+    sections["discretization"] = replace(sections["discretization"], tolerance=None)
+    varied = replace(scene, **sections)
+    try:
+        check_fe(varied)
+    except SceneError:
+        return None
+    return fe_cell(varied)
 
 
 def spectral_cell_solver(scene: CellScene) -> SpectralCellSolver:
     """The spectral cell of a small-slope scene, with the recipe of its finer grids (refinement)."""
     return SpectralCellSolver(spectral_cell(scene), make_cell=lambda n: spectral_cell(scene, grid=n),
-                              max_points=MAX_SPECTRAL_POINTS[scene.geometry.dim])
+                              max_points=MAX_SPECTRAL_POINTS[scene.geometry.dim],
+                              variant=lambda grid, **changes: spectral_variant(scene, grid, **changes))
+
+
+def spectral_variant(scene: CellScene, grid: int, **contact) -> SpectralCellSolver:
+    """The spectral cell of ``scene`` on ``grid`` with the ``[contact]`` keys ``contact`` changed (its
+    enforcement, its penalty): the same discretization, another interface model."""
+    varied = replace(scene, contact=replace(scene.contact, **contact))
+    return SpectralCellSolver(spectral_cell(varied, grid=grid),
+                              variant=lambda grid, **more: spectral_variant(varied, grid, **more))
 
 
 def cell_facts(scene: CellScene) -> dict[str, float]:
