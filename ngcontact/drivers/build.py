@@ -172,6 +172,7 @@ def friction_from_cell(path: str, *, width: float, overrides: dict | None = None
     if micro is None:
         raise SceneError("interface.friction", "from_cell", f"the cell {path!r} has no friction")
     arrays, _ = cell_bundle_arrays(cell_scene, cache_dir)
+    assert c.k_n is not None  # set by CellScene.check (exact contact: its default scale)
     values = cell_law.friction_from_bundle(arrays, k_n=c.k_n, friction=micro)
     info = {"source": "cell", "cell_scene": os.path.abspath(path), "micro_friction": c.friction,
             "micro_mu": c.mu, "micro_G": c.G, "mu0": values["mu0"], "G0": values["G0"], "huber_width": width,
@@ -250,6 +251,13 @@ def share_twin(scene: CellScene) -> Callable[[], SpectralCellSolver] | None:
     return lambda: spectral_variant(scene, grid)
 
 
+def scene_with(scene: CellScene, **sections) -> CellScene:
+    """``scene`` with these sections replaced, in the folder of the scene file (its data files' base)."""
+    out = replace(scene, **sections)
+    object.__setattr__(out, "base_dir", getattr(scene, "base_dir", "."))
+    return out
+
+
 def gradable(scene: CellScene) -> bool:
     """Whether an FE cell refines by meshes graded towards its contact edges: a flat 2D interface (the edges
     are points on a line) and no friction (every load is solved afresh on its own mesh)."""
@@ -269,7 +277,7 @@ def fe_variant(scene: CellScene, **changes) -> FECell | None:
     for key, value in changes.items():
         sections[VARIED[key]] = replace(sections[VARIED[key]], **{key: value})
     sections["discretization"] = replace(sections["discretization"], tolerance=None)
-    varied = replace(scene, **sections)
+    varied = scene_with(scene, **sections)
     try:
         check_fe(varied)
     except SceneError:
@@ -287,7 +295,7 @@ def spectral_cell_solver(scene: CellScene) -> SpectralCellSolver:
 def spectral_variant(scene: CellScene, grid: int, **contact) -> SpectralCellSolver:
     """The spectral cell of ``scene`` on ``grid`` with the ``[contact]`` keys ``contact`` changed (its
     enforcement, its penalty): the same discretization, another interface model."""
-    varied = replace(scene, contact=replace(scene.contact, **contact))
+    varied = scene_with(scene, contact=replace(scene.contact, **contact))
     return SpectralCellSolver(spectral_cell(varied, grid=grid),
                               variant=lambda grid, **more: spectral_variant(varied, grid, **more))
 
@@ -378,6 +386,7 @@ def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = Tr
         # set: the scene layer requires isotropic E and nu of both bodies for the spectral cell
         assert m.E is not None and m.nu is not None
         return Layer(E=m.E, nu=m.nu, h=h)
+    assert c.k_n is not None  # set by CellScene.check (exact contact: its default scale)
     return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
                         counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid, heights),
                         k_n=c.k_n,

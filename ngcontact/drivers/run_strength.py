@@ -61,6 +61,7 @@ def evaluate(scene: MacroScene, sol: MacroSolution) -> StrengthEvaluation:
     law = sol.problem.law
     kt = spec.tangential_stiffness
     if kt is None:
+        assert cs.contact.k_n is not None  # set by CellScene.check (exact contact: its default scale)
         kt = cs.contact.k_n if law.friction is not None else 0.0
     chi = None if P.gap is None else ng.IfPos(P.gap - 1e-14 * max(P.largest_gap(), 1e-300), 0.0, 1.0)
     corr = S.linear_correctors(P, contact_set=chi, tangential_stiffness=kt)
