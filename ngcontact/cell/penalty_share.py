@@ -76,7 +76,7 @@ def shares(per_load: list[dict[str, Any]], base: list[dict[str, float]], limit: 
     """
     out = []
     for k, (results, at, second) in enumerate(zip(per_load, base, limit)):
-        for name in SHARED:
+        for name in (n for n in SHARED if n in second):
             value = headline(results)[name]
             share = (at[name] - second[name]) * (STIFFER / (STIFFER - 1) if extrapolate else 1.0)
             inf = value - share
