@@ -7,6 +7,7 @@ driver calls these instead of building its own copies.
 from __future__ import annotations
 
 from collections.abc import Callable
+import functools
 import hashlib
 import json
 import math
@@ -221,13 +222,15 @@ def fe_cell(scene: CellScene) -> FECell:
     if gradable(scene):
         g = scene.geometry
         h0 = d.interface_maxh or d.maxh
-        # one twin for every load and level, as fine as the finest grading asks (within the grid's bound)
-        predictor = predictor_twin(scene, h0 * RATIO ** (MAX_STEPS * LEVELS_PER_STEP))
+        finest = h0 * RATIO ** (MAX_STEPS * LEVELS_PER_STEP)
+        # one twin for every load and level, as fine as the finest grading asks (within the grid's bound),
+        # built when a refinement first asks for it
+        predictor = functools.cache(lambda: predictor_twin(scene, finest))
 
         def graded(vertices, order):
             mesh = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
                                     vertices=vertices)
-            return cell_problem(scene, mesh, replace(model, order=order), predictor=predictor)
+            return cell_problem(scene, mesh, replace(model, order=order), predictor=predictor())
     friction = model.friction            # the whole surface's eqs. 42-43 take a threshold fixed in advance
     threshold = None if friction is None or friction.couples_to_pressure else friction.threshold(None)
     return FECell(cell, model, lambda: cell_problem(scene, cell, model), threshold=threshold, graded=graded,

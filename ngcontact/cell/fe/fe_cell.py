@@ -68,7 +68,8 @@ class FECell:
     h0
         The interface element size of the ungraded mesh (the grading's level 0).
     predictor
-        The start of first loads whose contact edges seed the graded meshes, or ``None``.
+        ``() ->`` the start of first loads whose contact edges seed the graded meshes (built when first
+        asked), or ``None``.
     variant
         ``(**changes) -> FECell`` of the same scene with ``order``, ``interface_maxh``, ``enforcement`` or
         ``k_n`` changed, ``None`` where the scene's checks refuse the change; ``None``: no variants.
@@ -81,7 +82,7 @@ class FECell:
 
     def __init__(self, cell, model: CellModel, make_problem: Callable[[], CellProblem], *,
                  threshold: float | None = None, graded: Callable[[list[float], int], CellProblem] | None = None,
-                 h0: float | None = None, predictor: Predictor | None = None,
+                 h0: float | None = None, predictor: Callable[[], Predictor | None] | None = None,
                  variant: Callable[..., FECell | None] | None = None, interface_maxh: float | None = None,
                  twin: Callable[[], Any] | None = None):
         self.cell, self.model, self._make_problem = cell, model, make_problem
@@ -169,7 +170,8 @@ class FECell:
         order = self.model.order
         out: list[GradedSolve] = []
         for k, load in enumerate(loads):
-            seed = self.predictor.edges(load) if self.predictor is not None else None
+            twin = self.predictor() if self.predictor is not None else None
+            seed = twin.edges(load) if twin is not None else None
             out.append(solve_to_tolerance(self.graded, load, tolerance, self.h0, period, order, seed=seed,
                                           required=required))
             log.info("load %d: contact fraction %.10g after %d grading steps", k,
