@@ -108,9 +108,9 @@ def test_k_n_is_required_with_the_penalty_only(tmp_path, capsys):
     assert code == 2 and "contact.k_n" in err and "required with enforcement = 'penalty'" in err
 
 
-def test_a_cell_that_cannot_be_graded_is_estimated_by_one_order_more():
+def test_a_cell_that_cannot_be_graded_is_estimated_by_one_order_more(caplog):
     """A curved S_C: the sweep at order p and p + 1, the richer one reported with twice the change as its
-    estimate; a stated tolerance out of reach fails, the default one returns the estimate."""
+    estimate; a stated tolerance out of reach fails, the default one returns the estimate with one warning."""
     import tomllib
     from ngcontact.scene.loader import from_dict
     scene = from_dict(tomllib.loads(CURVED))
@@ -125,7 +125,10 @@ def test_a_cell_that_cannot_be_graded_is_estimated_by_one_order_more():
     assert [d["discretization"] for d in refined.per_load[0]["discretizations"]] == ["scene", "second"]
     with pytest.raises(ConvergenceError, match="discretization.tolerance = 1e-12 not met"):
         cell_solver(scene).refine_to(1e-12, loads, required=True)
+    caplog.clear()
     assert cell_solver(scene).refine_to(1e-12, loads, required=False).estimates[0]["contact_fraction"] > 1e-12
+    said = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert len(said) == 1 and said[0].startswith("accuracy not met: the FE cell's estimated error")
 
 
 @pytest.mark.slow

@@ -164,8 +164,17 @@ class FECell:
         ``required = False`` (the default tolerance): out of reach, the best answer with its estimate; a
         cell whose second discretization is beyond :data:`DEFAULT_DOFS` is solved once, not estimated.
         """
-        if self.graded is None or self.h0 is None:
-            return self._compared(tolerance, loads, required)
+        refined = self._compared(tolerance, loads, required) if self.graded is None or self.h0 is None \
+            else self._graded(tolerance, loads, required)
+        worst = max((max(e.values()) for e in refined.estimates if e), default=0.0)
+        if worst > tolerance:        # only where not required: a required tolerance out of reach has raised
+            log.warning("accuracy not met: the FE cell's estimated error %.3g exceeds the default tolerance %g (%s); "
+                        "refine interface_maxh or the order, or set discretization.tolerance", worst, tolerance,
+                        refined.how)
+        return refined
+
+    def _graded(self, tolerance: float, loads: list[CellLoad], required: bool) -> Refinement:
+        """Each load on meshes graded towards its contact edges (:meth:`refine_to`)."""
         period = self.period
         order = self.model.order
         out: list[GradedSolve] = []
@@ -193,9 +202,10 @@ class FECell:
             raise ModelError("this FE cell was built without the recipe of a second discretization")
         if not required and self.default_refinement() == "none":
             sols = self.sweep(loads)
-            return Refinement(solutions=sols, estimates=[{} for _ in sols], how=(
-                f"not estimated: the second discretization ({second.how}) would exceed {DEFAULT_DOFS[self.dim]} "
-                "dofs; set discretization.tolerance to estimate it anyway"))
+            how = (f"not estimated: the second discretization ({second.how}) would exceed {DEFAULT_DOFS[self.dim]} "
+                   "dofs; set discretization.tolerance to estimate it anyway")
+            log.warning("accuracy not known: %s", how)
+            return Refinement(solutions=sols, estimates=[{} for _ in sols], how=how)
         richer = self.variant(order=second.order, **({"interface_maxh": second.interface_maxh}
                                                      if second.interface_maxh is not None else {}))
         if richer is None:
