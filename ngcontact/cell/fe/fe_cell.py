@@ -92,6 +92,7 @@ class FECell:
         self.threshold = threshold
         self.graded, self.h0, self.predictor = graded, h0, predictor
         self._problem: CellProblem | None = None
+        self._scene_ndof: int | None = None
 
     @classmethod
     def of(cls, problem: CellProblem, **options) -> FECell:
@@ -103,7 +104,14 @@ class FECell:
         """The cell problem of the last solve (the scene's mesh, or the last load's graded one)."""
         if self._problem is None:
             self._problem = self._make_problem()
+            self._scene_ndof = self._scene_ndof or int(self._problem.ndof)
         return self._problem
+
+    def scene_unknowns(self) -> int:
+        """The dofs of the scene's own discretization (before any refinement replaced the problem)."""
+        if self._scene_ndof is None:
+            self._scene_ndof = int(self._make_problem().ndof) if self._problem is not None else self.unknowns()
+        return self._scene_ndof
 
     # ------------------------------------------------------------ description
     def unknowns(self) -> int:
@@ -151,7 +159,7 @@ class FECell:
         if self.graded is not None and self.h0 is not None:
             return "graded"
         second = self.second()
-        if second is None or second.ndof(self.unknowns(), self.dim, self.model.order) > DEFAULT_DOFS[self.dim]:
+        if second is None or second.ndof(self.scene_unknowns(), self.dim, self.model.order) > DEFAULT_DOFS[self.dim]:
             return "none"
         return "compared"
 
