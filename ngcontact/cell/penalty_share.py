@@ -34,6 +34,7 @@ from typing import Any
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.cell_solver import CellSolver
+from ngcontact.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
 #: the run's progress lines (printed as its stage lines)
@@ -97,7 +98,12 @@ def penalty_share(cell: CellSolver, loads: list[CellLoad], per_load: list[dict[s
     if cell.penalty() is None:
         return None
     model = cell.share_solver()
-    found = limit_values(model, loads)
+    try:
+        found = limit_values(model, loads)
+    except ConvergenceError as exc:     # the limit is a second model: its failure is not the answer's
+        log.warning("the penalty's share is not known: its second sweep failed (%s)", exc)
+        return {"name": "penalty", "k_n": cell.penalty(), "how": f"not measured: the second sweep failed ({exc})",
+                "counted": False, "quantities": []}
     if found is None:
         return None
     limit, how = found

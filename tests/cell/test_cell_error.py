@@ -144,3 +144,24 @@ def test_the_3d_fe_estimate_bounds_its_error_against_the_converged_spectral_twin
         assert abs(f - fr) <= estimate["contact_fraction"] <= 10 * abs(f - fr)
         c, cr = sol.results["mean_closure"], ref.results["mean_closure"]
         assert abs(c - cr) / abs(cr) <= estimate["mean_closure"]
+
+
+def test_a_failed_limit_sweep_leaves_the_share_unknown_not_the_answer(caplog):
+    """The exact limit is a second model: when its sweep fails the answer stands, the share says why not."""
+    class Failing:
+        def sweep(self, loads):
+            raise ConvergenceError("Uzawa stalled", {})
+
+    class Penalized:
+        def penalty(self):
+            return 1e3
+
+        def share_solver(self):
+            return self
+
+        def varied(self, *, enforcement=None, k_n=None):
+            return Failing()
+
+    share = penalty_share(Penalized(), [], [])
+    assert share["quantities"] == [] and "Uzawa stalled" in share["how"] and not share["counted"]
+    assert any("penalty's share is not known" in r.getMessage() for r in caplog.records)

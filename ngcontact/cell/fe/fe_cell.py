@@ -183,6 +183,7 @@ class FECell:
 
     def _graded(self, tolerance: float, loads: list[CellLoad], required: bool) -> Refinement:
         """Each load on meshes graded towards its contact edges (:meth:`refine_to`)."""
+        assert self.graded is not None and self.h0 is not None       # refine_to's choice
         period = self.period
         order = self.model.order
         out: list[GradedSolve] = []
