@@ -123,6 +123,8 @@ def test_a_cell_that_cannot_be_graded_is_estimated_by_one_order_more(caplog):
         2 * abs(got["contact_fraction"] - first["contact_fraction"]), rel=1e-6, abs=1e-12)
     assert "order 2" in refined.how and cell.problem.model.order == 2
     assert [d["discretization"] for d in refined.per_load[0]["discretizations"]] == ["scene", "second"]
+    record = cell.solver_record(refined.solutions, refined)       # the report's solver entry
+    assert record["iterations"] == refined.solutions[0].iterations and len(record["per_load"]) == 1
     with pytest.raises(ConvergenceError, match="discretization.tolerance = 1e-12 not met"):
         cell_solver(scene).refine_to(1e-12, loads, required=True)
     caplog.clear()

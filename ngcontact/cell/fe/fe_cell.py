@@ -223,9 +223,11 @@ class FECell:
         self._problem = richer.problem
         per_load = [{"discretizations": [{"discretization": lv["discretization"],
                                           "contact_fraction": lv["contact_fraction"][k],
-                                          "mean_closure": lv["mean_closure"][k]} for lv in done.levels]}
-                    for k in range(len(done.solutions))]
-        return Refinement(solutions=done.solutions, estimates=done.estimates, per_load=per_load, how=second.how)
+                                          "mean_closure": lv["mean_closure"][k]} for lv in done.levels],
+                     "newton_iterations": s.iterations}          # the reported (second) discretization's
+                    for k, s in enumerate(done.solutions)]
+        return Refinement(solutions=done.solutions, estimates=done.estimates, per_load=per_load,
+                          histories=[s.newton for s in done.solutions], how=second.how)
 
     def response(self, pressure: float, length_unit: float = 1.0) -> Response:
         """The response at ``pressure`` (module docstring), from a first load's start."""
