@@ -34,7 +34,7 @@ from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral_start import SpectralStart
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
-from ngcontact.scene.cell_scene import CellScene, load_states, spectral_grid
+from ngcontact.scene.cell_scene import CellScene, check_fe, has_twin, load_states, spectral_grid
 from ngcontact.scene.spectral_grid import MAX_SPECTRAL_POINTS
 from ngcontact.scene.loader import as_dict, load_with_contact
 from ngcontact.scene.sections import MaterialSpec, resolve
@@ -245,7 +245,6 @@ SHARE_GRID = {2: 16384, 3: 256}
 def share_twin(scene: CellScene) -> Callable[[], SpectralCellSolver] | None:
     """``() -> `` the spectral cell of an FE cell's small-slope model on :data:`SHARE_GRID` (the penalty's
     share), where it has one: the penalty on a flat interface, frictionless, isotropic bodies."""
-    from ngcontact.scene.cell_scene import has_twin
     isotropic = all(scene.materials[m].C is None for m in (scene.bodies.rough, scene.bodies.counter))
     if not has_twin(scene) or scene.contact.friction != "none" or not isotropic:
         return None
@@ -275,7 +274,6 @@ VARIED = {"order": "discretization", "interface_maxh": "discretization", "enforc
 def fe_variant(scene: CellScene, **changes) -> FECell | None:
     """The FE cell of ``scene`` with the :data:`VARIED` keys changed, without its tolerance; ``None`` where
     the scene's checks (:func:`~ngcontact.scene.cell_scene.check_fe`) refuse the change."""
-    from ngcontact.scene.cell_scene import check_fe
     sections = {name: getattr(scene, name) for name in set(VARIED.values())}
     for key, value in changes.items():
         sections[VARIED[key]] = replace(sections[VARIED[key]], **{key: value})
