@@ -17,6 +17,19 @@ from ngcontact.cell.cell_load import CellLoad
 
 #: the columns of a surface distribution besides its coordinates, in the order a table shows them
 SURFACE_COLUMNS = ("pressure", "slip", "gap", "closure")
+#: the headline quantities of a load whose errors are estimated and reported (:func:`headline`)
+HEADLINE = ("contact_fraction", "mean_closure", "normal_stiffness")
+
+
+def headline(results: dict[str, Any]) -> dict[str, float]:
+    """The headline quantities of one load's results: the contact fraction, the mean closure and, where the
+    results carry a finite effective stiffness, its normal entry (``n0``)."""
+    out = {name: float(results[name]) for name in HEADLINE[:2] if name in results}
+    K = results.get("effective_stiffness")
+    if isinstance(K, dict) and K.get("matrix") is not None and "n0" in K.get("components", ()):
+        i = K["components"].index("n0")
+        out["normal_stiffness"] = float(K["matrix"][i][i])
+    return out
 
 
 @dataclass

@@ -93,15 +93,31 @@ class CellSolver(Protocol):
     def sweep(self, loads: list[CellLoad]) -> list[CellSolution]:
         """Solve the loads in order (each from the previous where the method continues)."""
 
-    def refine_to(self, tolerance: float, loads: list[CellLoad]) -> Refinement:
+    def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Solve the loads on refined discretizations until the estimated error meets ``tolerance``.
+
+        ``required``: the scene stated the tolerance (out of reach is a failure); else it is the default
+        one, and out of reach the best answer is returned with its estimate (the verdict marks it as not met).
 
         Raises
         ------
         ConvergenceError
-            The tolerance is out of the method's reach (its largest discretization); the message says
-            how far it got.
+            ``required`` and the tolerance is out of the method's reach (its largest discretization); the
+            message says how far it got.
         """
+
+    def penalty(self) -> float | None:
+        """The penalty ``k_n`` where the contact is enforced by the paper's Winkler layer (eq. 65), else
+        ``None`` (exact non-penetration)."""
+
+    def share_solver(self) -> CellSolver:
+        """The discretization of the same model on which the penalty's share is measured
+        (:mod:`ngcontact.cell.penalty_share`): the method's own, or a finer twin of the same model where it
+        has one that resolves the contact edges at a fraction of the cost."""
+
+    def varied(self, *, enforcement: str | None = None, k_n: float | None = None) -> CellSolver | None:
+        """The same cell on the same discretization with another enforcement or penalty (the penalty's share
+        of the answer, :mod:`ngcontact.cell.penalty_share`); ``None`` where the method cannot have it."""
 
     def response(self, pressure: float, length_unit: float = 1.0) -> Response:
         """The :data:`Response` at a mean pressure, solved from a first load's start; lengths scaled by

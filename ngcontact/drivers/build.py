@@ -7,6 +7,7 @@ driver calls these instead of building its own copies.
 from __future__ import annotations
 
 from collections.abc import Callable
+import functools
 import hashlib
 import json
 import math
@@ -33,7 +34,7 @@ from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral_start import SpectralStart
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
-from ngcontact.scene.cell_scene import CellScene, load_states, spectral_grid
+from ngcontact.scene.cell_scene import CellScene, check_fe, has_twin, load_states, spectral_grid
 from ngcontact.scene.spectral_grid import MAX_SPECTRAL_POINTS
 from ngcontact.scene.loader import as_dict, load_with_contact
 from ngcontact.scene.sections import MaterialSpec, resolve
@@ -172,6 +173,7 @@ def friction_from_cell(path: str, *, width: float, overrides: dict | None = None
     if micro is None:
         raise SceneError("interface.friction", "from_cell", f"the cell {path!r} has no friction")
     arrays, _ = cell_bundle_arrays(cell_scene, cache_dir)
+    assert c.k_n is not None  # set by CellScene.check (exact contact: its default scale)
     values = cell_law.friction_from_bundle(arrays, k_n=c.k_n, friction=micro)
     info = {"source": "cell", "cell_scene": os.path.abspath(path), "micro_friction": c.friction,
             "micro_mu": c.mu, "micro_G": c.G, "mu0": values["mu0"], "G0": values["G0"], "huber_width": width,
@@ -210,32 +212,93 @@ def cell_solver(scene: CellScene) -> CellSolver:
 
 
 def fe_cell(scene: CellScene) -> FECell:
-    """The FE cell of a scene: its mesh, its cell problem (built on the first solve) and, with
-    ``discretization.tolerance`` on a flat 2D cell, the graded meshes and the fine spectral predictor that
-    seeds them (:mod:`ngcontact.cell.fe.edge_grading`)."""
+    """The FE cell of a scene: its mesh, its cell problem (built on the first solve), its variants (another
+    order, interface size, enforcement or penalty: the error estimates and the penalty's share) and, on a
+    flat 2D frictionless cell, the graded meshes and the fine spectral predictor that seeds them
+    (:mod:`ngcontact.cell.fe.edge_grading`)."""
     cell, model = build_cell(scene), model_of(scene)
     d = scene.discretization
     graded = h0 = predictor = None
-    if d.tolerance is not None:
+    if gradable(scene):
         g = scene.geometry
         h0 = d.interface_maxh or d.maxh
-        # one twin for every load and level, as fine as the finest grading asks (within the grid's bound)
-        predictor = predictor_twin(scene, h0 * RATIO ** (MAX_STEPS * LEVELS_PER_STEP))
+        finest = h0 * RATIO ** (MAX_STEPS * LEVELS_PER_STEP)
+        # one twin for every load and level, as fine as the finest grading asks (within the grid's bound),
+        # built when a refinement first asks for it
+        predictor = functools.cache(lambda: predictor_twin(scene, finest))
 
         def graded(vertices, order):
             mesh = graded_flat_cell(g.period, g.h_rough, g.h_counter, maxh=d.maxh, interface_maxh=h0, order=order,
                                     vertices=vertices)
-            return cell_problem(scene, mesh, replace(model, order=order), predictor=predictor)
+            return cell_problem(scene, mesh, replace(model, order=order), predictor=predictor())
     friction = model.friction            # the whole surface's eqs. 42-43 take a threshold fixed in advance
     threshold = None if friction is None or friction.couples_to_pressure else friction.threshold(None)
     return FECell(cell, model, lambda: cell_problem(scene, cell, model), threshold=threshold, graded=graded,
-                  h0=h0, predictor=predictor)
+                  h0=h0, predictor=predictor, variant=lambda **changes: fe_variant(scene, **changes),
+                  interface_maxh=d.interface_maxh or d.maxh, twin=share_twin(scene))
+
+
+#: the spectral twin's grid on which an FE cell's penalty share is measured: it resolves the contact edges
+SHARE_GRID = {2: 16384, 3: 256}
+
+
+def share_twin(scene: CellScene) -> Callable[[], SpectralCellSolver] | None:
+    """``() -> `` the spectral cell of an FE cell's small-slope model on :data:`SHARE_GRID` (the penalty's
+    share), where it has one: the penalty on a flat interface, frictionless, isotropic bodies."""
+    isotropic = all(scene.materials[m].C is None for m in (scene.bodies.rough, scene.bodies.counter))
+    if not has_twin(scene) or scene.contact.friction != "none" or not isotropic:
+        return None
+    heights = map_heights(scene)
+    grid = max(SHARE_GRID[scene.geometry.dim], spectral_grid(scene, None if heights is None else heights.shape))
+    return lambda: spectral_variant(scene, grid)
+
+
+def scene_with(scene: CellScene, **sections) -> CellScene:
+    """``scene`` with these sections replaced, in the folder of the scene file (its data files' base)."""
+    out = replace(scene, **sections)
+    object.__setattr__(out, "base_dir", getattr(scene, "base_dir", "."))
+    return out
+
+
+def gradable(scene: CellScene) -> bool:
+    """Whether an FE cell refines by meshes graded towards its contact edges: a flat 2D interface (the edges
+    are points on a line) and no friction (every load is solved afresh on its own mesh)."""
+    g = scene.geometry
+    return g.dim == 2 and PROFILES[g.profile].flat and scene.contact.friction == "none"
+
+
+#: the keys of a variant of a cell scene and their sections
+VARIED = {"order": "discretization", "interface_maxh": "discretization", "enforcement": "contact", "k_n": "contact"}
+
+
+def fe_variant(scene: CellScene, **changes) -> FECell | None:
+    """The FE cell of ``scene`` with the :data:`VARIED` keys changed, without its tolerance; ``None`` where
+    the scene's checks (:func:`~ngcontact.scene.cell_scene.check_fe`) refuse the change."""
+    sections = {name: getattr(scene, name) for name in set(VARIED.values())}
+    for key, value in changes.items():
+        sections[VARIED[key]] = replace(sections[VARIED[key]], **{key: value})
+    sections["discretization"] = replace(sections["discretization"], tolerance=None)
+    varied = scene_with(scene, **sections)
+    try:
+        check_fe(varied)
+    except SceneError:
+        return None
+    return fe_cell(varied)
 
 
 def spectral_cell_solver(scene: CellScene) -> SpectralCellSolver:
     """The spectral cell of a small-slope scene, with the recipe of its finer grids (refinement)."""
     return SpectralCellSolver(spectral_cell(scene), make_cell=lambda n: spectral_cell(scene, grid=n),
-                              max_points=MAX_SPECTRAL_POINTS[scene.geometry.dim])
+                              max_points=MAX_SPECTRAL_POINTS[scene.geometry.dim],
+                              variant=lambda grid, **changes: spectral_variant(scene, grid, **changes))
+
+
+def spectral_variant(scene: CellScene, grid: int, **contact) -> SpectralCellSolver:
+    """The spectral cell of ``scene`` on ``grid`` with the ``[contact]`` keys ``contact`` changed (its
+    enforcement, its penalty): the same discretization, another interface model."""
+    varied = scene_with(scene, contact=replace(scene.contact, **contact))
+    return SpectralCellSolver(spectral_cell(varied, grid=grid),
+                              variant=lambda grid, **more: spectral_variant(varied, grid, **more))
 
 
 def cell_facts(scene: CellScene) -> dict[str, float]:
@@ -324,6 +387,7 @@ def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = Tr
         # set: the scene layer requires isotropic E and nu of both bodies for the spectral cell
         assert m.E is not None and m.nu is not None
         return Layer(E=m.E, nu=m.nu, h=h)
+    assert c.k_n is not None  # set by CellScene.check (exact contact: its default scale)
     return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
                         counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid, heights),
                         k_n=c.k_n,

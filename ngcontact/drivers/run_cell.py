@@ -29,6 +29,7 @@ from typing import Any
 
 from ngcontact.cell import admissibility, small_strain
 from ngcontact.cell.cell_solver import Refinement
+from ngcontact.cell.penalty_share import penalty_share
 from ngcontact.errors import ConvergenceError
 from ngcontact.drivers import cell_gap, cell_members
 from ngcontact.drivers.build import cell_facts, cell_loads, cell_solver
@@ -136,6 +137,11 @@ def run(scene, clock) -> Outcome:
         log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
     results["loads"] = per_load
     results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement)
+    if cell.penalty() is not None:  # the model's share: reported and printed, not counted against the tolerance
+        with clock.stage("penalty share"):
+            share = penalty_share(cell, loads, per_load, refined=refinement is not None)
+        if share is not None:
+            results["accuracy"]["model"] = share
     vtk = {}
     displaced = cell.displacements()
     if displaced is not None:

@@ -71,6 +71,7 @@ def recovery_of(scene: MacroScene, law) -> Recovery:
     cs, P = recovery_cell_problem(path, key="strength.cell")
     kt = spec.tangential_stiffness
     if kt is None:
+        assert cs.contact.k_n is not None  # set by CellScene.check (exact contact: its default scale)
         kt = cs.contact.k_n if law.friction is not None else 0.0
     chi = None if P.gap is None else ng.IfPos(P.gap - 1e-14 * max(P.largest_gap(), 1e-300), 0.0, 1.0)
     corr = S.linear_correctors(P, contact_set=chi, tangential_stiffness=kt)

@@ -55,8 +55,10 @@ class GapSpec:
 class ContactSpec:
     """Penalty contact and friction on S_C."""
 
-    k_n: float = param(doc="penalty (Winkler) stiffness k_n (with enforcement = 'exact' only the scale of the "
-                       "eq. 34 coefficients in the report)", units="Pa/m", check=positive())
+    k_n: float | None = param(None, doc="penalty (Winkler) stiffness k_n, required with enforcement = 'penalty'; "
+                              "with 'exact' optional: the scale of the eq. 34 coefficients in the report and the FE "
+                              "cell's augmentation, by default 10 E / h (E the softer body's modulus, h the interface "
+                              "mesh size or grid step)", units="Pa/m", check=positive())
     enforcement: str = param("penalty", doc="penalty: the paper's Winkler layer p = k_n [J.n - g]_+ (eq. 65) "
                              "and Huber-regularized friction; exact: non-penetration, the rigid limit k_n -> infinity: "
                              "spectral cell with exact friction (w unused), or FE cell (2D; 3D at order 1), "
@@ -77,6 +79,9 @@ class ContactSpec:
                                  "solve no contact problem")
 
     def check(self, path: str) -> None:
+        if self.k_n is None and self.enforcement == "penalty":
+            raise SceneError(f"{path}.k_n", MISSING, "required with enforcement = 'penalty' (the Winkler layer's "
+                             "stiffness, paper eq. 65); exact contact ('exact') needs none")
         need = () if self.friction == "none" else FRICTION_LAWS[self.friction].parameters
         # exact friction has no width: w is optional under exact enforcement (CellScene.check asks it of the FE cell)
         exact = self.enforcement == "exact" and self.friction != "none"
@@ -211,6 +216,8 @@ class CellScene:
             if self.materials[name].C is not None:
                 raise SceneError(f"materials.{name}.C", "...", "cell scenes take isotropic E, nu")
         dim = self.geometry.dim
+        if self.contact.k_n is None:       # exact contact without a scale: the default of contact.k_n's doc
+            object.__setattr__(self.contact, "k_n", exact_scale(self))
         g = self.contact.gap.kind
         if g == "bisinusoid" and dim != 3:
             raise SceneError("contact.gap.kind", g, f"not available for a {dim}D cell")
@@ -279,6 +286,7 @@ def check_penalty_ratio(scene: CellScene, spacing: tuple[float, str] | None = No
     d, c = scene.discretization, scene.contact
     h, what = spacing if spacing is not None else (d.interface_maxh or d.maxh, "the interface mesh size")
     E = min(scene.materials[name].E or 0.0 for name in (scene.bodies.rough, scene.bodies.counter))
+    assert c.k_n is not None  # set by CellScene.check (exact contact: its default scale)
     ratio = c.k_n * h / E if E > 0 else 0.0
     if 0 < ratio < MIN_PENALTY_RATIO:
         raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} {what}, "
@@ -288,6 +296,20 @@ def check_penalty_ratio(scene: CellScene, spacing: tuple[float, str] | None = No
         raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
                          f"E = {E:g} the softer body's modulus) must stay below {MAX_PENALTY_RATIO:g}: the "
                          "penalty would outweigh the bodies beyond what double precision resolves; lower k_n")
+
+
+#: ``k_n h / E`` of exact contact's default scale (``contact.k_n``): within the admissible ratios, and an
+#: augmentation of the interface as stiff as ten elements of the softer body
+EXACT_SCALE_RATIO = 10.0
+
+
+def exact_scale(scene: CellScene) -> float:
+    """The default ``k_n`` of exact contact: :data:`EXACT_SCALE_RATIO` ``E / h``, ``E`` the softer body's
+    modulus and ``h`` the interface mesh size (FE) or the grid step (spectral)."""
+    d, g = scene.discretization, scene.geometry
+    E = min(scene.materials[name].E or 1.0 for name in (scene.bodies.rough, scene.bodies.counter))
+    h = g.period / spectral_grid(scene) if d.method == "spectral" else (d.interface_maxh or d.maxh)
+    return EXACT_SCALE_RATIO * E / h
 
 
 def spectral_grid(scene: CellScene, heights_shape: tuple[int, ...] | None = None) -> int:

@@ -15,6 +15,8 @@ from ngcontact import cli
 from ngcontact.cell import admissibility
 from ngcontact.cell.admissibility import DEFAULT_TOLERANCE, PLAINLY_WRONG, verdict
 
+from height_map_cell import fe_height_map
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SHIPPED = os.path.join(ROOT, "geometries", "cells", "westergaard.toml")
 
@@ -119,12 +121,8 @@ def test_the_slopes_of_westergaard_s_gap():
 
 
 def _height_map_scene(tmp_path, interface_maxh):
-    text = open(os.path.join(ROOT, "geometries", "cells", "height_map.toml"), encoding="utf-8").read()
-    text = text.replace("interface_maxh = 0.12", f"interface_maxh = {interface_maxh}")
-    text = text.replace('file = "data/height_map_example.npy"',
-                        f'file = "{os.path.join(ROOT, "geometries", "cells", "data", "height_map_example.npy")}"')
     path = tmp_path / "map.toml"
-    path.write_text(text, encoding="utf-8")
+    path.write_text(fe_height_map(interface_maxh), encoding="utf-8")
     return path
 
 

@@ -30,6 +30,8 @@ from ngcontact.fem.materials import isotropic
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
+from height_map_cell import fe_height_map
+
 pytestmark = [pytest.mark.slow, pytest.mark.hard]
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -229,10 +231,12 @@ def test_huber_width_of_1e_12_sticks_with_slip_bounded_by_the_width(friction, sh
     assert sol.results["mean_traction"] == pytest.approx([shear, -p], rel=1e-6)
 
 
-def test_3d_cell_with_a_periodic_height_map():
-    """The shipped height map (small-slope model), two pressures: at most 20 Newton steps,
-    finite, equilibrium, contact grows with the pressure."""
-    scene = ngcontact.load(os.path.join(ROOT, "geometries", "cells", "height_map.toml"))
+def test_3d_cell_with_a_periodic_height_map(tmp_path):
+    """The shipped height map (small-slope model) on the FE cell with the penalty, two pressures: at most 20
+    Newton steps, finite, equilibrium, contact grows with the pressure."""
+    path = tmp_path / "map.toml"
+    path.write_text(fe_height_map(), encoding="utf-8")
+    scene = ngcontact.load(str(path))
     from ngcontact.drivers.build import build_cell, model_of
     cell = build_cell(scene)
     P = CellProblem(cell, model_of(scene))

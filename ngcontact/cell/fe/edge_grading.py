@@ -217,7 +217,8 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
 
 
 def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, tolerance: float, h0: float,
-                       period: float, order: int, seed: tuple[np.ndarray, float] | None = None) -> GradedSolve:
+                       period: float, order: int, seed: tuple[np.ndarray, float] | None = None,
+                       required: bool = True) -> GradedSolve:
     """Solve ``load`` on meshes graded towards the contact edges until the estimate meets ``tolerance``.
 
     The loop of the module docstring: grading levels until the contact
@@ -243,11 +244,14 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
         Contact edges known beforehand and their accuracy, ``(edges, spacing)``: the spectral twin's
         (:func:`ngcontact.cell.spectral_start.twin_edges`).  The first mesh is then graded towards them
         by :func:`seed_levels` levels instead of being the scene's uniform mesh.
+    required
+        ``False``: out of reach, the finest level's solution with the last comparisons as its estimate
+        (over the tolerance) instead of the error.
 
     Raises
     ------
     ConvergenceError
-        ``MAX_STEPS`` grading steps and ``MAX_ORDER_RAISES`` order raises did
+        ``required`` and ``MAX_STEPS`` grading steps and ``MAX_ORDER_RAISES`` order raises did
         not reach the tolerance (the figures in the message).
     """
     history: list[dict[str, Any]] = []
@@ -295,6 +299,9 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
         else:
             vertices = graded_vertices(edges, h0, step * LEVELS_PER_STEP, period)
         problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP, (problem, entry))
+    if not required and graded is not None:
+        return GradedSolve(problem=problem, solution=sol, history=history, estimate_from=(graded, entry),
+                           newton=newton)
     worst = graded["fraction_change"] if graded is not None else entry["fraction_change"]
     raise ConvergenceError(
         f"discretization.tolerance = {tolerance:g} not reached after {step} grading steps and {raises} order raises "

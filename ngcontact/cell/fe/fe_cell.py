@@ -3,7 +3,14 @@
 :class:`FECell` holds a :class:`~ngcontact.cell.fe.cell_problem.CellProblem` on the scene's mesh and, for
 a flat 2D cell, the recipe of meshes graded towards given contact edges; it answers loads, sweeps,
 refinement to a tolerance (each load on its own graded mesh, checked by one order more:
-:mod:`ngcontact.cell.fe.edge_grading`) and the pressure response of the two-scale table.
+:mod:`ngcontact.cell.fe.edge_grading`; a cell that cannot be graded by a second discretization and the
+difference: :mod:`ngcontact.cell.fe.second_discretization`) and the pressure response of the two-scale
+table.
+
+Refinement by default (a scene that states no tolerance, :meth:`FECell.default_refinement`): a graded cell
+refines to the default tolerance (its levels stop where the estimate meets it, and the graded meshes cost
+a few times the scene's); any other cell is estimated by its second discretization and flagged when over,
+if that discretization stays within :data:`DEFAULT_DOFS`, else not estimated.
 
 The response at a mean pressure ``p``: ``k_n0`` is eq. 34 on the real contact set, ``k_n`` times the
 contact fraction (located by the roots of the penetration in 2D) on a flat frictionless cell, else the
@@ -30,11 +37,15 @@ from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.cell.fe.edge_grading import GradedSolve, solve_to_tolerance
 from ngcontact.cell.fe.load_start import Predictor
+from ngcontact.cell.fe.second_discretization import compare, second_of
 from ngcontact.cell.fe.measures import contact_fraction, contact_integral, mean_jump, real_contact_coefficients
 from ngcontact.errors import ModelError
 from ngcontact.fem.quadrature import smooth_order
 
 log = logging.getLogger(__name__)
+
+#: the most dofs of the second discretization that estimates a cell's error by default (per dimension)
+DEFAULT_DOFS = {2: 120_000, 3: 40_000}
 
 
 class FECell:
@@ -57,18 +68,31 @@ class FECell:
     h0
         The interface element size of the ungraded mesh (the grading's level 0).
     predictor
-        The start of first loads whose contact edges seed the graded meshes, or ``None``.
+        ``() ->`` the start of first loads whose contact edges seed the graded meshes (built when first
+        asked), or ``None``.
+    variant
+        ``(**changes) -> FECell`` of the same scene with ``order``, ``interface_maxh``, ``enforcement`` or
+        ``k_n`` changed, ``None`` where the scene's checks refuse the change; ``None``: no variants.
+    interface_maxh
+        The scene's interface element size (the second discretization halves it where the order cannot rise).
+    twin
+        ``() -> CellSolver``: the spectral cell of the same small-slope model on a grid that resolves the
+        contact edges, where the cell has one (the penalty's share is measured on it), else ``None``.
     """
 
     def __init__(self, cell, model: CellModel, make_problem: Callable[[], CellProblem], *,
                  threshold: float | None = None, graded: Callable[[list[float], int], CellProblem] | None = None,
-                 h0: float | None = None, predictor: Predictor | None = None):
+                 h0: float | None = None, predictor: Callable[[], Predictor | None] | None = None,
+                 variant: Callable[..., FECell | None] | None = None, interface_maxh: float | None = None,
+                 twin: Callable[[], Any] | None = None):
         self.cell, self.model, self._make_problem = cell, model, make_problem
+        self.variant, self.interface_maxh, self.twin = variant, interface_maxh, twin
         self.dim = cell.dim
         self.period = float(cell.period[0])
         self.threshold = threshold
         self.graded, self.h0, self.predictor = graded, h0, predictor
         self._problem: CellProblem | None = None
+        self._scene_ndof: int | None = None
 
     @classmethod
     def of(cls, problem: CellProblem, **options) -> FECell:
@@ -80,7 +104,14 @@ class FECell:
         """The cell problem of the last solve (the scene's mesh, or the last load's graded one)."""
         if self._problem is None:
             self._problem = self._make_problem()
+            self._scene_ndof = self._scene_ndof or int(self._problem.ndof)
         return self._problem
+
+    def scene_unknowns(self) -> int:
+        """The dofs of the scene's own discretization (before any refinement replaced the problem)."""
+        if self._scene_ndof is None:
+            self._scene_ndof = int(self._make_problem().ndof) if self._problem is not None else self.unknowns()
+        return self._scene_ndof
 
     # ------------------------------------------------------------ description
     def unknowns(self) -> int:
@@ -102,19 +133,65 @@ class FECell:
     def sweep(self, loads: list[CellLoad]) -> list[CellSolution]:
         return self.problem.sweep(loads)
 
-    def refine_to(self, tolerance: float, loads: list[CellLoad]) -> Refinement:
+    def penalty(self) -> float | None:
+        return float(self.model.k_n) if self.model.enforcement == "penalty" else None
+
+    def share_solver(self):
+        """The spectral twin where the cell has one (the share is the model's, the same on any discretization
+        that resolves it, and the twin's grid resolves the contact edges far below the mesh), else this cell."""
+        return self.twin() if self.twin is not None else self
+
+    def varied(self, *, enforcement: str | None = None, k_n: float | None = None) -> FECell | None:
+        changes = {k: v for k, v in (("enforcement", enforcement), ("k_n", k_n)) if v is not None}
+        return self.variant(**changes) if self.variant is not None else None
+
+    def second(self):
+        """The richer discretization of the error estimate without grading
+        (:func:`~ngcontact.cell.fe.second_discretization.second_of`), ``None`` where the cell has no variants."""
+        if self.variant is None or self.interface_maxh is None:
+            return None
+        return second_of(self.dim, self.model.order, self.model.enforcement, self.interface_maxh)
+
+    def default_refinement(self) -> str:
+        """What a scene without a tolerance affords (module docstring): ``"graded"`` (refined to the default
+        tolerance), ``"compared"`` (estimated by the second discretization, flagged when over) or ``"none"``
+        (the second discretization would exceed :data:`DEFAULT_DOFS`; not estimated)."""
+        if self.graded is not None and self.h0 is not None:
+            return "graded"
+        second = self.second()
+        if second is None or second.ndof(self.scene_unknowns(), self.dim, self.model.order) > DEFAULT_DOFS[self.dim]:
+            return "none"
+        return "compared"
+
+    def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Each load on its own mesh, graded towards its contact edges until ``tolerance`` is met
-        (:func:`~ngcontact.cell.fe.edge_grading.solve_to_tolerance`); the last load's problem becomes this
-        cell's."""
-        if self.graded is None or self.h0 is None:
-            raise ModelError("a tolerance on the FE cell is built for flat 2D cells (graded towards the contact "
-                             "edges); this cell cannot be graded")
+        (:func:`~ngcontact.cell.fe.edge_grading.solve_to_tolerance`), the last load's problem becoming this
+        cell's; a cell that cannot be graded: the sweep on the scene's and a second discretization
+        (:mod:`~ngcontact.cell.fe.second_discretization`), the second's problem becoming this cell's.
+
+        ``required = False`` (the default tolerance): out of reach, the best answer with its estimate; a
+        cell whose second discretization is beyond :data:`DEFAULT_DOFS` is solved once, not estimated.
+        """
+        refined = self._compared(tolerance, loads, required) if self.graded is None or self.h0 is None \
+            else self._graded(tolerance, loads, required)
+        worst = max((max(e.values()) for e in refined.estimates if e), default=0.0)
+        if worst > tolerance:        # only where not required: a required tolerance out of reach has raised
+            log.warning("accuracy not met: the FE cell's estimated error %.3g exceeds the default tolerance %g (%s); "
+                        "refine interface_maxh or the order, or set discretization.tolerance", worst, tolerance,
+                        refined.how)
+        return refined
+
+    def _graded(self, tolerance: float, loads: list[CellLoad], required: bool) -> Refinement:
+        """Each load on meshes graded towards its contact edges (:meth:`refine_to`)."""
+        assert self.graded is not None and self.h0 is not None       # refine_to's choice
         period = self.period
         order = self.model.order
         out: list[GradedSolve] = []
         for k, load in enumerate(loads):
-            seed = self.predictor.edges(load) if self.predictor is not None else None
-            out.append(solve_to_tolerance(self.graded, load, tolerance, self.h0, period, order, seed=seed))
+            twin = self.predictor() if self.predictor is not None else None
+            seed = twin.edges(load) if twin is not None else None
+            out.append(solve_to_tolerance(self.graded, load, tolerance, self.h0, period, order, seed=seed,
+                                          required=required))
             log.info("load %d: contact fraction %.10g after %d grading steps", k,
                      out[-1].solution.results["contact_fraction"], len(out[-1].history) - 1)
         self._problem = out[-1].problem
@@ -126,6 +203,31 @@ class FECell:
                           histories=[g.newton for g in out],
                           how="each load on meshes graded towards its contact edges, then one order more: the larger "
                               "of the last grading change and the order's change")
+
+    def _compared(self, tolerance: float, loads: list[CellLoad], required: bool) -> Refinement:
+        """The sweep on the scene's discretization and on :meth:`second`, the difference the estimate."""
+        second = self.second()
+        if second is None or self.variant is None:
+            raise ModelError("this FE cell was built without the recipe of a second discretization")
+        if not required and self.default_refinement() == "none":
+            sols = self.sweep(loads)
+            how = (f"not estimated: the second discretization ({second.how}) would exceed {DEFAULT_DOFS[self.dim]} "
+                   "dofs; set discretization.tolerance to estimate it anyway")
+            log.warning("accuracy not known: %s", how)
+            return Refinement(solutions=sols, estimates=[{} for _ in sols], how=how)
+        richer = self.variant(order=second.order, **({"interface_maxh": second.interface_maxh}
+                                                     if second.interface_maxh is not None else {}))
+        if richer is None:
+            raise ModelError(f"the scene refuses its second discretization ({second.how})")
+        done = compare(lambda: self.sweep(loads), lambda: richer.sweep(loads), tolerance, required, second.how)
+        self._problem = richer.problem
+        per_load = [{"discretizations": [{"discretization": lv["discretization"],
+                                          "contact_fraction": lv["contact_fraction"][k],
+                                          "mean_closure": lv["mean_closure"][k]} for lv in done.levels],
+                     "newton_iterations": s.iterations}          # the reported (second) discretization's
+                    for k, s in enumerate(done.solutions)]
+        return Refinement(solutions=done.solutions, estimates=done.estimates, per_load=per_load,
+                          histories=[s.newton for s in done.solutions], how=second.how)
 
     def response(self, pressure: float, length_unit: float = 1.0) -> Response:
         """The response at ``pressure`` (module docstring), from a first load's start."""

@@ -41,14 +41,17 @@ class SpectralCellSolver:
         ``n -> SpectralCell`` of the same cell on ``n`` points per direction (refinement).
     max_points
         The most grid points refinement may use.
+    variant
+        ``(**changes) -> SpectralCellSolver`` of the same scene and grid with ``enforcement`` or ``k_n``
+        changed (the penalty's share), ``None`` where refused.
     """
 
     def __init__(self, cell: SpectralCell, make_cell: Callable[[int], SpectralCell] | None = None,
-                 max_points: int | None = None):
+                 max_points: int | None = None, variant: Callable[..., SpectralCellSolver | None] | None = None):
         self.cell = cell
         self.dim = cell.dim
         self.period = cell.period
-        self.make_cell, self.max_points = make_cell, max_points
+        self.make_cell, self.max_points, self.variant = make_cell, max_points, variant
 
     # ------------------------------------------------------------ description
     def unknowns(self) -> int:
@@ -84,7 +87,7 @@ class SpectralCellSolver:
     def sweep(self, loads: list[CellLoad]) -> list[CellSolution]:
         return [self.solution(s) for s in self.cell.sweep(loads)]
 
-    def refine_to(self, tolerance: float, loads: list[CellLoad]) -> Refinement:
+    def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Grids from the scene's up until the estimate meets ``tolerance``
         (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`); the finest grid's cell becomes this
         solver's."""
@@ -99,6 +102,17 @@ class SpectralCellSolver:
                           method={"grid": self.cell.grid, "points": self.cell.points,
                                   "refinement": refined.history},
                           how="grids of 4 times more points each: the change between the last two grids")
+
+    def penalty(self) -> float | None:
+        return float(self.cell.k_n) if self.cell.enforcement == "penalty" else None
+
+    def share_solver(self) -> SpectralCellSolver:
+        return self
+
+    def varied(self, *, enforcement: str | None = None, k_n: float | None = None) -> SpectralCellSolver | None:
+        """The same cell on the grid of the last solve with another enforcement or penalty."""
+        changes = {k: v for k, v in (("enforcement", enforcement), ("k_n", k_n)) if v is not None}
+        return self.variant(grid=self.cell.grid, **changes) if self.variant is not None else None
 
     def response(self, pressure: float, length_unit: float = 1.0) -> Response:
         """The response at ``pressure`` (module docstring), from zero pressure."""
