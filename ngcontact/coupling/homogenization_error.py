@@ -35,7 +35,8 @@ NO_CONSTANT = {"linear": "the whole-surface linear law glues every wall; where w
                          "with eps (the epsilon studies measure a field error that stays put): use the bundle law",
                "tabulated": "a tabulated pressure-closure law carries no tangential coupling of the walls; no epsilon "
                             "study measures its constant",
-               "file": "no epsilon study measures the constant of a law read from a file"}
+               "file": "no epsilon study measures the constant of a law read from a file",
+               "two_scale": "no epsilon study measures the constant of the two-scale loop's pressure-dependent law"}
 
 
 def estimate(law: str, period: float | None, length: float) -> dict[str, Any]:

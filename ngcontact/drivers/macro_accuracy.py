@@ -25,6 +25,7 @@ from dataclasses import replace
 from typing import Any, Callable
 
 from ngcontact.cell.admissibility import DEFAULT_TOLERANCE
+from ngcontact.coupling import homogenization_error
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.scene.schema import MAX_ORDER
@@ -127,4 +128,41 @@ def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], bal
         def safety_factor(s: MacroSolution) -> float:
             return linear_safety_factor(scene, s, recovery)
     samples = order_samples(scene, sol, solve, safety_factor)
-    return verdict(estimates(samples, sol), scene.discretization.tolerance, balance, two_scale)
+    out = verdict(estimates(samples, sol), scene.discretization.tolerance, balance, two_scale)
+    out["modelling"] = modelling(scene, sol)
+    return out
+
+
+def roughness_period(scene) -> float | None:
+    """The period of the roughness the scene's law homogenizes [m]: ``interface.roughness_period``, else the
+    law's cell's (or the two-scale loop's) period times ``cell_length_unit``, else ``None``."""
+    spec = scene.interface
+    if spec.roughness_period is not None:
+        return float(spec.roughness_period)
+    cell, unit = spec.cell, spec.cell_length_unit
+    if cell is None and scene.two_scale is not None:
+        cell, unit = scene.two_scale.cell, scene.two_scale.cell_length_unit
+    if cell is None:
+        return None
+    from ngcontact.scene import loader
+    from ngcontact.scene.sections import resolve
+    return float(loader.load(resolve(scene, cell)).geometry.period) * float(unit)
+
+
+def modelling(scene, sol: MacroSolution) -> dict[str, Any]:
+    """The modelling error of the homogenized interface, estimated from the ratio of the roughness period to
+    the interface's length (:mod:`ngcontact.coupling.homogenization_error`; 3D: the square root of its area),
+    beside the discretization error; a period not below the interface's length is no homogenization."""
+    import ngsolve as ng
+    mesh = sol.problem.mesh
+    size = float(ng.Integrate(ng.CF(1.0), mesh, ng.BND, definedon=mesh.Boundaries(sol.problem.interface)))
+    length = size ** 0.5 if mesh.dim == 3 else size
+    period = roughness_period(scene)
+    law = "two_scale" if scene.two_scale is not None else scene.interface.law
+    out = homogenization_error.estimate(law, period, length)
+    if period is not None and period >= length:
+        out.update(estimated=False, relative_error=None,
+                   how=f"not estimated: the roughness period {period:.3g} m is not smaller than the interface's "
+                       f"length {length:.3g} m; state interface.roughness_period (or the cell's length unit, "
+                       "interface.cell_length_unit) in metres")
+    return out

@@ -126,7 +126,10 @@ def accuracy_line(results: dict) -> str | None:
     parts = [f"{n} {q['value']:.4g} " + ("(no estimate)" if q.get("relative_error") is None
                                         else f"+/- {q['relative_error']:.2%}") for n, q in worst.items()]
     verdict = "met" if acc.get("met") else "NOT met"
-    return f"accuracy {verdict} (tolerance {acc['tolerance']:.3g}): " + ", ".join(parts)
+    model = acc.get("modelling") or {}
+    tail = (f"; modelling error of the homogenized interface ~ {model['relative_error']:.2%} (estimate C eps / L)"
+            if model.get("relative_error") is not None else "")
+    return f"accuracy {verdict} (tolerance {acc['tolerance']:.3g}): " + ", ".join(parts) + tail
 
 
 def file_names(outcome: Outcome) -> list[str]:

@@ -137,6 +137,11 @@ class InterfaceSpec:
                              "bundle (law = linear: its K0); then omit the explicit numbers")
     cell_length_unit: float = param(1.0, doc="length of one unit of the cell scene (scales its gaps)",
                                     units="m", check=positive())
+    roughness_period: float | None = param(None, doc="the period eps of the roughness the law homogenizes, for "
+                                           "the report's modelling-error estimate C eps / L "
+                                           "(results.accuracy.modelling); default: a cell's period times "
+                                           "cell_length_unit, none for a law given by its numbers",
+                                           units="m", check=positive())
     kn: float | None = param(None, doc="k_n0 of the linear law", units="Pa/m", check=positive())
     kt: float = param(0.0, doc="k_t0 (linear law; tabulated: tangential stiffness)", units="Pa/m",
                       check=nonnegative())

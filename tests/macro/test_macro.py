@@ -376,6 +376,10 @@ def test_block_on_a_sawtooth_cell_scene_transmits_the_load(tmp_path, monkeypatch
     assert abs(R["x"] - 2e6 * L) < 1e-8 * 2e6 * L and abs(R["y"] + 10e6 * L) < 1e-8 * 10e6 * L
     assert "open" not in out.results["interface"]["status"]
     assert out.results["law"]["directions"] == 2
+    # the modelling error of the cell's bundle law: C eps / L with eps = 1 cell unit of 0.1 mm, L = 20 mm
+    model = out.results["accuracy"]["modelling"]
+    assert model["estimated"] and model["eps_over_length"] == pytest.approx(1e-4 / L, rel=1e-9)
+    assert model["relative_error"] == pytest.approx(0.48 * 1e-4 / L, rel=1e-9)
 
 
 def test_femur_law_from_the_hip_cell_is_the_papers_32_GPa(tmp_path, monkeypatch):

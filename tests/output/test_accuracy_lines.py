@@ -29,3 +29,13 @@ def test_unmet_quantities_head_the_page():
     assert "von_mises_base" in lines[0] and "no error estimate: a stress singularity" in lines[0]
     assert lines[1].endswith("load 1, contact_fraction = 0.3, estimated relative error 0.033")
     assert accuracy_warnings({"results": {"accuracy": dict(VERDICT, met=True)}}) == []
+
+
+def test_the_terminal_line_ends_with_the_modelling_error_where_it_is_estimated():
+    modelling = {"estimated": True, "relative_error": 3.7e-4, "eps_over_length": 7.7e-4, "constant": 0.48,
+                 "how": "an estimate C eps / L"}
+    line = accuracy_line({"accuracy": dict(VERDICT, modelling=modelling)})
+    assert line is not None and line.endswith("; modelling error of the homogenized interface ~ 0.04% "
+                                              "(estimate C eps / L)")
+    none = dict(modelling, estimated=False, relative_error=None, how="not estimated: no period")
+    assert "modelling" not in (accuracy_line({"accuracy": dict(VERDICT, modelling=none)}) or "")
