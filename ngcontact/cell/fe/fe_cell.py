@@ -102,10 +102,15 @@ class FECell:
     def sweep(self, loads: list[CellLoad]) -> list[CellSolution]:
         return self.problem.sweep(loads)
 
-    def refine_to(self, tolerance: float, loads: list[CellLoad]) -> Refinement:
+    def refines_by_default(self) -> bool:
+        """No: a sweep without a stated tolerance keeps its fixed mesh (the FE cell's estimates are built
+        for graded flat 2D cells only)."""
+        return False
+
+    def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Each load on its own mesh, graded towards its contact edges until ``tolerance`` is met
-        (:func:`~ngcontact.cell.fe.edge_grading.solve_to_tolerance`); the last load's problem becomes this
-        cell's."""
+        (:func:`~ngcontact.cell.fe.edge_grading.solve_to_tolerance`; out of reach it raises, ``required`` or
+        not); the last load's problem becomes this cell's."""
         if self.graded is None or self.h0 is None:
             raise ModelError("a tolerance on the FE cell is built for flat 2D cells (graded towards the contact "
                              "edges); this cell cannot be graded")
