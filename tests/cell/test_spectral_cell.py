@@ -302,6 +302,7 @@ def test_the_fe_cell_takes_the_same_self_affine_surface_as_its_gap(tmp_path):
     text = open(SELF_AFFINE).read().replace('enforcement = "exact"', 'enforcement = "penalty"')
     text = text.replace("pressure = [0.001, 0.003, 0.01]", "pressure = [0.01]")
     text = text.replace("rolloff = 0.25, cutoff = 0.03125, grid = 256", "rolloff = 0.5, cutoff = 0.25, grid = 16")
+    text = "\n".join(line for line in text.splitlines() if not line.startswith("grid = "))   # the first grid
     fe_text = text.replace('method = "spectral"', "order = 2\nmaxh = 0.5\ninterface_maxh = 0.1")
     fe, _ = _run(tmp_path, fe_text, "fe")
     # the spectral grid samples the map's bilinear interpolant, the gap the FE cell integrates

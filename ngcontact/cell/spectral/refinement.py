@@ -26,19 +26,23 @@ the next.  The estimate here is a geometric tail bound over the last ``WINDOW`` 
    two successive differences disagree in rate, take the larger"), held to ``[RATE_FLOOR, RATE_CAP]``:
    never faster than first order in ``h`` (``RATE_FLOOR = 1/2``, the counted contact edges' order), and a
    sequence not contracting by at least ``RATE_CAP`` is taken as contracting by it;
-3. the size of the next differences is the envelope ``D = max_i |d_(k-i)| ENVELOPE^i``: the last
-   difference, or an earlier one shrunk by the second order the smooth parts reach, whichever is larger,
-   so that a last difference that vanished by coincidence is bounded by the one before it;
+3. the size of the next differences is the envelope ``D = max_i |d_(k-i)| ENVELOPE^i`` with ``ENVELOPE =
+   1/2``: the last difference, or an earlier one shrunk at the same first order, whichever is larger, so
+   that a last difference that vanished by coincidence (a symmetric cell gives the same fraction on two
+   grids; a count of points whose constant jumps with the edges) is bounded by the ones before it;
 4. the estimate of the finest level is the tail of the geometric series, ``D rho / (1 - rho)`` (Richardson
    with the observed rate), in the measure the verdict controls (contact fraction absolute, mean closure
    relative: :data:`ngcontact.cell.admissibility.ESTIMATED`).
 
 Its effectivity (estimate over the true error of the reported level) is measured by
 ``scripts/spectral_effectivity.py`` on Westergaard's sinusoid, a random 2D profile and a 3D bisinusoid
-against each cell's own value on a much finer grid (:doc:`docs/benchmarks.md`): the floor of the rate
+against each cell's own value on a much finer grid (``docs/benchmarks.md``): the floor of the rate
 makes it at least 1 where the error follows its envelope; it exceeds 10 where the reported level's error
-happens to cross zero (no estimate from differences can see that).  No safety factor beyond the floor of
-the rate is applied: the measured spread of the effectivity leaves none to spend.
+happens to cross zero, or where the sequence leaves a pre-asymptotic stretch for a much faster regime (the
+2D edge fit once its window holds enough points): no estimate from differences can see either.  First
+order in both the rate's floor and the envelope is the only safety factor: it is the slowest convergence of
+any estimated quantity (the counted 3D contact fraction, pre-asymptotic on coarse grids), so an estimate
+meant to bound every quantity can assume nothing faster.
 
 A stop needs ``MIN_LEVELS`` levels (three differences: the window).  The levels are known before the first
 solve (``grid`` times ``GROWTH^k`` up to ``max_points``, :func:`levels`; the scene layer bounds
@@ -69,8 +73,8 @@ MIN_LEVELS = WINDOW + 1
 #: the slowest and the fastest contraction per level the estimate assumes (module docstring)
 RATE_FLOOR = 0.5
 RATE_CAP = 0.7
-#: an earlier difference shrinks by this per level in the envelope (second order in the grid step)
-ENVELOPE = 0.25
+#: an earlier difference shrinks by this per level in the envelope (first order in the grid step)
+ENVELOPE = 0.5
 #: a last difference this many times below the envelope is said to have vanished (a remark only)
 VANISHED = 4.0
 #: the quantities estimated: whether the measure is relative
