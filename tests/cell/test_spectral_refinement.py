@@ -105,3 +105,53 @@ def test_the_shipped_exact_westergaard_scene_meets_one_in_a_million(tmp_path):
         exact = westergaard_contact_fraction(r * P_STAR, P_STAR)
         assert abs(load["contact_fraction"] - exact) <= 1e-6 * exact
         assert max(load["error_estimate"].values()) <= 1e-6
+
+
+def _report(tmp_path, text, *args):
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    code = cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet", *args])
+    return code, (json.loads((tmp_path / "o" / "report.json").read_text()) if code == 0 else None)
+
+
+def test_a_spectral_scene_without_a_tolerance_is_refined_to_the_default_one(tmp_path):
+    code, rep = _report(tmp_path, sinusoid_cell(pressure="0.0034523", depth="2.0"))
+    assert code == 0
+    acc, method = rep["results"]["accuracy"], rep["results"]["method"]
+    assert acc["tolerance_from"] == "default" and acc["tolerance"] == 0.01 and acc["estimated"] and acc["met"]
+    assert [level["grid"] for level in method["refinement"]][0] == 256 and method["grid"] >= 256 * 8
+    exact = westergaard_contact_fraction(0.0034523, P_STAR)
+    load = rep["results"]["loads"][0]
+    assert abs(load["contact_fraction"] - exact) <= load["error_estimate"]["contact_fraction"] <= 0.01
+
+
+def test_a_default_tolerance_out_of_reach_is_reported_not_failed(tmp_path, caplog, monkeypatch):
+    """Within the default size bound too few grids: the finest is the answer, unmet, with one warning line."""
+    from ngcontact.scene import spectral_grid
+    monkeypatch.setitem(spectral_grid.DEFAULT_REFINEMENT_POINTS, 2, 1024)
+    code, rep = _report(tmp_path, sinusoid_cell(pressure="0.0034523"))
+    assert code == 0
+    acc = rep["results"]["accuracy"]
+    assert rep["results"]["method"]["grid"] == 1024 and acc["tolerance_from"] == "default" and not acc["met"]
+    lines = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert sum(m.startswith("accuracy not met") and "default tolerance 0.01" in m for m in lines) == 1, lines
+
+
+def test_a_stated_tolerance_out_of_reach_ends_the_run(tmp_path, capsys, monkeypatch):
+    from ngcontact.scene import spectral_grid
+    monkeypatch.setitem(spectral_grid.MAX_SPECTRAL_POINTS, 2, 1024)      # three grids from 256
+    code, _ = _report(tmp_path, sinusoid_cell(discretization='method = "spectral"\ngrid = 256\ntolerance = 1e-6'))
+    assert code == 3 and "tolerance = 1e-06 not met" in capsys.readouterr().err
+
+
+def test_independent_loads_and_geometric_runs_are_not_refined(tmp_path):
+    text = sinusoid_cell(pressure="0.001, 0.003").replace("[discretization]", "independent = true\n[discretization]")
+    code, rep = _report(tmp_path, text, "--workers", "1")
+    assert code == 0 and rep["results"]["method"]["grid"] == 256 and "refinement" not in rep["results"]["method"]
+    acc = rep["results"]["accuracy"]
+    assert not acc["estimated"] and acc["how"].startswith("not estimated") and acc["tolerance_from"] == "default"
+    text = sinusoid_cell().replace("[load]\npressure = [0.005]\n", "").replace(
+        'enforcement = "exact"', 'enforcement = "exact"\ngeometric_only = true')
+    (tmp_path / "g").mkdir()
+    code, rep = _report(tmp_path / "g", text)
+    assert code == 0 and "whole_surface" in rep["results"] and "loads" not in rep["results"]
