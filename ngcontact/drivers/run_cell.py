@@ -103,13 +103,14 @@ def warn_unmet(verdict: dict, refinement: Refinement) -> None:
                 what, verdict["tolerance_from"], verdict["tolerance"], refinement.how.split(";")[0])
 
 
-def refine(scene, cell, loads) -> Refinement | None:
+def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
     """The sweep refined to the scene's tolerance, or to the default one where the cell refines by default
-    (not for independent loads), else ``None`` (the fixed discretization)."""
+    (not for independent loads, nor where the caller says not ``by_default``), else ``None`` (the fixed
+    discretization)."""
     tolerance = scene.discretization.tolerance
     if tolerance is not None:
         return cell.refine_to(tolerance, loads, required=True)
-    if scene.load.independent or not cell.refines_by_default():
+    if not by_default or scene.load.independent or not cell.refines_by_default():
         return None
     return cell.refine_to(admissibility.DEFAULT_TOLERANCE, loads, required=False)
 
@@ -123,8 +124,9 @@ def warn_before_solving(facts: dict[str, float]) -> None:
             log.warning("accuracy not met, known before solving: %s%s", c.message(), hint)
 
 
-def run(scene, clock) -> Outcome:
-    """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`)."""
+def run(scene, clock, refine_by_default: bool = True) -> Outcome:
+    """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`).  ``refine_by_default =
+    False``: no refinement unless the scene states a tolerance (an ensemble's members)."""
     with clock.stage("setup"):
         cell = cell_solver(scene)
         facts = cell_facts(scene)
@@ -139,7 +141,7 @@ def run(scene, clock) -> Outcome:
     loads = cell_loads(scene)
     refinement: Refinement | None = None
     with clock.stage("solve"):
-        refinement = refine(scene, cell, loads)
+        refinement = refine(scene, cell, loads, refine_by_default)
         if refinement is not None:
             sols = refinement.solutions
             if method is not None:
