@@ -81,8 +81,10 @@ class CellDiscretization(Discretization):
     method: str = param("fe", doc="fe: finite elements on a mesh of the cell; spectral: the small-slope cell "
                         "(flat interface, the roughness in the initial gap) as two periodic layers solved with "
                         "FFTs on a uniform grid of the interface", choices=("fe", "spectral"))
-    grid: int | None = param(None, doc="spectral: grid points per period and direction (default: a height "
-                             "map's own grid, else 1024 in 2D and 256 in 3D)", check=closed_interval(8, MAX_GRID))
+    grid: int | None = param(None, doc="spectral: grid points per period and direction of the first grid, "
+                             "which refinement to the tolerance (the scene's or the default) doubles (default: a "
+                             "height map's own grid, else 1024 in 2D and 256 in 3D)",
+                             check=closed_interval(8, MAX_GRID))
 
 
 @dataclass(frozen=True, kw_only=True)
