@@ -1,11 +1,19 @@
-"""How honest is the spectral cell's refinement estimate? Its effectivity on Westergaard's sinusoid.
+"""How honest is the spectral cell's refinement estimate? Its effectivity on three oracles.
 
-The spectral cell's refinement (``discretization.tolerance``, ``ngcontact.cell.spectral.refinement``)
-estimates the error of a grid's contact fraction by its change from the grid of 4 times fewer points.  The
-oracle is the converged value of the same model (two elastic layers of finite depth: Westergaard's half-space
-formula differs from it by the layers' finite depth), taken on the finest grid here.  For each load and grid
-the script writes the contact fraction, the estimate, the true error against that reference and their ratio,
-the effectivity (issue 35 asks for it between 1 and 10 on every oracle).
+The spectral cell's refinement (``discretization.tolerance``, ``ngcontact.cell.spectral.refinement``) stops
+on the first grid whose estimate meets the tolerance and reports that grid's answer.  Here each oracle is
+refined to several tolerances exactly as a run does, and the estimate of each load's contact fraction
+(absolute) and mean closure (relative) on the reported grid is held against its true error: the
+difference from the same cell's value on a much finer grid (the cells have layers of finite depth, so a
+half-space formula is not their converged value).  The ratio is the effectivity (issue 35 asks for it
+between 1 and 10 on every oracle).  Oracles, each with three loads and exact contact:
+
+* ``westergaard``: Westergaard's sinusoid ``2h sin^2(pi x)``, layers of depth 1, first grid 64, reference
+  on 65536 points;
+* ``random_2d``: a self-affine profile of 64 samples (Hurst 0.8, rms slope 0.1) as its piecewise linear
+  interpolant, first grid 64, reference on 65536 points;
+* ``bisinusoid_3d``: ``h (2 - cos 2 pi x - cos 2 pi y)``, first grid 32, grids up to 256, reference on
+  1024 x 1024 points.
 
     python scripts/spectral_effectivity.py [OUT] [--publish]
 
@@ -16,6 +24,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -24,48 +34,105 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 
 from ngcontact.cell.cell_load import cell_load  # noqa: E402
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell  # noqa: E402
+from ngcontact.cell.spectral.refinement import sweep_to_tolerance  # noqa: E402
+from ngcontact.errors import ConvergenceError  # noqa: E402
+from ngcontact.geometry.random_surface import self_affine  # noqa: E402
 from ngcontact.output.writer import write_csv  # noqa: E402
-from ngcontact.verification.moduli import e_star  # noqa: E402
-from ngcontact.verification.westergaard import westergaard_p_star  # noqa: E402
 
 NU, H, DEPTH = 0.3, 0.01, 1.0
-RATIOS = (0.05, 0.2, 0.5, 0.8)
-GRIDS = (64, 256, 1024, 4096, 16384, 65536)
-KEYS = ("p_over_pstar", "grid", "contact_fraction", "estimate", "true_error", "effectivity")
+TOLERANCES = (1e-2, 1e-3, 1e-4)
+KEYS = ("oracle", "tolerance", "load", "pressure", "grid", "quantity", "value", "estimate", "true_error",
+        "effectivity")
 
 
-def fraction(grid: int, pressure: float) -> float:
-    """The contact fraction of the exact spectral cell on ``grid`` points at ``pressure``."""
-    x = np.arange(grid) / grid
-    cell = SpectralCell(dim=2, period=1.0, grid=grid, rough=Layer(1.0, NU, DEPTH), counter=Layer(1.0, NU, DEPTH),
-                        gap=2 * H * np.sin(np.pi * x) ** 2, k_n=1e3, enforcement="exact", tol=1e-12,
-                        max_iter=100000)
-    return float(cell.solve(cell_load(2, pressure=pressure)).results["contact_fraction"])
+@dataclass
+class Oracle:
+    """A spectral cell by its gap on ``n`` points, its loads, first grid, largest grid and reference grid."""
+
+    name: str
+    dim: int
+    gap: Callable[[int], np.ndarray]
+    pressures: tuple[float, ...]
+    first: int
+    largest: int
+    reference: int
 
 
-def rows() -> list[dict]:
-    pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H, 1.0)
+def westergaard_gap(n: int) -> np.ndarray:
+    return 2 * H * np.sin(np.pi * np.arange(n) / n) ** 2
+
+
+def random_profile_gap(n: int, samples: int = 64, seed: int = 5) -> np.ndarray:
+    """A self-affine profile of ``samples`` points as its periodic piecewise linear interpolant on ``n`` points."""
+    heights = self_affine(dim=2, grid=samples, hurst=0.8, rms_slope=0.1, seed=seed)
+    closed = np.append(heights, heights[0])
+    return np.interp(np.arange(n) / n, np.arange(samples + 1) / samples, closed.max() - closed)
+
+
+def bisinusoid_gap(n: int) -> np.ndarray:
+    s = np.arange(n) / n
+    return H * (2 - np.cos(2 * np.pi * s[None, :]) - np.cos(2 * np.pi * s[:, None]))
+
+
+ORACLES = (Oracle("westergaard", 2, westergaard_gap, (0.000863, 0.00345, 0.00863), 64, 2 ** 12, 2 ** 16),
+           Oracle("random_2d", 2, random_profile_gap, (0.001, 0.003, 0.01), 64, 2 ** 12, 2 ** 16),
+           Oracle("bisinusoid_3d", 3, bisinusoid_gap, (0.001, 0.004, 0.01), 32, 256, 1024))
+
+
+class Solved:
+    """A spectral cell whose sweep is solved once (the levels are shared by the tolerances)."""
+
+    cache: dict = {}
+
+    def __init__(self, oracle: Oracle, n: int):
+        self.oracle, self.n = oracle, n
+        self.cell = SpectralCell(dim=oracle.dim, period=1.0, grid=n, rough=Layer(1.0, NU, DEPTH),
+                                 counter=Layer(1.0, NU, DEPTH), gap=oracle.gap(n), k_n=1e3, enforcement="exact",
+                                 tol=1e-12, max_iter=100000)
+        self.points = self.cell.points
+
+    def sweep(self, loads):
+        key = (self.oracle.name, self.n)
+        if key not in self.cache:
+            self.cache[key] = self.cell.sweep(loads)
+        return self.cache[key]
+
+
+def oracle_rows(oracle: Oracle, tolerances=TOLERANCES) -> list[dict]:
+    """Per tolerance, load and quantity: the reported value, its estimate, true error and effectivity."""
+    loads = [cell_load(oracle.dim, pressure=p) for p in oracle.pressures]
+    reference = Solved(oracle, oracle.reference).sweep(loads)
     out = []
-    for r in RATIOS:
-        f = [fraction(n, r * pstar) for n in GRIDS]
-        reference = f[-1]
-        for k in range(1, len(GRIDS) - 1):        # the finest grid is the reference itself
-            estimate, error = abs(f[k] - f[k - 1]), abs(f[k] - reference)
-            out.append({"p_over_pstar": r, "grid": GRIDS[k], "contact_fraction": f[k], "estimate": estimate,
-                        "true_error": error, "effectivity": estimate / error if error > 0 else float("inf")})
+    for tol in tolerances:
+        try:
+            refined = sweep_to_tolerance(lambda n: Solved(oracle, n), loads, tol, oracle.first, oracle.dim,
+                                         oracle.largest ** (oracle.dim - 1))
+        except ConvergenceError:
+            continue                      # beyond the study's largest grid: nothing reported
+        for k, (sol, ref, est) in enumerate(zip(refined.solutions, reference, refined.estimates)):
+            for name, relative in (("contact_fraction", False), ("mean_closure", True)):
+                value, exact = sol.results[name], ref.results[name]
+                error = abs(value - exact) / (abs(exact) if relative else 1.0)
+                out.append({"oracle": oracle.name, "tolerance": tol, "load": k, "pressure": oracle.pressures[k],
+                            "grid": refined.history[-1]["grid"], "quantity": name, "value": value,
+                            "estimate": est[name], "true_error": error,
+                            "effectivity": est[name] / error if error > 0 else float("inf")})
     return out
 
 
 def plot(data: list[dict], path: str) -> None:
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for r in RATIOS:
-        pts = [(d["grid"], d["effectivity"]) for d in data if d["p_over_pstar"] == r and np.isfinite(d["effectivity"])]
-        ax.loglog(*zip(*pts), "o-", label=f"p/p* = {r}")
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    for (oracle, quantity), marker in zip([(o.name, q) for o in ORACLES for q in ("contact_fraction", "mean_closure")],
+                                          "os^vDx"):
+        pts = [(d["true_error"], d["effectivity"]) for d in data
+               if d["oracle"] == oracle and d["quantity"] == quantity and np.isfinite(d["effectivity"])]
+        if pts:
+            ax.loglog(*zip(*pts), marker, label=f"{oracle}, {quantity}")
     ax.axhspan(1.0, 10.0, color="0.9", label="aim: 1 to 10")
-    ax.set_xlabel("grid points")
+    ax.set_xlabel("true error of the reported grid")
     ax.set_ylabel("effectivity (estimate / true error)")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -76,16 +143,21 @@ def main(argv=None) -> int:
     ap.add_argument("out", nargs="?", default=os.path.join("results", "spectral_effectivity"), help="output directory")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
-    data = rows()
+    data = [row for oracle in ORACLES for row in oracle_rows(oracle)]
     os.makedirs(args.out, exist_ok=True)
     csv_path = os.path.join(args.out, "spectral_effectivity.csv")
     write_csv(csv_path, list(KEYS), [[d[k] for k in KEYS] for d in data])
     plot(data, os.path.join(args.out, "spectral_effectivity.png"))
+    effs = np.array([d["effectivity"] for d in data])
+    print(f"{len(effs)} estimates: effectivity from {effs.min():.3g} to {effs.max():.3g}, "
+          f"{int(((effs < 1) | (effs > 10)).sum())} outside [1, 10]")
     if args.publish:
         benchmark_doc.publish("spectral_effectivity", "The spectral refinement's estimate against the converged value",
-                              csv_path, note="Westergaard's sinusoid on two layers of depth 1, exact contact; the "
-                              "estimate is the change from the grid of 4 times fewer points, the true error is "
-                              "against the 65536-point value. Issue 35 asks for effectivities between 1 and 10.",
+                              csv_path, note="Three oracles (Westergaard's sinusoid and a random 64-sample profile "
+                              "in 2D, a bisinusoid in 3D), exact contact, layers of depth 1, each refined to the "
+                              "tolerances 1e-2, 1e-3, 1e-4 as a run does (grids doubling, the geometric tail of the "
+                              "last three differences); the true error of the reported grid is against the same "
+                              "cell on a much finer grid. Issue 35 asks for effectivities between 1 and 10.",
                               png=os.path.join(args.out, "spectral_effectivity.png"))
     return 0
 

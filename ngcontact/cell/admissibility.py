@@ -116,21 +116,23 @@ def quantities(loads: list[dict[str, Any]], estimates: Sequence[dict[str, float]
 
 
 def verdict(loads: list[dict[str, Any]], tolerance: float | None, cell: Sequence[Check] = (),
-            estimates: Sequence[dict[str, float]] | None = None, how: str = ""
+            estimates: Sequence[dict[str, float]] | None = None, how: str = "", reached: bool = True
             ) -> tuple[dict[str, Any], list[Check]]:
     """The report's verdict on a sweep's results and its failed checks.
 
     ``{"tolerance", "tolerance_from", "met", "checks", "estimated", "quantities", "how"}``: ``cell`` are the
     checks of the cell itself (:func:`cell_checks`); ``estimates`` the refinement's per load (``None``: the
-    discretization was not refined, and its error is not estimated), made as ``how`` says.
+    discretization was not refined, and its error is not estimated), made as ``how`` says; ``reached =
+    False``: the refinement stopped at its size bound before it could show the tolerance met (too few levels),
+    so the verdict is not met whatever the estimates.
     """
     limit = DEFAULT_TOLERANCE if tolerance is None else tolerance
     checks = list(cell) + [c for k, results in enumerate(loads) for c in load_checks(k, results, limit)]
     failed = [c for c in checks if not c.ok]
     estimated = quantities(loads, estimates, limit) if estimates is not None else []
     out = {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
-           "met": not failed and all(q["met"] for q in estimated), "checks": [c.as_dict() for c in checks],
+           "met": reached and not failed and all(q["met"] for q in estimated), "checks": [c.as_dict() for c in checks],
            "estimated": estimates is not None, "quantities": estimated,
-           "how": how if estimates is not None else "not estimated: set discretization.tolerance to refine the "
-                                                      "discretization and estimate its error"}
+           "how": how if estimates is not None else (how or "not estimated: set discretization.tolerance to refine "
+                                                             "the discretization and estimate its error")}
     return out, failed

@@ -65,6 +65,9 @@ class Refinement:
     histories: list[Any] = field(default_factory=list)
     #: how the estimates were made, in words for the report
     how: str = ""
+    #: whether the refinement reached its tolerance within the method's size bound (an unrequired
+    #: tolerance out of reach leaves the finest level as the answer, marked as not meeting it)
+    met: bool = True
 
 
 class CellSolver(Protocol):
@@ -93,17 +96,21 @@ class CellSolver(Protocol):
     def sweep(self, loads: list[CellLoad]) -> list[CellSolution]:
         """Solve the loads in order (each from the previous where the method continues)."""
 
+    def refines_by_default(self) -> bool:
+        """Whether a sweep whose scene states no tolerance is refined to the default one
+        (:data:`ngcontact.cell.admissibility.DEFAULT_TOLERANCE`) by :meth:`refine_to`."""
+
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Solve the loads on refined discretizations until the estimated error meets ``tolerance``.
 
-        ``required``: the scene stated the tolerance (out of reach is a failure); else it is the default
-        one, and out of reach the best answer is returned with its estimate (the verdict marks it as not met).
+        ``required``: the scene stated the tolerance (else it is the default one, and the method may bound
+        its discretization more tightly).
 
         Raises
         ------
         ConvergenceError
-            ``required`` and the tolerance is out of the method's reach (its largest discretization); the
-            message says how far it got.
+            A ``required`` tolerance is out of the method's reach (its largest discretization); the
+            message says how far it got.  An unrequired one returns the finest level with ``met = False``.
         """
 
     def penalty(self) -> float | None:

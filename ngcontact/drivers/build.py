@@ -35,7 +35,7 @@ from ngcontact.cell.spectral_start import SpectralStart
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
 from ngcontact.scene.cell_scene import CellScene, check_fe, has_twin, load_states, spectral_grid
-from ngcontact.scene.spectral_grid import MAX_SPECTRAL_POINTS
+from ngcontact.scene.spectral_grid import DEFAULT_REFINEMENT_POINTS, MAX_SPECTRAL_POINTS
 from ngcontact.scene.loader import as_dict, load_with_contact
 from ngcontact.scene.sections import MaterialSpec, resolve
 
@@ -288,8 +288,9 @@ def fe_variant(scene: CellScene, **changes) -> FECell | None:
 
 def spectral_cell_solver(scene: CellScene) -> SpectralCellSolver:
     """The spectral cell of a small-slope scene, with the recipe of its finer grids (refinement)."""
+    dim = scene.geometry.dim
     return SpectralCellSolver(spectral_cell(scene), make_cell=lambda n: spectral_cell(scene, grid=n),
-                              max_points=MAX_SPECTRAL_POINTS[scene.geometry.dim],
+                              max_points=MAX_SPECTRAL_POINTS[dim], default_max_points=DEFAULT_REFINEMENT_POINTS[dim],
                               variant=lambda grid, **changes: spectral_variant(scene, grid, **changes))
 
 

@@ -18,7 +18,11 @@ adds its own iteration counts to each load, its ``results.method`` record
 (the spectral cell's grid) and its grid fields as ``.npy``.  With
 ``discretization.tolerance`` the sweep is refined until the estimate meets
 it (:meth:`~ngcontact.cell.cell_solver.CellSolver.refine_to`) and each load
-adds ``error_estimate`` (FE: also ``mesh_history``).  With
+adds ``error_estimate`` (FE: also ``mesh_history``); without it a cell that
+refines by default (the spectral cell) is refined to
+:data:`~ngcontact.cell.admissibility.DEFAULT_TOLERANCE` within a tighter size
+bound, and one that misses it is reported with ``accuracy.met = false`` and
+one warning line rather than failed.  With
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers.
 """
@@ -64,12 +68,14 @@ def surface_plots(sols, dim: int, period: float) -> dict:
 def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[str, float],
                      refinement: Refinement | None = None) -> dict:
     """The sweep's verdict (:mod:`ngcontact.cell.admissibility`) with the cell's own ``facts`` and the
-    refinement's estimates: each failed check is one warning line; a plainly wrong answer is no answer
-    (exit 3)."""
+    refinement's estimates: each failed check is one warning line, and so is an estimate beyond the default
+    tolerance; a plainly wrong answer is no answer (exit 3)."""
+    estimated = refinement is not None and bool(refinement.estimates)
     verdict, failed = admissibility.verdict(
         per_load, tolerance, admissibility.cell_checks(facts),
-        estimates=None if refinement is None else refinement.estimates,
-        how="" if refinement is None else refinement.how)
+        estimates=refinement.estimates if estimated and refinement is not None else None,
+        how="" if refinement is None else refinement.how,
+        reached=refinement is None or refinement.met)
     wrong = [c for c in failed if c.plainly_wrong]
     if wrong:
         raise ConvergenceError(
@@ -79,7 +85,38 @@ def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[
     for c in failed:
         if c.load is not None:       # the cell's own checks were said before the solve
             log.warning("accuracy not met: %s", c.message())
+    if refinement is not None:
+        warn_unmet(verdict, refinement)
     return verdict
+
+
+def warn_unmet(verdict: dict, refinement: Refinement) -> None:
+    """One warning line for a refinement that did not meet its (default) tolerance: the largest estimate,
+    and what to do."""
+    unmet = [q for q in verdict["quantities"] if not q["met"]]
+    if not unmet and refinement.met:
+        return
+    if unmet:
+        q = max(unmet, key=lambda q: q["error"] if q["controlled"] == "absolute" else q["relative_error"])
+        size = q["error"] if q["controlled"] == "absolute" else q["relative_error"]
+        what = f"the estimated {q['controlled']} error {size:.3g} of load {q['load']}'s {q['name']} exceeds"
+    else:
+        what = "too few grids within the size bound to show"
+    log.warning("accuracy not met: %s the %s tolerance %g on the finest discretization allowed (%s); state "
+                "discretization.tolerance to refine beyond the default size bound, or a finer discretization",
+                what, verdict["tolerance_from"], verdict["tolerance"], refinement.how.split(";")[0])
+
+
+def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
+    """The sweep refined to the scene's tolerance, or to the default one where the cell refines by default
+    (not for independent loads, nor where the caller says not ``by_default``), else ``None`` (the fixed
+    discretization)."""
+    tolerance = scene.discretization.tolerance
+    if tolerance is not None:
+        return cell.refine_to(tolerance, loads, required=True)
+    if not by_default or scene.load.independent or not cell.refines_by_default():
+        return None
+    return cell.refine_to(admissibility.DEFAULT_TOLERANCE, loads, required=False)
 
 
 def warn_before_solving(facts: dict[str, float]) -> None:
@@ -91,8 +128,9 @@ def warn_before_solving(facts: dict[str, float]) -> None:
             log.warning("accuracy not met, known before solving: %s%s", c.message(), hint)
 
 
-def run(scene, clock) -> Outcome:
-    """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`)."""
+def run(scene, clock, refine_by_default: bool = True) -> Outcome:
+    """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`).  ``refine_by_default =
+    False``: no refinement unless the scene states a tolerance (an ensemble's members)."""
     with clock.stage("setup"):
         cell = cell_solver(scene)
         facts = cell_facts(scene)
@@ -111,8 +149,8 @@ def run(scene, clock) -> Outcome:
     loads = cell_loads(scene)
     refinement: Refinement | None = None
     with clock.stage("solve"):
-        if scene.discretization.tolerance is not None:
-            refinement = cell.refine_to(scene.discretization.tolerance, loads)
+        refinement = refine(scene, cell, loads, refine_by_default)
+        if refinement is not None:
             sols = refinement.solutions
             if method is not None:
                 results["method"].update(refinement.method)
@@ -125,7 +163,7 @@ def run(scene, clock) -> Outcome:
     for k, sol in enumerate(sols):
         entry = cell.load_entry(sol)
         small_strain.check(entry, height, f"load {k}")
-        if refinement is not None:
+        if refinement is not None and refinement.estimates:
             entry["error_estimate"] = refinement.estimates[k]
             if refinement.per_load:
                 entry.update(refinement.per_load[k])

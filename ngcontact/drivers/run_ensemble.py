@@ -5,8 +5,9 @@ surface of ``geometry.spectrum`` (or of a measured file's spectrum, profile
 ``measured_spectrum``) drawn with the seed ``seed + m``
 (:mod:`ngcontact.geometry.random_surface`); it is solved over the scene's
 loads by the ``cell`` driver (:mod:`ngcontact.drivers.run_cell`, spectral or
-FE as the scene says), in a worker of the run's batch
-(:mod:`ngcontact.parallel.executor`), and returns per load the contact
+FE as the scene says; on its own grid or mesh unless the scene states a
+``discretization.tolerance``: the members are not refined to the default one),
+in a worker of the run's batch (:mod:`ngcontact.parallel.executor`), and returns per load the contact
 fraction, ``k_n0`` on the real contact set (paper eq. 34), the normal
 effective stiffness, the mean closure and the transmitted pressure.
 
@@ -66,7 +67,7 @@ def realization(job: tuple) -> dict:
     """Member of the batch: ``(scene, m)`` -> the seed, the number of unknowns and every load's quantities."""
     scene, m = job
     sc = member_scene(scene, m)
-    outcome = run_cell.run(sc, Clock())
+    outcome = run_cell.run(sc, Clock(), refine_by_default=False)
     return {"seed": sc.geometry.random_seed, "ndof": int(outcome.ndof),
             "loads": [measured(e) for e in outcome.results["loads"]]}
 

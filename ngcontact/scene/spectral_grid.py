@@ -22,6 +22,10 @@ STEPS_PER_ROOT = 3.0
 #: Largest number of spectral grid points of a cell by dimension (2D: points, 3D: points squared): where the
 #: estimate of :func:`spectral_cost` reaches about a quarter of an hour per load (2D) or 1 GB (3D).
 MAX_SPECTRAL_POINTS = {2: 2 ** 20, 3: 2 ** 22}
+#: Largest number of grid points refinement to the default tolerance may reach (a scene that states no
+#: ``discretization.tolerance``): where :func:`spectral_cost` is of the order of seconds per load.  Beyond
+#: it the finest grid is the answer, marked as not meeting the default tolerance.
+DEFAULT_REFINEMENT_POINTS = {2: 2 ** 16, 3: 2 ** 18}
 #: Largest ``discretization.tolerance`` of a spectral cell relative to ``solver.rtol``: two grids' answers,
 #: each only within ``rtol`` of the gap's scale, cannot show a smaller change.
 TOLERANCE_OVER_RTOL = 10.0

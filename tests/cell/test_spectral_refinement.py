@@ -28,13 +28,13 @@ def test_the_refined_sweep_meets_its_tolerance_and_the_estimate_bounds_the_true_
     loads = [cell_load(2, pressure=r * P_STAR) for r in LOADS]
     refined = sweep_to_tolerance(_make, loads, 1e-5, 256, 2, 2 ** 20)
     assert refined.estimate <= 1e-5
-    assert [h["grid"] for h in refined.history] == [256 * 4 ** k for k in range(len(refined.history))]
-    assert len(refined.history) >= 2 and "estimate" not in refined.history[0]
+    assert [h["grid"] for h in refined.history] == [256 * 2 ** k for k in range(len(refined.history))]
+    assert len(refined.history) >= 4 and "estimate" not in refined.history[0]
     for r, sol, est in zip(LOADS, refined.solutions, refined.estimates):
         exact = westergaard_contact_fraction(r * P_STAR, P_STAR)
         assert abs(sol.results["contact_fraction"] - exact) <= est["contact_fraction"] + 1e-12
         assert abs(sol.results["contact_fraction"] - exact) <= 1e-5
-    # the estimate of a level is the change from the level before it
+    # the estimate of a level bounds the change from the level before it
     last, before = refined.history[-1], refined.history[-2]
     change = max(abs(a - b) for a, b in zip(last["contact_fraction"], before["contact_fraction"]))
     assert change <= refined.estimate
@@ -44,11 +44,11 @@ def test_a_tolerance_beyond_the_largest_grid_raises_with_the_history():
     loads = [cell_load(2, pressure=0.05 * P_STAR)]
     with pytest.raises(ConvergenceError, match="tolerance = 1e-12 not met") as err:
         sweep_to_tolerance(_make, loads, 1e-12, 256, 2, 4096)
-    assert [h["grid"] for h in err.value.history["levels"]] == [256, 1024, 4096]
+    assert [h["grid"] for h in err.value.history["levels"]] == [256, 512, 1024, 2048, 4096]
 
 
-def test_next_grid_multiplies_the_points_by_four():
-    assert next_grid(1024, 2) == 4096 and next_grid(128, 3) == 256
+def test_next_grid_doubles_the_points_per_direction():
+    assert next_grid(1024, 2) == 2048 and next_grid(128, 3) == 256
 
 
 SCENE = sinusoid_cell(pressure="0.0034523", depth="2.0",
@@ -78,18 +78,20 @@ def test_a_sampled_map_is_refined_as_its_bilinear_interpolant(tmp_path):
     contact.  The refined answer is the direct solve on the final grid."""
     from pathlib import Path
     text = (Path(__file__).parents[2] / "geometries" / "cells" / "self_affine_spectral.toml").read_text()
-    text = text.split("[discretization]")[0]
+    text = text.split("[discretization]")[0].replace("grid = 256, seed", "grid = 64, seed")   # samples: 64 x 64
     own = tmp_path / "own.toml"
-    own.write_text(text + "[discretization]\nmethod = \"spectral\"\ngrid = 64\ntolerance = 0.05\n")
+    own.write_text(text + "[discretization]\nmethod = \"spectral\"\ngrid = 32\ntolerance = 0.05\n")
     assert cli.main(["run", str(own), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     rep = json.loads((tmp_path / "o" / "report.json").read_text())["results"]
     grids = [level["grid"] for level in rep["method"]["refinement"]]
-    assert grids[0] == 64 and rep["method"]["grid"] == grids[-1] > 64
+    assert grids[0] == 32 and rep["method"]["grid"] == grids[-1] > 64
     assert all(max(load["error_estimate"].values()) <= 0.05 for load in rep["loads"])
     direct = tmp_path / "direct.toml"
-    direct.write_text(text + f"[discretization]\nmethod = \"spectral\"\ngrid = {grids[-1]}\n")
+    # independent loads: the direct solve on that grid alone (a sweep would be refined to the default tolerance)
+    direct.write_text(text + f"independent = true\n[discretization]\nmethod = \"spectral\"\ngrid = {grids[-1]}\n")
     assert cli.main(["run", str(direct), "--out", str(tmp_path / "d"), "--quiet"]) == 0
     again = json.loads((tmp_path / "d" / "report.json").read_text())["results"]
+    assert again["method"]["grid"] == grids[-1] and not again["accuracy"]["estimated"]
     assert [load["contact_fraction"] for load in again["loads"]] == [load["contact_fraction"] for load in rep["loads"]]
 
 
@@ -103,3 +105,53 @@ def test_the_shipped_exact_westergaard_scene_meets_one_in_a_million(tmp_path):
         exact = westergaard_contact_fraction(r * P_STAR, P_STAR)
         assert abs(load["contact_fraction"] - exact) <= 1e-6 * exact
         assert max(load["error_estimate"].values()) <= 1e-6
+
+
+def _report(tmp_path, text, *args):
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    code = cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet", *args])
+    return code, (json.loads((tmp_path / "o" / "report.json").read_text()) if code == 0 else None)
+
+
+def test_a_spectral_scene_without_a_tolerance_is_refined_to_the_default_one(tmp_path):
+    code, rep = _report(tmp_path, sinusoid_cell(pressure="0.0034523", depth="2.0"))
+    assert code == 0
+    acc, method = rep["results"]["accuracy"], rep["results"]["method"]
+    assert acc["tolerance_from"] == "default" and acc["tolerance"] == 0.01 and acc["estimated"] and acc["met"]
+    assert [level["grid"] for level in method["refinement"]][0] == 256 and method["grid"] >= 256 * 8
+    exact = westergaard_contact_fraction(0.0034523, P_STAR)
+    load = rep["results"]["loads"][0]
+    assert abs(load["contact_fraction"] - exact) <= load["error_estimate"]["contact_fraction"] <= 0.01
+
+
+def test_a_default_tolerance_out_of_reach_is_reported_not_failed(tmp_path, caplog, monkeypatch):
+    """Within the default size bound too few grids: the finest is the answer, unmet, with one warning line."""
+    from ngcontact.scene import spectral_grid
+    monkeypatch.setitem(spectral_grid.DEFAULT_REFINEMENT_POINTS, 2, 1024)
+    code, rep = _report(tmp_path, sinusoid_cell(pressure="0.0034523"))
+    assert code == 0
+    acc = rep["results"]["accuracy"]
+    assert rep["results"]["method"]["grid"] == 1024 and acc["tolerance_from"] == "default" and not acc["met"]
+    lines = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert sum(m.startswith("accuracy not met") and "default tolerance 0.01" in m for m in lines) == 1, lines
+
+
+def test_a_stated_tolerance_out_of_reach_ends_the_run(tmp_path, capsys, monkeypatch):
+    from ngcontact.scene import spectral_grid
+    monkeypatch.setitem(spectral_grid.MAX_SPECTRAL_POINTS, 2, 1024)      # three grids from 256
+    code, _ = _report(tmp_path, sinusoid_cell(discretization='method = "spectral"\ngrid = 256\ntolerance = 1e-6'))
+    assert code == 3 and "tolerance = 1e-06 not met" in capsys.readouterr().err
+
+
+def test_independent_loads_and_geometric_runs_are_not_refined(tmp_path):
+    text = sinusoid_cell(pressure="0.001, 0.003").replace("[discretization]", "independent = true\n[discretization]")
+    code, rep = _report(tmp_path, text, "--workers", "1")
+    assert code == 0 and rep["results"]["method"]["grid"] == 256 and "refinement" not in rep["results"]["method"]
+    acc = rep["results"]["accuracy"]
+    assert not acc["estimated"] and acc["how"].startswith("not estimated") and acc["tolerance_from"] == "default"
+    text = sinusoid_cell().replace("[load]\npressure = [0.005]\n", "").replace(
+        'enforcement = "exact"', 'enforcement = "exact"\ngeometric_only = true')
+    (tmp_path / "g").mkdir()
+    code, rep = _report(tmp_path / "g", text)
+    assert code == 0 and "whole_surface" in rep["results"] and "loads" not in rep["results"]

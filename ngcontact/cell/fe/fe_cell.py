@@ -163,6 +163,12 @@ class FECell:
             return "none"
         return "compared"
 
+    def refines_by_default(self) -> bool:
+        """No: a sweep without a stated tolerance keeps the scene's mesh and says it is not estimated.  The
+        default estimate (:meth:`default_refinement`: grading, or a second discretization) multiplies an FE
+        cell's run time several times over, so it is asked for by stating ``discretization.tolerance``."""
+        return False
+
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Each load on its own mesh, graded towards its contact edges until ``tolerance`` is met
         (:func:`~ngcontact.cell.fe.edge_grading.solve_to_tolerance`), the last load's problem becoming this

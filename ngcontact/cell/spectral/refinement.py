@@ -1,36 +1,56 @@
-"""The spectral cell on finer and finer grids until a tolerance is met.
+"""The spectral cell on finer and finer grids until a tolerance is met, with an error estimate that bounds.
 
 The grid is the spectral cell's only discretization parameter
-(:mod:`ngcontact.cell.spectral.layered_cell`): the collocated pressure and gap, and
-with them the contact set of eq. 57 and the coefficients of eq. 34 on it,
-converge as the grid step shrinks.  The error of the contact fraction falls
-like the grid step or faster (2D: the edges located between grid points,
-:mod:`ngcontact.cell.spectral.grid_measures`; 3D: a count of grid points, one
-layer of points at the contact edges), with a constant that depends on where
-the edges fall between points, so it does not fall smoothly enough for
-Richardson extrapolation.  Hence a comparison estimate on widely spaced
-levels:
+(:mod:`ngcontact.cell.spectral.layered_cell`): the collocated pressure and gap, and with them the contact
+set of eq. 57 and the coefficients of eq. 34 on it, converge as the grid step ``h`` shrinks.  How they
+converge decides the estimate:
 
-1. solve the whole load sweep on grid ``N_0`` (``discretization.grid``), then
-   on grids with ``GROWTH`` times the points of the previous one (2D:
-   ``4 N``; 3D: ``2 N`` per direction);
-2. the estimate of level ``k`` is, over the loads, the larger of
-   ``|f_k - f_(k-1)|`` (contact fraction, absolute) and
-   ``|c_k - c_(k-1)| / |c_k|`` (mean closure, relative): the error of the
-   coarser level, an upper bound of the finer one's once the sequence
-   contracts by the factor ``GROWTH`` per level;
-3. stop when it is at most the tolerance; the answer reported is the finest
-   level's.  A level beyond ``max_points`` raises
-   :class:`~ngcontact.errors.ConvergenceError` with the history.
+* the contact fraction is a count of grid points in 3D (one layer of points at the contact edges: an
+  error of order ``h`` whose constant depends on where the edges cross the grid) and in 2D has its edges
+  located between points (:mod:`ngcontact.cell.spectral.grid_measures`): faster once the edge fit holds,
+  but again with a constant that jumps with the edges' position between points;
+* the mean closure is a mean of the collocated jump: smoother, but its error changes sign as the grid
+  crosses the contact edges.
 
-The levels are known before the first solve (``grid`` times ``GROWTH^k``
-up to ``max_points``, :func:`levels`; the scene layer bounds
-``max_points`` by the cost of a solve,
-:func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest is stated
-first, and each level prints one progress line as it ends.
+So the sequence ``q_0, q_1, ...`` of a quantity on levels ``k`` has errors ``e_k = q_k - q`` that fall
+like ``rho^k`` on the whole, but level to level by an erratic factor, and that may cross zero.  A
+Richardson estimate from the last two levels alone fails both ways: a difference that vanishes by a
+coincidence of the edges (a symmetric cell gives the same fraction on two grids) estimates zero, and the
+last difference of a sequence whose earlier levels were far from the asymptotic regime says nothing of
+the next.  The estimate here is a geometric tail bound over the last ``WINDOW`` differences
+``d_j = q_j - q_(j-1)`` (``j = k, k-1, k-2``):
 
-Each level solves from scratch: nothing carries between grids but the
-comparison, so a frictional load path is simply solved again per level.
+1. levels double the points per direction (:data:`GROWTH`): close enough that three differences cost
+   little more than the finest level (2D: twice the finest; 3D: 4/3 of it);
+2. the observed rate is the larger of the successive ratios ``|d_j| / |d_(j-1)|`` in the window ("where
+   two successive differences disagree in rate, take the larger"), held to ``[RATE_FLOOR, RATE_CAP]``:
+   never faster than first order in ``h`` (``RATE_FLOOR = 1/2``, the counted contact edges' order), and a
+   sequence not contracting by at least ``RATE_CAP`` is taken as contracting by it;
+3. the size of the next differences is the envelope ``D = max_i |d_(k-i)| ENVELOPE^i`` with ``ENVELOPE =
+   1/2``: the last difference, or an earlier one shrunk at the same first order, whichever is larger, so
+   that a last difference that vanished by coincidence (a symmetric cell gives the same fraction on two
+   grids; a count of points whose constant jumps with the edges) is bounded by the ones before it;
+4. the estimate of the finest level is the tail of the geometric series, ``D rho / (1 - rho)`` (Richardson
+   with the observed rate), in the measure the verdict controls (contact fraction absolute, mean closure
+   relative: :data:`ngcontact.cell.admissibility.ESTIMATED`).
+
+Its effectivity (estimate over the true error of the reported level) is measured by
+``scripts/spectral_effectivity.py`` on Westergaard's sinusoid, a random 2D profile and a 3D bisinusoid
+against each cell's own value on a much finer grid (``docs/benchmarks.md``): the floor of the rate
+makes it at least 1 where the error follows its envelope; it exceeds 10 where the reported level's error
+happens to cross zero, or where the sequence leaves a pre-asymptotic stretch for a much faster regime (the
+2D edge fit once its window holds enough points): no estimate from differences can see either.  First
+order in both the rate's floor and the envelope is the only safety factor: it is the slowest convergence of
+any estimated quantity (the counted 3D contact fraction, pre-asymptotic on coarse grids), so an estimate
+meant to bound every quantity can assume nothing faster.
+
+A stop needs ``MIN_LEVELS`` levels (three differences: the window).  The levels are known before the first
+solve (``grid`` times ``GROWTH^k`` up to ``max_points``, :func:`levels`; the scene layer bounds
+``max_points`` by the cost of a solve, :func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest
+is stated first, and each level prints one progress line as it ends.  A tolerance out of reach ends in a
+:class:`~ngcontact.errors.ConvergenceError` where it was required (the scene stated it), else the finest
+level is the answer, marked as not meeting it.  Each level solves from scratch: nothing carries between
+grids but the comparison, so a frictional load path is simply solved again per level.
 """
 from __future__ import annotations
 
@@ -45,18 +65,37 @@ log = logging.getLogger(__name__)
 #: the run's progress lines (printed as its stage lines, :func:`ngcontact.runner.solve`)
 progress = logging.getLogger("ngcontact.progress")
 
-#: points of a level over those of the previous level
-GROWTH = 4
+#: points per direction of a level over those of the previous level
+GROWTH = 2
+#: the differences the estimate looks at, and the fewest levels a stop needs
+WINDOW = 3
+MIN_LEVELS = WINDOW + 1
+#: the slowest and the fastest contraction per level the estimate assumes (module docstring)
+RATE_FLOOR = 0.5
+RATE_CAP = 0.7
+#: an earlier difference shrinks by this per level in the envelope (first order in the grid step)
+ENVELOPE = 0.5
+#: a last difference this many times below the envelope is said to have vanished (a remark only)
+VANISHED = 4.0
+#: the quantities estimated: whether the measure is relative
+QUANTITIES = {"contact_fraction": False, "mean_closure": True}
+#: how the estimate is made, for the report
+HOW = ("grids of twice the points per direction each; per quantity the geometric tail of the last "
+       f"{WINDOW} differences, rate the larger successive ratio held to [{RATE_FLOOR}, {RATE_CAP}], "
+       "an earlier difference bounding a vanished last one")
 
 
 @dataclass
 class RefinedSweep:
-    """The finest level's cell and solutions, the estimate per load and the history of levels."""
+    """The finest level's cell and solutions, the estimate per load, the history of levels, whether the
+    tolerance is met, and the estimate's remarks (guards that acted) per load."""
 
     cell: Any
     solutions: list
     estimates: list[dict[str, float]]
     history: list[dict[str, Any]] = field(default_factory=list)
+    met: bool = True
+    remarks: list[str] = field(default_factory=list)
 
     @property
     def estimate(self) -> float:
@@ -64,19 +103,40 @@ class RefinedSweep:
 
 
 def next_grid(grid: int, dim: int) -> int:
-    """Points per direction of the next level: ``GROWTH`` times the points in all."""
-    return grid * GROWTH if dim == 2 else grid * round(GROWTH ** 0.5)
+    """Points per direction of the next level: ``GROWTH`` times as many."""
+    return grid * GROWTH
 
 
-def level_change(coarse: list, fine: list) -> list[dict[str, float]]:
-    """Per load, the change of the contact fraction (absolute) and of the mean closure (relative)."""
-    out = []
-    for a, b in zip(coarse, fine):
-        fa, fb = a.results["contact_fraction"], b.results["contact_fraction"]
-        ca, cb = a.results["mean_closure"], b.results["mean_closure"]
-        out.append({"contact_fraction": abs(fb - fa),
-                    "mean_closure": abs(cb - ca) / abs(cb) if cb != 0 else abs(cb - ca)})
-    return out
+def tail_estimate(values: list[float], relative: bool) -> tuple[float, str]:
+    """The estimated error of the last of ``values`` (a quantity on successive levels; module docstring)
+    and a remark where a guard acted ("" otherwise).  Needs two values at least."""
+    d = [abs(b - a) for a, b in zip(values[:-1], values[1:])][::-1][:WINDOW]
+    ratios = [d[i] / d[i + 1] for i in range(len(d) - 1) if d[i + 1] > 0]
+    observed = max(ratios) if ratios else RATE_CAP
+    rate = min(max(observed, RATE_FLOOR), RATE_CAP)
+    terms = [d[i] * ENVELOPE ** i for i in range(len(d))]
+    envelope = max(terms)
+    scale = abs(values[-1]) if relative and values[-1] != 0 else 1.0
+    remark = []
+    if observed > RATE_CAP:
+        remark.append(f"not contracting (ratio {observed:.2g}): rate {RATE_CAP}")
+    if envelope > VANISHED * terms[0]:
+        remark.append("the last difference nearly vanished: an earlier one bounds it")
+    return envelope * rate / (1.0 - rate) / scale, "; ".join(remark)
+
+
+def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float]], list[str]]:
+    """Per load the estimate of each quantity on the last level of ``history``, and the remarks."""
+    estimates, remarks = [], []
+    for k in range(len(history[-1]["contact_fraction"])):
+        out, notes = {}, []
+        for name, relative in QUANTITIES.items():
+            out[name], note = tail_estimate([h[name][k] for h in history], relative)
+            if note:
+                notes.append(f"load {k} {name}: {note}")
+        estimates.append(out)
+        remarks.extend(notes)
+    return estimates, remarks
 
 
 def levels(grid: int, dim: int, max_points: int) -> list[int]:
@@ -90,41 +150,49 @@ def levels(grid: int, dim: int, max_points: int) -> list[int]:
     return out
 
 
+def solve_level(make_cell: Callable[[int], Any], loads: list, n: int) -> tuple[Any, list, dict[str, Any]]:
+    """The cell on ``n`` points per direction, its solutions of ``loads`` and the history entry of the level."""
+    t0 = time.perf_counter()
+    cell = make_cell(n)
+    sols = cell.sweep(loads)
+    entry: dict[str, Any] = {
+        "grid": n, "points": cell.points, "seconds": time.perf_counter() - t0,
+        "iterations": [s.iterations for s in sols],
+        "contact_fraction": [s.results["contact_fraction"] for s in sols],
+        "mean_closure": [s.results["mean_closure"] for s in sols]}
+    return cell, sols, entry
+
+
 def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: float, grid: int, dim: int,
-                       max_points: int) -> RefinedSweep:
+                       max_points: int, required: bool = True) -> RefinedSweep:
     """Solve ``loads`` on grids from ``grid`` up until the estimate meets ``tolerance`` (module docstring).
 
     ``make_cell(n)`` builds the spectral cell of ``n`` points per direction.  The grids it may reach
     (:func:`levels`) are known and stated before the first solve; each level logs one progress line.
+    Out of reach: a :class:`~ngcontact.errors.ConvergenceError` with the history where ``required``, else
+    the finest level with ``met = False``.
     """
     grids = levels(grid, dim, max_points)
     progress.info("spectral refinement may reach grid %d (%d points) in %d levels from grid %d", grids[-1],
                   grids[-1] ** (dim - 1), len(grids), grid)
     history: list[dict[str, Any]] = []
-    previous = None
-    n = grid
-    while True:
-        t0 = time.perf_counter()
-        cell = make_cell(n)
-        sols = cell.sweep(loads)
-        entry: dict[str, Any] = {
-            "grid": n, "points": cell.points, "seconds": time.perf_counter() - t0,
-            "iterations": [s.iterations for s in sols],
-            "contact_fraction": [s.results["contact_fraction"] for s in sols],
-            "mean_closure": [s.results["mean_closure"] for s in sols]}
-        estimates = level_change(previous, sols) if previous is not None else None
+    for n in grids:
+        cell, sols, entry = solve_level(make_cell, loads, n)
+        history.append(entry)
+        estimates, remarks = sweep_estimates(history) if len(history) > 1 else (None, [])
         if estimates is not None:
             entry["estimate"] = max(max(e.values()) for e in estimates)
-        history.append(entry)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
                       f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
-        if estimates is not None and entry["estimate"] <= tolerance:
-            return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history)
-        previous = sols
-        n = next_grid(n, dim)
-        if n ** (dim - 1) > max_points:
-            reached = f"{entry['estimate']:.3g}" if estimates is not None else "no estimate (one level)"
-            raise ConvergenceError(
-                f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on "
-                f"{entry['points']} grid points, and the next grid of {n} per direction would exceed "
-                f"{max_points} points; loosen the tolerance", {"levels": history})
+        if estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance:
+            return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, remarks=remarks)
+    reached = f"{entry['estimate']:.3g}" if estimates is not None else "no estimate (one level)"
+    message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on {entry['points']} "
+               f"grid points, and the next grid of {next_grid(grids[-1], dim)} per direction would exceed "
+               f"{max_points} points")
+    if required:
+        raise ConvergenceError(message + "; loosen the tolerance", {"levels": history})
+    if estimates is None:
+        estimates = [{name: float("inf") for name in QUANTITIES} for _ in sols]
+    return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, met=False,
+                        remarks=remarks + [message])

@@ -24,7 +24,7 @@ from ngcontact.cell.cell_solution import CellSolution
 from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.spectral import grid_measures
 from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
-from ngcontact.cell.spectral.refinement import sweep_to_tolerance
+from ngcontact.cell.spectral.refinement import HOW, sweep_to_tolerance
 
 #: the grid fields a solution hands on (the closure is in its surface distribution)
 FIELDS = ("pressure", "gap", "shear", "slip")
@@ -40,18 +40,22 @@ class SpectralCellSolver:
     make_cell
         ``n -> SpectralCell`` of the same cell on ``n`` points per direction (refinement).
     max_points
-        The most grid points refinement may use.
+        The most grid points refinement to a stated tolerance may use.
+    default_max_points
+        The most grid points refinement to the default tolerance may use (default: ``max_points``).
     variant
         ``(**changes) -> SpectralCellSolver`` of the same scene and grid with ``enforcement`` or ``k_n``
         changed (the penalty's share), ``None`` where refused.
     """
 
     def __init__(self, cell: SpectralCell, make_cell: Callable[[int], SpectralCell] | None = None,
-                 max_points: int | None = None, variant: Callable[..., SpectralCellSolver | None] | None = None):
+                 max_points: int | None = None, default_max_points: int | None = None,
+                 variant: Callable[..., SpectralCellSolver | None] | None = None):
         self.cell = cell
         self.dim = cell.dim
         self.period = cell.period
-        self.make_cell, self.max_points, self.variant = make_cell, max_points, variant
+        self.make_cell, self.max_points, self.default_max_points = make_cell, max_points, default_max_points
+        self.variant = variant
 
     # ------------------------------------------------------------ description
     def unknowns(self) -> int:
@@ -87,21 +91,34 @@ class SpectralCellSolver:
     def sweep(self, loads: list[CellLoad]) -> list[CellSolution]:
         return [self.solution(s) for s in self.cell.sweep(loads)]
 
+    def refines_by_default(self) -> bool:
+        """Whether a sweep without a stated tolerance is refined to the default one: where the recipe of
+        finer grids is known."""
+        return self.make_cell is not None and self.max_points is not None
+
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Grids from the scene's up until the estimate meets ``tolerance``
         (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`); the finest grid's cell becomes this
-        solver's."""
+        solver's.  A ``required`` tolerance (the scene's) may use grids up to ``max_points`` and raises out of
+        reach; the default one up to ``default_max_points``, and out of reach the finest level is the answer
+        with ``met = False``."""
         if self.make_cell is None or self.max_points is None:
             raise ValueError("this spectral cell was built without the recipe of finer grids")
         first, make = self.cell, self.make_cell
+        bound = self.max_points if required or self.default_max_points is None else self.default_max_points
+        bound = max(min(bound, self.max_points), first.points)
         refined = sweep_to_tolerance(lambda n: first if n == first.grid else make(n), loads, tolerance,
-                                     first.grid, first.dim, self.max_points)
+                                     first.grid, first.dim, bound, required=required)
         self.cell = refined.cell
-        return Refinement(solutions=[self.solution(s) for s in refined.solutions],
-                          estimates=list(refined.estimates),
-                          method={"grid": self.cell.grid, "points": self.cell.points,
-                                  "refinement": refined.history},
-                          how="grids of 4 times more points each: the change between the last two grids")
+        method = {"grid": self.cell.grid, "points": self.cell.points, "refinement": refined.history}
+        solutions = [self.solution(s) for s in refined.solutions]
+        if len(refined.history) < 2:
+            return Refinement(solutions=solutions, estimates=[], method=method, met=False,
+                              how=f"not estimated: the grid of {first.points} points is the largest of the size "
+                                  f"bound ({bound} points), so there is no finer grid to compare with")
+        how = HOW + (f" ({'; '.join(refined.remarks)})" if refined.remarks else "")
+        return Refinement(solutions=solutions, estimates=list(refined.estimates), method=method,
+                          met=refined.met, how=how)
 
     def penalty(self) -> float | None:
         return float(self.cell.k_n) if self.cell.enforcement == "penalty" else None

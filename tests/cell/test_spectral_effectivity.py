@@ -1,0 +1,94 @@
+"""The spectral refinement's estimate against the true error of the grid it reports (issue 35's effectivity).
+
+Each oracle is refined as a run refines it (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`)
+and the estimate of each load's contact fraction (absolute) and mean closure (relative) on the reported
+grid is held against its difference from the same cell's value on a grid 16 (2D) or 4 (3D, per direction; 8 in the slow tier)
+times finer: the layers have finite depth, so the converged value is the cell's own.
+"""
+import numpy as np
+import pytest
+
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
+from ngcontact.cell.spectral.refinement import tail_estimate, sweep_to_tolerance
+from ngcontact.geometry.random_surface import self_affine
+
+NU, H = 0.3, 0.01
+QUANTITIES = (("contact_fraction", False), ("mean_closure", True))
+
+
+def _cell(dim, gap, n):
+    return SpectralCell(dim=dim, period=1.0, grid=n, rough=Layer(1.0, NU, 1.0), counter=Layer(1.0, NU, 1.0),
+                        gap=gap(n), k_n=1e3, enforcement="exact", tol=1e-12, max_iter=100000)
+
+
+def _westergaard(n):
+    return 2 * H * np.sin(np.pi * np.arange(n) / n) ** 2
+
+
+PROFILE = self_affine(dim=2, grid=64, hurst=0.8, rms_slope=0.1, seed=5)
+
+
+def _random_profile(n):
+    closed = np.append(PROFILE, PROFILE[0])
+    return np.interp(np.arange(n) / n, np.arange(65) / 64, closed.max() - closed)
+
+
+def _bisinusoid(n):
+    s = np.arange(n) / n
+    return H * (2 - np.cos(2 * np.pi * s[None, :]) - np.cos(2 * np.pi * s[:, None]))
+
+
+def effectivities(dim, gap, pressures, first, tolerance, finer):
+    """Per load and quantity ``(estimate, true error)`` of the reported grid, and that grid."""
+    loads = [cell_load(dim, pressure=p) for p in pressures]
+    refined = sweep_to_tolerance(lambda n: _cell(dim, gap, n), loads, tolerance, first, dim, 2 ** 22)
+    grid = refined.history[-1]["grid"]
+    reference = _cell(dim, gap, grid * finer).sweep(loads)
+    out = []
+    for sol, ref, est in zip(refined.solutions, reference, refined.estimates):
+        for name, relative in QUANTITIES:
+            exact = ref.results[name]
+            error = abs(sol.results[name] - exact) / (abs(exact) if relative else 1.0)
+            out.append((name, est[name], error))
+    return out, grid
+
+
+ORACLES = {"westergaard": (2, _westergaard, (0.000863, 0.00345, 0.00863), 64, 16),
+           "random_profile": (2, _random_profile, (0.001, 0.003, 0.01), 64, 16),
+           "bisinusoid_3d": (3, _bisinusoid, (0.001, 0.004, 0.01), 8, 4)}
+
+
+@pytest.mark.parametrize("oracle", sorted(ORACLES))
+def test_the_estimate_bounds_the_error_of_the_reported_grid(oracle):
+    dim, gap, pressures, first, finer = ORACLES[oracle]
+    rows, grid = effectivities(dim, gap, pressures, first, 2e-2 if dim == 3 else 1e-2, finer)
+    assert grid >= first * 8                       # four levels at least
+    for name, estimate, error in rows:
+        assert estimate >= error, (oracle, name, estimate, error)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("oracle, tolerance", [("westergaard", 1e-4), ("random_profile", 1e-3),
+                                               ("bisinusoid_3d", 1e-2)])
+def test_the_estimate_bounds_the_error_at_tighter_tolerances(oracle, tolerance):
+    dim, gap, pressures, first, finer = ORACLES[oracle]
+    first, finer = (16, 8) if dim == 3 else (first, finer)
+    rows, _ = effectivities(dim, gap, pressures, first, tolerance, finer)
+    for name, estimate, error in rows:
+        assert estimate >= error, (oracle, name, estimate, error)
+
+
+def test_a_vanished_last_difference_is_bounded_by_the_one_before():
+    """A symmetric coincidence (the same value on two grids) estimates from the earlier differences."""
+    estimate, remark = tail_estimate([0.40, 0.50, 0.52, 0.52], relative=False)
+    # differences 0.1, 0.02, 0: the envelope is the largest of 0, 0.02 / 2 and 0.1 / 4, at the floor 1/2
+    assert estimate == pytest.approx(0.1 / 4) and "vanished" in remark
+
+
+def test_a_slow_sequence_takes_its_observed_rate_and_a_fast_one_first_order():
+    slow, _ = tail_estimate([1.0, 1.4, 1.64, 1.784], relative=False)      # differences 0.4, 0.24, 0.144: rate 0.6
+    assert slow == pytest.approx(0.144 * 0.6 / 0.4)
+    # rate 0.1, held to 1/2; the envelope: the largest of 0.001, 0.01 / 2 and 0.1 / 4
+    fast, _ = tail_estimate([1.0, 1.1, 1.11, 1.111], relative=False)
+    assert fast == pytest.approx(0.1 / 4)
