@@ -149,3 +149,18 @@ def test_a_planar_step_model_gives_lames_pressure(tmp_path, setting):
         assert "radius 75 -> 'mantle'" in listing
     p = mean_pressure(scene)
     assert abs(p / LAME - 1) < 1e-3, (p, LAME)
+
+
+@pytest.mark.slow
+def test_the_femur_posed_from_a_step_section_gives_the_built_in_peak_pressure(tmp_path, monkeypatch):
+    """geometries/macro/femur_stem_step.toml: the femur scene's section as two unnamed faces of a STEP file,
+    its supports and load chosen by where they lie; its peak interface pressure is the built-in shape's."""
+    import ngcontact
+
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
+    peaks = []
+    for path in (("femur_stem.toml",), ("macro", "femur_stem_step.toml")):
+        report, _ = ngcontact.solve(os.path.join(ROOT, "geometries", *path))
+        quantities = {q["name"]: q for q in report["results"]["accuracy"]["quantities"]}
+        peaks.append(quantities["peak_pressure"]["value"])
+    assert abs(peaks[1] / peaks[0] - 1) < 1e-3, peaks
