@@ -8,7 +8,7 @@ scene's tolerance.
 
 The limit is found by the cell protocol, whatever the method, on the cell's
 :meth:`~ngcontact.cell.cell_solver.CellSolver.share_solver`: the share is a property of the model, so it
-may be measured on any discretization of the same model that resolves it.  An FE cell of the small-slope
+may be taken from any discretization of the same model that resolves it.  An FE cell of the small-slope
 model measures it on its spectral twin (same layers, same ``k_n``) on a fine grid: the share is a shift of
 the contact edges by a fraction of an element, which a uniform mesh's own edge error (its edges cut
 elements anywhere) would swamp.  On that discretization

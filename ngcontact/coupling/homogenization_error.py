@@ -10,13 +10,13 @@ estimate and keep small) measure an error linear in the ratio,
 
 over the relative field (L2 away from the layer) and probe errors, ``L`` the interface's length (for the
 femur stem: the arc length of ``S_0``).  :data:`CONSTANTS` holds, per law, the largest ``C = E L / eps``
-those studies measured on the shipped scenes (``docs/benchmarks.md``, sections ``epsilon_*``; a test
+those studies found for the shipped scenes (``docs/benchmarks.md``, sections ``epsilon_*``; a test
 recomputes it from a study and checks the constant still bounds it).  A macro run whose law homogenizes a
 roughness of known period states
 
     E ~ C eps / L,   eps = the roughness period,  L = the interface's length (3D: the square root of its area),
 
-flagged as an estimate: ``C`` was measured on other geometries, and the scene's own constant may be
+flagged as an estimate: ``C`` comes from other geometries, and the scene's own constant may be
 smaller (the rectangular-valley blocks measure one a hundred times smaller than the femur's grooves).
 
 Laws without a constant say why instead: the whole-surface linearization (paper eq. 34) glues every wall,

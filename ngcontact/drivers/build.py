@@ -6,16 +6,15 @@ driver calls these instead of building its own copies.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
 import functools
 import hashlib
 import json
 import math
 import os
+from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
-
-from dataclasses import replace
 
 from ngcontact.cell.cell_solver import CellSolver
 from ngcontact.cell.coefficients import direction_bundle

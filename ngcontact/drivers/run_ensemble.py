@@ -17,7 +17,7 @@ values, and the band's shrinkage with ``M`` (the relative standard error of
 the mean of ``M, M/2, M/4, ...`` members on disjoint sub-ensembles and its
 fitted rate, ``-1/2`` for independent members).  Tables ``ensemble.csv``,
 ``ensemble_members.csv``, ``ensemble_shrinkage.csv``; plots
-``ensemble_law.png`` (the law with its band) and ``ensemble_band.png``.  Surfaces like a measured one
+``ensemble_law.png`` (the law with its band) and ``ensemble_band.png``.  Surfaces drawn with a scan's spectrum
 (``measured_spectrum``) add the record ``topography`` of :func:`ngcontact.drivers.cell_gap.topography`
 and its ``psd.png``.
 """
@@ -105,7 +105,7 @@ def run(scene, clock) -> Outcome:
     law = {q: {key: bands[q][key].tolist() for key in ("mean", "low", "high")} for q in QUANTITIES
            if q != "transmitted_pressure"}
     plots = {"ensemble_law": lambda path: figures.ensemble_law(path, pressure, law, QUANTITIES, M)}
-    topography = cell_gap.topography(scene)     # surfaces like a measured one: its record and spectrum
+    topography = cell_gap.topography(scene)     # surfaces drawn with a scan's spectrum: its record
     if topography is not None:
         results["topography"] = topography
         psd, title = topography["psd"], f"{topography['file']} ({topography['source']})"

@@ -22,6 +22,8 @@ Lengths are in the file's own units throughout.
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -201,7 +203,7 @@ MODEL_ROUGH, MODEL_COUNTER, MODEL_UNNAMED = "rough", "counter", "free"
 
 
 @dataclass
-class TwoBodyModel:
+class TwoBodyModel(ABC):
     """Two bodies read from a file and their faces, before meshing (in the file's units as read).
 
     Subclasses (a CAD file, :mod:`ngcontact.geometry.cad_model`; a mesh
@@ -235,16 +237,16 @@ class TwoBodyModel:
     def interface_faces(self) -> list[ModelFace]:
         return [f for f in self.faces if len(f.bodies) == 2]
 
+    @abstractmethod
     def containing(self, point) -> list[int]:
         """The bodies ``point`` lies in (within the tolerance)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def mesh(self, rough: int, counter: int, labels: dict[int, str], *, length_unit: float, maxh: float,
              interface_maxh: float, order: int):
         """The :class:`~ngcontact.geometry.bodies.MacroGeometry` in metres: regions ``rough``, ``counter``,
         boundary ``interface`` on the shared faces, ``labels`` (face index -> name) on the selected ones,
         the file's names on the others, :data:`MODEL_UNNAMED` where it has none."""
-        raise NotImplementedError
 
 
 def body_index(model: TwoBodyModel, key: str, *, name: str | None = None, index: int | None = None,

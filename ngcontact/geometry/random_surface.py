@@ -166,7 +166,7 @@ def from_psd(q: np.ndarray, C: np.ndarray, *, grid: int, period: float, seed: in
     Fourier coefficient ``Z_k`` of the forward FFT is a complex Gaussian of variance ``N^2 C / P^2`` (``N``
     points; the filtered white noise of :func:`self_affine` with a tabulated spectrum), so that the expected
     spectrum of the surface is ``C`` and its expected mean square height ``sum_k C / P^2``, that of the
-    surface ``C`` was measured on.  The surface is not scaled to one rms height: for a spectrum whose few
+    surface whose spectrum ``C`` is.  The surface is not scaled to one rms height: for a spectrum whose few
     longest waves carry most of the power, scaling every draw to one rms would bias the expected spectrum
     of the others.  A seed makes it reproducible.
     """

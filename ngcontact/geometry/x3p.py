@@ -28,10 +28,10 @@ MAIN_XML = """<?xml version="1.0" encoding="UTF-8"?>
     </Axes>
   </Record1>
   <Record2>
-    <Date>2026-01-01T00:00:00+00:00</Date>
+    <Date>1970-01-01T00:00:00+00:00</Date>
     <Instrument><Manufacturer>ngcontact</Manufacturer><Model>{model}</Model><Serial>0</Serial>
     <Version>1</Version></Instrument>
-    <CalibrationDate>2026-01-01T00:00:00+00:00</CalibrationDate>
+    <CalibrationDate>1970-01-01T00:00:00+00:00</CalibrationDate>
     <ProbingSystem><Type>NonContacting</Type><Identification>none</Identification></ProbingSystem>
     <Comment>{comment}</Comment>
   </Record2>

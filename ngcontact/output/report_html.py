@@ -1,13 +1,11 @@
 """``report.html``: a run's report as one self-contained page for a person to look at.
 
-Built from the report dictionary (:func:`ngcontact.output.report.build_report`)
-and the files the run staged beside it: the scene's title and effects, the key
-figures (picked generically from the report, plus a few per kind: the law,
-contact fraction, peak pressure, safety factor), the solver history (residuals
-per solve, drawn as an inline SVG), every PNG embedded as a base64 data URI,
-every CSV table as an HTML table, the results, timings and the scene itself.
-No network, no script: CSS is inline, other files (VTK, NumPy) are linked
-relatively.  Every number passes :func:`fmt`, which refuses NaN and infinity
+Built from the report dictionary (:func:`ngcontact.output.report.build_report`) and the files the run
+staged beside it: the scene's title and effects, the key figures (picked generically from the report,
+plus a few per kind: the law, contact fraction, peak pressure, safety factor), the solver history
+(residuals per solve, drawn as an inline SVG), every PNG embedded as a base64 data URI, every CSV table as
+an HTML table, the results, timings and the scene itself.  No network, no script: CSS is inline, other
+files (VTK, NumPy) are linked relatively.  Every number passes :func:`fmt`, which refuses NaN and infinity
 as the report does.
 """
 from __future__ import annotations
@@ -402,8 +400,7 @@ def accuracy_warnings(report: dict) -> list[str]:
 
 def quantity_line(q: dict) -> str:
     """One estimated quantity of an accuracy verdict: its value and relative error, or why it has none."""
-    where = f"load {q['load']}, " if q.get("load") is not None else ""
-    rel = q.get("relative_error")
+    where, rel = (f"load {q['load']}, " if q.get("load") is not None else ""), q.get("relative_error")
     if rel is None:
         return f"{where}{q.get('name')} = {fmt(q.get('value'))} has no error estimate: {q.get('how', '')}"
     return f"{where}{q.get('name')} = {fmt(q.get('value'))}, estimated relative error {fmt(rel)}"

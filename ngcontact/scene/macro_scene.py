@@ -19,12 +19,11 @@ Lengths in metres, stresses in pascals, interface stiffnesses in Pa/m.
 Two optional sections extend the macro solve (this kind rather than new kinds,
 because both act on a macro solution and share its geometry, law and output):
 
-* ``[two_scale]``: the coupling loop of paper Sec. 3.5
-  (:mod:`ngcontact.coupling.two_scale`): the scene's interface law is the start (the
-  assumed contact set), and the cell named there, tabulated adaptively in
-  the pressure over the macro pressures (cached on disk), supplies its own
-  response closure -> pressure as the interface law, until the table covers
-  the macro pressures and the macro normal stress stops changing;
+* ``[two_scale]``: the coupling loop of paper Sec. 3.5 (:mod:`ngcontact.coupling.two_scale`): the
+  scene's interface law is the start (the assumed contact set), and the cell named there, tabulated
+  adaptively in the pressure over the macro pressures (cached on disk), supplies its own response
+  closure -> pressure as the interface law, until the table covers the macro pressures and the macro
+  normal stress stops changing;
 * ``[strength]``: micro stresses in the layer and the check of paper eq. 78
   (:mod:`ngcontact.coupling.strength`) against ``materials.NAME.sigma_u`` of both
   bodies.
@@ -56,13 +55,12 @@ BOUNDARY_DOCS: dict = {**SHAPE_BOUNDARY_DOCS, "file": FILE_BOUNDARY_DOCS}
 class MacroDiscretization(Discretization):
     """Finite element discretization of a macro scene, and the accuracy its headline numbers are held to."""
 
-    tolerance: float | None = param(
-        None, doc="the relative accuracy the headline quantities (peak interface pressure, resultant, largest "
-        "von Mises and Tresca stress per body, safety factor; two-scale: the loop's residual and the cell "
-        "table's interpolation error) are held to: each is reported with its discretization error, estimated "
-        "from solves one order below and above on the same mesh, and results.accuracy.met says whether every "
-        "one is within; the mesh and order are not changed; default: 0.01",
-        check=open_interval(0, 1))
+    tolerance: float | None = param(None, check=open_interval(0, 1), doc="the relative accuracy the headline "
+        "quantities (peak interface pressure, resultant, largest von Mises and Tresca stress per body, safety "
+        "factor; two-scale: the loop's residual and the cell table's interpolation error) are held to: each is "
+        "reported with its discretization error, estimated from solves one order below and above on the same "
+        "mesh, and results.accuracy.met says whether every one is within; the mesh and order are not changed; "
+        "default: 0.01")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -137,11 +135,9 @@ class InterfaceSpec:
                              "bundle (law = linear: its K0); then omit the explicit numbers")
     cell_length_unit: float = param(1.0, doc="length of one unit of the cell scene (scales its gaps)",
                                     units="m", check=positive())
-    roughness_period: float | None = param(None, doc="the period eps of the roughness the law homogenizes, for "
-                                           "the report's modelling-error estimate C eps / L "
-                                           "(results.accuracy.modelling); default: a cell's period times "
-                                           "cell_length_unit, none for a law given by its numbers",
-                                           units="m", check=positive())
+    roughness_period: float | None = param(None, units="m", check=positive(), doc="the period eps of the "
+        "roughness the law homogenizes, for the modelling-error estimate C eps / L (results.accuracy.modelling); "
+        "default: a cell's period times cell_length_unit, none for a law given by its numbers")
     kn: float | None = param(None, doc="k_n0 of the linear law", units="Pa/m", check=positive())
     kt: float = param(0.0, doc="k_t0 (linear law; tabulated: tangential stiffness)", units="Pa/m",
                       check=nonnegative())

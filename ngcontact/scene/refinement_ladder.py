@@ -29,6 +29,8 @@ with fewer than 3 levels is dropped.
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 import copy
 import json
 from dataclasses import dataclass, field
@@ -68,21 +70,23 @@ class Level:
                           default=str)
 
 
-class Knob:
+class Knob(ABC):
     """A discretization knob: where it applies, its levels' key values and the variable of its rate."""
 
     name = ""
     variable = ""
 
+    @abstractmethod
     def applies(self, scene) -> bool:
-        raise NotImplementedError
+        ...
 
+    @abstractmethod
     def values(self, scene, n: int) -> list[dict[str, Any]]:
         """The keys of each of the ``n`` levels, coarsest first, the scene's own at ``n - 2``."""
-        raise NotImplementedError
 
+    @abstractmethod
     def parameter(self, changes: dict[str, Any]) -> float | None:
-        raise NotImplementedError
+        ...
 
     def size(self, scene, changes: dict[str, Any]) -> float | None:
         """The level's unknowns over the scene's, estimated (None: the knob does not fix them)."""

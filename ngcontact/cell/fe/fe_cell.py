@@ -77,7 +77,7 @@ class FECell:
         The scene's interface element size (the second discretization halves it where the order cannot rise).
     twin
         ``() -> CellSolver``: the spectral cell of the same small-slope model on a grid that resolves the
-        contact edges, where the cell has one (the penalty's share is measured on it), else ``None``.
+        contact edges, where the cell has one (the penalty's share is taken from it), else ``None``.
     """
 
     def __init__(self, cell, model: CellModel, make_problem: Callable[[], CellProblem], *,
