@@ -112,9 +112,18 @@ def _start(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, pbar: flo
     return p
 
 
+def _preconditioned(precondition, gs, on, mean_free: bool) -> np.ndarray:
+    """``Pi R M R^T gs``: the preconditioner on the contact set, made mean-free there under a prescribed mean."""
+    z = np.where(on, precondition(gs), 0.0)
+    if mean_free:
+        z = np.where(on, z - float(z[on].mean()), 0.0)
+    return z
+
+
 def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *, pbar: float | None,
                    tol: float, max_iter: int, gscale: float, p0: np.ndarray | None = None,
-                   norm: float | None = None) -> ConstrainedResult:
+                   norm: float | None = None,
+                   precondition: Callable[[np.ndarray], np.ndarray] | None = None) -> ConstrainedResult:
     """Minimize ``1/2 <p, A p> + <p, b>`` over ``p >= 0`` (module docstring).
 
     Parameters
@@ -164,8 +173,9 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
             return ConstrainedResult(p=p, gap=g, shift=0.0, iterations=it - 1, residuals=residuals)
         shift = float(g[on].mean()) if pbar is not None else 0.0
         gs = np.where(on, g - shift, 0.0)
-        G = inner(gs, gs)
-        t = np.where(on, gs + (G / g_old) * t if conjugate else gs, 0.0)
+        z = gs if precondition is None else _preconditioned(precondition, gs, on, pbar is not None)
+        G = inner(gs, z)
+        t = np.where(on, z + (G / g_old) * t if conjugate else z, 0.0)
         g_old = G
         r = apply_A(t)
         if pbar is not None:

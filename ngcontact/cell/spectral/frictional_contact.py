@@ -22,6 +22,7 @@ import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.spectral.layer_compliance import layer_matrix
+from ngcontact.solvers.active_set_newton import active_set_newton, traction_projector
 from ngcontact.solvers.projected_gradient import fista, prox_friction, prox_pressure
 
 
@@ -46,19 +47,7 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
     """
     import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
     d = cell.dim
-    n = cell.grid
-    k1 = 2 * np.pi * sfft.rfftfreq(n, d=cell.period / n)
-    if d == 2:
-        kv = k1[:, None]
-        nyq = np.arange(k1.size) == n // 2
-    else:
-        k0 = 2 * np.pi * sfft.fftfreq(n, d=cell.period / n)
-        kv = np.stack(np.broadcast_arrays(k1[None, :], k0[:, None]), axis=-1)
-        nyq = (np.arange(n)[:, None] == n // 2) | (np.arange(k1.size)[None, :] == n // 2)
-    K = (layer_matrix(kv, cell.rough.E, cell.rough.nu, cell.rough.h)
-         + layer_matrix(kv, cell.counter.E, cell.counter.nu, cell.counter.h, above=True))
-    K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
-    K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
+    K = _full_compliance(cell)
     K0 = np.real(np.diagonal(K.reshape(-1, d, d)[0])).copy()
     zero = (0,) * (d - 1)
     for c in range(d):
@@ -73,6 +62,71 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
         U = np.einsum("ab...,b...->a...", Km, T)
         return sfft.irfftn(U, s=cell.shape, axes=axes, workers=-1)
     return apply, L, K0
+
+
+def _full_compliance(cell) -> np.ndarray:
+    """``K(k) = C_rough + C_counter`` on the half spectrum, shape ``(*kshape, d, d)``, the coupling zeroed on
+    the Nyquist rows."""
+    import scipy.fft as sfft
+    d = cell.dim
+    n = cell.grid
+    k1 = 2 * np.pi * sfft.rfftfreq(n, d=cell.period / n)
+    if d == 2:
+        kv = k1[:, None]
+        nyq = np.arange(k1.size) == n // 2
+    else:
+        k0 = 2 * np.pi * sfft.fftfreq(n, d=cell.period / n)
+        kv = np.stack(np.broadcast_arrays(k1[None, :], k0[:, None]), axis=-1)
+        nyq = (np.arange(n)[:, None] == n // 2) | (np.arange(k1.size)[None, :] == n // 2)
+    K = (layer_matrix(kv, cell.rough.E, cell.rough.nu, cell.rough.h)
+         + layer_matrix(kv, cell.counter.E, cell.counter.nu, cell.counter.h, above=True))
+    K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
+    K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
+    return K
+
+def traction_preconditioner(cell, winkler: float):
+    """``r -> K_full^{-1} r`` by FFTs: the inverse of the full compliance (uniform modes kept, plus the penalty's
+    ``winkler`` on the normal component) per wave vector, the preconditioner of
+    :mod:`ngcontact.solvers.active_set_newton`."""
+    import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
+    d = cell.dim
+    K = _full_compliance(cell)
+    K[..., d - 1, d - 1] += winkler
+    Kinv = np.moveaxis(np.linalg.inv(K), (-2, -1), (0, 1)).copy()
+    axes = tuple(range(1, d))
+
+    def apply(r):
+        R = sfft.rfftn(r, axes=axes, workers=-1)
+        return sfft.irfftn(np.einsum("ab...,b...->a...", Kinv, R), s=cell.shape, axes=axes, workers=-1)
+    return apply
+
+
+def _linearization(cell, L: float, constrained: tuple[bool, ...]):
+    """``(t_hat, v, shifts) -> (projector, D)``: the free directions at a proximal point ``t_hat = prox(v)`` and the
+    curvature of the contact and friction terms on them (:mod:`ngcontact.solvers.active_set_newton`).
+
+    ``D``: the penalty's ``1 / k_n`` on the pressure, the Huber term's ``w / G`` on a sticking shear, and on a
+    slipping shear of a 3D cell the curvature of the friction disc's rim in the step ``1/L``,
+    ``L (|v_q - s| / G - 1)`` (the derivative of ``q = G z / |z|`` across ``z``).
+    """
+    d, f, exact = cell.dim, cell.friction, cell.enforcement == "exact"
+
+    def linearize(t_hat, v, shifts):
+        G = f.threshold(t_hat[d - 1]) * np.ones(cell.shape)
+        stick = (np.sum(t_hat[:d - 1] ** 2, axis=0) < (G * (1 - 1e-12)) ** 2) & (G > 0)
+        rim = ~stick & (G > 0)
+        D = np.zeros((d,) + cell.shape)
+        safe = np.where(G > 0, G, 1.0)
+        if not exact:
+            D[:d - 1] = np.where(stick, f.w / safe, 0.0)
+            D[d - 1] = 1.0 / cell.k_n
+        if d == 3:
+            sq = shifts[1]
+            z = v[:2] - (0.0 if sq is None else np.asarray(sq).reshape(2, 1, 1))
+            D[:2] += np.where(rim, L * np.maximum(np.sqrt(np.sum(z * z, axis=0)) / safe - 1.0, 0.0), 0.0)
+        return traction_projector(t_hat[d - 1] > 0, stick, rim, t_hat, constrained), D
+    return linearize
+
 
 def solve_frictional(cell, load: CellLoad, start) -> dict:
     """Tresca (or a Coulomb fixed point of Tresca problems) by FISTA in tractions."""
@@ -112,7 +166,12 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
         damp_q = 1.0 if exact else 1.0 + f.w / (L * np.maximum(G, 1e-300))
         q, sq = prox_friction(v[:d - 1], G, damp_q, mean_q, sq)
         return np.concatenate([q, p[None]]), (sp, sq)
-    res = fista(grad, prox, t0, L, tol=cell.tol, scale=scale, max_iter=cell.max_iter)
+    if cell.friction_method == "proximal":
+        res = fista(grad, prox, t0, L, tol=cell.tol, scale=scale, max_iter=cell.max_iter)
+    else:
+        res = active_set_newton(grad, apply, b, prox, _linearization(cell, L, tuple(prescribed_mean)),
+                                traction_preconditioner(cell, 0.0 if exact else 1.0 / cell.k_n), t0, L, tol=cell.tol,
+                                scale=scale, max_iter=cell.max_iter)
     t = res.t
     sp, sq = res.shifts
     Kt = apply(t)

@@ -1,0 +1,175 @@
+"""A primal-dual active-set (semismooth Newton) method for contact with friction in tractions.
+
+The problem is the one of :mod:`ngcontact.solvers.projected_gradient`:
+
+    min_t  1/2 <t, K t> + <t, b> + sum_i h_i(t_i),   mean(t_c) = m_c  (prescribed components),
+
+``t = (q, p)``, ``K`` the layers' compliance (symmetric positive
+semidefinite, applied by FFTs), ``h_i`` the separable contact and friction
+terms.  Its solution is the fixed point ``t = prox(t - (K t + b) / L)`` of the
+proximal-gradient map.  Accelerated proximal gradients reach it in
+``O(sqrt(kappa))`` steps per digit, ``kappa`` the condition number of ``K``
+on the contact set: for a compliance that falls like ``1 / |k|`` that is the
+number of grid points per direction, thousands of steps at 512^2.
+
+Method (Hintermueller, Ito & Kunisch, SIAM J. Optim. 13 (2003) 865-888, the
+primal-dual active-set strategy as a semismooth Newton method; for contact
+with Coulomb friction Hueeber, Stadler & Wohlmuth, SIAM J. Sci. Comput. 30
+(2008) 572-596).  Each outer step evaluates the proximal map once, which
+splits the unknowns into *free* ones (pressure where ``p > 0``, shear at a
+sticking point, ``|q| < G``) and *fixed* ones (``p = 0`` on the open set, the
+shear ``q = G n`` on the rim at a slipping point, ``n`` the direction of the
+proximal map's argument and ``G`` the threshold at its pressure), and then
+minimizes the quadratic energy over the free unknowns with the fixed ones
+held (a linear, symmetric positive definite problem on the free set, under
+the mean constraints).  With the slip direction and the Coulomb threshold
+frozen over each step this is the semismooth Newton step with the
+derivative of ``n`` and of ``G = mu p`` dropped; it is exact Newton for Tresca
+in 2D.  The free problem is solved by projected conjugate gradients
+preconditioned by ``R K_full^{-1} R^T`` (``R`` the restriction to the free
+set, ``K_full^{-1}`` the inverse of the full compliance per wave vector,
+applied by FFTs; Vollebregt, J. Comput. Phys. 257 (2014) 333-351): on a
+subset of the grid this preconditioned operator has a condition number that
+grows like ``log^2 N`` (the pseudo-differential operators of order -1 and 1
+are each other's inverses up to the restriction, as in domain
+decomposition), not like ``N``.  The inner tolerance follows the outer
+residual.
+
+Stopping rule: the fixed-point residual of :mod:`ngcontact.solvers.projected_gradient`,
+``|t - prox(t - grad / L)| L <= tol scale``, so both methods stop at the
+same accuracy.  Should the active sets cycle (no guarantee of global
+convergence without a line search), the solve goes on with accelerated
+proximal gradients from the last iterate (:func:`~ngcontact.solvers.projected_gradient.fista`).
+``iterations`` counts operator applications (outer plus inner steps), the
+unit of :func:`~ngcontact.solvers.projected_gradient.fista`'s steps.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from ngcontact.errors import ConvergenceError
+from ngcontact.solvers.constrained_cg import inner
+from ngcontact.solvers.projected_gradient import ProximalResult, fista
+
+#: outer steps after which a solve that has not converged goes on with accelerated proximal gradients
+MAX_OUTER = 40
+#: inner tolerance: this share of the outer residual
+INNER_SHARE = 0.05
+
+
+def traction_projector(pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, t_hat: np.ndarray,
+                       constrained: tuple[bool, ...]) -> Callable[[np.ndarray], np.ndarray]:
+    """The orthogonal projector onto the free directions of a proximal point ``t_hat = (q, p)``.
+
+    Free: the pressure where ``pressed``; the whole shear where ``stick``; at
+    a slipping point (``rim``) of a 3D cell the shear along the tangent of
+    the friction disc, ``n_perp`` (the slip direction's own update, the
+    semismooth Newton step of ``q = G z / |z|`` without its curvature term);
+    on each component group of prescribed mean, in addition, the sum zero
+    (the projection ``y - Pi lambda`` with ``(sum_i Pi_i) lambda = sum_i y_i``).
+    """
+    d = t_hat.shape[0]
+    turn = None
+    if d == 3:
+        q = t_hat[:2]
+        norm = np.sqrt(np.sum(q * q, axis=0))
+        on = rim & (norm > 0)
+        turn = np.where(on, np.stack([-q[1], q[0]]) / np.where(on, norm, 1.0), 0.0)
+
+    def shear(x):
+        y = np.where(stick, x, 0.0)
+        if turn is not None:
+            y = y + np.sum(x * turn, axis=0) * turn
+        return y
+    n_p = int(np.count_nonzero(pressed))
+    if d == 3 and constrained[0]:
+        M = np.eye(2) * float(np.count_nonzero(stick)) + np.einsum("aij,bij->ab", turn, turn)
+        M_inv = np.linalg.pinv(M)
+    elif constrained[0]:
+        M_inv = np.array([[1.0 / max(int(np.count_nonzero(stick)), 1)]])
+
+    def proj(x: np.ndarray) -> np.ndarray:
+        y = np.empty_like(x)
+        y[d - 1] = np.where(pressed, x[d - 1], 0.0)
+        if constrained[d - 1] and n_p:
+            y[d - 1] = np.where(pressed, y[d - 1] - float(y[d - 1].sum()) / n_p, 0.0)
+        y[:d - 1] = shear(x[:d - 1])
+        if constrained[0]:
+            lam = M_inv @ y[:d - 1].reshape(d - 1, -1).sum(axis=1)
+            y[:d - 1] -= shear(np.broadcast_to(lam.reshape((d - 1,) + (1,) * (d - 1)), y[:d - 1].shape))
+        return y
+    return proj
+
+
+def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np.ndarray,
+                 proj: Callable[[np.ndarray], np.ndarray], precondition: Callable[[np.ndarray], np.ndarray],
+                 atol: float, max_steps: int) -> tuple[np.ndarray, int]:
+    """Minimize ``1/2 <t, A t> + <t, b>`` over the free entries of ``t`` (the rest and the means held).
+
+    Projected preconditioned conjugate gradients from ``t`` (which meets the
+    mean constraints) until the projected gradient is below ``atol`` in the
+    maximum norm.  Returns ``(t, steps)``.
+    """
+    t = t.copy()
+    r = proj(apply(t) + b)
+    z = proj(precondition(r))
+    rz = inner(r, z)
+    d = z
+    for step in range(1, max_steps + 1):
+        if float(np.max(np.abs(r))) <= atol or rz <= 0:
+            return t, step - 1
+        Ad = proj(apply(d))
+        dAd = inner(d, Ad)
+        if dAd <= 0:
+            return t, step - 1
+        alpha = rz / dAd
+        t -= alpha * d
+        r -= alpha * Ad
+        z = proj(precondition(r))
+        rz, rz_old = inner(r, z), rz
+        d = z + (rz / rz_old) * d
+    return t, max_steps
+
+
+def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
+                      b: np.ndarray, prox: Callable[[np.ndarray, tuple], tuple],
+                      linearize: Callable[[np.ndarray, np.ndarray, tuple], tuple],
+                      precondition: Callable[[np.ndarray], np.ndarray], t0: np.ndarray, L: float, *, tol: float,
+                      scale: float, max_iter: int) -> ProximalResult:
+    """The active-set method of the module docstring.
+
+    ``grad(t) = apply(t) + b`` is the gradient of the smooth part
+    (``apply`` the linear operator); ``prox(v, shifts)`` as for
+    :func:`~ngcontact.solvers.projected_gradient.fista`; ``linearize(t_hat, v, shifts)``
+    at a proximal point ``t_hat = prox(v)`` the projector onto the free
+    directions (:func:`traction_projector`) and the curvature ``D`` of ``h``
+    along them (a diagonal);
+    ``precondition`` an approximate inverse of ``apply``.
+    """
+    t = t0.copy()
+    shifts: tuple = ()
+    residuals: list[float] = []
+    steps = 0
+    for _ in range(MAX_OUTER):
+        v = t - grad(t) / L
+        t_hat, shifts = prox(v, shifts)
+        steps += 1
+        res = float(np.max(np.abs(t - t_hat))) * L / scale
+        residuals.append(res)
+        if res <= tol:
+            return ProximalResult(t=t_hat, shifts=shifts, iterations=steps, residuals=residuals)
+        if steps >= max_iter:
+            break
+        atol = max(INNER_SHARE * res, 0.2 * tol) * scale
+        proj, D = linearize(t_hat, v, shifts)
+        t, inner_steps = free_minimum(lambda x: apply(x) + D * x, b, t_hat, proj, precondition, atol,
+                                      max(1, max_iter - steps))
+        steps += inner_steps
+    if steps >= max_iter:
+        raise ConvergenceError(f"active-set Newton: the residual ({residuals[-1]:.3g}, relative to the gap scale) "
+                               f"is above {tol:g} after {steps} steps", {"residuals": residuals[-5:]})
+    rest = fista(grad, prox, t, L, tol=tol, scale=scale, max_iter=max_iter - steps)
+    return ProximalResult(t=rest.t, shifts=rest.shifts, iterations=steps + rest.iterations,
+                          residuals=residuals + rest.residuals)
