@@ -45,7 +45,8 @@ unit of :func:`~ngcontact.solvers.projected_gradient.fista`'s steps.
 """
 from __future__ import annotations
 
-from typing import Callable
+from dataclasses import dataclass
+from typing import Callable, Protocol
 
 import numpy as np
 
@@ -53,8 +54,10 @@ from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.constrained_cg import inner
 from ngcontact.solvers.projected_gradient import ProximalResult, fista
 
-#: outer steps after which a solve that has not converged goes on with accelerated proximal gradients
-MAX_OUTER = 40
+#: outer steps without a new smallest residual after which the solve goes on with accelerated proximal gradients
+STALL = 6
+#: tolerance of each frozen-threshold problem of a Coulomb solve: this share of the law's residual
+FIXED_POINT_SHARE = 0.1
 #: inner tolerance: this share of the outer residual
 INNER_SHARE = 0.05
 
@@ -133,43 +136,97 @@ def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np
     return t, max_steps
 
 
-def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
-                      b: np.ndarray, prox: Callable[[np.ndarray, tuple], tuple],
-                      linearize: Callable[[np.ndarray, np.ndarray, tuple], tuple],
-                      precondition: Callable[[np.ndarray], np.ndarray], t0: np.ndarray, L: float, *, tol: float,
-                      scale: float, max_iter: int) -> ProximalResult:
-    """The active-set method of the module docstring.
+class Constraints(Protocol):
+    """The pointwise terms ``h_i`` (e.g. :class:`~ngcontact.cell.spectral.traction_constraints.TractionConstraints`)."""
 
-    ``grad(t) = apply(t) + b`` is the gradient of the smooth part
-    (``apply`` the linear operator); ``prox(v, shifts)`` as for
-    :func:`~ngcontact.solvers.projected_gradient.fista`; ``linearize(t_hat, v, shifts)``
-    at a proximal point ``t_hat = prox(v)`` the projector onto the free
-    directions (:func:`traction_projector`) and the curvature ``D`` of ``h``
-    along them (a diagonal);
+    threshold: Callable[[np.ndarray], np.ndarray]
+
+    def prox(self, v: np.ndarray, shifts: tuple) -> tuple[np.ndarray, tuple]: ...
+
+    def project(self, v: np.ndarray, shifts: tuple) -> np.ndarray: ...
+
+    def linearize(self, t_hat: np.ndarray, v: np.ndarray, shifts: tuple) -> tuple: ...
+
+    def frozen(self, G: np.ndarray) -> Constraints: ...
+
+
+@dataclass
+class _Point:
+    """An iterate ``t``, its proximal point ``t_hat = prox(v)``, ``v = t - grad(t) / L``, and its residual."""
+
+    t: np.ndarray
+    v: np.ndarray
+    t_hat: np.ndarray
+    shifts: tuple
+    res: float
+
+
+def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
+                      b: np.ndarray, h: Constraints, precondition: Callable[[np.ndarray], np.ndarray],
+                      t0: np.ndarray, L: float, *, tol: float, scale: float, max_iter: int) -> ProximalResult:
+    """The active-set method of the module docstring for the terms ``h`` with their own threshold rule.
+
+    ``grad(t) = apply(t) + b`` is the gradient of the smooth part;
     ``precondition`` an approximate inverse of ``apply``.
     """
-    t = t0.copy()
-    shifts: tuple = ()
     residuals: list[float] = []
     steps = 0
-    for _ in range(MAX_OUTER):
+
+    def evaluate(t, shifts):
+        nonlocal steps
+        steps += 1
         v = t - grad(t) / L
-        t_hat, shifts = prox(v, shifts)
+        t_hat, shifts = h.prox(v, shifts)
+        return _Point(t, v, t_hat, shifts, float(np.max(np.abs(t - t_hat))) * L / scale)
+
+    x = evaluate(t0.copy(), ())
+    best, since_best = x.res, 0
+    while since_best < STALL and steps < max_iter:
+        residuals.append(x.res)
+        if x.res <= tol:
+            return ProximalResult(t=x.t_hat, shifts=x.shifts, iterations=steps, residuals=residuals)
+        atol = max(INNER_SHARE * x.res, 0.2 * tol) * scale
+        proj, D = h.linearize(x.t_hat, x.v, x.shifts)
+        t_new, inner_steps = free_minimum(lambda y: apply(y) + D * y, b, x.t_hat, proj, precondition, atol,
+                                          max(1, max_iter - steps))
+        steps += inner_steps
+        # the free minimum, or its projection onto the constraints, whichever has the smaller residual
+        x = min(evaluate(t_new, x.shifts), evaluate(h.project(t_new, x.shifts), x.shifts), key=lambda y: y.res)
+        best, since_best = (x.res, 0) if x.res < best else (best, since_best + 1)
+    if steps >= max_iter:
+        raise ConvergenceError(f"active-set Newton: the residual ({residuals[-1]:.3g}, relative to the gap scale) "
+                               f"is above {tol:g} after {steps} steps", {"residuals": residuals[-5:]})
+    rest = fista(grad, h.prox, x.t, L, tol=tol, scale=scale, max_iter=max_iter - steps)
+    return ProximalResult(t=rest.t, shifts=rest.shifts, iterations=steps + rest.iterations,
+                          residuals=residuals + rest.residuals)
+
+
+def coulomb_active_set(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
+                       b: np.ndarray, h: Constraints, precondition: Callable[[np.ndarray], np.ndarray],
+                       t0: np.ndarray, L: float, *, tol: float, scale: float, max_iter: int) -> ProximalResult:
+    """A threshold that depends on the pressure: a fixed point of problems with a frozen threshold.
+
+    Each pass freezes ``G = G(p)`` at the proximal point's pressure and
+    solves that problem (:func:`active_set_newton`, warm-started, to a
+    tenth of the current residual); it stops when the residual of the law
+    itself (its threshold taken from the pressure of the proximal step)
+    meets ``tol``.
+    """
+    residuals: list[float] = []
+    steps = 0
+    t, shifts = t0, ()
+    d = t0.shape[0]
+    while steps < max_iter:
+        t_hat, shifts = h.prox(t - grad(t) / L, shifts)
         steps += 1
         res = float(np.max(np.abs(t - t_hat))) * L / scale
         residuals.append(res)
         if res <= tol:
             return ProximalResult(t=t_hat, shifts=shifts, iterations=steps, residuals=residuals)
-        if steps >= max_iter:
-            break
-        atol = max(INNER_SHARE * res, 0.2 * tol) * scale
-        proj, D = linearize(t_hat, v, shifts)
-        t, inner_steps = free_minimum(lambda x: apply(x) + D * x, b, t_hat, proj, precondition, atol,
-                                      max(1, max_iter - steps))
-        steps += inner_steps
-    if steps >= max_iter:
-        raise ConvergenceError(f"active-set Newton: the residual ({residuals[-1]:.3g}, relative to the gap scale) "
-                               f"is above {tol:g} after {steps} steps", {"residuals": residuals[-5:]})
-    rest = fista(grad, prox, t, L, tol=tol, scale=scale, max_iter=max_iter - steps)
-    return ProximalResult(t=rest.t, shifts=rest.shifts, iterations=steps + rest.iterations,
-                          residuals=residuals + rest.residuals)
+        frozen = h.frozen(np.asarray(h.threshold(t_hat[d - 1]), float))
+        sub = active_set_newton(grad, apply, b, frozen, precondition, t_hat, L, tol=max(tol, FIXED_POINT_SHARE * res),
+                                scale=scale, max_iter=max_iter - steps)
+        steps += sub.iterations
+        t = sub.t
+    raise ConvergenceError(f"active-set Newton (Coulomb): the residual ({residuals[-1]:.3g}, relative to the gap "
+                           f"scale) is above {tol:g} after {steps} steps", {"residuals": residuals[-5:]})

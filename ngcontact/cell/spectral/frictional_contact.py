@@ -22,8 +22,9 @@ import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.spectral.layer_compliance import layer_matrix
-from ngcontact.solvers.active_set_newton import active_set_newton, traction_projector
-from ngcontact.solvers.projected_gradient import fista, prox_friction, prox_pressure
+from ngcontact.cell.spectral.traction_constraints import TractionConstraints
+from ngcontact.solvers.active_set_newton import active_set_newton, coulomb_active_set
+from ngcontact.solvers.projected_gradient import fista
 
 
 def cell_load_normal(load: CellLoad) -> CellLoad:
@@ -101,33 +102,6 @@ def traction_preconditioner(cell, winkler: float):
     return apply
 
 
-def _linearization(cell, L: float, constrained: tuple[bool, ...]):
-    """``(t_hat, v, shifts) -> (projector, D)``: the free directions at a proximal point ``t_hat = prox(v)`` and the
-    curvature of the contact and friction terms on them (:mod:`ngcontact.solvers.active_set_newton`).
-
-    ``D``: the penalty's ``1 / k_n`` on the pressure, the Huber term's ``w / G`` on a sticking shear, and on a
-    slipping shear of a 3D cell the curvature of the friction disc's rim in the step ``1/L``,
-    ``L (|v_q - s| / G - 1)`` (the derivative of ``q = G z / |z|`` across ``z``).
-    """
-    d, f, exact = cell.dim, cell.friction, cell.enforcement == "exact"
-
-    def linearize(t_hat, v, shifts):
-        G = f.threshold(t_hat[d - 1]) * np.ones(cell.shape)
-        stick = (np.sum(t_hat[:d - 1] ** 2, axis=0) < (G * (1 - 1e-12)) ** 2) & (G > 0)
-        rim = ~stick & (G > 0)
-        D = np.zeros((d,) + cell.shape)
-        safe = np.where(G > 0, G, 1.0)
-        if not exact:
-            D[:d - 1] = np.where(stick, f.w / safe, 0.0)
-            D[d - 1] = 1.0 / cell.k_n
-        if d == 3:
-            sq = shifts[1]
-            z = v[:2] - (0.0 if sq is None else np.asarray(sq).reshape(2, 1, 1))
-            D[:2] += np.where(rim, L * np.maximum(np.sqrt(np.sum(z * z, axis=0)) / safe - 1.0, 0.0), 0.0)
-        return traction_projector(t_hat[d - 1] > 0, stick, rim, t_hat, constrained), D
-    return linearize
-
-
 def solve_frictional(cell, load: CellLoad, start) -> dict:
     """Tresca (or a Coulomb fixed point of Tresca problems) by FISTA in tractions."""
     d, f = cell.dim, cell.friction
@@ -147,7 +121,6 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
     if any(prescribed_mean[:d - 1]) and mean_q is None:
         raise ValueError("the spectral cell takes either the shear or the tangential jump in every direction")
     exact = cell.enforcement == "exact"
-    damp_p = 1.0 if exact else 1.0 + 1.0 / (L * cell.k_n)
     frictionless = cell.solve_normal(cell_load_normal(load), start)
     t0 = np.zeros((d,) + cell.shape)
     t0[d - 1] = frictionless["p"]
@@ -158,20 +131,14 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
     def grad(t):
         return apply(t) + b
 
-    def prox(v, shifts):
-        sp, sq = shifts if shifts else (0.0, None)
-        p, sp = prox_pressure(v[d - 1], damp_p, mean_p, sp)
-        # Tresca: the fixed threshold; Coulomb: mu times the pressure of this very step
-        G = np.asarray(f.threshold(p) * np.ones(cell.shape), float)
-        damp_q = 1.0 if exact else 1.0 + f.w / (L * np.maximum(G, 1e-300))
-        q, sq = prox_friction(v[:d - 1], G, damp_q, mean_q, sq)
-        return np.concatenate([q, p[None]]), (sp, sq)
+    h = TractionConstraints(cell.shape, lambda p: f.threshold(p), L, None if exact else f.w,
+                            None if exact else cell.k_n, mean_p, mean_q)
     if cell.friction_method == "proximal":
-        res = fista(grad, prox, t0, L, tol=cell.tol, scale=scale, max_iter=cell.max_iter)
+        res = fista(grad, h.prox, t0, L, tol=cell.tol, scale=scale, max_iter=cell.max_iter)
     else:
-        res = active_set_newton(grad, apply, b, prox, _linearization(cell, L, tuple(prescribed_mean)),
-                                traction_preconditioner(cell, 0.0 if exact else 1.0 / cell.k_n), t0, L, tol=cell.tol,
-                                scale=scale, max_iter=cell.max_iter)
+        solver = coulomb_active_set if f.couples_to_pressure else active_set_newton
+        res = solver(grad, apply, b, h, traction_preconditioner(cell, 0.0 if exact else 1.0 / cell.k_n), t0, L,
+                     tol=cell.tol, scale=scale, max_iter=cell.max_iter)
     t = res.t
     sp, sq = res.shifts
     Kt = apply(t)
