@@ -14,34 +14,49 @@ number of grid points per direction, thousands of steps at 512^2.
 
 Method (Hintermueller, Ito & Kunisch, SIAM J. Optim. 13 (2003) 865-888, the
 primal-dual active-set strategy as a semismooth Newton method; for contact
-with Coulomb friction Hueeber, Stadler & Wohlmuth, SIAM J. Sci. Comput. 30
-(2008) 572-596).  Each outer step evaluates the proximal map once, which
-splits the unknowns into *free* ones (pressure where ``p > 0``, shear at a
+with friction Hueeber, Stadler & Wohlmuth, SIAM J. Sci. Comput. 30 (2008)
+572-596).  Each outer step evaluates the proximal map once, which splits
+the unknowns into *free* ones (the pressure where ``p > 0``, the shear at a
 sticking point, ``|q| < G``) and *fixed* ones (``p = 0`` on the open set, the
-shear ``q = G n`` on the rim at a slipping point, ``n`` the direction of the
-proximal map's argument and ``G`` the threshold at its pressure), and then
-minimizes the quadratic energy over the free unknowns with the fixed ones
-held (a linear, symmetric positive definite problem on the free set, under
-the mean constraints).  With the slip direction and the Coulomb threshold
-frozen over each step this is the semismooth Newton step with the
-derivative of ``n`` and of ``G = mu p`` dropped; it is exact Newton for Tresca
-in 2D.  The free problem is solved by projected conjugate gradients
+shear ``q = G n`` on the rim at a slipping point), and then minimizes the
+quadratic energy over the free unknowns with the fixed ones held, under
+the mean constraints: a symmetric positive definite problem.  In 3D a
+slipping point keeps one free direction, the tangent ``n_perp`` of the
+friction disc, with the rim's curvature ``L (|z| / G - 1)`` as its diagonal
+(the derivative of ``q = G z / |z|`` across ``z``); for a given threshold
+this is the semismooth Newton step.  A point far outside the disc
+(``|z| > 2 G``) is held entirely: its turn is small and its curvature would
+spoil the conditioning.  Of the free minimum and its projection onto the
+constraints, the one with the smaller residual is the next iterate.
+
+The free problem is solved by projected conjugate gradients
 preconditioned by ``R K_full^{-1} R^T`` (``R`` the restriction to the free
-set, ``K_full^{-1}`` the inverse of the full compliance per wave vector,
-applied by FFTs; Vollebregt, J. Comput. Phys. 257 (2014) 333-351): on a
-subset of the grid this preconditioned operator has a condition number that
-grows like ``log^2 N`` (the pseudo-differential operators of order -1 and 1
-are each other's inverses up to the restriction, as in domain
-decomposition), not like ``N``.  The inner tolerance follows the outer
-residual.
+set, ``K_full^{-1}`` the inverse of the full 3 x 3 (2D: 2 x 2) compliance per
+wave vector, applied by FFTs; Vollebregt, J. Comput. Phys. 257 (2014)
+333-351): the compliance is a pseudo-differential operator of order -1 and
+its inverse one of order 1, so the preconditioned operator on a subset of
+the grid is spectrally equivalent to the identity up to the restriction's
+``log^2 N`` factor (as for the interface operators of domain
+decomposition), where ``K`` alone has a condition number of order ``N``.
+The inner tolerance is a share of the outer residual.
+
+Coulomb friction (a threshold ``G = mu p`` of the unknown pressure) has
+no potential, and with the threshold taken inside each Newton step the 3D
+active sets cycle; :func:`coulomb_active_set` therefore freezes the threshold
+at the current pressure, solves that Tresca problem, and repeats (the
+fixed point of Tresca problems of Panagiotopoulos and of Kalker's codes,
+cheap here because each pass starts from the last and needs few Newton
+steps).  No step of either loop is guaranteed to converge globally: an
+active-set solve that makes no new best residual in ``STALL`` steps, or a
+Coulomb solve without progress in ``STALL_PASSES`` passes, goes on with
+accelerated proximal gradients (:func:`~ngcontact.solvers.projected_gradient.fista`)
+from its last iterate, so the answer is always the one of that method.
 
 Stopping rule: the fixed-point residual of :mod:`ngcontact.solvers.projected_gradient`,
 ``|t - prox(t - grad / L)| L <= tol scale``, so both methods stop at the
-same accuracy.  Should the active sets cycle (no guarantee of global
-convergence without a line search), the solve goes on with accelerated
-proximal gradients from the last iterate (:func:`~ngcontact.solvers.projected_gradient.fista`).
-``iterations`` counts operator applications (outer plus inner steps), the
-unit of :func:`~ngcontact.solvers.projected_gradient.fista`'s steps.
+same accuracy.  ``iterations`` counts operator applications (residual
+evaluations plus inner steps), the unit of
+:func:`~ngcontact.solvers.projected_gradient.fista`'s steps.
 """
 from __future__ import annotations
 
@@ -58,6 +73,10 @@ from ngcontact.solvers.projected_gradient import ProximalResult, fista
 STALL = 6
 #: tolerance of each frozen-threshold problem of a Coulomb solve: this share of the law's residual
 FIXED_POINT_SHARE = 0.1
+#: a pass of a Coulomb solve makes progress when it brings the residual below this share of the best so far
+DECREASE = 0.7
+#: passes of a Coulomb solve without progress after which it goes on with accelerated proximal gradients
+STALL_PASSES = 4
 #: inner tolerance: this share of the outer residual
 INNER_SHARE = 0.05
 
@@ -87,7 +106,7 @@ def traction_projector(pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, 
             y = y + np.sum(x * turn, axis=0) * turn
         return y
     n_p = int(np.count_nonzero(pressed))
-    if d == 3 and constrained[0]:
+    if turn is not None and constrained[0]:
         M = np.eye(2) * float(np.count_nonzero(stick)) + np.einsum("aij,bij->ab", turn, turn)
         M_inv = np.linalg.pinv(M)
     elif constrained[0]:
@@ -139,7 +158,8 @@ def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np
 class Constraints(Protocol):
     """The pointwise terms ``h_i`` (e.g. :class:`~ngcontact.cell.spectral.traction_constraints.TractionConstraints`)."""
 
-    threshold: Callable[[np.ndarray], np.ndarray]
+    @property
+    def threshold(self) -> Callable[[np.ndarray], np.ndarray]: ...
 
     def prox(self, v: np.ndarray, shifts: tuple) -> tuple[np.ndarray, tuple]: ...
 
@@ -216,17 +236,23 @@ def coulomb_active_set(grad: Callable[[np.ndarray], np.ndarray], apply: Callable
     steps = 0
     t, shifts = t0, ()
     d = t0.shape[0]
-    while steps < max_iter:
+    best, since_best = np.inf, 0
+    while steps < max_iter and since_best < STALL_PASSES:
         t_hat, shifts = h.prox(t - grad(t) / L, shifts)
         steps += 1
         res = float(np.max(np.abs(t - t_hat))) * L / scale
         residuals.append(res)
         if res <= tol:
             return ProximalResult(t=t_hat, shifts=shifts, iterations=steps, residuals=residuals)
-        frozen = h.frozen(np.asarray(h.threshold(t_hat[d - 1]), float))
-        sub = active_set_newton(grad, apply, b, frozen, precondition, t_hat, L, tol=max(tol, FIXED_POINT_SHARE * res),
-                                scale=scale, max_iter=max_iter - steps)
+        best, since_best = (res, 0) if res < DECREASE * best else (min(best, res), since_best + 1)
+        G = np.asarray(h.threshold(t_hat[d - 1]), float)
+        sub = active_set_newton(grad, apply, b, h.frozen(G), precondition, t_hat, L,
+                                tol=max(tol, FIXED_POINT_SHARE * res), scale=scale, max_iter=max_iter - steps)
         steps += sub.iterations
         t = sub.t
+    if steps < max_iter:
+        rest = fista(grad, h.prox, t, L, tol=tol, scale=scale, max_iter=max_iter - steps)
+        return ProximalResult(t=rest.t, shifts=rest.shifts, iterations=steps + rest.iterations,
+                              residuals=residuals + rest.residuals)
     raise ConvergenceError(f"active-set Newton (Coulomb): the residual ({residuals[-1]:.3g}, relative to the gap "
                            f"scale) is above {tol:g} after {steps} steps", {"residuals": residuals[-5:]})

@@ -6,13 +6,20 @@ Friction (Tresca, or Coulomb with the threshold ``G = mu p``, paper eqs.
 ``t = (q, p)`` and ``K`` the layers' full 3 x 3 (2D: 2 x 2) compliance, whose normal/tangential coupling vanishes for
 identical layers only.  The cell is then the convex problem in tractions of
 :mod:`ngcontact.solvers.projected_gradient` (``|q| <= G``, ``p >= 0``),
-solved by accelerated proximal gradients.  Coulomb friction has no such
-potential; its threshold is taken from the pressure of the same proximal
-step, so that a fixed point of the iteration meets Coulomb's conditions
-with its own pressure (no outer fixed point of Tresca problems, each pass
-of which is a whole proximal-gradient solve).  With ``"penalty"``
-the friction is the FE cell's Huber-regularized one (width ``w``), with ``"exact"`` it is
-exact.  As in the FE cell, the Tresca threshold holds on the whole surface.
+solved by the active-set (semismooth Newton) method of
+:mod:`ngcontact.solvers.active_set_newton`: its free problems are solved
+by conjugate gradients preconditioned with the inverse of the full
+compliance per wave vector (:func:`traction_preconditioner`), so the step
+count grows like ``log N`` instead of like the ``sqrt(N)`` of accelerated
+proximal gradients (:mod:`ngcontact.solvers.projected_gradient`, kept as
+``SpectralCell.friction_method = "proximal"`` and as the active-set
+method's fallback).  Coulomb friction has no potential; its solution is
+the fixed point at which the threshold ``G = mu p`` is taken from the
+pressure of the proximal step itself, which both methods meet to the same
+tolerance.  With ``"penalty"`` the friction is the FE cell's
+Huber-regularized one (width ``w``), with ``"exact"`` it is exact.  As in
+the FE cell, the Tresca threshold holds on the whole surface.  The
+pointwise terms: :mod:`ngcontact.cell.spectral.traction_constraints`.
 
 Functions of a :class:`~ngcontact.cell.spectral.layered_cell.SpectralCell` ``cell``.
 """
@@ -103,7 +110,7 @@ def traction_preconditioner(cell, winkler: float):
 
 
 def solve_frictional(cell, load: CellLoad, start) -> dict:
-    """Tresca (or a Coulomb fixed point of Tresca problems) by FISTA in tractions."""
+    """Tresca or Coulomb friction in tractions (module docstring)."""
     d, f = cell.dim, cell.friction
     assert f is not None
     poisson = cell.poisson_shift(load.macro_strain)

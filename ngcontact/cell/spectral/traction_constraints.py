@@ -86,9 +86,13 @@ class TractionConstraints:
             D[:d - 1] = np.where(stick, self.w / safe, 0.0)
         if self.k_n is not None:
             D[d - 1] = 1.0 / self.k_n
+        turning = np.zeros(self.shape, bool)
         if d == 3:
             sq = shifts[1]
             z = v[:2] - (0.0 if sq is None else np.asarray(sq).reshape(2, 1, 1))
-            D[:2] += np.where(rim, self.L * np.maximum(np.sqrt(np.sum(z * z, axis=0)) / safe - 1.0, 0.0), 0.0)
+            bend = np.where(rim, np.maximum(np.sqrt(np.sum(z * z, axis=0)) / safe - 1.0, 0.0), np.inf)
+            # a rim point far outside the disc barely turns: held, which keeps the free problem well conditioned
+            turning = bend <= 1.0
+            D[:2] += np.where(turning, self.L * bend, 0.0)
         constrained = (self.mean_q is not None,) * (d - 1) + (self.mean_p is not None,)
-        return traction_projector(t_hat[d - 1] > 0, stick, rim, t_hat, constrained), D
+        return traction_projector(t_hat[d - 1] > 0, stick, turning, t_hat, constrained), D
