@@ -53,6 +53,9 @@ def test_preconditioned_constrained_cg_gives_the_plain_answer_in_fewer_steps(pre
     new, old = _solve_both(3, 64, cell_load(3, pressure=pressure))
     _agree(new, old, pressure)
     assert new.iterations < old.iterations
+    # the stiffness of the contact set: the masked CG, preconditioned or not
+    assert new.results["effective_stiffness"]["total"][0][0] == pytest.approx(
+        old.results["effective_stiffness"]["total"][0][0], rel=1e-8)
 
 
 def test_preconditioned_constrained_cg_under_a_prescribed_approach():
