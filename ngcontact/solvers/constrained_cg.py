@@ -131,6 +131,14 @@ def _start(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, pbar: flo
     return p
 
 
+def _gap_state(p: np.ndarray, g: np.ndarray, pbar: float | None, gscale: float) -> tuple[np.ndarray, float, float]:
+    """``(g, shift, residual)``: the gap, the multiplier of the mean (the mean gap on the contact set) and the
+    complementarity residual."""
+    on = p > 0
+    shift = float(g[on].mean()) if (pbar is not None and on.any()) else 0.0
+    return g, shift, _residual(p, g, shift, gscale)
+
+
 def _preconditioned(precondition, gs, on, mean_free: bool) -> np.ndarray:
     """``Pi R M R^T gs``: the preconditioner on the contact set, made mean-free there under a prescribed mean."""
     z = np.where(on, precondition(gs), 0.0)
@@ -220,15 +228,10 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
         scale = pbar / p.mean() if pbar is not None else 1.0
         p *= scale
         Ap = scale * (Ap - tau * At) if linear else apply_A(p)
-        g = Ap + b
-        on = p > 0
-        shift = float(g[on].mean()) if (pbar is not None and on.any()) else 0.0
-        res = _residual(p, g, shift, gscale)
+        g, shift, res = _gap_state(p, Ap + b, pbar, gscale)
         if res <= max(tol, roundoff_floor(norm, p, b, gscale)) and linear:
             Ap = apply_A(p)    # converged on an updated gap: confirmed on the gap itself
-            g = Ap + b
-            shift = float(g[on].mean()) if (pbar is not None and on.any()) else 0.0
-            res = _residual(p, g, shift, gscale)
+            g, shift, res = _gap_state(p, Ap + b, pbar, gscale)
         residuals.append(res)
         if res <= max(tol, roundoff_floor(norm, p, b, gscale)):
             return ConstrainedResult(p=p, gap=g - shift, shift=shift, iterations=it, residuals=residuals)
