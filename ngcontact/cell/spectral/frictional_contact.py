@@ -6,13 +6,20 @@ Friction (Tresca, or Coulomb with the threshold ``G = mu p``, paper eqs.
 ``t = (q, p)`` and ``K`` the layers' full 3 x 3 (2D: 2 x 2) compliance, whose normal/tangential coupling vanishes for
 identical layers only.  The cell is then the convex problem in tractions of
 :mod:`ngcontact.solvers.projected_gradient` (``|q| <= G``, ``p >= 0``),
-solved by accelerated proximal gradients.  Coulomb friction has no such
-potential; its threshold is taken from the pressure of the same proximal
-step, so that a fixed point of the iteration meets Coulomb's conditions
-with its own pressure (no outer fixed point of Tresca problems, each pass
-of which is a whole proximal-gradient solve).  With ``"penalty"``
-the friction is the FE cell's Huber-regularized one (width ``w``), with ``"exact"`` it is
-exact.  As in the FE cell, the Tresca threshold holds on the whole surface.
+solved by the active-set (semismooth Newton) method of
+:mod:`ngcontact.solvers.active_set_newton`: its free problems are solved
+by conjugate gradients preconditioned with the inverse of the full
+compliance per wave vector (:func:`traction_preconditioner`), so the step
+count grows like ``log N`` instead of like the ``sqrt(N)`` of accelerated
+proximal gradients (:mod:`ngcontact.solvers.projected_gradient`, kept as
+``SpectralCell.friction_method = "proximal"`` and as the active-set
+method's fallback).  Coulomb friction has no potential; its solution is
+the fixed point at which the threshold ``G = mu p`` is taken from the
+pressure of the proximal step itself, which both methods meet to the same
+tolerance.  With ``"penalty"`` the friction is the FE cell's
+Huber-regularized one (width ``w``), with ``"exact"`` it is exact.  As in
+the FE cell, the Tresca threshold holds on the whole surface.  The
+pointwise terms: :mod:`ngcontact.cell.spectral.traction_constraints`.
 
 Functions of a :class:`~ngcontact.cell.spectral.layered_cell.SpectralCell` ``cell``.
 """
@@ -22,7 +29,9 @@ import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.spectral.layer_compliance import layer_matrix
-from ngcontact.solvers.projected_gradient import fista, prox_friction, prox_pressure
+from ngcontact.cell.spectral.traction_constraints import TractionConstraints
+from ngcontact.solvers.active_set_newton import active_set_newton, coulomb_active_set
+from ngcontact.solvers.projected_gradient import fista
 
 
 def cell_load_normal(load: CellLoad) -> CellLoad:
@@ -46,19 +55,7 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
     """
     import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
     d = cell.dim
-    n = cell.grid
-    k1 = 2 * np.pi * sfft.rfftfreq(n, d=cell.period / n)
-    if d == 2:
-        kv = k1[:, None]
-        nyq = np.arange(k1.size) == n // 2
-    else:
-        k0 = 2 * np.pi * sfft.fftfreq(n, d=cell.period / n)
-        kv = np.stack(np.broadcast_arrays(k1[None, :], k0[:, None]), axis=-1)
-        nyq = (np.arange(n)[:, None] == n // 2) | (np.arange(k1.size)[None, :] == n // 2)
-    K = (layer_matrix(kv, cell.rough.E, cell.rough.nu, cell.rough.h)
-         + layer_matrix(kv, cell.counter.E, cell.counter.nu, cell.counter.h, above=True))
-    K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
-    K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
+    K = _full_compliance(cell)
     K0 = np.real(np.diagonal(K.reshape(-1, d, d)[0])).copy()
     zero = (0,) * (d - 1)
     for c in range(d):
@@ -74,8 +71,46 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
         return sfft.irfftn(U, s=cell.shape, axes=axes, workers=-1)
     return apply, L, K0
 
+
+def _full_compliance(cell) -> np.ndarray:
+    """``K(k) = C_rough + C_counter`` on the half spectrum, shape ``(*kshape, d, d)``, the coupling zeroed on
+    the Nyquist rows."""
+    import scipy.fft as sfft
+    d = cell.dim
+    n = cell.grid
+    k1 = 2 * np.pi * sfft.rfftfreq(n, d=cell.period / n)
+    if d == 2:
+        kv = k1[:, None]
+        nyq = np.arange(k1.size) == n // 2
+    else:
+        k0 = 2 * np.pi * sfft.fftfreq(n, d=cell.period / n)
+        kv = np.stack(np.broadcast_arrays(k1[None, :], k0[:, None]), axis=-1)
+        nyq = (np.arange(n)[:, None] == n // 2) | (np.arange(k1.size)[None, :] == n // 2)
+    K = (layer_matrix(kv, cell.rough.E, cell.rough.nu, cell.rough.h)
+         + layer_matrix(kv, cell.counter.E, cell.counter.nu, cell.counter.h, above=True))
+    K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
+    K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
+    return K
+
+def traction_preconditioner(cell, winkler: float):
+    """``r -> K_full^{-1} r`` by FFTs: the inverse of the full compliance (uniform modes kept, plus the penalty's
+    ``winkler`` on the normal component) per wave vector, the preconditioner of
+    :mod:`ngcontact.solvers.active_set_newton`."""
+    import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
+    d = cell.dim
+    K = _full_compliance(cell)
+    K[..., d - 1, d - 1] += winkler
+    Kinv = np.moveaxis(np.linalg.inv(K), (-2, -1), (0, 1)).copy()
+    axes = tuple(range(1, d))
+
+    def apply(r):
+        R = sfft.rfftn(r, axes=axes, workers=-1)
+        return sfft.irfftn(np.einsum("ab...,b...->a...", Kinv, R), s=cell.shape, axes=axes, workers=-1)
+    return apply
+
+
 def solve_frictional(cell, load: CellLoad, start) -> dict:
-    """Tresca (or a Coulomb fixed point of Tresca problems) by FISTA in tractions."""
+    """Tresca or Coulomb friction in tractions (module docstring)."""
     d, f = cell.dim, cell.friction
     assert f is not None
     poisson = cell.poisson_shift(load.macro_strain)
@@ -93,7 +128,6 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
     if any(prescribed_mean[:d - 1]) and mean_q is None:
         raise ValueError("the spectral cell takes either the shear or the tangential jump in every direction")
     exact = cell.enforcement == "exact"
-    damp_p = 1.0 if exact else 1.0 + 1.0 / (L * cell.k_n)
     frictionless = cell.solve_normal(cell_load_normal(load), start)
     t0 = np.zeros((d,) + cell.shape)
     t0[d - 1] = frictionless["p"]
@@ -104,15 +138,14 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
     def grad(t):
         return apply(t) + b
 
-    def prox(v, shifts):
-        sp, sq = shifts if shifts else (0.0, None)
-        p, sp = prox_pressure(v[d - 1], damp_p, mean_p, sp)
-        # Tresca: the fixed threshold; Coulomb: mu times the pressure of this very step
-        G = np.asarray(f.threshold(p) * np.ones(cell.shape), float)
-        damp_q = 1.0 if exact else 1.0 + f.w / (L * np.maximum(G, 1e-300))
-        q, sq = prox_friction(v[:d - 1], G, damp_q, mean_q, sq)
-        return np.concatenate([q, p[None]]), (sp, sq)
-    res = fista(grad, prox, t0, L, tol=cell.tol, scale=scale, max_iter=cell.max_iter)
+    h = TractionConstraints(cell.shape, lambda p: f.threshold(p), L, None if exact else f.w,
+                            None if exact else cell.k_n, mean_p, mean_q)
+    if cell.friction_method == "proximal":
+        res = fista(grad, h.prox, t0, L, tol=cell.tol, scale=scale, max_iter=cell.max_iter)
+    else:
+        solver = coulomb_active_set if f.couples_to_pressure else active_set_newton
+        res = solver(grad, apply, b, h, traction_preconditioner(cell, 0.0 if exact else 1.0 / cell.k_n), t0, L,
+                     tol=cell.tol, scale=scale, max_iter=cell.max_iter)
     t = res.t
     sp, sq = res.shifts
     Kt = apply(t)

@@ -114,7 +114,8 @@ def effective_stiffness(cell, active: np.ndarray) -> dict:
     if idx.size == cell.points and cell.enforcement == "exact":
         return {"components": ["n0"], "matrix": None, "compliance": [[0.0]], "total": [[S0]],
                 "reference": [[S0]]}
-    x, _ = masked_cg(cell.interface_compliance(uniform=False), active, np.ones(cell.shape))
+    x, _ = masked_cg(cell.interface_compliance(uniform=False), active, np.ones(cell.shape),
+                     precondition=cell.inverse_compliance() if cell.preconditioned else None)
     K = float(x.sum()) / cell.points
     S = 1.0 / (1.0 / K + cell.c0)
     return {"components": ["n0"], "matrix": [[K]], "compliance": [[1.0 / K]], "total": [[S]],

@@ -110,7 +110,16 @@ class SpectralCell:
         :class:`~ngcontact.laws.friction.FrictionLaw` (Tresca or Coulomb; its
         Huber width with ``"penalty"``, exact friction with ``"exact"``);
         ``None``: frictionless.
+
+    Solvers (class attributes; the older ones kept for comparison): ``preconditioned``: the frictionless
+    constrained CG preconditioned by the inverse compliance on the contact set
+    (:mod:`ngcontact.solvers.constrained_cg`), ``False`` without; ``friction_method``: ``"active_set"``
+    (:mod:`ngcontact.solvers.active_set_newton`) or ``"proximal"`` (accelerated proximal gradients,
+    :mod:`ngcontact.solvers.projected_gradient`).
     """
+
+    preconditioned: bool = True
+    friction_method: str = "active_set"
 
     def __init__(self, *, dim: int, period: float, grid: int, rough: Layer, counter: Layer,
                  gap: np.ndarray, k_n: float, enforcement: str = "exact", tol: float = 1e-12,
@@ -245,7 +254,8 @@ class SpectralCell:
         res = self.full_contact(b, pbar)
         if res is None:
             res = constrained_cg(self.interface_compliance(uniform=uniform), b, pbar=pbar, tol=self.tol,
-                                 max_iter=self.max_iter, gscale=self.gscale, p0=start, norm=self.norm(uniform))
+                                 max_iter=self.max_iter, gscale=self.gscale, p0=start, norm=self.norm(uniform),
+                                 precondition=self.inverse_compliance() if self.preconditioned else None)
         p = res.p
         winkler = p / self.k_n if self.enforcement == "penalty" else 0.0
         closure = self.g0 - (res.gap - winkler)
@@ -253,6 +263,11 @@ class SpectralCell:
         return {"p": p, "q": np.zeros((d - 1,) + self.shape), "closure": closure,
                 "slip": np.zeros((d - 1,) + self.shape), "far_face_jump": [0.0] * (d - 1) + [approach],
                 "iterations": res.iterations, "residuals": res.residuals}
+
+    def inverse_compliance(self):
+        """``r -> (C + 1/k_n)^{-1} r`` with the uniform mode kept: the preconditioner of the constrained CG."""
+        inv = 1.0 / (self.symbol + (1.0 / self.k_n if self.enforcement == "penalty" else 0.0))
+        return lambda r: self.convolve(r, inv)
 
     def norm(self, uniform: bool) -> float:
         """Largest eigenvalue of :meth:`interface_compliance`: the largest value of its symbol."""

@@ -1,0 +1,98 @@
+"""The pointwise contact and friction terms of the spectral cell's traction problem, for a given threshold rule.
+
+The frictional cell (:mod:`ngcontact.cell.spectral.frictional_contact`) is
+``min 1/2 <t, K t> + <t, b> + sum_i h_i(t_i)`` under prescribed means, ``t = (q, p)``;
+``h_i`` is ``p >= 0`` (plus ``p^2 / (2 k_n)`` with the penalty) and ``|q| <= G_i``
+(plus ``w |q|^2 / (2 G_i)`` with the Huber width).  This object holds what is
+local to a grid point: the proximal map of ``h`` in the step ``1/L``, the
+projection onto the constraints, and the linearization used by
+:mod:`ngcontact.solvers.active_set_newton`.  The threshold rule ``G(p)`` is
+the law's own (Coulomb: ``mu p`` of the same proximal step) or a frozen
+field (the Tresca problems of a Coulomb fixed point).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ngcontact.solvers.active_set_newton import traction_projector
+from ngcontact.solvers.projected_gradient import prox_friction, prox_pressure
+
+
+@dataclass
+class TractionConstraints:
+    """The terms ``h_i`` of one load (module docstring).
+
+    ``threshold``: ``p -> G`` (an array of the grid's shape); ``w`` and
+    ``k_n``: ``None`` for exact laws; ``mean_p``, ``mean_q``: the prescribed
+    means (``None`` where free); ``L``: the step's inverse.
+    """
+
+    shape: tuple[int, ...]
+    threshold: Callable[[np.ndarray], np.ndarray]
+    L: float
+    w: float | None
+    k_n: float | None
+    mean_p: float | None
+    mean_q: np.ndarray | None
+
+    @property
+    def d(self) -> int:
+        return len(self.shape) + 1
+
+    def frozen(self, G: np.ndarray) -> TractionConstraints:
+        """The same terms with the threshold field ``G`` held fixed (a Tresca problem)."""
+        return TractionConstraints(self.shape, lambda p: G, self.L, self.w, self.k_n, self.mean_p, self.mean_q)
+
+    def _G(self, p: np.ndarray) -> np.ndarray:
+        return np.asarray(self.threshold(p) * np.ones(self.shape), float)
+
+    def prox(self, v: np.ndarray, shifts: tuple) -> tuple[np.ndarray, tuple]:
+        """The proximal map of ``h / L`` at ``v`` (warm-started shifts of the means in, the new ones out)."""
+        d = self.d
+        sp, sq = shifts if shifts else (0.0, None)
+        damp_p = 1.0 if self.k_n is None else 1.0 + 1.0 / (self.L * self.k_n)
+        p, sp = prox_pressure(v[d - 1], damp_p, self.mean_p, sp)
+        G = self._G(p)          # Coulomb: mu times the pressure of this very step
+        damp_q = 1.0 if self.w is None else 1.0 + self.w / (self.L * np.maximum(G, 1e-300))
+        q, sq = prox_friction(v[:d - 1], G, damp_q, self.mean_q, sq)
+        return np.concatenate([q, p[None]]), (sp, sq)
+
+    def project(self, v: np.ndarray, shifts: tuple) -> np.ndarray:
+        """The projection onto ``p >= 0``, ``|q| <= G(p)`` and the means."""
+        d = self.d
+        sp, sq = shifts if shifts else (0.0, None)
+        p, _ = prox_pressure(v[d - 1], 1.0, self.mean_p, sp)
+        q, _ = prox_friction(v[:d - 1], self._G(p), 1.0, self.mean_q, sq)
+        return np.concatenate([q, p[None]])
+
+    def linearize(self, t_hat: np.ndarray, v: np.ndarray, shifts: tuple):
+        """``(projector, D)`` at a proximal point ``t_hat = prox(v)``: the free directions and the curvature of
+        ``h`` along them.
+
+        ``D``: the penalty's ``1 / k_n`` on the pressure, the Huber term's ``w / G`` on a sticking shear, and on
+        a slipping shear of a 3D cell the curvature of the friction disc's rim in the step ``1/L``,
+        ``L (|v_q - s| / G - 1)`` (the derivative of ``q = G z / |z|`` across ``z``).
+        """
+        d = self.d
+        G = self._G(t_hat[d - 1])
+        stick = (np.sum(t_hat[:d - 1] ** 2, axis=0) < (G * (1 - 1e-12)) ** 2) & (G > 0)
+        rim = ~stick & (G > 0)
+        D = np.zeros((d,) + self.shape)
+        safe = np.where(G > 0, G, 1.0)
+        if self.w is not None:
+            D[:d - 1] = np.where(stick, self.w / safe, 0.0)
+        if self.k_n is not None:
+            D[d - 1] = 1.0 / self.k_n
+        turning = np.zeros(self.shape, bool)
+        if d == 3:
+            sq = shifts[1]
+            z = v[:2] - (0.0 if sq is None else np.asarray(sq).reshape(2, 1, 1))
+            bend = np.where(rim, np.maximum(np.sqrt(np.sum(z * z, axis=0)) / safe - 1.0, 0.0), np.inf)
+            # a rim point far outside the disc barely turns: held, which keeps the free problem well conditioned
+            turning = bend <= 1.0
+            D[:2] += np.where(turning, self.L * bend, 0.0)
+        constrained = (self.mean_q is not None,) * (d - 1) + (self.mean_p is not None,)
+        return traction_projector(t_hat[d - 1] > 0, stick, turning, t_hat, constrained), D

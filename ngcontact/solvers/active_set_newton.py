@@ -1,0 +1,258 @@
+"""A primal-dual active-set (semismooth Newton) method for contact with friction in tractions.
+
+The problem is the one of :mod:`ngcontact.solvers.projected_gradient`:
+
+    min_t  1/2 <t, K t> + <t, b> + sum_i h_i(t_i),   mean(t_c) = m_c  (prescribed components),
+
+``t = (q, p)``, ``K`` the layers' compliance (symmetric positive
+semidefinite, applied by FFTs), ``h_i`` the separable contact and friction
+terms.  Its solution is the fixed point ``t = prox(t - (K t + b) / L)`` of the
+proximal-gradient map.  Accelerated proximal gradients reach it in
+``O(sqrt(kappa))`` steps per digit, ``kappa`` the condition number of ``K``
+on the contact set: for a compliance that falls like ``1 / |k|`` that is the
+number of grid points per direction, thousands of steps at 512^2.
+
+Method (Hintermueller, Ito & Kunisch, SIAM J. Optim. 13 (2003) 865-888, the
+primal-dual active-set strategy as a semismooth Newton method; for contact
+with friction Hueeber, Stadler & Wohlmuth, SIAM J. Sci. Comput. 30 (2008)
+572-596).  Each outer step evaluates the proximal map once, which splits
+the unknowns into *free* ones (the pressure where ``p > 0``, the shear at a
+sticking point, ``|q| < G``) and *fixed* ones (``p = 0`` on the open set, the
+shear ``q = G n`` on the rim at a slipping point), and then minimizes the
+quadratic energy over the free unknowns with the fixed ones held, under
+the mean constraints: a symmetric positive definite problem.  In 3D a
+slipping point keeps one free direction, the tangent ``n_perp`` of the
+friction disc, with the rim's curvature ``L (|z| / G - 1)`` as its diagonal
+(the derivative of ``q = G z / |z|`` across ``z``); for a given threshold
+this is the semismooth Newton step.  A point far outside the disc
+(``|z| > 2 G``) is held entirely: its turn is small and its curvature would
+spoil the conditioning.  Of the free minimum and its projection onto the
+constraints, the one with the smaller residual is the next iterate.
+
+The free problem is solved by projected conjugate gradients
+preconditioned by ``R K_full^{-1} R^T`` (``R`` the restriction to the free
+set, ``K_full^{-1}`` the inverse of the full 3 x 3 (2D: 2 x 2) compliance per
+wave vector, applied by FFTs; Vollebregt, J. Comput. Phys. 257 (2014)
+333-351): the compliance is a pseudo-differential operator of order -1 and
+its inverse one of order 1, so the preconditioned operator on a subset of
+the grid is spectrally equivalent to the identity up to the restriction's
+``log^2 N`` factor (as for the interface operators of domain
+decomposition), where ``K`` alone has a condition number of order ``N``.
+The inner tolerance is a share of the outer residual.
+
+Coulomb friction (a threshold ``G = mu p`` of the unknown pressure) has
+no potential, and with the threshold taken inside each Newton step the 3D
+active sets cycle; :func:`coulomb_active_set` therefore freezes the threshold
+at the current pressure, solves that Tresca problem, and repeats (the
+fixed point of Tresca problems of Panagiotopoulos and of Kalker's codes,
+cheap here because each pass starts from the last and needs few Newton
+steps).  No step of either loop is guaranteed to converge globally: an
+active-set solve that makes no new best residual in ``STALL`` steps, or a
+Coulomb solve without progress in ``STALL_PASSES`` passes, goes on with
+accelerated proximal gradients (:func:`~ngcontact.solvers.projected_gradient.fista`)
+from its last iterate, so the answer is always the one of that method.
+
+Stopping rule: the fixed-point residual of :mod:`ngcontact.solvers.projected_gradient`,
+``|t - prox(t - grad / L)| L <= tol scale``, so both methods stop at the
+same accuracy.  ``iterations`` counts operator applications (residual
+evaluations plus inner steps), the unit of
+:func:`~ngcontact.solvers.projected_gradient.fista`'s steps.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Protocol
+
+import numpy as np
+
+from ngcontact.errors import ConvergenceError
+from ngcontact.solvers.constrained_cg import inner
+from ngcontact.solvers.projected_gradient import ProximalResult, fista
+
+#: outer steps without a new smallest residual after which the solve goes on with accelerated proximal gradients
+STALL = 6
+#: tolerance of each frozen-threshold problem of a Coulomb solve: this share of the law's residual
+FIXED_POINT_SHARE = 0.1
+#: a pass of a Coulomb solve makes progress when it brings the residual below this share of the best so far
+DECREASE = 0.7
+#: passes of a Coulomb solve without progress after which it goes on with accelerated proximal gradients
+STALL_PASSES = 4
+#: inner tolerance: this share of the outer residual
+INNER_SHARE = 0.05
+
+
+def traction_projector(pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, t_hat: np.ndarray,
+                       constrained: tuple[bool, ...]) -> Callable[[np.ndarray], np.ndarray]:
+    """The orthogonal projector onto the free directions of a proximal point ``t_hat = (q, p)``.
+
+    Free: the pressure where ``pressed``; the whole shear where ``stick``; at
+    a slipping point (``rim``) of a 3D cell the shear along the tangent of
+    the friction disc, ``n_perp`` (the slip direction's own update, the
+    semismooth Newton step of ``q = G z / |z|`` without its curvature term);
+    on each component group of prescribed mean, in addition, the sum zero
+    (the projection ``y - Pi lambda`` with ``(sum_i Pi_i) lambda = sum_i y_i``).
+    """
+    d = t_hat.shape[0]
+    turn = None
+    if d == 3:
+        q = t_hat[:2]
+        norm = np.sqrt(np.sum(q * q, axis=0))
+        on = rim & (norm > 0)
+        turn = np.where(on, np.stack([-q[1], q[0]]) / np.where(on, norm, 1.0), 0.0)
+
+    def shear(x):
+        y = np.where(stick, x, 0.0)
+        if turn is not None:
+            y = y + np.sum(x * turn, axis=0) * turn
+        return y
+    n_p = int(np.count_nonzero(pressed))
+    if turn is not None and constrained[0]:
+        M = np.eye(2) * float(np.count_nonzero(stick)) + np.einsum("aij,bij->ab", turn, turn)
+        M_inv = np.linalg.pinv(M)
+    elif constrained[0]:
+        M_inv = np.array([[1.0 / max(int(np.count_nonzero(stick)), 1)]])
+
+    def proj(x: np.ndarray) -> np.ndarray:
+        y = np.empty_like(x)
+        y[d - 1] = np.where(pressed, x[d - 1], 0.0)
+        if constrained[d - 1] and n_p:
+            y[d - 1] = np.where(pressed, y[d - 1] - float(y[d - 1].sum()) / n_p, 0.0)
+        y[:d - 1] = shear(x[:d - 1])
+        if constrained[0]:
+            lam = M_inv @ y[:d - 1].reshape(d - 1, -1).sum(axis=1)
+            y[:d - 1] -= shear(np.broadcast_to(lam.reshape((d - 1,) + (1,) * (d - 1)), y[:d - 1].shape))
+        return y
+    return proj
+
+
+def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np.ndarray,
+                 proj: Callable[[np.ndarray], np.ndarray], precondition: Callable[[np.ndarray], np.ndarray],
+                 atol: float, max_steps: int) -> tuple[np.ndarray, int]:
+    """Minimize ``1/2 <t, A t> + <t, b>`` over the free entries of ``t`` (the rest and the means held).
+
+    Projected preconditioned conjugate gradients from ``t`` (which meets the
+    mean constraints) until the projected gradient is below ``atol`` in the
+    maximum norm.  Returns ``(t, steps)``.
+    """
+    t = t.copy()
+    r = proj(apply(t) + b)
+    z = proj(precondition(r))
+    rz = inner(r, z)
+    d = z
+    for step in range(1, max_steps + 1):
+        if float(np.max(np.abs(r))) <= atol or rz <= 0:
+            return t, step - 1
+        Ad = proj(apply(d))
+        dAd = inner(d, Ad)
+        if dAd <= 0:
+            return t, step - 1
+        alpha = rz / dAd
+        t -= alpha * d
+        r -= alpha * Ad
+        z = proj(precondition(r))
+        rz, rz_old = inner(r, z), rz
+        d = z + (rz / rz_old) * d
+    return t, max_steps
+
+
+class Constraints(Protocol):
+    """The pointwise terms ``h_i`` (e.g. :class:`~ngcontact.cell.spectral.traction_constraints.TractionConstraints`)."""
+
+    @property
+    def threshold(self) -> Callable[[np.ndarray], np.ndarray]: ...
+
+    def prox(self, v: np.ndarray, shifts: tuple) -> tuple[np.ndarray, tuple]: ...
+
+    def project(self, v: np.ndarray, shifts: tuple) -> np.ndarray: ...
+
+    def linearize(self, t_hat: np.ndarray, v: np.ndarray, shifts: tuple) -> tuple: ...
+
+    def frozen(self, G: np.ndarray) -> Constraints: ...
+
+
+@dataclass
+class _Point:
+    """An iterate ``t``, its proximal point ``t_hat = prox(v)``, ``v = t - grad(t) / L``, and its residual."""
+
+    t: np.ndarray
+    v: np.ndarray
+    t_hat: np.ndarray
+    shifts: tuple
+    res: float
+
+
+def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
+                      b: np.ndarray, h: Constraints, precondition: Callable[[np.ndarray], np.ndarray],
+                      t0: np.ndarray, L: float, *, tol: float, scale: float, max_iter: int) -> ProximalResult:
+    """The active-set method of the module docstring for the terms ``h`` with their own threshold rule.
+
+    ``grad(t) = apply(t) + b`` is the gradient of the smooth part;
+    ``precondition`` an approximate inverse of ``apply``.
+    """
+    residuals: list[float] = []
+    steps = 0
+
+    def evaluate(t, shifts):
+        nonlocal steps
+        steps += 1
+        v = t - grad(t) / L
+        t_hat, shifts = h.prox(v, shifts)
+        return _Point(t, v, t_hat, shifts, float(np.max(np.abs(t - t_hat))) * L / scale)
+
+    x = evaluate(t0.copy(), ())
+    best, since_best = x.res, 0
+    while since_best < STALL and steps < max_iter:
+        residuals.append(x.res)
+        if x.res <= tol:
+            return ProximalResult(t=x.t_hat, shifts=x.shifts, iterations=steps, residuals=residuals)
+        atol = max(INNER_SHARE * x.res, 0.2 * tol) * scale
+        proj, D = h.linearize(x.t_hat, x.v, x.shifts)
+        t_new, inner_steps = free_minimum(lambda y: apply(y) + D * y, b, x.t_hat, proj, precondition, atol,
+                                          max(1, max_iter - steps))
+        steps += inner_steps
+        # the free minimum, or its projection onto the constraints, whichever has the smaller residual
+        x = min(evaluate(t_new, x.shifts), evaluate(h.project(t_new, x.shifts), x.shifts), key=lambda y: y.res)
+        best, since_best = (x.res, 0) if x.res < best else (best, since_best + 1)
+    if steps >= max_iter:
+        raise ConvergenceError(f"active-set Newton: the residual ({residuals[-1]:.3g}, relative to the gap scale) "
+                               f"is above {tol:g} after {steps} steps", {"residuals": residuals[-5:]})
+    rest = fista(grad, h.prox, x.t, L, tol=tol, scale=scale, max_iter=max_iter - steps)
+    return ProximalResult(t=rest.t, shifts=rest.shifts, iterations=steps + rest.iterations,
+                          residuals=residuals + rest.residuals)
+
+
+def coulomb_active_set(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
+                       b: np.ndarray, h: Constraints, precondition: Callable[[np.ndarray], np.ndarray],
+                       t0: np.ndarray, L: float, *, tol: float, scale: float, max_iter: int) -> ProximalResult:
+    """A threshold that depends on the pressure: a fixed point of problems with a frozen threshold.
+
+    Each pass freezes ``G = G(p)`` at the proximal point's pressure and
+    solves that problem (:func:`active_set_newton`, warm-started, to a
+    tenth of the current residual); it stops when the residual of the law
+    itself (its threshold taken from the pressure of the proximal step)
+    meets ``tol``.
+    """
+    residuals: list[float] = []
+    steps = 0
+    t, shifts = t0, ()
+    d = t0.shape[0]
+    best, since_best = np.inf, 0
+    while steps < max_iter and since_best < STALL_PASSES:
+        t_hat, shifts = h.prox(t - grad(t) / L, shifts)
+        steps += 1
+        res = float(np.max(np.abs(t - t_hat))) * L / scale
+        residuals.append(res)
+        if res <= tol:
+            return ProximalResult(t=t_hat, shifts=shifts, iterations=steps, residuals=residuals)
+        best, since_best = (res, 0) if res < DECREASE * best else (min(best, res), since_best + 1)
+        G = np.asarray(h.threshold(t_hat[d - 1]), float)
+        sub = active_set_newton(grad, apply, b, h.frozen(G), precondition, t_hat, L,
+                                tol=max(tol, FIXED_POINT_SHARE * res), scale=scale, max_iter=max_iter - steps)
+        steps += sub.iterations
+        t = sub.t
+    if steps < max_iter:
+        rest = fista(grad, h.prox, t, L, tol=tol, scale=scale, max_iter=max_iter - steps)
+        return ProximalResult(t=rest.t, shifts=rest.shifts, iterations=steps + rest.iterations,
+                              residuals=residuals + rest.residuals)
+    raise ConvergenceError(f"active-set Newton (Coulomb): the residual ({residuals[-1]:.3g}, relative to the gap "
+                           f"scale) is above {tol:g} after {steps} steps", {"residuals": residuals[-5:]})

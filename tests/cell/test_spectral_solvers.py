@@ -1,0 +1,105 @@
+"""The spectral cell's fast solvers against the former ones: same answers to the tolerance, fewer steps.
+
+Frictionless: the constrained CG preconditioned by the inverse compliance on the contact set
+(:mod:`ngcontact.solvers.constrained_cg`) against the plain one.  Friction: the active-set method
+(:mod:`ngcontact.solvers.active_set_newton`) against accelerated proximal gradients
+(:mod:`ngcontact.solvers.projected_gradient`), exact and regularized, Tresca and Coulomb, dissimilar layers, 2D
+and 3D, under a prescribed mean or a prescribed jump.
+"""
+import numpy as np
+import pytest
+
+from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
+from ngcontact.geometry.random_surface import self_affine
+from ngcontact.laws.friction import Coulomb, Tresca
+
+P = 0.0027              # about 8 % contact on the maps below
+
+
+def _gap(dim: int, n: int) -> np.ndarray:
+    z = self_affine(dim=dim, grid=n, hurst=0.8, rms_slope=0.1, rolloff=0.25, cutoff=1 / 16, seed=7)
+    return z.max() - z
+
+
+def _cell(dim, n, *, friction=None, enforcement="exact", **old):
+    cell = SpectralCell(dim=dim, period=1.0, grid=n, rough=Layer(1.0, 0.3, 0.5), counter=Layer(3.0, 0.25, 0.3),
+                        gap=_gap(dim, n), k_n=1.0 if enforcement == "exact" else 30.0, enforcement=enforcement,
+                        tol=1e-10, max_iter=100000, friction=friction)
+    for key, value in old.items():
+        setattr(cell, key, value)
+    return cell
+
+
+def _solve_both(dim, n, load, **kw):
+    new = _cell(dim, n, **kw).solve(load)
+    old_kw = dict(preconditioned=False, friction_method="proximal")
+    old = _cell(dim, n, **kw, **old_kw).solve(load)
+    return new, old
+
+
+def _agree(new, old, scale):
+    assert np.allclose(new.fields["pressure"], old.fields["pressure"], rtol=0, atol=2e-6 * scale)
+    for key in ("shear", "slip", "closure"):
+        if key in old.fields:
+            ref = max(float(np.max(np.abs(old.fields[key]))), 1e-300)
+            assert np.allclose(new.fields[key], old.fields[key], rtol=0, atol=1e-5 * ref), key
+    assert np.allclose(new.results["far_face_jump"], old.results["far_face_jump"], rtol=1e-7, atol=1e-12)
+    assert new.results["contact_fraction"] == pytest.approx(old.results["contact_fraction"], rel=1e-6)
+
+
+@pytest.mark.parametrize("pressure", [P / 4, P, 4 * P])
+def test_preconditioned_constrained_cg_gives_the_plain_answer_in_fewer_steps(pressure):
+    new, old = _solve_both(3, 64, cell_load(3, pressure=pressure))
+    _agree(new, old, pressure)
+    assert new.iterations < old.iterations
+    # the stiffness of the contact set: the masked CG, preconditioned or not
+    assert new.results["effective_stiffness"]["total"][0][0] == pytest.approx(
+        old.results["effective_stiffness"]["total"][0][0], rel=1e-8)
+
+
+def test_preconditioned_constrained_cg_under_a_prescribed_approach():
+    cell = _cell(3, 64)
+    approach = cell.solve(cell_load(3, pressure=P)).results["far_face_jump"][-1]
+    new, old = _solve_both(3, 64, cell_load(3, normal_jump=approach))
+    _agree(new, old, P)
+
+
+def test_preconditioned_constrained_cg_needs_few_steps_on_a_random_map():
+    """The step count on a 128^2 random map stays small at three loads (the plain CG takes 40 to 90)."""
+    cell = _cell(3, 128)
+    steps = [cell.solve(cell_load(3, pressure=p)).iterations for p in (P / 4, P, 4 * P)]
+    assert max(steps) <= 40, steps
+
+
+CASES = [
+    (2, 256, Tresca(w=None, G=0.3 * P), "exact", (0.2 * P,)),
+    (2, 256, Coulomb(w=None, mu=0.5), "exact", (0.2 * P,)),
+    (2, 256, Coulomb(w=1e-4, mu=0.5), "penalty", (0.2 * P,)),
+    (2, 256, Tresca(w=1e-4, G=0.3 * P), "penalty", (0.2 * P,)),
+    (3, 32, Coulomb(w=None, mu=0.5), "exact", (0.2 * P, 0.05 * P)),
+    (3, 32, Tresca(w=None, G=0.3 * P), "exact", (0.1 * P, -0.1 * P)),
+    (3, 32, Coulomb(w=1e-4, mu=0.5), "penalty", (0.2 * P, 0.0)),
+]
+
+
+@pytest.mark.parametrize("dim, n, law, enforcement, shear", CASES)
+def test_active_set_friction_gives_the_proximal_answer(dim, n, law, enforcement, shear):
+    new, old = _solve_both(dim, n, cell_load(dim, pressure=P, shear=shear), friction=law, enforcement=enforcement)
+    _agree(new, old, P)
+    assert new.results["slip_fraction"] == pytest.approx(old.results["slip_fraction"], abs=2.0 / n ** (dim - 1))
+
+
+def test_active_set_friction_under_a_prescribed_tangential_jump():
+    law = Coulomb(w=None, mu=0.5)
+    sheared = _cell(2, 256, friction=law).solve(cell_load(2, pressure=P, shear=(0.2 * P,)))
+    jump = sheared.results["far_face_jump"][0]
+    new, old = _solve_both(2, 256, cell_load(2, pressure=P, tangential_jump=(jump,)), friction=law)
+    _agree(new, old, P)
+    assert new.results["mean_traction"][0] == pytest.approx(0.2 * P, rel=1e-6)
+
+
+def test_active_set_friction_needs_few_steps():
+    """Exact Coulomb friction, 2D, 1024 points: a bound on the operator applications (the proximal method: 600)."""
+    sol = _cell(2, 1024, friction=Coulomb(w=None, mu=0.5)).solve(cell_load(2, pressure=P, shear=(0.2 * P,)))
+    assert sol.iterations <= 150, sol.iterations
