@@ -24,7 +24,8 @@ the scene with ``ngcontact.load`` to compute ``p*`` from its own numbers
 (:mod:`ngcontact.verification.westergaard`), solves it with ``ngcontact.solve``
 and prints the contact fraction of every load next to Westergaard's.  The
 key number is the fraction at ``p = p*/2`` (exactly 1/2); the finite penalty
-lets the bodies overlap slightly and widens the patches by about 0.1-0.3 %.
+lets the bodies overlap slightly and widens the patches by a share of the
+answer that the report states (``results.accuracy.model``: about +0.3 %).
 
 Run from the repository's top directory (scene paths are relative to it)::
 

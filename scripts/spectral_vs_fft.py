@@ -23,9 +23,9 @@ Three measurements, one run, one CSV and one PNG:
 3. **Dissimilar finite layers** (``E = 1, 3``, ``nu = 0.3, 0.25``, 0.5 and
    0.3 thick) on the same surface: frictionless at 1024^2, and with exact
    Coulomb friction (``mu = 0.5``) under a mean shear of 0.2 times the
-   pressure at 512^2 (the accelerated proximal gradient needs some 2,000
-   steps there; 1024^2 takes over ten minutes): wall time and peak memory
-   of the whole process (each run in a child process).
+   pressure at 512^2 (the frictional solver's steps and time at each grid are
+   measured by ``scripts/spectral_friction_speed.py``): wall time and peak
+   memory of the whole process (each run in a child process).
 
 Usage::
 
