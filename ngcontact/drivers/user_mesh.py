@@ -116,6 +116,21 @@ def _echo_mesh(mesh) -> dict:
             "elements": mesh.ne, "vertices": mesh.nv}
 
 
+def accuracy_of(settings, sol: M.MacroSolution, info: dict, balance: dict) -> dict:
+    """The macro run's accuracy verdict (:func:`ngcontact.drivers.macro_accuracy.accuracy`) on the caller's
+    mesh: the default tolerance, no strength check or two-scale loop, and no roughness period (the law's
+    modelling error is not estimated)."""
+    from functools import partial
+
+    from ngcontact.drivers.macro_accuracy import accuracy
+    described = SimpleNamespace(
+        solver=settings.solver, output=settings.output, two_scale=None,
+        discretization=SimpleNamespace(tolerance=None),
+        interface=SimpleNamespace(law=info.get("type", "given"), roughness_period=None, cell=None,
+                                  cell_length_unit=1.0))
+    return accuracy(described, sol, partial(run_macro.solve_scene, described), balance)
+
+
 def run(mesh, law, *, rough: str, counter: str, materials: dict, interface: str = "interface",
         setting: str | None = None, supports=(), loads=(), gap=0.0, order: int = 2, solver: dict | None = None,
         output: dict | None = None, title: str = "", clock) -> tuple[Outcome, dict, list[str]]:
@@ -160,6 +175,8 @@ def run(mesh, law, *, rough: str, counter: str, materials: dict, interface: str 
         outcome = run_macro.measured(sol, MacroGeometry(mesh=mesh, rough=rough, counter=counter,
                                                         boundaries={b: "" for b in labels}, dims={}),
                                      info, settings.output)
+    with clock.stage("discretization error"):
+        outcome.results["accuracy"] = accuracy_of(settings, sol, info, outcome.results["equilibrium"])
     echo = {"kind": "macro", "title": title, "mesh": _echo_mesh(mesh), "setting": setting,
             "bodies": {"rough": rough, "counter": counter}, "interface": interface, "materials": materials_echo,
             "components": list(COMPONENTS[setting]), "supports": [loader.as_dict(s) for s in support_specs],
