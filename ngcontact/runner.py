@@ -244,9 +244,11 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
     """
     if not hasattr(scene, "kind"):
         scene = loader.load(scene)
-    n = thread_count()
-    clock = Clock(progress)
     mpi = mpi_world(scene, mpi_requested)
+    n = thread_count()
+    if mpi is not None and THREADS_ENV not in os.environ:
+        n = max(1, n // mpi.size)           # the ranks of one machine share its cores
+    clock = Clock(progress)
     with threads(n), batches(scene, workers, scheduler, batch_progress, note=progress) as ex, progress_lines(clock):
         if mpi is None:
             outcome = driver(scene).run(scene, clock)

@@ -72,9 +72,11 @@ def _on_root(world: World, make):
     if world.root:
         try:
             value = ("value", make())
+            sent = pickle.dumps(value)
         except Exception as exc:  # noqa: BLE001  (sent on, raised on every rank alike)
             value = ("error", exc)
-        world.comm.bcast(pickle.dumps(value))
+            sent = pickle.dumps(value)
+        world.comm.bcast(sent)
     else:
         value = pickle.loads(world.comm.bcast(None))
     if value[0] == "error":
