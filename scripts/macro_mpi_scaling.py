@@ -9,9 +9,10 @@ rank 0 and distributed; rank 0 gathers the solution and post-processes:
 :mod:`ngcontact.distributed.macro_run`).  Per run: dofs, wall time of the
 command, the report's solve stage, and every rank's peak resident memory
 (``VmHWM``) at its exit: rank 0 (which holds the whole mesh and the
-post-processing) and the largest of the others (a part of the mesh each).
+post-processing) and the largest of the others (a part of the mesh each;
+empty for one rank).
 
-    python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.003] [--ranks 1 2] [--publish]
+    python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--ranks 1 2] [--publish]
 
 Writes ``OUT/macro_mpi_scaling.csv`` and ``.png`` (default ``results/macro_mpi_scaling``).
 """
@@ -121,7 +122,7 @@ def measure(maxh: float, ranks: int, work: str) -> dict:
             "solve_s": round(rep["timings"]["solve"], 2), "newton": rep["solver"]["iterations"],
             "cg_iterations": sum(rep["solver"]["linear"].get("cg_iterations", [])),
             "peak_mb_rank0": round(peaks[0], 1),
-            "peak_mb_other_ranks": round(max(peaks[1:]), 1) if ranks > 1 else float("nan")}
+            "peak_mb_other_ranks": round(max(peaks[1:]), 1) if ranks > 1 else ""}
 
 
 def plot(data: list[dict], path: str) -> None:
@@ -152,7 +153,7 @@ def main(argv=None) -> int:
         return child(argv[1], argv[2])
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", nargs="?", default=os.path.join("results", "macro_mpi_scaling"), help="output directory")
-    ap.add_argument("--maxh", type=float, nargs="+", default=[0.004, 0.003], help="mesh sizes [m]")
+    ap.add_argument("--maxh", type=float, nargs="+", default=[0.004, 0.002, 0.001], help="mesh sizes [m]")
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2], help="numbers of MPI ranks")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)

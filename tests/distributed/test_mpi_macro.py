@@ -256,3 +256,21 @@ def test_without_mpi4py_a_distributed_run_says_what_to_install(tmp_path, how):
     assert "needs mpi4py, which is not installed" in done.stderr
     assert "pip install 'ngcontact[mpi]'" in done.stderr
     assert not out.exists()
+
+
+def test_a_tilted_support_becomes_the_same_affine_field():
+    """What rank 0 sends for a tilted support: ``u0 + G x`` equal to ``value + slope (s - s_mid)`` everywhere."""
+    import ngsolve as ng
+
+    from ngcontact.distributed.macro_run import absolute
+    from ngcontact.fem.two_body import Support, affine_field
+    from ngcontact.geometry import bodies as gm
+
+    mesh = gm.block_on_plane(1.0, 1.0, 1.0, maxh=0.5).mesh
+    tilted = Support(label="bottom", value=(1e-4, 2e-4), slope=(3e-4, -5e-4), along="x")
+    affine = absolute(tilted, mesh)
+    assert affine.gradient and not affine.slope
+    comps = ("x", "y")
+    diff = affine_field(mesh, tilted, comps) - affine_field(mesh, affine, comps)
+    err = ng.Integrate(ng.InnerProduct(diff, diff), mesh, definedon=mesh.Boundaries("bottom"))
+    assert abs(err) <= 1e-30
