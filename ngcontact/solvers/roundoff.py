@@ -62,10 +62,10 @@ def roundoff_floors(mat, vec, fixed, energy: float = 0.0) -> tuple[float, float]
     if type(mat).__name__.startswith("SparseMatrixSymmetric"):   # the upper triangle is the lower's transpose
         m += a.T @ u - a.diagonal() * u
     eps = ROUNDOFF * np.finfo(float).eps
-    um = _ranks_sum(vec, float(np.dot(u, m)))
+    um = ranks_sum(vec, float(np.dot(u, m)))
     energy_floor = eps * (abs(energy) + 0.5 * um)
     m[fixed] = 0.0
-    return eps * float(np.sqrt(_ranks_sum(vec, float(np.dot(m, m))))), energy_floor
+    return eps * float(np.sqrt(ranks_sum(vec, float(np.dot(m, m))))), energy_floor
 
 
 def local_matrix(mat):
@@ -73,7 +73,7 @@ def local_matrix(mat):
     return getattr(mat, "local_mat", mat)
 
 
-def _ranks_sum(vec, value: float) -> float:
+def ranks_sum(vec, value: float) -> float:
     """``value`` summed over the MPI ranks ``vec`` is distributed on (``value`` in one process)."""
     comm = getattr(vec, "comm", None)
     return float(comm.Sum(value)) if comm is not None and comm.size > 1 else value

@@ -55,7 +55,7 @@ from dataclasses import dataclass
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.solvers.roundoff import local_matrix
+from ngcontact.solvers.roundoff import local_matrix, ranks_sum
 
 
 @dataclass
@@ -158,7 +158,7 @@ class SplitEnergy:
         loads = self.key()
         if loads != self._loads:
             self.quadratic.Apply(self._zero, self._g)
-            self._c = self.quadratic.Energy(self._zero)
+            self._c = ranks_sum(self._zero, self.quadratic.Energy(self._zero))
             self._loads = loads
 
     def Apply(self, vec, out) -> None:  # noqa: N802 (NGSolve's name)
@@ -170,11 +170,13 @@ class SplitEnergy:
         out.data += self._work
 
     def Energy(self, vec) -> float:  # noqa: N802
-        """``Pi(vec)``."""
+        """``Pi(vec)`` (over every MPI rank of a distributed space: NGSolve's ``Energy`` of a form sums
+        the rank's own elements, the inner products of distributed vectors are global already)."""
         self._linear_part()
         self._work.data = self.K * vec
         quad = 0.5 * ng.InnerProduct(vec, self._work) + ng.InnerProduct(self._g, vec) + self._c
-        return quad + self.interface.Energy(vec)
+        return quad + ranks_sum(vec, self.interface.Energy(vec))     # a form's energy is its rank's elements'
+
 
     def AssembleLinearization(self, vec) -> None:  # noqa: N802
         """``mat = K + Psi''(vec)``: the first time by the whole form's assembly, which allocates its
