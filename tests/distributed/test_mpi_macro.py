@@ -219,6 +219,16 @@ def test_a_3d_press_fit_on_two_ranks_reports_what_one_process_does(tmp_path):
 
 
 @pytest.mark.mpi
+@pytest.mark.slow
+@needs_mpi
+def test_the_shipped_3d_femur_with_friction_on_two_ranks_reports_what_one_process_does(tmp_path):
+    text = (ROOT / "geometries" / "femur_stem_3d.toml").read_text()
+    assert "\nrtol = 1e-10\n" in text
+    parallel = _agree(tmp_path, text.replace("\nrtol = 1e-10\n", '\nrtol = 1e-10\nlinear = "iterative"\n'))
+    assert parallel["solver"]["coulomb"]["method"] == "coupled Newton"
+
+
+@pytest.mark.mpi
 @needs_mpi
 def test_direct_solver_under_mpiexec_is_refused_naming_the_key(tmp_path):
     scene = tmp_path / "scene.toml"
