@@ -40,6 +40,7 @@ import sys
 import threading
 
 from ngcontact._version import __version__
+from ngcontact.distributed.world import launched_rank
 from ngcontact.scene import loader as scene_mod
 from ngcontact.errors import ConvergenceError, ModelError, NgcontactError, OutputError, SceneError
 
@@ -88,6 +89,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("scene", help="scene file (TOML)")
     run.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>)")
     run.add_argument("--quiet", action="store_true", help="no progress lines")
+    run.add_argument("--mpi", action="store_true",
+                     help="a macro scene distributed over the MPI ranks of mpiexec -n N (the same happens under "
+                          "mpiexec without it); needs the extra ngcontact[mpi]")
     _compute_options(run)
     chk = sub.add_parser("check", help="validate a scene file without solving",
                          description="Validate a scene file and list the effects it calls for.")
@@ -192,7 +196,7 @@ def main(argv=None) -> int:
             if args.target is not None or args.levels is not None:
                 return _fail(EXIT_SCENE, "--target, --levels: options of the accuracy study only")
             return _study(args.scene, args.periods, args.out, quiet=args.quiet, compute=compute)
-        return _run(args.scene, args.out, quiet=args.quiet, compute=compute)
+        return _run(args.scene, args.out, quiet=args.quiet, compute=compute, mpi=args.mpi)
     except KeyboardInterrupt:
         return _fail(EXIT_INTERRUPTED, f"{args.scene}: interrupted; the output directory is as it was")
     except Terminated:
@@ -228,7 +232,8 @@ def _native_output_silenced(active: bool):
 
 
 def _fail(code: int, message: str) -> int:
-    print(f"ngcontact: error: {message}", file=sys.stderr)
+    if launched_rank() == 0:     # under mpiexec every rank fails alike: rank 0 says it
+        print(f"ngcontact: error: {message}", file=sys.stderr)
     return code
 
 
@@ -259,13 +264,15 @@ def _scheduler_named(compute: dict):
         raise
 
 
-def _run(path: str, out: str | None, quiet: bool, compute: dict) -> int:
+def _run(path: str, out: str | None, quiet: bool, compute: dict, mpi: bool = False) -> int:
     from ngcontact.output.progress_bar import BatchProgress
     from ngcontact.runner import solve
 
+    quiet = quiet or launched_rank() > 0
+
     def compute_run(sc, progress):
         with _scheduler_named(compute):
-            return solve(sc, progress, batch_progress=BatchProgress(quiet), **compute)
+            return solve(sc, progress, batch_progress=BatchProgress(quiet), mpi_requested=mpi, **compute)
 
     return _execute(path, out, quiet, compute_run, suffix="")
 
@@ -393,7 +400,8 @@ def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, v
         with _native_output_silenced(quiet):
             report, outcome = compute(sc, progress)
         _check_signals()
-        write_outputs(out, report, outcome, inputs)
+        if launched_rank() == 0:     # under mpiexec rank 0 holds the results and writes
+            write_outputs(out, report, outcome, inputs)
     except Exception as exc:
         return _classified(path, exc)
     if not quiet:

@@ -219,7 +219,7 @@ def driver(scene):
 
 
 def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int | None = None,
-          scheduler: str | None = None, batch_progress=None) -> tuple[dict, Outcome]:
+          scheduler: str | None = None, batch_progress=None, mpi_requested: bool = False) -> tuple[dict, Outcome]:
     """Solve ``scene`` (a validated scene or a path to a scene file).
 
     Parameters
@@ -235,6 +235,10 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
         at the address ``scheduler``.
     batch_progress
         Optional ``callable(label, finished, total)`` called as a batch advances.
+    mpi_requested
+        ``--mpi``: refuse at once where ``mpi4py`` is missing.  Under ``mpiexec -n N`` (N > 1) a macro
+        scene is solved distributed (:mod:`ngcontact.distributed.macro_run`) whether requested or not;
+        its report's ``compute.mpi_ranks`` is N, and only rank 0's outcome holds the results.
 
     Returns
     -------
@@ -242,18 +246,41 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
     """
     if not hasattr(scene, "kind"):
         scene = loader.load(scene)
+    mpi = mpi_world(scene, mpi_requested)
     n = thread_count()
+    if mpi is not None and THREADS_ENV not in os.environ:
+        n = max(1, n // mpi.size)           # the ranks of one machine share its cores
     clock = Clock(progress)
     with threads(n), batches(scene, workers, scheduler, batch_progress, note=progress) as ex, progress_lines(clock):
-        outcome = driver(scene).run(scene, clock)
+        if mpi is None:
+            outcome = driver(scene).run(scene, clock)
+        else:
+            from ngcontact.distributed import macro_run
+            outcome = macro_run.run(scene, clock, mpi)
     line = accuracy_line(outcome.results)
     if line is not None:
         clock.note(line)
+    compute = ex.describe()
+    if mpi is not None:
+        compute = {**compute, "mpi_ranks": mpi.size}
     report = build_report(kind=scene.kind, title=getattr(scene, "title", ""),
                           scene=loader.as_dict(scene), effects=loader.effects(scene),
                           outcome=outcome, timings=clock.total(), version=__version__, threads=n,
-                          compute=ex.describe())
+                          compute=compute)
     return report, outcome
+
+
+def mpi_world(scene, requested: bool = False):
+    """The MPI world of a distributed macro run (:func:`ngcontact.distributed.world.world`), or ``None``.
+
+    Raises :class:`~ngcontact.errors.SceneError` for a scene of another kind on several ranks.
+    """
+    from ngcontact.distributed.world import world
+    mpi = world(requested)
+    if mpi is not None and mpi.size > 1 and scene.kind != "macro":
+        raise SceneError("kind", scene.kind, f"'macro' on {mpi.size} MPI ranks (only a macro scene runs "
+                         "distributed; run other kinds in one process)")
+    return mpi if mpi is not None and mpi.size > 1 else None
 
 
 def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = None, *, workers: int | None = None,

@@ -7,7 +7,9 @@ solves on worker processes or a Dask cluster; no numerics, and the only
 room that starts a pool) beside them, the three problems (``cell``,
 ``macro``, ``resolved``) that never know each other, ``coupling`` where
 cell meets macro, ``verification`` above all numerics, ``drivers`` that
-translate scenes into objects, ``export`` (a scene's law for other FE
+translate scenes into objects, ``distributed`` (a macro scene over MPI
+ranks: the macro driver's pieces around a distributed mesh; the runner
+and the command line ask it for the ranks), ``export`` (a scene's law for other FE
 codes) above them, and ``output``, ``runner``, ``cli`` (and ``python -m
 ngcontact``) on top.  ``_version`` is a leaf that the package face
 (``ngcontact/__init__.py``) and the rooms that stamp reports and files
@@ -55,12 +57,15 @@ ALLOWED: dict[str, set[str]] = {
     "verification": PROBLEMS | {"cell", "macro", "resolved", "coupling"},
     "output": {"errors"},
     "drivers": PROBLEMS | {"scene", "parallel", "cell", "macro", "resolved", "coupling", "verification", "output"},
-    # the runner chooses where a run's batches go (parallel/executor.py) before a driver is imported
-    "runner": {"_version", "errors", "drivers", "scene", "output", "parallel"},
+    # a macro scene on a mesh distributed over MPI ranks: the macro driver's pieces around a distributed solve
+    "distributed": PROBLEMS | {"macro", "drivers", "output"},
+    # the runner chooses where a run's batches go (parallel/executor.py) before a driver is imported, and
+    # whether a macro scene runs distributed over MPI ranks
+    "runner": {"_version", "errors", "drivers", "scene", "output", "parallel", "distributed"},
     # the exporters read a scene's law through the drivers and write through output's atomic writer; the ccx
     # check solves its macro scene through the drivers and hands the solution to its harness in verification
     "export": PROBLEMS | {"_version", "scene", "macro", "coupling", "verification", "drivers", "output"},
-    "cli": {"_version", "errors", "runner", "scene", "output", "export"},
+    "cli": {"_version", "errors", "runner", "scene", "output", "export", "distributed"},
     # the package face: nothing inside the package imports it (its version is in _version); the law of a cell
     # and its energy on a mesh of the caller's are imported on first use
     "__init__": {"_version", "errors", "scene", "runner", "drivers.cell_scene_law", "macro.interface_form"},
@@ -323,10 +328,11 @@ def _raised_names(source: str) -> set[str]:
 
 def test_only_the_scene_layer_and_its_translator_raise_scene_errors():
     """Key paths of a scene belong to the scene layer and to the one scene -> objects translator
-    (drivers/, which checks what needs a mesh, such as boundary labels); geometry and the numerics
+    (drivers/, which checks what needs a mesh, such as boundary labels; distributed/, the macro driver's
+    pieces under MPI, which refuses what does not run distributed); geometry and the numerics
     raise their own errors with argument names (GeometryError, ModelError), translated above them."""
     offenders = sorted(str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob("*.py")
-                       if p.relative_to(PACKAGE).parts[0] not in ("scene", "drivers", "cli.py", "runner.py")
+                       if p.relative_to(PACKAGE).parts[0] not in ("scene", "drivers", "distributed", "cli.py", "runner.py")
                        and "SceneError" in _raised_names(p.read_text(encoding="utf-8")))
     assert not offenders, f"raise SceneError below the scene layer: {offenders}"
 

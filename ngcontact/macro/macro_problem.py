@@ -165,8 +165,11 @@ def check_problem(problem: MacroProblem) -> None:
     """Reject labels, regions and components that do not exist, and supports that leave a rigid motion.
 
     Raises :class:`ModelError` naming the label, the component or the free
-    motion (:func:`ngcontact.fem.rigid_modes.check_rigid_modes`).
+    motion (:func:`ngcontact.fem.rigid_modes.check_rigid_modes`).  A problem on a mesh distributed over
+    MPI ranks was checked on the whole mesh before (``parts["checked"]``): a rank's part says nothing.
     """
+    if problem.parts.get("checked"):
+        return
     two_body.check_labels(problem.mesh, problem.setting, problem.interface, problem.supports, problem.loads,
                           regions=(("rough", problem.rough), ("counter", problem.counter)))
     check_rigid_modes(problem.mesh, problem.setting, (problem.rough, problem.counter), problem.supports,
@@ -319,7 +322,8 @@ def _coupled_newton(problem: MacroProblem, fes, frame, gfu, newton: dict) -> dic
         gfu.vec.data = copy
 
     try:
-        rungs = ladder(solve_at, save, restore, start=max(float(slips.max(initial=0.0)), 10 * width), target=width)
+        largest = float(mesh.comm.Max(float(slips.max(initial=0.0))))       # over the ranks of a distributed mesh
+        rungs = ladder(solve_at, save, restore, start=max(largest, 10 * width), target=width)
     except ConvergenceError as err:
         raise ConvergenceError(f"Coulomb friction (solver.coulomb = 'newton'): {err}. A tangential load larger "
                                "than friction (mu times the pressure) can carry has no equilibrium: a body would "
@@ -343,6 +347,8 @@ def start_stiffness(problem: MacroProblem) -> float:
     law = problem.law
     if law.friction is None:
         return 0.0
+    if "start_stiffness" in problem.parts:      # found on the whole mesh before it was distributed
+        return problem.parts["start_stiffness"]
     free = free_rigid_modes(problem.mesh, problem.setting, (problem.rough, problem.counter), problem.supports,
                             problem.interface, holds_tangentially=False)
     return law.normal.stiffness if free else 0.0

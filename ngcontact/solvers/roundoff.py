@@ -48,8 +48,12 @@ def roundoff_floors(mat, vec, fixed, energy: float = 0.0) -> tuple[float, float]
     Residual: ``ROUNDOFF eps || |K| |u| ||`` over the free dofs.  Energy:
     ``ROUNDOFF eps (|energy| + |u| . |K| |u| / 2)``, the size of the terms
     whose sum it is.  ``K`` may be stored as its lower triangle (symmetric
-    storage).
+    storage).  A matrix and vector distributed over MPI ranks (NGSolve's
+    ``ParallelMatrix``) give each rank's local part; the sums are added over
+    the ranks, so that every rank stops where the others do (dofs shared by
+    ranks count once per rank: an estimate all the same).
     """
+    mat = local_matrix(mat)
     vals, cols, ptr = mat.CSR()
     u = np.abs(vec.FV().NumPy())
     n = len(u)
@@ -58,9 +62,21 @@ def roundoff_floors(mat, vec, fixed, energy: float = 0.0) -> tuple[float, float]
     if type(mat).__name__.startswith("SparseMatrixSymmetric"):   # the upper triangle is the lower's transpose
         m += a.T @ u - a.diagonal() * u
     eps = ROUNDOFF * np.finfo(float).eps
-    energy_floor = eps * (abs(energy) + 0.5 * float(np.dot(u, m)))
+    um = ranks_sum(vec, float(np.dot(u, m)))
+    energy_floor = eps * (abs(energy) + 0.5 * um)
     m[fixed] = 0.0
-    return eps * float(np.sqrt(np.dot(m, m))), energy_floor
+    return eps * float(np.sqrt(ranks_sum(vec, float(np.dot(m, m))))), energy_floor
+
+
+def local_matrix(mat):
+    """A rank's own sparse matrix of a matrix distributed over MPI ranks; ``mat`` itself in one process."""
+    return getattr(mat, "local_mat", mat)
+
+
+def ranks_sum(vec, value: float) -> float:
+    """``value`` summed over the MPI ranks ``vec`` is distributed on (``value`` in one process)."""
+    comm = getattr(vec, "comm", None)
+    return float(comm.Sum(value)) if comm is not None and comm.size > 1 else value
 
 
 def at_floor(rnorm: float, floor: float, r0: float, floor0: float) -> bool:

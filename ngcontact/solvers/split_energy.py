@@ -55,6 +55,8 @@ from dataclasses import dataclass
 import ngsolve as ng
 import numpy as np
 
+from ngcontact.solvers.roundoff import local_matrix, ranks_sum
+
 
 @dataclass
 class StateForm:
@@ -156,7 +158,7 @@ class SplitEnergy:
         loads = self.key()
         if loads != self._loads:
             self.quadratic.Apply(self._zero, self._g)
-            self._c = self.quadratic.Energy(self._zero)
+            self._c = ranks_sum(self._zero, self.quadratic.Energy(self._zero))
             self._loads = loads
 
     def Apply(self, vec, out) -> None:  # noqa: N802 (NGSolve's name)
@@ -168,11 +170,13 @@ class SplitEnergy:
         out.data += self._work
 
     def Energy(self, vec) -> float:  # noqa: N802
-        """``Pi(vec)``."""
+        """``Pi(vec)`` (over every MPI rank of a distributed space: NGSolve's ``Energy`` of a form sums
+        the rank's own elements, the inner products of distributed vectors are global already)."""
         self._linear_part()
         self._work.data = self.K * vec
         quad = 0.5 * ng.InnerProduct(vec, self._work) + ng.InnerProduct(self._g, vec) + self._c
-        return quad + self.interface.Energy(vec)
+        return quad + ranks_sum(vec, self.interface.Energy(vec))     # a form's energy is its rank's elements'
+
 
     def AssembleLinearization(self, vec) -> None:  # noqa: N802
         """``mat = K + Psi''(vec)``: the first time by the whole form's assembly, which allocates its
@@ -191,9 +195,9 @@ class SplitEnergy:
 
     def _sum_parts(self) -> None:
         """``whole.mat = K + Psi''`` from ``K`` and the interface's last assembly."""
-        vals = self.mat.AsVector().FV().NumPy()
+        vals = local_matrix(self.mat).AsVector().FV().NumPy()
         vals[:] = self._K_whole
-        vals[self._slots_psi] += self._psi.mat.AsVector().FV().NumPy()
+        vals[self._slots_psi] += local_matrix(self._psi.mat).AsVector().FV().NumPy()
 
     def preconditioner_form(self) -> ng.BilinearForm:
         """The form to register a preconditioner with: the preconditioning form if there is one (from then on
@@ -229,11 +233,13 @@ class SplitEnergy:
         self._renew = False
 
     def _locate(self, matrix) -> None:
-        """Where ``K``'s and the interface's entries sit in the tangent's ``matrix`` (once)."""
+        """Where ``K``'s and the interface's entries sit in the tangent's ``matrix`` (once).  Matrices
+        distributed over MPI ranks: each rank's own part (its elements' entries, added up by NGSolve)."""
+        matrix, psi, K = local_matrix(matrix), local_matrix(self._psi.mat), local_matrix(self.K)
         keys = _keys(matrix)
-        self._slots_psi = _positions(matrix, self._psi.mat, keys)
+        self._slots_psi = _positions(matrix, psi, keys)
         self._K_whole = np.zeros(matrix.nze)
-        self._K_whole[_positions(matrix, self.K, keys)] = self.K.AsVector().FV().NumPy()
+        self._K_whole[_positions(matrix, K, keys)] = K.AsVector().FV().NumPy()
 
 
 def _positions(whole, part, whole_keys: np.ndarray | None = None) -> np.ndarray:

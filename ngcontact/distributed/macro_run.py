@@ -1,0 +1,166 @@
+"""A ``macro`` scene solved on a mesh distributed over MPI ranks (``mpiexec -n N ngcontact run SCENE``).
+
+What is distributed: the mesh (made on rank 0, distributed by
+:func:`ngcontact.distributed.macro_mesh.distribute`), the spaces, the
+assembly of the energy (the bodies' elasticity and the interface law's
+energy, paper eqs. 44, 46-48), its residual and tangent, and Newton's
+tangent solves by BDDC-preconditioned CG (``solver.linear = "iterative"``,
+also for ``"auto"``; a sparse direct factorization does not run
+distributed, so ``"direct"`` is refused).  Coulomb friction is solved as in one process by the
+coupled Newton; the fixed point of ``solver.coulomb = "fixed_point"``
+compares sampled pressures between its passes and is refused here.
+
+What is not: rank 0 checks the model (labels, supports, rigid motions) on
+its whole mesh and reads the supports' geometric data off it (a tilted
+support's mid-point becomes the equivalent affine field ``u0 + G x``, the
+same everywhere), then gathers the solution
+(:func:`ngcontact.distributed.macro_mesh.gather`) and post-processes it on
+the whole mesh exactly as one process does (integrals, peaks, samples,
+figures and the VTK file); it alone writes.  A two-scale scene's cells and
+their batches stay on the executor of one process and are refused under
+MPI.
+"""
+from __future__ import annotations
+
+import pickle
+from dataclasses import replace
+
+import ngsolve as ng
+
+from ngcontact.distributed.macro_mesh import distribute, gather
+from ngcontact.distributed.world import World
+from ngcontact.drivers import run_macro as R
+from ngcontact.errors import SceneError
+from ngcontact.fem.two_body import Support, boundary_mid
+from ngcontact.laws import interface_energy as ie
+from ngcontact.macro import macro_problem as M
+from ngcontact.macro.macro_energy import gap_cf, local_jump
+from ngcontact.output.report import Outcome
+
+#: the fields of a macro problem rank 0 sends to the others (the mesh is each rank's; the gap is rebuilt)
+SENT = ("setting", "rough", "counter", "materials", "law", "supports", "loads", "body_forces", "order", "interface")
+
+
+def refuse(scene, world: World) -> None:
+    """What does not run distributed ends here with the scene key, its value and what is allowed."""
+    s = scene.solver
+    if scene.two_scale is not None:
+        raise SceneError("two_scale", "[two_scale]", f"a two-scale scene runs in one process, not on {world.size} "
+                         "MPI ranks (its cells' batches go to the executor: --workers / --scheduler)")
+    if s.linear == "direct":
+        raise SceneError("solver.linear", s.linear, "'iterative' or 'auto' under mpiexec (both: BDDC-"
+                         "preconditioned CG, which runs distributed; a sparse direct factorization does not)")
+    if s.coulomb == "fixed_point":
+        raise SceneError("solver.coulomb", s.coulomb, "'newton' under mpiexec (the coupled Newton runs "
+                         "distributed; the fixed point does not)")
+
+
+def absolute(support: Support, mesh) -> Support:
+    """A tilted support as the same affine field ``u0 + G x`` (its mid-point read off the whole mesh)."""
+    if support.gradient or not any(support.slope):
+        return support
+    axis = "xyz".index(support.along)
+    mid = boundary_mid(mesh, support.label, axis)
+    value = tuple(support.value) or (0.0,) * len(support.slope)
+    rows = tuple(tuple(float(s) if j == axis else 0.0 for j in range(mesh.dim)) for s in support.slope)
+    return replace(support, value=tuple(float(v) - float(s) * mid for v, s in zip(value, support.slope)),
+                   slope=(), gradient=rows)
+
+
+def _on_root(world: World, make):
+    """``make()`` on rank 0, its value (or its exception) on every rank."""
+    if world.root:
+        try:
+            value = ("value", make())
+            sent = pickle.dumps(value)
+        except Exception as exc:  # noqa: BLE001  (sent on, raised on every rank alike)
+            value = ("error", exc)
+            sent = pickle.dumps(value)
+        world.comm.bcast(sent)
+    else:
+        value = pickle.loads(world.comm.bcast(None))
+    if value[0] == "error":
+        raise value[1]
+    return value[1]
+
+
+def run(scene, clock, world: World) -> Outcome:
+    """Solve ``scene`` distributed over ``world``; rank 0's outcome is the report's, the others' are empty."""
+    refuse(scene, world)
+    scene = replace(scene, solver=replace(scene.solver, linear="iterative"))     # 'auto' chooses by size: CG here
+    order = scene.discretization.order
+    whole = serial = None
+    with clock.stage("mesh"):
+        if world.root:
+            whole = R.build_geometry(scene, order=1)
+        geo = distribute(whole, order, world)
+    with clock.stage("interface law"):
+        def checked():
+            nonlocal serial, whole
+            assert whole is not None
+            if order > 1:
+                whole.mesh.Curve(order)
+            serial, info = R.problem_of(scene, whole)
+            serial = replace(serial, supports=tuple(absolute(s, whole.mesh) for s in serial.supports))
+            M.check_problem(serial)
+            return {k: getattr(serial, k) for k in SENT}, info, M.start_stiffness(serial)
+        fields, info, stiffness = _on_root(world, checked)
+        problem = M.MacroProblem(mesh=geo.mesh, gap=R.gap_of(scene), **fields)
+        problem.parts.update(checked=True, start_stiffness=stiffness)
+    with clock.stage("solve"):
+        sol = R.solve_scene(scene, problem)
+    with clock.stage("post-processing"):
+        whole_sol = gathered(world, sol, serial)
+        if whole_sol is None:
+            return Outcome(results={}, ndof=sol.ndof, solver={})
+        assert whole is not None
+        outcome = R.measured(whole_sol, whole, info, scene.output)
+    outcome.solver["mpi"] = {"ranks": world.size, "distributed": "mesh, assembly, Newton with BDDC-CG",
+                             "rank_0": "checks, post-processing on the gathered solution, files"}
+    if scene.strength is not None:
+        from ngcontact.drivers.run_strength import evaluate
+        with clock.stage("strength check"):
+            st = evaluate(scene, whole_sol)
+        outcome.results["strength"] = st["results"]
+        outcome.tables["strength_map"] = st["table"]
+        outcome.vtk["worst_cell"] = st["vtk"]
+        outcome.plots.update(st["plots"])
+    outcome.results["accuracy"] = accuracy_not_estimated(scene, whole_sol, outcome.results["equilibrium"])
+    return outcome
+
+
+def accuracy_not_estimated(scene, sol: M.MacroSolution, balance: dict) -> dict:
+    """The verdict of a distributed run: the equilibrium check and the modelling-error estimate
+    (:mod:`ngcontact.drivers.macro_accuracy`); the neighbouring-order solves of the discretization estimate
+    would run on rank 0 alone, so they are not made, and the verdict says so."""
+    from ngcontact.drivers.macro_accuracy import modelling, verdict
+    out = verdict([], scene.discretization.tolerance, balance)
+    out.update(estimated=False, how="not estimated under MPI: the discretization estimate's solves at the "
+                                    "neighbouring orders run in one process (ngcontact run without mpiexec)")
+    out["modelling"] = modelling(scene, sol)
+    return out
+
+
+def gathered(world: World, sol: M.MacroSolution, serial: M.MacroProblem | None) -> M.MacroSolution | None:
+    """The distributed solution ``sol`` as a solution of ``serial`` (rank 0's whole problem) on rank 0."""
+    fes = frame = gfu = old = None
+    if world.root:
+        assert serial is not None
+        fes, frame = M.space_and_frame(serial)
+        gfu, old = ng.GridFunction(fes), ng.GridFunction(fes)
+    gather(world, sol.gfu, gfu)
+    if sol.previous is not None:
+        gather(world, sol.previous, old)
+    if not world.root:
+        return None
+    assert serial is not None and gfu is not None and old is not None and frame is not None
+    law = serial.law
+    G = None
+    if law.friction is not None and law.friction.coulomb:
+        a_old = local_jump(frame, old.components[0] - old.components[1])
+        G = ie.threshold(law.friction, ie.pressure(law.normal, a_old, gap_cf(serial.gap)))
+    elif law.friction is not None:
+        G = ng.CF(ie.threshold(law.friction, 0.0))
+    ur, uc = gfu.components
+    return M.MacroSolution(problem=serial, gfu=gfu, u_rough=ur, u_counter=uc, frame=frame,
+                           local_jump=local_jump(frame, ur - uc), threshold=G, history=sol.history, previous=old)
