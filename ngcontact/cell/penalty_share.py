@@ -117,5 +117,6 @@ def penalty_share(cell: CellSolver, loads: list[CellLoad], per_load: list[dict[s
     progress.info("penalty k_n = %g (the model, not the discretization): its share of the contact fraction %s %%",
                   cell.penalty(), " / ".join(f"{100 * e['relative_share']:+.2f}" for e in fractions))
     return {"name": "penalty", "k_n": cell.penalty(), "how": how, "counted": False,
-            "meaning": "the same quantity at the exact limit k_n -> infinity: the penalty's share of the answer "
+            "meaning": "the same quantity at the exact limit (non-penetration, k_n without bound): the penalty's share "
+                       "of the answer "
                        "(paper eq. 65, the model, not its discretization)", "quantities": entries}
