@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from press_fit_3d import press_fit_3d
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -73,61 +74,8 @@ linear = "iterative"
 """
 
 #: the 3D press fit of tests/macro/test_macro_3d_report.py on a coarser mesh
-PRESS_FIT_3D = """\
-kind = "macro"
-title = "3D press fit of two tubes, a quarter (MPI test)"
-
-[materials.steel]
-E = 210e9
-nu = 0.3
-
-[materials.bone]
-E = 17e9
-nu = 0.3
-
-[bodies]
-rough = "steel"
-counter = "bone"
-
-[geometry]
-shape = "coaxial"
-setting = "3d"
-
-[geometry.dimensions]
-a = 0.004
-b = 0.008
-c = 0.014
-height = 0.01
-
-[interface]
-law = "linear"
-kn = 1e13
-kt = 1e12
-gap = -2e-6
-
-[[supports]]
-boundary = "bottom"
-
-[[supports]]
-boundary = "sym_x"
-components = ["x"]
-
-[[supports]]
-boundary = "sym_y"
-components = ["y"]
-
-[[loads]]
-boundary = "top"
-pressure = 5e6
-
-[discretization]
-order = 2
-maxh = 0.005
-
-[solver]
-linear = "iterative"
-rtol = 1e-12
-"""
+PRESS_FIT_3D = press_fit_3d(maxh=0.005, title="3D press fit of two tubes, a quarter (MPI test)",
+                            solver='linear = "iterative"\nrtol = 1e-12\n')
 
 needs_mpi = pytest.mark.skipif(
     shutil.which("mpiexec") is None or importlib.util.find_spec("mpi4py") is None,

@@ -5,58 +5,9 @@ import numpy as np
 import pytest
 
 from ngcontact import cli
+from press_fit_3d import press_fit_3d
 
-SCENE = """\
-kind = "macro"
-title = "3D press fit of two tubes, a quarter"
-
-[materials.steel]
-E = 210e9
-nu = 0.3
-
-[materials.bone]
-E = 17e9
-nu = 0.3
-
-[bodies]
-rough = "steel"
-counter = "bone"
-
-[geometry]
-shape = "coaxial"
-setting = "3d"
-
-[geometry.dimensions]
-a = 0.004
-b = 0.008
-c = 0.014
-height = 0.01
-
-[interface]
-law = "linear"
-kn = 1e13
-kt = 1e12
-gap = -2e-6
-
-[[supports]]
-boundary = "bottom"
-
-[[supports]]
-boundary = "sym_x"
-components = ["x"]
-
-[[supports]]
-boundary = "sym_y"
-components = ["y"]
-
-[[loads]]
-boundary = "top"
-pressure = 5e6
-
-[discretization]
-order = 2
-maxh = 0.004
-"""
+SCENE = press_fit_3d()
 
 
 def test_a_3d_macro_scene_reports_its_interface_surface(tmp_path):
