@@ -17,6 +17,8 @@ import traceback
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from ngcontact.parallel.heap_thresholds import keep_freed_arrays
+
 #: Test-only fault injection, read in the submitting process: ``"MEMBER:ATTEMPTS:MODE"`` makes the member
 #: named ``MEMBER`` fail on its first ``ATTEMPTS`` attempts, by raising (``raise``) or by ending its worker
 #: process (``kill``).  Not a setting of the package: the tests of retries and failures use it.
@@ -80,11 +82,13 @@ def in_worker() -> bool:
 
 
 def one_thread(ignore_sigint: bool) -> None:
-    """Worker start: NGSolve and BLAS on one thread; a pool's workers leave SIGINT to the submitting process, which
-    stops them."""
+    """Worker start: NGSolve and BLAS on one thread, the C heap's thresholds as in this process
+    (:func:`~ngcontact.parallel.heap_thresholds.keep_freed_arrays`); a pool's workers leave SIGINT to the
+    submitting process, which stops them."""
     global _IN_WORKER
     _IN_WORKER = True
     os.environ["NGCONTACT_THREADS"] = "1"
+    keep_freed_arrays()
     if ignore_sigint:
         import signal
         signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -1,0 +1,48 @@
+"""The C heap's thresholds in a worker whose environment froze them (ngcontact.parallel.heap_thresholds)."""
+import os
+import subprocess
+import sys
+
+import pytest
+
+from ngcontact.parallel import heap_thresholds
+
+PROBE = """
+import resource, sys
+import numpy as np
+from ngcontact.parallel.heap_thresholds import keep_freed_arrays
+
+def faults():
+    start = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    for _ in range(50):
+        a = np.ones(2**19)          # 4 MiB, allocated and freed like an FFT buffer of a step
+        del a
+    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - start
+
+faults()
+before = faults()
+changed = keep_freed_arrays()
+faults()
+print(before, faults(), changed)
+"""
+
+
+def _probe(env_extra: dict) -> tuple[int, int, bool]:
+    env = {k: v for k, v in os.environ.items() if k not in heap_thresholds.FREEZING}
+    env.update(env_extra)
+    out = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True, check=True)
+    before, after, changed = out.stdout.split()
+    return int(before), int(after), changed == "True"
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc thresholds: Linux only")
+def test_a_frozen_threshold_is_raised_and_freed_arrays_are_reused():
+    before, after, changed = _probe({"MALLOC_TRIM_THRESHOLD_": "65536"})   # what Dask's nanny sets
+    assert changed
+    assert before > 50 * 500            # every 4 MiB array mapped afresh: about 1024 page faults each
+    assert after < before / 20          # reused from the heap
+
+
+def test_nothing_changes_where_the_environment_sets_no_threshold():
+    _, _, changed = _probe({})
+    assert not changed
