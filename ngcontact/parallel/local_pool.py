@@ -38,12 +38,14 @@ class LocalPool(Executor):
         self._started: Any = None     # the queue on which workers announce their start
         self._processes: dict = {}      # every worker process of the current pool, by pid
         self._lifetime: worker_lifetime.Record | None = None   # the current pool's record of its workers
+        self._warming: list = []      # the warm-up tasks of an early start, one per worker
         self.on_demand = False
 
     def _start(self):
         from concurrent.futures import ProcessPoolExecutor
         worker_lifetime.end_orphans()
         ctx = worker_lifetime.spawn_context()
+        self._warming = []
         self._started = ctx.SimpleQueue()
         self._processes = {}
         self._lifetime = worker_lifetime.Record()
@@ -64,8 +66,7 @@ class LocalPool(Executor):
         if self._pool is not None:
             return
         pool = self._start()
-        for _ in range(self.workers):
-            pool.submit(_warm_up, tuple(modules))
+        self._warming = [pool.submit(_warm_up, tuple(modules)) for _ in range(self.workers)]
 
     def start_on_demand(self) -> None:
         """Until the workers are started, a batch solves its first member in this process and starts them
@@ -91,14 +92,37 @@ class LocalPool(Executor):
             seconds = time.perf_counter() - t0
             if progress is not None:
                 progress(label, 1, len(items))
-            shifted = None if progress is None else (lambda lb, k, n: progress(lb, k + 1, n + 1))
+            shifted = _after(progress, 1)
             here = not self._worth_starting(seconds, len(items) - 1)
             log.debug("%s: first member %.3g s; the other %d run %s", label, seconds, len(items) - 1,
                       "in this process" if here else f"on {self.workers} workers")
             rest = (Executor._map if here else LocalPool._pool_map)(self, fn, items[1:], names[1:], label,
                                                                     shifted, fault)
             return first + rest
-        return self._pool_map(fn, items, names, label, progress, fault)
+        done = self._while_starting(fn, items, names, label, progress, fault)
+        if len(done) == len(items):
+            return done
+        rest = self._pool_map(fn, items[len(done):], names[len(done):], label, _after(progress, len(done)), fault)
+        return done + rest
+
+    def _while_starting(self, fn, items, names, label, progress, fault) -> list:
+        """The first members, solved in this process while no worker has started yet.
+
+        A pool started early (:meth:`start`) needs a second or two before its
+        first worker takes a member.  This process would wait for it; it
+        solves members itself instead, until a worker is ready.  A batch too
+        small to repay the start is then done here, as fast as serially, and
+        a large one loses nothing.
+        """
+        done: list = []
+        while len(done) < len(items) and self._warming and not any(w.done() for w in self._warming):
+            k = len(done)
+            done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
+                                  _after(progress, k, len(items)), fault)
+        if done:
+            log.debug("%s: %d of %d members solved in this process while the workers started", label,
+                      len(done), len(items))
+        return done
 
     def _pool_map(self, fn, items, names, label, progress, fault) -> list:
         from concurrent.futures import FIRST_COMPLETED, wait
@@ -208,6 +232,14 @@ class LocalPool(Executor):
 
 
 _STARTED = None
+
+
+def _after(progress, done: int, total: int | None = None):
+    """``progress`` of the members after the first ``done`` of a batch of ``total`` (default: ``done`` more than
+    the part reports): its counts shifted by ``done``."""
+    if progress is None or done == 0 and total is None:
+        return progress
+    return lambda label, k, n: progress(label, k + done, n + done if total is None else total)
 
 
 def _exit_code(proc, seconds: float = 2.0):

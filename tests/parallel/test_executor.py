@@ -5,6 +5,7 @@ Faults are injected through the test-only variable ``NGCONTACT_TEST_FAULT``
 are ``operator.neg`` so that a spawned worker needs nothing of the tests.
 """
 import operator
+import os
 
 import time
 
@@ -153,5 +154,25 @@ def test_a_pool_started_on_demand_uses_its_workers_only_where_they_repay_their_s
         assert (ex._pool is not None) == on_workers
         assert seen[0] == (0, len(ITEMS)) and seen[-1] == (len(ITEMS), len(ITEMS))
         assert [k for k, _ in seen] == sorted(k for k, _ in seen) and {n for _, n in seen} == {len(ITEMS)}
+    finally:
+        ex.close()
+
+
+def test_an_early_pool_solves_members_here_until_a_worker_has_started(monkeypatch):
+    """A pool started early (``start``) takes members only once a worker is ready: before that this process
+    solves them (a worker process runs with ``NGCONTACT_THREADS=1``, this one without it)."""
+    monkeypatch.delenv("NGCONTACT_THREADS", raising=False)
+    names = [f"m{k}" for k in range(6)]
+    ex = executor.LocalPool(2)
+    seen = []
+    try:
+        ex.start(("ngsolve",))            # a worker's start imports NGSolve: far longer than these members
+        here = ex.map(os.getenv, ["NGCONTACT_THREADS"] * 6, names, label="toy",
+                      progress=lambda label, k, n: seen.append((k, n)))
+        assert here == [None] * 6
+        assert seen == [(k, 6) for k in range(7)]
+        for warm in ex._warming:
+            warm.result(timeout=120)
+        assert ex.map(os.getenv, ["NGCONTACT_THREADS"] * 6, names, label="toy") == ["1"] * 6
     finally:
         ex.close()
