@@ -1,0 +1,151 @@
+"""Ensembles of a random surface on each executor: serial, a local pool of two workers, a Dask cluster of two.
+
+Three batches, each run as the command a user types (``ngcontact run SCENE
+--out DIR --quiet`` plus the executor's flag, in a fresh interpreter):
+
+* the shipped ``geometries/cells/self_affine_ensemble.toml`` (32 members on
+  a 64 x 64 grid: a batch of about two seconds, too small to repay two
+  workers' start);
+* the same class on a 256 x 256 grid, 16 members (seconds per member);
+* the shipped ``geometries/cells/measured_scan_ensemble.toml``.
+
+Executors: ``--workers 1`` (serial, the reference), ``--workers 2`` (a local
+pool started with the run), ``--scheduler`` on a ``distributed.LocalCluster``
+of two one-thread worker processes that this script starts once and warms
+with one run of each scene (a cluster outlives the runs it serves).  Per
+run: the command's wall time, the batch's wall time (``compute.batches``),
+both over the serial run's of the same repeat, and the largest relative
+difference of the members' contact fractions from the serial run.  The aims
+(the speed issue): no executor slower than serial on any shipped batch,
+two local workers at least 1.6x serial on the 256^2 ensemble, Dask within
+1.2x of the local pool.
+
+    MPLBACKEND=Agg python scripts/ensemble_executors.py results/ensemble_executors --publish
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+
+ROOT = benchmark_doc.ROOT
+SHIPPED = os.path.join(ROOT, "geometries", "cells", "self_affine_ensemble.toml")
+MEASURED = os.path.join(ROOT, "geometries", "cells", "measured_scan_ensemble.toml")
+REPEATS = 2
+
+
+def large(tmp: str) -> str:
+    """The shipped ensemble's surface class on a 256 x 256 grid with 16 members (a scene file in ``tmp``)."""
+    with open(SHIPPED) as fh:
+        text = fh.read()
+    text = text.replace("grid = 64,", "grid = 256,").replace("members = 32", "members = 16")
+    assert "grid = 256," in text and "members = 16" in text, "the shipped ensemble's text changed"
+    path = os.path.join(tmp, "self_affine_ensemble_256.toml")
+    with open(path, "w") as fh:
+        fh.write(text)
+    return path
+
+
+def run(scene: str, out: str, *flags: str) -> tuple[float, dict]:
+    """``ngcontact run scene --out out --quiet flags`` in a fresh interpreter: (wall seconds, report)."""
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "ngcontact", "run", scene, "--out", out, "--quiet", *flags],
+                   check=True, cwd=os.path.dirname(scene))
+    wall = time.perf_counter() - t0
+    with open(os.path.join(out, "report.json")) as fh:
+        return wall, json.load(fh)
+
+
+def batch_seconds(report: dict) -> float:
+    return sum(b["seconds"] for b in report["compute"]["batches"])
+
+
+def fractions(report: dict) -> np.ndarray:
+    """Every member's contact fraction at every load (the ensemble's members, in order)."""
+    return np.array([[load["contact_fraction"] for load in loads] for loads in report["results"]["members"]],
+                    dtype=float)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("out", nargs="?", default=os.path.join("results", "ensemble_executors"))
+    benchmark_doc.add_flag(parser)
+    args = parser.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    from distributed import LocalCluster
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp, LocalCluster(
+            n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster:
+        scenes = {"shipped 64^2 x 32": SHIPPED, "256^2 x 16": large(tmp), "measured scan": MEASURED}
+        dask = ("--scheduler", cluster.scheduler_address)
+        for name, scene in scenes.items():
+            run(scene, os.path.join(tmp, f"warm_{len(rows)}"), *dask)      # the cluster imports the package
+            for repeat in range(REPEATS):
+                ref: tuple[float, dict] | None = None
+                for executor, flags in (("serial", ("--workers", "1")), ("local 2", ("--workers", "2")),
+                                        ("dask 2", dask)):
+                    wall, report = run(scene, os.path.join(tmp, f"{len(rows)}"), *flags)
+                    ref = ref or (wall, report)
+                    diff = np.max(np.abs(fractions(report) - fractions(ref[1])) / np.abs(fractions(ref[1])))
+                    rows.append(dict(ensemble=name, executor=executor, repeat=repeat,
+                                     members=report["results"]["ensemble"]["members"], wall=wall,
+                                     batch=batch_seconds(report), speedup=ref[0] / wall,
+                                     batch_speedup=batch_seconds(ref[1]) / batch_seconds(report),
+                                     max_rel_diff=float(diff)))
+                    r = rows[-1]
+                    print(f"{name:>18} {executor:>8} #{repeat}: {wall:6.2f} s (x{r['speedup']:.2f}), batch "
+                          f"{r['batch']:6.2f} s (x{r['batch_speedup']:.2f}), diff {diff:.1e}", flush=True)
+    write(args.out, rows)
+    if args.publish:
+        benchmark_doc.publish(
+            "ensemble_executors", "Ensembles on each executor",
+            os.path.join(args.out, "ensemble_executors.csv"),
+            note="`ngcontact run` of three ensembles with `--workers 1` (serial, the reference), `--workers 2` "
+                 "and `--scheduler` on a local Dask cluster of two one-thread workers (warmed by one run). "
+                 "`wall` and `batch` in seconds; speedups over the serial run of the same repeat; "
+                 "`max_rel_diff`: the members' contact fractions against the serial run.",
+            png=os.path.join(args.out, "ensemble_executors.png"))
+
+
+def write(out: str, rows: list[dict]) -> None:
+    keys = ["ensemble", "executor", "repeat", "members", "wall", "batch", "speedup", "batch_speedup",
+            "max_rel_diff"]
+    with open(os.path.join(out, "ensemble_executors.csv"), "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(keys)
+        for r in rows:
+            w.writerow([r[k] for k in keys])
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    names = list(dict.fromkeys(r["ensemble"] for r in rows))
+    execs = ["serial", "local 2", "dask 2"]
+    fig, ax = plt.subplots(figsize=(7.5, 4))
+    width = 0.8 / len(execs)
+    for j, ex in enumerate(execs):
+        means = [np.mean([r["batch_speedup"] for r in rows if r["ensemble"] == n and r["executor"] == ex])
+                 for n in names]
+        ax.bar(np.arange(len(names)) + (j - 1) * width, means, width, label=ex)
+    ax.axhline(1.0, color="k", lw=0.8)
+    ax.axhline(1.6, color="k", ls=":", lw=0.8, label="aim of 2 workers on 256^2")
+    ax.set_xticks(np.arange(len(names)), names)
+    ax.set_ylabel("batch speedup over serial")
+    ax.legend(fontsize=8)
+    ax.set_title("ensembles on 2 cores: serial, local pool of 2, Dask cluster of 2", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "ensemble_executors.png"), dpi=120)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()
