@@ -6,7 +6,8 @@ one below and above on the same mesh (:mod:`ngcontact.macro.discretization_error
 * Lame's press fit of two tubes through a linear Winkler interface (plane strain quarter, the
   compliances in series, :mod:`ngcontact.verification.lame`): the pressure, the resultant of the
   quarter's interface (``p b`` per component) and the largest von Mises and Tresca stress of each tube
-  (at its bore) in closed form, at orders 1 to 4 on one coarse curved mesh;
+  (at its bore) in closed form, at orders 1 to 4 on one coarse mesh curved at the order (straight-sided
+  at order 1, whose neighbours are solved on it curved at order 2);
 * the femur / hip-stem scene (``geometries/femur_stem.toml``, order 3) against order 4 on its mesh
   sizes halved (a stress maximum: that field's largest value over a dense lattice of points per
   element), the safety factor by the linear recovery included (skipped with ``--quick``).
@@ -157,7 +158,8 @@ def main(argv=None) -> int:
                               "femur", csv_path, png=png,
                               note="Estimate: from the orders one below and above on the same mesh "
                               "(ngcontact/macro/discretization_error.py); Lame's press fit with the interface "
-                              "compliance in series on one coarse curved mesh (maxh 0.3) at orders 1 to 4; the "
+                              "compliance in series on one coarse mesh (maxh 0.3) curved at the order, at orders 1 to 4 (order 1: "
+                              "straight-sided, its neighbours solved on it curved at order 2); the "
                               "femur scene at its order 3 against order 4 on its mesh sizes halved (a stress maximum: "
                               "over a dense lattice of points per element). An empty "
                               "estimate is a quantity reported without one (not converging or singular). "

@@ -47,17 +47,20 @@ def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution]
     problem, ppe = sol.problem, scene.output.points_per_element
     own = DE.headlines(sol, ppe)
     component = next(n for n in own if n.startswith("resultant_")).removeprefix("resultant_")
-    out: dict[int, dict[str, DE.Sample]] = {}
+    if safety_factor is not None:
+        own["safety_factor"] = DE.Sample(safety_factor(sol))
+    out: dict[int, dict[str, DE.Sample]] = {problem.order: own}
     for q in DE.ladder(problem.order, MAX_ORDER):
         if q == problem.order:
-            s = sol
-        else:
-            other = replace(problem, order=q)
-            s = solve(other, DE.start_at_order(sol, other))
-        out[q] = own if s is sol else DE.headlines(s, ppe, component)
-        if safety_factor is not None:
-            out[q]["safety_factor"] = DE.Sample(safety_factor(s))
-    return out
+            continue
+        other = replace(problem, order=q)
+        start = DE.start_at_order(sol, other)
+        with DE.neighbour_mesh(problem.mesh, problem.order):
+            s = solve(other, start)
+            out[q] = DE.headlines(s, ppe, component)
+            if safety_factor is not None:
+                out[q]["safety_factor"] = DE.Sample(safety_factor(s))
+    return dict(sorted(out.items()))
 
 
 def estimates(samples: dict[int, dict[str, DE.Sample]], sol: MacroSolution) -> list[DE.Estimate]:
