@@ -158,8 +158,8 @@ def main(argv=None) -> int:
                               "femur", csv_path, png=png,
                               note="Estimate: from the orders one below and above on the same mesh "
                               "(ngcontact/macro/discretization_error.py); Lame's press fit with the interface "
-                              "compliance in series on one coarse mesh (maxh 0.3) curved at the order, at orders 1 to 4 (order 1: "
-                              "straight-sided, its neighbours solved on it curved at order 2); the "
+                              "compliance in series on one coarse mesh (maxh 0.3) curved at the order, at orders "
+                              "1 to 4 (order 1: straight-sided, its neighbours solved on it curved at order 2); the "
                               "femur scene at its order 3 against order 4 on its mesh sizes halved (a stress maximum: "
                               "over a dense lattice of points per element). An empty "
                               "estimate is a quantity reported without one (not converging or singular). "

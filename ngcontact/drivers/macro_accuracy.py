@@ -120,17 +120,26 @@ def warning_line(accuracy: dict) -> str:
     return f"accuracy not met (tolerance {accuracy['tolerance']:.3g}): " + "; ".join(parts)
 
 
-def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], balance: dict,
-             two_scale: dict | None = None, recovery=None) -> dict[str, Any]:
-    """``results.accuracy`` of the macro solution ``sol`` of ``scene``: the neighbouring orders solved by
-    ``solve(problem, start)``, the safety factor re-evaluated with the strength check's correctors ``recovery``."""
-    safety_factor = None
-    if recovery is not None:
-        from ngcontact.drivers.run_strength import linear_safety_factor
+def safety_factor_of(scene, recovery) -> Callable[[MacroSolution], float] | None:
+    """The safety factor of eq. 78 by the linear recovery with the strength check's correctors ``recovery``
+    (``None``: the scene has no ``[strength]``)."""
+    if recovery is None:
+        return None
+    from ngcontact.drivers.run_strength import linear_safety_factor
 
-        def safety_factor(s: MacroSolution) -> float:
-            return linear_safety_factor(scene, s, recovery)
-    samples = order_samples(scene, sol, solve, safety_factor)
+    def safety_factor(s: MacroSolution) -> float:
+        return linear_safety_factor(scene, s, recovery)
+    return safety_factor
+
+
+def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], balance: dict,
+             two_scale: dict | None = None, recovery=None,
+             samples: dict[int, dict[str, DE.Sample]] | None = None) -> dict[str, Any]:
+    """``results.accuracy`` of the macro solution ``sol`` of ``scene``: the neighbouring orders solved by
+    ``solve(problem, start)`` (or their ``samples``, made already by a refinement), the safety factor
+    re-evaluated with the strength check's correctors ``recovery``."""
+    if samples is None:
+        samples = order_samples(scene, sol, solve, safety_factor_of(scene, recovery))
     out = verdict(estimates(samples, sol), scene.discretization.tolerance, balance, two_scale)
     out["modelling"] = modelling(scene, sol)
     return out
