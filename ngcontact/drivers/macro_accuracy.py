@@ -89,19 +89,23 @@ def two_scale_quantities(two_scale: dict, tolerance: float) -> list[dict[str, An
                     "quantities' largest values (two_scale.table_tol bounds it)"}]
 
 
-def verdict(found: list[DE.Estimate], tolerance: float | None, balance: dict,
-            two_scale: dict | None = None) -> dict[str, Any]:
-    """``results.accuracy`` of a macro run (module docstring); one warning line when it is not met."""
+def verdict(found: list[DE.Estimate], tolerance: float | None, balance: dict | None,
+            two_scale: dict | None = None, how: str = HOW, absolute: tuple[str, ...] = ()) -> dict[str, Any]:
+    """``results.accuracy`` of a macro run (module docstring); one warning line when it is not met.
+    ``balance``: the equilibrium check (``None``: a run without one); ``absolute``: the names of fractions,
+    whose error is held to the tolerance itself."""
     limit = DEFAULT_TOLERANCE if tolerance is None else tolerance
-    quantities = [e.quantity(limit) for e in found]
+    quantities = [e.quantity(limit, e.name in absolute) for e in found]
     if two_scale is not None:
         quantities += two_scale_quantities(two_scale, limit)
-    value, bound = float(balance["error"]), float(balance["tolerance"])
-    eq = {"load": None, "name": "equilibrium", "value": value, "limit": bound, "ok": value <= bound,
-          "meaning": CHECKS["equilibrium"]}
+    checks = []
+    if balance is not None:
+        value, bound = float(balance["error"]), float(balance["tolerance"])
+        checks.append({"load": None, "name": "equilibrium", "value": value, "limit": bound, "ok": value <= bound,
+                       "meaning": CHECKS["equilibrium"]})
     out: dict[str, Any] = {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
-           "met": eq["ok"] and all(q["met"] for q in quantities), "checks": [eq], "estimated": True,
-           "quantities": quantities, "how": HOW}
+           "met": all(c["ok"] for c in checks) and all(q["met"] for q in quantities), "checks": checks,
+           "estimated": True, "quantities": quantities, "how": how}
     if not out["met"]:
         log.warning("ngcontact: warning: %s", warning_line(out))
     return out
@@ -114,8 +118,12 @@ def warning_line(accuracy: dict) -> str:
         if q["met"]:
             continue
         rel = q["relative_error"]
-        parts.append(f"{q['name']} {q['value']:.4g} has no error estimate ({q['how'].split(': ')[-1]})"
-                     if rel is None else f"{q['name']} {q['value']:.4g} +/- {rel:.2%}")
+        if q["error"] is None:
+            parts.append(f"{q['name']} {q['value']:.4g} has no error estimate ({q['how'].split(': ')[-1]})")
+        elif q.get("controlled") == "absolute" or rel is None:
+            parts.append(f"{q['name']} {q['value']:.4g} +/- {q['error']:.3g} (absolute)")
+        else:
+            parts.append(f"{q['name']} {q['value']:.4g} +/- {rel:.2%}")
     parts += [f"{c['name']} {c['value']:.3g} > {c['limit']:.3g}" for c in accuracy["checks"] if not c["ok"]]
     return f"accuracy not met (tolerance {accuracy['tolerance']:.3g}): " + "; ".join(parts)
 

@@ -290,12 +290,18 @@ class Estimate:
             return self.error / self.scale
         return 0.0 if self.error == 0 else None
 
-    def quantity(self, tolerance: float) -> dict[str, Any]:
-        """The verdict's entry (the format of :func:`ngcontact.cell.admissibility.quantities`)."""
+    def quantity(self, tolerance: float, absolute: bool = False) -> dict[str, Any]:
+        """The verdict's entry (the format of :func:`ngcontact.cell.admissibility.quantities`); ``absolute``:
+        the error itself is held to ``tolerance`` (a fraction), as a cell's contact fraction is."""
         rel = self.relative_error
+        if absolute:
+            controlled = self.error
+            rel = None if self.error is None else (self.error / abs(self.value) if self.value else None)
+        else:
+            controlled = rel
         out: dict[str, Any] = {"name": self.name, "value": self.value, "error": self.error,
-                               "relative_error": rel, "controlled": "relative",
-                               "met": rel is not None and rel <= tolerance, "how": self.how,
+                               "relative_error": rel, "controlled": "absolute" if absolute else "relative",
+                               "met": controlled is not None and controlled <= tolerance, "how": self.how,
                                "orders": list(self.orders),
                                "ratio": self.ratio if math.isfinite(self.ratio) else None}
         if self.singular_at is not None:
