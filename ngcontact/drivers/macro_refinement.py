@@ -17,10 +17,12 @@ Why the order (p), not the mesh near the interface (h)
       elasticity with a smooth interface law on a mesh curved to its geometry), the p-error falls
       geometrically: one order buys the observed factor ``rho``, where halving the
       interface elements buys ``2^-(p+1)`` at 4 (2D) or 8 (3D) times the unknowns near the interface.
-    * Where the fall is not geometric (a stress singularity at a corner, a difference that does not shrink)
-      the estimate says so and has no error (``error = None``): an h-refinement towards the interface would
-      not make a singular maximum converge either, so the refinement stops there at once and names the
-      quantity: the tolerance cannot be met on it, whatever the discretization.
+    * A stress maximum at a corner that grows with every order is a singularity: the estimate has no
+      error for it (``error = None``), and an h-refinement towards the interface would not make it
+      converge either, so the refinement stops there at once and names the quantity and the corner: the
+      tolerance cannot be met on it, whatever the discretization.  A difference that does not shrink
+      away from any corner (pre-asymptotic orders) has no estimate either, but the next order may show
+      the fall: the order is raised while the bounds allow.
 
 Each level is the run of the scene at that order: the mesh is curved at the raised order
 (``mesh.Curve``, as :func:`ngcontact.drivers.macro_geometry.build_geometry` curves a mesh of that
@@ -88,9 +90,9 @@ def top_dofs(sol: MacroSolution, order: int) -> int:
 
 def stop_reason(sol: MacroSolution, missed: list[DE.Estimate]) -> str | None:
     """Why the order cannot be raised further (``None``: it can)."""
-    blind = [e for e in missed if e.error is None]
-    if blind:
-        e = blind[0]
+    singular = [e for e in missed if e.singular_at is not None]
+    if singular:
+        e = singular[0]
         return (f"{e.name} has no error estimate ({e.how.split(': ')[-1]}), so no order can show it within the "
                 "tolerance")
     nxt = sol.problem.order + 1

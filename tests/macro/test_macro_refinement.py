@@ -3,6 +3,8 @@ met on Lame's press fit against the closed form, exit 3 with the figures when ou
 without a tolerance is run as it was."""
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -123,6 +125,12 @@ def test_a_quantity_without_estimate_stops_the_refinement_at_once():
     assert singular.error is None
     why = MR.stop_reason(None, MR.unmet([singular], 0.01))  # type: ignore[arg-type]
     assert why is not None and "von_mises_base has no error estimate" in why and "singularity" in why
+    # a difference that does not shrink away from any corner: the next order may show the fall, up to the bound
+    growing = DE.estimate("peak_pressure", {k: DE.Sample(v) for k, v in zip((1, 2, 3), (1.0, 1.1, 1.25))}, 2)
+    assert growing.error is None and growing.singular_at is None
+    at_bound = SimpleNamespace(problem=SimpleNamespace(order=MR.MAX_REFINED_ORDER))
+    why = MR.stop_reason(at_bound, MR.unmet([growing], 0.01))  # type: ignore[arg-type]
+    assert why == f"order {MR.MAX_REFINED_ORDER + 1} is beyond the refinement's bound (order <= {MR.MAX_REFINED_ORDER})"
 
 
 def test_a_scene_without_a_tolerance_keeps_its_order(tmp_path):
