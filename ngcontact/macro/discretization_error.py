@@ -131,9 +131,9 @@ def ladder(order: int, max_order: int) -> tuple[int, int, int]:
 @contextmanager
 def neighbour_mesh(mesh: ng.Mesh, order: int) -> Iterator[ng.Mesh]:
     """``mesh`` as the neighbours of a solution of ``order`` are solved and sampled on (module docstring):
-    itself, but curved at :data:`NEIGHBOUR_CURVE` for an order-1 solution, whose straight-sided mesh is
-    restored on leaving."""
-    if order > 1:
+    itself, but curved at :data:`NEIGHBOUR_CURVE` for an order-1 solution on a straight-sided mesh, which
+    is straight-sided again on leaving."""
+    if order > 1 or mesh.GetCurveOrder() > 1:
         yield mesh
         return
     mesh.Curve(NEIGHBOUR_CURVE)
