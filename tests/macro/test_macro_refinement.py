@@ -103,6 +103,14 @@ def test_a_tolerance_is_met_by_raising_the_order_and_the_closed_form_agrees(tmp_
     assert out.results["maxima"]["pressure"]["pressure"] == pytest.approx(
         next(q["value"] for q in acc["quantities"] if q["name"] == "peak_pressure"))
     assert "met at order 3 (refined from order 2)" in accuracy_line(out.results)
+    # the discretization that met it is the scene's at that order: the same numbers
+    path = tmp_path / "order3.toml"
+    path.write_text(PRESS_FIT.replace("order = 2", "order = 3"))
+    again = D.run(loader.load(path), Clock()).results
+    assert again["maxima"]["pressure"]["pressure"] == pytest.approx(out.results["maxima"]["pressure"]["pressure"],
+                                                                    rel=1e-10)
+    assert again["maxima"]["von_mises"]["max"]["value"] == pytest.approx(
+        out.results["maxima"]["von_mises"]["max"]["value"], rel=1e-10)
 
 
 def test_a_tolerance_out_of_reach_ends_the_run_with_the_figures(tmp_path, monkeypatch):
