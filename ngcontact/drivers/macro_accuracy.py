@@ -47,17 +47,20 @@ def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution]
     problem, ppe = sol.problem, scene.output.points_per_element
     own = DE.headlines(sol, ppe)
     component = next(n for n in own if n.startswith("resultant_")).removeprefix("resultant_")
-    out: dict[int, dict[str, DE.Sample]] = {}
+    if safety_factor is not None:
+        own["safety_factor"] = DE.Sample(safety_factor(sol))
+    out: dict[int, dict[str, DE.Sample]] = {problem.order: own}
     for q in DE.ladder(problem.order, MAX_ORDER):
         if q == problem.order:
-            s = sol
-        else:
-            other = replace(problem, order=q)
-            s = solve(other, DE.start_at_order(sol, other))
-        out[q] = own if s is sol else DE.headlines(s, ppe, component)
-        if safety_factor is not None:
-            out[q]["safety_factor"] = DE.Sample(safety_factor(s))
-    return out
+            continue
+        other = replace(problem, order=q)
+        start = DE.start_at_order(sol, other)
+        with DE.neighbour_mesh(problem.mesh, problem.order):
+            s = solve(other, start)
+            out[q] = DE.headlines(s, ppe, component)
+            if safety_factor is not None:
+                out[q]["safety_factor"] = DE.Sample(safety_factor(s))
+    return dict(sorted(out.items()))
 
 
 def estimates(samples: dict[int, dict[str, DE.Sample]], sol: MacroSolution) -> list[DE.Estimate]:
@@ -86,19 +89,23 @@ def two_scale_quantities(two_scale: dict, tolerance: float) -> list[dict[str, An
                     "quantities' largest values (two_scale.table_tol bounds it)"}]
 
 
-def verdict(found: list[DE.Estimate], tolerance: float | None, balance: dict,
-            two_scale: dict | None = None) -> dict[str, Any]:
-    """``results.accuracy`` of a macro run (module docstring); one warning line when it is not met."""
+def verdict(found: list[DE.Estimate], tolerance: float | None, balance: dict | None,
+            two_scale: dict | None = None, how: str = HOW, absolute: tuple[str, ...] = ()) -> dict[str, Any]:
+    """``results.accuracy`` of a macro run (module docstring); one warning line when it is not met.
+    ``balance``: the equilibrium check (``None``: a run without one); ``absolute``: the names of fractions,
+    whose error is held to the tolerance itself."""
     limit = DEFAULT_TOLERANCE if tolerance is None else tolerance
-    quantities = [e.quantity(limit) for e in found]
+    quantities = [e.quantity(limit, e.name in absolute) for e in found]
     if two_scale is not None:
         quantities += two_scale_quantities(two_scale, limit)
-    value, bound = float(balance["error"]), float(balance["tolerance"])
-    eq = {"load": None, "name": "equilibrium", "value": value, "limit": bound, "ok": value <= bound,
-          "meaning": CHECKS["equilibrium"]}
+    checks = []
+    if balance is not None:
+        value, bound = float(balance["error"]), float(balance["tolerance"])
+        checks.append({"load": None, "name": "equilibrium", "value": value, "limit": bound, "ok": value <= bound,
+                       "meaning": CHECKS["equilibrium"]})
     out: dict[str, Any] = {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
-           "met": eq["ok"] and all(q["met"] for q in quantities), "checks": [eq], "estimated": True,
-           "quantities": quantities, "how": HOW}
+           "met": all(c["ok"] for c in checks) and all(q["met"] for q in quantities), "checks": checks,
+           "estimated": True, "quantities": quantities, "how": how}
     if not out["met"]:
         log.warning("ngcontact: warning: %s", warning_line(out))
     return out
@@ -111,23 +118,36 @@ def warning_line(accuracy: dict) -> str:
         if q["met"]:
             continue
         rel = q["relative_error"]
-        parts.append(f"{q['name']} {q['value']:.4g} has no error estimate ({q['how'].split(': ')[-1]})"
-                     if rel is None else f"{q['name']} {q['value']:.4g} +/- {rel:.2%}")
+        if q["error"] is None:
+            parts.append(f"{q['name']} {q['value']:.4g} has no error estimate ({q['how'].split(': ')[-1]})")
+        elif q.get("controlled") == "absolute" or rel is None:
+            parts.append(f"{q['name']} {q['value']:.4g} +/- {q['error']:.3g} (absolute)")
+        else:
+            parts.append(f"{q['name']} {q['value']:.4g} +/- {rel:.2%}")
     parts += [f"{c['name']} {c['value']:.3g} > {c['limit']:.3g}" for c in accuracy["checks"] if not c["ok"]]
     return f"accuracy not met (tolerance {accuracy['tolerance']:.3g}): " + "; ".join(parts)
 
 
-def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], balance: dict,
-             two_scale: dict | None = None, recovery=None) -> dict[str, Any]:
-    """``results.accuracy`` of the macro solution ``sol`` of ``scene``: the neighbouring orders solved by
-    ``solve(problem, start)``, the safety factor re-evaluated with the strength check's correctors ``recovery``."""
-    safety_factor = None
-    if recovery is not None:
-        from ngcontact.drivers.run_strength import linear_safety_factor
+def safety_factor_of(scene, recovery) -> Callable[[MacroSolution], float] | None:
+    """The safety factor of eq. 78 by the linear recovery with the strength check's correctors ``recovery``
+    (``None``: the scene has no ``[strength]``)."""
+    if recovery is None:
+        return None
+    from ngcontact.drivers.run_strength import linear_safety_factor
 
-        def safety_factor(s: MacroSolution) -> float:
-            return linear_safety_factor(scene, s, recovery)
-    samples = order_samples(scene, sol, solve, safety_factor)
+    def safety_factor(s: MacroSolution) -> float:
+        return linear_safety_factor(scene, s, recovery)
+    return safety_factor
+
+
+def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], balance: dict,
+             two_scale: dict | None = None, recovery=None,
+             samples: dict[int, dict[str, DE.Sample]] | None = None) -> dict[str, Any]:
+    """``results.accuracy`` of the macro solution ``sol`` of ``scene``: the neighbouring orders solved by
+    ``solve(problem, start)`` (or their ``samples``, made already by a refinement), the safety factor
+    re-evaluated with the strength check's correctors ``recovery``."""
+    if samples is None:
+        samples = order_samples(scene, sol, solve, safety_factor_of(scene, recovery))
     out = verdict(estimates(samples, sol), scene.discretization.tolerance, balance, two_scale)
     out["modelling"] = modelling(scene, sol)
     return out

@@ -31,7 +31,8 @@ cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its c
   location and body;
 * ``detachment``: points where the interface changes between open and closed;
 * ``accuracy``: the headline quantities with their estimated discretization errors against
-  ``discretization.tolerance`` (:mod:`ngcontact.drivers.macro_accuracy`);
+  ``discretization.tolerance`` (:mod:`ngcontact.drivers.macro_accuracy`), which a scene that states it is
+  first refined towards (:mod:`ngcontact.drivers.macro_refinement`; ``accuracy.refinement``);
 * ``law``, ``dimensions``, ``newton_iterations``, ``coulomb_iterations``.
 """
 from __future__ import annotations
@@ -45,7 +46,8 @@ import numpy as np
 import ngsolve as ng
 
 from ngcontact.drivers.mesh_supports import supports_on
-from ngcontact.drivers.macro_accuracy import accuracy
+from ngcontact.drivers.macro_accuracy import accuracy, safety_factor_of
+from ngcontact.drivers.macro_refinement import refine
 from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
                                      law_from_cell, law_from_file, linear_solver)
 from ngcontact.laws import homogenized as il
@@ -273,6 +275,15 @@ def run(scene, clock) -> Outcome:
         else:
             from ngcontact.drivers.run_two_scale import couple
             sol, two_scale = couple(scene, problem, partial(solve_scene, scene))
+    recovery = refined = None
+    if scene.strength is not None:
+        from ngcontact.drivers.run_strength import recovery_of
+        with clock.stage("strength check"):
+            recovery = recovery_of(scene, sol.problem.law)
+    if scene.discretization.tolerance is not None:
+        with clock.stage("refinement to the tolerance"):
+            refined = refine(scene, sol, partial(solve_scene, scene), safety_factor_of(scene, recovery))
+        sol = refined.solution if refined else sol
     with clock.stage("post-processing"):
         outcome = measured(sol, geo, law_info, scene.output)
         results = outcome.results
@@ -281,21 +292,21 @@ def run(scene, clock) -> Outcome:
             if "interface" in results:
                 results["interface"]["contact_fraction"] = np.asarray(two_scale["interface_coefficients"]
                                                                      ["contact_fraction"])
-    recovery = None
     if scene.strength is not None:
         from ngcontact.drivers.run_strength import evaluate
         with clock.stage("strength check"):
-            st = evaluate(scene, sol)
+            st = evaluate(scene, sol, recovery)
         results["strength"] = st["results"]
         if two_scale is not None:
             results["two_scale"]["summary"] = two_scale_summary(two_scale, st["results"])
         outcome.tables["strength_map"] = st["table"]
         outcome.vtk["worst_cell"] = st["vtk"]
         outcome.plots.update(st["plots"])
-        recovery = st["recovery"]
     with clock.stage("discretization error"):
         results["accuracy"] = accuracy(scene, sol, partial(solve_scene, scene), results["equilibrium"], two_scale,
-                                       recovery)
+                                       recovery, None if refined is None else refined.samples)
+    if refined is not None:
+        results["accuracy"]["refinement"] = refined.record()
     return outcome
 
 

@@ -21,16 +21,20 @@ Returns an :class:`~ngcontact.output.report.Outcome`; no file I/O.
   closed: the whole surface of a rectangular valley profile is
   ``1 + 2 depth / period``);
 * ``probes``: displacements [m] at the study's probe points, if any;
+* ``accuracy``: the contact fraction and the contact force's magnitude with their discretization errors
+  estimated from the neighbouring orders on the run's mesh (:mod:`ngcontact.drivers.resolved_accuracy`);
 * ``newton_iterations``, ``ndof``.
 """
 from __future__ import annotations
 
 import logging
+from functools import partial
 
 import numpy as np
 
 from ngcontact.drivers.build import body_laws, micro_friction
 from ngcontact.drivers.mesh_supports import supports_on
+from ngcontact.drivers.resolved_accuracy import accuracy
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry import resolved_shapes as rs
@@ -175,6 +179,8 @@ def run(scene, clock) -> Outcome:
                    "probes": probes(scene, sol),
                    "newton_iterations": sol.history["newton_iterations"],
                    "elements": geo.mesh.ne}
+    with clock.stage("discretization error"):
+        results["accuracy"] = accuracy(sol, geo.length, partial(solve_scene, scene))
     vtk = {"resolved": VtkField(mesh=geo.mesh, fields={"u_rough": sol.u_rough, "u_counter": sol.u_counter},
                                 subdivision=1)}
     solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],

@@ -47,6 +47,16 @@ The estimate
     tabulated by ``scripts/macro_effectivity.py``.  At order 1
     the ladder is ``1, 2, 3``: 1.5 times the sum of ``|Q_2 - Q_1|`` and the extrapolation of order 2.
 
+The mesh of an order-1 run
+    An order-1 run leaves its mesh straight-sided (:data:`NEIGHBOUR_CURVE`): a curved boundary or
+    interface is a polygon, whose vertices are corners of that polygon's own solution.  Orders 2 and 3
+    on the polygon converge slowly there (ratios near 0.9, a stress maximum at a polygon vertex growing
+    with the order like a singularity) and towards the polygon's solution, not the scene's.  So the
+    neighbours of order 1 are solved on the same mesh curved at order 2 (:func:`neighbour_mesh`), the
+    geometry an order-2 run has: ``d_lo = Q_2 - Q_1`` then carries the polygon's geometric error
+    with the polynomial one, and ``d_hi`` sees a smooth boundary.  From order 2 on, the scene's own
+    curved mesh serves every order of the ladder.
+
 A stress maximum is the largest of the field's values at a few points per element; a refinement moves
 those points, the orders on one mesh do not.  The maximum over a denser lattice of points on the
 reported solution measures that share (``Sample.sampling``), and :data:`SAFETY` times it is added.
@@ -65,6 +75,8 @@ Where no estimate exists
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -88,6 +100,8 @@ SINGULAR_RATIO = 0.5
 AT_CORNER = 0.05
 #: turning angle of the boundary at a vertex [rad] above which the vertex is a corner
 CORNER_ANGLE = math.radians(30.0)
+#: the order the mesh is curved at while the neighbours of an order-1 solution are solved (module docstring)
+NEIGHBOUR_CURVE = 2
 
 
 @dataclass(frozen=True)
@@ -112,6 +126,21 @@ def ladder(order: int, max_order: int) -> tuple[int, int, int]:
     if order >= max_order:
         return (order - 2, order - 1, order)
     return (order - 1, order, order + 1)
+
+
+@contextmanager
+def neighbour_mesh(mesh: ng.Mesh, order: int) -> Iterator[ng.Mesh]:
+    """``mesh`` as the neighbours of a solution of ``order`` are solved and sampled on (module docstring):
+    itself, but curved at :data:`NEIGHBOUR_CURVE` for an order-1 solution on a straight-sided mesh, which
+    is straight-sided again on leaving."""
+    if order > 1 or mesh.GetCurveOrder() > 1:
+        yield mesh
+        return
+    mesh.Curve(NEIGHBOUR_CURVE)
+    try:
+        yield mesh
+    finally:
+        mesh.Curve(1)
 
 
 def start_at_order(sol: MacroSolution, problem: MacroProblem) -> ng.BaseVector:
@@ -261,12 +290,18 @@ class Estimate:
             return self.error / self.scale
         return 0.0 if self.error == 0 else None
 
-    def quantity(self, tolerance: float) -> dict[str, Any]:
-        """The verdict's entry (the format of :func:`ngcontact.cell.admissibility.quantities`)."""
+    def quantity(self, tolerance: float, absolute: bool = False) -> dict[str, Any]:
+        """The verdict's entry (the format of :func:`ngcontact.cell.admissibility.quantities`); ``absolute``:
+        the error itself is held to ``tolerance`` (a fraction), as a cell's contact fraction is."""
         rel = self.relative_error
+        if absolute:
+            controlled = self.error
+            rel = None if self.error is None else (self.error / abs(self.value) if self.value else None)
+        else:
+            controlled = rel
         out: dict[str, Any] = {"name": self.name, "value": self.value, "error": self.error,
-                               "relative_error": rel, "controlled": "relative",
-                               "met": rel is not None and rel <= tolerance, "how": self.how,
+                               "relative_error": rel, "controlled": "absolute" if absolute else "relative",
+                               "met": controlled is not None and controlled <= tolerance, "how": self.how,
                                "orders": list(self.orders),
                                "ratio": self.ratio if math.isfinite(self.ratio) else None}
         if self.singular_at is not None:

@@ -126,6 +126,9 @@ def accuracy_line(results: dict) -> str | None:
     parts = [f"{n} {q['value']:.4g} " + ("(no estimate)" if q.get("relative_error") is None
                                         else f"+/- {q['relative_error']:.2%}") for n, q in worst.items()]
     verdict = "met" if acc.get("met") else "NOT met"
+    refined = acc.get("refinement") or {}
+    if refined.get("order") is not None:
+        verdict += f" at order {refined['order']} (refined from order {refined.get('scene_order')})"
     model = acc.get("modelling") or {}
     tail = (f"; modelling error of the homogenized interface ~ {model['relative_error']:.2%} (estimate C eps / L)"
             if model.get("relative_error") is not None else "")

@@ -59,8 +59,10 @@ class MacroDiscretization(Discretization):
         "quantities (peak interface pressure, resultant, largest von Mises and Tresca stress per body, safety "
         "factor; two-scale: the loop's residual and the cell table's interpolation error) are held to: each is "
         "reported with its discretization error, estimated from solves one order below and above on the same "
-        "mesh, and results.accuracy.met says whether every one is within; the mesh and order are not changed; "
-        "default: 0.01")
+        "mesh, and results.accuracy.met says whether every one is within; a scene that states it is refined "
+        "towards it: the order is raised by one on the scene's mesh until every estimate meets it, up to order "
+        "4 and 2e6 unknowns (results.accuracy.refinement lists the levels and the order that met it), and a "
+        "tolerance out of reach ends the run (exit 3); default: 0.01, only judged (the scene's order is kept)")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -30,7 +30,7 @@ from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.femur import FemurStemDims, femur_stem, split_periods
 from ngcontact.geometry.resolved_bodies import resolved_blocks
-from ngcontact.output.report import Clock
+from ngcontact.output.report import Clock, accuracy_line
 from ngcontact.fem.reaction import boundary_reaction
 from ngcontact.fem.sampling import probe
 
@@ -164,6 +164,16 @@ def test_femur_grooves_scene_runs_in_equilibrium():
     # the stem sinks; the walls on one side of each groove open, so less than the whole surface is closed
     assert res["probes"][0][1] < 0
     assert 0.5 < res["contact_fraction"] < 1.2
+    # the headline quantities with their discretization errors, from the neighbouring orders on the mesh
+    acc = res["accuracy"]
+    q = {x["name"]: x for x in acc["quantities"]}
+    assert set(q) == {"contact_fraction", "contact_force"} and acc["tolerance_from"] == "default"
+    assert q["contact_fraction"]["value"] == res["contact_fraction"] and q["contact_fraction"]["orders"] == [1, 2, 3]
+    assert q["contact_fraction"]["controlled"] == "absolute" and q["contact_force"]["controlled"] == "relative"
+    assert q["contact_force"]["value"] == pytest.approx(math.hypot(*res["contact_force"]), rel=1e-12)
+    for x in q.values():
+        assert x["error"] is not None and 0 < x["error"] < 0.1 * abs(x["value"]), x
+    assert accuracy_line(res).startswith("accuracy ")
 
 
 # ---------------------------------------------------------- epsilon study
