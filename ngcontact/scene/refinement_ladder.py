@@ -261,6 +261,9 @@ def ladder(scene, data: dict, n: int) -> tuple[list[Level], list[str]]:
         mine = []
         for k, changes in enumerate(knob.values(scene, n)):
             level_data = with_keys(data, changes)
+            if not isinstance(knob, Tolerance) and scene.kind in ("macro", "direct"):
+                # a macro tolerance raises the order until met: a level of another knob is its setting alone
+                level_data.get("discretization", {}).pop("tolerance", None)
             level = Level(knob.name, k, changes, knob.parameter(changes), knob.size(scene, changes), level_data)
             try:
                 level = Level(knob.name, k, changes, level.parameter, level.size, level_data,

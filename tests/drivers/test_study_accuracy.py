@@ -92,6 +92,19 @@ def test_the_femur_ladder_brackets_the_scene_and_refines_it_once():
     assert h[2].key == order[1].key      # the scene's own level, run once
 
 
+def test_a_macro_tolerance_is_kept_only_by_the_tolerance_ladder():
+    """A macro tolerance raises the order until met: the levels of the other knobs drop it, so that each
+    level is its own setting; the tolerance ladder divides it."""
+    path = ROOT / "geometries" / "femur_stem.toml"
+    data = loader.parsed(path)
+    data.setdefault("discretization", {})["tolerance"] = 0.02
+    levels, _ = ladder(loader.from_dict(data, base_dir=str(path.parent)), data, 4)
+    by_knob = {knob: [lv for lv in levels if lv.knob == knob] for knob in ("h", "order", "tolerance")}
+    assert all(lv.scene.discretization.tolerance is None for lv in by_knob["h"] + by_knob["order"])
+    assert [lv.scene.discretization.tolerance for lv in by_knob["tolerance"]] == pytest.approx(
+        [0.02 * 4.0 ** -s for s in range(-2, 2)])
+
+
 @pytest.mark.parametrize("scene, knobs", [
     ("femur_stem_two_scale.toml", {"h": "discretization.maxh", "order": "discretization.order",
                                    "tolerance": "two_scale.table_tol"}),
