@@ -96,19 +96,30 @@ def _geometric(rate, exact=1.0, size=0.01, levels=5):
     return [exact + size * rate ** k for k in range(levels)]
 
 
-@pytest.mark.parametrize("name, rate", [("contact_fraction", 0.6), ("contact_fraction", 0.5),
-                                        ("mean_closure", 0.3), ("mean_closure", 0.25)])
+@pytest.mark.parametrize("name, rate", [("contact_fraction", 0.3), ("contact_fraction", 0.2), ("mean_closure", 0.3),
+                                        ("mean_closure", 0.25), ("mean_closure", 0.1)])
 def test_a_geometric_sequence_takes_richardson_at_its_observed_rate(name, rate):
-    """Where the window's two ratios agree the estimate is Richardson's tail at the observed rate, times the
-    spread: on an exactly geometric error it is between 1 and 10 times that error."""
+    """Where the window's two ratios agree the estimate is Richardson's tail at the observed rate (at least the
+    quantity's order), times the spread: on an exactly geometric error it is between 1 and 10 times that
+    error, and below the guarded bound."""
     values = _geometric(rate)
     relative = name == "mean_closure"
     estimate, form, remark = tail_estimate(values, relative, ORDER_RATE[name])
     d = abs(values[-1] - values[-2]) / (values[-1] if relative else 1.0)
-    assert form == RICHARDSON and f"{rate:.2g}" in remark
-    assert estimate == pytest.approx(2.0 * d * rate / (1 - rate))
+    used = max(rate, ORDER_RATE[name])
+    assert form == RICHARDSON and remark == f"rate {used:.2g}"
+    assert estimate == pytest.approx(2.0 * d * used / (1 - used))
     error = abs(values[-1] - 1.0)                 # the exact value is 1: absolute and relative alike
     assert 1.0 <= estimate / error <= 10.0
+
+
+def test_a_slow_geometric_sequence_keeps_the_guarded_bound_where_that_is_smaller():
+    # a contact fraction contracting by 0.6: Richardson's tail times 2, 3 d, exceeds the guarded d * 0.6 / 0.4
+    values = _geometric(0.6)
+    estimate, form, _ = tail_estimate(values, False, ORDER_RATE["contact_fraction"])
+    d = values[-2] - values[-1]
+    assert form == GUARDED and estimate == pytest.approx(d * 0.6 / 0.4)
+    assert estimate >= abs(values[-1] - 1.0)
 
 
 def test_richardson_never_assumes_a_rate_faster_than_the_quantitys_order():

@@ -28,7 +28,8 @@ takes one of two forms, which the report names (:func:`sweep_estimates`):
    misplaced edge perturbs it by more than a grid step's order less); the estimate is the tail of the
    geometric series beyond level ``k``, ``|d_k| rho / (1 - rho)``, times :data:`SPREAD`, the scatter of
    one level's error about the geometric model (the erratic factor above: an edge's position between two
-   points) that two ratios cannot resolve.
+   points) that two ratios cannot resolve.  Where that exceeds the guarded bound below, which holds
+   without the geometric model, the guarded bound is the estimate: Richardson only ever sharpens it.
 2. **The guarded bound** wherever the two ratios disagree, one difference vanished, or the sequence does
    not contract ("where two successive differences disagree in rate, the estimate says so and takes the
    larger"): the rate is the larger of the ratios held to ``[RATE_FLOOR, RATE_CAP]`` (never faster than
@@ -98,8 +99,8 @@ RICHARDSON, GUARDED = "Richardson", "guarded"
 HOW = ("grids of twice the points per direction each; per quantity and load, Richardson with the observed rate "
        f"of the last {WINDOW} differences where their two ratios agree within a factor {AGREE:g} (rate at least "
        f"{ORDER_RATE['contact_fraction']} for the contact fraction, {ORDER_RATE['mean_closure']} for the mean "
-       f"closure, the tail times {SPREAD:g}), elsewhere the guarded geometric tail: rate the larger ratio held to "
-       f"[{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished last one")
+       f"closure, the tail times {SPREAD:g}) if that is the smaller, else the guarded geometric tail: rate the "
+       f"larger ratio held to [{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished last one")
 
 
 @dataclass
@@ -162,14 +163,14 @@ def guarded_bound(d: list[float]) -> tuple[float, str]:
 
 def tail_estimate(values: list[float], relative: bool, order_rate: float = RATE_FLOOR) -> tuple[float, str, str]:
     """The estimated error of the last of ``values`` (a quantity on successive levels; module docstring), its
-    form (:data:`RICHARDSON` or :data:`GUARDED`) and a remark on it.  Needs two values at least;
-    ``order_rate`` is the quantity's :data:`ORDER_RATE`."""
+    form (:data:`RICHARDSON` where that is the smaller, else :data:`GUARDED`) and a remark on it.  Needs two
+    values at least; ``order_rate`` is the quantity's :data:`ORDER_RATE`."""
     d = differences(values, relative)
     fitted = richardson(d, order_rate)
-    if fitted is not None:
-        return fitted[0], RICHARDSON, f"observed rate {fitted[1]:.2g}"
     estimate, remark = guarded_bound(d)
-    return estimate, GUARDED, remark
+    if fitted is None or fitted[0] >= estimate:
+        return estimate, GUARDED, remark
+    return fitted[0], RICHARDSON, f"rate {fitted[1]:.2g}"
 
 
 def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float]], list[str], list[dict[str, str]]]:
