@@ -24,8 +24,8 @@ takes one of two forms, which the report names (:func:`sweep_estimates`):
    both contract at least by :data:`RATE_CAP`.  The rate is the larger of the two, but never faster than
    the quantity's own order in the grid step (:data:`ORDER_RATE`: first order, ``1/2`` per level, for the
    contact fraction, whose edges are counted or located between points; second order, ``1/4``, for the
-   mean closure, a mean of the jump that vanishes like ``(x - a)^(3/2)`` at an edge ``a``, so that a
-   misplaced edge perturbs it by more than a grid step's order less); the estimate is the tail of the
+   mean closure, a mean over the period of the collocated jump, which an edge ``a`` misplaced by a
+   fraction of a step barely moves, the gap opening like ``(x - a)^(3/2)`` beyond it); the estimate is the tail of the
    geometric series beyond level ``k``, ``|d_k| rho / (1 - rho)``, times :data:`SPREAD`, the scatter of
    one level's error about the geometric model (the erratic factor above: an edge's position between two
    points) that two ratios cannot resolve.  Where that exceeds the guarded bound below, which holds
