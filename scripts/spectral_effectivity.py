@@ -6,12 +6,14 @@ refined to several tolerances exactly as a run does, and the estimate of each lo
 (absolute) and mean closure (relative) on the reported grid is held against its true error: the
 difference from the same cell's value on a much finer grid (the cells have layers of finite depth, so a
 half-space formula is not their converged value).  The ratio is the effectivity (issue 35 asks for it
-between 1 and 10 on every oracle).  Oracles, each with three loads and exact contact:
+between 1 and 10 on every oracle); the form of each estimate (Richardson or the guarded bound), the true
+error of the grid twice as fine and whether the reported one is small by chance are listed beside it.
+Oracles, each with three loads and exact contact:
 
-* ``westergaard``: Westergaard's sinusoid ``2h sin^2(pi x)``, layers of depth 1, first grid 64, reference
-  on 65536 points;
+* ``westergaard``: Westergaard's sinusoid ``2h sin^2(pi x)``, layers of depth 1, first grid 64, grids up to
+  8192, reference on 65536 points;
 * ``random_2d``: a self-affine profile of 64 samples (Hurst 0.8, rms slope 0.1) as its piecewise linear
-  interpolant, first grid 64, reference on 65536 points;
+  interpolant, first grid 64, grids up to 8192, reference on 65536 points;
 * ``bisinusoid_3d``: ``h (2 - cos 2 pi x - cos 2 pi y)``, first grid 32, grids up to 256, reference on
   1024 x 1024 points.
 
@@ -41,8 +43,8 @@ from ngcontact.output.writer import write_csv  # noqa: E402
 
 NU, H, DEPTH = 0.3, 0.01, 1.0
 TOLERANCES = (1e-2, 1e-3, 1e-4)
-KEYS = ("oracle", "tolerance", "load", "pressure", "grid", "quantity", "value", "estimate", "true_error",
-        "effectivity")
+KEYS = ("oracle", "tolerance", "load", "pressure", "grid", "quantity", "value", "form", "estimate", "true_error",
+        "next_error", "by_chance", "effectivity")
 
 
 @dataclass
@@ -74,8 +76,8 @@ def bisinusoid_gap(n: int) -> np.ndarray:
     return H * (2 - np.cos(2 * np.pi * s[None, :]) - np.cos(2 * np.pi * s[:, None]))
 
 
-ORACLES = (Oracle("westergaard", 2, westergaard_gap, (0.000863, 0.00345, 0.00863), 64, 2 ** 12, 2 ** 16),
-           Oracle("random_2d", 2, random_profile_gap, (0.001, 0.003, 0.01), 64, 2 ** 12, 2 ** 16),
+ORACLES = (Oracle("westergaard", 2, westergaard_gap, (0.000863, 0.00345, 0.00863), 64, 2 ** 13, 2 ** 16),
+           Oracle("random_2d", 2, random_profile_gap, (0.001, 0.003, 0.01), 64, 2 ** 13, 2 ** 16),
            Oracle("bisinusoid_3d", 3, bisinusoid_gap, (0.001, 0.004, 0.01), 32, 256, 1024))
 
 
@@ -99,7 +101,9 @@ class Solved:
 
 
 def oracle_rows(oracle: Oracle, tolerances=TOLERANCES) -> list[dict]:
-    """Per tolerance, load and quantity: the reported value, its estimate, true error and effectivity."""
+    """Per tolerance, load and quantity: the reported value, the estimate's form and size, the true error, that
+    of the grid twice as fine, whether the true error is small by chance (of another sign than the coarser grid's,
+    or below the finer grid's) and the effectivity."""
     loads = [cell_load(oracle.dim, pressure=p) for p in oracle.pressures]
     reference = Solved(oracle, oracle.reference).sweep(loads)
     out = []
@@ -109,13 +113,21 @@ def oracle_rows(oracle: Oracle, tolerances=TOLERANCES) -> list[dict]:
                                          oracle.largest ** (oracle.dim - 1))
         except ConvergenceError:
             continue                      # beyond the study's largest grid: nothing reported
-        for k, (sol, ref, est) in enumerate(zip(refined.solutions, reference, refined.estimates)):
+        grid = refined.history[-1]["grid"]
+        finer = Solved(oracle, 2 * grid).sweep(loads)
+        for k, (sol, ref, est, form) in enumerate(zip(refined.solutions, reference, refined.estimates,
+                                                      refined.forms)):
             for name, relative in (("contact_fraction", False), ("mean_closure", True)):
                 value, exact = sol.results[name], ref.results[name]
-                error = abs(value - exact) / (abs(exact) if relative else 1.0)
+                scale = abs(exact) if relative else 1.0
+                error = abs(value - exact) / scale
+                coarser = refined.history[-2][name][k] - exact
+                next_error = abs(finer[k].results[name] - exact) / scale
                 out.append({"oracle": oracle.name, "tolerance": tol, "load": k, "pressure": oracle.pressures[k],
-                            "grid": refined.history[-1]["grid"], "quantity": name, "value": value,
+                            "grid": grid, "quantity": name, "value": value, "form": form[name],
                             "estimate": est[name], "true_error": error,
+                            "next_error": next_error,
+                            "by_chance": bool(coarser * (value - exact) < 0 or error < next_error),
                             "effectivity": est[name] / error if error > 0 else float("inf")})
     return out
 
@@ -149,15 +161,27 @@ def main(argv=None) -> int:
     write_csv(csv_path, list(KEYS), [[d[k] for k in KEYS] for d in data])
     plot(data, os.path.join(args.out, "spectral_effectivity.png"))
     effs = np.array([d["effectivity"] for d in data])
-    print(f"{len(effs)} estimates: effectivity from {effs.min():.3g} to {effs.max():.3g}, "
-          f"{int(((effs < 1) | (effs > 10)).sum())} outside [1, 10]")
+    outside = int(((effs < 1) | (effs > 10)).sum())
+    chance = sum(1 for d in data if d["effectivity"] > 10 and d["by_chance"])
+    summary = (f"{len(effs)} estimates: effectivity from {effs.min():.3g} to {effs.max():.3g}, {outside} outside "
+               f"[1, 10] ({int((effs < 1).sum())} below 1)")
+    print(summary)
     if args.publish:
         benchmark_doc.publish("spectral_effectivity", "The spectral refinement's estimate against the converged value",
                               csv_path, note="Three oracles (Westergaard's sinusoid and a random 64-sample profile "
                               "in 2D, a bisinusoid in 3D), exact contact, layers of depth 1, each refined to the "
-                              "tolerances 1e-2, 1e-3, 1e-4 as a run does (grids doubling, the geometric tail of the "
-                              "last three differences); the true error of the reported grid is against the same "
-                              "cell on a much finer grid. Issue 35 asks for effectivities between 1 and 10.",
+                              "tolerances 1e-2, 1e-3, 1e-4 as a run does (grids doubling; per quantity and load "
+                              "Richardson with the observed rate where the last two ratios of differences agree and "
+                              "it is the smaller, else the guarded geometric tail: column `form`); a tolerance not met "
+                              "within the study's largest grid reports nothing. The true error of the reported grid is "
+                              "against the same cell on a much finer grid; `next_error` is that of the grid "
+                              "twice as fine. Issue 35 asks for effectivities between 1 and 10. "
+                              f"{summary}. Of the rows above 10, {chance} have a reported error small by chance "
+                              "(`by_chance`: of another sign than the coarser grid's, or below the finer grid's); "
+                              "the others mostly hold in their window of three differences a much larger one "
+                              "from an earlier, slower stretch (in 2D before the edge fit of `grid_measures` "
+                              "takes hold, from 512 points on the sinusoid). No estimate from the differences "
+                              "up to the reported grid can see either.",
                               png=os.path.join(args.out, "spectral_effectivity.png"))
     return 0
 

@@ -67,6 +67,7 @@ def test_a_spectral_scene_with_a_tolerance_reports_the_estimate_and_the_grids(tm
     assert load["contact_fraction"] == pytest.approx(exact, abs=1e-5)
     acc = rep["results"]["accuracy"]                     # the same estimates in the verdict, per quantity
     assert acc["estimated"] and acc["met"] and acc["tolerance"] == 1e-5 and "grids" in acc["how"]
+    assert "Richardson on" in acc["how"]                # which form each estimate took
     fraction = next(q for q in acc["quantities"] if q["name"] == "contact_fraction")
     assert fraction["error"] == load["error_estimate"]["contact_fraction"] and fraction["controlled"] == "absolute"
     assert fraction["relative_error"] == pytest.approx(fraction["error"] / load["contact_fraction"])

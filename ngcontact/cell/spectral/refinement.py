@@ -13,36 +13,44 @@ converge decides the estimate:
   crosses the contact edges.
 
 So the sequence ``q_0, q_1, ...`` of a quantity on levels ``k`` has errors ``e_k = q_k - q`` that fall
-like ``rho^k`` on the whole, but level to level by an erratic factor, and that may cross zero.  A
-Richardson estimate from the last two levels alone fails both ways: a difference that vanishes by a
-coincidence of the edges (a symmetric cell gives the same fraction on two grids) estimates zero, and the
-last difference of a sequence whose earlier levels were far from the asymptotic regime says nothing of
-the next.  The estimate here is a geometric tail bound over the last ``WINDOW`` differences
-``d_j = q_j - q_(j-1)`` (``j = k, k-1, k-2``):
+like ``rho^k`` on the whole, but level to level by an erratic factor, and that may cross zero.  The
+estimate of the reported (finest) level ``k`` looks at the last ``WINDOW`` differences ``d_j = q_j - q_(j-1)``
+(``j = k, k-1, k-2``) of each quantity and each load on its own, in the measure the verdict controls
+(contact fraction absolute, mean closure relative: :data:`ngcontact.cell.admissibility.ESTIMATED`), and
+takes one of two forms, which the report names (:func:`sweep_estimates`):
 
-1. levels double the points per direction (:data:`GROWTH`): close enough that three differences cost
-   little more than the finest level (2D: twice the finest; 3D: 4/3 of it);
-2. the observed rate is the larger of the successive ratios ``|d_j| / |d_(j-1)|`` in the window ("where
-   two successive differences disagree in rate, take the larger"), held to ``[RATE_FLOOR, RATE_CAP]``:
-   never faster than first order in ``h`` (``RATE_FLOOR = 1/2``, the counted contact edges' order), and a
-   sequence not contracting by at least ``RATE_CAP`` is taken as contracting by it;
-3. the size of the next differences is the envelope ``D = max_i |d_(k-i)| ENVELOPE^i`` with ``ENVELOPE =
-   1/2``: the last difference, or an earlier one shrunk at the same first order, whichever is larger, so
-   that a last difference that vanished by coincidence (a symmetric cell gives the same fraction on two
-   grids; a count of points whose constant jumps with the edges) is bounded by the ones before it;
-4. the estimate of the finest level is the tail of the geometric series, ``D rho / (1 - rho)`` (Richardson
-   with the observed rate), in the measure the verdict controls (contact fraction absolute, mean closure
-   relative: :data:`ngcontact.cell.admissibility.ESTIMATED`).
+1. **Richardson with the observed rate**, where the sequence is seen to be geometric: the two successive
+   ratios ``|d_(k-1)| / |d_(k-2)|`` and ``|d_k| / |d_(k-1)|`` agree within the factor :data:`AGREE` and
+   both contract at least by :data:`RATE_CAP`.  The rate is the larger of the two, but never faster than
+   the quantity's own order in the grid step (:data:`ORDER_RATE`: first order, ``1/2`` per level, for the
+   contact fraction, whose edges are counted or located between points; second order, ``1/4``, for the
+   mean closure, a mean over the period of the collocated jump, which an edge ``a`` misplaced by a
+   fraction of a step barely moves, the gap opening like ``(x - a)^(3/2)`` beyond it); the estimate is the tail of the
+   geometric series beyond level ``k``, ``|d_k| rho / (1 - rho)``, times :data:`SPREAD`, the scatter of
+   one level's error about the geometric model (the erratic factor above: an edge's position between two
+   points) that two ratios cannot resolve.  Where that exceeds the guarded bound below, which holds
+   without the geometric model, the guarded bound is the estimate: Richardson only ever sharpens it.
+2. **The guarded bound** wherever the two ratios disagree, one difference vanished, or the sequence does
+   not contract ("where two successive differences disagree in rate, the estimate says so and takes the
+   larger"): the rate is the larger of the ratios held to ``[RATE_FLOOR, RATE_CAP]`` (never faster than
+   first order, and a sequence not contracting by ``RATE_CAP`` is taken as contracting by it), and the
+   size of the next differences is the envelope ``D = max_i |d_(k-i)| ENVELOPE^i`` with ``ENVELOPE =
+   1/2``: the last difference, or an earlier one shrunk at first order, whichever is larger, so that a
+   last difference that vanished by coincidence (a symmetric cell gives the same fraction on two grids; a
+   count of points whose constant jumps with the edges) is bounded by the ones before it.  The estimate
+   is the geometric tail ``D rho / (1 - rho)``.
+
+Levels double the points per direction (:data:`GROWTH`): close enough that three differences cost little
+more than the finest level (2D: twice the finest; 3D: 4/3 of it).
 
 Its effectivity (estimate over the true error of the reported level) is measured by
 ``scripts/spectral_effectivity.py`` on Westergaard's sinusoid, a random 2D profile and a 3D bisinusoid
-against each cell's own value on a much finer grid (``docs/benchmarks.md``): the floor of the rate
-makes it at least 1 where the error follows its envelope; it exceeds 10 where the reported level's error
-happens to cross zero, or where the sequence leaves a pre-asymptotic stretch for a much faster regime (the
-2D edge fit once its window holds enough points): no estimate from differences can see either.  First
-order in both the rate's floor and the envelope is the only safety factor: it is the slowest convergence of
-any estimated quantity (the counted 3D contact fraction, pre-asymptotic on coarse grids), so an estimate
-meant to bound every quantity can assume nothing faster.
+against each cell's own value on a much finer grid (``docs/benchmarks.md``).  No estimate from the levels
+up to ``k`` can be sharp where the error of level ``k`` itself is small by chance: where it crosses zero
+between two grids, or where the sequence leaves a pre-asymptotic stretch for a much faster regime (the 2D
+edge fit once its window holds enough points, :mod:`ngcontact.cell.spectral.grid_measures`), the
+differences up to level ``k`` still carry the size of the earlier errors, and the estimate exceeds the
+error by their ratio.
 
 A stop needs ``MIN_LEVELS`` levels (three differences: the window).  The levels are known before the first
 solve (``grid`` times ``GROWTH^k`` up to ``max_points``, :func:`levels`; the scene layer bounds
@@ -70,25 +78,35 @@ GROWTH = 2
 #: the differences the estimate looks at, and the fewest levels a stop needs
 WINDOW = 3
 MIN_LEVELS = WINDOW + 1
-#: the slowest and the fastest contraction per level the estimate assumes (module docstring)
+#: the slowest and the fastest contraction per level the guarded bound assumes (module docstring)
 RATE_FLOOR = 0.5
 RATE_CAP = 0.7
-#: an earlier difference shrinks by this per level in the envelope (first order in the grid step)
+#: an earlier difference shrinks by this per level in the guarded envelope (first order in the grid step)
 ENVELOPE = 0.5
 #: a last difference this many times below the envelope is said to have vanished (a remark only)
 VANISHED = 4.0
+#: two successive ratios within this factor of each other make the sequence geometric (Richardson)
+AGREE = 3.0
+#: the fastest contraction per level Richardson may assume: each quantity's own order in the grid step
+ORDER_RATE = {"contact_fraction": 0.5, "mean_closure": 0.25}
+#: Richardson's tail times this: the scatter of one level's error about the geometric model
+SPREAD = 2.0
 #: the quantities estimated: whether the measure is relative
 QUANTITIES = {"contact_fraction": False, "mean_closure": True}
+#: the two forms of the estimate, as the report names them
+RICHARDSON, GUARDED = "Richardson", "guarded"
 #: how the estimate is made, for the report
-HOW = ("grids of twice the points per direction each; per quantity the geometric tail of the last "
-       f"{WINDOW} differences, rate the larger successive ratio held to [{RATE_FLOOR}, {RATE_CAP}], "
-       "an earlier difference bounding a vanished last one")
+HOW = ("grids of twice the points per direction each; per quantity and load, Richardson with the observed rate "
+       f"of the last {WINDOW} differences where their two ratios agree within a factor {AGREE:g} (rate at least "
+       f"{ORDER_RATE['contact_fraction']} for the contact fraction, {ORDER_RATE['mean_closure']} for the mean "
+       f"closure, the tail times {SPREAD:g}) if that is the smaller, else the guarded geometric tail: rate the "
+       f"larger ratio held to [{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished last one")
 
 
 @dataclass
 class RefinedSweep:
     """The finest level's cell and solutions, the estimate per load, the history of levels, whether the
-    tolerance is met, and the estimate's remarks (guards that acted) per load."""
+    tolerance is met, the estimate's remarks (its forms, guards that acted) and its form per load."""
 
     cell: Any
     solutions: list
@@ -96,6 +114,8 @@ class RefinedSweep:
     history: list[dict[str, Any]] = field(default_factory=list)
     met: bool = True
     remarks: list[str] = field(default_factory=list)
+    #: per load, the form of each quantity's estimate (:data:`RICHARDSON` or :data:`GUARDED`)
+    forms: list[dict[str, str]] = field(default_factory=list)
 
     @property
     def estimate(self) -> float:
@@ -107,36 +127,69 @@ def next_grid(grid: int, dim: int) -> int:
     return grid * GROWTH
 
 
-def tail_estimate(values: list[float], relative: bool) -> tuple[float, str]:
-    """The estimated error of the last of ``values`` (a quantity on successive levels; module docstring)
-    and a remark where a guard acted ("" otherwise).  Needs two values at least."""
-    d = [abs(b - a) for a, b in zip(values[:-1], values[1:])][::-1][:WINDOW]
+def differences(values: list[float], relative: bool) -> list[float]:
+    """The sizes of the last ``WINDOW`` differences of ``values``, the newest first, in the estimate's measure."""
+    scale = abs(values[-1]) if relative and values[-1] != 0 else 1.0
+    return [abs(b - a) / scale for a, b in zip(values[:-1], values[1:])][::-1][:WINDOW]
+
+
+def richardson(d: list[float], order_rate: float) -> tuple[float, float] | None:
+    """Richardson's estimate from the differences ``d`` (newest first) and its rate, where the window's two
+    ratios agree (module docstring); ``None`` where they do not."""
+    if len(d) < WINDOW or min(d[1:]) <= 0:
+        return None
+    ratios = [d[i] / d[i + 1] for i in range(WINDOW - 1)]
+    if min(ratios) <= 0 or max(ratios) > RATE_CAP or max(ratios) > AGREE * min(ratios):
+        return None
+    rate = max(max(ratios), order_rate)
+    return SPREAD * d[0] * rate / (1.0 - rate), rate
+
+
+def guarded_bound(d: list[float]) -> tuple[float, str]:
+    """The guarded geometric tail from the differences ``d`` (newest first; module docstring) and a remark
+    where a guard acted ("" otherwise)."""
     ratios = [d[i] / d[i + 1] for i in range(len(d) - 1) if d[i + 1] > 0]
     observed = max(ratios) if ratios else RATE_CAP
     rate = min(max(observed, RATE_FLOOR), RATE_CAP)
     terms = [d[i] * ENVELOPE ** i for i in range(len(d))]
     envelope = max(terms)
-    scale = abs(values[-1]) if relative and values[-1] != 0 else 1.0
     remark = []
     if observed > RATE_CAP:
         remark.append(f"not contracting (ratio {observed:.2g}): rate {RATE_CAP}")
     if envelope > VANISHED * terms[0]:
         remark.append("the last difference nearly vanished: an earlier one bounds it")
-    return envelope * rate / (1.0 - rate) / scale, "; ".join(remark)
+    return envelope * rate / (1.0 - rate), "; ".join(remark)
 
 
-def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float]], list[str]]:
-    """Per load the estimate of each quantity on the last level of ``history``, and the remarks."""
-    estimates, remarks = [], []
+def tail_estimate(values: list[float], relative: bool, order_rate: float = RATE_FLOOR) -> tuple[float, str, str]:
+    """The estimated error of the last of ``values`` (a quantity on successive levels; module docstring), its
+    form (:data:`RICHARDSON` where that is the smaller, else :data:`GUARDED`) and a remark on it.  Needs two
+    values at least; ``order_rate`` is the quantity's :data:`ORDER_RATE`."""
+    d = differences(values, relative)
+    fitted = richardson(d, order_rate)
+    estimate, remark = guarded_bound(d)
+    if fitted is None or fitted[0] >= estimate:
+        return estimate, GUARDED, remark
+    return fitted[0], RICHARDSON, f"rate {fitted[1]:.2g}"
+
+
+def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float]], list[str], list[dict[str, str]]]:
+    """Per load the estimate of each quantity on the last level of ``history``, the remarks (which estimates
+    are Richardson's, the guards that acted) and per load the form of each estimate."""
+    estimates, forms, guarded = [], [], []
     for k in range(len(history[-1]["contact_fraction"])):
-        out, notes = {}, []
+        out, form = {}, {}
         for name, relative in QUANTITIES.items():
-            out[name], note = tail_estimate([h[name][k] for h in history], relative)
-            if note:
-                notes.append(f"load {k} {name}: {note}")
+            out[name], form[name], note = tail_estimate([h[name][k] for h in history], relative, ORDER_RATE[name])
+            if form[name] == GUARDED:
+                guarded.append(f"load {k} {name}" + (f": {note}" if note else ""))
         estimates.append(out)
-        remarks.extend(notes)
-    return estimates, remarks
+        forms.append(form)
+    total = len(forms) * len(QUANTITIES)
+    remarks = [f"Richardson on {total - len(guarded)} of {total} estimates"]
+    if guarded:
+        remarks.append("guarded on " + ", ".join(guarded))
+    return estimates, remarks, forms
 
 
 def levels(grid: int, dim: int, max_points: int) -> list[int]:
@@ -179,13 +232,14 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
     for n in grids:
         cell, sols, entry = solve_level(make_cell, loads, n)
         history.append(entry)
-        estimates, remarks = sweep_estimates(history) if len(history) > 1 else (None, [])
+        estimates, remarks, forms = sweep_estimates(history) if len(history) > 1 else (None, [], [])
         if estimates is not None:
             entry["estimate"] = max(max(e.values()) for e in estimates)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
                       f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
         if estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance:
-            return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, remarks=remarks)
+            return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, remarks=remarks,
+                                forms=forms)
     reached = f"{entry['estimate']:.3g}" if estimates is not None else "no estimate (one level)"
     message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on {entry['points']} "
                f"grid points, and the next grid of {next_grid(grids[-1], dim)} per direction would exceed "
@@ -195,4 +249,4 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
     if estimates is None:
         estimates = [{name: float("inf") for name in QUANTITIES} for _ in sols]
     return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, met=False,
-                        remarks=remarks + [message])
+                        remarks=remarks + [message], forms=forms)
