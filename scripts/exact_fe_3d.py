@@ -4,7 +4,7 @@ Two measurements, one run, one CSV and one PNG:
 
 1. **Westergaard's waves in a 3D cell.**  The gap ``2h sin^2(pi x)``
    (``h = 0.01``, period 1) does not depend on ``y``, so the 3D cell is in
-   plane strain and its contact fraction is Westergaard's (DESIGN Sec. 8).
+   plane strain and its contact fraction is Westergaard's (ngcontact.verification.westergaard).
    Bodies 1 deep, ``E = 1``, ``nu = 0.3``, loads ``p/p* = 0.2, 0.8``,
    refining the interface mesh and with it the bodies' (``maxh`` twice the
    interface's: order-1 bodies kept coarse stall the error at 5-6 %): exact enforcement at order 1 (what is built

@@ -36,7 +36,7 @@ energy of the bodies is the integral over ``S_C`` of
   maximum.
 
 * exact non-penetration by an augmented Lagrangian (the rigid limit
-  ``k_n -> infinity`` of the Winkler layer; not in the paper, DESIGN 7a):
+  ``k_n -> infinity`` of the Winkler layer; not in the paper):
   with a multiplier ``lambda >= 0`` held fixed, the normal energy is::
 
       psi_n(J; lambda) = (1 / (2 k)) ([lambda + k (J_n - g)]_+^2 - lambda^2),

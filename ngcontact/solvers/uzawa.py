@@ -1,7 +1,7 @@
 """Uzawa's iteration for an augmented Lagrangian, written once for any constraint.
 
 Exact non-penetration ``J_n - g <= 0`` (the rigid limit of the paper's
-Winkler layer, eqs. 7, 9 and 65 with ``k_n -> infinity``; DESIGN 7a) is the
+Winkler layer, eqs. 7, 9 and 65 with ``k_n -> infinity``) is the
 saddle point of the elastic energy and the multiplier term.  With the
 augmented energy of :func:`ngcontact.laws.penalty.augmented_normal_energy`
 Uzawa's iteration alternates

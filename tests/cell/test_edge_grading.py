@@ -1,6 +1,6 @@
 """Meshes graded towards the contact edges until a tolerance is met (ngcontact.cell.fe.edge_grading).
 
-Westergaard's sinusoid (DESIGN Sec. 8) is the oracle: its contact half-width
+Westergaard's sinusoid (oracle: ngcontact/verification/westergaard.py) is the oracle: its contact half-width
 ``a`` with ``sin^2(pi a) = p/p*`` is known in closed form.  The penalty
 ``k_n = 1e6 E`` is near-rigid: its own shift of the contact fraction
 (~1e-6) stays below the errors compared here.

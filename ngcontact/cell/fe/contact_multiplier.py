@@ -3,8 +3,7 @@
 With ``contact.enforcement = "exact"`` the cell problem (paper eqs. 49-51,
 57 and 65, :mod:`ngcontact.cell.fe.cell_problem`) keeps the bodies from
 overlapping instead of resisting the overlap with the Winkler layer
-``k_n [J_n - g]_+`` of eq. 65, the rigid limit ``k_n -> infinity``
-(DESIGN 7a).  Its contact energy is the augmented Lagrangian of
+``k_n [J_n - g]_+`` of eq. 65, the rigid limit ``k_n -> infinity``.  Its contact energy is the augmented Lagrangian of
 :func:`ngcontact.laws.penalty.augmented_normal_energy`,
 
     psi_n(J; lambda) = (1/(2k)) ([lambda + k (J_n - g)]_+^2 - lambda^2),

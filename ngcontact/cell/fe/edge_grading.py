@@ -2,7 +2,7 @@
 
 Near the edge ``a`` of a smooth contact patch the pressure behaves like
 ``sqrt(a - x)`` and the gap like ``(x - a)^(3/2)`` (the edge of Hertz and
-Westergaard contact, DESIGN Sec. 8): polynomials on a uniform mesh resolve
+Westergaard contact, ngcontact.verification.westergaard): polynomials on a uniform mesh resolve
 neither, and the contact fraction of the cell (paper Sec. 3.2.2, the real
 contact set of eq. 34) converges slowly and not monotonically under uniform
 refinement.  A mesh whose interface vertices crowd geometrically towards the

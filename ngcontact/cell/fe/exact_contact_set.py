@@ -17,7 +17,7 @@ elements around a touching node.  Between two closed nodes the surfaces are in
 contact, between two open ones they are not; between a closed node ``x_c``
 and an open one ``x_o`` lies a contact edge.  Beyond a smooth edge ``a``
 the opening grows like ``(x - a)^(3/2)`` (the Westergaard and Hertz edge,
-DESIGN 8), so ``opening^(2/3)`` is nearly linear there: the edge is the
+:mod:`ngcontact.verification.westergaard`), so ``opening^(2/3)`` is nearly linear there: the edge is the
 root of the line through ``opening^(2/3)`` at ``x_o`` and the next open
 node beyond it, kept between ``x_c`` and ``x_o``.  A closed node whose
 neighbours are both open holds a patch narrower than the node spacing:
@@ -77,8 +77,8 @@ def edge_fraction(lam_c, opening_o, length, estar) -> np.ndarray:
     closed one.
 
     At a smooth edge the pressure grows like ``A sqrt(d)`` inside and the
-    gap like ``(4 A / (3 E*)) d^(3/2)`` outside (the 2D Hertz edge, DESIGN
-    Sec. 8; with ``E*`` of the two bodies).  With ``lambda_c`` at distance
+    gap like ``(4 A / (3 E*)) d^(3/2)`` outside (the 2D Hertz edge of
+    :mod:`ngcontact.verification.hertz`; with ``E*`` of the two bodies).  With ``lambda_c`` at distance
     ``t L`` inside and the opening ``g_o`` at ``(1 - t) L`` outside, ``A``
     cancels: ``(1 - t)^(3/2) / t^(1/2) = 3 E* g_o / (4 lambda_c L)``, whose
     left side falls from infinity to 0 on ``(0, 1)``: one root, found by
