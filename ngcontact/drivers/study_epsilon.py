@@ -26,6 +26,13 @@ Each level is solved twice, on the scene's discretization and on one refined by
 interface) are the refined pair's, and beside each the estimate of its
 discretization error, the change between the two pairs.
 
+On blocks (``S_0`` the line ``y = 0``) the bundle law's solution is also rebuilt on the resolved bodies by
+the first-order corrector ``u^0 + eps u^1``
+(:class:`~ngcontact.coupling.first_order_corrector.FirstOrderCorrector`, its boundary layer from the station
+cells of :mod:`ngcontact.drivers.boundary_layer_cells`), and the row carries the L2 error over each whole
+body and the interior H1 error without and with it (``l2``, ``h1``, ``*_corrected``,
+:mod:`ngcontact.drivers.modelling_error`), each with its discretization estimate and fitted by the same rule.
+
 The levels are independent solves: a batch (:mod:`ngcontact.parallel.executor`)
 spreads them over the run's workers, so the wall times of a level are
 measured while the other workers run too.
