@@ -45,6 +45,11 @@ jump (the term the effective-stiffness law of :mod:`ngcontact.cell.fe.stiffness`
 problem), a correction of the macro solution, not of the layer.  ``u^1`` decays exponentially with
 ``|y - y_0| / eps``: away from a layer of a few periods it changes no norm beyond ``exp(-c)``, and on a
 probe outside the layer it changes nothing.
+
+The bound over ``Omega_B^delta`` holds with a constant of the region: when ``delta = c eps`` shrinks with
+``eps`` the region grows towards ``S_0``, where the error is largest, and the ratio of two levels reads as
+a rate below one until ``delta`` is small against the body; over one fixed region (the epsilon study's
+``h1``, :mod:`ngcontact.drivers.modelling_error`) the rate is the table's.
 """
 from __future__ import annotations
 
