@@ -33,9 +33,25 @@ Errors of a homogenized solution against the resolved solution ``u^eps`` (:func:
 * ``interface``: ``|F_h - F^eps| / |F^eps|`` of the force transmitted through a part of the interface,
   an interface resultant that equilibrium does not fix: blocks, the left half ``x < x0 + L/2``; femur,
   the axial force through the cylindrical part ``z > z_corner`` (the rest goes through the cone).
+
+Where ``S_0`` is the line ``y = 0`` (blocks; :func:`body_sampling`), also the norms of the first-order
+corrector's table (:mod:`ngcontact.coupling.first_order_corrector`):
+
+* ``l2``: relative L2 error over each whole resolved body (the larger of the two), the layer
+  ``|y| < band * eps`` included: the far points of ``field`` plus a grid of the layer fine enough to
+  resolve the roughness (``16`` columns a period, ``64`` rows across the layer), each point of the body the
+  resolved mesh puts it in;
+* ``h1``: relative H1 seminorm error ``||grad(u_h - u^eps)|| / ||grad u^eps||`` over both bodies outside
+  the band of the study's coarsest level and farther than a quarter of the smallest block dimension from
+  the blocks' outer faces (one interior region for every level: the corners of the outer faces, where
+  the supports meet the free sides, carry stress singularities whose discretization error would swamp
+  the modelling error in this norm);
+* ``l2_corrected``, ``h1_corrected``, ``probe_corrected``: the same of ``u^0 + eps u^1`` (the bundle
+  law's solution with its corrector).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import ngsolve as ng
@@ -44,11 +60,13 @@ import numpy as np
 from ngcontact.drivers import run_resolved as drv
 from ngcontact.fem import elasticity
 from ngcontact.fem.quadrature import resultant_order
+from ngcontact.geometry import resolved_shapes as rs
 from ngcontact.macro import macro_measures as MM
 from ngcontact.macro import macro_problem as M
 from ngcontact.resolved import resolved_problem as D
 
-ERRORS = ("field", "reaction", "moment", "probe", "interface")
+ERRORS = ("field", "reaction", "moment", "probe", "interface", "l2", "h1", "l2_corrected", "h1_corrected",
+          "probe_corrected")
 #: what each error measures (the report's ``error_definitions``)
 DEFINITIONS = dict(zip(ERRORS, (
     "relative L2 displacement error outside the band of half-width band * eps around S_0",
@@ -56,7 +74,15 @@ DEFINITIONS = dict(zip(ERRORS, (
     "largest relative error of a support's reaction moment",
     "largest displacement error at the probes / largest resolved probe displacement",
     "relative error of the force through a part of the interface (blocks: x < x0 + L/2; femur: axial force "
-    "through the cylinder z > z_corner)")))
+    "through the cylinder z > z_corner)",
+    "relative L2 displacement error over each whole resolved body, the layer included (the larger of the two)",
+    "relative H1 seminorm error outside the band of the coarsest level",
+    "l2 of the homogenized solution plus its first-order corrector",
+    "h1 of the homogenized solution plus its first-order corrector",
+    "probe of the homogenized solution plus its first-order corrector (probes lie outside the layer)")))
+
+#: the layer grid: columns per period and rows across the layer
+LAYER_COLUMNS, LAYER_ROWS = 16, 64
 
 
 def interface_force(sol: D.DirectSolution | M.MacroSolution, part=None) -> np.ndarray:
@@ -124,8 +150,9 @@ def measures(scene, sol: D.DirectSolution | M.MacroSolution, points: np.ndarray,
             "field": displacement_at(sol, points, body)}
 
 
-def errors(ref: dict, other: dict, weights: np.ndarray) -> dict:
-    """Relative errors of ``other`` against the resolved ``ref`` (see the module docstring)."""
+def errors(ref: dict, other: dict, weights: np.ndarray, sampling: BodySampling | None = None) -> dict:
+    """Relative errors of ``other`` against the resolved ``ref`` (see the module docstring); with a
+    ``sampling`` and measures that carry the layer values, ``l2`` and ``h1`` too (:func:`body_errors`)."""
     diff = other["field"] - ref["field"]
     field = np.sqrt(np.sum(weights[:, None] * diff ** 2) / np.sum(weights[:, None] * ref["field"] ** 2))
     force, moment, has_moment = 0.0, 0.0, False
@@ -147,6 +174,8 @@ def errors(ref: dict, other: dict, weights: np.ndarray) -> dict:
     if len(ref["probes"]):
         out["probe"] = float(np.max(np.linalg.norm(other["probes"] - ref["probes"], axis=1))
                              / np.max(np.linalg.norm(ref["probes"], axis=1)))
+    if sampling is not None and "layer" in ref and "layer" in other:
+        out.update(body_errors(ref, other, weights, sampling))
     return out
 
 
@@ -159,7 +188,7 @@ def combine(fn: Callable[..., Any], *trees):
 
 
 def discretization_errors(resolved: dict, homogenized: dict, resolved_fine: dict, homogenized_fine: dict,
-                          weights: np.ndarray) -> dict:
+                          weights: np.ndarray, sampling: BodySampling | None = None) -> dict:
     """The estimate ``delta = |e_h - e_(h/r)|`` of each error (module docstring), relative to the refined
     resolved solution's size, as :func:`errors` measures it.
 
@@ -169,4 +198,95 @@ def discretization_errors(resolved: dict, homogenized: dict, resolved_fine: dict
     """
     shifted = combine(lambda r, h, rf, hf: rf + (h - r) - (hf - rf), resolved, homogenized, resolved_fine,
                       homogenized_fine)
-    return errors(resolved_fine, shifted, weights)
+    return errors(resolved_fine, shifted, weights, sampling)
+
+
+@dataclass(frozen=True)
+class BodySampling:
+    """The points of the norms over each whole body (``l2``) and away from the layer (``h1``).
+
+    ``far_*``: the points of ``field`` (outside the band), each body by its side of ``S_0``; ``layer_*``: a
+    grid of the layer ``|y| < width``, whose resolved bodies (``layer_body``) each resolved mesh gives;
+    ``h1_*``: the points outside the coarsest level's band and away from the outer faces.
+    """
+
+    far_body: np.ndarray
+    far_weights: np.ndarray
+    layer_points: np.ndarray
+    layer_weights: np.ndarray
+    h1_points: np.ndarray
+    h1_weights: np.ndarray
+    h1_body: np.ndarray
+    width: float
+    layer_body: np.ndarray | None = None
+
+
+def body_sampling(scene, eps: float, h1_band: float) -> BodySampling | None:
+    """The :class:`BodySampling` of a level of period ``eps`` on blocks (``S_0`` the line ``y = 0``); ``None``
+    on other shapes (the layer grid follows a straight ``S_0``)."""
+    shape = drv.shape_of(scene)
+    if not isinstance(shape, rs.Blocks):
+        return None
+    width = scene.study.band * eps
+    far, far_w, far_b = sample_grid(scene, width)
+    nx = LAYER_COLUMNS * int(round(shape.length / eps))
+    xs = shape.x0 + (np.arange(nx) + 0.5) * shape.length / nx
+    ys = -width + (np.arange(LAYER_ROWS) + 0.5) * 2.0 * width / LAYER_ROWS
+    X, Y = np.meshgrid(xs, ys)
+    layer = np.column_stack([X.ravel(), Y.ravel()])
+    layer_w = np.full(len(layer), shape.length / nx * 2.0 * width / LAYER_ROWS)
+    if scene.geometry.setting == "axisymmetric":
+        layer_w = layer_w * 2.0 * np.pi * layer[:, 0]
+    h1, h1_w, h1_b = sample_grid(scene, h1_band)
+    margin = 0.25 * min(shape.length, shape.h_rough, shape.h_counter)
+    inner = (h1[:, 0] > shape.x0 + margin) & (h1[:, 0] < shape.x0 + shape.length - margin) & \
+        (h1[:, 1] > -shape.h_rough + margin) & (h1[:, 1] < shape.h_counter - margin)
+    h1, h1_w, h1_b = h1[inner], h1_w[inner], h1_b[inner]
+    return BodySampling(far_body=far_b, far_weights=far_w, layer_points=layer, layer_weights=layer_w,
+                        h1_points=h1, h1_weights=h1_w, h1_body=h1_b, width=width)
+
+
+def resolved_body(mesh: ng.Mesh, points: np.ndarray) -> np.ndarray:
+    """Body of each point in a resolved mesh (0 rough, 1 counter): the region of the element it lies in."""
+    counter = mesh.MaterialCF({"counter": 1.0}, default=0.0)
+    return np.rint(np.asarray(counter(mesh(points[:, 0], points[:, 1]))).ravel()).astype(int)
+
+
+def gradient_at(sol, points: np.ndarray, body: np.ndarray) -> np.ndarray:
+    """Displacement gradient at ``points`` (shape ``(m, 2, 2)``), each from the field of its ``body``."""
+    mesh = sol.problem.mesh
+    out = np.zeros((len(points), 2, 2))
+    for b, u in enumerate((sol.u_rough, sol.u_counter)):
+        mask = body == b
+        if np.any(mask):
+            out[mask] = np.asarray(ng.Grad(u)(mesh(points[mask, 0], points[mask, 1]))).reshape(-1, 2, 2)
+    return out
+
+
+def layer_measures(sol, sampling: BodySampling, layer_body: np.ndarray | None = None) -> dict:
+    """The layer values and the gradients away from the layer of one solution: resolved (``layer_body``
+    given: each point from the body it lies in) or homogenized (each point from its side of ``S_0``)."""
+    body = layer_body if layer_body is not None else (sampling.layer_points[:, 1] > 0).astype(int)
+    return {"layer": displacement_at(sol, sampling.layer_points, body),
+            "gradient": gradient_at(sol, sampling.h1_points, sampling.h1_body)}
+
+
+def body_errors(ref: dict, other: dict, weights: np.ndarray, sampling: BodySampling) -> dict:
+    """``l2`` and ``h1`` of ``other`` against the resolved ``ref`` (module docstring)."""
+    far, layer = other["field"] - ref["field"], other["layer"] - ref["layer"]
+    lb = sampling.layer_body if sampling.layer_body is not None else (sampling.layer_points[:, 1] > 0)
+    l2 = 0.0
+    for b in (0, 1):
+        fm, lm = sampling.far_body == b, lb == b
+
+        def norm2(f, g):
+            return float(np.sum(weights[fm, None] * f[fm] ** 2) + np.sum(sampling.layer_weights[lm, None]
+                                                                        * g[lm] ** 2))
+
+        l2 = max(l2, np.sqrt(norm2(far, layer) / norm2(ref["field"], ref["layer"])))
+    out = {"l2": float(l2)}
+    if len(sampling.h1_weights):
+        dg = other["gradient"] - ref["gradient"]
+        w = sampling.h1_weights[:, None, None]
+        out["h1"] = float(np.sqrt(np.sum(w * dg ** 2) / np.sum(w * ref["gradient"] ** 2)))
+    return out

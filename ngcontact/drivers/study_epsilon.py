@@ -26,6 +26,13 @@ Each level is solved twice, on the scene's discretization and on one refined by
 interface) are the refined pair's, and beside each the estimate of its
 discretization error, the change between the two pairs.
 
+On blocks (``S_0`` the line ``y = 0``) the bundle law's solution is also rebuilt on the resolved bodies by
+the first-order corrector ``u^0 + eps u^1``
+(:class:`~ngcontact.coupling.first_order_corrector.FirstOrderCorrector`, its boundary layer from the station
+cells of :mod:`ngcontact.drivers.boundary_layer_cells`), and the row carries the L2 error over each whole
+body and the interior H1 error without and with it (``l2``, ``h1``, ``*_corrected``,
+:mod:`ngcontact.drivers.modelling_error`), each with its discretization estimate and fitted by the same rule.
+
 The levels are independent solves: a batch (:mod:`ngcontact.parallel.executor`)
 spreads them over the run's workers, so the wall times of a level are
 measured while the other workers run too.
@@ -55,12 +62,13 @@ from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
 from ngcontact.macro import macro_measures as MM
 from ngcontact.coupling.cell_law import bundle_law
+from ngcontact.coupling.first_order_corrector import FirstOrderCorrector
 from ngcontact.drivers import modelling_error as E
+from ngcontact.drivers.boundary_layer_cells import boundary_layer, scaled_cell_problem
 from ngcontact.drivers import run_resolved as drv
 from ngcontact.output import plots
 from ngcontact.geometry.profiles import profile_cell
 from ngcontact.errors import SceneError
-from ngcontact.geometry.resolved_bodies import scaled_profile
 from ngcontact.cell.coefficients import direction_bundle
 from ngcontact.output.report import Outcome
 from ngcontact.verification.rates import fit_rate
@@ -98,22 +106,10 @@ def effective_law(scene, eps: float, mean_traction) -> tuple[il.LinearLaw, dict]
         counter body on ``S_0`` (compression positive), the cell's load.
     """
     from ngcontact.cell.cell_load import cell_load
-    from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
-    cell_scene = scene.cell_scene
-    g, d = cell_scene.geometry, cell_scene.discretization
-    s = eps / g.period
-    kw = drv.micro_law(cell_scene)
-    cell = profile_cell(scaled_profile(drv.profile_of(cell_scene), eps), h_rough=s * g.h_rough,
-                        h_counter=s * g.h_counter, maxh=s * d.maxh,
-                        interface_maxh=s * (d.interface_maxh or d.maxh), order=d.order)
-    mats = drv.materials_of(scene)
-    model = CellModel(rough=mats["rough"], counter=mats["counter"], k_n=kw["k_n"],
-                      gap=None if kw["gap"] is None else ng.CF(kw["gap"]), friction=kw["friction"],
-                      order=scene.discretization.order)
     tau_n, tau_t = (float(v) for v in mean_traction)
     if not tau_n > 0:
         raise ValueError(f"mean interface pressure {tau_n!r} <= 0: the cell has no load state in contact")
-    prob = CellProblem(cell, model, rtol=scene.solver.rtol, max_iter=scene.solver.max_iter)
+    prob = scaled_cell_problem(scene, eps)
     sol = prob.sweep([cell_load(2, pressure=tau_n, shear=(-tau_t,))])[0]
     eff = sol.results["effective_stiffness"]
     K = np.asarray(eff["matrix"], float)
@@ -171,15 +167,41 @@ def refined(scene, factor: float):
     return new
 
 
-def solve_pair(scene, N: int, bundle: il.BundleLaw, laws, points, body) -> dict[str, Any]:
+def corrected_measures(scene, sol: M.MacroSolution, N: int, homogenized: dict, sampling: E.BodySampling,
+                       resolved_mesh) -> dict:
+    """The measures of ``u^0 + eps u^1`` (:class:`~ngcontact.coupling.first_order_corrector.FirstOrderCorrector`
+    of the homogenized ``sol``, its boundary layer from the station cells of
+    :func:`ngcontact.drivers.boundary_layer_cells.boundary_layer`) at the points of the resolved bodies: the
+    layer's and the probes' values; the far field and the gradients away from the layer are
+    ``homogenized``'s (the corrector is ``u^0`` there)."""
+    corrector = FirstOrderCorrector(sol, drv.eps_of(scene, N), sampling.width, layer=boundary_layer(scene, sol, N))
+    out = dict(homogenized)
+    out["layer"] = corrector.at(sampling.layer_points, sampling.layer_body)
+    if len(homogenized["probes"]):
+        pts = np.asarray(scene.study.probes, float).reshape(-1, 2)
+        out["probes"] = corrector.at(pts, E.resolved_body(resolved_mesh, pts))
+    return out
+
+
+def solve_pair(scene, N: int, bundle: il.BundleLaw, laws, points, body,
+               sampling: E.BodySampling | None = None) -> dict[str, Any]:
     """The resolved run with ``N`` periods and the homogenized runs on one discretization: their measures
-    (:func:`ngcontact.drivers.modelling_error.measures`), unknowns, seconds and the effective law's record."""
+    (:func:`ngcontact.drivers.modelling_error.measures`), unknowns, seconds and the effective law's record.
+
+    With a ``sampling`` (:func:`ngcontact.drivers.modelling_error.body_sampling`) each solution also carries
+    its layer values and gradients (:func:`~ngcontact.drivers.modelling_error.layer_measures`), ``out``
+    the resolved bodies of the layer points (``layer_body``), and the bundle law's corrected solution its
+    measures (``laws["bundle_corrected"]``, :func:`corrected_measures`)."""
     t0 = time.perf_counter()
     geo = drv.build_resolved(scene, N)
     ref_sol = drv.solve_scene(scene, drv.problem_of(scene, geo))
     out: dict[str, Any] = {"resolved": E.measures(scene, ref_sol, points, body), "ndof_resolved": ref_sol.ndof,
                            "time_resolved": time.perf_counter() - t0, "laws": {},
                            "contact_fraction_resolved": D.contact_fraction(ref_sol, drv.interface_length(scene))}
+    if sampling is not None:
+        sampling = replace(sampling, layer_body=E.resolved_body(geo.mesh, sampling.layer_points))
+        out["layer_body"] = sampling.layer_body
+        out["resolved"].update(E.layer_measures(ref_sol, sampling, sampling.layer_body))
     t0 = time.perf_counter()
     flat = drv.build_flat(scene, scene.study.interface_maxh)
     t_mesh = time.perf_counter() - t0
@@ -201,25 +223,44 @@ def solve_pair(scene, N: int, bundle: il.BundleLaw, laws, points, body) -> dict[
             bundle_sol = sol
             out["ndof_homogenized"] = sol.ndof
         out["laws"][name] = E.measures(scene, sol, points, body)
+        if sampling is not None:
+            out["laws"][name].update(E.layer_measures(sol, sampling))
+            if name == "bundle":
+                out["laws"]["bundle_corrected"] = corrected_measures(scene, sol, N, out["laws"][name], sampling,
+                                                                     geo.mesh)
     return out
 
 
-def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS) -> dict:
+def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS, h1_band: float | None = None) -> dict:
     """One level: the resolved and homogenized runs on the scene's discretization and on the refined one
-    (module docstring); a row with the refined pair's errors and each error's discretization estimate."""
+    (module docstring); a row with the refined pair's errors and each error's discretization estimate.
+
+    ``h1_band``: half-width of the layer the ``h1`` norms leave out (default: the band of the scene's
+    coarsest level), the same for every level."""
     st = scene.study
     eps = drv.eps_of(scene, N)
     points, weights, body = E.sample_grid(scene, st.band * eps)
-    coarse = solve_pair(scene, N, bundle, laws, points, body)
-    fine = solve_pair(refined(scene, st.refinement), N, bundle, laws, points, body)
+    if h1_band is None:
+        h1_band = st.band * drv.eps_of(scene, min(st.periods))
+    sampling = E.body_sampling(scene, eps, max(h1_band, st.band * eps))
+    coarse = solve_pair(scene, N, bundle, laws, points, body, sampling)
+    fine = solve_pair(refined(scene, st.refinement), N, bundle, laws, points, body, sampling)
+    if sampling is not None:
+        sampling = replace(sampling, layer_body=fine["layer_body"])
     row: dict[str, Any] = {"N": N, "eps": eps}
-    row.update({k: v for k, v in fine.items() if k not in ("resolved", "laws")})
+    row.update({k: v for k, v in fine.items() if k not in ("resolved", "laws", "layer_body")})
     row["time_homogenized"] = fine["time_bundle"] if "bundle" in laws else fine[f"time_{laws[0]}"]
     row["time_discretization_check"] = sum(v for k, v in coarse.items() if k.startswith("time_"))
-    for name in laws:
-        model = E.errors(fine["resolved"], fine["laws"][name], weights)
+    for name in [*laws, "bundle_corrected"]:
+        if name not in fine["laws"]:
+            continue
+        model = E.errors(fine["resolved"], fine["laws"][name], weights, sampling)
         check = E.discretization_errors(coarse["resolved"], coarse["laws"][name], fine["resolved"],
-                                        fine["laws"][name], weights)
+                                        fine["laws"][name], weights, sampling)
+        if name == "bundle_corrected":
+            name = "bundle"
+            model = {f"{k}_corrected": model[k] for k in ("l2", "h1", "probe") if k in model}
+            check = {f"{k}_corrected": check[k] for k in ("l2", "h1", "probe") if k in check}
         for key, value in model.items():
             row[f"{name}_{key}"] = value
             row[f"{name}_{key}_discretization"] = check[key]
@@ -230,9 +271,10 @@ def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS) -> dict:
 
 
 def level_member(job: tuple) -> dict:
-    """Member of the batch of levels (:mod:`ngcontact.parallel.executor`): ``(scene, N, bundle, laws)`` -> row."""
-    scene, N, bundle, laws = job
-    return level(scene, N, bundle, laws=laws)
+    """Member of the batch of levels (:mod:`ngcontact.parallel.executor`): ``(scene, N, bundle, laws, h1_band)``
+    -> row."""
+    scene, N, bundle, laws, h1_band = job
+    return level(scene, N, bundle, laws=laws, h1_band=h1_band)
 
 
 def per_error(rows: list, laws, summary) -> dict:
@@ -310,7 +352,8 @@ def run_study(scene, periods=None, *, laws=LAWS, clock=None) -> Outcome:
         raise SceneError("study.band", scene.study.band, f"the band of N = {min(periods)} covers both "
                          "bodies: no points are left for the field error; take a smaller band or more periods")
     bundle = cell_bundle(scene)
-    jobs = [(scene, N, bundle, tuple(laws)) for N in periods]
+    h1_band = scene.study.band * drv.eps_of(scene, min(periods))
+    jobs = [(scene, N, bundle, tuple(laws), h1_band) for N in periods]
     names = [f"N = {N}" for N in periods]
     with clock.stage("levels") if clock is not None else contextlib.nullcontext():
         rows = executor.current().map(level_member, jobs, names, label="epsilon levels")

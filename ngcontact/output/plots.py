@@ -21,7 +21,8 @@ def _pyplot():
 
 def epsilon_study(path: str, rows: list, laws) -> None:
     """Error against ``eps`` (field and reaction; thin dotted: the field error's discretization estimate, where
-    the rows carry it) and cost against ``eps``."""
+    the rows carry it; the bundle law's L2 error over the whole bodies without and with the first-order
+    corrector, where the rows carry it) and cost against ``eps``."""
     plt = _pyplot()
     eps = np.array([r["eps"] for r in rows])
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -31,6 +32,10 @@ def epsilon_study(path: str, rows: list, laws) -> None:
         if f"{name}_field_discretization" in rows[0]:
             ax[0].loglog(eps, [r[f"{name}_field_discretization"] for r in rows], "x:", color=color, lw=0.8,
                          label=f"{name}: field, discretization estimate")
+    for key, style in (("l2", "v-"), ("l2_corrected", "^-")):
+        if f"bundle_{key}" in rows[0]:
+            ax[0].loglog(eps, [r[f"bundle_{key}"] for r in rows], style, color="C3" if key == "l2" else "C4",
+                         label=f"bundle: {key} (whole bodies)")
     ax[0].loglog(eps, eps / eps[0] * rows[0]["bundle_field"], "k:", label="slope 1")
     ax[0].axhline(0.01, color="gray", lw=0.8)
     ax[0].set_xlabel("eps [m]")

@@ -27,6 +27,7 @@ from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.resolved_bodies import flat_blocks, resolved_blocks
 from ngcontact.fem.reaction import boundary_reaction
+from ngcontact.verification.rates import fit_rate
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BLOCK = os.path.join(ROOT, "geometries", "direct", "block_rect_valleys.toml")
@@ -162,6 +163,15 @@ def test_epsilon_study_script_writes_report_csv_and_plot_and_refuses_a_mesh_rate
                                                         "discretization estimate exceeds 0.1 of the error")
     assert res["rates"]["bundle"]["reaction"] >= 0.8 and res["rate_levels"]["bundle"]["reaction"] == [4, 8, 16]
     assert res["discretization"] == {"refinement": 2.0, "share": 0.1}
+    # the L2 error over each whole body: eps^(1/2) from the counter's teeth carrying the rough body's field
+    # (large enough to be fitted on these meshes); the first-order corrector gives them the counter's
+    # (ngcontact.coupling.first_order_corrector) and leaves a fraction of it
+    assert res["rate_levels"]["bundle"]["l2"] == [4, 8, 16] and res["rates"]["bundle"]["l2"] < 0.7, res["rates"]
+    assert all(r["bundle_l2_corrected"] < 0.5 * r["bundle_l2"] for r in rows), rows
+    # the corrected error is small enough for these meshes' share to exceed a tenth: refused, though its
+    # raw slope is already about 1 (the shipped scene's meshes fit it: the slow test below)
+    assert res["rates"]["bundle"]["l2_corrected"] is None and "l2_corrected" in res["refused"]["bundle"]
+    assert fit_rate([r["eps"] for r in rows], [r["bundle_l2_corrected"] for r in rows]) >= 0.9
     finest = rows[-1]
     for key in ("field", "reaction", "moment", "interface", "probe"):
         assert finest[f"bundle_{key}"] < finest[f"linear_{key}"], (key, finest)
@@ -175,6 +185,7 @@ def test_epsilon_study_script_writes_report_csv_and_plot_and_refuses_a_mesh_rate
     assert (out / "epsilon.png").stat().st_size > 0
     header = (out / "epsilon.csv").read_text().splitlines()[0].split(",")
     assert "bundle_reaction" in header and "effective_field" in header and "bundle_field_discretization" in header
+    assert "bundle_l2_corrected" in header and "bundle_h1_corrected_discretization" in header
 
 
 @pytest.mark.slow
@@ -187,3 +198,7 @@ def test_the_shipped_block_study_rests_on_meshes_that_are_a_small_share_of_its_e
     assert all(r["bundle_field_discretization"] < 0.12 * r["bundle_field"] for r in rows), rows
     # the linear whole-surface law does not converge: its moment error stays put
     assert rates["linear"]["moment"] < 0.3, rates["linear"]
+    # the first-order corrector: L2 over each whole body and H1 in the interior at rate 1 (eps^(1/2) without)
+    for key in ("l2_corrected", "h1", "h1_corrected"):
+        assert res["rate_levels"]["bundle"][key] == [4, 8, 16] and rates["bundle"][key] >= 0.9, (key, rates)
+    assert rates["bundle"]["l2"] < 0.6, rates["bundle"]
