@@ -1,7 +1,7 @@
 """Driver of the ``macro`` kind: geometry -> macro problem -> solve -> results.
 
-Returns an :class:`~ngcontact.output.report.Outcome` (no file I/O here; a law from a
-cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its cache).
+Returns an :class:`~ngcontact.output.report.Outcome` (no file I/O here; a law from a cell scene is read
+through :mod:`ngcontact.coupling.cell_law`, which keeps its cache).
 
 ``results``:
 
@@ -27,8 +27,7 @@ cell scene is read through :mod:`ngcontact.coupling.cell_law`, which keeps its c
   boundary's mid-point, as the ``direct`` kind reports them
   (:func:`ngcontact.fem.reaction.support_reactions`);
 * ``maxima``: peak pressure and largest |shear| with their location, the
-  largest and smallest stress components, von Mises stress and strain with
-  location and body;
+  largest and smallest stress components, von Mises stress and strain with location and body;
 * ``detachment``: points where the interface changes between open and closed;
 * ``accuracy``: the headline quantities with their estimated discretization errors against
   ``discretization.tolerance`` (:mod:`ngcontact.drivers.macro_accuracy`), which a scene that states it is
