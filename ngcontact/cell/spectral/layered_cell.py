@@ -318,10 +318,13 @@ class SpectralCell:
             self._operators[uniform] = traction_operator(self, uniform)
         return self._operators[uniform]
 
-    def sweep(self, loads) -> list[SpectralSolution]:
-        """Solve loads in order, each starting from the previous pressure."""
+    def sweep(self, loads, starts: list[np.ndarray | None] | None = None) -> list[SpectralSolution]:
+        """Solve loads in order, each from its pressure in ``starts`` where given (e.g. a coarser grid's,
+        interpolated), else from the previous load's pressure."""
         out: list[SpectralSolution] = []
-        for load in loads:
-            start = out[-1].fields["pressure"] if out and load.traction[-1] is not None else None
+        for i, load in enumerate(loads):
+            start = starts[i] if starts is not None else None
+            if start is None and out and load.traction[-1] is not None:
+                start = out[-1].fields["pressure"]
             out.append(self.solve(load, start=start))
         return out
