@@ -198,9 +198,9 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
     progress.info("spectral refinement may reach grid %d (%d points) in %d levels from grid %d", grids[-1],
                   grids[-1] ** (dim - 1), len(grids), grid)
     history: list[dict[str, Any]] = []
-    sols = None
+    sols: list = []
     for n in grids:
-        cell, sols, entry = solve_level(make_cell, loads, n, sols)
+        cell, sols, entry = solve_level(make_cell, loads, n, sols or None)
         history.append(entry)
         estimates, remarks = sweep_estimates(history) if len(history) > 1 else (None, [])
         if estimates is not None:
