@@ -11,7 +11,8 @@ sampled on the coarser grids, between dissimilar finite layers (``E = 1, 3``,
   the contact set (:mod:`ngcontact.solvers.constrained_cg`).
 * **coulomb**: exact Coulomb friction (``mu = 0.5``) under the pressure ``p0`` and a mean shear ``0.2 p0``; the
   former solver is accelerated proximal gradients (:mod:`ngcontact.solvers.projected_gradient`), the current one
-  the active-set method (:mod:`ngcontact.solvers.active_set_newton`).
+  the active-set method (:mod:`ngcontact.solvers.active_set_newton`: the threshold's fixed point of Tresca
+  problems, Anderson-accelerated, then Newton steps with the law's own threshold).
 
 Each run is a child process, so its peak resident memory is its own.  ``steps``
 counts CG steps (frictionless, summed over the loads) or operator applications
@@ -135,7 +136,9 @@ def publish(csv_path: str, png: str, reason: str | None, command: str | None = N
         note="Random self-affine map between dissimilar finite layers, exact contact, tolerance 1e-10. "
              "frictionless: three loads (p0/4, p0, 4 p0), steps summed; coulomb: exact Coulomb mu = 0.5 under "
              "p0 and a mean shear 0.2 p0, steps = operator applications. former: plain constrained CG and "
-             "accelerated proximal gradients; current: preconditioned constrained CG and the active-set method. "
+             "accelerated proximal gradients; current: preconditioned constrained CG and the active-set method "
+             "(Coulomb: Anderson-accelerated threshold fixed point, then coupled Newton steps). Timings taken on "
+             "2 cores shared with other jobs: compare rows of one run, not absolute seconds. "
              "Aims (issue 38): Coulomb at 1024^2 <= 30 s and <= 2 GB, frictionless three loads <= 15 s. "
              f"Peer: {reason or 'Tamaas run'}.",
         png=png, command=command)

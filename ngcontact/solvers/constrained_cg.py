@@ -91,18 +91,10 @@ class ConstrainedResult:
     residuals: list[float]
 
 
-def inner(a: np.ndarray, b: np.ndarray) -> float:
+def inner(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> float:
     """``sum a b`` without BLAS: OpenBLAS' threads, spinning against another busy process, made a short dot
-    product hundreds of times slower than this plain sum."""
-    return float(np.multiply(a, b).sum())
-
-
-def _residual(p, g, shift, gscale) -> float:
-    gamma = g - shift
-    on = p > 0
-    r_on = float(np.max(np.abs(gamma[on]))) if on.any() else 0.0
-    r_off = float(np.max(-gamma[~on], initial=0.0))
-    return max(r_on, r_off) / gscale
+    product hundreds of times slower than this plain sum.  ``out``: a buffer of the shape for the products."""
+    return float(np.multiply(a, b, out=out).sum())
 
 
 def roundoff_floor(norm: float | None, p: np.ndarray, b: np.ndarray, gscale: float) -> float:
@@ -131,19 +123,45 @@ def _start(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, pbar: flo
     return p
 
 
-def _gap_state(p: np.ndarray, g: np.ndarray, pbar: float | None, gscale: float) -> tuple[np.ndarray, float, float]:
-    """``(g, shift, residual)``: the gap, the multiplier of the mean (the mean gap on the contact set) and the
-    complementarity residual."""
-    on = p > 0
-    shift = float(g[on].mean()) if (pbar is not None and on.any()) else 0.0
-    return g, shift, _residual(p, g, shift, gscale)
+class _ContactSet:
+    """The contact set ``{p > 0}`` of an iterate as a field of ones and zeros, with buffers of the grid's shape.
+
+    Restrictions, means and maxima over the set are products with the field: a reduction that skips the
+    points outside a scattered set branches at every point and costs several times a product.
+    """
+
+    def __init__(self, shape: tuple[int, ...]):
+        self.mask = np.zeros(shape)
+        self.rest = np.zeros(shape)
+        self.work = np.empty(shape)
+        self.count = 0
+
+    def update(self, p: np.ndarray) -> None:
+        np.greater(p, 0.0, out=self.mask)
+        np.subtract(1.0, self.mask, out=self.rest)
+        self.count = int(np.count_nonzero(self.mask))
+
+    def mean(self, x: np.ndarray) -> float:
+        """The mean of ``x`` over the set (0 on an empty set)."""
+        return inner(x, self.mask, self.work) / self.count if self.count else 0.0
+
+    def residual(self, g: np.ndarray, shift: float, gscale: float) -> float:
+        """``max(max_on |g - shift|, max_off max(shift - g, 0)) / gscale`` (module docstring)."""
+        gamma = np.subtract(g, shift, out=self.work)
+        r_off = -float(np.multiply(gamma, self.rest, out=self.rest).min())
+        np.subtract(1.0, self.mask, out=self.rest)
+        r_on = float(np.abs(np.multiply(gamma, self.mask, out=gamma), out=gamma).max())
+        return max(r_on, r_off, 0.0) / gscale
 
 
-def _preconditioned(precondition, gs, on, mean_free: bool) -> np.ndarray:
-    """``Pi R M R^T gs``: the preconditioner on the contact set, made mean-free there under a prescribed mean."""
-    z = np.where(on, precondition(gs), 0.0)
+def _preconditioned(precondition, gs: np.ndarray, on: _ContactSet, mean_free: bool) -> np.ndarray:
+    """``Pi R M R^T gs``: the preconditioner on the contact set, made mean-free there under a prescribed mean
+    (``precondition`` returns a new array)."""
+    z = precondition(gs)
+    z *= on.mask
     if mean_free:
-        z = np.where(on, z - float(z[on].mean()), 0.0)
+        z -= on.mean(z)
+        z *= on.mask
     return z
 
 
@@ -156,7 +174,7 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
     Parameters
     ----------
     apply_A
-        ``p -> A p`` (same shape as ``b``).
+        ``p -> A p`` (same shape as ``b``, a new array).
     b
         Initial gap on the grid.
     pbar
@@ -175,8 +193,8 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
         The largest eigenvalue of ``A`` (for a convolution: the largest value of its symbol), for the
         round-off floor of the stopping rule (module docstring); ``None``: no floor.
     precondition
-        ``r -> M r``, ``M`` symmetric positive definite and close to ``A^{-1}`` (module docstring);
-        ``None``: plain CG.
+        ``r -> M r`` (a new array), ``M`` symmetric positive definite and close to ``A^{-1}`` (module
+        docstring); ``None``: plain CG.
 
     Raises
     ------
@@ -187,62 +205,123 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
         raise ValueError(f"pbar = {pbar!r}: a prescribed mean pressure must be > 0")
     if not gscale > 0:
         raise ValueError(f"gscale = {gscale!r}: must be > 0")
-    n = b.size
-    p = _start(apply_A, b, pbar, p0)
-    t = np.zeros(b.shape)
-    g_old = 1.0
-    conjugate = False
-    residuals: list[float] = []
-    shift = 0.0
-    Ap = apply_A(p)
-    g = Ap + b
+    it = _Iteration(apply_A, b, pbar, gscale, norm, _start(apply_A, b, pbar, p0))
     started = reported = time.perf_counter()
-    for it in range(1, max_iter + 1):
-        on = p > 0
-        if not on.any():       # nothing pressed (approach below every summit): the open solution
-            residuals.append(_residual(p, g, 0.0, gscale))
-            return ConstrainedResult(p=p, gap=g, shift=0.0, iterations=it - 1, residuals=residuals)
-        shift = float(g[on].mean()) if pbar is not None else 0.0
-        gs = np.where(on, g - shift, 0.0)
-        z = gs if precondition is None else _preconditioned(precondition, gs, on, pbar is not None)
-        G = inner(gs, z)
-        t = np.where(on, z + (G / g_old) * t if conjugate else z, 0.0)
-        g_old = G
-        At = apply_A(t)
-        r = At - At[on].mean() if pbar is not None else At
-        rt = inner(np.where(on, r, 0.0), t)
-        if rt <= 0:            # no descent left: converged if complementary (a uniform start on a flat gap)
-            residuals.append(_residual(p, g, shift, gscale))
-            if residuals[-1] <= max(tol, roundoff_floor(norm, p, b, gscale)):
-                return ConstrainedResult(p=p, gap=g - shift, shift=shift, iterations=it - 1, residuals=residuals)
+    while it.steps < max_iter:
+        if not it.on.count:    # nothing pressed (approach below every summit): the open solution
+            it.residuals.append(it.on.residual(it.g, 0.0, gscale))
+            return it.result(0.0)
+        done = it.step(precondition, tol)
+        if done is not None:
+            return done
+        if it.stuck:
             break
-        tau = inner(gs, t) / rt
-        trial = p - tau * t
-        p = np.maximum(trial, 0.0)
-        back = (p == 0.0) & (g - shift < 0.0)
-        conjugate = not back.any()
-        # a step that clips nothing and puts nothing back moves A p along A t: no operator application needed
-        linear = conjugate and it % REFRESH != 0 and not bool(np.any(trial < 0.0))
-        if not conjugate:
-            p[back] -= tau * (g[back] - shift)
-        scale = pbar / p.mean() if pbar is not None else 1.0
-        p *= scale
-        Ap = scale * (Ap - tau * At) if linear else apply_A(p)
-        g, shift, res = _gap_state(p, Ap + b, pbar, gscale)
-        if res <= max(tol, roundoff_floor(norm, p, b, gscale)) and linear:
-            Ap = apply_A(p)    # converged on an updated gap: confirmed on the gap itself
-            g, shift, res = _gap_state(p, Ap + b, pbar, gscale)
-        residuals.append(res)
-        if res <= max(tol, roundoff_floor(norm, p, b, gscale)):
-            return ConstrainedResult(p=p, gap=g - shift, shift=shift, iterations=it, residuals=residuals)
         now = time.perf_counter()
         if now - reported >= PROGRESS_SECONDS:
             reported = now
             progress.info("constrained CG: step %d of at most %d, residual %.3g (tolerance %g), grid of %d points, "
-                          "%.0f s", it, max_iter, res, tol, n, now - started)
+                          "%.0f s", it.steps, max_iter, it.residuals[-1], tol, b.size, now - started)
+    last = f"{it.residuals[-1]:.3g}" if it.residuals else "not yet measured"
     raise ConvergenceError(
-        f"constrained CG: the complementarity residual {residuals[-1]:.3g} of the gap scale is above the "
-        f"tolerance {tol:g} after {len(residuals)} steps (grid of {n} points)", {"residuals": residuals[-5:]})
+        f"constrained CG: the complementarity residual {last} of the gap scale is above the "
+        f"tolerance {tol:g} after {len(it.residuals)} steps (grid of {b.size} points)",
+        {"residuals": it.residuals[-5:]})
+
+
+class _Iteration:
+    """The state of :func:`constrained_cg`: pressure ``p``, ``A p``, gap ``g = A p + b``, the multiplier of the
+    mean, the contact set, the search direction ``t`` and the conjugacy."""
+
+    def __init__(self, apply_A, b: np.ndarray, pbar: float | None, gscale: float, norm: float | None,
+                 p: np.ndarray):
+        self.apply_A, self.b, self.pbar, self.gscale = apply_A, b, pbar, gscale
+        self.floor_b = 0.0 if norm is None else float(np.max(np.abs(b)))
+        self.norm = norm
+        self.p = p
+        self.Ap = apply_A(p)
+        self.g = self.Ap + b
+        self.on = _ContactSet(b.shape)
+        self.on.update(p)
+        self.shift = self.on.mean(self.g) if pbar is not None else 0.0
+        self.t, self.gs, self.work = np.zeros(b.shape), np.empty(b.shape), np.empty(b.shape)
+        self.g_old, self.conjugate, self.steps, self.stuck = 1.0, False, 0, False
+        self.residuals: list[float] = []
+
+    def floor(self) -> float:
+        """:func:`roundoff_floor` of the iterate (``max|b|`` held)."""
+        if self.norm is None:
+            return 0.0
+        return ROUNDOFF * float(np.finfo(float).eps) * (self.norm * float(self.p.max()) + self.floor_b) / self.gscale
+
+    def result(self, shift: float) -> ConstrainedResult:
+        return ConstrainedResult(p=self.p, gap=self.g - shift, shift=shift, iterations=self.steps,
+                                 residuals=self.residuals)
+
+    def gap_state(self) -> float:
+        """The gap, the multiplier and the set of the current pressure; returns the residual."""
+        np.add(self.Ap, self.b, out=self.g)
+        self.on.update(self.p)
+        self.shift = self.on.mean(self.g) if self.pbar is not None else 0.0
+        return self.on.residual(self.g, self.shift, self.gscale)
+
+    def direction(self, precondition) -> np.ndarray:
+        """The conjugate (or, after a restart, the steepest) preconditioned direction on the contact set; the
+        restricted gap ``gs`` is kept for the step length."""
+        on, gs, t = self.on, self.gs, self.t
+        np.subtract(self.g, self.shift, out=gs)
+        gs *= on.mask
+        z = gs if precondition is None else _preconditioned(precondition, gs, on, self.pbar is not None)
+        G = inner(gs, z, self.work)
+        if self.conjugate:
+            t *= G / self.g_old
+            t += z
+            t *= on.mask
+        else:
+            np.copyto(t, z)
+        self.g_old = G
+        return t
+
+    def step(self, precondition, tol: float) -> ConstrainedResult | None:
+        """One step (module docstring); the result where it converged."""
+        self.steps += 1
+        on, p, shift = self.on, self.p, self.shift
+        t = self.direction(precondition)
+        At = self.apply_A(t)
+        rt = inner(At, t, self.work)
+        if self.pbar is not None:
+            rt -= on.mean(At) * float(t.sum())
+        if rt <= 0:            # no descent left: converged if complementary (a uniform start on a flat gap)
+            self.steps -= 1
+            self.residuals.append(on.residual(self.g, shift, self.gscale))
+            if self.residuals[-1] <= max(tol, self.floor()):
+                return self.result(shift)
+            self.stuck = True
+            return None
+        tau = inner(self.gs, t, self.work) / rt
+        trial = np.multiply(t, -tau, out=self.work)
+        trial += p
+        clipped = float(trial.min()) < 0.0
+        np.maximum(trial, 0.0, out=p)
+        back = (p == 0.0) & (self.g < shift)
+        self.conjugate = not back.any()
+        # a step that clips nothing and puts nothing back moves A p along A t: no operator application needed
+        linear = self.conjugate and self.steps % REFRESH != 0 and not clipped
+        if not self.conjugate:
+            p[back] -= tau * (self.g[back] - shift)
+        scale = self.pbar / p.mean() if self.pbar is not None else 1.0
+        p *= scale
+        if linear:
+            At *= tau
+            self.Ap -= At
+            self.Ap *= scale
+        else:
+            self.Ap = self.apply_A(p)
+        res = self.gap_state()
+        if res <= max(tol, self.floor()) and linear:
+            self.Ap = self.apply_A(p)    # converged on an updated gap: confirmed on the gap itself
+            res = self.gap_state()
+        self.residuals.append(res)
+        return self.result(self.shift) if res <= max(tol, self.floor()) else None
 
 
 def masked_cg(apply_A: Callable[[np.ndarray], np.ndarray], active: np.ndarray, rhs: np.ndarray, *,
@@ -260,22 +339,29 @@ def masked_cg(apply_A: Callable[[np.ndarray], np.ndarray], active: np.ndarray, r
     mask = active.astype(float)
     x = np.zeros(rhs.shape)
     r = rhs * mask
+    work = np.empty(rhs.shape)
 
     def prec(v):
-        return v if precondition is None else precondition(v) * mask
+        if precondition is None:
+            return v
+        z = precondition(v)
+        z *= mask
+        return z
     z = prec(r)
     d = z.copy()
-    rz = inner(r, z)
-    stop = rtol * rtol * inner(r, r)
+    rz = inner(r, z, work)
+    stop = rtol * rtol * inner(r, r, work)
     for it in range(1, max_iter + 1):
-        if inner(r, r) <= stop:
+        if inner(r, r, work) <= stop:
             return x, it - 1
-        Ad = apply_A(d) * mask
-        alpha = rz / inner(d, Ad)
-        x += alpha * d
-        r -= alpha * Ad
+        Ad = apply_A(d)
+        Ad *= mask
+        alpha = rz / inner(d, Ad, work)
+        x += np.multiply(d, alpha, out=work)
+        r -= np.multiply(Ad, alpha, out=work)
         z = prec(r)
-        rz, rz_old = inner(r, z), rz
-        d = z + (rz / rz_old) * d
+        rz, rz_old = inner(r, z, work), rz
+        d *= rz / rz_old
+        d += z
     raise ConvergenceError(f"masked CG: residual {np.sqrt(inner(r, r) / inner(rhs * mask, rhs * mask)):.3g} above "
                            f"{rtol:g} after {max_iter} steps", {})

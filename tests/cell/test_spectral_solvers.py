@@ -103,3 +103,23 @@ def test_active_set_friction_needs_few_steps():
     """Exact Coulomb friction, 2D, 1024 points: a bound on the operator applications (the proximal method: 600)."""
     sol = _cell(2, 1024, friction=Coulomb(w=None, mu=0.5)).solve(cell_load(2, pressure=P, shear=(0.2 * P,)))
     assert sol.iterations <= 150, sol.iterations
+
+
+@pytest.mark.parametrize("n, law, enforcement", [
+    (64, Coulomb(w=None, mu=0.5), "exact"), (64, Coulomb(w=1e-4, mu=0.5), "penalty"),
+    pytest.param(256, Coulomb(w=None, mu=0.5), "exact", marks=pytest.mark.slow)])
+def test_3d_coulomb_converges_without_the_proximal_fallback(monkeypatch, n, law, enforcement):
+    """3D Coulomb on a random map between dissimilar layers: the accelerated fixed point of Tresca problems and
+    the coupled Newton steps reach the tolerance by themselves, and give the proximal method's answer (at
+    256^2 the fixed point without acceleration stalled and went on with the proximal method)."""
+    import ngcontact.solvers.active_set_newton as asn
+    load = cell_load(3, pressure=P, shear=(0.2 * P, 0.05 * P))
+    old = _cell(3, n, friction=law, enforcement=enforcement, friction_method="proximal").solve(load)
+
+    def refused(*args, **kwargs):
+        raise AssertionError("the active-set method fell back to accelerated proximal gradients")
+    monkeypatch.setattr(asn, "fista", refused)
+    new = _cell(3, n, friction=law, enforcement=enforcement).solve(load)
+    _agree(new, old, P)
+    assert new.results["slip_fraction"] == pytest.approx(old.results["slip_fraction"], abs=2.0 / n ** 2)
+    assert new.iterations < old.iterations

@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
+from ngcontact.cell.spectral.fft_threads import fft_workers
 from ngcontact.cell.spectral.layer_compliance import layer_matrix
 from ngcontact.cell.spectral.traction_constraints import TractionConstraints
 from ngcontact.solvers.active_set_newton import active_set_newton, coulomb_active_set
@@ -66,9 +67,9 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
     axes = tuple(range(1, d))
 
     def apply(t):
-        T = sfft.rfftn(t, axes=axes, workers=-1)
+        T = sfft.rfftn(t, axes=axes, workers=fft_workers())
         U = np.einsum("ab...,b...->a...", Km, T)
-        return sfft.irfftn(U, s=cell.shape, axes=axes, workers=-1)
+        return sfft.irfftn(U, s=cell.shape, axes=axes, workers=fft_workers())
     return apply, L, K0
 
 
@@ -104,8 +105,8 @@ def traction_preconditioner(cell, winkler: float):
     axes = tuple(range(1, d))
 
     def apply(r):
-        R = sfft.rfftn(r, axes=axes, workers=-1)
-        return sfft.irfftn(np.einsum("ab...,b...->a...", Kinv, R), s=cell.shape, axes=axes, workers=-1)
+        R = sfft.rfftn(r, axes=axes, workers=fft_workers())
+        return sfft.irfftn(np.einsum("ab...,b...->a...", Kinv, R), s=cell.shape, axes=axes, workers=fft_workers())
     return apply
 
 

@@ -39,6 +39,7 @@ import numpy as np
 from ngcontact.cell.spectral import grid_measures as measures
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.spectral.layer_compliance import normal_compliance
+from ngcontact.cell.spectral.fft_threads import fft_workers
 from ngcontact.cell.spectral.frictional_contact import solve_frictional, traction_operator
 from ngcontact.geometry.random_surface import wave_vectors
 from ngcontact.laws.friction import FrictionLaw
@@ -157,9 +158,13 @@ class SpectralCell:
         return int(np.prod(self.shape))
 
     def convolve(self, p: np.ndarray, symbol: np.ndarray) -> np.ndarray:
-        """``IFFT(symbol FFT(p))`` on the grid (all cores)."""
+        """``IFFT(symbol FFT(p))`` on the grid (real FFTs on the run's threads, :mod:`.fft_threads`), a new
+        array."""
         import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
-        return sfft.irfftn(symbol * sfft.rfftn(p, workers=-1), s=self.shape, workers=-1)
+        workers = fft_workers()
+        spectrum = sfft.rfftn(p, workers=workers)
+        spectrum *= symbol
+        return sfft.irfftn(spectrum, s=self.shape, workers=workers, overwrite_x=True)
 
     def interface_compliance(self, uniform: bool):
         """``p -> C p (+ p / k_n)``, with or without the uniform mode of ``C``."""
@@ -290,13 +295,13 @@ class SpectralCell:
         import scipy.fft as sfft
         winkler = 1.0 / self.k_n if self.enforcement == "penalty" else 0.0
         sym = (self.fluctuation if pbar is not None else self.symbol) + winkler
-        bh = sfft.rfftn(b, workers=-1)
+        bh = sfft.rfftn(b, workers=fft_workers())
         ph = np.zeros_like(bh)
         nonzero = sym > 0
         ph[nonzero] = -bh[nonzero] / sym[nonzero]
         if pbar is not None:
             ph.flat[0] = pbar * self.points
-        p = sfft.irfftn(ph, s=self.shape, workers=-1)
+        p = sfft.irfftn(ph, s=self.shape, workers=fft_workers())
         if pbar is not None:
             p += pbar - float(p.mean())
         if not (np.all(np.isfinite(p)) and p.min() >= 0.0):
@@ -313,10 +318,13 @@ class SpectralCell:
             self._operators[uniform] = traction_operator(self, uniform)
         return self._operators[uniform]
 
-    def sweep(self, loads) -> list[SpectralSolution]:
-        """Solve loads in order, each starting from the previous pressure."""
+    def sweep(self, loads, starts: list[np.ndarray | None] | None = None) -> list[SpectralSolution]:
+        """Solve loads in order, each from its pressure in ``starts`` where given (e.g. a coarser grid's,
+        interpolated), else from the previous load's pressure."""
         out: list[SpectralSolution] = []
-        for load in loads:
-            start = out[-1].fields["pressure"] if out and load.traction[-1] is not None else None
+        for i, load in enumerate(loads):
+            start = starts[i] if starts is not None else None
+            if start is None and out and load.traction[-1] is not None:
+                start = out[-1].fields["pressure"]
             out.append(self.solve(load, start=start))
         return out
