@@ -40,7 +40,8 @@ TRACE_ORDER = 1
 def lower_trace(space: ng.FESpace, mesh: ng.Mesh, label: str = "contact", order: int = TRACE_ORDER) -> None:
     """Set the order of every edge and face of the boundary ``label`` of ``space`` (an ``H1`` or ``VectorH1``
     before any ``Periodic`` wrapper) to ``order`` and update it (module docstring)."""
-    edges, faces = set(), set()
+    edges: set[int] = set()
+    faces: set[int] = set()
     for el in mesh.Boundaries(label).Elements():
         edges.update(e.nr for e in el.edges)
         faces.update(f.nr for f in el.faces)
