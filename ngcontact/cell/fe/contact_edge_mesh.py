@@ -32,9 +32,11 @@ twin's grid is periodic), so the identified faces mesh the same.
 What remains.  With order-1 bodies the refined mesh leaves the bodies'
 stiffness error: order-1 tetrahedra are too stiff, the patch comes out too
 small, and that error falls with the body's element size below the patch,
-not with the edge's.  The edge refinement therefore pays where the
-interface error dominates (a coarse ``interface_maxh`` against the patch)
-and is combined with a fine enough ``maxh`` below the patch.
+not with the edge's.  Order-2 bodies on a linear trace on ``S_C``
+(:mod:`ngcontact.cell.fe.linear_trace`) remove most of it; what is left is
+the node-to-node contact set's own error, the contact edge placed within a
+part of ``edge_maxh`` (:mod:`ngcontact.cell.fe.exact_contact_set`), which
+falls with ``edge_maxh``.
 """
 from __future__ import annotations
 
