@@ -51,6 +51,9 @@ class CellModel:
         :mod:`ngcontact.cell.fe.contact_multiplier`).
     uzawa_rtol, uzawa_max_iter
         Stopping rule of Uzawa's iteration (:mod:`ngcontact.solvers.uzawa`).
+    linear_trace
+        Exact contact in 3D at ``order >= 2``: the displacements' trace on ``S_C`` of order 1, the bodies
+        of ``order`` (:mod:`ngcontact.cell.fe.linear_trace`); ignored elsewhere.
     """
 
     rough: _mat.ElasticLaw
@@ -67,6 +70,7 @@ class CellModel:
     enforcement: str = "penalty"
     uzawa_rtol: float = 1e-10
     uzawa_max_iter: int = 60
+    linear_trace: bool = False
 
     def __post_init__(self):
         if self.enforcement not in ("penalty", "exact"):

@@ -77,6 +77,7 @@ from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.cell_energy import cell_energy, interface_tangent, jump, preconditioning_form
 from ngcontact.cell.fe.discrete_cell import discretize
 from ngcontact.cell.fe.contact_quadrature import ContactQuadrature
+from ngcontact.cell.fe.linear_trace import trace_order
 from ngcontact.cell.fe.contact_quadrature import applies as quadrature_applies
 from ngcontact.cell.fe.coulomb_friction import METHODS, solve_coulomb
 from ngcontact.cell.fe.load_start import Predictor, check_start, start_load, starts_afresh, tangential_load
@@ -149,10 +150,11 @@ class CellProblem:
         if line_search not in ("exact", "armijo"):
             raise ValueError(f"line_search = {line_search!r}: must be 'exact' or 'armijo'")
         start = check_start(start, predictor, model.enforcement)
-        if model.enforcement == "exact" and cell.dim == 3 and model.order > TRIANGLE_MAX_ORDER:
+        if model.enforcement == "exact" and cell.dim == 3 and trace_order(model, 3) > TRIANGLE_MAX_ORDER:
             raise ModelError(f"order = {model.order} with enforcement = 'exact' in a 3D cell: exact contact on "
                              f"triangles is built for order <= {TRIANGLE_MAX_ORDER} (quadratic triangles leave corner "
-                             "nodes open inside the contact patch); use order 1, the penalty, or the spectral cell")
+                             "nodes open inside the contact patch); use order 1, a linear trace on S_C "
+                             "(CellModel.linear_trace), the penalty, or the spectral cell")
         if predictor is not None:
             predictor.check(cell.mesh)
         self.line_search, self.start, self.coulomb, self.predictor = line_search, start, coulomb, predictor

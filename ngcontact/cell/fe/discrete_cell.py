@@ -22,6 +22,7 @@ import ngsolve as ng
 from ngcontact.cell.coefficients import contact_normal
 from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.contact_multiplier import ContactMultiplier
+from ngcontact.cell.fe.linear_trace import lower_trace, trace_order
 from ngcontact.fem import elasticity as _el
 from ngcontact.fem.quadrature import sampling_order
 
@@ -81,8 +82,13 @@ def discretize(cell, model: CellModel, *, normal=None, inverse: str = "sparsecho
     sparse direct solver the forms' storage is chosen for."""
     mesh, dim = cell.mesh, cell.dim
     n = normal if normal is not None else contact_normal(cell)
-    Vr = _el.body_space(mesh, "rough", model.order, dirichlet="bottom", periodic=True)
-    Vc = _el.body_space(mesh, "counter", model.order, dirichlet="top", periodic=True)
+    bodies = [_el.body_space(mesh, name, model.order, dirichlet=far) for name, far in (("rough", "bottom"),
+                                                                                       ("counter", "top"))]
+    trace = trace_order(model, dim)
+    if trace < model.order:          # exact contact in 3D on a linear trace (ngcontact.cell.fe.linear_trace)
+        for V in bodies:
+            lower_trace(V, mesh, "contact", trace)
+    Vr, Vc = (ng.Periodic(V) for V in bodies)
     # U lives only where it enters (S_C and the far face): a NumberSpace on every element would couple all
     # dofs and make the factorization much slower
     N = ng.NumberSpace(mesh, definedon=mesh.Boundaries("contact|top"))
@@ -96,7 +102,7 @@ def discretize(cell, model: CellModel, *, normal=None, inverse: str = "sparsecho
         strain_params=tuple(ng.Parameter(0.0) for _ in range(1 if dim == 2 else 3)),
         # exact: the augmentation k_n as a Parameter (the constrained tangent extrapolates in it)
         augmentation=ng.Parameter(model.k_n),
-        multiplier=ContactMultiplier(mesh, model.order) if model.enforcement == "exact" else None,
+        multiplier=ContactMultiplier(mesh, trace) if model.enforcement == "exact" else None,
         tangential_free=tangential_determinate(mesh, n, dim, model), inverse=inverse)
 
 

@@ -1,0 +1,116 @@
+"""The 3D small-slope cell meshed finely along a predicted contact edge (Netgen's restricted local mesh size).
+
+Why the edge.  On a small-slope 3D cell (the flat cell of
+:func:`ngcontact.geometry.cell3d.flat_cell3d` with the initial gap ``g0``,
+paper eqs. 49-51 with exact non-penetration) the contact set at light
+loads is a few Hertz-like patches, a fraction of the cell wide.  A uniform
+interface mesh spends nearly all of its elements on open surface: the
+patch of the bisinusoid at a tenth of its full-contact pressure is about
+ten interface elements across at ``interface_maxh = 0.02``.  What the
+contact fraction needs is the edge resolved: the pressure is a square root
+inside it and the opening a ``3/2`` power outside it (the Hertz edge), and
+the node-based real contact set of exact enforcement
+(:mod:`ngcontact.cell.fe.exact_contact_set`) places the edge inside the
+element that straddles it from those two asymptotics, an error of a part
+of the element size at the edge.
+
+The prediction.  The spectral twin (the same layers and gap on a periodic
+grid, whose solution's pressure field the caller passes in) gives the
+contact set in a fraction of the FE solve: its edge points (:func:`edge_points`) are
+the midpoints between a grid point carrying pressure and a neighbour that
+does not, within half a grid spacing of the twin's own edge.
+
+The mesh (:func:`edge_refined_cell`).  Netgen's mesh size is restricted to
+``edge_maxh`` at each edge point on ``S_C`` (``MeshingParameters.RestrictH``)
+and grows from there at Netgen's grading rate to ``interface_maxh`` on the
+rest of ``S_C`` and ``maxh`` in the bodies, so the dofs go where the
+contact fraction's error is made, and the bodies below the patch (depth of
+the order of its radius, where the Hertz field decays) are refined with it.
+The restriction is applied on both sides of the periodic faces alike (the
+twin's grid is periodic), so the identified faces mesh the same.
+
+What remains.  With order-1 bodies the refined mesh leaves the bodies'
+stiffness error: order-1 tetrahedra are too stiff, the patch comes out too
+small, and that error falls with the body's element size below the patch,
+not with the edge's.  Order-2 bodies on a linear trace on ``S_C``
+(:mod:`ngcontact.cell.fe.linear_trace`) remove most of it; what is left is
+the node-to-node contact set's own error, the contact edge placed within a
+part of ``edge_maxh`` (:mod:`ngcontact.cell.fe.exact_contact_set`), which
+falls with ``edge_maxh``.
+"""
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import ngsolve as ng
+from netgen.csg import CSGeometry, Plane, Pnt, Vec
+from netgen.meshing import MeshingParameters
+
+from ngcontact.errors import GeometryError
+from ngcontact.geometry import cell3d
+from ngcontact.geometry.cell2d import Cell, periodic_maxh
+
+log = logging.getLogger(__name__)
+
+#: points of a restriction closer than this (relative to the period) to a periodic face are moved off it
+FACE_CLEARANCE = 1e-6
+
+
+def edge_points(pressure: np.ndarray, period: float) -> np.ndarray:
+    """Points ``(x, y)`` on the contact edges of a periodic ``n_y x n_x`` pressure grid (module docstring).
+
+    ``pressure[i, j]`` is the pressure at ``x = j P/n_x``, ``y = i P/n_y``.  An edge point is the midpoint
+    between two neighbours along ``x`` or ``y`` (periodically) of which one carries pressure (``> 0``) and
+    the other does not.  Returns an array of shape ``(m, 2)``, empty where the contact set has no edge.
+    """
+    p = np.asarray(pressure, float)
+    if p.ndim != 2:
+        raise ValueError(f"pressure has shape {p.shape}: a 2D grid of a 3D cell is needed")
+    ny, nx = p.shape
+    on = p > 0.0
+    out = []
+    for axis, n in ((1, nx), (0, ny)):
+        cut = on != np.roll(on, -1, axis=axis)
+        i, j = np.nonzero(cut)
+        x = (j + (0.5 if axis == 1 else 0.0)) * period / nx
+        y = (i + (0.5 if axis == 0 else 0.0)) * period / ny
+        out.append(np.stack((x, y), axis=1))
+    return np.concatenate(out) if out else np.empty((0, 2))
+
+
+def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1.0, h_rough: float = 1.0,
+                      h_counter: float = 1.0, maxh: float, interface_maxh: float) -> Cell:
+    """The flat periodic 3D cell (:func:`~ngcontact.geometry.cell3d.flat_cell3d`) with its mesh size
+    restricted to ``edge_maxh`` at ``points`` on ``S_C`` (module docstring).
+
+    Parameters
+    ----------
+    points
+        ``(m, 2)`` edge points ``(x, y)`` in ``[0, P)^2`` (:func:`edge_points`); none: the uniform cell.
+    edge_maxh
+        Element size at the edge points (``<= interface_maxh``).
+    period, h_rough, h_counter, maxh, interface_maxh
+        As for :func:`~ngcontact.geometry.cell3d.flat_cell3d`.
+    """
+    if not (np.isfinite(edge_maxh) and 0 < edge_maxh <= interface_maxh):
+        raise GeometryError("edge_maxh", edge_maxh, f"must be > 0 and <= interface_maxh = {interface_maxh}")
+    P = float(period)
+    lateral, bottom, top = cell3d._box_planes(P, float(h_rough), float(h_counter))
+    xm, xp, ym, yp = lateral
+    plane = Plane(Pnt(0, 0, 0), Vec(0, 0, 1)).bc("contact").maxh(periodic_maxh(interface_maxh, P))
+    box = xm * xp * ym * yp
+    geo = CSGeometry()
+    geo.Add((box * bottom * plane).mat("rough"))
+    geo.Add((box * top - plane).mat("counter"))
+    cell3d._identify_periodic(geo, lateral)
+    mp = MeshingParameters(maxh=periodic_maxh(maxh, P))
+    pts = np.clip(np.asarray(points, float).reshape(-1, 2) % P, FACE_CLEARANCE * P, (1.0 - FACE_CLEARANCE) * P)
+    for x, y in pts:
+        mp.RestrictH(x=float(x), y=float(y), z=0.0, h=float(edge_maxh))
+    ngmesh = geo.GenerateMesh(mp=mp)
+    cell3d._name_faces(ngmesh)
+    mesh = ng.Mesh(ngmesh)
+    log.info("edge-refined 3D cell: %d edge points at size %g, %d elements", len(pts), edge_maxh, mesh.ne)
+    return Cell(mesh=mesh, dim=3, period=(P, P), h_rough=float(h_rough), h_counter=float(h_counter))
+

@@ -1,0 +1,107 @@
+"""Richardson extrapolation of a 3D cell's contact fraction in the element size at its contact edge.
+
+On the mesh refined along the contact edge
+(:mod:`ngcontact.cell.fe.contact_edge_mesh`), with order-2 bodies on a
+linear trace on ``S_C`` (:mod:`ngcontact.cell.fe.linear_trace`), the bodies'
+error is of higher order and what is left of the contact fraction's error
+is the node-to-node contact set's: the contact edge is placed from the
+nodes around it (:mod:`ngcontact.cell.fe.exact_contact_set`) within a part
+of the element size ``h`` at the edge, so that
+
+    f(h) = f + C h + o(h),
+
+the first-order term of one sign (the nodal contact set reaches beyond
+the edge).  Two solves at ``h`` and ``r h`` (``r > 1``) then give
+
+    f ~ (r f(h) - f(r h)) / (r - 1),
+
+and a third size the observed rate ``q`` of the two successive differences
+(``f(h) - f(r1 h)`` against ``f(r1 h) - f(r2 h)``), with which the
+extrapolation is repeated.  Where the observed rate is far from 1 (outside
+:data:`RATE_RANGE`) the sizes are not in the asymptotic range: the
+extrapolation keeps the first order and says so.  The estimate of the
+extrapolated value's error: with two sizes the correction itself,
+``|f - f(h)|`` (nothing smaller is known from two points); with three the
+larger of the disagreement between the extrapolations of the finer and of
+the coarser pair, and between the first-order and the observed-rate
+extrapolations.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+#: observed rates outside this range are not taken (the sizes are not asymptotic)
+RATE_RANGE = (0.5, 2.0)
+
+
+@dataclass(frozen=True)
+class EdgeSizeExtrapolation:
+    """The extrapolated value, its estimated error, the rate used and how it was found."""
+
+    value: float
+    estimate: float
+    rate: float
+    how: str
+
+
+def extrapolate(sizes: list[float], values: list[float]) -> EdgeSizeExtrapolation:
+    """Richardson extrapolation of ``values`` at edge ``sizes`` to size 0 (module docstring).
+
+    ``sizes`` are at least two distinct positive element sizes, any order; the finest two extrapolate, a
+    third gives the observed rate.
+    """
+    if len(sizes) != len(values) or len(sizes) < 2:
+        raise ValueError(f"{len(sizes)} sizes and {len(values)} values: two or more of each are needed")
+    pairs = sorted(zip(sizes, values))
+    h = [float(s) for s, _ in pairs]
+    f = [float(v) for _, v in pairs]
+    if not (h[0] > 0 and all(b > a for a, b in zip(h, h[1:]))):
+        raise ValueError(f"sizes = {sizes}: must be distinct and > 0")
+    r = h[1] / h[0]
+    first = _richardson(f[0], f[1], r, 1.0)
+    rate, how = 1.0, "first order in the edge size (two sizes)"
+    if len(h) >= 3:
+        q = _observed_rate(h[:3], f[:3])
+        if q is not None and RATE_RANGE[0] <= q <= RATE_RANGE[1]:
+            rate, how = q, f"observed rate {q:.2f} of three edge sizes"
+        else:
+            how = (f"first order in the edge size: the observed rate {q if q is None else round(q, 2)} "
+                   f"of three sizes is outside {RATE_RANGE}")
+    value = _richardson(f[0], f[1], r, rate)
+    if len(h) >= 3:
+        coarser = _richardson(f[1], f[2], h[2] / h[1], rate)
+        estimate = max(abs(value - coarser), abs(value - first))
+    else:
+        estimate = abs(value - f[0])
+    return EdgeSizeExtrapolation(value=value, estimate=estimate, rate=rate, how=how)
+
+
+def _richardson(fine: float, coarse: float, r: float, q: float) -> float:
+    """``(r^q f(h) - f(r h)) / (r^q - 1)``."""
+    w = r ** q
+    return (w * fine - coarse) / (w - 1.0)
+
+
+def _observed_rate(h: list[float], f: list[float]) -> float | None:
+    """The rate ``q`` of ``f(h_k) = f + C h_k^q`` through three sizes (bisection on the ratio of the
+    differences), ``None`` where the differences change sign or vanish."""
+    d1, d2 = f[1] - f[0], f[2] - f[1]
+    if d1 == 0.0 or d2 == 0.0 or (d1 > 0) != (d2 > 0):
+        return None
+    target = d2 / d1
+
+    def ratio(q: float) -> float:
+        return (h[2] ** q - h[1] ** q) / (h[1] ** q - h[0] ** q)
+
+    lo, hi = 1e-3, 8.0
+    if not (ratio(lo) - target) * (ratio(hi) - target) < 0:
+        return None
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        if (ratio(lo) - target) * (ratio(mid) - target) <= 0:
+            hi = mid
+        else:
+            lo = mid
+    q = 0.5 * (lo + hi)
+    return q if math.isfinite(q) else None
