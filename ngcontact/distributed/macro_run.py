@@ -26,8 +26,11 @@ import pickle
 from dataclasses import replace
 
 import ngsolve as ng
+import numpy as np
 
 from ngcontact.distributed.macro_mesh import distribute, gather
+from ngcontact.distributed.reduced_measures import Reduced
+from ngcontact.distributed.vtk_pieces import RankPieces
 from ngcontact.distributed.world import World
 from ngcontact.drivers import run_macro as R
 from ngcontact.errors import SceneError
@@ -110,23 +113,41 @@ def run(scene, clock, world: World) -> Outcome:
     with clock.stage("solve"):
         sol = R.solve_scene(scene, problem)
     with clock.stage("post-processing"):
-        whole_sol = gathered(world, sol, serial)
-        if whole_sol is None:
-            return Outcome(results={}, ndof=sol.ndof, solver={})
-        assert whole is not None
-        outcome = R.measured(whole_sol, whole, info, scene.output)
-    outcome.solver["mpi"] = {"ranks": world.size, "distributed": "mesh, assembly, Newton with BDDC-CG",
-                             "rank_0": "checks, post-processing on the gathered solution, files"}
+        outcome = R.measured(sol, geo, info, scene.output, Reduced(world, whole.mesh if whole else None))
+        outcome.ndof = global_ndof(sol, world)
+        outcome.vtk["stress"].pieces = RankPieces(world)
+        outcome.results["accuracy"] = accuracy_not_estimated(scene, sol, outcome.results["equilibrium"])
+    outcome.solver["mpi"] = {"ranks": world.size, "distributed": "mesh, assembly, Newton with BDDC-CG, "
+                             "post-processing reduced over the ranks, VTK in pieces",
+                             "rank_0": "checks, the interface's samples in its mesh's order, figures, files"}
     if scene.strength is not None:
-        from ngcontact.drivers.run_strength import evaluate
         with clock.stage("strength check"):
-            st = evaluate(scene, whole_sol)
-        outcome.results["strength"] = st["results"]
-        outcome.tables["strength_map"] = st["table"]
-        outcome.vtk["worst_cell"] = st["vtk"]
-        outcome.plots.update(st["plots"])
-    outcome.results["accuracy"] = accuracy_not_estimated(scene, whole_sol, outcome.results["equilibrium"])
+            strength(scene, world, sol, serial, outcome)
+    if not world.root:
+        return Outcome(results={}, ndof=outcome.ndof, solver={}, vtk=outcome.vtk)
     return outcome
+
+
+def strength(scene, world: World, sol: M.MacroSolution, serial: M.MacroProblem | None, outcome: Outcome) -> None:
+    """The strength check (:mod:`ngcontact.drivers.run_strength`) on rank 0: its stress recovery samples
+    the whole field, so the solution is gathered for it (and only for it)."""
+    from ngcontact.drivers.run_strength import evaluate
+    whole_sol = gathered(world, sol, serial)
+    if whole_sol is None:
+        return
+    st = evaluate(scene, whole_sol)
+    outcome.results["strength"] = st["results"]
+    outcome.tables["strength_map"] = st["table"]
+    outcome.vtk["worst_cell"] = st["vtk"]
+    outcome.plots.update(st["plots"])
+
+
+def global_ndof(sol: M.MacroSolution, world: World) -> int:
+    """The free dofs of the distributed solution, each counted once (on the rank that is its master)."""
+    fes = sol.gfu.space
+    free = np.array(list(fes.FreeDofs()), dtype=bool)
+    master = np.array(list(fes.ParallelDofs().MasterDofs()), dtype=bool)
+    return int(world.comm.allreduce(int(np.count_nonzero(free & master))))
 
 
 def accuracy_not_estimated(scene, sol: M.MacroSolution, balance: dict) -> dict:
