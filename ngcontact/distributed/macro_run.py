@@ -10,15 +10,22 @@ distributed, so ``"direct"`` is refused).  Coulomb friction is solved as in one 
 coupled Newton; the fixed point of ``solver.coulomb = "fixed_point"``
 compares sampled pressures between its passes and is refused here.
 
+Post-processing is reduced over the ranks
+(:class:`ngcontact.distributed.reduced_measures.Reduced`): every rank
+measures its own elements and the parts are combined with MPI, so that the
+report holds one process's numbers without a gathered solution; the stress
+fields are written in pieces, a ``.vtu`` per rank and a ``.pvtu``
+(:mod:`ngcontact.distributed.vtk_pieces`).
+
 What is not: rank 0 checks the model (labels, supports, rigid motions) on
 its whole mesh and reads the supports' geometric data off it (a tilted
 support's mid-point becomes the equivalent affine field ``u0 + G x``, the
-same everywhere), then gathers the solution
-(:func:`ngcontact.distributed.macro_mesh.gather`) and post-processes it on
-the whole mesh exactly as one process does (integrals, peaks, samples,
-figures and the VTK file); it alone writes.  A two-scale scene's cells and
-their batches stay on the executor of one process and are refused under
-MPI.
+same everywhere), orders the interface's samples by its mesh, draws the
+figures and alone writes the report.  The strength check samples the whole
+stress field: with ``[strength]`` the solution is gathered on rank 0
+(:func:`ngcontact.distributed.macro_mesh.gather`) for it alone.  A two-scale
+scene's cells and their batches stay on the executor of one process and are
+refused under MPI.
 """
 from __future__ import annotations
 
