@@ -218,6 +218,22 @@ def test_the_shipped_3d_femur_with_friction_on_two_ranks_reports_what_one_proces
 
 
 @pytest.mark.mpi
+@pytest.mark.slow
+@needs_mpi
+def test_the_axisymmetric_femur_with_its_strength_check_on_two_ranks_reports_what_one_process_does(tmp_path):
+    """The strength check gathers the solution on rank 0 (its recovery samples the whole field); the rest of
+    the report is reduced over the ranks."""
+    text = (ROOT / "geometries" / "femur_stem.toml").read_text()
+    for old, new in (("\nrtol = 1e-10\n", '\nrtol = 1e-10\nlinear = "iterative"\n'), ("\norder = 3 ", "\norder = 2 "),
+                     ('"cells/hip_hills.toml"', f'"{ROOT / "geometries" / "cells" / "hip_hills.toml"}"')):
+        assert old in text
+        text = text.replace(old, new)
+    parallel = _agree(tmp_path, text)
+    assert parallel["results"]["strength"]["safety_factor"] > 1
+    assert (tmp_path / "parallel" / "worst_cell.vtu").exists()
+
+
+@pytest.mark.mpi
 @needs_mpi
 def test_direct_solver_under_mpiexec_is_refused_naming_the_key(tmp_path):
     scene = tmp_path / "scene.toml"
