@@ -40,6 +40,7 @@ import sys
 import threading
 
 from ngcontact._version import __version__
+from ngcontact.distributed.vtk_pieces import written
 from ngcontact.distributed.world import launched_rank
 from ngcontact.scene import loader as scene_mod
 from ngcontact.errors import ConvergenceError, ModelError, NgcontactError, OutputError, SceneError
@@ -400,8 +401,8 @@ def _execute(path: str, out: str | None, quiet: bool, compute, *, suffix: str, v
         with _native_output_silenced(quiet):
             report, outcome = compute(sc, progress)
         _check_signals()
-        if launched_rank() == 0:     # under mpiexec rank 0 holds the results and writes
-            write_outputs(out, report, outcome, inputs)
+        # under mpiexec rank 0 holds the results and writes; the other ranks write their VTK pieces
+        written(outcome, lambda: write_outputs(out, report, outcome, inputs))
     except Exception as exc:
         return _classified(path, exc)
     if not quiet:

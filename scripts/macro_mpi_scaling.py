@@ -1,30 +1,48 @@
-"""The 3D press fit on 1 and 2 MPI ranks at growing sizes: wall time and peak memory per rank against dofs.
+"""The 3D press fit and the 3D femur on 1, 2 and 3 MPI ranks at growing sizes: time and peak memory per rank.
 
-The scene is the quarter of two coaxial tubes pressed together (interference
-2 um, 5 MPa on the top; the scene of ``tests/distributed/test_mpi_macro.py``)
-at order 2, ``solver.linear = "iterative"`` (BDDC-CG, what runs distributed),
-refined by ``discretization.maxh``.  Each run is ``ngcontact run`` in its own
-processes: one process for 1 rank, ``mpiexec -n 2`` for 2 ranks (mesh made on
-rank 0 and distributed; rank 0 gathers the solution and post-processes:
-:mod:`ngcontact.distributed.macro_run`).  Per run: dofs, wall time of the
-command, the report's solve stage, and every rank's peak resident memory
-(``VmHWM``) at its exit: rank 0 (which holds the whole mesh and the
-post-processing) and the largest of the others (a part of the mesh each;
-empty for one rank).
+Scenes: the quarter of two coaxial tubes pressed together (interference
+2 um, 5 MPa on the top; the scene of ``tests/distributed/test_mpi_macro.py``),
+refined by ``discretization.maxh``; the shipped 3D femur with its hip stem
+(``geometries/femur_stem_3d.toml``, Coulomb friction), refined by dividing
+``maxh`` and ``interface_maxh`` by a factor.  Both at order 2 with
+``solver.linear = "iterative"`` (BDDC-CG, what runs distributed).
 
-    python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--ranks 1 2] [--publish]
+Each run is a fresh process (one rank) or ``mpiexec -n N`` (N ranks).
+NGSolve distributes the mesh to ranks 1 .. N-1 (rank 0 makes the mesh and
+keeps it whole, holding no element of the solve): 2 ranks are one part, 3
+ranks two parts.  Post-processing is reduced over the ranks
+(:mod:`ngcontact.distributed.reduced_measures`) and the VTK file written in
+pieces.  One process runs without its discretization error estimate (the
+solves at the neighbouring orders, which a distributed run does not make),
+so that both do the same work.  Per run: dofs, the work's wall time (the
+stages from meshing to post-processing), every rank's peak
+resident memory (``VmHWM`` at its exit) and the whole command's wall time
+(with starting the interpreters).
 
-Writes ``OUT/macro_mpi_scaling.csv`` and ``.png`` (default ``results/macro_mpi_scaling``).
+The model of 64 ranks is on paper: memory of a rank holding a part grows
+linearly with its dofs and rank 0's with the whole mesh's; both lines are
+fitted to the measured distributed runs of the scene with the largest run and evaluated at 63 parts.  The
+time is the measured time per dof of a part times the dofs of a part
+(BDDC-CG's iteration count grows only slowly with the size; communication
+across machines is not in the model).
+
+    python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--femur 1 1.5]
+                                        [--ranks 1 2 3] [--rows-from CSV ...] [--publish]
+
+Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_model.csv`` and ``.png`` (default
+``results/macro_mpi_scaling``).
 """
 from __future__ import annotations
 
 import argparse
-import atexit
 import json
 import os
+import re
 import subprocess
 import sys
 import time
+
+import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
@@ -32,10 +50,13 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 from ngcontact.output.writer import write_csv  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-KEYS = ("ranks", "maxh", "ndof", "wall_s", "solve_s", "newton", "cg_iterations", "peak_mb_rank0",
-        "peak_mb_other_ranks")
+KEYS = ("scene", "size", "ranks", "ndof", "work_s", "wall_s", "newton", "cg_iterations", "peak_mb_rank0",
+        "peak_mb_parts_max", "peak_mb_each")
+MODEL_KEYS = ("ndof", "ranks", "dofs_per_part", "part_gb", "rank0_gb", "solve_s_estimate")
+#: the sizes of the model of 64 ranks
+MODEL_NDOF = (2e6, 1e7, 5e7, 1e8)
 
-SCENE = """\
+PRESS_FIT = """\
 kind = "macro"
 title = "3D press fit of two tubes, a quarter (MPI scaling)"
 [materials.steel]
@@ -73,10 +94,24 @@ boundary = "top"
 pressure = 5e6
 [discretization]
 order = 2
-maxh = {maxh}
+maxh = {size}
+max_elements = 3000000
 [solver]
 linear = "iterative"
 """
+
+
+def femur(factor: float) -> str:
+    """The shipped 3D femur with ``maxh`` and ``interface_maxh`` divided by ``factor``, solved by BDDC-CG."""
+    with open(os.path.join(ROOT, "geometries", "femur_stem_3d.toml")) as fh:
+        text = fh.read()
+    for key in ("maxh", "interface_maxh"):
+        text = re.sub(rf"^{key} = ([0-9.e-]+)", lambda m: f"{key} = {float(m.group(1)) / factor:g}", text,
+                      flags=re.M)
+    return text.replace("\nrtol = 1e-10\n", '\nrtol = 1e-10\nlinear = "iterative"\n')
+
+
+SCENES = {"press_fit": lambda size: PRESS_FIT.format(size=size), "femur": femur}
 
 
 def _peak_mb() -> float:
@@ -89,62 +124,121 @@ def _peak_mb() -> float:
 
 
 def child(scene: str, out: str) -> int:
-    """One rank of a run: ``ngcontact run``, then its peak memory into ``out/peak_rank<R>.txt``."""
-    from ngcontact import cli
+    """One rank of a run: solve and write as ``ngcontact run`` does, without the discretization error
+    estimate in one process (as under MPI); its peak memory into a file."""
+    from ngcontact import runner
+    from ngcontact.distributed.macro_run import accuracy_not_estimated
+    from ngcontact.distributed.vtk_pieces import written
     from ngcontact.distributed.world import launched_rank
-    rank = launched_rank()
-    mem = os.path.join(os.path.dirname(out), f"{os.path.basename(out)}_peak_rank{rank}.txt")
-    atexit.register(lambda: open(mem, "w").write(f"{_peak_mb()}\n"))
-    return cli.main(["run", scene, "--out", out, "--quiet"])
+    from ngcontact.drivers import run_macro
+    from ngcontact.output.writer import write_outputs
+    run_macro.accuracy = lambda scene, sol, solve, balance, *rest: accuracy_not_estimated(scene, sol, balance)
+    report, outcome = runner.solve(scene)
+    written(outcome, lambda: write_outputs(out, report, outcome))
+    with open(f"{out}_peak_rank{launched_rank()}.txt", "w") as fh:
+        fh.write(f"{_peak_mb()}\n")
+    return 0
 
 
-def measure(maxh: float, ranks: int, work: str) -> dict:
-    """One run of the press fit at ``maxh`` on ``ranks`` ranks."""
-    tag = f"h{maxh:g}_r{ranks}"
+def measure(name: str, size: float, ranks: int, work: str) -> dict:
+    """One run of scene ``name`` at ``size`` on ``ranks`` ranks."""
+    tag = f"{name}_{size:g}_r{ranks}"
     scene = os.path.join(work, f"{tag}.toml")
     with open(scene, "w") as fh:
-        fh.write(SCENE.format(maxh=maxh))
+        fh.write(SCENES[name](size))
     out = os.path.join(work, tag)
     cmd = [sys.executable, os.path.abspath(__file__), "--child", scene, out]
     if ranks > 1:
         cmd = ["mpiexec", "-n", str(ranks)] + cmd
-    env = dict(os.environ, MPLBACKEND="Agg")
     t0 = time.perf_counter()
-    subprocess.run(cmd, check=True, env=env)
+    subprocess.run(cmd, check=True, env=dict(os.environ, MPLBACKEND="Agg"))
     wall = time.perf_counter() - t0
     with open(os.path.join(out, "report.json")) as fh:
         rep = json.load(fh)
     peaks = []
     for r in range(ranks):
         with open(f"{out}_peak_rank{r}.txt") as fh:
-            peaks.append(float(fh.read()))
-    return {"ranks": ranks, "maxh": maxh, "ndof": rep["ndof"], "wall_s": round(wall, 2),
-            "solve_s": round(rep["timings"]["solve"], 2), "newton": rep["solver"]["iterations"],
+            peaks.append(round(float(fh.read()), 1))
+    stages = {k: v for k, v in rep["timings"].items() if k != "total"}
+    parts = peaks[1:] if ranks > 1 else peaks
+    return {"scene": name, "size": size, "ranks": ranks, "ndof": rep["ndof"],
+            "work_s": round(sum(stages.values()), 2), "wall_s": round(wall, 2),
+            "newton": rep["solver"]["iterations"],
             "cg_iterations": sum(rep["solver"]["linear"].get("cg_iterations", [])),
-            "peak_mb_rank0": round(peaks[0], 1),
-            "peak_mb_other_ranks": round(max(peaks[1:]), 1) if ranks > 1 else ""}
+            "peak_mb_rank0": peaks[0], "peak_mb_parts_max": max(parts),
+            "peak_mb_each": " ".join(f"{p:g}" for p in peaks)}
+
+
+def read_rows(path: str) -> list[dict]:
+    """The rows of a ``macro_mpi_scaling.csv`` written by an earlier run."""
+    import csv
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    numbers = {"size": float, "ranks": int, "ndof": int, "work_s": float, "wall_s": float, "newton": int,
+               "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
+    return [{k: numbers[k](v) if k in numbers else v for k, v in row.items()} for row in rows]
+
+
+def model(data: list[dict], ranks: int = 64) -> list[dict]:
+    """What ``ranks`` ranks would need at :data:`MODEL_NDOF` (see the module's docstring)."""
+    dist = [d for d in data if d["ranks"] > 1]
+    scene = max(dist, key=lambda d: d["ndof"])["scene"] if dist else ""
+    dist = [d for d in dist if d["scene"] == scene]
+    if len({d["ndof"] for d in dist}) < 2:
+        return []
+    part = np.array([d["ndof"] / (d["ranks"] - 1) for d in dist])
+    ndof = np.array([d["ndof"] for d in dist], dtype=float)
+    a1, a0 = np.polyfit(part, [d["peak_mb_parts_max"] for d in dist], 1)
+    b1, b0 = np.polyfit(ndof, [d["peak_mb_rank0"] for d in dist], 1)
+    if a1 <= 0 or b1 <= 0:
+        return []
+    big = max(dist, key=lambda d: d["ndof"])
+    per_dof = big["work_s"] / (big["ndof"] / (big["ranks"] - 1))
+    rows = []
+    for n in MODEL_NDOF:
+        p = n / (ranks - 1)
+        rows.append({"ndof": int(n), "ranks": ranks, "dofs_per_part": int(p),
+                     "part_gb": round((a0 + a1 * p) / 1024, 2), "rank0_gb": round((b0 + b1 * n) / 1024, 2),
+                     "solve_s_estimate": round(per_dof * p, 1)})
+    return rows
 
 
 def plot(data: list[dict], path: str) -> None:
     import matplotlib.pyplot as plt
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 4))
-    for r in sorted({d["ranks"] for d in data}):
-        rows = sorted((d for d in data if d["ranks"] == r), key=lambda d: d["ndof"])
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for (name, r), mark in zip(sorted({(d["scene"], d["ranks"]) for d in data}), "os^vD<>ph*"):
+        rows = sorted((d for d in data if d["scene"] == name and d["ranks"] == r), key=lambda d: d["ndof"])
         n = [d["ndof"] for d in rows]
-        ax.loglog(n, [d["solve_s"] for d in rows], "o-", label=f"{r} rank(s): solve")
-        ax.loglog(n, [d["wall_s"] for d in rows], "s--", label=f"{r} rank(s): whole command")
-        bx.loglog(n, [d["peak_mb_rank0"] for d in rows], "o-", label=f"{r} rank(s): rank 0")
+        ax.loglog(n, [d["work_s"] for d in rows], mark + "-", label=f"{name}, {r} rank(s)")
+        bx.loglog(n, [d["peak_mb_parts_max"] for d in rows], mark + "-",
+                  label=f"{name}, {r} rank(s): " + ("largest part" if r > 1 else "the process"))
         if r > 1:
-            bx.loglog(n, [d["peak_mb_other_ranks"] for d in rows], "s--", label=f"{r} ranks: largest other")
+            bx.loglog(n, [d["peak_mb_rank0"] for d in rows], mark + ":", label=f"{name}, {r} ranks: rank 0")
     ax.set_xlabel("dofs")
-    ax.set_ylabel("time [s]")
+    ax.set_ylabel("work time [s] (without the order ladder)")
     bx.set_xlabel("dofs")
     bx.set_ylabel("peak memory per rank [MB]")
-    ax.legend(fontsize=8)
-    bx.legend(fontsize=8)
+    ax.legend(fontsize=7)
+    bx.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, BDDC-CG) in one process and under "
+        "`mpiexec -n 2` and `-n 3`. Rank 0 makes the mesh and keeps it whole but holds no element of the "
+        "solve, so 2 ranks are one part (its memory is that of one process's solve) and 3 ranks two parts. "
+        "`work_s`: the stages from meshing to post-processing (one process without its discretization error "
+        "estimate, which a distributed run does not make either). `peak_mb_each`: every rank's peak resident "
+        "memory, rank 0 first. "
+        "Measured on 2 cores shared with other jobs (3 ranks oversubscribe them): times are indicative, "
+        "memory is not affected.")
+MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the largest run (the press fit): the "
+              "peak memory of the largest part fitted as a line in its dofs, rank 0's as a line in the whole "
+              "mesh's dofs (it makes, curves and keeps the whole mesh), both evaluated for 64 ranks (63 parts); "
+              "the time is the largest run's work time per dof of a part times the dofs of a part (BDDC-CG "
+              "iterations grow slowly with the size; communication across machines is not modelled). Rank 0 "
+              "grows with the whole problem and is the limit: meshing in parallel would remove it.")
 
 
 def main(argv=None) -> int:
@@ -153,26 +247,37 @@ def main(argv=None) -> int:
         return child(argv[1], argv[2])
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", nargs="?", default=os.path.join("results", "macro_mpi_scaling"), help="output directory")
-    ap.add_argument("--maxh", type=float, nargs="+", default=[0.004, 0.002, 0.001], help="mesh sizes [m]")
-    ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2], help="numbers of MPI ranks")
+    ap.add_argument("--maxh", type=float, nargs="*", default=[0.004, 0.002, 0.001], help="press fit mesh sizes [m]")
+    ap.add_argument("--femur", type=float, nargs="*", default=[1.0, 1.5], help="femur refinement factors")
+    ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3], help="numbers of MPI ranks")
+    ap.add_argument("--rows-from", nargs="+", default=[], metavar="CSV",
+                    help="no runs: the rows of these CSV files of earlier runs (e.g. a large size run apart)")
+    ap.add_argument("--measured-by", default="", help="with --rows-from: the commands that measured the rows")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     work = os.path.abspath(os.path.join(args.out, "runs"))
     os.makedirs(work, exist_ok=True)
-    data = [measure(h, r, work) for h in args.maxh for r in args.ranks]
+    runs = [("press_fit", h) for h in args.maxh] + [("femur", f) for f in args.femur]
+    data = [row for path in args.rows_from for row in read_rows(path)]
+    for name, size in ([] if args.rows_from else runs):
+        for r in args.ranks:
+            data.append(measure(name, size, r, work))
+            print(" ".join(f"{k}={data[-1][k]}" for k in KEYS), flush=True)
     csv_path = os.path.join(args.out, "macro_mpi_scaling.csv")
     write_csv(csv_path, list(KEYS), [[d[k] for k in KEYS] for d in data])
-    plot(data, os.path.join(args.out, "macro_mpi_scaling.png"))
-    for d in data:
-        print(" ".join(f"{k}={d[k]}" for k in KEYS))
+    rows = model(data)
+    model_path = os.path.join(args.out, "macro_mpi_model.csv")
+    write_csv(model_path, list(MODEL_KEYS), [[m[k] for k in MODEL_KEYS] for m in rows])
+    png = os.path.join(args.out, "macro_mpi_scaling.png")
+    plot(data, png)
+    for m in rows:
+        print(" ".join(f"{k}={m[k]}" for k in MODEL_KEYS))
     if args.publish:
-        benchmark_doc.publish("macro_mpi_scaling", "The 3D press fit on 1 and 2 MPI ranks", csv_path,
-                              note="`ngcontact run` of the 3D press fit (order 2, BDDC-CG) in one process and "
-                              "under `mpiexec -n 2`; wall time of the whole command and of the solve stage, "
-                              "peak resident memory of rank 0 (whole mesh, post-processing) and of the other "
-                              "rank (its part of the mesh). Small sizes only, on a machine shared with other "
-                              "jobs: the times are indicative.",
-                              png=os.path.join(args.out, "macro_mpi_scaling.png"))
+        measured = f" The rows were measured by {args.measured_by}." if args.measured_by else ""
+        benchmark_doc.publish("macro_mpi_scaling", "The 3D press fit and femur on 1, 2 and 3 MPI ranks", csv_path,
+                              note=NOTE + measured, png=png)
+        benchmark_doc.publish("macro_mpi_model", "What 64 MPI ranks would need (a paper model)", model_path,
+                              note=MODEL_NOTE)
     return 0
 
 

@@ -10,15 +10,22 @@ distributed, so ``"direct"`` is refused).  Coulomb friction is solved as in one 
 coupled Newton; the fixed point of ``solver.coulomb = "fixed_point"``
 compares sampled pressures between its passes and is refused here.
 
+Post-processing is reduced over the ranks
+(:class:`ngcontact.distributed.reduced_measures.Reduced`): every rank
+measures its own elements and the parts are combined with MPI, so that the
+report holds one process's numbers without a gathered solution; the stress
+fields are written in pieces, a ``.vtu`` per rank and a ``.pvtu``
+(:mod:`ngcontact.distributed.vtk_pieces`).
+
 What is not: rank 0 checks the model (labels, supports, rigid motions) on
 its whole mesh and reads the supports' geometric data off it (a tilted
 support's mid-point becomes the equivalent affine field ``u0 + G x``, the
-same everywhere), then gathers the solution
-(:func:`ngcontact.distributed.macro_mesh.gather`) and post-processes it on
-the whole mesh exactly as one process does (integrals, peaks, samples,
-figures and the VTK file); it alone writes.  A two-scale scene's cells and
-their batches stay on the executor of one process and are refused under
-MPI.
+same everywhere), orders the interface's samples by its mesh, draws the
+figures and alone writes the report.  The strength check samples the whole
+stress field: with ``[strength]`` the solution is gathered on rank 0
+(:func:`ngcontact.distributed.macro_mesh.gather`) for it alone.  A two-scale
+scene's cells and their batches stay on the executor of one process and are
+refused under MPI.
 """
 from __future__ import annotations
 
@@ -26,8 +33,11 @@ import pickle
 from dataclasses import replace
 
 import ngsolve as ng
+import numpy as np
 
 from ngcontact.distributed.macro_mesh import distribute, gather
+from ngcontact.distributed.reduced_measures import Reduced
+from ngcontact.distributed.vtk_pieces import RankPieces
 from ngcontact.distributed.world import World
 from ngcontact.drivers import run_macro as R
 from ngcontact.errors import SceneError
@@ -110,23 +120,41 @@ def run(scene, clock, world: World) -> Outcome:
     with clock.stage("solve"):
         sol = R.solve_scene(scene, problem)
     with clock.stage("post-processing"):
-        whole_sol = gathered(world, sol, serial)
-        if whole_sol is None:
-            return Outcome(results={}, ndof=sol.ndof, solver={})
-        assert whole is not None
-        outcome = R.measured(whole_sol, whole, info, scene.output)
-    outcome.solver["mpi"] = {"ranks": world.size, "distributed": "mesh, assembly, Newton with BDDC-CG",
-                             "rank_0": "checks, post-processing on the gathered solution, files"}
+        outcome = R.measured(sol, geo, info, scene.output, Reduced(world, whole.mesh if whole else None))
+        outcome.ndof = global_ndof(sol, world)
+        outcome.vtk["stress"].pieces = RankPieces(world)
+        outcome.results["accuracy"] = accuracy_not_estimated(scene, sol, outcome.results["equilibrium"])
+    outcome.solver["mpi"] = {"ranks": world.size, "distributed": "mesh, assembly, Newton with BDDC-CG, "
+                             "post-processing reduced over the ranks, VTK in pieces",
+                             "rank_0": "checks, the interface's samples in its mesh's order, figures, files"}
     if scene.strength is not None:
-        from ngcontact.drivers.run_strength import evaluate
         with clock.stage("strength check"):
-            st = evaluate(scene, whole_sol)
-        outcome.results["strength"] = st["results"]
-        outcome.tables["strength_map"] = st["table"]
-        outcome.vtk["worst_cell"] = st["vtk"]
-        outcome.plots.update(st["plots"])
-    outcome.results["accuracy"] = accuracy_not_estimated(scene, whole_sol, outcome.results["equilibrium"])
+            strength(scene, world, sol, serial, outcome)
+    if not world.root:
+        return Outcome(results={}, ndof=outcome.ndof, solver={}, vtk=outcome.vtk)
     return outcome
+
+
+def strength(scene, world: World, sol: M.MacroSolution, serial: M.MacroProblem | None, outcome: Outcome) -> None:
+    """The strength check (:mod:`ngcontact.drivers.run_strength`) on rank 0: its stress recovery samples
+    the whole field, so the solution is gathered for it (and only for it)."""
+    from ngcontact.drivers.run_strength import evaluate
+    whole_sol = gathered(world, sol, serial)
+    if whole_sol is None:
+        return
+    st = evaluate(scene, whole_sol)
+    outcome.results["strength"] = st["results"]
+    outcome.tables["strength_map"] = st["table"]
+    outcome.vtk["worst_cell"] = st["vtk"]
+    outcome.plots.update(st["plots"])
+
+
+def global_ndof(sol: M.MacroSolution, world: World) -> int:
+    """The free dofs of the distributed solution, each counted once (on the rank that is its master)."""
+    fes = sol.gfu.space
+    free = np.array(list(fes.FreeDofs()), dtype=bool)
+    master = np.array(list(fes.ParallelDofs().MasterDofs()), dtype=bool)
+    return int(world.comm.allreduce(int(np.count_nonzero(free & master))))
 
 
 def accuracy_not_estimated(scene, sol: M.MacroSolution, balance: dict) -> dict:

@@ -63,7 +63,7 @@ from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
 
 from ngcontact.fem.rigid_modes import check_rigid_modes
-from ngcontact.fem.reaction import support_reactions
+from ngcontact.macro.solution_measures import WHOLE_MESH, Measures, reactions_of
 
 log = logging.getLogger(__name__)
 
@@ -222,10 +222,7 @@ def problem_of(scene, geometry: gm.MacroGeometry, *, order=None) -> tuple[M.Macr
 
 def reactions(sol: M.MacroSolution) -> dict:
     """Reaction force (and moment) of every supported boundary (:func:`ngcontact.fem.reaction.support_reactions`)."""
-    p = sol.problem
-    return support_reactions(p.mesh, p.setting, p.order, p.supports,
-                             ((p.rough, p.materials[p.rough], sol.u_rough),
-                              (p.counter, p.materials[p.counter], sol.u_counter)), p.body_forces)
+    return reactions_of(sol)
 
 
 def solve_scene(scene, problem: M.MacroProblem, start=None, rtol: float | None = None) -> M.MacroSolution:
@@ -241,15 +238,15 @@ def solve_scene(scene, problem: M.MacroProblem, start=None, rtol: float | None =
                    coulomb=s.coulomb, start=start)
 
 
-def checked_equilibrium(sol: M.MacroSolution) -> dict:
-    """:func:`ngcontact.macro.macro_measures.equilibrium`, refused beyond its tolerance.
+def checked_equilibrium(sol: M.MacroSolution, measures: Measures = WHOLE_MESH) -> dict:
+    """:func:`ngcontact.macro.macro_measures.equilibrium` (taken by ``measures``), refused beyond its tolerance.
 
     Raises
     ------
     ConvergenceError
         A body's forces do not balance: the figures of the worst one.
     """
-    eq = MM.equilibrium(sol)
+    eq = measures.equilibrium(sol)
     if not eq["error"] <= eq["tolerance"]:
         body, comp, f = max(((b, c, f) for b, fc in eq["bodies"].items() for c, f in fc.items()),
                             key=lambda t: abs(t[2]["imbalance"]))
@@ -309,30 +306,32 @@ def run(scene, clock) -> Outcome:
     return outcome
 
 
-def measured(sol: M.MacroSolution, geo: gm.MacroGeometry, law_info: dict, output) -> Outcome:
+def measured(sol: M.MacroSolution, geo: gm.MacroGeometry, law_info: dict, output,
+             measures: Measures = WHOLE_MESH) -> Outcome:
     """What a macro run reports of a solution on ``geo``: ``results`` (see the module's docstring; without
     the two-scale and strength parts), the interface table, the figures, the VTK fields and the solver's
-    record.  ``output``: the scene's ``[output]`` section (samples per interface element, VTK subdivision).
+    record.  ``output``: the scene's ``[output]`` section (samples per interface element, VTK subdivision);
+    ``measures``: where the measures are taken (one process's whole mesh, or reduced over MPI ranks).
 
     Raises
     ------
     ConvergenceError
         The solution is not in equilibrium (:func:`checked_equilibrium`).
     """
-    balance = checked_equilibrium(sol)
+    balance = checked_equilibrium(sol, measures)
     fields = MM.stress_fields(sol)
-    extrema = MM.field_extrema(sol, fields)
+    extrema = measures.extrema(sol, fields)
     problem = sol.problem
     results = {"setting": problem.setting, "bodies": {"rough": problem.rough, "counter": problem.counter},
                "dimensions": geo.dims, "law": law_info, "resultant": MM.resultant(sol),
-               "reactions": reactions(sol),
+               "reactions": measures.reactions(sol),
                "newton_iterations": sol.history["newton_iterations"],
                "coulomb_iterations": sol.history["coulomb_iterations"], "equilibrium": balance}
     maxima = {name: ext for name, ext in extrema.items()}
     tables: dict[str, Any] = {}
     plots: dict[str, Any] = {}
     interface = interface_2d if geo.mesh.dim == 2 else interface_3d
-    interface(sol, fields, output, geo, results, maxima, tables, plots)
+    interface(sol, fields, output, geo, results, maxima, tables, plots, measures)
     results["maxima"] = maxima
     results["warnings"] = small_strain_warnings(maxima["von_mises_strain"]["max"]["value"])
     vtk = {"stress": VtkField(mesh=geo.mesh, fields=dict(fields, u_rough=sol.u_rough, u_counter=sol.u_counter),
@@ -345,10 +344,10 @@ def measured(sol: M.MacroSolution, geo: gm.MacroGeometry, law_info: dict, output
     return Outcome(results=results, ndof=sol.ndof, solver=solver, tables=tables, vtk=vtk, plots=plots)
 
 
-def interface_2d(sol, fields, output, geo, results, maxima, tables, plots) -> None:
+def interface_2d(sol, fields, output, geo, results, maxima, tables, plots, measures: Measures) -> None:
     """The interface of a 2D (plane strain, axisymmetric) solution along its arc: profile, status, peaks,
     detachment, its table and figures (``output.points_per_element`` samples per element)."""
-    prof = MM.interface_profile(sol, output.points_per_element)
+    prof = measures.profile(sol, output.points_per_element)
     results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in prof.items()}
     results["status_counts"] = dict(Counter(prof["status"]))
     maxima["pressure"] = MM.peak_pressure(prof)
@@ -358,14 +357,14 @@ def interface_2d(sol, fields, output, geo, results, maxima, tables, plots) -> No
     header = list(prof)
     tables["interface"] = (header, list(zip(*[prof[h] for h in header])))
     plots["interface"] = lambda path, prof=prof: figures.macro_interface(path, prof)
-    samples = field_samples(sol, fields)
+    samples = measures.samples(field_samples, sol, fields)
     plots["stress"] = lambda path, d=samples: figures.macro_fields(path, **d)
 
 
-def interface_3d(sol, fields, output, geo, results, maxima, tables, plots) -> None:
+def interface_3d(sol, fields, output, geo, results, maxima, tables, plots, measures: Measures) -> None:
     """The interface of a 3D solution over its surface: samples, contact area, status, peaks, its table and
     figures (and the stress on the section plane where the mesh has one)."""
-    surf = MM.interface_surface(sol)
+    surf = measures.surface(sol)
     results["contact_area"] = surf.pop("contact_area")
     results["mean_pressure"] = MM.mean_pressure(sol)
     results["interface"] = {k: (list(v) if k == "status" else np.asarray(v)) for k, v in surf.items()}
@@ -378,7 +377,7 @@ def interface_3d(sol, fields, output, geo, results, maxima, tables, plots) -> No
     plots["interface"] = lambda path, sf=surf: figures.macro_interface_3d(path, sf)
     plots["interface_axial"] = lambda path, sf=surf: figures.macro_interface_axial(path, sf)
     if SECTION in M.boundary_labels(geo.mesh):
-        section = section_samples(sol, fields)
+        section = measures.samples(section_samples, sol, fields)
         plots["stress"] = lambda path, d=section: figures.macro_fields(path, **d)
 
 

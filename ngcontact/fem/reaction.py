@@ -79,7 +79,7 @@ def boundary_reaction(mesh, setting: str, law, u, region: str, label: str, order
     return out
 
 
-def support_reactions(mesh, setting: str, order: int, supports, bodies, forces=None) -> dict:
+def support_reactions(mesh, setting: str, order: int, supports, bodies, forces=None, centres=None) -> dict:
     """Reaction force (and, in plane strain, moment) of every supported boundary, summed over the bodies.
 
     ``supports``: the problem's :class:`~ngcontact.fem.two_body.Support`
@@ -90,7 +90,8 @@ def support_reactions(mesh, setting: str, order: int, supports, bodies, forces=N
     revolution vanishes) and there is no moment; a support fixing every
     component in plane strain also reports its moment about the boundary's
     mid-point (:func:`boundary_reaction`).  A boundary fixed in no kept
-    component has no entry.
+    component has no entry.  ``centres``: label -> that mid-point, where
+    ``mesh`` is one rank's part of a distributed mesh (see :func:`boundary_centre`).
     """
     comps = COMPONENTS[setting]
     out = {}
@@ -101,8 +102,9 @@ def support_reactions(mesh, setting: str, order: int, supports, bodies, forces=N
             keep.append("moment")
         if not keep:
             continue
-        xs = [mesh[v].point for el in mesh.Elements(ng.BND) if el.mat == label for v in el.vertices]
-        about = tuple(0.5 * (min(p[i] for p in xs) + max(p[i] for p in xs)) for i in range(mesh.dim))
+        about = (0.0,) * mesh.dim
+        if "moment" in keep:
+            about = (centres or {}).get(label) or boundary_centre(mesh, label)
         total: dict | None = None
         for region, law, u in bodies:
             r = boundary_reaction(mesh, setting, law, u, region, label, order, about=about,
@@ -111,3 +113,9 @@ def support_reactions(mesh, setting: str, order: int, supports, bodies, forces=N
         assert total is not None  # every problem has two bodies
         out[label] = {k: total[k] for k in keep}
     return out
+
+
+def boundary_centre(mesh, label: str) -> tuple[float, ...]:
+    """The mid-point of the bounding box of boundary ``label``'s vertices (the centre of its moment)."""
+    xs = [mesh[v].point for el in mesh.Elements(ng.BND) if el.mat == label for v in el.vertices]
+    return tuple(0.5 * (min(p[i] for p in xs) + max(p[i] for p in xs)) for i in range(mesh.dim))

@@ -92,28 +92,40 @@ def _sample_rule(dim: int, inset: float = 1e-3):
     return ng.IntegrationRule(pts, [0.0] * len(pts))
 
 
-def field_extrema(sol: MacroSolution, fields: dict) -> dict:
+def field_extrema(sol: MacroSolution, fields: dict, candidates=None) -> dict:
     """Largest and smallest value of each field with its location and body.
 
     Sampled next to the vertices, at edge midpoints and centroids of every
     element, on each body's side separately (the fields jump across ``S_0``).
+    ``candidates``: a function of this process's list of candidates (one
+    :func:`extrema_candidates` per body) returning every process's in a fixed
+    order (for a mesh distributed over MPI ranks); the first best is kept.
     """
-    p = sol.problem
-    mesh = p.mesh
-    rule = _sample_rule(mesh.dim)
-    coords = ng.CF((ng.x, ng.y, ng.z)[:mesh.dim])
+    mine = [extrema_candidates(sol, fields, region) for region in (sol.problem.rough, sol.problem.counter)]
+    every = mine if candidates is None else candidates(mine)
     out: dict[str, dict[str, dict[str, Any]]] = {name: {} for name in fields}
-    for region in (p.rough, p.counter):
-        mips = mesh.MapToAllElements(rule, mesh.Materials(region))
-        xyz = np.asarray(coords(mips)).reshape(-1, mesh.dim)
-        for name, cf in fields.items():
-            vals = np.asarray(cf(mips)).ravel()
-            for key, k in (("max", int(np.argmax(vals))), ("min", int(np.argmin(vals)))):
+    for cand in every:
+        for name, by_key in cand.items():
+            for key, found in by_key.items():
                 best = out[name].get(key)
-                better = best is None or (vals[k] > best["value"] if key == "max" else vals[k] < best["value"])
-                if better:
-                    out[name][key] = {"value": float(vals[k]), "location": [float(c) for c in xyz[k]],
-                                      "body": region}
+                if best is None or (found["value"] > best["value"] if key == "max" else found["value"] < best["value"]):
+                    out[name][key] = found
+    return out
+
+
+def extrema_candidates(sol: MacroSolution, fields: dict, region: str) -> dict:
+    """The largest and smallest sample of each field in ``region`` on this process's elements (none where
+    it has no elements of the region)."""
+    mesh = sol.problem.mesh
+    mips = mesh.MapToAllElements(_sample_rule(mesh.dim), mesh.Materials(region))
+    xyz = np.asarray(ng.CF((ng.x, ng.y, ng.z)[:mesh.dim])(mips)).reshape(-1, mesh.dim)
+    out: dict[str, dict[str, dict[str, Any]]] = {name: {} for name in fields}
+    if not len(xyz):
+        return out
+    for name, cf in fields.items():
+        vals = np.asarray(cf(mips)).ravel()
+        for key, k in (("max", int(np.argmax(vals))), ("min", int(np.argmin(vals)))):
+            out[name][key] = {"value": float(vals[k]), "location": [float(c) for c in xyz[k]], "body": region}
     return out
 
 
@@ -156,7 +168,7 @@ def mean_pressure(sol: MacroSolution) -> float:
     return float(force / ng.Integrate(w, p.mesh, ng.BND, definedon=on, order=energy_order(p.order)))
 
 
-def equilibrium(sol: MacroSolution) -> dict:
+def equilibrium(sol: MacroSolution, total=None) -> dict:
     """Each body's force balance at the solution, and its largest relative imbalance.
 
     For body ``B`` and every rigid translation ``e_i`` of it (axisymmetric:
@@ -174,6 +186,10 @@ def equilibrium(sol: MacroSolution) -> dict:
     magnitude, ``int |tau| w ds`` (an interference fit carries a large
     force whose resultant is zero).
 
+    ``total``: the sum of a number over the MPI ranks of a distributed
+    mesh (each rank's dot products of its part of the residual with the
+    test field; identity in one process).
+
     Returns
     -------
     dict
@@ -183,12 +199,15 @@ def equilibrium(sol: MacroSolution) -> dict:
     """
     p = sol.problem
     fes = sol.gfu.space
-    r = sol.gfu.vec.CreateVector()
-    energy_form(sol).Apply(sol.gfu.vec, r)
-    rl = sol.gfu.vec.CreateVector()
-    load_form(sol).Apply(sol.gfu.vec, rl)
+    add = total or float
+    vectors = []
+    for form in (energy_form(sol), load_form(sol)):
+        vec = sol.gfu.vec.CreateVector()
+        form.Apply(sol.gfu.vec, vec)
+        vec.Distribute()      # a residual's shared dofs split over the ranks (nothing in one process)
+        vectors.append(vec.FV().NumPy().copy())
+    r, rl = vectors
     free = np.array(list(fes.FreeDofs()), dtype=bool)
-    r, rl = np.asarray(r), np.asarray(rl)
     comps = ("z",) if p.setting == "axisymmetric" else COMPONENTS[p.setting]
     every = COMPONENTS[p.setting]
     test = ng.GridFunction(fes)
@@ -198,12 +217,13 @@ def equilibrium(sol: MacroSolution) -> dict:
         for c in comps:
             test.vec[:] = 0.0
             test.components[b].Set(ng.CF(tuple(1.0 if k == c else 0.0 for k in every)))
-            v = np.asarray(test.vec)
-            applied = -float(rl @ v)
-            interface = -float(r @ v) - applied  # r = elastic + interface - applied; elastic(e_i) = 0
-            supports = float(r[~free] @ v[~free])
+            test.vec.Cumulate()   # the test field whole on every rank that shares a dof
+            v = test.vec.FV().NumPy()
+            applied = -add(float(rl @ v))
+            interface = -add(float(r @ v)) - applied  # r = elastic + interface - applied; elastic(e_i) = 0
+            supports = add(float(r[~free] @ v[~free]))
             bodies[name][c] = {"applied": applied, "interface": interface, "supports": supports,
-                               "imbalance": -float(r[free] @ v[free])}
+                               "imbalance": -add(float(r[free] @ v[free]))}
     tau = interface_tractions(sol)
     magnitude = float(ng.Integrate(ng.sqrt(sum(t * t for t in tau)) * elasticity.weight(p.setting), p.mesh,
                                    ng.BND, definedon=p.mesh.Boundaries(p.interface), order=energy_order(p.order)))
@@ -227,6 +247,12 @@ def interface_profile(sol: MacroSolution, points_per_element: int = 5) -> dict:
     whether the law has a tangential stiffness).  Element end points appear
     once per element, so values that jump at a kink of ``n0`` show both sides.
     """
+    return profile_of(sol, profile_rows(sol, points_per_element))
+
+
+def profile_rows(sol: MacroSolution, points_per_element: int = 5) -> np.ndarray:
+    """The samples of :func:`interface_profile` on this process's interface elements, in their order:
+    shape ``(elements, points, 6)``, columns ``x, y``, the tractions ``tau_n, tau_t``, the jumps ``a_n, a_t``."""
     p = sol.problem
     mesh = p.mesh
     if mesh.dim != 2:
@@ -237,7 +263,12 @@ def interface_profile(sol: MacroSolution, points_per_element: int = 5) -> dict:
     tau = interface_tractions(sol)
     a = sol.local_jump
     cf = ng.CF((ng.x, ng.y, tau[0], tau[1], a[0], a[1]))
-    vals = np.asarray(cf(mips)).reshape(-1, k, 6)
+    return np.asarray(cf(mips)).reshape(-1, k, 6)
+
+
+def profile_of(sol: MacroSolution, vals: np.ndarray) -> dict:
+    """:func:`interface_profile` from the samples of every interface element (:func:`profile_rows`)."""
+    p = sol.problem
     order = _chain(vals[:, 0, :2], vals[:, -1, :2])
     rows = np.concatenate([vals[e, ::-1] if flip else vals[e] for e, flip in order])
     steps = np.hypot(np.diff(rows[:, 0]), np.diff(rows[:, 1]))
@@ -261,13 +292,25 @@ def interface_surface(sol: MacroSolution) -> dict:
     and ``contact_area``: the area of ``S_0`` where ``p > 0`` over its whole
     area, integrated with the energy's quadrature.
     """
-    p = sol.problem
-    mesh = p.mesh
-    mips = _surface_points(sol)
+    return surface_of(sol, surface_rows(sol))
+
+
+def surface_rows(sol: MacroSolution) -> np.ndarray:
+    """The samples of :func:`interface_surface` on this process's interface triangles, in their order:
+    one row per point (:data:`SURFACE_POINTS` of each triangle in turn), columns ``x, y, z``, the tractions
+    ``tau_n, tau_1, tau_2`` and the jumps ``a_n, a_1, a_2``."""
     tau = interface_tractions(sol)
     a = sol.local_jump
     cf = ng.CF((ng.x, ng.y, ng.z, tau[0], tau[1], tau[2], a[0], a[1], a[2]))
-    v = np.asarray(cf(mips)).reshape(-1, 9)
+    return np.asarray(cf(_surface_points(sol))).reshape(-1, 9)
+
+
+def surface_of(sol: MacroSolution, v: np.ndarray) -> dict:
+    """:func:`interface_surface` from the samples of every interface triangle (:func:`surface_rows`); the
+    contact area is integrated over the (possibly distributed) mesh."""
+    p = sol.problem
+    mesh = p.mesh
+    tau = interface_tractions(sol)
     shear = np.hypot(v[:, 4], v[:, 5])
     slip = np.hypot(v[:, 7], v[:, 8])
     on = mesh.Boundaries(p.interface)

@@ -23,7 +23,7 @@ import math
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any, Callable, Protocol
 
 import numpy as np
 
@@ -34,13 +34,29 @@ if TYPE_CHECKING:
 SCHEMA = "ngcontact-report/1"
 
 
+class Pieces(Protocol):
+    """How the fields on a mesh distributed over MPI ranks are written: a ``.vtu`` piece per rank holding
+    elements and the ``.pvtu`` file that names them (:mod:`ngcontact.distributed.vtk_pieces`)."""
+
+    def files(self, name: str) -> list[str]:
+        """The names of the files of ``name``: the ``.pvtu`` file and the pieces."""
+
+    def write(self, path_noext: str, item: VtkField) -> None:
+        """Write ``item`` (every rank its piece), on rank 0."""
+
+
 @dataclass
 class VtkField:
-    """Fields on a mesh to write as one ``.vtu`` file."""
+    """Fields on a mesh to write as one ``.vtu`` file (``pieces``: a mesh distributed over MPI ranks)."""
 
     mesh: ng.Mesh
     fields: dict[str, ng.CoefficientFunction]
     subdivision: int = 1
+    pieces: Pieces | None = None
+
+    def files(self, name: str) -> list[str]:
+        """The names of the files written for the field set ``name``."""
+        return [f"{name}.vtu"] if self.pieces is None else self.pieces.files(name)
 
 
 @dataclass
@@ -137,7 +153,7 @@ def accuracy_line(results: dict) -> str | None:
 
 def file_names(outcome: Outcome) -> list[str]:
     """The names of the files an outcome writes besides ``report.json`` (the report's ``files``)."""
-    return sorted([f"{n}.csv" for n in outcome.tables] + [f"{n}.vtu" for n in outcome.vtk]
+    return sorted([f"{n}.csv" for n in outcome.tables] + [f for n, v in outcome.vtk.items() for f in v.files(n)]
                   + [f"{n}.png" for n in outcome.plots] + [f"{n}.npy" for n in outcome.arrays] + list(outcome.texts))
 
 

@@ -67,7 +67,7 @@ STAGING_PREFIX = ".ngcontact-partial-"
 #: :func:`ngcontact.output.report.file_names`) and the law files of ``ngcontact export``
 #: (:data:`ngcontact.export.export_law.FORMATS`) and the scene an accuracy study recommends.  The manifest is
 #: handled apart.
-OWN_NAMES = re.compile(r"report\.json|report\.html|[a-z][a-z0-9_]*\.(?:csv|vtu|png|npy)"
+OWN_NAMES = re.compile(r"report\.json|report\.html|[a-z][a-z0-9_]*\.(?:csv|vtu|pvtu|png|npy)"
                        r"|interface_law(?:_[a-z]+)?\.(?:inp|mac|json)|recommended\.toml")
 
 
@@ -87,7 +87,11 @@ def write_csv(path: str, header, rows) -> None:
 
 
 def write_vtk(path_noext: str, item: VtkField) -> None:
-    """One ``.vtu`` file of the fields of ``item`` (NGSolve appends the extension)."""
+    """One ``.vtu`` file of the fields of ``item`` (NGSolve appends the extension); on a mesh distributed
+    over MPI ranks a ``.pvtu`` file and its pieces (``item.pieces``)."""
+    if item.pieces is not None:
+        item.pieces.write(path_noext, item)
+        return
     import ngsolve as ng
     names = list(item.fields)
     ng.VTKOutput(ma=item.mesh, coefs=[item.fields[n] for n in names], names=names,

@@ -154,17 +154,32 @@ def _largest_difference(serial: dict, parallel: dict) -> tuple[float, str]:
     return worst
 
 
-def _agree(tmp_path: Path, text: str) -> dict:
+def _agree(tmp_path: Path, text: str, ranks: int = 2) -> dict:
     serial = _run(tmp_path, text, "serial", 1)
-    parallel = _run(tmp_path, text, "parallel", 2)
-    assert parallel["compute"]["mpi_ranks"] == 2
-    assert parallel["solver"]["mpi"]["ranks"] == 2
+    parallel = _run(tmp_path, text, "parallel", ranks)
+    assert parallel["compute"]["mpi_ranks"] == ranks
+    assert parallel["solver"]["mpi"]["ranks"] == ranks
     assert "mpi_ranks" not in serial["compute"]
     assert parallel["ndof"] == serial["ndof"]
     err, where = _largest_difference(serial, parallel)
     assert err <= AGREEMENT, f"{where}: serial and 2 ranks differ by {err:.2e} of the largest value"
-    assert (tmp_path / "parallel" / "stress.vtu").exists()
+    _pieces_written(tmp_path / "parallel", parallel, ranks)
     return parallel
+
+
+def _pieces_written(out: Path, report: dict, ranks: int) -> None:
+    """The stress fields in parallel pieces: ``stress.pvtu`` naming a ``.vtu`` per rank that holds elements
+    (ranks 1 .. N-1), each with the fields' arrays; no gathered ``stress.vtu``."""
+    pvtu = (out / "stress.pvtu").read_text()
+    assert pvtu.count("<Piece ") == ranks - 1
+    for rank in range(1, ranks):
+        name = f"stress_proc{rank}.vtu"
+        assert f'Source="{name}"' in pvtu and name in report["files"]
+        head = (out / name).read_bytes()[:4000]
+        for field in ("von_mises", "u_rough", "u_counter"):
+            assert f'Name="{field}"'.encode() in head and f'Name="{field}"' in pvtu
+    assert not (out / "stress.vtu").exists() and not (out / "stress.pvd").exists()
+    assert "post-processing reduced over the ranks" in report["solver"]["mpi"]["distributed"]
 
 
 @pytest.mark.mpi
@@ -174,6 +189,15 @@ def test_a_2d_block_with_friction_on_two_ranks_reports_what_one_process_does(tmp
     counts = parallel["results"]["status_counts"]
     assert counts.get("slip", 0) > 0 and counts.get("stick", 0) > 0     # friction: both states occur
     assert parallel["solver"]["coulomb"]["method"] == "coupled Newton"
+
+
+@pytest.mark.mpi
+@needs_mpi
+def test_a_2d_block_on_three_ranks_puts_the_two_parts_interfaces_in_order(tmp_path):
+    """Rank 0 keeps no elements: three ranks are two parts, whose interface samples, extrema and sums are
+    combined in the order of one process (and two VTK pieces written)."""
+    parallel = _agree(tmp_path, BLOCK, ranks=3)
+    assert parallel["results"]["status_counts"].get("slip", 0) > 0
 
 
 @pytest.mark.mpi
@@ -191,6 +215,22 @@ def test_the_shipped_3d_femur_with_friction_on_two_ranks_reports_what_one_proces
     assert "\nrtol = 1e-10\n" in text
     parallel = _agree(tmp_path, text.replace("\nrtol = 1e-10\n", '\nrtol = 1e-10\nlinear = "iterative"\n'))
     assert parallel["solver"]["coulomb"]["method"] == "coupled Newton"
+
+
+@pytest.mark.mpi
+@pytest.mark.slow
+@needs_mpi
+def test_the_axisymmetric_femur_with_its_strength_check_on_two_ranks_reports_what_one_process_does(tmp_path):
+    """The strength check gathers the solution on rank 0 (its recovery samples the whole field); the rest of
+    the report is reduced over the ranks."""
+    text = (ROOT / "geometries" / "femur_stem.toml").read_text()
+    for old, new in (("\nrtol = 1e-10\n", '\nrtol = 1e-10\nlinear = "iterative"\n'), ("\norder = 3 ", "\norder = 2 "),
+                     ('"cells/hip_hills.toml"', f'"{ROOT / "geometries" / "cells" / "hip_hills.toml"}"')):
+        assert old in text
+        text = text.replace(old, new)
+    parallel = _agree(tmp_path, text)
+    assert parallel["results"]["strength"]["safety_factor"] > 1
+    assert (tmp_path / "parallel" / "worst_cell.vtu").exists()
 
 
 @pytest.mark.mpi
@@ -249,3 +289,22 @@ def test_a_tilted_support_becomes_the_same_affine_field():
     diff = affine_field(mesh, tilted, comps) - affine_field(mesh, affine, comps)
     err = ng.Integrate(ng.InnerProduct(diff, diff), mesh, definedon=mesh.Boundaries("bottom"))
     assert abs(err) <= 1e-30
+
+
+def test_the_pvtu_file_names_every_piece_and_the_fields_arrays():
+    """What rank 0 writes beside the pieces (no MPI needed: the text and the names only)."""
+    import ngsolve as ng
+
+    from ngcontact.distributed.vtk_pieces import RankPieces, pvtu
+    from ngcontact.distributed.world import World
+    from ngcontact.output.report import VtkField
+
+    pieces = RankPieces(World(comm=None, rank=0, size=3))
+    assert pieces.files("stress") == ["stress.pvtu", "stress_proc1.vtu", "stress_proc2.vtu"]
+    item = VtkField(mesh=None, fields={"von_mises": ng.CF(1.0), "u_rough": ng.CF((0.0, 0.0, 0.0))},
+                    pieces=pieces)
+    assert item.files("stress") == pieces.files("stress")
+    text = pvtu("stress", item, 3)
+    assert 'type="PUnstructuredGrid"' in text and text.count("<Piece ") == 2
+    assert 'Name="von_mises" NumberOfComponents="1"' in text and 'Name="u_rough" NumberOfComponents="3"' in text
+    assert VtkField(mesh=None, fields={}).files("stress") == ["stress.vtu"]

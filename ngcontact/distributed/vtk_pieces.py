@@ -1,0 +1,90 @@
+"""VTK fields of a mesh distributed over MPI ranks, written in parallel: a ``.vtu`` piece per rank and a ``.pvtu``.
+
+NGSolve's ``VTKOutput`` on a distributed mesh writes, on every rank that
+holds elements (ranks ``1 .. N-1``: rank 0 keeps none), the piece
+``NAME_proc<R>.vtu`` of its own elements; no rank gathers the fields.  Rank
+0 then writes ``NAME.pvtu``, the parallel file that names the pieces and
+their arrays (the points and one point array per field), which ParaView
+opens as one data set.
+
+Rank 0 alone runs the writer of the output directory
+(:mod:`ngcontact.output.writer`: staged in a temporary directory, moved into
+place).  The other ranks wait in :func:`written` for the path of each field
+set, which rank 0 sends when its writer reaches it, write their pieces
+there, and are released when rank 0's writer ends (whether or not it
+succeeded).
+"""
+from __future__ import annotations
+
+import os
+from typing import Callable
+
+from ngcontact.distributed.world import World, launched_rank
+
+
+class RankPieces:
+    """The :class:`~ngcontact.output.report.Pieces` of ``world``: one piece per rank ``1 .. N-1``."""
+
+    def __init__(self, world: World):
+        self.world = world
+
+    def files(self, name: str) -> list[str]:
+        return [f"{name}.pvtu"] + [piece(name, r) for r in range(1, self.world.size)]
+
+    def write(self, path_noext: str, item) -> None:
+        """On rank 0: send the path, write together with the other ranks, then the ``.pvtu`` file."""
+        self.world.comm.bcast(path_noext)
+        write_piece(path_noext, item, self.world)
+        with open(path_noext + ".pvtu", "w", encoding="utf-8") as fh:
+            fh.write(pvtu(os.path.basename(path_noext), item, self.world.size))
+
+
+def piece(name: str, rank: int) -> str:
+    """The file name of rank ``rank``'s piece (NGSolve's naming)."""
+    return f"{name}_proc{rank}.vtu"
+
+
+def write_piece(path_noext: str, item, world: World) -> None:
+    """Every rank's part of ``item``'s fields (together on all ranks; rank 0's is empty)."""
+    import ngsolve as ng
+    names = list(item.fields)
+    ng.VTKOutput(ma=item.mesh, coefs=[item.fields[n] for n in names], names=names, filename=path_noext,
+                 subdivision=item.subdivision, legacy=False).Do()
+    world.comm.Barrier()
+    stray = path_noext + ".pvd"           # NGSolve's collection file: the .pvtu replaces it
+    if world.root and os.path.exists(stray):
+        os.remove(stray)
+
+
+def pvtu(name: str, item, ranks: int) -> str:
+    """The ``.pvtu`` text of the pieces ``1 .. ranks-1`` of ``name`` with ``item``'s point arrays."""
+    arrays = "".join(f'      <PDataArray type="Float64" Name="{n}" NumberOfComponents="{cf.dim}"/>\n'
+                     for n, cf in item.fields.items())
+    pieces = "".join(f'    <Piece Source="{piece(name, r)}"/>\n' for r in range(1, ranks))
+    return ('<?xml version="1.0"?>\n'
+            '<VTKFile type="PUnstructuredGrid" version="1.0" byte_order="LittleEndian">\n'
+            '  <PUnstructuredGrid GhostLevel="0">\n'
+            '    <PPoints>\n      <PDataArray type="Float64" Name="Points" NumberOfComponents="3"/>\n'
+            '    </PPoints>\n'
+            f'    <PPointData>\n{arrays}    </PPointData>\n'
+            f'{pieces}'
+            '  </PUnstructuredGrid>\n</VTKFile>\n')
+
+
+def written(outcome, write: Callable[[], object]) -> None:
+    """``write()`` (the output directory's writer) on rank 0, with the other ranks writing their pieces of
+    ``outcome``'s distributed fields as rank 0 reaches them; without such fields just ``write()`` on rank 0."""
+    pieces = [v.pieces for v in outcome.vtk.values() if isinstance(v.pieces, RankPieces)]
+    if not pieces:
+        if launched_rank() == 0:
+            write()
+        return
+    world = pieces[0].world
+    if world.root:
+        try:
+            write()
+        finally:
+            world.comm.bcast(None)     # the other ranks stop waiting
+        return
+    while (path := world.comm.bcast(None)) is not None:
+        write_piece(path, outcome.vtk[os.path.basename(path)], world)
