@@ -168,9 +168,12 @@ class FECell:
         return "none" if self.refiner() is None else "sequence"
 
     def refines_by_default(self) -> bool:
-        """No: a sweep without a stated tolerance keeps the scene's mesh and says it is not estimated.  The
-        default estimate (:meth:`default_refinement`: grading, or a sequence of discretizations) multiplies an FE
-        cell's run time several times over, so it is asked for by stating ``discretization.tolerance``."""
+        """No: a sweep without a stated tolerance keeps the scene's mesh and says it is not estimated.  An
+        honest estimate of the value reported needs three discretizations (:meth:`default_refinement`: the
+        grading levels and three orders on the finest, or interface meshes halved twice, each several times
+        the last), which multiplies an FE cell's run time several times over (``scene_seconds`` against
+        ``seconds`` in ``docs/benchmarks.md``, FE effectivity), so it is asked for by stating
+        ``discretization.tolerance``."""
         return False
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
