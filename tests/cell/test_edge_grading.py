@@ -146,6 +146,11 @@ def _graded_scene(**solver):
     return dataclasses.replace(sc, solver=dataclasses.replace(sc.solver, **solver)) if solver else sc
 
 
+#: the spectral twin's contact fraction error on the share's grid: 2e-5 at 65,536 points, falling like the
+#: grid step (ngcontact.cell.spectral.grid_measures)
+TWIN_COLLOCATION = 2e-5 * 65536 / 16384
+
+
 def _fraction_shares(sc, loads, solutions) -> list[float]:
     """The penalty's share of each load's contact fraction (:mod:`ngcontact.cell.penalty_share`): Westergaard is
     the rigid limit, so an answer's error against it is bounded by its discretization estimate plus this."""
@@ -214,7 +219,9 @@ def test_the_shipped_graded_scene_meets_its_tolerance_against_westergaard():
         exact = westergaard_contact_fraction(entry["transmitted_pressure"], pstar)
         error = abs(entry["contact_fraction"] - exact)
         assert entry["error_estimate"]["contact_fraction"] <= sc.discretization.tolerance
-        assert error <= entry["error_estimate"]["contact_fraction"] + shares[k], (error, entry["error_estimate"])
+        # the share is measured on the spectral twin (SHARE_GRID points), known to its 2D collocation error
+        assert error <= entry["error_estimate"]["contact_fraction"] + shares[k] + TWIN_COLLOCATION, \
+            (error, entry["error_estimate"], shares[k])
         assert error / exact < 2e-5  # measured 8.9e-6 at worst
     # the solver record holds every level's Newton solve, not only the finest's, and counts them all
     per_load = report["solver"]["per_load"]

@@ -95,10 +95,11 @@ MAX_ORDER_RAISES = 2
 #: geometrically (the edges are isolated in elements ``h0 r^L``, the bulk is smooth), the contraction observed
 #: from order to order, three times the tail because that contraction grows slowly with the order
 ORDER_RATE = Convergence(floor=0.0, assumed=0.5, cap=0.7, safety=3.0)
-#: the contact fraction's error after a grading step over its change: the geometric tail at one level's ratio
-#: per step (a step adds LEVELS_PER_STEP levels, but towards edges located on the coarser level, and a
-#: penalty's edge layer of width ~E/k_n is resolved only once the elements are smaller: no faster is assumed)
-GRADING_TAIL = RATIO / (1.0 - RATIO)
+#: the contact fraction's error after a grading step over its change: the geometric tail at a ratio 1/2 per
+#: step, first order as a halved mesh (a step adds LEVELS_PER_STEP levels, but towards edges located on the
+#: coarser level, and a penalty's edge layer of width ~E/k_n is resolved only once the elements are smaller:
+#: no faster is assumed)
+GRADING_TAIL = 1.0
 #: Netgen's grading of the graded meshes: elements may grow by about this fraction away from the edges
 #: (0.5 halved the dofs of Westergaard's graded meshes against Netgen's default 0.3 at the same error)
 MESH_GRADING = 0.5
