@@ -335,8 +335,9 @@ def has_twin(scene: CellScene) -> bool:
 
 def check_fe(scene: CellScene) -> None:
     """What the FE cell needs of a scene: a Huber width with friction, an admissible penalty, order 1 for
-    exact contact in 3D, a flat interface for the spectral start, and a flat 2D frictionless cell for a
-    tolerance (graded meshes)."""
+    exact contact in 3D and a flat interface for the spectral start.  A tolerance suits every FE cell (graded
+    meshes on a flat 2D frictionless cell, else a sequence of finer interface meshes:
+    :mod:`ngcontact.cell.fe.second_discretization`)."""
     c, d, dim = scene.contact, scene.discretization, scene.geometry.dim
     if c.friction != "none" and c.w is None:
         raise SceneError("contact.w", MISSING, f"required for friction = {c.friction!r} in an FE cell, which "
@@ -354,16 +355,6 @@ def check_fe(scene: CellScene) -> None:
                          "'flat' or 'flat3d', or 'bisinusoid', 'height_map' or 'self_affine' with arrangement = "
                          f"'summit'), not enforcement {c.enforcement!r} on a {scene.geometry.profile!r} "
                          f"profile in the {scene.geometry.arrangement!r} arrangement; use 'auto' or 'rigid'")
-    if d.tolerance is not None and not (dim == 2 and PROFILES[scene.geometry.profile].flat):
-        raise SceneError("discretization.tolerance", d.tolerance,
-                         "refinement towards the contact edges needs a 2D cell with geometry.profile = "
-                         f"'flat' (the small-slope model), not a {dim}D {scene.geometry.profile!r} cell; remove "
-                         "the key and refine interface_maxh or order by hand")
-    if d.tolerance is not None and c.friction != "none":
-        raise SceneError("discretization.tolerance", d.tolerance,
-                         "refinement towards the contact edges solves every load afresh on its own mesh, "
-                         "which a frictional load path does not allow; remove the key or set "
-                         "contact.friction = 'none'")
 
 
 def check_spectral(scene: CellScene) -> None:

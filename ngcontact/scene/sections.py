@@ -68,13 +68,15 @@ class CellDiscretization(Discretization):
 
     tolerance: float | None = param(
         None, doc="refine until the estimated error of the contact fraction (absolute) and of the mean closure "
-        "(relative) is at most this: method 'fe' grades the interface mesh towards the contact edges (2D cells "
-        "with a flat interface), method 'spectral' doubles the grid's points per direction from "
-        "discretization.grid (a height map's or random surface's samples are interpolated bilinearly, the "
-        "surface the FE cell meshes too; at least four grids, the estimate the geometric tail of the last three "
-        "differences, at their observed rate where their ratios agree (Richardson), else guarded); the report "
-        "gives the estimate per load and the mesh or grid history, and a tolerance out of reach ends the run "
-        "(exit 3); default: 0.01 (accuracy.tolerance_from = 'default'): the spectral cell "
+        "(relative) is at most this: method 'fe' grades the interface mesh towards the contact edges and "
+        "raises the order on the finest (2D frictionless cells with a flat interface), any other FE cell (3D, "
+        "curved, frictional) halves interface_maxh level by level (at least three levels, the estimate from "
+        "the observed rate, up to 1e6 dofs in 2D and 4e5 in 3D), method 'spectral' doubles the grid's points "
+        "per direction from discretization.grid (a height map's or random surface's samples are interpolated "
+        "bilinearly, the surface the FE cell meshes too; at least four grids, the estimate the geometric tail "
+        "of the last three differences, at their observed rate where their ratios agree (Richardson), else "
+        "guarded); the report gives the estimate per load and the mesh or grid history, and a tolerance out of "
+        "reach ends the run (exit 3); default: 0.01 (accuracy.tolerance_from = 'default'): the spectral cell "
         "is refined to it up to 65536 grid points in 2D and 512 x 512 in 3D and, out of reach there, reports "
         "its finest grid with accuracy.met = false and a warning; the FE cell keeps its fixed mesh, its error "
         "not estimated",

@@ -18,15 +18,29 @@ The edges are not known in advance, so meshing and solving alternate:
    previous level's state (:func:`carry_over`), locate the edges again;
 3. when the contact fraction changes between two levels by at most the
    tolerance (``|f_k - f_(k-1)| <= tol``), or the grading has gone as far as
-   it goes, solve the finer level once more at one order higher: the bulk
-   away from the edges is smooth, and raising the order there is what
-   checks (and reduces) its error; stop when the level comparison changed
-   the contact fraction by at most the tolerance and the order comparison
-   changes both the contact fraction and the mean closure by at most it
-   (``|c_k - c_(k-1)| <= tol |c_k|``); else continue grading at the raised
-   order, or, at the finest grading, raise the order again.  The estimate is the larger of the two changes (the error
-   of the coarser solution of each pair: an upper bound of the finer one's
-   once the sequences contract); the answer reported is the finest.
+   it goes, solve the finer level once more at one order higher, and again
+   at one more: the bulk away from the edges is smooth, and raising the
+   order there is what checks (and reduces) its error; stop when the level
+   comparison changed the contact fraction by at most the tolerance, the
+   last order changes both the contact fraction and the mean closure by at
+   most it (``|c_k - c_(k-1)| <= tol |c_k|``), and the estimate meets it;
+   else continue grading at the raised order, or, at the finest grading,
+   raise the order again.  The answer reported is the highest order on the
+   finest mesh; its estimate is the observed-rate tail of the orders on that
+   mesh (:data:`ORDER_RATE`, :mod:`ngcontact.cell.fe.observed_rate`):
+   ``p``-refinement on one fixed mesh converges to the exact solution, not to
+   a mesh-dependent limit, so the tail of its sequence bounds the error of
+   the smooth bulk and of the edges where they sit at vertices; the grading
+   changes (errors of the coarser levels, often a hundred times the
+   finest's) only decide when to stop grading.  An edge that lies inside its
+   element (the vertex was put where the previous level found it) carries a
+   ``sqrt`` singularity inside the element, where ``p``-refinement converges
+   algebraically, too slowly for the geometric tail to see: the contact
+   fraction's estimate is at least the largest distance of an edge from its
+   nearest vertex (:func:`edge_offset`), the error of a patch length whose
+   end were placed at that vertex, and at least the tail of the last
+   grading step's change (:data:`GRADING_TAIL`: the edge's resolution,
+   which the order sequence on one mesh does not improve).
 
 The first mesh from the spectral twin.  With the penalty, a flat cell has
 a spectral twin (:mod:`ngcontact.cell.spectral_start`): the same
@@ -62,6 +76,7 @@ import ngsolve as ng
 
 from ngcontact.cell.fe.measures import contact_pieces
 from ngcontact.cell.fe.load_start import starts_afresh
+from ngcontact.cell.fe.observed_rate import Convergence
 from ngcontact.errors import ConvergenceError
 from ngcontact.geometry.cell2d import flat_cell
 
@@ -76,6 +91,15 @@ LEVELS_PER_STEP = 2
 MAX_STEPS = 4
 #: order raises (after the grading has settled) before the tolerance is declared out of reach
 MAX_ORDER_RAISES = 2
+#: how the answers of successive orders on one graded mesh converge (:mod:`ngcontact.cell.fe.observed_rate`):
+#: geometrically (the edges are isolated in elements ``h0 r^L``, the bulk is smooth), the contraction observed
+#: from order to order, three times the tail because that contraction grows slowly with the order
+ORDER_RATE = Convergence(floor=0.0, assumed=0.5, cap=0.7, safety=3.0)
+#: the contact fraction's error after a grading step over its change: the geometric tail at a ratio 1/2 per
+#: step, first order as a halved mesh (a step adds LEVELS_PER_STEP levels, but towards edges located on the
+#: coarser level, and a penalty's edge layer of width ~E/k_n is resolved only once the elements are smaller:
+#: no faster is assumed)
+GRADING_TAIL = 1.0
 #: Netgen's grading of the graded meshes: elements may grow by about this fraction away from the edges
 #: (0.5 halved the dofs of Westergaard's graded meshes against Netgen's default 0.3 at the same error)
 MESH_GRADING = 0.5
@@ -104,16 +128,53 @@ class GradedSolve:
 
     problem: Any
     solution: Any
-    estimate_from: tuple[dict[str, Any], dict[str, Any]]  # the level and the order comparison that met it
+    #: the entries of the orders solved on the finest graded mesh, lowest first (the last is the answer)
+    orders: list[dict[str, Any]]
+    #: the change of the contact fraction over the last grading step (at the order graded), or ``None``
+    grading_change: float | None = None
     history: list[dict[str, Any]] = field(default_factory=list)
     #: the Newton histories of every level's solve, in order, each with its ``"level"`` and ``"order"``
     newton: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def estimate(self) -> dict[str, float]:
-        """The larger of the last grading change and the order-raise change, per quantity."""
-        return {"contact_fraction": max(e["fraction_change"] for e in self.estimate_from),
-                "mean_closure": max(e["closure_change"] for e in self.estimate_from)}
+        """The error of the answer per quantity: the observed-rate tail of the orders on its mesh
+        (:func:`order_estimate`)."""
+        return order_estimate(self.orders, self.grading_change)[0]
+
+    @property
+    def remark(self) -> str:
+        """Where the orders' ratios disagree or a guard acted, in words ("" otherwise)."""
+        return order_estimate(self.orders, self.grading_change)[1]
+
+
+def order_estimate(orders: list[dict[str, Any]], grading_change: float | None = None
+                   ) -> tuple[dict[str, float], str]:
+    """The error of the last of ``orders`` (entries of successive orders on one mesh), per quantity, by the
+    observed rate of :data:`ORDER_RATE`; the contact fraction's at least the last solution's
+    :func:`edge_offset` and the tail of the last grading step's change (module docstring); and its remark."""
+    out, notes = {}, []
+    for name, relative in (("contact_fraction", False), ("mean_closure", True)):
+        out[name], note = ORDER_RATE.tail([e[name] for e in orders], relative)
+        if note:
+            notes.append(f"{name}: {note}")
+    offset = orders[-1].get("edge_offset", 0.0)
+    if offset > out["contact_fraction"]:
+        out["contact_fraction"] = offset
+        notes.append(f"contact_fraction: its edges lie up to {offset:.2g} from the vertices graded towards them")
+    grading = GRADING_TAIL * grading_change if grading_change is not None else 0.0
+    if grading > out["contact_fraction"]:
+        out["contact_fraction"] = grading
+        notes.append(f"contact_fraction: the last grading step's tail {grading:.2g}")
+    return out, "; ".join(notes)
+
+
+def edge_offset(edges, ends: np.ndarray) -> float:
+    """The largest distance of a contact edge from its nearest interface vertex (0 without edges)."""
+    if len(edges) == 0:
+        return 0.0
+    vertices = np.unique(ends)
+    return float(max(np.min(np.abs(vertices - e)) for e in edges))
 
 
 def graded_vertices(edges, h0: float, levels: int, period: float) -> list[float]:
@@ -203,7 +264,8 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
     ends = _interface_elements(problem.mesh)
     f, c = sol.results["contact_fraction"], sol.results["mean_closure"]
     entry = {"level": level, "order": p, "ndof": problem.ndof, "edges": [float(e) for e in edges],
-             "smallest_element": float(np.min(ends[:, 1] - ends[:, 0])), "contact_fraction": f,
+             "smallest_element": float(np.min(ends[:, 1] - ends[:, 0])), "edge_offset": edge_offset(edges, ends),
+             "contact_fraction": f,
              "mean_closure": c, "newton_iterations": sol.iterations, "fraction_change": None,
              "closure_change": None}
     if before is not None:
@@ -259,6 +321,7 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
     vertices: list[float] = []
     step = raises = 0
     graded: dict[str, Any] | None = None  # the last level-against-level comparison checked by an order raise
+    orders: list[dict[str, Any]] = []     # the entries of successive orders on the last graded mesh
 
     def run(vertices: list[float], p: int, level: int, before=None):
         return _solve_level(make_problem, load, vertices, p, level, before, history, newton)
@@ -281,14 +344,19 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
             # checks, and reduces, the error of the smooth bulk; repeated while the order changes the
             # answer and raises remain
             graded = entry
+            orders = [entry]
             while raises < MAX_ORDER_RAISES + 1:
                 order += 1
                 raises += 1
                 problem, sol, edges, entry = run(vertices, order, entry["level"], (problem, entry))
+                orders.append(entry)
                 if graded["fraction_change"] <= tolerance and met(entry):
-                    return GradedSolve(problem=problem, solution=sol, history=history,
-                                       estimate_from=(graded, entry), newton=newton)
-                if step < MAX_STEPS:
+                    # the changes meet it: a third order shows the rate, whose tail must meet it too
+                    tail = order_estimate(orders, graded["fraction_change"])[0]
+                    if len(orders) >= 3 and max(tail.values()) <= tolerance:
+                        return GradedSolve(problem=problem, solution=sol, orders=orders, history=history,
+                                           newton=newton, grading_change=graded["fraction_change"])
+                elif step < MAX_STEPS:
                     break
         if step == MAX_STEPS or raises > MAX_ORDER_RAISES:
             break
@@ -300,11 +368,14 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
             vertices = graded_vertices(edges, h0, step * LEVELS_PER_STEP, period)
         problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP, (problem, entry))
     if not required and graded is not None:
-        return GradedSolve(problem=problem, solution=sol, history=history, estimate_from=(graded, entry),
-                           newton=newton)
+        return GradedSolve(problem=problem, solution=sol, orders=orders, history=history, newton=newton,
+                           grading_change=graded["fraction_change"])
     worst = graded["fraction_change"] if graded is not None else entry["fraction_change"]
+    tail = order_estimate(orders, worst)[0] if len(orders) > 1 else {"contact_fraction": worst, "mean_closure": worst}
     raise ConvergenceError(
         f"discretization.tolerance = {tolerance:g} not reached after {step} grading steps and {raises} order raises "
         f"(smallest element {entry['smallest_element']:.3g}, order {entry['order']}): the contact fraction changes "
         f"by {worst:.3g} between the last two grading levels and by {entry['fraction_change']:.3g} with the last "
-        f"order, the mean closure by {entry['closure_change']:.3g}; loosen the tolerance or raise the order", {})
+        f"order, the mean closure by {entry['closure_change']:.3g}; the estimated errors of the last order are "
+        f"{tail['contact_fraction']:.3g} (contact fraction) and {tail['mean_closure']:.3g} (mean closure); loosen "
+        "the tolerance or raise the order", {"levels": history})

@@ -2,15 +2,15 @@
 
 :class:`FECell` holds a :class:`~ngcontact.cell.fe.cell_problem.CellProblem` on the scene's mesh and, for
 a flat 2D cell, the recipe of meshes graded towards given contact edges; it answers loads, sweeps,
-refinement to a tolerance (each load on its own graded mesh, checked by one order more:
-:mod:`ngcontact.cell.fe.edge_grading`; a cell that cannot be graded by a second discretization and the
-difference: :mod:`ngcontact.cell.fe.second_discretization`) and the pressure response of the two-scale
-table.
+refinement to a tolerance (each load on its own graded mesh, checked by higher orders:
+:mod:`ngcontact.cell.fe.edge_grading`; a cell that cannot be graded by a sequence of finer discretizations
+from its :class:`~ngcontact.cell.fe.second_discretization.Refiner` and the observed rate:
+:mod:`ngcontact.cell.fe.second_discretization`) and the pressure response of the two-scale table.
 
-Refinement by default (a scene that states no tolerance, :meth:`FECell.default_refinement`): a graded cell
-refines to the default tolerance (its levels stop where the estimate meets it, and the graded meshes cost
-a few times the scene's); any other cell is estimated by its second discretization and flagged when over,
-if that discretization stays within :data:`DEFAULT_DOFS`, else not estimated.
+Refinement to the default tolerance (:meth:`FECell.refine_to` with ``required = False``,
+:meth:`FECell.default_refinement`): a graded cell refines as with a stated one; any other cell refines
+within :data:`DEFAULT_DOFS` and is flagged when over (with the scene's level alone: not estimated).  A
+stated tolerance refines within :data:`MAX_DOFS`.
 
 The response at a mean pressure ``p``: ``k_n0`` is eq. 34 on the real contact set, ``k_n`` times the
 contact fraction (located by the roots of the penetration in 2D) on a flat frictionless cell, else the
@@ -35,17 +35,19 @@ from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.cell_problem import CellProblem
-from ngcontact.cell.fe.edge_grading import GradedSolve, solve_to_tolerance
+from ngcontact.cell.fe.edge_grading import ORDER_RATE, GradedSolve, solve_to_tolerance
 from ngcontact.cell.fe.load_start import Predictor
-from ngcontact.cell.fe.second_discretization import compare, second_of
+from ngcontact.cell.fe.second_discretization import InterfaceHalving, Refiner, as_refinement, refine
 from ngcontact.cell.fe.measures import contact_fraction, contact_integral, mean_jump, real_contact_coefficients
 from ngcontact.errors import ModelError
 from ngcontact.fem.quadrature import smooth_order
 
 log = logging.getLogger(__name__)
 
-#: the most dofs of the second discretization that estimates a cell's error by default (per dimension)
+#: the most dofs of a refined discretization at the default tolerance (per dimension)
 DEFAULT_DOFS = {2: 120_000, 3: 40_000}
+#: the most dofs of a refined discretization at a stated tolerance (per dimension)
+MAX_DOFS = {2: 1_000_000, 3: 400_000}
 
 
 class FECell:
@@ -78,14 +80,18 @@ class FECell:
     twin
         ``() -> CellSolver``: the spectral cell of the same small-slope model on a grid that resolves the
         contact edges, where the cell has one (the penalty's share is taken from it), else ``None``.
+    refiner
+        ``(cell) -> Refiner``: the discretizations refining a cell that cannot be graded; ``None``: the
+        interface element size halved level by level (:class:`InterfaceHalving`).
     """
 
     def __init__(self, cell, model: CellModel, make_problem: Callable[[], CellProblem], *,
                  threshold: float | None = None, graded: Callable[[list[float], int], CellProblem] | None = None,
                  h0: float | None = None, predictor: Callable[[], Predictor | None] | None = None,
                  variant: Callable[..., FECell | None] | None = None, interface_maxh: float | None = None,
-                 twin: Callable[[], Any] | None = None):
+                 twin: Callable[[], Any] | None = None, refiner: Callable[[FECell], Refiner] | None = None):
         self.cell, self.model, self._make_problem = cell, model, make_problem
+        self._refiner = refiner
         self.variant, self.interface_maxh, self.twin = variant, interface_maxh, twin
         self.dim = cell.dim
         self.period = float(cell.period[0])
@@ -145,38 +151,41 @@ class FECell:
         changes = {k: v for k, v in (("enforcement", enforcement), ("k_n", k_n)) if v is not None}
         return self.variant(**changes) if self.variant is not None else None
 
-    def second(self):
-        """The richer discretization of the error estimate without grading
-        (:func:`~ngcontact.cell.fe.second_discretization.second_of`), ``None`` where the cell has no variants."""
+    def refiner(self) -> Refiner | None:
+        """The discretizations that refine this cell where it cannot be graded
+        (:mod:`~ngcontact.cell.fe.second_discretization`), ``None`` where the cell has no variants."""
+        if self._refiner is not None:
+            return self._refiner(self)
         if self.variant is None or self.interface_maxh is None:
             return None
-        return second_of(self.dim, self.model.order, self.model.enforcement, self.interface_maxh)
+        return InterfaceHalving(self, self.variant, self.interface_maxh)
 
     def default_refinement(self) -> str:
-        """What a scene without a tolerance affords (module docstring): ``"graded"`` (refined to the default
-        tolerance), ``"compared"`` (estimated by the second discretization, flagged when over) or ``"none"``
-        (the second discretization would exceed :data:`DEFAULT_DOFS`; not estimated)."""
+        """How :meth:`refine_to` refines (module docstring): ``"graded"`` (meshes graded towards the contact
+        edges), ``"sequence"`` (the refiner's discretizations) or ``"none"`` (no recipe of another one)."""
         if self.graded is not None and self.h0 is not None:
             return "graded"
-        second = self.second()
-        if second is None or second.ndof(self.scene_unknowns(), self.dim, self.model.order) > DEFAULT_DOFS[self.dim]:
-            return "none"
-        return "compared"
+        return "none" if self.refiner() is None else "sequence"
 
     def refines_by_default(self) -> bool:
-        """No: a sweep without a stated tolerance keeps the scene's mesh and says it is not estimated.  The
-        default estimate (:meth:`default_refinement`: grading, or a second discretization) multiplies an FE
-        cell's run time several times over, so it is asked for by stating ``discretization.tolerance``."""
+        """No: a sweep without a stated tolerance keeps the scene's mesh and says it is not estimated.  An
+        honest estimate of the value reported needs three discretizations (:meth:`default_refinement`: the
+        grading levels and three orders on the finest, or interface meshes halved twice, each several times
+        the last), which multiplies an FE cell's run time several times over (``scene_seconds`` against
+        ``seconds`` in ``docs/benchmarks.md``, FE effectivity), so it is asked for by stating
+        ``discretization.tolerance``."""
         return False
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Each load on its own mesh, graded towards its contact edges until ``tolerance`` is met
         (:func:`~ngcontact.cell.fe.edge_grading.solve_to_tolerance`), the last load's problem becoming this
-        cell's; a cell that cannot be graded: the sweep on the scene's and a second discretization
-        (:mod:`~ngcontact.cell.fe.second_discretization`), the second's problem becoming this cell's.
+        cell's; a cell that cannot be graded: the sweep on the refiner's discretizations until the estimate
+        meets ``tolerance`` within :data:`MAX_DOFS` (:mod:`~ngcontact.cell.fe.second_discretization`), the
+        last one's problem becoming this cell's.
 
-        ``required = False`` (the default tolerance): out of reach, the best answer with its estimate; a
-        cell whose second discretization is beyond :data:`DEFAULT_DOFS` is solved once, not estimated.
+        ``required = False`` (the default tolerance): within :data:`DEFAULT_DOFS`, and out of reach the best
+        answer with its estimate; a cell whose first refinement is beyond that bound is solved once, not
+        estimated.
         """
         refined = self._compared(tolerance, loads, required) if self.graded is None or self.h0 is None \
             else self._graded(tolerance, loads, required)
@@ -207,33 +216,19 @@ class FECell:
                                      "newton_iterations": sum(h["newton_iterations"] for h in g.history)}
                                     for g in out],
                           histories=[g.newton for g in out],
-                          how="each load on meshes graded towards its contact edges, then one order more: the larger "
-                              "of the last grading change and the order's change")
+                          how="; ".join(["each load on meshes graded towards its contact edges, then higher orders "
+                                         "on the finest; the highest reported, its error " + ORDER_RATE.describe()]
+                                        + [f"load {k} {g.remark}" for k, g in enumerate(out) if g.remark]))
 
     def _compared(self, tolerance: float, loads: list[CellLoad], required: bool) -> Refinement:
-        """The sweep on the scene's discretization and on :meth:`second`, the difference the estimate."""
-        second = self.second()
-        if second is None or self.variant is None:
-            raise ModelError("this FE cell was built without the recipe of a second discretization")
-        if not required and self.default_refinement() == "none":
-            sols = self.sweep(loads)
-            how = (f"not estimated: the second discretization ({second.how}) would exceed {DEFAULT_DOFS[self.dim]} "
-                   "dofs; set discretization.tolerance to estimate it anyway")
-            log.warning("accuracy not known: %s", how)
-            return Refinement(solutions=sols, estimates=[{} for _ in sols], how=how)
-        richer = self.variant(order=second.order, **({"interface_maxh": second.interface_maxh}
-                                                     if second.interface_maxh is not None else {}))
-        if richer is None:
-            raise ModelError(f"the scene refuses its second discretization ({second.how})")
-        done = compare(lambda: self.sweep(loads), lambda: richer.sweep(loads), tolerance, required, second.how)
-        self._problem = richer.problem
-        per_load = [{"discretizations": [{"discretization": lv["discretization"],
-                                          "contact_fraction": lv["contact_fraction"][k],
-                                          "mean_closure": lv["mean_closure"][k]} for lv in done.levels],
-                     "newton_iterations": s.iterations}          # the reported (second) discretization's
-                    for k, s in enumerate(done.solutions)]
-        return Refinement(solutions=done.solutions, estimates=done.estimates, per_load=per_load,
-                          histories=[s.newton for s in done.solutions], how=second.how)
+        """The sweep on the refiner's discretizations, the last reported (:meth:`refine_to`)."""
+        refiner = self.refiner()
+        if refiner is None:
+            raise ModelError("this FE cell was built without the recipe of a finer discretization")
+        done = refine(refiner, loads, tolerance, (MAX_DOFS if required else DEFAULT_DOFS)[self.dim], required)
+        if done.cell is not self:
+            self._problem = done.cell.problem
+        return as_refinement(done)
 
     def response(self, pressure: float, length_unit: float = 1.0) -> Response:
         """The response at ``pressure`` (module docstring), from a first load's start."""

@@ -1,115 +1,170 @@
-"""The error of an FE cell that cannot be graded, by a second discretization and the difference.
+"""The error of an FE cell that cannot be graded, from a sequence of finer discretizations and its rate.
 
 Grading towards the contact edges (:mod:`ngcontact.cell.fe.edge_grading`) needs the flat 2D interface whose
-edges are points on a line.  A 3D cell (edges are curves), a curved ``S_C`` (square hills, a conforming
-profile) or a frictional load path (solved in order, not afresh per load) is estimated instead by solving
-the same sweep once more on a richer discretization and comparing:
+edges are points on a line and loads solved afresh.  A 3D cell (edges are curves), a curved ``S_C`` (square
+hills, a conforming profile) or a frictional load path (solved in order) is refined instead by solving the
+same sweep on a sequence of discretizations given by a :class:`Refiner`, and the error of the last is
+estimated from the sequence (:mod:`ngcontact.cell.fe.observed_rate`).
 
-* **one order more on the same mesh** (``p -> p + 1``) wherever the enforcement allows it (the penalty in
-  2D and 3D; exact contact in 2D).  Away from the contact edges the fields are smooth and the bulk's
-  error falls by a factor ``h^(p+1)``-like with each order; at the edges the pressure behaves like
-  ``sqrt(r)`` and the error of the edge location falls with ``p`` by a fixed factor of about
-  ``2^(-1/2)`` per element layer it is smeared over, so the order raise at least halves the error of
-  the contact fraction and of the mean closure (at worst it leaves the edge's contribution where it was
-  and removes the bulk's);
-* **the interface element size halved** (``h -> h/2``, the body mesh as before) where it does not: exact
-  contact in 3D, held to order 1 (quadratic triangles leave corner nodes open inside a contact patch).
-  The contact fraction of a uniform mesh converges like ``h`` (an edge cuts its elements anywhere, and
-  the fraction counts the cut elements' area to first order), the closure like ``h^(3/2)`` or faster, so
-  halving ``h`` halves the error at least.
+The refiner of every such cell is :class:`InterfaceHalving`: the interface element size halved from level to
+level at the scene's order (``h, h/2, h/4, ...``, the bulk mesh as before).  The contact fraction converges
+at least like ``h``: a contact edge cuts its elements anywhere, and the fraction counts the cut elements'
+share to first order (in 3D the fraction is the quadrature integral of the contact indicator, whose error at
+the edge curves is of that order whatever the polynomial order); the closure converges faster.  So the
+observed ratio of successive differences is held to at least ``1/2`` (:data:`HALVING_RATE`).  One order
+more on the same mesh is not a sequence that converges at a rate one may observe here: on the shipped 3D
+bisinusoid its contact fraction moved 0.029 from order 2 to 3 and 0.010 from 3 to 4 while the error of
+order 4 against the converged spectral twin was still 0.021 (the indicator's edge error does not fall with
+the order), so the tail of the differences would claim a quarter of the error.
 
-In both, the error ``e_2`` of the richer solution is at most half the error ``e_1`` of the first, so
-``|q_1 - q_2| >= e_1 - e_2 >= e_2``: the difference bounds the error of the richer solution, which is the
-one reported (the same argument as the graded loop's and the spectral grid doubling's).  Because the
-edge term of a uniform mesh does not fall monotonically (it depends on where the edge cuts its element),
-the estimate is the difference times :data:`SAFETY` (2: it still bounds ``e_2`` where the ratio
-``e_2/e_1`` is up to 2/3).  Per load: the contact fraction absolutely, the mean closure and the effective
-stiffness relatively, as the refinement's estimates everywhere (:mod:`ngcontact.cell.admissibility`).
+The loop (:func:`refine`): the scene's discretization is level 0; each next level is solved if its unknowns
+(known once its mesh is built, before the solve) are within the size bound; the estimate of the last level
+needs three levels (two observed differences), or two where the third is beyond the bound; it stops when the
+estimate meets the tolerance.  Out of reach: a :class:`~ngcontact.errors.ConvergenceError` with the figures
+where the tolerance was stated, else the last level with ``met = False``.  Per load: the contact fraction
+absolutely, the mean closure and the normal effective stiffness relatively, as everywhere
+(:data:`ngcontact.cell.admissibility.ESTIMATED`).  A better refiner of a 3D cell (local refinement towards
+the contact edge) is another :class:`Refiner` with its own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.
 """
 from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
-from typing import Any, Callable
+from dataclasses import dataclass, field
+from typing import Any, Callable, Protocol
 
 from ngcontact.cell.cell_solution import CellSolution, headline
+from ngcontact.cell.cell_solver import Refinement
+from ngcontact.cell.fe.observed_rate import Convergence, sequence_estimates
 from ngcontact.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
 #: the run's progress lines
 progress = logging.getLogger("ngcontact.progress")
 
-#: estimate over the difference of the two discretizations (module docstring)
-SAFETY = 2.0
+#: how the answers of an interface mesh halved level by level converge (module docstring)
+HALVING_RATE = Convergence(floor=0.5, assumed=0.5, cap=0.7, safety=1.5)
+#: the quantities estimated: whether the measure is relative
+MEASURES = {"contact_fraction": False, "mean_closure": True, "normal_stiffness": True}
+#: the most levels (the scene's and its refinements)
+MAX_LEVELS = 6
 
 
-@dataclass(frozen=True)
-class SecondDiscretization:
-    """The richer discretization of a cell: its order and interface element size, and in words."""
+class Refiner(Protocol):
+    """The discretizations of one FE cell, coarsest (the scene's) first, and how their answers converge."""
 
-    order: int
-    interface_maxh: float | None
-    how: str
+    #: how the estimate treats the sequence
+    rule: Convergence
 
-    def ndof(self, ndof: int, dim: int, order: int) -> int:
-        """The dofs it will have, from the first's: ``((p+2)/(p+1))^dim`` times for an order raise, ``4``
-        times (an upper bound: only the interface's elements shrink) for a halved 3D interface."""
-        if self.order > order:
-            return int(ndof * ((self.order + 1) / (order + 1)) ** dim)
-        return int(ndof * 2 ** (dim - 1))
+    def level(self, k: int) -> Any:
+        """The cell of level ``k`` (an object with ``sweep(loads)`` and ``unknowns()``), ``None`` where the
+        scene refuses it."""
 
-
-def second_of(dim: int, order: int, enforcement: str, interface_maxh: float) -> SecondDiscretization:
-    """The richer discretization of a cell (module docstring): one order more where the enforcement allows
-    it, else the interface element size halved."""
-    if enforcement == "penalty" or dim == 2:
-        return SecondDiscretization(order + 1, None, f"the sweep again at order {order + 1} on the same mesh: "
-                                    f"{SAFETY:g} x the change (the order raise at least halves the error)")
-    return SecondDiscretization(order, interface_maxh / 2, f"the sweep again with interface_maxh halved to "
-                                f"{interface_maxh / 2:g}: {SAFETY:g} x the change (the contact fraction converges "
-                                "like h, the closure faster)")
-
-
-def change(first: list[CellSolution], second: list[CellSolution]) -> list[dict[str, float]]:
-    """Per load, :data:`SAFETY` times the change of the contact fraction (absolute), the mean closure and the
-    normal effective stiffness (relative; :func:`~ngcontact.cell.cell_solution.headline`)."""
-    out = []
-    for a, b in zip(first, second):
-        qa, qb = headline(a.results), headline(b.results)
-        est = {}
-        for name in qb:
-            d = abs(qb[name] - qa[name])
-            est[name] = SAFETY * (d / abs(qb[name]) if name != "contact_fraction" and qb[name] != 0 else d)
-        out.append(est)
-    return out
+    def describe(self, k: int) -> str:
+        """Level ``k`` in words ("interface_maxh 0.03")."""
 
 
 @dataclass
-class Compared:
-    """The richer sweep, its estimates and the record of both discretizations."""
+class InterfaceHalving:
+    """Level ``k``: the scene's cell with ``interface_maxh / 2^k`` at the scene's order (module docstring)."""
 
+    scene_cell: Any
+    variant: Callable[..., Any]
+    interface_maxh: float
+    rule: Convergence = HALVING_RATE
+
+    def level(self, k: int) -> Any:
+        return self.scene_cell if k == 0 else self.variant(interface_maxh=self.interface_maxh / 2 ** k)
+
+    def describe(self, k: int) -> str:
+        return f"interface_maxh {self.interface_maxh / 2 ** k:g}"
+
+
+@dataclass
+class Sequence:
+    """The last level's cell and solutions, the estimate per load, the levels solved, whether the tolerance
+    is met, and how the estimate was made in words."""
+
+    cell: Any
     solutions: list[CellSolution]
     estimates: list[dict[str, float]]
-    levels: list[dict[str, Any]]
+    levels: list[dict[str, Any]] = field(default_factory=list)
+    met: bool = True
+    how: str = ""
 
 
-def compare(first: Callable[[], list[CellSolution]], second: Callable[[], list[CellSolution]],
-            tolerance: float, required: bool, how: str) -> Compared:
-    """Both sweeps, the estimate per load (module docstring); ``required`` and over ``tolerance``: the
-    :class:`~ngcontact.errors.ConvergenceError` with the figures."""
-    levels = []
-    sweeps = []
-    for name, run in (("scene", first), ("second", second)):
-        t0 = time.perf_counter()
-        sweeps.append(run())
-        levels.append({"discretization": name, "seconds": time.perf_counter() - t0,
-                       "contact_fraction": [s.results["contact_fraction"] for s in sweeps[-1]],
-                       "mean_closure": [s.results["mean_closure"] for s in sweeps[-1]]})
-        progress.info("FE error estimate, %s discretization: %.2f s", name, levels[-1]["seconds"])
-    estimates = change(sweeps[0], sweeps[1])
-    worst = max((max(e.values()) for e in estimates), default=0.0)
-    if required and worst > tolerance:
-        raise ConvergenceError(f"discretization.tolerance = {tolerance:g} not met: the estimate is {worst:.3g} "
-                               f"({how}); refine interface_maxh or raise the order", {"levels": levels})
-    return Compared(solutions=sweeps[1], estimates=estimates, levels=levels)
+def _level(cell, loads, k: int, refiner: Refiner) -> tuple[list[CellSolution], dict[str, Any]]:
+    """Solve level ``k`` and its record."""
+    t0 = time.perf_counter()
+    sols = cell.sweep(loads)
+    entry = {"discretization": refiner.describe(k), "ndof": int(cell.unknowns()),
+             "seconds": time.perf_counter() - t0,
+             "contact_fraction": [s.results["contact_fraction"] for s in sols],
+             "mean_closure": [s.results["mean_closure"] for s in sols]}
+    progress.info("FE refinement, %s: %d dofs, %.2f s", entry["discretization"], entry["ndof"], entry["seconds"])
+    return sols, entry
+
+
+def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, required: bool) -> Sequence:
+    """The sweep on the refiner's levels until the estimate meets ``tolerance`` (module docstring)."""
+    heads: list[list[dict[str, float]]] = []
+    levels: list[dict[str, Any]] = []
+    cell = sols = None
+    estimates: list[dict[str, float]] = []
+    remarks: list[str] = []
+    stop = f"the most levels ({MAX_LEVELS})"
+    for k in range(MAX_LEVELS):
+        nxt = refiner.level(k)
+        if nxt is None:
+            stop = f"the scene refuses {refiner.describe(k)}"
+            break
+        if k > 0 and nxt.unknowns() > max_dofs:
+            stop = f"{refiner.describe(k)} would have {nxt.unknowns()} dofs, beyond {max_dofs}"
+            break
+        cell = nxt
+        sols, entry = _level(cell, loads, k, refiner)
+        levels.append(entry)
+        heads.append([headline(s.results) for s in sols])
+        if len(heads) > 1:
+            estimates, remarks = sequence_estimates(heads, refiner.rule, MEASURES)
+            entry["estimate"] = max((max(e.values()) for e in estimates if e), default=0.0)
+            if len(heads) >= 3 and entry["estimate"] <= tolerance:
+                return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks))
+    assert cell is not None and sols is not None      # level 0 is the scene's own cell
+    worst = levels[-1].get("estimate")
+    if len(heads) == 2 and worst is not None and worst <= tolerance:   # the third level beyond the bound
+        return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks + [f"stopped: {stop}"]))
+    reached = "no estimate (one level)" if worst is None else f"{worst:.3g}"
+    message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on "
+               f"{levels[-1]['discretization']} ({levels[-1]['ndof']} dofs), and {stop}")
+    if required:
+        raise ConvergenceError(message + "; loosen the tolerance, or refine interface_maxh or the order by hand",
+                               {"levels": levels})
+    if not estimates:
+        estimates = [{} for _ in sols]
+    return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]))
+
+
+def _how(refiner: Refiner, levels: list[dict[str, Any]], remarks: list[str]) -> str:
+    """The estimate in words: the levels, the rule, the remarks."""
+    head = ("the sweep on " + ", ".join(lv["discretization"] for lv in levels) + "; the last reported, its error "
+            + refiner.rule.describe())
+    return "; ".join([head] + remarks)
+
+
+def as_refinement(done: Sequence) -> Refinement:
+    """The cell protocol's record of a refined sweep: per load every level's contact fraction and closure; a
+    sweep on the scene's level alone (the next beyond the default size bound) is not estimated."""
+    per_load = [{"discretizations": [{"discretization": lv["discretization"], "ndof": lv["ndof"],
+                                      "contact_fraction": lv["contact_fraction"][k],
+                                      "mean_closure": lv["mean_closure"][k]} for lv in done.levels],
+                 "newton_iterations": s.iterations}          # the reported (last) discretization's
+                for k, s in enumerate(done.solutions)]
+    histories = [s.newton for s in done.solutions]
+    if len(done.levels) == 1:
+        how = f"not estimated: {done.how.split('; ')[-1]}; set discretization.tolerance to refine beyond the bound"
+        log.warning("accuracy not known: %s", how)
+        return Refinement(solutions=done.solutions, estimates=[{} for _ in done.solutions], per_load=per_load,
+                          histories=histories, how=how)
+    return Refinement(solutions=done.solutions, estimates=done.estimates, per_load=per_load, histories=histories,
+                      how=done.how, met=done.met)

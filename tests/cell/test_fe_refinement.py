@@ -1,0 +1,134 @@
+"""The FE cell's error estimate of the value it reports, and its tolerance on every FE cell (issue 35):
+the observed-rate tail (ngcontact.cell.fe.observed_rate), the refinement loop behind its Refiner seam
+(ngcontact.cell.fe.second_discretization) and the effectivity on the fast oracle."""
+import json
+import os
+from dataclasses import dataclass
+
+import pytest
+
+from ngcontact import cli
+from ngcontact.cell.cell_solution import CellSolution
+from ngcontact.cell.fe.observed_rate import Convergence
+from ngcontact.cell.fe.second_discretization import HALVING_RATE, refine
+from ngcontact.drivers.build import cell_loads, cell_solver, spectral_variant
+from ngcontact.errors import ConvergenceError
+from ngcontact.scene.loader import load
+
+from test_cell_error import CURVED
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+RULE = Convergence(floor=0.0, assumed=0.5, cap=0.7, safety=1.0)
+
+
+def test_a_geometric_sequence_gives_the_exact_error_of_its_last_value():
+    """``q_j = q + C rho^j``: the tail ``d_n rho / (1 - rho)`` is ``|q_n - q|`` (Richardson, observed order)."""
+    q, rho = 0.3, 0.2
+    values = [q + 0.01 * rho ** j for j in range(4)]
+    estimate, remark = RULE.tail(values, relative=False)
+    assert estimate == pytest.approx(abs(values[-1] - q), rel=1e-9) and remark == ""
+    relative, _ = RULE.tail(values, relative=True)
+    assert relative == pytest.approx(abs(values[-1] - q) / values[-1], rel=1e-9)
+    assert Convergence(0.0, 0.5, 0.7, 3.0).tail(values, False)[0] == pytest.approx(3 * estimate, rel=1e-12)
+
+
+def test_disagreeing_ratios_are_said_and_the_larger_taken():
+    values = [1.0, 1.1, 1.11, 1.1105]           # ratios 0.1 then 0.05
+    estimate, remark = RULE.tail(values, relative=False)
+    assert estimate == pytest.approx(0.0005 * 0.1 / 0.9, rel=1e-9)
+    assert "disagree (0.1, 0.05)" in remark and "larger taken" in remark
+
+
+def test_the_guards_floor_cap_two_values_and_a_settled_sequence():
+    floored = Convergence(floor=0.5, assumed=0.5, cap=0.7, safety=1.0)
+    assert floored.tail([1.0, 1.1, 1.101], False)[0] == pytest.approx(0.001, rel=1e-9)   # ratio 0.01 -> 0.5
+    est, remark = RULE.tail([1.0, 1.1, 1.3], False)                                      # growing: ratio 2
+    assert est == pytest.approx(0.2 * 0.7 / 0.3, rel=1e-9) and "not contracting" in remark
+    est, remark = RULE.tail([1.0, 1.1], False)                                           # the assumed ratio
+    assert est == pytest.approx(0.1, rel=1e-9) and "two discretizations" in remark
+    assert RULE.tail([2.0, 2.0, 2.0], True) == (0.0, "")
+
+
+@dataclass
+class _Level:
+    """A stand-in discretization: its dofs and the contact fraction it answers."""
+
+    ndof: int
+    fraction: float
+
+    def unknowns(self) -> int:
+        return self.ndof
+
+    def sweep(self, loads):
+        return [CellSolution(load=None, results={"contact_fraction": self.fraction, "mean_closure": 1.0})]
+
+
+@dataclass
+class _Halving:
+    """A refiner whose level ``k`` has ``4^k`` times the dofs and the fraction ``0.5 + 0.1 / 2^k``."""
+
+    rule: Convergence = HALVING_RATE
+
+    def level(self, k):
+        return _Level(1000 * 4 ** k, 0.5 + 0.1 / 2 ** k)
+
+    def describe(self, k):
+        return f"level {k}"
+
+
+def test_the_loop_stops_at_three_levels_once_the_estimate_meets_the_tolerance():
+    done = refine(_Halving(), [None], 0.1, 10 ** 9, required=True)
+    assert [lv["discretization"] for lv in done.levels] == ["level 0", "level 1", "level 2"] and done.met
+    assert done.estimates[0]["contact_fraction"] == pytest.approx(1.5 * 0.025, rel=1e-12)  # ratio 1/2, tail = d
+    assert "level 0, level 1, level 2" in done.how
+
+
+def test_a_tolerance_beyond_the_size_bound_fails_with_the_figures_or_is_flagged():
+    with pytest.raises(ConvergenceError, match=r"tolerance = 0.001 not met: the estimate is 0.0375 on level 2 "
+                                               r"\(16000 dofs\), and level 3 would have 64000 dofs, beyond 20000"):
+        refine(_Halving(), [None], 1e-3, 20_000, required=True)
+    done = refine(_Halving(), [None], 1e-3, 20_000, required=False)
+    assert not done.met and done.solutions[0].results["contact_fraction"] == 0.525 and "beyond 20000" in done.how
+    two = refine(_Halving(), [None], 0.1, 5_000, required=False)         # the third level beyond the bound
+    assert two.met and len(two.levels) == 2 and "two discretizations" in two.how
+    alone = refine(_Halving(), [None], 0.1, 2_000, required=False)
+    assert alone.estimates == [{}] and not alone.met
+
+
+def test_stem_grooves_estimates_the_error_of_its_reported_closure_within_1_to_10():
+    """The shipped stem-groove cell (flat 2D, graded): against its spectral twin on 65,536 points (its closure
+    there within 2e-8 of 262,144 points'), the mean closure's effectivity lies in [1, 10]; its contact fraction's
+    true error is within the twin's collocation error, so only bounded by it."""
+    scene = load(os.path.join(ROOT, "geometries", "cells", "stem_grooves.toml"))
+    loads = cell_loads(scene)
+    reference = spectral_variant(scene, 65536).sweep(loads)[0].results
+    refined = cell_solver(scene).refine_to(0.01, loads, required=False)
+    got, estimate = refined.solutions[0].results, refined.estimates[0]
+    error = abs(got["mean_closure"] - reference["mean_closure"]) / reference["mean_closure"]
+    assert error <= estimate["mean_closure"] <= 10 * error, (error, estimate)
+    resolution = 2e-5      # the 2D spectral contact fraction's collocation error at 65,536 points
+    assert abs(got["contact_fraction"] - reference["contact_fraction"]) <= estimate["contact_fraction"] + resolution
+
+
+@pytest.mark.slow  # about 20 s on a loaded machine: the whole run; the loop's logic is tested above in ms
+def test_a_curved_cell_takes_a_tolerance_and_ends_with_exit_3_out_of_reach(tmp_path, capsys, monkeypatch):
+    """Once refused, a stated tolerance now refines a curved FE cell; a tolerance beyond the size bound (here
+    lowered to 500 dofs) ends as the graded path does (exit 3, the figures in the message)."""
+    from ngcontact.cell.fe import fe_cell
+    monkeypatch.setattr(fe_cell, "MAX_DOFS", {2: 500, 3: 500})
+    path = tmp_path / "curved.toml"
+    path.write_text(CURVED.replace("interface_maxh = 0.1\n", "interface_maxh = 0.1\ntolerance = 1e-9\n"))
+    code = cli.main(["run", str(path), "--out", str(tmp_path / "far"), "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 3 and "discretization.tolerance = 1e-09 not met" in err and "beyond 500" in err
+
+
+@pytest.mark.slow  # about a minute on a loaded machine: four levels and the penalty's share
+def test_a_curved_cell_meets_its_tolerance_and_reports_each_level(tmp_path, capsys):
+    path = tmp_path / "curved.toml"
+    path.write_text(CURVED.replace("interface_maxh = 0.1\n", "interface_maxh = 0.1\ntolerance = 0.5\n"))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "ok"), "--quiet"]) == 0, capsys.readouterr().err
+    report = json.loads((tmp_path / "ok" / "report.json").read_text())
+    entry = report["results"]["loads"][0]
+    assert entry["error_estimate"]["contact_fraction"] <= 0.5 and len(entry["discretizations"]) >= 3
+    assert report["results"]["accuracy"]["tolerance_from"] == "scene"
