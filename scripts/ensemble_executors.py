@@ -26,17 +26,15 @@ from __future__ import annotations
 
 import argparse
 import csv
-import json
 import os
-import subprocess
 import sys
 import tempfile
-import time
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+from scale_out import run  # noqa: E402  (a scene run as a user types it: wall seconds and report)
 
 ROOT = benchmark_doc.ROOT
 SHIPPED = os.path.join(ROOT, "geometries", "cells", "self_affine_ensemble.toml")
@@ -54,16 +52,6 @@ def large(tmp: str) -> str:
     with open(path, "w") as fh:
         fh.write(text)
     return path
-
-
-def run(scene: str, out: str, *flags: str) -> tuple[float, dict]:
-    """``ngcontact run scene --out out --quiet flags`` in a fresh interpreter: (wall seconds, report)."""
-    t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "ngcontact", "run", scene, "--out", out, "--quiet", *flags],
-                   check=True, cwd=os.path.dirname(scene))
-    wall = time.perf_counter() - t0
-    with open(os.path.join(out, "report.json")) as fh:
-        return wall, json.load(fh)
 
 
 def batch_seconds(report: dict) -> float:
