@@ -4,9 +4,9 @@ The macro problem of paper eqs. 44-48 / 69-71 (see :mod:`ngcontact.macro.macro_p
 built-in geometries: the axisymmetric femur with a press-fitted hip stem (paper Sec. 4.2-4.3), two
 coaxial tubes (Lame press fit; plane strain, axisymmetric or 3D) or a block on a base (friction); or on
 two bodies read from a CAD or mesh file (``geometry.shape = "file"``, keys in
-:mod:`ngcontact.scene.file_geometry`).  The interface law comes from explicit numbers (``linear`` K0, ``bundle`` of directions,
-``tabulated`` normal law) or from a ``cell`` scene named by
-``interface.cell`` (its direction bundle, computed on the fly and cached on
+:mod:`ngcontact.scene.file_geometry`).  The interface law comes from explicit numbers (``linear`` K0,
+``bundle`` of directions, ``tabulated`` normal law) or from a ``cell`` scene named by ``interface.cell``
+(its direction bundle, computed on the fly and cached on
 disk; see :mod:`ngcontact.coupling.cell_law`), with homogenized friction on top.
 Supports are those of the ``direct`` kind (:mod:`ngcontact.scene.supports`:
 constant, tilted, affine ``u0 + G x``, symmetry planes), on any boundary
