@@ -196,9 +196,20 @@ def discretization_errors(resolved: dict, homogenized: dict, resolved_fine: dict
     scene's discretization, then both on the refined one.  ``errors(R, R + (e_h - e_(h/r)))`` is the
     norm of the change of the signed difference in each error's own measure.
     """
-    shifted = combine(lambda r, h, rf, hf: rf + (h - r) - (hf - rf), resolved, homogenized, resolved_fine,
-                      homogenized_fine)
-    return errors(resolved_fine, shifted, weights, sampling)
+    return change(resolved, homogenized, resolved_fine, homogenized_fine, resolved_fine, weights, sampling)
+
+
+def change(resolved: dict, homogenized: dict, resolved_fine: dict, homogenized_fine: dict, reference: dict,
+           weights: np.ndarray, sampling: BodySampling | None = None) -> dict:
+    """``|e_a - e_b|`` of each error between two pairs ``a`` (``resolved``, ``homogenized``) and ``b`` (the
+    ``*_fine``), relative to the size of the resolved ``reference`` as :func:`errors` measures it:
+    ``errors(reference, reference + (e_a - e_b))``.  With ``reference`` the pair ``b``'s resolved solution
+    this is :func:`discretization_errors`; the three-mesh estimate (:mod:`ngcontact.drivers.richardson_tail`)
+    measures both of its changes against the finest resolved solution, so that their ratio is one of
+    changes alone."""
+    shifted = combine(lambda r, h, rf, hf, ref: ref + (h - r) - (hf - rf), resolved, homogenized, resolved_fine,
+                      homogenized_fine, reference)
+    return errors(reference, shifted, weights, sampling)
 
 
 @dataclass(frozen=True)
