@@ -17,7 +17,9 @@ errors contract by ``1/r`` or faster (order 2 elements away from corners contrac
 faster; at the re-entrant corners of the resolved valleys by about ``r^-1``).  The modelling error
 reported is the refined pair's, with ``delta`` beside it (:func:`discretization_errors`): a vector
 quantity (the field, the reactions, the probes, the interface force) compares the vectors ``e``, so
-that the estimate is a norm of the change, not the change of a norm.
+that the estimate is a norm of the change, not the change of a norm.  With a third discretization
+(``study.meshes = 3``) the contraction is observed instead of presumed: the errors are the finest pair's
+and the estimate the tail of the two changes (:func:`change`, :mod:`ngcontact.drivers.richardson_tail`).
 
 Errors of a homogenized solution against the resolved solution ``u^eps`` (:func:`errors`):
 
