@@ -36,10 +36,11 @@ CORRECTOR = ("l2", "l2_corrected", "h1", "h1_corrected", "probe_corrected")
 TWO = ("Each error is the modelling error on meshes refined by `study.refinement`, `*_discretization` its estimated "
        "discretization share (the change from the scene's meshes); seconds of the refined pair.")
 THREE = ("Each level on three discretizations (`study.meshes = 3`: the scene's, refined once and twice by "
-         "`study.refinement`); each error is the modelling error on the finest, `*_discretization` the Richardson "
-         "estimate d2 q / (1 - q) of its discretization share from the changes d1 (scene to once refined) and d2 "
-         "(once to twice refined), `*_ratio` the observed q = d2 / d1 (where q >= 1 the estimate is the largest "
-         "change: {largest}); seconds of the finest pair.")
+         "`study.refinement`); each error is the modelling error on the finest, `*_discretization` the sum of the "
+         "resolved and the homogenized solution's Richardson estimates d2 q / (1 - q) of their discretization "
+         "errors, from each solution's changes d1 (scene to once refined) and d2 (once to twice refined), "
+         "`*_ratio_resolved` and `*_ratio_homogenized` the observed q = d2 / d1 (where q >= 1 that solution's "
+         "term is its largest change: {largest}); seconds of the finest pair.")
 
 
 def largest_changes(results: dict) -> str:
@@ -92,7 +93,7 @@ def main(argv=None) -> int:
         name = os.path.splitext(os.path.basename(args.scene))[0]
         present = [law for law in laws if f"{law}_field" in rows[0]]
         three = results["discretization"].get("meshes") == 3
-        parts = ("", "_discretization", "_ratio") if three else ("", "_discretization")
+        parts = ("", "_discretization", "_ratio_resolved", "_ratio_homogenized") if three else ("", "_discretization")
         what = THREE.format(largest=largest_changes(results)) if three else TWO
         columns = ["N", "eps", "ndof_resolved"] + [
             f"{law}_{key}{part}" for law in present for key in ("field", "probe", "interface") + CORRECTOR

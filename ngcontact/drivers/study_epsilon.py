@@ -26,9 +26,10 @@ Each level is solved twice, on the scene's discretization and on one refined by
 interface) are the refined pair's, and beside each the estimate of its
 discretization error, the change between the two pairs.  With ``study.meshes = 3``
 each level is solved once more, refined again by the same factor; the errors are
-then the finest pair's and each estimate the Richardson tail of the two changes
-(:mod:`ngcontact.drivers.richardson_tail`; the largest change where their ratio does
-not contract, listed in ``results.discretization.largest_change``).
+then the finest pair's and each estimate the sum of the two solutions' Richardson tails of their changes
+(:mod:`ngcontact.drivers.richardson_tail`; a solution's largest change where the
+ratio of its changes does not contract, listed in
+``results.discretization.largest_change``).
 
 On blocks (``S_0`` the line ``y = 0``) the bundle law's solution is also rebuilt on the resolved bodies by
 the first-order corrector ``u^0 + eps u^1``
@@ -237,31 +238,36 @@ def solve_pair(scene, N: int, bundle: il.BundleLaw, laws, points, body,
 
 
 def estimates(pairs: list[tuple[dict, dict]], weights: np.ndarray,
-              sampling: E.BodySampling | None) -> dict[str, tuple[float, float | None, bool]]:
+              sampling: E.BodySampling | None) -> dict[str, tuple[float, dict | None, bool]]:
     """Per error: the discretization estimate of the finest of ``pairs`` (each ``(resolved, homogenized)``
-    measures, coarsest first), the observed ratio of the two changes and whether it contracts.
+    measures, coarsest first), the observed ratios of the changes and whether they contract.
 
     Two pairs: the change between them (:func:`~ngcontact.drivers.modelling_error.discretization_errors`),
-    no ratio.  Three: the Richardson tail of the two changes (:func:`ngcontact.drivers.richardson_tail.tail`;
-    the largest change where the ratio does not contract)."""
+    no ratios.  Three: the sum of the resolved and the homogenized solution's Richardson tails
+    (:mod:`ngcontact.drivers.richardson_tail`), ratios ``{"resolved": q, "homogenized": q}``, contracting
+    where both do."""
     if len(pairs) == 2:
         check = E.discretization_errors(*pairs[0], *pairs[1], weights, sampling)
         return {k: (v, None, True) for k, v in check.items()}
-    finest = pairs[-1][0]
-    first = E.change(*pairs[0], *pairs[1], finest, weights, sampling)
-    second = E.change(*pairs[1], *pairs[2], finest, weights, sampling)
-    out = {}
-    for key, d2 in second.items():
-        t = tail(first[key], d2)
-        out[key] = (t.estimate, t.ratio, t.contracts)
+    ref = pairs[-1][0]
+    moved = {"resolved": [E.change(a, ref, b, ref, ref, weights, sampling)
+                          for (a, _), (b, _) in zip(pairs, pairs[1:])],
+             "homogenized": [E.change(ref, a, ref, b, ref, weights, sampling)
+                             for (_, a), (_, b) in zip(pairs, pairs[1:])]}
+    out: dict[str, tuple[float, dict | None, bool]] = {}
+    for key in moved["resolved"][1]:
+        tails = {side: tail(first[key], second[key]) for side, (first, second) in moved.items()}
+        out[key] = (float(sum(t.estimate for t in tails.values())), {side: t.ratio for side, t in tails.items()},
+                    all(t.contracts for t in tails.values()))
     return out
 
 
 def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS, h1_band: float | None = None) -> dict:
     """One level: the resolved and homogenized runs on the scene's discretization and on ``study.meshes - 1``
     ones refined by ``study.refinement`` each (module docstring); a row with the finest pair's errors and
-    each error's discretization estimate (:func:`estimates`; three meshes: also ``*_ratio``, the observed
-    ratio of the two changes, ``None`` where the first is zero, and ``*_contracts``).
+    each error's discretization estimate (:func:`estimates`; three meshes: also ``*_ratio_resolved`` and
+    ``*_ratio_homogenized``, the observed ratio of each solution's two changes, ``None`` where the first is
+    zero, and ``*_contracts``, whether both contract).
 
     ``h1_band``: half-width of the layer the ``h1`` norms leave out (default: the band of the scene's
     coarsest level), the same for every level."""
@@ -291,9 +297,10 @@ def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS, h1_band: float | No
             check = {f"{k}_corrected": check[k] for k in ("l2", "h1", "probe") if k in check}
         for key, value in model.items():
             row[f"{name}_{key}"] = value
-            row[f"{name}_{key}_discretization"], ratio, contracts = check[key]
-            if len(pairs) == 3:
-                row[f"{name}_{key}_ratio"], row[f"{name}_{key}_contracts"] = ratio, contracts
+            row[f"{name}_{key}_discretization"], ratios, contracts = check[key]
+            if ratios is not None:
+                row.update({f"{name}_{key}_ratio_{side}": q for side, q in ratios.items()})
+                row[f"{name}_{key}_contracts"] = contracts
     log.info("N = %d: resolved %.2f s (%d dofs), bundle field error %.3e (discretization %.1e)", N,
              row["time_resolved"], row["ndof_resolved"], row.get("bundle_field", float("nan")),
              row.get("bundle_field_discretization", float("nan")))
@@ -351,9 +358,10 @@ def rates(rows: list, laws=LAWS, share: float = 0.1) -> tuple[dict, dict, dict]:
 
 
 #: how the three-mesh estimate is made (``results.discretization.estimate``)
-THREE_MESHES = ("the finest pair's errors; each estimate the Richardson tail d2 q / (1 - q) of the changes d1 "
-                "(coarse to middle) and d2 (middle to finest), q = d2 / d1 their observed ratio (*_ratio); where q "
-                "does not contract, the largest change (listed in largest_change: law -> error -> N)")
+THREE_MESHES = ("the finest pair's errors; each estimate the sum of the resolved and the homogenized solution's "
+                "Richardson tails d2 q / (1 - q), d1 and d2 the solution's changes (coarse to middle, middle to "
+                "finest) and q = d2 / d1 their observed ratio (*_ratio_resolved, *_ratio_homogenized); where a "
+                "solution's q does not contract, its largest change (listed in largest_change: law -> error -> N)")
 
 
 def discretization_record(rows: list, laws, study) -> dict:

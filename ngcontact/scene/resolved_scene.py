@@ -157,9 +157,9 @@ class StudySpec:
                               "between the two estimates its discretization error", check=closed_interval(1.5, 8))
     meshes: int = param(2, doc="discretizations per level: 2 (the scene's and one refined), or 3 (the scene's, "
                         "refined once and twice by study.refinement): the errors are then the finest pair's and "
-                        "each estimate the Richardson tail of the two changes (from their observed ratio; the "
-                        "largest change where it does not contract); ngcontact study epsilon --meshes overrides "
-                        "it", check=closed_interval(2, 3))
+                        "each estimate the sum of the resolved and the homogenized solution's Richardson tails of "
+                        "their two changes (from the observed ratio; a solution's largest change where it does "
+                        "not contract); ngcontact study epsilon --meshes overrides it", check=closed_interval(2, 3))
     discretization_share: float = param(0.1, doc="the rates in eps are fitted on the levels whose discretization "
                                         "estimate is at most this share of the error (the modelling error, not "
                                         "the meshes'); fewer than three such levels: no rate, and the report "

@@ -83,29 +83,31 @@ def test_the_three_mesh_estimate_is_the_geometric_tail_of_the_observed_ratio():
         tail(-1.0, 0.0)
 
 
-def test_three_pairs_measure_both_changes_against_the_finest_resolved_solution():
+def test_three_pairs_sum_the_tails_of_each_solution_s_changes():
     weights = np.array([1.0, 3.0])
-    resolved = [measures([[1.0, 0.0], [0.0, 2.0]], (10.0, 0.0), [1.0, 1.0], [4.0, 0.0]),
-                measures([[1.1, 0.0], [0.0, 2.0]], (10.5, 0.0), [1.0, 1.2], [4.0, 1.0]),
-                measures([[1.1, 0.0], [0.0, 2.1]], (10.6, 0.0), [1.0, 1.25], [4.0, 1.1])]
-    # the signed difference moves by 0.04, then 0.01 (vectors: the norm of the change); the probe's by 0.01,
-    # then 0.02 (does not contract)
-    homogenized = [E.combine(lambda r, o=o: r + 0.1 + o, res) for res, o in zip(resolved, (0.0, 0.04, 0.05))]
-    for h, res, o in zip(homogenized, resolved, (0.0, 0.01, 0.03)):
-        h["probes"] = res["probes"] + 0.1 + o
+    base = measures([[1.0, 0.0], [0.0, 2.0]], (10.0, 0.0), [1.0, 1.0], [4.0, 1.0])
+    # the resolved solution moves by 0.04, then 0.01; the homogenized one with it by 0.04, then stops: the
+    # difference does not change on the first step and does on the second, yet both solutions contract
+    resolved = [E.combine(lambda r, a=a: r + a, base) for a in (0.0, 0.04, 0.05)]
+    homogenized = [E.combine(lambda r, b=b: r + 0.1 + b, base) for b in (0.0, 0.04, 0.04)]
+    # the homogenized probes move by 0.01, then 0.02: no contraction, its largest change stands
+    for h, b in zip(homogenized, (0.0, 0.01, 0.03)):
+        h["probes"] = base["probes"] + 0.1 + b
     pairs = list(zip(resolved, homogenized))
     est = estimates(pairs, weights, None)
     ref = resolved[-1]
-    d1 = E.errors(ref, E.combine(lambda r: r + 0.04, ref), weights)
-    d2 = E.errors(ref, E.combine(lambda r: r + 0.01, ref), weights)
+
+    def moved(d):
+        return E.errors(ref, E.combine(lambda r: r + d, ref), weights)
+
     for key in ("field", "reaction", "interface"):
-        value, ratio, contracts = est[key]
-        assert contracts and ratio == pytest.approx(0.25) and value == pytest.approx(d2[key] / 3), key
-        assert d1[key] == pytest.approx(4 * d2[key])
-    value, ratio, contracts = est["probe"]
-    assert not contracts and ratio == pytest.approx(2.0)
-    assert value == pytest.approx(E.errors(ref, E.combine(lambda r: r + 0.02, ref), weights)["probe"])
-    # two pairs: the change between them, as before
+        value, ratios, contracts = est[key]
+        assert contracts and ratios == pytest.approx({"resolved": 0.25, "homogenized": 0.0}), key
+        assert value == pytest.approx(moved(0.01)[key] / 3), key
+    value, ratios, contracts = est["probe"]
+    assert not contracts and ratios == pytest.approx({"resolved": 0.25, "homogenized": 2.0})
+    assert value == pytest.approx(moved(0.01)["probe"] / 3 + moved(0.02)["probe"])
+    # two pairs: the change of the difference between them, as before
     two = estimates(pairs[1:], weights, None)
     assert {k: v[0] for k, v in two.items()} == pytest.approx(
         E.discretization_errors(*pairs[1], *pairs[2], weights))
