@@ -19,7 +19,8 @@ reported is the refined pair's, with ``delta`` beside it (:func:`discretization_
 quantity (the field, the reactions, the probes, the interface force) compares the vectors ``e``, so
 that the estimate is a norm of the change, not the change of a norm.  With a third discretization
 (``study.meshes = 3``) the contraction is observed instead of presumed: the errors are the finest pair's
-and the estimate the tail of the two changes (:func:`change`, :mod:`ngcontact.drivers.richardson_tail`).
+and the estimate the sum of the resolved and the homogenized solution's tails of their two changes
+(:func:`change`, :mod:`ngcontact.drivers.richardson_tail`).
 
 Errors of a homogenized solution against the resolved solution ``u^eps`` (:func:`errors`):
 
@@ -207,8 +208,8 @@ def change(resolved: dict, homogenized: dict, resolved_fine: dict, homogenized_f
     ``*_fine``), relative to the size of the resolved ``reference`` as :func:`errors` measures it:
     ``errors(reference, reference + (e_a - e_b))``.  With ``reference`` the pair ``b``'s resolved solution
     this is :func:`discretization_errors`; the three-mesh estimate (:mod:`ngcontact.drivers.richardson_tail`)
-    measures both of its changes against the finest resolved solution, so that their ratio is one of
-    changes alone."""
+    measures each solution's changes (the other solution held at ``reference`` in both pairs) against the
+    finest resolved solution, so that their ratio is one of changes alone."""
     shifted = combine(lambda r, h, rf, hf, ref: ref + (h - r) - (hf - rf), resolved, homogenized, resolved_fine,
                       homogenized_fine, reference)
     return errors(reference, shifted, weights, sampling)
