@@ -3,7 +3,7 @@
 ``ngcontact run SCENE [--out DIR]`` solves a scene and writes ``report.json``,
 CSV tables, VTK files for ParaView and PNG plots into ``DIR`` (default
 ``results/<scene name>``); ``ngcontact check SCENE`` only validates it;
-``ngcontact study epsilon SCENE [--periods N ...] [--out DIR]`` runs the
+``ngcontact study epsilon SCENE [--periods N ...] [--meshes 2|3] [--out DIR]`` runs the
 epsilon study of a ``direct`` scene (:func:`ngcontact.runner.study_epsilon`) and
 writes ``report.json``, ``epsilon.csv`` and ``epsilon.png`` into ``DIR``
 (default ``results/<scene name>_epsilon``); ``ngcontact study accuracy SCENE
@@ -131,6 +131,8 @@ def _study_parser(sub) -> None:
                                   "of kind cell, macro or direct")
     st.add_argument("--periods", type=int, nargs="+", metavar="N", help="epsilon: numbers of periods (default: the "
                                                                         "scene's)")
+    st.add_argument("--meshes", type=int, choices=(2, 3), help="epsilon: discretizations per level (default: the "
+                                                                "scene's study.meshes)")
     st.add_argument("--target", type=float, metavar="T", help="accuracy: the error to meet, in (0, 1) (contact "
                     "fractions absolute, other quantities relative); the cheapest level meeting it is written as "
                     "DIR/recommended.toml")
@@ -196,7 +198,7 @@ def main(argv=None) -> int:
         if args.command == "study":
             if args.target is not None or args.levels is not None:
                 return _fail(EXIT_SCENE, "--target, --levels: options of the accuracy study only")
-            return _study(args.scene, args.periods, args.out, quiet=args.quiet, compute=compute)
+            return _study(args.scene, args.periods, args.out, quiet=args.quiet, compute=compute, meshes=args.meshes)
         return _run(args.scene, args.out, quiet=args.quiet, compute=compute, mpi=args.mpi)
     except KeyboardInterrupt:
         return _fail(EXIT_INTERRUPTED, f"{args.scene}: interrupted; the output directory is as it was")
@@ -278,8 +280,9 @@ def _run(path: str, out: str | None, quiet: bool, compute: dict, mpi: bool = Fal
     return _execute(path, out, quiet, compute_run, suffix="")
 
 
-def _study(path: str, periods, out: str | None, quiet: bool, compute: dict) -> int:
-    """``ngcontact study epsilon``: the same code as ``scripts/epsilon_study.py``."""
+def _study(path: str, periods, out: str | None, quiet: bool, compute: dict, meshes: int | None = None) -> int:
+    """``ngcontact study epsilon``: the same code as ``scripts/epsilon_study.py``; ``meshes`` (``--meshes``)
+    replaces the scene's ``study.meshes``."""
     from ngcontact.runner import study_epsilon
 
     def require_study(sc):
@@ -290,7 +293,8 @@ def _study(path: str, periods, out: str | None, quiet: bool, compute: dict) -> i
 
     def run_study(sc, progress):
         with _scheduler_named(compute):
-            return study_epsilon(sc, periods, progress, batch_progress=BatchProgress(quiet), **compute)
+            return study_epsilon(sc, periods, progress, batch_progress=BatchProgress(quiet), meshes=meshes,
+                                 **compute)
 
     if periods is not None and (len(periods) < 3 or any(n < 1 for n in periods)
                                 or any(b <= a for a, b in zip(periods, periods[1:]))):
@@ -308,6 +312,8 @@ def _study_accuracy(args, compute: dict) -> int:
 
     if args.periods is not None:
         return _fail(EXIT_SCENE, "--periods: an option of the epsilon study only")
+    if args.meshes is not None:
+        return _fail(EXIT_SCENE, "--meshes: an option of the epsilon study only")
     if args.target is not None and not 0 < args.target < 1:
         return _fail(EXIT_SCENE, f"--target {args.target:g}: an error in (0, 1) (contact fractions absolute, other "
                                  "quantities relative), e.g. 0.01 for 1 %")

@@ -284,14 +284,15 @@ def mpi_world(scene, requested: bool = False):
 
 
 def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = None, *, workers: int | None = None,
-                  scheduler: str | None = None, batch_progress=None) -> tuple[dict, Outcome]:
+                  scheduler: str | None = None, batch_progress=None,
+                  meshes: int | None = None) -> tuple[dict, Outcome]:
     """The epsilon study of a ``direct`` scene with a ``[study]`` section, as a report; no file I/O.
 
     The resolved rough interface at ``N`` periods against the homogenized
     laws (:mod:`ngcontact.drivers.study_epsilon`); the command
     ``ngcontact study epsilon`` and ``scripts/epsilon_study.py`` call this.
     The levels are independent solves: ``workers``, ``scheduler`` and
-    ``batch_progress`` as in :func:`solve`.
+    ``batch_progress`` as in :func:`solve`; ``meshes`` (``--meshes``) replaces the scene's ``study.meshes``.
 
     Raises
     ------
@@ -306,6 +307,9 @@ def study_epsilon(scene, periods=None, progress: Callable[[str], None] | None = 
     if periods is not None:
         from ngcontact.scene.resolved_scene import with_study_periods
         scene = with_study_periods(scene, periods)
+    if meshes is not None:
+        from ngcontact.scene.resolved_scene import with_study_meshes
+        scene = with_study_meshes(scene, meshes)
     n = thread_count()
     clock = Clock(progress)
     with threads(n), batches(scene, workers, scheduler, batch_progress, start=True, note=progress,

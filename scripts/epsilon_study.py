@@ -7,8 +7,9 @@ whole-surface and the effective-stiffness laws are solved and compared (see
 (``results.rows``, ``results.rates``, ``results.below_1_percent``),
 ``DIR/epsilon.csv`` and ``DIR/epsilon.png`` (error and cost against eps).
 
-Usage: python scripts/epsilon_study.py SCENE [--periods 4 8 16 32] [--out DIR]
-(runs ``ngcontact study epsilon SCENE`` and prints its table)
+Usage: python scripts/epsilon_study.py SCENE [--periods 4 8 16 32] [--meshes 3] [--out DIR]
+(runs ``ngcontact study epsilon SCENE`` and prints its table; ``--meshes 3`` solves each level on a third
+discretization, ``study.meshes``)
 
 Exit status as ``ngcontact run``: 0 success, 2 invalid scene or output
 directory, 3 solver failure.
@@ -31,6 +32,23 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 CORRECTOR = ("l2", "l2_corrected", "h1", "h1_corrected", "probe_corrected")
 
 
+#: what the errors and their estimates are, with two and with three discretizations per level
+TWO = ("Each error is the modelling error on meshes refined by `study.refinement`, `*_discretization` its estimated "
+       "discretization share (the change from the scene's meshes); seconds of the refined pair.")
+THREE = ("Each level on three discretizations (`study.meshes = 3`: the scene's, refined once and twice by "
+         "`study.refinement`); each error is the modelling error on the finest, `*_discretization` the sum of the "
+         "resolved and the homogenized solution's Richardson estimates d2 q / (1 - q) of their discretization "
+         "errors, from each solution's changes d1 (scene to once refined) and d2 (once to twice refined), "
+         "`*_ratio_resolved` and `*_ratio_homogenized` the observed q = d2 / d1 (where q >= 1 that solution's "
+         "term is its largest change: {largest}); seconds of the finest pair.")
+
+
+def largest_changes(results: dict) -> str:
+    """The levels whose estimate is the largest change (the changes did not contract), per law and error."""
+    listed = results["discretization"]["largest_change"]
+    return "; ".join(f"{law} {key} at N = {ns}" for law, keys in listed.items() for key, ns in keys.items()) or "none"
+
+
 def rate_lines(results: dict) -> str:
     """One Markdown line per law: each error's rate in eps and the levels it rests on, or why it has none."""
     lines = []
@@ -49,6 +67,8 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("scene", help="scene file of kind 'direct' with a [study] section")
     p.add_argument("--periods", type=int, nargs="+", help="numbers of periods N (default: the scene's)")
+    p.add_argument("--meshes", type=int, choices=(2, 3), help="discretizations per level (default: the scene's "
+                                                               "study.meshes)")
     p.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     benchmark_doc.add_flag(p)
@@ -56,6 +76,7 @@ def main(argv=None) -> int:
     out = args.out or os.path.join("results", os.path.splitext(os.path.basename(args.scene))[0] + "_epsilon")
     code = cli_main(["study", "epsilon", args.scene, "--out", out]
                     + (["--periods", *map(str, args.periods)] if args.periods else [])
+                    + (["--meshes", str(args.meshes)] if args.meshes else [])
                     + (["--quiet"] if args.quiet else []))
     if code != EXIT_OK:
         return code
@@ -71,16 +92,17 @@ def main(argv=None) -> int:
     if args.publish:
         name = os.path.splitext(os.path.basename(args.scene))[0]
         present = [law for law in laws if f"{law}_field" in rows[0]]
+        three = results["discretization"].get("meshes") == 3
+        parts = ("", "_discretization", "_ratio_resolved", "_ratio_homogenized") if three else ("", "_discretization")
+        what = THREE.format(largest=largest_changes(results)) if three else TWO
         columns = ["N", "eps", "ndof_resolved"] + [
             f"{law}_{key}{part}" for law in present for key in ("field", "probe", "interface") + CORRECTOR
-            if f"{law}_{key}" in rows[0] for part in ("", "_discretization")] + ["time_resolved", "time_homogenized"]
+            if f"{law}_{key}" in rows[0] for part in parts] + ["time_resolved", "time_homogenized"]
         benchmark_doc.publish(f"epsilon_{name}", f"Epsilon study of `{name}`: resolved against homogenized",
                               os.path.join(out, "epsilon.csv"), columns=columns,
                               note=f"`{args.scene}` with N periods (period eps): the resolved run against the "
                                    "homogenized runs with the bundle, the linear whole-surface and the "
-                                   "effective-stiffness laws. Each error is the modelling error on meshes refined "
-                                   "by `study.refinement`, `*_discretization` its estimated discretization share "
-                                   "(the change from the scene's meshes); seconds of the refined pair. Where "
+                                   "effective-stiffness laws. " + what + " Where "
                                    "S_0 is straight (blocks) also, for the bundle law, `l2` (relative L2 over "
                                    "each whole body, the rough layer included; the larger of the two), `h1` "
                                    "(relative H1 seminorm outside the coarsest level's band, away from the "

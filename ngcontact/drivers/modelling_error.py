@@ -17,7 +17,10 @@ errors contract by ``1/r`` or faster (order 2 elements away from corners contrac
 faster; at the re-entrant corners of the resolved valleys by about ``r^-1``).  The modelling error
 reported is the refined pair's, with ``delta`` beside it (:func:`discretization_errors`): a vector
 quantity (the field, the reactions, the probes, the interface force) compares the vectors ``e``, so
-that the estimate is a norm of the change, not the change of a norm.
+that the estimate is a norm of the change, not the change of a norm.  With a third discretization
+(``study.meshes = 3``) the contraction is observed instead of presumed: the errors are the finest pair's
+and the estimate the sum of the resolved and the homogenized solution's tails of their two changes
+(:func:`change`, :mod:`ngcontact.drivers.richardson_tail`).
 
 Errors of a homogenized solution against the resolved solution ``u^eps`` (:func:`errors`):
 
@@ -196,9 +199,20 @@ def discretization_errors(resolved: dict, homogenized: dict, resolved_fine: dict
     scene's discretization, then both on the refined one.  ``errors(R, R + (e_h - e_(h/r)))`` is the
     norm of the change of the signed difference in each error's own measure.
     """
-    shifted = combine(lambda r, h, rf, hf: rf + (h - r) - (hf - rf), resolved, homogenized, resolved_fine,
-                      homogenized_fine)
-    return errors(resolved_fine, shifted, weights, sampling)
+    return change(resolved, homogenized, resolved_fine, homogenized_fine, resolved_fine, weights, sampling)
+
+
+def change(resolved: dict, homogenized: dict, resolved_fine: dict, homogenized_fine: dict, reference: dict,
+           weights: np.ndarray, sampling: BodySampling | None = None) -> dict:
+    """``|e_a - e_b|`` of each error between two pairs ``a`` (``resolved``, ``homogenized``) and ``b`` (the
+    ``*_fine``), relative to the size of the resolved ``reference`` as :func:`errors` measures it:
+    ``errors(reference, reference + (e_a - e_b))``.  With ``reference`` the pair ``b``'s resolved solution
+    this is :func:`discretization_errors`; the three-mesh estimate (:mod:`ngcontact.drivers.richardson_tail`)
+    measures each solution's changes (the other solution held at ``reference`` in both pairs) against the
+    finest resolved solution, so that their ratio is one of changes alone."""
+    shifted = combine(lambda r, h, rf, hf, ref: ref + (h - r) - (hf - rf), resolved, homogenized, resolved_fine,
+                      homogenized_fine, reference)
+    return errors(reference, shifted, weights, sampling)
 
 
 @dataclass(frozen=True)

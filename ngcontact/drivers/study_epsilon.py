@@ -24,7 +24,12 @@ Each level is solved twice, on the scene's discretization and on one refined by
 ``study.refinement``; the errors of each law against the resolved solution
 (:mod:`ngcontact.drivers.modelling_error`: field, reaction, moment, probe,
 interface) are the refined pair's, and beside each the estimate of its
-discretization error, the change between the two pairs.
+discretization error, the change between the two pairs.  With ``study.meshes = 3``
+each level is solved once more, refined again by the same factor; the errors are
+then the finest pair's and each estimate the sum of the two solutions' Richardson tails of their changes
+(:mod:`ngcontact.drivers.richardson_tail`; a solution's largest change where the
+ratio of its changes does not contract, listed in
+``results.discretization.largest_change``).
 
 On blocks (``S_0`` the line ``y = 0``) the bundle law's solution is also rebuilt on the resolved bodies by
 the first-order corrector ``u^0 + eps u^1``
@@ -65,6 +70,7 @@ from ngcontact.coupling.cell_law import bundle_law
 from ngcontact.coupling.first_order_corrector import FirstOrderCorrector
 from ngcontact.drivers import modelling_error as E
 from ngcontact.drivers.boundary_layer_cells import boundary_layer, scaled_cell_problem
+from ngcontact.drivers.richardson_tail import tail
 from ngcontact.drivers import run_resolved as drv
 from ngcontact.output import plots
 from ngcontact.geometry.profiles import profile_cell
@@ -231,9 +237,37 @@ def solve_pair(scene, N: int, bundle: il.BundleLaw, laws, points, body,
     return out
 
 
+def estimates(pairs: list[tuple[dict, dict]], weights: np.ndarray,
+              sampling: E.BodySampling | None) -> dict[str, tuple[float, dict | None, bool]]:
+    """Per error: the discretization estimate of the finest of ``pairs`` (each ``(resolved, homogenized)``
+    measures, coarsest first), the observed ratios of the changes and whether they contract.
+
+    Two pairs: the change between them (:func:`~ngcontact.drivers.modelling_error.discretization_errors`),
+    no ratios.  Three: the sum of the resolved and the homogenized solution's Richardson tails
+    (:mod:`ngcontact.drivers.richardson_tail`), ratios ``{"resolved": q, "homogenized": q}``, contracting
+    where both do."""
+    if len(pairs) == 2:
+        check = E.discretization_errors(*pairs[0], *pairs[1], weights, sampling)
+        return {k: (v, None, True) for k, v in check.items()}
+    ref = pairs[-1][0]
+    moved = {"resolved": [E.change(a, ref, b, ref, ref, weights, sampling)
+                          for (a, _), (b, _) in zip(pairs, pairs[1:])],
+             "homogenized": [E.change(ref, a, ref, b, ref, weights, sampling)
+                             for (_, a), (_, b) in zip(pairs, pairs[1:])]}
+    out: dict[str, tuple[float, dict | None, bool]] = {}
+    for key in moved["resolved"][1]:
+        tails = {side: tail(first[key], second[key]) for side, (first, second) in moved.items()}
+        out[key] = (float(sum(t.estimate for t in tails.values())), {side: t.ratio for side, t in tails.items()},
+                    all(t.contracts for t in tails.values()))
+    return out
+
+
 def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS, h1_band: float | None = None) -> dict:
-    """One level: the resolved and homogenized runs on the scene's discretization and on the refined one
-    (module docstring); a row with the refined pair's errors and each error's discretization estimate.
+    """One level: the resolved and homogenized runs on the scene's discretization and on ``study.meshes - 1``
+    ones refined by ``study.refinement`` each (module docstring); a row with the finest pair's errors and
+    each error's discretization estimate (:func:`estimates`; three meshes: also ``*_ratio_resolved`` and
+    ``*_ratio_homogenized``, the observed ratio of each solution's two changes, ``None`` where the first is
+    zero, and ``*_contracts``, whether both contract).
 
     ``h1_band``: half-width of the layer the ``h1`` norms leave out (default: the band of the scene's
     coarsest level), the same for every level."""
@@ -243,27 +277,30 @@ def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS, h1_band: float | No
     if h1_band is None:
         h1_band = st.band * drv.eps_of(scene, min(st.periods))
     sampling = E.body_sampling(scene, eps, max(h1_band, st.band * eps))
-    coarse = solve_pair(scene, N, bundle, laws, points, body, sampling)
-    fine = solve_pair(refined(scene, st.refinement), N, bundle, laws, points, body, sampling)
+    scenes = [scene] + [refined(scene, st.refinement ** k) for k in range(1, st.meshes)]
+    pairs = [solve_pair(s, N, bundle, laws, points, body, sampling) for s in scenes]
+    fine = pairs[-1]
     if sampling is not None:
         sampling = replace(sampling, layer_body=fine["layer_body"])
     row: dict[str, Any] = {"N": N, "eps": eps}
     row.update({k: v for k, v in fine.items() if k not in ("resolved", "laws", "layer_body")})
     row["time_homogenized"] = fine["time_bundle"] if "bundle" in laws else fine[f"time_{laws[0]}"]
-    row["time_discretization_check"] = sum(v for k, v in coarse.items() if k.startswith("time_"))
+    row["time_discretization_check"] = sum(v for p in pairs[:-1] for k, v in p.items() if k.startswith("time_"))
     for name in [*laws, "bundle_corrected"]:
         if name not in fine["laws"]:
             continue
         model = E.errors(fine["resolved"], fine["laws"][name], weights, sampling)
-        check = E.discretization_errors(coarse["resolved"], coarse["laws"][name], fine["resolved"],
-                                        fine["laws"][name], weights, sampling)
+        check = estimates([(p["resolved"], p["laws"][name]) for p in pairs], weights, sampling)
         if name == "bundle_corrected":
             name = "bundle"
             model = {f"{k}_corrected": model[k] for k in ("l2", "h1", "probe") if k in model}
             check = {f"{k}_corrected": check[k] for k in ("l2", "h1", "probe") if k in check}
         for key, value in model.items():
             row[f"{name}_{key}"] = value
-            row[f"{name}_{key}_discretization"] = check[key]
+            row[f"{name}_{key}_discretization"], ratios, contracts = check[key]
+            if ratios is not None:
+                row.update({f"{name}_{key}_ratio_{side}": q for side, q in ratios.items()})
+                row[f"{name}_{key}_contracts"] = contracts
     log.info("N = %d: resolved %.2f s (%d dofs), bundle field error %.3e (discretization %.1e)", N,
              row["time_resolved"], row["ndof_resolved"], row.get("bundle_field", float("nan")),
              row.get("bundle_field_discretization", float("nan")))
@@ -320,6 +357,33 @@ def rates(rows: list, laws=LAWS, share: float = 0.1) -> tuple[dict, dict, dict]:
     return fitted, used, refused
 
 
+#: how the three-mesh estimate is made (``results.discretization.estimate``)
+THREE_MESHES = ("the finest pair's errors; each estimate the sum of the resolved and the homogenized solution's "
+                "Richardson tails d2 q / (1 - q), d1 and d2 the solution's changes (coarse to middle, middle to "
+                "finest) and q = d2 / d1 their observed ratio (*_ratio_resolved, *_ratio_homogenized); where a "
+                "solution's q does not contract, its largest change (listed in largest_change: law -> error -> N)")
+
+
+def discretization_record(rows: list, laws, study) -> dict:
+    """``results.discretization``: the refinement and the share of the rule; with three meshes also how the
+    estimate is made and, per law and error, the levels whose ratio did not contract (the largest change
+    stands there, :mod:`ngcontact.drivers.richardson_tail`), each also a warning."""
+    out: dict[str, Any] = {"refinement": study.refinement, "share": study.discretization_share}
+    if study.meshes == 2:
+        return out
+    largest: dict[str, dict] = {}
+    for name in laws:
+        for key in ERRORS:
+            col = f"{name}_{key}_contracts"
+            bad = [r["N"] for r in rows if col in r and not r[col]]
+            if bad:
+                largest.setdefault(name, {})[key] = bad
+                log.warning("the %s law's %s error: the discretization changes do not contract at N = %s; its "
+                            "estimate there is the largest change", name, key, bad)
+    out.update(meshes=3, estimate=THREE_MESHES, largest_change=largest)
+    return out
+
+
 def threshold_eps(rows: list, laws=LAWS, tol: float = 0.01) -> dict:
     """Per law and error: the largest ``eps`` of the study from which on the error stays below ``tol``.
 
@@ -363,7 +427,7 @@ def run_study(scene, periods=None, *, laws=LAWS, clock=None) -> Outcome:
         for key, why in keys.items():
             log.warning("no rate of the %s law's %s error: %s", name, key, why)
     results = {"rows": rows, "rates": fitted, "rate_levels": used, "refused": refused,
-               "discretization": {"refinement": scene.study.refinement, "share": share},
+               "discretization": discretization_record(rows, laws, scene.study),
                "below_1_percent": threshold_eps(rows, laws),
                "bundle": {"directions": len(bundle.weights), "K0": bundle.matrix().tolist()},
                "error_definitions": E.DEFINITIONS}

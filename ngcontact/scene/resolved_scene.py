@@ -155,6 +155,11 @@ class StudySpec:
     refinement: float = param(2.0, doc="each level is solved again with every mesh size divided by this factor "
                               "(maxh, eps / elements_per_period, interface_maxh); the change of each error "
                               "between the two estimates its discretization error", check=closed_interval(1.5, 8))
+    meshes: int = param(2, doc="discretizations per level: 2 (the scene's and one refined), or 3 (the scene's, "
+                        "refined once and twice by study.refinement): the errors are then the finest pair's and "
+                        "each estimate the sum of the resolved and the homogenized solution's Richardson tails of "
+                        "their two changes (from the observed ratio; a solution's largest change where it does "
+                        "not contract); ngcontact study epsilon --meshes overrides it", check=closed_interval(2, 3))
     discretization_share: float = param(0.1, doc="the rates in eps are fitted on the levels whose discretization "
                                         "estimate is at most this share of the error (the modelling error, not "
                                         "the meshes'); fewer than three such levels: no rate, and the report "
@@ -321,4 +326,22 @@ def with_study_periods(scene: DirectScene, periods) -> DirectScene:
     except SceneError as err:
         raise SceneError("study.periods (from --periods)", levels,
                          f"with these levels {err.path} = {err.value!r} fails: {err.allowed}") from None
+    return new
+
+
+def with_study_meshes(scene: DirectScene, meshes: int) -> DirectScene:
+    """The scene with its study's ``meshes`` replaced (``ngcontact study epsilon --meshes``).
+
+    Raises
+    ------
+    SceneError
+        Naming ``study.meshes`` (from ``--meshes``) unless it is 2 or 3.
+    """
+    if scene.study is None:
+        raise SceneError("study", None, "the epsilon study needs a [study] section")
+    if meshes not in (2, 3):
+        raise SceneError("study.meshes (from --meshes)", meshes, "2 or 3")
+    new = replace(scene, study=replace(scene.study, meshes=int(meshes)))
+    if hasattr(scene, "cell_scene"):          # set by check when the scene was loaded (its linked cell)
+        object.__setattr__(new, "cell_scene", scene.cell_scene)
     return new
