@@ -440,14 +440,11 @@ def micro_friction(contact) -> FrictionLaw | None:
 
 
 def model_of(scene) -> CellModel:
-    """The FE cell's model of a cell scene.  Exact contact in a 3D cell at order >= 2 takes the linear trace
-    on ``S_C`` (:mod:`ngcontact.cell.fe.linear_trace`): the bodies of the scene's order, the vertex multiplier."""
-    c = scene.contact
-    ms = scene.load is not None and scene.load.macro_strain is not None
+    """The FE cell's model of a scene; exact contact in 3D at order >= 2 on a linear trace (its module)."""
+    c, order, ms = scene.contact, scene.discretization.order, getattr(scene.load, "macro_strain", None) is not None
     return CellModel(rough=elastic_law(scene.materials[scene.bodies.rough]),
                      counter=elastic_law(scene.materials[scene.bodies.counter]),
-                     k_n=c.k_n, gap=gap_cf(scene), friction=micro_friction(c), order=scene.discretization.order,
+                     k_n=c.k_n, gap=gap_cf(scene), friction=micro_friction(c), order=order,
                      macro_strain=ms, coulomb_rtol=scene.solver.coulomb_rtol,
                      coulomb_max_iter=scene.solver.coulomb_max_iter, enforcement=c.enforcement,
-                     linear_trace=c.enforcement == "exact" and scene.geometry.dim == 3
-                     and scene.discretization.order > 1)
+                     linear_trace=c.enforcement == "exact" and scene.geometry.dim == 3 and order > 1)
