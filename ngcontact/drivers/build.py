@@ -24,6 +24,7 @@ from ngcontact.cell.fe.fe_cell import FECell
 from ngcontact.cell.spectral.spectral_solver import SpectralCellSolver
 from ngcontact.coupling import cell_law
 from ngcontact.drivers.cell_gap import gap_cf, gap_samples, map_heights
+from ngcontact.drivers.contact_edge_refiner import edge_refiner
 from ngcontact.errors import SceneError
 from ngcontact.fem import materials
 from ngcontact.laws import homogenized as il
@@ -211,10 +212,8 @@ def cell_solver(scene: CellScene) -> CellSolver:
 
 
 def fe_cell(scene: CellScene) -> FECell:
-    """The FE cell of a scene: its mesh, its cell problem (built on the first solve), its variants (another
-    order, interface size, enforcement or penalty: the error estimates and the penalty's share) and, on a
-    flat 2D frictionless cell, the graded meshes and the fine spectral predictor that seeds them
-    (:mod:`ngcontact.cell.fe.edge_grading`)."""
+    """The FE cell of a scene: mesh, problem (built on first solve), variants, graded meshes and their predictor
+    (flat 2D frictionless: edge_grading), the contact edge's refiner where it has one (contact_edge_refiner)."""
     cell, model = build_cell(scene), model_of(scene)
     d = scene.discretization
     graded = h0 = predictor = None
@@ -234,7 +233,8 @@ def fe_cell(scene: CellScene) -> FECell:
     threshold = None if friction is None or friction.couples_to_pressure else friction.threshold(None)
     return FECell(cell, model, lambda: cell_problem(scene, cell, model), threshold=threshold, graded=graded,
                   h0=h0, predictor=predictor, variant=lambda **changes: fe_variant(scene, **changes),
-                  interface_maxh=d.interface_maxh or d.maxh, twin=share_twin(scene))
+                  interface_maxh=d.interface_maxh or d.maxh, twin=share_twin(scene),
+                  refiner=edge_refiner(scene, model, cell_problem, spectral_cell))
 
 
 #: the spectral twin's grid on which an FE cell's penalty share is measured: it resolves the contact edges
@@ -440,10 +440,11 @@ def micro_friction(contact) -> FrictionLaw | None:
 
 
 def model_of(scene) -> CellModel:
-    c = scene.contact
-    ms = scene.load is not None and scene.load.macro_strain is not None
+    """The FE cell's model of a scene; exact contact in 3D at order >= 2 on a linear trace (its module)."""
+    c, order, ms = scene.contact, scene.discretization.order, getattr(scene.load, "macro_strain", None) is not None
     return CellModel(rough=elastic_law(scene.materials[scene.bodies.rough]),
                      counter=elastic_law(scene.materials[scene.bodies.counter]),
-                     k_n=c.k_n, gap=gap_cf(scene), friction=micro_friction(c), order=scene.discretization.order,
+                     k_n=c.k_n, gap=gap_cf(scene), friction=micro_friction(c), order=order,
                      macro_strain=ms, coulomb_rtol=scene.solver.coulomb_rtol,
-                     coulomb_max_iter=scene.solver.coulomb_max_iter, enforcement=c.enforcement)
+                     coulomb_max_iter=scene.solver.coulomb_max_iter, enforcement=c.enforcement,
+                     linear_trace=c.enforcement == "exact" and scene.geometry.dim == 3 and order > 1)

@@ -61,7 +61,8 @@ class ContactSpec:
                               "mesh size or grid step)", units="Pa/m", check=positive())
     enforcement: str = param("penalty", doc="penalty: the paper's Winkler layer p = k_n [J.n - g]_+ (eq. 65) "
                              "and Huber-regularized friction; exact: non-penetration, the rigid limit k_n -> infinity: "
-                             "spectral cell with exact friction (w unused), or FE cell (2D; 3D at order 1), "
+                             "spectral cell with exact friction (w unused), or FE cell (in 3D at order >= 2 with a "
+                             "linear trace on S_C: the bodies of the order, the trace and multiplier of order 1), "
                              "node-to-node at the nodes of the trace (Gauss-Lobatto on segments, vertices of "
                              "triangles) by an "
                              "augmented Lagrangian with Uzawa updates (k_n is its "
@@ -334,21 +335,17 @@ def has_twin(scene: CellScene) -> bool:
 
 
 def check_fe(scene: CellScene) -> None:
-    """What the FE cell needs of a scene: a Huber width with friction, an admissible penalty, order 1 for
-    exact contact in 3D and a flat interface for the spectral start.  A tolerance suits every FE cell (graded
+    """What the FE cell needs of a scene: a Huber width with friction, an admissible penalty and a flat
+    interface for the spectral start (exact contact in 3D at order >= 2 takes a linear trace on ``S_C``,
+    :mod:`ngcontact.cell.fe.linear_trace`).  A tolerance suits every FE cell (graded
     meshes on a flat 2D frictionless cell, else a sequence of finer interface meshes:
     :mod:`ngcontact.cell.fe.second_discretization`)."""
-    c, d, dim = scene.contact, scene.discretization, scene.geometry.dim
+    c = scene.contact
     if c.friction != "none" and c.w is None:
         raise SceneError("contact.w", MISSING, f"required for friction = {c.friction!r} in an FE cell, which "
                          "regularizes friction with the Huber width w under exact enforcement too (the spectral "
                          "cell's exact friction needs none)")
     check_penalty_ratio(scene)
-    if c.enforcement == "exact" and dim == 3 and d.order > 1:
-        raise SceneError("discretization.order", d.order,
-                         "must be 1 with contact.enforcement = 'exact' in a 3D FE cell (quadratic triangles leave "
-                         "corner nodes open inside the contact patch); or use the penalty, or "
-                         "discretization.method = 'spectral' for a small-slope cell")
     if scene.solver.start == "spectral" and not has_twin(scene):
         raise SceneError("solver.start", "spectral", "starts from the spectral cell of the same small-slope cell: "
                          "it needs contact.enforcement = 'penalty' and a flat interface (geometry.profile = "

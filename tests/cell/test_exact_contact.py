@@ -236,16 +236,16 @@ def _sweep3d(P, ratios):
 
 
 def test_exact_contact_on_quadratic_triangles_is_refused(cell3d_coarse, tmp_path, capsys):
-    """Order 2 in 3D left corner nodes open inside the contact patch (contact_multiplier's docstring)."""
+    """Order 2 in 3D left corner nodes open inside the contact patch (contact_multiplier's docstring): refused
+    by the multiplier and by a model without the linear trace; a scene at order 2 takes the linear trace
+    (ngcontact.cell.fe.linear_trace) and is accepted."""
     with pytest.raises(ValueError, match="order = 2: exact contact on triangles"):
         ContactMultiplier(cell3d_coarse.mesh, 2)
     with pytest.raises(ModelError, match="order = 2 with enforcement = 'exact' in a 3D cell"):
         _problem3d(cell3d_coarse, 2, 1e2, 0.1)
     path = tmp_path / "s.toml"
     path.write_text(SCENE.replace('profile = "flat"', 'profile = "flat3d"'))
-    assert cli.main(["check", str(path)]) == 2
-    err = capsys.readouterr().err
-    assert "discretization.order = 2" in err and "3D FE cell" in err
+    assert cli.main(["check", str(path)]) == 0, capsys.readouterr().err
 
 
 def test_3d_exact_contact_is_independent_of_k_n_admissible_and_balanced(cell3d_coarse):
@@ -367,6 +367,24 @@ def test_an_exact_fe_scene_runs_end_to_end(tmp_path, dim, tolerance):
     assert load["contact_fraction"] == pytest.approx(westergaard_contact_fraction(0.0034523 / PSTAR, 1.0),
                                                      rel=tolerance)
     assert (tmp_path / "o" / "surface_load0.csv").exists()
+
+
+# measured at p/p* = 0.5, interface mesh 0.1 (0.05), bodies 0.4: order 1 -4.1 %, order 2 on the linear trace
+# +6.8 % (+3.6 %): the closed nodes' patches overshoot the contact set by a share of the interface mesh
+def test_an_exact_3d_fe_scene_at_order_2_runs_on_a_linear_trace(tmp_path):
+    """Through the command line, a 3D scene at order 2 with exact contact (once refused): the bodies quadratic,
+    the trace on S_C linear (ngcontact.cell.fe.linear_trace); non-penetration and the load held, the contact
+    fraction above Westergaard's (the converged value of the spectral twin of this gap) by less than 8 %."""
+    text = SCENE.replace('profile = "flat"', 'profile = "flat3d"').replace("maxh = 0.3", "maxh = 0.4").replace(
+        "interface_maxh = 0.02", "interface_maxh = 0.1").replace("pressure = [0.0034523]", "pressure = [0.0086307]")
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    (load,) = json.loads((tmp_path / "o" / "report.json").read_text())["results"]["loads"]
+    assert load["mean_pressure"] == pytest.approx(0.0086307, rel=1e-9)
+    assert load["max_penetration"] <= 1e-10
+    exact = westergaard_contact_fraction(0.0086307 / PSTAR, 1.0)
+    assert 1.0 < load["contact_fraction"] / exact < 1.08
 
 
 @pytest.mark.slow  # ~40 s: two loads graded towards their edges to a tolerance of 1e-3

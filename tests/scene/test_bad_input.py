@@ -945,11 +945,21 @@ def test_the_macro_friction_coefficient_documents_the_default_coupled_newton():
     assert SolverSpec().coulomb == "newton" and "solver.coulomb" in doc and "Newton" in doc
 
 
-def test_the_order_of_an_exact_3d_fe_cell_says_what_it_must_be(tmp_path, capsys):
+def test_order_2_of_an_exact_3d_fe_cell_is_accepted_on_a_linear_trace(tmp_path, capsys):
+    """Was refused ('must be 1 with contact.enforcement = exact in a 3D FE cell'); the scene now takes the
+    linear trace on S_C (ngcontact.cell.fe.linear_trace), the 2D cell and the penalty keep the full trace."""
+    from ngcontact.drivers.build import model_of
+    from ngcontact.scene.loader import load
     text = edit(CELL.format(contact='enforcement = "exact"'), ('profile = "flat"', 'profile = "flat3d"'),
                 ("order = 1", "order = 2"))
-    run_bad(tmp_path, capsys, text, "discretization.order = 2: must be 1 with contact.enforcement = 'exact' in a "
-            "3D FE cell", prefix=True)
+    scene = tmp_path / "scene.toml"
+    scene.write_text(text)
+    assert cli.main(["check", str(scene)]) == 0, capsys.readouterr().err
+    assert model_of(load(scene)).linear_trace
+    scene.write_text(edit(CELL.format(contact='enforcement = "exact"'), ("order = 1", "order = 2")))
+    assert not model_of(load(scene)).linear_trace
+    scene.write_text(edit(text, ('enforcement = "exact"', 'enforcement = "penalty"')))
+    assert not model_of(load(scene)).linear_trace
 
 
 def test_a_removed_key_names_its_successor(tmp_path, capsys):

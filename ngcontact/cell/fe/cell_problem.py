@@ -43,7 +43,7 @@ consistent, non-symmetric tangent), or the fixed point of Tresca problems
 ``G_k = mu p_{k-1}`` until ``max |p_k - p_{k-1}| <= coulomb_rtol * max p_k``
 on ``S_C``: the same solution (:mod:`ngcontact.cell.fe.coulomb_friction`).
 
-Exact non-penetration (``CellModel.enforcement = "exact"``, 2D, and 3D at order 1;
+Exact non-penetration (``CellModel.enforcement = "exact"``, 2D, and 3D at order 1 or on a linear trace;
 the rigid limit ``k_n -> infinity`` of the Winkler layer): the normal
 energy is the augmented Lagrangian
 ``(1/(2 k_n)) ([lambda + k_n (J.n - g)]_+^2 - lambda^2)``, integrated with a

@@ -6,11 +6,13 @@ hills, a conforming profile) or a frictional load path (solved in order) is refi
 same sweep on a sequence of discretizations given by a :class:`Refiner`, and the error of the last is
 estimated from the sequence (:mod:`ngcontact.cell.fe.observed_rate`).
 
-The refiner of every such cell is :class:`InterfaceHalving`: the interface element size halved from level to
-level at the scene's order (``h, h/2, h/4, ...``, the bulk mesh as before).  The contact fraction converges
-at least like ``h``: a contact edge cuts its elements anywhere, and the fraction counts the cut elements'
-share to first order (in 3D the fraction is the quadrature integral of the contact indicator, whose error at
-the edge curves is of that order whatever the polynomial order); the closure converges faster.  So the
+The refiner of such a cell is :class:`InterfaceHalving` (a flat 3D cell with exact contact:
+:class:`~ngcontact.cell.fe.contact_edge_refinement.ContactEdgeRefinement`): the interface element size halved
+from level to level at the scene's order (``h, h/2, h/4, ...``, the bulk mesh as before; along the contact
+edge only). The contact fraction converges at least like ``h``: a contact edge cuts its elements anywhere, and
+the fraction counts the cut elements' share to first order (in 3D the fraction is the quadrature integral of
+the contact indicator, whose error at the edge curves is of that order whatever the polynomial order); the
+closure converges faster.  So the
 observed ratio of successive differences is held to at least ``1/2`` (:data:`HALVING_RATE`).  One order
 more on the same mesh is not a sequence that converges at a rate one may observe here: on the shipped 3D
 bisinusoid its contact fraction moved 0.029 from order 2 to 3 and 0.010 from 3 to 4 while the error of
@@ -23,8 +25,8 @@ needs three levels (two observed differences), or two where the third is beyond 
 estimate meets the tolerance.  Out of reach: a :class:`~ngcontact.errors.ConvergenceError` with the figures
 where the tolerance was stated, else the last level with ``met = False``.  Per load: the contact fraction
 absolutely, the mean closure and the normal effective stiffness relatively, as everywhere
-(:data:`ngcontact.cell.admissibility.ESTIMATED`).  A better refiner of a 3D cell (local refinement towards
-the contact edge) is another :class:`Refiner` with its own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.
+(:data:`ngcontact.cell.admissibility.ESTIMATED`).  A refiner is any :class:`Refiner`, each with its
+own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.
 """
 from __future__ import annotations
 

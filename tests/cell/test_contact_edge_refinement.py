@@ -1,0 +1,75 @@
+"""The second discretization of a flat 3D cell with exact contact along its contact edge
+(ngcontact.cell.fe.contact_edge_refinement, wired by ngcontact.drivers.contact_edge_refiner)."""
+from __future__ import annotations
+
+
+import numpy as np
+import pytest
+
+from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
+from ngcontact.cell.fe.second_discretization import HALVING_RATE, InterfaceHalving
+from ngcontact.drivers.build import fe_cell
+from ngcontact.scene.loader import load
+from ngcontact.verification.moduli import e_star
+from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
+
+PSTAR = westergaard_p_star(e_star(1.0, 0.3, 1.0, 0.3), 0.01, 1.0)
+PRESSURE = 0.5 * PSTAR
+
+SCENE = f"""\
+kind = "cell"
+[materials.solid]
+E = 1.0
+nu = 0.3
+[bodies]
+rough = "solid"
+counter = "solid"
+[geometry]
+profile = "flat3d"
+h_rough = 1.0
+h_counter = 1.0
+[contact]
+k_n = 1.0e4
+enforcement = "exact"
+friction = "none"
+gap = {{ kind = "sinusoid", h = 0.01 }}
+[load]
+pressure = [{PRESSURE!r}]
+[discretization]
+order = 2
+maxh = 0.4
+interface_maxh = 0.1
+"""
+
+
+def _interface_sizes(mesh) -> np.ndarray:
+    """``x`` of the centroid and the longest edge of each triangle of ``S_C``."""
+    out = []
+    for el in mesh.Boundaries("contact").Elements():
+        v = np.array([mesh[w].point for w in el.vertices])
+        out.append((v[:, 0].mean(), max(np.linalg.norm(v[i] - v[i - 1]) for i in range(3))))
+    return np.array(out)
+
+
+@pytest.mark.slow  # ~17 s under load: the twin at 256^2 and the refined cell's mesh and space
+def test_an_exact_flat_3d_cell_refines_along_its_twins_contact_edge(tmp_path):
+    """Level 1 of the scene's refiner: the mesh finer (edge_maxh 0.05) at Westergaard's edges x = 1/2 +- a
+    (waves along x) than away from them, S_C with more triangles than the scene's; the penalty cell keeps
+    the halving."""
+    path = tmp_path / "s.toml"
+    path.write_text(SCENE)
+    cell = fe_cell(load(path))
+    refiner = cell.refiner()
+    assert isinstance(refiner, ContactEdgeRefinement) and refiner.rule is HALVING_RATE
+    assert refiner.level(0) is cell and refiner.describe(2).startswith("edge_maxh 0.025")
+    a = westergaard_contact_fraction(0.5, 1.0) / 2      # half the contact width (period 1)
+    pts = refiner.points()
+    assert len(pts) > 0 and np.all(np.abs(np.abs(pts[:, 0] - 0.5) - a) < 2.0 / 256)
+    sizes = _interface_sizes(refiner.level(1).problem.mesh)
+    near = np.abs(np.abs(sizes[:, 0] - 0.5) - a) < 0.02
+    far = np.abs(np.abs(sizes[:, 0] - 0.5) - a) > 0.2
+    # measured: mean longest edge 0.085 within 0.02 of the edges, 0.107 beyond 0.2 from them
+    assert sizes[near, 1].mean() < 0.85 * sizes[far, 1].mean()
+    assert len(sizes) > len(_interface_sizes(cell.problem.mesh))
+    path.write_text(SCENE.replace('enforcement = "exact"', 'enforcement = "penalty"'))
+    assert isinstance(fe_cell(load(path)).refiner(), InterfaceHalving)
