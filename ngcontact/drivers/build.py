@@ -1,8 +1,7 @@
 """Scene descriptions -> model objects: the one translator of the package.
 
-The scene layer only describes (frozen dataclasses, validated on load); this
-module turns its sections into the objects the model code takes.  Each kind's
-driver calls these instead of building its own copies.
+The scene layer only describes (frozen dataclasses, validated on load); this module turns its sections
+into the objects the model code takes.  Each kind's driver calls these instead of building its own copies.
 """
 from __future__ import annotations
 
