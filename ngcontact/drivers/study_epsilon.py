@@ -435,4 +435,5 @@ def run_study(scene, periods=None, *, laws=LAWS, clock=None) -> Outcome:
     table = (header, [[r[k] for k in header] for r in rows])
     return Outcome(results=results, ndof=max(r["ndof_resolved"] for r in rows),
                    tables={"epsilon": table},
-                   plots={"epsilon": lambda path, rows=rows, laws=laws: plots.epsilon_study(path, rows, laws)})
+                   plots={"epsilon": lambda path, rows=rows, laws=laws: plots.epsilon_study(path, rows, laws),
+                          "epsilon_errors": lambda path: plots.epsilon_errors(path, rows, laws, fitted, used)})

@@ -53,6 +53,46 @@ def epsilon_study(path: str, rows: list, laws) -> None:
     plt.close(fig)
 
 
+def epsilon_errors(path: str, rows: list, laws, rates: dict, levels: dict) -> None:
+    """One panel per error of the epsilon study: per law the modelling error against ``eps`` (markers), its
+    discretization estimate (thin dotted) and the fitted line ``C eps^rate`` over the levels it was fitted on
+    (dashed; ``rates[law][error]`` and ``levels[law][error]`` as :func:`ngcontact.drivers.study_epsilon.rates`
+    returns them), so that each rate can be read against the levels the share rule let in."""
+    plt = _pyplot()
+    keys = [k for k in dict.fromkeys(k for law in laws for k in rates.get(law, {}))]
+    if not keys:
+        return
+    cols = min(3, len(keys))
+    nrows = -(-len(keys) // cols)
+    fig, axes = plt.subplots(nrows, cols, figsize=(4.2 * cols, 3.4 * nrows), squeeze=False)
+    eps = np.array([r["eps"] for r in rows])
+    for ax, key in zip(axes.flat, keys):
+        for name, color in zip(laws, ("C0", "C1", "C2")):
+            col = f"{name}_{key}"
+            if col not in rows[0]:
+                continue
+            ax.loglog(eps, [max(r[col], 1e-300) for r in rows], "o-", color=color, label=name)
+            ax.loglog(eps, [max(r[f"{col}_discretization"], 1e-300) for r in rows], "x:", color=color, lw=0.8)
+            rate, used = rates.get(name, {}).get(key), levels.get(name, {}).get(key, [])
+            if rate is not None and used:
+                fit = [r for r in rows if r["N"] in used]
+                x = np.log([r["eps"] for r in fit])
+                c = float(np.mean(np.log([r[col] for r in fit]) - rate * x))
+                ax.loglog(np.exp(x), np.exp(c + rate * x), "--", color=color, lw=1.6,
+                          label=f"{name}: rate {rate:.2f}")
+        ax.set_title(key, fontsize=9)
+        ax.set_xlabel("eps [m]", fontsize=8)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=6)
+    for ax in list(axes.flat)[len(keys):]:
+        ax.set_visible(False)
+    fig.suptitle("modelling error (markers), its discretization estimate (dotted), fitted rate (dashed)",
+                 fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 # ------------------------------------------------------------------ cell
 def cell_surface(path: str, surfaces: list) -> None:
     """Contact pressure and slip along the cell's contact surface, one line per load.

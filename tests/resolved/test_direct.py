@@ -181,8 +181,8 @@ def test_epsilon_study_script_writes_report_csv_and_plot_and_refuses_a_mesh_rate
     # tangential stiffness below the whole-surface k_t0 = 0.6 k_n, increasing as the asperities shrink
     kt = [r["effective_law"]["K_eff"][1][1] for r in rows]
     assert all(k < 0.6 * KN for k in kt) and all(b > a for a, b in zip(kt, kt[1:])), kt
-    assert {"epsilon.csv", "epsilon.png"} <= set(rep["files"])
-    assert (out / "epsilon.png").stat().st_size > 0
+    assert {"epsilon.csv", "epsilon.png", "epsilon_errors.png"} <= set(rep["files"])
+    assert (out / "epsilon.png").stat().st_size > 0 and (out / "epsilon_errors.png").stat().st_size > 0
     header = (out / "epsilon.csv").read_text().splitlines()[0].split(",")
     assert "bundle_reaction" in header and "effective_field" in header and "bundle_field_discretization" in header
     assert "bundle_l2_corrected" in header and "bundle_h1_corrected_discretization" in header
