@@ -129,8 +129,11 @@ def to_plain(obj, path: str = "results"):
 
 def accuracy_line(results: dict) -> str | None:
     """The accuracy verdict (``results.accuracy``) in one terminal line: met or not, and per quantity its
-    value and estimated relative error (the largest over the loads of a sweep, with that load's value)."""
+    value and estimated relative error (the largest over the loads of a sweep, with that load's value); a
+    verdict without an estimate says so and how to get one (``accuracy.how``), never nothing."""
     acc = results.get("accuracy")
+    if isinstance(acc, dict) and acc.get("estimated") is False and not acc.get("quantities"):
+        return f"accuracy {acc.get('how') or 'not estimated'}"
     if not isinstance(acc, dict) or not acc.get("quantities"):
         return None
     worst: dict[str, dict] = {}

@@ -39,3 +39,10 @@ def test_the_terminal_line_ends_with_the_modelling_error_where_it_is_estimated()
                                               "(estimate C eps / L)")
     none = dict(modelling, estimated=False, relative_error=None, how="not estimated: no period")
     assert "modelling" not in (accuracy_line({"accuracy": dict(VERDICT, modelling=none)}) or "")
+
+
+def test_a_verdict_without_an_estimate_says_so_on_the_terminal():
+    how = "not estimated: set discretization.tolerance to refine the discretization and estimate its error"
+    line = accuracy_line({"accuracy": {"tolerance": 0.01, "met": True, "estimated": False, "how": how,
+                                       "checks": []}})
+    assert line == f"accuracy {how}"
