@@ -130,37 +130,45 @@ class LocalPool(Executor):
         results: dict[int, Any] = {}
         failures = {k: 0 for k in range(len(items))}
         pending: dict[Any, int] = {}
+        unsent: list[int] = []       # members whose submission found the pool already broken
         pool = self._pool or self._start()
 
         def submit(k):
-            pending[pool.submit(_pool_member, fn, items[k], names[k], failures[k], fault)] = k
+            try:
+                pending[pool.submit(_pool_member, fn, items[k], names[k], failures[k], fault)] = k
+            except BrokenProcessPool:    # a worker died while the batch was being submitted
+                unsent.append(k)
+                return
             # the pool spawns its workers on submission and forgets them once one dies: keep them
             self._processes.update(pool._processes or {})
 
         try:
             for k in range(len(items)):
                 submit(k)
-            while pending:
-                done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
+            while pending or unsent:
                 broken = []
-                for fut in done:
-                    k = pending.pop(fut)
-                    try:
-                        results[k] = fut.result()
-                    except BrokenProcessPool:
-                        broken.append(k)
-                        continue
-                    except Exception as exc:
-                        self._failed(label, names[k], failures, k, exc)
-                        submit(k)
-                        continue
-                    if progress is not None:
-                        progress(label, len(results), len(items))
-                if broken:
-                    # a worker died: its member counts a failure; the members of the other workers are innocent
+                if pending:
+                    done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
+                    for fut in done:
+                        k = pending.pop(fut)
+                        try:
+                            results[k] = fut.result()
+                        except BrokenProcessPool:
+                            broken.append(k)
+                            continue
+                        except Exception as exc:
+                            self._failed(label, names[k], failures, k, exc)
+                            submit(k)
+                            continue
+                        if progress is not None:
+                            progress(label, len(results), len(items))
+                if broken or (unsent and not pending):
+                    # a worker died: its member counts a failure; the members of the other workers are innocent,
+                    # and so are those never sent (unless nothing had started: then they count)
                     lost = broken + [pending.pop(f) for f in list(pending)]
+                    never, unsent[:] = list(unsent), []
                     culprits = self._running_on_dead_workers(names)
-                    for k in lost:
+                    for k in lost or never:
                         # a worker that died before it started a member (it could not even start: a script
                         # without an ``if __name__ == "__main__":`` guard) leaves no culprit: all count
                         if names[k] in culprits or not culprits:
@@ -170,7 +178,7 @@ class LocalPool(Executor):
                                 "'if __name__ == \"__main__\":' guard)"))
                     self._discard()
                     pool = self._start()
-                    for k in lost:
+                    for k in sorted(set(lost + never)):
                         submit(k)
         except BaseException:
             self._discard()

@@ -176,3 +176,33 @@ def test_an_early_pool_solves_members_here_until_a_worker_has_started(monkeypatc
         assert ex.map(os.getenv, ["NGCONTACT_THREADS"] * 6, names, label="toy") == ["1"] * 6
     finally:
         ex.close()
+
+
+def test_members_whose_submission_finds_the_pool_broken_are_sent_again(monkeypatch):
+    """A worker that dies while the batch is still being submitted breaks the pool under the submitting
+    loop (``submit`` raises): those members are sent again to a fresh pool, not lost."""
+    from concurrent.futures.process import BrokenProcessPool
+    ex = executor.LocalPool(2)
+    start = ex._start
+    calls = {"pools": 0}
+
+    def flaky_start():
+        pool = start()
+        calls["pools"] += 1
+        if calls["pools"] == 1:          # the first pool refuses the third submission as a broken one would
+            submit, sent = pool.submit, []
+
+            def refusing(*args, **kwargs):
+                sent.append(1)
+                if len(sent) == 3:
+                    raise BrokenProcessPool("a child process terminated abruptly")
+                return submit(*args, **kwargs)
+            monkeypatch.setattr(pool, "submit", refusing)
+        return pool
+
+    monkeypatch.setattr(ex, "_start", flaky_start)
+    try:
+        assert ex.map(operator.neg, ITEMS, NAMES, label="toy") == EXPECTED
+        assert calls["pools"] == 2
+    finally:
+        ex.close()
