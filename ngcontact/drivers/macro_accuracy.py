@@ -41,11 +41,14 @@ CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its 
 
 
 def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
-                  safety_factor: Callable[[MacroSolution], float] | None = None) -> dict[int, dict[str, DE.Sample]]:
+                  safety_factor: Callable[[MacroSolution], float] | None = None,
+                  component: str | None = None, dense_inset: float = 1e-3) -> dict[int, dict[str, DE.Sample]]:
     """The headline quantities at the three orders of the ladder (``sol`` is the scene's order; the other
-    two are solved by ``solve(problem, start)`` on the same mesh with the same law, from ``sol``)."""
+    two are solved by ``solve(problem, start)`` on the same mesh with the same law, from ``sol``);
+    ``component``: the resultant's (default: the largest of ``sol``'s); ``dense_inset``: of the lattice
+    a stress maximum's sampling error is measured on (:func:`ngcontact.macro.discretization_error.body_maxima`)."""
     problem, ppe = sol.problem, scene.output.points_per_element
-    own = DE.headlines(sol, ppe)
+    own = DE.headlines(sol, ppe, component, dense_inset)
     component = next(n for n in own if n.startswith("resultant_")).removeprefix("resultant_")
     if safety_factor is not None:
         own["safety_factor"] = DE.Sample(safety_factor(sol))
@@ -57,7 +60,7 @@ def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution]
         start = DE.start_at_order(sol, other)
         with DE.neighbour_mesh(problem.mesh, problem.order):
             s = solve(other, start)
-            out[q] = DE.headlines(s, ppe, component)
+            out[q] = DE.headlines(s, ppe, component, dense_inset)
             if safety_factor is not None:
                 out[q]["safety_factor"] = DE.Sample(safety_factor(s))
     return dict(sorted(out.items()))
@@ -142,13 +145,13 @@ def safety_factor_of(scene, recovery) -> Callable[[MacroSolution], float] | None
 
 def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], balance: dict,
              two_scale: dict | None = None, recovery=None,
-             samples: dict[int, dict[str, DE.Sample]] | None = None) -> dict[str, Any]:
+             found: list[DE.Estimate] | None = None) -> dict[str, Any]:
     """``results.accuracy`` of the macro solution ``sol`` of ``scene``: the neighbouring orders solved by
-    ``solve(problem, start)`` (or their ``samples``, made already by a refinement), the safety factor
-    re-evaluated with the strength check's correctors ``recovery``."""
-    if samples is None:
-        samples = order_samples(scene, sol, solve, safety_factor_of(scene, recovery))
-    out = verdict(estimates(samples, sol), scene.discretization.tolerance, balance, two_scale)
+    ``solve(problem, start)`` (or the estimates ``found`` already by a refinement, with its mesh levels),
+    the safety factor re-evaluated with the strength check's correctors ``recovery``."""
+    if found is None:
+        found = estimates(order_samples(scene, sol, solve, safety_factor_of(scene, recovery)), sol)
+    out = verdict(found, scene.discretization.tolerance, balance, two_scale)
     out["modelling"] = modelling(scene, sol)
     return out
 

@@ -1,35 +1,54 @@
-"""Refinement of a macro solution towards ``discretization.tolerance``: the order raised on the scene's mesh.
+"""Refinement of a macro solution towards ``discretization.tolerance``: the order first, then the mesh.
 
 A macro scene that states ``discretization.tolerance`` is not only judged against it: while the estimated
 relative error of a headline quantity (:mod:`ngcontact.macro.discretization_error`) exceeds the tolerance,
 the polynomial order is raised by one on the scene's mesh and the solution and its estimate are made
-again, until every quantity meets it or a bound is reached (:data:`MAX_REFINED_ORDER`, :data:`MAX_DOFS`).
-The report names the discretization that met it (``results.accuracy.refinement``); a tolerance out of
-reach ends the run with the figures of the last level, as a cell's refinement does (a
-:class:`~ngcontact.errors.ConvergenceError`: exit 3, nothing written).
+again.  When raising the order no longer pays, the mesh is refined where the error indicator is large
+(:mod:`ngcontact.macro.error_indicator`), level by level at that order, until every quantity meets the
+tolerance or a bound is reached (:data:`MAX_REFINED_ORDER`, :data:`MAX_DOFS`, :data:`MAX_MESH_LEVELS`).
+The report names the discretization that met it (``results.accuracy.refinement``: per level the order,
+the mesh level, its elements, unknowns, values and estimates); a tolerance out of reach ends the run with
+the figures of the last level, as a cell's refinement does (a :class:`~ngcontact.errors.ConvergenceError`:
+exit 3, nothing written).
 
-Why the order (p), not the mesh near the interface (h)
+The order (p) first
     * The estimate is an order ladder on one mesh: at order ``p`` it has solved ``p - 1, p, p + 1``.
       Raising the order is the step the estimate itself measures, and its observed ratio ``rho``
-      predicts the next error, ``e_{p+1} ~ rho e_p``; a refined mesh would start a new ladder of three
-      solves whose first difference says nothing of the mesh's effect.
+      predicts the next error, ``e_{p+1} ~ rho e_p``.
     * On a solution smooth on each element, which the macro problem's is away from corners (linear
       elasticity with a smooth interface law on a mesh curved to its geometry), the p-error falls
       geometrically: one order buys the observed factor ``rho``, where halving the
       interface elements buys ``2^-(p+1)`` at 4 (2D) or 8 (3D) times the unknowns near the interface.
-    * A stress maximum at a corner that grows with every order is a singularity: the estimate has no
-      error for it (``error = None``), and an h-refinement towards the interface would not make it
-      converge either, so the refinement stops there at once and names the quantity and the corner: the
-      tolerance cannot be met on it, whatever the discretization.  A difference that does not shrink
-      away from any corner (pre-asymptotic orders) has no estimate either, but the next order may show
-      the fall: the order is raised while the bounds allow.
+    * A difference that does not shrink away from any corner (pre-asymptotic orders) has no estimate,
+      but the next order may show the fall: the order is raised while the bounds allow.
 
-Each level is the run of the scene at that order: the mesh is curved at the raised order
+Then the mesh (h), where the order no longer pays
+    * at the order bound (:data:`MAX_REFINED_ORDER`), or where the ladder finds a stress maximum at a
+      corner growing with every order (a singular point: the order cannot show it within any
+      tolerance, :func:`stop_reason`).  There the error is local, and only smaller elements near the
+      corner reduce it: the mesh is refined where the indicator is large (its volume term grades towards
+      corners, its interface term puts the interface's elements first) by Doerfler marking and Netgen's
+      local refinement (:func:`ngcontact.macro.error_indicator.refine_marked`: new boundary vertices on
+      the geometry, the mesh curved again at the order), and the scene is solved again at the same order.
+    * Each mesh level is estimated by the order ladder on its mesh and by the sequence of mesh levels
+      with its observed rate (:mod:`ngcontact.macro.mesh_sequence`), the larger of the two; a corner's
+      maximum without a ladder estimate is estimated by the sequence alone once three levels exist.
+      A stress maximum's sampling error is measured on a lattice reaching the elements' faces
+      (:func:`ngcontact.macro.discretization_error.body_maxima` with ``dense_inset = 0``): at the errors a
+      tolerance beyond the order's reach asks for, the inset of the sample points from a boundary where
+      the maximum sits is a share of the error.
+    * A maximum that grows with every mesh level without an estimate is a true singularity (its value
+      depends on the mesh and has no limit): the refinement stops there and says so.
+    * A scene with ``[two_scale]`` keeps its mesh (the loop's interface state lives on it).
+
+Each order level is the run of the scene at that order: the mesh is curved at the raised order
 (``mesh.Curve``, as :func:`ngcontact.drivers.macro_geometry.build_geometry` curves a mesh of that
-order; the vertices are the scene's), so the discretization that met the tolerance is reproduced by the
-scene with ``discretization.order`` set to it.  The new order is solved from the last solution
-interpolated into its space, and its neighbours from it.  With ``[two_scale]`` every level is solved with
-the loop's converged law (as the estimate's neighbours are); the loop is not repeated.
+order; the vertices are the scene's), so the discretization that met the tolerance by the order alone is
+reproduced by the scene with ``discretization.order`` set to it.  The new order is solved from the last
+solution interpolated into its space, and its neighbours from it; a new mesh level is solved from the
+start, as the scene is.  The scene's mesh is refined in place, so the run reports on the refined mesh.
+With ``[two_scale]`` every level is solved with the loop's converged law (as the estimate's neighbours
+are); the loop is not repeated.
 
 A scene that states no tolerance is not refined: its run costs what it did.
 """
@@ -42,7 +61,10 @@ from typing import Any, Callable
 from ngcontact.drivers import macro_accuracy as MA
 from ngcontact.errors import ConvergenceError
 from ngcontact.macro import discretization_error as DE
-from ngcontact.macro.macro_problem import MacroSolution, space_and_frame
+from ngcontact.macro import error_indicator as EI
+from ngcontact.macro import mesh_sequence as MS
+from ngcontact.macro.macro_problem import MacroProblem, MacroSolution, space_and_frame
+from ngcontact.scene.schema import MAX_ORDER
 
 progress = logging.getLogger("ngcontact.progress")
 
@@ -50,9 +72,13 @@ progress = logging.getLogger("ngcontact.progress")
 MAX_REFINED_ORDER = 4
 #: the most unknowns of the highest order a level's estimate solves
 MAX_DOFS = 2_000_000
+#: the most mesh levels the refinement makes after the order
+MAX_MESH_LEVELS = 12
 #: what the report's ``accuracy.refinement.method`` says
-METHOD = ("p: the polynomial order raised by one on the scene's mesh (curved at the order) until every headline "
-          "quantity's estimated relative error is within discretization.tolerance (ngcontact.drivers.macro_refinement)")
+METHOD = ("p, then h: the polynomial order raised by one on the scene's mesh (curved at the order) while it "
+          "pays, then the mesh refined where the stress error indicator is large, interface first "
+          "(ngcontact.macro.error_indicator, Doerfler marking), until every headline quantity's estimated "
+          "relative error is within discretization.tolerance (ngcontact.drivers.macro_refinement)")
 
 
 @dataclass(frozen=True)
@@ -62,11 +88,15 @@ class Refined:
     solution: MacroSolution
     samples: dict[int, dict[str, DE.Sample]]
     history: list[dict[str, Any]]
+    estimates: list[DE.Estimate]
 
     def record(self) -> dict[str, Any]:
-        """``results.accuracy.refinement``: the method, its bounds, the levels and the order that met it."""
+        """``results.accuracy.refinement``: the method, its bounds, the levels and the order and mesh level
+        that met it."""
         return {"method": METHOD, "max_order": MAX_REFINED_ORDER, "max_dofs": MAX_DOFS,
+                "max_mesh_levels": MAX_MESH_LEVELS, "marking_bulk": EI.BULK,
                 "scene_order": self.history[0]["order"], "order": self.solution.problem.order,
+                "h_level": self.history[-1]["h_level"], "elements": self.history[-1]["elements"],
                 "ndof": self.solution.ndof, "levels": self.history}
 
 
@@ -75,16 +105,24 @@ def unmet(found: list[DE.Estimate], tolerance: float) -> list[DE.Estimate]:
     return [e for e in found if e.relative_error is None or e.relative_error > tolerance]
 
 
-def level(sol: MacroSolution, found: list[DE.Estimate], tolerance: float) -> dict[str, Any]:
-    """One level of the refinement as the report lists it: order, unknowns, each quantity's relative error."""
+def level(sol: MacroSolution, found: list[DE.Estimate], tolerance: float, h_level: int = 0) -> dict[str, Any]:
+    """One level of the refinement as the report lists it: order, mesh level (0: the scene's mesh), elements,
+    unknowns, each quantity's value and relative error."""
     missed = unmet(found, tolerance)
-    return {"order": sol.problem.order, "ndof": sol.ndof, "met": not missed,
+    return {"order": sol.problem.order, "h_level": h_level, "elements": sol.problem.mesh.ne, "ndof": sol.ndof,
+            "met": not missed, "values": {e.name: e.value for e in found},
             "relative_errors": {e.name: e.relative_error for e in found}}
 
 
 def top_dofs(sol: MacroSolution, order: int) -> int:
     """The unknowns of the highest order the estimate of ``order`` solves (``order + 1``) on ``sol``'s mesh."""
     fes, _ = space_and_frame(replace(sol.problem, order=order + 1))
+    return int(fes.ndof)
+
+
+def top_dofs_of(problem: MacroProblem) -> int:
+    """The unknowns of the highest order the estimate of ``problem``'s order solves on its mesh."""
+    fes, _ = space_and_frame(replace(problem, order=DE.ladder(problem.order, MAX_ORDER)[-1]))
     return int(fes.ndof)
 
 
@@ -110,10 +148,11 @@ def out_of_reach(tolerance: float, history: list[dict[str, Any]], missed: list[D
     last = history[-1]
     figures = ", ".join(f"{e.name} {e.value:.4g} " + ("(no estimate)" if e.relative_error is None
                                                       else f"+/- {e.relative_error:.3g}") for e in missed)
-    orders = " -> ".join(str(h["order"]) for h in history)
-    return (f"discretization.tolerance = {tolerance:g} not met: at order {last['order']} ({last['ndof']} unknowns; "
-            f"orders {orders}) the estimate misses it on {figures}; {why}; loosen the tolerance or make the mesh "
-            "finer (discretization.maxh, interface_maxh)")
+    orders = " -> ".join(str(h["order"]) for h in history if h["h_level"] == 0)
+    mesh = f", mesh level {last['h_level']}" if last["h_level"] else ""
+    return (f"discretization.tolerance = {tolerance:g} not met: at order {last['order']}{mesh} ({last['ndof']} "
+            f"unknowns; orders {orders}) the estimate misses it on {figures}; {why}; loosen the tolerance or make "
+            "the mesh finer (discretization.maxh, interface_maxh)")
 
 
 def raised(sol: MacroSolution, order: int, solve: Callable[..., MacroSolution]) -> MacroSolution:
@@ -124,17 +163,27 @@ def raised(sol: MacroSolution, order: int, solve: Callable[..., MacroSolution]) 
     return solve(problem, start)
 
 
+def h_refusal(scene) -> str | None:
+    """Why the mesh of ``scene`` is not refined (``None``: it may be)."""
+    if MAX_MESH_LEVELS < 1:
+        return f"the refinement's bound allows no mesh level ({MAX_MESH_LEVELS})"
+    if scene.two_scale is not None:
+        return ("the two-scale loop's interface state lives on the scene's mesh, so its mesh is not refined "
+                "(make the mesh finer: discretization.maxh, interface_maxh)")
+    return None
+
+
 def refine(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
            safety_factor: Callable[[MacroSolution], float] | None = None) -> Refined | None:
-    """Raise the order of ``sol`` until its headline quantities meet ``scene.discretization.tolerance``
-    (module docstring); ``solve(problem, start)`` solves a problem as the scene does.  ``None``: the scene
-    states no tolerance, and ``sol`` stands as it is.
+    """Refine ``sol`` until its headline quantities meet ``scene.discretization.tolerance`` (module
+    docstring): the order first, then the mesh; ``solve(problem, start)`` solves a problem as the scene
+    does.  ``None``: the scene states no tolerance, and ``sol`` stands as it is.
 
     Raises
     ------
     ConvergenceError
-        The tolerance is out of reach: a quantity without estimate, or a bound reached; the message gives
-        the last level's order, unknowns and estimates.
+        The tolerance is out of reach: a bound reached, or a quantity without estimate on every mesh; the
+        message gives the last level's order, mesh level, unknowns and estimates.
     """
     if scene.discretization.tolerance is None:
         return None
@@ -145,12 +194,74 @@ def refine(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
         found = MA.estimates(samples, sol)
         history.append(level(sol, found, tolerance))
         missed = unmet(found, tolerance)
-        worst = max((e.relative_error for e in found if e.relative_error is not None), default=0.0)
-        progress.info("macro order %d (%d unknowns): largest estimated relative error %.3g%s", sol.problem.order,
-                      sol.ndof, worst, "" if not missed else f", {len(missed)} quantities beyond {tolerance:g}")
+        _progress(sol, found, missed, tolerance, 0)
         if not missed:
-            return Refined(solution=sol, samples=samples, history=history)
+            return Refined(solution=sol, samples=samples, history=history, estimates=found)
         why = stop_reason(sol, missed)
         if why is not None:
-            raise ConvergenceError(out_of_reach(tolerance, history, missed, why), {"refinement": history})
+            break
         sol = raised(sol, sol.problem.order + 1, solve)
+    refusal = h_refusal(scene)
+    if refusal is not None:
+        raise ConvergenceError(out_of_reach(tolerance, history, missed, f"{why}; {refusal}"),
+                               {"refinement": history})
+    progress.info("macro: %s; the mesh is refined where the error indicator is large", why)
+    return refine_mesh(scene, Refined(solution=sol, samples=samples, history=history, estimates=found), solve,
+                       safety_factor, tolerance)
+
+
+def _progress(sol: MacroSolution, found: list[DE.Estimate], missed: list[DE.Estimate], tolerance: float,
+              h_level: int) -> None:
+    worst = max((e.relative_error for e in found if e.relative_error is not None), default=0.0)
+    progress.info("macro order %d, mesh level %d (%d unknowns): largest estimated relative error %.3g%s",
+                  sol.problem.order, h_level, sol.ndof, worst,
+                  "" if not missed else f", {len(missed)} quantities beyond {tolerance:g}")
+
+
+def h_stop_reason(sol: MacroSolution, missed: list[DE.Estimate], values: dict[str, list[float]],
+                  h_level: int) -> str | None:
+    """Why the mesh is not refined further (``None``: it is)."""
+    growing = [e for e in missed if e.error is None and MS.grows_without_bound(values[e.name])]
+    if growing:
+        e = growing[0]
+        return (f"{e.name} grows with every mesh level ({', '.join(f'{v:.4g}' for v in values[e.name][-3:])}) "
+                "without an estimate: a singularity, whose value depends on the mesh and does not converge")
+    if h_level >= MAX_MESH_LEVELS:
+        return f"mesh level {h_level + 1} is beyond the refinement's bound ({MAX_MESH_LEVELS} levels)"
+    return None
+
+
+def refine_mesh(scene, start: Refined, solve: Callable[..., MacroSolution],
+                safety_factor: Callable[[MacroSolution], float] | None, tolerance: float) -> Refined:
+    """The mesh refined where :func:`ngcontact.macro.error_indicator.indicator` is large, at the order
+    ``start`` reached, level by level until the tolerance is met (module docstring)."""
+    sol, history = start.solution, list(start.history)
+    values = {e.name: [e.value] for e in start.estimates}
+    component = next(n for n in values if n.startswith("resultant_")).removeprefix("resultant_")
+    h_level = 0
+    while True:
+        flags = EI.marked(EI.indicator(sol))
+        problem = replace(sol.problem)
+        EI.refine_marked(problem.mesh, flags, problem.order)
+        h_level += 1
+        dofs = top_dofs_of(problem)
+        if dofs > MAX_DOFS:
+            raise ConvergenceError(out_of_reach(tolerance, history, unmet(start.estimates, tolerance),
+                                                f"mesh level {h_level}'s estimate would solve {dofs} unknowns, "
+                                                f"beyond the refinement's bound of {MAX_DOFS}"),
+                                   {"refinement": history})
+        sol = solve(problem, None)
+        samples = MA.order_samples(scene, sol, solve, safety_factor, component, dense_inset=0.0)
+        ladder = MA.estimates(samples, sol)
+        for e in ladder:
+            values[e.name].append(e.value)
+        found = [MS.combined(e, values[e.name]) for e in ladder]
+        history.append(level(sol, found, tolerance, h_level))
+        missed = unmet(found, tolerance)
+        _progress(sol, found, missed, tolerance, h_level)
+        if not missed:
+            return Refined(solution=sol, samples=samples, history=history, estimates=found)
+        why = h_stop_reason(sol, missed, values, h_level)
+        if why is not None:
+            raise ConvergenceError(out_of_reach(tolerance, history, missed, why), {"refinement": history})
+        start = Refined(solution=sol, samples=samples, history=history, estimates=found)

@@ -300,7 +300,7 @@ def run(scene, clock) -> Outcome:
         outcome.plots.update(st["plots"])
     with clock.stage("discretization error"):
         results["accuracy"] = accuracy(scene, sol, partial(solve_scene, scene), results["equilibrium"], two_scale,
-                                       recovery, None if refined is None else refined.samples)
+                                       recovery, None if refined is None else refined.estimates)
     if refined is not None:
         results["accuracy"]["refinement"] = refined.record()
     return outcome

@@ -147,7 +147,8 @@ def accuracy_line(results: dict) -> str | None:
     verdict = "met" if acc.get("met") else "NOT met"
     refined = acc.get("refinement") or {}
     if refined.get("order") is not None:
-        verdict += f" at order {refined['order']} (refined from order {refined.get('scene_order')})"
+        verdict += f" at order {refined['order']} (refined from order {refined.get('scene_order')}"
+        verdict += f", mesh refined {refined['h_level']} times)" if refined.get("h_level") else ")"
     model = acc.get("modelling") or {}
     tail = (f"; modelling error of the homogenized interface ~ {model['relative_error']:.2%} (estimate C eps / L)"
             if model.get("relative_error") is not None else "")

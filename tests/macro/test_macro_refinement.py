@@ -1,4 +1,5 @@
-"""A macro scene that states ``discretization.tolerance`` is refined towards it (the order raised on its mesh):
+"""A macro scene that states ``discretization.tolerance`` is refined towards it (the order raised on its mesh;
+the mesh levels after it in ``test_mesh_refinement.py``):
 met on Lame's press fit against the closed form, exit 3 with the figures when out of reach, and a scene
 without a tolerance is run as it was."""
 from __future__ import annotations
@@ -117,6 +118,7 @@ def test_a_tolerance_out_of_reach_ends_the_run_with_the_figures(tmp_path, monkey
     """A :class:`ConvergenceError`, which the command line ends with exit 3 and nothing written
     (``tests/test_cli.py``), as a cell's tolerance out of reach."""
     monkeypatch.setattr(MR, "MAX_REFINED_ORDER", 3)
+    monkeypatch.setattr(MR, "MAX_MESH_LEVELS", 0)     # the mesh levels: tests/macro/test_mesh_refinement.py
     with pytest.raises(ConvergenceError) as info:
         D.run(loader.load(_scene(tmp_path, 1e-3)), Clock())
     err = str(info.value)

@@ -1,0 +1,176 @@
+"""Past the order, the macro refinement towards ``discretization.tolerance`` refines the mesh where the
+error indicator is large: on Lame's press fit the tolerance beyond order 4's reach is met on refined meshes
+with estimates bounding the closed form's error; at a block's corner the levels and the estimate of the
+peak pressure fall until the stress singularity ends the run with its figures."""
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from ngcontact.drivers import macro_refinement as MR
+from ngcontact.drivers import run_macro as D
+from ngcontact.errors import ConvergenceError
+from ngcontact.geometry import bodies as gm
+from ngcontact.fem.materials import isotropic
+from ngcontact.laws import homogenized as il
+from ngcontact.macro import discretization_error as DE
+from ngcontact.macro import error_indicator as EI
+from ngcontact.macro import macro_problem as M
+from ngcontact.macro import mesh_sequence as MS
+from ngcontact.output.report import Clock, accuracy_line
+from ngcontact.scene import loader
+
+from tests.macro.test_macro_refinement import PRESS_FIT, _lame
+
+BLOCK = """\
+kind = "macro"
+
+[materials.soft]
+E = 70e9
+nu = 0.33
+
+[materials.stiff]
+E = 210e9
+nu = 0.3
+
+[bodies]
+rough = "soft"
+counter = "stiff"
+
+[geometry]
+shape = "block"
+setting = "plane_strain"
+
+[geometry.dimensions]
+length = 1.0
+h_block = 0.5
+h_base = 0.5
+
+[interface]
+law = "linear"
+kn = 1e11
+kt = 4e10
+
+[[supports]]
+boundary = "bottom"
+components = ["y"]
+
+[[supports]]
+boundary = "base_sides"
+components = ["x"]
+
+[[loads]]
+boundary = "top"
+pressure = 1e6
+
+[discretization]
+order = 2
+maxh = 0.25
+tolerance = 1e-3
+"""
+
+
+# ------------------------------------------------------------------ the estimate from the mesh levels
+@pytest.mark.parametrize("rho", [0.2, 0.5, 0.8])
+def test_a_geometric_fall_over_mesh_levels_is_bounded(rho):
+    limit, e0 = 2.0, 0.3
+    values = [limit + e0 * rho ** k for k in range(4)]
+    err, how = MS.sequence_error(values, limit)
+    assert err is not None and 1.0 <= err / abs(values[-1] - limit) <= 10.0 and "geometric tail" in how
+
+
+def test_mesh_levels_that_disagree_in_rate_take_the_slower_and_say_so():
+    values = [1.0 + e for e in (0.4, 0.2, 0.18, 0.17)]      # ratios 0.1 then 0.5
+    err, how = MS.sequence_error(values, 1.0)
+    assert "disagree in rate" in how and err == pytest.approx(DE.SAFETY * 0.01 * 0.5 / 0.5)
+
+
+def test_a_value_growing_with_every_level_has_no_estimate_and_is_a_singularity():
+    values = [1.0, 1.3, 1.7, 2.3]
+    err, how = MS.sequence_error(values, 2.3)
+    assert err is None and "not converging" in how
+    assert MS.grows_without_bound(values) and not MS.grows_without_bound([1.0, 1.3, 1.4])
+
+
+def test_the_larger_of_the_ladder_and_the_sequence_is_reported():
+    ladder = DE.Estimate(name="q", value=1.1, error=1e-4, scale=1.1, ratio=0.1, orders=(3, 4, 5), how="ladder")
+    seq = MS.combined(ladder, [1.3, 1.15, 1.1])               # ratio 1/3: tail 1.5 x 0.05 x 0.5
+    assert seq.error == pytest.approx(DE.SAFETY * 0.05 * 0.5) and "larger than the order ladder's" in seq.how
+    corner = DE.Estimate(name="q", value=1.1, error=None, scale=1.1, ratio=2.0, orders=(3, 4, 5),
+                         how="orders: a stress singularity", singular_at=(0.0, 0.0))
+    assert MS.combined(corner, [1.3, 1.15]).error is None
+    settled = MS.combined(corner, [1.3, 1.15, 1.1])
+    assert settled.error == pytest.approx(seq.error) and settled.singular_at is None
+
+
+# ------------------------------------------------------------------ the indicator and the marking
+def test_doerfler_marks_the_fewest_largest_elements_carrying_half_the_squares():
+    eta = np.array([3.0, 1.0, 2.0, 0.5, 2.0])
+    assert EI.marked(eta, bulk=0.45).tolist() == [True, False, False, False, False]   # 9 of 18.25
+    assert EI.marked(eta).tolist() == [True, False, True, False, True]   # 9 + 4 >= 9.125; ties marked together
+    assert not EI.marked(np.zeros(3)).any()
+
+
+def test_the_indicator_is_largest_at_the_interface_corners_of_a_block():
+    g = gm.block_on_plane(1.0, 0.5, 0.5, maxh=0.25)
+    problem = M.MacroProblem(mesh=g.mesh, setting="plane_strain", rough="block", counter="base",
+                             materials={"block": isotropic(70e9, 0.33), "base": isotropic(210e9, 0.3)},
+                             law=il.InterfaceLaw(normal=il.LinearLaw(kn=1e11, kt=4e10)),
+                             supports=(M.Support(label="bottom", components=("y",)),
+                                       M.Support(label="base_sides", components=("x",))),
+                             loads=(M.Load(label="top", pressure=1e6),), order=2)
+    sol = M.solve(problem)
+    eta = EI.indicator(sol)
+    assert eta.shape == (g.mesh.ne,) and (eta >= 0).all()
+    mesh = g.mesh
+    worst = mesh[M.ng.ElementId(M.ng.VOL, int(np.argmax(eta)))]
+    corners = [np.array(mesh[v].point) for v in worst.vertices]
+    assert any(np.allclose(c, (0.0, 0.0)) or np.allclose(c, (1.0, 0.0)) for c in corners)
+    ne = mesh.ne
+    EI.refine_marked(mesh, EI.marked(eta), 2)
+    assert mesh.ne > ne and mesh.GetCurveOrder() == 2
+
+
+# ------------------------------------------------------------------ the refinement of a scene
+def test_a_tolerance_beyond_order_four_is_met_on_refined_meshes_and_the_closed_form_agrees(tmp_path):
+    tolerance = 1e-3
+    path = tmp_path / "press_fit.toml"
+    path.write_text(PRESS_FIT + f"tolerance = {tolerance}\n")
+    out = D.run(loader.load(path), Clock())
+    acc = out.results["accuracy"]
+    ref = acc["refinement"]
+    levels = ref["levels"]
+    assert acc["met"] and ref["order"] == MR.MAX_REFINED_ORDER and ref["h_level"] >= 1
+    assert [lv["order"] for lv in levels][:3] == [2, 3, 4] and {lv["order"] for lv in levels[3:]} == {4}
+    assert [lv["h_level"] for lv in levels] == [0, 0, 0] + list(range(1, len(levels) - 2))
+    assert all(a["elements"] < b["elements"] for a, b in zip(levels[2:], levels[3:]))
+    assert [lv["met"] for lv in levels] == [False] * (len(levels) - 1) + [True]
+    assert out.ndof == ref["ndof"] == levels[-1]["ndof"]
+    assert "mesh refined" in accuracy_line(out.results)
+    exact = _lame()
+    for q in acc["quantities"]:
+        true = abs(q["value"] - exact[q["name"]])
+        assert q["relative_error"] <= tolerance and true <= tolerance * abs(exact[q["name"]]), q
+        if true > 1e-8 * abs(exact[q["name"]]):            # the resultant balances the load to round-off
+            assert 1.0 <= q["error"] / true <= 10.0, q
+
+
+def test_a_corner_singularity_is_refined_towards_and_ends_the_run_with_its_figures(tmp_path):
+    path = tmp_path / "block.toml"
+    path.write_text(BLOCK)
+    with pytest.raises(ConvergenceError) as info:
+        D.run(loader.load(path), Clock())
+    levels = info.value.history["refinement"]
+    assert [lv["h_level"] for lv in levels if lv["order"] == MR.MAX_REFINED_ORDER][-1] >= 2
+    refined = [lv for lv in levels if lv["h_level"] > 0]
+    assert all(a["ndof"] < b["ndof"] for a, b in zip(levels, levels[1:]))
+    peak = [lv["relative_errors"]["peak_pressure"] for lv in levels if lv["order"] == MR.MAX_REFINED_ORDER]
+    assert peak[-1] < peak[0]                                 # the interface's estimate falls with the mesh
+    assert refined and "grows with every mesh level" in str(info.value) and "mesh level" in str(info.value)
+
+
+def test_a_two_scale_scene_keeps_its_mesh():
+    assert "two-scale" in MR.h_refusal(SimpleNamespace(two_scale=object()))
+    assert MR.h_refusal(SimpleNamespace(two_scale=None)) is None
