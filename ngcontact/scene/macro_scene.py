@@ -58,8 +58,9 @@ class MacroDiscretization(Discretization):
         "factor; two-scale: the loop's residual and the cell table's interpolation error) are held to: each is "
         "reported with its discretization error, estimated from solves one order below and above on the same "
         "mesh, and results.accuracy.met says whether every one is within; a scene that states it is refined "
-        "towards it: the order is raised by one on the scene's mesh until every estimate meets it, up to order "
-        "4 and 2e6 unknowns (results.accuracy.refinement lists the levels and the order that met it), and a "
+        "towards it: the order is raised by one on the scene's mesh while it pays (up to order 4), then the mesh "
+        "is refined where the stress error indicator is large, interface first (up to 12 levels and 2e6 "
+        "unknowns; results.accuracy.refinement lists the levels, their order, mesh level and unknowns), and a "
         "tolerance out of reach ends the run (exit 3); default: 0.01, only judged (the scene's order is kept)")
 
 
