@@ -174,3 +174,16 @@ def test_a_corner_singularity_is_refined_towards_and_ends_the_run_with_its_figur
 def test_a_two_scale_scene_keeps_its_mesh():
     assert "two-scale" in MR.h_refusal(SimpleNamespace(two_scale=object()))
     assert MR.h_refusal(SimpleNamespace(two_scale=None)) is None
+
+
+@pytest.mark.parametrize("bound, said", [("MAX_MESH_LEVELS", "mesh level 2 is beyond the refinement's bound (1 levels)"),
+                                         ("MAX_DOFS", "beyond the refinement's bound of 2000")])
+def test_the_mesh_levels_end_at_their_bounds_with_the_figures(tmp_path, monkeypatch, bound, said):
+    monkeypatch.setattr(MR, bound, 1 if bound == "MAX_MESH_LEVELS" else 2000)
+    path = tmp_path / "press_fit.toml"
+    path.write_text(PRESS_FIT + "tolerance = 1e-3\n")
+    with pytest.raises(ConvergenceError) as info:
+        D.run(loader.load(path), Clock())
+    levels = info.value.history["refinement"]
+    assert said in str(info.value) and "not met: at order 4" in str(info.value)
+    assert [lv["h_level"] for lv in levels] == ([0, 0, 0, 1] if bound == "MAX_MESH_LEVELS" else [0, 0, 0])
