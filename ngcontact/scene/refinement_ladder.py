@@ -262,7 +262,7 @@ def ladder(scene, data: dict, n: int) -> tuple[list[Level], list[str]]:
         for k, changes in enumerate(knob.values(scene, n)):
             level_data = with_keys(data, changes)
             if not isinstance(knob, Tolerance) and scene.kind in ("macro", "direct"):
-                # a macro tolerance raises the order until met: a level of another knob is its setting alone
+                # a macro tolerance refines (order, then mesh) until met: a level of another knob is its setting alone
                 level_data.get("discretization", {}).pop("tolerance", None)
             level = Level(knob.name, k, changes, knob.parameter(changes), knob.size(scene, changes), level_data)
             try:

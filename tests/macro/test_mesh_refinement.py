@@ -128,6 +128,13 @@ def test_the_indicator_is_largest_at_the_interface_corners_of_a_block():
     worst = mesh[M.ng.ElementId(M.ng.VOL, int(np.argmax(eta)))]
     corners = [np.array(mesh[v].point) for v in worst.vertices]
     assert any(np.allclose(c, (0.0, 0.0)) or np.allclose(c, (1.0, 0.0)) for c in corners)
+    # the interface term sits on the elements with an edge on the interface y = 0, and only there
+    recovered = {r: EI.recovered_stress(sol, r, EI.elasticity.stress(problem.materials[r], u, problem.setting)
+                                        .Reshape((9,))) for r, u in (("block", sol.u_rough), ("base", sol.u_counter))}
+    share = EI.interface_share(sol, recovered)
+    on_interface = np.array([sum(abs(mesh[v].point[1]) < 1e-12 for v in el.vertices) == 2
+                             for el in mesh.Elements(M.ng.VOL)])
+    assert (share[~on_interface] == 0).all() and (share[on_interface] > 0).all()
     ne = mesh.ne
     EI.refine_marked(mesh, EI.marked(eta), 2)
     assert mesh.ne > ne and mesh.GetCurveOrder() == 2
