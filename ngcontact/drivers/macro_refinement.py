@@ -34,7 +34,7 @@ Then the mesh (h), where the order no longer pays
       with its observed rate (:mod:`ngcontact.macro.mesh_sequence`), the larger of the two; a corner's
       maximum without a ladder estimate is estimated by the sequence alone once three levels exist.
       A stress maximum's sampling error is measured on a lattice reaching the elements' faces
-      (:func:`ngcontact.macro.discretization_error.body_maxima` with ``dense_inset = 0``): at the errors a
+      (:func:`ngcontact.macro.discretization_error.body_maxima` with :data:`FACE_INSET`): at the errors a
       tolerance beyond the order's reach asks for, the inset of the sample points from a boundary where
       the maximum sits is a share of the error.
     * A maximum that grows with every mesh level without an estimate is a true singularity (its value
@@ -74,6 +74,10 @@ MAX_REFINED_ORDER = 4
 MAX_DOFS = 2_000_000
 #: the most mesh levels the refinement makes after the order
 MAX_MESH_LEVELS = 12
+#: how far inwards a mesh level's stress maxima are sampled for their sampling error (module docstring):
+#: at the elements' faces up to round-off, never on the axis ``r = 0`` of an axisymmetric body, where the
+#: hoop strain ``u_r / r`` has no value
+FACE_INSET = 1e-6
 #: what the report's ``accuracy.refinement.method`` says
 METHOD = ("p, then h: the polynomial order raised by one on the scene's mesh (curved at the order) while it "
           "pays, then the mesh refined where the stress error indicator is large, interface first "
@@ -240,7 +244,8 @@ def refine_mesh(scene, start: Refined, solve: Callable[..., MacroSolution],
     component = next(n for n in values if n.startswith("resultant_")).removeprefix("resultant_")
     h_level = 0
     while True:
-        flags = EI.marked(EI.indicator(sol))
+        at = [start.samples[sol.problem.order][e.name].location for e in unmet(start.estimates, tolerance)]
+        flags = EI.marked(EI.indicator(sol)) | EI.holding(sol.problem.mesh, [x for x in at if x is not None])
         problem = replace(sol.problem)
         EI.refine_marked(problem.mesh, flags, problem.order)
         h_level += 1
@@ -251,7 +256,7 @@ def refine_mesh(scene, start: Refined, solve: Callable[..., MacroSolution],
                                                 f"beyond the refinement's bound of {MAX_DOFS}"),
                                    {"refinement": history})
         sol = solve(problem, None)
-        samples = MA.order_samples(scene, sol, solve, safety_factor, component, dense_inset=0.0)
+        samples = MA.order_samples(scene, sol, solve, safety_factor, component, dense_inset=FACE_INSET)
         ladder = MA.estimates(samples, sol)
         for e in ladder:
             values[e.name].append(e.value)

@@ -162,7 +162,7 @@ def body_maxima(sol: MacroSolution, dense_inset: float = 1e-3) -> dict[str, Samp
     sampled as :func:`ngcontact.macro.macro_measures.field_extrema` samples, with their location, and
     the maximum's sampling error: how much larger the maximum over a denser lattice of points per
     element (:func:`dense_rule`, moved ``dense_inset`` inwards) is.  A refinement moves the sample points;
-    the orders on one mesh do not, so this share of the error is measured apart.  ``dense_inset = 0``
+    the orders on one mesh do not, so this share of the error is measured apart.  A tiny ``dense_inset``
     reaches the elements' faces, where a maximum on the boundary is attained (the mesh levels of
     :mod:`ngcontact.drivers.macro_refinement`, where this offset outgrows the orders' differences)."""
     p = sol.problem

@@ -29,7 +29,9 @@ Why this indicator
 
 The elements to refine (:func:`marked`): the fewest with the largest indicators whose squares sum to at
 least :data:`BULK` of the total (Doerfler's bulk criterion, which makes adaptive refinement converge at
-the optimal rate for the energy error).
+the optimal rate for the energy error), and the elements that hold a quantity still beyond the tolerance
+(:func:`holding`: a stress maximum or the peak pressure is sampled at points of its element, so its
+sampling error and its local error shrink only with that element, wherever the energy error lies).
 """
 from __future__ import annotations
 
@@ -110,6 +112,16 @@ def marked(eta: np.ndarray, bulk: float = BULK) -> np.ndarray:
     count = int(np.searchsorted(np.cumsum(eta2[order]), bulk * total) + 1)
     threshold = eta2[order[min(count, len(eta2)) - 1]]
     out[eta2 >= threshold] = True
+    return out
+
+
+def holding(mesh: ng.Mesh, points: list[tuple[float, ...]]) -> np.ndarray:
+    """The volume elements holding ``points`` (a maximum's or a peak's location) as a boolean array."""
+    out = np.zeros(mesh.ne, dtype=bool)
+    for point in points:
+        found = mesh(*point)
+        if found.nr >= 0 and found.vb == ng.VOL:
+            out[found.nr] = True
     return out
 
 
