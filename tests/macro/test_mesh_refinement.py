@@ -194,3 +194,33 @@ def test_the_mesh_levels_end_at_their_bounds_with_the_figures(tmp_path, monkeypa
     levels = info.value.history["refinement"]
     assert said in str(info.value) and "not met: at order 4" in str(info.value)
     assert [lv["h_level"] for lv in levels] == ([0, 0, 0, 1] if bound == "MAX_MESH_LEVELS" else [0, 0, 0])
+
+
+SHAFT = PRESS_FIT.replace('setting = "plane_strain"', 'setting = "axisymmetric"').replace(
+    "a = 0.5", "a = 0.0\nheight = 0.5").replace('boundary = "sym_x"', 'boundary = "axis"').replace(
+    'components = ["x"]', 'components = ["r"]').replace('boundary = "sym_y"\ncomponents = ["y"]',
+                                                      'boundary = "bottom"\ncomponents = ["z"]\n\n[[supports]]\n'
+                                                      'boundary = "top"\ncomponents = ["z"]')
+
+
+@pytest.mark.slow
+def test_mesh_levels_of_a_shaft_on_its_axis_bound_the_closed_forms_error(tmp_path):
+    """A solid shaft in its tube, axisymmetric with both ends held in z (Lame's plane strain fit with
+    ``a = 0``): the mesh levels sample the shaft's stress next to the axis ``r = 0``, never on it."""
+    from ngcontact.fem.materials import tresca, von_mises
+    from ngcontact.verification.lame import lame_press_fit_pressure
+    path = tmp_path / "shaft.toml"
+    path.write_text(SHAFT + "tolerance = 2e-4\n")
+    acc = D.run(loader.load(path), Clock()).results["accuracy"]
+    assert acc["met"] and acc["refinement"]["h_level"] >= 1
+    p = lame_press_fit_pressure(0.0, 1.0, 2.0, 200.0, 0.3, 70.0, 0.25, 1e-3, 300.0)
+    shaft = np.diag([-p, -p, -0.6 * p])
+    r1, r2 = 1.0, 2.0
+    a, b = p * r1 ** 2 / (r2 ** 2 - r1 ** 2), p * r1 ** 2 * r2 ** 2 / (r2 ** 2 - r1 ** 2)
+    tube = np.diag([a - b, a + b, 0.25 * 2 * a])
+    exact = {"peak_pressure": p, "von_mises_inner": float(von_mises(shaft)), "tresca_inner": float(tresca(shaft)),
+             "von_mises_outer": float(von_mises(tube)), "tresca_outer": float(tresca(tube))}
+    for q in acc["quantities"]:
+        if q["name"] in exact:
+            true = abs(q["value"] - exact[q["name"]])
+            assert q["error"] >= true and q["error"] <= 10.0 * max(true, 1e-7 * exact[q["name"]]), q
