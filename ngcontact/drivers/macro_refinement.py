@@ -222,8 +222,7 @@ def _progress(sol: MacroSolution, found: list[DE.Estimate], missed: list[DE.Esti
                   "" if not missed else f", {len(missed)} quantities beyond {tolerance:g}")
 
 
-def h_stop_reason(sol: MacroSolution, missed: list[DE.Estimate], values: dict[str, list[float]],
-                  h_level: int) -> str | None:
+def h_stop_reason(missed: list[DE.Estimate], values: dict[str, list[float]], h_level: int) -> str | None:
     """Why the mesh is not refined further (``None``: it is)."""
     growing = [e for e in missed if e.error is None and MS.grows_without_bound(values[e.name])]
     if growing:
@@ -266,7 +265,7 @@ def refine_mesh(scene, start: Refined, solve: Callable[..., MacroSolution],
         _progress(sol, found, missed, tolerance, h_level)
         if not missed:
             return Refined(solution=sol, samples=samples, history=history, estimates=found)
-        why = h_stop_reason(sol, missed, values, h_level)
+        why = h_stop_reason(missed, values, h_level)
         if why is not None:
             raise ConvergenceError(out_of_reach(tolerance, history, missed, why), {"refinement": history})
         start = Refined(solution=sol, samples=samples, history=history, estimates=found)
