@@ -21,8 +21,8 @@ quantities and the smallest effectivity (over the quantities whose true error ex
 
     python scripts/macro_effectivity.py [OUT] [--quick] [--refinement-only] [--publish]
 
-Writes ``OUT/macro_effectivity.csv``, ``.png`` and ``OUT/macro_refinement.csv`` (default
-``results/macro_effectivity``).
+Writes ``OUT/macro_effectivity.csv``, ``.png`` and ``OUT/macro_refinement.csv``, ``.png`` (the levels of
+the run to the smallest tolerance; default ``results/macro_effectivity``).
 """
 from __future__ import annotations
 
@@ -147,8 +147,9 @@ def lame_scene(order: int, tolerance: float):
     return loader.from_dict(data, base_dir=ROOT)
 
 
-def refinement_rows(order: int = 1) -> list[dict]:
-    """The refinement from ``order`` to each of :data:`TOLERANCES`: where it stopped and how far it is."""
+def refinement_rows(order: int = 1, runs: dict | None = None) -> list[dict]:
+    """The refinement from ``order`` to each of :data:`TOLERANCES`: where it stopped and how far it is
+    (``runs``, if given, gets each tolerance's levels)."""
     exact = lame_exact()
     out = []
     for tol in TOLERANCES:
@@ -163,6 +164,8 @@ def refinement_rows(order: int = 1) -> list[dict]:
         except ConvergenceError as exc:
             levels, true, effectivity = exc.history["refinement"], None, None
         last = levels[-1]
+        if runs is not None:
+            runs[tol] = levels
         out.append({"tolerance": tol, "scene_order": order,
                     "orders": " ".join(str(lv["order"]) for lv in levels if lv["h_level"] == 0),
                     "mesh_levels": last["h_level"], "elements": last["elements"], "ndof": last["ndof"],
@@ -170,6 +173,37 @@ def refinement_rows(order: int = 1) -> list[dict]:
                     "largest_estimate": max(v for v in last["relative_errors"].values() if v is not None),
                     "largest_true_error": true, "seconds": time.perf_counter() - t0})
     return out
+
+
+def level_errors(level: dict) -> tuple[float, float]:
+    """The largest estimated and the largest true relative error of one refinement level on Lame's press fit
+    (the resultant left out: it balances the load to round-off at every level)."""
+    exact = lame_exact()
+    names = [n for n in level["values"] if not n.startswith("resultant_")]
+    estimate = max(level["relative_errors"][n] for n in names)
+    true = max(abs(level["values"][n] - exact[n]) / abs(exact[n]) for n in names)
+    return estimate, true
+
+
+def refinement_plot(levels: list[dict], tolerance: float, path: str) -> None:
+    """Per level of one refinement: the largest estimated and true relative error against the unknowns."""
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ndof = [lv["ndof"] for lv in levels]
+    est, true = zip(*(level_errors(lv) for lv in levels))
+    p_levels = [k for k, lv in enumerate(levels) if lv["h_level"] == 0]
+    ax.loglog(ndof, est, "o-", label="largest estimate")
+    ax.loglog(ndof, true, "s--", label="largest true error (closed form)")
+    for k, lv in enumerate(levels):
+        ax.annotate(f"p{lv['order']}" if k in p_levels else f"h{lv['h_level']}", (ndof[k], est[k]), fontsize=7,
+                    textcoords="offset points", xytext=(3, 4))
+    ax.axhline(tolerance, color="0.5", lw=0.8, label=f"tolerance {tolerance:g}")
+    ax.set_xlabel("unknowns of the level")
+    ax.set_ylabel("relative error (largest over the headline quantities)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
 
 
 def plot(data: list[dict], path: str) -> None:
@@ -202,12 +236,15 @@ def main(argv=None) -> int:
     os.makedirs(args.out, exist_ok=True)
     if not args.refinement_only:
         effectivity(args)
-    refined = refinement_rows()
+    runs: dict = {}
+    refined = refinement_rows(runs=runs)
     refine_csv = os.path.join(args.out, "macro_refinement.csv")
     write_csv(refine_csv, list(REFINE_KEYS), [[d[k] for k in REFINE_KEYS] for d in refined])
+    refine_png = os.path.join(args.out, "macro_refinement.png")
+    refinement_plot(runs[TOLERANCES[-1]], TOLERANCES[-1], refine_png)
     if args.publish:
         benchmark_doc.publish("macro_refinement", "The macro refinement towards discretization.tolerance",
-                              refine_csv,
+                              refine_csv, png=refine_png,
                               note="Lame's press fit above (maxh 0.3) as a scene of order 1 stating "
                               "discretization.tolerance: the order is raised on its mesh, curved at the order, up to "
                               "order 4, then the mesh is refined where the stress error indicator is large "
@@ -221,7 +258,10 @@ def main(argv=None) -> int:
                               "true error given). largest_true_error: the largest relative error against the closed "
                               "form over the headline quantities; smallest_effectivity: the smallest estimate / "
                               "true error over them (the resultant excluded where its true error is round-off). "
-                              "Wall times on 2 cores shared with other jobs (under load).")
+                              "The figure: every level of the run to the smallest tolerance (p: an order on the "
+                              "scene's mesh, h: a mesh level), the largest estimated and true relative error over "
+                              "the headline quantities but the resultant. Wall times on 2 cores shared with other "
+                              "jobs (under load).")
     return 0
 
 
