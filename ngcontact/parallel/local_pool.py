@@ -99,7 +99,8 @@ class LocalPool(Executor):
 
     def _judged_map(self, fn, items, names, label, progress, fault) -> list:
         """A batch of the run: members solved here, each timed, until the rest repays the workers (condition
-        (1) of :mod:`ngcontact.parallel.worker_payoff`) and a worker is ready, or the batch ends here.
+        (1) of :mod:`ngcontact.parallel.worker_payoff`, after at least ``MEASURED`` members) and a worker is
+        ready, or the batch ends here.
 
         Workers still starting when (1) fails are stopped (they take cores
         from this process); started ones are kept for the run's next batch.
@@ -114,10 +115,9 @@ class LocalPool(Executor):
                 done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
                                       _after(progress, k, len(items)), fault)
             if len(done) == len(items):
-                self._where("serial" if self._pool is None else "local", f"{len(done)} members solved here "
-                            "while the workers started")
+                self._where("serial", f"all {len(done)} members solved here while the workers started")
                 return done
-            payoff = worker_payoff.Payoff(clock.mean, len(items) - len(done), self.workers, self._start_ahead(),
+            payoff = worker_payoff.Payoff(clock.least, len(items) - len(done), self.workers, self._start_ahead(),
                                           FIRST_MEMBER_SECONDS)
             if not payoff.repaid:
                 if self._pool is not None and not all(w.done() for w in self._warming):
@@ -128,7 +128,7 @@ class LocalPool(Executor):
                                             _after(progress, len(done), len(items)), fault)
             if self._pool is None:
                 self.start()
-            if self._ready():
+            if self._ready() and len(done) >= worker_payoff.MEASURED:
                 self._where("local", payoff.describe(len(done)))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
                 return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
