@@ -122,7 +122,9 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
     once when the run will have a batch (``start``; default
     :func:`has_batches`), so that their start overlaps with the run's own
     preparation; otherwise only for a batch whose members take long enough to
-    repay the workers' start (:meth:`~ngcontact.parallel.executor.Executor.start_on_demand`).
+    repay the workers' start (:meth:`~ngcontact.parallel.executor.Executor.start_on_demand`).  Either way a
+    batch goes to the workers only where its rest repays them, else it finishes in this process
+    (:mod:`ngcontact.parallel.worker_payoff`).
     A scheduler address that is malformed, or where no scheduler answers (at
     once, or at the first batch), is a :class:`SceneError` naming
     ``scheduler`` or ``compute.scheduler``.

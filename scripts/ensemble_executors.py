@@ -10,7 +10,8 @@ Three batches, each run as the command a user types (``ngcontact run SCENE
 * the shipped ``geometries/cells/measured_scan_ensemble.toml``.
 
 Executors: ``--workers 1`` (serial, the reference), ``--workers 2`` (a local
-pool started with the run), ``--scheduler`` on a ``distributed.LocalCluster``
+pool started with the run; a batch goes to its workers only where its rest
+repays them, column ``ran``), ``--scheduler`` on a ``distributed.LocalCluster``
 of two one-thread worker processes that this script starts once and warms
 with one run of each scene (a cluster outlives the runs it serves).  Per
 run: the command's wall time, the batch's wall time (``compute.batches``),
@@ -58,6 +59,13 @@ def batch_seconds(report: dict) -> float:
     return sum(b["seconds"] for b in report["compute"]["batches"])
 
 
+def ran(report: dict) -> str:
+    """Where the batch ran: ``serial`` (the run's process, also a local pool's batch too small to repay its
+    workers), ``local`` or ``dask`` (``compute.batches[].executor``, else the run's executor)."""
+    batch = report["compute"]["batches"][0]
+    return batch.get("executor", report["compute"]["executor"])
+
+
 def fractions(report: dict) -> np.ndarray:
     """Every member's contact fraction at every load (the ensemble's members, in order)."""
     return np.array([[load["contact_fraction"] for load in loads] for loads in report["results"]["members"]],
@@ -86,7 +94,7 @@ def main() -> None:
                     ref = ref or (wall, report)
                     diff = np.max(np.abs(fractions(report) - fractions(ref[1])) / np.abs(fractions(ref[1])))
                     rows.append(dict(ensemble=name, executor=executor, repeat=repeat,
-                                     members=report["results"]["ensemble"]["members"], wall=wall,
+                                     members=report["results"]["ensemble"]["members"], ran=ran(report), wall=wall,
                                      batch=batch_seconds(report), speedup=ref[0] / wall,
                                      batch_speedup=batch_seconds(ref[1]) / batch_seconds(report),
                                      max_rel_diff=float(diff)))
@@ -100,13 +108,16 @@ def main() -> None:
             os.path.join(args.out, "ensemble_executors.csv"),
             note="`ngcontact run` of three ensembles with `--workers 1` (serial, the reference), `--workers 2` "
                  "and `--scheduler` on a local Dask cluster of two one-thread workers (warmed by one run). "
+                 "`ran`: where the batch ran (a local pool sends a batch to its workers only where its rest "
+                 "repays them, `ngcontact.parallel.worker_payoff`; else `serial`, in the run's process). "
                  "`wall` and `batch` in seconds; speedups over the serial run of the same repeat; "
-                 "`max_rel_diff`: the members' contact fractions against the serial run.",
+                 "`max_rel_diff`: the members' contact fractions against the serial run. Timed on a machine "
+                 "shared with other jobs (load average above): the ratios within one repeat are what counts.",
             png=os.path.join(args.out, "ensemble_executors.png"))
 
 
 def write(out: str, rows: list[dict]) -> None:
-    keys = ["ensemble", "executor", "repeat", "members", "wall", "batch", "speedup", "batch_speedup",
+    keys = ["ensemble", "executor", "repeat", "members", "ran", "wall", "batch", "speedup", "batch_speedup",
             "max_rel_diff"]
     with open(os.path.join(out, "ensemble_executors.csv"), "w", newline="") as fh:
         w = csv.writer(fh)

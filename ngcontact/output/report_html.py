@@ -199,8 +199,12 @@ def compute_items(compute: dict | None) -> list[tuple[str, str]]:
         return []
     where = {"serial": "this process", "local": f"{compute['workers']} local worker processes",
              "dask": f"{compute['workers']} Dask worker threads at {compute.get('scheduler', '?')}"}
-    batches = "; ".join(f"{b['label']}: {b['members']} in {fmt(b['seconds'], 's')}" for b in compute["batches"])
-    return [("batches ran on", where.get(compute["executor"], str(compute["executor"]))), ("batches", batches)]
+    here = {"serial": " (in this process)", "local": " (on the workers)"}
+    batches = "; ".join(f"{b['label']}: {b['members']} in {fmt(b['seconds'], 's')}{here.get(b.get('executor'), '')}"
+                        for b in compute["batches"])
+    items = [("batches ran on", where.get(compute["executor"], str(compute["executor"]))), ("batches", batches)]
+    decisions = "; ".join(f"{b['label']}: {b['decision']}" for b in compute["batches"] if b.get("decision"))
+    return items + ([("why there", decisions)] if decisions else [])
 
 
 def html_table(header: list[str], rows: list[list[str]], cls: str = "") -> str:

@@ -48,14 +48,22 @@ class Executor:
             progress(label, 0, len(items))
         fault = fault_from_env()
         t0 = time.perf_counter()
+        self.__dict__.pop("_spread", None)
         out = self._map(fn, list(items), list(names), label, progress, fault)
-        self.record.append({"label": label, "members": len(items), "seconds": time.perf_counter() - t0})
+        self.record.append({"label": label, "members": len(items), "seconds": time.perf_counter() - t0,
+                            **self.__dict__.pop("_spread", {})})
         return out
 
     @property
     def record(self) -> list[dict]:
-        """The batches this executor ran: label, number of members, wall seconds (in order)."""
+        """The batches this executor ran: label, number of members, wall seconds (in order); for a batch that
+        chose where it ran (a local pool's), ``executor`` (``serial``: finished in this process, or ``local``)
+        and the ``decision`` that chose it."""
         return self.__dict__.setdefault("_record", [])
+
+    def _where(self, executor: str, decision: str) -> None:
+        """Where the running batch went (``executor``) and why (``decision``): recorded with the batch."""
+        self.__dict__["_spread"] = {"executor": executor, "decision": decision}
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         out = []

@@ -15,7 +15,8 @@ Executors:
 * :class:`LocalPool` - a pool of worker processes on this machine
   (``spawn``: a fresh interpreter, never a fork of a process whose NGSolve
   task manager holds threads), each limited to one NGSolve thread so that
-  ``N`` workers use ``N`` cores;
+  ``N`` workers use ``N`` cores; a run's batch goes to them only where its
+  rest repays their start (:mod:`ngcontact.parallel.worker_payoff`);
 * :class:`DaskCluster` - the workers of a ``dask.distributed`` scheduler at
   an address; Dask is the cluster engine, this module only submits.
 

@@ -15,14 +15,20 @@ from typing import Any, Sequence
 
 from ngcontact.parallel.batch_executor import Executor
 from ngcontact.parallel.batch_member import one_thread, run_member
-from ngcontact.parallel import worker_lifetime
+from ngcontact.parallel import worker_lifetime, worker_payoff
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
 
 #: Wall seconds a local pool's workers take to start (fresh interpreters importing NGSolve and the package,
-#: all at once; an estimate for two workers starting together on two cores).
+#: all at once; an estimate for two workers starting together on two cores): ``R`` of
+#: :mod:`ngcontact.parallel.worker_payoff` for a pool not yet started.
 START_SECONDS = 2.0
+
+#: Seconds a worker's first member takes beyond the others (an estimate): what the run's process paid
+#: before its batch and a fresh worker pays in its first member, e.g. importing a measured surface's reader
+#: and reading its file; ``F`` of :mod:`ngcontact.parallel.worker_payoff`.
+FIRST_MEMBER_SECONDS = 1.0
 
 
 class LocalPool(Executor):
@@ -39,7 +45,8 @@ class LocalPool(Executor):
         self._processes: dict = {}      # every worker process of the current pool, by pid
         self._lifetime: worker_lifetime.Record | None = None   # the current pool's record of its workers
         self._warming: list = []      # the warm-up tasks of an early start, one per worker
-        self.on_demand = False
+        self._spawned = 0.0           # when the current pool's workers were spawned (perf_counter seconds)
+        self.judged = False           # the run's batches: the rest of each goes to workers only where repaid
 
     def _start(self):
         from concurrent.futures import ProcessPoolExecutor
@@ -49,6 +56,7 @@ class LocalPool(Executor):
         self._started = ctx.SimpleQueue()
         self._processes = {}
         self._lifetime = worker_lifetime.Record()
+        self._spawned = time.perf_counter()
         self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx, initializer=_worker_start,
                                          initargs=(self._started, os.getpid(), self._lifetime.path))
         return self._pool
@@ -61,49 +69,82 @@ class LocalPool(Executor):
         knows it will have a batch, this overlaps with what the run does
         before it (its own imports, the scene's meshes, a macro solve).  The
         pool spawns one process per submitted task while none is idle, so one
-        warm-up task per worker starts them all.
+        warm-up task per worker starts them all.  The run's batches then go to
+        the workers only where they repay them (:meth:`_judged_map`).
         """
+        self.judged = True
         if self._pool is not None:
             return
         pool = self._start()
         self._warming = [pool.submit(_warm_up, tuple(modules)) for _ in range(self.workers)]
 
     def start_on_demand(self) -> None:
-        """Until the workers are started, a batch solves its first member in this process and starts them
-        only if the rest will repay their start (:meth:`_worth_starting`); else the whole batch runs here.
-
-        For runs whose batches are few, small and unknown in advance (the
-        levels of a two-scale cell table: a handful of short cell solves
-        each, none at all on a warm cache), where two fresh interpreters
-        importing NGSolve on a machine of few cores would cost more than they save.
-        """
-        self.on_demand = True
-
-    def _worth_starting(self, seconds: float, rest: int) -> bool:
-        """Whether ``rest`` more members of ``seconds`` each finish sooner on the workers, start included."""
-        return rest * seconds * (1.0 - 1.0 / self.workers) > START_SECONDS
+        """Start the workers only for a batch whose rest repays their start (:meth:`_judged_map`): for runs
+        whose batches are few, small and unknown in advance (the levels of a two-scale cell table: a handful of
+        short cell solves each, none at all on a warm cache)."""
+        self.judged = True
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         if len(items) == 1:
+            self._where("serial", "a single member: solved in this process")
             return Executor._map(self, fn, items, names, label, progress, fault)
-        if self._pool is None and self.on_demand:
-            t0 = time.perf_counter()
-            first = Executor._map(self, fn, items[:1], names[:1], label, None, fault)
-            seconds = time.perf_counter() - t0
-            if progress is not None:
-                progress(label, 1, len(items))
-            shifted = _after(progress, 1)
-            here = not self._worth_starting(seconds, len(items) - 1)
-            log.debug("%s: first member %.3g s; the other %d run %s", label, seconds, len(items) - 1,
-                      "in this process" if here else f"on {self.workers} workers")
-            rest = (Executor._map if here else LocalPool._pool_map)(self, fn, items[1:], names[1:], label,
-                                                                    shifted, fault)
-            return first + rest
+        if self.judged:
+            return self._judged_map(fn, items, names, label, progress, fault)
+        self._where("local", f"every member on the {self.workers} workers")
         done = self._while_starting(fn, items, names, label, progress, fault)
         if len(done) == len(items):
             return done
         rest = self._pool_map(fn, items[len(done):], names[len(done):], label, _after(progress, len(done)), fault)
         return done + rest
+
+    def _judged_map(self, fn, items, names, label, progress, fault) -> list:
+        """A batch of the run: members solved here, each timed, until the rest repays the workers (condition
+        (1) of :mod:`ngcontact.parallel.worker_payoff`, after at least ``MEASURED`` members) and a worker is
+        ready, or the batch ends here.
+
+        Workers still starting when (1) fails are stopped (they take cores
+        from this process); started ones are kept for the run's next batch.
+        A pool not started is started once (1) holds, and this process
+        solves members while it starts.
+        """
+        clock = worker_payoff.MemberClock()
+        done: list = []
+        while True:
+            k = len(done)
+            with clock:
+                done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
+                                      _after(progress, k, len(items)), fault)
+            if len(done) == len(items):
+                self._where("serial", f"all {len(done)} members solved here while the workers started")
+                return done
+            payoff = worker_payoff.Payoff(clock.least, len(items) - len(done), self.workers, self._start_ahead(),
+                                          FIRST_MEMBER_SECONDS)
+            if not payoff.repaid:
+                if self._pool is not None and not all(w.done() for w in self._warming):
+                    self._discard()
+                self._where("serial", payoff.describe(len(done)))
+                log.debug("%s: %s", label, payoff.describe(len(done)))
+                return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
+                                            _after(progress, len(done), len(items)), fault)
+            if self._pool is None:
+                self.start()
+            if self._ready() and len(done) >= worker_payoff.MEASURED:
+                self._where("local", payoff.describe(len(done)))
+                log.debug("%s: %s", label, payoff.describe(len(done)))
+                return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
+                                             _after(progress, len(done)), fault)
+
+    def _ready(self) -> bool:
+        """Whether a worker of the current pool has started (a pool started without warm-up tasks: yes)."""
+        return self._pool is not None and (not self._warming or any(w.done() for w in self._warming))
+
+    def _start_ahead(self) -> float:
+        """Seconds of the workers' start still to come (``R`` of :mod:`ngcontact.parallel.worker_payoff`)."""
+        if self._pool is None:
+            return START_SECONDS
+        if self._ready():
+            return 0.0
+        return max(START_SECONDS - (time.perf_counter() - self._spawned), 0.0)
 
     def _while_starting(self, fn, items, names, label, progress, fault) -> list:
         """The first members, solved in this process while no worker has started yet.

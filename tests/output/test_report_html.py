@@ -102,6 +102,17 @@ def test_the_page_names_where_the_batches_ran_and_says_nothing_of_a_run_without_
     assert "batches ran on" not in render(report, str(tmp_path), ["interface.png"])
 
 
+def test_the_page_says_where_each_batch_of_a_local_pool_went_and_why(tmp_path):
+    report = macro_report(tmp_path)
+    report["compute"] = {"executor": "local", "workers": 2, "batches": [
+        {"label": "ensemble", "members": 8, "seconds": 1.5, "executor": "serial", "decision": "too small"},
+        {"label": "loads", "members": 16, "seconds": 4.0, "executor": "local", "decision": "repays"}]}
+    cards = dict(re.findall(r'<div class="label">([^<]*)</div><div class="value figure-value">([^<]*)</div>',
+                            render(report, str(tmp_path), ["interface.png"])))
+    assert cards["batches"] == "ensemble: 8 in 1.5 s (in this process); loads: 16 in 4 s (on the workers)"
+    assert cards["why there"] == "ensemble: too small; loads: repays"
+
+
 def test_a_non_finite_number_is_refused_and_a_failing_page_writes_nothing(tmp_path, monkeypatch):
     for bad in (float("nan"), float("inf")):
         with pytest.raises(ValueError, match="non-finite"):

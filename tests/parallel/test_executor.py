@@ -80,7 +80,16 @@ def test_make_chooses_serial_pool_or_cluster():
     assert executor.current().name == "serial"
 
 
-def test_a_started_pool_has_its_workers_running_before_the_first_batch_and_records_its_batches():
+@pytest.fixture
+def workers_always_repay(monkeypatch):
+    """No start ahead, no first member's extra: every batch's rest goes to workers (condition (1) of
+    :mod:`ngcontact.parallel.worker_payoff` holds for any member that takes time)."""
+    monkeypatch.setattr(local_pool, "START_SECONDS", 0.0)
+    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.0)
+
+
+def test_a_started_pool_has_its_workers_running_before_the_first_batch_and_records_its_batches(
+        workers_always_repay):
     ex = executor.LocalPool(2)
     try:
         ex.start()
@@ -142,8 +151,10 @@ def test_a_run_that_fails_while_its_workers_start_stops_them_at_once():
 def test_a_pool_started_on_demand_uses_its_workers_only_where_they_repay_their_start(
         monkeypatch, start_seconds, on_workers):
     """The first member runs here and times the batch; the rest go to the workers only if
-    ``rest * seconds * (1 - 1/workers)`` exceeds the workers' start (``START_SECONDS``)."""
+    ``rest * seconds * (1 - 1/workers)`` exceeds the workers' start (``START_SECONDS``) and a worker's first
+    member (``FIRST_MEMBER_SECONDS``)."""
     monkeypatch.setattr(local_pool, "START_SECONDS", start_seconds)
+    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.0)
     ex = executor.LocalPool(2)
     ex.start_on_demand()
     seen = []
@@ -158,9 +169,10 @@ def test_a_pool_started_on_demand_uses_its_workers_only_where_they_repay_their_s
         ex.close()
 
 
-def test_an_early_pool_solves_members_here_until_a_worker_has_started(monkeypatch):
+def test_an_early_pool_solves_members_here_until_a_worker_has_started(monkeypatch, workers_always_repay):
     """A pool started early (``start``) takes members only once a worker is ready: before that this process
-    solves them (a worker process runs with ``NGCONTACT_THREADS=1``, this one without it)."""
+    solves them (a worker process runs with ``NGCONTACT_THREADS=1``, this one without it).  Every batch's
+    first two members are solved here: they time the batch (:mod:`ngcontact.parallel.worker_payoff`)."""
     monkeypatch.delenv("NGCONTACT_THREADS", raising=False)
     names = [f"m{k}" for k in range(6)]
     ex = executor.LocalPool(2)
@@ -173,7 +185,7 @@ def test_an_early_pool_solves_members_here_until_a_worker_has_started(monkeypatc
         assert seen == [(k, 6) for k in range(7)]
         for warm in ex._warming:
             warm.result(timeout=120)
-        assert ex.map(os.getenv, ["NGCONTACT_THREADS"] * 6, names, label="toy") == ["1"] * 6
+        assert ex.map(os.getenv, ["NGCONTACT_THREADS"] * 6, names, label="toy") == [None] * 2 + ["1"] * 4
     finally:
         ex.close()
 

@@ -180,6 +180,8 @@ def test_workers_spawned_by_a_thread_that_ends_live_on_with_their_parent(tmp_pat
 
     from ngcontact.parallel import local_pool
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
+    monkeypatch.setattr(local_pool, "START_SECONDS", 0.0)          # every batch's rest goes to the workers
+    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.0)
     pool = local_pool.LocalPool(2)
     try:
         first = []

@@ -1,0 +1,89 @@
+"""A run's batch goes to local workers only where its rest repays them (condition (1) of
+:mod:`ngcontact.parallel.worker_payoff`): fake members of a known CPU cost, real workers.
+
+The member :func:`burn` spends a given number of CPU seconds and returns the
+id of the process that ran it, so a test sees where each member went.
+"""
+import os
+import time
+
+import pytest
+
+from ngcontact.parallel import local_pool
+from ngcontact.parallel.worker_payoff import MemberClock, Payoff
+
+
+def burn(seconds: float) -> int:
+    """A member of known cost: ``seconds`` of CPU time in the process that runs it; that process's id."""
+    t0 = time.process_time()
+    while time.process_time() - t0 < seconds:
+        pass
+    return os.getpid()
+
+
+def test_condition_1_weighs_the_saving_on_the_rest_against_the_start_ahead_and_a_first_member():
+    small = Payoff(member_seconds=0.13, rest=7, workers=2, start_ahead=0.0, first_member_seconds=1.0)
+    assert small.saving == pytest.approx(7 * 0.13 / 2) and not small.repaid
+    large = Payoff(member_seconds=0.65, rest=15, workers=2, start_ahead=0.5, first_member_seconds=1.0)
+    assert large.saving == pytest.approx(15 * 0.65 / 2) and large.cost == 1.5 and large.repaid
+    assert not Payoff(10.0, 0, 2, 0.0, 0.0).repaid and not Payoff(10.0, 5, 1, 0.0, 0.0).repaid
+    assert "the other 7 in this process" in small.describe(1)
+    assert "the other 15 on 2 workers" in large.describe(1)
+
+
+def test_a_member_is_timed_by_its_cpu_seconds_when_the_process_waits_beside_it():
+    clock = MemberClock()
+    with clock:
+        time.sleep(0.05)                 # wall time, no work: another process would have had the core
+    with clock:
+        burn(0.02)
+    assert len(clock.times) == 2 and clock.times[0] < 0.01 <= 0.02 <= clock.times[1] < 0.04
+    assert clock.least == clock.times[0]
+
+
+@pytest.fixture
+def ready_pool(monkeypatch):
+    """Two started workers (the start is paid: ``R = 0``), a worker's first member estimated at 0.2 s."""
+    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.2)
+    pool = local_pool.LocalPool(2)
+    pool.start()
+    for warm in pool._warming:
+        warm.result(timeout=120)
+    yield pool
+    pool.close()
+
+
+def test_a_batch_too_small_to_repay_workers_runs_serially_and_says_why(ready_pool):
+    """Three members of 0.05 s: the workers would save 0.05 s on the other two, less than 0.2 s."""
+    pids = ready_pool.map(burn, [0.05] * 3, ["a", "b", "c"], label="small")
+    assert pids == [os.getpid()] * 3
+    batch = ready_pool.describe()["batches"][-1]
+    assert (batch["label"], batch["executor"]) == ("small", "serial")
+    assert "the other 2 in this process" in batch["decision"]
+    assert ready_pool._pool is not None                  # started workers are kept for the next batch
+
+
+def test_a_large_batch_goes_to_the_workers_after_its_first_two_members(ready_pool):
+    """Twelve members of 0.05 s: 0.25 s saved on the other ten, more than 0.2 s."""
+    names = [f"m{k}" for k in range(12)]
+    pids = ready_pool.map(burn, [0.05] * 12, names, label="large")
+    assert pids[:2] == [os.getpid()] * 2 and os.getpid() not in pids[2:]
+    batch = ready_pool.describe()["batches"][-1]
+    assert batch["executor"] == "local" and "the other 10 on 2 workers" in batch["decision"]
+
+
+def test_workers_still_starting_are_stopped_when_the_batch_ends_here():
+    """A pool started as the run begins, a batch of a few short members: finished here, the workers stopped
+    at once rather than left to take cores from this process."""
+    pool = local_pool.LocalPool(2)
+    try:
+        pool.start()
+        processes = list(pool._pool._processes.values())
+        assert pool.map(burn, [0.01] * 3, ["a", "b", "c"], label="tiny") == [os.getpid()] * 3
+        assert pool._pool is None and pool.describe()["batches"][-1]["executor"] == "serial"
+        deadline = time.monotonic() + 5.0
+        while any(p.is_alive() for p in processes) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not any(p.is_alive() for p in processes)
+    finally:
+        pool.close()
