@@ -67,8 +67,15 @@ class CellDiscretization(Discretization):
     """Finite element discretization of a cell, with accuracy on request."""
 
     tolerance: float | None = param(
-        None, doc="refine until the estimated error of the contact fraction (absolute) and of the mean closure "
-        "(relative) is at most this: method 'fe' grades the interface mesh towards the contact edges and "
+        None, doc="refine until the estimated error of every headline quantity of each load is at most this, "
+        "each in its measure: the contact fraction absolute, the mean closure (the closure of the "
+        "pressure-closure table at the load's pressure) and the normal effective stiffness relative, the "
+        "coefficients of paper eq. 34 on the real contact set (k_n, k_t, k_nt, g_n, g_t, G_n, G_t) relative to "
+        "the largest magnitude of their group (stiffnesses, gap terms, thresholds: an entry small or zero by "
+        "symmetry is measured on its group's scale); the spectral cell estimates the effective stiffness "
+        "(first order in the grid step) and reports it without holding it to the tolerance, and does not "
+        "estimate a coefficient zero on every grid (flat interface); method 'fe' grades the interface mesh "
+        "towards the contact edges and "
         "raises the order on the finest (2D frictionless cells with a flat interface), any other FE cell (3D, "
         "curved, frictional) halves interface_maxh level by level (at least three levels, the estimate from "
         "the observed rate, up to 1e6 dofs in 2D and 4e5 in 3D), method 'spectral' doubles the grid's points "
