@@ -69,7 +69,8 @@ def measure(name: str) -> str:
 def scale(name: str, head: dict[str, float], whole: dict[str, Any] | None = None) -> float:
     """The size a headline quantity's absolute error is divided by in its :func:`measure`: 1 where that is
     absolute; the value where relative; for a coefficient the largest magnitude of its group among the
-    ``whole``-surface coefficients (``{"k_n": ..., "k_t": [...], ...}``; without them, among the load's own).
+    ``whole``-surface coefficients (``{"k_n": ..., "k_t": [...], ...}``), or among the load's own where those
+    are not given or vanish (the Coulomb threshold ``mu p`` has no whole-surface value without a pressure).
     A zero size is replaced by 1 (a quantity zero on its scale is measured absolutely)."""
     how = measure(name)
     if how == ABSOLUTE:
@@ -78,11 +79,12 @@ def scale(name: str, head: dict[str, float], whole: dict[str, Any] | None = None
         size = abs(head[name])
     else:
         group = _group(name)
+        size = 0.0
         if whole is not None:
             values = [whole[k] for k in COEFFICIENT_GROUPS[group] if k in whole]
             size = max((abs(float(v)) for x in values for v in (x if isinstance(x, (list, tuple)) else [x])),
                        default=0.0)
-        else:
+        if size == 0:
             size = max(abs(v) for n, v in head.items() if n.startswith(COEFFICIENT) and _group(n) == group)
     return size if size > 0 else 1.0
 
