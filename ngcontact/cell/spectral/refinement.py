@@ -114,9 +114,6 @@ ORDER_RATE = {"contact_fraction": 0.5, "mean_closure": 0.25}
 FIRST_ORDER = 0.5
 #: Richardson's tail times this: the scatter of one level's error about the geometric model
 SPREAD = 2.0
-#: the quantities every level records (the report's history); each load's other headline quantities are
-#: estimated too (:func:`sweep_estimates`): whether the measure is relative
-QUANTITIES = {"contact_fraction": False, "mean_closure": True}
 #: the estimated quantities refinement does not hold to the tolerance (module docstring): reported with their
 #: estimate only
 UNCONTROLLED = ("normal_stiffness",)
