@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from ngcontact.cell.cell_solution import headline
+from ngcontact.cell.cell_solution import headline, measure, scale
 
 #: the accuracy a scene that states none is held to (relative)
 DEFAULT_TOLERANCE = 0.01
@@ -94,29 +94,36 @@ def cell_checks(facts: dict[str, float]) -> list[Check]:
     return [Check(None, name, float(facts[name]), limits[name]) for name in limits if name in facts]
 
 
-#: the quantities whose discretization error a refinement estimates, and how the estimate measures it
+#: the quantities whose discretization error every refinement estimates, and how the estimate measures it; a
+#: refinement may estimate more of a load's headline quantities (the spectral cell: the coefficients of eq. 34),
+#: each in its :func:`~ngcontact.cell.cell_solution.measure`
 ESTIMATED = {"contact_fraction": "absolute", "mean_closure": "relative", "normal_stiffness": "relative"}
 
 
-def quantities(loads: list[dict[str, Any]], estimates: Sequence[dict[str, float]], tolerance: float
-               ) -> list[dict[str, Any]]:
-    """Per load and estimated quantity: its value, the estimated error (absolute and relative) and whether it
-    meets ``tolerance`` in the measure the refinement controls (:data:`ESTIMATED`)."""
+def quantities(loads: list[dict[str, Any]], estimates: Sequence[dict[str, float]], tolerance: float,
+               uncontrolled: Sequence[str] = (), scales: Sequence[dict[str, float]] = ()) -> list[dict[str, Any]]:
+    """Per load and estimated quantity: its value, the estimated error (absolute, relative to the value, and
+    in the measure the refinement controls, :func:`~ngcontact.cell.cell_solution.measure`, with the scale it
+    divides by: the refinement's ``scales`` per load where given), whether that meets ``tolerance`` and
+    whether it counts in the verdict (``counted``: not for the ``uncontrolled`` quantities, which the
+    refinement reports without holding them to the tolerance)."""
     out = []
     for k, (results, estimate) in enumerate(zip(loads, estimates)):
-        for name, measure in ESTIMATED.items():
-            if name not in estimate:
-                continue
-            value, e = headline(results)[name], float(estimate[name])
-            absolute = e if measure == "absolute" else e * abs(value)
-            relative = e if measure == "relative" else (e / abs(value) if value != 0 else None)
-            out.append({"load": k, "name": name, "value": value, "error": absolute, "relative_error": relative,
-                        "controlled": measure, "met": e <= tolerance})
+        head = headline(results)
+        for name in (n for n in estimate if n in head):
+            value, e = head[name], float(estimate[name])
+            size = scales[k][name] if k < len(scales) and name in scales[k] else scale(name, head)
+            absolute = e * size
+            out.append({"load": k, "name": name, "value": value, "error": absolute,
+                        "relative_error": absolute / abs(value) if value != 0 else None,
+                        "controlled": measure(name), "scale": size, "controlled_error": e, "met": e <= tolerance,
+                        "counted": name not in uncontrolled})
     return out
 
 
 def verdict(loads: list[dict[str, Any]], tolerance: float | None, cell: Sequence[Check] = (),
-            estimates: Sequence[dict[str, float]] | None = None, how: str = "", reached: bool = True
+            estimates: Sequence[dict[str, float]] | None = None, how: str = "", reached: bool = True,
+            uncontrolled: Sequence[str] = (), scales: Sequence[dict[str, float]] = ()
             ) -> tuple[dict[str, Any], list[Check]]:
     """The report's verdict on a sweep's results and its failed checks.
 
@@ -124,14 +131,17 @@ def verdict(loads: list[dict[str, Any]], tolerance: float | None, cell: Sequence
     checks of the cell itself (:func:`cell_checks`); ``estimates`` the refinement's per load (``None``: the
     discretization was not refined, and its error is not estimated), made as ``how`` says; ``reached =
     False``: the refinement stopped at its size bound before it could show the tolerance met (too few levels),
-    so the verdict is not met whatever the estimates.
+    so the verdict is not met whatever the estimates; ``uncontrolled``: estimated quantities the refinement
+    does not hold to the tolerance (listed, not counted); ``scales``: per load what each estimate divides
+    the absolute error by (:func:`quantities`).
     """
     limit = DEFAULT_TOLERANCE if tolerance is None else tolerance
     checks = list(cell) + [c for k, results in enumerate(loads) for c in load_checks(k, results, limit)]
     failed = [c for c in checks if not c.ok]
-    estimated = quantities(loads, estimates, limit) if estimates is not None else []
+    estimated = quantities(loads, estimates, limit, uncontrolled, scales) if estimates is not None else []
     out = {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
-           "met": reached and not failed and all(q["met"] for q in estimated), "checks": [c.as_dict() for c in checks],
+           "met": reached and not failed and all(q["met"] for q in estimated if q["counted"]),
+           "checks": [c.as_dict() for c in checks],
            "estimated": estimates is not None, "quantities": estimated,
            "how": how if estimates is not None else (how or "not estimated: set discretization.tolerance to refine "
                                                              "the discretization and estimate its error")}

@@ -47,8 +47,9 @@ class Refinement:
     solutions
         The finest level's solution of each load.
     estimates
-        Per load, the estimated error of each controlled quantity (``contact_fraction`` absolute,
-        ``mean_closure`` relative).
+        Per load, the estimated error of each estimated quantity in its measure
+        (:func:`~ngcontact.cell.cell_solution.measure`: ``contact_fraction`` absolute, ``mean_closure``
+        relative, ...).
     per_load
         Per load, what the report adds to the load's entry besides the estimate (an FE cell's
         ``mesh_history`` and its Newton steps summed over the levels), possibly empty.
@@ -68,6 +69,12 @@ class Refinement:
     #: whether the refinement reached its tolerance within the method's size bound (an unrequired
     #: tolerance out of reach leaves the finest level as the answer, marked as not meeting it)
     met: bool = True
+    #: the estimated quantities the refinement does not hold to the tolerance (reported with their estimate,
+    #: not counted in the verdict)
+    uncontrolled: tuple[str, ...] = ()
+    #: per load, what each estimate's absolute error was divided by in its measure
+    #: (:func:`~ngcontact.cell.cell_solution.scale`), where the method says
+    scales: list[dict[str, float]] = field(default_factory=list)
 
 
 class CellSolver(Protocol):

@@ -14,15 +14,19 @@ What an engineer reads first of each kind, as ``{name: value}`` (plain numbers):
 
 A report that estimates its own errors lists them in ``results.accuracy.quantities`` (per quantity its
 ``name``, ``value``, absolute ``error`` and, for a load of a cell, ``load``): those quantities join the
-headline ones under the same names (``{name}_load{k}`` for a load), with their estimated absolute error.
+headline ones under the same names (``{name}_load{k}`` for a load; a cell's ``normal_stiffness`` is its
+``effective_stiffness``), with their estimated absolute error.
 
 A fraction (contact fraction, contact area share) is compared in absolute terms, every other quantity
-relative to its value (:func:`measure`), as a cell's ``discretization.tolerance`` controls them.
+relative to its value (:func:`measure`), as a cell's ``discretization.tolerance`` controls them (a cell's
+estimated coefficients of eq. 34 are not among them: :func:`estimated`).
 """
 from __future__ import annotations
 
 import math
 from typing import Any
+
+from ngcontact.cell.cell_solution import COEFFICIENT
 
 #: quantities compared in absolute terms (fractions in [0, 1]); every other one relative to its value
 ABSOLUTE = ("contact_fraction", "contact_area", "whole_surface_contact_fraction")
@@ -90,16 +94,23 @@ def direct_quantities(results: dict) -> dict[str, float | None]:
 QUANTITIES = {"cell": cell_quantities, "macro": macro_quantities, "direct": direct_quantities}
 
 
+#: an estimated quantity's name in a cell's accuracy record -> its headline name
+ALIASES = {"normal_stiffness": "effective_stiffness"}
+
+
 def _name(entry: dict) -> str:
     load = entry.get("load")
-    return str(entry["name"]) + ("" if load is None else f"_load{load}")
+    name = str(entry["name"])
+    return ALIASES.get(name, name) + ("" if load is None else f"_load{load}")
 
 
 def estimated(report: dict) -> list[dict[str, Any]]:
-    """The entries of ``results.accuracy.quantities`` that name a quantity and give a finite error."""
+    """The entries of ``results.accuracy.quantities`` that name a quantity and give a finite error, but for a
+    cell's coefficients of eq. 34: they carry the penalty ``k_n`` as their scale (``k_n0 = k_n`` times the
+    contact fraction), which a study varies as a knob, so they are not one quantity across its levels."""
     entries = _get(report, "results.accuracy.quantities") or []
     return [e for e in entries if isinstance(e, dict) and isinstance(e.get("name"), str)
-            and _number(e.get("error")) is not None]
+            and not e["name"].startswith(COEFFICIENT) and _number(e.get("error")) is not None]
 
 
 def headline(report: dict) -> dict[str, dict[str, float | None]]:

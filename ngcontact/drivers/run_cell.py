@@ -75,7 +75,9 @@ def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[
         per_load, tolerance, admissibility.cell_checks(facts),
         estimates=refinement.estimates if estimated and refinement is not None else None,
         how="" if refinement is None else refinement.how,
-        reached=refinement is None or refinement.met)
+        reached=refinement is None or refinement.met,
+        uncontrolled=refinement.uncontrolled if refinement is not None else (),
+        scales=refinement.scales if refinement is not None else ())
     wrong = [c for c in failed if c.plainly_wrong]
     if wrong:
         raise ConvergenceError(
@@ -93,12 +95,12 @@ def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[
 def warn_unmet(verdict: dict, refinement: Refinement) -> None:
     """One warning line for a refinement that did not meet its (default) tolerance: the largest estimate,
     and what to do."""
-    unmet = [q for q in verdict["quantities"] if not q["met"]]
+    unmet = [q for q in verdict["quantities"] if not q["met"] and q["counted"]]
     if not unmet and refinement.met:
         return
     if unmet:
-        q = max(unmet, key=lambda q: q["error"] if q["controlled"] == "absolute" else q["relative_error"])
-        size = q["error"] if q["controlled"] == "absolute" else q["relative_error"]
+        q = max(unmet, key=lambda q: q["controlled_error"])
+        size = q["controlled_error"]
         what = f"the estimated {q['controlled']} error {size:.3g} of load {q['load']}'s {q['name']} exceeds"
     else:
         what = "too few grids within the size bound to show"
@@ -164,7 +166,8 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
         entry = cell.load_entry(sol)
         small_strain.check(entry, height, f"load {k}")
         if refinement is not None and refinement.estimates:
-            entry["error_estimate"] = refinement.estimates[k]
+            entry["error_estimate"] = {name: e for name, e in refinement.estimates[k].items()
+                                       if name not in refinement.uncontrolled}
             if refinement.per_load:
                 entry.update(refinement.per_load[k])
         per_load.append(entry)

@@ -391,7 +391,8 @@ def csv_table(directory: str, name: str) -> str:
 
 # ------------------------------------------------------------------ the page
 def accuracy_warnings(report: dict) -> list[str]:
-    """One line per failed check of the report's accuracy verdict (``results.accuracy``), for the page's top."""
+    """One line per failed check of the report's accuracy verdict (``results.accuracy``), for the page's top
+    (a quantity reported without being held to the tolerance, ``counted = false``, is no failed check)."""
     acc = _get(report, "results.accuracy") or {}
     if not isinstance(acc, dict) or acc.get("met", True):
         return []
@@ -399,7 +400,7 @@ def accuracy_warnings(report: dict) -> list[str]:
     checks = [f"{head}load {c.get('load')}, {c.get('name')} = {fmt(c.get('value'))} > {fmt(c.get('limit'))}"
               for c in acc.get("checks", []) if isinstance(c, dict) and not c.get("ok", True)]
     return checks + [head + quantity_line(q) for q in acc.get("quantities", [])
-                     if isinstance(q, dict) and not q.get("met", True)]
+                     if isinstance(q, dict) and not q.get("met", True) and q.get("counted", True)]
 
 
 def quantity_line(q: dict) -> str:

@@ -31,6 +31,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ngcontact.cell.cell_solution import COEFFICIENT, scale
+
 #: successive ratios the estimate looks at
 WINDOW = 2
 #: two successive ratios further apart than this factor are said to disagree
@@ -50,11 +52,13 @@ class Convergence:
     #: the factor on the geometric tail
     safety: float
 
-    def tail(self, values: list[float], relative: bool) -> tuple[float, str]:
-        """The estimated error of the last of ``values`` (absolute, or relative to the last value) and a
-        remark where the ratios disagree or a guard acted ("" otherwise).  Needs two values at least."""
+    def tail(self, values: list[float], relative: bool, scale: float | None = None) -> tuple[float, str]:
+        """The estimated error of the last of ``values`` (absolute, or relative to the last value, or divided
+        by ``scale`` where given) and a remark where the ratios disagree or a guard acted ("" otherwise).
+        Needs two values at least."""
         d = [abs(b - a) for a, b in zip(values[:-1], values[1:])]
-        scale = abs(values[-1]) if relative and values[-1] != 0 else 1.0
+        if scale is None:
+            scale = abs(values[-1]) if relative and values[-1] != 0 else 1.0
         if d[-1] == 0.0 and max(d) == 0.0:
             return 0.0, ""
         ratios = [d[j] / d[j - 1] if d[j - 1] > 0 else float("inf") for j in range(1, len(d))][-WINDOW:]
@@ -79,20 +83,28 @@ class Convergence:
                 f"successive differences{floor} ({self.assumed:g} assumed with two discretizations)")
 
 
-def sequence_estimates(levels: list[list[dict[str, float]]], rule: Convergence,
-                       measures: dict[str, bool]) -> tuple[list[dict[str, float]], list[str]]:
+def sequence_estimates(levels: list[list[dict[str, float]]], rule: Convergence, measures: dict[str, bool],
+                       whole: dict | None = None) -> tuple[list[dict[str, float]], list[str]]:
     """Per load the estimate of each quantity of the last level and the remarks.
 
     ``levels[i][k]`` holds load ``k``'s headline quantities on discretization ``i``; ``measures`` names the
-    quantities estimated and whether relatively.  A quantity missing on some level is not estimated."""
+    quantities estimated and whether relatively; with ``whole`` (the last level's whole-surface
+    coefficients) the coefficients of eq. 34 among them are estimated too, relative to their group there
+    (:func:`~ngcontact.cell.cell_solution.scale`), unless zero on every level.  A quantity missing on some
+    level is not estimated."""
     estimates, remarks = [], []
     for k in range(len(levels[-1])):
         out: dict[str, float] = {}
-        for name, relative in measures.items():
+        last = levels[-1][k]
+        names = dict(measures)
+        if whole is not None:
+            names.update({n: False for n in last if n.startswith(COEFFICIENT)})
+        for name, relative in names.items():
             values = [lv[k][name] for lv in levels if name in lv[k]]
-            if len(values) != len(levels):
+            if len(values) != len(levels) or (name.startswith(COEFFICIENT) and not any(values)):
                 continue
-            out[name], note = rule.tail(values, relative)
+            size = scale(name, last, whole) if name.startswith(COEFFICIENT) else None
+            out[name], note = rule.tail(values, relative, size)
             if note:
                 remarks.append(f"load {k} {name}: {note}")
         estimates.append(out)

@@ -25,7 +25,9 @@ needs three levels (two observed differences), or two where the third is beyond 
 estimate meets the tolerance.  Out of reach: a :class:`~ngcontact.errors.ConvergenceError` with the figures
 where the tolerance was stated, else the last level with ``met = False``.  Per load: the contact fraction
 absolutely, the mean closure and the normal effective stiffness relatively, as everywhere
-(:data:`ngcontact.cell.admissibility.ESTIMATED`).  A refiner is any :class:`Refiner`, each with its
+(:data:`ngcontact.cell.admissibility.ESTIMATED`), and the coefficients of eq. 34 on the real contact set
+relative to their group (:func:`ngcontact.cell.cell_solution.measure`), all held to the tolerance.
+A refiner is any :class:`Refiner`, each with its
 own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.
 """
 from __future__ import annotations
@@ -35,7 +37,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Protocol
 
-from ngcontact.cell.cell_solution import CellSolution, headline
+from ngcontact.cell.cell_solution import COEFFICIENT, CellSolution, headline, scale
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.cell.fe.observed_rate import Convergence, sequence_estimates
 from ngcontact.errors import ConvergenceError
@@ -93,6 +95,8 @@ class Sequence:
     levels: list[dict[str, Any]] = field(default_factory=list)
     met: bool = True
     how: str = ""
+    #: per load, what each estimate's absolute error is divided by (:func:`~ngcontact.cell.cell_solution.scale`)
+    scales: list[dict[str, float]] = field(default_factory=list)
 
 
 def _level(cell, loads, k: int, refiner: Refiner) -> tuple[list[CellSolution], dict[str, Any]]:
@@ -113,6 +117,7 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
     levels: list[dict[str, Any]] = []
     cell = sols = None
     estimates: list[dict[str, float]] = []
+    scales: list[dict[str, float]] = []
     remarks: list[str] = []
     stop = f"the most levels ({MAX_LEVELS})"
     for k in range(MAX_LEVELS):
@@ -128,14 +133,18 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
         levels.append(entry)
         heads.append([headline(s.results) for s in sols])
         if len(heads) > 1:
-            estimates, remarks = sequence_estimates(heads, refiner.rule, MEASURES)
+            # the coefficients' scale: the whole surface's (paper eq. 34 with w = 1), where a load reports them
+            whole = cell.whole_surface() if any(n.startswith(COEFFICIENT) for h in heads[-1] for n in h) else None
+            estimates, remarks = sequence_estimates(heads, refiner.rule, MEASURES, whole)
+            scales = [{n: scale(n, head, whole) for n in e} for e, head in zip(estimates, heads[-1])]
             entry["estimate"] = max((max(e.values()) for e in estimates if e), default=0.0)
             if len(heads) >= 3 and entry["estimate"] <= tolerance:
-                return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks))
+                return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks), scales)
     assert cell is not None and sols is not None      # level 0 is the scene's own cell
     worst = levels[-1].get("estimate")
     if len(heads) == 2 and worst is not None and worst <= tolerance:   # the third level beyond the bound
-        return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks + [f"stopped: {stop}"]))
+        return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks + [f"stopped: {stop}"]),
+                        scales)
     reached = "no estimate (one level)" if worst is None else f"{worst:.3g}"
     message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on "
                f"{levels[-1]['discretization']} ({levels[-1]['ndof']} dofs), and {stop}")
@@ -144,7 +153,7 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
                                {"levels": levels})
     if not estimates:
         estimates = [{} for _ in sols]
-    return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]))
+    return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]), scales)
 
 
 def _how(refiner: Refiner, levels: list[dict[str, Any]], remarks: list[str]) -> str:
@@ -169,4 +178,4 @@ def as_refinement(done: Sequence) -> Refinement:
         return Refinement(solutions=done.solutions, estimates=[{} for _ in done.solutions], per_load=per_load,
                           histories=histories, how=how)
     return Refinement(solutions=done.solutions, estimates=done.estimates, per_load=per_load, histories=histories,
-                      how=done.how, met=done.met)
+                      how=done.how, met=done.met, scales=done.scales)

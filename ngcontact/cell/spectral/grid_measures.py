@@ -49,18 +49,28 @@ EDGE_FIT_RTOL = 1e-4
 
 def contact_fraction(cell, p: np.ndarray, gap: np.ndarray) -> float:
     """Contact area per period: grid points in 3D; in 2D edges between points (module docstring)."""
+    return float(contact_weights(cell, p, gap).sum()) / cell.points
+
+
+def contact_weights(cell, p: np.ndarray, gap: np.ndarray) -> np.ndarray:
+    """Each grid point's share of its step in the real contact set: 1 in contact, 0 open (3D: that is all);
+    in 2D the step an edge cuts is shared (module docstring): the last contact point ``i`` before an edge at
+    ``i + t`` steps keeps ``min(t, 1/2) + 1/2`` of its step and the first open point gains ``max(t - 1/2, 0)``,
+    so that the weights sum to the located contact length, and a smooth function summed with them (eq. 34's
+    integrands) is integrated over the located set."""
     on = p > 0
+    weights = on.astype(float)
     if cell.dim == 3 or on.all() or not on.any():
-        return float(np.count_nonzero(on)) / cell.points
+        return weights
     n = cell.grid
-    length = float(np.count_nonzero(on))
     root = np.maximum(gap, 0.0) ** (2.0 / 3.0)       # smooth, with a simple root at a smooth contact edge
     for step in (1, -1):                            # edges on the right, then on the left of a patch
         last = on & ~np.roll(on, -step)             # in contact, the next point (in this direction) is not
         for i in np.flatnonzero(last):
             # open share of the grid step between the last contact point i and the first open point
-            length += edge_offset(root, on, int(i), step) - 0.5
-    return length / n
+            shift = edge_offset(root, on, int(i), step) - 0.5
+            weights[(int(i) + step) % n if shift > 0 else int(i)] += shift
+    return weights
 
 
 def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int) -> float:
@@ -128,17 +138,21 @@ def effective_stiffness(cell, active: np.ndarray) -> dict:
     return {"components": ["n0"], "matrix": [[K]], "compliance": [[1.0 / K]], "total": [[S]],
             "reference": [[S0]]}
 
-def coefficients(cell, active: np.ndarray, threshold: np.ndarray | None = None) -> Coefficients:
+def coefficients(cell, active: np.ndarray, threshold: np.ndarray | None = None,
+                 weights: np.ndarray | None = None) -> Coefficients:
     """Eqs. 34, 42-43 on the real contact set of a flat interface (``n = n0`` everywhere).
 
     ``K0 = k_n |S_real| / |T|`` on ``n0`` only, ``g_n = k_n mean(1_real g0)``,
     and the friction threshold ``G_t = mean(1_real G)`` per tangential
-    direction (``G`` the Tresca threshold or ``mu p``), ``G_n = 0``.
+    direction (``G`` the Tresca threshold or ``mu p``), ``G_n = 0``.  ``1_real`` is ``active``, or the
+    ``weights`` of :func:`contact_weights` where given (2D: the set with its edges located between points,
+    whose ``K0`` is ``k_n`` times the reported contact fraction).
     """
-    frac = float(np.count_nonzero(active)) / cell.points
+    w = active.astype(float) if weights is None else weights
+    frac = float(w.sum()) / cell.points
     kn0 = cell.k_n * frac
-    g_n = cell.k_n * float(np.where(active, cell.g0, 0.0).sum()) / cell.points
-    G_t = float(np.where(active, threshold, 0.0).sum()) / cell.points if threshold is not None else 0.0
+    g_n = cell.k_n * float((w * cell.g0).sum()) / cell.points
+    G_t = float((w * threshold).sum()) / cell.points if threshold is not None else 0.0
     nt = cell.dim - 1
     K0 = np.zeros((cell.dim, cell.dim))
     K0[0, 0] = kn0

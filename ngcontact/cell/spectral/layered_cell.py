@@ -216,7 +216,8 @@ class SpectralCell:
         elastic_gap = self.g0 - closure
         slip = np.sqrt(np.sum(state["slip"] ** 2, axis=0))
         mean_closure = float(closure.mean())
-        fraction = measures.contact_fraction(self, p, elastic_gap)
+        weights = measures.contact_weights(self, p, elastic_gap)
+        fraction = float(weights.sum()) / self.points
         results: dict[str, Any] = {
             "contact_fraction": fraction,
             "contact_fraction_grid": float(np.count_nonzero(p > 0)) / self.points,
@@ -236,7 +237,7 @@ class SpectralCell:
             results["max_slip"] = float(slip.max())
             results["slip_fraction"] = float(np.count_nonzero(state["slipping"])) / self.points
         results["effective_stiffness"] = measures.effective_stiffness(self, p > 0)
-        results["coefficients"] = measures.coefficients(self, p > 0, state.get("threshold")).as_dict()
+        results["coefficients"] = measures.coefficients(self, p > 0, state.get("threshold"), weights).as_dict()
         fields = {"pressure": p, "gap": np.maximum(elastic_gap, 0.0), "closure": closure}
         if self.friction is not None:
             fields.update(shear=q, slip=state["slip"])

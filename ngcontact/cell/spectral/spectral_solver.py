@@ -24,7 +24,7 @@ from ngcontact.cell.cell_solution import CellSolution
 from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.spectral import grid_measures
 from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
-from ngcontact.cell.spectral.refinement import HOW, sweep_to_tolerance
+from ngcontact.cell.spectral.refinement import HOW, UNCONTROLLED, sweep_to_tolerance
 
 #: the grid fields a solution hands on (the closure is in its surface distribution)
 FIELDS = ("pressure", "gap", "shear", "slip")
@@ -118,7 +118,8 @@ class SpectralCellSolver:
                                   f"bound ({bound} points), so there is no finer grid to compare with")
         how = HOW + (f" ({'; '.join(refined.remarks)})" if refined.remarks else "")
         return Refinement(solutions=solutions, estimates=list(refined.estimates), method=method,
-                          met=refined.met, how=how)
+                          met=refined.met, how=how, uncontrolled=UNCONTROLLED,
+                          scales=refined.scales)
 
     def penalty(self) -> float | None:
         return float(self.cell.k_n) if self.cell.enforcement == "penalty" else None
