@@ -38,6 +38,7 @@ import numpy as np
 
 from ngcontact.cell.spectral import grid_measures as measures
 from ngcontact.cell.cell_load import CellLoad
+from ngcontact.cell.spectral.convolution import Convolution
 from ngcontact.cell.spectral.layer_compliance import normal_compliance
 from ngcontact.cell.spectral.fft_threads import fft_workers
 from ngcontact.cell.spectral.frictional_contact import solve_frictional, traction_operator
@@ -166,15 +167,12 @@ class SpectralCell:
         spectrum *= symbol
         return sfft.irfftn(spectrum, s=self.shape, workers=workers, overwrite_x=True)
 
-    def interface_compliance(self, uniform: bool):
-        """``p -> C p (+ p / k_n)``, with or without the uniform mode of ``C``."""
-        sym = self.symbol if uniform else self.fluctuation
+    def interface_compliance(self, uniform: bool) -> Convolution:
+        """``p -> C p (+ p / k_n)``, with or without the uniform mode of ``C``: a
+        :class:`~ngcontact.cell.spectral.convolution.Convolution`, which the constrained CG also asks for its
+        step lengths by Parseval's identity."""
         winkler = 1.0 / self.k_n if self.enforcement == "penalty" else 0.0
-
-        def apply(p):
-            out = self.convolve(p, sym)
-            return out + winkler * p if winkler else out
-        return apply
+        return Convolution(self.symbol if uniform else self.fluctuation, self.shape, winkler)
 
     def poisson_shift(self, macro_strain) -> float:
         """Far-face approach due to an in-plane macro strain at fixed interface state (module docstring)."""
