@@ -206,19 +206,16 @@ class _ContactSet:
 
     def __init__(self, shape: tuple[int, ...]):
         self.mask = np.zeros(shape)
-        self.rest = np.zeros(shape)
         self.work = np.empty(shape)
         self.count = 0
 
     def update(self, p: np.ndarray) -> None:
         np.greater(p, 0.0, out=self.mask)
-        np.subtract(1.0, self.mask, out=self.rest)
         self.count = int(np.count_nonzero(self.mask))
 
     def widen(self, on: _ContactSet, more: np.ndarray) -> None:
         """This set becomes ``on`` with the points where ``more`` (booleans) holds."""
         np.logical_or(on.mask, more, out=self.mask, casting="unsafe")
-        np.subtract(1.0, self.mask, out=self.rest)
         self.count = int(np.count_nonzero(self.mask))
 
     def mean(self, x: np.ndarray) -> float:
@@ -226,12 +223,12 @@ class _ContactSet:
         return inner(x, self.mask, self.work) / self.count if self.count else 0.0
 
     def residual(self, g: np.ndarray, shift: float, gscale: float) -> float:
-        """``max(max_on |g - shift|, max_off max(shift - g, 0)) / gscale`` (module docstring)."""
+        """``max(max_on |g - shift|, max_off max(shift - g, 0)) / gscale`` (module docstring): at each point
+        ``max(-gamma, 1_on gamma)``, so the maximum of ``-gamma`` and of ``gamma`` on the set."""
         gamma = np.subtract(g, shift, out=self.work)
-        r_off = -float(np.multiply(gamma, self.rest, out=self.rest).min())
-        np.subtract(1.0, self.mask, out=self.rest)
-        r_on = float(np.abs(np.multiply(gamma, self.mask, out=gamma), out=gamma).max())
-        return max(r_on, r_off, 0.0) / gscale
+        r_neg = -float(gamma.min())
+        r_on = float(np.multiply(gamma, self.mask, out=gamma).max())
+        return max(r_on, r_neg, 0.0) / gscale
 
 
 def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *, pbar: float | None,
