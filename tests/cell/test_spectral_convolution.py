@@ -42,7 +42,8 @@ def test_the_convolution_answers_from_one_forward_transform(shape):
 
 @pytest.fixture
 def transforms(monkeypatch):
-    """The forward and inverse real FFTs called, counted."""
+    """The forward and inverse real FFTs called, counted (an inverse transform ends in ``irfft``, or is
+    ``irfftn``)."""
     counts = {"forward": 0, "inverse": 0}
 
     def counted(fn, key):
@@ -52,6 +53,7 @@ def transforms(monkeypatch):
         return wrapped
     monkeypatch.setattr(sfft, "rfftn", counted(sfft.rfftn, "forward"))
     monkeypatch.setattr(sfft, "irfftn", counted(sfft.irfftn, "inverse"))
+    monkeypatch.setattr(sfft, "irfft", counted(sfft.irfft, "inverse"))
     return counts
 
 

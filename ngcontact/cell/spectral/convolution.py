@@ -16,7 +16,9 @@ conjugate-gradient step from the forward transform ``X = FFT(x)`` alone (the sea
 * ``c A x = IFFT(c a X) + c w x`` by the inverse transform alone.
 
 So a step whose displacement is a multiple of its direction costs one forward and one inverse transform, and
-its step length costs none.
+its step length costs none.  The inverse transform is made in its two passes, complex-to-complex over the
+leading axes and complex-to-real along the last, each in place: the same transform as ``scipy.fft.irfftn``,
+with no copy of the spectrum.
 """
 from __future__ import annotations
 
@@ -61,7 +63,10 @@ class Convolution:
         X *= self.symbol
         if factor != 1.0:
             X *= factor
-        out = sfft.irfftn(X, s=self.shape, workers=fft_workers(), overwrite_x=True)
+        workers = fft_workers()
+        if len(self.shape) > 1:
+            X = sfft.ifftn(X, axes=tuple(range(len(self.shape) - 1)), workers=workers, overwrite_x=True)
+        out = sfft.irfft(X, n=self.shape[-1], axis=-1, workers=workers, overwrite_x=True)
         if self.diagonal:
             out += (factor * self.diagonal) * x
         return out

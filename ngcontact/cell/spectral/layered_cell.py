@@ -267,10 +267,10 @@ class SpectralCell:
                 "slip": np.zeros((d - 1,) + self.shape), "far_face_jump": [0.0] * (d - 1) + [approach],
                 "iterations": res.iterations, "residuals": res.residuals}
 
-    def inverse_compliance(self):
+    def inverse_compliance(self) -> Convolution:
         """``r -> (C + 1/k_n)^{-1} r`` with the uniform mode kept: the preconditioner of the constrained CG."""
-        inv = 1.0 / (self.symbol + (1.0 / self.k_n if self.enforcement == "penalty" else 0.0))
-        return lambda r: self.convolve(r, inv)
+        return Convolution(1.0 / (self.symbol + (1.0 / self.k_n if self.enforcement == "penalty" else 0.0)),
+                           self.shape)
 
     def norm(self, uniform: bool) -> float:
         """Largest eigenvalue of :meth:`interface_compliance`: the largest value of its symbol."""
