@@ -13,17 +13,33 @@ conditions are the contact conditions: with the gap ``gamma = A p + b - c``
 
     p >= 0,   gamma >= 0,   p gamma = 0.
 
-Method (Polonsky & Keer, Wear 231 (1999) 206-219).  Conjugate gradients on
-the current contact set ``{p > 0}``, the search direction made
-mean-free over the set when the mean pressure is prescribed; after each
-step the pressures are clipped at 0, points outside the set whose gap is
-negative are put back in contact with a steepest-descent step (and the
-conjugacy restarted), and the mean is rescaled to ``pbar``.  Chosen over a
-semismooth Newton with the FFT-applied operator because each step costs two
-operator applications and no inner linear solve, it needs no
-regularization of the complementarity, and it converges to the exact
-contact set of the grid (the active set settles in a few dozen steps, then
-it is plain CG on an SPD system).
+Method (Polonsky & Keer, Wear 231 (1999) 206-219, with two changes argued
+below).  Conjugate gradients on a working set, the search direction made
+mean-free over it when the mean pressure is prescribed; after each step the
+pressures are clipped at 0 and the mean is rescaled to ``pbar``.  Chosen
+over a semismooth Newton with the FFT-applied operator because each step
+costs one operator application (and one of the preconditioner) and no inner
+linear solve, it needs no regularization of the complementarity, and it
+converges to the exact contact set of the grid (the active set settles in a
+few dozen steps, then it is plain CG on an SPD system).
+
+* The working set is the contact set ``{p > 0}`` together with the points
+  outside it whose gap is negative, ``{p = 0, gamma < 0}``.  Polonsky and
+  Keer put such points back by a separate steepest-descent step of the
+  unpreconditioned size ``-tau gamma``; on the working set they enter through
+  the (preconditioned) direction itself, with the step of the points already
+  in contact, and the next clipping removes them again where the direction
+  does not press them.
+* The conjugacy is kept when the working set changes (Polonsky and Keer
+  restart it whenever a point is put back): the step is then a nonlinear
+  conjugate gradient of Fletcher-Reeves kind on the piecewise quadratic
+  ``f``, restarted only where the conjugate direction is no descent
+  direction (``<gs, t> <= 0``, ``gs`` the gap on the working set).  On a
+  random map a few hundred edge points enter and leave at every step for
+  tens of steps; a restart at each would make all these steps
+  steepest-descent steps.  Once the set has settled the step is the
+  conjugate-gradient step on the fixed set, and the stopping rule below
+  holds the answer to the same tolerance whichever way the set was found.
 
 Preconditioning (``precondition``, Vollebregt, J. Comput. Phys. 257 (2014)
 333-351).  The compliance of an elastic body falls like ``1 / |k|``, so on a
@@ -31,16 +47,26 @@ grid of ``N`` points per direction ``A`` has a condition number of order
 ``N`` on a contact set of many small patches (a random map), and plain CG needs ``O(sqrt(N))`` steps per digit:
 hundreds at 1024^2.  With ``M`` an approximation of ``A^{-1}`` (the inverse
 symbol ``|k|``-like, by FFTs) the search direction is ``Pi R M R^T g``
-(``R`` the restriction to the contact set, ``Pi`` the mean-free projection
+(``R`` the restriction to the working set, ``Pi`` the mean-free projection
 there): the preconditioned operator on the set is spectrally equivalent to
 the identity up to a ``log^2 N`` factor (the operators of order -1 and 1
 restricted to a subdomain, as in domain decomposition), so the step count
-hardly grows with the grid.  The rest of the method (clipping, the points
-put back, the restarts) is unchanged, and the answer is the same to the
-tolerance.  A step that clips no point and puts none back moves ``A p``
-along the search direction's ``A t``, so the gap is updated without an
-operator application; every ``REFRESH`` steps, and before a converged
-answer is returned, it is evaluated anew.
+hardly grows with the grid.  The answer is the same to the tolerance.
+
+Cost of a step, in operator applications (FFT pairs for a convolution).
+The step length needs ``<t, A t>``; the gap after the step needs ``A p``.
+A step that clips no point moves ``A p`` along ``A t``; a step that clips
+points changes ``p`` by ``-tau t`` plus the clipped values, and its ``A p``
+is one application to ``p``.  Where ``A`` is given as a
+:class:`DirectionOperator` (a convolution, whose forward transform ``T`` of
+``t`` gives ``<t, A t>`` by Parseval's identity and ``c A t`` by one inverse
+transform), a step costs one forward and one inverse transform, and one
+more forward transform where it clips points, plus the preconditioner's pair;
+a plain function ``A`` costs one application per step and one more where it
+clips.  The preconditioner's pair cannot be shared with the operator's: the
+restriction to the working set lies between them, and it is not diagonal in
+Fourier space.  Every ``REFRESH`` steps, and before a converged answer is
+returned, the gap is evaluated anew from ``p`` (round-off).
 
 Stopping rule: the complementarity residual, relative to the scale ``gscale``
 of the gap,
@@ -63,7 +89,7 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -92,9 +118,10 @@ class ConstrainedResult:
 
 
 def inner(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> float:
-    """``sum a b`` without BLAS: OpenBLAS' threads, spinning against another busy process, made a short dot
-    product hundreds of times slower than this plain sum.  ``out``: a buffer of the shape for the products."""
-    return float(np.multiply(a, b, out=out).sum())
+    """``sum a b`` in one pass without BLAS (``einsum``'s own loop): OpenBLAS' threads, spinning against another
+    busy process, made a short dot product hundreds of times slower than a plain sum.  ``out``: a buffer of the
+    shape for the products, accepted for callers that hold one and not needed."""
+    return float(np.einsum("i,i->", a.ravel(), b.ravel()))
 
 
 def roundoff_floor(norm: float | None, p: np.ndarray, b: np.ndarray, gscale: float) -> float:
@@ -104,6 +131,53 @@ def roundoff_floor(norm: float | None, p: np.ndarray, b: np.ndarray, gscale: flo
         return 0.0
     return ROUNDOFF * float(np.finfo(float).eps) * (norm * float(np.max(np.abs(p))) + float(np.max(np.abs(b)))) \
         / gscale
+
+
+@runtime_checkable
+class DirectionOperator(Protocol):
+    """``A`` seen along a search direction ``t`` from one transform ``T`` of it (module docstring, cost of a
+    step): :class:`ngcontact.cell.spectral.convolution.Convolution` by FFTs, :class:`_Applied` by one
+    application of a plain function."""
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """``A x`` (a new array)."""
+
+    def transform(self, x: np.ndarray) -> np.ndarray:
+        """The transform ``T`` of ``x`` from which :meth:`energy` and :meth:`from_transform` answer."""
+
+    def energy(self, T: np.ndarray, x: np.ndarray) -> float:
+        """``<x, A x>``."""
+
+    def from_transform(self, T: np.ndarray, x: np.ndarray, factor: float = 1.0) -> np.ndarray:
+        """``factor A x`` (a new array; ``T`` may be overwritten)."""
+
+
+class _Applied:
+    """A plain function ``x -> A x`` as a :class:`DirectionOperator`: the transform is ``A x`` itself."""
+
+    def __init__(self, apply_A: Callable[[np.ndarray], np.ndarray]):
+        self.apply_A = apply_A
+        self.work: np.ndarray | None = None
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        return self.apply_A(x)
+
+    def transform(self, x: np.ndarray) -> np.ndarray:
+        return self.apply_A(x)
+
+    def energy(self, T: np.ndarray, x: np.ndarray) -> float:
+        if self.work is None or self.work.shape != x.shape:
+            self.work = np.empty(x.shape)
+        return inner(T, x, self.work)
+
+    def from_transform(self, T: np.ndarray, x: np.ndarray, factor: float = 1.0) -> np.ndarray:
+        T *= factor
+        return T
+
+
+def direction_operator(apply_A) -> DirectionOperator:
+    """``apply_A`` where it is a :class:`DirectionOperator`, else the plain function wrapped as one."""
+    return apply_A if isinstance(apply_A, DirectionOperator) else _Applied(apply_A)
 
 
 def _start(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, pbar: float | None,
@@ -132,13 +206,16 @@ class _ContactSet:
 
     def __init__(self, shape: tuple[int, ...]):
         self.mask = np.zeros(shape)
-        self.rest = np.zeros(shape)
         self.work = np.empty(shape)
         self.count = 0
 
     def update(self, p: np.ndarray) -> None:
         np.greater(p, 0.0, out=self.mask)
-        np.subtract(1.0, self.mask, out=self.rest)
+        self.count = int(np.count_nonzero(self.mask))
+
+    def widen(self, on: _ContactSet, more: np.ndarray) -> None:
+        """This set becomes ``on`` with the points where ``more`` (booleans) holds."""
+        np.logical_or(on.mask, more, out=self.mask, casting="unsafe")
         self.count = int(np.count_nonzero(self.mask))
 
     def mean(self, x: np.ndarray) -> float:
@@ -146,23 +223,12 @@ class _ContactSet:
         return inner(x, self.mask, self.work) / self.count if self.count else 0.0
 
     def residual(self, g: np.ndarray, shift: float, gscale: float) -> float:
-        """``max(max_on |g - shift|, max_off max(shift - g, 0)) / gscale`` (module docstring)."""
+        """``max(max_on |g - shift|, max_off max(shift - g, 0)) / gscale`` (module docstring): at each point
+        ``max(-gamma, 1_on gamma)``, so the maximum of ``-gamma`` and of ``gamma`` on the set."""
         gamma = np.subtract(g, shift, out=self.work)
-        r_off = -float(np.multiply(gamma, self.rest, out=self.rest).min())
-        np.subtract(1.0, self.mask, out=self.rest)
-        r_on = float(np.abs(np.multiply(gamma, self.mask, out=gamma), out=gamma).max())
-        return max(r_on, r_off, 0.0) / gscale
-
-
-def _preconditioned(precondition, gs: np.ndarray, on: _ContactSet, mean_free: bool) -> np.ndarray:
-    """``Pi R M R^T gs``: the preconditioner on the contact set, made mean-free there under a prescribed mean
-    (``precondition`` returns a new array)."""
-    z = precondition(gs)
-    z *= on.mask
-    if mean_free:
-        z -= on.mean(z)
-        z *= on.mask
-    return z
+        r_neg = -float(gamma.min())
+        r_on = float(np.multiply(gamma, self.mask, out=gamma).max())
+        return max(r_on, r_neg, 0.0) / gscale
 
 
 def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *, pbar: float | None,
@@ -174,7 +240,8 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
     Parameters
     ----------
     apply_A
-        ``p -> A p`` (same shape as ``b``, a new array).
+        ``p -> A p`` (same shape as ``b``, a new array), or a :class:`DirectionOperator` (a convolution:
+        fewer transforms per step, module docstring).
     b
         Initial gap on the grid.
     pbar
@@ -205,10 +272,11 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
         raise ValueError(f"pbar = {pbar!r}: a prescribed mean pressure must be > 0")
     if not gscale > 0:
         raise ValueError(f"gscale = {gscale!r}: must be > 0")
-    it = _Iteration(apply_A, b, pbar, gscale, norm, _start(apply_A, b, pbar, p0))
+    it = _Iteration(direction_operator(apply_A), b, pbar, gscale, norm, _start(apply_A, b, pbar, p0))
     started = reported = time.perf_counter()
     while it.steps < max_iter:
-        if not it.on.count:    # nothing pressed (approach below every summit): the open solution
+        # nothing pressed and nothing penetrating (approach below every summit): the open solution
+        if not it.on.count and it.on.residual(it.g, 0.0, gscale) <= tol:
             it.residuals.append(it.on.residual(it.g, 0.0, gscale))
             return it.result(0.0)
         done = it.step(precondition, tol)
@@ -230,21 +298,21 @@ def constrained_cg(apply_A: Callable[[np.ndarray], np.ndarray], b: np.ndarray, *
 
 class _Iteration:
     """The state of :func:`constrained_cg`: pressure ``p``, ``A p``, gap ``g = A p + b``, the multiplier of the
-    mean, the contact set, the search direction ``t`` and the conjugacy."""
+    mean, the contact set, the working set, the search direction ``t`` and the conjugacy."""
 
-    def __init__(self, apply_A, b: np.ndarray, pbar: float | None, gscale: float, norm: float | None,
-                 p: np.ndarray):
-        self.apply_A, self.b, self.pbar, self.gscale = apply_A, b, pbar, gscale
+    def __init__(self, A: DirectionOperator, b: np.ndarray, pbar: float | None, gscale: float,
+                 norm: float | None, p: np.ndarray):
+        self.A, self.b, self.pbar, self.gscale = A, b, pbar, gscale
         self.floor_b = 0.0 if norm is None else float(np.max(np.abs(b)))
         self.norm = norm
         self.p = p
-        self.Ap = apply_A(p)
+        self.Ap = A(p)
         self.g = self.Ap + b
-        self.on = _ContactSet(b.shape)
+        self.on, self.working = _ContactSet(b.shape), _ContactSet(b.shape)
         self.on.update(p)
         self.shift = self.on.mean(self.g) if pbar is not None else 0.0
         self.t, self.gs, self.work = np.zeros(b.shape), np.empty(b.shape), np.empty(b.shape)
-        self.g_old, self.conjugate, self.steps, self.stuck = 1.0, False, 0, False
+        self.g_old, self.steps, self.stuck = 1.0, 0, False
         self.residuals: list[float] = []
 
     def floor(self) -> float:
@@ -264,18 +332,33 @@ class _Iteration:
         self.shift = self.on.mean(self.g) if self.pbar is not None else 0.0
         return self.on.residual(self.g, self.shift, self.gscale)
 
+    def _mean_free(self, x: np.ndarray) -> None:
+        """``x`` made mean-free over the working set under a prescribed mean (in place; 0 outside it)."""
+        x *= self.working.mask
+        if self.pbar is not None:
+            x -= self.working.mean(x)
+            x *= self.working.mask
+
     def direction(self, precondition) -> np.ndarray:
-        """The conjugate (or, after a restart, the steepest) preconditioned direction on the contact set; the
-        restricted gap ``gs`` is kept for the step length."""
-        on, gs, t = self.on, self.gs, self.t
-        np.subtract(self.g, self.shift, out=gs)
-        gs *= on.mask
-        z = gs if precondition is None else _preconditioned(precondition, gs, on, self.pbar is not None)
+        """The conjugate (or, at the first step and where that is no descent direction, the steepest)
+        preconditioned direction on the working set (module docstring); the gap there, less its mean under a
+        prescribed mean, is kept in ``gs`` for the step length."""
+        ws, gs, t = self.working, self.gs, self.t
+        ws.widen(self.on, self.g < self.shift)
+        np.subtract(self.g, ws.mean(self.g) if self.pbar is not None else 0.0, out=gs)
+        gs *= ws.mask
+        if precondition is None:
+            z = gs
+        else:
+            z = precondition(gs)
+            self._mean_free(z)
         G = inner(gs, z, self.work)
-        if self.conjugate:
+        if self.steps > 1:
             t *= G / self.g_old
             t += z
-            t *= on.mask
+            self._mean_free(t)
+            if inner(gs, t, self.work) <= 0.0:
+                np.copyto(t, z)
         else:
             np.copyto(t, z)
         self.g_old = G
@@ -286,10 +369,8 @@ class _Iteration:
         self.steps += 1
         on, p, shift = self.on, self.p, self.shift
         t = self.direction(precondition)
-        At = self.apply_A(t)
-        rt = inner(At, t, self.work)
-        if self.pbar is not None:
-            rt -= on.mean(At) * float(t.sum())
+        T = self.A.transform(t)
+        rt = self.A.energy(T, t)
         if rt <= 0:            # no descent left: converged if complementary (a uniform start on a flat gap)
             self.steps -= 1
             self.residuals.append(on.residual(self.g, shift, self.gscale))
@@ -302,23 +383,18 @@ class _Iteration:
         trial += p
         clipped = float(trial.min()) < 0.0
         np.maximum(trial, 0.0, out=p)
-        back = (p == 0.0) & (self.g < shift)
-        self.conjugate = not back.any()
-        # a step that clips nothing and puts nothing back moves A p along A t: no operator application needed
-        linear = self.conjugate and self.steps % REFRESH != 0 and not clipped
-        if not self.conjugate:
-            p[back] -= tau * (self.g[back] - shift)
         scale = self.pbar / p.mean() if self.pbar is not None else 1.0
         p *= scale
+        # a step that clips nothing moves A p along A t (module docstring, cost of a step)
+        linear = self.steps % REFRESH != 0 and not clipped
         if linear:
-            At *= tau
-            self.Ap -= At
+            self.Ap += self.A.from_transform(T, t, -tau)
             self.Ap *= scale
         else:
-            self.Ap = self.apply_A(p)
+            self.Ap = self.A(p)
         res = self.gap_state()
         if res <= max(tol, self.floor()) and linear:
-            self.Ap = self.apply_A(p)    # converged on an updated gap: confirmed on the gap itself
+            self.Ap = self.A(p)    # converged on an updated gap: confirmed on the gap itself
             res = self.gap_state()
         self.residuals.append(res)
         return self.result(self.shift) if res <= max(tol, self.floor()) else None

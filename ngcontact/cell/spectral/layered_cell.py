@@ -38,6 +38,7 @@ import numpy as np
 
 from ngcontact.cell.spectral import grid_measures as measures
 from ngcontact.cell.cell_load import CellLoad
+from ngcontact.cell.spectral.convolution import Convolution
 from ngcontact.cell.spectral.layer_compliance import normal_compliance
 from ngcontact.cell.spectral.fft_threads import fft_workers
 from ngcontact.cell.spectral.frictional_contact import solve_frictional, traction_operator
@@ -166,15 +167,12 @@ class SpectralCell:
         spectrum *= symbol
         return sfft.irfftn(spectrum, s=self.shape, workers=workers, overwrite_x=True)
 
-    def interface_compliance(self, uniform: bool):
-        """``p -> C p (+ p / k_n)``, with or without the uniform mode of ``C``."""
-        sym = self.symbol if uniform else self.fluctuation
+    def interface_compliance(self, uniform: bool) -> Convolution:
+        """``p -> C p (+ p / k_n)``, with or without the uniform mode of ``C``: a
+        :class:`~ngcontact.cell.spectral.convolution.Convolution`, which the constrained CG also asks for its
+        step lengths by Parseval's identity."""
         winkler = 1.0 / self.k_n if self.enforcement == "penalty" else 0.0
-
-        def apply(p):
-            out = self.convolve(p, sym)
-            return out + winkler * p if winkler else out
-        return apply
+        return Convolution(self.symbol if uniform else self.fluctuation, self.shape, winkler)
 
     def poisson_shift(self, macro_strain) -> float:
         """Far-face approach due to an in-plane macro strain at fixed interface state (module docstring)."""
@@ -270,10 +268,10 @@ class SpectralCell:
                 "slip": np.zeros((d - 1,) + self.shape), "far_face_jump": [0.0] * (d - 1) + [approach],
                 "iterations": res.iterations, "residuals": res.residuals}
 
-    def inverse_compliance(self):
+    def inverse_compliance(self) -> Convolution:
         """``r -> (C + 1/k_n)^{-1} r`` with the uniform mode kept: the preconditioner of the constrained CG."""
-        inv = 1.0 / (self.symbol + (1.0 / self.k_n if self.enforcement == "penalty" else 0.0))
-        return lambda r: self.convolve(r, inv)
+        return Convolution(1.0 / (self.symbol + (1.0 / self.k_n if self.enforcement == "penalty" else 0.0)),
+                           self.shape)
 
     def norm(self, uniform: bool) -> float:
         """Largest eigenvalue of :meth:`interface_compliance`: the largest value of its symbol."""
