@@ -38,7 +38,16 @@ its inverse one of order 1, so the preconditioned operator on a subset of
 the grid is spectrally equivalent to the identity up to the restriction's
 ``log^2 N`` factor (as for the interface operators of domain
 decomposition), where ``K`` alone has a condition number of order ``N``.
-The inner tolerance is a share of the outer residual.
+That equivalence fails where the curvature ``D`` dominates a point's own
+compliance ``k_self`` (``K``'s diagonal in real space): a slipping point's
+rim curvature is of the order of ``L``, the compliance of the longest wave,
+which exceeds ``k_self`` by a factor of the order of the grid's points per
+direction, and ``K^{-1}`` (of order 1) multiplies such an entry where the
+operator divides it.  The preconditioner is therefore split
+(:meth:`Preconditioner.for_curvature`): ``1 / (k_self + D)`` on the entries
+``D`` dominates, ``R K_full^{-1} R^T`` on the others, a block-Jacobi
+preconditioner that is still symmetric positive definite.  The inner
+tolerance is a share of the outer residual.
 
 Coulomb friction (a threshold ``G = mu p`` of the unknown pressure) has
 no potential, and with the threshold taken inside each Newton step from
@@ -167,6 +176,15 @@ def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np
     return t, max_steps
 
 
+class Preconditioner(Protocol):
+    """An approximate inverse of ``K`` (``r -> M r``) that splits off the entries a pointwise curvature ``D``
+    dominates (e.g. :class:`~ngcontact.cell.spectral.frictional_contact.TractionPreconditioner`)."""
+
+    def __call__(self, r: np.ndarray) -> np.ndarray: ...
+
+    def for_curvature(self, D: np.ndarray) -> Callable[[np.ndarray], np.ndarray]: ...
+
+
 class Constraints(Protocol):
     """The pointwise terms ``h_i`` (e.g. :class:`~ngcontact.cell.spectral.traction_constraints.TractionConstraints`)."""
 
@@ -194,12 +212,12 @@ class _Point:
 
 
 def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
-                      b: np.ndarray, h: Constraints, precondition: Callable[[np.ndarray], np.ndarray],
+                      b: np.ndarray, h: Constraints, precondition: Preconditioner,
                       t0: np.ndarray, L: float, *, tol: float, scale: float, max_iter: int) -> ProximalResult:
     """The active-set method of the module docstring for the terms ``h`` with their own threshold rule.
 
     ``grad(t) = apply(t) + b`` is the gradient of the smooth part;
-    ``precondition`` an approximate inverse of ``apply``.
+    ``precondition`` an approximate inverse of ``apply``, split for each free problem's curvature.
     """
     residuals: list[float] = []
     steps = 0
@@ -219,7 +237,8 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
             return ProximalResult(t=x.t_hat, shifts=x.shifts, iterations=steps, residuals=residuals)
         atol = max(INNER_SHARE * x.res, 0.2 * tol) * scale
         proj, D = h.linearize(x.t_hat, x.v, x.shifts)
-        t_new, inner_steps = free_minimum(lambda y: apply(y) + D * y, b, x.t_hat, proj, precondition, atol,
+        t_new, inner_steps = free_minimum(lambda y: apply(y) + D * y, b, x.t_hat, proj,
+                                          precondition.for_curvature(D), atol,
                                           max(1, max_iter - steps))
         steps += inner_steps
         # the free minimum, or its projection onto the constraints, whichever has the smaller residual
@@ -234,7 +253,7 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
 
 
 def coulomb_active_set(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
-                       b: np.ndarray, h: Constraints, precondition: Callable[[np.ndarray], np.ndarray],
+                       b: np.ndarray, h: Constraints, precondition: Preconditioner,
                        t0: np.ndarray, L: float, *, tol: float, scale: float, max_iter: int) -> ProximalResult:
     """A threshold that depends on the pressure: an accelerated fixed point of problems with a frozen threshold.
 
