@@ -106,7 +106,7 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float
     if c > 1:                   # Newton on all shifts at once, from the warm start; one sweep at a time below if not
         joint = _joint_shift(clip, s, target, radius, damping, tol)
         if joint is not None:
-            return clip(joint)[0], joint
+            return joint[1], joint[0]
     reach = float(np.max(np.abs(v))) + float(np.max(radius * damping))
     for _ in range(100):
         for a in range(c):
@@ -124,15 +124,22 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float
     raise ConvergenceError(f"the shift that makes the mean shear {target.tolist()} did not converge", {})
 
 
-def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping, tol: float) -> np.ndarray | None:
-    """Newton's method for all the shifts of :func:`prox_friction` at once (``None`` if it stalls)."""
+def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping,
+                 tol: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """Newton's method for all the shifts of :func:`prox_friction` at once: the shifts and their clipped
+    traction (``None`` if it stalls).  An accepted trial's clip is the next step's, so each step clips once
+    where its full step is taken."""
     c = len(s0)
     s = s0.copy()
+
+    def misfit(q):
+        return np.array([float(q[a].mean()) for a in range(c)]) - target
+    clipped = clip(s)
+    r = misfit(clipped[0])
     for _ in range(20):
-        q, z, norm, over = clip(s)
-        r = np.array([float(q[a].mean()) for a in range(c)]) - target
         if float(np.max(np.abs(r))) <= tol:
-            return s
+            return s, clipped[0]
+        q, z, norm, over = clipped
         # d mean(q_a) / d s_b = -mean((1/d) (delta_ab inside; (G/|z|)(delta_ab - z_a z_b / |z|^2) on the rim))
         inv = np.where(over, radius / np.where(over, norm, 1.0), 1.0) / damping
         unit = np.where(over, 1.0 / np.where(over, norm * norm, 1.0), 0.0)
@@ -147,9 +154,10 @@ def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping, tol:
         t = 1.0
         while t > 1e-4:
             trial = s - t * step
-            qt = clip(trial)[0]
-            if float(np.max(np.abs([float(qt[a].mean()) - target[a] for a in range(c)]))) < float(np.max(np.abs(r))):
-                s = trial
+            attempt = clip(trial)
+            r_trial = misfit(attempt[0])
+            if float(np.max(np.abs(r_trial))) < float(np.max(np.abs(r))):
+                s, clipped, r = trial, attempt, r_trial
                 break
             t *= 0.5
         else:
