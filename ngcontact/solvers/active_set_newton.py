@@ -100,6 +100,8 @@ STALL_PASSES = 2
 ANDERSON_DEPTH = 5
 #: inner tolerance: this share of the outer residual
 INNER_SHARE = 0.05
+#: a projection that moves no entry by more than this share of the largest is the point itself (round-off)
+SAME_POINT = 1e-13
 
 
 def traction_projector(pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, t_hat: np.ndarray,
@@ -114,30 +116,32 @@ def traction_projector(pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, 
     (the projection ``y - Pi lambda`` with ``(sum_i Pi_i) lambda = sum_i y_i``).
     """
     d = t_hat.shape[0]
-    turn = None
+    on = np.zeros(stick.shape, bool)
+    turn = np.zeros((2, 0))
     if d == 3:
         q = t_hat[:2]
-        norm = np.sqrt(np.sum(q * q, axis=0))
+        norm = np.hypot(q[0], q[1])
         on = rim & (norm > 0)
-        turn = np.where(on, np.stack([-q[1], q[0]]) / np.where(on, norm, 1.0), 0.0)
+        turn = np.stack([-q[1][on], q[0][on]]) / norm[on]    # n_perp at the turning points only (few)
+    stick_f, pressed_f = stick.astype(float), pressed.astype(float)
 
     def shear(x):
-        y = np.where(stick, x, 0.0)
-        if turn is not None:
-            y = y + np.sum(x * turn, axis=0) * turn
+        y = x * stick_f
+        if turn.shape[1]:
+            y[:, on] = np.sum(x[:, on] * turn, axis=0) * turn     # stick and rim are disjoint
         return y
     n_p = int(np.count_nonzero(pressed))
-    if turn is not None and constrained[0]:
-        M = np.eye(2) * float(np.count_nonzero(stick)) + np.einsum("aij,bij->ab", turn, turn)
-        M_inv = np.linalg.pinv(M)
+    if d == 3 and constrained[0]:
+        M_inv = np.linalg.pinv(np.eye(2) * float(np.count_nonzero(stick)) + turn @ turn.T)
     elif constrained[0]:
         M_inv = np.array([[1.0 / max(int(np.count_nonzero(stick)), 1)]])
 
     def proj(x: np.ndarray) -> np.ndarray:
         y = np.empty_like(x)
-        y[d - 1] = np.where(pressed, x[d - 1], 0.0)
+        np.multiply(x[d - 1], pressed_f, out=y[d - 1])
         if constrained[d - 1] and n_p:
-            y[d - 1] = np.where(pressed, y[d - 1] - float(y[d - 1].sum()) / n_p, 0.0)
+            y[d - 1] -= float(y[d - 1].sum()) / n_p
+            y[d - 1] *= pressed_f
         y[:d - 1] = shear(x[:d - 1])
         if constrained[0]:
             lam = M_inv @ y[:d - 1].reshape(d - 1, -1).sum(axis=1)
@@ -241,8 +245,13 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
                                           precondition.for_curvature(D), atol,
                                           max(1, max_iter - steps))
         steps += inner_steps
-        # the free minimum, or its projection onto the constraints, whichever has the smaller residual
-        x = min(evaluate(t_new, x.shifts), evaluate(h.project(t_new, x.shifts), x.shifts), key=lambda y: y.res)
+        # the free minimum, or its projection onto the constraints, whichever has the smaller residual (one
+        # evaluation where the free minimum is admissible already: the projection is the same point)
+        projected = h.project(t_new, x.shifts)
+        free = evaluate(t_new, x.shifts)
+        if float(np.max(np.abs(projected - t_new))) > SAME_POINT * float(np.max(np.abs(t_new))):
+            free = min(free, evaluate(projected, x.shifts), key=lambda y: y.res)
+        x = free
         best, since_best = (x.res, 0) if x.res < best else (best, since_best + 1)
     if steps >= max_iter:
         raise ConvergenceError(f"active-set Newton: the residual ({residuals[-1]:.3g}, relative to the gap scale) "

@@ -87,11 +87,17 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float
     """
     c = v.shape[0]
 
+    radius = np.broadcast_to(radius, v.shape[1:])
+
     def clip(s):
-        z = (v - s.reshape((c,) + (1,) * (v.ndim - 1))) / damping
-        norm = np.sqrt(np.sum(z * z, axis=0))
+        z = v - s.reshape((c,) + (1,) * (v.ndim - 1))
+        if not (np.isscalar(damping) and damping == 1.0):
+            z /= damping
+        norm = np.hypot(z[0], z[1]) if c == 2 else np.sqrt(np.sum(z * z, axis=0))
         over = norm > radius
-        return z * np.where(over, radius / np.where(over, norm, 1.0), 1.0), z, norm, over
+        q = z.copy()
+        q[:, over] *= radius[over] / norm[over]       # the points outside the disc (few) onto its rim
+        return q, z, norm, over
 
     s = np.zeros(c) if (mean is None or shift0 is None) else np.asarray(shift0, float).copy()
     if mean is None:
@@ -140,13 +146,13 @@ def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping,
         if float(np.max(np.abs(r))) <= tol:
             return s, clipped[0]
         q, z, norm, over = clipped
-        # d mean(q_a) / d s_b = -mean((1/d) (delta_ab inside; (G/|z|)(delta_ab - z_a z_b / |z|^2) on the rim))
-        inv = np.where(over, radius / np.where(over, norm, 1.0), 1.0) / damping
-        unit = np.where(over, 1.0 / np.where(over, norm * norm, 1.0), 0.0)
-        jac = np.empty((c, c))
-        for a in range(c):
-            for b in range(c):
-                jac[a, b] = -float(np.mean(inv * ((1.0 if a == b else 0.0) - unit * z[a] * z[b])))
+        # d mean(q_a) / d s_b = -mean((1/d) (delta_ab inside; (G/|z|)(delta_ab - z_a z_b / |z|^2) on the rim)),
+        # summed over the points inside the disc and over the (few) outside it apart
+        inv_d = np.broadcast_to(1.0 / np.asarray(damping, float), norm.shape)
+        inside = float(inv_d[~over].sum())
+        w = radius[over] / norm[over] * inv_d[over]
+        u = z[:, over] / norm[over]
+        jac = -(np.eye(c) * (inside + float(w.sum())) - np.einsum("k,ak,bk->ab", w, u, u)) / norm.size
         try:
             step = np.linalg.solve(jac, r)
         except np.linalg.LinAlgError:
