@@ -177,7 +177,8 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
         return apply(t) + b
 
     h = TractionConstraints(cell.shape, lambda p: f.threshold(p), L, None if exact else f.w,
-                            None if exact else cell.k_n, mean_p, mean_q)
+                            None if exact else cell.k_n, mean_p, mean_q,
+                            slope=f.affine_parts()[1] if f.couples_to_pressure else 0.0)
     if cell.friction_method == "proximal":
         res = fista(grad, h.prox, t0, L, tol=cell.tol, scale=scale, max_iter=cell.max_iter)
     else:
