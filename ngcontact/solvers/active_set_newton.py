@@ -189,7 +189,8 @@ def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np
 
     Projected preconditioned conjugate gradients from ``t`` (which meets the
     mean constraints) until the projected gradient is below ``atol`` in the
-    maximum norm.  Returns ``(t, steps)``.
+    maximum norm.  Returns ``(t, steps)``, ``steps`` the operator applications (the start's gradient
+    included).
     """
     t = t.copy()
     r = proj(apply(t) + b)
@@ -198,18 +199,18 @@ def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np
     d = z
     for step in range(1, max_steps + 1):
         if float(np.max(np.abs(r))) <= atol or rz <= 0:
-            return t, step - 1
+            return t, step
         Ad = proj(apply(d))
         dAd = inner(d, Ad)
         if dAd <= 0:
-            return t, step - 1
+            return t, step
         alpha = rz / dAd
         t -= alpha * d
         r -= alpha * Ad
         z = proj(precondition(r))
         rz, rz_old = inner(r, z), rz
         d = z + (rz / rz_old) * d
-    return t, max_steps
+    return t, max_steps + 1
 
 
 def coupled_step(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np.ndarray,
@@ -222,16 +223,16 @@ def coupled_step(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np
     operator is not symmetric: restarted GMRES (Saad & Schultz, SIAM J. Sci. Stat. Comput. 7 (1986)
     856-869), preconditioned from the right by ``proj M``, until the projected gradient is below ``atol`` in
     the maximum norm (its Euclidean norm, which GMRES minimizes, below the same share of its start inside a
-    cycle).  Returns ``(t + lift(u), steps)``.
+    cycle; the gradient after a cycle is the Krylov basis times ``H y``, not a new application).  Returns
+    ``(t + lift(u), steps)``, ``steps`` the operator applications (the start's gradient included).
     """
     u = np.zeros_like(t)
-    steps = 0
     r = proj(apply(t) + b)
+    steps = 1
     while steps < max_steps and float(np.max(np.abs(r))) > atol:
         beta = float(np.sqrt(inner(r, r)))
         target = beta * atol / float(np.max(np.abs(r)))
         basis, H = [-r / beta], np.zeros((GMRES_RESTART + 1, GMRES_RESTART))
-        y = np.zeros(0)
         for j in range(min(GMRES_RESTART, max_steps - steps)):
             w = proj(apply(lift(proj(precondition(basis[j])))))
             steps += 1
@@ -239,14 +240,15 @@ def coupled_step(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np
                 H[i, j] = inner(w, v)
                 w -= H[i, j] * v
             H[j + 1, j] = float(np.sqrt(inner(w, w)))
+            basis.append(w / max(H[j + 1, j], 1e-300))
             e1 = np.zeros(j + 2)
             e1[0] = beta
             y, *_ = np.linalg.lstsq(H[:j + 2, :j + 1], e1, rcond=None)
             if float(np.linalg.norm(H[:j + 2, :j + 1] @ y - e1)) <= target or H[j + 1, j] <= 1e-300:
                 break
-            basis.append(w / H[j + 1, j])
         u += proj(precondition(sum(c * v for c, v in zip(y, basis))))
-        r = proj(apply(t + lift(u)) + b)
+        # the new gradient without an application: A M V_j y = V_(j+1) H y, and basis[0] = -r / beta
+        r = r + sum(c * v for c, v in zip(H[:j + 2, :j + 1] @ y, basis))
     return t + lift(u), steps
 
 
