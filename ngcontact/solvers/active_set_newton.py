@@ -28,8 +28,8 @@ this is the semismooth Newton step.  Every slipping point turns, also one
 far outside the disc, whose large curvature the split preconditioner below
 takes (held instead, such a point would converge only as fast as the
 proximal-gradient map turns it, by ``G / |z|`` per step).  Of the free
-minimum and its projection onto the constraints, the one with the smaller
-residual is the next iterate.
+minimum's projection onto the constraints is the next iterate, or the free
+minimum itself where only that lowers the residual.
 
 The free problem is solved by projected conjugate gradients
 preconditioned by ``R K_full^{-1} R^T`` (``R`` the restriction to the free
@@ -321,13 +321,13 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
                                          precondition.for_curvature(D), atol,
                                           max(1, max_iter - steps))
         steps += inner_steps
-        # the free minimum, or its projection onto the constraints, whichever has the smaller residual (one
-        # evaluation where the free minimum is admissible already: the projection is the same point)
+        # the projection of the free minimum onto the constraints; where it does not lower the residual, the
+        # free minimum itself if that does (not evaluated where the projection is the same point)
         projected = h.project(t_new, x.shifts)
-        free = evaluate(t_new, x.shifts)
-        if float(np.max(np.abs(projected - t_new))) > SAME_POINT * float(np.max(np.abs(t_new))):
-            free = min(free, evaluate(projected, x.shifts), key=lambda y: y.res)
-        x = free
+        step = evaluate(projected, x.shifts)
+        if step.res >= x.res and float(np.max(np.abs(projected - t_new))) > SAME_POINT * float(np.max(np.abs(t_new))):
+            step = min(step, evaluate(t_new, x.shifts), key=lambda y: y.res)
+        x = step
         best, since_best = (x.res, 0) if x.res < best else (best, since_best + 1)
     if steps >= max_iter:
         raise ConvergenceError(f"active-set Newton: the residual ({residuals[-1]:.3g}, relative to the gap scale) "

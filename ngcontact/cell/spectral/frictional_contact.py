@@ -75,7 +75,11 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
 
 def _full_compliance(cell) -> np.ndarray:
     """``K(k) = C_rough + C_counter`` on the half spectrum, shape ``(*kshape, d, d)``, the coupling zeroed on
-    the Nyquist rows."""
+    the Nyquist rows: a new array, computed once per cell (:meth:`~.layered_cell.SpectralCell.cached`)."""
+    return cell.cached(("full compliance",), lambda: _layers_compliance(cell)).copy()
+
+
+def _layers_compliance(cell) -> np.ndarray:
     import scipy.fft as sfft
     d = cell.dim
     n = cell.grid
@@ -183,7 +187,7 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
         res = fista(grad, h.prox, t0, L, tol=cell.tol, scale=scale, max_iter=cell.max_iter)
     else:
         solver = coulomb_active_set if f.couples_to_pressure else active_set_newton
-        res = solver(grad, apply, b, h, TractionPreconditioner(cell, 0.0 if exact else 1.0 / cell.k_n), t0, L,
+        res = solver(grad, apply, b, h, cell.traction_preconditioner(0.0 if exact else 1.0 / cell.k_n), t0, L,
                      tol=cell.tol, scale=scale, max_iter=cell.max_iter)
     t = res.t
     sp, sq = res.shifts
