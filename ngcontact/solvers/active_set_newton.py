@@ -141,7 +141,7 @@ class FreeDirections:
         self.turn = np.zeros((d - 1, 0))
         if d == 3:
             q = t_hat[:2]
-            norm = np.hypot(q[0], q[1])
+            norm = np.sqrt(q[0] * q[0] + q[1] * q[1])
             self.on = rim & (norm > 0)
             self.turn = np.stack([-q[1][self.on], q[0][self.on]]) / norm[self.on]    # n_perp where turning (few)
         self.stick_f, self.pressed_f = stick.astype(float), pressed.astype(float)

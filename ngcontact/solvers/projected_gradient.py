@@ -93,7 +93,7 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float
         z = v - s.reshape((c,) + (1,) * (v.ndim - 1))
         if not (np.isscalar(damping) and damping == 1.0):
             z /= damping
-        norm = np.hypot(z[0], z[1]) if c == 2 else np.sqrt(np.sum(z * z, axis=0))
+        norm = np.sqrt(z[0] * z[0] + z[1] * z[1] if c == 2 else z[0] * z[0])     # 0 where z * z underflows
         over = norm > radius
         q = z.copy()
         q[:, over] *= radius[over] / norm[over]       # the points outside the disc (few) onto its rim

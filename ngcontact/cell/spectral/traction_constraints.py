@@ -96,7 +96,7 @@ class TractionConstraints:
             # every rim point turns: a large curvature (a point far outside the disc) is the split
             # preconditioner's diagonal block (:meth:`~.frictional_contact.TractionPreconditioner.for_curvature`)
             turning = rim
-            D[:2] += np.where(rim, self.L * np.maximum(np.hypot(z[0], z[1]) / safe - 1.0, 0.0), 0.0)
+            D[:2] += np.where(rim, self.L * np.maximum(np.sqrt(z[0] * z[0] + z[1] * z[1]) / safe - 1.0, 0.0), 0.0)
         constrained = (self.mean_q is not None,) * (d - 1) + (self.mean_p is not None,)
         free = traction_projector(t_hat[d - 1] > 0, stick, turning, t_hat, constrained)
         return free, D, (self._lift(t_hat, rim, free) if self.slope > 0 else None)
