@@ -11,12 +11,14 @@ sampled on the coarser grids, between dissimilar finite layers (``E = 1, 3``,
   the contact set (:mod:`ngcontact.solvers.constrained_cg`).
 * **coulomb**: exact Coulomb friction (``mu = 0.5``) under the pressure ``p0`` and a mean shear ``0.2 p0``; the
   former solver is accelerated proximal gradients (:mod:`ngcontact.solvers.projected_gradient`), the current one
-  the active-set method (:mod:`ngcontact.solvers.active_set_newton`: the threshold's fixed point of Tresca
-  problems, Anderson-accelerated, then Newton steps with the law's own threshold).
+  the active-set method (:mod:`ngcontact.solvers.active_set_newton`: semismooth Newton steps of the coupled law,
+  each a GMRES solve preconditioned by the split inverse compliance, with the Anderson-accelerated fixed point of
+  Tresca problems as its fallback).
 
 Each run is a child process, so its peak resident memory is its own.  ``steps``
 counts CG steps (frictionless, summed over the loads) or operator applications
-(friction).  Tamaas' frictional solvers are not run: the log and the
+(friction: every application of the 3-component operator, the frictionless start's one-component CG
+steps not included).  Tamaas' frictional solvers are not run: the log and the
 published note say why (the ``bench`` extra missing, or the rows not written
 yet: Tamaas solves one half-space against a rigid surface, not two finite
 layers, so only its steps and time would compare).
@@ -24,11 +26,11 @@ layers, so only its steps and time would compare).
 Usage::
 
     python scripts/spectral_friction_speed.py [OUT_DIR] [--grids 256 512 1024] [--old-max-grid 512]
-        [--coulomb-max-grid 1024] [--publish]
+        [--coulomb-max-grid 1024] [--cases frictionless coulomb] [--publish]
 
 ``--old-max-grid``: the largest grid on which the former frictional solver is
 run (it needs thousands of steps beyond it); ``--coulomb-max-grid``: the same
-for the current one.
+for the current one; ``--cases``: the cases run (default both).
 """
 from __future__ import annotations
 
@@ -51,6 +53,7 @@ log = logging.getLogger("spectral_friction_speed")
 FINEST = 1024
 P0 = 0.05 * 1.0 / (2 * (1 - 0.3 ** 2)) * 0.1
 MU, SHEAR, TOL = 0.5, 0.2, 1e-10
+CASES = ("frictionless", "coulomb")
 KEYS = ("case", "grid", "solver", "steps", "seconds", "peak_memory_gb", "contact_fraction", "slip_fraction")
 
 
@@ -129,16 +132,19 @@ def plot(rows: list[dict], path: str) -> None:
     plt.close(fig)
 
 
-def publish(csv_path: str, png: str, reason: str | None, command: str | None = None) -> None:
+def publish(csv_path: str, png: str, reason: str | None, cases=CASES, command: str | None = None) -> None:
     """This study's section of ``docs/benchmarks.md`` from its CSV and PNG."""
+    only = "" if set(cases) == set(CASES) else f"Only the {', '.join(cases)} rows were run this time. "
     benchmark_doc.publish(
         "spectral_friction_speed", "Spectral cell: frictionless and Coulomb solvers, former and current", csv_path,
         note="Random self-affine map between dissimilar finite layers, exact contact, tolerance 1e-10. "
              "frictionless: three loads (p0/4, p0, 4 p0), steps summed; coulomb: exact Coulomb mu = 0.5 under "
-             "p0 and a mean shear 0.2 p0, steps = operator applications. former: plain constrained CG and "
-             "accelerated proximal gradients; current: preconditioned constrained CG and the active-set method "
-             "(Coulomb: Anderson-accelerated threshold fixed point, then coupled Newton steps). Timings taken on "
-             "2 cores shared with other jobs: compare rows of one run, not absolute seconds. "
+             "p0 and a mean shear 0.2 p0, steps = applications of the 3-component operator (two FFT pairs per "
+             "Krylov step with its preconditioner). former: plain constrained CG and accelerated proximal "
+             "gradients; current: preconditioned constrained CG and the active-set method (Coulomb: semismooth "
+             "Newton steps of the coupled law by preconditioned GMRES, the Anderson-accelerated fixed point of "
+             "Tresca problems as fallback). Timings taken on 2 cores shared with other jobs: compare rows of one "
+             "run, not absolute seconds; the step counts do not depend on the load. " + only +
              "Aims (issue 38): Coulomb at 1024^2 <= 30 s and <= 2 GB, frictionless three loads <= 15 s. "
              f"Peer: {reason or 'Tamaas run'}.",
         png=png, command=command)
@@ -150,6 +156,7 @@ def main(argv=None) -> int:
     ap.add_argument("--grids", type=int, nargs="+", default=[256, 512, 1024])
     ap.add_argument("--old-max-grid", type=int, default=512)
     ap.add_argument("--coulomb-max-grid", type=int, default=FINEST)
+    ap.add_argument("--cases", nargs="+", choices=CASES, default=list(CASES))
     ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
@@ -161,7 +168,7 @@ def main(argv=None) -> int:
     os.makedirs(args.out, exist_ok=True)
     csv_path = os.path.join(args.out, "spectral_friction_speed.csv")
     for n in args.grids:
-        for case in ("frictionless", "coulomb"):
+        for case in args.cases:
             for solver in ("former", "current"):
                 if case == "coulomb" and n > (args.old_max_grid if solver == "former" else args.coulomb_max_grid):
                     log.info("coulomb %d^2 %s: skipped (above --old-max-grid %d or --coulomb-max-grid %d)", n, solver,
@@ -175,7 +182,7 @@ def main(argv=None) -> int:
     png = os.path.join(args.out, "spectral_friction_speed.png")
     plot(rows, png)
     if args.publish:
-        publish(csv_path, png, reason)
+        publish(csv_path, png, reason, args.cases)
     return 0
 
 

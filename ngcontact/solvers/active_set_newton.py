@@ -24,10 +24,12 @@ the mean constraints: a symmetric positive definite problem.  In 3D a
 slipping point keeps one free direction, the tangent ``n_perp`` of the
 friction disc, with the rim's curvature ``L (|z| / G - 1)`` as its diagonal
 (the derivative of ``q = G z / |z|`` across ``z``); for a given threshold
-this is the semismooth Newton step.  A point far outside the disc
-(``|z| > 2 G``) is held entirely: its turn is small and its curvature would
-spoil the conditioning.  Of the free minimum and its projection onto the
-constraints, the one with the smaller residual is the next iterate.
+this is the semismooth Newton step.  Every slipping point turns, also one
+far outside the disc, whose large curvature the split preconditioner below
+takes (held instead, such a point would converge only as fast as the
+proximal-gradient map turns it, by ``G / |z|`` per step).  Of the free
+minimum's projection onto the constraints is the next iterate, or the free
+minimum itself where only that lowers the residual.
 
 The free problem is solved by projected conjugate gradients
 preconditioned by ``R K_full^{-1} R^T`` (``R`` the restriction to the free
@@ -38,26 +40,49 @@ its inverse one of order 1, so the preconditioned operator on a subset of
 the grid is spectrally equivalent to the identity up to the restriction's
 ``log^2 N`` factor (as for the interface operators of domain
 decomposition), where ``K`` alone has a condition number of order ``N``.
-The inner tolerance is a share of the outer residual.
+That equivalence fails where the curvature ``D`` dominates a point's own
+compliance ``k_self`` (``K``'s diagonal in real space): a slipping point's
+rim curvature is of the order of ``L``, the compliance of the longest wave,
+which exceeds ``k_self`` by a factor of the order of the grid's points per
+direction, and ``K^{-1}`` (of order 1) multiplies such an entry where the
+operator divides it.  The preconditioner is therefore split
+(:meth:`Preconditioner.for_curvature`): ``1 / (k_self + D)`` on the entries
+``D`` dominates, ``R K_full^{-1} R^T`` on the others, a block-Jacobi
+preconditioner that is still symmetric positive definite.  The inner
+tolerance is a share of the outer residual.
 
 Coulomb friction (a threshold ``G = mu p`` of the unknown pressure) has
-no potential, and with the threshold taken inside each Newton step from
-the start the 3D active sets cycle (at a residual of a few percent on a
-random map between dissimilar layers).  :func:`coulomb_active_set`
-therefore solves the fixed point ``G = mu p(G)`` of Tresca problems (of
-Panagiotopoulos and of Kalker's codes; each pass a frozen-threshold
-problem, warm-started, to a hundredth of the current residual), with the
-threshold of each pass the Anderson combination of the previous ones
-(:mod:`ngcontact.solvers.anderson`): the plain fixed point contracts
-slowly where the normal-tangential coupling of dissimilar layers is strong
-(and not at all on fine grids), the few slow modes of the threshold being
-what the combination removes.  Once it makes no progress, the iterate is
-close enough for the semismooth Newton step of the law itself (the
-threshold of each step's own proximal pressure), whose active sets then
-settle.  Neither loop is guaranteed to converge globally: a Coulomb fixed
-point without progress in ``STALL_PASSES`` passes goes on with the coupled
-Newton steps, and an active-set solve that makes no new best residual in
-``STALL`` steps goes on with accelerated proximal gradients
+no potential.  Its semismooth Newton step keeps what the threshold's
+dependence adds to the derivative of the proximal map: at a slipping point
+``q = G(p) z / |z|`` moves with the pressure by ``(dG/dp) n dp``, so a free
+pressure there carries the shear along (``lift``, with the mean shear
+restored over the free shear), while the equations kept are those of the
+free directions (the normal gap, the stick and the turning shear), not the
+gap along the slip.  The step's linear problem is then not symmetric, and
+:func:`coupled_step` solves it by GMRES with the same split preconditioner
+(from the right).  Without that term (the threshold frozen within a step)
+the 3D active sets cycle from a residual of a few percent on a random map
+between dissimilar layers, and the method needed a fixed point of Tresca
+problems first; with it the Newton steps converge from the frictionless
+start.  This is the choice among the frictional solvers of spectral codes:
+an alternation of normal and frozen-threshold tangential problems (the
+Panagiotopoulos process of Kalker's codes; a tangential problem of given
+pressure solved by a Polonsky-Keer-type constrained CG on the stick set, as
+in Tamaas' ``PolonskyKeerTan``) converges linearly in the Coulomb coupling,
+slowly where dissimilar layers couple pressure and shear strongly;
+projected or primal-dual first-order iterations (Tamaas' ``Kato`` and
+``Condat``) need ``O(sqrt(kappa))`` or more steps per digit; the Newton
+step of the coupled law needs a few Krylov steps per active-set step and
+converges superlinearly once the sets settle.  :func:`coulomb_active_set`
+keeps the former method as its fallback: where the coupled Newton steps
+stall, the fixed point ``G = mu p(G)`` of Tresca problems (each pass a
+frozen-threshold problem, warm-started, to a hundredth of the current
+residual), with the threshold of each pass the Anderson combination of the
+previous ones (:mod:`ngcontact.solvers.anderson`), then the coupled Newton
+steps again.  Neither loop is guaranteed to converge globally: a Coulomb
+fixed point without progress in ``STALL_PASSES`` passes goes on with the
+coupled Newton steps, and an active-set solve that makes no new best
+residual in ``STALL`` steps goes on with accelerated proximal gradients
 (:func:`~ngcontact.solvers.projected_gradient.fista`) from its last
 iterate, so the answer is always the one of that method.
 
@@ -70,6 +95,7 @@ evaluations plus inner steps), the unit of
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from typing import Callable, Protocol
 
 import numpy as np
@@ -91,10 +117,13 @@ STALL_PASSES = 2
 ANDERSON_DEPTH = 5
 #: inner tolerance: this share of the outer residual
 INNER_SHARE = 0.05
+#: Krylov vectors of a cycle of the coupled Newton step's GMRES (:func:`coupled_step`)
+GMRES_RESTART = 20
+#: a projection that moves no entry by more than this share of the largest is the point itself (round-off)
+SAME_POINT = 1e-13
 
 
-def traction_projector(pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, t_hat: np.ndarray,
-                       constrained: tuple[bool, ...]) -> Callable[[np.ndarray], np.ndarray]:
+class FreeDirections:
     """The orthogonal projector onto the free directions of a proximal point ``t_hat = (q, p)``.
 
     Free: the pressure where ``pressed``; the whole shear where ``stick``; at
@@ -104,37 +133,53 @@ def traction_projector(pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, 
     on each component group of prescribed mean, in addition, the sum zero
     (the projection ``y - Pi lambda`` with ``(sum_i Pi_i) lambda = sum_i y_i``).
     """
-    d = t_hat.shape[0]
-    turn = None
-    if d == 3:
-        q = t_hat[:2]
-        norm = np.sqrt(np.sum(q * q, axis=0))
-        on = rim & (norm > 0)
-        turn = np.where(on, np.stack([-q[1], q[0]]) / np.where(on, norm, 1.0), 0.0)
 
-    def shear(x):
-        y = np.where(stick, x, 0.0)
-        if turn is not None:
-            y = y + np.sum(x * turn, axis=0) * turn
+    def __init__(self, pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, t_hat: np.ndarray,
+                 constrained: tuple[bool, ...]):
+        d = self.d = t_hat.shape[0]
+        self.on = np.zeros(stick.shape, bool)
+        self.turn = np.zeros((d - 1, 0))
+        if d == 3:
+            q = t_hat[:2]
+            norm = np.sqrt(q[0] * q[0] + q[1] * q[1])
+            self.on = rim & (norm > 0)
+            self.turn = np.stack([-q[1][self.on], q[0][self.on]]) / norm[self.on]    # n_perp where turning (few)
+        self.stick_f, self.pressed_f = stick.astype(float), pressed.astype(float)
+        self.n_p = int(np.count_nonzero(pressed))
+        self.constrained = constrained
+        self.M_inv = np.linalg.pinv(np.eye(d - 1) * float(max(np.count_nonzero(stick), d == 2))
+                                    + self.turn @ self.turn.T) if constrained[0] else None
+
+    def shear(self, x: np.ndarray) -> np.ndarray:
+        y = x * self.stick_f
+        if self.turn.shape[1]:
+            y[:, self.on] = np.sum(x[:, self.on] * self.turn, axis=0) * self.turn     # stick, rim disjoint
         return y
-    n_p = int(np.count_nonzero(pressed))
-    if turn is not None and constrained[0]:
-        M = np.eye(2) * float(np.count_nonzero(stick)) + np.einsum("aij,bij->ab", turn, turn)
-        M_inv = np.linalg.pinv(M)
-    elif constrained[0]:
-        M_inv = np.array([[1.0 / max(int(np.count_nonzero(stick)), 1)]])
 
-    def proj(x: np.ndarray) -> np.ndarray:
+    def mean_free(self, total: np.ndarray) -> np.ndarray:
+        """The free shear ``Pi lambda`` whose sum over the grid is ``total`` (prescribed mean shear only)."""
+        assert self.M_inv is not None
+        d = self.d
+        lam = self.M_inv @ total
+        return self.shear(np.broadcast_to(lam.reshape((d - 1,) + (1,) * (d - 1)), (d - 1,) + self.stick_f.shape))
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        d = self.d
         y = np.empty_like(x)
-        y[d - 1] = np.where(pressed, x[d - 1], 0.0)
-        if constrained[d - 1] and n_p:
-            y[d - 1] = np.where(pressed, y[d - 1] - float(y[d - 1].sum()) / n_p, 0.0)
-        y[:d - 1] = shear(x[:d - 1])
-        if constrained[0]:
-            lam = M_inv @ y[:d - 1].reshape(d - 1, -1).sum(axis=1)
-            y[:d - 1] -= shear(np.broadcast_to(lam.reshape((d - 1,) + (1,) * (d - 1)), y[:d - 1].shape))
+        np.multiply(x[d - 1], self.pressed_f, out=y[d - 1])
+        if self.constrained[d - 1] and self.n_p:
+            y[d - 1] -= float(y[d - 1].sum()) / self.n_p
+            y[d - 1] *= self.pressed_f
+        y[:d - 1] = self.shear(x[:d - 1])
+        if self.constrained[0]:
+            y[:d - 1] -= self.mean_free(y[:d - 1].reshape(d - 1, -1).sum(axis=1))
         return y
-    return proj
+
+
+def traction_projector(pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, t_hat: np.ndarray,
+                       constrained: tuple[bool, ...]) -> FreeDirections:
+    """The projector onto the free directions of ``t_hat`` (:class:`FreeDirections`)."""
+    return FreeDirections(pressed, stick, rim, t_hat, constrained)
 
 
 def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np.ndarray,
@@ -144,7 +189,8 @@ def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np
 
     Projected preconditioned conjugate gradients from ``t`` (which meets the
     mean constraints) until the projected gradient is below ``atol`` in the
-    maximum norm.  Returns ``(t, steps)``.
+    maximum norm.  Returns ``(t, steps)``, ``steps`` the operator applications (the start's gradient
+    included).
     """
     t = t.copy()
     r = proj(apply(t) + b)
@@ -153,18 +199,66 @@ def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np
     d = z
     for step in range(1, max_steps + 1):
         if float(np.max(np.abs(r))) <= atol or rz <= 0:
-            return t, step - 1
+            return t, step
         Ad = proj(apply(d))
         dAd = inner(d, Ad)
         if dAd <= 0:
-            return t, step - 1
+            return t, step
         alpha = rz / dAd
         t -= alpha * d
         r -= alpha * Ad
         z = proj(precondition(r))
         rz, rz_old = inner(r, z), rz
         d = z + (rz / rz_old) * d
-    return t, max_steps
+    return t, max_steps + 1
+
+
+def coupled_step(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np.ndarray,
+                 proj: Callable[[np.ndarray], np.ndarray], precondition: Callable[[np.ndarray], np.ndarray],
+                 atol: float, max_steps: int, *, lift: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, int]:
+    """The Newton step of a threshold that follows the pressure: ``proj(A (t + lift(u)) + b) = 0`` for ``u`` in
+    the free directions.
+
+    ``lift`` moves the shear of a slipping point with its pressure (``dG/dp`` times the slip direction), so the
+    operator is not symmetric: restarted GMRES (Saad & Schultz, SIAM J. Sci. Stat. Comput. 7 (1986)
+    856-869), preconditioned from the right by ``proj M``, until the projected gradient is below ``atol`` in
+    the maximum norm (its Euclidean norm, which GMRES minimizes, below the same share of its start inside a
+    cycle; the gradient after a cycle is the Krylov basis times ``H y``, not a new application).  Returns
+    ``(t + lift(u), steps)``, ``steps`` the operator applications (the start's gradient included).
+    """
+    u = np.zeros_like(t)
+    r = proj(apply(t) + b)
+    steps = 1
+    while steps < max_steps and float(np.max(np.abs(r))) > atol:
+        beta = float(np.sqrt(inner(r, r)))
+        target = beta * atol / float(np.max(np.abs(r)))
+        basis, H = [-r / beta], np.zeros((GMRES_RESTART + 1, GMRES_RESTART))
+        for j in range(min(GMRES_RESTART, max_steps - steps)):
+            w = proj(apply(lift(proj(precondition(basis[j])))))
+            steps += 1
+            for i, v in enumerate(basis):
+                H[i, j] = inner(w, v)
+                w -= H[i, j] * v
+            H[j + 1, j] = float(np.sqrt(inner(w, w)))
+            basis.append(w / max(H[j + 1, j], 1e-300))
+            e1 = np.zeros(j + 2)
+            e1[0] = beta
+            y, *_ = np.linalg.lstsq(H[:j + 2, :j + 1], e1, rcond=None)
+            if float(np.linalg.norm(H[:j + 2, :j + 1] @ y - e1)) <= target or H[j + 1, j] <= 1e-300:
+                break
+        u += proj(precondition(sum(c * v for c, v in zip(y, basis))))
+        # the new gradient without an application: A M V_j y = V_(j+1) H y, and basis[0] = -r / beta
+        r = r + sum(c * v for c, v in zip(H[:j + 2, :j + 1] @ y, basis))
+    return t + lift(u), steps
+
+
+class Preconditioner(Protocol):
+    """An approximate inverse of ``K`` (``r -> M r``) that splits off the entries a pointwise curvature ``D``
+    dominates (e.g. :class:`~ngcontact.cell.spectral.frictional_contact.TractionPreconditioner`)."""
+
+    def __call__(self, r: np.ndarray) -> np.ndarray: ...
+
+    def for_curvature(self, D: np.ndarray) -> Callable[[np.ndarray], np.ndarray]: ...
 
 
 class Constraints(Protocol):
@@ -194,12 +288,15 @@ class _Point:
 
 
 def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
-                      b: np.ndarray, h: Constraints, precondition: Callable[[np.ndarray], np.ndarray],
-                      t0: np.ndarray, L: float, *, tol: float, scale: float, max_iter: int) -> ProximalResult:
+                      b: np.ndarray, h: Constraints, precondition: Preconditioner,
+                      t0: np.ndarray, L: float, *, tol: float, scale: float, max_iter: int,
+                      fallback: bool = True) -> ProximalResult:
     """The active-set method of the module docstring for the terms ``h`` with their own threshold rule.
 
     ``grad(t) = apply(t) + b`` is the gradient of the smooth part;
-    ``precondition`` an approximate inverse of ``apply``.
+    ``precondition`` an approximate inverse of ``apply``, split for each free problem's curvature.  A solve
+    that stalls goes on with accelerated proximal gradients, or without ``fallback`` returns its last iterate
+    (its last residual above ``tol``).
     """
     residuals: list[float] = []
     steps = 0
@@ -218,27 +315,39 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
         if x.res <= tol:
             return ProximalResult(t=x.t_hat, shifts=x.shifts, iterations=steps, residuals=residuals)
         atol = max(INNER_SHARE * x.res, 0.2 * tol) * scale
-        proj, D = h.linearize(x.t_hat, x.v, x.shifts)
-        t_new, inner_steps = free_minimum(lambda y: apply(y) + D * y, b, x.t_hat, proj, precondition, atol,
+        proj, D, lift = h.linearize(x.t_hat, x.v, x.shifts)
+        newton_step = free_minimum if lift is None else partial(coupled_step, lift=lift)
+        t_new, inner_steps = newton_step(lambda y: apply(y) + D * y, b, x.t_hat, proj,
+                                         precondition.for_curvature(D), atol,
                                           max(1, max_iter - steps))
         steps += inner_steps
-        # the free minimum, or its projection onto the constraints, whichever has the smaller residual
-        x = min(evaluate(t_new, x.shifts), evaluate(h.project(t_new, x.shifts), x.shifts), key=lambda y: y.res)
+        # the projection of the free minimum onto the constraints; where it does not lower the residual, the
+        # free minimum itself if that does (not evaluated where the projection is the same point)
+        projected = h.project(t_new, x.shifts)
+        step = evaluate(projected, x.shifts)
+        if step.res >= x.res and float(np.max(np.abs(projected - t_new))) > SAME_POINT * float(np.max(np.abs(t_new))):
+            step = min(step, evaluate(t_new, x.shifts), key=lambda y: y.res)
+        x = step
         best, since_best = (x.res, 0) if x.res < best else (best, since_best + 1)
     if steps >= max_iter:
         raise ConvergenceError(f"active-set Newton: the residual ({residuals[-1]:.3g}, relative to the gap scale) "
                                f"is above {tol:g} after {steps} steps", {"residuals": residuals[-5:]})
+    if not fallback:
+        return ProximalResult(t=x.t, shifts=x.shifts, iterations=steps, residuals=residuals)
     rest = fista(grad, h.prox, x.t, L, tol=tol, scale=scale, max_iter=max_iter - steps)
     return ProximalResult(t=rest.t, shifts=rest.shifts, iterations=steps + rest.iterations,
                           residuals=residuals + rest.residuals)
 
 
 def coulomb_active_set(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
-                       b: np.ndarray, h: Constraints, precondition: Callable[[np.ndarray], np.ndarray],
+                       b: np.ndarray, h: Constraints, precondition: Preconditioner,
                        t0: np.ndarray, L: float, *, tol: float, scale: float, max_iter: int) -> ProximalResult:
-    """A threshold that depends on the pressure: an accelerated fixed point of problems with a frozen threshold.
+    """A threshold that depends on the pressure: Newton steps of the law itself, else an accelerated fixed point
+    of problems with a frozen threshold.
 
-    Each pass takes the law's threshold ``G(p)`` at the proximal point's
+    First :func:`active_set_newton` on the law itself (its free problems coupled through ``dG/dp``,
+    :func:`coupled_step`); where it stalls, from its last iterate, the fixed point: each pass takes the law's
+    threshold ``G(p)`` at the proximal point's
     pressure, combines it with the earlier passes' (:class:`~ngcontact.solvers.anderson.Anderson`),
     and solves the problem with that threshold frozen (:func:`active_set_newton`,
     warm-started, to ``FIXED_POINT_SHARE`` of the current residual); it stops when the
@@ -246,9 +355,12 @@ def coulomb_active_set(grad: Callable[[np.ndarray], np.ndarray], apply: Callable
     proximal step) meets ``tol``, and goes on with :func:`active_set_newton` on the law
     itself when ``STALL_PASSES`` passes make no progress (module docstring).
     """
-    residuals: list[float] = []
-    steps = 0
-    t, shifts = t0, ()
+    first = active_set_newton(grad, apply, b, h, precondition, t0, L, tol=tol, scale=scale, max_iter=max_iter,
+                              fallback=False)
+    if first.residuals and first.residuals[-1] <= tol:
+        return first
+    residuals, steps = list(first.residuals), first.iterations
+    t, shifts = first.t, ()
     d = t0.shape[0]
     best, since_best = np.inf, 0
     G: np.ndarray | None = None

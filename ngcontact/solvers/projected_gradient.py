@@ -87,11 +87,17 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float
     """
     c = v.shape[0]
 
+    radius = np.broadcast_to(radius, v.shape[1:])
+
     def clip(s):
-        z = (v - s.reshape((c,) + (1,) * (v.ndim - 1))) / damping
-        norm = np.sqrt(np.sum(z * z, axis=0))
+        z = v - s.reshape((c,) + (1,) * (v.ndim - 1))
+        if not (np.isscalar(damping) and damping == 1.0):
+            z /= damping
+        norm = np.sqrt(z[0] * z[0] + z[1] * z[1] if c == 2 else z[0] * z[0])     # 0 where z * z underflows
         over = norm > radius
-        return z * np.where(over, radius / np.where(over, norm, 1.0), 1.0), z, norm, over
+        q = z.copy()
+        q[:, over] *= radius[over] / norm[over]       # the points outside the disc (few) onto its rim
+        return q, z, norm, over
 
     s = np.zeros(c) if (mean is None or shift0 is None) else np.asarray(shift0, float).copy()
     if mean is None:
@@ -106,7 +112,7 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float
     if c > 1:                   # Newton on all shifts at once, from the warm start; one sweep at a time below if not
         joint = _joint_shift(clip, s, target, radius, damping, tol)
         if joint is not None:
-            return clip(joint)[0], joint
+            return joint[1], joint[0]
     reach = float(np.max(np.abs(v))) + float(np.max(radius * damping))
     for _ in range(100):
         for a in range(c):
@@ -124,22 +130,29 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float
     raise ConvergenceError(f"the shift that makes the mean shear {target.tolist()} did not converge", {})
 
 
-def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping, tol: float) -> np.ndarray | None:
-    """Newton's method for all the shifts of :func:`prox_friction` at once (``None`` if it stalls)."""
+def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping,
+                 tol: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """Newton's method for all the shifts of :func:`prox_friction` at once: the shifts and their clipped
+    traction (``None`` if it stalls).  An accepted trial's clip is the next step's, so each step clips once
+    where its full step is taken."""
     c = len(s0)
     s = s0.copy()
+
+    def misfit(q):
+        return np.array([float(q[a].mean()) for a in range(c)]) - target
+    clipped = clip(s)
+    r = misfit(clipped[0])
     for _ in range(20):
-        q, z, norm, over = clip(s)
-        r = np.array([float(q[a].mean()) for a in range(c)]) - target
         if float(np.max(np.abs(r))) <= tol:
-            return s
-        # d mean(q_a) / d s_b = -mean((1/d) (delta_ab inside; (G/|z|)(delta_ab - z_a z_b / |z|^2) on the rim))
-        inv = np.where(over, radius / np.where(over, norm, 1.0), 1.0) / damping
-        unit = np.where(over, 1.0 / np.where(over, norm * norm, 1.0), 0.0)
-        jac = np.empty((c, c))
-        for a in range(c):
-            for b in range(c):
-                jac[a, b] = -float(np.mean(inv * ((1.0 if a == b else 0.0) - unit * z[a] * z[b])))
+            return s, clipped[0]
+        q, z, norm, over = clipped
+        # d mean(q_a) / d s_b = -mean((1/d) (delta_ab inside; (G/|z|)(delta_ab - z_a z_b / |z|^2) on the rim)),
+        # summed over the points inside the disc and over the (few) outside it apart
+        inv_d = np.broadcast_to(1.0 / np.asarray(damping, float), norm.shape)
+        inside = float(inv_d[~over].sum())
+        w = radius[over] / norm[over] * inv_d[over]
+        u = z[:, over] / norm[over]
+        jac = -(np.eye(c) * (inside + float(w.sum())) - np.einsum("k,ak,bk->ab", w, u, u)) / norm.size
         try:
             step = np.linalg.solve(jac, r)
         except np.linalg.LinAlgError:
@@ -147,9 +160,10 @@ def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping, tol:
         t = 1.0
         while t > 1e-4:
             trial = s - t * step
-            qt = clip(trial)[0]
-            if float(np.max(np.abs([float(qt[a].mean()) - target[a] for a in range(c)]))) < float(np.max(np.abs(r))):
-                s = trial
+            attempt = clip(trial)
+            r_trial = misfit(attempt[0])
+            if float(np.max(np.abs(r_trial))) < float(np.max(np.abs(r))):
+                s, clipped, r = trial, attempt, r_trial
                 break
             t *= 0.5
         else:

@@ -9,7 +9,7 @@ identical layers only.  The cell is then the convex problem in tractions of
 solved by the active-set (semismooth Newton) method of
 :mod:`ngcontact.solvers.active_set_newton`: its free problems are solved
 by conjugate gradients preconditioned with the inverse of the full
-compliance per wave vector (:func:`traction_preconditioner`), so the step
+compliance per wave vector (:class:`TractionPreconditioner`), so the step
 count grows like ``log N`` instead of like the ``sqrt(N)`` of accelerated
 proximal gradients (:mod:`ngcontact.solvers.projected_gradient`, kept as
 ``SpectralCell.friction_method = "proximal"`` and as the active-set
@@ -75,7 +75,11 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
 
 def _full_compliance(cell) -> np.ndarray:
     """``K(k) = C_rough + C_counter`` on the half spectrum, shape ``(*kshape, d, d)``, the coupling zeroed on
-    the Nyquist rows."""
+    the Nyquist rows: a new array, computed once per cell (:meth:`~.layered_cell.SpectralCell.cached`)."""
+    return cell.cached(("full compliance",), lambda: _layers_compliance(cell)).copy()
+
+
+def _layers_compliance(cell) -> np.ndarray:
     import scipy.fft as sfft
     d = cell.dim
     n = cell.grid
@@ -93,21 +97,58 @@ def _full_compliance(cell) -> np.ndarray:
     K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
     return K
 
-def traction_preconditioner(cell, winkler: float):
+class TractionPreconditioner:
     """``r -> K_full^{-1} r`` by FFTs: the inverse of the full compliance (uniform modes kept, plus the penalty's
     ``winkler`` on the normal component) per wave vector, the preconditioner of
-    :mod:`ngcontact.solvers.active_set_newton`."""
-    import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
-    d = cell.dim
-    K = _full_compliance(cell)
-    K[..., d - 1, d - 1] += winkler
-    Kinv = np.moveaxis(np.linalg.inv(K), (-2, -1), (0, 1)).copy()
-    axes = tuple(range(1, d))
+    :mod:`ngcontact.solvers.active_set_newton`, and its split for a free problem with a pointwise curvature
+    (:meth:`for_curvature`).
+    """
 
-    def apply(r):
-        R = sfft.rfftn(r, axes=axes, workers=fft_workers())
-        return sfft.irfftn(np.einsum("ab...,b...->a...", Kinv, R), s=cell.shape, axes=axes, workers=fft_workers())
-    return apply
+    def __init__(self, cell, winkler: float):
+        d = cell.dim
+        K = _full_compliance(cell)
+        diagonal = np.real(np.diagonal(K, axis1=-2, axis2=-1))
+        # the real-space diagonal of K: the mean of its symbol over the whole spectrum (the half spectrum of
+        # the real FFT counts its inner columns twice)
+        weight = np.full(K.shape[d - 2], 2.0)
+        weight[0] = 1.0
+        if cell.grid % 2 == 0:
+            weight[-1] = 1.0
+        weight = weight.reshape((1,) * (d - 2) + (-1, 1))
+        #: per component, the compliance of a grid point under its own traction (``K``'s diagonal in real space)
+        self.self_compliance = (weight * diagonal).reshape(-1, d).sum(axis=0) / cell.points
+        self.included = np.zeros(d)
+        self.included[d - 1] = winkler
+        K[..., d - 1, d - 1] += winkler
+        self.Kinv = np.moveaxis(np.linalg.inv(K), (-2, -1), (0, 1)).copy()
+        self.shape, self.axes = cell.shape, tuple(range(1, d))
+
+    def __call__(self, r: np.ndarray) -> np.ndarray:
+        import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process
+        R = sfft.rfftn(r, axes=self.axes, workers=fft_workers())
+        return sfft.irfftn(np.einsum("ab...,b...->a...", self.Kinv, R), s=self.shape, axes=self.axes,
+                           workers=fft_workers())
+
+    def for_curvature(self, D: np.ndarray):
+        """The preconditioner of ``K + D`` (``D`` a pointwise curvature, :mod:`.traction_constraints`).
+
+        Where ``D`` beyond the diagonal already inverted (the penalty's ``winkler``) exceeds a point's
+        self-compliance (a slipping point's rim curvature ``L (|z| / G - 1)``, a Huber term ``w / G`` where
+        ``G`` is small), the operator is dominated by its diagonal there, and ``K^{-1}``, of order 1, would
+        amplify such an entry where it should divide it: those entries are preconditioned by the inverse of
+        the diagonal ``k_self + D``, the others by ``R K^{-1} R^T`` as before.  The two blocks make a
+        symmetric positive definite preconditioner (block Jacobi across the split).
+        """
+        d = D.shape[0]
+        k_self = self.self_compliance.reshape((d,) + (1,) * (d - 1))
+        heavy = D - self.included.reshape(k_self.shape) > k_self
+        if not heavy.any():
+            return self
+        pointwise = 1.0 / (k_self + D)
+
+        def apply(r):
+            return np.where(heavy, r * pointwise, self(np.where(heavy, 0.0, r)))
+        return apply
 
 
 def solve_frictional(cell, load: CellLoad, start) -> dict:
@@ -140,12 +181,13 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
         return apply(t) + b
 
     h = TractionConstraints(cell.shape, lambda p: f.threshold(p), L, None if exact else f.w,
-                            None if exact else cell.k_n, mean_p, mean_q)
+                            None if exact else cell.k_n, mean_p, mean_q,
+                            slope=f.affine_parts()[1] if f.couples_to_pressure else 0.0)
     if cell.friction_method == "proximal":
         res = fista(grad, h.prox, t0, L, tol=cell.tol, scale=scale, max_iter=cell.max_iter)
     else:
         solver = coulomb_active_set if f.couples_to_pressure else active_set_newton
-        res = solver(grad, apply, b, h, traction_preconditioner(cell, 0.0 if exact else 1.0 / cell.k_n), t0, L,
+        res = solver(grad, apply, b, h, cell.traction_preconditioner(0.0 if exact else 1.0 / cell.k_n), t0, L,
                      tol=cell.tol, scale=scale, max_iter=cell.max_iter)
     t = res.t
     sp, sq = res.shifts

@@ -41,7 +41,7 @@ from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.spectral.convolution import Convolution
 from ngcontact.cell.spectral.layer_compliance import normal_compliance
 from ngcontact.cell.spectral.fft_threads import fft_workers
-from ngcontact.cell.spectral.frictional_contact import solve_frictional, traction_operator
+from ngcontact.cell.spectral.frictional_contact import TractionPreconditioner, solve_frictional, traction_operator
 from ngcontact.geometry.random_surface import wave_vectors
 from ngcontact.laws.friction import FrictionLaw
 from ngcontact.solvers.constrained_cg import ConstrainedResult, constrained_cg
@@ -141,7 +141,7 @@ class SpectralCell:
         self.g0, self.k_n, self.enforcement = g0, float(k_n), enforcement
         self.tol, self.max_iter = tol, max_iter
         self.friction = friction
-        self._operators: dict[tuple[bool, ...], Any] = {}
+        self._operators: dict[tuple, Any] = {}
         k = wave_numbers(dim, grid, period)
         self.symbol = (normal_compliance(k, rough.E, rough.nu, rough.h)
                        + normal_compliance(k, counter.E, counter.nu, counter.h))
@@ -310,12 +310,19 @@ class SpectralCell:
         return ConstrainedResult(p=p, gap=g - shift, shift=shift, iterations=0, residuals=[])
 
     # ------------------------------------------------------------ friction
+    def cached(self, key: tuple, build):
+        """``build()``, built once per cell and ``key`` (the friction operators of a sweep)."""
+        if key not in self._operators:
+            self._operators[key] = build()
+        return self._operators[key]
+
     def traction_operator(self, uniform: tuple[bool, ...]):
-        """:func:`ngcontact.cell.spectral.frictional_contact.traction_operator`, built once per kind of load of a
-        sweep."""
-        if uniform not in self._operators:
-            self._operators[uniform] = traction_operator(self, uniform)
-        return self._operators[uniform]
+        """:func:`~.frictional_contact.traction_operator`, built once per kind of load of a sweep."""
+        return self.cached(uniform, lambda: traction_operator(self, uniform))
+
+    def traction_preconditioner(self, winkler: float) -> TractionPreconditioner:
+        """:class:`~ngcontact.cell.spectral.frictional_contact.TractionPreconditioner`, built once per cell."""
+        return self.cached(("preconditioner", winkler), lambda: TractionPreconditioner(self, winkler))
 
     def sweep(self, loads, starts: list[np.ndarray | None] | None = None) -> list[SpectralSolution]:
         """Solve loads in order, each from its pressure in ``starts`` where given (e.g. a coarser grid's,

@@ -37,6 +37,8 @@ class TractionConstraints:
     k_n: float | None
     mean_p: float | None
     mean_q: np.ndarray | None
+    #: ``dG/dp`` of the threshold rule (Coulomb: ``mu``; 0 for a frozen or constant threshold)
+    slope: float = 0.0
 
     @property
     def d(self) -> int:
@@ -69,8 +71,9 @@ class TractionConstraints:
         return np.concatenate([q, p[None]])
 
     def linearize(self, t_hat: np.ndarray, v: np.ndarray, shifts: tuple):
-        """``(projector, D)`` at a proximal point ``t_hat = prox(v)``: the free directions and the curvature of
-        ``h`` along them.
+        """``(projector, D, lift)`` at a proximal point ``t_hat = prox(v)``: the free directions, the curvature
+        of ``h`` along them and, for a threshold of slope ``dG/dp > 0`` (Coulomb), the map from free directions
+        to tractions (``None`` otherwise).
 
         ``D``: the penalty's ``1 / k_n`` on the pressure, the Huber term's ``w / G`` on a sticking shear, and on
         a slipping shear of a 3D cell the curvature of the friction disc's rim in the step ``1/L``,
@@ -90,9 +93,28 @@ class TractionConstraints:
         if d == 3:
             sq = shifts[1]
             z = v[:2] - (0.0 if sq is None else np.asarray(sq).reshape(2, 1, 1))
-            bend = np.where(rim, np.maximum(np.sqrt(np.sum(z * z, axis=0)) / safe - 1.0, 0.0), np.inf)
-            # a rim point far outside the disc barely turns: held, which keeps the free problem well conditioned
-            turning = bend <= 1.0
-            D[:2] += np.where(turning, self.L * bend, 0.0)
+            # every rim point turns: a large curvature (a point far outside the disc) is the split
+            # preconditioner's diagonal block (:meth:`~.frictional_contact.TractionPreconditioner.for_curvature`)
+            turning = rim
+            D[:2] += np.where(rim, self.L * np.maximum(np.sqrt(z[0] * z[0] + z[1] * z[1]) / safe - 1.0, 0.0), 0.0)
         constrained = (self.mean_q is not None,) * (d - 1) + (self.mean_p is not None,)
-        return traction_projector(t_hat[d - 1] > 0, stick, turning, t_hat, constrained), D
+        free = traction_projector(t_hat[d - 1] > 0, stick, turning, t_hat, constrained)
+        return free, D, (self._lift(t_hat, rim, free) if self.slope > 0 else None)
+
+    def _lift(self, t_hat: np.ndarray, rim: np.ndarray, free) -> Callable[[np.ndarray], np.ndarray]:
+        """``u -> u + (dG/dp) u_p n`` at the slipping points (``n = q / |q|``, the shear on the rim follows the
+        threshold ``G(p)``), the mean shear restored over the free shear (``free.mean_free``)."""
+        d = self.d
+        slipping = rim & (t_hat[d - 1] > 0)
+        q = t_hat[:d - 1][:, slipping]
+        n = q / np.sqrt(np.sum(q * q, axis=0))
+        slope, constrained = self.slope, self.mean_q is not None
+
+        def lift(u: np.ndarray) -> np.ndarray:
+            y = u.copy()
+            added = slope * u[d - 1][slipping] * n
+            y[:d - 1, slipping] += added
+            if constrained:
+                y[:d - 1] -= free.mean_free(added.sum(axis=1))
+            return y
+        return lift
