@@ -18,11 +18,14 @@ adds its own iteration counts to each load, its ``results.method`` record
 (the spectral cell's grid) and its grid fields as ``.npy``.  With
 ``discretization.tolerance`` the sweep is refined until the estimate meets
 it (:meth:`~ngcontact.cell.cell_solver.CellSolver.refine_to`) and each load
-adds ``error_estimate`` (FE: also ``mesh_history``); without it a cell that
-refines by default (the spectral cell) is refined to
-:data:`~ngcontact.cell.admissibility.DEFAULT_TOLERANCE` within a tighter size
-bound, and one that misses it is reported with ``accuracy.met = false`` and
-one warning line rather than failed.  With
+adds ``error_estimate`` (FE: also ``mesh_history``); without it the sweep is
+held to :data:`~ngcontact.cell.admissibility.DEFAULT_TOLERANCE`
+(:meth:`~ngcontact.cell.cell_solver.CellSolver.default_accuracy`): the
+spectral cell is refined to it within a tighter size bound, the FE cell keeps
+its discretization and estimates its error from one order more
+(:mod:`ngcontact.cell.fe.saturation`; each load adds ``error_estimate`` and
+``next_order``), and one that misses it is reported with
+``accuracy.met = false`` and one warning line rather than failed.  With
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers.
 """
@@ -100,23 +103,31 @@ def warn_unmet(verdict: dict, refinement: Refinement) -> None:
         q = max(unmet, key=lambda q: q["error"] if q["controlled"] == "absolute" else q["relative_error"])
         size = q["error"] if q["controlled"] == "absolute" else q["relative_error"]
         what = f"the estimated {q['controlled']} error {size:.3g} of load {q['load']}'s {q['name']} exceeds"
+    elif refinement.scene_discretization:
+        what = "no estimate shows"
     else:
         what = "too few grids within the size bound to show"
+    if refinement.scene_discretization:
+        log.warning("accuracy not met: %s the %s tolerance %g on the scene's own discretization (%s); state "
+                    "discretization.tolerance to refine it, or a finer interface_maxh or a higher order", what,
+                    verdict["tolerance_from"], verdict["tolerance"], refinement.how.split(";")[0])
+        return
     log.warning("accuracy not met: %s the %s tolerance %g on the finest discretization allowed (%s); state "
                 "discretization.tolerance to refine beyond the default size bound, or a finer discretization",
                 what, verdict["tolerance_from"], verdict["tolerance"], refinement.how.split(";")[0])
 
 
 def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
-    """The sweep refined to the scene's tolerance, or to the default one where the cell refines by default
-    (not for independent loads, nor where the caller says not ``by_default``), else ``None`` (the fixed
-    discretization)."""
+    """The sweep refined to the scene's tolerance, or held to the default one (the cell's
+    :meth:`~ngcontact.cell.cell_solver.CellSolver.default_accuracy`: the spectral cell refined to it, the FE
+    cell estimated on its own discretization; not for independent loads, nor where the caller says not
+    ``by_default``), else ``None`` (the fixed discretization, not estimated)."""
     tolerance = scene.discretization.tolerance
     if tolerance is not None:
         return cell.refine_to(tolerance, loads, required=True)
-    if not by_default or scene.load.independent or not cell.refines_by_default():
+    if not by_default or scene.load.independent:
         return None
-    return cell.refine_to(admissibility.DEFAULT_TOLERANCE, loads, required=False)
+    return cell.default_accuracy(admissibility.DEFAULT_TOLERANCE, loads)
 
 
 def warn_before_solving(facts: dict[str, float]) -> None:
@@ -177,7 +188,8 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
     results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement)
     if cell.penalty() is not None:  # the model's share: reported and printed, not counted against the tolerance
         with clock.stage("penalty share"):
-            share = penalty_share(cell, loads, per_load, refined=refinement is not None)
+            share = penalty_share(cell, loads, per_load,
+                                  refined=refinement is not None and not refinement.scene_discretization)
         if share is not None:
             results["accuracy"]["model"] = share
     vtk = {}
