@@ -25,7 +25,8 @@ spectral cell is refined to it within a tighter size bound, the FE cell keeps
 its discretization and estimates its error from one order more
 (:mod:`ngcontact.cell.fe.saturation`; each load adds ``error_estimate`` and
 ``next_order``), and one that misses it is reported with
-``accuracy.met = false`` and one warning line rather than failed.  With
+``accuracy.met = false`` and one warning line rather than failed; ``discretization.estimate = "off"``
+skips that estimate and says so (``accuracy.how``).  With
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers.
 """
@@ -69,15 +70,16 @@ def surface_plots(sols, dim: int, period: float) -> dict:
 
 
 def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[str, float],
-                     refinement: Refinement | None = None) -> dict:
+                     refinement: Refinement | None = None, unestimated: str = "") -> dict:
     """The sweep's verdict (:mod:`ngcontact.cell.admissibility`) with the cell's own ``facts`` and the
-    refinement's estimates: each failed check is one warning line, and so is an estimate beyond the default
-    tolerance; a plainly wrong answer is no answer (exit 3)."""
+    refinement's estimates (``unestimated``: why there is none, where the scene says it); each failed check
+    is one warning line, and so is an estimate beyond the default tolerance; a plainly wrong answer is no
+    answer (exit 3)."""
     estimated = refinement is not None and bool(refinement.estimates)
     verdict, failed = admissibility.verdict(
         per_load, tolerance, admissibility.cell_checks(facts),
         estimates=refinement.estimates if estimated and refinement is not None else None,
-        how="" if refinement is None else refinement.how,
+        how=unestimated if refinement is None else refinement.how,
         reached=refinement is None or refinement.met)
     wrong = [c for c in failed if c.plainly_wrong]
     if wrong:
@@ -125,9 +127,13 @@ def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
     tolerance = scene.discretization.tolerance
     if tolerance is not None:
         return cell.refine_to(tolerance, loads, required=True)
-    if not by_default or scene.load.independent:
+    if not by_default or scene.load.independent or scene.discretization.estimate == "off":
         return None
     return cell.default_accuracy(admissibility.DEFAULT_TOLERANCE, loads)
+
+
+#: the verdict's ``how`` of a scene that opts out of the default estimate
+OPTED_OUT = "not estimated (discretization.estimate = off)"
 
 
 def warn_before_solving(facts: dict[str, float]) -> None:
@@ -185,7 +191,9 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
             arrays[f"{name}_load{k}"] = values
         log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
     results["loads"] = per_load
-    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement)
+    opted_out = scene.discretization.tolerance is None and scene.discretization.estimate == "off"
+    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
+                                           unestimated=OPTED_OUT if opted_out else "")
     if cell.penalty() is not None:  # the model's share: reported and printed, not counted against the tolerance
         with clock.stage("penalty share"):
             share = penalty_share(cell, loads, per_load,

@@ -84,6 +84,11 @@ class CellDiscretization(Discretization):
         "sweep on about ((p + 1) / p)^dim times the unknowns), a miss reported with accuracy.met = false and a "
         "warning, not refined",
         check=open_interval(0, 1))
+    estimate: str = param("auto", doc="without a tolerance: auto estimates the error against the default "
+                          "tolerance as discretization.tolerance says (the spectral cell refined, the FE cell one "
+                          "order more on its own mesh); off skips that estimate (no second solve), and the report "
+                          "says 'not estimated (discretization.estimate = off)'; no effect with a tolerance",
+                          choices=("auto", "off"))
     method: str = param("fe", doc="fe: finite elements on a mesh of the cell; spectral: the small-slope cell "
                         "(flat interface, the roughness in the initial gap) as two periodic layers solved with "
                         "FFTs on a uniform grid of the interface", choices=("fe", "spectral"))

@@ -17,9 +17,9 @@ bound at ``beta =`` :data:`SATURATION`, for the quantities whose ratio ``beta`` 
 Why one order more, and ``q_p`` reported:
 
 * the bound needs only that the second discretization be the better one, which ``p + 1`` on the same mesh
-  is for every quantity: the same mesh holds the same geometry, and the enriched space contains the
-  scene's (``p``-refinement converges to the exact solution, not to a mesh-dependent limit;
-  :mod:`ngcontact.cell.fe.edge_grading`);
+  is for every quantity: the same mesh holds the same geometry (a curved one more closely), and on it the
+  enriched space contains the scene's (``p``-refinement converges to the exact solution, not to a
+  mesh-dependent limit; :mod:`ngcontact.cell.fe.edge_grading`);
 * reporting ``q_(p+1)`` instead would need its own error, ``beta / (1 - beta) d`` at a rate two values do
   not show (:mod:`ngcontact.cell.fe.observed_rate` needs three); reporting ``q_p`` keeps the scene's numbers
   and bounds their error from the one difference;
