@@ -75,6 +75,9 @@ class Refinement:
     #: per load, what each estimate's absolute error was divided by in its measure
     #: (:func:`~ngcontact.cell.cell_solution.scale`), where the method says
     scales: list[dict[str, float]] = field(default_factory=list)
+    #: the solutions are the scene's own discretization's, their error estimated without refining
+    #: (:meth:`CellSolver.default_accuracy` of an FE cell)
+    scene_discretization: bool = False
 
 
 class CellSolver(Protocol):
@@ -106,6 +109,12 @@ class CellSolver(Protocol):
     def refines_by_default(self) -> bool:
         """Whether a sweep whose scene states no tolerance is refined to the default one
         (:data:`ngcontact.cell.admissibility.DEFAULT_TOLERANCE`) by :meth:`refine_to`."""
+
+    def default_accuracy(self, tolerance: float, loads: list[CellLoad]) -> Refinement | None:
+        """The sweep of a scene that states no tolerance, held to the default ``tolerance``: refined to it
+        (:meth:`refine_to` with ``required = False``) where the method :meth:`refines_by_default`, else
+        solved on the scene's discretization with its error estimated (``scene_discretization``), or ``None``
+        (the fixed discretization, not estimated)."""
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Solve the loads on refined discretizations until the estimated error meets ``tolerance``.

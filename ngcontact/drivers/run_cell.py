@@ -18,11 +18,15 @@ adds its own iteration counts to each load, its ``results.method`` record
 (the spectral cell's grid) and its grid fields as ``.npy``.  With
 ``discretization.tolerance`` the sweep is refined until the estimate meets
 it (:meth:`~ngcontact.cell.cell_solver.CellSolver.refine_to`) and each load
-adds ``error_estimate`` (FE: also ``mesh_history``); without it a cell that
-refines by default (the spectral cell) is refined to
-:data:`~ngcontact.cell.admissibility.DEFAULT_TOLERANCE` within a tighter size
-bound, and one that misses it is reported with ``accuracy.met = false`` and
-one warning line rather than failed.  With
+adds ``error_estimate`` (FE: also ``mesh_history``); without it the sweep is
+held to :data:`~ngcontact.cell.admissibility.DEFAULT_TOLERANCE`
+(:meth:`~ngcontact.cell.cell_solver.CellSolver.default_accuracy`): the
+spectral cell is refined to it within a tighter size bound, the FE cell keeps
+its discretization and estimates its error from one order more
+(:mod:`ngcontact.cell.fe.saturation`; each load adds ``error_estimate`` and
+``next_order``), and one that misses it is reported with
+``accuracy.met = false`` and one warning line rather than failed; ``discretization.estimate = "off"``
+skips that estimate and says so (``accuracy.how``).  With
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers.
 """
@@ -66,15 +70,16 @@ def surface_plots(sols, dim: int, period: float) -> dict:
 
 
 def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[str, float],
-                     refinement: Refinement | None = None) -> dict:
+                     refinement: Refinement | None = None, unestimated: str = "") -> dict:
     """The sweep's verdict (:mod:`ngcontact.cell.admissibility`) with the cell's own ``facts`` and the
-    refinement's estimates: each failed check is one warning line, and so is an estimate beyond the default
-    tolerance; a plainly wrong answer is no answer (exit 3)."""
+    refinement's estimates (``unestimated``: why there is none, where the scene says it); each failed check
+    is one warning line, and so is an estimate beyond the default tolerance; a plainly wrong answer is no
+    answer (exit 3)."""
     estimated = refinement is not None and bool(refinement.estimates)
     verdict, failed = admissibility.verdict(
         per_load, tolerance, admissibility.cell_checks(facts),
         estimates=refinement.estimates if estimated and refinement is not None else None,
-        how="" if refinement is None else refinement.how,
+        how=unestimated if refinement is None else refinement.how,
         reached=refinement is None or refinement.met,
         uncontrolled=refinement.uncontrolled if refinement is not None else (),
         scales=refinement.scales if refinement is not None else ())
@@ -102,23 +107,35 @@ def warn_unmet(verdict: dict, refinement: Refinement) -> None:
         q = max(unmet, key=lambda q: q["controlled_error"])
         size = q["controlled_error"]
         what = f"the estimated {q['controlled']} error {size:.3g} of load {q['load']}'s {q['name']} exceeds"
+    elif refinement.scene_discretization:
+        what = "no estimate shows"
     else:
         what = "too few grids within the size bound to show"
+    if refinement.scene_discretization:
+        log.warning("accuracy not met: %s the %s tolerance %g on the scene's own discretization (%s); state "
+                    "discretization.tolerance to refine it, or a finer interface_maxh or a higher order", what,
+                    verdict["tolerance_from"], verdict["tolerance"], refinement.how.split(";")[0])
+        return
     log.warning("accuracy not met: %s the %s tolerance %g on the finest discretization allowed (%s); state "
                 "discretization.tolerance to refine beyond the default size bound, or a finer discretization",
                 what, verdict["tolerance_from"], verdict["tolerance"], refinement.how.split(";")[0])
 
 
 def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
-    """The sweep refined to the scene's tolerance, or to the default one where the cell refines by default
-    (not for independent loads, nor where the caller says not ``by_default``), else ``None`` (the fixed
-    discretization)."""
+    """The sweep refined to the scene's tolerance, or held to the default one (the cell's
+    :meth:`~ngcontact.cell.cell_solver.CellSolver.default_accuracy`: the spectral cell refined to it, the FE
+    cell estimated on its own discretization; not for independent loads, nor where the caller says not
+    ``by_default``), else ``None`` (the fixed discretization, not estimated)."""
     tolerance = scene.discretization.tolerance
     if tolerance is not None:
         return cell.refine_to(tolerance, loads, required=True)
-    if not by_default or scene.load.independent or not cell.refines_by_default():
+    if not by_default or scene.load.independent or scene.discretization.estimate == "off":
         return None
-    return cell.refine_to(admissibility.DEFAULT_TOLERANCE, loads, required=False)
+    return cell.default_accuracy(admissibility.DEFAULT_TOLERANCE, loads)
+
+
+#: the verdict's ``how`` of a scene that opts out of the default estimate
+OPTED_OUT = "not estimated (discretization.estimate = off)"
 
 
 def warn_before_solving(facts: dict[str, float]) -> None:
@@ -177,10 +194,13 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
             arrays[f"{name}_load{k}"] = values
         log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
     results["loads"] = per_load
-    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement)
+    opted_out = scene.discretization.tolerance is None and scene.discretization.estimate == "off"
+    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
+                                           unestimated=OPTED_OUT if opted_out else "")
     if cell.penalty() is not None:  # the model's share: reported and printed, not counted against the tolerance
         with clock.stage("penalty share"):
-            share = penalty_share(cell, loads, per_load, refined=refinement is not None)
+            share = penalty_share(cell, loads, per_load,
+                                  refined=refinement is not None and not refinement.scene_discretization)
         if share is not None:
             results["accuracy"]["model"] = share
     vtk = {}

@@ -89,9 +89,17 @@ class CellDiscretization(Discretization):
         "guarded); the report gives the estimate per load and the mesh or grid history, and a tolerance out of "
         "reach ends the run (exit 3); default: 0.01 (accuracy.tolerance_from = 'default'): the spectral cell "
         "is refined to it up to 65536 grid points in 2D and 512 x 512 in 3D and, out of reach there, reports "
-        "its finest grid with accuracy.met = false and a warning; the FE cell keeps its fixed mesh, its error "
-        "not estimated",
+        "its finest grid with accuracy.met = false and a warning; the FE cell keeps its mesh and order, reports "
+        "its own answer and estimates its error by the same sweep one order more on the same mesh (the change "
+        "times 4: the saturation assumption that order p + 1 keeps at most 3/4 of the error of order p; one more "
+        "sweep on about ((p + 1) / p)^dim times the unknowns), a miss reported with accuracy.met = false and a "
+        "warning, not refined",
         check=open_interval(0, 1))
+    estimate: str = param("auto", doc="without a tolerance: auto estimates the error against the default "
+                          "tolerance as discretization.tolerance says (the spectral cell refined, the FE cell one "
+                          "order more on its own mesh); off skips that estimate (no second solve), and the report "
+                          "says 'not estimated (discretization.estimate = off)'; no effect with a tolerance",
+                          choices=("auto", "off"))
     method: str = param("fe", doc="fe: finite elements on a mesh of the cell; spectral: the small-slope cell "
                         "(flat interface, the roughness in the initial gap) as two periodic layers solved with "
                         "FFTs on a uniform grid of the interface", choices=("fe", "spectral"))

@@ -355,7 +355,7 @@ def test_an_exact_fe_scene_runs_end_to_end(tmp_path, dim, tolerance):
     """Through the command line: the report's pressure, contact fraction and surface file (3D: a flat cell with
     the sinusoid gap, waves along x)."""
     text = SCENE if dim == 2 else SCENE.replace('profile = "flat"', 'profile = "flat3d"').replace(
-        "maxh = 0.3", "maxh = 0.4").replace("interface_maxh = 0.02", "interface_maxh = 0.1").replace(
+        "maxh = 0.3", "maxh = 0.4").replace("interface_maxh = 0.02", 'interface_maxh = 0.1\nestimate = "off"').replace(
         "order = 2", "order = 1")
     path = tmp_path / "s.toml"
     path.write_text(text)
@@ -376,11 +376,16 @@ def test_an_exact_3d_fe_scene_at_order_2_runs_on_a_linear_trace(tmp_path):
     the trace on S_C linear (ngcontact.cell.fe.linear_trace); non-penetration and the load held, the contact
     fraction above Westergaard's (the converged value of the spectral twin of this gap) by less than 8 %."""
     text = SCENE.replace('profile = "flat"', 'profile = "flat3d"').replace("maxh = 0.3", "maxh = 0.4").replace(
-        "interface_maxh = 0.02", "interface_maxh = 0.1").replace("pressure = [0.0034523]", "pressure = [0.0086307]")
+        "interface_maxh = 0.02", 'interface_maxh = 0.1\nestimate = "off"').replace("pressure = [0.0034523]",
+                                                                                "pressure = [0.0086307]")
     path = tmp_path / "s.toml"
     path.write_text(text)
     assert cli.main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
-    (load,) = json.loads((tmp_path / "o" / "report.json").read_text())["results"]["loads"]
+    results = json.loads((tmp_path / "o" / "report.json").read_text())["results"]
+    (load,) = results["loads"]
+    # the scene opts out of the default estimate (order 3 in 3D): the report says so
+    assert results["accuracy"]["how"] == "not estimated (discretization.estimate = off)"
+    assert not results["accuracy"]["estimated"] and "error_estimate" not in load
     assert load["mean_pressure"] == pytest.approx(0.0086307, rel=1e-9)
     assert load["max_penetration"] <= 1e-10
     exact = westergaard_contact_fraction(0.0086307 / PSTAR, 1.0)

@@ -223,7 +223,7 @@ pressure = [0.0034523, 0.00863075]
 
 
 def test_a_small_fe_cell_and_the_spectral_cell_of_the_same_scene_agree(tmp_path):
-    fe, _ = _run(tmp_path, SCENE.format(disc="order = 2\nmaxh = 0.25\ninterface_maxh = 0.005"), "fe")
+    fe, _ = _run(tmp_path, SCENE.format(disc='order = 2\nmaxh = 0.25\ninterface_maxh = 0.005\nestimate = "off"'), "fe")
     # refined from 256 by doubling to the default tolerance: four grids, the last of 2048 points
     sp, out = _run(tmp_path, SCENE.format(disc='method = "spectral"\ngrid = 256'), "spectral")
     assert sp["results"]["method"]["name"] == "spectral" and sp["results"]["method"]["grid"] == 2048

@@ -40,6 +40,7 @@ pressure = [0.01, 0.02]
 [discretization]
 order = 1
 maxh = 0.25
+estimate = "off"   # the effects, not the accuracy: no second solve
 """
 
 MACRO = """\

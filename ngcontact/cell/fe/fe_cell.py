@@ -7,10 +7,12 @@ refinement to a tolerance (each load on its own graded mesh, checked by higher o
 from its :class:`~ngcontact.cell.fe.second_discretization.Refiner` and the observed rate:
 :mod:`ngcontact.cell.fe.second_discretization`) and the pressure response of the two-scale table.
 
-Refinement to the default tolerance (:meth:`FECell.refine_to` with ``required = False``,
-:meth:`FECell.default_refinement`): a graded cell refines as with a stated one; any other cell refines
-within :data:`DEFAULT_DOFS` and is flagged when over (with the scene's level alone: not estimated).  A
-stated tolerance refines within :data:`MAX_DOFS`.
+A scene that states no tolerance keeps its mesh and order, and its error is estimated by one order more on
+the same mesh (:meth:`FECell.default_accuracy`, :mod:`ngcontact.cell.fe.saturation`), judged against the
+default tolerance without refining.  Refinement to a tolerance not required (:meth:`FECell.refine_to` with
+``required = False``, :meth:`FECell.default_refinement`): a graded cell refines as with a stated one; any
+other cell refines within :data:`DEFAULT_DOFS` and is flagged when over (with the scene's level alone: not
+estimated).  A stated tolerance refines within :data:`MAX_DOFS`.
 
 The response at a mean pressure ``p``: ``k_n0`` is eq. 34 on the real contact set, ``k_n`` times the
 contact fraction (located by the roots of the penetration in 2D) on a flat frictionless cell, else the
@@ -37,6 +39,7 @@ from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.cell.fe.edge_grading import ORDER_RATE, GradedSolve, solve_to_tolerance
 from ngcontact.cell.fe.load_start import Predictor
+from ngcontact.cell.fe.saturation import estimate_on_scene
 from ngcontact.cell.fe.second_discretization import InterfaceHalving, Refiner, as_refinement, refine
 from ngcontact.cell.fe.measures import contact_fraction, contact_integral, mean_jump, real_contact_coefficients
 from ngcontact.errors import ModelError
@@ -168,13 +171,18 @@ class FECell:
         return "none" if self.refiner() is None else "sequence"
 
     def refines_by_default(self) -> bool:
-        """No: a sweep without a stated tolerance keeps the scene's mesh and says it is not estimated.  An
-        honest estimate of the value reported needs three discretizations (:meth:`default_refinement`: the
-        grading levels and three orders on the finest, or interface meshes halved twice, each several times
-        the last), which multiplies an FE cell's run time several times over (``scene_seconds`` against
-        ``seconds`` in ``docs/benchmarks.md``, FE effectivity), so it is asked for by stating
-        ``discretization.tolerance``."""
+        """No: a sweep without a stated tolerance keeps the scene's mesh and order, and
+        :meth:`default_accuracy` estimates its error from one order more.  Refining it would need three
+        discretizations at least (:meth:`default_refinement`: the grading levels and three orders on the
+        finest, or interface meshes halved twice, each several times the last), so it is asked for by
+        stating ``discretization.tolerance``."""
         return False
+
+    def default_accuracy(self, tolerance: float, loads: list[CellLoad]) -> Refinement | None:
+        """The scene's sweep on its own discretization, its error estimated by the same sweep one order more
+        on the same mesh (:mod:`ngcontact.cell.fe.saturation`); judged against ``tolerance`` by the
+        verdict, not refined."""
+        return estimate_on_scene(self, loads)
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Each load on its own mesh, graded towards its contact edges until ``tolerance`` is met

@@ -96,6 +96,11 @@ class SpectralCellSolver:
         finer grids is known."""
         return self.make_cell is not None and self.max_points is not None
 
+    def default_accuracy(self, tolerance: float, loads: list[CellLoad]) -> Refinement | None:
+        """Refined to the default ``tolerance`` within the default size bound where the recipe of finer grids
+        is known (:meth:`refine_to`), else ``None``."""
+        return self.refine_to(tolerance, loads, required=False) if self.refines_by_default() else None
+
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Grids from the scene's up until the estimate meets ``tolerance``
         (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`); the finest grid's cell becomes this
