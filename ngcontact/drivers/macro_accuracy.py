@@ -27,6 +27,7 @@ from typing import Any, Callable
 from ngcontact.cell.admissibility import DEFAULT_TOLERANCE
 from ngcontact.coupling import homogenization_error
 from ngcontact.macro import discretization_error as DE
+from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.scene.schema import MAX_ORDER
 
@@ -150,7 +151,10 @@ def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], bal
     ``solve(problem, start)`` (or the estimates ``found`` already by a refinement, with its mesh levels),
     the safety factor re-evaluated with the strength check's correctors ``recovery``."""
     if found is None:
-        found = estimates(order_samples(scene, sol, solve, safety_factor_of(scene, recovery)), sol)
+        samples = order_samples(scene, sol, solve, safety_factor_of(scene, recovery))
+        found = estimates(samples, sol)
+        if sol.problem.mesh.dim == 2 and two_scale is None:
+            found = SM.check(found, sol, samples[sol.problem.order], solve)
     out = verdict(found, scene.discretization.tolerance, balance, two_scale)
     out["modelling"] = modelling(scene, sol)
     return out

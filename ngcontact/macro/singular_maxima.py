@@ -1,0 +1,123 @@
+"""Whether a body's largest stress has a converged value: a local mesh check at the boundary's corners.
+
+The order ladder (:mod:`ngcontact.macro.discretization_error`) estimates the error of a stress maximum
+from the orders ``p - 1, p, p + 1`` on one mesh.  The maximum is taken over sample points of each
+element (at a small inset from its faces), so what the orders converge to is the stress **at those
+points**: a limit that exists for every mesh but moves with it.  Where the exact stress is bounded and
+smooth, that limit is within the sampling error of the maximum, and the ladder's estimate stands.  Where
+it is not, the ladder is silent:
+
+Why a corner's maximum needs a mesh check
+    Near a vertex of a body's boundary where the boundary turns or its data change (a re-entrant corner,
+    the end of the interface where the law's traction stops, a clamp meeting a free face), the stress of
+    linear elasticity behaves like ``r^(lambda - 1)`` in the distance ``r`` from the vertex (Williams
+    1952), with ``lambda`` the smallest eigenvalue of the wedge with its two faces' conditions: below 1 at
+    a re-entrant corner or a clamped-free corner (the stress grows without bound), and a term
+    ``log r`` where the two faces' tractions do not match at the vertex (a pressure or shear that ends
+    with a jump, as a press fit's does where the bone ends).  Such a maximum is unbounded: its value is
+    set by the element size at the vertex and the sample points' inset, and every order on the mesh
+    agrees on it.  A corner with ``lambda > 1`` has a bounded stress that converges, but slowly
+    (algebraically in the element size), and the geometric fall of the order ladder overstates the
+    rate.
+
+The check
+    The elements holding a corner of the mesh's boundary (:func:`ngcontact.macro.discretization_error.
+    corner_points`) or a body's maximum are refined :data:`LEVELS` times (Netgen's local refinement,
+    on a copy of the mesh: the reported solution stays on the scene's), each level solved at the scene's
+    order; the maximum of each level is sampled as the scene's.  Each level halves the elements at the
+    corners, so the sample points there move closer to the vertex by a factor 2, and the level values
+    ``Q_0, Q_1, Q_2`` measure what the ladder cannot:
+
+    * a maximum that grows at each level by a difference that does not shrink (``r^(lambda - 1)`` grows
+      by a factor ``2^(1 - lambda)`` per halving, ``log r`` by a constant) has no converged value: it is
+      reported as **mesh dependent, singular at** the corner it sits at (``error = None``,
+      ``met = false``), never with a small estimate;
+    * otherwise the sequence's estimate (:func:`ngcontact.macro.mesh_sequence.sequence_error`, the
+      geometric tail of the level differences with the factor of safety) is taken where it exceeds the
+      ladder's, so a slowly converging corner is estimated from the mesh;
+    * a sequence that neither converges nor grows keeps no estimate (not converging).
+
+A maximum away from every corner is checked as well: a finer mesh at the corners may reveal that the
+body's largest stress is at a corner the scene's mesh under-resolves (the maximum moves there).
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Callable
+
+import ngsolve as ng
+import numpy as np
+
+from ngcontact.macro import discretization_error as DE
+from ngcontact.macro import error_indicator as EI
+from ngcontact.macro import mesh_sequence as MS
+from ngcontact.macro.macro_problem import MacroProblem, MacroSolution
+
+#: local refinements at the corners (three values with the scene's mesh: an observed rate)
+LEVELS = 2
+#: the stress measures whose maxima are checked
+STRESS = ("von_mises_", "tresca_")
+
+
+def checked_names(found: list[DE.Estimate]) -> list[str]:
+    """The stress maxima among the estimates."""
+    return [e.name for e in found if e.name.startswith(STRESS)]
+
+
+def local_levels(sol: MacroSolution, solve: Callable[..., MacroSolution], points: list[tuple[float, ...]],
+                 levels: int = LEVELS, dense_inset: float = 1e-3) -> list[tuple[MacroSolution, dict[str, DE.Sample]]]:
+    """The body maxima of ``levels`` solves on a copy of ``sol``'s mesh refined at ``points`` once more for
+    each (module docstring), at ``sol``'s order, each solved by ``solve(problem, None)``."""
+    order = sol.problem.order
+    mesh = ng.Mesh(sol.problem.mesh.ngmesh.Copy())
+    mesh.Curve(max(order, 1))
+    out = []
+    for _ in range(levels):
+        EI.refine_marked(mesh, EI.holding(mesh, points), max(order, 1))
+        problem: MacroProblem = replace(sol.problem, mesh=mesh)
+        s = solve(problem, None)
+        out.append((s, DE.body_maxima(s, dense_inset)))
+    return out
+
+
+def judged(e: DE.Estimate, samples: list[DE.Sample], corners: np.ndarray, h: float) -> DE.Estimate:
+    """The ladder's estimate ``e`` of a stress maximum judged by its values on the scene's mesh and the
+    local levels ``samples`` (module docstring); ``corners``, ``h``: where the finest level's maximum
+    is located as at a corner (:func:`ngcontact.macro.discretization_error.at_corner`)."""
+    values = [s.value for s in samples]
+    shown = ", ".join(f"{v:.4g}" for v in values)
+    head = f"{e.how}; corner check ({len(values) - 1} local refinements at the boundary's corners): {shown}"
+    if MS.grows_without_bound(values):
+        where = DE.at_corner(samples[-1].location, corners, h) or samples[-1].location
+        text = "" if where is None else f" at {DE._point(where)}"
+        return replace(e, error=None, singular_at=where,
+                       how=f"{head}: the maximum grows with every halving of the elements at the corners, as "
+                           f"r^(lambda - 1) or log r at a singular corner: mesh dependent, singular{text}")
+    seq, how = MS.sequence_error(values, e.scale)
+    if seq is None:
+        if e.error is None:
+            return replace(e, how=f"{head}; {how}")
+        return replace(e, error=max(e.error, DE.SAFETY * abs(values[-1] - values[-2])),
+                       how=f"{head}; {how}: at least {DE.SAFETY:g} x the last difference")
+    if e.error is None or seq > e.error:
+        return replace(e, error=seq, singular_at=None, how=f"{head}; {how}, larger than the order ladder's")
+    return replace(e, how=f"{head}; {how}, below the order ladder's")
+
+
+def check(found: list[DE.Estimate], sol: MacroSolution, samples: dict[str, DE.Sample],
+          solve: Callable[..., MacroSolution], levels: int = LEVELS) -> list[DE.Estimate]:
+    """``found`` with every stress maximum judged by the local levels at the corners and the maxima of
+    ``samples`` (the scene's order's, :func:`judged`); the other estimates unchanged."""
+    names = checked_names(found)
+    if not names or levels < 1:
+        return found
+    mesh = sol.problem.mesh
+    corners, h = DE.corner_points(mesh), DE.shortest_boundary_edge(mesh)
+    points = [tuple(c) for c in corners] + [samples[n].location for n in names if samples[n].location]
+    finer = local_levels(sol, solve, points, levels)
+    out = []
+    for e in found:
+        if e.name in names:
+            e = judged(e, [samples[e.name]] + [m[e.name] for _, m in finer], corners, h)
+        out.append(e)
+    return out
