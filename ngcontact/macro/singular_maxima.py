@@ -48,13 +48,18 @@ from typing import Callable
 import ngsolve as ng
 import numpy as np
 
+from ngcontact.fem.materials import tresca, von_mises
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro import error_indicator as EI
+from ngcontact.macro import macro_measures as MM
 from ngcontact.macro import mesh_sequence as MS
-from ngcontact.macro.macro_problem import MacroProblem, MacroSolution
+from ngcontact.macro.macro_problem import MacroSolution
 
 #: local refinements at the corners (three values with the scene's mesh: an observed rate)
 LEVELS = 2
+#: a corner whose stress grows without bound but stays below this share of the body's maximum leaves the
+#: maximum as it is (module docstring)
+RELEVANT = 0.5
 #: the stress measures whose maxima are checked
 STRESS = ("von_mises_", "tresca_")
 
@@ -64,35 +69,70 @@ def checked_names(found: list[DE.Estimate]) -> list[str]:
     return [e.name for e in found if e.name.startswith(STRESS)]
 
 
-def local_levels(sol: MacroSolution, solve: Callable[..., MacroSolution], points: list[tuple[float, ...]],
-                 levels: int = LEVELS, dense_inset: float = 1e-3) -> list[tuple[MacroSolution, dict[str, DE.Sample]]]:
-    """The body maxima of ``levels`` solves on a copy of ``sol``'s mesh refined at ``points`` once more for
-    each (module docstring), at ``sol``'s order, each solved by ``solve(problem, None)``."""
-    order = sol.problem.order
-    mesh = ng.Mesh(sol.problem.mesh.ngmesh.Copy())
-    mesh.Curve(max(order, 1))
-    out = []
-    for _ in range(levels):
-        EI.refine_marked(mesh, EI.holding(mesh, points), max(order, 1))
-        problem: MacroProblem = replace(sol.problem, mesh=mesh)
-        s = solve(problem, None)
-        out.append((s, DE.body_maxima(s, dense_inset)))
+def corner_maxima(sol: MacroSolution, corners: np.ndarray, radius: float) -> dict[str, np.ndarray]:
+    """Per stress measure and body (``von_mises_<region>``, ``tresca_<region>``) the largest value at the
+    sample points of :func:`ngcontact.macro.macro_measures.field_extrema` within ``radius`` of each corner
+    (one entry per row of ``corners``; 0 where the body has no point there)."""
+    p = sol.problem
+    mesh = p.mesh
+    sig = MM.stress(sol)
+    coords = ng.CF((ng.x, ng.y, ng.z)[:mesh.dim])
+    out: dict[str, np.ndarray] = {}
+    for region in (p.rough, p.counter):
+        mips = mesh.MapToAllElements(MM._sample_rule(mesh.dim), mesh.Materials(region))
+        s = np.asarray(sig(mips)).reshape(-1, 3, 3)
+        xyz = np.asarray(coords(mips)).reshape(-1, mesh.dim)
+        near = np.linalg.norm(xyz[:, None, :] - corners[None, :, :], axis=2) <= radius
+        for name, measure in (("von_mises", von_mises), ("tresca", tresca)):
+            values = measure(s)
+            out[f"{name}_{region}"] = np.where(near, values[:, None], 0.0).max(axis=0, initial=0.0)
     return out
 
 
-def judged(e: DE.Estimate, samples: list[DE.Sample], corners: np.ndarray, h: float) -> DE.Estimate:
+def local_levels(sol: MacroSolution, solve: Callable[..., MacroSolution], points: list[tuple[float, ...]],
+                 corners: np.ndarray, radius: float, levels: int = LEVELS
+                 ) -> list[tuple[dict[str, DE.Sample], dict[str, np.ndarray]]]:
+    """Per level the body maxima and :func:`corner_maxima` (within ``radius`` of ``corners``) of ``levels``
+    solves on a copy of ``sol``'s mesh refined at ``points`` once more for each (module docstring), at
+    ``sol``'s order, each solved by ``solve(problem, None)``.  Each level is measured before the next
+    refines the copy (a solution lives on the mesh as it was refined)."""
+    order = max(sol.problem.order, 1)
+    mesh = ng.Mesh(sol.problem.mesh.ngmesh.Copy())
+    mesh.Curve(order)
+    out = []
+    for _ in range(levels):
+        EI.refine_marked(mesh, EI.holding(mesh, points), order)
+        s = solve(replace(sol.problem, mesh=mesh), None)
+        out.append((DE.body_maxima(s), corner_maxima(s, corners, radius)))
+    return out
+
+
+def growing_corner(values: list[float], at_corners: np.ndarray) -> int | None:
+    """The corner (row of ``at_corners``: levels x corners, the largest stress near each) whose stress grows
+    with every level without shrinking differences and reaches :data:`RELEVANT` of the body's maximum
+    ``values[-1]`` on the finest level; the largest such, or ``None``."""
+    grows = [k for k in range(at_corners.shape[1]) if MS.grows_without_bound(list(at_corners[:, k]))
+             and at_corners[-1, k] >= RELEVANT * abs(values[-1])]
+    return max(grows, key=lambda k: at_corners[-1, k]) if grows else None
+
+
+def judged(e: DE.Estimate, samples: list[DE.Sample], at_corners: np.ndarray, corners: np.ndarray) -> DE.Estimate:
     """The ladder's estimate ``e`` of a stress maximum judged by its values on the scene's mesh and the
-    local levels ``samples`` (module docstring); ``corners``, ``h``: where the finest level's maximum
-    is located as at a corner (:func:`ngcontact.macro.discretization_error.at_corner`)."""
+    local levels ``samples``, and the largest stress near each of ``corners`` on each level
+    (``at_corners``, levels x corners) (module docstring)."""
     values = [s.value for s in samples]
     shown = ", ".join(f"{v:.4g}" for v in values)
     head = f"{e.how}; corner check ({len(values) - 1} local refinements at the boundary's corners): {shown}"
-    if MS.grows_without_bound(values):
-        where = DE.at_corner(samples[-1].location, corners, h) or samples[-1].location
-        text = "" if where is None else f" at {DE._point(where)}"
+    if e.singular_at is not None:
+        return replace(e, how=f"{head}: the order ladder found the singularity already")
+    k = growing_corner(values, at_corners)
+    if k is not None or MS.grows_without_bound(values):
+        where = tuple(float(c) for c in corners[k]) if k is not None else samples[-1].location
+        near = "" if k is None else " (" + ", ".join(f"{v:.4g}" for v in at_corners[:, k]) + " next to it)"
         return replace(e, error=None, singular_at=where,
-                       how=f"{head}: the maximum grows with every halving of the elements at the corners, as "
-                           f"r^(lambda - 1) or log r at a singular corner: mesh dependent, singular{text}")
+                       how=f"{head}: the stress grows with every halving of the elements at the corner{near}, as "
+                           "r^(lambda - 1) or log r at a singular corner, so the body's largest stress has no "
+                           f"converged value: mesh dependent, singular at {DE._point(where)}")
     seq, how = MS.sequence_error(values, e.scale)
     if seq is None:
         if e.error is None:
@@ -114,10 +154,12 @@ def check(found: list[DE.Estimate], sol: MacroSolution, samples: dict[str, DE.Sa
     mesh = sol.problem.mesh
     corners, h = DE.corner_points(mesh), DE.shortest_boundary_edge(mesh)
     points = [tuple(c) for c in corners] + [samples[n].location for n in names if samples[n].location]
-    finer = local_levels(sol, solve, points, levels)
+    finer = local_levels(sol, solve, points, corners, h, levels)
+    near = [corner_maxima(sol, corners, h)] + [n for _, n in finer]
     out = []
     for e in found:
         if e.name in names:
-            e = judged(e, [samples[e.name]] + [m[e.name] for _, m in finer], corners, h)
+            e = judged(e, [samples[e.name]] + [m[e.name] for m, _ in finer],
+                       np.array([n[e.name] for n in near]), corners)
         out.append(e)
     return out

@@ -1,0 +1,81 @@
+"""The corner check of a macro run's stress maxima (ngcontact.macro.singular_maxima): a singular maximum is
+reported as mesh dependent, a smooth one (Lame's press fit) keeps an estimate with effectivity >= 1."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ngcontact.macro import discretization_error as DE
+from ngcontact.macro import singular_maxima as SM
+
+from tests.macro.test_discretization_error import _block_text, _lame_exact
+
+
+def _ladder(name="von_mises_bone", error=1e3):
+    return DE.Estimate(name=name, value=5.0e6, error=error, scale=5.0e6, ratio=0.2, orders=(2, 3, 4), how="ladder")
+
+
+def test_a_corner_whose_stress_grows_at_every_level_makes_the_maximum_mesh_dependent():
+    samples = [DE.Sample(v, (0.011, 0.18)) for v in (5.0e6, 5.01e6, 5.02e6)]
+    corners = np.array([[0.0, 0.0], [0.011, 0.18]])
+    near = np.array([[0.1e6, 4.9e6], [0.1e6, 5.0e6], [0.1e6, 5.1e6]])
+    e = SM.judged(_ladder(), samples, near, corners)
+    assert e.error is None and e.singular_at == pytest.approx((0.011, 0.18))
+    assert "mesh dependent, singular at" in e.how
+    acc = e.quantity(0.01)
+    assert not acc["met"] and acc["singular_at"] == pytest.approx([0.011, 0.18])
+
+
+def test_a_converging_sequence_keeps_the_larger_of_ladder_and_sequence():
+    samples = [DE.Sample(v) for v in (5.0e6, 5.004e6, 5.005e6)]
+    near = np.array([[4.0e6], [4.0e6], [4.0e6]])
+    e = SM.judged(_ladder(error=10.0), samples, near, np.array([[0.0, 0.0]]))
+    assert e.error == pytest.approx(1.5 * 1e3 * 0.25 / 0.75)
+    # a corner growing far below the body's maximum leaves it
+    near = np.array([[1e5], [2e5], [3e5]])
+    assert SM.judged(_ladder(), [DE.Sample(5e6)] * 3, near, np.array([[0.0, 0.0]])).error is not None
+
+
+def test_lames_press_fit_keeps_estimates_that_bound_the_error():
+    """No corner of the quarter ring is singular (its straight sides are symmetry planes)."""
+    from ngcontact.drivers import macro_accuracy as MA
+    from ngcontact.fem.materials import isotropic
+    from ngcontact.geometry import bodies as gm
+    from ngcontact.laws import homogenized as il
+    from ngcontact.macro import macro_problem as M
+    from tests.macro import test_discretization_error as T
+    order = 2
+    g = gm.coaxial_plane_strain(T.A, T.B, T.C, maxh=0.3, order=order)
+    sup = (M.Support(label="sym_x", components=("x",)), M.Support(label="sym_y", components=("y",)))
+    prob = M.MacroProblem(mesh=g.mesh, setting="plane_strain", rough="inner", counter="outer",
+                          materials={"inner": isotropic(T.E_IN, T.NU_IN), "outer": isotropic(T.E_OUT, T.NU_OUT)},
+                          law=il.InterfaceLaw(normal=il.LinearLaw(kn=T.K_N)), gap=-T.DELTA, supports=sup, order=order)
+    sol = M.solve(prob)
+
+    class Scene:
+        class output:
+            points_per_element = 5
+
+    def solve(problem, start):
+        return M.solve(problem, start=start)
+    samples = MA.order_samples(Scene, sol, solve)
+    found = {e.name: e for e in SM.check(MA.estimates(samples, sol), sol, samples[order], solve)}
+    for name, value in _lame_exact().items():
+        e = found[name]
+        assert e.error is not None and e.singular_at is None, f"{name}: {e.how}"
+        assert e.error / abs(e.value - value) >= 1.0, f"{name}: {e.how}"
+
+
+def test_the_clamped_corner_of_a_block_is_mesh_dependent_in_the_default_run(tmp_path):
+    from ngcontact.drivers import macro_accuracy as MA
+    from ngcontact.drivers.run_macro import build_geometry, checked_equilibrium, problem_of, solve_scene
+    from ngcontact.scene import loader
+    path = tmp_path / "block.toml"
+    path.write_text(_block_text())
+    sc = loader.load(str(path))
+    problem, _ = problem_of(sc, build_geometry(sc))
+    sol = solve_scene(sc, problem)
+    acc = MA.accuracy(sc, sol, lambda p, start: solve_scene(sc, p, start), checked_equilibrium(sol))
+    q = {x["name"]: x for x in acc["quantities"]}
+    assert not acc["met"] and q["von_mises_base"]["error"] is None
+    assert "corner check" in q["von_mises_base"]["how"]
