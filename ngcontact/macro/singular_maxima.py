@@ -93,17 +93,17 @@ def local_levels(sol: MacroSolution, solve: Callable[..., MacroSolution], points
                  corners: np.ndarray, radius: float, levels: int = LEVELS
                  ) -> list[tuple[dict[str, DE.Sample], dict[str, np.ndarray]]]:
     """Per level the body maxima and :func:`corner_maxima` (within ``radius`` of ``corners``) of ``levels``
-    solves on a copy of ``sol``'s mesh refined at ``points`` once more for each (module docstring), at
-    ``sol``'s order, each solved by ``solve(problem, None)``.  Each level is measured before the next
-    refines the copy (a solution lives on the mesh as it was refined)."""
+    solves, each on a copy of the last level's mesh (the first: ``sol``'s) refined at ``points``, at
+    ``sol``'s order, each solved by ``solve(problem, start)`` from the last level's solution interpolated
+    into its space (:func:`ngcontact.macro.discretization_error.start_at_order`: the meshes are nested)."""
     order = max(sol.problem.order, 1)
-    mesh = ng.Mesh(sol.problem.mesh.ngmesh.Copy())
-    mesh.Curve(order)
     out = []
     for _ in range(levels):
+        mesh = ng.Mesh(sol.problem.mesh.ngmesh.Copy())
         EI.refine_marked(mesh, EI.holding(mesh, points), order)
-        s = solve(replace(sol.problem, mesh=mesh), None)
-        out.append((DE.body_maxima(s), corner_maxima(s, corners, radius)))
+        problem = replace(sol.problem, mesh=mesh)
+        sol = solve(problem, DE.start_at_order(sol, problem))
+        out.append((DE.body_maxima(sol), corner_maxima(sol, corners, radius)))
     return out
 
 
@@ -116,10 +116,12 @@ def growing_corner(values: list[float], at_corners: np.ndarray) -> int | None:
     return max(grows, key=lambda k: at_corners[-1, k]) if grows else None
 
 
-def judged(e: DE.Estimate, samples: list[DE.Sample], at_corners: np.ndarray, corners: np.ndarray) -> DE.Estimate:
+def judged(e: DE.Estimate, samples: list[DE.Sample], at_corners: np.ndarray, corners: np.ndarray,
+           h: float) -> DE.Estimate:
     """The ladder's estimate ``e`` of a stress maximum judged by its values on the scene's mesh and the
     local levels ``samples``, and the largest stress near each of ``corners`` on each level
-    (``at_corners``, levels x corners) (module docstring)."""
+    (``at_corners``, levels x corners) (module docstring); ``h``: the scene's shortest boundary edge, of
+    which a maximum within :data:`~ngcontact.macro.discretization_error.AT_CORNER` sits at a corner."""
     values = [s.value for s in samples]
     shown = ", ".join(f"{v:.4g}" for v in values)
     head = f"{e.how}; corner check ({len(values) - 1} local refinements at the boundary's corners): {shown}"
@@ -134,6 +136,12 @@ def judged(e: DE.Estimate, samples: list[DE.Sample], at_corners: np.ndarray, cor
                            "r^(lambda - 1) or log r at a singular corner, so the body's largest stress has no "
                            f"converged value: mesh dependent, singular at {DE._point(where)}")
     seq, how = MS.sequence_error(values, e.scale)
+    corner = DE.at_corner(samples[-1].location, corners, h)
+    if seq is None and corner is not None and len(values) >= 3:
+        return replace(e, error=None, singular_at=corner,
+                       how=f"{head}; {how}, at the corner {DE._point(corner)}: the body's largest stress sits at a "
+                           f"corner and moves with every halving of its elements: mesh dependent, singular at "
+                           f"{DE._point(corner)}")
     if seq is None:
         if e.error is None:
             return replace(e, how=f"{head}; {how}")
@@ -160,6 +168,6 @@ def check(found: list[DE.Estimate], sol: MacroSolution, samples: dict[str, DE.Sa
     for e in found:
         if e.name in names:
             e = judged(e, [samples[e.name]] + [m[e.name] for m, _ in finer],
-                       np.array([n[e.name] for n in near]), corners)
+                       np.array([n[e.name] for n in near]), corners, h)
         out.append(e)
     return out

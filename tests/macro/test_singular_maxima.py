@@ -19,7 +19,7 @@ def test_a_corner_whose_stress_grows_at_every_level_makes_the_maximum_mesh_depen
     samples = [DE.Sample(v, (0.011, 0.18)) for v in (5.0e6, 5.01e6, 5.02e6)]
     corners = np.array([[0.0, 0.0], [0.011, 0.18]])
     near = np.array([[0.1e6, 4.9e6], [0.1e6, 5.0e6], [0.1e6, 5.1e6]])
-    e = SM.judged(_ladder(), samples, near, corners)
+    e = SM.judged(_ladder(), samples, near, corners, 2e-3)
     assert e.error is None and e.singular_at == pytest.approx((0.011, 0.18))
     assert "mesh dependent, singular at" in e.how
     acc = e.quantity(0.01)
@@ -29,11 +29,11 @@ def test_a_corner_whose_stress_grows_at_every_level_makes_the_maximum_mesh_depen
 def test_a_converging_sequence_keeps_the_larger_of_ladder_and_sequence():
     samples = [DE.Sample(v) for v in (5.0e6, 5.004e6, 5.005e6)]
     near = np.array([[4.0e6], [4.0e6], [4.0e6]])
-    e = SM.judged(_ladder(error=10.0), samples, near, np.array([[0.0, 0.0]]))
+    e = SM.judged(_ladder(error=10.0), samples, near, np.array([[0.0, 0.0]]), 2e-3)
     assert e.error == pytest.approx(1.5 * 1e3 * 0.25 / 0.75)
     # a corner growing far below the body's maximum leaves it
     near = np.array([[1e5], [2e5], [3e5]])
-    assert SM.judged(_ladder(), [DE.Sample(5e6)] * 3, near, np.array([[0.0, 0.0]])).error is not None
+    assert SM.judged(_ladder(), [DE.Sample(5e6)] * 3, near, np.array([[0.0, 0.0]]), 2e-3).error is not None
 
 
 def test_lames_press_fit_keeps_estimates_that_bound_the_error():
@@ -79,3 +79,14 @@ def test_the_clamped_corner_of_a_block_is_mesh_dependent_in_the_default_run(tmp_
     q = {x["name"]: x for x in acc["quantities"]}
     assert not acc["met"] and q["von_mises_base"]["error"] is None
     assert "corner check" in q["von_mises_base"]["how"]
+
+
+def test_a_maximum_at_a_corner_that_neither_converges_nor_grows_is_mesh_dependent():
+    samples = [DE.Sample(v, (0.011, 0.18)) for v in (6.03e6, 6.01e6, 6.04e6)]
+    corners = np.array([[0.011, 0.18]])
+    near = np.array([[6.03e6], [6.01e6], [6.04e6]])
+    e = SM.judged(_ladder("tresca_bone"), samples, near, corners, 2e-3)
+    assert e.error is None and "mesh dependent, singular at" in e.how
+    # the same sequence away from every corner keeps at least its last difference
+    away = [DE.Sample(s.value, (0.0, 0.1)) for s in samples]
+    assert SM.judged(_ladder("tresca_bone"), away, near * 0.1, corners, 2e-3).error == pytest.approx(1.5 * 3e4)
