@@ -89,6 +89,20 @@ def corner_maxima(sol: MacroSolution, corners: np.ndarray, radius: float) -> dic
     return out
 
 
+def star(mesh: ng.Mesh, corners: np.ndarray) -> np.ndarray:
+    """The volume elements that have a vertex at one of ``corners`` (all of them: a stress maximum at a
+    vertex is sampled in each element around it), as a boolean array."""
+    out = np.zeros(mesh.ne, dtype=bool)
+    if not len(corners):
+        return out
+    pts = np.array([mesh[ng.NodeId(ng.VERTEX, i)].point for i in range(mesh.nv)])
+    tol = 1e-9 * float(np.abs(pts).max())
+    at = {i for i in range(mesh.nv) if np.min(np.linalg.norm(corners - pts[i], axis=1)) <= tol}
+    for el in mesh.Elements(ng.VOL):
+        out[el.nr] = any(v.nr in at for v in el.vertices)
+    return out
+
+
 def local_levels(sol: MacroSolution, solve: Callable[..., MacroSolution], points: list[tuple[float, ...]],
                  corners: np.ndarray, radius: float, levels: int = LEVELS
                  ) -> list[tuple[dict[str, DE.Sample], dict[str, np.ndarray]]]:
@@ -100,7 +114,7 @@ def local_levels(sol: MacroSolution, solve: Callable[..., MacroSolution], points
     out = []
     for _ in range(levels):
         mesh = ng.Mesh(sol.problem.mesh.ngmesh.Copy())
-        EI.refine_marked(mesh, EI.holding(mesh, points), order)
+        EI.refine_marked(mesh, EI.holding(mesh, points) | star(mesh, corners), order)
         problem = replace(sol.problem, mesh=mesh)
         sol = solve(problem, DE.start_at_order(sol, problem))
         out.append((DE.body_maxima(sol), corner_maxima(sol, corners, radius)))
