@@ -21,24 +21,32 @@ Why a corner's maximum needs a mesh check
     rate.
 
 The check
-    The elements holding a corner of the mesh's boundary (:func:`ngcontact.macro.discretization_error.
-    corner_points`) or a body's maximum are refined :data:`LEVELS` times (Netgen's local refinement,
-    on a copy of the mesh: the reported solution stays on the scene's), each level solved at the scene's
-    order; the maximum of each level is sampled as the scene's.  Each level halves the elements at the
-    corners, so the sample points there move closer to the vertex by a factor 2, and the level values
-    ``Q_0, Q_1, Q_2`` measure what the ladder cannot:
+    Every element with a vertex at a corner of the mesh's boundary (:func:`ngcontact.macro.discretization_error.
+    corner_points`: where two boundary labels meet or the boundary turns) and the elements holding a body's
+    maximum are refined :data:`LEVELS` times (Netgen's local refinement, on copies of the mesh: the reported
+    solution stays on the scene's), each level solved at the scene's order from the last level's solution
+    interpolated into its space (the meshes are nested, so the solve starts next to its solution).  Each
+    level halves the elements at the corners, so the sample points there move closer to the vertex by a
+    factor 2.  The body's maximum and the largest stress within one boundary edge of each corner are taken
+    on every level (``Q_0, Q_1, Q_2``):
 
-    * a maximum that grows at each level by a difference that does not shrink (``r^(lambda - 1)`` grows
-      by a factor ``2^(1 - lambda)`` per halving, ``log r`` by a constant) has no converged value: it is
-      reported as **mesh dependent, singular at** the corner it sits at (``error = None``,
-      ``met = false``), never with a small estimate;
+    * a corner whose stress grows at each level by a difference that does not shrink (``r^(lambda - 1)``
+      grows by a factor ``2^(1 - lambda)`` per halving, ``log r`` by a constant) and reaches
+      :data:`RELEVANT` of the body's maximum makes that maximum **mesh dependent, singular at** the corner
+      (``error = None``, ``met = false``), never a small estimate; so does a body maximum that grows so;
+    * a body maximum that sits at a corner (within :data:`~ngcontact.macro.discretization_error.AT_CORNER`
+      of the scene's shortest boundary edge) and whose levels neither converge nor grow has no rate and
+      no limit that could be extrapolated: mesh dependent as well;
     * otherwise the sequence's estimate (:func:`ngcontact.macro.mesh_sequence.sequence_error`, the
       geometric tail of the level differences with the factor of safety) is taken where it exceeds the
-      ladder's, so a slowly converging corner is estimated from the mesh;
-    * a sequence that neither converges nor grows keeps no estimate (not converging).
+      ladder's, so a slowly converging corner is estimated from the mesh; a sequence that does not
+      converge away from the corners adds its last difference times the factor of safety.
 
-A maximum away from every corner is checked as well: a finer mesh at the corners may reveal that the
-body's largest stress is at a corner the scene's mesh under-resolves (the maximum moves there).
+A corner whose stress grows but stays below :data:`RELEVANT` of the body's maximum leaves the maximum
+as it is: its value is the largest stress away from that corner, which the corner reaches only after
+many more halvings (a ``log r`` term gains a constant per halving).  A maximum the order ladder already
+found singular stays singular.  The check costs about one solve of the scene (two warm-started solves
+on meshes a little larger than the scene's).
 """
 from __future__ import annotations
 
@@ -148,7 +156,8 @@ def judged(e: DE.Estimate, samples: list[DE.Sample], at_corners: np.ndarray, cor
         return replace(e, error=None, singular_at=where,
                        how=f"{head}: the stress grows with every halving of the elements at the corner{near}, as "
                            "r^(lambda - 1) or log r at a singular corner, so the body's largest stress has no "
-                           f"converged value: mesh dependent, singular at {DE._point(where)}")
+                           "converged value: mesh dependent, singular"
+                           + ("" if where is None else f" at {DE._point(where)}"))
     seq, how = MS.sequence_error(values, e.scale)
     corner = DE.at_corner(samples[-1].location, corners, h)
     if seq is None and corner is not None and len(values) >= 3:
@@ -175,7 +184,7 @@ def check(found: list[DE.Estimate], sol: MacroSolution, samples: dict[str, DE.Sa
         return found
     mesh = sol.problem.mesh
     corners, h = DE.corner_points(mesh), DE.shortest_boundary_edge(mesh)
-    points = [tuple(c) for c in corners] + [samples[n].location for n in names if samples[n].location]
+    points = [loc for loc in (samples[n].location for n in names) if loc is not None]
     finer = local_levels(sol, solve, points, corners, h, levels)
     near = [corner_maxima(sol, corners, h)] + [n for _, n in finer]
     out = []
