@@ -193,4 +193,25 @@ def check(found: list[DE.Estimate], sol: MacroSolution, samples: dict[str, DE.Sa
             e = judged(e, [samples[e.name]] + [m[e.name] for m, _ in finer],
                        np.array([n[e.name] for n in near]), corners, h)
         out.append(e)
+    return same_body(out)
+
+
+def _body(name: str) -> str:
+    """The region of a stress maximum's name (``von_mises_<region>``, ``tresca_<region>``)."""
+    return next((name[len(p):] for p in STRESS if name.startswith(p)), name)
+
+
+def same_body(found: list[DE.Estimate]) -> list[DE.Estimate]:
+    """Every stress maximum of a body with one found singular at a corner made singular at that corner too:
+    ``sqrt(3)/2 tresca <= von_mises <= tresca``, so where one is unbounded, so is the other."""
+    singular = {_body(e.name): e for e in found if e.name.startswith(STRESS) and e.singular_at is not None}
+    out = []
+    for e in found:
+        hit = singular.get(_body(e.name)) if e.name.startswith(STRESS) and e.singular_at is None else None
+        if hit is not None and hit.singular_at is not None:
+            e = replace(e, error=None, singular_at=hit.singular_at,
+                        how=f"{e.how}; {hit.name} grows without bound at the corner and sqrt(3)/2 tresca <= "
+                            "von_mises <= tresca, so this maximum has no converged value either: mesh dependent, "
+                            f"singular at {DE._point(hit.singular_at)}")
+        out.append(e)
     return out

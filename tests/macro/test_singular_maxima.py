@@ -90,3 +90,18 @@ def test_a_maximum_at_a_corner_that_neither_converges_nor_grows_is_mesh_dependen
     # the same sequence away from every corner keeps at least its last difference
     away = [DE.Sample(s.value, (0.0, 0.1)) for s in samples]
     assert SM.judged(_ladder("tresca_bone"), away, near * 0.1, corners, 2e-3).error == pytest.approx(1.5 * 3e4)
+
+
+def test_the_other_measure_of_a_singular_body_is_singular_too():
+    found = [DE.Estimate(name="von_mises_bone", value=5e6, error=None, scale=5e6, ratio=0.2, orders=(2, 3, 4),
+                         how="x", singular_at=(0.011, 0.18)),
+             _ladder("tresca_bone"), _ladder("tresca_stem")]
+    out = {e.name: e for e in SM.same_body(found)}
+    assert out["tresca_bone"].error is None and out["tresca_bone"].singular_at == (0.011, 0.18)
+    assert out["tresca_stem"].error is not None
+
+
+def test_the_terminal_line_says_mesh_dependent():
+    from ngcontact.output import report
+    q = {"name": "von_mises_bone", "value": 5e6, "error": None, "relative_error": None, "singular_at": [0.011, 0.18]}
+    assert report._error_text(q) == "(mesh dependent: singular at (0.011, 0.18))"
