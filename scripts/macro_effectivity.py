@@ -12,8 +12,9 @@ one below and above on the same mesh (:mod:`ngcontact.macro.discretization_error
   sizes halved (a stress maximum: that field's largest value over a dense lattice of points per
   element), the safety factor by the linear recovery included (skipped with ``--quick``).
 
-Each stress maximum's estimate is the default run's: the order ladder judged by the corner check
-(:mod:`ngcontact.macro.singular_maxima`), which reports a maximum at a singular corner without an estimate.
+Each stress maximum's estimate is the default run's: the order ladder judged by
+:mod:`ngcontact.macro.singular_maxima`, which reports a maximum with no converged value (a closed end of
+the interface, a singular corner) without an estimate.
 
 For each quantity: the value, the estimate, the true error and their ratio, the effectivity (issue 35
 asks for it between 1 and 10).  Then the refinement towards ``discretization.tolerance``
@@ -293,11 +294,13 @@ def effectivity(args) -> None:
                               "femur scene at its order 3 against order 4 on its mesh sizes halved (a stress maximum: "
                               "over a dense lattice of points per element). Stress maxima as a default run estimates "
                               "them: the "
-                              "order ladder judged by two local refinements at the boundary's corners "
-                              "(ngcontact/macro/singular_maxima.py); the femur's bone maxima sit at the corner "
-                              "(11, 180) mm where the interface ends at the bone top and grow with every halving "
-                              "there (a singular corner, whose maximum has no converged value: the reference "
-                              "'order 4, mesh halved' moves with the mesh). An empty "
+                              "order ladder judged by ngcontact/macro/singular_maxima.py (a closed end of the "
+                              "interface "
+                              "on a free boundary, else two local refinements at the boundary's corners); the "
+                              "femur's interface ends closed at the bone top, "
+                              "(11, 180) mm, where the traction jumps and both bodies' stress grows without bound "
+                              "(its maxima have no converged value: the reference 'order 4, mesh halved' moves with "
+                              "the mesh, and the stem's maximum moves there under refinement). An empty "
                               "estimate is a quantity reported without one (not converging or singular). "
                               "Issue 35 asks for effectivities between 1 and 10.")
 

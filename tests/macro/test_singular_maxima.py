@@ -66,7 +66,9 @@ def test_lames_press_fit_keeps_estimates_that_bound_the_error():
         assert e.error / abs(e.value - value) >= 1.0, f"{name}: {e.how}"
 
 
-def test_the_clamped_corner_of_a_block_is_mesh_dependent_in_the_default_run(tmp_path):
+def test_a_block_whose_interface_ends_closed_on_its_free_side_is_mesh_dependent(tmp_path):
+    """Where the interface ends on a free side while closed, the traction jumps: both bodies' maxima have no
+    limit (the module's closed ends), found without the local levels."""
     from ngcontact.drivers import macro_accuracy as MA
     from ngcontact.drivers.run_macro import build_geometry, checked_equilibrium, problem_of, solve_scene
     from ngcontact.scene import loader
@@ -78,7 +80,17 @@ def test_the_clamped_corner_of_a_block_is_mesh_dependent_in_the_default_run(tmp_
     acc = MA.accuracy(sc, sol, lambda p, start: solve_scene(sc, p, start), checked_equilibrium(sol))
     q = {x["name"]: x for x in acc["quantities"]}
     assert not acc["met"] and q["von_mises_base"]["error"] is None
-    assert "corner check" in q["von_mises_base"]["how"]
+    # the ladder's singularity at the clamped corner stays where the ladder found it
+    assert q["von_mises_base"]["singular_at"] == pytest.approx([0.02, -0.005])
+    # the block's maxima: the interface ends on the block's free side while closed
+    assert q["von_mises_block"]["error"] is None and "mesh dependent, singular at" in q["von_mises_block"]["how"]
+    assert q["von_mises_block"]["singular_at"] == pytest.approx([0.02, 0.0])
+    assert "(mesh dependent: singular at (0.02, 0))" in report_line(acc)
+
+
+def report_line(acc: dict) -> str:
+    from ngcontact.output import report
+    return " ".join(report._error_text(q) for q in acc["quantities"])
 
 
 def test_a_maximum_at_a_corner_that_neither_converges_nor_grows_is_mesh_dependent():
