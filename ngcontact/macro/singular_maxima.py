@@ -1,4 +1,4 @@
-"""Whether a body's largest stress has a converged value: a local mesh check at the boundary's corners.
+"""Whether a body's largest stress has a converged value: the interface's closed ends, a mesh check at corners.
 
 The order ladder (:mod:`ngcontact.macro.discretization_error`) estimates the error of a stress maximum
 from the orders ``p - 1, p, p + 1`` on one mesh.  The maximum is taken over sample points of each
