@@ -15,6 +15,11 @@ The verdict has the format of the cell's (:func:`ngcontact.cell.admissibility.ve
   the cell table's interpolation error (relative, paper Sec. 3.5; :mod:`ngcontact.coupling.pressure_table`);
 * the check ``equilibrium`` (each body's forces balance, :func:`ngcontact.macro.macro_measures.equilibrium`).
 
+In 2D, without ``[two_scale]`` and without a refinement (whose mesh levels judge them), every stress maximum
+is also judged by two local refinements at the corners of the boundary
+(:mod:`ngcontact.macro.singular_maxima`): the ladder converges to the stress at sample points fixed on
+the mesh, which at a singular corner moves with the mesh; such a maximum is reported as mesh dependent.
+
 A quantity whose relative error exceeds the tolerance, or has none (not converging, a stress
 singularity), marks the verdict as not met and is said in one warning line.
 """
@@ -27,6 +32,7 @@ from typing import Any, Callable
 from ngcontact.cell.admissibility import DEFAULT_TOLERANCE
 from ngcontact.coupling import homogenization_error
 from ngcontact.macro import discretization_error as DE
+from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.scene.schema import MAX_ORDER
 
@@ -34,8 +40,9 @@ log = logging.getLogger(__name__)
 
 #: how the verdict's errors are estimated (the report's ``accuracy.how``)
 HOW = ("discretization error of each headline quantity from solves at the neighbouring polynomial orders on "
-       "the scene's mesh (ngcontact.macro.discretization_error); the two-scale loop's residual and the cell "
-       "table's interpolation error as their own quantities")
+       "the scene's mesh (ngcontact.macro.discretization_error), each stress maximum of a 2D run judged by two "
+       "local refinements at the boundary's corners (ngcontact.macro.singular_maxima); the two-scale loop's "
+       "residual and the cell table's interpolation error as their own quantities")
 #: the meaning of the macro run's checks
 CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its largest force"}
 
@@ -150,7 +157,10 @@ def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], bal
     ``solve(problem, start)`` (or the estimates ``found`` already by a refinement, with its mesh levels),
     the safety factor re-evaluated with the strength check's correctors ``recovery``."""
     if found is None:
-        found = estimates(order_samples(scene, sol, solve, safety_factor_of(scene, recovery)), sol)
+        samples = order_samples(scene, sol, solve, safety_factor_of(scene, recovery))
+        found = estimates(samples, sol)
+        if sol.problem.mesh.dim == 2 and two_scale is None:
+            found = SM.check(found, sol, samples[sol.problem.order], solve)
     out = verdict(found, scene.discretization.tolerance, balance, two_scale)
     out["modelling"] = modelling(scene, sol)
     return out

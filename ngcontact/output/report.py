@@ -127,6 +127,16 @@ def to_plain(obj, path: str = "results"):
 
 
 
+
+def _error_text(q: dict) -> str:
+    """A quantity's error on the terminal line: ``+/- rel``, ``(no estimate)``, or where its value has no
+    limit (a stress maximum at a singular corner) ``(mesh dependent: singular at (x, y))``."""
+    if q.get("singular_at") is not None:
+        return "(mesh dependent: singular at (" + ", ".join(f"{c:.4g}" for c in q["singular_at"]) + "))"
+    if q.get("relative_error") is None:
+        return "(no estimate)"
+    return f"+/- {q['relative_error']:.2%}"
+
 def accuracy_line(results: dict) -> str | None:
     """The accuracy verdict (``results.accuracy``) in one terminal line: met or not, and per quantity its
     value and estimated relative error (the largest over the loads of a sweep, with that load's value); a
@@ -142,8 +152,7 @@ def accuracy_line(results: dict) -> str | None:
         rel = q.get("relative_error")
         if seen is None or rel is None or (seen.get("relative_error") is not None and rel > seen["relative_error"]):
             worst[q["name"]] = q
-    parts = [f"{n} {q['value']:.4g} " + ("(no estimate)" if q.get("relative_error") is None
-                                        else f"+/- {q['relative_error']:.2%}") for n, q in worst.items()]
+    parts = [f"{n} {q['value']:.4g} " + _error_text(q) for n, q in worst.items()]
     verdict = "met" if acc.get("met") else "NOT met"
     refined = acc.get("refinement") or {}
     if refined.get("order") is not None:
