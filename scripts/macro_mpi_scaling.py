@@ -27,7 +27,8 @@ time is the measured time per dof of a part times the dofs of a part
 across machines is not in the model).
 
     python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--femur 1 1.5]
-                                        [--ranks 1 2 3] [--rows-from CSV ...] [--publish]
+                                        [--refined MAXH:K ...] [--ranks 1 2 3] [--rows-from CSV ...]
+                                        [--publish]
 
 Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_model.csv`` and ``.png`` (default
 ``results/macro_mpi_scaling``).
@@ -50,7 +51,7 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 from ngcontact.output.writer import write_csv  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-KEYS = ("scene", "size", "ranks", "ndof", "work_s", "wall_s", "newton", "cg_iterations", "peak_mb_rank0",
+KEYS = ("scene", "size", "refinements", "ranks", "ndof", "work_s", "wall_s", "newton", "cg_iterations", "peak_mb_rank0",
         "peak_mb_parts_max", "peak_mb_each")
 MODEL_KEYS = ("ndof", "ranks", "dofs_per_part", "part_gb", "rank0_gb", "solve_s_estimate")
 #: the sizes of the model of 64 ranks
@@ -95,6 +96,7 @@ pressure = 5e6
 [discretization]
 order = 2
 maxh = {size}
+refinements = {refinements}
 max_elements = 3000000
 [solver]
 linear = "iterative"
@@ -111,7 +113,9 @@ def femur(factor: float) -> str:
     return text.replace("\nrtol = 1e-10\n", '\nrtol = 1e-10\nlinear = "iterative"\n')
 
 
-SCENES = {"press_fit": lambda size: PRESS_FIT.format(size=size), "femur": femur}
+SCENES = {"press_fit": lambda size, k: PRESS_FIT.format(size=size, refinements=0),
+          "press_fit_refined": lambda size, k: PRESS_FIT.format(size=size, refinements=k),
+          "femur": lambda size, k: femur(size)}
 
 
 def _peak_mb() -> float:
@@ -140,12 +144,12 @@ def child(scene: str, out: str) -> int:
     return 0
 
 
-def measure(name: str, size: float, ranks: int, work: str) -> dict:
-    """One run of scene ``name`` at ``size`` on ``ranks`` ranks."""
-    tag = f"{name}_{size:g}_r{ranks}"
+def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0) -> dict:
+    """One run of scene ``name`` at ``size`` (refined ``refinements`` times) on ``ranks`` ranks."""
+    tag = f"{name}_{size:g}_k{refinements}_r{ranks}"
     scene = os.path.join(work, f"{tag}.toml")
     with open(scene, "w") as fh:
-        fh.write(SCENES[name](size))
+        fh.write(SCENES[name](size, refinements))
     out = os.path.join(work, tag)
     cmd = [sys.executable, os.path.abspath(__file__), "--child", scene, out]
     if ranks > 1:
@@ -161,7 +165,7 @@ def measure(name: str, size: float, ranks: int, work: str) -> dict:
             peaks.append(round(float(fh.read()), 1))
     stages = {k: v for k, v in rep["timings"].items() if k != "total"}
     parts = peaks[1:] if ranks > 1 else peaks
-    return {"scene": name, "size": size, "ranks": ranks, "ndof": rep["ndof"],
+    return {"scene": name, "size": size, "refinements": refinements, "ranks": ranks, "ndof": rep["ndof"],
             "work_s": round(sum(stages.values()), 2), "wall_s": round(wall, 2),
             "newton": rep["solver"]["iterations"],
             "cg_iterations": sum(rep["solver"]["linear"].get("cg_iterations", [])),
@@ -174,9 +178,9 @@ def read_rows(path: str) -> list[dict]:
     import csv
     with open(path, newline="") as fh:
         rows = list(csv.DictReader(fh))
-    numbers = {"size": float, "ranks": int, "ndof": int, "work_s": float, "wall_s": float, "newton": int,
-               "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
-    return [{k: numbers[k](v) if k in numbers else v for k, v in row.items()} for row in rows]
+    numbers = {"size": float, "refinements": int, "ranks": int, "ndof": int, "work_s": float, "wall_s": float,
+               "newton": int, "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
+    return [{k: numbers[k](row.get(k) or 0) if k in numbers else row.get(k, "") for k in KEYS} for row in rows]
 
 
 def model(data: list[dict], ranks: int = 64) -> list[dict]:
@@ -249,6 +253,8 @@ def main(argv=None) -> int:
     ap.add_argument("out", nargs="?", default=os.path.join("results", "macro_mpi_scaling"), help="output directory")
     ap.add_argument("--maxh", type=float, nargs="*", default=[0.004, 0.002, 0.001], help="press fit mesh sizes [m]")
     ap.add_argument("--femur", type=float, nargs="*", default=[1.0, 1.5], help="femur refinement factors")
+    ap.add_argument("--refined", nargs="*", default=[], metavar="MAXH:K",
+                    help="press fit meshes made with MAXH and refined K times uniformly (on the ranks under MPI)")
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3], help="numbers of MPI ranks")
     ap.add_argument("--rows-from", nargs="+", default=[], metavar="CSV",
                     help="no runs: the rows of these CSV files of earlier runs (e.g. a large size run apart)")
@@ -257,11 +263,12 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     work = os.path.abspath(os.path.join(args.out, "runs"))
     os.makedirs(work, exist_ok=True)
-    runs = [("press_fit", h) for h in args.maxh] + [("femur", f) for f in args.femur]
+    runs = [("press_fit", h, 0) for h in args.maxh] + [("femur", f, 0) for f in args.femur] + \
+        [("press_fit_refined", float(r.split(":")[0]), int(r.split(":")[1])) for r in args.refined]
     data = [row for path in args.rows_from for row in read_rows(path)]
-    for name, size in ([] if args.rows_from else runs):
+    for name, size, k in ([] if args.rows_from else runs):
         for r in args.ranks:
-            data.append(measure(name, size, r, work))
+            data.append(measure(name, size, r, work, k))
             print(" ".join(f"{k}={data[-1][k]}" for k in KEYS), flush=True)
     csv_path = os.path.join(args.out, "macro_mpi_scaling.csv")
     write_csv(csv_path, list(KEYS), [[d[k] for k in KEYS] for d in data])
