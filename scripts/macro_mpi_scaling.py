@@ -2,15 +2,20 @@
 
 Scenes: the quarter of two coaxial tubes pressed together (interference
 2 um, 5 MPa on the top; the scene of ``tests/distributed/test_mpi_macro.py``),
-refined by ``discretization.maxh``; the shipped 3D femur with its hip stem
+refined by ``discretization.maxh`` or, ``press_fit_refined``, made with ``maxh`` and split
+uniformly ``discretization.refinements`` times (under MPI on the ranks, each
+its own part; ``--refined MAXH:K``); the shipped 3D femur with its hip stem
 (``geometries/femur_stem_3d.toml``, Coulomb friction), refined by dividing
 ``maxh`` and ``interface_maxh`` by a factor.  Both at order 2 with
 ``solver.linear = "iterative"`` (BDDC-CG, what runs distributed).
 
 Each run is a fresh process (one rank) or ``mpiexec -n N`` (N ranks).
-NGSolve distributes the mesh to ranks 1 .. N-1 (rank 0 makes the mesh and
-keeps it whole, holding no element of the solve): 2 ranks are one part, 3
-ranks two parts.  Post-processing is reduced over the ranks
+NGSolve distributes the mesh to ranks 1 .. N-1 (rank 0 makes the mesh,
+coarse where the ranks refine it, distributes it and lets it go, holding no
+element of the solve): 2 ranks are one part, 3 ranks two parts.  Rank 0
+still holds BDDC's coarse problem, which NGSolve's parallel BDDC gathers and
+factorizes there (the wirebasket: vertices, edges and the whole interface
+surface's dofs, ``ngcontact.fem.elasticity.surface_wirebasket``).  Post-processing is reduced over the ranks
 (:mod:`ngcontact.distributed.reduced_measures`) and the VTK file written in
 pieces.  One process runs without its discretization error estimate (the
 solves at the neighbouring orders, which a distributed run does not make),
@@ -230,8 +235,10 @@ def plot(data: list[dict], path: str) -> None:
 
 
 NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, BDDC-CG) in one process and under "
-        "`mpiexec -n 2` and `-n 3`. Rank 0 makes the mesh and keeps it whole but holds no element of the "
-        "solve, so 2 ranks are one part (its memory is that of one process's solve) and 3 ranks two parts. "
+        "`mpiexec -n 2` and `-n 3`. Rank 0 makes the mesh (press_fit_refined: the coarse one, which the "
+        "ranks refine uniformly, each its part), distributes it and lets it go, holding no element of the "
+        "solve but BDDC's coarse problem (NGSolve's parallel BDDC factorizes it on rank 0), so 2 ranks "
+        "are one part and 3 ranks two parts. "
         "`work_s`: the stages from meshing to post-processing (one process without its discretization error "
         "estimate, which a distributed run does not make either). `peak_mb_each`: every rank's peak resident "
         "memory, rank 0 first. "
@@ -239,10 +246,12 @@ NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, BDDC-CG)
         "memory is not affected.")
 MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the largest run (the press fit): the "
               "peak memory of the largest part fitted as a line in its dofs, rank 0's as a line in the whole "
-              "mesh's dofs (it makes, curves and keeps the whole mesh), both evaluated for 64 ranks (63 parts); "
+              "mesh's dofs (BDDC's coarse problem, gathered there, grows with the whole mesh), both evaluated "
+              "for 64 ranks (63 parts); "
               "the time is the largest run's work time per dof of a part times the dofs of a part (BDDC-CG "
               "iterations grow slowly with the size; communication across machines is not modelled). Rank 0 "
-              "grows with the whole problem and is the limit: meshing in parallel would remove it.")
+              "grows with the whole problem and is the limit: a coarse solve distributed over the ranks would "
+              "remove it.")
 
 
 def main(argv=None) -> int:
