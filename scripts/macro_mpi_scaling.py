@@ -2,15 +2,20 @@
 
 Scenes: the quarter of two coaxial tubes pressed together (interference
 2 um, 5 MPa on the top; the scene of ``tests/distributed/test_mpi_macro.py``),
-refined by ``discretization.maxh``; the shipped 3D femur with its hip stem
+refined by ``discretization.maxh`` or, ``press_fit_refined``, made with ``maxh`` and split
+uniformly ``discretization.refinements`` times (under MPI on the ranks, each
+its own part; ``--refined MAXH:K``); the shipped 3D femur with its hip stem
 (``geometries/femur_stem_3d.toml``, Coulomb friction), refined by dividing
 ``maxh`` and ``interface_maxh`` by a factor.  Both at order 2 with
 ``solver.linear = "iterative"`` (BDDC-CG, what runs distributed).
 
 Each run is a fresh process (one rank) or ``mpiexec -n N`` (N ranks).
-NGSolve distributes the mesh to ranks 1 .. N-1 (rank 0 makes the mesh and
-keeps it whole, holding no element of the solve): 2 ranks are one part, 3
-ranks two parts.  Post-processing is reduced over the ranks
+NGSolve distributes the mesh to ranks 1 .. N-1 (rank 0 makes the mesh,
+coarse where the ranks refine it, distributes it and lets it go, holding no
+element of the solve): 2 ranks are one part, 3 ranks two parts.  Rank 0
+still holds BDDC's coarse problem, which NGSolve's parallel BDDC gathers and
+factorizes there (the wirebasket: vertices, edges and the whole interface
+surface's dofs, ``ngcontact.fem.elasticity.surface_wirebasket``).  Post-processing is reduced over the ranks
 (:mod:`ngcontact.distributed.reduced_measures`) and the VTK file written in
 pieces.  One process runs without its discretization error estimate (the
 solves at the neighbouring orders, which a distributed run does not make),
@@ -27,7 +32,8 @@ time is the measured time per dof of a part times the dofs of a part
 across machines is not in the model).
 
     python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--femur 1 1.5]
-                                        [--ranks 1 2 3] [--rows-from CSV ...] [--publish]
+                                        [--refined MAXH:K ...] [--ranks 1 2 3] [--rows-from CSV ...]
+                                        [--publish]
 
 Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_model.csv`` and ``.png`` (default
 ``results/macro_mpi_scaling``).
@@ -50,7 +56,7 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 from ngcontact.output.writer import write_csv  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-KEYS = ("scene", "size", "ranks", "ndof", "work_s", "wall_s", "newton", "cg_iterations", "peak_mb_rank0",
+KEYS = ("scene", "size", "refinements", "ranks", "ndof", "work_s", "wall_s", "newton", "cg_iterations", "peak_mb_rank0",
         "peak_mb_parts_max", "peak_mb_each")
 MODEL_KEYS = ("ndof", "ranks", "dofs_per_part", "part_gb", "rank0_gb", "solve_s_estimate")
 #: the sizes of the model of 64 ranks
@@ -95,6 +101,7 @@ pressure = 5e6
 [discretization]
 order = 2
 maxh = {size}
+refinements = {refinements}
 max_elements = 3000000
 [solver]
 linear = "iterative"
@@ -111,7 +118,9 @@ def femur(factor: float) -> str:
     return text.replace("\nrtol = 1e-10\n", '\nrtol = 1e-10\nlinear = "iterative"\n')
 
 
-SCENES = {"press_fit": lambda size: PRESS_FIT.format(size=size), "femur": femur}
+SCENES = {"press_fit": lambda size, k: PRESS_FIT.format(size=size, refinements=0),
+          "press_fit_refined": lambda size, k: PRESS_FIT.format(size=size, refinements=k),
+          "femur": lambda size, k: femur(size)}
 
 
 def _peak_mb() -> float:
@@ -140,12 +149,12 @@ def child(scene: str, out: str) -> int:
     return 0
 
 
-def measure(name: str, size: float, ranks: int, work: str) -> dict:
-    """One run of scene ``name`` at ``size`` on ``ranks`` ranks."""
-    tag = f"{name}_{size:g}_r{ranks}"
+def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0) -> dict:
+    """One run of scene ``name`` at ``size`` (refined ``refinements`` times) on ``ranks`` ranks."""
+    tag = f"{name}_{size:g}_k{refinements}_r{ranks}"
     scene = os.path.join(work, f"{tag}.toml")
     with open(scene, "w") as fh:
-        fh.write(SCENES[name](size))
+        fh.write(SCENES[name](size, refinements))
     out = os.path.join(work, tag)
     cmd = [sys.executable, os.path.abspath(__file__), "--child", scene, out]
     if ranks > 1:
@@ -161,7 +170,7 @@ def measure(name: str, size: float, ranks: int, work: str) -> dict:
             peaks.append(round(float(fh.read()), 1))
     stages = {k: v for k, v in rep["timings"].items() if k != "total"}
     parts = peaks[1:] if ranks > 1 else peaks
-    return {"scene": name, "size": size, "ranks": ranks, "ndof": rep["ndof"],
+    return {"scene": name, "size": size, "refinements": refinements, "ranks": ranks, "ndof": rep["ndof"],
             "work_s": round(sum(stages.values()), 2), "wall_s": round(wall, 2),
             "newton": rep["solver"]["iterations"],
             "cg_iterations": sum(rep["solver"]["linear"].get("cg_iterations", [])),
@@ -174,16 +183,18 @@ def read_rows(path: str) -> list[dict]:
     import csv
     with open(path, newline="") as fh:
         rows = list(csv.DictReader(fh))
-    numbers = {"size": float, "ranks": int, "ndof": int, "work_s": float, "wall_s": float, "newton": int,
-               "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
-    return [{k: numbers[k](v) if k in numbers else v for k, v in row.items()} for row in rows]
+    numbers = {"size": float, "refinements": int, "ranks": int, "ndof": int, "work_s": float, "wall_s": float,
+               "newton": int, "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
+    return [{k: numbers[k](row.get(k) or 0) if k in numbers else row.get(k, "") for k in KEYS} for row in rows]
 
 
 def model(data: list[dict], ranks: int = 64) -> list[dict]:
     """What ``ranks`` ranks would need at :data:`MODEL_NDOF` (see the module's docstring)."""
     dist = [d for d in data if d["ranks"] > 1]
-    scene = max(dist, key=lambda d: d["ndof"])["scene"] if dist else ""
-    dist = [d for d in dist if d["scene"] == scene]
+    def problem(d: dict) -> str:            # the press fit made finer by maxh or by refinements: one problem
+        return d["scene"].removesuffix("_refined")
+    scene = problem(max(dist, key=lambda d: d["ndof"])) if dist else ""
+    dist = [d for d in dist if problem(d) == scene]
     if len({d["ndof"] for d in dist}) < 2:
         return []
     part = np.array([d["ndof"] / (d["ranks"] - 1) for d in dist])
@@ -226,8 +237,10 @@ def plot(data: list[dict], path: str) -> None:
 
 
 NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, BDDC-CG) in one process and under "
-        "`mpiexec -n 2` and `-n 3`. Rank 0 makes the mesh and keeps it whole but holds no element of the "
-        "solve, so 2 ranks are one part (its memory is that of one process's solve) and 3 ranks two parts. "
+        "`mpiexec -n 2` and `-n 3`. Rank 0 makes the mesh (press_fit_refined: the coarse one, which the "
+        "ranks refine uniformly, each its part), distributes it and lets it go, holding no element of the "
+        "solve but BDDC's coarse problem (NGSolve's parallel BDDC factorizes it on rank 0), so 2 ranks "
+        "are one part and 3 ranks two parts. "
         "`work_s`: the stages from meshing to post-processing (one process without its discretization error "
         "estimate, which a distributed run does not make either). `peak_mb_each`: every rank's peak resident "
         "memory, rank 0 first. "
@@ -235,10 +248,13 @@ NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, BDDC-CG)
         "memory is not affected.")
 MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the largest run (the press fit): the "
               "peak memory of the largest part fitted as a line in its dofs, rank 0's as a line in the whole "
-              "mesh's dofs (it makes, curves and keeps the whole mesh), both evaluated for 64 ranks (63 parts); "
+              "mesh's dofs (BDDC's coarse problem, gathered there, grows with the whole mesh), both evaluated "
+              "for 64 ranks (63 parts); "
               "the time is the largest run's work time per dof of a part times the dofs of a part (BDDC-CG "
               "iterations grow slowly with the size; communication across machines is not modelled). Rank 0 "
-              "grows with the whole problem and is the limit: meshing in parallel would remove it.")
+              "grows with the whole problem and is the limit: a coarse solve distributed over the ranks would "
+              "remove it. Its line is fitted to sizes close together and understates large runs, whose coarse "
+              "factorization grows faster than linearly (the attempt at 2M dofs noted above).")
 
 
 def main(argv=None) -> int:
@@ -249,6 +265,8 @@ def main(argv=None) -> int:
     ap.add_argument("out", nargs="?", default=os.path.join("results", "macro_mpi_scaling"), help="output directory")
     ap.add_argument("--maxh", type=float, nargs="*", default=[0.004, 0.002, 0.001], help="press fit mesh sizes [m]")
     ap.add_argument("--femur", type=float, nargs="*", default=[1.0, 1.5], help="femur refinement factors")
+    ap.add_argument("--refined", nargs="*", default=[], metavar="MAXH:K",
+                    help="press fit meshes made with MAXH and refined K times uniformly (on the ranks under MPI)")
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3], help="numbers of MPI ranks")
     ap.add_argument("--rows-from", nargs="+", default=[], metavar="CSV",
                     help="no runs: the rows of these CSV files of earlier runs (e.g. a large size run apart)")
@@ -257,11 +275,12 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     work = os.path.abspath(os.path.join(args.out, "runs"))
     os.makedirs(work, exist_ok=True)
-    runs = [("press_fit", h) for h in args.maxh] + [("femur", f) for f in args.femur]
+    runs = [("press_fit", h, 0) for h in args.maxh] + [("femur", f, 0) for f in args.femur] + \
+        [("press_fit_refined", float(r.split(":")[0]), int(r.split(":")[1])) for r in args.refined]
     data = [row for path in args.rows_from for row in read_rows(path)]
-    for name, size in ([] if args.rows_from else runs):
+    for name, size, k in ([] if args.rows_from else runs):
         for r in args.ranks:
-            data.append(measure(name, size, r, work))
+            data.append(measure(name, size, r, work, k))
             print(" ".join(f"{k}={data[-1][k]}" for k in KEYS), flush=True)
     csv_path = os.path.join(args.out, "macro_mpi_scaling.csv")
     write_csv(csv_path, list(KEYS), [[d[k] for k in KEYS] for d in data])

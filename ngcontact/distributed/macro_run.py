@@ -17,31 +17,39 @@ report holds one process's numbers without a gathered solution; the stress
 fields are written in pieces, a ``.vtu`` per rank and a ``.pvtu``
 (:mod:`ngcontact.distributed.vtk_pieces`).
 
-What is not: rank 0 checks the model (labels, supports, rigid motions) on
-its whole mesh and reads the supports' geometric data off it (a tilted
-support's mid-point becomes the equivalent affine field ``u0 + G x``, the
-same everywhere), orders the interface's samples by its mesh, draws the
-figures and alone writes the report.  The strength check samples the whole
-stress field: with ``[strength]`` the solution is gathered on rank 0
-(:func:`ngcontact.distributed.macro_mesh.gather`) for it alone.  A two-scale
-scene's cells and their batches stay on the executor of one process and are
-refused under MPI.
+What is not: rank 0 makes the mesh with straight elements, checks the
+model on it (labels, supports, rigid motions: none of them depends on
+curving or refining) and reads the supports off it, then distributes it and
+lets it go (:func:`ngcontact.distributed.macro_mesh.distribute`); with
+``discretization.refinements`` it makes the coarse mesh only, and the ranks
+refine their parts, so that no rank holds the fine mesh whole.  A tilted
+support's mid-point, taken over the ranks' parts, becomes the equivalent
+affine field ``u0 + G x``.  Rank 0 orders the interface's samples by the
+whole mesh's numbering (:mod:`ngcontact.distributed.boundary_numbers`),
+draws the figures and alone writes the report.  The strength check samples
+the whole stress field: with ``[strength]`` rank 0 keeps its whole mesh and
+the solution is gathered onto it (:func:`ngcontact.distributed.macro_mesh.gather`)
+for the check alone (refinements on the ranks are refused then).  A
+two-scale scene's cells and their batches stay on the executor of one
+process and are refused under MPI.
 """
 from __future__ import annotations
 
 import pickle
 from dataclasses import replace
+from functools import partial
 
 import ngsolve as ng
 import numpy as np
 
 from ngcontact.distributed.macro_mesh import distribute, gather
-from ngcontact.distributed.reduced_measures import Reduced
+from ngcontact.distributed.reduced_measures import Reduced, boundary_mid
 from ngcontact.distributed.vtk_pieces import RankPieces
 from ngcontact.distributed.world import World
 from ngcontact.drivers import run_macro as R
 from ngcontact.errors import SceneError
-from ngcontact.fem.two_body import Support, boundary_mid
+from ngcontact.fem.two_body import Support
+from ngcontact.fem.two_body import boundary_mid as whole_mid
 from ngcontact.laws import interface_energy as ie
 from ngcontact.macro import macro_problem as M
 from ngcontact.macro.macro_energy import gap_cf, local_jump
@@ -63,14 +71,19 @@ def refuse(scene, world: World) -> None:
     if s.coulomb == "fixed_point":
         raise SceneError("solver.coulomb", s.coulomb, "'newton' under mpiexec (the coupled Newton runs "
                          "distributed; the fixed point does not)")
+    if scene.strength is not None and scene.discretization.refinements:
+        raise SceneError("discretization.refinements", scene.discretization.refinements, "0 with [strength] under "
+                         "mpiexec (the strength check gathers the solution onto rank 0's whole mesh, which a mesh "
+                         "refined on the ranks never is): refine by maxh instead, or run in one process")
 
 
-def absolute(support: Support, mesh) -> Support:
-    """A tilted support as the same affine field ``u0 + G x`` (its mid-point read off the whole mesh)."""
+def absolute(support: Support, mesh, mid=whole_mid) -> Support:
+    """A tilted support as the same affine field ``u0 + G x``; ``mid(mesh, label, axis)``: its boundary's
+    mid-point along the axis of its slope (of the whole mesh; under MPI reduced over the ranks' parts)."""
     if support.gradient or not any(support.slope):
         return support
     axis = "xyz".index(support.along)
-    mid = boundary_mid(mesh, support.label, axis)
+    mid = mid(mesh, support.label, axis)
     value = tuple(support.value) or (0.0,) * len(support.slope)
     rows = tuple(tuple(float(s) if j == axis else 0.0 for j in range(mesh.dim)) for s in support.slope)
     return replace(support, value=tuple(float(v) - float(s) * mid for v, s in zip(value, support.slope)),
@@ -98,35 +111,44 @@ def run(scene, clock, world: World) -> Outcome:
     """Solve ``scene`` distributed over ``world``; rank 0's outcome is the report's, the others' are empty."""
     refuse(scene, world)
     scene = replace(scene, solver=replace(scene.solver, linear="iterative"))     # 'auto' chooses by size: CG here
-    order = scene.discretization.order
+    order, keep = scene.discretization.order, scene.strength is not None
     whole = serial = None
     with clock.stage("mesh"):
         if world.root:
-            whole = R.build_geometry(scene, order=1)
-        geo = distribute(whole, order, world)
+            whole = R.build_geometry(scene, order=1, refinements=0)
     with clock.stage("interface law"):
         def checked():
-            nonlocal serial, whole
+            nonlocal serial
             assert whole is not None
-            if order > 1:
-                whole.mesh.Curve(order)
-            serial, info = R.problem_of(scene, whole)
-            serial = replace(serial, supports=tuple(absolute(s, whole.mesh) for s in serial.supports))
-            M.check_problem(serial)
-            return {k: getattr(serial, k) for k in SENT}, info, M.start_stiffness(serial)
+            problem, info = R.problem_of(scene, whole)
+            M.check_problem(problem)
+            serial = problem if keep else None
+            return {k: getattr(problem, k) for k in SENT}, info, M.start_stiffness(problem)
         fields, info, stiffness = _on_root(world, checked)
+    with clock.stage("mesh"):
+        geo, numbers = distribute(whole, order, scene.discretization.refinements, world, keep=keep)
+        if keep and world.root and order > 1:
+            assert whole is not None
+            whole.mesh.Curve(order)
+        whole = None                    # rank 0's whole mesh lives on in ``serial`` only for the strength check
+        mid = partial(boundary_mid, world)
+        fields["supports"] = tuple(absolute(s, geo.mesh, mid) for s in fields["supports"])
+    with clock.stage("interface law"):
         problem = M.MacroProblem(mesh=geo.mesh, gap=R.gap_of(scene), **fields)
         problem.parts.update(checked=True, start_stiffness=stiffness)
     with clock.stage("solve"):
         sol = R.solve_scene(scene, problem)
     with clock.stage("post-processing"):
-        outcome = R.measured(sol, geo, info, scene.output, Reduced(world, whole.mesh if whole else None))
+        outcome = R.measured(sol, geo, info, scene.output, Reduced(world, numbers))
         outcome.ndof = global_ndof(sol, world)
         outcome.vtk["stress"].pieces = RankPieces(world)
         outcome.results["accuracy"] = accuracy_not_estimated(scene, sol, outcome.results["equilibrium"])
     outcome.solver["mpi"] = {"ranks": world.size, "distributed": "mesh, assembly, Newton with BDDC-CG, "
                              "post-processing reduced over the ranks, VTK in pieces",
-                             "rank_0": "checks, the interface's samples in its mesh's order, figures, files"}
+                             "rank_0": "meshes (coarse where the ranks refine), checks, orders the interface's "
+                             "samples, figures, files",
+                             "elements": [int(n) for n in world.comm.allgather(geo.mesh.ne)],
+                             "refined_on_ranks": scene.discretization.refinements}
     if scene.strength is not None:
         with clock.stage("strength check"):
             strength(scene, world, sol, serial, outcome)

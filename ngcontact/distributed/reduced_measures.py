@@ -13,41 +13,52 @@ the whole solution:
 * the largest and smallest stresses: each rank's candidates, the first best
   of all kept in the order of the ranks;
 * the interface's samples (a surface: far fewer numbers than the solution):
-  each rank's interface elements with the mid-point of their vertices,
-  gathered on rank 0, put into the order of rank 0's whole mesh (the same
-  element has the same mid-point there) and sent to every rank, so that the
-  table, the peaks and the states are those of one process;
+  each rank's interface elements with their numbers in the whole mesh
+  (:mod:`ngcontact.distributed.boundary_numbers`), gathered on rank 0, put
+  into that order and sent to every rank, so that the table, the peaks and
+  the states are those of one process;
 * a figure's samples: gathered on rank 0 only, which draws.
 
 The moment of a support fixing every component (plane strain) is taken
-about the mid-point of its boundary, read off rank 0's whole mesh.
+about the mid-point of its boundary's bounding box, the smallest and
+largest coordinates of its vertices over the ranks.
 """
 from __future__ import annotations
 
 import ngsolve as ng
 import numpy as np
-from scipy.spatial import cKDTree
 
+from ngcontact.distributed.boundary_numbers import BoundaryNumbers
 from ngcontact.distributed.world import World
-from ngcontact.fem.reaction import boundary_centre
 from ngcontact.macro import macro_measures as MM
 from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.macro.solution_measures import Measures, Samples, reactions_of
 
 
-def element_keys(mesh, label: str) -> np.ndarray:
-    """The mid-point of the vertices of every boundary element ``label`` of ``mesh`` (this rank's), in order."""
-    rows = [np.mean([mesh[v].point for v in el.vertices], axis=0)
-            for el in mesh.Elements(ng.BND) if el.mat == label]
-    return np.asarray(rows, dtype=float).reshape(-1, mesh.dim)
+def boundary_box(world: World, mesh, label: str) -> tuple[np.ndarray, np.ndarray]:
+    """The smallest and largest coordinates of the vertices of boundary ``label`` over the ranks' parts."""
+    pts = np.asarray([mesh[v].point for el in mesh.Elements(ng.BND) if el.mat == label for v in el.vertices],
+                     dtype=float).reshape(-1, mesh.dim)
+    lo = pts.min(axis=0) if len(pts) else np.full(mesh.dim, np.inf)
+    hi = pts.max(axis=0) if len(pts) else np.full(mesh.dim, -np.inf)
+    return (np.min(np.asarray(world.comm.allgather(lo)), axis=0),
+            np.max(np.asarray(world.comm.allgather(hi)), axis=0))
+
+
+def boundary_mid(world: World, mesh, label: str, axis: int) -> float:
+    """Mid-point of boundary ``label``'s extent along axis ``axis`` over the ranks
+    (:func:`ngcontact.fem.two_body.boundary_mid` of the whole mesh)."""
+    lo, hi = boundary_box(world, mesh, label)
+    return float(0.5 * (lo[axis] + hi[axis]))
 
 
 class Reduced(Measures):
-    """The measures over ``world``'s ranks; ``whole``: rank 0's whole mesh (``None`` on the others)."""
+    """The measures over ``world``'s ranks; ``numbers``: this rank's boundary elements' numbers in the whole
+    mesh."""
 
-    def __init__(self, world: World, whole: ng.Mesh | None):
+    def __init__(self, world: World, numbers: BoundaryNumbers):
         self.world = world
-        self.whole = whole
+        self.numbers = numbers
         self.draws = world.root
 
     def _sum(self, value: float) -> float:
@@ -61,38 +72,32 @@ class Reduced(Measures):
             c for part in self.world.comm.allgather(mine) for c in part])
 
     def reactions(self, sol: MacroSolution) -> dict:
-        centres = None
-        if self.world.root:
-            assert self.whole is not None
-            p = sol.problem
-            centres = {s.label: boundary_centre(self.whole, s.label) for s in p.supports
-                       if p.setting == "plane_strain" and not s.components}
-        return reactions_of(sol, self.world.comm.bcast(centres))
+        p = sol.problem
+        centres = {}
+        for s in p.supports:
+            if p.setting == "plane_strain" and not s.components:
+                lo, hi = boundary_box(self.world, p.mesh, s.label)
+                centres[s.label] = tuple(float(0.5 * (a + b)) for a, b in zip(lo, hi))
+        return reactions_of(sol, centres)
 
     def _ordered(self, sol: MacroSolution, rows: np.ndarray) -> np.ndarray:
-        """Every rank's interface samples ``rows`` (one block per element) in rank 0's element order, on
-        every rank."""
+        """Every rank's interface samples ``rows`` (one block per element) in the whole mesh's element order,
+        on every rank."""
         label = sol.problem.interface
-        keys = element_keys(sol.problem.mesh, label)
-        if len(rows) != len(keys):
-            raise ValueError(f"interface samples of {len(rows)} elements for {len(keys)} interface elements")
-        parts = self.world.comm.gather((keys, rows), root=0)
+        numbers = self.numbers.of(sol.problem.mesh, label)
+        if len(rows) != len(numbers):
+            raise ValueError(f"interface samples of {len(rows)} elements for {len(numbers)} interface elements")
+        parts = self.world.comm.gather((numbers, rows), root=0)
         whole = None
         if self.world.root:
-            assert self.whole is not None and parts is not None
-            mine = element_keys(self.whole, label)
-            whole = np.full((len(mine),) + rows.shape[1:], np.nan)
-            tree = cKDTree(mine)
-            scale = float(np.max(np.abs(mine))) if mine.size else 1.0
-            for keys_r, rows_r in parts:
-                if not len(keys_r):
-                    continue
-                dist, at = tree.query(keys_r)
-                if np.any(dist > 1e-9 * scale):
-                    raise ValueError("an interface element of a rank is not in rank 0's mesh")
-                whole[at] = rows_r
-            if np.isnan(whole).any():
-                raise ValueError("an interface element of rank 0's mesh is on no rank")
+            assert parts is not None
+            every = np.unique(np.concatenate([n for n, _ in parts]))
+            if len(every) != self.numbers.labels.get(label, 0):
+                raise ValueError(f"{len(every)} of the whole mesh's {self.numbers.labels.get(label, 0)} interface "
+                                 "elements are on the ranks")
+            whole = np.full((len(every),) + rows.shape[1:], np.nan)
+            for numbers_r, rows_r in parts:
+                whole[np.searchsorted(every, numbers_r)] = rows_r
         return self.world.comm.bcast(whole)
 
     def surface(self, sol: MacroSolution) -> dict:

@@ -10,8 +10,10 @@ selectors (:mod:`ngcontact.geometry.face_selectors`).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
+
+import ngsolve as ng
 
 from ngcontact.errors import GeometryError, SceneError
 from ngcontact.geometry import bodies as gm
@@ -139,7 +141,8 @@ class FromFile:
         interface = sum(f.area for f in model.interface_faces()) * unit ** (dim - 1)
         width = min(v ** (1 / dim) for v in model.volumes) * unit
         n = mesh_size.estimate(dim, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
-        mesh_size.refuse_beyond(n, d.max_elements, *mesh_size.finest_size(d))
+        mesh_size.refuse_beyond(d.refined_count(n, dim), d.max_elements, *mesh_size.finest_size(d),
+                                hint=" or ask for fewer discretization.refinements" if d.refinements else "")
 
     def build(self, scene, sizes):
         chosen = self.selected(scene)
@@ -164,9 +167,30 @@ MACRO_SHAPES: dict[str, MacroShape] = {"femur_stem": FemurStem(), "coaxial": Coa
                                        "file": FromFile()}
 
 
-def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None) -> gm.MacroGeometry:
-    """Mesh the geometry of ``scene`` (sizes and order may be overridden)."""
+def build_geometry(scene, *, maxh=None, interface_maxh=None, order=None, refinements=None) -> gm.MacroGeometry:
+    """Mesh the geometry of ``scene`` (sizes, order and ``discretization.refinements`` may be overridden).
+
+    With refinements the mesh is made with straight elements, split
+    uniformly (:func:`refined_uniformly`) and curved to the order after the
+    last split, as every rank curves its refined part under MPI.
+    """
     d = scene.discretization
     maxh = maxh or d.maxh
+    times = d.refinements if refinements is None else refinements
     sizes = Sizes(maxh=maxh, interface_maxh=interface_maxh or d.interface_maxh or maxh, order=order or d.order)
-    return MACRO_SHAPES[scene.geometry.shape].build(scene, sizes)
+    if not times:
+        return MACRO_SHAPES[scene.geometry.shape].build(scene, sizes)
+    geo = MACRO_SHAPES[scene.geometry.shape].build(scene, replace(sizes, order=1))
+    mesh = refined_uniformly(geo.mesh.ngmesh, times)
+    if sizes.order > 1:
+        mesh.Curve(sizes.order)
+    return replace(geo, mesh=mesh)
+
+
+def refined_uniformly(ngmesh, times: int) -> ng.Mesh:
+    """The Netgen mesh ``ngmesh`` split ``times`` times uniformly (Netgen's ``Mesh.Refine``: a triangle into 4,
+    a tetrahedron into 8, the new boundary points projected onto its geometry where it has one), as an NGSolve
+    mesh.  The same call refines a rank's part of a distributed mesh consistently with its neighbours."""
+    for _ in range(times):
+        ngmesh.Refine()
+    return ng.Mesh(ngmesh)

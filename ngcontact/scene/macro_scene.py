@@ -37,9 +37,10 @@ from ngcontact.scene.macro_shapes import (REQUIRED, SETTINGS, SHAPES, boundaries
                                           check_shaft_axis, check_support_meaning, macro_extent)
 from ngcontact.scene.macro_shapes import BOUNDARY_DOCS as SHAPE_BOUNDARY_DOCS
 from ngcontact.scene.file_geometry import FILE_BOUNDARY_DOCS, BodySpec, FaceSelectorSpec, check_file_geometry
-from ngcontact.scene.sections import (Discretization, MaterialSpec, SolverSpec, base_dir_field,
+from ngcontact.scene.sections import (MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
 from ngcontact.scene import cell_links, mesh_size
+from ngcontact.scene.macro_discretization import MacroDiscretization
 from ngcontact.scene.cell_scene import FRICTION
 from ngcontact.scene.supports import SupportSpec, check_values
 from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
@@ -47,21 +48,6 @@ from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interva
 LAWS = ("linear", "bundle", "tabulated", "file")
 #: the kind's boundary labels by (shape, setting), read by the README reference
 BOUNDARY_DOCS: dict = {**SHAPE_BOUNDARY_DOCS, "file": FILE_BOUNDARY_DOCS}
-
-
-@dataclass(frozen=True, kw_only=True)
-class MacroDiscretization(Discretization):
-    """Finite element discretization of a macro scene, and the accuracy its headline numbers are held to."""
-
-    tolerance: float | None = param(None, check=open_interval(0, 1), doc="the relative accuracy the headline "
-        "quantities (peak interface pressure, resultant, largest von Mises and Tresca stress per body, safety "
-        "factor; two-scale: the loop's residual and the cell table's interpolation error) are held to: each is "
-        "reported with its discretization error, estimated from solves one order below and above on the same "
-        "mesh, and results.accuracy.met says whether every one is within; a scene that states it is refined "
-        "towards it: the order is raised by one on the scene's mesh while it pays (up to order 4), then the mesh "
-        "is refined where the stress error indicator is large, interface first (up to 12 levels and 2e6 "
-        "unknowns; results.accuracy.refinement lists the levels, their order, mesh level and unknowns), and a "
-        "tolerance out of reach ends the run (exit 3); default: 0.01, only judged (the scene's order is kept)")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -316,7 +302,8 @@ class MacroScene:
                                 | {"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         dim, volume, interface, width = macro_extent(g.shape, g.setting, dict(g.dimensions or {}))
         n = mesh_size.estimate(dim, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
-        mesh_size.refuse_beyond(n, d.max_elements, *mesh_size.finest_size(d))
+        mesh_size.refuse_beyond(d.refined_count(n, dim), d.max_elements, *mesh_size.finest_size(d),
+                                hint=" or ask for fewer discretization.refinements" if d.refinements else "")
 
     def check(self, path: str) -> None:
         check_material_names(self.materials, {"rough": self.bodies.rough, "counter": self.bodies.counter},

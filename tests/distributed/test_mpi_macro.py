@@ -207,6 +207,33 @@ def test_a_3d_press_fit_on_two_ranks_reports_what_one_process_does(tmp_path):
     assert parallel["results"]["setting"] == "3d"
 
 
+def _refined_once(text: str, maxh: str) -> str:
+    """``text`` with its ``maxh = MAXH`` line made ``maxh`` and one uniform refinement asked for."""
+    line = next(ln for ln in text.splitlines() if ln.startswith("maxh = "))
+    return text.replace(line + "\n", f"maxh = {maxh}\nrefinements = 1\n")
+
+
+@pytest.mark.mpi
+@needs_mpi
+@pytest.mark.parametrize("text, refined", [(BLOCK, "0.4"), (PRESS_FIT_3D, "0.01")], ids=["2d block", "3d press fit"])
+def test_a_mesh_refined_on_the_ranks_reports_what_one_process_does_on_the_same_refined_mesh(tmp_path, text, refined):
+    """Rank 0 meshes coarsely and distributes; every rank refines its part once uniformly and curves it.  The
+    report is that of one process refining the whole mesh once (interface samples in its order), and rank 0
+    holds no element of the fine mesh: the elements are all on the parts."""
+    from ngcontact.drivers.macro_geometry import build_geometry
+    from ngcontact.scene import loader
+
+    text = _refined_once(text, refined)
+    parallel = _agree(tmp_path, text, ranks=3)
+    (tmp_path / "check.toml").write_text(text)
+    scene = loader.load(tmp_path / "check.toml")
+    fine, coarse = build_geometry(scene, order=1), build_geometry(scene, order=1, refinements=0)
+    elements = parallel["solver"]["mpi"]["elements"]
+    assert elements[0] == 0 and min(elements[1:]) > 0
+    assert sum(elements) == fine.mesh.ne == 2 ** fine.mesh.dim * coarse.mesh.ne
+    assert parallel["solver"]["mpi"]["refined_on_ranks"] == 1
+
+
 @pytest.mark.mpi
 @pytest.mark.slow
 @needs_mpi

@@ -4,17 +4,19 @@
 parts with the MPI collectives; on one rank (a communicator whose
 collectives return this rank's own part) it must give the report of one
 process exactly, which checks its ordering of the interface samples by the
-elements' mid-points and its extrema and sums without ``mpiexec`` (the
+elements' numbers in the whole mesh (found by their mid-points) and its extrema and sums without ``mpiexec`` (the
 ``mpi`` tier checks two and three ranks).
 """
 from __future__ import annotations
 
+import ngsolve as ng
 import numpy as np
 import pytest
 from press_fit_3d import press_fit_3d
 from test_mpi_macro import BLOCK
 
-from ngcontact.distributed.reduced_measures import Reduced, element_keys
+from ngcontact.distributed.boundary_numbers import Coarse, midpoints, numbered
+from ngcontact.distributed.reduced_measures import Reduced
 from ngcontact.distributed.world import World
 from ngcontact.drivers import run_macro as R
 from ngcontact.scene import loader
@@ -36,6 +38,9 @@ class OneRank:
 
     def bcast(self, value, root=0):
         return value
+
+    def scatter(self, values, root=0):
+        return values[0]
 
 
 def _solved(tmp_path, text: str):
@@ -66,17 +71,19 @@ def _same(a, b, path=""):
 def test_one_rank_reduces_to_the_report_of_one_process(tmp_path, text):
     scene, geo, info, sol = _solved(tmp_path, text)
     whole = R.measured(sol, geo, info, scene.output)
-    reduced = R.measured(sol, geo, info, scene.output, Reduced(World(comm=OneRank(), rank=0, size=1), geo.mesh))
+    world = World(comm=OneRank(), rank=0, size=1)
+    numbers = numbered(world, geo.mesh, Coarse.of(geo.mesh))
+    assert np.array_equal(numbers.serial, np.arange(geo.mesh.GetNE(ng.BND)))
+    reduced = R.measured(sol, geo, info, scene.output, Reduced(world, numbers))
     _same(whole.results, reduced.results)
     assert whole.ndof == reduced.ndof
 
 
 def test_the_keys_of_the_interface_elements_are_their_vertices_mid_points():
-    import ngsolve as ng
-
     from ngcontact.geometry import bodies as gm
 
     mesh = gm.block_on_plane(1.0, 1.0, 1.0, maxh=0.5).mesh
-    keys = element_keys(mesh, "interface")
+    mine = np.array([el.mat == "interface" for el in mesh.Elements(ng.BND)])
+    keys = midpoints(mesh)[mine]
     assert len(keys) == sum(1 for el in mesh.Elements(ng.BND) if el.mat == "interface")
     assert np.allclose(keys[:, 1], keys[0, 1]) and len(np.unique(np.round(keys[:, 0], 12))) == len(keys)
