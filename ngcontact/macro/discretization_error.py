@@ -229,6 +229,15 @@ def corner_points(mesh: ng.Mesh) -> np.ndarray:
     """Vertices of the mesh's boundary (the interface included) where two boundary labels meet or, in 2D,
     the boundary turns by more than :data:`CORNER_ANGLE`, one row of coordinates each.  In 3D the
     vertices on the edges between labelled faces."""
+    labels, edges, pts = boundary_vertices(mesh)
+    corners = [v for v, names in labels.items() if len(names) > 1]
+    if mesh.dim == 2:
+        corners += [v for v, nb in edges.items() if len(labels[v]) == 1 and _turn(pts, v, nb) > CORNER_ANGLE]
+    return pts[sorted(set(corners))] if corners else np.zeros((0, mesh.dim))
+
+
+def boundary_vertices(mesh: ng.Mesh) -> tuple[dict[int, set[str]], dict[int, list[int]], np.ndarray]:
+    """Per boundary vertex its labels and its neighbours along the boundary, and every vertex's point."""
     labels: dict[int, set[str]] = {}
     edges: dict[int, list[int]] = {}
     for el in mesh.Elements(ng.BND):
@@ -236,11 +245,7 @@ def corner_points(mesh: ng.Mesh) -> np.ndarray:
         for v in vs:
             labels.setdefault(v, set()).add(el.mat)
             edges.setdefault(v, []).extend(w for w in vs if w != v)
-    pts = np.array([mesh[ng.NodeId(ng.VERTEX, i)].point for i in range(mesh.nv)])
-    corners = [v for v, names in labels.items() if len(names) > 1]
-    if mesh.dim == 2:
-        corners += [v for v, nb in edges.items() if len(labels[v]) == 1 and _turn(pts, v, nb) > CORNER_ANGLE]
-    return pts[sorted(set(corners))] if corners else np.zeros((0, mesh.dim))
+    return labels, edges, np.array([mesh[ng.NodeId(ng.VERTEX, i)].point for i in range(mesh.nv)])
 
 
 def _turn(pts: np.ndarray, v: int, neighbours: list[int]) -> float:

@@ -118,22 +118,10 @@ def corner_maxima(sol: MacroSolution, corners: np.ndarray, radius: float) -> dic
     return out
 
 
-def _boundary(mesh: ng.Mesh) -> tuple[dict[int, set[str]], dict[int, list[int]], np.ndarray]:
-    """Per boundary vertex its labels and its neighbours along the boundary, and every vertex's point."""
-    labels: dict[int, set[str]] = {}
-    edges: dict[int, list[int]] = {}
-    for el in mesh.Elements(ng.BND):
-        vs = [v.nr for v in el.vertices]
-        for v in vs:
-            labels.setdefault(v, set()).add(el.mat)
-            edges.setdefault(v, []).extend(w for w in vs if w != v)
-    return labels, edges, np.array([mesh[ng.NodeId(ng.VERTEX, i)].point for i in range(mesh.nv)])
-
-
 def corners_of(mesh: ng.Mesh) -> np.ndarray:
     """The corners the check refines at (2D): the boundary vertices where two labels meet, and those of one
     label where the boundary turns by more than :data:`SHARP`; one row of coordinates each."""
-    labels, edges, pts = _boundary(mesh)
+    labels, edges, pts = DE.boundary_vertices(mesh)
     found = [v for v, names in labels.items()
              if len(names) > 1 or DE._turn(pts, v, edges[v]) > SHARP]
     return pts[sorted(found)] if found else np.zeros((0, mesh.dim))
@@ -143,7 +131,7 @@ def closed_ends(sol: MacroSolution, points_per_element: int = 5) -> list[tuple[t
     """The ends of the interface on a boundary without support (free or loaded) where the interface is
     closed (pressure above :data:`CLOSED` of its peak), each with its pressure, the largest first."""
     p = sol.problem
-    labels, _, pts = _boundary(p.mesh)
+    labels, _, pts = DE.boundary_vertices(p.mesh)
     supported = {s.label for s in p.supports}
     ends = [v for v, names in labels.items()
             if p.interface in names and len(names) > 1 and not (names - {p.interface}) & supported]
