@@ -16,14 +16,12 @@ import html
 import math
 import os
 
+from ngcontact.output.residual_chart import MAX_SERIES, residual_chart, residual_series
+
 #: rows of a CSV table shown on the page (the file holds them all)
 MAX_TABLE_ROWS = 400
 #: a list longer than this is summarized (count, smallest, largest) instead of listed
 MAX_INLINE = 12
-#: residual series drawn in the solver chart
-MAX_SERIES = 40
-
-COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#17becf")
 _PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "\u00b5"), (1e-9, "n"))
 
 #: kind -> (label, dotted path into the report, SI unit or "") shown first when present
@@ -275,56 +273,6 @@ def nested(value, depth: int = 0) -> str:
 
 
 # ------------------------------------------------------------------ solver history
-def residual_series(solver, label: str = "") -> list[tuple[str, dict]]:
-    """Every record of the solver entry holding a ``residuals`` list, labelled by its place."""
-    found = []
-    if isinstance(solver, dict):
-        if isinstance(solver.get("residuals"), list) and solver["residuals"]:
-            found.append((label or "all solves", solver))
-        for k, v in solver.items():
-            if isinstance(v, (dict, list)) and k != "residuals":
-                found += residual_series(v, f"{label}.{k}" if label else k)
-    elif isinstance(solver, list):
-        for i, v in enumerate(solver):
-            found += residual_series(v, f"{label}[{i}]")
-    return found
-
-
-def residual_chart(series: list[tuple[str, list[float]]], width: int = 640, height: int = 240) -> str:
-    """log10 of each residual series against the step, as an inline SVG (non-positive values left out)."""
-    pts = [(name, [(i, math.log10(r)) for i, r in enumerate(res) if isinstance(r, (int, float)) and r > 0])
-           for name, res in series[:MAX_SERIES]]
-    pts = [(n, p) for n, p in pts if p]
-    if not pts:
-        return ""
-    xmax = max(1, max(i for _, p in pts for i, _ in p))
-    ys = [y for _, p in pts for _, y in p]
-    ylo, yhi = math.floor(min(ys)), math.ceil(max(ys))
-    yhi = yhi if yhi > ylo else ylo + 1
-    left, bottom = 50, 30
-
-    def xy(i, y):
-        return (left + (width - left - 10) * i / xmax, 10 + (height - bottom - 10) * (yhi - y) / (yhi - ylo))
-
-    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" role="img" '
-           f'aria-label="residual history"><rect width="100%" height="100%" fill="white"/>']
-    step = max(1, (yhi - ylo) // 6)
-    for e in range(ylo, yhi + 1, step):
-        _, y = xy(0, e)
-        out.append(f'<line x1="{left}" x2="{width - 10}" y1="{y:.1f}" y2="{y:.1f}" stroke="#eee"/>'
-                   f'<text x="{left - 4}" y="{y + 4:.1f}" font-size="11" text-anchor="end">1e{e}</text>')
-    out.append(f'<text x="{(width + left) / 2}" y="{height - 6}" font-size="11" text-anchor="middle">'
-               f'step (0 = start)</text>')
-    for k, (name, p) in enumerate(pts):
-        line = " ".join("%.1f,%.1f" % xy(i, y) for i, y in p)
-        out.append(f'<polyline fill="none" stroke="{COLOURS[k % len(COLOURS)]}" stroke-width="1.5" '
-                   f'points="{line}"><title>{_e(name)}</title></polyline>')
-    legend = "".join(f'<span style="color:{COLOURS[k % len(COLOURS)]}">\u25a0</span> {_e(n)} '
-                     for k, (n, _) in enumerate(pts[:8]))
-    more = f" \u2026 ({len(pts)} solves; the colours repeat in the order of the table)" if len(pts) > 8 else ""
-    return "".join(out) + f'</svg><p class="meta">{legend}{more}</p>'
-
-
 def solver_section(solver: dict) -> str:
     """Summary of the solver entry, its residual history as a chart and a table per solve."""
     if not solver:
