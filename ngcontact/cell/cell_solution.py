@@ -59,7 +59,7 @@ def measure(name: str) -> str:
     contact surface (eq. 34 with ``w = 1``): the coefficient ranges from zero (no contact) to its
     whole-surface value (full contact) as the contact fraction ranges over [0, 1], and an entry small or zero
     at a small load (``g_n`` grows like the cube of a patch's width) or by symmetry (``k_nt``, ``g_t`` of a
-    symmetric cell) is measured on the scale at which the macro law uses it; every other quantity relative to
+    symmetric cell) is judged on the scale at which the macro law uses it; every other quantity relative to
     its own value."""
     if name == "contact_fraction":
         return ABSOLUTE

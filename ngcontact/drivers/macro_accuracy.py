@@ -53,7 +53,7 @@ def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution]
     """The headline quantities at the three orders of the ladder (``sol`` is the scene's order; the other
     two are solved by ``solve(problem, start)`` on the same mesh with the same law, from ``sol``);
     ``component``: the resultant's (default: the largest of ``sol``'s); ``dense_inset``: of the lattice
-    a stress maximum's sampling error is measured on (:func:`ngcontact.macro.discretization_error.body_maxima`)."""
+    a stress maximum's sampling error is taken on (:func:`ngcontact.macro.discretization_error.body_maxima`)."""
     problem, ppe = sol.problem, scene.output.points_per_element
     own = DE.headlines(sol, ppe, component, dense_inset)
     component = next(n for n in own if n.startswith("resultant_")).removeprefix("resultant_")

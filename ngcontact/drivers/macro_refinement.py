@@ -33,7 +33,7 @@ Then the mesh (h), where the order no longer pays
     * Each mesh level is estimated by the order ladder on its mesh and by the sequence of mesh levels
       with its observed rate (:mod:`ngcontact.macro.mesh_sequence`), the larger of the two; a corner's
       maximum without a ladder estimate is estimated by the sequence alone once three levels exist.
-      A stress maximum's sampling error is measured on a lattice reaching the elements' faces
+      A stress maximum's sampling error is taken on a lattice reaching the elements' faces
       (:func:`ngcontact.macro.discretization_error.body_maxima` with :data:`FACE_INSET`): at the errors a
       tolerance beyond the order's reach asks for, the inset of the sample points from a boundary where
       the maximum sits is a share of the error.

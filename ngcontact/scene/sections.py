@@ -72,7 +72,7 @@ class CellDiscretization(Discretization):
         "table at the load's pressure) and the normal effective stiffness relative to their value, the "
         "coefficients of paper eq. 34 on the real contact set (k_n, k_t, k_nt, g_n, g_t, G_n, G_t) relative to "
         "the largest of their group (stiffnesses, gap terms, thresholds) on the whole contact surface, which "
-        "they reach in full contact (so an entry small at a small load or zero by symmetry is measured on the "
+        "they reach in full contact (so an entry small at a small load or zero by symmetry is judged on the "
         "scale the macro law uses it at); results.accuracy lists each with its value, absolute and relative "
         "error, measure and scale.  Method 'spectral' estimates all of them and holds all but the effective "
         "stiffness (first order in the grid step: reported with its estimate, counted = false) to the "
