@@ -163,3 +163,20 @@ def test_the_estimate_is_within_ten_times_the_error_where_that_error_is_not_smal
             assert effectivity >= 1.0, (k, name, effectivity)
             if k > 0:
                 assert effectivity <= 10.0, (k, name, effectivity)
+
+
+def test_a_coefficient_is_not_taken_as_geometric_where_the_contact_fraction_is_not():
+    """The coefficients of eq. 34 rest on the fraction's edges: a ``g_n`` whose own ratios agree takes the guarded
+    bound where the fraction of its load does (a vanished last difference), and Richardson where it does not."""
+    from ngcontact.cell.spectral.refinement import guarded_bound, sweep_estimates
+
+    def history(fractions):
+        return [{"headline": [{"contact_fraction": f, "coefficient_g_n": g}], "whole_surface": {"k_n": 1.0, "g_n": 1.0}}
+                for f, g in zip(fractions, _geometric(0.3, levels=4))]
+    g_n = _geometric(0.3, levels=4)
+    d = [abs(b - a) for a, b in zip(g_n[:-1], g_n[1:])][::-1]
+    estimates, _, forms = sweep_estimates(history([0.40, 0.50, 0.52, 0.52]))
+    assert forms[0] == {"contact_fraction": GUARDED, "coefficient_g_n": GUARDED}
+    assert estimates[0]["coefficient_g_n"] == pytest.approx(guarded_bound(d)[0])
+    _, _, forms = sweep_estimates(history(_geometric(0.3, levels=4)))
+    assert forms[0] == {"contact_fraction": RICHARDSON, "coefficient_g_n": RICHARDSON}

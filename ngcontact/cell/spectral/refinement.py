@@ -72,14 +72,21 @@ exceeds it by that drop.  So, for these quantities of a load whose edges have be
 The coefficients of eq. 34 on the real contact set are integrals over it (:mod:`ngcontact.cell.spectral.grid_measures`:
 ``k_n`` times the contact fraction, ``k_n`` times the gap integrated over the set), with the set's 2D edges
 located between points as the contact fraction's: they converge as the fraction does and are estimated at
-its first order.  The normal effective stiffness is the stiffness of the collocated contact set
+its first order, and where the fraction's sequence of a load is not seen to be geometric (its estimate is
+the guarded bound) neither are theirs, whose errors are the same edges' misplacements: a coefficient's own
+two ratios may agree by chance where the edges' errors change sign, and its Richardson tail then misses an
+error that grows from one grid to the next.
+
+The normal effective stiffness is the stiffness of the collocated contact set
 (:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`): its pressure, singular like the
 inverse square root of the distance to an edge, converges at first order in the grid step with a constant
 that the edges' position between points makes erratic, in 2D much slower than the fraction, so that a
-tolerance met by the other quantities would take many more grids for it.  It is estimated at first order,
-the estimate doubled (:data:`ERRATIC`: its error may exceed the differences beside it where two grids'
-errors share their sign and size, as on Westergaard's sinusoid at half its closing pressure) and reported,
-but not held to the tolerance (:data:`UNCONTROLLED`: listed in the verdict as not counted).
+tolerance met by the other quantities would take many more grids for it (several doublings at 1 %, and a
+tolerance of the order of the fraction's, as a 2D scene may state, beyond any grid the cost bound admits).
+It is estimated at first order, the estimate doubled (:data:`ERRATIC`: its error may exceed the
+differences beside it where two grids' errors share their sign and size, as on Westergaard's sinusoid at
+half its closing pressure) and reported, but not held to the tolerance (:data:`UNCONTROLLED`: listed in
+the verdict as not counted).
 
 Levels double the points per direction (:data:`GROWTH`): close enough that three differences cost little
 more than the finest level (2D: twice the finest; 3D: 4/3 of it).
@@ -236,13 +243,13 @@ def guarded_bound(d: list[float]) -> tuple[float, str]:
 
 
 def tail_estimate(values: list[float], relative: bool, order_rate: float = RATE_FLOOR,
-                  scale: float | None = None) -> tuple[float, str, str]:
+                  scale: float | None = None, geometric: bool = True) -> tuple[float, str, str]:
     """The estimated error of the last of ``values`` (a quantity on successive levels; module docstring), its
     form (:data:`RICHARDSON` where that is the smaller, else :data:`GUARDED`) and a remark on it.  Needs two
     values at least; ``order_rate`` is the quantity's :data:`ORDER_RATE`; ``scale``: the size the error is
-    divided by (default: 1, or the last value where ``relative``)."""
+    divided by (default: 1, or the last value where ``relative``); not ``geometric``: the guarded bound only."""
     d = differences(values, relative, scale)
-    fitted = richardson(d, order_rate)
+    fitted = richardson(d, order_rate) if geometric else None
     estimate, remark = guarded_bound(d)
     if fitted is None or fitted[0] >= estimate:
         return estimate, GUARDED, remark
@@ -263,7 +270,9 @@ def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float
             if None in values or not any(values):
                 continue
             size = scale(name, last, history[-1]["whole_surface"])
-            args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size)
+            # a coefficient's edges are the fraction's: not geometric where the fraction's sequence is not
+            geometric = not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
+            args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
             out[name], form[name], note = tail_estimate(values, *args)
             run = fitted_run(history, k) if on_edges(name) else 0
             if LOCATOR_LEVELS <= run < len(history):
