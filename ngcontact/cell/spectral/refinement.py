@@ -63,11 +63,14 @@ exceeds it by that drop.  So, for these quantities of a load whose edges have be
   differences, so two give the guarded bound), and the smaller of the two is reported: each is a bound on
   its own argument, the whole window's by the line's larger error, the fitted levels' by their own
   contraction;
-* with ``0 < r < LOCATOR_LEVELS`` the window compares the two locators, and a stop is deferred to the
-  level where the fitted levels are enough (:func:`locator_changing`), unless that level is beyond the
-  largest grid: the whole window's estimate then stands.  The deferral costs at most two 2D levels, each
-  twice the last; a load whose edges are never all fitted (a piecewise linear profile's kinks defeat the
-  quartic) is estimated on the whole window as before.
+* with ``0 < r < LOCATOR_LEVELS`` the window compares the two locators: its estimate bounds the error, but
+  by the line's.  Where the tolerance is the scene's own, a stop is deferred to the level where the fitted
+  levels are enough (:func:`locator_changing`), unless that level is beyond the largest grid (the whole
+  window's estimate then stands): at most two more 2D levels, each twice the last, buy an estimate within
+  a small factor of the error.  Refined to the default tolerance (the cheapest grid that meets it,
+  ``sharpen = False`` in :func:`sweep_to_tolerance`), the first grid whose estimate meets it stops, its
+  estimate a bound but not a sharp one.  A load whose edges are never all fitted (a piecewise linear
+  profile's kinks defeat the quartic) is estimated on the whole window.
 
 The coefficients of eq. 34 on the real contact set are integrals over it (:mod:`ngcontact.cell.spectral.grid_measures`:
 ``k_n`` times the contact fraction, ``k_n`` times the gap integrated over the set), with the set's 2D edges
@@ -100,8 +103,8 @@ stretch left for a faster regime that no recorded change of method marks, unlike
 above), the differences up to level ``k`` still carry the size of the earlier errors, and the estimate
 exceeds the error by their ratio.
 
-A stop needs ``MIN_LEVELS`` levels (three differences: the window) and no load's edge locator changing
-(above).  The levels are known before the first
+A stop needs ``MIN_LEVELS`` levels (three differences: the window) and, to a scene's own tolerance, no
+load's edge locator changing (above).  The levels are known before the first
 solve (``grid`` times ``GROWTH^k`` up to ``max_points``, :func:`levels`; the scene layer bounds
 ``max_points`` by the cost of a solve, :func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest
 is stated first, and each level prints one progress line as it ends.  A tolerance out of reach ends in a
@@ -362,13 +365,14 @@ def solve_level(make_cell: Callable[[int], Any], loads: list, n: int,
 
 
 def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: float, grid: int, dim: int,
-                       max_points: int, required: bool = True) -> RefinedSweep:
+                       max_points: int, required: bool = True, sharpen: bool = True) -> RefinedSweep:
     """Solve ``loads`` on grids from ``grid`` up until the estimate meets ``tolerance`` (module docstring).
 
     ``make_cell(n)`` builds the spectral cell of ``n`` points per direction.  The grids it may reach
     (:func:`levels`) are known and stated before the first solve; each level logs one progress line.
     Out of reach: a :class:`~ngcontact.errors.ConvergenceError` with the history where ``required``, else
-    the finest level with ``met = False``.
+    the finest level with ``met = False``.  ``sharpen``: a stop waits while an edge locator changes
+    (:func:`locator_changing`), else the first grid whose estimate meets the tolerance is the answer.
     """
     grids = levels(grid, dim, max_points)
     progress.info("spectral refinement may reach grid %d (%d points) in %d levels from grid %d", grids[-1],
@@ -383,7 +387,7 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
             entry["estimate"] = controlled_estimate(estimates)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
                       f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
-        settled = n == grids[-1] or not locator_changing(history)
+        settled = not sharpen or n == grids[-1] or not locator_changing(history)
         if estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance and settled:
             return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, remarks=remarks,
                                 forms=forms)
