@@ -267,7 +267,8 @@ def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float
     makes zero: ``k_t``, ``k_nt``, ``g_t``, ``G_n``; ``G_t`` without friction)."""
     estimates, forms, guarded = [], [], []
     for k, last in enumerate(history[-1]["headline"]):
-        out, form = {}, {}
+        out: dict[str, float] = {}
+        form: dict[str, str] = {}
         for name in last:
             values = [h["headline"][k].get(name) for h in history]
             if None in values or not any(values):
