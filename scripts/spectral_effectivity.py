@@ -189,16 +189,17 @@ def main(argv=None) -> int:
                               "but the stiffness meet the tolerance, the stiffness is reported with its estimate; "
                               "per quantity and load "
                               "Richardson with the observed rate where the last two ratios of differences agree and "
-                              "it is the smaller, else the guarded geometric tail: column `form`); a tolerance not met "
+                              "it is the smaller, else the guarded geometric tail: column `form`; in 2D the contact "
+                              "fraction and coefficients also on the levels whose edges the quartic located, a stop "
+                              "waiting for three of them); a tolerance not met "
                               "within the study's largest grid reports nothing. The true error of the reported grid is "
                               "against the same cell on a much finer grid; `next_error` is that of the grid "
                               "twice as fine. Issue 35 asks for effectivities between 1 and 10. "
                               f"{summary}. Of the rows above 10, {chance} have a reported error small by chance "
                               "(`by_chance`: of another sign than the coarser grid's, or below the finer grid's); "
-                              "the others mostly hold in their window of three differences a much larger one "
-                              "from an earlier, slower stretch (in 2D before the edge fit of `grid_measures` "
-                              "takes hold, from 512 points on the sinusoid). No estimate from the differences "
-                              "up to the reported grid can see either.",
+                              "in the others the error fell from the coarser grid by much more than the "
+                              "differences before it show. No estimate from the differences up to the reported "
+                              "grid can see either.",
                               png=os.path.join(args.out, "spectral_effectivity.png"))
     return 0
 

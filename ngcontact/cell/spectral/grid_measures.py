@@ -68,13 +68,14 @@ def contact_weights(cell, p: np.ndarray, gap: np.ndarray) -> np.ndarray:
         last = on & ~np.roll(on, -step)             # in contact, the next point (in this direction) is not
         for i in np.flatnonzero(last):
             # open share of the grid step between the last contact point i and the first open point
-            shift = edge_offset(root, on, int(i), step) - 0.5
+            shift = edge_offset(root, on, int(i), step)[0] - 0.5
             weights[(int(i) + step) % n if shift > 0 else int(i)] += shift
     return weights
 
 
-def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int) -> float:
-    """Distance in grid steps from the last contact point ``i`` to the edge (module docstring).
+def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int) -> tuple[float, bool]:
+    """Distance in grid steps from the last contact point ``i`` to the edge (module docstring), and whether
+    the quartic located it (``False``: the line through the first two open points).
 
     In ``[0, 1]`` from the line; from the quartic within half a step more on
     either side (the collocated solution may hold one point too many or too
@@ -92,18 +93,30 @@ def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int) -> float:
     hi = min(EDGE_WINDOW[1], run // EDGE_RUN_SHARE)
     lo = max(EDGE_WINDOW[0] * hi // EDGE_WINDOW[1], 2)
     if hi - lo < EDGE_MIN_POINTS:
-        return offset
+        return offset, False
     t = np.arange(lo, hi, dtype=float)
     r = root[(i + step * np.arange(lo, hi)) % n]
     coef, misfit, *_ = np.polyfit(t, r, 4, full=True)
     if not misfit.size or np.sqrt(misfit[0] / t.size) > EDGE_FIT_RTOL * float(r.max()):
-        return offset
+        return offset, False
     roots = np.roots(coef)
     real = roots[np.abs(roots.imag) <= 1e-9 * np.abs(roots)].real
     real = real[(real >= -0.5) & (real <= 1.5)]
     if real.size == 0:
-        return offset
-    return float(real[np.argmin(np.abs(real - offset))])
+        return offset, False
+    return float(real[np.argmin(np.abs(real - offset))]), True
+
+
+def edges_fitted(cell, p: np.ndarray, gap: np.ndarray) -> bool:
+    """Whether every contact edge of a 2D cell with contact and an open gap is located by the quartic of
+    :func:`edge_offset` (the sharp locator; module docstring); ``False`` in 3D, in full contact or without
+    contact (no edge located between points)."""
+    on = p > 0
+    if cell.dim == 3 or on.all() or not on.any():
+        return False
+    root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
+    return all(edge_offset(root, on, int(i), step)[1]
+               for step in (1, -1) for i in np.flatnonzero(on & ~np.roll(on, -step)))
 
 
 #: relative residual of the masked CG of :func:`effective_stiffness` (its ``K`` converges as its square)

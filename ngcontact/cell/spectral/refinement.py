@@ -26,12 +26,16 @@ the report names (:func:`sweep_estimates`):
    ratios ``|d_(k-1)| / |d_(k-2)|`` and ``|d_k| / |d_(k-1)|`` agree within the factor :data:`AGREE` and
    both contract at least by :data:`RATE_CAP`.  The rate is the larger of the two, but never faster than
    the quantity's own order in the grid step (:data:`ORDER_RATE`: first order, ``1/2`` per level, for the
-   contact fraction, whose edges are counted or located between points; second order, ``1/4``, for the
-   mean closure, a mean over the period of the collocated jump, which an edge ``a`` misplaced by a
-   fraction of a step barely moves, the gap opening like ``(x - a)^(3/2)`` beyond it); the estimate is the tail of the
-   geometric series beyond level ``k``, ``|d_k| rho / (1 - rho)``, times :data:`SPREAD`, the scatter of
-   one level's error about the geometric model (the erratic factor above: an edge's position between two
-   points) that two ratios cannot resolve.  Where that exceeds the guarded bound below, which holds
+   contact fraction, whose edges are counted or located between points, and for the mean closure too: a
+   mean of the collocated jump, which an edge misplaced by a fraction of a step barely moves (the gap
+   opens like ``(x - a)^(3/2)`` beyond an edge ``a``), but whose error is carried by the collocated
+   pressure at the edges, singular like the inverse square root of the distance to an edge, with a
+   first-order constant that changes sign as the edges cross the grid: two fast ratios just after such a
+   sign change do not show the first-order stretch that follows, as on Westergaard's sinusoid at a fifth
+   of its closing pressure); the estimate is the tail of the geometric series beyond level ``k``,
+   ``|d_k| rho / (1 - rho)``, times :data:`SPREAD`, the scatter of one level's error about the geometric
+   model (the erratic factor above: an edge's position between two points) that two ratios cannot
+   resolve.  Where that exceeds the guarded bound below, which holds
    without the geometric model, the guarded bound is the estimate: Richardson only ever sharpens it.
 2. **The guarded bound** wherever the two ratios disagree, one difference vanished, or the sequence does
    not contract ("where two successive differences disagree in rate, the estimate says so and takes the
@@ -43,17 +47,49 @@ the report names (:func:`sweep_estimates`):
    count of points whose constant jumps with the edges) is bounded by the ones before it.  The estimate
    is the geometric tail ``D rho / (1 - rho)``.
 
+In 2D the contact fraction and the coefficients of eq. 34 rest on edges located between points by one of
+two locators (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`): the quartic fitted to the open
+gap where its window holds enough points and the fit explains the gap, else the line through the first
+two open points, whose root is off by a fraction of a step (first order, with a large constant).  On a
+smooth gap the quartic takes over at a grid fixed by its window (every edge of a load:
+:func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`, recorded per level), and the error drops there
+by one to two orders of magnitude.  A difference between a level of the line and one of the quartic is the
+line's error, not a term of the quartic's sequence: the window then bounds the error by the line's, which
+exceeds it by that drop.  So, for these quantities of a load whose edges have been fitted on the last
+``r`` levels (:func:`fitted_run`), after levels of the line:
+
+* with ``r >= LOCATOR_LEVELS`` (two differences at least, so that one that vanished is seen beside the
+  other) the estimate is also taken on those ``r`` levels alone, by the same rule (Richardson needs three
+  differences, so two give the guarded bound), and the smaller of the two is reported: each is a bound on
+  its own argument, the whole window's by the line's larger error, the fitted levels' by their own
+  contraction;
+* with ``0 < r < LOCATOR_LEVELS`` the window compares the two locators: its estimate bounds the error, but
+  by the line's.  Where the tolerance is the scene's own, a stop is deferred to the level where the fitted
+  levels are enough (:func:`locator_changing`), unless that level is beyond the largest grid (the whole
+  window's estimate then stands): at most two more 2D levels, each twice the last, buy an estimate within
+  a small factor of the error.  Refined to the default tolerance (the cheapest grid that meets it,
+  ``sharpen = False`` in :func:`sweep_to_tolerance`), the first grid whose estimate meets it stops, its
+  estimate a bound but not a sharp one.  A load whose edges are never all fitted (a piecewise linear
+  profile's kinks defeat the quartic) is estimated on the whole window.
+
 The coefficients of eq. 34 on the real contact set are integrals over it (:mod:`ngcontact.cell.spectral.grid_measures`:
 ``k_n`` times the contact fraction, ``k_n`` times the gap integrated over the set), with the set's 2D edges
 located between points as the contact fraction's: they converge as the fraction does and are estimated at
-its first order.  The normal effective stiffness is the stiffness of the collocated contact set
+its first order, and where the fraction's sequence of a load is not seen to be geometric (its estimate is
+the guarded bound) neither are theirs, whose errors are the same edges' misplacements: a coefficient's own
+two ratios may agree by chance where the edges' errors change sign, and its Richardson tail then misses an
+error that grows from one grid to the next.
+
+The normal effective stiffness is the stiffness of the collocated contact set
 (:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`): its pressure, singular like the
 inverse square root of the distance to an edge, converges at first order in the grid step with a constant
 that the edges' position between points makes erratic, in 2D much slower than the fraction, so that a
-tolerance met by the other quantities would take many more grids for it.  It is estimated at first order,
-the estimate doubled (:data:`ERRATIC`: its error may exceed the differences beside it where two grids'
-errors share their sign and size, as on Westergaard's sinusoid at half its closing pressure) and reported,
-but not held to the tolerance (:data:`UNCONTROLLED`: listed in the verdict as not counted).
+tolerance met by the other quantities would take many more grids for it (several doublings at 1 %, and a
+tolerance of the order of the fraction's, as a 2D scene may state, beyond any grid the cost bound admits).
+It is estimated at first order, the estimate doubled (:data:`ERRATIC`: its error may exceed the
+differences beside it where two grids' errors share their sign and size, as on Westergaard's sinusoid at
+half its closing pressure) and reported, but not held to the tolerance (:data:`UNCONTROLLED`: listed in
+the verdict as not counted).
 
 Levels double the points per direction (:data:`GROWTH`): close enough that three differences cost little
 more than the finest level (2D: twice the finest; 3D: 4/3 of it).
@@ -62,12 +98,13 @@ Its effectivity (estimate over the true error of the reported level) is measured
 ``scripts/spectral_effectivity.py`` on Westergaard's sinusoid, a random 2D profile and a 3D bisinusoid
 against each cell's own value on a much finer grid (``docs/benchmarks.md``).  No estimate from the levels
 up to ``k`` can be sharp where the error of level ``k`` itself is small by chance: where it crosses zero
-between two grids, or where the sequence leaves a pre-asymptotic stretch for a much faster regime (the 2D
-edge fit once its window holds enough points, :mod:`ngcontact.cell.spectral.grid_measures`), the
-differences up to level ``k`` still carry the size of the earlier errors, and the estimate exceeds the
-error by their ratio.
+between two grids, or where it falls by much more than the differences before it show (a pre-asymptotic
+stretch left for a faster regime that no recorded change of method marks, unlike the 2D edge locator
+above), the differences up to level ``k`` still carry the size of the earlier errors, and the estimate
+exceeds the error by their ratio.
 
-A stop needs ``MIN_LEVELS`` levels (three differences: the window).  The levels are known before the first
+A stop needs ``MIN_LEVELS`` levels (three differences: the window) and, to a scene's own tolerance, no
+load's edge locator changing (above).  The levels are known before the first
 solve (``grid`` times ``GROWTH^k`` up to ``max_points``, :func:`levels`; the scene layer bounds
 ``max_points`` by the cost of a solve, :func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest
 is stated first, and each level prints one progress line as it ends.  A tolerance out of reach ends in a
@@ -86,8 +123,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ngcontact.cell.cell_solution import RELATIVE, headline, measure, scale
-from ngcontact.cell.spectral.grid_measures import coefficients
+from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale
+from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
 from ngcontact.errors import ConvergenceError
 
 log = logging.getLogger(__name__)
@@ -108,9 +145,9 @@ ENVELOPE = 0.5
 VANISHED = 4.0
 #: two successive ratios within this factor of each other make the sequence geometric (Richardson)
 AGREE = 3.0
-#: the fastest contraction per level Richardson may assume: each quantity's own order in the grid step (any
-#: other quantity: first order, :data:`FIRST_ORDER`)
-ORDER_RATE = {"contact_fraction": 0.5, "mean_closure": 0.25}
+#: the fastest contraction per level Richardson may assume: each quantity's own order in the grid step, first
+#: for each (module docstring; any other quantity: :data:`FIRST_ORDER`)
+ORDER_RATE = {"contact_fraction": 0.5, "mean_closure": 0.5}
 FIRST_ORDER = 0.5
 #: Richardson's tail times this: the scatter of one level's error about the geometric model
 SPREAD = 2.0
@@ -120,15 +157,19 @@ UNCONTROLLED = ("normal_stiffness",)
 #: a quantity's estimate times this: the stiffness's first-order constant jumps with the edges' position between
 #: points, so that its error may exceed the differences beside it (module docstring)
 ERRATIC = {"normal_stiffness": 2.0}
+#: the fewest levels whose 2D edges are all located by the quartic that estimate the quantities resting on the
+#: edges on their own (two differences: one that vanished is seen beside the other; module docstring)
+LOCATOR_LEVELS = 3
 #: the two forms of the estimate, as the report names them
 RICHARDSON, GUARDED = "Richardson", "guarded"
 #: how the estimate is made, for the report
 HOW = ("grids of twice the points per direction each; per quantity and load, Richardson with the observed rate "
        f"of the last {WINDOW} differences where their two ratios agree within a factor {AGREE:g} (rate at least "
-       f"{ORDER_RATE['mean_closure']} for the mean closure, {FIRST_ORDER} for the others, the tail times "
-       f"{SPREAD:g}) if that is the smaller, else the guarded geometric tail: rate the larger ratio held to "
-       f"[{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished last one; the effective "
-       f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance")
+       f"{FIRST_ORDER}, the tail times {SPREAD:g}) if that is the smaller, else the guarded geometric tail: "
+       f"rate the larger ratio held to [{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished "
+       "last one; in 2D the contact fraction and coefficients also on the levels whose edges the quartic "
+       f"located (at least {LOCATOR_LEVELS}), the smaller estimate; the effective stiffness's estimate times "
+       f"{ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance")
 
 
 @dataclass
@@ -205,13 +246,13 @@ def guarded_bound(d: list[float]) -> tuple[float, str]:
 
 
 def tail_estimate(values: list[float], relative: bool, order_rate: float = RATE_FLOOR,
-                  scale: float | None = None) -> tuple[float, str, str]:
+                  scale: float | None = None, geometric: bool = True) -> tuple[float, str, str]:
     """The estimated error of the last of ``values`` (a quantity on successive levels; module docstring), its
     form (:data:`RICHARDSON` where that is the smaller, else :data:`GUARDED`) and a remark on it.  Needs two
     values at least; ``order_rate`` is the quantity's :data:`ORDER_RATE`; ``scale``: the size the error is
-    divided by (default: 1, or the last value where ``relative``)."""
+    divided by (default: 1, or the last value where ``relative``); not ``geometric``: the guarded bound only."""
     d = differences(values, relative, scale)
-    fitted = richardson(d, order_rate)
+    fitted = richardson(d, order_rate) if geometric else None
     estimate, remark = guarded_bound(d)
     if fitted is None or fitted[0] >= estimate:
         return estimate, GUARDED, remark
@@ -226,14 +267,23 @@ def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float
     makes zero: ``k_t``, ``k_nt``, ``g_t``, ``G_n``; ``G_t`` without friction)."""
     estimates, forms, guarded = [], [], []
     for k, last in enumerate(history[-1]["headline"]):
-        out, form = {}, {}
+        out: dict[str, float] = {}
+        form: dict[str, str] = {}
         for name in last:
             values = [h["headline"][k].get(name) for h in history]
             if None in values or not any(values):
                 continue
             size = scale(name, last, history[-1]["whole_surface"])
-            out[name], form[name], note = tail_estimate(values, measure(name) == RELATIVE,
-                                                        ORDER_RATE.get(name, FIRST_ORDER), size)
+            # a coefficient's edges are the fraction's: not geometric where the fraction's sequence is not
+            geometric = not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
+            args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
+            out[name], form[name], note = tail_estimate(values, *args)
+            run = fitted_run(history, k) if on_edges(name) else 0
+            if LOCATOR_LEVELS <= run < len(history):
+                sharp = tail_estimate(values[-run:], *args)
+                if sharp[0] < out[name]:
+                    out[name], form[name], note = sharp[0], sharp[1], "; ".join(
+                        filter(None, (sharp[2], "the edge fit's own levels")))
             out[name] *= ERRATIC.get(name, 1.0)
             if form[name] == GUARDED:
                 guarded.append(f"load {k} {name}" + (f": {note}" if note else ""))
@@ -244,6 +294,30 @@ def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float
     if guarded:
         remarks.append("guarded on " + ", ".join(guarded))
     return estimates, remarks, forms
+
+
+def on_edges(name: str) -> bool:
+    """Whether a headline quantity rests on the contact edges located between points in 2D: the contact
+    fraction and the coefficients of eq. 34 on the real contact set (:mod:`~ngcontact.cell.spectral.grid_measures`)."""
+    return name == "contact_fraction" or name.startswith(COEFFICIENT)
+
+
+def fitted_run(history: list[dict[str, Any]], k: int) -> int:
+    """The levels at the end of ``history`` on which every edge of load ``k`` is located by the quartic
+    (:func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`; 0 where the last level's are not)."""
+    run = 0
+    for entry in reversed(history):
+        if not entry.get("edges_fitted", [False] * (k + 1))[k]:
+            break
+        run += 1
+    return run
+
+
+def locator_changing(history: list[dict[str, Any]]) -> bool:
+    """Whether some load's edges came to be located by the quartic fewer than :data:`LOCATOR_LEVELS` levels
+    ago: its differences up to the last level then still compare the two locators (module docstring)."""
+    loads = len(history[-1]["headline"])
+    return any(0 < run < min(LOCATOR_LEVELS, len(history)) for run in (fitted_run(history, k) for k in range(loads)))
 
 
 def levels(grid: int, dim: int, max_points: int) -> list[int]:
@@ -286,18 +360,20 @@ def solve_level(make_cell: Callable[[int], Any], loads: list, n: int,
         "contact_fraction": [s.results["contact_fraction"] for s in sols],
         "mean_closure": [s.results["mean_closure"] for s in sols],
         "headline": [headline(s.results) for s in sols],
+        "edges_fitted": [edges_fitted(cell, s.fields["pressure"], s.fields["gap"]) for s in sols],
         "whole_surface": coefficients(cell, np.ones(cell.shape, bool)).as_dict()}
     return cell, sols, entry
 
 
 def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: float, grid: int, dim: int,
-                       max_points: int, required: bool = True) -> RefinedSweep:
+                       max_points: int, required: bool = True, sharpen: bool = True) -> RefinedSweep:
     """Solve ``loads`` on grids from ``grid`` up until the estimate meets ``tolerance`` (module docstring).
 
     ``make_cell(n)`` builds the spectral cell of ``n`` points per direction.  The grids it may reach
     (:func:`levels`) are known and stated before the first solve; each level logs one progress line.
     Out of reach: a :class:`~ngcontact.errors.ConvergenceError` with the history where ``required``, else
-    the finest level with ``met = False``.
+    the finest level with ``met = False``.  ``sharpen``: a stop waits while an edge locator changes
+    (:func:`locator_changing`), else the first grid whose estimate meets the tolerance is the answer.
     """
     grids = levels(grid, dim, max_points)
     progress.info("spectral refinement may reach grid %d (%d points) in %d levels from grid %d", grids[-1],
@@ -312,7 +388,8 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
             entry["estimate"] = controlled_estimate(estimates)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
                       f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
-        if estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance:
+        settled = not sharpen or n == grids[-1] or not locator_changing(history)
+        if estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance and settled:
             return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, remarks=remarks,
                                 forms=forms)
     reached = f"{entry['estimate']:.3g}" if estimates is not None else "no estimate (one level)"

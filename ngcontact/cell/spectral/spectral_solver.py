@@ -105,7 +105,8 @@ class SpectralCellSolver:
         """Grids from the scene's up until the estimate meets ``tolerance``
         (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`); the finest grid's cell becomes this
         solver's.  A ``required`` tolerance (the scene's) may use grids up to ``max_points`` and raises out of
-        reach; the default one up to ``default_max_points``, and out of reach the finest level is the answer
+        reach, and waits for the 2D edge fit's own levels before a stop (``sharpen``); the default one up to
+        ``default_max_points``, its first grid that meets it the answer, and out of reach the finest level
         with ``met = False``."""
         if self.make_cell is None or self.max_points is None:
             raise ValueError("this spectral cell was built without the recipe of finer grids")
@@ -113,7 +114,7 @@ class SpectralCellSolver:
         bound = self.max_points if required or self.default_max_points is None else self.default_max_points
         bound = max(min(bound, self.max_points), first.points)
         refined = sweep_to_tolerance(lambda n: first if n == first.grid else make(n), loads, tolerance,
-                                     first.grid, first.dim, bound, required=required)
+                                     first.grid, first.dim, bound, required=required, sharpen=required)
         self.cell = refined.cell
         method = {"grid": self.cell.grid, "points": self.cell.points, "refinement": refined.history}
         solutions = [self.solution(s) for s in refined.solutions]
