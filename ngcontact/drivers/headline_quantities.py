@@ -135,7 +135,8 @@ def estimated(report: dict) -> list[dict[str, Any]]:
 
 def headline(report: dict) -> dict[str, dict[str, float | None]]:
     """``{name: {"value", "estimate"}}`` of a report: its kind's headline quantities and those its accuracy
-    record estimates (``estimate``: the absolute error the report estimates, else None)."""
+    record estimates (``estimate``: the absolute error the report estimates, else None; an indicator's: its
+    value, a relative error)."""
     results = report.get("results") or {}
     out = {name: {"value": v, "estimate": v if measure(name) == "indicator" else None}
            for name, v in QUANTITIES[report["kind"]](results).items() if v is not None}

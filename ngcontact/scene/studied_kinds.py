@@ -91,7 +91,7 @@ class Resolved(StudiedKind):
 
 
 #: the studied kinds, asked in this order
-KINDS: tuple[StudiedKind, ...] = (Cell(), TwoScale(), Macro(), Resolved())
+KINDS: tuple[StudiedKind, ...] = (Cell(), Macro(), TwoScale(), Resolved())
 
 
 def supported() -> str:
