@@ -266,3 +266,13 @@ def test_the_study_of_a_small_resolved_scene_recommends_one_that_meets_its_targe
     res = run_and_check_the_recommended_scene(tmp_path, resolved_scene(tmp_path), 0.01)
     assert set(res["ladder"]) == {"h", "order"}
     assert os.path.isfile(tmp_path / "study" / "accuracy_contact_force.png")
+
+
+def test_what_the_study_still_refuses_names_why():
+    """A cell with [ensemble] (random members) and a manufactured scene (a convergence study of its own)."""
+    with pytest.raises(SceneError) as err:
+        studied_kind(loader.load(ROOT / "geometries" / "cells" / "self_affine_ensemble.toml"))
+    assert err.value.path == "ensemble" and "random" in str(err.value)
+    with pytest.raises(SceneError) as err:
+        studied_kind(loader.load(ROOT / "geometries" / "verify_elasticity.toml"))
+    assert err.value.path == "kind" and all(k in str(err.value) for k in ("two-scale", "resolved", "macro", "cell"))
