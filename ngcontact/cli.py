@@ -7,9 +7,9 @@ CSV tables, VTK files for ParaView and PNG plots into ``DIR`` (default
 epsilon study of a ``direct`` scene (:func:`ngcontact.runner.study_epsilon`) and
 writes ``report.json``, ``epsilon.csv`` and ``epsilon.png`` into ``DIR``
 (default ``results/<scene name>_epsilon``); ``ngcontact study accuracy SCENE
-[--target T] [--levels N] [--out DIR]`` runs the accuracy study of a cell, macro or
-direct scene (:func:`ngcontact.runner.study_accuracy`: a ladder over its
-discretization knobs) and writes ``report.json``, ``accuracy_study.csv``, one
+[--target T] [--levels N] [--out DIR]`` runs the accuracy study of a cell, macro,
+two-scale or resolved (``direct``) scene (:func:`ngcontact.runner.study_accuracy`: a ladder over its
+discretization knobs, :mod:`ngcontact.scene.studied_kinds`) and writes ``report.json``, ``accuracy_study.csv``, one
 ``accuracy_<quantity>.png`` per headline quantity and, with a target met,
 ``recommended.toml`` (default ``results/<scene name>_accuracy``); ``ngcontact export SCENE --format
 abaqus|calculix|ansys|json [--out DIR]`` writes the interface law of a cell or
@@ -123,12 +123,14 @@ def _study_parser(sub) -> None:
                         description="epsilon: a 'direct' scene's resolved runs against the homogenized laws; write "
                                     "DIR/report.json, DIR/epsilon.csv and DIR/epsilon.png.  accuracy: a ladder over "
                                     "the scene's discretization knobs (mesh size, order, spectral grid, penalty, "
-                                    "tolerance), each level a whole run; write DIR/report.json, "
+                                    "tolerance; a two-scale loop's table and loop tolerances and its cell's grid, "
+                                    "mesh, order and penalty), each level a whole run; write DIR/report.json, "
                                     "DIR/accuracy_study.csv, a PNG per headline quantity (error against wall time) "
                                     "and, with --target met, DIR/recommended.toml.")
     st.add_argument("study", choices=("epsilon", "accuracy"), help="which study")
     st.add_argument("scene", help="scene file (TOML): epsilon, of kind 'direct' with a [study] section; accuracy, "
-                                  "of kind cell, macro or direct")
+                                  "a cell, macro, two-scale (macro with [two_scale]) or resolved ('direct') "
+                                  "scene")
     st.add_argument("--periods", type=int, nargs="+", metavar="N", help="epsilon: numbers of periods (default: the "
                                                                         "scene's)")
     st.add_argument("--meshes", type=int, choices=(2, 3), help="epsilon: discretizations per level (default: the "

@@ -85,10 +85,11 @@ def cell_key(cell_scene) -> str:
     return h.hexdigest()
 
 
-def cell_scene_of(path: str, *, key: str, overrides: dict | None = None, method: str | None = None) -> CellScene:
-    """The cell scene file ``path`` with ``[contact]`` overrides and another ``discretization.method`` if given
-    (:func:`~ngcontact.scene.loader.load_with_contact`)."""
-    cell_scene = load_with_contact(path, overrides, method)
+def cell_scene_of(path: str, *, key: str, overrides: dict | None = None, method: str | None = None,
+                  discretization: dict | None = None) -> CellScene:
+    """The cell scene file ``path`` with ``[contact]`` overrides, another ``discretization.method`` and other
+    ``[discretization]`` keys if given (:func:`~ngcontact.scene.loader.load_with_contact`)."""
+    cell_scene = load_with_contact(path, overrides, method, discretization)
     if cell_scene.kind != "cell":
         raise SceneError(key, path, f"names a {cell_scene.kind!r} scene; a 'cell' scene is needed")
     return cell_scene
@@ -325,12 +326,12 @@ CELL_METHODS: dict[str, Callable[[CellScene], CellSolver]] = {"fe": fe_cell, "sp
 
 
 def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = None,
-                    method: str | None = None) -> tuple[CellScene, CellProblem]:
+                    method: str | None = None, discretization: dict | None = None) -> tuple[CellScene, CellProblem]:
     """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene) -> the FE
     :class:`CellProblem` with the macro strain term, for what only the FE cell gives: the micro stresses of
     the strength recovery (paper eqs. 74-78) and the shear response; the scene's ``[solver]`` settings and its
     first loads' start (:func:`cell_problem`)."""
-    cs = load_with_contact(cell_path, overrides, method)
+    cs = load_with_contact(cell_path, overrides, method, discretization)
     if cs.kind != "cell":
         raise SceneError(key, cell_path, f"names a {cs.kind!r} scene; a 'cell' scene is needed")
     if cs.contact.geometric_only:

@@ -6,9 +6,13 @@ What an engineer reads first of each kind, as ``{name: value}`` (plain numbers):
   ``mean_closure_load{k}`` and the normal effective stiffness ``effective_stiffness_load{k}`` (the
   ``n0 n0`` entry of the tangent of the mean traction, :mod:`ngcontact.cell.fe.stiffness`); a cell
   without loads: the whole-surface coefficients of paper eq. 34 (``whole_surface_k_n``, ...);
-* macro (also two-scale): the peak interface pressure ``peak_pressure``, the magnitude of the interface
+* macro: the peak interface pressure ``peak_pressure``, the magnitude of the interface
   resultant ``resultant``, the largest von Mises stress ``max_von_mises`` and, with ``[strength]``, the
   safety factor of paper eq. 78 ``safety_factor``;
+* two-scale (a macro report with ``results.two_scale``): the macro ones and the loop's residual
+  ``two_scale_residual``, ``max |sigma_n(k) - sigma_n(k-1)|`` of its last step relative to the peak
+  pressure (paper Sec. 3.5), and, from the accuracy record, the cell table's interpolation error
+  ``cell_table_interpolation``;
 * direct: the resolved contact fraction ``contact_fraction`` and the magnitude of the contact force
   ``contact_force``.
 
@@ -19,7 +23,9 @@ headline ones under the same names (``{name}_load{k}`` for a load; a cell's ``no
 
 A fraction (contact fraction, contact area share) is compared in absolute terms, every other quantity
 relative to its value (:func:`measure`), as a cell's ``discretization.tolerance`` controls them (a cell's
-estimated coefficients of eq. 34 are not among them: :func:`estimated`).
+estimated coefficients of eq. 34 are not among them: :func:`estimated`).  The loop's residual and the
+table's interpolation error are **indicators**: each is itself a relative error of the two-scale answer,
+so its value is its own estimate (``estimate`` = ``value``), and it has no error against another level.
 """
 from __future__ import annotations
 
@@ -30,10 +36,14 @@ from ngcontact.cell.cell_solution import COEFFICIENT
 
 #: quantities compared in absolute terms (fractions in [0, 1]); every other one relative to its value
 ABSOLUTE = ("contact_fraction", "contact_area", "whole_surface_contact_fraction")
+#: quantities that are themselves relative errors of the answer (module docstring)
+INDICATORS = ("two_scale_residual", "cell_table_interpolation")
 
 
 def measure(name: str) -> str:
-    """``absolute`` for a fraction, else ``relative``."""
+    """``indicator`` for a relative error of the answer, ``absolute`` for a fraction, else ``relative``."""
+    if name in INDICATORS:
+        return "indicator"
     return "absolute" if name.startswith(ABSOLUTE) else "relative"
 
 
@@ -80,10 +90,20 @@ def cell_quantities(results: dict) -> dict[str, float | None]:
 
 
 def macro_quantities(results: dict) -> dict[str, float | None]:
-    return {"peak_pressure": _number(_get(results, "maxima.pressure.pressure")),
-            "resultant": _norm(results.get("resultant")),
-            "max_von_mises": _number(_get(results, "maxima.von_mises.max.value")),
-            "safety_factor": _number(_get(results, "strength.safety_factor"))}
+    out = {"peak_pressure": _number(_get(results, "maxima.pressure.pressure")),
+           "resultant": _norm(results.get("resultant")),
+           "max_von_mises": _number(_get(results, "maxima.von_mises.max.value")),
+           "safety_factor": _number(_get(results, "strength.safety_factor"))}
+    if isinstance(results.get("two_scale"), dict):
+        out["two_scale_residual"] = loop_residual(results["two_scale"])
+    return out
+
+
+def loop_residual(two_scale: dict) -> float | None:
+    """The two-scale loop's last change of the interface pressure relative to the peak pressure then."""
+    history = two_scale.get("history") or [{}]
+    change, peak = _number(history[-1].get("max_change") or 0.0), _number(history[-1].get("max_pressure"))
+    return None if change is None or not peak else change / peak
 
 
 def direct_quantities(results: dict) -> dict[str, float | None]:
@@ -115,12 +135,18 @@ def estimated(report: dict) -> list[dict[str, Any]]:
 
 def headline(report: dict) -> dict[str, dict[str, float | None]]:
     """``{name: {"value", "estimate"}}`` of a report: its kind's headline quantities and those its accuracy
-    record estimates (``estimate``: the absolute error the report estimates, else None)."""
+    record estimates (``estimate``: the absolute error the report estimates, else None; an indicator's: its
+    value, a relative error)."""
     results = report.get("results") or {}
-    out = {name: {"value": v, "estimate": None}
+    out = {name: {"value": v, "estimate": v if measure(name) == "indicator" else None}
            for name, v in QUANTITIES[report["kind"]](results).items() if v is not None}
     for entry in estimated(report):
         name = _name(entry)
+        if measure(name) == "indicator":
+            rel = _number(entry.get("relative_error"))
+            if rel is not None:
+                out[name] = {"value": rel, "estimate": rel}
+            continue
         value = _number(entry.get("value"))
         if name in out or value is not None:
             out.setdefault(name, {"value": value, "estimate": None})["estimate"] = abs(float(entry["error"]))

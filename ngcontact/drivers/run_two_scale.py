@@ -33,7 +33,8 @@ solve was warm-started), ``newton_per_solve``, ``tolerance`` [Pa],
 relative midpoint discrepancy accepted, ``nodes``), ``cache`` (key, whether
 the table came from it, its path), ``law`` (the macro law: the cell's
 tabulated response and its interpolation, the monotone cubic), ``cell`` (scene, method, its ``ndof`` (FE) or
-``grid_points`` (spectral) when it was solved, overrides) and the coefficients
+``grid_points`` (spectral) when it was solved, overrides and, where the section sets any, the
+``discretization`` keys it replaces: ``two_scale.cell_grid``, ...) and the coefficients
 at the interface samples (``contact_fraction``, ``k_n0``; along the profile
 in 2D and axisymmetry, on the interface surface in 3D); with a shear
 table also ``shear_table`` (rows, nodes, cell solves, the error estimates
@@ -58,6 +59,7 @@ from ngcontact.coupling import two_scale as T
 from ngcontact.macro.macro_measures import interface_samples
 from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
+from ngcontact.scene.two_scale_section import cell_discretization
 from ngcontact.parallel import executor
 
 log = logging.getLogger(__name__)
@@ -85,16 +87,20 @@ class PressureSolve:
     shared problem gives the numbers of a fresh one.
 
     ``method``: ``"fe"`` or ``"spectral"`` instead of the cell scene's own
-    ``discretization.method`` (``two_scale.cell_method``).  The cell is
+    ``discretization.method`` (``two_scale.cell_method``); ``discretization``: other keys of the cell's
+    ``[discretization]`` replaced (``two_scale.cell_grid``, ``cell_maxh``, ...).  The cell is
     reached through the cell protocol
     (:meth:`~ngcontact.cell.cell_solver.CellSolver.response`), each pressure
     from a first load's start, whichever method solves it.
     """
 
-    def __init__(self, path: str, length_unit: float, overrides: dict | None = None, method: str | None = None):
+    def __init__(self, path: str, length_unit: float, overrides: dict | None = None, method: str | None = None,
+                 discretization: dict | None = None):
         from ngcontact.drivers.build import cell_key, cell_scene_of
         self.path, self.length_unit, self.overrides = path, length_unit, dict(overrides or {})
-        scene = cell_scene_of(path, key="two_scale.cell", overrides=self.overrides, method=method)
+        self.discretization = dict(discretization or {})
+        scene = cell_scene_of(path, key="two_scale.cell", overrides=self.overrides, method=method,
+                              discretization=self.discretization)
         self.method = scene.discretization.method
         self.key = cell_key(scene)
         self._problem = None
@@ -102,7 +108,7 @@ class PressureSolve:
 
     def __getstate__(self):
         return {"path": self.path, "length_unit": self.length_unit, "overrides": self.overrides, "key": self.key,
-                "method": self.method, "_problem": None, "_shared": False}
+                "method": self.method, "discretization": self.discretization, "_problem": None, "_shared": False}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
@@ -112,7 +118,7 @@ class PressureSolve:
         """The cell this task solves: the scene's cell behind the cell protocol."""
         from ngcontact.drivers.build import cell_scene_of, cell_solver
         return cell_solver(cell_scene_of(self.path, key="two_scale.cell", overrides=self.overrides,
-                                         method=self.method))
+                                         method=self.method, discretization=self.discretization))
 
     def problem(self):
         """The cell of :meth:`build`, built once per process and worker thread."""
@@ -145,7 +151,7 @@ class ShearSolve(PressureSolve):
     def build(self):
         from ngcontact.drivers.build import recovery_cell_problem
         return recovery_cell_problem(self.path, key="two_scale.cell", overrides=self.overrides,
-                                     method=self.method)[1]
+                                     method=self.method, discretization=self.discretization)[1]
 
     def __call__(self, load) -> S.ShearResponse:  # type: ignore[override]
         return S.cell_shear_response(self.problem(), load[0], load[1], self.length_unit)
@@ -255,15 +261,18 @@ def couple(scene, problem, solve,
     spec = scene.two_scale
     path = resolve(scene, spec.cell)
     overrides = cell_links.overrides(scene.interface)
-    cell_scene = cell_scene_of(path, key="two_scale.cell", overrides=overrides, method=spec.cell_method)
-    task = PressureSolve(path, spec.cell_length_unit, overrides, spec.cell_method)
+    keys = cell_discretization(spec)
+    cell_scene = cell_scene_of(path, key="two_scale.cell", overrides=overrides, method=spec.cell_method,
+                               discretization=keys)
+    task = PressureSolve(path, spec.cell_length_unit, overrides, spec.cell_method, keys)
     key = table_key(cell_scene, spec.cell_length_unit, spec.table_tol)
     table, from_cache = cached_table(key, task, spec.table_tol, map_tasks, cache_dir)
     shear, skey, shear_cached = None, None, False
     if scene.interface.friction == "from_cell" and cell_scene.contact.friction != "none":
         skey = shear_key(cell_scene, spec.cell_length_unit, spec.table_tol)
-        shear, shear_cached = cached_shear(skey, ShearSolve(path, spec.cell_length_unit, overrides), spec.table_tol,
-                                           spec.cell_length_unit, shear_map, cache_dir)
+        shear_task = ShearSolve(path, spec.cell_length_unit, overrides, discretization=keys)
+        shear, shear_cached = cached_shear(skey, shear_task, spec.table_tol, spec.cell_length_unit, shear_map,
+                                           cache_dir)
     out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
                    points_per_element=scene.output.points_per_element, solve=solve, warm=warm, shear=shear)
     if table.solves:
@@ -282,7 +291,7 @@ def couple(scene, problem, solve,
            "law": {"type": "tabulated cell response p(c)", "interpolation": law.interpolation,
                    "closure": list(law.closure), "pressure": list(law.pressure)},
            "cell": {"scene": path, "method": task.method, **(task.size() if table.solves else {}),
-                    "overrides": overrides},
+                    "overrides": overrides, **({"discretization": keys} if keys else {})},
            "interface_coefficients": {"contact_fraction": coef["contact_fraction"], "k_n0": coef["k_n0"]}}
     if shear is not None:
         res["cell_solves"] += shear.solves

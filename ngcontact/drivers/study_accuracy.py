@@ -12,10 +12,12 @@ A level that fails is reported with its reason and left out.
 level is ``|q - q_ref|`` (a fraction: absolute; any other quantity: relative to ``|q_ref|``), which
 measures what refining that knob further would change, not the error the finest level itself keeps.  The
 reference's own error is the smaller the faster the knob converges; the knob's observed **rate** is the
-least-squares slope of ``log error`` against ``log x`` over its other levels (``x``: ``maxh``, the grid
-step, ``1/k_n``, the tolerance, or ``1/ndof`` for the order), and near the reference that slope is too
-steep (the difference to the reference shrinks faster than the error itself), so it is an upper estimate
-of the rate; two levels only give a two-point slope, which the report says.
+least-squares slope of ``log error`` against ``log x`` over its other levels (``x``: each knob's variable,
+``maxh``, the grid step, ``1/k_n``, a tolerance, or ``1/ndof`` for the order), and near the reference that
+slope is too steep (the difference to the reference shrinks faster than the error itself), so it is an upper estimate
+of the rate; two levels only give a two-point slope, which the report says.  An indicator of a two-scale
+run (the loop's residual, the cell table's interpolation error: relative errors themselves) is not compared
+with the reference: its value is its error, and its rate is the slope of that value.
 
 **Other knobs.** A level changes one knob; every other knob keeps the scene's setting and with it that
 knob's share of the error, which the scene's own level measures in that knob's ladder.  Errors add to first
@@ -85,11 +87,18 @@ def error_of(name: str, value: float, ref: float) -> float:
 
 
 def estimate_of(name: str, entry: dict) -> float | None:
-    """The report's estimated error of a quantity, in the quantity's measure (None where it has none)."""
+    """The report's estimated error of a quantity, in the quantity's measure (None where it has none; an
+    indicator's is its value, a relative error already)."""
     e, v = entry.get("estimate"), entry.get("value")
     if e is None or v is None:
         return None
     return e / abs(v) if measure(name) == "relative" and v != 0 else e
+
+
+def observed(q: dict) -> float | None:
+    """What a level's quantity shows along its knob: its error against the reference, or an indicator's own
+    value (it has no error against another level)."""
+    return q["estimated_error"] if q["measure"] == "indicator" else q["error"]
 
 
 def level_rows(levels: list[Level], runs: dict[str, dict], own_key: str) -> list[dict]:
@@ -111,8 +120,9 @@ def level_rows(levels: list[Level], runs: dict[str, dict], own_key: str) -> list
             quantities = {}
             for name, entry in run["quantities"].items():
                 r = ref_q.get(name, {}).get("value")
+                compared = r is not None and measure(name) != "indicator"
                 quantities[name] = {"value": entry["value"], "measure": measure(name),
-                                    "error": None if r is None else error_of(name, entry["value"], r),
+                                    "error": error_of(name, entry["value"], r) if compared else None,
                                     "estimated_error": estimate_of(name, entry)}
             rows.append({**row, "seconds": run["seconds"], "ndof": run["ndof"], "quantities": quantities})
     add_other_knobs(rows)
@@ -153,8 +163,8 @@ def rates(rows: list[dict]) -> dict[str, dict]:
         names = dict.fromkeys(n for r in fit for n in r["quantities"])
         per = {}
         for name in names:
-            pairs = [(xi, r["quantities"][name]["error"]) for xi, r in zip(x, fit)
-                     if ((r["quantities"].get(name) or {}).get("error") or 0.0) > ROUNDOFF]
+            pairs = [(xi, e) for xi, e in zip(x, (observed(r["quantities"][name]) if name in r["quantities"]
+                                                  else None for r in fit)) if e is not None and e > ROUNDOFF]
             per[name] = slope([p for p, _ in pairs], [e for _, e in pairs])
         out[knob] = {"variable": variables[knob], "levels_fitted": len(fit), "two_point": len(fit) == 2,
                      "rates": per}
@@ -222,10 +232,10 @@ def figures(rows: list[dict], target: float | None) -> dict[str, Callable]:
         series: dict[str, tuple[list, list]] = {}
         for r in rows:
             q = (r.get("quantities") or {}).get(name)
-            if q is not None and not r["reference"] and q["error"] is not None:
+            if q is not None and not r["reference"] and observed(q) is not None:
                 s = series.setdefault(r["knob"], ([], []))
                 s[0].append(r["seconds"])
-                s[1].append(q["error"])
+                s[1].append(observed(q))
         out[f"accuracy_{name}"] = (lambda path, name=name, series=series:
                                    plots.work_precision(path, name, measure(name), series, target))
     return out

@@ -69,7 +69,9 @@ class MemberFailure(Exception):
 
 
 #: One member at a time per process: Netgen's mesher keeps global state, and a Dask worker may run threads.
-_ONE_AT_A_TIME = threading.Lock()
+#: Re-entrant: a member may run a batch of its own in its thread, one member after the other (a two-scale
+#: level of an accuracy study tabulating its cell), which must not wait for itself.
+_ONE_AT_A_TIME = threading.RLock()
 
 
 #: True in a worker process (the test-only ``kill`` fault ends only a worker, never the submitting process).

@@ -55,17 +55,19 @@ def load(path: str | os.PathLike):
         _LOADING.pop()
 
 
-def load_with_contact(path: str | os.PathLike, overrides: dict | None = None, method: str | None = None):
+def load_with_contact(path: str | os.PathLike, overrides: dict | None = None, method: str | None = None,
+                      discretization: dict | None = None):
     """:func:`load` a cell scene with some keys of its ``[contact]`` section replaced.
 
     ``overrides`` maps ``[contact]`` keys (``k_n``, ``friction``, ``mu``,
     ``G``, ``w``) to values; a new ``friction`` drops the cell's own ``mu``,
     ``G`` and ``w`` unless they are overridden too.  ``method`` (``"fe"`` or
-    ``"spectral"``), when given, replaces ``discretization.method``.  The
-    result is validated as a whole (a fault names the cell key, e.g.
+    ``"spectral"``), when given, replaces ``discretization.method``, and
+    ``discretization`` other keys of that section (``grid``, ``maxh``, ...).
+    The result is validated as a whole (a fault names the cell key, e.g.
     ``contact.mu``).
     """
-    if not overrides and method is None:
+    if not overrides and method is None and not discretization:
         return load(path)
     path = os.fspath(path)
     base = load(path)   # the file itself must be a valid scene
@@ -79,8 +81,9 @@ def load_with_contact(path: str | os.PathLike, overrides: dict | None = None, me
             contact.pop(key, None)
     contact.update(overrides)
     data["contact"] = contact
-    if method is not None:
-        data["discretization"] = {**data.get("discretization", {}), "method": method}
+    if method is not None or discretization:
+        data["discretization"] = {**data.get("discretization", {}), **(discretization or {}),
+                                  **({} if method is None else {"method": method})}
     return from_dict(data, base_dir=os.path.dirname(os.path.abspath(path)))
 
 

@@ -43,7 +43,8 @@ from ngcontact.scene import cell_links, mesh_size
 from ngcontact.scene.macro_discretization import MacroDiscretization
 from ngcontact.scene.cell_scene import FRICTION
 from ngcontact.scene.supports import SupportSpec, check_values
-from ngcontact.scene.schema import at_least, nonempty, nonnegative, open_interval, param, positive
+from ngcontact.scene.two_scale_section import TwoScaleSpec, load_cell
+from ngcontact.scene.schema import at_least, nonempty, nonnegative, param, positive
 
 LAWS = ("linear", "bundle", "tabulated", "file")
 #: the kind's boundary labels by (shape, setting), read by the README reference
@@ -251,30 +252,6 @@ class StrengthSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
-class TwoScaleSpec:
-    """The two-scale coupling loop (paper Sec. 3.5)."""
-
-    cell: str = param(doc="cell scene (kind cell) solved at the macro pressures, relative to this scene; "
-                      "lengths in cell_length_unit, its [load] is not used")
-    cell_length_unit: float = param(1.0, doc="length of one unit of the cell scene (scales its gap terms)",
-                                    units="m", check=positive())
-    tol: float = param(doc="stop when max |sigma_n(k) - sigma_n(k-1)| over the interface points is below",
-                       units="Pa", check=positive())
-    max_iter: int = param(20, doc="largest number of law updates", check=at_least(1))
-    table_tol: float = param(0.01, doc="interpolation tolerance of the cell table (monotone cubic): the "
-                             "contact fraction, the closure and the law's pressure relative to their "
-                             "largest values at interval midpoints",
-                             check=positive())
-    table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
-                             "(below it the law follows the table's first secant down to p = 0)",
-                             check=open_interval(0, 1))
-    cell_method: str | None = param(None, doc="how the loop solves its cell: fe (finite elements) or spectral "
-                                    "(the small-slope cell on a grid, for a flat interface with the roughness in "
-                                    "the gap); default: the cell scene's discretization.method",
-                                    choices=("fe", "spectral"))
-
-
-@dataclass(frozen=True, kw_only=True)
 class MacroScene:
     kind: str = param(doc="problem type", choices=("macro",))
     title: str = param("", doc="free text shown in the report")
@@ -382,13 +359,8 @@ class MacroScene:
                 except SceneError as exc:
                     raise SceneError("interface.cell_" + next(iter(overrides)), overrides,
                                      f"the cell {rel!r} with these overrides is invalid: {exc}") from None
-            method = self.two_scale.cell_method if key == "two_scale.cell" and self.two_scale else None
-            if method is not None and cell.kind == "cell":
-                try:
-                    cell = load(resolve(self, rel), overrides, method)
-                except SceneError as exc:
-                    raise SceneError("two_scale.cell_method", method,
-                                     f"the cell {rel!r} cannot be solved by this method: {exc}") from None
+            if key == "two_scale.cell" and self.two_scale is not None and cell.kind == "cell":
+                cell = load_cell(load, resolve(self, rel), rel, overrides, self.two_scale)
             if key == "two_scale.cell" and cell.kind == "cell" and cell.discretization.method == "spectral":
                 cell_links.check_spectral_loop(self.interface, self.two_scale, rel, cell)
             if cell.kind != "cell":

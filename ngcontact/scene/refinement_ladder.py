@@ -1,20 +1,12 @@
 """The ladder of an accuracy study: copies of a scene, one discretization knob refined per level.
 
 A scene's answer depends on its discretization through a few knobs; each knob that exists for the
-scene's kind and method gives one ladder of ``n`` levels, every level the scene's own table with that
-knob's keys replaced (all other keys as the user wrote them):
-
-* ``h`` (FE cells, macro, direct): the mesh sizes halved per level, ``discretization.maxh`` and, where
-  the scene sets it, ``interface_maxh`` (direct: ``maxh`` halved and ``elements_per_period`` doubled);
-  the a-priori estimate ``e ~ C h^q`` makes the observed rate the slope in ``maxh``;
-* ``order`` (the same kinds): the polynomial order one more per level; its error falls faster than any
-  power of ``h``, so its rate is stated in the unknowns, ``e ~ C ndof^-r``;
-* ``grid`` (spectral cells): the grid points per period doubled per level, rate in the grid step;
-* ``k_n`` (cells with ``contact.enforcement = 'penalty'``): the penalty times 10 per level: the
-  penalty's share of the answer is ``O(1/k_n)`` (it adds ``1/k_n`` to the interface compliance, paper
-  eq. 65), rate in ``1/k_n``;
-* ``tolerance`` (cells that set ``discretization.tolerance``; two-scale scenes' ``two_scale.table_tol``):
-  divided by 4 per level, rate in the tolerance.
+scene's studied kind and method (:mod:`ngcontact.scene.studied_kinds`: cell, macro, two-scale,
+resolved) gives one ladder of ``n`` levels, every level the scene's own table with that knob's keys
+replaced (all other keys as the user wrote them).  The knobs and the variables their rates are stated in
+are those of :mod:`ngcontact.scene.discretization_knobs` (``h``, ``order``, ``grid``, ``k_n``,
+``tolerance``) and, for a two-scale loop, :mod:`ngcontact.scene.cell_table_knobs` (``table_tol``,
+``loop_tol``, the loop cell's ``cell_grid``, ``cell_h``, ``cell_order``, ``cell_k_n``).
 
 Every ladder ends one level beyond the scene: its level ``n - 2`` is the user's own discretization
 (where the knob's range allows; an order ladder starts at the lowest admissible order), the levels
@@ -29,8 +21,6 @@ with fewer than 3 levels is dropped.
 """
 from __future__ import annotations
 
-from abc import ABC, abstractmethod
-
 import copy
 import json
 from dataclasses import dataclass, field
@@ -38,12 +28,13 @@ from typing import Any
 
 from ngcontact.errors import SceneError
 from ngcontact.scene import loader
-from ngcontact.scene.schema import MAX_ORDER
+from ngcontact.scene.discretization_knobs import Knob
+from ngcontact.scene.studied_kinds import KINDS, StudiedKind, studied_kind, supported
 
 #: levels of a ladder: the default, and the bounds of ``--levels``
 DEFAULT_LEVELS, MIN_LEVELS, MAX_LEVELS = 4, 3, 6
 #: kinds the study refines, and what it says of the others
-SUPPORTED = "cell (FE and spectral; not with [ensemble]), macro (also two-scale and with [strength]) and direct"
+SUPPORTED = supported()
 
 
 @dataclass(frozen=True)
@@ -70,163 +61,14 @@ class Level:
                           default=str)
 
 
-class Knob(ABC):
-    """A discretization knob: where it applies, its levels' key values and the variable of its rate."""
-
-    name = ""
-    variable = ""
-
-    @abstractmethod
-    def applies(self, scene) -> bool:
-        ...
-
-    @abstractmethod
-    def values(self, scene, n: int) -> list[dict[str, Any]]:
-        """The keys of each of the ``n`` levels, coarsest first, the scene's own at ``n - 2``."""
-
-    @abstractmethod
-    def parameter(self, changes: dict[str, Any]) -> float | None:
-        ...
-
-    def size(self, scene, changes: dict[str, Any]) -> float | None:
-        """The level's unknowns over the scene's, estimated (None: the knob does not fix them)."""
-        return None
+#: every knob of every studied kind, by name (a knob's name means one variable in every kind)
+KNOBS: tuple[Knob, ...] = tuple({k.name: k for kind in KINDS for k in kind.knobs}.values())
 
 
-def space_dim(scene) -> int:
-    """The dimension the unknowns fill: a cell's, 3 for a 3D macro scene, else 2."""
-    if scene.kind == "cell":
-        return scene.geometry.dim
-    return 3 if getattr(scene.geometry, "setting", "") == "3d" else 2
-
-
-def _steps(n: int) -> range:
-    """Refinement steps relative to the scene: ``-(n - 2), ..., 0, 1``."""
-    return range(-(n - 2), 2)
-
-
-class MeshSize(Knob):
-    name, variable = "h", "maxh"
-
-    def applies(self, scene) -> bool:
-        return scene.kind in ("macro", "direct") or getattr(scene.discretization, "method", "fe") == "fe"
-
-    def values(self, scene, n):
-        d = scene.discretization
-        out = []
-        for s in _steps(n):
-            f = 2.0 ** -s
-            keys: dict[str, Any] = {"discretization.maxh": d.maxh * f}
-            if scene.kind == "direct":
-                keys["discretization.elements_per_period"] = d.elements_per_period / f
-            elif d.interface_maxh is not None:
-                keys["discretization.interface_maxh"] = d.interface_maxh * f
-            out.append(keys)
-        return out
-
-    def parameter(self, changes):
-        return changes["discretization.maxh"]
-
-    def size(self, scene, changes):
-        return (scene.discretization.maxh / changes["discretization.maxh"]) ** space_dim(scene)
-
-
-class Order(Knob):
-    name, variable = "order", "1/ndof"
-
-    def applies(self, scene) -> bool:
-        return MeshSize().applies(scene)
-
-    def values(self, scene, n):
-        axisymmetric = getattr(scene.geometry, "setting", "") == "axisymmetric"
-        lowest = 2 if axisymmetric else 1     # order 1 leaves no interior sample off the axis of revolution
-        p = scene.discretization.order
-        first = max(lowest, min(p - (n - 2), MAX_ORDER - n + 1))
-        return [{"discretization.order": q} for q in range(first, min(first + n, MAX_ORDER + 1))]
-
-    def parameter(self, changes):
-        return None
-
-    def size(self, scene, changes):
-        """Lagrange elements of order ``q`` carry about ``q^d`` nodes each."""
-        return (changes["discretization.order"] / scene.discretization.order) ** space_dim(scene)
-
-
-class SpectralGrid(Knob):
-    name, variable = "grid", "period / grid"
-
-    def applies(self, scene) -> bool:
-        return scene.kind == "cell" and scene.discretization.method == "spectral"
-
-    def values(self, scene, n):
-        g = grid_of(scene)
-        return [{"discretization.grid": int(g * 2.0 ** s)} for s in _steps(n) if g * 2.0 ** s >= 8]
-
-    def parameter(self, changes):
-        return 1.0 / changes["discretization.grid"]
-
-    def size(self, scene, changes):
-        return (changes["discretization.grid"] / grid_of(scene)) ** (scene.geometry.dim - 1)
-
-
-class Penalty(Knob):
-    name, variable = "k_n", "1/k_n"
-
-    def applies(self, scene) -> bool:
-        return scene.kind == "cell" and scene.contact.enforcement == "penalty" and not scene.contact.geometric_only
-
-    def values(self, scene, n):
-        return [{"contact.k_n": scene.contact.k_n * 10.0 ** s} for s in _steps(n)]
-
-    def parameter(self, changes):
-        return 1.0 / changes["contact.k_n"]
-
-    def size(self, scene, changes):
-        return 1.0
-
-
-class Tolerance(Knob):
-    name, variable = "tolerance", "tolerance"
-
-    def __init__(self, key: str = "discretization.tolerance"):
-        self.key = key
-
-    def applies(self, scene) -> bool:
-        section, name = self.key.split(".")
-        return getattr(getattr(scene, section, None), name, None) is not None
-
-    def values(self, scene, n):
-        section, name = self.key.split(".")
-        tol = getattr(getattr(scene, section), name)
-        return [{self.key: tol * 4.0 ** -s} for s in _steps(n)]
-
-    def parameter(self, changes):
-        return changes[self.key]
-
-
-KNOBS: tuple[Knob, ...] = (MeshSize(), Order(), SpectralGrid(), Penalty(), Tolerance(),
-                           Tolerance("two_scale.table_tol"))
-
-
-def grid_of(scene) -> int:
-    """The spectral cell's grid: ``discretization.grid``, else a 3D height map's own, else the default."""
-    from ngcontact.scene.cell_scene import spectral_grid
-    g = scene.geometry
-    if scene.discretization.grid is None and g.file is not None and g.dim == 3:
-        from ngcontact.geometry import tabulated
-        from ngcontact.scene.sections import resolve
-        return spectral_grid(scene, tabulated.read_height_map(resolve(scene, g.file), path="geometry.file").shape)
-    return spectral_grid(scene)
-
-
-def check_study(scene) -> None:
-    """Refuse a scene the study cannot refine: a :class:`SceneError` naming the kind and what is supported."""
-    if scene.kind not in ("cell", "macro", "direct"):
-        raise SceneError("kind", scene.kind, f"the accuracy study refines {SUPPORTED} scenes; a "
-                         f"{scene.kind!r} scene is a convergence study of its own: run it with 'ngcontact run'")
-    if scene.kind == "cell" and getattr(scene, "ensemble", None) is not None:
-        raise SceneError("ensemble", "[ensemble]", f"the accuracy study refines {SUPPORTED} scenes: the members "
-                         "of an ensemble are random; study one realization (a cell scene without [ensemble])")
+def check_study(scene) -> StudiedKind:
+    """The studied kind of ``scene`` (:func:`ngcontact.scene.studied_kinds.studied_kind`); a :class:`SceneError`
+    naming the kind and what is supported where the study cannot refine it."""
+    return studied_kind(scene)
 
 
 def with_keys(data: dict, changes: dict[str, Any]) -> dict:
@@ -249,21 +91,18 @@ def ladder(scene, data: dict, n: int) -> tuple[list[Level], list[str]]:
     SceneError
         The kind is not supported (:func:`check_study`), ``n`` is out of range, or no knob applies.
     """
-    check_study(scene)
+    kind = check_study(scene)
     if not MIN_LEVELS <= n <= MAX_LEVELS:
         raise SceneError("--levels", n, f"an integer in [{MIN_LEVELS}, {MAX_LEVELS}]: at least 3 levels give a "
                          "rate, and each level refines the previous one by a factor 2 to 10")
     levels: list[Level] = []
     dropped: list[str] = []
-    for knob in KNOBS:
+    for knob in kind.knobs:
         if not knob.applies(scene):
             continue
         mine = []
         for k, changes in enumerate(knob.values(scene, n)):
-            level_data = with_keys(data, changes)
-            if not isinstance(knob, Tolerance) and scene.kind in ("macro", "direct"):
-                # a macro tolerance refines (order, then mesh) until met: a level of another knob is its setting alone
-                level_data.get("discretization", {}).pop("tolerance", None)
+            level_data = kind.level_table(with_keys(data, knob.table_changes(scene, changes)), knob)
             level = Level(knob.name, k, changes, knob.parameter(changes), knob.size(scene, changes), level_data)
             try:
                 level = Level(knob.name, k, changes, level.parameter, level.size, level_data,

@@ -107,7 +107,8 @@ def test_a_macro_tolerance_is_kept_only_by_the_tolerance_ladder():
 
 @pytest.mark.parametrize("scene, knobs", [
     ("femur_stem_two_scale.toml", {"h": "discretization.maxh", "order": "discretization.order",
-                                   "tolerance": "two_scale.table_tol"}),
+                                   "table_tol": "two_scale.table_tol", "loop_tol": "two_scale.tol",
+                                   "cell_grid": "two_scale.cell_grid", "cell_k_n": "interface.cell_k_n"}),
     ("direct/block_rect_valleys.toml", {"h": "discretization.elements_per_period", "order": "discretization.order"}),
     ("cells/westergaard_exact.toml", {"grid": "discretization.grid", "tolerance": "discretization.tolerance"}),
 ])

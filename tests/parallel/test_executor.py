@@ -33,6 +33,15 @@ def test_serial_runs_every_member_in_order_and_reports_progress():
     assert seen == [("toy", k, len(ITEMS)) for k in range(len(ITEMS) + 1)]
 
 
+def _inner_batch(x):
+    """A member that runs a serial batch of its own (a two-scale level of an accuracy study tabulating its cell)."""
+    return sum(executor.Serial().map(operator.neg, [x, x], ["a", "b"]))
+
+
+def test_a_member_may_run_a_serial_batch_of_its_own():
+    assert executor.Serial().map(_inner_batch, ITEMS, NAMES) == [2 * e for e in EXPECTED]
+
+
 def test_names_must_be_distinct():
     with pytest.raises(ValueError, match="one distinct name per member"):
         executor.Serial().map(operator.neg, ITEMS, ["a"] * len(ITEMS))
