@@ -178,13 +178,15 @@ def coupled_step(step: FreeOperator, b: np.ndarray, t: np.ndarray, atol: float, 
     u = np.zeros_like(r)
     steps = 1
     basis = np.empty((GMRES_RESTART + 1, r.size))
+    preconditioned = np.empty((GMRES_RESTART, r.size))       # proj M basis_j, kept for the update
     while steps < max_steps and float(np.max(np.abs(r))) > atol:
         beta = float(np.sqrt(inner(r, r)))
         target = beta * atol / float(np.max(np.abs(r)))
         H = np.zeros((GMRES_RESTART + 1, GMRES_RESTART))
         np.multiply(r, -1.0 / beta, out=basis[0])
         for j in range(min(GMRES_RESTART, max_steps - steps)):
-            w = step.operator(lift.reduced(step.precondition(basis[j])))
+            preconditioned[j] = step.precondition(basis[j])
+            w = step.operator(lift.reduced(preconditioned[j]))
             steps += 1
             for i in range(j + 1):          # modified Gram-Schmidt
                 H[i, j] = inner(w, basis[i])
@@ -196,7 +198,7 @@ def coupled_step(step: FreeOperator, b: np.ndarray, t: np.ndarray, atol: float, 
             y, *_ = np.linalg.lstsq(H[:j + 2, :j + 1], e1, rcond=None)
             if float(np.linalg.norm(H[:j + 2, :j + 1] @ y - e1)) <= target or H[j + 1, j] <= 1e-300:
                 break
-        u += step.precondition(_combine(y, basis))
+        u += _combine(y, preconditioned)
         # the new gradient without an application: A M V_j y = V_(j+1) H y, and basis[0] = -r / beta
         r = r + _combine(H[:j + 2, :j + 1] @ y, basis)
     return step.add(t, lift.reduced(u)), steps

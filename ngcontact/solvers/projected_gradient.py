@@ -179,10 +179,10 @@ def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping,
         # d mean(q_a) / d s_b = -mean((1/d) (delta_ab inside; (G/|z|)(delta_ab - z_a z_b / |z|^2) on the rim)),
         # summed over the points inside the disc and over those outside it apart
         inv_d = np.broadcast_to(1.0 / np.asarray(damping, float), norm.shape)
-        inside = float(inv_d[~over].sum())
-        w = radius[over] / norm[over] * inv_d[over]
-        u = z[:, over] / norm[over]
-        jac = -(np.eye(c) * (inside + float(w.sum())) - np.einsum("k,ak,bk->ab", w, u, u)) / n
+        inside = float(np.sum(inv_d, where=~over))
+        w = np.divide(radius * inv_d, norm, out=np.zeros_like(norm), where=over)
+        w_uu = np.divide(w, norm * norm, out=np.zeros_like(norm), where=over)     # w / |z|^2, for u = z / |z|
+        jac = -(np.eye(c) * (inside + float(w.sum())) - np.einsum("k,ak,bk->ab", w_uu, z, z)) / n
         try:
             step = np.linalg.solve(jac, r)
         except np.linalg.LinAlgError:

@@ -64,7 +64,7 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
     for c in range(d):
         if not uniform[c]:
             K[zero + (c, c)] = 0.0
-    L = float(np.max(np.linalg.eigvalsh(K)))
+    L = _largest_eigenvalue(K)
     Km = np.moveaxis(K, (-2, -1), (0, 1)).copy()       # (d, d, *kshape)
     return partial(symbol_product, Km, cell.shape), L, K0
 
@@ -111,6 +111,28 @@ def _layers_compliance(cell) -> np.ndarray:
     K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
     K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
     return K
+
+def _real_form(K: np.ndarray) -> np.ndarray:
+    """``R = S K S^{-1}``, ``S = diag(1, .., 1, i)``: the layers' compliance (real in-plane block and diagonal,
+    imaginary normal/tangential coupling, :func:`~.layer_compliance.layer_matrix`) as a real symmetric matrix with
+    the same eigenvalues."""
+    d = K.shape[-1]
+    R = K.real.copy()
+    R[..., :d - 1, d - 1] = K[..., :d - 1, d - 1].imag
+    R[..., d - 1, :d - 1] = -K[..., d - 1, :d - 1].imag
+    return R
+
+
+def _largest_eigenvalue(K: np.ndarray) -> float:
+    """The largest eigenvalue of the Hermitian ``K`` over all wave vectors: the eigenvalues are computed only
+    where Gershgorin's bound (a row's diagonal plus the moduli of the rest) reaches the largest diagonal entry,
+    a lower bound of the answer."""
+    d = K.shape[-1]
+    R = np.abs(_real_form(K)).reshape(-1, d, d)
+    diagonal = np.real(np.diagonal(K, axis1=-2, axis2=-1)).reshape(-1, d)
+    bound = np.max(diagonal + R.sum(axis=-1) - np.abs(diagonal), axis=-1)
+    return float(np.max(np.linalg.eigvalsh(K.reshape(-1, d, d)[bound >= diagonal.max()])))
+
 
 class TractionPreconditioner:
     """``r -> K_full^{-1} r`` by FFTs: the inverse of the full compliance (uniform modes kept, plus the penalty's
