@@ -49,7 +49,11 @@ operator divides it.  The preconditioner is therefore split
 (:meth:`Preconditioner.for_curvature`): ``1 / (k_self + D)`` on the entries
 ``D`` dominates, ``R K_full^{-1} R^T`` on the others, a block-Jacobi
 preconditioner that is still symmetric positive definite.  The inner
-tolerance is a share of the outer residual.
+tolerance is a share of the outer residual.  The free directions live on the
+pressed, sticking and slipping points, a few percent of the grid where the
+contact is sparse: the Krylov vectors are held in the coordinates of that
+support (:mod:`ngcontact.solvers.free_directions`), and only the applications
+of ``K`` and ``K_full^{-1}`` by FFTs see the whole grid.
 
 Coulomb friction (a threshold ``G = mu p`` of the unknown pressure) has
 no potential.  Its semismooth Newton step keeps what the threshold's

@@ -31,7 +31,7 @@ import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.spectral.fft_threads import fft_workers
-from ngcontact.cell.spectral.layer_compliance import layer_matrix
+from ngcontact.cell.spectral.layer_compliance import layers_matrix
 from ngcontact.cell.spectral.traction_constraints import TractionConstraints
 from ngcontact.solvers.active_set_newton import active_set_newton, coulomb_active_set
 from ngcontact.solvers.free_directions import SplitPreconditioner
@@ -106,15 +106,15 @@ def _layers_compliance(cell) -> np.ndarray:
         k0 = 2 * np.pi * sfft.fftfreq(n, d=cell.period / n)
         kv = np.stack(np.broadcast_arrays(k1[None, :], k0[:, None]), axis=-1)
         nyq = (np.arange(n)[:, None] == n // 2) | (np.arange(k1.size)[None, :] == n // 2)
-    K = (layer_matrix(kv, cell.rough.E, cell.rough.nu, cell.rough.h)
-         + layer_matrix(kv, cell.counter.E, cell.counter.nu, cell.counter.h, above=True))
+    K = layers_matrix(kv, [(cell.rough.E, cell.rough.nu, cell.rough.h, False),
+                           (cell.counter.E, cell.counter.nu, cell.counter.h, True)])
     K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
     K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
     return K
 
 def _real_form(K: np.ndarray) -> np.ndarray:
     """``R = S K S^{-1}``, ``S = diag(1, .., 1, i)``: the layers' compliance (real in-plane block and diagonal,
-    imaginary normal/tangential coupling, :func:`~.layer_compliance.layer_matrix`) as a real symmetric matrix with
+    imaginary normal/tangential coupling, :func:`~.layer_compliance.layers_matrix`) as a real symmetric matrix with
     the same eigenvalues."""
     d = K.shape[-1]
     R = K.real.copy()
