@@ -265,9 +265,12 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
     def evaluate(t, shifts):
         nonlocal steps
         steps += 1
-        v = t - grad(t) / L
+        v = grad(t)
+        np.divide(v, -L, out=v)
+        v += t                                  # t - grad(t) / L, in place
         t_hat, shifts = h.prox(v, shifts)
-        return _Point(t, v, t_hat, shifts, float(np.max(np.abs(t - t_hat))) * L / scale)
+        change = t - t_hat
+        return _Point(t, v, t_hat, shifts, float(np.max(np.abs(change, out=change))) * L / scale)
 
     x = evaluate(t0.copy(), ())
     best, since_best = x.res, 0

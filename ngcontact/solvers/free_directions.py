@@ -46,8 +46,8 @@ class FreeDirections:
         # the points of the shear set: the free shear, and the rim's held shear, which a lift may move
         # (stick and rim disjoint)
         self.sheared = stick | rim
-        self.on = on[self.sheared]           # turning, among the points of the shear set
-        self.held = (rim & ~on)[self.sheared]
+        self.on = np.flatnonzero(on[self.sheared])           # turning, among the points of the shear set
+        self.held = np.flatnonzero((rim & ~on)[self.sheared])
         self.n_p = int(np.count_nonzero(pressed))
         self.n_q = int(np.count_nonzero(self.sheared))
         self.constrained = constrained
@@ -89,9 +89,10 @@ class FreeDirections:
 
     def _shear(self, qs: np.ndarray) -> None:
         """The shear's projection, in place: the tangent where turning, none where held."""
-        if self.turn.shape[1]:
+        if self.on.size:
             qs[:, self.on] = np.sum(qs[:, self.on] * self.turn, axis=0) * self.turn
-        qs[:, self.held] = 0.0
+        if self.held.size:
+            qs[:, self.held] = 0.0
 
     def mean_free_reduced(self, total: np.ndarray) -> np.ndarray:
         """The free shear ``Pi lambda`` whose sum over the grid is ``total``, on the shear set."""

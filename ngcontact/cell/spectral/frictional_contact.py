@@ -208,7 +208,9 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
     scale = cell.gscale
 
     def grad(t):
-        return apply(t) + b
+        g = apply(t)        # a new array
+        g += b
+        return g
 
     h = TractionConstraints(cell.shape, lambda p: f.threshold(p), L, None if exact else f.w,
                             None if exact else cell.k_n, mean_p, mean_q,
