@@ -6,7 +6,8 @@ tangent ``n_perp`` of the friction disc at a slipping point of a 3D cell, and on
 prescribed mean the sum zero.  :class:`FreeDirections` is the orthogonal projector onto them.
 
 Every free direction lives on the *support* ``S``: the pressure at the pressed points and the shear at the
-sticking and turning points, a few percent of the grid where the contact is sparse.  The Krylov vectors of a
+sticking and slipping points (a slipping point's shear turns in 3D and is held in 2D, where the Coulomb step's
+lift still moves it), a few percent of the grid where the contact is sparse.  The Krylov vectors of a
 step lie in the projector's range, so they are held in the coordinates of ``S`` alone (:meth:`gather`,
 :meth:`scatter`; the order: the shear components at the points of the shear set, then the pressure at the
 pressed points, each in the grid's order), and the projector acts there as :meth:`reduced`: the grid enters
