@@ -143,8 +143,10 @@ def publish(csv_path: str, png: str, reason: str | None, cases=CASES, command: s
              "Krylov step with its preconditioner). former: plain constrained CG and accelerated proximal "
              "gradients; current: preconditioned constrained CG and the active-set method (Coulomb: semismooth "
              "Newton steps of the coupled law by preconditioned GMRES, the Anderson-accelerated fixed point of "
-             "Tresca problems as fallback). Timings taken on 2 cores shared with other jobs: compare rows of one "
-             "run, not absolute seconds; the step counts do not depend on the load. " + only +
+             "Tresca problems as fallback; the Krylov vectors held on the support of the free directions, the "
+             "pressed, sticking and slipping points, so that beside the FFTs a Krylov step costs little). Timings "
+             "taken on 2 cores shared with other jobs: compare rows of one run, not absolute seconds; the step "
+             "counts do not depend on the load. " + only +
              "Aims (issue 38): Coulomb at 1024^2 <= 30 s and <= 2 GB, frictionless three loads <= 15 s. "
              f"Peer: {reason or 'Tamaas run'}.",
         png=png, command=command)

@@ -49,7 +49,11 @@ operator divides it.  The preconditioner is therefore split
 (:meth:`Preconditioner.for_curvature`): ``1 / (k_self + D)`` on the entries
 ``D`` dominates, ``R K_full^{-1} R^T`` on the others, a block-Jacobi
 preconditioner that is still symmetric positive definite.  The inner
-tolerance is a share of the outer residual.
+tolerance is a share of the outer residual.  The free directions live on the
+pressed, sticking and slipping points, a few percent of the grid where the
+contact is sparse: the Krylov vectors are held in the coordinates of that
+support (:mod:`ngcontact.solvers.free_directions`), and only the applications
+of ``K`` and ``K_full^{-1}`` by FFTs see the whole grid.
 
 Coulomb friction (a threshold ``G = mu p`` of the unknown pressure) has
 no potential.  Its semismooth Newton step keeps what the threshold's
@@ -103,6 +107,7 @@ import numpy as np
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.anderson import Anderson
 from ngcontact.solvers.constrained_cg import inner
+from ngcontact.solvers.free_directions import FreeDirections, FreeOperator, Lift, SplitPreconditioner
 from ngcontact.solvers.projected_gradient import ProximalResult, fista
 
 #: outer steps without a new smallest residual after which the solve goes on with accelerated proximal gradients
@@ -123,133 +128,89 @@ GMRES_RESTART = 20
 SAME_POINT = 1e-13
 
 
-class FreeDirections:
-    """The orthogonal projector onto the free directions of a proximal point ``t_hat = (q, p)``.
-
-    Free: the pressure where ``pressed``; the whole shear where ``stick``; at
-    a slipping point (``rim``) of a 3D cell the shear along the tangent of
-    the friction disc, ``n_perp`` (the slip direction's own update, the
-    semismooth Newton step of ``q = G z / |z|`` without its curvature term);
-    on each component group of prescribed mean, in addition, the sum zero
-    (the projection ``y - Pi lambda`` with ``(sum_i Pi_i) lambda = sum_i y_i``).
-    """
-
-    def __init__(self, pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, t_hat: np.ndarray,
-                 constrained: tuple[bool, ...]):
-        d = self.d = t_hat.shape[0]
-        self.on = np.zeros(stick.shape, bool)
-        self.turn = np.zeros((d - 1, 0))
-        if d == 3:
-            q = t_hat[:2]
-            norm = np.sqrt(q[0] * q[0] + q[1] * q[1])
-            self.on = rim & (norm > 0)
-            self.turn = np.stack([-q[1][self.on], q[0][self.on]]) / norm[self.on]    # n_perp where turning (few)
-        self.stick_f, self.pressed_f = stick.astype(float), pressed.astype(float)
-        self.n_p = int(np.count_nonzero(pressed))
-        self.constrained = constrained
-        self.M_inv = np.linalg.pinv(np.eye(d - 1) * float(max(np.count_nonzero(stick), d == 2))
-                                    + self.turn @ self.turn.T) if constrained[0] else None
-
-    def shear(self, x: np.ndarray) -> np.ndarray:
-        y = x * self.stick_f
-        if self.turn.shape[1]:
-            y[:, self.on] = np.sum(x[:, self.on] * self.turn, axis=0) * self.turn     # stick, rim disjoint
-        return y
-
-    def mean_free(self, total: np.ndarray) -> np.ndarray:
-        """The free shear ``Pi lambda`` whose sum over the grid is ``total`` (prescribed mean shear only)."""
-        assert self.M_inv is not None
-        d = self.d
-        lam = self.M_inv @ total
-        return self.shear(np.broadcast_to(lam.reshape((d - 1,) + (1,) * (d - 1)), (d - 1,) + self.stick_f.shape))
-
-    def __call__(self, x: np.ndarray) -> np.ndarray:
-        d = self.d
-        y = np.empty_like(x)
-        np.multiply(x[d - 1], self.pressed_f, out=y[d - 1])
-        if self.constrained[d - 1] and self.n_p:
-            y[d - 1] -= float(y[d - 1].sum()) / self.n_p
-            y[d - 1] *= self.pressed_f
-        y[:d - 1] = self.shear(x[:d - 1])
-        if self.constrained[0]:
-            y[:d - 1] -= self.mean_free(y[:d - 1].reshape(d - 1, -1).sum(axis=1))
-        return y
-
-
 def traction_projector(pressed: np.ndarray, stick: np.ndarray, rim: np.ndarray, t_hat: np.ndarray,
                        constrained: tuple[bool, ...]) -> FreeDirections:
-    """The projector onto the free directions of ``t_hat`` (:class:`FreeDirections`)."""
+    """The projector onto the free directions of ``t_hat``
+    (:class:`~ngcontact.solvers.free_directions.FreeDirections`)."""
     return FreeDirections(pressed, stick, rim, t_hat, constrained)
 
 
-def free_minimum(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np.ndarray,
-                 proj: Callable[[np.ndarray], np.ndarray], precondition: Callable[[np.ndarray], np.ndarray],
-                 atol: float, max_steps: int) -> tuple[np.ndarray, int]:
-    """Minimize ``1/2 <t, A t> + <t, b>`` over the free entries of ``t`` (the rest and the means held).
+def free_minimum(step: FreeOperator, b: np.ndarray, t: np.ndarray, atol: float,
+                 max_steps: int) -> tuple[np.ndarray, int]:
+    """Minimize ``1/2 <t, (A + D) t> + <t, b>`` over the free entries of ``t`` (the rest and the means held).
 
     Projected preconditioned conjugate gradients from ``t`` (which meets the
     mean constraints) until the projected gradient is below ``atol`` in the
-    maximum norm.  Returns ``(t, steps)``, ``steps`` the operator applications (the start's gradient
-    included).
+    maximum norm, in the coordinates of the free directions' support (:class:`FreeOperator`).  Returns
+    ``(t, steps)``, ``steps`` the operator applications (the start's gradient included).
     """
-    t = t.copy()
-    r = proj(apply(t) + b)
-    z = proj(precondition(r))
+    r = step.residual(t, b)
+    z = step.precondition(r)
     rz = inner(r, z)
     d = z
-    for step in range(1, max_steps + 1):
+    u = np.zeros_like(r)
+    for k in range(1, max_steps + 1):
         if float(np.max(np.abs(r))) <= atol or rz <= 0:
-            return t, step
-        Ad = proj(apply(d))
+            return step.add(t, u), k
+        Ad = step.operator(d)
         dAd = inner(d, Ad)
         if dAd <= 0:
-            return t, step
+            return step.add(t, u), k
         alpha = rz / dAd
-        t -= alpha * d
+        u -= alpha * d
         r -= alpha * Ad
-        z = proj(precondition(r))
+        z = step.precondition(r)
         rz, rz_old = inner(r, z), rz
         d = z + (rz / rz_old) * d
-    return t, max_steps + 1
+    return step.add(t, u), max_steps + 1
 
 
-def coupled_step(apply: Callable[[np.ndarray], np.ndarray], b: np.ndarray, t: np.ndarray,
-                 proj: Callable[[np.ndarray], np.ndarray], precondition: Callable[[np.ndarray], np.ndarray],
-                 atol: float, max_steps: int, *, lift: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, int]:
+def coupled_step(step: FreeOperator, b: np.ndarray, t: np.ndarray, atol: float, max_steps: int, *,
+                 lift: Lift) -> tuple[np.ndarray, int]:
     """The Newton step of a threshold that follows the pressure: ``proj(A (t + lift(u)) + b) = 0`` for ``u`` in
     the free directions.
 
     ``lift`` moves the shear of a slipping point with its pressure (``dG/dp`` times the slip direction), so the
     operator is not symmetric: restarted GMRES (Saad & Schultz, SIAM J. Sci. Stat. Comput. 7 (1986)
-    856-869), preconditioned from the right by ``proj M``, until the projected gradient is below ``atol`` in
+    856-869) in the coordinates of the free directions' support (:class:`FreeOperator`), preconditioned from
+    the right by ``proj M``, until the projected gradient is below ``atol`` in
     the maximum norm (its Euclidean norm, which GMRES minimizes, below the same share of its start inside a
     cycle; the gradient after a cycle is the Krylov basis times ``H y``, not a new application).  Returns
     ``(t + lift(u), steps)``, ``steps`` the operator applications (the start's gradient included).
     """
-    u = np.zeros_like(t)
-    r = proj(apply(t) + b)
+    r = step.residual(t, b)
+    u = np.zeros_like(r)
     steps = 1
+    basis = np.empty((GMRES_RESTART + 1, r.size))
+    preconditioned = np.empty((GMRES_RESTART, r.size))       # proj M basis_j, kept for the update
     while steps < max_steps and float(np.max(np.abs(r))) > atol:
         beta = float(np.sqrt(inner(r, r)))
         target = beta * atol / float(np.max(np.abs(r)))
-        basis, H = [-r / beta], np.zeros((GMRES_RESTART + 1, GMRES_RESTART))
+        H = np.zeros((GMRES_RESTART + 1, GMRES_RESTART))
+        np.multiply(r, -1.0 / beta, out=basis[0])
         for j in range(min(GMRES_RESTART, max_steps - steps)):
-            w = proj(apply(lift(proj(precondition(basis[j])))))
+            preconditioned[j] = step.precondition(basis[j])
+            w = step.operator(lift.reduced(preconditioned[j]))
             steps += 1
-            for i, v in enumerate(basis):
-                H[i, j] = inner(w, v)
-                w -= H[i, j] * v
+            for i in range(j + 1):          # modified Gram-Schmidt
+                H[i, j] = inner(w, basis[i])
+                w -= H[i, j] * basis[i]
             H[j + 1, j] = float(np.sqrt(inner(w, w)))
-            basis.append(w / max(H[j + 1, j], 1e-300))
+            np.multiply(w, 1.0 / max(H[j + 1, j], 1e-300), out=basis[j + 1])
             e1 = np.zeros(j + 2)
             e1[0] = beta
             y, *_ = np.linalg.lstsq(H[:j + 2, :j + 1], e1, rcond=None)
             if float(np.linalg.norm(H[:j + 2, :j + 1] @ y - e1)) <= target or H[j + 1, j] <= 1e-300:
                 break
-        u += proj(precondition(sum(c * v for c, v in zip(y, basis))))
+        u += _combine(y, preconditioned)
         # the new gradient without an application: A M V_j y = V_(j+1) H y, and basis[0] = -r / beta
-        r = r + sum(c * v for c, v in zip(H[:j + 2, :j + 1] @ y, basis))
-    return t + lift(u), steps
+        r = r + _combine(H[:j + 2, :j + 1] @ y, basis)
+    return step.add(t, lift.reduced(u)), steps
+
+
+def _combine(c: np.ndarray, basis: np.ndarray) -> np.ndarray:
+    """``sum_i c_i basis_i`` over the first ``len(c)`` rows (``einsum``'s own loop, no BLAS threads)."""
+    return np.einsum("i,ij->j", c, basis[:len(c)])
 
 
 class Preconditioner(Protocol):
@@ -258,7 +219,7 @@ class Preconditioner(Protocol):
 
     def __call__(self, r: np.ndarray) -> np.ndarray: ...
 
-    def for_curvature(self, D: np.ndarray) -> Callable[[np.ndarray], np.ndarray]: ...
+    def for_curvature(self, D: np.ndarray) -> SplitPreconditioner: ...
 
 
 class Constraints(Protocol):
@@ -304,9 +265,12 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
     def evaluate(t, shifts):
         nonlocal steps
         steps += 1
-        v = t - grad(t) / L
+        v = grad(t)
+        np.divide(v, -L, out=v)
+        v += t                                  # t - grad(t) / L, in place
         t_hat, shifts = h.prox(v, shifts)
-        return _Point(t, v, t_hat, shifts, float(np.max(np.abs(t - t_hat))) * L / scale)
+        change = t - t_hat
+        return _Point(t, v, t_hat, shifts, float(np.max(np.abs(change, out=change))) * L / scale)
 
     x = evaluate(t0.copy(), ())
     best, since_best = x.res, 0
@@ -316,10 +280,9 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
             return ProximalResult(t=x.t_hat, shifts=x.shifts, iterations=steps, residuals=residuals)
         atol = max(INNER_SHARE * x.res, 0.2 * tol) * scale
         proj, D, lift = h.linearize(x.t_hat, x.v, x.shifts)
+        operator = FreeOperator(apply, D, proj, precondition.for_curvature(D))
         newton_step = free_minimum if lift is None else partial(coupled_step, lift=lift)
-        t_new, inner_steps = newton_step(lambda y: apply(y) + D * y, b, x.t_hat, proj,
-                                         precondition.for_curvature(D), atol,
-                                          max(1, max_iter - steps))
+        t_new, inner_steps = newton_step(operator, b, x.t_hat, atol, max(1, max_iter - steps))
         steps += inner_steps
         # the projection of the free minimum onto the constraints; where it does not lower the residual, the
         # free minimum itself if that does (not evaluated where the projection is the same point)

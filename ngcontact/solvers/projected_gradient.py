@@ -76,6 +76,24 @@ def prox_pressure(v: np.ndarray, damping: float, mean: float | None, shift0: flo
     return np.maximum(v - x, 0.0) / damping, x
 
 
+def _clipper(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float):
+    """``s -> (q, z, norm, over)``: ``z = (v - s) / d``, ``q`` its clip to the discs ``|q| <= G``, ``over`` the points
+    outside them (``v`` of shape ``(c, m)``, ``radius`` and ``damping`` of ``m`` points or scalars)."""
+    c = v.shape[0]
+    plain = not isinstance(damping, np.ndarray) and damping == 1.0
+
+    def clip(s):
+        z = v - s.reshape(c, 1)
+        if not plain:
+            z /= damping
+        norm = np.sqrt(z[0] * z[0] + z[1] * z[1] if c == 2 else z[0] * z[0])     # 0 where z * z underflows
+        over = norm > radius
+        # the points outside the disc onto its rim
+        q = z * np.divide(radius, norm, out=np.ones_like(norm), where=over)
+        return q, z, norm, over
+    return clip
+
+
 def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float, mean: np.ndarray | None,
                   shift0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``q_i = clip_{|q| <= G_i}((v_i - s) / d_i)`` with ``s`` such that ``mean(q) = mean``.
@@ -83,37 +101,49 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float
     ``v``: shape ``(c, ...)`` with ``c`` tangential components; ``radius``
     the thresholds ``G_i``, ``damping`` the factors ``d_i``.  The shift is
     found one component at a time (each mean is decreasing in its own
-    shift), sweeping until both hold.
+    shift), sweeping until both hold.  A point of zero threshold carries no
+    shear whatever the shift: the shift is found on the others alone.
     """
     c = v.shape[0]
-
     radius = np.broadcast_to(radius, v.shape[1:])
-
-    def clip(s):
-        z = v - s.reshape((c,) + (1,) * (v.ndim - 1))
-        if not (np.isscalar(damping) and damping == 1.0):
-            z /= damping
-        norm = np.sqrt(z[0] * z[0] + z[1] * z[1] if c == 2 else z[0] * z[0])     # 0 where z * z underflows
-        over = norm > radius
-        q = z.copy()
-        q[:, over] *= radius[over] / norm[over]       # the points outside the disc (few) onto its rim
-        return q, z, norm, over
-
     s = np.zeros(c) if (mean is None or shift0 is None) else np.asarray(shift0, float).copy()
     if mean is None:
-        return clip(np.zeros(c))[0], s
+        flat = _clipper(v.reshape(c, -1), radius.reshape(-1), _flat(damping, radius))
+        return flat(s)[0].reshape(v.shape), s
     capacity = float(radius.mean())
     target = np.asarray(mean, float)
     if float(np.linalg.norm(target)) >= capacity:
         raise ConvergenceError(f"a mean shear of {float(np.linalg.norm(target)):.6g} exceeds the friction the "
                                f"interface can carry, {capacity:.6g} (the mean friction threshold): the interface "
                                "cannot carry this load", {})
-    tol = 1e-13 * max(capacity, 1e-300)
+    loaded = np.flatnonzero(radius.reshape(-1) > 0)
+    n = radius.size
+    vl, rl = v.reshape(c, -1)[:, loaded], radius.reshape(-1)[loaded]
+    flat_d = _flat(damping, radius)
+    dl = flat_d[loaded] if isinstance(flat_d, np.ndarray) else flat_d
+    s, ql = _shift(_clipper(vl, rl, dl), vl, rl, dl, s, target, n, 1e-13 * max(capacity, 1e-300))
+    q = np.zeros(v.shape)
+    q.reshape(c, -1)[:, loaded] = ql
+    return q, s
+
+
+def _flat(damping: np.ndarray | float, radius: np.ndarray) -> np.ndarray | float:
+    """The damping per point of the flattened grid (a scalar stays one)."""
+    if isinstance(damping, np.ndarray):
+        return np.broadcast_to(damping, radius.shape).reshape(-1)
+    return float(damping)
+
+
+def _shift(clip, v: np.ndarray, radius: np.ndarray, damping, s: np.ndarray, target: np.ndarray, n: int,
+           tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """The shifts ``s`` of :func:`prox_friction` whose clip's sum over the ``n`` points of the grid is ``n target``,
+    and that clip (``v``, ``radius``, ``damping``: the points of positive threshold)."""
+    c = v.shape[0]
     if c > 1:                   # Newton on all shifts at once, from the warm start; one sweep at a time below if not
-        joint = _joint_shift(clip, s, target, radius, damping, tol)
+        joint = _joint_shift(clip, s, target, radius, damping, tol, n)
         if joint is not None:
-            return joint[1], joint[0]
-    reach = float(np.max(np.abs(v))) + float(np.max(radius * damping))
+            return joint
+    reach = float(np.max(np.abs(v), initial=0.0)) + float(np.max(radius * damping, initial=0.0))
     for _ in range(100):
         for a in range(c):
             def f(x, a=a):
@@ -122,24 +152,24 @@ def prox_friction(v: np.ndarray, radius: np.ndarray, damping: np.ndarray | float
                 # d q_a / d s_a = -(1/d) (1 inside the disc; (G/|z|)(1 - z_a^2/|z|^2) on its rim)
                 rim = np.where(over, radius / np.where(over, norm, 1.0)
                                * (1.0 - z[a] ** 2 / np.where(over, norm * norm, 1.0)), 1.0)
-                return float(q[a].mean()) - target[a], -float(np.mean(rim / damping)) - 1e-300
+                return float(q[a].sum()) / n - target[a], -float(np.sum(rim / damping)) / n - 1e-300
             s[a] = _decreasing_root(f, -reach, reach, float(s[a]), tol)
         q = clip(s)[0]
-        if all(abs(float(q[a].mean()) - target[a]) <= 10 * tol for a in range(c)):
-            return q, s
+        if all(abs(float(q[a].sum()) / n - target[a]) <= 10 * tol for a in range(c)):
+            return s, q
     raise ConvergenceError(f"the shift that makes the mean shear {target.tolist()} did not converge", {})
 
 
 def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping,
-                 tol: float) -> tuple[np.ndarray, np.ndarray] | None:
+                 tol: float, n: int) -> tuple[np.ndarray, np.ndarray] | None:
     """Newton's method for all the shifts of :func:`prox_friction` at once: the shifts and their clipped
     traction (``None`` if it stalls).  An accepted trial's clip is the next step's, so each step clips once
-    where its full step is taken."""
+    where its full step is taken.  ``n``: the points of the grid (the means are over them)."""
     c = len(s0)
     s = s0.copy()
 
     def misfit(q):
-        return np.array([float(q[a].mean()) for a in range(c)]) - target
+        return np.array([float(q[a].sum()) / n for a in range(c)]) - target
     clipped = clip(s)
     r = misfit(clipped[0])
     for _ in range(20):
@@ -147,12 +177,12 @@ def _joint_shift(clip, s0: np.ndarray, target: np.ndarray, radius, damping,
             return s, clipped[0]
         q, z, norm, over = clipped
         # d mean(q_a) / d s_b = -mean((1/d) (delta_ab inside; (G/|z|)(delta_ab - z_a z_b / |z|^2) on the rim)),
-        # summed over the points inside the disc and over the (few) outside it apart
+        # summed over the points inside the disc and over those outside it apart
         inv_d = np.broadcast_to(1.0 / np.asarray(damping, float), norm.shape)
-        inside = float(inv_d[~over].sum())
-        w = radius[over] / norm[over] * inv_d[over]
-        u = z[:, over] / norm[over]
-        jac = -(np.eye(c) * (inside + float(w.sum())) - np.einsum("k,ak,bk->ab", w, u, u)) / norm.size
+        inside = float(np.sum(inv_d, where=~over))
+        w = np.divide(radius * inv_d, norm, out=np.zeros_like(norm), where=over)
+        w_uu = np.divide(w, norm * norm, out=np.zeros_like(norm), where=over)     # w / |z|^2, for u = z / |z|
+        jac = -(np.eye(c) * (inside + float(w.sum())) - np.einsum("k,ak,bk->ab", w_uu, z, z)) / n
         try:
             step = np.linalg.solve(jac, r)
         except np.linalg.LinAlgError:

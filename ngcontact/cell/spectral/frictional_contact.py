@@ -25,13 +25,16 @@ Functions of a :class:`~ngcontact.cell.spectral.layered_cell.SpectralCell` ``cel
 """
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.spectral.fft_threads import fft_workers
-from ngcontact.cell.spectral.layer_compliance import layer_matrix
+from ngcontact.cell.spectral.layer_compliance import layers_matrix
 from ngcontact.cell.spectral.traction_constraints import TractionConstraints
 from ngcontact.solvers.active_set_newton import active_set_newton, coulomb_active_set
+from ngcontact.solvers.free_directions import SplitPreconditioner
 from ngcontact.solvers.projected_gradient import fista
 
 
@@ -54,7 +57,6 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
     ``K0`` the diagonal of the uniform mode (the layers' uniaxial-strain
     and shear compliances).
     """
-    import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
     d = cell.dim
     K = _full_compliance(cell)
     K0 = np.real(np.diagonal(K.reshape(-1, d, d)[0])).copy()
@@ -62,15 +64,28 @@ def traction_operator(cell, uniform: tuple[bool, ...]):
     for c in range(d):
         if not uniform[c]:
             K[zero + (c, c)] = 0.0
-    L = float(np.max(np.linalg.eigvalsh(K)))
+    L = _largest_eigenvalue(K)
     Km = np.moveaxis(K, (-2, -1), (0, 1)).copy()       # (d, d, *kshape)
-    axes = tuple(range(1, d))
+    return partial(symbol_product, Km, cell.shape), L, K0
 
-    def apply(t):
-        T = sfft.rfftn(t, axes=axes, workers=fft_workers())
-        U = np.einsum("ab...,b...->a...", Km, T)
-        return sfft.irfftn(U, s=cell.shape, axes=axes, workers=fft_workers())
-    return apply, L, K0
+
+def symbol_product(symbol: np.ndarray, shape: tuple[int, ...], t: np.ndarray) -> np.ndarray:
+    """``IFFT(symbol FFT(t))`` for stacked fields ``t`` (shape ``(d, *shape)``), ``symbol`` of shape
+    ``(d, d, *kshape)`` on the half spectrum of the real FFT (a new array).
+
+    The product is written into a buffer of its own and the inverse transform made in its two passes,
+    complex-to-complex over the leading axes and complex-to-real along the last, each in place (as
+    :meth:`~.convolution.Convolution.from_transform`).
+    """
+    import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process
+    workers = fft_workers()
+    axes = tuple(range(1, len(shape) + 1))
+    T = sfft.rfftn(t, axes=axes, workers=workers)
+    U = np.einsum("ab...,b...->a...", symbol, T)
+    del T
+    if len(shape) > 1:
+        U = sfft.ifftn(U, axes=axes[:-1], workers=workers, overwrite_x=True)
+    return sfft.irfft(U, n=shape[-1], axis=-1, workers=workers, overwrite_x=True)
 
 
 def _full_compliance(cell) -> np.ndarray:
@@ -91,11 +106,33 @@ def _layers_compliance(cell) -> np.ndarray:
         k0 = 2 * np.pi * sfft.fftfreq(n, d=cell.period / n)
         kv = np.stack(np.broadcast_arrays(k1[None, :], k0[:, None]), axis=-1)
         nyq = (np.arange(n)[:, None] == n // 2) | (np.arange(k1.size)[None, :] == n // 2)
-    K = (layer_matrix(kv, cell.rough.E, cell.rough.nu, cell.rough.h)
-         + layer_matrix(kv, cell.counter.E, cell.counter.nu, cell.counter.h, above=True))
+    K = layers_matrix(kv, [(cell.rough.E, cell.rough.nu, cell.rough.h, False),
+                           (cell.counter.E, cell.counter.nu, cell.counter.h, True)])
     K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
     K[..., d - 1, :d - 1] = np.where(nyq[..., None], 0.0, K[..., d - 1, :d - 1])
     return K
+
+def _real_form(K: np.ndarray) -> np.ndarray:
+    """``R = S K S^{-1}``, ``S = diag(1, .., 1, i)``: the layers' compliance (real in-plane block and diagonal,
+    imaginary normal/tangential coupling, :func:`~.layer_compliance.layers_matrix`) as a real symmetric matrix with
+    the same eigenvalues."""
+    d = K.shape[-1]
+    R = K.real.copy()
+    R[..., :d - 1, d - 1] = K[..., :d - 1, d - 1].imag
+    R[..., d - 1, :d - 1] = -K[..., d - 1, :d - 1].imag
+    return R
+
+
+def _largest_eigenvalue(K: np.ndarray) -> float:
+    """The largest eigenvalue of the Hermitian ``K`` over all wave vectors: the eigenvalues are computed only
+    where Gershgorin's bound (a row's diagonal plus the moduli of the rest) reaches the largest diagonal entry,
+    a lower bound of the answer."""
+    d = K.shape[-1]
+    R = np.abs(_real_form(K)).reshape(-1, d, d)
+    diagonal = np.real(np.diagonal(K, axis1=-2, axis2=-1)).reshape(-1, d)
+    bound = np.max(diagonal + R.sum(axis=-1) - np.abs(diagonal), axis=-1)
+    return float(np.max(np.linalg.eigvalsh(K.reshape(-1, d, d)[bound >= diagonal.max()])))
+
 
 class TractionPreconditioner:
     """``r -> K_full^{-1} r`` by FFTs: the inverse of the full compliance (uniform modes kept, plus the penalty's
@@ -121,15 +158,12 @@ class TractionPreconditioner:
         self.included[d - 1] = winkler
         K[..., d - 1, d - 1] += winkler
         self.Kinv = np.moveaxis(np.linalg.inv(K), (-2, -1), (0, 1)).copy()
-        self.shape, self.axes = cell.shape, tuple(range(1, d))
+        self.shape = cell.shape
 
     def __call__(self, r: np.ndarray) -> np.ndarray:
-        import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process
-        R = sfft.rfftn(r, axes=self.axes, workers=fft_workers())
-        return sfft.irfftn(np.einsum("ab...,b...->a...", self.Kinv, R), s=self.shape, axes=self.axes,
-                           workers=fft_workers())
+        return symbol_product(self.Kinv, self.shape, r)
 
-    def for_curvature(self, D: np.ndarray):
+    def for_curvature(self, D: np.ndarray) -> SplitPreconditioner:
         """The preconditioner of ``K + D`` (``D`` a pointwise curvature, :mod:`.traction_constraints`).
 
         Where ``D`` beyond the diagonal already inverted (the penalty's ``winkler``) exceeds a point's
@@ -143,12 +177,8 @@ class TractionPreconditioner:
         k_self = self.self_compliance.reshape((d,) + (1,) * (d - 1))
         heavy = D - self.included.reshape(k_self.shape) > k_self
         if not heavy.any():
-            return self
-        pointwise = 1.0 / (k_self + D)
-
-        def apply(r):
-            return np.where(heavy, r * pointwise, self(np.where(heavy, 0.0, r)))
-        return apply
+            return SplitPreconditioner(self)
+        return SplitPreconditioner(self, heavy, 1.0 / (k_self + D))
 
 
 def solve_frictional(cell, load: CellLoad, start) -> dict:
@@ -178,7 +208,9 @@ def solve_frictional(cell, load: CellLoad, start) -> dict:
     scale = cell.gscale
 
     def grad(t):
-        return apply(t) + b
+        g = apply(t)        # a new array
+        g += b
+        return g
 
     h = TractionConstraints(cell.shape, lambda p: f.threshold(p), L, None if exact else f.w,
                             None if exact else cell.k_n, mean_p, mean_q,

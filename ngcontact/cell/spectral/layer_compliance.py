@@ -99,19 +99,28 @@ def layer_matrix(kvec, E: float, nu: float, h: float, *, above: bool = False) ->
     ``(..., d, d)``, complex.  ``above``: the layer lies above its loaded
     face (the counter body): the coupling changes sign.
     """
+    return layers_matrix(kvec, [(E, nu, h, above)])
+
+
+def layers_matrix(kvec, layers) -> np.ndarray:
+    """The sum of the compliances :func:`layer_matrix` of ``layers``, ``(E, nu, h, above)`` each, assembled once
+    from the sums of their plane and antiplane compliances (the matrix is linear in them)."""
     kvec = np.asarray(kvec, dtype=float)
     dt = kvec.shape[-1]
     kk = np.sqrt(np.sum(kvec * kvec, axis=-1))
-    nn, ll, ln = plane_compliances(kk, E, nu, h)
+    nn = ll = ln = aa = np.zeros(kk.shape)
+    for E, nu, h, above in layers:
+        n_, l_, c_ = plane_compliances(kk, E, nu, h)
+        nn, ll, ln = nn + n_, ll + l_, ln + (-1.0 if above else 1.0) * c_
+        if dt == 2:
+            aa = aa + antiplane_compliance(kk, E, nu, h)
     safe = np.where(kk == 0.0, 1.0, kk)
     e = kvec / safe[..., None]                      # unit vector along k (0 at k = 0)
-    sign = -1.0 if above else 1.0
     C = np.zeros(kvec.shape[:-1] + (dt + 1, dt + 1), dtype=complex)
     C[..., dt, dt] = nn
     if dt == 1:
         C[..., 0, 0] = ll
     else:
-        aa = antiplane_compliance(kk, E, nu, h)
         iso = kk == 0.0
         for a in range(2):
             for b in range(2):
@@ -119,6 +128,6 @@ def layer_matrix(kvec, E: float, nu: float, h: float, *, above: bool = False) ->
                 delta = 1.0 if a == b else 0.0
                 C[..., a, b] = np.where(iso, delta * ll, ll * proj + aa * (delta - proj))
     for a in range(dt):
-        C[..., a, dt] = 1j * sign * e[..., a] * ln
+        C[..., a, dt] = 1j * e[..., a] * ln
         C[..., dt, a] = -C[..., a, dt]
     return C

@@ -18,6 +18,7 @@ from typing import Callable
 import numpy as np
 
 from ngcontact.solvers.active_set_newton import traction_projector
+from ngcontact.solvers.free_directions import FreeDirections
 from ngcontact.solvers.projected_gradient import prox_friction, prox_pressure
 
 
@@ -89,32 +90,49 @@ class TractionConstraints:
             D[:d - 1] = np.where(stick, self.w / safe, 0.0)
         if self.k_n is not None:
             D[d - 1] = 1.0 / self.k_n
-        turning = np.zeros(self.shape, bool)
         if d == 3:
             sq = shifts[1]
             z = v[:2] - (0.0 if sq is None else np.asarray(sq).reshape(2, 1, 1))
             # every rim point turns: a large curvature (a point far outside the disc) is the split
             # preconditioner's diagonal block (:meth:`~.frictional_contact.TractionPreconditioner.for_curvature`)
-            turning = rim
             D[:2] += np.where(rim, self.L * np.maximum(np.sqrt(z[0] * z[0] + z[1] * z[1]) / safe - 1.0, 0.0), 0.0)
         constrained = (self.mean_q is not None,) * (d - 1) + (self.mean_p is not None,)
-        free = traction_projector(t_hat[d - 1] > 0, stick, turning, t_hat, constrained)
+        free = traction_projector(t_hat[d - 1] > 0, stick, rim, t_hat, constrained)    # a 2D rim is held
         return free, D, (self._lift(t_hat, rim, free) if self.slope > 0 else None)
 
-    def _lift(self, t_hat: np.ndarray, rim: np.ndarray, free) -> Callable[[np.ndarray], np.ndarray]:
-        """``u -> u + (dG/dp) u_p n`` at the slipping points (``n = q / |q|``, the shear on the rim follows the
-        threshold ``G(p)``), the mean shear restored over the free shear (``free.mean_free``)."""
-        d = self.d
-        slipping = rim & (t_hat[d - 1] > 0)
-        q = t_hat[:d - 1][:, slipping]
-        n = q / np.sqrt(np.sum(q * q, axis=0))
-        slope, constrained = self.slope, self.mean_q is not None
+    def _lift(self, t_hat: np.ndarray, rim: np.ndarray, free: FreeDirections) -> ShearFollowsPressure:
+        """The shear that follows the threshold ``G(p)`` at the slipping points (:class:`ShearFollowsPressure`)."""
+        slipping = rim & (t_hat[self.d - 1] > 0)
+        q = t_hat[:self.d - 1][:, slipping]
+        return ShearFollowsPressure(free, slipping, q / np.sqrt(np.sum(q * q, axis=0)), self.slope,
+                                    self.mean_q is not None)
 
-        def lift(u: np.ndarray) -> np.ndarray:
-            y = u.copy()
-            added = slope * u[d - 1][slipping] * n
-            y[:d - 1, slipping] += added
-            if constrained:
-                y[:d - 1] -= free.mean_free(added.sum(axis=1))
-            return y
-        return lift
+
+class ShearFollowsPressure:
+    """``u -> u + (dG/dp) u_p n`` at the slipping points (``n = q / |q|``, the shear on the rim follows the
+    threshold ``G(p)``), the mean shear restored over the free shear (``free.mean_free``) where it is prescribed:
+    on grid fields (call) and in the coordinates of the free directions' support (:meth:`reduced`), on which
+    it stays (a slipping point is pressed and turns).
+    """
+
+    def __init__(self, free: FreeDirections, slipping: np.ndarray, n: np.ndarray, slope: float, constrained: bool):
+        self.free, self.slipping, self.n, self.slope, self.constrained = free, slipping, n, slope, constrained
+        self.at_q, self.at_p = free.at_shear(slipping), free.at_pressure(slipping)
+
+    def __call__(self, u: np.ndarray) -> np.ndarray:
+        d = self.free.d
+        y = u.copy()
+        added = self.slope * u[d - 1][self.slipping] * self.n
+        y[:d - 1, self.slipping] += added
+        if self.constrained:
+            y[:d - 1] -= self.free.mean_free(added.sum(axis=1))
+        return y
+
+    def reduced(self, c: np.ndarray) -> np.ndarray:
+        y = c.copy()
+        qs, p = self.free.split(y)
+        added = self.slope * p[self.at_p] * self.n
+        qs[:, self.at_q] += added
+        if self.constrained:
+            qs -= self.free.mean_free_reduced(added.sum(axis=1))
+        return y
