@@ -104,7 +104,8 @@ def progress_lines(clock: Clock):
 
 
 #: What the members of every batch import (the scene translator and through it the model code): a worker
-#: started early imports them while this process prepares its batch.
+#: imports them as it starts (with the module of the batch's member function), while this process goes on
+#: solving members.
 WORKER_MODULES = ("ngsolve", "ngcontact.drivers.build")
 
 
@@ -118,13 +119,14 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
     (:func:`ngcontact.parallel.executor.make`), never more than the batch
     has members (``members``; default :func:`batch_members`) nor more than
     twice the cores: a request above that is cut, with one line to ``note``
-    (else to the log).  The workers are started at
-    once when the run will have a batch (``start``; default
-    :func:`has_batches`), so that their start overlaps with the run's own
-    preparation; otherwise only for a batch whose members take long enough to
-    repay the workers' start (:meth:`~ngcontact.parallel.executor.Executor.start_on_demand`).  Either way a
-    batch goes to the workers only where its rest repays them, else it finishes in this process
-    (:mod:`ngcontact.parallel.worker_payoff`).
+    (else to the log).  No worker is started before a batch whose rest
+    repays the workers' start (:mod:`ngcontact.parallel.worker_payoff`; its
+    first members are solved and timed in this process, which keeps solving
+    while the workers start): a batch kept in this process costs exactly the
+    serial run (:meth:`~ngcontact.parallel.executor.Executor.start_on_demand`).
+    ``start=True`` starts them at once instead, for a caller that knows its
+    batches repay them (their start then overlaps with the run's own
+    preparation); a batch still goes to them only where its rest repays them.
     A scheduler address that is malformed, or where no scheduler answers (at
     once, or at the first batch), is a :class:`SceneError` naming
     ``scheduler`` or ``compute.scheduler``.
@@ -143,10 +145,10 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
             (note or logging.getLogger("ngcontact.parallel.executor").info)(capped)
     try:
         ex = executor.make(workers, scheduler, members)
-        if has_batches(scene) if start is None else start:
+        if start:
             ex.start(WORKER_MODULES)
-        else:  # batches may come (a two-scale table's levels): workers only where they repay their start
-            ex.start_on_demand()
+        else:  # workers only for a batch whose rest repays their start
+            ex.start_on_demand(WORKER_MODULES)
         with executor.use(ex, progress):
             yield ex
     except SchedulerError as exc:

@@ -99,8 +99,9 @@ class Executor:
         ``modules``: what the members will import, imported by each worker as it starts.
         """
 
-    def start_on_demand(self) -> None:
-        """Start workers only for a batch that will repay their start (nothing to start here)."""
+    def start_on_demand(self, modules: Sequence[str] = ()) -> None:
+        """Start workers only for a batch that will repay their start, each importing ``modules`` as it
+        starts (nothing to start here)."""
 
     def close(self) -> None:
         """Release the workers (nothing to release here)."""
