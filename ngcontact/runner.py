@@ -12,8 +12,10 @@ Nothing is written to disk; :func:`ngcontact.output.writer.write_outputs` does t
 from __future__ import annotations
 
 import importlib
+import json
 import logging
 import os
+import time
 from contextlib import contextmanager
 from typing import Callable
 
@@ -123,15 +125,15 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
     repays the workers' start (:mod:`ngcontact.parallel.worker_payoff`; its
     first members are solved and timed in this process, which keeps solving
     while the workers start): a batch kept in this process costs exactly the
-    serial run (:meth:`~ngcontact.parallel.executor.Executor.start_on_demand`).
-    ``start=True`` starts them at once instead, for a caller that knows its
-    batches repay them (their start then overlaps with the run's own
-    preparation); a batch still goes to them only where its rest repays them.
+    serial run.  They start with the run (their start overlapping with its
+    preparation) where ``start`` says so, or where the last run of the same
+    batch on this machine forecasts that the rule sends it to them
+    (:mod:`ngcontact.parallel.batch_forecast`; recorded here after the run).
     A scheduler address that is malformed, or where no scheduler answers (at
     once, or at the first batch), is a :class:`SceneError` naming
     ``scheduler`` or ``compute.scheduler``.
     """
-    from ngcontact.parallel import executor
+    from ngcontact.parallel import batch_forecast, executor
     from ngcontact.parallel.dask_cluster import SchedulerError
     compute = getattr(scene, "compute", None)
     key = "scheduler"
@@ -139,18 +141,23 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
         scheduler, workers = compute.scheduler, compute.workers
         key = "compute.scheduler"
     members = batch_members(scene) if members is None else members
+    name = batch_forecast.key(json.dumps([__version__, str(getattr(scene, "base_dir", "")), loader.as_dict(scene)],
+                                         sort_keys=True, default=str)) if start is None and members else None
+    opened = time.perf_counter()
     if not scheduler:
         _, capped = executor.local_workers(workers, members)
         if capped is not None:
             (note or logging.getLogger("ngcontact.parallel.executor").info)(capped)
     try:
         ex = executor.make(workers, scheduler, members)
-        if start:
+        if start or (name is not None and batch_forecast.early(ex, name, members)):
             ex.start(WORKER_MODULES)
         else:  # workers only for a batch whose rest repays their start
             ex.start_on_demand(WORKER_MODULES)
         with executor.use(ex, progress):
             yield ex
+        if name is not None:
+            batch_forecast.remember_run(name, ex, opened)
     except SchedulerError as exc:
         raise SceneError(key, exc.address, exc.allowed) from None
 

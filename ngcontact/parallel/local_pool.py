@@ -83,6 +83,15 @@ class LocalPool(Executor):
         pool = self._start()
         self._warming = [pool.submit(_warm_up, self._modules) for _ in range(self.workers)]
 
+    def repays(self, forecast) -> bool:
+        """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send the rest of a batch
+        (its :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: the members after
+        the first ``MEASURED`` (solved here), of the forecast's seconds each, against the part of the start
+        that the run's lead before its batch leaves ahead, and a worker's first member."""
+        return worker_payoff.Payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
+                                    self.workers, max(START_SECONDS - forecast.lead_seconds, 0.0),
+                                    FIRST_MEMBER_SECONDS).repaid
+
     def start_on_demand(self, modules: Sequence[str] = ()) -> None:
         """Start no worker now: only once a batch's rest repays their start (:meth:`_judged_map`), each
         then importing ``modules`` and the module of the batch's member function as it starts.
@@ -118,13 +127,12 @@ class LocalPool(Executor):
         here), its workers importing the members' module as they start, and
         this process solves members while they start.
         """
-        clock = worker_payoff.MemberClock()
+        clock = self.member_clock            # each member solved here is timed by Executor._map
         done: list = []
         while True:
             k = len(done)
-            with clock:
-                done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
-                                      _after(progress, k, len(items)), fault)
+            done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
+                                  _after(progress, k, len(items)), fault)
             if len(done) == len(items):
                 self._where("serial", f"all {len(done)} members solved here while the workers started")
                 return done

@@ -103,9 +103,10 @@ def test_a_batch_kept_here_starts_no_worker_process():
         pool.close()
 
 
-def test_a_run_with_a_batch_starts_no_worker_before_its_batch_repays_them():
-    """The runner's context of a scene with a batch (an ensemble) spawns no worker as it opens; a small
-    batch in it spawns none either."""
+def test_a_run_with_a_batch_starts_no_worker_before_its_batch_repays_them(monkeypatch, tmp_path):
+    """The runner's context of a scene with a batch (an ensemble) spawns no worker as it opens (no record of
+    an earlier run of it: :mod:`ngcontact.parallel.batch_forecast`); a small batch in it spawns none either."""
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
     from ngcontact import runner
     from ngcontact.scene import loader
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
