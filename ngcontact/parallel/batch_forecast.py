@@ -23,8 +23,8 @@ while they start.
 A record is one small JSON file per batch, named by the SHA-256 of the
 run's description (the scene, the package version), in ``batches`` under
 the cell-law cache directory (``$NGCONTACT_CACHE``, default
-``~/.cache/ngcontact``); a record that cannot be read or written costs
-only the forecast.
+``~/.cache/ngcontact``; at most :data:`KEPT`, the oldest removed first); a
+record that cannot be read or written costs only the forecast.
 """
 from __future__ import annotations
 
@@ -38,6 +38,9 @@ log = logging.getLogger("ngcontact.parallel.executor")
 
 #: Folder of the records under the cache directory.
 FOLDER = "batches"
+
+#: Records kept at most (the oldest go first): the runs of scenes in many folders do not fill the cache.
+KEPT = 256
 
 
 @dataclass(frozen=True)
@@ -84,6 +87,9 @@ def remember(name: str, forecast: Forecast) -> None:
             json.dump({"members": forecast.members, "member_seconds": forecast.member_seconds,
                        "lead_seconds": forecast.lead_seconds}, f)
         os.replace(partial, path)
+        records = sorted(os.scandir(folder()), key=lambda e: e.stat().st_mtime)
+        for old in records[:max(len(records) - KEPT, 0)]:
+            os.remove(old.path)
     except OSError as exc:
         log.debug("no record of the batch in %s (%s)", folder(), exc)
         try:

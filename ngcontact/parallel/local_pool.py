@@ -49,6 +49,7 @@ class LocalPool(Executor):
         self._modules: tuple[str, ...] = ()   # what a worker started on demand imports as it starts
         self.judged = False           # the run's batches: the rest of each goes to workers only where repaid
         self.pools_started = 0        # pools of worker processes spawned so far (none for a batch kept here)
+        self.started = "never"        # when the workers first started: with the run, or during which batch
 
     def _start(self):
         from concurrent.futures import ProcessPoolExecutor
@@ -80,6 +81,8 @@ class LocalPool(Executor):
         self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
         if self._pool is not None:
             return
+        if self.started == "never":
+            self.started = "with the run" if not self.record else f"after batch {len(self.record)}"
         pool = self._start()
         self._warming = [pool.submit(_warm_up, self._modules) for _ in range(self.workers)]
 
@@ -146,6 +149,8 @@ class LocalPool(Executor):
                 return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
                                             _after(progress, len(done), len(items)), fault)
             if self._pool is None:
+                if self.started == "never":
+                    self.started = f"during batch '{label}'"
                 self.start((fn.__module__,))
             if self._ready() and len(done) >= worker_payoff.MEASURED:
                 self._where("local", payoff.describe(len(done)))
@@ -296,6 +301,11 @@ class LocalPool(Executor):
 
     def abort(self) -> None:
         self._discard()
+
+    def describe(self) -> dict:
+        """The executor's report (:meth:`Executor.describe`) and when its workers first started
+        (``workers_started``: ``with the run``, ``during batch '<label>'``, or ``never``)."""
+        return {**super().describe(), "workers_started": self.started}
 
 
 _STARTED = None

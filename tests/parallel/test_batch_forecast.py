@@ -55,3 +55,13 @@ def test_workers_start_with_the_run_only_where_the_last_run_of_the_batch_says_th
     monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.05)
     with runner.batches(scene, workers=2) as ex:            # they would now: started as the run opens
         assert ex.pools_started == 1 and ex._pool is not None
+        assert ex.describe()["workers_started"] == "with the run"
+
+
+def test_the_oldest_records_go_beyond_the_kept_number(monkeypatch, cache):
+    monkeypatch.setattr(batch_forecast, "KEPT", 2)
+    for k, name in enumerate("abc"):
+        batch_forecast.remember(name, Forecast(4, 1.0, 0.0))
+        os.utime(cache / batch_forecast.FOLDER / f"{name}.json", (k, k))
+    batch_forecast.remember("d", Forecast(4, 1.0, 0.0))
+    assert sorted(os.listdir(cache / batch_forecast.FOLDER)) == ["c.json", "d.json"]
