@@ -98,7 +98,7 @@ def remember(name: str, forecast: Forecast) -> None:
             pass
 
 
-def early(executor, name: str, members: int) -> bool:
+def early(executor, name: str, members: int | None) -> bool:
     """Whether ``executor`` should start its workers with the run: the last run of the batch recorded under
     ``name``, of as many ``members``, forecasts that condition (1) sends it to them
     (:meth:`~ngcontact.parallel.executor.Executor.repays`)."""
