@@ -12,8 +12,10 @@ Nothing is written to disk; :func:`ngcontact.output.writer.write_outputs` does t
 from __future__ import annotations
 
 import importlib
+import json
 import logging
 import os
+import time
 from contextlib import contextmanager
 from typing import Callable
 
@@ -104,7 +106,8 @@ def progress_lines(clock: Clock):
 
 
 #: What the members of every batch import (the scene translator and through it the model code): a worker
-#: started early imports them while this process prepares its batch.
+#: imports them as it starts (with the module of the batch's member function), while this process goes on
+#: solving members.
 WORKER_MODULES = ("ngsolve", "ngcontact.drivers.build")
 
 
@@ -118,18 +121,19 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
     (:func:`ngcontact.parallel.executor.make`), never more than the batch
     has members (``members``; default :func:`batch_members`) nor more than
     twice the cores: a request above that is cut, with one line to ``note``
-    (else to the log).  The workers are started at
-    once when the run will have a batch (``start``; default
-    :func:`has_batches`), so that their start overlaps with the run's own
-    preparation; otherwise only for a batch whose members take long enough to
-    repay the workers' start (:meth:`~ngcontact.parallel.executor.Executor.start_on_demand`).  Either way a
-    batch goes to the workers only where its rest repays them, else it finishes in this process
-    (:mod:`ngcontact.parallel.worker_payoff`).
+    (else to the log).  No worker is started before a batch whose rest
+    repays the workers' start (:mod:`ngcontact.parallel.worker_payoff`; its
+    first members are solved and timed in this process, which keeps solving
+    while the workers start): a batch kept in this process costs exactly the
+    serial run.  They start with the run (their start overlapping with its
+    preparation) where ``start`` says so, or where the last run of the same
+    batch on this machine forecasts that the rule sends it to them
+    (:mod:`ngcontact.parallel.batch_forecast`; recorded here after the run).
     A scheduler address that is malformed, or where no scheduler answers (at
     once, or at the first batch), is a :class:`SceneError` naming
     ``scheduler`` or ``compute.scheduler``.
     """
-    from ngcontact.parallel import executor
+    from ngcontact.parallel import batch_forecast, executor
     from ngcontact.parallel.dask_cluster import SchedulerError
     compute = getattr(scene, "compute", None)
     key = "scheduler"
@@ -137,18 +141,23 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
         scheduler, workers = compute.scheduler, compute.workers
         key = "compute.scheduler"
     members = batch_members(scene) if members is None else members
+    name = batch_forecast.key(json.dumps([__version__, str(getattr(scene, "base_dir", "")), loader.as_dict(scene)],
+                                         sort_keys=True, default=str)) if start is None and members else None
+    opened = time.perf_counter()
     if not scheduler:
         _, capped = executor.local_workers(workers, members)
         if capped is not None:
             (note or logging.getLogger("ngcontact.parallel.executor").info)(capped)
     try:
         ex = executor.make(workers, scheduler, members)
-        if has_batches(scene) if start is None else start:
+        if start or (name is not None and batch_forecast.early(ex, name, members)):
             ex.start(WORKER_MODULES)
-        else:  # batches may come (a two-scale table's levels): workers only where they repay their start
-            ex.start_on_demand()
+        else:  # workers only for a batch whose rest repays their start
+            ex.start_on_demand(WORKER_MODULES)
         with executor.use(ex, progress):
             yield ex
+        if name is not None:
+            batch_forecast.remember_run(name, ex, opened)
     except SchedulerError as exc:
         raise SceneError(key, exc.address, exc.allowed) from None
 

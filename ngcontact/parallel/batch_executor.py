@@ -16,6 +16,7 @@ from typing import Any, Callable, Sequence
 
 from ngcontact.errors import BatchError
 from ngcontact.parallel.batch_member import ATTEMPTS, fault_from_env, reason, run_member
+from ngcontact.parallel.worker_payoff import MemberClock
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
@@ -49,10 +50,25 @@ class Executor:
         fault = fault_from_env()
         t0 = time.perf_counter()
         self.__dict__.pop("_spread", None)
+        clock = self.__dict__["_clock"] = MemberClock()
         out = self._map(fn, list(items), list(names), label, progress, fault)
         self.record.append({"label": label, "members": len(items), "seconds": time.perf_counter() - t0,
                             **self.__dict__.pop("_spread", {})})
+        self.timings.append({"members": len(items), "began": t0,
+                             "member_seconds": clock.least if clock.times else None})
         return out
+
+    @property
+    def timings(self) -> list[dict]:
+        """The batches this executor ran, as timed in this process: ``members``, when each ``began``
+        (``time.perf_counter`` seconds) and the least ``min(wall, CPU)`` seconds of its members solved in
+        this process (``member_seconds``; None when none was)."""
+        return self.__dict__.setdefault("_timings", [])
+
+    @property
+    def member_clock(self) -> MemberClock:
+        """The clock of the members of the running batch solved in this process."""
+        return self.__dict__.setdefault("_clock", MemberClock())
 
     @property
     def record(self) -> list[dict]:
@@ -68,21 +84,25 @@ class Executor:
     def _map(self, fn, items, names, label, progress, fault) -> list:
         out = []
         for k, (item, name) in enumerate(zip(items, names)):
-            error: BaseException | None = None
-            for attempt in range(ATTEMPTS):
-                try:
-                    out.append(run_member(fn, item, name, attempt, fault))
-                    break
-                except Exception as exc:  # retried once, then reported
-                    error = exc
-                    log.info("%s: %s failed (%s)%s", label, name, reason(exc),
-                                "; retrying" if attempt + 1 < ATTEMPTS else "")
-            else:
-                assert error is not None
-                raise BatchError(label, name, reason(error)) from error
+            with self.member_clock:
+                out.append(self._member(fn, item, name, label, fault))
             if progress is not None:
                 progress(label, k + 1, len(items))
         return out
+
+    @staticmethod
+    def _member(fn, item, name, label, fault):
+        """One member in this process: its result, after one retry; a second failure ends the batch."""
+        error: BaseException | None = None
+        for attempt in range(ATTEMPTS):
+            try:
+                return run_member(fn, item, name, attempt, fault)
+            except Exception as exc:  # retried once, then reported
+                error = exc
+                log.info("%s: %s failed (%s)%s", label, name, reason(exc),
+                         "; retrying" if attempt + 1 < ATTEMPTS else "")
+        assert error is not None
+        raise BatchError(label, name, reason(error)) from error
 
     @staticmethod
     def _failed(label, name, failures, k, exc) -> None:
@@ -99,8 +119,14 @@ class Executor:
         ``modules``: what the members will import, imported by each worker as it starts.
         """
 
-    def start_on_demand(self) -> None:
-        """Start workers only for a batch that will repay their start (nothing to start here)."""
+    def repays(self, forecast) -> bool:
+        """Whether workers started now would take the run's batch (a
+        :class:`~ngcontact.parallel.batch_forecast.Forecast` of it): never, without workers to start."""
+        return False
+
+    def start_on_demand(self, modules: Sequence[str] = ()) -> None:
+        """Start workers only for a batch that will repay their start, each importing ``modules`` as it
+        starts (nothing to start here)."""
 
     def close(self) -> None:
         """Release the workers (nothing to release here)."""

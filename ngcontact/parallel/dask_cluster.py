@@ -134,6 +134,10 @@ class DaskCluster(Executor):
         """Connect to the scheduler now: an address that does not answer fails before any solve."""
         self.client  # noqa: B018 - the property connects
 
+    def start_on_demand(self, modules: Sequence[str] = ()) -> None:
+        """Connect now too: the cluster's workers run already, and a wrong address fails before any solve."""
+        self.start(modules)
+
     def _map(self, fn, items, names, label, progress, fault) -> list:
         from distributed import as_completed
         client = self.client

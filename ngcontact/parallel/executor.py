@@ -16,7 +16,9 @@ Executors:
   (``spawn``: a fresh interpreter, never a fork of a process whose NGSolve
   task manager holds threads), each limited to one NGSolve thread so that
   ``N`` workers use ``N`` cores; a run's batch goes to them only where its
-  rest repays their start (:mod:`ngcontact.parallel.worker_payoff`);
+  rest repays their start (:mod:`ngcontact.parallel.worker_payoff`), and
+  they start only then, or with the run where the last run of the same
+  batch forecasts it (:mod:`ngcontact.parallel.batch_forecast`);
 * :class:`DaskCluster` - the workers of a ``dask.distributed`` scheduler at
   an address; Dask is the cluster engine, this module only submits.
 

@@ -46,7 +46,10 @@ class LocalPool(Executor):
         self._lifetime: worker_lifetime.Record | None = None   # the current pool's record of its workers
         self._warming: list = []      # the warm-up tasks of an early start, one per worker
         self._spawned = 0.0           # when the current pool's workers were spawned (perf_counter seconds)
+        self._modules: tuple[str, ...] = ()   # what a worker started on demand imports as it starts
         self.judged = False           # the run's batches: the rest of each goes to workers only where repaid
+        self.pools_started = 0        # pools of worker processes spawned so far (none for a batch kept here)
+        self.started = "never"        # when the workers first started: with the run, or during which batch
 
     def _start(self):
         from concurrent.futures import ProcessPoolExecutor
@@ -57,6 +60,7 @@ class LocalPool(Executor):
         self._processes = {}
         self._lifetime = worker_lifetime.Record()
         self._spawned = time.perf_counter()
+        self.pools_started += 1
         self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx, initializer=_worker_start,
                                          initargs=(self._started, os.getpid(), self._lifetime.path))
         return self._pool
@@ -65,24 +69,42 @@ class LocalPool(Executor):
         """Spawn every worker now and let it import ``modules`` (what its members will need).
 
         A worker is a fresh interpreter: its start and imports take about a
-        second, which the batch would otherwise wait for.  Called when a run
-        knows it will have a batch, this overlaps with what the run does
-        before it (its own imports, the scene's meshes, a macro solve).  The
-        pool spawns one process per submitted task while none is idle, so one
-        warm-up task per worker starts them all.  The run's batches then go to
-        the workers only where they repay them (:meth:`_judged_map`).
+        second, which the batch would otherwise wait for.  For a caller that
+        knows its batches will repay the workers (:mod:`ngcontact.parallel.worker_payoff`),
+        this overlaps their start with what the run does before them (its own
+        imports, the scene's meshes, a macro solve).  The pool spawns one
+        process per submitted task while none is idle, so one warm-up task per
+        worker starts them all.  The run's batches then go to the workers only
+        where they repay them (:meth:`_judged_map`).
         """
         self.judged = True
+        self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
         if self._pool is not None:
             return
+        if self.started == "never":
+            self.started = "with the run" if not self.record else f"after batch {len(self.record)}"
         pool = self._start()
-        self._warming = [pool.submit(_warm_up, tuple(modules)) for _ in range(self.workers)]
+        self._warming = [pool.submit(_warm_up, self._modules) for _ in range(self.workers)]
 
-    def start_on_demand(self) -> None:
-        """Start the workers only for a batch whose rest repays their start (:meth:`_judged_map`): for runs
-        whose batches are few, small and unknown in advance (the levels of a two-scale cell table: a handful of
-        short cell solves each, none at all on a warm cache)."""
+    def repays(self, forecast) -> bool:
+        """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send the rest of a batch
+        (its :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: the members after
+        the first ``MEASURED`` (solved here), of the forecast's seconds each, against the part of the start
+        that the run's lead before its batch leaves ahead, and a worker's first member."""
+        return worker_payoff.Payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
+                                    self.workers, max(START_SECONDS - forecast.lead_seconds, 0.0),
+                                    FIRST_MEMBER_SECONDS).repaid
+
+    def start_on_demand(self, modules: Sequence[str] = ()) -> None:
+        """Start no worker now: only once a batch's rest repays their start (:meth:`_judged_map`), each
+        then importing ``modules`` and the module of the batch's member function as it starts.
+
+        A batch kept in this process then costs exactly the serial run: no
+        worker process ever takes a core from it, not even while the run sets
+        up.
+        """
         self.judged = True
+        self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         if len(items) == 1:
@@ -104,16 +126,16 @@ class LocalPool(Executor):
 
         Workers still starting when (1) fails are stopped (they take cores
         from this process); started ones are kept for the run's next batch.
-        A pool not started is started once (1) holds, and this process
-        solves members while it starts.
+        A pool not started is started once (1) holds (never for a batch kept
+        here), its workers importing the members' module as they start, and
+        this process solves members while they start.
         """
-        clock = worker_payoff.MemberClock()
+        clock = self.member_clock            # each member solved here is timed by Executor._map
         done: list = []
         while True:
             k = len(done)
-            with clock:
-                done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
-                                      _after(progress, k, len(items)), fault)
+            done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
+                                  _after(progress, k, len(items)), fault)
             if len(done) == len(items):
                 self._where("serial", f"all {len(done)} members solved here while the workers started")
                 return done
@@ -127,7 +149,9 @@ class LocalPool(Executor):
                 return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
                                             _after(progress, len(done), len(items)), fault)
             if self._pool is None:
-                self.start()
+                if self.started == "never":
+                    self.started = f"during batch '{label}'"
+                self.start((fn.__module__,))
             if self._ready() and len(done) >= worker_payoff.MEASURED:
                 self._where("local", payoff.describe(len(done)))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
@@ -247,7 +271,7 @@ class LocalPool(Executor):
         return {name for pid, name in last.items() if pid in died}
 
     def _discard(self) -> None:
-        """Stop the workers now (a broken pool, an error, an interruption)."""
+        """Stop the workers now (a broken pool, an error, an interruption, the end of the run)."""
         pool, self._pool = self._pool, None
         if pool is None:
             return
@@ -264,11 +288,10 @@ class LocalPool(Executor):
         self._forget(processes)
 
     def close(self) -> None:
-        if self._pool is not None:
-            processes = list((self._pool._processes or {}).values())
-            self._pool.shutdown(wait=True, cancel_futures=True)
-            self._pool = None
-            self._forget(processes)
+        """End the workers: every batch has returned, so they are idle and hold nothing of the run; they are
+        stopped at once rather than each left to finalize its interpreter (NGSolve loaded) while the run
+        waits."""
+        self._discard()
 
     def _forget(self, processes) -> None:
         """The pool's workers have stopped: its record goes (kept while one runs on, for the next run to end).
@@ -278,6 +301,11 @@ class LocalPool(Executor):
 
     def abort(self) -> None:
         self._discard()
+
+    def describe(self) -> dict:
+        """The executor's report (:meth:`Executor.describe`) and when its workers first started
+        (``workers_started``: ``with the run``, ``during batch '<label>'``, or ``never``)."""
+        return {**super().describe(), "workers_started": self.started}
 
 
 _STARTED = None
@@ -310,7 +338,8 @@ def _worker_start(started, parent: int, record: str | None) -> None:
 def _warm_up(modules: tuple[str, ...]) -> None:
     import importlib
     for module in modules:
-        importlib.import_module(module)
+        if module != "__main__":          # the submitting script: the spawn start has imported it already
+            importlib.import_module(module)
 
 
 def _pool_member(fn, item, name, attempt, fault):

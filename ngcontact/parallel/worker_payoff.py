@@ -40,8 +40,12 @@ does while they start, and one whose workers start late is finished here
 as soon as (1) fails.  When (1) fails, workers still starting are stopped
 at once (a starting worker takes a core from this process).
 
-Never slower than serial: a batch finished here is the serial batch, with
-at most its first members solved beside starting workers (bounded by
+Never slower than serial: the workers of a run are started on demand
+(:meth:`LocalPool.start_on_demand
+<ngcontact.parallel.local_pool.LocalPool.start_on_demand>`), only once (1)
+holds, so a batch whose rest never repays them is the serial batch, no
+worker process spawned; one whose workers were started and then stopped
+had at most a few members solved beside starting workers (bounded by
 their time times the share of the cores the workers took); a batch sent to
 the workers satisfies (1), so its rest ends sooner than serially by the
 margin of (1) when the estimates hold, and a batch whose workers start

@@ -235,10 +235,11 @@ def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_
     workers = []
     assert proc.stderr is not None
     for line in proc.stderr:          # plain progress lines: stderr is a pipe, not a terminal
-        if "ensemble: " in line and "finished" in line:
+        if "ensemble: " in line and "finished" in line:   # the workers start once a member has timed the batch
             workers = [c for c in psutil.Process(proc.pid).children(recursive=True)
                        if "spawn_main" in " ".join(c.cmdline())]
-            break
+            if len(workers) == 2:
+                break
     assert len(workers) == 2
     proc.send_signal(signal.SIGINT)
     rest = proc.stderr.read()

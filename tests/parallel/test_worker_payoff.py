@@ -87,3 +87,48 @@ def test_workers_still_starting_are_stopped_when_the_batch_ends_here():
         assert not any(p.is_alive() for p in processes)
     finally:
         pool.close()
+
+
+def test_a_batch_kept_here_starts_no_worker_process():
+    """Workers on demand: a batch whose rest does not repay them never spawns one, so it costs exactly the
+    serial run (nothing takes a core from this process, not even while the run sets up)."""
+    pool = local_pool.LocalPool(2)
+    try:
+        pool.start_on_demand(("ngsolve",))
+        assert pool.pools_started == 0 and pool._pool is None
+        assert pool.map(burn, [0.02] * 4, ["a", "b", "c", "d"], label="small") == [os.getpid()] * 4
+        assert pool.pools_started == 0 and pool._pool is None
+        assert pool.describe()["batches"][-1]["executor"] == "serial"
+        assert pool.describe()["workers_started"] == "never"
+    finally:
+        pool.close()
+
+
+def test_a_run_with_a_batch_starts_no_worker_before_its_batch_repays_them(monkeypatch, tmp_path):
+    """The runner's context of a scene with a batch (an ensemble) spawns no worker as it opens (no record of
+    an earlier run of it: :mod:`ngcontact.parallel.batch_forecast`); a small batch in it spawns none either."""
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path))
+    from ngcontact import runner
+    from ngcontact.scene import loader
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    scene = loader.load(os.path.join(root, "geometries", "cells", "self_affine_ensemble.toml"))
+    assert runner.has_batches(scene)
+    with runner.batches(scene, workers=2) as ex:
+        assert isinstance(ex, local_pool.LocalPool) and ex.pools_started == 0
+        assert ex.map(burn, [0.01] * 3, ["a", "b", "c"], label="small") == [os.getpid()] * 3
+        assert ex.pools_started == 0
+
+
+def test_workers_on_demand_start_inside_the_batch_that_repays_them(monkeypatch):
+    """A batch whose first member shows that its rest repays the workers starts them then (its members
+    after the first two go to them once one is ready: how many depends on the machine's load)."""
+    monkeypatch.setattr(local_pool, "START_SECONDS", 0.0)
+    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.0)
+    pool = local_pool.LocalPool(2)
+    try:
+        pool.start_on_demand(("ngsolve",))
+        pids = pool.map(burn, [0.02] * 20, [f"m{k}" for k in range(20)], label="large")
+        assert pool.pools_started == 1 and pool.describe()["workers_started"] == "during batch 'large'"
+        assert pids[:2] == [os.getpid()] * 2
+    finally:
+        pool.close()

@@ -1,0 +1,115 @@
+"""What a run's batch cost the last time the same batch ran on this machine: whether its workers may start early.
+
+Condition (1) of :mod:`ngcontact.parallel.worker_payoff` needs ``c``, the
+seconds of one member, and ``c`` is only known once members have been
+solved in the run's process: a local pool's workers are therefore started
+on demand, as a batch's first members have shown that its rest repays
+them.  Their start (``R``) then falls inside the batch.  Started with the
+run instead, it would overlap with what the run does before its batch (its
+imports, the scene's preparation), but only a batch that (1) sends to the
+workers may pay for that: any other must cost exactly the serial run.
+
+The forecast is (1) itself, read with what the last run of the same batch
+measured: ``c`` (the least ``min(wall, CPU)`` seconds of its members solved
+in its process) and the seconds from the opening of the run's batches to
+the start of its first batch (``lead``), during which workers started with
+the run start; so ``R = max(START_SECONDS - lead, 0)``.  Nothing is
+guessed: a batch never run on this machine has no forecast, and its workers
+start on demand.  The forecast only chooses when the workers start; where
+each batch runs is still decided by (1) on its own members, and workers
+started early for a batch that (1) then keeps in this process are stopped
+while they start.
+
+A record is one small JSON file per batch, named by the SHA-256 of the
+run's description (the scene, the package version), in ``batches`` under
+the cell-law cache directory (``$NGCONTACT_CACHE``, default
+``~/.cache/ngcontact``; at most :data:`KEPT`, the oldest removed first); a
+record that cannot be read or written costs only the forecast.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+from dataclasses import dataclass
+
+log = logging.getLogger("ngcontact.parallel.executor")
+
+#: Folder of the records under the cache directory.
+FOLDER = "batches"
+
+#: Records kept at most (the oldest go first): the runs of scenes in many folders do not fill the cache.
+KEPT = 256
+
+
+@dataclass(frozen=True)
+class Forecast:
+    """The last run's first batch: ``members``, the least seconds of one solved in its process
+    (``member_seconds``) and the seconds from the opening of its batches to that batch's start
+    (``lead_seconds``)."""
+
+    members: int
+    member_seconds: float
+    lead_seconds: float
+
+
+def key(description: str) -> str:
+    """The record's name of a run described by ``description`` (its scene and version as text)."""
+    return hashlib.sha256(description.encode()).hexdigest()
+
+
+def folder() -> str:
+    cache = os.environ.get("NGCONTACT_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "ngcontact")
+    return os.path.join(cache, FOLDER)
+
+
+def recorded(name: str) -> Forecast | None:
+    """The forecast recorded under ``name``, None if there is none (or it cannot be read)."""
+    try:
+        with open(os.path.join(folder(), f"{name}.json")) as f:
+            data = json.load(f)
+        forecast = Forecast(int(data["members"]), float(data["member_seconds"]), float(data["lead_seconds"]))
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if forecast.members < 1 or not forecast.member_seconds >= 0.0 or not forecast.lead_seconds >= 0.0:
+        return None
+    return forecast
+
+
+def remember(name: str, forecast: Forecast) -> None:
+    """Record ``forecast`` under ``name`` for the next run (written whole under another name, then renamed)."""
+    path = os.path.join(folder(), f"{name}.json")
+    partial = f"{path}.{os.getpid()}.partial"
+    try:
+        os.makedirs(folder(), exist_ok=True)
+        with open(partial, "w") as f:
+            json.dump({"members": forecast.members, "member_seconds": forecast.member_seconds,
+                       "lead_seconds": forecast.lead_seconds}, f)
+        os.replace(partial, path)
+        records = sorted(os.scandir(folder()), key=lambda e: e.stat().st_mtime)
+        for old in records[:max(len(records) - KEPT, 0)]:
+            os.remove(old.path)
+    except OSError as exc:
+        log.debug("no record of the batch in %s (%s)", folder(), exc)
+        try:
+            os.remove(partial)
+        except OSError:
+            pass
+
+
+def early(executor, name: str, members: int | None) -> bool:
+    """Whether ``executor`` should start its workers with the run: the last run of the batch recorded under
+    ``name``, of as many ``members``, forecasts that condition (1) sends it to them
+    (:meth:`~ngcontact.parallel.executor.Executor.repays`)."""
+    forecast = recorded(name)
+    return forecast is not None and forecast.members == members and executor.repays(forecast)
+
+
+def remember_run(name: str, executor, opened: float) -> None:
+    """Record under ``name`` the first batch of ``executor`` with members solved in this process: its
+    members, their least seconds, and its start's lead over ``opened`` (``time.perf_counter`` seconds when
+    the run's batches opened)."""
+    timed = next((t for t in executor.timings if t["member_seconds"] is not None), None)
+    if timed is not None:
+        remember(name, Forecast(timed["members"], timed["member_seconds"], max(timed["began"] - opened, 0.0)))
