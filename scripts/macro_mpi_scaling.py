@@ -32,8 +32,12 @@ time is the measured time per dof of a part times the dofs of a part
 across machines is not in the model).
 
     python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--femur 1 1.5]
-                                        [--refined MAXH:K ...] [--ranks 1 2 3] [--rows-from CSV ...]
-                                        [--publish]
+                                        [--refined MAXH:K ...] [--ranks 1 2 3] [--bddc JSON ...]
+                                        [--rows-from CSV ...] [--publish]
+
+``--bddc``: flags of NGSolve's BDDC to compare (``linear_solver.BDDC_FLAGS``
+in each run's processes), each run with each; per run also the time the
+ranks holding the mesh spend in BDDC's coarse solves.
 
 Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_model.csv`` and ``.png`` (default
 ``results/macro_mpi_scaling``).
@@ -259,6 +263,12 @@ NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, BDDC-CG)
         "`work_s`: the stages from meshing to post-processing (one process without its discretization error "
         "estimate, which a distributed run does not make either). `peak_mb_each`: every rank's peak resident "
         "memory, rank 0 first. "
+        "`bddc`: the flags of NGSolve's BDDC (`default`: none; its coarse problem, the vertices and the "
+        "interface surface, factorized by a sparse Cholesky, on rank 0 under MPI); rows with other flags "
+        "compare the coarse solves NGSolve offers at one size: `coarsetype` `local` (a Jacobi sweep instead "
+        "of the coarse factorization, on every rank) and `inverse` `umfpack`. `coarse_s`: the seconds the "
+        "ranks holding the mesh spend in BDDC's coarse solves (NGSolve's timer of the wirebasket solve: "
+        "under MPI their wait for rank 0; empty where not recorded). "
         "Measured on 2 cores shared with other jobs (3 ranks oversubscribe them): times are indicative, "
         "memory is not affected.")
 MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the largest run (the press fit): the "
@@ -268,8 +278,10 @@ MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the l
               "the time is the largest run's work time per dof of a part times the dofs of a part (BDDC-CG "
               "iterations grow slowly with the size; communication across machines is not modelled). Rank 0 "
               "grows with the whole problem and is the limit: a coarse solve distributed over the ranks would "
-              "remove it. Its line is fitted to sizes close together and understates large runs, whose coarse "
-              "factorization grows faster than linearly (the attempt at 2M dofs noted above).")
+              "remove it (NGSolve's own, MUMPS or hypre, is not built into its wheels, and its AMG of the "
+              "coarse problem, `coarsetype` `h1amg`, refuses a distributed matrix). Its line is fitted to sizes "
+              "close together and understates large runs, whose coarse factorization grows faster than linearly "
+              "(the attempt at 2M dofs noted above).")
 
 
 def main(argv=None) -> int:
