@@ -32,8 +32,12 @@ time is the measured time per dof of a part times the dofs of a part
 across machines is not in the model).
 
     python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--femur 1 1.5]
-                                        [--refined MAXH:K ...] [--ranks 1 2 3] [--rows-from CSV ...]
-                                        [--publish]
+                                        [--refined MAXH:K ...] [--ranks 1 2 3] [--bddc JSON ...]
+                                        [--rows-from CSV ...] [--publish]
+
+``--bddc``: flags of NGSolve's BDDC to compare (``linear_solver.BDDC_FLAGS``
+in each run's processes), each run with each; per run also the time the
+ranks holding the mesh spend in BDDC's coarse solves.
 
 Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_model.csv`` and ``.png`` (default
 ``results/macro_mpi_scaling``).
@@ -56,8 +60,10 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 from ngcontact.output.writer import write_csv  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-KEYS = ("scene", "size", "refinements", "ranks", "ndof", "work_s", "wall_s", "newton", "cg_iterations", "peak_mb_rank0",
-        "peak_mb_parts_max", "peak_mb_each")
+KEYS = ("scene", "size", "refinements", "ranks", "bddc", "ndof", "work_s", "wall_s", "newton", "cg_iterations",
+        "coarse_s", "peak_mb_rank0", "peak_mb_parts_max", "peak_mb_each")
+#: NGSolve's timer of BDDC's coarse solve (the wirebasket's), as the ranks holding the mesh see it
+COARSE_TIMER = "Apply BDDC preconditioner - wb solve"
 MODEL_KEYS = ("ndof", "ranks", "dofs_per_part", "part_gb", "rank0_gb", "solve_s_estimate")
 #: the sizes of the model of 64 ranks
 MODEL_NDOF = (2e6, 1e7, 5e7, 1e8)
@@ -132,10 +138,16 @@ def _peak_mb() -> float:
     return float("nan")
 
 
-def child(scene: str, out: str) -> int:
+def child(scene: str, out: str, bddc: str = "") -> int:
     """One rank of a run: solve and write as ``ngcontact run`` does, without the discretization error
-    estimate in one process (as under MPI); its peak memory into a file."""
+    estimate in one process (as under MPI), with BDDC's flags ``bddc`` (JSON; empty: the solver's); its
+    peak memory and the time of BDDC's coarse solves into a file."""
+    import ngsolve as ng
+
     from ngcontact import runner
+    from ngcontact.solvers import linear_solver
+    if bddc:
+        linear_solver.BDDC_FLAGS.update(json.loads(bddc))
     from ngcontact.distributed.macro_run import accuracy_not_estimated
     from ngcontact.distributed.vtk_pieces import written
     from ngcontact.distributed.world import launched_rank
@@ -144,19 +156,21 @@ def child(scene: str, out: str) -> int:
     run_macro.accuracy = lambda scene, sol, solve, balance, *rest: accuracy_not_estimated(scene, sol, balance)
     report, outcome = runner.solve(scene)
     written(outcome, lambda: write_outputs(out, report, outcome))
+    coarse = sum(t["time"] for t in ng.Timers() if t["name"] == COARSE_TIMER)
     with open(f"{out}_peak_rank{launched_rank()}.txt", "w") as fh:
-        fh.write(f"{_peak_mb()}\n")
+        fh.write(f"{_peak_mb()} {coarse}\n")
     return 0
 
 
-def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0) -> dict:
-    """One run of scene ``name`` at ``size`` (refined ``refinements`` times) on ``ranks`` ranks."""
-    tag = f"{name}_{size:g}_k{refinements}_r{ranks}"
+def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0, bddc: str = "") -> dict:
+    """One run of scene ``name`` at ``size`` (refined ``refinements`` times) on ``ranks`` ranks, with BDDC's
+    flags ``bddc`` (JSON)."""
+    tag = f"{name}_{size:g}_k{refinements}_r{ranks}" + (f"_{re.sub('[^a-z0-9]+', '', bddc.lower())}" if bddc else "")
     scene = os.path.join(work, f"{tag}.toml")
     with open(scene, "w") as fh:
         fh.write(SCENES[name](size, refinements))
     out = os.path.join(work, tag)
-    cmd = [sys.executable, os.path.abspath(__file__), "--child", scene, out]
+    cmd = [sys.executable, os.path.abspath(__file__), "--child", scene, out, bddc]
     if ranks > 1:
         cmd = ["mpiexec", "-n", str(ranks)] + cmd
     t0 = time.perf_counter()
@@ -164,16 +178,19 @@ def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0)
     wall = time.perf_counter() - t0
     with open(os.path.join(out, "report.json")) as fh:
         rep = json.load(fh)
-    peaks = []
+    peaks, coarse = [], []
     for r in range(ranks):
         with open(f"{out}_peak_rank{r}.txt") as fh:
-            peaks.append(round(float(fh.read()), 1))
+            peak, seconds = fh.read().split()
+        peaks.append(round(float(peak), 1))
+        coarse.append(float(seconds))
     stages = {k: v for k, v in rep["timings"].items() if k != "total"}
     parts = peaks[1:] if ranks > 1 else peaks
-    return {"scene": name, "size": size, "refinements": refinements, "ranks": ranks, "ndof": rep["ndof"],
+    return {"scene": name, "size": size, "refinements": refinements, "ranks": ranks, "bddc": bddc or "default",
+            "ndof": rep["ndof"],
             "work_s": round(sum(stages.values()), 2), "wall_s": round(wall, 2),
             "newton": rep["solver"]["iterations"],
-            "cg_iterations": sum(rep["solver"]["linear"].get("cg_iterations", [])),
+            "cg_iterations": sum(rep["solver"]["linear"].get("cg_iterations", [])), "coarse_s": round(max(coarse), 2),
             "peak_mb_rank0": peaks[0], "peak_mb_parts_max": max(parts),
             "peak_mb_each": " ".join(f"{p:g}" for p in peaks)}
 
@@ -185,7 +202,9 @@ def read_rows(path: str) -> list[dict]:
         rows = list(csv.DictReader(fh))
     numbers = {"size": float, "refinements": int, "ranks": int, "ndof": int, "work_s": float, "wall_s": float,
                "newton": int, "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
-    return [{k: numbers[k](row.get(k) or 0) if k in numbers else row.get(k, "") for k in KEYS} for row in rows]
+    defaults = {"bddc": "default", "coarse_s": ""}       # rows measured before these columns
+    return [{k: numbers[k](row.get(k) or 0) if k in numbers else row.get(k) or defaults.get(k, "") for k in KEYS}
+            for row in rows]
 
 
 def model(data: list[dict], ranks: int = 64) -> list[dict]:
@@ -244,6 +263,12 @@ NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, BDDC-CG)
         "`work_s`: the stages from meshing to post-processing (one process without its discretization error "
         "estimate, which a distributed run does not make either). `peak_mb_each`: every rank's peak resident "
         "memory, rank 0 first. "
+        "`bddc`: the flags of NGSolve's BDDC (`default`: none; its coarse problem, the vertices and the "
+        "interface surface, factorized by a sparse Cholesky, on rank 0 under MPI); rows with other flags "
+        "compare the coarse solves NGSolve offers at one size: `coarsetype` `local` (a Jacobi sweep instead "
+        "of the coarse factorization, on every rank) and `inverse` `umfpack`. `coarse_s`: the seconds the "
+        "ranks holding the mesh spend in BDDC's coarse solves (NGSolve's timer of the wirebasket solve: "
+        "under MPI their wait for rank 0; empty where not recorded). "
         "Measured on 2 cores shared with other jobs (3 ranks oversubscribe them): times are indicative, "
         "memory is not affected.")
 MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the largest run (the press fit): the "
@@ -253,14 +278,16 @@ MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the l
               "the time is the largest run's work time per dof of a part times the dofs of a part (BDDC-CG "
               "iterations grow slowly with the size; communication across machines is not modelled). Rank 0 "
               "grows with the whole problem and is the limit: a coarse solve distributed over the ranks would "
-              "remove it. Its line is fitted to sizes close together and understates large runs, whose coarse "
-              "factorization grows faster than linearly (the attempt at 2M dofs noted above).")
+              "remove it (NGSolve's own, MUMPS or hypre, is not built into its wheels, and its AMG of the "
+              "coarse problem, `coarsetype` `h1amg`, refuses a distributed matrix). Its line is fitted to sizes "
+              "close together and understates large runs, whose coarse factorization grows faster than linearly "
+              "(the attempt at 2M dofs noted above).")
 
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] == ["--child"]:
-        return child(argv[1], argv[2])
+        return child(*argv[1:4])
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", nargs="?", default=os.path.join("results", "macro_mpi_scaling"), help="output directory")
     ap.add_argument("--maxh", type=float, nargs="*", default=[0.004, 0.002, 0.001], help="press fit mesh sizes [m]")
@@ -268,6 +295,9 @@ def main(argv=None) -> int:
     ap.add_argument("--refined", nargs="*", default=[], metavar="MAXH:K",
                     help="press fit meshes made with MAXH and refined K times uniformly (on the ranks under MPI)")
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 3], help="numbers of MPI ranks")
+    ap.add_argument("--bddc", nargs="+", default=[""], metavar="JSON",
+                    help='flags of NGSolve\'s BDDC to compare, each run with each (e.g. \'{"inverse": "umfpack"}\'; '
+                         '"": the solver\'s)')
     ap.add_argument("--rows-from", nargs="+", default=[], metavar="CSV",
                     help="no runs: the rows of these CSV files of earlier runs (e.g. a large size run apart)")
     ap.add_argument("--measured-by", default="", help="with --rows-from: the commands that measured the rows")
@@ -279,16 +309,17 @@ def main(argv=None) -> int:
         [("press_fit_refined", float(r.split(":")[0]), int(r.split(":")[1])) for r in args.refined]
     data = [row for path in args.rows_from for row in read_rows(path)]
     for name, size, k in ([] if args.rows_from else runs):
-        for r in args.ranks:
-            data.append(measure(name, size, r, work, k))
+        for r, flags in ((r, f) for r in args.ranks for f in args.bddc):
+            data.append(measure(name, size, r, work, k, flags))
             print(" ".join(f"{k}={data[-1][k]}" for k in KEYS), flush=True)
     csv_path = os.path.join(args.out, "macro_mpi_scaling.csv")
     write_csv(csv_path, list(KEYS), [[d[k] for k in KEYS] for d in data])
-    rows = model(data)
+    default = [d for d in data if d["bddc"] == "default"]     # the other flags' rows compare the coarse solve
+    rows = model(default)
     model_path = os.path.join(args.out, "macro_mpi_model.csv")
     write_csv(model_path, list(MODEL_KEYS), [[m[k] for k in MODEL_KEYS] for m in rows])
     png = os.path.join(args.out, "macro_mpi_scaling.png")
-    plot(data, png)
+    plot(default, png)
     for m in rows:
         print(" ".join(f"{k}={m[k]}" for k in MODEL_KEYS))
     if args.publish:

@@ -51,6 +51,13 @@ definite on the free dofs.  Two ways:
   factorization stays far ahead (measured with ``scripts/scaling_3d.py``:
   docs/benchmarks.md, section scaling_3d).
 
+BDDC's coarse problem (the wirebasket) is factorized by a sparse Cholesky
+(``BDDC_FLAGS``: further flags of NGSolve's BDDC, none).  Under MPI NGSolve
+gathers it on rank 0 and factorizes it there, so rank 0 applies the coarse
+solve of every CG iteration while the ranks holding the mesh wait; the
+coarse solves NGSolve offers are compared in docs/benchmarks.md, section
+macro_mpi_scaling.
+
 BDDC reads the free dofs from the space; a solve whose free dofs differ
 from the space's (prescribed far-face translations of a cell) sets the
 space's free dofs to them first (:func:`match_free_dofs`).  The same free
@@ -80,6 +87,8 @@ UPDATABLE = ("sparsecholesky", "umfpack")
 AUTO_THRESHOLD = 20_000
 #: a kept BDDC is rebuilt once CG needs this many times the iterations per decade it needed after its build
 REBUILD_GROWTH = 2.0
+#: flags of NGSolve's BDDC beyond the space's coupling types (its coarse solve: module docstring); none
+BDDC_FLAGS: dict = {}
 
 
 @dataclass
@@ -138,7 +147,7 @@ class LinearSolver:
         # a split energy: BDDC is built by its preconditioning form, or its whole form
         target = form.preconditioner_form() if hasattr(form, "preconditioner_form") else form
         if id(target) not in self._pre:
-            self._pre[id(target)] = ng.Preconditioner(target, "bddc")
+            self._pre[id(target)] = ng.Preconditioner(target, "bddc", **BDDC_FLAGS)
 
     def prepare(self, form: ng.BilinearForm, freedofs, *, symmetric: bool = True,
                 forcing: float | None = None) -> "TangentSolve":
