@@ -53,8 +53,10 @@ log = logging.getLogger(__name__)
 #: how the verdict's errors are estimated (the report's ``accuracy.how``)
 HOW = ("discretization error of each headline quantity from solves at the neighbouring polynomial orders on "
        "the scene's mesh (ngcontact.macro.discretization_error), each stress maximum of a 2D run judged by two "
-       "local refinements at the boundary's corners (ngcontact.macro.singular_maxima); the two-scale loop's "
-       "residual and the cell table's interpolation error as their own quantities")
+       "local refinements at the boundary's corners (ngcontact.macro.singular_maxima); in 2D each stress maximum "
+       "and the safety factor also away from the singular points (*_away, ngcontact.macro.away_maxima), judged "
+       "by two local refinements there as well, counted where the global one is mesh dependent; the two-scale "
+       "loop's residual and the cell table's interpolation error as their own quantities")
 #: the meaning of the macro run's checks
 CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its largest force"}
 

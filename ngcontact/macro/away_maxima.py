@@ -14,7 +14,8 @@ their values at distance ``r``.  So ``M_B(r)`` is a converging quantity of the d
 error is estimated as every other headline quantity's: the order ladder
 (:mod:`ngcontact.macro.discretization_error`) on the sample points outside the balls, plus the sampling
 error of a denser lattice outside them, and in a refinement the sequence of mesh levels
-(:mod:`ngcontact.macro.mesh_sequence`).  Its name is the global maximum's with :data:`AWAY`
+(:mod:`ngcontact.macro.mesh_sequence`); besides, by two local refinements at the singular points, which
+see the error the singular points spread over the mesh (:mod:`ngcontact.macro.away_sequence`).  Its name is the global maximum's with :data:`AWAY`
 (``von_mises_bone_away``), and its entry says where it is attained (``location``).  The safety factor of
 eq. 78 is offered the same way: ``safety_factor_away``, the smallest ``sigma_u / sigma_eq`` of the micro
 stresses (eq. 75) over the interface points outside the balls.
@@ -31,6 +32,9 @@ The singular points (:func:`singular_points`), from the geometry, the supports a
   :data:`~ngcontact.macro.singular_maxima.SHARP` within one (:func:`reentrant_corners`): a free wedge
   wider than ``pi`` has ``lambda < 1`` (0.544 at 270 degrees).
 
+* an end of a load with a traction (a tangential part): the shear stress jumps there, ``(2 tau / pi) log r``
+  on a straight edge, and at a corner the two faces' shears disagree.
+
 A face meeting a symmetry plane (a support of its normal component) is a mirror of a straight face, no
 singular point.  A maximum found singular at a point outside every ball (by the order ladder or the corner
 check) makes the maximum away of that body mesh dependent there too (:func:`settle`): it lies in the set
@@ -38,12 +42,14 @@ check) makes the maximum away of that body mesh dependent there too (:func:`sett
 
 The radius
     The singular terms have no length of their own, so ``r`` says what "at the singular point" means:
-    by default :data:`RADIUS_SHARE` = 0.1 of the smallest extent of the two bodies' bounding boxes
-    (:func:`default_radius`; the femur's stem and bone are each 11 mm wide, so ``r = 1.1 mm``: the
-    stress beyond a millimetre of the bone's top edge, about the grid of a strain gauge), else
-    ``discretization.exclusion_radius`` [m], positive and below that smallest extent.  A smaller radius
-    gives a larger maximum, nearer the point, which converges more slowly (the stress's gradient on the
-    ball grows like ``r^(lambda - 2)``).
+    by default :data:`RADIUS_SHARE` = 1/4 of the smallest extent of the two bodies' bounding boxes
+    (:func:`default_radius`; the femur's stem and bone are each 11 mm wide, so ``r = 2.75 mm``, about half
+    the bone's wall at its top), else ``discretization.exclusion_radius`` [m], positive and below that
+    smallest extent.  A smaller radius gives a larger maximum, nearer the point, which converges more
+    slowly: the stress's gradient on the circle grows like ``r^(lambda - 2)``, and a circle inside the
+    elements that touch the singular point is resolved only once they are refined.  Because the maximum
+    of a stress growing towards the point is attained on the circle, the circle is sampled as well
+    (:func:`rim`, :data:`RIM` points each).
 
 What the verdict counts (:func:`settle`)
     A global maximum (or the global safety factor) that is mesh dependent and has a counterpart away from
@@ -135,6 +141,14 @@ def clamped_corners(sol: MacroSolution) -> list[tuple[float, ...]]:
             if names & clamped and (names - supported)]
 
 
+def shear_load_ends(sol: MacroSolution) -> list[tuple[float, ...]]:
+    """The boundary vertices where a load with a traction (a tangential part) meets another boundary."""
+    p = sol.problem
+    sheared = {load.label for load in p.loads if any(t != 0 for t in load.traction)}
+    labels, _, pts = DE.boundary_vertices(p.mesh)
+    return [tuple(float(c) for c in pts[v]) for v, names in labels.items() if names & sheared and len(names) > 1]
+
+
 def interior_angles(mesh: ng.Mesh, region: str) -> dict[int, float]:
     """Per vertex of body ``region`` the sum of its elements' angles there (2D; ``2 pi`` inside the body)."""
     pts = np.array([mesh[ng.NodeId(ng.VERTEX, i)].point for i in range(mesh.nv)])[:, :2]
@@ -170,6 +184,7 @@ def singular_points(sol: MacroSolution) -> tuple[np.ndarray, tuple[str, ...]]:
                                                    for end, _ in SM.closed_ends(sol)]
     found += [(c, "a clamped boundary meets an unsupported one") for c in clamped_corners(sol)]
     found += [(c, "a re-entrant corner") for c in reentrant_corners(sol)]
+    found += [(c, "a load with a traction ends there") for c in shear_load_ends(sol)]
     points: list[tuple[float, ...]] = []
     why: list[str] = []
     for point, reason in found:

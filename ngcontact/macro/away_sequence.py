@@ -16,7 +16,11 @@ order from the last level's solution interpolated into its space, as the corner 
 (``Q_0`` the scene's mesh, ``Q_1``, ``Q_2``).  Each level halves the elements at the singular points, so
 the polluting share falls by a fixed factor per level and the sequence's geometric tail
 (:func:`ngcontact.macro.mesh_sequence.sequence_error`, with the factor of safety) estimates what is left
-of it on the finest level.  So the finest level's value and location are reported, with the larger of
+of it on the finest level.  That factor is ``2^-lambda`` at a singular point of exponent ``lambda <= 1``
+(the error in energy falls like ``h^lambda`` where the elements at the point are halved; a logarithm
+has ``lambda = 1``), so at least :data:`SLOWEST` = 1/2: a smaller observed ratio is pre-asymptotic (the
+first level moves the circle of the ball out of the elements that touch the point, a step larger than
+the ones to come), and the tail is taken at ratio 1/2 at least, ``1.5 |Q_2 - Q_1|``.  So the finest level's value and location are reported, with the larger of
 the ladder's error (the mesh away from the singular points is the scene's, so the polynomial error there
 is the one the ladder measured) and the sequence's; a sequence that does not converge adds its last
 difference (:func:`judged`).  The check costs about one solve of the scene (two warm-started solves on
@@ -39,6 +43,8 @@ from ngcontact.macro.macro_problem import MacroSolution
 
 #: local refinements at the singular points (three values with the scene's mesh: an observed rate)
 LEVELS = 2
+#: the slowest fall per level the sequence's tail assumes at least (module docstring)
+SLOWEST = 0.5
 
 #: the safety factor away from the singular points of a solution, given which interface points count
 Safety = Callable[[MacroSolution, Callable[[np.ndarray], np.ndarray]], dict[str, DE.Sample]]
@@ -88,6 +94,10 @@ def _judged(e: DE.Estimate, values: list[float], location: tuple[float, ...] | N
     head = (f"{e.how}; {len(values) - 1} local refinements at the singular points: {shown}, the last "
             "reported")
     seq, how = MS.sequence_error(values, e.scale)
+    if seq is not None and len(values) >= 2:
+        floor = DE.SAFETY * abs(values[-1] - values[-2]) * SLOWEST / (1.0 - SLOWEST)
+        if floor > seq:
+            seq, how = floor, f"{how}; at least the tail at ratio {SLOWEST:g}, {floor:.3g}"
     e = replace(e, value=values[-1], location=location)
     if seq is None:
         if e.error is None:

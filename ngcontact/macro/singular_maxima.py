@@ -29,7 +29,10 @@ Where the interface ends closed on a free boundary
     ``log r`` term, a face held tangentially next to a free face ``r^(lambda - 1)`` with ``lambda < 1``.
     Every stress maximum of both bodies is then reported as mesh dependent, singular at that end, without
     a solve: its largest stress is unbounded, and a maximum elsewhere on a coarse mesh is overtaken there
-    under refinement.  An end on a supported boundary (a symmetry plane, as Lame's quarter ring has) is
+    under refinement (:func:`at_closed_ends`).  So is the safety factor of eq. 78: the micro stresses are
+    linear in the interface's stress and strain (eq. 75), which grow towards that end.  Their
+    counterparts away from the singular points converge (:mod:`ngcontact.macro.away_maxima`; maxima named
+    ``*_away`` are not checked here).  An end on a supported boundary (a symmetry plane, as Lame's quarter ring has) is
     a mirror, not an end, and is left to the check below.
 
 The check

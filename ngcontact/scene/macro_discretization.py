@@ -40,7 +40,7 @@ class MacroDiscretization(Discretization):
         "safety_factor_away in results.accuracy, with where each is attained; accuracy.exclusion lists the points): "
         "these converge, so they count in accuracy.met and in a refinement's target, while the global maxima, mesh "
         "dependent there, are listed with counted = false; 2D and axisymmetric runs without [two_scale]; must be "
-        "below the smallest extent of the bodies' bounding boxes; default: a tenth of that extent")
+        "below the smallest extent of the bodies' bounding boxes; default: a quarter of that extent")
     refinements: int = param(0, check=closed_interval(0, MAX_REFINEMENTS), doc="uniform refinements of the "
         "mesh made with maxh: every element split this many times (a triangle into 4, a tetrahedron into 8, "
         "new boundary points on the geometry; h = maxh / 2^k), curved to order after the last; under mpiexec "
