@@ -15,8 +15,9 @@ error is estimated as every other headline quantity's: the order ladder
 (:mod:`ngcontact.macro.discretization_error`) on the sample points outside the balls, plus the sampling
 error of a denser lattice outside them, and in a refinement the sequence of mesh levels
 (:mod:`ngcontact.macro.mesh_sequence`); besides, by two local refinements at the singular points, which
-see the error the singular points spread over the mesh (:mod:`ngcontact.macro.away_sequence`).  Its name is the global maximum's with :data:`AWAY`
-(``von_mises_bone_away``), and its entry says where it is attained (``location``).  The safety factor of
+see the error the singular points spread over the mesh (:mod:`ngcontact.macro.away_sequence`).  Its name
+is the global maximum's with :data:`AWAY` (``von_mises_bone_away``), and its entry says where it is
+attained (``location``).  The safety factor of
 eq. 78 is offered the same way: ``safety_factor_away``, the smallest ``sigma_u / sigma_eq`` of the micro
 stresses (eq. 75) over the interface points outside the balls.
 
@@ -213,16 +214,21 @@ def exclusion_of(sol: MacroSolution, radius: float | None = None) -> Exclusion |
     return Exclusion(points, float(radius), why, "scene")
 
 
+def circles(exclusion: Exclusion, count: int = RIM) -> np.ndarray:
+    """``count`` points on each ball's circle (offset by half a step), those outside the other balls."""
+    angle = 2.0 * math.pi * (np.arange(count) + 0.5) / count
+    ring = np.column_stack([np.cos(angle), np.sin(angle)]) * exclusion.radius
+    centres = np.repeat(exclusion.points, count, axis=0)
+    steps = np.tile(ring, (len(exclusion.points), 1))
+    return (centres + steps)[exclusion.outside(centres + steps * (1.0 + 1e-9))]
+
+
 def rim(sol: MacroSolution, exclusion: Exclusion, region: str) -> tuple[np.ndarray, np.ndarray]:
     """The stress tensors (``n x 3 x 3``) and points of body ``region`` on the balls' circles, :data:`RIM`
     points each (offset by half a step, so none falls on a straight boundary through the centre), those
     outside the other balls."""
     mesh = sol.problem.mesh
-    angle = 2.0 * math.pi * (np.arange(RIM) + 0.5) / RIM
-    ring = np.column_stack([np.cos(angle), np.sin(angle)]) * exclusion.radius
-    centres = np.repeat(exclusion.points, RIM, axis=0)
-    steps = np.tile(ring, (len(exclusion.points), 1))
-    pts = (centres + steps)[exclusion.outside(centres + steps * (1.0 + 1e-9))]
+    pts = circles(exclusion)
     sig = MM.stress(sol)
     values, kept = [], []
     for x in pts:
