@@ -109,11 +109,6 @@ class Exclusion:
                 "how": f"the maxima named *{AWAY} are taken outside a ball of this radius around each point "
                        "(ngcontact.macro.away_maxima)"}
 
-    def text(self) -> str:
-        """The balls in a few words, for the terminal line."""
-        pts = ", ".join(DE._point(tuple(p)) for p in self.points)
-        return f"*{AWAY}: outside {self.radius:.3g} m of {pts}"
-
 
 def body_extents(mesh: ng.Mesh, regions: tuple[str, ...]) -> dict[str, float]:
     """Per region the smallest extent of its vertices' bounding box."""
@@ -210,7 +205,7 @@ def exclusion_of(sol: MacroSolution, radius: float | None = None) -> Exclusion |
     if not len(points):
         return None
     if radius is None:
-        return Exclusion(points, RADIUS_SHARE * smallest_extent(p.mesh, (p.rough, p.counter)), why)
+        return Exclusion(points, default_radius(p.mesh, (p.rough, p.counter)), why)
     return Exclusion(points, float(radius), why, "scene")
 
 
