@@ -162,3 +162,20 @@ def test_the_femur_main_job_meets_its_tolerance_away_from_the_bone_edge():
     for name in ("von_mises_stem_away", "von_mises_bone_away", "tresca_bone_away", "safety_factor_away"):
         true = abs(q[name]["value"] - reference[name].value - reference[name].sampling)
         assert q[name]["error"] >= true, f"{name}: {q[name]['how']}"
+
+
+def test_report_html_tabulates_the_verdict_with_what_it_counts():
+    from ngcontact.output.report_html import accuracy_table, render
+    acc = {"met": True, "tolerance": 0.01, "quantities": [
+        {"name": "von_mises_bone", "value": 5.4e6, "error": None, "relative_error": None, "met": False,
+         "counted": False, "singular_at": [0.011, 0.18], "how": "x"},
+        {"name": "von_mises_bone_away", "value": 5.05e6, "error": 3e4, "relative_error": 6e-3, "met": True,
+         "counted": True, "location": [0.011, 0.177], "how": "x"}],
+           "exclusion": {"radius": 2.75e-3, "radius_from": "default", "points": [[0.011, 0.18]],
+                         "why": ["the interface ends there closed"], "how": "x"}}
+    report = {"kind": "macro", "results": {"accuracy": acc}}
+    table = accuracy_table(report)
+    assert "mesh dependent, singular at" in table and "not counted" in table and "von_mises_bone_away" in table
+    assert "2.75 mm" in table and "the interface ends there closed" in table
+    # a met verdict puts no warning at the top, whatever the uncounted quantities say
+    assert 'class="warn"' not in render(report, ".", [])
