@@ -19,18 +19,30 @@ In 2D, without ``[two_scale]`` and without a refinement (whose mesh levels judge
 is also judged by two local refinements at the corners of the boundary
 (:mod:`ngcontact.macro.singular_maxima`): the ladder converges to the stress at sample points fixed on
 the mesh, which at a singular corner moves with the mesh; such a maximum is reported as mesh dependent.
+Where the interface ends closed on a boundary without support, every stress maximum and the safety factor
+are mesh dependent (a refinement too judges them so).
 
-A quantity whose relative error exceeds the tolerance, or has none (not converging, a stress
+In 2D without ``[two_scale]``, where the bodies have singular points, each stress maximum and the safety
+factor have a counterpart away from them (:mod:`ngcontact.macro.away_maxima`: ``<name>_away``, outside a
+ball of radius ``discretization.exclusion_radius`` around each point, ``accuracy.exclusion``), estimated
+as the others; a mesh-dependent maximum with such a counterpart is listed with ``counted = false``.
+
+A counted quantity whose relative error exceeds the tolerance, or has none (not converging, a stress
 singularity), marks the verdict as not met and is said in one warning line.
 """
 from __future__ import annotations
 
 import logging
-from dataclasses import replace
-from typing import Any, Callable
+from dataclasses import dataclass, replace
+from typing import Any, Callable, Protocol
+
+import numpy as np
 
 from ngcontact.cell.admissibility import DEFAULT_TOLERANCE
 from ngcontact.coupling import homogenization_error
+from ngcontact.errors import SceneError
+from ngcontact.macro import away_maxima as AM
+from ngcontact.macro import away_sequence as AS
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroSolution
@@ -41,24 +53,59 @@ log = logging.getLogger(__name__)
 #: how the verdict's errors are estimated (the report's ``accuracy.how``)
 HOW = ("discretization error of each headline quantity from solves at the neighbouring polynomial orders on "
        "the scene's mesh (ngcontact.macro.discretization_error), each stress maximum of a 2D run judged by two "
-       "local refinements at the boundary's corners (ngcontact.macro.singular_maxima); the two-scale loop's "
-       "residual and the cell table's interpolation error as their own quantities")
+       "local refinements at the boundary's corners (ngcontact.macro.singular_maxima); in 2D each stress maximum "
+       "and the safety factor also away from the singular points (*_away, ngcontact.macro.away_maxima), judged "
+       "by two local refinements there as well, counted where the global one is mesh dependent; the two-scale "
+       "loop's residual and the cell table's interpolation error as their own quantities")
 #: the meaning of the macro run's checks
 CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its largest force"}
 
 
+@dataclass(frozen=True)
+class SafetyFactor:
+    """The safety factor of eq. 78 of a solution: ``samples(sol, keep)`` gives ``safety_factor`` with the
+    interface point where it is attained and, with ``keep`` (which of an array of points count), the
+    smallest over the points kept (``safety_factor_away``); called, the factor alone."""
+
+    samples: Callable[[MacroSolution, Callable[[np.ndarray], np.ndarray] | None], dict[str, DE.Sample]]
+
+    def __call__(self, sol: MacroSolution) -> float:
+        return self.samples(sol, None)["safety_factor"].value
+
+
+def exclusion_for(scene, sol: MacroSolution) -> AM.Exclusion | None:
+    """The balls around the singular points of ``sol`` (:mod:`ngcontact.macro.away_maxima`), with the
+    scene's ``discretization.exclusion_radius``; ``None`` with ``[two_scale]``, in 3D or without any."""
+    if getattr(scene, "two_scale", None) is not None:
+        return None
+    check_radius(scene, sol.problem)
+    return AM.exclusion_of(sol, getattr(scene.discretization, "exclusion_radius", None))
+
+
+def _added(s: MacroSolution, safety_factor, exclusion: AM.Exclusion | None, dense_inset: float
+           ) -> dict[str, DE.Sample]:
+    """The maxima away from the singular points and the safety factor(s) of ``s``."""
+    out = {} if exclusion is None else AM.away_maxima(s, exclusion, dense_inset)
+    if isinstance(safety_factor, SafetyFactor):
+        out.update(safety_factor.samples(s, None if exclusion is None else exclusion.outside))
+    elif safety_factor is not None:
+        out["safety_factor"] = DE.Sample(safety_factor(s))
+    return out
+
+
 def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
                   safety_factor: Callable[[MacroSolution], float] | None = None,
-                  component: str | None = None, dense_inset: float = 1e-3) -> dict[int, dict[str, DE.Sample]]:
+                  component: str | None = None, dense_inset: float = 1e-3,
+                  exclusion: AM.Exclusion | None = None) -> dict[int, dict[str, DE.Sample]]:
     """The headline quantities at the three orders of the ladder (``sol`` is the scene's order; the other
     two are solved by ``solve(problem, start)`` on the same mesh with the same law, from ``sol``);
     ``component``: the resultant's (default: the largest of ``sol``'s); ``dense_inset``: of the lattice
-    a stress maximum's sampling error is taken on (:func:`ngcontact.macro.discretization_error.body_maxima`)."""
+    a stress maximum's sampling error is taken on (:func:`ngcontact.macro.discretization_error.body_maxima`);
+    ``exclusion``: the balls the maxima away from the singular points are taken outside of."""
     problem, ppe = sol.problem, scene.output.points_per_element
     own = DE.headlines(sol, ppe, component, dense_inset)
     component = next(n for n in own if n.startswith("resultant_")).removeprefix("resultant_")
-    if safety_factor is not None:
-        own["safety_factor"] = DE.Sample(safety_factor(sol))
+    own.update(_added(sol, safety_factor, exclusion, dense_inset))
     out: dict[int, dict[str, DE.Sample]] = {problem.order: own}
     for q in DE.ladder(problem.order, MAX_ORDER):
         if q == problem.order:
@@ -68,8 +115,7 @@ def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution]
         with DE.neighbour_mesh(problem.mesh, problem.order):
             s = solve(other, start)
             out[q] = DE.headlines(s, ppe, component, dense_inset)
-            if safety_factor is not None:
-                out[q]["safety_factor"] = DE.Sample(safety_factor(s))
+            out[q].update(_added(s, safety_factor, exclusion, dense_inset))
     return dict(sorted(out.items()))
 
 
@@ -90,11 +136,11 @@ def two_scale_quantities(two_scale: dict, tolerance: float) -> list[dict[str, An
     rel = change / peak if peak > 0 else 0.0
     table = float(two_scale["table"]["error_estimate"])
     return [{"name": "two_scale_residual", "value": change, "error": change, "relative_error": rel,
-             "controlled": "relative", "met": rel <= tolerance,
+             "controlled": "relative", "met": rel <= tolerance, "counted": True,
              "how": "max |sigma_n(k) - sigma_n(k-1)| over the interface points at the loop's last step [Pa], "
                     "relative to the peak pressure"},
             {"name": "cell_table_interpolation", "value": table, "error": table, "relative_error": table,
-             "controlled": "relative", "met": table <= tolerance,
+             "controlled": "relative", "met": table <= tolerance, "counted": True,
              "how": "the monotone cubic's largest error at interval midpoints, relative to the tabulated "
                     "quantities' largest values (two_scale.table_tol bounds it)"}]
 
@@ -114,7 +160,7 @@ def verdict(found: list[DE.Estimate], tolerance: float | None, balance: dict | N
         checks.append({"load": None, "name": "equilibrium", "value": value, "limit": bound, "ok": value <= bound,
                        "meaning": CHECKS["equilibrium"]})
     out: dict[str, Any] = {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
-           "met": all(c["ok"] for c in checks) and all(q["met"] for q in quantities), "checks": checks,
+           "met": all(c["ok"] for c in checks) and all(q["met"] for q in quantities if q["counted"]), "checks": checks,
            "estimated": True, "quantities": quantities, "how": how}
     if not out["met"]:
         log.warning("ngcontact: warning: %s", warning_line(out))
@@ -125,7 +171,7 @@ def warning_line(accuracy: dict) -> str:
     """The unmet quantities of a verdict in one line."""
     parts = []
     for q in accuracy["quantities"]:
-        if q["met"]:
+        if q["met"] or not q.get("counted", True):
             continue
         rel = q["relative_error"]
         if q["error"] is None:
@@ -138,30 +184,77 @@ def warning_line(accuracy: dict) -> str:
     return f"accuracy not met (tolerance {accuracy['tolerance']:.3g}): " + "; ".join(parts)
 
 
-def safety_factor_of(scene, recovery) -> Callable[[MacroSolution], float] | None:
+def safety_factor_of(scene, recovery) -> SafetyFactor | None:
     """The safety factor of eq. 78 by the linear recovery with the strength check's correctors ``recovery``
     (``None``: the scene has no ``[strength]``)."""
     if recovery is None:
         return None
-    from ngcontact.drivers.run_strength import linear_safety_factor
+    from ngcontact.drivers.run_strength import linear_safety_factors
 
-    def safety_factor(s: MacroSolution) -> float:
-        return linear_safety_factor(scene, s, recovery)
-    return safety_factor
+    def samples(s: MacroSolution, keep) -> dict[str, DE.Sample]:
+        return linear_safety_factors(scene, s, recovery, keep)
+    return SafetyFactor(samples)
+
+
+def away_judged(found: list[DE.Estimate], sol: MacroSolution, solve: Callable[..., MacroSolution],
+                exclusion: AM.Exclusion | None, own: dict[str, DE.Sample], safety=None) -> list[DE.Estimate]:
+    """``found`` with the maxima away from the singular points judged by local refinements at those points
+    (:mod:`ngcontact.macro.away_sequence`; ``own``: the samples of ``sol``); nothing without ``exclusion``."""
+    if exclusion is None:
+        return found
+    at = {k: v for k, v in own.items() if k.endswith(AM.AWAY)}
+    finer = AS.levels(sol, solve, exclusion, at, safety.samples if isinstance(safety, SafetyFactor) else None)
+    return AS.judged(found, own, finer)
+
+
+def check_radius(scene, problem) -> None:
+    """``discretization.exclusion_radius`` of ``scene`` against the bodies of ``problem``'s mesh, before the
+    solve.
+
+    Raises
+    ------
+    SceneError
+        The radius not below the smallest extent of the bodies' bounding boxes
+        (:func:`ngcontact.macro.away_maxima.smallest_extent`).
+    """
+    radius = getattr(scene.discretization, "exclusion_radius", None)
+    if radius is None or problem.mesh.dim != 2:
+        return
+    smallest = AM.smallest_extent(problem.mesh, (problem.rough, problem.counter))
+    if not 0.0 < radius < smallest:
+        raise SceneError("discretization.exclusion_radius", radius, "must be > 0 and below the smallest extent of "
+                         f"the bodies' bounding boxes ({smallest:.4g} m)")
+
+
+class Judged(Protocol):
+    """Estimates made already (by a refinement, :mod:`ngcontact.drivers.macro_refinement`), with the balls
+    around the singular points they were made with."""
+
+    @property
+    def estimates(self) -> list[DE.Estimate]: ...
+
+    @property
+    def exclusion(self) -> AM.Exclusion | None: ...
 
 
 def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], balance: dict,
-             two_scale: dict | None = None, recovery=None,
-             found: list[DE.Estimate] | None = None) -> dict[str, Any]:
+             two_scale: dict | None = None, recovery=None, refined: Judged | None = None) -> dict[str, Any]:
     """``results.accuracy`` of the macro solution ``sol`` of ``scene``: the neighbouring orders solved by
-    ``solve(problem, start)`` (or the estimates ``found`` already by a refinement, with its mesh levels),
-    the safety factor re-evaluated with the strength check's correctors ``recovery``."""
+    ``solve(problem, start)`` (or the estimates a refinement made already, ``refined``, with its mesh levels
+    and its balls), the safety factor re-evaluated with the strength check's correctors ``recovery``."""
+    found, exclusion = (None, None) if refined is None else (refined.estimates, refined.exclusion)
     if found is None:
-        samples = order_samples(scene, sol, solve, safety_factor_of(scene, recovery))
+        exclusion = None if two_scale is not None else exclusion_for(scene, sol)
+        safety = safety_factor_of(scene, recovery)
+        samples = order_samples(scene, sol, solve, safety, exclusion=exclusion)
         found = estimates(samples, sol)
         if sol.problem.mesh.dim == 2 and two_scale is None:
             found = SM.check(found, sol, samples[sol.problem.order], solve)
+            found = AM.settle(away_judged(found, sol, solve, exclusion, samples[sol.problem.order], safety),
+                              exclusion)
     out = verdict(found, scene.discretization.tolerance, balance, two_scale)
+    if exclusion is not None:
+        out["exclusion"] = exclusion.record()
     out["modelling"] = modelling(scene, sol)
     return out
 

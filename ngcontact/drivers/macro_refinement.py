@@ -41,6 +41,17 @@ Then the mesh (h), where the order no longer pays
       depends on the mesh and has no limit): the refinement stops there and says so.
     * A scene with ``[two_scale]`` keeps its mesh (the loop's interface state lives on it).
 
+What is refined for
+    Only the quantities the verdict counts (:func:`unmet`).  In 2D without ``[two_scale]``, where the
+    interface ends closed on a boundary without support (:func:`ngcontact.macro.singular_maxima.closed_ends`
+    on the scene's solution), every stress maximum over a whole body and the safety factor are mesh
+    dependent on every level: their counterparts away from the singular points
+    (:mod:`ngcontact.macro.away_maxima`, the same balls on every level) converge, and they, not the
+    mesh-dependent maxima, are refined for; each level judges them by local refinements at the singular
+    points as well (:mod:`ngcontact.macro.away_sequence`), so a level's estimate of them has seen the
+    mesh there.  A maximum once judged mesh dependent is never refined for, so no time is spent on a
+    value without a limit.
+
 Each order level is the run of the scene at that order: the mesh is curved at the raised order
 (``mesh.Curve``, as :func:`ngcontact.drivers.macro_geometry.build_geometry` curves a mesh of that
 order; the vertices are the scene's), so the discretization that met the tolerance by the order alone is
@@ -60,9 +71,11 @@ from typing import Any, Callable
 
 from ngcontact.drivers import macro_accuracy as MA
 from ngcontact.errors import ConvergenceError
+from ngcontact.macro import away_maxima as AM
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro import error_indicator as EI
 from ngcontact.macro import mesh_sequence as MS
+from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroProblem, MacroSolution, space_and_frame
 from ngcontact.scene.schema import MAX_ORDER
 
@@ -93,6 +106,7 @@ class Refined:
     samples: dict[int, dict[str, DE.Sample]]
     history: list[dict[str, Any]]
     estimates: list[DE.Estimate]
+    exclusion: AM.Exclusion | None = None
 
     def record(self) -> dict[str, Any]:
         """``results.accuracy.refinement``: the method, its bounds, the levels and the order and mesh level
@@ -105,8 +119,27 @@ class Refined:
 
 
 def unmet(found: list[DE.Estimate], tolerance: float) -> list[DE.Estimate]:
-    """The estimates that miss ``tolerance`` (relative) or have no error."""
-    return [e for e in found if e.relative_error is None or e.relative_error > tolerance]
+    """The counted estimates that miss ``tolerance`` (relative) or have no error."""
+    return [e for e in found if e.counted and (e.relative_error is None or e.relative_error > tolerance)]
+
+
+@dataclass(frozen=True)
+class Singular:
+    """What makes a maximum singular on every level: the interface's closed ends on the scene's solution
+    (:func:`ngcontact.macro.singular_maxima.closed_ends`) and the balls around the singular points."""
+
+    ends: list[tuple[tuple[float, ...], float]]
+    exclusion: AM.Exclusion | None
+
+    @classmethod
+    def of(cls, scene, sol: MacroSolution) -> "Singular":
+        exclusion = MA.exclusion_for(scene, sol)
+        return cls(SM.closed_ends(sol) if exclusion is not None else [], exclusion)
+
+    def judged(self, found: list[DE.Estimate]) -> list[DE.Estimate]:
+        """``found`` with the maxima singular at a closed end mesh dependent, those with a counterpart away
+        from the singular points not counted (:func:`ngcontact.macro.away_maxima.settle`)."""
+        return AM.settle(SM.at_closed_ends(found, self.ends), self.exclusion)
 
 
 def level(sol: MacroSolution, found: list[DE.Estimate], tolerance: float, h_level: int = 0) -> dict[str, Any]:
@@ -193,14 +226,17 @@ def refine(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
         return None
     tolerance = float(scene.discretization.tolerance)
     history: list[dict[str, Any]] = []
+    singular = Singular.of(scene, sol)
     while True:
-        samples = MA.order_samples(scene, sol, solve, safety_factor)
-        found = MA.estimates(samples, sol)
+        samples = MA.order_samples(scene, sol, solve, safety_factor, exclusion=singular.exclusion)
+        found = singular.judged(MA.away_judged(MA.estimates(samples, sol), sol, solve, singular.exclusion,
+                                               samples[sol.problem.order], safety_factor))
         history.append(level(sol, found, tolerance))
         missed = unmet(found, tolerance)
         _progress(sol, found, missed, tolerance, 0)
         if not missed:
-            return Refined(solution=sol, samples=samples, history=history, estimates=found)
+            return Refined(solution=sol, samples=samples, history=history, estimates=found,
+                           exclusion=singular.exclusion)
         why = stop_reason(sol, missed)
         if why is not None:
             break
@@ -211,7 +247,7 @@ def refine(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
                                {"refinement": history})
     progress.info("macro: %s; the mesh is refined where the error indicator is large", why)
     return refine_mesh(scene, Refined(solution=sol, samples=samples, history=history, estimates=found), solve,
-                       safety_factor, tolerance)
+                       safety_factor, tolerance, singular)
 
 
 def _progress(sol: MacroSolution, found: list[DE.Estimate], missed: list[DE.Estimate], tolerance: float,
@@ -235,9 +271,11 @@ def h_stop_reason(missed: list[DE.Estimate], values: dict[str, list[float]], h_l
 
 
 def refine_mesh(scene, start: Refined, solve: Callable[..., MacroSolution],
-                safety_factor: Callable[[MacroSolution], float] | None, tolerance: float) -> Refined:
+                safety_factor: Callable[[MacroSolution], float] | None, tolerance: float,
+                singular: Singular = Singular([], None)) -> Refined:
     """The mesh refined where :func:`ngcontact.macro.error_indicator.indicator` is large, at the order
-    ``start`` reached, level by level until the tolerance is met (module docstring)."""
+    ``start`` reached, level by level until the tolerance is met (module docstring); ``singular``: what
+    makes a maximum singular on every level."""
     sol, history = start.solution, list(start.history)
     values = {e.name: [e.value] for e in start.estimates}
     component = next(n for n in values if n.startswith("resultant_")).removeprefix("resultant_")
@@ -255,16 +293,19 @@ def refine_mesh(scene, start: Refined, solve: Callable[..., MacroSolution],
                                                 f"beyond the refinement's bound of {MAX_DOFS}"),
                                    {"refinement": history})
         sol = solve(problem, None)
-        samples = MA.order_samples(scene, sol, solve, safety_factor, component, dense_inset=FACE_INSET)
-        ladder = MA.estimates(samples, sol)
+        samples = MA.order_samples(scene, sol, solve, safety_factor, component, dense_inset=FACE_INSET,
+                                   exclusion=singular.exclusion)
+        ladder = MA.away_judged(MA.estimates(samples, sol), sol, solve, singular.exclusion,
+                                samples[sol.problem.order], safety_factor)
         for e in ladder:
             values[e.name].append(e.value)
-        found = [MS.combined(e, values[e.name]) for e in ladder]
+        found = singular.judged([MS.combined(e, values[e.name]) for e in ladder])
         history.append(level(sol, found, tolerance, h_level))
         missed = unmet(found, tolerance)
         _progress(sol, found, missed, tolerance, h_level)
         if not missed:
-            return Refined(solution=sol, samples=samples, history=history, estimates=found)
+            return Refined(solution=sol, samples=samples, history=history, estimates=found,
+                           exclusion=singular.exclusion)
         why = h_stop_reason(missed, values, h_level)
         if why is not None:
             raise ConvergenceError(out_of_reach(tolerance, history, missed, why), {"refinement": history})

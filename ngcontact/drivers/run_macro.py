@@ -45,7 +45,7 @@ import numpy as np
 import ngsolve as ng
 
 from ngcontact.drivers.mesh_supports import supports_on
-from ngcontact.drivers.macro_accuracy import accuracy, safety_factor_of
+from ngcontact.drivers.macro_accuracy import accuracy, check_radius, safety_factor_of
 from ngcontact.drivers.macro_refinement import refine
 from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
                                      law_from_cell, law_from_file, linear_solver)
@@ -264,6 +264,7 @@ def run(scene, clock) -> Outcome:
         geo = build_geometry(scene)
     with clock.stage("interface law"):
         problem, law_info = problem_of(scene, geo)
+        check_radius(scene, problem)
     two_scale = None
     with clock.stage("solve"):
         if scene.two_scale is None:
@@ -300,7 +301,7 @@ def run(scene, clock) -> Outcome:
         outcome.plots.update(st["plots"])
     with clock.stage("discretization error"):
         results["accuracy"] = accuracy(scene, sol, partial(solve_scene, scene), results["equilibrium"], two_scale,
-                                       recovery, None if refined is None else refined.estimates)
+                                       recovery, refined)
     if refined is not None:
         results["accuracy"]["refinement"] = refined.record()
     return outcome

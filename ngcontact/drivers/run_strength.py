@@ -20,6 +20,7 @@ e_22, e_12`` in the law's frame, :mod:`ngcontact.coupling.interface_state`).
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypedDict
@@ -31,6 +32,8 @@ from ngcontact.coupling import strength as S
 from ngcontact.coupling.interface_state import cell_loads, interface_states
 from ngcontact.drivers.build import recovery_cell_problem
 from ngcontact.errors import ModelError, SceneError
+from ngcontact.macro.away_maxima import AWAY
+from ngcontact.macro.discretization_error import Sample
 from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.output import plots as figures
 from ngcontact.output.report import VtkField
@@ -110,6 +113,34 @@ def linear_safety_factor(scene: MacroScene, sol: MacroSolution, rec: Recovery) -
     smap = S.strength_map(rec.correctors, loads, scene.strength.criterion)
     names = ["r", "z"] if "r" in states else [k for k in ("x", "y", "z") if k in states]
     return float(S.check(smap, _sigma_u(scene), np.column_stack([states[k] for k in names]))["safety_factor"])
+
+
+def linear_safety_factors(scene: MacroScene, sol: MacroSolution, rec: Recovery,
+                          keep: Callable[[np.ndarray], np.ndarray] | None = None) -> dict[str, Sample]:
+    """:func:`linear_safety_factor` with the interface point where it is attained (``safety_factor``) and,
+    with ``keep`` (which of an array of interface points count), the smallest factor over the points kept
+    (``safety_factor_away``: :mod:`ngcontact.macro.away_maxima`; absent where none is kept)."""
+    assert scene.strength is not None
+    states, loads = _cell_loads(scene, sol, rec, warn=False)
+    smap = S.strength_map(rec.correctors, loads, scene.strength.criterion)
+    names = ["r", "z"] if "r" in states else [k for k in ("x", "y", "z") if k in states]
+    coords = np.column_stack([states[k] for k in names])
+    out = {"safety_factor": _smallest_factor(smap, _sigma_u(scene), coords, np.ones(len(coords), dtype=bool))}
+    kept = None if keep is None else np.asarray(keep(coords), dtype=bool)
+    if kept is not None and kept.any():
+        out["safety_factor" + AWAY] = _smallest_factor(smap, _sigma_u(scene), coords, kept)
+    return out
+
+
+def _smallest_factor(smap: S.StrengthMap, sigma_u: dict[str, float], coords: np.ndarray, kept: np.ndarray) -> Sample:
+    """The smallest ``sigma_u / sigma_eq`` of the bodies over the interface points ``kept`` (eq. 78), and where."""
+    best, at = math.inf, None
+    for body, values in smap.values.items():
+        masked = np.where(kept, values, -math.inf)
+        k = int(np.argmax(masked))
+        if masked[k] > 0 and sigma_u[body] / masked[k] < best:
+            best, at = float(sigma_u[body] / masked[k]), tuple(float(c) for c in coords[k])
+    return Sample(best, at)
 
 
 def evaluate(scene: MacroScene, sol: MacroSolution, rec: Recovery | None = None) -> StrengthEvaluation:

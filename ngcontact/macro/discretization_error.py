@@ -78,7 +78,7 @@ import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import ngsolve as ng
 import numpy as np
@@ -157,14 +157,17 @@ def start_at_order(sol: MacroSolution, problem: MacroProblem) -> ng.BaseVector:
 
 
 # ------------------------------------------------------------------ the quantities of one solution
-def body_maxima(sol: MacroSolution, dense_inset: float = 1e-3) -> dict[str, Sample]:
+def body_maxima(sol: MacroSolution, dense_inset: float = 1e-3,
+                keep: Callable[[np.ndarray], np.ndarray] | None = None) -> dict[str, Sample]:
     """Per body the largest von Mises and Tresca stress (``von_mises_<region>``, ``tresca_<region>``),
     sampled as :func:`ngcontact.macro.macro_measures.field_extrema` samples, with their location, and
     the maximum's sampling error: how much larger the maximum over a denser lattice of points per
     element (:func:`dense_rule`, moved ``dense_inset`` inwards) is.  A refinement moves the sample points;
     the orders on one mesh do not, so this share of the error is measured apart.  A tiny ``dense_inset``
     reaches the elements' faces, where a maximum on the boundary is attained (the mesh levels of
-    :mod:`ngcontact.drivers.macro_refinement`, where this offset outgrows the orders' differences)."""
+    :mod:`ngcontact.drivers.macro_refinement`, where this offset outgrows the orders' differences).
+    ``keep``: of an array of points (one row each) those the maxima are taken over (default: all; a body
+    without such a point has no entry)."""
     p = sol.problem
     mesh = p.mesh
     sig = MM.stress(sol)
@@ -177,6 +180,12 @@ def body_maxima(sol: MacroSolution, dense_inset: float = 1e-3) -> dict[str, Samp
         lattice = mesh.MapToAllElements(dense_rule(mesh.dim, dense_inset), where)
         dense = np.asarray(sig(lattice)).reshape(-1, 3, 3)
         xyz = np.asarray(coords(mips)).reshape(-1, mesh.dim)
+        if keep is not None:
+            inside = keep(xyz)
+            s, xyz = s[inside], xyz[inside]
+            dense = dense[keep(np.asarray(coords(lattice)).reshape(-1, mesh.dim))]
+            if not len(s) or not len(dense):
+                continue
         for name, measure in (("von_mises", von_mises), ("tresca", tresca)):
             values = measure(s)
             k = int(np.argmax(values))
@@ -290,6 +299,8 @@ class Estimate:
     orders: tuple[int, int, int]
     how: str
     singular_at: tuple[float, ...] | None = None
+    counted: bool = True                       # held to the tolerance (ngcontact.macro.away_maxima.settle)
+    location: tuple[float, ...] | None = None  # where the reported value is attained (a maximum)
 
     @property
     def relative_error(self) -> float | None:
@@ -310,11 +321,14 @@ class Estimate:
             controlled = rel
         out: dict[str, Any] = {"name": self.name, "value": self.value, "error": self.error,
                                "relative_error": rel, "controlled": "absolute" if absolute else "relative",
-                               "met": controlled is not None and controlled <= tolerance, "how": self.how,
+                               "met": controlled is not None and controlled <= tolerance, "counted": self.counted,
+                               "how": self.how,
                                "orders": list(self.orders),
                                "ratio": self.ratio if math.isfinite(self.ratio) else None}
         if self.singular_at is not None:
             out["singular_at"] = list(self.singular_at)
+        if self.location is not None:
+            out["location"] = list(self.location)
         return out
 
 
@@ -327,7 +341,8 @@ def estimate(name: str, by_order: dict[int, Sample], order: int, corners: np.nda
     d_lo, d_hi = q[mid] - q[lo], q[hi] - q[mid]
     rho = abs(d_hi) / abs(d_lo) if d_lo != 0 else (0.0 if d_hi == 0 else math.inf)
     scale = by_order[order].magnitude
-    base: dict[str, Any] = dict(name=name, value=q[order], scale=scale, ratio=rho, orders=(lo, mid, hi))
+    base: dict[str, Any] = dict(name=name, value=q[order], scale=scale, ratio=rho, orders=(lo, mid, hi),
+                                location=by_order[order].location)
     head = f"orders {lo}, {mid}, {hi} on the scene's mesh: differences {d_lo:.3g}, {d_hi:.3g} (ratio {rho:.2g})"
     if max(abs(d_lo), abs(d_hi)) <= NOISE * scale:
         return Estimate(**base, error=SAFETY * max(abs(d_lo), abs(d_hi)),

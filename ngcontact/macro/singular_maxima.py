@@ -29,7 +29,10 @@ Where the interface ends closed on a free boundary
     ``log r`` term, a face held tangentially next to a free face ``r^(lambda - 1)`` with ``lambda < 1``.
     Every stress maximum of both bodies is then reported as mesh dependent, singular at that end, without
     a solve: its largest stress is unbounded, and a maximum elsewhere on a coarse mesh is overtaken there
-    under refinement.  An end on a supported boundary (a symmetry plane, as Lame's quarter ring has) is
+    under refinement (:func:`at_closed_ends`).  So is the safety factor of eq. 78: the micro stresses are
+    linear in the interface's stress and strain (eq. 75), which grow towards that end.  Their
+    counterparts away from the singular points converge (:mod:`ngcontact.macro.away_maxima`; maxima named
+    ``*_away`` are not checked here).  An end on a supported boundary (a symmetry plane, as Lame's quarter ring has) is
     a mirror, not an end, and is left to the check below.
 
 The check
@@ -91,11 +94,15 @@ CLOSED = 1e-3
 SHARP = math.radians(60.0)
 #: the stress measures whose maxima are checked
 STRESS = ("von_mises_", "tresca_")
+#: the suffix of a maximum taken away from the singular points (:mod:`ngcontact.macro.away_maxima`), not checked
+AWAY = "_away"
+#: the safety factor of eq. 78, mesh dependent at a closed end as the stress maxima are
+SAFETY_FACTOR = "safety_factor"
 
 
 def checked_names(found: list[DE.Estimate]) -> list[str]:
-    """The stress maxima among the estimates."""
-    return [e.name for e in found if e.name.startswith(STRESS)]
+    """The stress maxima over the whole bodies among the estimates."""
+    return [e.name for e in found if e.name.startswith(STRESS) and not e.name.endswith(AWAY)]
 
 
 def corner_maxima(sol: MacroSolution, corners: np.ndarray, radius: float) -> dict[str, np.ndarray]:
@@ -150,14 +157,26 @@ def closed_ends(sol: MacroSolution, points_per_element: int = 5) -> list[tuple[t
 
 
 def at_closed_end(e: DE.Estimate, end: tuple[tuple[float, ...], float]) -> DE.Estimate:
-    """``e`` (a stress maximum) reported as mesh dependent at the closed end ``end`` of the interface."""
+    """``e`` (a stress maximum or the safety factor) reported as mesh dependent at the closed end ``end`` of
+    the interface."""
     point, pressure = end
+    what = ("neither body's largest stress has" if e.name != SAFETY_FACTOR else
+            "the micro stresses, linear in the interface's stress and strain there (eq. 75), grow as well and "
+            "the smallest safety factor has")
     return replace(e, error=None, singular_at=point,
                    how=f"{e.how}; the interface ends at {DE._point(point)} on a boundary without support while "
                        f"closed (pressure {pressure:.4g} there): the traction jumps there from the law's to none, "
                        "and the stress of both bodies grows towards that point like log r or r^(lambda - 1) "
-                       "(Williams 1952), so neither body's largest stress has a converged value: mesh dependent, "
-                       f"singular at {DE._point(point)}")
+                       f"(Williams 1952), so {what} a converged value: mesh dependent, singular at {DE._point(point)}")
+
+
+def at_closed_ends(found: list[DE.Estimate], ends: list[tuple[tuple[float, ...], float]]) -> list[DE.Estimate]:
+    """``found`` with every stress maximum over a whole body and the safety factor mesh dependent at the
+    first of the closed ends ``ends`` (:func:`closed_ends`; none: ``found`` as it is)."""
+    if not ends:
+        return found
+    names = set(checked_names(found)) | {SAFETY_FACTOR}
+    return [at_closed_end(e, ends[0]) if e.name in names and e.singular_at is None else e for e in found]
 
 
 def star(mesh: ng.Mesh, corners: np.ndarray) -> np.ndarray:
@@ -248,7 +267,7 @@ def check(found: list[DE.Estimate], sol: MacroSolution, samples: dict[str, DE.Sa
         return found
     ends = closed_ends(sol)
     if ends:
-        return [at_closed_end(e, ends[0]) if e.name in names and e.singular_at is None else e for e in found]
+        return at_closed_ends(found, ends)
     if levels < 1:
         return found
     mesh = sol.problem.mesh

@@ -130,9 +130,11 @@ def to_plain(obj, path: str = "results"):
 
 def _error_text(q: dict) -> str:
     """A quantity's error on the terminal line: ``+/- rel``, ``(no estimate)``, or where its value has no
-    limit (a stress maximum at a singular corner) ``(mesh dependent: singular at (x, y))``."""
+    limit (a stress maximum at a singular corner) ``(mesh dependent: singular at (x, y))``, followed by
+    ``not counted`` where the verdict does not count it."""
     if q.get("singular_at") is not None:
-        return "(mesh dependent: singular at (" + ", ".join(f"{c:.4g}" for c in q["singular_at"]) + "))"
+        text = "(mesh dependent: singular at (" + ", ".join(f"{c:.4g}" for c in q["singular_at"]) + "))"
+        return text + ("" if q.get("counted", True) else " not counted")
     if q.get("relative_error") is None:
         return "(no estimate)"
     return f"+/- {q['relative_error']:.2%}"
@@ -152,7 +154,7 @@ def accuracy_line(results: dict) -> str | None:
         rel = q.get("relative_error")
         if seen is None or rel is None or (seen.get("relative_error") is not None and rel > seen["relative_error"]):
             worst[q["name"]] = q
-    parts = [f"{n} {q['value']:.4g} " + _error_text(q) for n, q in worst.items()]
+    parts = [f"{n} {q['value']:.4g} " + _error_text(q) + _where(q) for n, q in worst.items()]
     verdict = "met" if acc.get("met") else "NOT met"
     refined = acc.get("refinement") or {}
     if refined.get("order") is not None:
@@ -161,7 +163,25 @@ def accuracy_line(results: dict) -> str | None:
     model = acc.get("modelling") or {}
     tail = (f"; modelling error of the homogenized interface ~ {model['relative_error']:.2%} (estimate C eps / L)"
             if model.get("relative_error") is not None else "")
-    return f"accuracy {verdict} (tolerance {acc['tolerance']:.3g}): " + ", ".join(parts) + tail
+    return f"accuracy {verdict} (tolerance {acc['tolerance']:.3g}): " + ", ".join(parts) + _away_text(acc) + tail
+
+
+def _where(q: dict) -> str:
+    """Where a maximum away from the singular points is attained (`` at (x, y)``), nothing for the others."""
+    if not str(q.get("name", "")).endswith("_away") or q.get("location") is None:
+        return ""
+    return " at (" + ", ".join(f"{c:.4g}" for c in q["location"]) + ")"
+
+
+def _away_text(acc: dict) -> str:
+    """What the maxima away from the singular points are and that the mesh-dependent ones are not counted
+    (``accuracy.exclusion``; nothing without it)."""
+    ex = acc.get("exclusion") or {}
+    if not ex.get("points"):
+        return ""
+    pts = ", ".join("(" + ", ".join(f"{c:.4g}" for c in p) + ")" for p in ex["points"])
+    return (f"; *_away: outside {ex['radius']:.3g} m of the singular points {pts} (counted; the mesh-dependent "
+            "maxima are listed, not counted)")
 
 
 def file_names(outcome: Outcome) -> list[str]:

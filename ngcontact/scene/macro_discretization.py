@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ngcontact.scene.schema import closed_interval, open_interval, param
+from ngcontact.scene.schema import closed_interval, open_interval, param, positive
 from ngcontact.scene.sections import Discretization
 
 #: the most uniform refinements a scene may ask for (3D: 8^4 = 4096 times the elements)
@@ -33,6 +33,14 @@ class MacroDiscretization(Discretization):
         "is refined where the stress error indicator is large, interface first (up to 12 levels and 2e6 "
         "unknowns; results.accuracy.refinement lists the levels, their order, mesh level and unknowns), and a "
         "tolerance out of reach ends the run (exit 3); default: 0.01, only judged (the scene's order is kept)")
+    exclusion_radius: float | None = param(None, check=positive(), units="m", doc="radius of the ball around each "
+        "singular point of the stress (where the interface ends closed on an unsupported boundary, a clamp meets an "
+        "unsupported boundary, a re-entrant corner) outside which each body's largest von Mises and Tresca stress and "
+        "the safety factor are also reported, with their own error estimates (von_mises_<body>_away, ..., "
+        "safety_factor_away in results.accuracy, with where each is attained; accuracy.exclusion lists the points): "
+        "these converge, so they count in accuracy.met and in a refinement's target, while the global maxima, mesh "
+        "dependent there, are listed with counted = false; 2D and axisymmetric runs without [two_scale]; must be "
+        "below the smallest extent of the bodies' bounding boxes; default: a quarter of that extent")
     refinements: int = param(0, check=closed_interval(0, MAX_REFINEMENTS), doc="uniform refinements of the "
         "mesh made with maxh: every element split this many times (a triangle into 4, a tetrahedron into 8, "
         "new boundary points on the geometry; h = maxh / 2^k), curved to order after the last; under mpiexec "
