@@ -9,7 +9,8 @@ import pytest
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
-from ngcontact.cell.fe.contact_edge_mesh import edge_points, edge_refined_cell
+from ngcontact.cell.fe.contact_edge_mesh import (LAYER_SPACING, PatchBody, edge_points, edge_refined_cell,
+                                                 patch_body, patch_radius)
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.errors import GeometryError
 from ngcontact.fem.materials import isotropic
@@ -40,6 +41,27 @@ def test_edge_points_ring_a_disk():
 def test_edge_maxh_beyond_the_interface_size_is_refused():
     with pytest.raises(GeometryError, match="edge_maxh"):
         edge_refined_cell(np.zeros((0, 2)), edge_maxh=0.3, maxh=0.4, interface_maxh=0.2)
+
+
+def test_patch_body_on_the_contact_points_of_a_disk():
+    """The points of a disk's grid, thinned to one per ``maxh``, inside the disk; the layers' heights 0 and
+    +-k LAYER_SPACING maxh to the depth; the radius of one patch of the disk's area."""
+    n = 64
+    s = np.arange(n) / n
+    p = np.where(np.hypot(s[None, :] - 0.5, s[:, None] - 0.5) < 0.2, 1.0, 0.0)
+    body = patch_body(p, 1.0, maxh=0.05, depth=0.35)
+    assert len(body.points) > 10
+    assert np.all(np.hypot(body.points[:, 0] - 0.5, body.points[:, 1] - 0.5) < 0.2)
+    assert len(body.points) < np.count_nonzero(p) / 4
+    np.testing.assert_allclose(np.sort(body.heights()), LAYER_SPACING * 0.05 * np.array([-2, -1, 0, 1, 2]))
+    assert abs(patch_radius(p, 1.0) - 0.2) < 0.01
+
+
+def test_patch_body_of_no_size_is_refused():
+    with pytest.raises(GeometryError, match="body maxh"):
+        PatchBody(points=np.zeros((1, 2)), maxh=0.0, depth=0.1)
+    with pytest.raises(GeometryError, match="body depth"):
+        PatchBody(points=np.zeros((1, 2)), maxh=0.1, depth=-1.0)
 
 
 def _interface_sizes(cell):
