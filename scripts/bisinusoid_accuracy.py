@@ -36,8 +36,8 @@ log = logging.getLogger("scaling_3d")
 
 ACC_H, ACC_RATIOS, ACC_EDGES, QUICK_EDGES, REF_GRIDS = 0.01, (0.005, 0.02, 0.05), (0.02, 0.01), (0.02,), (512, 1024)
 ACC_MAXH, ACC_INTERFACE, ACC_TWIN, ACC_ORDERS = 0.3, 0.1, 128, (1,)
-#: the ``patch`` method's sizes: edge ``a / 13``, bodies ``a / 10`` to ``0.9 a``
-ACC_PATCH = (13.0, 10.0, 0.9)
+#: the ``patch`` method's sizes: edge ``a / 13``, bodies ``a / 10`` to ``1.8 a``
+ACC_PATCH = (13.0, 10.0, 1.8)
 #: its bodies' size away from the patch
 PATCH_MAXH = 0.15
 

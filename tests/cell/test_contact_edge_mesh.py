@@ -143,3 +143,22 @@ def test_bisinusoid_extrapolated_in_the_edge_size_within_1_percent_of_the_conver
     ext = extrapolate(list(sizes), values)
     assert abs(ext.value / converged - 1.0) < 0.01
     assert abs(ext.value - converged) <= ext.estimate
+
+
+def _patch_refined(load, twin_grid: int, n_edge: float, n_body: float, depth: float, **sizes):
+    """The order-1 cell on the mesh refined along the twin's contact edge to ``a / n_edge`` and in the bodies
+    below and above its patch to ``a / n_body`` down to ``depth a`` (``a`` the twin's patch radius)."""
+    p = spectral(twin_grid).solve(load).fields["pressure"]
+    a = patch_radius(p, 1.0)
+    cell = edge_refined_cell(edge_points(p, 1.0), edge_maxh=a / n_edge,
+                             body=patch_body(p, 1.0, maxh=a / n_body, depth=depth * a), **sizes)
+    return CellProblem(cell, _model(1, a / n_edge)).solve(load, first=True, measure=False)
+
+
+def test_patch_refined_coarse_cell_against_the_spectral_cell():
+    """p/p* = 0.05, the edge at a/5, the bodies at a/4 to 0.75 a: within 6 % of the converged spectral cell's
+    contact fraction (docs/benchmarks.md, section scaling_3d: about -5 % at these sizes)."""
+    load = cell_load(3, pressure=0.05 * math.pi * H)
+    fe = _patch_refined(load, 64, 5.0, 4.0, 0.75, maxh=0.4, interface_maxh=0.2).results["contact_fraction"]
+    reference = spectral(512).solve(load).results["contact_fraction"]
+    assert abs(fe / reference - 1.0) < 0.06

@@ -39,11 +39,12 @@ patch radius ``a``).  A :class:`PatchBody` restricts the mesh size to
 thinned to about one per ``maxh``) on ``S_C`` and at the same points in
 layers ``LAYER_SPACING * maxh`` apart down into the rough body and up
 into the counter body to ``depth``; Netgen's grading fills between the
-layers.  Both sizes scale with ``a``: the error of the contact fraction is
-a function of ``edge_maxh / a`` and ``maxh / a``
-(docs/benchmarks.md, section ``scaling_3d``).  Order-2 bodies on a linear trace on ``S_C``
-(:mod:`ngcontact.cell.fe.linear_trace`) remove most of it; what is left is
-the node-to-node contact set's own error, the contact edge placed within a
+layers.  The sizes scale with ``a``: the error of the contact fraction is
+a function of ``edge_maxh / a``, ``maxh / a`` and ``depth / a`` (the
+bisinusoid's figures: docs/benchmarks.md, section ``scaling_3d``).  Order-2
+bodies on a linear trace on ``S_C`` (:mod:`ngcontact.cell.fe.linear_trace`)
+are the other way to lower the bodies' error; what is left then is the
+node-to-node contact set's own error, the contact edge placed within a
 part of ``edge_maxh`` (:mod:`ngcontact.cell.fe.exact_contact_set`), which
 falls with ``edge_maxh``.
 """
