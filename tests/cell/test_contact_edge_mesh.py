@@ -162,3 +162,15 @@ def test_patch_refined_coarse_cell_against_the_spectral_cell():
     fe = _patch_refined(load, 64, 5.0, 4.0, 0.75, maxh=0.4, interface_maxh=0.2).results["contact_fraction"]
     reference = spectral(512).solve(load).results["contact_fraction"]
     assert abs(fe / reference - 1.0) < 0.06
+
+
+@pytest.mark.slow  # ~100k dofs at order 1: minutes under load
+def test_patch_refined_cell_within_1_percent_of_the_converged_spectral_cell():
+    """p/p* = 0.005, the edge at a/13, the bodies at a/10 to 1.8 a (scripts/bisinusoid_accuracy.py's
+    ``ACC_PATCH``): within 1 % of the spectral cell's contact fraction extrapolated from 512^2 and 1024^2
+    (issue 38's aim at this load)."""
+    load = cell_load(3, pressure=0.005 * math.pi * H)
+    converged = 2.0 * spectral(1024).solve(load).results["contact_fraction"] \
+        - spectral(512).solve(load).results["contact_fraction"]
+    fe = _patch_refined(load, 128, 13.0, 10.0, 1.8, maxh=0.15, interface_maxh=0.1).results["contact_fraction"]
+    assert abs(fe / converged - 1.0) < 0.01
