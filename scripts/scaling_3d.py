@@ -19,20 +19,15 @@ Four measurements, one run, one CSV and one PNG:
    fraction against wall time.
 
 4. **Accuracy aim** (issue 38: within 1 % of the converged contact fraction
-   at ``p/p* = 0.005, 0.02, 0.05`` in at most 60 s each): the bisinusoid
-   ``h (2 - cos 2 pi x - cos 2 pi y)``, ``h = 0.01``, two layers 1 deep with
-   ``E* = 1``, ``p* = pi E* h / P``; the FE cell with exact contact on the
-   mesh refined along its spectral twin's contact edge
-   (:mod:`ngcontact.cell.fe.contact_edge_mesh`, twin on ``128^2``), order 1
-   and order 2 on a linear trace on ``S_C``
-   (:mod:`ngcontact.cell.fe.linear_trace`), the edge's element size refined
-   (``--accuracy-edges``), and with two or more sizes the Richardson
-   extrapolation in the edge size
-   (:mod:`ngcontact.cell.fe.edge_size_extrapolation`, column ``estimate``
-   its estimated relative error); the converged value is the spectral cell's
-   contact fraction extrapolated from ``512^2`` and ``1024^2`` (its grid
-   counting errs by one order in the spacing).  Column ``relative_error``;
-   the seconds include the twin, the meshing and the solve.
+   at ``p/p* = 0.005, 0.02, 0.05`` in at most 60 s each): the FE cell with
+   exact contact on the bisinusoid against the converged spectral cell,
+   its mesh refined along its spectral twin's contact edge (``edge`` rows,
+   ``--accuracy-edges``, ``--accuracy-orders``) or, order 1, along the edge
+   and in the bodies below and above the patch, the sizes scaled with the
+   patch radius (``patch`` rows, ``--accuracy-patch``); the sibling module
+   ``bisinusoid_accuracy.py`` says what is solved.  Column
+   ``relative_error``; the seconds include the twin, the meshing and the
+   solve (threads: ``--accuracy-threads``).
 
 Every solve of parts 1 and 2 runs in its own child process, so that its peak
 memory (``VmHWM``) is its own.  Reported per solve: dofs, wall time of the
@@ -58,6 +53,8 @@ product with the tangent, the size of BDDC's coarse problem) and writes
 Usage::
 
     python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral accuracy]
+                                 [--accuracy-edges [EDGE_MAXH ...]] [--accuracy-orders 1 2]
+                                 [--accuracy-patch N_EDGE N_BODY DEPTH | --accuracy-no-patch] [--accuracy-threads N]
                                  [--solvers iterative direct] [--breakdown INTERFACE_MAXH]
                                  [--coarse INTERFACE_MAXH [--k-n K]] [--republish CSV]
 
@@ -67,10 +64,8 @@ Writes ``scaling_3d.csv`` and ``scaling_3d.png`` into ``OUT_DIR`` (default
 from __future__ import annotations
 
 import argparse
-import itertools
 import json
 import logging
-import math
 import os
 import subprocess
 import sys
@@ -82,6 +77,7 @@ from ngcontact.output.writer import write_csv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+from bisinusoid_accuracy import ACC_EDGES, ACC_PATCH, QUICK_EDGES, accuracy_aim, extrapolated_rows  # noqa: E402
 
 log = logging.getLogger("scaling_3d")
 
@@ -95,12 +91,6 @@ AMPLITUDE, PRESSURES = 0.005, (0.00185, 0.0065)
 SPECTRAL_GRIDS, TAMAAS_GRID = (64, 128, 256, 512), 1024
 KEYS = ("part", "solver", "size", "ndof", "seconds", "measure_seconds", "newton_steps", "cg_iterations",
         "peak_memory_gb", "contact_fraction", "pressure", "relative_error", "estimate")
-# part 4, the accuracy aim: the bisinusoid h (2 - cos 2 pi x - cos 2 pi y), h = 0.01, E* = 1, layers 1 deep,
-# at p/p* with p* = pi E* h / P; FE exact on the edge-refined mesh (edge sizes; order 1, and order 2 on a linear
-# trace on S_C), the converged value the
-# spectral cell's Richardson extrapolation 2 f(REF_GRIDS[1]) - f(REF_GRIDS[0]) (first-order grid counting)
-ACC_H, ACC_RATIOS, ACC_EDGES, QUICK_EDGES, REF_GRIDS = 0.01, (0.005, 0.02, 0.05), (0.02, 0.01), (0.02,), (512, 1024)
-ACC_MAXH, ACC_INTERFACE, ACC_TWIN, ACC_ORDERS = 0.3, 0.1, 128, (1, 2)
 
 
 def peak_memory_gb() -> float:
@@ -236,76 +226,6 @@ def spectral_aim(quick: bool) -> list[dict]:
                      "seconds": time.perf_counter() - t0, "newton_steps": "", "cg_iterations": "",
                      "peak_memory_gb": "", "contact_fraction": float(np.mean(tr > 0)), "pressure": p})
     return rows
-
-
-def _bisinusoid_spectral(grid: int):
-    from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
-    from ngcontact.geometry.cell3d import bisinusoid_gap
-    nu, s = 0.3, np.arange(grid) / grid
-    E = 2.0 * (1.0 - nu ** 2)                  # E* = 1 for two equal bodies
-    layer = Layer(E, nu, 1.0)
-    return SpectralCell(dim=3, period=1.0, grid=grid, rough=layer, counter=layer, k_n=1.0, enforcement="exact",
-                        gap=bisinusoid_gap(ACC_H, 1.0, xy=(s[None, :], s[:, None])))
-
-
-def accuracy_aim(edges) -> list[dict]:
-    """Part 4: the FE cell (exact; order 1, order 2 on a linear trace) on the mesh refined along its spectral
-    twin's contact edge
-    (:mod:`ngcontact.cell.fe.contact_edge_mesh`) against the converged bisinusoid, per load: seconds (twin,
-    meshing and solve), dofs, relative error of the contact fraction."""
-    from ngcontact import runner
-    from ngcontact.cell.cell_load import cell_load
-    from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
-    from ngcontact.cell.fe.contact_edge_mesh import edge_points, edge_refined_cell
-    from ngcontact.fem.materials import isotropic
-    from ngcontact.geometry.cell3d import bisinusoid_gap
-    from ngcontact.solvers.linear_solver import LinearSolver
-    loads = [cell_load(3, pressure=r * math.pi * ACC_H) for r in ACC_RATIOS]
-    coarse, fine = (_bisinusoid_spectral(n) for n in REF_GRIDS)
-    converged = [2.0 * fine.solve(ld).results["contact_fraction"] - coarse.solve(ld).results["contact_fraction"]
-                 for ld in loads]
-    law = isotropic(2.0 * (1.0 - 0.3 ** 2), 0.3)
-    twin = _bisinusoid_spectral(ACC_TWIN)
-    rows = []
-    for edge, order, (ratio, ld, ref) in itertools.product(edges, ACC_ORDERS, zip(ACC_RATIOS, loads, converged)):
-        with runner.threads(runner.thread_count()):
-            t0 = time.perf_counter()
-            pts = edge_points(twin.solve(ld).fields["pressure"], 1.0)
-            cell = edge_refined_cell(pts, edge_maxh=edge, maxh=ACC_MAXH, interface_maxh=ACC_INTERFACE)
-            model = CellModel(rough=law, counter=law, k_n=100.0 * law.lame[1] / edge, order=order,
-                              gap=bisinusoid_gap(ACC_H, 1.0), enforcement="exact", linear_trace=order > 1)
-            P = CellProblem(cell, model, linear=LinearSolver("auto"))
-            sol = P.solve(ld, first=True, measure=False)
-            secs = time.perf_counter() - t0
-        f = float(sol.results["contact_fraction"])
-        rows.append({"part": "accuracy", "solver": f"fe exact order {order}, edge-refined", "size": edge,
-                     "ndof": P.ndof, "seconds": secs, "newton_steps": sol.iterations, "contact_fraction": f,
-                     "pressure": ratio, "relative_error": f / ref - 1.0})
-        log.info("accuracy: order %d p/p* %-6g edge size %-5g ndof %7d: fraction %.6f (converged %.6f, %+.2f %%), "
-                 "%.1f s", order, ratio, edge, P.ndof, f, ref, 100.0 * (f / ref - 1.0), secs)
-    return rows + extrapolated_rows(rows, dict(zip(ACC_RATIOS, converged)))
-
-
-def extrapolated_rows(rows: list[dict], converged: dict) -> list[dict]:
-    """Per load solved at order 2 (on a linear trace) at two or more edge sizes: the Richardson extrapolation
-    in the edge size (:mod:`ngcontact.cell.fe.edge_size_extrapolation`), its seconds the sum of the solves', its
-    dofs the finest's, ``estimate`` its estimated relative error.  Order 1 is left out: its error is two
-    opposite errors (too stiff a body, a contact set past the edge), not a power of the edge size."""
-    from ngcontact.cell.fe.edge_size_extrapolation import extrapolate
-    out = []
-    for solver, ratio in sorted({(r["solver"], r["pressure"]) for r in rows if "order 1" not in r["solver"]}):
-        sel = [r for r in rows if r["solver"] == solver and r["pressure"] == ratio]
-        if len(sel) < 2:
-            continue
-        ext = extrapolate([r["size"] for r in sel], [r["contact_fraction"] for r in sel])
-        finest = min(sel, key=lambda r: r["size"])
-        out.append({"part": "accuracy", "solver": solver + ", extrapolated",
-                    "size": " ".join(f"{r['size']:g}" for r in sel), "ndof": finest["ndof"],
-                    "seconds": sum(r["seconds"] for r in sel), "contact_fraction": ext.value, "pressure": ratio,
-                    "relative_error": ext.value / converged[ratio] - 1.0, "estimate": ext.estimate / ext.value})
-        log.info("accuracy: %s p/p* %g extrapolated (%s): %+.2f %% (estimate %.2f %%), %.1f s", solver, ratio, ext.how,
-                 100.0 * out[-1]["relative_error"], 100.0 * out[-1]["estimate"], out[-1]["seconds"])
-    return out
 
 
 def republished_rows(path: str) -> list[dict]:
@@ -539,7 +459,9 @@ def measured_rows(args) -> list[dict]:
     if "spectral" in args.parts:
         rows += spectral_aim(args.quick)
     if "accuracy" in args.parts:
-        rows += accuracy_aim(args.accuracy_edges or (QUICK_EDGES if args.quick else ACC_EDGES))
+        edges = args.accuracy_edges if args.accuracy_edges is not None else QUICK_EDGES if args.quick else ACC_EDGES
+        rows += accuracy_aim(edges, tuple(args.accuracy_orders), None if args.accuracy_no_patch else
+                             tuple(args.accuracy_patch), args.accuracy_threads)
     return rows
 
 
@@ -563,8 +485,17 @@ def main(argv=None) -> int:
     ap.add_argument("--coarse", type=float, default=None, metavar="INTERFACE_MAXH",
                     help="instead: BDDC's coarse problem on the converged cell of this interface mesh size, the "
                          "bubble term's gamma against the contact surface on the wirebasket")
-    ap.add_argument("--accuracy-edges", type=float, nargs="+", default=None, metavar="EDGE_MAXH",
-                    help="the edge element sizes of part 4 (default 0.02 0.01; --quick: 0.02)")
+    ap.add_argument("--accuracy-edges", type=float, nargs="*", default=None, metavar="EDGE_MAXH",
+                    help="the edge element sizes of part 4's edge-refined rows (default 0.02 0.01; --quick: 0.02; "
+                         "none: no such rows)")
+    ap.add_argument("--accuracy-orders", type=int, nargs="+", default=(1,), choices=(1, 2),
+                    help="the orders of part 4's edge-refined rows (2: on a linear trace; default 1)")
+    ap.add_argument("--accuracy-patch", type=float, nargs=3, default=ACC_PATCH, metavar=("N_EDGE", "N_BODY", "DEPTH"),
+                    help="part 4's patch-refined rows: edge a/N_EDGE, bodies a/N_BODY to DEPTH a, a the twin's patch "
+                         "radius (default %s)" % " ".join(f"{v:g}" for v in ACC_PATCH))
+    ap.add_argument("--accuracy-no-patch", action="store_true", help="no patch-refined rows in part 4")
+    ap.add_argument("--accuracy-threads", type=int, default=None,
+                    help="threads of part 4's FE solves (default: as ngcontact run)")
     ap.add_argument("--k-n", type=float, default=None, help="with --coarse: the penalty k_n (default the scene's)")
     ap.add_argument("--republish", metavar="CSV", default=None,
                     help="instead of measuring: the rows an earlier run measured (its scaling_3d.csv), the rows "
@@ -617,14 +548,18 @@ def main(argv=None) -> int:
                                    "Cholesky (`direct`) and BDDC-CG (`iterative`), started as `ngcontact run` "
                                    "starts it; part `macro`: a 3D press fit of two tubes; part `spectral`: the "
                                    "spectral cell against Tamaas (skipped without the `bench` extra); part `accuracy`: "
-                                   "the FE cell (exact; order 1, order 2 on a linear trace on S_C) on the mesh "
-                                   "refined along its spectral twin's contact edge (`size`: the edge's element "
-                                   "size; rows `extrapolated`, order 2 only: Richardson in the edge size over the "
-                                   "sizes listed, "
-                                   "`estimate` its estimated relative error), per `pressure` = p/p* "
+                                   "the FE cell (exact) on the mesh refined along its spectral twin's contact edge "
+                                   "(`edge-refined`, `size`: the edge's element size; order 1, or order 2 on a "
+                                   "linear trace on S_C with rows `extrapolated`: Richardson in the edge size "
+                                   "over the sizes listed, `estimate` its estimated relative error) or, order 1, "
+                                   "along the edge and in the bodies below and above the patch (`patch-refined`, "
+                                   "`size`: edge a/N_EDGE, bodies a/N_BODY to DEPTH a, a the twin's patch radius), "
+                                   "per `pressure` = p/p* "
                                    "(p* = pi E* h, h = 0.01, E* = 1), `relative_error` of the contact fraction "
                                    "against the spectral cell extrapolated from 512^2 and 1024^2 (issue 38 aims "
-                                   "at 1 % in 60 s); timings under the load of other jobs. Seconds of "
+                                   "at 1 % in 60 s; seconds: twin, meshing and solve" + (
+                                       f", {args.accuracy_threads} thread(s)" if args.accuracy_threads else "") +
+                                   "); timings under the load of other jobs. Seconds of "
                                    "setup and solve, of the measurement after it, Newton steps, CG iterations, "
                                    "peak memory. Fitted: " + ("; ".join(fits) if fits else "none") + ".",
                               png=os.path.join(args.out, "scaling_3d.png"))

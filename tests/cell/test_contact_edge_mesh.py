@@ -9,7 +9,8 @@ import pytest
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
-from ngcontact.cell.fe.contact_edge_mesh import edge_points, edge_refined_cell
+from ngcontact.cell.fe.contact_edge_mesh import (LAYER_SPACING, PatchBody, edge_points, edge_refined_cell,
+                                                 patch_body, patch_radius)
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.errors import GeometryError
 from ngcontact.fem.materials import isotropic
@@ -40,6 +41,27 @@ def test_edge_points_ring_a_disk():
 def test_edge_maxh_beyond_the_interface_size_is_refused():
     with pytest.raises(GeometryError, match="edge_maxh"):
         edge_refined_cell(np.zeros((0, 2)), edge_maxh=0.3, maxh=0.4, interface_maxh=0.2)
+
+
+def test_patch_body_on_the_contact_points_of_a_disk():
+    """The points of a disk's grid, thinned to one per ``maxh``, inside the disk; the layers' heights 0 and
+    +-k LAYER_SPACING maxh to the depth; the radius of one patch of the disk's area."""
+    n = 64
+    s = np.arange(n) / n
+    p = np.where(np.hypot(s[None, :] - 0.5, s[:, None] - 0.5) < 0.2, 1.0, 0.0)
+    body = patch_body(p, 1.0, maxh=0.05, depth=0.35)
+    assert len(body.points) > 10
+    assert np.all(np.hypot(body.points[:, 0] - 0.5, body.points[:, 1] - 0.5) < 0.2)
+    assert len(body.points) < np.count_nonzero(p) / 4
+    np.testing.assert_allclose(np.sort(body.heights()), LAYER_SPACING * 0.05 * np.array([-2, -1, 0, 1, 2]))
+    assert abs(patch_radius(p, 1.0) - 0.2) < 0.01
+
+
+def test_patch_body_of_no_size_is_refused():
+    with pytest.raises(GeometryError, match="body maxh"):
+        PatchBody(points=np.zeros((1, 2)), maxh=0.0, depth=0.1)
+    with pytest.raises(GeometryError, match="body depth"):
+        PatchBody(points=np.zeros((1, 2)), maxh=0.1, depth=-1.0)
 
 
 def _interface_sizes(cell):
@@ -121,3 +143,34 @@ def test_bisinusoid_extrapolated_in_the_edge_size_within_1_percent_of_the_conver
     ext = extrapolate(list(sizes), values)
     assert abs(ext.value / converged - 1.0) < 0.01
     assert abs(ext.value - converged) <= ext.estimate
+
+
+def _patch_refined(load, twin_grid: int, n_edge: float, n_body: float, depth: float, **sizes):
+    """The order-1 cell on the mesh refined along the twin's contact edge to ``a / n_edge`` and in the bodies
+    below and above its patch to ``a / n_body`` down to ``depth a`` (``a`` the twin's patch radius)."""
+    p = spectral(twin_grid).solve(load).fields["pressure"]
+    a = patch_radius(p, 1.0)
+    cell = edge_refined_cell(edge_points(p, 1.0), edge_maxh=a / n_edge,
+                             body=patch_body(p, 1.0, maxh=a / n_body, depth=depth * a), **sizes)
+    return CellProblem(cell, _model(1, a / n_edge)).solve(load, first=True, measure=False)
+
+
+def test_patch_refined_coarse_cell_against_the_spectral_cell():
+    """p/p* = 0.05, the edge at a/5, the bodies at a/4 to 0.75 a: within 6 % of the converged spectral cell's
+    contact fraction (docs/benchmarks.md, section scaling_3d: about -5 % at these sizes)."""
+    load = cell_load(3, pressure=0.05 * math.pi * H)
+    fe = _patch_refined(load, 64, 5.0, 4.0, 0.75, maxh=0.4, interface_maxh=0.2).results["contact_fraction"]
+    reference = spectral(512).solve(load).results["contact_fraction"]
+    assert abs(fe / reference - 1.0) < 0.06
+
+
+@pytest.mark.slow  # ~100k dofs at order 1: minutes under load
+def test_patch_refined_cell_within_1_percent_of_the_converged_spectral_cell():
+    """p/p* = 0.005, the edge at a/13, the bodies at a/10 to 1.8 a (scripts/bisinusoid_accuracy.py's
+    ``ACC_PATCH``): within 1 % of the spectral cell's contact fraction extrapolated from 512^2 and 1024^2
+    (issue 38's aim at this load)."""
+    load = cell_load(3, pressure=0.005 * math.pi * H)
+    converged = 2.0 * spectral(1024).solve(load).results["contact_fraction"] \
+        - spectral(512).solve(load).results["contact_fraction"]
+    fe = _patch_refined(load, 128, 13.0, 10.0, 1.8, maxh=0.15, interface_maxh=0.1).results["contact_fraction"]
+    assert abs(fe / converged - 1.0) < 0.01

@@ -29,18 +29,29 @@ the order of its radius, where the Hertz field decays) are refined with it.
 The restriction is applied on both sides of the periodic faces alike (the
 twin's grid is periodic), so the identified faces mesh the same.
 
-What remains.  With order-1 bodies the refined mesh leaves the bodies'
-stiffness error: order-1 tetrahedra are too stiff, the patch comes out too
-small, and that error falls with the body's element size below the patch,
-not with the edge's.  Order-2 bodies on a linear trace on ``S_C``
-(:mod:`ngcontact.cell.fe.linear_trace`) remove most of it; what is left is
-the node-to-node contact set's own error, the contact edge placed within a
+The bodies below the patch (:class:`PatchBody`, :func:`patch_body`).  With
+order-1 bodies the edge refinement alone leaves the bodies' stiffness
+error: order-1 tetrahedra are too stiff, the patch comes out too small,
+and that error falls with the body's element size below the patch, not
+with the edge's (the Hertz field decays over a depth of the order of the
+patch radius ``a``).  A :class:`PatchBody` restricts the mesh size to
+``maxh`` at the twin's contact points (its grid points carrying pressure,
+thinned to about one per ``maxh``) on ``S_C`` and at the same points in
+layers ``LAYER_SPACING * maxh`` apart down into the rough body and up
+into the counter body to ``depth``; Netgen's grading fills between the
+layers.  The sizes scale with ``a``: the error of the contact fraction is
+a function of ``edge_maxh / a``, ``maxh / a`` and ``depth / a`` (the
+bisinusoid's figures: docs/benchmarks.md, section ``scaling_3d``).  Order-2
+bodies on a linear trace on ``S_C`` (:mod:`ngcontact.cell.fe.linear_trace`)
+are the other way to lower the bodies' error; what is left then is the
+node-to-node contact set's own error, the contact edge placed within a
 part of ``edge_maxh`` (:mod:`ngcontact.cell.fe.exact_contact_set`), which
 falls with ``edge_maxh``.
 """
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 import ngsolve as ng
@@ -53,6 +64,8 @@ from ngcontact.geometry.cell2d import Cell, periodic_maxh
 
 log = logging.getLogger(__name__)
 
+#: distance of the layers of a :class:`PatchBody` restriction, in its element sizes
+LAYER_SPACING = 3.0
 #: points of a restriction closer than this (relative to the period) to a periodic face are moved off it
 FACE_CLEARANCE = 1e-6
 
@@ -79,8 +92,54 @@ def edge_points(pressure: np.ndarray, period: float) -> np.ndarray:
     return np.concatenate(out) if out else np.empty((0, 2))
 
 
+@dataclass(frozen=True)
+class PatchBody:
+    """The bodies below and above the contact patches meshed at ``maxh`` to ``depth`` (module docstring).
+
+    ``points``: ``(m, 2)`` points ``(x, y)`` of the patches on ``S_C``.
+    """
+
+    points: np.ndarray
+    maxh: float
+    depth: float
+
+    def __post_init__(self):
+        if not (np.isfinite(self.maxh) and self.maxh > 0):
+            raise GeometryError("body maxh", self.maxh, "must be > 0")
+        if not (np.isfinite(self.depth) and self.depth >= 0):
+            raise GeometryError("body depth", self.depth, "must be >= 0")
+
+    def heights(self) -> np.ndarray:
+        """The ``z`` of the layers: ``0`` and ``+-k LAYER_SPACING maxh`` up to ``depth``."""
+        k = np.arange(1, int(np.floor(self.depth / (LAYER_SPACING * self.maxh) + 1e-9)) + 1)
+        z = LAYER_SPACING * self.maxh * k
+        return np.concatenate(([0.0], -z, z))
+
+
+def patch_body(pressure: np.ndarray, period: float, *, maxh: float, depth: float) -> PatchBody:
+    """A :class:`PatchBody` on the contact points of a periodic ``n_y x n_x`` pressure grid (as for
+    :func:`edge_points`): the grid points carrying pressure, every ``s``-th along each axis with ``s`` the
+    grid steps in ``maxh`` (at least 1)."""
+    p = np.asarray(pressure, float)
+    if p.ndim != 2:
+        raise ValueError(f"pressure has shape {p.shape}: a 2D grid of a 3D cell is needed")
+    ny, nx = p.shape
+    stride = max(1, int(maxh * min(nx, ny) / period))
+    i, j = np.nonzero(p > 0.0)
+    keep = (i % stride == 0) & (j % stride == 0)
+    pts = np.stack((j[keep] * period / nx, i[keep] * period / ny), axis=1)
+    return PatchBody(points=pts, maxh=float(maxh), depth=float(depth))
+
+
+def patch_radius(pressure: np.ndarray, period: float) -> float:
+    """``a = P sqrt(f / pi)``: the radius of one round patch of the grid's contact fraction ``f`` (the
+    length the sizes of :func:`edge_refined_cell` scale with on a cell of one patch, module docstring)."""
+    return float(period) * float(np.sqrt(np.mean(np.asarray(pressure) > 0.0) / np.pi))
+
+
 def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1.0, h_rough: float = 1.0,
-                      h_counter: float = 1.0, maxh: float, interface_maxh: float) -> Cell:
+                      h_counter: float = 1.0, maxh: float, interface_maxh: float,
+                      body: PatchBody | None = None) -> Cell:
     """The flat periodic 3D cell (:func:`~ngcontact.geometry.cell3d.flat_cell3d`) with its mesh size
     restricted to ``edge_maxh`` at ``points`` on ``S_C`` (module docstring).
 
@@ -92,6 +151,8 @@ def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1
         Element size at the edge points (``<= interface_maxh``).
     period, h_rough, h_counter, maxh, interface_maxh
         As for :func:`~ngcontact.geometry.cell3d.flat_cell3d`.
+    body
+        The bodies below and above the patches refined too (:class:`PatchBody`), or ``None``.
     """
     if not (np.isfinite(edge_maxh) and 0 < edge_maxh <= interface_maxh):
         raise GeometryError("edge_maxh", edge_maxh, f"must be > 0 and <= interface_maxh = {interface_maxh}")
@@ -108,6 +169,12 @@ def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1
     pts = np.clip(np.asarray(points, float).reshape(-1, 2) % P, FACE_CLEARANCE * P, (1.0 - FACE_CLEARANCE) * P)
     for x, y in pts:
         mp.RestrictH(x=float(x), y=float(y), z=0.0, h=float(edge_maxh))
+    if body is not None:
+        below = np.clip(np.asarray(body.points, float).reshape(-1, 2) % P, FACE_CLEARANCE * P,
+                        (1.0 - FACE_CLEARANCE) * P)
+        for z in body.heights():
+            for x, y in below:
+                mp.RestrictH(x=float(x), y=float(y), z=float(z), h=float(body.maxh))
     ngmesh = geo.GenerateMesh(mp=mp)
     cell3d._name_faces(ngmesh)
     mesh = ng.Mesh(ngmesh)

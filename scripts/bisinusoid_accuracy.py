@@ -1,0 +1,146 @@
+"""Part 4 of ``scaling_3d.py``: the 3D FE cell's contact fraction on the bisinusoid against the converged value.
+
+The bisinusoid ``h (2 - cos 2 pi x - cos 2 pi y)``, ``h = 0.01``, two layers
+1 deep with ``E* = 1`` (``E = 2 (1 - nu^2)``, ``nu = 0.3``), bottom clamped,
+top a rigid plate, mean pressure ``p/p*`` with ``p* = pi E* h / P``
+(issue 38 aims at 1 % of the converged contact fraction at ``p/p* = 0.005,
+0.02, 0.05`` in at most 60 s each).  The FE cell (small slope: the flat
+cell with the gap ``g0``, the same problem as the spectral cell's) with
+exact contact, started from the spectral twin on ``128^2``:
+
+* ``edge``: the mesh refined along the twin's contact edge to the edge
+  sizes asked for (:func:`ngcontact.cell.fe.contact_edge_mesh.edge_refined_cell`),
+  the bodies at ``maxh = 0.3``; order 1, and order 2 on a linear trace on
+  ``S_C`` (:mod:`ngcontact.cell.fe.linear_trace`) where asked, with
+  Richardson's extrapolation in the edge size over two or more sizes
+  (:mod:`ngcontact.cell.fe.edge_size_extrapolation`);
+* ``patch``: order 1, the sizes scaled with the twin's patch radius ``a``
+  (:func:`~ngcontact.cell.fe.contact_edge_mesh.patch_radius`): the edge at
+  ``a / n_edge`` and the bodies below and above the patch at ``a / n_body``
+  to a depth ``d a`` (:class:`~ngcontact.cell.fe.contact_edge_mesh.PatchBody`).
+
+The converged value is the spectral cell's contact fraction extrapolated
+from ``512^2`` and ``1024^2`` (its grid counting errs by one order in the
+spacing).  Seconds: twin, meshing and solve, with the threads asked for.
+"""
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+import time
+
+import numpy as np
+
+log = logging.getLogger("scaling_3d")
+
+ACC_H, ACC_RATIOS, ACC_EDGES, QUICK_EDGES, REF_GRIDS = 0.01, (0.005, 0.02, 0.05), (0.02, 0.01), (0.02,), (512, 1024)
+ACC_MAXH, ACC_INTERFACE, ACC_TWIN, ACC_ORDERS = 0.3, 0.1, 128, (1,)
+#: the ``patch`` method's sizes: edge ``a / 13``, bodies ``a / 10`` to ``1.8 a``
+ACC_PATCH = (13.0, 10.0, 1.8)
+#: its bodies' size away from the patch
+PATCH_MAXH = 0.15
+
+
+def bisinusoid_spectral(grid: int):
+    """The spectral cell of the bisinusoid (module docstring) on a ``grid x grid`` grid."""
+    from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
+    from ngcontact.geometry.cell3d import bisinusoid_gap
+    nu, s = 0.3, np.arange(grid) / grid
+    E = 2.0 * (1.0 - nu ** 2)                  # E* = 1 for two equal bodies
+    layer = Layer(E, nu, 1.0)
+    return SpectralCell(dim=3, period=1.0, grid=grid, rough=layer, counter=layer, k_n=1.0, enforcement="exact",
+                        gap=bisinusoid_gap(ACC_H, 1.0, xy=(s[None, :], s[:, None])))
+
+
+def _fe_solve(cell, order: int, edge: float, load, threads: int) -> tuple[object, object]:
+    from ngcontact import runner
+    from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
+    from ngcontact.fem.materials import isotropic
+    from ngcontact.geometry.cell3d import bisinusoid_gap
+    from ngcontact.solvers.linear_solver import LinearSolver
+    law = isotropic(2.0 * (1.0 - 0.3 ** 2), 0.3)
+    model = CellModel(rough=law, counter=law, k_n=100.0 * law.lame[1] / edge, order=order,
+                      gap=bisinusoid_gap(ACC_H, 1.0), enforcement="exact", linear_trace=order > 1)
+    with runner.threads(threads):
+        P = CellProblem(cell, model, linear=LinearSolver("auto"))
+        return P, P.solve(load, first=True, measure=False)
+
+
+def _row(solver: str, size, P, sol, seconds: float, ratio: float, ref: float) -> dict:
+    f = float(sol.results["contact_fraction"])
+    log.info("accuracy: %s p/p* %-6g size %-12s ndof %7d: fraction %.6f (converged %.6f, %+.2f %%), %.1f s",
+             solver, ratio, size, P.ndof, f, ref, 100.0 * (f / ref - 1.0), seconds)
+    return {"part": "accuracy", "solver": solver, "size": size, "ndof": P.ndof, "seconds": seconds,
+            "newton_steps": sol.iterations, "contact_fraction": f, "pressure": ratio, "relative_error": f / ref - 1.0}
+
+
+def edge_rows(edges, orders, threads: int, loads, converged) -> list[dict]:
+    """The ``edge`` method (module docstring), per edge size, order and load."""
+    from ngcontact.cell.fe.contact_edge_mesh import edge_points, edge_refined_cell
+    twin, rows = bisinusoid_spectral(ACC_TWIN), []
+    for edge, order, (ratio, ld, ref) in itertools.product(edges, orders, zip(ACC_RATIOS, loads, converged)):
+        t0 = time.perf_counter()
+        pts = edge_points(twin.solve(ld).fields["pressure"], 1.0)
+        cell = edge_refined_cell(pts, edge_maxh=edge, maxh=ACC_MAXH, interface_maxh=ACC_INTERFACE)
+        P, sol = _fe_solve(cell, order, edge, ld, threads)
+        rows.append(_row(f"fe exact order {order}, edge-refined", edge, P, sol, time.perf_counter() - t0,
+                         ratio, ref))
+    return rows
+
+
+def patch_rows(patch, threads: int, loads, converged) -> list[dict]:
+    """The ``patch`` method (module docstring) per load; ``patch = (n_edge, n_body, d)``."""
+    from ngcontact.cell.fe.contact_edge_mesh import edge_points, edge_refined_cell, patch_body, patch_radius
+    twin, rows = bisinusoid_spectral(ACC_TWIN), []
+    n_edge, n_body, depth = patch
+    for ratio, ld, ref in zip(ACC_RATIOS, loads, converged):
+        t0 = time.perf_counter()
+        p = twin.solve(ld).fields["pressure"]
+        a = patch_radius(p, 1.0)
+        body = patch_body(p, 1.0, maxh=a / n_body, depth=depth * a)
+        cell = edge_refined_cell(edge_points(p, 1.0), edge_maxh=a / n_edge, maxh=PATCH_MAXH,
+                                 interface_maxh=ACC_INTERFACE, body=body)
+        P, sol = _fe_solve(cell, 1, a / n_edge, ld, threads)
+        rows.append(_row("fe exact order 1, patch-refined", f"a/{n_edge:g} a/{n_body:g} {depth:g}a", P, sol,
+                         time.perf_counter() - t0, ratio, ref))
+    return rows
+
+
+def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None = None) -> list[dict]:
+    """Part 4 (module docstring): the ``edge`` rows, the ``patch`` rows (``patch = None``: none) and the
+    extrapolations in the edge size of the order-2 ``edge`` rows; per load: seconds, dofs, relative error
+    of the contact fraction."""
+    from ngcontact import runner
+    from ngcontact.cell.cell_load import cell_load
+    loads = [cell_load(3, pressure=r * math.pi * ACC_H) for r in ACC_RATIOS]
+    coarse, fine = (bisinusoid_spectral(n) for n in REF_GRIDS)
+    converged = [2.0 * fine.solve(ld).results["contact_fraction"] - coarse.solve(ld).results["contact_fraction"]
+                 for ld in loads]
+    threads = runner.thread_count() if threads is None else threads
+    rows = edge_rows(edges, orders, threads, loads, converged) if edges else []
+    if patch is not None:
+        rows += patch_rows(patch, threads, loads, converged)
+    return rows + extrapolated_rows(rows, dict(zip(ACC_RATIOS, converged)))
+
+
+def extrapolated_rows(rows: list[dict], converged: dict) -> list[dict]:
+    """Per load solved at order 2 (on a linear trace) at two or more edge sizes: the Richardson extrapolation
+    in the edge size (:mod:`ngcontact.cell.fe.edge_size_extrapolation`), its seconds the sum of the solves', its
+    dofs the finest's, ``estimate`` its estimated relative error.  Order 1 is left out: its error is two
+    opposite errors (too stiff a body, a contact set past the edge), not a power of the edge size."""
+    from ngcontact.cell.fe.edge_size_extrapolation import extrapolate
+    out = []
+    for solver, ratio in sorted({(r["solver"], r["pressure"]) for r in rows if "order 2" in r["solver"]}):
+        sel = [r for r in rows if r["solver"] == solver and r["pressure"] == ratio]
+        if len(sel) < 2:
+            continue
+        ext = extrapolate([r["size"] for r in sel], [r["contact_fraction"] for r in sel])
+        finest = min(sel, key=lambda r: r["size"])
+        out.append({"part": "accuracy", "solver": solver + ", extrapolated",
+                    "size": " ".join(f"{r['size']:g}" for r in sel), "ndof": finest["ndof"],
+                    "seconds": sum(r["seconds"] for r in sel), "contact_fraction": ext.value, "pressure": ratio,
+                    "relative_error": ext.value / converged[ratio] - 1.0, "estimate": ext.estimate / ext.value})
+        log.info("accuracy: %s p/p* %g extrapolated (%s): %+.2f %% (estimate %.2f %%), %.1f s", solver, ratio, ext.how,
+                 100.0 * out[-1]["relative_error"], 100.0 * out[-1]["estimate"], out[-1]["seconds"])
+    return out
