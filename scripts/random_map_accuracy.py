@@ -53,8 +53,8 @@ TOLERANCE = 0.01
 REFERENCE = 2048
 TAMAAS_GRID, TAMAAS_TOL = 512, 1e-10
 KEYS = ("solver", "load", "pressure", "grid", "contact_fraction", "estimate", "estimate_relative", "reference",
-        "reference_half", "reference_richardson", "true_error", "true_error_relative", "effectivity",
-        "within_2_percent", "effectivity_in_1_10", "seconds", "solve_seconds", "note")
+        "reference_half", "reference_richardson", "true_error", "true_error_relative", "error_to_richardson",
+        "effectivity", "within_2_percent", "effectivity_in_1_10", "seconds", "solve_seconds", "note")
 
 SCENE = """kind = "cell"
 title = "Random 64 x 64 map, spectral cell, exact contact, tolerance 1 %"
@@ -138,11 +138,12 @@ def ngcontact_rows(out: str, quick: bool) -> list[dict]:
         estimate = load["error_estimate"]["contact_fraction"]
         error = abs(value - ref)
         effectivity = estimate / error if error > 0 else float("inf")
+        limit = richardson(value, ref_half, ref) if grid == reference // 4 else ref
         rows.append({"solver": "ngcontact spectral, tolerance " + str(tol), "load": k, "pressure": PRESSURES[k],
                      "grid": grid, "contact_fraction": value, "estimate": estimate,
                      "estimate_relative": estimate / value, "reference": ref, "reference_half": ref_half,
-                     "reference_richardson": richardson(value, ref_half, ref) if grid == reference // 4 else ref,
-                     "true_error": error, "true_error_relative": error / ref, "effectivity": effectivity,
+                     "reference_richardson": limit, "true_error": error, "true_error_relative": error / ref,
+                     "error_to_richardson": abs(value - limit) / abs(limit), "effectivity": effectivity,
                      "within_2_percent": bool(error <= 0.02 * ref), "effectivity_in_1_10": bool(1 <= effectivity <= 10),
                      "seconds": seconds, "solve_seconds": solve,
                      "note": f"grids {[lv['grid'] for lv in posed['method']['refinement']]}; "
@@ -203,14 +204,20 @@ def verdict(rows: list[dict]) -> str:
     ours = [r for r in rows if r["solver"].startswith("ngcontact")]
     peer = [r for r in rows if r["solver"].startswith("tamaas")][0]
     errors = ", ".join(f"{100 * r['true_error_relative']:.2g} %" for r in ours)
+    to_limit = ", ".join(f"{100 * r['error_to_richardson']:.3g} %" for r in ours)
+    limit_effs = ", ".join(f"{r['estimate'] / (r['error_to_richardson'] * r['reference_richardson']):.3g}"
+                           for r in ours)
     effs = ", ".join(f"{r['effectivity']:.3g}" for r in ours)
     within = all(r["within_2_percent"] for r in ours)
+    missed = sum(r["error_to_richardson"] > 0.02 for r in ours)
     honest = all(r["effectivity_in_1_10"] for r in ours)
-    time_part = (f"time: {ours[0]['seconds']:.3g} s against Tamaas' {peer['seconds']:.3g} s" if peer["seconds"] != ""
-                 else f"time: unmeasured here ({peer['note']}); this run took {ours[0]['seconds']:.3g} s")
-    return (f"Within 2 %: {'met' if within else 'not met'} (true errors {errors}, reported grid "
-            f"{ours[0]['grid']}). Effectivity in [1, 10]: {'met' if honest else 'not met'} ({effs}). "
-            f"{time_part}.")
+    took = f"{ours[0]['seconds']:.3g} s"
+    time_part = (f"Time against Tamaas: {took} against Tamaas' {peer['seconds']:.3g} s" if peer["seconds"] != ""
+                 else f"Time against Tamaas: unmeasured here ({peer['note']}); this run took {took}")
+    return (f"Within 2 %: {'met' if within else 'not met'} against the reference (true errors {errors}, reported "
+            f"grid {ours[0]['grid']}); against Richardson's limit {to_limit}: "
+            f"{'met' if not missed else f'{missed} of {len(ours)} loads beyond 2 %'}. Effectivity in [1, 10]: "
+            f"{'met' if honest else 'not met'} ({effs}; against Richardson's limit {limit_effs}). {time_part}.")
 
 
 def main(argv=None) -> int:
@@ -241,8 +248,9 @@ NOTE = ("The random 64 x 64 map of issue 35's first table (self-affine, Hurst 0.
         "tolerance), `estimate_relative` the same over the value. `reference`: the same scene on 2048 x 2048 "
         "points (the largest spectral grid), `reference_half` on 1024 x 1024 (their difference bounds the "
         "reference's error when each doubling at least halves it), `reference_richardson` the limit of the "
-        "reported, 1024 and 2048 grids at their observed rate (for comparison; the true error is against "
-        "`reference`). `effectivity` = estimate / true absolute error. Aims: every contact fraction within 2 % "
+        "reported, 1024 and 2048 grids at their observed rate (the true error is against `reference`; "
+        "`error_to_richardson` is the relative error against this limit, a second view of the reference's own "
+        "error). `effectivity` = estimate / true absolute error. Aims: every contact fraction within 2 % "
         "of the converged value, effectivity in [1, 10], no more time than Tamaas' Polonsky-Keer-Rey on 512 x 512 "
         "points for the same three loads. Timings on a 2-core machine shared with other jobs.")
 
