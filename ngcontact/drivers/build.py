@@ -331,9 +331,7 @@ def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = 
     :class:`CellProblem` with the macro strain term, for what only the FE cell gives: the micro stresses of
     the strength recovery (paper eqs. 74-78) and the shear response; the scene's ``[solver]`` settings and its
     first loads' start (:func:`cell_problem`)."""
-    cs = load_with_contact(cell_path, overrides, method, discretization)
-    if cs.kind != "cell":
-        raise SceneError(key, cell_path, f"names a {cs.kind!r} scene; a 'cell' scene is needed")
+    cs = cell_scene_of(cell_path, key=key, overrides=overrides, method=method, discretization=discretization)
     if cs.contact.geometric_only:
         raise SceneError(key, cell_path, "the cell scene has contact.geometric_only = true; the recovery "
                          "solves the cell, so it needs a contact model and a [load] section")
