@@ -4,7 +4,8 @@
 whose NGSolve task manager holds threads, limited to one NGSolve thread so
 that ``N`` workers use ``N`` cores.  A worker that dies counts a failure of
 the member it had started (its start record, by pid); the members of the
-workers the pool then stops are innocent.
+workers the pool then stops are innocent.  Which members of a run's batch go
+to the workers is the payoff rule's (:mod:`ngcontact.parallel.judged_batches`).
 """
 from __future__ import annotations
 
@@ -14,24 +15,14 @@ import time
 from typing import Any, Sequence
 
 from ngcontact.parallel.batch_executor import Executor
+from ngcontact.parallel.judged_batches import JudgedBatches, shifted_progress
 from ngcontact.parallel.batch_member import one_thread, run_member
-from ngcontact.parallel import worker_lifetime, worker_payoff
+from ngcontact.parallel import worker_lifetime
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
 
-#: Wall seconds a local pool's workers take to start (fresh interpreters importing NGSolve and the package,
-#: all at once; an estimate for two workers starting together on two cores): ``R`` of
-#: :mod:`ngcontact.parallel.worker_payoff` for a pool not yet started.
-START_SECONDS = 2.0
-
-#: Seconds a worker's first member takes beyond the others (an estimate): what the run's process paid
-#: before its batch and a fresh worker pays in its first member, e.g. importing a measured surface's reader
-#: and reading its file; ``F`` of :mod:`ngcontact.parallel.worker_payoff`.
-FIRST_MEMBER_SECONDS = 1.0
-
-
-class LocalPool(Executor):
+class LocalPool(JudgedBatches):
     """A pool of ``workers`` spawned worker processes on this machine (started on first use)."""
 
     name = "local"
@@ -86,26 +77,6 @@ class LocalPool(Executor):
         pool = self._start()
         self._warming = [pool.submit(_warm_up, self._modules) for _ in range(self.workers)]
 
-    def repays(self, forecast) -> bool:
-        """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send the rest of a batch
-        (its :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: the members after
-        the first ``MEASURED`` (solved here), of the forecast's seconds each, against the part of the start
-        that the run's lead before its batch leaves ahead, and a worker's first member."""
-        return worker_payoff.Payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
-                                    self.workers, max(START_SECONDS - forecast.lead_seconds, 0.0),
-                                    FIRST_MEMBER_SECONDS).repaid
-
-    def start_on_demand(self, modules: Sequence[str] = ()) -> None:
-        """Start no worker now: only once a batch's rest repays their start (:meth:`_judged_map`), each
-        then importing ``modules`` and the module of the batch's member function as it starts.
-
-        A batch kept in this process then costs exactly the serial run: no
-        worker process ever takes a core from it, not even while the run sets
-        up.
-        """
-        self.judged = True
-        self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
-
     def _map(self, fn, items, names, label, progress, fault) -> list:
         if len(items) == 1:
             self._where("serial", "a single member: solved in this process")
@@ -116,59 +87,9 @@ class LocalPool(Executor):
         done = self._while_starting(fn, items, names, label, progress, fault)
         if len(done) == len(items):
             return done
-        rest = self._pool_map(fn, items[len(done):], names[len(done):], label, _after(progress, len(done)), fault)
+        rest = self._pool_map(fn, items[len(done):], names[len(done):], label,
+                              shifted_progress(progress, len(done)), fault)
         return done + rest
-
-    def _judged_map(self, fn, items, names, label, progress, fault) -> list:
-        """A batch of the run: members solved here, each timed, until the rest repays the workers (condition
-        (1) of :mod:`ngcontact.parallel.worker_payoff`, after at least ``MEASURED`` members) and a worker is
-        ready, or the batch ends here.
-
-        Workers still starting when (1) fails are stopped (they take cores
-        from this process); started ones are kept for the run's next batch.
-        A pool not started is started once (1) holds (never for a batch kept
-        here), its workers importing the members' module as they start, and
-        this process solves members while they start.
-        """
-        clock = self.member_clock            # each member solved here is timed by Executor._map
-        done: list = []
-        while True:
-            k = len(done)
-            done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
-                                  _after(progress, k, len(items)), fault)
-            if len(done) == len(items):
-                self._where("serial", f"all {len(done)} members solved here while the workers started")
-                return done
-            payoff = worker_payoff.Payoff(clock.least, len(items) - len(done), self.workers, self._start_ahead(),
-                                          FIRST_MEMBER_SECONDS)
-            if not payoff.repaid:
-                if self._pool is not None and not all(w.done() for w in self._warming):
-                    self._discard()
-                self._where("serial", payoff.describe(len(done)))
-                log.debug("%s: %s", label, payoff.describe(len(done)))
-                return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
-                                            _after(progress, len(done), len(items)), fault)
-            if self._pool is None:
-                if self.started == "never":
-                    self.started = f"during batch '{label}'"
-                self.start((fn.__module__,))
-            if self._ready() and len(done) >= worker_payoff.MEASURED:
-                self._where("local", payoff.describe(len(done)))
-                log.debug("%s: %s", label, payoff.describe(len(done)))
-                return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
-                                             _after(progress, len(done)), fault)
-
-    def _ready(self) -> bool:
-        """Whether a worker of the current pool has started (a pool started without warm-up tasks: yes)."""
-        return self._pool is not None and (not self._warming or any(w.done() for w in self._warming))
-
-    def _start_ahead(self) -> float:
-        """Seconds of the workers' start still to come (``R`` of :mod:`ngcontact.parallel.worker_payoff`)."""
-        if self._pool is None:
-            return START_SECONDS
-        if self._ready():
-            return 0.0
-        return max(START_SECONDS - (time.perf_counter() - self._spawned), 0.0)
 
     def _while_starting(self, fn, items, names, label, progress, fault) -> list:
         """The first members, solved in this process while no worker has started yet.
@@ -183,7 +104,7 @@ class LocalPool(Executor):
         while len(done) < len(items) and self._warming and not any(w.done() for w in self._warming):
             k = len(done)
             done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
-                                  _after(progress, k, len(items)), fault)
+                                  shifted_progress(progress, k, len(items)), fault)
         if done:
             log.debug("%s: %d of %d members solved in this process while the workers started", label,
                       len(done), len(items))
@@ -309,14 +230,6 @@ class LocalPool(Executor):
 
 
 _STARTED = None
-
-
-def _after(progress, done: int, total: int | None = None):
-    """``progress`` of the members after the first ``done`` of a batch of ``total`` (default: ``done`` more than
-    the part reports): its counts shifted by ``done``."""
-    if progress is None or done == 0 and total is None:
-        return progress
-    return lambda label, k, n: progress(label, k + done, n + done if total is None else total)
 
 
 def _exit_code(proc, seconds: float = 2.0):

@@ -26,9 +26,9 @@ less wall time than CPU time); ``c`` is the least of these times, since
 noise only adds to a member's time and the first member also pays what
 this process does once (a lazy import, a cache filled).  ``R`` is an
 estimate of a fresh worker's start
-(:data:`~ngcontact.parallel.local_pool.START_SECONDS`) less the time the
+(:data:`~ngcontact.parallel.judged_batches.START_SECONDS`) less the time the
 workers have had since they were spawned; ``F`` an estimate
-(:data:`~ngcontact.parallel.local_pool.FIRST_MEMBER_SECONDS`).
+(:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS`).
 
 (1) is read after every member solved here, and the rest goes to the
 workers only once (1) holds after :data:`MEASURED` members and a worker is
@@ -42,7 +42,7 @@ at once (a starting worker takes a core from this process).
 
 Never slower than serial: the workers of a run are started on demand
 (:meth:`LocalPool.start_on_demand
-<ngcontact.parallel.local_pool.LocalPool.start_on_demand>`), only once (1)
+<ngcontact.parallel.judged_batches.JudgedBatches.start_on_demand>`), only once (1)
 holds, so a batch whose rest never repays them is the serial batch, no
 worker process spawned; one whose workers were started and then stopped
 had at most a few members solved beside starting workers (bounded by
@@ -50,7 +50,7 @@ their time times the share of the cores the workers took); a batch sent to
 the workers satisfies (1), so its rest ends sooner than serially by the
 margin of (1) when the estimates hold, and a batch whose workers start
 later than ``R`` keeps being solved here meanwhile (:meth:`LocalPool._judged_map
-<ngcontact.parallel.local_pool.LocalPool._judged_map>`).  A large batch
+<ngcontact.parallel.judged_batches.JudgedBatches._judged_map>`).  A large batch
 (``r c`` well above ``R + F``) goes to the workers after :data:`MEASURED`
 members, so it keeps its speedup, less their share.
 """

@@ -5,7 +5,7 @@ import os
 import pytest
 
 from ngcontact import runner
-from ngcontact.parallel import batch_forecast, executor, local_pool
+from ngcontact.parallel import batch_forecast, executor, judged_batches
 from ngcontact.parallel.batch_forecast import Forecast
 from ngcontact.scene import loader
 
@@ -30,8 +30,8 @@ def test_a_record_is_read_back_and_a_broken_one_is_no_forecast(cache):
 
 
 def test_the_forecast_is_condition_1_with_the_start_the_lead_leaves_ahead(monkeypatch):
-    monkeypatch.setattr(local_pool, "START_SECONDS", 2.0)
-    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 1.0)
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 2.0)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 1.0)
     pool = executor.LocalPool(2)
     # 14 members after the two solved here, 0.3 s each: 2.1 s saved against 1 s of a first member and
     # what of the 2 s start the lead leaves ahead
@@ -51,8 +51,8 @@ def test_workers_start_with_the_run_only_where_the_last_run_of_the_batch_says_th
     assert forecast.members == members and 0.01 <= forecast.member_seconds < 0.05
     with runner.batches(scene, workers=2) as ex:            # 30 x 0.01 s do not repay two workers
         assert ex.pools_started == 0
-    monkeypatch.setattr(local_pool, "START_SECONDS", 0.0)
-    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.05)
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.05)
     with runner.batches(scene, workers=2) as ex:            # they would now: started as the run opens
         assert ex.pools_started == 1 and ex._pool is not None
         assert ex.describe()["workers_started"] == "with the run"

@@ -12,7 +12,7 @@ import time
 import pytest
 
 from ngcontact.errors import BatchError
-from ngcontact.parallel import batch_member, executor, local_pool
+from ngcontact.parallel import batch_member, executor, judged_batches
 
 ITEMS = [1.5, -2.0, 3.25, 7.0, -0.5]
 NAMES = [f"m{k}" for k in range(len(ITEMS))]
@@ -93,8 +93,8 @@ def test_make_chooses_serial_pool_or_cluster():
 def workers_always_repay(monkeypatch):
     """No start ahead, no first member's extra: every batch's rest goes to workers (condition (1) of
     :mod:`ngcontact.parallel.worker_payoff` holds for any member that takes time)."""
-    monkeypatch.setattr(local_pool, "START_SECONDS", 0.0)
-    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
 
 
 def test_a_started_pool_has_its_workers_running_before_the_first_batch_and_records_its_batches(
@@ -162,8 +162,8 @@ def test_a_pool_started_on_demand_uses_its_workers_only_where_they_repay_their_s
     """The first member runs here and times the batch; the rest go to the workers only if
     ``rest * seconds * (1 - 1/workers)`` exceeds the workers' start (``START_SECONDS``) and a worker's first
     member (``FIRST_MEMBER_SECONDS``)."""
-    monkeypatch.setattr(local_pool, "START_SECONDS", start_seconds)
-    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "START_SECONDS", start_seconds)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
     ex = executor.LocalPool(2)
     ex.start_on_demand()
     seen = []

@@ -178,10 +178,10 @@ def test_workers_spawned_by_a_thread_that_ends_live_on_with_their_parent(tmp_pat
     import operator
     import threading
 
-    from ngcontact.parallel import local_pool
+    from ngcontact.parallel import judged_batches, local_pool
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
-    monkeypatch.setattr(local_pool, "START_SECONDS", 0.0)          # every batch's rest goes to the workers
-    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)          # every batch's rest goes to the workers
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
     pool = local_pool.LocalPool(2)
     try:
         first = []

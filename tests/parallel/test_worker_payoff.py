@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from ngcontact.parallel import local_pool
+from ngcontact.parallel import judged_batches, local_pool
 from ngcontact.parallel.worker_payoff import MemberClock, Payoff
 
 
@@ -44,7 +44,7 @@ def test_a_member_is_timed_by_its_cpu_seconds_when_the_process_waits_beside_it()
 @pytest.fixture
 def ready_pool(monkeypatch):
     """Two started workers (the start is paid: ``R = 0``), a worker's first member estimated at 0.2 s."""
-    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.2)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.2)
     pool = local_pool.LocalPool(2)
     pool.start()
     for warm in pool._warming:
@@ -122,8 +122,8 @@ def test_a_run_with_a_batch_starts_no_worker_before_its_batch_repays_them(monkey
 def test_workers_on_demand_start_inside_the_batch_that_repays_them(monkeypatch):
     """A batch whose first member shows that its rest repays the workers starts them then (its members
     after the first two go to them once one is ready: how many depends on the machine's load)."""
-    monkeypatch.setattr(local_pool, "START_SECONDS", 0.0)
-    monkeypatch.setattr(local_pool, "FIRST_MEMBER_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
     pool = local_pool.LocalPool(2)
     try:
         pool.start_on_demand(("ngsolve",))

@@ -1,0 +1,138 @@
+"""Which members of a local pool's batch go to its workers: the payoff rule applied member by member.
+
+A run's batches (:meth:`JudgedBatches.start_on_demand` or an early start) are judged: the first members
+are solved in the run's own process, each timed, and the rest goes to the workers only where condition
+(1) of :mod:`ngcontact.parallel.worker_payoff` holds for it, ``T_rest / (W - 1) > R + F`` in that
+module's terms: the rest's serial time against the workers' start still ahead (``R``,
+:data:`START_SECONDS` less the time since they were spawned) and a worker's first member
+(``F``, :data:`FIRST_MEMBER_SECONDS`).  A batch kept in this process starts no worker.
+
+The rule is a mixin of :class:`~ngcontact.parallel.local_pool.LocalPool`, whose worker processes it starts,
+uses and stops: this module holds the decision, that one the processes.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from abc import ABC, abstractmethod
+from typing import Any, Sequence
+
+from ngcontact.parallel.batch_executor import Executor
+from ngcontact.parallel import worker_payoff
+
+log = logging.getLogger("ngcontact.parallel.executor")
+
+
+#: Wall seconds a local pool's workers take to start (fresh interpreters importing NGSolve and the package,
+#: all at once; an estimate for two workers starting together on two cores): ``R`` of
+#: :mod:`ngcontact.parallel.worker_payoff` for a pool not yet started.
+START_SECONDS = 2.0
+
+#: Seconds a worker's first member takes beyond the others (an estimate): what the run's process paid
+#: before its batch and a fresh worker pays in its first member, e.g. importing a measured surface's reader
+#: and reading its file; ``F`` of :mod:`ngcontact.parallel.worker_payoff`.
+FIRST_MEMBER_SECONDS = 1.0
+
+
+class JudgedBatches(Executor, ABC):
+    """An executor of worker processes whose batches the payoff rule judges (module docstring); the
+    processes (:meth:`start`, :meth:`_pool_map`, :meth:`_discard`) are the subclass's."""
+
+    workers: int
+    judged: bool
+    started: str
+    _pool: Any
+    _warming: list
+    _spawned: float
+    _modules: tuple[str, ...]
+
+    @abstractmethod
+    def start(self, modules: Sequence[str] = ()) -> None:
+        """Spawn the workers now, each importing ``modules``."""
+
+    @abstractmethod
+    def _pool_map(self, fn, items, names, label, progress, fault) -> list:
+        """``fn`` over ``items`` on the workers."""
+
+    @abstractmethod
+    def _discard(self) -> None:
+        """Stop the workers now."""
+
+    def repays(self, forecast) -> bool:
+        """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send the rest of a batch
+        (its :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: the members after
+        the first ``MEASURED`` (solved here), of the forecast's seconds each, against the part of the start
+        that the run's lead before its batch leaves ahead, and a worker's first member."""
+        return worker_payoff.Payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
+                                    self.workers, max(START_SECONDS - forecast.lead_seconds, 0.0),
+                                    FIRST_MEMBER_SECONDS).repaid
+
+    def start_on_demand(self, modules: Sequence[str] = ()) -> None:
+        """Start no worker now: only once a batch's rest repays their start (:meth:`_judged_map`), each
+        then importing ``modules`` and the module of the batch's member function as it starts.
+
+        A batch kept in this process then costs exactly the serial run: no
+        worker process ever takes a core from it, not even while the run sets
+        up.
+        """
+        self.judged = True
+        self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
+
+    def _judged_map(self, fn, items, names, label, progress, fault) -> list:
+        """A batch of the run: members solved here, each timed, until the rest repays the workers (condition
+        (1) of :mod:`ngcontact.parallel.worker_payoff`, after at least ``MEASURED`` members) and a worker is
+        ready, or the batch ends here.
+
+        Workers still starting when (1) fails are stopped (they take cores
+        from this process); started ones are kept for the run's next batch.
+        A pool not started is started once (1) holds (never for a batch kept
+        here), its workers importing the members' module as they start, and
+        this process solves members while they start.
+        """
+        clock = self.member_clock            # each member solved here is timed by Executor._map
+        done: list = []
+        while True:
+            k = len(done)
+            done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
+                                  shifted_progress(progress, k, len(items)), fault)
+            if len(done) == len(items):
+                self._where("serial", f"all {len(done)} members solved here while the workers started")
+                return done
+            payoff = worker_payoff.Payoff(clock.least, len(items) - len(done), self.workers, self._start_ahead(),
+                                          FIRST_MEMBER_SECONDS)
+            if not payoff.repaid:
+                if self._pool is not None and not all(w.done() for w in self._warming):
+                    self._discard()
+                self._where("serial", payoff.describe(len(done)))
+                log.debug("%s: %s", label, payoff.describe(len(done)))
+                return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
+                                            shifted_progress(progress, len(done), len(items)), fault)
+            if self._pool is None:
+                if self.started == "never":
+                    self.started = f"during batch '{label}'"
+                self.start((fn.__module__,))
+            if self._ready() and len(done) >= worker_payoff.MEASURED:
+                self._where("local", payoff.describe(len(done)))
+                log.debug("%s: %s", label, payoff.describe(len(done)))
+                return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
+                                             shifted_progress(progress, len(done)), fault)
+
+    def _ready(self) -> bool:
+        """Whether a worker of the current pool has started (a pool started without warm-up tasks: yes)."""
+        return self._pool is not None and (not self._warming or any(w.done() for w in self._warming))
+
+    def _start_ahead(self) -> float:
+        """Seconds of the workers' start still to come (``R`` of :mod:`ngcontact.parallel.worker_payoff`)."""
+        if self._pool is None:
+            return START_SECONDS
+        if self._ready():
+            return 0.0
+        return max(START_SECONDS - (time.perf_counter() - self._spawned), 0.0)
+
+
+def shifted_progress(progress, done: int, total: int | None = None):
+    """``progress`` of the members after the first ``done`` of a batch of ``total`` (default: ``done`` more than
+    the part reports): its counts shifted by ``done``."""
+    if progress is None or done == 0 and total is None:
+        return progress
+    return lambda label, k, n: progress(label, k + done, n + done if total is None else total)
