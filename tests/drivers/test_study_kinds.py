@@ -20,10 +20,8 @@ from ngcontact.scene.studied_kinds import studied_kind
 
 ROOT = Path(__file__).resolve().parents[2]
 
-#: the loop's cell: Westergaard's sinusoidal gap on a flat interface between the press fit's materials,
-#: solved by the spectral cell (lengths in two_scale.cell_length_unit)
-LOOP_CELL = """\
-kind = "cell"
+#: the press fit's materials, shared by the loop's cell and the macro scene
+BODIES = """\
 [materials.inner]
 E = 200.0
 nu = 0.3
@@ -33,6 +31,13 @@ nu = 0.25
 [bodies]
 rough = "inner"
 counter = "outer"
+"""
+
+#: the loop's cell: Westergaard's sinusoidal gap on a flat interface between the press fit's materials,
+#: solved by the spectral cell (lengths in two_scale.cell_length_unit)
+LOOP_CELL = """\
+kind = "cell"
+""" + BODIES + """\
 [geometry]
 profile = "flat"
 h_rough = 1.0
@@ -52,15 +57,7 @@ grid = 64
 TWO_SCALE = """\
 kind = "macro"
 title = "two-scale press fit"
-[materials.inner]
-E = 200.0
-nu = 0.3
-[materials.outer]
-E = 70.0
-nu = 0.25
-[bodies]
-rough = "inner"
-counter = "outer"
+""" + BODIES + """\
 [geometry]
 shape = "coaxial"
 setting = "plane_strain"
