@@ -61,3 +61,11 @@ def test_comparison_flags_moved_and_missing_keys_only():
     assert bad == {"ndof": (100, 101), "loads.0.mean_closure": (2e-6, moved["loads.0.mean_closure"]),
                    "whole_surface.k_nt": (1e-13, 1e-3), "loads.0.contact_fraction": (0.5, None)}
     assert "loads.0.contact_fraction" in R.table([("scene", *b) for b in R.compare(gold, moved)])
+
+
+def test_a_rate_deviation_is_compared_at_the_size_of_the_rates_it_is_a_difference_of():
+    gold = {"rates.1.l2": 4.97, "max_rate_deviation": 0.03}
+    spread = {**gold, "max_rate_deviation": 0.03 + 0.1 * R.RTOL * 4.97}     # the rates' round-off, 1.7e-5 of itself
+    assert R.compare(gold, spread) == []
+    moved = {**gold, "max_rate_deviation": 0.03 + 10 * R.RTOL * 4.97}
+    assert [key for key, *_ in R.compare(gold, moved)] == ["max_rate_deviation"]
