@@ -11,32 +11,60 @@ extrapolation from three orders misses that share.
 Only smaller elements at the singular points remove it.  So the elements with a vertex at a singular
 point (:func:`ngcontact.macro.singular_maxima.star`), those the balls' circles cross (where a maximum
 away from a singular point is attained when the stress grows towards it; :data:`CIRCLE` points each) and
-those holding the maxima away are refined
-:data:`LEVELS` times (Netgen's local refinement, on copies of the mesh; each level solved at the scene's
-order from the last level's solution interpolated into its space, as the corner check of
-:mod:`ngcontact.macro.singular_maxima` does), and each maximum away is taken on every level
-(``Q_0`` the scene's mesh, ``Q_1``, ``Q_2``).  Each level halves the elements at the singular points, so
-the polluting share falls by a fixed factor per level and the sequence's geometric tail
-(:func:`ngcontact.macro.mesh_sequence.sequence_error`, with the factor of safety) estimates what is left
-of it on the finest level.  That factor is ``2^-lambda`` at a singular point of exponent ``lambda <= 1``
-(the error in energy falls like ``h^lambda`` where the elements at the point are halved; a logarithm
-has ``lambda = 1``), so at least :data:`SLOWEST` = 1/2: a smaller observed ratio is pre-asymptotic (the
-first level moves the circle of the ball out of the elements that touch the point, a step larger than
-the ones to come), and the tail is taken at ratio 1/2 at least, ``1.5 |Q_2 - Q_1|``.  Where the levels
-move the value by more than the ladder's estimate of the scene's mesh (``|Q_2 - Q_0| > e_ladder``), that
-estimate is contradicted: it saw only part of the error (on a coarse mesh the orders' differences have not
-reached their rate), and the finest level's error is bounded by ``|Q_2 - Q_0|`` as long as the two levels
-at least halve the error of the scene's mesh (the saturation assumption of a refinement); times the
-factor of safety it is the least error taken.  A ladder without an estimate (a ball's circle inside the
-elements at a singular point, where no order converges fast) leaves the sequence alone, whose levels
-move the circle out of those elements.  So the finest level's value and location are reported, with the larger of
-the ladder's error (the mesh away from the singular points is the scene's, so the polynomial error there
-is the one the ladder measured) and the sequence's; a sequence that does not converge adds its last
-difference (:func:`judged`).  The check costs about one solve of the scene (two warm-started solves on
-meshes a little larger).
+those holding the maxima away are refined :data:`LEVELS` times (Netgen's local refinement, on copies of
+the mesh; each level solved at the scene's order from the last level's solution interpolated into its
+space, as the corner check of :mod:`ngcontact.macro.singular_maxima` does), and each maximum away is
+taken on every level (``Q_0`` the scene's mesh, ``Q_1``, ``Q_2``).  The finest level's value and location
+are reported; its error (:func:`level_error`) from the differences ``d_1 = Q_1 - Q_0``,
+``d_2 = Q_2 - Q_1``, their ratio ``rho = |d_2| / |d_1|`` and two shares the levels do not see:
+
+* the order ladder's polynomial share ``e_P``: the ladder's estimate of the scene's mesh without its
+  sampling term, plus :data:`~ngcontact.macro.discretization_error.SAFETY` times the sampling error of the
+  finest level (``Sample.sampling``: the denser lattice's excess on the mesh the value is reported on).
+  The mesh away from the refined elements is the scene's, so the polynomial error there is at most the one
+  the ladder measured; a sampling error belongs to the mesh whose points sampled the maximum, and the
+  levels refine the elements holding it;
+* the move ``m = |Q_2 - Q_0|`` where it contradicts the ladder (``m > e_ladder``, the ladder's estimate of
+  the scene's mesh): that estimate saw only part of the error, and as long as the two levels at least
+  halve the error of the scene's mesh (the saturation assumption of a refinement) the finest level's
+  error is at most ``m``; ``e_m = SAFETY m``, else 0.
+
+Each level halves the elements at the singular points, so the polluting share falls by ``2^-lambda``
+per level at a singular point of exponent ``lambda <= 1`` (the error in energy falls like ``h^lambda``
+where the elements at the point are halved; a logarithm has ``lambda = 1``): a ratio of at least
+:data:`SLOWEST` = 1/2, and at most ``2^-0.544 = 0.69`` (the smallest exponent among the singular points
+of :mod:`ngcontact.macro.away_maxima`, a free wedge of 270 degrees).  The two differences agree in rate
+where they have one sign and ``1/4 <= rho <= 3/4`` (:data:`AGREE`: that range widened by a factor 2
+towards the faster fall of the refined elements' own local error and by a little towards the slower),
+and then Richardson's extrapolation with the observed rate gives the error left after the finest level,
+the sum of the differences still to come, added to the share the levels do not refine:
+
+    e = e_P + SAFETY |d_2| rho / (1 - rho).
+
+Where they disagree, the estimate says so and takes the larger of what bounds the error:
+
+* one sign, ``rho < 1/4``: faster than the halving allows, so pre-asymptotic (the first level moves
+  the circle of the ball out of the elements that touch the point, a step larger than the ones to come);
+  the tail at the slowest ratio, ``SAFETY |d_2| SLOWEST / (1 - SLOWEST)``:
+  ``e = max(e_P, SAFETY |d_2|, e_m)``;
+* one sign, ``3/4 < rho < 1``: slower than any singular point's pollution falls, so not that fall;
+  ``e = max(e_P, SAFETY |d_2|, e_m)``;
+* ``rho >= 1``: the difference does not shrink, no limit is extrapolated: the same, and without a
+  ladder estimate no estimate at all;
+* opposite signs, ``rho < 1``: the values oscillate about their limit, which lies between ``Q_1`` and
+  ``Q_2``, so ``|e_2| <= |d_2|``: ``e = min(SAFETY |d_2|, max(e_P, e_m))`` (the bracket caps the larger
+  of the other bounds; ``SAFETY |d_2|`` without a ladder estimate; an oscillation of a sampled maximum
+  is its sample points moving onto the field's maximum as the elements holding it shrink, not the fall
+  of the pollution).
+
+Differences below :data:`~ngcontact.macro.discretization_error.NOISE` of the quantity are round-off:
+``e = max(e_P, SAFETY max(|d_1|, |d_2|))``.  A ladder without an estimate (a ball's circle inside the
+elements at a singular point, where no order converges fast) has ``e_P = e_m = 0`` and leaves the levels
+alone.  The check costs about one solve of the scene (two warm-started solves on meshes a little larger).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Callable
 
@@ -46,7 +74,6 @@ import numpy as np
 from ngcontact.macro import away_maxima as AM
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro import error_indicator as EI
-from ngcontact.macro import mesh_sequence as MS
 from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroSolution
 
@@ -54,8 +81,10 @@ from ngcontact.macro.macro_problem import MacroSolution
 LEVELS = 2
 #: points per ball's circle whose elements each level refines
 CIRCLE = 64
-#: the slowest fall per level the sequence's tail assumes at least (module docstring)
+#: the slowest fall per level of the pollution of a singular point (module docstring)
 SLOWEST = 0.5
+#: the ratios of the last two differences that agree in rate with the halving (module docstring)
+AGREE = (0.25, 0.75)
 
 #: the safety factor away from the singular points of a solution, given which interface points count
 Safety = Callable[[MacroSolution, Callable[[np.ndarray], np.ndarray]], dict[str, DE.Sample]]
@@ -97,33 +126,64 @@ def judged(found: list[DE.Estimate], own: dict[str, DE.Sample], finer: list[dict
     for e in found:
         if finer and e.name.endswith(AM.AWAY) and e.singular_at is None and e.name in own \
                 and all(e.name in f for f in finer):
-            e = _judged(e, [own[e.name].value] + [f[e.name].value for f in finer], finer[-1][e.name].location)
+            e = _judged(e, [own[e.name]] + [f[e.name] for f in finer])
         out.append(e)
     return out
 
 
-def _judged(e: DE.Estimate, values: list[float], location: tuple[float, ...] | None) -> DE.Estimate:
-    """The error of the finest of ``values`` (the scene's mesh, then the levels; module docstring)."""
+def _judged(e: DE.Estimate, samples: list[DE.Sample]) -> DE.Estimate:
+    """The error of the finest of ``samples`` (the scene's mesh, then the levels; module docstring)."""
+    values = [s.value for s in samples]
     shown = ", ".join(f"{v:.6g}" for v in values)
-    seq, how = MS.sequence_error(values, e.scale)
-    parts = [f"{e.how}; {len(values) - 1} local refinements at the singular points: {shown}, the last reported",
-             how]
-    last, moved, ladder = abs(values[-1] - values[-2]), abs(values[-1] - values[0]), e.error
-    e = replace(e, value=values[-1], location=location)
-    if seq is None and ladder is None:
-        return replace(e, how="; ".join(parts))
-    if seq is None:
-        error = DE.SAFETY * last
-        parts.append(f"at least {DE.SAFETY:g} x the last difference")
-    else:
-        error = max(seq, DE.SAFETY * last * SLOWEST / (1.0 - SLOWEST))
-        parts.append(f"the tail at ratio {SLOWEST:g} at least: {error:.3g}")
-    if ladder is not None and ladder >= error:
-        error = ladder
-        parts.append("below the order ladder's, which is taken")
-    if ladder is not None and moved > ladder and DE.SAFETY * moved > error:
-        error = DE.SAFETY * moved
-        parts.append(f"the levels moved the value by {moved:.3g}, more than the order ladder's estimate of the scene's "
-                     f"mesh, which so saw only part of its error: {DE.SAFETY:g} x that move (the levels at least "
-                     "halve the error)")
-    return replace(e, error=error, how="; ".join(parts))
+    head = f"{e.how}; {len(values) - 1} local refinements at the singular points: {shown}, the last reported"
+    polynomial = None
+    if e.error is not None:
+        share = max(e.error - DE.SAFETY * samples[0].sampling, 0.0)
+        polynomial = share + DE.SAFETY * samples[-1].sampling
+        head += (f"; the ladder's share without the scene mesh's sampling {share:.3g}, with {DE.SAFETY:g} x the "
+                 f"finest level's sampling error {samples[-1].sampling:.3g}: {polynomial:.3g}")
+    error, how = level_error(values, e.scale, polynomial, e.error)
+    return replace(e, value=values[-1], location=samples[-1].location, error=error, how=f"{head}; {how}")
+
+
+def level_error(values: list[float], scale: float, polynomial: float | None, ladder: float | None
+                ) -> tuple[float | None, str]:
+    """The error of ``values[-1]``, the finest of the levels ``values`` (the scene's mesh first), given the
+    ladder's polynomial share ``e_P`` (``polynomial``) and the ladder's estimate of the scene's mesh
+    (``ladder``; ``None``: none), and how (module docstring: Richardson with the observed rate where the
+    last two differences agree in rate, else the larger of the bounds)."""
+    if len(values) < 3:
+        return polynomial, f"{len(values)} level(s): no observed rate"
+    q0, q1, q2 = values[-3:]
+    d1, d2 = q1 - q0, q2 - q1
+    base, s = polynomial or 0.0, DE.SAFETY
+    moved = abs(q2 - q0)
+    e_m = s * moved if ladder is not None and moved > ladder else 0.0
+    said = f"levels' differences {d1:.3g}, {d2:.3g}"
+    if max(abs(d1), abs(d2)) <= DE.NOISE * scale:
+        return max(base, s * max(abs(d1), abs(d2))), f"{said}: they agree to round-off"
+    rho = abs(d2) / abs(d1) if d1 != 0 else math.inf
+    said += f" (ratio {rho:.2g})"
+    if e_m:
+        said += (f"; the levels moved the value by {moved:.3g}, more than the ladder's estimate of the scene's "
+                 f"mesh, which so saw only part of its error: {s:g} x that move {e_m:.3g}")
+    if d1 * d2 >= 0 and AGREE[0] <= rho <= AGREE[1]:
+        tail = s * abs(d2) * rho / (1.0 - rho)
+        return base + tail, (f"{said}: they agree in rate, Richardson with the observed rate: e_P + {s:g} x "
+                             f"|d_2| ratio / (1 - ratio) = {base:.3g} + {tail:.3g}")
+    if d1 * d2 >= 0 and rho < AGREE[0]:
+        return max(base, s * abs(d2), e_m), (f"{said}: they disagree in rate, faster than the halving allows "
+                                             f"(pre-asymptotic): the larger of e_P, the tail at ratio {SLOWEST:g} "
+                                             f"({s:g} x |d_2|) and the move's")
+    if d1 * d2 < 0 and rho < 1.0:
+        larger = max(base, e_m) if polynomial is not None else s * abs(d2)
+        return min(s * abs(d2), larger), (f"{said}: they disagree in sign, an oscillation about the limit, which "
+                                          f"lies between the last two levels: the larger of e_P and the move's, "
+                                          f"at most {s:g} x |d_2|")
+    if rho < 1.0:
+        return max(base, s * abs(d2), e_m), (f"{said}: they disagree in rate, slower than the halving allows: "
+                                             f"the larger of e_P, {s:g} x |d_2| and the move's")
+    if polynomial is None:
+        return None, f"{said}: the difference does not shrink with the levels (not converging), no ladder estimate"
+    return max(base, s * abs(d2), e_m), (f"{said}: the difference does not shrink with the levels (not "
+                                         f"converging): the larger of e_P, {s:g} x |d_2| and the move's")

@@ -14,6 +14,7 @@ import pytest
 from ngcontact.drivers import macro_accuracy as MA
 from ngcontact.errors import SceneError
 from ngcontact.macro import away_maxima as AM
+from ngcontact.macro import away_sequence as AS
 from ngcontact.macro import discretization_error as DE
 from ngcontact.output.report import accuracy_line
 from ngcontact.scene import loader
@@ -107,6 +108,49 @@ def test_the_verdict_counts_the_maxima_away_not_the_mesh_dependent_ones():
     acc = MA.verdict([settled["von_mises_base"], settled["von_mises_base_away"]], 0.01, None)
     assert acc["met"] and [q["counted"] for q in acc["quantities"]] == [False, True]
     assert not MA.verdict(list(settled.values()), 0.01, None)["met"]
+
+
+def test_levels_that_agree_in_rate_are_extrapolated_with_their_rate():
+    """A geometric sequence at a ratio the halving allows: Richardson with the observed rate, added to the
+    ladder's polynomial share, is 1.5 times the true error of the finest level (no larger rule)."""
+    for rho in (0.3, 0.5, 0.7):
+        values = [1.0 + 0.1 * rho ** k for k in range(3)]
+        error, how = AS.level_error(values, 1.0, 0.0, 1.0)
+        assert error == pytest.approx(1.5 * 0.1 * rho ** 2) and "agree in rate" in how
+        assert AS.level_error(values, 1.0, 0.01, 1.0)[0] == pytest.approx(0.01 + 1.5 * 0.1 * rho ** 2)
+    # a move beyond the ladder's estimate does not overrule an agreeing rate
+    assert AS.level_error([1.0, 1.1, 1.15], 1.0, 0.0, 1e-3)[0] == pytest.approx(1.5 * 0.05)
+
+
+def test_levels_that_disagree_in_rate_take_the_larger_bound():
+    s = DE.SAFETY
+    # faster than the halving (pre-asymptotic): the tail at ratio 1/2, or the move past the ladder's estimate
+    error, how = AS.level_error([1.0, 1.1, 1.101], 1.0, 1e-4, 1.0)
+    assert error == pytest.approx(s * 1e-3) and "disagree in rate" in how
+    assert AS.level_error([1.0, 1.1, 1.101], 1.0, 1e-4, 0.01)[0] == pytest.approx(s * 0.101)
+    assert AS.level_error([1.0, 1.1, 1.101], 1.0, 0.05, 1.0)[0] == pytest.approx(0.05)
+    # slower than any singular point's pollution, or not shrinking at all
+    assert AS.level_error([1.0, 1.1, 1.19], 1.0, 1e-4, 1.0)[0] == pytest.approx(s * 0.09)
+    assert AS.level_error([1.0, 1.1, 1.3], 1.0, 1e-4, 1.0)[0] == pytest.approx(s * 0.2)
+    assert AS.level_error([1.0, 1.1, 1.3], 1.0, None, None)[0] is None
+    # an oscillation brackets the limit between the last two levels: the larger bound, capped by the bracket
+    error, how = AS.level_error([1.0, 1.1, 1.05], 1.0, 0.01, 1.0)
+    assert error == pytest.approx(0.01) and "disagree in sign" in how
+    assert AS.level_error([1.0, 1.1, 1.05], 1.0, 0.5, 1.0)[0] == pytest.approx(s * 0.05)
+    assert AS.level_error([1.0, 1.1, 1.05], 1.0, None, None)[0] == pytest.approx(s * 0.05)
+    # round-off
+    assert AS.level_error([1.0, 1.0 + 1e-12, 1.0], 1.0, 2e-3, 1.0)[0] == pytest.approx(2e-3)
+
+
+def test_the_finest_level_carries_its_own_sampling_error():
+    """The scene mesh's sampling term leaves the ladder's share; the finest level's takes its place."""
+    ladder = DE.Estimate(name="von_mises_stem_away", value=1.0, error=0.01 + DE.SAFETY * 0.02, scale=1.0,
+                         ratio=0.1, orders=(2, 3, 4), how="x")
+    own = {ladder.name: DE.Sample(1.0, (0.0, 0.0), sampling=0.02)}
+    finer = [{ladder.name: DE.Sample(1.0001, (0.0, 0.0))}, {ladder.name: DE.Sample(1.00015, (0.0, 1.0), sampling=0.002)}]
+    e = AS.judged([ladder], own, finer)[0]
+    assert e.value == 1.00015 and e.location == (0.0, 1.0)
+    assert e.error == pytest.approx(0.01 + DE.SAFETY * 0.002 + DE.SAFETY * 5e-5)
 
 
 @pytest.mark.parametrize("value, allowed", [("0.0", "must be > 0"), ("-1e-3", "must be > 0"),
