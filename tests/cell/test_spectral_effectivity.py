@@ -173,9 +173,9 @@ def test_a_coefficient_is_not_taken_as_geometric_where_the_contact_fraction_is_n
     bound where the fraction of its load does (a vanished last difference), and Richardson where it does not."""
     from ngcontact.cell.spectral.refinement import guarded_bound, sweep_estimates
 
-    def history(fractions):
-        return [{"headline": [{"contact_fraction": f, "coefficient_g_n": g}], "whole_surface": {"k_n": 1.0, "g_n": 1.0}}
-                for f, g in zip(fractions, _geometric(0.3, levels=4))]
+    def history(fractions):                     # every level's edges located by the quartic
+        return [{"headline": [{"contact_fraction": f, "coefficient_g_n": g}], "whole_surface": {"k_n": 1.0, "g_n": 1.0},
+                 "edges_fitted": [True]} for f, g in zip(fractions, _geometric(0.3, levels=4))]
     g_n = _geometric(0.3, levels=4)
     d = [abs(b - a) for a, b in zip(g_n[:-1], g_n[1:])][::-1]
     estimates, _, forms = sweep_estimates(history([0.40, 0.50, 0.52, 0.52]))
@@ -213,3 +213,19 @@ def test_after_a_deferred_stop_the_estimate_is_at_most_the_deferred_one_plus_the
     assert estimates[0]["contact_fraction"] == 0.001 and forms[0]["contact_fraction"] == RICHARDSON
     assert estimates[0]["mean_closure"] == pytest.approx((0.1 * 2.0 + 0.2) / 2.2)
     assert forms[0]["mean_closure"] == CARRIED
+
+
+def test_on_levels_of_the_line_the_contact_fraction_and_coefficients_take_the_guarded_bound():
+    """The line's first-order error jumps with the edges' position between points: two agreeing ratios of its
+    differences are a coincidence (module docstring of :mod:`~ngcontact.cell.spectral.refinement`).  A load
+    whose edges are not all fitted takes the guarded bound for the fraction and ``g_n``, the mean closure
+    (not on the edges) Richardson's tail."""
+    from ngcontact.cell.spectral.refinement import guarded_bound, sweep_estimates
+    values = _geometric(0.3, levels=4)
+    history = [{"headline": [{"contact_fraction": v, "coefficient_g_n": v, "mean_closure": v}],
+                "whole_surface": {"k_n": 1.0, "g_n": 1.0}, "edges_fitted": [fitted]}
+               for v, fitted in zip(values, (True, True, True, False))]
+    estimates, _, forms = sweep_estimates(history)
+    assert forms[0] == {"contact_fraction": GUARDED, "coefficient_g_n": GUARDED, "mean_closure": RICHARDSON}
+    d = [abs(b - a) for a, b in zip(values[:-1], values[1:])][::-1]
+    assert estimates[0]["contact_fraction"] == pytest.approx(guarded_bound(d)[0])

@@ -50,7 +50,10 @@ the report names (:func:`sweep_estimates`):
 In 2D the contact fraction and the coefficients of eq. 34 rest on edges located between points by one of
 two locators (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`): the quartic fitted to the open
 gap where its window holds enough points and the fit explains the gap, else the line through the first
-two open points, whose root is off by a fraction of a step (first order, with a large constant).  On a
+two open points, whose root is off by a fraction of a step (first order, with a constant that jumps with
+the edges' position between points; in 3D the fraction counts points, alike).  A window holding such levels
+takes the guarded bound for these quantities: two ratios of such differences agree by chance (an error
+that stalls over two grids, as on a profile with kinks, alternates as if geometric).  On a
 smooth gap the quartic takes over at a grid fixed by its window (every edge of a load:
 :func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`, recorded per level), and the error drops there
 by one to two orders of magnitude.  A difference between a level of the line and one of the quartic is the
@@ -66,28 +69,25 @@ exceeds it by that drop.  So, for these quantities of a load whose edges have be
 * with ``0 < r < MIN_LEVELS`` the fitted levels are too few to see their rate: with ``r < LOCATOR_LEVELS``
   the window compares the two locators, a bound by the line's error; with ``r = LOCATOR_LEVELS`` the two
   fitted differences give the guarded bound, whose envelope ``|d_(k-1)| ENVELOPE`` is still of the size
-  of the switch's drop.  Just after the switch the error may change sign (the edge fit's error and the
-  collocated pressure's first-order term, of opposite signs, cancel near some grid): ``|d_k|`` is then
-  far below ``|d_(k-1)|`` and neither says how fast the tail falls.  To a scene's own tolerance a stop
-  waits for ``MIN_LEVELS`` fitted levels (:func:`locator_changing`), unless that level is beyond the
-  largest grid (the whole window's estimate then stands): three differences whose two ratios decide
-  between Richardson (they agree and contract) and the guarded bound (they do not: "the estimate says so
-  and takes the larger").  Richardson's rate is held to first order there too, ``E = SPREAD |d_k| rho /
+  of the switch's drop.  Just after the switch the error may change sign, so that ``|d_k|`` is far below
+  ``|d_(k-1)|`` and neither says how fast the tail falls.  To a scene's own tolerance a stop waits for
+  ``MIN_LEVELS`` fitted levels (:func:`locator_changing`) unless that level is beyond the largest grid
+  (the whole window's estimate then stands): three differences whose two ratios decide between
+  Richardson (they agree and contract) and the guarded bound (they do not: "the estimate says so and
+  takes the larger").  Richardson's rate is held to first order there too, ``E = SPREAD |d_k| rho /
   (1 - rho)``, ``rho = max(|d_k| / |d_(k-1)|, |d_(k-1)| / |d_(k-2)|, 1/2)``: a contraction much faster
   than ``1/2`` right after the switch is the error crossing zero, and the next level falls at first order
   again (on Westergaard's sinusoid at a twentieth of its closing pressure the fitted errors fall by about
   16 per doubling twice, then by 2: the observed rate would estimate a tenth of the error, the first-order
-  one twice it).  The wait costs at most one 2D level more, twice the last: the sweep, whose levels sum to
-  about twice its finest, about doubles.  On the level after a deferred stop (one whose estimate met the
-  tolerance) each estimate is the smaller of its own and the deferred level's carried over,
-  ``E_k = min(E_k^own, E_(k-1) + |d_k|)`` (:data:`CARRIED`): by ``|e_k| <= |e_(k-1)| + |q_k - q_(k-1)|``
-  the second bounds the error wherever ``E_(k-1)`` does, and a quantity whose own window now holds a
-  vanished difference (the envelope of an older, larger one: the mean closure at a fifth of Westergaard's
-  closing pressure) is not estimated above what the deferred level stated.  Refined to the default
-  tolerance (the cheapest grid that meets it, ``sharpen = False`` in :func:`sweep_to_tolerance`), the
-  first grid whose estimate meets it stops, its estimate a bound but not a sharp one.  A load whose edges
-  are never all fitted (a piecewise linear profile's kinks defeat the quartic) is estimated on the whole
-  window.
+  one twice it).  The wait costs at most one 2D level more: the sweep, whose levels sum to about twice its
+  finest, about doubles.  On the level after a deferred stop (one whose estimate met the tolerance) each
+  estimate is the smaller of its own and the deferred one carried over, ``E_k = min(E_k^own, E_(k-1) +
+  |d_k|)`` (:data:`CARRIED`): by ``|e_k| <= |e_(k-1)| + |q_k - q_(k-1)|`` a bound wherever ``E_(k-1)`` is
+  one, it keeps a quantity whose window now holds a vanished difference (the mean closure at a fifth of
+  Westergaard's closing pressure) at what the deferred level stated.  Refined to the default tolerance
+  (``sharpen = False`` in :func:`sweep_to_tolerance`) the first grid whose estimate meets it stops, its
+  estimate a bound but not a sharp one.  A load whose edges are never all fitted (a piecewise linear
+  profile's kinks defeat the quartic) is estimated on the whole window.
 
 The coefficients of eq. 34 on the real contact set are integrals over it (:mod:`ngcontact.cell.spectral.grid_measures`:
 ``k_n`` times the contact fraction, ``k_n`` times the gap integrated over the set), with the set's 2D edges
@@ -184,11 +184,10 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"of the last {WINDOW} differences where their two ratios agree within a factor {AGREE:g} (rate at least "
        f"{FIRST_ORDER}, the tail times {SPREAD:g}) if that is the smaller, else the guarded geometric tail: "
        f"rate the larger ratio held to [{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished "
-       "last one; in 2D the contact fraction and coefficients also on the levels whose edges the quartic "
-       f"located (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller estimate; after a "
-       "stop so deferred, the deferred grid's estimate plus the last difference where smaller; the effective "
-       "stiffness's estimate times "
-       f"{ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance")
+       "last one; the contact fraction and coefficients guarded on levels of edges not all fitted by the quartic, "
+       f"and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
+       "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
+       f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance")
 
 
 @dataclass
@@ -296,8 +295,9 @@ def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float
             # a coefficient's edges are the fraction's: not geometric where the fraction's sequence is not
             geometric = not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
             args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
-            out[name], form[name], note = tail_estimate(values, *args)
             run = fitted_run(history, k) if on_edges(name) else 0
+            line = on_edges(name) and run < len(history)
+            out[name], form[name], note = tail_estimate(values, *args[:3], geometric and not line)
             if LOCATOR_LEVELS <= run < len(history):
                 sharp = tail_estimate(values[-run:], *args)
                 if sharp[0] < out[name]:
@@ -433,7 +433,7 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
                       f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
         settled = not sharpen or n == grids[-1] or not locator_changing(history)
         met = estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance
-        if met and settled:
+        if estimates is not None and met and settled:
             return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, remarks=remarks,
                                 forms=forms)
         deferred = estimates if met else None
