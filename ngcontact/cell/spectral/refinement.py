@@ -50,7 +50,10 @@ the report names (:func:`sweep_estimates`):
 In 2D the contact fraction and the coefficients of eq. 34 rest on edges located between points by one of
 two locators (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`): the quartic fitted to the open
 gap where its window holds enough points and the fit explains the gap, else the line through the first
-two open points, whose root is off by a fraction of a step (first order, with a large constant).  On a
+two open points, whose root is off by a fraction of a step (first order, with a constant that jumps with
+the edges' position between points; in 3D the fraction counts points, alike).  A window holding such levels
+takes the guarded bound for these quantities: two ratios of such differences agree by chance (an error
+that stalls over two grids, as on a profile with kinks, alternates as if geometric).  On a
 smooth gap the quartic takes over at a grid fixed by its window (every edge of a load:
 :func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`, recorded per level), and the error drops there
 by one to two orders of magnitude.  A difference between a level of the line and one of the quartic is the
@@ -63,12 +66,26 @@ exceeds it by that drop.  So, for these quantities of a load whose edges have be
   differences, so two give the guarded bound), and the smaller of the two is reported: each is a bound on
   its own argument, the whole window's by the line's larger error, the fitted levels' by their own
   contraction;
-* with ``0 < r < LOCATOR_LEVELS`` the window compares the two locators: its estimate bounds the error, but
-  by the line's.  Where the tolerance is the scene's own, a stop is deferred to the level where the fitted
-  levels are enough (:func:`locator_changing`), unless that level is beyond the largest grid (the whole
-  window's estimate then stands): at most two more 2D levels, each twice the last, buy an estimate within
-  a small factor of the error.  Refined to the default tolerance (the cheapest grid that meets it,
-  ``sharpen = False`` in :func:`sweep_to_tolerance`), the first grid whose estimate meets it stops, its
+* with ``0 < r < MIN_LEVELS`` the fitted levels are too few to see their rate: with ``r < LOCATOR_LEVELS``
+  the window compares the two locators, a bound by the line's error; with ``r = LOCATOR_LEVELS`` the two
+  fitted differences give the guarded bound, whose envelope ``|d_(k-1)| ENVELOPE`` is still of the size
+  of the switch's drop.  Just after the switch the error may change sign, so that ``|d_k|`` is far below
+  ``|d_(k-1)|`` and neither says how fast the tail falls.  To a scene's own tolerance a stop waits for
+  ``MIN_LEVELS`` fitted levels (:func:`locator_changing`) unless that level is beyond the largest grid
+  (the whole window's estimate then stands): three differences whose two ratios decide between
+  Richardson (they agree and contract) and the guarded bound (they do not: "the estimate says so and
+  takes the larger").  Richardson's rate is held to first order there too, ``E = SPREAD |d_k| rho /
+  (1 - rho)``, ``rho = max(|d_k| / |d_(k-1)|, |d_(k-1)| / |d_(k-2)|, 1/2)``: a contraction much faster
+  than ``1/2`` right after the switch is the error crossing zero, and the next level falls at first order
+  again (on Westergaard's sinusoid at a twentieth of its closing pressure the fitted errors fall by about
+  16 per doubling twice, then by 2: the observed rate would estimate a tenth of the error, the first-order
+  one twice it).  The wait costs at most one 2D level more: the sweep, whose levels sum to about twice its
+  finest, about doubles.  On the level after a deferred stop (one whose estimate met the tolerance) each
+  estimate is the smaller of its own and the deferred one carried over, ``E_k = min(E_k^own, E_(k-1) +
+  |d_k|)`` (:data:`CARRIED`): by ``|e_k| <= |e_(k-1)| + |q_k - q_(k-1)|`` a bound wherever ``E_(k-1)`` is
+  one, it keeps a quantity whose window now holds a vanished difference (the mean closure at a fifth of
+  Westergaard's closing pressure) at what the deferred level stated.  Refined to the default tolerance
+  (``sharpen = False`` in :func:`sweep_to_tolerance`) the first grid whose estimate meets it stops, its
   estimate a bound but not a sharp one.  A load whose edges are never all fitted (a piecewise linear
   profile's kinks defeat the quartic) is estimated on the whole window.
 
@@ -160,16 +177,17 @@ ERRATIC = {"normal_stiffness": 2.0}
 #: the fewest levels whose 2D edges are all located by the quartic that estimate the quantities resting on the
 #: edges on their own (two differences: one that vanished is seen beside the other; module docstring)
 LOCATOR_LEVELS = 3
-#: the two forms of the estimate, as the report names them
-RICHARDSON, GUARDED = "Richardson", "guarded"
+#: the forms of the estimate, as the report names them (:data:`CARRIED`: after a deferred stop, module docstring)
+RICHARDSON, GUARDED, CARRIED = "Richardson", "guarded", "carried"
 #: how the estimate is made, for the report
 HOW = ("grids of twice the points per direction each; per quantity and load, Richardson with the observed rate "
        f"of the last {WINDOW} differences where their two ratios agree within a factor {AGREE:g} (rate at least "
        f"{FIRST_ORDER}, the tail times {SPREAD:g}) if that is the smaller, else the guarded geometric tail: "
        f"rate the larger ratio held to [{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished "
-       "last one; in 2D the contact fraction and coefficients also on the levels whose edges the quartic "
-       f"located (at least {LOCATOR_LEVELS}), the smaller estimate; the effective stiffness's estimate times "
-       f"{ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance")
+       "last one; the contact fraction and coefficients guarded on levels of edges not all fitted by the quartic, "
+       f"and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
+       "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
+       f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance")
 
 
 @dataclass
@@ -277,8 +295,9 @@ def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float
             # a coefficient's edges are the fraction's: not geometric where the fraction's sequence is not
             geometric = not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
             args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
-            out[name], form[name], note = tail_estimate(values, *args)
             run = fitted_run(history, k) if on_edges(name) else 0
+            line = on_edges(name) and run < len(history)
+            out[name], form[name], note = tail_estimate(values, *args[:3], geometric and not line)
             if LOCATOR_LEVELS <= run < len(history):
                 sharp = tail_estimate(values[-run:], *args)
                 if sharp[0] < out[name]:
@@ -294,6 +313,24 @@ def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float
     if guarded:
         remarks.append("guarded on " + ", ".join(guarded))
     return estimates, remarks, forms
+
+
+def carried(previous: list[dict[str, float]], history: list[dict[str, Any]], estimates: list[dict[str, float]],
+            forms: list[dict[str, str]]) -> int:
+    """Lower ``estimates`` (per load, of the last level of ``history``; their ``forms`` with them) in place to
+    the estimates ``previous`` of the level before plus the difference between the two levels where that is
+    smaller: ``|e_k| <= |e_(k-1)| + |q_k - q_(k-1)|`` (module docstring).  Returns how many it lowered."""
+    last, before = history[-1], history[-2]
+    lowered = 0
+    for k, per_load in enumerate(estimates):
+        now, then = last["headline"][k], before["headline"][k]
+        for name, own in ((n, e) for n, e in per_load.items() if n in previous[k]):
+            bound = (previous[k][name] * scale(name, then, before["whole_surface"]) + abs(now[name] - then[name])
+                     ) / scale(name, now, last["whole_surface"])
+            if bound < own:
+                per_load[name], forms[k][name] = bound, CARRIED
+                lowered += 1
+    return lowered
 
 
 def on_edges(name: str) -> bool:
@@ -314,10 +351,11 @@ def fitted_run(history: list[dict[str, Any]], k: int) -> int:
 
 
 def locator_changing(history: list[dict[str, Any]]) -> bool:
-    """Whether some load's edges came to be located by the quartic fewer than :data:`LOCATOR_LEVELS` levels
-    ago: its differences up to the last level then still compare the two locators (module docstring)."""
+    """Whether some load's edges came to be located by the quartic fewer than :data:`MIN_LEVELS` levels
+    ago: its fitted levels then show fewer than the two ratios of differences that decide between
+    Richardson and the guarded bound (module docstring)."""
     loads = len(history[-1]["headline"])
-    return any(0 < run < min(LOCATOR_LEVELS, len(history)) for run in (fitted_run(history, k) for k in range(loads)))
+    return any(0 < run < min(MIN_LEVELS, len(history)) for run in (fitted_run(history, k) for k in range(loads)))
 
 
 def levels(grid: int, dim: int, max_points: int) -> list[int]:
@@ -380,18 +418,25 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
                   grids[-1] ** (dim - 1), len(grids), grid)
     history: list[dict[str, Any]] = []
     sols: list = []
+    deferred = None                 # the estimates of a level that met the tolerance but waited on the edge fit
     for n in grids:
         cell, sols, entry = solve_level(make_cell, loads, n, sols or None)
         history.append(entry)
         estimates, remarks, forms = sweep_estimates(history) if len(history) > 1 else (None, [], [])
+        if estimates is not None and deferred is not None:
+            if lowered := carried(deferred, history, estimates, forms):
+                remarks.append(f"{lowered} estimates carried from the deferred grid {history[-2]['grid']}: its "
+                               "estimate plus the last difference")
         if estimates is not None:
             entry["estimate"] = controlled_estimate(estimates)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
                       f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
         settled = not sharpen or n == grids[-1] or not locator_changing(history)
-        if estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance and settled:
+        met = estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance
+        if estimates is not None and met and settled:
             return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, remarks=remarks,
                                 forms=forms)
+        deferred = estimates if met else None
     reached = f"{entry['estimate']:.3g}" if estimates is not None else "no estimate (one level)"
     message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on {entry['points']} "
                f"grid points, and the next grid of {next_grid(grids[-1], dim)} per direction would exceed "
