@@ -17,11 +17,16 @@ exact contact, started from the spectral twin on ``128^2``:
 * ``patch``: order 1, the sizes scaled with the twin's patch radius ``a``
   (:func:`~ngcontact.cell.fe.contact_edge_mesh.patch_radius`): the edge at
   ``a / n_edge`` and the bodies below and above the patch at ``a / n_body``
-  to a depth ``d a`` (:class:`~ngcontact.cell.fe.contact_edge_mesh.PatchBody`).
+  to a depth ``d a`` (:class:`~ngcontact.cell.fe.contact_edge_mesh.PatchBody`), the bodies' size growing
+  with the depth at the rate ``growth`` (``0``: uniform to ``d a``).
 
 The converged value is the spectral cell's contact fraction extrapolated
 from ``512^2`` and ``1024^2`` (its grid counting errs by one order in the
-spacing).  Seconds: twin, meshing and solve, with the threads asked for.
+spacing).  Seconds: twin, meshing and solve, with the threads asked for;
+per phase: ``twin_seconds``, ``mesh_seconds``, ``solve_seconds`` (the
+cell problem's setup, the bodies' assembly, Uzawa's passes with their
+Newton steps and tangent solves, the contact fraction), and the tangent
+solves' CG iterations.
 """
 from __future__ import annotations
 
@@ -67,12 +72,19 @@ def _fe_solve(cell, order: int, edge: float, load, threads: int) -> tuple[object
         return P, P.solve(load, first=True, measure=False)
 
 
-def _row(solver: str, size, P, sol, seconds: float, ratio: float, ref: float) -> dict:
+def _row(solver: str, size, P, sol, phases: list[float], ratio: float, ref: float) -> dict:
+    """The row of one solve; ``phases``: the ``perf_counter`` times at its start and after the twin, the
+    meshing and the solve."""
     f = float(sol.results["contact_fraction"])
-    log.info("accuracy: %s p/p* %-6g size %-12s ndof %7d: fraction %.6f (converged %.6f, %+.2f %%), %.1f s",
-             solver, ratio, size, P.ndof, f, ref, 100.0 * (f / ref - 1.0), seconds)
+    twin, mesh, solve = (float(t) for t in np.diff(phases))
+    seconds = phases[-1] - phases[0]
+    log.info("accuracy: %s p/p* %-6g size %-12s ndof %7d: fraction %.6f (converged %.6f, %+.2f %%), %.1f s "
+             "(twin %.1f, mesh %.1f, solve %.1f)", solver, ratio, size, P.ndof, f, ref, 100.0 * (f / ref - 1.0),
+             seconds, twin, mesh, solve)
     return {"part": "accuracy", "solver": solver, "size": size, "ndof": P.ndof, "seconds": seconds,
-            "newton_steps": sol.iterations, "contact_fraction": f, "pressure": ratio, "relative_error": f / ref - 1.0}
+            "twin_seconds": twin, "mesh_seconds": mesh, "solve_seconds": solve,
+            "newton_steps": sol.iterations, "cg_iterations": sum(P.linear.iterations), "contact_fraction": f,
+            "pressure": ratio, "relative_error": f / ref - 1.0}
 
 
 def edge_rows(edges, orders, threads: int, loads, converged) -> list[dict]:
@@ -80,37 +92,43 @@ def edge_rows(edges, orders, threads: int, loads, converged) -> list[dict]:
     from ngcontact.cell.fe.contact_edge_mesh import edge_points, edge_refined_cell
     twin, rows = bisinusoid_spectral(ACC_TWIN), []
     for edge, order, (ratio, ld, ref) in itertools.product(edges, orders, zip(ACC_RATIOS, loads, converged)):
-        t0 = time.perf_counter()
+        phases = [time.perf_counter()]
         pts = edge_points(twin.solve(ld).fields["pressure"], 1.0)
+        phases.append(time.perf_counter())
         cell = edge_refined_cell(pts, edge_maxh=edge, maxh=ACC_MAXH, interface_maxh=ACC_INTERFACE)
+        phases.append(time.perf_counter())
         P, sol = _fe_solve(cell, order, edge, ld, threads)
-        rows.append(_row(f"fe exact order {order}, edge-refined", edge, P, sol, time.perf_counter() - t0,
-                         ratio, ref))
+        phases.append(time.perf_counter())
+        rows.append(_row(f"fe exact order {order}, edge-refined", edge, P, sol, phases, ratio, ref))
     return rows
 
 
-def patch_rows(patch, threads: int, loads, converged) -> list[dict]:
+def patch_rows(patch, threads: int, loads, converged, growth: float = 0.0) -> list[dict]:
     """The ``patch`` method (module docstring) per load; ``patch = (n_edge, n_body, d)``."""
     from ngcontact.cell.fe.contact_edge_mesh import edge_points, edge_refined_cell, patch_body, patch_radius
     twin, rows = bisinusoid_spectral(ACC_TWIN), []
     n_edge, n_body, depth = patch
     for ratio, ld, ref in zip(ACC_RATIOS, loads, converged):
-        t0 = time.perf_counter()
+        phases = [time.perf_counter()]
         p = twin.solve(ld).fields["pressure"]
+        phases.append(time.perf_counter())
         a = patch_radius(p, 1.0)
-        body = patch_body(p, 1.0, maxh=a / n_body, depth=depth * a)
+        body = patch_body(p, 1.0, maxh=a / n_body, depth=depth * a, growth=growth)
         cell = edge_refined_cell(edge_points(p, 1.0), edge_maxh=a / n_edge, maxh=PATCH_MAXH,
                                  interface_maxh=ACC_INTERFACE, body=body)
+        phases.append(time.perf_counter())
         P, sol = _fe_solve(cell, 1, a / n_edge, ld, threads)
-        rows.append(_row("fe exact order 1, patch-refined", f"a/{n_edge:g} a/{n_body:g} {depth:g}a", P, sol,
-                         time.perf_counter() - t0, ratio, ref))
+        phases.append(time.perf_counter())
+        size = f"a/{n_edge:g} a/{n_body:g} {depth:g}a" + (f" growth {growth:g}" if growth else "")
+        rows.append(_row("fe exact order 1, patch-refined", size, P, sol, phases, ratio, ref))
     return rows
 
 
-def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None = None) -> list[dict]:
-    """Part 4 (module docstring): the ``edge`` rows, the ``patch`` rows (``patch = None``: none) and the
-    extrapolations in the edge size of the order-2 ``edge`` rows; per load: seconds, dofs, relative error
-    of the contact fraction."""
+def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None = None,
+                 growth: float = 0.0) -> list[dict]:
+    """Part 4 (module docstring): the ``edge`` rows, the ``patch`` rows (``patch = None``: none; ``growth``: of
+    their bodies' size with the depth) and the extrapolations in the edge size of the order-2 ``edge`` rows;
+    per load: seconds, dofs, relative error of the contact fraction."""
     from ngcontact import runner
     from ngcontact.cell.cell_load import cell_load
     loads = [cell_load(3, pressure=r * math.pi * ACC_H) for r in ACC_RATIOS]
@@ -120,7 +138,7 @@ def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None 
     threads = runner.thread_count() if threads is None else threads
     rows = edge_rows(edges, orders, threads, loads, converged) if edges else []
     if patch is not None:
-        rows += patch_rows(patch, threads, loads, converged)
+        rows += patch_rows(patch, threads, loads, converged, growth)
     return rows + extrapolated_rows(rows, dict(zip(ACC_RATIOS, converged)))
 
 

@@ -27,7 +27,7 @@ Four measurements, one run, one CSV and one PNG:
    patch radius (``patch`` rows, ``--accuracy-patch``); the sibling module
    ``bisinusoid_accuracy.py`` says what is solved.  Column
    ``relative_error``; the seconds include the twin, the meshing and the
-   solve (threads: ``--accuracy-threads``).
+   solve (threads: ``--accuracy-threads``), and each phase on its own.
 
 Every solve of parts 1 and 2 runs in its own child process, so that its peak
 memory (``VmHWM``) is its own.  Reported per solve: dofs, wall time of the
@@ -54,7 +54,8 @@ Usage::
 
     python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral accuracy]
                                  [--accuracy-edges [EDGE_MAXH ...]] [--accuracy-orders 1 2]
-                                 [--accuracy-patch N_EDGE N_BODY DEPTH | --accuracy-no-patch] [--accuracy-threads N]
+                                 [--accuracy-patch N_EDGE N_BODY DEPTH | --accuracy-no-patch]
+                                 [--accuracy-patch-growth GROWTH] [--accuracy-threads N]
                                  [--solvers iterative direct] [--breakdown INTERFACE_MAXH]
                                  [--coarse INTERFACE_MAXH [--k-n K]] [--republish CSV]
 
@@ -89,8 +90,9 @@ MACRO_SIZES = (0.3, 0.2, 0.14, 0.1, 0.075, 0.041)
 QUICK_CELL, QUICK_MACRO = (0.16, 0.12), (0.35, 0.3)
 AMPLITUDE, PRESSURES = 0.005, (0.00185, 0.0065)
 SPECTRAL_GRIDS, TAMAAS_GRID = (64, 128, 256, 512), 1024
-KEYS = ("part", "solver", "size", "ndof", "seconds", "measure_seconds", "newton_steps", "cg_iterations",
-        "peak_memory_gb", "contact_fraction", "pressure", "relative_error", "estimate")
+KEYS = ("part", "solver", "size", "ndof", "seconds", "measure_seconds", "twin_seconds", "mesh_seconds",
+        "solve_seconds", "newton_steps", "cg_iterations", "peak_memory_gb", "contact_fraction", "pressure",
+        "relative_error", "estimate")
 
 
 def peak_memory_gb() -> float:
@@ -461,7 +463,7 @@ def measured_rows(args) -> list[dict]:
     if "accuracy" in args.parts:
         edges = args.accuracy_edges if args.accuracy_edges is not None else QUICK_EDGES if args.quick else ACC_EDGES
         rows += accuracy_aim(edges, tuple(args.accuracy_orders), None if args.accuracy_no_patch else
-                             tuple(args.accuracy_patch), args.accuracy_threads)
+                             tuple(args.accuracy_patch), args.accuracy_threads, args.accuracy_patch_growth)
     return rows
 
 
@@ -493,6 +495,9 @@ def main(argv=None) -> int:
     ap.add_argument("--accuracy-patch", type=float, nargs=3, default=ACC_PATCH, metavar=("N_EDGE", "N_BODY", "DEPTH"),
                     help="part 4's patch-refined rows: edge a/N_EDGE, bodies a/N_BODY to DEPTH a, a the twin's patch "
                          "radius (default %s)" % " ".join(f"{v:g}" for v in ACC_PATCH))
+    ap.add_argument("--accuracy-patch-growth", type=float, default=0.0, metavar="GROWTH",
+                    help="part 4's patch-refined rows: the bodies' size a/N_BODY + GROWTH |z| at depth |z| "
+                         "(default 0: a/N_BODY to DEPTH a)")
     ap.add_argument("--accuracy-no-patch", action="store_true", help="no patch-refined rows in part 4")
     ap.add_argument("--accuracy-threads", type=int, default=None,
                     help="threads of part 4's FE solves (default: as ngcontact run)")
@@ -553,11 +558,13 @@ def main(argv=None) -> int:
                                    "linear trace on S_C with rows `extrapolated`: Richardson in the edge size "
                                    "over the sizes listed, `estimate` its estimated relative error) or, order 1, "
                                    "along the edge and in the bodies below and above the patch (`patch-refined`, "
-                                   "`size`: edge a/N_EDGE, bodies a/N_BODY to DEPTH a, a the twin's patch radius), "
+                                   "`size`: edge a/N_EDGE, bodies a/N_BODY to DEPTH a, a the twin's patch radius; "
+                                   "`growth G`: the bodies' size a/N_BODY + G |z| at depth |z|), "
                                    "per `pressure` = p/p* "
                                    "(p* = pi E* h, h = 0.01, E* = 1), `relative_error` of the contact fraction "
                                    "against the spectral cell extrapolated from 512^2 and 1024^2 (issue 38 aims "
-                                   "at 1 % in 60 s; seconds: twin, meshing and solve" + (
+                                   "at 1 % in 60 s; seconds: twin, meshing and solve, each on its own in "
+                                   "`twin_seconds`, `mesh_seconds`, `solve_seconds`" + (
                                        f", {args.accuracy_threads} thread(s)" if args.accuracy_threads else "") +
                                    "); timings under the load of other jobs. Seconds of "
                                    "setup and solve, of the measurement after it, Newton steps, CG iterations, "

@@ -57,11 +57,26 @@ def test_patch_body_on_the_contact_points_of_a_disk():
     assert abs(patch_radius(p, 1.0) - 0.2) < 0.01
 
 
+def test_graded_patch_body_layers_spaced_by_their_size():
+    """With ``growth`` the size at depth ``|z|`` is ``maxh + growth |z|`` and each layer lies LAYER_SPACING of
+    the size of the one before it further out, to the depth, alike above and below."""
+    body = PatchBody(points=np.zeros((1, 2)), maxh=0.01, depth=0.2, growth=0.3)
+    z = np.sort(body.heights())
+    np.testing.assert_allclose(z, -z[::-1])
+    up = z[z >= 0.0]
+    assert up[0] == 0.0 and abs(up[1] - LAYER_SPACING * 0.01) < 1e-12 and up[-1] <= 0.2
+    np.testing.assert_allclose(np.diff(up)[1:], LAYER_SPACING * body.size(up[1:-1]))
+    np.testing.assert_allclose(body.size(up), 0.01 + 0.3 * up)
+    assert len(up) < len(np.sort(PatchBody(points=np.zeros((1, 2)), maxh=0.01, depth=0.2).heights())) / 2
+
+
 def test_patch_body_of_no_size_is_refused():
     with pytest.raises(GeometryError, match="body maxh"):
         PatchBody(points=np.zeros((1, 2)), maxh=0.0, depth=0.1)
     with pytest.raises(GeometryError, match="body depth"):
         PatchBody(points=np.zeros((1, 2)), maxh=0.1, depth=-1.0)
+    with pytest.raises(GeometryError, match="body growth"):
+        PatchBody(points=np.zeros((1, 2)), maxh=0.1, depth=0.1, growth=-0.5)
 
 
 def _interface_sizes(cell):

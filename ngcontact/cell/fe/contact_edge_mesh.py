@@ -96,30 +96,45 @@ def edge_points(pressure: np.ndarray, period: float) -> np.ndarray:
 class PatchBody:
     """The bodies below and above the contact patches meshed at ``maxh`` to ``depth`` (module docstring).
 
-    ``points``: ``(m, 2)`` points ``(x, y)`` of the patches on ``S_C``.
+    ``points``: ``(m, 2)`` points ``(x, y)`` of the patches on ``S_C``.  ``growth``: the size at depth ``|z|``
+    is ``maxh + growth |z|`` (``0``: ``maxh`` at every depth), graded like the Hertz field's gradient, which
+    falls with the distance from the patch.
     """
 
     points: np.ndarray
     maxh: float
     depth: float
+    growth: float = 0.0
 
     def __post_init__(self):
         if not (np.isfinite(self.maxh) and self.maxh > 0):
             raise GeometryError("body maxh", self.maxh, "must be > 0")
         if not (np.isfinite(self.depth) and self.depth >= 0):
             raise GeometryError("body depth", self.depth, "must be >= 0")
+        if not (np.isfinite(self.growth) and self.growth >= 0):
+            raise GeometryError("body growth", self.growth, "must be >= 0")
+
+    def size(self, z) -> np.ndarray:
+        """The element size at height ``z``: ``maxh + growth |z|``."""
+        return self.maxh + self.growth * np.abs(np.asarray(z, float))
 
     def heights(self) -> np.ndarray:
-        """The ``z`` of the layers: ``0`` and ``+-k LAYER_SPACING maxh`` up to ``depth``."""
-        k = np.arange(1, int(np.floor(self.depth / (LAYER_SPACING * self.maxh) + 1e-9)) + 1)
-        z = LAYER_SPACING * self.maxh * k
-        return np.concatenate(([0.0], -z, z))
+        """The ``z`` of the layers: ``0`` and ``+-z_k`` up to ``depth``, ``z_(k+1) = z_k + LAYER_SPACING
+        size(z_k)`` (:meth:`size`; evenly ``LAYER_SPACING maxh`` apart without growth)."""
+        z: list[float] = []
+        at = LAYER_SPACING * self.maxh
+        while at <= self.depth * (1.0 + 1e-9):
+            z.append(at)
+            at += LAYER_SPACING * float(self.size(at))
+        zz = np.array(z)
+        return np.concatenate(([0.0], -zz, zz))
 
 
-def patch_body(pressure: np.ndarray, period: float, *, maxh: float, depth: float) -> PatchBody:
+def patch_body(pressure: np.ndarray, period: float, *, maxh: float, depth: float,
+               growth: float = 0.0) -> PatchBody:
     """A :class:`PatchBody` on the contact points of a periodic ``n_y x n_x`` pressure grid (as for
     :func:`edge_points`): the grid points carrying pressure, every ``s``-th along each axis with ``s`` the
-    grid steps in ``maxh`` (at least 1)."""
+    grid steps in ``maxh`` (at least 1); ``growth`` as for :class:`PatchBody`."""
     p = np.asarray(pressure, float)
     if p.ndim != 2:
         raise ValueError(f"pressure has shape {p.shape}: a 2D grid of a 3D cell is needed")
@@ -128,7 +143,7 @@ def patch_body(pressure: np.ndarray, period: float, *, maxh: float, depth: float
     i, j = np.nonzero(p > 0.0)
     keep = (i % stride == 0) & (j % stride == 0)
     pts = np.stack((j[keep] * period / nx, i[keep] * period / ny), axis=1)
-    return PatchBody(points=pts, maxh=float(maxh), depth=float(depth))
+    return PatchBody(points=pts, maxh=float(maxh), depth=float(depth), growth=float(growth))
 
 
 def patch_radius(pressure: np.ndarray, period: float) -> float:
@@ -173,8 +188,9 @@ def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1
         below = np.clip(np.asarray(body.points, float).reshape(-1, 2) % P, FACE_CLEARANCE * P,
                         (1.0 - FACE_CLEARANCE) * P)
         for z in body.heights():
+            h = float(body.size(z))
             for x, y in below:
-                mp.RestrictH(x=float(x), y=float(y), z=float(z), h=float(body.maxh))
+                mp.RestrictH(x=float(x), y=float(y), z=float(z), h=h)
     ngmesh = geo.GenerateMesh(mp=mp)
     cell3d._name_faces(ngmesh)
     mesh = ng.Mesh(ngmesh)
