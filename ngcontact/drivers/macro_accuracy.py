@@ -74,10 +74,9 @@ class SafetyFactor:
 
 
 def exclusion_for(scene, sol: MacroSolution) -> AM.Exclusion | None:
-    """The balls around the singular points of ``sol`` (:mod:`ngcontact.macro.away_maxima`), with the
-    scene's ``discretization.exclusion_radius``; ``None`` with ``[two_scale]``, in 3D or without any."""
-    if getattr(scene, "two_scale", None) is not None:
-        return None
+    """The balls around the singular points of ``sol`` (tubes around its singular edges in 3D,
+    :mod:`ngcontact.macro.away_maxima`), with the scene's ``discretization.exclusion_radius``; ``None``
+    without any."""
     check_radius(scene, sol.problem)
     return AM.exclusion_of(sol, getattr(scene.discretization, "exclusion_radius", None))
 
@@ -218,7 +217,7 @@ def check_radius(scene, problem) -> None:
         (:func:`ngcontact.macro.away_maxima.smallest_extent`).
     """
     radius = getattr(scene.discretization, "exclusion_radius", None)
-    if radius is None or problem.mesh.dim != 2:
+    if radius is None:
         return
     smallest = AM.smallest_extent(problem.mesh, (problem.rough, problem.counter))
     if not 0.0 < radius < smallest:
@@ -244,14 +243,15 @@ def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], bal
     and its balls), the safety factor re-evaluated with the strength check's correctors ``recovery``."""
     found, exclusion = (None, None) if refined is None else (refined.estimates, refined.exclusion)
     if found is None:
-        exclusion = None if two_scale is not None else exclusion_for(scene, sol)
+        exclusion = exclusion_for(scene, sol)
         safety = safety_factor_of(scene, recovery)
         samples = order_samples(scene, sol, solve, safety, exclusion=exclusion)
         found = estimates(samples, sol)
-        if sol.problem.mesh.dim == 2 and two_scale is None:
+        if sol.problem.mesh.dim == 2:
             found = SM.check(found, sol, samples[sol.problem.order], solve)
-            found = AM.settle(away_judged(found, sol, solve, exclusion, samples[sol.problem.order], safety),
-                              exclusion)
+        else:
+            found = AM.inside_tubes(SM.at_closed_ends(found, SM.closed_ends(sol)), exclusion)
+        found = AM.settle(away_judged(found, sol, solve, exclusion, samples[sol.problem.order], safety), exclusion)
     out = verdict(found, scene.discretization.tolerance, balance, two_scale)
     if exclusion is not None:
         out["exclusion"] = exclusion.record()

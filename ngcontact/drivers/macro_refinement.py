@@ -139,7 +139,7 @@ class Singular:
     def judged(self, found: list[DE.Estimate]) -> list[DE.Estimate]:
         """``found`` with the maxima singular at a closed end mesh dependent, those with a counterpart away
         from the singular points not counted (:func:`ngcontact.macro.away_maxima.settle`)."""
-        return AM.settle(SM.at_closed_ends(found, self.ends), self.exclusion)
+        return AM.settle(AM.inside_tubes(SM.at_closed_ends(found, self.ends), self.exclusion), self.exclusion)
 
 
 def level(sol: MacroSolution, found: list[DE.Estimate], tolerance: float, h_level: int = 0) -> dict[str, Any]:
