@@ -15,17 +15,22 @@ The verdict has the format of the cell's (:func:`ngcontact.cell.admissibility.ve
   the cell table's interpolation error (relative, paper Sec. 3.5; :mod:`ngcontact.coupling.pressure_table`);
 * the check ``equilibrium`` (each body's forces balance, :func:`ngcontact.macro.macro_measures.equilibrium`).
 
-In 2D, without ``[two_scale]`` and without a refinement (whose mesh levels judge them), every stress maximum
-is also judged by two local refinements at the corners of the boundary
-(:mod:`ngcontact.macro.singular_maxima`): the ladder converges to the stress at sample points fixed on
-the mesh, which at a singular corner moves with the mesh; such a maximum is reported as mesh dependent.
+In 2D, without a refinement (whose mesh levels judge them), every stress maximum is also judged by two local
+refinements at the corners of the boundary (:mod:`ngcontact.macro.singular_maxima`): the ladder converges to
+the stress at sample points fixed on the mesh, which at a singular corner moves with the mesh; such a
+maximum is reported as mesh dependent.
 Where the interface ends closed on a boundary without support, every stress maximum and the safety factor
 are mesh dependent (a refinement too judges them so).
 
-In 2D without ``[two_scale]``, where the bodies have singular points, each stress maximum and the safety
-factor have a counterpart away from them (:mod:`ngcontact.macro.away_maxima`: ``<name>_away``, outside a
-ball of radius ``discretization.exclusion_radius`` around each point, ``accuracy.exclusion``), estimated
-as the others; a mesh-dependent maximum with such a counterpart is listed with ``counted = false``.
+Where the bodies have singular points (2D) or edges (3D), each stress maximum and the safety factor have
+a counterpart away from them (:mod:`ngcontact.macro.away_maxima`: ``<name>_away``, outside a ball of radius
+``discretization.exclusion_radius`` around each point, a tube around each edge, ``accuracy.exclusion``),
+estimated as the others; a mesh-dependent maximum with such a counterpart is listed with
+``counted = false``.  A two-scale run's macro solution is judged as a macro run's: its neighbouring orders
+and local levels are solved with the loop's converged law, which is pointwise in the closure (a table of
+the cell's response), so it holds on any mesh.  In 3D the corner check is not taken: a maximum over a
+whole body attained within the tubes is mesh dependent (:func:`ngcontact.macro.away_maxima.inside_tubes`),
+and one where the interface ends closed as in 2D.
 
 A counted quantity whose relative error exceeds the tolerance, or has none (not converging, a stress
 singularity), marks the verdict as not met and is said in one warning line.
@@ -53,9 +58,10 @@ log = logging.getLogger(__name__)
 #: how the verdict's errors are estimated (the report's ``accuracy.how``)
 HOW = ("discretization error of each headline quantity from solves at the neighbouring polynomial orders on "
        "the scene's mesh (ngcontact.macro.discretization_error), each stress maximum of a 2D run judged by two "
-       "local refinements at the boundary's corners (ngcontact.macro.singular_maxima); in 2D each stress maximum "
-       "and the safety factor also away from the singular points (*_away, ngcontact.macro.away_maxima), judged "
-       "by two local refinements there as well, counted where the global one is mesh dependent; the two-scale "
+       "local refinements at the boundary's corners (ngcontact.macro.singular_maxima); each stress maximum and "
+       "the safety factor also away from the singular points, in 3D the singular edges (*_away, "
+       "ngcontact.macro.away_maxima), judged by two local refinements there as well, counted where the global one "
+       "is mesh dependent; the two-scale "
        "loop's residual and the cell table's interpolation error as their own quantities")
 #: the meaning of the macro run's checks
 CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its largest force"}
