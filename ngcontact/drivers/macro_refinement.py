@@ -42,11 +42,12 @@ Then the mesh (h), where the order no longer pays
     * A scene with ``[two_scale]`` keeps its mesh (the loop's interface state lives on it).
 
 What is refined for
-    Only the quantities the verdict counts (:func:`unmet`).  In 2D without ``[two_scale]``, where the
-    interface ends closed on a boundary without support (:func:`ngcontact.macro.singular_maxima.closed_ends`
-    on the scene's solution), every stress maximum over a whole body and the safety factor are mesh
-    dependent on every level: their counterparts away from the singular points
-    (:mod:`ngcontact.macro.away_maxima`, the same balls on every level) converge, and they, not the
+    Only the quantities the verdict counts (:func:`unmet`).  Where the interface ends closed on a boundary
+    without support (:func:`ngcontact.macro.singular_maxima.closed_ends` on the scene's solution), every
+    stress maximum over a whole body and the safety factor are mesh dependent on every level (in 3D also
+    one attained within the tubes around the singular edges,
+    :func:`ngcontact.macro.away_maxima.inside_tubes`): their counterparts away from the singular points
+    (:mod:`ngcontact.macro.away_maxima`, the same balls or tubes on every level) converge, and they, not the
     mesh-dependent maxima, are refined for; each level judges them by local refinements at the singular
     points as well (:mod:`ngcontact.macro.away_sequence`), so a level's estimate of them has seen the
     mesh there.  A maximum once judged mesh dependent is never refined for, so no time is spent on a

@@ -14,6 +14,8 @@ from ngcontact.drivers import macro_accuracy as MA
 from ngcontact.macro import away_maxima as AM
 from ngcontact.macro import singular_edges as SE
 from ngcontact.macro.singular_set import SingularSet
+from ngcontact.output.report import accuracy_line
+from ngcontact.output.report_html import accuracy_table
 from ngcontact.scene import loader
 
 #: a block (20 x 10 x 5 mm) on a base of the same footprint clamped at its bottom, pressed on its top
@@ -100,10 +102,16 @@ def test_a_3d_clamp_edge_is_found_and_the_maximum_away_from_it_converges_with_th
         assert ex.singular.distance(where)[0] >= ex.radius * (1 - 1e-9)       # outside the tubes or on them
     # the verdict counts the maxima away, not the global maxima (mesh dependent at the clamp or the closed end)
     settled = AM.settle(AM.inside_tubes(SM.at_closed_ends(list(found.values()), SM.closed_ends(sol)), ex), ex)
-    q = {x["name"]: x for x in MA.verdict(settled, 0.5, None)["quantities"]}
+    acc = MA.verdict(settled, 0.5, None)
+    q = {x["name"]: x for x in acc["quantities"]}
     for body in ("rough", "counter"):
         assert not q[f"von_mises_{body}"]["counted"] and q[f"von_mises_{body}"]["singular_at"] is not None
         assert q[f"von_mises_{body}_away"]["counted"] and q[f"von_mises_{body}_away"]["error"] is not None
+    # the terminal line and the page name the singular edges
+    acc["exclusion"] = ex.record()
+    assert "of the singular edges (2 curves, 0.12 m: " in accuracy_line({"accuracy": acc})
+    page = accuracy_table({"results": {"accuracy": acc}})
+    assert "singular edge" in page and SE.CLAMPED in page
 
 
 def test_the_distance_to_a_singular_set_of_points_and_segments():
@@ -135,7 +143,7 @@ def _two_scale(tmp_path):
 
 def test_a_two_scale_run_reports_its_maxima_away_with_their_estimates(tmp_path):
     from ngcontact.drivers import run_macro as D
-    from ngcontact.output.report import Clock, accuracy_line
+    from ngcontact.output.report import Clock
     out = D.run(_two_scale(tmp_path), Clock())
     acc = out.results["accuracy"]
     q = {x["name"]: x for x in acc["quantities"]}
