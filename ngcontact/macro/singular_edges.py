@@ -50,10 +50,11 @@ TET_EDGES = ((0, 1, 2, 3), (0, 2, 1, 3), (0, 3, 1, 2), (1, 2, 0, 3), (1, 3, 0, 2
 
 def boundary_edges(mesh: ng.Mesh) -> tuple[dict[tuple[int, int], set[str]], np.ndarray]:
     """Per edge of the boundary mesh (its two vertex numbers, the smaller first) the labels of the boundary
-    elements that hold it (not those on faces inside one body, :func:`internal_faces`), and every vertex's
+    elements that hold it (not those on faces inside one body,
+    :func:`ngcontact.macro.discretization_error.internal_faces`), and every vertex's
     point."""
     labels: dict[tuple[int, int], set[str]] = {}
-    inner = internal_faces(mesh)
+    inner = DE.internal_faces(mesh)
     for el in mesh.Elements(ng.BND):
         vs = [v.nr for v in el.vertices]
         if tuple(sorted(vs)) in inner:
@@ -62,22 +63,6 @@ def boundary_edges(mesh: ng.Mesh) -> tuple[dict[tuple[int, int], set[str]], np.n
             a, b = vs[k - 1], vs[k]
             labels.setdefault((min(a, b), max(a, b)), set()).add(el.mat)
     return labels, np.array([mesh[ng.NodeId(ng.VERTEX, i)].point for i in range(mesh.nv)])
-
-
-def internal_faces(mesh: ng.Mesh) -> set[tuple[int, ...]]:
-    """The faces (sorted vertex numbers) between two volume elements of one body: labelled boundary elements
-    there (a solid's internal faces, as the 3D femur's stem has where its cone and cylinders meet) bound no
-    body."""
-    seen: dict[tuple[int, ...], str] = {}
-    out = set()
-    for el in mesh.Elements(ng.VOL):
-        vs = [v.nr for v in el.vertices]
-        for k in range(len(vs)):
-            face = tuple(sorted(vs[:k] + vs[k + 1:]))
-            if seen.get(face) == el.mat:
-                out.add(face)
-            seen[face] = el.mat
-    return out
 
 
 def dihedral_angles(mesh: ng.Mesh, region: str, edges: set[tuple[int, int]]) -> dict[tuple[int, int], float]:

@@ -137,9 +137,10 @@ def corners_of(mesh: ng.Mesh) -> np.ndarray:
 def closed_ends(sol: MacroSolution, points_per_element: int = 5) -> list[tuple[tuple[float, ...], float]]:
     """The ends of the interface on a boundary without support (free or loaded) where the interface is
     closed (pressure above :data:`CLOSED` of its peak), each with its pressure, the largest first (3D: the
-    vertices of its boundary edges there, :func:`ngcontact.macro.macro_measures.interface_surface`)."""
+    vertices of its boundary edges there, :func:`ngcontact.macro.macro_measures.interface_surface`; faces
+    inside one body are no boundary)."""
     p = sol.problem
-    labels, _, pts = DE.boundary_vertices(p.mesh)
+    labels, _, pts = DE.boundary_vertices(p.mesh, bodies_only=p.mesh.dim == 3)
     supported = {s.label for s in p.supports}
     ends = [v for v, names in labels.items()
             if p.interface in names and len(names) > 1 and not (names - {p.interface}) & supported]
