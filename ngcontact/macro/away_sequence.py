@@ -8,14 +8,14 @@ falls only algebraically with the order and pollutes the stress everywhere (Babu
 converges algebraically on a mesh not graded towards a singular point).  The ladder's geometric
 extrapolation from three orders misses that share.
 
-Only smaller elements at the singular points remove it.  So the elements with a vertex at a singular
-point (in 3D: on a singular edge, :meth:`ngcontact.macro.singular_set.SingularSet.star`), those the balls'
+Only smaller elements at the singular points remove it.  So the elements with a vertex at a singular point
+(in 3D: on a singular edge, :meth:`ngcontact.macro.singular_set.SingularSet.star`), those the balls'
 circles cross (where a maximum away from a singular point is attained when the stress grows towards it;
-:data:`CIRCLE` points each) and those holding the maxima away are refined :data:`LEVELS` times (Netgen's local refinement, on copies of
-the mesh; each level solved at the scene's order from the last level's solution interpolated into its
-space, as the corner check of :mod:`ngcontact.macro.singular_maxima` does), and each maximum away is
-taken on every level (``Q_0`` the scene's mesh, ``Q_1``, ``Q_2``).  The finest level's value and location
-are reported; its error (:func:`level_error`) from the differences ``d_1 = Q_1 - Q_0``,
+:data:`CIRCLE` points each) and those holding the maxima away are refined :data:`LEVELS` times (Netgen's
+local refinement, on copies of the mesh; each level solved at the scene's order from the last level's
+solution interpolated into its space, as the corner check of :mod:`ngcontact.macro.singular_maxima` does),
+and each maximum away is taken on every level (``Q_0`` the scene's mesh, ``Q_1``, ``Q_2``).  The finest
+level's value and location are reported; its error (:func:`level_error`) from the differences ``d_1 = Q_1 - Q_0``,
 ``d_2 = Q_2 - Q_1``, their ratio ``rho = |d_2| / |d_1|`` and two shares the levels do not see:
 
 * the order ladder's polynomial share ``e_P``: the ladder's estimate of the scene's mesh without its
