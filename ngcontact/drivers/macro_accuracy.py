@@ -15,10 +15,10 @@ The verdict has the format of the cell's (:func:`ngcontact.cell.admissibility.ve
   the cell table's interpolation error (relative, paper Sec. 3.5; :mod:`ngcontact.coupling.pressure_table`);
 * the check ``equilibrium`` (each body's forces balance, :func:`ngcontact.macro.macro_measures.equilibrium`).
 
-In 2D, without a refinement (whose mesh levels judge them), every stress maximum is also judged by two local
-refinements at the corners of the boundary (:mod:`ngcontact.macro.singular_maxima`): the ladder converges to
-the stress at sample points fixed on the mesh, which at a singular corner moves with the mesh; such a
-maximum is reported as mesh dependent.
+In 2D, without ``[two_scale]`` and without a refinement (whose mesh levels judge them), every stress maximum
+is also judged by two local refinements at the corners of the boundary
+(:mod:`ngcontact.macro.singular_maxima`): the ladder converges to the stress at sample points fixed on the
+mesh, which at a singular corner moves with the mesh; such a maximum is reported as mesh dependent.
 Where the interface ends closed on a boundary without support, every stress maximum and the safety factor
 are mesh dependent (a refinement too judges them so).
 
@@ -26,11 +26,13 @@ Where the bodies have singular points (2D) or edges (3D), each stress maximum an
 a counterpart away from them (:mod:`ngcontact.macro.away_maxima`: ``<name>_away``, outside a ball of radius
 ``discretization.exclusion_radius`` around each point, a tube around each edge, ``accuracy.exclusion``),
 estimated as the others; a mesh-dependent maximum with such a counterpart is listed with
-``counted = false``.  A two-scale run's macro solution is judged as a macro run's: its neighbouring orders
-and local levels are solved with the loop's converged law, which is pointwise in the closure (a table of
-the cell's response), so it holds on any mesh.  In 3D the corner check is not taken: a maximum over a
-whole body attained within the tubes is mesh dependent (:func:`ngcontact.macro.away_maxima.inside_tubes`),
-and one where the interface ends closed as in 2D.
+``counted = false``.  In 3D the corner check is not taken: a maximum over a whole body attained within
+the tubes is mesh dependent (:func:`ngcontact.macro.away_maxima.inside_tubes`), and one where the
+interface ends closed as in 2D.  A two-scale run reports the maxima away as a macro run does: their
+neighbouring orders and local levels are solved with the loop's converged law, which is pointwise in the
+closure (a table of the cell's response), so it holds on any mesh; its maxima over whole bodies keep the
+order ladder's judgement alone (neither the corner check nor the closed ends), as before, so they stay
+counted beside their counterparts unless the ladder finds them singular.
 
 A counted quantity whose relative error exceeds the tolerance, or has none (not converging, a stress
 singularity), marks the verdict as not met and is said in one warning line.
@@ -253,9 +255,9 @@ def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], bal
         safety = safety_factor_of(scene, recovery)
         samples = order_samples(scene, sol, solve, safety, exclusion=exclusion)
         found = estimates(samples, sol)
-        if sol.problem.mesh.dim == 2:
+        if two_scale is None and sol.problem.mesh.dim == 2:
             found = SM.check(found, sol, samples[sol.problem.order], solve)
-        else:
+        elif two_scale is None:
             found = AM.inside_tubes(SM.at_closed_ends(found, SM.closed_ends(sol)), exclusion)
         found = AM.settle(away_judged(found, sol, solve, exclusion, samples[sol.problem.order], safety), exclusion)
     out = verdict(found, scene.discretization.tolerance, balance, two_scale)

@@ -127,20 +127,26 @@ def unmet(found: list[DE.Estimate], tolerance: float) -> list[DE.Estimate]:
 @dataclass(frozen=True)
 class Singular:
     """What makes a maximum singular on every level: the interface's closed ends on the scene's solution
-    (:func:`ngcontact.macro.singular_maxima.closed_ends`) and the balls around the singular points."""
+    (:func:`ngcontact.macro.singular_maxima.closed_ends`) and the balls (tubes) around the singular points
+    (edges); ``globals_judged``: whether the maxima over whole bodies are judged by them (not with
+    ``[two_scale]``, :mod:`ngcontact.drivers.macro_accuracy`)."""
 
     ends: list[tuple[tuple[float, ...], float]]
     exclusion: AM.Exclusion | None
+    globals_judged: bool = True
 
     @classmethod
     def of(cls, scene, sol: MacroSolution) -> "Singular":
         exclusion = MA.exclusion_for(scene, sol)
-        return cls(SM.closed_ends(sol) if exclusion is not None else [], exclusion)
+        judged = scene.two_scale is None
+        return cls(SM.closed_ends(sol) if exclusion is not None and judged else [], exclusion, judged)
 
     def judged(self, found: list[DE.Estimate]) -> list[DE.Estimate]:
-        """``found`` with the maxima singular at a closed end mesh dependent, those with a counterpart away
-        from the singular points not counted (:func:`ngcontact.macro.away_maxima.settle`)."""
-        return AM.settle(AM.inside_tubes(SM.at_closed_ends(found, self.ends), self.exclusion), self.exclusion)
+        """``found`` with the maxima singular at a closed end (in 3D within the tubes) mesh dependent, those
+        with a counterpart away from the singular points not counted
+        (:func:`ngcontact.macro.away_maxima.settle`)."""
+        tubes = self.exclusion if self.globals_judged else None
+        return AM.settle(AM.inside_tubes(SM.at_closed_ends(found, self.ends), tubes), self.exclusion)
 
 
 def level(sol: MacroSolution, found: list[DE.Estimate], tolerance: float, h_level: int = 0) -> dict[str, Any]:
