@@ -17,15 +17,22 @@ The verdict has the format of the cell's (:func:`ngcontact.cell.admissibility.ve
 
 In 2D, without ``[two_scale]`` and without a refinement (whose mesh levels judge them), every stress maximum
 is also judged by two local refinements at the corners of the boundary
-(:mod:`ngcontact.macro.singular_maxima`): the ladder converges to the stress at sample points fixed on
-the mesh, which at a singular corner moves with the mesh; such a maximum is reported as mesh dependent.
+(:mod:`ngcontact.macro.singular_maxima`): the ladder converges to the stress at sample points fixed on the
+mesh, which at a singular corner moves with the mesh; such a maximum is reported as mesh dependent.
 Where the interface ends closed on a boundary without support, every stress maximum and the safety factor
 are mesh dependent (a refinement too judges them so).
 
-In 2D without ``[two_scale]``, where the bodies have singular points, each stress maximum and the safety
-factor have a counterpart away from them (:mod:`ngcontact.macro.away_maxima`: ``<name>_away``, outside a
-ball of radius ``discretization.exclusion_radius`` around each point, ``accuracy.exclusion``), estimated
-as the others; a mesh-dependent maximum with such a counterpart is listed with ``counted = false``.
+Where the bodies have singular points (2D) or edges (3D), each stress maximum and the safety factor have
+a counterpart away from them (:mod:`ngcontact.macro.away_maxima`: ``<name>_away``, outside a ball of radius
+``discretization.exclusion_radius`` around each point, a tube around each edge, ``accuracy.exclusion``),
+estimated as the others; a mesh-dependent maximum with such a counterpart is listed with
+``counted = false``.  In 3D the corner check is not taken: a maximum over a whole body attained within
+the tubes is mesh dependent (:func:`ngcontact.macro.away_maxima.inside_tubes`), and one where the
+interface ends closed as in 2D.  A two-scale run reports the maxima away as a macro run does: their
+neighbouring orders and local levels are solved with the loop's converged law, which is pointwise in the
+closure (a table of the cell's response), so it holds on any mesh; its maxima over whole bodies keep the
+order ladder's judgement alone (neither the corner check nor the closed ends), as before, so they stay
+counted beside their counterparts unless the ladder finds them singular.
 
 A counted quantity whose relative error exceeds the tolerance, or has none (not converging, a stress
 singularity), marks the verdict as not met and is said in one warning line.
@@ -53,9 +60,10 @@ log = logging.getLogger(__name__)
 #: how the verdict's errors are estimated (the report's ``accuracy.how``)
 HOW = ("discretization error of each headline quantity from solves at the neighbouring polynomial orders on "
        "the scene's mesh (ngcontact.macro.discretization_error), each stress maximum of a 2D run judged by two "
-       "local refinements at the boundary's corners (ngcontact.macro.singular_maxima); in 2D each stress maximum "
-       "and the safety factor also away from the singular points (*_away, ngcontact.macro.away_maxima), judged "
-       "by two local refinements there as well, counted where the global one is mesh dependent; the two-scale "
+       "local refinements at the boundary's corners (ngcontact.macro.singular_maxima); each stress maximum and "
+       "the safety factor also away from the singular points, in 3D the singular edges (*_away, "
+       "ngcontact.macro.away_maxima), judged by two local refinements there as well, counted where the global one "
+       "is mesh dependent; the two-scale "
        "loop's residual and the cell table's interpolation error as their own quantities")
 #: the meaning of the macro run's checks
 CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its largest force"}
@@ -74,10 +82,9 @@ class SafetyFactor:
 
 
 def exclusion_for(scene, sol: MacroSolution) -> AM.Exclusion | None:
-    """The balls around the singular points of ``sol`` (:mod:`ngcontact.macro.away_maxima`), with the
-    scene's ``discretization.exclusion_radius``; ``None`` with ``[two_scale]``, in 3D or without any."""
-    if getattr(scene, "two_scale", None) is not None:
-        return None
+    """The balls around the singular points of ``sol`` (tubes around its singular edges in 3D,
+    :mod:`ngcontact.macro.away_maxima`), with the scene's ``discretization.exclusion_radius``; ``None``
+    without any."""
     check_radius(scene, sol.problem)
     return AM.exclusion_of(sol, getattr(scene.discretization, "exclusion_radius", None))
 
@@ -218,7 +225,7 @@ def check_radius(scene, problem) -> None:
         (:func:`ngcontact.macro.away_maxima.smallest_extent`).
     """
     radius = getattr(scene.discretization, "exclusion_radius", None)
-    if radius is None or problem.mesh.dim != 2:
+    if radius is None:
         return
     smallest = AM.smallest_extent(problem.mesh, (problem.rough, problem.counter))
     if not 0.0 < radius < smallest:
@@ -244,14 +251,15 @@ def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], bal
     and its balls), the safety factor re-evaluated with the strength check's correctors ``recovery``."""
     found, exclusion = (None, None) if refined is None else (refined.estimates, refined.exclusion)
     if found is None:
-        exclusion = None if two_scale is not None else exclusion_for(scene, sol)
+        exclusion = exclusion_for(scene, sol)
         safety = safety_factor_of(scene, recovery)
         samples = order_samples(scene, sol, solve, safety, exclusion=exclusion)
         found = estimates(samples, sol)
-        if sol.problem.mesh.dim == 2 and two_scale is None:
+        if two_scale is None and sol.problem.mesh.dim == 2:
             found = SM.check(found, sol, samples[sol.problem.order], solve)
-            found = AM.settle(away_judged(found, sol, solve, exclusion, samples[sol.problem.order], safety),
-                              exclusion)
+        elif two_scale is None:
+            found = AM.inside_tubes(SM.at_closed_ends(found, SM.closed_ends(sol)), exclusion)
+        found = AM.settle(away_judged(found, sol, solve, exclusion, samples[sol.problem.order], safety), exclusion)
     out = verdict(found, scene.discretization.tolerance, balance, two_scale)
     if exclusion is not None:
         out["exclusion"] = exclusion.record()

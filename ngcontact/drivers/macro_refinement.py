@@ -42,11 +42,12 @@ Then the mesh (h), where the order no longer pays
     * A scene with ``[two_scale]`` keeps its mesh (the loop's interface state lives on it).
 
 What is refined for
-    Only the quantities the verdict counts (:func:`unmet`).  In 2D without ``[two_scale]``, where the
-    interface ends closed on a boundary without support (:func:`ngcontact.macro.singular_maxima.closed_ends`
-    on the scene's solution), every stress maximum over a whole body and the safety factor are mesh
-    dependent on every level: their counterparts away from the singular points
-    (:mod:`ngcontact.macro.away_maxima`, the same balls on every level) converge, and they, not the
+    Only the quantities the verdict counts (:func:`unmet`).  Where the interface ends closed on a boundary
+    without support (:func:`ngcontact.macro.singular_maxima.closed_ends` on the scene's solution), every
+    stress maximum over a whole body and the safety factor are mesh dependent on every level (in 3D also
+    one attained within the tubes around the singular edges,
+    :func:`ngcontact.macro.away_maxima.inside_tubes`): their counterparts away from the singular points
+    (:mod:`ngcontact.macro.away_maxima`, the same balls or tubes on every level) converge, and they, not the
     mesh-dependent maxima, are refined for; each level judges them by local refinements at the singular
     points as well (:mod:`ngcontact.macro.away_sequence`), so a level's estimate of them has seen the
     mesh there.  A maximum once judged mesh dependent is never refined for, so no time is spent on a
@@ -126,20 +127,26 @@ def unmet(found: list[DE.Estimate], tolerance: float) -> list[DE.Estimate]:
 @dataclass(frozen=True)
 class Singular:
     """What makes a maximum singular on every level: the interface's closed ends on the scene's solution
-    (:func:`ngcontact.macro.singular_maxima.closed_ends`) and the balls around the singular points."""
+    (:func:`ngcontact.macro.singular_maxima.closed_ends`) and the balls (tubes) around the singular points
+    (edges); ``globals_judged``: whether the maxima over whole bodies are judged by them (not with
+    ``[two_scale]``, :mod:`ngcontact.drivers.macro_accuracy`)."""
 
     ends: list[tuple[tuple[float, ...], float]]
     exclusion: AM.Exclusion | None
+    globals_judged: bool = True
 
     @classmethod
     def of(cls, scene, sol: MacroSolution) -> "Singular":
         exclusion = MA.exclusion_for(scene, sol)
-        return cls(SM.closed_ends(sol) if exclusion is not None else [], exclusion)
+        judged = scene.two_scale is None
+        return cls(SM.closed_ends(sol) if exclusion is not None and judged else [], exclusion, judged)
 
     def judged(self, found: list[DE.Estimate]) -> list[DE.Estimate]:
-        """``found`` with the maxima singular at a closed end mesh dependent, those with a counterpart away
-        from the singular points not counted (:func:`ngcontact.macro.away_maxima.settle`)."""
-        return AM.settle(SM.at_closed_ends(found, self.ends), self.exclusion)
+        """``found`` with the maxima singular at a closed end (in 3D within the tubes) mesh dependent, those
+        with a counterpart away from the singular points not counted
+        (:func:`ngcontact.macro.away_maxima.settle`)."""
+        tubes = self.exclusion if self.globals_judged else None
+        return AM.settle(AM.inside_tubes(SM.at_closed_ends(found, self.ends), tubes), self.exclusion)
 
 
 def level(sol: MacroSolution, found: list[DE.Estimate], tolerance: float, h_level: int = 0) -> dict[str, Any]:

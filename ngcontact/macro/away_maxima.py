@@ -1,4 +1,4 @@
-"""The largest stress of each body away from its singular points: a maximum that converges, with its error.
+"""The largest stress of each body away from its singular points (edges in 3D): a maximum that converges.
 
 Where the stress of linear elasticity is unbounded at a point of a body's boundary (Williams 1952; the
 cases of :mod:`ngcontact.macro.singular_maxima`), the body's largest stress has no limit: its value is set
@@ -56,7 +56,21 @@ What the verdict counts (:func:`settle`)
     A global maximum (or the global safety factor) that is mesh dependent and has a counterpart away from
     the singular points is listed with its mesh-dependent value and ``counted = false``: the verdict
     (``accuracy.met``) and a refinement's target are the counterpart's.  A mesh-dependent maximum without
-    one is counted (not met), as before.  2D and axisymmetric runs only.
+    one is counted (not met), as before.
+
+In 3D
+    The singular points are edges (:mod:`ngcontact.macro.singular_edges`: the same four cases, found edge by
+    edge of the boundary mesh), the balls are tubes of radius ``r`` around them
+    (:class:`ngcontact.macro.singular_set.SingularSet` gives the distance to points and edges alike), and
+    the rim is sampled on rings of :data:`RING` points around each edge segment.  The maxima away and the
+    safety factor away are estimated as in 2D: the order ladder outside the tubes and the local refinements
+    at the edges (:mod:`ngcontact.macro.away_sequence`).  The corner check of 2D (local refinements telling
+    a growing corner from a bounded one, :mod:`ngcontact.macro.singular_maxima`) is not taken in 3D: a
+    maximum over a whole body or the safety factor attained within the tubes is mesh dependent there
+    (:func:`inside_tubes`), since a clamped, closed or re-entrant edge has ``lambda < 1`` or a logarithm;
+    one attained outside them is the maximum away as well and keeps the ladder's estimate.  Where the
+    interface ends closed, every maximum over a whole body is mesh dependent as in 2D
+    (:func:`ngcontact.macro.singular_maxima.at_closed_ends`).
 """
 from __future__ import annotations
 
@@ -72,6 +86,8 @@ from ngcontact.macro import discretization_error as DE
 from ngcontact.macro import macro_measures as MM
 from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroSolution
+from ngcontact.macro.singular_edges import singular_edges
+from ngcontact.macro.singular_set import SingularSet
 
 #: the suffix of a quantity taken away from the singular points
 AWAY = SM.AWAY
@@ -79,35 +95,53 @@ AWAY = SM.AWAY
 RADIUS_SHARE = 0.25
 #: points on each ball's circle where the stress is sampled (:func:`rim`)
 RIM = 256
+#: points on each ring around a singular edge where the stress is sampled (3D, :func:`rim`)
+RING = 24
 #: the global quantities that have a counterpart away from the singular points
 GLOBAL = ("von_mises_", "tresca_", "safety_factor")
 
 
 @dataclass(frozen=True)
 class Exclusion:
-    """The balls of radius ``radius`` around the singular ``points`` (one row each), with why each is one."""
+    """The region within ``radius`` of the singular ``points`` (one row each, with why each is one) and, in
+    3D, of the singular ``edges`` (``m x 2 x 3`` segments, with ``edge_why``): balls in 2D, tubes in 3D
+    (:class:`ngcontact.macro.singular_set.SingularSet` answers for both)."""
 
     points: np.ndarray
     radius: float
     why: tuple[str, ...]
     radius_from: str = "default"
+    edges: np.ndarray | None = None
+    edge_why: tuple[str, ...] = ()
+
+    @property
+    def singular(self) -> SingularSet:
+        """The singular set the region is around."""
+        dim = self.points.shape[1] if np.ndim(self.points) == 2 else 2
+        edges = np.zeros((0, 2, dim)) if self.edges is None else self.edges
+        return SingularSet(np.asarray(self.points, dtype=float).reshape(-1, dim), tuple(self.why), edges,
+                           tuple(self.edge_why))
 
     def outside(self, xyz: np.ndarray) -> np.ndarray:
-        """Which of the points ``xyz`` (one row each) lie outside every ball."""
-        xyz = np.asarray(xyz, dtype=float).reshape(-1, self.points.shape[1])
-        dist = np.linalg.norm(xyz[:, None, :] - self.points[None, :, :], axis=2)
-        return dist.min(axis=1, initial=math.inf) > self.radius
+        """Which of the points ``xyz`` (one row each) lie outside the region."""
+        return self.singular.distance(xyz, self.radius) > self.radius
 
     def covers(self, point: tuple[float, ...]) -> bool:
-        """``point`` lies within one of the balls."""
+        """``point`` lies within the region."""
         return not bool(self.outside(np.asarray(point))[0])
 
     def record(self) -> dict:
-        """``results.accuracy.exclusion``: the radius, where it comes from, the points and why each is one."""
-        return {"radius": self.radius, "radius_from": self.radius_from,
-                "points": [[float(c) for c in p] for p in self.points], "why": list(self.why),
-                "how": f"the maxima named *{AWAY} are taken outside a ball of this radius around each point "
-                       "(ngcontact.macro.away_maxima)"}
+        """``results.accuracy.exclusion``: the radius, where it comes from, the points and why each is one and,
+        in 3D, the singular edges as connected curves (reason, length, segments, ends)."""
+        out = {"radius": self.radius, "radius_from": self.radius_from,
+               "points": [[float(c) for c in p] for p in self.points], "why": list(self.why),
+               "how": f"the maxima named *{AWAY} are taken outside a ball of this radius around each point "
+                      "(ngcontact.macro.away_maxima)"}
+        if self.edges is not None and len(self.edges):
+            out["edges"] = self.singular.curves()
+            out["how"] = (f"the maxima named *{AWAY} are taken outside a tube of this radius around each singular "
+                          "edge (ngcontact.macro.away_maxima, ngcontact.macro.singular_edges)")
+        return out
 
 
 def body_extents(mesh: ng.Mesh, regions: tuple[str, ...]) -> dict[str, float]:
@@ -196,42 +230,44 @@ def smallest_extent(mesh: ng.Mesh, regions: tuple[str, ...]) -> float:
 
 
 def exclusion_of(sol: MacroSolution, radius: float | None = None) -> Exclusion | None:
-    """The balls of the module docstring on ``sol`` (``radius``: the scene's, in ``(0, smallest extent)``,
-    else the default); ``None`` in 3D or where the bodies have no singular point."""
+    """The region of the module docstring on ``sol`` (``radius``: the scene's, in ``(0, smallest extent)``,
+    else the default): balls around the singular points in 2D, tubes around the singular edges in 3D
+    (:func:`ngcontact.macro.singular_edges.singular_edges`); ``None`` where the bodies have none."""
     p = sol.problem
-    if p.mesh.dim != 2:
+    found = SingularSet.of_points(*singular_points(sol)) if p.mesh.dim == 2 else singular_edges(sol)
+    if not len(found):
         return None
-    points, why = singular_points(sol)
-    if not len(points):
-        return None
+    edges = found.edges if len(found.edges) else None
     if radius is None:
-        return Exclusion(points, default_radius(p.mesh, (p.rough, p.counter)), why)
-    return Exclusion(points, float(radius), why, "scene")
+        return Exclusion(found.points, default_radius(p.mesh, (p.rough, p.counter)), found.why, edges=edges,
+                         edge_why=found.edge_why)
+    return Exclusion(found.points, float(radius), found.why, "scene", edges, found.edge_why)
 
 
 def circles(exclusion: Exclusion, count: int = RIM) -> np.ndarray:
-    """``count`` points on each ball's circle (offset by half a step), those outside the other balls."""
-    angle = 2.0 * math.pi * (np.arange(count) + 0.5) / count
-    ring = np.column_stack([np.cos(angle), np.sin(angle)]) * exclusion.radius
-    centres = np.repeat(exclusion.points, count, axis=0)
-    steps = np.tile(ring, (len(exclusion.points), 1))
-    return (centres + steps)[exclusion.outside(centres + steps * (1.0 + 1e-9))]
+    """``count`` points on each ball's circle (2D) or on each ring around a singular edge's segment (3D),
+    offset by half a step, those outside the rest of the region
+    (:meth:`ngcontact.macro.singular_set.SingularSet.rim`)."""
+    return exclusion.singular.rim(exclusion.radius, count)
 
 
 def rim(sol: MacroSolution, exclusion: Exclusion, region: str) -> tuple[np.ndarray, np.ndarray]:
-    """The stress tensors (``n x 3 x 3``) and points of body ``region`` on the balls' circles, :data:`RIM`
-    points each (offset by half a step, so none falls on a straight boundary through the centre), those
-    outside the other balls."""
+    """The stress tensors (``n x 3 x 3``) and points of body ``region`` on the region's boundary:
+    :data:`RIM` points on each ball's circle in 2D, :data:`RING` on each ring around a singular edge in 3D
+    (offset by half a step, so none falls on a straight boundary or a symmetry plane through the set),
+    those outside the rest of the region."""
     mesh = sol.problem.mesh
-    pts = circles(exclusion)
-    sig = MM.stress(sol)
-    values, kept = [], []
-    for x in pts:
-        mip = mesh(*x)
-        if mip.nr >= 0 and mesh[ng.ElementId(ng.VOL, mip.nr)].mat == region:
-            values.append(np.asarray(sig(mip)).reshape(3, 3))
-            kept.append(x)
-    return np.array(values).reshape(-1, 3, 3), np.array(kept).reshape(-1, 2)
+    pts = circles(exclusion, RIM if mesh.dim == 2 else RING)
+    if not len(pts):
+        return np.zeros((0, 3, 3)), np.zeros((0, mesh.dim))
+    mips = mesh(*pts.T)
+    found = mips["nr"] >= 0
+    mips, pts = mips[found], pts[found]
+    if not len(pts):
+        return np.zeros((0, 3, 3)), np.zeros((0, mesh.dim))
+    inside = np.asarray(mesh.MaterialCF({region: 1.0}, default=0.0)(mips)).ravel() > 0.5
+    values = np.asarray(MM.stress(sol)(mips[inside])).reshape(-1, 3, 3)
+    return values, pts[inside]
 
 
 def away_maxima(sol: MacroSolution, exclusion: Exclusion, dense_inset: float = 1e-3) -> dict[str, DE.Sample]:
@@ -268,6 +304,26 @@ def _global(name: str) -> str:
 def _body_of(name: str) -> str:
     """The body a stress maximum's name names (``safety_factor``: the interface, both bodies)."""
     return next((name[len(p):] for p in GLOBAL[:2] if name.startswith(p)), "interface")
+
+
+def inside_tubes(found: list[DE.Estimate], exclusion: Exclusion | None) -> list[DE.Estimate]:
+    """``found`` with each maximum over a whole body and the safety factor that a 3D run attains within the
+    tubes around the singular edges made mesh dependent at the edge's nearest point (module docstring,
+    "In 3D"); the others, and every estimate of a 2D run, as they are."""
+    if exclusion is None or exclusion.edges is None or not len(exclusion.edges):
+        return found
+    out = []
+    for e in found:
+        if e.name.startswith(GLOBAL) and not e.name.endswith(AWAY) and e.singular_at is None \
+                and e.location is not None and exclusion.covers(e.location):
+            at = exclusion.singular.nearest(e.location)
+            e = replace(e, error=None, singular_at=at,
+                        how=f"{e.how}; attained at {DE._point(e.location)}, within {exclusion.radius:.3g} m of a "
+                            "singular edge, where the stress grows like d^(lambda - 1) or log d in the distance d "
+                            "to the edge (the 2D wedge's, Grisvard 1985), so its value is set by the mesh there: "
+                            f"mesh dependent, singular at {DE._point(at)}")
+        out.append(e)
+    return out
 
 
 def settle(found: list[DE.Estimate], exclusion: Exclusion | None) -> list[DE.Estimate]:

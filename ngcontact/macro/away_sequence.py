@@ -8,14 +8,14 @@ falls only algebraically with the order and pollutes the stress everywhere (Babu
 converges algebraically on a mesh not graded towards a singular point).  The ladder's geometric
 extrapolation from three orders misses that share.
 
-Only smaller elements at the singular points remove it.  So the elements with a vertex at a singular
-point (:func:`ngcontact.macro.singular_maxima.star`), those the balls' circles cross (where a maximum
-away from a singular point is attained when the stress grows towards it; :data:`CIRCLE` points each) and
-those holding the maxima away are refined :data:`LEVELS` times (Netgen's local refinement, on copies of
-the mesh; each level solved at the scene's order from the last level's solution interpolated into its
-space, as the corner check of :mod:`ngcontact.macro.singular_maxima` does), and each maximum away is
-taken on every level (``Q_0`` the scene's mesh, ``Q_1``, ``Q_2``).  The finest level's value and location
-are reported; its error (:func:`level_error`) from the differences ``d_1 = Q_1 - Q_0``,
+Only smaller elements at the singular points remove it.  So the elements with a vertex at a singular point
+(in 3D: on a singular edge, :meth:`ngcontact.macro.singular_set.SingularSet.star`), those the balls'
+circles cross (where a maximum away from a singular point is attained when the stress grows towards it;
+:data:`CIRCLE` points each) and those holding the maxima away are refined :data:`LEVELS` times (Netgen's
+local refinement, on copies of the mesh; each level solved at the scene's order from the last level's
+solution interpolated into its space, as the corner check of :mod:`ngcontact.macro.singular_maxima` does),
+and each maximum away is taken on every level (``Q_0`` the scene's mesh, ``Q_1``, ``Q_2``).  The finest
+level's value and location are reported; its error (:func:`level_error`) from the differences ``d_1 = Q_1 - Q_0``,
 ``d_2 = Q_2 - Q_1``, their ratio ``rho = |d_2| / |d_1|`` and two shares the levels do not see:
 
 * the order ladder's polynomial share ``e_P``: the ladder's estimate of the scene's mesh without its
@@ -61,6 +61,13 @@ Differences below :data:`~ngcontact.macro.discretization_error.NOISE` of the qua
 ``e = max(e_P, SAFETY max(|d_1|, |d_2|))``.  A ladder without an estimate (a ball's circle inside the
 elements at a singular point, where no order converges fast) has ``e_P = e_m = 0`` and leaves the levels
 alone.  The check costs about one solve of the scene (two warm-started solves on meshes a little larger).
+
+In 3D the elements the tubes' rings cross are not refined: the tube around an edge crosses a layer of
+elements along its whole length, and refining that layer twice multiplies the unknowns along every
+singular edge by about 8 per level, where the elements touching the edge (which carry the polluting
+share) and those holding the maxima (where the maximum away sits on the tube) are a thin set.  The rings'
+elements are refined where they hold a maximum.  The exponents along an edge are the 2D wedge's, so the
+ratios above hold there as well.
 """
 from __future__ import annotations
 
@@ -74,7 +81,6 @@ import numpy as np
 from ngcontact.macro import away_maxima as AM
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro import error_indicator as EI
-from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroSolution
 
 #: local refinements at the singular points (three values with the scene's mesh: an observed rate)
@@ -105,11 +111,11 @@ def levels(sol: MacroSolution, solve: Callable[..., MacroSolution], exclusion: A
     by ``solve(problem, start)`` at ``sol``'s order from the last level's solution."""
     order = max(sol.problem.order, 1)
     points = [s.location for s in at.values() if s.location is not None]
-    circle = AM.circles(exclusion, CIRCLE)
+    circle = AM.circles(exclusion, CIRCLE) if sol.problem.mesh.dim == 2 else np.zeros((0, 3))
     out = []
     for _ in range(count):
         mesh = ng.Mesh(sol.problem.mesh.ngmesh.Copy())
-        marked = SM.star(mesh, exclusion.points) | EI.holding(mesh, points + [tuple(x) for x in circle])
+        marked = exclusion.singular.star(mesh) | EI.holding(mesh, points + [tuple(x) for x in circle])
         EI.refine_marked(mesh, marked, order)
         problem = replace(sol.problem, mesh=mesh)
         sol = solve(problem, DE.start_at_order(sol, problem))

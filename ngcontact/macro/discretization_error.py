@@ -245,16 +245,36 @@ def corner_points(mesh: ng.Mesh) -> np.ndarray:
     return pts[sorted(set(corners))] if corners else np.zeros((0, mesh.dim))
 
 
-def boundary_vertices(mesh: ng.Mesh) -> tuple[dict[int, set[str]], dict[int, list[int]], np.ndarray]:
-    """Per boundary vertex its labels and its neighbours along the boundary, and every vertex's point."""
+def boundary_vertices(mesh: ng.Mesh, bodies_only: bool = False
+                      ) -> tuple[dict[int, set[str]], dict[int, list[int]], np.ndarray]:
+    """Per boundary vertex its labels and its neighbours along the boundary, and every vertex's point;
+    ``bodies_only``: without the boundary elements inside one body (:func:`internal_faces`)."""
     labels: dict[int, set[str]] = {}
     edges: dict[int, list[int]] = {}
+    inner = internal_faces(mesh) if bodies_only else set()
     for el in mesh.Elements(ng.BND):
         vs = [v.nr for v in el.vertices]
+        if tuple(sorted(vs)) in inner:
+            continue
         for v in vs:
             labels.setdefault(v, set()).add(el.mat)
             edges.setdefault(v, []).extend(w for w in vs if w != v)
     return labels, edges, np.array([mesh[ng.NodeId(ng.VERTEX, i)].point for i in range(mesh.nv)])
+
+
+def internal_faces(mesh: ng.Mesh) -> set[tuple[int, ...]]:
+    """The facets (sorted vertex numbers) between two simplices of one body: labelled boundary elements there
+    (a solid's internal faces, as the 3D femur's stem has where its cone and cylinders meet) bound no body."""
+    seen: dict[tuple[int, ...], str] = {}
+    out = set()
+    for el in mesh.Elements(ng.VOL):
+        vs = [v.nr for v in el.vertices]
+        for k in range(len(vs)):
+            facet = tuple(sorted(vs[:k] + vs[k + 1:]))
+            if seen.get(facet) == el.mat:
+                out.add(facet)
+            seen[facet] = el.mat
+    return out
 
 
 def _turn(pts: np.ndarray, v: int, neighbours: list[int]) -> float:

@@ -136,16 +136,22 @@ def corners_of(mesh: ng.Mesh) -> np.ndarray:
 
 def closed_ends(sol: MacroSolution, points_per_element: int = 5) -> list[tuple[tuple[float, ...], float]]:
     """The ends of the interface on a boundary without support (free or loaded) where the interface is
-    closed (pressure above :data:`CLOSED` of its peak), each with its pressure, the largest first."""
+    closed (pressure above :data:`CLOSED` of its peak), each with its pressure, the largest first (3D: the
+    vertices of its boundary edges there, :func:`ngcontact.macro.macro_measures.interface_surface`; faces
+    inside one body are no boundary)."""
     p = sol.problem
-    labels, _, pts = DE.boundary_vertices(p.mesh)
+    labels, _, pts = DE.boundary_vertices(p.mesh, bodies_only=p.mesh.dim == 3)
     supported = {s.label for s in p.supports}
     ends = [v for v, names in labels.items()
             if p.interface in names and len(names) > 1 and not (names - {p.interface}) & supported]
     if not ends:
         return []
-    prof = MM.interface_profile(sol, points_per_element)
-    xy = np.column_stack([prof[n] for n in prof if n in ("x", "y", "r", "z")][:2])
+    if p.mesh.dim == 2:
+        prof = MM.interface_profile(sol, points_per_element)
+        xy = np.column_stack([prof[n] for n in prof if n in ("x", "y", "r", "z")][:2])
+    else:
+        prof = MM.interface_surface(sol)
+        xy = np.column_stack([prof["x"], prof["y"], prof["z"]])
     pressure = np.asarray(prof["pressure"], dtype=float)
     peak = float(pressure.max(initial=0.0))
     out = []

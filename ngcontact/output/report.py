@@ -177,6 +177,11 @@ def _away_text(acc: dict) -> str:
     """What the maxima away from the singular points are and that the mesh-dependent ones are not counted
     (``accuracy.exclusion``; nothing without it)."""
     ex = acc.get("exclusion") or {}
+    if ex.get("edges"):
+        kinds = ", ".join(dict.fromkeys(c["why"] for c in ex["edges"]))
+        length = sum(float(c["length"]) for c in ex["edges"])
+        return (f"; *_away: outside {ex['radius']:.3g} m of the singular edges ({len(ex['edges'])} curves, "
+                f"{length:.3g} m: {kinds}) (counted; the mesh-dependent maxima are listed, not counted)")
     if not ex.get("points"):
         return ""
     pts = ", ".join("(" + ", ".join(f"{c:.4g}" for c in p) + ")" for p in ex["points"])

@@ -255,9 +255,20 @@ def accuracy_table(report: dict) -> str:
     ex = acc.get("exclusion") or {}
     note = (f"<p>*_away: outside {fmt(ex.get('radius'), 'm')} of the singular points {fmt(ex.get('points'))} "
             f"({_e(', '.join(ex.get('why', [])))}); the mesh-dependent maxima are listed, not counted.</p>"
-            if ex.get("points") else "")
+            if ex.get("points") else "") + _edges_note(ex)
     return ("<h3>Accuracy (met: " + fmt(acc.get("met")) + ")</h3>" + note
             + html_table(["quantity", "value", "relative error", "counted", "at"], rows))
+
+
+def _edges_note(ex: dict) -> str:
+    """The singular edges of a 3D run's verdict (``accuracy.exclusion.edges``): per curve why, length, ends."""
+    curves = [c for c in ex.get("edges") or [] if isinstance(c, dict)]
+    if not curves:
+        return ""
+    rows = [[str(c.get("why")), fmt(c.get("length")), fmt(c.get("segments")), fmt(c.get("ends"))] for c in curves]
+    return (f"<p>*_away: outside a tube of radius {fmt(ex.get('radius'), 'm')} around the singular edges; the "
+            "mesh-dependent maxima are listed, not counted.</p>"
+            + html_table(["singular edge", "length [m]", "segments", "ends"], rows))
 
 
 def nested(value, depth: int = 0) -> str:

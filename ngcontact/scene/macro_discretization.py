@@ -34,13 +34,16 @@ class MacroDiscretization(Discretization):
         "unknowns; results.accuracy.refinement lists the levels, their order, mesh level and unknowns), and a "
         "tolerance out of reach ends the run (exit 3); default: 0.01, only judged (the scene's order is kept)")
     exclusion_radius: float | None = param(None, check=positive(), units="m", doc="radius of the ball around each "
-        "singular point of the stress (where the interface ends closed on an unsupported boundary, a clamp meets an "
-        "unsupported boundary, a re-entrant corner) outside which each body's largest von Mises and Tresca stress and "
-        "the safety factor are also reported, with their own error estimates (von_mises_<body>_away, ..., "
-        "safety_factor_away in results.accuracy, with where each is attained; accuracy.exclusion lists the points): "
-        "these converge, so they count in accuracy.met and in a refinement's target, while the global maxima, mesh "
-        "dependent there, are listed with counted = false; 2D and axisymmetric runs without [two_scale]; must be "
-        "below the smallest extent of the bodies' bounding boxes; default: a quarter of that extent")
+        "singular point of the stress (where the interface ends closed on an unsupported boundary, a clamp "
+        "meets an unsupported boundary, a re-entrant corner, a load with a "
+        "traction ends; in 3D the tube around each such edge, a re-entrant edge by the body's dihedral angle) "
+        "outside which each body's largest von Mises and Tresca stress and the safety factor are also "
+        "reported, with their own error estimates (von_mises_<body>_away, ..., safety_factor_away in "
+        "results.accuracy, with where each is attained; accuracy.exclusion lists the points, in 3D the "
+        "edges): these converge, so they count in accuracy.met and in a refinement's target, while the global "
+        "maxima, mesh dependent there, are listed with counted = false; 2D, axisymmetric and 3D runs, with "
+        "[two_scale] too; must be below the smallest extent of the bodies' bounding boxes; default: a quarter "
+        "of that extent")
     refinements: int = param(0, check=closed_interval(0, MAX_REFINEMENTS), doc="uniform refinements of the "
         "mesh made with maxh: every element split this many times (a triangle into 4, a tetrahedron into 8, "
         "new boundary points on the geometry; h = maxh / 2^k), curved to order after the last; under mpiexec "
