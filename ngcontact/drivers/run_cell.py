@@ -26,7 +26,8 @@ its discretization and estimates its error from one order more
 (:mod:`ngcontact.cell.fe.saturation`; each load adds ``error_estimate`` and
 ``next_order``), and one that misses it is reported with
 ``accuracy.met = false`` and one warning line rather than failed; ``discretization.estimate = "off"``
-skips that estimate and says so (``accuracy.how``).  With
+skips that estimate and says so (``accuracy.how``).  ``accuracy.method`` states the method that solved
+the cell and why (``discretization.method = "auto"`` resolved: :mod:`ngcontact.scene.cell_method`).  With
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers.
 """
@@ -147,6 +148,16 @@ def warn_before_solving(facts: dict[str, float]) -> None:
             log.warning("accuracy not met, known before solving: %s%s", c.message(), hint)
 
 
+def method_choice(scene) -> dict[str, Any]:
+    """``results.accuracy.method``: the method that solved the scene and why
+    (:class:`~ngcontact.scene.cell_method.MethodChoice`; a scene built without the check: its method only)."""
+    choice = getattr(scene, "method_choice", None)
+    if choice is not None:
+        return choice.as_dict()
+    method = scene.discretization.method
+    return {"method": method, "requested": method, "reason": "", "statement": method}
+
+
 def run(scene, clock, refine_by_default: bool = True) -> Outcome:
     """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`).  ``refine_by_default =
     False``: no refinement unless the scene states a tolerance (an ensemble's members)."""
@@ -164,6 +175,7 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
         checks = [c.as_dict() for c in admissibility.cell_checks(facts) if c.name == "rms_slope"]
         results["topography"] = dict(topography, small_slope=checks[0] if checks else None)
     if scene.contact.geometric_only:
+        results["accuracy"] = {"method": method_choice(scene)}
         return Outcome(results=results, ndof=0)
     loads = cell_loads(scene)
     refinement: Refinement | None = None
@@ -197,6 +209,7 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
     opted_out = scene.discretization.tolerance is None and scene.discretization.estimate == "off"
     results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
                                            unestimated=OPTED_OUT if opted_out else "")
+    results["accuracy"]["method"] = method_choice(scene)
     if cell.penalty() is not None:  # the model's share: reported and printed, not counted against the tolerance
         with clock.stage("penalty share"):
             share = penalty_share(cell, loads, per_load,
