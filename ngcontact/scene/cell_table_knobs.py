@@ -34,8 +34,9 @@ def loop_cell(scene):
     """The cell scene of ``scene``'s two-scale loop as the loop solves it (its contact overrides, method and
     discretization keys applied)."""
     spec = scene.two_scale
-    return load_cell(loader.load_with_contact, resolve(scene, spec.cell), spec.cell,
-                     cell_links.overrides(scene.interface), spec, shear_from_cell=scene.interface.friction == "from_cell")
+    overrides = cell_links.overrides(scene.interface)
+    return load_cell(loader.load_with_contact, resolve(scene, spec.cell), spec.cell, overrides, spec,
+                     shear_from_cell=scene.interface.friction == "from_cell")
 
 
 class LoopCellKnob(Knob):
