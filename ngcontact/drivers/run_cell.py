@@ -175,8 +175,7 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
         checks = [c.as_dict() for c in admissibility.cell_checks(facts) if c.name == "rms_slope"]
         results["topography"] = dict(topography, small_slope=checks[0] if checks else None)
     if scene.contact.geometric_only:
-        results["accuracy"] = {"method": method_choice(scene)}
-        return Outcome(results=results, ndof=0)
+        return Outcome(results={**results, "accuracy": {"method": method_choice(scene)}}, ndof=0)
     loads = cell_loads(scene)
     refinement: Refinement | None = None
     with clock.stage("solve"):
@@ -207,9 +206,8 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
         log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
     results["loads"] = per_load
     opted_out = scene.discretization.tolerance is None and scene.discretization.estimate == "off"
-    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
-                                           unestimated=OPTED_OUT if opted_out else "")
-    results["accuracy"]["method"] = method_choice(scene)
+    results["accuracy"] = dict(accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
+                                                unestimated=OPTED_OUT if opted_out else ""), method=method_choice(scene))
     if cell.penalty() is not None:  # the model's share: reported and printed, not counted against the tolerance
         with clock.stage("penalty share"):
             share = penalty_share(cell, loads, per_load,
