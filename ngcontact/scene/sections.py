@@ -118,7 +118,8 @@ class CellDiscretization(Discretization):
                         "FE-only key); a macro scene's strength.cell, and a two-scale loop whose friction comes "
                         "from a frictional cell, solve an auto cell by fe (they need the FE cell's stresses and "
                         "shear response)", choices=("auto", "fe", "spectral"))
-    grid: int | None = param(None, doc="spectral: grid points per period and direction of the first grid, "
+    grid: int | None = param(None, doc="spectral (set with method = 'auto', it asks for the spectral cell): grid "
+                             "points per period and direction of the first grid, "
                              "which refinement to the tolerance (the scene's or the default) doubles (default: a "
                              "height map's own grid, else 1024 in 2D and 256 in 3D)",
                              check=closed_interval(8, MAX_GRID))
