@@ -139,6 +139,12 @@ def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
 OPTED_OUT = "not estimated (discretization.estimate = off)"
 
 
+def opted_out(scene) -> str:
+    """The verdict's ``how`` where the scene opts out of the default estimate (:data:`OPTED_OUT`), else ``""``."""
+    d = scene.discretization
+    return OPTED_OUT if d.tolerance is None and d.estimate == "off" else ""
+
+
 def warn_before_solving(facts: dict[str, float]) -> None:
     """What is known before the solve: a cell that cannot meet its accuracy says so at once."""
     for c in admissibility.cell_checks(facts):
@@ -205,9 +211,8 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
             arrays[f"{name}_load{k}"] = values
         log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
     results["loads"] = per_load
-    opted_out = scene.discretization.tolerance is None and scene.discretization.estimate == "off"
     results["accuracy"] = dict(accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
-                                                unestimated=OPTED_OUT if opted_out else ""), method=method_choice(scene))
+                                                unestimated=opted_out(scene)), method=method_choice(scene))
     if cell.penalty() is not None:  # the model's share: reported and printed, not counted against the tolerance
         with clock.stage("penalty share"):
             share = penalty_share(cell, loads, per_load,

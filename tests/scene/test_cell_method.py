@@ -142,9 +142,9 @@ def test_the_report_states_the_method_and_why(tmp_path, capsys):
 
 
 def _auto_cell(tmp_path, friction: str = "") -> str:
-    """The shipped stem-groove cell without its FE-only keys (``method = "auto"`` then picks the spectral cell)."""
+    """A copy of the shipped stem-groove cell, which sets no FE-only key (``method = "auto"`` picks the spectral
+    cell), with ``friction`` added to its ``[contact]``."""
     text = open(os.path.join(GEOMETRIES, "cells", "stem_grooves.toml"), encoding="utf-8").read()
-    text = text.split("[discretization]")[0] + "[solver]\nrtol = 1e-10\n"
     if friction:
         text = text.replace("[load]", friction + "\n[load]")
     path = tmp_path / "auto_cell.toml"
@@ -181,3 +181,15 @@ def test_links_that_need_the_fe_cell_solve_an_auto_cell_by_fe(tmp_path):
     from ngcontact.drivers.build import recovery_cell_problem
     scene, problem = recovery_cell_problem(path, key="strength.cell")
     assert scene.discretization.method == "fe" and problem is not None
+
+
+def test_a_geometric_only_cell_states_its_method_too():
+    from ngcontact.drivers import run_cell
+    from ngcontact.output.report import Clock
+    data = cell(contact={"k_n": 1e3, "geometric_only": True})
+    del data["load"]
+    outcome = run_cell.run(loader.from_dict(data), Clock())
+    assert outcome.results["accuracy"] == {"method": {
+        "method": "spectral", "requested": "auto", "reason": "a small-slope cell (flat interface, no initial gap), no "
+        "FE-only key set", "statement": "spectral: a small-slope cell (flat interface, no initial gap), no FE-only "
+        "key set"}}
