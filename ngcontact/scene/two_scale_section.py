@@ -86,10 +86,12 @@ def _loaded(load, path: str, rel: str, overrides: dict, spec: TwoScaleSpec, meth
     try:
         cell = load(path, overrides, method, keys)
     except SceneError as exc:
-        key, value = named or (("two_scale.cell_method", method) if method is not None
-                               else next((f"two_scale.cell_{k}", v) for k, v in keys.items()))
-        what = "with it" if key.startswith("two_scale.cell_") and key != "two_scale.cell_method" else "by this method"
-        what = "by the FE cell its shear table needs" if named else what
+        if named is not None:
+            (key, value), what = named, "by the FE cell its shear table needs"
+        elif method is not None:
+            key, value, what = "two_scale.cell_method", method, "by this method"
+        else:
+            (key, value), what = next((f"two_scale.cell_{k}", v) for k, v in keys.items()), "with it"
         raise SceneError(key, value, f"the cell {rel!r} cannot be solved {what}: {exc}") from None
     resolved = getattr(getattr(cell, "discretization", None), "method", None)
     for k, v in keys.items():
