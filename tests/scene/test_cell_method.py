@@ -139,6 +139,8 @@ def test_the_report_states_the_method_and_why(tmp_path, capsys):
     assert "cell method spectral: a small-slope cell" in capsys.readouterr().err     # the progress lines
     assert "spectral: a small-slope cell (flat interface, a sinusoid initial gap)" in (out / "report.html").read_text()
     assert method_line(report["results"]) == "cell method " + stated["statement"]
+    assert cli.main(["check", str(path)]) == 0             # said before solving too
+    assert f"{path}: cell method " + stated["statement"] in capsys.readouterr().out
 
 
 def _auto_cell(tmp_path, friction: str = "") -> str:
