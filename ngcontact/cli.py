@@ -254,6 +254,9 @@ def _check(path: str) -> int:
         return _classified(path, exc)
     for line in notes:
         print(line)
+    choice = getattr(sc, "method_choice", None)      # a cell scene's discretization.method, resolved
+    if choice is not None:
+        print(f"{path}: cell method {choice.statement}")
     print(f"{path}: valid {sc.kind} scene; effects: {', '.join(scene_mod.effects(sc)) or 'none'}")
     return EXIT_OK
 

@@ -21,7 +21,7 @@ from typing import Callable
 
 from ngcontact._version import __version__
 from ngcontact.errors import SceneError
-from ngcontact.output.report import Clock, Outcome, accuracy_line, build_report
+from ngcontact.output.report import Clock, Outcome, accuracy_line, build_report, method_line
 from ngcontact.scene import loader
 
 #: kind -> the driver module whose ``run(scene, clock)`` solves it; imported
@@ -268,9 +268,9 @@ def solve(scene, progress: Callable[[str], None] | None = None, *, workers: int 
         else:
             from ngcontact.distributed import macro_run
             outcome = macro_run.run(scene, clock, mpi)
-    line = accuracy_line(outcome.results)
-    if line is not None:
-        clock.note(line)
+    for line in (method_line(outcome.results), accuracy_line(outcome.results)):
+        if line is not None:
+            clock.note(line)
     compute = ex.describe()
     if mpi is not None:
         compute = {**compute, "mpi_ranks": mpi.size}

@@ -31,11 +31,13 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 
 from ngcontact.drivers.build import cell_loads, cell_solver, spectral_variant  # noqa: E402
 from ngcontact.output.writer import write_csv  # noqa: E402
-from ngcontact.scene.loader import load  # noqa: E402
+from ngcontact.scene.loader import load_with_contact  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: shipped FE cells and the grid of their converged spectral twin
 ORACLES = {"westergaard": 262144, "stem_grooves": 262144, "bisinusoid": 512}
+#: the FE discretization of a shipped cell that leaves its method to "auto" (which gives it the spectral cell)
+FE_MESH = {"stem_grooves": {"order": 2, "maxh": 25e-6, "interface_maxh": 1e-6}}
 #: the coarser grid of the oracle's resolution: this many times fewer points per direction (per dimension)
 COARSER = {2: 4, 3: 2}
 #: the 2D spectral contact fraction's collocation error at 65,536 points (ngcontact.cell.spectral.grid_measures)
@@ -72,7 +74,7 @@ def estimators(scene, loads) -> dict:
 
 
 def rows(name: str, grid: int, only: list[str] | None = None) -> list[dict]:
-    scene = load(os.path.join(ROOT, "geometries", "cells", f"{name}.toml"))
+    scene = load_with_contact(os.path.join(ROOT, "geometries", "cells", f"{name}.toml"), None, "fe", FE_MESH.get(name))
     loads, dim = cell_loads(scene), scene.geometry.dim
     reference = spectral_variant(scene, grid).sweep(loads)
     coarser = spectral_variant(scene, grid // COARSER[dim]).sweep(loads)

@@ -256,6 +256,7 @@ def scene_with(scene: CellScene, **sections) -> CellScene:
     """``scene`` with these sections replaced, in the folder of the scene file (its data files' base)."""
     out = replace(scene, **sections)
     object.__setattr__(out, "base_dir", getattr(scene, "base_dir", "."))
+    object.__setattr__(out, "method_choice", getattr(scene, "method_choice", None))
     return out
 
 
@@ -327,11 +328,16 @@ CELL_METHODS: dict[str, Callable[[CellScene], CellSolver]] = {"fe": fe_cell, "sp
 
 def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = None,
                     method: str | None = None, discretization: dict | None = None) -> tuple[CellScene, CellProblem]:
-    """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene) -> the FE
+    """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene; a cell whose
+    ``method = "auto"`` chose the spectral cell is solved by fe) -> the FE
     :class:`CellProblem` with the macro strain term, for what only the FE cell gives: the micro stresses of
     the strength recovery (paper eqs. 74-78) and the shear response; the scene's ``[solver]`` settings and its
     first loads' start (:func:`cell_problem`)."""
     cs = cell_scene_of(cell_path, key=key, overrides=overrides, method=method, discretization=discretization)
+    choice = cs.method_choice
+    if method is None and choice is not None and choice.automatic and choice.method != "fe":
+        # an "auto" cell is solved by the cell the recovery needs (ngcontact.scene.cell_method)
+        cs = cell_scene_of(cell_path, key=key, overrides=overrides, method="fe", discretization=discretization)
     if cs.contact.geometric_only:
         raise SceneError(key, cell_path, "the cell scene has contact.geometric_only = true; the recovery "
                          "solves the cell, so it needs a contact model and a [load] section")

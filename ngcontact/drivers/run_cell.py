@@ -26,7 +26,8 @@ its discretization and estimates its error from one order more
 (:mod:`ngcontact.cell.fe.saturation`; each load adds ``error_estimate`` and
 ``next_order``), and one that misses it is reported with
 ``accuracy.met = false`` and one warning line rather than failed; ``discretization.estimate = "off"``
-skips that estimate and says so (``accuracy.how``).  With
+skips that estimate and says so (``accuracy.how``).  ``accuracy.method`` states the method that solved
+the cell and why (``discretization.method = "auto"`` resolved: :mod:`ngcontact.scene.cell_method`).  With
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers.
 """
@@ -138,6 +139,12 @@ def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
 OPTED_OUT = "not estimated (discretization.estimate = off)"
 
 
+def opted_out(scene) -> str:
+    """The verdict's ``how`` where the scene opts out of the default estimate (:data:`OPTED_OUT`), else ``""``."""
+    d = scene.discretization
+    return OPTED_OUT if d.tolerance is None and d.estimate == "off" else ""
+
+
 def warn_before_solving(facts: dict[str, float]) -> None:
     """What is known before the solve: a cell that cannot meet its accuracy says so at once."""
     for c in admissibility.cell_checks(facts):
@@ -145,6 +152,16 @@ def warn_before_solving(facts: dict[str, float]) -> None:
             hint = ("; use discretization.method = 'spectral', which solves on the map's own points, or a finer "
                     "discretization.interface_maxh" if c.name == "interface_resolution" else "")
             log.warning("accuracy not met, known before solving: %s%s", c.message(), hint)
+
+
+def method_choice(scene) -> dict[str, Any]:
+    """``results.accuracy.method``: the method that solved the scene and why
+    (:class:`~ngcontact.scene.cell_method.MethodChoice`; a scene built without the check: its method only)."""
+    choice = getattr(scene, "method_choice", None)
+    if choice is not None:
+        return choice.as_dict()
+    method = scene.discretization.method
+    return {"method": method, "requested": method, "reason": "", "statement": method}
 
 
 def run(scene, clock, refine_by_default: bool = True) -> Outcome:
@@ -164,7 +181,7 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
         checks = [c.as_dict() for c in admissibility.cell_checks(facts) if c.name == "rms_slope"]
         results["topography"] = dict(topography, small_slope=checks[0] if checks else None)
     if scene.contact.geometric_only:
-        return Outcome(results=results, ndof=0)
+        return Outcome(results={**results, "accuracy": {"method": method_choice(scene)}}, ndof=0)
     loads = cell_loads(scene)
     refinement: Refinement | None = None
     with clock.stage("solve"):
@@ -194,9 +211,8 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
             arrays[f"{name}_load{k}"] = values
         log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
     results["loads"] = per_load
-    opted_out = scene.discretization.tolerance is None and scene.discretization.estimate == "off"
-    results["accuracy"] = accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
-                                           unestimated=OPTED_OUT if opted_out else "")
+    results["accuracy"] = dict(accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
+                                                unestimated=opted_out(scene)), method=method_choice(scene))
     if cell.penalty() is not None:  # the model's share: reported and printed, not counted against the tolerance
         with clock.stage("penalty share"):
             share = penalty_share(cell, loads, per_load,

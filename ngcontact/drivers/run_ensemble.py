@@ -90,7 +90,8 @@ def run(scene, clock) -> Outcome:
                             "quantities": QUANTITIES,
                             "band": "mean -+ t(0.975, M-1) s / sqrt(M), s the sample standard deviation"},
                "loads": loads, "shrinkage": shrink,
-               "members": [mem["loads"] for mem in members]}
+               "members": [mem["loads"] for mem in members],
+               "accuracy": {"method": run_cell.method_choice(scene)}}
     header = ["load"] + [f"{q}_{key}" for q in QUANTITIES for key in ("mean", "low", "high", "half_width")]
     rows = [[k] + [loads[k][q][key] for q in QUANTITIES for key in ("mean", "low", "high", "half_width")]
             for k in range(n)]

@@ -59,7 +59,7 @@ from ngcontact.coupling import two_scale as T
 from ngcontact.macro.macro_measures import interface_samples
 from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
-from ngcontact.scene.two_scale_section import cell_discretization
+from ngcontact.scene.two_scale_section import cell_discretization, load_cell
 from ngcontact.parallel import executor
 
 log = logging.getLogger(__name__)
@@ -262,15 +262,19 @@ def couple(scene, problem, solve,
     path = resolve(scene, spec.cell)
     overrides = cell_links.overrides(scene.interface)
     keys = cell_discretization(spec)
-    cell_scene = cell_scene_of(path, key="two_scale.cell", overrides=overrides, method=spec.cell_method,
-                               discretization=keys)
-    task = PressureSolve(path, spec.cell_length_unit, overrides, spec.cell_method, keys)
+
+    def of(p, o, m=None, d=None):
+        return cell_scene_of(p, key="two_scale.cell", overrides=o, method=m, discretization=d)
+    # the cell as the loop solves it, its method resolved once (an "auto" cell by fe where the shear table needs it)
+    cell_scene = load_cell(of, path, spec.cell, overrides, spec, scene.interface.friction == "from_cell")
+    method = cell_scene.discretization.method
+    task = PressureSolve(path, spec.cell_length_unit, overrides, method, keys)
     key = table_key(cell_scene, spec.cell_length_unit, spec.table_tol)
     table, from_cache = cached_table(key, task, spec.table_tol, map_tasks, cache_dir)
     shear, skey, shear_cached = None, None, False
     if scene.interface.friction == "from_cell" and cell_scene.contact.friction != "none":
         skey = shear_key(cell_scene, spec.cell_length_unit, spec.table_tol)
-        shear_task = ShearSolve(path, spec.cell_length_unit, overrides, discretization=keys)
+        shear_task = ShearSolve(path, spec.cell_length_unit, overrides, method, discretization=keys)
         shear, shear_cached = cached_shear(skey, shear_task, spec.table_tol, spec.cell_length_unit, shear_map,
                                            cache_dir)
     out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
@@ -291,6 +295,7 @@ def couple(scene, problem, solve,
            "law": {"type": "tabulated cell response p(c)", "interpolation": law.interpolation,
                    "closure": list(law.closure), "pressure": list(law.pressure)},
            "cell": {"scene": path, "method": task.method, **(task.size() if table.solves else {}),
+                    "method_choice": cell_scene.method_choice.statement if cell_scene.method_choice else task.method,
                     "overrides": overrides, **({"discretization": keys} if keys else {})},
            "interface_coefficients": {"contact_fraction": coef["contact_fraction"], "k_n0": coef["k_n0"]}}
     if shear is not None:

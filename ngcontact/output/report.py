@@ -139,6 +139,15 @@ def _error_text(q: dict) -> str:
         return "(no estimate)"
     return f"+/- {q['relative_error']:.2%}"
 
+def method_line(results: dict) -> str | None:
+    """The method that solved a cell and why (``results.accuracy.method``) in one terminal line, else ``None``."""
+    acc = results.get("accuracy")
+    method = acc.get("method") if isinstance(acc, dict) else None
+    if not isinstance(method, dict) or not method.get("reason"):
+        return None
+    return f"cell method {method['statement']}"
+
+
 def accuracy_line(results: dict) -> str | None:
     """The accuracy verdict (``results.accuracy``) in one terminal line: met or not, and per quantity its
     value and estimated relative error (the largest over the loads of a sweep, with that load's value); a

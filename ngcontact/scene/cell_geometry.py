@@ -194,3 +194,8 @@ def check_profile_heights(g: CellGeometry, bounds: tuple, path: str = "geometry"
 def small_slope(geometry: CellGeometry) -> bool:
     """A free-form 3D profile in the summit arrangement: flat interface plus gap."""
     return PROFILES[geometry.profile].free_form and geometry.arrangement == "summit"
+
+
+def flat_interface(geometry: CellGeometry) -> bool:
+    """The small-slope model: a flat ``S_C`` with the roughness in the initial gap (what the spectral cell solves)."""
+    return PROFILES[geometry.profile].flat or small_slope(geometry)

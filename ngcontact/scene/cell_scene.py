@@ -11,13 +11,15 @@ solved.  Solved by :mod:`ngcontact.drivers.run_cell`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.laws.friction import FRICTION_LAWS
 from ngcontact.scene.spectral_grid import TOLERANCE_OVER_RTOL, check_spectral_size
-from ngcontact.scene.cell_geometry import CellGeometry, check_features, check_profile_heights, small_slope
+from ngcontact.scene.cell_method import MethodChoice, resolve_method
+from ngcontact.scene.cell_geometry import (CellGeometry, check_features, check_profile_heights, flat_interface,
+                                          small_slope)
 from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size
@@ -160,6 +162,8 @@ class CellScene:
                                           "mean and the 95 % band")
     compute: ComputeSpec = param(ComputeSpec(), doc="where independent solves run (loads, ensemble members)")
     base_dir: str = base_dir_field()
+    #: the method that solves the scene and why (``discretization.method`` resolved by :meth:`check`)
+    method_choice: MethodChoice | None = field(default=None, init=False, repr=False, compare=False)
 
     def check_files(self, load) -> None:
         """Read and validate the tabulated profile / height map / measured topography / gap named by the scene.
@@ -217,6 +221,7 @@ class CellScene:
             if self.materials[name].C is not None:
                 raise SceneError(f"materials.{name}.C", "...", "cell scenes take isotropic E, nu")
         dim = self.geometry.dim
+        resolve_method(self)               # "auto" -> fe or spectral, before anything asks for the method
         if self.contact.k_n is None:       # exact contact without a scale: the default of contact.k_n's doc
             object.__setattr__(self.contact, "k_n", exact_scale(self))
         g = self.contact.gap.kind
@@ -321,11 +326,6 @@ def spectral_grid(scene: CellScene, heights_shape: tuple[int, ...] | None = None
         n = max(heights_shape) - 1
         return n + n % 2
     return 1024 if scene.geometry.dim == 2 else 256
-
-
-def flat_interface(geometry) -> bool:
-    """The small-slope model: a flat ``S_C`` with the roughness in the initial gap (what the spectral cell solves)."""
-    return PROFILES[geometry.profile].flat or small_slope(geometry)
 
 
 def has_twin(scene: CellScene) -> bool:

@@ -27,15 +27,16 @@ from typing import Any
 from ngcontact.scene import cell_links, loader
 from ngcontact.scene.discretization_knobs import Knob, Tolerance, grid_of, steps
 from ngcontact.scene.sections import resolve
-from ngcontact.scene.two_scale_section import cell_discretization
+from ngcontact.scene.two_scale_section import load_cell
 
 
 def loop_cell(scene):
     """The cell scene of ``scene``'s two-scale loop as the loop solves it (its contact overrides, method and
     discretization keys applied)."""
     spec = scene.two_scale
-    return loader.load_with_contact(resolve(scene, spec.cell), cell_links.overrides(scene.interface),
-                                    spec.cell_method, cell_discretization(spec))
+    overrides = cell_links.overrides(scene.interface)
+    return load_cell(loader.load_with_contact, resolve(scene, spec.cell), spec.cell, overrides, spec,
+                     shear_from_cell=scene.interface.friction == "from_cell")
 
 
 class LoopCellKnob(Knob):

@@ -360,7 +360,8 @@ class MacroScene:
                     raise SceneError("interface.cell_" + next(iter(overrides)), overrides,
                                      f"the cell {rel!r} with these overrides is invalid: {exc}") from None
             if key == "two_scale.cell" and self.two_scale is not None and cell.kind == "cell":
-                cell = load_cell(load, resolve(self, rel), rel, overrides, self.two_scale)
+                cell = load_cell(load, resolve(self, rel), rel, overrides, self.two_scale,
+                                 shear_from_cell=self.interface.friction == "from_cell")
             if key == "two_scale.cell" and cell.kind == "cell" and cell.discretization.method == "spectral":
                 cell_links.check_spectral_loop(self.interface, self.two_scale, rel, cell)
             if cell.kind != "cell":

@@ -14,6 +14,11 @@ key path, the value and what is allowed,
 * values outside their range or set of choices,
 * strings (and names of tables) longer than :data:`MAX_STRING` characters.
 
+A section that declares a field ``given`` (``init=False``) is told the keys
+its table set (:data:`GIVEN`), so that a rule can tell a key the scene wrote
+from one left at its default (``discretization.method = "auto"``,
+:mod:`ngcontact.scene.cell_method`).
+
 Cross-field rules live in a method ``check(self, path)`` of the dataclass,
 called after construction.  :func:`describe` walks the same metadata to write
 the scene-file reference of the README, so documentation and validation come
@@ -73,6 +78,15 @@ MAX_LEVELS = 8
 MAX_STRING = 4096
 #: Largest scene file (bytes), checked before it is parsed; the shipped scenes are below 6 kB.
 MAX_SCENE_BYTES = 2 ** 20
+
+
+#: the name of a section's field that holds the keys its table set (see the module docstring)
+GIVEN = "given"
+
+
+def given_field():
+    """The field :data:`GIVEN` of a section: the keys its table set, filled in by :func:`build`."""
+    return dataclasses.field(default=frozenset(), init=False, repr=False, compare=False)
 
 
 def _named(text: str, fn: Callable[[Any], bool]) -> Check:
@@ -191,6 +205,8 @@ def build(cls, data: Any, path: str = ""):
         _apply_checks(f, value, key)
         values[name] = value
     obj = cls(**values)
+    if any(f.name == GIVEN and not f.init for f in dataclasses.fields(cls)):
+        object.__setattr__(obj, GIVEN, frozenset(values))
     check = getattr(obj, "check", None)
     if callable(check):
         check(path)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.fem import materials as _materials
 from ngcontact.scene.mesh_size import MAX_ELEMENTS
-from ngcontact.scene.schema import MAX_ORDER, at_least, closed_interval, open_interval, param, positive
+from ngcontact.scene.schema import MAX_ORDER, at_least, closed_interval, given_field, open_interval, param, positive
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -103,13 +103,27 @@ class CellDiscretization(Discretization):
                           "order more on its own mesh); off skips that estimate (no second solve), and the report "
                           "says 'not estimated (discretization.estimate = off)'; no effect with a tolerance",
                           choices=("auto", "off"))
-    method: str = param("fe", doc="fe: finite elements on a mesh of the cell; spectral: the small-slope cell "
-                        "(flat interface, the roughness in the initial gap) as two periodic layers solved with "
-                        "FFTs on a uniform grid of the interface", choices=("fe", "spectral"))
-    grid: int | None = param(None, doc="spectral: grid points per period and direction of the first grid, "
+    method: str = param("auto", doc="which cell solves the scene: fe, finite elements on a mesh of the cell (any "
+                        "profile; writes the bodies' fields and stresses); spectral, the small-slope cell (flat "
+                        "interface, the roughness in the initial gap) as two periodic layers solved with FFTs on a "
+                        "uniform grid of the interface; auto (the default), chosen once when the scene is checked "
+                        "and stated in the report (results.accuracy.method, its reason in one sentence): spectral "
+                        "for a small-slope cell (geometry.profile 'flat' or 'flat3d', or 'bisinusoid', "
+                        "'height_map', 'measured_spectrum' or 'self_affine' with arrangement = 'summit') that sets "
+                        "no key only the FE cell reads (discretization.order, maxh, interface_maxh, max_elements; "
+                        "solver.atol, max_iter, inverse, linear, iterative_from, start, coulomb, coulomb_rtol, "
+                        "coulomb_max_iter; contact.w with exact friction, which the spectral cell solves without a "
+                        "width) and no tolerance below 10 x solver.rtol, else fe; a scene that sets "
+                        "discretization.grid is spectral (refused for a cell that is not small-slope, or beside an "
+                        "FE-only key); a macro scene's strength.cell, and a two-scale loop whose friction comes "
+                        "from a frictional cell, solve an auto cell by fe (they need the FE cell's stresses and "
+                        "shear response)", choices=("auto", "fe", "spectral"))
+    grid: int | None = param(None, doc="spectral (set with method = 'auto', it asks for the spectral cell): grid "
+                             "points per period and direction of the first grid, "
                              "which refinement to the tolerance (the scene's or the default) doubles (default: a "
                              "height map's own grid, else 1024 in 2D and 256 in 3D)",
                              check=closed_interval(8, MAX_GRID))
+    given: frozenset[str] = given_field()
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -151,6 +165,7 @@ class SolverSpec:
                                 "Coulomb Newton stopping at rtol): stop when max |p_k - p_k-1| <= coulomb_rtol x "
                                 "max p_k on the contact surface", check=positive())
     coulomb_max_iter: int = param(40, doc="Coulomb fixed point: largest number of Tresca passes", check=at_least(1))
+    given: frozenset[str] = given_field()
 
 
 def check_material_names(materials: dict, names: dict, path: str) -> None:

@@ -39,7 +39,9 @@ class TwoScaleSpec:
                              check=open_interval(0, 1))
     cell_method: str | None = param(None, doc="how the loop solves its cell: fe (finite elements) or spectral "
                                     "(the small-slope cell on a grid, for a flat interface with the roughness in "
-                                    "the gap); default: the cell scene's discretization.method",
+                                    "the gap); default: the cell scene's discretization.method as it resolves ('auto': "
+                                    "spectral for a small-slope cell, else fe; fe for a frictional cell whose shear "
+                                    "interface.friction = 'from_cell' tabulates)",
                                     choices=("fe", "spectral"))
     cell_grid: int | None = param(None, doc="spectral cell: its discretization.grid in the loop (default: the "
                                   "cell scene's)", check=closed_interval(8, MAX_GRID))
@@ -60,23 +62,41 @@ def cell_discretization(spec: TwoScaleSpec | None) -> dict:
     return {k: v for k, v in values.items() if v is not None}
 
 
-def load_cell(load, path: str, rel: str, overrides: dict, spec: TwoScaleSpec):
+def load_cell(load, path: str, rel: str, overrides: dict, spec: TwoScaleSpec, shear_from_cell: bool = False):
     """The loop's cell scene as the loop solves it: ``load(path, overrides, method, discretization)`` with
-    ``spec``'s method and discretization keys; a :class:`SceneError` names the key that made it invalid."""
+    ``spec``'s method and discretization keys; a :class:`SceneError` names the key that made it invalid.
+    ``shear_from_cell``: the loop also tabulates the cell's shear (``interface.friction = "from_cell"``), which
+    needs the FE cell: a frictional cell whose ``method = "auto"`` chose the spectral cell is solved by fe
+    (:mod:`ngcontact.scene.cell_method`)."""
+    cell = _loaded(load, path, rel, overrides, spec, spec.cell_method)
+    choice = getattr(cell, "method_choice", None)
+    if (shear_from_cell and spec.cell_method is None and choice is not None and choice.automatic
+            and choice.method != "fe" and cell.contact.friction != "none"):
+        cell = _loaded(load, path, rel, overrides, spec, "fe", ("interface.friction", "from_cell"))
+    return cell
+
+
+def _loaded(load, path: str, rel: str, overrides: dict, spec: TwoScaleSpec, method: str | None,
+            named: tuple[str, str] | None = None):
+    """The cell by ``method`` with ``spec``'s keys; a fault names ``named`` (key, value), else the key of ``spec``
+    that made the cell invalid."""
     keys = cell_discretization(spec)
-    if spec.cell_method is None and not keys:
+    if method is None and not keys:
         return load(path, overrides)
     try:
-        cell = load(path, overrides, spec.cell_method, keys)
+        cell = load(path, overrides, method, keys)
     except SceneError as exc:
-        key, value = (("two_scale.cell_method", spec.cell_method) if spec.cell_method is not None
-                      else next((f"two_scale.cell_{k}", v) for k, v in keys.items()))
-        what = "by this method" if key == "two_scale.cell_method" else "with it"
+        if named is not None:
+            (key, value), what = named, "by the FE cell its shear table needs"
+        elif method is not None:
+            key, value, what = "two_scale.cell_method", method, "by this method"
+        else:
+            (key, value), what = next((f"two_scale.cell_{k}", v) for k, v in keys.items()), "with it"
         raise SceneError(key, value, f"the cell {rel!r} cannot be solved {what}: {exc}") from None
-    method = getattr(getattr(cell, "discretization", None), "method", None)
+    resolved = getattr(getattr(cell, "discretization", None), "method", None)
     for k, v in keys.items():
-        if method is not None and CELL_DISCRETIZATION[k] != method:
+        if resolved is not None and CELL_DISCRETIZATION[k] != resolved:
             raise SceneError(f"two_scale.cell_{k}", v, f"sets the {CELL_DISCRETIZATION[k]} cell's "
-                             f"discretization.{k}, but the loop solves the cell {rel!r} by method {method!r}; "
+                             f"discretization.{k}, but the loop solves the cell {rel!r} by method {resolved!r}; "
                              f"remove it, or set two_scale.cell_method = {CELL_DISCRETIZATION[k]!r}")
     return cell

@@ -3,7 +3,6 @@ answer, its error from one order more on the same mesh (ngcontact.cell.fe.satura
 default tolerance, and a miss is never silent."""
 import json
 import logging
-import os
 from dataclasses import dataclass, field
 
 import pytest
@@ -11,10 +10,9 @@ import pytest
 from ngcontact import cli
 from ngcontact.cell.fe.saturation import SATURATION, estimate_on_scene, saturation_estimates
 from ngcontact.drivers.build import cell_loads, fe_variant, spectral_variant
-from ngcontact.scene.loader import load
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-STEM = os.path.join(ROOT, "geometries", "cells", "stem_grooves.toml")
+from fe_cells import fe_scene, fe_table, toml
+
 #: the 2D spectral contact fraction's collocation error at 65,536 points (ngcontact.cell.spectral.grid_measures)
 COLLOCATION = 2e-5
 
@@ -65,7 +63,7 @@ def test_a_cell_that_cannot_raise_its_order_is_not_estimated_and_not_met():
 def test_the_default_estimate_bounds_the_error_on_the_stem_grooves(order):
     """The stem-groove cell (flat 2D, penalty) on a coarser interface mesh, against its spectral twin on
     65,536 points: the estimate of the scene's own answer is at least its error and at most ten times it."""
-    scene = load(STEM)
+    scene = fe_scene("stem_grooves")      # the shipped scene is solved by the spectral cell; here its FE cell
     loads = cell_loads(scene)
     reference = spectral_variant(scene, 65536).sweep(loads)[0].results
     done = fe_variant(scene, interface_maxh=4e-6, order=order).default_accuracy(0.01, loads)
@@ -78,8 +76,9 @@ def test_the_default_estimate_bounds_the_error_on_the_stem_grooves(order):
 
 
 def _coarse_stem(tmp_path, order: int):
-    text = open(STEM, encoding="utf-8").read().replace("order = 2\n", f"order = {order}\n")
-    text = text.replace("interface_maxh = 1e-6", "interface_maxh = 4e-6")
+    table = fe_table("stem_grooves")
+    table["discretization"].update(order=order, interface_maxh=4e-6)
+    text = toml(table)
     path = tmp_path / f"stem_order{order}.toml"
     path.write_text(text, encoding="utf-8")
     return path

@@ -13,8 +13,8 @@ from ngcontact.cell.fe.observed_rate import Convergence
 from ngcontact.cell.fe.second_discretization import HALVING_RATE, refine
 from ngcontact.drivers.build import cell_loads, cell_solver, spectral_variant
 from ngcontact.errors import ConvergenceError
-from ngcontact.scene.loader import load
 
+from fe_cells import fe_scene
 from test_cell_error import CURVED
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -99,7 +99,7 @@ def test_stem_grooves_estimates_the_error_of_its_reported_closure_within_1_to_10
     """The shipped stem-groove cell (flat 2D, graded): against its spectral twin on 65,536 points (its closure
     there within 2e-8 of 262,144 points'), the mean closure's effectivity lies in [1, 10]; its contact fraction's
     true error is within the twin's collocation error, so only bounded by it."""
-    scene = load(os.path.join(ROOT, "geometries", "cells", "stem_grooves.toml"))
+    scene = fe_scene("stem_grooves")      # the shipped scene is solved by the spectral cell; here its FE cell
     loads = cell_loads(scene)
     reference = spectral_variant(scene, 65536).sweep(loads)[0].results
     refined = cell_solver(scene).refine_to(0.01, loads, required=False)

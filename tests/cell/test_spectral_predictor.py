@@ -15,6 +15,7 @@ from ngcontact.fem.interpolants import periodic_grid
 from ngcontact.drivers.build import TWIN_GRID, build_cell, cell_loads, cell_problem, model_of, predictor_twin
 from ngcontact.scene.loader import load
 
+from fe_cells import FE, fe_scene
 from height_map_cell import fe_height_map
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -25,6 +26,8 @@ def _scene(name):
         import tomllib
         from ngcontact.scene.loader import from_dict
         return from_dict(tomllib.loads(fe_height_map()))
+    if name in FE:                    # shipped for the spectral cell (method = "auto"); here its FE cell
+        return fe_scene(name)
     return load(os.path.join(ROOT, "geometries", "cells", f"{name}.toml"))
 
 

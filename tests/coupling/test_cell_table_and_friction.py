@@ -21,6 +21,8 @@ from ngcontact.macro import macro_measures as MM
 from ngcontact.macro import macro_problem as M
 from ngcontact.scene.loader import from_dict, load
 
+from fe_cells import FE
+
 CELLS = os.path.join(os.path.dirname(__file__), "..", "..", "geometries", "cells")
 
 
@@ -124,14 +126,15 @@ def test_copies_of_a_pressure_solve_in_one_worker_share_its_cell_problem_and_its
     import pickle
     monkeypatch.setattr(R, "_BUILT", {})
     path = os.path.join(CELLS, "stem_grooves.toml")
-    task = R.PressureSolve(path, 1.0)
+    mesh = {k: v for k, v in FE["stem_grooves"].items() if k != "method"}     # its FE cell (fe_cells)
+    task = R.PressureSolve(path, 1.0, method="fe", discretization=mesh)
     first, second = (pickle.loads(pickle.dumps(task)) for _ in range(2))
-    other_cell = pickle.loads(pickle.dumps(R.PressureSolve(path, 1.0, {"k_n": 1e15})))
+    other_cell = pickle.loads(pickle.dumps(R.PressureSolve(path, 1.0, {"k_n": 1e15}, "fe", mesh)))
     assert first.problem() is second.problem() and other_cell.problem() is not first.problem()
     assert task.problem() is not first.problem()          # the submitting process keeps its own
     pressures = (40.0, 5.0)
     shared = [second(p) for p in pressures]               # the second after the first on one problem
-    fresh = [R.PressureSolve(path, 1.0)(p) for p in pressures[1:]]   # not a copy: builds its own cell
+    fresh = [R.PressureSolve(path, 1.0, method="fe", discretization=mesh)(p) for p in pressures[1:]]  # its own cell
     for key in PT.KEYS:
         assert shared[1][key] == pytest.approx(fresh[0][key], rel=1e-10, abs=1e-14), key
 

@@ -20,13 +20,20 @@ from ngcontact.drivers.build import cell_scene_of
 from ngcontact.macro import macro_measures as MM
 from ngcontact.scene.loader import load
 
+from fe_cells import FE
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 GROOVES = os.path.join(ROOT, "geometries", "cells", "stem_grooves.toml")
+#: the groove cell's FE discretization (fe_cells.FE) as a two-scale loop's cell keys
+FE_MESH = {k: v for k, v in FE["stem_grooves"].items() if k != "method"}
 
 
 def test_the_spectral_groove_cell_answers_like_the_fe_cell():
-    fe, spectral = R.PressureSolve(GROOVES, 1.0), R.PressureSolve(GROOVES, 1.0, method="spectral")
-    assert fe.method == "fe" and spectral.method == "spectral"     # default: the cell scene's own method
+    # the cell scene's own method: "auto", the spectral cell of this small-slope cell; the FE cell by its mesh
+    assert R.PressureSolve(GROOVES, 1.0).method == "spectral"
+    fe = R.PressureSolve(GROOVES, 1.0, method="fe", discretization=FE_MESH)
+    spectral = R.PressureSolve(GROOVES, 1.0, method="spectral")
+    assert fe.method == "fe" and spectral.method == "spectral"
     assert fe.key != spectral.key                                    # two tables, two cache entries
     k_n = cell_scene_of(GROOVES, key="two_scale.cell").contact.k_n
     for p in (1e6, 5e6):
@@ -62,8 +69,10 @@ def test_the_femur_loop_reaches_the_same_state_with_either_cell(tmp_path):
     geo = D.build_geometry(shipped)
     runs = {}
     for method in ("fe", "spectral"):
+        # the FE cell by the groove cell's FE mesh (the shipped cell scene leaves its method to "auto")
+        mesh = {f"cell_{k}": v for k, v in FE_MESH.items()} if method == "fe" else {}
         scene = dataclasses.replace(shipped, strength=None,
-                                    two_scale=dataclasses.replace(shipped.two_scale, cell_method=method))
+                                    two_scale=dataclasses.replace(shipped.two_scale, cell_method=method, **mesh))
         object.__setattr__(scene, "base_dir", shipped.base_dir)
         problem, _ = D.problem_of(scene, geo)
         sol, res = R.couple(scene, problem, partial(D.solve_scene, scene), map_tasks=PT.serial_map,

@@ -45,6 +45,8 @@ from ngcontact.laws import interface_energy as ie
 from ngcontact.macro import macro_problem as M
 from ngcontact.scene.loader import load
 
+from fe_cells import fe_scene
+
 pytestmark = pytest.mark.slow
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -55,7 +57,7 @@ CORNER = 0.13     # z of the cone-cylinder corner of the stem
 
 @pytest.fixture(scope="module")
 def groove_response():
-    cs = load(os.path.join(GEOMETRIES, "cells", "stem_grooves.toml"))
+    cs = fe_scene("stem_grooves")         # the shipped cell is solved spectrally ("auto"); here its FE cell
     s = cs.solver
     cell = CellProblem(build_cell(cs, interface_maxh=4e-6), model_of(cs), rtol=s.rtol, atol=s.atol,
                        max_iter=s.max_iter)

@@ -140,6 +140,8 @@ def test_an_fe_penalty_cell_in_the_loop_gives_its_mesh_order_and_penalty_knobs()
     path = ROOT / "geometries" / "femur_stem_two_scale.toml"
     data = loader.parsed(path)
     data["two_scale"]["cell_method"] = "fe"
+    # the groove cell leaves its method to "auto" (the spectral cell): its FE mesh through the loop's keys
+    data["two_scale"].update(cell_maxh=25e-6, cell_interface_maxh=1e-6)
     levels, _ = ladder(loader.from_dict(data, base_dir=str(path.parent)), data, 3)
     knobs = {lv.knob: lv.changes for lv in levels}
     assert {"cell_h", "cell_order", "cell_k_n"} <= set(knobs) and "cell_grid" not in knobs
