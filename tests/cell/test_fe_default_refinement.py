@@ -7,13 +7,17 @@ import json
 import logging
 import math
 import tomllib
+from dataclasses import dataclass
 
 import pytest
 
 from ngcontact import cli
 from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.cell.fe.default_refinement import BUDGET_KEY
+from ngcontact.cell.cell_solution import CellSolution
 from ngcontact.cell.fe.observed_rate import dofs_to_meet, exponent
+from ngcontact.cell.fe.second_discretization import HALVING_RATE, refine
+from ngcontact.errors import ModelError
 from ngcontact.drivers.build import cell_loads, cell_solver
 from ngcontact.scene.loader import from_dict
 from ngcontact.verification.moduli import e_star
@@ -129,3 +133,37 @@ def test_the_opt_out_keeps_a_single_solve(tmp_path, capsys, monkeypatch):
     acc = report["results"]["accuracy"]
     assert acc["how"] == "not estimated (discretization.estimate = off)" and not acc["estimated"]
     assert len(solves) == 1 and "mesh_history" not in report["results"]["loads"][0]
+
+
+class _Unmeshable:
+    """A refiner whose level 2 the mesher cannot build (level k: 1000 4^k dofs, fraction 0.5 + 0.1 / 2^k)."""
+
+    rule = HALVING_RATE
+
+    def level(self, k):
+        if k == 2:
+            raise ModelError("Netgen's mesher failed")
+        return _Level(1000 * 4 ** k, 0.5 + 0.1 / 2 ** k)
+
+    def describe(self, k):
+        return f"level {k}"
+
+
+@dataclass
+class _Level:
+    ndof: int
+    fraction: float
+
+    def unknowns(self) -> int:
+        return self.ndof
+
+    def sweep(self, loads):
+        return [CellSolution(load=None, results={"contact_fraction": self.fraction, "mean_closure": 1.0})]
+
+
+def test_a_level_the_mesher_cannot_build_ends_a_default_refinement_not_the_run():
+    """Unrequired: the levels before it are the answer, not met, the reason in ``how``; required: the error."""
+    done = refine(_Unmeshable(), [None], 1e-3, 10 ** 9, required=False)
+    assert not done.met and len(done.levels) == 2 and "level 2 cannot be built (Netgen's mesher failed)" in done.how
+    with pytest.raises(ModelError):
+        refine(_Unmeshable(), [None], 1e-3, 10 ** 9, required=True)

@@ -77,7 +77,7 @@ import ngsolve as ng
 from ngcontact.cell.fe.measures import contact_pieces
 from ngcontact.cell.fe.load_start import starts_afresh
 from ngcontact.cell.fe.observed_rate import Convergence
-from ngcontact.errors import ConvergenceError
+from ngcontact.errors import ConvergenceError, ModelError, SceneError
 from ngcontact.geometry.cell2d import flat_cell
 
 log = logging.getLogger(__name__)
@@ -265,7 +265,12 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
     given (carried over unless the problem starts afresh); record the changes against it in ``history`` and
     the Newton histories in ``newton``.  Returns the problem, the solution, its contact edges and its entry.
     :class:`OverBudget` where the mesh holds more than ``max_dofs`` unknowns (not solved)."""
-    problem = make_problem(vertices, p)
+    try:
+        problem = make_problem(vertices, p)
+    except (ModelError, SceneError) as exc:
+        if max_dofs is None:
+            raise
+        raise OverBudget(f"grading level {level} at order {p} cannot be meshed ({exc})") from exc
     if max_dofs is not None and problem.ndof > max_dofs:
         raise OverBudget(f"grading level {level} at order {p} would have {problem.ndof} dofs, beyond {max_dofs}")
     fresh = before is None or starts_afresh(problem, load)
@@ -292,7 +297,7 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
 
 class OverBudget(Exception):
     """A level's mesh holds more unknowns than the refinement may solve (``max_dofs`` of
-    :func:`solve_to_tolerance`)."""
+    :func:`solve_to_tolerance`), or cannot be built where the refinement is bounded so."""
 
 
 def _stopped(why: str, problem, sol, entry: dict[str, Any], orders: list[dict[str, Any]],

@@ -40,7 +40,7 @@ from typing import Any, Callable, Protocol
 from ngcontact.cell.cell_solution import COEFFICIENT, CellSolution, headline, scale
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.cell.fe.observed_rate import Convergence, dofs_to_meet, exponent, sequence_estimates
-from ngcontact.errors import ConvergenceError, SceneError
+from ngcontact.errors import ConvergenceError, ModelError, SceneError
 
 log = logging.getLogger(__name__)
 #: the run's progress lines
@@ -129,7 +129,7 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
     for k in range(MAX_LEVELS):
         try:
             nxt = refiner.level(k)
-        except SceneError as exc:         # a level the mesher cannot build: out of reach, as a refused one
+        except (SceneError, ModelError) as exc:     # a level the mesher cannot build: out of reach, as refused
             if required or k == 0:
                 raise
             stop = f"{refiner.describe(k)} cannot be built ({exc})"
