@@ -13,7 +13,7 @@ import pytest
 
 from ngcontact import cli
 from ngcontact.cell.fe.cell_problem import CellProblem
-from ngcontact.cell.fe.default_refinement import BUDGET_KEY
+from ngcontact.cell.fe.default_refinement import BUDGET_KEY, sequence_shortfall
 from ngcontact.cell.cell_solution import CellSolution
 from ngcontact.cell.fe.observed_rate import dofs_to_meet, exponent
 from ngcontact.cell.fe.second_discretization import HALVING_RATE, refine
@@ -165,5 +165,7 @@ def test_a_level_the_mesher_cannot_build_ends_a_default_refinement_not_the_run()
     """Unrequired: the levels before it are the answer, not met, the reason in ``how``; required: the error."""
     done = refine(_Unmeshable(), [None], 1e-3, 10 ** 9, required=False)
     assert not done.met and len(done.levels) == 2 and "level 2 cannot be built (Netgen's mesher failed)" in done.how
+    said = sequence_shortfall(done, 1e-3, 120_000)       # the warning says why it stopped, not only the budget
+    assert f"{BUDGET_KEY} = 120000" in said and "stopped: level 2 cannot be built" in said
     with pytest.raises(ModelError):
         refine(_Unmeshable(), [None], 1e-3, 10 ** 9, required=True)

@@ -68,15 +68,16 @@ def worst(estimates: list[dict[str, float]]) -> float:
     return max((max(e.values()) for e in estimates if e), default=0.0)
 
 
-def shortfall(tolerance: float, budget: int, finest: str, estimate: float, need: tuple[float, float] | None) -> str:
-    """The shortfall in words: the budget, the finest discretization, the estimate, and what meeting the
-    tolerance would take."""
+def shortfall(tolerance: float, budget: int, finest: str, estimate: float, need: tuple[float, float] | None,
+              stop: str = "") -> str:
+    """The shortfall in words: the budget, the finest discretization, the estimate, why the refinement stopped
+    where that was not the budget, and what meeting the tolerance would take."""
     head = (f"after refining within {BUDGET_KEY} = {budget} (finest: {finest}; largest estimate {estimate:.3g} "
-            f"against {tolerance:g})")
+            f"against {tolerance:g}{'; stopped: ' + stop if stop else ''})")
     if need is None:
         return head + "; the estimates do not fall fast enough to extrapolate what meeting it would take"
-    return (head + f"; meeting it would take about {need[0]:.2g} dofs (the estimate falling like dofs^-{need[1]:.2g} "
-            "as observed)")
+    return (head + f"; meeting it would take about {need[0]:.2g} dofs (the estimate falling like "
+            f"dofs^-{need[1]:.2g}, as observed, or as assumed where one level is estimated)")
 
 
 def sequence_shortfall(done: Sequence, tolerance: float, budget: int) -> str:
@@ -90,7 +91,8 @@ def sequence_shortfall(done: Sequence, tolerance: float, budget: int) -> str:
                  (HALVING_RATE.assumed, growth))
     e = worst(done.estimates)
     finest = f"{levels[-1]['discretization']}, {levels[-1]['ndof']} dofs"
-    return shortfall(tolerance, budget, finest, e, dofs_to_meet(levels[-1]["ndof"], e, tolerance, a))
+    why = "" if done.beyond is not None or "would take about" in done.stop else done.stop
+    return shortfall(tolerance, budget, finest, e, dofs_to_meet(levels[-1]["ndof"], e, tolerance, a), why)
 
 
 def graded_shortfall(solves: list[GradedSolve], tolerance: float, budget: int) -> str:

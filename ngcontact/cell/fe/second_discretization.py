@@ -99,6 +99,8 @@ class Sequence:
     scales: list[dict[str, float]] = field(default_factory=list)
     #: the unknowns of the first level beyond the size bound (not solved), where that stopped the loop
     beyond: int | None = None
+    #: why the loop stopped short of the tolerance, in words ("" where it met it)
+    stop: str = ""
 
 
 def _level(cell, loads, k: int, refiner: Refiner, known: list[CellSolution] | None = None
@@ -171,7 +173,7 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
     if not estimates:
         estimates = [{} for _ in sols]
     return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]), scales,
-                    beyond)
+                    beyond, stop)
 
 
 def _beyond_reach(levels: list[dict[str, Any]], tolerance: float, max_dofs: int) -> str | None:
