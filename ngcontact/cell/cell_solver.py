@@ -78,6 +78,9 @@ class Refinement:
     #: the solutions are the scene's own discretization's, their error estimated without refining
     #: (:meth:`CellSolver.default_accuracy` of an FE cell)
     scene_discretization: bool = False
+    #: where a refinement towards the default tolerance ended on its budget before meeting it: the budget and
+    #: what meeting the tolerance would take, in words (the run's warning and ``accuracy.shortfall``), else ""
+    shortfall: str = ""
 
 
 class CellSolver(Protocol):

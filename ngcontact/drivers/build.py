@@ -234,7 +234,8 @@ def fe_cell(scene: CellScene) -> FECell:
     return FECell(cell, model, lambda: cell_problem(scene, cell, model), threshold=threshold, graded=graded,
                   h0=h0, predictor=predictor, variant=lambda **changes: fe_variant(scene, **changes),
                   interface_maxh=d.interface_maxh or d.maxh, twin=share_twin(scene),
-                  refiner=edge_refiner(scene, model, cell_problem, spectral_cell))
+                  refiner=edge_refiner(scene, model, cell_problem, spectral_cell), budget=d.budget_dofs,
+                  refine_default=d.estimate == "auto")
 
 
 #: the spectral twin's grid on which an FE cell's penalty share is measured: it resolves the contact edges

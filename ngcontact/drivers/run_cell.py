@@ -21,12 +21,16 @@ it (:meth:`~ngcontact.cell.cell_solver.CellSolver.refine_to`) and each load
 adds ``error_estimate`` (FE: also ``mesh_history``); without it the sweep is
 held to :data:`~ngcontact.cell.admissibility.DEFAULT_TOLERANCE`
 (:meth:`~ngcontact.cell.cell_solver.CellSolver.default_accuracy`): the
-spectral cell is refined to it within a tighter size bound, the FE cell keeps
-its discretization and estimates its error from one order more
+spectral cell is refined to it within a tighter size bound; the FE cell
+estimates its own answer's error from one order more
 (:mod:`ngcontact.cell.fe.saturation`; each load adds ``error_estimate`` and
-``next_order``), and one that misses it is reported with
-``accuracy.met = false`` and one warning line rather than failed; ``discretization.estimate = "off"``
-skips that estimate and says so (``accuracy.how``).  ``accuracy.method`` states the method that solved
+``next_order``) and, where that misses it, is refined within
+``discretization.budget_dofs`` (:mod:`ngcontact.cell.fe.default_refinement`;
+``discretization.estimate = "estimate"``: not refined); one that misses it
+is reported with ``accuracy.met = false``, ``accuracy.shortfall`` where the
+budget ended first, and one warning line rather than failed (exit 0);
+``discretization.estimate = "off"`` skips that estimate and says so
+(``accuracy.how``).  ``accuracy.method`` states the method that solved
 the cell and why (``discretization.method = "auto"`` resolved: :mod:`ngcontact.scene.cell_method`).  With
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers.
@@ -93,6 +97,8 @@ def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[
     for c in failed:
         if c.load is not None:       # the cell's own checks were said before the solve
             log.warning("accuracy not met: %s", c.message())
+    if refinement is not None and refinement.shortfall and not verdict["met"]:
+        verdict["shortfall"] = refinement.shortfall
     if refinement is not None:
         warn_unmet(verdict, refinement)
     return verdict
@@ -112,6 +118,11 @@ def warn_unmet(verdict: dict, refinement: Refinement) -> None:
         what = "no estimate shows"
     else:
         what = "too few grids within the size bound to show"
+    if refinement.shortfall:
+        log.warning("accuracy not met: %s the %s tolerance %g %s; raise discretization.budget_dofs or state "
+                    "discretization.tolerance", what if unmet else "the refinement did not show",
+                    verdict["tolerance_from"], verdict["tolerance"], refinement.shortfall)
+        return
     if refinement.scene_discretization:
         log.warning("accuracy not met: %s the %s tolerance %g on the scene's own discretization (%s); state "
                     "discretization.tolerance to refine it, or a finer interface_maxh or a higher order", what,

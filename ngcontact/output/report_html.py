@@ -382,8 +382,9 @@ def accuracy_warnings(report: dict) -> list[str]:
     head = f"Accuracy not met (tolerance {fmt(acc.get('tolerance'))}): "
     checks = [f"{head}load {c.get('load')}, {c.get('name')} = {fmt(c.get('value'))} > {fmt(c.get('limit'))}"
               for c in acc.get("checks", []) if isinstance(c, dict) and not c.get("ok", True)]
+    shortfall = [head + acc["shortfall"]] if isinstance(acc.get("shortfall"), str) else []
     return checks + [head + quantity_line(q) for q in acc.get("quantities", [])
-                     if isinstance(q, dict) and not q.get("met", True) and q.get("counted", True)]
+                     if isinstance(q, dict) and not q.get("met", True) and q.get("counted", True)] + shortfall
 
 
 def quantity_line(q: dict) -> str:

@@ -92,17 +92,28 @@ class CellDiscretization(Discretization):
         "gives the estimate per load and the mesh or grid history, and a tolerance out of "
         "reach ends the run (exit 3); default: 0.01 (accuracy.tolerance_from = 'default'): the spectral cell "
         "is refined to it up to 65536 grid points in 2D and 512 x 512 in 3D and, out of reach there, reports "
-        "its finest grid with accuracy.met = false and a warning; the FE cell keeps its mesh and order, reports "
-        "its own answer and estimates its error by the same sweep one order more on the same mesh (the change "
-        "times 4: the saturation assumption that order p + 1 keeps at most 3/4 of the error of order p; one more "
-        "sweep on about ((p + 1) / p)^dim times the unknowns), a miss reported with accuracy.met = false and a "
-        "warning, not refined",
+        "its finest grid with accuracy.met = false and a warning; the FE cell first estimates its own answer's "
+        "error by the same sweep one order more on the same mesh (the change times 4: the saturation assumption "
+        "that order p + 1 keeps at most 3/4 of the error of order p; one more sweep on about ((p + 1) / p)^dim "
+        "times the unknowns) and reports it where that meets 0.01, else is refined towards 0.01 as a stated "
+        "tolerance refines it, within discretization.budget_dofs; a budget spent before 0.01 is met reports the "
+        "finest answer with accuracy.met = false, one warning naming the estimate, the budget and the dofs "
+        "meeting 0.01 would take at the observed rate (accuracy.shortfall), and exit status 0",
         check=open_interval(0, 1))
-    estimate: str = param("auto", doc="without a tolerance: auto estimates the error against the default "
-                          "tolerance as discretization.tolerance says (the spectral cell refined, the FE cell one "
-                          "order more on its own mesh); off skips that estimate (no second solve), and the report "
-                          "says 'not estimated (discretization.estimate = off)'; no effect with a tolerance",
-                          choices=("auto", "off"))
+    estimate: str = param("auto", doc="without a tolerance: auto holds the sweep to the default tolerance as "
+                          "discretization.tolerance says (the spectral cell refined; the FE cell estimated by one "
+                          "order more on its own mesh, and refined within discretization.budget_dofs where that "
+                          "misses it); estimate (FE cell) estimates its own answer by one order more and does not "
+                          "refine, a miss reported with accuracy.met = false and a warning (two sweeps: for runs "
+                          "not about accuracy); off skips the estimate (no second solve), and the report says "
+                          "'not estimated (discretization.estimate = off)'; no effect with a tolerance",
+                          choices=("auto", "estimate", "off"))
+    budget_dofs: int | None = param(None, doc="FE cell without a tolerance, estimate = 'auto': the most unknowns "
+                                    "of a discretization its refinement towards the default tolerance solves (a "
+                                    "finer interface mesh or graded mesh, or a higher order, beyond it is not "
+                                    "solved); default 120000 in 2D, 40000 in 3D.  A stated tolerance refines up "
+                                    "to 1e6 dofs in 2D and 4e5 in 3D whatever this says; no effect on a spectral "
+                                    "cell (its default refinement has its own bound)", check=at_least(1000))
     method: str = param("auto", doc="which cell solves the scene: fe, finite elements on a mesh of the cell (any "
                         "profile; writes the bodies' fields and stresses); spectral, the small-slope cell (flat "
                         "interface, the roughness in the initial gap) as two periodic layers solved with FFTs on a "
@@ -110,7 +121,7 @@ class CellDiscretization(Discretization):
                         "and stated in the report (results.accuracy.method, its reason in one sentence): spectral "
                         "for a small-slope cell (geometry.profile 'flat' or 'flat3d', or 'bisinusoid', "
                         "'height_map', 'measured_spectrum' or 'self_affine' with arrangement = 'summit') that sets "
-                        "no key only the FE cell reads (discretization.order, maxh, interface_maxh, max_elements; "
+                        "no key only the FE cell reads (discretization.order, maxh, interface_maxh, max_elements, budget_dofs; "
                         "solver.atol, max_iter, inverse, linear, iterative_from, start, coulomb, coulomb_rtol, "
                         "coulomb_max_iter; contact.w with exact friction, which the spectral cell solves without a "
                         "width) and no tolerance below 10 x solver.rtol, else fe; a scene that sets "

@@ -60,6 +60,15 @@ class Cell(StudiedKind):
                               "[ensemble])")
         return None
 
+    def level_table(self, data, knob):
+        """A level answers on its own discretization: an FE cell without a tolerance is estimated there and
+        not refined towards the default one (``discretization.estimate = "estimate"``, unless the scene opts
+        out of the estimate), so each level's cost and error are its knob's."""
+        disc = data.setdefault("discretization", {})
+        if disc.get("estimate", "auto") == "auto":
+            disc["estimate"] = "estimate"
+        return data
+
 
 class Macro(StudiedKind):
     name, summary = "macro", "macro (also with [strength])"

@@ -26,6 +26,8 @@ def _sinusoid(tmp_path, h: float):
     text = text.replace("gap = { kind = \"sinusoid\", h = 0.01 }", f"gap = {{ kind = \"sinusoid\", h = {h!r} }}")
     text = "\n".join("pressure = [0.00863075]" if line.startswith("pressure = [") else line
                      for line in text.splitlines())
+    # the checks of one discretization, not its refinement: estimated on the scene's mesh, not refined
+    text = text.replace("[discretization]\n", '[discretization]\nestimate = "estimate"\n')
     path = tmp_path / f"sinusoid_{h:g}.toml"
     path.write_text(text, encoding="utf-8")
     return path
@@ -122,7 +124,7 @@ def test_the_slopes_of_westergaard_s_gap():
 
 def _height_map_scene(tmp_path, interface_maxh):
     path = tmp_path / "map.toml"
-    path.write_text(fe_height_map(interface_maxh), encoding="utf-8")
+    path.write_text(fe_height_map(interface_maxh) + 'estimate = "estimate"\n', encoding="utf-8")
     return path
 
 

@@ -77,7 +77,7 @@ import ngsolve as ng
 from ngcontact.cell.fe.measures import contact_pieces
 from ngcontact.cell.fe.load_start import starts_afresh
 from ngcontact.cell.fe.observed_rate import Convergence
-from ngcontact.errors import ConvergenceError
+from ngcontact.errors import ConvergenceError, ModelError, SceneError
 from ngcontact.geometry.cell2d import flat_cell
 
 log = logging.getLogger(__name__)
@@ -135,6 +135,8 @@ class GradedSolve:
     history: list[dict[str, Any]] = field(default_factory=list)
     #: the Newton histories of every level's solve, in order, each with its ``"level"`` and ``"order"``
     newton: list[dict[str, Any]] = field(default_factory=list)
+    #: why the loop stopped before the tolerance at a size bound (``max_dofs``), else ""
+    stopped: str = ""
 
     @property
     def estimate(self) -> dict[str, float]:
@@ -154,6 +156,13 @@ def order_estimate(orders: list[dict[str, Any]], grading_change: float | None = 
     observed rate of :data:`ORDER_RATE`; the contact fraction's at least the last solution's
     :func:`edge_offset` and the tail of the last grading step's change (module docstring); and its remark."""
     out, notes = {}, []
+    if len(orders) < 2:        # stopped before an order was raised: the last grading step's changes
+        last = orders[-1]
+        change = last["fraction_change"] if grading_change is None else grading_change
+        unknown = float("inf")
+        return ({"contact_fraction": unknown if change is None else GRADING_TAIL * change,
+                 "mean_closure": unknown if last["closure_change"] is None else last["closure_change"]},
+                "stopped before an order was raised: the last grading step's changes")
     for name, relative in (("contact_fraction", False), ("mean_closure", True)):
         out[name], note = ORDER_RATE.tail([e[name] for e in orders], relative)
         if note:
@@ -251,11 +260,19 @@ def seed_levels(h0: float, spacing: float) -> int:
 
 
 def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, before, history: list,
-                 newton: list):
+                 newton: list, max_dofs: int | None = None):
     """Solve ``load`` on a new mesh (grading ``level``, order ``p``), from ``before = (problem, entry)`` when
     given (carried over unless the problem starts afresh); record the changes against it in ``history`` and
-    the Newton histories in ``newton``.  Returns the problem, the solution, its contact edges and its entry."""
-    problem = make_problem(vertices, p)
+    the Newton histories in ``newton``.  Returns the problem, the solution, its contact edges and its entry.
+    :class:`OverBudget` where the mesh holds more than ``max_dofs`` unknowns (not solved)."""
+    try:
+        problem = make_problem(vertices, p)
+    except (ModelError, SceneError) as exc:
+        if max_dofs is None:
+            raise
+        raise OverBudget(f"grading level {level} at order {p} cannot be meshed ({exc})") from exc
+    if max_dofs is not None and problem.ndof > max_dofs:
+        raise OverBudget(f"grading level {level} at order {p} would have {problem.ndof} dofs, beyond {max_dofs}")
     fresh = before is None or starts_afresh(problem, load)
     if not fresh:
         carry_over(before[0], problem)
@@ -278,9 +295,25 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
     return problem, sol, edges, entry
 
 
+class OverBudget(Exception):
+    """A level's mesh holds more unknowns than the refinement may solve (``max_dofs`` of
+    :func:`solve_to_tolerance`), or cannot be built where the refinement is bounded so."""
+
+
+def _stopped(why: str, problem, sol, entry: dict[str, Any], orders: list[dict[str, Any]],
+             graded: dict[str, Any] | None, history: list, newton: list) -> GradedSolve:
+    """The last level solved when the next is beyond the size bound: with the orders on its mesh, or alone
+    where no order raise has checked it (its estimate then the last grading step's changes)."""
+    log.info("graded refinement stopped: %s", why)
+    if not orders or orders[-1] is not entry:
+        orders, graded = [entry], None
+    return GradedSolve(problem=problem, solution=sol, orders=orders, history=history, newton=newton,
+                       grading_change=graded["fraction_change"] if graded is not None else None, stopped=why)
+
+
 def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, tolerance: float, h0: float,
                        period: float, order: int, seed: tuple[np.ndarray, float] | None = None,
-                       required: bool = True) -> GradedSolve:
+                       required: bool = True, max_dofs: int | None = None) -> GradedSolve:
     """Solve ``load`` on meshes graded towards the contact edges until the estimate meets ``tolerance``.
 
     The loop of the module docstring: grading levels until the contact
@@ -309,6 +342,9 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
     required
         ``False``: out of reach, the finest level's solution with the last comparisons as its estimate
         (over the tolerance) instead of the error.
+    max_dofs
+        With ``required = False``: no level after the first whose mesh holds more unknowns is solved; the
+        loop stops there as out of reach (``None``: no bound but the steps and raises).
 
     Raises
     ------
@@ -324,7 +360,8 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
     orders: list[dict[str, Any]] = []     # the entries of successive orders on the last graded mesh
 
     def run(vertices: list[float], p: int, level: int, before=None):
-        return _solve_level(make_problem, load, vertices, p, level, before, history, newton)
+        return _solve_level(make_problem, load, vertices, p, level, before, history, newton,
+                            None if required or before is None else max_dofs)
 
     def met(entry) -> bool:
         return entry["fraction_change"] is not None and max(entry["fraction_change"],
@@ -337,36 +374,39 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
     problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP)
     if seed is not None:
         entry["seed"] = {"edges": [float(e) for e in seed[0]], "spacing": float(seed[1])}
-    while True:
-        change = entry["fraction_change"]
-        if change is not None and (change <= tolerance or step == MAX_STEPS):
-            # the edges are resolved (or graded as far as they go): one order more on the same mesh
-            # checks, and reduces, the error of the smooth bulk; repeated while the order changes the
-            # answer and raises remain
-            graded = entry
-            orders = [entry]
-            while raises < MAX_ORDER_RAISES + 1:
-                order += 1
-                raises += 1
-                problem, sol, edges, entry = run(vertices, order, entry["level"], (problem, entry))
-                orders.append(entry)
-                if graded["fraction_change"] <= tolerance and met(entry):
-                    # the changes meet it: a third order shows the rate, whose tail must meet it too
-                    tail = order_estimate(orders, graded["fraction_change"])[0]
-                    if len(orders) >= 3 and max(tail.values()) <= tolerance:
-                        return GradedSolve(problem=problem, solution=sol, orders=orders, history=history,
-                                           newton=newton, grading_change=graded["fraction_change"])
-                elif step < MAX_STEPS:
-                    break
-        if step == MAX_STEPS or raises > MAX_ORDER_RAISES:
-            break
-        step += 1
-        if len(edges) == 0:  # full (or no) contact: no edge to grade towards; halve the interface mesh instead
-            n = int(round(period / h0)) * 2 ** step
-            vertices = [period * (i + 0.5) / n for i in range(n)]
-        else:
-            vertices = graded_vertices(edges, h0, step * LEVELS_PER_STEP, period)
-        problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP, (problem, entry))
+    try:
+        while True:
+            change = entry["fraction_change"]
+            if change is not None and (change <= tolerance or step == MAX_STEPS):
+                # the edges are resolved (or graded as far as they go): one order more on the same mesh
+                # checks, and reduces, the error of the smooth bulk; repeated while the order changes the
+                # answer and raises remain
+                graded = entry
+                orders = [entry]
+                while raises < MAX_ORDER_RAISES + 1:
+                    order += 1
+                    raises += 1
+                    problem, sol, edges, entry = run(vertices, order, entry["level"], (problem, entry))
+                    orders.append(entry)
+                    if graded["fraction_change"] <= tolerance and met(entry):
+                        # the changes meet it: a third order shows the rate, whose tail must meet it too
+                        tail = order_estimate(orders, graded["fraction_change"])[0]
+                        if len(orders) >= 3 and max(tail.values()) <= tolerance:
+                            return GradedSolve(problem=problem, solution=sol, orders=orders, history=history,
+                                               newton=newton, grading_change=graded["fraction_change"])
+                    elif step < MAX_STEPS:
+                        break
+            if step == MAX_STEPS or raises > MAX_ORDER_RAISES:
+                break
+            step += 1
+            if len(edges) == 0:  # full (or no) contact: no edge to grade towards; halve the interface mesh instead
+                n = int(round(period / h0)) * 2 ** step
+                vertices = [period * (i + 0.5) / n for i in range(n)]
+            else:
+                vertices = graded_vertices(edges, h0, step * LEVELS_PER_STEP, period)
+            problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP, (problem, entry))
+    except OverBudget as over:         # the levels solved stay; the answer is the last one solved
+        return _stopped(str(over), problem, sol, entry, orders, graded, history, newton)
     if not required and graded is not None:
         return GradedSolve(problem=problem, solution=sol, orders=orders, history=history, newton=newton,
                            grading_change=graded["fraction_change"])

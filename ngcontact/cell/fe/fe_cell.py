@@ -7,12 +7,14 @@ refinement to a tolerance (each load on its own graded mesh, checked by higher o
 from its :class:`~ngcontact.cell.fe.second_discretization.Refiner` and the observed rate:
 :mod:`ngcontact.cell.fe.second_discretization`) and the pressure response of the two-scale table.
 
-A scene that states no tolerance keeps its mesh and order, and its error is estimated by one order more on
-the same mesh (:meth:`FECell.default_accuracy`, :mod:`ngcontact.cell.fe.saturation`), judged against the
-default tolerance without refining.  Refinement to a tolerance not required (:meth:`FECell.refine_to` with
-``required = False``, :meth:`FECell.default_refinement`): a graded cell refines as with a stated one; any
-other cell refines within :data:`DEFAULT_DOFS` and is flagged when over (with the scene's level alone: not
-estimated).  A stated tolerance refines within :data:`MAX_DOFS`.
+A scene that states no tolerance is held to the default one (:meth:`FECell.default_accuracy`,
+:mod:`ngcontact.cell.fe.default_refinement`): its own answer, its error estimated by one order more on the
+same mesh (:mod:`ngcontact.cell.fe.saturation`), reported where that meets the tolerance, else refined as a
+stated tolerance refines it (:meth:`FECell.default_refinement`) within the scene's budget of unknowns
+(``discretization.budget_dofs``, default :data:`DEFAULT_DOFS`); with ``discretization.estimate =
+"estimate"`` it is estimated and not refined.  Refinement to a tolerance not required
+(:meth:`FECell.refine_to` with ``required = False``) is bounded so too and flagged when over (with the
+scene's level alone: not estimated).  A stated tolerance refines within :data:`MAX_DOFS`.
 
 The response at a mean pressure ``p``: ``k_n0`` is eq. 34 on the real contact set, ``k_n`` times the
 contact fraction (located by the roots of the penetration in 2D) on a flat frictionless cell, else the
@@ -37,10 +39,11 @@ from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.coefficients import coefficients
 from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.cell_problem import CellProblem
+from ngcontact.cell.fe.default_refinement import held_to_default
 from ngcontact.cell.fe.edge_grading import ORDER_RATE, GradedSolve, solve_to_tolerance
 from ngcontact.cell.fe.load_start import Predictor
 from ngcontact.cell.fe.saturation import estimate_on_scene
-from ngcontact.cell.fe.second_discretization import InterfaceHalving, Refiner, as_refinement, refine
+from ngcontact.cell.fe.second_discretization import InterfaceHalving, Refiner, Sequence, as_refinement, refine
 from ngcontact.cell.fe.measures import contact_fraction, contact_integral, mean_jump, real_contact_coefficients
 from ngcontact.errors import ModelError
 from ngcontact.fem.quadrature import smooth_order
@@ -86,15 +89,24 @@ class FECell:
     refiner
         ``(cell) -> Refiner``: the discretizations refining a cell that cannot be graded; ``None``: the
         interface element size halved level by level (:class:`InterfaceHalving`).
+    budget
+        The most unknowns of a discretization the refinement towards the default tolerance solves
+        (``discretization.budget_dofs``); ``None``: :data:`DEFAULT_DOFS`.
+    refine_default
+        Whether a sweep without a stated tolerance is refined where its own answer misses the default one
+        (``discretization.estimate = "auto"``), or only estimated (``"estimate"``).
     """
 
     def __init__(self, cell, model: CellModel, make_problem: Callable[[], CellProblem], *,
                  threshold: float | None = None, graded: Callable[[list[float], int], CellProblem] | None = None,
                  h0: float | None = None, predictor: Callable[[], Predictor | None] | None = None,
                  variant: Callable[..., FECell | None] | None = None, interface_maxh: float | None = None,
-                 twin: Callable[[], Any] | None = None, refiner: Callable[[FECell], Refiner] | None = None):
+                 twin: Callable[[], Any] | None = None, refiner: Callable[[FECell], Refiner] | None = None,
+                 budget: int | None = None, refine_default: bool = True):
         self.cell, self.model, self._make_problem = cell, model, make_problem
         self._refiner = refiner
+        self.budget = int(budget) if budget is not None else DEFAULT_DOFS[cell.dim]
+        self.refine_default = refine_default
         self.variant, self.interface_maxh, self.twin = variant, interface_maxh, twin
         self.dim = cell.dim
         self.period = float(cell.period[0])
@@ -115,6 +127,10 @@ class FECell:
             self._problem = self._make_problem()
             self._scene_ndof = self._scene_ndof or int(self._problem.ndof)
         return self._problem
+
+    def restore(self, problem: CellProblem) -> None:
+        """Make ``problem`` (one this cell solved before, e.g. the scene's) the one reported again."""
+        self._problem = problem
 
     def scene_unknowns(self) -> int:
         """The dofs of the scene's own discretization (before any refinement replaced the problem)."""
@@ -171,18 +187,17 @@ class FECell:
         return "none" if self.refiner() is None else "sequence"
 
     def refines_by_default(self) -> bool:
-        """No: a sweep without a stated tolerance keeps the scene's mesh and order, and
-        :meth:`default_accuracy` estimates its error from one order more.  Refining it would need three
-        discretizations at least (:meth:`default_refinement`: the grading levels and three orders on the
-        finest, or interface meshes halved twice, each several times the last), so it is asked for by
-        stating ``discretization.tolerance``."""
-        return False
+        """Whether a sweep without a stated tolerance whose own answer misses the default one is refined
+        (within :attr:`budget`): where the scene asks it (``discretization.estimate = "auto"``) and the cell
+        has a recipe of finer discretizations (:meth:`default_refinement`)."""
+        return self.refine_default and self.default_refinement() != "none"
 
     def default_accuracy(self, tolerance: float, loads: list[CellLoad]) -> Refinement | None:
-        """The scene's sweep on its own discretization, its error estimated by the same sweep one order more
-        on the same mesh (:mod:`ngcontact.cell.fe.saturation`); judged against ``tolerance`` by the
-        verdict, not refined."""
-        return estimate_on_scene(self, loads)
+        """The sweep held to the default ``tolerance``: the scene's own answer and its error from one order
+        more on the same mesh (:mod:`ngcontact.cell.fe.saturation`), refined within :attr:`budget` where that
+        misses ``tolerance`` and the cell :meth:`refines_by_default`
+        (:mod:`ngcontact.cell.fe.default_refinement`)."""
+        return held_to_default(self, tolerance, loads) if self.refines_by_default() else estimate_on_scene(self, loads)
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Each load on its own mesh, graded towards its contact edges until ``tolerance`` is met
@@ -191,12 +206,15 @@ class FECell:
         meets ``tolerance`` within :data:`MAX_DOFS` (:mod:`~ngcontact.cell.fe.second_discretization`), the
         last one's problem becoming this cell's.
 
-        ``required = False`` (the default tolerance): within :data:`DEFAULT_DOFS`, and out of reach the best
+        ``required = False`` (the default tolerance): within :attr:`budget`, and out of reach the best
         answer with its estimate; a cell whose first refinement is beyond that bound is solved once, not
         estimated.
         """
-        refined = self._compared(tolerance, loads, required) if self.graded is None or self.h0 is None \
-            else self._graded(tolerance, loads, required)
+        bound = MAX_DOFS[self.dim] if required else self.budget
+        if self.graded is None or self.h0 is None:
+            refined = as_refinement(self.compared(tolerance, loads, bound, required))
+        else:
+            refined = self.graded_solves(tolerance, loads, required, None if required else bound)[0]
         worst = max((max(e.values()) for e in refined.estimates if e), default=0.0)
         if worst > tolerance:        # only where not required: a required tolerance out of reach has raised
             log.warning("accuracy not met: the FE cell's estimated error %.3g exceeds the default tolerance %g (%s); "
@@ -204,8 +222,10 @@ class FECell:
                         refined.how)
         return refined
 
-    def _graded(self, tolerance: float, loads: list[CellLoad], required: bool) -> Refinement:
-        """Each load on meshes graded towards its contact edges (:meth:`refine_to`)."""
+    def graded_solves(self, tolerance: float, loads: list[CellLoad], required: bool,
+                      max_dofs: int | None = None) -> tuple[Refinement, list[GradedSolve]]:
+        """Each load on meshes graded towards its contact edges (:meth:`refine_to`; ``max_dofs``: no mesh
+        beyond it after the first), and the graded solves."""
         assert self.graded is not None and self.h0 is not None       # refine_to's choice
         period = self.period
         order = self.model.order
@@ -214,10 +234,12 @@ class FECell:
             twin = self.predictor() if self.predictor is not None else None
             seed = twin.edges(load) if twin is not None else None
             out.append(solve_to_tolerance(self.graded, load, tolerance, self.h0, period, order, seed=seed,
-                                          required=required))
+                                          required=required, max_dofs=max_dofs))
             log.info("load %d: contact fraction %.10g after %d grading steps", k,
                      out[-1].solution.results["contact_fraction"], len(out[-1].history) - 1)
         self._problem = out[-1].problem
+        remarks = [f"load {k} {g.remark}" for k, g in enumerate(out) if g.remark]
+        remarks += [f"load {k} stopped: {g.stopped}" for k, g in enumerate(out) if g.stopped]
         return Refinement(solutions=[g.solution for g in out], estimates=[g.estimate for g in out],
                           per_load=[{"mesh_history": g.history,
                                      # the Newton steps of every level the load was solved on
@@ -226,17 +248,19 @@ class FECell:
                           histories=[g.newton for g in out],
                           how="; ".join(["each load on meshes graded towards its contact edges, then higher orders "
                                          "on the finest; the highest reported, its error " + ORDER_RATE.describe()]
-                                        + [f"load {k} {g.remark}" for k, g in enumerate(out) if g.remark]))
+                                        + remarks)), out
 
-    def _compared(self, tolerance: float, loads: list[CellLoad], required: bool) -> Refinement:
-        """The sweep on the refiner's discretizations, the last reported (:meth:`refine_to`)."""
+    def compared(self, tolerance: float, loads: list[CellLoad], max_dofs: int, required: bool,
+                 first: list[CellSolution] | None = None) -> Sequence:
+        """The sweep on the refiner's discretizations, the last's problem becoming this cell's
+        (:meth:`refine_to`; ``first``: the scene's sweep, solved already)."""
         refiner = self.refiner()
         if refiner is None:
             raise ModelError("this FE cell was built without the recipe of a finer discretization")
-        done = refine(refiner, loads, tolerance, (MAX_DOFS if required else DEFAULT_DOFS)[self.dim], required)
+        done = refine(refiner, loads, tolerance, max_dofs, required, first)
         if done.cell is not self:
             self._problem = done.cell.problem
-        return as_refinement(done)
+        return done
 
     def response(self, pressure: float, length_unit: float = 1.0) -> Response:
         """The response at ``pressure`` (module docstring), from a first load's start."""

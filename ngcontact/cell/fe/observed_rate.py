@@ -29,6 +29,7 @@ The effectivity (estimate over the true error of the reported value) is measured
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from ngcontact.cell.cell_solution import COEFFICIENT, scale
@@ -109,3 +110,23 @@ def sequence_estimates(levels: list[list[dict[str, float]]], rule: Convergence, 
                 remarks.append(f"load {k} {name}: {note}")
         estimates.append(out)
     return estimates, remarks
+
+
+def exponent(ndofs: list[float], errors: list[float], assumed: tuple[float, float]) -> float | None:
+    """The exponent ``a`` of errors falling like ``N^(-a)`` in the unknowns ``N``: observed
+    on the last two ``(ndofs, errors)`` pairs, else from ``assumed = (ratio per level, growth of the unknowns
+    per level)``; ``None`` where neither shows the errors falling as the unknowns grow
+    (:mod:`ngcontact.cell.fe.default_refinement`)."""
+    if len(ndofs) >= 2 and ndofs[-1] > ndofs[-2] and 0 < errors[-1] < errors[-2]:
+        return math.log(errors[-2] / errors[-1]) / math.log(ndofs[-1] / ndofs[-2])
+    if 0 < assumed[0] < 1 < assumed[1]:
+        return math.log(1 / assumed[0]) / math.log(assumed[1])
+    return None
+
+
+def dofs_to_meet(ndof: float, estimate: float, tolerance: float, a: float | None) -> tuple[float, float] | None:
+    """The unknowns ``N = N_n (e_n / tol)^(1/a)`` meeting ``tolerance`` from an estimate ``e_n`` on ``N_n``
+    unknowns, and ``a``; ``None`` without a finite estimate or an exponent."""
+    if a is None or a <= 0 or not math.isfinite(estimate):
+        return None
+    return ndof * max(estimate / tolerance, 1.0) ** (1 / a), a

@@ -1,11 +1,12 @@
 """The error of an FE cell's answer on the scene's own mesh, from one order more (the saturation assumption).
 
 A cell scene that states no ``discretization.tolerance`` is held to the default one
-(:data:`ngcontact.cell.admissibility.DEFAULT_TOLERANCE`) but keeps its discretization: order ``p`` on its
-mesh, whose answer ``q_p`` is reported.  Its error is estimated by solving the same sweep once more at order
-``p + 1`` on the same mesh (a curved interface meshed at the new order's geometry).  Where the higher order
-leaves at most a fraction ``beta < 1`` of the lower order's error (the *saturation assumption* of
-hierarchical a posteriori estimators: the enriched space is closer to the solution by a fixed factor),
+(:data:`ngcontact.cell.admissibility.DEFAULT_TOLERANCE`) and first keeps its discretization: order ``p`` on
+its mesh, whose answer ``q_p`` is reported where its estimate meets that tolerance.  Its error is
+estimated by solving the same sweep once more at order ``p + 1`` on the same mesh (a curved interface
+meshed at the new order's geometry).  Where the higher order leaves at most a fraction ``beta < 1`` of
+the lower order's error (the *saturation assumption* of hierarchical a posteriori estimators: the enriched
+space is closer to the solution by a fixed factor),
 
     |q_p - q| <= |q_p - q_(p+1)| + |q_(p+1) - q| <= d + beta |q_p - q|,     so     |q_p - q| <= d / (1 - beta),
 
@@ -41,11 +42,12 @@ more moves the edge by an algebraic, not geometric, fraction: on the oracles of 
 ``docs/benchmarks.md``, FE effectivity) order ``p + 1`` keeps up to about half the error of order ``p``.
 ``3/4`` bounds that with a margin, and keeps the estimate within ten times the error.
 
-The estimate does not refine: a sweep whose estimate exceeds the default tolerance is reported with
-``accuracy.met = false`` and one warning line (:mod:`ngcontact.drivers.run_cell`), and stating
-``discretization.tolerance`` refines it (:meth:`~ngcontact.cell.fe.fe_cell.FECell.refine_to`).  Where
-the order cannot rise (the scene's checks refuse it, or the enriched sweep fails), the answer is reported
-not estimated, with the reason, and not met.
+The estimate itself does not refine: a sweep whose estimate exceeds the default tolerance is refined within
+the scene's budget (:mod:`ngcontact.cell.fe.default_refinement`), or, with ``discretization.estimate =
+"estimate"``, reported with ``accuracy.met = false`` and one warning line (:mod:`ngcontact.drivers.run_cell`);
+stating ``discretization.tolerance`` refines it (:meth:`~ngcontact.cell.fe.fe_cell.FECell.refine_to`).
+Where the order cannot rise (the scene's checks refuse it, or the enriched sweep fails), the answer is
+reported not estimated, with the reason, and not met.
 """
 from __future__ import annotations
 

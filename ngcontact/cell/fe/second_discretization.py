@@ -39,8 +39,8 @@ from typing import Any, Callable, Protocol
 
 from ngcontact.cell.cell_solution import COEFFICIENT, CellSolution, headline, scale
 from ngcontact.cell.cell_solver import Refinement
-from ngcontact.cell.fe.observed_rate import Convergence, sequence_estimates
-from ngcontact.errors import ConvergenceError
+from ngcontact.cell.fe.observed_rate import Convergence, dofs_to_meet, exponent, sequence_estimates
+from ngcontact.errors import ConvergenceError, ModelError, SceneError
 
 log = logging.getLogger(__name__)
 #: the run's progress lines
@@ -97,12 +97,17 @@ class Sequence:
     how: str = ""
     #: per load, what each estimate's absolute error is divided by (:func:`~ngcontact.cell.cell_solution.scale`)
     scales: list[dict[str, float]] = field(default_factory=list)
+    #: the unknowns of the first level beyond the size bound (not solved), where that stopped the loop
+    beyond: int | None = None
+    #: why the loop stopped short of the tolerance, in words ("" where it met it)
+    stop: str = ""
 
 
-def _level(cell, loads, k: int, refiner: Refiner) -> tuple[list[CellSolution], dict[str, Any]]:
-    """Solve level ``k`` and its record."""
+def _level(cell, loads, k: int, refiner: Refiner, known: list[CellSolution] | None = None
+           ) -> tuple[list[CellSolution], dict[str, Any]]:
+    """Solve level ``k`` (``known``: its sweep, solved already) and its record."""
     t0 = time.perf_counter()
-    sols = cell.sweep(loads)
+    sols = cell.sweep(loads) if known is None else known
     entry = {"discretization": refiner.describe(k), "ndof": int(cell.unknowns()),
              "seconds": time.perf_counter() - t0,
              "contact_fraction": [s.results["contact_fraction"] for s in sols],
@@ -111,8 +116,10 @@ def _level(cell, loads, k: int, refiner: Refiner) -> tuple[list[CellSolution], d
     return sols, entry
 
 
-def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, required: bool) -> Sequence:
-    """The sweep on the refiner's levels until the estimate meets ``tolerance`` (module docstring)."""
+def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, required: bool,
+           first: list[CellSolution] | None = None) -> Sequence:
+    """The sweep on the refiner's levels until the estimate meets ``tolerance`` (module docstring); ``first``:
+    the scene's sweep (level 0), where solved already."""
     heads: list[list[dict[str, float]]] = []
     levels: list[dict[str, Any]] = []
     cell = sols = None
@@ -120,16 +127,24 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
     scales: list[dict[str, float]] = []
     remarks: list[str] = []
     stop = f"the most levels ({MAX_LEVELS})"
+    beyond = None
     for k in range(MAX_LEVELS):
-        nxt = refiner.level(k)
+        try:
+            nxt = refiner.level(k)
+        except (SceneError, ModelError) as exc:     # a level the mesher cannot build: out of reach, as refused
+            if required or k == 0:
+                raise
+            stop = f"{refiner.describe(k)} cannot be built ({exc})"
+            break
         if nxt is None:
             stop = f"the scene refuses {refiner.describe(k)}"
             break
         if k > 0 and nxt.unknowns() > max_dofs:
-            stop = f"{refiner.describe(k)} would have {nxt.unknowns()} dofs, beyond {max_dofs}"
+            beyond = int(nxt.unknowns())
+            stop = f"{refiner.describe(k)} would have {beyond} dofs, beyond {max_dofs}"
             break
         cell = nxt
-        sols, entry = _level(cell, loads, k, refiner)
+        sols, entry = _level(cell, loads, k, refiner, first if k == 0 else None)
         levels.append(entry)
         heads.append([headline(s.results) for s in sols])
         if len(heads) > 1:
@@ -140,6 +155,10 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
             entry["estimate"] = max((max(e.values()) for e in estimates if e), default=0.0)
             if len(heads) >= 3 and entry["estimate"] <= tolerance:
                 return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks), scales)
+            hopeless = None if required or len(heads) < 3 else _beyond_reach(levels, tolerance, max_dofs)
+            if hopeless is not None:
+                stop = hopeless
+                break
     assert cell is not None and sols is not None      # level 0 is the scene's own cell
     worst = levels[-1].get("estimate")
     if len(heads) == 2 and worst is not None and worst <= tolerance:   # the third level beyond the bound
@@ -153,7 +172,19 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
                                {"levels": levels})
     if not estimates:
         estimates = [{} for _ in sols]
-    return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]), scales)
+    return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]), scales,
+                    beyond, stop)
+
+
+def _beyond_reach(levels: list[dict[str, Any]], tolerance: float, max_dofs: int) -> str | None:
+    """Why an unrequired tolerance is out of reach within ``max_dofs`` at the rate the last two estimated levels
+    show (:func:`~ngcontact.cell.fe.observed_rate.dofs_to_meet`), else ``None``."""
+    est = [lv for lv in levels if "estimate" in lv]
+    a = exponent([lv["ndof"] for lv in est], [lv["estimate"] for lv in est], (0.0, 0.0))
+    need = dofs_to_meet(levels[-1]["ndof"], levels[-1]["estimate"], tolerance, a)
+    if need is None or need[0] <= max_dofs:
+        return None
+    return f"meeting {tolerance:g} would take about {need[0]:.2g} dofs at the observed rate, beyond {max_dofs}"
 
 
 def _how(refiner: Refiner, levels: list[dict[str, Any]], remarks: list[str]) -> str:
