@@ -315,7 +315,17 @@ PHASES_NOTE = ("Every rank's resident memory [MB] by phase of the runs above tha
                "matrix and BDDC, built by its assembly), CG, the round-off floors of the Newton step, the whole "
                "solve, post-processing and writing the outputs (the VTK piece), what the solve leaves, and the "
                "peak (`VmHWM`). `code`: the commit measured (`183c603`: before the round-off floors were "
-               "taken in blocks, which copied the absolute values of all the tangent's entries at once).")
+               "taken in blocks; they copied the absolute values of all the tangent's entries at once). "
+               "What a part holds at its peak is the tangent and BDDC's local matrices (its harmonic "
+               "extensions and interior solves) as the assembly builds them; the mesh, the geometry and the "
+               "interface law's data are a few tens of MB, the solve's matrices are let go before "
+               "post-processing and the VTK piece, and rank 0 holds the whole mesh only until it is "
+               "distributed. Storing the symmetric tangent as its lower triangle (NGSolve's "
+               "`symmetric_storage`) would halve the matrix and BDDC's local matrices, but NGSolve's parallel "
+               "BDDC refuses it (`CumulationOperator::Mult called, but y is not distributed` in CG's first "
+               "preconditioner application on 2 ranks), so it is not used. With 2 ranks the part holds every "
+               "element and the serial peak less the coarse factorization on rank 0; 3 ranks (2 parts, "
+               "oversubscribing the 2 cores) show what distributing the elements gives.")
 MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the largest run (the press fit): the "
               "peak memory of the largest part fitted as a line in its dofs, rank 0's as a line in the whole "
               "mesh's dofs (BDDC's coarse problem, gathered there, grows with the whole mesh), both evaluated "
