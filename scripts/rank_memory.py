@@ -156,15 +156,49 @@ def available_gb() -> float:
     return float("nan")
 
 
+def descendants(pid: int) -> list[int]:
+    """The processes below ``pid`` (children, theirs, ...), from the parent ids in /proc/*/stat."""
+    parent: dict[int, int] = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as fh:
+                    parent[int(entry)] = int(fh.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+    found, todo = [], [pid]
+    while todo:
+        below = [p for p, q in parent.items() if q == todo[-1]]
+        todo.pop()
+        found += below
+        todo += below
+    return found
+
+
+def _commands(pids: list[int]) -> dict[int, bytes]:
+    """The command lines of those of ``pids`` that still run."""
+    found = {}
+    for pid in pids:
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as fh:
+                found[pid] = fh.read()
+        except OSError:
+            continue
+    return found
+
+
 class MemoryGuard:
     """A large run on a machine shared with other jobs: it starts only with ``start_gb`` available
     (``MemAvailable``; else it waits ``wait_s`` and looks again, ``tries`` times, then gives up), and a
-    watchdog ends the whole run (its process group: ``mpiexec`` and every rank) once less than ``floor_gb``
-    is left.  ``low_gb``: the least available memory seen during the run."""
+    watchdog ends the whole run once less than ``floor_gb`` is left: ``mpiexec`` is asked to stop (it
+    passes the signal to the ranks, which its process manager starts in sessions of their own), and
+    whatever of it still runs ``grace_s`` later is killed, process by process.  ``low_gb``: the least
+    available memory seen during the run."""
 
     def __init__(self, start_gb: float, floor_gb: float, tries: int = 5, wait_s: float = 120.0,
-                 every_s: float = 1.0):
-        self.start_gb, self.floor_gb, self.tries, self.wait_s, self.every_s = start_gb, floor_gb, tries, wait_s, every_s
+                 every_s: float = 1.0, grace_s: float = 5.0):
+        self.start_gb, self.floor_gb, self.tries, self.wait_s = start_gb, floor_gb, tries, wait_s
+        self.every_s, self.grace_s = every_s, grace_s
         self.low_gb = float("inf")
 
     def wait_for_memory(self) -> None:
@@ -178,22 +212,36 @@ class MemoryGuard:
         raise RuntimeError(f"memory guard: less than {self.start_gb:g} GB available after {self.tries} attempts; "
                            "the run was not started")
 
+    def end(self, proc: subprocess.Popen, seen: dict[int, bytes]) -> None:
+        """Stop ``proc`` and everything it started (``seen``: its descendants met while it ran, by id, with
+        their command lines, so that a process given a reused id is left alone)."""
+        import signal
+        seen.update(_commands(descendants(proc.pid)))
+        proc.terminate()
+        try:
+            proc.wait(self.grace_s)
+        except subprocess.TimeoutExpired:
+            pass
+        for pid, command in seen.items():
+            if _commands([pid]).get(pid) == command:
+                os.kill(pid, signal.SIGKILL)
+        if proc.poll() is None:
+            proc.kill()
+
     def run(self, cmd: list[str], env: dict) -> None:
         """``cmd`` under the guard; raises where it failed or the watchdog ended it."""
-        import signal
         self.wait_for_memory()
-        proc = subprocess.Popen(cmd, env=env, start_new_session=True)
-        killed = False
+        proc = subprocess.Popen(cmd, env=env)
+        seen: dict[int, bytes] = {}
         while proc.poll() is None:
             have = available_gb()
             self.low_gb = min(self.low_gb, have)
-            if have < self.floor_gb and not killed:
+            seen.update(_commands(descendants(proc.pid)))
+            if have < self.floor_gb:
                 print(f"memory guard: {have:.2f} GB available < {self.floor_gb:g} GB: ending the run", flush=True)
-                os.killpg(proc.pid, signal.SIGKILL)
-                killed = True
+                self.end(proc, seen)
+                raise RuntimeError(f"memory guard: the run was ended below {self.floor_gb:g} GB available")
             time.sleep(self.every_s)
-        if killed:
-            raise RuntimeError(f"memory guard: the run was ended below {self.floor_gb:g} GB available")
         if proc.returncode:
             raise subprocess.CalledProcessError(proc.returncode, cmd)
         print(f"memory guard: at least {self.low_gb:.1f} GB stayed available", flush=True)
