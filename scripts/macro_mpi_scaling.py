@@ -292,7 +292,7 @@ def plot(data: list[dict], path: str) -> None:
     plt.close(fig)
 
 
-NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, the press fit also at `order` 3; BDDC-CG) "
+NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2 unless `order` says otherwise; BDDC-CG) "
         "in one process and under "
         "`mpiexec -n 2` and `-n 3`. Rank 0 makes the mesh (press_fit_refined: the coarse one, which the "
         "ranks refine uniformly, each its part), distributes it and lets it go, holding no element of the "
