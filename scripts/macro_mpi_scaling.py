@@ -6,23 +6,31 @@ refined by ``discretization.maxh`` or, ``press_fit_refined``, made with ``maxh``
 uniformly ``discretization.refinements`` times (under MPI on the ranks, each
 its own part; ``--refined MAXH:K``); the shipped 3D femur with its hip stem
 (``geometries/femur_stem_3d.toml``, Coulomb friction), refined by dividing
-``maxh`` and ``interface_maxh`` by a factor.  Both at order 2 with
-``solver.linear = "iterative"`` (BDDC-CG, what runs distributed).
+``maxh`` and ``interface_maxh`` by a factor.  Both at order 2 (the press
+fit at ``--order``) with ``solver.linear = "iterative"`` (BDDC-CG, what
+runs distributed).
 
 Each run is a fresh process (one rank) or ``mpiexec -n N`` (N ranks).
 NGSolve distributes the mesh to ranks 1 .. N-1 (rank 0 makes the mesh,
 coarse where the ranks refine it, distributes it and lets it go, holding no
 element of the solve): 2 ranks are one part, 3 ranks two parts.  Rank 0
 still holds BDDC's coarse problem, which NGSolve's parallel BDDC gathers and
-factorizes there (the wirebasket: vertices, edges and the whole interface
-surface's dofs, ``ngcontact.fem.elasticity.surface_wirebasket``).  Post-processing is reduced over the ranks
+factorizes there (the wirebasket: the vertices and the whole interface
+surface's dofs, ``ngcontact.fem.elasticity.surface_wirebasket``; a higher
+order puts fewer vertices under as many dofs).  Post-processing is reduced over the ranks
 (:mod:`ngcontact.distributed.reduced_measures`) and the VTK file written in
 pieces.  One process runs without its discretization error estimate (the
 solves at the neighbouring orders, which a distributed run does not make),
 so that both do the same work.  Per run: dofs, the work's wall time (the
 stages from meshing to post-processing), every rank's peak
 resident memory (``VmHWM`` at its exit) and the whole command's wall time
-(with starting the interpreters).
+(with starting the interpreters); per rank also its memory by phase
+(``rank_memory.Phases``: at the start, the largest within the mesh, the
+assemblies, CG, the round-off floors, the solve, post-processing and
+writing, and what the solve leaves), into ``OUT/macro_mpi_phases.csv``.
+``--guard START_GB FLOOR_GB``: each run starts only with ``START_GB``
+available (waiting and retrying, then giving up) and is ended once less
+than ``FLOOR_GB`` is left (``rank_memory.MemoryGuard``).
 
 The model of 64 ranks is on paper: memory of a rank holding a part grows
 linearly with its dofs and rank 0's with the whole mesh's; both lines are
@@ -33,14 +41,15 @@ across machines is not in the model).
 
     python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--femur 1 1.5]
                                         [--refined MAXH:K ...] [--ranks 1 2 3] [--bddc JSON ...]
-                                        [--rows-from CSV ...] [--publish]
+                                        [--order P] [--guard START_GB FLOOR_GB] [--code LABEL]
+                                        [--rows-from CSV ...] [--phases-from CSV ...] [--publish]
 
 ``--bddc``: flags of NGSolve's BDDC to compare (``linear_solver.BDDC_FLAGS``
 in each run's processes), each run with each; per run also the time the
 ranks holding the mesh spend in BDDC's coarse solves.
 
-Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_model.csv`` and ``.png`` (default
-``results/macro_mpi_scaling``).
+Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_phases.csv``, ``OUT/macro_mpi_model.csv`` and ``.png``
+(default ``results/macro_mpi_scaling``).
 """
 from __future__ import annotations
 
@@ -56,12 +65,13 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+from rank_memory import PHASE_KEYS, PHASE_TABLE_KEYS, MemoryGuard, Phases, phase_rows, phase_table  # noqa: E402
 
 from ngcontact.output.writer import write_csv  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-KEYS = ("scene", "size", "refinements", "ranks", "bddc", "ndof", "work_s", "wall_s", "newton", "cg_iterations",
-        "coarse_s", "peak_mb_rank0", "peak_mb_parts_max", "peak_mb_each")
+KEYS = ("code", "scene", "size", "refinements", "order", "ranks", "bddc", "ndof", "work_s", "wall_s", "newton",
+        "cg_iterations", "coarse_s", "peak_mb_rank0", "peak_mb_parts_max", "peak_mb_each")
 #: NGSolve's timer of BDDC's coarse solve (the wirebasket's), as the ranks holding the mesh see it
 COARSE_TIMER = "Apply BDDC preconditioner - wb solve"
 MODEL_KEYS = ("ndof", "ranks", "dofs_per_part", "part_gb", "rank0_gb", "solve_s_estimate")
@@ -105,7 +115,7 @@ components = ["y"]
 boundary = "top"
 pressure = 5e6
 [discretization]
-order = 2
+order = {order}
 maxh = {size}
 refinements = {refinements}
 max_elements = 3000000
@@ -124,9 +134,9 @@ def femur(factor: float) -> str:
     return text.replace("\nrtol = 1e-10\n", '\nrtol = 1e-10\nlinear = "iterative"\n')
 
 
-SCENES = {"press_fit": lambda size, k: PRESS_FIT.format(size=size, refinements=0),
-          "press_fit_refined": lambda size, k: PRESS_FIT.format(size=size, refinements=k),
-          "femur": lambda size, k: femur(size)}
+SCENES = {"press_fit": lambda size, k, p: PRESS_FIT.format(size=size, refinements=0, order=p),
+          "press_fit_refined": lambda size, k, p: PRESS_FIT.format(size=size, refinements=k, order=p),
+          "femur": lambda size, k, p: femur(size)}
 
 
 def _peak_mb() -> float:
@@ -154,27 +164,39 @@ def child(scene: str, out: str, bddc: str = "") -> int:
     from ngcontact.drivers import run_macro
     from ngcontact.output.writer import write_outputs
     run_macro.accuracy = lambda scene, sol, solve, balance, *rest: accuracy_not_estimated(scene, sol, balance)
+    phases = Phases()
+    phases.install()
     report, outcome = runner.solve(scene)
+    phases.enter("write the outputs")
     written(outcome, lambda: write_outputs(out, report, outcome))
+    phases.leave()
     coarse = sum(t["time"] for t in ng.Timers() if t["name"] == COARSE_TIMER)
     with open(f"{out}_peak_rank{launched_rank()}.txt", "w") as fh:
         fh.write(f"{_peak_mb()} {coarse}\n")
+    with open(f"{out}_phases_rank{launched_rank()}.json", "w") as fh:
+        json.dump(phases.table(), fh)
     return 0
 
 
-def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0, bddc: str = "") -> dict:
-    """One run of scene ``name`` at ``size`` (refined ``refinements`` times) on ``ranks`` ranks, with BDDC's
-    flags ``bddc`` (JSON)."""
-    tag = f"{name}_{size:g}_k{refinements}_r{ranks}" + (f"_{re.sub('[^a-z0-9]+', '', bddc.lower())}" if bddc else "")
+def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0, bddc: str = "", order: int = 2,
+            guard: MemoryGuard | None = None, code: str = "") -> dict:
+    """One run of scene ``name`` at ``size`` (refined ``refinements`` times, the press fit at ``order``) on
+    ``ranks`` ranks, with BDDC's flags ``bddc`` (JSON), under the memory ``guard`` if given; its ranks'
+    memory by phase goes to ``OUT_phase_table.csv`` beside its output, labelled ``code``."""
+    tag = f"{name}_{size:g}_k{refinements}_p{order}_r{ranks}" + \
+        (f"_{re.sub('[^a-z0-9]+', '', bddc.lower())}" if bddc else "")
     scene = os.path.join(work, f"{tag}.toml")
     with open(scene, "w") as fh:
-        fh.write(SCENES[name](size, refinements))
+        fh.write(SCENES[name](size, refinements, order))
     out = os.path.join(work, tag)
     cmd = [sys.executable, os.path.abspath(__file__), "--child", scene, out, bddc]
     if ranks > 1:
         cmd = ["mpiexec", "-n", str(ranks)] + cmd
     t0 = time.perf_counter()
-    subprocess.run(cmd, check=True, env=dict(os.environ, MPLBACKEND="Agg"))
+    if guard is None:
+        subprocess.run(cmd, check=True, env=dict(os.environ, MPLBACKEND="Agg"))
+    else:
+        guard.run(cmd, env=dict(os.environ, MPLBACKEND="Agg"))
     wall = time.perf_counter() - t0
     with open(os.path.join(out, "report.json")) as fh:
         rep = json.load(fh)
@@ -184,15 +206,30 @@ def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0,
             peak, seconds = fh.read().split()
         peaks.append(round(float(peak), 1))
         coarse.append(float(seconds))
+    phases = phase_rows(out, ranks)
+    write_csv(f"{out}_phases.csv", list(PHASE_KEYS), [[p.get(k, "") for k in PHASE_KEYS] for p in phases])
+    for p in phases:
+        print(" ".join(f"{k}={p.get(k, '')}" for k in PHASE_KEYS), flush=True)
+    table = phase_table(phases, peaks, {"code": code, "scene": name, "ndof": rep["ndof"], "order": order,
+                                        "ranks": ranks})
+    write_csv(f"{out}_phase_table.csv", list(PHASE_TABLE_KEYS), [[t[k] for k in PHASE_TABLE_KEYS] for t in table])
     stages = {k: v for k, v in rep["timings"].items() if k != "total"}
     parts = peaks[1:] if ranks > 1 else peaks
-    return {"scene": name, "size": size, "refinements": refinements, "ranks": ranks, "bddc": bddc or "default",
+    return {"code": code, "scene": name, "size": size, "refinements": refinements,
+            "order": order if name != "femur" else 2, "ranks": ranks, "bddc": bddc or "default",
             "ndof": rep["ndof"],
             "work_s": round(sum(stages.values()), 2), "wall_s": round(wall, 2),
             "newton": rep["solver"]["iterations"],
             "cg_iterations": sum(rep["solver"]["linear"].get("cg_iterations", [])), "coarse_s": round(max(coarse), 2),
             "peak_mb_rank0": peaks[0], "peak_mb_parts_max": max(parts),
-            "peak_mb_each": " ".join(f"{p:g}" for p in peaks)}
+            "peak_mb_each": " ".join(f"{p:g}" for p in peaks), "tag": tag}
+
+
+def read_table(path: str) -> list[dict]:
+    """The rows of a CSV file as dicts of strings."""
+    import csv
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
 
 
 def read_rows(path: str) -> list[dict]:
@@ -200,9 +237,9 @@ def read_rows(path: str) -> list[dict]:
     import csv
     with open(path, newline="") as fh:
         rows = list(csv.DictReader(fh))
-    numbers = {"size": float, "refinements": int, "ranks": int, "ndof": int, "work_s": float, "wall_s": float,
-               "newton": int, "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
-    defaults = {"bddc": "default", "coarse_s": ""}       # rows measured before these columns
+    numbers = {"size": float, "refinements": int, "order": int, "ranks": int, "ndof": int, "work_s": float,
+               "wall_s": float, "newton": int, "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
+    defaults = {"bddc": "default", "coarse_s": "", "order": 2, "code": ""}   # rows measured before these columns
     return [{k: numbers[k](row.get(k) or 0) if k in numbers else row.get(k) or defaults.get(k, "") for k in KEYS}
             for row in rows]
 
@@ -255,14 +292,15 @@ def plot(data: list[dict], path: str) -> None:
     plt.close(fig)
 
 
-NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, BDDC-CG) in one process and under "
+NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2 unless `order` says otherwise; BDDC-CG) "
+        "in one process and under "
         "`mpiexec -n 2` and `-n 3`. Rank 0 makes the mesh (press_fit_refined: the coarse one, which the "
         "ranks refine uniformly, each its part), distributes it and lets it go, holding no element of the "
         "solve but BDDC's coarse problem (NGSolve's parallel BDDC factorizes it on rank 0), so 2 ranks "
         "are one part and 3 ranks two parts. "
         "`work_s`: the stages from meshing to post-processing (one process without its discretization error "
         "estimate, which a distributed run does not make either). `peak_mb_each`: every rank's peak resident "
-        "memory, rank 0 first. "
+        "memory, rank 0 first. `code`: the commit measured. "
         "`bddc`: the flags of NGSolve's BDDC (`default`: none; its coarse problem, the vertices and the "
         "interface surface, factorized by a sparse Cholesky, on rank 0 under MPI); rows with other flags "
         "compare the coarse solves NGSolve offers at one size: `coarsetype` `local` (a Jacobi sweep instead "
@@ -271,6 +309,23 @@ NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2, BDDC-CG)
         "under MPI their wait for rank 0; empty where not recorded). "
         "Measured on 2 cores shared with other jobs (3 ranks oversubscribe them): times are indicative, "
         "memory is not affected.")
+PHASES_NOTE = ("Every rank's resident memory [MB] by phase of the runs above that recorded it (sampled every "
+               "50 ms: NGSolve allocates in C++, out of Python's sight): at its start (the interpreter with "
+               "NGSolve and MPI loaded), the largest within the mesh (made, distributed), the assemblies (the "
+               "matrix and BDDC, built by its assembly), CG, the round-off floors of the Newton step, the whole "
+               "solve, post-processing and writing the outputs (the VTK piece), what the solve leaves, and the "
+               "peak (`VmHWM`). `code`: the commit measured (`183c603`: before the round-off floors were "
+               "taken in blocks; they copied the absolute values of all the tangent's entries at once). "
+               "What a part holds at its peak is the tangent and BDDC's local matrices (its harmonic "
+               "extensions and interior solves) as the assembly builds them; the mesh, the geometry and the "
+               "interface law's data are a few tens of MB, the solve's matrices are let go before "
+               "post-processing and the VTK piece, and rank 0 holds the whole mesh only until it is "
+               "distributed. Storing the symmetric tangent as its lower triangle (NGSolve's "
+               "`symmetric_storage`) would halve the matrix and BDDC's local matrices, but NGSolve's parallel "
+               "BDDC refuses it (`CumulationOperator::Mult called, but y is not distributed` in CG's first "
+               "preconditioner application on 2 ranks), so it is not used. With 2 ranks the part holds every "
+               "element and the serial peak less the coarse factorization on rank 0; 3 ranks (2 parts, "
+               "oversubscribing the 2 cores) show what distributing the elements gives.")
 MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the largest run (the press fit): the "
               "peak memory of the largest part fitted as a line in its dofs, rank 0's as a line in the whole "
               "mesh's dofs (BDDC's coarse problem, gathered there, grows with the whole mesh), both evaluated "
@@ -282,6 +337,34 @@ MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the l
               "coarse problem, `coarsetype` `h1amg`, refuses a distributed matrix). Its line is fitted to sizes "
               "close together and understates large runs, whose coarse factorization grows faster than linearly "
               "(the attempt at 2M dofs noted above).")
+
+
+def write_and_publish(args, data: list[dict], work: str) -> None:
+    """The CSV files and the plot of ``data`` (and the phase tables of its runs) under ``args.out``; with
+    ``args.publish`` their sections of docs/benchmarks.md."""
+    csv_path = os.path.join(args.out, "macro_mpi_scaling.csv")
+    write_csv(csv_path, list(KEYS), [[d[k] for k in KEYS] for d in data])
+    phases_path = os.path.join(args.out, "macro_mpi_phases.csv")
+    tables = args.phases_from + [os.path.join(work, f"{d['tag']}_phase_table.csv") for d in data if d.get("tag")]
+    write_csv(phases_path, list(PHASE_TABLE_KEYS), [[t[k] for k in PHASE_TABLE_KEYS] for path in tables
+                                                     for t in read_table(path)])
+    default = [d for d in data if d["bddc"] == "default"]     # the other flags' rows compare the coarse solve
+    rows = model([d for d in default if int(d["order"]) == 2])    # the model: the order-2 runs' lines
+    model_path = os.path.join(args.out, "macro_mpi_model.csv")
+    write_csv(model_path, list(MODEL_KEYS), [[m[k] for k in MODEL_KEYS] for m in rows])
+    png = os.path.join(args.out, "macro_mpi_scaling.png")
+    plot(default, png)
+    for m in rows:
+        print(" ".join(f"{k}={m[k]}" for k in MODEL_KEYS))
+    if args.publish:
+        measured = f" The rows were measured by {args.measured_by}." if args.measured_by else ""
+        benchmark_doc.publish("macro_mpi_scaling", "The 3D press fit and femur on 1, 2 and 3 MPI ranks", csv_path,
+                              note=NOTE + measured, png=png)
+        if tables:
+            benchmark_doc.publish("macro_mpi_phases", "Where a rank's memory goes: its phases", phases_path,
+                                  note=PHASES_NOTE)
+        benchmark_doc.publish("macro_mpi_model", "What 64 MPI ranks would need (a paper model)", model_path,
+                              note=MODEL_NOTE)
 
 
 def main(argv=None) -> int:
@@ -298,11 +381,20 @@ def main(argv=None) -> int:
     ap.add_argument("--bddc", nargs="+", default=[""], metavar="JSON",
                     help='flags of NGSolve\'s BDDC to compare, each run with each (e.g. \'{"inverse": "umfpack"}\'; '
                          '"": the solver\'s)')
+    ap.add_argument("--order", type=int, default=2, help="the press fit's polynomial order")
+    ap.add_argument("--guard", type=float, nargs=2, default=None, metavar=("START_GB", "FLOOR_GB"),
+                    help="start each run only with START_GB available (MemAvailable; waits and retries, then gives "
+                         "up) and end it once less than FLOOR_GB is left (a large run on a shared machine)")
+    ap.add_argument("--code", default="", help="the label of the code measured in the phase table (default: the "
+                    "commit)")
+    ap.add_argument("--phases-from", nargs="+", default=[], metavar="CSV",
+                    help="the phase tables (RUN_phase_table.csv) of earlier runs to publish with these runs'")
     ap.add_argument("--rows-from", nargs="+", default=[], metavar="CSV",
                     help="no runs: the rows of these CSV files of earlier runs (e.g. a large size run apart)")
     ap.add_argument("--measured-by", default="", help="with --rows-from: the commands that measured the rows")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
+    args.code = args.code or benchmark_doc.git_commit()
     work = os.path.abspath(os.path.join(args.out, "runs"))
     os.makedirs(work, exist_ok=True)
     runs = [("press_fit", h, 0) for h in args.maxh] + [("femur", f, 0) for f in args.femur] + \
@@ -310,24 +402,14 @@ def main(argv=None) -> int:
     data = [row for path in args.rows_from for row in read_rows(path)]
     for name, size, k in ([] if args.rows_from else runs):
         for r, flags in ((r, f) for r in args.ranks for f in args.bddc):
-            data.append(measure(name, size, r, work, k, flags))
+            guard = MemoryGuard(*args.guard) if args.guard else None
+            try:
+                data.append(measure(name, size, r, work, k, flags, args.order, guard, args.code))
+            except RuntimeError as exc:            # the memory guard did not start or ended the run
+                print(f"{name} {size:g} refined {k} on {r} rank(s): {exc}", flush=True)
+                continue
             print(" ".join(f"{k}={data[-1][k]}" for k in KEYS), flush=True)
-    csv_path = os.path.join(args.out, "macro_mpi_scaling.csv")
-    write_csv(csv_path, list(KEYS), [[d[k] for k in KEYS] for d in data])
-    default = [d for d in data if d["bddc"] == "default"]     # the other flags' rows compare the coarse solve
-    rows = model(default)
-    model_path = os.path.join(args.out, "macro_mpi_model.csv")
-    write_csv(model_path, list(MODEL_KEYS), [[m[k] for k in MODEL_KEYS] for m in rows])
-    png = os.path.join(args.out, "macro_mpi_scaling.png")
-    plot(default, png)
-    for m in rows:
-        print(" ".join(f"{k}={m[k]}" for k in MODEL_KEYS))
-    if args.publish:
-        measured = f" The rows were measured by {args.measured_by}." if args.measured_by else ""
-        benchmark_doc.publish("macro_mpi_scaling", "The 3D press fit and femur on 1, 2 and 3 MPI ranks", csv_path,
-                              note=NOTE + measured, png=png)
-        benchmark_doc.publish("macro_mpi_model", "What 64 MPI ranks would need (a paper model)", model_path,
-                              note=MODEL_NOTE)
+    write_and_publish(args, data, work)
     return 0
 
 

@@ -53,19 +53,37 @@ def roundoff_floors(mat, vec, fixed, energy: float = 0.0) -> tuple[float, float]
     the ranks, so that every rank stops where the others do (dofs shared by
     ranks count once per rank: an estimate all the same).
     """
-    mat = local_matrix(mat)
-    vals, cols, ptr = mat.CSR()
     u = np.abs(vec.FV().NumPy())
-    n = len(u)
-    a = sp.csr_matrix((np.abs(np.asarray(vals)), np.asarray(cols), np.asarray(ptr)), shape=(n, n))
-    m = a @ u
-    if type(mat).__name__.startswith("SparseMatrixSymmetric"):   # the upper triangle is the lower's transpose
-        m += a.T @ u - a.diagonal() * u
+    m = abs_product(local_matrix(mat), u)
     eps = ROUNDOFF * np.finfo(float).eps
     um = ranks_sum(vec, float(np.dot(u, m)))
     energy_floor = eps * (abs(energy) + 0.5 * um)
     m[fixed] = 0.0
     return eps * float(np.sqrt(ranks_sum(vec, float(np.dot(m, m))))), energy_floor
+
+
+#: stored entries of a matrix taken at a time by :func:`abs_product`
+CHUNK = 1 << 19
+
+
+def abs_product(mat, u: np.ndarray) -> np.ndarray:
+    """``|K| u`` for NGSolve's sparse ``mat`` (full or its lower triangle), taken ``CHUNK`` stored entries
+    at a time, so that the absolute values never need a copy of the whole matrix."""
+    vals, cols, ptr = (np.asarray(a) for a in mat.CSR())
+    n = len(u)
+    lower = type(mat).__name__.startswith("SparseMatrixSymmetric")   # the upper triangle is the lower's transpose
+    m = np.zeros(n)
+    r0 = 0
+    while r0 < n:
+        r1 = max(int(np.searchsorted(ptr, ptr[r0] + CHUNK, side="right")) - 1, r0 + 1)
+        s0, s1 = int(ptr[r0]), int(ptr[r1])
+        block = sp.csr_matrix((np.abs(vals[s0:s1]), cols[s0:s1], ptr[r0:r1 + 1] - s0), shape=(r1 - r0, n))
+        m[r0:r1] += block @ u
+        if lower:
+            m += block.T @ u[r0:r1]
+            m[r0:r1] -= block.diagonal(r0) * u[r0:r1]
+        r0 = r1
+    return m
 
 
 def local_matrix(mat):

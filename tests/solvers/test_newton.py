@@ -103,11 +103,15 @@ def test_cell_newton_records_the_active_set_and_finds_no_false_cycle():
     assert 0 < sizes[-1] < total      # partial contact: some points in, some out
 
 
+@pytest.mark.parametrize("chunk", [1 << 19, 37])
 @pytest.mark.parametrize("symmetric_storage", [False, True])
-def test_the_roundoff_floor_is_eps_times_abs_k_times_abs_u_on_the_free_dofs(symmetric_storage):
-    """``ROUNDOFF eps || |K| |u| ||`` over the free dofs, from either storage of ``K`` (a dense check)."""
+def test_the_roundoff_floor_is_eps_times_abs_k_times_abs_u_on_the_free_dofs(symmetric_storage, chunk, monkeypatch):
+    """``ROUNDOFF eps || |K| |u| ||`` over the free dofs, from either storage of ``K`` (a dense check), the
+    matrix taken whole or in blocks of ``chunk`` stored entries."""
     import numpy as np
+    from ngcontact.solvers import roundoff
     from ngcontact.solvers.roundoff import ROUNDOFF, roundoff_floors
+    monkeypatch.setattr(roundoff, "CHUNK", chunk)
     mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.25))
     V = ng.VectorH1(mesh, order=2, dirichlet="bottom")
     u, v = V.TnT()
