@@ -145,7 +145,7 @@ def test_the_rigid_predictor_brackets_a_subnormal_and_a_zero_load(p):
 
 # ------------------------------------------------------------------ FE exact cell: the contact set
 EXACT = sinusoid_cell(k_n="1.0e3", enforcement="exact", pressure="{pressure}",
-                        discretization="order = 2\nmaxh = 0.25\ninterface_maxh = 0.05")
+                        discretization="order = 2\nmaxh = 0.25\ninterface_maxh = 0.05\nestimate = \"off\"")
 
 
 def test_the_exact_cell_counts_no_touching_node_as_contact_at_zero_load(tmp_path):
@@ -165,7 +165,7 @@ def test_the_exact_cell_contact_fraction_vanishes_with_the_load(tmp_path):
 
 
 # ------------------------------------------------------------------ small strain
-@pytest.mark.parametrize("disc", ['method = "spectral"\ngrid = 64', "order = 1\nmaxh = 0.5"])
+@pytest.mark.parametrize("disc", ['method = "spectral"\ngrid = 64', "order = 1\nmaxh = 0.5\nestimate = \"off\""])
 def test_a_far_face_jump_beyond_small_strain_is_warned_and_recorded(tmp_path, caplog, disc):
     """Was: a far-face jump of 14867 in a cell 2 high, without a word."""
     text = sinusoid_cell(k_n="1e-2", enforcement="penalty", pressure="1e-5, 0.2", discretization=disc)
