@@ -24,8 +24,8 @@ from ngcontact.cell.spectral.spectral_solver import SpectralCellSolver
 from ngcontact.coupling import cell_law
 from ngcontact.drivers.cell_gap import gap_cf, gap_samples, map_heights
 from ngcontact.drivers.contact_edge_refiner import edge_refiner
+from ngcontact.drivers.scene_laws import elastic_law
 from ngcontact.errors import SceneError
-from ngcontact.fem import materials
 from ngcontact.laws import homogenized as il
 from ngcontact.laws.friction import FRICTION_LAWS, FrictionLaw
 from ngcontact.solvers.linear_solver import LinearSolver
@@ -36,36 +36,7 @@ from ngcontact.scene.cell_geometry import small_slope
 from ngcontact.scene.cell_scene import CellScene, check_fe, has_twin, load_states, spectral_grid
 from ngcontact.scene.spectral_grid import DEFAULT_REFINEMENT_POINTS, MAX_SPECTRAL_POINTS
 from ngcontact.scene.loader import as_dict, load_with_contact
-from ngcontact.scene.sections import MaterialSpec, resolve
-
-
-def elastic_law(spec: MaterialSpec) -> materials.ElasticLaw:
-    """The elastic law a ``[materials.NAME]`` section describes (isotropic or Voigt ``C``)."""
-    if spec.C is not None:
-        return materials.anisotropic(spec.C)
-    assert spec.E is not None and spec.nu is not None  # guaranteed by MaterialSpec.check
-    return materials.isotropic(spec.E, spec.nu)
-
-
-def body_laws(scene, names: dict[str, str]) -> dict[str, materials.ElasticLaw]:
-    """``{body: law}`` for ``{body: material name}`` of ``scene.materials``."""
-    return {body: elastic_law(scene.materials[name]) for body, name in names.items()}
-
-
-def interface_normal_law(spec) -> il.NormalLaw | None:
-    """The homogenized normal law of an ``[interface]`` section's numbers (``None`` with a cell)."""
-    if spec.cell is not None:
-        return None
-    return il.normal_law(spec.law, kn=spec.kn, kt=spec.kt, knt=spec.knt, gap_force=spec.gap_force,
-                         weights=spec.weights, directions=spec.directions, gaps=spec.gaps,
-                         closure=spec.closure, pressure=spec.pressure)
-
-
-def interface_friction(spec) -> il.Friction | None:
-    """Homogenized friction of an ``[interface]`` section (``None`` without mu and threshold)."""
-    if spec.mu == 0.0 and spec.threshold == 0.0:
-        return None
-    return il.Friction(mu=spec.mu, threshold=spec.threshold, width=spec.huber_width)
+from ngcontact.scene.sections import resolve
 
 
 def cell_loads(scene: CellScene) -> list[CellLoad]:

@@ -47,8 +47,8 @@ import ngsolve as ng
 from ngcontact.drivers.mesh_supports import supports_on
 from ngcontact.drivers.macro_accuracy import accuracy, check_radius, safety_factor_of
 from ngcontact.drivers.macro_refinement import refine
-from ngcontact.drivers.build import (body_laws, friction_from_cell, interface_friction, interface_normal_law,
-                                     law_from_cell, law_from_file, linear_solver)
+from ngcontact.drivers.build import friction_from_cell, law_from_cell, law_from_file, linear_solver
+from ngcontact.drivers.scene_laws import body_laws, interface_friction, interface_normal_law
 from ngcontact.laws import homogenized as il
 from ngcontact.fem.interpolants import piecewise_linear
 from ngcontact.macro import macro_problem as M

@@ -19,7 +19,7 @@ import numpy as np
 from ngcontact.parallel import executor
 from ngcontact.verification import manufactured
 from ngcontact.verification import rates as studies
-from ngcontact.drivers.build import body_laws
+from ngcontact.drivers.scene_laws import body_laws
 from ngcontact.errors import ConvergenceError
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField

@@ -32,7 +32,8 @@ from functools import partial
 
 import numpy as np
 
-from ngcontact.drivers.build import body_laws, micro_friction
+from ngcontact.drivers.build import micro_friction
+from ngcontact.drivers.scene_laws import body_laws
 from ngcontact.drivers.mesh_supports import supports_on
 from ngcontact.drivers.resolved_accuracy import accuracy
 from ngcontact.resolved import resolved_problem as D

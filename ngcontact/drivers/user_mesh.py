@@ -24,7 +24,7 @@ from types import SimpleNamespace
 import ngsolve as ng
 
 from ngcontact.drivers import run_macro
-from ngcontact.drivers.build import elastic_law
+from ngcontact.drivers.scene_laws import elastic_law
 from ngcontact.drivers.cell_scene_law import CellLaw
 from ngcontact.fem.elasticity import COMPONENTS
 from ngcontact.fem.materials import ElasticLaw

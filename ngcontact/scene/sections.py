@@ -6,7 +6,7 @@
 * ``[solver]``: Newton tolerances and limits.
 
 Descriptions only: the drivers turn them into model objects
-(:func:`ngcontact.drivers.build.elastic_law`).
+(:func:`ngcontact.drivers.scene_laws.elastic_law`).
 """
 from __future__ import annotations
 
@@ -121,10 +121,10 @@ class CellDiscretization(Discretization):
                         "and stated in the report (results.accuracy.method, its reason in one sentence): spectral "
                         "for a small-slope cell (geometry.profile 'flat' or 'flat3d', or 'bisinusoid', "
                         "'height_map', 'measured_spectrum' or 'self_affine' with arrangement = 'summit') that sets "
-                        "no key only the FE cell reads (discretization.order, maxh, interface_maxh, max_elements, budget_dofs; "
-                        "solver.atol, max_iter, inverse, linear, iterative_from, start, coulomb, coulomb_rtol, "
-                        "coulomb_max_iter; contact.w with exact friction, which the spectral cell solves without a "
-                        "width) and no tolerance below 10 x solver.rtol, else fe; a scene that sets "
+                        "no key only the FE cell reads (discretization.order, maxh, interface_maxh, max_elements, "
+                        "budget_dofs; solver.atol, max_iter, inverse, linear, iterative_from, start, coulomb, "
+                        "coulomb_rtol, coulomb_max_iter; contact.w with exact friction, which the spectral cell "
+                        "solves without a width) and no tolerance below 10 x solver.rtol, else fe; a scene that sets "
                         "discretization.grid is spectral (refused for a cell that is not small-slope, or beside an "
                         "FE-only key); a macro scene's strength.cell, and a two-scale loop whose friction comes "
                         "from a frictional cell, solve an auto cell by fe (they need the FE cell's stresses and "
