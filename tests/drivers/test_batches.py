@@ -71,6 +71,7 @@ independent = true
 order = 2
 maxh = 0.3
 interface_maxh = 0.08
+estimate = "off"
 [solver]
 rtol = 1e-10
 """
