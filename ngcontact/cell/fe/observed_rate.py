@@ -40,6 +40,11 @@ WINDOW = 2
 DISAGREE = 2.0
 
 
+def ratio_text(ratio: float) -> str:
+    """A ratio of successive differences in a remark; one after a level without change has no finite value."""
+    return f"{ratio:.2g}" if math.isfinite(ratio) else "unbounded (the level before changed nothing)"
+
+
 @dataclass(frozen=True)
 class Convergence:
     """How a knob's sequence of answers may be assumed to converge (module docstring)."""
@@ -70,10 +75,10 @@ class Convergence:
         else:
             observed = max(ratios)
             if len(ratios) > 1 and max(ratios) > DISAGREE * min(ratios):
-                remark.append("successive ratios disagree (" + ", ".join(f"{r:.2g}" for r in ratios)
+                remark.append("successive ratios disagree (" + ", ".join(ratio_text(r) for r in ratios)
                               + "): the larger taken")
             if observed > self.cap:
-                remark.append(f"not contracting (ratio {observed:.2g}): ratio {self.cap:g} taken")
+                remark.append(f"not contracting (ratio {ratio_text(observed)}): ratio {self.cap:g} taken")
             rate = min(max(observed, self.floor), self.cap)
         return self.safety * d[-1] * rate / (1.0 - rate) / scale, "; ".join(remark)
 
