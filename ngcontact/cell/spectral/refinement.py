@@ -108,13 +108,13 @@ differences beside it where two grids' errors share their sign and size, as on W
 half its closing pressure) and reported, but not held to the tolerance (:data:`UNCONTROLLED`: listed in
 the verdict as not counted).
 
-Two checks beyond the differences end each level's estimate.  A 2D contact island of fewer than
-:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points has no resolved edges: its error may
-stall over grids while the differences vanish, so its share of the quantities on the edges is a floor under
-their estimates (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``).  An estimate
-above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times its last difference rests on an earlier
-difference, a carried estimate or an island, and may exceed the error by as much: it is flagged with its
-reason and listed in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
+Two checks end each level's estimate.  A 2D contact island of fewer than
+:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points has no resolved edges: its error may stall
+while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
+(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``).  An estimate (not Richardson's)
+above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the
+last contraction may exceed the error by as much: flagged with its reason, it is listed in the report
+(:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
 Levels double the points per direction (:data:`GROWTH`): close enough that three differences cost little
 more than the finest level (2D: twice the finest; 3D: 4/3 of it).
@@ -199,7 +199,7 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
        f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance; in 2D "
        f"at least the share of contact islands of fewer than {ISLAND_POINTS} points; an estimate above {LOOSE:g} "
-       "times its last difference flagged as possibly loose by as much")
+       "times the error its last difference leaves at the last rate flagged as possibly loose by as much")
 
 
 @dataclass
