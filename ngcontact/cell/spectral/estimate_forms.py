@@ -40,9 +40,8 @@ LOOSE = 10.0
 #: the slowest contraction per level the error left by the last difference is taken at (first order)
 FIRST_ORDER = 0.5
 #: why, per form of the estimate (module docstring)
-WHY_LOOSE = {GUARDED: "an earlier difference bounds it, and the error may have fallen as fast as the last one",
-             CARRIED: "carried from the deferred grid, whose error may have fallen as fast as the last difference",
-             ISLAND: "an unresolved island's share bounds it, whatever the island's true width below it"}
+WHY_LOOSE = {GUARDED: "an earlier difference bounds it", CARRIED: "carried from the deferred grid",
+             ISLAND: "an unresolved island's share bounds it"}
 
 
 def loose_flags(history: list[dict[str, Any]], estimates: list[dict[str, float]], forms: list[dict[str, str]]
@@ -59,7 +58,7 @@ def loose_flags(history: list[dict[str, Any]], estimates: list[dict[str, float]]
             left, rate = tail_left([h["headline"][k][name] / size for h in history[-3:]])
             if forms[k][name] != RICHARDSON and e > LOOSE * left:
                 ratio = f"{e / left:.3g} times" if left > 0 else "far above"
-                out[name] = (f"{ratio} the error left by the last difference at the rate {rate:.2g}: "
+                out[name] = (f"{ratio} the tail the last difference leaves at its rate {rate:.2g}: "
                              f"{WHY_LOOSE.get(forms[k][name], WHY_LOOSE[GUARDED])}")
         flags.append(out)
     return flags
