@@ -229,3 +229,92 @@ def test_on_levels_of_the_line_the_contact_fraction_and_coefficients_take_the_gu
     assert forms[0] == {"contact_fraction": GUARDED, "coefficient_g_n": GUARDED, "mean_closure": RICHARDSON}
     d = [abs(b - a) for a, b in zip(values[:-1], values[1:])][::-1]
     assert estimates[0]["contact_fraction"] == pytest.approx(guarded_bound(d)[0])
+
+
+PROFILE_11 = self_affine(dim=2, grid=64, hurst=0.8, rms_slope=0.1, seed=11)
+
+
+def _random_profile_11(n):
+    closed = np.append(PROFILE_11, PROFILE_11[0])
+    return np.interp(np.arange(n) / n, np.arange(65) / 64, closed.max() - closed)
+
+
+def test_a_stalled_error_on_an_unresolved_island_is_bounded_by_the_islands_share():
+    """The seed-11 profile (loads 0.001, 0.003, 0.01) at p = 0.001 holds a contact island narrower than a step on grids 256 to 1024: its
+    error stalls over 512 and 1024 while the differences vanish (module docstring of
+    :mod:`~ngcontact.cell.spectral.contact_edges`).  Refined to 1e-2 the island's share bounds the contact
+    fraction, ``k_n`` and ``g_n`` of the load within [1, 10] times their error (``g_n`` was 0.56), on the
+    grid the differences alone chose."""
+    from ngcontact.cell.spectral.contact_edges import ISLAND
+    loads = [cell_load(2, pressure=p) for p in (0.001, 0.003, 0.01)]
+    refined = sweep_to_tolerance(lambda n: _cell(2, _random_profile_11, n), loads, 1e-2, 64, 2, 2 ** 22)
+    assert refined.history[-1]["grid"] == 1024 and refined.history[-1]["islands"][0]["points"] == 1
+    head, exact = headline(refined.solutions[0].results), headline(_cell(2, _random_profile_11, 16384).sweep(
+        loads)[0].results)
+    for name in ("contact_fraction", "coefficient_k_n", "coefficient_g_n"):
+        effectivity = refined.estimates[0][name] / (abs(head[name] - exact[name]) / refined.scales[0][name])
+        assert refined.forms[0][name] == ISLAND and 1.0 <= effectivity <= 10.0, (name, effectivity)
+    assert any("contact island" in remark for remark in refined.remarks)
+
+
+def test_on_westergaards_sinusoid_at_light_loads_an_estimate_beyond_ten_times_the_error_is_flagged():
+    """At p = 0.0004 and 0.0015 the errors of the quantities on the edges fall by 6 to 25 per doubling once the
+    quartic locates the edges, faster than the differences before show: the guarded bounds exceed the errors by
+    78 to 406 times.  Each estimate bounds its error, and each above ten times it carries the estimator's own
+    flag with its reason, listed in the report's remarks."""
+    from ngcontact.cell.spectral.refinement import UNCONTROLLED
+    loads = [cell_load(2, pressure=p) for p in (0.0004, 0.0015)]
+    refined = sweep_to_tolerance(lambda n: _cell(2, _westergaard, n), loads, 1e-2, 64, 2, 2 ** 22)
+    reference = _cell(2, _westergaard, 2 ** 16).sweep(loads)
+    loose = 0
+    for k, (sol, ref) in enumerate(zip(refined.solutions, reference)):
+        head, exact = headline(sol.results), headline(ref.results)
+        for name in (n for n in refined.estimates[k] if n not in UNCONTROLLED):
+            effectivity = refined.estimates[k][name] / (abs(head[name] - exact[name]) / refined.scales[k][name])
+            assert effectivity >= 1.0, (k, name, effectivity)
+            if effectivity > 10.0:
+                assert "an earlier difference bounds it" in refined.flags[k][name], (k, name, effectivity)
+                loose += 1
+    assert loose >= 5
+    assert any(remark.startswith("may exceed the error by more than 10 times") for remark in refined.remarks)
+
+
+def test_contact_islands_of_a_periodic_mask_and_the_share_of_the_unresolved_ones():
+    """Runs of contact wrap around the period; an island of fewer than four points holds its points and one open
+    point on each side (eq. 34 on them: ``K0 = k_n |S| / |T|``, ``g_n = k_n mean(1_S g0)``)."""
+    from ngcontact.cell.spectral.contact_edges import islands, unresolved_share
+    on = np.array([1, 0, 1, 1, 0, 0, 0, 1], bool)
+    assert sorted(islands(on)) == [(2, 2), (7, 2)]
+    assert islands(np.ones(8, bool)) == [] and islands(np.zeros(8, bool)) == []
+    cell = _cell(2, _westergaard, 64)
+    p = np.zeros(64)
+    p[10] = 1.0                                  # one point: unresolved
+    p[30:40] = 1.0                               # ten points: resolved
+    share = unresolved_share(cell, p)
+    assert share["points"] == 1 and share["islands"] == 1
+    assert share["share"]["contact_fraction"] == pytest.approx(3 / 64)
+    assert share["share"]["coefficient_g_n"] == pytest.approx(cell.k_n * cell.g0[9:12].sum() / 64)
+    p[10] = 0.0
+    assert unresolved_share(cell, p)["share"] == {}
+
+
+def test_an_island_raises_an_estimate_below_its_share_and_a_loose_guarded_bound_is_flagged():
+    """:func:`~ngcontact.cell.spectral.contact_edges.island_floor` raises only the estimates below the share (in
+    their measure); :func:`~ngcontact.cell.spectral.estimate_forms.loose_flags` flags a guarded estimate above ten
+    times the tail its last difference leaves at the last rate, never a Richardson one."""
+    from ngcontact.cell.spectral.contact_edges import ISLAND, island_floor
+    from ngcontact.cell.spectral.estimate_forms import loose_flags, tail_left
+    whole = {"k_n": 2.0, "g_n": 1.0}
+    history = [{"grid": 2 ** j, "whole_surface": whole, "headline": [{"contact_fraction": f, "coefficient_g_n": g}],
+                "islands": [{"points": 1, "islands": 1, "share": {"contact_fraction": 0.01,
+                                                                  "coefficient_g_n": 0.002}}]}
+               for j, (f, g) in enumerate(((0.30, 0.1), (0.32, 0.11), (0.321, 0.1101)))]
+    estimates = [{"contact_fraction": 0.004, "coefficient_g_n": 0.05}]
+    forms = [{"contact_fraction": GUARDED, "coefficient_g_n": RICHARDSON}]
+    assert len(island_floor(history, estimates, forms)) == 1
+    assert estimates == [{"contact_fraction": 0.01, "coefficient_g_n": 0.05}]
+    assert forms == [{"contact_fraction": ISLAND, "coefficient_g_n": RICHARDSON}]
+    left, rate = tail_left([0.30, 0.32, 0.321])  # differences 0.02, 0.001: rate 0.05
+    assert rate == pytest.approx(0.05) and left == pytest.approx(0.001 * 0.05 / 0.95)
+    flags = loose_flags(history, estimates, forms)
+    assert set(flags[0]) == {"contact_fraction"} and "island" in flags[0]["contact_fraction"]

@@ -108,6 +108,14 @@ differences beside it where two grids' errors share their sign and size, as on W
 half its closing pressure) and reported, but not held to the tolerance (:data:`UNCONTROLLED`: listed in
 the verdict as not counted).
 
+Two checks end each level's estimate.  A 2D contact island of fewer than
+:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points has no resolved edges: its error may stall
+while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
+(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``).  An estimate (not Richardson's)
+above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the
+last contraction may exceed the error by as much: flagged with its reason, it is listed in the report
+(:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
+
 Levels double the points per direction (:data:`GROWTH`): close enough that three differences cost little
 more than the finest level (2D: twice the finest; 3D: 4/3 of it).
 
@@ -141,6 +149,10 @@ from typing import Any, Callable
 import numpy as np
 
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale
+from ngcontact.cell.spectral.contact_edges import (ISLAND_POINTS, fitted_run, island_floor, on_edges,
+                                                   unresolved_share)
+from ngcontact.cell.spectral.estimate_forms import (CARRIED, GUARDED, LOOSE, RICHARDSON, loose_flags,
+                                                   loose_remarks)
 from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
 from ngcontact.errors import ConvergenceError
 
@@ -177,8 +189,6 @@ ERRATIC = {"normal_stiffness": 2.0}
 #: the fewest levels whose 2D edges are all located by the quartic that estimate the quantities resting on the
 #: edges on their own (two differences: one that vanished is seen beside the other; module docstring)
 LOCATOR_LEVELS = 3
-#: the forms of the estimate, as the report names them (:data:`CARRIED`: after a deferred stop, module docstring)
-RICHARDSON, GUARDED, CARRIED = "Richardson", "guarded", "carried"
 #: how the estimate is made, for the report
 HOW = ("grids of twice the points per direction each; per quantity and load, Richardson with the observed rate "
        f"of the last {WINDOW} differences where their two ratios agree within a factor {AGREE:g} (rate at least "
@@ -187,7 +197,9 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        "last one; the contact fraction and coefficients guarded on levels of edges not all fitted by the quartic, "
        f"and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
        "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
-       f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance")
+       f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance; in 2D "
+       f"at least the share of contact islands of fewer than {ISLAND_POINTS} points; an estimate above {LOOSE:g} "
+       "times the error its last difference leaves at the last rate flagged as possibly loose by as much")
 
 
 @dataclass
@@ -203,6 +215,8 @@ class RefinedSweep:
     remarks: list[str] = field(default_factory=list)
     #: per load, the form of each quantity's estimate (:data:`RICHARDSON` or :data:`GUARDED`)
     forms: list[dict[str, str]] = field(default_factory=list)
+    #: per load, the estimates that may exceed the error by more than :data:`LOOSE` times, with the reason
+    flags: list[dict[str, str]] = field(default_factory=list)
 
     @property
     def estimate(self) -> float:
@@ -333,23 +347,6 @@ def carried(previous: list[dict[str, float]], history: list[dict[str, Any]], est
     return lowered
 
 
-def on_edges(name: str) -> bool:
-    """Whether a headline quantity rests on the contact edges located between points in 2D: the contact
-    fraction and the coefficients of eq. 34 on the real contact set (:mod:`~ngcontact.cell.spectral.grid_measures`)."""
-    return name == "contact_fraction" or name.startswith(COEFFICIENT)
-
-
-def fitted_run(history: list[dict[str, Any]], k: int) -> int:
-    """The levels at the end of ``history`` on which every edge of load ``k`` is located by the quartic
-    (:func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`; 0 where the last level's are not)."""
-    run = 0
-    for entry in reversed(history):
-        if not entry.get("edges_fitted", [False] * (k + 1))[k]:
-            break
-        run += 1
-    return run
-
-
 def locator_changing(history: list[dict[str, Any]]) -> bool:
     """Whether some load's edges came to be located by the quartic fewer than :data:`MIN_LEVELS` levels
     ago: its fitted levels then show fewer than the two ratios of differences that decide between
@@ -399,6 +396,7 @@ def solve_level(make_cell: Callable[[int], Any], loads: list, n: int,
         "mean_closure": [s.results["mean_closure"] for s in sols],
         "headline": [headline(s.results) for s in sols],
         "edges_fitted": [edges_fitted(cell, s.fields["pressure"], s.fields["gap"]) for s in sols],
+        "islands": [unresolved_share(cell, s.fields["pressure"]) for s in sols],
         "whole_surface": coefficients(cell, np.ones(cell.shape, bool)).as_dict()}
     return cell, sols, entry
 
@@ -418,6 +416,7 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
                   grids[-1] ** (dim - 1), len(grids), grid)
     history: list[dict[str, Any]] = []
     sols: list = []
+    flags: list[dict[str, str]] = []
     deferred = None                 # the estimates of a level that met the tolerance but waited on the edge fit
     for n in grids:
         cell, sols, entry = solve_level(make_cell, loads, n, sols or None)
@@ -428,14 +427,16 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
                 remarks.append(f"{lowered} estimates carried from the deferred grid {history[-2]['grid']}: its "
                                "estimate plus the last difference")
         if estimates is not None:
+            remarks += island_floor(history, estimates, forms)
+            flags = loose_flags(history, estimates, forms)
             entry["estimate"] = controlled_estimate(estimates)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
                       f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
         settled = not sharpen or n == grids[-1] or not locator_changing(history)
         met = estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance
         if estimates is not None and met and settled:
-            return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, remarks=remarks,
-                                forms=forms)
+            return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history,
+                                remarks=remarks + loose_remarks(flags), forms=forms, flags=flags)
         deferred = estimates if met else None
     reached = f"{entry['estimate']:.3g}" if estimates is not None else "no estimate (one level)"
     message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on {entry['points']} "
@@ -446,4 +447,4 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
     if estimates is None:
         estimates = [{name: float("inf") for name in headline(s.results)} for s in sols]
     return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, met=False,
-                        remarks=remarks + [message], forms=forms)
+                        remarks=remarks + loose_remarks(flags) + [message], forms=forms, flags=flags)

@@ -1,0 +1,116 @@
+"""The contact set's edges and islands as the refinement's estimate sees them (2D spectral cell).
+
+The headline quantities that rest on the contact edges (:func:`on_edges`: the contact fraction and the
+coefficients of eq. 34 on the real contact set, :mod:`~ngcontact.cell.spectral.grid_measures`) are
+estimated by :mod:`~ngcontact.cell.spectral.refinement` from their differences between grids, and two
+things the differences cannot show are read off the levels here:
+
+* which of the two edge locators placed a load's edges on each level (:func:`fitted_run`,
+  :func:`locator_changing`; the refinement's module docstring says why a window across the change of
+  locator bounds the quartic's error by the line's);
+* **contact islands too narrow for the grid** (:func:`unresolved_share`).  An island of ``w`` collocation
+  points is resolved when its edges are: each edge is located between the last contact point and the
+  first open one, by the line through the first two open points to within a step, so an island of fewer
+  than :data:`ISLAND_POINTS` points is narrower than the reach of its two edges' locators, and its
+  collocated pressure (singular like the inverse square root of the distance to either edge, paper eq. 57
+  on the set) has no interior.  Its located width then does not converge at the first order of the
+  resolved edges: it may be close to nothing on two successive grids (an island below a step wide at
+  both), so that the differences vanish while the error is the island's whole share; it stalls.  Such an
+  island's share of each quantity is bounded by its points and one step beyond each edge: the share of
+  eq. 34 on its points and its two open neighbours (``K0 = k_n |S| / |T|``, ``g_n = k_n mean(1_S g0)``,
+  :func:`~ngcontact.cell.spectral.grid_measures.coefficients`), whatever the island's true width below
+  that.  The refinement takes it as a floor on the difference-based estimate of each quantity on the
+  edges (:func:`island_floor`): the floor falls like ``h`` while islands stay unresolved, and vanishes
+  once every island spans :data:`ISLAND_POINTS` points.
+
+In 3D the contact fraction counts points and no edge is located between them: an island's points are
+counted as every other point is, and no floor is taken.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ngcontact.cell.cell_solution import COEFFICIENT, scale
+from ngcontact.cell.spectral.grid_measures import coefficients
+
+#: the fewest collocation points of a resolved 2D contact island (module docstring)
+ISLAND_POINTS = 4
+#: the form of an estimate raised to the floor of the unresolved islands, as the report names it
+ISLAND = "island"
+
+
+def on_edges(name: str) -> bool:
+    """Whether a headline quantity rests on the contact edges located between points in 2D: the contact
+    fraction and the coefficients of eq. 34 on the real contact set (:mod:`~ngcontact.cell.spectral.grid_measures`)."""
+    return name == "contact_fraction" or name.startswith(COEFFICIENT)
+
+
+def fitted_run(history: list[dict[str, Any]], k: int) -> int:
+    """The levels at the end of ``history`` on which every edge of load ``k`` is located by the quartic
+    (:func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`; 0 where the last level's are not)."""
+    run = 0
+    for entry in reversed(history):
+        if not entry.get("edges_fitted", [False] * (k + 1))[k]:
+            break
+        run += 1
+    return run
+
+
+def locator_changing(history: list[dict[str, Any]], min_levels: int) -> bool:
+    """Whether some load's edges came to be located by the quartic fewer than ``min_levels`` levels ago:
+    its fitted levels then show fewer than the two ratios of differences that decide between Richardson and
+    the guarded bound (:mod:`~ngcontact.cell.spectral.refinement`)."""
+    loads = len(history[-1]["headline"])
+    return any(0 < run < min(min_levels, len(history)) for run in (fitted_run(history, k) for k in range(loads)))
+
+
+def islands(on: np.ndarray) -> list[tuple[int, int]]:
+    """The runs of ``True`` of a periodic 1D mask as ``(first point, points)``; none where it is all
+    ``True`` or all ``False``."""
+    if on.all() or not on.any():
+        return []
+    first = np.flatnonzero(on & ~np.roll(on, 1))
+    last = np.flatnonzero(on & ~np.roll(on, -1))
+    last = np.roll(last, -1) if last[0] < first[0] else last      # the run that wraps ends after the others
+    return [(int(a), int((b - a) % on.size) + 1) for a, b in zip(first, last)]
+
+
+def unresolved_share(cell, p: np.ndarray) -> dict[str, Any]:
+    """The share of each quantity on the edges held by the islands of fewer than :data:`ISLAND_POINTS`
+    points of a 2D pressure ``p`` (module docstring): ``{"points": the smallest island's points (0 without
+    islands), "islands": how many are unresolved, "share": {headline name: absolute share}}``; no share in
+    3D or without such islands."""
+    runs = islands(p > 0) if cell.dim == 2 else []
+    small = [(a, w) for a, w in runs if w < ISLAND_POINTS]
+    out: dict[str, Any] = {"points": min((w for _, w in runs), default=0), "islands": len(small), "share": {}}
+    if small:
+        mask = np.zeros(p.shape, bool)
+        for a, w in small:
+            mask[np.arange(a - 1, a + w + 1) % p.size] = True       # the island and an open point each side
+        whole = coefficients(cell, mask).as_dict()
+        out["share"] = {"contact_fraction": whole["contact_fraction"], COEFFICIENT + "k_n": whole["k_n"],
+                        COEFFICIENT + "g_n": whole["g_n"]}
+    return out
+
+
+def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]], forms: list[dict[str, str]]
+                 ) -> list[str]:
+    """Raise in place each estimate of a quantity on the edges (per load, of the last level of ``history``;
+    its form with it) to the share of the load's unresolved islands in its measure where that is larger
+    (module docstring).  Returns a remark per load raised."""
+    last = history[-1]
+    remarks = []
+    for k, (per_load, unresolved) in enumerate(zip(estimates, last.get("islands", []))):
+        raised = []
+        for name, share in unresolved["share"].items():
+            if name in per_load and (floor := share / scale(name, last["headline"][k], last["whole_surface"])
+                                     ) > per_load[name]:
+                per_load[name], forms[k][name] = floor, ISLAND
+                raised.append(name)
+        if raised:
+            remarks.append(f"load {k}: {unresolved['islands']} contact island(s) of fewer than {ISLAND_POINTS} "
+                           f"points (the smallest {unresolved['points']}) on grid {last['grid']}: "
+                           f"{', '.join(raised)} bounded by their share, one step beyond each edge")
+    return remarks
