@@ -194,10 +194,10 @@ def body_maxima(sol: MacroSolution, dense_inset: float = 1e-3,
     return out
 
 
-def dense_rule(dim: int, inset: float = 1e-3) -> ng.IntegrationRule:
-    """A lattice of points in the reference element (6 intervals per edge in 2D, 4 in 3D), moved
+def dense_rule(dim: int, inset: float = 1e-3, intervals: int | None = None) -> ng.IntegrationRule:
+    """A lattice of points in the reference element (``intervals`` per edge, default 6 in 2D, 4 in 3D), moved
     ``inset`` inwards as :func:`ngcontact.macro.macro_measures.field_extrema`'s points are."""
-    n = 6 if dim == 2 else 4
+    n = intervals or (6 if dim == 2 else 4)
     span = 1.0 - (dim + 1) * inset
     pts = [tuple(inset + span * c / n for c in idx) for idx in np.ndindex(*(n + 1,) * dim) if sum(idx) <= n]
     return ng.IntegrationRule(pts, [0.0] * len(pts))

@@ -181,10 +181,11 @@ def test_a_radius_beyond_the_bodies_is_refused_before_the_solve(tmp_path, monkey
 
 @pytest.mark.slow
 def test_the_femur_main_job_meets_its_tolerance_away_from_the_bone_edge():
-    """The femur's maxima away from the bone's top edge bound their error against the scene's mesh sizes
-    divided by 4 at order 4 (the reference's own maxima over a lattice reaching the faces)."""
-    from dataclasses import replace
-
+    """The femur's maxima away from the bone's top edge bound their error, by at most 10 times (issue 35),
+    against the converged reference of ngcontact.drivers.macro_reference (order 4 on the scene's mesh sizes
+    divided by 4, the suprema over the set outside the balls sampled densely), the reference the effectivity
+    benchmark (scripts/macro_effectivity.py) measures against."""
+    from ngcontact.drivers import macro_reference as MR
     from ngcontact.drivers.run_macro import build_geometry, checked_equilibrium, problem_of, solve_scene
     from ngcontact.drivers.run_strength import recovery_of
     sc = loader.load(os.path.join(ROOT, "geometries", "femur_stem.toml"))
@@ -195,17 +196,17 @@ def test_the_femur_main_job_meets_its_tolerance_away_from_the_bone_edge():
                       recovery=recovery)
     q = {x["name"]: x for x in acc["quantities"]}
     assert acc["met"] and q["safety_factor"]["singular_at"] == pytest.approx([0.011, 0.18])
-    d = sc.discretization
-    fine_problem, _ = problem_of(sc, build_geometry(sc, maxh=d.maxh / 4, interface_maxh=d.interface_maxh / 4,
-                                                   order=4))
-    fine = solve_scene(sc, replace(fine_problem, order=4))
+    run_exclusion = MA.exclusion_for(sc, sol)
+    assert run_exclusion is not None
+    fine = MR.refined(sc, run_exclusion)
     exclusion = MA.exclusion_for(sc, fine)
     assert exclusion is not None and exclusion.radius == pytest.approx(acc["exclusion"]["radius"])
-    reference = AM.away_maxima(fine, exclusion, 1e-6)
-    reference.update(MA.safety_factor_of(sc, recovery).samples(fine, exclusion.outside))
+    assert np.allclose(exclusion.points, run_exclusion.points)
+    reference = MR.sampled(sc, fine, exclusion, recovery)
     for name in ("von_mises_stem_away", "von_mises_bone_away", "tresca_bone_away", "safety_factor_away"):
-        true = abs(q[name]["value"] - reference[name].value - reference[name].sampling)
-        assert q[name]["error"] >= true, f"{name}: {q[name]['how']}"
+        true = abs(q[name]["value"] - reference[name].value)
+        assert true > 10 * reference[name].sampling, name
+        assert true <= q[name]["error"] <= 10 * true, f"{name}: {q[name]['how']}"
 
 
 def test_report_html_tabulates_the_verdict_with_what_it_counts():
