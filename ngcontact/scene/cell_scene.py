@@ -109,7 +109,9 @@ class LoadSpec:
                                                    "3D (e_xx, e_yy, e_xy), one set per sweep", units="")
     independent: bool = param(False, doc="solve every load on its own from the unloaded cell (no continuation "
                               "from the previous load), so that the loads run in parallel (see [compute]); "
-                              "frictionless contact only")
+                              "frictionless contact only.  Without discretization.tolerance the FE cell holds each "
+                              "load to the default one on its own, as a chained sweep is held (the same "
+                              "results.accuracy); the spectral cell solves them on the scene's grid, not estimated")
 
     def check(self, path: str) -> None:
         if (self.pressure is None) == (self.normal_jump is None):
