@@ -172,8 +172,8 @@ def warn_before_solving(facts: dict[str, float]) -> None:
 
 def method_choice(scene) -> dict[str, Any]:
     """``results.accuracy.method``: the method that solved the scene and why
-    (:class:`~ngcontact.scene.cell_method.MethodChoice`; a scene built without the check: its method only)."""
-    choice = getattr(scene, "method_choice", None)
+    (:class:`~ngcontact.scene.cell_method.MethodChoice`; a scene not built by the loader: its method only)."""
+    choice = scene.method_choice
     if choice is not None:
         return choice.as_dict()
     method = scene.discretization.method

@@ -11,7 +11,7 @@ solved.  Solved by :mod:`ngcontact.drivers.run_cell`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
 from ngcontact.geometry.profile_registry import PROFILES
@@ -23,7 +23,8 @@ from ngcontact.scene.cell_geometry import (CellGeometry, check_features, check_p
 from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import check_selected, closed_interval, nonempty, nonnegative, param, positive
+from ngcontact.scene.schema import (check_selected, closed_interval, derived_field, nonempty, nonnegative, param,
+                                   positive)
 
 GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 #: "none" and the names of the micro friction laws (:data:`ngcontact.laws.friction.FRICTION_LAWS`)
@@ -164,8 +165,13 @@ class CellScene:
                                           "mean and the 95 % band")
     compute: ComputeSpec = param(ComputeSpec(), doc="where independent solves run (loads, ensemble members)")
     base_dir: str = base_dir_field()
-    #: the method that solves the scene and why (``discretization.method`` resolved by :meth:`check`)
-    method_choice: MethodChoice | None = field(default=None, init=False, repr=False, compare=False)
+    #: the method that solves the scene and why (``discretization.method`` resolved by :meth:`resolved`)
+    method_choice: MethodChoice | None = derived_field()
+
+    def resolved(self) -> CellScene:
+        """The scene with its derived field: ``discretization.method = "auto"`` resolved to fe or spectral
+        (:func:`~ngcontact.scene.cell_method.resolve_method`), before anything asks for the method."""
+        return resolve_method(self)
 
     def check_files(self, load) -> None:
         """Read and validate the tabulated profile / height map / measured topography / gap named by the scene.
@@ -223,7 +229,6 @@ class CellScene:
             if self.materials[name].C is not None:
                 raise SceneError(f"materials.{name}.C", "...", "cell scenes take isotropic E, nu")
         dim = self.geometry.dim
-        resolve_method(self)               # "auto" -> fe or spectral, before anything asks for the method
         if self.contact.k_n is None:       # exact contact without a scale: the default of contact.k_n's doc
             object.__setattr__(self.contact, "k_n", exact_scale(self))
         g = self.contact.gap.kind
