@@ -32,14 +32,14 @@ two-scale loop with friction from its cell) solve an ``auto`` cell by fe (:attr:
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TypeVar
 
 from ngcontact.errors import SceneError
 from ngcontact.scene.cell_geometry import flat_interface, small_slope
 from ngcontact.scene.spectral_grid import TOLERANCE_OVER_RTOL
+from ngcontact.scene.sections import CellDiscretization
 
-if TYPE_CHECKING:
-    from ngcontact.scene.cell_scene import CellScene
+D = TypeVar("D", bound=CellDiscretization)
 
 #: the keys only the FE cell reads, by section (the spectral cell has no mesh, no Newton steps, no sparse solve)
 FE_ONLY: dict[str, tuple[str, ...]] = {
@@ -129,14 +129,9 @@ def choose(scene) -> MethodChoice:
     return MethodChoice("spectral", f"a small-slope cell ({small_slope_text(scene)}), no FE-only key set")
 
 
-def resolve_method(scene: CellScene) -> CellScene:
-    """The scene with its ``discretization.method`` resolved: the section's ``method`` the chosen one, and the
-    :class:`MethodChoice` its field ``method_choice`` (a new scene, by ``dataclasses.replace``); a scene
-    already resolved is returned as it is."""
-    if scene.method_choice is not None:
-        return scene
-    choice = choose(scene)
-    d = scene.discretization
-    resolved = replace(d, method=choice.method)
-    object.__setattr__(resolved, "given", d.given)      # the keys the section's table set (not a field of replace)
-    return replace(scene, discretization=resolved, method_choice=choice)
+def resolved_discretization(d: D, choice: MethodChoice) -> D:
+    """The scene's ``[discretization]`` with its ``method`` the chosen one (the scene's new section, by
+    ``dataclasses.replace``; :meth:`ngcontact.scene.cell_scene.CellScene.resolved`)."""
+    out = replace(d, method=choice.method)
+    object.__setattr__(out, "given", d.given)      # the keys the section's table set (not a field of replace)
+    return out

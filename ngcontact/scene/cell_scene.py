@@ -11,13 +11,13 @@ solved.  Solved by :mod:`ngcontact.drivers.run_cell`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.laws.friction import FRICTION_LAWS
 from ngcontact.scene.spectral_grid import TOLERANCE_OVER_RTOL, check_spectral_size
-from ngcontact.scene.cell_method import MethodChoice, resolve_method
+from ngcontact.scene.cell_method import MethodChoice, choose, resolved_discretization
 from ngcontact.scene.cell_geometry import (CellGeometry, check_features, check_profile_heights, flat_interface,
                                           small_slope)
 from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
@@ -169,9 +169,14 @@ class CellScene:
     method_choice: MethodChoice | None = derived_field()
 
     def resolved(self) -> CellScene:
-        """The scene with its derived field: ``discretization.method = "auto"`` resolved to fe or spectral
-        (:func:`~ngcontact.scene.cell_method.resolve_method`), before anything asks for the method."""
-        return resolve_method(self)
+        """The scene with its derived field, before anything asks for the method: ``discretization.method =
+        "auto"`` resolved to fe or spectral (:func:`~ngcontact.scene.cell_method.choose`), a new scene by
+        ``dataclasses.replace``; a scene resolved already is returned as it is."""
+        if self.method_choice is not None:
+            return self
+        choice = choose(self)
+        return replace(self, discretization=resolved_discretization(self.discretization, choice),
+                       method_choice=choice)
 
     def check_files(self, load) -> None:
         """Read and validate the tabulated profile / height map / measured topography / gap named by the scene.
