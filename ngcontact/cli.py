@@ -43,6 +43,7 @@ from ngcontact._version import __version__
 from ngcontact.distributed.vtk_pieces import written
 from ngcontact.distributed.world import launched_rank
 from ngcontact.scene import loader as scene_mod
+from ngcontact.scene.cell_scene import CellScene
 from ngcontact.errors import ConvergenceError, ModelError, NgcontactError, OutputError, SceneError
 
 EXIT_OK, EXIT_SCENE, EXIT_SOLVER = 0, 2, 3
@@ -254,7 +255,7 @@ def _check(path: str) -> int:
         return _classified(path, exc)
     for line in notes:
         print(line)
-    choice = getattr(sc, "method_choice", None)      # a cell scene's discretization.method, resolved
+    choice = sc.method_choice if isinstance(sc, CellScene) else None   # discretization.method, resolved
     if choice is not None:
         print(f"{path}: cell method {choice.statement}")
     print(f"{path}: valid {sc.kind} scene; effects: {', '.join(scene_mod.effects(sc)) or 'none'}")

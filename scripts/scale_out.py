@@ -4,7 +4,8 @@ The batch: the 2D FE cell of a sinusoidal profile (conforming, order 2,
 ``maxh = 0.06``, ``interface_maxh = 0.01``: a solve of well under a second,
 short enough for a worker's start to matter) under 16 pressures with ``load.independent = true``, so each
 load is a member of the batch (:mod:`ngcontact.drivers.cell_members`) that
-meshes and solves its own cell.  Each run is the command a user types,
+meshes and solves its own cell (``discretization.estimate = "off"``: one solve
+per load, not held to the default tolerance).  Each run is the command a user types,
 ``ngcontact run SCENE --out DIR --quiet`` in a fresh interpreter, with
 
 * ``--workers 1`` with ``NGCONTACT_THREADS=1``: one worker on one thread, the
@@ -82,6 +83,7 @@ independent = true
 order = 2
 maxh = 0.06
 interface_maxh = 0.01
+estimate = "off"
 """
 NOOP_TASKS = 200
 REPEATS = 2

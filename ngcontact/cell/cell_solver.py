@@ -119,6 +119,13 @@ class CellSolver(Protocol):
         solved on the scene's discretization with its error estimated (``scene_discretization``), or ``None``
         (the fixed discretization, not estimated)."""
 
+    def holds_loads_alone(self) -> bool:
+        """Whether :meth:`default_accuracy` holds one load solved alone from the unloaded cell (a scene's
+        independent loads, each a member of a batch: :mod:`ngcontact.drivers.cell_members`) to the default
+        tolerance as it holds a sweep, returning its refinement: where the method's estimate and refinement
+        are each load's own.  Where not, independent loads are solved on the scene's discretization, not
+        estimated."""
+
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Solve the loads on refined discretizations until the estimated error meets ``tolerance``.
 
@@ -163,3 +170,37 @@ class CellSolver(Protocol):
 
     def set_state(self, state: Any) -> None:
         """Put a state of :meth:`state` (from a cell built identically, e.g. in a worker) in place."""
+
+
+def joined(parts: list[Refinement]) -> Refinement:
+    """The refinement of a sweep whose loads were held to a tolerance one by one: ``parts`` are the loads'
+    own refinements in the loads' order (:meth:`CellSolver.holds_loads_alone`).
+
+    The lists run over the loads (a part without estimates, scales or per-load records adds empty ones for
+    its loads, so that they stay aligned); the sweep meets the tolerance where every part does, and its
+    solutions are the scene's discretization's only where every part's are; ``how`` is the parts' one
+    statement, or each distinct one with the loads it holds for; the shortfall is that of the unmet part
+    with the largest estimate, the one that sets what meeting the tolerance would take.
+    """
+    def rows(pick) -> list:
+        if not any(pick(p) for p in parts):
+            return []
+        return [row for p in parts for row in (pick(p) or [{} for _ in p.solutions])]
+
+    hows: dict[str, list[int]] = {}
+    k = 0
+    for p in parts:
+        hows.setdefault(p.how, []).extend(range(k, k + len(p.solutions)))
+        k += len(p.solutions)
+    how = next(iter(hows)) if len(hows) == 1 else "; ".join(
+        f"load{'s' if len(ks) > 1 else ''} {', '.join(map(str, ks))}: {h}" for h, ks in hows.items())
+    unmet = [p for p in parts if p.shortfall]
+    worst = max(unmet, key=lambda p: max((max(e.values()) for e in p.estimates if e), default=0.0), default=None)
+    return Refinement(solutions=[s for p in parts for s in p.solutions], estimates=rows(lambda p: p.estimates),
+                      per_load=rows(lambda p: p.per_load), method=parts[-1].method if parts else {},
+                      histories=[h for p in parts for h in (p.histories or [s.newton for s in p.solutions])],
+                      how=how, met=all(p.met for p in parts),
+                      uncontrolled=tuple(dict.fromkeys(u for p in parts for u in p.uncontrolled)),
+                      scales=rows(lambda p: p.scales),
+                      scene_discretization=all(p.scene_discretization for p in parts),
+                      shortfall=worst.shortfall if worst is not None else "")

@@ -228,7 +228,6 @@ def scene_with(scene: CellScene, **sections) -> CellScene:
     """``scene`` with these sections replaced, in the folder of the scene file (its data files' base)."""
     out = replace(scene, **sections)
     object.__setattr__(out, "base_dir", getattr(scene, "base_dir", "."))
-    object.__setattr__(out, "method_choice", getattr(scene, "method_choice", None))
     return out
 
 

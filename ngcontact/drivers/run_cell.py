@@ -33,7 +33,9 @@ budget ended first, and one warning line rather than failed (exit 0);
 (``accuracy.how``).  ``accuracy.method`` states the method that solved
 the cell and why (``discretization.method = "auto"`` resolved: :mod:`ngcontact.scene.cell_method`).  With
 ``load.independent`` every load is solved from the unloaded cell as a member
-of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers.
+of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers, and
+held to the default tolerance on its own where the method holds a load alone
+(the FE cell): the same accuracy, report and warning as the chained sweep's.
 """
 from __future__ import annotations
 
@@ -136,13 +138,16 @@ def warn_unmet(verdict: dict, refinement: Refinement) -> None:
 def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
     """The sweep refined to the scene's tolerance, or held to the default one (the cell's
     :meth:`~ngcontact.cell.cell_solver.CellSolver.default_accuracy`: the spectral cell refined to it, the FE
-    cell estimated on its own discretization; not for independent loads, nor where the caller says not
+    cell estimated on its own discretization and refined where that misses it; independent loads each on its
+    own as a member of a batch, :func:`ngcontact.drivers.cell_members.held`; not where the caller says not
     ``by_default``), else ``None`` (the fixed discretization, not estimated)."""
     tolerance = scene.discretization.tolerance
     if tolerance is not None:
         return cell.refine_to(tolerance, loads, required=True)
-    if not by_default or scene.load.independent or scene.discretization.estimate == "off":
+    if not by_default or scene.discretization.estimate == "off":
         return None
+    if scene.load.independent:
+        return cell_members.held(scene, cell, admissibility.DEFAULT_TOLERANCE)
     return cell.default_accuracy(admissibility.DEFAULT_TOLERANCE, loads)
 
 
@@ -167,8 +172,8 @@ def warn_before_solving(facts: dict[str, float]) -> None:
 
 def method_choice(scene) -> dict[str, Any]:
     """``results.accuracy.method``: the method that solved the scene and why
-    (:class:`~ngcontact.scene.cell_method.MethodChoice`; a scene built without the check: its method only)."""
-    choice = getattr(scene, "method_choice", None)
+    (:class:`~ngcontact.scene.cell_method.MethodChoice`; a scene not built by the loader: its method only)."""
+    choice = scene.method_choice
     if choice is not None:
         return choice.as_dict()
     method = scene.discretization.method

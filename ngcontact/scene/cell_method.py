@@ -7,9 +7,10 @@ solved as two periodic elastic layers with FFTs.  On a small-slope cell both sol
 FE cell's predictor and penalty share are that spectral twin), and the spectral cell refines its grid to the
 default tolerance far faster than the FE cell refines its mesh, so it is the default there.
 
-``method = "auto"`` (the default) is resolved once, when the scene is checked
-(:meth:`ngcontact.scene.cell_scene.CellScene.check`), into a :class:`MethodChoice`: the method and the
-reason in one sentence, which the report states.  The rule, in order:
+``method = "auto"`` (the default) is resolved once, when the scene is built and before its checks
+(:meth:`ngcontact.scene.cell_scene.CellScene.resolved`), into a :class:`MethodChoice`: the method and the
+reason in one sentence, which the report states; the scene holds it as its typed field ``method_choice``.
+The rule, in order:
 
 1. a scene that sets ``discretization.grid`` (only the spectral cell's grid) is spectral; it is refused
    for a cell that is not small-slope, and beside a key only the FE cell reads (:data:`FE_ONLY`);
@@ -31,10 +32,14 @@ two-scale loop with friction from its cell) solve an ``auto`` cell by fe (:attr:
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TypeVar
 
 from ngcontact.errors import SceneError
 from ngcontact.scene.cell_geometry import flat_interface, small_slope
 from ngcontact.scene.spectral_grid import TOLERANCE_OVER_RTOL
+from ngcontact.scene.sections import CellDiscretization
+
+D = TypeVar("D", bound=CellDiscretization)
 
 #: the keys only the FE cell reads, by section (the spectral cell has no mesh, no Newton steps, no sparse solve)
 FE_ONLY: dict[str, tuple[str, ...]] = {
@@ -124,14 +129,9 @@ def choose(scene) -> MethodChoice:
     return MethodChoice("spectral", f"a small-slope cell ({small_slope_text(scene)}), no FE-only key set")
 
 
-def resolve_method(scene) -> None:
-    """Resolve the scene's ``discretization.method`` once: the section's ``method`` becomes the chosen one and
-    the scene keeps the :class:`MethodChoice` (``scene.method_choice``); a scene already resolved is left."""
-    if getattr(scene, "method_choice", None) is not None:
-        return
-    choice = choose(scene)
-    d = scene.discretization
-    resolved = replace(d, method=choice.method)
-    object.__setattr__(resolved, "given", d.given)
-    object.__setattr__(scene, "discretization", resolved)
-    object.__setattr__(scene, "method_choice", choice)
+def resolved_discretization(d: D, choice: MethodChoice) -> D:
+    """The scene's ``[discretization]`` with its ``method`` the chosen one (the scene's new section, by
+    ``dataclasses.replace``; :meth:`ngcontact.scene.cell_scene.CellScene.resolved`)."""
+    out = replace(d, method=choice.method)
+    object.__setattr__(out, "given", d.given)      # the keys the section's table set (not a field of replace)
+    return out

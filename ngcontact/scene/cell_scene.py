@@ -11,19 +11,20 @@ solved.  Solved by :mod:`ngcontact.drivers.run_cell`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, replace
 
 from ngcontact.errors import MISSING, GeometryError, SceneError
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.laws.friction import FRICTION_LAWS
 from ngcontact.scene.spectral_grid import TOLERANCE_OVER_RTOL, check_spectral_size
-from ngcontact.scene.cell_method import MethodChoice, resolve_method
+from ngcontact.scene.cell_method import MethodChoice, choose, resolved_discretization
 from ngcontact.scene.cell_geometry import (CellGeometry, check_features, check_profile_heights, flat_interface,
                                           small_slope)
 from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
                                      check_material_names)
 from ngcontact.scene import mesh_size
-from ngcontact.scene.schema import check_selected, closed_interval, nonempty, nonnegative, param, positive
+from ngcontact.scene.schema import (check_selected, closed_interval, derived_field, nonempty, nonnegative, param,
+                                   positive)
 
 GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 #: "none" and the names of the micro friction laws (:data:`ngcontact.laws.friction.FRICTION_LAWS`)
@@ -109,7 +110,9 @@ class LoadSpec:
                                                    "3D (e_xx, e_yy, e_xy), one set per sweep", units="")
     independent: bool = param(False, doc="solve every load on its own from the unloaded cell (no continuation "
                               "from the previous load), so that the loads run in parallel (see [compute]); "
-                              "frictionless contact only")
+                              "frictionless contact only.  Without discretization.tolerance the FE cell holds each "
+                              "load to the default one on its own, as a chained sweep is held (the same "
+                              "results.accuracy); the spectral cell solves them on the scene's grid, not estimated")
 
     def check(self, path: str) -> None:
         if (self.pressure is None) == (self.normal_jump is None):
@@ -162,8 +165,18 @@ class CellScene:
                                           "mean and the 95 % band")
     compute: ComputeSpec = param(ComputeSpec(), doc="where independent solves run (loads, ensemble members)")
     base_dir: str = base_dir_field()
-    #: the method that solves the scene and why (``discretization.method`` resolved by :meth:`check`)
-    method_choice: MethodChoice | None = field(default=None, init=False, repr=False, compare=False)
+    #: the method that solves the scene and why (``discretization.method`` resolved by :meth:`resolved`)
+    method_choice: MethodChoice | None = derived_field()
+
+    def resolved(self) -> CellScene:
+        """The scene with its derived field, before anything asks for the method: ``discretization.method =
+        "auto"`` resolved to fe or spectral (:func:`~ngcontact.scene.cell_method.choose`), a new scene by
+        ``dataclasses.replace``; a scene resolved already is returned as it is."""
+        if self.method_choice is not None:
+            return self
+        choice = choose(self)
+        return replace(self, discretization=resolved_discretization(self.discretization, choice),
+                       method_choice=choice)
 
     def check_files(self, load) -> None:
         """Read and validate the tabulated profile / height map / measured topography / gap named by the scene.
@@ -221,7 +234,6 @@ class CellScene:
             if self.materials[name].C is not None:
                 raise SceneError(f"materials.{name}.C", "...", "cell scenes take isotropic E, nu")
         dim = self.geometry.dim
-        resolve_method(self)               # "auto" -> fe or spectral, before anything asks for the method
         if self.contact.k_n is None:       # exact contact without a scale: the default of contact.k_n's doc
             object.__setattr__(self.contact, "k_n", exact_scale(self))
         g = self.contact.gap.kind

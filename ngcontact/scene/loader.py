@@ -13,7 +13,7 @@ import os
 
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.scene.kinds import KINDS
-from ngcontact.scene.schema import MAX_SCENE_BYTES, build
+from ngcontact.scene.schema import MAX_SCENE_BYTES, build, is_key
 from ngcontact.scene.sections import check_input_file, resolve
 
 try:  # Python >= 3.11
@@ -167,7 +167,7 @@ def as_dict(scene) -> dict:
 
 def _plain(obj):
     if dataclasses.is_dataclass(obj):
-        return {f.name: _plain(getattr(obj, f.name)) for f in dataclasses.fields(obj) if f.init}
+        return {f.name: _plain(getattr(obj, f.name)) for f in dataclasses.fields(obj) if is_key(f)}
     if isinstance(obj, dict):
         return {k: _plain(v) for k, v in obj.items()}
     if isinstance(obj, tuple):

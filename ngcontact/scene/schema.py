@@ -19,6 +19,12 @@ its table set (:data:`GIVEN`), so that a rule can tell a key the scene wrote
 from one left at its default (``discretization.method = "auto"``,
 :mod:`ngcontact.scene.cell_method`).
 
+A field the scene derives from its keys rather than reads from its file
+(:func:`derived_field`: a cell scene's resolved ``discretization.method``) is no
+key: :func:`build` leaves it out of the table and, where the dataclass has a
+method ``resolved(self)``, builds the instance that method returns (the scene
+with its derived fields, by ``dataclasses.replace``) before the checks.
+
 Cross-field rules live in a method ``check(self, path)`` of the dataclass,
 called after construction.  :func:`describe` walks the same metadata to write
 the scene-file reference of the README, so documentation and validation come
@@ -87,6 +93,22 @@ GIVEN = "given"
 def given_field():
     """The field :data:`GIVEN` of a section: the keys its table set, filled in by :func:`build`."""
     return dataclasses.field(default=frozenset(), init=False, repr=False, compare=False)
+
+
+#: the metadata flag of a :func:`derived_field`
+DERIVED = "derived"
+
+
+def derived_field():
+    """A field the scene derives from its keys (module docstring): typed, set through the constructor or
+    ``dataclasses.replace`` by the dataclass's ``resolved``, ``None`` until then; not a key of the file, the
+    reference or the report's scene."""
+    return dataclasses.field(default=None, repr=False, compare=False, metadata={DERIVED: True})
+
+
+def is_key(f: dataclasses.Field) -> bool:
+    """Whether field ``f`` is a key of the scene file (not a loader's or a :func:`derived_field`)."""
+    return f.init and not f.metadata.get(DERIVED, False)
 
 
 def _named(text: str, fn: Callable[[Any], bool]) -> Check:
@@ -185,7 +207,7 @@ def build(cls, data: Any, path: str = ""):
     if not isinstance(data, dict):
         raise SceneError(path or "<scene>", data, "must be a table")
     hints = typing.get_type_hints(cls)
-    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    fields = {f.name: f for f in dataclasses.fields(cls) if is_key(f)}
     unknown = sorted(set(data) - set(fields))
     if unknown:
         key = unknown[0]
@@ -207,6 +229,9 @@ def build(cls, data: Any, path: str = ""):
     obj = cls(**values)
     if any(f.name == GIVEN and not f.init for f in dataclasses.fields(cls)):
         object.__setattr__(obj, GIVEN, frozenset(values))
+    resolved = getattr(obj, "resolved", None)
+    if callable(resolved):
+        obj = resolved()
     check = getattr(obj, "check", None)
     if callable(check):
         check(path)
@@ -326,7 +351,7 @@ def describe(cls, path: str = "") -> list[dict]:
     rows = []
     hints = typing.get_type_hints(cls)
     for f in dataclasses.fields(cls):
-        if not f.init:
+        if not is_key(f):
             continue
         tp = hints[f.name]
         key = _join(path, f.name)

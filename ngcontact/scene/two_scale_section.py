@@ -69,7 +69,7 @@ def load_cell(load, path: str, rel: str, overrides: dict, spec: TwoScaleSpec, sh
     needs the FE cell: a frictional cell whose ``method = "auto"`` chose the spectral cell is solved by fe
     (:mod:`ngcontact.scene.cell_method`)."""
     cell = _loaded(load, path, rel, overrides, spec, spec.cell_method)
-    choice = getattr(cell, "method_choice", None)
+    choice = cell.method_choice
     if (shear_from_cell and spec.cell_method is None and choice is not None and choice.automatic
             and choice.method != "fe" and cell.contact.friction != "none"):
         cell = _loaded(load, path, rel, overrides, spec, "fe", ("interface.friction", "from_cell"))

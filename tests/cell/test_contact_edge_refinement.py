@@ -13,33 +13,13 @@ from ngcontact.scene.loader import load
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
+from sinusoid_cell import sinusoid_cell
+
 PSTAR = westergaard_p_star(e_star(1.0, 0.3, 1.0, 0.3), 0.01, 1.0)
 PRESSURE = 0.5 * PSTAR
 
-SCENE = f"""\
-kind = "cell"
-[materials.solid]
-E = 1.0
-nu = 0.3
-[bodies]
-rough = "solid"
-counter = "solid"
-[geometry]
-profile = "flat3d"
-h_rough = 1.0
-h_counter = 1.0
-[contact]
-k_n = 1.0e4
-enforcement = "exact"
-friction = "none"
-gap = {{ kind = "sinusoid", h = 0.01 }}
-[load]
-pressure = [{PRESSURE!r}]
-[discretization]
-order = 2
-maxh = 0.4
-interface_maxh = 0.1
-"""
+SCENE = sinusoid_cell(k_n="1.0e4", pressure=repr(PRESSURE), profile="flat3d", friction="none",
+                      discretization="order = 2\nmaxh = 0.4\ninterface_maxh = 0.1")
 
 
 def _interface_sizes(mesh) -> np.ndarray:

@@ -23,31 +23,11 @@ from ngcontact.scene.loader import from_dict
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
 
+from sinusoid_cell import sinusoid_cell
+
 PRESSURE = 0.0034523            # p / p* = 0.2
 #: Westergaard's sinusoid with exact contact on a coarse order-1 mesh: the contact fraction 0.40 against 0.295
-SCENE = f"""\
-kind = "cell"
-[materials.solid]
-E = 1.0
-nu = 0.3
-[bodies]
-rough = "solid"
-counter = "solid"
-[geometry]
-profile = "flat"
-h_rough = 1.0
-h_counter = 1.0
-[contact]
-k_n = 1.0e4
-enforcement = "exact"
-gap = {{ kind = "sinusoid", h = 0.01 }}
-[load]
-pressure = [{PRESSURE}]
-[discretization]
-order = 1
-maxh = 0.4
-interface_maxh = 0.1
-"""
+SCENE = sinusoid_cell(k_n="1.0e4", pressure=f"{PRESSURE}", discretization="order = 1\nmaxh = 0.4\ninterface_maxh = 0.1")
 
 
 def _exact() -> float:

@@ -12,9 +12,12 @@ A scene that states no tolerance is held to the default one (:meth:`FECell.defau
 same mesh (:mod:`ngcontact.cell.fe.saturation`), reported where that meets the tolerance, else refined as a
 stated tolerance refines it (:meth:`FECell.default_refinement`) within the scene's budget of unknowns
 (``discretization.budget_dofs``, default :data:`DEFAULT_DOFS`); with ``discretization.estimate =
-"estimate"`` it is estimated and not refined.  Refinement to a tolerance not required
-(:meth:`FECell.refine_to` with ``required = False``) is bounded so too and flagged when over (with the
-scene's level alone: not estimated).  A stated tolerance refines within :data:`MAX_DOFS`.
+"estimate"`` it is estimated and not refined.  A load solved alone (independent loads) is held so on its own
+(:meth:`FECell.holds_loads_alone`): its estimate is one order more on the same mesh for that load, its
+refinement meshes graded towards its own contact edges or that load on the refiner's finer discretizations.
+Refinement to a tolerance not required (:meth:`FECell.refine_to` with ``required = False``) is bounded so
+too and flagged when over (with the scene's level alone: not estimated).  A stated tolerance refines within
+:data:`MAX_DOFS`.
 
 The response at a mean pressure ``p``: ``k_n0`` is eq. 34 on the real contact set, ``k_n`` times the
 contact fraction (located by the roots of the penetration in 2D) on a flat frictionless cell, else the
@@ -54,6 +57,11 @@ log = logging.getLogger(__name__)
 DEFAULT_DOFS = {2: 120_000, 3: 40_000}
 #: the most dofs of a refined discretization at a stated tolerance (per dimension)
 MAX_DOFS = {2: 1_000_000, 3: 400_000}
+
+
+def _named(k: int, n: int) -> str:
+    """The prefix of load ``k``'s remark in a sweep of ``n`` loads (none for a load alone)."""
+    return f"load {k} " if n > 1 else ""
 
 
 class FECell:
@@ -192,6 +200,9 @@ class FECell:
         has a recipe of finer discretizations (:meth:`default_refinement`)."""
         return self.refine_default and self.default_refinement() != "none"
 
+    def holds_loads_alone(self) -> bool:
+        return True     # a load's estimate and refinement need no other load (module docstring)
+
     def default_accuracy(self, tolerance: float, loads: list[CellLoad]) -> Refinement | None:
         """The sweep held to the default ``tolerance``: the scene's own answer and its error from one order
         more on the same mesh (:mod:`ngcontact.cell.fe.saturation`), refined within :attr:`budget` where that
@@ -238,8 +249,8 @@ class FECell:
             log.info("load %d: contact fraction %.10g after %d grading steps", k,
                      out[-1].solution.results["contact_fraction"], len(out[-1].history) - 1)
         self._problem = out[-1].problem
-        remarks = [f"load {k} {g.remark}" for k, g in enumerate(out) if g.remark]
-        remarks += [f"load {k} stopped: {g.stopped}" for k, g in enumerate(out) if g.stopped]
+        remarks = [f"{_named(k, len(out))}{g.remark}" for k, g in enumerate(out) if g.remark]
+        remarks += [f"{_named(k, len(out))}stopped: {g.stopped}" for k, g in enumerate(out) if g.stopped]
         return Refinement(solutions=[g.solution for g in out], estimates=[g.estimate for g in out],
                           per_load=[{"mesh_history": g.history,
                                      # the Newton steps of every level the load was solved on

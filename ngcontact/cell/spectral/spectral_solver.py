@@ -96,6 +96,12 @@ class SpectralCellSolver:
         finer grids is known."""
         return self.make_cell is not None and self.max_points is not None
 
+    def holds_loads_alone(self) -> bool:
+        """No: the default refinement chooses one grid for the sweep (``results.method``'s grid and its
+        levels), so independent loads are solved on the scene's grid, not estimated (the way to solve a given
+        grid alone)."""
+        return False
+
     def default_accuracy(self, tolerance: float, loads: list[CellLoad]) -> Refinement | None:
         """Refined to the default ``tolerance`` within the default size bound where the recipe of finer grids
         is known (:meth:`refine_to`), else ``None``."""
