@@ -57,6 +57,7 @@ def _agree(chained: dict, alone: dict) -> None:
             assert diff <= bound, (k, name, diff, bound)
 
 
+@pytest.mark.slow
 def test_independent_loads_spend_the_budget_and_say_so_as_the_chained_sweep(tmp_path, caplog):
     """budget_dofs = 1000: the load at p / p* = 0.2 stops at its second graded mesh in both modes; the report
     says not met with the same shortfall and the same single warning line; the full-contact load, alone, keeps
