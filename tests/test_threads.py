@@ -16,10 +16,10 @@ def _run(tmp_path, monkeypatch, value, name):
     else:
         monkeypatch.setenv("NGCONTACT_THREADS", value)
     out = tmp_path / name
-    # threads, not accuracy: the scene's own discretization, estimated and not refined
+    # threads, not accuracy: the scene's own discretization, not estimated (no second sweep)
     path = tmp_path / f"{name}.toml"
     path.write_text(open(SCENE, encoding="utf-8").read().replace("[discretization]\n",
-                                                                   '[discretization]\nestimate = "estimate"\n'))
+                                                                   '[discretization]\nestimate = "off"\n'))
     assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 0
     return json.loads((out / "report.json").read_text())
 

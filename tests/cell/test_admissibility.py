@@ -124,7 +124,7 @@ def test_the_slopes_of_westergaard_s_gap():
 
 def _height_map_scene(tmp_path, interface_maxh):
     path = tmp_path / "map.toml"
-    path.write_text(fe_height_map(interface_maxh) + 'estimate = "estimate"\n', encoding="utf-8")
+    path.write_text(fe_height_map(interface_maxh) + 'estimate = "off"\n', encoding="utf-8")
     return path
 
 
