@@ -14,8 +14,8 @@ import os
 import shutil
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-KEYS = ("code", "scene", "size", "refinements", "order", "ranks", "bddc", "ndof", "work_s", "wall_s", "newton",
-        "cg_iterations", "coarse_s", "peak_mb_rank0", "peak_mb_parts_max", "peak_mb_each")
+KEYS = ("code", "scene", "size", "refinements", "order", "ranks", "threads", "bddc", "ndof", "work_s", "wall_s",
+        "newton", "cg_iterations", "coarse_s", "peak_mb_rank0", "peak_mb_parts_max", "peak_mb_each")
 #: the folder of the published rows, phase tables and the note of how they were measured (module docstring)
 ARCHIVE = os.path.join(ROOT, "docs", "benchmarks", "macro_mpi")
 ROWS, PHASES, MEASURED = "macro_mpi_scaling.csv", "macro_mpi_phases.csv", "measured_by.md"
@@ -33,7 +33,7 @@ def read_rows(path: str) -> list[dict]:
         rows = list(csv.DictReader(fh))
     numbers = {"size": float, "refinements": int, "order": int, "ranks": int, "ndof": int, "work_s": float,
                "wall_s": float, "newton": int, "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
-    defaults = {"bddc": "default", "coarse_s": "", "order": 2, "code": ""}   # rows measured before these columns
+    defaults = {"bddc": "default", "coarse_s": "", "order": 2, "code": "", "threads": ""}   # rows before these columns
     return [{k: numbers[k](row.get(k) or 0) if k in numbers else row.get(k) or defaults.get(k, "") for k in KEYS}
             for row in rows]
 

@@ -223,7 +223,8 @@ def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0,
     stages = {k: v for k, v in rep["timings"].items() if k != "total"}
     parts = peaks[1:] if ranks > 1 else peaks
     return {"code": code, "scene": name, "size": size, "refinements": refinements,
-            "order": order if name != "femur" else 2, "ranks": ranks, "bddc": bddc or "default",
+            "order": order if name != "femur" else 2, "ranks": ranks, "threads": rep.get("threads", ""),
+            "bddc": bddc or "default",
             "ndof": rep["ndof"],
             "work_s": round(sum(stages.values()), 2), "wall_s": round(wall, 2),
             "newton": rep["solver"]["iterations"],
@@ -288,7 +289,8 @@ NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2 unless `o
         "are one part and 3 ranks two parts. "
         "`work_s`: the stages from meshing to post-processing (one process without its discretization error "
         "estimate, which a distributed run does not make either). `peak_mb_each`: every rank's peak resident "
-        "memory, rank 0 first. `code`: the commit measured. "
+        "memory, rank 0 first. `code`: the commit measured. `threads`: NGSolve's threads per rank (one process: "
+        "the cores, 2, unless `NGCONTACT_THREADS` says otherwise; N ranks share them; empty: not recorded). "
         "`bddc`: the flags of NGSolve's BDDC (`default`: none; its coarse problem, the vertices and the "
         "interface surface, factorized by a sparse Cholesky, on rank 0 under MPI); rows with other flags "
         "compare the coarse solves NGSolve offers at one size: `coarsetype` `local` (a Jacobi sweep instead "
