@@ -19,11 +19,11 @@ stops when the Euclidean norm of that recursive residual is at most
 (:data:`ngcontact.solvers.newton.LINEAR_MARGIN`): the test that follows
 then passes with that margin, in one process as on N ranks, and the
 number of iterations differs only where round-off moves the recursive
-residual across ``reach`` (an iteration more or fewer).  Without ``reach``
+residual across ``reach`` (by a few iterations: CG's iterates in one
+process and on the ranks drift apart with round-off).  Without ``reach``
 it is NGSolve's CG.
 """
 from __future__ import annotations
-
 
 import ngsolve as ng
 from ngsolve.krylovspace import CGSolver
