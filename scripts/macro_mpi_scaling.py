@@ -42,14 +42,22 @@ across machines is not in the model).
     python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--femur 1 1.5]
                                         [--refined MAXH:K ...] [--ranks 1 2 3] [--bddc JSON ...]
                                         [--order P] [--guard START_GB FLOOR_GB] [--code LABEL]
-                                        [--rows-from CSV ...] [--phases-from CSV ...] [--publish]
+                                        [--rows-from CSV|DIR ...] [--phases-from CSV ...]
+                                        [--measured-by MD] [--publish]
 
 ``--bddc``: flags of NGSolve's BDDC to compare (``linear_solver.BDDC_FLAGS``
 in each run's processes), each run with each; per run also the time the
 ranks holding the mesh spend in BDDC's coarse solves.
 
 Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_phases.csv``, ``OUT/macro_mpi_model.csv`` and ``.png``
-(default ``results/macro_mpi_scaling``).
+(default ``results/macro_mpi_scaling``).  ``--rows-from``: no runs, the rows
+of earlier ones (their CSV files, or a folder holding ``macro_mpi_scaling.csv``,
+``macro_mpi_phases.csv`` and ``measured_by.md``, the Markdown note of how they
+were measured; ``--measured-by``: a further such note).  ``--publish`` keeps
+what it publishes in the folder ``macro_mpi_rows.ARCHIVE`` (docs/benchmarks/macro_mpi), so
+that the sections are published again from it, in any clone, by
+``--rows-from docs/benchmarks/macro_mpi --publish`` (a short command in their
+stamp), each row's ``code`` naming the commit it measured.
 """
 from __future__ import annotations
 
@@ -65,13 +73,12 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+from macro_mpi_rows import KEYS, MEASURED, PHASES, ROWS, inputs, keep, read_rows, read_table  # noqa: E402
 from rank_memory import PHASE_KEYS, PHASE_TABLE_KEYS, MemoryGuard, Phases, phase_rows, phase_table  # noqa: E402
 
 from ngcontact.output.writer import write_csv  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-KEYS = ("code", "scene", "size", "refinements", "order", "ranks", "bddc", "ndof", "work_s", "wall_s", "newton",
-        "cg_iterations", "coarse_s", "peak_mb_rank0", "peak_mb_parts_max", "peak_mb_each")
 #: NGSolve's timer of BDDC's coarse solve (the wirebasket's), as the ranks holding the mesh see it
 COARSE_TIMER = "Apply BDDC preconditioner - wb solve"
 MODEL_KEYS = ("ndof", "ranks", "dofs_per_part", "part_gb", "rank0_gb", "solve_s_estimate")
@@ -216,32 +223,14 @@ def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0,
     stages = {k: v for k, v in rep["timings"].items() if k != "total"}
     parts = peaks[1:] if ranks > 1 else peaks
     return {"code": code, "scene": name, "size": size, "refinements": refinements,
-            "order": order if name != "femur" else 2, "ranks": ranks, "bddc": bddc or "default",
+            "order": order if name != "femur" else 2, "ranks": ranks, "threads": rep.get("threads", ""),
+            "bddc": bddc or "default",
             "ndof": rep["ndof"],
             "work_s": round(sum(stages.values()), 2), "wall_s": round(wall, 2),
             "newton": rep["solver"]["iterations"],
             "cg_iterations": sum(rep["solver"]["linear"].get("cg_iterations", [])), "coarse_s": round(max(coarse), 2),
             "peak_mb_rank0": peaks[0], "peak_mb_parts_max": max(parts),
             "peak_mb_each": " ".join(f"{p:g}" for p in peaks), "tag": tag}
-
-
-def read_table(path: str) -> list[dict]:
-    """The rows of a CSV file as dicts of strings."""
-    import csv
-    with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
-
-
-def read_rows(path: str) -> list[dict]:
-    """The rows of a ``macro_mpi_scaling.csv`` written by an earlier run."""
-    import csv
-    with open(path, newline="") as fh:
-        rows = list(csv.DictReader(fh))
-    numbers = {"size": float, "refinements": int, "order": int, "ranks": int, "ndof": int, "work_s": float,
-               "wall_s": float, "newton": int, "cg_iterations": int, "peak_mb_rank0": float, "peak_mb_parts_max": float}
-    defaults = {"bddc": "default", "coarse_s": "", "order": 2, "code": ""}   # rows measured before these columns
-    return [{k: numbers[k](row.get(k) or 0) if k in numbers else row.get(k) or defaults.get(k, "") for k in KEYS}
-            for row in rows]
 
 
 def model(data: list[dict], ranks: int = 64) -> list[dict]:
@@ -300,7 +289,8 @@ NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2 unless `o
         "are one part and 3 ranks two parts. "
         "`work_s`: the stages from meshing to post-processing (one process without its discretization error "
         "estimate, which a distributed run does not make either). `peak_mb_each`: every rank's peak resident "
-        "memory, rank 0 first. `code`: the commit measured. "
+        "memory, rank 0 first. `code`: the commit measured. `threads`: NGSolve's threads per rank (one process: "
+        "the cores, 2, unless `NGCONTACT_THREADS` says otherwise; N ranks share them; empty: not recorded). "
         "`bddc`: the flags of NGSolve's BDDC (`default`: none; its coarse problem, the vertices and the "
         "interface surface, factorized by a sparse Cholesky, on rank 0 under MPI); rows with other flags "
         "compare the coarse solves NGSolve offers at one size: `coarsetype` `local` (a Jacobi sweep instead "
@@ -336,7 +326,7 @@ MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the l
               "remove it (NGSolve's own, MUMPS or hypre, is not built into its wheels, and its AMG of the "
               "coarse problem, `coarsetype` `h1amg`, refuses a distributed matrix). Its line is fitted to sizes "
               "close together and understates large runs, whose coarse factorization grows faster than linearly "
-              "(the attempt at 2M dofs noted above).")
+              f"(the attempt at 2M dofs in [{MEASURED}](benchmarks/macro_mpi/{MEASURED})).")
 
 
 def write_and_publish(args, data: list[dict], work: str) -> None:
@@ -357,7 +347,10 @@ def write_and_publish(args, data: list[dict], work: str) -> None:
     for m in rows:
         print(" ".join(f"{k}={m[k]}" for k in MODEL_KEYS))
     if args.publish:
-        measured = f" The rows were measured by {args.measured_by}." if args.measured_by else ""
+        notes = args.notes + ([args.measured_by] if args.measured_by else [])
+        keep(csv_path, phases_path if tables else None, notes)
+        measured = (f" How the rows of each `code` were measured, and what they show: "
+                    f"[{MEASURED}](benchmarks/macro_mpi/{MEASURED})." if notes else "")
         benchmark_doc.publish("macro_mpi_scaling", "The 3D press fit and femur on 1, 2 and 3 MPI ranks", csv_path,
                               note=NOTE + measured, png=png)
         if tables:
@@ -389,9 +382,12 @@ def main(argv=None) -> int:
                     "commit)")
     ap.add_argument("--phases-from", nargs="+", default=[], metavar="CSV",
                     help="the phase tables (RUN_phase_table.csv) of earlier runs to publish with these runs'")
-    ap.add_argument("--rows-from", nargs="+", default=[], metavar="CSV",
-                    help="no runs: the rows of these CSV files of earlier runs (e.g. a large size run apart)")
-    ap.add_argument("--measured-by", default="", help="with --rows-from: the commands that measured the rows")
+    ap.add_argument("--rows-from", nargs="+", default=[], metavar="CSV|DIR",
+                    help="no runs: the rows of these CSV files of earlier runs (e.g. a large size run apart), or "
+                         f"of folders holding {ROWS}, {PHASES} and {MEASURED} (e.g. docs/benchmarks/macro_mpi)")
+    ap.add_argument("--measured-by", default="", metavar="MD",
+                    help="with --rows-from: a Markdown file saying how its CSV files' rows were measured, kept with "
+                         "the folders' notes")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     args.code = args.code or benchmark_doc.git_commit()
@@ -399,7 +395,9 @@ def main(argv=None) -> int:
     os.makedirs(work, exist_ok=True)
     runs = [("press_fit", h, 0) for h in args.maxh] + [("femur", f, 0) for f in args.femur] + \
         [("press_fit_refined", float(r.split(":")[0]), int(r.split(":")[1])) for r in args.refined]
-    data = [row for path in args.rows_from for row in read_rows(path)]
+    rows_from, phases_from, args.notes = inputs(args.rows_from)
+    args.phases_from = phases_from + args.phases_from
+    data = [row for path in rows_from for row in read_rows(path)]
     for name, size, k in ([] if args.rows_from else runs):
         for r, flags in ((r, f) for r in args.ranks for f in args.bddc):
             guard = MemoryGuard(*args.guard) if args.guard else None

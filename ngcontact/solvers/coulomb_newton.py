@@ -225,7 +225,7 @@ class _Record:
         out = self.res if out is None else out
         self.residual_form.Apply(vec, out)
         mask_fixed(out, self.fixed)
-        return math.sqrt(max(ng.InnerProduct(out, out), 0.0))
+        return out.Norm()          # not InnerProduct(out, out): see newton._Iteration.residual
 
     def state(self) -> float:
         """Freeze the threshold at the iterate, return ``|R|`` (into ``self.res``); the energy and the largest

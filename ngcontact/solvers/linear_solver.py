@@ -42,7 +42,10 @@ definite on the free dofs.  Two ways:
   Eisenstat-Walker), never below ``rtol = 1e-10``; ``forcing = False``
   solves every step to ``rtol``.  The forcing saves many more CG
   iterations than the Newton step it may add costs, and leaves the
-  contact fraction the same to round-off.
+  contact fraction the same to round-off.  The linear solve of a
+  quadratic energy stops instead on the Euclidean residual that Newton's
+  test measures (:class:`~ngcontact.solvers.residual_cg.ResidualCG`,
+  ``TangentSolve.apply(reach=...)``).
 * ``"auto"``: in 3D iterative from ``threshold`` free dofs on (default
   ``AUTO_THRESHOLD``), direct below; in 2D direct.  The threshold lies
   where BDDC-CG overtakes the factorization on the 3D bisinusoid cell and
@@ -168,15 +171,17 @@ class LinearSolver:
         if pre is None:
             raise RuntimeError("LinearSolver.register(form) must come before the form's first assembly")
         record = self._kept_preconditioner(form)
-        from ngsolve.krylovspace import CGSolver, GMResSolver
-        krylov = CGSolver if symmetric else GMResSolver
+        from ngsolve.krylovspace import GMResSolver
+
+        from ngcontact.solvers.residual_cg import ResidualCG
+        krylov = ResidualCG if symmetric else GMResSolver
         self.methods.add("cg+bddc" if symmetric else "gmres+bddc")
         tol = self.rtol
         if symmetric and self.forcing and forcing is not None:
             tol = max(self.rtol, forcing)
-        self.tolerances.append(tol)
-        return TangentSolve(self, krylov(form.mat, pre.mat, tol=tol, maxiter=self.max_iter,
-                                         printrates=False), counted=True, record=record, decades=-math.log10(tol))
+        extra = {"freedofs": freedofs} if symmetric else {}
+        return TangentSolve(self, krylov(form.mat, pre.mat, tol=tol, maxiter=self.max_iter, printrates=False,
+                                         **extra), counted=True, record=record, tol=tol)
 
     def preconditioned(self, form: ng.BilinearForm) -> bool:
         """Whether a preconditioner is registered with ``form`` (rebuilt at each of its assemblies)."""
@@ -289,29 +294,37 @@ def forcing_term(rnorm: float, previous: float | None, eta_previous: float | Non
 
 
 class TangentSolve:
-    """``out = K^-1 rhs`` by one factorization or by CG; CG's iterations go to the owner's record (and to
-    ``record``, the preconditioner's: ``[iterations per decade after its build, last ones]``, for a
-    solve to ``decades`` decades)."""
+    """``out = K^-1 rhs`` by one factorization or by CG to the relative tolerance ``tol``; CG's iterations
+    and tolerance go to the owner's record, one entry per solve (and to ``record``, the preconditioner's:
+    ``[iterations per decade after its build, last ones]``)."""
 
     def __init__(self, owner: LinearSolver, inverse, counted: bool, record: list | None = None,
-                 decades: float = 1.0):
-        self.owner, self.inverse, self.counted, self.record = owner, inverse, counted, record
-        self.decades = max(decades, 1.0)
+                 tol: float = 0.1):
+        self.owner, self.inverse, self.counted, self.record, self.tol = owner, inverse, counted, record, tol
 
-    def apply(self, rhs, out) -> None:
+    def apply(self, rhs, out, reach: float | None = None) -> None:
+        """``out = K^-1 rhs``; with ``reach``, CG stops once the Euclidean norm of ``rhs - K out`` is at most
+        ``reach`` (:class:`~ngcontact.solvers.residual_cg.ResidualCG`: a linear solve of Newton's iteration,
+        judged by that norm); a factorization ignores it."""
         self.owner.solves += 1
+        tol = self.tol
+        if self.counted and reach is not None and hasattr(self.inverse, "reach"):
+            self.inverse.reach = reach
+            size = rhs.Norm()
+            tol = reach / size if size > 0 else 1.0
         out.data = self.inverse * rhs
         if not self.counted:
             return
         its = int(self.inverse.iterations)
         self.owner.iterations.append(its)
+        self.owner.tolerances.append(tol)
         if self.record is not None:
-            rate = max(its, 1) / self.decades
+            rate = max(its, 1) / max(-math.log10(tol), 1.0)
             if self.record[0] is None:
                 self.record[0] = rate
             self.record[1] = rate
         if its >= self.owner.max_iter:
-            raise ConvergenceError(f"preconditioned CG did not reach rtol {self.owner.rtol:g} in "
+            raise ConvergenceError(f"preconditioned CG did not reach its relative tolerance {tol:g} in "
                                    f"{self.owner.max_iter} iterations (solver.linear = 'iterative'); "
                                    "use solver.linear = 'direct'", {"cg_iterations": list(self.owner.iterations)})
 

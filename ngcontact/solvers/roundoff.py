@@ -49,9 +49,11 @@ def roundoff_floors(mat, vec, fixed, energy: float = 0.0) -> tuple[float, float]
     ``ROUNDOFF eps (|energy| + |u| . |K| |u| / 2)``, the size of the terms
     whose sum it is.  ``K`` may be stored as its lower triangle (symmetric
     storage).  A matrix and vector distributed over MPI ranks (NGSolve's
-    ``ParallelMatrix``) give each rank's local part; the sums are added over
-    the ranks, so that every rank stops where the others do (dofs shared by
-    ranks count once per rank: an estimate all the same).
+    ``ParallelMatrix``) give each rank's local part ``K_r``: ``|K_r| |u|``
+    summed over the ranks is the product with ``sum_r |K_r|`` (``|K|`` where
+    no two ranks' elements add to one entry, as on 2 ranks: one part), its
+    norm taken with each dof once (:func:`summed_norm`), so that every rank
+    stops where the others do, and where one process does.
     """
     u = np.abs(vec.FV().NumPy())
     m = abs_product(local_matrix(mat), u)
@@ -59,7 +61,20 @@ def roundoff_floors(mat, vec, fixed, energy: float = 0.0) -> tuple[float, float]
     um = ranks_sum(vec, float(np.dot(u, m)))
     energy_floor = eps * (abs(energy) + 0.5 * um)
     m[fixed] = 0.0
-    return eps * float(np.sqrt(ranks_sum(vec, float(np.dot(m, m))))), energy_floor
+    return eps * summed_norm(vec, m), energy_floor
+
+
+def summed_norm(vec, local: np.ndarray) -> float:
+    """``|sum_r local_r|``: the norm of the vector whose entries are ``local`` summed over the MPI ranks
+    ``vec`` is distributed on, each dof counted once (``|local|`` in one process)."""
+    comm = getattr(vec, "comm", None)
+    if comm is None or comm.size == 1:
+        return float(np.linalg.norm(local))
+    import ngsolve as ng
+    parts = vec.CreateVector()
+    parts.FV().NumPy()[:] = local
+    parts.SetParallelStatus(ng.la.PARALLEL_STATUS.DISTRIBUTED)
+    return float(parts.Norm())
 
 
 #: stored entries of a matrix taken at a time by :func:`abs_product`
