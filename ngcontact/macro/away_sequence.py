@@ -130,7 +130,7 @@ GROWING = AGREE[1]
 #: the safety factor away from the singular points of a solution, given which interface points count
 Safety = Callable[[MacroSolution, Callable[[np.ndarray], np.ndarray]], dict[str, DE.Sample]]
 #: why a point where a maximum away grows with the levels joins the singular points (:func:`grown`)
-GROWN = "the stress grows there with every local refinement"
+GROWN = "the stress grows there with every refinement"
 #: whether a location lies next to the region around the singular set (:func:`beside`)
 Beside = Callable[[tuple[float, ...] | None], bool]
 
@@ -211,9 +211,10 @@ def judged(found: list[DE.Estimate], own: dict[str, DE.Sample], finer: list[dict
 
 
 def grown(found: list[DE.Estimate], exclusion: AM.Exclusion | None, mesh: ng.Mesh) -> list[tuple[float, ...]]:
-    """The points outside the region around the singular set where a maximum away of ``found`` grows with
-    the levels (:func:`judged`), each at the vertex of ``mesh`` nearest to it (the singular point of the
-    element holding it), none within the radius of another."""
+    """The points outside the region around the singular set where a maximum away of ``found`` is singular
+    (it grows with the levels, :func:`judged`, or with the order at a corner of the boundary,
+    :func:`ngcontact.macro.discretization_error.estimate`), each at the vertex of ``mesh`` nearest to it
+    (the singular point of the element holding it), none within the radius of another."""
     if exclusion is None:
         return []
     pts = np.array([mesh[ng.NodeId(ng.VERTEX, i)].point for i in range(mesh.nv)])
