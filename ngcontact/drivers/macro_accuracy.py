@@ -30,9 +30,17 @@ estimated as the others; a mesh-dependent maximum with such a counterpart is lis
 the tubes is mesh dependent (:func:`ngcontact.macro.away_maxima.inside_tubes`), and one where the
 interface ends closed as in 2D.  A two-scale run reports the maxima away as a macro run does: their
 neighbouring orders and local levels are solved with the loop's converged law, which is pointwise in the
-closure (a table of the cell's response), so it holds on any mesh; its maxima over whole bodies keep the
-order ladder's judgement alone (neither the corner check nor the closed ends), as before, so they stay
-counted beside their counterparts unless the ladder finds them singular.
+closure (a table of the cell's response), so it holds on any mesh; its maxima over whole bodies and its
+safety factor take neither the corner check nor the closed ends, and are judged by the same local levels
+as their counterparts away (:mod:`ngcontact.macro.away_sequence`, "The maxima over whole bodies"), so
+that a maximum away is never reported above its body's maximum of the same level.
+
+Where a maximum away grows with the local levels at a point outside the balls (2D), as at a kink of the
+gap of a closed interface much stiffer than its bodies over the element size (the two-scale femur's
+cone-cylinder corner, where the converged cell law is tabulated), that point joins the singular points
+and every quantity is judged once more with it (:func:`judged`: the orders and levels solved again,
+about as long as the first judgement; once, so a point found on the second pass leaves its maximum away
+mesh dependent).
 
 A counted quantity whose relative error exceeds the tolerance, or has none (not converging, a stress
 singularity), marks the verdict as not met and is said in one warning line.
@@ -112,7 +120,7 @@ def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution]
     problem, ppe = sol.problem, scene.output.points_per_element
     own = DE.headlines(sol, ppe, component, dense_inset)
     component = next(n for n in own if n.startswith("resultant_")).removeprefix("resultant_")
-    own.update(_added(sol, safety_factor, exclusion, dense_inset))
+    own = AM.bounded({**own, **_added(sol, safety_factor, exclusion, dense_inset)})
     out: dict[int, dict[str, DE.Sample]] = {problem.order: own}
     for q in DE.ladder(problem.order, MAX_ORDER):
         if q == problem.order:
@@ -121,8 +129,8 @@ def order_samples(scene, sol: MacroSolution, solve: Callable[..., MacroSolution]
         start = DE.start_at_order(sol, other)
         with DE.neighbour_mesh(problem.mesh, problem.order):
             s = solve(other, start)
-            out[q] = DE.headlines(s, ppe, component, dense_inset)
-            out[q].update(_added(s, safety_factor, exclusion, dense_inset))
+            out[q] = AM.bounded({**DE.headlines(s, ppe, component, dense_inset),
+                                 **_added(s, safety_factor, exclusion, dense_inset)})
     return dict(sorted(out.items()))
 
 
@@ -204,14 +212,17 @@ def safety_factor_of(scene, recovery) -> SafetyFactor | None:
 
 
 def away_judged(found: list[DE.Estimate], sol: MacroSolution, solve: Callable[..., MacroSolution],
-                exclusion: AM.Exclusion | None, own: dict[str, DE.Sample], safety=None) -> list[DE.Estimate]:
+                exclusion: AM.Exclusion | None, own: dict[str, DE.Sample], safety=None, whole: bool = False
+                ) -> list[DE.Estimate]:
     """``found`` with the maxima away from the singular points judged by local refinements at those points
-    (:mod:`ngcontact.macro.away_sequence`; ``own``: the samples of ``sol``); nothing without ``exclusion``."""
+    (:mod:`ngcontact.macro.away_sequence`; ``own``: the samples of ``sol``), with ``whole`` the maxima over
+    whole bodies and the safety factor by the same levels; nothing without ``exclusion``."""
     if exclusion is None:
         return found
-    at = {k: v for k, v in own.items() if k.endswith(AM.AWAY)}
-    finer = AS.levels(sol, solve, exclusion, at, safety.samples if isinstance(safety, SafetyFactor) else None)
-    return AS.judged(found, own, finer)
+    at = {k: v for k, v in own.items() if k.endswith(AM.AWAY) or (whole and k.startswith(AM.GLOBAL))}
+    finer = AS.levels(sol, solve, exclusion, at, safety.samples if isinstance(safety, SafetyFactor) else None,
+                      whole=whole)
+    return AS.judged(found, own, finer, AS.beside(sol.problem.mesh, exclusion))
 
 
 def check_radius(scene, problem) -> None:
@@ -244,6 +255,34 @@ class Judged(Protocol):
     def exclusion(self) -> AM.Exclusion | None: ...
 
 
+def judged(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], two_scale: bool,
+           safety: SafetyFactor | None) -> tuple[list[DE.Estimate], AM.Exclusion | None]:
+    """Every headline quantity's estimate on ``sol`` (module docstring) and the region around the singular
+    points it was judged with: in 2D, where a maximum away grows with the local levels at a point outside
+    the balls (:func:`ngcontact.macro.away_sequence.grown`), that point joins the singular points and the
+    quantities are judged once more (module docstring)."""
+    exclusion = exclusion_for(scene, sol)
+    found = _judged(scene, sol, solve, two_scale, safety, exclusion)
+    grown = AS.grown(found, exclusion, sol.problem.mesh) if sol.problem.mesh.dim == 2 else []
+    if grown and exclusion is not None:
+        exclusion = exclusion.joined(grown, AS.GROWN)
+        found = _judged(scene, sol, solve, two_scale, safety, exclusion)
+    return AM.settle(found, exclusion), exclusion
+
+
+def _judged(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], two_scale: bool,
+            safety: SafetyFactor | None, exclusion: AM.Exclusion | None) -> list[DE.Estimate]:
+    """The estimates of :func:`judged` with the region ``exclusion``, before
+    :func:`ngcontact.macro.away_maxima.settle`."""
+    samples = order_samples(scene, sol, solve, safety, exclusion=exclusion)
+    found = estimates(samples, sol)
+    if not two_scale and sol.problem.mesh.dim == 2:
+        found = SM.check(found, sol, samples[sol.problem.order], solve)
+    elif not two_scale:
+        found = AM.inside_tubes(SM.at_closed_ends(found, SM.closed_ends(sol)), exclusion)
+    return away_judged(found, sol, solve, exclusion, samples[sol.problem.order], safety, whole=two_scale)
+
+
 def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], balance: dict,
              two_scale: dict | None = None, recovery=None, refined: Judged | None = None) -> dict[str, Any]:
     """``results.accuracy`` of the macro solution ``sol`` of ``scene``: the neighbouring orders solved by
@@ -251,15 +290,7 @@ def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], bal
     and its balls), the safety factor re-evaluated with the strength check's correctors ``recovery``."""
     found, exclusion = (None, None) if refined is None else (refined.estimates, refined.exclusion)
     if found is None:
-        exclusion = exclusion_for(scene, sol)
-        safety = safety_factor_of(scene, recovery)
-        samples = order_samples(scene, sol, solve, safety, exclusion=exclusion)
-        found = estimates(samples, sol)
-        if two_scale is None and sol.problem.mesh.dim == 2:
-            found = SM.check(found, sol, samples[sol.problem.order], solve)
-        elif two_scale is None:
-            found = AM.inside_tubes(SM.at_closed_ends(found, SM.closed_ends(sol)), exclusion)
-        found = AM.settle(away_judged(found, sol, solve, exclusion, samples[sol.problem.order], safety), exclusion)
+        found, exclusion = judged(scene, sol, solve, two_scale is not None, safety_factor_of(scene, recovery))
     out = verdict(found, scene.discretization.tolerance, balance, two_scale)
     if exclusion is not None:
         out["exclusion"] = exclusion.record()

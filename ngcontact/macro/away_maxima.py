@@ -36,6 +36,11 @@ The singular points (:func:`singular_points`), from the geometry, the supports a
 * an end of a load with a traction (a tangential part): the shear stress jumps there, ``(2 tau / pi) log r``
   on a straight edge, and at a corner the two faces' shears disagree.
 
+And, found by the solution's local levels in 2D (:mod:`ngcontact.macro.away_sequence`): a point where a
+maximum away grows with every halving of the elements holding it, as a stiff closed interface makes a kink
+of its gap one (:func:`ngcontact.macro.away_sequence.grown`); the maxima away are then taken outside its
+ball too (:func:`ngcontact.drivers.macro_accuracy.judged`).
+
 A face meeting a symmetry plane (a support of its normal component) is a mirror of a straight face, no
 singular point.  A maximum found singular at a point outside every ball (by the order ladder or the corner
 check) makes the maximum away of that body mesh dependent there too (:func:`settle`): it lies in the set
@@ -56,7 +61,14 @@ What the verdict counts (:func:`settle`)
     A global maximum (or the global safety factor) that is mesh dependent and has a counterpart away from
     the singular points is listed with its mesh-dependent value and ``counted = false``: the verdict
     (``accuracy.met``) and a refinement's target are the counterpart's.  A mesh-dependent maximum without
-    one is counted (not met), as before.
+    one is counted (not met), as before.  A maximum away found singular outside every ball makes its
+    body's maximum singular there too, as a body's does its counterpart's: the body holds the set.
+
+On one mesh
+    The set away from the singular points is part of the body, so on every mesh a body's maximum is at
+    least its maximum away, and the safety factor over the interface at most its counterpart away
+    (:func:`bounded`: where the rim's points, which are not among the body's sample points, find a larger
+    stress, the body's maximum is that sample).
 
 In 3D
     The singular points are edges (:mod:`ngcontact.macro.singular_edges`: the same four cases, found edge by
@@ -125,6 +137,11 @@ class Exclusion:
     def outside(self, xyz: np.ndarray) -> np.ndarray:
         """Which of the points ``xyz`` (one row each) lie outside the region."""
         return self.singular.distance(xyz, self.radius) > self.radius
+
+    def joined(self, points: list[tuple[float, ...]], why: str) -> Exclusion:
+        """The region with ``points`` (one reason ``why`` for all) among its singular points."""
+        rows = np.vstack([np.asarray(self.points, dtype=float).reshape(-1, len(points[0])), np.asarray(points)])
+        return replace(self, points=rows, why=self.why + (why,) * len(points))
 
     def covers(self, point: tuple[float, ...]) -> bool:
         """``point`` lies within the region."""
@@ -297,6 +314,23 @@ def away_maxima(sol: MacroSolution, exclusion: Exclusion, dense_inset: float = 1
     return out
 
 
+def bounded(samples: dict[str, DE.Sample]) -> dict[str, DE.Sample]:
+    """``samples`` of one solution with each maximum over a whole body at least its counterpart's away and the
+    safety factor at most its counterpart's away: the set away from the singular points is part of the body
+    (part of the interface), so on one mesh a maximum over it cannot exceed the body's, nor a minimum over it
+    fall below the interface's; where the rim's points (not among the body's sample points) find a larger
+    stress, the body's maximum is that sample."""
+    out = dict(samples)
+    for name, away in samples.items():
+        whole = _global(name) if name.endswith(AWAY) else None
+        if whole is None or whole not in samples:
+            continue
+        smaller = whole.startswith(GLOBAL[2])
+        if (away.value < samples[whole].value) if smaller else (away.value > samples[whole].value):
+            out[whole] = away
+    return out
+
+
 def _global(name: str) -> str:
     return name[:-len(AWAY)]
 
@@ -329,14 +363,24 @@ def inside_tubes(found: list[DE.Estimate], exclusion: Exclusion | None) -> list[
 def settle(found: list[DE.Estimate], exclusion: Exclusion | None) -> list[DE.Estimate]:
     """``found`` with what the verdict counts (module docstring): a mesh-dependent global maximum with a
     counterpart away is not counted; a counterpart whose body is singular outside every ball is mesh
-    dependent there."""
+    dependent there, and a body whose counterpart is singular outside every ball (found so by the local
+    levels, :mod:`ngcontact.macro.away_sequence`) is mesh dependent there too."""
     if exclusion is None:
         return found
     names = {e.name for e in found}
     outside = {_body_of(e.name): e for e in found if e.name.startswith(GLOBAL) and not e.name.endswith(AWAY)
                and e.singular_at is not None and not exclusion.covers(e.singular_at)}
+    away = {_body_of(_global(e.name)): e for e in found if e.name.endswith(AWAY) and e.singular_at is not None
+            and not exclusion.covers(e.singular_at)}
     out = []
     for e in found:
+        whole = e.name.startswith(GLOBAL) and not e.name.endswith(AWAY) and e.singular_at is None
+        hit = away.get(_body_of(e.name)) if whole else None
+        if hit is not None and hit.singular_at is not None:
+            e = replace(e, error=None, singular_at=hit.singular_at,
+                        how=f"{e.how}; {hit.name} is singular at {DE._point(hit.singular_at)}, outside the balls "
+                            "around the singular points, and the body holds that set, so this maximum has no "
+                            f"converged value either: mesh dependent, singular at {DE._point(hit.singular_at)}")
         if e.name.endswith(AWAY):
             hit = outside.get(_body_of(_global(e.name)))
             if hit is not None and hit.singular_at is not None and e.singular_at is None:

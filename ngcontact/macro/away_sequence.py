@@ -62,6 +62,37 @@ Differences below :data:`~ngcontact.macro.discretization_error.NOISE` of the qua
 elements at a singular point, where no order converges fast) has ``e_P = e_m = 0`` and leaves the levels
 alone.  The check costs about one solve of the scene (two warm-started solves on meshes a little larger).
 
+A stress maximum that grows where the levels refine
+    Before the rules above, a stress maximum whose levels grow at each level (``Q_0 < Q_1 < Q_2`` in
+    magnitude), the last difference at least :data:`GROWING` ``= 3/4`` of the first, by more than the
+    ladder's estimate over the levels (:func:`growing`), has no converged value: a bounded stress's error
+    falls by at least ``2^-0.544 = 0.69`` per halving of the elements at the singular points (above) and
+    by ``2^-p`` where the elements holding it are halved, whereas ``log r`` gains a constant and
+    ``r^(lambda - 1)`` a factor ``2^(1 - lambda)`` with every halving of the elements at its point.  It is
+    reported mesh dependent, singular at the finest level's location, with the value of the scene's mesh
+    (the mesh every maximum over a whole body is reported on).  Such a point need not be one of
+    :func:`ngcontact.macro.away_maxima.singular_points`: a closed interface much stiffer than its bodies
+    over the element size, ``k_n h >> E``, transmits a kink of its gap (an interference that stops
+    growing, as the two-scale femur's does at the stem's cone-cylinder corner) as a kink of the
+    displacement, whose traction grows like ``log r`` down to the law's own length ``E / k_n`` (the
+    Hilbert transform of a jump in the gap's slope), far below the element size; a compliant law
+    (``E / k_n`` above the element size) smooths the same kink.  A maximum away next to the region's
+    boundary (within the diameter of the scene mesh's element holding it, :func:`beside`) is exempt: it
+    grows as the levels resolve the circle towards the bounded value there.  In 2D such a point joins the
+    singular points (:func:`grown`, at the nearest vertex of the scene's mesh, reason :data:`GROWN`) and
+    the quantities are judged once more outside its ball too
+    (:func:`ngcontact.drivers.macro_accuracy.judged`); in 3D the growth runs along an edge whose extent
+    the levels do not find, and the maximum away stays mesh dependent.
+
+The maxima over whole bodies
+    Where no other check judges them (a two-scale run, :mod:`ngcontact.drivers.macro_accuracy`), the
+    levels also take the maxima over whole bodies and the safety factor over the whole interface
+    (``whole``) and judge them as their counterparts away.  On every mesh a maximum over a body is at least
+    its maximum away, and the safety factor at most its counterpart away
+    (:func:`ngcontact.macro.away_maxima.bounded`); judged so, a maximum away and its body's are reported
+    from the finest level where both converge and from the scene's mesh where both grow, the one away
+    never above its body's.
+
 In 3D the elements the tubes' rings cross are not refined: the tube around an edge crosses a layer of
 elements along its whole length, and refining that layer twice multiplies the unknowns along every
 singular edge by about 8 per level, where the elements touching the edge (which carry the polluting
@@ -81,6 +112,7 @@ import numpy as np
 from ngcontact.macro import away_maxima as AM
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro import error_indicator as EI
+from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroSolution
 
 #: local refinements at the singular points (three values with the scene's mesh: an observed rate)
@@ -91,24 +123,38 @@ CIRCLE = 64
 SLOWEST = 0.5
 #: the ratios of the last two differences that agree in rate with the halving (module docstring)
 AGREE = (0.25, 0.75)
+#: a stress maximum growing at each level with the last difference at least this share of the first has no
+#: converged value (module docstring): slower than the pollution of any singular point falls
+GROWING = AGREE[1]
 
 #: the safety factor away from the singular points of a solution, given which interface points count
 Safety = Callable[[MacroSolution, Callable[[np.ndarray], np.ndarray]], dict[str, DE.Sample]]
+#: why a point where a maximum away grows with the levels joins the singular points (:func:`grown`)
+GROWN = "the stress grows there with every refinement"
+#: whether a location lies next to the region around the singular set (:func:`beside`)
+Beside = Callable[[tuple[float, ...] | None], bool]
 
 
-def sampled(sol: MacroSolution, exclusion: AM.Exclusion, safety: Safety | None) -> dict[str, DE.Sample]:
-    """The maxima away from the singular points of ``sol`` and, with ``safety``, the safety factor away."""
+def sampled(sol: MacroSolution, exclusion: AM.Exclusion, safety: Safety | None, whole: bool = False
+            ) -> dict[str, DE.Sample]:
+    """The maxima away from the singular points of ``sol`` and, with ``safety``, the safety factor away; with
+    ``whole`` the maxima over whole bodies (and the safety factor over the whole interface) as well, each at
+    least its counterpart's away (:func:`ngcontact.macro.away_maxima.bounded`)."""
     out = AM.away_maxima(sol, exclusion)
+    if whole:
+        out.update(DE.body_maxima(sol))
     if safety is not None:
-        out.update({k: v for k, v in safety(sol, exclusion.outside).items() if k.endswith(AM.AWAY)})
-    return out
+        out.update({k: v for k, v in safety(sol, exclusion.outside).items() if whole or k.endswith(AM.AWAY)})
+    return AM.bounded(out)
 
 
 def levels(sol: MacroSolution, solve: Callable[..., MacroSolution], exclusion: AM.Exclusion,
-           at: dict[str, DE.Sample], safety: Safety | None = None, count: int = LEVELS) -> list[dict[str, DE.Sample]]:
-    """The maxima away (:func:`sampled`) on ``count`` levels, each a copy of the last level's mesh (the first:
-    ``sol``'s) refined at the singular points and at the locations of ``at`` (the maxima on ``sol``), solved
-    by ``solve(problem, start)`` at ``sol``'s order from the last level's solution."""
+           at: dict[str, DE.Sample], safety: Safety | None = None, count: int = LEVELS, whole: bool = False
+           ) -> list[dict[str, DE.Sample]]:
+    """The maxima away (:func:`sampled`; with ``whole`` those over whole bodies too) on ``count`` levels, each
+    a copy of the last level's mesh (the first: ``sol``'s) refined at the singular points and at the
+    locations of ``at`` (the maxima on ``sol``), solved by ``solve(problem, start)`` at ``sol``'s order from
+    the last level's solution."""
     order = max(sol.problem.order, 1)
     points = [s.location for s in at.values() if s.location is not None]
     circle = AM.circles(exclusion, CIRCLE) if sol.problem.mesh.dim == 2 else np.zeros((0, 3))
@@ -119,28 +165,92 @@ def levels(sol: MacroSolution, solve: Callable[..., MacroSolution], exclusion: A
         EI.refine_marked(mesh, marked, order)
         problem = replace(sol.problem, mesh=mesh)
         sol = solve(problem, DE.start_at_order(sol, problem))
-        out.append(sampled(sol, exclusion, safety))
+        out.append(sampled(sol, exclusion, safety, whole))
     return out
 
 
-def judged(found: list[DE.Estimate], own: dict[str, DE.Sample], finer: list[dict[str, DE.Sample]]
-           ) -> list[DE.Estimate]:
-    """``found`` with each maximum away (not mesh dependent) judged by its value on the scene's mesh
-    (``own``) and the local levels ``finer`` (module docstring): the value and location of the finest
-    level; the other estimates unchanged."""
-    out = []
+def beside(mesh: ng.Mesh, exclusion: AM.Exclusion) -> Beside:
+    """Whether a location lies within the diameter of ``mesh``'s element holding it of the region around the
+    singular set (a ball's circle, a tube's mantle): where a maximum away grows as the levels resolve the
+    region's boundary, towards its bounded value there (module docstring)."""
+    def test(point: tuple[float, ...] | None) -> bool:
+        if point is None:
+            return False
+        gap = float(exclusion.singular.distance(np.asarray(point, dtype=float))[0]) - exclusion.radius
+        return gap <= element_diameter(mesh, point)
+    return test
+
+
+def element_diameter(mesh: ng.Mesh, point: tuple[float, ...]) -> float:
+    """The largest distance between two vertices of ``mesh``'s volume element holding ``point`` (0 where no
+    element holds it)."""
+    found = mesh(*point)
+    if found.nr < 0 or found.vb != ng.VOL:
+        return 0.0
+    xyz = np.array([mesh[v].point for v in mesh[ng.ElementId(ng.VOL, found.nr)].vertices])
+    return float(max(np.linalg.norm(a - b) for a in xyz for b in xyz))
+
+
+def judged(found: list[DE.Estimate], own: dict[str, DE.Sample], finer: list[dict[str, DE.Sample]],
+           near: Beside | None = None) -> list[DE.Estimate]:
+    """``found`` with each quantity the levels ``finer`` sampled (the maxima away; with ``whole`` in
+    :func:`levels` those over whole bodies too), not mesh dependent, judged by its value on the scene's
+    mesh (``own``) and on the levels (module docstring): the value and location of the finest level, or
+    mesh dependent where a stress maximum grows with the levels (:func:`growing`; a maximum away not where
+    ``near`` says it is next to the region around the singular set); the other estimates unchanged.  A
+    body's von Mises and Tresca maxima so judged are singular together
+    (:func:`ngcontact.macro.singular_maxima.same_body`)."""
+    out, names = [], set()
     for e in found:
-        if finer and e.name.endswith(AM.AWAY) and e.singular_at is None and e.name in own \
-                and all(e.name in f for f in finer):
-            e = _judged(e, [own[e.name]] + [f[e.name] for f in finer])
+        if finer and e.singular_at is None and e.name in own and all(e.name in f for f in finer):
+            e = _judged(e, [own[e.name]] + [f[e.name] for f in finer], near)
+            names.add(e.name)
         out.append(e)
+    together = {e.name: e for e in SM.same_body([e for e in out if e.name in names])}
+    return [together.get(e.name, e) for e in out]
+
+
+def grown(found: list[DE.Estimate], exclusion: AM.Exclusion | None, mesh: ng.Mesh) -> list[tuple[float, ...]]:
+    """The points outside the region around the singular set where a maximum away of ``found`` is singular
+    (it grows with the levels, :func:`judged`, or with the order at a corner of the boundary,
+    :func:`ngcontact.macro.discretization_error.estimate`), each at the vertex of ``mesh`` nearest to it
+    (the singular point of the element holding it), none within the radius of another."""
+    if exclusion is None:
+        return []
+    pts = np.array([mesh[ng.NodeId(ng.VERTEX, i)].point for i in range(mesh.nv)])
+    out: list[tuple[float, ...]] = []
+    for e in found:
+        if e.name.endswith(AM.AWAY) and e.singular_at is not None and not exclusion.covers(e.singular_at):
+            at = tuple(float(c) for c in pts[int(np.argmin(np.linalg.norm(pts - np.asarray(e.singular_at), axis=1)))])
+            if all(np.linalg.norm(np.subtract(at, q)) > exclusion.radius for q in out):
+                out.append(at)
     return out
 
 
-def _judged(e: DE.Estimate, samples: list[DE.Sample]) -> DE.Estimate:
-    """The error of the finest of ``samples`` (the scene's mesh, then the levels; module docstring)."""
+def growing(e: DE.Estimate, values: list[float]) -> bool:
+    """A stress maximum whose levels ``values`` (the scene's mesh first) grow at each level, the last
+    difference at least :data:`GROWING` of the first, by more than ``e``'s ladder estimate over the levels
+    (module docstring)."""
+    if not e.name.startswith(SM.STRESS) or len(values) < 3:
+        return False
+    q0, q1, q2 = (abs(v) for v in values[-3:])
+    return q0 < q1 < q2 and q2 - q1 >= GROWING * (q1 - q0) and q2 - q0 > (e.error or 0.0)
+
+
+def _judged(e: DE.Estimate, samples: list[DE.Sample], near: Beside | None = None) -> DE.Estimate:
+    """The error of the finest of ``samples`` (the scene's mesh, then the levels; module docstring), or the
+    scene mesh's value, mesh dependent, where it grows with the levels."""
     values = [s.value for s in samples]
     shown = ", ".join(f"{v:.6g}" for v in values)
+    at = samples[-1].location
+    if growing(e, values) and at is not None and not (e.name.endswith(AM.AWAY) and near is not None and near(at)):
+        return replace(e, error=None, singular_at=at,
+                       how=f"{e.how}; {len(values) - 1} local refinements at the singular points and at the maxima: "
+                           f"{shown}: it grows with every halving of the elements holding it, by a difference that "
+                           f"does not fall as a bounded stress's error does (the last at least {GROWING:g} of the "
+                           "first) and by more than the ladder's estimate, as log r or r^(lambda - 1) grows on "
+                           "the meshes the levels reach, so this maximum has no converged value there: mesh "
+                           f"dependent, singular at {DE._point(at)} (the value of the scene's mesh)")
     head = f"{e.how}; {len(values) - 1} local refinements at the singular points: {shown}, the last reported"
     polynomial = None
     if e.error is not None:

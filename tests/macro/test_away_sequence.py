@@ -1,0 +1,172 @@
+"""The local levels at the singular points (ngcontact.macro.away_sequence) against the maxima over whole bodies:
+on one mesh a maximum away never exceeds its body's; a maximum that grows with every level is mesh dependent
+at the scene mesh's value (the corner of the two-scale femur, where the stiff tabulated law makes the kink of
+the press fit's gap a point where the stress grows like log r), its point joins the singular points, and
+the maxima away are then taken outside its ball, as at the single-scale femur's singular points."""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import replace
+
+import ngsolve as ng
+import numpy as np
+import pytest
+from netgen.geom2d import unit_square
+
+from ngcontact.drivers import macro_accuracy as MA
+from ngcontact.macro import away_maxima as AM
+from ngcontact.macro import away_sequence as AS
+from ngcontact.macro import discretization_error as DE
+from ngcontact.scene import loader
+
+from tests.macro.test_away_maxima import _block
+from tests.macro.test_discretization_error import ROOT
+
+#: the levels of the two-scale femur's stem at its cone-cylinder corner before the fix (MPa)
+GROWING = (12.94, 19.26, 25.32)
+
+
+def _pairs(samples: dict[str, DE.Sample]) -> list[tuple[str, str]]:
+    return [(n, n[:-len(AM.AWAY)]) for n in samples if n.endswith(AM.AWAY) and n[:-len(AM.AWAY)] in samples]
+
+
+def test_on_every_mesh_no_maximum_away_exceeds_its_bodys(tmp_path):
+    """The scene's mesh at each order of the ladder and each local level: the set away from the singular
+    points is part of the body."""
+    from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
+    sc = loader.load(_block(tmp_path))
+    problem, _ = problem_of(sc, build_geometry(sc))
+    sol = solve_scene(sc, problem)
+    ex = MA.exclusion_for(sc, sol)
+
+    def solve(p, start):
+        return solve_scene(sc, p, start)
+    orders = MA.order_samples(sc, sol, solve, exclusion=ex)
+    own = AS.sampled(sol, ex, None, whole=True)
+    levels = AS.levels(sol, solve, ex, own, whole=True)
+    meshes = list(orders.values()) + [own] + levels
+    assert all(len(_pairs(s)) == 4 for s in meshes)
+    for s in meshes:
+        for away, whole in _pairs(s):
+            assert s[away].value <= s[whole].value, (away, s[away], s[whole])
+    # the base's maximum sits at its clamped corner and grows with the levels; the one away does not
+    base = [s["von_mises_base"].value for s in [own] + levels]
+    assert base[0] < base[1] < base[2] and levels[-1]["von_mises_base_away"].value < 0.6 * base[2]
+
+
+def test_a_body_maximum_is_at_least_its_maximum_away_on_one_mesh():
+    rim = DE.Sample(3.0, (0.1, 0.0))
+    samples = {"von_mises_stem": DE.Sample(2.0, (0.5, 0.5)), "von_mises_stem_away": rim,
+               "tresca_stem": DE.Sample(4.0, (0.5, 0.5)), "tresca_stem_away": DE.Sample(3.5, (0.1, 0.0)),
+               "safety_factor": DE.Sample(2.0, (0.0, 1.0)), "safety_factor_away": DE.Sample(1.5, (0.0, 0.9))}
+    out = AM.bounded(samples)
+    assert out["von_mises_stem"] == rim and out["tresca_stem"].value == 4.0
+    # a minimum over the whole interface is at most the one away from the singular points
+    assert out["safety_factor"].value == 1.5
+
+
+def _ladder(name, value, error=None):
+    return DE.Estimate(name=name, value=value, error=error, scale=value, ratio=2.7, orders=(2, 3, 4), how="ladder",
+                       location=(0.011, 0.13))
+
+
+def _singular(e: DE.Estimate, at=(0.011, 0.13)) -> DE.Estimate:
+    return replace(e, error=None, singular_at=at)
+
+
+def test_a_maximum_that_grows_with_every_level_is_mesh_dependent_at_the_scene_meshs_value():
+    """The stem of the two-scale femur at its cone-cylinder corner: its levels grow by a difference that
+    falls by 0.96, slower than a bounded stress's error; the ladder saw no convergence either."""
+    names = ("von_mises_stem", "von_mises_stem_away", "tresca_stem_away")
+    found = [_ladder(n, GROWING[0]) for n in names]
+    own = {n: DE.Sample(GROWING[0], (0.011, 0.13)) for n in names}
+    growing = [{n: DE.Sample(v * (1.1 if n.startswith("tresca") else 1.0), (0.011, 0.13)) for n in names}
+               for v in GROWING[1:]]
+    out = {e.name: e for e in AS.judged(found, own, growing, lambda at: False)}
+    for name in names:
+        e = out[name]
+        assert e.error is None and e.singular_at == (0.011, 0.13), e.how
+        assert e.value == GROWING[0] and e.location == (0.011, 0.13)
+        assert "grows with every halving" in e.how
+    # next to a ball's circle a maximum away grows towards its bounded value there: judged by its levels
+    out = {e.name: e for e in AS.judged(found, own, growing, lambda at: True)}
+    assert out["von_mises_stem_away"].error is not None and out["von_mises_stem_away"].value == GROWING[2]
+    assert out["von_mises_stem"].error is None
+    # growth within the ladder's estimate, or a difference that falls as a bounded stress's, is no growth
+    assert not AS.growing(_ladder("von_mises_bone", 54.2, error=41.6), [54.2, 56.4, 61.6])
+    assert not AS.growing(_ladder("von_mises_bone", 54.2), [54.2, 56.4, 57.5])
+    assert not AS.growing(_ladder("safety_factor", 0.24), [0.24, 0.3, 0.36])
+
+
+def test_a_maximum_away_singular_outside_the_balls_makes_its_bodys_singular_too():
+    exclusion = AM.Exclusion(np.array([[0.0, 0.0]]), 0.1, ("a clamped boundary meets an unsupported one",))
+    found = [_ladder("von_mises_stem", 12.9, 0.1), _singular(_ladder("von_mises_stem_away", 12.9)),
+             _ladder("tresca_stem", 14.4, 0.1), _ladder("von_mises_bone", 54.0, 0.1)]
+    settled = {e.name: e for e in AM.settle(found, exclusion)}
+    for name in ("von_mises_stem", "tresca_stem"):
+        assert settled[name].singular_at == (0.011, 0.13) and settled[name].error is None
+    assert not settled["von_mises_stem"].counted and settled["von_mises_stem_away"].counted
+    assert settled["von_mises_bone"].singular_at is None
+
+
+def test_a_point_where_a_maximum_away_grows_joins_the_singular_points():
+    mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.2))
+    exclusion = AM.Exclusion(np.array([[0.0, 0.0]]), 0.1, ("a clamped boundary meets an unsupported one",))
+    far, twin, inside = (1.0, 0.999), (0.999, 1.0), (0.05, 0.0)
+    found = [_singular(_ladder("von_mises_a_away", 1.0), far), _singular(_ladder("von_mises_b_away", 1.0), twin),
+             _singular(_ladder("tresca_a_away", 1.0), inside), _ladder("tresca_b_away", 1.0)]
+    points = AS.grown(found, exclusion, mesh)
+    assert points == [(1.0, 1.0)]       # the vertex nearest to the growth, once; none within a ball
+    joined = exclusion.joined(points, AS.GROWN)
+    assert joined.covers((0.95, 0.95)) and joined.record()["why"][-1] == AS.GROWN
+    assert AS.beside(mesh, exclusion)((0.12, 0.0)) and not AS.beside(mesh, exclusion)((0.6, 0.6))
+
+
+def test_the_quantities_are_judged_again_with_a_point_found_growing(monkeypatch):
+    first = AM.Exclusion(np.array([[0.0, 0.0]]), 0.1, ("a clamped boundary meets an unsupported one",))
+    seen = []
+
+    def judged_once(scene, sol, solve, two_scale, safety, exclusion):
+        seen.append(exclusion)
+        if len(seen) == 1:
+            return [_singular(_ladder("von_mises_stem_away", 12.9)), _ladder("von_mises_stem", 12.9, 1.0)]
+        return [_ladder("von_mises_stem_away", 10.9, 0.01), _ladder("von_mises_stem", 12.9, 1.0)]
+
+    class Sol:
+        class problem:
+            mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.5))
+    monkeypatch.setattr(MA, "exclusion_for", lambda scene, sol: first)
+    monkeypatch.setattr(MA, "_judged", judged_once)
+    monkeypatch.setattr(AS, "grown", lambda found, exclusion, mesh: [(0.011, 0.13)])
+    found, exclusion = MA.judged(None, Sol(), None, True, None)
+    assert len(seen) == 2 and seen[1] is exclusion and exclusion.why[-1] == AS.GROWN
+    assert np.allclose(exclusion.points[-1], (0.011, 0.13))
+    assert {e.name: e.value for e in found} == {"von_mises_stem_away": 10.9, "von_mises_stem": 12.9}
+
+
+@pytest.mark.slow
+def test_the_two_scale_femurs_corner_is_a_singular_point_and_no_maximum_away_exceeds_its_bodys():
+    """The stiff cell law of the loop makes the cone-cylinder corner (r = 11 mm, z = 130 mm, where the press
+    fit's interference stops growing) a point where the stress grows with every halving: it joins the
+    singular points and, as at the single-scale femur's bone edge, the bodies' maxima there are mesh
+    dependent and not counted, and the maxima away from it converge with their estimates."""
+    from ngcontact.drivers import run_macro as D
+    from ngcontact.output.report import Clock
+    out = D.run(loader.load(os.path.join(ROOT, "geometries", "femur_stem_two_scale.toml")), Clock())
+    acc = out.results["accuracy"]
+    q = {x["name"]: x for x in acc["quantities"]}
+    ex = acc["exclusion"]
+    corner = [p for p, why in zip(ex["points"], ex["why"]) if why == AS.GROWN]
+    assert len(corner) == 1 and corner[0] == pytest.approx([0.011, 0.13]), ex
+    for body in ("stem", "bone"):
+        for measure in ("von_mises", "tresca"):
+            whole, away = q[f"{measure}_{body}"], q[f"{measure}_{body}_away"]
+            assert away["value"] <= whole["value"], (away, whole)
+            assert away["counted"] and away["error"] is not None and away["relative_error"] < 0.01, away["how"]
+            assert min(math.dist(away["location"], p) for p in ex["points"]) >= ex["radius"] * (1 - 1e-9)
+    for measure in ("von_mises", "tresca"):
+        stem = q[f"{measure}_stem"]
+        assert stem["error"] is None and stem["singular_at"] == pytest.approx([0.011, 0.13], abs=1e-5)
+        assert not stem["counted"]
+    assert q["safety_factor"]["value"] <= q["safety_factor_away"]["value"]
