@@ -160,7 +160,7 @@ def _scene(tmp_path=None, *, gap=None, load=None, contact=None, symmetry=None):
         np.save(tmp_path / "gap.npy", gap)
         geometry = {"profile": "flat3d", "h_rough": 0.6, "h_counter": 0.6}
         c["gap"] = {"kind": "tabulated", "file": "gap.npy"}
-    d = {"method": "fe", "order": 1, "maxh": 0.3, "interface_maxh": 0.15, "estimate": "off"}
+    d = {"method": "fe", "order": 1, "maxh": 0.3, "interface_maxh": 0.25, "estimate": "off"}
     if symmetry is not None:
         d["symmetry"] = symmetry
     data = {"kind": "cell", "materials": {"solid": {"E": 1.0, "nu": 0.3}},
