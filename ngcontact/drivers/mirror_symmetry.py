@@ -16,8 +16,10 @@ on it, the shear traction on it too.  The quarter ``[0, P/2]^2`` with ``u_x = 0`
 ``u_y = 0`` on ``y = 0, P/2`` (the shear traction natural) solves the same problem
 (:mod:`ngcontact.geometry.cell3d`); its means over the quarter are those over the period, so the contact
 fraction, the mean closure, the normal stiffness and the eq. 34 coefficients are unchanged in the limit,
-at a quarter of the unknowns.  ``symmetry = "auto"`` (the default) uses the quarter where the cell is
-admissible and states why not where it is not (:class:`SymmetryChoice`); ``"off"`` always meshes the period.
+at a quarter of the unknowns.  ``symmetry = "auto"`` uses the quarter where the cell is admissible and
+states why not where it is not (:class:`SymmetryChoice`); ``"off"`` (the default) always meshes the period:
+at the same sizes the quarter is the faster cell, not the more accurate one (docs/benchmarks.md, "3D at
+scale"), so it is asked for, not chosen for the user.
 """
 from __future__ import annotations
 
@@ -104,7 +106,8 @@ def symmetry_choice(scene: CellScene) -> SymmetryChoice:
     """The :class:`SymmetryChoice` of a cell scene's FE cell (module docstring)."""
     requested = scene.discretization.symmetry
     if requested == "off":
-        return SymmetryChoice(False, "discretization.symmetry = 'off'", requested)
+        default = "" if "symmetry" in scene.discretization.given else " (the default; 'auto' meshes the quarter)"
+        return SymmetryChoice(False, f"discretization.symmetry = 'off'{default}", requested)
     refusal = _refusal(scene)
     if refusal:
         return SymmetryChoice(False, refusal, requested)

@@ -151,7 +151,7 @@ def test_evenness_is_decided_on_the_samples():
     assert not mirror_invariant(C)
 
 
-def _scene(tmp_path=None, *, gap=None, load=None, contact=None, symmetry=None):
+def _scene(tmp_path=None, *, gap=None, load=None, contact=None, symmetry="auto"):
     """A coarse 3D bisinusoid FE cell (or flat3d with a tabulated gap ``gap``: the array written to a file)."""
     geometry = {"profile": "bisinusoid", "arrangement": "summit", "amplitude": 0.005, "h_rough": 0.6,
                 "h_counter": 0.6}
@@ -179,6 +179,14 @@ def test_a_symmetric_scene_is_meshed_as_its_quarter_and_says_so():
     off = _scene(symmetry="off")
     assert not symmetry_choice(off).used and not build_cell(off).symmetric
     assert symmetry_choice(off).reason == "discretization.symmetry = 'off'"
+
+
+def test_the_default_meshes_the_period_and_says_auto_would_mesh_the_quarter():
+    """symmetry = "off" is the default: the quarter is asked for."""
+    scene = _scene(symmetry=None)
+    choice = symmetry_choice(scene)
+    assert scene.discretization.symmetry == "off" and not choice.used and not build_cell(scene).symmetric
+    assert choice.reason == "discretization.symmetry = 'off' (the default; 'auto' meshes the quarter)"
 
 
 def test_a_gap_that_is_not_even_keeps_the_period(tmp_path):
