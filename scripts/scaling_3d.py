@@ -45,6 +45,10 @@ whole contact surface on the wirebasket (``scaling_3d_coarse.csv``, ``.png``).
 With ``--republish CSV`` it measures nothing: it reads the measured rows of
 an earlier run's ``scaling_3d.csv``, makes the rows derived from them again
 (the edge-size extrapolations) and writes (and publishes) them as a run.
+With ``--keep-rows CSV`` it measures as asked and keeps that earlier run's rows
+above the new ones (a run adding rows to a published table, which ``--publish``
+rewrites whole); the section says which rows are whose, and whether the
+accuracy aim is met and by which row.
 
 With ``--breakdown INTERFACE_MAXH`` it measures instead where one iterative
 cell solve spends its time (CG per iteration, one BDDC application, one
@@ -59,7 +63,7 @@ Usage::
                                  [--accuracy-patch-growth GROWTH] [--accuracy-cells quarter period]
                                  [--accuracy-threads N]
                                  [--solvers iterative direct] [--breakdown INTERFACE_MAXH]
-                                 [--coarse INTERFACE_MAXH [--k-n K]] [--republish CSV]
+                                 [--coarse INTERFACE_MAXH [--k-n K]] [--republish CSV] [--keep-rows CSV]
 
 Writes ``scaling_3d.csv`` and ``scaling_3d.png`` into ``OUT_DIR`` (default
 ``results/scaling_3d``) and logs the tables and the fitted exponents.
@@ -80,7 +84,8 @@ from ngcontact.output.writer import write_csv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
-from bisinusoid_accuracy import ACC_CELLS, ACC_EDGES, ACC_PATCH, QUICK_EDGES, accuracy_aim, extrapolated_rows  # noqa: E402,E501
+from bisinusoid_accuracy import (ACC_CELLS, ACC_EDGES, ACC_PATCH, QUICK_EDGES, accuracy_aim,  # noqa: E402
+                                 aim_status, extrapolated_rows)
 
 log = logging.getLogger("scaling_3d")
 
@@ -517,6 +522,9 @@ def main(argv=None) -> int:
     ap.add_argument("--republish", metavar="CSV", default=None,
                     help="instead of measuring: the rows an earlier run measured (its scaling_3d.csv), the rows "
                          "derived from them made again, written (and with --publish published) as a run's")
+    ap.add_argument("--keep-rows", metavar="CSV", default=None,
+                    help="the rows an earlier run measured (its scaling_3d.csv) kept above those measured now, "
+                         "their derived rows made again: a run that adds rows to a published table")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
@@ -544,6 +552,8 @@ def main(argv=None) -> int:
                                   png=os.path.join(args.out, "scaling_3d_coarse.png"))
         return 0
     rows = republished_rows(args.republish) if args.republish else measured_rows(args)
+    kept = republished_rows(args.keep_rows) if args.keep_rows else []
+    rows = kept + rows
     os.makedirs(args.out, exist_ok=True)
     write_csv(os.path.join(args.out, "scaling_3d.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
     plot(rows, os.path.join(args.out, "scaling_3d.png"))
@@ -561,6 +571,9 @@ def main(argv=None) -> int:
                               note=("Rows measured by an earlier run (its CSV re-read with `--republish`; its "
                                     "timings, its machine's load), the extrapolated rows made again from them. "
                                     if args.republish else "") +
+                                   (f"The first {len(kept)} rows were measured by an earlier run (its CSV kept "
+                                    "with `--keep-rows`: its timings, its machine's load), the others by this "
+                                    "one. " if kept else "") + aim_status(rows) + " " +
                                    "Part `cell`: the 3D bisinusoid cell (order 2) refined, one load by sparse "
                                    "Cholesky (`direct`) and BDDC-CG (`iterative`), started as `ngcontact run` "
                                    "starts it; part `macro`: a 3D press fit of two tubes; part `spectral`: the "
