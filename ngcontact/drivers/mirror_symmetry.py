@@ -18,8 +18,8 @@ on it, the shear traction on it too.  The quarter ``[0, P/2]^2`` with ``u_x = 0`
 fraction, the mean closure, the normal stiffness and the eq. 34 coefficients are unchanged in the limit,
 at a quarter of the unknowns.  ``symmetry = "auto"`` uses the quarter where the cell is admissible and
 states why not where it is not (:class:`SymmetryChoice`); ``"off"`` (the default) always meshes the period:
-at the same sizes the quarter is the faster cell, not the more accurate one (docs/benchmarks.md, "3D at
-scale"), so it is asked for, not chosen for the user.
+at the same sizes the quarter is the faster cell, not the more accurate one (docs/benchmarks.md,
+section scaling_3d), so it is asked for, not chosen for the user.
 """
 from __future__ import annotations
 

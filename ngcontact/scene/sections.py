@@ -132,12 +132,13 @@ class CellDiscretization(Discretization):
                         "shear response)", choices=("auto", "fe", "spectral"))
     symmetry: str = param("off", doc="3D FE cell: off (the default) meshes the whole period; auto meshes the "
                           "quarter [0, P/2]^2 of a cell that is even about its mid-lines (the initial gap even in "
-                          "x and in y, checked on its samples to round-off; a normal load, no in-plane macro shear e_xy; no friction; isotropic or axis-orthotropic "
-                          "bodies; the flat small-slope mesh) with zero normal displacement and zero shear traction "
+                          "x and in y, checked on its samples to round-off; a normal load, no in-plane macro "
+                          "shear e_xy; no friction; isotropic or axis-orthotropic bodies; the flat small-slope "
+                          "mesh) with zero normal displacement and zero shear traction "
                           "on its four mirror faces instead of the periodic identification: the same means over a "
                           "quarter of the unknowns; results.accuracy.symmetry states whether it was used and, if "
                           "not, why (at the same sizes the quarter is the faster cell, not the more accurate one: "
-                          "docs/benchmarks.md, 3D scaling)",
+                          "docs/benchmarks.md, section scaling_3d)",
                           choices=("auto", "off"))
     grid: int | None = param(None, doc="spectral (set with method = 'auto', it asks for the spectral cell): grid "
                              "points per period and direction of the first grid, "
