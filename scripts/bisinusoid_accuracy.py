@@ -20,6 +20,10 @@ exact contact, started from the spectral twin on ``128^2``:
   to a depth ``d a`` (:class:`~ngcontact.cell.fe.contact_edge_mesh.PatchBody`), the bodies' size growing
   with the depth at the rate ``growth`` (``0``: uniform to ``d a``).
 
+Each on the whole period or on its mirror-symmetric quarter (column ``cell``: ``period`` or ``quarter``,
+:mod:`ngcontact.drivers.mirror_symmetry`; the bisinusoid is even about the cell's mid-lines): the same
+sizes, the twin's points folded into the quarter, about a quarter of the unknowns.
+
 The converged value is the spectral cell's contact fraction extrapolated
 from ``512^2`` and ``1024^2`` (its grid counting errs by one order in the
 spacing).  Seconds: twin, meshing and solve, with the threads asked for;
@@ -45,6 +49,8 @@ ACC_MAXH, ACC_INTERFACE, ACC_TWIN, ACC_ORDERS = 0.3, 0.1, 128, (1,)
 ACC_PATCH = (13.0, 10.0, 1.8)
 #: its bodies' size away from the patch
 PATCH_MAXH = 0.15
+#: the cells meshed, side by side: the mirror-symmetric quarter and the whole period
+ACC_CELLS = ("quarter", "period")
 
 
 def bisinusoid_spectral(grid: int):
@@ -72,63 +78,66 @@ def _fe_solve(cell, order: int, edge: float, load, threads: int) -> tuple[object
         return P, P.solve(load, first=True, measure=False)
 
 
-def _row(solver: str, size, P, sol, phases: list[float], ratio: float, ref: float) -> dict:
+def _row(solver: str, size, P, sol, phases: list[float], ratio: float, ref: float, cell: str) -> dict:
     """The row of one solve; ``phases``: the ``perf_counter`` times at its start and after the twin, the
     meshing and the solve."""
     f = float(sol.results["contact_fraction"])
     twin, mesh, solve = (float(t) for t in np.diff(phases))
     seconds = phases[-1] - phases[0]
-    log.info("accuracy: %s p/p* %-6g size %-12s ndof %7d: fraction %.6f (converged %.6f, %+.2f %%), %.1f s "
-             "(twin %.1f, mesh %.1f, solve %.1f)", solver, ratio, size, P.ndof, f, ref, 100.0 * (f / ref - 1.0),
-             seconds, twin, mesh, solve)
-    return {"part": "accuracy", "solver": solver, "size": size, "ndof": P.ndof, "seconds": seconds,
+    log.info("accuracy: %s, %s p/p* %-6g size %-12s ndof %7d: fraction %.6f (converged %.6f, %+.2f %%), %.1f s "
+             "(twin %.1f, mesh %.1f, solve %.1f)", solver, cell, ratio, size, P.ndof, f, ref,
+             100.0 * (f / ref - 1.0), seconds, twin, mesh, solve)
+    return {"part": "accuracy", "solver": solver, "cell": cell, "size": size, "ndof": P.ndof, "seconds": seconds,
             "twin_seconds": twin, "mesh_seconds": mesh, "solve_seconds": solve,
             "newton_steps": sol.iterations, "cg_iterations": sum(P.linear.iterations), "contact_fraction": f,
             "pressure": ratio, "relative_error": f / ref - 1.0}
 
 
-def edge_rows(edges, orders, threads: int, loads, converged) -> list[dict]:
-    """The ``edge`` method (module docstring), per edge size, order and load."""
+def edge_rows(edges, orders, threads: int, loads, converged, cells=ACC_CELLS) -> list[dict]:
+    """The ``edge`` method (module docstring), per edge size, order, load and cell."""
     from ngcontact.cell.fe.contact_edge_mesh import edge_points, edge_refined_cell
     twin, rows = bisinusoid_spectral(ACC_TWIN), []
-    for edge, order, (ratio, ld, ref) in itertools.product(edges, orders, zip(ACC_RATIOS, loads, converged)):
+    for edge, order, (ratio, ld, ref), which in itertools.product(edges, orders, zip(ACC_RATIOS, loads, converged),
+                                                                   cells):
         phases = [time.perf_counter()]
         pts = edge_points(twin.solve(ld).fields["pressure"], 1.0)
         phases.append(time.perf_counter())
-        cell = edge_refined_cell(pts, edge_maxh=edge, maxh=ACC_MAXH, interface_maxh=ACC_INTERFACE)
+        cell = edge_refined_cell(pts, edge_maxh=edge, maxh=ACC_MAXH, interface_maxh=ACC_INTERFACE,
+                                 symmetric=which == "quarter")
         phases.append(time.perf_counter())
         P, sol = _fe_solve(cell, order, edge, ld, threads)
         phases.append(time.perf_counter())
-        rows.append(_row(f"fe exact order {order}, edge-refined", edge, P, sol, phases, ratio, ref))
+        rows.append(_row(f"fe exact order {order}, edge-refined", edge, P, sol, phases, ratio, ref, which))
     return rows
 
 
-def patch_rows(patch, threads: int, loads, converged, growth: float = 0.0) -> list[dict]:
-    """The ``patch`` method (module docstring) per load; ``patch = (n_edge, n_body, d)``."""
+def patch_rows(patch, threads: int, loads, converged, growth: float = 0.0, cells=ACC_CELLS) -> list[dict]:
+    """The ``patch`` method (module docstring) per load and cell; ``patch = (n_edge, n_body, d)``."""
     from ngcontact.cell.fe.contact_edge_mesh import edge_points, edge_refined_cell, patch_body, patch_radius
     twin, rows = bisinusoid_spectral(ACC_TWIN), []
     n_edge, n_body, depth = patch
-    for ratio, ld, ref in zip(ACC_RATIOS, loads, converged):
+    for (ratio, ld, ref), which in itertools.product(zip(ACC_RATIOS, loads, converged), cells):
         phases = [time.perf_counter()]
         p = twin.solve(ld).fields["pressure"]
         phases.append(time.perf_counter())
         a = patch_radius(p, 1.0)
         body = patch_body(p, 1.0, maxh=a / n_body, depth=depth * a, growth=growth)
         cell = edge_refined_cell(edge_points(p, 1.0), edge_maxh=a / n_edge, maxh=PATCH_MAXH,
-                                 interface_maxh=ACC_INTERFACE, body=body)
+                                 interface_maxh=ACC_INTERFACE, body=body, symmetric=which == "quarter")
         phases.append(time.perf_counter())
         P, sol = _fe_solve(cell, 1, a / n_edge, ld, threads)
         phases.append(time.perf_counter())
         size = f"a/{n_edge:g} a/{n_body:g} {depth:g}a" + (f" growth {growth:g}" if growth else "")
-        rows.append(_row("fe exact order 1, patch-refined", size, P, sol, phases, ratio, ref))
+        rows.append(_row("fe exact order 1, patch-refined", size, P, sol, phases, ratio, ref, which))
     return rows
 
 
 def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None = None,
-                 growth: float = 0.0) -> list[dict]:
+                 growth: float = 0.0, cells=ACC_CELLS) -> list[dict]:
     """Part 4 (module docstring): the ``edge`` rows, the ``patch`` rows (``patch = None``: none; ``growth``: of
     their bodies' size with the depth) and the extrapolations in the edge size of the order-2 ``edge`` rows;
-    per load: seconds, dofs, relative error of the contact fraction."""
+    per load and cell (``cells``: ``"quarter"``, ``"period"``): seconds, dofs, relative error of the contact
+    fraction."""
     from ngcontact import runner
     from ngcontact.cell.cell_load import cell_load
     loads = [cell_load(3, pressure=r * math.pi * ACC_H) for r in ACC_RATIOS]
@@ -136,9 +145,9 @@ def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None 
     converged = [2.0 * fine.solve(ld).results["contact_fraction"] - coarse.solve(ld).results["contact_fraction"]
                  for ld in loads]
     threads = runner.thread_count() if threads is None else threads
-    rows = edge_rows(edges, orders, threads, loads, converged) if edges else []
+    rows = edge_rows(edges, orders, threads, loads, converged, cells) if edges else []
     if patch is not None:
-        rows += patch_rows(patch, threads, loads, converged, growth)
+        rows += patch_rows(patch, threads, loads, converged, growth, cells)
     return rows + extrapolated_rows(rows, dict(zip(ACC_RATIOS, converged)))
 
 
@@ -149,16 +158,48 @@ def extrapolated_rows(rows: list[dict], converged: dict) -> list[dict]:
     opposite errors (too stiff a body, a contact set past the edge), not a power of the edge size."""
     from ngcontact.cell.fe.edge_size_extrapolation import extrapolate
     out = []
-    for solver, ratio in sorted({(r["solver"], r["pressure"]) for r in rows if "order 2" in r["solver"]}):
-        sel = [r for r in rows if r["solver"] == solver and r["pressure"] == ratio]
+    def cell(r):          # rows of a run before the quarter cell: the period's
+        return r.get("cell") or "period"
+    for solver, which, ratio in sorted({(r["solver"], cell(r), r["pressure"]) for r in rows
+                                        if "order 2" in r["solver"]}):
+        sel = [r for r in rows if r["solver"] == solver and cell(r) == which and r["pressure"] == ratio]
         if len(sel) < 2:
             continue
         ext = extrapolate([r["size"] for r in sel], [r["contact_fraction"] for r in sel])
         finest = min(sel, key=lambda r: r["size"])
-        out.append({"part": "accuracy", "solver": solver + ", extrapolated",
+        out.append({"part": "accuracy", "solver": solver + ", extrapolated", "cell": which,
                     "size": " ".join(f"{r['size']:g}" for r in sel), "ndof": finest["ndof"],
                     "seconds": sum(r["seconds"] for r in sel), "contact_fraction": ext.value, "pressure": ratio,
                     "relative_error": ext.value / converged[ratio] - 1.0, "estimate": ext.estimate / ext.value})
         log.info("accuracy: %s p/p* %g extrapolated (%s): %+.2f %% (estimate %.2f %%), %.1f s", solver, ratio, ext.how,
                  100.0 * out[-1]["relative_error"], 100.0 * out[-1]["estimate"], out[-1]["seconds"])
     return out
+
+
+def aim_status(rows: list[dict], tolerance: float = 0.01, seconds: float = 60.0) -> str:
+    """Whether issue 38's aim (within ``tolerance`` of the converged contact fraction in at most ``seconds``
+    per load) is met, per load, in one Markdown sentence: the fastest row of part 4 meeting it (its cell, its
+    kind, its error; an extrapolation's own estimate beside it, and whether that estimate alone would
+    certify the tolerance); where none does in time, the fastest row within the tolerance and its time, or
+    that no row is within it."""
+    acc = [r for r in rows if r.get("part") == "accuracy" and isinstance(r.get("relative_error"), float)]
+    parts = []
+    for ratio in sorted({r["pressure"] for r in acc}):
+        ok = [r for r in acc if r["pressure"] == ratio and abs(r["relative_error"]) <= tolerance
+              and r["seconds"] <= seconds]
+        close = [r for r in acc if r["pressure"] == ratio and abs(r["relative_error"]) <= tolerance]
+        if not close:
+            parts.append(f"p/p* = {ratio:g}: not met (no row within {100.0 * tolerance:g} %)")
+            continue
+        best = min(ok or close, key=lambda r: r["seconds"])
+        verdict = "met" if ok else f"within {100.0 * tolerance:g} % but not in {seconds:g} s"
+        text = (f"p/p* = {ratio:g}: {verdict} by `{best['solver']}` on the {best.get('cell') or 'period'} "
+                f"(size {best['size']}), {100.0 * best['relative_error']:+.2f} % in {best['seconds']:.0f} s")
+        if isinstance(best.get("estimate"), float):
+            own = "within" if best["estimate"] <= tolerance else "above"
+            text += (f", its own estimate {100.0 * best['estimate']:.2f} % ({own} {100.0 * tolerance:g} %: "
+                     f"{'certified' if own == 'within' else 'not certified'} without the converged value)")
+        parts.append(text)
+    return ("Aim (issue 38: within %g %% of the converged contact fraction in at most %g s per load; an "
+            "extrapolation's seconds are the sum of its solves'): " % (100.0 * tolerance, seconds)
+            + ("; ".join(parts) if parts else "no accuracy rows") + ".")

@@ -24,7 +24,8 @@ Four measurements, one run, one CSV and one PNG:
    its mesh refined along its spectral twin's contact edge (``edge`` rows,
    ``--accuracy-edges``, ``--accuracy-orders``) or, order 1, along the edge
    and in the bodies below and above the patch, the sizes scaled with the
-   patch radius (``patch`` rows, ``--accuracy-patch``); the sibling module
+   patch radius (``patch`` rows, ``--accuracy-patch``), each on the whole period and on its
+   mirror-symmetric quarter side by side (column ``cell``, ``--accuracy-cells``); the sibling module
    ``bisinusoid_accuracy.py`` says what is solved.  Column
    ``relative_error``; the seconds include the twin, the meshing and the
    solve (threads: ``--accuracy-threads``), and each phase on its own.
@@ -44,6 +45,10 @@ whole contact surface on the wirebasket (``scaling_3d_coarse.csv``, ``.png``).
 With ``--republish CSV`` it measures nothing: it reads the measured rows of
 an earlier run's ``scaling_3d.csv``, makes the rows derived from them again
 (the edge-size extrapolations) and writes (and publishes) them as a run.
+With ``--keep-rows CSV`` it measures as asked and keeps that earlier run's rows
+above the new ones (a run adding rows to a published table, which ``--publish``
+rewrites whole); the section says which rows are whose, and whether the
+accuracy aim is met and by which row.
 
 With ``--breakdown INTERFACE_MAXH`` it measures instead where one iterative
 cell solve spends its time (CG per iteration, one BDDC application, one
@@ -55,9 +60,10 @@ Usage::
     python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral accuracy]
                                  [--accuracy-edges [EDGE_MAXH ...]] [--accuracy-orders 1 2]
                                  [--accuracy-patch N_EDGE N_BODY DEPTH | --accuracy-no-patch]
-                                 [--accuracy-patch-growth GROWTH] [--accuracy-threads N]
+                                 [--accuracy-patch-growth GROWTH] [--accuracy-cells quarter period]
+                                 [--accuracy-threads N]
                                  [--solvers iterative direct] [--breakdown INTERFACE_MAXH]
-                                 [--coarse INTERFACE_MAXH [--k-n K]] [--republish CSV]
+                                 [--coarse INTERFACE_MAXH [--k-n K]] [--republish CSV] [--keep-rows CSV]
 
 Writes ``scaling_3d.csv`` and ``scaling_3d.png`` into ``OUT_DIR`` (default
 ``results/scaling_3d``) and logs the tables and the fitted exponents.
@@ -78,7 +84,8 @@ from ngcontact.output.writer import write_csv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
-from bisinusoid_accuracy import ACC_EDGES, ACC_PATCH, QUICK_EDGES, accuracy_aim, extrapolated_rows  # noqa: E402
+from bisinusoid_accuracy import (ACC_CELLS, ACC_EDGES, ACC_PATCH, QUICK_EDGES, accuracy_aim,  # noqa: E402
+                                 aim_status, extrapolated_rows)
 
 log = logging.getLogger("scaling_3d")
 
@@ -90,9 +97,18 @@ MACRO_SIZES = (0.3, 0.2, 0.14, 0.1, 0.075, 0.041)
 QUICK_CELL, QUICK_MACRO = (0.16, 0.12), (0.35, 0.3)
 AMPLITUDE, PRESSURES = 0.005, (0.00185, 0.0065)
 SPECTRAL_GRIDS, TAMAAS_GRID = (64, 128, 256, 512), 1024
-KEYS = ("part", "solver", "size", "ndof", "seconds", "measure_seconds", "twin_seconds", "mesh_seconds",
+KEYS = ("part", "solver", "cell", "size", "ndof", "seconds", "measure_seconds", "twin_seconds", "mesh_seconds",
         "solve_seconds", "newton_steps", "cg_iterations", "peak_memory_gb", "contact_fraction", "pressure",
         "relative_error", "estimate")
+
+
+def period_scene():
+    """The shipped bisinusoid cell scene meshed over its whole period (``discretization.symmetry = "off"``):
+    parts 1 and the solver studies measure cost against the period's dofs."""
+    from dataclasses import replace
+    from ngcontact.scene.loader import load
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    return replace(scene, discretization=replace(scene.discretization, symmetry="off"))
 
 
 def peak_memory_gb() -> float:
@@ -110,7 +126,7 @@ def cell_child(size: float, policy: str) -> dict:
     from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
     from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
-    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    scene = period_scene()
     cell = build_cell(scene, interface_maxh=size)
     with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
         t0 = time.perf_counter()
@@ -313,9 +329,8 @@ def breakdown(size: float, out: str) -> dict:
     from ngcontact import runner
     from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
-    from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
-    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    scene = period_scene()
     cell = build_cell(scene, interface_maxh=size)
     with runner.threads(runner.thread_count()):
         P = CellProblem(cell, model_of(scene), linear=LinearSolver("iterative"), predictor=predictor_twin(scene, size))
@@ -390,9 +405,8 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
     from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
     from ngcontact.fem import elasticity
-    from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
-    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
+    scene = period_scene()
     model = model_of(scene) if k_n is None else replace(model_of(scene), k_n=k_n)
     rows = []
     with runner.threads(runner.thread_count()):
@@ -463,7 +477,8 @@ def measured_rows(args) -> list[dict]:
     if "accuracy" in args.parts:
         edges = args.accuracy_edges if args.accuracy_edges is not None else QUICK_EDGES if args.quick else ACC_EDGES
         rows += accuracy_aim(edges, tuple(args.accuracy_orders), None if args.accuracy_no_patch else
-                             tuple(args.accuracy_patch), args.accuracy_threads, args.accuracy_patch_growth)
+                             tuple(args.accuracy_patch), args.accuracy_threads, args.accuracy_patch_growth,
+                             tuple(args.accuracy_cells))
     return rows
 
 
@@ -499,12 +514,17 @@ def main(argv=None) -> int:
                     help="part 4's patch-refined rows: the bodies' size a/N_BODY + GROWTH |z| at depth |z| "
                          "(default 0: a/N_BODY to DEPTH a)")
     ap.add_argument("--accuracy-no-patch", action="store_true", help="no patch-refined rows in part 4")
+    ap.add_argument("--accuracy-cells", nargs="+", choices=ACC_CELLS, default=ACC_CELLS,
+                    help="part 4's cells, side by side: the mirror-symmetric quarter, the whole period (default both)")
     ap.add_argument("--accuracy-threads", type=int, default=None,
                     help="threads of part 4's FE solves (default: as ngcontact run)")
     ap.add_argument("--k-n", type=float, default=None, help="with --coarse: the penalty k_n (default the scene's)")
     ap.add_argument("--republish", metavar="CSV", default=None,
                     help="instead of measuring: the rows an earlier run measured (its scaling_3d.csv), the rows "
                          "derived from them made again, written (and with --publish published) as a run's")
+    ap.add_argument("--keep-rows", metavar="CSV", default=None,
+                    help="the rows an earlier run measured (its scaling_3d.csv) kept above those measured now, "
+                         "their derived rows made again: a run that adds rows to a published table")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
@@ -532,6 +552,8 @@ def main(argv=None) -> int:
                                   png=os.path.join(args.out, "scaling_3d_coarse.png"))
         return 0
     rows = republished_rows(args.republish) if args.republish else measured_rows(args)
+    kept = republished_rows(args.keep_rows) if args.keep_rows else []
+    rows = kept + rows
     os.makedirs(args.out, exist_ok=True)
     write_csv(os.path.join(args.out, "scaling_3d.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
     plot(rows, os.path.join(args.out, "scaling_3d.png"))
@@ -549,6 +571,9 @@ def main(argv=None) -> int:
                               note=("Rows measured by an earlier run (its CSV re-read with `--republish`; its "
                                     "timings, its machine's load), the extrapolated rows made again from them. "
                                     if args.republish else "") +
+                                   (f"The first {len(kept)} rows were measured by an earlier run (its CSV kept "
+                                    "with `--keep-rows`: its timings, its machine's load), the others by this "
+                                    "one. " if kept else "") + aim_status(rows) + " " +
                                    "Part `cell`: the 3D bisinusoid cell (order 2) refined, one load by sparse "
                                    "Cholesky (`direct`) and BDDC-CG (`iterative`), started as `ngcontact run` "
                                    "starts it; part `macro`: a 3D press fit of two tubes; part `spectral`: the "
@@ -559,7 +584,9 @@ def main(argv=None) -> int:
                                    "over the sizes listed, `estimate` its estimated relative error) or, order 1, "
                                    "along the edge and in the bodies below and above the patch (`patch-refined`, "
                                    "`size`: edge a/N_EDGE, bodies a/N_BODY to DEPTH a, a the twin's patch radius; "
-                                   "`growth G`: the bodies' size a/N_BODY + G |z| at depth |z|), "
+                                   "`growth G`: the bodies' size a/N_BODY + G |z| at depth |z|), each on the whole "
+                                   "period and on its mirror-symmetric quarter (`cell`: `period`, `quarter`: the "
+                                   "same sizes, zero normal displacement on the quarter's mirror faces), "
                                    "per `pressure` = p/p* "
                                    "(p* = pi E* h, h = 0.01, E* = 1), `relative_error` of the contact fraction "
                                    "against the spectral cell extrapolated from 512^2 and 1024^2 (issue 38 aims "

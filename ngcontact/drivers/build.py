@@ -24,6 +24,7 @@ from ngcontact.cell.spectral.spectral_solver import SpectralCellSolver
 from ngcontact.coupling import cell_law
 from ngcontact.drivers.cell_gap import gap_cf, gap_samples, map_heights
 from ngcontact.drivers.contact_edge_refiner import edge_refiner
+from ngcontact.drivers.mirror_symmetry import symmetry_choice
 from ngcontact.drivers.scene_laws import elastic_law
 from ngcontact.errors import SceneError
 from ngcontact.laws import homogenized as il
@@ -166,8 +167,9 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
             return cell3d.surface_cell(kind.heights(g, file), period=g.period, h_rough=g.h_rough,
                                        h_counter=g.h_counter, maxh=maxh, interface_maxh=ih,
                                        order=order)
-        if kind.solid is None:  # flat, or a small-slope profile carried by the gap
-            return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih)
+        if kind.solid is None:  # flat, or a small-slope profile carried by the gap; its quarter where symmetric
+            return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih,
+                                      symmetric=symmetry_choice(scene).used)
         return kind.solid(g, maxh=maxh, interface_maxh=ih)
     from ngcontact.geometry import profiles as pr
     assert kind.profile is not None  # every 2D profile has its builder

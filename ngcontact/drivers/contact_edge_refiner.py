@@ -15,6 +15,7 @@ from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.contact_edge_mesh import edge_refined_cell
 from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
 from ngcontact.cell.fe.fe_cell import FECell
+from ngcontact.drivers.mirror_symmetry import symmetry_choice
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
 from ngcontact.scene.cell_scene import CellScene, load_states
@@ -44,6 +45,7 @@ def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any]
         return None
     g, d = scene.geometry, scene.discretization
     h = d.interface_maxh or d.maxh
+    symmetric = symmetry_choice(scene).used      # the scene's cell's quarter, refined alike
 
     def pressures():
         twin = spectral(scene, grid=EDGE_TWIN_GRID, friction=False, tol=EDGE_TWIN_RTOL)
@@ -51,7 +53,7 @@ def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any]
 
     def cell_at(points, edge_maxh):
         cell = edge_refined_cell(points, edge_maxh=edge_maxh, period=g.period, h_rough=g.h_rough,
-                                 h_counter=g.h_counter, maxh=d.maxh, interface_maxh=h)
+                                 h_counter=g.h_counter, maxh=d.maxh, interface_maxh=h, symmetric=symmetric)
         return FECell.of(problem(scene, cell, model))
 
     return lambda fe: ContactEdgeRefinement(fe, pressures, cell_at, h, float(g.period))

@@ -102,11 +102,13 @@ def bilinear_integrand(law: ElasticLaw, u, v, setting: str):
     return ng.InnerProduct(stress(law, u, setting), strain(v, setting)) * weight(setting)
 
 
-def body_space(mesh, body: str, order: int, dirichlet: str = "", periodic: bool = False):
-    """``VectorH1`` of order ``order`` on region ``body`` (optionally periodic)."""
+def body_space(mesh, body: str, order: int, dirichlet: str = "", periodic: bool = False,
+               components: dict[str, str] | None = None):
+    """``VectorH1`` of order ``order`` on region ``body`` (optionally periodic); ``components``: component-wise
+    Dirichlet flags beside ``dirichlet`` (``{"dirichletx": "symmetry_x"}``: ``u_x = 0`` there)."""
     if order < 1:
         raise ModelError(f"order = {order!r}: must be >= 1")
-    V = vector_h1(mesh, order=order, definedon=mesh.Materials(body), dirichlet=dirichlet)
+    V = vector_h1(mesh, order=order, definedon=mesh.Materials(body), dirichlet=dirichlet, **(components or {}))
     return ng.Periodic(V) if periodic else V
 
 

@@ -93,20 +93,27 @@ class Segment:
 
 @dataclass(frozen=True)
 class Cell:
-    """A meshed periodic cell and its geometric data (no physics)."""
+    """A meshed periodic cell and its geometric data (no physics).
+
+    ``symmetric``: the mesh covers one quarter ``[0, P/2]^2`` of a 3D period whose cell is even about its
+    mid-lines, its lateral faces the mirror planes ``symmetry_x`` and ``symmetry_y`` (naming contract of
+    :mod:`ngcontact.geometry`) instead of periodic faces.
+    """
 
     mesh: ng.Mesh
     dim: int
     period: tuple[float, ...]          # period in each tangential direction
     h_rough: float         # depth of the rough body below y = 0
     h_counter: float       # height of the counter body above y = 0
+    symmetric: bool = False
 
     @property
     def area(self) -> float:
-        """``|T|``: projected area (3D) or length (2D) of one cell."""
+        """Projected area (3D) or length (2D) of the meshed part of a period: ``|T|``, or on a symmetric
+        cell the quarter's ``|T| / 4``, over which a mean over the period is the same mean."""
         a = 1.0
         for p in self.period:
-            a *= p
+            a *= 0.5 * p if self.symmetric else p
         return a
 
 

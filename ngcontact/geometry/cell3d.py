@@ -5,6 +5,21 @@ The cell is ``[0, P] x [0, P] x [-h_rough, h_counter]``; the macro normal
 faces ``x = 0, P`` and ``y = 0, P`` are identified periodically
 (``CSGeometry.PeriodicSurfaces``).
 
+Mirror-symmetric quarter
+------------------------
+A cell whose gap is even about its mid-lines ``x = P/2`` and ``y = P/2``
+(a periodic function even about ``P/2`` is even about ``0`` too), under a
+normal frictionless load, has a solution with the same mirror symmetry: the
+in-plane displacement normal to each mirror plane vanishes on it, and so
+does the shear traction on it.  :func:`flat_cell3d` and
+:func:`ngcontact.cell.fe.contact_edge_mesh.edge_refined_cell` with
+``symmetric=True`` mesh the quarter ``[0, P/2]^2`` instead; its lateral
+faces are ``symmetry_x`` (``x = 0, P/2``) and ``symmetry_y``
+(``y = 0, P/2``), where the cell problem holds ``u_x`` resp. ``u_y`` at zero
+and leaves the shear traction natural.  Means over the quarter are the
+means over the period (:attr:`~ngcontact.geometry.cell2d.Cell.area` is the
+quarter's).
+
 Shapes
 ------
 * :func:`flat_cell3d` -- the plane interface ``z = 0``;
@@ -49,7 +64,9 @@ from ngcontact.quiet import quiet
 log = logging.getLogger(__name__)
 
 ARRANGEMENTS = ("conforming", "summit")
-_KEEP = ("periodic", "top", "bottom")
+#: the lateral faces of a symmetric quarter, holding ``u_x`` resp. ``u_y`` at zero
+SYMMETRY_FACES = ("symmetry_x", "symmetry_y")
+_KEEP = ("periodic", "top", "bottom") + SYMMETRY_FACES
 
 
 def _positive(key, value):
@@ -58,33 +75,38 @@ def _positive(key, value):
     return float(value)
 
 
-def _box_planes(P, h_rough, h_counter):
-    """Lateral, bottom and top half-spaces of the cell."""
-    xm = Plane(Pnt(0, 0, 0), Vec(-1, 0, 0)).bc("periodic")
-    xp = Plane(Pnt(P, 0, 0), Vec(1, 0, 0)).bc("periodic")
-    ym = Plane(Pnt(0, 0, 0), Vec(0, -1, 0)).bc("periodic")
-    yp = Plane(Pnt(0, P, 0), Vec(0, 1, 0)).bc("periodic")
+def _box_planes(P, h_rough, h_counter, symmetric: bool = False):
+    """Lateral, bottom and top half-spaces of the cell (``symmetric``: of its quarter ``[0, P/2]^2``, the
+    lateral planes named after the displacement component they hold, :data:`SYMMETRY_FACES`)."""
+    side = 0.5 * P if symmetric else P
+    bx, by = SYMMETRY_FACES if symmetric else ("periodic", "periodic")
+    xm = Plane(Pnt(0, 0, 0), Vec(-1, 0, 0)).bc(bx)
+    xp = Plane(Pnt(side, 0, 0), Vec(1, 0, 0)).bc(bx)
+    ym = Plane(Pnt(0, 0, 0), Vec(0, -1, 0)).bc(by)
+    yp = Plane(Pnt(0, side, 0), Vec(0, 1, 0)).bc(by)
     bottom = Plane(Pnt(0, 0, -h_rough), Vec(0, 0, -1)).bc("bottom")
     top = Plane(Pnt(0, 0, h_counter), Vec(0, 0, 1)).bc("top")
     return (xm, xp, ym, yp), bottom, top
 
 
-def _identify_periodic(geo, lateral) -> None:
+def _identify_periodic(geo, lateral, symmetric: bool = False) -> None:
     """Identify the lateral planes ``x = 0, P`` and ``y = 0, P`` periodically (Netgen announces each
-    identification on C++'s standard output: kept off the terminal)."""
+    identification on C++'s standard output: kept off the terminal); a symmetric quarter's are not."""
+    if symmetric:
+        return
     xm, xp, ym, yp = lateral
     with quiet("stdout"):
         geo.PeriodicSurfaces(xm, xp)
         geo.PeriodicSurfaces(ym, yp)
 
 
-def _mesh(geo, maxh: float, P: float, h_rough: float, h_counter: float) -> Cell:
+def _mesh(geo, maxh: float, P: float, h_rough: float, h_counter: float, symmetric: bool = False) -> Cell:
     ngmesh = geo.GenerateMesh(maxh=periodic_maxh(maxh, P))
     _name_faces(ngmesh)
     mesh = ng.Mesh(ngmesh)
     log.debug("3D cell: %d elements, boundaries %s", mesh.ne, sorted(set(mesh.GetBoundaries())))
     return Cell(mesh=mesh, dim=3, period=(P, P), h_rough=float(h_rough),
-                h_counter=float(h_counter))
+                h_counter=float(h_counter), symmetric=symmetric)
 
 
 def _name_faces(ngmesh) -> None:
@@ -109,8 +131,9 @@ def _name_faces(ngmesh) -> None:
 
 
 def flat_cell3d(period: float = 1.0, h_rough: float = 1.0, h_counter: float = 1.0, *,
-                maxh: float, interface_maxh: float | None = None) -> Cell:
-    """Two bodies bonded along the plane ``z = 0`` of a periodic ``period x period`` cell.
+                maxh: float, interface_maxh: float | None = None, symmetric: bool = False) -> Cell:
+    """Two bodies bonded along the plane ``z = 0`` of a periodic ``period x period`` cell (``symmetric``:
+    its quarter ``[0, P/2]^2`` between mirror planes, module docstring).
 
     Parameters
     ----------
@@ -123,15 +146,23 @@ def flat_cell3d(period: float = 1.0, h_rough: float = 1.0, h_counter: float = 1.
     """
     P = _positive("period", period)
     hr, hc = _positive("h_rough", h_rough), _positive("h_counter", h_counter)
-    lat, bottom, top = _box_planes(P, hr, hc)
+    geo = flat_geometry(P, hr, hc, periodic_maxh(interface_maxh or maxh, P), symmetric)
+    return _mesh(geo, maxh, P, hr, hc, symmetric)
+
+
+def flat_geometry(P: float, h_rough: float, h_counter: float, interface_maxh: float,
+                  symmetric: bool = False) -> CSGeometry:
+    """The CSG geometry of :func:`flat_cell3d`: the two bodies of the box (or its symmetric quarter) split
+    by the plane ``contact`` at ``z = 0`` meshed at ``interface_maxh``, the lateral faces identified (periodic)."""
+    lat, bottom, top = _box_planes(P, h_rough, h_counter, symmetric)
     xm, xp, ym, yp = lat
-    plane = Plane(Pnt(0, 0, 0), Vec(0, 0, 1)).bc("contact").maxh(periodic_maxh(interface_maxh or maxh, P))
+    plane = Plane(Pnt(0, 0, 0), Vec(0, 0, 1)).bc("contact").maxh(interface_maxh)
     box = xm * xp * ym * yp
     geo = CSGeometry()
     geo.Add((box * bottom * plane).mat("rough"))
     geo.Add((box * top - plane).mat("counter"))
-    _identify_periodic(geo, (xm, xp, ym, yp))
-    return _mesh(geo, maxh, P, hr, hc)
+    _identify_periodic(geo, lat, symmetric)
+    return geo
 
 
 def square_hills_cell(side: float, height: float, *, period: float = 1.0,

@@ -140,12 +140,15 @@ def _error_text(q: dict) -> str:
     return f"+/- {q['relative_error']:.2%}"
 
 def method_line(results: dict) -> str | None:
-    """The method that solved a cell and why (``results.accuracy.method``) in one terminal line, else ``None``."""
+    """The method that solved a cell and why (``results.accuracy.method``) in one terminal line, with a 3D FE
+    cell's symmetry (``results.accuracy.symmetry``: its quarter or its period, and why), else ``None``."""
     acc = results.get("accuracy")
     method = acc.get("method") if isinstance(acc, dict) else None
-    if not isinstance(method, dict) or not method.get("reason"):
-        return None
-    return f"cell method {method['statement']}"
+    symmetry = acc.get("symmetry") if isinstance(acc, dict) else None
+    parts = [f"cell method {method['statement']}"] if isinstance(method, dict) and method.get("reason") else []
+    if isinstance(symmetry, dict):
+        parts.append(f"meshed as its {symmetry['statement']}")
+    return "; ".join(parts) or None
 
 
 def accuracy_line(results: dict) -> str | None:

@@ -51,6 +51,7 @@ HIGHLIGHTS: dict[str, list[tuple[str, str, str]]] = {
     ],
     "cell": [
         ("cell method", "results.accuracy.method.statement", ""),
+        ("cell symmetry", "results.accuracy.symmetry.statement", ""),
         ("method", "results.method.name", ""),
         ("whole-surface k_n", "results.whole_surface.k_n", ""),
         ("whole-surface k_t", "results.whole_surface.k_t", ""),

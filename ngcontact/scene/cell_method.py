@@ -43,7 +43,7 @@ D = TypeVar("D", bound=CellDiscretization)
 
 #: the keys only the FE cell reads, by section (the spectral cell has no mesh, no Newton steps, no sparse solve)
 FE_ONLY: dict[str, tuple[str, ...]] = {
-    "discretization": ("order", "maxh", "interface_maxh", "max_elements", "budget_dofs"),
+    "discretization": ("order", "maxh", "interface_maxh", "max_elements", "budget_dofs", "symmetry"),
     "solver": ("atol", "max_iter", "inverse", "linear", "iterative_from", "start", "coulomb", "coulomb_rtol",
                "coulomb_max_iter"),
 }

@@ -121,3 +121,30 @@ def test_a_state_that_cuts_new_elements_widens_the_high_rule_and_the_solve_goes_
     assert len(calls) == 2 and all(h["converged"] for h in sol.newton)
     # against the module's solve of the same cell and load (the fixture's)
     assert sol.results["contact_fraction"] == pytest.approx(solution.results["contact_fraction"], rel=1e-9)
+
+
+def test_the_split_energy_has_the_residual_as_its_derivative_at_order_3():
+    """From order 3 on ``2p`` exceeds ``Integrate``'s own default order: the energy integrates each element
+    by the residual's rule, so it equals the uniform high rule's and its slope along a direction is the
+    residual's (a Newton step's line search would otherwise judge the step by another energy)."""
+    from dataclasses import replace
+
+    from ngcontact.cell.fe.predictor import set_start
+    P = CellProblem(build_cell(SCENE, maxh=0.6, interface_maxh=0.25), replace(model_of(SCENE), order=3))
+    load0 = cell_loads(SCENE)[0]
+    P._apply_load(load0)
+    set_start(P, load0)                  # the rigid start: open, closed and cut elements
+    Q, uniform, u = P._quadrature, P._parts[1], P.gfu.vec
+    Q.restart(u)
+    assert any(Q.cut[int(e)] for e in Q.contact)
+    assert Q.Energy(u) == pytest.approx(uniform.Energy(u), rel=1e-12)
+    rng = np.random.default_rng(0)
+    d, r, trial = u.CreateVector(), u.CreateVector(), u.CreateVector()
+    d.FV().NumPy()[:] = rng.standard_normal(len(d)) * 1e-3 * np.max(np.abs(u.FV().NumPy()))
+    Q.Apply(u, r)
+    h = 1e-4
+    trial.data = u + h * d
+    plus = Q.Energy(trial)
+    trial.data = u - h * d
+    slope = (plus - Q.Energy(trial)) / (2.0 * h)
+    assert slope == pytest.approx(float(np.dot(d.FV().NumPy(), r.FV().NumPy())), rel=1e-6)

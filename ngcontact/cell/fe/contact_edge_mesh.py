@@ -55,7 +55,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import ngsolve as ng
-from netgen.csg import CSGeometry, Plane, Pnt, Vec
 from netgen.meshing import MeshingParameters
 
 from ngcontact.errors import GeometryError
@@ -154,7 +153,7 @@ def patch_radius(pressure: np.ndarray, period: float) -> float:
 
 def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1.0, h_rough: float = 1.0,
                       h_counter: float = 1.0, maxh: float, interface_maxh: float,
-                      body: PatchBody | None = None) -> Cell:
+                      body: PatchBody | None = None, symmetric: bool = False) -> Cell:
     """The flat periodic 3D cell (:func:`~ngcontact.geometry.cell3d.flat_cell3d`) with its mesh size
     restricted to ``edge_maxh`` at ``points`` on ``S_C`` (module docstring).
 
@@ -168,25 +167,20 @@ def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1
         As for :func:`~ngcontact.geometry.cell3d.flat_cell3d`.
     body
         The bodies below and above the patches refined too (:class:`PatchBody`), or ``None``.
+    symmetric
+        Mesh the quarter ``[0, P/2]^2`` between mirror planes (:mod:`ngcontact.geometry.cell3d`): the points
+        of the period are folded into it (:func:`fold_quarter`).
     """
     if not (np.isfinite(edge_maxh) and 0 < edge_maxh <= interface_maxh):
         raise GeometryError("edge_maxh", edge_maxh, f"must be > 0 and <= interface_maxh = {interface_maxh}")
     P = float(period)
-    lateral, bottom, top = cell3d._box_planes(P, float(h_rough), float(h_counter))
-    xm, xp, ym, yp = lateral
-    plane = Plane(Pnt(0, 0, 0), Vec(0, 0, 1)).bc("contact").maxh(periodic_maxh(interface_maxh, P))
-    box = xm * xp * ym * yp
-    geo = CSGeometry()
-    geo.Add((box * bottom * plane).mat("rough"))
-    geo.Add((box * top - plane).mat("counter"))
-    cell3d._identify_periodic(geo, lateral)
+    geo = cell3d.flat_geometry(P, float(h_rough), float(h_counter), periodic_maxh(interface_maxh, P), symmetric)
     mp = MeshingParameters(maxh=periodic_maxh(maxh, P))
-    pts = np.clip(np.asarray(points, float).reshape(-1, 2) % P, FACE_CLEARANCE * P, (1.0 - FACE_CLEARANCE) * P)
+    pts = _inside(points, P, symmetric)
     for x, y in pts:
         mp.RestrictH(x=float(x), y=float(y), z=0.0, h=float(edge_maxh))
     if body is not None:
-        below = np.clip(np.asarray(body.points, float).reshape(-1, 2) % P, FACE_CLEARANCE * P,
-                        (1.0 - FACE_CLEARANCE) * P)
+        below = _inside(body.points, P, symmetric)
         for z in body.heights():
             h = float(body.size(z))
             for x, y in below:
@@ -194,6 +188,28 @@ def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1
     ngmesh = geo.GenerateMesh(mp=mp)
     cell3d._name_faces(ngmesh)
     mesh = ng.Mesh(ngmesh)
-    log.info("edge-refined 3D cell: %d edge points at size %g, %d elements", len(pts), edge_maxh, mesh.ne)
-    return Cell(mesh=mesh, dim=3, period=(P, P), h_rough=float(h_rough), h_counter=float(h_counter))
+    log.info("edge-refined 3D cell%s: %d edge points at size %g, %d elements", " (symmetric quarter)" if symmetric
+             else "", len(pts), edge_maxh, mesh.ne)
+    return Cell(mesh=mesh, dim=3, period=(P, P), h_rough=float(h_rough), h_counter=float(h_counter),
+                symmetric=symmetric)
+
+
+def fold_quarter(points: np.ndarray, period: float) -> np.ndarray:
+    """Points ``(x, y)`` of the period mirrored into the quarter ``[0, P/2]^2``: ``x -> min(x, P - x)``
+    (``x`` taken modulo ``P``), the same in ``y``, duplicates (to a millionth of the period) dropped.  On a
+    cell even about its mid-lines a point and its mirror images carry the same solution."""
+    P = float(period)
+    q = np.asarray(points, float).reshape(-1, 2) % P
+    q = np.minimum(q, P - q)
+    if not len(q):
+        return q
+    _, keep = np.unique(np.round(q / (FACE_CLEARANCE * P)).astype(np.int64), axis=0, return_index=True)
+    return q[np.sort(keep)]
+
+
+def _inside(points: np.ndarray, P: float, symmetric: bool) -> np.ndarray:
+    """The restriction's points inside the meshed box, moved :data:`FACE_CLEARANCE` off its lateral faces."""
+    side = 0.5 * P if symmetric else P
+    pts = fold_quarter(points, P) if symmetric else np.asarray(points, float).reshape(-1, 2) % P
+    return np.clip(pts, FACE_CLEARANCE * P, side - FACE_CLEARANCE * P)
 

@@ -99,7 +99,8 @@ class ContactQuadrature:
         return [stiffness * ds for ds in self.measures]
 
     def _per_element(self, cf, order: int) -> np.ndarray:
-        values = ng.Integrate(cf, self.state.space.mesh, ng.BND, order=order, element_wise=True)
+        mesh = self.state.space.mesh
+        values = ng.Integrate(cf, mesh, ng.BND, order=order, element_wise=True, definedon=mesh.Boundaries("contact"))
         return np.asarray(values)[self.contact]
 
     def cut_elements(self, vec) -> np.ndarray:
@@ -140,9 +141,15 @@ class ContactQuadrature:
                 "contact_elements": len(self.contact), "high_order": self._high, "low_order": self._low}
 
     def Energy(self, vec) -> float:  # noqa: N802 (NGSolve's name)
+        """``Psi(vec)`` by the residual's rules: order ``2p + contact_bonus_order`` on ``C``, ``2p`` on the
+        other contact elements, integrated element by element at those orders, so that :meth:`Apply` is its
+        derivative (``Integrate`` of a ``ds`` term would take its own default order, below ``2p`` from
+        order 3 on, an energy whose slope along a Newton step differs from the residual's)."""
         self.state.vec.data = vec
-        mesh = self.state.space.mesh
-        return sum(float(ng.Integrate(self._energy * ds, mesh)) for ds in self.measures)
+        cut = np.array([self.cut[int(e)] for e in self.contact], dtype=bool)
+        high = self._per_element(self._energy, self._high)
+        low = self._per_element(self._energy, self._low)
+        return float(high[cut].sum() + low[~cut].sum())
 
     def Apply(self, vec, out) -> None:  # noqa: N802
         self.state.vec.data = vec

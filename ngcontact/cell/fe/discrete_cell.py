@@ -1,13 +1,14 @@
 """The discrete cell: what a state of the FE cell problem lives on and is measured with (no state).
 
-The cell problem of paper eqs. 49-51 (penalized, eq. 65) discretized on a meshed cell: the space
-``X = (u_r, u_c, U_1 .. U_d)`` of the two bodies' periodic fluctuations (``u_r`` zero on ``bottom``,
-``u_c`` zero on ``top``) and the far face's rigid translation ``U`` (one ``NumberSpace`` per component,
-defined only where it enters: on ``S_C`` and on the far face), the micro normal ``n`` on ``S_C``, the gap
-``g`` (for the penalty its interpolant of the displacement order on ``S_C``: the penetration ``J.n - g_h``
-is then a polynomial per element, its sign not polluted by the interpolation error of a transcendental
-gap), the load's parameters (far-face tractions ``tbar``, macro strain ``E`` of eq. 63), and, for exact
-enforcement, the multiplier on ``S_C``'s nodes and the augmentation ``k_n``.
+The cell problem of paper eqs. 49-51 (penalized, eq. 65) discretized on a meshed cell: the space ``X = (u_r,
+u_c, U_1 .. U_d)`` of the two bodies' periodic fluctuations (``u_r`` zero on ``bottom``, ``u_c`` zero on
+``top``; on a symmetric quarter cell, :mod:`ngcontact.geometry.cell3d`, not periodic but with the displacement
+normal to each mirror plane zero on it, :func:`mirror_flags`) and the far face's rigid translation ``U`` (one
+``NumberSpace`` per component, defined only where it enters: on ``S_C`` and on the far face), the micro normal
+``n`` on ``S_C``, the gap ``g`` (for the penalty its interpolant of the displacement order on ``S_C``: the
+penetration ``J.n - g_h`` is then a polynomial per element, its sign not polluted by the interpolation error
+of a transcendental gap), the load's parameters (far-face tractions ``tbar``, macro strain ``E`` of eq. 63),
+and, for exact enforcement, the multiplier on ``S_C``'s nodes and the augmentation ``k_n``.
 
 :func:`discretize` builds it once; the energy (:mod:`ngcontact.cell.fe.cell_energy`) and the cell problem
 (:class:`~ngcontact.cell.fe.cell_problem.CellProblem`, which adds the state and the solvers) read it.
@@ -25,6 +26,7 @@ from ngcontact.cell.fe.contact_multiplier import ContactMultiplier
 from ngcontact.cell.fe.linear_trace import lower_trace, trace_order
 from ngcontact.fem import elasticity as _el
 from ngcontact.fem.quadrature import sampling_order
+from ngcontact.geometry.cell3d import SYMMETRY_FACES
 
 
 @dataclass(frozen=True)
@@ -82,13 +84,14 @@ def discretize(cell, model: CellModel, *, normal=None, inverse: str = "sparsecho
     sparse direct solver the forms' storage is chosen for."""
     mesh, dim = cell.mesh, cell.dim
     n = normal if normal is not None else contact_normal(cell)
-    bodies = [_el.body_space(mesh, name, model.order, dirichlet=far) for name, far in (("rough", "bottom"),
-                                                                                       ("counter", "top"))]
+    mirror = mirror_flags(cell)
+    bodies = [_el.body_space(mesh, name, model.order, dirichlet=far, components=mirror)
+              for name, far in (("rough", "bottom"), ("counter", "top"))]
     trace = trace_order(model, dim)
     if trace < model.order:          # exact contact in 3D on a linear trace (ngcontact.cell.fe.linear_trace)
         for V in bodies:
             lower_trace(V, mesh, "contact", trace)
-    Vr, Vc = (ng.Periodic(V) for V in bodies)
+    Vr, Vc = bodies if getattr(cell, "symmetric", False) else (ng.Periodic(V) for V in bodies)
     # U lives only where it enters (S_C and the far face): a NumberSpace on every element would couple all
     # dofs and make the factorization much slower
     N = ng.NumberSpace(mesh, definedon=mesh.Boundaries("contact|top"))
@@ -104,6 +107,15 @@ def discretize(cell, model: CellModel, *, normal=None, inverse: str = "sparsecho
         augmentation=ng.Parameter(model.k_n),
         multiplier=ContactMultiplier(mesh, trace) if model.enforcement == "exact" else None,
         tangential_free=tangential_determinate(mesh, n, dim, model), inverse=inverse)
+
+
+def mirror_flags(cell) -> dict[str, str]:
+    """The component-wise Dirichlet flags of a symmetric quarter cell (:mod:`ngcontact.geometry.cell3d`): the
+    displacement normal to each mirror plane held at zero on it (``u_x`` on ``symmetry_x``, ``u_y`` on
+    ``symmetry_y``), the shear traction there left natural (zero); none on a periodic cell."""
+    if not getattr(cell, "symmetric", False):
+        return {}
+    return {f"dirichlet{axis}": face for axis, face in zip("xy", SYMMETRY_FACES)}
 
 
 def discrete_gap(mesh, model: CellModel):
