@@ -35,8 +35,8 @@ the report names (:func:`sweep_estimates`):
    of its closing pressure); the estimate is the tail of the geometric series beyond level ``k``,
    ``|d_k| rho / (1 - rho)``, times :data:`SPREAD`, the scatter of one level's error about the geometric
    model (the erratic factor above: an edge's position between two points) that two ratios cannot
-   resolve.  Where that exceeds the guarded bound below, which holds
-   without the geometric model, the guarded bound is the estimate: Richardson only ever sharpens it.
+   resolve.  Where that exceeds the guarded bound below (which holds without the geometric model), the
+   guarded bound is the estimate: Richardson only ever sharpens it.
 2. **The guarded bound** wherever the two ratios disagree, one difference vanished, or the sequence does
    not contract ("where two successive differences disagree in rate, the estimate says so and takes the
    larger"): the rate is the larger of the ratios held to ``[RATE_FLOOR, RATE_CAP]`` (never faster than
@@ -180,8 +180,7 @@ ORDER_RATE = {"contact_fraction": 0.5, "mean_closure": 0.5}
 FIRST_ORDER = 0.5
 #: Richardson's tail times this: the scatter of one level's error about the geometric model
 SPREAD = 2.0
-#: the estimated quantities refinement does not hold to the tolerance (module docstring): reported with their
-#: estimate only
+#: estimated quantities refinement does not hold to the tolerance (module docstring): reported with estimates
 UNCONTROLLED = ("normal_stiffness",)
 #: a quantity's estimate times this: the stiffness's first-order constant jumps with the edges' position between
 #: points, so that its error may exceed the differences beside it (module docstring)
