@@ -75,7 +75,8 @@ from ngcontact.fem.materials import ElasticLaw
 from ngcontact.fem.quadrature import sampling_order
 from ngcontact.fem.sampling import boundary_values
 from ngcontact.solvers.coulomb import coulomb_fixed_point
-from ngcontact.solvers.linear_solver import LinearSolver
+from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask
+from ngcontact.solvers.roundoff import free_norm
 from ngcontact.solvers.newton import minimize
 from ngcontact.fem.rigid_modes import check_rigid_modes, free_rigid_modes
 from ngcontact.solvers.continuation import INTERMEDIATE_RTOL, ladder
@@ -358,9 +359,7 @@ def _residual_norm(form, gfu: ng.GridFunction) -> float:
     """Norm of the free part of the residual of ``form`` at ``gfu`` (as Newton measures it)."""
     r = gfu.vec.CreateVector()
     form.Apply(gfu.vec, r)
-    free = np.array(list(gfu.space.FreeDofs()), dtype=bool)
-    r.FV().NumPy()[~free] = 0.0
-    return float(r.Norm())            # over the MPI ranks, each dof once (newton._Iteration.residual)
+    return free_norm(r, fixed_mask(gfu.space.FreeDofs()))
 
 
 def _warm(gfu: ng.GridFunction, start: ng.BaseVector) -> None:

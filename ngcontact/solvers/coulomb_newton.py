@@ -81,10 +81,10 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.errors import ConvergenceError
-from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask, mask_fixed
+from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask
 from ngcontact.solvers.line_search import ARMIJO, MIN_STEP, armijo, exact_step
 from ngcontact.solvers.newton import ActiveSetCycle, NewtonHistory
-from ngcontact.solvers.roundoff import at_floor, roundoff_floors
+from ngcontact.solvers.roundoff import at_floor, free_norm, roundoff_floors
 
 log = logging.getLogger(__name__)
 
@@ -224,8 +224,7 @@ class _Record:
         """``|R(vec)|`` on the free dofs, ``R(vec)`` left in ``out`` (default ``self.res``)."""
         out = self.res if out is None else out
         self.residual_form.Apply(vec, out)
-        mask_fixed(out, self.fixed)
-        return out.Norm()          # not InnerProduct(out, out): see newton._Iteration.residual
+        return free_norm(out, self.fixed)
 
     def state(self) -> float:
         """Freeze the threshold at the iterate, return ``|R|`` (into ``self.res``); the energy and the largest

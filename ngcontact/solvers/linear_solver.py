@@ -179,7 +179,7 @@ class LinearSolver:
         tol = self.rtol
         if symmetric and self.forcing and forcing is not None:
             tol = max(self.rtol, forcing)
-        extra = {"freedofs": freedofs} if symmetric else {}
+        extra = {"fixed": fixed_mask(freedofs)} if symmetric else {}
         return TangentSolve(self, krylov(form.mat, pre.mat, tol=tol, maxiter=self.max_iter, printrates=False,
                                          **extra), counted=True, record=record, tol=tol)
 

@@ -42,8 +42,8 @@ import ngsolve as ng
 
 from ngcontact.errors import ConvergenceError
 from ngcontact.solvers.line_search import ARMIJO, MIN_STEP, armijo, exact_step
-from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask, forcing_term, mask_fixed
-from ngcontact.solvers.roundoff import at_floor, at_roundoff, roundoff_floors, within_roundoff
+from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask, forcing_term
+from ngcontact.solvers.roundoff import at_floor, at_roundoff, free_norm, roundoff_floors, within_roundoff
 
 log = logging.getLogger(__name__)
 
@@ -216,15 +216,10 @@ class _Iteration:
         self.eta: float | None = None
 
     def residual(self, vec) -> float:
-        """``|r(vec)|`` on the free dofs; leaves ``r(vec)`` in ``self.res``.
-
-        ``Norm()``, not ``sqrt(InnerProduct(r, r))``: on MPI ranks the residual is distributed (each rank
-        holds its elements' part of a shared dof's entry), and NGSolve's inner product of a distributed
-        vector with itself cumulates it in place first, so that it multiplies the cumulated vector by
-        itself and counts every dof shared by k ranks k times; the norm counts each once."""
+        """``|r(vec)|`` on the free dofs, over the MPI ranks (:func:`~ngcontact.solvers.roundoff.free_norm`);
+        leaves ``r(vec)`` in ``self.res``."""
         self.form.Apply(vec, self.res)
-        mask_fixed(self.res, self.fixed)
-        return self.res.Norm()
+        return free_norm(self.res, self.fixed)
 
     def tolerance_met(self) -> bool:
         """The residual is within the requested tolerance."""

@@ -28,10 +28,13 @@ from __future__ import annotations
 import ngsolve as ng
 from ngsolve.krylovspace import CGSolver
 
+from ngcontact.solvers.roundoff import free_norm
+
 
 class ResidualCG(CGSolver):
     """Preconditioned CG that stops on ``|r_k| <= reach`` when ``reach`` is set (module docstring), the norm
-    taken on ``freedofs`` (the fixed dofs' rows hold the supports' reactions, not a residual).
+    taken on the free dofs (``fixed``: the mask of the others, whose rows hold the supports' reactions, not a
+    residual).
 
     ``reach``: the absolute Euclidean norm of the residual ``rhs - K x`` to
     reach (``None``: NGSolve's stopping rule, ``tol`` times the first
@@ -39,10 +42,10 @@ class ResidualCG(CGSolver):
     the first one included, as NGSolve's does.
     """
 
-    def __init__(self, *args, freedofs, **kwargs):
+    def __init__(self, *args, fixed, **kwargs):
         super().__init__(*args, **kwargs)
         self.reach: float | None = None
-        self.free = ng.Projector(freedofs, True)
+        self.fixed = fixed
 
     def _SolveImpl(self, rhs, sol):
         if self.reach is None:
@@ -53,7 +56,7 @@ class ResidualCG(CGSolver):
         s.data = z
         rz = ng.InnerProduct(z, r)
         self.iterations = 1
-        while _norm(r, rf, self.free) > self.reach:
+        while _norm(r, rf, self.fixed) > self.reach:
             if self.iterations >= self.maxiter:
                 return
             ks.data = self.mat * s
@@ -69,8 +72,8 @@ class ResidualCG(CGSolver):
             s.data = (rz / rz_old) * s + z
 
 
-def _norm(vec, work, free) -> float:
-    """The Euclidean norm of ``vec`` on the free dofs (``free``: their projector; ``work``: a vector to hold
-    the projection), over the ranks for a vector distributed by NGSolve."""
-    work.data = free * vec
-    return work.Norm()
+def _norm(vec, work, fixed) -> float:
+    """The Euclidean norm of ``vec`` on the free dofs (``fixed``: the mask of the others; ``work``: a vector
+    to hold the masked copy, ``vec`` left as it is), over the ranks for a vector distributed by NGSolve."""
+    work.data = vec
+    return free_norm(work, fixed)

@@ -64,6 +64,17 @@ def roundoff_floors(mat, vec, fixed, energy: float = 0.0) -> tuple[float, float]
     return eps * summed_norm(vec, m), energy_floor
 
 
+def free_norm(vec, fixed) -> float:
+    """``|vec|`` on the free dofs, with the entries that are not free zeroed in ``vec``.
+
+    ``Norm()``, not ``sqrt(InnerProduct(vec, vec))``: on MPI ranks a residual is distributed (each rank holds
+    its elements' part of a shared dof's entry), and NGSolve's inner product of a distributed vector with
+    itself cumulates it in place first, so that it multiplies the cumulated vector by itself and counts
+    every dof shared by k ranks k times; the norm counts each once."""
+    vec.FV().NumPy()[fixed] = 0.0
+    return float(vec.Norm())
+
+
 def summed_norm(vec, local: np.ndarray) -> float:
     """``|sum_r local_r|``: the norm of the vector whose entries are ``local`` summed over the MPI ranks
     ``vec`` is distributed on, each dof counted once (``|local|`` in one process)."""
