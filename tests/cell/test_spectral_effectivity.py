@@ -298,6 +298,31 @@ def test_contact_islands_of_a_periodic_mask_and_the_share_of_the_unresolved_ones
     assert unresolved_share(cell, p)["share"] == {}
 
 
+def test_3d_contact_islands_across_the_period_and_the_share_of_the_narrow_ones():
+    """In 3D an island is 4-connected across the period too; one without a run of four points along either
+    direction of the grid is unresolved, and its share holds its points and their open 4-neighbours."""
+    from ngcontact.cell.spectral.contact_edges import narrow_islands, periodic_labels, unresolved_share
+    on = np.zeros((16, 16), bool)
+    on[0, 5] = on[15, 5] = True                 # two points joined across the period: narrow
+    on[6:11, 6:11] = True                       # five by five: resolved
+    on[3, 14:16] = on[3, 0:2] = True            # four in a row across the period, one point wide: narrow
+    labels, n = periodic_labels(on)
+    assert n == 3 and labels[0, 5] == labels[15, 5] and labels[3, 15] == labels[3, 0]
+    narrow, count, points = narrow_islands(on)
+    assert count == 2 and points == 2 and narrow.sum() == 6 and not narrow[8, 8]
+    cell = _cell(3, _bisinusoid, 16)
+    p = np.where(on, 1.0, 0.0)
+    share = unresolved_share(cell, p)
+    ring = narrow.copy()
+    for axis in (0, 1):
+        ring |= np.roll(narrow, 1, axis=axis) | np.roll(narrow, -1, axis=axis)
+    assert share["islands"] == 2 and share["share"]["contact_fraction"] == pytest.approx(ring.sum() / 256)
+    assert ring.sum() == 2 + 6 + 4 + 10         # the pair and its 6 open neighbours, the row and its 10
+    assert share["share"]["coefficient_g_n"] == pytest.approx(cell.k_n * cell.g0[ring].sum() / 256)
+    p[0, 5] = p[15, 5] = p[3] = 0.0
+    assert unresolved_share(cell, p)["share"] == {} and unresolved_share(cell, np.ones((16, 16)))["islands"] == 0
+
+
 def test_an_island_raises_an_estimate_below_its_share_and_a_loose_guarded_bound_is_flagged():
     """:func:`~ngcontact.cell.spectral.contact_edges.island_floor` raises only the estimates below the share (in
     their measure); :func:`~ngcontact.cell.spectral.estimate_forms.loose_flags` flags a guarded estimate above ten
