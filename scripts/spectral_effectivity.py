@@ -260,8 +260,8 @@ def main(argv=None) -> int:
                               "quartic (in 3D: a count of points), and in 2D also estimated on the levels whose "
                               "edges the quartic located, a stop to the tolerance waiting for four of them; on the "
                               "grid after such a wait the waited grid's estimate plus the last difference where "
-                              "smaller: `carried`; in 2D at least the share of contact islands of fewer than "
-                              "four points, their points and one step beyond each edge: `island`); a tolerance not "
+                              "smaller: `carried`; at least the share of contact islands of fewer than four "
+                              "points (3D: across), their points and a step beyond: `island`); a tolerance not "
                               "met within the study's largest grid reports nothing. The true error of the reported "
                               "grid is against the same cell on a much finer grid; `next_error` is that of the grid "
                               "twice as fine, `reference_change` the reference's own change from the grid of half "
@@ -270,15 +270,18 @@ def main(argv=None) -> int:
                               "grid, their edges located there, against the reference. `flag`: the estimator's own "
                               "statement that its estimate may exceed the error by more than ten times (a "
                               "guarded, carried or island estimate above ten times the error its last difference "
-                              "leaves at the last contraction), with its reason, as the report lists it. Issue 35 "
-                              "asks for effectivities between 1 and 10. "
+                              "leaves at the last contraction, or an estimate of any form above ten times the error "
+                              "it leaves at the contraction before where the last two disagree, the last twice as "
+                              "slow or more), with its reason, as the report lists it (results.accuracy.quantities"
+                              "[].loose). Issue 35 asks for effectivities between 1 and 10. "
                               f"{summary}. Of the rows above 10, {chance} have a reported error small by chance "
                               "(`by_chance`: of another sign than the coarser grid's, or below the finer grid's); "
                               "in the others the error fell from the coarser grid by much more than the "
-                              "differences before it show. No estimate from the differences up to the reported "
-                              "grid can see either. A row whose true error lies below its `locator_bias` has the "
-                              "edge localisation's error cancelled by the collocation's: its effectivity measures "
-                              "that cancellation.",
+                              "differences before it show: where their last two contractions disagree the flag "
+                              "says so; where they agree, no estimate from the differences up to the reported "
+                              "grid can see it (nor a chance error). A row whose true error lies below its "
+                              "`locator_bias` has the edge localisation's error cancelled by the collocation's: its "
+                              "effectivity measures that cancellation.",
                               png=os.path.join(args.out, "spectral_effectivity.png"))
     return 0
 

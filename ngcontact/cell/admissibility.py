@@ -101,12 +101,15 @@ ESTIMATED = {"contact_fraction": "absolute", "mean_closure": "relative", "normal
 
 
 def quantities(loads: list[dict[str, Any]], estimates: Sequence[dict[str, float]], tolerance: float,
-               uncontrolled: Sequence[str] = (), scales: Sequence[dict[str, float]] = ()) -> list[dict[str, Any]]:
+               uncontrolled: Sequence[str] = (), scales: Sequence[dict[str, float]] = (),
+               loose: Sequence[dict[str, str]] = ()) -> list[dict[str, Any]]:
     """Per load and estimated quantity: its value, the estimated error (absolute, relative to the value, and
     in the measure the refinement controls, :func:`~ngcontact.cell.cell_solution.measure`, with the scale it
     divides by: the refinement's ``scales`` per load where given), whether that meets ``tolerance`` and
     whether it counts in the verdict (``counted``: not for the ``uncontrolled`` quantities, which the
-    refinement reports without holding them to the tolerance)."""
+    refinement reports without holding them to the tolerance) and ``loose``: the refinement's statement that
+    the estimate may exceed the error by more than ten times, with its reason (per load in ``loose`` where
+    the method makes it, :func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`), else ``None``."""
     out = []
     for k, (results, estimate) in enumerate(zip(loads, estimates)):
         head = headline(results)
@@ -117,14 +120,15 @@ def quantities(loads: list[dict[str, Any]], estimates: Sequence[dict[str, float]
             out.append({"load": k, "name": name, "value": value, "error": absolute,
                         "relative_error": absolute / abs(value) if value != 0 else None,
                         "controlled": measure(name), "scale": size, "controlled_error": e, "met": e <= tolerance,
-                        "counted": name not in uncontrolled})
+                        "counted": name not in uncontrolled,
+                        "loose": loose[k].get(name) if k < len(loose) else None})
     return out
 
 
 def verdict(loads: list[dict[str, Any]], tolerance: float | None, cell: Sequence[Check] = (),
             estimates: Sequence[dict[str, float]] | None = None, how: str = "", reached: bool = True,
-            uncontrolled: Sequence[str] = (), scales: Sequence[dict[str, float]] = ()
-            ) -> tuple[dict[str, Any], list[Check]]:
+            uncontrolled: Sequence[str] = (), scales: Sequence[dict[str, float]] = (),
+            loose: Sequence[dict[str, str]] = ()) -> tuple[dict[str, Any], list[Check]]:
     """The report's verdict on a sweep's results and its failed checks.
 
     ``{"tolerance", "tolerance_from", "met", "checks", "estimated", "quantities", "how"}``: ``cell`` are the
@@ -133,12 +137,13 @@ def verdict(loads: list[dict[str, Any]], tolerance: float | None, cell: Sequence
     False``: the refinement stopped at its size bound before it could show the tolerance met (too few levels),
     so the verdict is not met whatever the estimates; ``uncontrolled``: estimated quantities the refinement
     does not hold to the tolerance (listed, not counted); ``scales``: per load what each estimate divides
-    the absolute error by (:func:`quantities`).
+    the absolute error by, ``loose`` per load the estimates that may exceed their error by more than ten
+    times (:func:`quantities`).
     """
     limit = DEFAULT_TOLERANCE if tolerance is None else tolerance
     checks = list(cell) + [c for k, results in enumerate(loads) for c in load_checks(k, results, limit)]
     failed = [c for c in checks if not c.ok]
-    estimated = quantities(loads, estimates, limit, uncontrolled, scales) if estimates is not None else []
+    estimated = quantities(loads, estimates, limit, uncontrolled, scales, loose) if estimates is not None else []
     out = {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
            "met": reached and not failed and all(q["met"] for q in estimated if q["counted"]),
            "checks": [c.as_dict() for c in checks],

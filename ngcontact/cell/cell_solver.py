@@ -75,6 +75,9 @@ class Refinement:
     #: per load, what each estimate's absolute error was divided by in its measure
     #: (:func:`~ngcontact.cell.cell_solution.scale`), where the method says
     scales: list[dict[str, float]] = field(default_factory=list)
+    #: per load, the estimates the method states may exceed their error by more than ten times, with the
+    #: reason (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`), where the method says
+    loose: list[dict[str, str]] = field(default_factory=list)
     #: the solutions are the scene's own discretization's, their error estimated without refining
     #: (:meth:`CellSolver.default_accuracy` of an FE cell)
     scene_discretization: bool = False
@@ -201,6 +204,6 @@ def joined(parts: list[Refinement]) -> Refinement:
                       histories=[h for p in parts for h in (p.histories or [s.newton for s in p.solutions])],
                       how=how, met=all(p.met for p in parts),
                       uncontrolled=tuple(dict.fromkeys(u for p in parts for u in p.uncontrolled)),
-                      scales=rows(lambda p: p.scales),
+                      scales=rows(lambda p: p.scales), loose=rows(lambda p: p.loose),
                       scene_discretization=all(p.scene_discretization for p in parts),
                       shortfall=worst.shortfall if worst is not None else "")

@@ -92,7 +92,8 @@ def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[
         how=unestimated if refinement is None else refinement.how,
         reached=refinement is None or refinement.met,
         uncontrolled=refinement.uncontrolled if refinement is not None else (),
-        scales=refinement.scales if refinement is not None else ())
+        scales=refinement.scales if refinement is not None else (),
+        loose=refinement.loose if refinement is not None else ())
     wrong = [c for c in failed if c.plainly_wrong]
     if wrong:
         raise ConvergenceError(

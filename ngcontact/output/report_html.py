@@ -235,7 +235,7 @@ def kind_tables(report: dict) -> str:
         parts.append("<h3>Law per load</h3>" + _rows_table(loads, LOAD_COLUMNS))
     if report.get("kind") == "accuracy-study":
         parts.append(study_tables(report))
-    if report.get("kind") == "macro":
+    if report.get("kind") in ("macro", "cell"):
         parts.append(accuracy_table(report))
     if isinstance(history, list) and history:
         parts.append("<h3>Two-scale iterations (max_change: largest pressure change over the interface)</h3>"
@@ -244,23 +244,26 @@ def kind_tables(report: dict) -> str:
 
 
 def accuracy_table(report: dict) -> str:
-    """A macro run's accuracy verdict as a table: per quantity its value, estimated relative error (or that it
-    is mesh dependent), whether the verdict counts it and where it is attained; the balls the maxima away
-    from the singular points are taken outside of."""
+    """A run's accuracy verdict as a table: per quantity (a cell's per load) its value, estimated relative error
+    (or that it is mesh dependent), whether the verdict counts it, where a macro run attains it, and beside it
+    the estimator's statement that the estimate may exceed the error by more than ten times (``loose``); the
+    balls the maxima away from the singular points are taken outside of."""
     acc = _get(report, "results.accuracy") or {}
     quantities = [q for q in acc.get("quantities", []) if isinstance(q, dict)] if isinstance(acc, dict) else []
     if not quantities:
         return ""
-    rows = [[str(q.get("name")), fmt(q.get("value")),
+    macro, loose = report.get("kind") == "macro", any(q.get("loose") for q in quantities)
+    rows = [[(f"load {q['load']}, " if q.get("load") is not None else "") + str(q.get("name")), fmt(q.get("value")),
              "mesh dependent, singular at " + fmt(q["singular_at"]) if q.get("singular_at") is not None
-             else fmt(q.get("relative_error")), fmt(q.get("counted", True)), fmt(q.get("location"))]
-            for q in quantities]
+             else fmt(q.get("relative_error")), fmt(q.get("counted", True))]
+            + [fmt(q.get("location"))] * macro + [q.get("loose") or ""] * loose for q in quantities]
     ex = acc.get("exclusion") or {}
     note = (f"<p>*_away: outside {fmt(ex.get('radius'), 'm')} of the singular points {fmt(ex.get('points'))} "
             f"({_e(', '.join(ex.get('why', [])))}); the mesh-dependent maxima are listed, not counted.</p>"
             if ex.get("points") else "") + _edges_note(ex)
     return ("<h3>Accuracy (met: " + fmt(acc.get("met")) + ")</h3>" + note
-            + html_table(["quantity", "value", "relative error", "counted", "at"], rows))
+            + html_table(["quantity", "value", "relative error", "counted"] + ["at"] * macro
+                         + ["loose: may exceed the error by more than 10 times"] * loose, rows))
 
 
 def _edges_note(ex: dict) -> str:

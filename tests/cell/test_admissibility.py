@@ -97,6 +97,15 @@ def test_the_spectral_cell_carries_the_same_verdict(tmp_path, capsys, name):
     acc = report["results"]["accuracy"]
     balances = [c for c in acc["checks"] if c["name"] == "pressure_balance"]
     assert acc["met"] and [c["load"] for c in balances] == list(range(len(report["results"]["loads"])))
+    # the estimates the refinement states may exceed their error by more than ten times: per quantity, as in `how`
+    loose = {(q["load"], q["name"]): q["loose"] for q in acc["quantities"]}
+    assert all(why is None or isinstance(why, str) for why in loose.values())
+    flagged = [(k, name, why) for (k, name), why in loose.items() if why]
+    assert flagged and all(f"load {k} {name} ({why})" in acc["how"] for k, name, why in flagged)
+    from ngcontact.output.report_html import render
+    page = render(report, str(tmp_path), [])
+    k, name, why = flagged[0]
+    assert f"<td>load {k}, {name}</td>" in page and f"<td>{why}</td>" in page.split(f"<td>load {k}, {name}</td>")[1]
 
 
 def test_the_page_shows_a_missed_accuracy_at_its_top():
@@ -150,3 +159,21 @@ def test_the_estimated_quantities_of_a_refinement():
     assert not v["met"] and not failed and v["estimated"] and v["how"] == "x"      # no check failed: an estimate
     v, _ = verdict(loads, None)
     assert not v["estimated"] and v["quantities"] == [] and "not estimated" in v["how"]
+
+
+def test_an_estimate_that_may_be_loose_says_so_beside_its_quantity():
+    """``loose``: the refinement's statement that an estimate may exceed its error by more than ten times, per
+    quantity of the verdict (``None`` where it makes none) and in the page's accuracy table beside it."""
+    from ngcontact.output.report_html import render
+    loads = [{"contact_fraction": 0.2, "mean_closure": -0.5}, {"contact_fraction": 0.3, "mean_closure": -0.4}]
+    estimates = [{"contact_fraction": 0.004, "mean_closure": 0.002}] * 2
+    v, _ = verdict(loads, 0.01, estimates=estimates, how="x", loose=[{}, {"mean_closure": "an earlier difference"}])
+    assert [(q["load"], q["name"], q["loose"]) for q in v["quantities"]] == [
+        (0, "contact_fraction", None), (0, "mean_closure", None), (1, "contact_fraction", None),
+        (1, "mean_closure", "an earlier difference")]
+    assert all(q["loose"] is None for q in verdict(loads, 0.01, estimates=estimates, how="x")[0]["quantities"])
+    page = render({"title": "t", "kind": "cell", "results": {"accuracy": v}}, ".", [])
+    row = page.split("<td>load 1, mean_closure</td>")[1].split("</tr>")[0]
+    assert "<td>an earlier difference</td>" in row and "may exceed the error by more than 10 times" in page
+    v, _ = verdict(loads, 0.01, estimates=estimates, how="x")
+    assert "may exceed" not in render({"title": "t", "kind": "cell", "results": {"accuracy": v}}, ".", [])

@@ -298,6 +298,31 @@ def test_contact_islands_of_a_periodic_mask_and_the_share_of_the_unresolved_ones
     assert unresolved_share(cell, p)["share"] == {}
 
 
+def test_3d_contact_islands_across_the_period_and_the_share_of_the_narrow_ones():
+    """In 3D an island is 4-connected across the period too; one without a run of four points along either
+    direction of the grid is unresolved, and its share holds its points and their open 4-neighbours."""
+    from ngcontact.cell.spectral.contact_edges import narrow_islands, periodic_labels, unresolved_share
+    on = np.zeros((16, 16), bool)
+    on[0, 5] = on[15, 5] = True                 # two points joined across the period: narrow
+    on[6:11, 6:11] = True                       # five by five: resolved
+    on[3, 14:16] = on[3, 0:2] = True            # four in a row across the period, one point wide: narrow
+    labels, n = periodic_labels(on)
+    assert n == 3 and labels[0, 5] == labels[15, 5] and labels[3, 15] == labels[3, 0]
+    narrow, count, points = narrow_islands(on)
+    assert count == 2 and points == 2 and narrow.sum() == 6 and not narrow[8, 8]
+    cell = _cell(3, _bisinusoid, 16)
+    p = np.where(on, 1.0, 0.0)
+    share = unresolved_share(cell, p)
+    ring = narrow.copy()
+    for axis in (0, 1):
+        ring |= np.roll(narrow, 1, axis=axis) | np.roll(narrow, -1, axis=axis)
+    assert share["islands"] == 2 and share["share"]["contact_fraction"] == pytest.approx(ring.sum() / 256)
+    assert ring.sum() == 2 + 6 + 4 + 10         # the pair and its 6 open neighbours, the row and its 10
+    assert share["share"]["coefficient_g_n"] == pytest.approx(cell.k_n * cell.g0[ring].sum() / 256)
+    p[0, 5] = p[15, 5] = p[3] = 0.0
+    assert unresolved_share(cell, p)["share"] == {} and unresolved_share(cell, np.ones((16, 16)))["islands"] == 0
+
+
 def test_an_island_raises_an_estimate_below_its_share_and_a_loose_guarded_bound_is_flagged():
     """:func:`~ngcontact.cell.spectral.contact_edges.island_floor` raises only the estimates below the share (in
     their measure); :func:`~ngcontact.cell.spectral.estimate_forms.loose_flags` flags a guarded estimate above ten
@@ -318,3 +343,35 @@ def test_an_island_raises_an_estimate_below_its_share_and_a_loose_guarded_bound_
     assert rate == pytest.approx(0.05) and left == pytest.approx(0.001 * 0.05 / 0.95)
     flags = loose_flags(history, estimates, forms)
     assert set(flags[0]) == {"contact_fraction"} and "island" in flags[0]["contact_fraction"]
+
+
+def test_contractions_that_disagree_flag_an_estimate_of_any_form_above_ten_times_the_faster_tail():
+    """Where the last contraction is at least twice as slow as the one before, the estimate (which takes the
+    slower) is flagged when above ten times the tail its last difference leaves at the faster one, Richardson's
+    too, with both contractions; contractions that agree flag nothing."""
+    from ngcontact.cell.spectral.estimate_forms import faster_contraction, loose_flags, loose_reason
+    values = [1.0, 1.0 - 3.2e-4, 1.0 - 3.2e-4 - 6.4e-5, 1.0 - 3.2e-4 - 6.4e-5 - 3.5e-5]   # 0.2, then 0.55
+    left, before, last = faster_contraction(values)
+    assert (before, last) == (pytest.approx(0.2), pytest.approx(0.546875))
+    assert left == pytest.approx(3.5e-5 * 0.2 / 0.8)
+    assert loose_reason(values, 8.6e-5, RICHARDSON) == ""                     # 9.8 times: within
+    reason = loose_reason(values, 8.8e-5, RICHARDSON)                        # 10.1 times
+    assert reason.startswith("10.1 times") and "disagree (0.2, then 0.55)" in reason
+    steady = [1.0, 1.0 - 3.2e-4, 1.0 - 3.2e-4 - 1.0e-4, 1.0 - 3.2e-4 - 1.0e-4 - 3.5e-5]   # 0.31, then 0.35
+    assert faster_contraction(steady) is None and loose_reason(steady, 1e-3, RICHARDSON) == ""
+    history = [{"whole_surface": {}, "headline": [{"mean_closure": v}]} for v in values]
+    flags = loose_flags(history, [{"mean_closure": 2e-4}], [{"mean_closure": GUARDED}])  # 5.7 and 22.9 times
+    assert "the last two contractions disagree" in flags[0]["mean_closure"]
+
+
+def test_on_the_random_profile_the_mean_closure_estimate_loose_by_ten_is_flagged():
+    """The random profile's sweep at tolerance 1e-3, its lightest load: the mean closure's error falls about five times from
+    the coarser grid while the last difference only halves (contractions 0.19, then 0.55), so the estimate
+    exceeds its error by about ten times; it bounds it, and the estimator says it may be loose, with both
+    contractions."""
+    loads = [cell_load(2, pressure=p) for p in (0.001, 0.003, 0.01)]        # the three loads stop on grid 4096
+    refined = sweep_to_tolerance(lambda n: _cell(2, _random_profile, n), loads, 1e-3, 64, 2, 2 ** 22)
+    exact = _cell(2, _random_profile, 2 ** 16).sweep(loads)[0].results["mean_closure"]
+    error = abs(refined.solutions[0].results["mean_closure"] - exact) / abs(exact)
+    assert refined.history[-1]["grid"] == 4096 and refined.estimates[0]["mean_closure"] >= error
+    assert "the last two contractions disagree" in refined.flags[0]["mean_closure"]

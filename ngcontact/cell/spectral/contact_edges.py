@@ -1,4 +1,4 @@
-"""The contact set's edges and islands as the refinement's estimate sees them (2D spectral cell).
+"""The contact set's edges and islands as the refinement's estimate sees them (spectral cell).
 
 The headline quantities that rest on the contact edges (:func:`on_edges`: the contact fraction and the
 coefficients of eq. 34 on the real contact set, :mod:`~ngcontact.cell.spectral.grid_measures`) are
@@ -23,14 +23,21 @@ things the differences cannot show are read off the levels here:
   edges (:func:`island_floor`): the floor falls like ``h`` while islands stay unresolved, and vanishes
   once every island spans :data:`ISLAND_POINTS` points.
 
-In 3D the contact fraction counts points and no edge is located between them: an island's points are
-counted as every other point is, and no floor is taken.
+In 3D the contact fraction counts points and no edge is located between them: the count of an island is off
+by about one layer of points along its boundary, an error of order ``h`` times its perimeter that is a
+small part of a resolved island's area.  An island fewer than :data:`ISLAND_POINTS` points across in a
+direction of the grid (no run of that many contact points along it: :func:`narrow_islands`; the islands are
+4-connected across the period, :func:`periodic_labels`) is all boundary: its count may be off by its whole
+size, and two grids may count it alike while its true area differs, as a 2D island's located width may.
+Its share is bounded the same way, by its points and one step beyond its boundary (the 4-neighbours of its
+points), eq. 34 on them; the refinement takes it as the same floor.
 """
 from __future__ import annotations
 
 from typing import Any
 
 import numpy as np
+from scipy import ndimage
 
 from ngcontact.cell.cell_solution import COEFFICIENT, scale
 from ngcontact.cell.spectral.grid_measures import coefficients
@@ -77,18 +84,63 @@ def islands(on: np.ndarray) -> list[tuple[int, int]]:
     return [(int(a), int((b - a) % on.size) + 1) for a, b in zip(first, last)]
 
 
+def periodic_labels(on: np.ndarray) -> tuple[np.ndarray, int]:
+    """The islands of a periodic 2D mask (4-connected, across the period too) as a label ``1..n`` per point
+    (0 where open) and their number ``n``; none where it is all ``True`` or all ``False``."""
+    if on.all() or not on.any():
+        return np.zeros(on.shape, int), 0
+    labels, n = ndimage.label(on)
+    parent = np.arange(n + 1)
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            i = parent[i]
+        return i
+    for a, b in ((labels[0, :], labels[-1, :]), (labels[:, 0], labels[:, -1])):     # the opposite sides meet
+        for i, j in zip(a[(a > 0) & (b > 0)], b[(a > 0) & (b > 0)]):
+            ri, rj = root(int(i)), root(int(j))
+            parent[max(ri, rj)] = min(ri, rj)
+    _, compact = np.unique([root(i) for i in range(n + 1)], return_inverse=True)
+    return compact[labels], int(compact.max())
+
+
+def narrow_islands(on: np.ndarray) -> tuple[np.ndarray, int, int]:
+    """The points of the islands of a periodic 2D mask fewer than :data:`ISLAND_POINTS` points across in
+    either direction of the grid (no run of that many along it, module docstring), how many such islands,
+    and the smallest island's points (0 without islands)."""
+    labels, n = periodic_labels(on)
+    if n == 0:
+        return np.zeros(on.shape, bool), 0, 0
+    wide = np.ones(n + 1, bool)
+    for axis in (0, 1):
+        run = on.copy()
+        for step in range(1, ISLAND_POINTS):
+            run &= np.roll(on, -step, axis=axis)
+        wide &= np.bincount(labels[run], minlength=n + 1) > 0
+    narrow = ~wide
+    narrow[0] = False
+    return narrow[labels], int(narrow.sum()), int(np.bincount(labels.ravel())[1:].min())
+
+
 def unresolved_share(cell, p: np.ndarray) -> dict[str, Any]:
     """The share of each quantity on the edges held by the islands of fewer than :data:`ISLAND_POINTS`
-    points of a 2D pressure ``p`` (module docstring): ``{"points": the smallest island's points (0 without
-    islands), "islands": how many are unresolved, "share": {headline name: absolute share}}``; no share in
-    3D or without such islands."""
-    runs = islands(p > 0) if cell.dim == 2 else []
-    small = [(a, w) for a, w in runs if w < ISLAND_POINTS]
-    out: dict[str, Any] = {"points": min((w for _, w in runs), default=0), "islands": len(small), "share": {}}
-    if small:
-        mask = np.zeros(p.shape, bool)
+    points of a pressure ``p`` (in 3D: points across, :func:`narrow_islands`; module docstring):
+    ``{"points": the smallest island's points (0 without islands), "islands": how many are unresolved,
+    "share": {headline name: absolute share}}``; no share without such islands."""
+    mask = np.zeros(p.shape, bool)
+    if cell.dim == 2:
+        runs = islands(p > 0)
+        small = [(a, w) for a, w in runs if w < ISLAND_POINTS]
         for a, w in small:
             mask[np.arange(a - 1, a + w + 1) % p.size] = True       # the island and an open point each side
+        count, points = len(small), min((w for _, w in runs), default=0)
+    else:
+        narrow, count, points = narrow_islands(p > 0)
+        mask = narrow.copy()
+        for axis in (0, 1):                                         # the island and its open 4-neighbours
+            mask |= np.roll(narrow, 1, axis=axis) | np.roll(narrow, -1, axis=axis)
+    out: dict[str, Any] = {"points": points, "islands": count, "share": {}}
+    if count:
         whole = coefficients(cell, mask).as_dict()
         out["share"] = {"contact_fraction": whole["contact_fraction"], COEFFICIENT + "k_n": whole["k_n"],
                         COEFFICIENT + "g_n": whole["g_n"]}
@@ -111,6 +163,6 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                 raised.append(name)
         if raised:
             remarks.append(f"load {k}: {unresolved['islands']} contact island(s) of fewer than {ISLAND_POINTS} "
-                           f"points (the smallest {unresolved['points']}) on grid {last['grid']}: "
+                           f"points (in 3D across; the smallest {unresolved['points']}) on grid {last['grid']}: "
                            f"{', '.join(raised)} bounded by their share, one step beyond each edge")
     return remarks

@@ -21,9 +21,21 @@ in the report (:func:`loose_remarks`).  The flag never lowers an estimate: a fas
 by a first-order one (on Westergaard's sinusoid at a twentieth of its closing pressure the quartic's errors
 fall by about 16 per doubling twice, then by 2), and an earlier difference bounds the error where the last
 one vanished by coincidence (a stall, a symmetric cell).  Richardson's form states its rate and holds it to
-first order on purpose (the same sinusoid) and is not flagged.  An estimate within :data:`LOOSE` times the
-tail may still exceed an error that is small by chance (one that crosses zero on the reported grid), which
-no difference shows.
+first order on purpose (the same sinusoid) and is not flagged by that tail.
+
+Where the last two contractions disagree, the last at least :data:`DISAGREE` times slower than the one
+before (``|d_k| / |d_(k-1)| >= 2 |d_(k-1)| / |d_(k-2)|``: their observed orders in the grid step differ by
+one or more), every form takes the slower ("where two successive differences disagree in rate, the estimate
+says so and takes the larger", issue 35).  The last difference is then large for the contraction before it:
+it carries the error of level ``k - 1`` more than that of level ``k``, which may have fallen at the faster
+contraction, as the mean closure of a random profile does on the whole (at about a quarter per level) while
+single levels scatter about that rate.  So an estimate of any form above :data:`LOOSE` times the tail its
+last difference leaves at the faster contraction, ``|d_k| rho' / (1 - rho')`` with ``rho' = |d_(k-1)| /
+|d_(k-2)|`` (:func:`faster_contraction`), is flagged too, with both contractions: it says so.  An estimate
+within :data:`LOOSE` times both tails may still exceed an error that is small by chance (one that crosses
+zero on the reported grid, or a level's error that falls several times faster than its differences while
+their two contractions agree), which no difference shows (``docs/benchmarks.md``, the spectral
+effectivity).
 """
 from __future__ import annotations
 
@@ -37,6 +49,9 @@ from ngcontact.cell.spectral.contact_edges import ISLAND
 RICHARDSON, GUARDED, CARRIED = "Richardson", "guarded", "carried"
 #: an estimate above this many times the last difference of its quantity is flagged (module docstring)
 LOOSE = 10.0
+#: two successive contractions of a quantity differing by this factor or more differ by at least one order in
+#: the grid step (each level halves it): they disagree (module docstring)
+DISAGREE = 2.0
 #: the slowest contraction per level the error left by the last difference is taken at (first order)
 FIRST_ORDER = 0.5
 #: why, per form of the estimate (module docstring)
@@ -46,22 +61,58 @@ WHY_LOOSE = {GUARDED: "an earlier difference bounds it", CARRIED: "carried from 
 
 def loose_flags(history: list[dict[str, Any]], estimates: list[dict[str, float]], forms: list[dict[str, str]]
                 ) -> list[dict[str, str]]:
-    """Per load, the estimates of the last level of ``history`` above :data:`LOOSE` times the error that the
-    last contraction would leave (:func:`tail_left`, in the quantity's measure), with the reason (module
-    docstring)."""
+    """Per load, the estimates of the last level of ``history`` that may exceed their error by more than
+    :data:`LOOSE` times, with the reason (:func:`loose_reason`, in the quantity's measure; module docstring)."""
     last = history[-1]
     flags = []
     for k, per_load in enumerate(estimates):
         now, out = last["headline"][k], {}
         for name, e in per_load.items():
             size = scale(name, now, last["whole_surface"])
-            left, rate = tail_left([h["headline"][k][name] / size for h in history[-3:]])
-            if forms[k][name] != RICHARDSON and e > LOOSE * left:
-                ratio = f"{e / left:.3g} times" if left > 0 else "far above"
-                out[name] = (f"{ratio} the tail the last difference leaves at its rate {rate:.2g}: "
-                             f"{WHY_LOOSE.get(forms[k][name], WHY_LOOSE[GUARDED])}")
+            why = loose_reason([h["headline"][k][name] / size for h in history[-4:]], e, forms[k][name])
+            if why:
+                out[name] = why
         flags.append(out)
     return flags
+
+
+def loose_reason(values: list[float], estimate: float, form: str) -> str:
+    """Why ``estimate`` (of the last of ``values``, two to four levels of a quantity in its measure, made in
+    ``form``) may exceed its error by more than :data:`LOOSE` times, "" where it may not (module docstring):
+    above :data:`LOOSE` times the tail its last difference leaves at the last contraction (:func:`tail_left`;
+    not Richardson's form), or above :data:`LOOSE` times the tail it leaves at the contraction before, where
+    the last two disagree, the last slower by :data:`DISAGREE` or more (:func:`faster_contraction`; any
+    form)."""
+    left, rate = tail_left(values[-3:])
+    if form != RICHARDSON and estimate > LOOSE * left:
+        return (f"{times(estimate, left)} the tail the last difference leaves at its rate {rate:.2g}: "
+                f"{WHY_LOOSE.get(form, WHY_LOOSE[GUARDED])}")
+    faster = faster_contraction(values)
+    if faster is not None and estimate > LOOSE * faster[0]:
+        return (f"{times(estimate, faster[0])} the tail the last difference leaves at the rate before it, "
+                f"{faster[1]:.2g}: the last two contractions disagree ({faster[1]:.2g}, then {faster[2]:.2g}), "
+                "the estimate takes the slower")
+    return ""
+
+
+def times(estimate: float, left: float) -> str:
+    """``estimate`` over ``left`` in words."""
+    return f"{estimate / left:.3g} times" if left > 0 else "far above"
+
+
+def faster_contraction(values: list[float]) -> tuple[float, float, float] | None:
+    """Where the last of the two contractions of ``values`` (four levels) is at least :data:`DISAGREE` times
+    slower than the one before, ``|d_k| / |d_(k-1)| >= DISAGREE |d_(k-1)| / |d_(k-2)|``: the tail the last
+    difference leaves at the contraction before, ``|d_k| rho / (1 - rho)`` with that ``rho`` (held to at most
+    :data:`FIRST_ORDER`), and the two contractions; else ``None``."""
+    d = [abs(b - a) for a, b in zip(values[:-1], values[1:])]
+    if len(d) < 3 or d[0] <= 0 or d[1] <= 0:
+        return None
+    before, last = d[1] / d[0], d[2] / d[1]
+    if last < DISAGREE * before:
+        return None
+    rate = min(before, FIRST_ORDER)
+    return d[2] * rate / (1.0 - rate), before, last
 
 
 def tail_left(values: list[float]) -> tuple[float, float]:

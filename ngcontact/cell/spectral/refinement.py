@@ -108,13 +108,13 @@ differences beside it where two grids' errors share their sign and size, as on W
 half its closing pressure) and reported, but not held to the tolerance (:data:`UNCONTROLLED`: listed in
 the verdict as not counted).
 
-Two checks end each level's estimate.  A 2D contact island of fewer than
-:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points has no resolved edges: its error may stall
+Two checks end each level's estimate.  A contact island of fewer than
+:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: it may stall
 while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
 (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``).  An estimate (not Richardson's)
 above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the
-last contraction may exceed the error by as much: flagged with its reason, it is listed in the report
-(:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
+last contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the
+error by as much: flagged with its reason, per quantity in the report (:func:`estimate_forms.loose_flags`).
 
 Levels double the points per direction (:data:`GROWTH`): close enough that three differences cost little
 more than the finest level (2D: twice the finest; 3D: 4/3 of it).
@@ -196,9 +196,10 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        "last one; the contact fraction and coefficients guarded on levels of edges not all fitted by the quartic, "
        f"and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
        "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
-       f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance; in 2D "
-       f"at least the share of contact islands of fewer than {ISLAND_POINTS} points; an estimate above {LOOSE:g} "
-       "times the error its last difference leaves at the last rate flagged as possibly loose by as much")
+       f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance; at least "
+       f"the share of contact islands of fewer than {ISLAND_POINTS} points (3D: across); an estimate above {LOOSE:g} "
+       "times the error its last difference leaves at the last rate, or at the rate before where the last is "
+       "twice as slow or more, flagged as possibly loose by as much (accuracy.quantities[].loose)")
 
 
 @dataclass

@@ -131,7 +131,7 @@ class SpectralCellSolver:
         how = HOW + (f" ({'; '.join(refined.remarks)})" if refined.remarks else "")
         return Refinement(solutions=solutions, estimates=list(refined.estimates), method=method,
                           met=refined.met, how=how, uncontrolled=UNCONTROLLED,
-                          scales=refined.scales)
+                          scales=refined.scales, loose=refined.flags)
 
     def penalty(self) -> float | None:
         return float(self.cell.k_n) if self.cell.enforcement == "penalty" else None
