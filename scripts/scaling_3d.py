@@ -48,7 +48,12 @@ an earlier run's ``scaling_3d.csv``, makes the rows derived from them again
 With ``--keep-rows CSV`` it measures as asked and keeps that earlier run's rows
 above the new ones (a run adding rows to a published table, which ``--publish``
 rewrites whole); the section says which rows are whose, and whether the
-accuracy aim is met and by which row.
+accuracy aim is met and by which row.  Either takes a folder holding a
+``scaling_3d.csv`` too.  ``--publish`` keeps the published rows in the folder
+docs/benchmarks/scaling_3d with ``measured_by.md``, the note of which commands
+and commits measured them (:mod:`scaling_3d_rows`), so that the section is
+published again, in any clone, by
+``python scripts/scaling_3d.py --republish docs/benchmarks/scaling_3d --publish``.
 
 With ``--breakdown INTERFACE_MAXH`` it measures instead where one iterative
 cell solve spends its time (CG per iteration, one BDDC application, one
@@ -63,7 +68,7 @@ Usage::
                                  [--accuracy-patch-growth GROWTH] [--accuracy-cells quarter period]
                                  [--accuracy-threads N]
                                  [--solvers iterative direct] [--breakdown INTERFACE_MAXH]
-                                 [--coarse INTERFACE_MAXH [--k-n K]] [--republish CSV] [--keep-rows CSV]
+                                 [--coarse INTERFACE_MAXH [--k-n K]] [--republish CSV|DIR] [--keep-rows CSV|DIR]
 
 Writes ``scaling_3d.csv`` and ``scaling_3d.png`` into ``OUT_DIR`` (default
 ``results/scaling_3d``) and logs the tables and the fitted exponents.
@@ -85,7 +90,8 @@ from ngcontact.output.writer import write_csv
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
 from bisinusoid_accuracy import (ACC_CELLS, ACC_EDGES, ACC_PATCH, QUICK_EDGES, accuracy_aim,  # noqa: E402
-                                 aim_status, extrapolated_rows)
+                                 aim_status)
+from scaling_3d_rows import ARCHIVE, MEASURED, keep, republished_rows  # noqa: E402
 
 log = logging.getLogger("scaling_3d")
 
@@ -244,27 +250,6 @@ def spectral_aim(quick: bool) -> list[dict]:
                      "seconds": time.perf_counter() - t0, "newton_steps": "", "cg_iterations": "",
                      "peak_memory_gb": "", "contact_fraction": float(np.mean(tr > 0)), "pressure": p})
     return rows
-
-
-def republished_rows(path: str) -> list[dict]:
-    """The rows an earlier run measured, read from its ``scaling_3d.csv``, with the rows derived from them
-    (:func:`extrapolated_rows`) made again by this script: the converged contact fraction per load is the one
-    that run compared with (``contact_fraction / (1 + relative_error)`` of its rows)."""
-    import csv
-
-    def value(text: str):
-        for kind in (int, float):
-            try:
-                return kind(text)
-            except ValueError:
-                pass
-        return text
-    with open(path, newline="") as fh:
-        rows = [{k: value(v) for k, v in r.items() if v != ""} for r in csv.DictReader(fh)
-                if not r["solver"].endswith(", extrapolated")]
-    accuracy = [r for r in rows if r["part"] == "accuracy"]
-    converged = {r["pressure"]: r["contact_fraction"] / (1.0 + r["relative_error"]) for r in accuracy}
-    return rows + extrapolated_rows(accuracy, converged)
 
 
 def exponent(rows: list[dict], part: str, solver: str) -> float | None:
@@ -519,14 +504,18 @@ def main(argv=None) -> int:
     ap.add_argument("--accuracy-threads", type=int, default=None,
                     help="threads of part 4's FE solves (default: as ngcontact run)")
     ap.add_argument("--k-n", type=float, default=None, help="with --coarse: the penalty k_n (default the scene's)")
-    ap.add_argument("--republish", metavar="CSV", default=None,
-                    help="instead of measuring: the rows an earlier run measured (its scaling_3d.csv), the rows "
-                         "derived from them made again, written (and with --publish published) as a run's")
-    ap.add_argument("--keep-rows", metavar="CSV", default=None,
-                    help="the rows an earlier run measured (its scaling_3d.csv) kept above those measured now, "
-                         "their derived rows made again: a run that adds rows to a published table")
+    ap.add_argument("--republish", metavar="CSV|DIR", default=None,
+                    help="instead of measuring: the rows an earlier run measured (its scaling_3d.csv, or a folder "
+                         "holding one: docs/benchmarks/scaling_3d keeps the published rows), the rows derived from "
+                         "them made again, written (and with --publish published) as a run's")
+    ap.add_argument("--keep-rows", metavar="CSV|DIR", default=None,
+                    help="the rows an earlier run measured (its scaling_3d.csv, or a folder holding one) kept above "
+                         "those measured now, their derived rows made again: a run that adds rows to a published "
+                         "table")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
+    if args.republish and args.keep_rows:
+        ap.error("--republish measures nothing, --keep-rows keeps rows above those measured: give one of them")
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     if args.breakdown is not None:
         breakdown(args.breakdown, args.out)
@@ -553,6 +542,7 @@ def main(argv=None) -> int:
         return 0
     rows = republished_rows(args.republish) if args.republish else measured_rows(args)
     kept = republished_rows(args.keep_rows) if args.keep_rows else []
+    n_new = 0 if args.republish else len(rows)
     rows = kept + rows
     os.makedirs(args.out, exist_ok=True)
     write_csv(os.path.join(args.out, "scaling_3d.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
@@ -566,14 +556,19 @@ def main(argv=None) -> int:
                 fits.append(f"{part} {solver} `time ~ dofs^{b:.2f}`")
     log.info("wrote %s", os.path.join(args.out, "scaling_3d.csv"))
     if args.publish:
+        keep(os.path.join(args.out, "scaling_3d.csv"), args.republish or args.keep_rows, len(rows) - n_new, n_new)
+        archive = os.path.relpath(ARCHIVE, os.path.join(ROOT, "docs"))
         benchmark_doc.publish("scaling_3d", "3D at scale: direct against iterative; the bisinusoid aim",
                               os.path.join(args.out, "scaling_3d.csv"),
-                              note=("Rows measured by an earlier run (its CSV re-read with `--republish`; its "
-                                    "timings, its machine's load), the extrapolated rows made again from them. "
+                              note=("Rows measured by earlier runs (re-read with `--republish`; their "
+                                    "timings, their machine's load), the extrapolated rows made again from them. "
                                     if args.republish else "") +
                                    (f"The first {len(kept)} rows were measured by an earlier run (its CSV kept "
                                     "with `--keep-rows`: its timings, its machine's load), the others by this "
-                                    "one. " if kept else "") + aim_status(rows) + " " +
+                                    "one. " if kept else "") +
+                                   f"The rows are kept in `docs/{archive}/`; which commands measured them, at "
+                                   f"which commits, on how many threads and under which load: "
+                                   f"[{MEASURED}]({archive}/{MEASURED}). " + aim_status(rows) + " " +
                                    "Part `cell`: the 3D bisinusoid cell (order 2) refined, one load by sparse "
                                    "Cholesky (`direct`) and BDDC-CG (`iterative`), started as `ngcontact run` "
                                    "starts it; part `macro`: a 3D press fit of two tubes; part `spectral`: the "

@@ -64,7 +64,18 @@ def cell_scene_of(path: str, *, key: str, overrides: dict | None = None, method:
     cell_scene = load_with_contact(path, overrides, method, discretization)
     if cell_scene.kind != "cell":
         raise SceneError(key, path, f"names a {cell_scene.kind!r} scene; a 'cell' scene is needed")
-    return cell_scene
+    return with_symmetry(cell_scene)
+
+
+def with_symmetry(scene: CellScene) -> CellScene:
+    """The scene with its derived field ``symmetry_choice``: whether its FE cell is the mirror-symmetric
+    quarter (:func:`~ngcontact.drivers.mirror_symmetry.symmetry_choice`, which samples the gap), decided once
+    where the drivers take a cell scene in (:func:`cell_scene_of`, :func:`ngcontact.drivers.run_cell.run`, a
+    scene handed to :func:`ngcontact.drivers.cell_scene_law.cell_law`); a scene that has it is returned as it
+    is.  Its readers mesh a scene without it (not taken in by a driver) over its period."""
+    if scene.symmetry_choice is not None:
+        return scene
+    return scene_with(scene, symmetry_choice=symmetry_choice(scene))
 
 
 def cell_bundle_arrays(cell_scene: CellScene, cache_dir: str | None = None) -> tuple[dict, bool]:
@@ -168,8 +179,9 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
                                        h_counter=g.h_counter, maxh=maxh, interface_maxh=ih,
                                        order=order)
         if kind.solid is None:  # flat, or a small-slope profile carried by the gap; its quarter where symmetric
+            symmetry = scene.symmetry_choice
             return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih,
-                                      symmetric=symmetry_choice(scene).used)
+                                      symmetric=symmetry is not None and symmetry.used)
         return kind.solid(g, maxh=maxh, interface_maxh=ih)
     from ngcontact.geometry import profiles as pr
     assert kind.profile is not None  # every 2D profile has its builder
@@ -227,7 +239,8 @@ def share_twin(scene: CellScene) -> Callable[[], SpectralCellSolver] | None:
 
 
 def scene_with(scene: CellScene, **sections) -> CellScene:
-    """``scene`` with these sections replaced, in the folder of the scene file (its data files' base)."""
+    """``scene`` with these sections (or derived fields) replaced, in the folder of the scene file (its data
+    files' base)."""
     out = replace(scene, **sections)
     object.__setattr__(out, "base_dir", getattr(scene, "base_dir", "."))
     return out

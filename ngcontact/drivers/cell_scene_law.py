@@ -59,7 +59,7 @@ def _cell_scene(cell):
         path = os.fspath(cell)
         return build.cell_scene_of(path, key="cell"), os.path.abspath(path)
     if getattr(cell, "kind", None) == "cell":
-        return cell, None
+        return build.with_symmetry(cell), None
     raise refuse("cell", cell if getattr(cell, "kind", None) is None else f"a {cell.kind!r} scene",
                  "a cell scene file or a scene of kind 'cell' from ngcontact.load")
 

@@ -20,40 +20,25 @@ at a quarter of the unknowns.  ``symmetry = "auto"`` uses the quarter where the 
 states why not where it is not (:class:`SymmetryChoice`); ``"off"`` (the default) always meshes the period:
 at the same sizes the quarter is the faster cell, not the more accurate one (docs/benchmarks.md,
 section scaling_3d), so it is asked for, not chosen for the user.
+
+The choice is made once per scene: :func:`ngcontact.drivers.build.with_symmetry` sets it as the scene's
+typed field ``symmetry_choice`` where the drivers take a cell scene in, and the mesh
+(:func:`~ngcontact.drivers.build.build_cell`), the contact edge's refiner and the report read that field.
 """
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 
 from ngcontact.drivers.cell_gap import gap_samples
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
+from ngcontact.scene.cell_method import SymmetryChoice
 from ngcontact.scene.cell_scene import CellScene, load_states
 
 #: grid points per period and direction on which the gap's mirror symmetry is checked
 CHECK_GRID = 64
 #: the gap is even where its samples and their mirror images differ by at most this times its largest value
 EVEN_RTOL = 1e-10
-
-
-@dataclass(frozen=True)
-class SymmetryChoice:
-    """Whether the FE cell is meshed as its symmetric quarter (``used``), what the scene asked for
-    (``requested``: ``"auto"`` or ``"off"``) and why, in one sentence."""
-
-    used: bool
-    reason: str
-    requested: str = "auto"
-
-    @property
-    def statement(self) -> str:
-        return ("symmetric quarter: " if self.used else "full period: ") + self.reason
-
-    def as_dict(self) -> dict:
-        return {"used": self.used, "requested": self.requested, "reason": self.reason,
-                "statement": self.statement}
 
 
 def even_gap(samples: np.ndarray) -> bool:

@@ -33,7 +33,7 @@ budget ended first, and one warning line rather than failed (exit 0);
 (``accuracy.how``).  ``accuracy.method`` states the method that solved
 the cell and why (``discretization.method = "auto"`` resolved: :mod:`ngcontact.scene.cell_method`), and of a 3D
 FE cell ``accuracy.symmetry`` whether it was meshed as its mirror-symmetric quarter and why
-(``discretization.symmetry``: :mod:`ngcontact.drivers.mirror_symmetry`).  With
+(``discretization.symmetry``: :mod:`ngcontact.drivers.mirror_symmetry`, decided once as the run starts).  With
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers, and
 held to the default tolerance on its own where the method holds a load alone
@@ -49,8 +49,7 @@ from ngcontact.cell.cell_solver import Refinement
 from ngcontact.cell.penalty_share import penalty_share
 from ngcontact.errors import ConvergenceError
 from ngcontact.drivers import cell_gap, cell_members
-from ngcontact.drivers.build import cell_facts, cell_loads, cell_solver
-from ngcontact.drivers.mirror_symmetry import symmetry_choice
+from ngcontact.drivers.build import cell_facts, cell_loads, cell_solver, with_symmetry
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Outcome, VtkField
 
@@ -188,6 +187,7 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
     """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`).  ``refine_by_default =
     False``: no refinement unless the scene states a tolerance (an ensemble's members)."""
     with clock.stage("setup"):
+        scene = with_symmetry(scene)       # its FE cell's quarter or period, decided once for the run
         cell = cell_solver(scene)
         facts = cell_facts(scene)
     warn_before_solving(facts)
@@ -233,8 +233,9 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
     results["loads"] = per_load
     results["accuracy"] = dict(accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
                                                 unestimated=opted_out(scene)), method=method_choice(scene))
-    if scene.discretization.method == "fe" and scene.geometry.dim == 3:   # its quarter or its period, and why
-        results["accuracy"]["symmetry"] = symmetry_choice(scene).as_dict()
+    symmetry = scene.symmetry_choice             # of a 3D FE cell: its quarter or its period, and why
+    if scene.discretization.method == "fe" and scene.geometry.dim == 3 and symmetry is not None:
+        results["accuracy"]["symmetry"] = symmetry.as_dict()
     if cell.penalty() is not None:  # the model's share: reported and printed, not counted against the tolerance
         with clock.stage("penalty share"):
             share = penalty_share(cell, loads, per_load,

@@ -45,8 +45,9 @@ QUANTITIES = {
 
 
 def member_scene(scene, m: int):
-    """The cell scene of member ``m``: the random surface's seed advanced by ``m``, no ensemble."""
-    member = replace(scene, ensemble=None, geometry=scene.geometry.reseeded(m))
+    """The cell scene of member ``m``: the random surface's seed advanced by ``m``, no ensemble; its FE cell's
+    symmetry decided anew for its own gap (as the member's run starts)."""
+    member = replace(scene, ensemble=None, geometry=scene.geometry.reseeded(m), symmetry_choice=None)
     object.__setattr__(member, "base_dir", scene.base_dir)   # not a field of replace: a measured file's folder
     return member
 

@@ -28,6 +28,12 @@ The rule, in order:
 What only the FE cell writes, the bodies' displacement fields (VTK) and their largest stresses, needs
 ``method = "fe"``; the links of a macro scene that need them (``strength.cell``, the shear table of a
 two-scale loop with friction from its cell) solve an ``auto`` cell by fe (:attr:`MethodChoice.automatic`).
+
+Which FE cell, its mirror-symmetric quarter or its period (``discretization.symmetry``), is the scene's
+second resolved choice, a :class:`SymmetryChoice` in its typed field ``symmetry_choice``.  Its rule
+(:mod:`ngcontact.drivers.mirror_symmetry`) samples the initial gap, read from the scene's files after the
+checks, so the drivers resolve it, once, where they take a cell scene in
+(:func:`ngcontact.drivers.build.with_symmetry`), not :meth:`~ngcontact.scene.cell_scene.CellScene.resolved`.
 """
 from __future__ import annotations
 
@@ -70,6 +76,24 @@ class MethodChoice:
 
     def as_dict(self) -> dict:
         return {"method": self.method, "requested": self.requested, "reason": self.reason,
+                "statement": self.statement}
+
+
+@dataclass(frozen=True)
+class SymmetryChoice:
+    """Whether the FE cell is meshed as its symmetric quarter (``used``), what the scene asked for
+    (``requested``: ``"auto"`` or ``"off"``) and why, in one sentence."""
+
+    used: bool
+    reason: str
+    requested: str = "auto"
+
+    @property
+    def statement(self) -> str:
+        return ("symmetric quarter: " if self.used else "full period: ") + self.reason
+
+    def as_dict(self) -> dict:
+        return {"used": self.used, "requested": self.requested, "reason": self.reason,
                 "statement": self.statement}
 
 

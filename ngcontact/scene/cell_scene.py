@@ -17,7 +17,7 @@ from ngcontact.errors import MISSING, GeometryError, SceneError
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.laws.friction import FRICTION_LAWS
 from ngcontact.scene.spectral_grid import TOLERANCE_OVER_RTOL, check_spectral_size
-from ngcontact.scene.cell_method import MethodChoice, choose, resolved_discretization
+from ngcontact.scene.cell_method import MethodChoice, SymmetryChoice, choose, resolved_discretization
 from ngcontact.scene.cell_geometry import (CellGeometry, check_features, check_profile_heights, flat_interface,
                                           small_slope)
 from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
@@ -167,6 +167,8 @@ class CellScene:
     base_dir: str = base_dir_field()
     #: the method that solves the scene and why (``discretization.method`` resolved by :meth:`resolved`)
     method_choice: MethodChoice | None = derived_field()
+    #: its FE cell, quarter or period, and why (``discretization.symmetry``, set by drivers.build.with_symmetry)
+    symmetry_choice: SymmetryChoice | None = derived_field()
 
     def resolved(self) -> CellScene:
         """The scene with its derived field, before anything asks for the method: ``discretization.method =

@@ -20,10 +20,12 @@ from one left at its default (``discretization.method = "auto"``,
 :mod:`ngcontact.scene.cell_method`).
 
 A field the scene derives from its keys rather than reads from its file
-(:func:`derived_field`: a cell scene's resolved ``discretization.method``) is no
-key: :func:`build` leaves it out of the table and, where the dataclass has a
-method ``resolved(self)``, builds the instance that method returns (the scene
-with its derived fields, by ``dataclasses.replace``) before the checks.
+(:func:`derived_field`: a cell scene's resolved ``discretization.method``, and
+its FE cell's symmetry, which the drivers resolve since its rule reads the
+gap's files) is no key: :func:`build` leaves it out of the table and, where the
+dataclass has a method ``resolved(self)``, builds the instance that method
+returns (the scene with its derived fields, by ``dataclasses.replace``) before
+the checks.
 
 Cross-field rules live in a method ``check(self, path)`` of the dataclass,
 called after construction.  :func:`describe` walks the same metadata to write
@@ -101,8 +103,8 @@ DERIVED = "derived"
 
 def derived_field():
     """A field the scene derives from its keys (module docstring): typed, set through the constructor or
-    ``dataclasses.replace`` by the dataclass's ``resolved``, ``None`` until then; not a key of the file, the
-    reference or the report's scene."""
+    ``dataclasses.replace`` by the dataclass's ``resolved`` (or by the driver that resolves it), ``None``
+    until then; not a key of the file, the reference or the report's scene."""
     return dataclasses.field(default=None, repr=False, compare=False, metadata={DERIVED: True})
 
 

@@ -15,13 +15,14 @@ from netgen.meshing import Element2D, Element3D, FaceDescriptor, IdentificationT
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
 from ngcontact.cell.fe.contact_edge_mesh import edge_refined_cell, fold_quarter
-from ngcontact.drivers.build import build_cell
+from ngcontact.drivers import build as B, run_cell
+from ngcontact.drivers.build import build_cell, cell_scene_of, with_symmetry
 from ngcontact.drivers.mirror_symmetry import even_gap, mirror_invariant, symmetry_choice
 from ngcontact.errors import SceneError
 from ngcontact.fem.materials import isotropic
 from ngcontact.geometry.cell2d import Cell
 from ngcontact.geometry.cell3d import bisinusoid_gap, flat_cell3d
-from ngcontact.output.report import method_line
+from ngcontact.output.report import Clock, method_line
 from ngcontact.scene import loader
 
 LAW = isotropic(2.0 * (1.0 - 0.3 ** 2), 0.3)        # E* = 1 for two equal bodies
@@ -151,8 +152,9 @@ def test_evenness_is_decided_on_the_samples():
     assert not mirror_invariant(C)
 
 
-def _scene(tmp_path=None, *, gap=None, load=None, contact=None, symmetry="auto"):
-    """A coarse 3D bisinusoid FE cell (or flat3d with a tabulated gap ``gap``: the array written to a file)."""
+def _scene(tmp_path=None, *, gap=None, load=None, contact=None, symmetry="auto", taken_in=True):
+    """A coarse 3D bisinusoid FE cell (or flat3d with a tabulated gap ``gap``: the array written to a file), as
+    the drivers take it in (``taken_in``: its symmetry resolved by ``with_symmetry``) or as loaded."""
     geometry = {"profile": "bisinusoid", "arrangement": "summit", "amplitude": 0.005, "h_rough": 0.6,
                 "h_counter": 0.6}
     c = {"enforcement": "exact", **(contact or {})}
@@ -166,7 +168,8 @@ def _scene(tmp_path=None, *, gap=None, load=None, contact=None, symmetry="auto")
     data = {"kind": "cell", "materials": {"solid": {"E": 1.0, "nu": 0.3}},
             "bodies": {"rough": "solid", "counter": "solid"}, "geometry": geometry, "contact": c,
             "load": load or {"pressure": [0.008]}, "discretization": d}
-    return loader.from_dict(data, base_dir=str(tmp_path or "."))
+    scene = loader.from_dict(data, base_dir=str(tmp_path or "."))
+    return with_symmetry(scene) if taken_in else scene
 
 
 def test_a_symmetric_scene_is_meshed_as_its_quarter_and_says_so():
@@ -216,3 +219,24 @@ def test_a_tangential_load_or_friction_keeps_the_period():
 def test_a_bad_symmetry_names_the_key_and_the_values():
     with pytest.raises(SceneError, match=r"discretization.symmetry = 'quarter': must be one of 'auto', 'off'"):
         _scene(symmetry="quarter")
+
+
+def test_the_choice_is_a_field_of_the_scene_decided_once_per_run(tmp_path, monkeypatch):
+    """The loader leaves ``symmetry_choice`` unset (its rule reads the gap); ``with_symmetry`` sets it by
+    ``dataclasses.replace`` (the folder kept), a resolved scene is returned as it is, a nested cell scene is
+    resolved as it is loaded, and a run decides once: its mesh, refiner and report read the field."""
+    raw = _scene(tmp_path, taken_in=False)
+    assert raw.symmetry_choice is None
+    scene = with_symmetry(raw)
+    assert scene.symmetry_choice == symmetry_choice(raw) and scene.symmetry_choice.used
+    assert scene.base_dir == str(tmp_path) and with_symmetry(scene) is scene
+    path = tmp_path / "cell.toml"
+    path.write_text('kind = "cell"\n[materials.solid]\nE = 1.0\nnu = 0.3\n[bodies]\nrough = "solid"\n'
+                    'counter = "solid"\n[geometry]\nprofile = "bisinusoid"\narrangement = "summit"\n'
+                    'amplitude = 0.005\nh_rough = 0.6\nh_counter = 0.6\n[contact]\nenforcement = "exact"\n'
+                    '[load]\npressure = [0.008]\n[discretization]\nmethod = "fe"\nsymmetry = "auto"\n')
+    assert cell_scene_of(str(path), key="cell").symmetry_choice.used
+    calls = []
+    monkeypatch.setattr(B, "symmetry_choice", lambda sc: calls.append(sc) or symmetry_choice(sc))
+    out = run_cell.run(raw, Clock())
+    assert len(calls) == 1 and out.results["accuracy"]["symmetry"] == scene.symmetry_choice.as_dict()
