@@ -35,19 +35,26 @@ than ``FLOOR_GB`` is left (``rank_memory.MemoryGuard``).
 The model of 64 ranks is on paper: memory of a rank holding a part grows
 linearly with its dofs and rank 0's with the whole mesh's; both lines are
 fitted to the measured distributed runs of the scene with the largest run and evaluated at 63 parts.  The
-time is the measured time per dof of a part times the dofs of a part
+time is the measured time per dof of a part (of the fastest run at the
+largest size) times the dofs of a part
 (BDDC-CG's iteration count grows only slowly with the size; communication
 across machines is not in the model).
 
     python scripts/macro_mpi_scaling.py [OUT] [--maxh 0.004 0.002 0.001] [--femur 1 1.5]
                                         [--refined MAXH:K ...] [--ranks 1 2 3] [--bddc JSON ...]
-                                        [--order P] [--guard START_GB FLOOR_GB] [--code LABEL]
+                                        [--order P] [--rank-threads T ...] [--guard START_GB FLOOR_GB]
+                                        [--code LABEL]
                                         [--rows-from CSV|DIR ...] [--phases-from CSV ...]
                                         [--measured-by MD] [--publish]
 
 ``--bddc``: flags of NGSolve's BDDC to compare (``linear_solver.BDDC_FLAGS``
 in each run's processes), each run with each; per run also the time the
-ranks holding the mesh spend in BDDC's coarse solves.
+ranks holding the mesh spend in BDDC's coarse solves.  ``--rank-threads``:
+NGSolve's threads of each rank of a distributed run (``NGCONTACT_THREADS``
+per rank; e.g. ``1 2``: rank 0, which holds no element, on one thread and
+the part on 2), recorded per rank in the ``threads`` column.  MPICH's
+settings (``MPIR_CVAR_...``) reach the ranks from the environment; name
+them in ``--code`` (e.g. ``--code 6f44d61+heavy_yield``).
 
 Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_phases.csv``, ``OUT/macro_mpi_model.csv`` and ``.png``
 (default ``results/macro_mpi_scaling``).  ``--rows-from``: no runs, the rows
@@ -185,20 +192,36 @@ def child(scene: str, out: str, bddc: str = "") -> int:
     return 0
 
 
+def launch(child: list[str], ranks: int, rank_threads: tuple[int, ...] = ()) -> list[str]:
+    """The command running ``child`` in one process or on ``ranks`` ranks (``mpiexec``); with
+    ``rank_threads`` rank r runs on ``rank_threads[min(r, len - 1)]`` threads (``NGCONTACT_THREADS`` of
+    each rank, by mpiexec's form for several programs)."""
+    if ranks == 1:
+        return child
+    if not rank_threads:
+        return ["mpiexec", "-n", str(ranks)] + child
+    cmd = ["mpiexec"]
+    for r in range(ranks):
+        threads = rank_threads[min(r, len(rank_threads) - 1)]
+        cmd += ([":"] if r else []) + ["-n", "1", "-env", "NGCONTACT_THREADS", str(threads)] + child
+    return cmd
+
+
 def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0, bddc: str = "", order: int = 2,
-            guard: MemoryGuard | None = None, code: str = "") -> dict:
+            guard: MemoryGuard | None = None, code: str = "", rank_threads: tuple[int, ...] = ()) -> dict:
     """One run of scene ``name`` at ``size`` (refined ``refinements`` times, the press fit at ``order``) on
-    ``ranks`` ranks, with BDDC's flags ``bddc`` (JSON), under the memory ``guard`` if given; its ranks'
-    memory by phase goes to ``OUT_phase_table.csv`` beside its output, labelled ``code``."""
+    ``ranks`` ranks, with BDDC's flags ``bddc`` (JSON), each rank on its ``rank_threads`` (:func:`launch`),
+    under the memory ``guard`` if given; its ranks' memory by phase goes to ``OUT_phase_table.csv`` beside
+    its output, labelled ``code``."""
+    rank_threads = rank_threads if ranks > 1 else ()
     tag = f"{name}_{size:g}_k{refinements}_p{order}_r{ranks}" + \
-        (f"_{re.sub('[^a-z0-9]+', '', bddc.lower())}" if bddc else "")
+        (f"_{re.sub('[^a-z0-9]+', '', bddc.lower())}" if bddc else "") + \
+        (f"_t{'-'.join(map(str, rank_threads))}" if rank_threads else "")
     scene = os.path.join(work, f"{tag}.toml")
     with open(scene, "w") as fh:
         fh.write(SCENES[name](size, refinements, order))
     out = os.path.join(work, tag)
-    cmd = [sys.executable, os.path.abspath(__file__), "--child", scene, out, bddc]
-    if ranks > 1:
-        cmd = ["mpiexec", "-n", str(ranks)] + cmd
+    cmd = launch([sys.executable, os.path.abspath(__file__), "--child", scene, out, bddc], ranks, rank_threads)
     t0 = time.perf_counter()
     if guard is None:
         subprocess.run(cmd, check=True, env=dict(os.environ, MPLBACKEND="Agg"))
@@ -223,7 +246,9 @@ def measure(name: str, size: float, ranks: int, work: str, refinements: int = 0,
     stages = {k: v for k, v in rep["timings"].items() if k != "total"}
     parts = peaks[1:] if ranks > 1 else peaks
     return {"code": code, "scene": name, "size": size, "refinements": refinements,
-            "order": order if name != "femur" else 2, "ranks": ranks, "threads": rep.get("threads", ""),
+            "order": order if name != "femur" else 2, "ranks": ranks,
+            "threads": " ".join(str(rank_threads[min(r, len(rank_threads) - 1)]) for r in range(ranks))
+            if rank_threads else rep.get("threads", ""),
             "bddc": bddc or "default",
             "ndof": rep["ndof"],
             "work_s": round(sum(stages.values()), 2), "wall_s": round(wall, 2),
@@ -248,7 +273,8 @@ def model(data: list[dict], ranks: int = 64) -> list[dict]:
     b1, b0 = np.polyfit(ndof, [d["peak_mb_rank0"] for d in dist], 1)
     if a1 <= 0 or b1 <= 0:
         return []
-    big = max(dist, key=lambda d: d["ndof"])
+    largest = max(d["ndof"] for d in dist)
+    big = min((d for d in dist if d["ndof"] == largest), key=lambda d: d["work_s"])   # the least disturbed
     per_dof = big["work_s"] / (big["ndof"] / (big["ranks"] - 1))
     rows = []
     for n in MODEL_NDOF:
@@ -290,7 +316,8 @@ NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2 unless `o
         "`work_s`: the stages from meshing to post-processing (one process without its discretization error "
         "estimate, which a distributed run does not make either). `peak_mb_each`: every rank's peak resident "
         "memory, rank 0 first. `code`: the commit measured. `threads`: NGSolve's threads per rank (one process: "
-        "the cores, 2, unless `NGCONTACT_THREADS` says otherwise; N ranks share them; empty: not recorded). "
+        "the cores, 2, unless `NGCONTACT_THREADS` says otherwise; N ranks share them; several numbers: each "
+        "rank's, rank 0 first, set apart; empty: not recorded). "
         "`bddc`: the flags of NGSolve's BDDC (`default`: none; its coarse problem, the vertices and the "
         "interface surface, factorized by a sparse Cholesky, on rank 0 under MPI); rows with other flags "
         "compare the coarse solves NGSolve offers at one size: `coarsetype` `local` (a Jacobi sweep instead "
@@ -298,7 +325,8 @@ NOTE = ("`ngcontact run` of the 3D press fit and the 3D femur (order 2 unless `o
         "ranks holding the mesh spend in BDDC's coarse solves (NGSolve's timer of the wirebasket solve: "
         "under MPI their wait for rank 0; empty where not recorded). "
         "Measured on 2 cores shared with other jobs (3 ranks oversubscribe them): times are indicative, "
-        "memory is not affected.")
+        "memory is not affected; the rows of code `56148f8` on the machine with nothing else running (load "
+        "about 1).")
 PHASES_NOTE = ("Every rank's resident memory [MB] by phase of the runs above that recorded it (sampled every "
                "50 ms: NGSolve allocates in C++, out of Python's sight): at its start (the interpreter with "
                "NGSolve and MPI loaded), the largest within the mesh (made, distributed), the assemblies (the "
@@ -320,7 +348,8 @@ MODEL_NOTE = ("On paper, from the distributed runs above of the scene with the l
               "peak memory of the largest part fitted as a line in its dofs, rank 0's as a line in the whole "
               "mesh's dofs (BDDC's coarse problem, gathered there, grows with the whole mesh), both evaluated "
               "for 64 ranks (63 parts); "
-              "the time is the largest run's work time per dof of a part times the dofs of a part (BDDC-CG "
+              "the time is the work time per dof of a part of the fastest run at the largest size (the one "
+              "least slowed by other jobs) times the dofs of a part (BDDC-CG "
               "iterations grow slowly with the size; communication across machines is not modelled). Rank 0 "
               "grows with the whole problem and is the limit: a coarse solve distributed over the ranks would "
               "remove it (NGSolve's own, MUMPS or hypre, is not built into its wheels, and its AMG of the "
@@ -375,6 +404,9 @@ def main(argv=None) -> int:
                     help='flags of NGSolve\'s BDDC to compare, each run with each (e.g. \'{"inverse": "umfpack"}\'; '
                          '"": the solver\'s)')
     ap.add_argument("--order", type=int, default=2, help="the press fit's polynomial order")
+    ap.add_argument("--rank-threads", type=int, nargs="+", default=[], metavar="T",
+                    help="runs on several ranks: rank r on the r-th T threads (the last for the rest; e.g. 1 2: "
+                         "rank 0 on one, the parts on 2), instead of the cores shared evenly")
     ap.add_argument("--guard", type=float, nargs=2, default=None, metavar=("START_GB", "FLOOR_GB"),
                     help="start each run only with START_GB available (MemAvailable; waits and retries, then gives "
                          "up) and end it once less than FLOOR_GB is left (a large run on a shared machine)")
@@ -402,7 +434,8 @@ def main(argv=None) -> int:
         for r, flags in ((r, f) for r in args.ranks for f in args.bddc):
             guard = MemoryGuard(*args.guard) if args.guard else None
             try:
-                data.append(measure(name, size, r, work, k, flags, args.order, guard, args.code))
+                data.append(measure(name, size, r, work, k, flags, args.order, guard, args.code,
+                                    tuple(args.rank_threads)))
             except RuntimeError as exc:            # the memory guard did not start or ended the run
                 print(f"{name} {size:g} refined {k} on {r} rank(s): {exc}", flush=True)
                 continue

@@ -5,7 +5,9 @@ records, per phase of a run (the stages of its clock, the mesh's
 distribution, the assemblies, the tangent solves, the round-off floors,
 the writing of the outputs), the memory at its start and end and the
 largest sample in between: what Python's own tracing cannot see, since
-NGSolve allocates in C++.  :class:`MemoryGuard` starts a command only with
+NGSolve allocates in C++.  Each phase also has its wall time and the
+process's CPU time over it (all its threads): a rank waiting in MPI's
+polling calls spends CPU time as fast as wall time.  :class:`MemoryGuard` starts a command only with
 enough memory available and ends its whole process group when the
 machine's available memory falls below a floor (a large run on a machine
 shared with other jobs).  Used by ``scripts/macro_mpi_scaling.py``.
@@ -47,7 +49,8 @@ class Phases:
 
     def enter(self, name: str) -> None:
         rss = _status_mb("VmRSS")
-        row = {"phase": name, "start_mb": rss, "peak_mb": rss, "end_mb": rss, "t0": time.perf_counter()}
+        row = {"phase": name, "start_mb": rss, "peak_mb": rss, "end_mb": rss, "t0": time.perf_counter(),
+               "c0": time.process_time()}
         self._open.append(row)
         self.rows.append(row)
 
@@ -56,6 +59,7 @@ class Phases:
         row["end_mb"] = _status_mb("VmRSS")
         row["peak_mb"] = max(row["peak_mb"], row["end_mb"])
         row["seconds"] = round(time.perf_counter() - row.pop("t0"), 2)
+        row["cpu_s"] = round(time.process_time() - row.pop("c0"), 2)
 
     def wrap(self, owner, attr: str, name: str) -> None:
         """``owner.attr`` (a function or method) recorded as phase ``name`` at each call."""
@@ -105,13 +109,14 @@ class Phases:
                 last = merged[-1]
                 last.update(peak_mb=max(last["peak_mb"], row["peak_mb"]), end_mb=row["end_mb"],
                             seconds=round(last.get("seconds", 0) + row.get("seconds", 0), 2),
+                            cpu_s=round(last.get("cpu_s", 0) + row.get("cpu_s", 0), 2),
                             calls=last["calls"] + 1)
             else:
                 merged.append(dict(row, calls=1))
         return [{k: round(v, 1) if isinstance(v, float) else v for k, v in r.items()} for r in merged]
 
 
-PHASE_KEYS = ("rank", "phase", "calls", "seconds", "start_mb", "peak_mb", "end_mb")
+PHASE_KEYS = ("rank", "phase", "calls", "seconds", "cpu_s", "start_mb", "peak_mb", "end_mb")
 #: one row per rank of a run: its resident memory [MB] at the start, the largest within each phase
 #: (phases by their names in :class:`Phases`, merged where several make one column), left after the solve
 PHASE_COLUMNS = {"mesh_mb": ("mesh", "distribute the mesh"),

@@ -45,7 +45,7 @@ import numpy as np
 from ngcontact.distributed.macro_mesh import distribute, gather
 from ngcontact.distributed.reduced_measures import Reduced, boundary_mid
 from ngcontact.distributed.vtk_pieces import RankPieces
-from ngcontact.distributed.world import World
+from ngcontact.distributed.world import World, broadcast
 from ngcontact.drivers import run_macro as R
 from ngcontact.errors import SceneError
 from ngcontact.fem.two_body import Support
@@ -91,7 +91,8 @@ def absolute(support: Support, mesh, mid=whole_mid) -> Support:
 
 
 def _on_root(world: World, make):
-    """``make()`` on rank 0, its value (or its exception) on every rank."""
+    """``make()`` on rank 0, its value (or its exception) on every rank, which sleep meanwhile
+    (:func:`~ngcontact.distributed.world.broadcast`)."""
     if world.root:
         try:
             value = ("value", make())
@@ -99,9 +100,9 @@ def _on_root(world: World, make):
         except Exception as exc:  # noqa: BLE001  (sent on, raised on every rank alike)
             value = ("error", exc)
             sent = pickle.dumps(value)
-        world.comm.bcast(sent)
+        broadcast(world, sent)
     else:
-        value = pickle.loads(world.comm.bcast(None))
+        value = pickle.loads(broadcast(world))
     if value[0] == "error":
         raise value[1]
     return value[1]

@@ -12,14 +12,14 @@ Rank 0 alone runs the writer of the output directory
 place).  The other ranks wait in :func:`written` for the path of each field
 set, which rank 0 sends when its writer reaches it, write their pieces
 there, and are released when rank 0's writer ends (whether or not it
-succeeded).
+succeeded); they sleep while they wait (:func:`ngcontact.distributed.world.broadcast`).
 """
 from __future__ import annotations
 
 import os
 from typing import Callable
 
-from ngcontact.distributed.world import World, launched_rank
+from ngcontact.distributed.world import World, broadcast, launched_rank
 
 
 class RankPieces:
@@ -33,7 +33,7 @@ class RankPieces:
 
     def write(self, path_noext: str, item) -> None:
         """On rank 0: send the path, write together with the other ranks, then the ``.pvtu`` file."""
-        self.world.comm.bcast(path_noext)
+        broadcast(self.world, path_noext)
         write_piece(path_noext, item, self.world)
         with open(path_noext + ".pvtu", "w", encoding="utf-8") as fh:
             fh.write(pvtu(os.path.basename(path_noext), item, self.world.size))
@@ -84,7 +84,7 @@ def written(outcome, write: Callable[[], object]) -> None:
         try:
             write()
         finally:
-            world.comm.bcast(None)     # the other ranks stop waiting
+            broadcast(world)     # the other ranks stop waiting
         return
-    while (path := world.comm.bcast(None)) is not None:
+    while (path := broadcast(world)) is not None:
         write_piece(path, outcome.vtk[os.path.basename(path)], world)

@@ -10,6 +10,7 @@ install, before anything is solved or written.
 from __future__ import annotations
 
 import os
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -17,6 +18,9 @@ from ngcontact.errors import ModelError
 
 #: what to install for MPI runs
 INSTALL = "pip install 'ngcontact[mpi]' (mpi4py and mpich, which gives mpiexec)"
+
+#: seconds between a waiting rank's looks at whether the others have reached :func:`broadcast`
+POLL_S = 0.002
 
 #: environment variables holding the number of ranks, by process manager (MPICH / Hydra, Open MPI)
 SIZE_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE")
@@ -75,3 +79,17 @@ def world(requested: bool = False) -> World | None:
     if comm.size <= 1 and not requested:
         return None
     return World(comm=comm, rank=comm.rank, size=comm.size)
+
+
+def broadcast(world: World, value: Any = None) -> Any:
+    """Rank 0's ``value`` on every rank, the ranks that reach it first asleep until all have.
+
+    MPICH's blocking calls poll without pause: a rank waiting in ``bcast`` while rank 0 works alone
+    (makes the mesh, writes the report) keeps a core busy that rank 0, or another job, needs.  Here
+    every rank enters a non-blocking barrier and tests it every :data:`POLL_S` seconds, sleeping in
+    between; once all have entered, rank 0's value is broadcast (pickled by mpi4py).
+    """
+    arrived = world.comm.Ibarrier()
+    while not arrived.Test():
+        time.sleep(POLL_S)
+    return world.comm.bcast(value)
