@@ -24,7 +24,7 @@ from ngcontact.cell.spectral.spectral_solver import SpectralCellSolver
 from ngcontact.coupling import cell_law
 from ngcontact.drivers.cell_gap import gap_cf, gap_samples, map_heights
 from ngcontact.drivers.contact_edge_refiner import edge_refiner
-from ngcontact.drivers.mirror_symmetry import symmetry_choice
+from ngcontact.drivers.mirror_symmetry import quarter, symmetry_choice
 from ngcontact.drivers.scene_laws import elastic_law
 from ngcontact.errors import SceneError
 from ngcontact.laws import homogenized as il
@@ -72,7 +72,8 @@ def with_symmetry(scene: CellScene) -> CellScene:
     quarter (:func:`~ngcontact.drivers.mirror_symmetry.symmetry_choice`, which samples the gap), decided once
     where the drivers take a cell scene in (:func:`cell_scene_of`, :func:`ngcontact.drivers.run_cell.run`, a
     scene handed to :func:`ngcontact.drivers.cell_scene_law.cell_law`); a scene that has it is returned as it
-    is.  Its readers mesh a scene without it (not taken in by a driver) over its period."""
+    is.  A scene without it is decided where it is meshed
+    (:func:`~ngcontact.drivers.mirror_symmetry.quarter`), alike."""
     if scene.symmetry_choice is not None:
         return scene
     return scene_with(scene, symmetry_choice=symmetry_choice(scene))
@@ -179,9 +180,8 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
                                        h_counter=g.h_counter, maxh=maxh, interface_maxh=ih,
                                        order=order)
         if kind.solid is None:  # flat, or a small-slope profile carried by the gap; its quarter where symmetric
-            symmetry = scene.symmetry_choice
             return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih,
-                                      symmetric=symmetry is not None and symmetry.used)
+                                      symmetric=quarter(scene))
         return kind.solid(g, maxh=maxh, interface_maxh=ih)
     from ngcontact.geometry import profiles as pr
     assert kind.profile is not None  # every 2D profile has its builder
