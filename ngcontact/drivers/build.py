@@ -34,6 +34,7 @@ from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral_start import SpectralStart
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
+from ngcontact.scene.cell_method import SymmetryChoice
 from ngcontact.scene.cell_scene import CellScene, check_fe, has_twin, load_states, spectral_grid
 from ngcontact.scene.spectral_grid import DEFAULT_REFINEMENT_POINTS, MAX_SPECTRAL_POINTS
 from ngcontact.scene.loader import as_dict, load_with_contact
@@ -317,8 +318,8 @@ def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = 
     """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene; a cell whose
     ``method = "auto"`` chose the spectral cell is solved by fe) -> the FE
     :class:`CellProblem` with the macro strain term, for what only the FE cell gives: the micro stresses of
-    the strength recovery (paper eqs. 74-78) and the shear response; the scene's ``[solver]`` settings and its
-    first loads' start (:func:`cell_problem`)."""
+    the strength recovery (paper eqs. 74-78) and the shear response, over the cell's period
+    (:data:`RECOVERY_PERIOD`); the scene's ``[solver]`` settings and its first loads' start (:func:`cell_problem`)."""
     cs = cell_scene_of(cell_path, key=key, overrides=overrides, method=method, discretization=discretization)
     choice = cs.method_choice
     if method is None and choice is not None and choice.automatic and choice.method != "fe":
@@ -331,8 +332,13 @@ def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = 
         raise SceneError(key, cell_path, f"the cell scene is solved by discretization.method = "
                          f"{cs.discretization.method!r}; the strength recovery needs the body stresses and the macro "
                          "strain term of the FE cell: use a cell scene with method = 'fe'")
+    cs = scene_with(cs, symmetry_choice=SymmetryChoice(False, RECOVERY_PERIOD, cs.discretization.symmetry))
     return cs, cell_problem(cs, model=replace(model_of(cs), macro_strain=True))
 
+
+#: why the recovery's cell is its period whatever ``discretization.symmetry``: the quarter's mirror faces (zero
+#: normal displacement) would hold its tangential loads wrongly
+RECOVERY_PERIOD = "the recovery's correctors and the shear response load the cell tangentially"
 
 #: the FE cell problem's start of first loads for each ``solver.start`` of a scene (``None``: its default)
 FE_START = {"auto": None, "spectral": "predictor", "rigid": "rigid", "closed": "closed"}

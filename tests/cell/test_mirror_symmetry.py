@@ -255,3 +255,19 @@ def test_a_scene_not_taken_in_by_a_driver_is_meshed_as_it_asked():
     assert not MS.quarter(off) and not build_cell(off).symmetric
     forced = B.scene_with(raw, symmetry_choice=MS.SymmetryChoice(False, "set by hand"))
     assert not MS.quarter(forced) and not build_cell(forced).symmetric
+
+
+def test_the_recovery_cell_keeps_the_period_whatever_the_scene_asks(tmp_path):
+    """The strength recovery's correctors and the shear response load the cell tangentially (macro shear
+    strains, shear tractions), which the quarter's mirror faces would hold wrongly: a scene that would mesh
+    its quarter for its own normal loads gives the recovery its period, and says why."""
+    path = tmp_path / "cell.toml"
+    path.write_text('kind = "cell"\n[materials.solid]\nE = 1.0\nnu = 0.3\n[bodies]\nrough = "solid"\n'
+                    'counter = "solid"\n[geometry]\nprofile = "bisinusoid"\narrangement = "summit"\n'
+                    'amplitude = 0.005\nh_rough = 0.6\nh_counter = 0.6\n[contact]\nenforcement = "exact"\n'
+                    '[load]\npressure = [0.008]\n[discretization]\nmethod = "fe"\nsymmetry = "auto"\norder = 1\n'
+                    'maxh = 0.3\ninterface_maxh = 0.25\n')
+    assert cell_scene_of(str(path), key="strength.cell").symmetry_choice.used
+    cs, P = B.recovery_cell_problem(str(path), key="strength.cell")
+    assert not cs.symmetry_choice.used and cs.symmetry_choice.reason == B.RECOVERY_PERIOD
+    assert not P.cell.symmetric
