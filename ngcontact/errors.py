@@ -18,7 +18,11 @@ MISSING = _Missing()
 
 
 class NgcontactError(Exception):
-    """Base class of all errors raised by the package."""
+    """Base class of all errors raised by the package.
+
+    The errors of this module pickle with the arguments they were made of (``__reduce__`` where these are not
+    the message alone), so that one raised in a worker process or on MPI rank 0 is raised alike where it is
+    received."""
 
 
 class SceneError(NgcontactError):
@@ -40,6 +44,9 @@ class SceneError(NgcontactError):
         self.allowed = allowed
         super().__init__(f"{path} = {_show(value)}: {allowed}")
 
+    def __reduce__(self):
+        return type(self), (self.path, self.value, self.allowed)
+
 
 class ConvergenceError(NgcontactError):
     """A nonlinear solve that did not converge; carries its iteration history."""
@@ -47,6 +54,9 @@ class ConvergenceError(NgcontactError):
     def __init__(self, message: str, history: dict):
         self.history = history
         super().__init__(message)
+
+    def __reduce__(self):
+        return type(self), (str(self), self.history)
 
 
 class ModelError(NgcontactError, ValueError):
@@ -75,6 +85,9 @@ class GeometryError(ModelError):
         self.allowed = allowed
         super().__init__(f"{name} = {_show(value)}: {allowed}")
 
+    def __reduce__(self):
+        return type(self), (self.name, self.value, self.allowed)
+
 
 class BatchError(NgcontactError):
     """A member of a batch of independent solves failed twice (its retry too): ``label: member: reason``.
@@ -87,6 +100,9 @@ class BatchError(NgcontactError):
         self.member = member
         self.reason = reason
         super().__init__(f"{label}: {member} failed twice: {reason}")
+
+    def __reduce__(self):
+        return type(self), (self.label, self.member, self.reason)
 
 
 class OutputError(NgcontactError):

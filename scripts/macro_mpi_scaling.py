@@ -47,14 +47,12 @@ across machines is not in the model).
                                         [--rows-from CSV|DIR ...] [--phases-from CSV ...]
                                         [--measured-by MD] [--publish]
 
-``--bddc``: flags of NGSolve's BDDC to compare (``linear_solver.BDDC_FLAGS``
-in each run's processes), each run with each; per run also the time the
-ranks holding the mesh spend in BDDC's coarse solves.  ``--rank-threads``:
-NGSolve's threads of each rank of a distributed run (``NGCONTACT_THREADS``
-per rank; e.g. ``1 2``: rank 0, which holds no element, on one thread and
-the part on 2), recorded per rank in the ``threads`` column.  MPICH's
-settings (``MPIR_CVAR_...``) reach the ranks from the environment; name
-them in ``--code`` (e.g. ``--code 6f44d61+heavy_yield``).
+``--bddc``: flags of NGSolve's BDDC to compare (``linear_solver.BDDC_FLAGS`` in each run's processes), each
+run with each; per run also the time the ranks holding the mesh spend in BDDC's coarse solves.
+``--rank-threads``: NGSolve's threads of each rank of a distributed run (``NGCONTACT_THREADS`` per rank; e.g.
+``1 2``: rank 0, which holds no element, on one thread and the part on 2), recorded per rank in the
+``threads`` column.  MPICH's settings (``MPIR_CVAR_...``) reach the ranks from the environment; name them in
+``--code`` (e.g. ``--code 6f44d61+heavy_yield``).
 
 Writes ``OUT/macro_mpi_scaling.csv``, ``OUT/macro_mpi_phases.csv``, ``OUT/macro_mpi_model.csv`` and ``.png``
 (default ``results/macro_mpi_scaling``).  ``--rows-from``: no runs, the rows
@@ -422,6 +420,8 @@ def main(argv=None) -> int:
                          "the folders' notes")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
+    if any(t < 1 for t in args.rank_threads):
+        ap.error(f"--rank-threads {' '.join(map(str, args.rank_threads))}: each rank's threads, integers >= 1")
     args.code = args.code or benchmark_doc.git_commit()
     work = os.path.abspath(os.path.join(args.out, "runs"))
     os.makedirs(work, exist_ok=True)

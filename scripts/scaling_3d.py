@@ -91,7 +91,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
 from bisinusoid_accuracy import (ACC_CELLS, ACC_EDGES, ACC_PATCH, QUICK_EDGES, accuracy_aim,  # noqa: E402
                                  aim_status)
-from scaling_3d_rows import ARCHIVE, MEASURED, keep, republished_rows  # noqa: E402
+from scaling_3d_rows import ARCHIVE, MEASURED, keep, measured, read_rows, with_extrapolations  # noqa: E402
 
 log = logging.getLogger("scaling_3d")
 
@@ -540,10 +540,9 @@ def main(argv=None) -> int:
                                        "contact surface on the wirebasket.",
                                   png=os.path.join(args.out, "scaling_3d_coarse.png"))
         return 0
-    rows = republished_rows(args.republish) if args.republish else measured_rows(args)
-    kept = republished_rows(args.keep_rows) if args.keep_rows else []
-    n_new = 0 if args.republish else len(rows)
-    rows = kept + rows
+    kept = read_rows(args.republish or args.keep_rows) if args.republish or args.keep_rows else []
+    new = [] if args.republish else measured(measured_rows(args))
+    rows = with_extrapolations(kept + new)          # the derived rows last, made from every measured row
     os.makedirs(args.out, exist_ok=True)
     write_csv(os.path.join(args.out, "scaling_3d.csv"), list(KEYS), [[r.get(k, "") for k in KEYS] for r in rows])
     plot(rows, os.path.join(args.out, "scaling_3d.png"))
@@ -556,7 +555,7 @@ def main(argv=None) -> int:
                 fits.append(f"{part} {solver} `time ~ dofs^{b:.2f}`")
     log.info("wrote %s", os.path.join(args.out, "scaling_3d.csv"))
     if args.publish:
-        keep(os.path.join(args.out, "scaling_3d.csv"), args.republish or args.keep_rows, len(rows) - n_new, n_new)
+        keep(os.path.join(args.out, "scaling_3d.csv"), args.republish or args.keep_rows, len(kept), len(new))
         archive = os.path.relpath(ARCHIVE, os.path.join(ROOT, "docs"))
         benchmark_doc.publish("scaling_3d", "3D at scale: direct against iterative; the bisinusoid aim",
                               os.path.join(args.out, "scaling_3d.csv"),
@@ -565,7 +564,7 @@ def main(argv=None) -> int:
                                     if args.republish else "") +
                                    (f"The first {len(kept)} rows were measured by an earlier run (its CSV kept "
                                     "with `--keep-rows`: its timings, its machine's load), the others by this "
-                                    "one. " if kept else "") +
+                                    "one, the extrapolated rows made from all. " if args.keep_rows else "") +
                                    f"The rows are kept in `docs/{archive}/`; which commands measured them, at "
                                    f"which commits, on how many threads and under which load: "
                                    f"[{MEASURED}]({archive}/{MEASURED}). " + aim_status(rows) + " " +

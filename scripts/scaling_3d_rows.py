@@ -36,11 +36,28 @@ def is_archive(path: str | None) -> bool:
     return path is not None and os.path.abspath(rows_file(path)) == os.path.join(ARCHIVE, ROWS)
 
 
-def republished_rows(path: str) -> list[dict]:
-    """The rows an earlier run measured, read from its ``scaling_3d.csv`` (or a folder holding one), with the
-    rows derived from them (:func:`extrapolated_rows`) made again by this script: the converged contact
-    fraction per load is the one that run compared with (``contact_fraction / (1 + relative_error)`` of its
-    rows)."""
+#: the end of the solver of a row derived from the measured ones (:func:`extrapolated_rows`)
+EXTRAPOLATED = ", extrapolated"
+
+
+def measured(rows: list[dict]) -> list[dict]:
+    """The measured ``rows``: those not derived from others."""
+    return [r for r in rows if not str(r.get("solver", "")).endswith(EXTRAPOLATED)]
+
+
+def with_extrapolations(rows: list[dict]) -> list[dict]:
+    """The measured ``rows`` in their order, then the rows derived from all of them (:func:`extrapolated_rows`;
+    the converged contact fraction per load the one the rows compared with, ``contact_fraction / (1 +
+    relative_error)``).  A run that keeps an earlier run's rows and a republication of its table make the same
+    table: the derived rows last, made from every measured row."""
+    rows = measured(rows)
+    accuracy = [r for r in rows if r["part"] == "accuracy"]
+    converged = {r["pressure"]: r["contact_fraction"] / (1.0 + r["relative_error"]) for r in accuracy}
+    return rows + extrapolated_rows(accuracy, converged)
+
+
+def read_rows(path: str) -> list[dict]:
+    """The measured rows of an earlier run's ``scaling_3d.csv`` (or a folder holding one), numbers as numbers."""
     def value(text: str):
         for kind in (int, float):
             try:
@@ -49,18 +66,15 @@ def republished_rows(path: str) -> list[dict]:
                 pass
         return text
     with open(rows_file(path), newline="") as fh:
-        rows = [{k: value(v) for k, v in r.items() if v != ""} for r in csv.DictReader(fh)
-                if not r["solver"].endswith(", extrapolated")]
-    accuracy = [r for r in rows if r["part"] == "accuracy"]
-    converged = {r["pressure"]: r["contact_fraction"] / (1.0 + r["relative_error"]) for r in accuracy}
-    return rows + extrapolated_rows(accuracy, converged)
+        return measured([{k: value(v) for k, v in r.items() if v != ""} for r in csv.DictReader(fh)])
 
 
 def keep(csv_path: str, earlier: str | None, n_earlier: int, n_new: int) -> None:
     """The published rows ``csv_path`` into ``ARCHIVE``, and the note of how they were measured: its first
     ``n_earlier`` rows are those of ``earlier`` (``--republish`` or ``--keep-rows``: the folder's own note
     where they are the folder's rows, else a line naming the file), the ``n_new`` rows below them this run's
-    (a line with its command, commit, machine, load and date)."""
+    (a line with its command, commit, machine, load and date); the derived rows follow them
+    (:func:`with_extrapolations`)."""
     note = os.path.join(ARCHIVE, MEASURED)
     if is_archive(earlier) and not n_new:
         return                                  # published again from the kept rows: they and their note stay

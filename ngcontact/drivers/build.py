@@ -24,7 +24,7 @@ from ngcontact.cell.spectral.spectral_solver import SpectralCellSolver
 from ngcontact.coupling import cell_law
 from ngcontact.drivers.cell_gap import gap_cf, gap_samples, map_heights
 from ngcontact.drivers.contact_edge_refiner import edge_refiner
-from ngcontact.drivers.mirror_symmetry import symmetry_choice
+from ngcontact.drivers.mirror_symmetry import quarter, symmetry_choice
 from ngcontact.drivers.scene_laws import elastic_law
 from ngcontact.errors import SceneError
 from ngcontact.laws import homogenized as il
@@ -34,6 +34,7 @@ from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral_start import SpectralStart
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
+from ngcontact.scene.cell_method import SymmetryChoice
 from ngcontact.scene.cell_scene import CellScene, check_fe, has_twin, load_states, spectral_grid
 from ngcontact.scene.spectral_grid import DEFAULT_REFINEMENT_POINTS, MAX_SPECTRAL_POINTS
 from ngcontact.scene.loader import as_dict, load_with_contact
@@ -72,7 +73,8 @@ def with_symmetry(scene: CellScene) -> CellScene:
     quarter (:func:`~ngcontact.drivers.mirror_symmetry.symmetry_choice`, which samples the gap), decided once
     where the drivers take a cell scene in (:func:`cell_scene_of`, :func:`ngcontact.drivers.run_cell.run`, a
     scene handed to :func:`ngcontact.drivers.cell_scene_law.cell_law`); a scene that has it is returned as it
-    is.  Its readers mesh a scene without it (not taken in by a driver) over its period."""
+    is.  A scene without it is decided where it is meshed
+    (:func:`~ngcontact.drivers.mirror_symmetry.quarter`), alike."""
     if scene.symmetry_choice is not None:
         return scene
     return scene_with(scene, symmetry_choice=symmetry_choice(scene))
@@ -179,9 +181,8 @@ def build_cell(scene, maxh=None, interface_maxh=None, order=None):
                                        h_counter=g.h_counter, maxh=maxh, interface_maxh=ih,
                                        order=order)
         if kind.solid is None:  # flat, or a small-slope profile carried by the gap; its quarter where symmetric
-            symmetry = scene.symmetry_choice
             return cell3d.flat_cell3d(g.period, g.h_rough, g.h_counter, maxh=maxh, interface_maxh=ih,
-                                      symmetric=symmetry is not None and symmetry.used)
+                                      symmetric=quarter(scene))
         return kind.solid(g, maxh=maxh, interface_maxh=ih)
     from ngcontact.geometry import profiles as pr
     assert kind.profile is not None  # every 2D profile has its builder
@@ -317,8 +318,8 @@ def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = 
     """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene; a cell whose
     ``method = "auto"`` chose the spectral cell is solved by fe) -> the FE
     :class:`CellProblem` with the macro strain term, for what only the FE cell gives: the micro stresses of
-    the strength recovery (paper eqs. 74-78) and the shear response; the scene's ``[solver]`` settings and its
-    first loads' start (:func:`cell_problem`)."""
+    the strength recovery (paper eqs. 74-78) and the shear response, over the cell's period
+    (:data:`RECOVERY_PERIOD`); the scene's ``[solver]`` settings and its first loads' start (:func:`cell_problem`)."""
     cs = cell_scene_of(cell_path, key=key, overrides=overrides, method=method, discretization=discretization)
     choice = cs.method_choice
     if method is None and choice is not None and choice.automatic and choice.method != "fe":
@@ -331,8 +332,13 @@ def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = 
         raise SceneError(key, cell_path, f"the cell scene is solved by discretization.method = "
                          f"{cs.discretization.method!r}; the strength recovery needs the body stresses and the macro "
                          "strain term of the FE cell: use a cell scene with method = 'fe'")
+    cs = scene_with(cs, symmetry_choice=SymmetryChoice(False, RECOVERY_PERIOD, cs.discretization.symmetry))
     return cs, cell_problem(cs, model=replace(model_of(cs), macro_strain=True))
 
+
+#: why the recovery's cell is its period whatever ``discretization.symmetry``: the quarter's mirror faces (zero
+#: normal displacement) would hold its tangential loads wrongly
+RECOVERY_PERIOD = "the recovery's correctors and the shear response load the cell tangentially"
 
 #: the FE cell problem's start of first loads for each ``solver.start`` of a scene (``None``: its default)
 FE_START = {"auto": None, "spectral": "predictor", "rigid": "rigid", "closed": "closed"}

@@ -15,6 +15,7 @@ from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.contact_edge_mesh import edge_refined_cell
 from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
 from ngcontact.cell.fe.fe_cell import FECell
+from ngcontact.drivers.mirror_symmetry import quarter
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
 from ngcontact.scene.cell_scene import CellScene, load_states
@@ -44,8 +45,7 @@ def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any]
         return None
     g, d = scene.geometry, scene.discretization
     h = d.interface_maxh or d.maxh
-    symmetry = scene.symmetry_choice              # the scene's cell's quarter, refined alike
-    symmetric = symmetry is not None and symmetry.used
+    symmetric = quarter(scene)                    # the scene's cell's quarter, refined alike
 
     def pressures():
         twin = spectral(scene, grid=EDGE_TWIN_GRID, friction=False, tol=EDGE_TWIN_RTOL)

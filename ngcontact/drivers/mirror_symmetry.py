@@ -24,6 +24,9 @@ section scaling_3d), so it is asked for, not chosen for the user.
 The choice is made once per scene: :func:`ngcontact.drivers.build.with_symmetry` sets it as the scene's
 typed field ``symmetry_choice`` where the drivers take a cell scene in, and the mesh
 (:func:`~ngcontact.drivers.build.build_cell`), the contact edge's refiner and the report read that field.
+The rule depends on the scene alone, so a scene meshed without the field (built by hand and handed to the
+mesh or the cell problem directly) is decided where it is meshed (:func:`quarter`), with the same answer: a
+scene that asks for ``"auto"`` is never meshed over its period for want of the field.
 """
 from __future__ import annotations
 
@@ -98,3 +101,10 @@ def symmetry_choice(scene: CellScene) -> SymmetryChoice:
         return SymmetryChoice(False, refusal, requested)
     return SymmetryChoice(True, "the gap is even about the cell's mid-lines and the load normal and frictionless: "
                           "the quarter [0, P/2]^2 with zero normal displacement on its mirror faces", requested)
+
+
+def quarter(scene: CellScene) -> bool:
+    """Whether the scene's FE cell is meshed as its mirror-symmetric quarter: its field ``symmetry_choice``
+    where a driver resolved it, else :func:`symmetry_choice` decided now (module docstring)."""
+    choice = scene.symmetry_choice
+    return (symmetry_choice(scene) if choice is None else choice).used

@@ -138,6 +138,29 @@ def warn_unmet(verdict: dict, refinement: Refinement) -> None:
                 what, verdict["tolerance_from"], verdict["tolerance"], refinement.how.split(";")[0])
 
 
+def load_records(cell, sols: list, refinement: Refinement | None, height: float
+                 ) -> tuple[list[dict], dict[str, Any], dict[str, Any]]:
+    """Per load its entry of ``results.loads`` (with the refinement's estimate of its controlled quantities
+    and its per-load record where refined), its surface table and its fields' arrays; each load's strain
+    checked small against the cell's ``height`` (:mod:`ngcontact.cell.small_strain`)."""
+    per_load, tables, arrays = [], {}, {}
+    for k, sol in enumerate(sols):
+        entry = cell.load_entry(sol)
+        small_strain.check(entry, height, f"load {k}")
+        if refinement is not None and refinement.estimates:
+            entry["error_estimate"] = {name: e for name, e in refinement.estimates[k].items()
+                                       if name not in refinement.uncontrolled}
+            if refinement.per_load:
+                entry.update(refinement.per_load[k])
+        per_load.append(entry)
+        if sol.surface:
+            tables[f"surface_load{k}"] = sol.surface_table()
+        for name, values in sol.fields.items():
+            arrays[f"{name}_load{k}"] = values
+        log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
+    return per_load, tables, arrays
+
+
 def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
     """The sweep refined to the scene's tolerance, or held to the default one (the cell's
     :meth:`~ngcontact.cell.cell_solver.CellSolver.default_accuracy`: the spectral cell refined to it, the FE
@@ -214,22 +237,7 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
             sols = cell_members.solve(scene, cell)
         else:
             sols = cell.sweep(loads)
-    per_load, tables, arrays = [], {}, {}
-    height = scene.geometry.h_rough + scene.geometry.h_counter
-    for k, sol in enumerate(sols):
-        entry = cell.load_entry(sol)
-        small_strain.check(entry, height, f"load {k}")
-        if refinement is not None and refinement.estimates:
-            entry["error_estimate"] = {name: e for name, e in refinement.estimates[k].items()
-                                       if name not in refinement.uncontrolled}
-            if refinement.per_load:
-                entry.update(refinement.per_load[k])
-        per_load.append(entry)
-        if sol.surface:
-            tables[f"surface_load{k}"] = sol.surface_table()
-        for name, values in sol.fields.items():
-            arrays[f"{name}_load{k}"] = values
-        log.info("load %d: %d iterations, contact fraction %.8f", k, sol.iterations, sol.results["contact_fraction"])
+    per_load, tables, arrays = load_records(cell, sols, refinement, scene.geometry.h_rough + scene.geometry.h_counter)
     results["loads"] = per_load
     results["accuracy"] = dict(accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
                                                 unestimated=opted_out(scene)), method=method_choice(scene))

@@ -1,13 +1,10 @@
 """Scene kind ``cell``: the micro contact problem of one periodic cell.
 
-Sections: ``[geometry]`` (profile and arrangement,
-:mod:`ngcontact.scene.cell_geometry`),
-``[contact]`` (penalty ``k_n``, initial gap, friction law), ``[load]``
-(pressure or normal jump, shear or tangential jump, macro strain; lists are
-sweeps), ``[bodies]`` (material names), ``[discretization]``, ``[solver]``.
-With ``contact.geometric_only = true`` only the coefficients of the whole
-contact surface (paper eq. 34, 42-43) are computed and no contact problem is
-solved.  Solved by :mod:`ngcontact.drivers.run_cell`.
+Sections: ``[geometry]`` (profile and arrangement, :mod:`ngcontact.scene.cell_geometry`), ``[contact]`` (penalty
+``k_n``, initial gap, friction law), ``[load]`` (pressure or normal jump, shear or tangential jump, macro
+strain; lists are sweeps), ``[bodies]`` (material names), ``[discretization]``, ``[solver]``. With
+``contact.geometric_only = true`` only the coefficients of the whole contact surface (paper eq. 34, 42-43) are
+computed and no contact problem is solved.  Solved by :mod:`ngcontact.drivers.run_cell`.
 """
 from __future__ import annotations
 

@@ -138,7 +138,8 @@ class CellDiscretization(Discretization):
                           "on its four mirror faces instead of the periodic identification: the same means over a "
                           "quarter of the unknowns; results.accuracy.symmetry states whether it was used and, if "
                           "not, why (at the same sizes the quarter is the faster cell, not the more accurate one: "
-                          "docs/benchmarks.md, section scaling_3d)",
+                          "docs/benchmarks.md, section scaling_3d); the cell of a strength check or of a shear "
+                          "table, loaded tangentially, keeps its period",
                           choices=("auto", "off"))
     grid: int | None = param(None, doc="spectral (set with method = 'auto', it asks for the spectral cell): grid "
                              "points per period and direction of the first grid, "

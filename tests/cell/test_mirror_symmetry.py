@@ -17,6 +17,7 @@ from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
 from ngcontact.cell.fe.contact_edge_mesh import edge_refined_cell, fold_quarter
 from ngcontact.drivers import build as B, run_cell
 from ngcontact.drivers.build import build_cell, cell_scene_of, with_symmetry
+from ngcontact.drivers import mirror_symmetry as MS
 from ngcontact.drivers.mirror_symmetry import even_gap, mirror_invariant, symmetry_choice
 from ngcontact.errors import SceneError
 from ngcontact.fem.materials import isotropic
@@ -237,6 +238,36 @@ def test_the_choice_is_a_field_of_the_scene_decided_once_per_run(tmp_path, monke
                     '[load]\npressure = [0.008]\n[discretization]\nmethod = "fe"\nsymmetry = "auto"\n')
     assert cell_scene_of(str(path), key="cell").symmetry_choice.used
     calls = []
-    monkeypatch.setattr(B, "symmetry_choice", lambda sc: calls.append(sc) or symmetry_choice(sc))
+    counted = lambda sc: calls.append(sc) or symmetry_choice(sc)      # noqa: E731
+    monkeypatch.setattr(B, "symmetry_choice", counted)
+    monkeypatch.setattr(MS, "symmetry_choice", counted)                 # the mesh's own decision (quarter)
     out = run_cell.run(raw, Clock())
     assert len(calls) == 1 and out.results["accuracy"]["symmetry"] == scene.symmetry_choice.as_dict()
+
+
+def test_a_scene_not_taken_in_by_a_driver_is_meshed_as_it_asked():
+    """A scene handed to the mesh or the cell problem without ``with_symmetry`` (``symmetry_choice`` unset) is
+    decided where it is meshed: "auto" of an even gap gives the quarter, as a driver's run would, "off" the
+    period; the field, where set, is what the mesh reads."""
+    raw = _scene(taken_in=False)
+    assert raw.symmetry_choice is None and MS.quarter(raw) and build_cell(raw).symmetric
+    off = _scene(symmetry="off", taken_in=False)
+    assert not MS.quarter(off) and not build_cell(off).symmetric
+    forced = B.scene_with(raw, symmetry_choice=MS.SymmetryChoice(False, "set by hand"))
+    assert not MS.quarter(forced) and not build_cell(forced).symmetric
+
+
+def test_the_recovery_cell_keeps_the_period_whatever_the_scene_asks(tmp_path):
+    """The strength recovery's correctors and the shear response load the cell tangentially (macro shear
+    strains, shear tractions), which the quarter's mirror faces would hold wrongly: a scene that would mesh
+    its quarter for its own normal loads gives the recovery its period, and says why."""
+    path = tmp_path / "cell.toml"
+    path.write_text('kind = "cell"\n[materials.solid]\nE = 1.0\nnu = 0.3\n[bodies]\nrough = "solid"\n'
+                    'counter = "solid"\n[geometry]\nprofile = "bisinusoid"\narrangement = "summit"\n'
+                    'amplitude = 0.005\nh_rough = 0.6\nh_counter = 0.6\n[contact]\nenforcement = "exact"\n'
+                    '[load]\npressure = [0.008]\n[discretization]\nmethod = "fe"\nsymmetry = "auto"\norder = 1\n'
+                    'maxh = 0.3\ninterface_maxh = 0.25\n')
+    assert cell_scene_of(str(path), key="strength.cell").symmetry_choice.used
+    cs, P = B.recovery_cell_problem(str(path), key="strength.cell")
+    assert not cs.symmetry_choice.used and cs.symmetry_choice.reason == B.RECOVERY_PERIOD
+    assert not P.cell.symmetric

@@ -336,7 +336,8 @@ def test_an_island_raises_an_estimate_below_its_share_and_a_loose_guarded_bound_
                for j, (f, g) in enumerate(((0.30, 0.1), (0.32, 0.11), (0.321, 0.1101)))]
     estimates = [{"contact_fraction": 0.004, "coefficient_g_n": 0.05}]
     forms = [{"contact_fraction": GUARDED, "coefficient_g_n": RICHARDSON}]
-    assert len(island_floor(history, estimates, forms)) == 1
+    remarks = island_floor(history, estimates, forms)
+    assert len(remarks) == 1 and "the smallest island 1 point(s)" in remarks[0]
     assert estimates == [{"contact_fraction": 0.01, "coefficient_g_n": 0.05}]
     assert forms == [{"contact_fraction": ISLAND, "coefficient_g_n": RICHARDSON}]
     left, rate = tail_left([0.30, 0.32, 0.321])  # differences 0.02, 0.001: rate 0.05

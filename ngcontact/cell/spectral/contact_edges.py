@@ -163,6 +163,6 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                 raised.append(name)
         if raised:
             remarks.append(f"load {k}: {unresolved['islands']} contact island(s) of fewer than {ISLAND_POINTS} "
-                           f"points (in 3D across; the smallest {unresolved['points']}) on grid {last['grid']}: "
-                           f"{', '.join(raised)} bounded by their share, one step beyond each edge")
+                           f"points (in 3D across; the smallest island {unresolved['points']} point(s)) on grid "
+                           f"{last['grid']}: {', '.join(raised)} bounded by their share, one step beyond each edge")
     return remarks

@@ -109,12 +109,12 @@ half its closing pressure) and reported, but not held to the tolerance (:data:`U
 the verdict as not counted).
 
 Two checks end each level's estimate.  A contact island of fewer than
-:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: it may stall
-while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
-(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``).  An estimate (not Richardson's)
-above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the
-last contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the
-error by as much: flagged with its reason, per quantity in the report (:func:`estimate_forms.loose_flags`).
+:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: its error may
+stall while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
+(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``).  An estimate (not Richardson's) above
+:data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the last
+contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much:
+flagged with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
 Levels double the points per direction (:data:`GROWTH`): close enough that three differences cost little
 more than the finest level (2D: twice the finest; 3D: 4/3 of it).
@@ -151,8 +151,7 @@ import numpy as np
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale
 from ngcontact.cell.spectral.contact_edges import (ISLAND_POINTS, fitted_run, island_floor, on_edges,
                                                    unresolved_share)
-from ngcontact.cell.spectral.estimate_forms import (CARRIED, GUARDED, LOOSE, RICHARDSON, loose_flags,
-                                                   loose_remarks)
+from ngcontact.cell.spectral.estimate_forms import CARRIED, GUARDED, LOOSE, RICHARDSON, loose_flags, loose_remarks
 from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
 from ngcontact.errors import ConvergenceError
 

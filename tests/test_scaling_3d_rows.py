@@ -1,0 +1,59 @@
+"""scripts/scaling_3d_rows.py: the published rows of the section scaling_3d, kept and published again alike."""
+import csv
+import os
+import sys
+
+import pytest
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import scaling_3d_rows as S  # noqa: E402
+
+KEYS = ["part", "solver", "cell", "size", "ndof", "seconds", "contact_fraction", "pressure", "relative_error"]
+
+
+def _row(size: float, fraction: float, converged: float = 0.0147) -> dict:
+    return {"part": "accuracy", "solver": "fe exact order 2, edge-refined", "cell": "quarter", "size": size,
+            "ndof": int(1000 / size), "seconds": 1.0, "contact_fraction": fraction, "pressure": 0.005,
+            "relative_error": fraction / converged - 1.0}
+
+
+def _write(path, rows: list[dict]) -> None:
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, KEYS, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+
+
+def test_kept_rows_and_new_ones_make_the_table_their_republication_makes(tmp_path):
+    """An earlier run's rows (two edge sizes and their extrapolation) kept above a new size: the measured rows in
+    their order, then one extrapolation over all three sizes, the table that republishing its CSV makes again."""
+    earlier = [_row(0.01, 0.0152), _row(0.005, 0.01485)]
+    table = S.with_extrapolations(earlier)
+    assert [r["solver"].endswith(S.EXTRAPOLATED) for r in table] == [False, False, True]
+    _write(tmp_path / S.ROWS, table)
+    kept = S.read_rows(str(tmp_path))                       # a folder stands for its scaling_3d.csv
+    assert [r["size"] for r in kept] == [0.01, 0.005]
+    joined = S.with_extrapolations(kept + [_row(0.0025, 0.014725)])
+    assert [r["size"] for r in joined] == [0.01, 0.005, 0.0025, "0.01 0.005 0.0025"]
+    _write(tmp_path / "joined.csv", joined)
+    again = S.with_extrapolations(S.read_rows(str(tmp_path / "joined.csv")))
+    assert [r["size"] for r in again] == [r["size"] for r in joined]
+    assert again[-1]["contact_fraction"] == pytest.approx(joined[-1]["contact_fraction"], rel=1e-12)
+
+
+def test_the_note_numbers_the_kept_rows_then_the_new_ones(tmp_path, monkeypatch):
+    """A run that measures starts the note; one that keeps the folder's rows adds its own line after the kept
+    rows' numbers; republishing the folder changes neither file."""
+    monkeypatch.setattr(S, "ARCHIVE", str(tmp_path / "archive"))
+    out = tmp_path / "out.csv"
+    _write(out, S.with_extrapolations([_row(0.01, 0.0152), _row(0.005, 0.01485)]))
+    S.keep(str(out), None, 0, 2)
+    note = tmp_path / "archive" / S.MEASURED
+    lines = note.read_text().splitlines()
+    assert lines[0] == S.TITLE and lines[2].startswith("- Rows 1-2: `python ")
+    S.keep(str(out), S.ARCHIVE, 2, 1)
+    assert note.read_text().splitlines()[:3] == lines[:3] and note.read_text().splitlines()[3].startswith("- Rows 3-3:")
+    before = note.read_text(), (tmp_path / "archive" / S.ROWS).read_text()
+    S.keep(str(out), S.ARCHIVE, 3, 0)
+    assert (note.read_text(), (tmp_path / "archive" / S.ROWS).read_text()) == before
