@@ -1,0 +1,35 @@
+"""Hostile numbers a new user may write, found by the reliability audit of issue 35: each ends in exit 2, one
+line naming the key, the value and what is allowed, and nothing written (``run_bad`` of
+:mod:`tests.scene.test_bad_input`), never in a solver failure, an unexpected error or a non-finite number."""
+import pytest
+
+from sinusoid_cell import sinusoid_cell
+from test_bad_input import edit, run_bad
+
+SPECTRAL = sinusoid_cell(discretization='method = "spectral"\ngrid = 64\ntolerance = 0.1')
+
+LENGTHS = "must lie in [1e-09, 1e+09]: choose a length unit (e.g. mm or um) in which the geometry's sizes fall in " \
+          "that range"
+
+
+@pytest.mark.parametrize("key, value", [("period", "1e-300"), ("h_rough", "1e300")])
+def test_a_spectral_cell_scaled_beyond_the_lengths_the_fe_cell_takes(tmp_path, capsys, key, value):
+    """Was: exit 3, 'non-finite number nan at report.results.method.refinement[0].mean_closure[0]'."""
+    text = edit(SPECTRAL, ('profile = "flat"', f'profile = "flat"\n{key} = {value}')) if key == "period" else \
+        edit(SPECTRAL, ("h_rough = 1.0", f"h_rough = {value}"))
+    run_bad(tmp_path, capsys, text, f"geometry.{key} = {float(value)!r}: {LENGTHS}")
+
+
+@pytest.mark.parametrize("old, new, key, shown", [
+    ("h = 0.01", "h = 1e300", "contact.gap.h", "1e+300"),
+    ('{ kind = "sinusoid", h = 0.01 }', '{ kind = "constant", value = 1e300 }', "contact.gap.value", "1e+300"),
+    ("pressure = [0.005]", "normal_jump = [1e300]", "load.normal_jump[0]", "1e+300")])
+@pytest.mark.parametrize("method", ["spectral", "fe"])
+def test_a_gap_or_jump_beyond_the_length_range(tmp_path, capsys, old, new, key, shown, method):
+    """Was: exit 3 ('unexpected error (OverflowError)', 'complementarity residual nan', 'the start value gives
+    a non-finite energy or residual')."""
+    text = SPECTRAL if method == "spectral" else sinusoid_cell(
+        enforcement="penalty", discretization="order = 1\nmaxh = 0.5")
+    run_bad(tmp_path, capsys, edit(text, (old, new)),
+            f"{key} = {float(shown)!r}: must be at most 1e+09 in magnitude: choose a length unit (e.g. mm or um) in "
+            "which the geometry's sizes fall in [1e-09, 1e+09]")
