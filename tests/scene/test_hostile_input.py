@@ -1,7 +1,12 @@
 """Hostile numbers a new user may write, found by the reliability audit of issue 35: each ends in exit 2, one
 line naming the key, the value and what is allowed, and nothing written (``run_bad`` of
 :mod:`tests.scene.test_bad_input`), never in a solver failure, an unexpected error or a non-finite number."""
+import json
+import logging
+
 import pytest
+
+from ngcontact import cli
 
 from sinusoid_cell import sinusoid_cell
 from test_bad_input import edit, run_bad
@@ -33,3 +38,15 @@ def test_a_gap_or_jump_beyond_the_length_range(tmp_path, capsys, old, new, key, 
     run_bad(tmp_path, capsys, edit(text, (old, new)),
             f"{key} = {float(shown)!r}: must be at most 1e+09 in magnitude: choose a length unit (e.g. mm or um) in "
             "which the geometry's sizes fall in [1e-09, 1e+09]")
+
+
+def test_the_strain_of_a_load_far_beyond_the_modulus_is_warned_not_an_overflow(tmp_path, caplog):
+    """Was: 'unexpected error (OverflowError)', exit 3: the far-face strain squared the jump of 1e300 / E.  The
+    linear cell's answer is finite; its strain is recorded and warned as beyond small strain."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text(edit(SPECTRAL, ("pressure = [0.005]", "pressure = [1e300]")))
+    with caplog.at_level(logging.WARNING):
+        assert cli.main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    assert any("is beyond small strain" in r.getMessage() for r in caplog.records)
+    load = json.loads((tmp_path / "out" / "report.json").read_text())["results"]["loads"][0]
+    assert 1e299 < load["far_face_strain"] < 1e302
