@@ -4,6 +4,7 @@ line naming the key, the value and what is allowed, and nothing written (``run_b
 import json
 import logging
 
+import numpy as np
 import pytest
 
 from ngcontact import cli
@@ -50,3 +51,32 @@ def test_the_strain_of_a_load_far_beyond_the_modulus_is_warned_not_an_overflow(t
     assert any("is beyond small strain" in r.getMessage() for r in caplog.records)
     load = json.loads((tmp_path / "out" / "report.json").read_text())["results"]["loads"][0]
     assert 1e299 < load["far_face_strain"] < 1e302
+
+
+HEIGHT_MAP = sinusoid_cell(discretization='method = "spectral"\ntolerance = 0.1', profile="height_map")
+
+
+def test_a_height_map_spanning_beyond_the_length_range(tmp_path, capsys):
+    """Was: exit 3, 'constrained CG: the complementarity residual nan' (heights of 1e298 on a period of 1)."""
+    x = np.linspace(0.0, 1.0, 17)
+    H = 1e298 * np.cos(2 * np.pi * x)[None, :] * np.cos(2 * np.pi * x)[:, None]
+    text = edit(HEIGHT_MAP, ('profile = "height_map"', 'profile = "height_map"\nfile = "map.npy"\n'
+                                                       'arrangement = "summit"'),
+                ('gap = { kind = "sinusoid", h = 0.01 }\n', ""))
+    run_bad(tmp_path, capsys, text, "geometry.file (map.npy) = 'heights spanning 2e+298': must span at most 1e+09: "
+            "choose a length unit (e.g. mm or um) in which the geometry's sizes fall in [1e-09, 1e+09]",
+            files={"map.npy": H})
+
+
+def test_a_gap_table_beyond_the_length_range(tmp_path, capsys):
+    """Was: exit 3, 'constrained CG: the complementarity residual nan' (a tabulated gap of 1e300)."""
+    text = edit(SPECTRAL, ('{ kind = "sinusoid", h = 0.01 }', '{ kind = "tabulated", file = "gap.csv" }'))
+    run_bad(tmp_path, capsys, text, "contact.gap.file (gap.csv) = 'heights spanning 1e+300': must span at most "
+            "1e+09: choose a length unit (e.g. mm or um) in which the geometry's sizes fall in [1e-09, 1e+09]",
+            files={"gap.csv": "x,g\n0,0\n0.5,1e300\n1,0\n"})
+
+
+def test_the_span_bound_of_tabulated_data_is_the_scene_s_length_range():
+    from ngcontact.geometry.tabulated import MAX_SPAN
+    from ngcontact.scene.mesh_size import LENGTH_RANGE
+    assert MAX_SPAN == LENGTH_RANGE[1] and f"[{LENGTH_RANGE[0]:g}, {LENGTH_RANGE[1]:g}]" in LENGTHS
