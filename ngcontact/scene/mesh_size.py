@@ -82,8 +82,14 @@ def check_cell_lengths(scene) -> None:
     spans = {"contact.gap.h": gap.h, "contact.gap.value": gap.value}
     for key in ("normal_jump", "tangential_jump"):
         spans.update({f"load.{key}[{i}]": v for i, v in enumerate(getattr(load, key, None) or ())})
+    check_magnitudes(spans)
+
+
+def check_magnitudes(lengths: dict) -> None:
+    """Every ``{key: length}`` (``None`` skipped) of any sign, zero included, at most the upper end of
+    :data:`LENGTH_RANGE` in magnitude: gaps, interferences and jumps."""
     hi = LENGTH_RANGE[1]
-    for key, value in spans.items():
+    for key, value in lengths.items():
         if value is not None and abs(value) > hi:
             raise SceneError(key, value, f"must be at most {hi:g} in magnitude: choose a length unit (e.g. mm or "
                              f"um) in which the geometry's sizes fall in [{LENGTH_RANGE[0]:g}, {hi:g}]")

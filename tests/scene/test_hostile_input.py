@@ -10,7 +10,7 @@ import pytest
 from ngcontact import cli
 
 from sinusoid_cell import sinusoid_cell
-from test_bad_input import edit, run_bad
+from test_bad_input import MACRO, edit, run_bad
 
 SPECTRAL = sinusoid_cell(discretization='method = "spectral"\ngrid = 64\ntolerance = 0.1')
 
@@ -80,3 +80,13 @@ def test_the_span_bound_of_tabulated_data_is_the_scene_s_length_range():
     from ngcontact.geometry.tabulated import MAX_SPAN
     from ngcontact.scene.mesh_size import LENGTH_RANGE
     assert MAX_SPAN == LENGTH_RANGE[1] and f"[{LENGTH_RANGE[0]:g}, {LENGTH_RANGE[1]:g}]" in LENGTHS
+
+
+@pytest.mark.parametrize("line, key, shown", [("gap = -1e300", "interface.gap", "-1e+300"),
+                                              ("gap_table = [[0.0, 1e300], [0.02, 0.0]]", "interface.gap_table[0]",
+                                               "1e+300")])
+def test_a_macro_gap_beyond_the_length_range(tmp_path, capsys, line, key, shown):
+    """Was: exit 3, 'the start value gives a non-finite energy or residual' (an interference of 1e300 m)."""
+    run_bad(tmp_path, capsys, edit(MACRO, ("kt = 1e11", f"kt = 1e11\n{line}")),
+            f"{key} = {float(shown)!r}: must be at most 1e+09 in magnitude: choose a length unit (e.g. mm or um) in "
+            "which the geometry's sizes fall in [1e-09, 1e+09]")
