@@ -90,3 +90,21 @@ def test_a_macro_gap_beyond_the_length_range(tmp_path, capsys, line, key, shown)
     run_bad(tmp_path, capsys, edit(MACRO, ("kt = 1e11", f"kt = 1e11\n{line}")),
             f"{key} = {float(shown)!r}: must be at most 1e+09 in magnitude: choose a length unit (e.g. mm or um) in "
             "which the geometry's sizes fall in [1e-09, 1e+09]")
+
+
+def test_a_strain_beyond_small_strain_is_no_met_accuracy(tmp_path, caplog):
+    """Was: accuracy.met = true beside a far-face strain of 7e299 (and of 10 in a cell 2 high): the warning
+    said the linear cell model does not hold, the verdict did not.  The strain is now a check of each load,
+    against the small-strain bound, and a miss makes the result not met (reported, not refused)."""
+    text = sinusoid_cell(k_n="1e-2", enforcement="penalty", pressure="1e-5, 0.2",
+                         discretization='method = "spectral"\ngrid = 64')
+    scene = tmp_path / "scene.toml"
+    scene.write_text(text)
+    with caplog.at_level(logging.WARNING):
+        assert cli.main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    acc = json.loads((tmp_path / "out" / "report.json").read_text())["results"]["accuracy"]
+    strain = {c["load"]: c for c in acc["checks"] if c["name"] == "far_face_strain"}
+    assert strain[0]["ok"] and not strain[1]["ok"] and strain[1]["limit"] == 0.05
+    assert not acc["met"]
+    assert len([r for r in caplog.records if "far_face_strain" in r.getMessage() or "small strain" in
+                r.getMessage()]) == 1      # the small-strain warning, said once
