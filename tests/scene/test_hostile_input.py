@@ -108,3 +108,23 @@ def test_a_strain_beyond_small_strain_is_no_met_accuracy(tmp_path, caplog):
     assert not acc["met"]
     assert len([r for r in caplog.records if "far_face_strain" in r.getMessage() or "small strain" in
                 r.getMessage()]) == 1      # the small-strain warning, said once
+
+
+SELF_AFFINE = edit(SPECTRAL, ('profile = "flat"', 'profile = "self_affine"\narrangement = "summit"\nspectrum = { '
+                              'hurst = 0.8, rms_slope = 0.1, rolloff = 0.25, cutoff = 0.0625, grid = 32, seed = 3 }'),
+                   ('gap = { kind = "sinusoid", h = 0.01 }\n', ""))
+
+
+@pytest.mark.parametrize("key", ["rms_slope", "rms_height"])
+def test_a_random_surface_drawn_beyond_the_length_range(tmp_path, capsys, key):
+    """Was: exit 3, 'constrained CG: the complementarity residual nan' (rms_slope or rms_height = 1e300).  The
+    surface is drawn when the scene runs (``check`` does not draw it)."""
+    run_bad(tmp_path, capsys, edit(SELF_AFFINE, ("rms_slope = 0.1", f"{key} = 1e300")),
+            f"inadmissible model input: {key} = 1e+300: draws heights spanning ", prefix=True, commands=("run",))
+
+
+def test_a_rolloff_longer_than_the_period_is_named(tmp_path, capsys):
+    """Was: 'cutoff = 0.0625: need ... rolloff (100) <= longest (1)': the key named was not the one at fault."""
+    run_bad(tmp_path, capsys, edit(SELF_AFFINE, ("rolloff = 0.25", "rolloff = 100.0")),
+            "inadmissible model input: rolloff = 100.0: need 2 grid steps (0.0625) <= cutoff < rolloff (100) <= "
+            "longest (1) <= period (1)", commands=("run",))
