@@ -3,15 +3,18 @@ line naming the key, the value and what is allowed, and nothing written (``run_b
 :mod:`tests.scene.test_bad_input`), never in a solver failure, an unexpected error or a non-finite number."""
 import json
 import logging
+import os
 
 import numpy as np
 import pytest
 
 from ngcontact import cli
+from ngcontact.scene.resolved_scene import MAX_SAMPLES
 
 from sinusoid_cell import sinusoid_cell
 from test_bad_input import MACRO, edit, run_bad
 
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SPECTRAL = sinusoid_cell(discretization='method = "spectral"\ngrid = 64\ntolerance = 0.1')
 
 LENGTHS = "must lie in [1e-09, 1e+09]: choose a length unit (e.g. mm or um) in which the geometry's sizes fall in " \
@@ -128,3 +131,14 @@ def test_a_rolloff_longer_than_the_period_is_named(tmp_path, capsys):
     run_bad(tmp_path, capsys, edit(SELF_AFFINE, ("rolloff = 0.25", "rolloff = 100.0")),
             "inadmissible model input: rolloff = 100.0: need 2 grid steps (0.0625) <= cutoff < rolloff (100) <= "
             "longest (1) <= period (1)", commands=("run",))
+
+
+def test_an_epsilon_study_sampling_grid_beyond_its_bound(tmp_path, capsys):
+    """Was: accepted by check and run; the grid of 1e8 x 1e8 points is allocated only after every level's
+    solves (a MemoryError at the end of the study)."""
+    direct = os.path.join(ROOT, "geometries", "direct")
+    text = edit(open(os.path.join(direct, "block_rect_valleys.toml")).read(),
+                ("grid = [100, 50]", "grid = [100000000, 100000000]"))
+    run_bad(tmp_path, capsys, text, f"study.grid = [100000000, 100000000]: must lie in [4, {MAX_SAMPLES}]",
+            files={"rect_valleys_cell.toml": open(os.path.join(direct, "rect_valleys_cell.toml")).read()},
+            commands=("check",))
