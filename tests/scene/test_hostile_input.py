@@ -142,3 +142,15 @@ def test_an_epsilon_study_sampling_grid_beyond_its_bound(tmp_path, capsys):
     run_bad(tmp_path, capsys, text, f"study.grid = [100000000, 100000000]: must lie in [4, {MAX_SAMPLES}]",
             files={"rect_valleys_cell.toml": open(os.path.join(direct, "rect_valleys_cell.toml")).read()},
             commands=("check",))
+
+
+@pytest.mark.parametrize("old, new, key, shown", [
+    ('boundary = "bottom"', 'boundary = "bottom"\ncomponents = ["y"]\ndisplacement = [-1e300]',
+     "supports[0].displacement[0]", "-1e+300"),
+    ('boundary = "bottom"', 'boundary = "bottom"\ncomponents = ["y"]\nslope = [1e300]', "supports[0].slope[0]",
+     "1e+300")])
+def test_a_prescribed_displacement_or_gradient_beyond_the_length_range(tmp_path, capsys, old, new, key, shown):
+    """Was: exit 3, 'the start value gives a non-finite energy or residual' (a macro or direct scene's support
+    displacement or slope of 1e300)."""
+    text = edit(MACRO, (old, new), ("[[loads]]", '[[supports]]\nboundary = "bottom"\ncomponents = ["x"]\n\n[[loads]]'))
+    run_bad(tmp_path, capsys, text, f"{key} = {float(shown)!r}: must be at most 1e+09 in magnitude", prefix=True)
