@@ -25,8 +25,9 @@ SMALL_STRAIN = 0.05
 
 
 def far_face_strain(results: dict[str, Any], height: float) -> float:
-    """``|U| / height`` of one load's results (module docstring)."""
-    return math.sqrt(sum(float(u) ** 2 for u in results["far_face_jump"])) / height
+    """``|U| / height`` of one load's results (module docstring); ``|U|`` by ``hypot``, which does not overflow
+    where the squares of the components would."""
+    return math.hypot(*(float(u) for u in results["far_face_jump"])) / height
 
 
 def check(results: dict[str, Any], height: float, label: str) -> float:

@@ -186,14 +186,14 @@ def recommendation(rows: list[dict], levels: list[Level], target: float | None, 
         return {}, {}
     candidates = [r for r in rows if "quantities" in r and not r["reference"] and r["quantities"]]
     meeting = sorted((r for r in candidates if level_error(r) <= target), key=lambda r: r["seconds"])
-    if not meeting:
+    if not meeting:         # a miss is never silent: one warning line besides the report's verdict
         best = min(candidates, key=level_error, default=None)
-        return {"target": target, "met": False,
-                "statement": f"no level of the study met the target {target:g}"
-                             + ("" if best is None else f"; the closest, {best['knob']}: {best['setting']}, has "
-                                f"error {level_error(best):.3g}") + "; the finest levels are the references and "
-                                "cannot be judged against themselves: make a reference level the scene and study it "
-                                "again"}, {}
+        statement = (f"no level of the study met the target {target:g}"
+                     + ("" if best is None else f"; the closest, {best['knob']}: {best['setting']}, has error "
+                        f"{level_error(best):.3g}") + "; the finest levels are the references and cannot be judged "
+                     "against themselves: make a reference level the scene and study it again")
+        log.warning("accuracy study: %s", statement)
+        return {"target": target, "met": False, "statement": statement}, {}
     best = meeting[0]
     level = next(lv for lv in levels if lv.key == best["key"])
     text = dumps(with_absolute_paths(level.data, base_dir),

@@ -34,7 +34,7 @@ from ngcontact.laws import homogenized as il
 from ngcontact.macro import macro_problem as M
 from ngcontact.macro.interface_form import check_interface, interface_law, refuse, setting_of
 from ngcontact.output.report import Outcome
-from ngcontact.scene import loader, schema
+from ngcontact.scene import loader, mesh_size, schema
 from ngcontact.scene.macro_scene import LoadSpec, OutputSpec, SupportSpec
 from ngcontact.scene.sections import MaterialSpec, SolverSpec
 
@@ -153,8 +153,10 @@ def run(mesh, law, *, rough: str, counter: str, materials: dict, interface: str 
     law = interface_law(law, mesh.dim)
     if not (isinstance(order, int) and 1 <= order <= schema.MAX_ORDER):
         raise refuse("order", order, f"an integer in [1, {schema.MAX_ORDER}]")
-    if not isinstance(gap, (int, float, ng.CoefficientFunction)):
-        raise refuse("gap", gap, "a number or a CoefficientFunction (the macro normal gap g0, < 0 an interference)")
+    if isinstance(gap, bool) or not (isinstance(gap, ng.CoefficientFunction) or isinstance(gap, (int, float))
+                                     and abs(gap) <= mesh_size.LENGTH_RANGE[1]):   # not NaN: no comparison holds
+        raise refuse("gap", gap, f"a finite number of magnitude at most {mesh_size.LENGTH_RANGE[1]:g} (the macro "
+                     "normal gap g0 in the mesh's length unit, < 0 an interference) or a CoefficientFunction")
     elastic, materials_echo = _materials(materials, rough, counter)
     labels = boundary_labels(mesh)
     support_specs = _specs(supports, SupportSpec, "supports", labels)

@@ -111,6 +111,10 @@ def read_mesh(path: str, key: str = "geometry.file") -> MeshModel:
     adjacent = _face_bodies(tets, tet_body)
     volumes = np.abs(np.linalg.det(np.stack([pts[tets[:, k]] - pts[tets[:, 0]] for k in (1, 2, 3)], axis=2))) / 6
     size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    flat = int(np.count_nonzero(~(volumes > 1e-12 * size ** 3)))   # NaN counts: a point the reader left unset
+    if flat or not np.isfinite(pts).all():
+        raise GeometryError(key, path, f"holds {flat} of its {len(tets)} tetrahedra of zero volume (or points that "
+                            "are not finite): the file is damaged or truncated; write it again")
     by_face: list[list] = [[] for _ in range(m.GetNFaceDescriptors())]
     owners: list[set] = [set() for _ in by_face]
     for el in m.Elements2D():

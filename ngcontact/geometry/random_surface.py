@@ -29,6 +29,7 @@ import math
 import numpy as np
 
 from ngcontact.errors import GeometryError
+from ngcontact.geometry.tabulated import MAX_SPAN
 
 
 def wave_vectors(dim: int, n: int, period: float):
@@ -85,9 +86,12 @@ def self_affine(*, dim: int = 3, grid: int = 256, period: float = 1.0, hurst: fl
     longest = period if longest is None else longest
     rolloff = longest if rolloff is None else rolloff
     cutoff = 4 * step if cutoff is None else cutoff
-    if not (2 * step <= cutoff < rolloff <= longest <= period):
-        raise GeometryError("cutoff", cutoff, f"need 2 grid steps ({2 * step:g}) <= cutoff < rolloff ({rolloff:g}) "
-                            f"<= longest ({longest:g}) <= period ({period:g})")
+    order = [("cutoff", cutoff, 2 * step <= cutoff < rolloff), ("rolloff", rolloff, rolloff <= longest),
+             ("longest", longest, longest <= period)]
+    for name, value, ok in order:   # the first inequality that fails names its key
+        if not ok:
+            raise GeometryError(name, value, f"need 2 grid steps ({2 * step:g}) <= cutoff < rolloff ({rolloff:g}) "
+                                f"<= longest ({longest:g}) <= period ({period:g})")
     q_l, q_r, q_s = (2 * math.pi / w for w in (longest, rolloff, cutoff))
     ks, q = wave_vectors(dim, grid, period)
     exponent = -2 * (1 + hurst) if dim == 3 else -(1 + 2 * hurst)
@@ -107,7 +111,14 @@ def self_affine(*, dim: int = 3, grid: int = 256, period: float = 1.0, hurst: fl
         zh = sfft.rfftn(z)
         grads = [sfft.irfftn(1j * k * zh, s=shape) for k in ks]
         scale = target / float(np.sqrt(np.mean(sum(g ** 2 for g in grads))))
-    return z * scale
+    with np.errstate(over="ignore", invalid="ignore"):
+        z = z * scale
+        span = float(np.ptp(z))
+    if not span <= MAX_SPAN:
+        raise GeometryError("rms_height" if rms_height is not None else "rms_slope", target,
+                            f"draws heights spanning {span:.3g}, more than {MAX_SPAN:g}: choose a length unit (e.g. mm "
+                            "or um) in which the geometry's sizes fall in [1e-09, 1e+09]")
+    return z
 
 
 def as_height_map(z: np.ndarray) -> np.ndarray:

@@ -25,6 +25,9 @@ from ngcontact.errors import GeometryError
 from ngcontact.geometry.profiles import Profile, tabulated
 
 PERIODIC_TOL = 1e-9
+#: Largest span of a map's heights or a gap table's values: the upper end of the lengths a scene takes
+#: (``LENGTH_RANGE`` of :mod:`ngcontact.scene.mesh_size`); beyond it the layers' energies overflow.
+MAX_SPAN = 1e9
 
 #: Largest data file read (a FIFO, a device or a huge file would hang or exhaust memory).
 MAX_DATA_BYTES = 64 * 2 ** 20
@@ -148,6 +151,7 @@ def check_height_map(H, *, path: str = "height_map") -> np.ndarray:
     if len(bad):
         i, j = bad[0]
         raise GeometryError(f"{path}[{i}, {j}]", float(H[i, j]), "heights must be finite")
+    check_span(H, path)
     tol = PERIODIC_TOL * max(1.0, float(np.ptp(H)))
     for axis, name in ((0, "row"), (1, "column")):
         first, last = np.take(H, 0, axis=axis), np.take(H, -1, axis=axis)
@@ -184,7 +188,17 @@ def read_gap_csv(file, *, path: str | None = None) -> tuple[np.ndarray, np.ndarr
     x = np.array([p[0] for p in pts], dtype=float)
     g = np.array([p[1] for p in pts], dtype=float)
     _check_nonnegative(g, where)
+    check_span(g, where)
     return x, g
+
+
+def check_span(values: np.ndarray, where: str) -> None:
+    """Refuse heights or gaps whose span (largest minus smallest) exceeds :data:`MAX_SPAN`."""
+    with np.errstate(over="ignore"):
+        span = float(np.max(values)) - float(np.min(values))
+    if not span <= MAX_SPAN:
+        raise GeometryError(where, f"heights spanning {span:.3g}", f"must span at most {MAX_SPAN:g}: choose a length "
+                            "unit (e.g. mm or um) in which the geometry's sizes fall in [1e-09, 1e+09]")
 
 
 def read_gap_map(file, *, path: str | None = None) -> np.ndarray:

@@ -22,12 +22,14 @@ The contract, for ``ngcontact run SCENE --out DIR`` and every study:
 * ``DIR`` must not contain the scene or any file the scene reads (the
   directory ``.``, a parent, a data folder): refused before any work.
 * Atomic as a whole: every file is first written into a staging directory
-  ``.ngcontact-partial-<pid>-<random>`` beside or inside ``DIR``, on the
-  same file system; the files are then moved into place by renames, with
-  SIGINT and SIGTERM held back, and the manifest last.  A failure or an
-  interruption before that leaves ``DIR`` as it was and removes the staging
-  directory; one left behind by a killed run (its process no longer exists)
-  is removed by the next run that stages there.
+  ``.ngcontact-partial-<pid>-<host>-<random>`` beside or inside ``DIR``, on
+  the same file system (``<host>``: :func:`host_tag`); the files are then
+  moved into place by renames, with SIGINT and SIGTERM held back, and the
+  manifest last.  A failure or an interruption before that leaves ``DIR`` as
+  it was and removes the staging directory; one left behind by a killed run
+  of this machine (its process no longer exists) is removed by the next run
+  that stages there.  Another machine's (a file system shared by a
+  cluster's nodes) is never removed: its process number means nothing here.
 
 Errors are :class:`~ngcontact.errors.OutputError` with one line naming
 ``--out`` and the reason.
@@ -37,12 +39,14 @@ from __future__ import annotations
 import csv
 import errno
 import glob
+import hashlib
 import json
 import logging
 import os
 import re
 import shutil
 import signal
+import socket
 import tempfile
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Iterable
@@ -204,13 +208,20 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def host_tag() -> str:
+    """Eight hex digits of this machine's name, in its staging directories' names (no ``-``)."""
+    return hashlib.sha256(socket.gethostname().encode()).hexdigest()[:8]
+
+
 def remove_stale_staging(directory: str) -> list[str]:
-    """Remove staging directories of runs whose process no longer exists; returns their paths."""
+    """Remove staging directories of this machine's runs whose process no longer exists (a name without a
+    machine's tag counts as this machine's); returns their paths."""
     removed = []
     for path in glob.glob(os.path.join(directory, STAGING_PREFIX + "*")):
-        rest = os.path.basename(path)[len(STAGING_PREFIX):]
-        pid = rest.split("-", 1)[0]
-        if pid.isdigit() and os.path.isdir(path) and not os.path.islink(path) and not _alive(int(pid)):
+        parts = os.path.basename(path)[len(STAGING_PREFIX):].split("-")
+        pid, elsewhere = parts[0], len(parts) > 2 and parts[1] != host_tag()
+        if pid.isdigit() and not elsewhere and os.path.isdir(path) and not os.path.islink(path) \
+                and not _alive(int(pid)):
             shutil.rmtree(path, ignore_errors=True)
             removed.append(path)
     return removed
@@ -256,7 +267,7 @@ def _staged(out_dir: str, names: list[str], inputs: Iterable[str], fill, version
     stage_in = real if os.path.isdir(real) else _existing_ancestor(real)
     remove_stale_staging(stage_in)
     try:
-        tmp = tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=stage_in)
+        tmp = tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-{host_tag()}-", dir=stage_in)
     except OSError as exc:
         raise OutputError(f"--out {out_dir}: cannot write in {stage_in} ({exc.strerror})") from None
     try:

@@ -265,13 +265,12 @@ class CellScene:
                                      "shear and fixes no tangential jump: give 0 or set contact.friction")
 
     def check_size(self) -> None:
-        """The element estimate of :mod:`ngcontact.scene.mesh_size` against ``max_elements``."""
+        """The lengths and the element estimate of :mod:`ngcontact.scene.mesh_size` (``max_elements``)."""
         g, d = self.geometry, self.discretization
+        mesh_size.check_cell_lengths(self)
         if d.method == "spectral":
             return          # no mesh: the grid is bounded by its own check
         P, dim = g.period, g.dim
-        mesh_size.check_lengths({"geometry.period": P, "geometry.h_rough": g.h_rough, "geometry.h_counter": g.h_counter,
-                                 "discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         width = min(P, g.h_rough, g.h_counter)
         n = mesh_size.estimate(dim, P ** (dim - 1) * (g.h_rough + g.h_counter), d.maxh, width=width,
                                interface=P ** (dim - 1), h_interface=d.interface_maxh)

@@ -270,8 +270,10 @@ class MacroScene:
     base_dir: str = base_dir_field()
 
     def check_size(self) -> None:
-        """The element estimate of :mod:`ngcontact.scene.mesh_size` against ``max_elements``."""
-        g, d = self.geometry, self.discretization
+        """The gap's magnitude and the element estimate of :mod:`ngcontact.scene.mesh_size` (``max_elements``)."""
+        g, d, i = self.geometry, self.discretization, self.interface
+        mesh_size.check_magnitudes({"interface.gap": i.gap} | {f"interface.gap_table[{k}]": row[1]
+                                                                for k, row in enumerate(i.gap_table or ())})
         if g.shape == "file":   # the extent is known once the file is read (drivers/macro_geometry.py)
             mesh_size.check_lengths({"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
             return

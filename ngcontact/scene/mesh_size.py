@@ -67,3 +67,29 @@ def refuse_beyond(n: float, max_elements: int, size_key: str, size: float, *, pa
         raise SceneError(size_key, size, f"the mesh would have about {n:.2g} elements, more than "
                          f"{path}.max_elements = {max_elements}; coarsen it{hint}, or raise "
                          f"{path}.max_elements if the machine can take it")
+
+
+def check_cell_lengths(scene) -> None:
+    """A cell scene's lengths within :data:`LENGTH_RANGE`, whichever method solves it: the period and the
+    layers' heights (and an FE cell's mesh sizes) in the range, the initial gap's amplitude or value and the
+    prescribed jumps at most its upper end in magnitude (zero is a gap or jump, not a scale).  Beyond it the
+    layers' compliance and the energies overflow double precision."""
+    g, d, gap, load = scene.geometry, scene.discretization, scene.contact.gap, scene.load
+    lengths = {"geometry.period": g.period, "geometry.h_rough": g.h_rough, "geometry.h_counter": g.h_counter}
+    if d.method != "spectral":
+        lengths.update({"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
+    check_lengths(lengths)
+    spans = {"contact.gap.h": gap.h, "contact.gap.value": gap.value}
+    for key in ("normal_jump", "tangential_jump"):
+        spans.update({f"load.{key}[{i}]": v for i, v in enumerate(getattr(load, key, None) or ())})
+    check_magnitudes(spans)
+
+
+def check_magnitudes(lengths: dict) -> None:
+    """Every ``{key: length}`` (``None`` skipped) of any sign, zero included, at most the upper end of
+    :data:`LENGTH_RANGE` in magnitude: gaps, interferences and jumps."""
+    hi = LENGTH_RANGE[1]
+    for key, value in lengths.items():
+        if value is not None and abs(value) > hi:
+            raise SceneError(key, value, f"must be at most {hi:g} in magnitude: choose a length unit (e.g. mm or "
+                             f"um) in which the geometry's sizes fall in [{LENGTH_RANGE[0]:g}, {hi:g}]")

@@ -137,6 +137,11 @@ class DirectMesh:
                               "have more elements (a guard against sizes that hang the mesher)", check=at_least(1))
 
 
+#: Largest number of field-error samples per direction of ``study.grid``: the points of every level are held in
+#: memory and evaluated on each of its solutions, after all of them are solved.
+MAX_SAMPLES = 2048
+
+
 @dataclass(frozen=True, kw_only=True)
 class StudySpec:
     """Epsilon study: resolved runs against the homogenized laws."""
@@ -151,7 +156,7 @@ class StudySpec:
         (), doc="points (x, y) or (r, z) away from the layer where displacements are compared", units="m",
         allowed="pairs of numbers inside a body, outside the band of the coarsest level")
     grid: tuple[int, int] = param((100, 50), doc="sampling grid of the field error: (nx, ny) per block, "
-                                  "or (nr, nz) over the femur's bounding box", check=at_least(4))
+                                  "or (nr, nz) over the femur's bounding box", check=closed_interval(4, MAX_SAMPLES))
     refinement: float = param(2.0, doc="each level is solved again with every mesh size divided by this factor "
                               "(maxh, eps / elements_per_period, interface_maxh); the change of each error "
                               "between the two estimates its discretization error", check=closed_interval(1.5, 8))

@@ -23,6 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ngcontact.errors import SceneError
+from ngcontact.scene.mesh_size import LENGTH_RANGE, check_magnitudes
 from ngcontact.scene.schema import distinct, param
 
 
@@ -53,7 +54,8 @@ class SupportSpec:
 
 
 def check_values(supports, comps: tuple[str, ...], setting: str) -> None:
-    """Components known; one value per component; ``G``'s shape; no mixed forms; symmetry alone.
+    """Components known; one value per component; ``G``'s shape; no mixed forms; symmetry alone; values and
+    gradients at most the upper end of the length range in magnitude (:mod:`ngcontact.scene.mesh_size`).
 
     Raises :class:`SceneError` naming ``supports[i].KEY``, the value and what
     is allowed.
@@ -83,6 +85,13 @@ def check_values(supports, comps: tuple[str, ...], setting: str) -> None:
             key = "displacement" if s.displacement else "slope"
             raise SceneError(f"supports[{i}].{key}", getattr(s, key), "give either displacement and slope "
                              "(values at the boundary's mid-point) or u0 and G (u = u0 + G x), not both")
+        check_magnitudes({f"supports[{i}].{key}[{k}]": v for key in ("displacement", "u0")
+                          for k, v in enumerate(getattr(s, key))})
+        for key, v in [(f"slope[{k}]", v) for k, v in enumerate(s.slope)] + [
+                (f"G[{r}][{c}]", v) for r, row in enumerate(s.G) for c, v in enumerate(row)]:
+            if abs(v) > LENGTH_RANGE[1]:
+                raise SceneError(f"supports[{i}].{key}", v, f"must be at most {LENGTH_RANGE[1]:g} in magnitude (a "
+                                 "displacement gradient, metres per metre)")
         if s.slope and dim == 3:
             raise SceneError(f"supports[{i}].slope", s.slope, "a face in 3D has two directions: give the "
                              "tilt as u0 and G (u = u0 + G x)")
