@@ -31,3 +31,32 @@ def test_bad_sizes_are_refused():
         extrapolate([0.01], [1.0])
     with pytest.raises(ValueError, match="distinct"):
         extrapolate([0.01, 0.01], [1.0, 1.1])
+
+
+def test_an_error_the_sizes_do_not_see_is_bounded_by_the_grid_convergence_index():
+    """``f(h) = f + E_0 + C h^q``: the differences see ``C h^q`` only, Richardson keeps ``E_0``; the estimate
+    (1.25 x the correction) bounds it while ``|E_0|`` is at most 1.25 x the finest size's ``C h^q``, where
+    the extrapolations' disagreement alone (zero here: three sizes fit exactly) does not."""
+    sizes, q, C = [0.01, 0.005, 0.0025], 0.8, 0.05
+    for share in (-1.2, -0.5, 0.5, 1.2):
+        e0 = share * C * 0.0025 ** q
+        out = extrapolate(sizes, [1.0 + e0 + C * h ** q for h in sizes])
+        assert out.rate == pytest.approx(q, rel=1e-6) and out.value == pytest.approx(1.0 + e0, abs=1e-12)
+        assert 1.0 <= out.estimate / abs(out.value - 1.0) <= 10.0
+
+
+#: the quarter cell's order-2 contact fractions on the bisinusoid at edge sizes 0.01, 0.005, 0.0025 and the
+#: converged spectral value, per p/p* (docs/benchmarks.md, section scaling_3d: ``scripts/bisinusoid_accuracy.py``)
+QUARTER_ROWS = {0.005: ([0.01473, 0.01466, 0.0145], 0.014213),
+                0.02: ([0.03764, 0.03724, 0.03701], 0.036435),
+                0.05: ([0.0707, 0.07008, 0.0697], 0.068702)}
+
+
+@pytest.mark.parametrize("ratio", sorted(QUARTER_ROWS))
+def test_effectivity_against_the_converged_bisinusoid_is_between_1_and_10(ratio):
+    """Issue 35: the estimate of the extrapolated contact fraction over its true error against the converged
+    spectral cell, on the quarter cell's measured rows at the three loads of issue 38, within [1, 10]."""
+    values, converged = QUARTER_ROWS[ratio]
+    out = extrapolate([0.01, 0.005, 0.0025], values)
+    assert abs(out.value / converged - 1.0) < 0.01
+    assert 1.0 <= out.estimate / abs(out.value - converged) <= 10.0

@@ -132,3 +132,20 @@ def test_a_curved_cell_meets_its_tolerance_and_reports_each_level(tmp_path, caps
     entry = report["results"]["loads"][0]
     assert entry["error_estimate"]["contact_fraction"] <= 0.5 and len(entry["discretizations"]) >= 3
     assert report["results"]["accuracy"]["tolerance_from"] == "scene"
+
+
+def test_the_contact_edge_ladder_reports_the_contact_fraction_extrapolated_in_the_edge_size():
+    """From three refined levels on, the contact edge's refiner reports the contact fraction as the
+    extrapolation of the last three in the edge size (:mod:`ngcontact.cell.fe.edge_size_extrapolation`), its
+    estimate the grid convergence index (1.25 x the correction), the last level's own value beside it; the
+    closure keeps the geometric tail."""
+    from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
+    ladder = ContactEdgeRefinement(_Level(1000, 0.6), lambda: [], lambda points, h: _Level(1000, 0.5 + 0.2 * h),
+                                   interface_maxh=0.1, period=1.0)
+    done = refine(ladder, [None], 0.005, 10 ** 9, required=True)
+    assert len(done.levels) == 4 and done.met          # three refined levels: edge sizes 0.05, 0.025, 0.0125
+    results = done.solutions[0].results
+    assert results["contact_fraction"] == pytest.approx(0.5, abs=1e-12)
+    assert results["contact_fraction_last_level"] == pytest.approx(0.5025, abs=1e-12)
+    assert done.estimates[0]["contact_fraction"] == pytest.approx(1.25 * 0.0025, rel=1e-9)
+    assert "load 0 contact_fraction: extrapolated, observed rate 1.00" in done.how

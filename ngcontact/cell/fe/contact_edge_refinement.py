@@ -14,7 +14,11 @@ at the contact edge only: level 0 is the scene's cell, level ``k >= 1`` the cell
 of the spectral twin's solutions at the sweep's loads (the same layers and gap on a periodic grid).  The
 sequence's element size at the edge is thus ``h, h/2, h/4, ...`` as for the halving, and its answers converge
 at the same first order, so the estimate takes the same rule
-(:data:`~ngcontact.cell.fe.second_discretization.HALVING_RATE`).
+(:data:`~ngcontact.cell.fe.second_discretization.HALVING_RATE`), but for the contact fraction: from three
+refined levels on it is reported as the Richardson extrapolation in the edge size of the last three
+(:mod:`ngcontact.cell.fe.edge_size_extrapolation`, levels ``k >= 1`` only: level 0 is not refined at the
+edge), with that module's estimate (the grid convergence index of the last level), the refiner answering
+:class:`~ngcontact.cell.fe.second_discretization.Extrapolating`.
 """
 from __future__ import annotations
 
@@ -24,8 +28,13 @@ from typing import Any, Callable
 import numpy as np
 
 from ngcontact.cell.fe.contact_edge_mesh import edge_points
+from ngcontact.cell.fe.edge_size_extrapolation import EdgeSizeExtrapolation, extrapolate
 from ngcontact.cell.fe.observed_rate import Convergence
 from ngcontact.cell.fe.second_discretization import HALVING_RATE
+
+
+#: the refined levels whose contact fractions are extrapolated (the last ones)
+EXTRAPOLATED_LEVELS = 3
 
 
 def twin_edge_points(pressures: list[np.ndarray], period: float) -> np.ndarray:
@@ -63,6 +72,19 @@ class ContactEdgeRefinement:
 
     def level(self, k: int) -> Any:
         return self.scene_cell if k == 0 else self.cell_at(self.points(), self.edge_maxh(k))
+
+    def extrapolated(self, heads: list[list[dict[str, float]]]) -> dict[str, list[EdgeSizeExtrapolation | None]]:
+        """Per load the contact fraction extrapolated from the last three refined levels (module docstring);
+        ``None`` per load before three refined levels."""
+        refined = list(range(1, len(heads)))[-EXTRAPOLATED_LEVELS:]
+        if len(refined) < EXTRAPOLATED_LEVELS:
+            return {}
+        sizes = [self.edge_maxh(k) for k in refined]
+        out: list[EdgeSizeExtrapolation | None] = []
+        for load in range(len(heads[-1])):
+            values = [heads[k][load]["contact_fraction"] for k in refined if "contact_fraction" in heads[k][load]]
+            out.append(extrapolate(sizes, values) if len(values) == len(sizes) else None)
+        return {"contact_fraction": out}
 
     def describe(self, k: int) -> str:
         if k == 0:

@@ -19,12 +19,38 @@ and a third size the observed rate ``q`` of the two successive differences
 (``f(h) - f(r1 h)`` against ``f(r1 h) - f(r2 h)``), with which the
 extrapolation is repeated.  Where the observed rate is far from 1 (outside
 :data:`RATE_RANGE`) the sizes are not in the asymptotic range: the
-extrapolation keeps the first order and says so.  The estimate of the
-extrapolated value's error: with two sizes the correction itself,
-``|f - f(h)|`` (nothing smaller is known from two points); with three the
-larger of the disagreement between the extrapolations of the finer and of
-the coarser pair, and between the first-order and the observed-rate
-extrapolations.
+extrapolation keeps the first order and says so.
+
+The estimate of the extrapolated value's error.  With two sizes: the
+correction itself, ``|f - f(h)|`` (nothing smaller is known from two
+points).  With three, the finest value's error is split as
+
+    f(h) - f_conv = E_0 + C h^q + o(h^q),
+
+``C h^q`` the part the edge size carries (what the differences see) and
+``E_0`` the part of the knobs the sequence keeps fixed (the element size
+away from the edge and in the bodies, the linear trace's consistency on
+``S_C``): constant along the sequence, it cancels in every difference and
+Richardson keeps it, ``f - f_conv = E_0 + o(h^q)``.  No combination of the
+three values can see ``E_0``; the disagreement of two extrapolations (the
+finer and the coarser pair, the first order and the observed rate) measures
+the ``o(h^q)`` remainder only, and alone it under-bounds the error wherever
+``E_0`` is the larger part.  The estimate is therefore Roache's grid
+convergence index of the finest value (P. J. Roache, J. Fluids Eng. 116
+(1994) 405-413),
+
+    GCI = F_s |f(h) - f(r h)| / (r^q - 1) = F_s |c|,    c = f(h) - f,
+
+the correction ``c`` Richardson made, times the safety factor ``F_s``
+(:data:`SAFETY`: 1.25 where three sizes show a rate in range, 3 where the
+first order is assumed), and at least the last difference and the
+extrapolations' disagreement.  It bounds the extrapolated value's error
+``|E_0 + o(h^q)|`` as long as the part the sequence keeps fixed is at most
+``F_s`` times the part it removed at the finest size: the premise of
+refining the edge alone (the contact fraction's error is made at the edge,
+:mod:`ngcontact.cell.fe.contact_edge_mesh`).  Its effectivity against the
+converged bisinusoid is measured by ``scripts/bisinusoid_accuracy.py``
+(docs/benchmarks.md, section ``scaling_3d``).
 """
 from __future__ import annotations
 
@@ -33,6 +59,8 @@ from dataclasses import dataclass
 
 #: observed rates outside this range are not taken (the sizes are not asymptotic)
 RATE_RANGE = (0.5, 2.0)
+#: the grid convergence index's safety factor: with a rate observed in range, with the first order assumed
+SAFETY = {"observed": 1.25, "assumed": 3.0}
 
 
 @dataclass(frozen=True)
@@ -49,7 +77,8 @@ def extrapolate(sizes: list[float], values: list[float]) -> EdgeSizeExtrapolatio
     """Richardson extrapolation of ``values`` at edge ``sizes`` to size 0 (module docstring).
 
     ``sizes`` are at least two distinct positive element sizes, any order; the finest two extrapolate, a
-    third gives the observed rate.
+    third gives the observed rate; the estimate is the module docstring's (two sizes: the correction; three:
+    the grid convergence index).
     """
     if len(sizes) != len(values) or len(sizes) < 2:
         raise ValueError(f"{len(sizes)} sizes and {len(values)} values: two or more of each are needed")
@@ -60,21 +89,22 @@ def extrapolate(sizes: list[float], values: list[float]) -> EdgeSizeExtrapolatio
         raise ValueError(f"sizes = {sizes}: must be distinct and > 0")
     r = h[1] / h[0]
     first = _richardson(f[0], f[1], r, 1.0)
-    rate, how = 1.0, "first order in the edge size (two sizes)"
-    if len(h) >= 3:
-        q = _observed_rate(h[:3], f[:3])
-        if q is not None and RATE_RANGE[0] <= q <= RATE_RANGE[1]:
-            rate, how = q, f"observed rate {q:.2f} of three edge sizes"
-        else:
-            how = (f"first order in the edge size: the observed rate {q if q is None else round(q, 2)} "
-                   f"of three sizes is outside {RATE_RANGE}")
-    value = _richardson(f[0], f[1], r, rate)
-    if len(h) >= 3:
-        coarser = _richardson(f[1], f[2], h[2] / h[1], rate)
-        estimate = max(abs(value - coarser), abs(value - first))
+    if len(h) == 2:
+        return EdgeSizeExtrapolation(value=first, estimate=abs(first - f[0]), rate=1.0,
+                                     how="first order in the edge size (two sizes), the correction its estimate")
+    q = _observed_rate(h[:3], f[:3])
+    if q is not None and RATE_RANGE[0] <= q <= RATE_RANGE[1]:
+        rate, safety = q, SAFETY["observed"]
+        how = f"observed rate {q:.2f} of three edge sizes"
     else:
-        estimate = abs(value - f[0])
-    return EdgeSizeExtrapolation(value=value, estimate=estimate, rate=rate, how=how)
+        rate, safety = 1.0, SAFETY["assumed"]
+        how = (f"first order in the edge size: the observed rate {q if q is None else round(q, 2)} "
+               f"of three sizes is outside {RATE_RANGE}")
+    value = _richardson(f[0], f[1], r, rate)
+    coarser = _richardson(f[1], f[2], h[2] / h[1], rate)
+    estimate = max(safety * abs(f[0] - value), abs(f[0] - f[1]), abs(value - coarser), abs(value - first))
+    return EdgeSizeExtrapolation(value=value, estimate=estimate, rate=rate,
+                                 how=f"{how}; estimate {safety:g} x the correction (grid convergence index)")
 
 
 def _richardson(fine: float, coarse: float, r: float, q: float) -> float:

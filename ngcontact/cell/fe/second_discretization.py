@@ -35,7 +35,7 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable, Protocol
+from typing import Any, Callable, Protocol, runtime_checkable
 
 from ngcontact.cell.cell_solution import COEFFICIENT, CellSolution, headline, scale
 from ngcontact.cell.cell_solver import Refinement
@@ -66,6 +66,18 @@ class Refiner(Protocol):
 
     def describe(self, k: int) -> str:
         """Level ``k`` in words ("interface_maxh 0.03")."""
+
+
+@runtime_checkable
+class Extrapolating(Protocol):
+    """A refiner whose levels form a sequence in one size to which a quantity extrapolates
+    (:class:`~ngcontact.cell.fe.contact_edge_refinement.ContactEdgeRefinement`: the contact fraction in the
+    element size at the contact edge): the value reported is the extrapolation, its estimate the
+    extrapolation's, in place of the last level's value and geometric tail."""
+
+    def extrapolated(self, heads: list[list[dict[str, float]]]) -> dict[str, list[Any]]:
+        """Per quantity name, per load the extrapolation (``value``, ``estimate``, ``how``) of the levels'
+        headline quantities ``heads[level][load]``, or ``None`` where the levels do not yet give one."""
 
 
 @dataclass
@@ -151,6 +163,8 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
             # the coefficients' scale: the whole surface's (paper eq. 34 with w = 1), where a load reports them
             whole = cell.whole_surface() if any(n.startswith(COEFFICIENT) for h in heads[-1] for n in h) else None
             estimates, remarks = sequence_estimates(heads, refiner.rule, MEASURES, whole)
+            if isinstance(refiner, Extrapolating):
+                remarks += _extrapolate(refiner.extrapolated(heads), sols, estimates)
             scales = [{n: scale(n, head, whole) for n in e} for e, head in zip(estimates, heads[-1])]
             entry["estimate"] = max((max(e.values()) for e in estimates if e), default=0.0)
             if len(heads) >= 3 and entry["estimate"] <= tolerance:
@@ -174,6 +188,23 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
         estimates = [{} for _ in sols]
     return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]), scales,
                     beyond, stop)
+
+
+def _extrapolate(found: dict[str, list[Any]], sols: list[CellSolution], estimates: list[dict[str, float]]
+                 ) -> list[str]:
+    """Report each extrapolated quantity (:class:`Extrapolating`) as its extrapolation: the value in the
+    load's results (the last level's own value beside it as ``<name>_last_level``), its estimate in place of
+    the geometric tail; the remarks saying so."""
+    remarks = []
+    for name, per_load in found.items():
+        for k, ext in enumerate(per_load):
+            if ext is None or name not in estimates[k]:
+                continue
+            sols[k].results.setdefault(f"{name}_last_level", sols[k].results[name])
+            sols[k].results[name] = ext.value
+            estimates[k][name] = ext.estimate
+            remarks.append(f"load {k} {name}: extrapolated, {ext.how}")
+    return remarks
 
 
 def _beyond_reach(levels: list[dict[str, Any]], tolerance: float, max_dofs: int) -> str | None:
