@@ -213,6 +213,33 @@ def test_a_refinement_judges_a_level_again_with_a_point_found_growing(tmp_path, 
         assert math.dist(found[name].location, middle) >= seen[1].radius * (1 - 1e-9), name
 
 
+def test_a_mesh_level_that_finds_a_growing_point_restarts_the_sequence_of_the_maxima_away(tmp_path, monkeypatch):
+    """Where a mesh level of the refinement joins a point to the singular points, the earlier levels' maxima
+    away were taken over a larger set: their sequence starts again, the other quantities' goes on."""
+    from ngcontact.drivers import macro_refinement as MR
+    from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
+    sc = loader.load(_block(tmp_path, tolerance=0.5, maxh=0.005))
+    problem, _ = problem_of(sc, build_geometry(sc))
+    sol = solve_scene(sc, problem)
+    singular = MR.Singular.of(sc, sol)
+    assert singular.exclusion is not None
+    joined = singular.exclusion.joined([(0.01, 0.0)], AS.GROWN)
+    names = ("von_mises_block_away", "resultant_y")
+    start = MR.Refined(solution=sol, samples={sol.problem.order: {n: DE.Sample(1.0, (0.01, 0.001)) for n in names}},
+                       history=[{"order": sol.problem.order, "h_level": 0}],
+                       estimates=[_ladder(n, 1.0, error=1.0) for n in names])
+    found = [_ladder(n, 1.001, error=1e-4) for n in names]
+
+    def level(scene, s, solve, safety, given, component, inset):
+        assert given.exclusion is singular.exclusion and component == "y"
+        return found, start.samples, replace(given, exclusion=joined)
+    monkeypatch.setattr(MR, "judged_level", level)
+    out = MR.refine_mesh(sc, start, lambda p, start: solve_scene(sc, p, start), None, 0.01, singular)
+    assert out.exclusion is joined and out.history[-1]["h_level"] == 1
+    how = {e.name: e.how for e in out.estimates}
+    assert "1 mesh level(s)" in how["von_mises_block_away"] and "2 mesh level(s)" in how["resultant_y"]
+
+
 @pytest.mark.slow
 def test_the_two_scale_femurs_corner_is_a_singular_point_and_no_maximum_away_exceeds_its_bodys():
     """The stiff cell law of the loop makes the cone-cylinder corner (r = 11 mm, z = 130 mm, where the press
