@@ -40,7 +40,9 @@ gap of a closed interface much stiffer than its bodies over the element size (th
 cone-cylinder corner, where the converged cell law is tabulated), that point joins the singular points
 and every quantity is judged once more with it (:func:`judged`: the orders and levels solved again,
 about as long as the first judgement; once, so a point found on the second pass leaves its maximum away
-mesh dependent).
+mesh dependent).  A safety factor that falls with the local levels is judged as the mirror of a growing
+maximum (:mod:`ngcontact.macro.away_sequence`), and a refinement towards ``discretization.tolerance``
+judges each of its levels by the same two passes (:func:`rejudged`).
 
 A counted quantity whose relative error exceeds the tolerance, or has none (not converging, a stress
 singularity), marks the verdict as not met and is said in one warning line.
@@ -49,7 +51,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, replace
-from typing import Any, Callable, Protocol
+from typing import Any, Callable, Protocol, TypeVar
 
 import numpy as np
 
@@ -64,6 +66,8 @@ from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.scene.schema import MAX_ORDER
 
 log = logging.getLogger(__name__)
+#: what a judgement makes besides its estimates (:func:`rejudged`)
+T = TypeVar("T")
 
 #: how the verdict's errors are estimated (the report's ``accuracy.how``)
 HOW = ("discretization error of each headline quantity from solves at the neighbouring polynomial orders on "
@@ -261,13 +265,25 @@ def judged(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], two_s
     points it was judged with: in 2D, where a maximum away grows with the local levels at a point outside
     the balls (:func:`ngcontact.macro.away_sequence.grown`), that point joins the singular points and the
     quantities are judged once more (module docstring)."""
-    exclusion = exclusion_for(scene, sol)
-    found = _judged(scene, sol, solve, two_scale, safety, exclusion)
-    grown = AS.grown(found, exclusion, sol.problem.mesh) if sol.problem.mesh.dim == 2 else []
+    def judge(exclusion: AM.Exclusion | None) -> tuple[list[DE.Estimate], None]:
+        return _judged(scene, sol, solve, two_scale, safety, exclusion), None
+    (found, _), exclusion = rejudged(judge, exclusion_for(scene, sol), sol.problem.mesh)
+    return AM.settle(found, exclusion), exclusion
+
+
+def rejudged(judge: Callable[[AM.Exclusion | None], tuple[list[DE.Estimate], T]], exclusion: AM.Exclusion | None,
+             mesh) -> tuple[tuple[list[DE.Estimate], T], AM.Exclusion | None]:
+    """``judge(exclusion)`` (the estimates and what else the judgement made) and the region it was made with:
+    in 2D, where a maximum away grows (a safety factor away falls) with the local levels at a point outside
+    the region (:func:`ngcontact.macro.away_sequence.grown`), that point joins the singular points and
+    ``judge`` is called once more with it (module docstring).  The verdict (:func:`judged`) and a refinement's
+    levels (:mod:`ngcontact.drivers.macro_refinement`) judge by this one rule."""
+    out = judge(exclusion)
+    grown = AS.grown(out[0], exclusion, mesh) if mesh.dim == 2 else []
     if grown and exclusion is not None:
         exclusion = exclusion.joined(grown, AS.GROWN)
-        found = _judged(scene, sol, solve, two_scale, safety, exclusion)
-    return AM.settle(found, exclusion), exclusion
+        out = judge(exclusion)
+    return out, exclusion
 
 
 def _judged(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], two_scale: bool,

@@ -51,7 +51,12 @@ What is refined for
     mesh-dependent maxima, are refined for; each level judges them by local refinements at the singular
     points as well (:mod:`ngcontact.macro.away_sequence`), so a level's estimate of them has seen the
     mesh there.  A maximum once judged mesh dependent is never refined for, so no time is spent on a
-    value without a limit.
+    value without a limit.  Each level is judged by the verdict's rule
+    (:func:`ngcontact.drivers.macro_accuracy.rejudged`, :func:`judged_level`): in 2D a point outside the
+    balls where a maximum away grows (the safety factor away falls) with the local levels joins the singular
+    points, the level is judged once more outside its ball too, and the levels after keep that region; the
+    sequence of mesh levels of a maximum away starts again where its region changed, since its earlier
+    values were taken over a larger set.
 
 Each order level is the run of the scene at that order: the mesh is curved at the raised order
 (``mesh.Curve``, as :func:`ngcontact.drivers.macro_geometry.build_geometry` curves a mesh of that
@@ -149,6 +154,23 @@ class Singular:
         return AM.settle(AM.inside_tubes(SM.at_closed_ends(found, self.ends), tubes), self.exclusion)
 
 
+def judged_level(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
+                 safety_factor: Callable[[MacroSolution], float] | None, singular: Singular,
+                 component: str | None = None, dense_inset: float = 1e-3
+                 ) -> tuple[list[DE.Estimate], dict[int, dict[str, DE.Sample]], Singular]:
+    """The estimates of one level ``sol`` by the order ladder and the local refinements at the singular points
+    (:func:`ngcontact.drivers.macro_accuracy.away_judged`), judged by the verdict's rule
+    (:func:`ngcontact.drivers.macro_accuracy.rejudged`): in 2D a point where a maximum away grows with the
+    local levels joins the singular points and the level is judged once more with it; the ladder's samples
+    and ``singular`` with that region (kept by the levels after).  Before :meth:`Singular.judged`."""
+    def judge(exclusion: AM.Exclusion | None) -> tuple[list[DE.Estimate], dict[int, dict[str, DE.Sample]]]:
+        samples = MA.order_samples(scene, sol, solve, safety_factor, component, dense_inset, exclusion)
+        return MA.away_judged(MA.estimates(samples, sol), sol, solve, exclusion, samples[sol.problem.order],
+                              safety_factor), samples
+    (found, samples), exclusion = MA.rejudged(judge, singular.exclusion, sol.problem.mesh)
+    return found, samples, replace(singular, exclusion=exclusion)
+
+
 def level(sol: MacroSolution, found: list[DE.Estimate], tolerance: float, h_level: int = 0) -> dict[str, Any]:
     """One level of the refinement as the report lists it: order, mesh level (0: the scene's mesh), elements,
     unknowns, each quantity's value and relative error."""
@@ -235,9 +257,8 @@ def refine(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
     history: list[dict[str, Any]] = []
     singular = Singular.of(scene, sol)
     while True:
-        samples = MA.order_samples(scene, sol, solve, safety_factor, exclusion=singular.exclusion)
-        found = singular.judged(MA.away_judged(MA.estimates(samples, sol), sol, solve, singular.exclusion,
-                                               samples[sol.problem.order], safety_factor))
+        ladder, samples, singular = judged_level(scene, sol, solve, safety_factor, singular)
+        found = singular.judged(ladder)
         history.append(level(sol, found, tolerance))
         missed = unmet(found, tolerance)
         _progress(sol, found, missed, tolerance, 0)
@@ -300,10 +321,10 @@ def refine_mesh(scene, start: Refined, solve: Callable[..., MacroSolution],
                                                 f"beyond the refinement's bound of {MAX_DOFS}"),
                                    {"refinement": history})
         sol = solve(problem, None)
-        samples = MA.order_samples(scene, sol, solve, safety_factor, component, dense_inset=FACE_INSET,
-                                   exclusion=singular.exclusion)
-        ladder = MA.away_judged(MA.estimates(samples, sol), sol, solve, singular.exclusion,
-                                samples[sol.problem.order], safety_factor)
+        ladder, samples, judged = judged_level(scene, sol, solve, safety_factor, singular, component, FACE_INSET)
+        if judged.exclusion is not singular.exclusion:
+            values.update({name: [] for name in values if name.endswith(AM.AWAY)})
+        singular = judged
         for e in ladder:
             values[e.name].append(e.value)
         found = singular.judged([MS.combined(e, values[e.name]) for e in ladder])

@@ -84,6 +84,17 @@ A stress maximum that grows where the levels refine
     (:func:`ngcontact.drivers.macro_accuracy.judged`); in 3D the growth runs along an edge whose extent
     the levels do not find, and the maximum away stays mesh dependent.
 
+A safety factor that falls where the levels refine
+    The safety factor of eq. 78 is a minimum over the interface, ``sigma_u / sigma_eq`` of the micro stresses
+    (eq. 75); its reciprocal, the utilisation ``sigma_eq / sigma_u``, is a maximum of a stress.  Where that
+    stress grows like ``log r``, ``A + B k`` on level ``k``, the utilisation grows so and the safety factor
+    falls like ``1 / log r``, by differences whose ratio ``A / (A + 2B)`` shows no fixed rate.  So the mirror
+    of the test above is taken on the utilisation (:func:`growing`): levels whose utilisation grows at each
+    level, the last difference at least :data:`GROWING` of the first, and whose safety factor falls by more
+    than the ladder's estimate, have no converged value: mesh dependent, singular at the finest level's
+    location, with the value of the scene's mesh.  The safety factor away is judged as a maximum away is
+    (exempt next to the region's boundary; in 2D its point joins the singular points).
+
 The maxima over whole bodies
     Where no other check judges them (a two-scale run, :mod:`ngcontact.drivers.macro_accuracy`), the
     levels also take the maxima over whole bodies and the safety factor over the whole interface
@@ -229,28 +240,35 @@ def grown(found: list[DE.Estimate], exclusion: AM.Exclusion | None, mesh: ng.Mes
 
 def growing(e: DE.Estimate, values: list[float]) -> bool:
     """A stress maximum whose levels ``values`` (the scene's mesh first) grow at each level, the last
-    difference at least :data:`GROWING` of the first, by more than ``e``'s ladder estimate over the levels
-    (module docstring)."""
-    if not e.name.startswith(SM.STRESS) or len(values) < 3:
+    difference at least :data:`GROWING` of the first, by more than ``e``'s ladder estimate over the levels; a
+    safety factor (a minimum) whose reciprocal, the utilisation, so grows and which falls by more than that
+    estimate (module docstring)."""
+    if len(values) < 3:
         return False
-    q0, q1, q2 = (abs(v) for v in values[-3:])
-    return q0 < q1 < q2 and q2 - q1 >= GROWING * (q1 - q0) and q2 - q0 > (e.error or 0.0)
+    last = [abs(v) for v in values[-3:]]
+    if e.name.startswith(SM.STRESS):
+        q0, q1, q2 = last
+        move = q2 - q0
+    elif e.name.startswith(SM.SAFETY_FACTOR) and all(0.0 < v < math.inf for v in last):
+        q0, q1, q2 = (1.0 / v for v in last)
+        move = last[0] - last[2]
+    else:
+        return False
+    return q0 < q1 < q2 and q2 - q1 >= GROWING * (q1 - q0) and move > (e.error or 0.0)
 
 
 def _judged(e: DE.Estimate, samples: list[DE.Sample], near: Beside | None = None) -> DE.Estimate:
     """The error of the finest of ``samples`` (the scene's mesh, then the levels; module docstring), or the
-    scene mesh's value, mesh dependent, where it grows with the levels."""
+    scene mesh's value, mesh dependent, where it grows (a safety factor: falls) with the levels."""
     values = [s.value for s in samples]
     shown = ", ".join(f"{v:.6g}" for v in values)
     at = samples[-1].location
     if growing(e, values) and at is not None and not (e.name.endswith(AM.AWAY) and near is not None and near(at)):
         return replace(e, error=None, singular_at=at,
-                       how=f"{e.how}; {len(values) - 1} local refinements at the singular points and at the maxima: "
-                           f"{shown}: it grows with every halving of the elements holding it, by a difference that "
-                           f"does not fall as a bounded stress's error does (the last at least {GROWING:g} of the "
-                           "first) and by more than the ladder's estimate, as log r or r^(lambda - 1) grows on "
-                           "the meshes the levels reach, so this maximum has no converged value there: mesh "
-                           f"dependent, singular at {DE._point(at)} (the value of the scene's mesh)")
+                       how=f"{e.how}; {len(values) - 1} local refinements at the singular points and at the "
+                           f"{'minima' if e.name.startswith(SM.SAFETY_FACTOR) else 'maxima'}: {shown}: "
+                           f"{_unbounded(e.name)}: mesh dependent, singular at {DE._point(at)} (the value of "
+                           "the scene's mesh)")
     head = f"{e.how}; {len(values) - 1} local refinements at the singular points: {shown}, the last reported"
     polynomial = None
     if e.error is not None:
@@ -303,3 +321,16 @@ def level_error(values: list[float], scale: float, polynomial: float | None, lad
         return None, f"{said}: the difference does not shrink with the levels (not converging), no ladder estimate"
     return max(base, s * abs(d2), e_m), (f"{said}: the difference does not shrink with the levels (not "
                                          f"converging): the larger of e_P, {s:g} x |d_2| and the move's")
+
+
+def _unbounded(name: str) -> str:
+    """Why a quantity :func:`growing` says grows (a safety factor: falls) has no converged value."""
+    if name.startswith(SM.SAFETY_FACTOR):
+        return (f"it falls with every halving of the elements holding it, by more than the ladder's estimate, and "
+                f"its reciprocal (the utilisation sigma_eq / sigma_u) grows by a difference that does not fall as "
+                f"a bounded stress's error does (the last at least {GROWING:g} of the first), as 1 / log r or "
+                "r^(1 - lambda) falls on the meshes the levels reach, so this minimum has no converged value there")
+    return (f"it grows with every halving of the elements holding it, by a difference that does not fall as a "
+            f"bounded stress's error does (the last at least {GROWING:g} of the first) and by more than the "
+            "ladder's estimate, as log r or r^(lambda - 1) grows on the meshes the levels reach, so this maximum "
+            "has no converged value there")

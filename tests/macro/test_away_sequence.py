@@ -99,6 +99,43 @@ def test_a_maximum_that_grows_with_every_level_is_mesh_dependent_at_the_scene_me
     assert not AS.growing(_ladder("safety_factor", 0.24), [0.24, 0.3, 0.36])
 
 
+def test_a_safety_factor_that_falls_with_every_level_is_mesh_dependent_as_a_growing_maximum_is():
+    """The mirror of a maximum growing like log r: the utilisation 1 / safety factor grows by the same step on
+    each level (A + B k), so the safety factor falls like 1 / log r; reported mesh dependent at the scene
+    mesh's value, not counted beside a converged counterpart away, and said so on the terminal and in html."""
+    from ngcontact.output.report import accuracy_line
+    from ngcontact.output.report_html import accuracy_table
+    falling = [1.0 / (2.0 + k) for k in range(3)]
+    names = ("safety_factor", "safety_factor_away")
+    found = [_ladder(n, falling[0], error=0.01) for n in names]
+    own = {n: DE.Sample(falling[0], (0.011, 0.13)) for n in names}
+    finer = [{n: DE.Sample(v, (0.011, 0.13)) for n in names} for v in falling[1:]]
+    out = {e.name: e for e in AS.judged(found, own, finer, lambda at: False)}
+    for name in names:
+        e = out[name]
+        assert e.error is None and e.singular_at == (0.011, 0.13) and e.value == falling[0], e.how
+        assert "falls with every halving" in e.how and "minima" in e.how
+    # its own differences fall by A / (A + 2B) = 1/2: the test on the factor itself would call it converging
+    d1, d2 = falling[1] - falling[0], falling[2] - falling[1]
+    assert d2 / d1 == pytest.approx(0.5)
+    # a fall within the ladder's estimate, a rise, or a fall that shrinks as a bounded quantity's is none
+    assert not AS.growing(_ladder("safety_factor", falling[0], error=0.3), falling)
+    assert not AS.growing(_ladder("safety_factor", 0.24), [0.24, 0.3, 0.36])
+    # the two-scale femur's whole-interface levels at its corner: the utilisation's difference shrinks by 0.14
+    assert not AS.growing(_ladder("safety_factor", 0.2393, error=0.0636), [0.239287, 0.197703, 0.193097])
+    # beside a converged safety factor away it is listed, not counted, and said to be mesh dependent
+    exclusion = AM.Exclusion(np.array([[0.011, 0.13]]), 0.00275, (AS.GROWN,))
+    settled = AM.settle([out["safety_factor"], _ladder("safety_factor_away", 0.41, error=0.002)], exclusion)
+    acc = MA.verdict(settled, None, None)
+    q = {x["name"]: x for x in acc["quantities"]}
+    assert not q["safety_factor"]["met"] and not q["safety_factor"]["counted"] and q["safety_factor"]["error"] is None
+    assert acc["met"] and q["safety_factor_away"]["counted"]
+    line = accuracy_line({"accuracy": acc})
+    assert "safety_factor 0.5 (mesh dependent: singular at (0.011, 0.13)) not counted" in line, line
+    html = accuracy_table({"results": {"accuracy": acc}})
+    assert "mesh dependent, singular at" in html
+
+
 def test_a_maximum_away_singular_outside_the_balls_makes_its_bodys_singular_too():
     exclusion = AM.Exclusion(np.array([[0.0, 0.0]]), 0.1, ("a clamped boundary meets an unsupported one",))
     found = [_ladder("von_mises_stem", 12.9, 0.1), _singular(_ladder("von_mises_stem_away", 12.9)),
@@ -143,6 +180,64 @@ def test_the_quantities_are_judged_again_with_a_point_found_growing(monkeypatch)
     assert len(seen) == 2 and seen[1] is exclusion and exclusion.why[-1] == AS.GROWN
     assert np.allclose(exclusion.points[-1], (0.011, 0.13))
     assert {e.name: e.value for e in found} == {"von_mises_stem_away": 10.9, "von_mises_stem": 12.9}
+
+
+def test_a_refinement_judges_a_level_again_with_a_point_found_growing(tmp_path, monkeypatch):
+    """A tolerance-driven refinement judges its levels by the verdict's rule
+    (ngcontact.drivers.macro_accuracy.rejudged): where a maximum away grows with the local levels at a point
+    outside the balls (here the middle of the block's interface, said to be one), the point joins the
+    singular points, the level is judged once more outside its ball too, and the run keeps that region."""
+    from ngcontact.drivers import macro_refinement as MR
+    from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
+    sc = loader.load(_block(tmp_path, tolerance=0.5, maxh=0.005))
+    problem, _ = problem_of(sc, build_geometry(sc))
+    sol = solve_scene(sc, problem)
+    grown, judged, seen, middle = AS.grown, MA.away_judged, [], (0.01, 0.0)
+
+    def away_judged(found, sol, solve, exclusion, *args, **kwargs):
+        seen.append(exclusion)
+        return judged(found, sol, solve, exclusion, *args, **kwargs)
+
+    def growing_in_the_middle(found, exclusion, mesh):
+        e = next(e for e in found if e.name == "von_mises_block_away")
+        return grown([replace(e, singular_at=middle)], exclusion, mesh)
+    monkeypatch.setattr(AS, "grown", growing_in_the_middle)
+    monkeypatch.setattr(MA, "away_judged", away_judged)
+    refined = MR.refine(sc, sol, lambda p, start: solve_scene(sc, p, start))
+    assert refined is not None and len(refined.history) == 1
+    assert len(seen) == 2 and seen[1].why[-1] == AS.GROWN and refined.exclusion is seen[1]
+    assert len(seen[1].points) == len(seen[0].points) + 1 and np.allclose(seen[1].points[-1], middle)
+    found = {e.name: e for e in refined.estimates}
+    for name in ("von_mises_block_away", "tresca_block_away", "von_mises_base_away", "tresca_base_away"):
+        assert found[name].location is not None and found[name].error is not None, found[name].how
+        assert math.dist(found[name].location, middle) >= seen[1].radius * (1 - 1e-9), name
+
+
+def test_a_mesh_level_that_finds_a_growing_point_restarts_the_sequence_of_the_maxima_away(tmp_path, monkeypatch):
+    """Where a mesh level of the refinement joins a point to the singular points, the earlier levels' maxima
+    away were taken over a larger set: their sequence starts again, the other quantities' goes on."""
+    from ngcontact.drivers import macro_refinement as MR
+    from ngcontact.drivers.run_macro import build_geometry, problem_of, solve_scene
+    sc = loader.load(_block(tmp_path, tolerance=0.5, maxh=0.005))
+    problem, _ = problem_of(sc, build_geometry(sc))
+    sol = solve_scene(sc, problem)
+    singular = MR.Singular.of(sc, sol)
+    assert singular.exclusion is not None
+    joined = singular.exclusion.joined([(0.01, 0.0)], AS.GROWN)
+    names = ("von_mises_block_away", "resultant_y")
+    start = MR.Refined(solution=sol, samples={sol.problem.order: {n: DE.Sample(1.0, (0.01, 0.001)) for n in names}},
+                       history=[{"order": sol.problem.order, "h_level": 0}],
+                       estimates=[_ladder(n, 1.0, error=1.0) for n in names])
+    found = [_ladder(n, 1.001, error=1e-4) for n in names]
+
+    def level(scene, s, solve, safety, given, component, inset):
+        assert given.exclusion is singular.exclusion and component == "y"
+        return found, start.samples, replace(given, exclusion=joined)
+    monkeypatch.setattr(MR, "judged_level", level)
+    out = MR.refine_mesh(sc, start, lambda p, start: solve_scene(sc, p, start), None, 0.01, singular)
+    assert out.exclusion is joined and out.history[-1]["h_level"] == 1
+    how = {e.name: e.how for e in out.estimates}
+    assert "1 mesh level(s)" in how["von_mises_block_away"] and "2 mesh level(s)" in how["resultant_y"]
 
 
 @pytest.mark.slow
