@@ -34,6 +34,10 @@ MAX_DATA_BYTES = 64 * 2 ** 20
 #: Largest number of rows of a tabulated profile, whose every row becomes a segment of the mesh's
 #: geometry (a gap table is interpolated, not meshed, and may be longer).
 MAX_PROFILE_ROWS = 4096
+#: Smallest step in ``x`` between a meshed profile's points, relative to the period: a closer pair is a
+#: feature a million times smaller than the cell, which Netgen's mesher cannot resolve (it fails, or
+#: where the feature lies against the cell's side, does not end).
+MIN_PROFILE_STEP = 1e-6
 
 
 def file_kind(mode: int) -> str | None:
@@ -68,7 +72,8 @@ def check_data_file(file, where: str, what: str = "file") -> None:
 
 
 def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MAX_PROFILE_ROWS,
-                     value: str = "y", what: str = "profile") -> Profile:
+                     min_step: float | None = MIN_PROFILE_STEP, value: str = "y",
+                     what: str = "profile") -> Profile:
     """Read and validate a periodic profile from a CSV file with columns ``x, y``.
 
     Parameters
@@ -79,6 +84,9 @@ def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MA
         Name used in error messages (default: the file name).
     max_rows
         Largest number of data rows (``None``: no limit but the file size).
+    min_step
+        Smallest step in ``x`` between consecutive rows, relative to the period (``None``: any increase;
+        a gap table is interpolated, not meshed).
     value, what
         Name of the second column and of the tabulated function in messages.
 
@@ -114,7 +122,16 @@ def read_profile_csv(file, *, path: str | None = None, max_rows: int | None = MA
             ys.append(float(row[1]))
         except ValueError:
             raise GeometryError(f"{where}[line {line}]", "not two numbers", f"x and {value} must be numbers") from None
-    return tabulated(xs, ys, path=where, lines=[line for line, _ in numbered], value=value, what=what)
+    lines = [line for line, _ in numbered]
+    profile = tabulated(xs, ys, path=where, lines=lines, value=value, what=what)
+    if min_step is not None:
+        step = min_step * xs[-1]
+        for i in range(1, len(xs)):
+            if xs[i] - xs[i - 1] < step:
+                raise GeometryError(f"{where}[line {lines[i]}].x", xs[i],
+                                    f"x must increase by at least {min_step:g} of the period ({step:.3g}; previous "
+                                    f"x = {xs[i - 1]!r}): closer points make a feature the mesher cannot resolve")
+    return profile
 
 
 def read_height_map(file, *, path: str | None = None) -> np.ndarray:
@@ -183,7 +200,7 @@ def read_gap_csv(file, *, path: str | None = None) -> tuple[np.ndarray, np.ndarr
         NumPy arrays of the samples.
     """
     where = path or str(file)
-    prof = read_profile_csv(file, path=where, max_rows=None, value="g", what="gap")
+    prof = read_profile_csv(file, path=where, max_rows=None, min_step=None, value="g", what="gap")
     pts = [p.start for p in prof.pieces] + [prof.pieces[-1].end]
     x = np.array([p[0] for p in pts], dtype=float)
     g = np.array([p[1] for p in pts], dtype=float)

@@ -81,8 +81,9 @@ class CellGeometry:
     amplitude: float | None = param(None, doc="profile amplitude (sinusoid, bisinusoid)", units="m",
                                     check=positive())
     file: str | None = param(None, doc="tabulated profile: CSV with columns x, y in the scene's length unit, "
-                             "an optional header line, x strictly increasing from 0 to the period, the last row "
-                             "(x = period) repeating the first y, at most 4096 rows (2D); height map: .npy array "
+                             "an optional header line, x increasing from 0 to the period by steps of at least 1e-6 of "
+                             "it, the last row (x = period) repeating the first y, at most 4096 rows (2D); height map: "
+                             ".npy array "
                              "whose last row/column repeat the first (3D, small-slope model), or a measured "
                              "topography in an instrument's format (X3P, DATX, OPD, SUR, PLU, IBW, DI, plain-text "
                              "matrix, ...; read by SurfaceTopography, pip install 'ngcontact[topography]'; its "

@@ -154,3 +154,14 @@ def test_a_prescribed_displacement_or_gradient_beyond_the_length_range(tmp_path,
     displacement or slope of 1e300)."""
     text = edit(MACRO, (old, new), ("[[loads]]", '[[supports]]\nboundary = "bottom"\ncomponents = ["x"]\n\n[[loads]]'))
     run_bad(tmp_path, capsys, text, f"{key} = {float(shown)!r}: must be at most 1e+09 in magnitude", prefix=True)
+
+
+
+@pytest.mark.parametrize("rows, line, x", [("0,0\n1e-9,-0.1\n0.7,-0.2\n1,0\n", 3, "1e-09"),
+                                           ("0,0\n0.3,-0.1\n0.3000000001,-0.2\n1,0\n", 4, "0.3000000001")])
+def test_a_profile_wall_closer_than_the_mesher_resolves(tmp_path, capsys, rows, line, x):
+    """Was: a point 1e-9 from the cell's side hung Netgen's mesher for over ten minutes, deaf to Ctrl-C."""
+    with open(os.path.join(ROOT, "geometries", "cells", "tabulated_profile.toml")) as f:
+        text = f.read().replace('file = "data/profile_example.csv"', 'file = "p.csv"')
+    run_bad(tmp_path, capsys, text, f"geometry.file (p.csv)[line {line}].x = {x}: x must increase by at least 1e-06 of the "
+            "period (1e-06; previous x = ", prefix=True, files={"p.csv": "x,y\n" + rows})
