@@ -66,6 +66,17 @@ def measure(name: str) -> str:
     return GROUP if name.startswith(COEFFICIENT) else RELATIVE
 
 
+def worst_estimate(estimates: list[dict[str, float]], skip: tuple[str, ...] = ()) -> str:
+    """The largest of the per-load ``estimates`` (each in its quantity's :func:`measure`) with the quantity
+    and load that hold it, e.g. ``"0.0166 (mean_closure, relative, at load 0)"``: what keeps a refinement
+    from its tolerance.  ``skip``: quantities not held to the tolerance."""
+    found = [(e, name, k) for k, per_load in enumerate(estimates) for name, e in per_load.items() if name not in skip]
+    if not found:
+        return "no estimate"
+    e, name, k = max(found)
+    return f"{e:.3g} ({name}, {measure(name)}, at load {k})"
+
+
 def scale(name: str, head: dict[str, float], whole: dict[str, Any] | None = None) -> float:
     """The size a headline quantity's absolute error is divided by in its :func:`measure`: 1 where that is
     absolute; the value where relative; for a coefficient the largest magnitude of its group among the

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import pytest
 
 from ngcontact import cli
-from ngcontact.cell.cell_solution import CellSolution
+from ngcontact.cell.cell_solution import CellSolution, worst_estimate
 from ngcontact.cell.fe.observed_rate import Convergence
 from ngcontact.cell.fe.second_discretization import HALVING_RATE, refine
 from ngcontact.drivers.build import cell_loads, cell_solver, spectral_variant
@@ -84,7 +84,8 @@ def test_the_loop_stops_at_three_levels_once_the_estimate_meets_the_tolerance():
 
 
 def test_a_tolerance_beyond_the_size_bound_fails_with_the_figures_or_is_flagged():
-    with pytest.raises(ConvergenceError, match=r"tolerance = 0.001 not met: the estimate is 0.0375 on level 2 "
+    with pytest.raises(ConvergenceError, match=r"tolerance = 0.001 not met: the estimate is 0.0375 "
+                                               r"\(contact_fraction, absolute, at load 0\) on level 2 "
                                                r"\(16000 dofs\), and level 3 would have 64000 dofs, beyond 20000"):
         refine(_Halving(), [None], 1e-3, 20_000, required=True)
     done = refine(_Halving(), [None], 1e-3, 20_000, required=False)
@@ -149,3 +150,10 @@ def test_the_contact_edge_ladder_reports_the_contact_fraction_extrapolated_in_th
     assert results["contact_fraction_last_level"] == pytest.approx(0.5025, abs=1e-12)
     assert done.estimates[0]["contact_fraction"] == pytest.approx(1.25 * 0.0025, rel=1e-9)
     assert "load 0 contact_fraction: extrapolated, observed rate 1.00" in done.how
+
+
+def test_the_worst_estimate_names_its_quantity_measure_and_load():
+    per_load = [{"contact_fraction": 0.002, "normal_stiffness": 0.5}, {"mean_closure": 0.0166}]
+    assert worst_estimate(per_load) == "0.5 (normal_stiffness, relative, at load 0)"
+    assert worst_estimate(per_load, skip=("normal_stiffness",)) == "0.0166 (mean_closure, relative, at load 1)"
+    assert worst_estimate([{}], skip=()) == "no estimate"

@@ -37,7 +37,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Protocol, runtime_checkable
 
-from ngcontact.cell.cell_solution import COEFFICIENT, CellSolution, headline, scale
+from ngcontact.cell.cell_solution import COEFFICIENT, CellSolution, headline, scale, worst_estimate
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.cell.fe.observed_rate import Convergence, dofs_to_meet, exponent, sequence_estimates
 from ngcontact.errors import ConvergenceError, ModelError, SceneError
@@ -178,7 +178,7 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
     if len(heads) == 2 and worst is not None and worst <= tolerance:   # the third level beyond the bound
         return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks + [f"stopped: {stop}"]),
                         scales)
-    reached = "no estimate (one level)" if worst is None else f"{worst:.3g}"
+    reached = "no estimate (one level)" if worst is None else worst_estimate(estimates)
     message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on "
                f"{levels[-1]['discretization']} ({levels[-1]['ndof']} dofs), and {stop}")
     if required:

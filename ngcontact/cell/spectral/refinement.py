@@ -148,7 +148,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale
+from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
 from ngcontact.cell.spectral.contact_edges import (ISLAND_POINTS, fitted_run, island_floor, on_edges,
                                                    unresolved_share)
 from ngcontact.cell.spectral.estimate_forms import CARRIED, GUARDED, LOOSE, RICHARDSON, loose_flags, loose_remarks
@@ -437,7 +437,7 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
             return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history,
                                 remarks=remarks + loose_remarks(flags), forms=forms, flags=flags)
         deferred = estimates if met else None
-    reached = f"{entry['estimate']:.3g}" if estimates is not None else "no estimate (one level)"
+    reached = worst_estimate(estimates, UNCONTROLLED) if estimates is not None else "no estimate (one level)"
     message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on {entry['points']} "
                f"grid points, and the next grid of {next_grid(grids[-1], dim)} per direction would exceed "
                f"{max_points} points")
