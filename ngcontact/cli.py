@@ -89,7 +89,7 @@ def _parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="solve a scene and write report.json, VTK, CSV and PNG",
                          description="Solve a scene; write DIR/report.json, VTK files, CSV tables and PNG plots.")
     run.add_argument("scene", help="scene file (TOML)")
-    run.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>)")
+    run.add_argument("--out", metavar="DIR", type=_out_dir, help="output directory (default: results/<scene name>)")
     run.add_argument("--quiet", action="store_true", help="no progress lines")
     run.add_argument("--mpi", action="store_true",
                      help="a macro scene distributed over the MPI ranks of mpiexec -n N (the same happens under "
@@ -104,7 +104,8 @@ def _parser() -> argparse.ArgumentParser:
                         "direction bundle) or of a macro scene (the law its interface uses).")
     ex.add_argument("scene", help="scene file (TOML) of kind cell or macro")
     ex.add_argument("--format", required=True, metavar="FORMAT", help="abaqus, calculix, ansys or json")
-    ex.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_export)")
+    ex.add_argument("--out", metavar="DIR", type=_out_dir,
+                    help="output directory (default: results/<scene name>_export)")
     ex.add_argument("--length-unit", type=float, default=1.0, metavar="M",
                     help="cell scene: metres per cell length unit, in [1e-12, 1000] (default 1)")
     ex.add_argument("--max-pressure", type=float, metavar="PA", help="largest pressure of the table [Pa] "
@@ -141,10 +142,19 @@ def _study_parser(sub) -> None:
                     "DIR/recommended.toml")
     st.add_argument("--levels", type=int, metavar="N", help="accuracy: levels per knob, in [3, 6] (default 4: two "
                     "coarser than the scene, the scene, one finer)")
-    st.add_argument("--out", metavar="DIR", help="output directory (default: results/<scene name>_epsilon or "
-                                                 "_accuracy)")
+    st.add_argument("--out", metavar="DIR", type=_out_dir,
+                    help="output directory (default: results/<scene name>_epsilon or _accuracy)")
     st.add_argument("--quiet", action="store_true", help="no progress lines")
     _compute_options(st)
+
+
+def _out_dir(text: str) -> str:
+    """An output directory named by a non-blank path (an empty ``--out`` is no directory; without the option
+    the run writes to its default)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: must name a directory (omit --out for the default, "
+                                         "results/<scene name>)")
+    return text
 
 
 def _workers(text: str) -> int:

@@ -237,6 +237,19 @@ def test_a_malformed_scheduler_option_exits_2_at_once_naming_it_and_the_allowed_
     assert not out.exists()
 
 
+@pytest.mark.parametrize("command", [["run"], ["export"], ["study", "accuracy"]])
+def test_an_empty_out_option_exits_2_and_writes_nowhere(scene_file, tmp_path, capsys, monkeypatch, command):
+    """Was: ``--out ""`` quietly wrote to the default results/<scene name>."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as info:
+        cli.main(command + [str(scene_file), "--out", ""])
+    assert info.value.code == 2
+    last = capsys.readouterr().err.splitlines()[-1]
+    assert last == (f"ngcontact {command[0]}: error: argument --out: '': must name a directory (omit --out for the "
+                    "default, results/<scene name>)")
+    assert os.listdir(tmp_path) == ["small.toml"]
+
+
 @pytest.mark.parametrize("command", ["check", "run"])
 def test_a_malformed_compute_scheduler_exits_2_naming_the_key(tmp_path, capsys, command):
     cell = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "geometries", "cells",
