@@ -27,6 +27,8 @@ GAPS = ("none", "constant", "sinusoid", "bisinusoid", "tabulated")
 #: "none" and the names of the micro friction laws (:data:`ngcontact.laws.friction.FRICTION_LAWS`)
 FRICTION = ("none", *FRICTION_LAWS)
 ENFORCEMENTS = ("penalty", "exact")
+#: Most loads of one sweep (each a cell solve with its own fields and files).
+MAX_LOADS = 1000
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -92,10 +94,10 @@ class ContactSpec:
 
 @dataclass(frozen=True, kw_only=True)
 class LoadSpec:
-    """Mean load of the cell; lists of equal length (or length 1) make a sweep."""
+    """Mean load of the cell; lists of equal length (or length 1) make a sweep of at most :data:`MAX_LOADS`."""
 
-    pressure: tuple[float, ...] | None = param(None, doc="mean normal pressure, compression positive",
-                                               units="Pa", check=positive())
+    pressure: tuple[float, ...] | None = param(None, units="Pa", check=positive(), doc="mean normal pressure, "
+                                               f"compression positive (at most {MAX_LOADS} loads)")
     normal_jump: tuple[float, ...] | None = param(None, doc="prescribed far-face normal jump "
                                                   "(rough minus counter, positive closes)", units="m")
     shear: tuple[float, ...] | None = param(None, doc="mean shear on the counter's far face along "
@@ -117,10 +119,11 @@ class LoadSpec:
                              "give exactly one of pressure and normal_jump")
         if self.shear is not None and self.tangential_jump is not None:
             raise SceneError(f"{path}.shear", self.shear, "give shear or tangential_jump, not both")
-        for key in ("pressure", "normal_jump", "shear", "tangential_jump"):
+        for key, per_load in (("pressure", 1), ("normal_jump", 1), ("shear", 2), ("tangential_jump", 2)):
             v = getattr(self, key)
-            if v is not None and len(v) == 0:
-                raise SceneError(f"{path}.{key}", v, "must not be empty")
+            if v is not None and not 0 < len(v) <= per_load * MAX_LOADS:
+                raise SceneError(f"{path}.{key}", f"{len(v)} entries", f"must not be empty; a sweep takes at most "
+                                 f"{MAX_LOADS} loads ({per_load * MAX_LOADS} entries), each a solve of its own")
 
 
 #: Most realizations of an ensemble.  The 95 % band's half-width is ``t s / sqrt(M)`` (``s`` the members'

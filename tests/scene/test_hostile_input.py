@@ -165,3 +165,17 @@ def test_a_profile_wall_closer_than_the_mesher_resolves(tmp_path, capsys, rows, 
         text = f.read().replace('file = "data/profile_example.csv"', 'file = "p.csv"')
     run_bad(tmp_path, capsys, text, f"geometry.file (p.csv)[line {line}].x = {x}: x must increase by at least 1e-06 of the "
             "period (1e-06; previous x = ", prefix=True, files={"p.csv": "x,y\n" + rows})
+
+
+def test_a_sweep_of_more_loads_than_a_run_can_hold():
+    """Was: a list of 100,000 pressures was accepted (hours of solves, files per load)."""
+    from ngcontact.scene.cell_scene import MAX_LOADS, LoadSpec
+    from ngcontact.errors import SceneError
+    LoadSpec(pressure=(0.01,) * MAX_LOADS).check("load")
+    with pytest.raises(SceneError, match=rf"load.pressure = '{MAX_LOADS + 1} entries': must not be empty; a sweep "
+                                         rf"takes at most {MAX_LOADS} loads \({MAX_LOADS} entries\)"):
+        LoadSpec(pressure=(0.01,) * (MAX_LOADS + 1)).check("load")
+    with pytest.raises(SceneError, match=rf"load.shear = '{2 * MAX_LOADS + 1} entries'"):
+        LoadSpec(pressure=(0.01,), shear=(0.0,) * (2 * MAX_LOADS + 1)).check("load")
+    with pytest.raises(SceneError, match="load.pressure = '0 entries': must not be empty"):
+        LoadSpec(pressure=()).check("load")
