@@ -113,7 +113,7 @@ Two checks end each level's estimate.  A contact island of fewer than
 stall while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
 (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``); a window across the level where the last
 island came to be resolved is also taken on the resolved levels alone, the smaller reported (the same module's
-docstring).  An estimate (not Richardson's) above
+docstring).  An estimate (not Richardson's nor an island's) above
 :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the last
 contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much:
 flagged with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
