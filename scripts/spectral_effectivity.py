@@ -219,8 +219,10 @@ def summarize(data: list[dict]) -> tuple[str, int]:
         for e in [[d["effectivity"] for d in data if d["quantity"] == q]])
     above = [d for d in data if d["effectivity"] > 10]
     unflagged = [d for d in above if not d["flag"]]
-    summary += (f"; per quantity: {per_quantity}; {sum(1 for d in data if d['flag'])} flagged by the estimator "
-                f"(column `flag`), of them {sum(1 for d in above if d['flag'])} above 10; above 10 and not flagged: "
+    flagged = sum(1 for d in data if d["flag"])
+    summary += (f"; per quantity: {per_quantity}; {flagged} flagged by the estimator (column `flag`), of them "
+                f"{sum(1 for d in above if d['flag'])} above 10 and {flagged - sum(1 for d in above if d['flag'])} at "
+                f"most 10 (the estimate within ten times the error after all); above 10 and not flagged: "
                 f"{listed(unflagged)}; of those, not by chance: {listed([d for d in unflagged if not d['by_chance']])}"
                 f"; rows whose true error is below the reference's own change (`reference_change`, its difference "
                 f"from the grid of half the points): {sum(1 for d in data if d['true_error'] < d['reference_change'])}"
@@ -261,7 +263,9 @@ def main(argv=None) -> int:
                               "edges the quartic located, a stop to the tolerance waiting for four of them; on the "
                               "grid after such a wait the waited grid's estimate plus the last difference where "
                               "smaller: `carried`; at least the share of contact islands of fewer than four "
-                              "points (3D: across), their points and a step beyond: `island`); a tolerance not "
+                              "points (3D: across), their points and a step beyond: `island`; a window across the "
+                              "level where a load's last such island came to be resolved also estimated on the "
+                              "resolved levels alone, at least three, the smaller); a tolerance not "
                               "met within the study's largest grid reports nothing. The true error of the reported "
                               "grid is against the same cell on a much finer grid; `next_error` is that of the grid "
                               "twice as fine, `reference_change` the reference's own change from the grid of half "
@@ -269,8 +273,9 @@ def main(argv=None) -> int:
                               "grid's edge localisation alone: the reference's own pressure and gap sampled on the "
                               "grid, their edges located there, against the reference. `flag`: the estimator's own "
                               "statement that its estimate may exceed the error by more than ten times (a "
-                              "guarded, carried or island estimate above ten times the error its last difference "
-                              "leaves at the last contraction, or an estimate of any form above ten times the error "
+                              "guarded or carried estimate above ten times the error its last difference "
+                              "leaves at the last contraction, not an island's share, whose stalled error the last "
+                              "difference does not measure, or an estimate of any form above ten times the error "
                               "it leaves at the contraction before where the last two disagree, the last twice as "
                               "slow or more), with its reason, as the report lists it (results.accuracy.quantities"
                               "[].loose). Issue 35 asks for effectivities between 1 and 10. "
