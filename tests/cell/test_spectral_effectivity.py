@@ -422,3 +422,20 @@ def test_on_the_seed_11_profile_the_mean_closure_after_its_island_resolves_is_wi
             assert effectivity >= 1.0, (k, name, effectivity)
             if (k, name) == (1, "mean_closure"):
                 assert effectivity <= 10.0 and refined.forms[k][name] == GUARDED, effectivity
+
+
+@pytest.mark.parametrize("args, says", [(["--held-out", "1,x"], "'1,x': comma-separated non-negative integer"),
+                                        (["--held-out", "-3"], "non-negative"),
+                                        (["--held-out", "1", "--publish"], "the five oracles only")])
+def test_the_effectivity_scripts_held_out_seeds_are_refused_unless_integers_and_unpublished(tmp_path, capsys,
+                                                                                           args, says):
+    import os
+    import sys
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+    import spectral_effectivity
+    with pytest.raises(SystemExit) as exit_:
+        spectral_effectivity.main([str(tmp_path / "out")] + args)
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and "--held-out" in err and says in err
+    assert not (tmp_path / "out").exists()
+    assert [o.name for o in spectral_effectivity.held_out([3])] == ["random_2d_seed3"]
