@@ -31,6 +31,20 @@ direction of the grid (no run of that many contact points along it: :func:`narro
 size, and two grids may count it alike while its true area differs, as a 2D island's located width may.
 Its share is bounded the same way, by its points and one step beyond its boundary (the 4-neighbours of its
 points), eq. 34 on them; the refinement takes it as the same floor.
+
+**A window across an island's resolution.**  While a load has an unresolved island, every headline quantity
+carries the island's stalled share (the mean closure and the stiffness too: the island's collocated pressure,
+on fewer points than its edges' reach, has no interior); once every island spans :data:`ISLAND_POINTS`
+points, that share falls at the rate of resolved edges.  A difference between the last level with such an
+island and the first without is therefore that island's error, not a term of the resolved sequence, as a
+difference across the change of 2D edge locator is the line's (:mod:`~ngcontact.cell.spectral.refinement`):
+the guarded envelope, which shrinks an earlier difference at first order only (``|d_(k-i)| / 2^i``), then
+bounds the resolved levels' error by the unresolved one's.  So each quantity of a load whose islands are all
+resolved on the last ``r`` levels (:func:`resolved_run`) only, ``r`` at least the refinement's
+``LOCATOR_LEVELS`` (two differences: one that vanished is seen beside the other), is also estimated on
+those ``r`` levels alone by the same rule, and the smaller estimate is reported (each bounds the error on its
+own argument; on the edges' quantities the levels must also be the quartic's where any are).  An island
+still unresolved on the last level keeps its floor; a window of resolved levels is left as it is.
 """
 from __future__ import annotations
 
@@ -60,6 +74,18 @@ def fitted_run(history: list[dict[str, Any]], k: int) -> int:
     run = 0
     for entry in reversed(history):
         if not entry.get("edges_fitted", [False] * (k + 1))[k]:
+            break
+        run += 1
+    return run
+
+
+def resolved_run(history: list[dict[str, Any]], k: int) -> int:
+    """The levels at the end of ``history`` on which load ``k`` has no contact island of fewer than
+    :data:`ISLAND_POINTS` points (3D: across; :func:`unresolved_share`, recorded per level; a level without that
+    record counts as resolved)."""
+    run = 0
+    for entry in reversed(history):
+        if entry.get("islands", [{}] * (k + 1))[k].get("islands", 0):
             break
         run += 1
     return run

@@ -14,14 +14,20 @@ first order), the error ``e_k = sum_(j > k) d_j`` is the tail left by the last d
 ``|d_k| rho / (1 - rho)`` (:func:`tail_left`).  An estimate above :data:`LOOSE` times that tail (in the
 quantity's measure, :func:`~ngcontact.cell.cell_solution.measure`) therefore rests on something else than
 the last step: an earlier, larger difference (the guarded envelope: a first-order stretch before a faster
-regime, such as the 2D edges' quartic once it locates them, or an error that crossed zero), the deferred
-grid's estimate carried over, or an unresolved island's share.  The error may then lie below the estimate
-by more than :data:`LOOSE` times, and the estimate is flagged with its reason (:func:`loose_flags`), listed
-in the report (:func:`loose_remarks`).  The flag never lowers an estimate: a fast last step is often followed
-by a first-order one (on Westergaard's sinusoid at a twentieth of its closing pressure the quartic's errors
-fall by about 16 per doubling twice, then by 2), and an earlier difference bounds the error where the last
-one vanished by coincidence (a stall, a symmetric cell).  Richardson's form states its rate and holds it to
-first order on purpose (the same sinusoid) and is not flagged by that tail.
+regime, such as the 2D edges' quartic once it locates them, or an error that crossed zero) or the deferred
+grid's estimate carried over.  The error may then lie below the estimate by more than :data:`LOOSE` times,
+and the estimate is flagged with its reason (:func:`loose_flags`), listed in the report
+(:func:`loose_remarks`).  The flag never lowers an estimate: a fast last step is often followed by a
+first-order one (on Westergaard's sinusoid at a twentieth of its closing pressure the quartic's errors fall
+by about 16 per doubling twice, then by 2), and an earlier difference bounds the error where the last one
+vanished by coincidence (a stall, a symmetric cell).  Richardson's form states its rate and holds it to
+first order on purpose (the same sinusoid) and is not flagged by that tail.  Nor is an unresolved island's
+share (:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`): such an island's error stalls while the
+differences vanish (:mod:`~ngcontact.cell.spectral.contact_edges`), so the last difference measures neither
+its size nor how far it lies below the share.  The share exceeds that error by more than :data:`LOOSE`
+times only where the island's located width happens to be right to a tenth of its points and one step
+beyond each edge, which, like an error small by chance, no difference shows; the report names the island
+and its share instead.
 
 Where the last two contractions disagree, the last at least :data:`DISAGREE` times slower than the one
 before (``|d_k| / |d_(k-1)| >= 2 |d_(k-1)| / |d_(k-2)|``: their observed orders in the grid step differ by
@@ -55,8 +61,7 @@ DISAGREE = 2.0
 #: the slowest contraction per level the error left by the last difference is taken at (first order)
 FIRST_ORDER = 0.5
 #: why, per form of the estimate (module docstring)
-WHY_LOOSE = {GUARDED: "an earlier difference bounds it", CARRIED: "carried from the deferred grid",
-             ISLAND: "an unresolved island's share bounds it"}
+WHY_LOOSE = {GUARDED: "an earlier difference bounds it", CARRIED: "carried from the deferred grid"}
 
 
 def loose_flags(history: list[dict[str, Any]], estimates: list[dict[str, float]], forms: list[dict[str, str]]
@@ -80,11 +85,11 @@ def loose_reason(values: list[float], estimate: float, form: str) -> str:
     """Why ``estimate`` (of the last of ``values``, two to four levels of a quantity in its measure, made in
     ``form``) may exceed its error by more than :data:`LOOSE` times, "" where it may not (module docstring):
     above :data:`LOOSE` times the tail its last difference leaves at the last contraction (:func:`tail_left`;
-    not Richardson's form), or above :data:`LOOSE` times the tail it leaves at the contraction before, where
-    the last two disagree, the last slower by :data:`DISAGREE` or more (:func:`faster_contraction`; any
-    form)."""
+    not Richardson's form nor an island's share), or above :data:`LOOSE` times the tail it leaves at the
+    contraction before, where the last two disagree, the last slower by :data:`DISAGREE` or more
+    (:func:`faster_contraction`; any form)."""
     left, rate = tail_left(values[-3:])
-    if form != RICHARDSON and estimate > LOOSE * left:
+    if form not in (RICHARDSON, ISLAND) and estimate > LOOSE * left:
         return (f"{times(estimate, left)} the tail the last difference leaves at its rate {rate:.2g}: "
                 f"{WHY_LOOSE.get(form, WHY_LOOSE[GUARDED])}")
     faster = faster_contraction(values)

@@ -111,7 +111,9 @@ the verdict as not counted).
 Two checks end each level's estimate.  A contact island of fewer than
 :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: its error may
 stall while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
-(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``).  An estimate (not Richardson's) above
+(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``); a window across the level where the last
+island came to be resolved is also taken on the resolved levels alone, the smaller reported (the same module's
+docstring).  An estimate (not Richardson's nor an island's) above
 :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the last
 contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much:
 flagged with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
@@ -149,8 +151,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
-from ngcontact.cell.spectral.contact_edges import (ISLAND_POINTS, fitted_run, island_floor, on_edges,
-                                                   unresolved_share)
+from ngcontact.cell.spectral.contact_edges import (ISLAND_POINTS, fitted_run, island_floor, on_edges, resolved_run,
+                                                   unresolved_share, locator_changing as edges_changing)
 from ngcontact.cell.spectral.estimate_forms import CARRIED, GUARDED, LOOSE, RICHARDSON, loose_flags, loose_remarks
 from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
 from ngcontact.errors import ConvergenceError
@@ -196,7 +198,8 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
        "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
        f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance; at least "
-       f"the share of contact islands of fewer than {ISLAND_POINTS} points (3D: across); an estimate above {LOOSE:g} "
+       f"the share of contact islands of fewer than {ISLAND_POINTS} points (3D: across), and after such islands "
+       f"also estimated on the resolved levels (at least {LOCATOR_LEVELS}), the smaller; an estimate above {LOOSE:g} "
        "times the error its last difference leaves at the last rate, or at the rate before where the last is "
        "twice as slow or more, flagged as possibly loose by as much (accuracy.quantities[].loose)")
 
@@ -308,14 +311,14 @@ def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float
             # a coefficient's edges are the fraction's: not geometric where the fraction's sequence is not
             geometric = not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
             args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
-            run = fitted_run(history, k) if on_edges(name) else 0
-            line = on_edges(name) and run < len(history)
-            out[name], form[name], note = tail_estimate(values, *args[:3], geometric and not line)
+            fitted = fitted_run(history, k) if on_edges(name) else len(history)
+            run = min(fitted, resolved_run(history, k))        # levels of the quartic and of resolved islands
+            out[name], form[name], note = tail_estimate(values, *args[:3], geometric and fitted == len(history))
             if LOCATOR_LEVELS <= run < len(history):
                 sharp = tail_estimate(values[-run:], *args)
                 if sharp[0] < out[name]:
-                    out[name], form[name], note = sharp[0], sharp[1], "; ".join(
-                        filter(None, (sharp[2], "the edge fit's own levels")))
+                    out[name], form[name], note = sharp[0], sharp[1], "; ".join(filter(None, (sharp[2], (
+                        "the edge fit's own levels" if run == fitted else "the levels of resolved islands"))))
             out[name] *= ERRATIC.get(name, 1.0)
             if form[name] == GUARDED:
                 guarded.append(f"load {k} {name}" + (f": {note}" if note else ""))
@@ -347,11 +350,9 @@ def carried(previous: list[dict[str, float]], history: list[dict[str, Any]], est
 
 
 def locator_changing(history: list[dict[str, Any]]) -> bool:
-    """Whether some load's edges came to be located by the quartic fewer than :data:`MIN_LEVELS` levels
-    ago: its fitted levels then show fewer than the two ratios of differences that decide between
-    Richardson and the guarded bound (module docstring)."""
-    loads = len(history[-1]["headline"])
-    return any(0 < run < min(MIN_LEVELS, len(history)) for run in (fitted_run(history, k) for k in range(loads)))
+    """Whether some load's edges came to be located by the quartic fewer than :data:`MIN_LEVELS` levels ago
+    (:func:`~ngcontact.cell.spectral.contact_edges.locator_changing`; module docstring)."""
+    return edges_changing(history, MIN_LEVELS)
 
 
 def levels(grid: int, dim: int, max_points: int) -> list[int]:
