@@ -46,6 +46,21 @@ def test_a_polygonal_valleys_estimate_is_round_off(name):
         assert q["error"] <= 1e-13 * q["scale"], q
 
 
+def test_example_26s_square_hills_are_exact_and_their_estimate_round_off():
+    """Paper Example 26, the hip coating's hills of side 0.4 touching at their summits: ``k_n0 = 0.16 k_n`` on the
+    real contact set, here the whole surface of the summit arrangement (3D, geometry order 2 and 3 alike)."""
+    import tomllib
+    with open(os.path.join(ROOT, "geometries", "cells", "hip_hills.toml"), "rb") as f:
+        data = tomllib.load(f)
+    del data["load"], data["solver"]
+    data["contact"].update(k_n=1.0, geometric_only=True)
+    out = run_cell.run(loader.from_dict(data), Clock())
+    quantities = {q["name"]: q for q in out.results["accuracy"]["quantities"]}
+    assert out.results["accuracy"]["met"]
+    assert quantities["whole_surface_k_n"]["value"] == pytest.approx(0.16, rel=1e-13)
+    assert all(q["error"] <= 1e-13 * q["scale"] for q in quantities.values())
+
+
 def test_a_coefficient_beyond_the_tolerance_or_an_unestimated_surface_is_not_met():
     from ngcontact.cell.whole_surface import verdict
     whole = {"k_n": 0.8, "k_t": 0.4, "k_nt": 0.0, "contact_fraction": 1.3}
