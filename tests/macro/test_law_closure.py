@@ -5,7 +5,6 @@ import os
 from dataclasses import replace
 
 import ngsolve as ng
-import pytest
 
 from ngcontact.drivers import macro_accuracy as MA
 from ngcontact.fem.interpolants import piecewise_linear
