@@ -32,7 +32,9 @@ ES = e_star(1.0, NU, 1.0, NU)
 P = math.pi * ES * B * B / (4 * R)            # Hertz's load of half-width B, per period
 
 
-def test_the_graded_estimate_bounds_its_error_against_the_row_of_hertz_cylinders():
+# 1e-3: two grading steps more, about 17 s on one thread (twice that under load): the slow tier
+@pytest.mark.parametrize("tolerance", [1e-2, pytest.param(1e-3, marks=pytest.mark.slow)])
+def test_the_graded_estimate_bounds_its_error_against_the_row_of_hertz_cylinders(tolerance):
     assert hertz_half_width(P, R, ES) == pytest.approx(B, rel=1e-14)
     exact = 2 * periodic_hertz_half_width(P, R, ES, 1.0)
     model = CellModel(rough=LAW, counter=LAW, k_n=1e3, gap=(ng.x - 0.5) ** 2 / (2 * R), order=3,
@@ -42,9 +44,9 @@ def test_the_graded_estimate_bounds_its_error_against_the_row_of_hertz_cylinders
         cell = graded_flat_cell(1.0, 2.0, 2.0, maxh=0.3, interface_maxh=0.02, order=order, vertices=vertices)
         return CellProblem(cell, replace(model, order=order), max_iter=100)
 
-    g = solve_to_tolerance(make, cell_load(2, pressure=P), 1e-2, 0.02, 1.0, 3)
+    g = solve_to_tolerance(make, cell_load(2, pressure=P), tolerance, 0.02, 1.0, 3)
     error = abs(g.solution.results["contact_fraction"] - exact)
     estimate = g.estimate["contact_fraction"]
     assert error > 1e-9                        # the discretization's, far above the oracle's round-off
-    assert estimate <= 1e-2
+    assert estimate <= tolerance
     assert estimate / error >= 1.0, (estimate, error)
