@@ -106,6 +106,11 @@ class CellSolver(Protocol):
     def whole_surface(self) -> dict[str, Any]:
         """The coefficients of the whole contact surface (paper eqs. 34, 42-43; no contact solve)."""
 
+    def whole_surface_error(self) -> tuple[dict[str, float] | None, str]:
+        """The estimated absolute error of each scalar coefficient of :meth:`whole_surface`
+        (:func:`ngcontact.cell.whole_surface.flat` names them) and how it was estimated, or ``None`` and the
+        reason it is not."""
+
     def solve(self, load: CellLoad, *, first: bool = True, measure: bool = True) -> CellSolution:
         """Solve one load; ``first``: from a first load's start (else continued from the last state)."""
 

@@ -156,7 +156,8 @@ def run(scene, clock, world: World) -> Outcome:
         outcome = R.measured(sol, geo, info, scene.output, Reduced(world, numbers))
         outcome.ndof = global_ndof(sol, world)
         outcome.vtk["stress"].pieces = RankPieces(world)
-        outcome.results["accuracy"] = accuracy_not_estimated(scene, sol, outcome.results["equilibrium"])
+        outcome.results["accuracy"] = accuracy_not_estimated(scene, sol, outcome.results["equilibrium"],
+                                                                  world)
     outcome.solver["mpi"] = {"ranks": world.size, "distributed": "mesh, assembly, Newton with BDDC-CG, "
                              "post-processing reduced over the ranks, VTK in pieces",
                              "rank_0": "meshes (coarse where the ranks refine), checks, orders the interface's "
@@ -193,12 +194,16 @@ def global_ndof(sol: M.MacroSolution, world: World) -> int:
     return int(world.comm.allreduce(int(np.count_nonzero(free & master))))
 
 
-def accuracy_not_estimated(scene, sol: M.MacroSolution, balance: dict) -> dict:
-    """The verdict of a distributed run: the equilibrium check and the modelling-error estimate
+def accuracy_not_estimated(scene, sol: M.MacroSolution, balance: dict, world: World) -> dict:
+    """The verdict of a distributed run: the equilibrium and law-closure checks and the modelling-error estimate
     (:mod:`ngcontact.drivers.macro_accuracy`); the neighbouring-order solves of the discretization estimate
     would run on rank 0 alone, so they are not made, and the verdict says so."""
     from ngcontact.drivers.macro_accuracy import modelling, verdict
-    out = verdict([], scene.discretization.tolerance, balance)
+    from ngcontact.macro import law_closure as LC
+    mine = LC.law_closure(sol, scene.solver.coulomb_rtol)      # this rank's samples; the largest over the ranks
+    closure = LC.closure_of(max(world.comm.allgather(mine["difference"])), max(world.comm.allgather(mine["scale"])),
+                            mine["tolerance"], int(world.comm.allreduce(mine["samples"])))
+    out = verdict([], scene.discretization.tolerance, balance, closure=closure)
     out.update(estimated=False, how="not estimated under MPI: the discretization estimate's solves at the "
                                     "neighbouring orders run in one process (ngcontact run without mpiexec)")
     out["modelling"] = modelling(scene, sol)

@@ -13,7 +13,9 @@ The verdict has the format of the cell's (:func:`ngcontact.cell.admissibility.ve
 * with ``[two_scale]`` (the neighbouring orders solved with the loop's converged law) also the loop's
   own residual, ``max |sigma_n(k) - sigma_n(k-1)|`` of its last step relative to the peak pressure, and
   the cell table's interpolation error (relative, paper Sec. 3.5; :mod:`ngcontact.coupling.pressure_table`);
-* the check ``equilibrium`` (each body's forces balance, :func:`ngcontact.macro.macro_measures.equilibrium`).
+* the checks ``equilibrium`` (each body's forces balance, :func:`ngcontact.macro.macro_measures.equilibrium`)
+  and ``law_closure`` (the interface's tractions are its law's at its jumps, with the friction threshold of the
+  current pressure: :mod:`ngcontact.macro.law_closure`).
 
 In 2D, without ``[two_scale]`` and without a refinement (whose mesh levels judge them), every stress maximum
 is also judged by two local refinements at the corners of the boundary
@@ -61,6 +63,7 @@ from ngcontact.errors import SceneError
 from ngcontact.macro import away_maxima as AM
 from ngcontact.macro import away_sequence as AS
 from ngcontact.macro import discretization_error as DE
+from ngcontact.macro import law_closure as LC
 from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.scene.schema import MAX_ORDER
@@ -78,7 +81,8 @@ HOW = ("discretization error of each headline quantity from solves at the neighb
        "is mesh dependent; the two-scale "
        "loop's residual and the cell table's interpolation error as their own quantities")
 #: the meaning of the macro run's checks
-CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its largest force"}
+CHECKS = {"equilibrium": "the largest force imbalance of a body relative to its largest force",
+          "law_closure": LC.MEANING}
 
 
 @dataclass(frozen=True)
@@ -165,19 +169,22 @@ def two_scale_quantities(two_scale: dict, tolerance: float) -> list[dict[str, An
 
 
 def verdict(found: list[DE.Estimate], tolerance: float | None, balance: dict | None,
-            two_scale: dict | None = None, how: str = HOW, absolute: tuple[str, ...] = ()) -> dict[str, Any]:
+            two_scale: dict | None = None, how: str = HOW, absolute: tuple[str, ...] = (),
+            closure: dict | None = None) -> dict[str, Any]:
     """``results.accuracy`` of a macro run (module docstring); one warning line when it is not met.
     ``balance``: the equilibrium check (``None``: a run without one); ``absolute``: the names of fractions,
-    whose error is held to the tolerance itself."""
+    whose error is held to the tolerance itself; ``closure``: the law's closure
+    (:func:`ngcontact.macro.law_closure.law_closure`; ``None``: not taken)."""
     limit = DEFAULT_TOLERANCE if tolerance is None else tolerance
     quantities = [e.quantity(limit, e.name in absolute) for e in found]
     if two_scale is not None:
         quantities += two_scale_quantities(two_scale, limit)
     checks = []
-    if balance is not None:
-        value, bound = float(balance["error"]), float(balance["tolerance"])
-        checks.append({"load": None, "name": "equilibrium", "value": value, "limit": bound, "ok": value <= bound,
-                       "meaning": CHECKS["equilibrium"]})
+    for name, record in (("equilibrium", balance), ("law_closure", closure)):
+        if record is not None:
+            value, bound = float(record["error"]), float(record["tolerance"])
+            checks.append({"load": None, "name": name, "value": value, "limit": bound, "ok": value <= bound,
+                           "meaning": CHECKS[name]})
     out: dict[str, Any] = {"tolerance": limit, "tolerance_from": "scene" if tolerance is not None else "default",
            "met": all(c["ok"] for c in checks) and all(q["met"] for q in quantities if q["counted"]), "checks": checks,
            "estimated": True, "quantities": quantities, "how": how}
@@ -307,7 +314,8 @@ def accuracy(scene, sol: MacroSolution, solve: Callable[..., MacroSolution], bal
     found, exclusion = (None, None) if refined is None else (refined.estimates, refined.exclusion)
     if found is None:
         found, exclusion = judged(scene, sol, solve, two_scale is not None, safety_factor_of(scene, recovery))
-    out = verdict(found, scene.discretization.tolerance, balance, two_scale)
+    out = verdict(found, scene.discretization.tolerance, balance, two_scale,
+                  closure=LC.law_closure(sol, scene.solver.coulomb_rtol))
     if exclusion is not None:
         out["exclusion"] = exclusion.record()
     out["modelling"] = modelling(scene, sol)

@@ -44,7 +44,7 @@ from __future__ import annotations
 import logging
 from typing import Any
 
-from ngcontact.cell import admissibility, small_strain
+from ngcontact.cell import admissibility, small_strain, whole_surface
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.cell.penalty_share import penalty_share
 from ngcontact.errors import ConvergenceError
@@ -225,7 +225,14 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
         checks = [c.as_dict() for c in admissibility.cell_checks(facts) if c.name == "rms_slope"]
         results["topography"] = dict(topography, small_slope=checks[0] if checks else None)
     if scene.contact.geometric_only:
-        return Outcome(results={**results, "accuracy": {"method": method_choice(scene)}}, ndof=0)
+        with clock.stage("whole-surface estimate"):
+            errors, how = cell.whole_surface_error()
+        tolerance = scene.discretization.tolerance or admissibility.DEFAULT_TOLERANCE
+        accuracy = whole_surface.verdict(results["whole_surface"], errors, tolerance, how)
+        if not accuracy["met"]:
+            log.warning("accuracy not met: %s", accuracy["how"] if errors is None else ", ".join(
+                f"{q['name']} {q['controlled_error']:.3g}" for q in accuracy["quantities"] if not q["met"]))
+        return Outcome(results={**results, "accuracy": dict(accuracy, method=method_choice(scene))}, ndof=0)
     loads = cell_loads(scene)
     refinement: Refinement | None = None
     with clock.stage("solve"):

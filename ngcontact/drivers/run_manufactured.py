@@ -3,7 +3,11 @@
 For every order ``p`` and level ``k = 1..levels`` it solves the manufactured
 problem of :mod:`ngcontact.verification.manufactured` on the mesh refined ``k`` times and
 measures the L2 and H1-seminorm errors; :mod:`ngcontact.verification.rates` fits the
-observed rates (expected ``p + 1`` and ``p``).  Each level is one linear
+observed rates (expected ``p + 1`` and ``p``).  Each level also estimates its two errors without ``u*``, from
+one order more on the same mesh (:func:`ngcontact.verification.manufactured.level_runner`), and the report
+holds each estimate against its true error: ``l2_effectivity``, ``h1_effectivity`` per row (none where the
+error is at round-off, :data:`ROUNDOFF_ERROR`, and the ratio meaningless) and their range,
+``results.estimate``.  Each level is one linear
 solve (assembled ``BilinearForm``/``LinearForm``, sparse direct factorization);
 its relative residual ``|f - A u| / |f|`` on the free dofs is the solver
 history.  A residual above :data:`LINEAR_RTOL` means the factorization failed
@@ -27,7 +31,11 @@ from ngcontact.output.report import Outcome, VtkField
 log = logging.getLogger(__name__)
 
 LINEAR_RTOL = 1e-8
-TABLE_KEYS = studies.ROW_KEYS + ("solve_seconds", "relative_residual")
+TABLE_KEYS = studies.ROW_KEYS + ("l2_estimate", "h1_estimate", "l2_effectivity", "h1_effectivity", "solve_seconds",
+                                  "relative_residual")
+#: how a level's errors are estimated (``results.estimate.how``)
+ESTIMATE_HOW = ("|u_p - u_(p+1)| / (1 - 0.75), u_(p+1) the same problem at one order more on the same mesh (the "
+                "saturation assumption), in the L2 norm and the H1 seminorm")
 
 
 #: Errors below this fraction of the study's largest error (of the same norm) are round-off, not discretization
@@ -83,6 +91,9 @@ def run(scene, clock) -> Outcome:
     norms = dict(zip(("l2", "h1"), manufactured.exact_norms(
         manufactured.problem(m.setting, laws_of(scene), m.maxh, order=m.orders[-1]))))
     floor = {n: max(ROUNDOFF_ERROR * max(r[n] for r in rows), SOLUTION_ROUNDOFF * norms[n]) for n in ("l2", "h1")}
+    for row in rows:       # each estimate against its true error, where that is above round-off
+        for n in ("l2", "h1"):
+            row[f"{n}_effectivity"] = row[f"{n}_estimate"] / row[n] if row[n] > floor[n] else None
     judged = studies.judge(rows, floor, m.rate_tolerance)
     rates, expected, verified = judged["rates"], judged["expected_rates"], judged["verified"]
     if not verified or judged["orders_without_rate"]:
@@ -99,6 +110,7 @@ def run(scene, clock) -> Outcome:
         "orders_at_roundoff": judged["orders_at_roundoff"],
         "orders_without_rate": {str(p): n for p, n in judged["orders_without_rate"].items()},
         "roundoff_error_floor": floor,
+        "estimate": {"how": ESTIMATE_HOW, "effectivity": {n: effectivity_range(rows, n) for n in ("l2", "h1")}},
         "solution_norms": norms,
         "rate_tolerance": m.rate_tolerance,
         "verified": verified,
@@ -114,6 +126,13 @@ def run(scene, clock) -> Outcome:
                    tables={"convergence": studies.table(rows, TABLE_KEYS),
                            "rates": _rates_table(rates, expected)},
                    vtk=vtk, plots={"convergence": lambda path: figures.convergence(path, rows, rates)})
+
+
+def effectivity_range(rows: list[dict], norm: str) -> dict:
+    """The smallest and largest effectivity of ``norm``'s estimates over the rows above round-off, and how many
+    (``None`` where every row is at round-off)."""
+    found = [r[f"{norm}_effectivity"] for r in rows if r[f"{norm}_effectivity"] is not None]
+    return {"min": min(found) if found else None, "max": max(found) if found else None, "rows": len(found)}
 
 
 def finest_solution(scene, vec: np.ndarray | None) -> tuple[manufactured.Problem, ng.GridFunction]:

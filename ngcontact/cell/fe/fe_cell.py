@@ -45,6 +45,7 @@ from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.cell.fe.default_refinement import held_to_default
 from ngcontact.cell.fe.edge_grading import ORDER_RATE, GradedSolve, solve_to_tolerance
 from ngcontact.cell.fe.load_start import Predictor
+from ngcontact.cell.fe import whole_surface_error
 from ngcontact.cell.fe.saturation import estimate_on_scene
 from ngcontact.cell.fe.second_discretization import InterfaceHalving, Refiner, Sequence, as_refinement, refine
 from ngcontact.cell.fe.measures import contact_fraction, contact_integral, mean_jump, real_contact_coefficients
@@ -158,6 +159,13 @@ class FECell:
 
     def whole_surface(self) -> dict[str, Any]:
         return coefficients(self.cell, kn=self.model.k_n, gap=self.model.gap, G=self.threshold).as_dict()
+
+    def whole_surface_error(self) -> tuple[dict[str, float] | None, str]:
+        """One geometry order more on the same mesh (:mod:`ngcontact.cell.fe.whole_surface_error`)."""
+        higher = self.variant(order=self.model.order + 1) if self.variant is not None else None
+        if higher is None:
+            return None, f"the scene's checks refuse geometry order {self.model.order + 1}, one more than its own"
+        return whole_surface_error.estimates(self.whole_surface(), higher.whole_surface()), whole_surface_error.HOW
 
     # ----------------------------------------------------------------- solves
     def solve(self, load: CellLoad, *, first: bool = True, measure: bool = True) -> CellSolution:

@@ -25,6 +25,7 @@ from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.spectral import grid_measures
 from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
 from ngcontact.cell.spectral.refinement import HOW, UNCONTROLLED, sweep_to_tolerance
+from ngcontact.cell.whole_surface import flat
 
 #: the grid fields a solution hands on (the closure is in its surface distribution)
 FIELDS = ("pressure", "gap", "shear", "slip")
@@ -72,6 +73,14 @@ class SpectralCellSolver:
 
     def whole_surface(self) -> dict[str, Any]:
         return grid_measures.coefficients(self.cell, np.ones(self.cell.shape, bool)).as_dict()
+
+    def whole_surface_error(self) -> tuple[dict[str, float] | None, str]:
+        """Exact (zero): the small-slope cell's contact surface is the flat interface, whose normal is ``n0``
+        everywhere, so the normal components ``beta`` of eq. 34 are constants on any grid, and a term carrying
+        the gap is its mean over the grid's points, the exact mean of the gap as the cell defines it (on its
+        own grid)."""
+        return ({name: 0.0 for name in flat(self.whole_surface())},
+                "exact: the flat interface of the small-slope cell, the gap's mean over its own grid")
 
     # ----------------------------------------------------------------- solves
     def solution(self, sol: SpectralSolution) -> CellSolution:
