@@ -280,6 +280,7 @@ class MacroScene:
         mesh_size.check_lengths({f"geometry.dimensions.{k}": v for k, v in (g.dimensions or {}).items() if v != 0}
                                 | {"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         dim, volume, interface, width = macro_extent(g.shape, g.setting, dict(g.dimensions or {}))
+        magnitudes.check_body_forces(self, width)
         n = mesh_size.estimate(dim, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
         mesh_size.refuse_beyond(d.refined_count(n, dim), d.max_elements, *mesh_size.finest_size(d),
                                 hint=" or ask for fewer discretization.refinements" if d.refinements else "")

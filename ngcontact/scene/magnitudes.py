@@ -81,13 +81,14 @@ def check_moduli_ratio(materials: dict, names) -> None:
                          "(a support) or bring the moduli closer")
 
 
-def check_load_strain(key: str, value: float, stress: float, E: float, name: str) -> None:
-    """A load ``value`` under ``key`` whose stress ``stress`` over the softer body's modulus ``E`` (material
-    ``name``) is at most :data:`MAX_LOAD_STRAIN`."""
-    strain = abs(stress) / E
+def check_load_strain(key: str, value, magnitude: float, E: float, name: str, *, width: float | None = None) -> None:
+    """A load ``value`` under ``key`` of magnitude ``magnitude``: its stress (``magnitude``, times ``width`` for a
+    force density) over the softer body's modulus ``E`` (material ``name``) at most :data:`MAX_LOAD_STRAIN`."""
+    strain = abs(magnitude) * (width or 1.0) / E
     if not strain <= MAX_LOAD_STRAIN:
+        most = f"{E:g}" if width is None else f"E / {width:g} = {E / width:g} (over the bodies' smallest width)"
         raise SceneError(key, value, f"strains the softer body (materials.{name}, E = {E:g}) by {strain:.3g}; "
-                         f"a load must stay below a strain of {MAX_LOAD_STRAIN:g}, i.e. at most {E:g} in "
+                         f"a load must stay below a strain of {MAX_LOAD_STRAIN:g}, i.e. at most {most} in "
                          "magnitude (a body compressed by its own size; linear elasticity holds to about 0.05): "
                          "check the load and the units")
 
@@ -151,6 +152,16 @@ def check_surface_loads(scene) -> None:
         if load.traction:
             check_load_strain(f"loads[{i}].traction", load.traction, float(np.hypot.reduce(load.traction)),
                               E, name)
+
+
+def check_body_forces(scene, width: float) -> None:
+    """A macro scene's body force densities: a force density ``f`` over a body at least ``width`` across (the
+    geometry's smallest width) stresses it by at least about ``|f| width``, held like a surface load."""
+    E, name = softer(scene.materials, (scene.bodies.rough, scene.bodies.counter))
+    for role in ("rough", "counter"):
+        f = getattr(scene.body_forces, role)
+        if f:
+            check_load_strain(f"body_forces.{role}", f, float(np.hypot.reduce(f)), E, name, width=width)
 
 
 def interface_stiffness(interface) -> tuple[str, str, float] | None:

@@ -91,6 +91,30 @@ def test_a_macro_load_beyond_the_modulus(tmp_path, capsys, line, key, shown, str
     run_bad(tmp_path, capsys, edit(MACRO, ("pressure = 10e6", line)), f"{key} = {shown}: {STEEL.format(strain)}")
 
 
+def test_a_macro_body_force_beyond_the_modulus(tmp_path, capsys):
+    """A force density over the bodies' smallest width (5 mm here) is the stress held against the modulus."""
+    run_bad(tmp_path, capsys, edit(MACRO, ("[discretization]", "[body_forces]\nrough = [0.0, -1e14]\n\n"
+                                                               "[discretization]")),
+            "body_forces.rough = [0.0, -100000000000000.0]: strains the softer body (materials.steel, E = 2.1e+11) by 2.38; a "
+            "load must stay below a strain of 1, i.e. at most E / 0.005 = 4.2e+13 (over the bodies' smallest width) "
+            "in magnitude (a body compressed by its own size; linear elasticity holds to about 0.05): check the load "
+            "and the units")
+
+
+def test_a_refused_scene_leaves_an_earlier_output_directory_as_it_was(tmp_path, capsys):
+    """``ngcontact run bad.toml --out D`` with D holding an earlier run's output: exit 2, D byte for byte as it was."""
+    from ngcontact import cli
+    good, scene, out = tmp_path / "good.toml", tmp_path / "bad.toml", tmp_path / "D"
+    good.write_text(MACRO)
+    assert cli.main(["run", str(good), "--out", str(out), "--quiet"]) == 0
+    scene.write_text(edit(MACRO, ("pressure = 10e6", "pressure = 1e300")))
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert "report.json" in before
+    assert cli.main(["run", str(scene), "--out", str(out), "--quiet"]) == 2
+    assert "loads[0].pressure = 1e+300: strains the softer body" in capsys.readouterr().err
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
 def test_a_macro_modulus_beyond_any_stress_unit(tmp_path, capsys):
     """Was: exit 3, 'the linear solve gave non-finite values: the system is singular'."""
     run_bad(tmp_path, capsys, edit(MACRO, ("E = 210e9", "E = 1e-308")), f"materials.steel.E = 1e-308: {MODULUS}")
