@@ -45,9 +45,9 @@ import numpy as np
 from ngcontact.distributed.macro_mesh import distribute, gather
 from ngcontact.distributed.reduced_measures import Reduced, boundary_mid
 from ngcontact.distributed.vtk_pieces import RankPieces
-from ngcontact.distributed.world import World, broadcast
+from ngcontact.distributed.world import World, broadcast, sent_error
 from ngcontact.drivers import run_macro as R
-from ngcontact.errors import NgcontactError, SceneError
+from ngcontact.errors import SceneError
 from ngcontact.fem.two_body import Support
 from ngcontact.fem.two_body import boundary_mid as whole_mid
 from ngcontact.laws import interface_energy as ie
@@ -106,19 +106,6 @@ def _on_root(world: World, make):
     if value[0] == "error":
         raise value[1]
     return value[1]
-
-
-def sent_error(exc: Exception) -> bytes:
-    """``("error", exc)`` pickled for the other ranks; an exception that does not come back from pickling as
-    itself (its class's arguments are not its ``args``, or it holds what does not pickle) is sent as a
-    :class:`~ngcontact.errors.NgcontactError` with its class and message, so that rank 0 always sends and every
-    rank raises (none waits for a value that never comes)."""
-    try:
-        sent = pickle.dumps(("error", exc))
-        pickle.loads(sent)
-        return sent
-    except Exception:  # noqa: BLE001  (any failure to pickle or unpickle)
-        return pickle.dumps(("error", NgcontactError(f"on rank 0: {type(exc).__name__}: {exc}")))
 
 
 def run(scene, clock, world: World) -> Outcome:

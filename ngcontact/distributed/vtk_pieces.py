@@ -11,15 +11,25 @@ Rank 0 alone runs the writer of the output directory
 (:mod:`ngcontact.output.writer`: staged in a temporary directory, moved into
 place).  The other ranks wait in :func:`written` for the path of each field
 set, which rank 0 sends when its writer reaches it, write their pieces
-there, and are released when rank 0's writer ends (whether or not it
-succeeded); they sleep while they wait (:func:`ngcontact.distributed.world.broadcast`).
+there, and are released when rank 0's writer ends; they sleep while they
+wait (:func:`ngcontact.distributed.world.broadcast`).
+
+A write that fails never leaves a rank waiting for a collective call the
+others do not make (MPI matches a blocking barrier only with a blocking
+one).  Every rank makes the same calls whatever happens: after writing its
+piece each rank sends the others its outcome, nothing or its error (an
+``allgather`` where a barrier stood), and all raise the error of the
+lowest failing rank; rank 0's writer, ended by it or by any other error,
+sends that error instead of the closing ``None``, and every rank raises it
+as itself (pickled: :func:`ngcontact.distributed.world.sent_error`), so
+that the run ends on every rank with the same error and exit status.
 """
 from __future__ import annotations
 
 import os
 from typing import Callable
 
-from ngcontact.distributed.world import World, broadcast, launched_rank
+from ngcontact.distributed.world import World, broadcast, launched_rank, raise_sent, sent_error
 
 
 class RankPieces:
@@ -45,12 +55,19 @@ def piece(name: str, rank: int) -> str:
 
 
 def write_piece(path_noext: str, item, world: World) -> None:
-    """Every rank's part of ``item``'s fields (together on all ranks; rank 0's is empty)."""
-    import ngsolve as ng
-    names = list(item.fields)
-    ng.VTKOutput(ma=item.mesh, coefs=[item.fields[n] for n in names], names=names, filename=path_noext,
-                 subdivision=item.subdivision, legacy=False).Do()
-    world.comm.Barrier()
+    """Every rank's part of ``item``'s fields (together on all ranks; rank 0's is empty), then every rank's
+    outcome to all (module docstring): the error of the lowest failing rank is raised on every rank."""
+    try:
+        import ngsolve as ng
+        names = list(item.fields)
+        ng.VTKOutput(ma=item.mesh, coefs=[item.fields[n] for n in names], names=names, filename=path_noext,
+                     subdivision=item.subdivision, legacy=False).Do()
+        mine = None
+    except Exception as exc:  # noqa: BLE001  (sent to every rank, raised there alike)
+        mine = sent_error(exc, world.rank)
+    failed = [sent for sent in world.comm.allgather(mine) if sent is not None]
+    if failed:
+        raise_sent(failed[0])
     stray = path_noext + ".pvd"           # NGSolve's collection file: the .pvtu replaces it
     if world.root and os.path.exists(stray):
         os.remove(stray)
@@ -83,8 +100,15 @@ def written(outcome, write: Callable[[], object]) -> None:
     if world.root:
         try:
             write()
-        finally:
-            broadcast(world)     # the other ranks stop waiting
+        except BaseException as exc:
+            broadcast(world, sent_error(exc))   # the other ranks stop waiting and raise it
+            raise
+        broadcast(world)     # the other ranks stop waiting
         return
-    while (path := broadcast(world)) is not None:
-        write_piece(path, outcome.vtk[os.path.basename(path)], world)
+    while isinstance(message := broadcast(world), str):
+        try:
+            write_piece(message, outcome.vtk.get(os.path.basename(message)), world)
+        except Exception:  # noqa: BLE001  (raised on rank 0 too: the message that ends its writer says how)
+            pass
+    if message is not None:
+        raise_sent(message)

@@ -10,11 +10,12 @@ install, before anything is solved or written.
 from __future__ import annotations
 
 import os
+import pickle
 import time
 from dataclasses import dataclass
 from typing import Any
 
-from ngcontact.errors import ModelError
+from ngcontact.errors import ModelError, NgcontactError
 
 #: what to install for MPI runs
 INSTALL = "pip install 'ngcontact[mpi]' (mpi4py and mpich, which gives mpiexec)"
@@ -93,3 +94,21 @@ def broadcast(world: World, value: Any = None) -> Any:
     while not arrived.Test():
         time.sleep(POLL_S)
     return world.comm.bcast(value)
+
+
+def sent_error(exc: BaseException, rank: int = 0) -> bytes:
+    """``("error", exc)`` pickled for the other ranks; an exception that does not come back from pickling as
+    itself (its class's arguments are not its ``args``, or it holds what does not pickle) is sent as a
+    :class:`~ngcontact.errors.NgcontactError` with its class, message and the ``rank`` it was raised on, so that
+    the sending rank always sends and every rank raises (none waits for a value that never comes)."""
+    try:
+        sent = pickle.dumps(("error", exc))
+        pickle.loads(sent)
+        return sent
+    except Exception:  # noqa: BLE001  (any failure to pickle or unpickle)
+        return pickle.dumps(("error", NgcontactError(f"on rank {rank}: {type(exc).__name__}: {exc}")))
+
+
+def raise_sent(sent: bytes) -> None:
+    """Raise the exception :func:`sent_error` pickled."""
+    raise pickle.loads(sent)[1]

@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from ngcontact.errors import MISSING, GeometryError
+from ngcontact.geometry import x3p
 
 #: the optional dependency's name in ``pyproject.toml``
 EXTRA = "topography"
@@ -148,6 +149,7 @@ def read_scan(file, reading: Reading, where: str = "geometry.file") -> tuple[np.
     check_data_file(file, where, "topography file")
     if Path(file).stat().st_size == 0:
         raise GeometryError(where, str(file), "is empty; must be a topography file")
+    x3p.check_checksums(file, where)       # an X3P container's MD5s: a corrupted file is refused
     r, ch, facts = _reader(file, where)
     if facts["dim"] != 2:
         raise GeometryError(where, str(file), f"holds a {facts['dim']}D scan; a cell's height map is a 2D scan")

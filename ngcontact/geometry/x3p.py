@@ -1,8 +1,10 @@
-"""A minimal X3P file (ISO 25178-72 / ISO 5436-2): a height map written as an instrument would write its scan.
+"""A minimal X3P file (ISO 25178-72 / ISO 5436-2): a height map written as an instrument would write its scan,
+and the check of a file's checksums before its heights are read.
 
-Used by the tests of measured topographies (:mod:`ngcontact.geometry.topography`) and by the script that
-writes the shipped scan, so that both read the heights back through SurfaceTopography's reader, the
-route of a real instrument's file.
+:func:`write_x3p` is used by the tests of measured topographies (:mod:`ngcontact.geometry.topography`) and
+by the script that writes the shipped scan, so that both read the heights back through SurfaceTopography's
+reader, the route of a real instrument's file.  :func:`check_checksums` is run on every X3P file a scene
+reads (SurfaceTopography does not check them).
 
 The container is a zip of ``main.xml`` (the axes: ``CX``, ``CY`` incremental with their spacing in metres,
 ``CZ`` absolute heights in metres; the matrix dimensions and the link to the data) and the binary heights
@@ -12,9 +14,13 @@ checksums the standard asks for.
 from __future__ import annotations
 
 import hashlib
+import re
 import zipfile
+from xml.etree import ElementTree
 
 import numpy as np
+
+from ngcontact.errors import GeometryError
 
 MAIN_XML = """<?xml version="1.0" encoding="UTF-8"?>
 <p:ISO5436_2 xmlns:p="http://www.opengps.eu/2008/ISO5436_2">
@@ -60,3 +66,84 @@ def write_x3p(path, heights, spacing: tuple[float, float], *, model: str = "ngco
         for name, content in (("main.xml", main), ("bindata/data.bin", data),
                               ("md5checksum.hex", f"{hashlib.md5(main).hexdigest()} *main.xml\n".encode())):
             z.writestr(zipfile.ZipInfo(name, date_time=stamp), content, compress_type=zipfile.ZIP_DEFLATED)
+
+
+#: the container's checksum entry (ISO 25178-72): ``<MD5 of main.xml> *main.xml``
+CHECKSUM_FILE = "md5checksum.hex"
+_MD5 = re.compile(r"[0-9a-fA-F]{32}")
+
+
+def check_checksums(file, where: str) -> None:
+    """Refuse an X3P file whose bytes differ from the MD5 checksums it states: a corrupted file.
+
+    ISO 25178-72 makes ``md5checksum.hex`` part of the container: one line ``<32 hex digits> *main.xml``,
+    the MD5 of ``main.xml`` (the name after the digits says which member is meant; none means
+    ``main.xml``), and ``main.xml`` states the MD5 of the point data (``MD5ChecksumPointData`` beside
+    ``PointDataLink``).  Each stated checksum must be the MD5 of its member (hexadecimal digits in either
+    case), else :class:`~ngcontact.errors.GeometryError` under ``where`` names the file, the member, the
+    actual and the stated checksum.  A file without ``md5checksum.hex``, or whose ``main.xml`` states no
+    point-data checksum, is read as it is (older writers leave them out); a file that is not a zip holding
+    ``main.xml`` is left to the reader.
+    """
+    if not zipfile.is_zipfile(file):
+        return
+    try:
+        with zipfile.ZipFile(file) as z:
+            names = set(z.namelist())
+            if "main.xml" not in names:
+                return
+            stated = []
+            if CHECKSUM_FILE in names:
+                stated += [(member, digits, CHECKSUM_FILE) for member, digits in _listed(z.read(CHECKSUM_FILE), file,
+                                                                                        where)]
+            stated += _point_data(z.read("main.xml"))
+            for member, digits, source in stated:
+                if member not in names:
+                    raise GeometryError(where, str(file), f"is corrupted: its {source} states the checksum of "
+                                        f"{member!r}, which the file does not hold")
+                actual = _md5(z, member)
+                if actual != digits.lower():
+                    raise GeometryError(where, str(file), f"is corrupted: the MD5 of its {member} is {actual}, but "
+                                        f"its {source} states {digits.lower()}; read the scan from the instrument "
+                                        "again")
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError) as err:
+        raise GeometryError(where, str(file), f"is not a readable X3P container: {err}") from None
+
+
+def _listed(text: bytes, file, where: str) -> list[tuple[str, str]]:
+    """``(member, digits)`` of each line of ``md5checksum.hex``: ``digits [*]name``, name default main.xml."""
+    out = []
+    for line in text.decode("utf-8", "replace").splitlines():
+        if not line.strip():
+            continue
+        digits, _, name = line.strip().partition(" ")
+        if not _MD5.fullmatch(digits):
+            shown = line.strip()[:64]
+            raise GeometryError(where, str(file), f"is corrupted: its {CHECKSUM_FILE} holds {shown!r}, not an MD5 "
+                                "checksum (32 hexadecimal digits)")
+        out.append((name.strip().lstrip("*").strip() or "main.xml", digits))
+    return out
+
+
+def _point_data(main: bytes) -> list[tuple[str, str, str]]:
+    """``(member, digits, "main.xml")`` of the point data's stated checksum, if ``main.xml`` states one."""
+    try:
+        root = ElementTree.fromstring(main)
+    except ElementTree.ParseError:
+        return []       # the reader names a main.xml it cannot parse
+    link = root.find(".//DataLink")
+    if link is None:
+        return []
+    member, digits = link.findtext("PointDataLink"), link.findtext("MD5ChecksumPointData")
+    if not member or not digits or not _MD5.fullmatch(digits.strip()):
+        return []
+    return [(member.strip(), digits.strip(), "main.xml")]
+
+
+def _md5(z: zipfile.ZipFile, member: str) -> str:
+    """The MD5 of a member, read in blocks."""
+    h = hashlib.md5()
+    with z.open(member) as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()

@@ -88,7 +88,9 @@ class CellGeometry:
                              "topography in an instrument's format (X3P, DATX, OPD, SUR, PLU, IBW, DI, plain-text "
                              "matrix, ...; read by SurfaceTopography, pip install 'ngcontact[topography]'; its "
                              "heights in metres and period = its physical size, twice it with periodize = "
-                             "'mirror'); a regular file of at most 64 MiB, relative to the scene file")
+                             "'mirror'; an X3P file whose MD5 checksums, md5checksum.hex's and the point data's, "
+                             "do not match is refused as corrupted); a regular file of at most 64 MiB, relative to "
+                             "the scene file")
     spectrum: SpectrumSpec | None = param(None, doc="self_affine: the power spectrum and seed of the random surface")
     units: str | None = param(None, doc="measured file: the length unit of its heights and size, where the file "
                               "states none (a different one than the file's is refused)", choices=tuple(UNITS))

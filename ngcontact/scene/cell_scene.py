@@ -19,7 +19,7 @@ from ngcontact.scene.cell_geometry import (CellGeometry, check_features, check_p
                                           small_slope)
 from ngcontact.scene.sections import (CellDiscretization, ComputeSpec, MaterialSpec, SolverSpec, base_dir_field,
                                      check_material_names)
-from ngcontact.scene import mesh_size
+from ngcontact.scene import magnitudes, mesh_size
 from ngcontact.scene.schema import (check_selected, closed_interval, derived_field, nonempty, nonnegative, param,
                                    positive)
 
@@ -242,6 +242,7 @@ class CellScene:
         if g == "bisinusoid" and dim != 3:
             raise SceneError("contact.gap.kind", g, f"not available for a {dim}D cell")
         self.check_size()
+        magnitudes.check_cell(self)
         if self.contact.geometric_only:
             if self.load is not None:
                 raise SceneError("load", "...", "not used with contact.geometric_only = true; remove it")
@@ -284,17 +285,9 @@ class CellScene:
         mesh_size.refuse_beyond(n, d.max_elements, key, value, hint=hint)
 
 
-#: Largest admissible ``k_n h / E``: beyond it the tangent of the penalty term outweighs the bodies'
-#: by more than double precision can resolve, and the residual cannot be evaluated (k_n = 1e16 on a
-#: cell with E = 1 reported a pressure 63 % off equilibrium as converged).
-MAX_PENALTY_RATIO = 1e10
-#: Smallest admissible ``k_n h / E``: below it the interface is so much softer than the bodies that the jump
-#: dwarfs their deformation (k_n = 1e-300 gave a far-face jump of 1e298 under a pressure of 0.01).
-MIN_PENALTY_RATIO = 1e-8
-
-
 def check_penalty_ratio(scene: CellScene, spacing: tuple[float, str] | None = None) -> None:
-    """``k_n h / E`` of the cell, ``h`` its interface mesh size and ``E`` the softer body's modulus.
+    """``k_n h / E`` of the cell, ``h`` its interface mesh size and ``E`` the softer body's modulus, within
+    the bounds of :func:`ngcontact.scene.magnitudes.check_penalty_ratio`.
 
     ``spacing``: ``(h, what it is)`` instead of the mesh size, and the lower bound only: the spectral cell
     (:func:`check_spectral`) with ``h`` its grid step.  Its penalty adds ``1/k_n`` to the layers' compliance,
@@ -304,17 +297,9 @@ def check_penalty_ratio(scene: CellScene, spacing: tuple[float, str] | None = No
     """
     d, c = scene.discretization, scene.contact
     h, what = spacing if spacing is not None else (d.interface_maxh or d.maxh, "the interface mesh size")
-    E = min(scene.materials[name].E or 0.0 for name in (scene.bodies.rough, scene.bodies.counter))
+    E, _ = magnitudes.softer(scene.materials, (scene.bodies.rough, scene.bodies.counter))
     assert c.k_n is not None  # set by CellScene.check (exact contact: its default scale)
-    ratio = c.k_n * h / E if E > 0 else 0.0
-    if 0 < ratio < MIN_PENALTY_RATIO:
-        raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} {what}, "
-                         f"E = {E:g} the softer body's modulus) must be at least {MIN_PENALTY_RATIO:g}: the "
-                         "interface would hold nothing and the jump would dwarf the bodies; raise k_n")
-    if spacing is None and ratio > MAX_PENALTY_RATIO:
-        raise SceneError("contact.k_n", c.k_n, f"k_n h / E = {ratio:.3g} (h = {h:g} the interface mesh size, "
-                         f"E = {E:g} the softer body's modulus) must stay below {MAX_PENALTY_RATIO:g}: the "
-                         "penalty would outweigh the bodies beyond what double precision resolves; lower k_n")
+    magnitudes.check_penalty_ratio("contact.k_n", c.k_n, "k_n", h, what, E, upper=spacing is None)
 
 
 #: ``k_n h / E`` of exact contact's default scale (``contact.k_n``): within the admissible ratios, and an

@@ -39,7 +39,7 @@ from ngcontact.scene.macro_shapes import BOUNDARY_DOCS as SHAPE_BOUNDARY_DOCS
 from ngcontact.scene.file_geometry import FILE_BOUNDARY_DOCS, BodySpec, FaceSelectorSpec, check_file_geometry
 from ngcontact.scene.sections import (MaterialSpec, SolverSpec, base_dir_field,
                                       check_material_names, check_supports_once)
-from ngcontact.scene import cell_links, mesh_size
+from ngcontact.scene import cell_links, magnitudes, mesh_size
 from ngcontact.scene.macro_discretization import MacroDiscretization
 from ngcontact.scene.cell_scene import FRICTION
 from ngcontact.scene.supports import SupportSpec, check_values
@@ -280,6 +280,7 @@ class MacroScene:
         mesh_size.check_lengths({f"geometry.dimensions.{k}": v for k, v in (g.dimensions or {}).items() if v != 0}
                                 | {"discretization.maxh": d.maxh, "discretization.interface_maxh": d.interface_maxh})
         dim, volume, interface, width = macro_extent(g.shape, g.setting, dict(g.dimensions or {}))
+        magnitudes.check_body_forces(self, width)
         n = mesh_size.estimate(dim, volume, d.maxh, width=width, interface=interface, h_interface=d.interface_maxh)
         mesh_size.refuse_beyond(d.refined_count(n, dim), d.max_elements, *mesh_size.finest_size(d),
                                 hint=" or ask for fewer discretization.refinements" if d.refinements else "")
@@ -287,6 +288,8 @@ class MacroScene:
     def check(self, path: str) -> None:
         check_material_names(self.materials, {"rough": self.bodies.rough, "counter": self.bodies.counter},
                              "bodies")
+        magnitudes.check_surface_loads(self)
+        magnitudes.check_macro_interface(self)
         self.check_size()
         comps = COMPONENTS[self.geometry.setting]
         shape, setting = self.geometry.shape, self.geometry.setting
@@ -368,6 +371,8 @@ class MacroScene:
                 cell_links.check_spectral_loop(self.interface, self.two_scale, rel, cell)
             if cell.kind != "cell":
                 raise SceneError(key, rel, f"invalid cell scene: must be of kind 'cell', not {cell.kind!r}")
+            if key == "interface.cell" and cell.contact.k_n is not None:   # its bundle's weights are k_n's
+                magnitudes.check_cell_law(self, key, rel, cell, "k_n" in overrides)
             cell_links.check_friction_source(self.interface, key, rel, cell)
             if (key == "two_scale.cell" and self.geometry.setting == "3d" and self.interface.friction == "from_cell"
                     and cell.contact.friction != "none"):

@@ -42,7 +42,7 @@ from ngcontact.geometry.resolved_shapes import RESOLVED_SHAPES, resolved_shape
 from ngcontact.scene.macro_shapes import FEMUR_BOUNDARIES, check_dimensions, check_support_meaning
 from ngcontact.scene.sections import (ComputeSpec, MaterialSpec, check_supports_once, SolverSpec, base_dir_field,
                                      check_material_names)
-from ngcontact.scene import mesh_size
+from ngcontact.scene import magnitudes, mesh_size
 from ngcontact.scene.supports import SupportSpec, check_values
 from ngcontact.scene.schema import (MAX_ORDER, MAX_PERIODS, at_least, closed_interval, nonempty,
                                     open_interval, param, positive)
@@ -192,6 +192,7 @@ class DirectScene:
         for name in (self.bodies.rough, self.bodies.counter):
             if self.materials[name].C is not None:
                 raise SceneError(f"materials.{name}.C", "...", "direct scenes take isotropic E, nu")
+        magnitudes.check_surface_loads(self)
         g = self.geometry
         labels, comps = BOUNDARIES[g.shape], COMPONENTS[g.setting]
         groups: tuple[tuple[str, tuple[SupportSpec | DirectLoad, ...]], ...] = (
@@ -247,7 +248,18 @@ class DirectScene:
         if cell.contact.gap.kind not in ("none", "constant"):
             raise SceneError("geometry.cell", self.geometry.cell,
                              f"gap kind {cell.contact.gap.kind!r} is not resolved; use none or constant")
+        check_resolved_penalty(self, cell)
         object.__setattr__(self, "cell_scene", cell)
+
+
+def check_resolved_penalty(scene: DirectScene, cell) -> None:
+    """The cell's ``k_n`` on the resolved interface, meshed at ``eps / elements_per_period``
+    (:func:`ngcontact.scene.magnitudes.check_penalty_ratio`; ``k_n`` is used as the cell gives it)."""
+    g, d = scene.geometry, scene.discretization
+    E, _ = magnitudes.softer(scene.materials, (scene.bodies.rough, scene.bodies.counter))
+    h = resolved_shape(g).interface_length() / g.periods / d.elements_per_period
+    magnitudes.check_penalty_ratio("geometry.cell", cell.contact.k_n, "the cell's k_n", h,
+                                   "the resolved interface mesh size", E, shown=g.cell)
 
 
 def _check_blocks_study(scene: DirectScene) -> None:

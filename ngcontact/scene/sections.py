@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 from ngcontact.errors import MISSING, SceneError
 from ngcontact.fem import materials as _materials
+from ngcontact.scene import magnitudes
 from ngcontact.scene.mesh_size import MAX_ELEMENTS
 from ngcontact.scene.schema import MAX_ORDER, at_least, closed_interval, given_field, open_interval, param, positive
 
@@ -23,7 +24,9 @@ from ngcontact.scene.schema import MAX_ORDER, at_least, closed_interval, given_f
 class MaterialSpec:
     """Elastic material: isotropic ``(E, nu)`` or anisotropic ``C``."""
 
-    E: float | None = param(None, doc="Young's modulus (isotropic)", units="Pa", check=positive())
+    E: float | None = param(None, doc="Young's modulus (isotropic); within [1e-20, 1e20] (a stress unit's range) and "
+                            "at most 1e10 times the other body's (double precision), each load at most E of the "
+                            "softer body (a strain of 1): ngcontact.scene.magnitudes", units="Pa", check=positive())
     nu: float | None = param(None, doc="Poisson's ratio (isotropic)", check=open_interval(-1, 0.5))
     C: tuple[tuple[float, ...], ...] | None = param(
         None, doc="6x6 Voigt stiffness matrix, order 11,22,33,23,13,12 with engineering shear strains",
@@ -40,11 +43,12 @@ class MaterialSpec:
                 raise SceneError(path + ".E", MISSING, "required (or give C); a number > 0")
             if self.nu is None:
                 raise SceneError(path + ".nu", MISSING, "required (or give C); a number in (-1, 0.5)")
-            return
-        try:
-            _materials.anisotropic(self.C)
-        except ValueError as exc:
-            raise SceneError(path + ".C", self.C, str(exc).replace("C ", "", 1)) from None
+        else:
+            try:
+                _materials.anisotropic(self.C)
+            except ValueError as exc:
+                raise SceneError(path + ".C", self.C, str(exc).replace("C ", "", 1)) from None
+        magnitudes.check_modulus(self, path)
 
 @dataclass(frozen=True, kw_only=True)
 class Discretization:

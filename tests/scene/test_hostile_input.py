@@ -44,16 +44,22 @@ def test_a_gap_or_jump_beyond_the_length_range(tmp_path, capsys, old, new, key, 
             "which the geometry's sizes fall in [1e-09, 1e+09]")
 
 
-def test_the_strain_of_a_load_far_beyond_the_modulus_is_warned_not_an_overflow(tmp_path, caplog):
-    """Was: 'unexpected error (OverflowError)', exit 3: the far-face strain squared the jump of 1e300 / E.  The
-    linear cell's answer is finite; its strain is recorded and warned as beyond small strain."""
+def test_the_strain_of_a_load_beyond_small_strain_is_warned_and_one_beyond_the_modulus_refused(tmp_path, caplog,
+                                                                                                 capsys):
+    """Was: 'unexpected error (OverflowError)', exit 3: the far-face strain squared the jump of 1e300 / E; then
+    exit 0 with a far-face strain of 1e300, warned.  A load straining the bodies beyond small strain but less
+    than by their own size is solved, its strain recorded and warned; one beyond it (1e300 here) is refused
+    before the solve (:mod:`ngcontact.scene.magnitudes`, tests/scene/test_absurd_magnitudes.py)."""
     scene = tmp_path / "scene.toml"
-    scene.write_text(edit(SPECTRAL, ("pressure = [0.005]", "pressure = [1e300]")))
+    scene.write_text(edit(SPECTRAL, ("pressure = [0.005]", "pressure = [0.5]")))
     with caplog.at_level(logging.WARNING):
         assert cli.main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert any("is beyond small strain" in r.getMessage() for r in caplog.records)
     load = json.loads((tmp_path / "out" / "report.json").read_text())["results"]["loads"][0]
-    assert 1e299 < load["far_face_strain"] < 1e302
+    assert 0.05 < load["far_face_strain"] < 1.0
+    (tmp_path / "refused").mkdir()
+    run_bad(tmp_path / "refused", capsys, edit(SPECTRAL, ("pressure = [0.005]", "pressure = [1e300]")),
+            "load.pressure[0] = 1e+300: strains the softer body (materials.solid, E = 1) by 1e+300; ", prefix=True)
 
 
 HEIGHT_MAP = sinusoid_cell(discretization='method = "spectral"\ntolerance = 0.1', profile="height_map")
