@@ -51,7 +51,9 @@ SAMPLES, SEED = 64, 3
 TOLERANCE = 0.01
 #: the reference grid (the largest spectral grid a 3D cell accepts) and the grid half as fine beside it
 REFERENCE = 2048
-TAMAAS_GRID, TAMAAS_TOL = 512, 1e-10
+#: Tamaas' tolerance bounds its own residual (the relative orthogonality of pressure and gap), not the contact
+#: fraction: the row is timed at TAMAAS_TOL and the contact fractions are checked against TAMAAS_TIGHT
+TAMAAS_GRID, TAMAAS_TOL, TAMAAS_TIGHT = 512, 1e-4, 1e-10
 KEYS = ("solver", "load", "pressure", "grid", "contact_fraction", "estimate", "estimate_relative", "reference",
         "reference_half", "reference_richardson", "true_error", "true_error_relative", "error_to_richardson",
         "effectivity", "within_2_percent", "effectivity_in_1_10", "seconds", "solve_seconds", "note")
@@ -91,6 +93,16 @@ method = "spectral"
 def cutoff(samples: int) -> float:
     """The spectrum's short-wavelength cut-off: 1/32 of the period, at least two of the map's grid steps."""
     return max(1 / 32, 2 / samples)
+
+
+def map_gap(grid: int, samples: int = SAMPLES) -> np.ndarray:
+    """The scene's initial gap on ``grid x grid`` points: ``max H - H`` of the map's bilinear interpolant, as
+    :func:`ngcontact.drivers.cell_gap.gap_samples` samples it (a rigid surface of height ``-gap`` for Tamaas)."""
+    from ngcontact.geometry import cell3d
+    from ngcontact.geometry.random_surface import as_height_map, self_affine
+    heights = as_height_map(self_affine(dim=3, grid=samples, period=1.0, hurst=0.8, rms_slope=0.1, rolloff=0.25,
+                                        cutoff=cutoff(samples), seed=SEED))
+    return cell3d.bilinear_samples(heights.max() - heights, 1.0, grid)
 
 
 def scene_text(discretization: str, samples: int = SAMPLES) -> str:
@@ -160,24 +172,30 @@ def tamaas_row(out: str, quick: bool) -> dict:
     except ImportError:
         row["note"] = "skipped: tamaas is not importable here (pip extra bench)"
         return row
-    from ngcontact.geometry import cell3d
-    from ngcontact.geometry.random_surface import as_height_map, self_affine
-    samples = 16 if quick else SAMPLES
-    heights = as_height_map(self_affine(dim=3, grid=samples, period=1.0, hurst=0.8, rms_slope=0.1, rolloff=0.25,
-                                        cutoff=cutoff(samples), seed=SEED))
-    surface = -cell3d.bilinear_samples(heights.max() - heights, 1.0, TAMAAS_GRID)
+    surface = -map_gap(TAMAAS_GRID, 16 if quick else SAMPLES)
     tm.set_log_level(tm.LogLevel.error)
-    found = []
+
+    def solve(tol: float) -> list[float]:
+        found = []
+        for p in PRESSURES:
+            model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, 1.0], [TAMAAS_GRID, TAMAAS_GRID])
+            model.E, model.nu = E_STAR, 0.0  # Tamaas' E* = E / (1 - nu^2) = the pair's E / (2 (1 - nu^2))
+            solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(surface), tol)
+            solver.max_iter = 100000
+            solver.solve(p)  # the mean pressure p
+            found.append(float(np.mean(np.asarray(model.traction) > 0)))
+        return found
+
     t0 = time.perf_counter()
-    for p in PRESSURES:
-        model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, 1.0], [TAMAAS_GRID, TAMAAS_GRID])
-        model.E, model.nu = E_STAR, 0.0
-        solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(surface), TAMAAS_TOL)
-        solver.max_iter = 100000
-        solver.solve(p)
-        found.append(float(np.mean(np.asarray(model.traction) > 0)))
-    row.update(seconds=time.perf_counter() - t0,
-               note="half-space contact fractions " + ", ".join(f"{f:.4g}" for f in found) + " (time only)")
+    found = solve(TAMAAS_TOL)
+    seconds = time.perf_counter() - t0
+    tight = solve(TAMAAS_TIGHT)
+    drift = max(abs(a - b) / b for a, b in zip(found, tight))
+    row.update(seconds=seconds,
+               note=f"tolerance {TAMAAS_TOL:g}; half-space contact fractions "
+                    + ", ".join(f"{f:.4g}" for f in found)
+                    + f" (time only: a half-space, not the layers); they differ from tolerance {TAMAAS_TIGHT:g}'s "
+                      f"by at most {100 * drift:.2g} %")
     return row
 
 
