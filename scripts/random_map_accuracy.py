@@ -35,6 +35,7 @@ import os
 import subprocess
 import sys
 import time
+from typing import Any
 
 import numpy as np
 
@@ -165,7 +166,7 @@ def ngcontact_rows(out: str, quick: bool) -> list[dict]:
 
 def tamaas_row(out: str, quick: bool) -> dict:
     """Tamaas' Polonsky-Keer-Rey on the bilinear surface on 512 x 512 points, the three loads; or why not."""
-    row = {key: "" for key in KEYS}
+    row: dict[str, Any] = {key: "" for key in KEYS}
     row.update(solver="tamaas PolonskyKeerRey", grid=TAMAAS_GRID)
     try:
         import tamaas as tm

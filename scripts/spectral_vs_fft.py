@@ -172,7 +172,8 @@ def random_map(quick: bool) -> list[dict]:
     t0 = time.perf_counter()
     cell = SpectralCell(dim=3, period=1.0, grid=n, rough=Layer(E, NU, THICK), counter=Layer(E, NU, THICK), gap=g0,
                         k_n=1.0, enforcement="exact", tol=TOL, max_iter=100000)
-    ends, sols = [], []
+    ends: list[float] = []
+    sols: list = []
     for p in rma.PRESSURES:  # as SpectralCell.sweep: each load from the previous one's pressure, timed one by one
         sols.append(cell.solve(cell_load(3, pressure=p), start=sols[-1].fields["pressure"] if sols else None))
         ends.append(time.perf_counter())
