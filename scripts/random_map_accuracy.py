@@ -21,6 +21,10 @@ contact fraction within 2 % of the converged value, each effectivity in [1, 10],
 Tamaas' Polonsky-Keer-Rey solver on 512 x 512 points for the same three loads: that row is measured where
 ``import tamaas`` works (the ``bench`` extra; one half-space of the pair's ``E* = E / (2 (1 - nu^2))``
 against the rigid bilinear surface on 512 x 512 points) and says why it is skipped where it does not.
+Tamaas stops at its own relative residual, not at an error of the contact fraction: its row is timed at
+``TAMAAS_TOL`` and its contact fractions are compared with a solve at ``TAMAAS_TIGHT`` (the row's note gives
+their largest difference), so that the time compared is that of an answer converged far below the 1 % posed
+to ours.
 
     python scripts/random_map_accuracy.py [OUT] [--quick] [--publish]
 
@@ -35,6 +39,7 @@ import os
 import subprocess
 import sys
 import time
+from typing import Any
 
 import numpy as np
 
@@ -51,7 +56,9 @@ SAMPLES, SEED = 64, 3
 TOLERANCE = 0.01
 #: the reference grid (the largest spectral grid a 3D cell accepts) and the grid half as fine beside it
 REFERENCE = 2048
-TAMAAS_GRID, TAMAAS_TOL = 512, 1e-10
+#: Tamaas' tolerance bounds its own residual (the relative orthogonality of pressure and gap), not the contact
+#: fraction: the row is timed at TAMAAS_TOL and the contact fractions are checked against TAMAAS_TIGHT
+TAMAAS_GRID, TAMAAS_TOL, TAMAAS_TIGHT = 512, 1e-4, 1e-10
 KEYS = ("solver", "load", "pressure", "grid", "contact_fraction", "estimate", "estimate_relative", "reference",
         "reference_half", "reference_richardson", "true_error", "true_error_relative", "error_to_richardson",
         "effectivity", "within_2_percent", "effectivity_in_1_10", "seconds", "solve_seconds", "note")
@@ -91,6 +98,16 @@ method = "spectral"
 def cutoff(samples: int) -> float:
     """The spectrum's short-wavelength cut-off: 1/32 of the period, at least two of the map's grid steps."""
     return max(1 / 32, 2 / samples)
+
+
+def map_gap(grid: int, samples: int = SAMPLES) -> np.ndarray:
+    """The scene's initial gap on ``grid x grid`` points: ``max H - H`` of the map's bilinear interpolant, as
+    :func:`ngcontact.drivers.cell_gap.gap_samples` samples it (a rigid surface of height ``-gap`` for Tamaas)."""
+    from ngcontact.geometry import cell3d
+    from ngcontact.geometry.random_surface import as_height_map, self_affine
+    heights = as_height_map(self_affine(dim=3, grid=samples, period=1.0, hurst=0.8, rms_slope=0.1, rolloff=0.25,
+                                        cutoff=cutoff(samples), seed=SEED))
+    return cell3d.bilinear_samples(heights.max() - heights, 1.0, grid)
 
 
 def scene_text(discretization: str, samples: int = SAMPLES) -> str:
@@ -153,31 +170,37 @@ def ngcontact_rows(out: str, quick: bool) -> list[dict]:
 
 def tamaas_row(out: str, quick: bool) -> dict:
     """Tamaas' Polonsky-Keer-Rey on the bilinear surface on 512 x 512 points, the three loads; or why not."""
-    row = {key: "" for key in KEYS}
+    row: dict[str, Any] = {key: "" for key in KEYS}
     row.update(solver="tamaas PolonskyKeerRey", grid=TAMAAS_GRID)
     try:
         import tamaas as tm
     except ImportError:
         row["note"] = "skipped: tamaas is not importable here (pip extra bench)"
         return row
-    from ngcontact.geometry import cell3d
-    from ngcontact.geometry.random_surface import as_height_map, self_affine
-    samples = 16 if quick else SAMPLES
-    heights = as_height_map(self_affine(dim=3, grid=samples, period=1.0, hurst=0.8, rms_slope=0.1, rolloff=0.25,
-                                        cutoff=cutoff(samples), seed=SEED))
-    surface = -cell3d.bilinear_samples(heights.max() - heights, 1.0, TAMAAS_GRID)
+    surface = -map_gap(TAMAAS_GRID, 16 if quick else SAMPLES)
     tm.set_log_level(tm.LogLevel.error)
-    found = []
+
+    def solve(tol: float) -> list[float]:
+        found = []
+        for p in PRESSURES:
+            model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, 1.0], [TAMAAS_GRID, TAMAAS_GRID])
+            model.E, model.nu = E_STAR, 0.0  # Tamaas' E* = E / (1 - nu^2) = the pair's E / (2 (1 - nu^2))
+            solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(surface), tol)
+            solver.max_iter = 100000
+            solver.solve(p)  # the mean pressure p
+            found.append(float(np.mean(np.asarray(model.traction) > 0)))
+        return found
+
     t0 = time.perf_counter()
-    for p in PRESSURES:
-        model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, 1.0], [TAMAAS_GRID, TAMAAS_GRID])
-        model.E, model.nu = E_STAR, 0.0
-        solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(surface), TAMAAS_TOL)
-        solver.max_iter = 100000
-        solver.solve(p)
-        found.append(float(np.mean(np.asarray(model.traction) > 0)))
-    row.update(seconds=time.perf_counter() - t0,
-               note="half-space contact fractions " + ", ".join(f"{f:.4g}" for f in found) + " (time only)")
+    found = solve(TAMAAS_TOL)
+    seconds = time.perf_counter() - t0
+    tight = solve(TAMAAS_TIGHT)
+    drift = max(abs(a - b) / b for a, b in zip(found, tight))
+    row.update(seconds=seconds,
+               note=f"tolerance {TAMAAS_TOL:g}; half-space contact fractions "
+                    + ", ".join(f"{f:.4g}" for f in found)
+                    + f" (time only: a half-space, not the layers); they differ from tolerance {TAMAAS_TIGHT:g}'s "
+                      f"by at most {100 * drift:.2g} %")
     return row
 
 
