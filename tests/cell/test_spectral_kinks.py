@@ -40,7 +40,7 @@ def test_the_kinks_of_a_piecewise_linear_map_are_its_samples_and_a_sinusoid_has_
     assert not kinks(np.full(64, 0.3)).any()                    # no curvature at all: rounding is no kink
 
 
-def test_an_edge_within_a_step_of_a_kink_holds_a_step_of_each_quantity_on_the_edges():
+def test_an_edge_within_a_step_of_a_kink_holds_a_step_of_each_quantity_on_the_edges_and_a_notch_its_width():
     n, k_n = 64, 1e3
     x = np.arange(n, dtype=float)
     g0 = np.where(x <= 20, 1e-4 * (x - 10) ** 2, 0.01 + 0.02 * (x - 20))       # a parabola, a kink at 20, a line
@@ -56,6 +56,13 @@ def test_an_edge_within_a_step_of_a_kink_holds_a_step_of_each_quantity_on_the_ed
     far = np.where((x >= 5) & (x <= 15), 1.0, 0.0)                # both edges five steps or more from the kink
     assert kink_share(cell, far, gap)["share"] == {} and kink_share(cell, np.ones(n), gap)["edges"] == 0
     assert unresolved_share(cell, p)["kinks"]["edges"] == 0     # without the deformed gap: not located
+    # a notch: one open point at the kink inside contact, located a step wide between contact points two apart,
+    # its error at most max(1, 2 - 1) steps; its two edges are not counted on their own
+    notched = np.where((x >= 5) & (x <= 25) & (x != 20), 1.0, 0.0)
+    share = kink_share(cell, notched, np.where(notched > 0, 0.0, np.minimum(np.abs(x - 25.5), np.abs(x - 4.5))))
+    assert (share["edges"], share["notches"]) == (2, 1)
+    assert share["share"]["contact_fraction"] == pytest.approx(1 / n)
+    assert share["share"]["coefficient_g_n"] == pytest.approx(k_n * g0[17:24].max() / n)
 
 
 def test_on_the_seed_1_profile_an_edge_pinned_to_a_kink_is_bounded_and_flagged():
