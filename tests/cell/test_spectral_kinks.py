@@ -52,7 +52,7 @@ def test_an_edge_within_a_step_of_a_kink_holds_a_step_of_each_quantity_on_the_ed
     assert share["edges"] == 1
     assert share["share"]["contact_fraction"] == pytest.approx(1 / n)
     assert share["share"]["coefficient_k_n"] == pytest.approx(k_n / n)
-    assert share["share"]["coefficient_g_n"] == pytest.approx(k_n * g0[18:24].max() / n)
+    assert share["share"]["coefficient_g_n"] == pytest.approx(k_n * g0[19:23].max() / n)
     far = np.where((x >= 5) & (x <= 15), 1.0, 0.0)                # both edges five steps or more from the kink
     assert kink_share(cell, far, gap)["share"] == {} and kink_share(cell, np.ones(n), gap)["edges"] == 0
     assert unresolved_share(cell, p)["kinks"]["edges"] == 0     # without the deformed gap: not located
@@ -62,7 +62,7 @@ def test_an_edge_within_a_step_of_a_kink_holds_a_step_of_each_quantity_on_the_ed
     share = kink_share(cell, notched, np.where(notched > 0, 0.0, np.minimum(np.abs(x - 25.5), np.abs(x - 4.5))))
     assert (share["edges"], share["notches"]) == (2, 1)
     assert share["share"]["contact_fraction"] == pytest.approx(1 / n)
-    assert share["share"]["coefficient_g_n"] == pytest.approx(k_n * g0[17:24].max() / n)
+    assert share["share"]["coefficient_g_n"] == pytest.approx(k_n * g0[18:23].max() / n)
 
 
 def test_on_the_seed_1_profile_an_edge_pinned_to_a_kink_is_bounded_and_flagged():

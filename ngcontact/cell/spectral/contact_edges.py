@@ -58,7 +58,8 @@ sample on 1024 to 8192 points, off it by a fifth of the 4096 grid's step on 65,5
 stalls at a third of a step while its differences fall tenfold).  Where the edge's true position lies within one
 step of the kink, moving the located edge by one step bounds its error: the contact fraction changes by ``h /
 P``, ``K0 = k_n |S| / |T|`` by ``k_n h / P`` and ``g_n = k_n mean(1_S g0)`` by at most ``k_n h / P`` times the
-largest ``g0`` within two steps of the edge (:func:`kink_share`), summed over such edges.
+largest ``g0`` within a step of the edge (the grid points bounding the piecewise-linear ``g0`` there;
+:func:`kink_share`), summed over such edges.
 The refinement takes that share as a floor on the estimate of each quantity on the edges, as an island's
 (:func:`island_floor`, form :data:`KINK`).  The floor rests on the edge lying within a step of the kink, which
 no difference shows (its premise: an edge pinned to a kink lies at it to a fraction of a step on each grid that
@@ -195,7 +196,7 @@ def kinks(g0: np.ndarray) -> np.ndarray:
 def kink_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
     """The share of each quantity on the edges held by the 2D contact edges of a pressure ``p`` (``gap`` the
     deformed gap the edges are located on) that lie within one grid step of a kink of the cell's gap ``g0``
-    (:func:`kinks`): one step per such edge, ``g_n``'s at the largest ``g0`` within two steps of the edge; a notch
+    (:func:`kinks`): one step per such edge, ``g_n``'s at the largest ``g0`` within a step of the edge; a notch
     (an open run of fewer than :data:`ISLAND_POINTS` points both of whose edges are such) ``max(w, s - w)`` steps,
     its located width ``w`` against the ``s`` steps between its contact points (module docstring).
     ``{"edges": how many, "notches": how many, "share": {headline name: absolute share}}``; no share without."""
@@ -208,8 +209,9 @@ def kink_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
     for step in (1, -1):
         for i in (int(j) for j in np.flatnonzero(on & ~np.roll(on, -step))):
             t = edge_offset(root, on, i, step)[0]
-            edges[i, step] = (t, bool(np.min(np.abs((at - i - step * t + n / 2) % n - n / 2)) <= 1.0),
-                              float(cell.g0[(i + step * np.arange(-2, 4)) % n].max()))
+            x = i + step * t
+            reach = np.arange(int(np.floor(x - 1.0)), int(np.ceil(x + 1.0)) + 1) % n   # the steps it may move across
+            edges[i, step] = (t, bool(np.min(np.abs((at - x + n / 2) % n - n / 2)) <= 1.0), float(cell.g0[reach].max()))
     steps_heights, notches = [], 0
     for first, w in islands(~on):                        # a notch: both edges of a short open run at a kink
         right, left = ((first - 1) % n, 1), ((first + w) % n, -1)
