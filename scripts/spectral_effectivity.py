@@ -9,7 +9,8 @@ whole-surface values: ``ngcontact.cell.cell_solution.measure``) is held against 
 measure: the difference from the same cell's value on a much finer grid (the cells have layers of finite depth, so a
 half-space formula is not their converged value).  The ratio is the effectivity (issue 35 asks for it
 between 1 and 10 on every oracle); the form of each estimate (Richardson, the guarded bound, or carried from
-a grid where a stop waited, or the share of unresolved contact islands), the true error of the grid twice as
+a grid where a stop waited, the share of unresolved contact islands, or a step at each 2D edge within a step
+of a kink of the profile's piecewise-linear interpolant), the true error of the grid twice as
 fine, whether the reported one is small by chance, and the estimator's own flag where it states that its
 estimate may exceed the error by more than ten times (``ngcontact.cell.spectral.estimate_forms``) are listed
 beside it.
@@ -295,7 +296,9 @@ def main(argv=None) -> int:
                               "smaller: `carried`; at least the share of contact islands of fewer than four "
                               "points (3D: across), their points and a step beyond: `island`; a window across the "
                               "level where a load's last such island came to be resolved also estimated on the "
-                              "resolved levels alone, at least three, the smaller); a tolerance not "
+                              "resolved levels alone, at least three, the smaller; in 2D at least a grid step per "
+                              "contact edge within a step of a kink of a profile's piecewise-linear interpolant, "
+                              "where the edge may stay pinned over grids: `kink`); a tolerance not "
                               "met within the study's largest grid reports nothing. The true error of the reported "
                               "grid is against the same cell on a much finer grid; `next_error` is that of the grid "
                               "twice as fine, `reference_change` the reference's own change from the grid of half "
@@ -303,7 +306,7 @@ def main(argv=None) -> int:
                               "grid's edge localisation alone: the reference's own pressure and gap sampled on the "
                               "grid, their edges located there, against the reference. `flag`: the estimator's own "
                               "statement that its estimate may exceed the error by more than ten times (a "
-                              "guarded or carried estimate above ten times the error its last difference "
+                              "guarded, carried or kink estimate above ten times the error its last difference "
                               "leaves at the last contraction, not an island's share, whose stalled error the last "
                               "difference does not measure, or an estimate of any form above ten times the error "
                               "it leaves at the contraction before where the last two disagree, the last twice as "

@@ -45,6 +45,36 @@ resolved on the last ``r`` levels (:func:`resolved_run`) only, ``r`` at least th
 those ``r`` levels alone by the same rule, and the smaller estimate is reported (each bounds the error on its
 own argument; on the edges' quantities the levels must also be the quartic's where any are).  An island
 still unresolved on the last level keeps its floor; a window of resolved levels is left as it is.
+
+**An edge at a kink of the map.**  A height map's surface is the piecewise-linear interpolant of its samples
+(:mod:`~ngcontact.drivers.cell_gap`): its gap ``g0`` has a slope that jumps at each sample, ``g0''`` a Dirac
+there.  Beside such a kink the gap beyond an edge is not ``(x - a)^(3/2)``: the edge's position is set by the
+pressure's balance against a gap whose curvature is concentrated at one point, and it converges only once the
+grid resolves the kink's neighbourhood, not at the first order of a smooth edge.  An edge located within a grid
+step of a kink (:func:`kinks`: points whose second difference of ``g0`` exceeds :data:`KINK_RATIO` times those
+two points away, a Dirac among the smooth or zero curvature of the segments beside it) may thus stall
+over several grids, pinned to the kink while the differences shrink (random profiles of 64 samples: an edge at a
+sample on 1024 to 8192 points, off it by a fifth of the 4096 grid's step on 65,536; the contact fraction's error
+stalls at a third of a step while its differences fall tenfold).  Where the edge's true position lies within one
+step of the kink, moving the located edge by one step bounds its error: the contact fraction changes by ``h /
+P``, ``K0 = k_n |S| / |T|`` by ``k_n h / P`` and ``g_n = k_n mean(1_S g0)`` by at most ``k_n h / P`` times the
+largest ``g0`` within a step of the edge (the grid points bounding the piecewise-linear ``g0`` there;
+:func:`kink_share`), summed over such edges.
+The refinement takes that share as a floor on the estimate of each quantity on the edges, as an island's
+(:func:`island_floor`, form :data:`KINK`).  The floor rests on the edge lying within a step of the kink, which
+no difference shows (its premise: an edge pinned to a kink lies at it to a fraction of a step on each grid that
+does not resolve it); it falls like ``h``, and exceeds the error of an edge located to a fraction ``f`` of a step
+by ``1 / f``, so that an estimate it sets above ``LOOSE`` times the error the last difference
+leaves is flagged (:mod:`~ngcontact.cell.spectral.estimate_forms`).  A notch (an open run of fewer than
+:data:`ISLAND_POINTS` points inside contact at a kink where the map's valley is sharper than the pressed surface
+follows) has both edges within a step of its kink: its true width lies between nothing and the ``s`` steps
+between its two contact points (a wider one would open a point more), so its error is at most ``max(w, s - w)``
+steps, ``w`` its located width (one open point located a step wide, the notch far narrower: on the random
+profile of seed 9 at p = 0.01 the located width halves with the step); one that no grid point sees yet is not
+bounded here (on
+the random profile of seed 6 at p = 0.003 such a notch carries half the 4096 grid's error in the contact
+fraction, within the step of each of its load's two other edges at kinks).  A smooth gap (``g0''`` continuous)
+has no kinks, and in 3D the points are counted, no edge located between them.
 """
 from __future__ import annotations
 
@@ -54,12 +84,16 @@ import numpy as np
 from scipy import ndimage
 
 from ngcontact.cell.cell_solution import COEFFICIENT, scale
-from ngcontact.cell.spectral.grid_measures import coefficients
+from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset
 
 #: the fewest collocation points of a resolved 2D contact island (module docstring)
 ISLAND_POINTS = 4
 #: the form of an estimate raised to the floor of the unresolved islands, as the report names it
 ISLAND = "island"
+#: the form of an estimate raised to the floor of the edges beside a kink of the map (module docstring)
+KINK = "kink"
+#: a point's second difference of the gap over the smaller of its neighbours' that makes it a kink
+KINK_RATIO = 4.0
 
 
 def on_edges(name: str) -> bool:
@@ -148,11 +182,60 @@ def narrow_islands(on: np.ndarray) -> tuple[np.ndarray, int, int]:
     return narrow[labels], int(narrow.sum()), int(np.bincount(labels.ravel())[1:].min())
 
 
-def unresolved_share(cell, p: np.ndarray) -> dict[str, Any]:
+def kinks(g0: np.ndarray) -> np.ndarray:
+    """The points of a periodic 1D gap at a kink of its piecewise-linear interpolant (module docstring): whose
+    second difference ``c_i = |g_(i-1) - 2 g_i + g_(i+1)|`` exceeds :data:`KINK_RATIO` times the larger of
+    ``c_(i-2)`` and ``c_(i+2)``, and rounding.  A Dirac of ``g0''`` falls on the one or two points beside the kink
+    (on a point, or between two), while a smooth curvature varies little over two steps: where it crosses zero
+    linearly, ``c_i = a |x_i|`` lies below ``a (|x_i| + 2 h)``, the larger of the two."""
+    c = np.abs(np.roll(g0, 1) - 2.0 * g0 + np.roll(g0, -1))
+    beside = np.maximum(np.roll(c, 2), np.roll(c, -2))
+    return (c > KINK_RATIO * beside) & (c > 1e3 * np.finfo(float).eps * float(np.abs(g0).max()))
+
+
+def kink_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
+    """The share of each quantity on the edges held by the 2D contact edges of a pressure ``p`` (``gap`` the
+    deformed gap the edges are located on) that lie within one grid step of a kink of the cell's gap ``g0``
+    (:func:`kinks`): one step per such edge, ``g_n``'s at the largest ``g0`` within a step of the edge; a notch
+    (an open run of fewer than :data:`ISLAND_POINTS` points both of whose edges are such) ``max(w, s - w)`` steps,
+    its located width ``w`` against the ``s`` steps between its contact points (module docstring).
+    ``{"edges": how many, "notches": how many, "share": {headline name: absolute share}}``; no share without."""
+    on, n = p > 0, p.size
+    at = np.flatnonzero(kinks(cell.g0))
+    if cell.dim != 2 or on.all() or not on.any() or at.size == 0:
+        return {"edges": 0, "notches": 0, "share": {}}
+    root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
+    edges = {}                                           # (last contact point, step): (offset, kinked, largest g0)
+    for step in (1, -1):
+        for i in (int(j) for j in np.flatnonzero(on & ~np.roll(on, -step))):
+            t = edge_offset(root, on, i, step)[0]
+            x = i + step * t
+            reach = np.arange(int(np.floor(x - 1.0)), int(np.ceil(x + 1.0)) + 1) % n   # the steps it may move across
+            edges[i, step] = (t, bool(np.min(np.abs((at - x + n / 2) % n - n / 2)) <= 1.0), float(cell.g0[reach].max()))
+    steps_heights, notches = [], 0
+    for first, w in islands(~on):                        # a notch: both edges of a short open run at a kink
+        right, left = ((first - 1) % n, 1), ((first + w) % n, -1)
+        if w < ISLAND_POINTS and edges[right][1] and edges[left][1]:
+            located = w + 1 - edges[right][0] - edges[left][0]
+            steps_heights.append((max(located, w + 1 - located), max(edges[right][2], edges[left][2])))
+            del edges[right], edges[left]
+            notches += 1
+    steps_heights += [(1.0, height) for _, kinked, height in edges.values() if kinked]
+    count = len(steps_heights) + notches
+    if not steps_heights:
+        return {"edges": 0, "notches": 0, "share": {}}
+    steps = sum(s for s, _ in steps_heights)
+    return {"edges": count, "notches": notches, "share": {
+        "contact_fraction": steps / n, COEFFICIENT + "k_n": cell.k_n * steps / n,
+        COEFFICIENT + "g_n": cell.k_n * sum(s * h for s, h in steps_heights) / n}}
+
+
+def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict[str, Any]:
     """The share of each quantity on the edges held by the islands of fewer than :data:`ISLAND_POINTS`
     points of a pressure ``p`` (in 3D: points across, :func:`narrow_islands`; module docstring):
     ``{"points": the smallest island's points (0 without islands), "islands": how many are unresolved,
-    "share": {headline name: absolute share}}``; no share without such islands."""
+    "share": {headline name: absolute share}, "kinks": the share of the edges beside a kink of the map}``
+    (:func:`kink_share`, 2D with the deformed ``gap``); no share without such islands or edges."""
     mask = np.zeros(p.shape, bool)
     if cell.dim == 2:
         runs = islands(p > 0)
@@ -165,7 +248,9 @@ def unresolved_share(cell, p: np.ndarray) -> dict[str, Any]:
         mask = narrow.copy()
         for axis in (0, 1):                                         # the island and its open 4-neighbours
             mask |= np.roll(narrow, 1, axis=axis) | np.roll(narrow, -1, axis=axis)
-    out: dict[str, Any] = {"points": points, "islands": count, "share": {}}
+    out: dict[str, Any] = {"points": points, "islands": count, "share": {},
+                           "kinks": kink_share(cell, p, gap) if gap is not None else {"edges": 0, "notches": 0,
+                                                                                      "share": {}}}
     if count:
         whole = coefficients(cell, mask).as_dict()
         out["share"] = {"contact_fraction": whole["contact_fraction"], COEFFICIENT + "k_n": whole["k_n"],
@@ -181,14 +266,22 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
     last = history[-1]
     remarks = []
     for k, (per_load, unresolved) in enumerate(zip(estimates, last.get("islands", []))):
-        raised = []
-        for name, share in unresolved["share"].items():
-            if name in per_load and (floor := share / scale(name, last["headline"][k], last["whole_surface"])
-                                     ) > per_load[name]:
-                per_load[name], forms[k][name] = floor, ISLAND
-                raised.append(name)
-        if raised:
-            remarks.append(f"load {k}: {unresolved['islands']} contact island(s) of fewer than {ISLAND_POINTS} "
-                           f"points (in 3D across; the smallest island {unresolved['points']} point(s)) on grid "
-                           f"{last['grid']}: {', '.join(raised)} bounded by their share, one step beyond each edge")
+        for form, shares in ((ISLAND, unresolved["share"]), (KINK, unresolved.get("kinks", {}).get("share", {}))):
+            raised = []
+            for name, share in shares.items():
+                if name in per_load and (floor := share / scale(name, last["headline"][k], last["whole_surface"])
+                                         ) > per_load[name]:
+                    per_load[name], forms[k][name] = floor, form
+                    raised.append(name)
+            if raised and form == ISLAND:
+                remarks.append(f"load {k}: {unresolved['islands']} contact island(s) of fewer than {ISLAND_POINTS} "
+                               f"points (in 3D across; the smallest island {unresolved['points']} point(s)) on grid "
+                               f"{last['grid']}: {', '.join(raised)} bounded by their share, one step beyond each "
+                               "edge")
+            elif raised:
+                kinked = unresolved["kinks"]
+                remarks.append(f"load {k}: {kinked['edges']} contact edge(s) within a step of a kink of the map on "
+                               f"grid {last['grid']} ({kinked['notches']} notch(es) of fewer than {ISLAND_POINTS} open "
+                               f"points at one): {', '.join(raised)} bounded by a step at each edge, a notch by its "
+                               "width or the rest of the steps between its contact points")
     return remarks

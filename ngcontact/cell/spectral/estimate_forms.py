@@ -1,33 +1,35 @@
 """The forms of the spectral refinement's estimate, and the estimates that may be loose by much.
 
 :mod:`~ngcontact.cell.spectral.refinement` estimates the error of each headline quantity of a load on the
-reported grid ``k`` in one of four forms, which the report names: Richardson's tail with the observed rate
+reported grid ``k`` in one of five forms, which the report names: Richardson's tail with the observed rate
 (:data:`RICHARDSON`), the guarded geometric tail (:data:`GUARDED`), the estimate of a deferred grid plus the
-last difference (:data:`CARRIED`), or the share of contact islands too narrow for the grid
-(:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`).  Each is a bound on its own argument; none is sharp
-where the error of grid ``k`` is far below the differences that bound it.
+last difference (:data:`CARRIED`), the share of contact islands too narrow for the grid
+(:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), or a step at each 2D edge within a step of a kink of
+a map's piecewise-linear surface (:data:`~ngcontact.cell.spectral.contact_edges.KINK`). Each is a bound on its
+own argument; none is sharp where the error of grid ``k`` is far below the differences that bound it.
 
 The last two differences ``d_(k-1)``, ``d_k`` (``d_k = q_k - q_(k-1)``) say how large that error is in the
 model every form rests on: where the levels beyond ``k`` contract as the last one did, by ``rho = |d_k| /
 |d_(k-1)|`` (held to at most first order in the grid step, ``rho <= 1/2``: a slower last step is taken at
-first order), the error ``e_k = sum_(j > k) d_j`` is the tail left by the last difference,
-``|d_k| rho / (1 - rho)`` (:func:`tail_left`).  An estimate above :data:`LOOSE` times that tail (in the
-quantity's measure, :func:`~ngcontact.cell.cell_solution.measure`) therefore rests on something else than
-the last step: an earlier, larger difference (the guarded envelope: a first-order stretch before a faster
-regime, such as the 2D edges' quartic once it locates them, or an error that crossed zero) or the deferred
-grid's estimate carried over.  The error may then lie below the estimate by more than :data:`LOOSE` times,
-and the estimate is flagged with its reason (:func:`loose_flags`), listed in the report
-(:func:`loose_remarks`).  The flag never lowers an estimate: a fast last step is often followed by a
-first-order one (on Westergaard's sinusoid at a twentieth of its closing pressure the quartic's errors fall
-by about 16 per doubling twice, then by 2), and an earlier difference bounds the error where the last one
-vanished by coincidence (a stall, a symmetric cell).  Richardson's form states its rate and holds it to
-first order on purpose (the same sinusoid) and is not flagged by that tail.  Nor is an unresolved island's
-share (:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`): such an island's error stalls while the
-differences vanish (:mod:`~ngcontact.cell.spectral.contact_edges`), so the last difference measures neither
-its size nor how far it lies below the share.  The share exceeds that error by more than :data:`LOOSE`
-times only where the island's located width happens to be right to a tenth of its points and one step
-beyond each edge, which, like an error small by chance, no difference shows; the report names the island
-and its share instead.
+first order), the error ``e_k = sum_(j > k) d_j`` is the tail left by the last difference, ``|d_k| rho / (1 -
+rho)`` (:func:`tail_left`). An estimate above :data:`LOOSE` times that tail (in the quantity's measure,
+:func:`~ngcontact.cell.cell_solution.measure`) therefore rests on something else than the last step: an
+earlier, larger difference (the guarded envelope: a first-order stretch before a faster regime, such as the 2D
+edges' quartic once it locates them, or an error that crossed zero), the deferred grid's estimate carried
+over, or a step at an edge beside a kink of the map (a bound while the edge may be pinned to the kink; an edge
+located within a tenth of a step of its true place has an error more than :data:`LOOSE` times below it, and
+unlike an island's stalled share the last difference then shows it). The error may then lie below the estimate
+by more than :data:`LOOSE` times, and the estimate is flagged with its reason (:func:`loose_flags`), listed in
+the report (:func:`loose_remarks`). The flag never lowers an estimate: a fast last step is often followed by a
+first-order one (on Westergaard's sinusoid at a twentieth of its closing pressure the quartic's errors fall by
+about 16 per doubling twice, then by 2), and an earlier difference bounds the error where the last one
+vanished by coincidence (a stall, a symmetric cell). Richardson's form states its rate and holds it to first
+order on purpose (the same sinusoid) and is not flagged by that tail. Nor is an unresolved island's share
+(:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`): such an island's error stalls while the differences
+vanish (:mod:`~ngcontact.cell.spectral.contact_edges`), so the last difference measures neither its size nor
+how far it lies below the share. The share exceeds that error by more than :data:`LOOSE` times only where the
+island's located width happens to be right to a tenth of its points and one step beyond each edge, which, like
+an error small by chance, no difference shows; the report names the island and its share instead.
 
 Where the last two contractions disagree, the last at least :data:`DISAGREE` times slower than the one
 before (``|d_k| / |d_(k-1)| >= 2 |d_(k-1)| / |d_(k-2)|``: their observed orders in the grid step differ by
@@ -48,7 +50,7 @@ from __future__ import annotations
 from typing import Any
 
 from ngcontact.cell.cell_solution import scale
-from ngcontact.cell.spectral.contact_edges import ISLAND
+from ngcontact.cell.spectral.contact_edges import ISLAND, KINK
 
 #: the forms of the estimate, as the report names them (:data:`CARRIED`: after a deferred stop, module
 #: docstring of :mod:`~ngcontact.cell.spectral.refinement`)
@@ -61,7 +63,8 @@ DISAGREE = 2.0
 #: the slowest contraction per level the error left by the last difference is taken at (first order)
 FIRST_ORDER = 0.5
 #: why, per form of the estimate (module docstring)
-WHY_LOOSE = {GUARDED: "an earlier difference bounds it", CARRIED: "carried from the deferred grid"}
+WHY_LOOSE = {GUARDED: "an earlier difference bounds it", CARRIED: "carried from the deferred grid",
+             KINK: "a contact edge within a step of a kink of the map, bounded by a step there"}
 
 
 def loose_flags(history: list[dict[str, Any]], estimates: list[dict[str, float]], forms: list[dict[str, str]]

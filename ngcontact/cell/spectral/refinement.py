@@ -108,18 +108,18 @@ differences beside it where two grids' errors share their sign and size, as on W
 half its closing pressure) and reported, but not held to the tolerance (:data:`UNCONTROLLED`: listed in
 the verdict as not counted).
 
-Two checks end each level's estimate.  A contact island of fewer than
+Two checks end each level's estimate. A contact island of fewer than
 :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: its error may
 stall while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
-(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``); a window across the level where the last
-island came to be resolved is also taken on the resolved levels alone, the smaller reported (the same module's
-docstring).  An estimate (not Richardson's nor an island's) above
-:data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the last
-contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much:
-flagged with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
+(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``; a 2D edge within a step of a kink of a
+map's surface, one step: ``kink``); a window across the level where the last island came to be resolved is also taken
+on the resolved levels alone, the smaller reported (the same module's docstring). An estimate (not Richardson's nor an
+island's) above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at
+the last contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the error by
+as much: flagged with its reason, per quantity in the report
+(:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
-Levels double the points per direction (:data:`GROWTH`): close enough that three differences cost little
-more than the finest level (2D: twice the finest; 3D: 4/3 of it).
+Levels double the points per direction (:data:`GROWTH`): three differences cost twice the finest level in 2D, 4/3 in 3D.
 
 Its effectivity (estimate over the true error of the reported level) is measured by
 ``scripts/spectral_effectivity.py`` on Westergaard's sinusoid, a random 2D profile and a 3D bisinusoid
@@ -199,9 +199,9 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
        f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance; at least "
        f"the share of contact islands of fewer than {ISLAND_POINTS} points (3D: across), and after such islands "
-       f"also estimated on the resolved levels (at least {LOCATOR_LEVELS}), the smaller; an estimate above {LOOSE:g} "
-       "times the error its last difference leaves at the last rate, or at the rate before where the last is "
-       "twice as slow or more, flagged as possibly loose by as much (accuracy.quantities[].loose)")
+       f"also on the resolved levels (at least {LOCATOR_LEVELS}), the smaller; a step per 2D edge within a step of a "
+       f"kink of the map's piecewise-linear surface; above {LOOSE:g} times the error its last difference leaves at "
+       "the last rate, or the one before where the last is twice as slow or more: flagged (quantities[].loose)")
 
 
 @dataclass
@@ -396,7 +396,7 @@ def solve_level(make_cell: Callable[[int], Any], loads: list, n: int,
         "mean_closure": [s.results["mean_closure"] for s in sols],
         "headline": [headline(s.results) for s in sols],
         "edges_fitted": [edges_fitted(cell, s.fields["pressure"], s.fields["gap"]) for s in sols],
-        "islands": [unresolved_share(cell, s.fields["pressure"]) for s in sols],
+        "islands": [unresolved_share(cell, s.fields["pressure"], s.fields["gap"]) for s in sols],
         "whole_surface": coefficients(cell, np.ones(cell.shape, bool)).as_dict()}
     return cell, sols, entry
 
