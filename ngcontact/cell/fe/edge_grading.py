@@ -71,7 +71,7 @@ import ngsolve as ng
 
 from ngcontact.cell.fe.measures import contact_pieces
 from ngcontact.cell.fe.load_start import starts_afresh
-from ngcontact.cell.fe.grading_estimate import LEVELS_PER_STEP, RATIO, edge_offset, merged, order_estimate, set_move
+from ngcontact.cell.fe.grading_estimate import LEVELS_PER_STEP, RATIO, merged, order_estimate, set_move
 from ngcontact.cell.fe.observed_rate import DISAGREE
 from ngcontact.errors import ConvergenceError, ModelError, SceneError
 from ngcontact.geometry.cell2d import flat_cell
@@ -136,6 +136,15 @@ class GradedSolve:
     def remark(self) -> str:
         """Where the orders' ratios disagree or a guard acted, in words ("" otherwise)."""
         return order_estimate(self.orders, self.grading_change)[1]
+
+
+def edge_offset(edges, ends: np.ndarray) -> float:
+    """The largest distance of a contact edge from its nearest interface vertex (0 without edges): where the
+    mesh put its vertices against the edges found on it, recorded per level (not part of the estimate)."""
+    if len(edges) == 0:
+        return 0.0
+    vertices = np.unique(ends)
+    return float(max(np.min(np.abs(vertices - e)) for e in edges))
 
 
 def graded_vertices(edges, h0: float, levels: int, period: float) -> list[float]:

@@ -116,14 +116,6 @@ def grading_tail(orders: list[dict[str, Any]], grading_change: float | None) -> 
                                         f"level graded towards, {how}")
 
 
-def edge_offset(edges, ends: np.ndarray) -> float:
-    """The largest distance of a contact edge from its nearest interface vertex (0 without edges)."""
-    if len(edges) == 0:
-        return 0.0
-    vertices = np.unique(ends)
-    return float(max(np.min(np.abs(vertices - e)) for e in edges))
-
-
 def merged(intervals) -> np.ndarray:
     """``(n, 2)`` disjoint intervals, sorted, with those that touch joined."""
     out: list[list[float]] = []
