@@ -4,13 +4,13 @@ A cylinder gap ``(x - 1/2)^2 / (2R)`` in a periodic cell of period 1 pressed to 
 (:mod:`ngcontact.verification.hertz`).  The cell is periodic, so its exact answer is the row of cylinders
 (:mod:`ngcontact.verification.periodic_hertz`), narrower than Hertz by ``(pi b)^2 / 12 = 3.3e-4`` relative: the
 contact fraction ``0.0399868418``, to round-off.  Exact contact, so no penalty shifts the answer either, and
-the true error is the discretization's alone.
+the true error is the discretization's alone; the penalty ``k_n = 1e6 E`` (slow tier) shifts it by less
+than its discretization error at these tolerances.
 
-Measured (tolerance 1e-2, NGCONTACT_THREADS=1, 11 s): contact fraction 0.0399405, true error 4.6e-5, estimate
-1.1e-3 (the last grading step's tail), effectivity 24; at tolerance 1e-3 (17 s) 1.9e-6 against 8.2e-5,
-effectivity 44.  The estimate bounds the error (effectivity >= 1), which this test holds; it is looser than the
-issue's factor 10 on this oracle, where the grading converges faster than the tail the estimator assumes
-(``GRADING_TAIL``, ``ORDER_RATE`` of :mod:`ngcontact.cell.fe.edge_grading`) -- an open item, not asserted here.
+The estimate is the larger of the orders' tail and the grading's
+(:mod:`ngcontact.cell.fe.grading_estimate`).  Measured (NGCONTACT_THREADS=1): exact, tolerance 1e-2 (19 s),
+error 4.6e-5, estimate 3.5e-4 (the orders' tail), effectivity 7.5; tolerance 1e-3 (28 s), 1.9e-6 against
+1.4e-5, 7.4; penalty at 1e-2, 7.9e-5 against 6.2e-4 (the grading's tail at its observed ratio 0.2), 7.9.
 """
 import math
 from dataclasses import replace
@@ -32,13 +32,18 @@ ES = e_star(1.0, NU, 1.0, NU)
 P = math.pi * ES * B * B / (4 * R)            # Hertz's load of half-width B, per period
 
 
-# 1e-3: two grading steps more, about 17 s on one thread (twice that under load): the slow tier
-@pytest.mark.parametrize("tolerance", [1e-2, pytest.param(1e-3, marks=pytest.mark.slow)])
-def test_the_graded_estimate_bounds_its_error_against_the_row_of_hertz_cylinders(tolerance):
+# 1e-3: two grading steps more, about 28 s on one thread (twice that under load), and the penalty: the slow tier
+@pytest.mark.parametrize("tolerance, enforcement", [
+    (1e-2, "exact"),
+    pytest.param(1e-3, "exact", marks=pytest.mark.slow),
+    pytest.param(1e-2, "penalty", marks=pytest.mark.slow),
+])
+def test_the_graded_estimate_bounds_its_error_within_ten_times_against_the_row_of_hertz_cylinders(tolerance,
+                                                                                                     enforcement):
     assert hertz_half_width(P, R, ES) == pytest.approx(B, rel=1e-14)
     exact = 2 * periodic_hertz_half_width(P, R, ES, 1.0)
-    model = CellModel(rough=LAW, counter=LAW, k_n=1e3, gap=(ng.x - 0.5) ** 2 / (2 * R), order=3,
-                      enforcement="exact")
+    model = CellModel(rough=LAW, counter=LAW, k_n=1e6 if enforcement == "penalty" else 1e3,
+                      gap=(ng.x - 0.5) ** 2 / (2 * R), order=3, enforcement=enforcement)
 
     def make(vertices, order):
         cell = graded_flat_cell(1.0, 2.0, 2.0, maxh=0.3, interface_maxh=0.02, order=order, vertices=vertices)
@@ -49,4 +54,4 @@ def test_the_graded_estimate_bounds_its_error_against_the_row_of_hertz_cylinders
     estimate = g.estimate["contact_fraction"]
     assert error > 1e-9                        # the discretization's, far above the oracle's round-off
     assert estimate <= tolerance
-    assert estimate / error >= 1.0, (estimate, error)
+    assert 1.0 <= estimate / error <= 10.0, (estimate, error, g.remark)

@@ -21,13 +21,14 @@ A cell scene that states no ``discretization.tolerance`` is held to the default 
        |q_n - q| <= sum_(j > n) d_j <= d_n rho / (1 - rho),
 
    taken with the larger observed ``rho`` of the last two ratios, held to the knob's guaranteed floor and
-   cap and multiplied by a safety factor (:data:`~ngcontact.cell.fe.edge_grading.ORDER_RATE`,
+   cap and multiplied by a safety factor (:data:`~ngcontact.cell.fe.grading_estimate.ORDER_RATE`,
    :data:`~ngcontact.cell.fe.second_discretization.HALVING_RATE`).
 
 Why the sequences converge, so that the bound holds with ``rho < 1``: on one fixed (graded) mesh,
 ``p``-refinement converges to the exact solution of the cell problem, not to a mesh-dependent limit, and
 geometrically in ``p`` for the smooth bulk and for edges that sit at vertices, which the grading puts them
-at (an edge left inside its element is bounded separately by its distance from the vertex); under a halved
+at (an edge left inside its element is bounded separately, by the grading's tail of
+:mod:`ngcontact.cell.fe.grading_estimate`); under a halved
 interface element size the contact fraction's error is at least of first order in the size (an edge cuts
 its elements anywhere, and the fraction counts the cut elements' share to first order) and the closure's of
 higher order, so the ratio of successive errors tends to ``1/2`` or less, which the floor assumes.  The
@@ -54,7 +55,8 @@ from typing import Any
 
 from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.cell_solver import Refinement
-from ngcontact.cell.fe.edge_grading import ORDER_RATE, GradedSolve
+from ngcontact.cell.fe.edge_grading import GradedSolve
+from ngcontact.cell.fe.grading_estimate import ORDER_RATE
 from ngcontact.cell.fe.observed_rate import dofs_to_meet, exponent
 from ngcontact.cell.fe.saturation import estimate_on_scene
 from ngcontact.cell.fe.second_discretization import HALVING_RATE, Sequence, as_refinement

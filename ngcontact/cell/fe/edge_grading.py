@@ -30,17 +30,12 @@ The edges are not known in advance, so meshing and solving alternate:
    mesh (:data:`ORDER_RATE`, :mod:`ngcontact.cell.fe.observed_rate`):
    ``p``-refinement on one fixed mesh converges to the exact solution, not to
    a mesh-dependent limit, so the tail of its sequence bounds the error of
-   the smooth bulk and of the edges where they sit at vertices; the grading
-   changes (errors of the coarser levels, often a hundred times the
-   finest's) only decide when to stop grading.  An edge that lies inside its
-   element (the vertex was put where the previous level found it) carries a
-   ``sqrt`` singularity inside the element, where ``p``-refinement converges
-   algebraically, too slowly for the geometric tail to see: the contact
-   fraction's estimate is at least the largest distance of an edge from its
-   nearest vertex (:func:`edge_offset`), the error of a patch length whose
-   end were placed at that vertex, and at least the tail of the last
-   grading step's change (:data:`GRADING_TAIL`: the edge's resolution,
-   which the order sequence on one mesh does not improve).
+   the smooth bulk.  An edge that lies inside its element (the vertex was
+   put where the previous level found it) carries a ``sqrt`` singularity
+   inside the element, where ``p``-refinement converges algebraically and
+   not monotonically (on Westergaard and Hertz the last order is often
+   worse than the one before): that error is the grading's, bounded by
+   its own tail (:func:`~ngcontact.cell.fe.grading_estimate.grading_tail`).
 
 The first mesh from the spectral twin.  With the penalty, a flat cell has
 a spectral twin (:mod:`ngcontact.cell.spectral_start`): the same
@@ -76,30 +71,18 @@ import ngsolve as ng
 
 from ngcontact.cell.fe.measures import contact_pieces
 from ngcontact.cell.fe.load_start import starts_afresh
-from ngcontact.cell.fe.observed_rate import Convergence
+from ngcontact.cell.fe.grading_estimate import LEVELS_PER_STEP, RATIO, merged, order_estimate, set_move
+from ngcontact.cell.fe.observed_rate import DISAGREE
 from ngcontact.errors import ConvergenceError, ModelError, SceneError
 from ngcontact.geometry.cell2d import flat_cell
 
 log = logging.getLogger(__name__)
 
-#: ratio of consecutive element sizes towards an edge
-RATIO = 0.25
-#: grading levels added per step
-LEVELS_PER_STEP = 2
 #: steps before the tolerance is declared out of reach: the smallest element is then
 #: h0 r^8 ~ 1.5e-5 h0 (Netgen fails on segments some 1e-8 of the period long)
 MAX_STEPS = 4
 #: order raises (after the grading has settled) before the tolerance is declared out of reach
 MAX_ORDER_RAISES = 2
-#: how the answers of successive orders on one graded mesh converge (:mod:`ngcontact.cell.fe.observed_rate`):
-#: geometrically (the edges are isolated in elements ``h0 r^L``, the bulk is smooth), the contraction observed
-#: from order to order, three times the tail because that contraction grows slowly with the order
-ORDER_RATE = Convergence(floor=0.0, assumed=0.5, cap=0.7, safety=3.0)
-#: the contact fraction's error after a grading step over its change: the geometric tail at a ratio 1/2 per
-#: step, first order as a halved mesh (a step adds LEVELS_PER_STEP levels, but towards edges located on the
-#: coarser level, and a penalty's edge layer of width ~E/k_n is resolved only once the elements are smaller:
-#: no faster is assumed)
-GRADING_TAIL = 1.0
 #: Netgen's grading of the graded meshes: elements may grow by about this fraction away from the edges
 #: (0.5 halved the dofs of Westergaard's graded meshes against Netgen's default 0.3 at the same error)
 MESH_GRADING = 0.5
@@ -115,7 +98,12 @@ def contact_edges(problem) -> np.ndarray:
     where the state changes between consecutive pieces along ``x``
     (periodically), inside an element or at a vertex.
     """
-    pieces = sorted((min(a, b), max(a, b), on) for a, b, on, _ in contact_pieces(problem))
+    return _edges(contact_pieces(problem))
+
+
+def _edges(pieces) -> np.ndarray:
+    """The edges of :func:`contact_edges` from the pieces of :func:`~ngcontact.cell.fe.measures.contact_pieces`."""
+    pieces = sorted((min(a, b), max(a, b), on) for a, b, on, _ in pieces)
     if not pieces:
         return np.empty(0)
     edges = [p[1] for p, q in zip(pieces, pieces[1:] + pieces[:1]) if p[2] != q[2]]
@@ -150,36 +138,9 @@ class GradedSolve:
         return order_estimate(self.orders, self.grading_change)[1]
 
 
-def order_estimate(orders: list[dict[str, Any]], grading_change: float | None = None
-                   ) -> tuple[dict[str, float], str]:
-    """The error of the last of ``orders`` (entries of successive orders on one mesh), per quantity, by the
-    observed rate of :data:`ORDER_RATE`; the contact fraction's at least the last solution's
-    :func:`edge_offset` and the tail of the last grading step's change (module docstring); and its remark."""
-    out, notes = {}, []
-    if len(orders) < 2:        # stopped before an order was raised: the last grading step's changes
-        last = orders[-1]
-        change = last["fraction_change"] if grading_change is None else grading_change
-        unknown = float("inf")
-        return ({"contact_fraction": unknown if change is None else GRADING_TAIL * change,
-                 "mean_closure": unknown if last["closure_change"] is None else last["closure_change"]},
-                "stopped before an order was raised: the last grading step's changes")
-    for name, relative in (("contact_fraction", False), ("mean_closure", True)):
-        out[name], note = ORDER_RATE.tail([e[name] for e in orders], relative)
-        if note:
-            notes.append(f"{name}: {note}")
-    offset = orders[-1].get("edge_offset", 0.0)
-    if offset > out["contact_fraction"]:
-        out["contact_fraction"] = offset
-        notes.append(f"contact_fraction: its edges lie up to {offset:.2g} from the vertices graded towards them")
-    grading = GRADING_TAIL * grading_change if grading_change is not None else 0.0
-    if grading > out["contact_fraction"]:
-        out["contact_fraction"] = grading
-        notes.append(f"contact_fraction: the last grading step's tail {grading:.2g}")
-    return out, "; ".join(notes)
-
-
 def edge_offset(edges, ends: np.ndarray) -> float:
-    """The largest distance of a contact edge from its nearest interface vertex (0 without edges)."""
+    """The largest distance of a contact edge from its nearest interface vertex (0 without edges): where the
+    mesh put its vertices against the edges found on it, recorded per level (not part of the estimate)."""
     if len(edges) == 0:
         return 0.0
     vertices = np.unique(ends)
@@ -260,10 +221,13 @@ def seed_levels(h0: float, spacing: float) -> int:
 
 
 def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, before, history: list,
-                 newton: list, max_dofs: int | None = None):
+                 newton: list, max_dofs: int | None = None, towards: tuple[Any, float] | None = None):
     """Solve ``load`` on a new mesh (grading ``level``, order ``p``), from ``before = (problem, entry)`` when
     given (carried over unless the problem starts afresh); record the changes against it in ``history`` and
-    the Newton histories in ``newton``.  Returns the problem, the solution, its contact edges and its entry.
+    the Newton histories in ``newton``; ``towards = (contact set, period)``: the contact set of the level whose
+    edges the mesh was graded towards, the entry's ``set_move`` measured from it
+    (:func:`~ngcontact.cell.fe.grading_estimate.set_move`).  Returns the problem, the solution, its
+    contact edges and its entry.
     :class:`OverBudget` where the mesh holds more than ``max_dofs`` unknowns (not solved)."""
     try:
         problem = make_problem(vertices, p)
@@ -277,11 +241,15 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
     if not fresh:
         carry_over(before[0], problem)
     sol = problem.solve(load, first=fresh)
-    edges = contact_edges(problem)
+    pieces = contact_pieces(problem)
+    edges = _edges(pieces)
+    contact = merged([(a, b) for a, b, on, _ in pieces if on])
     ends = _interface_elements(problem.mesh)
     f, c = sol.results["contact_fraction"], sol.results["mean_closure"]
     entry = {"level": level, "order": p, "ndof": problem.ndof, "edges": [float(e) for e in edges],
              "smallest_element": float(np.min(ends[:, 1] - ends[:, 0])), "edge_offset": edge_offset(edges, ends),
+             "contact_set": contact.tolist(),
+             "set_move": None if towards is None else set_move(contact, towards[0], towards[1]),
              "contact_fraction": f,
              "mean_closure": c, "newton_iterations": sol.iterations, "fraction_change": None,
              "closure_change": None}
@@ -293,6 +261,16 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
     log.info("grading level %d, order %d: %d dofs, contact fraction %.10g, change %s", level, p,
              problem.ndof, f, entry["fraction_change"])
     return problem, sol, edges, entry
+
+
+def _agreed_ratio(changes: list[float]) -> float | None:
+    """The contraction of the last grading steps where their last two ratios agree (within
+    :data:`~ngcontact.cell.fe.observed_rate.DISAGREE`): the larger; else ``None`` (one ratio, or two that
+    disagree, as before the asymptotic range: the theory's rate stands, module docstring)."""
+    if len(changes) < 3 or min(changes[-3:-1]) <= 0.0:
+        return None
+    ratios = [changes[-2] / changes[-3], changes[-1] / changes[-2]]
+    return max(ratios) if max(ratios) <= DISAGREE * min(ratios) else None
 
 
 class OverBudget(Exception):
@@ -359,9 +337,12 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
     graded: dict[str, Any] | None = None  # the last level-against-level comparison checked by an order raise
     orders: list[dict[str, Any]] = []     # the entries of successive orders on the last graded mesh
 
+    towards: tuple[Any, float] | None = None   # the edges the current mesh is graded towards, and the period
+    steps: list[tuple[int, float]] = []        # (order, contact fraction change) of each grading step
+
     def run(vertices: list[float], p: int, level: int, before=None):
         return _solve_level(make_problem, load, vertices, p, level, before, history, newton,
-                            None if required or before is None else max_dofs)
+                            None if required or before is None else max_dofs, towards)
 
     def met(entry) -> bool:
         return entry["fraction_change"] is not None and max(entry["fraction_change"],
@@ -383,6 +364,7 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
                 # answer and raises remain
                 graded = entry
                 orders = [entry]
+                entry["grading_ratio"] = _agreed_ratio([c for p, c in steps if p == entry["order"]])
                 while raises < MAX_ORDER_RAISES + 1:
                     order += 1
                     raises += 1
@@ -402,9 +384,12 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
             if len(edges) == 0:  # full (or no) contact: no edge to grade towards; halve the interface mesh instead
                 n = int(round(period / h0)) * 2 ** step
                 vertices = [period * (i + 0.5) / n for i in range(n)]
+                towards = None
             else:
                 vertices = graded_vertices(edges, h0, step * LEVELS_PER_STEP, period)
+                towards = (entry["contact_set"], period)
             problem, sol, edges, entry = run(vertices, order, step * LEVELS_PER_STEP, (problem, entry))
+            steps.append((order, entry["fraction_change"]))
     except OverBudget as over:         # the levels solved stay; the answer is the last one solved
         return _stopped(str(over), problem, sol, entry, orders, graded, history, newton)
     if not required and graded is not None:

@@ -43,7 +43,8 @@ from ngcontact.cell.coefficients import coefficients
 from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.cell.fe.default_refinement import held_to_default
-from ngcontact.cell.fe.edge_grading import ORDER_RATE, GradedSolve, solve_to_tolerance
+from ngcontact.cell.fe.edge_grading import GradedSolve, solve_to_tolerance
+from ngcontact.cell.fe.grading_estimate import ORDER_RATE
 from ngcontact.cell.fe.load_start import Predictor
 from ngcontact.cell.fe import whole_surface_error
 from ngcontact.cell.fe.saturation import estimate_on_scene
