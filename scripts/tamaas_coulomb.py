@@ -113,15 +113,16 @@ def _model(n: int, E: float, nu: float):
 def run_tamaas(name: str, z: np.ndarray, E: float, nu: float, mu: float, pressure: float, shear: float,
                steps: int) -> tuple[np.ndarray, np.ndarray, float]:
     """Tamaas' solver ``name`` for ``steps`` steps on the map ``z`` (``[y, x]``): ``(t, grad, seconds)`` in our
-    layout, ``grad = K t + b`` from Tamaas' own operator applied to its final traction."""
+    layout, ``grad = K t + b`` from Tamaas' own operator applied to its final traction, ``seconds`` from the model's
+    creation to the solver's return."""
     import tamaas as tm
     if name not in SOLVERS:
         raise ValueError(f"Tamaas solver {name!r}: one of {SOLVERS}")
+    t0 = time.perf_counter()
     model = _model(z.shape[0], E, nu)
     solver = getattr(tm, name)(model, np.ascontiguousarray(z.T), UNREACHABLE, mu)
     solver.max_iter = int(steps)
     solver.dump_freq = 10 ** 9
-    t0 = time.perf_counter()
     solver.solve([shear, 0.0, pressure])
     seconds = time.perf_counter() - t0
     T = np.array(model.traction)
@@ -148,7 +149,7 @@ def next_steps(attempts: list[tuple[int, float]], tol: float, first: int) -> int
     """The step count of the next run of a Tamaas solver, from its runs so far ``(steps, residual)``; ``None``: stop.
 
     First ``first`` steps, then twice as many; then the count at which the residual, falling geometrically as between
-    the last two runs, meets ``tol`` (5 % added, at least 10 % more than the last run, at most twice as many).  Stops
+    the last two runs, meets ``tol`` (10 % added, at least 10 % more than the last run, at most twice as many).  Stops
     when the last run met ``tol``, when a run did not lower the residual, or when doubling the first run's steps cut
     it by less than ``STALL_FACTOR`` (the solver stalls).
     """
@@ -164,4 +165,4 @@ def next_steps(attempts: list[tuple[int, float]], tol: float, first: int) -> int
         return None
     rate = (math.log(r0) - math.log(r1)) / (n1 - n0)
     guess = n1 + math.log(r1 / tol) / rate
-    return int(min(2 * n1, max(1.1 * n1, 1.05 * guess)))
+    return int(min(2 * n1, max(1.1 * n1, 1.1 * guess)))
