@@ -101,11 +101,12 @@ def _layers_compliance(cell) -> np.ndarray:
     k1 = 2 * np.pi * sfft.rfftfreq(n, d=cell.period / n)
     if d == 2:
         kv = k1[:, None]
-        nyq = np.arange(k1.size) == n // 2
+        nyq = np.arange(k1.size) == (n // 2 if n % 2 == 0 else -1)
     else:
         k0 = 2 * np.pi * sfft.fftfreq(n, d=cell.period / n)
         kv = np.stack(np.broadcast_arrays(k1[None, :], k0[:, None]), axis=-1)
-        nyq = (np.arange(n)[:, None] == n // 2) | (np.arange(k1.size)[None, :] == n // 2)
+        half = n // 2 if n % 2 == 0 else -1          # an odd grid has no Nyquist mode
+        nyq = (np.arange(n)[:, None] == half) | (np.arange(k1.size)[None, :] == half)
     K = layers_matrix(kv, [(cell.rough.E, cell.rough.nu, cell.rough.h, False),
                            (cell.counter.E, cell.counter.nu, cell.counter.h, True)])
     K[..., :d - 1, d - 1] = np.where(nyq[..., None], 0.0, K[..., :d - 1, d - 1])
