@@ -84,9 +84,9 @@ A stress maximum that grows where the levels refine
     growing differences is no bound on a quantity without a limit (the two-scale femur's bone: 54.2,
     56.7, 61.9 MPa, ratio 2.1, and 67.8, 74.5 on two further levels, beside a ladder estimate of 77 %).
     A maximum that grows by contracting differences (converging from below) keeps its estimate from the
-    rules above.  It is reported mesh dependent, singular at the finest level's location, with the value of
-    the scene's mesh
-    (the mesh every maximum over a whole body is reported on).  Such a point need not be one of
+    rules above.  A growing one is reported mesh dependent, singular at the finest level's location, with
+    the value of the scene's mesh (the mesh every maximum over a whole body is reported on).  Such a point
+    need not be one of
     :func:`ngcontact.macro.away_maxima.singular_points`: a closed interface much stiffer than its bodies
     over the element size, ``k_n h >> E``, transmits a kink of its gap (an interference that stops
     growing, as the two-scale femur's does at the stem's cone-cylinder corner) as a kink of the
