@@ -138,6 +138,23 @@ def test_a_safety_factor_converging_from_above_keeps_its_finite_estimate():
         assert abs(out.value - 0.188) <= out.error, out.how
 
 
+def test_a_rise_within_the_sampling_error_is_the_lattice_finding_the_maximum_not_growth():
+    """The two-scale femur's stem away from its corner, on its axis: each level raises the maximum by less than
+    the sampling error of the level before (the denser lattice's excess), as a level's finer lattice finds the
+    field's maximum; the same rises with the sampling resolved would be growth."""
+    values, sampling = [10.8604e6, 10.8657e6, 10.8815e6], [2.2e4, 2.15e4, 1.11e3]
+    e = _ladder("tresca_stem_away", values[0], error=7.06e4)
+    assert not AS.growing(e, values, sampling) and AS.growing(e, values)
+    out = AS._judged(e, [DE.Sample(v, (0.0009, 0.1716), sampling=s) for v, s in zip(values, sampling)])
+    assert out.singular_at is None and out.error is not None and out.value == values[-1], out.how
+    # one rise resolved, the other not: no growth either
+    assert not AS.growing(e, values, [1e3, 2.15e4, 0.0]) and not AS.growing(e, values, [2.2e4, 1e3, 0.0])
+    # a safety factor's fall within the sampling error of its minimum likewise
+    falling = [1.0 / (2.0 + k) for k in range(3)]
+    assert AS.growing(_ladder("safety_factor", 0.5), falling)
+    assert not AS.growing(_ladder("safety_factor", 0.5), falling, [0.2, 0.0, 0.0])
+
+
 def test_a_quantity_at_round_off_is_not_growing():
     """Differences at round-off carry no rate: an oscillation, or a drift of a few ulps, is no growth."""
     for name, q in (("von_mises_stem", 12.94), ("safety_factor", 0.2393)):
