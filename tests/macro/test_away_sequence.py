@@ -312,7 +312,7 @@ def test_a_mesh_level_that_finds_a_growing_point_restarts_the_sequence_of_the_ma
 def test_the_two_scale_femurs_corner_is_a_singular_point_and_no_maximum_away_exceeds_its_bodys():
     """The stiff cell law of the loop makes the cone-cylinder corner (r = 11 mm, z = 130 mm, where the press
     fit's interference stops growing) a point where the stress grows with every halving: it joins the
-    singular points and, as at the single-scale femur's bone edge, the bodies' maxima there are mesh
+    singular points and, as at the single-scale femur's bone edge, both bodies' maxima there are mesh
     dependent and not counted, and the maxima away from it converge with their estimates."""
     from ngcontact.drivers import run_macro as D
     from ngcontact.output.report import Clock
@@ -329,7 +329,13 @@ def test_the_two_scale_femurs_corner_is_a_singular_point_and_no_maximum_away_exc
             assert away["counted"] and away["error"] is not None and away["relative_error"] < 0.01, away["how"]
             assert min(math.dist(away["location"], p) for p in ex["points"]) >= ex["radius"] * (1 - 1e-9)
     for measure in ("von_mises", "tresca"):
-        stem = q[f"{measure}_stem"]
-        assert stem["error"] is None and stem["singular_at"] == pytest.approx([0.011, 0.13], abs=1e-5)
-        assert not stem["counted"]
+        # the bone's maximum over the whole body sits at the same corner and grows with every level by
+        # differences that do not contract (54.2, 56.7, 61.9 MPa): mesh dependent there too, however large
+        # the ladder's estimate (77 %), not a finite estimate
+        for body in ("stem", "bone"):
+            whole = q[f"{measure}_{body}"]
+            assert whole["error"] is None and whole["singular_at"] == pytest.approx([0.011, 0.13], abs=1e-5)
+            assert not whole["counted"], whole["how"]
     assert q["safety_factor"]["value"] <= q["safety_factor_away"]["value"]
+    # the safety factor falls with the levels by contracting differences: it converges and keeps its estimate
+    assert q["safety_factor"]["error"] is not None and q["safety_factor"].get("singular_at") is None
