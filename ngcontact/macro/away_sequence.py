@@ -82,9 +82,10 @@ A stress maximum that grows where the levels refine
     lattice alone may raise the value by as much with the field unchanged (the two-scale femur's stem away
     from its corner, on its axis: 10.8604, 10.8657, 10.8815 MPa, each rise below the sampling error of
     22 and 21.5 kPa of the level before, the last level's 1.1 kPa: the lattice finding the maximum, not a
-    growing field).  ``c`` lies above the slowest contraction of a converging stress (0.69) and
-    below the logarithm's 1 by a margin for a log-singular maximum whose sample points still approach the
-    point (the two-scale femur's stem at its corner: 12.94, 19.26, 25.32 MPa, ratio 0.96).  This holds
+    growing field; two further levels give 10.8745, 10.8763 MPa).  ``c`` lies above the slowest
+    contraction of a converging stress (0.69) and below the logarithm's 1 by a margin for a log-singular
+    maximum whose sample points still approach the point (the two-scale femur's stem at its corner: 12.94,
+    19.26, 25.32 MPa, ratio 0.96).  This holds
     whatever the order ladder's estimate on the scene's mesh: the ladder sees the polynomial error of one
     mesh, not how the value moves as the elements at the point shrink, and a large ladder estimate beside
     growing differences is no bound on a quantity without a limit (the two-scale femur's bone: 54.2,
@@ -92,19 +93,17 @@ A stress maximum that grows where the levels refine
     A maximum that grows by contracting differences (converging from below) keeps its estimate from the
     rules above.  A growing one is reported mesh dependent, singular at the finest level's location, with
     the value of the scene's mesh (the mesh every maximum over a whole body is reported on).  Such a point
-    need not be one of
-    :func:`ngcontact.macro.away_maxima.singular_points`: a closed interface much stiffer than its bodies
-    over the element size, ``k_n h >> E``, transmits a kink of its gap (an interference that stops
-    growing, as the two-scale femur's does at the stem's cone-cylinder corner) as a kink of the
-    displacement, whose traction grows like ``log r`` down to the law's own length ``E / k_n`` (the
-    Hilbert transform of a jump in the gap's slope), far below the element size; a compliant law
-    (``E / k_n`` above the element size) smooths the same kink.  A maximum away next to the region's
-    boundary (within the diameter of the scene mesh's element holding it, :func:`beside`) is exempt: it
-    grows as the levels resolve the circle towards the bounded value there.  In 2D such a point joins the
-    singular points (:func:`grown`, at the nearest vertex of the scene's mesh, reason :data:`GROWN`) and
-    the quantities are judged once more outside its ball too
-    (:func:`ngcontact.drivers.macro_accuracy.judged`); in 3D the growth runs along an edge whose extent
-    the levels do not find, and the maximum away stays mesh dependent.
+    need not be one of :func:`ngcontact.macro.away_maxima.singular_points`: a closed interface much stiffer
+    than its bodies over the element size, ``k_n h >> E``, transmits a kink of its gap (an interference that
+    stops growing, as the two-scale femur's does at the stem's cone-cylinder corner) as a kink of the
+    displacement, whose traction grows like ``log r`` down to the law's own length ``E / k_n`` (the Hilbert
+    transform of a jump in the gap's slope), far below the element size; a compliant law (``E / k_n`` above
+    the element size) smooths the same kink.  A maximum away next to the region's boundary (within the
+    diameter of the scene mesh's element holding it, :func:`beside`) is exempt: it grows as the levels resolve
+    the circle towards the bounded value there.  In 2D such a point joins the singular points (:func:`grown`,
+    at the nearest vertex of the scene's mesh, reason :data:`GROWN`) and the quantities are judged once more
+    outside its ball too (:func:`ngcontact.drivers.macro_accuracy.judged`); in 3D the growth runs along an
+    edge whose extent the levels do not find, and the maximum away stays mesh dependent.
 
 A safety factor that falls where the levels refine
     The safety factor of eq. 78 is a minimum over the interface, ``sigma_u / sigma_eq`` of the micro stresses
