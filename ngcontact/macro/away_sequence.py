@@ -63,26 +63,47 @@ elements at a singular point, where no order converges fast) has ``e_P = e_m = 0
 alone.  The check costs about one solve of the scene (two warm-started solves on meshes a little larger).
 
 A stress maximum that grows where the levels refine
-    Before the rules above, a stress maximum whose levels grow at each level (``Q_0 < Q_1 < Q_2`` in
-    magnitude), the last difference at least :data:`GROWING` ``= 3/4`` of the first, by more than the
-    ladder's estimate over the levels (:func:`growing`), has no converged value: a bounded stress's error
-    falls by at least ``2^-0.544 = 0.69`` per halving of the elements at the singular points (above) and
-    by ``2^-p`` where the elements holding it are halved, whereas ``log r`` gains a constant and
-    ``r^(lambda - 1)`` a factor ``2^(1 - lambda)`` with every halving of the elements at its point.  It is
-    reported mesh dependent, singular at the finest level's location, with the value of the scene's mesh
-    (the mesh every maximum over a whole body is reported on).  Such a point need not be one of
-    :func:`ngcontact.macro.away_maxima.singular_points`: a closed interface much stiffer than its bodies
-    over the element size, ``k_n h >> E``, transmits a kink of its gap (an interference that stops
-    growing, as the two-scale femur's does at the stem's cone-cylinder corner) as a kink of the
-    displacement, whose traction grows like ``log r`` down to the law's own length ``E / k_n`` (the
-    Hilbert transform of a jump in the gap's slope), far below the element size; a compliant law
-    (``E / k_n`` above the element size) smooths the same kink.  A maximum away next to the region's
-    boundary (within the diameter of the scene mesh's element holding it, :func:`beside`) is exempt: it
-    grows as the levels resolve the circle towards the bounded value there.  In 2D such a point joins the
-    singular points (:func:`grown`, at the nearest vertex of the scene's mesh, reason :data:`GROWN`) and
-    the quantities are judged once more outside its ball too
-    (:func:`ngcontact.drivers.macro_accuracy.judged`); in 3D the growth runs along an edge whose extent
-    the levels do not find, and the maximum away stays mesh dependent.
+    Before the rules above, the levels are asked whether they converge at all (:func:`growing`).  Level ``k``
+    halves the elements at the singular points and those holding the maximum, ``h_k = 2^-k h_0`` there, and
+    its difference is ``d_k = Q_k - Q_(k-1)``.  A maximum converging at rate ``q`` (``Q_k = Q + C h_k^q``)
+    has differences that contract by ``d_(k+1) / d_k = 2^-q``: at most ``2^-0.544 = 0.69`` for the
+    pollution of the slowest singular point (above), ``2^-p`` where the elements holding it are halved.  A
+    maximum at a point where the stress is unbounded does not: ``log(1/r)`` sampled at ``r ~ h_k`` gains
+    ``Q_k = A + B k log 2``, constant differences (``d_(k+1) / d_k = 1``), and ``r^(lambda - 1)`` gains a
+    factor ``2^(1 - lambda) > 1`` per level.  So a stress maximum whose magnitude grows at each of the last
+    three levels by resolved differences, ``d_k > max(NOISE scale, s_(k-1))``, with
+
+        d_2 >= c d_1,   c = GROWING = 3/4
+
+    has no converged value.  A difference is resolved above round-off
+    (:data:`~ngcontact.macro.discretization_error.NOISE` of the scale) and above the sampling error
+    ``s_(k-1)`` of the level it starts from (``Sample.sampling``, the denser lattice's excess): a sampled
+    maximum lies below the field's by up to that error, and a level halves the elements holding it, so its
+    lattice alone may raise the value by as much with the field unchanged (the two-scale femur's stem away
+    from its corner, on its axis: 10.8604, 10.8657, 10.8815 MPa, each rise below the sampling error of
+    22 and 21.5 kPa of the level before, the last level's 1.1 kPa: the lattice finding the maximum, not a
+    growing field; two further levels give 10.8745, 10.8763 MPa).  ``c`` lies above the slowest
+    contraction of a converging stress (0.69) and below the logarithm's 1 by a margin for a log-singular
+    maximum whose sample points still approach the point (the two-scale femur's stem at its corner: 12.94,
+    19.26, 25.32 MPa, ratio 0.96).  This holds
+    whatever the order ladder's estimate on the scene's mesh: the ladder sees the polynomial error of one
+    mesh, not how the value moves as the elements at the point shrink, and a large ladder estimate beside
+    growing differences is no bound on a quantity without a limit (the two-scale femur's bone: 54.2,
+    56.7, 61.9 MPa, ratio 2.1, and 67.8, 74.5 on two further levels, beside a ladder estimate of 77 %).
+    A maximum that grows by contracting differences (converging from below) keeps its estimate from the
+    rules above.  A growing one is reported mesh dependent, singular at the finest level's location, with
+    the value of the scene's mesh (the mesh every maximum over a whole body is reported on).  Such a point
+    need not be one of :func:`ngcontact.macro.away_maxima.singular_points`: a closed interface much stiffer
+    than its bodies over the element size, ``k_n h >> E``, transmits a kink of its gap (an interference that
+    stops growing, as the two-scale femur's does at the stem's cone-cylinder corner) as a kink of the
+    displacement, whose traction grows like ``log r`` down to the law's own length ``E / k_n`` (the Hilbert
+    transform of a jump in the gap's slope), far below the element size; a compliant law (``E / k_n`` above
+    the element size) smooths the same kink.  A maximum away next to the region's boundary (within the
+    diameter of the scene mesh's element holding it, :func:`beside`) is exempt: it grows as the levels resolve
+    the circle towards the bounded value there.  In 2D such a point joins the singular points (:func:`grown`,
+    at the nearest vertex of the scene's mesh, reason :data:`GROWN`) and the quantities are judged once more
+    outside its ball too (:func:`ngcontact.drivers.macro_accuracy.judged`); in 3D the growth runs along an
+    edge whose extent the levels do not find, and the maximum away stays mesh dependent.
 
 A safety factor that falls where the levels refine
     The safety factor of eq. 78 is a minimum over the interface, ``sigma_u / sigma_eq`` of the micro stresses
@@ -90,9 +111,11 @@ A safety factor that falls where the levels refine
     stress grows like ``log r``, ``A + B k`` on level ``k``, the utilisation grows so and the safety factor
     falls like ``1 / log r``, by differences whose ratio ``A / (A + 2B)`` shows no fixed rate.  So the mirror
     of the test above is taken on the utilisation (:func:`growing`): levels whose utilisation grows at each
-    level, the last difference at least :data:`GROWING` of the first, and whose safety factor falls by more
-    than the ladder's estimate, have no converged value: mesh dependent, singular at the finest level's
-    location, with the value of the scene's mesh.  The safety factor away is judged as a maximum away is
+    level, the last difference at least :data:`GROWING` of the first, have no converged value, whatever the
+    ladder's estimate: mesh dependent, singular at the finest level's location, with the value of the
+    scene's mesh.  A safety factor that falls by contracting utilisation differences converges from above
+    (0.2393, 0.1977, 0.1931, 0.1905, 0.1892: the utilisation's differences contract by 0.14, 0.58, 0.51)
+    and keeps its estimate.  The safety factor away is judged as a maximum away is
     (exempt next to the region's boundary; in 2D its point joins the singular points).
 
 The maxima over whole bodies
@@ -238,23 +261,25 @@ def grown(found: list[DE.Estimate], exclusion: AM.Exclusion | None, mesh: ng.Mes
     return out
 
 
-def growing(e: DE.Estimate, values: list[float]) -> bool:
-    """A stress maximum whose levels ``values`` (the scene's mesh first) grow at each level, the last
-    difference at least :data:`GROWING` of the first, by more than ``e``'s ladder estimate over the levels; a
-    safety factor (a minimum) whose reciprocal, the utilisation, so grows and which falls by more than that
-    estimate (module docstring)."""
+def growing(e: DE.Estimate, values: list[float], sampling: list[float] | None = None) -> bool:
+    """A stress maximum whose magnitude grows at each of the last three levels ``values`` (the scene's mesh
+    first) by differences that do not contract, ``d_2 >= GROWING d_1``, each resolved: above round-off and the
+    sampling error of the level it starts from (``sampling``, one per level; none: 0); a safety factor (a
+    minimum) whose reciprocal, the utilisation, so grows, its own falls resolved so.  The ladder's estimate
+    ``e.error`` plays no part: a quantity without a limit has no error to compare it with (module docstring)."""
     if len(values) < 3:
         return False
     last = [abs(v) for v in values[-3:]]
+    floor = [max(DE.NOISE * max(e.scale, max(last)), s) for s in (sampling or [0.0] * len(values))[-3:-1]]
     if e.name.startswith(SM.STRESS):
         q0, q1, q2 = last
-        move = q2 - q0
+        resolved = q1 - q0 > floor[0] and q2 - q1 > floor[1]
     elif e.name.startswith(SM.SAFETY_FACTOR) and all(0.0 < v < math.inf for v in last):
         q0, q1, q2 = (1.0 / v for v in last)
-        move = last[0] - last[2]
+        resolved = last[0] - last[1] > floor[0] and last[1] - last[2] > floor[1]
     else:
         return False
-    return q0 < q1 < q2 and q2 - q1 >= GROWING * (q1 - q0) and move > (e.error or 0.0)
+    return resolved and q2 - q1 >= GROWING * (q1 - q0)
 
 
 def _judged(e: DE.Estimate, samples: list[DE.Sample], near: Beside | None = None) -> DE.Estimate:
@@ -263,7 +288,8 @@ def _judged(e: DE.Estimate, samples: list[DE.Sample], near: Beside | None = None
     values = [s.value for s in samples]
     shown = ", ".join(f"{v:.6g}" for v in values)
     at = samples[-1].location
-    if growing(e, values) and at is not None and not (e.name.endswith(AM.AWAY) and near is not None and near(at)):
+    exempt = e.name.endswith(AM.AWAY) and near is not None and at is not None and near(at)
+    if growing(e, values, [x.sampling for x in samples]) and at is not None and not exempt:
         return replace(e, error=None, singular_at=at,
                        how=f"{e.how}; {len(values) - 1} local refinements at the singular points and at the "
                            f"{'minima' if e.name.startswith(SM.SAFETY_FACTOR) else 'maxima'}: {shown}: "
@@ -326,11 +352,11 @@ def level_error(values: list[float], scale: float, polynomial: float | None, lad
 def _unbounded(name: str) -> str:
     """Why a quantity :func:`growing` says grows (a safety factor: falls) has no converged value."""
     if name.startswith(SM.SAFETY_FACTOR):
-        return (f"it falls with every halving of the elements holding it, by more than the ladder's estimate, and "
-                f"its reciprocal (the utilisation sigma_eq / sigma_u) grows by a difference that does not fall as "
-                f"a bounded stress's error does (the last at least {GROWING:g} of the first), as 1 / log r or "
-                "r^(1 - lambda) falls on the meshes the levels reach, so this minimum has no converged value there")
-    return (f"it grows with every halving of the elements holding it, by a difference that does not fall as a "
-            f"bounded stress's error does (the last at least {GROWING:g} of the first) and by more than the "
-            "ladder's estimate, as log r or r^(lambda - 1) grows on the meshes the levels reach, so this maximum "
-            "has no converged value there")
+        return (f"it falls with every halving of the elements holding it, and its reciprocal (the utilisation "
+                f"sigma_eq / sigma_u) grows by differences that do not contract as a converging stress's do "
+                f"(the last at least {GROWING:g} of the first), as 1 / log r or r^(1 - lambda) falls on the meshes "
+                "the levels reach, so this minimum has no converged value there, whatever the ladder's estimate")
+    return (f"it grows with every halving of the elements holding it, by differences above its sampling error "
+            f"that do not contract as a converging stress's do (the last at least {GROWING:g} of the first), as "
+            "log r or r^(lambda - 1) grows on the meshes the levels reach, so this maximum has no converged value "
+            "there, whatever the ladder's estimate")
