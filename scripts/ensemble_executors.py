@@ -93,7 +93,7 @@ def main() -> None:
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
     from distributed import LocalCluster
-    rows = []
+    rows: list[dict] = []
     with tempfile.TemporaryDirectory() as tmp, LocalCluster(
             n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster:
         scenes = {"shipped 64^2 x 32": SHIPPED, "256^2 x 16": large(tmp), "measured scan": MEASURED}
