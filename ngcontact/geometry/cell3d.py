@@ -58,6 +58,7 @@ import ngsolve as ng
 from netgen.csg import CSGeometry, OrthoBrick, Plane, Pnt, Vec
 
 from ngcontact.errors import GeometryError
+from ngcontact.geometry import mesher
 from ngcontact.geometry.cell2d import Cell, periodic_maxh
 from ngcontact.quiet import quiet
 
@@ -101,7 +102,7 @@ def _identify_periodic(geo, lateral, symmetric: bool = False) -> None:
 
 
 def _mesh(geo, maxh: float, P: float, h_rough: float, h_counter: float, symmetric: bool = False) -> Cell:
-    ngmesh = geo.GenerateMesh(maxh=periodic_maxh(maxh, P))
+    ngmesh = mesher.generate(geo, maxh=periodic_maxh(maxh, P))
     _name_faces(ngmesh)
     mesh = ng.Mesh(ngmesh)
     log.debug("3D cell: %d elements, boundaries %s", mesh.ne, sorted(set(mesh.GetBoundaries())))
@@ -296,7 +297,8 @@ def surface_cell(heights, *, period: float = 1.0, h_rough: float, h_counter: flo
             f.name = "periodic"
         else:
             f.name = "contact"
-    mesh = ng.Mesh(occ.OCCGeometry(shape).GenerateMesh(maxh=periodic_maxh(_positive("discretization.maxh", maxh), P)))
+    size = periodic_maxh(_positive("discretization.maxh", maxh), P)
+    mesh = ng.Mesh(mesher.generate(occ.OCCGeometry(shape), maxh=size))
     if order > 1:
         mesh.Curve(order)
     log.debug("OCC surface cell: %d elements", mesh.ne)

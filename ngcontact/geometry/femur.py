@@ -38,6 +38,7 @@ import ngsolve as ng
 import numpy as np
 from netgen.geom2d import SplineGeometry
 
+from ngcontact.geometry import mesher
 from ngcontact.geometry.profiles import Profile
 from ngcontact.geometry.resolved_bodies import profile_chain
 
@@ -236,7 +237,7 @@ def femur_stem(dims: FemurStemDims, profile: Profile | None = None, periods: int
     seg((d.r_tip, d.z_tip), (d.r_tip, 0.0), BONE, 0, "canal")
     geo.SetMaterial(STEM, regions[0])
     geo.SetMaterial(BONE, regions[1])
-    mesh = ng.Mesh(geo.GenerateMesh(maxh=maxh, grading=grading))
+    mesh = ng.Mesh(mesher.generate(geo, maxh=maxh, grading=grading))
     if order > 1:
         mesh.Curve(order)
     return FemurMesh(mesh=mesh, interface=label, periods=0 if profile is None else periods, eps=eps,

@@ -4,7 +4,8 @@ Frictionless: the constrained CG preconditioned by the inverse compliance on the
 (:mod:`ngcontact.solvers.constrained_cg`) against the plain one.  Friction: the active-set method
 (:mod:`ngcontact.solvers.active_set_newton`) against accelerated proximal gradients
 (:mod:`ngcontact.solvers.projected_gradient`), exact and regularized, Tresca and Coulomb, dissimilar layers, 2D
-and 3D, under a prescribed mean or a prescribed jump.
+and 3D, under a prescribed mean or a prescribed jump.  Exact Coulomb friction against the Huber-regularized law
+as its width ``w`` goes to zero (paper eqs. 16-17, :mod:`ngcontact.laws.friction`).
 """
 import numpy as np
 import pytest
@@ -123,3 +124,42 @@ def test_3d_coulomb_converges_without_the_proximal_fallback(monkeypatch, n, law,
     _agree(new, old, P)
     assert new.results["slip_fraction"] == pytest.approx(old.results["slip_fraction"], abs=2.0 / n ** 2)
     assert new.iterations < old.iterations
+
+
+def _slipping(sol, dim: int, mu: float) -> np.ndarray:
+    """The points where the shear reaches the threshold ``mu p`` (the complement of the stick set in contact)."""
+    p = np.ravel(sol.fields["pressure"])
+    q = np.sqrt(np.sum(np.reshape(sol.fields["shear"], (dim - 1, -1)) ** 2, axis=0))
+    return (q >= mu * p * (1 - 1e-9)) & (p > 0)
+
+
+@pytest.mark.parametrize("dim, n", [(2, 256), (3, 32)])
+def test_exact_coulomb_is_the_limit_of_the_huber_law(dim, n):
+    """Huber Coulomb at ``w``, ``w/4``, ``w/16`` approaches exact Coulomb at first order (each quarter of the
+    width divides the error by about 4; pre-asymptotic, at least 3.4 in RMS and 3 in the max norm): the
+    tractions, the mean tangential jump, and the stick set (which becomes the exact one).
+
+    The Huber law lets a sticking point slip up to ``w`` (``J_t = w q / G``); the largest slip here is about
+    ``5e-4``, so ``w = 8e-6`` is already a small width.  Both laws use the same normal penalty (with exact
+    normal enforcement the spectral cell drops the width), so the only difference is the friction's
+    regularization.
+    """
+    mu, shear = 0.5, (0.2 * P,) if dim == 2 else (0.2 * P, 0.05 * P)
+    load = cell_load(dim, pressure=P, shear=shear)
+    exact = _cell(dim, n, friction=Coulomb(w=None, mu=mu), enforcement="penalty").solve(load)
+    t_ex = np.concatenate([np.reshape(exact.fields["shear"], (dim - 1, -1)), np.ravel(exact.fields["pressure"])[None]])
+    slip_ex = _slipping(exact, dim, mu)
+    assert 0 < np.count_nonzero(slip_ex) < np.count_nonzero(np.ravel(exact.fields["pressure"]) > 0)
+    rms, top, jump, stick = [], [], [], []
+    for w in (8e-6, 2e-6, 5e-7):
+        huber = _cell(dim, n, friction=Coulomb(w=w, mu=mu), enforcement="penalty").solve(load)
+        t = np.concatenate([np.reshape(huber.fields["shear"], (dim - 1, -1)), np.ravel(huber.fields["pressure"])[None]])
+        rms.append(float(np.sqrt(np.mean((t - t_ex) ** 2))) / P)
+        top.append(float(np.max(np.abs(t - t_ex))) / P)
+        jump.append(abs(huber.results["far_face_jump"][0] - exact.results["far_face_jump"][0]))
+        stick.append(int(np.count_nonzero(_slipping(huber, dim, mu) != slip_ex)))
+    for e in (rms, jump):
+        assert e[0] > 3.4 * e[1] > 3.4 ** 2 * e[2] > 0, e
+    assert top[0] > 3 * top[1] > 9 * top[2], top
+    assert top[2] < 0.02, top       # the error is far above the solver's tolerance, 1e-10, and small at w/16
+    assert stick[0] >= stick[1] >= stick[2] == 0, stick
