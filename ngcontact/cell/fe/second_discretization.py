@@ -22,7 +22,11 @@ the order), so the tail of the differences would claim a quarter of the error.
 The loop (:func:`refine`): the scene's discretization is level 0; each next level is solved if its unknowns
 (known once its mesh is built, before the solve) are within the size bound; the estimate of the last level
 needs three levels (two observed differences), or two where the third is beyond the bound; it stops when the
-estimate meets the tolerance.  Out of reach: a :class:`~ngcontact.errors.ConvergenceError` with the figures
+estimate meets the tolerance.  An :class:`Extrapolating` refiner names the levels its geometric tails take
+(:meth:`~Extrapolating.sequence`: those of one sequence in its size) and when its extrapolation exists
+(:meth:`~Extrapolating.ready`); before that its estimate within the tolerance does not stop the loop, since
+the tail of levels not yet asymptotic in that size claims less than their error.  Out of reach: a
+:class:`~ngcontact.errors.ConvergenceError` with the figures
 where the tolerance was stated, else the last level with ``met = False``.  Per load: the contact fraction
 absolutely, the mean closure and the normal effective stiffness relatively, as everywhere
 (:data:`ngcontact.cell.admissibility.ESTIMATED`), and the coefficients of eq. 34 on the real contact set
@@ -78,6 +82,13 @@ class Extrapolating(Protocol):
     def extrapolated(self, heads: list[list[dict[str, float]]]) -> dict[str, list[Any]]:
         """Per quantity name, per load the extrapolation (``value``, ``estimate``, ``how``) of the levels'
         headline quantities ``heads[level][load]``, or ``None`` where the levels do not yet give one."""
+
+    def sequence(self, heads: list[list[dict[str, float]]]) -> list[list[dict[str, float]]]:
+        """The levels whose differences the geometric tails take: those of one sequence in the size."""
+
+    def ready(self, levels: int) -> bool:
+        """Whether ``levels`` solved levels give the extrapolation: before, the sequence is not taken as
+        converged, whatever the geometric tail says (the levels it is made of are not yet asymptotic)."""
 
 
 @dataclass
@@ -162,12 +173,13 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
         if len(heads) > 1:
             # the coefficients' scale: the whole surface's (paper eq. 34 with w = 1), where a load reports them
             whole = cell.whole_surface() if any(n.startswith(COEFFICIENT) for h in heads[-1] for n in h) else None
-            estimates, remarks = sequence_estimates(heads, refiner.rule, MEASURES, whole)
+            sequence = refiner.sequence(heads) if isinstance(refiner, Extrapolating) else heads
+            estimates, remarks = sequence_estimates(sequence, refiner.rule, MEASURES, whole)
             if isinstance(refiner, Extrapolating):
                 remarks += _extrapolate(refiner.extrapolated(heads), sols, estimates)
             scales = [{n: scale(n, head, whole) for n in e} for e, head in zip(estimates, heads[-1])]
             entry["estimate"] = max((max(e.values()) for e in estimates if e), default=0.0)
-            if len(heads) >= 3 and entry["estimate"] <= tolerance:
+            if len(heads) >= 3 and _settled(refiner, len(heads)) and entry["estimate"] <= tolerance:
                 return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks), scales)
             hopeless = None if required or len(heads) < 3 else _beyond_reach(levels, tolerance, max_dofs)
             if hopeless is not None:
@@ -175,7 +187,7 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
                 break
     assert cell is not None and sols is not None      # level 0 is the scene's own cell
     worst = levels[-1].get("estimate")
-    if len(heads) == 2 and worst is not None and worst <= tolerance:   # the third level beyond the bound
+    if len(heads) == 2 and _settled(refiner, 2) and worst is not None and worst <= tolerance:   # third beyond
         return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks + [f"stopped: {stop}"]),
                         scales)
     reached = "no estimate (one level)" if worst is None else worst_estimate(estimates)
@@ -188,6 +200,12 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
         estimates = [{} for _ in sols]
     return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]), scales,
                     beyond, stop)
+
+
+def _settled(refiner: Refiner, levels: int) -> bool:
+    """Whether an estimate within the tolerance on ``levels`` levels ends the loop: always, but for an
+    :class:`Extrapolating` refiner not :meth:`~Extrapolating.ready` yet."""
+    return not isinstance(refiner, Extrapolating) or refiner.ready(levels)
 
 
 def _extrapolate(found: dict[str, list[Any]], sols: list[CellSolution], estimates: list[dict[str, float]]
