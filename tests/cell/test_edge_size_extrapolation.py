@@ -14,10 +14,19 @@ def test_two_sizes_remove_a_first_order_error_and_bound_it_by_the_correction():
 
 def test_three_sizes_find_the_rate_and_estimate_by_the_coarser_pair():
     sizes = [0.04, 0.02, 0.01]
-    out = extrapolate(sizes, [1.0 + 2.0 * h ** 1.5 for h in sizes])
-    assert out.rate == pytest.approx(1.5, rel=1e-6)
+    out = extrapolate(sizes, [1.0 + 2.0 * h ** 0.75 for h in sizes])
+    assert out.rate == pytest.approx(0.75, rel=1e-6)
     assert out.value == pytest.approx(1.0, abs=1e-12)
     assert out.estimate >= abs(out.value - 1.0)
+
+
+def test_a_rate_faster_than_first_order_is_not_taken():
+    """Sizes that shrink the difference faster than first order (here ``h^1.5``) extrapolate at first order,
+    say so, and the estimate (3 x the correction) still bounds the error left."""
+    sizes = [0.04, 0.02, 0.01]
+    out = extrapolate(sizes, [1.0 + 2.0 * h ** 1.5 for h in sizes])
+    assert out.rate == 1.0 and "outside (0.5, 1.0)" in out.how
+    assert 1.0 <= out.estimate / abs(out.value - 1.0) <= 10.0
 
 
 def test_a_rate_out_of_range_keeps_the_first_order_and_says_so():
