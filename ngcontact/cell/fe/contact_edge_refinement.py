@@ -19,9 +19,10 @@ edges' length), a relative error ``2 delta / l`` with ``l = 2 A / L`` the patche
 the relative error is a function of ``h / l``.  So the first refined level is already a fixed part of the
 narrowest load's ``l`` and the others halve it,
 
-    h_k = min(interface_maxh, l / (N_1 2^(k - 1))),        N_1 = EDGE_CELLS,
+    h_k = min(interface_maxh / 2, l / N_1) / 2^(k - 1),        N_1 = EDGE_CELLS,
 
-(without a contact edge at any load, ``interface_maxh / 2^k``): the contact fraction's relative error is
+(at most the interface halving's sizes ``interface_maxh / 2^k``, which it is without a contact edge at any
+load, so that the sizes always halve): the contact fraction's relative error is
 then the same at every load, a light load's small patch is refined as far relative to its size as a heavy
 load's, and each level's elements along the edge, ``L / h_k``, are as many at every load (``L / h_k = 2 A
 N_1 2^(k-1) / l^2`` with ``A`` of order ``l^2`` per patch).  No level coarser than ``l / N_1`` is solved:
@@ -113,7 +114,7 @@ class ContactEdgeRefinement:
         width = self.width()
         if width is None:
             return self.interface_maxh / 2 ** k
-        return min(self.interface_maxh, width / (EDGE_CELLS * 2 ** (k - 1)))
+        return min(self.interface_maxh / 2, width / EDGE_CELLS) / 2 ** (k - 1)
 
     def points(self, k: int = 1) -> np.ndarray:
         """The twin's edge points at the loads for level ``k``, on the grid of :func:`twin_grid`."""
