@@ -26,6 +26,7 @@ from __future__ import annotations
 from typing import Any, Callable
 
 from ngcontact.cell.cell_load import cell_load
+from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.contact_edge_mesh import edge_refined_cell
 from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
@@ -36,7 +37,7 @@ from ngcontact.scene.cell_scene import CellScene, load_states
 
 #: the bodies' size of an edge-refined cell whose scene sets no maxh, in periods (module docstring)
 BULK_MAXH = 0.3
-#: tolerance of the twin's solve: only its contact set is used
+#: tolerance of the twin's solve (its contact set places the edge; its answers floor the estimates)
 EDGE_TWIN_RTOL = 1e-8
 
 
@@ -71,13 +72,23 @@ def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any]
     symmetric = quarter(scene)                    # the scene's cell's quarter, refined alike
     bulk = bulk_maxh(scene)
 
+    solved: dict[int, list] = {}
+
+    def twin(grid: int) -> list:
+        if grid not in solved:
+            cell = spectral(scene, grid=grid, friction=False, tol=EDGE_TWIN_RTOL)
+            solved[grid] = [cell.solve(cell_load(g.dim, **state)) for state in load_states(scene)]
+        return solved[grid]
+
     def pressures(grid: int):
-        twin = spectral(scene, grid=grid, friction=False, tol=EDGE_TWIN_RTOL)
-        return [twin.solve(cell_load(g.dim, **state)).fields["pressure"] for state in load_states(scene)]
+        return [s.fields["pressure"] for s in twin(grid)]
+
+    def heads(grid: int):
+        return [headline(s.results) for s in twin(grid)]
 
     def cell_at(points, edge_maxh):
         cell = edge_refined_cell(points, edge_maxh=edge_maxh, period=g.period, h_rough=g.h_rough,
                                  h_counter=g.h_counter, maxh=bulk, interface_maxh=h, symmetric=symmetric)
         return FECell.of(problem(scene, cell, model))
 
-    return lambda fe: ContactEdgeRefinement(fe, pressures, cell_at, h, float(g.period))
+    return lambda fe: ContactEdgeRefinement(fe, pressures, cell_at, h, float(g.period), twin_heads=heads)

@@ -42,6 +42,21 @@ refined levels on it is reported as the Richardson extrapolation in the edge siz
 of the last level), the refiner answering
 :class:`~ngcontact.cell.fe.second_discretization.Extrapolating`; a sweep on this ladder is not taken as
 converged before that extrapolation exists (:meth:`ContactEdgeRefinement.ready`).
+
+The twin's floor.  Those estimates see only the edge size; the error made at the sizes the ladder keeps
+(``interface_maxh`` away from the edge, the bodies, the linear trace) does not change from level to level
+and is not in them.  The twin solves the same continuum problem (the flat layers, the same gap carried as a
+function on a flat ``S_C``, the same materials, exact frictionless contact), so with ``q_N`` its value on
+``N`` points per direction and ``q`` the exact one, for the reported ``q_h``
+
+    |q_h - q| <= |q_h - q_N| + |q_N - q|,        |q_N - q| <= TWIN_SAFETY |q_N - q_{N/2}|,
+
+the second since the spectral cell converges at first order in its grid step (a geometric tail at rate 1/2
+equals the last difference; :data:`TWIN_SAFETY` = 2 covers the stiffness's scatter about that rate,
+:data:`ngcontact.cell.spectral.refinement.ERRATIC`).  ``N`` is the twin's grid of the last level (its
+solutions at the loads place that level's edge), ``N/2`` that of the level before or one coarser solve.
+Each of the contact fraction, the mean closure and the normal stiffness takes the larger of its ladder's
+estimate and this floor (:meth:`ContactEdgeRefinement.twin_floors`).
 """
 from __future__ import annotations
 
@@ -64,6 +79,10 @@ EXTRAPOLATED_LEVELS = 3
 EDGE_CELLS = 10.0
 #: the twin's grid points per direction: at least the first, at most the second (module docstring)
 TWIN_GRIDS = (256, 1024)
+#: the twin's own error over its last difference (module docstring, "The twin's floor")
+TWIN_SAFETY = 2.0
+#: the quantities given the twin's floor
+TWIN_FLOORED = ("contact_fraction", "mean_closure", "normal_stiffness")
 
 
 def twin_grid(edge_maxh: float, period: float) -> int:
@@ -86,7 +105,8 @@ class ContactEdgeRefinement:
 
     ``scene_cell`` is level 0; ``pressures(grid)`` gives the twin's pressure grids at the loads on a
     ``grid x grid`` grid (each grid asked once); ``cell_at(points, edge_maxh)`` the cell (``sweep``,
-    ``unknowns``) on the mesh refined at ``points``; ``period`` the cell's period.
+    ``unknowns``) on the mesh refined at ``points``; ``period`` the cell's period; ``twin_heads(grid)``, where
+    given, the twin's headline quantities at the loads on that grid (from the same solves as ``pressures``).
     """
 
     scene_cell: Any
@@ -95,6 +115,7 @@ class ContactEdgeRefinement:
     interface_maxh: float
     period: float
     rule: Convergence = HALVING_RATE
+    twin_heads: Callable[[int], list[dict[str, float]]] | None = None
     _grids: dict[int, list[np.ndarray]] = field(default_factory=dict, repr=False)
 
     def twin(self, grid: int) -> list[np.ndarray]:
@@ -146,6 +167,21 @@ class ContactEdgeRefinement:
             values = [heads[k][load]["contact_fraction"] for k in refined if "contact_fraction" in heads[k][load]]
             out.append(extrapolate(sizes, values) if len(values) == len(sizes) else None)
         return {"contact_fraction": out}
+
+    def twin_floors(self, reported: list[dict[str, float]], k: int) -> list[dict[str, tuple[float, str]]]:
+        """Per load, per quantity of :data:`TWIN_FLOORED`, the floor ``|q_h - q_N| + TWIN_SAFETY |q_N - q_{N/2}|``
+        of the absolute error of level ``k``'s reported value ``q_h`` and its form in words (module docstring,
+        "The twin's floor"); none without the twin's quantities or at level 0."""
+        if self.twin_heads is None or k == 0:
+            return [{} for _ in reported]
+        n = twin_grid(self.edge_maxh(k), self.period)
+        fine, coarse = self.twin_heads(n), self.twin_heads(n // 2)
+        if not len(fine) == len(coarse) == len(reported):
+            return [{} for _ in reported]
+        form = f"spectral twin: |q - q_N| + {TWIN_SAFETY:g} |q_N - q_N/2|, N = {n}"
+        return [{name: (abs(q[name] - a[name]) + TWIN_SAFETY * abs(a[name] - b[name]), form)
+                 for name in TWIN_FLOORED if name in q and name in a and name in b}
+                for q, a, b in zip(reported, fine, coarse)]
 
     def describe(self, k: int) -> str:
         if k == 0:

@@ -32,7 +32,9 @@ absolutely, the mean closure and the normal effective stiffness relatively, as e
 (:data:`ngcontact.cell.admissibility.ESTIMATED`), and the coefficients of eq. 34 on the real contact set
 relative to their group (:func:`ngcontact.cell.cell_solution.measure`), all held to the tolerance.
 A refiner is any :class:`Refiner`, each with its
-own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.
+own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.  A :class:`Floored` refiner also gives a floor of
+each quantity's absolute error that its sequence cannot see (the contact edge's ladder: its spectral twin,
+:mod:`ngcontact.cell.fe.contact_edge_refinement`, "The twin's floor"); the estimate is the larger of the two.
 """
 from __future__ import annotations
 
@@ -89,6 +91,15 @@ class Extrapolating(Protocol):
     def ready(self, levels: int) -> bool:
         """Whether ``levels`` solved levels give the extrapolation: before, the sequence is not taken as
         converged, whatever the geometric tail says (the levels it is made of are not yet asymptotic)."""
+
+
+@runtime_checkable
+class Floored(Protocol):
+    """A refiner with a floor of the error its sequence does not see (module docstring)."""
+
+    def twin_floors(self, reported: list[dict[str, float]], k: int) -> list[dict[str, tuple[float, str]]]:
+        """Per load, per quantity, the floor of the absolute error of level ``k``'s ``reported`` value and its
+        form in words."""
 
 
 @dataclass
@@ -177,6 +188,9 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
             estimates, remarks = sequence_estimates(sequence, refiner.rule, MEASURES, whole)
             if isinstance(refiner, Extrapolating):
                 remarks += _extrapolate(refiner.extrapolated(heads), sols, estimates)
+            if isinstance(refiner, Floored):
+                remarks += _floor(refiner.twin_floors([headline(s.results) for s in sols], len(heads) - 1),
+                                  sols, estimates, whole)
             scales = [{n: scale(n, head, whole) for n in e} for e, head in zip(estimates, heads[-1])]
             entry["estimate"] = max((max(e.values()) for e in estimates if e), default=0.0)
             if len(heads) >= 3 and _settled(refiner, len(heads)) and entry["estimate"] <= tolerance:
@@ -222,6 +236,23 @@ def _extrapolate(found: dict[str, list[Any]], sols: list[CellSolution], estimate
             sols[k].results[name] = ext.value
             estimates[k][name] = ext.estimate
             remarks.append(f"load {k} {name}: extrapolated, {ext.how}")
+    return remarks
+
+
+def _floor(floors: list[dict[str, tuple[float, str]]], sols: list[CellSolution], estimates: list[dict[str, float]],
+           whole: dict[str, Any] | None) -> list[str]:
+    """Raise each estimated quantity's estimate to its :class:`Floored` floor (in the quantity's measure) where
+    that is larger; the remarks naming the floor's form."""
+    remarks = []
+    for k, per_load in enumerate(floors):
+        head = headline(sols[k].results)
+        for name, (bound, form) in per_load.items():
+            if name not in estimates[k]:
+                continue
+            floor = bound / scale(name, head, whole)
+            if floor > estimates[k][name]:
+                remarks.append(f"load {k} {name}: {estimates[k][name]:.3g} raised to the {form} ({floor:.3g})")
+                estimates[k][name] = floor
     return remarks
 
 
