@@ -39,7 +39,7 @@ tolerance = 0.01
 """
 
 
-@pytest.mark.slow  # about a minute per load: four levels of the quarter cell up to 42k dofs, the spectral 1024^2
+@pytest.mark.slow  # 100-200 CPU s per load: five or six levels of the quarter up to 165k dofs, the spectral 1024^2
 @pytest.mark.parametrize("ratio", [0.005, 0.02, 0.05])
 def test_the_scene_reports_a_contact_fraction_within_1_percent_and_an_estimate_that_bounds_its_error(
         tmp_path, ratio):
