@@ -6,16 +6,18 @@ estimate that bounds the true error (effectivity, estimate over true error,
 in ``[1, 10]``).  The scene is the bisinusoid of ``scripts/bisinusoid_accuracy.py``
 (``h (2 - cos 2 pi x - cos 2 pi y)``, ``h = 0.01``, two layers 1 deep with
 ``E* = 1``, ``p* = pi E* h / P``) with exact contact, ``discretization.method
-= "fe"``, ``tolerance = 0.01`` and ``symmetry`` as asked, every other key at
-its default; one scene per load, each run as ``python -m ngcontact run``, the loads
-side by side (wall seconds and each run's CPU seconds).  Its refinement along the
-contact edge (:mod:`ngcontact.cell.fe.contact_edge_refinement`) reports the
-contact fraction extrapolated in the edge size with its grid convergence
-index (:mod:`ngcontact.cell.fe.edge_size_extrapolation`).  The converged
+= "fe"``, ``tolerance = 0.01`` and ``symmetry`` as asked (``default``: the key
+not set), every other key at its default; one scene per load, each run as
+``python -m ngcontact run``, the loads side by side (wall seconds and each run's
+CPU seconds).  Its refinement along the contact edge
+(:mod:`ngcontact.cell.fe.contact_edge_refinement`: edge sizes scaled with the
+patch width, the bodies at ``maxh`` 0.3, :mod:`ngcontact.drivers.contact_edge_refiner`)
+reports the contact fraction extrapolated in the edge size with its grid
+convergence index (:mod:`ngcontact.cell.fe.edge_size_extrapolation`).  The converged
 value is the spectral cell's contact fraction extrapolated from ``512^2``
 and ``1024^2`` (as in ``bisinusoid_accuracy.py``).
 
-    python scripts/bisinusoid_scene_accuracy.py [OUT] [--ratios 0.005 0.02 0.05] [--symmetry auto] [--publish]
+    python scripts/bisinusoid_scene_accuracy.py [OUT] [--ratios 0.005 0.02 0.05] [--symmetry default] [--publish]
 
 Writes ``OUT/bisinusoid_scene_accuracy.csv`` and ``.png`` (default ``results/bisinusoid_scene_accuracy``).
 """
@@ -60,8 +62,7 @@ pressure = [{p!r}]
 [discretization]
 method = "fe"
 tolerance = 0.01
-symmetry = "{symmetry}"
-"""
+{symmetry}"""
 
 
 def converged(ratio: float) -> float:
@@ -77,7 +78,7 @@ def start(out: str, ratio: float, symmetry: str) -> tuple[subprocess.Popen, floa
     path = os.path.join(out, f"p{ratio:g}.toml")
     with open(path, "w") as fh:
         fh.write(SCENE.format(ratio=ratio, E=2.0 * (1.0 - 0.3 ** 2), h=ACC_H, p=ratio * math.pi * ACC_H,
-                              symmetry=symmetry))
+                              symmetry="" if symmetry == "default" else f'symmetry = "{symmetry}"\n'))
     run = [sys.executable, "-m", "ngcontact", "run", path, "--out", os.path.join(out, f"p{ratio:g}"), "--quiet"]
     with open(os.path.join(out, f"p{ratio:g}.err"), "w") as err:
         return subprocess.Popen(run, stderr=err), time.perf_counter()
@@ -132,14 +133,17 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", nargs="?", default=os.path.join("results", "bisinusoid_scene_accuracy"))
     ap.add_argument("--ratios", type=float, nargs="+", default=list(RATIOS), help="loads p/p*")
-    ap.add_argument("--symmetry", default="auto", choices=("auto", "off"), help="discretization.symmetry")
+    ap.add_argument("--symmetry", default="default", choices=("default", "auto", "off"),
+                    help="discretization.symmetry (default: not set)")
+    ap.add_argument("--serial", action="store_true", help="one load after the other (wall time of a run alone)")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    runs = [start(args.out, ratio, args.symmetry) for ratio in args.ratios]     # side by side
     references = [converged(ratio) for ratio in args.ratios]
+    runs = [] if args.serial else [start(args.out, ratio, args.symmetry) for ratio in args.ratios]   # side by side
     rows = []
-    for ratio, run, reference in zip(args.ratios, runs, references):
+    for k, (ratio, reference) in enumerate(zip(args.ratios, references)):
+        run = start(args.out, ratio, args.symmetry) if args.serial else runs[k]
         rows.append(finish(args.out, ratio, args.symmetry, run, reference))
         print(", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in rows[-1].items()),
               flush=True)
@@ -154,11 +158,14 @@ def main(argv=None) -> int:
         benchmark_doc.publish(
             "bisinusoid_scene_accuracy", "The 3D bisinusoid FE cell as a scene: error, estimate, time", csv_path,
             note="The bisinusoid of section `scaling_3d` posed as a scene (exact contact, `discretization.method = "
-            "\"fe\"`, `tolerance = 0.01`, `symmetry` as in column `symmetry`, every other key at its default: "
-            "order 2 on a linear trace, maxh 0.1), one scene per load `pressure` = p/p*, each run by `ngcontact "
-            "run`, the three side by side. Its refinement along the contact edge (levels: the scene's mesh, "
-            "then edge sizes 0.05, 0.025, ...) reports the contact fraction extrapolated in the edge size from "
-            "its last three refined levels "
+            "\"fe\"`, `tolerance = 0.01`, `symmetry` as in column `symmetry` (`default`: not set, which for this "
+            "cell is the quarter), every other key at its default: order 2 on a linear trace, interface_maxh 0.1, "
+            "the bodies at maxh 0.3 since the cell refines along its contact edge), one scene per load `pressure` "
+            "= p/p*, each run by `ngcontact run`, the three side by side (or one after the other: `--serial`). "
+            "Its refinement along the contact edge "
+            "(levels: the scene's mesh, then edge sizes l/10, l/20, l/40 with l the narrowest patch width of the "
+            "spectral twin, the twin's grid step at most the edge size) reports the contact fraction "
+            "extrapolated in the edge size from its last three refined levels "
             "(`last_level`: the last level's own value) with the grid convergence index as `estimate` "
             "(relative); `relative_error` against `converged` (the spectral cell extrapolated from 512^2 and "
             "1024^2); `effectivity` = estimate / |error| (issue 35: within [1, 10]); `met`: the report's verdict "

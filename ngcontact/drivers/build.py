@@ -23,7 +23,7 @@ from ngcontact.cell.fe.fe_cell import FECell
 from ngcontact.cell.spectral.spectral_solver import SpectralCellSolver
 from ngcontact.coupling import cell_law
 from ngcontact.drivers.cell_gap import gap_cf, gap_samples, map_heights
-from ngcontact.drivers.contact_edge_refiner import edge_refiner
+from ngcontact.drivers.contact_edge_refiner import edge_refiner, scene_sizes
 from ngcontact.drivers.mirror_symmetry import quarter, symmetry_choice
 from ngcontact.drivers.scene_laws import elastic_law
 from ngcontact.errors import SceneError
@@ -38,6 +38,7 @@ from ngcontact.scene.cell_method import SymmetryChoice
 from ngcontact.scene.cell_scene import CellScene, check_fe, has_twin, load_states, spectral_grid
 from ngcontact.scene.spectral_grid import DEFAULT_REFINEMENT_POINTS, MAX_SPECTRAL_POINTS
 from ngcontact.scene.loader import as_dict, load_with_contact
+from ngcontact.scene.schema import replaced
 from ngcontact.scene.sections import resolve
 
 
@@ -200,8 +201,8 @@ def cell_solver(scene: CellScene) -> CellSolver:
 def fe_cell(scene: CellScene) -> FECell:
     """The FE cell of a scene: mesh, problem (built on first solve), variants, graded meshes and their predictor
     (flat 2D frictionless: edge_grading), the contact edge's refiner where it has one (contact_edge_refiner)."""
-    cell, model = build_cell(scene), model_of(scene)
     d = scene.discretization
+    cell, model = build_cell(scene, **scene_sizes(scene)), model_of(scene)     # contact_edge_refiner.bulk_maxh
     graded = h0 = predictor = None
     if gradable(scene):
         g = scene.geometry
@@ -263,8 +264,8 @@ def fe_variant(scene: CellScene, **changes) -> FECell | None:
     the scene's checks (:func:`~ngcontact.scene.cell_scene.check_fe`) refuse the change."""
     sections = {name: getattr(scene, name) for name in set(VARIED.values())}
     for key, value in changes.items():
-        sections[VARIED[key]] = replace(sections[VARIED[key]], **{key: value})
-    sections["discretization"] = replace(sections["discretization"], tolerance=None)
+        sections[VARIED[key]] = replaced(sections[VARIED[key]], **{key: value})
+    sections["discretization"] = replaced(sections["discretization"], tolerance=None)
     varied = scene_with(scene, **sections)
     try:
         if not varied.contact.geometric_only:   # a scene without a solve skips the solve's checks (CellScene)

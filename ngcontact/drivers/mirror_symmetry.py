@@ -17,9 +17,18 @@ on it, the shear traction on it too.  The quarter ``[0, P/2]^2`` with ``u_x = 0`
 (:mod:`ngcontact.geometry.cell3d`); its means over the quarter are those over the period, so the contact
 fraction, the mean closure, the normal stiffness and the eq. 34 coefficients are unchanged in the limit,
 at a quarter of the unknowns.  ``symmetry = "auto"`` uses the quarter where the cell is admissible and
-states why not where it is not (:class:`SymmetryChoice`); ``"off"`` (the default) always meshes the period:
-at the same sizes the quarter is the faster cell, not the more accurate one (docs/benchmarks.md,
-section scaling_3d), so it is asked for, not chosen for the user.
+states why not where it is not (:class:`SymmetryChoice`); ``"off"`` always meshes the period.
+
+The default (:func:`requested`).  A cell refined along its contact edge
+(:func:`~ngcontact.scene.cell_method.refines_along_edge`: exact contact, frictionless, isotropic, the flat
+3D mesh) defaults to ``"auto"``: its reported contact fraction is the extrapolation in the edge size, whose
+estimate (:mod:`ngcontact.cell.fe.edge_size_extrapolation`) is checked on the quarter against the converged
+bisinusoid (docs/benchmarks.md, section ``bisinusoid_scene_accuracy``), and at the same sizes the quarter
+solves a quarter of the unknowns.  Every other FE cell defaults to ``"off"``: its estimate is the interface
+halving's geometric tail (:mod:`ngcontact.cell.fe.second_discretization`), whose ratio floor of ``1/2``
+assumes first-order convergence, and the quarter's finer halved levels of the shipped penalty bisinusoid
+converge more slowly than that (their tail under-estimates the error), so the quarter is asked for there,
+not chosen for the user.
 
 The choice is made once per scene: :func:`ngcontact.drivers.build.with_symmetry` sets it as the scene's
 typed field ``symmetry_choice`` where the drivers take a cell scene in, and the mesh
@@ -35,7 +44,7 @@ import numpy as np
 from ngcontact.drivers.cell_gap import gap_samples
 from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import small_slope
-from ngcontact.scene.cell_method import SymmetryChoice
+from ngcontact.scene.cell_method import SymmetryChoice, refines_along_edge
 from ngcontact.scene.cell_scene import CellScene, load_states
 
 #: grid points per period and direction on which the gap's mirror symmetry is checked
@@ -90,17 +99,24 @@ def _refusal(scene: CellScene) -> str:
     return ""
 
 
+def requested(scene: CellScene) -> str:
+    """``discretization.symmetry`` as the scene sets it, else its default: ``"auto"`` for a cell refined along
+    its contact edge, ``"off"`` for any other (module docstring)."""
+    d = scene.discretization
+    return d.symmetry if "symmetry" in d.given or not refines_along_edge(scene) else "auto"
+
+
 def symmetry_choice(scene: CellScene) -> SymmetryChoice:
     """The :class:`SymmetryChoice` of a cell scene's FE cell (module docstring)."""
-    requested = scene.discretization.symmetry
-    if requested == "off":
+    asked = requested(scene)
+    if asked == "off":
         default = "" if "symmetry" in scene.discretization.given else " (the default; 'auto' meshes the quarter)"
-        return SymmetryChoice(False, f"discretization.symmetry = 'off'{default}", requested)
+        return SymmetryChoice(False, f"discretization.symmetry = 'off'{default}", asked)
     refusal = _refusal(scene)
     if refusal:
-        return SymmetryChoice(False, refusal, requested)
+        return SymmetryChoice(False, refusal, asked)
     return SymmetryChoice(True, "the gap is even about the cell's mid-lines and the load normal and frictionless: "
-                          "the quarter [0, P/2]^2 with zero normal displacement on its mirror faces", requested)
+                          "the quarter [0, P/2]^2 with zero normal displacement on its mirror faces", asked)
 
 
 def quarter(scene: CellScene) -> bool:

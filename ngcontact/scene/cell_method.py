@@ -41,6 +41,7 @@ from dataclasses import dataclass, replace
 from typing import TypeVar
 
 from ngcontact.errors import SceneError
+from ngcontact.geometry.profile_registry import PROFILES
 from ngcontact.scene.cell_geometry import flat_interface, small_slope
 from ngcontact.scene.spectral_grid import TOLERANCE_OVER_RTOL
 from ngcontact.scene.sections import CellDiscretization
@@ -151,6 +152,17 @@ def choose(scene) -> MethodChoice:
                             f"what the spectral cell's solver resolves ({TOLERANCE_OVER_RTOL:g} x solver.rtol = "
                             f"{floor:g})")
     return MethodChoice("spectral", f"a small-slope cell ({small_slope_text(scene)}), no FE-only key set")
+
+
+def refines_along_edge(scene) -> bool:
+    """Whether the scene's FE cell refines along its spectral twin's contact edge
+    (:mod:`ngcontact.drivers.contact_edge_refiner`): a 3D cell meshed flat (a flat profile, or a small-slope
+    one carried by the gap), exact contact, no friction, isotropic bodies."""
+    g, c = scene.geometry, scene.contact
+    kind = PROFILES[g.profile]
+    flat_mesh = kind.solid is None and (kind.heights is None or small_slope(g))
+    isotropic = all(scene.materials[m].C is None for m in (scene.bodies.rough, scene.bodies.counter))
+    return g.dim == 3 and flat_mesh and c.enforcement == "exact" and c.friction == "none" and isotropic
 
 
 def resolved_discretization(d: D, choice: MethodChoice) -> D:

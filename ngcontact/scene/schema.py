@@ -97,6 +97,15 @@ def given_field():
     return dataclasses.field(default=frozenset(), init=False, repr=False, compare=False)
 
 
+def replaced(section, **changes):
+    """``dataclasses.replace(section, **changes)`` keeping the keys the section's table set (its
+    :data:`GIVEN`, which ``replace`` resets): a changed section's defaults are decided as the original's."""
+    out = dataclasses.replace(section, **changes)
+    if hasattr(section, GIVEN):
+        object.__setattr__(out, GIVEN, getattr(section, GIVEN))
+    return out
+
+
 #: the metadata flag of a :func:`derived_field`
 DERIVED = "derived"
 

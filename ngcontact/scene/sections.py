@@ -87,9 +87,11 @@ class CellDiscretization(Discretization):
         "raises the order on the finest (2D frictionless cells with a flat interface), any other FE cell (3D, "
         "curved, frictional) halves interface_maxh level by level (at least three levels, the estimate from "
         "the observed rate, up to 1e6 dofs in 2D and 4e5 in 3D; a flat 3D cell with exact contact and no "
-        "friction halves the element size along its spectral twin's contact edges instead, and from three such "
-        "levels on reports the contact fraction extrapolated in that size from the last three, its estimate "
-        "the grid convergence index, the last level's own value as loads[k].contact_fraction_last_level), "
+        "friction refines along its spectral twin's contact edges instead, to a tenth of the narrowest patch width "
+        "and halved per level (its bodies at maxh 0.3 periods unless maxh is set), reports from three such "
+        "levels on the contact fraction extrapolated in that size from the last three, its estimate the grid "
+        "convergence index, the last level's own value as loads[k].contact_fraction_last_level, and does not "
+        "stop before), "
         "method 'spectral' doubles the grid's points "
         "per direction from discretization.grid (a height map's or random surface's samples are interpolated "
         "bilinearly, the surface the FE cell meshes too; at least four grids, the estimate the geometric tail "
@@ -138,7 +140,7 @@ class CellDiscretization(Discretization):
                         "FE-only key); a macro scene's strength.cell, and a two-scale loop whose friction comes "
                         "from a frictional cell, solve an auto cell by fe (they need the FE cell's stresses and "
                         "shear response)", choices=("auto", "fe", "spectral"))
-    symmetry: str = param("off", doc="3D FE cell: off (the default) meshes the whole period; auto meshes the "
+    symmetry: str = param("off", doc="3D FE cell: off meshes the whole period; auto meshes the "
                           "quarter [0, P/2]^2 of a cell that is even about its mid-lines (the initial gap even in "
                           "x and in y, checked on its samples to round-off; a normal load, no in-plane macro "
                           "shear e_xy; no friction; isotropic or axis-orthotropic bodies; the flat small-slope "
@@ -147,7 +149,9 @@ class CellDiscretization(Discretization):
                           "quarter of the unknowns; results.accuracy.symmetry states whether it was used and, if "
                           "not, why (at the same sizes the quarter is the faster cell, not the more accurate one: "
                           "docs/benchmarks.md, section scaling_3d); the cell of a strength check or of a shear "
-                          "table, loaded tangentially, keeps its period",
+                          "table, loaded tangentially, keeps its period; default: auto for a cell refined along its "
+                          "contact edge (a flat or small-slope 3D mesh, exact contact, no friction, isotropic "
+                          "bodies: its extrapolated estimate is checked on the quarter), off for any other",
                           choices=("auto", "off"))
     grid: int | None = param(None, doc="spectral (set with method = 'auto', it asks for the spectral cell): grid "
                              "points per period and direction of the first grid, "

@@ -33,7 +33,7 @@ def _interface_sizes(mesh) -> np.ndarray:
 
 @pytest.mark.slow  # ~17 s under load: the twin at 256^2 and the refined cell's mesh and space
 def test_an_exact_flat_3d_cell_refines_along_its_twins_contact_edge(tmp_path):
-    """Level 1 of the scene's refiner: the mesh finer (edge_maxh 0.05) at Westergaard's edges x = 1/2 +- a
+    """Level 1 of the scene's refiner: the mesh finer (edge_maxh below interface_maxh) at Westergaard's edges x = 1/2 +- a
     (waves along x) than away from them, S_C with more triangles than the scene's; the penalty cell keeps
     the halving."""
     path = tmp_path / "s.toml"
@@ -41,7 +41,8 @@ def test_an_exact_flat_3d_cell_refines_along_its_twins_contact_edge(tmp_path):
     cell = fe_cell(load(path))
     refiner = cell.refiner()
     assert isinstance(refiner, ContactEdgeRefinement) and refiner.rule is HALVING_RATE
-    assert refiner.level(0) is cell and refiner.describe(2).startswith("edge_maxh 0.025")
+    h1 = refiner.edge_maxh(1)        # the strips' width 2a over EDGE_CELLS, within interface_maxh
+    assert h1 < 0.1 and refiner.level(0) is cell and refiner.describe(2).startswith(f"edge_maxh {h1 / 2:g}")
     a = westergaard_contact_fraction(0.5, 1.0) / 2      # half the contact width (period 1)
     pts = refiner.points()
     assert len(pts) > 0 and np.all(np.abs(np.abs(pts[:, 0] - 0.5) - a) < 2.0 / 256)
@@ -53,3 +54,43 @@ def test_an_exact_flat_3d_cell_refines_along_its_twins_contact_edge(tmp_path):
     assert len(sizes) > len(_interface_sizes(cell.problem.mesh))
     path.write_text(SCENE.replace('enforcement = "exact"', 'enforcement = "penalty"'))
     assert isinstance(fe_cell(load(path)).refiner(), InterfaceHalving)
+
+
+def _disk(grid: int, radius: float) -> np.ndarray:
+    """A pressure grid carrying pressure on the disk of ``radius`` about the period's corner (periodically)."""
+    s = np.arange(grid) / grid
+    d = np.minimum(s, 1.0 - s)
+    return np.where(d[None, :] ** 2 + d[:, None] ** 2 < radius ** 2, 1.0, 0.0)
+
+
+def test_the_patch_width_is_the_radius_of_a_disk_and_the_width_of_a_strip():
+    from ngcontact.cell.fe.contact_edge_mesh import patch_length
+    assert patch_length(_disk(512, 0.1), 1.0) == pytest.approx(0.1, rel=0.03)
+    assert patch_length(_disk(512, 0.05), 1.0) == pytest.approx(0.05, rel=0.03)
+    strip = np.zeros((256, 256))
+    strip[:, :64] = 1.0                                  # a band a quarter of the period wide
+    assert patch_length(strip, 1.0) == pytest.approx(0.25, rel=0.3)   # straight edges: within (4/pi - 1)
+    assert patch_length(np.zeros((64, 64)), 1.0) is None
+
+
+def test_the_edge_sizes_scale_with_the_narrowest_patch_and_the_twin_resolves_them():
+    """Level 1 at the narrowest load's patch width over EDGE_CELLS, halved per level; the edge points of a
+    level from a twin whose grid step is at most its edge size; halving interface_maxh without an edge."""
+    from ngcontact.cell.fe.contact_edge_refinement import EDGE_CELLS, twin_grid
+    asked = []
+
+    def pressures(grid):
+        asked.append(grid)
+        return [_disk(grid, 0.08), _disk(grid, 0.15)]
+
+    ladder = ContactEdgeRefinement(None, pressures, lambda points, h: (points, h), interface_maxh=0.1, period=1.0)
+    assert ladder.edge_maxh(1) == pytest.approx(0.08 / EDGE_CELLS, rel=0.03)
+    assert ladder.edge_maxh(3) == pytest.approx(ladder.edge_maxh(1) / 4)
+    points, h = ladder.level(3)
+    assert h == ladder.edge_maxh(3) and 1.0 / twin_grid(h, 1.0) <= h and asked == [256, twin_grid(h, 1.0)]
+    assert len(points) > len(ladder.points(1))
+    assert twin_grid(0.0025, 1.0) == 512 and twin_grid(0.1, 1.0) == 256 and twin_grid(1e-4, 1.0) == 1024
+    wide = ContactEdgeRefinement(None, lambda grid: [_disk(grid, 0.4)], lambda p, h: h, 0.05, 1.0)
+    assert [wide.edge_maxh(k) for k in (1, 2)] == [0.025, 0.0125]     # the halving's sizes where l/10 is coarser
+    flat = ContactEdgeRefinement(None, lambda grid: [np.zeros((grid, grid))], lambda p, h: h, 0.1, 1.0)
+    assert flat.edge_maxh(2) == pytest.approx(0.025) and not flat.ready(3) and flat.ready(4)

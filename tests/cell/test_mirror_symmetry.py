@@ -186,11 +186,20 @@ def test_a_symmetric_scene_is_meshed_as_its_quarter_and_says_so():
 
 
 def test_the_default_meshes_the_period_and_says_auto_would_mesh_the_quarter():
-    """symmetry = "off" is the default: the quarter is asked for."""
-    scene = _scene(symmetry=None)
+    """Without symmetry, a cell refined by its interface halving (here the penalty) meshes the period: the
+    quarter is asked for there."""
+    scene = _scene(symmetry=None, contact={"enforcement": "penalty", "k_n": 1000.0})
     choice = symmetry_choice(scene)
     assert scene.discretization.symmetry == "off" and not choice.used and not build_cell(scene).symmetric
     assert choice.reason == "discretization.symmetry = 'off' (the default; 'auto' meshes the quarter)"
+
+
+def test_a_cell_refined_along_its_contact_edge_defaults_to_its_quarter():
+    """Without symmetry, the exact frictionless cell (refined along its contact edge) is meshed as its
+    quarter, stated as asked for by auto; set to off it keeps the period."""
+    choice = symmetry_choice(_scene(symmetry=None))
+    assert choice.used and choice.requested == "auto" and build_cell(_scene(symmetry=None)).symmetric
+    assert not symmetry_choice(_scene(symmetry="off")).used
 
 
 def test_a_gap_that_is_not_even_keeps_the_period(tmp_path):

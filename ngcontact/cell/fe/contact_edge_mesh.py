@@ -151,6 +151,25 @@ def patch_radius(pressure: np.ndarray, period: float) -> float:
     return float(period) * float(np.sqrt(np.mean(np.asarray(pressure) > 0.0) / np.pi))
 
 
+def patch_length(pressure: np.ndarray, period: float) -> float | None:
+    """``l = 2 A / L``: the length the contact set of a periodic ``n x n`` pressure grid is wide, from its area
+    ``A`` (the grid points carrying pressure) and its edges' length ``L`` (``None`` without an edge).
+
+    ``l`` is the radius of a round patch (``2 pi a^2 / 2 pi a``) and the width of a strip, and a set of many
+    patches has the ``l`` of their sizes weighted by their edges.  An edge displaced by ``delta`` moves the
+    contact fraction by ``L delta / P^2``, its relative error is ``delta L / A = 2 delta / l``: an element
+    size at the edge that is a fixed part of ``l`` gives a contact fraction of a fixed relative accuracy,
+    whatever the load.  ``L`` is counted from the edge points (:func:`edge_points`): a curve of length ``L``
+    crosses the grid lines ``L (|n_x| + |n_y|) / Delta`` times, and ``|n_x| + |n_y|`` has the mean ``4 / pi``
+    over the directions of a closed convex curve, so ``L = (pi / 4) m Delta`` from ``m`` crossings."""
+    p = np.asarray(pressure, float)
+    crossings = len(edge_points(p, period))
+    if crossings == 0:
+        return None
+    area = float(np.mean(p > 0.0)) * period ** 2
+    return 2.0 * area / (0.25 * np.pi * crossings * period / p.shape[1])
+
+
 def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1.0, h_rough: float = 1.0,
                       h_counter: float = 1.0, maxh: float, interface_maxh: float,
                       body: PatchBody | None = None, symmetric: bool = False) -> Cell:

@@ -7,18 +7,56 @@ size (:mod:`ngcontact.cell.fe.contact_edge_mesh`, "Why the edge").  Halving ``in
 (:class:`~ngcontact.cell.fe.second_discretization.InterfaceHalving`) multiplies the elements of ``S_C`` by
 four per level, nearly all of them on open surface or inside the patches.
 
-:class:`ContactEdgeRefinement` keeps the scene's ``maxh`` and ``interface_maxh`` and halves the element size
-at the contact edge only: level 0 is the scene's cell, level ``k >= 1`` the cell of
-:func:`~ngcontact.cell.fe.contact_edge_mesh.edge_refined_cell` with
-``edge_maxh = interface_maxh / 2^k`` at the edge points (:func:`~ngcontact.cell.fe.contact_edge_mesh.edge_points`)
-of the spectral twin's solutions at the sweep's loads (the same layers and gap on a periodic grid).  The
-sequence's element size at the edge is thus ``h, h/2, h/4, ...`` as for the halving, and its answers converge
-at the same first order, so the estimate takes the same rule
+:class:`ContactEdgeRefinement` keeps the scene's ``maxh`` and ``interface_maxh`` and refines at the contact
+edge only: level 0 is the scene's cell, level ``k >= 1`` the cell of
+:func:`~ngcontact.cell.fe.contact_edge_mesh.edge_refined_cell` restricted to ``edge_maxh = h_k`` at the
+edge points (:func:`~ngcontact.cell.fe.contact_edge_mesh.edge_points`) of the spectral twin's solutions at
+the sweep's loads (the same layers and gap on a periodic grid).
+
+The sizes.  An edge placed ``delta`` off moves the contact fraction ``f`` by ``delta L / P^2`` (``L`` the
+edges' length), a relative error ``2 delta / l`` with ``l = 2 A / L`` the patches' width
+(:func:`~ngcontact.cell.fe.contact_edge_mesh.patch_length`); with ``delta`` a part of the edge size ``h``
+the relative error is a function of ``h / l``.  So the first refined level is already a fixed part of the
+narrowest load's ``l`` and the others halve it,
+
+    h_k = min(interface_maxh / 2, l / N_1) / 2^(k - 1),        N_1 = EDGE_CELLS,
+
+(at most the interface halving's sizes ``interface_maxh / 2^k``, which it is without a contact edge at any
+load, so that the sizes always halve): the contact fraction's relative error is
+then the same at every load, a light load's small patch is refined as far relative to its size as a heavy
+load's, and each level's elements along the edge, ``L / h_k``, are as many at every load (``L / h_k = 2 A
+N_1 2^(k-1) / l^2`` with ``A`` of order ``l^2`` per patch).  No level coarser than ``l / N_1`` is solved:
+those see the patch with a few elements across, where the edge term is not yet ``C h``
+(:mod:`ngcontact.cell.fe.edge_size_extrapolation`) and a geometric tail on them claims less than the error.
+
+The points.  Netgen restricts the size at each point given and grades away from it, so where the twin's
+points are further apart along the edge than ``h_k`` the edge between them is meshed coarser than ``h_k``
+(and by how much depends on where the points fall): the twin of level ``k`` has a grid step ``Delta <= h_k``
+(the power of two ``n >= P / h_k`` points per direction, within :data:`TWIN_GRIDS`), so that its edge
+points are at most ``h_k`` apart along the edge and within ``Delta / 2`` of the twin's own edge.
+
+The estimate.  The answers converge at first order in ``h_k``, so the estimate takes the halving's rule
 (:data:`~ngcontact.cell.fe.second_discretization.HALVING_RATE`), but for the contact fraction: from three
 refined levels on it is reported as the Richardson extrapolation in the edge size of the last three
-(:mod:`ngcontact.cell.fe.edge_size_extrapolation`, levels ``k >= 1`` only: level 0 is not refined at the
-edge), with that module's estimate (the grid convergence index of the last level), the refiner answering
-:class:`~ngcontact.cell.fe.second_discretization.Extrapolating`.
+(:mod:`ngcontact.cell.fe.edge_size_extrapolation`), with that module's estimate (the grid convergence index
+of the last level), the refiner answering
+:class:`~ngcontact.cell.fe.second_discretization.Extrapolating`; a sweep on this ladder is not taken as
+converged before that extrapolation exists (:meth:`ContactEdgeRefinement.ready`).
+
+The twin's floor.  Those estimates see only the edge size; the error made at the sizes the ladder keeps
+(``interface_maxh`` away from the edge, the bodies, the linear trace) does not change from level to level
+and is not in them.  The twin solves the same continuum problem (the flat layers, the same gap carried as a
+function on a flat ``S_C``, the same materials, exact frictionless contact), so with ``q_N`` its value on
+``N`` points per direction and ``q`` the exact one, for the reported ``q_h``
+
+    |q_h - q| <= |q_h - q_N| + |q_N - q|,        |q_N - q| <= TWIN_SAFETY |q_N - q_{N/2}|,
+
+the second since the spectral cell converges at first order in its grid step (a geometric tail at rate 1/2
+equals the last difference; :data:`TWIN_SAFETY` = 2 covers the stiffness's scatter about that rate,
+:data:`ngcontact.cell.spectral.refinement.ERRATIC`).  ``N`` is the twin's grid of the last level (its
+solutions at the loads place that level's edge), ``N/2`` that of the level before or one coarser solve.
+Each of the contact fraction, the mean closure and the normal stiffness takes the larger of its ladder's
+estimate and this floor (:meth:`ContactEdgeRefinement.twin_floors`).
 """
 from __future__ import annotations
 
@@ -27,7 +65,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ngcontact.cell.fe.contact_edge_mesh import edge_points
+import math
+
+from ngcontact.cell.fe.contact_edge_mesh import edge_points, patch_length
 from ngcontact.cell.fe.edge_size_extrapolation import EdgeSizeExtrapolation, extrapolate
 from ngcontact.cell.fe.observed_rate import Convergence
 from ngcontact.cell.fe.second_discretization import HALVING_RATE
@@ -35,6 +75,21 @@ from ngcontact.cell.fe.second_discretization import HALVING_RATE
 
 #: the refined levels whose contact fractions are extrapolated (the last ones)
 EXTRAPOLATED_LEVELS = 3
+#: ``N_1``: the first refined level's edge size is the narrowest patch width over this (module docstring)
+EDGE_CELLS = 10.0
+#: the twin's grid points per direction: at least the first, at most the second (module docstring)
+TWIN_GRIDS = (256, 1024)
+#: the twin's own error over its last difference (module docstring, "The twin's floor")
+TWIN_SAFETY = 2.0
+#: the quantities given the twin's floor
+TWIN_FLOORED = ("contact_fraction", "mean_closure", "normal_stiffness")
+
+
+def twin_grid(edge_maxh: float, period: float) -> int:
+    """The twin's points per direction at edge size ``edge_maxh``: the power of two ``n >= P / h``, within
+    :data:`TWIN_GRIDS` (module docstring)."""
+    n = 2 ** math.ceil(math.log2(period / edge_maxh - 1e-9))
+    return int(min(max(n, TWIN_GRIDS[0]), TWIN_GRIDS[1]))
 
 
 def twin_edge_points(pressures: list[np.ndarray], period: float) -> np.ndarray:
@@ -45,33 +100,60 @@ def twin_edge_points(pressures: list[np.ndarray], period: float) -> np.ndarray:
 
 @dataclass
 class ContactEdgeRefinement:
-    """Level ``k``: the scene's cell, then its mesh refined to ``interface_maxh / 2^k`` along the twin's
-    contact edges (module docstring).
+    """Level ``k``: the scene's cell, then its mesh refined to ``h_k`` along the twin's contact edges (module
+    docstring).
 
-    ``scene_cell`` is level 0; ``pressures()`` gives the twin's pressure grids at the loads (asked once, on
-    the first refined level); ``cell_at(points, edge_maxh)`` the cell (``sweep``, ``unknowns``) on the mesh
-    refined at ``points``; ``period`` the cell's period.
+    ``scene_cell`` is level 0; ``pressures(grid)`` gives the twin's pressure grids at the loads on a
+    ``grid x grid`` grid (each grid asked once); ``cell_at(points, edge_maxh)`` the cell (``sweep``,
+    ``unknowns``) on the mesh refined at ``points``; ``period`` the cell's period; ``twin_heads(grid)``, where
+    given, the twin's headline quantities at the loads on that grid (from the same solves as ``pressures``).
     """
 
     scene_cell: Any
-    pressures: Callable[[], list[np.ndarray]]
+    pressures: Callable[[int], list[np.ndarray]]
     cell_at: Callable[[np.ndarray, float], Any]
     interface_maxh: float
     period: float
     rule: Convergence = HALVING_RATE
-    _points: list[np.ndarray] = field(default_factory=list, repr=False)
+    twin_heads: Callable[[int], list[dict[str, float]]] | None = None
+    _grids: dict[int, list[np.ndarray]] = field(default_factory=dict, repr=False)
 
-    def points(self) -> np.ndarray:
-        """The twin's edge points at the loads (computed once)."""
-        if not self._points:
-            self._points.append(twin_edge_points(self.pressures(), self.period))
-        return self._points[0]
+    def twin(self, grid: int) -> list[np.ndarray]:
+        """The twin's pressure grids at the loads on ``grid`` (computed once per grid)."""
+        if grid not in self._grids:
+            self._grids[grid] = self.pressures(grid)
+        return self._grids[grid]
+
+    def width(self) -> float | None:
+        """The narrowest patch width ``l`` over the loads on the coarsest twin (module docstring), ``None``
+        where no load has a contact edge."""
+        widths = [w for p in self.twin(TWIN_GRIDS[0]) if (w := patch_length(p, self.period)) is not None]
+        return min(widths) if widths else None
 
     def edge_maxh(self, k: int) -> float:
-        return self.interface_maxh / 2 ** k
+        """``h_k`` (module docstring)."""
+        width = self.width()
+        if width is None:
+            return self.interface_maxh / 2 ** k
+        return min(self.interface_maxh / 2, width / EDGE_CELLS) / 2 ** (k - 1)
+
+    def points(self, k: int = 1) -> np.ndarray:
+        """The twin's edge points at the loads for level ``k``, on the grid of :func:`twin_grid`."""
+        return twin_edge_points(self.twin(twin_grid(self.edge_maxh(k), self.period)), self.period)
 
     def level(self, k: int) -> Any:
-        return self.scene_cell if k == 0 else self.cell_at(self.points(), self.edge_maxh(k))
+        return self.scene_cell if k == 0 else self.cell_at(self.points(k), self.edge_maxh(k))
+
+    def sequence(self, heads: list[list[dict[str, float]]]) -> list[list[dict[str, float]]]:
+        """The levels of the geometric tails (the mean closure, the stiffness, the coefficients): the refined
+        ones, once there are two; level 0 is not refined at the edge, and its step to level 1 changes the
+        mesh everywhere, not the edge size, so it is no difference of the sequence in ``h_k``."""
+        return heads[1:] if len(heads) > 2 else heads
+
+    def ready(self, levels: int) -> bool:
+        """Whether ``levels`` solved levels (the scene's and the refined) give the extrapolation (module
+        docstring): at least :data:`EXTRAPOLATED_LEVELS` refined ones."""
+        return levels - 1 >= EXTRAPOLATED_LEVELS
 
     def extrapolated(self, heads: list[list[dict[str, float]]]) -> dict[str, list[EdgeSizeExtrapolation | None]]:
         """Per load the contact fraction extrapolated from the last three refined levels (module docstring);
@@ -85,6 +167,21 @@ class ContactEdgeRefinement:
             values = [heads[k][load]["contact_fraction"] for k in refined if "contact_fraction" in heads[k][load]]
             out.append(extrapolate(sizes, values) if len(values) == len(sizes) else None)
         return {"contact_fraction": out}
+
+    def twin_floors(self, reported: list[dict[str, float]], k: int) -> list[dict[str, tuple[float, str]]]:
+        """Per load, per quantity of :data:`TWIN_FLOORED`, the floor ``|q_h - q_N| + TWIN_SAFETY |q_N - q_{N/2}|``
+        of the absolute error of level ``k``'s reported value ``q_h`` and its form in words (module docstring,
+        "The twin's floor"); none without the twin's quantities or at level 0."""
+        if self.twin_heads is None or k == 0:
+            return [{} for _ in reported]
+        n = twin_grid(self.edge_maxh(k), self.period)
+        fine, coarse = self.twin_heads(n), self.twin_heads(n // 2)
+        if not len(fine) == len(coarse) == len(reported):
+            return [{} for _ in reported]
+        form = f"spectral twin: |q - q_N| + {TWIN_SAFETY:g} |q_N - q_N/2|, N = {n}"
+        return [{name: (abs(q[name] - a[name]) + TWIN_SAFETY * abs(a[name] - b[name]), form)
+                 for name in TWIN_FLOORED if name in q and name in a and name in b}
+                for q, a, b in zip(reported, fine, coarse)]
 
     def describe(self, k: int) -> str:
         if k == 0:

@@ -17,9 +17,17 @@ the edge).  Two solves at ``h`` and ``r h`` (``r > 1``) then give
 
 and a third size the observed rate ``q`` of the two successive differences
 (``f(h) - f(r1 h)`` against ``f(r1 h) - f(r2 h)``), with which the
-extrapolation is repeated.  Where the observed rate is far from 1 (outside
-:data:`RATE_RANGE`) the sizes are not in the asymptotic range: the
-extrapolation keeps the first order and says so.
+extrapolation is repeated.  Where the observed rate is outside
+:data:`RATE_RANGE` the sizes are not in the asymptotic range: the
+extrapolation keeps the first order and says so.  The range ends at 1:
+the expansion's leading term is of first order, so a faster observed rate
+(the last difference shrunk by more than the size's ratio) is the ``o(h)``
+terms or the mesh's own scatter (where the edge falls among the nodes
+differs from mesh to mesh by a part of ``h``) shortening the last step,
+not a faster convergence, and taking it would correct by less than the
+first-order term ``(f(rh) - f(h)) / (r - 1)`` that remains; a slower one
+(down to ``1/2``) says the ``o(h)`` terms still add to the first-order
+one, and extrapolates further.
 
 The estimate of the extrapolated value's error.  With two sizes: the
 correction itself, ``|f - f(h)|`` (nothing smaller is known from two
@@ -42,8 +50,11 @@ convergence index of the finest value (P. J. Roache, J. Fluids Eng. 116
     GCI = F_s |f(h) - f(r h)| / (r^q - 1) = F_s |c|,    c = f(h) - f,
 
 the correction ``c`` Richardson made, times the safety factor ``F_s``
-(:data:`SAFETY`: 1.25 where three sizes show a rate in range, 3 where the
-first order is assumed), and at least the last difference and the
+(:data:`SAFETY`: 1.25 where three sizes show a rate in range, Roache's
+three-grid factor; 3 where the first order is assumed for want of a rate,
+his two-grid one; 2 where the rate shows faster than first order and the
+first order is taken, in between: the differences' sign and ratio are
+observed, but the correction is not the one they fit), and at least the last difference and the
 extrapolations' disagreement.  It bounds the extrapolated value's error
 ``|E_0 + o(h^q)|`` as long as the part the sequence keeps fixed is at most
 ``F_s`` times the part it removed at the finest size: the premise of
@@ -58,9 +69,11 @@ import math
 from dataclasses import dataclass
 
 #: observed rates outside this range are not taken (the sizes are not asymptotic)
-RATE_RANGE = (0.5, 2.0)
-#: the grid convergence index's safety factor: with a rate observed in range, with the first order assumed
-SAFETY = {"observed": 1.25, "assumed": 3.0}
+RATE_RANGE = (0.5, 1.0)
+#: the grid convergence index's safety factor: with a rate observed in range, with one observed faster than the
+#: range and the first order taken, with the first order assumed (no rate: the differences change sign or
+#: the rate is slower than the range)
+SAFETY = {"observed": 1.25, "faster": 2.0, "assumed": 3.0}
 
 
 @dataclass(frozen=True)
@@ -97,7 +110,7 @@ def extrapolate(sizes: list[float], values: list[float]) -> EdgeSizeExtrapolatio
         rate, safety = q, SAFETY["observed"]
         how = f"observed rate {q:.2f} of three edge sizes"
     else:
-        rate, safety = 1.0, SAFETY["assumed"]
+        rate, safety = 1.0, SAFETY["faster" if q is not None and q > RATE_RANGE[1] else "assumed"]
         how = (f"first order in the edge size: the observed rate {q if q is None else round(q, 2)} "
                f"of three sizes is outside {RATE_RANGE}")
     value = _richardson(f[0], f[1], r, rate)

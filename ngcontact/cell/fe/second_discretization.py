@@ -22,13 +22,19 @@ the order), so the tail of the differences would claim a quarter of the error.
 The loop (:func:`refine`): the scene's discretization is level 0; each next level is solved if its unknowns
 (known once its mesh is built, before the solve) are within the size bound; the estimate of the last level
 needs three levels (two observed differences), or two where the third is beyond the bound; it stops when the
-estimate meets the tolerance.  Out of reach: a :class:`~ngcontact.errors.ConvergenceError` with the figures
+estimate meets the tolerance.  An :class:`Extrapolating` refiner names the levels its geometric tails take
+(:meth:`~Extrapolating.sequence`: those of one sequence in its size) and when its extrapolation exists
+(:meth:`~Extrapolating.ready`); before that its estimate within the tolerance does not stop the loop, since
+the tail of levels not yet asymptotic in that size claims less than their error.  Out of reach: a
+:class:`~ngcontact.errors.ConvergenceError` with the figures
 where the tolerance was stated, else the last level with ``met = False``.  Per load: the contact fraction
 absolutely, the mean closure and the normal effective stiffness relatively, as everywhere
 (:data:`ngcontact.cell.admissibility.ESTIMATED`), and the coefficients of eq. 34 on the real contact set
 relative to their group (:func:`ngcontact.cell.cell_solution.measure`), all held to the tolerance.
 A refiner is any :class:`Refiner`, each with its
-own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.
+own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.  A :class:`Floored` refiner also gives a floor of
+each quantity's absolute error that its sequence cannot see (the contact edge's ladder: its spectral twin,
+:mod:`ngcontact.cell.fe.contact_edge_refinement`, "The twin's floor"); the estimate is the larger of the two.
 """
 from __future__ import annotations
 
@@ -78,6 +84,22 @@ class Extrapolating(Protocol):
     def extrapolated(self, heads: list[list[dict[str, float]]]) -> dict[str, list[Any]]:
         """Per quantity name, per load the extrapolation (``value``, ``estimate``, ``how``) of the levels'
         headline quantities ``heads[level][load]``, or ``None`` where the levels do not yet give one."""
+
+    def sequence(self, heads: list[list[dict[str, float]]]) -> list[list[dict[str, float]]]:
+        """The levels whose differences the geometric tails take: those of one sequence in the size."""
+
+    def ready(self, levels: int) -> bool:
+        """Whether ``levels`` solved levels give the extrapolation: before, the sequence is not taken as
+        converged, whatever the geometric tail says (the levels it is made of are not yet asymptotic)."""
+
+
+@runtime_checkable
+class Floored(Protocol):
+    """A refiner with a floor of the error its sequence does not see (module docstring)."""
+
+    def twin_floors(self, reported: list[dict[str, float]], k: int) -> list[dict[str, tuple[float, str]]]:
+        """Per load, per quantity, the floor of the absolute error of level ``k``'s ``reported`` value and its
+        form in words."""
 
 
 @dataclass
@@ -162,12 +184,16 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
         if len(heads) > 1:
             # the coefficients' scale: the whole surface's (paper eq. 34 with w = 1), where a load reports them
             whole = cell.whole_surface() if any(n.startswith(COEFFICIENT) for h in heads[-1] for n in h) else None
-            estimates, remarks = sequence_estimates(heads, refiner.rule, MEASURES, whole)
+            sequence = refiner.sequence(heads) if isinstance(refiner, Extrapolating) else heads
+            estimates, remarks = sequence_estimates(sequence, refiner.rule, MEASURES, whole)
             if isinstance(refiner, Extrapolating):
                 remarks += _extrapolate(refiner.extrapolated(heads), sols, estimates)
+            if isinstance(refiner, Floored):
+                remarks += _floor(refiner.twin_floors([headline(s.results) for s in sols], len(heads) - 1),
+                                  sols, estimates, whole)
             scales = [{n: scale(n, head, whole) for n in e} for e, head in zip(estimates, heads[-1])]
             entry["estimate"] = max((max(e.values()) for e in estimates if e), default=0.0)
-            if len(heads) >= 3 and entry["estimate"] <= tolerance:
+            if len(heads) >= 3 and _settled(refiner, len(heads)) and entry["estimate"] <= tolerance:
                 return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks), scales)
             hopeless = None if required or len(heads) < 3 else _beyond_reach(levels, tolerance, max_dofs)
             if hopeless is not None:
@@ -175,7 +201,7 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
                 break
     assert cell is not None and sols is not None      # level 0 is the scene's own cell
     worst = levels[-1].get("estimate")
-    if len(heads) == 2 and worst is not None and worst <= tolerance:   # the third level beyond the bound
+    if len(heads) == 2 and _settled(refiner, 2) and worst is not None and worst <= tolerance:   # third beyond
         return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks + [f"stopped: {stop}"]),
                         scales)
     reached = "no estimate (one level)" if worst is None else worst_estimate(estimates)
@@ -188,6 +214,12 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
         estimates = [{} for _ in sols]
     return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]), scales,
                     beyond, stop)
+
+
+def _settled(refiner: Refiner, levels: int) -> bool:
+    """Whether an estimate within the tolerance on ``levels`` levels ends the loop: always, but for an
+    :class:`Extrapolating` refiner not :meth:`~Extrapolating.ready` yet."""
+    return not isinstance(refiner, Extrapolating) or refiner.ready(levels)
 
 
 def _extrapolate(found: dict[str, list[Any]], sols: list[CellSolution], estimates: list[dict[str, float]]
@@ -204,6 +236,23 @@ def _extrapolate(found: dict[str, list[Any]], sols: list[CellSolution], estimate
             sols[k].results[name] = ext.value
             estimates[k][name] = ext.estimate
             remarks.append(f"load {k} {name}: extrapolated, {ext.how}")
+    return remarks
+
+
+def _floor(floors: list[dict[str, tuple[float, str]]], sols: list[CellSolution], estimates: list[dict[str, float]],
+           whole: dict[str, Any] | None) -> list[str]:
+    """Raise each estimated quantity's estimate to its :class:`Floored` floor (in the quantity's measure) where
+    that is larger; the remarks naming the floor's form."""
+    remarks = []
+    for k, per_load in enumerate(floors):
+        head = headline(sols[k].results)
+        for name, (bound, form) in per_load.items():
+            if name not in estimates[k]:
+                continue
+            floor = bound / scale(name, head, whole)
+            if floor > estimates[k][name]:
+                remarks.append(f"load {k} {name}: {estimates[k][name]:.3g} raised to the {form} ({floor:.3g})")
+                estimates[k][name] = floor
     return remarks
 
 
