@@ -29,7 +29,10 @@ print(before, faults(), changed)
 
 def _probe(env_extra: dict) -> tuple[int, int, bool]:
     env = {k: v for k, v in os.environ.items() if k not in heap_thresholds.FREEZING}
-    env.update(env_extra)
+    # NumPy asks for transparent huge pages on arrays of 4 MiB and more; where the kernel grants them (it
+    # depends on where the mapping happens to fall, so on every import before the probe's loop) an array
+    # costs a few faults, not one per 4 KiB page, and the count no longer shows whether it was mapped afresh
+    env.update(env_extra, NUMPY_MADVISE_HUGEPAGE="0")
     out = subprocess.run([sys.executable, "-c", PROBE], env=env, capture_output=True, text=True, check=True)
     before, after, changed = out.stdout.split()
     return int(before), int(after), changed == "True"
