@@ -71,7 +71,8 @@ import ngsolve as ng
 
 from ngcontact.cell.fe.measures import contact_pieces
 from ngcontact.cell.fe.load_start import starts_afresh
-from ngcontact.cell.fe.grading_estimate import LEVELS_PER_STEP, RATIO, merged, order_estimate, set_move
+from ngcontact.cell.cell_solver import Refinement
+from ngcontact.cell.fe.grading_estimate import LEVELS_PER_STEP, ORDER_RATE, RATIO, merged, order_estimate, set_move
 from ngcontact.cell.fe.observed_rate import DISAGREE
 from ngcontact.errors import ConvergenceError, ModelError, SceneError
 from ngcontact.geometry.cell2d import flat_cell
@@ -404,3 +405,25 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
         f"order, the mean closure by {entry['closure_change']:.3g}; the estimated errors of the last order are "
         f"{tail['contact_fraction']:.3g} (contact fraction) and {tail['mean_closure']:.3g} (mean closure); loosen "
         "the tolerance or raise the order", {"levels": history})
+
+
+def _named(k: int, n: int) -> str:
+    """The prefix of load ``k``'s remark in a sweep of ``n`` loads (none for a load alone)."""
+    return f"load {k} " if n > 1 else ""
+
+
+def graded_refinement(solves: list[GradedSolve]) -> Refinement:
+    """A sweep's loads, each solved on its graded meshes, as the sweep's refinement: the highest order's
+    answer per load with its estimate (:func:`solve_to_tolerance`), the meshes and Newton steps per load."""
+    n = len(solves)
+    remarks = [f"{_named(k, n)}{g.remark}" for k, g in enumerate(solves) if g.remark]
+    remarks += [f"{_named(k, n)}stopped: {g.stopped}" for k, g in enumerate(solves) if g.stopped]
+    return Refinement(solutions=[g.solution for g in solves], estimates=[g.estimate for g in solves],
+                      per_load=[{"mesh_history": g.history,
+                                 # the Newton steps of every level the load was solved on
+                                 "newton_iterations": sum(h["newton_iterations"] for h in g.history)}
+                                for g in solves],
+                      histories=[g.newton for g in solves],
+                      how="; ".join(["each load on meshes graded towards its contact edges, then higher orders "
+                                     "on the finest; the highest reported, its error " + ORDER_RATE.describe()]
+                                    + remarks))

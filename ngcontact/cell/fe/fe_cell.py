@@ -43,8 +43,7 @@ from ngcontact.cell.coefficients import coefficients
 from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.cell.fe.default_refinement import held_to_default
-from ngcontact.cell.fe.edge_grading import GradedSolve, solve_to_tolerance
-from ngcontact.cell.fe.grading_estimate import ORDER_RATE
+from ngcontact.cell.fe.edge_grading import GradedSolve, graded_refinement, solve_to_tolerance
 from ngcontact.cell.fe.load_start import Predictor
 from ngcontact.cell.fe import whole_surface_error
 from ngcontact.cell.fe.saturation import estimate_on_scene
@@ -59,11 +58,6 @@ log = logging.getLogger(__name__)
 DEFAULT_DOFS = {2: 120_000, 3: 40_000}
 #: the most dofs of a refined discretization at a stated tolerance (per dimension)
 MAX_DOFS = {2: 1_000_000, 3: 400_000}
-
-
-def _named(k: int, n: int) -> str:
-    """The prefix of load ``k``'s remark in a sweep of ``n`` loads (none for a load alone)."""
-    return f"load {k} " if n > 1 else ""
 
 
 class FECell:
@@ -258,17 +252,7 @@ class FECell:
             log.info("load %d: contact fraction %.10g after %d grading steps", k,
                      out[-1].solution.results["contact_fraction"], len(out[-1].history) - 1)
         self._problem = out[-1].problem
-        remarks = [f"{_named(k, len(out))}{g.remark}" for k, g in enumerate(out) if g.remark]
-        remarks += [f"{_named(k, len(out))}stopped: {g.stopped}" for k, g in enumerate(out) if g.stopped]
-        return Refinement(solutions=[g.solution for g in out], estimates=[g.estimate for g in out],
-                          per_load=[{"mesh_history": g.history,
-                                     # the Newton steps of every level the load was solved on
-                                     "newton_iterations": sum(h["newton_iterations"] for h in g.history)}
-                                    for g in out],
-                          histories=[g.newton for g in out],
-                          how="; ".join(["each load on meshes graded towards its contact edges, then higher orders "
-                                         "on the finest; the highest reported, its error " + ORDER_RATE.describe()]
-                                        + remarks)), out
+        return graded_refinement(out), out
 
     def compared(self, tolerance: float, loads: list[CellLoad], max_dofs: int, required: bool,
                  first: list[CellSolution] | None = None) -> Sequence:

@@ -1,9 +1,8 @@
 """The spectral cell on finer and finer grids until a tolerance is met, with an error estimate that bounds.
 
-The grid is the spectral cell's only discretization parameter
-(:mod:`ngcontact.cell.spectral.layered_cell`): the collocated pressure and gap, and with them the contact
-set of eq. 57 and the coefficients of eq. 34 on it, converge as the grid step ``h`` shrinks.  How they
-converge decides the estimate:
+The grid is the spectral cell's only discretization parameter (:mod:`ngcontact.cell.spectral.layered_cell`):
+the collocated pressure and gap, and with them the contact set of eq. 57 and the coefficients of eq. 34 on
+it, converge as the grid step ``h`` shrinks.  How they converge decides the estimate:
 
 * the contact fraction is a count of grid points in 3D (one layer of points at the contact edges: an
   error of order ``h`` whose constant depends on where the edges cross the grid) and in 2D has its edges
