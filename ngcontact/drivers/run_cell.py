@@ -37,7 +37,8 @@ FE cell ``accuracy.symmetry`` whether it was meshed as its mirror-symmetric quar
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers, and
 held to the default tolerance on its own where the method holds a load alone
-(the FE cell): the same accuracy, report and warning as the chained sweep's.
+(the FE cell; the spectral cell, each load on its own grids): the same
+accuracy, report and warning as the chained sweep's.
 """
 from __future__ import annotations
 

@@ -7,8 +7,8 @@ refined to the default 1 % within ``discretization.budget_dofs`` load by load; i
 chained sweep's within their estimates; a budget spent first reports ``accuracy.met = false``, the same
 shortfall and the same one warning line as the chained sweep; ``discretization.estimate = "estimate"``
 estimates every load on the scene's mesh as the chained sweep does.  The spectral cell's independent loads
-keep the scene's grid, unestimated (tests/cell/test_spectral_refinement.py,
-``test_independent_loads_and_geometric_runs_are_not_refined``).
+are each refined on their own grids (tests/cell/test_spectral_refinement.py,
+``test_independent_loads_are_each_refined_and_estimated_and_geometric_runs_are_not``).
 """
 import logging
 

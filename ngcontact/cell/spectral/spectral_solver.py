@@ -106,10 +106,11 @@ class SpectralCellSolver:
         return self.make_cell is not None and self.max_points is not None
 
     def holds_loads_alone(self) -> bool:
-        """No: the default refinement chooses one grid for the sweep (``results.method``'s grid and its
-        levels), so independent loads are solved on the scene's grid, not estimated (the way to solve a given
-        grid alone)."""
-        return False
+        """Yes where the recipe of finer grids is known (:meth:`refines_by_default`): the grid-doubling
+        estimate and refinement of a sweep (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`)
+        are per load already, each load solved from zero pressure, so a load refined alone takes the same
+        estimate, only its own grids (those of the worst load of a sweep it would share)."""
+        return self.refines_by_default()
 
     def default_accuracy(self, tolerance: float, loads: list[CellLoad]) -> Refinement | None:
         """Refined to the default ``tolerance`` within the default size bound where the recipe of finer grids
