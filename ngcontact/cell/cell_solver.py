@@ -127,6 +127,12 @@ class CellSolver(Protocol):
         solved on the scene's discretization with its error estimated (``scene_discretization``), or ``None``
         (the fixed discretization, not estimated)."""
 
+    def scene_estimate(self, loads: list[CellLoad]) -> Refinement | None:
+        """The sweep on the scene's own discretization with its error estimated and not refined
+        (``scene_discretization``; an ensemble's members, whose numbers stay the scene's): the FE cell by one
+        order more on the same mesh, the spectral cell from coarser grids; not estimated (the reason in
+        ``how``, not met) where the method cannot, ``None`` without the recipe of another discretization."""
+
     def holds_loads_alone(self) -> bool:
         """Whether :meth:`default_accuracy` holds one load solved alone from the unloaded cell (a scene's
         independent loads, each a member of a batch: :mod:`ngcontact.drivers.cell_members`) to the default

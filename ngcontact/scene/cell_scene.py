@@ -163,7 +163,10 @@ class CellScene:
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     ensemble: EnsembleSpec | None = param(None, doc="solve the loads on M realizations of the random surface "
                                           "(geometry.profile = 'self_affine' or 'measured_spectrum'); report the "
-                                          "mean and the 95 % band")
+                                          "mean and the 95 % band; each member on the scene's discretization "
+                                          "with its error estimated there (the spectral cell from three coarser "
+                                          "grids, the FE cell by one order more), results.accuracy the largest "
+                                          "member estimate beside the band")
     compute: ComputeSpec = param(ComputeSpec(), doc="where independent solves run (loads, ensemble members)")
     base_dir: str = base_dir_field()
     #: the method that solves the scene and why (``discretization.method`` resolved by :meth:`resolved`)
