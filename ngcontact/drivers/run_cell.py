@@ -46,7 +46,7 @@ import logging
 from typing import Any
 
 from ngcontact.cell import admissibility, small_strain, whole_surface
-from ngcontact.cell.cell_solver import Refinement
+from ngcontact.cell.cell_solver import Refinement, joined
 from ngcontact.cell.penalty_share import penalty_share
 from ngcontact.errors import ConvergenceError
 from ngcontact.drivers import cell_gap, cell_members
@@ -176,8 +176,10 @@ def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
         return cell.refine_to(tolerance, loads, required=True)
     if scene.discretization.estimate == "off":
         return None
-    if not by_default:
-        return cell.scene_estimate(loads)
+    if not by_default:       # independent loads each from the unloaded cell, in this process (a member already)
+        parts = [cell.scene_estimate([load]) for load in loads] if scene.load.independent else [
+            cell.scene_estimate(loads)]
+        return None if any(p is None for p in parts) else joined([p for p in parts if p is not None])
     if scene.load.independent:
         return cell_members.held(scene, cell, admissibility.DEFAULT_TOLERANCE)
     return cell.default_accuracy(admissibility.DEFAULT_TOLERANCE, loads)
