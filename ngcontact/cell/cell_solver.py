@@ -127,12 +127,18 @@ class CellSolver(Protocol):
         solved on the scene's discretization with its error estimated (``scene_discretization``), or ``None``
         (the fixed discretization, not estimated)."""
 
+    def scene_estimate(self, loads: list[CellLoad]) -> Refinement | None:
+        """The sweep on the scene's own discretization with its error estimated and not refined
+        (``scene_discretization``; an ensemble's members, whose numbers stay the scene's): the FE cell by one
+        order more on the same mesh, the spectral cell from coarser grids; not estimated (the reason in
+        ``how``, not met) where the method cannot, ``None`` without the recipe of another discretization."""
+
     def holds_loads_alone(self) -> bool:
         """Whether :meth:`default_accuracy` holds one load solved alone from the unloaded cell (a scene's
         independent loads, each a member of a batch: :mod:`ngcontact.drivers.cell_members`) to the default
         tolerance as it holds a sweep, returning its refinement: where the method's estimate and refinement
-        are each load's own.  Where not, independent loads are solved on the scene's discretization, not
-        estimated."""
+        are each load's own (the FE cell; the spectral cell with the recipe of its finer grids).  Where not,
+        independent loads are solved on the scene's discretization, not estimated."""
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Solve the loads on refined discretizations until the estimated error meets ``tolerance``.
@@ -188,7 +194,9 @@ def joined(parts: list[Refinement]) -> Refinement:
     its loads, so that they stay aligned); the sweep meets the tolerance where every part does, and its
     solutions are the scene's discretization's only where every part's are; ``how`` is the parts' one
     statement, or each distinct one with the loads it holds for; the shortfall is that of the unmet part
-    with the largest estimate, the one that sets what meeting the tolerance would take.
+    with the largest estimate, the one that sets what meeting the tolerance would take.  ``method`` is the
+    last part's (its discretization is the one the driver's cell holds), with every part's under
+    ``per_load`` where they differ (a spectral load's own grid and levels).
     """
     def rows(pick) -> list:
         if not any(pick(p) for p in parts):
@@ -205,10 +213,21 @@ def joined(parts: list[Refinement]) -> Refinement:
     unmet = [p for p in parts if p.shortfall]
     worst = max(unmet, key=lambda p: max((max(e.values()) for e in p.estimates if e), default=0.0), default=None)
     return Refinement(solutions=[s for p in parts for s in p.solutions], estimates=rows(lambda p: p.estimates),
-                      per_load=rows(lambda p: p.per_load), method=parts[-1].method if parts else {},
+                      per_load=rows(lambda p: p.per_load), method=joined_method(parts),
                       histories=[h for p in parts for h in (p.histories or [s.newton for s in p.solutions])],
                       how=how, met=all(p.met for p in parts),
                       uncontrolled=tuple(dict.fromkeys(u for p in parts for u in p.uncontrolled)),
                       scales=rows(lambda p: p.scales), loose=rows(lambda p: p.loose),
                       scene_discretization=all(p.scene_discretization for p in parts),
                       shortfall=worst.shortfall if worst is not None else "")
+
+
+def joined_method(parts: list[Refinement]) -> dict[str, Any]:
+    """The ``method`` record of :func:`joined`: the last part's, and every part's under ``per_load`` where
+    they differ."""
+    if not parts:
+        return {}
+    last = dict(parts[-1].method)
+    if any(p.method != parts[-1].method for p in parts):
+        last["per_load"] = [p.method for p in parts]
+    return last

@@ -51,9 +51,13 @@ without an estimate; under ``"auto"`` a load's refinement may leave the
 scene's mesh, so the last load is held by the driver's own cell (its mesh,
 fields and unknowns are the report's, as the chained refinement's last
 level is).  ``discretization.estimate = "off"`` keeps the plain batch: one
-solve per load.  A method whose default refinement is one discretization of
-the sweep (the spectral cell's grid) does not hold loads alone: its
-independent loads are solved on the scene's discretization, not estimated.
+solve per load.  The spectral cell holds a load alone too: its grid-doubling
+estimate is per load already (:mod:`ngcontact.cell.spectral.refinement`), so
+a member refines its own load's grids, and ``results.method`` gives the last
+load's grid and levels with every load's under ``per_load``
+(:func:`ngcontact.cell.cell_solver.joined`).  A method that cannot hold a load
+alone (a spectral cell built without the recipe of finer grids) solves its
+independent loads on the scene's discretization, not estimated.
 """
 from __future__ import annotations
 

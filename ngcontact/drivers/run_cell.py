@@ -37,7 +37,8 @@ FE cell ``accuracy.symmetry`` whether it was meshed as its mirror-symmetric quar
 ``load.independent`` every load is solved from the unloaded cell as a member
 of a batch (:mod:`ngcontact.drivers.cell_members`), on the run's workers, and
 held to the default tolerance on its own where the method holds a load alone
-(the FE cell): the same accuracy, report and warning as the chained sweep's.
+(the FE cell; the spectral cell, each load on its own grids): the same
+accuracy, report and warning as the chained sweep's.
 """
 from __future__ import annotations
 
@@ -45,7 +46,7 @@ import logging
 from typing import Any
 
 from ngcontact.cell import admissibility, small_strain, whole_surface
-from ngcontact.cell.cell_solver import Refinement
+from ngcontact.cell.cell_solver import Refinement, joined
 from ngcontact.cell.penalty_share import penalty_share
 from ngcontact.errors import ConvergenceError
 from ngcontact.drivers import cell_gap, cell_members
@@ -79,11 +80,11 @@ def surface_plots(sols, dim: int, period: float) -> dict:
 
 
 def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[str, float],
-                     refinement: Refinement | None = None, unestimated: str = "") -> dict:
+                     refinement: Refinement | None = None, unestimated: str = "", warn: bool = True) -> dict:
     """The sweep's verdict (:mod:`ngcontact.cell.admissibility`) with the cell's own ``facts`` and the
     refinement's estimates (``unestimated``: why there is none, where the scene says it); each failed check
-    is one warning line, and so is an estimate beyond the default tolerance; a plainly wrong answer is no
-    answer (exit 3)."""
+    is one warning line, and so is an estimate beyond the default tolerance (not ``warn``: none, the caller
+    says it); a plainly wrong answer is no answer (exit 3)."""
     estimated = refinement is not None and bool(refinement.estimates)
     verdict, failed = admissibility.verdict(
         per_load, tolerance, admissibility.cell_checks(facts),
@@ -99,13 +100,13 @@ def accuracy_verdict(per_load: list[dict], tolerance: float | None, facts: dict[
             f"the cell's answer contradicts its own load: {wrong[0].message()}; the interface is not resolved "
             "(a contact patch narrower than the elements): refine the interface mesh, use contact.enforcement = "
             "'exact', or discretization.method = 'spectral' for a small-slope cell", {"checks": verdict["checks"]})
-    for c in failed:
+    for c in failed if warn else ():
         # the cell's own checks were said before the solve, the small strain by its own warning
         if c.load is not None and c.name not in admissibility.MODEL_LIMITS:
             log.warning("accuracy not met: %s", c.message())
     if refinement is not None and refinement.shortfall and not verdict["met"]:
         verdict["shortfall"] = refinement.shortfall
-    if refinement is not None:
+    if refinement is not None and warn:
         warn_unmet(verdict, refinement)
     return verdict
 
@@ -166,13 +167,19 @@ def refine(scene, cell, loads, by_default: bool = True) -> Refinement | None:
     """The sweep refined to the scene's tolerance, or held to the default one (the cell's
     :meth:`~ngcontact.cell.cell_solver.CellSolver.default_accuracy`: the spectral cell refined to it, the FE
     cell estimated on its own discretization and refined where that misses it; independent loads each on its
-    own as a member of a batch, :func:`ngcontact.drivers.cell_members.held`; not where the caller says not
-    ``by_default``), else ``None`` (the fixed discretization, not estimated)."""
+    own as a member of a batch, :func:`ngcontact.drivers.cell_members.held`); where the caller says not
+    ``by_default`` (an ensemble's member) the scene's discretization with its error estimated
+    (:meth:`~ngcontact.cell.cell_solver.CellSolver.scene_estimate`); ``None`` where the scene opts out (the
+    fixed discretization, not estimated)."""
     tolerance = scene.discretization.tolerance
     if tolerance is not None:
         return cell.refine_to(tolerance, loads, required=True)
-    if not by_default or scene.discretization.estimate == "off":
+    if scene.discretization.estimate == "off":
         return None
+    if not by_default:       # independent loads each from the unloaded cell, in this process (a member already)
+        parts = [cell.scene_estimate([load]) for load in loads] if scene.load.independent else [
+            cell.scene_estimate(loads)]
+        return None if any(p is None for p in parts) else joined([p for p in parts if p is not None])
     if scene.load.independent:
         return cell_members.held(scene, cell, admissibility.DEFAULT_TOLERANCE)
     return cell.default_accuracy(admissibility.DEFAULT_TOLERANCE, loads)
@@ -207,9 +214,10 @@ def method_choice(scene) -> dict[str, Any]:
     return {"method": method, "requested": method, "reason": "", "statement": method}
 
 
-def run(scene, clock, refine_by_default: bool = True) -> Outcome:
-    """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`).  ``refine_by_default =
-    False``: no refinement unless the scene states a tolerance (an ensemble's members)."""
+def run(scene, clock, member: bool = False) -> Outcome:
+    """Solve a ``cell`` scene; no file I/O (see :mod:`ngcontact.output.report`).  ``member``: an ensemble's
+    member, not refined unless the scene states a tolerance but estimated on its own discretization, and its
+    verdict's warnings left to the ensemble's (:mod:`ngcontact.drivers.run_ensemble`)."""
     with clock.stage("setup"):
         scene = with_symmetry(scene)       # its FE cell's quarter or period, decided once for the run
         cell = cell_solver(scene)
@@ -236,7 +244,7 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
     loads = cell_loads(scene)
     refinement: Refinement | None = None
     with clock.stage("solve"):
-        refinement = refine(scene, cell, loads, refine_by_default)
+        refinement = refine(scene, cell, loads, not member)
         if refinement is not None:
             sols = refinement.solutions
             if method is not None:
@@ -248,7 +256,8 @@ def run(scene, clock, refine_by_default: bool = True) -> Outcome:
     per_load, tables, arrays = load_records(cell, sols, refinement, scene.geometry.h_rough + scene.geometry.h_counter)
     results["loads"] = per_load
     results["accuracy"] = dict(accuracy_verdict(per_load, scene.discretization.tolerance, facts, refinement,
-                                                unestimated=opted_out(scene)), method=method_choice(scene))
+                                                unestimated=opted_out(scene), warn=not member),
+                               method=method_choice(scene))
     symmetry = scene.symmetry_choice             # of a 3D FE cell: its quarter or its period, and why
     if scene.discretization.method == "fe" and scene.geometry.dim == 3 and symmetry is not None:
         results["accuracy"]["symmetry"] = symmetry.as_dict()

@@ -6,10 +6,21 @@ surface of ``geometry.spectrum`` (or of a measured file's spectrum, profile
 (:mod:`ngcontact.geometry.random_surface`); it is solved over the scene's
 loads by the ``cell`` driver (:mod:`ngcontact.drivers.run_cell`, spectral or
 FE as the scene says; on its own grid or mesh unless the scene states a
-``discretization.tolerance``: the members are not refined to the default one),
-in a worker of the run's batch (:mod:`ngcontact.parallel.executor`), and returns per load the contact
+``discretization.tolerance``: the members are not refined to the default one,
+but each is estimated there, :meth:`~ngcontact.cell.cell_solver.CellSolver.scene_estimate`:
+the spectral cell from three coarser grids, at most a third of its solve more in
+3D and seven eighths in 2D, the FE cell by one order more on its mesh, about
+``((p + 1) / p)^d`` times its unknowns; ``discretization.estimate = "off"``
+skips it), in a worker of the run's batch (:mod:`ngcontact.parallel.executor`), and returns per load the contact
 fraction, ``k_n0`` on the real contact set (paper eq. 34), the normal
-effective stiffness, the mean closure and the transmitted pressure.
+effective stiffness, the mean closure and the transmitted pressure, each
+load with ``error_estimate`` (the absolute error of the quantities estimated;
+``results.members``), and its accuracy verdict.  ``results.accuracy`` is the ensemble's
+(:mod:`ngcontact.drivers.ensemble_accuracy`): per load and quantity the
+largest member estimate beside the band's half-width, met where every
+member's verdict is, one warning line where not; ``accuracy.cost`` the
+seconds of the members' solves and of their estimates' extra solves (where
+the method counts them).
 
 Results: per load the mean of each quantity over the members and its 95 %
 confidence band (:mod:`ngcontact.verification.confidence_band`), every member's
@@ -23,11 +34,13 @@ and its ``psd.png``.
 """
 from __future__ import annotations
 
+import time
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
-from ngcontact.drivers import cell_gap, run_cell
+from ngcontact.drivers import cell_gap, ensemble_accuracy, run_cell
 from ngcontact.errors import ModelError
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Clock, Outcome
@@ -65,12 +78,27 @@ def measured(entry: dict) -> dict[str, float]:
 
 
 def realization(job: tuple) -> dict:
-    """Member of the batch: ``(scene, m)`` -> the seed, the number of unknowns and every load's quantities."""
+    """Member of the batch: ``(scene, m)`` -> the seed, the number of unknowns, every load's quantities, its
+    accuracy verdict (:func:`~ngcontact.drivers.ensemble_accuracy.member_record`) and its seconds (the
+    estimate's extra solves where the method counts them)."""
     scene, m = job
     sc = member_scene(scene, m)
-    outcome = run_cell.run(sc, Clock(), refine_by_default=False)
-    return {"seed": sc.geometry.random_seed, "ndof": int(outcome.ndof),
-            "loads": [measured(e) for e in outcome.results["loads"]]}
+    t0 = time.perf_counter()
+    outcome = run_cell.run(sc, Clock(), member=True)
+    method = outcome.results.get("method") or {}
+    accuracy = ensemble_accuracy.member_record(outcome.results["accuracy"])
+    loads: list[dict[str, Any]] = [dict(measured(e)) for e in outcome.results["loads"]]
+    for entry, estimate in zip(loads, ensemble_accuracy.member_estimates(accuracy, len(loads))):
+        entry["error_estimate"] = estimate
+    return {"seed": sc.geometry.random_seed, "ndof": int(outcome.ndof), "loads": loads, "accuracy": accuracy,
+            "seconds": time.perf_counter() - t0, "estimate_seconds": method.get("estimate_seconds")}
+
+
+def cost(members: list[dict]) -> dict:
+    """``accuracy.cost``: the members' seconds summed, and of those their estimates' extra solves where known."""
+    extra = [mem["estimate_seconds"] for mem in members if mem["estimate_seconds"] is not None]
+    return {"member_seconds": float(sum(mem["seconds"] for mem in members)),
+            "estimate_seconds": float(sum(extra)) if extra else None}
 
 
 def run(scene, clock) -> Outcome:
@@ -92,7 +120,8 @@ def run(scene, clock) -> Outcome:
                             "band": "mean -+ t(0.975, M-1) s / sqrt(M), s the sample standard deviation"},
                "loads": loads, "shrinkage": shrink,
                "members": [mem["loads"] for mem in members],
-               "accuracy": {"method": run_cell.method_choice(scene)}}
+               "accuracy": dict(ensemble_accuracy.verdict(members, loads), cost=cost(members),
+                                method=run_cell.method_choice(scene))}
     header = ["load"] + [f"{q}_{key}" for q in QUANTITIES for key in ("mean", "low", "high", "half_width")]
     rows = [[k] + [loads[k][q][key] for q in QUANTITIES for key in ("mean", "low", "high", "half_width")]
             for k in range(n)]

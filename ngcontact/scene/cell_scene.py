@@ -109,9 +109,10 @@ class LoadSpec:
                                                    "3D (e_xx, e_yy, e_xy), one set per sweep", units="")
     independent: bool = param(False, doc="solve every load on its own from the unloaded cell (no continuation "
                               "from the previous load), so that the loads run in parallel (see [compute]); "
-                              "frictionless contact only.  Without discretization.tolerance the FE cell holds each "
-                              "load to the default one on its own, as a chained sweep is held (the same "
-                              "results.accuracy); the spectral cell solves them on the scene's grid, not estimated")
+                              "frictionless contact only.  Without discretization.tolerance each load is held to the "
+                              "default one on its own, as a chained sweep is held (the same results.accuracy): the "
+                              "FE cell estimated and refined within budget_dofs, the spectral cell refined by grid "
+                              "doubling from discretization.grid (results.method.per_load: each load's grids)")
 
     def check(self, path: str) -> None:
         if (self.pressure is None) == (self.normal_jump is None):
@@ -162,7 +163,10 @@ class CellScene:
     solver: SolverSpec = param(SolverSpec(), doc="Newton settings")
     ensemble: EnsembleSpec | None = param(None, doc="solve the loads on M realizations of the random surface "
                                           "(geometry.profile = 'self_affine' or 'measured_spectrum'); report the "
-                                          "mean and the 95 % band")
+                                          "mean and the 95 % band; each member on the scene's discretization "
+                                          "with its error estimated there (the spectral cell from three coarser "
+                                          "grids, the FE cell by one order more), results.accuracy the largest "
+                                          "member estimate beside the band")
     compute: ComputeSpec = param(ComputeSpec(), doc="where independent solves run (loads, ensemble members)")
     base_dir: str = base_dir_field()
     #: the method that solves the scene and why (``discretization.method`` resolved by :meth:`resolved`)

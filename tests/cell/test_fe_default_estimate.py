@@ -8,13 +8,20 @@ from dataclasses import dataclass, field
 import pytest
 
 from ngcontact import cli
+from ngcontact.cell.cell_solution import headline, scale
 from ngcontact.cell.fe.saturation import SATURATION, estimate_on_scene, saturation_estimates
 from ngcontact.drivers.build import cell_loads, fe_variant, spectral_variant
 
 from fe_cells import fe_scene, fe_table, toml
 
-#: the 2D spectral contact fraction's collocation error at 65,536 points (ngcontact.cell.spectral.grid_measures)
+#: the 2D spectral contact fraction's collocation error at 65,536 points (ngcontact.cell.spectral.grid_measures),
+#: which bounds the coefficients' too (k_n times the fraction, k_n times the gap over the contact set)
 COLLOCATION = 2e-5
+#: the 2D spectral effective stiffness's error at 65,536 points (relative): first order in the grid step, about
+#: the change from 32,768 points (1.2e-4 on the stem grooves), twice that
+STIFFNESS_COLLOCATION = 2.5e-4
+#: the headline quantities of a flat frictionless cell whose estimates are checked (k_t, g_t, G: zero, exact)
+ESTIMATED = ("contact_fraction", "mean_closure", "normal_stiffness", "coefficient_k_n", "coefficient_g_n")
 
 
 def test_the_bound_of_the_saturation_assumption():
@@ -26,6 +33,14 @@ def test_the_bound_of_the_saturation_assumption():
     assert got["contact_fraction"] == pytest.approx(0.01 / (1 - SATURATION), rel=1e-12)
     assert got["mean_closure"] == pytest.approx(0.05 / (1 - SATURATION), rel=1e-12)
     assert "normal_stiffness" not in got
+    # every headline quantity of both, each in its measure: a coefficient relative to its group on the whole
+    # surface, the stiffness relative; a coefficient zero at both orders (a flat interface's k_t) is exact
+    low = [{"normal_stiffness": 5.0, "coefficient_k_n": 1.0, "coefficient_k_t": 0.0, "coefficient_g_n": 0.2}]
+    high = [{"normal_stiffness": 5.5, "coefficient_k_n": 1.2, "coefficient_k_t": 0.0, "coefficient_g_n": 0.1}]
+    (got,) = saturation_estimates(low, high, whole={"k_n": 4.0, "k_t": 0.0, "g_n": 2.0})
+    assert got == pytest.approx({"normal_stiffness": 0.1 / (1 - SATURATION),
+                                 "coefficient_k_n": 0.05 / (1 - SATURATION),
+                                 "coefficient_g_n": 0.05 / (1 - SATURATION)}, rel=1e-12)
     # a sequence that keeps exactly the fraction beta of its error: the bound is the error itself
     q, e = 0.5, 0.04
     (tight,) = saturation_estimates([{"contact_fraction": q + e}], [{"contact_fraction": q + SATURATION * e}])
@@ -62,18 +77,24 @@ def test_a_cell_that_cannot_raise_its_order_is_not_estimated_and_not_met():
 @pytest.mark.parametrize("order", [1, 2])
 def test_the_default_estimate_bounds_the_error_on_the_stem_grooves(order):
     """The stem-groove cell (flat 2D, penalty) on a coarser interface mesh, against its spectral twin on
-    65,536 points: the estimate of the scene's own answer is at least its error and at most ten times it."""
+    65,536 points: the estimate of every headline quantity of the scene's own answer is at least its error
+    (the fraction and the closure: at most ten times it, the stiffness too)."""
     scene = fe_scene("stem_grooves")      # the shipped scene is solved by the spectral cell; here its FE cell
     loads = cell_loads(scene)
-    reference = spectral_variant(scene, 65536).sweep(loads)[0].results
+    reference = headline(spectral_variant(scene, 65536).sweep(loads)[0].results)
     # the estimate of the scene's own answer (which the default refines where it misses 1 %)
-    done = estimate_on_scene(fe_variant(scene, interface_maxh=4e-6, order=order), loads)
-    got, estimate = done.solutions[0].results, done.estimates[0]
-    assert done.scene_discretization
-    fraction = abs(got["contact_fraction"] - reference["contact_fraction"])
-    assert max(fraction - COLLOCATION, 0) <= estimate["contact_fraction"] <= 10 * fraction, (fraction, estimate)
-    closure = abs(got["mean_closure"] - reference["mean_closure"]) / reference["mean_closure"]
-    assert closure <= estimate["mean_closure"] <= 10 * closure, (closure, estimate)
+    cell = fe_variant(scene, interface_maxh=4e-6, order=order)
+    done = estimate_on_scene(cell, loads)
+    got, estimate = headline(done.solutions[0].results), done.estimates[0]
+    assert done.scene_discretization and set(ESTIMATED) <= set(estimate), estimate
+    whole = cell.whole_surface()
+    error = {name: abs(got[name] - reference[name]) / scale(name, got, whole) for name in ESTIMATED}
+    assert done.scales[0] == {name: scale(name, got, whole) for name in estimate}
+    slack = dict.fromkeys(ESTIMATED, COLLOCATION) | {"mean_closure": 0.0, "normal_stiffness": STIFFNESS_COLLOCATION}
+    for name in ESTIMATED:
+        assert max(error[name] - slack[name], 0) <= estimate[name], (name, error[name], estimate[name])
+    for name in ("contact_fraction", "mean_closure", "normal_stiffness"):
+        assert estimate[name] <= 10 * error[name], (name, error[name], estimate[name])
 
 
 def _coarse_stem(tmp_path, order: int):
@@ -87,8 +108,9 @@ def _coarse_stem(tmp_path, order: int):
 
 def test_a_default_run_beyond_one_percent_warns_once_and_is_not_met(tmp_path, capsys, caplog):
     """Order 1 on a coarse interface mesh, estimated and not refined (discretization.estimate = "estimate"):
-    the closure's estimate exceeds the default 1 %; the run ends (exit 0) with accuracy.met = false, the estimate per load, one warning line naming the quantity, and the
-    terminal's accuracy line with the estimates."""
+    the estimates of the closure, the effective stiffness and k_n exceed the default 1 %; the run ends (exit 0)
+    with accuracy.met = false, the estimate per load, one warning line naming the largest, and the terminal's
+    accuracy line with the estimates."""
     out = tmp_path / "out"
     with caplog.at_level(logging.WARNING):
         code = cli.main(["run", str(_coarse_stem(tmp_path, 1)), "--out", str(out)])
@@ -99,9 +121,10 @@ def test_a_default_run_beyond_one_percent_warns_once_and_is_not_met(tmp_path, ca
     acc = results["accuracy"]
     assert acc["tolerance_from"] == "default" and acc["estimated"] and not acc["met"]
     unmet = [q for q in acc["quantities"] if not q["met"]]
-    assert [q["name"] for q in unmet] == ["mean_closure"] and unmet[0]["relative_error"] > 0.01
+    assert [q["name"] for q in unmet] == ["mean_closure", "normal_stiffness", "coefficient_k_n"]
+    assert all(q["controlled_error"] > 0.01 for q in unmet)
     entry = results["loads"][0]
     assert entry["error_estimate"]["mean_closure"] > 0.01 and entry["next_order"]["order"] == 2
     lines = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
     unmet_lines = [m for m in lines if "scene's own discretization" in m]
-    assert len(unmet_lines) == 1 and "load 0's mean_closure exceeds the default tolerance 0.01" in unmet_lines[0]
+    assert len(unmet_lines) == 1 and "load 0's normal_stiffness exceeds the default tolerance 0.01" in unmet_lines[0]

@@ -89,8 +89,8 @@ def test_a_sampled_map_is_refined_as_its_bilinear_interpolant(tmp_path):
     assert grids[0] == 32 and rep["method"]["grid"] == grids[-1] > 64
     assert all(max(load["error_estimate"].values()) <= 0.05 for load in rep["loads"])
     direct = tmp_path / "direct.toml"
-    # independent loads: the direct solve on that grid alone (a sweep would be refined to the default tolerance)
-    direct.write_text(text + f"independent = true\n[discretization]\nmethod = \"spectral\"\ngrid = {grids[-1]}\n")
+    # no estimate: the direct solve on that grid alone (else refined to the default tolerance)
+    direct.write_text(text + f"[discretization]\nmethod = \"spectral\"\ngrid = {grids[-1]}\nestimate = \"off\"\n")
     assert cli.main(["run", str(direct), "--out", str(tmp_path / "d"), "--quiet"]) == 0
     again = json.loads((tmp_path / "d" / "report.json").read_text())["results"]
     assert again["method"]["grid"] == grids[-1] and not again["accuracy"]["estimated"]
@@ -146,12 +146,24 @@ def test_a_stated_tolerance_out_of_reach_ends_the_run(tmp_path, capsys, monkeypa
     assert code == 3 and "tolerance = 1e-06 not met" in capsys.readouterr().err
 
 
-def test_independent_loads_and_geometric_runs_are_not_refined(tmp_path):
-    text = sinusoid_cell(pressure="0.001, 0.003").replace("[discretization]", "independent = true\n[discretization]")
+def test_independent_loads_are_each_refined_and_estimated_and_geometric_runs_are_not(tmp_path):
+    """Each independent load is refined by grid doubling on its own, to the default tolerance, and its estimate
+    bounds its error against Westergaard's closed form (layers deep enough to stand for half-spaces; issue 35:
+    every number with its error)."""
+    pressures = (0.001, 0.003)
+    text = sinusoid_cell(pressure=", ".join(map(str, pressures)), depth="2.0").replace(
+        "[discretization]", "independent = true\n[discretization]")
     code, rep = _report(tmp_path, text, "--workers", "1")
-    assert code == 0 and rep["results"]["method"]["grid"] == 256 and "refinement" not in rep["results"]["method"]
-    acc = rep["results"]["accuracy"]
-    assert not acc["estimated"] and acc["how"].startswith("not estimated") and acc["tolerance_from"] == "default"
+    assert code == 0
+    method, acc = rep["results"]["method"], rep["results"]["accuracy"]
+    assert acc["estimated"] and acc["met"] and acc["tolerance_from"] == "default" and "grids" in acc["how"]
+    own = [m["refinement"] for m in method["per_load"]]      # each load's own grids, from the scene's
+    assert len(own) == 2 and all(levels[0]["grid"] == 256 and len(levels) >= 4 for levels in own)
+    for p, load in zip(pressures, rep["results"]["loads"]):
+        error = abs(load["contact_fraction"] - westergaard_contact_fraction(p, P_STAR))
+        assert error <= load["error_estimate"]["contact_fraction"] <= 0.01
+    names = {(q["load"], q["name"]) for q in acc["quantities"]}
+    assert {(k, n) for k in (0, 1) for n in ("contact_fraction", "mean_closure")} <= names
     text = sinusoid_cell().replace("[load]\npressure = [0.005]\n", "").replace(
         'enforcement = "exact"', 'enforcement = "exact"\ngeometric_only = true')
     (tmp_path / "g").mkdir()

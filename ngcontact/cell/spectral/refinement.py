@@ -292,12 +292,13 @@ def tail_estimate(values: list[float], relative: bool, order_rate: float = RATE_
     return fitted[0], RICHARDSON, f"rate {fitted[1]:.2g}"
 
 
-def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float]], list[str], list[dict[str, str]]]:
+def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
+                    ) -> tuple[list[dict[str, float]], list[str], list[dict[str, str]]]:
     """Per load the estimate of each headline quantity on the last level of ``history`` (in its measure,
     :func:`~ngcontact.cell.cell_solution.measure`), the remarks (which estimates are Richardson's, the guards
     that acted) and per load the form of each estimate.  A quantity missing on some level (a stiffness in full
     contact) is not estimated, nor one that is zero on every level (a coefficient that the flat interface
-    makes zero: ``k_t``, ``k_nt``, ``g_t``, ``G_n``; ``G_t`` without friction)."""
+    makes zero: ``k_t``, ``k_nt``, ``g_t``, ``G_n``; ``G_t`` without friction); not ``geometric_ok``: guarded only."""
     estimates, forms, guarded = [], [], []
     for k, last in enumerate(history[-1]["headline"]):
         out: dict[str, float] = {}
@@ -308,7 +309,7 @@ def sweep_estimates(history: list[dict[str, Any]]) -> tuple[list[dict[str, float
                 continue
             size = scale(name, last, history[-1]["whole_surface"])
             # a coefficient's edges are the fraction's: not geometric where the fraction's sequence is not
-            geometric = not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
+            geometric = geometric_ok and not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
             args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
             fitted = fitted_run(history, k) if on_edges(name) else len(history)
             run = min(fitted, resolved_run(history, k))        # levels of the quartic and of resolved islands

@@ -23,6 +23,7 @@ from ngcontact.cell.cell_load import CellLoad, cell_load
 from ngcontact.cell.cell_solution import CellSolution
 from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.spectral import grid_measures
+from ngcontact.cell.spectral.coarser_grids import HOW as COARSER_HOW, estimate_from_coarser, why_not
 from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
 from ngcontact.cell.spectral.refinement import HOW, UNCONTROLLED, sweep_to_tolerance
 from ngcontact.cell.whole_surface import flat
@@ -106,15 +107,34 @@ class SpectralCellSolver:
         return self.make_cell is not None and self.max_points is not None
 
     def holds_loads_alone(self) -> bool:
-        """No: the default refinement chooses one grid for the sweep (``results.method``'s grid and its
-        levels), so independent loads are solved on the scene's grid, not estimated (the way to solve a given
-        grid alone)."""
-        return False
+        """Yes where the recipe of finer grids is known (:meth:`refines_by_default`): the grid-doubling
+        estimate and refinement of a sweep (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`)
+        are per load already, each load solved from zero pressure, so a load refined alone takes the same
+        estimate, only its own grids (those of the worst load of a sweep it would share)."""
+        return self.refines_by_default()
 
     def default_accuracy(self, tolerance: float, loads: list[CellLoad]) -> Refinement | None:
         """Refined to the default ``tolerance`` within the default size bound where the recipe of finer grids
         is known (:meth:`refine_to`), else ``None``."""
         return self.refine_to(tolerance, loads, required=False) if self.refines_by_default() else None
+
+    def scene_estimate(self, loads: list[CellLoad]) -> Refinement | None:
+        """The sweep on the scene's grid, its error estimated from three coarser grids
+        (:mod:`ngcontact.cell.spectral.coarser_grids`); not estimated (the reason in ``how``, not met) where the
+        grid does not halve so; ``None`` without the recipe of other grids."""
+        if self.make_cell is None:
+            return None
+        first, make = self.cell, self.make_cell
+        done = estimate_from_coarser(lambda n: first if n == first.grid else make(n), loads, first.grid)
+        if done is None:
+            return Refinement(solutions=self.sweep(loads), estimates=[], how=why_not(first.grid), met=False,
+                              scene_discretization=True)
+        method = {"estimate_grids": [h["grid"] for h in done.history],
+                  "estimate_seconds": sum(h["seconds"] for h in done.history[:-1])}
+        how = COARSER_HOW + f"; {HOW}" + (f" ({'; '.join(done.remarks)})" if done.remarks else "")
+        return Refinement(solutions=[self.solution(s) for s in done.solutions], estimates=list(done.estimates),
+                          method=method, how=how, uncontrolled=UNCONTROLLED, scales=done.scales, loose=done.flags,
+                          scene_discretization=True)
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
         """Grids from the scene's up until the estimate meets ``tolerance``
