@@ -31,9 +31,10 @@ The mesh step (what converged, and why not the interface alone)
     elements first and grades towards every corner), and every element beside a boundary element of
     ``S_C^eps`` that is partly closed (an edge of the closed set, whose position the contact fraction
     measures).  Netgen's local refinement places the new boundary vertices on the geometry and the mesh
-    is curved again at the order.  On the shipped rectangular valleys, halving only the interface's
-    elements (``elements_per_period`` doubled) left the contact force's order differences unchanged over
-    five levels: its error sat at the far-field corners of the blocks, which the indicator finds.
+    is curved again at the order.  The interface alone is not enough: on the shipped rectangular valleys
+    the contact force's error sits in the far field (halving ``maxh`` removes most of it, doubling
+    ``elements_per_period`` next to none), at the corners where the displaced and clamped faces meet the
+    free sides, which the indicator reaches after the valleys' corners.
     Each mesh level is estimated by the order ladder on its mesh and by the sequence of mesh levels at that
     order with its observed rate (:func:`ngcontact.macro.mesh_sequence.combined`): the larger of the two, or
     the sequence's alone where the ladder has none.  A quantity growing with every level without an estimate

@@ -11,8 +11,9 @@ from ngcontact.cli import main as cli_main
 from ngcontact.drivers import resolved_refinement as RR
 from ngcontact.drivers import run_resolved as drv
 from ngcontact.errors import ConvergenceError
-from ngcontact.output.report import Clock
+from ngcontact.output.report import Clock, accuracy_line
 from ngcontact.scene import loader
+from ngcontact.scene.refinement_ladder import ladder
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BLOCK = os.path.join(ROOT, "geometries", "direct", "block_rect_valleys.toml")
@@ -35,18 +36,18 @@ def small_block(tmp_path, tolerance: float | None = None, maxh: float = 0.25, pe
     return str(path)
 
 
-def sinusoid_block(tmp_path, tolerance: float | None = None, per_period: int = 4) -> str:
+def sinusoid_block(tmp_path, tolerance: float | None = None) -> str:
     """The small block with a sinusoid of amplitude 0.1 eps instead of the valleys, sheared more than pressed:
     the closed set covers about half the surface, its edges inside the elements."""
     cell = open(CELL).read().replace('profile = "rectangular"', 'profile = "sinusoid"\namplitude = 0.1')
     cell = "\n".join(line for line in cell.splitlines() if not line.startswith(("width", "depth")))
     (tmp_path / "sinusoid_cell.toml").write_text(cell)
-    text = open(small_block(tmp_path, tolerance, per_period=per_period)).read().replace(CELL, "sinusoid_cell.toml")
+    text = open(small_block(tmp_path, tolerance)).read().replace(CELL, "sinusoid_cell.toml")
     for old, new in (("displacement = [1e-4, -1e-4]", "displacement = [4e-4, -3e-5]"),
                      ("slope = [0.0, -1.5e-4]", "slope = [0.0, 0.0]")):
         assert old in text, old
         text = text.replace(old, new)
-    path = tmp_path / f"sinusoid_{tolerance}_{per_period}.toml"
+    path = tmp_path / f"sinusoid_{tolerance}.toml"
     path.write_text(text)
     return str(path)
 
@@ -63,6 +64,7 @@ def test_a_tolerance_is_reached_by_the_order_and_its_estimate_bounds_the_error_o
     assert [lv["met"] for lv in refined["levels"]] == [False, False, True]
     assert refined["scene_order"] == 2 and refined["order"] == 4 and res["elements"] == refined["elements"]
     assert q["contact_force"]["value"] == pytest.approx(sum(f * f for f in res["contact_force"]) ** 0.5, rel=1e-12)
+    assert "met at order 4 (refined from order 2)" in accuracy_line(res)
     # a finer run (far field and interface four times finer, order 4) without a tolerance: judged against the
     # default, not refined; the true error is within the difference plus the finer run's own estimate
     fine = drv.run(loader.load(small_block(tmp_path, None, maxh=0.0625, per_period=16, order=4)), Clock(None))
@@ -101,7 +103,7 @@ def test_a_mesh_level_refines_where_the_indicator_is_large_and_lowers_the_estima
     assert errors[4] < errors[2], errors
 
 
-def test_a_partly_closed_sinusoid_meets_its_tolerance_on_refined_meshes_and_the_fraction_is_bounded(tmp_path):
+def test_a_partly_closed_sinusoid_meets_its_tolerance_on_refined_meshes_refined_at_its_edges(tmp_path):
     """Its contact fraction's order ladder is erratic (the closed set's edges inside elements): the order stops
     at 3 and the mesh is refined, at the closed set's edges too, until both quantities meet 1e-3."""
     scene = loader.load(sinusoid_block(tmp_path, 1e-3))
@@ -115,11 +117,7 @@ def test_a_partly_closed_sinusoid_meets_its_tolerance_on_refined_meshes_and_the_
     sol = drv.solve_scene(scene, drv.problem_of(scene, drv.build_resolved(scene)))
     edges = RR.closed_set_edges(sol)
     assert 0 < edges.sum() < 0.2 * len(edges)
-    # a finer run, the interface 32 times finer at order 2: the fraction's true error is within the estimate
-    fine = drv.run(loader.load(sinusoid_block(tmp_path, None, per_period=128)), Clock(None)).results
-    ref = {x["name"]: x for x in fine["accuracy"]["quantities"]}["contact_fraction"]
-    bound = abs(q["contact_fraction"]["value"] - ref["value"]) + ref["error"]
-    assert bound <= q["contact_fraction"]["error"], (bound, q["contact_fraction"])
+    # (its estimates against a run refined to 1e-4: the slow test below)
 
 
 @pytest.mark.slow
@@ -134,3 +132,15 @@ def test_the_estimates_of_a_refined_sinusoid_bound_its_error_against_a_run_refin
         assert r["error"] <= 0.2 * q["error"], (q, r)
         true = abs(q["value"] - r["value"])
         assert true + r["error"] <= q["error"] <= 10.0 * true, (q["name"], true, q["error"])
+
+
+def test_the_accuracy_study_of_a_resolved_scene_with_a_tolerance_varies_it_and_drops_it_elsewhere(tmp_path):
+    """A scene that states the tolerance is refined until it is met: the h and order ladders' levels leave it
+    out (each level its own setting), the tolerance's own ladder divides it by 4 per level."""
+    path = small_block(tmp_path, 1e-3)
+    levels, dropped = ladder(loader.load(path), loader.parsed(path), 3)
+    assert not dropped, dropped
+    assert [lv.knob for lv in levels] == ["h"] * 3 + ["order"] * 3 + ["tolerance"] * 3
+    assert all(lv.scene.discretization.tolerance is None for lv in levels if lv.knob != "tolerance")
+    assert [lv.scene.discretization.tolerance for lv in levels if lv.knob == "tolerance"] == pytest.approx(
+        [4e-3, 1e-3, 2.5e-4])
