@@ -289,15 +289,18 @@ def _progress(sol: MacroSolution, found: list[DE.Estimate], missed: list[DE.Esti
                   "" if not missed else f", {len(missed)} quantities beyond {tolerance:g}")
 
 
-def h_stop_reason(missed: list[DE.Estimate], values: dict[str, list[float]], h_level: int) -> str | None:
-    """Why the mesh is not refined further (``None``: it is)."""
+def h_stop_reason(missed: list[DE.Estimate], values: dict[str, list[float]], h_level: int,
+                  bound: int | None = None) -> str | None:
+    """Why the mesh is not refined beyond level ``h_level`` (``None``: it is); ``bound``: the most mesh levels
+    (default :data:`MAX_MESH_LEVELS`)."""
+    bound = MAX_MESH_LEVELS if bound is None else bound
     growing = [e for e in missed if e.error is None and MS.grows_without_bound(values[e.name])]
     if growing:
         e = growing[0]
         return (f"{e.name} grows with every mesh level ({', '.join(f'{v:.4g}' for v in values[e.name][-3:])}) "
                 "without an estimate: a singularity, whose value depends on the mesh and does not converge")
-    if h_level >= MAX_MESH_LEVELS:
-        return f"mesh level {h_level + 1} is beyond the refinement's bound ({MAX_MESH_LEVELS} levels)"
+    if h_level >= bound:
+        return f"mesh level {h_level + 1} is beyond the refinement's bound ({bound} levels)"
     return None
 
 

@@ -38,7 +38,8 @@ The mesh step (what converged, and why not the interface alone)
     Each mesh level is estimated by the order ladder on its mesh and by the sequence of mesh levels at that
     order with its observed rate (:func:`ngcontact.macro.mesh_sequence.combined`): the larger of the two, or
     the sequence's alone where the ladder has none.  A quantity growing with every level without an estimate
-    has no limit: the refinement stops there and says so.
+    has no limit: the refinement stops there and says so
+    (:func:`ngcontact.drivers.macro_refinement.h_stop_reason`).
 
 A scene that states no tolerance is not refined: it is judged against the default one and costs what it did.
 """
@@ -52,6 +53,7 @@ from typing import Any, Callable
 import ngsolve as ng
 import numpy as np
 
+from ngcontact.drivers import macro_refinement as MR
 from ngcontact.drivers import resolved_accuracy as RA
 from ngcontact.errors import ConvergenceError
 from ngcontact.fem import two_body
@@ -186,7 +188,7 @@ def refine_mesh(scene, start: Refined, length: float, solve: Solve, tolerance: f
     values = {e.name: [e.value] for e in start.estimates}
     missed = unmet(start.estimates, tolerance)
     for h_level in range(1, MAX_MESH_LEVELS + 2):
-        why = mesh_stop_reason(missed, values, h_level)
+        why = MR.h_stop_reason(missed, values, h_level - 1, MAX_MESH_LEVELS)
         if why is not None:
             raise ConvergenceError(out_of_reach(tolerance, history, missed, why), {"refinement": history})
         problem = replace(sol.problem)
@@ -210,18 +212,6 @@ def refine_mesh(scene, start: Refined, length: float, solve: Solve, tolerance: f
         if not missed:
             return Refined(sol, found, history)
     raise AssertionError("unreachable: the loop ends at the mesh levels' bound")  # pragma: no cover
-
-
-def mesh_stop_reason(missed: list[DE.Estimate], values: dict[str, list[float]], h_level: int) -> str | None:
-    """Why mesh level ``h_level`` is not made (``None``: it is)."""
-    growing = [e for e in missed if e.error is None and MS.grows_without_bound(values[e.name])]
-    if growing:
-        e = growing[0]
-        return (f"{e.name} grows with every mesh level ({', '.join(f'{v:.6g}' for v in values[e.name][-3:])}) "
-                "without an estimate: it has no limit")
-    if h_level > MAX_MESH_LEVELS:
-        return f"mesh level {h_level} is beyond the refinement's bound ({MAX_MESH_LEVELS} levels)"
-    return None
 
 
 def flags(sol: D.DirectSolution) -> np.ndarray:
