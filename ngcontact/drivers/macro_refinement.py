@@ -39,7 +39,11 @@ Then the mesh (h), where the order no longer pays
       the maximum sits is a share of the error.
     * A maximum that grows with every mesh level without an estimate is a true singularity (its value
       depends on the mesh and has no limit): the refinement stops there and says so.
-    * A scene with ``[two_scale]`` keeps its mesh (the loop's interface state lives on it).
+    * A scene with ``[two_scale]`` refines its mesh too: each mesh level runs the coupling loop again on
+      the refined mesh from the tables the scene's loop made (``level_solve``,
+      :class:`ngcontact.drivers.run_two_scale.Relevel`).  The cell's law is a function of the macro jump,
+      not of the macro mesh, so the table is re-used as it stands where it covers the level's pressures
+      and grows by the cell solves of the new range where a finer mesh finds higher ones.
 
 What is refined for
     Only the quantities the verdict counts (:func:`unmet`).  Where the interface ends closed on a boundary
@@ -64,8 +68,8 @@ order; the vertices are the scene's), so the discretization that met the toleran
 reproduced by the scene with ``discretization.order`` set to it.  The new order is solved from the last
 solution interpolated into its space, and its neighbours from it; a new mesh level is solved from the
 start, as the scene is.  The scene's mesh is refined in place, so the run reports on the refined mesh.
-With ``[two_scale]`` every level is solved with the loop's converged law (as the estimate's neighbours
-are); the loop is not repeated.
+With ``[two_scale]`` every order level and the estimate's neighbours are solved with the loop's converged
+law; a mesh level runs the loop again from its tables (above).
 
 A scene that states no tolerance is not refined: its run costs what it did.
 """
@@ -233,17 +237,16 @@ def h_refusal(scene) -> str | None:
     """Why the mesh of ``scene`` is not refined (``None``: it may be)."""
     if MAX_MESH_LEVELS < 1:
         return f"the refinement's bound allows no mesh level ({MAX_MESH_LEVELS})"
-    if scene.two_scale is not None:
-        return ("the two-scale loop's interface state lives on the scene's mesh, so its mesh is not refined "
-                "(make the mesh finer: discretization.maxh, interface_maxh)")
     return None
 
 
 def refine(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
-           safety_factor: Callable[[MacroSolution], float] | None = None) -> Refined | None:
+           safety_factor: Callable[[MacroSolution], float] | None = None,
+           level_solve: Callable[..., MacroSolution] | None = None) -> Refined | None:
     """Refine ``sol`` until its headline quantities meet ``scene.discretization.tolerance`` (module
     docstring): the order first, then the mesh; ``solve(problem, start)`` solves a problem as the scene
-    does.  ``None``: the scene states no tolerance, and ``sol`` stands as it is.
+    does, ``level_solve`` a new mesh level (default ``solve``; a two-scale scene's loop on the refined mesh).
+    ``None``: the scene states no tolerance, and ``sol`` stands as it is.
 
     Raises
     ------
@@ -275,7 +278,7 @@ def refine(scene, sol: MacroSolution, solve: Callable[..., MacroSolution],
                                {"refinement": history})
     progress.info("macro: %s; the mesh is refined where the error indicator is large", why)
     return refine_mesh(scene, Refined(solution=sol, samples=samples, history=history, estimates=found), solve,
-                       safety_factor, tolerance, singular)
+                       safety_factor, tolerance, singular, level_solve)
 
 
 def _progress(sol: MacroSolution, found: list[DE.Estimate], missed: list[DE.Estimate], tolerance: float,
@@ -286,24 +289,28 @@ def _progress(sol: MacroSolution, found: list[DE.Estimate], missed: list[DE.Esti
                   "" if not missed else f", {len(missed)} quantities beyond {tolerance:g}")
 
 
-def h_stop_reason(missed: list[DE.Estimate], values: dict[str, list[float]], h_level: int) -> str | None:
-    """Why the mesh is not refined further (``None``: it is)."""
+def h_stop_reason(missed: list[DE.Estimate], values: dict[str, list[float]], h_level: int,
+                  bound: int | None = None) -> str | None:
+    """Why the mesh is not refined beyond level ``h_level`` (``None``: it is); ``bound``: the most mesh levels
+    (default :data:`MAX_MESH_LEVELS`)."""
+    bound = MAX_MESH_LEVELS if bound is None else bound
     growing = [e for e in missed if e.error is None and MS.grows_without_bound(values[e.name])]
     if growing:
         e = growing[0]
         return (f"{e.name} grows with every mesh level ({', '.join(f'{v:.4g}' for v in values[e.name][-3:])}) "
                 "without an estimate: a singularity, whose value depends on the mesh and does not converge")
-    if h_level >= MAX_MESH_LEVELS:
-        return f"mesh level {h_level + 1} is beyond the refinement's bound ({MAX_MESH_LEVELS} levels)"
+    if h_level >= bound:
+        return f"mesh level {h_level + 1} is beyond the refinement's bound ({bound} levels)"
     return None
 
 
 def refine_mesh(scene, start: Refined, solve: Callable[..., MacroSolution],
                 safety_factor: Callable[[MacroSolution], float] | None, tolerance: float,
-                singular: Singular = Singular([], None)) -> Refined:
+                singular: Singular = Singular([], None),
+                level_solve: Callable[..., MacroSolution] | None = None) -> Refined:
     """The mesh refined where :func:`ngcontact.macro.error_indicator.indicator` is large, at the order
     ``start`` reached, level by level until the tolerance is met (module docstring); ``singular``: what
-    makes a maximum singular on every level."""
+    makes a maximum singular on every level; ``level_solve``: how a new level is solved (default ``solve``)."""
     sol, history = start.solution, list(start.history)
     values = {e.name: [e.value] for e in start.estimates}
     component = next(n for n in values if n.startswith("resultant_")).removeprefix("resultant_")
@@ -320,7 +327,7 @@ def refine_mesh(scene, start: Refined, solve: Callable[..., MacroSolution],
                                                 f"mesh level {h_level}'s estimate would solve {dofs} unknowns, "
                                                 f"beyond the refinement's bound of {MAX_DOFS}"),
                                    {"refinement": history})
-        sol = solve(problem, None)
+        sol = (level_solve or solve)(problem, None)
         ladder, samples, judged = judged_level(scene, sol, solve, safety_factor, singular, component, FACE_INSET)
         if judged.exclusion is not singular.exclusion:
             values.update({name: [] for name in values if name.endswith(AM.AWAY)})

@@ -13,9 +13,11 @@ The contact fraction is an integral of an indicator over ``S_C^eps`` whose edge 
 moves with the order inside an element: its p-convergence is algebraic at best, and where its
 differences do not shrink the verdict says so rather than give a number.  The verdict has the macro
 run's format (:func:`ngcontact.drivers.macro_accuracy.verdict`) without its equilibrium check, and is
-held to :data:`~ngcontact.cell.admissibility.DEFAULT_TOLERANCE` (the kind has no
-``discretization.tolerance``): a miss is one warning line, the terminal's accuracy line and
-``report.html``'s top say it.  The epsilon study's modelling error is another quantity, in its own report.
+held to the scene's ``discretization.tolerance`` (towards which the run is refined first,
+:mod:`ngcontact.drivers.resolved_refinement`), else to
+:data:`~ngcontact.cell.admissibility.DEFAULT_TOLERANCE`: a miss is one warning line, the terminal's
+accuracy line and ``report.html``'s top say it.  The epsilon study's modelling error is another quantity,
+in its own report.
 """
 from __future__ import annotations
 
@@ -57,11 +59,19 @@ def order_samples(sol: D.DirectSolution, length: float, solve: Callable[[D.Direc
     return dict(sorted(out.items()))
 
 
-def accuracy(sol: D.DirectSolution, length: float, solve: Callable[[D.DirectProblem], D.DirectSolution]
-             ) -> dict[str, Any]:
-    """``results.accuracy`` of the resolved solution ``sol`` (module docstring); ``length``: the macro length
-    the contact fraction is taken per."""
+def estimates(sol: D.DirectSolution, length: float, solve: Callable[[D.DirectProblem], D.DirectSolution]
+              ) -> list[DE.Estimate]:
+    """The headline quantities of ``sol`` with their errors by the order ladder on its mesh."""
     samples = order_samples(sol, length, solve)
     order = sol.problem.order
-    found = [DE.estimate(name, {q: s[name] for q, s in samples.items()}, order) for name in samples[order]]
-    return MA.verdict(found, None, None, how=HOW, absolute=FRACTIONS)
+    return [DE.estimate(name, {q: s[name] for q, s in samples.items()}, order) for name in samples[order]]
+
+
+def accuracy(sol: D.DirectSolution, length: float, solve: Callable[[D.DirectProblem], D.DirectSolution],
+             tolerance: float | None = None, found: list[DE.Estimate] | None = None) -> dict[str, Any]:
+    """``results.accuracy`` of the resolved solution ``sol`` (module docstring); ``length``: the macro length
+    the contact fraction is taken per; ``tolerance``: the scene's (``None``: the default); ``found``: the
+    estimates a refinement made already (else made here)."""
+    if found is None:
+        found = estimates(sol, length, solve)
+    return MA.verdict(found, tolerance, None, how=HOW, absolute=FRACTIONS)

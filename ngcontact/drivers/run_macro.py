@@ -265,13 +265,13 @@ def run(scene, clock) -> Outcome:
     with clock.stage("interface law"):
         problem, law_info = problem_of(scene, geo)
         check_radius(scene, problem)
-    two_scale = None
+    two_scale = relevel = None
     with clock.stage("solve"):
         if scene.two_scale is None:
             sol = solve_scene(scene, problem)
         else:
-            from ngcontact.drivers.run_two_scale import couple
-            sol, two_scale = couple(scene, problem, partial(solve_scene, scene))
+            from ngcontact.drivers.run_two_scale import couple_loop
+            sol, two_scale, relevel = couple_loop(scene, problem, partial(solve_scene, scene))
     recovery = refined = None
     if scene.strength is not None:
         from ngcontact.drivers.run_strength import recovery_of
@@ -279,13 +279,13 @@ def run(scene, clock) -> Outcome:
             recovery = recovery_of(scene, sol.problem.law)
     if scene.discretization.tolerance is not None:
         with clock.stage("refinement to the tolerance"):
-            refined = refine(scene, sol, partial(solve_scene, scene), safety_factor_of(scene, recovery))
+            refined = refine(scene, sol, partial(solve_scene, scene), safety_factor_of(scene, recovery), relevel)
         sol = refined.solution if refined else sol
     with clock.stage("post-processing"):
         outcome = measured(sol, geo, law_info, scene.output)
         results = outcome.results
         if two_scale is not None:
-            results["two_scale"] = two_scale
+            results["two_scale"] = two_scale if relevel is None else relevel.record(two_scale, sol)
             if "interface" in results:
                 results["interface"]["contact_fraction"] = np.asarray(two_scale["interface_coefficients"]
                                                                      ["contact_fraction"])

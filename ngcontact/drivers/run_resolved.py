@@ -23,6 +23,9 @@ Returns an :class:`~ngcontact.output.report.Outcome`; no file I/O.
 * ``probes``: displacements [m] at the study's probe points, if any;
 * ``accuracy``: the contact fraction and the contact force's magnitude with their discretization errors
   estimated from the neighbouring orders on the run's mesh (:mod:`ngcontact.drivers.resolved_accuracy`);
+  with ``discretization.tolerance`` the run is first refined towards it, order then interface mesh
+  (:mod:`ngcontact.drivers.resolved_refinement`; ``accuracy.refinement``), and every result is the
+  refined solution's;
 * ``newton_iterations``, ``ndof``.
 """
 from __future__ import annotations
@@ -36,6 +39,7 @@ from ngcontact.drivers.build import micro_friction
 from ngcontact.drivers.scene_laws import body_laws
 from ngcontact.drivers.mesh_supports import supports_on
 from ngcontact.drivers.resolved_accuracy import accuracy
+from ngcontact.drivers.resolved_refinement import refine
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry import resolved_shapes as rs
@@ -171,6 +175,12 @@ def run(scene, clock) -> Outcome:
         geo = build_resolved(scene)
     with clock.stage("solve"):
         sol = solve_scene(scene, problem_of(scene, geo))
+    refined = None
+    if scene.discretization.tolerance is not None:
+        with clock.stage("refinement to the tolerance"):
+            refined = refine(scene, sol, geo.length, partial(solve_scene, scene))
+        if refined is not None:
+            sol = refined.solution
     with clock.stage("post-processing"):
         results = {"periods": geo.periods, "eps": geo.eps, "setting": scene.geometry.setting,
                    "shape": scene.geometry.shape, "segments": [list(sg) for sg in geo.segments],
@@ -179,9 +189,12 @@ def run(scene, clock) -> Outcome:
                    "contact_fraction": D.contact_fraction(sol, geo.length),
                    "probes": probes(scene, sol),
                    "newton_iterations": sol.history["newton_iterations"],
-                   "elements": geo.mesh.ne}
+                   "elements": sol.problem.mesh.ne}
     with clock.stage("discretization error"):
-        results["accuracy"] = accuracy(sol, geo.length, partial(solve_scene, scene))
+        results["accuracy"] = accuracy(sol, geo.length, partial(solve_scene, scene), scene.discretization.tolerance,
+                                       None if refined is None else refined.estimates)
+    if refined is not None:
+        results["accuracy"]["refinement"] = refined.record()
     vtk = {"resolved": VtkField(mesh=geo.mesh, fields={"u_rough": sol.u_rough, "u_counter": sol.u_counter},
                                 subdivision=1)}
     solver = {"iterations": sol.history["newton_iterations"], "converged": sol.history["converged"],

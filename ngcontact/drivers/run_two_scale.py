@@ -247,10 +247,57 @@ def shear_executor_map(response: Callable[[S.ShearLoad], S.ShearResponse], loads
                                   label="shear table level")
 
 
-def couple(scene, problem, solve,
-           map_tasks: Callable[[Callable[[float], PT.Response], Sequence[float]], list[PT.Response]] = executor_map,
-           cache_dir: str | None = None, warm: bool = True, shear_map=shear_executor_map):
-    """Run the loop of ``scene.two_scale`` from ``problem``; returns ``(solution, results)``.
+class Relevel:
+    """The loop of a two-scale scene run again on another macro mesh (a mesh level of
+    :mod:`ngcontact.drivers.macro_refinement`) from the tables the scene's loop made: the cell's law does not
+    change with the macro mesh, so a table that covers the level's pressures (and, with a shear table, its
+    jumps) is its law as it stands, and one that does not grows by the cell solves the new range needs.
+    ``__call__(problem, start)`` has the macro solve's signature; ``loops`` lists each level's loop."""
+
+    def __init__(self, scene, table: PT.CellTable, shear: S.ShearTable | None, solve):
+        self.spec, self.output, self.table, self.shear, self.solve = scene.two_scale, scene.output, table, shear, solve
+        self.loops: list[dict[str, Any]] = []
+
+    def __call__(self, problem, start=None):
+        spec = self.spec
+        solves = self.table.solves + (self.shear.solves if self.shear is not None else 0)
+        out = T.couple(problem, self.table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
+                       points_per_element=self.output.points_per_element, solve=self.solve, shear=self.shear)
+        added = self.table.solves + (self.shear.solves if self.shear is not None else 0) - solves
+        self.loops.append({"elements": problem.mesh.ne, "iterations": len(out.history) - 1, "cell_solves": added,
+                           "max_change": out.history[-1]["max_change"]})
+        return out.solution
+
+    def record(self, results: dict, sol) -> dict:
+        """``results`` (``results["two_scale"]``) of the refined solution ``sol``, updated where mesh levels ran:
+        its interface coefficients, the table as it grew, the cell solves and the levels' loops
+        (``mesh_levels``)."""
+        if not self.loops:
+            return results
+        p = interface_samples(sol, self.output.points_per_element)["pressure"]
+        coef = self.table(np.asarray(p))
+        results["interface_coefficients"] = {"contact_fraction": coef["contact_fraction"], "k_n0": coef["k_n0"]}
+        results["table"] = self.table.as_dict()
+        results["cell_solves"] = self.table.solves + (self.shear.solves if self.shear is not None else 0)
+        results["mesh_levels"] = self.loops
+        return results
+
+
+def couple(scene, problem, solve, **kw):
+    """Run the loop of ``scene.two_scale`` from ``problem``; returns ``(solution, results)``
+    (:func:`couple_loop` without its :class:`Relevel`)."""
+    sol, res, _ = couple_loop(scene, problem, solve, **kw)
+    return sol, res
+
+
+#: how the cell solves of one table level run (:func:`executor_map`, or serially in tests)
+MapTasks = Callable[[Callable[[float], PT.Response], Sequence[float]], list[PT.Response]]
+
+
+def couple_loop(scene, problem, solve, map_tasks: MapTasks = executor_map,
+                cache_dir: str | None = None, warm: bool = True, shear_map=shear_executor_map):
+    """Run the loop of ``scene.two_scale`` from ``problem``; returns ``(solution, results, relevel)``,
+    ``relevel`` the loop on another macro mesh from the same tables (:class:`Relevel`).
 
     ``solve(problem, start)``: the macro solve (warm-started from the
     vector ``start`` when it is not None); ``map_tasks``: runs the cell
@@ -303,4 +350,4 @@ def couple(scene, problem, solve,
         res["shear_table"] = shear.as_dict()
         res["shear_table"]["cache"] = {"key": skey, "table_from_cache": shear_cached}
         res["law"]["tangential"] = "tabulated cell shear T(p, a_t) (the cell's own friction)"
-    return out.solution, res
+    return out.solution, res, Relevel(scene, table, shear, solve)

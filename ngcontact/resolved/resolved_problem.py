@@ -256,10 +256,13 @@ def contact_force(sol: DirectSolution, x_range=None, part=None) -> np.ndarray:
     return np.asarray(vals, float).ravel()
 
 
+def closed_indicator(sol: DirectSolution) -> ng.CoefficientFunction:
+    """1 where ``J.n - g >= 0`` on ``S_C^eps`` (closed), else 0."""
+    return ng.IfPos(-_contact.penetration(sol.jump, sol.normal, sol.problem.gap), 0.0, 1.0)
+
+
 def contact_fraction(sol: DirectSolution, length: float) -> float:
     """Measure of ``{J.n - g >= 0}`` on ``S_C^eps`` (high-order quadrature) per unit macro length."""
     p = sol.problem
-    pen = _contact.penetration(sol.jump, sol.normal, p.gap)
-    ind = ng.IfPos(-pen, 0.0, 1.0)
-    return float(ng.Integrate(ind, p.mesh, ng.BND, definedon=p.mesh.Boundaries(p.contact),
+    return float(ng.Integrate(closed_indicator(sol), p.mesh, ng.BND, definedon=p.mesh.Boundaries(p.contact),
                               order=kink_order(p.order))) / length

@@ -11,10 +11,10 @@ scene and knows no kind by name:
 * **two-scale** (a macro scene with ``[two_scale]``): the macro knobs and the loop's, ``table_tol``,
   ``loop_tol`` and its cell's ``cell_grid`` / ``cell_h``, ``cell_order`` / ``cell_k_n``;
 * **resolved** (``kind = "direct"``, the rough geometry meshed period by period): ``h`` (far-field
-  ``maxh`` and ``elements_per_period``), ``order``.
+  ``maxh`` and ``elements_per_period``), ``order``, ``tolerance`` (where set).
 
-A macro scene that states ``discretization.tolerance`` is refined until it is met (order, then mesh), so
-every ladder but the tolerance's own drops it: each level is its own setting.
+A macro or resolved scene that states ``discretization.tolerance`` is refined until it is met (order, then
+mesh), so every ladder but the tolerance's own drops it: each level is its own setting.
 """
 from __future__ import annotations
 
@@ -78,9 +78,7 @@ class Macro(StudiedKind):
         return scene.kind == "macro" and scene.two_scale is None
 
     def level_table(self, data, knob):
-        if not knob.sets_tolerance:
-            data.get("discretization", {}).pop("tolerance", None)
-        return data
+        return without_tolerance(data, knob)
 
 
 class TwoScale(Macro):
@@ -93,10 +91,21 @@ class TwoScale(Macro):
 
 class Resolved(StudiedKind):
     name, summary = "resolved", "resolved (direct)"
-    knobs: tuple[Knob, ...] = (ResolvedMeshSize(), Order())
+    knobs: tuple[Knob, ...] = (ResolvedMeshSize(), Order(), Tolerance())
 
     def takes(self, scene) -> bool:
         return scene.kind == "direct"
+
+    def level_table(self, data, knob):
+        return without_tolerance(data, knob)
+
+
+def without_tolerance(data: dict, knob: Knob) -> dict:
+    """A level's table without ``discretization.tolerance`` unless ``knob`` varies it (a scene that states it
+    is refined until it is met, so another knob's level would not be its own setting)."""
+    if not knob.sets_tolerance:
+        data.get("discretization", {}).pop("tolerance", None)
+    return data
 
 
 #: the studied kinds, asked in this order

@@ -178,9 +178,49 @@ def test_a_corner_singularity_is_refined_towards_and_ends_the_run_with_its_figur
     assert refined and "grows with every mesh level" in str(info.value) and "mesh level" in str(info.value)
 
 
-def test_a_two_scale_scene_keeps_its_mesh():
-    assert "two-scale" in MR.h_refusal(SimpleNamespace(two_scale=object()))
-    assert MR.h_refusal(SimpleNamespace(two_scale=None)) is None
+def two_scale_press_fit(tmp_path, monkeypatch, tolerance: float):
+    """The press fit coupled with a spectral Westergaard cell (tests/drivers/test_study_kinds.py), its table cached
+    in ``tmp_path``, with ``discretization.tolerance``."""
+    from tests.drivers.test_study_kinds import two_scale_scene
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))
+    path = two_scale_scene(tmp_path)
+    path.write_text(path.read_text().replace("maxh = 0.3", f"maxh = 0.3\ntolerance = {tolerance}"))
+    return loader.load(path)
+
+
+def test_a_two_scale_scene_refines_its_mesh_by_the_loop_on_its_table(tmp_path, monkeypatch):
+    """Past order 4 the two-scale press fit's mesh is refined: each level runs the loop again from the cell table
+    (which covers the level's pressures: no cell solve), and the interface coefficients are the refined mesh's."""
+    assert MR.h_refusal(SimpleNamespace(two_scale=object())) is None
+    out = D.run(two_scale_press_fit(tmp_path, monkeypatch, 1e-3), Clock())
+    res = out.results
+    acc, ts = res["accuracy"], res["two_scale"]
+    ref = acc["refinement"]
+    assert ref["order"] == MR.MAX_REFINED_ORDER and ref["h_level"] >= 1 and out.ndof == ref["ndof"]
+    assert len(ts["mesh_levels"]) == ref["h_level"]
+    assert all(lv["cell_solves"] == 0 and lv["max_change"] == 0.0 for lv in ts["mesh_levels"]), ts["mesh_levels"]
+    assert [lv["elements"] for lv in ts["mesh_levels"]] == [lv["elements"] for lv in ref["levels"][3:]]
+    assert len(ts["interface_coefficients"]["contact_fraction"]) == len(res["interface"]["pressure"])
+    q = {x["name"]: x for x in acc["quantities"]}
+    assert all(x["met"] for name, x in q.items() if name != "cell_table_interpolation"), q
+    # the tolerance refines the macro discretization, not the table (two_scale.table_tol = 0.02): said, not met
+    assert not q["cell_table_interpolation"]["met"] and not acc["met"]
+
+
+@pytest.mark.slow
+def test_a_two_scale_scene_estimates_bound_its_error_against_one_refined_ten_times_further(tmp_path, monkeypatch):
+    coarse = D.run(two_scale_press_fit(tmp_path, monkeypatch, 1e-3), Clock()).results["accuracy"]
+    fine = D.run(two_scale_press_fit(tmp_path, monkeypatch, 1e-4), Clock()).results["accuracy"]
+    assert fine["refinement"]["h_level"] > coarse["refinement"]["h_level"]
+    ref = {x["name"]: x for x in fine["quantities"]}
+    for q in coarse["quantities"]:
+        r = ref.get(q["name"])
+        if q["name"] in ("cell_table_interpolation", "two_scale_residual") or r is None:
+            continue
+        true = abs(q["value"] - r["value"])
+        if true <= 1e-8 * abs(r["value"]):           # the resultant balances the load to round-off on both
+            continue
+        assert true + r["error"] <= q["error"] <= 10.0 * true, (q["name"], true, r["error"], q["error"])
 
 
 @pytest.mark.parametrize("bound, said", [("MAX_MESH_LEVELS", "mesh level 2 is beyond the refinement's bound (1 levels)"),
