@@ -38,7 +38,8 @@ Then the mesh (h), where the order no longer pays
       tolerance beyond the order's reach asks for, the inset of the sample points from a boundary where
       the maximum sits is a share of the error.
     * A maximum that grows with every mesh level without an estimate is a true singularity (its value
-      depends on the mesh and has no limit): the refinement stops there and says so.
+      depends on the mesh and has no limit; :func:`ngcontact.macro.mesh_sequence.growing`, the test of the
+      corner check and of the levels at the singular points): the refinement stops there and says so.
     * A scene with ``[two_scale]`` keeps its mesh (the loop's interface state lives on it).
 
 What is refined for
@@ -288,7 +289,7 @@ def _progress(sol: MacroSolution, found: list[DE.Estimate], missed: list[DE.Esti
 
 def h_stop_reason(missed: list[DE.Estimate], values: dict[str, list[float]], h_level: int) -> str | None:
     """Why the mesh is not refined further (``None``: it is)."""
-    growing = [e for e in missed if e.error is None and MS.grows_without_bound(values[e.name])]
+    growing = [e for e in missed if e.error is None and SM.growing(e, values[e.name])]
     if growing:
         e = growing[0]
         return (f"{e.name} grows with every mesh level ({', '.join(f'{v:.4g}' for v in values[e.name][-3:])}) "
