@@ -341,11 +341,14 @@ class MacroScene:
                              shown=self.geometry.file, missing="no such CAD file")
         if self.interface.law_file is not None:
             from ngcontact.scene import law_file
-            contents = law_file.read(resolve(self, self.interface.law_file))
+            where = resolve(self, self.interface.law_file)
+            contents = law_file.read(where)
             try:
                 law_file.normal_law_of(contents, self.interface.law_file_form)
             except ValueError as exc:
                 raise SceneError("interface.law_file_form", self.interface.law_file_form, str(exc)) from None
+            magnitudes.check_file_law(self, "interface.law_file", where,
+                                      law_file.stiffness(contents, self.interface.law_file_form))
         files = (("interface.cell", self.interface.cell, False),
                  ("strength.cell", self.strength.cell if self.strength else None, True),
                  ("two_scale.cell", self.two_scale.cell if self.two_scale else None, True))
