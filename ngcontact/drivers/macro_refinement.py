@@ -38,7 +38,8 @@ Then the mesh (h), where the order no longer pays
       tolerance beyond the order's reach asks for, the inset of the sample points from a boundary where
       the maximum sits is a share of the error.
     * A maximum that grows with every mesh level without an estimate is a true singularity (its value
-      depends on the mesh and has no limit): the refinement stops there and says so.
+      depends on the mesh and has no limit; :func:`ngcontact.macro.mesh_sequence.growing`, the test of the
+      corner check and of the levels at the singular points): the refinement stops there and says so.
     * A scene with ``[two_scale]`` refines its mesh too: each mesh level runs the coupling loop again on
       the refined mesh from the tables the scene's loop made (``level_solve``,
       :class:`ngcontact.drivers.run_two_scale.Relevel`).  The cell's law is a function of the macro jump,
@@ -294,7 +295,7 @@ def h_stop_reason(missed: list[DE.Estimate], values: dict[str, list[float]], h_l
     """Why the mesh is not refined beyond level ``h_level`` (``None``: it is); ``bound``: the most mesh levels
     (default :data:`MAX_MESH_LEVELS`)."""
     bound = MAX_MESH_LEVELS if bound is None else bound
-    growing = [e for e in missed if e.error is None and MS.grows_without_bound(values[e.name])]
+    growing = [e for e in missed if e.error is None and SM.growing(e, values[e.name])]
     if growing:
         e = growing[0]
         return (f"{e.name} grows with every mesh level ({', '.join(f'{v:.4g}' for v in values[e.name][-3:])}) "

@@ -63,7 +63,8 @@ elements at a singular point, where no order converges fast) has ``e_P = e_m = 0
 alone.  The check costs about one solve of the scene (two warm-started solves on meshes a little larger).
 
 A stress maximum that grows where the levels refine
-    Before the rules above, the levels are asked whether they converge at all (:func:`growing`).  Level ``k``
+    Before the rules above, the levels are asked whether they converge at all
+    (:func:`ngcontact.macro.mesh_sequence.growing`, the one test the corner check makes too).  Level ``k``
     halves the elements at the singular points and those holding the maximum, ``h_k = 2^-k h_0`` there, and
     its difference is ``d_k = Q_k - Q_(k-1)``.  A maximum converging at rate ``q`` (``Q_k = Q + C h_k^q``)
     has differences that contract by ``d_(k+1) / d_k = 2^-q``: at most ``2^-0.544 = 0.69`` for the
@@ -73,7 +74,7 @@ A stress maximum that grows where the levels refine
     factor ``2^(1 - lambda) > 1`` per level.  So a stress maximum whose magnitude grows at each of the last
     three levels by resolved differences, ``d_k > max(NOISE scale, s_(k-1))``, with
 
-        d_2 >= c d_1,   c = GROWING = 3/4
+        d_2 >= c d_1,   c = GROWING = 3/4   (:data:`ngcontact.macro.mesh_sequence.GROWING`)
 
     has no converged value.  A difference is resolved above round-off
     (:data:`~ngcontact.macro.discretization_error.NOISE` of the scale) and above the sampling error
@@ -110,8 +111,9 @@ A safety factor that falls where the levels refine
     (eq. 75); its reciprocal, the utilisation ``sigma_eq / sigma_u``, is a maximum of a stress.  Where that
     stress grows like ``log r``, ``A + B k`` on level ``k``, the utilisation grows so and the safety factor
     falls like ``1 / log r``, by differences whose ratio ``A / (A + 2B)`` shows no fixed rate.  So the mirror
-    of the test above is taken on the utilisation (:func:`growing`): levels whose utilisation grows at each
-    level, the last difference at least :data:`GROWING` of the first, have no converged value, whatever the
+    of the test above is taken on the utilisation (:func:`ngcontact.macro.singular_maxima.growing`): levels
+    whose utilisation grows at each level, the last difference at least ``GROWING`` of the first, have no
+    converged value, whatever the
     ladder's estimate: mesh dependent, singular at the finest level's location, with the value of the
     scene's mesh.  A safety factor that falls by contracting utilisation differences converges from above
     (0.2393, 0.1977, 0.1931, 0.1905, 0.1892: the utilisation's differences contract by 0.14, 0.58, 0.51)
@@ -146,6 +148,7 @@ import numpy as np
 from ngcontact.macro import away_maxima as AM
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro import error_indicator as EI
+from ngcontact.macro import mesh_sequence as MS
 from ngcontact.macro import singular_maxima as SM
 from ngcontact.macro.macro_problem import MacroSolution
 
@@ -155,12 +158,9 @@ LEVELS = 2
 CIRCLE = 64
 #: the slowest fall per level of the pollution of a singular point (module docstring)
 SLOWEST = 0.5
-#: the ratios of the last two differences that agree in rate with the halving (module docstring)
-AGREE = (0.25, 0.75)
-#: a stress maximum growing at each level with the last difference at least this share of the first has no
-#: converged value (module docstring): slower than the pollution of any singular point falls
-GROWING = AGREE[1]
-
+#: the ratios of the last two differences that agree in rate with the halving (module docstring); above the
+#: upper one a growing maximum has no limit (:data:`ngcontact.macro.mesh_sequence.GROWING`)
+AGREE = (0.25, MS.GROWING)
 #: the safety factor away from the singular points of a solution, given which interface points count
 Safety = Callable[[MacroSolution, Callable[[np.ndarray], np.ndarray]], dict[str, DE.Sample]]
 #: why a point where a maximum away grows with the levels joins the singular points (:func:`grown`)
@@ -230,8 +230,9 @@ def judged(found: list[DE.Estimate], own: dict[str, DE.Sample], finer: list[dict
     """``found`` with each quantity the levels ``finer`` sampled (the maxima away; with ``whole`` in
     :func:`levels` those over whole bodies too), not mesh dependent, judged by its value on the scene's
     mesh (``own``) and on the levels (module docstring): the value and location of the finest level, or
-    mesh dependent where a stress maximum grows with the levels (:func:`growing`; a maximum away not where
-    ``near`` says it is next to the region around the singular set); the other estimates unchanged.  A
+    mesh dependent where a stress maximum grows with the levels
+    (:func:`ngcontact.macro.singular_maxima.growing`; a maximum away not where ``near`` says it is next to
+    the region around the singular set); the other estimates unchanged.  A
     body's von Mises and Tresca maxima so judged are singular together
     (:func:`ngcontact.macro.singular_maxima.same_body`)."""
     out, names = [], set()
@@ -261,27 +262,6 @@ def grown(found: list[DE.Estimate], exclusion: AM.Exclusion | None, mesh: ng.Mes
     return out
 
 
-def growing(e: DE.Estimate, values: list[float], sampling: list[float] | None = None) -> bool:
-    """A stress maximum whose magnitude grows at each of the last three levels ``values`` (the scene's mesh
-    first) by differences that do not contract, ``d_2 >= GROWING d_1``, each resolved: above round-off and the
-    sampling error of the level it starts from (``sampling``, one per level; none: 0); a safety factor (a
-    minimum) whose reciprocal, the utilisation, so grows, its own falls resolved so.  The ladder's estimate
-    ``e.error`` plays no part: a quantity without a limit has no error to compare it with (module docstring)."""
-    if len(values) < 3:
-        return False
-    last = [abs(v) for v in values[-3:]]
-    floor = [max(DE.NOISE * max(e.scale, max(last)), s) for s in (sampling or [0.0] * len(values))[-3:-1]]
-    if e.name.startswith(SM.STRESS):
-        q0, q1, q2 = last
-        resolved = q1 - q0 > floor[0] and q2 - q1 > floor[1]
-    elif e.name.startswith(SM.SAFETY_FACTOR) and all(0.0 < v < math.inf for v in last):
-        q0, q1, q2 = (1.0 / v for v in last)
-        resolved = last[0] - last[1] > floor[0] and last[1] - last[2] > floor[1]
-    else:
-        return False
-    return resolved and q2 - q1 >= GROWING * (q1 - q0)
-
-
 def _judged(e: DE.Estimate, samples: list[DE.Sample], near: Beside | None = None) -> DE.Estimate:
     """The error of the finest of ``samples`` (the scene's mesh, then the levels; module docstring), or the
     scene mesh's value, mesh dependent, where it grows (a safety factor: falls) with the levels."""
@@ -289,7 +269,7 @@ def _judged(e: DE.Estimate, samples: list[DE.Sample], near: Beside | None = None
     shown = ", ".join(f"{v:.6g}" for v in values)
     at = samples[-1].location
     exempt = e.name.endswith(AM.AWAY) and near is not None and at is not None and near(at)
-    if growing(e, values, [x.sampling for x in samples]) and at is not None and not exempt:
+    if SM.growing(e, values, [x.sampling for x in samples]) and at is not None and not exempt:
         return replace(e, error=None, singular_at=at,
                        how=f"{e.how}; {len(values) - 1} local refinements at the singular points and at the "
                            f"{'minima' if e.name.startswith(SM.SAFETY_FACTOR) else 'maxima'}: {shown}: "
@@ -350,13 +330,14 @@ def level_error(values: list[float], scale: float, polynomial: float | None, lad
 
 
 def _unbounded(name: str) -> str:
-    """Why a quantity :func:`growing` says grows (a safety factor: falls) has no converged value."""
+    """Why a quantity :func:`ngcontact.macro.singular_maxima.growing` says grows (a safety factor: falls) has no
+    converged value."""
     if name.startswith(SM.SAFETY_FACTOR):
         return (f"it falls with every halving of the elements holding it, and its reciprocal (the utilisation "
                 f"sigma_eq / sigma_u) grows by differences that do not contract as a converging stress's do "
-                f"(the last at least {GROWING:g} of the first), as 1 / log r or r^(1 - lambda) falls on the meshes "
+                f"(the last at least {MS.GROWING:g} of the first), as 1 / log r or r^(1 - lambda) falls on the meshes "
                 "the levels reach, so this minimum has no converged value there, whatever the ladder's estimate")
     return (f"it grows with every halving of the elements holding it, by differences above its sampling error "
-            f"that do not contract as a converging stress's do (the last at least {GROWING:g} of the first), as "
+            f"that do not contract as a converging stress's do (the last at least {MS.GROWING:g} of the first), as "
             "log r or r^(lambda - 1) grows on the meshes the levels reach, so this maximum has no converged value "
             "there, whatever the ladder's estimate")

@@ -26,6 +26,11 @@ The reported error is the larger of the ladder's and the sequence's; a quantity 
 (a corner's maximum) takes the sequence's alone, so a corner whose maximum converges under refinement
 is estimated, and one that does not stays without an estimate.  A sequence that does not converge while
 the ladder has an estimate adds its last difference: ``max(e_ladder, 1.5 |d_hi|)``.
+
+Whether levels grow without a limit (:func:`growing`: rises above round-off and sampling that do not
+contract) is decided here once, for the refinement's stop, the corner check of
+:mod:`ngcontact.macro.singular_maxima` and the levels at the singular points of
+:mod:`ngcontact.macro.away_sequence`.
 """
 from __future__ import annotations
 
@@ -33,6 +38,11 @@ import math
 from dataclasses import replace
 
 from ngcontact.macro import discretization_error as DE
+
+#: a maximum growing at each level with the last difference at least this share of the first has no limit
+#: (:func:`growing`): above the slowest contraction of a converging stress's differences (0.69), below the
+#: logarithm's 1 by a margin for a log-singular maximum whose sample points still approach its point
+GROWING = 0.75
 
 
 def _ratio(values: list[float]) -> tuple[float, str]:
@@ -85,10 +95,27 @@ def combined(ladder: DE.Estimate, values: list[float]) -> DE.Estimate:
     return replace(ladder, how=f"{ladder.how}; larger than the mesh sequence's ({how})")
 
 
-def grows_without_bound(values: list[float]) -> bool:
-    """The magnitude grew at each of the last two levels and the difference did not shrink: a
-    singularity under refinement."""
+def growing(values: list[float], scale: float, sampling: list[float] | None = None, minimum: bool = False) -> bool:
+    """Whether a maximum's levels ``values`` (the coarsest first) have no limit: its magnitude grows at each of
+    the last three levels by differences that do not contract, ``d_2 >= GROWING d_1``, each resolved, that is
+    above round-off (:data:`~ngcontact.macro.discretization_error.NOISE` of ``scale`` or of the values) and
+    above the sampling error of the level it starts from (``sampling``, one per level; none: 0).  With
+    ``minimum`` the values are a minimum (a safety factor): its reciprocal is the maximum tested for growth,
+    and its own falls are the differences that must be resolved.
+
+    A maximum converging at rate ``q`` on levels that halve the elements holding it has differences that
+    contract by ``2^-q`` per level: at most ``2^-0.544 = 0.69`` for the pollution of the slowest singular
+    point of :mod:`ngcontact.macro.away_maxima`.  One that is unbounded does not: ``log(1/r)`` sampled at
+    ``r ~ h_k = 2^-k h_0`` gains a constant per level (ratio 1), ``r^(lambda - 1)`` a factor
+    ``2^(1 - lambda) > 1``.  :data:`GROWING` lies between the two; the argument and the figures it was
+    measured on are in :mod:`ngcontact.macro.away_sequence`.  No estimate of the scene's own mesh enters:
+    a quantity without a limit has no error to compare its growth with."""
     if len(values) < 3:
         return False
-    q0, q1, q2 = (abs(v) for v in values[-3:])
-    return q0 < q1 < q2 and (q2 - q1) >= (q1 - q0)
+    last = [abs(v) for v in values[-3:]]
+    if minimum and not all(0.0 < v < math.inf for v in last):
+        return False
+    floor = [max(DE.NOISE * max(scale, max(last)), s) for s in (sampling or [0.0] * len(values))[-3:-1]]
+    rises = [last[0] - last[1], last[1] - last[2]] if minimum else [last[1] - last[0], last[2] - last[1]]
+    q0, q1, q2 = (1.0 / v for v in last) if minimum else last
+    return rises[0] > floor[0] and rises[1] > floor[1] and q2 - q1 >= GROWING * (q1 - q0)

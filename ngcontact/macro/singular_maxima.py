@@ -43,22 +43,29 @@ The check
     interpolated into its space (the meshes are nested, so the solve starts next to its solution).  Each
     level halves the elements at the corners, so the sample points there move closer to the vertex by a
     factor 2.  The body's maximum and the largest stress within one boundary edge of each corner are taken
-    on every level (``Q_0, Q_1, Q_2``):
+    on every level (``Q_0, Q_1, Q_2``), each with its sampling error (the denser lattice's excess).
 
-    Growth counts only beyond the ladder's own estimate over the levels (a converging maximum moves by
-    less than its error when the mesh is refined at the corners):
+    A maximum grows when its levels have no limit by the one test of
+    :func:`ngcontact.macro.mesh_sequence.growing`, the test the levels at the singular points make
+    (:mod:`ngcontact.macro.away_sequence`): it rises at each level by more than round-off and the sampling
+    error of the level it starts from, and the last rise is at least
+    :data:`~ngcontact.macro.mesh_sequence.GROWING` of the first (``log r`` gains a constant per halving,
+    ``r^(lambda - 1)`` a factor ``2^(1 - lambda)``, a converging maximum's rises contract by ``2^-0.544``
+    or faster).  The ladder's estimate plays no part: it measures the polynomial error of one mesh, and a
+    quantity without a limit has no error it could be compared with.  Then:
 
-    * a corner whose stress grows at each level by a difference that does not shrink (``r^(lambda - 1)``
-      grows by a factor ``2^(1 - lambda)`` per halving, ``log r`` by a constant) and reaches
-      :data:`RELEVANT` of the body's maximum makes that maximum **mesh dependent, singular at** the corner
-      (``error = None``, ``met = false``), never a small estimate; so does a body maximum that grows so;
+    * a corner whose stress so grows and reaches :data:`RELEVANT` of the body's maximum makes that maximum
+      **mesh dependent, singular at** the corner (``error = None``, ``met = false``), never a small
+      estimate; so does a body maximum that grows so;
     * a body maximum that sits at a corner (within :data:`~ngcontact.macro.discretization_error.AT_CORNER`
       of the scene's shortest boundary edge) and whose levels neither converge nor grow has no rate and
       no limit that could be extrapolated: mesh dependent as well;
-    * otherwise the sequence's estimate (:func:`ngcontact.macro.mesh_sequence.sequence_error`, the
-      geometric tail of the level differences with the factor of safety) is taken where it exceeds the
-      ladder's, so a slowly converging corner is estimated from the mesh; a sequence that does not
-      converge away from the corners adds its last difference times the factor of safety.
+    * otherwise the sequence's estimate is taken where it exceeds the ladder's, so a slowly converging
+      corner is estimated from the mesh.  The value reported is the scene mesh's ``Q_0`` (the solution
+      stays on it), so its error is the move the levels made, ``|Q_2 - Q_0|``, plus the error left after
+      the finest level (:func:`ngcontact.macro.mesh_sequence.sequence_error`, the geometric tail of the
+      level differences with the factor of safety); a sequence that does not converge away from the
+      corners takes at least that move plus its last difference times the factor of safety.
 
 A corner whose stress grows but stays below :data:`RELEVANT` of the body's maximum leaves the maximum
 as it is: its value is the largest stress away from that corner, which the corner reaches only after
@@ -105,24 +112,33 @@ def checked_names(found: list[DE.Estimate]) -> list[str]:
     return [e.name for e in found if e.name.startswith(STRESS) and not e.name.endswith(AWAY)]
 
 
-def corner_maxima(sol: MacroSolution, corners: np.ndarray, radius: float) -> dict[str, np.ndarray]:
+def corner_maxima(sol: MacroSolution, corners: np.ndarray, radius: float
+                  ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Per stress measure and body (``von_mises_<region>``, ``tresca_<region>``) the largest value at the
     sample points of :func:`ngcontact.macro.macro_measures.field_extrema` within ``radius`` of each corner
-    (one entry per row of ``corners``; 0 where the body has no point there)."""
+    (one entry per row of ``corners``; 0 where the body has no point there), and its sampling error: how much
+    larger the largest value on the denser lattice of
+    :func:`ngcontact.macro.discretization_error.dense_rule` within that radius is (as
+    :func:`ngcontact.macro.discretization_error.body_maxima` measures a body's)."""
     p = sol.problem
     mesh = p.mesh
     sig = MM.stress(sol)
     coords = ng.CF((ng.x, ng.y, ng.z)[:mesh.dim])
     out: dict[str, np.ndarray] = {}
+    sampling: dict[str, np.ndarray] = {}
     for region in (p.rough, p.counter):
-        mips = mesh.MapToAllElements(MM._sample_rule(mesh.dim), mesh.Materials(region))
-        s = np.asarray(sig(mips)).reshape(-1, 3, 3)
-        xyz = np.asarray(coords(mips)).reshape(-1, mesh.dim)
-        near = np.linalg.norm(xyz[:, None, :] - corners[None, :, :], axis=2) <= radius
+        by_rule = []
+        for rule in (MM._sample_rule(mesh.dim), DE.dense_rule(mesh.dim)):
+            mips = mesh.MapToAllElements(rule, mesh.Materials(region))
+            xyz = np.asarray(coords(mips)).reshape(-1, mesh.dim)
+            near = np.linalg.norm(xyz[:, None, :] - corners[None, :, :], axis=2) <= radius
+            by_rule.append((np.asarray(sig(mips)).reshape(-1, 3, 3), near))
         for name, measure in (("von_mises", von_mises), ("tresca", tresca)):
-            values = measure(s)
-            out[f"{name}_{region}"] = np.where(near, values[:, None], 0.0).max(axis=0, initial=0.0)
-    return out
+            coarse, dense = (np.where(near, measure(s)[:, None], 0.0).max(axis=0, initial=0.0)
+                             for s, near in by_rule)
+            out[f"{name}_{region}"] = coarse
+            sampling[f"{name}_{region}"] = np.maximum(dense - coarse, 0.0)
+    return out, sampling
 
 
 def corners_of(mesh: ng.Mesh) -> np.ndarray:
@@ -201,7 +217,7 @@ def star(mesh: ng.Mesh, corners: np.ndarray) -> np.ndarray:
 
 def local_levels(sol: MacroSolution, solve: Callable[..., MacroSolution], points: list[tuple[float, ...]],
                  corners: np.ndarray, radius: float, levels: int = LEVELS
-                 ) -> list[tuple[dict[str, DE.Sample], dict[str, np.ndarray]]]:
+                 ) -> list[tuple[dict[str, DE.Sample], tuple[dict[str, np.ndarray], dict[str, np.ndarray]]]]:
     """Per level the body maxima and :func:`corner_maxima` (within ``radius`` of ``corners``) of ``levels``
     solves, each on a copy of the last level's mesh (the first: ``sol``'s) refined at ``points``, at
     ``sol``'s order, each solved by ``solve(problem, start)`` from the last level's solution interpolated
@@ -217,29 +233,39 @@ def local_levels(sol: MacroSolution, solve: Callable[..., MacroSolution], points
     return out
 
 
-def growing_corner(values: list[float], at_corners: np.ndarray, error: float = 0.0) -> int | None:
-    """The corner (row of ``at_corners``: levels x corners, the largest stress near each) whose stress grows
-    with every level without shrinking differences, by more than the ladder's ``error`` over the levels,
-    and reaches :data:`RELEVANT` of the body's maximum ``values[-1]`` on the finest level; the largest
-    such, or ``None``."""
-    grows = [k for k in range(at_corners.shape[1]) if MS.grows_without_bound(list(at_corners[:, k]))
-             and at_corners[-1, k] - at_corners[0, k] > error and at_corners[-1, k] >= RELEVANT * abs(values[-1])]
+def growing(e: DE.Estimate, values: list[float], sampling: list[float] | None = None) -> bool:
+    """Whether the levels ``values`` of the quantity ``e`` (the scene's mesh first; ``sampling``: their
+    sampling errors) grow without a limit (:func:`ngcontact.macro.mesh_sequence.growing`): a maximum's
+    magnitude, a safety factor's (a minimum's) reciprocal, the utilisation."""
+    return MS.growing(values, e.scale, sampling, minimum=e.name.startswith(SAFETY_FACTOR))
+
+
+def growing_corner(e: DE.Estimate, values: list[float], at_corners: np.ndarray,
+                   sampling: np.ndarray | None = None) -> int | None:
+    """The corner (column of ``at_corners``: levels x corners, the largest stress near each; ``sampling``: its
+    sampling errors, default 0) whose stress grows without a limit (:func:`growing`, on the scale of the
+    body's maximum ``e``) and reaches :data:`RELEVANT` of the body's maximum ``values[-1]`` on the finest
+    level; the largest such, or ``None``."""
+    grows = [k for k in range(at_corners.shape[1])
+             if growing(e, list(at_corners[:, k]), None if sampling is None else list(sampling[:, k]))
+             and at_corners[-1, k] >= RELEVANT * abs(values[-1])]
     return max(grows, key=lambda k: at_corners[-1, k]) if grows else None
 
 
 def judged(e: DE.Estimate, samples: list[DE.Sample], at_corners: np.ndarray, corners: np.ndarray,
-           h: float) -> DE.Estimate:
+           h: float, sampling: np.ndarray | None = None) -> DE.Estimate:
     """The ladder's estimate ``e`` of a stress maximum judged by its values on the scene's mesh and the
     local levels ``samples``, and the largest stress near each of ``corners`` on each level
-    (``at_corners``, levels x corners) (module docstring); ``h``: the scene's shortest boundary edge, of
-    which a maximum within :data:`~ngcontact.macro.discretization_error.AT_CORNER` sits at a corner."""
+    (``at_corners``, levels x corners; ``sampling``: their sampling errors, default 0) (module docstring);
+    ``h``: the scene's shortest boundary edge, of which a maximum within
+    :data:`~ngcontact.macro.discretization_error.AT_CORNER` sits at a corner."""
     values = [s.value for s in samples]
     shown = ", ".join(f"{v:.4g}" for v in values)
     head = f"{e.how}; corner check ({len(values) - 1} local refinements at the boundary's corners): {shown}"
     if e.singular_at is not None:
         return replace(e, how=f"{head}: the order ladder found the singularity already")
-    k = growing_corner(values, at_corners, e.error or 0.0)
-    if k is not None or (MS.grows_without_bound(values) and values[-1] - values[0] > (e.error or 0.0)):
+    k = growing_corner(e, values, at_corners, sampling)
+    if k is not None or growing(e, values, [s.sampling for s in samples]):
         where = tuple(float(c) for c in corners[k]) if k is not None else samples[-1].location
         near = "" if k is None else " (" + ", ".join(f"{v:.4g}" for v in at_corners[:, k]) + " next to it)"
         return replace(e, error=None, singular_at=where,
@@ -254,13 +280,19 @@ def judged(e: DE.Estimate, samples: list[DE.Sample], at_corners: np.ndarray, cor
                        how=f"{head}; {how}, at the corner {DE._point(corner)}: the body's largest stress sits at a "
                            f"corner and moves with every halving of its elements: mesh dependent, singular at "
                            f"{DE._point(corner)}")
+    moved = abs(values[-1] - values[0])
+    said = f"the scene mesh's value, reported, lies {moved:.3g} from the finest level's"
     if seq is None:
         if e.error is None:
             return replace(e, how=f"{head}; {how}")
-        return replace(e, error=max(e.error, DE.SAFETY * abs(values[-1] - values[-2])),
-                       how=f"{head}; {how}: at least {DE.SAFETY:g} x the last difference")
-    if e.error is None or seq > e.error:
-        return replace(e, error=seq, singular_at=None, how=f"{head}; {how}, larger than the order ladder's")
+        last = moved + DE.SAFETY * abs(values[-1] - values[-2])
+        return replace(e, error=max(e.error, last),
+                       how=f"{head}; {how}; {said}: at least that plus {DE.SAFETY:g} x the last difference, "
+                           f"{last:.3g}")
+    total = moved + seq
+    how = f"{how}; {said}: with the tail {total:.3g}"
+    if e.error is None or total > e.error:
+        return replace(e, error=total, singular_at=None, how=f"{head}; {how}, larger than the order ladder's")
     return replace(e, how=f"{head}; {how}, below the order ladder's")
 
 
@@ -285,7 +317,8 @@ def check(found: list[DE.Estimate], sol: MacroSolution, samples: dict[str, DE.Sa
     for e in found:
         if e.name in names:
             e = judged(e, [samples[e.name]] + [m[e.name] for m, _ in finer],
-                       np.array([n[e.name] for n in near]), corners, h)
+                       np.array([n[e.name] for n, _ in near]), corners, h,
+                       sampling=np.array([s[e.name] for _, s in near]))
         out.append(e)
     return same_body(out)
 

@@ -19,7 +19,12 @@ t1])``, compression positive)::
 
 This module only reads and validates it (at load time, like every file a
 scene names); :mod:`ngcontact.export.json_law` writes it and
-:mod:`ngcontact.drivers.build` turns it into a law.
+:mod:`ngcontact.drivers.build` turns it into a law.  The table is checked
+row by row as a monotone law's, every form the file holds as the package's
+law, and the form the scene uses by its stiffness (:func:`stiffness`)
+against the bodies as a law the scene states is
+(:func:`ngcontact.scene.magnitudes.check_file_law`); each fault names the
+file, the row or key, its value and what is allowed.
 """
 from __future__ import annotations
 
@@ -74,6 +79,7 @@ def read(path: str, key: str = "interface.law_file") -> dict:
         raise SceneError(f"{key}: table", tab, "an object with closure and pressure lists")
     out["table"] = {"closure": _numbers(tab.get("closure"), f"{key}: table.closure", 1),
                     "pressure": _numbers(tab.get("pressure"), f"{key}: table.pressure", 1)}
+    _check_rows(out["table"], key, path)
     fr = data.get("friction")
     if not isinstance(fr, dict):
         raise SceneError(f"{key}: friction", fr, "an object with mu and stick_slope")
@@ -86,6 +92,10 @@ def read(path: str, key: str = "interface.law_file") -> dict:
         out["bundle"] = {"weights": _numbers(b.get("weights"), f"{key}: bundle.weights", 1),
                          "directions": _numbers(b.get("directions"), f"{key}: bundle.directions", 2),
                          "gaps": _numbers(b.get("gaps"), f"{key}: bundle.gaps", 1)}
+        for i, w in enumerate(out["bundle"]["weights"]):
+            if not w > 0:
+                raise SceneError(f"{key}: bundle.weights[{i}]", w, f"in the law file {path}: each direction's weight "
+                                 "(a stiffness, Pa/m) must be > 0")
     if data.get("coefficients") is not None:
         co = data["coefficients"]
         if not isinstance(co, dict):
@@ -99,6 +109,49 @@ def read(path: str, key: str = "interface.law_file") -> dict:
             except ValueError as exc:
                 raise SceneError(f"{key}: {form}", path, str(exc)) from None
     return out
+
+
+def _check_rows(table: dict, key: str, path: str) -> None:
+    """The pressure-closure table of a law file is a monotone law's, row by row (the rule of
+    :class:`ngcontact.laws.tabulated_law.TabulatedLaw`, each fault named by its row): as many pressures as
+    closures, at least two rows, the closures strictly increasing, the pressures non-decreasing from 0 and
+    not all 0."""
+    c, p = table["closure"], table["pressure"]
+    where = f"in the law file {path}"
+    if len(p) != len(c) or len(c) < 2:
+        raise SceneError(f"{key}: table.pressure", f"{len(p)} rows", f"{where}: one pressure per closure "
+                         f"({len(c)} closures), at least two rows")
+    if p[0] != 0.0:
+        raise SceneError(f"{key}: table.pressure[0]", p[0], f"{where}: must be 0 (contact starts at the first "
+                         "closure)")
+    for i in range(1, len(c)):
+        if not c[i] > c[i - 1]:
+            raise SceneError(f"{key}: table.closure[{i}]", c[i], f"{where}: the closures must increase strictly "
+                             f"(row {i - 1} has {c[i - 1]!r})")
+        if p[i] < p[i - 1]:
+            raise SceneError(f"{key}: table.pressure[{i}]", p[i], f"{where}: the pressures must not decrease, a "
+                             f"monotone law with a convex energy (row {i - 1} has {p[i - 1]!r})")
+    if not any(p):
+        raise SceneError(f"{key}: table.pressure", list(p), f"{where}: the table carries no pressure; a law needs "
+                         "a positive pressure in some row")
+
+
+def stiffness(contents: dict, form: str) -> tuple[str, str, float, object]:
+    """``(field, symbol, k, value)``: the largest normal stiffness ``k`` of the file's law of ``form``, taken as
+    an explicit law's is (:func:`ngcontact.scene.magnitudes.interface_stiffness`): the steepest slope
+    ``dp/dc`` of the pressure-closure table (``field``: the row it ends at, ``value`` that row's pressure; a
+    slope beyond double precision is ``inf``), the summed bundle weights, ``K0``'s normal entry."""
+    if form == "bundle":
+        w = contents["bundle"]["weights"]
+        return "bundle.weights", "sum(weights)", float(math.fsum(w)), list(w)
+    if form == "linear":
+        kn = contents["coefficients"]["K0"][0][0]
+        return "coefficients.K0[0][0]", "K0_nn", kn, kn
+    c, p = contents["table"]["closure"], contents["table"]["pressure"]
+    slopes = [(p[i] - p[i - 1]) / (c[i] - c[i - 1]) if math.isfinite(p[i] - p[i - 1]) else math.inf
+              for i in range(1, len(c))]
+    i = max(range(len(slopes)), key=lambda j: slopes[j]) + 1
+    return f"table.pressure[{i}]", f"dp/dc (rows {i - 1}-{i})", slopes[i - 1], p[i]
 
 
 def _has(contents: dict, form: str) -> bool:

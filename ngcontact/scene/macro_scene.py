@@ -115,7 +115,10 @@ class InterfaceSpec:
                      "default, also from a cell), tabulated (pressure against closure) or file (a law file of "
                      "`ngcontact export --format json`, see law_file)", choices=LAWS)
     law_file: str | None = param(None, doc="law = file: the JSON law file, relative to this scene (SI units; "
-                                 "cell_length_unit is not applied); a regular file of at most 64 MiB")
+                                 "cell_length_unit is not applied); a regular file of at most 64 MiB; its table "
+                                 "monotone row by row, the used form's stiffness k h / E within "
+                                 f"[{magnitudes.MIN_PENALTY_RATIO:g}, {magnitudes.MAX_STIFFNESS_RATIO:g}] as a "
+                                 "stated law's: ngcontact.scene.magnitudes")
     law_file_form: str = param("bundle", doc="law = file: which of the file's laws: bundle (exact), tabulated "
                                "(its pressure-closure table, tangential stiffness = its stick slope) or linear (K0)",
                                choices=("bundle", "tabulated", "linear"))
@@ -341,11 +344,14 @@ class MacroScene:
                              shown=self.geometry.file, missing="no such CAD file")
         if self.interface.law_file is not None:
             from ngcontact.scene import law_file
-            contents = law_file.read(resolve(self, self.interface.law_file))
+            where = resolve(self, self.interface.law_file)
+            contents = law_file.read(where)
             try:
                 law_file.normal_law_of(contents, self.interface.law_file_form)
             except ValueError as exc:
                 raise SceneError("interface.law_file_form", self.interface.law_file_form, str(exc)) from None
+            magnitudes.check_file_law(self, "interface.law_file", where,
+                                      law_file.stiffness(contents, self.interface.law_file_form))
         files = (("interface.cell", self.interface.cell, False),
                  ("strength.cell", self.strength.cell if self.strength else None, True),
                  ("two_scale.cell", self.two_scale.cell if self.two_scale else None, True))

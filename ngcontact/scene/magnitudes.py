@@ -167,7 +167,8 @@ def check_body_forces(scene, width: float) -> None:
 def interface_stiffness(interface) -> tuple[str, str, float] | None:
     """``(key, symbol, k)``: the largest normal stiffness of a macro law given by its numbers: ``kn`` of the
     linear law, the summed ``weights`` of a bundle (its ``k_n0`` when every direction is normal), the
-    steepest slope of a tabulated pressure-closure law; ``None`` for a law from a cell or a file."""
+    steepest slope of a tabulated pressure-closure law; ``None`` for a law from a cell or a file (those are
+    checked where they are read: :func:`check_cell_law`, :func:`check_file_law`)."""
     if interface.cell is not None or interface.law == "file":
         return None
     if interface.law == "linear":
@@ -189,6 +190,19 @@ def check_macro_interface(scene) -> None:
     E, _ = softer(scene.materials, (scene.bodies.rough, scene.bodies.counter))
     shown = {"interface.kn": None, "interface.weights": i.weights, "interface.pressure": i.pressure}[key]
     check_penalty_ratio(key, k, symbol, d.interface_maxh or d.maxh, "the interface mesh size", E, shown=shown)
+
+
+def check_file_law(scene, key: str, shown: str, found: tuple[str, str, float, object]) -> None:
+    """The law a macro scene reads from the law file ``shown`` under ``key`` (``interface.law_file``), its
+    stiffness ``found`` (:func:`ngcontact.scene.law_file.stiffness`: the field of the file, its symbol, ``k``
+    and the file's value there) held as an explicit law's is (:func:`check_macro_interface`): ``k h / E``
+    within [:data:`MIN_PENALTY_RATIO`, :data:`MAX_STIFFNESS_RATIO`] at the interface mesh size; a slope
+    beyond double precision (``inf``) is beyond the upper bound."""
+    field, symbol, k, value = found
+    d = scene.discretization
+    E, _ = softer(scene.materials, (scene.bodies.rough, scene.bodies.counter))
+    check_penalty_ratio(f"{key} ({shown}): {field}", k, symbol, d.interface_maxh or d.maxh,
+                        "the interface mesh size", E, shown=value)
 
 
 def check_cell_law(scene, key: str, rel: str, cell, overridden: bool) -> None:

@@ -211,7 +211,7 @@ def test_bad_law_files_name_the_key(tmp_path):
     data = json_law.as_dict(law)
     data["table"]["closure"][1] = data["table"]["closure"][0]  # not strictly increasing
     (tmp_path / "flat.json").write_text(json.dumps(data))
-    with pytest.raises(SceneError, match="tabulated.*strictly increasing"):
+    with pytest.raises(SceneError, match=r"table\.closure\[1\] = .*flat\.json: the closures must increase strictly"):
         loader.load(_macro_with_file(tmp_path, "flat.json"))
     data = json_law.as_dict(law)
     data["bundle"] = None

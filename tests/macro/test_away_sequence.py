@@ -18,6 +18,7 @@ from ngcontact.drivers import macro_accuracy as MA
 from ngcontact.macro import away_maxima as AM
 from ngcontact.macro import away_sequence as AS
 from ngcontact.macro import discretization_error as DE
+from ngcontact.macro import singular_maxima as SM
 from ngcontact.scene import loader
 
 from tests.macro.test_away_maxima import _block
@@ -94,8 +95,8 @@ def test_a_maximum_that_grows_with_every_level_is_mesh_dependent_at_the_scene_me
     assert out["von_mises_stem_away"].error is not None and out["von_mises_stem_away"].value == GROWING[2]
     assert out["von_mises_stem"].error is None
     # a difference that contracts as a converging stress's does, or a fall, is no growth
-    assert not AS.growing(_ladder("von_mises_bone", 54.2), [54.2, 56.4, 57.5])
-    assert not AS.growing(_ladder("safety_factor", 0.24), [0.24, 0.3, 0.36])
+    assert not SM.growing(_ladder("von_mises_bone", 54.2), [54.2, 56.4, 57.5])
+    assert not SM.growing(_ladder("safety_factor", 0.24), [0.24, 0.3, 0.36])
 
 
 #: the two-scale femur bone's whole-body von Mises maximum on the scene's mesh, its two local levels and two
@@ -112,8 +113,8 @@ def test_a_maximum_growing_by_differences_that_do_not_contract_is_mesh_dependent
     bone's ladder said 77 %, which once let its growth pass as within the estimate)."""
     for error in (None, 0.01, 41.6, 1e3):
         e = _ladder("von_mises_bone", BONE[0], error=error)
-        assert AS.growing(e, list(BONE[:3])) and AS.growing(e, list(BONE))
-        assert all(AS.growing(e, list(BONE[k:k + 3])) for k in range(3))
+        assert SM.growing(e, list(BONE[:3])) and SM.growing(e, list(BONE))
+        assert all(SM.growing(e, list(BONE[k:k + 3])) for k in range(3))
         out = AS._judged(e, [DE.Sample(v, (0.0139, 0.13)) for v in BONE[:3]], lambda at: False)
         assert out.error is None and out.singular_at == (0.0139, 0.13) and out.value == BONE[0], out.how
         assert "grows with every halving" in out.how
@@ -121,8 +122,8 @@ def test_a_maximum_growing_by_differences_that_do_not_contract_is_mesh_dependent
         assert not acc["met"] and acc["quantities"][0]["error"] is None
     # constant differences (log r): growth; differences contracting at 2^-0.544 = 0.69 (the slowest converging
     # pollution) or faster: none
-    assert AS.growing(_ladder("tresca_bone", 1.0, error=5.0), [1.0, 1.1, 1.2])
-    assert not AS.growing(_ladder("tresca_bone", 1.0, error=5.0), [1.0, 1.1, 1.1 + 0.1 * 2 ** -0.544])
+    assert SM.growing(_ladder("tresca_bone", 1.0, error=5.0), [1.0, 1.1, 1.2])
+    assert not SM.growing(_ladder("tresca_bone", 1.0, error=5.0), [1.0, 1.1, 1.1 + 0.1 * 2 ** -0.544])
 
 
 def test_a_safety_factor_converging_from_above_keeps_its_finite_estimate():
@@ -130,7 +131,7 @@ def test_a_safety_factor_converging_from_above_keeps_its_finite_estimate():
     levels are extrapolated, whatever the ladder's estimate."""
     for error in (None, 1e-4, 0.0636):
         e = _ladder("safety_factor", SAFETY[0], error=error)
-        assert not any(AS.growing(e, list(SAFETY[k:k + 3])) for k in range(3)) and not AS.growing(e, list(SAFETY))
+        assert not any(SM.growing(e, list(SAFETY[k:k + 3])) for k in range(3)) and not SM.growing(e, list(SAFETY))
         samples = [DE.Sample(v, (0.011, 0.13)) for v in SAFETY[2:]]
         out = AS._judged(e, samples, lambda at: False)
         assert out.error is not None and out.singular_at is None and out.value == SAFETY[-1], out.how
@@ -144,15 +145,15 @@ def test_a_rise_within_the_sampling_error_is_the_lattice_finding_the_maximum_not
     field's maximum; the same rises with the sampling resolved would be growth."""
     values, sampling = [10.8604e6, 10.8657e6, 10.8815e6], [2.2e4, 2.15e4, 1.11e3]
     e = _ladder("tresca_stem_away", values[0], error=7.06e4)
-    assert not AS.growing(e, values, sampling) and AS.growing(e, values)
+    assert not SM.growing(e, values, sampling) and SM.growing(e, values)
     out = AS._judged(e, [DE.Sample(v, (0.0009, 0.1716), sampling=s) for v, s in zip(values, sampling)])
     assert out.singular_at is None and out.error is not None and out.value == values[-1], out.how
     # one rise resolved, the other not: no growth either
-    assert not AS.growing(e, values, [1e3, 2.15e4, 0.0]) and not AS.growing(e, values, [2.2e4, 1e3, 0.0])
+    assert not SM.growing(e, values, [1e3, 2.15e4, 0.0]) and not SM.growing(e, values, [2.2e4, 1e3, 0.0])
     # a safety factor's fall within the sampling error of its minimum likewise
     falling = [1.0 / (2.0 + k) for k in range(3)]
-    assert AS.growing(_ladder("safety_factor", 0.5), falling)
-    assert not AS.growing(_ladder("safety_factor", 0.5), falling, [0.2, 0.0, 0.0])
+    assert SM.growing(_ladder("safety_factor", 0.5), falling)
+    assert not SM.growing(_ladder("safety_factor", 0.5), falling, [0.2, 0.0, 0.0])
 
 
 def test_a_quantity_at_round_off_is_not_growing():
@@ -162,7 +163,7 @@ def test_a_quantity_at_round_off_is_not_growing():
         wobble = [q, q * (1 + 3e-15), q * (1 - 2e-15), q * (1 + 4e-15)]
         drift = [q * (1 + k * 1e-13) for k in range(3)] if name.startswith("von") else \
             [q * (1 - k * 1e-13) for k in range(3)]
-        assert not AS.growing(e, wobble) and not AS.growing(e, wobble[1:]) and not AS.growing(e, drift)
+        assert not SM.growing(e, wobble) and not SM.growing(e, wobble[1:]) and not SM.growing(e, drift)
         out = AS._judged(e, [DE.Sample(v) for v in wobble[:3]])
         assert out.singular_at is None and out.error is not None and "round-off" in out.how
 
@@ -187,10 +188,10 @@ def test_a_safety_factor_that_falls_with_every_level_is_mesh_dependent_as_a_grow
     d1, d2 = falling[1] - falling[0], falling[2] - falling[1]
     assert d2 / d1 == pytest.approx(0.5)
     # a ladder's estimate as large as the whole fall does not make it converge; a rise is no fall
-    assert AS.growing(_ladder("safety_factor", falling[0], error=0.3), falling)
-    assert not AS.growing(_ladder("safety_factor", 0.24), [0.24, 0.3, 0.36])
+    assert SM.growing(_ladder("safety_factor", falling[0], error=0.3), falling)
+    assert not SM.growing(_ladder("safety_factor", 0.24), [0.24, 0.3, 0.36])
     # the two-scale femur's whole-interface levels at its corner: the utilisation's difference shrinks by 0.14
-    assert not AS.growing(_ladder("safety_factor", 0.2393, error=0.0636), [0.239287, 0.197703, 0.193097])
+    assert not SM.growing(_ladder("safety_factor", 0.2393, error=0.0636), [0.239287, 0.197703, 0.193097])
     # beside a converged safety factor away it is listed, not counted, and said to be mesh dependent
     exclusion = AM.Exclusion(np.array([[0.011, 0.13]]), 0.00275, (AS.GROWN,))
     settled = AM.settle([out["safety_factor"], _ladder("safety_factor_away", 0.41, error=0.002)], exclusion)

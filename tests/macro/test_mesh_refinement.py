@@ -91,7 +91,7 @@ def test_a_value_growing_with_every_level_has_no_estimate_and_is_a_singularity()
     values = [1.0, 1.3, 1.7, 2.3]
     err, how = MS.sequence_error(values, 2.3)
     assert err is None and "not converging" in how
-    assert MS.grows_without_bound(values) and not MS.grows_without_bound([1.0, 1.3, 1.4])
+    assert MS.growing(values, 2.3) and not MS.growing([1.0, 1.3, 1.4], 1.4)
 
 
 def test_the_larger_of_the_ladder_and_the_sequence_is_reported():
