@@ -13,18 +13,26 @@ The forecast is (1) itself, read with what the last run of the same batch
 measured: ``c`` (the least ``min(wall, CPU)`` seconds of its members solved
 in its process) and the seconds from the opening of the run's batches to
 the start of its first batch (``lead``), during which workers started with
-the run start; so ``R = max(START_SECONDS - lead, 0)``.  Nothing is
-guessed: a batch never run on this machine has no forecast, and its workers
-start on demand.  The forecast only chooses when the workers start; where
-each batch runs is still decided by (1) on its own members, and workers
-started early for a batch that (1) then keeps in this process are stopped
-while they start.
+the run start; so ``R`` is the start's wall time less ``lead``, and the
+cores free as the run opens are the load average's, (3) of
+:mod:`ngcontact.parallel.free_cores`.  Nothing is guessed: a batch never
+run on this machine has no forecast, and its workers start on demand.
+The forecast only chooses when the workers start; where each batch runs
+is still decided by (1) on its own members, and workers started early for
+a batch that (1) then keeps in this process are stopped while they start.
 
 A record is one small JSON file per batch, named by the SHA-256 of the
 run's description (the scene, the package version), in ``batches`` under
 the cell-law cache directory (``$NGCONTACT_CACHE``, default
 ``~/.cache/ngcontact``; at most :data:`KEPT`, the oldest removed first); a
 record that cannot be read or written costs only the forecast.
+
+Beside them, ``worker_start.json`` holds the CPU seconds of the last
+:data:`STARTS_KEPT` local worker starts measured on this machine (each
+worker's own CPU time once its imports are done): ``S`` of (1), whose
+median replaces the estimate
+:data:`~ngcontact.parallel.judged_batches.START_SECONDS` once one start has
+been measured.
 """
 from __future__ import annotations
 
@@ -41,6 +49,12 @@ FOLDER = "batches"
 
 #: Records kept at most (the oldest go first): the runs of scenes in many folders do not fill the cache.
 KEPT = 256
+
+#: The record of a local worker's start as measured on this machine (CPU seconds of its last starts).
+START_FILE = "worker_start.json"
+
+#: Measured starts kept; the payoff rule takes their median.
+STARTS_KEPT = 5
 
 
 @dataclass(frozen=True)
@@ -78,24 +92,55 @@ def recorded(name: str) -> Forecast | None:
 
 
 def remember(name: str, forecast: Forecast) -> None:
-    """Record ``forecast`` under ``name`` for the next run (written whole under another name, then renamed)."""
-    path = os.path.join(folder(), f"{name}.json")
+    """Record ``forecast`` under ``name`` for the next run."""
+    _write(f"{name}.json", {"members": forecast.members, "member_seconds": forecast.member_seconds,
+                            "lead_seconds": forecast.lead_seconds})
+
+
+def _write(file: str, data: dict) -> None:
+    """``data`` as the record ``file`` (written whole under another name, then renamed; the oldest records
+    beyond :data:`KEPT` removed); a record that cannot be written is only logged."""
+    path = os.path.join(folder(), file)
     partial = f"{path}.{os.getpid()}.partial"
     try:
         os.makedirs(folder(), exist_ok=True)
         with open(partial, "w") as f:
-            json.dump({"members": forecast.members, "member_seconds": forecast.member_seconds,
-                       "lead_seconds": forecast.lead_seconds}, f)
+            json.dump(data, f)
         os.replace(partial, path)
         records = sorted(os.scandir(folder()), key=lambda e: e.stat().st_mtime)
         for old in records[:max(len(records) - KEPT, 0)]:
             os.remove(old.path)
     except OSError as exc:
-        log.debug("no record of the batch in %s (%s)", folder(), exc)
+        log.debug("no record %s in %s (%s)", file, folder(), exc)
         try:
             os.remove(partial)
         except OSError:
             pass
+
+
+def _starts() -> list[float]:
+    try:
+        with open(os.path.join(folder(), START_FILE)) as f:
+            starts = [float(s) for s in json.load(f)["cpu_seconds"]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    return [s for s in starts if 0.0 <= s < 1e4]
+
+
+def start_seconds(default: float) -> float:
+    """CPU seconds a local worker's start costs on this machine (a fresh interpreter importing NGSolve and
+    the members' modules): the median of the last :data:`STARTS_KEPT` starts measured, ``default`` before
+    any."""
+    starts = sorted(_starts())
+    if not starts:
+        return default
+    mid = len(starts) // 2
+    return starts[mid] if len(starts) % 2 else 0.5 * (starts[mid - 1] + starts[mid])
+
+
+def remember_start(seconds: float) -> None:
+    """Add a measured start (CPU seconds of a worker until its imports were done) to the record."""
+    _write(START_FILE, {"cpu_seconds": (_starts() + [float(seconds)])[-STARTS_KEPT:]})
 
 
 def early(executor, name: str, members: int | None) -> bool:

@@ -2,10 +2,12 @@
 
 A run's batches (:meth:`JudgedBatches.start_on_demand` or an early start) are judged: the first members
 are solved in the run's own process, each timed, and the rest goes to the workers only where condition
-(1) of :mod:`ngcontact.parallel.worker_payoff` holds for it, ``T_rest / (W - 1) > R + F`` in that
-module's terms: the rest's serial time against the workers' start still ahead (``R``,
-:data:`START_SECONDS` less the time since they were spawned) and a worker's first member
-(``F``, :data:`FIRST_MEMBER_SECONDS`).  A batch kept in this process starts no worker.
+(1) of :mod:`ngcontact.parallel.worker_payoff` holds for it: the rest's serial time against the workers'
+start still ahead (``R``), a worker's first member (``F``, :data:`FIRST_MEMBER_SECONDS`) and the CPU
+time of their starts (``S``, measured on this machine: :func:`start_cost`), on the cores other processes
+leave free (``f``, :mod:`ngcontact.parallel.free_cores`, read at each look).  A batch kept in this
+process starts no worker; while the workers solve a batch, this process's NGSolve threads sleep
+(:func:`~ngcontact.parallel.batch_member.threads_asleep`).
 
 The rule is a mixin of :class:`~ngcontact.parallel.local_pool.LocalPool`, whose worker processes it starts,
 uses and stops: this module holds the decision, that one the processes.
@@ -17,16 +19,24 @@ import time
 from abc import ABC, abstractmethod
 from typing import Any, Sequence
 
+from ngcontact.parallel import batch_forecast, worker_payoff
 from ngcontact.parallel.batch_executor import Executor
-from ngcontact.parallel import worker_payoff
+from ngcontact.parallel.batch_member import threads_asleep
+from ngcontact.parallel.free_cores import CoreWatch, Reading
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
 
-#: Wall seconds a local pool's workers take to start (fresh interpreters importing NGSolve and the package,
-#: all at once; an estimate for two workers starting together on two cores): ``R`` of
-#: :mod:`ngcontact.parallel.worker_payoff` for a pool not yet started.
+#: CPU seconds of a local worker's start (a fresh interpreter importing NGSolve and the package) before
+#: one has been measured on this machine (an estimate): ``S`` of :mod:`ngcontact.parallel.worker_payoff`.
 START_SECONDS = 2.0
+
+
+def start_cost() -> float:
+    """``S``: the CPU seconds of a worker's start as measured on this machine
+    (:func:`~ngcontact.parallel.batch_forecast.start_seconds`), :data:`START_SECONDS` before any."""
+    return batch_forecast.start_seconds(START_SECONDS)
+
 
 #: Seconds a worker's first member takes beyond the others (an estimate): what the run's process paid
 #: before its batch and a fresh worker pays in its first member, e.g. importing a measured surface's reader
@@ -58,14 +68,34 @@ class JudgedBatches(Executor, ABC):
     def _discard(self) -> None:
         """Stop the workers now."""
 
+    @property
+    def cores(self) -> CoreWatch:
+        """The watch of the cores other processes leave free (opened with the run's batches)."""
+        watch = self.__dict__.get("_cores")
+        if watch is None:
+            watch = self.__dict__["_cores"] = CoreWatch(self._worker_pids)
+        return watch
+
+    def _worker_pids(self) -> list[int]:
+        return list((self._pool._processes or {}).keys()) if self._pool is not None else []
+
+    def payoff(self, member_seconds: float, rest: int, lead: float = 0.0) -> worker_payoff.Payoff:
+        """Condition (1) of :mod:`ngcontact.parallel.worker_payoff` for ``rest`` members of
+        ``member_seconds`` each, with the cores free now and the workers' start still ahead (less ``lead``
+        seconds of the run before its batch, for a start with the run)."""
+        cores = self.cores.reading()
+        ahead, cpu = self._start_ahead(cores)
+        return worker_payoff.Payoff(member_seconds, rest, self.workers, max(ahead - lead, 0.0),
+                                    FIRST_MEMBER_SECONDS, cpu, cores)
+
     def repays(self, forecast) -> bool:
         """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send the rest of a batch
         (its :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: the members after
         the first ``MEASURED`` (solved here), of the forecast's seconds each, against the part of the start
-        that the run's lead before its batch leaves ahead, and a worker's first member."""
-        return worker_payoff.Payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
-                                    self.workers, max(START_SECONDS - forecast.lead_seconds, 0.0),
-                                    FIRST_MEMBER_SECONDS).repaid
+        that the run's lead before its batch leaves ahead, a worker's first member and the starts' CPU
+        time, on the cores free as the run opens."""
+        return self.payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
+                           forecast.lead_seconds).repaid
 
     def start_on_demand(self, modules: Sequence[str] = ()) -> None:
         """Start no worker now: only once a batch's rest repays their start (:meth:`_judged_map`), each
@@ -98,8 +128,7 @@ class JudgedBatches(Executor, ABC):
             if len(done) == len(items):
                 self._where("serial", f"all {len(done)} members solved here while the workers started")
                 return done
-            payoff = worker_payoff.Payoff(clock.least, len(items) - len(done), self.workers, self._start_ahead(),
-                                          FIRST_MEMBER_SECONDS)
+            payoff = self.payoff(clock.least, len(items) - len(done))
             if not payoff.repaid:
                 if self._pool is not None and not all(w.done() for w in self._warming):
                     self._discard()
@@ -114,20 +143,25 @@ class JudgedBatches(Executor, ABC):
             if self._ready() and len(done) >= worker_payoff.MEASURED:
                 self._where("local", payoff.describe(len(done)))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
-                return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
-                                             shifted_progress(progress, len(done)), fault)
+                with threads_asleep():
+                    return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
+                                                 shifted_progress(progress, len(done)), fault)
 
     def _ready(self) -> bool:
         """Whether a worker of the current pool has started (a pool started without warm-up tasks: yes)."""
         return self._pool is not None and (not self._warming or any(w.done() for w in self._warming))
 
-    def _start_ahead(self) -> float:
-        """Seconds of the workers' start still to come (``R`` of :mod:`ngcontact.parallel.worker_payoff`)."""
+    def _start_ahead(self, cores: Reading) -> tuple[float, float]:
+        """The workers' start still to come: wall seconds (``R`` of :mod:`ngcontact.parallel.worker_payoff`,
+        ``S max(1, (W + 1) / f)`` for a pool not started) and the CPU seconds of each start not yet paid."""
+        cpu = start_cost()
+        wall = cpu * max(1.0, (self.workers + 1) / max(cores.free, 1e-9))
         if self._pool is None:
-            return START_SECONDS
+            return wall, cpu
         if self._ready():
-            return 0.0
-        return max(START_SECONDS - (time.perf_counter() - self._spawned), 0.0)
+            return 0.0, 0.0
+        ahead = max(wall - (time.perf_counter() - self._spawned), 0.0)
+        return ahead, cpu * ahead / wall if wall > 0.0 else 0.0
 
 
 def shifted_progress(progress, done: int, total: int | None = None):

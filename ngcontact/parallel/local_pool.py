@@ -17,7 +17,7 @@ from typing import Any, Sequence
 from ngcontact.parallel.batch_executor import Executor
 from ngcontact.parallel.judged_batches import JudgedBatches, shifted_progress
 from ngcontact.parallel.batch_member import one_thread, run_member
-from ngcontact.parallel import worker_lifetime
+from ngcontact.parallel import batch_forecast, worker_lifetime
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
@@ -76,6 +76,8 @@ class LocalPool(JudgedBatches):
             self.started = "with the run" if not self.record else f"after batch {len(self.record)}"
         pool = self._start()
         self._warming = [pool.submit(_warm_up, self._modules) for _ in range(self.workers)]
+        for warm in self._warming:
+            warm.add_done_callback(_measured_start)
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         if len(items) == 1:
@@ -248,11 +250,19 @@ def _worker_start(started, parent: int, record: str | None) -> None:
     one_thread(ignore_sigint=True)
 
 
-def _warm_up(modules: tuple[str, ...]) -> None:
+def _warm_up(modules: tuple[str, ...]) -> float:
+    """A worker's imports as it starts; returns the worker's CPU seconds so far: its start's cost."""
     import importlib
     for module in modules:
         if module != "__main__":          # the submitting script: the spawn start has imported it already
             importlib.import_module(module)
+    return time.process_time()
+
+
+def _measured_start(warm) -> None:
+    """A worker's start is done: its CPU seconds join the machine's record (``S`` of the payoff rule)."""
+    if not warm.cancelled() and warm.exception() is None:
+        batch_forecast.remember_start(warm.result())
 
 
 def _pool_member(fn, item, name, attempt, fault):

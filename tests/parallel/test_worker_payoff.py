@@ -9,7 +9,8 @@ import time
 
 import pytest
 
-from ngcontact.parallel import judged_batches, local_pool
+from ngcontact.parallel import batch_forecast, free_cores, judged_batches, local_pool
+from ngcontact.parallel.free_cores import Reading
 from ngcontact.parallel.worker_payoff import MemberClock, Payoff
 
 
@@ -130,5 +131,91 @@ def test_workers_on_demand_start_inside_the_batch_that_repays_them(monkeypatch):
         pids = pool.map(burn, [0.02] * 20, [f"m{k}" for k in range(20)], label="large")
         assert pool.pools_started == 1 and pool.describe()["workers_started"] == "during batch 'large'"
         assert pids[:2] == [os.getpid()] * 2
+    finally:
+        pool.close()
+
+
+def test_condition_1_counts_the_cores_other_processes_leave_and_the_work_of_the_starts():
+    """A rest that repays two workers on an idle machine does not on one whose other jobs leave 1.5 cores
+    (``P = 1.5``: 12 x 0.5 x 0.5 = 3 CPU s against 2 x (1.5 + 0.5)), nor on one they keep busy."""
+    idle, half, busy = (Reading(2, b, "a test's") for b in (0.0, 0.5, 2.0))
+    kw = dict(member_seconds=0.5, rest=12, workers=2, start_ahead=0.0, first_member_seconds=0.5, start_cpu=1.5)
+    assert Payoff(**kw, cores=idle).repaid and Payoff(**kw, cores=idle).parallel == 2.0
+    on_half = Payoff(**kw, cores=half)
+    assert on_half.parallel == 1.5 and on_half.core_saving == pytest.approx(3.0) and on_half.core_cost == 4.0
+    assert not on_half.repaid and "the other 12 in this process" in on_half.describe(2)
+    on_busy = Payoff(**kw, cores=busy)
+    assert on_busy.busy and not on_busy.repaid and "busy with other processes" in on_busy.describe(2)
+
+
+@pytest.fixture
+def busy_machine(monkeypatch):
+    """Two cores, both kept busy by other processes (a load average of 2, no ``/proc/stat`` to read)."""
+    monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
+    monkeypatch.setattr(free_cores, "load_average", lambda: 2.0)
+
+
+def test_a_batch_on_a_machine_whose_cores_are_busy_runs_serially_and_says_why(monkeypatch, busy_machine):
+    """A batch that repays free workers (no start to pay, no first member's extra) stays in this process
+    when other jobs keep the cores busy; no worker process is started for it, and its record says why."""
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
+    pool = local_pool.LocalPool(2)
+    try:
+        pool.start_on_demand(("ngsolve",))
+        pids = pool.map(burn, [0.02] * 12, [f"m{k}" for k in range(12)], label="busy")
+        assert pids == [os.getpid()] * 12 and pool.pools_started == 0
+        batch = pool.describe()["batches"][-1]
+        assert batch["executor"] == "serial"
+        assert "0 of 2 cores free (one-minute load average 2.00)" in batch["decision"]
+        assert "busy with other processes" in batch["decision"]
+    finally:
+        pool.close()
+
+
+def test_started_workers_are_left_idle_while_other_jobs_keep_the_cores_busy(monkeypatch, ready_pool):
+    """Workers already started do not take a batch while the cores are busy: they would only take turns
+    with the other jobs."""
+    monkeypatch.setattr(free_cores, "load_average", lambda: 2.0 * len(free_cores.affinity()))
+    names = [f"m{k}" for k in range(12)]
+    assert ready_pool.map(burn, [0.05] * 12, names, label="large") == [os.getpid()] * 12
+    assert "busy with other processes" in ready_pool.describe()["batches"][-1]["decision"]
+
+
+def test_a_workers_start_is_measured_and_kept_for_the_next_runs(ready_pool):
+    """The workers' start (``S`` of condition (1)) is their CPU seconds once their imports are done (NGSolve
+    among them: more than a tenth of a second, less than a minute), recorded on this machine as each
+    worker's start ends."""
+    deadline = time.monotonic() + 10.0
+    while len(batch_forecast._starts()) < 2 and time.monotonic() < deadline:
+        time.sleep(0.05)                  # the record is written as each start ends, beside this thread
+    starts = batch_forecast._starts()
+    assert len(starts) == 2 and all(0.1 < s < 60.0 for s in starts)
+    assert batch_forecast.start_seconds(default=-1.0) == pytest.approx(sum(starts) / 2)
+
+
+def test_the_start_is_the_median_of_the_last_ones_measured():
+    assert batch_forecast.start_seconds(default=2.5) == 2.5
+    for s in (9.0, 1.0, 1.2, 1.4, 1.1, 1.3):
+        batch_forecast.remember_start(s)
+    assert batch_forecast._starts() == [1.0, 1.2, 1.4, 1.1, 1.3] and batch_forecast.start_seconds(0.0) == 1.2
+
+
+def blas_threads(_) -> int:
+    """The most threads of any BLAS loaded in this process, after loading SciPy's own (``scipy.linalg``)."""
+    import scipy.linalg  # noqa: F401 - loads SciPy's OpenBLAS where the process had not
+    from threadpoolctl import threadpool_info
+    return max(d["num_threads"] for d in threadpool_info() if d["user_api"] == "blas")
+
+
+def test_workers_run_every_blas_on_one_thread_even_one_loaded_after_their_start(monkeypatch):
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
+    pool = local_pool.LocalPool(2)
+    try:
+        pool.start()
+        for warm in pool._warming:
+            warm.result(timeout=120)
+        assert pool._pool_map(blas_threads, [0, 1, 2, 3], list("abcd"), "blas", None, None) == [1] * 4
     finally:
         pool.close()
