@@ -120,19 +120,25 @@ def test_a_run_with_a_batch_starts_no_worker_before_its_batch_repays_them(monkey
         assert ex.pools_started == 0
 
 
-def test_workers_on_demand_start_inside_the_batch_that_repays_them(monkeypatch):
-    """A batch whose first member shows that its rest repays the workers starts them then (its members
-    after the first two go to them once one is ready: how many depends on the machine's load)."""
+@pytest.fixture
+def on_demand_pool(monkeypatch):
+    """A pool whose workers start on demand, with no start to pay and no first member's extra: a batch of
+    members that take time repays them where the cores are free."""
     monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
     pool = local_pool.LocalPool(2)
-    try:
-        pool.start_on_demand(("ngsolve",))
-        pids = pool.map(burn, [0.02] * 20, [f"m{k}" for k in range(20)], label="large")
-        assert pool.pools_started == 1 and pool.describe()["workers_started"] == "during batch 'large'"
-        assert pids[:2] == [os.getpid()] * 2
-    finally:
-        pool.close()
+    pool.start_on_demand(("ngsolve",))
+    yield pool
+    pool.close()
+
+
+def test_workers_on_demand_start_inside_the_batch_that_repays_them(on_demand_pool):
+    """A batch whose first member shows that its rest repays the workers starts them then (its members
+    after the first two go to them once one is ready: how many depends on the machine's load)."""
+    pids = on_demand_pool.map(burn, [0.02] * 20, [f"m{k}" for k in range(20)], label="large")
+    assert on_demand_pool.pools_started == 1
+    assert on_demand_pool.describe()["workers_started"] == "during batch 'large'"
+    assert pids[:2] == [os.getpid()] * 2
 
 
 def test_condition_1_counts_the_cores_other_processes_leave_and_the_work_of_the_starts():
@@ -155,22 +161,15 @@ def busy_machine(monkeypatch):
     monkeypatch.setattr(free_cores, "load_average", lambda: 2.0)
 
 
-def test_a_batch_on_a_machine_whose_cores_are_busy_runs_serially_and_says_why(monkeypatch, busy_machine):
+def test_a_batch_on_a_machine_whose_cores_are_busy_runs_serially_and_says_why(busy_machine, on_demand_pool):
     """A batch that repays free workers (no start to pay, no first member's extra) stays in this process
     when other jobs keep the cores busy; no worker process is started for it, and its record says why."""
-    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
-    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
-    pool = local_pool.LocalPool(2)
-    try:
-        pool.start_on_demand(("ngsolve",))
-        pids = pool.map(burn, [0.02] * 12, [f"m{k}" for k in range(12)], label="busy")
-        assert pids == [os.getpid()] * 12 and pool.pools_started == 0
-        batch = pool.describe()["batches"][-1]
-        assert batch["executor"] == "serial"
-        assert "0 of 2 cores free (one-minute load average 2.00)" in batch["decision"]
-        assert "busy with other processes" in batch["decision"]
-    finally:
-        pool.close()
+    pids = on_demand_pool.map(burn, [0.02] * 12, [f"m{k}" for k in range(12)], label="busy")
+    assert pids == [os.getpid()] * 12 and on_demand_pool.pools_started == 0
+    batch = on_demand_pool.describe()["batches"][-1]
+    assert batch["executor"] == "serial"
+    assert "0 of 2 cores free (one-minute load average 2.00)" in batch["decision"]
+    assert "busy with other processes" in batch["decision"]
 
 
 def test_started_workers_are_left_idle_while_other_jobs_keep_the_cores_busy(monkeypatch, ready_pool):
