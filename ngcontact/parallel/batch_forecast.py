@@ -27,12 +27,15 @@ the cell-law cache directory (``$NGCONTACT_CACHE``, default
 ``~/.cache/ngcontact``; at most :data:`KEPT`, the oldest removed first); a
 record that cannot be read or written costs only the forecast.
 
-Beside them, ``worker_start.json`` holds the CPU seconds of the last
-:data:`STARTS_KEPT` local worker starts measured on this machine (each
-worker's own CPU time once its imports are done): ``S`` of (1), whose
-median replaces the estimate
-:data:`~ngcontact.parallel.judged_batches.START_SECONDS` once one start has
-been measured.
+Beside them, ``worker_costs.json`` holds the last :data:`COSTS_KEPT`
+measurements of what a local worker costs on this machine: its start
+(``S`` of (1): each worker's own CPU time once its imports are done) and its
+first member's extra (``F``: the CPU time of a worker's first member less
+the cheapest member of the batch solved in the run's process); their
+medians replace the estimates
+:data:`~ngcontact.parallel.judged_batches.START_SECONDS` and
+:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS` once
+measured.
 """
 from __future__ import annotations
 
@@ -50,11 +53,14 @@ FOLDER = "batches"
 #: Records kept at most (the oldest go first): the runs of scenes in many folders do not fill the cache.
 KEPT = 256
 
-#: The record of a local worker's start as measured on this machine (CPU seconds of its last starts).
-START_FILE = "worker_start.json"
+#: The record of a local worker's costs as measured on this machine, by kind: ``start`` (CPU seconds of a
+#: worker's start, until its imports are done) and ``first_member`` (CPU seconds a worker's first member
+#: took beyond the cheapest member of its batch solved in the run's process).
+COSTS_FILE = "worker_costs.json"
+COSTS = ("start", "first_member")
 
-#: Measured starts kept; the payoff rule takes their median.
-STARTS_KEPT = 5
+#: Measured costs kept per kind; the payoff rule takes their median.
+COSTS_KEPT = 5
 
 
 @dataclass(frozen=True)
@@ -118,29 +124,31 @@ def _write(file: str, data: dict) -> None:
             pass
 
 
-def _starts() -> list[float]:
+def measured_costs(kind: str) -> list[float]:
+    """The last costs of ``kind`` (:data:`COSTS`) measured on this machine, oldest first."""
     try:
-        with open(os.path.join(folder(), START_FILE)) as f:
-            starts = [float(s) for s in json.load(f)["cpu_seconds"]]
+        with open(os.path.join(folder(), COSTS_FILE)) as f:
+            costs = [float(s) for s in json.load(f)[kind]]
     except (OSError, ValueError, KeyError, TypeError):
         return []
-    return [s for s in starts if 0.0 <= s < 1e4]
+    return [s for s in costs if 0.0 <= s < 1e4]
 
 
-def start_seconds(default: float) -> float:
-    """CPU seconds a local worker's start costs on this machine (a fresh interpreter importing NGSolve and
-    the members' modules): the median of the last :data:`STARTS_KEPT` starts measured, ``default`` before
-    any."""
-    starts = sorted(_starts())
-    if not starts:
+def cost_seconds(kind: str, default: float) -> float:
+    """CPU seconds of a worker's cost ``kind`` on this machine (:data:`COSTS`): the median of the last
+    :data:`COSTS_KEPT` measured, ``default`` before any."""
+    costs = sorted(measured_costs(kind))
+    if not costs:
         return default
-    mid = len(starts) // 2
-    return starts[mid] if len(starts) % 2 else 0.5 * (starts[mid - 1] + starts[mid])
+    mid = len(costs) // 2
+    return costs[mid] if len(costs) % 2 else 0.5 * (costs[mid - 1] + costs[mid])
 
 
-def remember_start(seconds: float) -> None:
-    """Add a measured start (CPU seconds of a worker until its imports were done) to the record."""
-    _write(START_FILE, {"cpu_seconds": (_starts() + [float(seconds)])[-STARTS_KEPT:]})
+def remember_cost(kind: str, seconds: float) -> None:
+    """Add a measured cost of ``kind`` (:data:`COSTS`) to the machine's record."""
+    data = {k: measured_costs(k) for k in COSTS}
+    data[kind] = (data[kind] + [float(seconds)])[-COSTS_KEPT:]
+    _write(COSTS_FILE, data)
 
 
 def early(executor, name: str, members: int | None) -> bool:

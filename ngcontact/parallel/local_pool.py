@@ -119,6 +119,7 @@ class LocalPool(JudgedBatches):
         failures = {k: 0 for k in range(len(items))}
         pending: dict[Any, int] = {}
         unsent: list[int] = []       # members whose submission found the pool already broken
+        firsts: list[float] = []     # CPU seconds of the first member of each worker that had one here
         pool = self._pool or self._start()
 
         def submit(k):
@@ -140,7 +141,7 @@ class LocalPool(JudgedBatches):
                     for fut in done:
                         k = pending.pop(fut)
                         try:
-                            results[k] = fut.result()
+                            results[k], seconds, first = fut.result()
                         except BrokenProcessPool:
                             broken.append(k)
                             continue
@@ -148,6 +149,8 @@ class LocalPool(JudgedBatches):
                             self._failed(label, names[k], failures, k, exc)
                             submit(k)
                             continue
+                        if first:
+                            firsts.append(seconds)
                         if progress is not None:
                             progress(label, len(results), len(items))
                 if broken or (unsent and not pending):
@@ -171,6 +174,9 @@ class LocalPool(JudgedBatches):
         except BaseException:
             self._discard()
             raise
+        if firsts and self.member_clock.times:    # ``F``: a first member's CPU beyond the cheapest here
+            batch_forecast.remember_cost("first_member", max(sorted(firsts)[len(firsts) // 2]
+                                                             - self.member_clock.least, 0.0))
         return [results[k] for k in range(len(items))]
 
     def _running_on_dead_workers(self, names) -> set[str]:
@@ -262,10 +268,18 @@ def _warm_up(modules: tuple[str, ...]) -> float:
 def _measured_start(warm) -> None:
     """A worker's start is done: its CPU seconds join the machine's record (``S`` of the payoff rule)."""
     if not warm.cancelled() and warm.exception() is None:
-        batch_forecast.remember_start(warm.result())
+        batch_forecast.remember_cost("start", warm.result())
+
+
+_SOLVED = 0
 
 
 def _pool_member(fn, item, name, attempt, fault):
+    """One member in a worker: its result, its CPU seconds, and whether it was the worker's first."""
+    global _SOLVED
     if _STARTED is not None:
         _STARTED.put((os.getpid(), name))
-    return run_member(fn, item, name, attempt, fault)
+    t0 = time.process_time()
+    result = run_member(fn, item, name, attempt, fault)
+    _SOLVED += 1
+    return result, time.process_time() - t0, _SOLVED == 1

@@ -6,7 +6,7 @@ draws of one surface class, the loads or levels of a batch solves of one
 size), on ``W`` workers.  With ``r`` members still to solve, finishing them
 here takes ``r c``.  On the workers the rest ends
 
-* no sooner than ``R + F + r c / W``: the workers take members only after
+* no sooner than ``R + F + c ceil(r / W)``: the workers take members only after
   the part of their start still ahead, ``R`` wall seconds (none once a
   worker has started), and each worker's first member pays what this
   process paid before the batch and a fresh interpreter has not (the
@@ -21,7 +21,7 @@ here takes ``r c``.  On the workers the rest ends
 
 The workers repay themselves when both bounds end before ``r c``::
 
-    r c (1 - 1/W)  >  R + F      and      r c (P - 1)  >  W (S + F)      (1)
+    c (r - ceil(r / W))  >  R + F      and      r c (P - 1)  >  W (S + F)      (1)
 
 the time the workers save on the rest against the time they cost before
 they save any, and the cores they would gain against the work they add.
@@ -37,25 +37,32 @@ processes' load and the workers' own start, which takes cores from this
 process while it runs; wall seconds where NGSolve's threads solve it in
 less wall time than CPU time); ``c`` is the least of these times, since
 noise only adds to a member's time and the first member also pays what
-this process does once (a lazy import, a cache filled).  ``S`` is measured
-too, by every worker that starts (its CPU seconds once its imports are
-done), and kept for the next runs
-(:func:`~ngcontact.parallel.batch_forecast.start_seconds`; the estimate
-:data:`~ngcontact.parallel.judged_batches.START_SECONDS` before the first).
-``R`` is ``S`` stretched by the cores that this process and the ``W``
-starting workers share, ``S max(1, (W + 1) / f)``, less the time the
-workers have had since they were spawned; ``F`` an estimate
-(:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS`).
+this process does once (a lazy import, a cache filled).  ``S`` and ``F``
+are measured too, by the workers (``S``: a worker's CPU seconds once its
+imports are done; ``F``: its first member's CPU seconds less ``c``), and
+kept per machine (:func:`~ngcontact.parallel.batch_forecast.cost_seconds`).
+On a machine that has measured no worker yet, ``S`` is the CPU seconds this
+process spent before its batch (a fresh worker repeats its interpreter and
+imports, and the batch's preparation is on top; at most
+:data:`~ngcontact.parallel.judged_batches.START_SECONDS`, for a process
+that computed long before its batch) and ``F`` what this
+process's first member took beyond its cheapest, at most
+:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS` (so the
+first look waits for a second member; without a batch, the estimates
+:data:`~ngcontact.parallel.judged_batches.START_SECONDS` and
+:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS`).  ``R``
+is ``S`` less the time the workers have had since they were spawned: a
+start on busy cores takes longer, which the second condition counts.
 
 (1) is read after every member solved here, and the rest goes to the
 workers only once (1) holds after :data:`MEASURED` members and a worker is
-ready.  A batch whose first member already fails (1) ends here at once: the
-least time can only be smaller than it.  Both sides of (1) shrink as members
-are solved here: in the first, the left by ``c (1 - 1/W)`` per member,
+ready.  A batch whose first :data:`MEASURED` members fail (1) ends here at
+once: the least time can only be smaller than it.  Both sides of (1) shrink as members
+are solved here: in the first, the left by about ``c (1 - 1/W)`` per member,
 the right by ``c`` while ``R > 0``; in the second, the left by
 ``c (P - 1)``, the right as the start is paid (the part of ``S`` ahead is
-``S`` times the part of ``R`` ahead); so a batch that repays its workers at
-first still does while they start, and one whose workers start late is
+``R``); so a batch that repays its workers at first still does while they
+start, and one whose workers start late is
 finished here as soon as (1) fails.  ``f`` is read anew at each look: on a
 machine whose other jobs take the cores meanwhile, the rest stays here.
 When (1) fails, workers still starting are stopped at once (a starting
@@ -79,6 +86,7 @@ members, so it keeps its speedup, less their share.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -112,8 +120,9 @@ class Payoff:
 
     @property
     def saving(self) -> float:
-        """Seconds the workers save on the rest, once they take members: ``r c (1 - 1/W)``."""
-        return self.rest * self.member_seconds * (1.0 - 1.0 / self.workers)
+        """Seconds the workers save on the rest, once they take members: ``c (r - ceil(r / W))`` (a member
+        is not split: one member alone saves nothing)."""
+        return self.member_seconds * (self.rest - math.ceil(self.rest / self.workers))
 
     @property
     def cost(self) -> float:

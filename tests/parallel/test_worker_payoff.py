@@ -24,9 +24,10 @@ def burn(seconds: float) -> int:
 
 def test_condition_1_weighs_the_saving_on_the_rest_against_the_start_ahead_and_a_first_member():
     small = Payoff(member_seconds=0.13, rest=7, workers=2, start_ahead=0.0, first_member_seconds=1.0)
-    assert small.saving == pytest.approx(7 * 0.13 / 2) and not small.repaid
+    assert small.saving == pytest.approx(3 * 0.13) and not small.repaid        # 7 members: 4 on one worker
     large = Payoff(member_seconds=0.65, rest=15, workers=2, start_ahead=0.5, first_member_seconds=1.0)
-    assert large.saving == pytest.approx(15 * 0.65 / 2) and large.cost == 1.5 and large.repaid
+    assert large.saving == pytest.approx(7 * 0.65) and large.cost == 1.5 and large.repaid
+    assert Payoff(10.0, 1, 2, 0.0, 0.0).saving == 0.0                             # one member is not split
     assert not Payoff(10.0, 0, 2, 0.0, 0.0).repaid and not Payoff(10.0, 5, 1, 0.0, 0.0).repaid
     assert "the other 7 in this process" in small.describe(1)
     assert "the other 15 on 2 workers" in large.describe(1)
@@ -55,12 +56,13 @@ def ready_pool(monkeypatch):
 
 
 def test_a_batch_too_small_to_repay_workers_runs_serially_and_says_why(ready_pool):
-    """Three members of 0.05 s: the workers would save 0.05 s on the other two, less than 0.2 s."""
+    """Three members of 0.05 s: the workers would save 0.05 s on the other two, less than 0.2 s; after the
+    second, none on the last one."""
     pids = ready_pool.map(burn, [0.05] * 3, ["a", "b", "c"], label="small")
     assert pids == [os.getpid()] * 3
     batch = ready_pool.describe()["batches"][-1]
     assert (batch["label"], batch["executor"]) == ("small", "serial")
-    assert "the other 2 in this process" in batch["decision"]
+    assert batch["decision"].startswith("2 members solved here") and "the other 1 in this process" in batch["decision"]
     assert ready_pool._pool is not None                  # started workers are kept for the next batch
 
 
@@ -186,18 +188,28 @@ def test_a_workers_start_is_measured_and_kept_for_the_next_runs(ready_pool):
     among them: more than a tenth of a second, less than a minute), recorded on this machine as each
     worker's start ends."""
     deadline = time.monotonic() + 10.0
-    while len(batch_forecast._starts()) < 2 and time.monotonic() < deadline:
+    while len(batch_forecast.measured_costs("start")) < 2 and time.monotonic() < deadline:
         time.sleep(0.05)                  # the record is written as each start ends, beside this thread
-    starts = batch_forecast._starts()
+    starts = batch_forecast.measured_costs("start")
     assert len(starts) == 2 and all(0.1 < s < 60.0 for s in starts)
-    assert batch_forecast.start_seconds(default=-1.0) == pytest.approx(sum(starts) / 2)
+    assert judged_batches.start_cost() == pytest.approx(sum(starts) / 2)
 
 
-def test_the_start_is_the_median_of_the_last_ones_measured():
-    assert batch_forecast.start_seconds(default=2.5) == 2.5
+def test_a_workers_first_member_is_measured_beyond_the_cheapest_member_here(ready_pool):
+    """``F``: members of 0.05 s everywhere, so a worker's first member costs next to nothing more."""
+    assert judged_batches.first_member_cost() == 0.2          # the estimate, before any measurement
+    ready_pool.map(burn, [0.05] * 12, [f"m{k}" for k in range(12)], label="large")
+    [first] = batch_forecast.measured_costs("first_member")
+    assert 0.0 <= first < 0.03 and judged_batches.first_member_cost() == first
+
+
+def test_a_cost_is_the_median_of_the_last_ones_measured():
+    assert batch_forecast.cost_seconds("start", default=2.5) == 2.5
     for s in (9.0, 1.0, 1.2, 1.4, 1.1, 1.3):
-        batch_forecast.remember_start(s)
-    assert batch_forecast._starts() == [1.0, 1.2, 1.4, 1.1, 1.3] and batch_forecast.start_seconds(0.0) == 1.2
+        batch_forecast.remember_cost("start", s)
+    batch_forecast.remember_cost("first_member", 0.5)
+    assert batch_forecast.measured_costs("start") == [1.0, 1.2, 1.4, 1.1, 1.3]
+    assert batch_forecast.cost_seconds("start", 0.0) == 1.2 and batch_forecast.cost_seconds("first_member", 0.0) == 0.5
 
 
 def blas_threads(_) -> int:
