@@ -60,17 +60,26 @@ def threads(n: int):
     One thread runs without the task manager: with it a 3D cell solve is markedly slower.  The
     BLAS libraries loaded (NGSolve's OpenBLAS under its direct solvers, NumPy's) run on one thread
     meanwhile: their own threads, which keep spinning after each call, would share the cores with
-    NGSolve's, and a solve with both pools on the same cores runs several times slower.
+    NGSolve's, and a solve with both pools on the same cores runs several times slower.  So do those the run
+    loads later (SciPy's own OpenBLAS, loaded by the first ``scipy.linalg`` call), by the variables they read
+    as they load (:data:`~ngcontact.parallel.batch_member.BLAS_THREADS_ENV`, where unset; restored after).
     """
     from threadpoolctl import threadpool_limits
-    with threadpool_limits(limits=1):
-        if n == 1:
-            yield
-            return
-        import ngsolve as ng
-        ng.SetNumThreads(n)
-        with ng.TaskManager():
-            yield
+    from ngcontact.parallel.batch_member import BLAS_THREADS_ENV
+    unset = [name for name in BLAS_THREADS_ENV if name not in os.environ]
+    os.environ.update({name: "1" for name in unset})
+    try:
+        with threadpool_limits(limits=1):
+            if n == 1:
+                yield
+                return
+            import ngsolve as ng
+            ng.SetNumThreads(n)
+            with ng.TaskManager():
+                yield
+    finally:
+        for name in unset:
+            os.environ.pop(name, None)
 
 
 #: The logger of the progress lines of long computations inside a stage (a spectral solve running longer

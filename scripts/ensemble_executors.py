@@ -20,7 +20,9 @@ where that record forecasts that the batch goes to them:
 ``--scheduler`` on a ``distributed.LocalCluster``
 of two one-thread worker processes that this script starts once and warms
 with one run of each scene (a cluster outlives the runs it serves).  Per
-run: the command's wall time, the batch's wall time (``compute.batches``),
+run: the one-minute load average as it began (the machine is shared; a
+local pool keeps a batch in the run's process while other jobs keep the
+cores busy), the command's wall time, the batch's wall time (``compute.batches``),
 both over the serial run's of the same repeat, and the largest relative
 difference of the members' contact fractions from the serial run; per
 ensemble and executor, the medians over the ``REPEATS`` repeats (the
@@ -105,23 +107,28 @@ def main() -> None:
                 ref: tuple[float, dict] | None = None
                 for executor, flags in (("serial", ("--workers", "1")), ("local 2 first", ("--workers", "2")),
                                         ("local 2", ("--workers", "2")), ("dask 2", dask)):
+                    load = os.getloadavg()[0]            # the machine's other jobs as the run begins
                     fresh = os.path.join(tmp, f"empty_{len(rows)}")
                     os.environ["NGCONTACT_CACHE"] = fresh if executor == "local 2 first" else records
                     wall, report = run(scene, os.path.join(tmp, f"{len(rows)}"), *flags)
                     ref = ref or (wall, report)
                     diff = np.max(np.abs(fractions(report) - fractions(ref[1])) / np.abs(fractions(ref[1])))
                     rows.append(dict(ensemble=name, executor=executor, repeat=repeat,
-                                     members=report["results"]["ensemble"]["members"], ran=ran(report),
+                                     members=report["results"]["ensemble"]["members"], load=load,
+                                     ran=ran(report),
                                      started=started(report), wall=wall,
                                      batch=batch_seconds(report), speedup=ref[0] / wall,
                                      batch_speedup=batch_seconds(ref[1]) / batch_seconds(report),
                                      max_rel_diff=float(diff)))
                     r = rows[-1]
-                    print(f"{name:>18} {executor:>13} #{repeat}: {wall:6.2f} s (x{r['speedup']:.2f}), batch "
+                    print(f"{name:>18} {executor:>13} #{repeat} (load {load:.1f}): {wall:6.2f} s "
+                          f"(x{r['speedup']:.2f}), batch "
                           f"{r['batch']:6.2f} s (x{r['batch_speedup']:.2f}), {r['ran']}, {r['started']}, "
                           f"diff {diff:.1e}", flush=True)
+    loads = [r["load"] for r in rows]
     rows += medians(rows)
     write(args.out, rows)
+    print(f"load average as the runs began: {min(loads):.1f} to {max(loads):.1f}, median {np.median(loads):.1f}")
     if args.publish:
         benchmark_doc.publish(
             "ensemble_executors", "Ensembles on each executor",
@@ -134,6 +141,10 @@ def main() -> None:
                  "and `--scheduler` on a local Dask cluster of two one-thread workers (warmed by one run). "
                  "`ran`: where the batch ran (a local pool sends a batch to its workers only where its rest "
                  "repays them, `ngcontact.parallel.worker_payoff`; else `serial`, in the run's process). "
+                 "`load`: the one-minute load average as the run began (2 cores; over the whole benchmark "
+                 f"{min(loads):.1f} to {max(loads):.1f}, median {np.median(loads):.1f}): the payoff rule "
+                 "keeps a batch in the run's process while other jobs keep the cores busy "
+                 "(`ngcontact.parallel.free_cores`), so under load `local 2` is the serial run by design. "
                  "`wall` and `batch` in seconds; speedups over the serial run of the same repeat; "
                  "`max_rel_diff`: the members' contact fractions against the serial run. Timed on a machine "
                  f"shared with other jobs (load average above): the ratios within one repeat are what counts, "
@@ -151,7 +162,8 @@ def medians(rows: list[dict]) -> list[dict]:
             sel = [r for r in rows if r["ensemble"] == name and r["executor"] == ex]
             if not sel:
                 continue
-            med = {k: float(np.median([r[k] for r in sel])) for k in ("wall", "batch", "speedup", "batch_speedup")}
+            med = {k: float(np.median([r[k] for r in sel]))
+                   for k in ("load", "wall", "batch", "speedup", "batch_speedup")}
             out.append(dict(ensemble=name, executor=ex, repeat="median", members=sel[0]["members"],
                             ran="/".join(dict.fromkeys(r["ran"] for r in sel)),
                             started="/".join(dict.fromkeys(r["started"] for r in sel)), **med,
@@ -160,8 +172,8 @@ def medians(rows: list[dict]) -> list[dict]:
 
 
 def write(out: str, rows: list[dict]) -> None:
-    keys = ["ensemble", "executor", "repeat", "members", "ran", "started", "wall", "batch", "speedup", "batch_speedup",
-            "max_rel_diff"]
+    keys = ["ensemble", "executor", "repeat", "members", "load", "ran", "started", "wall", "batch", "speedup",
+            "batch_speedup", "max_rel_diff"]
     with open(os.path.join(out, "ensemble_executors.csv"), "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(keys)

@@ -48,6 +48,7 @@ class Executor:
         if progress is not None:
             progress(label, 0, len(items))
         fault = fault_from_env()
+        self.__dict__["_lead_cpu"] = time.process_time()   # this process's CPU seconds before the batch
         t0 = time.perf_counter()
         self.__dict__.pop("_spread", None)
         clock = self.__dict__["_clock"] = MemberClock()

@@ -13,18 +13,29 @@ The forecast is (1) itself, read with what the last run of the same batch
 measured: ``c`` (the least ``min(wall, CPU)`` seconds of its members solved
 in its process) and the seconds from the opening of the run's batches to
 the start of its first batch (``lead``), during which workers started with
-the run start; so ``R = max(START_SECONDS - lead, 0)``.  Nothing is
-guessed: a batch never run on this machine has no forecast, and its workers
-start on demand.  The forecast only chooses when the workers start; where
-each batch runs is still decided by (1) on its own members, and workers
-started early for a batch that (1) then keeps in this process are stopped
-while they start.
+the run start; so ``R`` is the start's wall time less ``lead``, and the
+cores free as the run opens are the load average's, (3) of
+:mod:`ngcontact.parallel.free_cores`.  Nothing is guessed: a batch never
+run on this machine has no forecast, and its workers start on demand.
+The forecast only chooses when the workers start; where each batch runs
+is still decided by (1) on its own members, and workers started early for
+a batch that (1) then keeps in this process are stopped while they start.
 
 A record is one small JSON file per batch, named by the SHA-256 of the
 run's description (the scene, the package version), in ``batches`` under
 the cell-law cache directory (``$NGCONTACT_CACHE``, default
 ``~/.cache/ngcontact``; at most :data:`KEPT`, the oldest removed first); a
 record that cannot be read or written costs only the forecast.
+
+Beside them, ``worker_costs.json`` holds the last :data:`COSTS_KEPT`
+measurements of what a local worker costs on this machine: its start
+(``S`` of (1): each worker's own CPU time once its imports are done) and its
+first member's extra (``F``: the CPU time of a worker's first member less
+the cheapest member of the batch solved in the run's process); their
+medians replace the estimates
+:data:`~ngcontact.parallel.judged_batches.START_SECONDS` and
+:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS` once
+measured.
 """
 from __future__ import annotations
 
@@ -41,6 +52,15 @@ FOLDER = "batches"
 
 #: Records kept at most (the oldest go first): the runs of scenes in many folders do not fill the cache.
 KEPT = 256
+
+#: The record of a local worker's costs as measured on this machine, by kind: ``start`` (CPU seconds of a
+#: worker's start, until its imports are done) and ``first_member`` (CPU seconds a worker's first member
+#: took beyond the cheapest member of its batch solved in the run's process).
+COSTS_FILE = "worker_costs.json"
+COSTS = ("start", "first_member")
+
+#: Measured costs kept per kind; the payoff rule takes their median.
+COSTS_KEPT = 5
 
 
 @dataclass(frozen=True)
@@ -78,24 +98,57 @@ def recorded(name: str) -> Forecast | None:
 
 
 def remember(name: str, forecast: Forecast) -> None:
-    """Record ``forecast`` under ``name`` for the next run (written whole under another name, then renamed)."""
-    path = os.path.join(folder(), f"{name}.json")
+    """Record ``forecast`` under ``name`` for the next run."""
+    _write(f"{name}.json", {"members": forecast.members, "member_seconds": forecast.member_seconds,
+                            "lead_seconds": forecast.lead_seconds})
+
+
+def _write(file: str, data: dict) -> None:
+    """``data`` as the record ``file`` (written whole under another name, then renamed; the oldest records
+    beyond :data:`KEPT` removed); a record that cannot be written is only logged."""
+    path = os.path.join(folder(), file)
     partial = f"{path}.{os.getpid()}.partial"
     try:
         os.makedirs(folder(), exist_ok=True)
         with open(partial, "w") as f:
-            json.dump({"members": forecast.members, "member_seconds": forecast.member_seconds,
-                       "lead_seconds": forecast.lead_seconds}, f)
+            json.dump(data, f)
         os.replace(partial, path)
         records = sorted(os.scandir(folder()), key=lambda e: e.stat().st_mtime)
         for old in records[:max(len(records) - KEPT, 0)]:
             os.remove(old.path)
     except OSError as exc:
-        log.debug("no record of the batch in %s (%s)", folder(), exc)
+        log.debug("no record %s in %s (%s)", file, folder(), exc)
         try:
             os.remove(partial)
         except OSError:
             pass
+
+
+def measured_costs(kind: str) -> list[float]:
+    """The last costs of ``kind`` (:data:`COSTS`) measured on this machine, oldest first."""
+    try:
+        with open(os.path.join(folder(), COSTS_FILE)) as f:
+            costs = [float(s) for s in json.load(f)[kind]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    return [s for s in costs if 0.0 <= s < 1e4]
+
+
+def cost_seconds(kind: str, default: float) -> float:
+    """CPU seconds of a worker's cost ``kind`` on this machine (:data:`COSTS`): the median of the last
+    :data:`COSTS_KEPT` measured, ``default`` before any."""
+    costs = sorted(measured_costs(kind))
+    if not costs:
+        return default
+    mid = len(costs) // 2
+    return costs[mid] if len(costs) % 2 else 0.5 * (costs[mid - 1] + costs[mid])
+
+
+def remember_cost(kind: str, seconds: float) -> None:
+    """Add a measured cost of ``kind`` (:data:`COSTS`) to the machine's record."""
+    data = {k: measured_costs(k) for k in COSTS}
+    data[kind] = (data[kind] + [float(seconds)])[-COSTS_KEPT:]
+    _write(COSTS_FILE, data)
 
 
 def early(executor, name: str, members: int | None) -> bool:

@@ -11,7 +11,9 @@ the test-only fault injection of the retry tests.
 """
 from __future__ import annotations
 
+import contextlib
 import os
+import sys
 import threading
 import traceback
 from dataclasses import dataclass
@@ -83,13 +85,21 @@ def in_worker() -> bool:
     return _IN_WORKER
 
 
+#: The variables by which the BLAS and OpenMP libraries a process loads later (SciPy's own OpenBLAS, loaded
+#: by the first member that needs ``scipy.linalg``) learn their number of threads as they load.
+BLAS_THREADS_ENV = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
 def one_thread(ignore_sigint: bool) -> None:
-    """Worker start: NGSolve and BLAS on one thread, the C heap's thresholds as in this process
+    """Worker start: NGSolve and BLAS on one thread (the libraries loaded already by ``threadpoolctl``, those
+    loaded later by :data:`BLAS_THREADS_ENV`), the C heap's thresholds as in this process
     (:func:`~ngcontact.parallel.heap_thresholds.keep_freed_arrays`); a pool's workers leave SIGINT to the
     submitting process, which stops them."""
     global _IN_WORKER
     _IN_WORKER = True
     os.environ["NGCONTACT_THREADS"] = "1"
+    for name in BLAS_THREADS_ENV:
+        os.environ[name] = "1"
     keep_freed_arrays()
     if ignore_sigint:
         import signal
@@ -98,6 +108,23 @@ def one_thread(ignore_sigint: bool) -> None:
     ngsolve.SetNumThreads(1)
     from threadpoolctl import threadpool_limits
     threadpool_limits(limits=1)     # nor BLAS threads (runner.threads): for the rest of the worker's life
+
+
+@contextlib.contextmanager
+def threads_asleep():
+    """Within the block, the NGSolve task manager's threads of this process sleep between looks for work
+    (``pyngcore.SuspendTaskManager``): while workers solve a batch, this process only waits, and its idle
+    threads would otherwise spin on the cores the workers compute on.  Nothing where NGSolve is not loaded."""
+    if "pyngcore" not in sys.modules:
+        yield
+        return
+    from pyngcore import SuspendTaskManager
+    with SuspendTaskManager(SLEEP_MICROSECONDS):
+        yield
+
+
+#: Microseconds the task manager's idle threads sleep between looks for work while workers compute.
+SLEEP_MICROSECONDS = 10_000
 
 
 def reason(exc: BaseException) -> str:

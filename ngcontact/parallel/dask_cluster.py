@@ -19,7 +19,7 @@ from typing import Any, Sequence
 
 from ngcontact.errors import NgcontactError
 from ngcontact.parallel.batch_executor import Executor
-from ngcontact.parallel.batch_member import in_worker, one_thread, reason, run_member
+from ngcontact.parallel.batch_member import in_worker, one_thread, reason, run_member, threads_asleep
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
@@ -153,16 +153,17 @@ class DaskCluster(Executor):
 
         futures = as_completed([submit(k) for k in range(len(items))], loop=client.loop)
         try:
-            for fut in futures:
-                k = index.pop(fut)
-                if fut.status == "finished":
-                    results[k] = fut.result()
-                    if progress is not None:
-                        progress(label, len(results), len(items))
-                    continue
-                exc = fut.exception()
-                self._failed(label, names[k], failures, k, exc)
-                futures.add(submit(k))
+            with threads_asleep():          # this process only waits: its NGSolve threads leave the cores
+                for fut in futures:
+                    k = index.pop(fut)
+                    if fut.status == "finished":
+                        results[k] = fut.result()
+                        if progress is not None:
+                            progress(label, len(results), len(items))
+                        continue
+                    exc = fut.exception()
+                    self._failed(label, names[k], failures, k, exc)
+                    futures.add(submit(k))
         except BaseException:
             client.cancel(list(index))
             raise

@@ -2,10 +2,12 @@
 
 A run's batches (:meth:`JudgedBatches.start_on_demand` or an early start) are judged: the first members
 are solved in the run's own process, each timed, and the rest goes to the workers only where condition
-(1) of :mod:`ngcontact.parallel.worker_payoff` holds for it, ``T_rest / (W - 1) > R + F`` in that
-module's terms: the rest's serial time against the workers' start still ahead (``R``,
-:data:`START_SECONDS` less the time since they were spawned) and a worker's first member
-(``F``, :data:`FIRST_MEMBER_SECONDS`).  A batch kept in this process starts no worker.
+(1) of :mod:`ngcontact.parallel.worker_payoff` holds for it: the rest's serial time against the workers'
+start still ahead (``R``), a worker's first member (``F``: :func:`first_member_cost`) and the CPU
+time of their starts (``S``: :func:`start_cost`; both measured on this machine), on the cores other processes
+leave free (``f``, :mod:`ngcontact.parallel.free_cores`, read at each look).  A batch kept in this
+process starts no worker; while the workers solve a batch, this process's NGSolve threads sleep
+(:func:`~ngcontact.parallel.batch_member.threads_asleep`).
 
 The rule is a mixin of :class:`~ngcontact.parallel.local_pool.LocalPool`, whose worker processes it starts,
 uses and stops: this module holds the decision, that one the processes.
@@ -17,21 +19,37 @@ import time
 from abc import ABC, abstractmethod
 from typing import Any, Sequence
 
+from ngcontact.parallel import batch_forecast, worker_payoff
 from ngcontact.parallel.batch_executor import Executor
-from ngcontact.parallel import worker_payoff
+from ngcontact.parallel.batch_member import threads_asleep
+from ngcontact.parallel.free_cores import CoreWatch
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
 
-#: Wall seconds a local pool's workers take to start (fresh interpreters importing NGSolve and the package,
-#: all at once; an estimate for two workers starting together on two cores): ``R`` of
-#: :mod:`ngcontact.parallel.worker_payoff` for a pool not yet started.
+#: CPU seconds of a local worker's start (a fresh interpreter importing NGSolve and the package) before
+#: one has been measured on this machine (an estimate): ``S`` of :mod:`ngcontact.parallel.worker_payoff`.
 START_SECONDS = 2.0
 
-#: Seconds a worker's first member takes beyond the others (an estimate): what the run's process paid
-#: before its batch and a fresh worker pays in its first member, e.g. importing a measured surface's reader
-#: and reading its file; ``F`` of :mod:`ngcontact.parallel.worker_payoff`.
+
+#: CPU seconds a worker's first member takes beyond the others before one has been measured on this machine
+#: (an estimate): what the run's process paid before its batch and a fresh worker pays in its first member,
+#: e.g. importing a measured surface's reader and reading its file; ``F`` of
+#: :mod:`ngcontact.parallel.worker_payoff`.
 FIRST_MEMBER_SECONDS = 1.0
+
+
+def start_cost(default: float | None = None) -> float:
+    """``S``: the CPU seconds of a worker's start as measured on this machine
+    (:func:`~ngcontact.parallel.batch_forecast.cost_seconds`), ``default`` (:data:`START_SECONDS`) before
+    any."""
+    return batch_forecast.cost_seconds("start", START_SECONDS if default is None else default)
+
+
+def first_member_cost(default: float | None = None) -> float:
+    """``F``: the CPU seconds of a worker's first member beyond the others, as measured on this machine,
+    ``default`` (:data:`FIRST_MEMBER_SECONDS`) before any."""
+    return batch_forecast.cost_seconds("first_member", FIRST_MEMBER_SECONDS if default is None else default)
 
 
 class JudgedBatches(Executor, ABC):
@@ -58,14 +76,41 @@ class JudgedBatches(Executor, ABC):
     def _discard(self) -> None:
         """Stop the workers now."""
 
+    @property
+    def cores(self) -> CoreWatch:
+        """The watch of the cores other processes leave free (opened with the run's batches)."""
+        watch = self.__dict__.get("_cores")
+        if watch is None:
+            watch = self.__dict__["_cores"] = CoreWatch(self._worker_pids)
+        return watch
+
+    def _worker_pids(self) -> list[int]:
+        return list((self._pool._processes or {}).keys()) if self._pool is not None else []
+
+    def payoff(self, member_seconds: float, rest: int, lead: float = 0.0,
+               first: float | None = None) -> worker_payoff.Payoff:
+        """Condition (1) of :mod:`ngcontact.parallel.worker_payoff` for ``rest`` members of
+        ``member_seconds`` each, with the cores free now and the workers' start still ahead (less ``lead``
+        seconds of the run before its batch, for a start with the run).  Where this machine has measured no
+        worker yet, ``S`` is the CPU seconds this process spent before its batch (its interpreter, its
+        imports and the batch's preparation: what a fresh worker repeats, and more), at most
+        :data:`START_SECONDS`, and ``F`` what this process's own first member took beyond its cheapest
+        (``first``, where two were solved), at most :data:`FIRST_MEMBER_SECONDS`."""
+        cores = self.cores.reading()
+        lead_cpu = self.__dict__.get("_lead_cpu")
+        ahead = self._start_ahead(start_cost(None if lead_cpu is None else min(lead_cpu, START_SECONDS)))
+        return worker_payoff.Payoff(member_seconds, rest, self.workers, max(ahead - lead, 0.0),
+                                    first_member_cost(None if first is None else min(first, FIRST_MEMBER_SECONDS)),
+                                    ahead, cores)
+
     def repays(self, forecast) -> bool:
         """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send the rest of a batch
         (its :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: the members after
         the first ``MEASURED`` (solved here), of the forecast's seconds each, against the part of the start
-        that the run's lead before its batch leaves ahead, and a worker's first member."""
-        return worker_payoff.Payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
-                                    self.workers, max(START_SECONDS - forecast.lead_seconds, 0.0),
-                                    FIRST_MEMBER_SECONDS).repaid
+        that the run's lead before its batch leaves ahead, a worker's first member and the starts' CPU
+        time, on the cores free as the run opens."""
+        return self.payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
+                           forecast.lead_seconds).repaid
 
     def start_on_demand(self, modules: Sequence[str] = ()) -> None:
         """Start no worker now: only once a batch's rest repays their start (:meth:`_judged_map`), each
@@ -96,13 +141,16 @@ class JudgedBatches(Executor, ABC):
             done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
                                   shifted_progress(progress, k, len(items)), fault)
             if len(done) == len(items):
-                self._where("serial", f"all {len(done)} members solved here while the workers started")
+                self._where("serial", f"all {len(done)} members solved here"
+                            + (" while the workers started" if self._pool is not None else ""))
                 return done
-            payoff = worker_payoff.Payoff(clock.least, len(items) - len(done), self.workers, self._start_ahead(),
-                                          FIRST_MEMBER_SECONDS)
+            first = clock.times[0] - clock.least if len(clock.times) >= 2 else None
+            payoff = self.payoff(clock.least, len(items) - len(done), first=first)
             if not payoff.repaid:
-                if self._pool is not None and not all(w.done() for w in self._warming):
-                    self._discard()
+                if self._pool is not None and not all(w.done() for w in self._warming) and payoff.rest > 1:
+                    self._discard()     # (a last member here takes one member's time: the start goes on)
+                if len(done) < worker_payoff.MEASURED:
+                    continue        # the second member here measures what the first paid once: look again
                 self._where("serial", payoff.describe(len(done)))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
                 return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
@@ -114,20 +162,22 @@ class JudgedBatches(Executor, ABC):
             if self._ready() and len(done) >= worker_payoff.MEASURED:
                 self._where("local", payoff.describe(len(done)))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
-                return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
-                                             shifted_progress(progress, len(done)), fault)
+                with threads_asleep():
+                    return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
+                                                 shifted_progress(progress, len(done)), fault)
 
     def _ready(self) -> bool:
         """Whether a worker of the current pool has started (a pool started without warm-up tasks: yes)."""
         return self._pool is not None and (not self._warming or any(w.done() for w in self._warming))
 
-    def _start_ahead(self) -> float:
-        """Seconds of the workers' start still to come (``R`` of :mod:`ngcontact.parallel.worker_payoff`)."""
+    def _start_ahead(self, start: float) -> float:
+        """Seconds of the workers' start still to come (``R`` of :mod:`ngcontact.parallel.worker_payoff`), of
+        ``start`` CPU seconds in all (``S``): all of it for a pool not started."""
         if self._pool is None:
-            return START_SECONDS
+            return start
         if self._ready():
             return 0.0
-        return max(START_SECONDS - (time.perf_counter() - self._spawned), 0.0)
+        return max(start - (time.perf_counter() - self._spawned), 0.0)
 
 
 def shifted_progress(progress, done: int, total: int | None = None):

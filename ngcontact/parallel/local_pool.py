@@ -17,7 +17,7 @@ from typing import Any, Sequence
 from ngcontact.parallel.batch_executor import Executor
 from ngcontact.parallel.judged_batches import JudgedBatches, shifted_progress
 from ngcontact.parallel.batch_member import one_thread, run_member
-from ngcontact.parallel import worker_lifetime
+from ngcontact.parallel import batch_forecast, worker_lifetime
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
@@ -76,6 +76,8 @@ class LocalPool(JudgedBatches):
             self.started = "with the run" if not self.record else f"after batch {len(self.record)}"
         pool = self._start()
         self._warming = [pool.submit(_warm_up, self._modules) for _ in range(self.workers)]
+        for warm in self._warming:
+            warm.add_done_callback(_measured_start)
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         if len(items) == 1:
@@ -117,6 +119,7 @@ class LocalPool(JudgedBatches):
         failures = {k: 0 for k in range(len(items))}
         pending: dict[Any, int] = {}
         unsent: list[int] = []       # members whose submission found the pool already broken
+        firsts: list[float] = []     # CPU seconds of the first member of each worker that had one here
         pool = self._pool or self._start()
 
         def submit(k):
@@ -138,7 +141,7 @@ class LocalPool(JudgedBatches):
                     for fut in done:
                         k = pending.pop(fut)
                         try:
-                            results[k] = fut.result()
+                            results[k], seconds, first = fut.result()
                         except BrokenProcessPool:
                             broken.append(k)
                             continue
@@ -146,6 +149,8 @@ class LocalPool(JudgedBatches):
                             self._failed(label, names[k], failures, k, exc)
                             submit(k)
                             continue
+                        if first:
+                            firsts.append(seconds)
                         if progress is not None:
                             progress(label, len(results), len(items))
                 if broken or (unsent and not pending):
@@ -169,6 +174,9 @@ class LocalPool(JudgedBatches):
         except BaseException:
             self._discard()
             raise
+        if firsts and self.member_clock.times:    # ``F``: a first member's CPU beyond the cheapest here
+            batch_forecast.remember_cost("first_member", max(sorted(firsts)[len(firsts) // 2]
+                                                             - self.member_clock.least, 0.0))
         return [results[k] for k in range(len(items))]
 
     def _running_on_dead_workers(self, names) -> set[str]:
@@ -248,14 +256,30 @@ def _worker_start(started, parent: int, record: str | None) -> None:
     one_thread(ignore_sigint=True)
 
 
-def _warm_up(modules: tuple[str, ...]) -> None:
+def _warm_up(modules: tuple[str, ...]) -> float:
+    """A worker's imports as it starts; returns the worker's CPU seconds so far: its start's cost."""
     import importlib
     for module in modules:
         if module != "__main__":          # the submitting script: the spawn start has imported it already
             importlib.import_module(module)
+    return time.process_time()
+
+
+def _measured_start(warm) -> None:
+    """A worker's start is done: its CPU seconds join the machine's record (``S`` of the payoff rule)."""
+    if not warm.cancelled() and warm.exception() is None:
+        batch_forecast.remember_cost("start", warm.result())
+
+
+_SOLVED = 0
 
 
 def _pool_member(fn, item, name, attempt, fault):
+    """One member in a worker: its result, its CPU seconds, and whether it was the worker's first."""
+    global _SOLVED
     if _STARTED is not None:
         _STARTED.put((os.getpid(), name))
-    return run_member(fn, item, name, attempt, fault)
+    t0 = time.process_time()
+    result = run_member(fn, item, name, attempt, fault)
+    _SOLVED += 1
+    return result, time.process_time() - t0, _SOLVED == 1

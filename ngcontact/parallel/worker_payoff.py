@@ -1,21 +1,34 @@
 """Whether the rest of a batch repays a local pool's workers, or finishes faster in the run's own process.
 
 A batch (:mod:`ngcontact.parallel.executor`) of ``n`` members, each a whole
-solve of about ``c`` seconds (the members of an ensemble are draws of one
-surface class, the loads or levels of a batch solves of one size), on ``W``
-workers.  With ``r`` members still to solve, finishing them here takes
-``r c``; on the workers it takes about ``r c / W``, but only once the
-workers can take members: after the part of their start still ahead, ``R``
-(spawning a fresh interpreter and importing NGSolve; none once a worker has
-started), and after each worker has solved a first member, which pays what
-this process paid before the batch and a fresh interpreter has not (the
-libraries a member imports beyond NGSolve, such as a measured surface's
-reader, the files it reads), ``F``.  The workers repay themselves when::
+solve of about ``c`` seconds on one core (the members of an ensemble are
+draws of one surface class, the loads or levels of a batch solves of one
+size), on ``W`` workers.  With ``r`` members still to solve, finishing them
+here takes ``r c``.  On the workers the rest ends
 
-    r c (1 - 1/W)  >  R + F                                              (1)
+* no sooner than ``R + F + c ceil(r / W)``: the workers take members only after
+  the part of their start still ahead, ``R`` wall seconds (none once a
+  worker has started), and each worker's first member pays what this
+  process paid before the batch and a fresh interpreter has not (the
+  libraries a member imports beyond NGSolve, the files it reads), ``F``;
+* no sooner than ``(r c + W (S + F)) / P``: the work of the rest, of each
+  worker's start (``S`` CPU seconds: an interpreter importing NGSolve and
+  the members' modules) and of its first member, on the ``P = min(W, f)``
+  cores the run gets, ``f`` being the cores other processes leave free
+  (:mod:`ngcontact.parallel.free_cores`, eq. 2 or 3): on busy cores a
+  worker only takes turns with other jobs, and its start takes the cores of
+  this process.
+
+The workers repay themselves when both bounds end before ``r c``::
+
+    c (r - ceil(r / W))  >  R + F      and      r c (P - 1)  >  W (S + F)      (1)
 
 the time the workers save on the rest against the time they cost before
-they save any.
+they save any, and the cores they would gain against the work they add.
+On a free machine (``P = W = 2``) the second reads ``r c > 2 (S + F)``,
+the first with the start's CPU time for its wall time; with ``f <= 1``
+(other jobs keep the cores busy) no batch repays workers, whatever its
+size: it stays here, and its record says why.
 
 ``c`` is measured, never guessed: every batch solves its first members in
 this process and times each as ``min(wall, CPU)`` seconds of this process
@@ -24,23 +37,40 @@ processes' load and the workers' own start, which takes cores from this
 process while it runs; wall seconds where NGSolve's threads solve it in
 less wall time than CPU time); ``c`` is the least of these times, since
 noise only adds to a member's time and the first member also pays what
-this process does once (a lazy import, a cache filled).  ``R`` is an
-estimate of a fresh worker's start
-(:data:`~ngcontact.parallel.judged_batches.START_SECONDS`) less the time the
-workers have had since they were spawned; ``F`` an estimate
-(:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS`).
+this process does once (a lazy import, a cache filled).  ``S`` and ``F``
+are measured too, by the workers (``S``: a worker's CPU seconds once its
+imports are done; ``F``: its first member's CPU seconds less ``c``), and
+kept per machine (:func:`~ngcontact.parallel.batch_forecast.cost_seconds`).
+On a machine that has measured no worker yet, ``S`` is the CPU seconds this
+process spent before its batch (a fresh worker repeats its interpreter and
+imports, and the batch's preparation is on top; at most
+:data:`~ngcontact.parallel.judged_batches.START_SECONDS`, for a process
+that computed long before its batch) and ``F`` what this
+process's first member took beyond its cheapest, at most
+:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS` (so the
+first look waits for a second member; without a batch, the estimates
+:data:`~ngcontact.parallel.judged_batches.START_SECONDS` and
+:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS`).  ``R``
+is ``S`` less the time the workers have had since they were spawned: a
+start on busy cores takes longer, which the second condition counts.
 
 (1) is read after every member solved here, and the rest goes to the
 workers only once (1) holds after :data:`MEASURED` members and a worker is
-ready.  A batch whose first member already fails (1) ends here at once: the
-least time can only be smaller than it.  Both sides of (1) shrink as members
-are solved here: the left by ``c (1 - 1/W)`` per member, the right by
-``c`` while ``R > 0``; so a batch that repays its workers at first still
-does while they start, and one whose workers start late is finished here
-as soon as (1) fails.  When (1) fails, workers still starting are stopped
-at once (a starting worker takes a core from this process).
+ready.  A batch whose first :data:`MEASURED` members fail (1) ends here at
+once: the least time can only be smaller than it.  Both sides of (1) shrink as members
+are solved here: in the first, the left by about ``c (1 - 1/W)`` per member,
+the right by ``c`` while ``R > 0``; in the second, the left by
+``c (P - 1)``, the right as the start is paid (the part of ``S`` ahead is
+``R``); so a batch that repays its workers at first still does while they
+start, and one whose workers start late is
+finished here as soon as (1) fails.  ``f`` is read anew at each look: on a
+machine whose other jobs take the cores meanwhile, the rest stays here.
+When (1) fails, workers still starting are stopped at once (a starting
+worker takes a core from this process).
 
-Never slower than serial: the workers of a run are started on demand
+Never slower than serial, also on a shared machine: no worker starts while
+other jobs keep the cores busy (``f <= 1``), and the workers of a run are
+started on demand
 (:meth:`LocalPool.start_on_demand
 <ngcontact.parallel.judged_batches.JudgedBatches.start_on_demand>`), only once (1)
 holds, so a batch whose rest never repays them is the serial batch, no
@@ -56,8 +86,11 @@ members, so it keeps its speedup, less their share.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
+
+from ngcontact.parallel.free_cores import Reading
 
 #: Members solved in this process before the rest of a batch may go to the workers (each timed; the least
 #: time is ``c``): the first also pays what this process does once.
@@ -67,19 +100,29 @@ MEASURED = 2
 @dataclass(frozen=True)
 class Payoff:
     """Condition (1) for the rest of a batch: ``rest`` members of ``member_seconds`` each on ``workers``
-    workers, against ``start_ahead`` seconds of their start still to come and ``first_member_seconds`` of a
-    worker's first member."""
+    workers, against ``start_ahead`` wall seconds of their start still to come (``R``),
+    ``first_member_seconds`` of a worker's first member (``F``), ``start_cpu`` CPU seconds of each worker's
+    start still to be paid (``S``; none for started workers) and the ``cores`` other processes leave free
+    (a :class:`~ngcontact.parallel.free_cores.Reading`; None: every core)."""
 
     member_seconds: float
     rest: int
     workers: int
     start_ahead: float
     first_member_seconds: float
+    start_cpu: float = 0.0
+    cores: Reading | None = None
+
+    @property
+    def parallel(self) -> float:
+        """``P = min(W, f)``: the cores the workers would compute on."""
+        return float(self.workers) if self.cores is None else min(float(self.workers), self.cores.free)
 
     @property
     def saving(self) -> float:
-        """Seconds the workers save on the rest, once they take members: ``r c (1 - 1/W)``."""
-        return self.rest * self.member_seconds * (1.0 - 1.0 / self.workers)
+        """Seconds the workers save on the rest, once they take members: ``c (r - ceil(r / W))`` (a member
+        is not split: one member alone saves nothing)."""
+        return self.member_seconds * (self.rest - math.ceil(self.rest / self.workers))
 
     @property
     def cost(self) -> float:
@@ -87,18 +130,41 @@ class Payoff:
         return self.start_ahead + self.first_member_seconds
 
     @property
+    def core_saving(self) -> float:
+        """CPU seconds of the rest that the workers' extra cores take over: ``r c (P - 1)``."""
+        return self.rest * self.member_seconds * (self.parallel - 1.0)
+
+    @property
+    def core_cost(self) -> float:
+        """CPU seconds the workers add: ``W (S + F)``."""
+        return self.workers * (self.start_cpu + self.first_member_seconds)
+
+    @property
+    def busy(self) -> bool:
+        """Whether other processes leave the workers no core of their own (``P <= 1``)."""
+        return self.parallel <= 1.0
+
+    @property
     def repaid(self) -> bool:
         """Condition (1): the rest goes to the workers."""
-        return self.rest > 0 and self.workers > 1 and self.saving > self.cost
+        return (self.rest > 0 and self.workers > 1 and not self.busy and self.saving > self.cost
+                and self.core_saving > self.core_cost)
 
     def describe(self, solved: int) -> str:
         """One line for the report: what was measured and what was decided, after ``solved`` members here."""
+        cores = "" if self.cores is None else f"; {self.cores.describe()}"
+        first = (f"{solved} member{'s' if solved > 1 else ''} solved here, the cheapest in "
+                 f"{self.member_seconds:.3g} s{cores}")
+        if self.busy and self.rest > 0 and self.workers > 1:
+            return (f"{first}: the cores are busy with other processes, so {self.workers} workers would only "
+                    f"take turns with them; the other {self.rest} in this process")
         where = f"the other {self.rest} on {self.workers} workers" if self.repaid else \
             f"the other {self.rest} in this process"
-        return (f"{solved} member{'s' if solved > 1 else ''} solved here, the cheapest in {self.member_seconds:.3g} s: "
-                f"{self.workers} workers would save {self.saving:.3g} s on the other {self.rest} against "
-                f"{self.start_ahead:.3g} s of their start still ahead and {self.first_member_seconds:.3g} s "
-                f"of a worker's first member; {where}")
+        return (f"{first}: {self.workers} workers would save {self.saving:.3g} s on the other {self.rest} "
+                f"against {self.start_ahead:.3g} s of their start still ahead and "
+                f"{self.first_member_seconds:.3g} s of a worker's first member, and on {self.parallel:.2g} "
+                f"cores {self.core_saving:.3g} CPU s against {self.core_cost:.3g} CPU s of their starts "
+                f"({self.start_cpu:.3g} s each) and first members; {where}")
 
 
 class MemberClock:

@@ -19,7 +19,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import stats
 
 #: Confidence level of the band.
 LEVEL = 0.95
@@ -39,6 +38,7 @@ def band(samples) -> dict[str, np.ndarray]:
     same = np.all(x == x[0], axis=0)
     std = np.where(same, 0.0, x.std(axis=0, ddof=1))
     se = std / math.sqrt(M)
+    from scipy import stats     # imported here: a second of a worker's start that solves ensemble members
     half = stats.t.ppf(0.5 + LEVEL / 2, M - 1) * se
     return {"mean": mean, "std": std, "standard_error": se, "half_width": half,
             "low": mean - half, "high": mean + half}

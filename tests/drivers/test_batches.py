@@ -19,6 +19,7 @@ import pytest
 
 from ngcontact import cli
 from ngcontact.runner import solve
+from ngcontact.parallel import free_cores
 from ngcontact.parallel.batch_member import FAULT_ENV
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -228,11 +229,13 @@ def test_a_member_that_always_fails_ends_the_run_with_exit_3_and_writes_nothing(
 
 def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_path):
     psutil = pytest.importorskip("psutil")
-    scene = ensemble(tmp_path, members=200, grid=64)
+    scene = ensemble(tmp_path, members=400, grid=64)
     out = tmp_path / "out"
     out.mkdir()
     (out / "notes.txt").write_text("mine")
-    env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    # an idle machine (a batch stays in the run's process while other jobs keep the cores busy)
+    env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
+               **{free_cores.LOAD_ENV: "0"})
     proc = subprocess.Popen([sys.executable, "-m", "ngcontact.cli", "run", scene, "--out", str(out),
                              "--workers", "2"], stderr=subprocess.PIPE, text=True, env=env, cwd=str(tmp_path))
     workers = []

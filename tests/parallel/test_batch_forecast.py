@@ -5,7 +5,7 @@ import os
 import pytest
 
 from ngcontact import runner
-from ngcontact.parallel import batch_forecast, executor, judged_batches
+from ngcontact.parallel import batch_forecast, executor, free_cores, judged_batches
 from ngcontact.parallel.batch_forecast import Forecast
 from ngcontact.scene import loader
 
@@ -29,13 +29,18 @@ def test_a_record_is_read_back_and_a_broken_one_is_no_forecast(cache):
         assert batch_forecast.recorded("abc") is None
 
 
-def test_the_forecast_is_condition_1_with_the_start_the_lead_leaves_ahead(monkeypatch):
+def test_the_forecast_is_condition_1_on_the_cores_free_as_the_run_opens(monkeypatch):
     monkeypatch.setattr(judged_batches, "START_SECONDS", 2.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 1.0)
+    monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
     pool = executor.LocalPool(2)
-    # 14 members after the two solved here, 0.3 s each: 2.1 s saved against 1 s of a first member and
-    # what of the 2 s start the lead leaves ahead
-    assert pool.repays(Forecast(16, 0.3, 1.5)) and not pool.repays(Forecast(16, 0.3, 0.5))
+    # 14 members after the two solved here, 0.5 s each, on an idle machine of two cores: 3.5 s saved
+    # against 1 s of a first member and the 2 s start less the lead; on the cores, 7 CPU s against
+    # 2 x (2 + 1) s of starts and first members
+    assert pool.repays(Forecast(16, 0.5, 1.5)) and pool.repays(Forecast(16, 0.5, 0.0))
+    assert not pool.repays(Forecast(16, 0.4, 10.0))          # 5.6 CPU s do not repay 6 CPU s
+    monkeypatch.setattr(free_cores, "load_average", lambda: 1.0)
+    assert not pool.repays(Forecast(16, 0.5, 1.5))           # one core left: the workers would gain none
     assert not pool.repays(Forecast(8, 0.15, 10.0))          # the measured scan's kind: never repaid
     assert not executor.Serial().repays(Forecast(1000, 10.0, 10.0))
 

@@ -9,7 +9,8 @@ import time
 
 import pytest
 
-from ngcontact.parallel import judged_batches, local_pool
+from ngcontact.parallel import batch_forecast, free_cores, judged_batches, local_pool
+from ngcontact.parallel.free_cores import Reading
 from ngcontact.parallel.worker_payoff import MemberClock, Payoff
 
 
@@ -23,9 +24,10 @@ def burn(seconds: float) -> int:
 
 def test_condition_1_weighs_the_saving_on_the_rest_against_the_start_ahead_and_a_first_member():
     small = Payoff(member_seconds=0.13, rest=7, workers=2, start_ahead=0.0, first_member_seconds=1.0)
-    assert small.saving == pytest.approx(7 * 0.13 / 2) and not small.repaid
+    assert small.saving == pytest.approx(3 * 0.13) and not small.repaid        # 7 members: 4 on one worker
     large = Payoff(member_seconds=0.65, rest=15, workers=2, start_ahead=0.5, first_member_seconds=1.0)
-    assert large.saving == pytest.approx(15 * 0.65 / 2) and large.cost == 1.5 and large.repaid
+    assert large.saving == pytest.approx(7 * 0.65) and large.cost == 1.5 and large.repaid
+    assert Payoff(10.0, 1, 2, 0.0, 0.0).saving == 0.0                             # one member is not split
     assert not Payoff(10.0, 0, 2, 0.0, 0.0).repaid and not Payoff(10.0, 5, 1, 0.0, 0.0).repaid
     assert "the other 7 in this process" in small.describe(1)
     assert "the other 15 on 2 workers" in large.describe(1)
@@ -54,12 +56,13 @@ def ready_pool(monkeypatch):
 
 
 def test_a_batch_too_small_to_repay_workers_runs_serially_and_says_why(ready_pool):
-    """Three members of 0.05 s: the workers would save 0.05 s on the other two, less than 0.2 s."""
+    """Three members of 0.05 s: the workers would save 0.05 s on the other two, less than 0.2 s; after the
+    second, none on the last one."""
     pids = ready_pool.map(burn, [0.05] * 3, ["a", "b", "c"], label="small")
     assert pids == [os.getpid()] * 3
     batch = ready_pool.describe()["batches"][-1]
     assert (batch["label"], batch["executor"]) == ("small", "serial")
-    assert "the other 2 in this process" in batch["decision"]
+    assert batch["decision"].startswith("2 members solved here") and "the other 1 in this process" in batch["decision"]
     assert ready_pool._pool is not None                  # started workers are kept for the next batch
 
 
@@ -119,16 +122,111 @@ def test_a_run_with_a_batch_starts_no_worker_before_its_batch_repays_them(monkey
         assert ex.pools_started == 0
 
 
-def test_workers_on_demand_start_inside_the_batch_that_repays_them(monkeypatch):
+@pytest.fixture
+def on_demand_pool(monkeypatch):
+    """A pool whose workers start on demand, with no start to pay and no first member's extra: a batch of
+    members that take time repays them where the cores are free."""
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
+    pool = local_pool.LocalPool(2)
+    pool.start_on_demand(("ngsolve",))
+    yield pool
+    pool.close()
+
+
+def test_workers_on_demand_start_inside_the_batch_that_repays_them(on_demand_pool):
     """A batch whose first member shows that its rest repays the workers starts them then (its members
     after the first two go to them once one is ready: how many depends on the machine's load)."""
+    pids = on_demand_pool.map(burn, [0.02] * 20, [f"m{k}" for k in range(20)], label="large")
+    assert on_demand_pool.pools_started == 1
+    assert on_demand_pool.describe()["workers_started"] == "during batch 'large'"
+    assert pids[:2] == [os.getpid()] * 2
+
+
+def test_condition_1_counts_the_cores_other_processes_leave_and_the_work_of_the_starts():
+    """A rest that repays two workers on an idle machine does not on one whose other jobs leave 1.5 cores
+    (``P = 1.5``: 12 x 0.5 x 0.5 = 3 CPU s against 2 x (1.5 + 0.5)), nor on one they keep busy."""
+    idle, half, busy = (Reading(2, b, "a test's") for b in (0.0, 0.5, 2.0))
+    kw = dict(member_seconds=0.5, rest=12, workers=2, start_ahead=0.0, first_member_seconds=0.5, start_cpu=1.5)
+    assert Payoff(**kw, cores=idle).repaid and Payoff(**kw, cores=idle).parallel == 2.0
+    on_half = Payoff(**kw, cores=half)
+    assert on_half.parallel == 1.5 and on_half.core_saving == pytest.approx(3.0) and on_half.core_cost == 4.0
+    assert not on_half.repaid and "the other 12 in this process" in on_half.describe(2)
+    on_busy = Payoff(**kw, cores=busy)
+    assert on_busy.busy and not on_busy.repaid and "busy with other processes" in on_busy.describe(2)
+
+
+@pytest.fixture
+def busy_machine(monkeypatch):
+    """Two cores, both kept busy by other processes (a load average of 2, no ``/proc/stat`` to read)."""
+    monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
+    monkeypatch.setattr(free_cores, "load_average", lambda: 2.0)
+
+
+def test_a_batch_on_a_machine_whose_cores_are_busy_runs_serially_and_says_why(busy_machine, on_demand_pool):
+    """A batch that repays free workers (no start to pay, no first member's extra) stays in this process
+    when other jobs keep the cores busy; no worker process is started for it, and its record says why."""
+    pids = on_demand_pool.map(burn, [0.02] * 12, [f"m{k}" for k in range(12)], label="busy")
+    assert pids == [os.getpid()] * 12 and on_demand_pool.pools_started == 0
+    batch = on_demand_pool.describe()["batches"][-1]
+    assert batch["executor"] == "serial"
+    assert "0 of 2 cores free (one-minute load average 2.00)" in batch["decision"]
+    assert "busy with other processes" in batch["decision"]
+
+
+def test_started_workers_are_left_idle_while_other_jobs_keep_the_cores_busy(monkeypatch, ready_pool):
+    """Workers already started do not take a batch while the cores are busy: they would only take turns
+    with the other jobs."""
+    monkeypatch.setattr(free_cores, "load_average", lambda: 2.0 * len(free_cores.affinity()))
+    names = [f"m{k}" for k in range(12)]
+    assert ready_pool.map(burn, [0.05] * 12, names, label="large") == [os.getpid()] * 12
+    assert "busy with other processes" in ready_pool.describe()["batches"][-1]["decision"]
+
+
+def test_a_workers_start_is_measured_and_kept_for_the_next_runs(ready_pool):
+    """The workers' start (``S`` of condition (1)) is their CPU seconds once their imports are done (NGSolve
+    among them: more than a tenth of a second, less than a minute), recorded on this machine as each
+    worker's start ends."""
+    deadline = time.monotonic() + 10.0
+    while len(batch_forecast.measured_costs("start")) < 2 and time.monotonic() < deadline:
+        time.sleep(0.05)                  # the record is written as each start ends, beside this thread
+    starts = batch_forecast.measured_costs("start")
+    assert len(starts) == 2 and all(0.1 < s < 60.0 for s in starts)
+    assert judged_batches.start_cost() == pytest.approx(sum(starts) / 2)
+
+
+def test_a_workers_first_member_is_measured_beyond_the_cheapest_member_here(ready_pool):
+    """``F``: members of 0.05 s everywhere, so a worker's first member costs next to nothing more."""
+    assert judged_batches.first_member_cost() == 0.2          # the estimate, before any measurement
+    ready_pool.map(burn, [0.05] * 12, [f"m{k}" for k in range(12)], label="large")
+    [first] = batch_forecast.measured_costs("first_member")
+    assert 0.0 <= first < 0.03 and judged_batches.first_member_cost() == first
+
+
+def test_a_cost_is_the_median_of_the_last_ones_measured():
+    assert batch_forecast.cost_seconds("start", default=2.5) == 2.5
+    for s in (9.0, 1.0, 1.2, 1.4, 1.1, 1.3):
+        batch_forecast.remember_cost("start", s)
+    batch_forecast.remember_cost("first_member", 0.5)
+    assert batch_forecast.measured_costs("start") == [1.0, 1.2, 1.4, 1.1, 1.3]
+    assert batch_forecast.cost_seconds("start", 0.0) == 1.2 and batch_forecast.cost_seconds("first_member", 0.0) == 0.5
+
+
+def blas_threads(_) -> int:
+    """The most threads of any BLAS loaded in this process, after loading SciPy's own (``scipy.linalg``)."""
+    import scipy.linalg  # noqa: F401 - loads SciPy's OpenBLAS where the process had not
+    from threadpoolctl import threadpool_info
+    return max(d["num_threads"] for d in threadpool_info() if d["user_api"] == "blas")
+
+
+def test_workers_run_every_blas_on_one_thread_even_one_loaded_after_their_start(monkeypatch):
     monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
     pool = local_pool.LocalPool(2)
     try:
-        pool.start_on_demand(("ngsolve",))
-        pids = pool.map(burn, [0.02] * 20, [f"m{k}" for k in range(20)], label="large")
-        assert pool.pools_started == 1 and pool.describe()["workers_started"] == "during batch 'large'"
-        assert pids[:2] == [os.getpid()] * 2
+        pool.start()
+        for warm in pool._warming:
+            warm.result(timeout=120)
+        assert pool._pool_map(blas_threads, [0, 1, 2, 3], list("abcd"), "blas", None, None) == [1] * 4
     finally:
         pool.close()
