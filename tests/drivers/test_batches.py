@@ -238,12 +238,17 @@ def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_
                **{free_cores.LOAD_ENV: "0"})
     proc = subprocess.Popen([sys.executable, "-m", "ngcontact.cli", "run", scene, "--out", str(out),
                              "--workers", "2"], stderr=subprocess.PIPE, text=True, env=env, cwd=str(tmp_path))
+    def command(child):
+        try:
+            return " ".join(child.cmdline())
+        except psutil.Error:          # a child that exits (or is a zombie) while it is listed is not a worker
+            return ""
+
     workers = []
     assert proc.stderr is not None
     for line in proc.stderr:          # plain progress lines: stderr is a pipe, not a terminal
         if "ensemble: " in line and "finished" in line:   # the workers start once a member has timed the batch
-            workers = [c for c in psutil.Process(proc.pid).children(recursive=True)
-                       if "spawn_main" in " ".join(c.cmdline())]
+            workers = [c for c in psutil.Process(proc.pid).children(recursive=True) if "spawn_main" in command(c)]
             if len(workers) == 2:
                 break
     assert len(workers) == 2
