@@ -41,9 +41,9 @@ def test_the_shipped_entry_is_the_main_job_cells_under_the_current_key():
     readable and small."""
     _, _, key = SHIP.main_job_cell()
     assert SHIP.shipped() == [f"{key}.npz"], (
-        f"the shipped strength cell {SHIP.shipped()} is not the current key {key} (the cell, its discretization "
-        "or the code that computes it changed): run `python scripts/ship_strength_cell.py` and commit "
-        "ngcontact/data/strength_cells")
+        f"the shipped strength cell {SHIP.shipped()} is not the current key {key} (the cell, its discretization, "
+        "the code that computes it or the package's, NGSolve's or Netgen's version changed): run "
+        "`python scripts/ship_strength_cell.py` and commit ngcontact/data/strength_cells")
     arrays = SC.read_entry(key, SC.SHIPPED)
     assert arrays is not None and arrays["states"].shape[0] == 7
     assert os.path.getsize(os.path.join(SC.SHIPPED, f"{key}.npz")) < LARGEST_SHIPPED
