@@ -5,9 +5,12 @@ first run fills whatever the run caches, the next one finds it.  Each
 repeat makes a new empty cache directory and runs the main job twice in it
 (``cold``, then ``warm``), each in a fresh interpreter as a user types it;
 per run the command's wall time, its peak resident memory (the child's
-``ru_maxrss``), the report's stage times and whether the cache directory
-holds anything afterwards.  The speed issue's aim: the first run within 2x
-a warm one.
+``ru_maxrss``), the report's stage times, whether the cache directory
+holds anything afterwards and where the strength check's cell came from
+(``strength_cell``: shipped with the package, cached or computed,
+:mod:`ngcontact.drivers.strength_cell`).  The speed issue's aims: the first
+run within 2x a warm one, and the strength check's stage no longer than
+the macro solve's (``strength_over_solve`` <= 1).
 
     MPLBACKEND=Agg python scripts/main_job_first_run.py results/main_job_first_run --publish
 """
@@ -59,13 +62,17 @@ def main() -> None:
                 r = run(cache, os.path.join(tmp, f"{state}_{repeat}"))
                 stages = r["report"]["timings"]
                 rows.append(dict(run=state, repeat=repeat, wall=r["wall"], peak_memory_mb=r["peak_memory_mb"],
-                                 cached_files=r["cached_files"],
+                                 cached_files=r["cached_files"], solve=stages["solve"],
+                                 strength=stages["strength check"],
+                                 strength_over_solve=stages["strength check"] / stages["solve"],
+                                 strength_cell=r["report"]["results"]["strength"]["cell"].get("source", "computed"),
                                  stages="; ".join(f"{k} {v:.2f}" for k, v in stages.items())))
                 print(f"{state} #{repeat}: {r['wall']:.2f} s, {r['cached_files']} cached files", flush=True)
     for r in rows:
         warm = [w["wall"] for w in rows if w["run"] == "warm" and w["repeat"] == r["repeat"]][0]
         r["over_warm"] = r["wall"] / warm
-    keys = ["run", "repeat", "wall", "over_warm", "peak_memory_mb", "cached_files", "stages"]
+    keys = ["run", "repeat", "wall", "over_warm", "solve", "strength", "strength_over_solve", "strength_cell",
+            "peak_memory_mb", "cached_files", "stages"]
     path = os.path.join(args.out, "main_job_first_run.csv")
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
@@ -77,7 +84,11 @@ def main() -> None:
                               note="`ngcontact run geometries/femur_stem.toml` with an empty cell-law cache "
                                    "(`cold`) and again with what that run cached (`warm`), each repeat in a new "
                                    "cache directory. `wall` in seconds; `over_warm`: the run's time over the warm "
-                                   "run of its repeat (aim: the cold run within 2x).")
+                                   "run of its repeat (aim: the cold run within 2x); `solve` and `strength`: the "
+                                   "report's stages of the macro solve and of the strength check (both of its "
+                                   "parts: the cell's correctors and the check), `strength_over_solve` their "
+                                   "ratio (aim: <= 1); `strength_cell`: where the strength cell's correctors "
+                                   "came from (`shipped` with the package, `cached`, `computed`).")
 
 
 if __name__ == "__main__":

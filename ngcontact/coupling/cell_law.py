@@ -22,7 +22,8 @@ The arrays are cached in ``cache_dir`` (default ``$NGCONTACT_CACHE`` or
 ``~/.cache/ngcontact``) under a key that names the cell; the driver
 (:func:`ngcontact.drivers.build.law_from_cell`) takes the SHA-256 of the
 validated cell scene and of the files it names, so an edited cell scene is
-recomputed.  Each entry ``<key>.npz`` also holds its own description: the
+recomputed.  Each entry ``<key>.npz`` (compressed; float arrays, and byte arrays
+kept as bytes) also holds its own description: the
 cache format, the package version that wrote it, the key and the SHA-256 of
 the three arrays.  An entry that cannot be read, was written by another
 version or format, names another key, fails its checksum or holds arrays of
@@ -83,12 +84,18 @@ def _bundle_shapes(arrays: dict) -> str | None:
     return None
 
 
+def _stored(a) -> np.ndarray:
+    """An entry's array as it is kept: bytes (``uint8``, e.g. a mesh file) as they are, anything else as floats."""
+    a = np.asarray(a)
+    return np.array(a) if a.dtype == np.uint8 else np.array(a, dtype=float)
+
+
 def _read_entry(path: str, key: str, names=ARRAYS, fmt: str = CACHE_VERSION,
                 shapes: Callable[[dict], str | None] = _bundle_shapes) -> dict:
     """The arrays of a cache entry; raises ``ValueError`` naming what is wrong with it."""
     try:
         with np.load(path, allow_pickle=False) as data:
-            arrays = {k: np.array(data[k], dtype=float) for k in names}
+            arrays = {k: _stored(data[k]) for k in names}
             meta = json.loads(str(data["meta"]))
     except OSError as exc:
         raise ValueError(f"unreadable ({exc.strerror or type(exc).__name__})") from None
@@ -167,14 +174,14 @@ def write_cached(key: str, arrays: dict, names=ARRAYS, fmt: str = CACHE_VERSION,
                     skipped, _kind(skipped), os.path.basename(path))
     # Any values: np.savez's stub would otherwise match the arrays against
     # its keyword-only allow_pickle: bool
-    data: dict[str, Any] = {k: np.asarray(arrays[k], float) for k in names}
+    data: dict[str, Any] = {k: _stored(arrays[k]) for k in names}
     meta = {"format": fmt, "version": _package_version(), "key": key, "sha256": _digest(data, names)}
     tmp = None
     try:
         os.makedirs(cache_dir, exist_ok=True)
         fd, tmp = tempfile.mkstemp(suffix=".npz", dir=cache_dir)
         os.close(fd)
-        np.savez(tmp, meta=np.array(json.dumps(meta)), **data)
+        np.savez_compressed(tmp, meta=np.array(json.dumps(meta)), **data)
         os.replace(tmp, path)
         log.info("cell data computed and cached in %s", path)
     except OSError as exc:

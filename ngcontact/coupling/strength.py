@@ -150,7 +150,8 @@ class Correctors:
 
 def linear_correctors(problem: CellProblem, *, contact_set: ng.CoefficientFunction | None = None,
                       tangential_stiffness: float = 0.0) -> Correctors:
-    """Unit-load correctors of the cell with a fixed contact set (module docstring).
+    """Unit-load correctors of the cell with a fixed contact set (module docstring): the states of
+    :func:`corrector_states` sampled by :func:`sampled_correctors`.
 
     Parameters
     ----------
@@ -167,57 +168,98 @@ def linear_correctors(problem: CellProblem, *, contact_set: ng.CoefficientFuncti
 
     Raises
     ------
-    ValueError
+    ModelError
         The cell problem lacks the macro strain term.
     """
+    states = corrector_states(problem, contact_set=contact_set, tangential_stiffness=tangential_stiffness)
+    return sampled_correctors(problem, states, tangential_stiffness=tangential_stiffness)
+
+
+def _carries_shear(problem: CellProblem, tangential_stiffness: float) -> bool:
+    """Whether the fixed-set cell carries a mean shear: a stick stiffness ``k_t > 0`` or a free tangential jump
+    (else a unit shear gets a zero corrector)."""
+    return tangential_stiffness > 0 or problem.tangential_free
+
+
+def corrector_states(problem: CellProblem, *, contact_set: ng.CoefficientFunction | None = None,
+                     tangential_stiffness: float = 0.0) -> np.ndarray:
+    """``(K + 1, ndof)``: the displacement of the fixed-set cell (:func:`linear_correctors`) at the zero load
+    (the gap alone), then at each unit load ``e_k`` (:func:`load_names`), whole states, not differences; a
+    unit shear the cell does not carry (:func:`_carries_shear`) repeats the zero load's row.  One
+    factorization serves every row."""
     m = problem.model
     if not m.macro_strain:
         raise ModelError("linear correctors need a cell problem built with macro_strain = True")
     X, d = problem.X, problem.dim
     form = _fixed_set_form(problem, contact_set, tangential_stiffness)
     free = ng.BitArray(X.FreeDofs())
-    shear_free = tangential_stiffness > 0 or problem.tangential_free
-    if not shear_free:
+    carried = _carries_shear(problem, tangential_stiffness)
+    if not carried:
         for i in range(d - 1):
             free.Clear(problem.u_dofs[i])
-    names = load_names(d)
+    K = len(load_names(d))
     zero = problem.gfu.vec.CreateVector()
     zero[:] = 0.0
-    apply_load_vector(problem, np.zeros(len(names)))
+    apply_load_vector(problem, np.zeros(K))
     form.AssembleLinearization(zero)
     inv = form.mat.Inverse(free, inverse=problem.inverse)
     res = zero.CreateVector()
-
-    vectors: list[ng.BaseVector] = []
-
-    def state(l: np.ndarray) -> BodySamples:
-        apply_load_vector(problem, l)
+    rows = np.zeros((K + 1, len(zero)))
+    for k in range(-1, K):
+        if not carried and 0 <= k < d - 1:
+            rows[k + 1] = rows[0]
+            continue
+        apply_load_vector(problem, np.eye(K)[k] if k >= 0 else np.zeros(K))
         form.Apply(zero, res)
         problem.gfu.vec.data = -(inv * res)
-        v = zero.CreateVector()
-        v.data = problem.gfu.vec
-        vectors.append(v)
+        rows[k + 1] = problem.gfu.vec.FV().NumPy()
+    apply_load_vector(problem, np.zeros(K))
+    log.info("linear correctors: %d unit loads, one factorization", K)
+    return rows
+
+
+def sampled_correctors(problem: CellProblem, states: np.ndarray, *, tangential_stiffness: float = 0.0
+                       ) -> Correctors:
+    """The :class:`Correctors` of the rows of :func:`corrector_states` on ``problem``: the stresses at the
+    element points (:func:`sample_stresses`) of the zero load and the differences the unit loads add (eq. 75),
+    zero for a shear the cell does not carry.  The state of ``problem`` is overwritten.
+
+    Raises
+    ------
+    ValueError
+        ``states`` is not ``(K + 1, ndof)`` for this problem.
+    """
+    d, K = problem.dim, len(load_names(problem.dim))
+    states = np.asarray(states, float)
+    if states.shape != (K + 1, problem.ndof):
+        raise ValueError(f"corrector states of shape {states.shape}, the cell needs {(K + 1, problem.ndof)}")
+    carried = _carries_shear(problem, tangential_stiffness)
+
+    def vector(row: np.ndarray) -> ng.BaseVector:
+        v = problem.gfu.vec.CreateVector()
+        v.FV().NumPy()[:] = row
+        return v
+
+    def sampled(l: np.ndarray, row: np.ndarray) -> BodySamples:
+        apply_load_vector(problem, l)
+        problem.gfu.vec.FV().NumPy()[:] = row
         return sample_stresses(problem)
 
-    base = state(np.zeros(len(names)))
+    base = sampled(np.zeros(K), states[0])
+    vectors = [vector(states[0])]
     unit: dict[str, list[np.ndarray]] = {b: [] for b in BODIES}
-    for k in range(len(names)):
-        if not shear_free and k < d - 1:
+    for k in range(K):
+        if not carried and k < d - 1:
             for b in BODIES:  # a free tangential jump carries no shear: zero corrector
                 unit[b].append(np.zeros_like(base[b]["stress"]))
-            v = zero.CreateVector()
-            v[:] = 0.0
-            vectors.append(v)
+            vectors.append(vector(np.zeros(problem.ndof)))
             continue
-        e = np.zeros(len(names))
-        e[k] = 1.0
-        s = state(e)
-        vectors[-1].data -= vectors[0]
+        s = sampled(np.eye(K)[k], states[k + 1])
+        vectors.append(vector(states[k + 1] - states[0]))
         for b in BODIES:
             unit[b].append(s[b]["stress"] - base[b]["stress"])
-    apply_load_vector(problem, np.zeros(len(names)))
-    log.info("linear correctors: %d unit loads, one factorization", len(names))
-    return Correctors(names=names, points={b: base[b]["points"] for b in BODIES},
+    apply_load_vector(problem, np.zeros(K))
+    return Correctors(names=load_names(d), points={b: base[b]["points"] for b in BODIES},
                       base={b: base[b]["stress"] for b in BODIES},
                       unit={b: np.array(unit[b]) for b in BODIES}, states=vectors)
 

@@ -317,11 +317,17 @@ CELL_METHODS: dict[str, Callable[[CellScene], CellSolver]] = {"fe": fe_cell, "sp
 
 def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = None,
                     method: str | None = None, discretization: dict | None = None) -> tuple[CellScene, CellProblem]:
+    """:func:`recovery_cell_scene` and its meshed FE :class:`CellProblem` with the macro strain term."""
+    cs = recovery_cell_scene(cell_path, key=key, overrides=overrides, method=method, discretization=discretization)
+    return cs, cell_problem(cs, model=replace(model_of(cs), macro_strain=True))
+
+
+def recovery_cell_scene(cell_path: str, *, key: str, overrides: dict | None = None, method: str | None = None,
+                        discretization: dict | None = None) -> CellScene:
     """Cell scene (with ``[contact]`` overrides, ``method = "fe"`` for a spectral scene; a cell whose
-    ``method = "auto"`` chose the spectral cell is solved by fe) -> the FE
-    :class:`CellProblem` with the macro strain term, for what only the FE cell gives: the micro stresses of
-    the strength recovery (paper eqs. 74-78) and the shear response, over the cell's period
-    (:data:`RECOVERY_PERIOD`); the scene's ``[solver]`` settings and its first loads' start (:func:`cell_problem`)."""
+    ``method = "auto"`` chose the spectral cell is solved by fe) of the FE cell for what only it gives: the
+    micro stresses of the strength recovery (paper eqs. 74-78) and the shear response, over the cell's period
+    (:data:`RECOVERY_PERIOD`); its problem has the scene's ``[solver]`` settings (:func:`cell_problem`)."""
     cs = cell_scene_of(cell_path, key=key, overrides=overrides, method=method, discretization=discretization)
     choice = cs.method_choice
     if method is None and choice is not None and choice.automatic and choice.method != "fe":
@@ -334,8 +340,7 @@ def recovery_cell_problem(cell_path: str, *, key: str, overrides: dict | None = 
         raise SceneError(key, cell_path, f"the cell scene is solved by discretization.method = "
                          f"{cs.discretization.method!r}; the strength recovery needs the body stresses and the macro "
                          "strain term of the FE cell: use a cell scene with method = 'fe'")
-    cs = scene_with(cs, symmetry_choice=SymmetryChoice(False, RECOVERY_PERIOD, cs.discretization.symmetry))
-    return cs, cell_problem(cs, model=replace(model_of(cs), macro_strain=True))
+    return scene_with(cs, symmetry_choice=SymmetryChoice(False, RECOVERY_PERIOD, cs.discretization.symmetry))
 
 
 #: why the recovery's cell is its period whatever ``discretization.symmetry``: the quarter's mirror faces (zero
@@ -388,9 +393,8 @@ def spectral_cell(scene: CellScene, grid: int | None = None, friction: bool = Tr
     assert c.k_n is not None  # set by CellScene.check (exact contact: its default scale)
     return SpectralCell(dim=g.dim, period=g.period, grid=grid, rough=layer(scene.bodies.rough, g.h_rough),
                         counter=layer(scene.bodies.counter, g.h_counter), gap=gap_samples(scene, grid, heights),
-                        k_n=c.k_n,
-                        enforcement=c.enforcement, tol=s.rtol if tol is None else tol, max_iter=s.cg_max_iter,
-                        friction=micro_friction(c) if friction else None)
+                        k_n=c.k_n, enforcement=c.enforcement, tol=s.rtol if tol is None else tol,
+                        max_iter=s.cg_max_iter, friction=micro_friction(c) if friction else None)
 
 
 #: grid points of the spectral predictor's twin per interface element size (at least), and its bounds
@@ -426,11 +430,8 @@ def predictor_twin(scene: CellScene, interface_maxh: float | None = None) -> Spe
 
 
 def micro_friction(contact) -> FrictionLaw | None:
-    """The micro friction of a cell scene's ``[contact]`` section (``None`` without friction).
-
-    The law's class from :data:`ngcontact.laws.friction.FRICTION_LAWS` by the scene's name, built from
-    the section's values of its ``parameters``.
-    """
+    """The micro friction of a cell scene's ``[contact]`` section (``None`` without friction): the law of
+    :data:`ngcontact.laws.friction.FRICTION_LAWS` of its name, built from the section's ``parameters``."""
     if contact.friction == "none":
         return None
     law = FRICTION_LAWS[contact.friction]

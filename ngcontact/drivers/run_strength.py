@@ -10,7 +10,8 @@ the caller's :class:`~ngcontact.output.report.Outcome`.  See
 ``safety_factor``, ``macro_point`` (index into the interface samples: the
 profile in 2D and axisymmetry, with its ``s`` [m], the surface in 3D;
 coordinates [m]) and ``cell_point`` (cell coordinates, cell units),
-``cell`` (scene path, ``ndof``, contact fraction of the fixed contact set),
+``cell`` (scene path, ``ndof``, the fixed contact set, ``source``: where its correctors came from,
+``shipped`` with the package, ``cached`` or ``computed``, :mod:`ngcontact.drivers.strength_cell`),
 ``tangential_stiffness`` and, with nonlinear recovery, the linear and
 nonlinear maxima at the re-solved points.  The table
 ``strength_map`` has one row per interface sample with its macro state (2D:
@@ -25,18 +26,19 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypedDict
 
-import ngsolve as ng
 import numpy as np
 
 from ngcontact.coupling import strength as S
 from ngcontact.coupling.interface_state import cell_loads, interface_states
-from ngcontact.drivers.build import recovery_cell_problem
+from ngcontact.drivers.build import recovery_cell_scene
+from ngcontact.drivers.strength_cell import fixed_set_correctors
 from ngcontact.errors import ModelError, SceneError
 from ngcontact.macro.away_maxima import AWAY
 from ngcontact.macro.discretization_error import Sample
 from ngcontact.macro.macro_problem import MacroSolution
 from ngcontact.output import plots as figures
 from ngcontact.output.report import VtkField
+from ngcontact.scene.cell_scene import CellScene
 from ngcontact.scene.macro_scene import MacroScene
 from ngcontact.scene.sections import resolve
 
@@ -63,22 +65,30 @@ class Recovery:
     tangential_stiffness: float
     fixed_set: bool             # the contact set is S_C without gap (else all of S_C)
     correctors: S.Correctors
+    source: str = "computed"    # where its corrector states came from (drivers.strength_cell)
 
 
-def recovery_of(scene: MacroScene, law) -> Recovery:
-    """The cell of ``scene.strength`` and its correctors for the macro interface law ``law``."""
+def strength_cell(scene: MacroScene, law) -> tuple[str, CellScene, float]:
+    """The cell of ``scene.strength`` for the macro interface law ``law``: its path, its scene
+    (:func:`ngcontact.drivers.build.recovery_cell_scene`) and the stick stiffness ``k_t`` of its fixed set."""
     spec = scene.strength
     # set: the caller (drivers.run_macro) evaluates only scenes with a [strength] section
     assert spec is not None
     path = resolve(scene, spec.cell)
-    cs, P = recovery_cell_problem(path, key="strength.cell")
+    cs = recovery_cell_scene(path, key="strength.cell")
     kt = spec.tangential_stiffness
     if kt is None:
         assert cs.contact.k_n is not None  # set by CellScene.check (exact contact: its default scale)
         kt = cs.contact.k_n if law.friction is not None else 0.0
-    chi = None if P.gap is None else ng.IfPos(P.gap - 1e-14 * max(P.largest_gap(), 1e-300), 0.0, 1.0)
-    corr = S.linear_correctors(P, contact_set=chi, tangential_stiffness=kt)
-    return Recovery(path, P, float(kt), chi is not None, corr)
+    return path, cs, float(kt)
+
+
+def recovery_of(scene: MacroScene, law) -> Recovery:
+    """The cell of ``scene.strength`` and its correctors for the macro interface law ``law`` (shipped with
+    the package, cached or computed: :mod:`ngcontact.drivers.strength_cell`)."""
+    path, cs, kt = strength_cell(scene, law)
+    P, corr, source = fixed_set_correctors(cs, kt)
+    return Recovery(path, P, kt, P.gap is not None, corr, source)
 
 
 def _cell_loads(scene: MacroScene, sol: MacroSolution, rec: Recovery, warn: bool = True):
@@ -174,7 +184,8 @@ def evaluate(scene: MacroScene, sol: MacroSolution, rec: Recovery | None = None)
     res.update({"recovery": spec.recovery, "tangential_stiffness": float(kt), "load_names": list(corr.names),
                 "worst_cell_load": worst_load.tolist(),
                 "cell": {"scene": path, "ndof": int(P.ndof), "dim": P.dim,
-                         "fixed_contact_set": "S_C without gap" if rec.fixed_set else "all of S_C"}})
+                         "fixed_contact_set": "S_C without gap" if rec.fixed_set else "all of S_C",
+                         "source": rec.source}})
     res.update(extra)
     table, plots = _table_and_plots(res, smap, states, names, along, worst_stress, spec.criterion, P.dim)
     return {"results": res, "table": table, "vtk": vtk, "plots": plots, "recovery": rec}
