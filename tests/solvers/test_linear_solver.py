@@ -231,6 +231,34 @@ def test_a_direct_solve_of_the_same_matrix_and_free_dofs_refreshes_its_factoriza
     assert solver.prepare(form, other, symmetric=symmetric).inverse is not first
 
 
+def test_a_direct_solve_of_a_matrix_with_the_values_of_its_factorization_keeps_it():
+    """The same matrix assembled again with the same values (an augmented tangent whose contact set stayed)
+    is not refactorized but counted as kept; once its values change it is refreshed; every solve is that of
+    the matrix as it is."""
+    from netgen.geom2d import unit_square
+    mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.2))
+    V = ng.H1(mesh, order=2, dirichlet="bottom")
+    u, v = V.TnT()
+    c = ng.Parameter(1.0)
+    form = ng.BilinearForm(V, symmetric=True)
+    form += (ng.grad(u) * ng.grad(v) + c * u * v) * ng.dx
+    solver = LinearSolver("direct")
+    x = ng.GridFunction(V).vec
+    free = np.array([V.FreeDofs()[i] for i in range(V.ndof)])
+    x.FV().NumPy()[:] = np.where(free, np.random.default_rng(3).normal(size=V.ndof), 0.0)
+    rhs, y = x.CreateVector(), x.CreateVector()
+    kept = []
+    for value in (1.0, 1.0, 1.0, 7.0, 7.0):
+        c.Set(value)
+        form.Assemble()
+        inv = solver.prepare(form, V.FreeDofs()).inverse
+        kept.append(solver.kept)
+        rhs.data = form.mat * x
+        y.data = inv * rhs
+        assert np.max(np.abs(y.FV().NumPy() - x.FV().NumPy())) < 1e-11
+    assert kept == [0, 1, 2, 2, 3] and solver.summary()["factorizations_kept"] == 3
+
+
 def test_a_3d_cell_s_coarse_problem_holds_the_vertices_and_its_tangent_not_the_bubble_term():
     """A 3D cell's BDDC is built from its preconditioning form (the tangent plus the bubble term on S_C), so
     the contact surface's edge dofs stay interface dofs; the tangent CG multiplies by is the energy's own
