@@ -67,7 +67,7 @@ def test_a_3d_cell_solved_iteratively_equals_the_direct_solve():
 @pytest.mark.parametrize("enforcement", ["penalty", "exact"])
 def test_the_effective_stiffness_by_cg_equals_the_factorized_one_and_the_next_load_still_solves(enforcement):
     """A large 3D cell's effective stiffness is measured without factorizing its matrix (CG with BDDC on the
-    free dofs without the far-face translations, the three augmentations of exact contact included): the
+    free dofs without the far-face translations, exact contact's rigid limit included): the
     direct numbers to 1e-9, and the next load's Newton solve, whose kept BDDC that assembly replaced,
     converges as the direct one does."""
     from dataclasses import replace
