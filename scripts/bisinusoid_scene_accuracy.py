@@ -38,7 +38,11 @@ from bisinusoid_accuracy import ACC_H, bisinusoid_spectral  # noqa: E402
 
 RATIOS = (0.005, 0.02, 0.05)
 KEYS = ("pressure", "symmetry", "levels", "ndof", "contact_fraction", "last_level", "converged", "relative_error",
-        "estimate", "effectivity", "met", "seconds", "cpu_seconds", "note")
+        "estimate", "effectivity", "effectivity_closure", "effectivity_stiffness", "effectivity_k_n",
+        "effectivity_g_n", "met", "seconds", "cpu_seconds", "note")
+#: the other estimated quantities whose effectivity is shown (column ``effectivity_<short name>``)
+OTHERS = {"mean_closure": "closure", "normal_stiffness": "stiffness", "coefficient_k_n": "k_n",
+          "coefficient_g_n": "g_n"}
 
 SCENE = """kind = "cell"
 title = "Bisinusoid, exact contact, p/p* = {ratio:g}"
@@ -65,12 +69,16 @@ tolerance = 0.01
 {symmetry}"""
 
 
-def converged(ratio: float) -> float:
-    """The spectral cell's contact fraction at ``p/p* = ratio`` extrapolated from 512^2 and 1024^2."""
+def converged(ratio: float) -> dict[str, float]:
+    """The spectral cell's headline quantities at ``p/p* = ratio`` extrapolated from 512^2 and 1024^2 (its
+    contact fraction, closure, normal stiffness and eq. 34 coefficients converge at first order in the grid
+    step); its ``k_n`` is 1, and the coefficients ``k_n``, ``g_n`` of exact contact are proportional to it
+    (the contact set does not depend on it): :func:`finish` scales them by the scene's."""
     from ngcontact.cell.cell_load import cell_load
+    from ngcontact.cell.cell_solution import headline
     load = cell_load(3, pressure=ratio * math.pi * ACC_H)
-    coarse, fine = (bisinusoid_spectral(n).solve(load).results["contact_fraction"] for n in (512, 1024))
-    return 2.0 * fine - coarse
+    coarse, fine = (headline(bisinusoid_spectral(n).solve(load).results) for n in (512, 1024))
+    return {name: 2.0 * fine[name] - coarse[name] for name in fine if name in coarse}
 
 
 def start(out: str, ratio: float, symmetry: str) -> tuple[subprocess.Popen, float]:
@@ -84,9 +92,12 @@ def start(out: str, ratio: float, symmetry: str) -> tuple[subprocess.Popen, floa
         return subprocess.Popen(run, stderr=err), time.perf_counter()
 
 
-def finish(out: str, ratio: float, symmetry: str, started: tuple[subprocess.Popen, float], reference: float) -> dict:
+def finish(out: str, ratio: float, symmetry: str, started: tuple[subprocess.Popen, float],
+           converged: dict[str, float]) -> dict:
     """Wait for the run at ``p/p* = ratio`` and its row: the report's contact fraction and estimate against
-    ``reference``, the run's wall and CPU seconds."""
+    the ``converged`` one, the effectivities of the other estimated quantities (:data:`OTHERS`), the run's
+    wall and CPU seconds."""
+    reference = converged["contact_fraction"]
     proc, t0 = started
     _, status, usage = os.wait4(proc.pid, 0)
     seconds = time.perf_counter() - t0
@@ -100,8 +111,16 @@ def finish(out: str, ratio: float, symmetry: str, started: tuple[subprocess.Pope
     if proc.returncode != 0:
         raise RuntimeError(f"the scene at p/p* = {ratio:g} ended with exit {proc.returncode}")
     with open(os.path.join(out, f"p{ratio:g}", "report.json")) as fh:
-        results = json.load(fh)["results"]
+        report = json.load(fh)
+    results, k_n = report["results"], float(report["scene"]["contact"]["k_n"])
     load = results["loads"][0]
+    errors = {q["name"]: q["error"] for q in results["accuracy"]["quantities"] if q.get("load", 0) == 0}
+    others = {}
+    for name, short in OTHERS.items():
+        q = next((q for q in results["accuracy"]["quantities"] if q["name"] == name), None)
+        exact = converged.get(name, math.nan) * (k_n if name.startswith("coefficient_") else 1.0)
+        if q is not None and math.isfinite(exact) and q["value"] != exact:
+            others[f"effectivity_{short}"] = errors[name] / abs(q["value"] - exact)
     f = float(load["contact_fraction"])
     estimate = float(load["error_estimate"]["contact_fraction"])
     levels = load.get("discretizations", [])
@@ -109,7 +128,8 @@ def finish(out: str, ratio: float, symmetry: str, started: tuple[subprocess.Pope
             "ndof": levels[-1]["ndof"] if levels else "", "contact_fraction": f,
             "last_level": load.get("contact_fraction_last_level", f), "converged": reference,
             "relative_error": f / reference - 1.0, "estimate": estimate / f,
-            "effectivity": estimate / abs(f - reference), "met": results["accuracy"]["met"], "seconds": seconds,
+            "effectivity": estimate / abs(f - reference), **others, "met": results["accuracy"]["met"],
+            "seconds": seconds,
             "cpu_seconds": cpu, "note": ""}
 
 
@@ -171,9 +191,13 @@ def main(argv=None) -> int:
             "1024^2); `effectivity` = estimate / |error| (issue 35: within [1, 10]); `met`: the report's verdict "
             "(`exit 3`: the tolerance out of reach, no report, `note` its message) on the scene's tolerance "
             "(absolute 0.01 on the contact fraction, relative on the closure, the "
-            "stiffness and the coefficients). `seconds`: wall time of the run, `cpu_seconds`: its process's CPU "
-            "time (issue 38 aims at 60 s per load); measured under the load of other jobs sharing the 2 cores, "
-            "so the wall times are inflated, the CPU times less so.", png=png)
+            "stiffness and the coefficients). `effectivity_closure`, `_stiffness`, `_k_n`, `_g_n`: the report's "
+            "estimate of the mean closure, the normal effective stiffness and the coefficients k_n, g_n of eq. 34 "
+            "on the real contact set over their true error against the spectral cell's values extrapolated alike "
+            "(the coefficients scaled to the scene's k_n). `seconds`: wall time of the run, `cpu_seconds`: its "
+            "process's CPU time (issue 38 aims at 60 s per load), with the threads of the environment "
+            f"(NGCONTACT_THREADS = {os.environ.get('NGCONTACT_THREADS', 'not set')}); measured under the load of "
+            "other jobs sharing the 2 cores, so the wall times are inflated, the CPU times less so.", png=png)
     return 0
 
 

@@ -15,7 +15,15 @@ definite on the free dofs.  Two ways:
   is assembled in place), so while the free dofs stay the same the
   factorization is only refreshed (``Update``: the fill-reducing ordering
   and symbolic analysis are kept), cheaper than a fresh one and with the
-  same solution to round-off.
+  same solution to round-off;
+  where the matrix holds the very values it was factorized with, the
+  factorization is kept as it is.  The augmented Lagrangian's tangent of exact
+  contact (:mod:`ngcontact.cell.fe.contact_multiplier`) is the bodies'
+  stiffness plus ``k n n^T`` at the points whose augmented pressure is
+  positive: the same matrix, to the bit, for as long as that set and ``k``
+  stay, which is most of Uzawa's passes and their Newton steps once the
+  contact set has settled (on the 3D bisinusoid cell most refreshes of a
+  level were of an unchanged matrix).
 * ``"iterative"``: conjugate gradients preconditioned by NGSolve's BDDC
   (balancing domain decomposition by constraints, one subdomain per element)
   with a vertex-only wirebasket: the body spaces mark their edge dofs as
@@ -80,6 +88,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.errors import ConvergenceError
+from ngcontact.solvers.roundoff import local_matrix
 
 POLICIES = ("direct", "iterative", "auto")
 #: LU solvers NGSolve offers for a non-symmetric tangent; any other ``inverse`` (Cholesky) gives way to UMFPACK
@@ -126,6 +135,8 @@ class LinearSolver:
     #: iterative solves with the BDDC of an earlier step, and rebuilds forced by CG's growth
     reuses: int = 0
     rebuilds: int = 0
+    #: direct solves whose matrix held the values of its last factorization (kept, not refreshed)
+    kept: int = 0
 
     def __post_init__(self):
         if self.policy not in POLICIES:
@@ -226,16 +237,22 @@ class LinearSolver:
         return record
 
     def _factorization(self, form: ng.BilinearForm, freedofs, inverse: str):
-        """The factorization of ``form.mat`` on ``freedofs``: refreshed in place (``Update``) when the same
-        matrix (hence sparsity) and free dofs were factorized before by ``inverse``, else a fresh one."""
+        """The factorization of ``form.mat`` on ``freedofs``: kept as it is when the same matrix holds the
+        same values on the same free dofs as at its factorization (module docstring), refreshed in place
+        (``Update``) when only its values changed, else a fresh one."""
         mat, free = form.mat, freedofs.__getstate__()
         key = (id(form), inverse)
         held = self._factors.get(key)
+        values = local_matrix(mat).AsVector().FV().NumPy()
         if held is not None and held[0] is mat and held[1] == free and inverse in UPDATABLE:
-            held[2].Update()
+            if np.array_equal(held[3], values):
+                self.kept += 1
+            else:
+                held[2].Update()
+                held[3][:] = values
             return held[2]
         inv = mat.Inverse(freedofs, inverse=inverse)
-        self._factors[key] = (mat, free, inv)
+        self._factors[key] = (mat, free, inv, values.copy())
         return inv
 
     def summary(self) -> dict:
@@ -244,6 +261,8 @@ class LinearSolver:
         if self.policy == "auto":
             out["threshold"] = self.threshold
         out["method"] = ", ".join(sorted(self.methods)) or f"direct ({self.inverse})"
+        if self.kept:
+            out["factorizations_kept"] = self.kept
         if self.iterations:
             out.update(cg_iterations=list(self.iterations), cg_rtol=self.rtol,
                        krylov_tolerances=list(self.tolerances), inexact_newton=self.forcing,

@@ -193,6 +193,12 @@ class SplitEnergy:
         self._sum_parts()
         self.assembled_whole = False
 
+    def interface_product(self, vec, x, out) -> None:
+        """``out = Psi''(vec) x``: the interface's tangent alone, assembled at ``vec`` (the tangent of the next
+        :meth:`AssembleLinearization` assembles it again, at its own state)."""
+        self._psi.AssembleLinearization(vec)
+        out.data = self._psi.mat * x
+
     def _sum_parts(self) -> None:
         """``whole.mat = K + Psi''`` from ``K`` and the interface's last assembly."""
         vals = local_matrix(self.mat).AsVector().FV().NumPy()

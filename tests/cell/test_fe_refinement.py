@@ -175,6 +175,25 @@ def test_the_contact_edge_ladder_takes_its_spectral_twins_floor_where_larger():
     assert "load 0 contact_fraction: " not in done.how.replace("load 0 contact_fraction: extrapolated", "")
 
 
+def test_the_twin_floors_the_normal_coefficients_of_eq_34_too():
+    """The floor ``|q_h - q_N| + 2 |q_N - q_N/2|`` of each floored quantity, the coefficients ``k_n`` and
+    ``g_n`` on the real contact set among them; a quantity the twin does not answer gets none."""
+    from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
+
+    def twin_heads(grid):
+        fine = grid == 256
+        return [{"contact_fraction": 0.5, "coefficient_k_n": 12.0 if fine else 12.5,
+                 "coefficient_g_n": 0.030 if fine else 0.031}]
+
+    ladder = ContactEdgeRefinement(_Level(1000, 0.6), lambda grid: [], lambda points, h: _Level(1000, 0.5),
+                                   interface_maxh=0.1, period=1.0, twin_heads=twin_heads)
+    floors = ladder.twin_floors([{"contact_fraction": 0.51, "coefficient_k_n": 12.2, "coefficient_g_n": 0.0302,
+                                  "mean_closure": 1.0}], 1)[0]
+    assert floors["coefficient_k_n"][0] == pytest.approx(0.2 + 2 * 0.5, rel=1e-12)
+    assert floors["coefficient_g_n"][0] == pytest.approx(0.0002 + 2 * 0.001, rel=1e-9)
+    assert floors["contact_fraction"][0] == pytest.approx(0.01, rel=1e-9) and "mean_closure" not in floors
+
+
 def test_the_contact_edge_ladder_is_not_taken_as_converged_before_its_extrapolation():
     """Levels whose contact fraction and closure do not change meet any tolerance by their geometric tail
     after three levels; the contact edge's ladder still solves a third refined level (four in all), the

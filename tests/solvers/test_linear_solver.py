@@ -67,7 +67,7 @@ def test_a_3d_cell_solved_iteratively_equals_the_direct_solve():
 @pytest.mark.parametrize("enforcement", ["penalty", "exact"])
 def test_the_effective_stiffness_by_cg_equals_the_factorized_one_and_the_next_load_still_solves(enforcement):
     """A large 3D cell's effective stiffness is measured without factorizing its matrix (CG with BDDC on the
-    free dofs without the far-face translations, the three augmentations of exact contact included): the
+    free dofs without the far-face translations, exact contact's rigid limit included): the
     direct numbers to 1e-9, and the next load's Newton solve, whose kept BDDC that assembly replaced,
     converges as the direct one does."""
     from dataclasses import replace
@@ -229,6 +229,34 @@ def test_a_direct_solve_of_the_same_matrix_and_free_dofs_refreshes_its_factoriza
     other = ng.BitArray(V.FreeDofs())
     other.Clear(int(np.flatnonzero(free)[0]))
     assert solver.prepare(form, other, symmetric=symmetric).inverse is not first
+
+
+def test_a_direct_solve_of_a_matrix_with_the_values_of_its_factorization_keeps_it():
+    """The same matrix assembled again with the same values (an augmented tangent whose contact set stayed)
+    is not refactorized but counted as kept; once its values change it is refreshed; every solve is that of
+    the matrix as it is."""
+    from netgen.geom2d import unit_square
+    mesh = ng.Mesh(unit_square.GenerateMesh(maxh=0.2))
+    V = ng.H1(mesh, order=2, dirichlet="bottom")
+    u, v = V.TnT()
+    c = ng.Parameter(1.0)
+    form = ng.BilinearForm(V, symmetric=True)
+    form += (ng.grad(u) * ng.grad(v) + c * u * v) * ng.dx
+    solver = LinearSolver("direct")
+    x = ng.GridFunction(V).vec
+    free = np.array([V.FreeDofs()[i] for i in range(V.ndof)])
+    x.FV().NumPy()[:] = np.where(free, np.random.default_rng(3).normal(size=V.ndof), 0.0)
+    rhs, y = x.CreateVector(), x.CreateVector()
+    kept = []
+    for value in (1.0, 1.0, 1.0, 7.0, 7.0):
+        c.Set(value)
+        form.Assemble()
+        inv = solver.prepare(form, V.FreeDofs()).inverse
+        kept.append(solver.kept)
+        rhs.data = form.mat * x
+        y.data = inv * rhs
+        assert np.max(np.abs(y.FV().NumPy() - x.FV().NumPy())) < 1e-11
+    assert kept == [0, 1, 2, 2, 3] and solver.summary()["factorizations_kept"] == 3
 
 
 def test_a_3d_cell_s_coarse_problem_holds_the_vertices_and_its_tangent_not_the_bubble_term():

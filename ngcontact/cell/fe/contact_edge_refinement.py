@@ -55,8 +55,9 @@ the second since the spectral cell converges at first order in its grid step (a 
 equals the last difference; :data:`TWIN_SAFETY` = 2 covers the stiffness's scatter about that rate,
 :data:`ngcontact.cell.spectral.refinement.ERRATIC`).  ``N`` is the twin's grid of the last level (its
 solutions at the loads place that level's edge), ``N/2`` that of the level before or one coarser solve.
-Each of the contact fraction, the mean closure and the normal stiffness takes the larger of its ladder's
-estimate and this floor (:meth:`ContactEdgeRefinement.twin_floors`).
+Each of the contact fraction, the mean closure, the normal stiffness and the normal coefficients of eq. 34
+on the real contact set, ``k_n`` and ``g_n`` (the twin integrates the same ``k_n`` and gap over its contact
+set), takes the larger of its ladder's estimate and this floor (:meth:`ContactEdgeRefinement.twin_floors`).
 """
 from __future__ import annotations
 
@@ -82,7 +83,7 @@ TWIN_GRIDS = (256, 1024)
 #: the twin's own error over its last difference (module docstring, "The twin's floor")
 TWIN_SAFETY = 2.0
 #: the quantities given the twin's floor
-TWIN_FLOORED = ("contact_fraction", "mean_closure", "normal_stiffness")
+TWIN_FLOORED = ("contact_fraction", "mean_closure", "normal_stiffness", "coefficient_k_n", "coefficient_g_n")
 
 
 def twin_grid(edge_maxh: float, period: float) -> int:
