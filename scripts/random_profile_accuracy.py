@@ -34,7 +34,7 @@ refinement reports with its estimate but does not hold to the tolerance) within 
 tolerance out of reach (the child's exit 3) is a row of its own and makes this script end in exit 3 after
 writing its figures.
 
-    python scripts/random_profile_accuracy.py [OUT] [--seeds 1,2,3] [--publish]
+    python scripts/random_profile_accuracy.py [OUT] [--seeds 1 2 3] [--publish]
 
 Writes ``OUT/random_profile_accuracy.csv`` and ``.png`` (default ``results/random_profile_accuracy``).
 """
@@ -76,31 +76,15 @@ KEYS = ("seed", "run", "load", "pressure", "quantity", "counted", "grid", "value
 
 SCENE = """kind = "cell"
 title = "Random 2D profile (64 samples, seed {seed}), exact contact"
-
-[materials.solid]
-E = {E}
-nu = {NU}
-
-[bodies]
-rough = "solid"
-counter = "solid"
-
-[geometry]
-profile = "flat"
-period = 1.0
-h_rough = 1.0
-h_counter = 1.0
+materials = {{ solid = {{ E = {E}, nu = {NU} }} }}
+bodies = {{ rough = "solid", counter = "solid" }}
+geometry = {{ profile = "flat", period = 1.0, h_rough = 1.0, h_counter = 1.0 }}
+load = {{ pressure = [{pressures}] }}
 
 [contact]
 enforcement = "exact"
+gap = {{ kind = "tabulated", file = "{gap}" }}
 {k_n}
-[contact.gap]
-kind = "tabulated"
-file = "{gap}"
-
-[load]
-pressure = [{pressures}]
-
 {discretization}"""
 
 
@@ -258,23 +242,19 @@ def verdict(rows: list[dict]) -> str:
     return ". ".join(parts) + f". Largest reference change (2^17 to 2^18, in the measure): {bound:.2g}."
 
 
-def seed_list(text: str) -> list[int]:
-    """``--seeds``' comma-separated seeds, refused unless each is a non-negative integer."""
-    try:
-        seeds = [int(s) for s in text.split(",")]
-    except ValueError:
-        seeds = [-1]
-    if min(seeds) < 0:
-        raise argparse.ArgumentTypeError(f"--seeds = {text!r}: comma-separated non-negative integers are allowed, "
-                                         "e.g. 1,2,3")
-    return seeds
+def seed_arg(text: str) -> int:
+    """One of ``--seeds``: a non-negative integer, else refused naming the value."""
+    if not text.isdigit():
+        raise argparse.ArgumentTypeError(f"--seeds {text!r}: non-negative integer seeds are allowed, e.g. 1 2 3")
+    return int(text)
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out", nargs="?", default=os.path.join("results", "random_profile_accuracy"),
                     help="output directory")
-    ap.add_argument("--seeds", type=seed_list, default=list(SEEDS), help="the profiles' seeds (default 1,2,3,4,5)")
+    ap.add_argument("--seeds", type=seed_arg, nargs="+", default=list(SEEDS),
+                    help="the profiles' seeds (default: %(default)s)")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
