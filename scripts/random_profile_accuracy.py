@@ -2,7 +2,8 @@
 
 The cell is posed as a user poses a random profile: the package's generator
 (:func:`ngcontact.geometry.random_surface.self_affine` with ``dim = 2``: 64 samples per period, Hurst 0.8,
-rms slope 0.1, one seed per cell) draws the heights ``h_j``, and the initial gap ``g_j = max h - h_j`` is
+rms slope 0.1, one seed per cell: seeds 1 to 7, none chosen, and 11, whose lightest load holds a contact island
+narrower than four points up to 2048 points) draws the heights ``h_j``, and the initial gap ``g_j = max h - h_j`` is
 written as a CSV table (``x, g``, the first row repeated at ``x = P``) that the scene names as its
 ``[contact.gap]`` (``kind = "tabulated"``) on a flat interface: the small-slope cell, whose surface is the
 table's piecewise-linear interpolant (:func:`ngcontact.drivers.cell_gap.gap_samples`).  Two layers of depth
@@ -60,7 +61,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 E, NU = 1.0, 0.3
 PRESSURES = (0.001, 0.003, 0.01)
 SAMPLES = 64
-SEEDS = (1, 2, 3, 4, 5)
+SEEDS = (1, 2, 3, 4, 5, 6, 7, 11)
 TOLERANCE = 1e-4
 #: the defaults' aim: every headline quantity within this relative error of the converged value
 DEFAULT_AIM = 0.01
