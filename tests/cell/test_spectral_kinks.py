@@ -12,7 +12,7 @@ import pytest
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
-from ngcontact.cell.spectral.contact_edges import KINK, kink_share, kinks, unresolved_share
+from ngcontact.cell.spectral.contact_edges import KINK, LOCATED_STEP, kink_share, kinks, unresolved_share
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral.refinement import sweep_to_tolerance
 from ngcontact.geometry.random_surface import self_affine
@@ -49,20 +49,27 @@ def test_an_edge_within_a_step_of_a_kink_holds_a_step_of_each_quantity_on_the_ed
     gap = np.where(p > 0, 0.0, np.minimum(np.abs(x - 20.5), np.abs(x - 4.5)))
     assert np.flatnonzero(kinks(g0)).tolist() == [0, 20, 63]      # the period's wrap is a kink too
     share = kink_share(cell, p, gap)
-    assert share["edges"] == 1
-    assert share["share"]["contact_fraction"] == pytest.approx(1 / n)
-    assert share["share"]["coefficient_k_n"] == pytest.approx(k_n / n)
-    assert share["share"]["coefficient_g_n"] == pytest.approx(k_n * g0[19:23].max() / n)
+    share_step = LOCATED_STEP                                     # the other edge, at 4.5: a share of a step
+    assert (share["edges"], share["located"]) == (1, 1)
+    assert share["share"]["contact_fraction"] == pytest.approx((1 + share_step) / n)
+    assert share["share"]["coefficient_k_n"] == pytest.approx(k_n * (1 + share_step) / n)
+    assert share["share"]["coefficient_g_n"] == pytest.approx(k_n * (g0[19:23].max() + share_step * g0[3:7].max()) / n)
     far = np.where((x >= 5) & (x <= 15), 1.0, 0.0)                # both edges five steps or more from the kink
-    assert kink_share(cell, far, gap)["share"] == {} and kink_share(cell, np.ones(n), gap)["edges"] == 0
+    away = kink_share(cell, far, gap)
+    assert (away["edges"], away["located"]) == (0, 2) and away["share"]["contact_fraction"] == pytest.approx(2 * share_step / n)
+    assert kink_share(cell, np.ones(n), gap)["edges"] == 0
+    smooth = SimpleNamespace(dim=2, g0=0.01 * np.sin(np.pi * x / n) ** 2, k_n=k_n)  # no kink: no edge's share
+    assert kink_share(smooth, far, gap)["share"] == {}
     assert unresolved_share(cell, p)["kinks"]["edges"] == 0     # without the deformed gap: not located
     # a notch: one open point at the kink inside contact, located a step wide between contact points two apart,
-    # its error at most max(1, 2 - 1) steps; its two edges are not counted on their own
+    # its error at most max(1, 2 - 1) steps; its two edges are not counted on their own; the outer two, at 4.5
+    # and 25.5, a share of a step each
     notched = np.where((x >= 5) & (x <= 25) & (x != 20), 1.0, 0.0)
     share = kink_share(cell, notched, np.where(notched > 0, 0.0, np.minimum(np.abs(x - 25.5), np.abs(x - 4.5))))
-    assert (share["edges"], share["notches"]) == (2, 1)
-    assert share["share"]["contact_fraction"] == pytest.approx(1 / n)
-    assert share["share"]["coefficient_g_n"] == pytest.approx(k_n * g0[18:23].max() / n)
+    assert (share["edges"], share["notches"], share["located"]) == (2, 1, 2)
+    assert share["share"]["contact_fraction"] == pytest.approx((1 + 2 * share_step) / n)
+    assert share["share"]["coefficient_g_n"] == pytest.approx(
+        k_n * (g0[18:23].max() + share_step * (g0[3:7].max() + g0[24:28].max())) / n)
 
 
 def test_on_the_seed_1_profile_an_edge_pinned_to_a_kink_is_bounded_and_flagged():
@@ -82,5 +89,5 @@ def test_on_the_seed_1_profile_an_edge_pinned_to_a_kink_is_bounded_and_flagged()
             assert effectivity >= 1.0, (k, name, effectivity)
     for name in ("contact_fraction", "coefficient_k_n", "coefficient_g_n"):
         assert refined.forms[0][name] == KINK
-        assert "a contact edge within a step of a kink of the map" in refined.flags[0][name]
+        assert "the contact edges of a map with kinks" in refined.flags[0][name]
     assert any("within a step of a kink" in remark for remark in refined.remarks)

@@ -75,6 +75,30 @@ bounded here (on
 the random profile of seed 6 at p = 0.003 such a notch carries half the 4096 grid's error in the contact
 fraction, within the step of each of its load's two other edges at kinks).  A smooth gap (``g0''`` continuous)
 has no kinks, and in 3D the points are counted, no edge located between them.
+
+**Every other edge of a map with kinks.**  Away from the kinks the gap beyond an edge is smooth over the few
+steps the line through the first two open points reads, but neither locator converges as on a smooth gap:
+the line is off by a fraction of a step whose size and sign change from grid to grid, as the kinks nearest to
+the edge move between points, and the quartic's window, tens to hundreds of steps wide, reaches across the next
+kink on fine grids and is off by as much (random profiles of 64 samples, seeds 1 to 12, three loads, grids 1024
+to 32,768 against 131,072 points, 141 loads and grids where both have as many edges: the contact fraction's
+error over a load's edges 0.035 of a step per edge in the median, 0.13 in the ninetieth percentile, 0.22 at
+most, and 0.9 of a step at one quartic's edge).  So the edges' error is of the order of the step, with
+a constant erratic from grid to grid: the differences between grids may show its changes of sign and not its
+size (on seed 7 at p = 0.003 the error grows from 0.014 to 0.21 of a step per grid on 2048 to 8192 points
+while the differences contract twofold, and an estimate from them is half the error).  On a map with kinks each
+edge not at a kink therefore holds :data:`LOCATED_STEP` of a step of each quantity on the edges, summed over the
+edges, as the same floor (form :data:`KINK`): above every one of those errors, about seven times the median
+one (the estimate then exceeds such an error by as much, and says so where it exceeds ten times what the last
+difference leaves), and a tolerance of 1e-4 of the contact fraction is met with six to twelve edges from
+16,384 to 32,768 points (``scripts/random_profile_accuracy.py``).  The normal effective stiffness, of the
+collocated contact set (points, no located edges), has the same erratic first-order error: on the same
+profiles (seeds 1 to 12, 16 and 27, grids 1024 to 8192 against 131,072 points) it was 0.1 of the stiffness's
+change with every edge a step out in the median, 0.28 in the ninetieth percentile, 0.53 at most (seed 2 at
+p = 0.001 on 4096 points, beside a difference-based estimate of its own); on seed 16 at p = 0.003 the default
+grid's estimate was 0.7 times the error.  Half that change (:data:`STIFFNESS_STEP`: the edges' quarter of a
+step, doubled as the stiffness's estimate is) is the same floor under its estimate (:func:`stiffness_share`,
+two masked CG solves per load and level); the stiffness is reported with it, not held to the tolerance.
 """
 from __future__ import annotations
 
@@ -84,7 +108,7 @@ import numpy as np
 from scipy import ndimage
 
 from ngcontact.cell.cell_solution import COEFFICIENT, scale
-from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset
+from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset, effective_stiffness
 
 #: the fewest collocation points of a resolved 2D contact island (module docstring)
 ISLAND_POINTS = 4
@@ -94,6 +118,10 @@ ISLAND = "island"
 KINK = "kink"
 #: a point's second difference of the gap over the smaller of its neighbours' that makes it a kink
 KINK_RATIO = 4.0
+#: the share of a step that bounds the located position of any other edge of a map with kinks (module docstring)
+LOCATED_STEP = 0.25
+#: the share of the stiffness's change with every edge a step out that bounds its error on such a map (same)
+STIFFNESS_STEP = 0.5
 
 
 def on_edges(name: str) -> bool:
@@ -198,8 +226,10 @@ def kink_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
     deformed gap the edges are located on) that lie within one grid step of a kink of the cell's gap ``g0``
     (:func:`kinks`): one step per such edge, ``g_n``'s at the largest ``g0`` within a step of the edge; a notch
     (an open run of fewer than :data:`ISLAND_POINTS` points both of whose edges are such) ``max(w, s - w)`` steps,
-    its located width ``w`` against the ``s`` steps between its contact points (module docstring).
-    ``{"edges": how many, "notches": how many, "share": {headline name: absolute share}}``; no share without."""
+    its located width ``w`` against the ``s`` steps between its contact points (module docstring); and
+    :data:`LOCATED_STEP` of a step per other edge of a map with kinks.  ``{"edges": how many at a kink,
+    "notches": how many, "located": how many others, "share": {headline name: absolute share}}``; no share
+    without kinks."""
     on, n = p > 0, p.size
     at = np.flatnonzero(kinks(cell.g0))
     if cell.dim != 2 or on.all() or not on.any() or at.size == 0:
@@ -220,14 +250,24 @@ def kink_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
             steps_heights.append((max(located, w + 1 - located), max(edges[right][2], edges[left][2])))
             del edges[right], edges[left]
             notches += 1
-    steps_heights += [(1.0, height) for _, kinked, height in edges.values() if kinked]
-    count = len(steps_heights) + notches
+    kinked_edges = sum(1 for _, kinked, _ in edges.values() if kinked)
+    steps_heights += [(1.0 if kinked else LOCATED_STEP, height) for _, kinked, height in edges.values()]
     if not steps_heights:
         return {"edges": 0, "notches": 0, "share": {}}
     steps = sum(s for s, _ in steps_heights)
-    return {"edges": count, "notches": notches, "share": {
+    return {"edges": kinked_edges + 2 * notches, "notches": notches, "located": len(edges) - kinked_edges, "share": {
         "contact_fraction": steps / n, COEFFICIENT + "k_n": cell.k_n * steps / n,
         COEFFICIENT + "g_n": cell.k_n * sum(s * h for s, h in steps_heights) / n}}
+
+
+def stiffness_share(cell, on: np.ndarray) -> float:
+    """:data:`STIFFNESS_STEP` times the change of the normal effective stiffness of the 2D contact set ``on``
+    (:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`) when every edge moves a step out: the
+    floor of its estimate on a map with kinks (module docstring)."""
+    stiffness, grown = (effective_stiffness(cell, s)["matrix"] for s in (on, on | np.roll(on, 1) | np.roll(on, -1)))
+    if stiffness is None or grown is None:          # full contact: no finite stiffness to compare
+        return 0.0
+    return STIFFNESS_STEP * abs(grown[0][0] - stiffness[0][0])
 
 
 def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict[str, Any]:
@@ -251,6 +291,8 @@ def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict
     out: dict[str, Any] = {"points": points, "islands": count, "share": {},
                            "kinks": kink_share(cell, p, gap) if gap is not None else {"edges": 0, "notches": 0,
                                                                                       "share": {}}}
+    if out["kinks"]["share"]:
+        out["kinks"]["share"]["normal_stiffness"] = stiffness_share(cell, p > 0)
     if count:
         whole = coefficients(cell, mask).as_dict()
         out["share"] = {"contact_fraction": whole["contact_fraction"], COEFFICIENT + "k_n": whole["k_n"],
@@ -282,6 +324,8 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                 kinked = unresolved["kinks"]
                 remarks.append(f"load {k}: {kinked['edges']} contact edge(s) within a step of a kink of the map on "
                                f"grid {last['grid']} ({kinked['notches']} notch(es) of fewer than {ISLAND_POINTS} open "
-                               f"points at one): {', '.join(raised)} bounded by a step at each edge, a notch by its "
-                               "width or the rest of the steps between its contact points")
+                               f"points at one) and {kinked.get('located', 0)} other(s): {', '.join(raised)} bounded "
+                               f"by a step at each edge at a kink, {LOCATED_STEP:g} of a step at each other, a notch "
+                               "by its width or the rest of the steps between its contact points, the stiffness by "
+                               f"{STIFFNESS_STEP:g} of its change with every edge a step out")
     return remarks

@@ -64,7 +64,7 @@ DISAGREE = 2.0
 FIRST_ORDER = 0.5
 #: why, per form of the estimate (module docstring)
 WHY_LOOSE = {GUARDED: "an earlier difference bounds it", CARRIED: "carried from the deferred grid",
-             KINK: "a contact edge within a step of a kink of the map, bounded by a step there"}
+             KINK: "the contact edges of a map with kinks, bounded by a step at a kink, a quarter elsewhere"}
 
 
 def loose_flags(history: list[dict[str, Any]], estimates: list[dict[str, float]], forms: list[dict[str, str]]

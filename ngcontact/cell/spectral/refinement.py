@@ -110,12 +110,12 @@ the verdict as not counted).
 Two checks end each level's estimate. A contact island of fewer than
 :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: its error may
 stall while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
-(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``; a 2D edge within a step of a kink of a
-map's surface, one step: ``kink``); a window across the level where the last island came to be resolved is also taken
-on the resolved levels alone, the smaller reported (the same module's docstring). An estimate (not Richardson's nor an
-island's) above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at
-the last contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the error by
-as much: flagged with its reason, per quantity in the report
+(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``; a 2D edge of a map with kinks, a step
+within a step of one, else a quarter: ``kink``); a window across the level where the last island came to be resolved
+is also taken on the resolved levels alone, the smaller reported (the same module's docstring). An estimate (not
+Richardson's nor an island's) above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last
+difference leaves at the last contraction, or (any form) at the one before where the last is twice as slow or more,
+may exceed the error by as much: flagged with its reason, per quantity in the report
 (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
 Levels double the points per direction (:data:`GROWTH`): three differences cost twice the finest level in 2D, 4/3 in 3D.
@@ -150,8 +150,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
-from ngcontact.cell.spectral.contact_edges import (ISLAND_POINTS, fitted_run, island_floor, on_edges, resolved_run,
-                                                   unresolved_share, locator_changing as edges_changing)
+from ngcontact.cell.spectral.contact_edges import (ISLAND_POINTS, LOCATED_STEP, fitted_run, island_floor, on_edges,
+                                                   resolved_run, unresolved_share, locator_changing as edges_changing)
 from ngcontact.cell.spectral.estimate_forms import CARRIED, GUARDED, LOOSE, RICHARDSON, loose_flags, loose_remarks
 from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
 from ngcontact.errors import ConvergenceError
@@ -199,8 +199,9 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance; at least "
        f"the share of contact islands of fewer than {ISLAND_POINTS} points (3D: across), and after such islands "
        f"also on the resolved levels (at least {LOCATOR_LEVELS}), the smaller; a step per 2D edge within a step of a "
-       f"kink of the map's piecewise-linear surface; above {LOOSE:g} times the error its last difference leaves at "
-       "the last rate, or the one before where the last is twice as slow or more: flagged (quantities[].loose)")
+       f"kink of the map's piecewise-linear surface, {LOCATED_STEP:g} of one per other edge of such a map; above "
+       f"{LOOSE:g} times the error its last difference leaves at the last rate, or the one before where the last is "
+       "twice as slow or more: flagged (quantities[].loose)")
 
 
 @dataclass

@@ -1,0 +1,296 @@
+"""Issue 35's second aim: a random 2D profile posed with the defaults, and with a tolerance of 1e-4.
+
+The cell is posed as a user poses a random profile: the package's generator
+(:func:`ngcontact.geometry.random_surface.self_affine` with ``dim = 2``: 64 samples per period, Hurst 0.8,
+rms slope 0.1, one seed per cell: seeds 1 to 7, none chosen, and 11, whose lightest load holds a contact island
+narrower than four points up to 2048 points) draws the heights ``h_j``, and the initial gap ``g_j = max h - h_j`` is
+written as a CSV table (``x, g``, the first row repeated at ``x = P``) that the scene names as its
+``[contact.gap]`` (``kind = "tabulated"``) on a flat interface: the small-slope cell, whose surface is the
+table's piecewise-linear interpolant (:func:`ngcontact.drivers.cell_gap.gap_samples`).  Two layers of depth
+1 (``E = 1``, ``nu = 0.3``), exact contact, three mean pressures (contact fractions from a few per cent to
+about a third).  Two runs per seed, each ``ngcontact run`` in a child process, its wall time measured
+around it:
+
+* ``defaults``: no ``[discretization]`` section at all (the method, the first grid and the default
+  tolerance of 1 % are the package's);
+* ``tolerance 1e-4``: ``[discretization] tolerance = 1e-4`` and nothing else.
+
+The converged reference of each seed is the same scene (the same table, so the same interpolant; the same
+``contact.k_n``, the scale of the eq. 34 coefficients) on ``REFERENCES`` = 2^16, 2^17 and 2^18 points with
+the estimate off.  The finest is the reference; its own error is bounded by its change from 2^17
+(``reference_change``: the difference of the last doubling bounds the rest of the tail where each doubling
+at least halves the error, as the rows show) and checked against Richardson's limit of the three at their
+observed rate (``error_to_richardson``).  Both are listed beside each row: a row's true error is meaningful
+only where it exceeds them.
+
+Per seed, run, load and headline quantity (the contact fraction first, the mean closure, the normal
+effective stiffness, the eq. 34 coefficients ``k_n`` and ``g_n`` on the real contact set): the reported value
+and its absolute estimate, the true absolute error against the reference, the same two in the package's
+measure (``ngcontact.cell.cell_solution.measure``: the contact fraction absolute, the closure and stiffness
+relative, a coefficient relative to its whole-surface value) and relative to the value, the effectivity
+(estimate / true error), the grid reached, the run's wall time and its solve time.  The aims: with the
+defaults every quantity within 1 % of the converged value and every estimate at least the true error; with
+the tolerance every quantity the package holds to it (``counted``: all but the stiffness, which a 2D
+refinement reports with its estimate but does not hold to the tolerance) within 1e-4 in its measure.  A
+tolerance out of reach (the child's exit 3) is a row of its own and makes this script end in exit 3 after
+writing its figures.
+
+    python scripts/random_profile_accuracy.py [OUT] [--seeds 1 2 3] [--publish]
+
+Writes ``OUT/random_profile_accuracy.csv`` and ``.png`` (default ``results/random_profile_accuracy``).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
+from random_map_accuracy import richardson  # noqa: E402  (the limit of three grids at their observed rate)
+
+from ngcontact.cell.cell_solution import headline  # noqa: E402
+from ngcontact.output.writer import write_csv  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+E, NU = 1.0, 0.3
+PRESSURES = (0.001, 0.003, 0.01)
+SAMPLES = 64
+SEEDS = (1, 2, 3, 4, 5, 6, 7, 11)
+TOLERANCE = 1e-4
+#: the defaults' aim: every headline quantity within this relative error of the converged value
+DEFAULT_AIM = 0.01
+#: the reference grids: the finest is the reference, the two coarser ones bound and extrapolate it
+REFERENCES = (2 ** 16, 2 ** 17, 2 ** 18)
+RUNS = {"defaults": "", "tolerance 1e-4": f"[discretization]\ntolerance = {TOLERANCE:g}\n"}
+#: the child's exit status of a tolerance out of reach (:mod:`ngcontact.cli`)
+OUT_OF_REACH = 3
+KEYS = ("seed", "run", "load", "pressure", "quantity", "counted", "grid", "value", "estimate", "reference",
+        "true_error", "measure", "estimate_measure", "true_error_measure", "true_error_relative",
+        "reference_change", "error_to_richardson", "effectivity", "aim", "aim_met", "seconds", "solve_seconds",
+        "note")
+
+SCENE = """kind = "cell"
+title = "Random 2D profile (64 samples, seed {seed}), exact contact"
+materials = {{ solid = {{ E = {E}, nu = {NU} }} }}
+bodies = {{ rough = "solid", counter = "solid" }}
+geometry = {{ profile = "flat", period = 1.0, h_rough = 1.0, h_counter = 1.0 }}
+load = {{ pressure = [{pressures}] }}
+
+[contact]
+enforcement = "exact"
+gap = {{ kind = "tabulated", file = "{gap}" }}
+{k_n}
+{discretization}"""
+
+
+def profile_gap(seed: int, samples: int = SAMPLES) -> tuple[np.ndarray, np.ndarray]:
+    """The table of the gap below the highest summit of the random profile of ``seed``: ``x`` from 0 to the
+    period and ``g = max h - h`` (the first sample repeated at the end)."""
+    from ngcontact.geometry.random_surface import as_height_map, self_affine
+    h = as_height_map(self_affine(dim=2, grid=samples, hurst=0.8, rms_slope=0.1, seed=seed))
+    return np.arange(samples + 1) / samples, h.max() - h
+
+
+def write_gap(out: str, seed: int) -> str:
+    """Write the gap table of ``seed`` into ``out`` (full precision); its file name."""
+    name = f"gap_seed{seed}.csv"
+    x, g = profile_gap(seed)
+    np.savetxt(os.path.join(out, name), np.column_stack([x, g]), delimiter=",", header="x,g", comments="",
+               fmt="%.17g")
+    return name
+
+
+def scene_text(seed: int, gap: str, discretization: str = "", k_n: float | None = None) -> str:
+    return SCENE.format(seed=seed, E=E, NU=NU, gap=gap, pressures=", ".join(map(str, PRESSURES)),
+                        k_n="" if k_n is None else f"k_n = {k_n!r}\n", discretization=discretization)
+
+
+def reference_text(seed: int, gap: str, grid: int, k_n: float) -> str:
+    """The scene of ``seed`` on ``grid`` points with the estimate off and the posed runs' ``k_n``."""
+    return scene_text(seed, gap, f'[discretization]\ngrid = {grid}\nestimate = "off"\n', k_n)
+
+
+def run(text: str, out: str, name: str) -> tuple[dict | None, float, str]:
+    """``ngcontact run`` of the scene ``text`` in a child process: its report's results (``None`` where it
+    wrote none), wall time and, out of reach (exit 3), the child's last line of error."""
+    path = os.path.join(out, name + ".toml")
+    with open(path, "w") as fh:
+        fh.write(text)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, (ROOT, os.environ.get("PYTHONPATH")))))
+    t0 = time.perf_counter()
+    child = subprocess.run([sys.executable, "-m", "ngcontact", "run", path, "--out", os.path.join(out, name),
+                            "--quiet"], env=env, capture_output=True, text=True)
+    seconds = time.perf_counter() - t0
+    if child.returncode not in (0, OUT_OF_REACH):
+        raise RuntimeError(f"ngcontact run {path} failed ({child.returncode}): {child.stderr.strip()[-2000:]}")
+    report = os.path.join(out, name, "report.json")
+    if child.returncode == OUT_OF_REACH or not os.path.exists(report):
+        lines = child.stderr.strip().splitlines() or ["no report written"]
+        return None, seconds, lines[-1]
+    with open(report) as fh:
+        return json.load(fh)["results"], seconds, ""
+
+
+def heads(results: dict) -> list[dict[str, float]]:
+    """Per load the headline quantities (:func:`ngcontact.cell.cell_solution.headline`)."""
+    return [headline(load) for load in results["loads"]]
+
+
+def posed_rows(seed: int, run_name: str, results: dict | None, seconds: float, note: str,
+               reference: list[list[dict[str, float]]]) -> list[dict]:
+    """The rows of one posed run against the reference grids' headline quantities (coarsest first)."""
+    if results is None:
+        return [{**{key: "" for key in KEYS}, "seed": seed, "run": run_name, "seconds": seconds,
+                 "aim": f"true error <= {TOLERANCE:g}", "aim_met": False, "note": "out of reach: " + note}]
+    levels = results["method"].get("refinement", [])
+    grid, solve = results["method"]["grid"], sum(level["seconds"] for level in levels)
+    rows = []
+    for q in results["accuracy"]["quantities"]:
+        k, name = q["load"], q["name"]
+        coarse, half, fine = (ref[k][name] for ref in reference)
+        error = abs(q["value"] - fine)
+        limit = richardson(coarse, half, fine)
+        row = {"seed": seed, "run": run_name, "load": k, "pressure": PRESSURES[k], "quantity": name,
+               "counted": q["counted"], "grid": grid, "value": q["value"], "estimate": q["error"],
+               "reference": fine, "true_error": error, "measure": q["controlled"],
+               "estimate_measure": q["controlled_error"], "true_error_measure": error / q["scale"],
+               "true_error_relative": error / abs(fine), "reference_change": abs(fine - half) / q["scale"],
+               "error_to_richardson": abs(q["value"] - limit) / q["scale"],
+               "effectivity": q["error"] / error if error > 0 else float("inf"),
+               "seconds": seconds, "solve_seconds": solve,
+               "note": f"grids {[level['grid'] for level in levels]}"
+                       + (f"; flagged: {q['loose']}" if q.get("loose") else "")}
+        if run_name == "defaults":
+            row["aim"] = f"within {100 * DEFAULT_AIM:g} %, estimate >= error"
+            row["aim_met"] = bool(row["true_error_relative"] <= DEFAULT_AIM and q["error"] >= error)
+        else:
+            row["aim"] = f"true error <= {TOLERANCE:g}" if q["counted"] else "estimate >= error (not held)"
+            row["aim_met"] = bool(row["true_error_measure"] <= TOLERANCE if q["counted"] else q["error"] >= error)
+        rows.append(row)
+    return rows
+
+
+def seed_rows(seed: int, out: str) -> list[dict]:
+    """Both posed runs of ``seed`` and their rows against the seed's reference."""
+    gap = write_gap(out, seed)
+    posed = {name: run(scene_text(seed, gap, extra), out, f"seed{seed}_{name.replace(' ', '_')}")
+             for name, extra in RUNS.items()}
+    k_n = next(r[0]["whole_surface"]["k_n"] for r in posed.values() if r[0] is not None)
+    reference = []
+    for grid in REFERENCES:
+        results, _, note = run(reference_text(seed, gap, grid, k_n), out, f"seed{seed}_grid{grid}")
+        if results is None:
+            raise RuntimeError(f"the reference grid {grid} of seed {seed} wrote no report: {note}")
+        reference.append(heads(results))
+    return [row for name, (results, seconds, note) in posed.items()
+            for row in posed_rows(seed, name, results, seconds, note, reference)]
+
+
+def plot(rows: list[dict], path: str) -> None:
+    """Per seed and load the true error (dots) and the estimate (bars) of each quantity: relative with the
+    defaults, in the measure held to the tolerance at 1e-4; the aims as lines."""
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    quantities = list(dict.fromkeys(r["quantity"] for r in rows))
+    cases = list(dict.fromkeys((r["seed"], r["load"]) for r in rows))
+    for ax, (run_name, key, aim) in zip(axes, (("defaults", "true_error_relative", DEFAULT_AIM),
+                                               ("tolerance 1e-4", "true_error_measure", TOLERANCE))):
+        for j, name in enumerate(quantities):
+            sel = [r for r in rows if r["run"] == run_name and r["quantity"] == name]
+            x = [cases.index((r["seed"], r["load"])) + 0.12 * (j - 2) for r in sel]
+            est = [r["estimate_measure"] if key == "true_error_measure" else r["estimate"] / abs(r["reference"])
+                   for r in sel]
+            ax.semilogy(x, [max(r[key], 1e-12) for r in sel], "o", color=f"C{j}", ms=4, label=f"{name}: true error")
+            ax.semilogy(x, est, "_", color=f"C{j}", ms=9, mew=2, label=f"{name}: estimate")
+        held = " (not the stiffness)" if aim == TOLERANCE else ""
+        ax.axhline(aim, color="0.4", lw=0.8, label=f"aim {aim:g}{held}")
+        ax.set_xticks(range(len(cases)), [f"{s}/{k}" for s, k in cases], fontsize=6)
+        ax.set_title(f"{run_name}: {'relative error' if key == 'true_error_relative' else 'error in the measure held'}",
+                     fontsize=8)
+        ax.set_xlabel("seed / load")
+    axes[0].legend(fontsize=5, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def verdict(rows: list[dict]) -> str:
+    """The aims in words, with the worst figures."""
+    parts = []
+    for run_name in RUNS:
+        sel = [r for r in rows if r["run"] == run_name]
+        lost = [r for r in sel if r["quantity"] == ""]
+        got = [r for r in sel if r["quantity"] != ""]
+        missed = [r for r in got if not r["aim_met"]]
+        fraction = [r for r in got if r["quantity"] == "contact_fraction"]
+        worst = max(got, key=lambda r: r["true_error_relative"]) if got else None
+        effs = [r["effectivity"] for r in got]
+        grids = sorted({r["grid"] for r in got})
+        text = (f"{run_name}: aim {'met' if not missed and not lost else 'not met'} on {len(got)} rows"
+                + (f" ({len(missed)} missed: " + ", ".join(f"seed {r['seed']} load {r['load']} {r['quantity']}"
+                                                            for r in missed) + ")" if missed else "")
+                + (f", out of reach on seeds {[r['seed'] for r in lost]}" if lost else ""))
+        if worst is not None:
+            text += (f"; contact fraction true errors up to {max(r['true_error'] for r in fraction):.2g} absolute "
+                     f"({100 * max(r['true_error_relative'] for r in fraction):.2g} %), largest relative error "
+                     f"{100 * worst['true_error_relative']:.2g} % ({worst['quantity']}, seed {worst['seed']} load "
+                     f"{worst['load']}); effectivity {min(effs):.3g} to {max(effs):.3g}; grids {grids}; wall time "
+                     f"{min(r['seconds'] for r in got):.3g} to {max(r['seconds'] for r in got):.3g} s per seed")
+        parts.append(text)
+    bound = max(r["reference_change"] for r in rows if r["quantity"] != "")
+    return ". ".join(parts) + f". Largest reference change (2^17 to 2^18, in the measure): {bound:.2g}."
+
+
+def seed_arg(text: str) -> int:
+    """One of ``--seeds``: a non-negative integer, else refused naming the value."""
+    if not text.isdigit():
+        raise argparse.ArgumentTypeError(f"--seeds {text!r}: non-negative integer seeds are allowed, e.g. 1 2 3")
+    return int(text)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", nargs="?", default=os.path.join("results", "random_profile_accuracy"),
+                    help="output directory")
+    ap.add_argument("--seeds", type=seed_arg, nargs="+", default=list(SEEDS),
+                    help="the profiles' seeds (default: %(default)s)")
+    benchmark_doc.add_flag(ap)
+    args = ap.parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    rows = [row for seed in args.seeds for row in seed_rows(seed, args.out)]
+    csv_path = os.path.join(args.out, "random_profile_accuracy.csv")
+    write_csv(csv_path, list(KEYS), [[r[k] for k in KEYS] for r in rows])
+    png = os.path.join(args.out, "random_profile_accuracy.png")
+    plot([r for r in rows if r["quantity"] != ""], png)
+    summary = verdict(rows)
+    print(summary)
+    if args.publish:
+        benchmark_doc.publish("random_profile_accuracy", "A random 2D profile with the defaults and with a "
+                              "tolerance of 1e-4 (issue 35)", csv_path, note=NOTE + " " + summary, png=png)
+    return OUT_OF_REACH if any(r["quantity"] == "" for r in rows) else 0
+
+
+NOTE = ("Random 2D profiles of 64 samples (self-affine, Hurst 0.8, rms slope 0.1, the seeds of column `seed`) "
+        "drawn by the package's generator, their gap below the highest summit written as a CSV table and posed "
+        "as a flat interface with that tabulated gap (its piecewise-linear interpolant), layers of depth 1, exact "
+        "contact, three mean pressures, run as `ngcontact run`: `defaults` with no `[discretization]` section, "
+        "`tolerance 1e-4` with `discretization.tolerance = 1e-4` only (`seconds`: the child's wall time, "
+        "start-up included; `solve_seconds`: its refinement's levels; `grid`: the grid reported). `estimate`: "
+        "the reported absolute estimate; `true_error`: against the same scene on 2^18 points (`reference`); "
+        "`measure`, `estimate_measure`, `true_error_measure`: both in the measure the package holds to the "
+        "tolerance; `reference_change`: the reference's change from 2^17 points and `error_to_richardson` the "
+        "error against Richardson's limit of 2^16, 2^17, 2^18 points, both in that measure; `effectivity` = "
+        "estimate / true error. `counted`: held to the tolerance (the 2D stiffness is reported with its "
+        "estimate, not held). Aims: with the defaults every quantity within 1 % and every estimate at least "
+        "the error; with the tolerance every counted quantity within 1e-4 in its measure. Timings on a 2-core "
+        "machine shared with other jobs.")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
