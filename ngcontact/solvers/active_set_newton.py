@@ -29,11 +29,14 @@ far outside the disc, whose large curvature the split preconditioner below
 takes (held instead, such a point would converge only as fast as the
 proximal-gradient map turns it, by ``G / |z|`` per step).  The free
 minimum's projection onto the constraints is the next iterate, or the free
-minimum itself where only that lowers the residual; where neither does, the
-step is shortened: the projection of ``t_hat + alpha (t_free - t_hat)`` for
-``alpha = 1/2, 1/4, 1/8``, the first that lowers the residual by Armijo's
-share ``1 - 1e-4 alpha`` (else the smallest residual met): a damped Newton
-method on the fixed-point residual as merit function.  The semismooth Newton
+minimum itself where only that lowers the residual.  Where the step raises
+the root mean square of the fixed-point residual (the Euclidean merit
+function of damped semismooth Newton methods), it is shortened: the
+projection of ``t_hat + alpha (t_free - t_hat)`` for ``alpha = 1/2, 1/4,
+1/8``, the first that lowers it by Armijo's share ``1 - 1e-4 alpha`` (else
+the smallest met).  The maximum norm, the stopping rule's, as the merit
+took up to 1.9 times the operator applications on the random maps tried
+at 512^2.  The semismooth Newton
 step converges only locally (Qi and Sun, Math. Program. 58 (1993) 353-367;
 Hintermueller, Ito and Kunisch prove global convergence for M-matrices,
 which a compliance, positive off the diagonal, is not): undamped, the Coulomb
@@ -253,13 +256,15 @@ class Constraints(Protocol):
 
 @dataclass
 class _Point:
-    """An iterate ``t``, its proximal point ``t_hat = prox(v)``, ``v = t - grad(t) / L``, and its residual."""
+    """An iterate ``t``, its proximal point ``t_hat = prox(v)``, ``v = t - grad(t) / L``, and its residual in
+    the maximum norm (``res``, the stopping rule's) and in the root mean square (``rms``)."""
 
     t: np.ndarray
     v: np.ndarray
     t_hat: np.ndarray
     shifts: tuple
     res: float
+    rms: float
 
 
 def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[[np.ndarray], np.ndarray],
@@ -284,7 +289,8 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
         v += t                                  # t - grad(t) / L, in place
         t_hat, shifts = h.prox(v, shifts)
         change = t - t_hat
-        return _Point(t, v, t_hat, shifts, float(np.max(np.abs(change, out=change))) * L / scale)
+        rms = float(np.sqrt(np.mean(change * change))) * L / scale
+        return _Point(t, v, t_hat, shifts, float(np.max(np.abs(change, out=change))) * L / scale, rms)
 
     x = evaluate(t0.copy(), ())
     best, since_best = x.res, 0
@@ -304,7 +310,7 @@ def active_set_newton(grad: Callable[[np.ndarray], np.ndarray], apply: Callable[
         step = evaluate(projected, x.shifts)
         if step.res >= x.res and float(np.max(np.abs(projected - t_new))) > SAME_POINT * float(np.max(np.abs(t_new))):
             step = min(step, evaluate(t_new, x.shifts), key=lambda y: y.res)
-        if step.res >= x.res:
+        if step.rms >= x.rms:
             step = _damped(evaluate, h, x, t_new, step)
         x = step
         best, since_best = (x.res, 0) if x.res < best else (best, since_best + 1)
@@ -369,15 +375,15 @@ def coulomb_active_set(grad: Callable[[np.ndarray], np.ndarray], apply: Callable
 
 def _damped(evaluate: Callable[[np.ndarray, tuple], _Point], h: Constraints, x: _Point, t_new: np.ndarray,
             full: _Point) -> _Point:
-    """A shorter step where the full one raises the residual: the projections of ``t_hat + alpha (t_new - t_hat)``,
-    ``alpha = 1/2, 1/4, ...`` (``DAMPINGS`` of them), the first that lowers the residual by Armijo's share
-    ``1 - ARMIJO alpha``; where none does, the smallest residual met, the full step's included."""
+    """A shorter step where the full one raises the residual's root mean square: the projections of ``t_hat +
+    alpha (t_new - t_hat)``, ``alpha = 1/2, 1/4, ...`` (``DAMPINGS`` of them), the first that lowers it by
+    Armijo's share ``1 - ARMIJO alpha``; where none does, the smallest met, the full step's included."""
     best = full
     alpha = 1.0
     for _ in range(DAMPINGS):
         alpha *= 0.5
         trial = evaluate(h.project(x.t_hat + alpha * (t_new - x.t_hat), x.shifts), x.shifts)
-        if trial.res <= (1.0 - ARMIJO * alpha) * x.res:
+        if trial.rms <= (1.0 - ARMIJO * alpha) * x.rms:
             return trial
-        best = min(best, trial, key=lambda y: y.res)
+        best = min(best, trial, key=lambda y: y.rms)
     return best
