@@ -124,7 +124,7 @@ def _halfspace_coulomb_steps(n: int) -> int:
 def test_coulomb_steps_on_the_halfspace_grow_slowly_with_the_grid():
     """At 256^2 the coupled Newton steps raised the residual step after step while the stick and slip sets swapped
     points, until the solve gave up on them for the fixed point of Tresca problems: 363 operator applications
-    against 62 at 128^2 and 177 at 512^2.  A step that raises the residual is shortened
+    against 62 at 128^2 and 177 at 512^2.  A step that raises the residual (its root mean square) is shortened
     (:func:`ngcontact.solvers.active_set_newton.active_set_newton`): at most twice the steps of 128^2."""
     coarse, fine = _halfspace_coulomb_steps(128), _halfspace_coulomb_steps(256)
     assert fine <= 2 * coarse, (coarse, fine)

@@ -6,17 +6,12 @@ those of the scene's cell on the named interface mesh (:func:`ngcontact.drivers.
 and its estimate (one order more on that mesh) bounds its true error against the spectral reference, whose own
 change from the grid of half its points is far below that error.
 """
-import importlib.util
 import os
 import sys
 from dataclasses import replace
 
-_SCRIPTS = os.path.join(os.path.dirname(__file__), "..", "..", "scripts")
-sys.path.insert(0, _SCRIPTS)
-_SPEC = importlib.util.spec_from_file_location("spectral_vs_fft", os.path.join(_SCRIPTS, "spectral_vs_fft.py"))
-assert _SPEC is not None and _SPEC.loader is not None
-S = importlib.util.module_from_spec(_SPEC)
-_SPEC.loader.exec_module(S)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+import spectral_vs_fft as S  # noqa: E402
 
 
 def test_an_fe_row_solves_its_named_mesh_and_its_estimate_bounds_its_error():
