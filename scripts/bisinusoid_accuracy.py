@@ -34,6 +34,7 @@ solves' CG iterations.
 """
 from __future__ import annotations
 
+import functools
 import itertools
 import logging
 import math
@@ -141,9 +142,7 @@ def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None 
     from ngcontact import runner
     from ngcontact.cell.cell_load import cell_load
     loads = [cell_load(3, pressure=r * math.pi * ACC_H) for r in ACC_RATIOS]
-    coarse, fine = (bisinusoid_spectral(n) for n in REF_GRIDS)
-    converged = [2.0 * fine.solve(ld).results["contact_fraction"] - coarse.solve(ld).results["contact_fraction"]
-                 for ld in loads]
+    converged = [2.0 * twin_fraction(REF_GRIDS[1], r) - twin_fraction(REF_GRIDS[0], r) for r in ACC_RATIOS]
     threads = runner.thread_count() if threads is None else threads
     rows = edge_rows(edges, orders, threads, loads, converged, cells) if edges else []
     if patch is not None:
@@ -151,11 +150,34 @@ def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None 
     return rows + extrapolated_rows(rows, dict(zip(ACC_RATIOS, converged)))
 
 
-def extrapolated_rows(rows: list[dict], converged: dict) -> list[dict]:
+@functools.lru_cache(maxsize=None)
+def twin_fraction(grid: int, ratio: float) -> float:
+    """The spectral cell's contact fraction at ``p/p* = ratio`` on a ``grid x grid`` grid (each solved once)."""
+    from ngcontact.cell.cell_load import cell_load
+    sol = bisinusoid_spectral(grid).solve(cell_load(3, pressure=ratio * math.pi * ACC_H))
+    return float(sol.results["contact_fraction"])
+
+
+def twin_floor(value: float, edge: float, ratio: float, twin=twin_fraction) -> tuple[float, int]:
+    """The floor of the contact-edge ladder on an extrapolated contact fraction ``value`` whose finest edge size
+    is ``edge`` (:meth:`ngcontact.cell.fe.contact_edge_refinement.ContactEdgeRefinement.twin_floors`): ``|q - q_N|
+    + TWIN_SAFETY |q_N - q_{N/2}|`` with ``q_N = twin(N, ratio)`` the spectral twin's on the ladder's grid ``N``
+    of that edge size; returns the floor (absolute) and ``N``."""
+    from ngcontact.cell.fe.contact_edge_refinement import TWIN_SAFETY, twin_grid
+    n = twin_grid(edge, 1.0)
+    fine, coarse = twin(n, ratio), twin(n // 2, ratio)
+    return abs(value - fine) + TWIN_SAFETY * abs(fine - coarse), n
+
+
+def extrapolated_rows(rows: list[dict], converged: dict, twin=twin_fraction) -> list[dict]:
     """Per load solved at order 2 (on a linear trace) at two or more edge sizes: the Richardson extrapolation
     in the edge size (:mod:`ngcontact.cell.fe.edge_size_extrapolation`), its seconds the sum of the solves', its
-    dofs the finest's, ``estimate`` its estimated relative error.  Order 1 is left out: its error is two
-    opposite errors (too stiff a body, a contact set past the edge), not a power of the edge size."""
+    dofs the finest's.  Its estimated relative error as the contact-edge ladder of ``ngcontact run`` makes it
+    (:mod:`ngcontact.cell.fe.contact_edge_refinement`): ``estimate_gci`` the extrapolation's grid convergence
+    index, ``estimate_twin`` the spectral twin's floor (:func:`twin_floor`, ``twin(grid, p/p*)`` the twin's
+    contact fraction), ``estimate`` the larger; ``effectivity`` = estimate / |relative_error|.  Order 1 is left
+    out: its error is two opposite errors (too stiff a body, a contact set past the edge), not a power of the
+    edge size."""
     from ngcontact.cell.fe.edge_size_extrapolation import extrapolate
     out = []
     def cell(r):          # rows of a run before the quarter cell: the period's
@@ -167,12 +189,17 @@ def extrapolated_rows(rows: list[dict], converged: dict) -> list[dict]:
             continue
         ext = extrapolate([r["size"] for r in sel], [r["contact_fraction"] for r in sel])
         finest = min(sel, key=lambda r: r["size"])
+        floor, n = twin_floor(ext.value, finest["size"], ratio, twin)
+        error = ext.value / converged[ratio] - 1.0
+        estimate = max(ext.estimate, floor) / ext.value
         out.append({"part": "accuracy", "solver": solver + ", extrapolated", "cell": which,
                     "size": " ".join(f"{r['size']:g}" for r in sel), "ndof": finest["ndof"],
                     "seconds": sum(r["seconds"] for r in sel), "contact_fraction": ext.value, "pressure": ratio,
-                    "relative_error": ext.value / converged[ratio] - 1.0, "estimate": ext.estimate / ext.value})
-        log.info("accuracy: %s p/p* %g extrapolated (%s): %+.2f %% (estimate %.2f %%), %.1f s", solver, ratio, ext.how,
-                 100.0 * out[-1]["relative_error"], 100.0 * out[-1]["estimate"], out[-1]["seconds"])
+                    "relative_error": error, "estimate": estimate, "estimate_gci": ext.estimate / ext.value,
+                    "estimate_twin": floor / ext.value, "effectivity": estimate / abs(error) if error else ""})
+        log.info("accuracy: %s p/p* %g extrapolated (%s): %+.2f %%, estimate %.2f %% (GCI %.2f %%, twin floor "
+                 "%.2f %% at %d^2), %.1f s", solver, ratio, ext.how, 100.0 * error, 100.0 * estimate,
+                 100.0 * out[-1]["estimate_gci"], 100.0 * out[-1]["estimate_twin"], n, out[-1]["seconds"])
     return out
 
 

@@ -28,7 +28,11 @@ Four measurements, one run, one CSV and one PNG:
    mirror-symmetric quarter side by side (column ``cell``, ``--accuracy-cells``); the sibling module
    ``bisinusoid_accuracy.py`` says what is solved.  Column
    ``relative_error``; the seconds include the twin, the meshing and the
-   solve (threads: ``--accuracy-threads``), and each phase on its own.
+   solve (threads: ``--accuracy-threads``), and each phase on its own.  The
+   order-2 rows' extrapolations carry the estimate of the contact-edge ladder
+   (:mod:`ngcontact.cell.fe.contact_edge_refinement`): the larger of the grid
+   convergence index and the spectral twin's floor, each in its own column,
+   and their effectivity against the converged value.
 
 Every solve of parts 1 and 2 runs in its own child process, so that its peak
 memory (``VmHWM``) is its own.  Reported per solve: dofs, wall time of the
@@ -105,7 +109,7 @@ AMPLITUDE, PRESSURES = 0.005, (0.00185, 0.0065)
 SPECTRAL_GRIDS, TAMAAS_GRID = (64, 128, 256, 512), 1024
 KEYS = ("part", "solver", "cell", "size", "ndof", "seconds", "measure_seconds", "twin_seconds", "mesh_seconds",
         "solve_seconds", "newton_steps", "cg_iterations", "peak_memory_gb", "contact_fraction", "pressure",
-        "relative_error", "estimate")
+        "relative_error", "estimate", "estimate_gci", "estimate_twin", "effectivity")
 
 
 def period_scene():
@@ -575,7 +579,11 @@ def main(argv=None) -> int:
                                    "the FE cell (exact) on the mesh refined along its spectral twin's contact edge "
                                    "(`edge-refined`, `size`: the edge's element size; order 1, or order 2 on a "
                                    "linear trace on S_C with rows `extrapolated`: Richardson in the edge size "
-                                   "over the sizes listed, `estimate` its estimated relative error) or, order 1, "
+                                   "over the sizes listed, `estimate` its estimated relative error as the contact-"
+                                   "edge ladder of `ngcontact run` makes it, the larger of `estimate_gci` (the "
+                                   "grid convergence index of the extrapolation) and `estimate_twin` (the spectral "
+                                   "twin's floor |q - q_N| + 2 |q_N - q_N/2|, N the twin's grid of the finest edge "
+                                   "size), `effectivity` = estimate / |relative_error|) or, order 1, "
                                    "along the edge and in the bodies below and above the patch (`patch-refined`, "
                                    "`size`: edge a/N_EDGE, bodies a/N_BODY to DEPTH a, a the twin's patch radius; "
                                    "`growth G`: the bodies' size a/N_BODY + G |z| at depth |z|), each on the whole "

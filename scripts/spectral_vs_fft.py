@@ -17,9 +17,13 @@ Four measurements, one run, one CSV and one PNG:
    relative L2 difference of the pressure fields, iterations and wall time.
 2. **FE cell against the spectral cell** on the shipped bisinusoid
    (``geometries/cells/bisinusoid.toml``: finite layers 0.6 thick, the
-   penalty of the scene): the FE cell over a ladder of interface mesh sizes
-   and the spectral cell at 512^2, contact fraction, mean closure and the
-   far-face stiffness; the gap between them closes under FE refinement.
+   penalty of the scene): the FE cell over a ladder of interface mesh sizes,
+   each solved on the mesh its row names (``discretization.estimate =
+   "estimate"``: not refined towards the default tolerance), its contact
+   fraction's error estimate (one order more on the same mesh) beside its
+   true error against the spectral cell at 512^2 (its own change from 256^2
+   as its estimate); contact fraction, mean closure and the far-face
+   stiffness.
 3. **Issue 38's random map against Tamaas** (skipped without the ``bench``
    extra for Tamaas' rows): the random 64 x 64 map of
    ``scripts/random_map_accuracy.py`` (issue 35's cell), its bilinear
@@ -87,9 +91,10 @@ MU, SHEAR = 0.5, 0.2                      # part 3 with friction: Coulomb mu, me
 FRICTION_GRID = 512                       # part 3 with friction (1024^2 takes over 10 minutes: see the note)
 GRIDS, FINEST = (128, 256, 512, 1024), 1024
 MAP_GRID, MAP_GRID_QUICK = 1024, 256        # part 3: the random map's grid (issue 38: 1024^2)
+SPECTRAL_GRID, SPECTRAL_GRID_QUICK = 512, 128  # part 2: the spectral reference's grid
 TOL = 1e-10
-KEYS = ("part", "solver", "setting", "grid_or_ndof", "contact_fraction", "pressure_l2_difference", "mean_closure",
-        "stiffness", "iterations", "seconds", "peak_memory_gb")
+KEYS = ("part", "solver", "setting", "grid_or_ndof", "contact_fraction", "estimate", "true_error",
+        "pressure_l2_difference", "mean_closure", "stiffness", "iterations", "seconds", "peak_memory_gb")
 
 
 def surface(n: int) -> np.ndarray:
@@ -249,20 +254,38 @@ def run_variant(scene, **changes):
 
 
 def fe_against_spectral(sizes, quick: bool) -> list[dict]:
+    """Part 2 (module docstring), each row the discretization it names: FE ``estimate = "estimate"`` (one order
+    more, :mod:`ngcontact.cell.fe.saturation`; the default refinement had solved 0.12 and 0.06 alike on 38,826
+    dofs), the spectral cell ``estimate = "off"`` on ``G``^2 and ``(G/2)``^2, ``G``^2 the reference."""
     from ngcontact.scene.loader import load
     scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
-    rows = []
-    settings = [("spectral", replace(scene.discretization, method="spectral", grid=128 if quick else 512))]
-    settings += [("fe", replace(scene.discretization, interface_maxh=h)) for h in sizes]
-    for kind, disc in settings:
-        out, load0, secs = run_variant(scene, discretization=disc)
-        rows.append({"part": "bisinusoid", "solver": f"ngcontact {kind}",
-                     "setting": f"grid {disc.grid}" if kind == "spectral" else f"order {disc.order}, interface_maxh "
-                     f"{disc.interface_maxh}", "grid_or_ndof": out.ndof, "contact_fraction": load0["contact_fraction"],
+    grid = SPECTRAL_GRID_QUICK if quick else SPECTRAL_GRID
+    fractions = {}
+    for n in (grid // 2, grid):
+        out, load0, secs = run_variant(scene, discretization=replace(scene.discretization, method="spectral", grid=n,
+                                                                     estimate="off"))
+        fractions[n] = load0["contact_fraction"]
+    reference = fractions[grid]
+    rows = [{"part": "bisinusoid", "solver": "ngcontact spectral", "setting": f"grid {grid}", "grid_or_ndof": out.ndof,
+             "contact_fraction": reference, "estimate": abs(reference - fractions[grid // 2]),
+             "mean_closure": load0["mean_closure"], "stiffness": load0["effective_stiffness"]["total"][-1][-1],
+             "iterations": out.solver["iterations"], "seconds": secs}]
+    log.info("bisinusoid spectral %d^2: fraction %.5f (change from %d^2: %.2g; %.1f s)", grid, reference, grid // 2,
+             rows[0]["estimate"], secs)
+    for h in sizes:
+        out, load0, secs = run_variant(scene, discretization=replace(scene.discretization, interface_maxh=h,
+                                                                     estimate="estimate"))
+        estimate = load0.get("error_estimate", {}).get("contact_fraction")
+        rows.append({"part": "bisinusoid", "solver": "ngcontact fe",
+                     "setting": f"order {scene.discretization.order}, interface_maxh {h:g}, one order more",
+                     "grid_or_ndof": out.ndof, "contact_fraction": load0["contact_fraction"],
+                     "estimate": "" if estimate is None else estimate,
+                     "true_error": abs(load0["contact_fraction"] - reference),
                      "mean_closure": load0["mean_closure"], "stiffness": load0["effective_stiffness"]["total"][-1][-1],
                      "iterations": out.solver["iterations"], "seconds": secs})
-        log.info("bisinusoid %-40s ndof %8d: fraction %.5f closure %.8f stiffness %.5f (%.1f s)", rows[-1]["setting"],
-                 out.ndof, load0["contact_fraction"], load0["mean_closure"], rows[-1]["stiffness"], secs)
+        log.info("bisinusoid %-40s ndof %8d: fraction %.5f, estimate %s, true error %.2g (%.1f s)",
+                 rows[-1]["setting"], out.ndof, load0["contact_fraction"],
+                 "none" if estimate is None else f"{estimate:.2g}", rows[-1]["true_error"], secs)
     return rows
 
 
@@ -319,7 +342,8 @@ def plot(rows: list[dict], path: str) -> None:
     bis = [r for r in rows if r["part"] == "bisinusoid"]
     fe = [(r["grid_or_ndof"], r["contact_fraction"]) for r in bis if r["solver"] == "ngcontact fe"]
     spectral = [(r["setting"], r["contact_fraction"]) for r in bis if r["solver"] == "ngcontact spectral"]
-    fe_against_spectral_panel(axes[2], fe, spectral, "")
+    estimates = [r["estimate"] if r.get("estimate") != "" else 0.0 for r in bis if r["solver"] == "ngcontact fe"]
+    fe_against_spectral_panel(axes[2], fe, spectral, "", estimates)
     random_map_panel(axes[3], rows)
     finish(fig, axes, path)
 
@@ -335,11 +359,15 @@ def random_map_panel(ax, rows: list[dict]) -> None:
            title="random 64^2 map, bilinear on the grid: time per load")
 
 
-def fe_against_spectral_panel(ax, fe: list[tuple[int, float]], spectral: list[tuple[str, float]], what: str) -> None:
+def fe_against_spectral_panel(ax, fe: list[tuple[int, float]], spectral: list[tuple[str, float]], what: str,
+                              estimates: list[float] | None = None) -> None:
     """The bisinusoid's contact fraction: FE ``(dofs, fraction)`` against the spectral cell's ``(setting, fraction)``
-    as lines; ``what`` names the enforcement (empty: the scene's)."""
+    as lines; ``what`` names the enforcement (empty: the scene's); ``estimates``: the FE values' estimated errors,
+    drawn as error bars."""
     if fe:
-        ax.semilogx([d for d, _ in fe], [f for _, f in fe], "o-", label=f"FE cell{what}")
+        ax.errorbar([d for d, _ in fe], [f for _, f in fe], yerr=estimates, fmt="o-", capsize=3,
+                    label=f"FE cell{what}" + (" (bars: its estimate)" if estimates else ""))
+        ax.set_xscale("log")
     for setting, f in spectral:
         ax.axhline(f, color="k", ls="--", label=f"spectral{what}, {setting}")
     ax.set(xlabel="FE dofs", ylabel="contact fraction", title=f"bisinusoid: FE{what} against spectral{what}")
@@ -407,7 +435,12 @@ def main(argv=None) -> int:
                               os.path.join(args.out, "spectral_vs_fft.csv"),
                               note="Part 1: a random self-affine surface on two thick layers against Tamaas' "
                                    "half-space solver (skipped without the `bench` extra); part 2: the FE cell "
-                                   "against the spectral cell on the bisinusoid; part 3 (`random_map`): issue "
+                                   "against the spectral cell on the bisinusoid, each FE row solved on the "
+                                   "interface mesh it names (`discretization.estimate = 'estimate'`: not "
+                                   "refined), `estimate` its contact fraction's error estimate (one order more on "
+                                   "the same mesh, the change over 1 - 0.75), `true_error` its distance to the "
+                                   "spectral row (absolute; the spectral row's `estimate`: its change from the "
+                                   "grid of half its points); part 3 (`random_map`): issue "
                                    "38's random 64 x 64 map, bilinear on 1024^2, three loads, ours and Tamaas' "
                                    "at the same grid and tolerance (each by its own stopping rule; seconds per "
                                    "load); part 4: dissimilar finite layers, frictionless and with Coulomb "

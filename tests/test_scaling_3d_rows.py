@@ -57,3 +57,34 @@ def test_the_note_numbers_the_kept_rows_then_the_new_ones(tmp_path, monkeypatch)
     before = note.read_text(), (tmp_path / "archive" / S.ROWS).read_text()
     S.keep(str(out), S.ARCHIVE, 3, 0)
     assert (note.read_text(), (tmp_path / "archive" / S.ROWS).read_text()) == before
+
+
+def test_an_extrapolation_carries_the_ladders_estimate():
+    """The extrapolated row's estimate is the contact-edge ladder's: the larger of the grid convergence index and
+    the spectral twin's floor |q - q_N| + 2 |q_N - q_N/2| on the twin's grid N of the finest edge size (512 at
+    0.0025), each in its own column."""
+    import bisinusoid_accuracy as B
+    rows = [_row(0.01, 0.0152), _row(0.005, 0.01485), _row(0.0025, 0.014725)]
+    asked = []
+
+    def twin(grid, ratio, values={512: 0.0147, 256: 0.0146}):
+        asked.append((grid, ratio))
+        return values[grid]
+    (row,) = B.extrapolated_rows(rows, {0.005: 0.0147}, twin)
+    assert sorted(asked) == [(256, 0.005), (512, 0.005)]
+    q = row["contact_fraction"]
+    assert row["estimate_twin"] == pytest.approx((abs(q - 0.0147) + 2 * 0.0001) / q, rel=1e-12)
+    assert row["estimate"] == max(row["estimate_gci"], row["estimate_twin"])
+    assert row["effectivity"] == pytest.approx(row["estimate"] / abs(q / 0.0147 - 1.0), rel=1e-12)
+    (close,) = B.extrapolated_rows(rows, {0.005: 0.0147}, lambda grid, ratio: q)
+    assert close["estimate_twin"] == 0.0 and close["estimate"] == close["estimate_gci"]
+
+
+def test_the_published_extrapolations_bound_their_errors():
+    """On the kept rows of the section (docs/benchmarks/scaling_3d), measured against the spectral cell
+    extrapolated from 512^2 and 1024^2, every extrapolation's estimate (with the real spectral twin) is at least
+    its true error: effectivity >= 1."""
+    rows = [r for r in S.with_extrapolations(S.read_rows(S.ARCHIVE)) if r["solver"].endswith(S.EXTRAPOLATED)]
+    assert rows
+    for r in rows:
+        assert r["estimate"] >= abs(r["relative_error"]), r
