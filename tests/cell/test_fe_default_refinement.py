@@ -149,3 +149,17 @@ def test_a_level_the_mesher_cannot_build_ends_a_default_refinement_not_the_run()
     assert f"{BUDGET_KEY} = 120000" in said and "stopped: level 2 cannot be built" in said
     with pytest.raises(ModelError):
         refine(_Unmeshable(), [None], 1e-3, 10 ** 9, required=True)
+
+
+def test_a_projection_beyond_any_machine_is_said_to_be_out_of_reach():
+    """An estimate falling like dofs^-0.06 does not project to a number of unknowns worth printing: the
+    shortfall says the tolerance is out of reach of the refinement, with the rate; a reachable one keeps its
+    figure."""
+    from ngcontact.cell.fe.default_refinement import OUT_OF_REACH, shortfall
+    from ngcontact.cell.fe.observed_rate import dofs_to_meet
+    slow = shortfall(0.01, 120_000, "interface_maxh 0.00625, 17558 dofs", 0.209,
+                     dofs_to_meet(17558, 0.209, 0.01, 0.06))
+    assert "out of reach of this refinement" in slow and "dofs^-0.06" in slow and "about" not in slow
+    assert f"{OUT_OF_REACH:.0e}" in slow
+    fast = shortfall(0.01, 120_000, "interface_maxh 0.05, 17558 dofs", 0.02, dofs_to_meet(17558, 0.02, 0.01, 1.0))
+    assert "meeting it would take about 3.5e+04 dofs" in fast and "out of reach" not in fast

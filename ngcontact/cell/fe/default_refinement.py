@@ -69,6 +69,8 @@ from ngcontact.cell.fe.second_discretization import HALVING_RATE, Sequence, as_r
 
 #: the scene key of the budget, as the warning names it
 BUDGET_KEY = "discretization.budget_dofs"
+#: unknowns beyond any machine this package runs on: a projection above it is said to be out of reach
+OUT_OF_REACH = 1e9
 
 
 #: the quantities the graded refinement estimates and holds to a tolerance (:mod:`ngcontact.cell.fe.grading_estimate`)
@@ -113,8 +115,11 @@ def shortfall(tolerance: float, budget: int, finest: str, estimate: float, need:
             f"against {tolerance:g}{'; stopped: ' + stop if stop else ''})")
     if need is None:
         return head + "; the estimates do not fall fast enough to extrapolate what meeting it would take"
-    return (head + f"; meeting it would take about {need[0]:.2g} dofs (the estimate falling like "
-            f"dofs^-{need[1]:.2g}, as observed, or as assumed where one level is estimated)")
+    rate = f"the estimate falling like dofs^-{need[1]:.2g}, as observed, or as assumed where one level is estimated"
+    if need[0] > OUT_OF_REACH:
+        return (head + f"; at that rate ({rate}) meeting it would take more than {OUT_OF_REACH:.0e} dofs: out of "
+                "reach of this refinement (another discretization.method or a looser tolerance)")
+    return head + f"; meeting it would take about {need[0]:.2g} dofs ({rate})"
 
 
 def sequence_shortfall(done: Sequence, tolerance: float, budget: int) -> str:
