@@ -21,6 +21,7 @@ from typing import Callable
 
 from ngcontact._version import __version__
 from ngcontact.errors import SceneError
+from ngcontact.output.progress_lines import progress_lines
 from ngcontact.output.report import Clock, Outcome, accuracy_line, build_report, method_line
 from ngcontact.scene import loader
 
@@ -80,38 +81,6 @@ def threads(n: int):
     finally:
         for name in unset:
             os.environ.pop(name, None)
-
-
-#: The logger of the progress lines of long computations inside a stage (a spectral solve running longer
-#: than a few seconds, each level of a refinement): :func:`progress_lines` prints them as the stage lines.
-PROGRESS_LOGGER = "ngcontact.progress"
-
-
-class _ProgressHandler(logging.Handler):
-    def __init__(self, clock: Clock):
-        super().__init__(logging.INFO)
-        self.clock = clock
-
-    def emit(self, record: logging.LogRecord) -> None:
-        self.clock.note(record.getMessage())
-
-
-@contextmanager
-def progress_lines(clock: Clock):
-    """Within the block, INFO records of :data:`PROGRESS_LOGGER` are progress lines of ``clock`` (printed as
-    the stage lines are, so ``--quiet`` drops them too) and nothing else."""
-    logger = logging.getLogger(PROGRESS_LOGGER)
-    handler = _ProgressHandler(clock)
-    level, propagate = logger.level, logger.propagate
-    logger.addHandler(handler)
-    logger.setLevel(logging.INFO)
-    logger.propagate = False
-    try:
-        yield
-    finally:
-        logger.removeHandler(handler)
-        logger.setLevel(level)
-        logger.propagate = propagate
 
 
 #: What the members of every batch import (the scene translator and through it the model code): a worker
