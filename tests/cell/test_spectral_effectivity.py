@@ -17,7 +17,8 @@ import pytest
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
-from ngcontact.cell.spectral.refinement import GUARDED, ORDER_RATE, RICHARDSON, sweep_to_tolerance, tail_estimate
+from ngcontact.cell.spectral.estimate_forms import GUARDED, RICHARDSON, tail_estimate
+from ngcontact.cell.spectral.refinement import ORDER_RATE, sweep_to_tolerance
 from ngcontact.geometry.random_surface import self_affine
 
 NU, H = 0.3, 0.01
@@ -171,7 +172,8 @@ def test_the_estimate_is_within_ten_times_the_error_where_that_error_is_not_smal
 def test_a_coefficient_is_not_taken_as_geometric_where_the_contact_fraction_is_not():
     """The coefficients of eq. 34 rest on the fraction's edges: a ``g_n`` whose own ratios agree takes the guarded
     bound where the fraction of its load does (a vanished last difference), and Richardson where it does not."""
-    from ngcontact.cell.spectral.refinement import guarded_bound, sweep_estimates
+    from ngcontact.cell.spectral.estimate_forms import guarded_bound
+    from ngcontact.cell.spectral.refinement import sweep_estimates
 
     def history(fractions):                     # every level's edges located by the quartic
         return [{"headline": [{"contact_fraction": f, "coefficient_g_n": g}], "whole_surface": {"k_n": 1.0, "g_n": 1.0},
@@ -202,7 +204,8 @@ def test_a_stop_waits_for_three_differences_on_the_levels_whose_edges_the_quarti
 def test_after_a_deferred_stop_the_estimate_is_at_most_the_deferred_one_plus_the_last_difference():
     """``|e_k| <= |e_(k-1)| + |q_k - q_(k-1)|``: the carried bound replaces a larger own estimate, in each
     quantity's measure (the mean closure relative to its value on each level), and leaves a smaller one."""
-    from ngcontact.cell.spectral.refinement import CARRIED, carried
+    from ngcontact.cell.spectral.estimate_forms import CARRIED
+    from ngcontact.cell.spectral.refinement import carried
 
     whole = {"k_n": 1.0, "g_n": 1.0}
     history = [{"headline": [{"contact_fraction": 0.30, "mean_closure": 2.0}], "whole_surface": whole},
@@ -220,7 +223,8 @@ def test_on_levels_of_the_line_the_contact_fraction_and_coefficients_take_the_gu
     differences are a coincidence (module docstring of :mod:`~ngcontact.cell.spectral.refinement`).  A load
     whose edges are not all fitted takes the guarded bound for the fraction and ``g_n``, the mean closure
     (not on the edges) Richardson's tail."""
-    from ngcontact.cell.spectral.refinement import guarded_bound, sweep_estimates
+    from ngcontact.cell.spectral.estimate_forms import guarded_bound
+    from ngcontact.cell.spectral.refinement import sweep_estimates
     values = _geometric(0.3, levels=4)
     history = [{"headline": [{"contact_fraction": v, "coefficient_g_n": v, "mean_closure": v}],
                 "whole_surface": {"k_n": 1.0, "g_n": 1.0}, "edges_fitted": [fitted]}

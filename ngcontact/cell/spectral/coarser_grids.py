@@ -2,7 +2,7 @@
 
 Refinement to a tolerance (:mod:`ngcontact.cell.spectral.refinement`) estimates the error of the finest of a
 sequence of grids, each with twice the points per direction of the one before, from the differences
-``d_j = q_j - q_(j-1)`` of its last :data:`~ngcontact.cell.spectral.refinement.WINDOW` levels
+``d_j = q_j - q_(j-1)`` of its last :data:`~ngcontact.cell.spectral.estimate_forms.WINDOW` levels
 (:func:`~ngcontact.cell.spectral.refinement.sweep_estimates`: Richardson with the observed rate where the
 sequence is seen to be geometric, else the guarded geometric tail; the island floor and the loose flags).
 That estimate needs the sequence that ends at the reported grid, not grids beyond it.  So a cell answered on

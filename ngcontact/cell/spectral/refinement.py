@@ -152,7 +152,9 @@ import numpy as np
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
 from ngcontact.cell.spectral.contact_edges import (ISLAND_POINTS, LOCATED_STEP, fitted_run, island_floor, on_edges,
                                                    resolved_run, unresolved_share, locator_changing as edges_changing)
-from ngcontact.cell.spectral.estimate_forms import CARRIED, GUARDED, LOOSE, RICHARDSON, loose_flags, loose_remarks
+from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP, RATE_FLOOR,
+                                                    SPREAD, WINDOW, loose_flags, loose_remarks,
+                                                    tail_estimate)
 from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
 from ngcontact.errors import ConvergenceError
 
@@ -162,24 +164,11 @@ progress = logging.getLogger("ngcontact.progress")
 
 #: points per direction of a level over those of the previous level
 GROWTH = 2
-#: the differences the estimate looks at, and the fewest levels a stop needs
-WINDOW = 3
+#: the fewest levels a stop needs: one more than the differences the estimate looks at
 MIN_LEVELS = WINDOW + 1
-#: the slowest and the fastest contraction per level the guarded bound assumes (module docstring)
-RATE_FLOOR = 0.5
-RATE_CAP = 0.7
-#: an earlier difference shrinks by this per level in the guarded envelope (first order in the grid step)
-ENVELOPE = 0.5
-#: a last difference this many times below the envelope is said to have vanished (a remark only)
-VANISHED = 4.0
-#: two successive ratios within this factor of each other make the sequence geometric (Richardson)
-AGREE = 3.0
 #: the fastest contraction per level Richardson may assume: each quantity's own order in the grid step, first
 #: for each (module docstring; any other quantity: :data:`FIRST_ORDER`)
 ORDER_RATE = {"contact_fraction": 0.5, "mean_closure": 0.5}
-FIRST_ORDER = 0.5
-#: Richardson's tail times this: the scatter of one level's error about the geometric model
-SPREAD = 2.0
 #: estimated quantities refinement does not hold to the tolerance (module docstring): reported with estimates
 UNCONTROLLED = ("normal_stiffness",)
 #: a quantity's estimate times this: the stiffness's first-order constant jumps with the edges' position between
@@ -241,56 +230,6 @@ def controlled_estimate(estimates: list[dict[str, float]]) -> float:
 def next_grid(grid: int, dim: int) -> int:
     """Points per direction of the next level: ``GROWTH`` times as many."""
     return grid * GROWTH
-
-
-def differences(values: list[float], relative: bool, scale: float | None = None) -> list[float]:
-    """The sizes of the last ``WINDOW`` differences of ``values``, the newest first, in the estimate's measure:
-    divided by ``scale`` where given, else by the last value where ``relative``."""
-    if scale is None:
-        scale = abs(values[-1]) if relative and values[-1] != 0 else 1.0
-    return [abs(b - a) / scale for a, b in zip(values[:-1], values[1:])][::-1][:WINDOW]
-
-
-def richardson(d: list[float], order_rate: float) -> tuple[float, float] | None:
-    """Richardson's estimate from the differences ``d`` (newest first) and its rate, where the window's two
-    ratios agree (module docstring); ``None`` where they do not."""
-    if len(d) < WINDOW or min(d[1:]) <= 0:
-        return None
-    ratios = [d[i] / d[i + 1] for i in range(WINDOW - 1)]
-    if min(ratios) <= 0 or max(ratios) > RATE_CAP or max(ratios) > AGREE * min(ratios):
-        return None
-    rate = max(max(ratios), order_rate)
-    return SPREAD * d[0] * rate / (1.0 - rate), rate
-
-
-def guarded_bound(d: list[float]) -> tuple[float, str]:
-    """The guarded geometric tail from the differences ``d`` (newest first; module docstring) and a remark
-    where a guard acted ("" otherwise)."""
-    ratios = [d[i] / d[i + 1] for i in range(len(d) - 1) if d[i + 1] > 0]
-    observed = max(ratios) if ratios else RATE_CAP
-    rate = min(max(observed, RATE_FLOOR), RATE_CAP)
-    terms = [d[i] * ENVELOPE ** i for i in range(len(d))]
-    envelope = max(terms)
-    remark = []
-    if observed > RATE_CAP:
-        remark.append(f"not contracting (ratio {observed:.2g}): rate {RATE_CAP}")
-    if envelope > VANISHED * terms[0]:
-        remark.append("the last difference nearly vanished: an earlier one bounds it")
-    return envelope * rate / (1.0 - rate), "; ".join(remark)
-
-
-def tail_estimate(values: list[float], relative: bool, order_rate: float = RATE_FLOOR,
-                  scale: float | None = None, geometric: bool = True) -> tuple[float, str, str]:
-    """The estimated error of the last of ``values`` (a quantity on successive levels; module docstring), its
-    form (:data:`RICHARDSON` where that is the smaller, else :data:`GUARDED`) and a remark on it.  Needs two
-    values at least; ``order_rate`` is the quantity's :data:`ORDER_RATE`; ``scale``: the size the error is
-    divided by (default: 1, or the last value where ``relative``); not ``geometric``: the guarded bound only."""
-    d = differences(values, relative, scale)
-    fitted = richardson(d, order_rate) if geometric else None
-    estimate, remark = guarded_bound(d)
-    if fitted is None or fitted[0] >= estimate:
-        return estimate, GUARDED, remark
-    return fitted[0], RICHARDSON, f"rate {fitted[1]:.2g}"
 
 
 def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
