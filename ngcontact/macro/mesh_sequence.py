@@ -107,8 +107,8 @@ def growing(values: list[float], scale: float, sampling: list[float] | None = No
     contract by ``2^-q`` per level: at most ``2^-0.544 = 0.69`` for the pollution of the slowest singular
     point of :mod:`ngcontact.macro.away_maxima`.  One that is unbounded does not: ``log(1/r)`` sampled at
     ``r ~ h_k = 2^-k h_0`` gains a constant per level (ratio 1), ``r^(lambda - 1)`` a factor
-    ``2^(1 - lambda) > 1``.  :data:`GROWING` lies between the two; the argument and the figures it was
-    measured on are in :mod:`ngcontact.macro.away_sequence`.  No estimate of the scene's own mesh enters:
+    ``2^(1 - lambda) > 1``.  :data:`GROWING` lies between the two (the argument in full:
+    :mod:`ngcontact.macro.away_sequence`).  No estimate of the scene's own mesh enters:
     a quantity without a limit has no error to compare its growth with."""
     if len(values) < 3:
         return False

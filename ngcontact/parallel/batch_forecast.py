@@ -53,7 +53,7 @@ FOLDER = "batches"
 #: Records kept at most (the oldest go first): the runs of scenes in many folders do not fill the cache.
 KEPT = 256
 
-#: The record of a local worker's costs as measured on this machine, by kind: ``start`` (CPU seconds of a
+#: The record of a local worker's costs as this machine timed them, by kind: ``start`` (CPU seconds of a
 #: worker's start, until its imports are done) and ``first_member`` (CPU seconds a worker's first member
 #: took beyond the cheapest member of its batch solved in the run's process).
 COSTS_FILE = "worker_costs.json"
@@ -125,7 +125,7 @@ def _write(file: str, data: dict) -> None:
 
 
 def measured_costs(kind: str) -> list[float]:
-    """The last costs of ``kind`` (:data:`COSTS`) measured on this machine, oldest first."""
+    """The last costs of ``kind`` (:data:`COSTS`) this machine timed, oldest first."""
     try:
         with open(os.path.join(folder(), COSTS_FILE)) as f:
             costs = [float(s) for s in json.load(f)[kind]]

@@ -4,7 +4,7 @@ A run's batches (:meth:`JudgedBatches.start_on_demand` or an early start) are ju
 are solved in the run's own process, each timed, and the rest goes to the workers only where condition
 (1) of :mod:`ngcontact.parallel.worker_payoff` holds for it: the rest's serial time against the workers'
 start still ahead (``R``), a worker's first member (``F``: :func:`first_member_cost`) and the CPU
-time of their starts (``S``: :func:`start_cost`; both measured on this machine), on the cores other processes
+time of their starts (``S``: :func:`start_cost`; both as this machine timed them), on the cores other processes
 leave free (``f``, :mod:`ngcontact.parallel.free_cores`, read at each look).  A batch kept in this
 process starts no worker; while the workers solve a batch, this process's NGSolve threads sleep
 (:func:`~ngcontact.parallel.batch_member.threads_asleep`).
@@ -28,11 +28,11 @@ log = logging.getLogger("ngcontact.parallel.executor")
 
 
 #: CPU seconds of a local worker's start (a fresh interpreter importing NGSolve and the package) before
-#: one has been measured on this machine (an estimate): ``S`` of :mod:`ngcontact.parallel.worker_payoff`.
+#: this machine has timed one (an estimate): ``S`` of :mod:`ngcontact.parallel.worker_payoff`.
 START_SECONDS = 2.0
 
 
-#: CPU seconds a worker's first member takes beyond the others before one has been measured on this machine
+#: CPU seconds a worker's first member takes beyond the others before this machine has timed one
 #: (an estimate): what the run's process paid before its batch and a fresh worker pays in its first member,
 #: e.g. importing a measured surface's reader and reading its file; ``F`` of
 #: :mod:`ngcontact.parallel.worker_payoff`.
@@ -40,14 +40,14 @@ FIRST_MEMBER_SECONDS = 1.0
 
 
 def start_cost(default: float | None = None) -> float:
-    """``S``: the CPU seconds of a worker's start as measured on this machine
+    """``S``: the CPU seconds of a worker's start as this machine timed it
     (:func:`~ngcontact.parallel.batch_forecast.cost_seconds`), ``default`` (:data:`START_SECONDS`) before
     any."""
     return batch_forecast.cost_seconds("start", START_SECONDS if default is None else default)
 
 
 def first_member_cost(default: float | None = None) -> float:
-    """``F``: the CPU seconds of a worker's first member beyond the others, as measured on this machine,
+    """``F``: the CPU seconds of a worker's first member beyond the others, as this machine timed it,
     ``default`` (:data:`FIRST_MEMBER_SECONDS`) before any."""
     return batch_forecast.cost_seconds("first_member", FIRST_MEMBER_SECONDS if default is None else default)
 
