@@ -93,26 +93,21 @@ def test_the_effective_stiffness_by_cg_equals_the_factorized_one_and_the_next_lo
                                                                 rel=1e-8)
 
 
-def _coarse_bisinusoid_by_cg():
-    """The shipped bisinusoid cell on a coarse mesh solved by BDDC-CG: its solution, state and solver record."""
-    from ngcontact.cell.fe.cell_problem import CellProblem
-    from ngcontact.drivers.build import build_cell, cell_loads, model_of
-    from ngcontact.scene.loader import load
-    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
-    P = CellProblem(build_cell(scene, maxh=0.6, interface_maxh=0.2), model_of(scene),
-                    linear=LinearSolver("iterative"))
-    sol = P.solve(cell_loads(scene)[0], first=True, measure=False)
-    return sol, P.gfu.vec.FV().NumPy().copy(), P.linear.summary()
-
-
 def test_a_kept_bddc_gives_the_state_of_one_rebuilt_at_every_step(monkeypatch):
     """The split energy keeps BDDC across Newton steps (only CG's iterations may grow); rebuilt at every
     step (growth limit 0) it gives the same cell state to Newton's tolerance, and the record says which."""
+    from ngcontact.cell.fe.cell_problem import CellProblem
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.scene.loader import load
     from ngcontact.solvers import linear_solver
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
     out, default = {}, linear_solver.REBUILD_GROWTH
     for growth in (default, 0.0):
         monkeypatch.setattr(linear_solver, "REBUILD_GROWTH", growth)
-        out[growth] = _coarse_bisinusoid_by_cg()
+        P = CellProblem(build_cell(scene, maxh=0.6, interface_maxh=0.2), model_of(scene),
+                        linear=LinearSolver("iterative"))
+        sol = P.solve(cell_loads(scene)[0], first=True, measure=False)
+        out[growth] = (sol, P.gfu.vec.FV().NumPy().copy(), P.linear.summary())
     (kept, u_kept, s_kept), (every, u_every, s_every) = out[default], out[0.0]
     assert s_kept["bddc_kept"] >= 1
     assert s_every["bddc_kept"] == 0 and s_every["bddc_rebuilt_for_growth"] == every.iterations - 1
@@ -124,14 +119,21 @@ def test_a_kept_bddc_that_gives_up_is_rebuilt_within_the_solve_and_gives_the_sam
     """CG with a kept BDDC stops at its cap (here 2 iterations) and the step is solved again with a BDDC built
     at its state: the same cell state to Newton's tolerance as without the cap, the rebuilds counted and the
     given-up iterations recorded as solves of their own."""
+    from ngcontact.cell.fe.cell_problem import CellProblem
+    from ngcontact.drivers.build import build_cell, cell_loads, model_of
+    from ngcontact.scene.loader import load
     from ngcontact.solvers import linear_solver
+    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
     out = {}
     uncapped = linear_solver.TangentSolve.cap
     for cap in (None, 2):
         if cap is not None:
             monkeypatch.setattr(linear_solver.TangentSolve, "cap",
                                 lambda self, tol: None if uncapped(self, tol) is None else cap)
-        out[cap] = _coarse_bisinusoid_by_cg()
+        P = CellProblem(build_cell(scene, maxh=0.6, interface_maxh=0.2), model_of(scene),
+                        linear=LinearSolver("iterative"))
+        sol = P.solve(cell_loads(scene)[0], first=True, measure=False)
+        out[cap] = (sol, P.gfu.vec.FV().NumPy().copy(), P.linear.summary())
     (free, u_free, s_free), (capped, u_capped, s_capped) = out[None], out[2]
     assert s_free["bddc_kept"] >= 1
     gave_up = s_capped["bddc_rebuilt_for_growth"] - s_free["bddc_rebuilt_for_growth"]
