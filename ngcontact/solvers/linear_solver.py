@@ -44,14 +44,7 @@ definite on the free dofs.  Two ways:
   assembled once, the interface at each step) keeps it across Newton steps
   while CG's iterations per decade stay within ``REBUILD_GROWTH`` times
   their rate after its build (a rebuild costs an assembly; a kept BDDC
-  costs CG iterations as the tangent drifts from its own).  The same rule
-  holds within a solve: CG with a kept BDDC stops at that many iterations
-  for the decades it is asked (at least ``MIN_CAP``), and the step is solved
-  again with a BDDC built at its state.  Uzawa's passes of exact contact
-  move the contact set, and with it the penalty's entries of the tangent:
-  on the 3D bisinusoid cell (p/p* = 0.05) a kept BDDC took 109 and 358 iterations where a
-  fresh one takes 11 to 36, at 165k dofs about 17 CPU s against one
-  assembly's 0.7 s.  CG stops at
+  costs CG iterations as the tangent drifts from its own).  CG stops at
   ``|r_k| <= eta |r_0|`` in the preconditioned norm: an inexact Newton
   step, ``eta`` from the Newton residual's decrease (:func:`forcing_term`,
   Eisenstat-Walker), never below ``rtol = 1e-10``; ``forcing = False``
@@ -106,8 +99,6 @@ UPDATABLE = ("sparsecholesky", "umfpack")
 AUTO_THRESHOLD = 20_000
 #: a kept BDDC is rebuilt once CG needs this many times the iterations per decade it needed after its build
 REBUILD_GROWTH = 2.0
-#: the fewest iterations a kept BDDC is allowed before it is rebuilt within a solve (:meth:`TangentSolve.cap`)
-MIN_CAP = 20
 #: flags of NGSolve's BDDC beyond the space's coupling types (its coarse solve: module docstring); none
 BDDC_FLAGS: dict = {}
 
@@ -200,15 +191,8 @@ class LinearSolver:
         if symmetric and self.forcing and forcing is not None:
             tol = max(self.rtol, forcing)
         extra = {"fixed": fixed_mask(freedofs)} if symmetric else {}
-
-        def fresh(rebuild: bool = False):
-            """The Krylov solver with the registered BDDC; ``rebuild``: after building it anew at this step's
-            state (the kept one gave up: :meth:`TangentSolve.apply`)."""
-            if rebuild:
-                form.rebuild()
-                self.rebuilds += 1
-            return krylov(form.mat, pre.mat, tol=tol, maxiter=self.max_iter, printrates=False, **extra)
-        return TangentSolve(self, fresh(), counted=True, record=record, tol=tol, renew=fresh)
+        return TangentSolve(self, krylov(form.mat, pre.mat, tol=tol, maxiter=self.max_iter, printrates=False,
+                                         **extra), counted=True, record=record, tol=tol)
 
     def preconditioned(self, form: ng.BilinearForm) -> bool:
         """Whether a preconditioner is registered with ``form`` (rebuilt at each of its assemblies)."""
@@ -334,17 +318,8 @@ class TangentSolve:
     ``[iterations per decade after its build, last ones]``)."""
 
     def __init__(self, owner: LinearSolver, inverse, counted: bool, record: list | None = None,
-                 tol: float = 0.1, renew=None):
+                 tol: float = 0.1):
         self.owner, self.inverse, self.counted, self.record, self.tol = owner, inverse, counted, record, tol
-        self.renew = renew
-
-    def cap(self, tol: float) -> int | None:
-        """The iterations a kept BDDC may take to ``tol``: ``REBUILD_GROWTH`` times its rate after its build
-        per decade asked (the rule :meth:`LinearSolver._kept_preconditioner` applies between solves, here
-        within one), at least ``MIN_CAP``; ``None`` for a BDDC just built or a solve that cannot rebuild."""
-        if self.record is None or self.record[0] is None or self.renew is None:
-            return None
-        return max(MIN_CAP, math.ceil(REBUILD_GROWTH * self.record[0] * max(-math.log10(tol), 1.0)))
 
     def apply(self, rhs, out, reach: float | None = None) -> None:
         """``out = K^-1 rhs``; with ``reach``, CG stops once the Euclidean norm of ``rhs - K out`` is at most
@@ -356,25 +331,10 @@ class TangentSolve:
             self.inverse.reach = reach
             size = rhs.Norm()
             tol = reach / size if size > 0 else 1.0
-        cap = self.cap(tol) if self.counted else None
-        if cap is not None:
-            self.inverse.maxiter = min(cap, self.owner.max_iter)
         out.data = self.inverse * rhs
         if not self.counted:
             return
         its = int(self.inverse.iterations)
-        if cap is not None and its >= cap:
-            # the kept BDDC has drifted from this tangent (a moved contact set): CG would take many times its
-            # usual iterations; a BDDC built at this state costs about one assembly (module docstring)
-            assert self.record is not None and self.renew is not None
-            self.inverse = self.renew(rebuild=True)
-            if reach is not None and hasattr(self.inverse, "reach"):
-                self.inverse.reach = reach
-            self.record[0] = None
-            out.data = self.inverse * rhs
-            its = int(self.inverse.iterations)
-            self.owner.iterations.append(cap)       # the iterations given up, recorded as a solve of their own
-            self.owner.tolerances.append(tol)
         self.owner.iterations.append(its)
         self.owner.tolerances.append(tol)
         if self.record is not None:
