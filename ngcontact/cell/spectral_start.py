@@ -52,6 +52,10 @@ load (a frictionless flat ``S_C`` carries no shear anyway; with friction
 Newton takes up the shear from there).  A twin that fails leaves the
 rigid start, recorded with the reason, and so does one whose contact set
 misses every point of ``S_C`` (a light load: the start would float).
+Exact contact (Uzawa's iteration, :mod:`ngcontact.cell.fe.contact_multiplier`) takes the exact twin
+(:func:`start_multiplier_on_twin`): the state stays the rigid predictor's and the multiplier starts as
+the twin's pressure, near Uzawa's fixed point; the edge-refined levels of the 3D cell start so, each from
+the twin on its own grid (:mod:`ngcontact.drivers.contact_edge_refiner`).
 A frictionless sweep starts every pressure afresh from the twin
 (:meth:`~ngcontact.cell.fe.cell_problem.CellProblem.sweep`: one minimizer, so
 the previous state need not be kept); a frictional one continues from the
@@ -119,6 +123,8 @@ def spectral_start(problem, load: CellLoad, twin: SpectralCell) -> dict:
     sol = twin_solution(twin, load, "starting from the rigid predictor")
     if isinstance(sol, str):
         return {"kind": "rigid", "twin_failed": sol}
+    if problem.multiplier is not None:
+        return start_multiplier_on_twin(problem, sol, twin)
     target = periodic_grid(sol.fields["closure"] - twin.g0, twin.period)
     move = ng.GridFunction(problem.X)
     move.components[0].Set((target - problem.penetration) * problem.n, ng.BND,
@@ -134,6 +140,24 @@ def spectral_start(problem, load: CellLoad, twin: SpectralCell) -> dict:
                 f"{sol.results['contact_fraction']:.3g}) misses every point of S_C"}
     log.info("spectral predictor: %d-point grid, contact fraction %.6f", twin.grid, sol.results["contact_fraction"])
     return {"kind": "spectral", "grid": twin.grid, "iterations": sol.iterations,
+            "contact_fraction": float(sol.results["contact_fraction"])}
+
+
+def start_multiplier_on_twin(problem, sol: SpectralSolution, twin: SpectralCell) -> dict:
+    """Exact contact: Uzawa's multiplier starts as the twin's pressure, the state at the rigid start.
+
+    With a zero multiplier Uzawa's first pass solves the penalty problem of the start's augmentation, whose
+    contact set and pressure the later passes correct.  With ``lambda`` the exact twin's pressure
+    (interpolated bilinearly at the multiplier's points, ``>= 0``) the passes start near their fixed point,
+    which does not depend on the start (:mod:`ngcontact.solvers.uzawa`).  The state stays the rigid
+    predictor's: it penetrates over the rigid overlap, so the augmented pressure ``lambda + k s`` is positive
+    there and the first tangent carries the load (the twin's state, closed on its contact set, would leave
+    the interpolation's misfit as the only penetration).  Returns the start's record.
+    """
+    m = problem.multiplier
+    m.set_point_values(np.maximum(m.at_points(periodic_grid(sol.fields["pressure"], twin.period)), 0.0))
+    log.info("spectral predictor: %d-point grid, the multiplier at the twin's pressure", twin.grid)
+    return {"kind": "spectral multiplier", "grid": twin.grid, "iterations": sol.iterations,
             "contact_fraction": float(sol.results["contact_fraction"])}
 
 

@@ -29,8 +29,9 @@ from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.contact_edge_mesh import edge_refined_cell
-from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
+from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement, twin_grid
 from ngcontact.cell.fe.fe_cell import FECell
+from ngcontact.cell.spectral_start import SpectralStart
 from ngcontact.drivers.mirror_symmetry import quarter
 from ngcontact.scene.cell_method import refines_along_edge
 from ngcontact.scene.cell_scene import CellScene, load_states
@@ -62,7 +63,9 @@ def scene_sizes(scene: CellScene) -> dict[str, float]:
 def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any],
                  spectral: Callable[..., Any]) -> Callable[[FECell], ContactEdgeRefinement] | None:
     """``(scene's FE cell) -> `` its :class:`ContactEdgeRefinement`, or ``None`` where the scene has none
-    (:func:`refines_along_edge`).  ``problem(scene, cell, model)``: the scene's cell problem on another mesh;
+    (:func:`refines_along_edge`).  ``problem(scene, cell, model, predictor=)``: the scene's cell problem on
+    another mesh, each level's started from the twin on that level's grid (:func:`twin_grid`: the state on
+    the twin's contact set, the multiplier its pressure, :mod:`ngcontact.cell.spectral_start`);
     ``spectral(scene, grid=, friction=, tol=)``: its spectral cell (both from :mod:`ngcontact.drivers.build`,
     which wires this refiner into the FE cell it makes)."""
     if not refines_along_edge(scene):
@@ -73,10 +76,11 @@ def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any]
     bulk = bulk_maxh(scene)
 
     solved: dict[int, list] = {}
+    cells: dict[int, Any] = {}
 
     def twin(grid: int) -> list:
         if grid not in solved:
-            cell = spectral(scene, grid=grid, friction=False, tol=EDGE_TWIN_RTOL)
+            cells[grid] = cell = spectral(scene, grid=grid, friction=False, tol=EDGE_TWIN_RTOL)
             solved[grid] = [cell.solve(cell_load(g.dim, **state)) for state in load_states(scene)]
         return solved[grid]
 
@@ -89,6 +93,8 @@ def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any]
     def cell_at(points, edge_maxh):
         cell = edge_refined_cell(points, edge_maxh=edge_maxh, period=g.period, h_rough=g.h_rough,
                                  h_counter=g.h_counter, maxh=bulk, interface_maxh=h, symmetric=symmetric)
-        return FECell.of(problem(scene, cell, model))
+        grid = twin_grid(edge_maxh, float(g.period))
+        twin(grid)
+        return FECell.of(problem(scene, cell, model, predictor=SpectralStart(cells[grid])))
 
     return lambda fe: ContactEdgeRefinement(fe, pressures, cell_at, h, float(g.period), twin_heads=heads)

@@ -95,16 +95,15 @@ def check_start(start: str | None, predictor: Predictor | None, enforcement: str
     Raises
     ------
     ValueError
-        ``start`` is none of :data:`STARTS`, or ``"predictor"`` without a predictor or with exact enforcement.
+        ``start`` is none of :data:`STARTS`, or ``"predictor"`` without a predictor.
     """
     if start is None:
         start = "rigid" if predictor is None else "predictor"
     if start not in STARTS:
         raise ValueError(f"start = {start!r}: must be 'rigid', 'closed' or 'predictor'")
-    if start == "predictor" and (predictor is None or enforcement != "penalty"):
-        raise ValueError("start = 'predictor' needs a predictor (the cell's spectral twin) and the penalty "
-                         f"(predictor {'given' if predictor is not None else 'missing'}, "
-                         f"enforcement {enforcement!r})")
+    if start == "predictor" and predictor is None:
+        raise ValueError("start = 'predictor' needs a predictor (the cell's spectral twin), none given "
+                         f"(enforcement {enforcement!r})")
     return start
 
 
