@@ -22,6 +22,7 @@ from typing import Callable
 from ngcontact._version import __version__
 from ngcontact.errors import SceneError
 from ngcontact.output.progress_lines import progress_lines
+from ngcontact.parallel.free_cores import affinity
 from ngcontact.output.report import Clock, Outcome, accuracy_line, build_report, method_line
 from ngcontact.scene import loader
 
@@ -44,7 +45,7 @@ def thread_count() -> int:
     """Threads of a run: ``NGCONTACT_THREADS`` or the cores available to this process."""
     raw = os.environ.get(THREADS_ENV)
     if raw is None:
-        return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        return len(affinity())
     try:
         n = int(raw)
     except ValueError:

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import contextvars
 import logging
-import os
 import time
 from typing import Any, Callable, Sequence
 
 from ngcontact.errors import BatchError
 from ngcontact.parallel.batch_member import ATTEMPTS, fault_from_env, reason, run_member
+from ngcontact.parallel.free_cores import affinity
 from ngcontact.parallel.worker_payoff import MemberClock
 
 log = logging.getLogger("ngcontact.parallel.executor")
@@ -29,7 +29,7 @@ PROGRESS: contextvars.ContextVar[Progress | None] = contextvars.ContextVar("ngco
 
 def default_workers() -> int:
     """The cores this process may use."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    return len(affinity())
 
 
 # --------------------------------------------------------------- executors
