@@ -13,6 +13,8 @@ The verdict has the format of the cell's (:func:`ngcontact.cell.admissibility.ve
 * with ``[two_scale]`` (the neighbouring orders solved with the loop's converged law) also the loop's
   own residual, ``max |sigma_n(k) - sigma_n(k-1)|`` of its last step relative to the peak pressure, and
   the cell table's interpolation error (relative, paper Sec. 3.5; :mod:`ngcontact.coupling.pressure_table`);
+  with the scene's tolerance the table's share of the headline quantities instead (``cell_table_share``,
+  :mod:`ngcontact.coupling.table_share`), the table's own error then listed but not counted;
 * the checks ``equilibrium`` (each body's forces balance, :func:`ngcontact.macro.macro_measures.equilibrium`)
   and ``law_closure`` (the interface's tractions are its law's at its jumps, with the friction threshold of the
   current pressure: :mod:`ngcontact.macro.law_closure`).

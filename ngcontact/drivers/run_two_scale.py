@@ -5,7 +5,11 @@ No file I/O here except the cell-table cache of :mod:`ngcontact.coupling.cell_la
 SHA-256 of the validated cell scene with its overrides, the data files it
 names, the cell length unit and the table tolerance, so a second run of the
 same scene solves no cell problem; an edited cell scene or data file gives
-another key.
+another key.  A table that grows during the run (the loop, a mesh level of
+the macro refinement, the refinement towards ``discretization.tolerance`` of
+:mod:`ngcontact.coupling.table_share`) is written back at once (atomically),
+with the responses its share's estimate solved (``held``), so the next run
+starts from it.
 
 The cell solves of one table level go through ``map_tasks`` (default:
 :func:`executor_map`, one batch of the run's executor, ``--workers`` local
