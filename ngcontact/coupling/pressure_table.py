@@ -123,13 +123,18 @@ class CellTable:
         self.values = nodes
         return {float(p): (nodes.get(float(p)) or self.held[float(p)]) for p in pressures}
 
-    def used_midpoints(self, pressures) -> list[float]:
-        """The midpoints of the table's intervals that hold any of ``pressures`` (the pressures a macro
-        solution uses: its law's error reaches it there only)."""
+    def used_midpoints(self, pressures, margin: int = 1) -> list[float]:
+        """The midpoints of the table's intervals from the one holding the least of ``pressures`` to the one
+        holding the largest (the pressures a macro solution uses: its law's error reaches it there only),
+        and ``margin`` more on either side, whose nodes' slopes the cubic's in the range depend on."""
         P = self.pressures
         p = np.asarray(pressures, float)
-        k = np.unique(np.clip(np.searchsorted(P, p[(p >= P[0]) & (p <= P[-1])], side="right") - 1, 0, len(P) - 2))
-        return [float(0.5 * (P[i] + P[i + 1])) for i in k]
+        p = p[(p >= P[0]) & (p <= P[-1])]
+        if not len(p):
+            return []
+        k = np.clip(np.searchsorted(P, [p.min(), p.max()], side="right") - 1, 0, len(P) - 2)
+        lo, hi = max(int(k[0]) - margin, 0), min(int(k[1]) + margin, len(P) - 2)
+        return [float(0.5 * (P[i] + P[i + 1])) for i in range(lo, hi + 1)]
 
     def _scale(self, key: str) -> float:
         return max([abs(v[key]) for v in self.values.values()] + [1e-300])
