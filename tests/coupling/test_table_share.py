@@ -20,7 +20,7 @@ from ngcontact.laws import homogenized as il
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro import macro_problem as M
 from ngcontact.macro.macro_measures import interface_samples
-from ngcontact.output.report import Clock
+from ngcontact.output.report import Clock, accuracy_line
 from ngcontact.scene import loader
 
 from tests.drivers.test_study_kinds import two_scale_scene
@@ -119,6 +119,8 @@ def test_a_tolerance_refines_the_table_reports_its_share_and_a_second_run_reuses
     assert share["rounds"][0]["share"] > share["limit"]               # the scene's table alone misses it
     assert not own["counted"] and own["value"] > 1e-3                # the table's own error is said, not judged
     assert first["accuracy"]["met"], first["accuracy"]["quantities"]
+    assert f"cell_table_interpolation {own['value']:.4g} +/- {own['value']:.2%} not counted" in \
+        accuracy_line(first)
     ts = first["two_scale"]
     assert ts["table"]["held"] >= 1 and ts["cell_solves"] > 0
     second = D.run(scene_with(tmp_path, monkeypatch, 1e-3), Clock()).results
