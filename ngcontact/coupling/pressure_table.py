@@ -79,6 +79,10 @@ class CellTable:
         runs the independent cell solves of one refinement level.
     values
         Responses known already (e.g. read from a cache): not solved again.
+    held
+        Responses solved but not nodes of the table (the midpoints of the last estimate of the table's share
+        of a macro run's error, :mod:`ngcontact.coupling.table_share`): a pressure asked for that is held
+        becomes a node without a cell solve.
     """
 
     response: Callable[[float], Response]
@@ -88,6 +92,7 @@ class CellTable:
     values: dict[float, Response] = field(default_factory=dict)
     error_estimate: float = 0.0
     solves: int = 0   # cell problems solved by this table (not those it was given)
+    held: dict[float, Response] = field(default_factory=dict)
 
     @property
     def pressures(self) -> np.ndarray:
@@ -95,6 +100,9 @@ class CellTable:
 
     def _solve(self, pressures) -> None:
         todo = sorted({float(p) for p in pressures} - set(self.values))
+        for p in [p for p in todo if p in self.held]:
+            self.values[p] = self.held.pop(p)
+        todo = [p for p in todo if p not in self.values]
         if not todo:
             return
         if self.solves + len(todo) > self.max_solves:
@@ -105,6 +113,28 @@ class CellTable:
                 raise ConvergenceError(f"cell table: non-finite cell response at p = {p:.6g}", dict(value))
             self.values[p] = {k: float(value[k]) for k in KEYS}
         self.solves += len(todo)
+
+    def hold(self, pressures) -> dict[float, Response]:
+        """The responses at ``pressures`` (solved where neither a node nor held), kept in :attr:`held` where they
+        are not nodes; the table's law is unchanged."""
+        nodes = dict(self.values)
+        self._solve(pressures)
+        self.held.update({p: v for p, v in self.values.items() if p not in nodes})
+        self.values = nodes
+        return {float(p): (nodes.get(float(p)) or self.held[float(p)]) for p in pressures}
+
+    def used_midpoints(self, pressures, margin: int = 1) -> list[float]:
+        """The midpoints of the table's intervals from the one holding the least of ``pressures`` to the one
+        holding the largest (the pressures a macro solution uses: its law's error reaches it there only),
+        and ``margin`` more on either side, whose nodes' slopes the cubic's in the range depend on."""
+        P = self.pressures
+        p = np.asarray(pressures, float)
+        p = p[(p >= P[0]) & (p <= P[-1])]
+        if not len(p):
+            return []
+        k = np.clip(np.searchsorted(P, [p.min(), p.max()], side="right") - 1, 0, len(P) - 2)
+        lo, hi = max(int(k[0]) - margin, 0), min(int(k[1]) + margin, len(P) - 2)
+        return [float(0.5 * (P[i] + P[i + 1])) for i in range(lo, hi + 1)]
 
     def _scale(self, key: str) -> float:
         return max([abs(v[key]) for v in self.values.values()] + [1e-300])
@@ -165,7 +195,8 @@ class CellTable:
     def as_dict(self) -> dict[str, list[float] | int | float]:
         P = self.pressures
         return {"pressure": P.tolist(), "cell_solves": self.solves, "nodes": len(P), "tolerance": self.tol,
-                "error_estimate": self.error_estimate, **{key: [self.values[q][key] for q in P] for key in KEYS}}
+                "error_estimate": self.error_estimate, "held": len(self.held),
+                **{key: [self.values[q][key] for q in P] for key in KEYS}}
 
 
 def response_law(table: CellTable) -> il.TabulatedLaw:

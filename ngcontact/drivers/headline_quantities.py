@@ -12,7 +12,8 @@ What an engineer reads first of each kind, as ``{name: value}`` (plain numbers):
 * two-scale (a macro report with ``results.two_scale``): the macro ones and the loop's residual
   ``two_scale_residual``, ``max |sigma_n(k) - sigma_n(k-1)|`` of its last step relative to the peak
   pressure (paper Sec. 3.5), and, from the accuracy record, the cell table's interpolation error
-  ``cell_table_interpolation``;
+  ``cell_table_interpolation`` and, with the scene's tolerance, its share of the macro quantities
+  ``cell_table_share`` (:mod:`ngcontact.coupling.table_share`);
 * direct: the resolved contact fraction ``contact_fraction`` and the magnitude of the contact force
   ``contact_force``.
 
@@ -37,7 +38,7 @@ from ngcontact.cell.cell_solution import COEFFICIENT
 #: quantities compared in absolute terms (fractions in [0, 1]); every other one relative to its value
 ABSOLUTE = ("contact_fraction", "contact_area", "whole_surface_contact_fraction")
 #: quantities that are themselves relative errors of the answer (module docstring)
-INDICATORS = ("two_scale_residual", "cell_table_interpolation")
+INDICATORS = ("two_scale_residual", "cell_table_interpolation", "cell_table_share")
 
 
 def measure(name: str) -> str:

@@ -13,6 +13,8 @@ The verdict has the format of the cell's (:func:`ngcontact.cell.admissibility.ve
 * with ``[two_scale]`` (the neighbouring orders solved with the loop's converged law) also the loop's
   own residual, ``max |sigma_n(k) - sigma_n(k-1)|`` of its last step relative to the peak pressure, and
   the cell table's interpolation error (relative, paper Sec. 3.5; :mod:`ngcontact.coupling.pressure_table`);
+  with the scene's tolerance the table's share of the headline quantities instead (``cell_table_share``,
+  :mod:`ngcontact.coupling.table_share`), the table's own error then listed but not counted;
 * the checks ``equilibrium`` (each body's forces balance, :func:`ngcontact.macro.macro_measures.equilibrium`)
   and ``law_closure`` (the interface's tractions are its law's at its jumps, with the friction threshold of the
   current pressure: :mod:`ngcontact.macro.law_closure`).
@@ -152,20 +154,24 @@ def estimates(samples: dict[int, dict[str, DE.Sample]], sol: MacroSolution) -> l
 
 
 def two_scale_quantities(two_scale: dict, tolerance: float) -> list[dict[str, Any]]:
-    """The loop's residual and the cell table's interpolation error as quantities of the verdict."""
+    """The loop's residual and the cell table's interpolation error as quantities of the verdict; where the
+    scene's tolerance had the table's share of the headline quantities estimated
+    (:mod:`ngcontact.coupling.table_share`), that share too, and the table's own error is listed but not
+    counted (the share is what it costs the macro quantities)."""
     last = two_scale["history"][-1]
     change = float(last["max_change"] or 0.0)
     peak = float(last["max_pressure"])
     rel = change / peak if peak > 0 else 0.0
     table = float(two_scale["table"]["error_estimate"])
+    share = two_scale.get("table_share")
     return [{"name": "two_scale_residual", "value": change, "error": change, "relative_error": rel,
              "controlled": "relative", "met": rel <= tolerance, "counted": True,
              "how": "max |sigma_n(k) - sigma_n(k-1)| over the interface points at the loop's last step [Pa], "
                     "relative to the peak pressure"},
             {"name": "cell_table_interpolation", "value": table, "error": table, "relative_error": table,
-             "controlled": "relative", "met": table <= tolerance, "counted": True,
+             "controlled": "relative", "met": table <= tolerance, "counted": share is None,
              "how": "the monotone cubic's largest error at interval midpoints, relative to the tabulated "
-                    "quantities' largest values (two_scale.table_tol bounds it)"}]
+                    "quantities' largest values (two_scale.table_tol bounds it)"}] + ([] if share is None else [share])
 
 
 def verdict(found: list[DE.Estimate], tolerance: float | None, balance: dict | None,

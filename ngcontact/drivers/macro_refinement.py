@@ -44,7 +44,10 @@ Then the mesh (h), where the order no longer pays
       the refined mesh from the tables the scene's loop made (``level_solve``,
       :class:`ngcontact.drivers.run_two_scale.Relevel`).  The cell's law is a function of the macro jump,
       not of the macro mesh, so the table is re-used as it stands where it covers the level's pressures
-      and grows by the cell solves of the new range where a finer mesh finds higher ones.
+      and grows by the cell solves of the new range where a finer mesh finds higher ones.  The table itself
+      was refined before, on the scene's mesh, until its share of the headline quantities met its part of
+      the tolerance (:mod:`ngcontact.coupling.table_share`); a level that extends it has that share
+      estimated again on the refined solution (:meth:`ngcontact.drivers.run_two_scale.Relevel.record`).
 
 What is refined for
     Only the quantities the verdict counts (:func:`unmet`).  Where the interface ends closed on a boundary

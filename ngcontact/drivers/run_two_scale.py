@@ -5,7 +5,11 @@ No file I/O here except the cell-table cache of :mod:`ngcontact.coupling.cell_la
 SHA-256 of the validated cell scene with its overrides, the data files it
 names, the cell length unit and the table tolerance, so a second run of the
 same scene solves no cell problem; an edited cell scene or data file gives
-another key.
+another key.  A table that grows during the run (the loop, a mesh level of
+the macro refinement, the refinement towards ``discretization.tolerance`` of
+:mod:`ngcontact.coupling.table_share`) is written back at once (atomically),
+with the responses its share's estimate solved (``held``), so the next run
+starts from it.
 
 The cell solves of one table level go through ``map_tasks`` (default:
 :func:`executor_map`, one batch of the run's executor, ``--workers`` local
@@ -55,7 +59,9 @@ import numpy as np
 from ngcontact.coupling import cell_law
 from ngcontact.coupling import shear_table as S
 from ngcontact.coupling import pressure_table as PT
+from ngcontact.coupling import table_share as TS
 from ngcontact.coupling import two_scale as T
+from ngcontact.macro import discretization_error as DE
 from ngcontact.macro.macro_measures import interface_samples
 from ngcontact.scene import cell_links
 from ngcontact.scene.sections import resolve
@@ -64,8 +70,9 @@ from ngcontact.parallel import executor
 
 log = logging.getLogger(__name__)
 
-TABLE_FORMAT = "cell-table-2"
-TABLE_ARRAYS = ("pressure",) + PT.KEYS + ("error_estimate",)
+TABLE_FORMAT = "cell-table-3"
+#: ``held``: 1 at a pressure solved for the estimate of the table's share but not a node of its law
+TABLE_ARRAYS = ("pressure",) + PT.KEYS + ("error_estimate", "held")
 
 
 #: cell problems built by unpickled tasks in this process (a worker), by task kind, content key and thread
@@ -208,7 +215,8 @@ def table_key(cell_scene, length_unit: float, tol: float) -> str:
 
 def _table_shapes(arrays: dict) -> str | None:
     n = arrays["pressure"].shape
-    if len(n) != 1 or n[0] < 2 or any(arrays[k].shape != n for k in PT.KEYS) or arrays["error_estimate"].shape != (1,):
+    if len(n) != 1 or any(arrays[k].shape != n for k in PT.KEYS + ("held",)) or \
+            arrays["error_estimate"].shape != (1,) or np.count_nonzero(arrays["held"] == 0) < 2:
         return "arrays of shapes " + ", ".join(str(arrays[k].shape) for k in TABLE_ARRAYS)
     if np.any(np.diff(arrays["pressure"]) <= 0):
         return "pressures not increasing"
@@ -222,15 +230,19 @@ def cached_table(key: str, response, tol: float, map_tasks, cache_dir: str | Non
     if found is None:
         return table, False
     for i, p in enumerate(found["pressure"]):
-        table.values[float(p)] = {k: float(found[k][i]) for k in PT.KEYS}
+        (table.held if found["held"][i] else table.values)[float(p)] = {k: float(found[k][i]) for k in PT.KEYS}
     table.error_estimate = float(found["error_estimate"][0])
     return table, True
 
 
 def store_table(key: str, table: PT.CellTable, cache_dir: str | None = None) -> None:
-    P = table.pressures
+    """Write ``table`` (its nodes and the responses it holds) under ``key``, atomically: a run that grew the
+    table leaves it for the next."""
+    known = {**table.held, **table.values}
+    P = np.array(sorted(known))
     arrays = {"pressure": P, "error_estimate": np.array([table.error_estimate]),
-              **{k: np.array([table.values[q][k] for q in P]) for k in PT.KEYS}}
+              "held": np.array([float(q not in table.values) for q in P]),
+              **{k: np.array([known[q][k] for q in P]) for k in PT.KEYS}}
     cell_law.write_cached(key, arrays, TABLE_ARRAYS, TABLE_FORMAT, cache_dir)
 
 
@@ -252,11 +264,18 @@ class Relevel:
     :mod:`ngcontact.drivers.macro_refinement`) from the tables the scene's loop made: the cell's law does not
     change with the macro mesh, so a table that covers the level's pressures (and, with a shear table, its
     jumps) is its law as it stands, and one that does not grows by the cell solves the new range needs.
-    ``__call__(problem, start)`` has the macro solve's signature; ``loops`` lists each level's loop."""
+    ``__call__(problem, start)`` has the macro solve's signature; ``loops`` lists each level's loop.
+    ``write_back()`` stores the tables in the cell-law cache (after every growth: the next run starts from
+    them); :meth:`table_share` estimates the table's share of the run's error and refines the table for it.
+    """
 
-    def __init__(self, scene, table: PT.CellTable, shear: S.ShearTable | None, solve):
+    def __init__(self, scene, table: PT.CellTable, shear: S.ShearTable | None, solve,
+                 write_back: Callable[[], None] = lambda: None):
         self.spec, self.output, self.table, self.shear, self.solve = scene.two_scale, scene.output, table, shear, solve
         self.loops: list[dict[str, Any]] = []
+        self.write_back = write_back
+        self.share: TS.TableShare | None = None
+        self.shared_at = 0   # the mesh levels run when the share was estimated
 
     def __call__(self, problem, start=None):
         spec = self.spec
@@ -266,20 +285,47 @@ class Relevel:
         added = self.table.solves + (self.shear.solves if self.shear is not None else 0) - solves
         self.loops.append({"elements": problem.mesh.ne, "iterations": len(out.history) - 1, "cell_solves": added,
                            "max_change": out.history[-1]["max_change"]})
+        if added:
+            self.write_back()
         return out.solution
+
+    def table_share(self, sol, tolerance: float, refine: bool = True):
+        """The table's share of the headline quantities of ``sol`` (:mod:`ngcontact.coupling.table_share`),
+        with ``refine`` the table refined until it is below its fraction of ``tolerance``; the tables are
+        written back to the cache either way.  Returns the answer's solution."""
+        component = next(n for n in DE.headlines(sol, self.output.points_per_element)
+                         if n.startswith("resultant_")).removeprefix("resultant_")
+
+        def measure(s):
+            return DE.headlines(s, self.output.points_per_element, component)
+        try:
+            self.share = TS.estimate(sol, self.table, self.solve, measure, tolerance, self.output.points_per_element,
+                                     refine)
+        finally:
+            self.write_back()
+        self.shared_at = len(self.loops)
+        return self.share.solution
 
     def record(self, results: dict, sol) -> dict:
         """``results`` (``results["two_scale"]``) of the refined solution ``sol``, updated where mesh levels ran:
         its interface coefficients, the table as it grew, the cell solves and the levels' loops
-        (``mesh_levels``)."""
-        if not self.loops:
+        (``mesh_levels``), and the table's share of the error (``table_share``, :meth:`table_share`): estimated
+        again on ``sol`` where mesh levels extended the table since (not refined: that would change the answer
+        the macro refinement's estimates were made on)."""
+        if self.share is not None and any(lv["cell_solves"] for lv in self.loops[self.shared_at:]):
+            self.table_share(sol, self.share.tolerance, refine=False)
+        if self.share is not None:
+            results["table_share"] = self.share.quantity()
+        if not self.loops and self.share is None:
             return results
         p = interface_samples(sol, self.output.points_per_element)["pressure"]
         coef = self.table(np.asarray(p))
         results["interface_coefficients"] = {"contact_fraction": coef["contact_fraction"], "k_n0": coef["k_n0"]}
         results["table"] = self.table.as_dict()
         results["cell_solves"] = self.table.solves + (self.shear.solves if self.shear is not None else 0)
-        results["mesh_levels"] = self.loops
+        if self.loops:
+            results["mesh_levels"] = self.loops
+        results["law"].update(law_record(PT.response_law(self.table)))
         return results
 
 
@@ -326,10 +372,12 @@ def couple_loop(scene, problem, solve, map_tasks: MapTasks = executor_map,
                                            cache_dir)
     out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
                    points_per_element=scene.output.points_per_element, solve=solve, warm=warm, shear=shear)
-    if table.solves:
-        store_table(key, table, cache_dir)
-    if shear is not None and shear.solves and skey is not None:
-        store_shear(skey, shear, cache_dir)
+    def write_back() -> None:
+        if table.solves:
+            store_table(key, table, cache_dir)
+        if shear is not None and shear.solves and skey is not None:
+            store_shear(skey, shear, cache_dir)
+    write_back()
     p = interface_samples(out.solution, scene.output.points_per_element)["pressure"]
     coef = table(np.asarray(p))
     law = PT.response_law(table)
@@ -339,8 +387,7 @@ def couple_loop(scene, problem, solve, map_tasks: MapTasks = executor_map,
            "table": table.as_dict(),
            "cache": {"key": key, "table_from_cache": from_cache,
                      "directory": cache_dir or cell_law.cache_dir_default()},
-           "law": {"type": "tabulated cell response p(c)", "interpolation": law.interpolation,
-                   "closure": list(law.closure), "pressure": list(law.pressure)},
+           "law": {"type": "tabulated cell response p(c)", **law_record(law)},
            "cell": {"scene": path, "method": task.method, **(task.size() if table.solves else {}),
                     "method_choice": cell_scene.method_choice.statement if cell_scene.method_choice else task.method,
                     "overrides": overrides, **({"discretization": keys} if keys else {})},
@@ -350,4 +397,13 @@ def couple_loop(scene, problem, solve, map_tasks: MapTasks = executor_map,
         res["shear_table"] = shear.as_dict()
         res["shear_table"]["cache"] = {"key": skey, "table_from_cache": shear_cached}
         res["law"]["tangential"] = "tabulated cell shear T(p, a_t) (the cell's own friction)"
-    return out.solution, res, Relevel(scene, table, shear, solve)
+    relevel = Relevel(scene, table, shear, solve, write_back)
+    if scene.discretization.tolerance is None:
+        return out.solution, res, relevel
+    sol = relevel.table_share(out.solution, float(scene.discretization.tolerance))
+    return sol, relevel.record(res, sol), relevel
+
+
+def law_record(law) -> dict[str, Any]:
+    """The report's record of the macro law ``p = P(c)`` of a cell table."""
+    return {"interpolation": law.interpolation, "closure": list(law.closure), "pressure": list(law.pressure)}

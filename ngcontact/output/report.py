@@ -137,7 +137,7 @@ def _error_text(q: dict) -> str:
         return text + ("" if q.get("counted", True) else " not counted")
     if q.get("relative_error") is None:
         return "(no estimate)"
-    return f"+/- {q['relative_error']:.2%}"
+    return f"+/- {q['relative_error']:.2%}" + ("" if q.get("counted", True) else " not counted")
 
 def method_line(results: dict) -> str | None:
     """The method that solved a cell and why (``results.accuracy.method``) in one terminal line, with a 3D FE

@@ -32,7 +32,14 @@ class MacroDiscretization(Discretization):
         "towards it: the order is raised by one on the scene's mesh while it pays (up to order 4), then the mesh "
         "is refined where the stress error indicator is large, interface first (up to 12 levels and 2e6 "
         "unknowns; results.accuracy.refinement lists the levels, their order, mesh level and unknowns), and a "
-        "tolerance out of reach ends the run (exit 3); default: 0.01, only judged (the scene's order is kept)")
+        "tolerance out of reach ends the run (exit 3); with [two_scale] the cell table is refined first: its "
+        "share of the headline quantities (from their changes as the table's intervals holding the "
+        "interface's pressures are halved twice and the macro problem is solved again) is held to half the "
+        "tolerance by halving those intervals (up to 8 times; results.accuracy's cell_table_share, per "
+        "quantity and per round, the table's own interpolation error then listed but not counted), and the "
+        "grown table is written back to the cell-law cache with the estimate's cell solves, so the next run "
+        "starts from it and solves no cell again; default: 0.01, only judged (the scene's order and cell "
+        "table are kept)")
     exclusion_radius: float | None = param(None, check=positive(), units="m", doc="radius of the ball around each "
         "singular point of the stress (where the interface ends closed on an unsupported boundary, a clamp "
         "meets an unsupported boundary, a re-entrant corner, a load with a "

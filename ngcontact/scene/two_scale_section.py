@@ -32,7 +32,9 @@ class TwoScaleSpec:
     max_iter: int = param(20, doc="largest number of law updates", check=at_least(1))
     table_tol: float = param(0.01, doc="interpolation tolerance of the cell table (monotone cubic): the "
                              "contact fraction, the closure and the law's pressure relative to their "
-                             "largest values at interval midpoints",
+                             "largest values at interval midpoints; with discretization.tolerance the "
+                             "table is refined further where the interface's pressures lie, until its share "
+                             "of the macro quantities is below half the tolerance",
                              check=positive())
     table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
                              "(below it the law follows the table's first secant down to p = 0)",

@@ -1,0 +1,163 @@
+"""The cell table's share of a two-scale run's error (ngcontact.coupling.table_share): on the press fit coupled with
+a spectral Westergaard cell (tests/drivers/test_study_kinds.py) ``discretization.tolerance`` refines the table
+where the interface's pressures lie, reports its share in ``results.accuracy``, bounds the error against a much
+finer table, writes the grown table back to the cache for the next run, and ends with its figures where the
+target is out of reach."""
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+import pytest
+
+from ngcontact.coupling import pressure_table as PT
+from ngcontact.coupling import table_share as TS
+from ngcontact.drivers import run_macro as D
+from ngcontact.drivers import run_two_scale as R
+from ngcontact.drivers.macro_geometry import build_geometry
+from ngcontact.errors import ConvergenceError
+from ngcontact.laws import homogenized as il
+from ngcontact.macro import discretization_error as DE
+from ngcontact.macro import macro_problem as M
+from ngcontact.macro.macro_measures import interface_samples
+from ngcontact.output.report import Clock, accuracy_line
+from ngcontact.scene import loader
+
+from tests.drivers.test_study_kinds import two_scale_scene
+
+
+def scene_with(tmp_path, monkeypatch, tolerance: float | None = None, table_tol: float = 0.02, gap: float = -1e-3):
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))
+    tmp_path.mkdir(exist_ok=True)
+    path = two_scale_scene(tmp_path)
+    text = path.read_text().replace("table_tol = 0.02", f"table_tol = {table_tol}").replace("gap = -1e-3",
+                                                                                           f"gap = {gap!r}")
+    if tolerance is not None:
+        text = text.replace("maxh = 0.3", f"maxh = 0.3\ntolerance = {tolerance}")
+    path.write_text(text)
+    return loader.load(path)
+
+
+def loop(scene, tmp_path):
+    """The scene's loop on its own mesh and order (no macro refinement), the cell solves in this process."""
+    problem, _ = D.problem_of(scene, build_geometry(scene))
+    return R.couple_loop(scene, problem, partial(D.solve_scene, scene), map_tasks=PT.serial_map,
+                         cache_dir=str(tmp_path / "cache"))
+
+
+def reference(sol, table: PT.CellTable, scene, halvings: int):
+    """``sol`` solved again with ``table``'s intervals around the interface's pressures halved ``halvings`` times
+    (the law there 2^halvings times finer; each halving at least halves its error)."""
+    p = interface_samples(sol, scene.output.points_per_element)["pressure"]
+    lo, hi = 0.9 * p[p > 0].min(), 1.1 * p.max()
+    fine = PT.CellTable(table.response, table.tol, values=dict(table.values))
+    for _ in range(halvings):
+        P = fine.pressures
+        fine._solve([0.5 * (a + b) for a, b in zip(P[:-1], P[1:]) if b >= lo and a <= hi])
+    law = il.InterfaceLaw(normal=PT.response_law(fine), friction=sol.problem.law.friction)
+    return D.solve_scene(scene, M.replace_law(sol.problem, law), sol.gfu.vec)
+
+
+def test_held_responses_become_nodes_without_a_cell_solve_and_survive_the_cache(tmp_path):
+    calls: list[float] = []
+
+    def response(p):
+        calls.append(p)
+        return {"contact_fraction": min(p, 1.0), "k_n0": 1.0, "g_n0": 0.0, "closure": p + p ** 3}
+    table = PT.CellTable(response, tol=1e-2, map_tasks=PT.serial_map)
+    table.cover(0.1, 1.0)
+    nodes, solved = dict(table.values), len(calls)
+    P = table.pressures
+    k = int(np.searchsorted(P, 0.5)) - 1                      # the interval holding 0.5 and 0.55
+    assert P[k] < 0.5 < 0.55 < P[k + 1]
+    mids = table.used_midpoints([0.5, 0.55])                 # it and one neighbour on either side
+    assert mids == pytest.approx([0.5 * (P[i] + P[i + 1]) for i in (k - 1, k, k + 1)])
+    assert table.used_midpoints([0.5, 0.55], margin=0) == pytest.approx([0.5 * (P[k] + P[k + 1])])
+    held = table.hold(mids)
+    assert table.values == nodes and set(table.held) == set(mids) and len(calls) == solved + 3
+    R.store_table("k" * 64, table, str(tmp_path))
+    again, cached = R.cached_table("k" * 64, response, 1e-2, PT.serial_map, str(tmp_path))
+    assert cached and again.values == nodes and again.held == held
+    again._solve(mids[:1])                                   # a held pressure asked for: a node, not a solve
+    assert mids[0] in again.values and set(again.held) == set(mids[1:]) and len(calls) == solved + 3
+
+
+@pytest.mark.parametrize("gap, least", [(-2e-3, 6), (-1.5e-3, 6), (-1e-3, 1), (-5e-4, 6)])
+def test_the_table_share_bounds_its_error_against_a_much_finer_table(tmp_path, monkeypatch, gap, least):
+    """Effectivity of the share (the used intervals halved twice) on the scene's mesh: between 1 and 10 on every
+    quantity whose error against a much finer table is above round-off (:func:`reference`), at least ``least``
+    of them.  At the scene's interference the stresses lie where the cell's law is exact (only the peak
+    pressure, at the interface's end, feels the table); at twice it one halving alone underestimates the
+    error (the second halving's bound is needed), at 1.5 times it without the neighbouring intervals."""
+    scene = scene_with(tmp_path, monkeypatch, gap=gap)
+    sol, _, relevel = loop(scene, tmp_path)
+    answer = relevel.table_share(sol, 1e-3)
+    share = relevel.share
+    assert share is not None and share.share <= TS.FRACTION * 1e-3
+    ref = reference(answer, relevel.table, scene, 4)
+    assert len(ref.problem.law.normal.pressure) > 2 * len(relevel.table.values)
+    component = next(k for k in share.values if k.startswith("resultant_")).removeprefix("resultant_")
+    ref = DE.headlines(ref, scene.output.points_per_element, component)
+    assert DE.headlines(answer, scene.output.points_per_element, component)["peak_pressure"].value == \
+        pytest.approx(share.values["peak_pressure"], rel=1e-12)
+    compared = []
+    for name, value in share.values.items():
+        true = abs(value - ref[name].value)
+        if true <= 1e-9 * abs(ref[name].value):             # round-off of the Newton solves
+            continue
+        compared.append(name)
+        assert true <= share.errors[name] <= 10 * true, (name, share.errors[name], true)
+    assert "peak_pressure" in compared and len(compared) >= least, compared
+
+
+def test_a_tolerance_refines_the_table_reports_its_share_and_a_second_run_reuses_it(tmp_path, monkeypatch):
+    first = D.run(scene_with(tmp_path, monkeypatch, 1e-3), Clock()).results
+    q = {x["name"]: x for x in first["accuracy"]["quantities"]}
+    share, own = q["cell_table_share"], q["cell_table_interpolation"]
+    assert share["met"] and share["counted"] and share["value"] <= TS.FRACTION * 1e-3 == share["limit"]
+    assert "halved" in share["how"] and len(share["rounds"]) >= 2
+    assert share["rounds"][0]["share"] > share["limit"]               # the scene's table alone misses it
+    assert not own["counted"] and own["value"] > 1e-3                # the table's own error is said, not judged
+    assert first["accuracy"]["met"], first["accuracy"]["quantities"]
+    assert f"cell_table_interpolation {own['value']:.4g} +/- {own['value']:.2%} not counted" in \
+        accuracy_line(first)
+    ts = first["two_scale"]
+    assert ts["table"]["held"] >= 1 and ts["cell_solves"] > 0
+    second = D.run(scene_with(tmp_path, monkeypatch, 1e-3), Clock()).results
+    again = {x["name"]: x for x in second["accuracy"]["quantities"]}
+    assert second["two_scale"]["cache"]["table_from_cache"] and second["two_scale"]["cell_solves"] == 0
+    assert second["two_scale"]["table"]["nodes"] == ts["table"]["nodes"]
+    assert again["cell_table_share"]["value"] == pytest.approx(share["value"], rel=1e-6)
+    assert again["peak_pressure"]["value"] == pytest.approx(q["peak_pressure"]["value"], rel=1e-9)
+
+
+def test_a_share_out_of_reach_ends_the_run_with_its_figures(tmp_path, monkeypatch):
+    monkeypatch.setattr(TS, "MAX_ROUNDS", 1)
+    with pytest.raises(ConvergenceError) as info:
+        D.run(scene_with(tmp_path, monkeypatch, 1e-6), Clock())
+    said = str(info.value)
+    assert "not met by the cell table" in said and "1 halvings are the bound" in said and "nodes" in said
+    rounds = info.value.history["table_share"]
+    assert len(rounds) == 1 and np.isfinite(rounds[0]["share"]) and rounds[0]["share"] > TS.FRACTION * 1e-6
+    # what was solved is cached for the next run
+    assert any(p.suffix == ".npz" for p in (tmp_path / "cache").iterdir())
+
+
+def test_a_table_grown_on_another_macro_level_is_written_back_for_the_next_run(tmp_path, monkeypatch):
+    """A mesh level whose pressures the table does not cover grows it (:class:`ngcontact.drivers.run_two_scale.
+    Relevel`); the grown table is in the cache at once, so the next run solves none of those cells again."""
+    from dataclasses import replace
+    scene = scene_with(tmp_path, monkeypatch)
+    problem, _ = D.problem_of(scene, build_geometry(scene))
+    sol, res, relevel = R.couple_loop(scene, problem, partial(D.solve_scene, scene), map_tasks=PT.serial_map,
+                                      cache_dir=str(tmp_path / "cache"))
+    nodes = res["table"]["nodes"]
+    relevel(replace(problem, gap=2 * problem.gap))           # twice the interference: higher pressures
+    assert relevel.loops[-1]["cell_solves"] > 0 and len(relevel.table.values) > nodes
+    key = res["cache"]["key"]
+    cached, found = R.cached_table(key, relevel.table.response, scene.two_scale.table_tol, PT.serial_map,
+                                   str(tmp_path / "cache"))
+    assert found and cached.values == relevel.table.values
+    again, res2, _ = R.couple_loop(scene, problem, partial(D.solve_scene, scene), map_tasks=PT.serial_map,
+                                   cache_dir=str(tmp_path / "cache"))
+    assert res2["cache"]["table_from_cache"] and res2["cell_solves"] == 0
