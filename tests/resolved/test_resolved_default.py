@@ -3,6 +3,7 @@ run's order, :mod:`ngcontact.drivers.resolved_accuracy`) against references on m
 (estimate / true error) lies in [1, 10] where the order ladder on the run's mesh fell below 1."""
 from __future__ import annotations
 
+import os
 from dataclasses import replace
 from functools import partial
 
@@ -61,7 +62,8 @@ def test_the_default_estimate_bounds_the_error_at_every_order_on_the_sinusoid_an
     """Orders 1 to 5 on the sinusoid (two meshes) and 2 to 4 on the rectangular valleys: effectivity at least 1;
     at most 10 unless the run's error is smaller than its once-refined twin's (an error small by chance, which
     no difference of the two can see).  References: the sinusoid at order 4 on its finer mesh refined three
-    times (64 times the elements), the valleys at order 4 on a mesh four times finer refined once."""
+    times (64 times the elements), the valleys at order 4 on a mesh four times finer refined once.  With ``-s``
+    it prints each case's effectivity, and the order ladder's (the former default) beside it."""
     sinusoid = reference(sinusoid_block(tmp_path, order=4, maxh=0.125, per_period=8), 3)
     valleys = reference(small_block(tmp_path, order=4, maxh=0.0625, per_period=16), 1)
     cases = [(sinusoid_block(tmp_path, order=p, maxh=0.25, per_period=4), sinusoid) for p in (1, 2, 3, 4, 5)]
@@ -80,6 +82,7 @@ def test_the_default_estimate_bounds_the_error_at_every_order_on_the_sinusoid_an
 
         found = RA.accuracy(sol, geo.length, solve)["quantities"]
         twin = values(twins[0], geo.length)
+        ladder = {e.name: e.error for e in RA.estimates(sol, geo.length, partial(drv.solve_scene, scene))}
         for q in found:
             true = abs(q["value"] - ref[q["name"]])
             if q["name"] == "contact_fraction" and ref is valleys:
@@ -88,6 +91,10 @@ def test_the_default_estimate_bounds_the_error_at_every_order_on_the_sinusoid_an
                 continue
             chance = true < abs(twin[q["name"]] - ref[q["name"]])
             rows.append((path, q["name"], q["error"] / true, chance))
+            before = "none" if ladder[q["name"]] is None else f"{ladder[q['name']] / true:.3g}"
+            print(f"{os.path.basename(path)[:-5]:40s} order {scene.discretization.order} {q['name']:16s} "
+                  f"true {true:9.3g}  effectivity: order ladder {before:>6s}, default {q['error'] / true:.3g}"
+                  + ("  (small by chance)" if chance else ""))
     assert len(rows) == 19
     low = [r for r in rows if r[2] < 1.0]
     high = [r for r in rows if r[2] > 10.0 and not r[3]]
