@@ -41,7 +41,13 @@ The mesh step (what converged, and why not the interface alone)
     has no limit: the refinement stops there and says so
     (:func:`ngcontact.drivers.macro_refinement.h_stop_reason`).
 
-A scene that states no tolerance is not refined: it is judged against the default one and costs what it did.
+A level of the order that the ladder finds within the tolerance is confirmed by one uniform refinement of its
+mesh at its order (:func:`ngcontact.drivers.resolved_accuracy.guarded`: the larger of the two estimates), since
+on a closed set whose edges lie inside elements the orders' values oscillate and the ladder alone may fall
+below the error; where the confirmation misses, the mesh is refined.
+
+A scene that states no tolerance is not refined: it is judged against the default one
+(:func:`ngcontact.drivers.resolved_accuracy.h_step_estimates`) and costs what it did plus that estimate.
 """
 from __future__ import annotations
 
@@ -171,9 +177,16 @@ def refine(scene, sol: D.DirectSolution, length: float, solve: Solve) -> Refined
         missed = unmet(found, tolerance)
         _progress(history[-1], missed, tolerance)
         if not missed:
-            return Refined(sol, found, history)
-        why = order_pays(sol, missed)
-        if why is not None:
+            found = RA.guarded(found, RA.h_step_estimates(sol, length, solve))
+            missed = unmet(found, tolerance)
+            history[-1] = level(sol, found, tolerance, 0)
+            if not missed:
+                return Refined(sol, found, history)
+            why = "the order ladder meets the tolerance, but not the estimate of the mesh refined uniformly once"
+            break
+        paid = order_pays(sol, missed)
+        if paid is not None:
+            why = paid
             break
         order = sol.problem.order + 1
         sol.problem.mesh.Curve(order)

@@ -22,7 +22,8 @@ Returns an :class:`~ngcontact.output.report.Outcome`; no file I/O.
   ``1 + 2 depth / period``);
 * ``probes``: displacements [m] at the study's probe points, if any;
 * ``accuracy``: the contact fraction and the contact force's magnitude with their discretization errors
-  estimated from the neighbouring orders on the run's mesh (:mod:`ngcontact.drivers.resolved_accuracy`);
+  estimated from one more solve at the run's order on its mesh refined uniformly once
+  (:mod:`ngcontact.drivers.resolved_accuracy`);
   with ``discretization.tolerance`` the run is first refined towards it, order then interface mesh
   (:mod:`ngcontact.drivers.resolved_refinement`; ``accuracy.refinement``), and every result is the
   refined solution's;

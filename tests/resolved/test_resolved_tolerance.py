@@ -37,13 +37,14 @@ def small_block(tmp_path, tolerance: float | None = None, maxh: float = 0.25, pe
     return str(path)
 
 
-def sinusoid_block(tmp_path, tolerance: float | None = None) -> str:
+def sinusoid_block(tmp_path, tolerance: float | None = None, **sizes) -> str:
     """The small block with a sinusoid of amplitude 0.1 eps instead of the valleys, sheared more than pressed:
-    the closed set covers about half the surface, its edges inside the elements."""
+    the closed set covers about half the surface, its edges inside the elements; ``sizes``: ``maxh``,
+    ``per_period``, ``order`` of :func:`small_block`."""
     cell = open(CELL).read().replace('profile = "rectangular"', 'profile = "sinusoid"\namplitude = 0.1')
     cell = "\n".join(line for line in cell.splitlines() if not line.startswith(("width", "depth")))
     (tmp_path / "sinusoid_cell.toml").write_text(cell)
-    return small_block(tmp_path, tolerance, cell=str(tmp_path / "sinusoid_cell.toml"),
+    return small_block(tmp_path, tolerance, cell=str(tmp_path / "sinusoid_cell.toml"), **sizes,
                        edits=(("displacement = [1e-4, -1e-4]", "displacement = [4e-4, -3e-5]"),
                               ("slope = [0.0, -1.5e-4]", "slope = [0.0, 0.0]")))
 
