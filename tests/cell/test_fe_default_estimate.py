@@ -79,8 +79,8 @@ def test_a_cell_that_cannot_raise_its_order_is_not_estimated_and_not_met():
 def test_the_default_estimate_bounds_the_error_on_the_stem_grooves(order):
     """The stem-groove cell (flat 2D, penalty) on a coarser interface mesh, against its spectral twin on
     65,536 points: the estimate of every headline quantity of the scene's own answer is at least its error
-    and at most ten times it (at order 1: 9.1 the fraction and k_n, 9.3 g_n, 3.7 the closure, 3.8 the
-    stiffness; at order 2 all 3.3 to 4.2).  The coefficients' errors (4e-4 and 2e-5 at order 1) are
+    and at most ten times it (at order 1: 9.1 the fraction and k_n, 9.3 g_n, 3.7 the closure, 4.0 the
+    stiffness; at order 2 all 3.4 to 4.3).  The coefficients' errors (4e-4 and 2e-5 at order 1) are
     well above their spectral twin's resolution (the fraction's 2e-5 and, for ``g_n``, the fraction's
     times the gap at the contact edge, 2e-7)."""
     scene = fe_scene("stem_grooves")      # the shipped scene is solved by the spectral cell; here its FE cell
@@ -105,19 +105,20 @@ def test_the_default_estimate_bounds_the_error_on_the_stem_grooves(order):
 
 
 
-#: an error below this is round-off (the Westergaard cell's full-contact load): no effectivity
+#: an error below this is round-off (the Westergaard cell's full-contact load): no effectivity (the stiffness's
+#: there, 2e-10, is within its twin's resolution)
 ROUND_OFF = 1e-10
 
 
 @pytest.mark.parametrize("order", [1, 2])
 def test_the_default_estimate_bounds_the_error_on_westergaard(order):
     """The Westergaard cell (flat 2D, penalty) on an interface mesh twice the shipped one's, against its
-    spectral twin on 65,536 points, at its five loads: the estimates of the contact fraction, the closure and
-    the coefficients k_n and g_n are between one and ten times their errors (1.95 to 3.96 at both orders;
-    the full-contact load's errors are round-off).  The effective stiffness's is at least its error; at
-    order 2 it is 22 times it at load 1, where the error (5e-4) is smaller than the change the penalty's
-    quadrature of the contact edge makes (3e-3 between ``contact_bonus_order`` 12 and 40), so it is not
-    held to ten."""
+    spectral twin on 65,536 points, at its five loads: the estimate of every headline quantity is between one
+    and ten times its error (1.6 to 6.6 at both orders; the full-contact load's errors are round-off, at most
+    2e-10).  The
+    stiffness's needs the penalty's tangent integrated exactly up to the contact edges
+    (:func:`ngcontact.cell.fe.stiffness.edge_correction`): at the energy's rule it was 22 times its error at
+    order 2, load 1."""
     scene = load_with_contact(shipped("westergaard"), None, "fe", None)
     loads = cell_loads(scene)
     references = [headline(s.results) for s in spectral_variant(scene, 65536).sweep(loads)]
@@ -132,7 +133,7 @@ def test_the_default_estimate_bounds_the_error_on_westergaard(order):
             if error < ROUND_OFF:
                 continue
             assert max(error - slack[name], 0) <= estimate[name], (name, error, estimate[name])
-            if name != "normal_stiffness":
+            if error > slack[name]:          # within the twin's resolution the ratio is not known
                 assert estimate[name] <= 10 * error, (name, error, estimate[name])
 
 def _coarse_stem(tmp_path, order: int):
