@@ -123,7 +123,7 @@ class Coefficients:
 
 
 def coefficients(cell: Cell, kn=1.0, gap=None, G=None, weight=None, *,
-                 intorder: int | None = None, normal=None) -> Coefficients:
+                 intorder: int | None = None, normal=None, integrate=None) -> Coefficients:
     """The coefficients of paper eqs. 34 and 42-43 (see the module docstring).
 
     Parameters
@@ -143,6 +143,13 @@ def coefficients(cell: Cell, kn=1.0, gap=None, G=None, weight=None, *,
         Quadrature order on ``contact``; default ``2 * curve order + 4``.
     normal
         Micro normal CF; default :func:`contact_normal` of ``cell``.
+    integrate
+        ``integrate(cf)``: the integral over ``S_C`` of the vector CF ``cf`` as
+        an array; default NGSolve's quadrature at ``intorder``.  A weight with
+        a jump inside an element (the real contact set's indicator) is
+        integrated exactly by a caller that cuts the elements at its edges and
+        passes that integral, with ``weight`` left 1
+        (:func:`ngcontact.cell.fe.measures.real_contact_coefficients`).
 
     Returns
     -------
@@ -165,8 +172,11 @@ def coefficients(cell: Cell, kn=1.0, gap=None, G=None, weight=None, *,
         entries.append(Gt * ng.sqrt(ng.IfPos(sq, sq, 0.0)))
     entries.append(w)
     mesh = cell.mesh
-    vals = ng.Integrate(ng.CF(tuple(entries)), mesh, definedon=mesh.Boundaries("contact"),
-                        order=_intorder(cell, intorder))
+    if integrate is None:
+        vals = ng.Integrate(ng.CF(tuple(entries)), mesh, definedon=mesh.Boundaries("contact"),
+                            order=_intorder(cell, intorder))
+    else:
+        vals = integrate(ng.CF(tuple(entries)))
     vals = np.asarray(vals, dtype=float).ravel() / cell.area
     K0 = vals[:dim * dim].reshape(dim, dim)
     K0 = 0.5 * (K0 + K0.T)

@@ -63,7 +63,7 @@ SHIPPED = str(PACKAGE / "data" / "strength_cells")
 #: scene's reading and checks (the validated scene is in the key) and :mod:`ngcontact.quiet`
 SOURCES = (
     "cell/coefficients.py", "cell/fe/cell_energy.py", "cell/fe/cell_model.py", "cell/fe/cell_problem.py",
-    "cell/fe/contact_quadrature.py", "cell/fe/discrete_cell.py", "cell/fe/linear_trace.py",
+    "cell/fe/contact_quadrature.py", "cell/fe/discrete_cell.py", "cell/fe/edge_cuts.py", "cell/fe/linear_trace.py",
     "cell/fe/load_start.py", "cell/fe/measures.py", "coupling/strength.py", "drivers/build.py",
     "drivers/cell_gap.py", "drivers/mirror_symmetry.py", "drivers/scene_laws.py", "drivers/strength_cell.py",
     "fem/elasticity.py", "fem/materials.py", "fem/quadrature.py", "fem/two_body.py", "geometry/cell2d.py",

@@ -248,6 +248,12 @@ class SplitEnergy:
         self._K_whole[_positions(matrix, K, keys)] = K.AsVector().FV().NumPy()
 
 
+def add_matrix(whole, part) -> None:
+    """``whole += part`` in place: two matrices of one space and storage, ``part`` storing a subset of the
+    entries ``whole`` stores (a term's matrix into the whole form's)."""
+    whole, part = local_matrix(whole), local_matrix(part)
+    whole.AsVector().FV().NumPy()[_positions(whole, part)] += part.AsVector().FV().NumPy()
+
 def _positions(whole, part, whole_keys: np.ndarray | None = None) -> np.ndarray:
     """Where each stored entry of the sparse matrix ``part`` sits among the stored entries of ``whole``.
 

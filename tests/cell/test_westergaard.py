@@ -139,7 +139,7 @@ def test_bernstein_coefficients_reproduce_the_polynomial_and_bound_it():
     """The one-sign filter of ``contact_pieces``: on ``[0, 1]`` a polynomial equals
     ``sum_k b_k C(n, k) t^k (1 - t)^(n - k)`` and so lies between its smallest and largest ``b_k``."""
     from math import comb
-    from ngcontact.cell.fe.measures import _bernstein
+    from ngcontact.cell.fe.edge_cuts import _bernstein
     rng = np.random.default_rng(3)
     t = np.linspace(0.0, 1.0, 41)
     for n in (1, 2, 4, 6):

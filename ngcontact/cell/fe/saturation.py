@@ -50,9 +50,17 @@ indicator) are set by the same contact edges as the fraction; the normal effecti
 the cell's compliance less the bonded laminate's, carries the bulk's smooth error and, through the pressure's
 square root at the edges, the edges' error, amplified by the difference of nearly equal compliances.  On
 the stem-groove cell against its spectral twin (``tests/cell/test_fe_default_estimate.py``, orders 1 and 2)
-the estimate is 3.8 and 3.3 times the stiffness's error, 2.9 times the coefficients' at order 2, and 15
-(``g_n``) to 36 (``k_n``) times at order 1, where their error is smaller than one order more's change
-(bounds, loose where the coarse order is right by chance).
+the estimate is 4.0 and 4.3 times the stiffness's error, 3.4 times the coefficients' at order 2 and 9.1
+(``k_n``, as the fraction) to 9.3 (``g_n``) times at order 1, where order 2 is further from the limit than
+order 1 (a bound, loose where the coarse order is right by chance); on the Westergaard cell (its five loads,
+both orders) every quantity's between 1.6 and 6.6.  That holds because both sides put the contact edges
+where the fraction does: the coefficients are integrated over the pieces in contact, the edges cut inside
+the elements, with the scene's gap (:func:`ngcontact.cell.fe.measures.real_contact_coefficients`), and the
+stiffness's tangent is integrated exactly up to the edges (:func:`ngcontact.cell.fe.stiffness.edge_correction`).
+An indicator integrated by quadrature puts each edge at a quadrature point, a change between the two
+orders' rules that is not the error of either: ``k_n``'s estimate was 36 times its error, the stiffness's
+22 times (Westergaard, order 2); the penalty's interpolant of the gap added an error to ``g_n`` that at
+order 1 cancelled the edges' (15 times).
 
 The estimate itself does not refine: a sweep whose estimate exceeds the default tolerance is refined within
 the scene's budget (:mod:`ngcontact.cell.fe.default_refinement`), or, with ``discretization.estimate =
