@@ -37,10 +37,13 @@ the time the workers save on the rest against the trips and extra time of
 the members each worker solves.  A batch for which (4) fails stays in this
 process, its record saying why (as the local rule's does); so does a batch
 whose probe fails (a worker that cannot import the members' module).  Before
-its probe, the probe also imports the members' modules on every worker (each
-worker's first member would otherwise pay it), while this process goes on
-solving members; (4) is first read once that is done and at least
-:data:`MEASURED` members were solved here.
+timing the trips, the probe imports the members' modules on every worker
+(each worker's first member would otherwise pay it), while this process goes
+on solving members; (4) is read once that is done and at least
+:data:`MEASURED` members were solved here, and only then: as members are
+solved here both sides of (4) shrink in proportion (the saving by about
+``c (1 - 1/W)`` per member, the cost by ``(o + e) / W``), so a later look
+would decide the same.
 """
 from __future__ import annotations
 
