@@ -64,12 +64,9 @@ from ngcontact.parallel.batch_member import in_worker, one_thread
 #: time is ``c``): the first also pays what this process does once.
 MEASURED = 2
 
-#: The record of the clusters' costs, by scheduler address and kind (:data:`COSTS`), beside the local
-#: workers' (:mod:`ngcontact.parallel.batch_forecast`).
-COSTS_FILE = "dask_costs.json"
-
-#: ``round_trip``: ``o`` of (4); ``member_extra``: ``e``.
-COSTS = ("round_trip", "member_extra")
+#: The record of the clusters' costs beside the local workers' (:mod:`ngcontact.parallel.batch_forecast`): by
+#: scheduler address, the last ``round_trip`` seconds measured (``o`` of (4)) and ``member_extra`` (``e``).
+COSTS_FILE, COSTS = "dask_costs.json", ("round_trip", "member_extra")
 
 #: Seconds the probe of a batch may take before the batch is kept in this process.
 PROBE_SECONDS = 30.0
