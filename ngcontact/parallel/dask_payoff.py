@@ -27,7 +27,9 @@ the worker less ``c``: a slower machine, a worker's own overheads), measured
 by every batch the cluster solved.  Both are kept per scheduler address
 (:data:`COSTS_FILE`, the last :data:`~ngcontact.parallel.batch_forecast.COSTS_KEPT`
 of each) and the rule takes their medians, so one slow probe does not decide
-alone; ``e`` is 0 before the cluster has solved a batch.
+alone; ``e`` is 0 before the cluster has solved a batch, and never less: a
+cluster whose members measured faster than here (a faster machine, or only
+this process's other threads in its CPU time) is not counted on.
 
 The cluster repays its trips when the rest ends sooner there::
 
@@ -83,6 +85,9 @@ class DaskPayoff:
     workers: int
     round_trip: float
     member_extra: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "member_extra", max(self.member_extra, 0.0))     # ``e >= 0``
 
     @property
     def per_worker(self) -> int:

@@ -53,6 +53,7 @@ def test_condition_4_weighs_the_saving_on_the_rest_against_the_trips_and_a_worke
     slow = DaskPayoff(member_seconds=0.3, rest=6, workers=2, round_trip=0.02, member_extra=0.4)
     assert slow.cost == pytest.approx(3 * 0.42) and not slow.repaid     # a cluster whose members cost more
     assert not DaskPayoff(10.0, 6, 1, 0.0, 0.0).repaid and not DaskPayoff(10.0, 0, 2, 0.0, 0.0).repaid
+    assert DaskPayoff(0.1, 2, 2, 0.2, -0.15).cost == pytest.approx(0.2)    # a faster cluster is not counted on
     assert "the other 6 on the cluster's 2 workers" in large.describe(2)
     assert "the other 6 in this process" in slow.describe(2)
 
