@@ -72,8 +72,11 @@ def test_a_dask_batch_too_small_to_repay_the_trips_runs_serially_and_says_why(da
 def test_a_large_dask_batch_goes_to_the_cluster_after_its_first_two_members(dask):
     """Eight members of 0.3 s: 0.9 s saved on the other six, against three trips of milliseconds; on the
     workers each member costs what it costs here, so its extra time is measured near zero."""
-    pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="large")
+    seen = []
+    pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="large",
+                    progress=lambda *a: seen.append(a[1:]))
     assert pids[:2] == [os.getpid()] * 2 and os.getpid() not in pids[2:] and len(set(pids[2:])) == 2
+    assert seen == [(k, 8) for k in range(9)]                   # one count per member, wherever it ran
     batch = dask.describe()["batches"][-1]
     assert batch["executor"] == "dask" and "the other 6 on the cluster's 2 workers" in batch["decision"]
     (trip,), (extra,) = (dask_payoff.measured_costs(dask.address, k) for k in dask_payoff.COSTS)
