@@ -19,7 +19,9 @@ where that record forecasts that the batch goes to them:
 ``ngcontact.parallel.batch_forecast``; column ``started``); and
 ``--scheduler`` on a ``distributed.LocalCluster``
 of two one-thread worker processes that this script starts once and warms
-with one run of each scene (a cluster outlives the runs it serves).  Per
+with one run of each scene (a cluster outlives the runs it serves; a batch
+goes to it only where its rest repays the members' trips,
+``ngcontact.parallel.dask_payoff``, column ``ran``).  Per
 run: the one-minute load average as it began (the machine is shared; a
 local pool keeps a batch in the run's process while other jobs keep the
 cores busy), the command's wall time, the batch's wall time (``compute.batches``),
@@ -133,14 +135,17 @@ def main() -> None:
         benchmark_doc.publish(
             "ensemble_executors", "Ensembles on each executor",
             os.path.join(args.out, "ensemble_executors.csv"),
-            note="`ngcontact run` of three ensembles with `--workers 1` (serial, the reference), `--workers 2` "
+            note="`ngcontact run` of three ensembles with `--workers 1` (serial, the reference: its FFTs on one "
+                 "thread on these grids of at most 256^2 points, as a worker's, "
+                 "`ngcontact.cell.spectral.fft_threads`), `--workers 2` "
                  "twice (`local 2 first`: no record of the batch, its workers start only once its first members "
                  "have shown that they repay; `local 2`: after the serial run has recorded the batch, its "
                  "workers start with the run where the record forecasts that the batch goes to them, "
                  "`ngcontact.parallel.batch_forecast`; `started`: when the workers started) "
                  "and `--scheduler` on a local Dask cluster of two one-thread workers (warmed by one run). "
                  "`ran`: where the batch ran (a local pool sends a batch to its workers only where its rest "
-                 "repays them, `ngcontact.parallel.worker_payoff`; else `serial`, in the run's process). "
+                 "repays them, `ngcontact.parallel.worker_payoff`, a Dask cluster only where it repays the "
+                 "members' trips, `ngcontact.parallel.dask_payoff`; else `serial`, in the run's process). "
                  "`load`: the one-minute load average as the run began (2 cores; over the whole benchmark "
                  f"{min(loads):.1f} to {max(loads):.1f}, median {np.median(loads):.1f}): the payoff rule "
                  "keeps a batch in the run's process while other jobs keep the cores busy "

@@ -10,15 +10,26 @@ scheduler that does (a client whose connection fails half-way tries to
 close itself again as the interpreter ends, and waits a minute there).
 Both failures are :class:`SchedulerError`: an input to correct, or a
 scheduler to start, before any solve (the runner names the address's key).
+
+A run's batches (:meth:`DaskCluster.start_on_demand`, as the runner opens
+them) go to the cluster only where their rest repays its trips: their first
+members are solved and timed in this process while the workers import the
+members' modules, and condition (4) of :mod:`ngcontact.parallel.dask_payoff`
+decides, as :mod:`ngcontact.parallel.worker_payoff` does for a local pool;
+the batch's record says where it ran and why.  A cluster used directly
+(:func:`ngcontact.parallel.executor.use`) sends every member there.
 """
 from __future__ import annotations
 
 import logging
+import statistics
 import time
 from typing import Any, Sequence
 
 from ngcontact.errors import NgcontactError
+from ngcontact.parallel import dask_payoff
 from ngcontact.parallel.batch_executor import Executor
+from ngcontact.parallel.judged_batches import shifted_progress
 from ngcontact.parallel.batch_member import in_worker, one_thread, reason, run_member, threads_asleep
 
 log = logging.getLogger("ngcontact.parallel.executor")
@@ -82,6 +93,8 @@ class DaskCluster(Executor):
         check_address(address)
         self.address = address
         self._client: Any = None      # the distributed Client, connected on first use
+        self._modules: tuple[str, ...] = ()   # what the workers import before a batch's members
+        self.judged = False           # the run's batches: the rest of each goes to the cluster only where repaid
 
     @property
     def client(self):
@@ -131,17 +144,76 @@ class DaskCluster(Executor):
                               "the address")
 
     def start(self, modules: Sequence[str] = ()) -> None:
-        """Connect to the scheduler now: an address that does not answer fails before any solve."""
+        """Connect to the scheduler now (an address that does not answer fails before any solve); the run's
+        batches then go to the cluster only where they repay it (:meth:`_judged_map`), the workers importing
+        ``modules`` and the members' module first."""
         self.client  # noqa: B018 - the property connects
+        self.judged = True
+        self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
 
     def start_on_demand(self, modules: Sequence[str] = ()) -> None:
-        """Connect now too: the cluster's workers run already, and a wrong address fails before any solve."""
+        """As :meth:`start`: the cluster's workers run already, and a wrong address fails before any solve."""
         self.start(modules)
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
+        if not self.judged:
+            self._where("dask", f"every member on the cluster's {self.workers} worker threads")
+            return self._cluster_map(fn, items, names, label, progress, fault)
+        if len(items) == 1:
+            self._where("serial", "a single member: solved in this process")
+            return Executor._map(self, fn, items, names, label, progress, fault)
+        return self._judged_map(fn, items, names, label, progress, fault)
+
+    def _judged_map(self, fn, items, names, label, progress, fault) -> list:
+        """A batch of the run: members solved here, each timed, while the cluster's workers import the
+        members' modules; then condition (4) of :mod:`ngcontact.parallel.dask_payoff`, with the trip timed on
+        the cluster now, sends the rest there or keeps it here (the batch's record says which and why)."""
+        clock = self.member_clock
+        probe = dask_payoff.Probe(self.client, label)
+        probe.warm(self._modules + (fn.__module__,))
+        done: list = []
+        while len(done) < len(items):
+            k = len(done)
+            done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
+                                  shifted_progress(progress, k, len(items)), fault)
+            if len(done) < dask_payoff.MEASURED or len(done) == len(items) or not probe.warm_done():
+                continue
+            try:
+                trip = probe.round_trip(items[len(done)], dask_payoff.result_bytes(done[-1]))
+            except Exception as exc:   # a worker that cannot import the members' module, or a lost one
+                why = (f"{len(done)} members solved here; the cluster's probe failed ({reason(exc)}): the other "
+                       f"{len(items) - len(done)} in this process")
+                return self._here(fn, items, names, label, progress, fault, done, why)
+            dask_payoff.remember_cost(self.address, "round_trip", trip)
+            payoff = dask_payoff.DaskPayoff(
+                clock.least, len(items) - len(done), len(probe.workers),
+                dask_payoff.cost_seconds(self.address, "round_trip", trip),
+                dask_payoff.cost_seconds(self.address, "member_extra"))
+            if not payoff.repaid:
+                return self._here(fn, items, names, label, progress, fault, done, payoff.describe(len(done)))
+            self._where("dask", payoff.describe(len(done)))
+            log.debug("%s: %s", label, payoff.describe(len(done)))
+            rest = self._cluster_map(fn, items[len(done):], names[len(done):], label,
+                                     shifted_progress(progress, len(done)), fault)
+            return done + rest
+        importing = not probe.warm_done()
+        probe.cancel()
+        self._where("serial", f"all {len(done)} members solved here"
+                    + (" while the cluster's workers imported their modules" if importing else ""))
+        return done
+
+    def _here(self, fn, items, names, label, progress, fault, done, why) -> list:
+        """The rest of a batch in this process, ``why`` recorded with it."""
+        self._where("serial", why)
+        log.debug("%s: %s", label, why)
+        return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
+                                    shifted_progress(progress, len(done), len(items)), fault)
+
+    def _cluster_map(self, fn, items, names, label, progress, fault) -> list:
         from distributed import as_completed
         client = self.client
         results: dict[int, Any] = {}
+        seconds: list[float] = []
         failures = {k: 0 for k in range(len(items))}
         index: dict[Any, int] = {}
 
@@ -157,7 +229,8 @@ class DaskCluster(Executor):
                 for fut in futures:
                     k = index.pop(fut)
                     if fut.status == "finished":
-                        results[k] = fut.result()
+                        results[k], s = fut.result()
+                        seconds.append(s)
                         if progress is not None:
                             progress(label, len(results), len(items))
                         continue
@@ -167,6 +240,9 @@ class DaskCluster(Executor):
         except BaseException:
             client.cancel(list(index))
             raise
+        if self.member_clock.times:      # ``e``: a member's time on a worker beyond the cheapest here
+            dask_payoff.remember_cost(self.address, "member_extra",
+                                      statistics.median(seconds) - self.member_clock.least)
         return [results[k] for k in range(len(items))]
 
     def close(self) -> None:
@@ -176,6 +252,9 @@ class DaskCluster(Executor):
 
 
 def _dask_member(fn, item, name, attempt, fault):
+    """One member on a worker: its result and its ``min(wall, CPU)`` seconds there."""
     if not in_worker():
         one_thread(ignore_sigint=False)
-    return run_member(fn, item, name, attempt, fault)
+    wall, cpu = time.perf_counter(), time.thread_time()
+    result = run_member(fn, item, name, attempt, fault)
+    return result, min(time.perf_counter() - wall, time.thread_time() - cpu)

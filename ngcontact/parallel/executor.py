@@ -20,7 +20,9 @@ Executors:
   they start only then, or with the run where the last run of the same
   batch forecasts it (:mod:`ngcontact.parallel.batch_forecast`);
 * :class:`DaskCluster` - the workers of a ``dask.distributed`` scheduler at
-  an address; Dask is the cluster engine, this module only submits.
+  an address; Dask is the cluster engine, this module only submits; a run's
+  batch goes to them only where its rest repays the trips of its members
+  (:mod:`ngcontact.parallel.dask_payoff`, timed on the cluster).
 
 Failures (the attempt itself: :mod:`ngcontact.parallel.batch_member`): a member that raises (or whose
 worker process dies) is run once more; a second failure ends the batch with :class:`~ngcontact.errors.BatchError`

@@ -166,19 +166,44 @@ class Serial(dict):
         return self[name]
 
 
+@pytest.fixture
+def cluster_always_repays(monkeypatch):
+    """Condition (4) of the Dask payoff rule held whatever the members cost, after one member solved here
+    and the workers' imports awaited: these batches are too small to repay a cluster
+    (:func:`test_a_dask_batch_too_small_to_repay_runs_serially`), and the tests below are of the numbers of
+    the members the cluster solves."""
+    from ngcontact.parallel import dask_payoff
+    monkeypatch.setattr(dask_payoff, "MEASURED", 1)
+    monkeypatch.setattr(dask_payoff.Probe, "warm_done",
+                        lambda self: all(f.result(timeout=120) is not None for f in self._warming))
+    monkeypatch.setattr(dask_payoff.DaskPayoff, "repaid", property(lambda self: True))
+
+
 @pytest.mark.parametrize("name", ["ensemble", "spectral", pytest.param("fe", marks=pytest.mark.slow)])
-def test_a_dask_cluster_gives_the_serial_numbers(cluster, scenes, name):
+def test_a_dask_cluster_gives_the_serial_numbers(cluster, scenes, name, cluster_always_repays):
     paths, serial = scenes
     report, _ = solve(paths[name], scheduler=cluster)
     assert_same(numbers(report), numbers(serial[name]))
     compute = report["compute"]
     assert (compute["executor"], compute["scheduler"], compute["workers"]) == ("dask", cluster, 2)
+    assert compute["batches"][0]["executor"] == "dask"          # every member but the first solved there
     # the spectral loads are refined to the default tolerance each on its own, the last by the driver's own cell
     # (its grid is the report's: ngcontact.drivers.cell_members), so the batch holds the others
     members = {"ensemble": 4, "spectral": 2, "fe": 3}[name]
     assert [(b["label"], b["members"]) for b in compute["batches"]] == [
         ("ensemble" if name == "ensemble" else "loads", members)]
     assert serial[name]["compute"]["executor"] == "serial"
+
+
+def test_a_dask_batch_too_small_to_repay_runs_serially(cluster, scenes):
+    """The spectral sweep's two loads on the cluster: both solved in the run's process (a second member alone
+    saves nothing on two workers), the report saying so, with the serial numbers."""
+    paths, serial = scenes
+    report, _ = solve(paths["spectral"], scheduler=cluster)
+    assert_same(numbers(report), numbers(serial["spectral"]))
+    batch = report["compute"]["batches"][0]
+    assert (report["compute"]["executor"], batch["members"], batch["executor"]) == ("dask", 2, "serial")
+    assert batch["decision"].startswith("all 2 members solved here")
 
 
 @pytest.mark.slow

@@ -54,7 +54,7 @@ class Convolution:
         """``X = FFT(x)`` on the half spectrum (a new array)."""
         import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process
         self.forward += 1
-        return sfft.rfftn(x, workers=fft_workers())
+        return sfft.rfftn(x, workers=fft_workers(x.size))
 
     def from_transform(self, X: np.ndarray, x: np.ndarray, factor: float = 1.0) -> np.ndarray:
         """``factor A x`` from ``X = FFT(x)`` and ``x`` (a new array; ``X`` is overwritten)."""
@@ -63,7 +63,7 @@ class Convolution:
         X *= self.symbol
         if factor != 1.0:
             X *= factor
-        workers = fft_workers()
+        workers = fft_workers(x.size)
         if len(self.shape) > 1:
             X = sfft.ifftn(X, axes=tuple(range(len(self.shape) - 1)), workers=workers, overwrite_x=True)
         out = sfft.irfft(X, n=self.shape[-1], axis=-1, workers=workers, overwrite_x=True)

@@ -78,7 +78,7 @@ def symbol_product(symbol: np.ndarray, shape: tuple[int, ...], t: np.ndarray) ->
     :meth:`~.convolution.Convolution.from_transform`).
     """
     import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process
-    workers = fft_workers()
+    workers = fft_workers(t.size)
     axes = tuple(range(1, len(shape) + 1))
     T = sfft.rfftn(t, axes=axes, workers=workers)
     U = np.einsum("ab...,b...->a...", symbol, T)

@@ -162,7 +162,7 @@ class SpectralCell:
         """``IFFT(symbol FFT(p))`` on the grid (real FFTs on the run's threads, :mod:`.fft_threads`), a new
         array."""
         import scipy.fft as sfft  # on use: importing scipy.fft would slow the start of every process (and batch worker)
-        workers = fft_workers()
+        workers = fft_workers(p.size)
         spectrum = sfft.rfftn(p, workers=workers)
         spectrum *= symbol
         return sfft.irfftn(spectrum, s=self.shape, workers=workers, overwrite_x=True)
@@ -294,13 +294,13 @@ class SpectralCell:
         import scipy.fft as sfft
         winkler = 1.0 / self.k_n if self.enforcement == "penalty" else 0.0
         sym = (self.fluctuation if pbar is not None else self.symbol) + winkler
-        bh = sfft.rfftn(b, workers=fft_workers())
+        bh = sfft.rfftn(b, workers=fft_workers(b.size))
         ph = np.zeros_like(bh)
         nonzero = sym > 0
         ph[nonzero] = -bh[nonzero] / sym[nonzero]
         if pbar is not None:
             ph.flat[0] = pbar * self.points
-        p = sfft.irfftn(ph, s=self.shape, workers=fft_workers())
+        p = sfft.irfftn(ph, s=self.shape, workers=fft_workers(b.size))
         if pbar is not None:
             p += pbar - float(p.mean())
         if not (np.all(np.isfinite(p)) and p.min() >= 0.0):

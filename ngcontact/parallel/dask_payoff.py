@@ -1,0 +1,216 @@
+"""Whether the rest of a batch repays a Dask cluster's workers, or finishes faster in the run's own process.
+
+A cluster's workers run already: unlike a local pool's
+(:mod:`ngcontact.parallel.worker_payoff`) they have no start to repay, but
+every member sent to them pays a trip, and they may be other machines, whose
+cores the load of this one says nothing about.  With ``r`` members of a
+batch still to solve, ``c`` seconds each in this process (the least
+``min(wall, CPU)`` seconds of the members solved here, as the local rule
+times them), finishing them here takes ``r c``.  On the cluster's ``W``
+workers the rest ends no sooner than::
+
+    ceil(r / W) (c + e + o)
+
+``W`` is the number of the cluster's worker processes (the scheduler's
+list, not this machine's cores): a process solves one member at a time
+(Netgen's mesher keeps global state,
+:func:`~ngcontact.parallel.batch_member.run_member`), so a worker's threads
+beyond its first add no member running beside another.  ``o`` is one
+member's trip: the scheduler's round trip and the transfer of the member's
+prepared state (its item) there and of its result back.  It is measured on
+the cluster at each batch, as the batch's first members are solved here: a
+probe task per worker carrying the next member's item and returning as many
+bytes as the first member's result pickled, ``o`` being its wall time here
+less the time it ran on the worker.  ``e`` is what a member costs on the
+cluster's workers beyond its time here (its ``min(wall, CPU)`` seconds on
+the worker less ``c``: a slower machine, a worker's own overheads), measured
+by every batch the cluster solved.  Both are kept per scheduler address
+(:data:`COSTS_FILE`, the last :data:`~ngcontact.parallel.batch_forecast.COSTS_KEPT`
+of each) and the rule takes their medians, so one slow probe does not decide
+alone; ``e`` is 0 before the cluster has solved a batch, and never less: a
+cluster whose members measured faster than here (a faster machine, or only
+this process's other threads in its CPU time) is not counted on.
+
+The cluster repays its trips when the rest ends sooner there::
+
+    c (r - ceil(r / W))  >  ceil(r / W) (o + e)                                (4)
+
+the time the workers save on the rest against the trips and extra time of
+the members each worker solves.  A batch for which (4) fails stays in this
+process, its record saying why (as the local rule's does); so does a batch
+whose probe fails (a worker that cannot import the members' module).  Before
+timing the trips, the probe imports the members' modules on every worker
+(each worker's first member would otherwise pay it), while this process goes
+on solving members; (4) is read once that is done and at least
+:data:`MEASURED` members were solved here, and only then: as members are
+solved here both sides of (4) shrink in proportion (the saving by about
+``c (1 - 1/W)`` per member, the cost by ``(o + e) / W``), so a later look
+would decide the same.
+"""
+from __future__ import annotations
+
+import importlib
+import json
+import math
+import os
+import pickle
+import statistics
+import time
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+from ngcontact.parallel import batch_forecast
+from ngcontact.parallel.batch_member import in_worker, one_thread
+
+#: Members solved in this process before the rest of a batch may go to the cluster (each timed; the least
+#: time is ``c``): the first also pays what this process does once.
+MEASURED = 2
+
+#: The record of the clusters' costs beside the local workers' (:mod:`ngcontact.parallel.batch_forecast`): by
+#: scheduler address, the last ``round_trip`` seconds measured (``o`` of (4)) and ``member_extra`` (``e``).
+COSTS_FILE, COSTS = "dask_costs.json", ("round_trip", "member_extra")
+
+#: Seconds the probe of a batch may take before the batch is kept in this process.
+PROBE_SECONDS = 30.0
+
+
+@dataclass(frozen=True)
+class DaskPayoff:
+    """Condition (4) for the rest of a batch: ``rest`` members of ``member_seconds`` each on ``workers``
+    worker processes of a cluster, each member's trip ``round_trip`` seconds (``o``) and its extra time on a
+    worker ``member_extra`` (``e``)."""
+
+    member_seconds: float
+    rest: int
+    workers: int
+    round_trip: float
+    member_extra: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "member_extra", max(self.member_extra, 0.0))     # ``e >= 0``
+
+    @property
+    def per_worker(self) -> int:
+        """``ceil(r / W)``: the members of the busiest worker."""
+        return math.ceil(self.rest / max(self.workers, 1))
+
+    @property
+    def saving(self) -> float:
+        """Seconds the workers save on the rest: ``c (r - ceil(r / W))``."""
+        return self.member_seconds * (self.rest - self.per_worker)
+
+    @property
+    def cost(self) -> float:
+        """Seconds the busiest worker's members add: ``ceil(r / W) (o + e)``."""
+        return self.per_worker * (self.round_trip + self.member_extra)
+
+    @property
+    def repaid(self) -> bool:
+        """Condition (4): the rest goes to the cluster."""
+        return self.rest > 0 and self.workers > 1 and self.saving > self.cost
+
+    def describe(self, solved: int) -> str:
+        """One line for the report: what was measured and what was decided, after ``solved`` members here."""
+        where = (f"the other {self.rest} on the cluster's {self.workers} workers" if self.repaid
+                 else f"the other {self.rest} in this process")
+        return (f"{solved} member{'s' if solved > 1 else ''} solved here, the cheapest in "
+                f"{self.member_seconds:.3g} s: the cluster's {self.workers} worker"
+                f"{'s' if self.workers != 1 else ''} would save {self.saving:.3g} s on the other {self.rest} "
+                f"against {self.cost:.3g} s of trips ({self.round_trip:.3g} s each: the scheduler's round trip, "
+                f"the member's state and result, timed on the cluster) and of a member's extra time on a "
+                f"worker ({self.member_extra:.3g} s); {where}")
+
+
+# ------------------------------------------------ the record, per scheduler address
+def measured_costs(address: str, kind: str) -> list[float]:
+    """The last costs of ``kind`` (:data:`COSTS`) measured on the cluster at ``address``, oldest first."""
+    try:
+        with open(os.path.join(batch_forecast.folder(), COSTS_FILE)) as f:
+            costs = [float(s) for s in json.load(f)[address][kind]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    return [s for s in costs if math.isfinite(s) and abs(s) < 1e4]
+
+
+def cost_seconds(address: str, kind: str, default: float = 0.0) -> float:
+    """The median of the last costs of ``kind`` measured at ``address``, ``default`` before any."""
+    costs = measured_costs(address, kind)
+    return statistics.median(costs) if costs else default
+
+
+def remember_cost(address: str, kind: str, seconds: float) -> None:
+    """Add a cost of ``kind`` measured at ``address`` to the record (the last
+    :data:`~ngcontact.parallel.batch_forecast.COSTS_KEPT` of each kind are kept)."""
+    try:
+        with open(os.path.join(batch_forecast.folder(), COSTS_FILE)) as f:
+            data = json.load(f)
+        if not isinstance(data, dict):
+            data = {}
+    except (OSError, ValueError):
+        data = {}
+    entry = {k: measured_costs(address, k) for k in COSTS}
+    entry[kind] = (entry[kind] + [float(seconds)])[-batch_forecast.COSTS_KEPT:]
+    data[address] = entry
+    batch_forecast._write(COSTS_FILE, data)
+
+
+# ------------------------------------------------ the probe
+def probe_task(modules: Sequence[str], item: Any, nbytes: int) -> tuple[float, bytes]:
+    """On a worker: its start as a member's (one thread), ``modules`` imported, ``item`` received; returns the
+    seconds this took on the worker and ``nbytes`` bytes (a member's result's size)."""
+    t0 = time.perf_counter()
+    if not in_worker():
+        one_thread(ignore_sigint=False)
+    for module in modules:
+        if module != "__main__":
+            importlib.import_module(module)
+    return time.perf_counter() - t0, bytes(nbytes)
+
+
+def result_bytes(result: Any) -> int:
+    """The size of a member's result as it travels (pickled); 0 for one that does not pickle here."""
+    try:
+        return len(pickle.dumps(result, protocol=pickle.HIGHEST_PROTOCOL))
+    except Exception:  # a result only cloudpickle handles: its size is not counted
+        return 0
+
+
+class Probe:
+    """The probe of one batch on the cluster behind ``client``: every worker imports ``modules``
+    (:meth:`warm`, in the background), then the trips are timed (:meth:`round_trip`)."""
+
+    def __init__(self, client, label: str):
+        self.client = client
+        self.label = label
+        self.workers = list(client.scheduler_info()["workers"])
+        self._warming: list = []
+
+    def _submit(self, modules, item, nbytes) -> list:
+        return [self.client.submit(probe_task, tuple(modules), item, nbytes, workers=[w],
+                                   allow_other_workers=False, pure=False,
+                                   key=f"ngcontact-probe-{self.label}-{k}-{time.time_ns()}")
+                for k, w in enumerate(self.workers)]
+
+    def warm(self, modules: Sequence[str]) -> None:
+        """Every worker imports ``modules`` now (in the background)."""
+        self._warming = self._submit(modules, None, 0)
+
+    def warm_done(self) -> bool:
+        return all(f.done() for f in self._warming)
+
+    def round_trip(self, item: Any, nbytes: int) -> float:
+        """``o`` of (4) measured now: the median over the workers of a probe's wall time here, carrying
+        ``item`` and returning ``nbytes``, less its time on the worker (this process waits meanwhile).  A
+        probe that fails raises its error (after :data:`PROBE_SECONDS`: ``TimeoutError``)."""
+        from distributed import as_completed
+        for fut in self._warming:
+            fut.result(timeout=PROBE_SECONDS)            # a worker that cannot import a module fails here
+        sent = time.perf_counter()
+        trips = []
+        for fut in as_completed(self._submit((), item, nbytes), timeout=PROBE_SECONDS, loop=self.client.loop):
+            on_worker, _ = fut.result()
+            trips.append(max(time.perf_counter() - sent - on_worker, 0.0))
+        return statistics.median(trips)
+
+    def cancel(self) -> None:
+        self.client.cancel(self._warming)

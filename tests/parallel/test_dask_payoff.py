@@ -1,0 +1,105 @@
+"""A run's batch goes to a Dask cluster only where its rest repays the members' trips (condition (4) of
+:mod:`ngcontact.parallel.dask_payoff`): fake members of a known CPU cost, a real ``LocalCluster`` of two
+one-thread worker processes.
+
+The member :func:`burn` spends a given number of CPU seconds and returns the id of the process that ran it,
+so a test sees where each member went.
+"""
+import os
+import time
+
+import pytest
+
+from ngcontact.parallel import dask_payoff
+from ngcontact.parallel.dask_cluster import DaskCluster
+from ngcontact.parallel.dask_payoff import DaskPayoff
+
+
+def burn(seconds: float) -> int:
+    """A member of known cost: ``seconds`` of CPU time in the thread that runs it; that process's id."""
+    t0 = time.thread_time()
+    while time.thread_time() - t0 < seconds:
+        pass
+    return os.getpid()
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """Two worker processes, one thread each, that have imported NGSolve and this module (a warm cluster);
+    no client of the test's own is left as Dask's default (the executor must work without one)."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
+                                  dashboard_address=None) as c, distributed.Client(c, set_as_default=False) as client:
+        probe = dask_payoff.Probe(client, "warm")
+        probe.warm(("ngsolve", __name__))
+        for fut in probe._warming:
+            fut.result(timeout=120)
+        yield c.scheduler_address
+
+
+@pytest.fixture
+def dask(cluster):
+    ex = DaskCluster(cluster)
+    ex.start_on_demand(("ngsolve",))
+    yield ex
+    ex.close()
+
+
+def test_condition_4_weighs_the_saving_on_the_rest_against_the_trips_and_a_workers_extra_time():
+    last = DaskPayoff(member_seconds=0.1, rest=1, workers=2, round_trip=0.01, member_extra=0.0)
+    assert last.saving == 0.0 and not last.repaid                       # one member is not split
+    large = DaskPayoff(member_seconds=0.3, rest=6, workers=2, round_trip=0.02, member_extra=0.0)
+    assert large.saving == pytest.approx(0.9) and large.cost == pytest.approx(0.06) and large.repaid
+    slow = DaskPayoff(member_seconds=0.3, rest=6, workers=2, round_trip=0.02, member_extra=0.4)
+    assert slow.cost == pytest.approx(3 * 0.42) and not slow.repaid     # a cluster whose members cost more
+    assert not DaskPayoff(10.0, 6, 1, 0.0, 0.0).repaid and not DaskPayoff(10.0, 0, 2, 0.0, 0.0).repaid
+    assert DaskPayoff(0.1, 2, 2, 0.2, -0.15).cost == pytest.approx(0.2)    # a faster cluster is not counted on
+    assert "the other 6 on the cluster's 2 workers" in large.describe(2)
+    assert "the other 6 in this process" in slow.describe(2)
+
+
+def test_a_dask_batch_too_small_to_repay_the_trips_runs_serially_and_says_why(dask):
+    """Three members of 0.1 s: after two here, the last one alone saves nothing on two workers."""
+    pids = dask.map(burn, [0.1] * 3, ["a", "b", "c"], label="small")
+    assert pids == [os.getpid()] * 3
+    batch = dask.describe()["batches"][-1]
+    assert (batch["label"], batch["executor"]) == ("small", "serial")
+    assert batch["decision"].startswith("2 members solved here") and "the other 1 in this process" in batch["decision"]
+    assert dask_payoff.measured_costs(dask.address, "round_trip")           # the trip was timed on the cluster
+    assert dask_payoff.measured_costs(dask.address, "member_extra") == []   # no member went there
+
+
+def test_a_large_dask_batch_goes_to_the_cluster_after_its_first_two_members(dask):
+    """Eight members of 0.3 s: 0.9 s saved on the other six, against three trips of milliseconds; on the
+    workers each member costs what it costs here, so its extra time is measured near zero."""
+    seen = []
+    pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="large",
+                    progress=lambda *a: seen.append(a[1:]))
+    assert pids[:2] == [os.getpid()] * 2 and os.getpid() not in pids[2:] and len(set(pids[2:])) == 2
+    assert seen == [(k, 8) for k in range(9)]                   # one count per member, wherever it ran
+    batch = dask.describe()["batches"][-1]
+    assert batch["executor"] == "dask" and "the other 6 on the cluster's 2 workers" in batch["decision"]
+    (trip,), (extra,) = (dask_payoff.measured_costs(dask.address, k) for k in dask_payoff.COSTS)
+    assert 0.0 <= trip < 0.3 and abs(extra) < 0.1
+
+
+def test_a_cluster_whose_members_were_measured_slower_keeps_the_batch_here(dask):
+    """The same eight members, on a cluster whose record says a member costs 1 s more there: the rest stays
+    here, and the decision names that extra time."""
+    dask_payoff.remember_cost(dask.address, "member_extra", 1.0)
+    pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="large")
+    assert pids == [os.getpid()] * 8
+    batch = dask.describe()["batches"][-1]
+    assert batch["executor"] == "serial" and "extra time on a worker (1 s)" in batch["decision"]
+    assert "the other 6 in this process" in batch["decision"]
+
+
+def test_a_cluster_used_directly_sends_every_member_there(cluster):
+    """Without the run's judgement (:func:`ngcontact.parallel.executor.use` of a cluster made by hand) every
+    member goes to the workers."""
+    ex = DaskCluster(cluster)
+    try:
+        pids = ex.map(burn, [0.01] * 3, ["a", "b", "c"], label="direct")
+        assert os.getpid() not in pids and ex.describe()["batches"][-1]["executor"] == "dask"
+    finally:
+        ex.close()
