@@ -44,7 +44,13 @@ definite on the free dofs.  Two ways:
   assembled once, the interface at each step) keeps it across Newton steps
   while CG's iterations per decade stay within ``REBUILD_GROWTH`` times
   their rate after its build (a rebuild costs an assembly; a kept BDDC
-  costs CG iterations as the tangent drifts from its own).  CG stops at
+  costs CG iterations as the tangent drifts from its own).  A step whose
+  contact set moved far can find the kept BDDC far off at once (on the 3D
+  bisinusoid cell after a Uzawa update: 270 iterations for two decades where
+  the build took 26), so a solve with a kept BDDC is capped at
+  ``REBUILD_GROWTH`` times the iterations its decades took after the build
+  (at least ``KEPT_MIN_ITERATIONS``); past the cap BDDC is rebuilt at the
+  step's state and the step solved again, its iterations counted together.  CG stops at
   ``|r_k| <= eta |r_0|`` in the preconditioned norm: an inexact Newton
   step, ``eta`` from the Newton residual's decrease (:func:`forcing_term`,
   Eisenstat-Walker), never below ``rtol = 1e-10``; ``forcing = False``
@@ -99,6 +105,9 @@ UPDATABLE = ("sparsecholesky", "umfpack")
 AUTO_THRESHOLD = 20_000
 #: a kept BDDC is rebuilt once CG needs this many times the iterations per decade it needed after its build
 REBUILD_GROWTH = 2.0
+#: a CG solve with a kept BDDC stops at ``REBUILD_GROWTH`` times the iterations its decades took after the
+#: build, at least this many, and is solved again with BDDC rebuilt (module docstring)
+KEPT_MIN_ITERATIONS = 20
 #: flags of NGSolve's BDDC beyond the space's coupling types (its coarse solve: module docstring); none
 BDDC_FLAGS: dict = {}
 
@@ -191,15 +200,22 @@ class LinearSolver:
         if symmetric and self.forcing and forcing is not None:
             tol = max(self.rtol, forcing)
         extra = {"fixed": fixed_mask(freedofs)} if symmetric else {}
+        retry = None
+        if symmetric and record is not None and record[0] is not None and not form.assembled_whole:
+            def retry() -> "TangentSolve":          # the kept BDDC's CG ran past its cap: rebuilt, solved again
+                form.rebuild()
+                self.rebuilds += 1
+                return self.prepare(form, freedofs, symmetric=symmetric, forcing=forcing)
         return TangentSolve(self, krylov(form.mat, pre.mat, tol=tol, maxiter=self.max_iter, printrates=False,
-                                         **extra), counted=True, record=record, tol=tol)
+                                         **extra), counted=True, record=record, tol=tol, retry=retry)
 
     def preconditioned(self, form: ng.BilinearForm) -> bool:
         """Whether a preconditioner is registered with ``form`` (rebuilt at each of its assemblies)."""
         return _key(form) in self._pre
 
-    def exact_inverse(self, form: ng.BilinearForm, freedofs):
-        """``K^-1`` on ``freedofs`` to ``MEASURE_RTOL``, for measurements after a solve (a Schur complement).
+    def exact_inverse(self, form: ng.BilinearForm, freedofs, rtol: float | None = None):
+        """``K^-1`` on ``freedofs`` to ``rtol`` (default ``MEASURE_RTOL``), for measurements after a solve (a
+        Schur complement).
 
         ``form`` has just been assembled with the space's free dofs equal to
         ``freedofs`` (:meth:`register` before the assembly).  Direct: a fresh
@@ -213,7 +229,7 @@ class LinearSolver:
             return form.mat.Inverse(freedofs, inverse=self.inverse)
         from ngsolve.krylovspace import CGSolver
         pre = self._pre[_key(form)]
-        return CGSolver(form.mat, pre.mat, tol=MEASURE_RTOL, maxiter=self.max_iter,
+        return CGSolver(form.mat, pre.mat, tol=MEASURE_RTOL if rtol is None else rtol, maxiter=self.max_iter,
                         printrates=False)
 
     def _kept_preconditioner(self, form) -> list | None:
@@ -318,8 +334,10 @@ class TangentSolve:
     ``[iterations per decade after its build, last ones]``)."""
 
     def __init__(self, owner: LinearSolver, inverse, counted: bool, record: list | None = None,
-                 tol: float = 0.1):
+                 tol: float = 0.1, retry=None):
         self.owner, self.inverse, self.counted, self.record, self.tol = owner, inverse, counted, record, tol
+        #: ``() -> TangentSolve`` with BDDC rebuilt, where this one keeps an earlier BDDC (its CG then capped)
+        self.retry = retry
 
     def apply(self, rhs, out, reach: float | None = None) -> None:
         """``out = K^-1 rhs``; with ``reach``, CG stops once the Euclidean norm of ``rhs - K out`` is at most
@@ -331,10 +349,21 @@ class TangentSolve:
             self.inverse.reach = reach
             size = rhs.Norm()
             tol = reach / size if size > 0 else 1.0
+        if self.retry is not None:
+            assert self.record is not None and self.record[0] is not None
+            cap = math.ceil(REBUILD_GROWTH * self.record[0] * max(-math.log10(tol), 1.0))
+            self.inverse.maxiter = min(self.owner.max_iter, max(cap, KEPT_MIN_ITERATIONS))
         out.data = self.inverse * rhs
         if not self.counted:
             return
         its = int(self.inverse.iterations)
+        if self.retry is not None and its >= self.inverse.maxiter:
+            # the kept BDDC no longer fits the tangent: the iterations spent stay counted in the fresh solve's
+            self.owner.solves -= 1
+            fresh = self.retry()
+            fresh.apply(rhs, out, reach)
+            self.owner.iterations[-1] += its
+            return
         self.owner.iterations.append(its)
         self.owner.tolerances.append(tol)
         if self.record is not None:
