@@ -137,22 +137,45 @@ class ShearTable:
     solves: int = 0
     covered_jump: float = 0.0   # the largest s a cover() asked for
     checked: list[tuple[float, float, float]] = field(default_factory=list)   # (lo, middle, hi) rows checked
+    #: responses solved for the estimate of the table's share of a macro run's error but not nodes of its law
+    #: (:mod:`ngcontact.coupling.table_share`): a node asked for that is held is taken without a cell solve
+    held: dict[ShearLoad, tuple[float, float]] = field(default_factory=dict)
 
     # ------------------------------------------------------------ solves
-    def _solve(self, loads: Sequence[ShearLoad]) -> None:
-        todo = sorted({(float(p), float(d)) for p, d in loads} - {(p, d) for p, r in self.rows.items() for d in r})
+    def _known(self) -> set[ShearLoad]:
+        return {(p, d) for p, r in self.rows.items() for d in r} | set(self.held)
+
+    def _fetch(self, todo: list[ShearLoad]) -> dict[ShearLoad, tuple[float, float]]:
+        """Cell solves of ``todo`` (none known), counted against :attr:`max_solves`."""
         if not todo:
-            return
+            return {}
         if self.solves + len(todo) > self.max_solves:
             raise ConvergenceError(f"shear table: more than {self.max_solves} cell solves for tolerance "
                                    f"{self.tol:g}", {"pressures": sorted(self.rows)})
+        out = {}
         for (p, d), value in zip(todo, self.map_tasks(self.response, todo)):
             s, t = float(value["jump"]), float(value["shear"])
             if not (np.isfinite(s) and np.isfinite(t)):
                 raise ConvergenceError(f"shear table: non-finite cell response at p = {p:.6g}, jump {d:.6g}",
                                        dict(value))
-            self.rows.setdefault(p, {0.0: (0.0, 0.0)})[d] = (s, t)
+            out[(p, d)] = (s, t)
         self.solves += len(todo)
+        return out
+
+    def _solve(self, loads: Sequence[ShearLoad]) -> None:
+        wanted = {(float(p), float(d)) for p, d in loads}
+        for load in sorted(wanted & set(self.held)):
+            self.rows.setdefault(load[0], {0.0: (0.0, 0.0)})[load[1]] = self.held.pop(load)
+        for (p, d), v in self._fetch(sorted(wanted - self._known())).items():
+            self.rows.setdefault(p, {0.0: (0.0, 0.0)})[d] = v
+
+    def hold(self, loads: Sequence[ShearLoad]) -> dict[ShearLoad, tuple[float, float]]:
+        """The responses at ``loads`` (solved where neither a node nor held), kept in :attr:`held` where they
+        are not nodes; the table's law is unchanged."""
+        wanted = {(float(p), float(d)) for p, d in loads}
+        self.held.update(self._fetch(sorted(wanted - self._known())))
+        return {(p, d): self.rows[p][d] if p in self.rows and d in self.rows[p] else self.held[(p, d)]
+                for p, d in wanted}
 
     def row(self, p: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(Delta, s, tau)`` of the row at ``p``, sorted by ``Delta``."""
@@ -292,6 +315,78 @@ class ShearTable:
                      "estimates %.2e (jump), %.2e (pressure)", len(self.rows), P[0], P[-1], self.covered_jump,
                      self.solves, self.jump_error, self.pressure_error)
         return self.solves > before
+
+    # ------------------------------------------------------------ finer tables (the share of a macro run)
+    def used_loads(self, pressures: np.ndarray, jumps: np.ndarray, margin: int = 1) -> list[ShearLoad]:
+        """The cell loads that halve the table where a macro interface with ``pressures`` and tangential
+        ``jumps`` [m] uses it (:mod:`ngcontact.coupling.table_share`): a row at the middle of every pressure
+        interval (the law's zero row at ``p = 0`` included) from the one holding the least pressure to the one
+        holding the largest and ``margin`` more on either side, with the far-face jumps of its neighbour of
+        more nodes carried along the ray ``s / p``; and on every row in that range, new rows too, the middle
+        of every jump interval up to the one holding the interface's largest ``|s| / p`` carried to the row,
+        and ``margin`` more (a flat interval of a monotone row, exact, is not halved)."""
+        keep = np.asarray(pressures, float) > 0
+        p, s = np.asarray(pressures, float)[keep], np.abs(np.asarray(jumps, float)[keep])
+        if not len(p) or not self.rows:
+            return []
+        P = np.concatenate([[0.0], self.pressures])
+        k = np.clip(np.searchsorted(P, [p.min(), p.max()], side="right") - 1, 0, len(P) - 2)
+        lo, hi = max(int(k[0]) - margin, 0), min(int(k[1]) + margin, len(P) - 2)
+        ray = float(np.max(s / p))
+        rows = {float(q): (float(q), self.row(float(q))[0]) for q in P[lo:hi + 2] if q > 0}
+        for i in range(lo, hi + 1):
+            m = 0.5 * (P[i] + P[i + 1])
+            near = max((q for q in (P[i], P[i + 1]) if q > 0), key=lambda q: len(self.rows[q]))
+            rows[float(m)] = (near, self.row(near)[0] * m / near)
+        loads = [(q, float(d)) for q, (_, d_q) in rows.items() if q not in self.rows for d in d_q[1:]]
+        for q, (near, d_q) in rows.items():
+            _, s_n, _ = self.row(near)
+            j = min(int(np.searchsorted(s_n, ray * near, side="right")) + margin, len(d_q) - 1)
+            loads += [(q, float(0.5 * (a + b))) for a, b, a0, b0 in zip(d_q[:j], d_q[1:j + 1], self.row(near)[0][:j],
+                                                                        self.row(near)[0][1:j + 1])
+                      if not self._flat(near, float(a0), float(b0))]
+        return loads
+
+    def finer(self, pressures: np.ndarray, jumps: np.ndarray, keeper: ShearTable | None = None) -> ShearTable:
+        """A copy halved where ``pressures`` and ``jumps`` use it (:meth:`used_loads`), its new responses held
+        by ``keeper`` (default this table)."""
+        got = (keeper or self).hold(self.used_loads(pressures, jumps))
+        rows = {p: dict(r) for p, r in self.rows.items()}
+        for (p, d), v in got.items():
+            rows.setdefault(p, {0.0: (0.0, 0.0)})[d] = v
+        return ShearTable(self.response, self.tol, self.length_unit, map_tasks=self.map_tasks, rows=rows)
+
+    def own_errors(self, level: ShearTable) -> list[tuple[float, list[ShearLoad]]]:
+        """This table's own error where ``level`` (a :meth:`finer` copy) adds nodes, with the loads that would
+        mend it: a new row's largest discrepancy against this table's rows around it carried along the rays
+        (as the law interpolates; the zero row at ``p = 0``), a new node of a row its discrepancy against the
+        row's polyline; both relative to the largest shear of the table (as the tolerance's checks)."""
+        scale = max(self._row_scale(p) for p in self.rows)
+        P = np.concatenate([[0.0], self.pressures])
+        out = []
+        for q in sorted(set(level.rows) - set(self.rows)):
+            i = min(int(np.searchsorted(P, q)), len(P) - 1)
+            lo, hi = P[i - 1], P[i]
+            _, s, t = level.row(q)
+            f = (q - lo) / (hi - lo)
+            guess = f * self.along_ray(hi, q, s) + ((1 - f) * self.along_ray(lo, q, s) if lo > 0 else 0.0)
+            out.append((float(np.max(np.abs(t - guess))) / scale, [(q, d) for d in level.rows[q] if d != 0.0]))
+        for p in self.rows:
+            _, s, t = self.row(p)
+            for d in sorted(set(level.rows[p]) - set(self.rows[p])):
+                sm, tm = level.rows[p][d]
+                out.append((abs(tm - float(np.interp(sm, s, t))) / scale, [(p, d)]))
+        return out
+
+    def adopt(self, level: ShearTable, mark: float = 0.0) -> int:
+        """Make the nodes of ``level`` (a :meth:`finer` copy) this table's, their responses taken from
+        :attr:`held`; with ``mark > 0`` only where this table's own error (:meth:`own_errors`) is at least
+        ``mark`` times its largest.  Returns the number of nodes added."""
+        groups = self.own_errors(level)
+        top = max((e for e, _ in groups), default=0.0)
+        loads = [x for e, g in groups if e >= mark * top for x in g]
+        self._solve(loads)
+        return len(loads)
 
     # ------------------------------------------------------------ law and report
     def law(self) -> il.CellShear:
