@@ -245,3 +245,28 @@ def test_the_shear_tables_share_bounds_its_error_against_a_much_finer_table(tmp_
         compared.append(name)
         assert true <= share.errors[name] <= 10 * true, (name, share.errors[name], true)
     assert len(compared) >= 3, compared
+
+
+def test_the_safety_factor_is_a_quantity_of_the_share_and_bounded(tmp_path, monkeypatch):
+    """With ``[strength]`` the safety factor of eq. 78 (linear recovery on the shipped hip-hills cell) is a
+    headline quantity of the share, its estimate between 1 and 10 times its error against a much finer table
+    (the press fit at twice its interference, where the stresses feel the table)."""
+    import os
+    from ngcontact.drivers.macro_accuracy import safety_factor_of
+    from ngcontact.drivers.run_strength import recovery_of
+    scene_with(tmp_path, monkeypatch, gap=-2e-3)
+    path = tmp_path / "two_scale.toml"
+    cell = os.path.abspath("geometries/cells/hip_hills.toml")
+    path.write_text(path.read_text().replace("E = 200.0\n", "E = 200.0\nsigma_u = 1.0\n")
+                    .replace("E = 70.0\n", "E = 70.0\nsigma_u = 0.5\n")
+                    + f'\n[strength]\ncell = "{cell}"\ncriterion = "von_mises"\nrecovery = "linear"\n')
+    scene = loader.load(path)
+    sol, _, relevel = loop(scene, tmp_path)
+    safety = safety_factor_of(scene, recovery_of(scene, sol.problem.law))
+    answer = relevel.table_share(sol, 1e-3, safety=safety)
+    share = relevel.share
+    assert share is not None and "safety_factor" in share.errors and share.share <= TS.FRACTION * 1e-3
+    true = abs(share.values["safety_factor"] - safety(reference(answer, relevel.table, scene, 4)))
+    assert true > 1e-9 * share.values["safety_factor"]
+    assert true <= share.errors["safety_factor"] <= 10 * true, (share.errors["safety_factor"], true)
+    assert share.values["safety_factor"] == pytest.approx(safety(answer), rel=1e-12)
