@@ -169,10 +169,13 @@ def _friction_block(tmp_path):
     0.002 along the interface, part of it sticking) as a two-scale scene under ``friction = "from_cell"``; its
     cell's responses are replaced by the closed forms below (:func:`analytic_tables`)."""
     import importlib.util
-    spec = importlib.util.spec_from_file_location("sawtooth_shear", "scripts/sawtooth_shear.py")
+    from pathlib import Path
+    spec = importlib.util.spec_from_file_location("sawtooth_shear", Path(__file__).parents[2] / "scripts" /
+                                                  "sawtooth_shear.py")
     assert spec is not None and spec.loader is not None
     S = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(S)
+    tmp_path.mkdir(parents=True, exist_ok=True)
     S.write_cell(str(tmp_path))
     return S.macro_scene(str(tmp_path), *S.VARIANTS["from_cell"], u=0.002)
 
@@ -205,7 +208,7 @@ def analytic_tables(scene, tol: float = 0.05):
 
 def shear_reference(answer, relevel, scene, halvings: int = 3):
     """``answer`` solved again with both tables halved ``halvings`` times more where its interface uses them (the
-    shear table in its pressures and its jumps, :meth:`~ngcontact.coupling.shear_table.ShearTable.used_loads`)."""
+    shear table in its pressures and its jumps, :func:`~ngcontact.coupling.table_share.shear_loads`)."""
     from ngcontact.macro.macro_measures import interface_profile
     prof = interface_profile(answer, scene.output.points_per_element)
     fine = PT.CellTable(relevel.table.response, relevel.table.tol, values=dict(relevel.table.values))
@@ -213,7 +216,7 @@ def shear_reference(answer, relevel, scene, halvings: int = 3):
     relevel.shear.max_solves = 10 ** 6                       # closed forms: the reference costs no cell solve
     for _ in range(halvings):
         fine = TS._finer(fine, dict(fine.values), prof["pressure"][prof["pressure"] > 0])
-        fine_shear = fine_shear.finer(prof["pressure"], prof["jump_t"], keeper=relevel.shear)
+        fine_shear = TS.shear_finer(fine_shear, prof["pressure"], prof["jump_t"], keeper=relevel.shear)
     law = il.InterfaceLaw(normal=PT.response_law(fine), friction=fine_shear.law())
     return D.solve_scene(scene, M.replace_law(answer.problem, law), answer.gfu.vec)
 
@@ -256,13 +259,14 @@ def test_the_safety_factor_is_a_quantity_of_the_share_and_bounded(tmp_path, monk
     from ngcontact.drivers.run_strength import recovery_of
     scene_with(tmp_path, monkeypatch, gap=-2e-3)
     path = tmp_path / "two_scale.toml"
-    cell = os.path.abspath("geometries/cells/hip_hills.toml")
+    cell = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "geometries", "cells", "hip_hills.toml"))
     path.write_text(path.read_text().replace("E = 200.0\n", "E = 200.0\nsigma_u = 1.0\n")
                     .replace("E = 70.0\n", "E = 70.0\nsigma_u = 0.5\n")
                     + f'\n[strength]\ncell = "{cell}"\ncriterion = "von_mises"\nrecovery = "linear"\n')
     scene = loader.load(path)
     sol, _, relevel = loop(scene, tmp_path)
     safety = safety_factor_of(scene, recovery_of(scene, sol.problem.law))
+    assert safety is not None
     answer = relevel.table_share(sol, 1e-3, safety=safety)
     share = relevel.share
     assert share is not None and "safety_factor" in share.errors and share.share <= TS.FRACTION * 1e-3
