@@ -99,17 +99,22 @@ HOW = ("the table's intervals holding the macro interface's pressures (and one m
        "monotone cubic's error at least halves with its intervals; ngcontact.coupling.table_share)")
 
 
-class PressurePart:
-    """The pressure table as a part of the share: its intervals holding the interface's pressures halved."""
+class _Part:
+    """A table of the macro law as a part of the share: ``table`` and its cell solves."""
 
-    name = "pressure_table"
-
-    def __init__(self, table: CellTable):
+    def __init__(self, table):
         self.table = table
 
     @property
     def solves(self) -> int:
         return self.table.solves
+
+
+class PressurePart(_Part):
+    """The pressure table as a part of the share: its intervals holding the interface's pressures halved."""
+
+    name = "pressure_table"
+    table: CellTable
 
     def nodes(self, level: CellTable | None = None) -> int:
         return len((level or self.table).values)
@@ -126,7 +131,7 @@ class PressurePart:
 
     def adopt(self, level: CellTable) -> int:
         """The midpoints of ``level`` made nodes; with :data:`MARK` > 0 only those where the table's own error
-        (:meth:`CellTable.discrepancy`) is at least ``mark`` times its largest.  Returns how many."""
+        (:meth:`CellTable.discrepancy`) is at least that fraction of its largest.  Returns how many."""
         new = {m: level.values[m] for m in set(level.values) - set(self.table.values)}
         errors = self.table.discrepancy(new) if new else {}
         top = max(errors.values(), default=0.0)
@@ -135,17 +140,11 @@ class PressurePart:
         return sum(e >= MARK * top for e in errors.values())
 
 
-class ShearPart:
+class ShearPart(_Part):
     """The shear table as a part of the share (module docstring)."""
 
     name = "shear_table"
-
-    def __init__(self, table: ShearTable):
-        self.table = table
-
-    @property
-    def solves(self) -> int:
-        return self.table.solves
+    table: ShearTable
 
     def nodes(self, level: ShearTable | None = None) -> int:
         return sum(len(r) for r in (level or self.table).rows.values())

@@ -24,7 +24,8 @@ gets its shear table (:mod:`ngcontact.coupling.shear_table`): the macro
 law's tangential part is then the cell's tabulated shear instead of the
 ``mu0`` of eqs. 42-43 (which only starts the loop); its cell solves go
 through the same executor (:class:`ShearSolve` tasks) and it is cached the
-same way under its own key.
+same way under its own key, with the loads its share's estimate solved
+(``held``, format ``cell-shear-table-2``).
 
 ``results["two_scale"]``: ``converged``, ``iterations`` (law updates),
 ``macro_solves``, ``cell_solves`` (cell problems solved in this run),
