@@ -274,3 +274,26 @@ def test_the_safety_factor_is_a_quantity_of_the_share_and_bounded(tmp_path, monk
     assert true > 1e-9 * share.values["safety_factor"]
     assert true <= share.errors["safety_factor"] <= 10 * true, (share.errors["safety_factor"], true)
     assert share.values["safety_factor"] == pytest.approx(safety(answer), rel=1e-12)
+
+
+def test_the_shear_tables_held_loads_survive_the_cache_and_become_nodes_without_a_cell_solve(tmp_path):
+    from ngcontact.coupling import shear_table as ST
+    calls: list = []
+
+    def response(load):
+        calls.append(load)
+        return shear_response(load)
+    table = ST.ShearTable(response, tol=0.05, length_unit=1e-4)
+    table.cover(2e-4, 2e-3, 5e-4)
+    nodes, solved = {p: dict(r) for p, r in table.rows.items()}, len(calls)
+    p, s = np.array([5e-4, 1e-3, 1.5e-3]), np.array([1e-4, 2e-4, 3e-4])
+    level = TS.shear_finer(table, p, s)
+    added = {(q, d) for q, r in level.rows.items() for d in r} - {(q, d) for q, r in nodes.items() for d in r}
+    assert table.rows == nodes and set(table.held) == {x for x in added if x[1] != 0.0}
+    assert len(calls) == solved + len(table.held) and set(level.rows) > set(nodes)   # new rows at the middles
+    R.store_shear("s" * 64, table, str(tmp_path))
+    again, cached = R.cached_shear("s" * 64, response, 0.05, 1e-4, ST.serial_map, str(tmp_path))
+    assert cached and again.rows == nodes and again.held == table.held
+    assert TS.ShearPart(again).adopt(level) == len(table.held)          # all made nodes (SHEAR_MARK = 0) ...
+    assert len(calls) == solved + len(table.held) and not again.held     # ... without a cell solve
+    assert again.rows == level.rows
