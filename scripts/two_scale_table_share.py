@@ -123,11 +123,12 @@ def shear_rows(tmp: Path) -> list[dict]:
     seconds = time.perf_counter() - start
     share = relevel.share
     assert share is not None
+    solves = relevel.shear.solves + relevel.table.solves - solves        # the share's (not the reference's)
+    nodes_answer = sum(len(r) for r in relevel.shear.rows.values())
     component = next(k for k in share.values if k.startswith("resultant_")).removeprefix("resultant_")
     exact = DE.headlines(shear_reference(answer, relevel, scene), scene.output.points_per_element, component)
-    return compared(share, exact, SHEAR, None, nodes_scene=nodes,
-                    nodes_answer=sum(len(r) for r in relevel.shear.rows.values()), rounds=len(share.rounds),
-                    cell_solves=relevel.shear.solves + relevel.table.solves - solves, seconds=seconds)
+    return compared(share, exact, SHEAR, None, nodes_scene=nodes, nodes_answer=nodes_answer,
+                    rounds=len(share.rounds), cell_solves=solves, seconds=seconds)
 
 
 def shear_marked_row(tmp: Path) -> dict:
@@ -224,7 +225,18 @@ def main(argv=None) -> int:
                               "the cell's linear range). nodes_scene: the table the loop made; nodes_answer: the "
                               "answer's; cell_solves: the share's. Rows 'whole run': the scene run twice on one "
                               "cache (macro refinement included); the second starts from the table the first grew "
-                              "and wrote back. Wall times on 2 cores shared with other jobs.")
+                              "and wrote back. A refinement round makes nodes of the pressure table's first "
+                              f"midpoints where its own error is at least {TS.MARK:g} of its largest; rows 'share, "
+                              "all first midpoints adopted': every one (the rule before), per interference the "
+                              "quantity of least effectivity with the share's cell solves. Rows 'shear table': the "
+                              "sawtooth block of scripts/sawtooth_shear.py (moved 0.002, part of the interface "
+                              "sticking) under friction = from_cell, its cell's responses closed forms "
+                              "(tests/coupling/test_table_share.py; a cell solve costs nothing there, its count is "
+                              "the figure), both tables' share (pressure_part, shear_part: relative, added) against "
+                              "both tables halved three more times where the interface uses them; nodes: the shear "
+                              "table's; 'marked': the shear table's first midpoints marked by its own error "
+                              "(SHEAR_MARK 0.5), which stalls (share by the last of 8 rounds). "
+                              "Wall times on 2 cores shared with other jobs.")
     return 0
 
 
