@@ -235,7 +235,8 @@ def main(argv=None) -> int:
                               "the figure), both tables' share (pressure_part, shear_part: relative, added) against "
                               "both tables halved three more times where the interface uses them; nodes: the shear "
                               "table's; 'marked': the shear table's first midpoints marked by its own error "
-                              "(SHEAR_MARK 0.5), which stalls (share by the last of 8 rounds). "
+                              "(SHEAR_MARK 0.5), which stalls (its share by its last round; out of reach at the test's "
+                              "bound of 1e5 cell solves or 8 rounds). "
                               "Wall times on 2 cores shared with other jobs.")
     return 0
 
