@@ -12,6 +12,16 @@ The scene: Lame's press fit (plane strain quarter, order 2, maxh 0.3) coupled wi
 * per quantity the value, the estimate, the true error and the effectivity (estimate / true error; issue 35
   asks for 1 to 10), where the true error is above round-off.
 
+The same with every first midpoint of a refinement round made a node (``table_share.MARK = 0``, the rule before
+the marking by the table's own error): its cell solves and its smallest effectivity ("all adopted" rows).
+
+The shear table's share: the sawtooth block of ``scripts/sawtooth_shear.py`` (pressed, moved along the interface
+with part of it sticking) under ``friction = "from_cell"``, its cell's responses closed forms
+(``tests/coupling/test_table_share.py``: ``normal_response``, ``shear_response``; a cell solve costs nothing, its
+count is the figure), at the same tolerance: per quantity the estimate, each table's part, the true error against
+both tables halved three more times where the interface uses them; and the same with the shear table's first
+midpoints marked by its own error (``table_share.SHEAR_MARK = 0.5``).
+
 Then the whole run (``ngcontact run``'s driver, the tolerance refining the macro discretization as well) twice
 on one cache: the cell solves and wall time of each (the second starts from the table the first grew).
 Usage::
@@ -39,14 +49,18 @@ from ngcontact.drivers import run_macro as D  # noqa: E402
 from ngcontact.macro import discretization_error as DE  # noqa: E402
 from ngcontact.output.report import Clock  # noqa: E402
 from ngcontact.output.writer import write_csv  # noqa: E402
-from tests.coupling.test_table_share import loop, reference, scene_with  # noqa: E402
+from ngcontact.errors import ConvergenceError  # noqa: E402
+from tests.coupling.test_table_share import (_friction_block, analytic_tables, loop, reference,  # noqa: E402
+                                             scene_with, shear_reference)
 
 TOLERANCE = 1e-3
 GAPS = (-2e-3, -1.5e-3, -1e-3, -5e-4)
 #: the scene's own interference (the whole runs')
 SCENE_GAP = -1e-3
-KEYS = ("run", "gap", "quantity", "value", "estimate", "true_error", "effectivity", "nodes_scene", "nodes_answer",
-        "rounds", "cell_solves", "seconds")
+KEYS = ("run", "gap", "quantity", "value", "estimate", "true_error", "effectivity", "pressure_part", "shear_part",
+        "nodes_scene", "nodes_answer", "rounds", "cell_solves", "seconds")
+#: the run label of the shear rows
+SHEAR = "shear table, friction block"
 
 
 class _Env:
@@ -57,7 +71,20 @@ class _Env:
         os.environ[key] = value
 
 
-def share_rows(gap: float, tmp: Path) -> list[dict]:
+def compared(share, exact: dict, run: str, gap, **extra) -> list[dict]:
+    """Per quantity of ``share`` its value, estimate, parts, true error against ``exact`` and effectivity."""
+    rows = []
+    for name, value in share.values.items():
+        true = abs(value - exact[name].value)
+        above = true > 1e-9 * abs(exact[name].value)
+        parts = {f"{t.removesuffix('_table')}_part": q.get(name) for t, q in share.parts.items()}
+        rows.append({"run": run, "gap": gap, "quantity": name, "value": value, "estimate": share.errors[name],
+                     "true_error": true, "effectivity": share.errors[name] / true if above else None,
+                     "pressure_part": None, "shear_part": None, **parts, **extra})
+    return rows
+
+
+def share_rows(gap: float, tmp: Path, run: str = "share on the scene's mesh") -> list[dict]:
     scene = scene_with(tmp, _Env, gap=gap)
     sol, res, relevel = loop(scene, tmp)
     start = time.perf_counter()
@@ -68,17 +95,63 @@ def share_rows(gap: float, tmp: Path) -> list[dict]:
     ref = reference(answer, relevel.table, scene, 4)
     component = next(k for k in share.values if k.startswith("resultant_")).removeprefix("resultant_")
     exact = DE.headlines(ref, scene.output.points_per_element, component)
-    rows = []
-    for name, value in share.values.items():
-        true = abs(value - exact[name].value)
-        above = true > 1e-9 * abs(exact[name].value)
-        rows.append({"run": "share on the scene's mesh", "gap": gap, "quantity": name, "value": value,
-                     "estimate": share.errors[name], "true_error": true,
-                     "effectivity": share.errors[name] / true if above else None,
-                     "nodes_scene": res["table"]["nodes"], "nodes_answer": len(relevel.table.values),
-                     "rounds": len(share.rounds), "cell_solves": sum(r["cell_solves"] for r in share.rounds),
-                     "seconds": seconds})
-    return rows
+    return compared(share, exact, run, gap, nodes_scene=res["table"]["nodes"], nodes_answer=len(relevel.table.values),
+                    rounds=len(share.rounds), cell_solves=sum(r["cell_solves"] for r in share.rounds),
+                    seconds=seconds)
+
+
+def all_adopted_rows(tmp: Path) -> list[dict]:
+    """Per interference the share with every first midpoint adopted: its quantity of least effectivity."""
+    mark, TS.MARK = TS.MARK, 0.0
+    try:
+        rows = []
+        for k, gap in enumerate(GAPS):
+            found = [r for r in share_rows(gap, tmp / f"all{k}", "share, all first midpoints adopted")
+                     if r["effectivity"] is not None]
+            rows.append(min(found, key=lambda r: r["effectivity"]))
+        return rows
+    finally:
+        TS.MARK = mark
+
+
+def shear_rows(tmp: Path) -> list[dict]:
+    scene = _friction_block(tmp)
+    sol, relevel = analytic_tables(scene)
+    nodes = sum(len(r) for r in relevel.shear.rows.values())
+    start, solves = time.perf_counter(), relevel.shear.solves + relevel.table.solves
+    answer = relevel.table_share(sol, TOLERANCE)
+    seconds = time.perf_counter() - start
+    share = relevel.share
+    assert share is not None
+    solves = relevel.shear.solves + relevel.table.solves - solves        # the share's (not the reference's)
+    nodes_answer = sum(len(r) for r in relevel.shear.rows.values())
+    component = next(k for k in share.values if k.startswith("resultant_")).removeprefix("resultant_")
+    exact = DE.headlines(shear_reference(answer, relevel, scene), scene.output.points_per_element, component)
+    return compared(share, exact, SHEAR, None, nodes_scene=nodes, nodes_answer=nodes_answer,
+                    rounds=len(share.rounds), cell_solves=solves, seconds=seconds)
+
+
+def shear_marked_row(tmp: Path) -> dict:
+    """The shear table's first midpoints marked by its own error: the share by round, and its cell solves."""
+    mark, TS.SHEAR_MARK = TS.SHEAR_MARK, 0.5
+    try:
+        scene = _friction_block(tmp)
+        sol, relevel = analytic_tables(scene)
+        start, solves = time.perf_counter(), relevel.shear.solves + relevel.table.solves
+        try:
+            relevel.table_share(sol, TOLERANCE)
+            rounds = relevel.share.rounds if relevel.share is not None else []
+            run = SHEAR + ", marked"
+        except ConvergenceError as err:
+            rounds, run = err.history["table_share"], SHEAR + ", marked: out of reach"
+        return {"run": run, "gap": None, "quantity": "cell_table_share", "value": rounds[-1]["share"],
+                "estimate": rounds[-1]["share"], "true_error": None, "effectivity": None, "pressure_part": None,
+                "shear_part": rounds[-1]["parts"]["shear_table"]["share"], "nodes_scene": None,
+                "nodes_answer": rounds[-1]["nodes"]["shear_table"], "rounds": len(rounds),
+                "cell_solves": relevel.shear.solves + relevel.table.solves - solves,
+                "seconds": time.perf_counter() - start}
+    finally:
+        TS.SHEAR_MARK = mark
 
 
 def run_rows(tmp: Path) -> list[dict]:
@@ -89,7 +162,8 @@ def run_rows(tmp: Path) -> list[dict]:
         res = D.run(scene, Clock()).results
         q = {x["name"]: x for x in res["accuracy"]["quantities"]}["cell_table_share"]
         rows.append({"run": run, "gap": SCENE_GAP, "quantity": "cell_table_share", "value": q["value"],
-                     "estimate": q["error"], "true_error": None, "effectivity": None, "nodes_scene": None,
+                     "estimate": q["error"], "true_error": None, "effectivity": None, "pressure_part": None,
+                     "shear_part": None, "nodes_scene": None,
                      "nodes_answer": res["two_scale"]["table"]["nodes"], "rounds": len(q["rounds"]),
                      "cell_solves": res["two_scale"]["cell_solves"], "seconds": time.perf_counter() - start})
     return rows
@@ -99,9 +173,13 @@ def plot(rows: list[dict], path: str) -> None:
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(5.5, 4.5))
     for gap in GAPS:
-        pts = [(r["true_error"], r["estimate"]) for r in rows if r["gap"] == gap and r["effectivity"] is not None]
+        pts = [(r["true_error"], r["estimate"]) for r in rows if r["gap"] == gap and r["effectivity"] is not None
+               and r["run"] == "share on the scene's mesh"]
         if pts:
-            ax.loglog(*zip(*pts), "o", label=f"gap {gap:g}")
+            ax.loglog(*zip(*pts), "o", label=f"press fit, gap {gap:g}")
+    pts = [(r["true_error"], r["estimate"]) for r in rows if r["run"] == SHEAR and r["effectivity"] is not None]
+    if pts:
+        ax.loglog(*zip(*pts), "s", label="friction block (both tables)")
     lo, hi = ax.get_xlim()
     ax.loglog([lo, hi], [lo, hi], "k-", lw=0.8, label="effectivity 1")
     ax.loglog([lo, hi], [10 * lo, 10 * hi], "k--", lw=0.8, label="effectivity 10")
@@ -120,6 +198,9 @@ def main(argv=None) -> int:
     os.makedirs(args.out, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         rows = [r for k, gap in enumerate(GAPS) for r in share_rows(gap, Path(tmp) / f"gap{k}")]
+        rows += all_adopted_rows(Path(tmp))
+        rows += shear_rows(Path(tmp) / "shear")
+        rows.append(shear_marked_row(Path(tmp) / "marked"))
         rows += run_rows(Path(tmp) / "run")
     csv_path = os.path.join(args.out, "two_scale_table_share.csv")
     write_csv(csv_path, list(KEYS), [[r[k] for k in KEYS] for r in rows])
@@ -144,7 +225,19 @@ def main(argv=None) -> int:
                               "the cell's linear range). nodes_scene: the table the loop made; nodes_answer: the "
                               "answer's; cell_solves: the share's. Rows 'whole run': the scene run twice on one "
                               "cache (macro refinement included); the second starts from the table the first grew "
-                              "and wrote back. Wall times on 2 cores shared with other jobs.")
+                              "and wrote back. A refinement round makes nodes of the pressure table's first "
+                              f"midpoints where its own error is at least {TS.MARK:g} of its largest; rows 'share, "
+                              "all first midpoints adopted': every one (the rule before), per interference the "
+                              "quantity of least effectivity with the share's cell solves. Rows 'shear table': the "
+                              "sawtooth block of scripts/sawtooth_shear.py (moved 0.002, part of the interface "
+                              "sticking) under friction = from_cell, its cell's responses closed forms "
+                              "(tests/coupling/test_table_share.py; a cell solve costs nothing there, its count is "
+                              "the figure), both tables' share (pressure_part, shear_part: relative, added) against "
+                              "both tables halved three more times where the interface uses them; nodes: the shear "
+                              "table's; 'marked': the shear table's first midpoints marked by its own error "
+                              "(SHEAR_MARK 0.5), which stalls (its share by its last round; out of reach at the test's "
+                              "bound of 1e5 cell solves or 8 rounds). "
+                              "Wall times on 2 cores shared with other jobs.")
     return 0
 
 

@@ -139,19 +139,29 @@ class CellTable:
     def _scale(self, key: str) -> float:
         return max([abs(v[key]) for v in self.values.values()] + [1e-300])
 
+    def discrepancy(self, responses: dict[float, Response], scales: CellTable | None = None) -> dict[float, float]:
+        """The largest relative discrepancy of each of ``responses`` (pressure -> response) against this table's
+        interpolants and law (module docstring), relative to the largest values of ``scales`` (default this
+        table)."""
+        law, scales = response_law(self), scales or self
+        p_scale = float(max(scales.pressures[-1], max(responses)))
+        out = {}
+        for m, vm in responses.items():
+            at = self(m)
+            out[m] = max([abs(vm[k] - float(at[k])) / scales._scale(k) for k in CHECKED]
+                         + [abs(m - float(ie.pressure(law, [vm["closure"], 0.0]))) / p_scale])
+        return out
+
     def _refine(self, intervals: list[tuple[float, float]]) -> None:
         """Check the intervals level by level (one batch of independent cell solves per level)."""
         while intervals:
             mids = [0.5 * (a + b) for a, b in intervals]
             before = CellTable(self.response, self.tol, values=dict(self.values))  # the nodes before this level
-            law = response_law(before)
             self._solve(mids)
-            p_scale = float(self.pressures[-1])
+            errors = before.discrepancy({m: self.values[m] for m in mids}, self)
             nxt = []
             for (lo, hi), m in zip(intervals, mids):
-                vm, at = self.values[m], before(m)
-                err = max([abs(vm[k] - float(at[k])) / self._scale(k) for k in CHECKED]
-                          + [abs(m - float(ie.pressure(law, [vm["closure"], 0.0]))) / p_scale])
+                err = errors[m]
                 if err > self.tol and hi - lo > 1e-6 * hi:
                     nxt += [(lo, m), (m, hi)]
                 else:

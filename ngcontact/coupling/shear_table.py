@@ -137,22 +137,45 @@ class ShearTable:
     solves: int = 0
     covered_jump: float = 0.0   # the largest s a cover() asked for
     checked: list[tuple[float, float, float]] = field(default_factory=list)   # (lo, middle, hi) rows checked
+    #: responses solved for the estimate of the table's share of a macro run's error but not nodes of its law
+    #: (:mod:`ngcontact.coupling.table_share`): a node asked for that is held is taken without a cell solve
+    held: dict[ShearLoad, tuple[float, float]] = field(default_factory=dict)
 
     # ------------------------------------------------------------ solves
-    def _solve(self, loads: Sequence[ShearLoad]) -> None:
-        todo = sorted({(float(p), float(d)) for p, d in loads} - {(p, d) for p, r in self.rows.items() for d in r})
+    def _known(self) -> set[ShearLoad]:
+        return {(p, d) for p, r in self.rows.items() for d in r} | set(self.held)
+
+    def _fetch(self, todo: list[ShearLoad]) -> dict[ShearLoad, tuple[float, float]]:
+        """Cell solves of ``todo`` (none known), counted against :attr:`max_solves`."""
         if not todo:
-            return
+            return {}
         if self.solves + len(todo) > self.max_solves:
             raise ConvergenceError(f"shear table: more than {self.max_solves} cell solves for tolerance "
                                    f"{self.tol:g}", {"pressures": sorted(self.rows)})
+        out = {}
         for (p, d), value in zip(todo, self.map_tasks(self.response, todo)):
             s, t = float(value["jump"]), float(value["shear"])
             if not (np.isfinite(s) and np.isfinite(t)):
                 raise ConvergenceError(f"shear table: non-finite cell response at p = {p:.6g}, jump {d:.6g}",
                                        dict(value))
-            self.rows.setdefault(p, {0.0: (0.0, 0.0)})[d] = (s, t)
+            out[(p, d)] = (s, t)
         self.solves += len(todo)
+        return out
+
+    def _solve(self, loads: Sequence[ShearLoad]) -> None:
+        wanted = {(float(p), float(d)) for p, d in loads}
+        for load in sorted(wanted & set(self.held)):
+            self.rows.setdefault(load[0], {0.0: (0.0, 0.0)})[load[1]] = self.held.pop(load)
+        for (p, d), v in self._fetch(sorted(wanted - self._known())).items():
+            self.rows.setdefault(p, {0.0: (0.0, 0.0)})[d] = v
+
+    def hold(self, loads: Sequence[ShearLoad]) -> dict[ShearLoad, tuple[float, float]]:
+        """The responses at ``loads`` (solved where neither a node nor held), kept in :attr:`held` where they
+        are not nodes; the table's law is unchanged."""
+        wanted = {(float(p), float(d)) for p, d in loads}
+        self.held.update(self._fetch(sorted(wanted - self._known())))
+        return {(p, d): self.rows[p][d] if p in self.rows and d in self.rows[p] else self.held[(p, d)]
+                for p, d in wanted}
 
     def row(self, p: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(Delta, s, tau)`` of the row at ``p``, sorted by ``Delta``."""

@@ -265,18 +265,21 @@ def run(scene, clock) -> Outcome:
     with clock.stage("interface law"):
         problem, law_info = problem_of(scene, geo)
         check_radius(scene, problem)
-    two_scale = relevel = None
+    two_scale = relevel = recovery = refined = None
+    if scene.strength is not None:
+        from ngcontact.drivers.run_strength import recovery_of
+        with clock.stage("strength check"):
+            # the correctors depend on the law only through whether it has a tangential part, which the
+            # two-scale loop keeps (its tabulated shear where the start law has friction): built before the loop,
+            # the tables' share counts the safety factor (ngcontact.coupling.table_share)
+            recovery = recovery_of(scene, problem.law)
     with clock.stage("solve"):
         if scene.two_scale is None:
             sol = solve_scene(scene, problem)
         else:
             from ngcontact.drivers.run_two_scale import couple_loop
-            sol, two_scale, relevel = couple_loop(scene, problem, partial(solve_scene, scene))
-    recovery = refined = None
-    if scene.strength is not None:
-        from ngcontact.drivers.run_strength import recovery_of
-        with clock.stage("strength check"):
-            recovery = recovery_of(scene, sol.problem.law)
+            sol, two_scale, relevel = couple_loop(scene, problem, partial(solve_scene, scene),
+                                                  safety=safety_factor_of(scene, recovery))
     if scene.discretization.tolerance is not None:
         with clock.stage("refinement to the tolerance"):
             refined = refine(scene, sol, partial(solve_scene, scene), safety_factor_of(scene, recovery), relevel)

@@ -24,7 +24,8 @@ gets its shear table (:mod:`ngcontact.coupling.shear_table`): the macro
 law's tangential part is then the cell's tabulated shear instead of the
 ``mu0`` of eqs. 42-43 (which only starts the loop); its cell solves go
 through the same executor (:class:`ShearSolve` tasks) and it is cached the
-same way under its own key.
+same way under its own key, with the loads its share's estimate solved
+(``held``, format ``cell-shear-table-2``).
 
 ``results["two_scale"]``: ``converged``, ``iterations`` (law updates),
 ``macro_solves``, ``cell_solves`` (cell problems solved in this run),
@@ -164,8 +165,9 @@ class ShearSolve(PressureSolve):
         return S.cell_shear_response(self.problem(), load[0], load[1], self.length_unit)
 
 
-SHEAR_FORMAT = "cell-shear-table-1"
-SHEAR_ARRAYS = ("row_pressure", "far_face_jump", "jump", "shear", "errors", "checked")
+SHEAR_FORMAT = "cell-shear-table-2"
+#: ``held``: 1 at a load solved for the estimate of the tables' share but not a node of the law
+SHEAR_ARRAYS = ("row_pressure", "far_face_jump", "jump", "shear", "errors", "checked", "held")
 
 
 def shear_key(cell_scene, length_unit: float, tol: float) -> str:
@@ -176,7 +178,7 @@ def shear_key(cell_scene, length_unit: float, tol: float) -> str:
 
 def _shear_shapes(arrays: dict) -> str | None:
     n = arrays["row_pressure"].shape
-    if len(n) != 1 or any(arrays[k].shape != n for k in ("far_face_jump", "jump", "shear")) or \
+    if len(n) != 1 or any(arrays[k].shape != n for k in ("far_face_jump", "jump", "shear", "held")) or \
             arrays["errors"].shape != (3,) or arrays["checked"].ndim != 2 or arrays["checked"].shape[1] != 3:
         return "arrays of shapes " + ", ".join(str(arrays[k].shape) for k in SHEAR_ARRAYS)
     return None
@@ -189,17 +191,22 @@ def cached_shear(key: str, response, tol: float, length_unit: float, map_tasks, 
     table = S.ShearTable(response, tol=tol, length_unit=length_unit, map_tasks=map_tasks)
     if found is None:
         return table, False
-    for p, d, s, t in zip(*(found[k] for k in ("row_pressure", "far_face_jump", "jump", "shear"))):
-        table.rows.setdefault(float(p), {})[float(d)] = (float(s), float(t))
+    for p, d, s, t, h in zip(*(found[k] for k in ("row_pressure", "far_face_jump", "jump", "shear", "held"))):
+        if h:
+            table.held[(float(p), float(d))] = (float(s), float(t))
+        else:
+            table.rows.setdefault(float(p), {})[float(d)] = (float(s), float(t))
     table.jump_error, table.pressure_error, table.covered_jump = (float(x) for x in found["errors"])
     table.checked = [(float(a), float(b), float(c)) for a, b, c in found["checked"]]
     return table, True
 
 
 def store_shear(key: str, table: S.ShearTable, cache_dir: str | None = None) -> None:
-    flat = [(p, d, s, t) for p in table.pressures for d, (s, t) in sorted(table.rows[p].items())]
-    cols = np.array(flat, float).reshape(-1, 4)
+    flat = [(p, d, s, t, 0.0) for p in table.pressures for d, (s, t) in sorted(table.rows[p].items())]
+    flat += [(p, d, s, t, 1.0) for (p, d), (s, t) in sorted(table.held.items())]
+    cols = np.array(flat, float).reshape(-1, 5)
     arrays = {"row_pressure": cols[:, 0], "far_face_jump": cols[:, 1], "jump": cols[:, 2], "shear": cols[:, 3],
+              "held": cols[:, 4],
               "errors": np.array([table.jump_error, table.pressure_error, table.covered_jump]),
               "checked": np.array(table.checked, float).reshape(-1, 3)}
     cell_law.write_cached(key, arrays, SHEAR_ARRAYS, SHEAR_FORMAT, cache_dir)
@@ -275,6 +282,7 @@ class Relevel:
         self.loops: list[dict[str, Any]] = []
         self.write_back = write_back
         self.share: TS.TableShare | None = None
+        self.safety = None   # the strength check's safety factor, a quantity of the share (table_share)
         self.shared_at = 0   # the mesh levels run when the share was estimated
 
     def __call__(self, problem, start=None):
@@ -289,17 +297,26 @@ class Relevel:
             self.write_back()
         return out.solution
 
-    def table_share(self, sol, tolerance: float, refine: bool = True):
-        """The table's share of the headline quantities of ``sol`` (:mod:`ngcontact.coupling.table_share`),
-        with ``refine`` the table refined until it is below its fraction of ``tolerance``; the tables are
-        written back to the cache either way.  Returns the answer's solution."""
+    def table_share(self, sol, tolerance: float, refine: bool = True, safety=None):
+        """The tables' share of the headline quantities of ``sol`` (:mod:`ngcontact.coupling.table_share`: the
+        pressure table's and, with one, the shear table's), with ``refine`` the tables refined until it is below
+        its fraction of ``tolerance``; the tables are written back to the cache either way.  ``safety``: the
+        strength check's :class:`~ngcontact.drivers.macro_accuracy.SafetyFactor`, whose ``safety_factor`` is
+        then a quantity of the share too (kept from the first call).  Returns the answer's solution."""
         component = next(n for n in DE.headlines(sol, self.output.points_per_element)
                          if n.startswith("resultant_")).removeprefix("resultant_")
+        self.safety = safety if safety is not None else self.safety
 
         def measure(s):
-            return DE.headlines(s, self.output.points_per_element, component)
+            out = DE.headlines(s, self.output.points_per_element, component)
+            if self.safety is not None:
+                out["safety_factor"] = self.safety.samples(s, None)["safety_factor"]
+            return out
+        parts: list = [TS.PressurePart(self.table)]
+        if self.shear is not None and self.shear.rows:
+            parts.append(TS.ShearPart(self.shear))
         try:
-            self.share = TS.estimate(sol, self.table, self.solve, measure, tolerance, self.output.points_per_element,
+            self.share = TS.estimate(sol, parts, self.solve, measure, tolerance, self.output.points_per_element,
                                      refine)
         finally:
             self.write_back()
@@ -341,14 +358,15 @@ MapTasks = Callable[[Callable[[float], PT.Response], Sequence[float]], list[PT.R
 
 
 def couple_loop(scene, problem, solve, map_tasks: MapTasks = executor_map,
-                cache_dir: str | None = None, warm: bool = True, shear_map=shear_executor_map):
+                cache_dir: str | None = None, warm: bool = True, shear_map=shear_executor_map, safety=None):
     """Run the loop of ``scene.two_scale`` from ``problem``; returns ``(solution, results, relevel)``,
     ``relevel`` the loop on another macro mesh from the same tables (:class:`Relevel`).
 
     ``solve(problem, start)``: the macro solve (warm-started from the
     vector ``start`` when it is not None); ``map_tasks``: runs the cell
     solves of one table level (:class:`~ngcontact.coupling.pressure_table.CellTable`);
-    ``warm = False`` cold-starts every macro solve (for comparisons).
+    ``warm = False`` cold-starts every macro solve (for comparisons); ``safety``: the strength check's safety
+    factor, counted in the tables' share (:meth:`Relevel.table_share`).
     """
     from ngcontact.drivers.build import cell_scene_of
     spec = scene.two_scale
@@ -400,7 +418,7 @@ def couple_loop(scene, problem, solve, map_tasks: MapTasks = executor_map,
     relevel = Relevel(scene, table, shear, solve, write_back)
     if scene.discretization.tolerance is None:
         return out.solution, res, relevel
-    sol = relevel.table_share(out.solution, float(scene.discretization.tolerance))
+    sol = relevel.table_share(out.solution, float(scene.discretization.tolerance), safety=safety)
     return sol, relevel.record(res, sol), relevel
 
 

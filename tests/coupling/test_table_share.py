@@ -161,3 +161,139 @@ def test_a_table_grown_on_another_macro_level_is_written_back_for_the_next_run(t
     again, res2, _ = R.couple_loop(scene, problem, partial(D.solve_scene, scene), map_tasks=PT.serial_map,
                                    cache_dir=str(tmp_path / "cache"))
     assert res2["cache"]["table_from_cache"] and res2["cell_solves"] == 0
+
+
+# --------------------------------------------------------------------------- the shear table's share
+def _friction_block(tmp_path):
+    """The sawtooth shear block of ``scripts/sawtooth_shear.py`` (1 x 1 blocks, pressed with 1e-3 and moved by
+    0.002 along the interface, part of it sticking) as a two-scale scene under ``friction = "from_cell"``; its
+    cell's responses are replaced by the closed forms below (:func:`analytic_tables`)."""
+    import importlib.util
+    from pathlib import Path
+    spec = importlib.util.spec_from_file_location("sawtooth_shear", Path(__file__).parents[2] / "scripts" /
+                                                  "sawtooth_shear.py")
+    assert spec is not None and spec.loader is not None
+    S = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(S)
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    S.write_cell(str(tmp_path))
+    return S.macro_scene(str(tmp_path), *S.VARIANTS["from_cell"], u=0.002)
+
+
+def normal_response(p):
+    """A stiffening cell: closure 1e-6 (p / 1e-3)^0.7 (the scale of the scene's start law, k_n = 1000)."""
+    return {"contact_fraction": min(1.0, float(np.sqrt(p / 2e-3))), "k_n0": 1.0, "g_n0": 0.0,
+            "closure": 1e-6 * (p / 1e-3) ** 0.7}
+
+
+def shear_response(load):
+    """A cell that sticks, then slides at 0.3 p sqrt(1 + p / 1e-3): tau = that tanh(s / (0.5 p)), s = Delta 1e-4
+    (odd in s; not exact along the rays s / p of the table's interpolation in p)."""
+    p, d = load
+    s = d * 1e-4
+    return {"jump": s, "shear": 0.3 * p * float(np.sqrt(1 + p / 1e-3)) * float(np.tanh(s / (0.5 * p)))}
+
+
+def analytic_tables(scene, tol: float = 0.05):
+    from ngcontact.coupling import shear_table as ST
+    from ngcontact.coupling import two_scale as T
+    problem, _ = D.problem_of(scene, build_geometry(scene))
+    table = PT.CellTable(normal_response, tol=tol)
+    shear = ST.ShearTable(shear_response, tol=tol, length_unit=1e-4, max_solves=10 ** 5)
+    solve = partial(D.solve_scene, scene)
+    out = T.couple(problem, table, tol=1e-9, max_iter=20, table_min=1e-3, solve=solve, shear=shear,
+                   points_per_element=scene.output.points_per_element)
+    return out.solution, R.Relevel(scene, table, shear, solve)
+
+
+def shear_reference(answer, relevel, scene, halvings: int = 3):
+    """``answer`` solved again with both tables halved ``halvings`` times more where its interface uses them (the
+    shear table in its pressures and its jumps, :func:`~ngcontact.coupling.table_share.shear_loads`)."""
+    from ngcontact.macro.macro_measures import interface_profile
+    prof = interface_profile(answer, scene.output.points_per_element)
+    fine = PT.CellTable(relevel.table.response, relevel.table.tol, values=dict(relevel.table.values))
+    fine_shear = relevel.shear
+    relevel.shear.max_solves = 10 ** 6                       # closed forms: the reference costs no cell solve
+    for _ in range(halvings):
+        fine = TS._finer(fine, dict(fine.values), prof["pressure"][prof["pressure"] > 0])
+        fine_shear = TS.shear_finer(fine_shear, prof["pressure"], prof["jump_t"], keeper=relevel.shear)
+    law = il.InterfaceLaw(normal=PT.response_law(fine), friction=fine_shear.law())
+    return D.solve_scene(scene, M.replace_law(answer.problem, law), answer.gfu.vec)
+
+
+@pytest.mark.slow
+def test_the_shear_tables_share_bounds_its_error_against_a_much_finer_table(tmp_path):
+    """Effectivity of the two tables' share on a frictional block whose cell shear comes from a table: between
+    1 and 10 on every quantity whose error against both tables halved three times more where the interface uses
+    them is above round-off; the shear table's part is reported beside the pressure table's, and the tolerance
+    had the shear table refined (its own first estimate misses the limit)."""
+    scene = _friction_block(tmp_path)
+    sol, relevel = analytic_tables(scene)
+    answer = relevel.table_share(sol, 1e-3)
+    share = relevel.share
+    assert share is not None and set(share.parts) == {"pressure_table", "shear_table"}
+    q = share.quantity()
+    assert q["met"] and q["parts"]["shear_table"]["share"] > q["parts"]["pressure_table"]["share"] > 0
+    assert share.rounds[0]["parts"]["shear_table"]["share"] > share.limit and "shear_table" in share.rounds[0]["halved"]
+    for name, e in share.shares.items():                     # the parts add
+        assert e == pytest.approx(sum(share.parts[t][name] for t in share.parts), rel=1e-12)
+    ref = shear_reference(answer, relevel, scene)
+    component = next(k for k in share.values if k.startswith("resultant_")).removeprefix("resultant_")
+    ref_q = DE.headlines(ref, scene.output.points_per_element, component)
+    compared = []
+    for name, value in share.values.items():
+        true = abs(value - ref_q[name].value)
+        if true <= 1e-9 * abs(ref_q[name].value):
+            continue
+        compared.append(name)
+        assert true <= share.errors[name] <= 10 * true, (name, share.errors[name], true)
+    assert len(compared) >= 3, compared
+
+
+def test_the_safety_factor_is_a_quantity_of_the_share_and_bounded(tmp_path, monkeypatch):
+    """With ``[strength]`` the safety factor of eq. 78 (linear recovery on the shipped hip-hills cell) is a
+    headline quantity of the share, its estimate between 1 and 10 times its error against a much finer table
+    (the press fit at twice its interference, where the stresses feel the table)."""
+    import os
+    from ngcontact.drivers.macro_accuracy import safety_factor_of
+    from ngcontact.drivers.run_strength import recovery_of
+    scene_with(tmp_path, monkeypatch, gap=-2e-3)
+    path = tmp_path / "two_scale.toml"
+    cell = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", "geometries", "cells", "hip_hills.toml"))
+    path.write_text(path.read_text().replace("E = 200.0\n", "E = 200.0\nsigma_u = 1.0\n")
+                    .replace("E = 70.0\n", "E = 70.0\nsigma_u = 0.5\n")
+                    + f'\n[strength]\ncell = "{cell}"\ncriterion = "von_mises"\nrecovery = "linear"\n')
+    scene = loader.load(path)
+    sol, _, relevel = loop(scene, tmp_path)
+    safety = safety_factor_of(scene, recovery_of(scene, sol.problem.law))
+    assert safety is not None
+    answer = relevel.table_share(sol, 1e-3, safety=safety)
+    share = relevel.share
+    assert share is not None and "safety_factor" in share.errors and share.share <= TS.FRACTION * 1e-3
+    true = abs(share.values["safety_factor"] - safety(reference(answer, relevel.table, scene, 4)))
+    assert true > 1e-9 * share.values["safety_factor"]
+    assert true <= share.errors["safety_factor"] <= 10 * true, (share.errors["safety_factor"], true)
+    assert share.values["safety_factor"] == pytest.approx(safety(answer), rel=1e-12)
+
+
+def test_the_shear_tables_held_loads_survive_the_cache_and_become_nodes_without_a_cell_solve(tmp_path):
+    from ngcontact.coupling import shear_table as ST
+    calls: list = []
+
+    def response(load):
+        calls.append(load)
+        return shear_response(load)
+    table = ST.ShearTable(response, tol=0.05, length_unit=1e-4)
+    table.cover(2e-4, 2e-3, 5e-4)
+    nodes, solved = {p: dict(r) for p, r in table.rows.items()}, len(calls)
+    p, s = np.array([5e-4, 1e-3, 1.5e-3]), np.array([1e-4, 2e-4, 3e-4])
+    level = TS.shear_finer(table, p, s)
+    added = {(q, d) for q, r in level.rows.items() for d in r} - {(q, d) for q, r in nodes.items() for d in r}
+    assert table.rows == nodes and set(table.held) == {x for x in added if x[1] != 0.0}
+    assert len(calls) == solved + len(table.held) and set(level.rows) > set(nodes)   # new rows at the middles
+    R.store_shear("s" * 64, table, str(tmp_path))
+    again, cached = R.cached_shear("s" * 64, response, 0.05, 1e-4, ST.serial_map, str(tmp_path))
+    assert cached and again.rows == nodes and again.held == table.held
+    assert TS.ShearPart(again).adopt(level) == len(table.held)          # all made nodes (SHEAR_MARK = 0) ...
+    assert len(calls) == solved + len(table.held) and not again.held     # ... without a cell solve
+    assert again.rows == level.rows
