@@ -163,11 +163,14 @@ def posed_rows(seed: int, run_name: str, results: dict | None, seconds: float, n
                "estimate_measure": q["controlled_error"], "true_error_measure": error / q["scale"],
                "true_error_relative": error / abs(fine), "reference_change": abs(fine - half) / q["scale"],
                "error_to_richardson": abs(q["value"] - limit) / q["scale"],
-               "effectivity": q["error"] / error if error > 0 else float("inf"),
+               "effectivity": q["error"] / error if error > 0 else "",
                "seconds": seconds, "solve_seconds": solve,
                "note": f"grids {[level['grid'] for level in levels]}"
                        + (f"; flagged: {q['loose']}" if q.get("loose") else "")}
-        if run_name == "defaults":
+        if grid >= REFERENCES[-1]:          # no finer reference: the true error is not resolved
+            row.update(effectivity="", aim="unresolved: the posed grid is not coarser than the reference",
+                       aim_met="", note=row["note"] + "; posed grid >= reference grid")
+        elif run_name == "defaults":
             row["aim"] = f"within {100 * DEFAULT_AIM:g} %, estimate >= error"
             row["aim_met"] = bool(row["true_error_relative"] <= DEFAULT_AIM and q["error"] >= error)
         else:
@@ -228,7 +231,8 @@ def verdict(rows: list[dict]) -> str:
     for run_name in RUNS:
         sel = [r for r in rows if r["run"] == run_name]
         lost = [r for r in sel if r["quantity"] == ""]
-        got = [r for r in sel if r["quantity"] != ""]
+        unresolved = [r for r in sel if r["quantity"] != "" and r["effectivity"] == ""]
+        got = [r for r in sel if r["quantity"] != "" and r["effectivity"] != ""]
         missed = [r for r in got if not r["aim_met"]]
         fraction = [r for r in got if r["quantity"] == "contact_fraction"]
         worst = max(got, key=lambda r: r["true_error_relative"]) if got else None
@@ -239,6 +243,8 @@ def verdict(rows: list[dict]) -> str:
                 + (f" ({len(missed)} missed: " + ", ".join(f"seed {r['seed']} load {r['load']} {r['quantity']}"
                                                             for r in missed) + ")" if missed else "")
                 + (f", out of reach on seeds {[r['seed'] for r in lost]}" if lost else "")
+                + (f", {len(unresolved)} rows unresolved (posed grid >= reference grid, seeds "
+                   f"{sorted({r['seed'] for r in unresolved})})" if unresolved else "")
                 + (f"; reported not met (said so): {len(unmet)} quantities of "
                    f"{sorted({q for _, _, q in unmet})} on seeds {sorted({sd for sd, _, _ in unmet})}" if unmet
                    else "; every quantity reported met"))
@@ -249,7 +255,7 @@ def verdict(rows: list[dict]) -> str:
                      f"{worst['load']}); effectivity {min(effs):.3g} to {max(effs):.3g}; grids {grids}; wall time "
                      f"{min(r['seconds'] for r in got):.3g} to {max(r['seconds'] for r in got):.3g} s per seed")
         parts.append(text)
-    bound = max(r["reference_change"] for r in rows if r["quantity"] != "")
+    bound = max((r["reference_change"] for r in rows if r["quantity"] != ""), default=0.0)
     return ". ".join(parts) + f". Largest reference change (2^17 to 2^18, in the measure): {bound:.2g}."
 
 
@@ -273,7 +279,7 @@ def main(argv=None) -> int:
     csv_path = os.path.join(args.out, "random_profile_accuracy.csv")
     write_csv(csv_path, list(KEYS), [[r[k] for k in KEYS] for r in rows])
     png = os.path.join(args.out, "random_profile_accuracy.png")
-    plot([r for r in rows if r["quantity"] != ""], png)
+    plot([r for r in rows if r["quantity"] != "" and r["effectivity"] != ""], png)
     summary = verdict(rows)
     print(summary)
     if args.publish:
