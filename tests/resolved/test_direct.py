@@ -22,7 +22,7 @@ from ngcontact.fem import materials as mat
 from ngcontact.scene import loader as scene_mod
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
-from ngcontact.drivers.study_epsilon import run_study
+from ngcontact.drivers.study_epsilon import TWO_MESHES, run_study
 from ngcontact.errors import SceneError
 from ngcontact.geometry import profiles as pr
 from ngcontact.geometry.resolved_bodies import flat_blocks, resolved_blocks
@@ -162,7 +162,7 @@ def test_epsilon_study_script_writes_report_csv_and_plot_and_refuses_a_mesh_rate
     assert res["refused"]["bundle"]["field"].startswith("0 level(s) qualify: at N = [4, 8, 16] the "
                                                         "discretization estimate exceeds 0.1 of the error")
     assert res["rates"]["bundle"]["reaction"] >= 0.8 and res["rate_levels"]["bundle"]["reaction"] == [4, 8, 16]
-    assert res["discretization"] == {"refinement": 2.0, "share": 0.1}
+    assert res["discretization"] == {"refinement": 2.0, "share": 0.1, "estimate": TWO_MESHES}
     # the L2 error over each whole body: eps^(1/2) from the counter's teeth carrying the rough body's field
     # (large enough to be fitted on these meshes); the first-order corrector gives them the counter's
     # (ngcontact.coupling.first_order_corrector) and leaves a fraction of it
@@ -177,6 +177,8 @@ def test_epsilon_study_script_writes_report_csv_and_plot_and_refuses_a_mesh_rate
         assert finest[f"bundle_{key}"] < finest[f"linear_{key}"], (key, finest)
     # the resolved interface opens one wall per valley: 1 + 0.3 of 1.6 per period closed
     assert all(abs(r["contact_fraction_resolved"] - 1.3) < 0.05 for r in rows)
+    # ... at the valleys' corners, which every mesh finds: its discretization estimate is round-off
+    assert all(0 <= r["contact_fraction_resolved_discretization"] < 1e-9 for r in rows), rows
     # the effective stiffness of the cell scaled to eps tends to the bundle's open-wall value:
     # tangential stiffness below the whole-surface k_t0 = 0.6 k_n, increasing as the asperities shrink
     kt = [r["effective_law"]["K_eff"][1][1] for r in rows]
