@@ -33,14 +33,18 @@ CORRECTOR = ("l2", "l2_corrected", "h1", "h1_corrected", "probe_corrected")
 
 
 #: what the errors and their estimates are, with two and with three discretizations per level
-TWO = ("Each error is the modelling error on meshes refined by `study.refinement`, `*_discretization` its estimated "
-       "discretization share (the change from the scene's meshes); seconds of the refined pair.")
+TWO = ("Each error is the modelling error on meshes refined by `study.refinement` r, `*_discretization` the estimate "
+       "of its discretization error, 1.5 delta / (r - 1) from the change delta from the scene's meshes (an error "
+       "at least linear in h, times 1.5: the rule of a resolved run's default estimate); `contact_fraction_resolved` "
+       "the resolved run's, with its estimate by the same rule; seconds of the refined pair.")
 THREE = ("Each level on three discretizations (`study.meshes = 3`: the scene's, refined once and twice by "
-         "`study.refinement`); each error is the modelling error on the finest, `*_discretization` the sum of the "
-         "resolved and the homogenized solution's Richardson estimates d2 q / (1 - q) of their discretization "
+         "`study.refinement` r); each error is the modelling error on the finest, `*_discretization` the sum of the "
+         "resolved and the homogenized solution's Richardson estimates 1.5 d2 q / (1 - q) of their discretization "
          "errors, from each solution's changes d1 (scene to once refined) and d2 (once to twice refined), "
-         "`*_ratio_resolved` and `*_ratio_homogenized` the observed q = d2 / d1 (where q >= 1 that solution's "
-         "term is its largest change: {largest}); seconds of the finest pair.")
+         "`*_ratio_resolved` and `*_ratio_homogenized` the observed q = d2 / d1, taken as at least 1/r (an "
+         "error at least linear in h; where q >= 1 that solution's "
+         "term is 1.5 times its largest change over r - 1: {largest}); `contact_fraction_resolved` the resolved "
+         "run's, with its estimate by the same rule; seconds of the finest pair.")
 
 
 def largest_changes(results: dict) -> str:
@@ -95,7 +99,8 @@ def main(argv=None) -> int:
         three = results["discretization"].get("meshes") == 3
         parts = ("", "_discretization", "_ratio_resolved", "_ratio_homogenized") if three else ("", "_discretization")
         what = THREE.format(largest=largest_changes(results)) if three else TWO
-        columns = ["N", "eps", "ndof_resolved"] + [
+        columns = ["N", "eps", "ndof_resolved", "contact_fraction_resolved",
+                   "contact_fraction_resolved_discretization"] + [
             f"{law}_{key}{part}" for law in present for key in ("field", "probe", "interface") + CORRECTOR
             if f"{law}_{key}" in rows[0] for part in parts] + ["time_resolved", "time_homogenized"]
         benchmark_doc.publish(f"epsilon_{name}", f"Epsilon study of `{name}`: resolved against homogenized",

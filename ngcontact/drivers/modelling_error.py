@@ -12,15 +12,16 @@ the same level, the scene's and one refined by a factor ``r``; the change of the
 
     delta = |e_h - e_(h/r)|,
 
-estimates the discretization error of ``e_h``, and bounds that of ``e_(h/r)`` once both discretization
-errors contract by ``1/r`` or faster (order 2 elements away from corners contract by ``r^-2`` or
-faster; at the re-entrant corners of the resolved valleys by about ``r^-1``).  The modelling error
-reported is the refined pair's, with ``delta`` beside it (:func:`discretization_errors`): a vector
-quantity (the field, the reactions, the probes, the interface force) compares the vectors ``e``, so
-that the estimate is a norm of the change, not the change of a norm.  With a third discretization
-(``study.meshes = 3``) the contraction is observed instead of presumed: the errors are the finest pair's
-and the estimate the sum of the resolved and the homogenized solution's tails of their two changes
-(:func:`change`, :mod:`ngcontact.drivers.richardson_tail`).
+is the quantity's change over the refinement, from which the discretization error of the refined pair's
+``e_(h/r)`` is estimated by the rule of :func:`ngcontact.drivers.richardson_tail.tail`: ``1.5 delta / (r - 1)``
+once both discretization errors contract by ``1/r`` or faster (order 2 elements away from corners contract by
+``r^-2`` or faster; at the re-entrant corners of the resolved valleys by about ``r^-1``), the factor 1.5 a
+margin of safety.  The modelling error reported is the refined pair's, with that estimate beside it
+(:func:`discretization_errors` gives ``delta``): a vector quantity (the field, the reactions, the probes, the
+interface force) compares the vectors ``e``, so that the estimate is a norm of the change, not the change of a
+norm.  With a third discretization (``study.meshes = 3``) the contraction is observed instead of presumed: the
+errors are the finest pair's and the estimate the sum of the resolved and the homogenized solution's estimates
+from their two changes (:func:`change`, :mod:`ngcontact.drivers.richardson_tail`).
 
 Errors of a homogenized solution against the resolved solution ``u^eps`` (:func:`errors`):
 
@@ -192,7 +193,7 @@ def combine(fn: Callable[..., Any], *trees):
 
 def discretization_errors(resolved: dict, homogenized: dict, resolved_fine: dict, homogenized_fine: dict,
                           weights: np.ndarray, sampling: BodySampling | None = None) -> dict:
-    """The estimate ``delta = |e_h - e_(h/r)|`` of each error (module docstring), relative to the refined
+    """The change ``delta = |e_h - e_(h/r)|`` of each error (module docstring), relative to the refined
     resolved solution's size, as :func:`errors` measures it.
 
     Each argument is :func:`measures` of one solution: the resolved and the homogenized one on the

@@ -8,10 +8,11 @@ contact fraction is) and the magnitude of the contact force through it.
 The default estimate: one uniform refinement at the run's order (:func:`h_step_estimates`)
     A run without ``discretization.tolerance`` solves once more, at its own order, on a copy of its mesh
     refined uniformly once (every triangle into four, the new boundary vertices on the geometry, curved as
-    the run's mesh is), and estimates the error of ``Q_h`` from the difference ``d = Q_{h/2} - Q_h``.
-    If the error contracts by a factor ``rho`` per halving of ``h``, ``e_h = d / (1 - rho)``; with
-    ``rho <= 1/2`` (:data:`CONTRACTION`) ``|e_h| <= 2 |d|``, and the estimate is
-    :data:`~ngcontact.macro.discretization_error.SAFETY` times that bound,
+    the run's mesh is), and estimates the error of ``Q_h`` from the difference ``d = Q_{h/2} - Q_h`` by the
+    rule the epsilon study uses too (:func:`ngcontact.drivers.richardson_tail.tail`): if the error contracts
+    by a factor ``rho`` per halving of ``h``, ``e_h = d / (1 - rho)``; with ``rho <= 1/2`` (an error at
+    least linear in ``h``, :data:`~ngcontact.drivers.richardson_tail.RATE`) ``|e_h| <= 2 |d|``, and the
+    estimate is :data:`~ngcontact.macro.discretization_error.SAFETY` times that bound,
 
         e_h = 1.5 |Q_{h/2} - Q_h| / (1 - 1/2) = 3 |Q_{h/2} - Q_h|.
 
@@ -60,6 +61,7 @@ import ngsolve as ng
 import numpy as np
 
 from ngcontact.drivers import macro_accuracy as MA
+from ngcontact.drivers.richardson_tail import of_values, presumed_ratio
 from ngcontact.macro import discretization_error as DE
 from ngcontact.resolved import resolved_problem as D
 from ngcontact.scene.schema import MAX_ORDER
@@ -69,8 +71,8 @@ HOW = ("discretization error of the resolved contact fraction (absolute) and of 
        "without a tolerance 3 x their change on the run's mesh refined uniformly once at its order (an error "
        "contracting by at least 1/2 per halving, times 1.5), with one the refinement's last level "
        "(ngcontact.drivers.resolved_accuracy)")
-#: the slowest contraction of the headline quantities' error per uniform halving of ``h`` (module docstring)
-CONTRACTION = 0.5
+#: the uniform refinement of the default estimate halves ``h``
+HALVING = 2.0
 #: the quantities that are fractions: their error is held to the tolerance as it is
 FRACTIONS = ("contact_fraction",)
 
@@ -118,12 +120,13 @@ def h_step_estimate(name: str, coarse: DE.Sample, fine: DE.Sample, order: int) -
     d = fine.value - coarse.value
     scale = coarse.magnitude
     head = f"order {order} on the run's mesh and on it refined uniformly once: change {d:.3g}"
+    error = of_values([coarse.value, fine.value], HALVING, member=0, noise=DE.NOISE * scale).estimate
     if abs(d) <= DE.NOISE * scale:
-        error, rule = DE.SAFETY * abs(d), "the meshes agree to round-off and the solver's tolerance"
+        rule = "the meshes agree to round-off and the solver's tolerance"
     else:
-        error = DE.SAFETY * abs(d) / (1.0 - CONTRACTION)
-        rule = (f"{DE.SAFETY:g} x |d| / (1 - {CONTRACTION:g}), an error that at least halves with h (ngcontact."
-                "drivers.resolved_accuracy)")
+        q = presumed_ratio(HALVING)
+        rule = (f"{DE.SAFETY:g} x |d| / (1 - {q:g}), an error that at least halves with h (ngcontact."
+                "drivers.richardson_tail)")
     return DE.Estimate(name=name, value=coarse.value, error=error, scale=scale, ratio=math.nan,
                        orders=(order, order, order), how=f"{head}: {rule}")
 

@@ -20,16 +20,16 @@ or the axisymmetric femur with a stem) with a flat interface, with
   traction of the bundle solution (pressure ``p = mean tau_n``, shear on the
   counter's far face ``-mean tau_t``); cell heights scale with ``eps``.
 
-Each level is solved twice, on the scene's discretization and on one refined by
-``study.refinement``; the errors of each law against the resolved solution
-(:mod:`ngcontact.drivers.modelling_error`: field, reaction, moment, probe,
-interface) are the refined pair's, and beside each the estimate of its
-discretization error, the change between the two pairs.  With ``study.meshes = 3``
-each level is solved once more, refined again by the same factor; the errors are
-then the finest pair's and each estimate the sum of the two solutions' Richardson tails of their changes
-(:mod:`ngcontact.drivers.richardson_tail`; a solution's largest change where the
-ratio of its changes does not contract, listed in
-``results.discretization.largest_change``).
+Each level is solved twice, on the scene's discretization and on one refined by ``study.refinement`` (``r``);
+the errors of each law against the resolved solution (:mod:`ngcontact.drivers.modelling_error`: field,
+reaction, moment, probe, interface) are the refined pair's, and beside each the estimate of its discretization
+error from the change ``delta`` between the two pairs, ``1.5 delta / (r - 1)`` (an error at least linear in
+``h``, times the factor of safety: :func:`ngcontact.drivers.richardson_tail.tail`, a resolved run's default
+estimate's rule too).  With ``study.meshes = 3`` each level is solved once more, refined again by ``r``; the
+errors are the finest pair's, each estimate the sum of the two solutions' by the same rule from their two
+changes at their observed ratio (a solution's largest change where it does not contract, listed in
+``results.discretization.largest_change``).  The resolved contact fraction of each level (the finest mesh's)
+carries its estimate by the same rule (``contact_fraction_resolved_discretization``).
 
 On blocks (``S_0`` the line ``y = 0``) the bundle law's solution is also rebuilt on the resolved bodies by
 the first-order corrector ``u^0 + eps u^1``
@@ -70,7 +70,8 @@ from ngcontact.coupling.cell_law import bundle_law
 from ngcontact.coupling.first_order_corrector import FirstOrderCorrector
 from ngcontact.drivers import modelling_error as E
 from ngcontact.drivers.boundary_layer_cells import boundary_layer, scaled_cell_problem
-from ngcontact.drivers.richardson_tail import tail
+from ngcontact.drivers.richardson_tail import of_values, tail
+from ngcontact.macro.discretization_error import NOISE
 from ngcontact.drivers import run_resolved as drv
 from ngcontact.output import plots
 from ngcontact.geometry.profiles import profile_cell
@@ -237,26 +238,27 @@ def solve_pair(scene, N: int, bundle: il.BundleLaw, laws, points, body,
     return out
 
 
-def estimates(pairs: list[tuple[dict, dict]], weights: np.ndarray,
-              sampling: E.BodySampling | None) -> dict[str, tuple[float, dict | None, bool]]:
+def estimates(pairs: list[tuple[dict, dict]], weights: np.ndarray, sampling: E.BodySampling | None,
+              refinement: float) -> dict[str, tuple[float, dict | None, bool]]:
     """Per error: the discretization estimate of the finest of ``pairs`` (each ``(resolved, homogenized)``
-    measures, coarsest first), the observed ratios of the changes and whether they contract.
+    measures, coarsest first, each refined by ``refinement``), the observed ratios of the changes and whether
+    they contract (:func:`ngcontact.drivers.richardson_tail.tail`; relative errors, so changes below
+    :data:`~ngcontact.macro.discretization_error.NOISE` are round-off).
 
-    Two pairs: the change between them (:func:`~ngcontact.drivers.modelling_error.discretization_errors`),
-    no ratios.  Three: the sum of the resolved and the homogenized solution's Richardson tails
-    (:mod:`ngcontact.drivers.richardson_tail`), ratios ``{"resolved": q, "homogenized": q}``, contracting
-    where both do."""
+    Two pairs: from the change between them (:func:`~ngcontact.drivers.modelling_error.discretization_errors`),
+    no ratios.  Three: the sum of the resolved and the homogenized solution's estimates from their own
+    changes, ratios ``{"resolved": q, "homogenized": q}``, contracting where both do."""
     if len(pairs) == 2:
         check = E.discretization_errors(*pairs[0], *pairs[1], weights, sampling)
-        return {k: (v, None, True) for k, v in check.items()}
+        return {k: (tail([v], refinement, noise=NOISE).estimate, None, True) for k, v in check.items()}
     ref = pairs[-1][0]
     moved = {"resolved": [E.change(a, ref, b, ref, ref, weights, sampling)
                           for (a, _), (b, _) in zip(pairs, pairs[1:])],
              "homogenized": [E.change(ref, a, ref, b, ref, weights, sampling)
                              for (_, a), (_, b) in zip(pairs, pairs[1:])]}
     out: dict[str, tuple[float, dict | None, bool]] = {}
-    for key in moved["resolved"][1]:
-        tails = {side: tail(first[key], second[key]) for side, (first, second) in moved.items()}
+    for key in moved["resolved"][-1]:
+        tails = {side: tail([step[key] for step in steps], refinement, noise=NOISE) for side, steps in moved.items()}
         out[key] = (float(sum(t.estimate for t in tails.values())), {side: t.ratio for side, t in tails.items()},
                     all(t.contracts for t in tails.values()))
     return out
@@ -286,11 +288,13 @@ def level(scene, N: int, bundle: il.BundleLaw, *, laws=LAWS, h1_band: float | No
     row.update({k: v for k, v in fine.items() if k not in ("resolved", "laws", "layer_body")})
     row["time_homogenized"] = fine["time_bundle"] if "bundle" in laws else fine[f"time_{laws[0]}"]
     row["time_discretization_check"] = sum(v for p in pairs[:-1] for k, v in p.items() if k.startswith("time_"))
+    row["contact_fraction_resolved_discretization"] = of_values(
+        [p["contact_fraction_resolved"] for p in pairs], st.refinement, noise=NOISE).estimate
     for name in [*laws, "bundle_corrected"]:
         if name not in fine["laws"]:
             continue
         model = E.errors(fine["resolved"], fine["laws"][name], weights, sampling)
-        check = estimates([(p["resolved"], p["laws"][name]) for p in pairs], weights, sampling)
+        check = estimates([(p["resolved"], p["laws"][name]) for p in pairs], weights, sampling, st.refinement)
         if name == "bundle_corrected":
             name = "bundle"
             model = {f"{k}_corrected": model[k] for k in ("l2", "h1", "probe") if k in model}
@@ -359,18 +363,23 @@ def rates(rows: list, laws=LAWS, share: float = 0.1) -> tuple[dict, dict, dict]:
 
 #: how the three-mesh estimate is made (``results.discretization.estimate``)
 THREE_MESHES = ("the finest pair's errors; each estimate the sum of the resolved and the homogenized solution's "
-                "Richardson tails d2 q / (1 - q), d1 and d2 the solution's changes (coarse to middle, middle to "
-                "finest) and q = d2 / d1 their observed ratio (*_ratio_resolved, *_ratio_homogenized); where a "
-                "solution's q does not contract, its largest change (listed in largest_change: law -> error -> N)")
+                "Richardson tails 1.5 d2 q / (1 - q), d1 and d2 the solution's changes (coarse to middle, middle "
+                "to finest) and q = d2 / d1 their observed ratio (*_ratio_resolved, *_ratio_homogenized), at least "
+                "1/r (an error at least linear in h); where a solution's q does not contract, 1.5 times its "
+                "largest change over (r - 1) (listed in largest_change: law -> error -> N)")
+#: how the two-mesh estimate is made (``results.discretization.estimate``)
+TWO_MESHES = ("the refined pair's errors; each estimate 1.5 delta / (r - 1), delta the change of the pair's signed "
+              "difference from the scene's meshes: an error at least linear in h, times 1.5 "
+              "(ngcontact.drivers.richardson_tail)")
 
 
 def discretization_record(rows: list, laws, study) -> dict:
-    """``results.discretization``: the refinement and the share of the rule; with three meshes also how the
-    estimate is made and, per law and error, the levels whose ratio did not contract (the largest change
-    stands there, :mod:`ngcontact.drivers.richardson_tail`), each also a warning."""
+    """``results.discretization``: the refinement, the share of the rule and how the estimate is made; with
+    three meshes also, per law and error, the levels whose ratio did not contract (the largest change stands
+    there, :mod:`ngcontact.drivers.richardson_tail`), each also a warning."""
     out: dict[str, Any] = {"refinement": study.refinement, "share": study.discretization_share}
     if study.meshes == 2:
-        return out
+        return {**out, "estimate": TWO_MESHES}
     largest: dict[str, dict] = {}
     for name in laws:
         for key in ERRORS:
@@ -379,7 +388,7 @@ def discretization_record(rows: list, laws, study) -> dict:
             if bad:
                 largest.setdefault(name, {})[key] = bad
                 log.warning("the %s law's %s error: the discretization changes do not contract at N = %s; its "
-                            "estimate there is the largest change", name, key, bad)
+                            "estimate there rests on the largest change", name, key, bad)
     out.update(meshes=3, estimate=THREE_MESHES, largest_change=largest)
     return out
 

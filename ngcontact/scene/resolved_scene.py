@@ -168,13 +168,15 @@ class StudySpec:
     grid: tuple[int, int] = param((100, 50), doc="sampling grid of the field error: (nx, ny) per block, "
                                   "or (nr, nz) over the femur's bounding box", check=closed_interval(4, MAX_SAMPLES))
     refinement: float = param(2.0, doc="each level is solved again with every mesh size divided by this factor "
-                              "(maxh, eps / elements_per_period, interface_maxh); the change of each error "
-                              "between the two estimates its discretization error", check=closed_interval(1.5, 8))
+                              "(maxh, eps / elements_per_period, interface_maxh); the change delta of each "
+                              "error between the two gives its discretization estimate 1.5 delta / (refinement - 1)",
+                        check=closed_interval(1.5, 8))
     meshes: int = param(2, doc="discretizations per level: 2 (the scene's and one refined), or 3 (the scene's, "
                         "refined once and twice by study.refinement): the errors are then the finest pair's and "
                         "each estimate the sum of the resolved and the homogenized solution's Richardson tails of "
-                        "their two changes (from the observed ratio; a solution's largest change where it does "
-                        "not contract); ngcontact study epsilon --meshes overrides it", check=closed_interval(2, 3))
+                        "their two changes, times 1.5 (the observed ratio, at least 1 / refinement; a solution's "
+                        "largest change where it does not contract); ngcontact study epsilon --meshes overrides it",
+                        check=closed_interval(2, 3))
     discretization_share: float = param(0.1, doc="the rates in eps are fitted on the levels whose discretization "
                                         "estimate is at most this share of the error (the modelling error, not "
                                         "the meshes'); fewer than three such levels: no rate, and the report "

@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 
 from ngcontact.drivers import modelling_error as E
-from ngcontact.drivers.richardson_tail import Tail, tail
-from ngcontact.drivers.study_epsilon import discretization_record, estimates, rates
+from ngcontact.drivers import resolved_accuracy as ra
+from ngcontact.drivers.richardson_tail import Tail, of_values, tail
+from ngcontact.drivers.study_epsilon import TWO_MESHES, discretization_record, estimates, rates
+from ngcontact.macro import discretization_error as DE
 
 
 def measures(field, reaction, probe, interface) -> dict:
@@ -67,20 +69,40 @@ def test_an_error_at_round_off_has_no_rate_and_says_why():
 
 
 def test_the_three_mesh_estimate_is_the_geometric_tail_of_the_observed_ratio():
-    # changes 0.04 then 0.01: ratio 1/4, tail 0.01 (1/4 + 1/16 + ...) = 0.01 / 3
-    t = tail(0.04, 0.01)
-    assert t.contracts and t.ratio == pytest.approx(0.25) and t.estimate == pytest.approx(0.01 / 3)
-    # ratio 1/2: the tail is the last change itself (what the two-mesh rule takes); slower: more than it
-    assert tail(0.02, 0.01).estimate == pytest.approx(0.01)
-    assert tail(0.0125, 0.01).estimate == pytest.approx(0.04)
-    # no contraction: the largest change, and the estimate says it is not a tail
-    grown = tail(0.01, 0.03)
-    assert not grown.contracts and grown.ratio == pytest.approx(3.0) and grown.estimate == 0.03
-    assert tail(0.01, 0.01) == Tail(estimate=0.01, ratio=1.0, contracts=False)
-    assert tail(0.0, 0.002) == Tail(estimate=0.002, ratio=None, contracts=False)
-    assert tail(0.0, 0.0) == Tail(estimate=0.0, ratio=0.0, contracts=True)
+    # changes 0.0125 then 0.01: ratio 0.8, slower than the presumed 1/2: tail 0.01 0.8 / 0.2, times the safety
+    t = tail([0.0125, 0.01], 2.0)
+    assert t.contracts and t.ratio == pytest.approx(0.8) and t.estimate == pytest.approx(1.5 * 0.04)
+    # ratio 1/2: 1.5 times the last change (what the two-mesh rule presumes at r = 2); faster: the presumed 1/2
+    assert tail([0.02, 0.01], 2.0).estimate == pytest.approx(0.015)
+    fast = tail([0.04, 0.01], 2.0)
+    assert fast.contracts and fast.ratio == pytest.approx(0.25) and fast.estimate == pytest.approx(0.015)
+    # r = 1.5: the presumed ratio 2/3, so an observed 0.6 gives 1.5 x 0.01 x 2
+    assert tail([0.01, 0.006], 1.5).estimate == pytest.approx(1.5 * 0.006 * 2)
+    # no contraction: the largest change continued at the presumed contraction 1/r, and the estimate says so
+    grown = tail([0.01, 0.03], 2.0)
+    assert not grown.contracts and grown.ratio == pytest.approx(3.0) and grown.estimate == pytest.approx(0.045)
+    assert tail([0.01, 0.03], 1.5).estimate == pytest.approx(1.5 * 0.03 * 2)
+    assert tail([0.01, 0.01], 2.0) == Tail(estimate=0.015, ratio=1.0, contracts=False)
+    assert tail([0.0, 0.002], 2.0) == Tail(estimate=pytest.approx(0.003), ratio=None, contracts=False)
+    assert tail([0.0, 0.0], 2.0) == Tail(estimate=0.0, ratio=0.0, contracts=True)
     with pytest.raises(ValueError, match="norms"):
-        tail(-1.0, 0.0)
+        tail([-1.0, 0.0], 2.0)
+    with pytest.raises(ValueError, match="refinement"):
+        tail([0.01], 1.0)
+
+
+def test_one_rule_for_two_meshes_the_resolved_default_and_the_study():
+    # one change at r = 2: the coarser value's error 3 |d| (a resolved run's default), the finer's 1.5 |d|
+    assert of_values([1.0, 1.01], 2.0, member=0).estimate == pytest.approx(0.03)
+    assert of_values([1.0, 1.01], 2.0).estimate == pytest.approx(0.015)
+    # r = 1.5: the presumed contraction 2/3, the finer value's error 1.5 |d| (2/3) / (1/3) = 3 |d|
+    assert of_values([1.0, 1.01], 1.5).estimate == pytest.approx(0.03)
+    # three values: the coarsest's error adds the changes after it to the tail (ratio 0.8)
+    assert of_values([1.0, 1.0125, 1.0225], 2.0, member=0).estimate == pytest.approx(1.5 * (0.0225 + 0.04))
+    # round-off: 1.5 times the change, no contraction presumed
+    assert of_values([1.3, 1.3 + 1e-12], 2.0, member=0, noise=1e-8).estimate == pytest.approx(1.5e-12, rel=1e-3)
+    d = ra.h_step_estimate("q", DE.Sample(2.0), DE.Sample(2.1), 2)
+    assert d.error == pytest.approx(of_values([2.0, 2.1], ra.HALVING, member=0).estimate) and "1.5 x |d|" in d.how
 
 
 def test_three_pairs_sum_the_tails_of_each_solution_s_changes():
@@ -94,7 +116,7 @@ def test_three_pairs_sum_the_tails_of_each_solution_s_changes():
     for h, b in zip(homogenized, (0.0, 0.01, 0.03)):
         h["probes"] = base["probes"] + 0.1 + b
     pairs = list(zip(resolved, homogenized))
-    est = estimates(pairs, weights, None)
+    est = estimates(pairs, weights, None, 2.0)
     ref = resolved[-1]
 
     def moved(d):
@@ -103,14 +125,15 @@ def test_three_pairs_sum_the_tails_of_each_solution_s_changes():
     for key in ("field", "reaction", "interface"):
         value, ratios, contracts = est[key]
         assert contracts and ratios == pytest.approx({"resolved": 0.25, "homogenized": 0.0}), key
-        assert value == pytest.approx(moved(0.01)[key] / 3), key
+        assert value == pytest.approx(1.5 * moved(0.01)[key]), key   # ratio 1/4 taken as the presumed 1/2
     value, ratios, contracts = est["probe"]
     assert not contracts and ratios == pytest.approx({"resolved": 0.25, "homogenized": 2.0})
-    assert value == pytest.approx(moved(0.01)["probe"] / 3 + moved(0.02)["probe"])
-    # two pairs: the change of the difference between them, as before
-    two = estimates(pairs[1:], weights, None)
-    assert {k: v[0] for k, v in two.items()} == pytest.approx(
-        E.discretization_errors(*pairs[1], *pairs[2], weights))
+    assert value == pytest.approx(1.5 * (moved(0.01)["probe"] + moved(0.02)["probe"]))
+    # two pairs: from the change of the difference between them, 1.5 delta / (r - 1)
+    for r in (2.0, 1.5):
+        two = estimates(pairs[1:], weights, None, r)
+        assert {k: v[0] for k, v in two.items()} == pytest.approx(
+            {k: 1.5 * v / (r - 1) for k, v in E.discretization_errors(*pairs[1], *pairs[2], weights).items()})
     assert all(v[1] is None for v in two.values())
 
 
@@ -121,5 +144,5 @@ def test_levels_whose_changes_do_not_contract_are_listed_in_the_results():
     record = discretization_record(rows, ("bundle",), study)
     assert record["meshes"] == 3 and record["largest_change"] == {"bundle": {"probe": [8, 16]}}
     assert "Richardson" in record["estimate"]
-    assert discretization_record(rows, ("bundle",), SimpleNamespace(refinement=2.0, discretization_share=0.1,
-                                                                    meshes=2)) == {"refinement": 2.0, "share": 0.1}
+    two = discretization_record(rows, ("bundle",), SimpleNamespace(refinement=2.0, discretization_share=0.1, meshes=2))
+    assert two == {"refinement": 2.0, "share": 0.1, "estimate": TWO_MESHES} and "1.5 delta / (r - 1)" in TWO_MESHES
