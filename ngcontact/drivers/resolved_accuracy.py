@@ -37,9 +37,8 @@ Why not the order ladder on the run's mesh
     contact fraction's ``2, 3, 4`` 0.00099 against 0.00265 (0.38).  A uniform refinement moves every
     element edge and halves the distance the closed set's edges can lie from a node: its change measures
     the error ``h`` holds, which is what limits the resolved solution.  It costs one solve at four times the
-    unknowns (the resolved scenes are 2D): 1.3 to 4.4 times the run's own solve on the tests' blocks, 3.3
-    to 3.8 on the shipped block of eight valleys, 1.8 to 2.7 on the shipped femur, 0.7 to 1.7 times the
-    ladder's two solves at ``p - 1`` and ``p + 1`` (the run's ``timings`` list it as ``discretization error``).
+    unknowns (the resolved scenes are 2D), about what the ladder's two solves at ``p - 1`` and ``p + 1`` cost;
+    the run's ``timings`` list it as ``discretization error``.
 
 With a tolerance the run is refined first (:mod:`ngcontact.drivers.resolved_refinement`, the order ladder on
 each level and the sequence of its mesh levels) and its estimates are those of the last level; a level that

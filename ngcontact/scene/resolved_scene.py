@@ -138,11 +138,13 @@ class DirectMesh:
     tolerance: float | None = param(None, check=open_interval(0, 1), doc="the accuracy the headline quantities "
         "are held to: the contact fraction of the resolved surface (a fraction: its absolute error) and the "
         "contact force's magnitude (its relative error), each reported with its discretization error estimated "
-        "from solves one order below and above on the same mesh (results.accuracy); a scene that states it is "
+        "from one uniform refinement at the run's order, 3 |Q(h/2) - Q(h)| (results.accuracy); a scene that "
+        "states it is "
         "refined towards it: the order raised by one while that buys more per unknown than a local refinement "
         "(up to order 4), then the mesh refined where the stress error indicator is large and at the edges of "
         "the closed set, interface first (up to 8 levels, max_elements and 1e6 unknowns), each mesh level "
-        "estimated by the larger of the order ladder and the sequence of levels; results.accuracy.refinement "
+        "estimated by the larger of the order ladder and the sequence of levels (a level met by the order "
+        "alone held to the uniform refinement's estimate too); results.accuracy.refinement "
         "lists the levels (order, mesh level, unknowns, values, errors); a tolerance out of reach ends the run "
         "(exit 3) with the last level's figures; default: 0.01, only judged (the scene's order and mesh are kept)")
 
