@@ -22,7 +22,9 @@ the order), so the tail of the differences would claim a quarter of the error.
 The loop (:func:`refine`): the scene's discretization is level 0; each next level is solved if its unknowns
 (known once its mesh is built, before the solve) are within the size bound; the estimate of the last level
 needs three levels (two observed differences), or two where the third is beyond the bound; it stops when the
-estimate meets the tolerance.  An :class:`Extrapolating` refiner names the levels its geometric tails take
+estimate meets the tolerance, or, where no tolerance was stated, when the observed rate of the estimate puts
+the tolerance beyond the size bound (:func:`_beyond_reach`) by each of the last two pairs of estimated levels:
+one pair of a sequence not yet asymptotic can show a rate far below the one that follows.  An :class:`Extrapolating` refiner names the levels its geometric tails take
 (:meth:`~Extrapolating.sequence`: those of one sequence in its size) and when its extrapolation exists
 (:meth:`~Extrapolating.ready`); before that its estimate within the tolerance does not stop the loop, since
 the tail of levels not yet asymptotic in that size claims less than their error.  Out of reach: a
@@ -257,14 +259,20 @@ def _floor(floors: list[dict[str, tuple[float, str]]], sols: list[CellSolution],
 
 
 def _beyond_reach(levels: list[dict[str, Any]], tolerance: float, max_dofs: int) -> str | None:
-    """Why an unrequired tolerance is out of reach within ``max_dofs`` at the rate the last two estimated levels
-    show (:func:`~ngcontact.cell.fe.observed_rate.dofs_to_meet`), else ``None``."""
+    """Why an unrequired tolerance is out of reach within ``max_dofs`` at the rates both the last two pairs of
+    estimated levels show (:func:`~ngcontact.cell.fe.observed_rate.dofs_to_meet`), else ``None``."""
     est = [lv for lv in levels if "estimate" in lv]
-    a = exponent([lv["ndof"] for lv in est], [lv["estimate"] for lv in est], (0.0, 0.0))
-    need = dofs_to_meet(levels[-1]["ndof"], levels[-1]["estimate"], tolerance, a)
-    if need is None or need[0] <= max_dofs:
+    if len(est) < 3:
         return None
-    return f"meeting {tolerance:g} would take about {need[0]:.2g} dofs at the observed rate, beyond {max_dofs}"
+    needs = []
+    for pair in (est[-3:-1], est[-2:]):
+        a = exponent([lv["ndof"] for lv in pair], [lv["estimate"] for lv in pair], (0.0, 0.0))
+        need = dofs_to_meet(pair[-1]["ndof"], pair[-1]["estimate"], tolerance, a)
+        if need is None or need[0] <= max_dofs:
+            return None
+        needs.append(need[0])
+    return (f"meeting {tolerance:g} would take about {needs[-1]:.2g} dofs at the observed rate (and "
+            f"{needs[0]:.2g} at the rate of the pair of levels before), beyond {max_dofs}")
 
 
 def _how(refiner: Refiner, levels: list[dict[str, Any]], remarks: list[str]) -> str:
