@@ -269,9 +269,7 @@ def run(scene, clock) -> Outcome:
     if scene.strength is not None:
         from ngcontact.drivers.run_strength import recovery_of
         with clock.stage("strength check"):
-            # the correctors depend on the law only through whether it has a tangential part, which the
-            # two-scale loop keeps (its tabulated shear where the start law has friction): built before the loop,
-            # the tables' share counts the safety factor (ngcontact.coupling.table_share)
+            # before the loop (which keeps the one feature of the law the correctors depend on: a tangential part)
             recovery = recovery_of(scene, problem.law)
     with clock.stage("solve"):
         if scene.two_scale is None:
@@ -279,7 +277,7 @@ def run(scene, clock) -> Outcome:
         else:
             from ngcontact.drivers.run_two_scale import couple_loop
             sol, two_scale, relevel = couple_loop(scene, problem, partial(solve_scene, scene),
-                                                  safety=safety_factor_of(scene, recovery))
+                                                  safety=safety_factor_of(scene, recovery))   # in the table share
     if scene.discretization.tolerance is not None:
         with clock.stage("refinement to the tolerance"):
             refined = refine(scene, sol, partial(solve_scene, scene), safety_factor_of(scene, recovery), relevel)
