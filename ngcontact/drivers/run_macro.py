@@ -5,11 +5,10 @@ through :mod:`ngcontact.coupling.cell_law`, which keeps its cache).
 
 ``results``:
 
-* ``interface``: arrays along the interface (2D / axisymmetric): ``s`` arc
-  length from the end with the largest ``z`` (``y``) [m], ``r, z`` (or
-  ``x, y``) [m], ``pressure`` [Pa, compression positive], ``shear`` [Pa,
-  traction along ``t0``], ``jump_n`` [m, ``J . n0``, positive closes],
-  ``jump_t`` [m, ``J . t0``], ``status`` (``open`` / ``stick`` / ``slip``);
+* ``interface``: arrays along the interface (2D / axisymmetric): ``s`` arc length from the end with the
+  largest ``z`` (``y``) [m], ``r, z`` (or ``x, y``) [m], ``pressure`` [Pa, compression positive], ``shear``
+  [Pa, traction along ``t0``], ``jump_n`` [m, ``J . n0``, positive closes], ``jump_t`` [m, ``J . t0``],
+  ``status`` (``open`` / ``stick`` / ``slip``);
   3D: the same on the interface surface (``x, y, z``, ``pressure``,
   ``shear_1``, ``shear_2`` along the law's tangents ``t1, t2``, ``shear`` their
   magnitude, ``jump_n``, ``jump_t1``, ``jump_t2``, ``status``) with

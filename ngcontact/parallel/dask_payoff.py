@@ -17,7 +17,7 @@ list, not this machine's cores): a process solves one member at a time
 :func:`~ngcontact.parallel.batch_member.run_member`), so a worker's threads
 beyond its first add no member running beside another.  ``o`` is one
 member's trip: the scheduler's round trip and the transfer of the member's
-prepared state (its item) there and of its result back.  It is measured on
+prepared state (its item) there and of its result back.  It is timed on
 the cluster at each batch, as the batch's first members are solved here: a
 probe task per worker carrying the next member's item and returning as many
 bytes as the first member's result pickled, ``o`` being its wall time here
@@ -123,7 +123,7 @@ class DaskPayoff:
 
 # ------------------------------------------------ the record, per scheduler address
 def measured_costs(address: str, kind: str) -> list[float]:
-    """The last costs of ``kind`` (:data:`COSTS`) measured on the cluster at ``address``, oldest first."""
+    """The last costs of ``kind`` (:data:`COSTS`) timed on the cluster at ``address``, oldest first."""
     try:
         with open(os.path.join(batch_forecast.folder(), COSTS_FILE)) as f:
             costs = [float(s) for s in json.load(f)[address][kind]]

@@ -59,13 +59,12 @@ are added as floors:
 * **the indicator's share** (:func:`indicator_share`). A coefficient integrates ``k_n`` (``k_n``) or ``k_n g0``
   (``g_n``) over the real contact set as its quadrature points see it: the multiplier's interpolant positive
   (exact) or the penetration (penalty), which differs from the located edges by up to the element holding each
-  edge, whatever the order (on Westergaard at a fifth of its closing pressure, exact, ``k_n`` is off by 0.43 %
-  and ``g_n`` by 1.3 % on a mesh whose contact fraction is within 1.3e-5, its smallest element 1.25e-3). So each
-  edge adds ``k_n h_e / P`` (``g_n``: times the largest ``g0`` at the ends of those elements), ``h_e`` the
+  edge, whatever the order (an error the contact fraction, whose edges are located exactly, does not carry).
+  So each edge adds ``k_n h_e / P`` (``g_n``: times the largest ``g0`` at the ends of those elements), ``h_e`` the
   largest element touching the edge, ``P`` the interface's length: a bound while the indicator is off by at most
   that element. It falls with the element at the edge, by ``1/16`` per grading step. The stiffness is that of
-  the contact set held closed: it moves with the set's measure as ``k_n`` does (measured on Westergaard at half
-  its closing pressure: errors of 1.18e-4 in both, of opposite signs), and takes the share of ``k_n`` relative
+  the contact set held closed: it moves with the set's measure as ``k_n`` does (on Westergaard's oracle their
+  errors are alike in size, of opposite signs), and takes the share of ``k_n`` relative
   to ``k_n`` as its floor;
 * **its grading's tail** (:func:`quantity_grading_tail`): the quantity's own change over the last grading
   step, at the grading's rate;
