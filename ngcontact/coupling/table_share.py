@@ -31,10 +31,9 @@ own error (the discrepancy of the held response against ``T``'s interpolants and
 :meth:`~ngcontact.coupling.pressure_table.CellTable.discrepancy`) is at least :data:`MARK` of its largest become
 nodes, the macro problem is solved with the new law, and the estimate is made again (the other midpoints stay
 held: the next estimate halves those intervals without a cell solve), at most :data:`MAX_ROUNDS` times.
-Adopting all of ``T'`` solves more cells for the same share: on the press fit at four interferences 78 cell solves
-against 60 marked, the effectivity staying at least 1.44 (``scripts/two_scale_table_share.py``).  Beyond
-:data:`MAX_ROUNDS`, beyond that, or past the table's bound on its cell solves, the tolerance is out of
-reach and the run ends with its figures (a :class:`~ngcontact.errors.ConvergenceError`, exit 3).  The rest of
+Adopting all of ``T'`` solves more cells for the same share (``scripts/two_scale_table_share.py`` sets the two
+side by side).  Beyond :data:`MAX_ROUNDS` rounds, or past the table's bound on its cell solves, the tolerance is
+out of reach and the run ends with its figures (a :class:`~ngcontact.errors.ConvergenceError`, exit 3).  The rest of
 the tolerance is left to the macro discretization and the loop's residual, each judged on its own.
 
 The midpoints of the last estimate are solved but are not nodes of the answer's law: the table keeps them
@@ -52,7 +51,7 @@ whose part exceeds its even share of the limit (at least the larger) is refined;
 midpoints all become nodes (:data:`SHEAR_MARK` = 0): marked by its own error (a row's discrepancy against its
 neighbours carried along the rays, a jump node's against the row's polyline) its share stalled on the frictional
 block of ``scripts/two_scale_table_share.py``, its own largest error lying where the macro quantities feel it
-least.  A halving of the shear table costs about 3.4 times its nodes in cell solves (both directions), against
+least.  A halving of the shear table costs several times its nodes in cell solves (both directions), against
 the pressure table's one per interval.
 
 Where the scene has a strength check, its safety factor (eq. 78 by the linear recovery) is a headline quantity
