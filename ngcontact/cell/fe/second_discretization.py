@@ -24,8 +24,9 @@ The loop (:func:`refine`): the scene's discretization is level 0; each next leve
 needs three levels (two observed differences), or two where the third is beyond the bound; it stops when the
 estimate meets the tolerance, or, where no tolerance was stated, when the observed rate of the estimate puts
 the tolerance beyond the size bound (:func:`_beyond_reach`) by each of the last two pairs of estimated levels:
-one pair of a sequence not yet asymptotic can show a rate far below the one that follows.  An :class:`Extrapolating` refiner names the levels its geometric tails take
-(:meth:`~Extrapolating.sequence`: those of one sequence in its size) and when its extrapolation exists
+one pair of a sequence not yet asymptotic can show a rate far below the one that follows.  An
+:class:`Extrapolating` refiner names the levels its geometric tails take (:meth:`~Extrapolating.sequence`:
+those of one sequence in its size) and when its extrapolation exists
 (:meth:`~Extrapolating.ready`); before that its estimate within the tolerance does not stop the loop, since
 the tail of levels not yet asymptotic in that size claims less than their error.  Out of reach: a
 :class:`~ngcontact.errors.ConvergenceError` with the figures
