@@ -124,31 +124,72 @@ def _write(file: str, data: dict) -> None:
             pass
 
 
+@dataclass(frozen=True)
+class CostRecord:
+    """Timed costs kept in the record ``file`` (of :func:`folder`), the last :data:`COSTS_KEPT` of each of
+    ``kinds``: this machine's (``scope`` ``None``) or one entry per ``scope`` (a Dask scheduler's address,
+    :mod:`ngcontact.parallel.dask_payoff`).  A value outside ``[least, 1e4)`` s is a damaged record's and is
+    dropped."""
+
+    file: str
+    kinds: tuple[str, ...]
+    least: float = 0.0
+
+    def _data(self) -> dict:
+        try:
+            with open(os.path.join(folder(), self.file)) as f:
+                data = json.load(f)
+        except (OSError, ValueError):
+            return {}
+        return data if isinstance(data, dict) else {}
+
+    def measured(self, kind: str, scope: str | None = None) -> list[float]:
+        """The last costs of ``kind``, oldest first."""
+        data = self._data()
+        try:
+            costs = [float(s) for s in (data if scope is None else data[scope])[kind]]
+        except (ValueError, KeyError, TypeError):
+            return []
+        return [s for s in costs if self.least <= s < 1e4]
+
+    def median(self, kind: str, default: float, scope: str | None = None) -> float:
+        """The median of the last costs of ``kind``, ``default`` before any."""
+        costs = sorted(self.measured(kind, scope))
+        if not costs:
+            return default
+        mid = len(costs) // 2
+        return costs[mid] if len(costs) % 2 else 0.5 * (costs[mid - 1] + costs[mid])
+
+    def remember(self, kind: str, seconds: float, scope: str | None = None) -> None:
+        """Add a cost of ``kind`` to the record (a scope's entry beside the others')."""
+        entry = {k: self.measured(k, scope) for k in self.kinds}
+        entry[kind] = (entry[kind] + [float(seconds)])[-COSTS_KEPT:]
+        if scope is None:
+            _write(self.file, entry)
+        else:
+            data = self._data()
+            data[scope] = entry
+            _write(self.file, data)
+
+
+#: this machine's record of a local worker's costs (:data:`COSTS`)
+WORKER_COSTS = CostRecord(COSTS_FILE, COSTS)
+
+
 def measured_costs(kind: str) -> list[float]:
     """The last costs of ``kind`` (:data:`COSTS`) this machine timed, oldest first."""
-    try:
-        with open(os.path.join(folder(), COSTS_FILE)) as f:
-            costs = [float(s) for s in json.load(f)[kind]]
-    except (OSError, ValueError, KeyError, TypeError):
-        return []
-    return [s for s in costs if 0.0 <= s < 1e4]
+    return WORKER_COSTS.measured(kind)
 
 
 def cost_seconds(kind: str, default: float) -> float:
     """CPU seconds of a worker's cost ``kind`` on this machine (:data:`COSTS`): the median of the last
     :data:`COSTS_KEPT` measured, ``default`` before any."""
-    costs = sorted(measured_costs(kind))
-    if not costs:
-        return default
-    mid = len(costs) // 2
-    return costs[mid] if len(costs) % 2 else 0.5 * (costs[mid - 1] + costs[mid])
+    return WORKER_COSTS.median(kind, default)
 
 
 def remember_cost(kind: str, seconds: float) -> None:
     """Add a measured cost of ``kind`` (:data:`COSTS`) to the machine's record."""
-    data = {k: measured_costs(k) for k in COSTS}
-    data[kind] = (data[kind] + [float(seconds)])[-COSTS_KEPT:]
-    _write(COSTS_FILE, data)
+    WORKER_COSTS.remember(kind, seconds)
 
 
 def early(executor, name: str, members: int | None) -> bool:

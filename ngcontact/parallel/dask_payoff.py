@@ -50,9 +50,7 @@ would decide the same.
 from __future__ import annotations
 
 import importlib
-import json
 import math
-import os
 import pickle
 import statistics
 import time
@@ -122,36 +120,24 @@ class DaskPayoff:
 
 
 # ------------------------------------------------ the record, per scheduler address
+#: the record of (4)'s costs per scheduler address (``e`` may be measured below 0; it is held at 0 where used)
+RECORD = batch_forecast.CostRecord(COSTS_FILE, COSTS, least=-1e4)
+
+
 def measured_costs(address: str, kind: str) -> list[float]:
     """The last costs of ``kind`` (:data:`COSTS`) timed on the cluster at ``address``, oldest first."""
-    try:
-        with open(os.path.join(batch_forecast.folder(), COSTS_FILE)) as f:
-            costs = [float(s) for s in json.load(f)[address][kind]]
-    except (OSError, ValueError, KeyError, TypeError):
-        return []
-    return [s for s in costs if math.isfinite(s) and abs(s) < 1e4]
+    return RECORD.measured(kind, address)
 
 
 def cost_seconds(address: str, kind: str, default: float = 0.0) -> float:
     """The median of the last costs of ``kind`` measured at ``address``, ``default`` before any."""
-    costs = measured_costs(address, kind)
-    return statistics.median(costs) if costs else default
+    return RECORD.median(kind, default, address)
 
 
 def remember_cost(address: str, kind: str, seconds: float) -> None:
     """Add a cost of ``kind`` measured at ``address`` to the record (the last
     :data:`~ngcontact.parallel.batch_forecast.COSTS_KEPT` of each kind are kept)."""
-    try:
-        with open(os.path.join(batch_forecast.folder(), COSTS_FILE)) as f:
-            data = json.load(f)
-        if not isinstance(data, dict):
-            data = {}
-    except (OSError, ValueError):
-        data = {}
-    entry = {k: measured_costs(address, k) for k in COSTS}
-    entry[kind] = (entry[kind] + [float(seconds)])[-batch_forecast.COSTS_KEPT:]
-    data[address] = entry
-    batch_forecast._write(COSTS_FILE, data)
+    RECORD.remember(kind, seconds, address)
 
 
 # ------------------------------------------------ the probe
