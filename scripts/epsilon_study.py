@@ -41,8 +41,8 @@ THREE = ("Each level on three discretizations (`study.meshes = 3`: the scene's, 
          "`study.refinement` r); each error is the modelling error on the finest, `*_discretization` the sum of the "
          "resolved and the homogenized solution's Richardson estimates 1.5 d2 q / (1 - q) of their discretization "
          "errors, from each solution's changes d1 (scene to once refined) and d2 (once to twice refined), "
-         "`*_ratio_resolved` and `*_ratio_homogenized` the observed q = d2 / d1, taken as at least 1/r (an "
-         "error at least linear in h; where q >= 1 that solution's "
+         "`*_ratio_resolved` and `*_ratio_homogenized` the observed q = d2 / d1; where q < 1/r each term is the "
+         "larger of that and d2 / (r - 1), the bound of an error linear in h (where q >= 1 that solution's "
          "term is 1.5 times its largest change over r - 1: {largest}); `contact_fraction_resolved` the resolved "
          "run's, with its estimate by the same rule; seconds of the finest pair.")
 

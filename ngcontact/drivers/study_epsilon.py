@@ -27,9 +27,10 @@ error from the change ``delta`` between the two pairs, ``1.5 delta / (r - 1)`` (
 ``h``, times the factor of safety: :func:`ngcontact.drivers.richardson_tail.tail`, a resolved run's default
 estimate's rule too).  With ``study.meshes = 3`` each level is solved once more, refined again by ``r``; the
 errors are the finest pair's, each estimate the sum of the two solutions' by the same rule from their two
-changes at their observed ratio (a solution's largest change where it does not contract, listed in
-``results.discretization.largest_change``).  The resolved contact fraction of each level (the finest mesh's)
-carries its estimate by the same rule (``contact_fraction_resolved_discretization``).
+changes at their observed ratio, or the bound of an error linear in ``h`` where larger (a solution's largest
+change where it does not contract, listed in ``results.discretization.largest_change``).  The resolved contact
+fraction of each level (the finest mesh's) carries its estimate by the same rule
+(``contact_fraction_resolved_discretization``).
 
 On blocks (``S_0`` the line ``y = 0``) the bundle law's solution is also rebuilt on the resolved bodies by
 the first-order corrector ``u^0 + eps u^1``
@@ -364,9 +365,9 @@ def rates(rows: list, laws=LAWS, share: float = 0.1) -> tuple[dict, dict, dict]:
 #: how the three-mesh estimate is made (``results.discretization.estimate``)
 THREE_MESHES = ("the finest pair's errors; each estimate the sum of the resolved and the homogenized solution's "
                 "Richardson tails 1.5 d2 q / (1 - q), d1 and d2 the solution's changes (coarse to middle, middle "
-                "to finest) and q = d2 / d1 their observed ratio (*_ratio_resolved, *_ratio_homogenized), at least "
-                "1/r (an error at least linear in h); where a solution's q does not contract, 1.5 times its "
-                "largest change over (r - 1) (listed in largest_change: law -> error -> N)")
+                "to finest) and q = d2 / d1 their observed ratio (*_ratio_resolved, *_ratio_homogenized), or "
+                "d2 / (r - 1) where larger (an error at least linear in h); where a solution's q does not contract, "
+                "1.5 times its largest change over (r - 1) (listed in largest_change: law -> error -> N)")
 #: how the two-mesh estimate is made (``results.discretization.estimate``)
 TWO_MESHES = ("the refined pair's errors; each estimate 1.5 delta / (r - 1), delta the change of the pair's signed "
               "difference from the scene's meshes: an error at least linear in h, times 1.5 "

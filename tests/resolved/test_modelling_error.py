@@ -72,12 +72,19 @@ def test_the_three_mesh_estimate_is_the_geometric_tail_of_the_observed_ratio():
     # changes 0.0125 then 0.01: ratio 0.8, slower than the presumed 1/2: tail 0.01 0.8 / 0.2, times the safety
     t = tail([0.0125, 0.01], 2.0)
     assert t.contracts and t.ratio == pytest.approx(0.8) and t.estimate == pytest.approx(1.5 * 0.04)
-    # ratio 1/2: 1.5 times the last change (what the two-mesh rule presumes at r = 2); faster: the presumed 1/2
+    # ratio 1/2: 1.5 times the last change (what the two-mesh rule presumes at r = 2)
     assert tail([0.02, 0.01], 2.0).estimate == pytest.approx(0.015)
+    # faster than the presumed 1/2, the two disagree: the larger of the observed tail with the safety (0.005)
+    # and the presumed bound without it (0.01 x 1)
     fast = tail([0.04, 0.01], 2.0)
-    assert fast.contracts and fast.ratio == pytest.approx(0.25) and fast.estimate == pytest.approx(0.015)
-    # r = 1.5: the presumed ratio 2/3, so an observed 0.6 gives 1.5 x 0.01 x 2
-    assert tail([0.01, 0.006], 1.5).estimate == pytest.approx(1.5 * 0.006 * 2)
+    assert fast.contracts and fast.ratio == pytest.approx(0.25) and fast.estimate == pytest.approx(0.01)
+    # r = 1.5, presumed 2/3: an observed 0.6 gives 1.5 x 0.006 x 1.5 = 0.0135 over the presumed 0.006 x 2
+    assert tail([0.01, 0.006], 1.5).estimate == pytest.approx(1.5 * 0.006 * 1.5)
+    # the two tails cross at q = 4/7 (r = 1.5): 2 d_n below, continuous through q0 = 2/3 (3 d_n there)
+    assert tail([0.01, 0.004], 1.5).estimate == pytest.approx(0.004 * 2)
+    assert tail([0.03, 0.02 - 1e-12], 1.5).estimate == pytest.approx(3 * 0.02)
+    # the coarsest value's error adds its seen changes to both: 1.5 (0.05 + 0.01 / 3) over 0.05 + 0.01
+    assert tail([0.04, 0.01], 2.0, member=0).estimate == pytest.approx(1.5 * (0.05 + 0.01 / 3))
     # no contraction: the largest change continued at the presumed contraction 1/r, and the estimate says so
     grown = tail([0.01, 0.03], 2.0)
     assert not grown.contracts and grown.ratio == pytest.approx(3.0) and grown.estimate == pytest.approx(0.045)
@@ -125,10 +132,11 @@ def test_three_pairs_sum_the_tails_of_each_solution_s_changes():
     for key in ("field", "reaction", "interface"):
         value, ratios, contracts = est[key]
         assert contracts and ratios == pytest.approx({"resolved": 0.25, "homogenized": 0.0}), key
-        assert value == pytest.approx(1.5 * moved(0.01)[key]), key   # ratio 1/4 taken as the presumed 1/2
+        # ratio 1/4, faster than the presumed 1/2: the presumed bound 0.01 x 1 over the observed 1.5 x 0.01 / 3
+        assert value == pytest.approx(moved(0.01)[key]), key
     value, ratios, contracts = est["probe"]
     assert not contracts and ratios == pytest.approx({"resolved": 0.25, "homogenized": 2.0})
-    assert value == pytest.approx(1.5 * (moved(0.01)["probe"] + moved(0.02)["probe"]))
+    assert value == pytest.approx(moved(0.01)["probe"] + 1.5 * moved(0.02)["probe"])
     # two pairs: from the change of the difference between them, 1.5 delta / (r - 1)
     for r in (2.0, 1.5):
         two = estimates(pairs[1:], weights, None, r)

@@ -1,6 +1,7 @@
 """The epsilon study's discretization estimates against a much finer mesh pair: the rule of
-:func:`ngcontact.drivers.richardson_tail.tail` (1.5 delta / (r - 1) with two meshes; with three the observed ratio,
-at least the presumed 1/r) bounds the error of the pair it reports, on the smallest study of the tests."""
+:func:`ngcontact.drivers.richardson_tail.tail` (1.5 delta / (r - 1) with two meshes; with three the observed
+ratio's tail, or the bound of the presumed 1/r where larger) bounds the error of the pair it reports, on the
+smallest study of the tests."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -40,11 +41,10 @@ def test_the_study_s_discretization_estimate_bounds_the_error_of_its_pair(tmp_pa
                                        oracle["laws"][law], weights, at_oracle)
         effectivity.update({f"{law}_{k}": row[f"{law}_{k}_discretization"] / v for k, v in true.items()})
     assert len(effectivity) == 14
-    # every estimate bounds its error; with two meshes by at most ten times (issue 35's aim: 1.1 to 8.0), with
-    # three the presumed ratio 2/3 replaces the faster observed 0.40 to 0.62 of the probes and the interior H1
-    # norm, whose estimates reach 11.7 times their errors
-    assert all(e >= 1.0 for e in effectivity.values()), effectivity
-    assert max(effectivity.values()) <= (10.0 if meshes == 2 else 12.0), effectivity
+    # every estimate bounds its error by at most ten times (issue 35's aim): with two meshes 1.1 to 7.9, with
+    # three 2.3 to 9.2, the faster observed ratios (0.24 to 0.62 against the presumed 2/3) held at the larger of
+    # their tail and the presumed rate's bound
+    assert all(1.0 <= e <= 10.0 for e in effectivity.values()), effectivity
     # the resolved contact fraction: 1 + 0.3 of 1.6 per period, its closed set's edges at the valleys' corners,
     # found by every mesh: the meshes agree to round-off, and so does the estimate with the oracle
     assert row["contact_fraction_resolved"] == pytest.approx(1.3, abs=1e-12)
