@@ -146,10 +146,10 @@ def remember_cost(address: str, kind: str, seconds: float) -> None:
 def probe_task(modules: Sequence[str], item: Any, nbytes: int) -> tuple[float, bytes]:
     """On a worker: its start as a member's (one thread), ``modules`` imported, ``item`` received; returns the
     seconds this took on the worker and ``nbytes`` bytes (a member's result's size).  A probe cancelled while
-    it runs (its batch stayed in the run's process) imports no further module: Dask cannot stop a running
-    task, so the task looks before each import (:func:`cancelled`)."""
+    it runs (its batch stayed in the run's process) starts and imports nothing more: Dask cannot stop a
+    running task, so the task looks before each step (:func:`cancelled`)."""
     t0 = time.perf_counter()
-    if not in_worker():
+    if not in_worker() and not cancelled():
         one_thread(ignore_sigint=False)
     for module in modules:
         if cancelled():
@@ -220,8 +220,9 @@ class Probe:
         return statistics.median(trips)
 
     def cancel(self) -> None:
-        """The batch stays in the run's process: every probe task is cancelled (a queued one never runs, a
-        running one imports no further module, :func:`probe_task`) and its result dropped on the worker."""
+        """Done with the probe (the batch decided where it runs, or ended): every probe task is cancelled (a
+        queued one never runs, a running one imports no further module, :func:`probe_task`) and its result
+        dropped on the worker."""
         sent, self._sent, self._warming = self._sent, [], []
         if sent:
             self.client.cancel(sent)
