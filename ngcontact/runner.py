@@ -65,9 +65,15 @@ def threads(n: int):
     NGSolve's, and a solve with both pools on the same cores runs several times slower.  So do those the run
     loads later (SciPy's own OpenBLAS, loaded by the first ``scipy.linalg`` call), by the variables they read
     as they load (:data:`~ngcontact.parallel.batch_member.BLAS_THREADS_ENV`, where unset; restored after).
+    The C heap keeps freed arrays as a batch worker's does, where the environment froze its thresholds
+    (:func:`~ngcontact.parallel.heap_thresholds.keep_freed_arrays`; a process that started a Dask cluster
+    has, and passes it on to the runs it starts): else every FFT buffer of a spectral step is mapped and
+    zero-filled afresh, and a member solved here costs more CPU than on a worker.
     """
     from threadpoolctl import threadpool_limits
     from ngcontact.parallel.batch_member import BLAS_THREADS_ENV
+    from ngcontact.parallel.heap_thresholds import keep_freed_arrays
+    keep_freed_arrays()
     unset = [name for name in BLAS_THREADS_ENV if name not in os.environ]
     os.environ.update({name: "1" for name in unset})
     try:

@@ -18,7 +18,9 @@ of the same repeat has recorded the batch (its workers start with the run
 where that record forecasts that the batch goes to them:
 ``ngcontact.parallel.batch_forecast``; column ``started``); and
 ``--scheduler`` on a ``distributed.LocalCluster``
-of two one-thread worker processes that this script starts once and warms
+of two one-thread worker processes that this script starts once (the runs
+get the environment this script was started with, not the variables Dask's
+nanny leaks into the process that starts a cluster) and warms
 with one run of each scene (a cluster outlives the runs it serves; a batch
 goes to it only where its rest repays the members' trips,
 ``ngcontact.parallel.dask_payoff``, column ``ran``).  Per
@@ -98,8 +100,11 @@ def main() -> None:
     os.makedirs(args.out, exist_ok=True)
     from distributed import LocalCluster
     rows: list[dict] = []
+    shell = dict(os.environ)
     with tempfile.TemporaryDirectory() as tmp, LocalCluster(
             n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster:
+        os.environ.clear()              # the nanny's variables leak into this process: the runs get the shell's
+        os.environ.update(shell)
         scenes = {"shipped 64^2 x 32": SHIPPED, "256^2 x 16": large(tmp), "measured scan": MEASURED}
         dask = ("--scheduler", cluster.scheduler_address)
         records = os.path.join(tmp, "cache")

@@ -167,10 +167,18 @@ class DaskCluster(Executor):
     def _judged_map(self, fn, items, names, label, progress, fault) -> list:
         """A batch of the run: members solved here, each timed, while the cluster's workers import the
         members' modules; then condition (4) of :mod:`ngcontact.parallel.dask_payoff`, with the trip timed on
-        the cluster now, sends the rest there or keeps it here (the batch's record says which and why)."""
-        clock = self.member_clock
+        the cluster now, sends the rest there or keeps it here (the batch's record says which and why).  Its
+        probe is cancelled however the batch ends (:meth:`~ngcontact.parallel.dask_payoff.Probe.cancel`): a
+        batch kept here leaves no probe importing on the workers."""
         probe = dask_payoff.Probe(self.client, label)
         probe.warm(self._modules + (fn.__module__,))
+        try:
+            return self._probed_map(probe, fn, items, names, label, progress, fault)
+        finally:
+            probe.cancel()
+
+    def _probed_map(self, probe, fn, items, names, label, progress, fault) -> list:
+        clock = self.member_clock
         done: list = []
         while len(done) < len(items):
             k = len(done)
@@ -183,12 +191,14 @@ class DaskCluster(Executor):
             except Exception as exc:   # a worker that cannot import the members' module, or a lost one
                 why = (f"{len(done)} members solved here; the cluster's probe failed ({reason(exc)}): the other "
                        f"{len(items) - len(done)} in this process")
+                probe.cancel()
                 return self._here(fn, items, names, label, progress, fault, done, why)
             dask_payoff.remember_cost(self.address, "round_trip", trip)
             payoff = dask_payoff.DaskPayoff(
                 clock.least, len(items) - len(done), len(probe.workers),
                 dask_payoff.cost_seconds(self.address, "round_trip", trip),
                 dask_payoff.cost_seconds(self.address, "member_extra"))
+            probe.cancel()                 # done with: its results leave the workers
             if not payoff.repaid:
                 return self._here(fn, items, names, label, progress, fault, done, payoff.describe(len(done)))
             self._where("dask", payoff.describe(len(done)))
@@ -197,7 +207,6 @@ class DaskCluster(Executor):
                                      shifted_progress(progress, len(done)), fault)
             return done + rest
         importing = not probe.warm_done()
-        probe.cancel()
         self._where("serial", f"all {len(done)} members solved here"
                     + (" while the cluster's workers imported their modules" if importing else ""))
         return done

@@ -38,7 +38,9 @@ The cluster repays its trips when the rest ends sooner there::
 the time the workers save on the rest against the trips and extra time of
 the members each worker solves.  A batch for which (4) fails stays in this
 process, its record saying why (as the local rule's does); so does a batch
-whose probe fails (a worker that cannot import the members' module).  Before
+whose probe fails (a worker that cannot import the members' module).  A
+batch that stays here cancels its probe, whose tasks import no further
+module once cancelled (:meth:`Probe.cancel`).  Before
 timing the trips, the probe imports the members' modules on every worker
 (each worker's first member would otherwise pay it), while this process goes
 on solving members; (4) is read once that is done and at least
@@ -143,14 +145,30 @@ def remember_cost(address: str, kind: str, seconds: float) -> None:
 # ------------------------------------------------ the probe
 def probe_task(modules: Sequence[str], item: Any, nbytes: int) -> tuple[float, bytes]:
     """On a worker: its start as a member's (one thread), ``modules`` imported, ``item`` received; returns the
-    seconds this took on the worker and ``nbytes`` bytes (a member's result's size)."""
+    seconds this took on the worker and ``nbytes`` bytes (a member's result's size).  A probe cancelled while
+    it runs (its batch stayed in the run's process) starts and imports nothing more: Dask cannot stop a
+    running task, so the task looks before each step (:func:`cancelled`)."""
     t0 = time.perf_counter()
-    if not in_worker():
+    if not in_worker() and not cancelled():
         one_thread(ignore_sigint=False)
     for module in modules:
+        if cancelled():
+            break
         if module != "__main__":
             importlib.import_module(module)
     return time.perf_counter() - t0, bytes(nbytes)
+
+
+def cancelled() -> bool:
+    """Whether the task running this on a Dask worker has been cancelled by its client (released by the
+    scheduler: the worker lets a running task go on, marked ``cancelled``); False outside a task."""
+    try:
+        from distributed import get_worker
+        worker = get_worker()
+        task = worker.state.tasks.get(worker.get_current_task())
+    except (ImportError, ValueError, AttributeError, KeyError):    # not in a Dask task
+        return False
+    return task is None or task.state == "cancelled"
 
 
 def result_bytes(result: Any) -> int:
@@ -170,12 +188,15 @@ class Probe:
         self.label = label
         self.workers = list(client.scheduler_info()["workers"])
         self._warming: list = []
+        self._sent: list = []         # every probe task submitted, until cancelled
 
     def _submit(self, modules, item, nbytes) -> list:
-        return [self.client.submit(probe_task, tuple(modules), item, nbytes, workers=[w],
-                                   allow_other_workers=False, pure=False,
-                                   key=f"ngcontact-probe-{self.label}-{k}-{time.time_ns()}")
-                for k, w in enumerate(self.workers)]
+        futures = [self.client.submit(probe_task, tuple(modules), item, nbytes, workers=[w],
+                                      allow_other_workers=False, pure=False,
+                                      key=f"ngcontact-probe-{self.label}-{k}-{time.time_ns()}")
+                   for k, w in enumerate(self.workers)]
+        self._sent += futures
+        return futures
 
     def warm(self, modules: Sequence[str]) -> None:
         """Every worker imports ``modules`` now (in the background)."""
@@ -199,4 +220,9 @@ class Probe:
         return statistics.median(trips)
 
     def cancel(self) -> None:
-        self.client.cancel(self._warming)
+        """Done with the probe (the batch decided where it runs, or ended): every probe task is cancelled (a
+        queued one never runs, a running one imports no further module, :func:`probe_task`) and its result
+        dropped on the worker."""
+        sent, self._sent, self._warming = self._sent, [], []
+        if sent:
+            self.client.cancel(sent)

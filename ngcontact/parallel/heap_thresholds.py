@@ -1,4 +1,4 @@
-"""The C heap's thresholds in a worker whose environment fixed them (glibc's ``malloc``).
+"""The C heap's thresholds in a worker or a run whose environment fixed them (glibc's ``malloc``).
 
 glibc serves an allocation above its *mmap threshold* by a fresh ``mmap``
 and returns it to the kernel when freed; the kernel zero-fills every page
@@ -9,7 +9,10 @@ Setting ``MALLOC_TRIM_THRESHOLD_`` in the environment (Dask's nanny does,
 threshold at its start value of 128 KiB.  A spectral cell allocates and
 frees FFT buffers of a few MiB in every step, so each step pays the page
 faults of all its buffers: a member of a batch then costs several times the
-CPU it costs in this process.
+CPU it costs in this process.  The variable also leaks into the process that
+started a local Dask cluster (Dask's nanny sets it there before spawning its
+workers), and so into every run that process starts: a run's own process
+(:func:`ngcontact.runner.threads`) raises the thresholds as a worker does.
 
 :func:`keep_freed_arrays` sets both thresholds once, where that variable is
 set, to what the adaptive rule would reach for arrays up to

@@ -5,7 +5,9 @@ one-thread worker processes.
 The member :func:`burn` spends a given number of CPU seconds and returns the id of the process that ran it,
 so a test sees where each member went.
 """
+import functools
 import os
+import sys
 import time
 
 import pytest
@@ -103,3 +105,72 @@ def test_a_cluster_used_directly_sends_every_member_there(cluster):
         assert os.getpid() not in pids and ex.describe()["batches"][-1]["executor"] == "dask"
     finally:
         ex.close()
+
+
+SLOW_MODULE = """import os, time
+open(os.path.join({folder!r}, __name__ + ".began." + str(os.getpid())), "w").close()   # a worker began it
+time.sleep({seconds!r})
+"""
+
+
+def started(folder, module: str) -> int:
+    """How many workers have begun importing ``module`` (the markers its import leaves in ``folder``)."""
+    return sum(name.startswith(module + ".began.") for name in os.listdir(folder))
+
+
+def wait_for_probes(folder: str, module: str, workers: int) -> int:
+    """A member that waits until ``workers`` probes are running (have begun importing ``module``)."""
+    deadline = time.monotonic() + 60
+    while started(folder, module) < workers:
+        assert time.monotonic() < deadline, "the probes never started"
+        time.sleep(0.02)
+    return os.getpid()
+
+
+def test_a_batch_kept_here_stops_its_running_probe_before_the_next_module(cluster, tmp_path):
+    """Two members solved here end the batch while each worker's probe imports the first of three slow
+    modules: the probe is cancelled, and once it has left the workers neither worker imported the second or the
+    third."""
+    tag = f"slow_{os.getpid()}_{time.monotonic_ns()}"
+    modules = [f"{tag}_{k}" for k in range(3)]
+    for module, seconds in zip(modules, (4.0, 1.0, 1.0)):     # the first long enough for both workers to begin it
+        (tmp_path / f"{module}.py").write_text(SLOW_MODULE.format(folder=str(tmp_path), seconds=seconds))
+    ex = DaskCluster(cluster)
+    try:
+        ex.client.run(search_path, str(tmp_path), True)
+        ex.start_on_demand(modules)
+        workers = len(ex.client.scheduler_info()["workers"])
+        pids = ex.map(functools.partial(wait_for_probes, str(tmp_path), modules[0]), [workers, 0], ["a", "b"],
+                      label="kept")
+        assert pids == [os.getpid()] * 2 and ex.describe()["batches"][-1]["executor"] == "serial"
+        assert "while the cluster's workers imported their modules" in ex.describe()["batches"][-1]["decision"]
+        deadline = time.monotonic() + 60        # the cancelled probes end their running import, then leave
+        while any(ex.client.run(kept_probes).values()):
+            assert time.monotonic() < deadline, ex.client.run(kept_probes)
+            time.sleep(0.1)
+        imported = ex.client.run(lambda: sorted(m for m in sys.modules if m.startswith(tag)))
+        assert list(imported.values()) == [modules[:1]] * workers
+        assert started(tmp_path, modules[1]) == 0
+    finally:
+        ex.client.run(search_path, str(tmp_path), False)
+        ex.close()
+
+
+def search_path(folder: str, add: bool) -> None:
+    """On a worker: ``folder`` added to (or removed from) the module search path."""
+    import importlib
+    if add:
+        sys.path.insert(0, folder)
+        importlib.invalidate_caches()
+    elif folder in sys.path:
+        sys.path.remove(folder)
+
+
+def kept_probes(dask_worker) -> list:
+    """The probe tasks of the batch ``kept`` a worker still holds (running, cancelled while running, or their
+    results), with their states."""
+    return [(key, ts.state) for key, ts in dask_worker.state.tasks.items() if "ngcontact-probe-kept-" in str(key)]
+
+
+def test_a_probe_outside_a_dask_task_is_never_cancelled():
+    assert dask_payoff.cancelled() is False
