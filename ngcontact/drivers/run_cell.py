@@ -126,9 +126,8 @@ def warn_unmet(verdict: dict, refinement: Refinement) -> None:
     else:
         what = "too few grids within the size bound to show"
     if refinement.shortfall:
-        log.warning("accuracy not met: %s the %s tolerance %g %s; raise discretization.budget_dofs or state "
-                    "discretization.tolerance", what if unmet else "the refinement did not show",
-                    verdict["tolerance_from"], verdict["tolerance"], refinement.shortfall)
+        log.warning("accuracy not met: %s the %s tolerance %g %s; %s", what if unmet else "the refinement did not show",
+                    verdict["tolerance_from"], verdict["tolerance"], refinement.shortfall, refinement.remedy)
         return
     if refinement.scene_discretization:
         log.warning("accuracy not met: %s the %s tolerance %g on the scene's own discretization (%s); state "

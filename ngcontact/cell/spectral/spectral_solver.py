@@ -25,7 +25,7 @@ from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.spectral import grid_measures
 from ngcontact.cell.spectral.coarser_grids import HOW as COARSER_HOW, estimate_from_coarser, why_not
 from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
-from ngcontact.cell.spectral.refinement import HOW, UNCONTROLLED, sweep_to_tolerance
+from ngcontact.cell.spectral.refinement import HOW, sweep_to_tolerance, uncontrolled
 from ngcontact.cell.whole_surface import flat
 
 #: the grid fields a solution hands on (the closure is in its surface distribution)
@@ -133,7 +133,8 @@ class SpectralCellSolver:
                   "estimate_seconds": sum(h["seconds"] for h in done.history[:-1])}
         how = COARSER_HOW + f"; {HOW}" + (f" ({'; '.join(done.remarks)})" if done.remarks else "")
         return Refinement(solutions=[self.solution(s) for s in done.solutions], estimates=list(done.estimates),
-                          method=method, how=how, uncontrolled=UNCONTROLLED, scales=done.scales, loose=done.flags,
+                          method=method, how=how, uncontrolled=uncontrolled(first.dim), scales=done.scales,
+                          loose=done.flags,
                           scene_discretization=True)
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
@@ -159,8 +160,10 @@ class SpectralCellSolver:
                                   f"bound ({bound} points), so there is no finer grid to compare with")
         how = HOW + (f" ({'; '.join(refined.remarks)})" if refined.remarks else "")
         return Refinement(solutions=solutions, estimates=list(refined.estimates), method=method,
-                          met=refined.met, how=how, uncontrolled=UNCONTROLLED,
-                          scales=refined.scales, loose=refined.flags)
+                          met=refined.met, how=how, uncontrolled=refined.uncontrolled,
+                          scales=refined.scales, loose=refined.flags, shortfall=refined.capped,
+                          remedy="the stiffness converges at first order in the grid step: state a looser "
+                                 "discretization.tolerance to meet it, or read it with its estimate")
 
     def penalty(self) -> float | None:
         return float(self.cell.k_n) if self.cell.enforcement == "penalty" else None
