@@ -118,9 +118,11 @@ class CellDiscretization(Discretization):
     estimate: str = param("auto", doc="without a tolerance: auto holds the sweep to the default tolerance as "
                           "discretization.tolerance says (the spectral cell refined; the FE cell estimated by one "
                           "order more on its own mesh, and refined within discretization.budget_dofs where that "
-                          "misses it); estimate (FE cell) estimates its own answer by one order more and does not "
-                          "refine, a miss reported with accuracy.met = false and a warning (two sweeps: for runs "
-                          "not about accuracy); off skips the estimate (no second solve), and the report says "
+                          "misses it); estimate estimates the scene's own answer and does not refine (the FE cell by "
+                          "one order more on its mesh: two sweeps; the spectral cell from three coarser grids, "
+                          "each with half the points per direction of the next), a miss reported with "
+                          "accuracy.met = false and a warning (for runs not about accuracy: each level of "
+                          "ngcontact study accuracy); off skips the estimate (no second solve), and the report says "
                           "'not estimated (discretization.estimate = off)'; no effect with a tolerance",
                           choices=("auto", "estimate", "off"))
     budget_dofs: int | None = param(None, doc="FE cell without a tolerance, estimate = 'auto': the most unknowns "
