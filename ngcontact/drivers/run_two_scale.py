@@ -314,7 +314,7 @@ class Relevel:
             return out
         parts: list = [TS.PressurePart(self.table)]
         if self.shear is not None and self.shear.rows:
-            parts.append(TS.ShearPart(self.shear))
+            parts += [TS.ShearPart(self.shear, "pressure"), TS.ShearPart(self.shear, "jump")]
         try:
             self.share = TS.estimate(sol, parts, self.solve, measure, tolerance, self.output.points_per_element,
                                      refine)
