@@ -73,7 +73,8 @@ rays, a jump node's against the row's polyline) its share stalled on the frictio
 Where the scene has a strength check, its safety factor (eq. 78 by the linear recovery) is a headline quantity
 of the share too: its correctors are the strength cell's and depend on the law only through whether it has a
 tangential part, which no table refinement changes, so each estimate's solve gives its safety factor at the cost
-of one linear recovery.
+of one linear recovery.  So are the maxima away from the bodies' singular points (the caller's ``measure``:
+:meth:`ngcontact.drivers.run_two_scale.Relevel.table_share`).
 """
 from __future__ import annotations
 
