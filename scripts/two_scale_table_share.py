@@ -47,12 +47,11 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 
 from ngcontact.coupling import table_share as TS  # noqa: E402
 from ngcontact.drivers import run_macro as D  # noqa: E402
-from ngcontact.macro import discretization_error as DE  # noqa: E402
 from ngcontact.output.report import Clock  # noqa: E402
 from ngcontact.output.writer import write_csv  # noqa: E402
 from ngcontact.errors import ConvergenceError  # noqa: E402
-from tests.coupling.test_table_share import (_friction_block, analytic_tables, loop, reference,  # noqa: E402
-                                             scene_with, shear_reference)
+from tests.coupling.test_table_share import (_friction_block, analytic_tables, loop, measured,  # noqa: E402
+                                             reference, scene_with, shear_reference)
 
 TOLERANCE = 1e-3
 GAPS = (-2e-3, -1.5e-3, -1e-3, -5e-4)
@@ -101,7 +100,7 @@ def share_rows(gap: float, tmp: Path, run: str = "share on the scene's mesh") ->
     assert share is not None
     ref = reference(answer, relevel.table, scene, 4)
     component = next(k for k in share.values if k.startswith("resultant_")).removeprefix("resultant_")
-    exact = DE.headlines(ref, scene.output.points_per_element, component)
+    exact = measured(ref, relevel, scene, component)
     return compared(share, exact, run, gap, nodes_scene=res["table"]["nodes"], nodes_answer=len(relevel.table.values),
                     rounds=len(share.rounds), cell_solves=sum(r["cell_solves"] for r in share.rounds),
                     seconds=seconds)
@@ -133,7 +132,7 @@ def shear_rows(tmp: Path) -> list[dict]:
     solves = relevel.shear.solves + relevel.table.solves - solves        # the share's (not the reference's)
     nodes_answer = sum(len(r) for r in relevel.shear.rows.values())
     component = next(k for k in share.values if k.startswith("resultant_")).removeprefix("resultant_")
-    exact = DE.headlines(shear_reference(answer, relevel, scene), scene.output.points_per_element, component)
+    exact = measured(shear_reference(answer, relevel, scene), relevel, scene, component)
     return compared(share, exact, SHEAR, None, nodes_scene=nodes, nodes_answer=nodes_answer,
                     rounds=len(share.rounds), cell_solves=solves, seconds=seconds)
 
