@@ -322,10 +322,11 @@ def test_the_shear_tables_held_loads_survive_the_cache_and_become_nodes_without_
 @pytest.mark.slow
 def test_the_shear_share_of_an_fe_friction_cell_is_met_within_the_tables_bound(tmp_path):
     """The frictional block with its real FE cell (the sawtooth of ``scripts/sawtooth_shear.py``, micro Coulomb;
-    cell solves in this process): the tolerance is met by the tables' share within the shear table's bound on cell
-    solves (halved in both directions at once and up to the interface's largest ``|s| / p``, the first round
-    alone passed it and the run ended with exit 3).  Each direction's halving asks for less than half the cells
-    of the rows' whole halving, and the share's rounds name both directions' parts."""
+    cell solves in this process): the tolerance 5e-3 is met by the tables' share in its first round, within the
+    shear table's bound on cell solves (halved in both directions at once and up to the interface's largest
+    ``|s| / p``, that round alone passed the bound and the run ended with exit 3).  Each direction's halving asks
+    for less than half the cells of the rows' whole halving, the share's two levels in both directions for less
+    than twice them, and the share's rounds name both directions' parts."""
     from functools import partial as _partial
     from ngcontact.coupling import shear_table as ST
     from ngcontact.macro.macro_measures import interface_profile
@@ -338,8 +339,11 @@ def test_the_shear_share_of_an_fe_friction_cell_is_met_within_the_tables_bound(t
     for direction in ("pressure", "jump"):
         assert 0 < len(TS.shear_loads(relevel.shear, prof["pressure"], prof["jump_t"], direction=direction)) < whole / 2
     before = relevel.shear.solves
-    relevel.table_share(sol, 1e-3)
+    relevel.table_share(sol, 5e-3)
     share = relevel.share
-    assert share is not None and share.share <= share.limit and relevel.shear.solves <= relevel.shear.max_solves
-    assert relevel.shear.solves - before < whole, (relevel.shear.solves - before, whole)
+    assert share is not None and share.share <= share.limit and len(share.rounds) == 1
+    assert relevel.shear.solves <= relevel.shear.max_solves
+    # the whole halving's first level alone asks for ``whole`` cells, its second (four times the rows' nodes)
+    # for about three times that: the share's two levels in both directions for less than twice the first
+    assert relevel.shear.solves - before < 2 * whole, (relevel.shear.solves - before, whole)
     assert {"shear_table_in_pressure", "shear_table_in_jump"} <= set(share.rounds[-1]["parts"])
