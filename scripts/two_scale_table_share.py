@@ -20,7 +20,8 @@ with part of it sticking) under ``friction = "from_cell"``, its cell's responses
 (``tests/coupling/test_table_share.py``: ``normal_response``, ``shear_response``; a cell solve costs nothing, its
 count is the figure), at the same tolerance: per quantity the estimate, each table's part, the true error against
 both tables halved three more times where the interface uses them; and the same with the shear table's first
-midpoints marked by its own error (``table_share.SHEAR_MARK = 0.5``).
+midpoints marked by its own error (``table_share.SHEAR_MARK = 0.5``).  And the same block with its real FE cell
+(the sawtooth of ``scripts/sawtooth_shear.py``): the cell solves and wall time of the loop and of the share.
 
 Then the whole run (``ngcontact run``'s driver, the tolerance refining the macro discretization as well) twice
 on one cache: the cell solves and wall time of each (the second starts from the table the first grew).
@@ -46,21 +47,28 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 
 from ngcontact.coupling import table_share as TS  # noqa: E402
 from ngcontact.drivers import run_macro as D  # noqa: E402
-from ngcontact.macro import discretization_error as DE  # noqa: E402
 from ngcontact.output.report import Clock  # noqa: E402
 from ngcontact.output.writer import write_csv  # noqa: E402
 from ngcontact.errors import ConvergenceError  # noqa: E402
-from tests.coupling.test_table_share import (_friction_block, analytic_tables, loop, reference,  # noqa: E402
-                                             scene_with, shear_reference)
+from tests.coupling.test_table_share import (_friction_block, analytic_tables, loop, measured,  # noqa: E402
+                                             reference, scene_with, shear_reference)
 
 TOLERANCE = 1e-3
 GAPS = (-2e-3, -1.5e-3, -1e-3, -5e-4)
 #: the scene's own interference (the whole runs')
 SCENE_GAP = -1e-3
-KEYS = ("run", "gap", "quantity", "value", "estimate", "true_error", "effectivity", "pressure_part", "shear_part",
+KEYS = ("run", "gap", "quantity", "value", "estimate", "true_error", "effectivity", "pressure_part",
+        "shear_pressure_part", "shear_jump_part",
         "nodes_scene", "nodes_answer", "rounds", "cell_solves", "seconds")
+#: the CSV column of each part of the share
+PART = {"pressure_table": "pressure_part", "shear_table_in_pressure": "shear_pressure_part",
+        "shear_table_in_jump": "shear_jump_part"}
+NO_PARTS = dict.fromkeys(PART.values())
 #: the run label of the shear rows
 SHEAR = "shear table, friction block"
+FE_SHEAR = "shear table, friction block, FE cell"
+#: the FE block's tolerances (the maxima away ask the table for more at the others' 1e-3)
+FE_TOLERANCES = (5e-3, TOLERANCE)
 
 
 class _Env:
@@ -77,10 +85,10 @@ def compared(share, exact: dict, run: str, gap, **extra) -> list[dict]:
     for name, value in share.values.items():
         true = abs(value - exact[name].value)
         above = true > 1e-9 * abs(exact[name].value)
-        parts = {f"{t.removesuffix('_table')}_part": q.get(name) for t, q in share.parts.items()}
+        parts = {PART[t]: q.get(name) for t, q in share.parts.items()}
         rows.append({"run": run, "gap": gap, "quantity": name, "value": value, "estimate": share.errors[name],
                      "true_error": true, "effectivity": share.errors[name] / true if above else None,
-                     "pressure_part": None, "shear_part": None, **parts, **extra})
+                     **NO_PARTS, **parts, **extra})
     return rows
 
 
@@ -94,7 +102,7 @@ def share_rows(gap: float, tmp: Path, run: str = "share on the scene's mesh") ->
     assert share is not None
     ref = reference(answer, relevel.table, scene, 4)
     component = next(k for k in share.values if k.startswith("resultant_")).removeprefix("resultant_")
-    exact = DE.headlines(ref, scene.output.points_per_element, component)
+    exact = measured(ref, relevel, scene, component)
     return compared(share, exact, run, gap, nodes_scene=res["table"]["nodes"], nodes_answer=len(relevel.table.values),
                     rounds=len(share.rounds), cell_solves=sum(r["cell_solves"] for r in share.rounds),
                     seconds=seconds)
@@ -126,9 +134,61 @@ def shear_rows(tmp: Path) -> list[dict]:
     solves = relevel.shear.solves + relevel.table.solves - solves        # the share's (not the reference's)
     nodes_answer = sum(len(r) for r in relevel.shear.rows.values())
     component = next(k for k in share.values if k.startswith("resultant_")).removeprefix("resultant_")
-    exact = DE.headlines(shear_reference(answer, relevel, scene), scene.output.points_per_element, component)
+    exact = measured(shear_reference(answer, relevel, scene), relevel, scene, component)
     return compared(share, exact, SHEAR, None, nodes_scene=nodes, nodes_answer=nodes_answer,
                     rounds=len(share.rounds), cell_solves=solves, seconds=seconds)
+
+
+def fe_shear_rows(tmp: Path) -> list[dict]:
+    """The same block with its real FE cell (cell solves in this process): the cell solves and wall time of the
+    loop (``nodes_scene``: its shear table), then per tolerance of :data:`FE_TOLERANCES`, each from the loop's
+    tables (its cache copied), the share per quantity with its parts, its cell solves and wall time, or where it
+    is out of reach its share by its last round (no oracle: a table halved three more times would take
+    thousands of cell solves)."""
+    import shutil
+    from functools import partial
+    from ngcontact.coupling import pressure_table as PT
+    from ngcontact.coupling import shear_table as ST
+    from ngcontact.drivers import run_two_scale as R
+    from ngcontact.drivers.macro_geometry import build_geometry
+    scene = _friction_block(tmp)
+    problem, _ = D.problem_of(scene, build_geometry(scene))
+    start = time.perf_counter()
+    sol, _, relevel = R.couple_loop(scene, problem, partial(D.solve_scene, scene), map_tasks=PT.serial_map,
+                                    cache_dir=str(tmp / "cache"), shear_map=ST.serial_map)
+    nodes = sum(len(r) for r in relevel.shear.rows.values())
+    rows = [{"run": FE_SHEAR + ", loop", "gap": None, "quantity": None, "value": None, "estimate": None,
+             "true_error": None, "effectivity": None, **NO_PARTS, "nodes_scene": nodes, "nodes_answer": nodes,
+             "rounds": None, "cell_solves": relevel.shear.solves + relevel.table.solves,
+             "seconds": time.perf_counter() - start}]
+    for k, tol in enumerate(FE_TOLERANCES):
+        cache = tmp / f"cache{k}"
+        shutil.copytree(tmp / "cache", cache)
+        sol, _, relevel = R.couple_loop(scene, problem, partial(D.solve_scene, scene), map_tasks=PT.serial_map,
+                                        cache_dir=str(cache), shear_map=ST.serial_map)
+        run, start = f"{FE_SHEAR}, tolerance {tol:g}", time.perf_counter()
+        try:
+            relevel.table_share(sol, tol)
+        except ConvergenceError as err:
+            last = err.history["table_share"][-1]
+            rows.append({"run": run + ": out of reach", "gap": None, "quantity": last["largest_in"],
+                         "value": None, "estimate": last["share"], "true_error": None, "effectivity": None,
+                         **NO_PARTS, **{PART[n]: r["share"] for n, r in last["parts"].items()},
+                         "nodes_scene": nodes, "nodes_answer": sum(len(r) for r in relevel.shear.rows.values()),
+                         "rounds": len(err.history["table_share"]),
+                         "cell_solves": relevel.shear.solves + relevel.table.solves,
+                         "seconds": time.perf_counter() - start})
+            continue
+        seconds, share = time.perf_counter() - start, relevel.share
+        assert share is not None
+        for name, value in share.values.items():
+            rows.append({"run": run, "gap": None, "quantity": name, "value": value, "estimate": share.errors[name],
+                         "true_error": None, "effectivity": None, **NO_PARTS,
+                         **{PART[t]: q.get(name) for t, q in share.parts.items()}, "nodes_scene": nodes,
+                         "nodes_answer": sum(len(r) for r in relevel.shear.rows.values()),
+                         "rounds": len(share.rounds), "cell_solves": relevel.shear.solves + relevel.table.solves,
+                         "seconds": seconds})
+    return rows
 
 
 def shear_marked_row(tmp: Path) -> dict:
@@ -145,9 +205,9 @@ def shear_marked_row(tmp: Path) -> dict:
         except ConvergenceError as err:
             rounds, run = err.history["table_share"], SHEAR + ", marked: out of reach"
         return {"run": run, "gap": None, "quantity": "cell_table_share", "value": rounds[-1]["share"],
-                "estimate": rounds[-1]["share"], "true_error": None, "effectivity": None, "pressure_part": None,
-                "shear_part": rounds[-1]["parts"]["shear_table"]["share"], "nodes_scene": None,
-                "nodes_answer": rounds[-1]["nodes"]["shear_table"], "rounds": len(rounds),
+                "estimate": rounds[-1]["share"], "true_error": None, "effectivity": None, **NO_PARTS,
+                **{PART[n]: r["share"] for n, r in rounds[-1]["parts"].items() if n.startswith("shear")},
+                "nodes_scene": None, "nodes_answer": rounds[-1]["nodes"]["shear_table_in_jump"], "rounds": len(rounds),
                 "cell_solves": relevel.shear.solves + relevel.table.solves - solves,
                 "seconds": time.perf_counter() - start}
     finally:
@@ -162,8 +222,7 @@ def run_rows(tmp: Path) -> list[dict]:
         res = D.run(scene, Clock()).results
         q = {x["name"]: x for x in res["accuracy"]["quantities"]}["cell_table_share"]
         rows.append({"run": run, "gap": SCENE_GAP, "quantity": "cell_table_share", "value": q["value"],
-                     "estimate": q["error"], "true_error": None, "effectivity": None, "pressure_part": None,
-                     "shear_part": None, "nodes_scene": None,
+                     "estimate": q["error"], "true_error": None, "effectivity": None, **NO_PARTS, "nodes_scene": None,
                      "nodes_answer": res["two_scale"]["table"]["nodes"], "rounds": len(q["rounds"]),
                      "cell_solves": res["two_scale"]["cell_solves"], "seconds": time.perf_counter() - start})
     return rows
@@ -201,6 +260,7 @@ def main(argv=None) -> int:
         rows += all_adopted_rows(Path(tmp))
         rows += shear_rows(Path(tmp) / "shear")
         rows.append(shear_marked_row(Path(tmp) / "marked"))
+        rows += fe_shear_rows(Path(tmp) / "fe")
         rows += run_rows(Path(tmp) / "run")
     csv_path = os.path.join(args.out, "two_scale_table_share.csv")
     write_csv(csv_path, list(KEYS), [[r[k] for k in KEYS] for r in rows])
@@ -232,11 +292,17 @@ def main(argv=None) -> int:
                               "sawtooth block of scripts/sawtooth_shear.py (moved 0.002, part of the interface "
                               "sticking) under friction = from_cell, its cell's responses closed forms "
                               "(tests/coupling/test_table_share.py; a cell solve costs nothing there, its count is "
-                              "the figure), both tables' share (pressure_part, shear_part: relative, added) against "
+                              "the figure), both tables' share (pressure_part and the shear table's by direction, "
+                              "shear_pressure_part and shear_jump_part: relative, added) against "
                               "both tables halved three more times where the interface uses them; nodes: the shear "
                               "table's; 'marked': the shear table's first midpoints marked by its own error "
                               "(SHEAR_MARK 0.5), which stalls (its share by its last round; out of reach at the test's "
-                              "bound of 1e5 cell solves or 8 rounds). "
+                              "bound of 1e5 cell solves or 8 rounds). Rows 'FE cell': the same block with its real "
+                              "FE cell (the sawtooth, micro Coulomb mu 0.3, order 2; cell solves in the process): "
+                              "the loop's cell solves and time (', loop'), then per tolerance, each from the loop's "
+                              "tables, the share's (cell_solves: the share's), per quantity with its parts, or out "
+                              "of reach its share by the last round and where it is largest (no oracle: a table "
+                              "halved three more times would take thousands of cell solves). "
                               "Wall times on 2 cores shared with other jobs.")
     return 0
 

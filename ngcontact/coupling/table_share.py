@@ -30,7 +30,10 @@ Refinement: while the share exceeds :data:`FRACTION` of the tolerance, the midpo
 own error (the discrepancy of the held response against ``T``'s interpolants and law,
 :meth:`~ngcontact.coupling.pressure_table.CellTable.discrepancy`) is at least :data:`MARK` of its largest become
 nodes, the macro problem is solved with the new law, and the estimate is made again (the other midpoints stay
-held: the next estimate halves those intervals without a cell solve), at most :data:`MAX_ROUNDS` times.
+held: the next estimate halves those intervals without a cell solve), at most :data:`MAX_ROUNDS` times.  A round
+whose first halving alone puts the share above the limit (``2 d1``, the smaller of the two bounds, the tables'
+parts added) refines without the second halving, which could only raise the estimate; its share is recorded as
+that lower bound (``halvings`` 1 in its round).
 Adopting all of ``T'`` solves more cells for the same share (``scripts/two_scale_table_share.py`` sets the two
 side by side).  Beyond :data:`MAX_ROUNDS` rounds, or past the table's bound on its cell solves, the tolerance is
 out of reach and the run ends with its figures (a :class:`~ngcontact.errors.ConvergenceError`, exit 3).  The rest of
@@ -42,22 +45,36 @@ of the scene reproduces the first and estimates its share without a cell solve.
 
 A cell with micro friction has a second table, the shear table of :mod:`ngcontact.coupling.shear_table`
 (rows ``s -> tau`` at pressures, the macro law's tangential part).  Its share is estimated the same way, each
-table on its own (the other held at its nodes): the rows' pressure intervals holding the interface's pressures,
-and one more on either side, get a row at their middle, and every row in that range its jump intervals halved up
-to the one holding the interface's largest ``|s| / p`` carried to it along the ray, and one more
-(:func:`shear_loads`); twice, as above.  The errors of the two tables add, ``e_Q = e_Q(pressure table) +
-e_Q(shear table)``; each table's part is reported (``parts``).  While the sum exceeds the limit, every table
-whose part exceeds its even share of the limit (at least the larger) is refined; the shear table's first
-midpoints all become nodes (:data:`SHEAR_MARK` = 0): marked by its own error (a row's discrepancy against its
-neighbours carried along the rays, a jump node's against the row's polyline) its share stalled on the frictional
-block of ``scripts/two_scale_table_share.py``, its own largest error lying where the macro quantities feel it
-least.  A halving of the shear table costs several times its nodes in cell solves (both directions), against
-the pressure table's one per interval.
+table on its own (the other held at its nodes), and the shear table in each of its two directions on its own:
+in the pressure, the rows' pressure intervals holding the interface's pressures, and one more on either side,
+get a row at their middle (at the far-face jumps of a neighbour carried along the ray); in the jump, every row
+in that range its jump intervals halved (:func:`shear_loads`); twice, as above.  The law's error is the sum of
+the two directions' exactly, ``T - tau = (I_p tau - tau) + I_p (T_i - tau_i)``: the rows interpolated in ``p``
+(``I_p``, along the rays) less the cell's response, plus the rows' polyline errors interpolated so; halving
+the rows changes the first, halving the rows' intervals the second.  Halved in both at once, each level would
+cost the product (four times the visited nodes, sixteen the second level); one direction at a time, twice and
+four times.  In the jump only the intervals up to the one holding the largest ``|s| / p`` of the interface's
+points that use the row, carried to it along the ray, and one more: the law at a point of pressure ``p`` in
+``[p_i, p_i+1]`` reads the rows ``i`` and ``i + 1`` only, at ``s p_i / p`` and ``s p_i+1 / p``, so a row's
+jumps in use are those of the points in the pressure intervals beside it (and, for the points between the
+samples where the law is integrated, in theirs).  The interface's largest ``|s| / p`` instead is unbounded at
+the contact's edge (``p -> 0``) and took every interval of every row in range.  A new row likewise ends one
+interval beyond the furthest its points reach (beyond its last node the law holds its shear; no point of the
+interface is there); made a node it is made whole (:func:`whole_rows`), so that the table's rows reach as far
+as before and its cover (:meth:`~ngcontact.coupling.shear_table.ShearTable.cover`) and a second run of the
+scene solve no cell for it.  The parts add, ``e_Q = e_Q(pressure table) + e_Q(shear table, pressure) +
+e_Q(shear table, jump)``; each part is reported (``parts``).  While the sum exceeds the limit, every part that
+exceeds its even share of the limit (at least the largest) is refined, so the shear table in the direction
+where its error reaches the macro quantities; that direction's first midpoints all become nodes
+(:data:`SHEAR_MARK` = 0): marked by its own error (a row's discrepancy against its neighbours carried along the
+rays, a jump node's against the row's polyline) its share stalled on the frictional block of
+``scripts/two_scale_table_share.py``, its own largest error lying where the macro quantities feel it least.
 
 Where the scene has a strength check, its safety factor (eq. 78 by the linear recovery) is a headline quantity
 of the share too: its correctors are the strength cell's and depend on the law only through whether it has a
 tangential part, which no table refinement changes, so each estimate's solve gives its safety factor at the cost
-of one linear recovery.
+of one linear recovery.  So are the maxima away from the bodies' singular points (the caller's ``measure``:
+:meth:`ngcontact.drivers.run_two_scale.Relevel.table_share`).
 """
 from __future__ import annotations
 
@@ -92,7 +109,7 @@ MARK = 0.5
 SHEAR_MARK = 0.0
 #: what the report's ``how`` says
 HOW = ("the table's intervals holding the macro interface's pressures (and one more on either side; with a shear "
-       "table also its rows' pressure and jump intervals the interface uses) halved "
+       "table also its rows' pressure and jump intervals the interface uses, one direction at a time) halved "
        "twice (one cell solve at each midpoint) and the macro problem solved again with each law: the larger of "
        "twice the first change of each headline quantity and the first change plus twice the second (the "
        "monotone cubic's error at least halves with its intervals; ngcontact.coupling.table_share)")
@@ -118,11 +135,10 @@ class PressurePart(_Part):
     def nodes(self, level: CellTable | None = None) -> int:
         return len((level or self.table).values)
 
-    def levels(self, sol: M.MacroSolution, points_per_element: int) -> list[CellTable]:
+    def finer(self, sol: M.MacroSolution, points_per_element: int, of: CellTable | None = None) -> CellTable:
+        """``of`` (default the table) halved where ``sol``'s interface uses it, held by the table."""
         p = interface_samples(sol, points_per_element)["pressure"]
-        p = p[p > 0]
-        once = _finer(self.table, dict(self.table.values), p)
-        return [once, _finer(self.table, dict(once.values), p)]
+        return _finer(self.table, dict((of or self.table).values), p[p > 0])
 
     @staticmethod
     def law(level: CellTable, law: il.InterfaceLaw) -> il.InterfaceLaw:
@@ -140,18 +156,25 @@ class PressurePart(_Part):
 
 
 class ShearPart(_Part):
-    """The shear table as a part of the share (module docstring)."""
+    """The shear table halved in one ``direction`` (``"pressure"``: new rows; ``"jump"``: the rows' intervals) as a
+    part of the share (module docstring)."""
 
-    name = "shear_table"
     table: ShearTable
+
+    def __init__(self, table: ShearTable, direction: str):
+        super().__init__(table)
+        self.direction = direction
+        self.name = f"shear_table_in_{direction}"
 
     def nodes(self, level: ShearTable | None = None) -> int:
         return sum(len(r) for r in (level or self.table).rows.values())
 
-    def levels(self, sol: M.MacroSolution, points_per_element: int) -> list[ShearTable]:
+    def finer(self, sol: M.MacroSolution, points_per_element: int, of: ShearTable | None = None) -> ShearTable:
+        """``of`` (default the table) halved in :attr:`direction` where ``sol``'s interface uses it, held by the
+        table."""
         prof = interface_profile(sol, points_per_element)
-        once = shear_finer(self.table, prof["pressure"], prof["jump_t"])
-        return [once, shear_finer(once, prof["pressure"], prof["jump_t"], keeper=self.table)]
+        return shear_finer(of or self.table, prof["pressure"], prof["jump_t"], keeper=self.table,
+                           direction=self.direction)
 
     @staticmethod
     def law(level: ShearTable, law: il.InterfaceLaw) -> il.InterfaceLaw:
@@ -163,18 +186,36 @@ class ShearPart(_Part):
         groups = shear_own_errors(self.table, level)
         top = max((e for e, _ in groups), default=0.0)
         loads = [x for e, g in groups if e >= SHEAR_MARK * top for x in g]
+        loads = sorted(set(loads) | set(whole_rows(self.table, {q for q, _ in loads} - set(self.table.rows))))
         self.table._solve(loads)
         return len(loads)
 
 
-def shear_loads(table: ShearTable, pressures: np.ndarray, jumps: np.ndarray, margin: int = 1) -> list[ShearLoad]:
+def _rays(P: np.ndarray, p: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Per pressure interval ``i`` of ``P`` (``lo <= i <= hi``) the largest ``|s| / p`` of the samples in it or in
+    its neighbours (a margin for the points between the samples, where the macro law is integrated)."""
+    k = np.clip(np.searchsorted(P, p, side="right") - 1, 0, len(P) - 2)
+    own = np.zeros(len(P) - 1)
+    np.maximum.at(own, k, s / p)
+    wide = np.maximum(own, np.maximum(np.concatenate([[0.0], own[:-1]]), np.concatenate([own[1:], [0.0]])))
+    return wide
+
+
+def shear_loads(table: ShearTable, pressures: np.ndarray, jumps: np.ndarray, margin: int = 1,
+                whole: bool = False, direction: str = "both") -> list[ShearLoad]:
     """The cell loads that halve ``table`` where a macro interface with ``pressures`` and tangential ``jumps`` [m]
     uses it (module docstring): a row at the middle of every pressure interval (the law's zero row at ``p = 0``
     included) from the one holding the least pressure to the one holding the largest and ``margin`` more on
-    either side, with the far-face jumps of its neighbour of more nodes carried along the ray ``s / p``; and on
-    every row in that range, new rows too, the middle of every jump interval up to the one holding the
-    interface's largest ``|s| / p`` carried to the row, and ``margin`` more (a flat interval of a monotone row,
-    exact, is not halved)."""
+    either side, at the far-face jumps of its neighbour of more nodes carried along the ray ``s / p``; on every
+    row in that range, new rows too, the middle of every jump interval up to the one holding the largest
+    ``|s| / p`` of the interface's points that use the row (those in the pressure intervals beside it, and in
+    theirs: :func:`_rays`) carried to it, and ``margin`` more (a flat interval of a monotone row, exact, is not
+    halved).  A new row ends there (its last node at the end of its last halved interval; beyond it the law holds
+    its shear, where no point of the interface is).  ``whole``: every interval of those rows and whole new rows
+    (the oracle's finer tables); ``direction``: ``"pressure"`` the new rows alone (at their first nodes),
+    ``"jump"`` the halved intervals of the rows there are alone, ``"both"`` all."""
+    if direction not in ("pressure", "jump", "both"):
+        raise ValueError(f"direction {direction!r}: 'pressure', 'jump' or 'both'")
     keep = np.asarray(pressures, float) > 0
     p, s = np.asarray(pressures, float)[keep], np.abs(np.asarray(jumps, float)[keep])
     if not len(p) or not table.rows:
@@ -182,30 +223,51 @@ def shear_loads(table: ShearTable, pressures: np.ndarray, jumps: np.ndarray, mar
     P = np.concatenate([[0.0], table.pressures])
     k = np.clip(np.searchsorted(P, [p.min(), p.max()], side="right") - 1, 0, len(P) - 2)
     lo, hi = max(int(k[0]) - margin, 0), min(int(k[1]) + margin, len(P) - 2)
-    ray = float(np.max(s / p))
-    rows = {float(q): (float(q), table.row(float(q))[0]) for q in P[lo:hi + 2] if q > 0}
+    R = np.full(len(P) - 1, np.inf) if whole else _rays(P, p, s)
+    # per row: (the row whose nodes it has, its far-face jumps, the largest ray of the points that use it)
+    rows = {float(P[i]): (float(P[i]), table.row(float(P[i]))[0], max(R[i - 1], R[i] if i < len(R) else 0.0))
+            for i in range(max(lo, 1), hi + 2)}
     for i in range(lo, hi + 1):
         m = 0.5 * (P[i] + P[i + 1])
         near = max((q for q in (P[i], P[i + 1]) if q > 0), key=lambda q: len(table.rows[q]))
-        rows[float(m)] = (near, table.row(near)[0] * m / near)
-    loads = [(q, float(d)) for q, (_, d_q) in rows.items() if q not in table.rows for d in d_q[1:]]
-    for q, (near, d_q) in rows.items():
+        rows[float(m)] = (float(near), table.row(near)[0] * m / near, R[i])
+    loads = []
+    for q, (near, d_q, ray) in rows.items():
         d_n, s_n, _ = table.row(near)
         j = min(int(np.searchsorted(s_n, ray * near, side="right")) + margin, len(d_q) - 1)
-        loads += [(q, float(0.5 * (a + b))) for a, b, a0, b0 in zip(d_q[:j], d_q[1:j + 1], d_n[:j], d_n[1:j + 1])
-                  if not table._flat(near, float(a0), float(b0))]
+        new = q not in table.rows
+        if new and direction != "jump":
+            loads += [(q, float(d)) for d in d_q[1:j + 1]]
+        if direction == "both" or (direction == "jump" and not new):
+            loads += [(q, float(0.5 * (a + b))) for a, b, a0, b0 in zip(d_q[:j], d_q[1:j + 1], d_n[:j],
+                                                                           d_n[1:j + 1])
+                      if not table._flat(near, float(a0), float(b0))]
     return loads
 
 
-def shear_finer(table: ShearTable, pressures: np.ndarray, jumps: np.ndarray, keeper: ShearTable | None = None
-                ) -> ShearTable:
+def shear_finer(table: ShearTable, pressures: np.ndarray, jumps: np.ndarray, keeper: ShearTable | None = None,
+                whole: bool = False, direction: str = "both") -> ShearTable:
     """A copy of ``table`` halved where ``pressures`` and ``jumps`` use it (:func:`shear_loads`), its new
     responses held by ``keeper`` (default ``table``)."""
-    got = (keeper or table).hold(shear_loads(table, pressures, jumps))
+    got = (keeper or table).hold(shear_loads(table, pressures, jumps, whole=whole, direction=direction))
     rows = {p: dict(r) for p, r in table.rows.items()}
     for (p, d), v in got.items():
         rows.setdefault(p, {0.0: (0.0, 0.0)})[d] = v
     return ShearTable(table.response, table.tol, table.length_unit, map_tasks=table.map_tasks, rows=rows)
+
+
+def whole_rows(table: ShearTable, new: set[float]) -> list[ShearLoad]:
+    """The loads that make rows of ``table`` at the new pressures ``new`` whole: all far-face jumps of the row
+    beside each of more nodes, carried along the ray (as :func:`shear_loads` made its first ones).  A row made
+    so reaches as far as its neighbours, and the table's cover (:meth:`ShearTable.cover`) finds it as it finds
+    them (a second run of the scene solves no cell for it)."""
+    P = table.pressures
+    loads = []
+    for q in sorted(new):
+        i = int(np.searchsorted(P, q))
+        near = max((float(x) for x in P[max(i - 1, 0):i + 1]), key=lambda x: len(table.rows[x]))
+        loads += [(q, float(d)) for d in table.row(near)[0][1:] * q / near]
+    return loads
 
 
 def shear_own_errors(table: ShearTable, level: ShearTable) -> list[tuple[float, list[ShearLoad]]]:
@@ -223,7 +285,7 @@ def shear_own_errors(table: ShearTable, level: ShearTable) -> list[tuple[float, 
         f = (q - lo) / (hi - lo)
         guess = f * table.along_ray(hi, q, s) + ((1 - f) * table.along_ray(lo, q, s) if lo > 0 else 0.0)
         out.append((float(np.max(np.abs(t - guess))) / scale, [(q, d) for d in level.rows[q] if d != 0.0]))
-    for p in table.rows:
+    for p in set(table.rows) & set(level.rows):
         _, s, t = table.row(p)
         for d in sorted(set(level.rows[p]) - set(table.rows[p])):
             sm, tm = level.rows[p][d]
@@ -297,27 +359,34 @@ def estimate(sol: M.MacroSolution, parts: CellTable | Sequence[PressurePart | Sh
     tables: list[Any] = [PressurePart(parts)] if isinstance(parts, CellTable) else list(parts)
     rounds: list[dict[str, Any]] = []
     own = measure(sol)
+    limit = FRACTION * tolerance
     while True:
-        solves = sum(part.solves for part in tables)
+        solves = _solves(tables)
+        levels: dict[str, list[Any]] = {part.name: [] for part in tables}
+        found: dict[str, list[tuple[M.MacroSolution, dict[str, Sample]]]] = {part.name: [] for part in tables}
+        for step in range(2):
+            for part in tables:
+                try:
+                    level = part.finer(sol, points_per_element, *levels[part.name][-1:])
+                except ConvergenceError as err:
+                    raise ConvergenceError(_out_of_reach(tolerance, rounds, str(err)),
+                                           {"table_share": rounds}) from None
+                got = solve(M.replace_law(sol.problem, part.law(level, sol.problem.law)), sol.gfu.vec)
+                levels[part.name].append(level)
+                found[part.name].append((got, measure(got)))
+            if step == 0 and refine and _first_bound(own, found) > limit:
+                break                               # refined in any case: the second halving would not decide it
         by_part: dict[str, dict[str, float]] = {}
-        first: dict[str, tuple[Any, M.MacroSolution, dict[str, Sample]]] = {}
         record: dict[str, dict[str, Any]] = {}
         second_larger: set[str] = set()
         for part in tables:
-            try:
-                levels = part.levels(sol, points_per_element)
-            except ConvergenceError as err:
-                raise ConvergenceError(_out_of_reach(tolerance, rounds, str(err)),
-                                       {"table_share": rounds}) from None
-            solutions = [solve(M.replace_law(sol.problem, part.law(lv, sol.problem.law)), sol.gfu.vec)
-                         for lv in levels]
-            once, twice = (measure(s) for s in solutions)
-            d1, d2 = _changes(own, once), _changes(once, twice)
+            once = found[part.name][0][1]
+            d1 = _changes(own, once)
+            d2 = _changes(once, found[part.name][1][1]) if len(found[part.name]) > 1 else {}
             by_part[part.name] = {k: max(FACTOR * d1[k], d1[k] + FACTOR * d2.get(k, 0.0)) for k in d1}
             second_larger |= {k for k in d1 if d1[k] + FACTOR * d2.get(k, 0.0) > FACTOR * d1[k]
                               and own[k].magnitude > 0 and by_part[part.name][k] / own[k].magnitude > 1e-12}
-            first[part.name] = (levels[0], solutions[0], once)
-            sizes = [part.nodes()] + [part.nodes(lv) for lv in levels]
+            sizes = [part.nodes()] + [part.nodes(lv) for lv in levels[part.name]]
             record[part.name] = {"nodes": sizes[0], "midpoints": [b - a for a, b in zip(sizes, sizes[1:])]}
         errors = {k: sum(e.get(k, 0.0) for e in by_part.values()) for k in own if k in by_part[tables[0].name]}
         shares = {k: e / own[k].magnitude for k, e in errors.items() if own[k].magnitude > 0}
@@ -327,10 +396,12 @@ def estimate(sol: M.MacroSolution, parts: CellTable | Sequence[PressurePart | Sh
         for name, q in part_shares.items():
             record[name]["share"] = max(q.values(), default=0.0)
         rounds.append({"nodes": {n: r["nodes"] for n, r in record.items()}, "parts": record,
-                       "cell_solves": sum(part.solves for part in tables) - solves, "share": share.share,
-                       "largest_in": _largest(shares), "second_halving_larger": sorted(second_larger)})
-        progress.info("cell tables: %s; their share of the macro quantities %.3g (limit %.3g)",
-                      ", ".join(f"{n} {r['nodes']} nodes" for n, r in record.items()), share.share, share.limit)
+                       "cell_solves": _solves(tables) - solves, "share": share.share,
+                       "largest_in": _largest(shares), "second_halving_larger": sorted(second_larger),
+                       "halvings": len(found[tables[0].name])})
+        progress.info("cell tables: %s; their share of the macro quantities %s%.3g (limit %.3g)",
+                      ", ".join(f"{n} {r['nodes']} nodes" for n, r in record.items()),
+                      "at least " if rounds[-1]["halvings"] < 2 else "", share.share, share.limit)
         if not refine or share.share <= share.limit:
             return share
         if len(rounds) >= MAX_ROUNDS:
@@ -339,15 +410,27 @@ def estimate(sol: M.MacroSolution, parts: CellTable | Sequence[PressurePart | Sh
         even = share.limit / len(tables)
         chosen = [p for p in tables if record[p.name]["share"] > even] or \
             [max(tables, key=lambda p: record[p.name]["share"])]
-        rounds[-1]["halved"] = {p.name: p.adopt(first[p.name][0]) for p in chosen}
+        rounds[-1]["halved"] = {p.name: p.adopt(levels[p.name][0]) for p in chosen}
         if len(chosen) == 1 and rounds[-1]["halved"][chosen[0].name] == record[chosen[0].name]["midpoints"][0]:
-            sol, own = first[chosen[0].name][1], first[chosen[0].name][2]     # all of T' adopted: solved already
+            sol, own = found[chosen[0].name][0]     # all of T' adopted: solved already
         else:
             law = sol.problem.law
             for part in chosen:
                 law = part.law(part.table, law)
-            sol = solve(M.replace_law(sol.problem, law), first[chosen[0].name][1].gfu.vec)
+            sol = solve(M.replace_law(sol.problem, law), found[chosen[0].name][0][0].gfu.vec)
             own = measure(sol)
+
+
+def _solves(tables: Sequence[Any]) -> int:
+    """The cell solves of the parts' tables (two parts may halve one table)."""
+    return sum(t.solves for t in {id(part.table): part.table for part in tables}.values())
+
+
+def _first_bound(own: dict[str, Sample], found: dict[str, list[tuple[M.MacroSolution, dict[str, Sample]]]]
+                 ) -> float:
+    """The share by the first halving alone (twice its change, the parts added): a lower bound of the estimate."""
+    err = {k: sum(FACTOR * _changes(own, f[0][1]).get(k, 0.0) for f in found.values()) for k in own}
+    return max((e / own[k].magnitude for k, e in err.items() if own[k].magnitude > 0), default=0.0)
 
 
 def _out_of_reach(tolerance: float, rounds: list[dict[str, Any]], why: str) -> str:

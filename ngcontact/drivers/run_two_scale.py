@@ -62,6 +62,7 @@ from ngcontact.coupling import shear_table as S
 from ngcontact.coupling import pressure_table as PT
 from ngcontact.coupling import table_share as TS
 from ngcontact.coupling import two_scale as T
+from ngcontact.macro import away_maxima as AM
 from ngcontact.macro import discretization_error as DE
 from ngcontact.macro.macro_measures import interface_samples
 from ngcontact.scene import cell_links
@@ -283,6 +284,8 @@ class Relevel:
         self.write_back = write_back
         self.share: TS.TableShare | None = None
         self.safety = None   # the strength check's safety factor, a quantity of the share (table_share)
+        self.radius = getattr(scene.discretization, "exclusion_radius", None)
+        self.exclusion: AM.Exclusion | None | bool = False   # the balls of the maxima away (table_share)
         self.shared_at = 0   # the mesh levels run when the share was estimated
 
     def __call__(self, problem, start=None):
@@ -302,19 +305,27 @@ class Relevel:
         pressure table's and, with one, the shear table's), with ``refine`` the tables refined until it is below
         its fraction of ``tolerance``; the tables are written back to the cache either way.  ``safety``: the
         strength check's :class:`~ngcontact.drivers.macro_accuracy.SafetyFactor`, whose ``safety_factor`` is
-        then a quantity of the share too (kept from the first call).  Returns the answer's solution."""
+        then a quantity of the share too (kept from the first call).  Where the bodies have singular points, the
+        maxima away from them (``*_away``, :mod:`ngcontact.macro.away_maxima`, and the safety factor away) are
+        quantities of the share as well, outside the balls of the first call's solution (the same set at every
+        level; the points a macro refinement finds later are not among them).  Returns the answer's solution."""
         component = next(n for n in DE.headlines(sol, self.output.points_per_element)
                          if n.startswith("resultant_")).removeprefix("resultant_")
         self.safety = safety if safety is not None else self.safety
+        if self.exclusion is False:
+            self.exclusion = AM.exclusion_of(sol, self.radius)
+        exclusion = self.exclusion if isinstance(self.exclusion, AM.Exclusion) else None
 
         def measure(s):
             out = DE.headlines(s, self.output.points_per_element, component)
+            if exclusion is not None:
+                out.update(AM.away_maxima(s, exclusion))
             if self.safety is not None:
-                out["safety_factor"] = self.safety.samples(s, None)["safety_factor"]
+                out.update(self.safety.samples(s, None if exclusion is None else exclusion.outside))
             return out
         parts: list = [TS.PressurePart(self.table)]
         if self.shear is not None and self.shear.rows:
-            parts.append(TS.ShearPart(self.shear))
+            parts += [TS.ShearPart(self.shear, "pressure"), TS.ShearPart(self.shear, "jump")]
         try:
             self.share = TS.estimate(sol, parts, self.solve, measure, tolerance, self.output.points_per_element,
                                      refine)
