@@ -14,8 +14,9 @@ CPU seconds).  Its refinement along the contact edge
 patch width, the bodies at ``maxh`` 0.3, :mod:`ngcontact.drivers.contact_edge_refiner`)
 reports the contact fraction extrapolated in the edge size with its grid
 convergence index (:mod:`ngcontact.cell.fe.edge_size_extrapolation`).  The converged
-value is the spectral cell's contact fraction extrapolated from ``512^2``
-and ``1024^2`` (as in ``bisinusoid_accuracy.py``).
+value is the spectral cell's contact fraction extrapolated from ``1024^2``
+and ``2048^2`` (``REF_GRIDS`` of ``bisinusoid_accuracy.py``, whose docstring says
+why not ``512^2``).
 
     python scripts/bisinusoid_scene_accuracy.py [OUT] [--ratios 0.005 0.02 0.05] [--symmetry default] [--publish]
 
@@ -34,7 +35,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
-from bisinusoid_accuracy import ACC_H, bisinusoid_spectral  # noqa: E402
+from bisinusoid_accuracy import ACC_H, REF_GRIDS, bisinusoid_spectral  # noqa: E402
 
 RATIOS = (0.005, 0.02, 0.05)
 KEYS = ("pressure", "symmetry", "levels", "ndof", "contact_fraction", "last_level", "converged", "relative_error",
@@ -70,14 +71,14 @@ tolerance = 0.01
 
 
 def converged(ratio: float) -> dict[str, float]:
-    """The spectral cell's headline quantities at ``p/p* = ratio`` extrapolated from 512^2 and 1024^2 (its
+    """The spectral cell's headline quantities at ``p/p* = ratio`` extrapolated from :data:`REF_GRIDS` (its
     contact fraction, closure, normal stiffness and eq. 34 coefficients converge at first order in the grid
     step); its ``k_n`` is 1, and the coefficients ``k_n``, ``g_n`` of exact contact are proportional to it
     (the contact set does not depend on it): :func:`finish` scales them by the scene's."""
     from ngcontact.cell.cell_load import cell_load
     from ngcontact.cell.cell_solution import headline
     load = cell_load(3, pressure=ratio * math.pi * ACC_H)
-    coarse, fine = (headline(bisinusoid_spectral(n).solve(load).results) for n in (512, 1024))
+    coarse, fine = (headline(bisinusoid_spectral(n).solve(load).results) for n in REF_GRIDS)
     return {name: 2.0 * fine[name] - coarse[name] for name in fine if name in coarse}
 
 
@@ -187,8 +188,9 @@ def main(argv=None) -> int:
             "spectral twin, the twin's grid step at most the edge size) reports the contact fraction "
             "extrapolated in the edge size from its last three refined levels "
             "(`last_level`: the last level's own value) with the grid convergence index as `estimate` "
-            "(relative); `relative_error` against `converged` (the spectral cell extrapolated from 512^2 and "
-            "1024^2); `effectivity` = estimate / |error| (issue 35: within [1, 10]); `met`: the report's verdict "
+            "(relative); `relative_error` against `converged` (the spectral cell extrapolated from "
+            f"{REF_GRIDS[0]}^2 and {REF_GRIDS[1]}^2); `effectivity` = estimate / |error| (issue 35: within [1, 10]); "
+            "`met`: the report's verdict "
             "(`exit 3`: the tolerance out of reach, no report, `note` its message) on the scene's tolerance "
             "(absolute 0.01 on the contact fraction, relative on the closure, the "
             "stiffness and the coefficients). `effectivity_closure`, `_stiffness`, `_k_n`, `_g_n`: the report's "

@@ -582,7 +582,7 @@ def main(argv=None) -> int:
                                    "over the sizes listed, `estimate` its estimated relative error as the contact-"
                                    "edge ladder of `ngcontact run` makes it, the larger of `estimate_gci` (the "
                                    "grid convergence index of the extrapolation) and `estimate_twin` (the spectral "
-                                   "twin's floor |q - q_N| + 2 |q_N - q_N/2|, N the twin's grid of the finest edge "
+                                   "twin's floor |q - q_N| + 2 |q_N - q_N/2|, N = 2048 whatever the finest edge "
                                    "size), `effectivity` = estimate / |relative_error|) or, order 1, "
                                    "along the edge and in the bodies below and above the patch (`patch-refined`, "
                                    "`size`: edge a/N_EDGE, bodies a/N_BODY to DEPTH a, a the twin's patch radius; "
@@ -591,7 +591,7 @@ def main(argv=None) -> int:
                                    "same sizes, zero normal displacement on the quarter's mirror faces), "
                                    "per `pressure` = p/p* "
                                    "(p* = pi E* h, h = 0.01, E* = 1), `relative_error` of the contact fraction "
-                                   "against the spectral cell extrapolated from 512^2 and 1024^2 (issue 38 aims "
+                                   "against the spectral cell extrapolated from 1024^2 and 2048^2 (issue 38 aims "
                                    "at 1 % in 60 s; seconds: twin, meshing and solve, each on its own in "
                                    "`twin_seconds`, `mesh_seconds`, `solve_seconds`" + (
                                        f", {args.accuracy_threads} thread(s)" if args.accuracy_threads else "") +

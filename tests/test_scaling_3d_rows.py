@@ -61,17 +61,17 @@ def test_the_note_numbers_the_kept_rows_then_the_new_ones(tmp_path, monkeypatch)
 
 def test_an_extrapolation_carries_the_ladders_estimate():
     """The extrapolated row's estimate is the contact-edge ladder's: the larger of the grid convergence index and
-    the spectral twin's floor |q - q_N| + 2 |q_N - q_N/2| on the twin's grid N of the finest edge size (512 at
-    0.0025), each in its own column."""
+    the spectral twin's floor |q - q_N| + 2 |q_N - q_N/2| on the ladder's floor grid N (FLOOR_GRID = 2048,
+    whatever the finest edge size), each in its own column."""
     import bisinusoid_accuracy as B
     rows = [_row(0.01, 0.0152), _row(0.005, 0.01485), _row(0.0025, 0.014725)]
     asked = []
 
-    def twin(grid, ratio, values={512: 0.0147, 256: 0.0146}):
+    def twin(grid, ratio, values={2048: 0.0147, 1024: 0.0146}):
         asked.append((grid, ratio))
         return values[grid]
     (row,) = B.extrapolated_rows(rows, {0.005: 0.0147}, twin)
-    assert sorted(asked) == [(256, 0.005), (512, 0.005)]
+    assert sorted(asked) == [(1024, 0.005), (2048, 0.005)]
     q = row["contact_fraction"]
     assert row["estimate_twin"] == pytest.approx((abs(q - 0.0147) + 2 * 0.0001) / q, rel=1e-12)
     assert row["estimate"] == max(row["estimate_gci"], row["estimate_twin"])

@@ -90,9 +90,10 @@ def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any]
     def heads(grid: int):
         return [headline(s.results) for s in twin(grid)]
 
-    def cell_at(points, edge_maxh):
+    def cell_at(points, edge_maxh, grading):
         cell = edge_refined_cell(points, edge_maxh=edge_maxh, period=g.period, h_rough=g.h_rough,
-                                 h_counter=g.h_counter, maxh=bulk, interface_maxh=h, symmetric=symmetric)
+                                 h_counter=g.h_counter, maxh=bulk, interface_maxh=h, symmetric=symmetric,
+                                 grading=grading)
         grid = twin_grid(edge_maxh, float(g.period))
         twin(grid)
         return FECell.of(problem(scene, cell, model, predictor=SpectralStart(cells[grid])))

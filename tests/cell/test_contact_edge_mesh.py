@@ -43,6 +43,19 @@ def test_edge_maxh_beyond_the_interface_size_is_refused():
         edge_refined_cell(np.zeros((0, 2)), edge_maxh=0.3, maxh=0.4, interface_maxh=0.2)
 
 
+def test_the_grading_is_netgens_and_a_smaller_one_meshes_finer_away_from_the_edge():
+    """``grading`` outside (0, 1] is refused by name; the default is Netgen's 0.3, and 0.15 grows the elements
+    more slowly away from the same edge points: more of them, the size at the edge the same."""
+    pts = np.array([[0.5, 0.5 + 0.1 * c] for c in (-1.0, 1.0)])
+    for bad in (0.0, -0.1, 1.5, float("nan")):
+        with pytest.raises(GeometryError, match="grading"):
+            edge_refined_cell(pts, edge_maxh=0.02, maxh=0.4, interface_maxh=0.2, grading=bad)
+    sizes = dict(edge_maxh=0.02, maxh=0.4, interface_maxh=0.2)
+    default = edge_refined_cell(pts, **sizes).mesh.ne
+    assert edge_refined_cell(pts, grading=0.3, **sizes).mesh.ne == default
+    assert edge_refined_cell(pts, grading=0.15, **sizes).mesh.ne > 1.5 * default
+
+
 def test_patch_body_on_the_contact_points_of_a_disk():
     """The points of a disk's grid, thinned to one per ``maxh``, inside the disk; the layers' heights 0 and
     +-k LAYER_SPACING maxh to the depth; the radius of one patch of the disk's area."""

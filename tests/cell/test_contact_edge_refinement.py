@@ -83,14 +83,18 @@ def test_the_edge_sizes_scale_with_the_narrowest_patch_and_the_twin_resolves_the
         asked.append(grid)
         return [_disk(grid, 0.08), _disk(grid, 0.15)]
 
-    ladder = ContactEdgeRefinement(None, pressures, lambda points, h: (points, h), interface_maxh=0.1, period=1.0)
+    ladder = ContactEdgeRefinement(None, pressures, lambda points, h, grading: (points, h), interface_maxh=0.1,
+                                   period=1.0)
     assert ladder.edge_maxh(1) == pytest.approx(0.08 / EDGE_CELLS, rel=0.03)
     assert ladder.edge_maxh(3) == pytest.approx(ladder.edge_maxh(1) / 4)
     points, h = ladder.level(3)
     assert h == ladder.edge_maxh(3) and 1.0 / twin_grid(h, 1.0) <= h and asked == [256, twin_grid(h, 1.0)]
     assert len(points) > len(ladder.points(1))
     assert twin_grid(0.0025, 1.0) == 512 and twin_grid(0.1, 1.0) == 256 and twin_grid(1e-4, 1.0) == 1024
-    wide = ContactEdgeRefinement(None, lambda grid: [_disk(grid, 0.4)], lambda p, h: h, 0.05, 1.0)
+    wide = ContactEdgeRefinement(None, lambda grid: [_disk(grid, 0.4)], lambda p, h, grading: h, 0.05, 1.0)
     assert [wide.edge_maxh(k) for k in (1, 2)] == [0.025, 0.0125]     # the halving's sizes where l/10 is coarser
-    flat = ContactEdgeRefinement(None, lambda grid: [np.zeros((grid, grid))], lambda p, h: h, 0.1, 1.0)
+    flat = ContactEdgeRefinement(None, lambda grid: [np.zeros((grid, grid))], lambda p, h, grading: h, 0.1, 1.0)
+    graded = ContactEdgeRefinement(None, lambda grid: [np.zeros((grid, grid))], lambda p, h, g: g, 0.1, 1.0,
+                                   grading=0.2)
+    assert graded.level(1) == graded.level(3) == 0.2 and flat.grading == 0.3      # every level's, Netgen's
     assert flat.edge_maxh(2) == pytest.approx(0.025) and not flat.ready(3) and flat.ready(4)

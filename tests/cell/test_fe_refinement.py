@@ -141,7 +141,8 @@ def test_the_contact_edge_ladder_reports_the_contact_fraction_extrapolated_in_th
     estimate the grid convergence index (1.25 x the correction), the last level's own value beside it; the
     closure keeps the geometric tail."""
     from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
-    ladder = ContactEdgeRefinement(_Level(1000, 0.6), lambda grid: [], lambda points, h: _Level(1000, 0.5 + 0.2 * h),
+    ladder = ContactEdgeRefinement(_Level(1000, 0.6), lambda grid: [],
+                                   lambda points, h, grading: _Level(1000, 0.5 + 0.2 * h),
                                    interface_maxh=0.1, period=1.0)
     done = refine(ladder, [None], 0.005, 10 ** 9, required=True)
     assert len(done.levels) == 4 and done.met          # three refined levels: edge sizes 0.05, 0.025, 0.0125
@@ -154,38 +155,41 @@ def test_the_contact_edge_ladder_reports_the_contact_fraction_extrapolated_in_th
 
 def test_the_contact_edge_ladder_takes_its_spectral_twins_floor_where_larger():
     """The ladder's closure does not change with the edge size (its geometric tail: zero), but the twin,
-    the same continuum problem, answers 1.01 on its last level's grid (256 points, the edge sizes here are
-    above the grid's step) and 1.012 on half that: the closure's estimate is the floor
+    the same continuum problem, answers 1.01 on the floor's grid (FLOOR_GRID points, whatever grid places the
+    level's edge) and 1.012 on half that: the closure's estimate is the floor
     ``|1 - 1.01| + 2 |1.01 - 1.012| = 0.014`` (relative), named in the record; the contact fraction, whose
     twin agrees with its extrapolation, keeps the extrapolation's estimate."""
-    from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
+    from ngcontact.cell.fe.contact_edge_refinement import FLOOR_GRID, ContactEdgeRefinement
     asked = []
 
     def twin_heads(grid):
         asked.append(grid)
-        return [{"contact_fraction": 0.5, "mean_closure": 1.01 if grid == 256 else 1.012}]
+        return [{"contact_fraction": 0.5, "mean_closure": 1.01 if grid == FLOOR_GRID else 1.012}]
 
-    ladder = ContactEdgeRefinement(_Level(1000, 0.6), lambda grid: [], lambda points, h: _Level(1000, 0.5 + 0.2 * h),
+    ladder = ContactEdgeRefinement(_Level(1000, 0.6), lambda grid: [],
+                                   lambda points, h, grading: _Level(1000, 0.5 + 0.2 * h),
                                    interface_maxh=0.1, period=1.0, twin_heads=twin_heads)
     done = refine(ladder, [None], 0.05, 10 ** 9, required=True)
-    assert len(done.levels) == 4 and done.met and set(asked) == {256, 128}
+    assert len(done.levels) == 4 and done.met and set(asked) == {FLOOR_GRID, FLOOR_GRID // 2}
     assert done.estimates[0]["mean_closure"] == pytest.approx(0.014, rel=1e-9)
     assert done.estimates[0]["contact_fraction"] == pytest.approx(1.25 * 0.0025, rel=1e-9)
-    assert "load 0 mean_closure: 0 raised to the spectral twin: |q - q_N| + 2 |q_N - q_N/2|, N = 256" in done.how
+    assert ("load 0 mean_closure: 0 raised to the spectral twin: |q - q_N| + 2 |q_N - q_N/2|, "
+            f"N = {FLOOR_GRID}") in done.how
     assert "load 0 contact_fraction: " not in done.how.replace("load 0 contact_fraction: extrapolated", "")
 
 
 def test_the_twin_floors_the_normal_coefficients_of_eq_34_too():
     """The floor ``|q_h - q_N| + 2 |q_N - q_N/2|`` of each floored quantity, the coefficients ``k_n`` and
     ``g_n`` on the real contact set among them; a quantity the twin does not answer gets none."""
-    from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
+    from ngcontact.cell.fe.contact_edge_refinement import FLOOR_GRID, ContactEdgeRefinement
 
     def twin_heads(grid):
-        fine = grid == 256
+        fine = grid == FLOOR_GRID
         return [{"contact_fraction": 0.5, "coefficient_k_n": 12.0 if fine else 12.5,
                  "coefficient_g_n": 0.030 if fine else 0.031}]
 
-    ladder = ContactEdgeRefinement(_Level(1000, 0.6), lambda grid: [], lambda points, h: _Level(1000, 0.5),
+    ladder = ContactEdgeRefinement(_Level(1000, 0.6), lambda grid: [],
+                                   lambda points, h, grading: _Level(1000, 0.5),
                                    interface_maxh=0.1, period=1.0, twin_heads=twin_heads)
     floors = ladder.twin_floors([{"contact_fraction": 0.51, "coefficient_k_n": 12.2, "coefficient_g_n": 0.0302,
                                   "mean_closure": 1.0}], 1)[0]
@@ -199,7 +203,8 @@ def test_the_contact_edge_ladder_is_not_taken_as_converged_before_its_extrapolat
     after three levels; the contact edge's ladder still solves a third refined level (four in all), the
     extrapolation's premise, and a plain refiner stops at three."""
     from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
-    ladder = ContactEdgeRefinement(_Level(1000, 0.5), lambda grid: [], lambda points, h: _Level(1000, 0.5),
+    ladder = ContactEdgeRefinement(_Level(1000, 0.5), lambda grid: [],
+                                   lambda points, h, grading: _Level(1000, 0.5),
                                    interface_maxh=0.1, period=1.0)
     assert len(refine(ladder, [None], 0.01, 10 ** 9, required=True).levels) == 4
 

@@ -65,6 +65,8 @@ log = logging.getLogger(__name__)
 
 #: distance of the layers of a :class:`PatchBody` restriction, in its element sizes
 LAYER_SPACING = 3.0
+#: Netgen's grading (its default): how fast the size may grow away from a restricted point
+GRADING = 0.3
 #: points of a restriction closer than this (relative to the period) to a periodic face are moved off it
 FACE_CLEARANCE = 1e-6
 
@@ -172,7 +174,7 @@ def patch_length(pressure: np.ndarray, period: float) -> float | None:
 
 def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1.0, h_rough: float = 1.0,
                       h_counter: float = 1.0, maxh: float, interface_maxh: float,
-                      body: PatchBody | None = None, symmetric: bool = False) -> Cell:
+                      body: PatchBody | None = None, symmetric: bool = False, grading: float = GRADING) -> Cell:
     """The flat periodic 3D cell (:func:`~ngcontact.geometry.cell3d.flat_cell3d`) with its mesh size
     restricted to ``edge_maxh`` at ``points`` on ``S_C`` (module docstring).
 
@@ -189,12 +191,17 @@ def edge_refined_cell(points: np.ndarray, *, edge_maxh: float, period: float = 1
     symmetric
         Mesh the quarter ``[0, P/2]^2`` between mirror planes (:mod:`ngcontact.geometry.cell3d`): the points
         of the period are folded into it (:func:`fold_quarter`).
+    grading
+        Netgen's grading ``gamma``: the size grows at most like ``edge_maxh + gamma r`` with the distance ``r``
+        from the edge points (in ``(0, 1]``; :data:`GRADING`, Netgen's default, where not given).
     """
+    if not (np.isfinite(grading) and 0 < grading <= 1):
+        raise GeometryError("grading", grading, "must be in (0, 1]")
     if not (np.isfinite(edge_maxh) and 0 < edge_maxh <= interface_maxh):
         raise GeometryError("edge_maxh", edge_maxh, f"must be > 0 and <= interface_maxh = {interface_maxh}")
     P = float(period)
     geo = cell3d.flat_geometry(P, float(h_rough), float(h_counter), periodic_maxh(interface_maxh, P), symmetric)
-    mp = MeshingParameters(maxh=periodic_maxh(maxh, P))
+    mp = MeshingParameters(maxh=periodic_maxh(maxh, P), grading=float(grading))
     pts = _inside(points, P, symmetric)
     for x, y in pts:
         mp.RestrictH(x=float(x), y=float(y), z=0.0, h=float(edge_maxh))

@@ -43,6 +43,23 @@ of the last level), the refiner answering
 :class:`~ngcontact.cell.fe.second_discretization.Extrapolating`; a sweep on this ladder is not taken as
 converged before that extrapolation exists (:meth:`ContactEdgeRefinement.ready`).
 
+The grading.  Netgen grows the size from ``h_k`` at the edge at most like ``h_k + gamma r`` with the distance
+``r`` (``gamma`` its grading, :data:`~ngcontact.cell.fe.contact_edge_mesh.GRADING`), so a patch width from
+the edge, at the patch's centre and in the bodies below it, the elements are about ``gamma l`` whatever
+``h_k``, and the bodies' error made there (order 2 on a linear trace on ``S_C``) does not fall with the edge
+size: on the bisinusoid's quarter (``p/p* = 0.05``, ``gamma = 0.3``) the normal stiffness stays 0.8 to 1.0 %
+above the converged one from ``l/20`` to ``l/160``.  A grading falling with the level,
+``gamma_k = 0.3 2^(-beta (k - 1))``, was measured on that cell and rejected: the near field holds about
+``L l / (gamma^2 h_k)`` elements (``L`` the edges' length), and the unknowns of the level at ``l/40`` grew
+from 41k at ``gamma = 0.3`` to 95k at 0.21 and 186k at 0.15, a level's unknowns growing about 4-fold instead of
+2-fold at ``beta = 1/2``; the stiffness's error fell (0.5 % at 0.21, 0.07 % at 0.15), but each level's step
+then moves two sizes at once, and the contact fraction's extrapolation in ``h_k`` alone claimed 13 times its
+true error (``beta = 1/2``), the stiffness's geometric tail 3.9 % (``beta = 1/4``, a fourth level of 312k
+unknowns).  Nor does a smaller fixed grading pay: at ``gamma = 0.25`` (the levels' unknowns 1.1 to 1.4 times)
+the stiffness's error scattered between -0.7 and +1.6 % from level to level, not below that at 0.3.  So every
+level keeps the one grading (:attr:`ContactEdgeRefinement.grading`, Netgen's 0.3), and that error, the same
+at every level and so in no difference of the sequence, is what the twin's floor below bounds.
+
 The twin's floor.  Those estimates see only the edge size; the error made at the sizes the ladder keeps
 (``interface_maxh`` away from the edge, the bodies, the linear trace) does not change from level to level
 and is not in them.  The twin solves the same continuum problem (the flat layers, the same gap carried as a
@@ -53,8 +70,13 @@ function on a flat ``S_C``, the same materials, exact frictionless contact), so 
 
 the second since the spectral cell converges at first order in its grid step (a geometric tail at rate 1/2
 equals the last difference; :data:`TWIN_SAFETY` = 2 covers the stiffness's scatter about that rate,
-:data:`ngcontact.cell.spectral.refinement.ERRATIC`).  ``N`` is the twin's grid of the last level (its
-solutions at the loads place that level's edge), ``N/2`` that of the level before or one coarser solve.
+:data:`ngcontact.cell.spectral.refinement.ERRATIC`).  ``N`` is :data:`FLOOR_GRID` at every level, not the
+grid that places the level's edge: the grids of the first levels (256, 512 points) lie off the first-order line
+of the finer ones (on the bisinusoid at ``p/p* = 0.05`` the stiffness on 512 points is 0.07 % above those on
+1024 and 2048, which agree to 0.01 %; at ``p/p* = 0.02`` the floor from 512 and 256 points was 0.8 % of the
+stiffness, from 2048 and 1024 0.02 %), and a floor as large as the tolerance would hold back the levels whose
+own error is within it.  The two solves, once per sweep, cost about 10 CPU seconds per load on 2048^2 and
+1.5 on 1024^2 (the bisinusoid's two layers).
 Each of the contact fraction, the mean closure, the normal stiffness and the normal coefficients of eq. 34
 on the real contact set, ``k_n`` and ``g_n`` (the twin integrates the same ``k_n`` and gap over its contact
 set), takes the larger of its ladder's estimate and this floor (:meth:`ContactEdgeRefinement.twin_floors`).
@@ -68,7 +90,7 @@ import numpy as np
 
 import math
 
-from ngcontact.cell.fe.contact_edge_mesh import edge_points, patch_length
+from ngcontact.cell.fe.contact_edge_mesh import GRADING, edge_points, patch_length
 from ngcontact.cell.fe.edge_size_extrapolation import EdgeSizeExtrapolation, extrapolate
 from ngcontact.cell.fe.observed_rate import Convergence
 from ngcontact.cell.fe.second_discretization import HALVING_RATE
@@ -80,6 +102,8 @@ EXTRAPOLATED_LEVELS = 3
 EDGE_CELLS = 10.0
 #: the twin's grid points per direction: at least the first, at most the second (module docstring)
 TWIN_GRIDS = (256, 1024)
+#: ``N`` of the twin's floor, on every level (module docstring, "The twin's floor"); ``N/2`` with it
+FLOOR_GRID = 2048
 #: the twin's own error over its last difference (module docstring, "The twin's floor")
 TWIN_SAFETY = 2.0
 #: the quantities given the twin's floor
@@ -105,18 +129,20 @@ class ContactEdgeRefinement:
     docstring).
 
     ``scene_cell`` is level 0; ``pressures(grid)`` gives the twin's pressure grids at the loads on a
-    ``grid x grid`` grid (each grid asked once); ``cell_at(points, edge_maxh)`` the cell (``sweep``,
-    ``unknowns``) on the mesh refined at ``points``; ``period`` the cell's period; ``twin_heads(grid)``, where
-    given, the twin's headline quantities at the loads on that grid (from the same solves as ``pressures``).
+    ``grid x grid`` grid (each grid asked once); ``cell_at(points, edge_maxh, grading)`` the cell (``sweep``,
+    ``unknowns``) on the mesh refined at ``points`` with Netgen's ``grading`` (every level's: module
+    docstring, "The grading"); ``period`` the cell's period; ``twin_heads(grid)``, where given, the twin's
+    headline quantities at the loads on that grid (from the same solves as ``pressures``).
     """
 
     scene_cell: Any
     pressures: Callable[[int], list[np.ndarray]]
-    cell_at: Callable[[np.ndarray, float], Any]
+    cell_at: Callable[[np.ndarray, float, float], Any]
     interface_maxh: float
     period: float
     rule: Convergence = HALVING_RATE
     twin_heads: Callable[[int], list[dict[str, float]]] | None = None
+    grading: float = GRADING
     _grids: dict[int, list[np.ndarray]] = field(default_factory=dict, repr=False)
 
     def twin(self, grid: int) -> list[np.ndarray]:
@@ -143,7 +169,7 @@ class ContactEdgeRefinement:
         return twin_edge_points(self.twin(twin_grid(self.edge_maxh(k), self.period)), self.period)
 
     def level(self, k: int) -> Any:
-        return self.scene_cell if k == 0 else self.cell_at(self.points(k), self.edge_maxh(k))
+        return self.scene_cell if k == 0 else self.cell_at(self.points(k), self.edge_maxh(k), self.grading)
 
     def sequence(self, heads: list[list[dict[str, float]]]) -> list[list[dict[str, float]]]:
         """The levels of the geometric tails (the mean closure, the stiffness, the coefficients): the refined
@@ -175,7 +201,7 @@ class ContactEdgeRefinement:
         "The twin's floor"); none without the twin's quantities or at level 0."""
         if self.twin_heads is None or k == 0:
             return [{} for _ in reported]
-        n = twin_grid(self.edge_maxh(k), self.period)
+        n = FLOOR_GRID
         fine, coarse = self.twin_heads(n), self.twin_heads(n // 2)
         if not len(fine) == len(coarse) == len(reported):
             return [{} for _ in reported]
