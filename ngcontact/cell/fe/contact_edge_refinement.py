@@ -47,18 +47,15 @@ The grading.  Netgen grows the size from ``h_k`` at the edge at most like ``h_k 
 ``r`` (``gamma`` its grading, :data:`~ngcontact.cell.fe.contact_edge_mesh.GRADING`), so a patch width from
 the edge, at the patch's centre and in the bodies below it, the elements are about ``gamma l`` whatever
 ``h_k``, and the bodies' error made there (order 2 on a linear trace on ``S_C``) does not fall with the edge
-size: on the bisinusoid's quarter (``p/p* = 0.05``, ``gamma = 0.3``) the normal stiffness stays 0.8 to 1.0 %
-above the converged one from ``l/20`` to ``l/160``.  A grading falling with the level,
-``gamma_k = 0.3 2^(-beta (k - 1))``, was measured on that cell and rejected: the near field holds about
-``L l / (gamma^2 h_k)`` elements (``L`` the edges' length), and the unknowns of the level at ``l/40`` grew
-from 41k at ``gamma = 0.3`` to 95k at 0.21 and 186k at 0.15, a level's unknowns growing about 4-fold instead of
-2-fold at ``beta = 1/2``; the stiffness's error fell (0.5 % at 0.21, 0.07 % at 0.15), but each level's step
-then moves two sizes at once, and the contact fraction's extrapolation in ``h_k`` alone claimed 13 times its
-true error (``beta = 1/2``), the stiffness's geometric tail 3.9 % (``beta = 1/4``, a fourth level of 312k
-unknowns).  Nor does a smaller fixed grading pay: at ``gamma = 0.25`` (the levels' unknowns 1.1 to 1.4 times)
-the stiffness's error scattered between -0.7 and +1.6 % from level to level, not below that at 0.3.  So every
-level keeps the one grading (:attr:`ContactEdgeRefinement.grading`, Netgen's 0.3), and that error, the same
-at every level and so in no difference of the sequence, is what the twin's floor below bounds.
+size: on the bisinusoid's quarter at Netgen's 0.3 the normal stiffness stays at one offset from the converged
+one over the levels.  A grading falling with the level, ``gamma_k = 0.3 2^(-beta (k - 1))``, does not pay: the
+near field holds about ``L l / (gamma^2 h_k)`` elements (``L`` the edges' length), so at ``beta = 1/2`` a
+level's unknowns grow about 4-fold instead of 2-fold, and each step moves two sizes at once, which the
+extrapolation in ``h_k`` alone misreads (its estimate far above the contact fraction's error at ``beta = 1/2``,
+an extra level for the stiffness's tail at ``beta = 1/4``).  A smaller fixed grading costs unknowns without a
+steadier stiffness.  So every level keeps the one grading (:attr:`ContactEdgeRefinement.grading`, Netgen's
+0.3), and that error, the same at every level and so in no difference of the sequence, is what the twin's
+floor below bounds.
 
 The twin's floor.  Those estimates see only the edge size; the error made at the sizes the ladder keeps
 (``interface_maxh`` away from the edge, the bodies, the linear trace) does not change from level to level
@@ -71,12 +68,10 @@ function on a flat ``S_C``, the same materials, exact frictionless contact), so 
 the second since the spectral cell converges at first order in its grid step (a geometric tail at rate 1/2
 equals the last difference; :data:`TWIN_SAFETY` = 2 covers the stiffness's scatter about that rate,
 :data:`ngcontact.cell.spectral.refinement.ERRATIC`).  ``N`` is :data:`FLOOR_GRID` at every level, not the
-grid that places the level's edge: the grids of the first levels (256, 512 points) lie off the first-order line
-of the finer ones (on the bisinusoid at ``p/p* = 0.05`` the stiffness on 512 points is 0.07 % above those on
-1024 and 2048, which agree to 0.01 %; at ``p/p* = 0.02`` the floor from 512 and 256 points was 0.8 % of the
-stiffness, from 2048 and 1024 0.02 %), and a floor as large as the tolerance would hold back the levels whose
-own error is within it.  The two solves, once per sweep, cost about 10 CPU seconds per load on 2048^2 and
-1.5 on 1024^2 (the bisinusoid's two layers).
+grid that places the level's edge: the grids of the first levels (256, 512 points) lie off the first-order
+line of the finer ones, and a floor as large as the tolerance would hold back the levels whose own error is
+within it.  The two solves are made once per sweep; their cost is in the bisinusoid's benchmark section
+(``docs/benchmarks.md``, ``bisinusoid_scene_accuracy``).
 Each of the contact fraction, the mean closure, the normal stiffness and the normal coefficients of eq. 34
 on the real contact set, ``k_n`` and ``g_n`` (the twin integrates the same ``k_n`` and gap over its contact
 set), takes the larger of its ladder's estimate and this floor (:meth:`ContactEdgeRefinement.twin_floors`).

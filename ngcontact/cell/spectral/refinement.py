@@ -107,8 +107,8 @@ is held to the tolerance like the others, within a stated cap (:func:`stiffness_
 quantity meets the tolerance, refinement goes on for the stiffness alone for at most :data:`STIFFNESS_LEVELS`
 more levels within the largest grid, and only while its estimate, were it to fall by :data:`STIFFNESS_RATE` per
 level (second order: faster than its error's first order, so that a stiffness whose guarded estimate collapses
-once its differences contract, as on the random profile of seed 2 from 9.5 % on 8192 points to 0.7 % on 32,768, is
-not given up early), could meet it within them.  Beyond the cap (a 2D tolerance of the order of the fraction's,
+once its differences contract, as on the random profiles of ``docs/benchmarks.md`` (``random_profile_accuracy``),
+is not given up early), could meet it within them.  Beyond the cap (a 2D tolerance of the order of the fraction's,
 1e-4, would take millions of points at first order) the refinement stops, ``met = False``, the stiffness counted
 in the verdict as not met (one warning line) and the cap named in the remarks, whether or not the scene stated
 the tolerance: the other quantities met it, and the figures stand.  In 3D, whose cost bound (points squared)
