@@ -208,8 +208,7 @@ def fe_cell(scene: CellScene) -> FECell:
         g = scene.geometry
         h0 = d.interface_maxh or d.maxh
         finest = h0 * RATIO ** (MAX_STEPS * LEVELS_PER_STEP)
-        # one twin for every load and level, as fine as the finest grading asks (within the grid's bound),
-        # built when a refinement first asks for it
+        # one twin for every load and level, as fine as the finest grading asks (grid-bound), built on demand
         predictor = functools.cache(lambda: predictor_twin(scene, finest))
 
         def graded(vertices, order):
