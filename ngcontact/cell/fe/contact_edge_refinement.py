@@ -87,9 +87,9 @@ the ladder's error is much larger than the twin's.  ``N`` is :data:`FLOOR_GRID` 
 that places the level's edge: the grids of the first levels (256, 512 points) lie off the first-order line of
 the finer ones, and a bound as large as the tolerance would hold back the levels whose own error is within
 it; ``N/4`` enters only through its difference halved.  The three solves are made once per sweep (``N/4``
-is often among the grids that place the edges, and the cheapest); their cost and the bound's effectivity against the spectral
-cell converged on finer grids are in the bisinusoid's benchmark section (``docs/benchmarks.md``,
-``bisinusoid_scene_accuracy``).
+is often among the grids that place the edges, and the cheapest); their cost and the bound's effectivity
+against the spectral cell converged on finer grids are in the bisinusoid's benchmark section
+(``docs/benchmarks.md``, ``bisinusoid_scene_accuracy``).
 
 Each of the mean closure, the normal stiffness and the normal coefficients of eq. 34 on the real contact set,
 ``k_n`` and ``g_n`` (the twin integrates the same ``k_n`` and gap over its contact set), whose ladder's
