@@ -108,10 +108,10 @@ def start(out: str, ratio: float, symmetry: str) -> tuple[subprocess.Popen, floa
 
 
 def finish(out: str, ratio: float, symmetry: str, started: tuple[subprocess.Popen, float],
-           converged: dict[str, float], checked: dict[str, float]) -> dict:
+           converged: dict[str, float], checked: dict[str, float] | None = None) -> dict:
     """Wait for the run at ``p/p* = ratio`` and its row: the report's contact fraction and estimate against
     the ``converged`` one, the effectivities of the other estimated quantities (:data:`OTHERS`), the check of
-    the reference against ``checked`` (module docstring), the run's wall and CPU seconds."""
+    the reference against ``checked`` where given (module docstring), the run's wall and CPU seconds."""
     reference = converged["contact_fraction"]
     proc, t0 = started
     _, status, usage = os.wait4(proc.pid, 0)
@@ -136,7 +136,7 @@ def finish(out: str, ratio: float, symmetry: str, started: tuple[subprocess.Pope
         exact = converged.get(name, math.nan) * (k_n if name.startswith("coefficient_") else 1.0)
         if q is not None and math.isfinite(exact) and q["value"] != exact:
             others[f"effectivity_{short}"] = errors[name] / abs(q["value"] - exact)
-    checks, shifts = [], []
+    checks, shifts, checked = [], [], checked or {}
     for q in (q for q in results["accuracy"]["quantities"] if q.get("load", 0) == 0 and q["name"] in checked):
         s = k_n if q["name"].startswith("coefficient_") else 1.0
         exact, check = converged[q["name"]] * s, checked[q["name"]] * s
