@@ -33,6 +33,12 @@ Four measurements, one run, one CSV and one PNG:
    (:mod:`ngcontact.cell.fe.contact_edge_refinement`): the larger of the grid
    convergence index and the spectral twin's floor, each in its own column,
    and their effectivity against the converged value.
+5. **The aim as a scene** (``scene``, ``bisinusoid_aim.py``): the same bisinusoid
+   posed as a scene, one ``ngcontact run`` per load on one thread, its
+   contact-edge ladder's contact fraction and estimate, wall and CPU seconds.
+
+Parts 4 and 5 score their contact fractions against the one converged value
+(``bisinusoid_accuracy.converged``), and so does ``--republish`` the kept rows.
 
 Every solve of parts 1 and 2 runs in its own child process, so that its peak
 memory (``VmHWM``) is its own.  Reported per solve: dofs, wall time of the
@@ -66,7 +72,7 @@ product with the tangent, the size of BDDC's coarse problem) and writes
 
 Usage::
 
-    python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral accuracy]
+    python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral accuracy scene]
                                  [--accuracy-edges [EDGE_MAXH ...]] [--accuracy-orders 1 2]
                                  [--accuracy-patch N_EDGE N_BODY DEPTH | --accuracy-no-patch]
                                  [--accuracy-patch-growth GROWTH] [--accuracy-cells quarter period]
@@ -93,8 +99,8 @@ from ngcontact.output.writer import write_csv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
-from bisinusoid_accuracy import (ACC_CELLS, ACC_EDGES, ACC_PATCH, QUICK_EDGES, accuracy_aim,  # noqa: E402
-                                 aim_status)
+from bisinusoid_accuracy import ACC_CELLS, ACC_EDGES, ACC_PATCH, QUICK_EDGES, REF_GRIDS, accuracy_aim  # noqa: E402
+from bisinusoid_aim import aim_status, plot_aim, scene_rows  # noqa: E402
 from scaling_3d_rows import ARCHIVE, MEASURED, keep, measured, read_rows, with_extrapolations  # noqa: E402
 
 log = logging.getLogger("scaling_3d")
@@ -107,9 +113,9 @@ MACRO_SIZES = (0.3, 0.2, 0.14, 0.1, 0.075, 0.041)
 QUICK_CELL, QUICK_MACRO = (0.16, 0.12), (0.35, 0.3)
 AMPLITUDE, PRESSURES = 0.005, (0.00185, 0.0065)
 SPECTRAL_GRIDS, TAMAAS_GRID = (64, 128, 256, 512), 1024
-KEYS = ("part", "solver", "cell", "size", "ndof", "seconds", "measure_seconds", "twin_seconds", "mesh_seconds",
-        "solve_seconds", "newton_steps", "cg_iterations", "peak_memory_gb", "contact_fraction", "pressure",
-        "relative_error", "estimate", "estimate_gci", "estimate_twin", "effectivity")
+KEYS = ("part", "solver", "cell", "size", "ndof", "seconds", "cpu_seconds", "measure_seconds", "twin_seconds",
+        "mesh_seconds", "solve_seconds", "newton_steps", "cg_iterations", "peak_memory_gb", "contact_fraction",
+        "pressure", "relative_error", "estimate", "estimate_gci", "estimate_twin", "effectivity")
 
 
 def period_scene():
@@ -134,7 +140,6 @@ def cell_child(size: float, policy: str) -> dict:
     from ngcontact import runner
     from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
-    from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
     scene = period_scene()
     cell = build_cell(scene, interface_maxh=size)
@@ -142,10 +147,10 @@ def cell_child(size: float, policy: str) -> dict:
         t0 = time.perf_counter()
         # as ngcontact run: the first load starts from the spectral twin's contact set
         P = CellProblem(cell, model_of(scene), linear=LinearSolver(policy), predictor=predictor_twin(scene, size))
-        load = cell_loads(scene)[0]
-        sol = P.solve(load, first=True, measure=False)
+        first = cell_loads(scene)[0]
+        sol = P.solve(first, first=True, measure=False)
         secs = time.perf_counter() - t0
-        P.measure(load)                                # what ngcontact run reports: effective stiffness, stresses
+        P.measure(first)                                # what ngcontact run reports: effective stiffness, stresses
         measure_secs = time.perf_counter() - t0 - secs
     return {"part": "cell", "solver": policy, "size": size, "ndof": P.ndof, "seconds": secs,
             "measure_seconds": measure_secs,
@@ -268,7 +273,7 @@ def plot(rows: list[dict], path: str) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
+    fig, axes = plt.subplots(1, 4, figsize=(20, 4.2))
     for ax, part in zip(axes[:2], ("cell", "macro")):
         for solver, style in (("iterative", "o-"), ("direct", "s--")):
             sel = [r for r in rows if r["part"] == part and r["solver"] == solver]
@@ -301,6 +306,10 @@ def plot(rows: list[dict], path: str) -> None:
     ax.set_title("bisinusoid, 20 % and 60 % contact")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
+    shown = [any(r["part"] == part for r in rows) for part in ("cell", "macro")] + [
+        any(r["solver"] == "tamaas" for r in rows), plot_aim(axes[3], rows)]
+    for ax in (ax for ax, drawn in zip(axes, shown) if not drawn):
+        ax.set_axis_off()                       # a part without rows in this table
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -430,7 +439,7 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
                 elasticity.BUBBLE_GAMMA = gamma
                 state = ng.GridFunction(P.X)        # the converged state the preconditioner is built at
                 state.vec.data = P.gfu.vec
-                measure(preconditioning_form(P, state), "vertices + bubble term", gamma)
+                measure(preconditioning_form(P.discrete, state), "vertices + bubble term", gamma)
         finally:
             elasticity.BUBBLE_GAMMA = default
         elasticity.surface_wirebasket(P.X, P.mesh, "contact")
@@ -468,6 +477,8 @@ def measured_rows(args) -> list[dict]:
         rows += accuracy_aim(edges, tuple(args.accuracy_orders), None if args.accuracy_no_patch else
                              tuple(args.accuracy_patch), args.accuracy_threads, args.accuracy_patch_growth,
                              tuple(args.accuracy_cells))
+    if "scene" in args.parts:
+        rows += scene_rows(os.path.join(args.out, "scene"))
     return rows
 
 
@@ -481,9 +492,9 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="two small sizes of each part (a smoke run)")
     ap.add_argument("--direct-max", type=int, default=45000,
                     help="no direct solves beyond the first size above this many dofs")
-    ap.add_argument("--parts", nargs="+", choices=("cell", "macro", "spectral", "accuracy"),
-                    default=("cell", "macro", "spectral", "accuracy"),
-                    help="which of the four measurements to run (default: all)")
+    ap.add_argument("--parts", nargs="+", choices=("cell", "macro", "spectral", "accuracy", "scene"),
+                    default=("cell", "macro", "spectral", "accuracy", "scene"),
+                    help="which of the five measurements to run (default: all)")
     ap.add_argument("--solvers", nargs="+", choices=("iterative", "direct"), default=("iterative", "direct"),
                     help="which linear solvers of parts 1 and 2 to run (default: both)")
     ap.add_argument("--breakdown", type=float, default=None, metavar="INTERFACE_MAXH",
@@ -591,11 +602,16 @@ def main(argv=None) -> int:
                                    "same sizes, zero normal displacement on the quarter's mirror faces), "
                                    "per `pressure` = p/p* "
                                    "(p* = pi E* h, h = 0.01, E* = 1), `relative_error` of the contact fraction "
-                                   "against the spectral cell extrapolated from 1024^2 and 2048^2 (issue 38 aims "
+                                   f"against the spectral cell extrapolated from {REF_GRIDS[0]}^2 and "
+                                   f"{REF_GRIDS[1]}^2, the kept rows' errors too (issue 38 aims "
                                    "at 1 % in 60 s; seconds: twin, meshing and solve, each on its own in "
                                    "`twin_seconds`, `mesh_seconds`, `solve_seconds`" + (
                                        f", {args.accuracy_threads} thread(s)" if args.accuracy_threads else "") +
-                                   "); timings under the load of other jobs. Seconds of "
+                                   "); part `scene`: the bisinusoid posed as a scene, one `ngcontact run` per "
+                                   "load on one thread, the contact fraction its contact-edge ladder reports "
+                                   "(`size`: its levels), `estimate` its own (relative), `cpu_seconds` the run's "
+                                   "CPU time, `seconds` its wall time; timings under the load of other jobs. "
+                                   "Seconds of "
                                    "setup and solve, of the measurement after it, Newton steps, CG iterations, "
                                    "peak memory. Fitted: " + ("; ".join(fits) if fits else "none") + ".",
                               png=os.path.join(args.out, "scaling_3d.png"))
