@@ -118,15 +118,21 @@ def aim_status(rows: list[dict], tolerance: float = 0.01, seconds: float = 60.0)
 
 def plot_aim(ax, rows: list[dict], tolerance: float = 0.01, seconds: float = 60.0) -> bool:
     """The aim's panel: |relative error| against the seconds of :func:`cost`, per load and kind of row (the
-    scene's filled, part 4's open), the aim's box dashed; whether any row was drawn."""
+    scene's filled squares, part 4's solves open circles, its extrapolations open diamonds), the aim's box
+    dashed; whether any row was drawn."""
     scored = [r for r in rows if r.get("part") in ("scene", "accuracy") and isinstance(r.get("relative_error"), float)]
+    kinds = (("solves of part accuracy (s)", "o", False), ("their extrapolations (s)", "D", False),
+             ("scene (CPU s)", "s", True))
+
+    def kind(r):
+        return 2 if r["part"] == "scene" else 1 if str(r["solver"]).endswith(", extrapolated") else 0
     for k, ratio in enumerate(sorted({r["pressure"] for r in scored})):
-        for part, marker, fill in (("accuracy", "o", "none"), ("scene", "s", f"C{k}")):
-            sel = [r for r in scored if r["part"] == part and r["pressure"] == ratio]
+        for j, (name, marker, filled) in enumerate(kinds):
+            sel = [r for r in scored if kind(r) == j and r["pressure"] == ratio]
             if sel:
                 ax.loglog([cost(r)[0] for r in sel], [max(abs(r["relative_error"]), 1e-5) for r in sel], marker,
-                          color=f"C{k}", mfc=fill, ls="none",
-                          label=f"p/p* = {ratio:g}, {'scene (CPU s)' if part == 'scene' else 'part accuracy (s)'}")
+                          color=f"C{k}", mfc=f"C{k}" if filled else "none", ls="none",
+                          label=f"p/p* = {ratio:g}, {name}")
     ax.axhline(tolerance, color="k", lw=0.8, ls="--")
     ax.axvline(seconds, color="k", lw=0.8, ls="--")
     ax.set_xlabel("seconds (a scene's: CPU)")

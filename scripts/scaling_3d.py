@@ -256,11 +256,18 @@ def exponent(rows: list[dict], part: str, solver: str) -> float | None:
 
 
 def plot(rows: list[dict], path: str) -> None:
+    """One panel per part with rows in this table: cost against dofs of parts 1 and 2, the spectral cell
+    against Tamaas, the aim (:func:`bisinusoid_aim.plot_aim`)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 4, figsize=(20, 4.2))
-    for ax, part in zip(axes[:2], ("cell", "macro")):
+    fe = [part for part in ("cell", "macro") if any(r["part"] == part for r in rows)]
+    spectral = any(r["solver"] == "tamaas" for r in rows)
+    aim = any(r["part"] in ("accuracy", "scene") for r in rows)
+    n = max(len(fe) + spectral + aim, 1)
+    fig, axes = plt.subplots(1, n, figsize=(5 * n, 4.2), squeeze=False)
+    panels = iter(axes[0])
+    for part, ax in zip(fe, panels):            # fe first: zip stops on it before taking a panel
         for solver, style in (("iterative", "o-"), ("direct", "s--")):
             sel = [r for r in rows if r["part"] == part and r["solver"] == solver]
             if sel:
@@ -275,27 +282,25 @@ def plot(rows: list[dict], path: str) -> None:
         ax.set_ylabel("wall time, setup and solve [s]")
         ax.set_title("3D cell (bisinusoid)" if part == "cell" else "3D macro press fit")
         ax.grid(True, which="both", alpha=0.3)
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend()
-    ax = axes[2]
-    for p in PRESSURES:
-        ref = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "tamaas" and r["pressure"] == p]
-        sel = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "ngcontact spectral"
-               and r["pressure"] == p]
-        if ref and sel:
-            f0 = ref[0]["contact_fraction"]
-            ax.loglog([r["seconds"] for r in sel], [max(abs(r["contact_fraction"] / f0 - 1), 1e-8) for r in sel],
-                      "^-", label=f"spectral, p = {p:g} (Tamaas {TAMAAS_GRID}^2: {f0:.4f})")
-    ax.axhline(5e-3, color="k", lw=0.8, ls=":", label="0.5 %")
-    ax.set_xlabel("wall time [s]")
-    ax.set_ylabel("contact fraction, relative to Tamaas 1024^2")
-    ax.set_title("bisinusoid, 20 % and 60 % contact")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    shown = [any(r["part"] == part for r in rows) for part in ("cell", "macro")] + [
-        any(r["solver"] == "tamaas" for r in rows), plot_aim(axes[3], rows)]
-    for ax in (ax for ax, drawn in zip(axes, shown) if not drawn):
-        ax.set_axis_off()                       # a part without rows in this table
+        ax.legend()
+    if spectral:
+        ax = next(panels)
+        for p in PRESSURES:
+            ref = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "tamaas" and r["pressure"] == p]
+            sel = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "ngcontact spectral"
+                   and r["pressure"] == p]
+            if ref and sel:
+                f0 = ref[0]["contact_fraction"]
+                ax.loglog([r["seconds"] for r in sel], [max(abs(r["contact_fraction"] / f0 - 1), 1e-8) for r in sel],
+                          "^-", label=f"spectral, p = {p:g} (Tamaas {TAMAAS_GRID}^2: {f0:.4f})")
+        ax.axhline(5e-3, color="k", lw=0.8, ls=":", label="0.5 %")
+        ax.set_xlabel("wall time [s]")
+        ax.set_ylabel("contact fraction, relative to Tamaas 1024^2")
+        ax.set_title("bisinusoid, 20 % and 60 % contact")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    if aim:
+        plot_aim(next(panels), rows)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

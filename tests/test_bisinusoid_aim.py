@@ -73,3 +73,17 @@ def test_the_aims_panel_draws_the_scored_rows_only(tmp_path):
     points = [line.get_xydata().tolist() for line in full.get_lines()[:2]]
     assert points == [[[34.2, pytest.approx(0.0043)]], [[32.0, pytest.approx(0.004)]]]
     plt.close(fig)
+
+
+def test_the_sections_figure_has_a_panel_per_part_with_rows(tmp_path):
+    """scaling_3d.plot draws no empty panel: the aim's alone for a table of accuracy and scene rows, a cost
+    panel beside it once cell rows are in (5 inches a panel at 120 dpi)."""
+    import matplotlib.image
+    import scaling_3d
+    aim = [A.scene_row(_scene(0.005, 0.0043, 34.2), QUARTER)]
+    cell = [{"part": "cell", "solver": "iterative", "ndof": n, "seconds": n / 1000} for n in (1000, 2000)]
+    widths = []
+    for rows in (aim, cell + aim, []):
+        scaling_3d.plot(rows, str(tmp_path / "f.png"))
+        widths.append(matplotlib.image.imread(str(tmp_path / "f.png")).shape[1])
+    assert widths == [600, 1200, 600]
