@@ -37,6 +37,14 @@ rows cover the jumps ``[0, s_hi]`` asked for (the macro interface's, with
 headroom): a row is extended by doubling ``Delta`` until its last jump
 reaches ``s_hi`` or its shear levels off (the last doubling changed it by
 at most ``tol``; beyond the row the law holds the shear: the cell slides).
+A range asked for that exceeds the rows by at most ``tol`` (relative: in
+pressure at either end, and in the jump) is covered already: the loop asks
+with headroom, so the interface's own pressures and jumps lie well inside
+the rows, while the request moves a little with the macro solution each
+time the law changes.  Extended by any excess, the loop's last growth on
+the FE friction block (``scripts/two_scale_table_share.py``) moved its
+largest pressure by a relative 1e-6 and the loop added four rows within
+1e-6 of the last one: the same row solved four more times.
 The cell solves of one level (all rows' new nodes together) are independent
 and go through ``map_tasks``, like the pressure table's.
 
@@ -292,10 +300,12 @@ class ShearTable:
         else:
             P = list(self.pressures)
             new = []
-            if lo < P[0] * (1 - 1e-6):
+            if lo < P[0] * (1 - self.tol):       # within tol of the rows: covered (module docstring)
                 new += [float(q) for q in np.geomspace(EXTEND_BELOW * lo, P[0], start_nodes)[:-1]]
-            if hi > P[-1] * (1 + 1e-6):
+            if hi > P[-1] * (1 + self.tol):
                 new += [float(q) for q in np.geomspace(P[-1], hi, start_nodes)[1:]]
+            if s_hi <= self.covered_jump * (1 + self.tol):
+                s_hi = min(s_hi, self.covered_jump)
             self._build(sorted(set(P) | set(new)), max(s_hi, self.covered_jump))
         longer = s_hi > self.covered_jump and bool(self.checked)
         self.covered_jump = max(self.covered_jump, s_hi)
