@@ -248,6 +248,12 @@ def test_the_shear_tables_share_bounds_its_error_against_a_much_finer_table(tmp_
     assert q["met"] and max(q["parts"][n]["share"] for n in shear) > q["parts"]["pressure_table"]["share"] > 0
     first = share.rounds[0]
     assert max(first["parts"][n]["share"] for n in shear) > share.limit / 3 and set(shear) & set(first["halved"])
+    # one part refined a round, the largest, and estimated alone in the next: the others' estimates carried
+    assert len(share.rounds) > 1 and all(len(r["halved"]) == 1 for r in share.rounds[:-1])
+    for before, r in zip(share.rounds, share.rounds[1:]):
+        (name,) = before["halved"]
+        assert name == max(before["parts"], key=lambda n: before["parts"][n]["share"])
+        assert [n for n, part in r["parts"].items() if not part.get("carried")] == [name]
     for name, e in share.shares.items():                     # the parts add
         assert e == pytest.approx(sum(share.parts[t][name] for t in share.parts), rel=1e-12)
     ref = shear_reference(answer, relevel, scene)
