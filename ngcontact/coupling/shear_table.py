@@ -88,6 +88,9 @@ ShearLoad = tuple[float, float]
 EXTEND_BELOW = 0.5
 #: largest number of doublings of a row's far-face jump
 MAX_DOUBLINGS = 24
+#: two far-face jumps of one row closer than this (relative) are one load: a row's jumps carried along the rays
+#: by two paths (``d q / a`` and ``(d m / a) q / m``) differ in their last bits, and were solved twice
+SAME_LOAD = 1e-12
 
 
 def serial_map(task: Callable[[ShearLoad], ShearResponse], items: Sequence[ShearLoad]) -> list[ShearResponse]:
@@ -170,8 +173,26 @@ class ShearTable:
         self.solves += len(todo)
         return out
 
-    def _solve(self, loads: Sequence[ShearLoad]) -> None:
-        wanted = {(float(p), float(d)) for p, d in loads}
+    def _matched(self, loads: Sequence[ShearLoad]) -> set[ShearLoad]:
+        """``loads``, each replaced by a known one of its row within :data:`SAME_LOAD` where there is one."""
+        known: dict[float, list[float]] = {}
+        for p, d in self._known():
+            known.setdefault(p, []).append(d)
+        rows = {p: np.array(sorted(ds)) for p, ds in known.items()}
+        out = set()
+        for p, d in loads:
+            p, d = float(p), float(d)
+            ds = rows.get(p)
+            if ds is not None and len(ds):
+                near = float(ds[np.argmin(np.abs(ds - d))])
+                d = near if abs(near - d) <= SAME_LOAD * abs(d) else d
+            out.add((p, d))
+        return out
+
+    def _solve(self, loads: Sequence[ShearLoad], match: bool = False) -> None:
+        """Make ``loads`` nodes (held ones without a cell solve); with ``match`` a load known to round-off
+        (:data:`SAME_LOAD`) is the known one."""
+        wanted = self._matched(loads) if match else {(float(p), float(d)) for p, d in loads}
         for load in sorted(wanted & set(self.held)):
             self.rows.setdefault(load[0], {0.0: (0.0, 0.0)})[load[1]] = self.held.pop(load)
         for (p, d), v in self._fetch(sorted(wanted - self._known())).items():
@@ -179,8 +200,9 @@ class ShearTable:
 
     def hold(self, loads: Sequence[ShearLoad]) -> dict[ShearLoad, tuple[float, float]]:
         """The responses at ``loads`` (solved where neither a node nor held), kept in :attr:`held` where they
-        are not nodes; the table's law is unchanged."""
-        wanted = {(float(p), float(d)) for p, d in loads}
+        are not nodes (a load known to round-off, :data:`SAME_LOAD`, is the known one); the table's law is
+        unchanged."""
+        wanted = self._matched(loads)
         self.held.update(self._fetch(sorted(wanted - self._known())))
         return {(p, d): self.rows[p][d] if p in self.rows and d in self.rows[p] else self.held[(p, d)]
                 for p, d in wanted}

@@ -182,7 +182,7 @@ class ShearPart(_Part):
         top = max((e for e, _ in groups), default=0.0)
         loads = [x for e, g in groups if e >= SHEAR_MARK * top for x in g]
         loads = sorted(set(loads) | set(whole_rows(self.table, {q for q, _ in loads} - set(self.table.rows))))
-        self.table._solve(loads)
+        self.table._solve(loads, match=True)
         return len(loads)
 
 

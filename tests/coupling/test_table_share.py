@@ -353,3 +353,31 @@ def test_the_shear_share_of_an_fe_friction_cell_is_met_within_the_tables_bound(t
     # for about three times that: the share's two levels in both directions for less than twice the first
     assert relevel.shear.solves - before < 2 * whole, (relevel.shear.solves - before, whole)
     assert {"shear_table_in_pressure", "shear_table_in_jump"} <= set(share.rounds[-1]["parts"])
+
+
+def test_no_cell_load_of_the_shear_table_is_solved_twice_across_the_shares_rounds():
+    """A round's second halving in pressure solves rows at the quarter points at the jumps of a neighbour carried
+    along the rays; made nodes, the first midpoints carry their own (``d m / a``), and the next round's first
+    halving carries those to the same quarter points (``(d m / a) q / m``): the same loads up to their last bits,
+    which were solved again (21 cell solves on the FE friction block at 1e-3)."""
+    from ngcontact.coupling import shear_table as ST
+    calls: list = []
+
+    def response(load):
+        calls.append(load)
+        return shear_response(load)
+    table = ST.ShearTable(response, tol=0.05, length_unit=1e-4)
+    table.cover(2e-4, 2e-3, 5e-4)
+    p = np.linspace(3e-4, 1.8e-3, 31)
+    s = 2e-5 * np.sin(np.linspace(0.1, 3.0, 31))
+    for _ in range(2):                                       # two rounds refining the pressure direction
+        first = TS.shear_finer(table, p, s, direction="pressure")
+        TS.shear_finer(first, p, s, keeper=table, direction="pressure")
+        TS.ShearPart(table, "pressure").adopt(first)
+    TS.shear_finer(TS.shear_finer(table, p, s, direction="pressure"), p, s, keeper=table, direction="pressure")
+    by_row: dict = {}
+    for q, d in calls:
+        by_row.setdefault(q, []).append(d)
+    twice = [(q, a, b) for q, ds in by_row.items() for a, b in zip(sorted(ds), sorted(ds)[1:])
+             if b - a <= 1e-9 * abs(b)]
+    assert len(calls) > 100 and not twice, twice[:3]
