@@ -295,15 +295,22 @@ def test_the_safety_factor_is_a_quantity_of_the_share_and_bounded(tmp_path, monk
     assert share.values["safety_factor"] == pytest.approx(safety(answer), rel=1e-12)
 
 
-def test_the_shear_tables_held_loads_survive_the_cache_and_become_nodes_without_a_cell_solve(tmp_path):
+def counted_shear_table(calls: list):
+    """A shear table of :func:`shear_response` over p in [2e-4, 2e-3], s up to 5e-4, its cell loads in ``calls``."""
     from ngcontact.coupling import shear_table as ST
-    calls: list = []
 
     def response(load):
         calls.append(load)
         return shear_response(load)
     table = ST.ShearTable(response, tol=0.05, length_unit=1e-4)
     table.cover(2e-4, 2e-3, 5e-4)
+    return table
+
+
+def test_the_shear_tables_held_loads_survive_the_cache_and_become_nodes_without_a_cell_solve(tmp_path):
+    from ngcontact.coupling import shear_table as ST
+    calls: list = []
+    table = counted_shear_table(calls)
     nodes, solved = {p: dict(r) for p, r in table.rows.items()}, len(calls)
     p, s = np.array([5e-4, 1e-3, 1.5e-3]), np.array([1e-5, 2e-5, 3e-5])   # |s| / p small: the rows' first jumps
     assert len(TS.shear_loads(table, p, s)) < len(TS.shear_loads(table, p, s, whole=True)) / 2
@@ -312,7 +319,7 @@ def test_the_shear_tables_held_loads_survive_the_cache_and_become_nodes_without_
     assert table.rows == nodes and set(table.held) == {x for x in added if x[1] != 0.0}
     assert len(calls) == solved + len(table.held) and set(level.rows) > set(nodes)   # new rows at the middles
     R.store_shear("s" * 64, table, str(tmp_path))
-    again, cached = R.cached_shear("s" * 64, response, 0.05, 1e-4, ST.serial_map, str(tmp_path))
+    again, cached = R.cached_shear("s" * 64, table.response, 0.05, 1e-4, ST.serial_map, str(tmp_path))
     assert cached and again.rows == nodes and again.held == table.held
     rest = TS.whole_rows(again, set(level.rows) - set(again.rows))     # the new rows made whole when adopted
     assert rest and all(len(r) < len(nodes[max(nodes)]) for q, r in level.rows.items() if q not in nodes)
@@ -360,14 +367,8 @@ def test_no_cell_load_of_the_shear_table_is_solved_twice_across_the_shares_round
     along the rays; made nodes, the first midpoints carry their own (``d m / a``), and the next round's first
     halving carries those to the same quarter points (``(d m / a) q / m``): the same loads up to their last bits,
     which were solved again (21 cell solves on the FE friction block at 1e-3)."""
-    from ngcontact.coupling import shear_table as ST
     calls: list = []
-
-    def response(load):
-        calls.append(load)
-        return shear_response(load)
-    table = ST.ShearTable(response, tol=0.05, length_unit=1e-4)
-    table.cover(2e-4, 2e-3, 5e-4)
+    table = counted_shear_table(calls)
     p = np.linspace(3e-4, 1.8e-3, 31)
     s = 2e-5 * np.sin(np.linspace(0.1, 3.0, 31))
     for _ in range(2):                                       # two rounds refining the pressure direction
