@@ -347,6 +347,8 @@ def test_the_shear_share_of_an_fe_friction_cell_is_met_within_the_tables_bound(t
     problem, _ = D.problem_of(scene, build_geometry(scene))
     sol, _, relevel = R.couple_loop(scene, problem, _partial(D.solve_scene, scene), map_tasks=PT.serial_map,
                                     cache_dir=str(tmp_path / "cache"), shear_map=ST.serial_map)
+    P = relevel.shear.pressures                 # no row again where the loop's range moved by round-off only
+    assert np.min(np.diff(P) / P[1:]) > relevel.shear.tol / 10, P
     prof = interface_profile(sol, scene.output.points_per_element)
     whole = len(TS.shear_loads(relevel.shear, prof["pressure"], prof["jump_t"], whole=True))
     for direction in ("pressure", "jump"):
