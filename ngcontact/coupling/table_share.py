@@ -57,13 +57,12 @@ points between the samples where the law is integrated, in theirs). The interfac
 unbounded at the contact's edge (``p -> 0``) and took every interval of every row in range. A new row likewise ends
 one interval beyond the furthest its points reach (beyond its last node the law holds its shear; no point of the
 interface is there); made a node it is made whole (:func:`whole_rows`): the rows reach as far as before, and the
-table's cover and a second run of the scene solve no cell for it. The parts add,
-``e_Q = e_Q(pressure table) + e_Q(shear table, pressure) + e_Q(shear table, jump)``; each part is reported
-(``parts``). While the sum exceeds the limit, the largest part alone is refined and the next round estimates it
-alone; the others keep their last estimates (``carried``): refining one table or direction leaves the others' terms
-of the law's error as they were (new rows take their jumps along the rays, their polyline errors their neighbours').
-A direction's first midpoints all become nodes (:data:`SHEAR_MARK` = 0): marked by the table's own error its share
-stalled on the frictional block, that error lying where the macro quantities feel it least.
+table's cover and a second run of the scene solve no cell for it. The parts add, ``e_Q = e_Q(pressure table) +
+e_Q(shear table, pressure) + e_Q(shear table, jump)``; each part is reported (``parts``). While the sum exceeds the
+limit, the largest part alone is refined and the next round estimates it alone; the others keep their last estimates
+(``carried``): refining one table or direction leaves the others' terms of the law's error as they were (new rows take
+their jumps along the rays, their polyline errors their neighbours'). A direction's first midpoints all become nodes
+(:data:`SHEAR_MARK` = 0): marked by the table's own error, which lies where the macro feels it least, its share stalled.
 
 Where the scene has a strength check, its safety factor (eq. 78 by the linear recovery) is a headline quantity
 of the share too: its correctors are the strength cell's and depend on the law only through whether it has a
