@@ -8,7 +8,7 @@ from ngcontact import cli
 from sinusoid_cell import sinusoid_cell
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
-from ngcontact.cell.spectral.refinement import next_grid, sweep_to_tolerance
+from ngcontact.cell.spectral.refinement import STIFFNESS, controlled_estimate, next_grid, sweep_to_tolerance
 from ngcontact.errors import ConvergenceError
 from ngcontact.verification.moduli import e_star
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star
@@ -27,7 +27,12 @@ def _make(n):
 def test_the_refined_sweep_meets_its_tolerance_and_the_estimate_bounds_the_true_error():
     loads = [cell_load(2, pressure=r * P_STAR) for r in LOADS]
     refined = sweep_to_tolerance(_make, loads, 1e-5, 256, 2, 2 ** 20)
-    assert refined.estimate <= 1e-5
+    # every quantity but the 2D stiffness meets 1e-5; the stiffness, first order in the grid step, would take
+    # millions of points: refinement stops at its cap, not met, and says where and why
+    held = controlled_estimate(refined.estimates, (STIFFNESS,))
+    assert held <= 1e-5 < refined.estimate and not refined.met
+    assert refined.capped.startswith(f"on grid {refined.history[-1]['grid']}")
+    assert any(r.startswith("the normal stiffness's estimate") for r in refined.remarks)
     assert [h["grid"] for h in refined.history] == [256 * 2 ** k for k in range(len(refined.history))]
     assert len(refined.history) >= 4 and "estimate" not in refined.history[0]
     for r, sol, est in zip(LOADS, refined.solutions, refined.estimates):
@@ -37,13 +42,13 @@ def test_the_refined_sweep_meets_its_tolerance_and_the_estimate_bounds_the_true_
     # the estimate of a level bounds the change from the level before it
     last, before = refined.history[-1], refined.history[-2]
     change = max(abs(a - b) for a, b in zip(last["contact_fraction"], before["contact_fraction"]))
-    assert change <= refined.estimate
+    assert change <= held
 
 
 def test_a_tolerance_beyond_the_largest_grid_raises_with_the_history():
     loads = [cell_load(2, pressure=0.05 * P_STAR)]
     with pytest.raises(ConvergenceError, match=r"tolerance = 1e-12 not met: the estimate is \S+ \((contact_fraction|"
-                                               r"mean_closure|coefficient_\w+), \w+.*, at load 0\) on ") as err:
+                                               r"mean_closure|normal_stiffness|coefficient_\w+), \w+.*, at load 0\) on ") as err:
         sweep_to_tolerance(_make, loads, 1e-12, 256, 2, 4096)
     assert [h["grid"] for h in err.value.history["levels"]] == [256, 512, 1024, 2048, 4096]
 
@@ -63,11 +68,17 @@ def test_a_spectral_scene_with_a_tolerance_reports_the_estimate_and_the_grids(tm
     rep = json.loads((tmp_path / "o" / "report.json").read_text())
     method, load = rep["results"]["method"], rep["results"]["loads"][0]
     assert method["grid"] == method["refinement"][-1]["grid"] > 256
-    assert max(load["error_estimate"].values()) <= 1e-5
+    # every quantity but the 2D stiffness meets 1e-5; the stiffness ends at its cap: counted, not met, the run's
+    # figures stand (exit 0) with the shortfall named
+    assert max(e for name, e in load["error_estimate"].items() if name != STIFFNESS) <= 1e-5
     exact = westergaard_contact_fraction(0.0034523, P_STAR)
     assert load["contact_fraction"] == pytest.approx(exact, abs=1e-5)
     acc = rep["results"]["accuracy"]                     # the same estimates in the verdict, per quantity
-    assert acc["estimated"] and acc["met"] and acc["tolerance"] == 1e-5 and "grids" in acc["how"]
+    assert acc["estimated"] and not acc["met"] and acc["tolerance"] == 1e-5 and "grids" in acc["how"]
+    stiffness = next(q for q in acc["quantities"] if q["name"] == STIFFNESS)
+    assert stiffness["counted"] and not stiffness["met"] and stiffness["controlled_error"] > 1e-5
+    assert f"on grid {method['grid']}" in acc["shortfall"]
+    assert all(q["met"] for q in acc["quantities"] if q["name"] != STIFFNESS)
     assert "Richardson on" in acc["how"]                # which form each estimate took
     fraction = next(q for q in acc["quantities"] if q["name"] == "contact_fraction")
     assert fraction["error"] == load["error_estimate"]["contact_fraction"] and fraction["controlled"] == "absolute"
