@@ -110,10 +110,10 @@ level (second order: faster than its error's first order, so that a stiffness wh
 once its differences contract, as on the random profiles of ``docs/benchmarks.md`` (``random_profile_accuracy``),
 is not given up early), could meet it within them.  Beyond the cap (a 2D tolerance of the order of the fraction's,
 1e-4, would take millions of points at first order) the refinement stops, ``met = False``, the stiffness counted
-in the verdict as not met (one warning line) and the cap named in the remarks, whether or not the scene stated
-the tolerance: the other quantities met it, and the figures stand.  In 3D, whose cost bound (points squared)
-allows a few doublings only, it is reported with its estimate and not held (:func:`uncontrolled`: listed in the
-verdict as not counted).
+in the verdict as not met (one warning line) and the cap named in the remarks; a scene's stated tolerance so missed
+ends its run (:meth:`~ngcontact.cell.spectral.spectral_solver.SpectralCellSolver.refine_to`).  In 3D, whose cost
+bound (points squared) allows a few doublings only, it is reported with its estimate and not held
+(:func:`uncontrolled`: listed in the verdict as not counted).
 
 Two checks end each level's estimate. A contact island of fewer than
 :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: its error may

@@ -20,13 +20,14 @@ from typing import Any
 import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad, cell_load
-from ngcontact.cell.cell_solution import CellSolution
+from ngcontact.cell.cell_solution import CellSolution, worst_estimate
 from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.spectral import grid_measures
 from ngcontact.cell.spectral.coarser_grids import HOW as COARSER_HOW, estimate_from_coarser, why_not
 from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
 from ngcontact.cell.spectral.refinement import HOW, sweep_to_tolerance, uncontrolled
 from ngcontact.cell.whole_surface import flat
+from ngcontact.errors import ConvergenceError
 
 #: the grid fields a solution hands on (the closure is in its surface distribution)
 FIELDS = ("pressure", "gap", "shear", "slip")
@@ -152,7 +153,9 @@ class SpectralCellSolver:
         solver's.  A ``required`` tolerance (the scene's) may use grids up to ``max_points`` and raises out of
         reach, and waits for the 2D edge fit's own levels before a stop (``sharpen``); the default one up to
         ``default_max_points``, its first grid that meets it the answer, and out of reach the finest level
-        with ``met = False``."""
+        with ``met = False``.  A required tolerance the 2D stiffness misses at its cap
+        (:func:`~ngcontact.cell.spectral.refinement.stiffness_capped`) is out of reach too: it raises, with the
+        figures (issue 35: a stated tolerance out of reach ends the run, exit 3, never ``met = false``)."""
         if self.make_cell is None or self.max_points is None:
             raise ValueError("this spectral cell was built without the recipe of finer grids")
         first, make = self.cell, self.make_cell
@@ -160,6 +163,13 @@ class SpectralCellSolver:
         bound = max(min(bound, self.max_points), first.points)
         refined = sweep_to_tolerance(lambda n: first if n == first.grid else make(n), loads, tolerance,
                                      first.grid, first.dim, bound, required=required, sharpen=required)
+        if required and refined.capped:
+            raise ConvergenceError(
+                f"discretization.tolerance = {tolerance:g} not met: the estimate is "
+                f"{worst_estimate(refined.estimates)} {refined.capped}: "
+                + next(r for r in refined.remarks if r.startswith("the normal stiffness's estimate"))
+                + "; state a looser discretization.tolerance (every counted quantity's estimate is held to it)",
+                {"levels": refined.history})
         self.cell = refined.cell
         method = {"grid": self.cell.grid, "points": self.cell.points, "refinement": refined.history}
         solutions = [self.solution(s) for s in refined.solutions]
