@@ -34,10 +34,11 @@ relative, a coefficient relative to its whole-surface value) and relative to the
 (estimate / true error), the grid reached, the run's wall time and its solve time.  The aims: with the
 defaults every quantity within 1 % of the converged value and every estimate at least the true error; with
 the tolerance every quantity the package holds to it (``counted``: every one in 2D, the stiffness too) and
-reports as meeting it (``met``) within 1e-4 in its measure, and every one it reports as not meeting it (the 2D
-stiffness where the refinement stopped at its cap for the stiffness alone: ``accuracy.met = false`` with a
-warning) with an estimate at least its true error.  A tolerance out of reach (the child's exit 3) is a row of
-its own and makes this script end in exit 3 after writing its figures.
+reports as meeting it (``met``) within 1e-4 in its measure.  A tolerance out of reach (the child's exit 3: the
+2D stiffness where the refinement stopped at its cap for the stiffness alone, a stated tolerance being no
+answer unless every counted quantity meets it) is a row of its own, the child's message (the largest estimate,
+the grid reached, what meeting it would take) in its note, and makes this script end in exit 3 after writing
+its figures.
 
     python scripts/random_profile_accuracy.py [OUT] [--seeds 1 2 3] [--jobs 2] [--publish]
 
@@ -319,10 +320,10 @@ NOTE = ("Random 2D profiles of 64 samples (self-affine, Hurst 0.8, rms slope 0.1
         "the 2^20 grid, both in that measure; `effectivity` = estimate / true error. "
         "`counted`: held to the tolerance (in 2D every quantity, the stiffness too: "
         "refined for it up to three grids beyond the one where the others met it, while its estimate falling by "
-        "a quarter per grid could meet it); `met`: the run's own verdict on it (not met: the stiffness stopped "
-        "at that cap, `accuracy.met = false` with a warning). Aims: with the defaults every quantity within 1 % "
-        "and every estimate at least the error; with the tolerance every quantity reported as met within 1e-4 "
-        "in its measure, every one reported as not met with an estimate at least its error. Timings on a "
+        "a quarter per grid could meet it); `met`: the run's own verdict on it. A stated tolerance the stiffness "
+        "misses at that cap is out of reach: the child ends in exit 3 without a report, one row with its message "
+        "in `note`. Aims: with the defaults every quantity within 1 % and every estimate at least the error; with "
+        "the tolerance every quantity reported as met within 1e-4 in its measure. Timings on a "
         "2-core machine shared with other jobs.")
 
 
