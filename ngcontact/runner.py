@@ -21,8 +21,8 @@ from typing import Callable
 
 from ngcontact._version import __version__
 from ngcontact.errors import SceneError
+from ngcontact.parallel.free_cores import affinity   # first: its window of the cores opens with the process
 from ngcontact.output.progress_lines import progress_lines
-from ngcontact.parallel.free_cores import affinity
 from ngcontact.output.report import Clock, Outcome, accuracy_line, build_report, method_line
 from ngcontact.scene import loader
 
@@ -409,7 +409,6 @@ def study_accuracy(path: str, levels: int | None = None, target: float | None = 
         The scene is invalid or of a kind the study does not refine, ``levels`` or ``target`` is out of
         range, or no knob of the scene gives enough admissible levels.
     """
-    import json
     from ngcontact.scene import refinement_ladder as rl
     if target is not None and not 0 < target < 1:
         raise SceneError("--target", target, "an error in (0, 1) (contact fractions absolute, other quantities "
@@ -424,7 +423,7 @@ def study_accuracy(path: str, levels: int | None = None, target: float | None = 
         clock.note(f"left out: {line}")
     distinct = len({lv.key for lv in ladder})
     clock.note(f"{distinct} distinct runs (the scene's own level is shared by its ladders)")
-    own_key = json.dumps(loader.as_dict(scene), sort_keys=True, default=str)
+    own_key = rl.own_key(scene, loader.parsed(path))
     with batches(scene, workers, scheduler, batch_progress, start=True, note=progress, members=distinct) as ex:
         from ngcontact.drivers.study_accuracy import run_study
         outcome = run_study(scene, ladder, dropped, level_report, own_key=own_key, target=target, clock=clock)

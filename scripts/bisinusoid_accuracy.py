@@ -77,6 +77,7 @@ def _fe_solve(cell, order: int, edge: float, load, threads: int) -> tuple[object
     from ngcontact.geometry.cell3d import bisinusoid_gap
     from ngcontact.solvers.linear_solver import LinearSolver
     law = isotropic(2.0 * (1.0 - 0.3 ** 2), 0.3)
+    assert law.lame is not None                 # an isotropic law has its Lame constants
     model = CellModel(rough=law, counter=law, k_n=100.0 * law.lame[1] / edge, order=order,
                       gap=bisinusoid_gap(ACC_H, 1.0), enforcement="exact", linear_trace=order > 1)
     with runner.threads(threads):
@@ -147,7 +148,7 @@ def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None 
     from ngcontact import runner
     from ngcontact.cell.cell_load import cell_load
     loads = [cell_load(3, pressure=r * math.pi * ACC_H) for r in ACC_RATIOS]
-    converged = [2.0 * twin_fraction(REF_GRIDS[1], r) - twin_fraction(REF_GRIDS[0], r) for r in ACC_RATIOS]
+    converged = [converged_fraction(r) for r in ACC_RATIOS]
     threads = runner.thread_count() if threads is None else threads
     rows = edge_rows(edges, orders, threads, loads, converged, cells) if edges else []
     if patch is not None:
@@ -156,11 +157,33 @@ def accuracy_aim(edges, orders=ACC_ORDERS, patch=ACC_PATCH, threads: int | None 
 
 
 @functools.lru_cache(maxsize=None)
-def twin_fraction(grid: int, ratio: float) -> float:
-    """The spectral cell's contact fraction at ``p/p* = ratio`` on a ``grid x grid`` grid (each solved once)."""
+def twin_headline(grid: int, ratio: float) -> dict[str, float]:
+    """The spectral cell's headline quantities (:func:`ngcontact.cell.cell_solution.headline`: contact fraction,
+    mean closure, normal stiffness, eq. 34 coefficients) at ``p/p* = ratio`` on a ``grid x grid`` grid, each
+    grid and load solved once per process."""
     from ngcontact.cell.cell_load import cell_load
-    sol = bisinusoid_spectral(grid).solve(cell_load(3, pressure=ratio * math.pi * ACC_H))
-    return float(sol.results["contact_fraction"])
+    from ngcontact.cell.cell_solution import headline
+    return headline(bisinusoid_spectral(grid).solve(cell_load(3, pressure=ratio * math.pi * ACC_H)).results)
+
+
+def twin_fraction(grid: int, ratio: float) -> float:
+    """The spectral cell's contact fraction at ``p/p* = ratio`` on a ``grid x grid`` grid (:func:`twin_headline`)."""
+    return twin_headline(grid, ratio)["contact_fraction"]
+
+
+def converged(ratio: float) -> dict[str, float]:
+    """The converged bisinusoid at ``p/p* = ratio``: the spectral cell's headline quantities extrapolated from
+    :data:`REF_GRIDS` ``(n, 2 n)`` as ``2 q_2n - q_n`` (each converges at first order in the grid step; module
+    docstring for why not ``512^2``).  The one reference of ``scaling_3d.py`` (the measured rows and, on
+    ``--republish``, the kept ones) and of the scene's rows; its ``k_n`` is 1 and the coefficients ``k_n``,
+    ``g_n`` of exact contact are proportional to it (the contact set does not depend on it)."""
+    coarse, fine = (twin_headline(n, ratio) for n in REF_GRIDS)
+    return {name: 2.0 * fine[name] - coarse[name] for name in fine if name in coarse}
+
+
+def converged_fraction(ratio: float) -> float:
+    """The converged contact fraction at ``p/p* = ratio`` (:func:`converged`)."""
+    return converged(ratio)["contact_fraction"]
 
 
 def twin_floor(value: float, edge: float, ratio: float, twin=twin_fraction) -> tuple[float, int]:
@@ -207,31 +230,3 @@ def extrapolated_rows(rows: list[dict], converged: dict, twin=twin_fraction) -> 
                  100.0 * out[-1]["estimate_gci"], 100.0 * out[-1]["estimate_twin"], n, out[-1]["seconds"])
     return out
 
-
-def aim_status(rows: list[dict], tolerance: float = 0.01, seconds: float = 60.0) -> str:
-    """Whether issue 38's aim (within ``tolerance`` of the converged contact fraction in at most ``seconds``
-    per load) is met, per load, in one Markdown sentence: the fastest row of part 4 meeting it (its cell, its
-    kind, its error; an extrapolation's own estimate beside it, and whether that estimate alone would
-    certify the tolerance); where none does in time, the fastest row within the tolerance and its time, or
-    that no row is within it."""
-    acc = [r for r in rows if r.get("part") == "accuracy" and isinstance(r.get("relative_error"), float)]
-    parts = []
-    for ratio in sorted({r["pressure"] for r in acc}):
-        ok = [r for r in acc if r["pressure"] == ratio and abs(r["relative_error"]) <= tolerance
-              and r["seconds"] <= seconds]
-        close = [r for r in acc if r["pressure"] == ratio and abs(r["relative_error"]) <= tolerance]
-        if not close:
-            parts.append(f"p/p* = {ratio:g}: not met (no row within {100.0 * tolerance:g} %)")
-            continue
-        best = min(ok or close, key=lambda r: r["seconds"])
-        verdict = "met" if ok else f"within {100.0 * tolerance:g} % but not in {seconds:g} s"
-        text = (f"p/p* = {ratio:g}: {verdict} by `{best['solver']}` on the {best.get('cell') or 'period'} "
-                f"(size {best['size']}), {100.0 * best['relative_error']:+.2f} % in {best['seconds']:.0f} s")
-        if isinstance(best.get("estimate"), float):
-            own = "within" if best["estimate"] <= tolerance else "above"
-            text += (f", its own estimate {100.0 * best['estimate']:.2f} % ({own} {100.0 * tolerance:g} %: "
-                     f"{'certified' if own == 'within' else 'not certified'} without the converged value)")
-        parts.append(text)
-    return ("Aim (issue 38: within %g %% of the converged contact fraction in at most %g s per load; an "
-            "extrapolation's seconds are the sum of its solves'): " % (100.0 * tolerance, seconds)
-            + ("; ".join(parts) if parts else "no accuracy rows") + ".")

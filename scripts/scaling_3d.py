@@ -1,6 +1,6 @@
 """3D at scale: cost against size of a 3D cell and a 3D macro problem, direct and iterative; the bisinusoid aim.
 
-Four measurements, one run, one CSV and one PNG:
+Five measurements, one run, one CSV and one PNG:
 
 1. **3D cell** (``geometries/cells/bisinusoid.toml``: order 2, the scene's
    pressure), refining ``interface_maxh``: the Newton solve of one load with
@@ -33,6 +33,12 @@ Four measurements, one run, one CSV and one PNG:
    (:mod:`ngcontact.cell.fe.contact_edge_refinement`): the larger of the grid
    convergence index and the spectral twin's floor, each in its own column,
    and their effectivity against the converged value.
+5. **The aim as a scene** (``scene``, ``bisinusoid_aim.py``): the same bisinusoid
+   posed as a scene, one ``ngcontact run`` per load on one thread, its
+   contact-edge ladder's contact fraction and estimate, wall and CPU seconds.
+
+Parts 4 and 5 score their contact fractions against the one converged value
+(``bisinusoid_accuracy.converged``), and so does ``--republish`` the kept rows.
 
 Every solve of parts 1 and 2 runs in its own child process, so that its peak
 memory (``VmHWM``) is its own.  Reported per solve: dofs, wall time of the
@@ -41,10 +47,6 @@ measurement ``ngcontact run`` makes after it (effective stiffness: a Schur
 complement by the same linear-solver policy; stresses), Newton steps, CG
 iterations, peak memory (measurement included), contact fraction; per
 solver the exponent ``b`` of ``time ~ dofs^b`` fitted over the sizes.
-
-With ``--coarse INTERFACE_MAXH [--k-n K]`` it measures instead BDDC's coarse
-problem on the converged cell: the bubble term's ``gamma`` against the
-whole contact surface on the wirebasket (``scaling_3d_coarse.csv``, ``.png``).
 
 With ``--republish CSV`` it measures nothing: it reads the measured rows of
 an earlier run's ``scaling_3d.csv``, makes the rows derived from them again
@@ -59,14 +61,12 @@ and commits measured them (:mod:`scaling_3d_rows`), so that the section is
 published again, in any clone, by
 ``python scripts/scaling_3d.py --republish docs/benchmarks/scaling_3d --publish``.
 
-With ``--breakdown INTERFACE_MAXH`` it measures instead where one iterative
-cell solve spends its time (CG per iteration, one BDDC application, one
-product with the tangent, the size of BDDC's coarse problem) and writes
-``scaling_3d_breakdown.csv`` and ``.png``.
+With ``--breakdown INTERFACE_MAXH`` or ``--coarse INTERFACE_MAXH [--k-n K]`` it
+runs instead one of the BDDC studies of :mod:`scaling_3d_bddc` (its own CSV, PNG and section).
 
 Usage::
 
-    python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral accuracy]
+    python scripts/scaling_3d.py [OUT_DIR] [--quick] [--direct-max 45000] [--parts cell macro spectral accuracy scene]
                                  [--accuracy-edges [EDGE_MAXH ...]] [--accuracy-orders 1 2]
                                  [--accuracy-patch N_EDGE N_BODY DEPTH | --accuracy-no-patch]
                                  [--accuracy-patch-growth GROWTH] [--accuracy-cells quarter period]
@@ -93,8 +93,9 @@ from ngcontact.output.writer import write_csv
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
-from bisinusoid_accuracy import (ACC_CELLS, ACC_EDGES, ACC_PATCH, QUICK_EDGES, accuracy_aim,  # noqa: E402
-                                 aim_status)
+from bisinusoid_accuracy import ACC_CELLS, ACC_EDGES, ACC_PATCH, QUICK_EDGES, REF_GRIDS, accuracy_aim  # noqa: E402
+from bisinusoid_aim import aim_status, plot_aim, scene_rows  # noqa: E402
+from scaling_3d_bddc import period_scene, study  # noqa: E402
 from scaling_3d_rows import ARCHIVE, MEASURED, keep, measured, read_rows, with_extrapolations  # noqa: E402
 
 log = logging.getLogger("scaling_3d")
@@ -107,18 +108,9 @@ MACRO_SIZES = (0.3, 0.2, 0.14, 0.1, 0.075, 0.041)
 QUICK_CELL, QUICK_MACRO = (0.16, 0.12), (0.35, 0.3)
 AMPLITUDE, PRESSURES = 0.005, (0.00185, 0.0065)
 SPECTRAL_GRIDS, TAMAAS_GRID = (64, 128, 256, 512), 1024
-KEYS = ("part", "solver", "cell", "size", "ndof", "seconds", "measure_seconds", "twin_seconds", "mesh_seconds",
-        "solve_seconds", "newton_steps", "cg_iterations", "peak_memory_gb", "contact_fraction", "pressure",
-        "relative_error", "estimate", "estimate_gci", "estimate_twin", "effectivity")
-
-
-def period_scene():
-    """The shipped bisinusoid cell scene meshed over its whole period (``discretization.symmetry = "off"``):
-    parts 1 and the solver studies measure cost against the period's dofs."""
-    from dataclasses import replace
-    from ngcontact.scene.loader import load
-    scene = load(os.path.join(ROOT, "geometries", "cells", "bisinusoid.toml"))
-    return replace(scene, discretization=replace(scene.discretization, symmetry="off"))
+KEYS = ("part", "solver", "cell", "size", "ndof", "seconds", "cpu_seconds", "measure_seconds", "twin_seconds",
+        "mesh_seconds", "solve_seconds", "newton_steps", "cg_iterations", "peak_memory_gb", "contact_fraction",
+        "pressure", "relative_error", "estimate", "estimate_gci", "estimate_twin", "effectivity")
 
 
 def peak_memory_gb() -> float:
@@ -134,7 +126,6 @@ def cell_child(size: float, policy: str) -> dict:
     from ngcontact import runner
     from ngcontact.cell.fe.cell_problem import CellProblem
     from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
-    from ngcontact.scene.loader import load
     from ngcontact.solvers.linear_solver import LinearSolver
     scene = period_scene()
     cell = build_cell(scene, interface_maxh=size)
@@ -142,10 +133,10 @@ def cell_child(size: float, policy: str) -> dict:
         t0 = time.perf_counter()
         # as ngcontact run: the first load starts from the spectral twin's contact set
         P = CellProblem(cell, model_of(scene), linear=LinearSolver(policy), predictor=predictor_twin(scene, size))
-        load = cell_loads(scene)[0]
-        sol = P.solve(load, first=True, measure=False)
+        first = cell_loads(scene)[0]
+        sol = P.solve(first, first=True, measure=False)
         secs = time.perf_counter() - t0
-        P.measure(load)                                # what ngcontact run reports: effective stiffness, stresses
+        P.measure(first)                                # what ngcontact run reports: effective stiffness, stresses
         measure_secs = time.perf_counter() - t0 - secs
     return {"part": "cell", "solver": policy, "size": size, "ndof": P.ndof, "seconds": secs,
             "measure_seconds": measure_secs,
@@ -265,11 +256,18 @@ def exponent(rows: list[dict], part: str, solver: str) -> float | None:
 
 
 def plot(rows: list[dict], path: str) -> None:
+    """One panel per part with rows in this table: cost against dofs of parts 1 and 2, the spectral cell
+    against Tamaas, the aim (:func:`bisinusoid_aim.plot_aim`)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
-    for ax, part in zip(axes[:2], ("cell", "macro")):
+    fe = [part for part in ("cell", "macro") if any(r["part"] == part for r in rows)]
+    spectral = any(r["solver"] == "tamaas" for r in rows)
+    aim = any(r["part"] in ("accuracy", "scene") for r in rows)
+    n = max(len(fe) + spectral + aim, 1)
+    fig, axes = plt.subplots(1, n, figsize=(5 * n, 4.2), squeeze=False)
+    panels = iter(axes[0])
+    for part, ax in zip(fe, panels):            # fe first: zip stops on it before taking a panel
         for solver, style in (("iterative", "o-"), ("direct", "s--")):
             sel = [r for r in rows if r["part"] == part and r["solver"] == solver]
             if sel:
@@ -284,178 +282,28 @@ def plot(rows: list[dict], path: str) -> None:
         ax.set_ylabel("wall time, setup and solve [s]")
         ax.set_title("3D cell (bisinusoid)" if part == "cell" else "3D macro press fit")
         ax.grid(True, which="both", alpha=0.3)
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend()
-    ax = axes[2]
-    for p in PRESSURES:
-        ref = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "tamaas" and r["pressure"] == p]
-        sel = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "ngcontact spectral"
-               and r["pressure"] == p]
-        if ref and sel:
-            f0 = ref[0]["contact_fraction"]
-            ax.loglog([r["seconds"] for r in sel], [max(abs(r["contact_fraction"] / f0 - 1), 1e-8) for r in sel],
-                      "^-", label=f"spectral, p = {p:g} (Tamaas {TAMAAS_GRID}^2: {f0:.4f})")
-    ax.axhline(5e-3, color="k", lw=0.8, ls=":", label="0.5 %")
-    ax.set_xlabel("wall time [s]")
-    ax.set_ylabel("contact fraction, relative to Tamaas 1024^2")
-    ax.set_title("bisinusoid, 20 % and 60 % contact")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+        ax.legend()
+    if spectral:
+        ax = next(panels)
+        for p in PRESSURES:
+            ref = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "tamaas" and r["pressure"] == p]
+            sel = [r for r in rows if r["part"] == "bisinusoid" and r["solver"] == "ngcontact spectral"
+                   and r["pressure"] == p]
+            if ref and sel:
+                f0 = ref[0]["contact_fraction"]
+                ax.loglog([r["seconds"] for r in sel], [max(abs(r["contact_fraction"] / f0 - 1), 1e-8) for r in sel],
+                          "^-", label=f"spectral, p = {p:g} (Tamaas {TAMAAS_GRID}^2: {f0:.4f})")
+        ax.axhline(5e-3, color="k", lw=0.8, ls=":", label="0.5 %")
+        ax.set_xlabel("wall time [s]")
+        ax.set_ylabel("contact fraction, relative to Tamaas 1024^2")
+        ax.set_title("bisinusoid, 20 % and 60 % contact")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    if aim:
+        plot_aim(next(panels), rows)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
-
-
-BREAKDOWN_KEYS = ("size", "ndof", "wirebasket_dofs", "wirebasket_contact_dofs", "cg_iterations", "cg_seconds",
-                  "ms_per_cg_iteration", "ms_per_matvec", "ms_per_bddc")
-
-
-def breakdown(size: float, out: str) -> dict:
-    """Where an iterative 3D cell solve spends its time: CG's cost per iteration against one product with the
-    tangent and one BDDC application, and the size of BDDC's coarse problem (its wirebasket dofs, and those of
-    them on the contact surface).  Writes ``scaling_3d_breakdown.csv`` and ``.png``."""
-    import ngsolve as ng
-    from ngcontact import runner
-    from ngcontact.cell.fe.cell_problem import CellProblem
-    from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
-    from ngcontact.solvers.linear_solver import LinearSolver
-    scene = period_scene()
-    cell = build_cell(scene, interface_maxh=size)
-    with runner.threads(runner.thread_count()):
-        P = CellProblem(cell, model_of(scene), linear=LinearSolver("iterative"), predictor=predictor_twin(scene, size))
-        import ngsolve.krylovspace as K
-        spent = [0.0]
-        solve = K.CGSolver._SolveImpl
-
-        def timed(self, *a, **kw):
-            t0 = time.perf_counter()
-            try:
-                return solve(self, *a, **kw)
-            finally:
-                spent[0] += time.perf_counter() - t0
-        K.CGSolver._SolveImpl = timed
-        try:
-            P.solve(cell_loads(scene)[0], first=True, measure=False)
-        finally:
-            K.CGSolver._SolveImpl = solve
-        A = P.energy().mat
-        pre = next(iter(P.linear._pre.values())).mat
-        x, y = A.CreateColVector(), A.CreateColVector()
-        x.SetRandom()
-        ms = {}
-        for name, op in (("matvec", A), ("bddc", pre)):
-            t0 = time.perf_counter()
-            for _ in range(20):
-                y.data = op * x
-            ms[name] = (time.perf_counter() - t0) / 20 * 1e3
-    wb = ng.COUPLING_TYPE.WIREBASKET_DOF
-    X = P.X
-    on_contact = {d for el in cell.mesh.Boundaries("contact").Elements() for d in X.GetDofNrs(el) if d >= 0}
-    its = sum(P.linear.iterations)
-    row = {"size": size, "ndof": X.ndof, "wirebasket_dofs": sum(X.CouplingType(d) == wb for d in range(X.ndof)),
-           "wirebasket_contact_dofs": sum(X.CouplingType(d) == wb for d in on_contact), "cg_iterations": its,
-           "cg_seconds": spent[0], "ms_per_cg_iteration": spent[0] / max(its, 1) * 1e3,
-           "ms_per_matvec": ms["matvec"], "ms_per_bddc": ms["bddc"]}
-    log.info("breakdown at interface_maxh %g: %s", size, ", ".join(f"{k} = {row[k]:.4g}" for k in BREAKDOWN_KEYS))
-    os.makedirs(out, exist_ok=True)
-    write_csv(os.path.join(out, "scaling_3d_breakdown.csv"), list(BREAKDOWN_KEYS), [[row[k] for k in BREAKDOWN_KEYS]])
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    names = ("ms_per_cg_iteration", "ms_per_bddc", "ms_per_matvec")
-    ax.bar(range(3), [row[k] for k in names])
-    ax.set_xticks(range(3), ["CG iteration", "BDDC application", "tangent product"])
-    ax.set_ylabel("ms")
-    ax.set_title(f"3D cell, {row['ndof']} dofs: coarse problem {row['wirebasket_dofs']} dofs "
-                 f"({row['wirebasket_contact_dofs']} on S_C)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "scaling_3d_breakdown.png"), dpi=120)
-    plt.close(fig)
-    return row
-
-
-COARSE_KEYS = ("size", "ndof", "k_n", "coarse", "gamma", "wirebasket_dofs", "cg_iterations", "cg_seconds",
-               "ms_per_cg_iteration")
-COARSE_GAMMAS = (3e-5, 1.1e-4, 3e-4, 1e-3)
-
-
-def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
-    """BDDC's coarse problem on the converged 3D cell: the bubble term's ``gamma`` (the contact surface's
-    edge dofs as interface dofs, :func:`ngcontact.fem.elasticity.bubble_term`) against the whole contact
-    surface on the wirebasket.  Each preconditioner is built at the converged state and CG solves one
-    tangent system with a random right-hand side to 1e-8.  Writes ``scaling_3d_coarse.csv`` and ``.png``."""
-    from dataclasses import replace
-
-    import ngsolve as ng
-    from ngsolve.krylovspace import CGSolver
-    from ngcontact import runner
-    from ngcontact.cell.fe.cell_energy import preconditioning_form
-    from ngcontact.cell.fe.cell_problem import CellProblem
-    from ngcontact.drivers.build import build_cell, cell_loads, model_of, predictor_twin
-    from ngcontact.fem import elasticity
-    from ngcontact.solvers.linear_solver import LinearSolver
-    scene = period_scene()
-    model = model_of(scene) if k_n is None else replace(model_of(scene), k_n=k_n)
-    rows = []
-    with runner.threads(runner.thread_count()):
-        P = CellProblem(build_cell(scene, interface_maxh=size), model, linear=LinearSolver("iterative"),
-                        predictor=predictor_twin(scene, size))
-        P.solve(cell_loads(scene)[0], first=True, measure=False)
-        A = P.energy().mat
-        b = A.CreateColVector()
-        b.SetRandom()
-        free = P.X.FreeDofs()
-        b.FV().NumPy()[~np.array(free, dtype=bool)] = 0.0
-        WB = ng.COUPLING_TYPE.WIREBASKET_DOF
-        default = elasticity.BUBBLE_GAMMA
-
-        def measure(form, coarse, gamma):
-            pre = ng.Preconditioner(getattr(form, "form", form), "bddc")
-            form.AssembleLinearization(P.gfu.vec)
-            x = A.CreateColVector()
-            cg = CGSolver(A, pre.mat, tol=1e-8, maxiter=5000, printrates=False)
-            t0 = time.perf_counter()
-            x.data = cg * b
-            secs = time.perf_counter() - t0
-            row = {"size": size, "ndof": P.X.ndof, "k_n": model.k_n, "coarse": coarse, "gamma": gamma,
-                   "wirebasket_dofs": sum(P.X.CouplingType(d) == WB for d in range(P.X.ndof)),
-                   "cg_iterations": cg.iterations, "cg_seconds": secs,
-                   "ms_per_cg_iteration": secs / max(cg.iterations, 1) * 1e3}
-            log.info("coarse %-20s gamma %-8s: %5d CG iterations, %.2f s, %.1f ms each, %d coarse dofs", coarse,
-                     gamma, row["cg_iterations"], secs, row["ms_per_cg_iteration"], row["wirebasket_dofs"])
-            rows.append(row)
-        try:
-            for gamma in COARSE_GAMMAS:
-                elasticity.BUBBLE_GAMMA = gamma
-                state = ng.GridFunction(P.X)        # the converged state the preconditioner is built at
-                state.vec.data = P.gfu.vec
-                measure(preconditioning_form(P, state), "vertices + bubble term", gamma)
-        finally:
-            elasticity.BUBBLE_GAMMA = default
-        elasticity.surface_wirebasket(P.X, P.mesh, "contact")
-        measure(P.form, "contact surface", "")
-    os.makedirs(out, exist_ok=True)
-    write_csv(os.path.join(out, "scaling_3d_coarse.csv"), list(COARSE_KEYS),
-              [[r[k] for k in COARSE_KEYS] for r in rows])
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 3.8))
-    bubble = [r for r in rows if r["gamma"] != ""]
-    ax.semilogx([r["gamma"] for r in bubble], [r["cg_seconds"] for r in bubble], "o-",
-                label=f"vertices + bubble term ({bubble[0]['wirebasket_dofs']} coarse dofs)")
-    ax.axhline(rows[-1]["cg_seconds"], color="k", ls="--",
-               label=f"contact surface on the wirebasket ({rows[-1]['wirebasket_dofs']} coarse dofs)")
-    ax.axvline(default, color="0.6", lw=0.8, ls=":", label=f"BUBBLE_GAMMA = {default:g}")
-    ax.set_xlabel("gamma")
-    ax.set_ylabel("CG solve to 1e-8 [s]")
-    ax.set_title(f"3D bisinusoid cell, {rows[0]['ndof']} dofs, k_n = {model.k_n:g}", fontsize=9)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "scaling_3d_coarse.png"), dpi=120)
-    plt.close(fig)
-    return rows
 
 
 def measured_rows(args) -> list[dict]:
@@ -468,6 +316,8 @@ def measured_rows(args) -> list[dict]:
         rows += accuracy_aim(edges, tuple(args.accuracy_orders), None if args.accuracy_no_patch else
                              tuple(args.accuracy_patch), args.accuracy_threads, args.accuracy_patch_growth,
                              tuple(args.accuracy_cells))
+    if "scene" in args.parts:
+        rows += scene_rows(os.path.join(args.out, "scene"))
     return rows
 
 
@@ -481,9 +331,9 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="two small sizes of each part (a smoke run)")
     ap.add_argument("--direct-max", type=int, default=45000,
                     help="no direct solves beyond the first size above this many dofs")
-    ap.add_argument("--parts", nargs="+", choices=("cell", "macro", "spectral", "accuracy"),
-                    default=("cell", "macro", "spectral", "accuracy"),
-                    help="which of the four measurements to run (default: all)")
+    ap.add_argument("--parts", nargs="+", choices=("cell", "macro", "spectral", "accuracy", "scene"),
+                    default=("cell", "macro", "spectral", "accuracy", "scene"),
+                    help="which of the five measurements to run (default: all)")
     ap.add_argument("--solvers", nargs="+", choices=("iterative", "direct"), default=("iterative", "direct"),
                     help="which linear solvers of parts 1 and 2 to run (default: both)")
     ap.add_argument("--breakdown", type=float, default=None, metavar="INTERFACE_MAXH",
@@ -521,28 +371,7 @@ def main(argv=None) -> int:
     if args.republish and args.keep_rows:
         ap.error("--republish measures nothing, --keep-rows keeps rows above those measured: give one of them")
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    if args.breakdown is not None:
-        breakdown(args.breakdown, args.out)
-        if args.publish:
-            benchmark_doc.publish("scaling_3d_breakdown", "3D cell: where an iterative solve spends its time",
-                                  os.path.join(args.out, "scaling_3d_breakdown.csv"),
-                                  note="One BDDC-CG cell solve of the bisinusoid: CG iterations and seconds, "
-                                       "milliseconds per CG iteration, per BDDC application and per product with "
-                                       "the tangent; the size of BDDC's coarse problem (wirebasket dofs, those on "
-                                       "the contact surface).",
-                                  png=os.path.join(args.out, "scaling_3d_breakdown.png"))
-        return 0
-    if args.coarse is not None:
-        coarse_study(args.coarse, args.out, args.k_n)
-        if args.publish:
-            benchmark_doc.publish("scaling_3d_coarse", "3D cell: BDDC's coarse problem, bubble term against "
-                                  "the contact surface on the wirebasket",
-                                  os.path.join(args.out, "scaling_3d_coarse.csv"),
-                                  note="CG to 1e-8 on the tangent of the converged bisinusoid cell with a random "
-                                       "right-hand side: the bubble term of `ngcontact.fem.elasticity.bubble_term` "
-                                       "for several `gamma` (the shipped one is `BUBBLE_GAMMA`), and the whole "
-                                       "contact surface on the wirebasket.",
-                                  png=os.path.join(args.out, "scaling_3d_coarse.png"))
+    if study(args):                     # --breakdown or --coarse: a BDDC study instead
         return 0
     kept = read_rows(args.republish or args.keep_rows) if args.republish or args.keep_rows else []
     new = [] if args.republish else measured(measured_rows(args))
@@ -591,11 +420,16 @@ def main(argv=None) -> int:
                                    "same sizes, zero normal displacement on the quarter's mirror faces), "
                                    "per `pressure` = p/p* "
                                    "(p* = pi E* h, h = 0.01, E* = 1), `relative_error` of the contact fraction "
-                                   "against the spectral cell extrapolated from 1024^2 and 2048^2 (issue 38 aims "
+                                   f"against the spectral cell extrapolated from {REF_GRIDS[0]}^2 and "
+                                   f"{REF_GRIDS[1]}^2, the kept rows' errors too (issue 38 aims "
                                    "at 1 % in 60 s; seconds: twin, meshing and solve, each on its own in "
                                    "`twin_seconds`, `mesh_seconds`, `solve_seconds`" + (
                                        f", {args.accuracy_threads} thread(s)" if args.accuracy_threads else "") +
-                                   "); timings under the load of other jobs. Seconds of "
+                                   "); part `scene`: the bisinusoid posed as a scene, one `ngcontact run` per "
+                                   "load on one thread, the contact fraction its contact-edge ladder reports "
+                                   "(`size`: its levels), `estimate` its own (relative), `cpu_seconds` the run's "
+                                   "CPU time, `seconds` its wall time; timings under the load of other jobs. "
+                                   "Seconds of "
                                    "setup and solve, of the measurement after it, Newton steps, CG iterations, "
                                    "peak memory. Fitted: " + ("; ".join(fits) if fits else "none") + ".",
                               png=os.path.join(args.out, "scaling_3d.png"))

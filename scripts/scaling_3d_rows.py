@@ -16,7 +16,7 @@ import os
 import shutil
 
 import benchmark_doc
-from bisinusoid_accuracy import extrapolated_rows
+from bisinusoid_accuracy import converged_fraction, extrapolated_rows
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: the folder of the published rows and the note of how they were measured (module docstring)
@@ -45,15 +45,28 @@ def measured(rows: list[dict]) -> list[dict]:
     return [r for r in rows if not str(r.get("solver", "")).endswith(EXTRAPOLATED)]
 
 
-def with_extrapolations(rows: list[dict]) -> list[dict]:
-    """The measured ``rows`` in their order, then the rows derived from all of them (:func:`extrapolated_rows`;
-    the converged contact fraction per load the one the rows compared with, ``contact_fraction / (1 +
-    relative_error)``).  A run that keeps an earlier run's rows and a republication of its table make the same
-    table: the derived rows last, made from every measured row."""
-    rows = measured(rows)
+def rescored(row: dict, reference=converged_fraction) -> dict:
+    """A measured row of the bisinusoid (parts ``accuracy`` and ``scene``) with its ``relative_error`` against
+    ``reference(p/p*)``, the converged contact fraction (:func:`bisinusoid_accuracy.converged_fraction`), and
+    its ``effectivity`` = estimate / |relative_error| where it has an estimate, whatever reference it was
+    measured against; any other row as it is."""
+    if row.get("part") not in ("accuracy", "scene") or not isinstance(row.get("contact_fraction"), float):
+        return row
+    error = row["contact_fraction"] / reference(row["pressure"]) - 1.0
+    out = {**row, "relative_error": error}
+    if isinstance(row.get("estimate"), float) and error:
+        out["effectivity"] = row["estimate"] / abs(error)
+    return out
+
+
+def with_extrapolations(rows: list[dict], reference=converged_fraction) -> list[dict]:
+    """The measured ``rows`` in their order, their errors against ``reference`` (:func:`rescored`: the kept rows
+    of an earlier reference scored again), then the rows derived from all of them (:func:`extrapolated_rows`).
+    A run that keeps an earlier run's rows and a republication of its table make the same table: the derived
+    rows last, made from every measured row."""
+    rows = [rescored(r, reference) for r in measured(rows)]
     accuracy = [r for r in rows if r["part"] == "accuracy"]
-    converged = {r["pressure"]: r["contact_fraction"] / (1.0 + r["relative_error"]) for r in accuracy}
-    return rows + extrapolated_rows(accuracy, converged)
+    return rows + extrapolated_rows(accuracy, {p: reference(p) for p in {r["pressure"] for r in accuracy}})
 
 
 def read_rows(path: str) -> list[dict]:

@@ -15,8 +15,8 @@ This package, spectral: the small-slope cell of two layers ``DEPTH`` thick
 solved on a grid with FFTs and exact contact
 (:mod:`ngcontact.cell.spectral.layered_cell`), from ``N = 2^10`` to ``2^16`` points,
 the contact edges placed between grid points; and the same refined from
-``N = 2^10`` to the tolerances 1e-4, 1e-5, 1e-6
-(``geometries/cells/westergaard_exact.toml``), every level timed.
+``N = 2^10`` to the tolerances 1e-4, 1e-5, 1e-6 (the refinement of
+``geometries/cells/westergaard_exact.toml``), every level timed.
 
 This package, FE: the FE cell of :class:`ngcontact.cell.fe.cell_problem.CellProblem`
 (bodies 2 periods deep, so that their finite depth changes the half-space
@@ -214,8 +214,10 @@ def spectral(n: int) -> dict:
 def spectral_to_tolerance(tolerance: float) -> dict:
     """The four loads on the spectral cell refined from ``N = 2^10`` until the estimate meets ``tolerance``.
 
-    The scene ``geometries/cells/westergaard_exact.toml`` at ``tolerance = 1e-6``
-    (:mod:`ngcontact.cell.spectral.refinement`); the time includes every level.
+    The refinement of the scene ``geometries/cells/westergaard_exact.toml``
+    (:mod:`ngcontact.cell.spectral.refinement`), called directly: where the 2D stiffness ends at its cap the
+    sweep of the other quantities is timed, which a scene stating the tolerance would refuse (exit 3); the
+    time includes every level.
     """
     pstar = westergaard_p_star(e_star(1.0, NU, 1.0, NU), H_GAP, 1.0)
     t0 = time.perf_counter()

@@ -84,6 +84,8 @@ class Refinement:
     #: where a refinement towards the default tolerance ended on its budget before meeting it: the budget and
     #: what meeting the tolerance would take, in words (the run's warning and ``accuracy.shortfall``), else ""
     shortfall: str = ""
+    #: what the run's warning advises where there is a shortfall
+    remedy: str = "raise discretization.budget_dofs or state discretization.tolerance"
 
 
 class CellSolver(Protocol):
@@ -219,7 +221,8 @@ def joined(parts: list[Refinement]) -> Refinement:
                       uncontrolled=tuple(dict.fromkeys(u for p in parts for u in p.uncontrolled)),
                       scales=rows(lambda p: p.scales), loose=rows(lambda p: p.loose),
                       scene_discretization=all(p.scene_discretization for p in parts),
-                      shortfall=worst.shortfall if worst is not None else "")
+                      shortfall=worst.shortfall if worst is not None else "",
+                      **({"remedy": worst.remedy} if worst is not None else {}))
 
 
 def joined_method(parts: list[Refinement]) -> dict[str, Any]:

@@ -37,6 +37,14 @@ rows cover the jumps ``[0, s_hi]`` asked for (the macro interface's, with
 headroom): a row is extended by doubling ``Delta`` until its last jump
 reaches ``s_hi`` or its shear levels off (the last doubling changed it by
 at most ``tol``; beyond the row the law holds the shear: the cell slides).
+A range asked for that exceeds the rows by at most ``tol`` (relative: in
+pressure at either end, and in the jump) is covered already: the loop asks
+with headroom, so the interface's own pressures and jumps lie well inside
+the rows, while the request moves a little with the macro solution each
+time the law changes.  Extended by any excess, the loop's last growth on
+the FE friction block (``scripts/two_scale_table_share.py``) moved its
+largest pressure by a relative 1e-6 and the loop added four rows within
+1e-6 of the last one: the same row solved four more times.
 The cell solves of one level (all rows' new nodes together) are independent
 and go through ``map_tasks``, like the pressure table's.
 
@@ -80,6 +88,9 @@ ShearLoad = tuple[float, float]
 EXTEND_BELOW = 0.5
 #: largest number of doublings of a row's far-face jump
 MAX_DOUBLINGS = 24
+#: two far-face jumps of one row closer than this (relative) are one load: a row's jumps carried along the rays
+#: by two paths (``d q / a`` and ``(d m / a) q / m``) differ in their last bits, and were solved twice
+SAME_LOAD = 1e-12
 
 
 def serial_map(task: Callable[[ShearLoad], ShearResponse], items: Sequence[ShearLoad]) -> list[ShearResponse]:
@@ -162,8 +173,26 @@ class ShearTable:
         self.solves += len(todo)
         return out
 
-    def _solve(self, loads: Sequence[ShearLoad]) -> None:
-        wanted = {(float(p), float(d)) for p, d in loads}
+    def _matched(self, loads: Sequence[ShearLoad]) -> set[ShearLoad]:
+        """``loads``, each replaced by a known one of its row within :data:`SAME_LOAD` where there is one."""
+        known: dict[float, list[float]] = {}
+        for p, d in self._known():
+            known.setdefault(p, []).append(d)
+        rows = {p: np.array(sorted(ds)) for p, ds in known.items()}
+        out = set()
+        for p, d in loads:
+            p, d = float(p), float(d)
+            ds = rows.get(p)
+            if ds is not None and len(ds):
+                near = float(ds[np.argmin(np.abs(ds - d))])
+                d = near if abs(near - d) <= SAME_LOAD * abs(d) else d
+            out.add((p, d))
+        return out
+
+    def _solve(self, loads: Sequence[ShearLoad], match: bool = False) -> None:
+        """Make ``loads`` nodes (held ones without a cell solve); with ``match`` a load known to round-off
+        (:data:`SAME_LOAD`) is the known one."""
+        wanted = self._matched(loads) if match else {(float(p), float(d)) for p, d in loads}
         for load in sorted(wanted & set(self.held)):
             self.rows.setdefault(load[0], {0.0: (0.0, 0.0)})[load[1]] = self.held.pop(load)
         for (p, d), v in self._fetch(sorted(wanted - self._known())).items():
@@ -171,8 +200,9 @@ class ShearTable:
 
     def hold(self, loads: Sequence[ShearLoad]) -> dict[ShearLoad, tuple[float, float]]:
         """The responses at ``loads`` (solved where neither a node nor held), kept in :attr:`held` where they
-        are not nodes; the table's law is unchanged."""
-        wanted = {(float(p), float(d)) for p, d in loads}
+        are not nodes (a load known to round-off, :data:`SAME_LOAD`, is the known one); the table's law is
+        unchanged."""
+        wanted = self._matched(loads)
         self.held.update(self._fetch(sorted(wanted - self._known())))
         return {(p, d): self.rows[p][d] if p in self.rows and d in self.rows[p] else self.held[(p, d)]
                 for p, d in wanted}
@@ -292,10 +322,12 @@ class ShearTable:
         else:
             P = list(self.pressures)
             new = []
-            if lo < P[0] * (1 - 1e-6):
+            if lo < P[0] * (1 - self.tol):       # within tol of the rows: covered (module docstring)
                 new += [float(q) for q in np.geomspace(EXTEND_BELOW * lo, P[0], start_nodes)[:-1]]
-            if hi > P[-1] * (1 + 1e-6):
+            if hi > P[-1] * (1 + self.tol):
                 new += [float(q) for q in np.geomspace(P[-1], hi, start_nodes)[1:]]
+            if s_hi <= self.covered_jump * (1 + self.tol):
+                s_hi = min(s_hi, self.covered_jump)
             self._build(sorted(set(P) | set(new)), max(s_hi, self.covered_jump))
         longer = s_hi > self.covered_jump and bool(self.checked)
         self.covered_jump = max(self.covered_jump, s_hi)

@@ -26,49 +26,43 @@ bound is the larger are listed per round as ``second_halving_larger``).  The lar
 Its effectivity is tested against a table halved four times more (tests/coupling/test_table_share.py) and
 measured by ``scripts/two_scale_table_share.py`` (docs/benchmarks.md).
 
-Refinement: while the share exceeds :data:`FRACTION` of the tolerance, the midpoints of ``T'`` where the table's
-own error (the discrepancy of the held response against ``T``'s interpolants and law,
+Refinement: while the share exceeds :data:`FRACTION` of the tolerance, the midpoints of ``T'`` where the table's own
+error (the discrepancy of the held response against ``T``'s interpolants and law,
 :meth:`~ngcontact.coupling.pressure_table.CellTable.discrepancy`) is at least :data:`MARK` of its largest become
-nodes, the macro problem is solved with the new law, and the estimate is made again (the other midpoints stay
-held: the next estimate halves those intervals without a cell solve), at most :data:`MAX_ROUNDS` times.  A round
-whose first halving alone puts the share above the limit (``2 d1``, the smaller of the two bounds, the tables'
-parts added) refines without the second halving, which could only raise the estimate; its share is recorded as
-that lower bound (``halvings`` 1 in its round).
-Adopting all of ``T'`` solves more cells for the same share (``scripts/two_scale_table_share.py`` sets the two
-side by side).  Beyond :data:`MAX_ROUNDS` rounds, or past the table's bound on its cell solves, the tolerance is
-out of reach and the run ends with its figures (a :class:`~ngcontact.errors.ConvergenceError`, exit 3).  The rest of
-the tolerance is left to the macro discretization and the loop's residual, each judged on its own.
+nodes, the macro problem is solved with the new law, and the estimate is made again (the other midpoints stay held:
+the next estimate halves those intervals without a cell solve), at most :data:`MAX_ROUNDS` times.  A round whose
+first halving alone puts the share above the limit (``2 d1``, the smaller bound, the parts added) refines without
+the second halving, which could only raise it; its share is that lower bound (``halvings`` 1).  Beyond
+:data:`MAX_ROUNDS` rounds, or past the table's bound on its cell solves, the tolerance is out of reach and the run
+ends with its figures (a :class:`~ngcontact.errors.ConvergenceError`, exit 3).  The rest of the tolerance is left to
+the macro discretization and the loop's residual, each judged on its own.
 
 The midpoints of the last estimate are solved but are not nodes of the answer's law: the table keeps them
 (:attr:`~ngcontact.coupling.pressure_table.CellTable.held`) and the cache stores them, so that a second run
 of the scene reproduces the first and estimates its share without a cell solve.
 
-A cell with micro friction has a second table, the shear table of :mod:`ngcontact.coupling.shear_table`
-(rows ``s -> tau`` at pressures, the macro law's tangential part).  Its share is estimated the same way, each
-table on its own (the other held at its nodes), and the shear table in each of its two directions on its own:
-in the pressure, the rows' pressure intervals holding the interface's pressures, and one more on either side,
-get a row at their middle (at the far-face jumps of a neighbour carried along the ray); in the jump, every row
-in that range its jump intervals halved (:func:`shear_loads`); twice, as above.  The law's error is the sum of
-the two directions' exactly, ``T - tau = (I_p tau - tau) + I_p (T_i - tau_i)``: the rows interpolated in ``p``
-(``I_p``, along the rays) less the cell's response, plus the rows' polyline errors interpolated so; halving
-the rows changes the first, halving the rows' intervals the second.  Halved in both at once, each level would
-cost the product (four times the visited nodes, sixteen the second level); one direction at a time, twice and
-four times.  In the jump only the intervals up to the one holding the largest ``|s| / p`` of the interface's
-points that use the row, carried to it along the ray, and one more: the law at a point of pressure ``p`` in
-``[p_i, p_i+1]`` reads the rows ``i`` and ``i + 1`` only, at ``s p_i / p`` and ``s p_i+1 / p``, so a row's
-jumps in use are those of the points in the pressure intervals beside it (and, for the points between the
-samples where the law is integrated, in theirs).  The interface's largest ``|s| / p`` instead is unbounded at
-the contact's edge (``p -> 0``) and took every interval of every row in range.  A new row likewise ends one
-interval beyond the furthest its points reach (beyond its last node the law holds its shear; no point of the
-interface is there); made a node it is made whole (:func:`whole_rows`), so that the table's rows reach as far
-as before and its cover (:meth:`~ngcontact.coupling.shear_table.ShearTable.cover`) and a second run of the
-scene solve no cell for it.  The parts add, ``e_Q = e_Q(pressure table) + e_Q(shear table, pressure) +
-e_Q(shear table, jump)``; each part is reported (``parts``).  While the sum exceeds the limit, every part that
-exceeds its even share of the limit (at least the largest) is refined, so the shear table in the direction
-where its error reaches the macro quantities; that direction's first midpoints all become nodes
-(:data:`SHEAR_MARK` = 0): marked by its own error (a row's discrepancy against its neighbours carried along the
-rays, a jump node's against the row's polyline) its share stalled on the frictional block of
-``scripts/two_scale_table_share.py``, its own largest error lying where the macro quantities feel it least.
+A cell with micro friction has a second table, the shear table of :mod:`ngcontact.coupling.shear_table` (rows
+``s -> tau`` at pressures, the macro law's tangential part). Its share is estimated the same way, each table on its
+own (the other held at its nodes), and the shear table in each of its two directions on its own: in the pressure,
+the rows' pressure intervals holding the interface's pressures, and one more on either side, get a row at their
+middle (at the far-face jumps of a neighbour carried along the ray); in the jump, every row in that range its jump
+intervals halved (:func:`shear_loads`); twice, as above. The law's error is the sum of the two directions' exactly,
+``T - tau = (I_p tau - tau) + I_p (T_i - tau_i)`` (``I_p``: the rows interpolated in ``p`` along the rays): halving
+the rows changes the first, halving the rows' intervals the second, and one direction at a time costs twice and four
+times the visited nodes, not four and sixteen times. In the jump only the intervals up to the one holding the
+largest ``|s| / p`` of the interface's points that use the row, carried to it along the ray, and one more: the law
+at a point of pressure ``p`` in ``[p_i, p_i+1]`` reads the rows ``i`` and ``i + 1`` only, at ``s p_i / p`` and
+``s p_i+1 / p``, so a row's jumps in use are those of the points in the pressure intervals beside it (and, for the
+points between the samples where the law is integrated, in theirs). The interface's largest ``|s| / p`` instead is
+unbounded at the contact's edge (``p -> 0``) and took every interval of every row in range. A new row likewise ends
+one interval beyond the furthest its points reach (beyond its last node the law holds its shear; no point of the
+interface is there); made a node it is made whole (:func:`whole_rows`): the rows reach as far as before, and the
+table's cover and a second run of the scene solve no cell for it. The parts add, ``e_Q = e_Q(pressure table) +
+e_Q(shear table, pressure) + e_Q(shear table, jump)``; each part is reported (``parts``). While the sum exceeds the
+limit, the largest part alone is refined and the next round estimates it alone; the others keep their last estimates
+(``carried``): refining one table or direction leaves the others' terms of the law's error as they were (new rows take
+their jumps along the rays, their polyline errors their neighbours'). A direction's first midpoints all become nodes
+(:data:`SHEAR_MARK` = 0): marked by the table's own error, which lies where the macro feels it least, its share stalled.
 
 Where the scene has a strength check, its safety factor (eq. 78 by the linear recovery) is a headline quantity
 of the share too: its correctors are the strength cell's and depend on the law only through whether it has a
@@ -187,7 +181,7 @@ class ShearPart(_Part):
         top = max((e for e, _ in groups), default=0.0)
         loads = [x for e, g in groups if e >= SHEAR_MARK * top for x in g]
         loads = sorted(set(loads) | set(whole_rows(self.table, {q for q, _ in loads} - set(self.table.rows))))
-        self.table._solve(loads)
+        self.table._solve(loads, match=True)
         return len(loads)
 
 
@@ -360,12 +354,15 @@ def estimate(sol: M.MacroSolution, parts: CellTable | Sequence[PressurePart | Sh
     rounds: list[dict[str, Any]] = []
     own = measure(sol)
     limit = FRACTION * tolerance
+    active: list[Any] = list(tables)         # the parts estimated this round; the others' last estimates
+    carried: dict[str, dict[str, float]] = {}
+    records: dict[str, dict[str, Any]] = {}
     while True:
         solves = _solves(tables)
-        levels: dict[str, list[Any]] = {part.name: [] for part in tables}
-        found: dict[str, list[tuple[M.MacroSolution, dict[str, Sample]]]] = {part.name: [] for part in tables}
+        levels: dict[str, list[Any]] = {part.name: [] for part in active}
+        found: dict[str, list[tuple[M.MacroSolution, dict[str, Sample]]]] = {part.name: [] for part in active}
         for step in range(2):
-            for part in tables:
+            for part in active:
                 try:
                     level = part.finer(sol, points_per_element, *levels[part.name][-1:])
                 except ConvergenceError as err:
@@ -374,12 +371,12 @@ def estimate(sol: M.MacroSolution, parts: CellTable | Sequence[PressurePart | Sh
                 got = solve(M.replace_law(sol.problem, part.law(level, sol.problem.law)), sol.gfu.vec)
                 levels[part.name].append(level)
                 found[part.name].append((got, measure(got)))
-            if step == 0 and refine and _first_bound(own, found) > limit:
+            if step == 0 and refine and _first_bound(own, found, carried) > limit:
                 break                               # refined in any case: the second halving would not decide it
         by_part: dict[str, dict[str, float]] = {}
         record: dict[str, dict[str, Any]] = {}
         second_larger: set[str] = set()
-        for part in tables:
+        for part in active:
             once = found[part.name][0][1]
             d1 = _changes(own, once)
             d2 = _changes(once, found[part.name][1][1]) if len(found[part.name]) > 1 else {}
@@ -388,7 +385,12 @@ def estimate(sol: M.MacroSolution, parts: CellTable | Sequence[PressurePart | Sh
                               and own[k].magnitude > 0 and by_part[part.name][k] / own[k].magnitude > 1e-12}
             sizes = [part.nodes()] + [part.nodes(lv) for lv in levels[part.name]]
             record[part.name] = {"nodes": sizes[0], "midpoints": [b - a for a, b in zip(sizes, sizes[1:])]}
-        errors = {k: sum(e.get(k, 0.0) for e in by_part.values()) for k in own if k in by_part[tables[0].name]}
+        for part in (p for p in tables if p.name in carried):   # not refined since (module docstring)
+            by_part[part.name] = {k: v * own[k].magnitude for k, v in carried[part.name].items() if k in own}
+            record[part.name] = {**records[part.name], "nodes": part.nodes(), "midpoints": [], "carried": True}
+        by_part = {part.name: by_part[part.name] for part in tables}
+        record = {part.name: record[part.name] for part in tables}
+        errors = {k: sum(e.get(k, 0.0) for e in by_part.values()) for k in own if k in by_part[active[0].name]}
         shares = {k: e / own[k].magnitude for k, e in errors.items() if own[k].magnitude > 0}
         part_shares = {name: {k: e[k] / own[k].magnitude for k in shares if k in e} for name, e in by_part.items()}
         share = TableShare(sol, {k: s.value for k, s in own.items()}, errors, shares, tolerance, rounds, part_shares,
@@ -398,7 +400,7 @@ def estimate(sol: M.MacroSolution, parts: CellTable | Sequence[PressurePart | Sh
         rounds.append({"nodes": {n: r["nodes"] for n, r in record.items()}, "parts": record,
                        "cell_solves": _solves(tables) - solves, "share": share.share,
                        "largest_in": _largest(shares), "second_halving_larger": sorted(second_larger),
-                       "halvings": len(found[tables[0].name])})
+                       "halvings": len(found[active[0].name])})
         progress.info("cell tables: %s; their share of the macro quantities %s%.3g (limit %.3g)",
                       ", ".join(f"{n} {r['nodes']} nodes" for n, r in record.items()),
                       "at least " if rounds[-1]["halvings"] < 2 else "", share.share, share.limit)
@@ -407,18 +409,19 @@ def estimate(sol: M.MacroSolution, parts: CellTable | Sequence[PressurePart | Sh
         if len(rounds) >= MAX_ROUNDS:
             raise ConvergenceError(_out_of_reach(tolerance, rounds, f"{MAX_ROUNDS} halvings are the bound"),
                                    {"table_share": rounds})
-        even = share.limit / len(tables)
-        chosen = [p for p in tables if record[p.name]["share"] > even] or \
-            [max(tables, key=lambda p: record[p.name]["share"])]
-        rounds[-1]["halved"] = {p.name: p.adopt(levels[p.name][0]) for p in chosen}
-        if len(chosen) == 1 and rounds[-1]["halved"][chosen[0].name] == record[chosen[0].name]["midpoints"][0]:
-            sol, own = found[chosen[0].name][0]     # all of T' adopted: solved already
+        part = max(tables, key=lambda p: record[p.name]["share"])   # the largest part alone (module docstring)
+        try:
+            level = levels[part.name][0] if part in active else part.finer(sol, points_per_element)
+        except ConvergenceError as err:
+            raise ConvergenceError(_out_of_reach(tolerance, rounds, str(err)), {"table_share": rounds}) from None
+        rounds[-1]["halved"] = {part.name: part.adopt(level)}
+        if part in active and rounds[-1]["halved"][part.name] == record[part.name]["midpoints"][0]:
+            sol, own = found[part.name][0]     # all of T' adopted: solved already
         else:
-            law = sol.problem.law
-            for part in chosen:
-                law = part.law(part.table, law)
-            sol = solve(M.replace_law(sol.problem, law), found[chosen[0].name][0][0].gfu.vec)
+            start = found[part.name][0][0].gfu.vec if part in active else sol.gfu.vec
+            sol = solve(M.replace_law(sol.problem, part.law(part.table, sol.problem.law)), start)
             own = measure(sol)
+        active, carried, records = [part], {n: q for n, q in part_shares.items() if n != part.name}, record
 
 
 def _solves(tables: Sequence[Any]) -> int:
@@ -426,10 +429,12 @@ def _solves(tables: Sequence[Any]) -> int:
     return sum(t.solves for t in {id(part.table): part.table for part in tables}.values())
 
 
-def _first_bound(own: dict[str, Sample], found: dict[str, list[tuple[M.MacroSolution, dict[str, Sample]]]]
-                 ) -> float:
-    """The share by the first halving alone (twice its change, the parts added): a lower bound of the estimate."""
-    err = {k: sum(FACTOR * _changes(own, f[0][1]).get(k, 0.0) for f in found.values()) for k in own}
+def _first_bound(own: dict[str, Sample], found: dict[str, list[tuple[M.MacroSolution, dict[str, Sample]]]],
+                 carried: dict[str, dict[str, float]]) -> float:
+    """The share by the first halving alone (twice its change; the parts, ``carried`` too, added): a lower bound."""
+    first = [_changes(own, f[0][1]) for f in found.values()] + [{k: v * own[k].magnitude / FACTOR for k, v in
+                                                                  c.items() if k in own} for c in carried.values()]
+    err = {k: sum(FACTOR * d.get(k, 0.0) for d in first) for k in own}
     return max((e / own[k].magnitude for k, e in err.items() if own[k].magnitude > 0), default=0.0)
 
 

@@ -279,7 +279,8 @@ def spectral_cell_solver(scene: CellScene) -> SpectralCellSolver:
     dim = scene.geometry.dim
     return SpectralCellSolver(spectral_cell(scene), make_cell=lambda n: spectral_cell(scene, grid=n),
                               max_points=MAX_SPECTRAL_POINTS[dim], default_max_points=DEFAULT_REFINEMENT_POINTS[dim],
-                              variant=lambda grid, **changes: spectral_variant(scene, grid, **changes))
+                              variant=lambda grid, **changes: spectral_variant(scene, grid, **changes),
+                              refine_default=scene.discretization.estimate == "auto")
 
 
 def spectral_variant(scene: CellScene, grid: int, **contact) -> SpectralCellSolver:

@@ -72,8 +72,8 @@ def _norm(value) -> float | None:
 
 def _normal_stiffness(entry: dict) -> float | None:
     eff = entry.get("effective_stiffness")
-    if not isinstance(eff, dict) or "n0" not in (eff.get("components") or []):
-        return None
+    if not isinstance(eff, dict) or "n0" not in (eff.get("components") or []) or eff.get("matrix") is None:
+        return None         # no finite stiffness (full contact under exact non-penetration)
     k = eff["components"].index("n0")
     return _number(eff["matrix"][k][k])
 

@@ -126,13 +126,13 @@ def warn_unmet(verdict: dict, refinement: Refinement) -> None:
     else:
         what = "too few grids within the size bound to show"
     if refinement.shortfall:
-        log.warning("accuracy not met: %s the %s tolerance %g %s; raise discretization.budget_dofs or state "
-                    "discretization.tolerance", what if unmet else "the refinement did not show",
-                    verdict["tolerance_from"], verdict["tolerance"], refinement.shortfall)
+        log.warning("accuracy not met: %s the %s tolerance %g %s; %s", what if unmet else "the refinement did not show",
+                    verdict["tolerance_from"], verdict["tolerance"], refinement.shortfall, refinement.remedy)
         return
     if refinement.scene_discretization:
         log.warning("accuracy not met: %s the %s tolerance %g on the scene's own discretization (%s); state "
-                    "discretization.tolerance to refine it, or a finer interface_maxh or a higher order", what,
+                    "discretization.tolerance to refine it, or a finer discretization (FE: interface_maxh, order; "
+                    "spectral: grid)", what,
                     verdict["tolerance_from"], verdict["tolerance"], refinement.how.split(";")[0])
         return
     log.warning("accuracy not met: %s the %s tolerance %g on the finest discretization allowed (%s); state "

@@ -28,7 +28,7 @@ from typing import Any
 
 from ngcontact.errors import SceneError
 from ngcontact.scene import loader
-from ngcontact.scene.discretization_knobs import Knob
+from ngcontact.scene.discretization_knobs import Knob, Tolerance
 from ngcontact.scene.studied_kinds import KINDS, StudiedKind, studied_kind, supported
 
 #: levels of a ladder: the default, and the bounds of ``--levels``
@@ -81,6 +81,14 @@ def with_keys(data: dict, changes: dict[str, Any]) -> dict:
             node = node.setdefault(part, {})
         node[last] = value
     return out
+
+
+def own_key(scene, data: dict) -> str:
+    """The :attr:`Level.key` of the scene's own level (parsed table ``data``): the table as a level of its kind
+    prepares it (a cell estimated on its own discretization, :meth:`StudiedKind.level_table`), its tolerance
+    kept as the user runs it, so that the level of each ladder that is the scene is found as such."""
+    table = check_study(scene).level_table(copy.deepcopy(data), Tolerance())
+    return Level("own", 0, {}, None, None, table, loader.from_dict(table, base_dir=scene.base_dir)).key
 
 
 def ladder(scene, data: dict, n: int) -> tuple[list[Level], list[str]]:

@@ -61,9 +61,12 @@ class Cell(StudiedKind):
         return None
 
     def level_table(self, data, knob):
-        """A level answers on its own discretization: an FE cell without a tolerance is estimated there and
-        not refined towards the default one (``discretization.estimate = "estimate"``, unless the scene opts
-        out of the estimate), so each level's cost and error are its knob's."""
+        """A level answers on its own discretization: a cell without a tolerance is estimated there and not
+        refined towards the default one (``discretization.estimate = "estimate"``, unless the scene opts out
+        of the estimate; the FE cell by one order more on its mesh, the spectral cell from coarser grids), so
+        each level's cost and error are its knob's.  Refined to the default tolerance, every level of a grid
+        ladder would end on the grid where that tolerance is met (the 2D spectral stiffness's drives it to
+        the same grid from every start), and the ladder would no longer vary its knob."""
         disc = data.setdefault("discretization", {})
         if disc.get("estimate", "auto") == "auto":
             disc["estimate"] = "estimate"

@@ -153,20 +153,40 @@ def test_the_estimate_is_within_ten_times_the_error_where_that_error_is_not_smal
     bounded the quartic's error by the line's, a hundred times larger (module docstring of
     :mod:`~ngcontact.cell.spectral.refinement`), and the estimates of the contact fraction and the coefficients
     exceeded the error by as much.  A stop waits for three differences on the quartic's levels (on 4096
-    points): there every quantity held to the tolerance of each load is estimated within [1, 10] times its
-    error, the lightest load's included, whose error changes sign just after the locator's change."""
-    from ngcontact.cell.spectral.refinement import UNCONTROLLED
+    points): there every quantity but the stiffness of each load is estimated within [1, 10] times its error,
+    the lightest load's included, whose error changes sign just after the locator's change.  With 4096 points
+    the largest grid, the stiffness, which misses 1e-3 there, is capped: not met, said so, its estimate a bound."""
+    from ngcontact.cell.spectral.refinement import STIFFNESS
     dim, gap, pressures, first, finer = ORACLES["westergaard"]
     loads = [cell_load(dim, pressure=p) for p in pressures]
-    refined = sweep_to_tolerance(lambda n: _cell(dim, gap, n), loads, 1e-3, first, dim, 2 ** 22)
+    refined = sweep_to_tolerance(lambda n: _cell(dim, gap, n), loads, 1e-3, first, dim, 2 ** 12)
     grid = refined.history[-1]["grid"]
     reference = _cell(dim, gap, grid * finer).sweep(loads)
     for k, (sol, ref, est) in enumerate(zip(refined.solutions, reference, refined.estimates)):
         head, exact = headline(sol.results), headline(ref.results)
-        for name in (n for n in est if n not in UNCONTROLLED):
+        for name in est:
             effectivity = est[name] / (abs(head[name] - exact[name]) / refined.scales[k][name])
-            assert 1.0 <= effectivity <= 10.0, (k, name, effectivity)
-    assert grid == 4096
+            assert 1.0 <= effectivity and (name == STIFFNESS or effectivity <= 10.0), (k, name, effectivity)
+    assert grid == 4096 and not refined.met and max(e[STIFFNESS] for e in refined.estimates) > 1e-3
+    assert refined.capped.startswith("on grid 4096") and "not met" in refined.remarks[-1]
+
+
+def test_a_2d_stiffness_that_misses_the_tolerance_is_refined_until_it_meets_it():
+    """The 2D stiffness is held to the tolerance (module docstring of :mod:`~ngcontact.cell.spectral.refinement`):
+    on Westergaard's sinusoid at 1e-3 every other quantity meets it on 4096 points, the stiffness on a finer grid,
+    within the cap of three more levels; every estimate there bounds its error."""
+    from ngcontact.cell.spectral.refinement import STIFFNESS, STIFFNESS_LEVELS
+    dim, gap, pressures, first, finer = ORACLES["westergaard"]
+    loads = [cell_load(dim, pressure=p) for p in pressures]
+    refined = sweep_to_tolerance(lambda n: _cell(dim, gap, n), loads, 1e-3, first, dim, 2 ** 22)
+    grid = refined.history[-1]["grid"]
+    assert refined.met and 4096 < grid <= 4096 * 2 ** STIFFNESS_LEVELS and refined.estimate <= 1e-3
+    assert max(e[STIFFNESS] for e in refined.estimates) <= 1e-3
+    reference = _cell(dim, gap, grid * finer).sweep(loads)
+    for k, (sol, ref, est) in enumerate(zip(refined.solutions, reference, refined.estimates)):
+        head, exact = headline(sol.results), headline(ref.results)
+        for name in est:
+            assert est[name] >= abs(head[name] - exact[name]) / refined.scales[k][name], (k, name)
 
 
 def test_a_coefficient_is_not_taken_as_geometric_where_the_contact_fraction_is_not():
@@ -251,7 +271,7 @@ def test_a_stalled_error_on_an_unresolved_island_is_bounded_by_the_islands_share
     grid the differences alone chose."""
     from ngcontact.cell.spectral.contact_edges import ISLAND
     loads = [cell_load(2, pressure=p) for p in (0.001, 0.003, 0.01)]
-    refined = sweep_to_tolerance(lambda n: _cell(2, _random_profile_11, n), loads, 1e-2, 64, 2, 2 ** 22)
+    refined = sweep_to_tolerance(lambda n: _cell(2, _random_profile_11, n), loads, 1e-2, 64, 2, 2 ** 10)
     assert refined.history[-1]["grid"] == 1024 and refined.history[-1]["islands"][0]["points"] == 1
     head, exact = headline(refined.solutions[0].results), headline(_cell(2, _random_profile_11, 16384).sweep(
         loads)[0].results)
@@ -266,14 +286,13 @@ def test_on_westergaards_sinusoid_at_light_loads_an_estimate_beyond_ten_times_th
     quartic locates the edges, faster than the differences before show: the guarded bounds exceed the errors by
     78 to 406 times.  Each estimate bounds its error, and each above ten times it carries the estimator's own
     flag with its reason, listed in the report's remarks."""
-    from ngcontact.cell.spectral.refinement import UNCONTROLLED
     loads = [cell_load(2, pressure=p) for p in (0.0004, 0.0015)]
     refined = sweep_to_tolerance(lambda n: _cell(2, _westergaard, n), loads, 1e-2, 64, 2, 2 ** 22)
     reference = _cell(2, _westergaard, 2 ** 16).sweep(loads)
     loose = 0
     for k, (sol, ref) in enumerate(zip(refined.solutions, reference)):
         head, exact = headline(sol.results), headline(ref.results)
-        for name in (n for n in refined.estimates[k] if n not in UNCONTROLLED):
+        for name in refined.estimates[k]:
             effectivity = refined.estimates[k][name] / (abs(head[name] - exact[name]) / refined.scales[k][name])
             assert effectivity >= 1.0, (k, name, effectivity)
             if effectivity > 10.0:
@@ -377,7 +396,8 @@ def test_on_the_random_profile_the_mean_closure_estimate_loose_by_ten_is_flagged
     exceeds its error by about ten times; it bounds it, and the estimator says it may be loose, with both
     contractions."""
     loads = [cell_load(2, pressure=p) for p in (0.001, 0.003, 0.01)]        # the three loads stop on grid 4096
-    refined = sweep_to_tolerance(lambda n: _cell(2, _random_profile, n), loads, 1e-3, 64, 2, 2 ** 22)
+    # (the largest here: every quantity but the stiffness meets 1e-3 there, the stiffness is capped)
+    refined = sweep_to_tolerance(lambda n: _cell(2, _random_profile, n), loads, 1e-3, 64, 2, 2 ** 12)
     exact = _cell(2, _random_profile, 2 ** 16).sweep(loads)[0].results["mean_closure"]
     error = abs(refined.solutions[0].results["mean_closure"] - exact) / abs(exact)
     assert refined.history[-1]["grid"] == 4096 and refined.estimates[0]["mean_closure"] >= error
@@ -413,9 +433,10 @@ def test_on_the_seed_11_profile_the_mean_closure_after_its_island_resolves_is_wi
     """The seed-11 profile at p = 0.003 holds an island of 3 points on 1024 points and of 4 to 15 on 2048 to 8192
     (refined to 1e-3, reported on 8192).  Its mean closure's window held the difference across the island's
     resolution, whose first-order envelope set the estimate at 11 times the error; on the resolved levels it is
-    within [1, 10] times it, and every estimate of the sweep still bounds its error."""
+    within [1, 10] times it, and every estimate of the sweep still bounds its error (8192 points the largest grid:
+    every quantity but the stiffness meets 1e-3 there, the stiffness is capped, not met)."""
     loads = [cell_load(2, pressure=p) for p in (0.001, 0.003, 0.01)]
-    refined = sweep_to_tolerance(lambda n: _cell(2, _random_profile_11, n), loads, 1e-3, 64, 2, 2 ** 22)
+    refined = sweep_to_tolerance(lambda n: _cell(2, _random_profile_11, n), loads, 1e-3, 64, 2, 2 ** 13)
     assert refined.history[-1]["grid"] == 8192
     assert [h["islands"][1]["islands"] > 0 for h in refined.history[-4:]] == [True, False, False, False]
     reference = _cell(2, _random_profile_11, 2 ** 16).sweep(loads)

@@ -14,7 +14,7 @@ from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.spectral.contact_edges import KINK, LOCATED_STEP, kink_share, kinks, unresolved_share
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
-from ngcontact.cell.spectral.refinement import sweep_to_tolerance
+from ngcontact.cell.spectral.refinement import controlled_estimate, sweep_to_tolerance
 from ngcontact.geometry.random_surface import self_affine
 
 
@@ -76,11 +76,14 @@ def test_on_the_seed_1_profile_an_edge_pinned_to_a_kink_is_bounded_and_flagged()
     """The seed-1 profile at p = 0.001 holds an edge on a sample, located there on 1024 to 8192 points and a fifth
     of the 4096 grid's step beyond it on 65,536: refined to 1e-3 (reported on 4096) the contact fraction's
     guarded estimate was 0.75 times its error, k_n's alike, g_n's 0.64.  The kink's floor bounds them, flagged
-    as possibly loose with its reason; every estimate of the sweep bounds its error."""
+    as possibly loose with its reason; every estimate of the sweep bounds its error.  The 2D stiffness, held to
+    the tolerance too, would refine on to 32,768 points, past the pinned edge: the sweep is bounded at 4096, where
+    every other quantity meets 1e-3, and ends there at the stiffness's cap, not met."""
     gap = _map_gap(1)
     loads = [cell_load(2, pressure=p) for p in (0.001, 0.003, 0.01)]
-    refined = sweep_to_tolerance(lambda n: _cell(gap, n), loads, 1e-3, 64, 2, 2 ** 22)
-    assert refined.history[-1]["grid"] == 4096
+    refined = sweep_to_tolerance(lambda n: _cell(gap, n), loads, 1e-3, 64, 2, 4096)
+    assert refined.history[-1]["grid"] == 4096 and not refined.met and "4096" in refined.capped
+    assert controlled_estimate(refined.estimates, ("normal_stiffness",)) <= 1e-3 < refined.estimate
     reference = _cell(gap, 2 ** 16).sweep(loads)
     for k, (sol, ref) in enumerate(zip(refined.solutions, reference)):
         head, exact = headline(sol.results), headline(ref.results)

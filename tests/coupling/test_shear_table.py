@@ -68,6 +68,22 @@ def test_cell_solves_of_a_level_go_through_the_map_in_batches_and_a_covered_rang
     assert table.pressures[-1] == pytest.approx(2.0)
 
 
+def test_a_range_that_moves_by_round_off_solves_no_row_again():
+    """The loop asks for its range again after each growth of the law; the macro solution, and with it the range,
+    moves a little each time (on the FE friction block by a relative 1.06e-6, just past the former slack of 1e-6,
+    and four rows were added within 1e-6 of the last one).  A range beyond the rows by less than the tolerance
+    is covered: no row is solved twice; one beyond it by more grows the table."""
+    calls: list = []
+    table = S.ShearTable(synthetic(calls), tol=0.02)
+    table.cover(0.1, 1.0, 0.05)
+    before, rows = table.solves, set(table.rows)
+    moved = 1 + 1.06e-6
+    assert not table.cover(0.1 / moved, 1.0 * moved, 0.05 * moved) and table.solves == before
+    assert set(table.rows) == rows
+    assert not table.cover(0.1, 1.0 * (1 + 0.5 * table.tol), 0.05) and table.solves == before
+    assert table.cover(0.1, 1.0 * (1 + 2 * table.tol), 0.05) and table.solves > before
+
+
 def test_the_cache_reproduces_the_table_and_its_law(tmp_path):
     calls: list = []
     table = S.ShearTable(synthetic(calls), tol=0.02)

@@ -25,10 +25,12 @@ TARGET = 0.05
 
 
 def small_cell(tmp_path: Path) -> Path:
-    """A spectral penalty cell of two loads on a coarse grid: its ladders are the grid and k_n."""
+    """A spectral penalty cell of two loads on a coarse grid: its ladders are the grid and k_n.  Each level
+    answers on its own grid, estimated from coarser ones: on 64 points the 2D stiffness's estimate from grids 8
+    to 64 is about 0.5, so the scene's grid is 256 (every level still below 0.1 s)."""
     path = tmp_path / "cell.toml"
     path.write_text(sinusoid_cell(enforcement="penalty", pressure="0.002, 0.008",
-                                  discretization='method = "spectral"\ngrid = 64'))
+                                  discretization='method = "spectral"\ngrid = 256'))
     return path
 
 
@@ -48,6 +50,11 @@ def test_the_study_writes_its_files_and_a_scene_that_meets_the_target(tmp_path):
     assert (out / "accuracy_contact_fraction_load0.png").stat().st_size > 0
     assert "Accuracy study" in (out / "report.html").read_text()
     assert res["rates"]["grid"]["rates"]["mean_closure_load1"] > 0
+    # each grid level answers on its own grid (not refined to the default tolerance, which would end every
+    # level on one grid), and the scene's own level is found in both ladders
+    assert [lv["ndof"] for lv in res["levels"] if lv["knob"] == "grid"] == [64, 128, 256, 512]
+    assert [lv["setting"] for lv in res["levels"] if lv["own_scene"]] == ["discretization.grid = 256",
+                                                                          "contact.k_n = 1000"]
     # the recommended scene, run as a user runs it, meets the target against the study's reference
     verdict = res["target"]
     assert verdict["met"] and (out / "recommended.toml").is_file()

@@ -8,10 +8,11 @@ A cell scene that states no ``discretization.tolerance`` is held to the default 
    headline quantity).  Where every load's estimate meets ``tol`` that answer is reported: no refinement
    solves fewer unknowns than the scene's own discretization, so it is the cheapest that meets the
    tolerance.  A cell refined by grading (below) is refined only where a quantity the grading holds misses
-   ``tol`` (:data:`GRADED_HOLDS`, the two its levels estimate): a miss of the effective stiffness or of a
+   ``tol`` (:data:`~ngcontact.cell.fe.grading_estimate.HELD`): a miss of the effective stiffness or of a
    coefficient of eq. 34 alone is reported with ``accuracy.met = false`` and one warning line, since graded
-   levels would not show it met; after a graded refinement those quantities keep an estimate, the scene's
-   carried to the refined answer (:func:`carried_over`);
+   levels estimate them (:mod:`ngcontact.cell.fe.grading_estimate`) but do not refine for them; a quantity
+   the graded levels do not estimate keeps the scene's estimate, carried to the refined answer
+   (:func:`carried_over`);
 2. else the sweep is refined towards ``tol`` as a stated tolerance refines it
    (:meth:`~ngcontact.cell.fe.fe_cell.FECell.default_refinement`), but no discretization holding more than
    the budget's unknowns (``discretization.budget_dofs``; :data:`ngcontact.cell.fe.fe_cell.DEFAULT_DOFS`)
@@ -62,7 +63,7 @@ from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.cell_solution import GROUP, headline, measure, scale
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.cell.fe.edge_grading import GradedSolve
-from ngcontact.cell.fe.grading_estimate import ORDER_RATE
+from ngcontact.cell.fe.grading_estimate import HELD, ORDER_RATE
 from ngcontact.cell.fe.observed_rate import dofs_to_meet, exponent
 from ngcontact.cell.fe.saturation import estimate_on_scene
 from ngcontact.cell.fe.second_discretization import HALVING_RATE, Sequence, as_refinement
@@ -73,10 +74,6 @@ BUDGET_KEY = "discretization.budget_dofs"
 OUT_OF_REACH = 1e9
 
 
-#: the quantities the graded refinement estimates and holds to a tolerance (:mod:`ngcontact.cell.fe.grading_estimate`)
-GRADED_HOLDS = ("contact_fraction", "mean_closure")
-
-
 def worst(estimates: list[dict[str, float]], names: tuple[str, ...] | None = None) -> float:
     """The largest estimate over the loads and quantities (0 without any); only of ``names`` where given."""
     return max((e for per_load in estimates for n, e in per_load.items() if names is None or n in names),
@@ -84,8 +81,8 @@ def worst(estimates: list[dict[str, float]], names: tuple[str, ...] | None = Non
 
 
 def carried_over(first: Refinement, refined: Refinement) -> Refinement:
-    """``refined`` (graded solves, whose estimates hold :data:`GRADED_HOLDS` only) with the scene's saturation
-    estimate of every other quantity carried to the refined answer: ``|q_r - q| <= |q_0 - q| + |q_r - q_0|``,
+    """``refined`` (graded solves) with the scene's saturation estimate of every quantity they do not estimate
+    carried to the refined answer: ``|q_r - q| <= |q_0 - q| + |q_r - q_0|``,
     so ``E_r = (E_0 s_0 + |q_r - q_0|) / s_r`` in each quantity's measure (``s``: its scale, a coefficient's
     the whole surface's group, the same on both), a bound wherever the scene's is one."""
     estimates, scales = [], []
@@ -173,7 +170,7 @@ def held_to_default(cell: Any, tolerance: float, loads: list[CellLoad]) -> Refin
     ``cell.budget`` unknowns, with the shortfall where the budget ended first."""
     first = estimate_on_scene(cell, loads)
     graded = cell.default_refinement() == "graded"
-    if not first.estimates or worst(first.estimates, GRADED_HOLDS if graded else None) <= tolerance:
+    if not first.estimates or worst(first.estimates, HELD if graded else None) <= tolerance:
         return first          # met on the scene's own discretization, or not estimable (said so)
     ndof, scene_problem = cell.unknowns(), cell.problem
     if graded:

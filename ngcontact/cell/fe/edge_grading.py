@@ -23,11 +23,15 @@ The edges are not known in advance, so meshing and solving alternate:
    order there is what checks (and reduces) its error; stop when the level
    comparison changed the contact fraction by at most the tolerance, the
    last order changes both the contact fraction and the mean closure by at
-   most it (``|c_k - c_(k-1)| <= tol |c_k|``), and the estimate meets it;
+   most it (``|c_k - c_(k-1)| <= tol |c_k|``), and the estimate of both
+   meets it (:data:`~ngcontact.cell.fe.grading_estimate.HELD`; the stiffness
+   and the coefficients of eq. 34 are estimated too and counted in the
+   verdict, not refined for: :mod:`~ngcontact.cell.fe.grading_estimate`);
    else continue grading at the raised order, or, at the finest grading,
-   raise the order again.  The answer reported is the highest order on the
-   finest mesh; its estimate is the observed-rate tail of the orders on that
-   mesh (:data:`ORDER_RATE`, :mod:`ngcontact.cell.fe.observed_rate`):
+   raise the order again.
+   The answer reported is the highest order on the finest mesh; its
+   estimate is the observed-rate tail of the orders on that mesh
+   (:data:`ORDER_RATE`, :mod:`ngcontact.cell.fe.observed_rate`):
    ``p``-refinement on one fixed mesh converges to the exact solution, not to
    a mesh-dependent limit, so the tail of its sequence bounds the error of
    the smooth bulk.  An edge that lies inside its element (the vertex was
@@ -72,7 +76,9 @@ import ngsolve as ng
 from ngcontact.cell.fe.measures import contact_pieces
 from ngcontact.cell.fe.load_start import starts_afresh
 from ngcontact.cell.cell_solver import Refinement
-from ngcontact.cell.fe.grading_estimate import LEVELS_PER_STEP, ORDER_RATE, RATIO, merged, order_estimate, set_move
+from ngcontact.cell.cell_solution import headline
+from ngcontact.cell.fe.grading_estimate import (HELD, LEVELS_PER_STEP, ORDER_RATE, RATIO, edge_cells, merged,
+                                                  order_estimate, set_move)
 from ngcontact.cell.fe.observed_rate import DISAGREE
 from ngcontact.errors import ConvergenceError, ModelError, SceneError
 from ngcontact.geometry.cell2d import flat_cell
@@ -184,6 +190,7 @@ def _interface_elements(mesh) -> np.ndarray:
     return np.sort(np.asarray(ng.x(mips)).reshape(-1, 2), axis=1)
 
 
+
 def carry_over(old, new) -> None:
     """Start ``new`` (another mesh of the same cell) from the state of ``old``.
 
@@ -253,10 +260,14 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
              "set_move": None if towards is None else set_move(contact, towards[0], towards[1]),
              "contact_fraction": f,
              "mean_closure": c, "newton_iterations": sol.iterations, "fraction_change": None,
-             "closure_change": None}
+             "closure_change": None, "headline": headline(sol.results), "changes": None,
+             "edge_cells": edge_cells(problem, edges), "k_n": float(problem.model.k_n),
+             "length": float(np.sum(ends[:, 1] - ends[:, 0]))}
     if before is not None:
         entry["fraction_change"] = abs(f - before[1]["contact_fraction"])
         entry["closure_change"] = abs(c - before[1]["mean_closure"]) / max(abs(c), 1e-300)
+        then = before[1].get("headline", {})
+        entry["changes"] = {name: abs(v - then[name]) for name, v in entry["headline"].items() if name in then}
     history.append(entry)
     newton.extend(dict(h, level=level, order=p) for h in sol.newton)
     log.info("grading level %d, order %d: %d dofs, contact fraction %.10g, change %s", level, p,
@@ -374,7 +385,7 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
                     if graded["fraction_change"] <= tolerance and met(entry):
                         # the changes meet it: a third order shows the rate, whose tail must meet it too
                         tail = order_estimate(orders, graded["fraction_change"])[0]
-                        if len(orders) >= 3 and max(tail.values()) <= tolerance:
+                        if len(orders) >= 3 and max(tail[n] for n in HELD) <= tolerance:
                             return GradedSolve(problem=problem, solution=sol, orders=orders, history=history,
                                                newton=newton, grading_change=graded["fraction_change"])
                     elif step < MAX_STEPS:

@@ -72,6 +72,7 @@ import numpy as np
 from ngcontact.cell.fe.cell_energy import jump
 from ngcontact.cell.fe.contact_multiplier import max_augmentation
 from ngcontact.cell.fe.edge_cuts import element_cuts, piece_rule
+from ngcontact.cell.fe.exact_contact_set import closed_nodes
 from ngcontact.fem import materials as _mat
 from ngcontact.laws import penalty as _contact
 from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask, mask_fixed, match_free_dofs
@@ -276,13 +277,22 @@ def effective_stiffness(problem) -> dict:
     compliance is singular (e.g. a component the interface does not
     resist beyond the bulk).  An open interface transmits nothing
     (``S`` singular): its stiffness is the limit
-    ``S (I - S_0^-1 S)^-1 = 0`` and ``compliance`` is ``None``.
+    ``S (I - S_0^-1 S)^-1 = 0`` and ``compliance`` is ``None``.  An
+    interface closed at every node under exact enforcement (full contact)
+    has no compliance beyond the bulk's: ``S = S_0`` in the rigid limit, the
+    stiffness is infinite, ``matrix`` is ``None`` and ``compliance`` zero, as
+    the spectral cell reports it (a difference ``S^-1 - S_0^-1`` of round-off
+    size inverted would be a number of ``1e9`` to ``1e11`` that changes with
+    the solver's start and the mesh, and its "estimate" with it).
     """
     dim = problem.dim
     keep = [i for i in range(dim) if i == dim - 1 or problem.tangential_free]
     names = (["t0"] if dim == 2 else ["t1", "t2"]) + ["n0"]
     S = tangent_stiffness(problem, keep)
     S0 = reference_stiffness(problem)[np.ix_(keep, keep)]
+    if problem.multiplier is not None and bool(np.all(closed_nodes(problem)[0])):
+        return {"components": [names[i] for i in keep], "matrix": None,
+                "compliance": np.zeros((len(keep), len(keep))).tolist(), "total": S.tolist(), "reference": S0.tolist()}
     if np.linalg.cond(S) > 1e12 * np.linalg.cond(S0):  # (partly) open: S^-1 does not exist
         compliance = None
         A = np.eye(len(keep)) - np.linalg.solve(S0, S)

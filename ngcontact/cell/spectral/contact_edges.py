@@ -98,7 +98,7 @@ change with every edge a step out in the median, 0.28 in the ninetieth percentil
 p = 0.001 on 4096 points, beside a difference-based estimate of its own); on seed 16 at p = 0.003 the default
 grid's estimate was 0.7 times the error.  Half that change (:data:`STIFFNESS_STEP`: the edges' quarter of a
 step, doubled as the stiffness's estimate is) is the same floor under its estimate (:func:`stiffness_share`,
-two masked CG solves per load and level); the stiffness is reported with it, not held to the tolerance.
+two masked CG solves per load and level); the 2D stiffness is held to the tolerance with it.
 """
 from __future__ import annotations
 

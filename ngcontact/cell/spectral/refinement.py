@@ -79,14 +79,15 @@ exceeds it by that drop.  So, for these quantities of a load whose edges have be
   again (on Westergaard's sinusoid at a twentieth of its closing pressure the fitted errors fall by about
   16 per doubling twice, then by 2: the observed rate would estimate a tenth of the error, the first-order
   one twice it).  The wait costs at most one 2D level more: the sweep, whose levels sum to about twice its
-  finest, about doubles.  On the level after a deferred stop (one whose estimate met the tolerance) each
-  estimate is the smaller of its own and the deferred one carried over, ``E_k = min(E_k^own, E_(k-1) +
-  |d_k|)`` (:data:`CARRIED`): by ``|e_k| <= |e_(k-1)| + |q_k - q_(k-1)|`` a bound wherever ``E_(k-1)`` is
-  one, it keeps a quantity whose window now holds a vanished difference (the mean closure at a fifth of
-  Westergaard's closing pressure) at what the deferred level stated.  Refined to the default tolerance
-  (``sharpen = False`` in :func:`sweep_to_tolerance`) the first grid whose estimate meets it stops, its
-  estimate a bound but not a sharp one.  A load whose edges are never all fitted (a piecewise linear
-  profile's kinks defeat the quartic) is estimated on the whole window.
+  finest, about doubles. On the level after a deferred stop (one whose estimates met the tolerance, the 2D
+  stiffness's aside: a level refined on for the stiffness alone defers too) each estimate is the smaller of
+  its own and the deferred one carried over, ``E_k = min(E_k^own, E_(k-1) + |d_k|)`` (:data:`CARRIED`): by
+  ``|e_k| <= |e_(k-1)| + |q_k - q_(k-1)|`` a bound wherever ``E_(k-1)`` is one, it keeps a quantity whose
+  window now holds a vanished difference (the mean closure at a fifth of Westergaard's closing pressure) at
+  what the deferred level stated. Refined to the default tolerance (``sharpen = False`` in
+  :func:`sweep_to_tolerance`) the first grid whose estimate meets it stops, its estimate a bound but not a
+  sharp one. A load whose edges are never all fitted (a piecewise linear profile's kinks defeat the quartic)
+  is estimated on the whole window.
 
 The coefficients of eq. 34 on the real contact set are integrals over it (:mod:`ngcontact.cell.spectral.grid_measures`:
 ``k_n`` times the contact fraction, ``k_n`` times the gap integrated over the set), with the set's 2D edges
@@ -99,13 +100,20 @@ error that grows from one grid to the next.
 The normal effective stiffness is the stiffness of the collocated contact set
 (:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`): its pressure, singular like the
 inverse square root of the distance to an edge, converges at first order in the grid step with a constant
-that the edges' position between points makes erratic, in 2D much slower than the fraction, so that a
-tolerance met by the other quantities would take many more grids for it (several doublings at 1 %, and a
-tolerance of the order of the fraction's, as a 2D scene may state, beyond any grid the cost bound admits).
-It is estimated at first order, the estimate doubled (:data:`ERRATIC`: its error may exceed the
-differences beside it where two grids' errors share their sign and size, as on Westergaard's sinusoid at
-half its closing pressure) and reported, but not held to the tolerance (:data:`UNCONTROLLED`: listed in
-the verdict as not counted).
+that the edges' position between points makes erratic, in 2D much slower than the fraction. It is estimated at
+first order, the estimate doubled (:data:`ERRATIC`: its error may exceed the differences beside it where two
+grids' errors share their sign and size, as on Westergaard's sinusoid at half its closing pressure).  In 2D it
+is held to the tolerance like the others, within a stated cap (:func:`stiffness_capped`): once every other
+quantity meets the tolerance, refinement goes on for the stiffness alone for at most :data:`STIFFNESS_LEVELS`
+more levels within the largest grid, and only while its estimate, were it to fall by :data:`STIFFNESS_RATE` per
+level (second order: faster than its error's first order, so that a stiffness whose guarded estimate collapses
+once its differences contract, as on the random profiles of ``docs/benchmarks.md`` (``random_profile_accuracy``),
+is not given up early), could meet it within them.  Beyond the cap (a 2D tolerance of the order of the fraction's,
+1e-4, would take millions of points at first order) the refinement stops, ``met = False``, the stiffness counted
+in the verdict as not met (one warning line) and the cap named in the remarks; a scene's stated tolerance so missed
+ends its run (:meth:`~ngcontact.cell.spectral.spectral_solver.SpectralCellSolver.refine_to`).  In 3D, whose cost
+bound (points squared) allows a few doublings only, it is reported with its estimate and not held
+(:func:`uncontrolled`: listed in the verdict as not counted).
 
 Two checks end each level's estimate. A contact island of fewer than
 :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: its error may
@@ -169,11 +177,15 @@ MIN_LEVELS = WINDOW + 1
 #: the fastest contraction per level Richardson may assume: each quantity's own order in the grid step, first
 #: for each (module docstring; any other quantity: :data:`FIRST_ORDER`)
 ORDER_RATE = {"contact_fraction": 0.5, "mean_closure": 0.5}
-#: estimated quantities refinement does not hold to the tolerance (module docstring): reported with estimates
-UNCONTROLLED = ("normal_stiffness",)
+#: the quantity held to the tolerance within a cap in 2D, reported and not held in 3D (module docstring)
+STIFFNESS = "normal_stiffness"
+#: the most levels the 2D stiffness alone may take beyond the grid where every other quantity met the tolerance,
+#: and the contraction per level it is projected at (second order: optimistic; module docstring)
+STIFFNESS_LEVELS = 3
+STIFFNESS_RATE = 0.25
 #: a quantity's estimate times this: the stiffness's first-order constant jumps with the edges' position between
 #: points, so that its error may exceed the differences beside it (module docstring)
-ERRATIC = {"normal_stiffness": 2.0}
+ERRATIC = {"normal_stiffness": {2: 1.0, 3: 2.0}}
 #: the fewest levels whose 2D edges are all located by the quartic that estimate the quantities resting on the
 #: edges on their own (two differences: one that vanished is seen beside the other; module docstring)
 LOCATOR_LEVELS = 3
@@ -185,7 +197,9 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        "last one; the contact fraction and coefficients guarded on levels of edges not all fitted by the quartic, "
        f"and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
        "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
-       f"stiffness's estimate times {ERRATIC['normal_stiffness']:g}, reported, not held to the tolerance; at least "
+       f"stiffness's estimate times {ERRATIC[STIFFNESS][2]:g} in 2D, held to the tolerance up to {STIFFNESS_LEVELS} "
+       f"levels beyond the grid where the others met it while its estimate falling by {STIFFNESS_RATE:g} per level "
+       f"would meet it (else not met), times {ERRATIC[STIFFNESS][3]:g} in 3D, reported, not held; at least "
        f"the share of contact islands of fewer than {ISLAND_POINTS} points (3D: across), and after such islands "
        f"also on the resolved levels (at least {LOCATOR_LEVELS}), the smaller; a step per 2D edge within a step of a "
        f"kink of the map's piecewise-linear surface, {LOCATED_STEP:g} of one per other edge of such a map; above "
@@ -209,10 +223,15 @@ class RefinedSweep:
     #: per load, the estimates that may exceed the error by more than :data:`LOOSE` times, with the reason
     flags: list[dict[str, str]] = field(default_factory=list)
 
+    #: the quantities the sweep does not hold to the tolerance (:func:`uncontrolled`)
+    uncontrolled: tuple[str, ...] = ()
+    #: where refinement stopped at the 2D stiffness's cap (:func:`stiffness_capped`): on which grid and why, else ""
+    capped: str = ""
+
     @property
     def estimate(self) -> float:
         """The largest estimate of a quantity held to the tolerance."""
-        return controlled_estimate(self.estimates)
+        return controlled_estimate(self.estimates, self.uncontrolled)
 
     @property
     def scales(self) -> list[dict[str, float]]:
@@ -221,10 +240,32 @@ class RefinedSweep:
                 for head in self.history[-1]["headline"]]
 
 
-def controlled_estimate(estimates: list[dict[str, float]]) -> float:
-    """The largest of the ``estimates`` (per load) of the quantities held to the tolerance."""
-    return max((e for per_load in estimates for name, e in per_load.items() if name not in UNCONTROLLED),
-               default=0.0)
+def uncontrolled(dim: int) -> tuple[str, ...]:
+    """The estimated quantities a refinement of a ``dim``-dimensional cell does not hold to the tolerance (module
+    docstring): none in 2D, the normal effective stiffness in 3D."""
+    return () if dim == 2 else (STIFFNESS,)
+
+
+def controlled_estimate(estimates: list[dict[str, float]], skip: tuple[str, ...] = ()) -> float:
+    """The largest of the ``estimates`` (per load) of the quantities held to the tolerance (not in ``skip``)."""
+    return max((e for per_load in estimates for name, e in per_load.items() if name not in skip), default=0.0)
+
+
+def stiffness_capped(estimates: list[dict[str, float]], tolerance: float, grid: int, left: int) -> str:
+    """Where every quantity but the stiffness meets ``tolerance`` on ``grid`` points per direction and the
+    stiffness does not, with ``left`` levels the stiffness may still take (module docstring): a remark saying why
+    refinement stops where its largest estimate ``E``, falling by :data:`STIFFNESS_RATE` per level, would still
+    miss the tolerance after them; ``""`` where refinement may go on, or the stiffness meets it."""
+    stiffness = max((per[STIFFNESS] for per in estimates if STIFFNESS in per), default=0.0)
+    if stiffness <= tolerance or controlled_estimate(estimates, (STIFFNESS,)) > tolerance:
+        return ""
+    if left > 0 and stiffness * STIFFNESS_RATE ** left <= tolerance:
+        return ""
+    return (f"the normal stiffness's estimate {stiffness:.3g} misses the tolerance {tolerance:g} on grid {grid} "
+            f"while every other quantity meets it, and {max(left, 0)} more level(s) within the cap (at most "
+            f"{STIFFNESS_LEVELS} beyond the grid where the others met it, within the largest grid) would not "
+            f"meet it even at {STIFFNESS_RATE:g} per level; at first order it would take about "
+            f"{int(np.ceil(grid * stiffness / tolerance))} points per direction: not met")
 
 
 def next_grid(grid: int, dim: int) -> int:
@@ -240,6 +281,7 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
     contact) is not estimated, nor one that is zero on every level (a coefficient that the flat interface
     makes zero: ``k_t``, ``k_nt``, ``g_t``, ``G_n``; ``G_t`` without friction); not ``geometric_ok``: guarded only."""
     estimates, forms, guarded = [], [], []
+    dim = 2 if history[-1].get("points") == history[-1].get("grid") else 3      # 3D: points = grid^2
     for k, last in enumerate(history[-1]["headline"]):
         out: dict[str, float] = {}
         form: dict[str, str] = {}
@@ -259,7 +301,7 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
                 if sharp[0] < out[name]:
                     out[name], form[name], note = sharp[0], sharp[1], "; ".join(filter(None, (sharp[2], (
                         "the edge fit's own levels" if run == fitted else "the levels of resolved islands"))))
-            out[name] *= ERRATIC.get(name, 1.0)
+            out[name] *= ERRATIC.get(name, {}).get(dim, 1.0)
             if form[name] == GUARDED:
                 guarded.append(f"load {k} {name}" + (f": {note}" if note else ""))
         estimates.append(out)
@@ -352,12 +394,14 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
     (:func:`locator_changing`), else the first grid whose estimate meets the tolerance is the answer.
     """
     grids = levels(grid, dim, max_points)
+    skip = uncontrolled(dim)
     progress.info("spectral refinement may reach grid %d (%d points) in %d levels from grid %d", grids[-1],
                   grids[-1] ** (dim - 1), len(grids), grid)
     history: list[dict[str, Any]] = []
     sols: list = []
     flags: list[dict[str, str]] = []
     deferred = None                 # the estimates of a level that met the tolerance but waited on the edge fit
+    first_met = None                # the level on which every quantity but the stiffness first met it
     for n in grids:
         cell, sols, entry = solve_level(make_cell, loads, n, sols or None)
         history.append(entry)
@@ -369,16 +413,29 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
         if estimates is not None:
             remarks += island_floor(history, estimates, forms)
             flags = loose_flags(history, estimates, forms)
-            entry["estimate"] = controlled_estimate(estimates)
+            entry["estimate"] = controlled_estimate(estimates, skip)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
                       f", estimate {entry['estimate']:.3g}" if estimates is not None else "")
         settled = not sharpen or n == grids[-1] or not locator_changing(history)
-        met = estimates is not None and len(history) >= MIN_LEVELS and entry["estimate"] <= tolerance
-        if estimates is not None and met and settled:
-            return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history,
-                                remarks=remarks + loose_remarks(flags), forms=forms, flags=flags)
-        deferred = estimates if met else None
-    reached = worst_estimate(estimates, UNCONTROLLED) if estimates is not None else "no estimate (one level)"
+        ready = estimates is not None and len(history) >= MIN_LEVELS
+        met = ready and entry["estimate"] <= tolerance
+        done = RefinedSweep(cell=cell, solutions=sols, estimates=estimates or [], history=history,
+                            remarks=remarks + loose_remarks(flags), forms=forms, flags=flags, uncontrolled=skip)
+        if met and settled:
+            return done
+        rest = ready and controlled_estimate(estimates or [], skip + (STIFFNESS,)) <= tolerance
+        others = rest and settled
+        first_met = len(history) if others and first_met is None else first_met
+        left = min(len(grids) - len(history), STIFFNESS_LEVELS - len(history) + (first_met or 0))
+        capped = stiffness_capped(estimates or [], tolerance, n, left) if others and not skip else ""
+        if capped:
+            done.met, done.remarks = False, done.remarks + [capped]
+            done.capped = (f"on grid {n}, where refinement stopped at its cap for the stiffness alone (at most "
+                           f"{STIFFNESS_LEVELS} levels beyond the grid where every other quantity met it)")
+            progress.info("spectral refinement stops on grid %d: the normal stiffness is capped", n)
+            return done
+        deferred = estimates if rest else None      # every quantity but the stiffness met it: carried on
+    reached = worst_estimate(estimates, skip) if estimates is not None else "no estimate (one level)"
     message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on {entry['points']} "
                f"grid points, and the next grid of {next_grid(grids[-1], dim)} per direction would exceed "
                f"{max_points} points")
@@ -387,4 +444,5 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
     if estimates is None:
         estimates = [{name: float("inf") for name in headline(s.results)} for s in sols]
     return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history, met=False,
-                        remarks=remarks + loose_remarks(flags) + [message], forms=forms, flags=flags)
+                        remarks=remarks + loose_remarks(flags) + [message], forms=forms, flags=flags,
+                        uncontrolled=skip)

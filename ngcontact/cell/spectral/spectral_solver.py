@@ -20,13 +20,14 @@ from typing import Any
 import numpy as np
 
 from ngcontact.cell.cell_load import CellLoad, cell_load
-from ngcontact.cell.cell_solution import CellSolution
+from ngcontact.cell.cell_solution import CellSolution, worst_estimate
 from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.spectral import grid_measures
 from ngcontact.cell.spectral.coarser_grids import HOW as COARSER_HOW, estimate_from_coarser, why_not
 from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
-from ngcontact.cell.spectral.refinement import HOW, UNCONTROLLED, sweep_to_tolerance
+from ngcontact.cell.spectral.refinement import HOW, sweep_to_tolerance, uncontrolled
 from ngcontact.cell.whole_surface import flat
+from ngcontact.errors import ConvergenceError
 
 #: the grid fields a solution hands on (the closure is in its surface distribution)
 FIELDS = ("pressure", "gap", "shear", "slip")
@@ -45,6 +46,10 @@ class SpectralCellSolver:
         The most grid points refinement to a stated tolerance may use.
     default_max_points
         The most grid points refinement to the default tolerance may use (default: ``max_points``).
+    refine_default
+        Whether a sweep without a stated tolerance is refined to the default one (``discretization.estimate =
+        "auto"``), or answered on its own grid with its error estimated from coarser grids (``"estimate"``: a
+        level of an accuracy study, whose grid is its knob's setting).
     variant
         ``(**changes) -> SpectralCellSolver`` of the same scene and grid with ``enforcement`` or ``k_n``
         changed (the penalty's share), ``None`` where refused.
@@ -52,8 +57,9 @@ class SpectralCellSolver:
 
     def __init__(self, cell: SpectralCell, make_cell: Callable[[int], SpectralCell] | None = None,
                  max_points: int | None = None, default_max_points: int | None = None,
-                 variant: Callable[..., SpectralCellSolver | None] | None = None):
+                 variant: Callable[..., SpectralCellSolver | None] | None = None, refine_default: bool = True):
         self.cell = cell
+        self.refine_default = refine_default
         self.dim = cell.dim
         self.period = cell.period
         self.make_cell, self.max_points, self.default_max_points = make_cell, max_points, default_max_points
@@ -103,20 +109,24 @@ class SpectralCellSolver:
 
     def refines_by_default(self) -> bool:
         """Whether a sweep without a stated tolerance is refined to the default one: where the recipe of
-        finer grids is known."""
-        return self.make_cell is not None and self.max_points is not None
+        finer grids is known and the scene asks it (:attr:`refine_default`)."""
+        return self.refine_default and self.make_cell is not None and self.max_points is not None
 
     def holds_loads_alone(self) -> bool:
-        """Yes where the recipe of finer grids is known (:meth:`refines_by_default`): the grid-doubling
-        estimate and refinement of a sweep (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`)
-        are per load already, each load solved from zero pressure, so a load refined alone takes the same
+        """Yes where the recipe of other grids is known: the grid-doubling estimate and refinement of a sweep
+        (:func:`~ngcontact.cell.spectral.refinement.sweep_to_tolerance`, and the coarser grids' estimate) are
+        per load already, each load solved from zero pressure, so a load refined alone takes the same
         estimate, only its own grids (those of the worst load of a sweep it would share)."""
-        return self.refines_by_default()
+        return self.make_cell is not None and self.max_points is not None
 
     def default_accuracy(self, tolerance: float, loads: list[CellLoad]) -> Refinement | None:
-        """Refined to the default ``tolerance`` within the default size bound where the recipe of finer grids
-        is known (:meth:`refine_to`), else ``None``."""
-        return self.refine_to(tolerance, loads, required=False) if self.refines_by_default() else None
+        """Refined to the default ``tolerance`` within the default size bound where the cell
+        :meth:`refines_by_default` (:meth:`refine_to`); else, where the recipe of other grids is known, the
+        scene's own grid with its error estimated from coarser grids (:meth:`scene_estimate`; a miss is
+        reported, not refined); else ``None``."""
+        if self.refines_by_default():
+            return self.refine_to(tolerance, loads, required=False)
+        return self.scene_estimate(loads) if self.holds_loads_alone() else None
 
     def scene_estimate(self, loads: list[CellLoad]) -> Refinement | None:
         """The sweep on the scene's grid, its error estimated from three coarser grids
@@ -133,7 +143,8 @@ class SpectralCellSolver:
                   "estimate_seconds": sum(h["seconds"] for h in done.history[:-1])}
         how = COARSER_HOW + f"; {HOW}" + (f" ({'; '.join(done.remarks)})" if done.remarks else "")
         return Refinement(solutions=[self.solution(s) for s in done.solutions], estimates=list(done.estimates),
-                          method=method, how=how, uncontrolled=UNCONTROLLED, scales=done.scales, loose=done.flags,
+                          method=method, how=how, uncontrolled=uncontrolled(first.dim), scales=done.scales,
+                          loose=done.flags,
                           scene_discretization=True)
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
@@ -142,7 +153,9 @@ class SpectralCellSolver:
         solver's.  A ``required`` tolerance (the scene's) may use grids up to ``max_points`` and raises out of
         reach, and waits for the 2D edge fit's own levels before a stop (``sharpen``); the default one up to
         ``default_max_points``, its first grid that meets it the answer, and out of reach the finest level
-        with ``met = False``."""
+        with ``met = False``.  A required tolerance the 2D stiffness misses at its cap
+        (:func:`~ngcontact.cell.spectral.refinement.stiffness_capped`) is out of reach too: it raises, with the
+        figures (issue 35: a stated tolerance out of reach ends the run, exit 3, never ``met = false``)."""
         if self.make_cell is None or self.max_points is None:
             raise ValueError("this spectral cell was built without the recipe of finer grids")
         first, make = self.cell, self.make_cell
@@ -150,6 +163,13 @@ class SpectralCellSolver:
         bound = max(min(bound, self.max_points), first.points)
         refined = sweep_to_tolerance(lambda n: first if n == first.grid else make(n), loads, tolerance,
                                      first.grid, first.dim, bound, required=required, sharpen=required)
+        if required and refined.capped:
+            raise ConvergenceError(
+                f"discretization.tolerance = {tolerance:g} not met: the estimate is "
+                f"{worst_estimate(refined.estimates)} {refined.capped}: "
+                + next(r for r in refined.remarks if r.startswith("the normal stiffness's estimate"))
+                + "; state a looser discretization.tolerance (every counted quantity's estimate is held to it)",
+                {"levels": refined.history})
         self.cell = refined.cell
         method = {"grid": self.cell.grid, "points": self.cell.points, "refinement": refined.history}
         solutions = [self.solution(s) for s in refined.solutions]
@@ -159,8 +179,10 @@ class SpectralCellSolver:
                                   f"bound ({bound} points), so there is no finer grid to compare with")
         how = HOW + (f" ({'; '.join(refined.remarks)})" if refined.remarks else "")
         return Refinement(solutions=solutions, estimates=list(refined.estimates), method=method,
-                          met=refined.met, how=how, uncontrolled=UNCONTROLLED,
-                          scales=refined.scales, loose=refined.flags)
+                          met=refined.met, how=how, uncontrolled=refined.uncontrolled,
+                          scales=refined.scales, loose=refined.flags, shortfall=refined.capped,
+                          remedy="the stiffness converges at first order in the grid step: state a looser "
+                                 "discretization.tolerance to meet it, or read it with its estimate")
 
     def penalty(self) -> float | None:
         return float(self.cell.k_n) if self.cell.enforcement == "penalty" else None
