@@ -10,7 +10,7 @@ import pytest
 from ngcontact import cli
 from ngcontact.cell.cell_solution import CellSolution, worst_estimate
 from ngcontact.cell.fe.observed_rate import Convergence
-from ngcontact.cell.fe.second_discretization import HALVING_RATE, refine
+from ngcontact.cell.fe.second_discretization import HALVING_RATE, as_refinement, refine
 from ngcontact.drivers.build import cell_loads, cell_solver, spectral_variant
 from ngcontact.errors import ConvergenceError
 
@@ -51,16 +51,22 @@ def test_the_guards_floor_cap_two_values_and_a_settled_sequence():
 
 @dataclass
 class _Level:
-    """A stand-in discretization: its dofs and the contact fraction it answers."""
+    """A stand-in discretization: its dofs and the contact fraction, closure and (where given) normal
+    stiffness it answers."""
 
     ndof: int
     fraction: float
+    closure: float = 1.0
+    stiffness: float | None = None
 
     def unknowns(self) -> int:
         return self.ndof
 
     def sweep(self, loads):
-        return [CellSolution(load=None, results={"contact_fraction": self.fraction, "mean_closure": 1.0})]
+        results = {"contact_fraction": self.fraction, "mean_closure": self.closure}
+        if self.stiffness is not None:
+            results["effective_stiffness"] = {"matrix": [[self.stiffness]], "components": ["n0"]}
+        return [CellSolution(load=None, results=results)]
 
 
 @dataclass
@@ -153,12 +159,13 @@ def test_the_contact_edge_ladder_reports_the_contact_fraction_extrapolated_in_th
     assert "load 0 contact_fraction: extrapolated, observed rate 1.00" in done.how
 
 
-def test_the_contact_edge_ladder_takes_its_spectral_twins_floor_where_larger():
+def test_the_contact_edge_ladder_takes_its_spectral_twins_bound_for_the_closure():
     """The ladder's closure does not change with the edge size (its geometric tail: zero), but the twin,
-    the same continuum problem, answers 1.01 on the floor's grid (FLOOR_GRID points, whatever grid places the
-    level's edge) and 1.012 on half that: the closure's estimate is the floor
-    ``|1 - 1.01| + 2 |1.01 - 1.012| = 0.014`` (relative), named in the record; the contact fraction, whose
-    twin agrees with its extrapolation, keeps the extrapolation's estimate."""
+    the same continuum problem, answers 1.01 on the bound's grid (FLOOR_GRID points, whatever grid places the
+    level's edge) and 1.012 on half and a quarter of it: the closure's estimate is the twin's bound
+    ``1.25 |1 - 1.01| + 2 max(|1.01 - 1.012|, |1.012 - 1.012| / 2) = 0.0165`` (relative), in place of the
+    tail, named in the record; the contact fraction, whose twin agrees with its extrapolation, keeps the
+    extrapolation's estimate."""
     from ngcontact.cell.fe.contact_edge_refinement import FLOOR_GRID, ContactEdgeRefinement
     asked = []
 
@@ -170,17 +177,50 @@ def test_the_contact_edge_ladder_takes_its_spectral_twins_floor_where_larger():
                                    lambda points, h, grading: _Level(1000, 0.5 + 0.2 * h),
                                    interface_maxh=0.1, period=1.0, twin_heads=twin_heads)
     done = refine(ladder, [None], 0.05, 10 ** 9, required=True)
-    assert len(done.levels) == 4 and done.met and set(asked) == {FLOOR_GRID, FLOOR_GRID // 2}
-    assert done.estimates[0]["mean_closure"] == pytest.approx(0.014, rel=1e-9)
+    assert len(done.levels) == 4 and done.met and set(asked) == {FLOOR_GRID, FLOOR_GRID // 2, FLOOR_GRID // 4}
+    assert done.estimates[0]["mean_closure"] == pytest.approx(0.0165, rel=1e-9)
     assert done.estimates[0]["contact_fraction"] == pytest.approx(1.25 * 0.0025, rel=1e-9)
-    assert ("load 0 mean_closure: 0 raised to the spectral twin: |q - q_N| + 2 |q_N - q_N/2|, "
-            f"N = {FLOOR_GRID}") in done.how
+    assert ("load 0 mean_closure: the spectral twin: 1.25 |q - q_N| + 2 max(|q_N - q_N/2|, |q_N/2 - q_N/4| / 2), "
+            f"N = {FLOOR_GRID} (0.0165) in place of the sequence's 0") in done.how
     assert "load 0 contact_fraction: " not in done.how.replace("load 0 contact_fraction: extrapolated", "")
 
 
+def test_the_twins_bound_replaces_a_tail_that_overstates_and_takes_an_earlier_difference():
+    """A closure falling by 0.002 per level (its geometric tail at the capped ratio 0.7, 3.5 times the last
+    difference) whose twin answers near its last level's value: the twin's bound, not the tail, is its estimate.
+    A twin whose last difference vanished (a crossing) is bounded by the one before it halved."""
+    from ngcontact.cell.fe.contact_edge_refinement import FLOOR_GRID, ContactEdgeRefinement
+
+    def twin_heads(grid):
+        return [{"contact_fraction": 0.5, "mean_closure": {FLOOR_GRID: 1.0, FLOOR_GRID // 2: 1.0}.get(grid, 1.004)}]
+
+    levels = iter([1.008, 1.006, 1.004, 1.002, 1.0])
+    ladder = ContactEdgeRefinement(_Level(1000, 0.6, next(levels)), lambda grid: [],
+                                   lambda points, h, grading: _Level(1000, 0.5 + 0.2 * h, next(levels)),
+                                   interface_maxh=0.1, period=1.0, twin_heads=twin_heads)
+    done = refine(ladder, [None], 0.05, 10 ** 9, required=True)
+    assert len(done.levels) == 4
+    # |1.002 - 1| 1.25 + 2 max(0, 0.004 / 2), relative to 1.002
+    assert done.estimates[0]["mean_closure"] == pytest.approx((0.0025 + 0.004) / 1.002, rel=1e-9)
+
+
+def test_the_ladder_reports_the_stiffness_but_does_not_hold_it_to_the_tolerance():
+    """The stiffness's error is the grading's, which no level reduces: the ladder stops on the other
+    quantities, and the stiffness is reported with its estimate, not counted."""
+    from ngcontact.cell.fe.contact_edge_refinement import UNREDUCED, ContactEdgeRefinement
+    ladder = ContactEdgeRefinement(_Level(1000, 0.6, stiffness=1.1), lambda grid: [],
+                                   lambda points, h, grading: _Level(1000, 0.5 + 0.2 * h, stiffness=1.0 + h),
+                                   interface_maxh=0.1, period=1.0)
+    done = refine(ladder, [None], 0.005, 10 ** 9, required=True)
+    assert len(done.levels) == 4 and done.met and done.uncontrolled == UNREDUCED == ("normal_stiffness",)
+    assert done.estimates[0]["normal_stiffness"] > 0.005
+    assert as_refinement(done).uncontrolled == UNREDUCED
+
+
 def test_the_twin_floors_the_normal_coefficients_of_eq_34_too():
-    """The floor ``|q_h - q_N| + 2 |q_N - q_N/2|`` of each floored quantity, the coefficients ``k_n`` and
-    ``g_n`` on the real contact set among them; a quantity the twin does not answer gets none."""
+    """The bound ``1.25 |q_h - q_N| + 2 max(|q_N - q_N/2|, |q_N/2 - q_N/4| / 2)`` of each floored quantity, the
+    coefficients ``k_n`` and ``g_n`` on the real contact set among them; a quantity the twin does not answer
+    gets none."""
     from ngcontact.cell.fe.contact_edge_refinement import FLOOR_GRID, ContactEdgeRefinement
 
     def twin_heads(grid):
@@ -193,9 +233,9 @@ def test_the_twin_floors_the_normal_coefficients_of_eq_34_too():
                                    interface_maxh=0.1, period=1.0, twin_heads=twin_heads)
     floors = ladder.twin_floors([{"contact_fraction": 0.51, "coefficient_k_n": 12.2, "coefficient_g_n": 0.0302,
                                   "mean_closure": 1.0}], 1)[0]
-    assert floors["coefficient_k_n"][0] == pytest.approx(0.2 + 2 * 0.5, rel=1e-12)
-    assert floors["coefficient_g_n"][0] == pytest.approx(0.0002 + 2 * 0.001, rel=1e-9)
-    assert floors["contact_fraction"][0] == pytest.approx(0.01, rel=1e-9) and "mean_closure" not in floors
+    assert floors["coefficient_k_n"][0] == pytest.approx(1.25 * 0.2 + 2 * 0.5, rel=1e-12)
+    assert floors["coefficient_g_n"][0] == pytest.approx(1.25 * 0.0002 + 2 * 0.001, rel=1e-9)
+    assert floors["contact_fraction"][0] == pytest.approx(1.25 * 0.01, rel=1e-9) and "mean_closure" not in floors
 
 
 def test_the_contact_edge_ladder_is_not_taken_as_converged_before_its_extrapolation():

@@ -55,26 +55,53 @@ extrapolation in ``h_k`` alone misreads (its estimate far above the contact frac
 an extra level for the stiffness's tail at ``beta = 1/4``).  A smaller fixed grading costs unknowns without a
 steadier stiffness.  So every level keeps the one grading (:attr:`ContactEdgeRefinement.grading`, Netgen's
 0.3), and that error, the same at every level and so in no difference of the sequence, is what the twin's
-floor below bounds.
+bound below measures.
 
-The twin's floor.  Those estimates see only the edge size; the error made at the sizes the ladder keeps
-(``interface_maxh`` away from the edge, the bodies, the linear trace) does not change from level to level
-and is not in them.  The twin solves the same continuum problem (the flat layers, the same gap carried as a
-function on a flat ``S_C``, the same materials, exact frictionless contact), so with ``q_N`` its value on
-``N`` points per direction and ``q`` the exact one, for the reported ``q_h``
+The twin's bound.  Those estimates see only the edge size; the error made at the sizes the ladder keeps
+(``interface_maxh`` away from the edge, the bodies at the grading's size, the linear trace) does not change
+from level to level and is not in them.  A geometric tail of the levels presumes that their limit is the
+converged value; where a part ``E_0`` of the error is fixed along the ladder, the tail bounds the rest and
+says nothing of ``E_0``, and where ``E_0`` has the other sign than the edge's part it also overstates the
+error of the level at which the two cancel (the differences still show the edge's part falling, the sum is
+smaller).  The twin solves the same continuum problem (the flat layers, the same gap carried as a function
+on a flat ``S_C``, the same materials, exact frictionless contact), so with ``q_N`` its value on ``N``
+points per direction and ``q`` the exact one, for the reported ``q_h``
 
-    |q_h - q| <= |q_h - q_N| + |q_N - q|,        |q_N - q| <= TWIN_SAFETY |q_N - q_{N/2}|,
+    |q_h - q| <= |q_h - q_N| + |q_N - q|,
+    |q_N - q| <= TWIN_SAFETY max(|q_N - q_{N/2}|, |q_{N/2} - q_{N/4}| / 2) = U,
 
-the second since the spectral cell converges at first order in its grid step (a geometric tail at rate 1/2
-equals the last difference; :data:`TWIN_SAFETY` = 2 covers the stiffness's scatter about that rate,
-:data:`ngcontact.cell.spectral.refinement.ERRATIC`).  ``N`` is :data:`FLOOR_GRID` at every level, not the
-grid that places the level's edge: the grids of the first levels (256, 512 points) lie off the first-order
-line of the finer ones, and a floor as large as the tolerance would hold back the levels whose own error is
-within it.  The two solves are made once per sweep; their cost is in the bisinusoid's benchmark section
+the whole error, the part fixed along the ladder with the rest, measured rather than modelled.  The twin's
+own tail ``U`` is the spectral cell's guarded bound
+(:mod:`ngcontact.cell.spectral.refinement`): first order in its grid step, so a geometric tail at rate 1/2
+equals the next difference, taken as the last one or the one before halved, whichever is larger (the
+stiffness's differences change sign from grid to grid, and a last one that vanished at a crossing under-bounds
+the twin's error), times :data:`TWIN_SAFETY` = 2 for the scatter about that rate
+(:data:`ngcontact.cell.spectral.refinement.ERRATIC`).  The bound itself is
+
+    B = DISTANCE_SAFETY |q_h - q_N| + U,
+
+the measured distance with Roache's safety factor :data:`DISTANCE_SAFETY` (1.25, the three-grid factor of the
+edge extrapolation's grid convergence index, :mod:`ngcontact.cell.fe.edge_size_extrapolation`): without it
+the effectivity would exceed 1 by ``U / |q_h - q|`` only, a margin that rests on the twin's rate alone where
+the ladder's error is much larger than the twin's.  ``N`` is :data:`FLOOR_GRID` at every level, not the grid
+that places the level's edge: the grids of the first levels (256, 512 points) lie off the first-order line of
+the finer ones, and a bound as large as the tolerance would hold back the levels whose own error is within
+it; ``N/4`` enters only through its difference halved.  The three solves are made once per sweep (``N/4``
+is often among the grids that place the edges, and the cheapest); their cost and the bound's effectivity
+against the spectral cell converged on finer grids are in the bisinusoid's benchmark section
 (``docs/benchmarks.md``, ``bisinusoid_scene_accuracy``).
-Each of the contact fraction, the mean closure, the normal stiffness and the normal coefficients of eq. 34
-on the real contact set, ``k_n`` and ``g_n`` (the twin integrates the same ``k_n`` and gap over its contact
-set), takes the larger of its ladder's estimate and this floor (:meth:`ContactEdgeRefinement.twin_floors`).
+
+Each of the mean closure, the normal stiffness and the normal coefficients of eq. 34 on the real contact set,
+``k_n`` and ``g_n`` (the twin integrates the same ``k_n`` and gap over its contact set), whose ladder's
+estimate is a geometric tail, takes ``B`` in its place (:data:`TWIN_MEASURED`); the contact fraction, whose
+extrapolation's grid convergence index admits a fixed part up to its safety factor times its correction,
+takes the larger of that and ``B`` (:meth:`ContactEdgeRefinement.twin_floors`).
+
+The stiffness is not held to the tolerance (:data:`UNREDUCED`, reported with ``B``, not counted in the
+verdict, as the spectral cell's).  Its error is the grading's ("The grading" above): made a patch width
+from the edge, at the element size ``gamma l`` the ladder keeps, it stays at one offset from level to level,
+so that a tolerance below that offset would refine the edge to the most levels in vain and end the scene
+without an answer whose other quantities met it.
 """
 from __future__ import annotations
 
@@ -97,12 +124,19 @@ EXTRAPOLATED_LEVELS = 3
 EDGE_CELLS = 10.0
 #: the twin's grid points per direction: at least the first, at most the second (module docstring)
 TWIN_GRIDS = (256, 1024)
-#: ``N`` of the twin's floor, on every level (module docstring, "The twin's floor"); ``N/2`` with it
+#: ``N`` of the twin's bound, on every level (module docstring, "The twin's bound"); ``N/2``, ``N/4`` with it
 FLOOR_GRID = 2048
-#: the twin's own error over its last difference (module docstring, "The twin's floor")
+#: the twin's own error over the larger of its last difference and the one before halved (module docstring,
+#: "The twin's bound")
 TWIN_SAFETY = 2.0
-#: the quantities given the twin's floor
+#: the factor on the distance of the reported value from the twin's (module docstring, "The twin's bound")
+DISTANCE_SAFETY = 1.25
+#: the quantities given the twin's bound
 TWIN_FLOORED = ("contact_fraction", "mean_closure", "normal_stiffness", "coefficient_k_n", "coefficient_g_n")
+#: those whose estimate is the twin's bound in place of the ladder's geometric tail (the rest: the larger)
+TWIN_MEASURED = ("mean_closure", "normal_stiffness", "coefficient_k_n", "coefficient_g_n")
+#: the estimated quantities the ladder does not reduce: reported, not held to the tolerance (module docstring)
+UNREDUCED = ("normal_stiffness",)
 
 
 def twin_grid(edge_maxh: float, period: float) -> int:
@@ -138,6 +172,10 @@ class ContactEdgeRefinement:
     rule: Convergence = HALVING_RATE
     twin_heads: Callable[[int], list[dict[str, float]]] | None = None
     grading: float = GRADING
+    #: the quantities whose estimate is the twin's bound alone (:data:`TWIN_MEASURED`)
+    measured: tuple[str, ...] = TWIN_MEASURED
+    #: the quantities not held to the tolerance (:data:`UNREDUCED`)
+    uncontrolled: tuple[str, ...] = UNREDUCED
     _grids: dict[int, list[np.ndarray]] = field(default_factory=dict, repr=False)
 
     def twin(self, grid: int) -> list[np.ndarray]:
@@ -191,19 +229,22 @@ class ContactEdgeRefinement:
         return {"contact_fraction": out}
 
     def twin_floors(self, reported: list[dict[str, float]], k: int) -> list[dict[str, tuple[float, str]]]:
-        """Per load, per quantity of :data:`TWIN_FLOORED`, the floor ``|q_h - q_N| + TWIN_SAFETY |q_N - q_{N/2}|``
-        of the absolute error of level ``k``'s reported value ``q_h`` and its form in words (module docstring,
-        "The twin's floor"); none without the twin's quantities or at level 0."""
+        """Per load, per quantity of :data:`TWIN_FLOORED`, the bound
+        ``DISTANCE_SAFETY |q_h - q_N| + TWIN_SAFETY max(|q_N - q_{N/2}|, |q_{N/2} - q_{N/4}| / 2)`` of the absolute
+        error of level ``k``'s reported value ``q_h`` and its form in words (module docstring, "The twin's
+        bound"); none without the twin's quantities or at level 0."""
         if self.twin_heads is None or k == 0:
             return [{} for _ in reported]
         n = FLOOR_GRID
-        fine, coarse = self.twin_heads(n), self.twin_heads(n // 2)
-        if not len(fine) == len(coarse) == len(reported):
+        fine, half, quarter = self.twin_heads(n), self.twin_heads(n // 2), self.twin_heads(n // 4)
+        if not len(fine) == len(half) == len(quarter) == len(reported):
             return [{} for _ in reported]
-        form = f"spectral twin: |q - q_N| + {TWIN_SAFETY:g} |q_N - q_N/2|, N = {n}"
-        return [{name: (abs(q[name] - a[name]) + TWIN_SAFETY * abs(a[name] - b[name]), form)
-                 for name in TWIN_FLOORED if name in q and name in a and name in b}
-                for q, a, b in zip(reported, fine, coarse)]
+        form = (f"spectral twin: {DISTANCE_SAFETY:g} |q - q_N| + {TWIN_SAFETY:g} max(|q_N - q_N/2|, "
+                f"|q_N/2 - q_N/4| / 2), N = {n}")
+        return [{name: (DISTANCE_SAFETY * abs(q[name] - a[name])
+                        + TWIN_SAFETY * max(abs(a[name] - b[name]), 0.5 * abs(b[name] - c[name])), form)
+                 for name in TWIN_FLOORED if all(name in x for x in (q, a, b, c))}
+                for q, a, b, c in zip(reported, fine, half, quarter)]
 
     def describe(self, k: int) -> str:
         if k == 0:

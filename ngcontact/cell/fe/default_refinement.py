@@ -128,7 +128,7 @@ def sequence_shortfall(done: Sequence, tolerance: float, budget: int) -> str:
     growth = levels[-1]["ndof"] / levels[-2]["ndof"] if len(levels) >= 2 else 0.0
     a = exponent([lv["ndof"] for lv in estimated], [lv["estimate"] for lv in estimated],
                  (HALVING_RATE.assumed, growth))
-    e = worst(done.estimates)
+    e = worst([{n: v for n, v in per_load.items() if n not in done.uncontrolled} for per_load in done.estimates])
     finest = f"{levels[-1]['discretization']}, {levels[-1]['ndof']} dofs"
     why = "" if done.beyond is not None or "would take about" in done.stop else done.stop
     return shortfall(tolerance, budget, finest, e, dofs_to_meet(levels[-1]["ndof"], e, tolerance, a), why)

@@ -232,7 +232,8 @@ class FECell:
             refined = as_refinement(self.compared(tolerance, loads, bound, required))
         else:
             refined = self.graded_solves(tolerance, loads, required, None if required else bound)[0]
-        worst = max((max(e.values()) for e in refined.estimates if e), default=0.0)
+        worst = max((v for e in refined.estimates for n, v in e.items() if n not in refined.uncontrolled),
+                    default=0.0)
         if worst > tolerance:        # only where not required: a required tolerance out of reach has raised
             log.warning("accuracy not met: the FE cell's estimated error %.3g exceeds the default tolerance %g (%s); "
                         "refine interface_maxh or the order, or set discretization.tolerance", worst, tolerance,

@@ -35,9 +35,11 @@ absolutely, the mean closure and the normal effective stiffness relatively, as e
 (:data:`ngcontact.cell.admissibility.ESTIMATED`), and the coefficients of eq. 34 on the real contact set
 relative to their group (:func:`ngcontact.cell.cell_solution.measure`), all held to the tolerance.
 A refiner is any :class:`Refiner`, each with its
-own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.  A :class:`Floored` refiner also gives a floor of
-each quantity's absolute error that its sequence cannot see (the contact edge's ladder: its spectral twin,
-:mod:`ngcontact.cell.fe.contact_edge_refinement`, "The twin's floor"); the estimate is the larger of the two.
+own :class:`~ngcontact.cell.fe.observed_rate.Convergence`.  A :class:`Floored` refiner also gives a bound of
+each quantity's absolute error that includes what its sequence cannot see (the contact edge's ladder: its
+spectral twin, :mod:`ngcontact.cell.fe.contact_edge_refinement`, "The twin's bound"); the estimate is that
+bound where the refiner names the quantity as measured by it, else the larger of the two; the quantities it
+names as uncontrolled are reported with their estimate and neither stop the loop nor count in the verdict.
 """
 from __future__ import annotations
 
@@ -98,7 +100,12 @@ class Extrapolating(Protocol):
 
 @runtime_checkable
 class Floored(Protocol):
-    """A refiner with a floor of the error its sequence does not see (module docstring)."""
+    """A refiner with a bound of the error that includes what its sequence does not see (module docstring)."""
+
+    #: the quantities whose estimate is that bound alone, in place of the sequence's
+    measured: tuple[str, ...]
+    #: the quantities reported with their estimate but not held to the tolerance
+    uncontrolled: tuple[str, ...]
 
     def twin_floors(self, reported: list[dict[str, float]], k: int) -> list[dict[str, tuple[float, str]]]:
         """Per load, per quantity, the floor of the absolute error of level ``k``'s ``reported`` value and its
@@ -138,6 +145,8 @@ class Sequence:
     beyond: int | None = None
     #: why the loop stopped short of the tolerance, in words ("" where it met it)
     stop: str = ""
+    #: the estimated quantities not held to the tolerance (:class:`Floored`)
+    uncontrolled: tuple[str, ...] = ()
 
 
 def _level(cell, loads, k: int, refiner: Refiner, known: list[CellSolution] | None = None
@@ -165,6 +174,7 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
     remarks: list[str] = []
     stop = f"the most levels ({MAX_LEVELS})"
     beyond = None
+    free = refiner.uncontrolled if isinstance(refiner, Floored) else ()
     for k in range(MAX_LEVELS):
         try:
             nxt = refiner.level(k)
@@ -193,11 +203,12 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
                 remarks += _extrapolate(refiner.extrapolated(heads), sols, estimates)
             if isinstance(refiner, Floored):
                 remarks += _floor(refiner.twin_floors([headline(s.results) for s in sols], len(heads) - 1),
-                                  sols, estimates, whole)
+                                  sols, estimates, whole, refiner.measured)
             scales = [{n: scale(n, head, whole) for n in e} for e, head in zip(estimates, heads[-1])]
-            entry["estimate"] = max((max(e.values()) for e in estimates if e), default=0.0)
+            entry["estimate"] = max((v for e in estimates for n, v in e.items() if n not in free), default=0.0)
             if len(heads) >= 3 and _settled(refiner, len(heads)) and entry["estimate"] <= tolerance:
-                return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks), scales)
+                return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks), scales,
+                                uncontrolled=free)
             hopeless = None if required or len(heads) < 3 else _beyond_reach(levels, tolerance, max_dofs)
             if hopeless is not None:
                 stop = hopeless
@@ -206,8 +217,8 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
     worst = levels[-1].get("estimate")
     if len(heads) == 2 and _settled(refiner, 2) and worst is not None and worst <= tolerance:   # third beyond
         return Sequence(cell, sols, estimates, levels, True, _how(refiner, levels, remarks + [f"stopped: {stop}"]),
-                        scales)
-    reached = "no estimate (one level)" if worst is None else worst_estimate(estimates)
+                        scales, uncontrolled=free)
+    reached = "no estimate (one level)" if worst is None else worst_estimate(estimates, free)
     message = (f"discretization.tolerance = {tolerance:g} not met: the estimate is {reached} on "
                f"{levels[-1]['discretization']} ({levels[-1]['ndof']} dofs), and {stop}")
     if required:
@@ -216,7 +227,7 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
     if not estimates:
         estimates = [{} for _ in sols]
     return Sequence(cell, sols, estimates, levels, False, _how(refiner, levels, remarks + [message]), scales,
-                    beyond, stop)
+                    beyond, stop, free)
 
 
 def _settled(refiner: Refiner, levels: int) -> bool:
@@ -243,9 +254,10 @@ def _extrapolate(found: dict[str, list[Any]], sols: list[CellSolution], estimate
 
 
 def _floor(floors: list[dict[str, tuple[float, str]]], sols: list[CellSolution], estimates: list[dict[str, float]],
-           whole: dict[str, Any] | None) -> list[str]:
-    """Raise each estimated quantity's estimate to its :class:`Floored` floor (in the quantity's measure) where
-    that is larger; the remarks naming the floor's form."""
+           whole: dict[str, Any] | None, measured: tuple[str, ...] = ()) -> list[str]:
+    """Set each estimated quantity's estimate to its :class:`Floored` bound (in the quantity's measure): in
+    place of the sequence's for the ``measured`` quantities, else where the bound is larger; the remarks naming
+    the bound's form."""
     remarks = []
     for k, per_load in enumerate(floors):
         head = headline(sols[k].results)
@@ -253,7 +265,11 @@ def _floor(floors: list[dict[str, tuple[float, str]]], sols: list[CellSolution],
             if name not in estimates[k]:
                 continue
             floor = bound / scale(name, head, whole)
-            if floor > estimates[k][name]:
+            if name in measured:
+                remarks.append(f"load {k} {name}: the {form} ({floor:.3g}) in place of the sequence's "
+                               f"{estimates[k][name]:.3g}")
+                estimates[k][name] = floor
+            elif floor > estimates[k][name]:
                 remarks.append(f"load {k} {name}: {estimates[k][name]:.3g} raised to the {form} ({floor:.3g})")
                 estimates[k][name] = floor
     return remarks
@@ -298,4 +314,4 @@ def as_refinement(done: Sequence) -> Refinement:
         return Refinement(solutions=done.solutions, estimates=[{} for _ in done.solutions], per_load=per_load,
                           histories=histories, how=how)
     return Refinement(solutions=done.solutions, estimates=done.estimates, per_load=per_load, histories=histories,
-                      how=done.how, met=done.met, scales=done.scales)
+                      how=done.how, met=done.met, scales=done.scales, uncontrolled=done.uncontrolled)
