@@ -171,13 +171,14 @@ def twin_fraction(grid: int, ratio: float) -> float:
     return twin_headline(grid, ratio)["contact_fraction"]
 
 
-def converged(ratio: float) -> dict[str, float]:
+def converged(ratio: float, grids: tuple[int, int] = REF_GRIDS) -> dict[str, float]:
     """The converged bisinusoid at ``p/p* = ratio``: the spectral cell's headline quantities extrapolated from
-    :data:`REF_GRIDS` ``(n, 2 n)`` as ``2 q_2n - q_n`` (each converges at first order in the grid step; module
-    docstring for why not ``512^2``).  The one reference of ``scaling_3d.py`` (the measured rows and, on
-    ``--republish``, the kept ones) and of the scene's rows; its ``k_n`` is 1 and the coefficients ``k_n``,
-    ``g_n`` of exact contact are proportional to it (the contact set does not depend on it)."""
-    coarse, fine = (twin_headline(n, ratio) for n in REF_GRIDS)
+    ``grids`` ``(n, 2 n)`` (:data:`REF_GRIDS` unless a check asks for finer) as ``2 q_2n - q_n`` (each converges at
+    first order in the grid step; module docstring for why not ``512^2``).  The one reference of ``scaling_3d.py``
+    (the measured rows and, on ``--republish``, the kept ones) and of ``bisinusoid_scene_accuracy.py``; its ``k_n``
+    is 1 and the coefficients ``k_n``, ``g_n`` of exact contact are proportional to it (the contact set does not
+    depend on it)."""
+    coarse, fine = (twin_headline(n, ratio) for n in grids)
     return {name: 2.0 * fine[name] - coarse[name] for name in fine if name in coarse}
 
 

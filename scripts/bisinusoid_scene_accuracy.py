@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import functools
 import json
 import math
 import os
@@ -42,7 +41,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
-from bisinusoid_accuracy import ACC_H, REF_GRIDS, bisinusoid_spectral  # noqa: E402
+from bisinusoid_accuracy import ACC_H, REF_GRIDS, converged  # noqa: E402
 
 RATIOS = (0.005, 0.02, 0.05)
 #: the grids of the reference's check (module docstring)
@@ -77,23 +76,6 @@ pressure = [{p!r}]
 method = "fe"
 tolerance = 0.01
 {symmetry}"""
-
-
-def converged(ratio: float, grids: tuple[int, int] = REF_GRIDS) -> dict[str, float]:
-    """The spectral cell's headline quantities at ``p/p* = ratio`` extrapolated from ``grids`` (:data:`REF_GRIDS`;
-    its contact fraction, closure, normal stiffness and eq. 34 coefficients converge at first order in the grid
-    step); its ``k_n`` is 1, and the coefficients ``k_n``, ``g_n`` of exact contact are proportional to it (the
-    contact set does not depend on it): :func:`finish` scales them by the scene's."""
-    coarse, fine = (_spectral(n, ratio) for n in grids)
-    return {name: 2.0 * fine[name] - coarse[name] for name in fine if name in coarse}
-
-
-@functools.lru_cache(maxsize=None)
-def _spectral(grid: int, ratio: float) -> dict[str, float]:
-    """The spectral cell's headline quantities on ``grid`` at ``p/p* = ratio`` (each solved once)."""
-    from ngcontact.cell.cell_load import cell_load
-    from ngcontact.cell.cell_solution import headline
-    return headline(bisinusoid_spectral(grid).solve(cell_load(3, pressure=ratio * math.pi * ACC_H)).results)
 
 
 def start(out: str, ratio: float, symmetry: str) -> tuple[subprocess.Popen, float]:
