@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import csv
 import json
 import os
 import subprocess
@@ -244,7 +245,8 @@ def verdict(rows: list[dict]) -> str:
         effs = [r["effectivity"] for r in got]
         grids = sorted({r["grid"] for r in got})
         unmet = sorted({(r["seed"], r["load"], r["quantity"]) for r in got if not r["met"]})
-        text = (f"{run_name}: aim {'met' if not missed and not lost else 'not met'} on {len(got)} rows"
+        text = (f"{run_name}: aim {'met' if not missed and not lost else 'not met'}; "
+                f"{len(got) - len(missed)} of {len(got)} measured rows within it"
                 + (f" ({len(missed)} missed: " + ", ".join(f"seed {r['seed']} load {r['load']} {r['quantity']}"
                                                             for r in missed) + ")" if missed else "")
                 + (f", out of reach on seeds {[r['seed'] for r in lost]}" if lost else "")
@@ -263,6 +265,25 @@ def verdict(rows: list[dict]) -> str:
     bound = max((r["reference_change"] for r in rows if r["quantity"] != ""), default=0.0)
     return ". ".join(parts) + (f". Largest change of the finest grid from 2^19 to 2^20 points (in the measure): "
                                f"{bound:.2g}.")
+
+
+def read_rows(path: str) -> list[dict]:
+    """The rows of this script's CSV at ``path``, typed as :func:`seed_rows` makes them (integers for the seed,
+    load and grid, booleans for the flags, floats for the figures, ``""`` where a row has no figure)."""
+    with open(path, newline="") as fh:
+        raw = list(csv.DictReader(fh))
+    if not raw or set(raw[0]) != set(KEYS):
+        raise SystemExit(f"--from-csv {path!r}: not this script's CSV (columns {', '.join(KEYS)})")
+    return [{k: _typed(k, v) for k, v in r.items()} for r in raw]
+
+
+def _typed(key: str, text: str):
+    if text in ("", "True", "False"):
+        return {"": "", "True": True, "False": False}[text]
+    try:
+        return int(text) if key in ("seed", "load", "grid") else float(text)
+    except ValueError:
+        return text
 
 
 def seed_arg(text: str) -> int:
@@ -287,12 +308,18 @@ def main(argv=None) -> int:
                     help="the profiles' seeds (default: %(default)s)")
     ap.add_argument("--jobs", type=jobs_arg, default=1,
                     help="seeds run at once, each in its own child processes (default: %(default)s)")
+    ap.add_argument("--from-csv", metavar="CSV",
+                    help="run nothing: read the rows an earlier run of this script wrote, and write the summary, "
+                         "the plot and (with --publish) the section from them")
     benchmark_doc.add_flag(ap)
     args = ap.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
-    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:    # the work is in the children
-        rows = [row for rows in pool.map(lambda seed: seed_rows(seed, args.out), args.seeds) for row in rows]
     csv_path = os.path.join(args.out, "random_profile_accuracy.csv")
+    if args.from_csv:
+        rows = read_rows(args.from_csv)
+    else:
+        with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:    # the work is in the children
+            rows = [row for rows in pool.map(lambda seed: seed_rows(seed, args.out), args.seeds) for row in rows]
     write_csv(csv_path, list(KEYS), [[r[k] for k in KEYS] for r in rows])
     png = os.path.join(args.out, "random_profile_accuracy.png")
     plot([r for r in rows if r["quantity"] != "" and r["effectivity"] != ""], png)
@@ -300,7 +327,9 @@ def main(argv=None) -> int:
     print(summary)
     if args.publish:
         benchmark_doc.publish("random_profile_accuracy", "A random 2D profile with the defaults and with a "
-                              "tolerance of 1e-4 (issue 35)", csv_path, note=NOTE + " " + summary, png=png)
+                              "tolerance of 1e-4 (issue 35)", csv_path, note=NOTE + (
+                                  " The rows were measured by an earlier run of this script and read from its CSV "
+                                  "(`--from-csv`)." if args.from_csv else "") + " " + summary, png=png)
     return OUT_OF_REACH if any(r["quantity"] == "" for r in rows) else 0
 
 

@@ -40,6 +40,29 @@ def _results(tmp_path, name, text):
     return report["results"]
 
 
+def test_a_kept_csv_gives_back_the_rows_and_their_verdict(tmp_path):
+    """``--from-csv`` reads the rows an earlier run wrote, typed as that run held them: its CSV, verdict and exit
+    status come back unchanged; a CSV of other columns is refused by name."""
+    measured = {k: "" for k in S.KEYS}
+    measured.update(seed=3, run="tolerance 1e-4", load=1, pressure=0.005, quantity="contact_fraction", counted=True,
+                    met=True, grid=1048576, value=0.25, estimate=2e-6, reference=0.250001, true_error=1e-6,
+                    measure="absolute", estimate_measure=2e-6, true_error_measure=1e-6, true_error_relative=4e-6,
+                    reference_change=1e-7, error_to_finest=1e-6, effectivity=2.0, solve_seconds=18.0, aim="true error <= 0.0001", aim_met=True, seconds=20.5, note="grids [1024]")
+    lost = {k: "" for k in S.KEYS}
+    lost.update(seed=2, run="tolerance 1e-4", aim="true error <= 0.0001", aim_met=False, note="out of reach: exit 3")
+    rows = [measured, lost]
+    first = tmp_path / "first.csv"
+    S.write_csv(str(first), list(S.KEYS), [[r[k] for k in S.KEYS] for r in rows])
+    assert S.read_rows(str(first)) == rows
+    assert S.main([str(tmp_path / "again"), "--from-csv", str(first)]) == S.OUT_OF_REACH
+    assert (tmp_path / "again" / "random_profile_accuracy.csv").read_text() == first.read_text()
+    assert "tolerance 1e-4: aim not met; 1 of 1 measured rows within it, out of reach on seeds [2]" in S.verdict(rows)
+    other = tmp_path / "other.csv"
+    other.write_text("seed,run\n1,defaults\n")
+    with pytest.raises(SystemExit, match="not this script's CSV"):
+        S.read_rows(str(other))
+
+
 def test_the_posed_scenes_state_no_discretization_but_the_tolerance(tmp_path):
     gap = S.write_gap(str(tmp_path), SEED)
     for name, extra, given in (("defaults", S.RUNS["defaults"], set()), ("tol", S.RUNS["tolerance 1e-4"],
