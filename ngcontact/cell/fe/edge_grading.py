@@ -26,7 +26,8 @@ The edges are not known in advance, so meshing and solving alternate:
    most it (``|c_k - c_(k-1)| <= tol |c_k|``), and the estimate of both
    meets it (:data:`~ngcontact.cell.fe.grading_estimate.HELD`; the stiffness
    and the coefficients of eq. 34 are estimated too and counted in the
-   verdict, not refined for: :mod:`~ngcontact.cell.fe.grading_estimate`);
+   verdict, not refined for, a stated tolerance they miss ending the run:
+   :mod:`~ngcontact.cell.fe.grading_estimate`);
    else continue grading at the raised order, or, at the finest grading,
    raise the order again.
    The answer reported is the highest order on the finest mesh; its

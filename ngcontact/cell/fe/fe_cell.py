@@ -44,12 +44,13 @@ from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.cell.fe.default_refinement import held_to_default
 from ngcontact.cell.fe.edge_grading import GradedSolve, graded_refinement, solve_to_tolerance
+from ngcontact.cell.fe.grading_estimate import unheld
 from ngcontact.cell.fe.load_start import Predictor
 from ngcontact.cell.fe import whole_surface_error
 from ngcontact.cell.fe.saturation import estimate_on_scene
 from ngcontact.cell.fe.second_discretization import InterfaceHalving, Refiner, Sequence, as_refinement, refine
 from ngcontact.cell.fe.measures import contact_fraction, contact_integral, mean_jump, real_contact_coefficients
-from ngcontact.errors import ModelError
+from ngcontact.errors import ConvergenceError, ModelError
 from ngcontact.fem.quadrature import smooth_order
 
 log = logging.getLogger(__name__)
@@ -226,12 +227,22 @@ class FECell:
         ``required = False`` (the default tolerance): within :attr:`budget`, and out of reach the best
         answer with its estimate; a cell whose first refinement is beyond that bound is solved once, not
         estimated.
+
+        Raises
+        ------
+        ConvergenceError
+            ``required`` and out of reach, or the graded levels met it for the quantities they hold and
+            another counted quantity's estimate misses it (:func:`~ngcontact.cell.fe.grading_estimate.unheld`:
+            issue 35, a stated tolerance out of reach ends the run, exit 3, never ``met = false``).
         """
         bound = MAX_DOFS[self.dim] if required else self.budget
         if self.graded is None or self.h0 is None:
             refined = as_refinement(self.compared(tolerance, loads, bound, required))
         else:
-            refined = self.graded_solves(tolerance, loads, required, None if required else bound)[0]
+            refined, solves = self.graded_solves(tolerance, loads, required, None if required else bound)
+            if required and any(v > tolerance for e in refined.estimates for v in e.values()):
+                raise ConvergenceError(unheld(tolerance, refined.estimates, [g.orders[-1] for g in solves]),
+                                       {"levels": [g.history for g in solves]})
         worst = max((v for e in refined.estimates for n, v in e.items() if n not in refined.uncontrolled),
                     default=0.0)
         if worst > tolerance:        # only where not required: a required tolerance out of reach has raised

@@ -53,8 +53,9 @@ by the same observed-rate tail (:func:`order_estimate`), and counted in the verd
 only the fraction and the closure to the tolerance (:data:`HELD`): grading further until the indicator's
 share below meets it drove the meshes past the levels the fraction's estimate is tested on (on Hertz's row of
 cylinders at 1e-2 two grading steps more, where the fraction's grading tail took 0.8 of its error), so a miss
-of theirs is reported, ``accuracy.met = false`` with one warning line.  Three parts the orders do not show
-are added as floors:
+of theirs is reported where the tolerance is the default one, ``accuracy.met = false`` with one warning line;
+a stated tolerance so missed ends the run with the figures (:func:`unheld`, exit 3).  Three parts the orders do
+not show are added as floors:
 
 * **the indicator's share** (:func:`indicator_share`). A coefficient integrates ``k_n`` (``k_n``) or ``k_n g0``
   (``g_n``) over the real contact set as its quadrature points see it: the multiplier's interpolant positive
@@ -84,7 +85,7 @@ from typing import Any
 import ngsolve as ng
 import numpy as np
 
-from ngcontact.cell.cell_solution import COEFFICIENT, scale
+from ngcontact.cell.cell_solution import COEFFICIENT, measure, scale
 from ngcontact.cell.fe.observed_rate import Convergence
 
 #: the quantities the graded refinement holds to a tolerance (module docstring); the others are estimated and
@@ -152,6 +153,21 @@ def order_estimate(orders: list[dict[str, Any]], grading_change: float | None = 
             out[name] = own[0]
             notes.append(f"{name}: {own[1]}")
     return out, "; ".join(notes)
+
+
+def unheld(tolerance: float, estimates: list[dict[str, float]], finest: list[dict[str, Any]]) -> str:
+    """Why a stated ``tolerance`` is not met by graded levels that met it for the quantities they hold
+    (:data:`HELD`): the largest estimate (one of a quantity they do not hold), the finest mesh of its load
+    (``finest``: each load's last level entry) and the held quantities' largest estimate (module docstring)."""
+    e, name, k = max((v, n, k) for k, per_load in enumerate(estimates) for n, v in per_load.items())
+    held = max((v for per_load in estimates for n, v in per_load.items() if n in HELD), default=0.0)
+    mesh = finest[k]
+    return (f"discretization.tolerance = {tolerance:g} not met: the estimate is {e:.3g} ({name}, {measure(name)}, "
+            f"at load {k}) on its finest graded mesh (smallest element {mesh['smallest_element']:.3g}, order "
+            f"{mesh['order']}, {mesh['ndof']} dofs); the graded refinement holds the contact fraction and the mean "
+            f"closure to the tolerance (their estimates up to {held:.3g}) and estimates the effective stiffness and "
+            "the coefficients of eq. 34 without refining for them; state a looser discretization.tolerance (every "
+            "counted quantity's estimate is held to it)")
 
 
 def alternating(values: list[float]) -> float:
