@@ -148,8 +148,7 @@ class ShearTable:
     solves: int = 0
     covered_jump: float = 0.0   # the largest s a cover() asked for
     checked: list[tuple[float, float, float]] = field(default_factory=list)   # (lo, middle, hi) rows checked
-    #: responses solved for the estimate of the table's share of a macro run's error but not nodes of its law
-    #: (:mod:`ngcontact.coupling.table_share`): a node asked for that is held is taken without a cell solve
+    #: solved for the share's estimate (:mod:`ngcontact.coupling.table_share`), not nodes: taken without a solve
     held: dict[ShearLoad, tuple[float, float]] = field(default_factory=dict)
 
     # ------------------------------------------------------------ solves
@@ -175,15 +174,14 @@ class ShearTable:
 
     def _matched(self, loads: Sequence[ShearLoad]) -> set[ShearLoad]:
         """``loads``, each replaced by a known one of its row within :data:`SAME_LOAD` where there is one."""
-        known: dict[float, list[float]] = {}
+        rows: dict[float, list[float]] = {}
         for p, d in self._known():
-            known.setdefault(p, []).append(d)
-        rows = {p: np.array(sorted(ds)) for p, ds in known.items()}
+            rows.setdefault(p, []).append(d)
         out = set()
         for p, d in loads:
             p, d = float(p), float(d)
-            ds = rows.get(p)
-            if ds is not None and len(ds):
+            ds = np.asarray(rows.get(p, []), dtype=float)
+            if ds.size:
                 near = float(ds[np.argmin(np.abs(ds - d))])
                 d = near if abs(near - d) <= SAME_LOAD * abs(d) else d
             out.add((p, d))
@@ -220,7 +218,6 @@ class ShearTable:
     def _row_scale(self, p: float) -> float:
         return max(float(np.max(np.abs(self.row(p)[2]))), 1e-300)
 
-    # ------------------------------------------------------------ one row
     def _plateaued(self, p: float) -> bool:
         """The row's shear changed by at most ``tol`` over the last doubling of the far-face jump."""
         r = self.rows[p]

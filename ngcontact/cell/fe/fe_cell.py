@@ -218,22 +218,18 @@ class FECell:
         return estimate_on_scene(self, loads)    # one order more on the scene's mesh (ngcontact.cell.fe.saturation)
 
     def refine_to(self, tolerance: float, loads: list[CellLoad], required: bool = True) -> Refinement:
-        """Each load on its own mesh, graded towards its contact edges until ``tolerance`` is met
-        (:func:`~ngcontact.cell.fe.edge_grading.solve_to_tolerance`), the last load's problem becoming this
-        cell's; a cell that cannot be graded: the sweep on the refiner's discretizations until the estimate
-        meets ``tolerance`` within :data:`MAX_DOFS` (:mod:`~ngcontact.cell.fe.second_discretization`), the
-        last one's problem becoming this cell's.
-
-        ``required = False`` (the default tolerance): within :attr:`budget`, and out of reach the best
-        answer with its estimate; a cell whose first refinement is beyond that bound is solved once, not
-        estimated.
+        """Each load on its own mesh graded towards its contact edges until ``tolerance`` is met
+        (:func:`~ngcontact.cell.fe.edge_grading.solve_to_tolerance`); a cell that cannot be graded: the sweep on
+        the refiner's discretizations until the estimate meets it within :data:`MAX_DOFS`
+        (:mod:`~ngcontact.cell.fe.second_discretization`); the last problem becomes this cell's. ``required =
+        False`` (the default tolerance): within :attr:`budget`, out of reach the best answer with its estimate
+        (:func:`warn_unmet`); a cell whose first refinement is beyond that bound is solved once, not estimated.
 
         Raises
         ------
         ConvergenceError
-            ``required`` and out of reach, or the graded levels met it for the quantities they hold and
-            another counted quantity's estimate misses it (:func:`~ngcontact.cell.fe.grading_estimate.unheld`:
-            issue 35, a stated tolerance out of reach ends the run, exit 3, never ``met = false``).
+            ``required`` and out of reach, or a counted quantity the graded levels do not hold missing it
+            (:func:`~ngcontact.cell.fe.grading_estimate.unheld`; issue 35: exit 3, never ``met = false``).
         """
         bound = MAX_DOFS[self.dim] if required else self.budget
         if self.graded is None or self.h0 is None:
@@ -243,12 +239,7 @@ class FECell:
             if required and any(v > tolerance for e in refined.estimates for v in e.values()):
                 raise ConvergenceError(unheld(tolerance, refined.estimates, [g.orders[-1] for g in solves]),
                                        {"levels": [g.history for g in solves]})
-        worst = max((v for e in refined.estimates for n, v in e.items() if n not in refined.uncontrolled),
-                    default=0.0)
-        if worst > tolerance:        # only where not required: a required tolerance out of reach has raised
-            log.warning("accuracy not met: the FE cell's estimated error %.3g exceeds the default tolerance %g (%s); "
-                        "refine interface_maxh or the order, or set discretization.tolerance", worst, tolerance,
-                        refined.how)
+        warn_unmet(refined, tolerance)       # only where not required: a required tolerance out of reach has raised
         return refined
 
     def graded_solves(self, tolerance: float, loads: list[CellLoad], required: bool,
@@ -256,14 +247,12 @@ class FECell:
         """Each load on meshes graded towards its contact edges (:meth:`refine_to`; ``max_dofs``: no mesh
         beyond it after the first), and the graded solves."""
         assert self.graded is not None and self.h0 is not None       # refine_to's choice
-        period = self.period
-        order = self.model.order
         out: list[GradedSolve] = []
         for k, load in enumerate(loads):
             twin = self.predictor() if self.predictor is not None else None
             seed = twin.edges(load) if twin is not None else None
-            out.append(solve_to_tolerance(self.graded, load, tolerance, self.h0, period, order, seed=seed,
-                                          required=required, max_dofs=max_dofs))
+            out.append(solve_to_tolerance(self.graded, load, tolerance, self.h0, self.period, self.model.order,
+                                          seed=seed, required=required, max_dofs=max_dofs))
             log.info("load %d: contact fraction %.10g after %d grading steps", k,
                      out[-1].solution.results["contact_fraction"], len(out[-1].history) - 1)
         self._problem = out[-1].problem
@@ -322,3 +311,13 @@ class FECell:
             raise RuntimeError(f"a worker's cell has {0 if state is None else len(state)} dofs, this one "
                                f"{len(vec)}: the mesh was not rebuilt identically")
         vec[:] = state
+
+
+def warn_unmet(refined: Refinement, tolerance: float) -> None:
+    """One warning line where a counted quantity's estimate misses the default ``tolerance`` (issue 35: the run
+    goes on, ``accuracy.met = false``; a stated tolerance has raised before)."""
+    worst = max((v for e in refined.estimates for n, v in e.items() if n not in refined.uncontrolled), default=0.0)
+    if worst > tolerance:
+        log.warning("accuracy not met: the FE cell's estimated error %.3g exceeds the default tolerance %g (%s); "
+                    "refine interface_maxh or the order, or set discretization.tolerance", worst, tolerance,
+                    refined.how)
