@@ -185,30 +185,33 @@ def coarse_study(size: float, out: str, k_n: float | None = None) -> list[dict]:
     return rows
 
 
+#: the studies of this module: option, section, title, note (the CSV and PNG are named after the section)
+STUDIES = (
+    ("breakdown", "scaling_3d_breakdown", "3D cell: where an iterative solve spends its time",
+     "One BDDC-CG cell solve of the bisinusoid: CG iterations and seconds, milliseconds per CG iteration, per BDDC "
+     "application and per product with the tangent; the size of BDDC's coarse problem (wirebasket dofs, those on "
+     "the contact surface)."),
+    ("coarse", "scaling_3d_coarse", "3D cell: BDDC's coarse problem, bubble term against the contact surface on "
+     "the wirebasket",
+     "CG to 1e-8 on the tangent of the converged bisinusoid cell with a random right-hand side: the bubble term of "
+     "`ngcontact.fem.elasticity.bubble_term` for several `gamma` (the shipped one is `BUBBLE_GAMMA`), and the whole "
+     "contact surface on the wirebasket."),
+)
+
+
 def study(args) -> bool:
     """The study ``args`` ask for (``--breakdown`` or ``--coarse``), run into ``args.out`` and with
     ``--publish`` published; whether one was asked for."""
-    if args.breakdown is not None:
-        breakdown(args.breakdown, args.out)
+    for option, section, title, note in STUDIES:
+        size = getattr(args, option)
+        if size is None:
+            continue
+        if option == "breakdown":
+            breakdown(size, args.out)
+        else:
+            coarse_study(size, args.out, args.k_n)
         if args.publish:
-            benchmark_doc.publish("scaling_3d_breakdown", "3D cell: where an iterative solve spends its time",
-                                  os.path.join(args.out, "scaling_3d_breakdown.csv"),
-                                  note="One BDDC-CG cell solve of the bisinusoid: CG iterations and seconds, "
-                                       "milliseconds per CG iteration, per BDDC application and per product with "
-                                       "the tangent; the size of BDDC's coarse problem (wirebasket dofs, those on "
-                                       "the contact surface).",
-                                  png=os.path.join(args.out, "scaling_3d_breakdown.png"))
-        return True
-    if args.coarse is not None:
-        coarse_study(args.coarse, args.out, args.k_n)
-        if args.publish:
-            benchmark_doc.publish("scaling_3d_coarse", "3D cell: BDDC's coarse problem, bubble term against "
-                                  "the contact surface on the wirebasket",
-                                  os.path.join(args.out, "scaling_3d_coarse.csv"),
-                                  note="CG to 1e-8 on the tangent of the converged bisinusoid cell with a random "
-                                       "right-hand side: the bubble term of `ngcontact.fem.elasticity.bubble_term` "
-                                       "for several `gamma` (the shipped one is `BUBBLE_GAMMA`), and the whole "
-                                       "contact surface on the wirebasket.",
-                                  png=os.path.join(args.out, "scaling_3d_coarse.png"))
+            benchmark_doc.publish(section, title, os.path.join(args.out, f"{section}.csv"), note=note,
+                                  png=os.path.join(args.out, f"{section}.png"))
         return True
     return False
