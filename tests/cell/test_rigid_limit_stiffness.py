@@ -39,9 +39,10 @@ def test_the_rigid_limit_from_one_inverse_is_the_limit_of_the_schur_complements(
     s1, s2, s4 = (schur(m) for m in (1024.0, 2048.0, 4096.0))
     limit = (8.0 * s4 - 6.0 * s2 + s1) / 3.0
     # the normal column alone and all three agree to round-off with a direct solve: the energy form v^T K v
-    # (stiffness.schur_complement) sums products larger than its result, and 1.8e-12 was seen between the two;
-    # BDDC-CG stops each solve at its relative residual (MEASURE_RTOL), and on two threads its sums run in
-    # another order: 2e-11 was seen in CI
-    same = 1e-11 if policy == "direct" else 1e-9
+    # (stiffness.schur_complement) sums products larger than its result, and on two threads the assembly's
+    # parallel sums run in an order that depends on the machine's load (1.8e-12 seen on a quiet machine, 1.8e-11
+    # in CI beside two other test runs); BDDC-CG stops each solve at its relative residual (MEASURE_RTOL), and
+    # its sums run in another order too: 2e-11 was seen in CI
+    same = 1e-10 if policy == "direct" else 1e-9
     assert normal == pytest.approx(limit, rel=1e-8) and every[2, 2] == pytest.approx(normal, rel=same)
     assert abs(schur(1.0) / limit - 1.0) > 1e-3
