@@ -265,8 +265,8 @@ def test_the_shipped_graded_scene_meets_its_tolerance_against_westergaard():
 
 @pytest.mark.slow  # about 30 s: the shipped scene's four loads graded to 1e-4, with exact contact
 def test_the_graded_scene_with_exact_contact_meets_its_tolerance_at_the_round_off_of_its_finest_meshes():
-    """Elements of 1e-6 of the period put Uzawa's measures at about 1e-10, their round-off: the passes stop
-    there (they had alternated between two states up to the pass limit) and every load meets the tolerance of
+    """On the finest graded meshes Uzawa's measures reach their round-off: the passes stop there (they had
+    alternated between two states up to the pass limit) and every load meets the tolerance of
     1e-4 the scene was shipped with.  The graded levels alone: their estimates of g_n (up to 3.3e-3) and the
     stiffness miss 1e-4 with exact contact, so a run stating it would end in exit 3."""
     import dataclasses
