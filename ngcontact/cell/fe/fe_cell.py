@@ -236,7 +236,7 @@ class FECell:
             refined = as_refinement(self.compared(tolerance, loads, bound, required))
         else:
             refined, solves = self.graded_solves(tolerance, loads, required, None if required else bound)
-            if required and any(v > tolerance for e in refined.estimates for v in e.values()):
+            if required and counted_worst(refined) > tolerance:
                 raise ConvergenceError(unheld(tolerance, refined.estimates, [g.orders[-1] for g in solves]),
                                        {"levels": [g.history for g in solves]})
         warn_unmet(refined, tolerance)       # only where not required: a required tolerance out of reach has raised
@@ -316,8 +316,14 @@ class FECell:
 def warn_unmet(refined: Refinement, tolerance: float) -> None:
     """One warning line where a counted quantity's estimate misses the default ``tolerance`` (issue 35: the run
     goes on, ``accuracy.met = false``; a stated tolerance has raised before)."""
-    worst = max((v for e in refined.estimates for n, v in e.items() if n not in refined.uncontrolled), default=0.0)
+    worst = counted_worst(refined)
     if worst > tolerance:
         log.warning("accuracy not met: the FE cell's estimated error %.3g exceeds the default tolerance %g (%s); "
                     "refine interface_maxh or the order, or set discretization.tolerance", worst, tolerance,
                     refined.how)
+
+
+def counted_worst(refined: Refinement) -> float:
+    """The largest estimate of a quantity the verdict counts (not one of ``refined.uncontrolled``): what a stated
+    tolerance raises on and the default one warns on."""
+    return max((v for e in refined.estimates for n, v in e.items() if n not in refined.uncontrolled), default=0.0)
