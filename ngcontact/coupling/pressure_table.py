@@ -107,7 +107,8 @@ class CellTable:
             return
         if self.solves + len(todo) > self.max_solves:
             raise ConvergenceError(f"cell table: more than {self.max_solves} cell solves for "
-                                   f"tolerance {self.tol:g}", {"pressures": sorted(self.values)})
+                                   f"tolerance {self.tol:g} (two_scale.max_cell_solves: {self.solves} made, "
+                                   f"{len(todo)} more asked)", {"pressures": sorted(self.values)})
         for p, value in zip(todo, self.map_tasks(self.response, todo)):
             if not all(np.isfinite(value[k]) for k in KEYS):
                 raise ConvergenceError(f"cell table: non-finite cell response at p = {p:.6g}", dict(value))

@@ -185,11 +185,12 @@ def _shear_shapes(arrays: dict) -> str | None:
     return None
 
 
-def cached_shear(key: str, response, tol: float, length_unit: float, map_tasks, cache_dir: str | None = None
-                 ) -> tuple[S.ShearTable, bool]:
-    """A :class:`~ngcontact.coupling.shear_table.ShearTable` filled from the cache when it holds ``key``."""
+def cached_shear(key: str, response, tol: float, length_unit: float, map_tasks, cache_dir: str | None = None,
+                 max_solves: int = S.ShearTable.max_solves) -> tuple[S.ShearTable, bool]:
+    """A :class:`~ngcontact.coupling.shear_table.ShearTable` filled from the cache when it holds ``key``; at most
+    ``max_solves`` cell solves in this run (``two_scale.max_cell_solves``)."""
     found = cell_law.read_cached(key, SHEAR_ARRAYS, SHEAR_FORMAT, cache_dir, _shear_shapes)
-    table = S.ShearTable(response, tol=tol, length_unit=length_unit, map_tasks=map_tasks)
+    table = S.ShearTable(response, tol=tol, length_unit=length_unit, map_tasks=map_tasks, max_solves=max_solves)
     if found is None:
         return table, False
     for p, d, s, t, h in zip(*(found[k] for k in ("row_pressure", "far_face_jump", "jump", "shear", "held"))):
@@ -231,10 +232,12 @@ def _table_shapes(arrays: dict) -> str | None:
     return None
 
 
-def cached_table(key: str, response, tol: float, map_tasks, cache_dir: str | None = None) -> tuple[PT.CellTable, bool]:
-    """A :class:`~ngcontact.coupling.pressure_table.CellTable` filled from the cache when it holds ``key``."""
+def cached_table(key: str, response, tol: float, map_tasks, cache_dir: str | None = None,
+                 max_solves: int = PT.CellTable.max_solves) -> tuple[PT.CellTable, bool]:
+    """A :class:`~ngcontact.coupling.pressure_table.CellTable` filled from the cache when it holds ``key``; at most
+    ``max_solves`` cell solves in this run (``two_scale.max_cell_solves``)."""
     found = cell_law.read_cached(key, TABLE_ARRAYS, TABLE_FORMAT, cache_dir, _table_shapes)
-    table = PT.CellTable(response, tol=tol, map_tasks=map_tasks)
+    table = PT.CellTable(response, tol=tol, map_tasks=map_tasks, max_solves=max_solves)
     if found is None:
         return table, False
     for i, p in enumerate(found["pressure"]):
@@ -392,13 +395,13 @@ def couple_loop(scene, problem, solve, map_tasks: MapTasks = executor_map,
     method = cell_scene.discretization.method
     task = PressureSolve(path, spec.cell_length_unit, overrides, method, keys)
     key = table_key(cell_scene, spec.cell_length_unit, spec.table_tol)
-    table, from_cache = cached_table(key, task, spec.table_tol, map_tasks, cache_dir)
+    table, from_cache = cached_table(key, task, spec.table_tol, map_tasks, cache_dir, spec.max_cell_solves)
     shear, skey, shear_cached = None, None, False
     if scene.interface.friction == "from_cell" and cell_scene.contact.friction != "none":
         skey = shear_key(cell_scene, spec.cell_length_unit, spec.table_tol)
         shear_task = ShearSolve(path, spec.cell_length_unit, overrides, method, discretization=keys)
         shear, shear_cached = cached_shear(skey, shear_task, spec.table_tol, spec.cell_length_unit, shear_map,
-                                           cache_dir)
+                                           cache_dir, spec.max_cell_solves)
     out = T.couple(problem, table, tol=spec.tol, max_iter=spec.max_iter, table_min=spec.table_min,
                    points_per_element=scene.output.points_per_element, solve=solve, warm=warm, shear=shear)
     def write_back() -> None:

@@ -36,6 +36,11 @@ class TwoScaleSpec:
                              "table is refined further where the interface's pressures lie, until its share "
                              "of the macro quantities is below half the tolerance",
                              check=positive())
+    max_cell_solves: int = param(800, doc="largest number of cell solves of each of the loop's tables (the "
+                                 "pressure table, and the shear table of interface.friction = 'from_cell') in one "
+                                 "run, the loop's own and those of the refinement towards discretization.tolerance "
+                                 "together; a table that needs more ends the run in exit 3 with its figures",
+                                 check=at_least(1))
     table_min: float = param(1e-3, doc="smallest tabulated pressure as a fraction of the largest "
                              "(below it the law follows the table's first secant down to p = 0)",
                              check=open_interval(0, 1))

@@ -357,7 +357,7 @@ def test_the_shear_share_of_an_fe_friction_cell_is_met_within_the_tables_bound(t
     relevel.table_share(sol, 5e-3)
     share = relevel.share
     assert share is not None and share.share <= share.limit and len(share.rounds) == 1
-    assert relevel.shear.solves <= relevel.shear.max_solves
+    assert relevel.shear.solves <= relevel.shear.max_solves == scene.two_scale.max_cell_solves
     # the whole halving's first level alone asks for ``whole`` cells, its second (four times the rows' nodes)
     # for about three times that: the share's two levels in both directions for less than twice the first
     assert relevel.shear.solves - before < 2 * whole, (relevel.shear.solves - before, whole)

@@ -151,3 +151,37 @@ def test_warm_and_cold_starts_reach_the_same_two_scale_state(tmp_path):
     assert np.max(np.abs(p_warm - p_cold)) <= 1e-8 * np.max(p_cold)
     assert any(w for w, _ in s_warm) and not any(w for w, _ in s_cold)
     assert sum(n for _, n in s_warm) < sum(n for _, n in s_cold)
+
+
+def test_a_table_past_its_cell_solve_bound_exits_3_naming_the_key(tmp_path, monkeypatch, capsys):
+    """``two_scale.max_cell_solves`` bounds each of the loop's tables in one run: the shipped two-scale femur
+    with a bound of 3 ends in exit 3, the message naming the key and the solves made, and nothing written;
+    the bound of the key is the table's (a run whose tables need fewer solves is not touched by it)."""
+    import os
+    from ngcontact import cli
+    from ngcontact.drivers import run_two_scale as R
+
+    root = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "geometries")
+    text = open(os.path.join(root, "femur_stem_two_scale.toml")).read()
+    assert "\nmax_iter = 20\n" in text
+    bounded = text.replace("\nmax_iter = 20\n", "\nmax_iter = 20\nmax_cell_solves = 3\n", 1)
+    (tmp_path / "cells").mkdir()
+    for name in ("stem_grooves.toml", "hip_hills.toml"):
+        (tmp_path / "cells" / name).write_text(open(os.path.join(root, "cells", name)).read())
+    scene = tmp_path / "scene.toml"
+    scene.write_text(bounded)
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))       # a fresh table: every node a solve
+    seen = []
+    original = R.cached_table
+
+    def spy(*args, **kwargs):
+        table, found = original(*args, **kwargs)
+        seen.append(table.max_solves)
+        return table, found
+    monkeypatch.setattr(R, "cached_table", spy)
+    out = tmp_path / "out"
+    assert cli.main(["run", str(scene), "--out", str(out), "--quiet"]) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert "more than 3 cell solves" in err and "two_scale.max_cell_solves" in err, err
+    assert seen == [3] and not out.exists()

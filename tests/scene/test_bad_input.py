@@ -428,6 +428,8 @@ def test_two_scale_tolerance_and_iteration_limit(tmp_path, capsys):
             files={"cell.toml": cell_text})
     run_bad(tmp_path, capsys, edit(base, ("tol = 1e3", "tol = 1e3\nmax_iter = 0")),
             "two_scale.max_iter = 0: must be >= 1", files={"cell.toml": cell_text})
+    run_bad(tmp_path, capsys, edit(base, ("tol = 1e3", "tol = 1e3\nmax_cell_solves = 0")),
+            "two_scale.max_cell_solves = 0: must be >= 1", files={"cell.toml": cell_text})
 
 
 def test_strength_check_without_ultimate_stress(tmp_path, capsys):
