@@ -293,7 +293,8 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
             # a coefficient's edges are the fraction's: not geometric where the fraction's sequence is not
             geometric = geometric_ok and not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
             args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
-            fitted = fitted_run(history, k) if on_edges(name) else len(history)
+            # the 2D stiffness is that of the located set (grid_measures): on the edges as well
+            fitted = fitted_run(history, k) if on_edges(name) or (name == STIFFNESS and dim == 2) else len(history)
             run = min(fitted, resolved_run(history, k))        # levels of the quartic and of resolved islands
             out[name], form[name], note = tail_estimate(values, *args[:3], geometric and fitted == len(history))
             if LOCATOR_LEVELS <= run < len(history):
