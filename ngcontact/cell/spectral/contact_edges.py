@@ -91,14 +91,14 @@ edge not at a kink therefore holds :data:`LOCATED_STEP` of a step of each quanti
 edges, as the same floor (form :data:`KINK`): above every one of those errors, about seven times the median
 one (the estimate then exceeds such an error by as much, and says so where it exceeds ten times what the last
 difference leaves), and a tolerance of 1e-4 of the contact fraction is met with six to twelve edges from
-16,384 to 32,768 points (``scripts/random_profile_accuracy.py``).  The normal effective stiffness, of the
-collocated contact set (points, no located edges), has the same erratic first-order error: on the same
-profiles (seeds 1 to 12, 16 and 27, grids 1024 to 8192 against 131,072 points) it was 0.1 of the stiffness's
-change with every edge a step out in the median, 0.28 in the ninetieth percentile, 0.53 at most (seed 2 at
-p = 0.001 on 4096 points, beside a difference-based estimate of its own); on seed 16 at p = 0.003 the default
-grid's estimate was 0.7 times the error.  Half that change (:data:`STIFFNESS_STEP`: the edges' quarter of a
-step, doubled as the stiffness's estimate is) is the same floor under its estimate (:func:`stiffness_share`,
-two masked CG solves per load and level); the 2D stiffness is held to the tolerance with it.
+16,384 to 32,768 points (``scripts/random_profile_accuracy.py``).  The 2D normal effective stiffness, of the
+set with its edges located between points (exact contact, :mod:`~ngcontact.cell.spectral.grid_measures`), carries
+the same edges' error: each edge's share is its steps above (a step at a kink, a notch's on each of its edges,
+:data:`LOCATED_STEP` elsewhere) times the stiffness's change with that edge alone a step out
+(:func:`~ngcontact.cell.spectral.grid_measures.edge_stiffness`), summed (:func:`stiffness_share`), the same
+floor under its estimate.  (With a penalty the stiffness is the collocated set's, whose error on the same
+profiles was 0.1 of its change with every edge a step out in the median, 0.53 at most: :data:`STIFFNESS_STEP`
+of each edge's change.)
 """
 from __future__ import annotations
 
@@ -120,7 +120,7 @@ KINK = "kink"
 KINK_RATIO = 4.0
 #: the share of a step that bounds the located position of any other edge of a map with kinks (module docstring)
 LOCATED_STEP = 0.25
-#: the share of the stiffness's change with every edge a step out that bounds its error on such a map (same)
+#: with a penalty, the share of the stiffness's change with each edge a step out that bounds its error (same)
 STIFFNESS_STEP = 0.5
 
 
@@ -343,5 +343,5 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                                f"points at one) and {kinked.get('located', 0)} other(s): {', '.join(raised)} bounded "
                                f"by a step at each edge at a kink, {LOCATED_STEP:g} of a step at each other, a notch "
                                "by its width or the rest of the steps between its contact points, the stiffness by "
-                               f"{STIFFNESS_STEP:g} of its change with every edge a step out")
+                               "as many steps of its change with each edge a step out")
     return remarks
