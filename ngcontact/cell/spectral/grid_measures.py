@@ -44,11 +44,11 @@ the change ``K_grown - K_set`` with every edge that may move a step out
 (three open points ahead, so its open run stays open) moved, shared among
 them as their stress intensities squared, which the collocated ``p'`` at
 each last contact point is proportional to (the local problem again).  On
-the periodic punch with its edges anywhere between points the error falls
-from 2e-5 to 1.2e-2 (the set's ``K``) to 1e-9 to 8e-5 (located) on 1024 to
-16,384 points, at second order; on Westergaard's sinusoid
-(``geometries/cells/westergaard_exact.toml``) from 1.2e-4 to 6e-3 to 4e-8
-to 1.9e-4, the quartic-located edges' error taking over.  Where the edges
+the periodic punch with its edges anywhere between points, on 1024 to 16,384
+points, the relative error is 6e-6 to 1.2e-2 with the set's ``K`` and 2e-9
+to 8e-5 with the located one, which falls at second order; on Westergaard's
+sinusoid (``geometries/cells/westergaard_exact.toml``) 1.2e-4 to 6e-3 and
+1.6e-8 to 1.9e-4, the quartic-located edges' error taking over.  Where the edges
 are located to a fraction of a step only (beside a kink of a map), the
 stiffness's error is theirs: ``sum_e dK_e`` times their error in steps
 (:mod:`~ngcontact.cell.spectral.contact_edges`).
