@@ -91,14 +91,14 @@ edge not at a kink therefore holds :data:`LOCATED_STEP` of a step of each quanti
 edges, as the same floor (form :data:`KINK`): above every one of those errors, about seven times the median
 one (the estimate then exceeds such an error by as much, and says so where it exceeds ten times what the last
 difference leaves), and a tolerance of 1e-4 of the contact fraction is met with six to twelve edges from
-16,384 to 32,768 points (``scripts/random_profile_accuracy.py``).  The normal effective stiffness, of the
-collocated contact set (points, no located edges), has the same erratic first-order error: on the same
-profiles (seeds 1 to 12, 16 and 27, grids 1024 to 8192 against 131,072 points) it was 0.1 of the stiffness's
-change with every edge a step out in the median, 0.28 in the ninetieth percentile, 0.53 at most (seed 2 at
-p = 0.001 on 4096 points, beside a difference-based estimate of its own); on seed 16 at p = 0.003 the default
-grid's estimate was 0.7 times the error.  Half that change (:data:`STIFFNESS_STEP`: the edges' quarter of a
-step, doubled as the stiffness's estimate is) is the same floor under its estimate (:func:`stiffness_share`,
-two masked CG solves per load and level); the 2D stiffness is held to the tolerance with it.
+16,384 to 32,768 points (``scripts/random_profile_accuracy.py``).  The 2D normal effective stiffness, of the
+set with its edges located between points (exact contact, :mod:`~ngcontact.cell.spectral.grid_measures`), carries
+the same edges' error: each edge's share is its steps above (a step at a kink, a notch's on each of its edges,
+:data:`LOCATED_STEP` elsewhere) times the stiffness's change with that edge alone a step out
+(:func:`~ngcontact.cell.spectral.grid_measures.edge_stiffness`), summed (:func:`stiffness_share`), the same
+floor under its estimate.  (With a penalty the stiffness is the collocated set's, whose error on the same
+profiles was 0.1 of its change with every edge a step out in the median, 0.53 at most: :data:`STIFFNESS_STEP`
+of each edge's change.)
 """
 from __future__ import annotations
 
@@ -108,7 +108,7 @@ import numpy as np
 from scipy import ndimage
 
 from ngcontact.cell.cell_solution import COEFFICIENT, scale
-from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset, effective_stiffness
+from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset, edge_stiffness
 
 #: the fewest collocation points of a resolved 2D contact island (module docstring)
 ISLAND_POINTS = 4
@@ -120,7 +120,7 @@ KINK = "kink"
 KINK_RATIO = 4.0
 #: the share of a step that bounds the located position of any other edge of a map with kinks (module docstring)
 LOCATED_STEP = 0.25
-#: the share of the stiffness's change with every edge a step out that bounds its error on such a map (same)
+#: with a penalty, the share of the stiffness's change with each edge a step out that bounds its error (same)
 STIFFNESS_STEP = 0.5
 
 
@@ -230,10 +230,26 @@ def kink_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
     :data:`LOCATED_STEP` of a step per other edge of a map with kinks.  ``{"edges": how many at a kink,
     "notches": how many, "located": how many others, "share": {headline name: absolute share}}``; no share
     without kinks."""
+    steps, kinked_edges, notches = edge_steps(cell, p, gap)
+    if not steps:
+        return {"edges": 0, "notches": 0, "share": {}}
+    n = p.size
+    total = sum(s for s, _, _ in steps.values()) - sum(s for s, _, notch in steps.values() if notch) / 2
+    heights = sum(s * h for s, h, notch in steps.values()) - sum(s * h for s, h, notch in steps.values() if notch) / 2
+    return {"edges": kinked_edges + 2 * notches, "notches": notches, "located": len(steps) - kinked_edges - 2 * notches,
+            "share": {"contact_fraction": total / n, COEFFICIENT + "k_n": cell.k_n * total / n,
+                      COEFFICIENT + "g_n": cell.k_n * heights / n}}
+
+
+def edge_steps(cell, p: np.ndarray, gap: np.ndarray) -> tuple[dict[tuple[int, int], tuple[float, float, bool]],
+                                                              int, int]:
+    """The steps of its error that bound each located 2D edge of a map with kinks (:func:`kink_share`), as
+    ``{(last contact point, step): (steps, largest g0 within a step, of a notch)}`` (a notch's steps on each of its
+    two edges), with how many edges lie at a kink outside notches and how many notches; none without kinks."""
     on, n = p > 0, p.size
     at = np.flatnonzero(kinks(cell.g0))
     if cell.dim != 2 or on.all() or not on.any() or at.size == 0:
-        return {"edges": 0, "notches": 0, "share": {}}
+        return {}, 0, 0
     root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
     edges = {}                                           # (last contact point, step): (offset, kinked, largest g0)
     for step in (1, -1):
@@ -242,32 +258,32 @@ def kink_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
             x = i + step * t
             reach = np.arange(int(np.floor(x - 1.0)), int(np.ceil(x + 1.0)) + 1) % n   # the steps it may move across
             edges[i, step] = (t, bool(np.min(np.abs((at - x + n / 2) % n - n / 2)) <= 1.0), float(cell.g0[reach].max()))
-    steps_heights, notches = [], 0
+    steps: dict[tuple[int, int], tuple[float, float, bool]] = {}
+    notches = 0
     for first, w in islands(~on):                        # a notch: both edges of a short open run at a kink
         right, left = ((first - 1) % n, 1), ((first + w) % n, -1)
         if w < ISLAND_POINTS and edges[right][1] and edges[left][1]:
             located = w + 1 - edges[right][0] - edges[left][0]
-            steps_heights.append((max(located, w + 1 - located), max(edges[right][2], edges[left][2])))
+            notch = (max(located, w + 1 - located), max(edges[right][2], edges[left][2]), True)
+            steps[right] = steps[left] = notch
             del edges[right], edges[left]
             notches += 1
-    kinked_edges = sum(1 for _, kinked, _ in edges.values() if kinked)
-    steps_heights += [(1.0 if kinked else LOCATED_STEP, height) for _, kinked, height in edges.values()]
-    if not steps_heights:
-        return {"edges": 0, "notches": 0, "share": {}}
-    steps = sum(s for s, _ in steps_heights)
-    return {"edges": kinked_edges + 2 * notches, "notches": notches, "located": len(edges) - kinked_edges, "share": {
-        "contact_fraction": steps / n, COEFFICIENT + "k_n": cell.k_n * steps / n,
-        COEFFICIENT + "g_n": cell.k_n * sum(s * h for s, h in steps_heights) / n}}
+    steps.update({key: (1.0 if kinked else LOCATED_STEP, height, False) for key, (_, kinked, height) in edges.items()})
+    return steps, sum(1 for _, kinked, _ in edges.values() if kinked), notches
 
 
-def stiffness_share(cell, on: np.ndarray) -> float:
-    """:data:`STIFFNESS_STEP` times the change of the normal effective stiffness of the 2D contact set ``on``
-    (:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`) when every edge moves a step out: the
-    floor of its estimate on a map with kinks (module docstring)."""
-    stiffness, grown = (effective_stiffness(cell, s)["matrix"] for s in (on, on | np.roll(on, 1) | np.roll(on, -1)))
-    if stiffness is None or grown is None:          # full contact: no finite stiffness to compare
+def stiffness_share(cell, p: np.ndarray, gap: np.ndarray) -> float:
+    """The share of the 2D normal effective stiffness held by the located edges of a map with kinks: per edge its
+    steps of :func:`edge_steps` times the stiffness's change with that edge a step out
+    (:func:`~ngcontact.cell.spectral.grid_measures.edge_stiffness`), summed; with a penalty, whose stiffness is the
+    collocated set's, :data:`STIFFNESS_STEP` of a step per edge (module docstring); 0 without kinks."""
+    steps = edge_steps(cell, p, gap)[0]
+    if not steps:
         return 0.0
-    return STIFFNESS_STEP * abs(grown[0][0] - stiffness[0][0])
+    shares = edge_stiffness(cell, p > 0, gap)["edges"]
+    exact = cell.enforcement == "exact"
+    return sum((s if exact else STIFFNESS_STEP) * abs(shares[key][1]) for key, (s, _, _) in steps.items()
+               if key in shares)
 
 
 def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict[str, Any]:
@@ -291,8 +307,8 @@ def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict
     out: dict[str, Any] = {"points": points, "islands": count, "share": {},
                            "kinks": kink_share(cell, p, gap) if gap is not None else {"edges": 0, "notches": 0,
                                                                                       "share": {}}}
-    if out["kinks"]["share"]:
-        out["kinks"]["share"]["normal_stiffness"] = stiffness_share(cell, p > 0)
+    if out["kinks"]["share"] and gap is not None:
+        out["kinks"]["share"]["normal_stiffness"] = stiffness_share(cell, p, gap)
     if count:
         whole = coefficients(cell, mask).as_dict()
         out["share"] = {"contact_fraction": whole["contact_fraction"], COEFFICIENT + "k_n": whole["k_n"],
@@ -327,5 +343,5 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                                f"points at one) and {kinked.get('located', 0)} other(s): {', '.join(raised)} bounded "
                                f"by a step at each edge at a kink, {LOCATED_STEP:g} of a step at each other, a notch "
                                "by its width or the rest of the steps between its contact points, the stiffness by "
-                               f"{STIFFNESS_STEP:g} of its change with every edge a step out")
+                               "as many steps of its change with each edge a step out")
     return remarks

@@ -234,7 +234,7 @@ class SpectralCell:
         if self.friction is not None:
             results["max_slip"] = float(slip.max())
             results["slip_fraction"] = float(np.count_nonzero(state["slipping"])) / self.points
-        results["effective_stiffness"] = measures.effective_stiffness(self, p > 0)
+        results["effective_stiffness"] = measures.effective_stiffness(self, p > 0, elastic_gap)
         results["coefficients"] = measures.coefficients(self, p > 0, state.get("threshold"), weights).as_dict()
         fields = {"pressure": p, "gap": np.maximum(elastic_gap, 0.0), "closure": closure}
         if self.friction is not None:

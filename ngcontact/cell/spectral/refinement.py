@@ -97,19 +97,19 @@ the guarded bound) neither are theirs, whose errors are the same edges' misplace
 two ratios may agree by chance where the edges' errors change sign, and its Richardson tail then misses an
 error that grows from one grid to the next.
 
-The normal effective stiffness is the stiffness of the collocated contact set
-(:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`): its pressure, singular like the
-inverse square root of the distance to an edge, converges at first order in the grid step with a constant
-that the edges' position between points makes erratic, in 2D much slower than the fraction. It is estimated at
-first order, the estimate doubled (:data:`ERRATIC`: its error may exceed the differences beside it where two
-grids' errors share their sign and size, as on Westergaard's sinusoid at half its closing pressure).  In 2D it
+The normal effective stiffness (:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`) is in 3D
+that of the collocated contact set, whose pressure, singular like the inverse square root of the distance to an
+edge, converges at first order with a constant that the edges' position between points makes erratic: estimated
+at first order, doubled (:data:`ERRATIC`).  In 2D (exact contact) it is that of the set with its edges located
+between points: its error is the located edges', and it is estimated as the fraction is.  In 2D it
 is held to the tolerance like the others, within a stated cap (:func:`stiffness_capped`): once every other
 quantity meets the tolerance, refinement goes on for the stiffness alone for at most :data:`STIFFNESS_LEVELS`
 more levels within the largest grid, and only while its estimate, were it to fall by :data:`STIFFNESS_RATE` per
-level (second order: faster than its error's first order, so that a stiffness whose guarded estimate collapses
-once its differences contract, as on the random profiles of ``docs/benchmarks.md`` (``random_profile_accuracy``),
-is not given up early), could meet it within them.  Beyond the cap (a 2D tolerance of the order of the fraction's,
-1e-4, would take millions of points at first order) the refinement stops, ``met = False``, the stiffness counted
+level (second order: faster than the first order of edges located to a fraction of a step, so that a stiffness
+whose guarded estimate collapses once its differences contract, as on the random profiles of
+``docs/benchmarks.md`` (``random_profile_accuracy``), is not given up early), could meet it within them.  Beyond
+the cap (a tolerance of 1e-4 where a narrow contact island, whose stiffness is sensitive to its width, has an edge
+located to a fraction of a step only) the refinement stops, ``met = False``, the stiffness counted
 in the verdict as not met (one warning line) and the cap named in the remarks; a scene's stated tolerance so missed
 ends its run (:meth:`~ngcontact.cell.spectral.spectral_solver.SpectralCellSolver.refine_to`).  In 3D, whose cost
 bound (points squared) allows a few doublings only, it is reported with its estimate and not held
@@ -194,7 +194,8 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"of the last {WINDOW} differences where their two ratios agree within a factor {AGREE:g} (rate at least "
        f"{FIRST_ORDER}, the tail times {SPREAD:g}) if that is the smaller, else the guarded geometric tail: "
        f"rate the larger ratio held to [{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished "
-       "last one; the contact fraction and coefficients guarded on levels of edges not all fitted by the quartic, "
+       "last one; the contact fraction, coefficients and 2D stiffness (of the located set) guarded on levels of "
+       "edges not all fitted by the quartic, "
        f"and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
        "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
        f"stiffness's estimate times {ERRATIC[STIFFNESS][2]:g} in 2D, held to the tolerance up to {STIFFNESS_LEVELS} "
@@ -293,7 +294,8 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
             # a coefficient's edges are the fraction's: not geometric where the fraction's sequence is not
             geometric = geometric_ok and not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
             args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
-            fitted = fitted_run(history, k) if on_edges(name) else len(history)
+            located = on_edges(name) or (name == STIFFNESS and dim == 2)       # 2D: the located set's stiffness
+            fitted = fitted_run(history, k) if located else len(history)
             run = min(fitted, resolved_run(history, k))        # levels of the quartic and of resolved islands
             out[name], form[name], note = tail_estimate(values, *args[:3], geometric and fitted == len(history))
             if LOCATOR_LEVELS <= run < len(history):

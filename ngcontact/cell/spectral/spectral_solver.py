@@ -181,8 +181,9 @@ class SpectralCellSolver:
         return Refinement(solutions=solutions, estimates=list(refined.estimates), method=method,
                           met=refined.met, how=how, uncontrolled=refined.uncontrolled,
                           scales=refined.scales, loose=refined.flags, shortfall=refined.capped,
-                          remedy="the stiffness converges at first order in the grid step: state a looser "
-                                 "discretization.tolerance to meet it, or read it with its estimate")
+                          remedy="the stiffness converges as its contact edges are located (at first order where "
+                                 "to a fraction of a step): state a looser discretization.tolerance to meet it, "
+                                 "or read it with its estimate")
 
     def penalty(self) -> float | None:
         return float(self.cell.k_n) if self.cell.enforcement == "penalty" else None
