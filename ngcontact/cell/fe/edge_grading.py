@@ -29,8 +29,10 @@ The edges are not known in advance, so meshing and solving alternate:
    its edges' part (the grading's tail, the contact set's share, which no
    order reduces: :func:`~ngcontact.cell.fe.grading_estimate.edges_miss`),
    grade once more at the order graded and check the new mesh by its own
-   orders; else continue grading at the raised order, or, at the finest
-   grading, raise the order again.
+   orders, as where the orders are spent before it is met (an edge inside
+   its element converges only algebraically in the order); else continue
+   grading at the raised order, or, at the finest grading, raise the order
+   again.
    The answer reported is the highest order on the finest mesh; its
    estimate is the observed-rate tail of the orders on that mesh
    (:data:`ORDER_RATE`, :mod:`ngcontact.cell.fe.observed_rate`):
@@ -397,6 +399,9 @@ def solve_to_tolerance(make_problem: Callable[[list[float], int], Any], load, to
                             break
                     elif step < MAX_STEPS:
                         break
+                else:
+                    if step < MAX_STEPS:     # the orders spent: an edge's singularity inside its element converges
+                        order, raises = graded["order"], 0    # algebraically in the order; grade once more
             if step == MAX_STEPS or raises > MAX_ORDER_RAISES:
                 break
             step += 1
