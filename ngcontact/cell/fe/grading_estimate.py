@@ -73,6 +73,12 @@ stated tolerance still missed when the steps and orders are spent ends the run w
   in sign the sequence swings about its limit (an edge inside its element: the last order may be worse than
   the one before), and the last change bounds the error, as an alternating series' last term does.
 
+The orders' tail itself, of every quantity, is that of an alternating series where the last two changes
+alternate (:func:`orders_tail`): the remainder of a series whose terms alternate and contract by ``rho`` is
+at most its first term, ``rho |d_k|``, not the monotone ``rho / (1 - rho) |d_k|``.  On Hertz's row at ``1e-2``
+with exact contact the fraction's values over orders 3 to 5 swing by 1.1e-5 and 6.1e-6 about the limit (error
+2.2e-6): the monotone tail was 10 times the error, the alternating one 4.6.
+
 Against Westergaard's closed forms (``2a``, ``k_n 2a``, ``k_n h (2a - sin(2 pi a) / pi)``) and the spectral
 cell's stiffness of the same layers on 2^16 to 2^18 points (Richardson's limit), exact contact, at ``p/p* =
 0.5`` and tolerance ``1e-2``, the estimates bound the errors (``tests/cell/test_graded_headline_estimates.py``);
@@ -134,7 +140,7 @@ def order_estimate(orders: list[dict[str, Any]], grading_change: float | None = 
         values = [e.get("headline", {}).get(name, e.get(name)) for e in orders]
         if None in values or not any(values):
             continue
-        out[name], note = ORDER_RATE.tail(values, False, scale(name, last))
+        out[name], note = orders_tail(values, scale(name, last))
         if note:
             notes.append(f"{name}: {note}")
     grading, note = grading_tail(orders, grading_change)
@@ -152,6 +158,21 @@ def order_estimate(orders: list[dict[str, Any]], grading_change: float | None = 
             out[name] = own[0]
             notes.append(f"{name}: {own[1]}")
     return out, "; ".join(notes)
+
+
+def orders_tail(values: list[float], size: float) -> tuple[float, str]:
+    """The orders' tail of :data:`ORDER_RATE` over ``values`` (successive orders), in the measure of ``size``;
+    where the last two changes alternate in sign, the remainder of an alternating series contracting at the
+    same ratio ``rho``: at most the first change omitted, ``rho |d_k|`` instead of the monotone ``rho / (1 -
+    rho) |d_k|``, so the tail times ``1 - rho`` (module docstring; with the same safety factor 3 it still
+    bounds a monotone remainder while ``rho <= 2/3``)."""
+    tail, note = ORDER_RATE.tail(values, False, size)
+    swing = alternating(values)
+    if swing > 0.0 and tail > 0.0:
+        x = tail * size / (ORDER_RATE.safety * swing)      # rho / (1 - rho) of the tail
+        tail /= 1.0 + x
+        note = "; ".join(n for n in (note, "alternating: the first change omitted bounds the rest") if n)
+    return tail, note
 
 
 def edges_miss(orders: list[dict[str, Any]], grading_change: float | None, estimate: dict[str, float],
