@@ -111,7 +111,9 @@ class CellDiscretization(Discretization):
         "error by the same sweep one order more on the same mesh (the change times 4: the saturation assumption "
         "that order p + 1 keeps at most 3/4 of the error of order p; one more sweep on about ((p + 1) / p)^dim "
         "times the unknowns; every headline quantity it reports) and reports it where that meets 0.01, else is "
-        "refined towards 0.01 as a stated tolerance refines it, within "
+        "refined towards 0.01 as a stated tolerance refines it (a graded cell only where the contact fraction or "
+        "the mean closure misses it; a miss of the effective stiffness or an eq. 34 coefficient alone is "
+        "reported with accuracy.met = false and a warning), within "
         "discretization.budget_dofs; a budget spent before 0.01 is met reports the "
         "finest answer with accuracy.met = false, one warning naming the estimate, the budget and the dofs "
         "meeting 0.01 would take at the observed rate (accuracy.shortfall), and exit status 0",

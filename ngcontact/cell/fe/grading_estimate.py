@@ -310,11 +310,11 @@ def set_move(contact, towards, period: float) -> float | None:
 def edge_cells(problem, edges) -> list[list[float]]:
     """Per contact edge the largest interface element touching it and the largest initial gap at those elements'
     ends, ``[size, gap]``: where the edge may lie and the gap there
-    (:func:`set_share`)."""
+    (:func:`set_share`); a cell without an initial gap (a flat patch) has gap 0 there."""
     rule = ng.IntegrationRule([(0.0,), (1.0,)], [0.0, 0.0])
     mips = problem.mesh.MapToAllElements(rule, problem.mesh.Boundaries("contact"))
     x = np.asarray(ng.x(mips)).reshape(-1, 2)
-    g = np.asarray(problem.gap(mips), dtype=float).reshape(-1, 2)
+    g = np.zeros(x.shape) if problem.gap is None else np.asarray(problem.gap(mips), dtype=float).reshape(-1, 2)
     lo, hi = x.min(axis=1), x.max(axis=1)
     out = []
     for e in edges:
