@@ -7,12 +7,13 @@ A cell scene that states no ``discretization.tolerance`` is held to the default 
    same mesh (:mod:`ngcontact.cell.fe.saturation`: ``|q_p - q| <= |q_(p+1) - q_p| / (1 - beta)``, every
    headline quantity).  Where every load's estimate meets ``tol`` that answer is reported: no refinement
    solves fewer unknowns than the scene's own discretization, so it is the cheapest that meets the
-   tolerance.  A cell refined by grading (below) is refined only where a quantity the grading holds misses
-   ``tol`` (:data:`~ngcontact.cell.fe.grading_estimate.HELD`): a miss of the effective stiffness or of a
-   coefficient of eq. 34 alone is reported with ``accuracy.met = false`` and one warning line, since graded
-   levels estimate them (:mod:`ngcontact.cell.fe.grading_estimate`) but do not refine for them; a quantity
-   the graded levels do not estimate keeps the scene's estimate, carried to the refined answer
-   (:func:`carried_over`);
+   tolerance.  A cell refined by grading (below) is refined by default only where the contact fraction or
+   the closure misses ``tol`` on the scene's mesh (:data:`DEFAULT_HELD`): a miss of the effective stiffness
+   or of a coefficient of eq. 34 alone is reported with ``accuracy.met = false`` and one warning line (the
+   one-order-more estimate of those on a coarse mesh, e.g. under a penalty near its limit ``k_n h / E ~
+   1e10``, is no guide to where graded levels would end); a stated tolerance's graded levels hold them all
+   (:mod:`ngcontact.cell.fe.grading_estimate`).  A quantity the graded levels do not estimate keeps the
+   scene's estimate, carried to the refined answer (:func:`carried_over`);
 2. else the sweep is refined towards ``tol`` as a stated tolerance refines it
    (:meth:`~ngcontact.cell.fe.fe_cell.FECell.default_refinement`), but no discretization holding more than
    the budget's unknowns (``discretization.budget_dofs``; :data:`ngcontact.cell.fe.fe_cell.DEFAULT_DOFS`)
@@ -63,11 +64,14 @@ from ngcontact.cell.cell_load import CellLoad
 from ngcontact.cell.cell_solution import GROUP, headline, measure, scale
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.cell.fe.edge_grading import GradedSolve
-from ngcontact.cell.fe.grading_estimate import HELD, ORDER_RATE
+from ngcontact.cell.fe.grading_estimate import ORDER_RATE
 from ngcontact.cell.fe.observed_rate import dofs_to_meet, exponent
 from ngcontact.cell.fe.saturation import estimate_on_scene
 from ngcontact.cell.fe.second_discretization import HALVING_RATE, Sequence, as_refinement
 
+#: the quantities whose miss of the default tolerance on the scene's own mesh starts a graded refinement
+#: (module docstring, step 1)
+DEFAULT_HELD = ("contact_fraction", "mean_closure")
 #: the scene key of the budget, as the warning names it
 BUDGET_KEY = "discretization.budget_dofs"
 #: unknowns beyond any machine this package runs on: a projection above it is said to be out of reach
@@ -170,7 +174,7 @@ def held_to_default(cell: Any, tolerance: float, loads: list[CellLoad]) -> Refin
     ``cell.budget`` unknowns, with the shortfall where the budget ended first."""
     first = estimate_on_scene(cell, loads)
     graded = cell.default_refinement() == "graded"
-    if not first.estimates or worst(first.estimates, HELD if graded else None) <= tolerance:
+    if not first.estimates or worst(first.estimates, DEFAULT_HELD if graded else None) <= tolerance:
         return first          # met on the scene's own discretization, or not estimable (said so)
     ndof, scene_problem = cell.unknowns(), cell.problem
     if graded:

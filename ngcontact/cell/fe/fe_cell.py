@@ -44,13 +44,12 @@ from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.cell_problem import CellProblem
 from ngcontact.cell.fe.default_refinement import held_to_default
 from ngcontact.cell.fe.edge_grading import GradedSolve, graded_refinement, solve_to_tolerance
-from ngcontact.cell.fe.grading_estimate import unheld
 from ngcontact.cell.fe.load_start import Predictor
 from ngcontact.cell.fe import whole_surface_error
 from ngcontact.cell.fe.saturation import estimate_on_scene
 from ngcontact.cell.fe.second_discretization import InterfaceHalving, Refiner, Sequence, as_refinement, refine
 from ngcontact.cell.fe.measures import contact_fraction, contact_integral, mean_jump, real_contact_coefficients
-from ngcontact.errors import ConvergenceError, ModelError
+from ngcontact.errors import ModelError
 from ngcontact.fem.quadrature import smooth_order
 
 log = logging.getLogger(__name__)
@@ -228,17 +227,14 @@ class FECell:
         Raises
         ------
         ConvergenceError
-            ``required`` and out of reach, or a counted quantity the graded levels do not hold missing it
-            (:func:`~ngcontact.cell.fe.grading_estimate.unheld`; issue 35: exit 3, never ``met = false``).
+            ``required`` and out of reach for a counted quantity (the graded levels hold every one:
+            :func:`~ngcontact.cell.fe.grading_estimate.out_of_reach`; issue 35: exit 3, never ``met = false``).
         """
         bound = MAX_DOFS[self.dim] if required else self.budget
         if self.graded is None or self.h0 is None:
             refined = as_refinement(self.compared(tolerance, loads, bound, required))
         else:
-            refined, solves = self.graded_solves(tolerance, loads, required, None if required else bound)
-            if required and counted_worst(refined) > tolerance:
-                raise ConvergenceError(unheld(tolerance, refined.estimates, [g.orders[-1] for g in solves]),
-                                       {"levels": [g.history for g in solves]})
+            refined = self.graded_solves(tolerance, loads, required, None if required else bound)[0]
         warn_unmet(refined, tolerance)       # only where not required: a required tolerance out of reach has raised
         return refined
 
