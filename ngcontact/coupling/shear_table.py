@@ -160,9 +160,9 @@ class ShearTable:
         if not todo:
             return {}
         if self.solves + len(todo) > self.max_solves:
-            raise ConvergenceError(f"shear table: more than {self.max_solves} cell solves for tolerance "
-                                   f"{self.tol:g} (two_scale.max_cell_solves: {self.solves} made, "
-                                   f"{len(todo)} more asked)", {"pressures": sorted(self.rows)})
+            raise ConvergenceError(f"shear table: more than {self.max_solves} cell solves for tolerance {self.tol:g} "
+                                   f"(two_scale.max_cell_solves: {self.solves} made, {len(todo)} more asked)",
+                                   {"pressures": sorted(self.rows)})
         out = {}
         for (p, d), value in zip(todo, self.map_tasks(self.response, todo)):
             s, t = float(value["jump"]), float(value["shear"])
