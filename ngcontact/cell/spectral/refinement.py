@@ -137,16 +137,15 @@ stretch left for a faster regime that no recorded change of method marks, unlike
 above), the differences up to level ``k`` still carry the size of the earlier errors, and the estimate
 exceeds the error by their ratio.
 
-A stop needs ``MIN_LEVELS`` levels (three differences: the window) and, to a scene's own tolerance, no
-load's edge locator changing (above).  The levels are known before the first solve (``grid`` times
-``GROWTH^k`` up to ``max_points``, :func:`levels`; the scene layer bounds ``max_points`` by the cost of a
-solve, :func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest is stated first, and each level
-prints one progress line as it ends.  A tolerance out of reach ends in a
-:class:`~ngcontact.errors.ConvergenceError` where it was required (the scene stated it), else the finest
-level is the answer, marked as not meeting it.  Each level starts its loads from the coarser level's
-pressures, interpolated onto its grid (:func:`prolong`; the coarse points are every other fine point): a
-start only, which saves the first steps of the constrained CG in which the contact set shrinks from full
-contact, while the answer is the level's own to its solver's tolerance.
+A stop needs ``MIN_LEVELS`` levels (three differences: the window) and, to a scene's own tolerance, no load's
+edge locator changing (above).  The levels are known before the first solve (``grid`` times ``GROWTH^k`` up to
+``max_points``, :func:`levels`; the scene layer bounds ``max_points`` by the cost of a solve,
+:func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest is stated first, and each level prints one
+progress line as it ends.  A tolerance out of reach ends in a :class:`~ngcontact.errors.ConvergenceError` where
+it was required (the scene stated it), else the finest level is the answer, marked as not meeting it.  Each
+level starts its loads from the coarser level's pressures, interpolated onto its grid (:func:`prolong`; the
+coarse points are every other fine point): a start only (it saves the constrained CG's first steps, where the
+contact set shrinks from full contact); the answer is the level's own.
 """
 from __future__ import annotations
 
