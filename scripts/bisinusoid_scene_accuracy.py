@@ -13,7 +13,9 @@ CPU seconds).  Its refinement along the contact edge
 (:mod:`ngcontact.cell.fe.contact_edge_refinement`: edge sizes scaled with the
 patch width, the bodies at ``maxh`` 0.3, :mod:`ngcontact.drivers.contact_edge_refiner`)
 reports the contact fraction extrapolated in the edge size with its grid
-convergence index (:mod:`ngcontact.cell.fe.edge_size_extrapolation`).  The converged
+convergence index (:mod:`ngcontact.cell.fe.edge_size_extrapolation`), and refines
+Netgen's grading at the last edge size where the normal stiffness alone misses
+the tolerance (every estimated quantity counted in the verdict).  The converged
 value is the spectral cell's contact fraction extrapolated from ``1024^2``
 and ``2048^2`` (``REF_GRIDS`` of ``bisinusoid_accuracy.py``, whose docstring says
 why not ``512^2``).  The estimates of the other quantities are also measured
@@ -201,8 +203,10 @@ def main(argv=None) -> int:
             "stiffness and the coefficients). `effectivity_closure`, `_stiffness`, `_k_n`, `_g_n`: the report's "
             "estimate of the mean closure, the normal effective stiffness and the coefficients k_n, g_n of eq. 34 "
             "on the real contact set over their true error against the spectral cell's values extrapolated alike "
-            "(the coefficients scaled to the scene's k_n); the stiffness is reported with its estimate but not "
-            "counted in `met` (its error is the grading's, which the ladder does not reduce). The ladder bounds "
+            "(the coefficients scaled to the scene's k_n); every one is counted in `met`, the stiffness too: its error "
+            "is made in the mesh graded away from the contact edge, so where after the three edge levels it alone "
+            "misses the tolerance the ladder adds levels at the last edge size with Netgen's grading 0.3 times "
+            "1/sqrt(2) per level (`levels` counts every level, `ndof` is the last's). The ladder bounds "
             "the closure, the stiffness and the coefficients by the distance from its spectral twin on the same "
             f"grids as `converged`, so the reference is checked on finer ones: `check_effectivity`, the smallest "
             f"effectivity of the row against the spectral cell extrapolated from {CHECK_GRIDS[0]}^2 and "

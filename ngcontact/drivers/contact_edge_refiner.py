@@ -20,16 +20,25 @@ exact on any mesh.  What the contact fraction and the closure carry from the bod
 field, refined with the edge from level to level, and a coarser far field saves its unknowns at every level
 (the errors the scene reaches so: docs/benchmarks.md, section ``bisinusoid_scene_accuracy``).  A scene that
 sets ``maxh`` keeps it.
+
+The twin's grids (:func:`edge_refiner`).  Each grid is solved once for every level that asks it (the edge
+points of the levels, their start, the bound of the estimates).  A grid finer than every level's start
+(beyond :data:`~ngcontact.cell.fe.contact_edge_refinement.TWIN_GRIDS`: the bound's finest) starts its
+constrained CG from the next coarser grid's pressure, each value on its four points (:func:`prolonged`): the
+same strictly convex problem, so the same minimizer to the solver's tolerance, in fewer steps (the
+bisinusoid at ``p/p* = 0.02`` on ``2048^2``: 18 steps instead of 27, 6.2 instead of 8.7 CPU seconds).
 """
 from __future__ import annotations
 
 from typing import Any, Callable
 
+import numpy as np
+
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.fe.cell_model import CellModel
 from ngcontact.cell.fe.contact_edge_mesh import edge_refined_cell
-from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement, twin_grid
+from ngcontact.cell.fe.contact_edge_refinement import TWIN_GRIDS, ContactEdgeRefinement, twin_grid
 from ngcontact.cell.fe.fe_cell import FECell
 from ngcontact.cell.spectral_start import SpectralStart
 from ngcontact.drivers.mirror_symmetry import quarter
@@ -60,6 +69,12 @@ def scene_sizes(scene: CellScene) -> dict[str, float]:
     return {} if bulk == d.maxh else {"maxh": bulk, "interface_maxh": d.interface_maxh or d.maxh}
 
 
+def prolonged(pressure: np.ndarray) -> np.ndarray:
+    """A periodic grid's pressure on the grid of twice its points per direction, each value on its four
+    points: the start of the finer twin (module docstring)."""
+    return np.kron(np.asarray(pressure, float), np.ones((2, 2)))
+
+
 def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any],
                  spectral: Callable[..., Any]) -> Callable[[FECell], ContactEdgeRefinement] | None:
     """``(scene's FE cell) -> `` its :class:`ContactEdgeRefinement`, or ``None`` where the scene has none
@@ -81,7 +96,12 @@ def edge_refiner(scene: CellScene, model: CellModel, problem: Callable[..., Any]
     def twin(grid: int) -> list:
         if grid not in solved:
             cells[grid] = cell = spectral(scene, grid=grid, friction=False, tol=EDGE_TWIN_RTOL)
-            solved[grid] = [cell.solve(cell_load(g.dim, **state)) for state in load_states(scene)]
+            loads = [cell_load(g.dim, **state) for state in load_states(scene)]
+            if grid > TWIN_GRIDS[1] and grid // 2 in solved:       # no level's start: from the coarser grid
+                solved[grid] = [cell.solve(load, start=prolonged(s.fields["pressure"]))
+                                for load, s in zip(loads, solved[grid // 2])]
+            else:
+                solved[grid] = [cell.solve(load) for load in loads]
         return solved[grid]
 
     def pressures(grid: int):

@@ -204,17 +204,47 @@ def test_the_twins_bound_replaces_a_tail_that_overstates_and_takes_an_earlier_di
     assert done.estimates[0]["mean_closure"] == pytest.approx((0.0025 + 0.004) / 1.002, rel=1e-9)
 
 
-def test_the_ladder_reports_the_stiffness_but_does_not_hold_it_to_the_tolerance():
-    """The stiffness's error is the grading's, which no level reduces: the ladder stops on the other
-    quantities, and the stiffness is reported with its estimate, not counted."""
-    from ngcontact.cell.fe.contact_edge_refinement import UNREDUCED, ContactEdgeRefinement
-    ladder = ContactEdgeRefinement(_Level(1000, 0.6, stiffness=1.1), lambda grid: [],
-                                   lambda points, h, grading: _Level(1000, 0.5 + 0.2 * h, stiffness=1.0 + h),
-                                   interface_maxh=0.1, period=1.0)
+def test_the_ladder_refines_its_grading_where_the_stiffness_alone_misses_the_tolerance():
+    """A stiffness whose error is the grading's (``0.05 gamma^2``, the same at every edge size) against a twin
+    that answers the converged 1.0: after the edge sequence (three refined levels, the contact fraction's
+    extrapolation within the tolerance) its bound ``1.25 |S - 1| / S`` = 0.0056 misses 0.005, so level 4 keeps
+    the last edge size and takes the grading 0.3 / sqrt(2), whose stiffness meets it; the stiffness is counted,
+    and the contact fraction stays the edge sequence's extrapolation."""
+    from ngcontact.cell.fe.contact_edge_refinement import GRADING_STEP, ContactEdgeRefinement
+    built = []
+
+    def cell_at(points, h, grading):
+        built.append((h, grading))
+        return _Level(1000, 0.5 + 0.2 * h, stiffness=1.0 + 0.05 * grading ** 2)
+
+    ladder = ContactEdgeRefinement(_Level(1000, 0.6, stiffness=1.1), lambda grid: [], cell_at, interface_maxh=0.1,
+                                   period=1.0, twin_heads=lambda grid: [{"contact_fraction": 0.5,
+                                                                         "normal_stiffness": 1.0}])
     done = refine(ladder, [None], 0.005, 10 ** 9, required=True)
-    assert len(done.levels) == 4 and done.met and done.uncontrolled == UNREDUCED == ("normal_stiffness",)
-    assert done.estimates[0]["normal_stiffness"] > 0.005
-    assert as_refinement(done).uncontrolled == UNREDUCED
+    assert len(done.levels) == 5 and done.met and done.uncontrolled == () == as_refinement(done).uncontrolled
+    assert built[-1] == (built[-2][0], pytest.approx(0.3 * GRADING_STEP)) and ladder.edge_levels == 3
+    assert done.levels[3]["estimate"] > 0.005 >= done.levels[4]["estimate"]
+    assert done.estimates[0]["normal_stiffness"] == pytest.approx(1.25 * 0.00225 / 1.00225, rel=1e-9)
+    results = done.solutions[0].results
+    assert results["contact_fraction"] == pytest.approx(0.5, abs=1e-12)
+    assert results["contact_fraction_last_level"] == pytest.approx(0.5025, abs=1e-12)
+    assert "grading 0.212" in done.levels[4]["discretization"]
+
+
+def test_a_quantity_the_grading_does_not_reduce_missing_after_it_began_is_out_of_reach():
+    """A closure that the grading's level moves off the twin's (0.0088 at grading 0.212) misses the tolerance
+    after the edge sequence ended: no grading level reduces it, so a stated tolerance ends there (exit 3's
+    error, naming the quantity), not at the most levels."""
+    from ngcontact.cell.fe.contact_edge_refinement import ContactEdgeRefinement
+    ladder = ContactEdgeRefinement(
+        _Level(1000, 0.6, stiffness=1.1), lambda grid: [],
+        lambda points, h, g: _Level(1000, 0.5 + 0.2 * h, closure=1.0 + 0.1 * (0.3 - g), stiffness=1.0 + 0.05 * g ** 2),
+        interface_maxh=0.1, period=1.0,
+        twin_heads=lambda grid: [{"contact_fraction": 0.5, "mean_closure": 1.0, "normal_stiffness": 1.0}])
+    with pytest.raises(ConvergenceError, match="mean_closure missed the tolerance after the edge sequence ended "
+                                               "at level 3") as info:
+        refine(ladder, [None], 0.005, 10 ** 9, required=True)
+    assert len(info.value.history["levels"]) == 5
 
 
 def test_the_twin_floors_the_normal_coefficients_of_eq_34_too():

@@ -44,18 +44,20 @@ of the last level), the refiner answering
 converged before that extrapolation exists (:meth:`ContactEdgeRefinement.ready`).
 
 The grading.  Netgen grows the size from ``h_k`` at the edge at most like ``h_k + gamma r`` with the distance
-``r`` (``gamma`` its grading, :data:`~ngcontact.cell.fe.contact_edge_mesh.GRADING`), so a patch width from
-the edge, at the patch's centre and in the bodies below it, the elements are about ``gamma l`` whatever
-``h_k``, and the bodies' error made there (order 2 on a linear trace on ``S_C``) does not fall with the edge
-size: on the bisinusoid's quarter at Netgen's 0.3 the normal stiffness stays at one offset from the converged
-one over the levels.  A grading falling with the level, ``gamma_k = 0.3 2^(-beta (k - 1))``, does not pay: the
-near field holds about ``L l / (gamma^2 h_k)`` elements (``L`` the edges' length), so at ``beta = 1/2`` a
-level's unknowns grow about 4-fold instead of 2-fold, and each step moves two sizes at once, which the
-extrapolation in ``h_k`` alone misreads (its estimate far above the contact fraction's error at ``beta = 1/2``,
-an extra level for the stiffness's tail at ``beta = 1/4``).  A smaller fixed grading costs unknowns without a
-steadier stiffness.  So every level keeps the one grading (:attr:`ContactEdgeRefinement.grading`, Netgen's
-0.3), and that error, the same at every level and so in no difference of the sequence, is what the twin's
-bound below measures.
+``r`` (``gamma`` its grading, :data:`~ngcontact.cell.fe.contact_edge_mesh.GRADING`), so beyond ``r ~ h_k /
+gamma`` the elements are about ``gamma r`` whatever ``h_k``, and the error the bodies make there (order 2 on a
+linear trace on ``S_C``) does not fall with the edge size: on the bisinusoid's quarter at Netgen's 0.3 the
+normal stiffness stays at one offset above the converged one over the edge levels.  That offset is made in
+the graded band around the edge, not a patch width away: refining the bodies below and above the patch
+(:class:`~ngcontact.cell.fe.contact_edge_mesh.PatchBody`) or ``S_C`` around it to a small part of ``l``
+leaves it, a smaller grading lowers it.  A grading falling with every edge level, ``gamma_k = 0.3 2^(-beta
+(k - 1))``, does not pay: the near field holds about ``L l / (gamma^2 h_k)`` elements (``L`` the edges'
+length), so at ``beta = 1/2`` a level's unknowns grow about 4-fold instead of 2-fold, and each step moves two
+sizes at once, which the extrapolation in ``h_k`` alone misreads (its estimate far above the contact
+fraction's error).  So the edge sequence keeps the one grading (:attr:`ContactEdgeRefinement.grading`,
+Netgen's 0.3), that error, the same at every edge level and so in no difference of the sequence, is what
+the twin's bound below measures, and the grading is refined on its own levels after the edge sequence where
+that bound misses the tolerance ("The grading's levels" below).
 
 The twin's bound.  Those estimates see only the edge size; the error made at the sizes the ladder keeps
 (``interface_maxh`` away from the edge, the bodies at the grading's size, the linear trace) does not change
@@ -97,11 +99,19 @@ estimate is a geometric tail, takes ``B`` in its place (:data:`TWIN_MEASURED`); 
 extrapolation's grid convergence index admits a fixed part up to its safety factor times its correction,
 takes the larger of that and ``B`` (:meth:`ContactEdgeRefinement.twin_floors`).
 
-The stiffness is not held to the tolerance (:data:`UNREDUCED`, reported with ``B``, not counted in the
-verdict, as the spectral cell's).  Its error is the grading's ("The grading" above): made a patch width
-from the edge, at the element size ``gamma l`` the ladder keeps, it stays at one offset from level to level,
-so that a tolerance below that offset would refine the edge to the most levels in vain and end the scene
-without an answer whose other quantities met it.
+The grading's levels.  Every estimated quantity is held to the tolerance, the stiffness by its own knob
+(:meth:`ContactEdgeRefinement.steer`, the loop's
+:class:`~ngcontact.cell.fe.second_discretization.Steered`): where the edge sequence's extrapolation exists
+(:meth:`~ContactEdgeRefinement.ready`) and only the quantities of :data:`GRADED` (the stiffness, whose
+error is the grading's) miss the tolerance, the next level keeps the last edge level's size and points and
+multiplies the grading by :data:`GRADING_STEP` = ``1/sqrt(2)``, each further level again, so that the near
+field's ``L l / (gamma^2 h)`` elements double per level as they do per halving of the edge size.  The
+contact fraction stays the extrapolation of the edge sequence (its levels share one grading and their sizes
+form one sequence; :meth:`~ContactEdgeRefinement.extrapolated`), the last level's own value beside it; the
+closure, the stiffness and the coefficients are the last level's with its bound ``B``.  A quantity the
+grading does not reduce that misses the tolerance once those levels have begun ends the ladder there, with
+the reason (a stated tolerance: exit 3).  What the grading's level costs and the effectivity of the
+stiffness's bound on the bisinusoid: ``docs/benchmarks.md``, section ``bisinusoid_scene_accuracy``.
 """
 from __future__ import annotations
 
@@ -135,8 +145,11 @@ DISTANCE_SAFETY = 1.25
 TWIN_FLOORED = ("contact_fraction", "mean_closure", "normal_stiffness", "coefficient_k_n", "coefficient_g_n")
 #: those whose estimate is the twin's bound in place of the ladder's geometric tail (the rest: the larger)
 TWIN_MEASURED = ("mean_closure", "normal_stiffness", "coefficient_k_n", "coefficient_g_n")
-#: the estimated quantities the ladder does not reduce: reported, not held to the tolerance (module docstring)
-UNREDUCED = ("normal_stiffness",)
+#: the quantities whose error is the grading's: where only they miss the tolerance after the edge sequence, the
+#: next level refines the grading (module docstring, "The grading's levels")
+GRADED = ("normal_stiffness",)
+#: the grading's factor from one grading level to the next (module docstring, "The grading's levels")
+GRADING_STEP = 2.0 ** -0.5
 
 
 def twin_grid(edge_maxh: float, period: float) -> int:
@@ -159,9 +172,10 @@ class ContactEdgeRefinement:
 
     ``scene_cell`` is level 0; ``pressures(grid)`` gives the twin's pressure grids at the loads on a
     ``grid x grid`` grid (each grid asked once); ``cell_at(points, edge_maxh, grading)`` the cell (``sweep``,
-    ``unknowns``) on the mesh refined at ``points`` with Netgen's ``grading`` (every level's: module
-    docstring, "The grading"); ``period`` the cell's period; ``twin_heads(grid)``, where given, the twin's
-    headline quantities at the loads on that grid (from the same solves as ``pressures``).
+    ``unknowns``) on the mesh refined at ``points`` with Netgen's ``grading`` (:attr:`grading` on the edge
+    sequence, finer on the grading's levels: module docstring); ``period`` the cell's period;
+    ``twin_heads(grid)``, where given, the twin's headline quantities at the loads on that grid (from the same
+    solves as ``pressures``).
     """
 
     scene_cell: Any
@@ -174,8 +188,12 @@ class ContactEdgeRefinement:
     grading: float = GRADING
     #: the quantities whose estimate is the twin's bound alone (:data:`TWIN_MEASURED`)
     measured: tuple[str, ...] = TWIN_MEASURED
-    #: the quantities not held to the tolerance (:data:`UNREDUCED`)
-    uncontrolled: tuple[str, ...] = UNREDUCED
+    #: the quantities not held to the tolerance (none: every estimated quantity has its knob)
+    uncontrolled: tuple[str, ...] = ()
+    #: the quantities the grading's levels reduce (:data:`GRADED`)
+    graded: tuple[str, ...] = GRADED
+    #: the last level of the edge sequence, once the grading's levels have begun (:meth:`steer`)
+    edge_levels: int | None = None
     _grids: dict[int, list[np.ndarray]] = field(default_factory=dict, repr=False)
 
     def twin(self, grid: int) -> list[np.ndarray]:
@@ -197,18 +215,49 @@ class ContactEdgeRefinement:
             return self.interface_maxh / 2 ** k
         return min(self.interface_maxh / 2, width / EDGE_CELLS) / 2 ** (k - 1)
 
+    def edge_level(self, k: int) -> int:
+        """The level of the edge sequence whose edge size and points level ``k`` has: ``k``, or the last edge
+        level for a grading level (module docstring, "The grading's levels")."""
+        return k if self.edge_levels is None else min(k, self.edge_levels)
+
+    def grading_of(self, k: int) -> float:
+        """Level ``k``'s grading: :attr:`grading` on the edge sequence, times :data:`GRADING_STEP` per grading
+        level after it."""
+        steps = 0 if self.edge_levels is None else max(k - self.edge_levels, 0)
+        return self.grading * GRADING_STEP ** steps
+
+    def steer(self, k: int, missing: set[str]) -> str | None:
+        """The knob of level ``k`` (:class:`~ngcontact.cell.fe.second_discretization.Steered`): the grading once
+        the edge sequence gives its extrapolation and only quantities of :attr:`graded` miss the tolerance, the
+        edge size before; a quantity the grading does not reduce missing it after the grading's levels began
+        is out of this ladder's reach (the reason)."""
+        if self.edge_levels is None:
+            if missing and missing <= set(self.graded) and self.ready(k):
+                self.edge_levels = k - 1
+            return None
+        rest = sorted(missing - set(self.graded))
+        if rest:
+            return (f"{', '.join(rest)} missed the tolerance after the edge sequence ended at level "
+                    f"{self.edge_levels}, and the grading's levels do not reduce it")
+        return None
+
     def points(self, k: int = 1) -> np.ndarray:
         """The twin's edge points at the loads for level ``k``, on the grid of :func:`twin_grid`."""
         return twin_edge_points(self.twin(twin_grid(self.edge_maxh(k), self.period)), self.period)
 
     def level(self, k: int) -> Any:
-        return self.scene_cell if k == 0 else self.cell_at(self.points(k), self.edge_maxh(k), self.grading)
+        if k == 0:
+            return self.scene_cell
+        edge = self.edge_level(k)
+        return self.cell_at(self.points(edge), self.edge_maxh(edge), self.grading_of(k))
 
     def sequence(self, heads: list[list[dict[str, float]]]) -> list[list[dict[str, float]]]:
         """The levels of the geometric tails (the mean closure, the stiffness, the coefficients): the refined
-        ones, once there are two; level 0 is not refined at the edge, and its step to level 1 changes the
-        mesh everywhere, not the edge size, so it is no difference of the sequence in ``h_k``."""
-        return heads[1:] if len(heads) > 2 else heads
+        ones of the edge sequence, once there are two; level 0 is not refined at the edge, and its step to
+        level 1 changes the mesh everywhere, not the edge size, so it is no difference of the sequence in
+        ``h_k``; a grading level moves another size (module docstring)."""
+        edge = heads[:self.edge_level(len(heads) - 1) + 1]
+        return edge[1:] if len(edge) > 2 else edge
 
     def ready(self, levels: int) -> bool:
         """Whether ``levels`` solved levels (the scene's and the refined) give the extrapolation (module
@@ -218,7 +267,7 @@ class ContactEdgeRefinement:
     def extrapolated(self, heads: list[list[dict[str, float]]]) -> dict[str, list[EdgeSizeExtrapolation | None]]:
         """Per load the contact fraction extrapolated from the last three refined levels (module docstring);
         ``None`` per load before three refined levels."""
-        refined = list(range(1, len(heads)))[-EXTRAPOLATED_LEVELS:]
+        refined = list(range(1, self.edge_level(len(heads) - 1) + 1))[-EXTRAPOLATED_LEVELS:]
         if len(refined) < EXTRAPOLATED_LEVELS:
             return {}
         sizes = [self.edge_maxh(k) for k in refined]
@@ -236,7 +285,7 @@ class ContactEdgeRefinement:
         if self.twin_heads is None or k == 0:
             return [{} for _ in reported]
         n = FLOOR_GRID
-        fine, half, quarter = self.twin_heads(n), self.twin_heads(n // 2), self.twin_heads(n // 4)
+        quarter, half, fine = self.twin_heads(n // 4), self.twin_heads(n // 2), self.twin_heads(n)   # coarse first
         if not len(fine) == len(half) == len(quarter) == len(reported):
             return [{} for _ in reported]
         form = (f"spectral twin: {DISTANCE_SAFETY:g} |q - q_N| + {TWIN_SAFETY:g} max(|q_N - q_N/2|, "
@@ -249,5 +298,8 @@ class ContactEdgeRefinement:
     def describe(self, k: int) -> str:
         if k == 0:
             return f"interface_maxh {self.interface_maxh:g}"
-        return f"edge_maxh {self.edge_maxh(k):g} along the contact edge (interface_maxh {self.interface_maxh:g})"
+        edge = self.edge_level(k)
+        graded = f", grading {self.grading_of(k):.3g}" if edge < k else ""
+        return (f"edge_maxh {self.edge_maxh(edge):g} along the contact edge{graded} "
+                f"(interface_maxh {self.interface_maxh:g})")
 

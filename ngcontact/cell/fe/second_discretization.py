@@ -40,6 +40,9 @@ each quantity's absolute error that includes what its sequence cannot see (the c
 spectral twin, :mod:`ngcontact.cell.fe.contact_edge_refinement`, "The twin's bound"); the estimate is that
 bound where the refiner names the quantity as measured by it, else the larger of the two; the quantities it
 names as uncontrolled are reported with their estimate and neither stop the loop nor count in the verdict.
+A :class:`Steered` refiner has more than one knob: before each level the loop tells it which quantities'
+estimates miss the tolerance, and it chooses the knob of the next level from them (the contact edge's ladder:
+the edge size, or its grading where only the stiffness misses), or names why no level of its can meet them.
 """
 from __future__ import annotations
 
@@ -112,6 +115,16 @@ class Floored(Protocol):
         form in words."""
 
 
+@runtime_checkable
+class Steered(Protocol):
+    """A refiner whose next level depends on which estimates miss the tolerance (module docstring)."""
+
+    def steer(self, k: int, missing: set[str]) -> str | None:
+        """Choose the knob of level ``k`` from the quantities whose estimates miss the tolerance on the levels
+        solved so far (none before the first estimate); a reason in words where none of its levels can meet
+        them (the loop stops there), else ``None``."""
+
+
 @dataclass
 class InterfaceHalving:
     """Level ``k``: the scene's cell with ``interface_maxh / 2^k`` at the scene's order (module docstring)."""
@@ -176,6 +189,11 @@ def refine(refiner: Refiner, loads: list, tolerance: float, max_dofs: int, requi
     beyond = None
     free = refiner.uncontrolled if isinstance(refiner, Floored) else ()
     for k in range(MAX_LEVELS):
+        if isinstance(refiner, Steered):
+            why = refiner.steer(k, {n for e in estimates for n, v in e.items() if v > tolerance and n not in free})
+            if why is not None:
+                stop = why
+                break
         try:
             nxt = refiner.level(k)
         except (SceneError, ModelError) as exc:     # a level the mesher cannot build: out of reach, as refused
