@@ -54,10 +54,12 @@ FOLDER = "batches"
 KEPT = 256
 
 #: The record of a local worker's costs as this machine timed them, by kind: ``start`` (CPU seconds of a
-#: worker's start, until its imports are done) and ``first_member`` (CPU seconds a worker's first member
-#: took beyond the cheapest member of its batch solved in the run's process).
+#: spawned worker's start, until its imports are done), ``first_member`` (CPU seconds a worker's first member
+#: took beyond the cheapest member of its batch solved in the run's process), ``server`` (CPU seconds of a
+#: fork server's start, until its imports are done) and ``fork`` (CPU seconds of a worker forked by it,
+#: before its first member: :mod:`ngcontact.parallel.fork_server`).
 COSTS_FILE = "worker_costs.json"
-COSTS = ("start", "first_member")
+COSTS = ("start", "first_member", "server", "fork")
 
 #: Measured costs kept per kind; the payoff rule takes their median.
 COSTS_KEPT = 5

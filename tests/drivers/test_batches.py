@@ -19,7 +19,7 @@ import pytest
 
 from ngcontact import cli
 from ngcontact.runner import solve
-from ngcontact.parallel import free_cores
+from ngcontact.parallel import fork_server, free_cores
 from ngcontact.parallel.batch_member import FAULT_ENV
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -252,6 +252,13 @@ def test_a_member_that_always_fails_ends_the_run_with_exit_3_and_writes_nothing(
     assert not out.exists()
 
 
+#: What the command line of a local worker holds: a spawned one's, or a fork server's (and its workers').
+WORKER_MARKS = ("spawn_main", "from multiprocessing.forkserver import main")
+
+#: The processes of two local workers: the fork server and the two it forks, or two spawned workers.
+WORKER_PROCESSES = 3 if fork_server.available() else 2
+
+
 def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_path):
     psutil = pytest.importorskip("psutil")
     scene = ensemble(tmp_path, members=400, grid=64)
@@ -273,10 +280,11 @@ def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_
     assert proc.stderr is not None
     for line in proc.stderr:          # plain progress lines: stderr is a pipe, not a terminal
         if "ensemble: " in line and "finished" in line:   # the workers start once a member has timed the batch
-            workers = [c for c in psutil.Process(proc.pid).children(recursive=True) if "spawn_main" in command(c)]
-            if len(workers) == 2:
+            workers = [c for c in psutil.Process(proc.pid).children(recursive=True)
+                       if any(mark in command(c) for mark in WORKER_MARKS)]
+            if len(workers) == WORKER_PROCESSES:
                 break
-    assert len(workers) == 2
+    assert len(workers) == WORKER_PROCESSES
     proc.send_signal(signal.SIGINT)
     rest = proc.stderr.read()
     assert proc.wait(timeout=60) == 130, rest
