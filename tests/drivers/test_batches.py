@@ -218,6 +218,36 @@ def test_two_local_workers_give_the_serial_numbers(scenes, name):
     assert [s[1:] for s in seen] == [(k, total) for k in range(total + 1)]
 
 
+@pytest.fixture
+def local_workers_always_repay(monkeypatch, tmp_path):
+    """Condition (1) of the local payoff rule held whatever the members cost (no start, fork or first
+    member to repay, an idle machine, no measured cost) and the fork server's imports awaited before the
+    rule looks: these batches are too small to repay workers, and the test below is of the numbers of the
+    members the forked workers solve."""
+    from ngcontact.parallel import judged_batches, local_pool
+    for name in ("START_SECONDS", "FORK_SECONDS", "FIRST_MEMBER_SECONDS"):
+        monkeypatch.setattr(judged_batches, name, 0.0)
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(free_cores, "core_seconds", lambda cores: None)
+    monkeypatch.setattr(free_cores, "load_average", lambda: 0.0)
+    ready = local_pool.LocalPool._ready
+    monkeypatch.setattr(local_pool.LocalPool, "_ready",
+                        lambda self: (self._server.wait(120) if self._server is not None else True) and ready(self))
+
+
+def test_members_forked_by_the_fork_server_give_the_serial_numbers(scenes, local_workers_always_repay):
+    """The ensemble's members after the first two, solved by workers forked from the fork server (the default
+    local pool here): the serial numbers to 1e-12."""
+    from ngcontact.parallel import local_pool
+    assert fork_server.available() and local_pool.LocalPool(2).method == "forkserver"
+    paths, serial = scenes
+    report, _ = solve(paths["ensemble"], workers=2)
+    assert_same(numbers(report), numbers(serial["ensemble"]))
+    batch = report["compute"]["batches"][0]
+    assert (report["compute"]["executor"], batch["members"], batch["executor"]) == ("local", 4, "local")
+    assert "the other 2 on 2 workers" in batch["decision"]
+
+
 @pytest.mark.slow
 def test_independent_loads_differ_from_the_continuation_only_by_the_solver_tolerance(scenes, tmp_path):
     """Negative control of the mode: the chained sweep solves the same problems from other starts."""

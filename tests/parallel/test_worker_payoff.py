@@ -147,6 +147,31 @@ def test_workers_on_demand_start_inside_the_batch_that_repays_them(on_demand_poo
     assert pids[:2] == [os.getpid()] * 2
 
 
+def test_a_fork_servers_start_once_begun_is_spent_and_not_counted_again(monkeypatch):
+    """Before the fork server starts, each of the two workers pays half its start and a fork (``S``) and
+    waits for all of it (``R``); once it has started (with the run, as a forecast would start it), the rule
+    in the batch counts only what its imports have still to do and the forks: a rest that does not repay
+    the whole start (14 x 0.1 s against 2 x (1 + 0.05 + 0.1) CPU s) is sent once the start is paid."""
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 2.0)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.05)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.1)
+    pool = local_pool.LocalPool(2, method="forkserver")
+    try:
+        before = pool.payoff(0.1, 14)
+        assert before.start_cpu == pytest.approx(1.05) and before.start_ahead == pytest.approx(2.05)
+        assert not before.repaid and before.core_cost == pytest.approx(2.3)
+        pool.start(("ngsolve",))
+        begun = pool.payoff(0.1, 14)
+        assert begun.start_cpu == 0.05 and 0.05 <= begun.start_ahead <= 2.05
+        assert pool.wait_ready(120)
+        ready = pool.payoff(0.1, 14)
+        assert (ready.start_cpu, ready.start_ahead) == (0.05, 0.05) and ready.repaid
+        assert pool.map(burn, [0.1] * 16, [f"m{k}" for k in range(16)], label="spent")[2:].count(os.getpid()) == 0
+        assert pool.payoff(0.1, 14).start_cpu == 0.0            # forked workers: nothing left to pay
+    finally:
+        pool.close()
+
+
 def test_condition_1_counts_the_cores_other_processes_leave_and_the_work_of_the_starts():
     """A rest that repays two workers on an idle machine does not on one whose other jobs leave 1.5 cores
     (``P = 1.5``: 12 x 0.5 x 0.5 = 3 CPU s against 2 x (1.5 + 0.5)), nor on one they keep busy."""
