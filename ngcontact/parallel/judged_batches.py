@@ -116,23 +116,26 @@ class JudgedBatches(Executor, ABC):
 
     @property
     def cores(self) -> CoreWatch:
-        """The watch of the cores other processes leave free (opened with the run's batches)."""
+        """The watch of the cores other processes leave free: its first window opened as the process did
+        (:data:`~ngcontact.parallel.free_cores.OPENING`), so that the run's first look reads what its
+        imports and preparation left free, not the load average."""
         watch = self.__dict__.get("_cores")
         if watch is None:
-            watch = self.__dict__["_cores"] = CoreWatch(self._worker_pids)
+            watch = self.__dict__["_cores"] = CoreWatch(self._worker_pids, opening=True)
         return watch
 
     def payoff(self, member_seconds: float, rest: int, lead: float = 0.0,
-               first: float | None = None) -> worker_payoff.Payoff:
+               first: float | None = None, lead_cpu: float | None = None) -> worker_payoff.Payoff:
         """Condition (1) of :mod:`ngcontact.parallel.worker_payoff` for ``rest`` members of
         ``member_seconds`` each, with the cores free now and the workers' start still ahead (less ``lead``
         seconds of the run before its batch, for a start with the run).  Where this machine has measured no
         worker yet, ``S`` is the CPU seconds this process spent before its batch (its interpreter, its
         imports and the batch's preparation: what a fresh worker repeats, and more), at most
         :data:`START_SECONDS`, and ``F`` what this process's own first member took beyond its cheapest
-        (``first``, where two were solved), at most :data:`FIRST_MEMBER_SECONDS`."""
+        (``first``, where two were solved), at most :data:`FIRST_MEMBER_SECONDS`; ``lead_cpu`` replaces this
+        process's CPU seconds before its batch (a forecast's, read before any batch)."""
         cores = self.cores.reading()
-        lead_cpu = self.__dict__.get("_lead_cpu")
+        lead_cpu = self.__dict__.get("_lead_cpu") if lead_cpu is None else lead_cpu
         ahead, cpu = self._start_still(None if lead_cpu is None else min(lead_cpu, START_SECONDS))
         return worker_payoff.Payoff(member_seconds, rest, self.workers, max(ahead - lead, 0.0),
                                     first_member_cost(None if first is None else min(first, FIRST_MEMBER_SECONDS)),
@@ -143,9 +146,10 @@ class JudgedBatches(Executor, ABC):
         (its :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: the members after
         the first ``MEASURED`` (solved here), of the forecast's seconds each, against the part of the start
         that the run's lead before its batch leaves ahead, a worker's first member and the starts' CPU
-        time, on the cores free as the run opens."""
+        time (before this machine has timed a worker: as the last run's process measured them), on the
+        cores free as the run opens."""
         return self.payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
-                           forecast.lead_seconds).repaid
+                           forecast.lead_seconds, forecast.first_seconds, forecast.start_seconds).repaid
 
     def start_on_demand(self, modules: Sequence[str] = ()) -> None:
         """Start no worker now: only once a batch's rest repays their start (:meth:`_judged_map`), each
