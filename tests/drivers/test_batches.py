@@ -298,8 +298,10 @@ def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_
     # an idle machine (a batch stays in the run's process while other jobs keep the cores busy)
     env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
                **{free_cores.LOAD_ENV: "0"})
+    # SIGINT as a terminal's run gets it, also where this test runs in a background job (which ignores it)
     proc = subprocess.Popen([sys.executable, "-m", "ngcontact.cli", "run", scene, "--out", str(out),
-                             "--workers", "2"], stderr=subprocess.PIPE, text=True, env=env, cwd=str(tmp_path))
+                             "--workers", "2"], stderr=subprocess.PIPE, text=True, env=env, cwd=str(tmp_path),
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     def command(child):
         try:
             return " ".join(child.cmdline())
