@@ -64,6 +64,7 @@ READY_ENV = "NGCONTACT_FORK_SERVER_RECORD"
 #: The module the server imports last: its imports are done.
 READY_MODULE = "ngcontact.parallel.fork_server_ready"
 
+
 class _ForkWorker(ForkServerProcess):
     """A worker forked by the server's only thread: the kernel's death signal follows the server."""
 
