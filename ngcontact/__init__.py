@@ -8,8 +8,10 @@ and the scene-file reference.
 """
 from ngcontact._version import __version__
 from ngcontact.errors import ConvergenceError, ModelError, NgcontactError, SceneError
-from ngcontact.scene.loader import load
+# the runner first: it opens the window in which the run's first look reads the free cores
+# (ngcontact.parallel.free_cores.OPENING) before NGSolve and the scene's modules load
 from ngcontact.runner import solve, solve_mesh
+from ngcontact.scene.loader import load
 
 __all__ = ["ConvergenceError", "ModelError", "NgcontactError", "SceneError", "cell_law", "interface_form", "load",
            "solve", "solve_mesh", "__version__"]

@@ -21,8 +21,8 @@ from typing import Callable
 
 from ngcontact._version import __version__
 from ngcontact.errors import SceneError
+from ngcontact.parallel.free_cores import affinity   # first: its window of the cores opens with the process
 from ngcontact.output.progress_lines import progress_lines
-from ngcontact.parallel.free_cores import affinity
 from ngcontact.output.report import Clock, Outcome, accuracy_line, build_report, method_line
 from ngcontact.scene import loader
 

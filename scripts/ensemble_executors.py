@@ -10,8 +10,9 @@ Three batches, each run as the command a user types (``ngcontact run SCENE
 * the shipped ``geometries/cells/measured_scan_ensemble.toml``.
 
 Executors: ``--workers 1`` (serial, the reference), ``--workers 2`` (a local
-pool: a batch goes to its workers only where its rest repays them, column
-``ran``) twice: ``local 2 first``, the run of a machine that has not run
+pool, its workers forked by a fork server that imports NGSolve and the
+package once, ``ngcontact.parallel.fork_server``: a batch goes to its
+workers only where its rest repays them, column ``ran``) twice: ``local 2 first``, the run of a machine that has not run
 the batch before (its workers start, if ever, once the batch's first
 members have shown that they repay), and ``local 2``, after the serial run
 of the same repeat has recorded the batch (its workers start with the run
@@ -142,7 +143,8 @@ def main() -> None:
             os.path.join(args.out, "ensemble_executors.csv"),
             note="`ngcontact run` of three ensembles with `--workers 1` (serial, the reference: its FFTs on one "
                  "thread on these grids of at most 256^2 points, as a worker's, "
-                 "`ngcontact.cell.spectral.fft_threads`), `--workers 2` "
+                 "`ngcontact.cell.spectral.fft_threads`), `--workers 2` (workers forked by a fork server that "
+                 "imports NGSolve and the package once, `ngcontact.parallel.fork_server`) "
                  "twice (`local 2 first`: no record of the batch, its workers start only once its first members "
                  "have shown that they repay; `local 2`: after the serial run has recorded the batch, its "
                  "workers start with the run where the record forecasts that the batch goes to them, "

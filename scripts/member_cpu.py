@@ -30,6 +30,9 @@ own process.  Configurations:
   inherits (``ngcontact.parallel.heap_thresholds``);
 * ``local worker``: a spawned process started as a local pool's worker
   (``ngcontact.parallel.batch_member.one_thread``);
+* ``forked worker``: a local pool's worker as the pool starts it by
+  default, forked by a fork server that imported NGSolve and the
+  package (``ngcontact.parallel.fork_server``);
 * ``dask worker``: a one-thread worker of a ``distributed.LocalCluster``,
   started as a member's task starts it (``one_thread``);
 * ``dask worker, bare``: the same worker without that start (Dask's
@@ -62,7 +65,8 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 MEMBERS, ROUNDS = 6, 3
 NANNY_ENV = {"MALLOC_TRIM_THRESHOLD_": "65536", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
              "OPENBLAS_NUM_THREADS": "1"}
-CONFIGS = ("run", "run, 1 thread", "run, nanny env", "local worker", "dask worker", "dask worker, bare")
+CONFIGS = ("run", "run, 1 thread", "run, nanny env", "local worker", "forked worker", "dask worker",
+           "dask worker, bare")
 
 
 def timed(job) -> dict:
@@ -107,6 +111,16 @@ def measure(config: str) -> list[dict]:
                                  initargs=(True,)) as pool:
             pool.submit(timed, jobs[0]).result()
             rows = [pool.submit(timed, job).result() for job in jobs]
+    elif config == "forked worker":
+        from ngcontact.parallel.local_pool import LocalPool
+        pool = LocalPool(1, method="forkserver")
+        try:
+            pool.start(("ngsolve", "ngcontact.drivers.build", "ngcontact.drivers.run_ensemble"))
+            pool.wait_ready()
+            pool._pool_map(timed, jobs[:1], ["warm"], "warm", None, None)
+            rows = pool._pool_map(timed, jobs, [f"m{k}" for k in range(len(jobs))], "members", None, None)
+        finally:
+            pool.close()
     else:
         from distributed import Client, LocalCluster
         start = config == "dask worker"
@@ -173,7 +187,8 @@ def main() -> None:
                  f"after one to warm up, in a fresh interpreter per configuration, the configurations in turn "
                  f"{ROUNDS} times (`where`: the run's own process from a shell's environment, on one thread, and "
                  "with the "
-                 "variables Dask's nanny leaks into a process that starts a cluster; a local pool's worker; a "
+                 "variables Dask's nanny leaks into a process that starts a cluster; a spawned local worker; a "
+                 "worker forked by the local pool's fork server; a "
                  "Dask worker as a member's task starts it, and without that start). `cpu`: CPU seconds of the "
                  "whole process per member, median with its quartiles `cpu_q1`, `cpu_q3`; `thread`: of the "
                  "solving thread; `cpu_over_run`: over the run's own process; `faults`: minor page faults per "

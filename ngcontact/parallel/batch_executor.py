@@ -56,14 +56,18 @@ class Executor:
         self.record.append({"label": label, "members": len(items), "seconds": time.perf_counter() - t0,
                             **self.__dict__.pop("_spread", {})})
         self.timings.append({"members": len(items), "began": t0,
-                             "member_seconds": clock.least if clock.times else None})
+                             "member_seconds": clock.least if clock.times else None,
+                             "lead_cpu": self.__dict__["_lead_cpu"],
+                             "first_seconds": clock.times[0] - clock.least if len(clock.times) > 1 else None})
         return out
 
     @property
     def timings(self) -> list[dict]:
         """The batches this executor ran, as timed in this process: ``members``, when each ``began``
-        (``time.perf_counter`` seconds) and the least ``min(wall, CPU)`` seconds of its members solved in
-        this process (``member_seconds``; None when none was)."""
+        (``time.perf_counter`` seconds), the least ``min(wall, CPU)`` seconds of its members solved in
+        this process (``member_seconds``; None when none was), this process's CPU seconds as it began
+        (``lead_cpu``) and what its first member here took beyond the least (``first_seconds``; None
+        with fewer than two here)."""
         return self.__dict__.setdefault("_timings", [])
 
     @property

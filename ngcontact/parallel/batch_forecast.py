@@ -13,10 +13,17 @@ The forecast is (1) itself, read with what the last run of the same batch
 measured: ``c`` (the least ``min(wall, CPU)`` seconds of its members solved
 in its process) and the seconds from the opening of the run's batches to
 the start of its first batch (``lead``), during which workers started with
-the run start; so ``R`` is the start's wall time less ``lead``, and the
-cores free as the run opens are the load average's, (3) of
-:mod:`ngcontact.parallel.free_cores`.  Nothing is guessed: a batch never
-run on this machine has no forecast, and its workers start on demand.
+the run start; so ``R`` is the start's wall time less ``lead``.  Where this
+machine has timed no worker yet, ``S`` and ``F`` are estimated as the rule
+estimates them in the batch, from what the last run's process measured:
+its CPU seconds before its batch (``start``) and what its first member
+took beyond its cheapest (``first``).  The cores free as the run opens are
+(2) of :mod:`ngcontact.parallel.free_cores`, over the window of the run's
+imports and preparation (the one-minute load average, (3), only where no
+window is open: it would count the run just before this one, a serial run
+of the same batch, as another job, and no early start would ever pass).
+Nothing is guessed: a batch never run on this machine has no forecast, and
+its workers start on demand.
 The forecast only chooses when the workers start; where each batch runs
 is still decided by (1) on its own members, and workers started early for
 a batch that (1) then keeps in this process are stopped while they start.
@@ -54,10 +61,12 @@ FOLDER = "batches"
 KEPT = 256
 
 #: The record of a local worker's costs as this machine timed them, by kind: ``start`` (CPU seconds of a
-#: worker's start, until its imports are done) and ``first_member`` (CPU seconds a worker's first member
-#: took beyond the cheapest member of its batch solved in the run's process).
+#: spawned worker's start, until its imports are done), ``first_member`` (CPU seconds a worker's first member
+#: took beyond the cheapest member of its batch solved in the run's process), ``server`` (CPU seconds of a
+#: fork server's start, until its imports are done) and ``fork`` (CPU seconds of a worker forked by it,
+#: before its first member: :mod:`ngcontact.parallel.fork_server`).
 COSTS_FILE = "worker_costs.json"
-COSTS = ("start", "first_member")
+COSTS = ("start", "first_member", "server", "fork")
 
 #: Measured costs kept per kind; the payoff rule takes their median.
 COSTS_KEPT = 5
@@ -66,12 +75,15 @@ COSTS_KEPT = 5
 @dataclass(frozen=True)
 class Forecast:
     """The last run's first batch: ``members``, the least seconds of one solved in its process
-    (``member_seconds``) and the seconds from the opening of its batches to that batch's start
-    (``lead_seconds``)."""
+    (``member_seconds``), the seconds from the opening of its batches to that batch's start
+    (``lead_seconds``), the CPU seconds of its process before that batch (``start_seconds``) and what its
+    first member there took beyond the least (``first_seconds``; None with fewer than two there)."""
 
     members: int
     member_seconds: float
     lead_seconds: float
+    start_seconds: float | None = None
+    first_seconds: float | None = None
 
 
 def key(description: str) -> str:
@@ -89,10 +101,13 @@ def recorded(name: str) -> Forecast | None:
     try:
         with open(os.path.join(folder(), f"{name}.json")) as f:
             data = json.load(f)
-        forecast = Forecast(int(data["members"]), float(data["member_seconds"]), float(data["lead_seconds"]))
+        forecast = Forecast(int(data["members"]), float(data["member_seconds"]), float(data["lead_seconds"]),
+                            *(None if data.get(k) is None else float(data[k])
+                              for k in ("start_seconds", "first_seconds")))
     except (OSError, ValueError, KeyError, TypeError):
         return None
-    if forecast.members < 1 or not forecast.member_seconds >= 0.0 or not forecast.lead_seconds >= 0.0:
+    seconds = (forecast.member_seconds, forecast.lead_seconds, forecast.start_seconds, forecast.first_seconds)
+    if forecast.members < 1 or not all(t is None or t >= 0.0 for t in seconds):
         return None
     return forecast
 
@@ -100,7 +115,8 @@ def recorded(name: str) -> Forecast | None:
 def remember(name: str, forecast: Forecast) -> None:
     """Record ``forecast`` under ``name`` for the next run."""
     _write(f"{name}.json", {"members": forecast.members, "member_seconds": forecast.member_seconds,
-                            "lead_seconds": forecast.lead_seconds})
+                            "lead_seconds": forecast.lead_seconds, "start_seconds": forecast.start_seconds,
+                            "first_seconds": forecast.first_seconds})
 
 
 def _write(file: str, data: dict) -> None:
@@ -202,8 +218,9 @@ def early(executor, name: str, members: int | None) -> bool:
 
 def remember_run(name: str, executor, opened: float) -> None:
     """Record under ``name`` the first batch of ``executor`` with members solved in this process: its
-    members, their least seconds, and its start's lead over ``opened`` (``time.perf_counter`` seconds when
-    the run's batches opened)."""
+    members, their least seconds, its start's lead over ``opened`` (``time.perf_counter`` seconds when
+    the run's batches opened), this process's CPU seconds before it and its first member's extra."""
     timed = next((t for t in executor.timings if t["member_seconds"] is not None), None)
     if timed is not None:
-        remember(name, Forecast(timed["members"], timed["member_seconds"], max(timed["began"] - opened, 0.0)))
+        remember(name, Forecast(timed["members"], timed["member_seconds"], max(timed["began"] - opened, 0.0),
+                                timed["lead_cpu"], timed["first_seconds"]))

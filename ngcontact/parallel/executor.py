@@ -12,10 +12,12 @@ Executors:
 
 * :class:`Serial` - in this process, one member after the other (one
   worker, or a single member);
-* :class:`LocalPool` - a pool of worker processes on this machine
-  (``spawn``: a fresh interpreter, never a fork of a process whose NGSolve
-  task manager holds threads), each limited to one NGSolve thread so that
-  ``N`` workers use ``N`` cores; a run's batch goes to them only where its
+* :class:`LocalPool` - a pool of worker processes on this machine, forked
+  by a fork server that imports NGSolve and the package once
+  (:mod:`ngcontact.parallel.fork_server`; ``spawn``, each a fresh
+  interpreter, where there is none), never a fork of a process whose
+  NGSolve task manager holds threads, each limited to one NGSolve thread
+  so that ``N`` workers use ``N`` cores; a run's batch goes to them only where its
   rest repays their start (:mod:`ngcontact.parallel.worker_payoff`), and
   they start only then, or with the run where the last run of the same
   batch forecasts it (:mod:`ngcontact.parallel.batch_forecast`);
@@ -40,7 +42,7 @@ the levels of a two-scale table in ``coupling/``::
 
 with ``solve_level`` a module-level function of plain data.  A script that
 runs batches on local workers needs an ``if __name__ == "__main__":`` guard:
-the workers are spawned interpreters that import the main module.
+each worker imports the main module as it starts.
 """
 from __future__ import annotations
 

@@ -22,6 +22,17 @@ of the others' use)::
 
 ``f`` is held to ``[0, C]``.  Each reading from a window long enough opens
 the next window, so a reading tells what the last seconds left free.
+
+The run's first look (whether its workers start with the run,
+:mod:`ngcontact.parallel.batch_forecast`) comes about a second after the
+process started, before any batch: its window opens as this module is
+imported (:data:`OPENING`, as the package is, before NGSolve and the
+scene's modules load), and (2) is read over the process's imports and the
+scene's loading, where they span at least :data:`WINDOW_SECONDS` and at
+most :data:`OPENING_SECONDS`.  (3) would count as another job's what the
+machine ran in the last minute, such as the run just before this one: a
+one-minute load average of 1 after one serial run leaves ``f <= 1`` on two
+cores, and so no early start, on a machine that is idle.
 """
 from __future__ import annotations
 
@@ -32,6 +43,10 @@ from typing import Callable, Iterable
 
 #: Wall seconds a window must span for reading (2); shorter ones read the load average (3).
 WINDOW_SECONDS = 0.25
+
+#: Wall seconds beyond which the window opened as the process started (:data:`OPENING`) is too old to tell what
+#: the cores are left now: a watch opened later starts a window of its own (and reads (3) at once).
+OPENING_SECONDS = 60.0
 
 #: Test-only: a one-minute load average read instead of the machine's (and no ``/proc/stat`` window), for the
 #: tests that run the command line in a process of its own on a machine shared with other jobs.  Not a
@@ -107,12 +122,15 @@ class Reading:
 
 class CoreWatch:
     """The cores other processes left free since the last reading: (2), else (3).  ``workers`` gives the
-    pids of the run's worker processes (their CPU time is the run's own)."""
+    pids of the run's worker processes (their CPU time is the run's own); ``opening``: the first window
+    opens where the process's did (:data:`OPENING`, if at most :data:`OPENING_SECONDS` old), not now."""
 
-    def __init__(self, workers: Callable[[], Iterable[int]] = tuple):
+    def __init__(self, workers: Callable[[], Iterable[int]] = tuple, opening: bool = False):
         self.cores = affinity()
         self._workers = workers
         self._mark = self._sample()
+        if opening and OPENING[1] is not None and self._mark[0] - OPENING[0] <= OPENING_SECONDS:
+            self._mark = OPENING
 
     def _sample(self) -> tuple[float, float | None, float]:
         own = time.process_time() + sum(process_seconds(pid) for pid in self._workers())
@@ -132,3 +150,8 @@ class CoreWatch:
         busy = max((spent1 - spent0) - (own1 - own0), 0.0) / window
         return Reading(len(self.cores), busy, f"{busy:.2g} cores busy with other processes over the last "
                                               f"{window:.2g} s")
+
+
+#: The first window's opening sample of the process, taken as the package is imported: (wall, CPU seconds
+#: of every process on this process's cores, CPU seconds of this process), as :meth:`CoreWatch._sample`.
+OPENING = CoreWatch()._mark

@@ -4,8 +4,12 @@ A run's batches (:meth:`JudgedBatches.start_on_demand` or an early start) are ju
 are solved in the run's own process, each timed, and the rest goes to the workers only where condition
 (1) of :mod:`ngcontact.parallel.worker_payoff` holds for it: the rest's serial time against the workers'
 start still ahead (``R``), a worker's first member (``F``: :func:`first_member_cost`) and the CPU
-time of their starts (``S``: :func:`start_cost`; both as this machine timed them), on the cores other processes
-leave free (``f``, :mod:`ngcontact.parallel.free_cores`, read at each look).  A batch kept in this
+time of their starts (``S``: :func:`start_cost` for a spawned worker; :func:`server_cost` shared by the
+``W`` workers of a fork server plus :func:`fork_cost` each; all as this machine timed them), on the cores
+other processes leave free (``f``, :mod:`ngcontact.parallel.free_cores`, read at each look).  A start
+that has begun is spent: the rule counts only what it has still to do (``R``) and the forks, so a pool
+started with the run (:mod:`ngcontact.parallel.batch_forecast`, which counted the whole start) is never
+charged for it twice.  A batch kept in this
 process starts no worker; while the workers solve a batch, this process's NGSolve threads sleep
 (:func:`~ngcontact.parallel.batch_member.threads_asleep`).
 
@@ -39,11 +43,29 @@ START_SECONDS = 2.0
 FIRST_MEMBER_SECONDS = 1.0
 
 
+#: CPU seconds of a worker's fork from a fork server before this machine has timed one (an estimate: the
+#: fork, unpickling the start's data, the one-thread limits; ``S_fork`` of
+#: :mod:`ngcontact.parallel.fork_server`).
+FORK_SECONDS = 0.05
+
+
 def start_cost(default: float | None = None) -> float:
     """``S``: the CPU seconds of a worker's start as this machine timed it
     (:func:`~ngcontact.parallel.batch_forecast.cost_seconds`), ``default`` (:data:`START_SECONDS`) before
     any."""
     return batch_forecast.cost_seconds("start", START_SECONDS if default is None else default)
+
+
+def server_cost(default: float | None = None) -> float:
+    """``S_server``: the CPU seconds of a fork server's start (a fresh interpreter importing NGSolve and the
+    members' modules) as this machine timed it, ``default`` (:data:`START_SECONDS`) before any."""
+    return batch_forecast.cost_seconds("server", START_SECONDS if default is None else default)
+
+
+def fork_cost() -> float:
+    """``S_fork``: the CPU seconds of a worker's fork from a fork server as this machine timed it,
+    :data:`FORK_SECONDS` before any."""
+    return batch_forecast.cost_seconds("fork", FORK_SECONDS)
 
 
 def first_member_cost(default: float | None = None) -> float:
@@ -54,7 +76,7 @@ def first_member_cost(default: float | None = None) -> float:
 
 class JudgedBatches(Executor, ABC):
     """An executor of worker processes whose batches the payoff rule judges (module docstring); the
-    processes (:meth:`start`, :meth:`_pool_map`, :meth:`_discard`) are the subclass's."""
+    processes (:meth:`start`, :meth:`_pool_map`, :meth:`_abandon_start`) are the subclass's."""
 
     workers: int
     judged: bool
@@ -73,44 +95,61 @@ class JudgedBatches(Executor, ABC):
         """``fn`` over ``items`` on the workers."""
 
     @abstractmethod
-    def _discard(self) -> None:
-        """Stop the workers now."""
+    def _abandon_start(self) -> None:
+        """Stop the workers (or what starts them) still starting."""
+
+    @abstractmethod
+    def _launched(self) -> bool:
+        """Whether the workers' start has begun (it is then spent)."""
+
+    @abstractmethod
+    def _ready(self) -> bool:
+        """Whether a worker can take a member now."""
+
+    @abstractmethod
+    def _start_still(self, estimate: float | None) -> tuple[float, float]:
+        """``(R, S)`` of condition (1), this process having spent ``estimate`` CPU seconds before its batch."""
+
+    @abstractmethod
+    def _worker_pids(self) -> list[int]:
+        """The pids of the run's worker processes (and of what starts them)."""
 
     @property
     def cores(self) -> CoreWatch:
-        """The watch of the cores other processes leave free (opened with the run's batches)."""
+        """The watch of the cores other processes leave free: its first window opened as the process did
+        (:data:`~ngcontact.parallel.free_cores.OPENING`), so that the run's first look reads what its
+        imports and preparation left free, not the load average."""
         watch = self.__dict__.get("_cores")
         if watch is None:
-            watch = self.__dict__["_cores"] = CoreWatch(self._worker_pids)
+            watch = self.__dict__["_cores"] = CoreWatch(self._worker_pids, opening=True)
         return watch
 
-    def _worker_pids(self) -> list[int]:
-        return list((self._pool._processes or {}).keys()) if self._pool is not None else []
-
     def payoff(self, member_seconds: float, rest: int, lead: float = 0.0,
-               first: float | None = None) -> worker_payoff.Payoff:
+               first: float | None = None, lead_cpu: float | None = None) -> worker_payoff.Payoff:
         """Condition (1) of :mod:`ngcontact.parallel.worker_payoff` for ``rest`` members of
         ``member_seconds`` each, with the cores free now and the workers' start still ahead (less ``lead``
         seconds of the run before its batch, for a start with the run).  Where this machine has measured no
         worker yet, ``S`` is the CPU seconds this process spent before its batch (its interpreter, its
         imports and the batch's preparation: what a fresh worker repeats, and more), at most
         :data:`START_SECONDS`, and ``F`` what this process's own first member took beyond its cheapest
-        (``first``, where two were solved), at most :data:`FIRST_MEMBER_SECONDS`."""
+        (``first``, where two were solved), at most :data:`FIRST_MEMBER_SECONDS`; ``lead_cpu`` replaces this
+        process's CPU seconds before its batch (a forecast's, read before any batch)."""
         cores = self.cores.reading()
-        lead_cpu = self.__dict__.get("_lead_cpu")
-        ahead = self._start_ahead(start_cost(None if lead_cpu is None else min(lead_cpu, START_SECONDS)))
+        lead_cpu = self.__dict__.get("_lead_cpu") if lead_cpu is None else lead_cpu
+        ahead, cpu = self._start_still(None if lead_cpu is None else min(lead_cpu, START_SECONDS))
         return worker_payoff.Payoff(member_seconds, rest, self.workers, max(ahead - lead, 0.0),
                                     first_member_cost(None if first is None else min(first, FIRST_MEMBER_SECONDS)),
-                                    ahead, cores)
+                                    cpu, cores)
 
     def repays(self, forecast) -> bool:
         """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send the rest of a batch
         (its :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: the members after
         the first ``MEASURED`` (solved here), of the forecast's seconds each, against the part of the start
         that the run's lead before its batch leaves ahead, a worker's first member and the starts' CPU
-        time, on the cores free as the run opens."""
+        time (before this machine has timed a worker: as the last run's process measured them), on the
+        cores free as the run opens."""
         return self.payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
-                           forecast.lead_seconds).repaid
+                           forecast.lead_seconds, forecast.first_seconds, forecast.start_seconds).repaid
 
     def start_on_demand(self, modules: Sequence[str] = ()) -> None:
         """Start no worker now: only once a batch's rest repays their start (:meth:`_judged_map`), each
@@ -142,20 +181,20 @@ class JudgedBatches(Executor, ABC):
                                   shifted_progress(progress, k, len(items)), fault)
             if len(done) == len(items):
                 self._where("serial", f"all {len(done)} members solved here"
-                            + (" while the workers started" if self._pool is not None else ""))
+                            + (" while the workers started" if self._launched() else ""))
                 return done
             first = clock.times[0] - clock.least if len(clock.times) >= 2 else None
             payoff = self.payoff(clock.least, len(items) - len(done), first=first)
             if not payoff.repaid:
-                if self._pool is not None and not all(w.done() for w in self._warming) and payoff.rest > 1:
-                    self._discard()     # (a last member here takes one member's time: the start goes on)
+                if self._launched() and not self._ready() and payoff.rest > 1:
+                    self._abandon_start()   # (a last member here takes one member's time: the start goes on)
                 if len(done) < worker_payoff.MEASURED:
                     continue        # the second member here measures what the first paid once: look again
                 self._where("serial", payoff.describe(len(done)))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
                 return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
                                             shifted_progress(progress, len(done), len(items)), fault)
-            if self._pool is None:
+            if not self._launched():
                 if self.started == "never":
                     self.started = f"during batch '{label}'"
                 self.start((fn.__module__,))
@@ -166,16 +205,12 @@ class JudgedBatches(Executor, ABC):
                     return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
                                                  shifted_progress(progress, len(done)), fault)
 
-    def _ready(self) -> bool:
-        """Whether a worker of the current pool has started (a pool started without warm-up tasks: yes)."""
-        return self._pool is not None and (not self._warming or any(w.done() for w in self._warming))
-
     def _start_ahead(self, start: float) -> float:
         """Seconds of the workers' start still to come (``R`` of :mod:`ngcontact.parallel.worker_payoff`), of
         ``start`` CPU seconds in all (``S``): all of it for a pool not started."""
         if self._pool is None:
             return start
-        if self._ready():
+        if not self._warming or any(w.done() for w in self._warming):
             return 0.0
         return max(start - (time.perf_counter() - self._spawned), 0.0)
 

@@ -1,11 +1,19 @@
 """A pool of worker processes on this machine (:mod:`ngcontact.parallel.executor`).
 
-``spawn``: each worker is a fresh interpreter, never a fork of a process
-whose NGSolve task manager holds threads, limited to one NGSolve thread so
-that ``N`` workers use ``N`` cores.  A worker that dies counts a failure of
-the member it had started (its start record, by pid); the members of the
-workers the pool then stops are innocent.  Which members of a run's batch go
-to the workers is the payoff rule's (:mod:`ngcontact.parallel.judged_batches`).
+Each worker is limited to one NGSolve thread, so that ``N`` workers use
+``N`` cores.  They start in one of two ways (``method``):
+
+* ``forkserver`` (the default where it exists): one fresh interpreter, the
+  fork server, imports NGSolve and the members' modules once, beside this
+  process, and forks every worker from itself in milliseconds
+  (:mod:`ngcontact.parallel.fork_server`); never a fork of this process,
+  whose NGSolve task manager may hold threads;
+* ``spawn``: each worker a fresh interpreter importing them by itself.
+
+A worker that dies counts a failure of the member it had started (its
+start record, by pid); the members of the workers the pool then stops are
+innocent.  Which members of a run's batch go to the workers is the payoff
+rule's (:mod:`ngcontact.parallel.judged_batches`).
 """
 from __future__ import annotations
 
@@ -15,22 +23,34 @@ import time
 from typing import Any, Sequence
 
 from ngcontact.parallel.batch_executor import Executor
-from ngcontact.parallel.judged_batches import JudgedBatches, shifted_progress
+from ngcontact.parallel.judged_batches import JudgedBatches, fork_cost, server_cost, shifted_progress, start_cost
 from ngcontact.parallel.batch_member import one_thread, run_member
-from ngcontact.parallel import batch_forecast, worker_lifetime
+from ngcontact.parallel import batch_forecast, fork_server, worker_lifetime
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
 
+#: How a pool's workers start: forked by a fork server, or each a fresh interpreter.
+METHODS = ("forkserver", "spawn")
+
+
 class LocalPool(JudgedBatches):
-    """A pool of ``workers`` spawned worker processes on this machine (started on first use)."""
+    """A pool of ``workers`` worker processes on this machine (started on first use), forked by a fork
+    server or spawned (``method``; default: ``forkserver`` where :func:`fork_server.available`)."""
 
     name = "local"
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, method: str | None = None):
         if workers < 1:
             raise ValueError(f"workers = {workers}: must be >= 1")
+        if method is None:
+            method = "forkserver" if fork_server.available() else "spawn"
+        if method not in METHODS:
+            raise ValueError(f"method = {method!r}: must be one of {', '.join(METHODS)}")
+        self.method = method
         self.workers = workers
+        self._server: fork_server.Server | None = None   # the fork server, started with the pool
+        self._forked = 0              # pools of workers forked by the current server
         self._pool: Any = None        # the ProcessPoolExecutor, started on first use
         self._started: Any = None     # the queue on which workers announce their start
         self._processes: dict = {}      # every worker process of the current pool, by pid
@@ -43,24 +63,93 @@ class LocalPool(JudgedBatches):
         self.started = "never"        # when the workers first started: with the run, or during which batch
 
     def _start(self):
+        """A new pool of workers (none running yet: they start as members are submitted)."""
         from concurrent.futures import ProcessPoolExecutor
         worker_lifetime.end_orphans()
-        ctx = worker_lifetime.spawn_context()
         self._warming = []
-        self._started = ctx.SimpleQueue()
         self._processes = {}
         self._lifetime = worker_lifetime.Record()
         self._spawned = time.perf_counter()
-        self.pools_started += 1
+        if self.method == "forkserver":
+            server = self._open_server()
+            self.pools_started += self._forked > 0      # the first pool of a server was counted with it
+            self._forked += 1
+            ctx: Any = fork_server.context()
+            run = (os.getpid(), worker_lifetime.process_start(os.getpid()))
+            args: tuple = (server.pid, self._lifetime.path, run)
+        else:
+            self.pools_started += 1
+            ctx = worker_lifetime.spawn_context()
+            args = (os.getpid(), self._lifetime.path, None)
+        self._started = ctx.SimpleQueue()
         self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=ctx, initializer=_worker_start,
-                                         initargs=(self._started, os.getpid(), self._lifetime.path))
+                                         initargs=(self._started, *args))
         return self._pool
+
+    def _open_server(self) -> fork_server.Server:
+        """The pool's fork server, started now if it has none (its imports go on beside this process)."""
+        if self._server is None:
+            self._server = fork_server.acquire(self._modules)
+            self._forked = 0
+            self.pools_started += 1
+        return self._server
+
+    def _launched(self) -> bool:
+        return self._pool is not None or self._server is not None
+
+    def _ready(self) -> bool:
+        """Whether a worker can take a member now: a started worker (spawn), or a fork server whose imports
+        are done (its workers fork in milliseconds)."""
+        if self._pool is not None and (self.method == "forkserver" or not self._warming
+                                       or any(w.done() for w in self._warming)):
+            return True
+        return self._server is not None and self._server.ready()
+
+    def _start_still(self, estimate: float | None) -> tuple[float, float]:
+        """``(R, S)`` of condition (1): wall seconds of the workers' start still ahead and the CPU seconds
+        each worker's start still costs, this process having spent ``estimate`` CPU seconds before its batch
+        (the estimate of an interpreter's start before this machine has timed one).  A fork server's start,
+        once begun, is spent: only what its imports have still to do delays the workers, and each costs its
+        fork; before it has begun, each of the ``W`` workers pays a ``W``-th of it and its fork."""
+        if self.method == "spawn":
+            ahead = self._start_ahead(start_cost(estimate))
+            return ahead, ahead
+        if self._pool is not None:
+            return 0.0, 0.0
+        fork = fork_cost()
+        if self._server is None:
+            server = server_cost(estimate)
+            return server + fork, server / self.workers + fork
+        return self._server.start_still(server_cost(estimate), fork), fork
+
+    def _abandon_start(self) -> None:
+        """Stop workers (or a fork server) still starting: they would take cores from this process."""
+        self._discard()
+        self._stop_server()
+
+    def _stop_server(self) -> None:
+        server, self._server = self._server, None
+        if server is not None:
+            fork_server.release(server)
+
+    def _worker_pids(self) -> list[int]:
+        pids = list((self._pool._processes or {}).keys()) if self._pool is not None else []
+        return pids + ([self._server.pid] if self._server is not None else [])
+
+    def wait_ready(self, seconds: float = 120.0) -> bool:
+        """Wait at most ``seconds`` until a worker can take a member (a started pool); whether one can."""
+        if self._server is not None and self._pool is None:
+            return self._server.wait(seconds)
+        for warm in self._warming:
+            warm.result(timeout=seconds)
+        return self._ready()
 
     def start(self, modules: Sequence[str] = ()) -> None:
         """Spawn every worker now and let it import ``modules`` (what its members will need).
 
-        A worker is a fresh interpreter: its start and imports take about a
-        second, which the batch would otherwise wait for.  For a caller that
+        A spawned worker is a fresh interpreter: its start and imports take
+        about a second, which the batch would otherwise wait for; a fork
+        server makes them once, and its workers fork as a batch needs them.  For a caller that
         knows its batches will repay the workers (:mod:`ngcontact.parallel.worker_payoff`),
         this overlaps their start with what the run does before them (its own
         imports, the scene's meshes, a macro solve).  The pool spawns one
@@ -70,10 +159,13 @@ class LocalPool(JudgedBatches):
         """
         self.judged = True
         self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
-        if self._pool is not None:
+        if self._launched():
             return
         if self.started == "never":
             self.started = "with the run" if not self.record else f"after batch {len(self.record)}"
+        if self.method == "forkserver":
+            self._open_server()       # the workers fork once a batch sends them members
+            return
         pool = self._start()
         self._warming = [pool.submit(_warm_up, self._modules) for _ in range(self.workers)]
         for warm in self._warming:
@@ -86,6 +178,7 @@ class LocalPool(JudgedBatches):
         if self.judged:
             return self._judged_map(fn, items, names, label, progress, fault)
         self._where("local", f"every member on the {self.workers} workers")
+        self._modules = tuple(dict.fromkeys(self._modules + (fn.__module__,)))   # a server not started yet
         done = self._while_starting(fn, items, names, label, progress, fault)
         if len(done) == len(items):
             return done
@@ -103,7 +196,7 @@ class LocalPool(JudgedBatches):
         a large one loses nothing.
         """
         done: list = []
-        while len(done) < len(items) and self._warming and not any(w.done() for w in self._warming):
+        while len(done) < len(items) and self._launched() and not self._ready():
             k = len(done)
             done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
                                   shifted_progress(progress, k, len(items)), fault)
@@ -120,6 +213,7 @@ class LocalPool(JudgedBatches):
         pending: dict[Any, int] = {}
         unsent: list[int] = []       # members whose submission found the pool already broken
         firsts: list[float] = []     # CPU seconds of the first member of each worker that had one here
+        starts: list[float] = []     # CPU seconds of each such worker before its first member (its start)
         pool = self._pool or self._start()
 
         def submit(k):
@@ -141,7 +235,7 @@ class LocalPool(JudgedBatches):
                     for fut in done:
                         k = pending.pop(fut)
                         try:
-                            results[k], seconds, first = fut.result()
+                            results[k], seconds, start = fut.result()
                         except BrokenProcessPool:
                             broken.append(k)
                             continue
@@ -149,8 +243,9 @@ class LocalPool(JudgedBatches):
                             self._failed(label, names[k], failures, k, exc)
                             submit(k)
                             continue
-                        if first:
+                        if start is not None:
                             firsts.append(seconds)
+                            starts.append(start)
                         if progress is not None:
                             progress(label, len(results), len(items))
                 if broken or (unsent and not pending):
@@ -177,6 +272,8 @@ class LocalPool(JudgedBatches):
         if firsts and self.member_clock.times:    # ``F``: a first member's CPU beyond the cheapest here
             batch_forecast.remember_cost("first_member", max(sorted(firsts)[len(firsts) // 2]
                                                              - self.member_clock.least, 0.0))
+        if starts and self.method == "forkserver":          # ``S_fork``: a forked worker's start
+            batch_forecast.remember_cost("fork", sorted(starts)[len(starts) // 2])
         return [results[k] for k in range(len(items))]
 
     def _running_on_dead_workers(self, names) -> set[str]:
@@ -219,8 +316,9 @@ class LocalPool(JudgedBatches):
     def close(self) -> None:
         """End the workers: every batch has returned, so they are idle and hold nothing of the run; they are
         stopped at once rather than each left to finalize its interpreter (NGSolve loaded) while the run
-        waits."""
+        waits.  Then the fork server (where the pool started it)."""
         self._discard()
+        self._stop_server()
 
     def _forget(self, processes) -> None:
         """The pool's workers have stopped: its record goes (kept while one runs on, for the next run to end).
@@ -230,6 +328,7 @@ class LocalPool(JudgedBatches):
 
     def abort(self) -> None:
         self._discard()
+        self._stop_server()
 
     def describe(self) -> dict:
         """The executor's report (:meth:`Executor.describe`) and when its workers first started
@@ -249,9 +348,13 @@ def _exit_code(proc, seconds: float = 2.0):
     return proc.exitcode
 
 
-def _worker_start(started, parent: int, record: str | None) -> None:
+def _worker_start(started, parent: int, record: str | None, run: tuple[int, int] | None) -> None:
+    """A worker's start: it ends with ``parent`` (and with the run's process ``run``, pid and start time,
+    where a fork server is the parent), then takes one thread."""
     global _STARTED
-    worker_lifetime.die_with_parent(parent, record)
+    worker_lifetime.die_with_parent(parent, record, run)
+    if run is not None:
+        fork_server.leave_server()
     _STARTED = started
     one_thread(ignore_sigint=True)
 
@@ -275,11 +378,12 @@ _SOLVED = 0
 
 
 def _pool_member(fn, item, name, attempt, fault):
-    """One member in a worker: its result, its CPU seconds, and whether it was the worker's first."""
+    """One member in a worker: its result, its CPU seconds, and for the worker's first member the worker's
+    CPU seconds before it (its start; None for the others)."""
     global _SOLVED
     if _STARTED is not None:
         _STARTED.put((os.getpid(), name))
     t0 = time.process_time()
     result = run_member(fn, item, name, attempt, fault)
     _SOLVED += 1
-    return result, time.process_time() - t0, _SOLVED == 1
+    return result, time.process_time() - t0, t0 if _SOLVED == 1 else None

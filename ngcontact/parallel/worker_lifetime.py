@@ -17,14 +17,17 @@ parent's stdout.  Three guards, for three ways a worker can miss the end:
 * **a watchdog** thread in each worker that compares the parent's pid with
   the one it started with every :data:`WATCH_SECONDS` and ends the worker
   once it differs (the worker was handed to another process): for workers
-  spawned by another thread, and systems without the death signal;
+  spawned by another thread, and systems without the death signal; a
+  worker forked by a fork server (:mod:`ngcontact.parallel.fork_server`,
+  the server being its parent) also watches the run's process, by pid and
+  start time;
 * **records**: each pool writes the pids of its parent and of its workers,
   with their start times, to a small file in :func:`record_dir`; a pool
   about to start ends the workers of records whose parent is gone
   (:func:`end_orphans`), should any have escaped the two guards above.  A
   process is ended only when it is provably one of these workers: the same
-  pid *and* start time (a reused pid has another), a worker's command line,
-  and this user's.
+  pid *and* start time (a reused pid has another), a worker's (or a fork
+  server's) command line, and this user's.
 
 The resource tracker of :mod:`multiprocessing`, a child of the parent too,
 reads a pipe whose write ends only the parent and its workers hold: once
@@ -55,6 +58,10 @@ _PR_SET_PDEATHSIG = 1
 
 #: What the command line of a ``spawn`` worker holds (Python's own ``multiprocessing.spawn`` start).
 _WORKER_MARKS = (b"from multiprocessing.spawn import spawn_main", b"--multiprocessing-fork")
+
+#: What the command line of a fork server holds, and so of each worker it forks
+#: (:mod:`ngcontact.parallel.fork_server`).
+SERVER_MARK = b"from multiprocessing.forkserver import main"
 
 
 # ------------------------------------------------------------------ parent
@@ -134,7 +141,7 @@ def end_orphans() -> list[int]:
     ended = []
     for name in names:
         path = os.path.join(folder, name)
-        parent, workers = _read_record(path)
+        parent, workers = read_record(path)
         if parent is None or process_start(parent[0]) == parent[1]:
             continue                                  # not a record, or its parent still runs
         for pid, start in workers:
@@ -154,7 +161,8 @@ def end_orphans() -> list[int]:
     return ended
 
 
-def _read_record(path: str) -> tuple[tuple[int, int] | None, list[tuple[int, int]]]:
+def read_record(path: str) -> tuple[tuple[int, int] | None, list[tuple[int, int]]]:
+    """A record's ``(parent pid, start)`` (None if it has none) and its workers' ``(pid, start)``."""
     parent, workers = None, []
     try:
         with open(path) as f:
@@ -187,7 +195,8 @@ def process_start(pid: int) -> int | None:
 
 
 def _is_our_worker(pid: int) -> bool:
-    """Whether ``pid`` runs as this user with the command line of a ``spawn`` worker."""
+    """Whether ``pid`` runs as this user with the command line of a ``spawn`` worker, of a fork server or of
+    a worker forked by one."""
     try:
         if os.stat(f"/proc/{pid}").st_uid != os.getuid():
             return False
@@ -195,19 +204,25 @@ def _is_our_worker(pid: int) -> bool:
             cmdline = f.read()
     except OSError:
         return False
-    return all(mark in cmdline for mark in _WORKER_MARKS)
+    return all(mark in cmdline for mark in _WORKER_MARKS) or SERVER_MARK in cmdline
 
 
 # ------------------------------------------------------------------ worker
-def die_with_parent(parent: int, record: str | None) -> None:
-    """In a worker as it starts: end with ``parent`` (the pid of the process that spawned it), and enter the
-    worker in its pool's ``record``."""
+def die_with_parent(parent: int, record: str | None, run: tuple[int, int] | None = None) -> None:
+    """In a worker as it starts: end with ``parent`` (the pid of the process that spawned it) and with the
+    run's process ``run`` (pid and start time; a fork server's worker: its parent is the server), and enter
+    the worker in its pool's ``record``."""
     import multiprocessing
     if getattr(multiprocessing.current_process(), "by_main_thread", False):
-        _death_signal()
-    if os.getppid() != parent:               # the parent is gone already (before it could signal)
-        os._exit(1)
-    threading.Thread(target=_watch, args=(parent,), name="ngcontact-parent-watch", daemon=True).start()
+        death_signal()
+    if os.getppid() != parent or run is not None and process_start(run[0]) != run[1]:
+        os._exit(1)                          # the parent is gone already (before it could signal)
+    threading.Thread(target=_watch, args=(parent, run), name="ngcontact-parent-watch", daemon=True).start()
+    enter(record)
+
+
+def enter(record: str | None) -> None:
+    """Enter this process in a pool's ``record`` (``worker PID START``; nothing without one)."""
     start = process_start(os.getpid())
     if record is not None and start is not None:
         try:
@@ -217,7 +232,7 @@ def die_with_parent(parent: int, record: str | None) -> None:
             pass                                # the record is gone: its parent has ended the pool
 
 
-def _death_signal() -> None:
+def death_signal() -> None:
     """SIGKILL for this process when the thread that spawned it ends (Linux ``prctl``; elsewhere nothing)."""
     if not sys.platform.startswith("linux"):
         return
@@ -231,8 +246,8 @@ def _death_signal() -> None:
     prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
 
 
-def _watch(parent: int) -> None:
+def _watch(parent: int, run: tuple[int, int] | None) -> None:
     while True:
         time.sleep(WATCH_SECONDS)
-        if os.getppid() != parent:
+        if os.getppid() != parent or run is not None and process_start(run[0]) != run[1]:
             os._exit(1)

@@ -13,7 +13,10 @@ here takes ``r c``.  On the workers the rest ends
   libraries a member imports beyond NGSolve, the files it reads), ``F``;
 * no sooner than ``(r c + W (S + F)) / P``: the work of the rest, of each
   worker's start (``S`` CPU seconds: an interpreter importing NGSolve and
-  the members' modules) and of its first member, on the ``P = min(W, f)``
+  the members' modules; for workers forked by a fork server, a ``W``-th of
+  the server's start and a fork, and only the fork once the server's start
+  has begun: :mod:`ngcontact.parallel.fork_server`) and of its first
+  member, on the ``P = min(W, f)``
   cores the run gets, ``f`` being the cores other processes leave free
   (:mod:`ngcontact.parallel.free_cores`, eq. 2 or 3): on busy cores a
   worker only takes turns with other jobs, and its start takes the cores of

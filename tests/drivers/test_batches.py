@@ -19,7 +19,7 @@ import pytest
 
 from ngcontact import cli
 from ngcontact.runner import solve
-from ngcontact.parallel import free_cores
+from ngcontact.parallel import fork_server, free_cores
 from ngcontact.parallel.batch_member import FAULT_ENV
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -218,6 +218,36 @@ def test_two_local_workers_give_the_serial_numbers(scenes, name):
     assert [s[1:] for s in seen] == [(k, total) for k in range(total + 1)]
 
 
+@pytest.fixture
+def local_workers_always_repay(monkeypatch, tmp_path):
+    """Condition (1) of the local payoff rule held whatever the members cost (no start, fork or first
+    member to repay, an idle machine, no measured cost) and the fork server's imports awaited before the
+    rule looks: these batches are too small to repay workers, and the test below is of the numbers of the
+    members the forked workers solve."""
+    from ngcontact.parallel import judged_batches, local_pool
+    for name in ("START_SECONDS", "FORK_SECONDS", "FIRST_MEMBER_SECONDS"):
+        monkeypatch.setattr(judged_batches, name, 0.0)
+    monkeypatch.setenv("NGCONTACT_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(free_cores, "core_seconds", lambda cores: None)
+    monkeypatch.setattr(free_cores, "load_average", lambda: 0.0)
+    ready = local_pool.LocalPool._ready
+    monkeypatch.setattr(local_pool.LocalPool, "_ready",
+                        lambda self: (self._server.wait(120) if self._server is not None else True) and ready(self))
+
+
+def test_members_forked_by_the_fork_server_give_the_serial_numbers(scenes, local_workers_always_repay):
+    """The ensemble's members after the first two, solved by workers forked from the fork server (the default
+    local pool here): the serial numbers to 1e-12."""
+    from ngcontact.parallel import local_pool
+    assert fork_server.available() and local_pool.LocalPool(2).method == "forkserver"
+    paths, serial = scenes
+    report, _ = solve(paths["ensemble"], workers=2)
+    assert_same(numbers(report), numbers(serial["ensemble"]))
+    batch = report["compute"]["batches"][0]
+    assert (report["compute"]["executor"], batch["members"], batch["executor"]) == ("local", 4, "local")
+    assert "the other 2 on 2 workers" in batch["decision"]
+
+
 @pytest.mark.slow
 def test_independent_loads_differ_from_the_continuation_only_by_the_solver_tolerance(scenes, tmp_path):
     """Negative control of the mode: the chained sweep solves the same problems from other starts."""
@@ -252,6 +282,13 @@ def test_a_member_that_always_fails_ends_the_run_with_exit_3_and_writes_nothing(
     assert not out.exists()
 
 
+#: What the command line of a local worker holds: a spawned one's, or a fork server's (and its workers').
+WORKER_MARKS = ("spawn_main", "from multiprocessing.forkserver import main")
+
+#: The processes of two local workers: the fork server and the two it forks, or two spawned workers.
+WORKER_PROCESSES = 3 if fork_server.available() else 2
+
+
 def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_path):
     psutil = pytest.importorskip("psutil")
     scene = ensemble(tmp_path, members=400, grid=64)
@@ -261,8 +298,10 @@ def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_
     # an idle machine (a batch stays in the run's process while other jobs keep the cores busy)
     env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
                **{free_cores.LOAD_ENV: "0"})
+    # SIGINT as a terminal's run gets it, also where this test runs in a background job (which ignores it)
     proc = subprocess.Popen([sys.executable, "-m", "ngcontact.cli", "run", scene, "--out", str(out),
-                             "--workers", "2"], stderr=subprocess.PIPE, text=True, env=env, cwd=str(tmp_path))
+                             "--workers", "2"], stderr=subprocess.PIPE, text=True, env=env, cwd=str(tmp_path),
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     def command(child):
         try:
             return " ".join(child.cmdline())
@@ -273,10 +312,11 @@ def test_ctrl_c_stops_the_workers_and_leaves_the_output_directory_as_it_was(tmp_
     assert proc.stderr is not None
     for line in proc.stderr:          # plain progress lines: stderr is a pipe, not a terminal
         if "ensemble: " in line and "finished" in line:   # the workers start once a member has timed the batch
-            workers = [c for c in psutil.Process(proc.pid).children(recursive=True) if "spawn_main" in command(c)]
-            if len(workers) == 2:
+            workers = [c for c in psutil.Process(proc.pid).children(recursive=True)
+                       if any(mark in command(c) for mark in WORKER_MARKS)]
+            if len(workers) == WORKER_PROCESSES:
                 break
-    assert len(workers) == 2
+    assert len(workers) == WORKER_PROCESSES
     proc.send_signal(signal.SIGINT)
     rest = proc.stderr.read()
     assert proc.wait(timeout=60) == 130, rest

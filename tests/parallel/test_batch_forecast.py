@@ -1,6 +1,7 @@
 """Workers start with the run only where the last run of the same batch forecasts that condition (1) of
 :mod:`ngcontact.parallel.worker_payoff` sends it to them (:mod:`ngcontact.parallel.batch_forecast`)."""
 import os
+import time
 
 import pytest
 
@@ -24,25 +25,104 @@ def test_a_record_is_read_back_and_a_broken_one_is_no_forecast(cache):
     assert batch_forecast.recorded("abc") is None
     batch_forecast.remember("abc", Forecast(16, 0.5, 1.25))
     assert batch_forecast.recorded("abc") == Forecast(16, 0.5, 1.25)
-    for text in ("{", '{"members": 0, "member_seconds": 1, "lead_seconds": 0}', '{"members": 3}'):
+    batch_forecast.remember("abc", Forecast(16, 0.5, 1.25, 0.75, 0.125))
+    assert batch_forecast.recorded("abc") == Forecast(16, 0.5, 1.25, 0.75, 0.125)
+    for text in ("{", '{"members": 0, "member_seconds": 1, "lead_seconds": 0}', '{"members": 3}',
+                 '{"members": 3, "member_seconds": 1, "lead_seconds": 0, "start_seconds": -1}',
+                 '{"members": 3, "member_seconds": 1, "lead_seconds": 0, "first_seconds": NaN}'):
         (cache / batch_forecast.FOLDER / "abc.json").write_text(text)
         assert batch_forecast.recorded("abc") is None
 
 
-def test_the_forecast_is_condition_1_on_the_cores_free_as_the_run_opens(monkeypatch):
+@pytest.mark.parametrize("method", ["spawn", "forkserver"])
+def test_the_forecast_is_condition_1_on_the_cores_free_as_the_run_opens(monkeypatch, method):
     monkeypatch.setattr(judged_batches, "START_SECONDS", 2.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 1.0)
     monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
-    pool = executor.LocalPool(2)
+    pool = executor.LocalPool(2, method=method)
     # 14 members after the two solved here, 0.5 s each, on an idle machine of two cores: 3.5 s saved
-    # against 1 s of a first member and the 2 s start less the lead; on the cores, 7 CPU s against
-    # 2 x (2 + 1) s of starts and first members
+    # against 1 s of a first member and the 2 s start (and a fork: 0.05 s) less the lead; on the cores,
+    # 7 CPU s against 2 x (2 + 1) s of spawned starts and first members, or one server's 2 s start shared
+    # by the two workers: 2 x (1 + 0.05 + 1) = 4.1 s
     assert pool.repays(Forecast(16, 0.5, 1.5)) and pool.repays(Forecast(16, 0.5, 0.0))
-    assert not pool.repays(Forecast(16, 0.4, 10.0))          # 5.6 CPU s do not repay 6 CPU s
+    if method == "spawn":
+        assert not pool.repays(Forecast(16, 0.4, 10.0))      # 5.6 CPU s do not repay 6 CPU s
+    else:
+        assert pool.repays(Forecast(16, 0.4, 10.0))          # 5.6 CPU s repay 4.1 CPU s
+        assert not pool.repays(Forecast(16, 0.25, 10.0))     # 3.5 CPU s do not
     monkeypatch.setattr(free_cores, "load_average", lambda: 1.0)
     assert not pool.repays(Forecast(16, 0.5, 1.5))           # one core left: the workers would gain none
     assert not pool.repays(Forecast(8, 0.15, 10.0))          # the measured scan's kind: never repaid
     assert not executor.Serial().repays(Forecast(1000, 10.0, 10.0))
+
+
+def idle_since_the_process_opened(monkeypatch, load: float) -> None:
+    """A machine of two cores on which only this process has computed since the package was imported (0.5 s
+    ago, :data:`~ngcontact.parallel.free_cores.OPENING`), with a one-minute load average of ``load`` left by
+    the run that ended just before."""
+    monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
+    monkeypatch.setattr(free_cores, "load_average", lambda: load)
+    monkeypatch.setattr(free_cores, "core_seconds", lambda cores: time.process_time())
+    monkeypatch.setattr(free_cores, "OPENING", (time.perf_counter() - 0.5, time.process_time(), time.process_time()))
+
+
+def test_the_forecast_reads_the_cores_over_the_runs_opening_not_the_load_average(monkeypatch):
+    """The serial run just before leaves a one-minute load average of 1.1 on an idle machine of two cores:
+    read as other jobs, it would leave 0.9 cores free and never an early start.  The run's first look reads
+    what the window opened with its process (its imports) left free: both cores."""
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 2.0)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 1.0)
+    idle_since_the_process_opened(monkeypatch, load=1.1)
+    pool = executor.LocalPool(2)
+    assert pool.repays(Forecast(16, 0.5, 1.5))
+    assert pool.cores.reading().source == "one-minute load average 1.10"    # then no window: (3)
+    monkeypatch.setattr(free_cores, "core_seconds", lambda cores: time.perf_counter() + time.process_time())
+    monkeypatch.setattr(free_cores, "OPENING", (time.perf_counter() - 0.5, time.perf_counter(), time.process_time()))
+    assert not executor.LocalPool(2).repays(Forecast(16, 0.5, 1.5))   # another job on a core all along
+    monkeypatch.setattr(free_cores, "OPENING", (time.perf_counter() - 1e3, time.process_time(), time.process_time()))
+    assert not executor.LocalPool(2).repays(Forecast(16, 0.5, 1.5))   # a window that old is no reading
+
+
+@pytest.mark.parametrize("method", ["spawn", "forkserver"])
+def test_before_a_worker_is_timed_the_forecast_takes_the_last_runs_own_start_and_first_member(monkeypatch,
+                                                                                                method):
+    """The 256^2 ensemble's kind: 14 members of 0.25 s after the two solved here.  Against the estimates
+    (2 s start, 1 s first member) they would not repay; against what the last run's process measured before
+    its batch (0.8 s of CPU, 0.5 s of them ahead of the batch) and its first member (0.03 s beyond the
+    cheapest), they do, as the rule in the batch will find.  The shipped 64^2 ensemble's kind (30 members of
+    0.04 s): 1.2 CPU s do not repay two spawned starts (2 x 0.83 s), and do repay a fork server's start
+    shared by the two workers and their forks (2 x (0.4 + 0.05 + 0.03) = 0.96 s; 0.6 s saved against
+    0.35 s of the start still ahead and 0.03 s)."""
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 2.0)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.05)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 1.0)
+    monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
+    pool = executor.LocalPool(2, method=method)
+    assert not pool.repays(Forecast(16, 0.25, 0.5))
+    assert pool.repays(Forecast(16, 0.25, 0.5, start_seconds=0.8, first_seconds=0.03))
+    assert not pool.repays(Forecast(16, 0.25, 0.5, start_seconds=5.0, first_seconds=3.0))   # held to the estimates
+    shipped = Forecast(32, 0.04, 0.5, start_seconds=0.8, first_seconds=0.03)
+    assert pool.repays(shipped) == (method == "forkserver")
+    assert not pool.repays(Forecast(32, 0.03, 0.5, start_seconds=0.8, first_seconds=0.03))  # 0.9 CPU s: never
+
+
+def test_workers_start_with_the_run_after_a_serial_run_of_the_batch_on_an_idle_machine(monkeypatch, cache):
+    """The benchmark's sequence: a serial run records the batch, the next run with two workers starts them as
+    it opens, although the serial run left a one-minute load average of 1.1; nothing measured a worker yet."""
+    scene = loader.load(os.path.join(ROOT, "geometries", "cells", "self_affine_ensemble.toml"))
+    members = runner.batch_members(scene)
+    names = [f"m{k}" for k in range(members)]
+    with runner.batches(scene, workers=1) as ex:
+        ex.map(burn, [0.05] * members, names, label="ensemble")
+    [record] = os.listdir(cache / batch_forecast.FOLDER)
+    forecast = batch_forecast.recorded(record[:-len(".json")])
+    assert forecast.start_seconds == pytest.approx(ex.timings[0]["lead_cpu"]) and forecast.start_seconds > 0
+    assert 0.0 <= forecast.first_seconds < 0.05
+    assert batch_forecast.measured_costs("start") == []
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.3)     # this test process's lead CPU is no start's
+    idle_since_the_process_opened(monkeypatch, load=1.1)
+    with runner.batches(scene, workers=2) as ex:
+        assert ex.pools_started == 1 and ex.describe()["workers_started"] == "with the run"
 
 
 def test_workers_start_with_the_run_only_where_the_last_run_of_the_batch_says_they_take_it(monkeypatch, cache):
@@ -57,9 +137,10 @@ def test_workers_start_with_the_run_only_where_the_last_run_of_the_batch_says_th
     with runner.batches(scene, workers=2) as ex:            # 30 x 0.01 s do not repay two workers
         assert ex.pools_started == 0
     monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.05)
     with runner.batches(scene, workers=2) as ex:            # they would now: started as the run opens
-        assert ex.pools_started == 1 and ex._pool is not None
+        assert ex.pools_started == 1 and ex._launched()
         assert ex.describe()["workers_started"] == "with the run"
 
 

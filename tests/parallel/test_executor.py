@@ -12,14 +12,14 @@ import time
 import pytest
 
 from ngcontact.errors import BatchError
-from ngcontact.parallel import batch_member, executor, judged_batches
+from ngcontact.parallel import batch_member, executor, judged_batches, local_pool, worker_lifetime
 
 ITEMS = [1.5, -2.0, 3.25, 7.0, -0.5]
 NAMES = [f"m{k}" for k in range(len(ITEMS))]
 EXPECTED = [-x for x in ITEMS]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def pool():
     p = executor.LocalPool(2)
     yield p
@@ -94,23 +94,38 @@ def workers_always_repay(monkeypatch):
     """No start ahead, no first member's extra: every batch's rest goes to workers (condition (1) of
     :mod:`ngcontact.parallel.worker_payoff` holds for any member that takes time)."""
     monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
 
 
+@pytest.mark.parametrize("method", local_pool.METHODS)
 def test_a_started_pool_has_its_workers_running_before_the_first_batch_and_records_its_batches(
-        workers_always_repay):
-    ex = executor.LocalPool(2)
+        workers_always_repay, method):
+    """Spawned workers run once started; a fork server runs (its workers fork as a batch sends them
+    members).  A second start keeps them, and the batch runs on them."""
+    ex = executor.LocalPool(2, method=method)
     try:
         ex.start()
+        server = ex._server
         ex.start()                                           # a second start keeps the same workers
-        processes = list(ex._pool._processes.values())
-        assert len(processes) == 2 and all(p.is_alive() for p in processes)
+        assert ex._server is server and ex.pools_started == 1
+        if method == "spawn":
+            processes = list(ex._pool._processes.values())
+            assert len(processes) == 2 and all(p.is_alive() for p in processes)
+        else:
+            assert ex._pool is None and worker_lifetime.process_start(server.pid) is not None
+        assert ex.wait_ready(120)
         assert ex.map(operator.neg, ITEMS, NAMES, label="toy") == EXPECTED
-        assert list(ex._pool._processes.values()) == processes   # the batch ran on the started workers
+        if method == "spawn":
+            assert list(ex._pool._processes.values()) == processes   # the batch ran on the started workers
+        else:                 # forked by the server as the batch's rest was sent: no other pool started
+            assert 1 <= len(ex._pool._processes) <= 2 and ex._server is server and ex.pools_started == 1
         assert ex.describe()["executor"] == "local" and ex.describe()["workers"] == 2
+        assert ex.describe()["batches"][-1]["executor"] == "local"
         assert [(b["label"], b["members"]) for b in ex.describe()["batches"]] == [("toy", len(ITEMS))]
     finally:
         ex.close()
+    assert method == "spawn" or worker_lifetime.process_start(server.pid) is None   # the server ends with it
 
 
 def test_runs_with_batches_start_their_workers_at_once_and_others_do_not():
@@ -140,14 +155,17 @@ def test_every_shipped_scene_says_whether_it_has_batches():
         assert isinstance(has_batches(scene), bool), path
 
 
-def test_a_run_that_fails_while_its_workers_start_stops_them_at_once():
-    ex = executor.LocalPool(2)
+@pytest.mark.parametrize("method", local_pool.METHODS)
+def test_a_run_that_fails_while_its_workers_start_stops_them_at_once(method):
+    ex = executor.LocalPool(2, method=method)
     with pytest.raises(KeyboardInterrupt):
         with executor.use(ex):
             ex.start()
-            processes = list(ex._pool._processes.values())
+            processes = list(ex._pool._processes.values()) if method == "spawn" else []
+            server = ex._server.pid if method == "forkserver" else None
             raise KeyboardInterrupt
-    assert ex._pool is None
+    assert ex._pool is None and ex._server is None
+    assert server is None or worker_lifetime.process_start(server) is None
     # the pool's manager thread reaps the workers too; until it has recorded an exit code, is_alive() of
     # a worker that is gone can still say True, so allow that bookkeeping a moment
     deadline = time.monotonic() + 2.0
@@ -163,6 +181,7 @@ def test_a_pool_started_on_demand_uses_its_workers_only_where_they_repay_their_s
     ``rest * seconds * (1 - 1/workers)`` exceeds the workers' start (``START_SECONDS``) and a worker's first
     member (``FIRST_MEMBER_SECONDS``)."""
     monkeypatch.setattr(judged_batches, "START_SECONDS", start_seconds)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", start_seconds)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
     ex = executor.LocalPool(2)
     ex.start_on_demand()
@@ -171,7 +190,7 @@ def test_a_pool_started_on_demand_uses_its_workers_only_where_they_repay_their_s
         out = ex.map(operator.neg, ITEMS, [f"m{k}" for k in range(len(ITEMS))], label="toy",
                      progress=lambda label, k, n: seen.append((k, n)))
         assert out == [-x for x in ITEMS]
-        assert (ex._pool is not None) == on_workers
+        assert (ex.pools_started > 0) == on_workers, ex.describe()   # workers (or their fork server) started
         assert seen[0] == (0, len(ITEMS)) and seen[-1] == (len(ITEMS), len(ITEMS))
         assert [k for k, _ in seen] == sorted(k for k, _ in seen) and {n for _, n in seen} == {len(ITEMS)}
     finally:
@@ -192,8 +211,7 @@ def test_an_early_pool_solves_members_here_until_a_worker_has_started(monkeypatc
                       progress=lambda label, k, n: seen.append((k, n)))
         assert here == [None] * 6
         assert seen == [(k, 6) for k in range(7)]
-        for warm in ex._warming:
-            warm.result(timeout=120)
+        assert ex.wait_ready(120)
         assert ex.map(os.getenv, ["NGCONTACT_THREADS"] * 6, names, label="toy") == [None] * 2 + ["1"] * 4
     finally:
         ex.close()

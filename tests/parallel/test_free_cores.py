@@ -70,3 +70,15 @@ def test_the_runs_process_loads_every_blas_on_one_thread():
                                                            "MKL_NUM_THREADS")}
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
     assert out.stdout.split() == ["1", "False"]
+
+
+def test_the_window_of_the_runs_first_look_opens_before_ngsolve_and_the_scene_modules_load():
+    """The package opens the window (:data:`~ngcontact.parallel.free_cores.OPENING`) before its heavy imports,
+    so that a run's first look, about a second later, reads (2) over them rather than the load average."""
+    code = ("import sys\norder = []\nclass Seen:\n    def find_spec(self, name, path=None, target=None):\n"
+            "        order.append(name)\nsys.meta_path.insert(0, Seen())\nimport ngcontact\n"
+            "print(order.index('ngcontact.parallel.free_cores'), order.index('ngsolve'),"
+            " order.index('ngcontact.scene.loader'))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    opening, ngsolve, loader = map(int, out.stdout.split())
+    assert opening < ngsolve and opening < loader

@@ -17,6 +17,8 @@ import time
 
 import pytest
 
+from ngcontact.parallel import worker_lifetime
+
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc (Linux)")
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -39,7 +41,8 @@ SCRIPT = textwrap.dedent("""\
 
     if __name__ == "__main__":
         folder = sys.argv[1]
-        LocalPool(2).map(member, [os.path.join(folder, f"m{k}") for k in range(4)], [f"m{k}" for k in range(4)])
+        LocalPool(2, method=sys.argv[2]).map(member, [os.path.join(folder, f"m{k}") for k in range(4)],
+                                             [f"m{k}" for k in range(4)])
 """)
 
 
@@ -98,22 +101,29 @@ def wait_for(condition, seconds: float, step: float = 0.05):
         time.sleep(step)
 
 
-def test_a_parent_killed_with_sigkill_takes_its_workers_and_the_resource_tracker_with_it(tmp_path):
+@pytest.mark.parametrize("method", ["spawn", "forkserver"])
+def test_a_parent_killed_with_sigkill_takes_its_workers_and_the_resource_tracker_with_it(tmp_path, method):
+    """Spawned workers, or a fork server and the two workers it forked (their parent is the server, which
+    the run's end ends): none outlives the run killed while its members run."""
     script = tmp_path / "batch.py"
     script.write_text(SCRIPT)
     marks = tmp_path / "marks"
     marks.mkdir()
     env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
                XDG_RUNTIME_DIR=str(tmp_path))
-    proc = subprocess.Popen([sys.executable, str(script), str(marks)], env=env, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen([sys.executable, str(script), str(marks), method], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     below: dict[int, int] = {}
     try:
         started = wait_for(lambda: len(os.listdir(marks)) >= 2, 25.0)
         assert started, "the workers did not start their members"
         below = descendants(proc.pid)
         kinds = [open(f"/proc/{pid}/cmdline", "rb").read() for pid in below]
-        assert sum(b"spawn_main" in k for k in kinds) == 2, kinds
+        if method == "spawn":
+            assert sum(b"spawn_main" in k for k in kinds) == 2, kinds
+        else:                           # the server and its two workers, forked: the server's command line
+            assert sum(worker_lifetime.SERVER_MARK in k for k in kinds) == 3, kinds
+            assert sum(stat(pid)[0] == proc.pid for pid in below) == 2      # the server, the tracker
         assert any(b"resource_tracker" in k for k in kinds), kinds
         proc.send_signal(signal.SIGKILL)
         proc.wait(timeout=10)
@@ -134,12 +144,13 @@ def test_the_next_pool_ends_the_orphans_of_an_earlier_run_by_their_records_and_n
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
     worker = [sys.executable, "-c", "from multiprocessing.spawn import spawn_main; import time; time.sleep(60)",
               "--multiprocessing-fork"]
+    server = [sys.executable, "-c", "from multiprocessing.forkserver import main; import time; time.sleep(60)"]
     gone = subprocess.Popen([sys.executable, "-c", "pass"])
     gone_start = stat(gone.pid)[2]
     gone.wait()
     procs = {name: subprocess.Popen(cmd) for name, cmd in (
-        ("orphan", worker), ("of a live parent", worker), ("not a worker", ["sleep", "60"]),
-        ("reused pid", worker))}
+        ("orphan", worker), ("orphan server", server), ("of a live parent", worker),
+        ("not a worker", ["sleep", "60"]), ("reused pid", worker))}
     try:
         starts = {name: wait_for(lambda p=p: stat(p.pid), 5.0)[2] for name, p in procs.items()}
         here = stat(os.getpid())[2]
@@ -147,6 +158,7 @@ def test_the_next_pool_ends_the_orphans_of_an_earlier_run_by_their_records_and_n
         os.makedirs(folder, exist_ok=True)
         records = {
             "a.txt": f"parent {gone.pid} {gone_start}\nworker {procs['orphan'].pid} {starts['orphan']}\n"
+                     f"worker {procs['orphan server'].pid} {starts['orphan server']}\n"
                      f"worker {procs['not a worker'].pid} {starts['not a worker']}\n"
                      f"worker {procs['reused pid'].pid} {starts['reused pid'] + 1}\n",
             "b.txt": f"parent {os.getpid()} {here}\nworker {procs['of a live parent'].pid} "
@@ -159,7 +171,8 @@ def test_the_next_pool_ends_the_orphans_of_an_earlier_run_by_their_records_and_n
         try:
             pool.start()                                  # a new pool ends the orphans before it starts
             assert procs["orphan"].wait(timeout=5) == -signal.SIGKILL
-            assert all(p.poll() is None for name, p in procs.items() if name != "orphan")
+            assert procs["orphan server"].wait(timeout=5) == -signal.SIGKILL
+            assert all(p.poll() is None for name, p in procs.items() if not name.startswith("orphan"))
         finally:
             pool.close()
         # the record of the dead parent is done with, as is the pool's own once closed; the live parent's stays
@@ -172,32 +185,41 @@ def test_the_next_pool_ends_the_orphans_of_an_earlier_run_by_their_records_and_n
             p.wait()
 
 
-def test_workers_spawned_by_a_thread_that_ends_live_on_with_their_parent(tmp_path, monkeypatch):
-    """The kernel's death signal follows the *thread* that spawned a worker: a pool started by a thread
-    that then ends keeps its workers (they watch the parent's pid instead) and runs its batches."""
+@pytest.mark.parametrize("method", ["spawn", "forkserver"])
+def test_workers_spawned_by_a_thread_that_ends_live_on_with_their_parent(tmp_path, monkeypatch, method):
+    """The kernel's death signal follows the *thread* that spawned a worker (or started a fork server): a
+    pool started by a thread that then ends keeps its workers (they watch the parent's pid instead; the
+    server asked for no death signal) and runs its batches."""
     import operator
     import threading
 
     from ngcontact.parallel import judged_batches, local_pool
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
     monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)          # every batch's rest goes to the workers
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
-    pool = local_pool.LocalPool(2)
+    pool = local_pool.LocalPool(2, method=method)
     try:
         first = []
 
-        def starter():             # starts the workers and waits for a batch: they have started by its end
+        def starter():             # starts the workers (or the server) and waits until they are ready
             pool.start()
             first.append(pool.map(operator.neg, [1.0, 2.0], ["a", "b"]))
+            pool.wait_ready(120)
 
         thread = threading.Thread(target=starter)
         thread.start()
         thread.join()
         assert first == [[-1.0, -2.0]]
-        workers = list(pool._pool._processes.values())
-        assert len(workers) == 2
+        server = pool._server.pid if method == "forkserver" else None
+        workers = list(pool._pool._processes.values()) if method == "spawn" else []
+        assert len(workers) == 2 or server is not None
         time.sleep(0.5)            # a death signal, had it been asked for, is on its way
         assert pool.map(operator.neg, [1.0, 2.0, 3.0, 4.0], ["a", "b", "c", "d"]) == [-1.0, -2.0, -3.0, -4.0]
-        assert list(pool._pool._processes.values()) == workers and all(w.is_alive() for w in workers)
+        assert pool.describe()["batches"][-1]["executor"] == "local"
+        if method == "spawn":
+            assert list(pool._pool._processes.values()) == workers and all(w.is_alive() for w in workers)
+        else:
+            assert pool._server.pid == server and worker_lifetime.process_start(server) is not None
     finally:
         pool.close()

@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from ngcontact.parallel import batch_forecast, free_cores, judged_batches, local_pool
+from ngcontact.parallel import batch_forecast, free_cores, judged_batches, local_pool, worker_lifetime
 from ngcontact.parallel.free_cores import Reading
 from ngcontact.parallel.worker_payoff import MemberClock, Payoff
 
@@ -49,8 +49,7 @@ def ready_pool(monkeypatch):
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.2)
     pool = local_pool.LocalPool(2)
     pool.start()
-    for warm in pool._warming:
-        warm.result(timeout=120)
+    assert pool.wait_ready(120)
     yield pool
     pool.close()
 
@@ -63,7 +62,7 @@ def test_a_batch_too_small_to_repay_workers_runs_serially_and_says_why(ready_poo
     batch = ready_pool.describe()["batches"][-1]
     assert (batch["label"], batch["executor"]) == ("small", "serial")
     assert batch["decision"].startswith("2 members solved here") and "the other 1 in this process" in batch["decision"]
-    assert ready_pool._pool is not None                  # started workers are kept for the next batch
+    assert ready_pool._launched() and ready_pool._ready()    # started workers (or server) kept for the next batch
 
 
 def test_a_large_batch_goes_to_the_workers_after_its_first_two_members(ready_pool):
@@ -75,15 +74,19 @@ def test_a_large_batch_goes_to_the_workers_after_its_first_two_members(ready_poo
     assert batch["executor"] == "local" and "the other 10 on 2 workers" in batch["decision"]
 
 
-def test_workers_still_starting_are_stopped_when_the_batch_ends_here():
-    """A pool started as the run begins, a batch of a few short members: finished here, the workers stopped
-    at once rather than left to take cores from this process."""
-    pool = local_pool.LocalPool(2)
+@pytest.mark.parametrize("method", local_pool.METHODS)
+def test_workers_still_starting_are_stopped_when_the_batch_ends_here(method):
+    """A pool started as the run begins, a batch of a few short members: finished here, the workers (or
+    their fork server, still importing) stopped at once rather than left to take cores from this process."""
+    pool = local_pool.LocalPool(2, method=method)
     try:
         pool.start()
-        processes = list(pool._pool._processes.values())
+        processes = list(pool._pool._processes.values()) if method == "spawn" else []
+        server = pool._server.pid if method == "forkserver" else None
         assert pool.map(burn, [0.01] * 3, ["a", "b", "c"], label="tiny") == [os.getpid()] * 3
-        assert pool._pool is None and pool.describe()["batches"][-1]["executor"] == "serial"
+        assert pool._pool is None and pool._server is None
+        assert pool.describe()["batches"][-1]["executor"] == "serial"
+        assert server is None or worker_lifetime.process_start(server) is None
         deadline = time.monotonic() + 5.0
         while any(p.is_alive() for p in processes) and time.monotonic() < deadline:
             time.sleep(0.05)
@@ -98,9 +101,9 @@ def test_a_batch_kept_here_starts_no_worker_process():
     pool = local_pool.LocalPool(2)
     try:
         pool.start_on_demand(("ngsolve",))
-        assert pool.pools_started == 0 and pool._pool is None
+        assert pool.pools_started == 0 and pool._pool is None and pool._server is None
         assert pool.map(burn, [0.02] * 4, ["a", "b", "c", "d"], label="small") == [os.getpid()] * 4
-        assert pool.pools_started == 0 and pool._pool is None
+        assert pool.pools_started == 0 and pool._pool is None and pool._server is None
         assert pool.describe()["batches"][-1]["executor"] == "serial"
         assert pool.describe()["workers_started"] == "never"
     finally:
@@ -127,6 +130,7 @@ def on_demand_pool(monkeypatch):
     """A pool whose workers start on demand, with no start to pay and no first member's extra: a batch of
     members that take time repays them where the cores are free."""
     monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
     pool = local_pool.LocalPool(2)
     pool.start_on_demand(("ngsolve",))
@@ -141,6 +145,31 @@ def test_workers_on_demand_start_inside_the_batch_that_repays_them(on_demand_poo
     assert on_demand_pool.pools_started == 1
     assert on_demand_pool.describe()["workers_started"] == "during batch 'large'"
     assert pids[:2] == [os.getpid()] * 2
+
+
+def test_a_fork_servers_start_once_begun_is_spent_and_not_counted_again(monkeypatch):
+    """Before the fork server starts, each of the two workers pays half its start and a fork (``S``) and
+    waits for all of it (``R``); once it has started (with the run, as a forecast would start it), the rule
+    in the batch counts only what its imports have still to do and the forks: a rest that does not repay
+    the whole start (14 x 0.1 s against 2 x (1 + 0.05 + 0.1) CPU s) is sent once the start is paid."""
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 2.0)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.05)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.1)
+    pool = local_pool.LocalPool(2, method="forkserver")
+    try:
+        before = pool.payoff(0.1, 14)
+        assert before.start_cpu == pytest.approx(1.05) and before.start_ahead == pytest.approx(2.05)
+        assert not before.repaid and before.core_cost == pytest.approx(2.3)
+        pool.start(("ngsolve",))
+        begun = pool.payoff(0.1, 14)
+        assert begun.start_cpu == 0.05 and 0.05 <= begun.start_ahead <= 2.05
+        assert pool.wait_ready(120)
+        ready = pool.payoff(0.1, 14)
+        assert (ready.start_cpu, ready.start_ahead) == (0.05, 0.05) and ready.repaid
+        assert pool.map(burn, [0.1] * 16, [f"m{k}" for k in range(16)], label="spent")[2:].count(os.getpid()) == 0
+        assert pool.payoff(0.1, 14).start_cpu == 0.0            # forked workers: nothing left to pay
+    finally:
+        pool.close()
 
 
 def test_condition_1_counts_the_cores_other_processes_leave_and_the_work_of_the_starts():
@@ -183,16 +212,33 @@ def test_started_workers_are_left_idle_while_other_jobs_keep_the_cores_busy(monk
     assert "busy with other processes" in ready_pool.describe()["batches"][-1]["decision"]
 
 
-def test_a_workers_start_is_measured_and_kept_for_the_next_runs(ready_pool):
-    """The workers' start (``S`` of condition (1)) is their CPU seconds once their imports are done (NGSolve
-    among them: more than a tenth of a second, less than a minute), recorded on this machine as each
-    worker's start ends."""
-    deadline = time.monotonic() + 10.0
-    while len(batch_forecast.measured_costs("start")) < 2 and time.monotonic() < deadline:
-        time.sleep(0.05)                  # the record is written as each start ends, beside this thread
-    starts = batch_forecast.measured_costs("start")
-    assert len(starts) == 2 and all(0.1 < s < 60.0 for s in starts)
-    assert judged_batches.start_cost() == pytest.approx(sum(starts) / 2)
+@pytest.mark.parametrize("method", local_pool.METHODS)
+def test_a_workers_start_is_measured_and_kept_for_the_next_runs(method):
+    """The workers' start (``S`` of condition (1)) is recorded on this machine: a spawned worker's CPU
+    seconds once its imports are done, as each worker's start ends; a fork server's once its imports are
+    done (NGSolve among them: more than a tenth of a second, less than a minute) and each forked worker's
+    before its first member (a fork: less than a tenth of the server's)."""
+    pool = local_pool.LocalPool(2, method=method)
+    try:
+        pool.start(("ngsolve",))
+        assert pool.wait_ready(120)
+        if method == "spawn":
+            deadline = time.monotonic() + 10.0
+            while len(batch_forecast.measured_costs("start")) < 2 and time.monotonic() < deadline:
+                time.sleep(0.05)          # the record is written as each start ends, beside this thread
+            starts = batch_forecast.measured_costs("start")
+            assert len(starts) == 2 and all(0.1 < s < 60.0 for s in starts)
+            assert judged_batches.start_cost() == pytest.approx(sum(starts) / 2)
+            return
+        [server] = batch_forecast.measured_costs("server")
+        assert 0.1 < server < 60.0 and judged_batches.server_cost() == server
+        assert batch_forecast.measured_costs("fork") == [] and judged_batches.fork_cost() == 0.05
+        import operator                   # a member whose module the server has imported (the forks' own cost)
+        pool._pool_map(operator.neg, [1.0] * 4, list("abcd"), "forks", None, None)
+        [fork] = batch_forecast.measured_costs("fork")
+        assert 0.0 < fork < 0.1 * server and judged_batches.fork_cost() == fork
+    finally:
+        pool.close()
 
 
 def test_a_workers_first_member_is_measured_beyond_the_cheapest_member_here(ready_pool):
@@ -221,12 +267,12 @@ def blas_threads(_) -> int:
 
 def test_workers_run_every_blas_on_one_thread_even_one_loaded_after_their_start(monkeypatch):
     monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
     pool = local_pool.LocalPool(2)
     try:
         pool.start()
-        for warm in pool._warming:
-            warm.result(timeout=120)
+        assert pool.wait_ready(120)
         assert pool._pool_map(blas_threads, [0, 1, 2, 3], list("abcd"), "blas", None, None) == [1] * 4
     finally:
         pool.close()
