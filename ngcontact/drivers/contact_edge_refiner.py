@@ -25,8 +25,8 @@ The twin's grids (:func:`edge_refiner`).  Each grid is solved once for every lev
 points of the levels, their start, the bound of the estimates).  A grid finer than every level's start
 (beyond :data:`~ngcontact.cell.fe.contact_edge_refinement.TWIN_GRIDS`: the bound's finest) starts its
 constrained CG from the next coarser grid's pressure, each value on its four points (:func:`prolonged`): the
-same strictly convex problem, so the same minimizer to the solver's tolerance, in fewer steps (the
-bisinusoid at ``p/p* = 0.02`` on ``2048^2``: 18 steps instead of 27, 6.2 instead of 8.7 CPU seconds).
+same strictly convex problem, so the same minimizer to the solver's tolerance, in about two thirds of the
+steps on the bisinusoid's ``2048^2``.
 """
 from __future__ import annotations
 

@@ -75,9 +75,8 @@ stated tolerance still missed when the steps and orders are spent ends the run w
 
 The orders' tail itself, of every quantity, is that of an alternating series where the last two changes
 alternate (:func:`orders_tail`): the remainder of a series whose terms alternate and contract by ``rho`` is
-at most its first term, ``rho |d_k|``, not the monotone ``rho / (1 - rho) |d_k|``.  On Hertz's row at ``1e-2``
-with exact contact the fraction's values over orders 3 to 5 swing by 1.1e-5 and 6.1e-6 about the limit (error
-2.2e-6): the monotone tail was 10 times the error, the alternating one 4.6.
+at most its first term, ``rho |d_k|``, not the monotone ``rho / (1 - rho) |d_k|``, which on Hertz's patch with
+exact contact (``tests/cell/test_hertz_effectivity.py``) bounded a swinging fraction ten times over.
 
 Against Westergaard's closed forms (``2a``, ``k_n 2a``, ``k_n h (2a - sin(2 pi a) / pi)``) and the spectral
 cell's stiffness of the same layers on 2^16 to 2^18 points (Richardson's limit), exact contact, at ``p/p* =

@@ -32,24 +32,22 @@ The normal stiffness in 2D (exact contact) on the located set.  The tangent
 problem at a fixed contact set is a flat punch: its pressure ``p'`` is
 singular like ``1/sqrt(distance)`` at each edge, and the stiffness of a set
 of collocation points is that of the continuous set whose edges lie
-:data:`PUNCH_EDGE` = 0.31 of a step beyond its last contact points
-(measured against the periodic flat punch of half-width ``a`` on a period
-``L`` of two half-planes, ``K = pi E* / (2 L ln(1 / sin(pi a / L)))``: the
-offset found from each set's ``K`` is 0.3100 to 1e-4 of a step on 1024 to
-65,536 points, for ``a/L`` from 0.1 to 0.4; the local problem at an edge is
-the same half-line problem on every grid).  The stiffness of the set whose
-edges are at the located ``i + t`` is then ``K_set + sum_e dK_e (t_e -
-0.31)``, ``dK_e`` the change of ``K`` with edge ``e`` alone a step out:
-the change ``K_grown - K_set`` with every edge that may move a step out
-(three open points ahead, so its open run stays open) moved, shared among
-them as their stress intensities squared, which the collocated ``p'`` at
-each last contact point is proportional to (the local problem again).  On
-the periodic punch with its edges anywhere between points, on 1024 to 16,384
-points, the relative error is 6e-6 to 1.2e-2 with the set's ``K`` and 2e-9
-to 8e-5 with the located one, which falls at second order; on Westergaard's
-sinusoid (``geometries/cells/westergaard_exact.toml``) 1.2e-4 to 6e-3 and
-1.6e-8 to 1.9e-4, the quartic-located edges' error taking over.  Where the edges
-are located to a fraction of a step only (beside a kink of a map), the
+:data:`PUNCH_EDGE` of a step beyond its last contact points.  The offset is
+found against the periodic flat punch of half-width ``a`` on a period ``L``
+of two half-planes, ``K = pi E* / (2 L ln(1 / sin(pi a / L)))``; it is the
+same on every grid and every ``a``, since the local problem at an edge is
+the same half-line problem (``tests/cell/test_spectral_located_stiffness.py``
+measures it and the second-order convergence below).  The stiffness of the
+set whose edges are at the located ``i + t`` is then ``K_set + sum_e dK_e
+(t_e - PUNCH_EDGE)``, ``dK_e`` the change of ``K`` with edge ``e`` alone a
+step out: the change ``K_grown - K_set`` with every edge that may move a
+step out (three open points ahead, so its open run stays open) moved, shared
+among them as their stress intensities squared, which the collocated ``p'``
+at each last contact point is proportional to (the local problem again).
+The set's ``K`` converges at first order in the step, the located one at
+second order until the located edges' own error takes over (the spectral
+refinement's section of ``docs/benchmarks.md``).  Where the edges are
+located to a fraction of a step only (beside a kink of a map), the
 stiffness's error is theirs: ``sum_e dK_e`` times their error in steps
 (:mod:`~ngcontact.cell.spectral.contact_edges`).
 
