@@ -130,7 +130,7 @@ class ShearTable:
     length_unit
         Metres per cell length unit (``s`` is in metres, ``Delta`` in cell units).
     max_solves
-        Largest number of cell solves of this table.
+        Largest number of cell solves of this table (a scene's ``two_scale.max_cell_solves``).
     map_tasks
         Runs the independent cell solves of one level.
     rows
@@ -151,7 +151,6 @@ class ShearTable:
     #: solved for the share's estimate (:mod:`ngcontact.coupling.table_share`), not nodes: taken without a solve
     held: dict[ShearLoad, tuple[float, float]] = field(default_factory=dict)
 
-    # ------------------------------------------------------------ solves
     def _known(self) -> set[ShearLoad]:
         return {(p, d) for p, r in self.rows.items() for d in r} | set(self.held)
 
