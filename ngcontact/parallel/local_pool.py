@@ -23,9 +23,10 @@ import time
 from typing import Any, Sequence
 
 from ngcontact.parallel.batch_executor import Executor
-from ngcontact.parallel.judged_batches import JudgedBatches, fork_cost, server_cost, shifted_progress, start_cost
+from ngcontact.parallel.judged_batches import shifted_progress
 from ngcontact.parallel.batch_member import one_thread, run_member
 from ngcontact.parallel import batch_forecast, fork_server, worker_lifetime
+from ngcontact.parallel.pool_start import PoolStart
 
 log = logging.getLogger("ngcontact.parallel.executor")
 
@@ -34,7 +35,7 @@ log = logging.getLogger("ngcontact.parallel.executor")
 METHODS = ("forkserver", "spawn")
 
 
-class LocalPool(JudgedBatches):
+class LocalPool(PoolStart):
     """A pool of ``workers`` worker processes on this machine (started on first use), forked by a fork
     server or spawned (``method``; default: ``forkserver`` where :func:`fork_server.available`)."""
 
@@ -86,63 +87,10 @@ class LocalPool(JudgedBatches):
                                          initargs=(self._started, *args))
         return self._pool
 
-    def _open_server(self) -> fork_server.Server:
-        """The pool's fork server, started now if it has none (its imports go on beside this process)."""
-        if self._server is None:
-            self._server = fork_server.acquire(self._modules)
-            self._forked = 0
-            self.pools_started += 1
-        return self._server
-
-    def _launched(self) -> bool:
-        return self._pool is not None or self._server is not None
-
-    def _ready(self) -> bool:
-        """Whether a worker can take a member now: a started worker (spawn), or a fork server whose imports
-        are done (its workers fork in milliseconds)."""
-        if self._pool is not None and (self.method == "forkserver" or not self._warming
-                                       or any(w.done() for w in self._warming)):
-            return True
-        return self._server is not None and self._server.ready()
-
-    def _start_still(self, estimate: float | None) -> tuple[float, float]:
-        """``(R, S)`` of condition (1): wall seconds of the workers' start still ahead and the CPU seconds
-        each worker's start still costs, this process having spent ``estimate`` CPU seconds before its batch
-        (the estimate of an interpreter's start before this machine has timed one).  A fork server's start,
-        once begun, is spent: only what its imports have still to do delays the workers, and each costs its
-        fork; before it has begun, each of the ``W`` workers pays a ``W``-th of it and its fork."""
-        if self.method == "spawn":
-            ahead = self._start_ahead(start_cost(estimate))
-            return ahead, ahead
-        if self._pool is not None:
-            return 0.0, 0.0
-        fork = fork_cost()
-        if self._server is None:
-            server = server_cost(estimate)
-            return server + fork, server / self.workers + fork
-        return self._server.start_still(server_cost(estimate), fork), fork
-
     def _abandon_start(self) -> None:
         """Stop workers (or a fork server) still starting: they would take cores from this process."""
         self._discard()
         self._stop_server()
-
-    def _stop_server(self) -> None:
-        server, self._server = self._server, None
-        if server is not None:
-            fork_server.release(server)
-
-    def _worker_pids(self) -> list[int]:
-        pids = list((self._pool._processes or {}).keys()) if self._pool is not None else []
-        return pids + ([self._server.pid] if self._server is not None else [])
-
-    def wait_ready(self, seconds: float = 120.0) -> bool:
-        """Wait at most ``seconds`` until a worker can take a member (a started pool); whether one can."""
-        if self._server is not None and self._pool is None:
-            return self._server.wait(seconds)
-        for warm in self._warming:
-            warm.result(timeout=seconds)
-        return self._ready()
 
     def start(self, modules: Sequence[str] = ()) -> None:
         """Spawn every worker now and let it import ``modules`` (what its members will need).
