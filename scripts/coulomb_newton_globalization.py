@@ -37,8 +37,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from ngcontact import runner  # noqa: E402
 
 from ngcontact.cell.fe import coulomb_friction  # noqa: E402
-from ngcontact.drivers.build import cell_loads  # noqa: E402
-from ngcontact.drivers.cell_members import fe_problem  # noqa: E402
+from ngcontact.drivers.build import cell_loads, cell_problem  # noqa: E402
 from ngcontact.errors import ConvergenceError  # noqa: E402
 from ngcontact.macro import macro_problem  # noqa: E402
 from ngcontact.scene.loader import load  # noqa: E402
@@ -80,7 +79,7 @@ def globalization(name: str):
 
 def run_cell() -> dict:
     scene = load(CELL)
-    problem = fe_problem(scene)
+    problem = cell_problem(scene)
     t0 = time.perf_counter()
     try:
         with runner.threads(runner.thread_count()):   # as ngcontact run: task manager, BLAS on one thread
