@@ -25,6 +25,7 @@ below the plateau matters, and the resolved ratio depends on eps.
 """
 from __future__ import annotations
 
+import argparse
 import csv
 import math
 import os
@@ -196,6 +197,9 @@ def main(out: str, periods: list[int], publish: bool = False) -> None:
 
 
 if __name__ == "__main__":
-    _args = [a for a in sys.argv[1:] if a != "--publish"]
-    main(_args[0] if _args else os.path.join("results", "sawtooth_shear"),
-         [int(n) for n in _args[1:]] or [8, 16, 32], publish="--publish" in sys.argv[1:])
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", nargs="?", default=os.path.join("results", "sawtooth_shear"), help="output directory")
+    ap.add_argument("periods", nargs="*", type=int, default=[8, 16, 32], help="numbers of periods resolved")
+    ap.add_argument("--publish", action="store_true", help="write the section of docs/benchmarks.md")
+    a = ap.parse_args()
+    main(a.out, a.periods, publish=a.publish)

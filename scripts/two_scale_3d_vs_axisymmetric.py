@@ -25,6 +25,7 @@ Usage::
 """
 from __future__ import annotations
 
+import argparse
 import csv
 import os
 from functools import partial
@@ -156,5 +157,8 @@ def main(out: str, publish: bool = False) -> list[dict]:
 
 
 if __name__ == "__main__":
-    _args = [a for a in sys.argv[1:] if a != "--publish"]
-    main(_args[0] if _args else os.path.join("results", "two_scale_3d"), publish="--publish" in sys.argv[1:])
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", nargs="?", default=os.path.join("results", "two_scale_3d"), help="output directory")
+    ap.add_argument("--publish", action="store_true", help="write the section of docs/benchmarks.md")
+    a = ap.parse_args()
+    main(a.out, publish=a.publish)
