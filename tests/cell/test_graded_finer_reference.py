@@ -10,7 +10,7 @@ contact set's share its estimate would be 0.78 times its error).  The rest are b
 0.05 (its error 2.4e-8 is 440 times below the set's share of the fraction's estimate, which 0.5 needs) and the
 closure at 0.5 (15: the orders' tail of a closure converging faster than geometrically).  At p/p* = 0.8 the
 finer solve's passes may swing between two edge positions 3.3e-7 apart, as far as the answer is from either:
-no verdict there.
+no verdict there (seen at 0.2 too, once in three runs: :data:`SWING`).
 """
 import os
 import sys
@@ -29,6 +29,9 @@ from ngcontact.drivers.build import cell_loads, fe_cell  # noqa: E402
 RATE = ("contact_fraction", "coefficient_k_n", "coefficient_g_n")
 #: per load (its index in the scene) the quantities whose effectivity must lie between 1 and 10
 WITHIN_TEN = {0: RATE + ("mean_closure",), 2: RATE + ("normal_stiffness",)}
+#: the finer solve's passes swung between two edge positions where its fraction moved by more than this (6e-7
+#: where seen, at p/p* = 0.2 and 0.8; at 0.05 and 0.5 its passes agreed to 1e-8 in five runs): no verdict then
+SWING = 1e-7
 
 
 # about 70 s each on one thread: the load to 1e-4, then four solves of 30k dofs at order 7
@@ -51,4 +54,5 @@ def test_the_graded_estimates_bound_their_error_within_ten_times_against_the_fin
             assert value >= error, (name, value, error)
             if name in WITHIN_TEN[k]:
                 assert value <= 10.0 * error, (name, value, error)
-    assert set(WITHIN_TEN[k]) <= judged, (judged, WITHIN_TEN[k])   # the oracle resolves what is held to 10
+    # the oracle resolves what is held to 10, unless its passes swung (the script's judged column says so too)
+    assert set(WITHIN_TEN[k]) <= judged or own["contact_fraction"] > SWING, (judged, WITHIN_TEN[k], own)
