@@ -84,9 +84,9 @@ cell's stiffness of the same layers on 2^16 to 2^18 points (Richardson's limit),
 on the shipped ``westergaard_graded.toml`` at ``1e-4`` (penalty ``k_n = 1e6``) against the same model graded
 three levels and two orders finer (``scripts/graded_effectivity.py``), those of the fraction, ``k_n`` and ``g_n``
 lie between 1 and 10 at ``p/p* = 0.05`` and ``0.5``, the stiffness's at 0.5
-(``tests/cell/test_graded_finer_reference.py``).  At ``p/p* = 0.05`` the stiffness's error is some 440 times
-below the set's share its estimate takes; at 0.5 the share is what bounds it (its orders' tail and own grading
-tail are below its error there).
+(``tests/cell/test_graded_finer_reference.py``).  At light loads the stiffness's error lies far below the set's
+share its estimate takes; at ``p/p* = 0.5`` the share is what bounds it (its orders' tail and own grading tail
+are below its error there).
 """
 from __future__ import annotations
 
