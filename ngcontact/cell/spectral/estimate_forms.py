@@ -50,7 +50,7 @@ from __future__ import annotations
 from typing import Any
 
 from ngcontact.cell.cell_solution import scale
-from ngcontact.cell.spectral.contact_edges import ISLAND, KINK
+from ngcontact.cell.spectral.contact_edges import ISLAND, KINK, PENALTY_ZONE
 
 #: the forms of the estimate, as the report names them (:data:`CARRIED`: after a deferred stop, module
 #: docstring of :mod:`~ngcontact.cell.spectral.refinement`)
@@ -108,7 +108,7 @@ def loose_reason(values: list[float], estimate: float, form: str) -> str:
     contraction before, where the last two disagree, the last slower by :data:`DISAGREE` or more
     (:func:`faster_contraction`; any form)."""
     left, rate = tail_left(values[-3:])
-    if form not in (RICHARDSON, ISLAND) and estimate > LOOSE * left:
+    if form not in (RICHARDSON, ISLAND, PENALTY_ZONE) and estimate > LOOSE * left:
         return (f"{times(estimate, left)} the tail the last difference leaves at its rate {rate:.2g}: "
                 f"{WHY_LOOSE.get(form, WHY_LOOSE[GUARDED])}")
     faster = faster_contraction(values)
