@@ -111,17 +111,22 @@ while the differences between grids vanish (the quartic's window is a fixed shar
 ``lambda``, takes over and converges at first order.  On Westergaard's sinusoid (layers of depth 1) refined to
 1e-3 at ``k_n = 1e4`` the contact fraction of each load is off by 0.71 ``lambda`` per edge on 16,384 points
 (8e-5) while the estimate from the differences was 1.6e-5 to 4.6e-6; at ``k_n = 1e3, 1e5, 1e6`` the outer edge
-is off by 0.49, 1.18 and about 1.3 ``lambda`` (the penalty's own move of the edge, which it misses in part,
+is off by 0.49, 1.15 and 1.46 ``lambda`` (the penalty's own move of the edge, which it misses in part,
 grows like ``lambda ln(1 / lambda)``: :mod:`ngcontact.cell.penalty_share`).  So each edge of a penalty located on
 points beyond ``lambda`` (by the quartic, or by the line on a step above ``lambda``; :func:`penalty_zone_share`)
 holds ``B = PENALTY_LOG lambda ln(P / lambda)`` (``P`` the period), with ``PENALTY_LOG = 1/4``: 1.9 to 3.6
 ``lambda`` from ``k_n = 1e3`` to ``1e6``, two and a half to four times the error above; the contact fraction
 ``B / P`` per edge, ``K0 = k_n |S| / |T|`` ``k_n B / P``, ``g_n`` ``k_n B / P`` times the largest ``g0`` within
 ``B`` and a step of the edge, summed over such edges, the same floor as an island's (form :data:`PENALTY_ZONE`;
-like an island's stalled share it is not flagged by its last difference, which does not show it).  A level whose
-edges are all located by the line within ``lambda`` holds none, and a run of such levels is a locator's own, as
-the quartic's (:func:`fitted_run`): a window across the change from the quartic's levels is also taken on them
-alone (their errors first order with a constant that jumps with the edges' position between points: guarded,
+like an island's stalled share it is not flagged by its last difference, which does not show it).  Within ``lambda``
+the gap opens like ``(x - a)^2`` (the pressure falls to zero linearly), so ``gap^(2/3)`` goes like ``(x - a)^(4/3)``
+and the line through its first two open points, a step apart, is off by up to a third of a step (``1 - 1/(2^(4/3) -
+1)`` where the first lies a step beyond the edge), and by more where the collocated set holds a point too many or
+too few: first order, with a constant that jumps with the edge's position between points, which the differences may
+hide (at ``k_n = 1e4`` refined to 1e-4 the contact fraction's guarded estimate on 524,288 points was half its error,
+0.38 of a step per edge).  Each edge so located holds :data:`INSIDE_STEP` of a step, half, in the same floor (about
+1.3 times that error).  A run of levels whose edges are all located so is a locator's own, as the quartic's
+(:func:`fitted_run`): a window across the change from the quartic's levels is also taken on them alone (guarded,
 never Richardson's), and a stop to a scene's own tolerance waits for three differences on them.
 """
 from __future__ import annotations
@@ -150,6 +155,8 @@ STIFFNESS_STEP = 0.5
 PENALTY_ZONE = "penalty zone"
 #: the kind of a level whose penalty's edges are all located by the line on points within its length
 INSIDE = "inside"
+#: the share of a step that bounds a penalty's edge located by the line within its length (module docstring)
+INSIDE_STEP = 0.5
 #: the bound on such an edge's error over ``lambda ln(P / lambda)``, ``lambda = E* / k_n`` (module docstring)
 PENALTY_LOG = 0.25
 
@@ -338,30 +345,30 @@ def penalty_length(cell) -> float:
 
 
 def penalty_zone_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
-    """The share of each quantity on the edges held by the 2D edges of a penalty's pressure ``p`` that are
-    located on points farther than its length from the edge (:func:`penalty_length`; module docstring): by the
-    quartic, or by the line on a step above ``lambda``.  Each such edge may be off by ``B = PENALTY_LOG lambda
-    ln(P / lambda)``: the contact fraction by ``B / P``, ``K0`` by ``k_n B / P``, ``g_n`` by ``k_n B / P`` times the
-    largest ``g0`` within ``B`` and a step of the edge.  ``{"edges": how many, "bound": B, "share": {headline
-    name: absolute share}}``; no share without such edges."""
+    """The share of each quantity on the edges held by the 2D edges of a penalty's pressure ``p`` (module
+    docstring): an edge located on points farther than its length ``lambda`` (:func:`penalty_length`; by the
+    quartic, or by the line on a step above ``lambda``) may be off by ``B = PENALTY_LOG lambda ln(P / lambda)``,
+    one located by the line within it by :data:`INSIDE_STEP` of a step ``h``: the contact fraction by that over
+    ``P``, ``K0`` ``k_n`` times as much, ``g_n`` that times the largest ``g0`` within it and a step of the edge.
+    ``{"edges": how many beyond, "bound": B, "inside": whether none is, "share": {headline name: absolute
+    share}}``; no share without a penalty's edges."""
     lam, on, n = penalty_length(cell), p > 0, p.size
     if lam <= 0.0 or on.all() or not on.any():
         return {"edges": 0, "bound": 0.0, "share": {}, "inside": False}
     step = cell.period / n
     bound = PENALTY_LOG * lam * max(np.log(cell.period / lam), 1.0)
     root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
-    reach = int(np.ceil(bound / step)) + 1
-    edges, heights = 0, 0.0
+    edges, total, heights = 0, 0.0, 0.0
     for side in (1, -1):
         for i in (int(j) for j in np.flatnonzero(on & ~np.roll(on, -side))):
-            if edge_offset(root, on, i, side)[1] or step > lam:
-                edges += 1
-                heights += float(cell.g0[np.arange(i - reach, i + reach + 1) % n].max())
-    if not edges:
-        return {"edges": 0, "bound": bound, "share": {}, "inside": True}
-    return {"edges": edges, "bound": bound, "inside": False, "share": {
-        "contact_fraction": edges * bound / cell.period, COEFFICIENT + "k_n": cell.k_n * edges * bound / cell.period,
-        COEFFICIENT + "g_n": cell.k_n * heights * bound / cell.period}}
+            beyond = edge_offset(root, on, i, side)[1] or step > lam
+            off = bound if beyond else INSIDE_STEP * step
+            reach = int(np.ceil(off / step)) + 1
+            edges, total = edges + beyond, total + off
+            heights += off * float(cell.g0[np.arange(i - reach, i + reach + 1) % n].max())
+    return {"edges": edges, "bound": bound, "inside": not edges, "share": {
+        "contact_fraction": total / cell.period, COEFFICIENT + "k_n": cell.k_n * total / cell.period,
+        COEFFICIENT + "g_n": cell.k_n * heights / cell.period}}
 
 
 def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict[str, Any]:
@@ -420,7 +427,8 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                 zone = unresolved["penalty"]
                 remarks.append(f"load {k}: {zone['edges']} contact edge(s) of the penalty located on grid "
                                f"{last['grid']} on points beyond its length E*/k_n: {', '.join(raised)} bounded by "
-                               f"{zone['bound']:.3g} per edge ({PENALTY_LOG:g} E*/k_n ln(period k_n / E*))")
+                               f"{zone['bound']:.3g} per edge ({PENALTY_LOG:g} E*/k_n ln(period k_n / E*)), "
+                               f"{INSIDE_STEP:g} of a step per edge located within it")
             elif raised:
                 kinked = unresolved["kinks"]
                 remarks.append(f"load {k}: {kinked['edges']} contact edge(s) within a step of a kink of the map on "
