@@ -127,7 +127,7 @@ hide (at ``k_n = 1e4`` refined to 1e-4 the contact fraction's guarded estimate o
 0.38 of a step per edge).  Each edge so located holds :data:`INSIDE_STEP` of a step, half, in the same floor (about
 1.3 times that error).  A run of levels whose edges are all located so is a locator's own, as the quartic's
 (:func:`fitted_run`): a window across the change from the quartic's levels is also taken on them alone (guarded,
-never Richardson's), and a stop to a scene's own tolerance waits for three differences on them.
+never Richardson's; a stop does not wait for them, :func:`locator_changing`: the whole window's bound stands).
 """
 from __future__ import annotations
 
@@ -205,9 +205,10 @@ def resolved_run(history: list[dict[str, Any]], k: int) -> int:
 def locator_changing(history: list[dict[str, Any]], min_levels: int) -> bool:
     """Whether some load's edges came to be located by the quartic fewer than ``min_levels`` levels ago:
     its fitted levels then show fewer than the two ratios of differences that decide between Richardson and
-    the guarded bound (:mod:`~ngcontact.cell.spectral.refinement`)."""
-    loads = len(history[-1]["headline"])
-    return any(0 < run < min(min_levels, len(history)) for run in (fitted_run(history, k) for k in range(loads)))
+    the guarded bound (:mod:`~ngcontact.cell.spectral.refinement`); not a penalty's line within its length, whose
+    levels take the guarded bound on either window (module docstring)."""
+    loads = [k for k in range(len(history[-1]["headline"])) if locator_kind(history[-1], k) != INSIDE]
+    return any(0 < run < min(min_levels, len(history)) for run in (fitted_run(history, k) for k in loads))
 
 
 def islands(on: np.ndarray) -> list[tuple[int, int]]:
