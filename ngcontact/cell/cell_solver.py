@@ -168,6 +168,12 @@ class CellSolver(Protocol):
         """The same cell on the same discretization with another enforcement or penalty (the penalty's share
         of the answer, :mod:`ngcontact.cell.penalty_share`); ``None`` where the method cannot have it."""
 
+    def share_resolution(self) -> tuple[CellSolver, float] | None:
+        """Where this discretization locates contact edges on points farther than the penalty's length
+        ``E*/k_n``: a twin of the same model on a discretization that resolves the length of a softer penalty,
+        and that penalty (the share of the contact fraction is extrapolated from it,
+        :mod:`ngcontact.cell.penalty_share`); else ``None``."""
+
     def response(self, pressure: float, length_unit: float = 1.0) -> Response:
         """The :data:`Response` at a mean pressure, solved from a first load's start; lengths scaled by
         ``length_unit``."""

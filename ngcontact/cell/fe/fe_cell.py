@@ -181,6 +181,10 @@ class FECell:
         changes = {k: v for k, v in (("enforcement", enforcement), ("k_n", k_n)) if v is not None}
         return self.variant(**changes) if self.variant is not None else None
 
+    def share_resolution(self) -> None:
+        """None: the share is measured on the spectral twin, which resolves it there (:meth:`share_solver`)."""
+        return None
+
     def refiner(self) -> Refiner | None:
         """The discretizations that refine this cell where it cannot be graded
         (:mod:`~ngcontact.cell.fe.second_discretization`), ``None`` where the cell has no variants."""

@@ -99,6 +99,35 @@ the same edges' error: each edge's share is its steps above (a step at a kink, a
 floor under its estimate.  (With a penalty the stiffness is the collocated set's, whose error on the same
 profiles was 0.1 of its change with every edge a step out in the median, 0.53 at most: :data:`STIFFNESS_STEP`
 of each edge's change.)
+
+**A penalty's edges.**  With the Winkler layer of eq. 65 (``contact.enforcement = "penalty"``) the gap beyond an
+edge opens like ``(x - a)^(3/2)`` only farther than the length ``lambda = E*/k_n`` from it (:func:`penalty_length`,
+``1/E* = sum (1 - nu^2)/E`` over the two bodies): nearer, the layer carries the pressure, which falls to zero
+smoothly, and the gap opens faster.  The quartic's window (tens to hundreds of steps) and, on a step above
+``lambda``, the line's two points read the gap there, where it looks like that of a rigid edge placed off the
+penalty's own: the located edge converges, as the grid is refined, to that outer edge, and its error stalls
+while the differences between grids vanish (the quartic's window is a fixed share of the open run up to about
+7,500 points per period), then grows as the window shrinks into ``lambda``, before the line, on steps below
+``lambda``, takes over and converges at first order.  On Westergaard's sinusoid (layers of depth 1) refined to
+1e-3 at ``k_n = 1e4`` the contact fraction of each load is off by 0.71 ``lambda`` per edge on 16,384 points
+(8e-5) while the estimate from the differences was 1.6e-5 to 4.6e-6; at ``k_n = 1e3, 1e5, 1e6`` the outer edge
+is off by 0.49, 1.15 and 1.46 ``lambda`` (the penalty's own move of the edge, which it misses in part,
+grows like ``lambda ln(1 / lambda)``: :mod:`ngcontact.cell.penalty_share`).  So each edge of a penalty located on
+points beyond ``lambda`` (by the quartic, or by the line on a step above ``lambda``; :func:`penalty_zone_share`)
+holds ``B = PENALTY_LOG lambda ln(P / lambda)`` (``P`` the period), with ``PENALTY_LOG = 1/4``: 1.9 to 3.6
+``lambda`` from ``k_n = 1e3`` to ``1e6``, two and a half to four times the error above; the contact fraction
+``B / P`` per edge, ``K0 = k_n |S| / |T|`` ``k_n B / P``, ``g_n`` ``k_n B / P`` times the largest ``g0`` within
+``B`` and a step of the edge, summed over such edges, the same floor as an island's (form :data:`PENALTY_ZONE`;
+like an island's stalled share it is not flagged by its last difference, which does not show it).  Within ``lambda``
+the gap opens like ``(x - a)^2`` (the pressure falls to zero linearly), so ``gap^(2/3)`` goes like ``(x - a)^(4/3)``
+and the line through its first two open points, a step apart, is off by up to a third of a step (``1 - 1/(2^(4/3) -
+1)`` where the first lies a step beyond the edge), and by more where the collocated set holds a point too many or
+too few: first order, with a constant that jumps with the edge's position between points, which the differences may
+hide (at ``k_n = 1e4`` refined to 1e-4 the contact fraction's guarded estimate on 524,288 points was half its error,
+0.38 of a step per edge).  Each edge so located holds :data:`INSIDE_STEP` of a step, half, in the same floor (about
+1.3 times that error).  A run of levels whose edges are all located so is a locator's own, as the quartic's
+(:func:`fitted_run`): a window across the change from the quartic's levels is also taken on them alone (guarded,
+never Richardson's; a stop does not wait for them, :func:`locator_changing`: the whole window's bound stands).
 """
 from __future__ import annotations
 
@@ -122,6 +151,14 @@ KINK_RATIO = 4.0
 LOCATED_STEP = 0.25
 #: with a penalty, the share of the stiffness's change with each edge a step out that bounds its error (same)
 STIFFNESS_STEP = 0.5
+#: the form of an estimate raised to the floor of a penalty's edges read beyond its length (module docstring)
+PENALTY_ZONE = "penalty zone"
+#: the kind of a level whose penalty's edges are all located by the line on points within its length
+INSIDE = "inside"
+#: the share of a step that bounds a penalty's edge located by the line within its length (module docstring)
+INSIDE_STEP = 0.5
+#: the bound on such an edge's error over ``lambda ln(P / lambda)``, ``lambda = E* / k_n`` (module docstring)
+PENALTY_LOG = 0.25
 
 
 def on_edges(name: str) -> bool:
@@ -132,13 +169,25 @@ def on_edges(name: str) -> bool:
 
 def fitted_run(history: list[dict[str, Any]], k: int) -> int:
     """The levels at the end of ``history`` on which every edge of load ``k`` is located by the quartic
-    (:func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`; 0 where the last level's are not)."""
+    (:func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`), or, with a penalty, by the line on points
+    within its length (:func:`penalty_zone_share`: ``inside``; module docstring); the last level's kind
+    only, 0 where it is neither."""
+    kinds = [locator_kind(entry, k) for entry in history]
     run = 0
-    for entry in reversed(history):
-        if not entry.get("edges_fitted", [False] * (k + 1))[k]:
+    for kind in reversed(kinds):
+        if kind is None or kind != kinds[-1]:
             break
         run += 1
     return run
+
+
+def locator_kind(entry: dict[str, Any], k: int) -> str | None:
+    """How a level located the edges of load ``k``: ``"quartic"``, ``"inside"`` (a penalty's edges, all by the
+    line on points within its length) or ``None`` (the line elsewhere)."""
+    if entry.get("edges_fitted", [False] * (k + 1))[k]:
+        return "quartic"
+    zone = entry.get("islands", [{}] * (k + 1))[k].get("penalty", {})
+    return INSIDE if zone.get("inside") else None
 
 
 def resolved_run(history: list[dict[str, Any]], k: int) -> int:
@@ -156,9 +205,10 @@ def resolved_run(history: list[dict[str, Any]], k: int) -> int:
 def locator_changing(history: list[dict[str, Any]], min_levels: int) -> bool:
     """Whether some load's edges came to be located by the quartic fewer than ``min_levels`` levels ago:
     its fitted levels then show fewer than the two ratios of differences that decide between Richardson and
-    the guarded bound (:mod:`~ngcontact.cell.spectral.refinement`)."""
-    loads = len(history[-1]["headline"])
-    return any(0 < run < min(min_levels, len(history)) for run in (fitted_run(history, k) for k in range(loads)))
+    the guarded bound (:mod:`~ngcontact.cell.spectral.refinement`); not a penalty's line within its length, whose
+    levels take the guarded bound on either window (module docstring)."""
+    loads = [k for k in range(len(history[-1]["headline"])) if locator_kind(history[-1], k) != INSIDE]
+    return any(0 < run < min(min_levels, len(history)) for run in (fitted_run(history, k) for k in loads))
 
 
 def islands(on: np.ndarray) -> list[tuple[int, int]]:
@@ -286,6 +336,42 @@ def stiffness_share(cell, p: np.ndarray, gap: np.ndarray) -> float:
                if key in shares)
 
 
+def penalty_length(cell) -> float:
+    """The length ``lambda = E* / k_n`` over which a 2D penalty's edge departs from a rigid one (module docstring):
+    ``E*`` the plane-strain modulus of the two bodies in series, ``1 / E* = sum (1 - nu^2) / E``; 0 for exact
+    contact and in 3D."""
+    if cell.dim != 2 or cell.enforcement != "penalty":
+        return 0.0
+    return 1.0 / (cell.k_n * sum((1.0 - layer.nu ** 2) / layer.E for layer in (cell.rough, cell.counter)))
+
+
+def penalty_zone_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
+    """The share of each quantity on the edges held by the 2D edges of a penalty's pressure ``p`` (module
+    docstring): an edge located on points farther than its length ``lambda`` (:func:`penalty_length`; by the
+    quartic, or by the line on a step above ``lambda``) may be off by ``B = PENALTY_LOG lambda ln(P / lambda)``,
+    one located by the line within it by :data:`INSIDE_STEP` of a step ``h``: the contact fraction by that over
+    ``P``, ``K0`` ``k_n`` times as much, ``g_n`` that times the largest ``g0`` within it and a step of the edge.
+    ``{"edges": how many beyond, "bound": B, "inside": whether none is, "share": {headline name: absolute
+    share}}``; no share without a penalty's edges."""
+    lam, on, n = penalty_length(cell), p > 0, p.size
+    if lam <= 0.0 or on.all() or not on.any():
+        return {"edges": 0, "bound": 0.0, "share": {}, "inside": False}
+    step = cell.period / n
+    bound = PENALTY_LOG * lam * max(np.log(cell.period / lam), 1.0)
+    root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
+    edges, total, heights = 0, 0.0, 0.0
+    for side in (1, -1):
+        for i in (int(j) for j in np.flatnonzero(on & ~np.roll(on, -side))):
+            beyond = edge_offset(root, on, i, side)[1] or step > lam
+            off = bound if beyond else INSIDE_STEP * step
+            reach = int(np.ceil(off / step)) + 1
+            edges, total = edges + beyond, total + off
+            heights += off * float(cell.g0[np.arange(i - reach, i + reach + 1) % n].max())
+    return {"edges": edges, "bound": bound, "inside": not edges, "share": {
+        "contact_fraction": total / cell.period, COEFFICIENT + "k_n": cell.k_n * total / cell.period,
+        COEFFICIENT + "g_n": cell.k_n * heights / cell.period}}
+
+
 def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict[str, Any]:
     """The share of each quantity on the edges held by the islands of fewer than :data:`ISLAND_POINTS`
     points of a pressure ``p`` (in 3D: points across, :func:`narrow_islands`; module docstring):
@@ -307,6 +393,7 @@ def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict
     out: dict[str, Any] = {"points": points, "islands": count, "share": {},
                            "kinks": kink_share(cell, p, gap) if gap is not None else {"edges": 0, "notches": 0,
                                                                                       "share": {}}}
+    out["penalty"] = penalty_zone_share(cell, p, gap) if gap is not None else {"edges": 0, "share": {}, "inside": False}
     if out["kinks"]["share"] and gap is not None:
         out["kinks"]["share"]["normal_stiffness"] = stiffness_share(cell, p, gap)
     if count:
@@ -324,7 +411,8 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
     last = history[-1]
     remarks = []
     for k, (per_load, unresolved) in enumerate(zip(estimates, last.get("islands", []))):
-        for form, shares in ((ISLAND, unresolved["share"]), (KINK, unresolved.get("kinks", {}).get("share", {}))):
+        for form, shares in ((ISLAND, unresolved["share"]), (KINK, unresolved.get("kinks", {}).get("share", {})),
+                             (PENALTY_ZONE, unresolved.get("penalty", {}).get("share", {}))):
             raised = []
             for name, share in shares.items():
                 if name in per_load and (floor := share / scale(name, last["headline"][k], last["whole_surface"])
@@ -336,6 +424,12 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                                f"points (in 3D across; the smallest island {unresolved['points']} point(s)) on grid "
                                f"{last['grid']}: {', '.join(raised)} bounded by their share, one step beyond each "
                                "edge")
+            elif raised and form == PENALTY_ZONE:
+                zone = unresolved["penalty"]
+                remarks.append(f"load {k}: {zone['edges']} contact edge(s) of the penalty located on grid "
+                               f"{last['grid']} on points beyond its length E*/k_n: {', '.join(raised)} bounded by "
+                               f"{zone['bound']:.3g} per edge ({PENALTY_LOG:g} E*/k_n ln(period k_n / E*)), "
+                               f"{INSIDE_STEP:g} of a step per edge located within it")
             elif raised:
                 kinked = unresolved["kinks"]
                 remarks.append(f"load {k}: {kinked['edges']} contact edge(s) within a step of a kink of the map on "

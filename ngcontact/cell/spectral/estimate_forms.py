@@ -1,12 +1,13 @@
 """The forms of the spectral refinement's estimate, and the estimates that may be loose by much.
 
 :mod:`~ngcontact.cell.spectral.refinement` estimates the error of each headline quantity of a load on the
-reported grid ``k`` in one of five forms, which the report names: Richardson's tail with the observed rate
+reported grid ``k`` in one of six forms, which the report names: Richardson's tail with the observed rate
 (:data:`RICHARDSON`), the guarded geometric tail (:data:`GUARDED`), the estimate of a deferred grid plus the
 last difference (:data:`CARRIED`), the share of contact islands too narrow for the grid
-(:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), or a step at each 2D edge within a step of a kink of
-a map's piecewise-linear surface (:data:`~ngcontact.cell.spectral.contact_edges.KINK`). Each is a bound on its
-own argument; none is sharp where the error of grid ``k`` is far below the differences that bound it.
+(:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), a step at each 2D edge within a step of a kink of
+a map's piecewise-linear surface (:data:`~ngcontact.cell.spectral.contact_edges.KINK`), or a share of a penalty's
+length at each 2D edge located beyond it (:data:`~ngcontact.cell.spectral.contact_edges.PENALTY_ZONE`). Each is a
+bound on its own argument; none is sharp where the error of grid ``k`` is far below the differences that bound it.
 
 The last two differences ``d_(k-1)``, ``d_k`` (``d_k = q_k - q_(k-1)``) say how large that error is in the
 model every form rests on: where the levels beyond ``k`` contract as the last one did, by ``rho = |d_k| /
@@ -25,7 +26,8 @@ first-order one (on Westergaard's sinusoid at a twentieth of its closing pressur
 about 16 per doubling twice, then by 2), and an earlier difference bounds the error where the last one
 vanished by coincidence (a stall, a symmetric cell). Richardson's form states its rate and holds it to first
 order on purpose (the same sinusoid) and is not flagged by that tail. Nor is an unresolved island's share
-(:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`): such an island's error stalls while the differences
+(:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), nor a penalty's zone (its located edges' error stalls
+alike): such an island's error stalls while the differences
 vanish (:mod:`~ngcontact.cell.spectral.contact_edges`), so the last difference measures neither its size nor
 how far it lies below the share. The share exceeds that error by more than :data:`LOOSE` times only where the
 island's located width happens to be right to a tenth of its points and one step beyond each edge, which, like
@@ -50,7 +52,7 @@ from __future__ import annotations
 from typing import Any
 
 from ngcontact.cell.cell_solution import scale
-from ngcontact.cell.spectral.contact_edges import ISLAND, KINK
+from ngcontact.cell.spectral.contact_edges import ISLAND, KINK, PENALTY_ZONE
 
 #: the forms of the estimate, as the report names them (:data:`CARRIED`: after a deferred stop, module
 #: docstring of :mod:`~ngcontact.cell.spectral.refinement`)
@@ -108,7 +110,7 @@ def loose_reason(values: list[float], estimate: float, form: str) -> str:
     contraction before, where the last two disagree, the last slower by :data:`DISAGREE` or more
     (:func:`faster_contraction`; any form)."""
     left, rate = tail_left(values[-3:])
-    if form not in (RICHARDSON, ISLAND) and estimate > LOOSE * left:
+    if form not in (RICHARDSON, ISLAND, PENALTY_ZONE) and estimate > LOOSE * left:
         return (f"{times(estimate, left)} the tail the last difference leaves at its rate {rate:.2g}: "
                 f"{WHY_LOOSE.get(form, WHY_LOOSE[GUARDED])}")
     faster = faster_contraction(values)

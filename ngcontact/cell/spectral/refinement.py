@@ -115,12 +115,13 @@ ends its run (:meth:`~ngcontact.cell.spectral.spectral_solver.SpectralCellSolver
 bound (points squared) allows a few doublings only, it is reported with its estimate and not held
 (:func:`uncontrolled`: listed in the verdict as not counted).
 
-Two checks end each level's estimate. A contact island of fewer than
-:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: its error may
-stall while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
-(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``; a 2D edge of a map with kinks, a step
-within a step of one, else a quarter: ``kink``); a window across the level where the last island came to be resolved
-is also taken on the resolved levels alone, the smaller reported (the same module's docstring). An estimate (not
+Two checks end a level's estimate. An island of fewer than :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS`
+points (3D: across) has no resolved edges: its error may stall while the differences vanish, so its share of the
+quantities on the edges is a floor under their estimates (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`,
+form ``island``; a 2D edge of a map with kinks, a step within a step of one, else a quarter: ``kink``; a penalty's 2D
+edge located on points beyond its length ``E*/k_n``: ``penalty zone``, whose error no difference shows either); a window
+across the level where the last island came to be resolved is also taken on the resolved levels alone, the smaller
+reported (the same module's docstring). An estimate (not
 Richardson's nor an island's) above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last
 difference leaves at the last contraction, or (any form) at the one before where the last is twice as slow or more,
 may exceed the error by as much: flagged with its reason, per quantity in the report
@@ -157,15 +158,14 @@ from typing import Any, Callable
 import numpy as np
 
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
-from ngcontact.cell.spectral.contact_edges import (ISLAND_POINTS, LOCATED_STEP, fitted_run, island_floor, on_edges,
-                                                   resolved_run, unresolved_share, locator_changing as edges_changing)
+from ngcontact.cell.spectral.contact_edges import (INSIDE, ISLAND_POINTS, LOCATED_STEP, PENALTY_LOG, fitted_run,
+                                                   island_floor, locator_kind, on_edges, resolved_run, unresolved_share,
+                                                   locator_changing as edges_changing)
 from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP, RATE_FLOOR,
-                                                    SPREAD, WINDOW, loose_flags, loose_remarks,
-                                                    tail_estimate)
+                                                    SPREAD, WINDOW, loose_flags, loose_remarks, tail_estimate)
 from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
 from ngcontact.errors import ConvergenceError
 
-log = logging.getLogger(__name__)
 #: the run's progress lines (printed as its stage lines, :func:`ngcontact.runner.solve`)
 progress = logging.getLogger("ngcontact.progress")
 
@@ -202,7 +202,8 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"would meet it (else not met), times {ERRATIC[STIFFNESS][3]:g} in 3D, reported, not held; at least "
        f"the share of contact islands of fewer than {ISLAND_POINTS} points (3D: across), and after such islands "
        f"also on the resolved levels (at least {LOCATOR_LEVELS}), the smaller; a step per 2D edge within a step of a "
-       f"kink of the map's piecewise-linear surface, {LOCATED_STEP:g} of one per other edge of such a map; above "
+       f"kink of the map's piecewise-linear surface, {LOCATED_STEP:g} of one per other edge of such a map, "
+       f"{PENALTY_LOG:g} E*/k_n ln(period k_n / E*) per edge of a penalty located on points beyond E*/k_n; above "
        f"{LOOSE:g} times the error its last difference leaves at the last rate, or the one before where the last is "
        "twice as slow or more: flagged (quantities[].loose)")
 
@@ -222,7 +223,6 @@ class RefinedSweep:
     forms: list[dict[str, str]] = field(default_factory=list)
     #: per load, the estimates that may exceed the error by more than :data:`LOOSE` times, with the reason
     flags: list[dict[str, str]] = field(default_factory=list)
-
     #: the quantities the sweep does not hold to the tolerance (:func:`uncontrolled`)
     uncontrolled: tuple[str, ...] = ()
     #: where refinement stopped at the 2D stiffness's cap (:func:`stiffness_capped`): on which grid and why, else ""
@@ -290,10 +290,11 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
             if None in values or not any(values):
                 continue
             size = scale(name, last, history[-1]["whole_surface"])
-            # a coefficient's edges are the fraction's: not geometric where the fraction's sequence is not
-            geometric = geometric_ok and not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED)
-            args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
             located = on_edges(name) or (name == STIFFNESS and dim == 2)       # 2D: the located set's stiffness
+            # not geometric: a coefficient where the fraction is not (its edges), a penalty's line within E*/k_n
+            geometric = geometric_ok and not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED
+                                              or located and locator_kind(history[-1], k) == INSIDE)
+            args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
             fitted = fitted_run(history, k) if located else len(history)
             run = min(fitted, resolved_run(history, k))        # levels of the quartic and of resolved islands
             out[name], form[name], note = tail_estimate(values, *args[:3], geometric and fitted == len(history))

@@ -24,6 +24,7 @@ from ngcontact.cell.cell_solution import CellSolution, worst_estimate
 from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.spectral import grid_measures
 from ngcontact.cell.spectral.coarser_grids import HOW as COARSER_HOW, estimate_from_coarser, why_not
+from ngcontact.cell.spectral.contact_edges import penalty_length
 from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
 from ngcontact.cell.spectral.refinement import HOW, sweep_to_tolerance, uncontrolled
 from ngcontact.cell.whole_surface import flat
@@ -31,6 +32,9 @@ from ngcontact.errors import ConvergenceError
 
 #: the grid fields a solution hands on (the closure is in its surface distribution)
 FIELDS = ("pressure", "gap", "shear", "slip")
+#: a 2D penalty's share of the contact fraction is measured where its length E*/k_n spans this many grid steps, on
+#: at least this many points (:meth:`SpectralCellSolver.share_resolution`)
+SHARE_STEPS, SHARE_GRID = 32, 32768
 
 
 class SpectralCellSolver:
@@ -195,6 +199,19 @@ class SpectralCellSolver:
         """The same cell on the grid of the last solve with another enforcement or penalty."""
         changes = {k: v for k, v in (("enforcement", enforcement), ("k_n", k_n)) if v is not None}
         return self.variant(grid=self.cell.grid, **changes) if self.variant is not None else None
+
+    def share_resolution(self) -> tuple[SpectralCellSolver, float] | None:
+        """A 2D penalty whose length ``lambda = E*/k_n`` spans fewer than :data:`SHARE_STEPS` steps of the grid:
+        the cell on :data:`SHARE_GRID` points at least and the softer penalty ``k_1`` whose length spans that
+        many of its steps (at most ``k_n``); ``None`` otherwise (module docstring of
+        :mod:`ngcontact.cell.penalty_share`)."""
+        lam = penalty_length(self.cell)
+        if lam <= 0.0 or lam >= SHARE_STEPS * self.cell.period / self.cell.grid or self.variant is None:
+            return None
+        grid = max(self.cell.grid, SHARE_GRID)
+        twin = self.variant(grid=grid)
+        k1 = min(self.cell.k_n, self.cell.k_n * lam * grid / (SHARE_STEPS * self.cell.period))
+        return (twin, k1) if twin is not None else None
 
     def response(self, pressure: float, length_unit: float = 1.0) -> Response:
         """The response at ``pressure`` (module docstring), from zero pressure."""
