@@ -33,6 +33,35 @@ how far it lies below the share. The share exceeds that error by more than :data
 island's located width happens to be right to a tenth of its points and one step beyond each edge, which, like
 an error small by chance, no difference shows; the report names the island and its share instead.
 
+**A change of regime within the window.**  The guarded envelope ``D = max_i |d_(k-i)| / 2^i`` carries each
+earlier difference to level ``k`` at first order.  Where the last contraction ``c = |d_k| / |d_(k-1)|`` is at
+least :data:`DISAGREE` times faster than the one before, ``c' = |d_(k-1)| / |d_(k-2)|`` (:func:`regime_changed`),
+the sequence has left the regime of ``d_(k-2)``: either a faster one set in at level ``k - 1`` (the 2D edges'
+quartic, an island resolved, the end of a pre-asymptotic stretch), and ``d_(k-2)`` is a difference of the
+earlier regime, which the first-order envelope carries to level ``k`` above the error by the ratio of the two
+regimes' contractions; or the last difference vanished by coincidence, and the error of level ``k`` is about
+that of level ``k - 1``.  In both the bound needs only the levels since the change, ``k - 2`` to ``k``
+(:func:`guarded_bound`):
+
+    ``E = D rho / (1 - rho)``,  ``D = max(|d_k|, |d_(k-1)| min(SAFETY c', ENVELOPE))``,  ``rho = max(c, c')``
+    held to ``[RATE_FLOOR, RATE_CAP]``.
+
+``|d_(k-1)| c'`` is the last difference the regime before predicts; where the last one vanished, the error
+of level ``k - 1`` it leaves is the tail ``|d_(k-1)| c' / (1 - c')``, at most ``SAFETY |d_(k-1)| c'`` for ``c'
+<= 1/2`` (:data:`SAFETY` = 2: the stated safety factor), and never more than the first-order envelope's own
+term ``|d_(k-1)| / 2``.  The tail beyond ``k`` still falls at the slower of the two contractions, as every
+guarded rate does ("where two successive differences disagree in rate, the estimate says so and takes the
+larger", issue 35): a tail at the faster one stopped a penalty cell's refinement a grid early, where its
+quartic-located edges carry an error no difference shows.  So the estimate never exceeds the whole window's
+envelope: it drops ``d_(k-2)``, and shrinks ``d_(k-1)`` faster than first order where the regime before
+contracted by less than ``ENVELOPE / SAFETY``.  Its premise, that a vanished last difference leaves at most
+what the regime before predicts, is what the oracles test (``docs/benchmarks.md``, the spectral
+effectivity).  A zero difference is
+a coincidence of equal values (a symmetric cell), not a contraction: the whole window's envelope bounds it.
+The estimate from the scene's own grid and coarser ones (:mod:`~ngcontact.cell.spectral.coarser_grids`),
+where a fast contraction of coarse grids may be a coincidence of roughness appearing level by level, keeps
+the whole window's envelope.
+
 Where the last two contractions disagree, the last at least :data:`DISAGREE` times slower than the one
 before (``|d_k| / |d_(k-1)| >= 2 |d_(k-1)| / |d_(k-2)|``: their observed orders in the grid step differ by
 one or more), every form takes the slower ("where two successive differences disagree in rate, the estimate
@@ -74,6 +103,9 @@ RATE_FLOOR = 0.5
 RATE_CAP = 0.7
 #: an earlier difference shrinks by this per level in the guarded envelope (first order in the grid step)
 ENVELOPE = 0.5
+#: where the last contraction is :data:`DISAGREE` times faster than the one before, the difference before the last
+#: shrinks by this many times the contraction before it, at most :data:`ENVELOPE` (module docstring)
+SAFETY = 2.0
 #: a last difference this many times below the envelope is said to have vanished (a remark only)
 VANISHED = 4.0
 #: two successive ratios within this factor of each other make the sequence geometric (Richardson)
@@ -177,12 +209,21 @@ def richardson(d: list[float], order_rate: float) -> tuple[float, float] | None:
     return SPREAD * d[0] * rate / (1.0 - rate), rate
 
 
-def guarded_bound(d: list[float]) -> tuple[float, str]:
-    """The guarded geometric tail from the differences ``d`` (newest first; module docstring) and a remark
-    where a guard acted ("" otherwise)."""
+def guarded_bound(d: list[float], regime: bool = True) -> tuple[float, str]:
+    """The guarded geometric tail ``E = D rho / (1 - rho)`` from the differences ``d`` (newest first; module
+    docstring of :mod:`~ngcontact.cell.spectral.refinement`) and a remark where a guard acted ("" otherwise):
+    ``rho`` the larger ratio held to ``[RATE_FLOOR, RATE_CAP]``, ``D = max_i |d_(k-i)| ENVELOPE^i``, or where the
+    last contraction ``c = |d_k| / |d_(k-1)|`` is at least :data:`DISAGREE` times faster than the one before,
+    ``c' = |d_(k-1)| / |d_(k-2)|`` (:func:`regime_changed`; ``regime``), ``D`` on the levels since,
+    ``max(|d_k|, |d_(k-1)| min(SAFETY c', ENVELOPE))`` (module docstring)."""
     ratios = [d[i] / d[i + 1] for i in range(len(d) - 1) if d[i + 1] > 0]
     observed = max(ratios) if ratios else RATE_CAP
     rate = min(max(observed, RATE_FLOOR), RATE_CAP)
+    if regime and regime_changed(d):
+        shrink = min(SAFETY * d[1] / d[2], ENVELOPE)
+        return max(d[0], d[1] * shrink) * rate / (1.0 - rate), (
+            f"the last contraction {d[0] / d[1]:.2g} at least {DISAGREE:g} times faster than the one before, "
+            f"{d[1] / d[2]:.2g}: the levels since, the difference before the last shrunk by {shrink:.2g}")
     terms = [d[i] * ENVELOPE ** i for i in range(len(d))]
     envelope = max(terms)
     remark = []
@@ -193,15 +234,24 @@ def guarded_bound(d: list[float]) -> tuple[float, str]:
     return envelope * rate / (1.0 - rate), "; ".join(remark)
 
 
+def regime_changed(d: list[float]) -> bool:
+    """Whether the last of the differences ``d`` (newest first, three at least) contracted at least
+    :data:`DISAGREE` times faster than the one before, ``|d_k| / |d_(k-1)| <= |d_(k-1)| / |d_(k-2)| / DISAGREE``,
+    each difference measured (a zero one is a coincidence of equal values; module docstring)."""
+    return len(d) >= WINDOW and min(d[:WINDOW]) > 0 and DISAGREE * d[0] * d[2] <= d[1] * d[1]
+
+
 def tail_estimate(values: list[float], relative: bool, order_rate: float = RATE_FLOOR,
-                  scale: float | None = None, geometric: bool = True) -> tuple[float, str, str]:
+                  scale: float | None = None, geometric: bool = True, regime: bool = True
+                  ) -> tuple[float, str, str]:
     """The estimated error of the last of ``values`` (a quantity on successive levels; module docstring), its
     form (:data:`RICHARDSON` where that is the smaller, else :data:`GUARDED`) and a remark on it.  Needs two
     values at least; ``order_rate`` is the quantity's :data:`ORDER_RATE`; ``scale``: the size the error is
-    divided by (default: 1, or the last value where ``relative``); not ``geometric``: the guarded bound only."""
+    divided by (default: 1, or the last value where ``relative``); not ``geometric``: the guarded bound only; not
+    ``regime``: its envelope over the whole window, a change of regime not looked for (:func:`guarded_bound`)."""
     d = differences(values, relative, scale)
     fitted = richardson(d, order_rate) if geometric else None
-    estimate, remark = guarded_bound(d)
+    estimate, remark = guarded_bound(d, regime)
     if fitted is None or fitted[0] >= estimate:
         return estimate, GUARDED, remark
     return fitted[0], RICHARDSON, f"rate {fitted[1]:.2g}"

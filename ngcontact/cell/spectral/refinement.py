@@ -43,8 +43,8 @@ the report names (:func:`sweep_estimates`):
    size of the next differences is the envelope ``D = max_i |d_(k-i)| ENVELOPE^i`` with ``ENVELOPE =
    1/2``: the last difference, or an earlier one shrunk at first order, whichever is larger, so that a
    last difference that vanished by coincidence (a symmetric cell gives the same fraction on two grids; a
-   count of points whose constant jumps with the edges) is bounded by the ones before it.  The estimate
-   is the geometric tail ``D rho / (1 - rho)``.
+   count of points whose constant jumps with the edges) is bounded by the ones before it; the tail ``D rho /
+   (1 - rho)``, on the levels since where the last ratio is twice as fast (:mod:`.estimate_forms`).
 
 In 2D the contact fraction and the coefficients of eq. 34 rest on edges located between points by one of
 two locators (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`): the quartic fitted to the open
@@ -63,8 +63,7 @@ exceeds it by that drop.  So, for these quantities of a load whose edges have be
 * with ``r >= LOCATOR_LEVELS`` (two differences at least, so that one that vanished is seen beside the
   other) the estimate is also taken on those ``r`` levels alone, by the same rule (Richardson needs three
   differences, so two give the guarded bound), and the smaller of the two is reported: each is a bound on
-  its own argument, the whole window's by the line's larger error, the fitted levels' by their own
-  contraction;
+  its own argument, the whole window's by the line's larger error, the fitted levels' by their own contraction;
 * with ``0 < r < MIN_LEVELS`` the fitted levels are too few to see their rate: with ``r < LOCATOR_LEVELS``
   the window compares the two locators, a bound by the line's error; with ``r = LOCATOR_LEVELS`` the two
   fitted differences give the guarded bound, whose envelope ``|d_(k-1)| ENVELOPE`` is still of the size
@@ -161,8 +160,9 @@ from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measur
 from ngcontact.cell.spectral.contact_edges import (INSIDE, ISLAND_POINTS, LOCATED_STEP, PENALTY_LOG, fitted_run,
                                                    island_floor, locator_kind, on_edges, resolved_run, unresolved_share,
                                                    locator_changing as edges_changing)
-from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP, RATE_FLOOR,
-                                                    SPREAD, WINDOW, loose_flags, loose_remarks, tail_estimate)
+from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, DISAGREE, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP,
+                                                    RATE_FLOOR, SAFETY, SPREAD, WINDOW, loose_flags, loose_remarks,
+                                                    tail_estimate)
 from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
 from ngcontact.errors import ConvergenceError
 
@@ -193,8 +193,9 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"of the last {WINDOW} differences where their two ratios agree within a factor {AGREE:g} (rate at least "
        f"{FIRST_ORDER}, the tail times {SPREAD:g}) if that is the smaller, else the guarded geometric tail: "
        f"rate the larger ratio held to [{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished "
-       "last one; the contact fraction, coefficients and 2D stiffness (of the located set) guarded on levels of "
-       "edges not all fitted by the quartic, "
+       f"last one (after a last ratio {DISAGREE:g} times below the one before, the last three levels: the difference "
+       f"before shrunk by {SAFETY:g} times that ratio, at most 1/2, the rate alike); the contact fraction, "
+       "coefficients and 2D stiffness (of the located set) guarded on levels of edges not all fitted by the quartic, "
        f"and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
        "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
        f"stiffness's estimate times {ERRATIC[STIFFNESS][2]:g} in 2D, held to the tolerance up to {STIFFNESS_LEVELS} "
@@ -294,12 +295,13 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
             # not geometric: a coefficient where the fraction is not (its edges), a penalty's line within E*/k_n
             geometric = geometric_ok and not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED
                                               or located and locator_kind(history[-1], k) == INSIDE)
-            args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size, geometric)
+            args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size)
             fitted = fitted_run(history, k) if located else len(history)
             run = min(fitted, resolved_run(history, k))        # levels of the quartic and of resolved islands
-            out[name], form[name], note = tail_estimate(values, *args[:3], geometric and fitted == len(history))
+            out[name], form[name], note = tail_estimate(values, *args, geometric and fitted == len(history),
+                                                         geometric_ok)
             if LOCATOR_LEVELS <= run < len(history):
-                sharp = tail_estimate(values[-run:], *args)
+                sharp = tail_estimate(values[-run:], *args, geometric, geometric_ok)
                 if sharp[0] < out[name]:
                     out[name], form[name], note = sharp[0], sharp[1], "; ".join(filter(None, (sharp[2], (
                         "the edge fit's own levels" if run == fitted else "the levels of resolved islands"))))
