@@ -35,7 +35,11 @@ machine is shared: a single repeat's ratio carries the other jobs' noise).  The 
 (the speed issue): no executor slower than serial on any shipped batch,
 two local workers at least 1.6x serial on the 256^2 ensemble, Dask within
 1.2x of the local pool.  The records live in a temporary cache directory
-(``NGCONTACT_CACHE``), an empty one for each ``local 2 first`` run.
+(``NGCONTACT_CACHE``), an empty one for each ``local 2 first`` run.  Each
+run's batch decision (where it went, and the payoff rule's inputs: ``c``,
+``R``, ``F``, ``S``, the free cores and how they were read) goes to
+``decisions.txt`` beside the CSV; ``--repeats`` and ``--only`` make a
+shorter run (never published).
 
     MPLBACKEND=Agg python scripts/ensemble_executors.py results/ensemble_executors --publish
 """
@@ -57,6 +61,7 @@ ROOT = benchmark_doc.ROOT
 SHIPPED = os.path.join(ROOT, "geometries", "cells", "self_affine_ensemble.toml")
 MEASURED = os.path.join(ROOT, "geometries", "cells", "measured_scan_ensemble.toml")
 REPEATS = 5
+ENSEMBLES = ("shipped 64^2 x 32", "256^2 x 16", "measured scan")
 
 
 def large(tmp: str) -> str:
@@ -96,22 +101,31 @@ def fractions(report: dict) -> np.ndarray:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("out", nargs="?", default=os.path.join("results", "ensemble_executors"))
+    parser.add_argument("--repeats", type=int, default=REPEATS, help=f"repeats per ensemble (default {REPEATS})")
+    parser.add_argument("--only", choices=ENSEMBLES, action="append",
+                        help="only this ensemble (repeatable; default: all three)")
     benchmark_doc.add_flag(parser)
     args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error(f"--repeats = {args.repeats}: must be >= 1")
+    if args.publish and (args.repeats != REPEATS or args.only):
+        parser.error("--publish: only the whole benchmark (every ensemble, the default --repeats)")
     os.makedirs(args.out, exist_ok=True)
     from distributed import LocalCluster
     rows: list[dict] = []
+    decisions: list[str] = []        # each run's batch: where it went and the payoff rule's inputs
     shell = dict(os.environ)
     with tempfile.TemporaryDirectory() as tmp, LocalCluster(
             n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None) as cluster:
         os.environ.clear()              # the nanny's variables leak into this process: the runs get the shell's
         os.environ.update(shell)
-        scenes = {"shipped 64^2 x 32": SHIPPED, "256^2 x 16": large(tmp), "measured scan": MEASURED}
+        scenes = dict(zip(ENSEMBLES, (SHIPPED, large(tmp), MEASURED)))
+        scenes = {name: scene for name, scene in scenes.items() if not args.only or name in args.only}
         dask = ("--scheduler", cluster.scheduler_address)
         records = os.path.join(tmp, "cache")
         for name, scene in scenes.items():
             run(scene, os.path.join(tmp, f"warm_{len(rows)}"), *dask)      # the cluster imports the package
-            for repeat in range(REPEATS):
+            for repeat in range(args.repeats):
                 ref: tuple[float, dict] | None = None
                 for executor, flags in (("serial", ("--workers", "1")), ("local 2 first", ("--workers", "2")),
                                         ("local 2", ("--workers", "2")), ("dask 2", dask)):
@@ -133,9 +147,13 @@ def main() -> None:
                           f"(x{r['speedup']:.2f}), batch "
                           f"{r['batch']:6.2f} s (x{r['batch_speedup']:.2f}), {r['ran']}, {r['started']}, "
                           f"diff {diff:.1e}", flush=True)
+                    decisions.append(f"{name} | {executor} | #{repeat} | load {load:.2f} | "
+                                     f"{report['compute']['batches'][0].get('decision', '')}")
     loads = [r["load"] for r in rows]
     rows += medians(rows)
     write(args.out, rows)
+    with open(os.path.join(args.out, "decisions.txt"), "w") as fh:
+        fh.write("\n".join(decisions) + "\n")
     print(f"load average as the runs began: {min(loads):.1f} to {max(loads):.1f}, median {np.median(loads):.1f}")
     if args.publish:
         benchmark_doc.publish(

@@ -12,16 +12,23 @@ Both failures are :class:`SchedulerError`: an input to correct, or a
 scheduler to start, before any solve (the runner names the address's key).
 
 A run's batches (:meth:`DaskCluster.start_on_demand`, as the runner opens
-them) go to the cluster only where their rest repays its trips: their first
-members are solved and timed in this process while the workers import the
-members' modules, and condition (4) of :mod:`ngcontact.parallel.dask_payoff`
-decides, as :mod:`ngcontact.parallel.worker_payoff` does for a local pool;
-the batch's record says where it ran and why.  A cluster used directly
+them) go to the cluster only where their rest repays its trips and the
+connection: their first members are solved and timed in this process, and
+condition (4) of :mod:`ngcontact.parallel.dask_payoff` decides, as
+:mod:`ngcontact.parallel.worker_payoff` does for a local pool; the batch's
+record says where it ran and why.  A run connects (imports dask.distributed,
+most of a second, and makes a client) only once a batch's rest repays that
+too: a run whose batches all stay here costs the serial run, its address
+checked by a bare TCP connection (:meth:`DaskCluster._reach`; a plain TCP
+address is also read without dask.distributed, :func:`tcp_host_port`).  A cluster used directly
 (:func:`ngcontact.parallel.executor.use`) sends every member there.
 """
 from __future__ import annotations
 
+import functools
 import logging
+import re
+import socket
 import statistics
 import time
 from typing import Any, Sequence
@@ -41,10 +48,26 @@ CONNECT_SECONDS = 5.0
 ADDRESS_FORMS = "tcp://HOST:PORT or HOST:PORT (also tls://, ws://, wss://, ucx:// HOST:PORT)"
 
 
+#: A plain TCP address (``tcp://HOST:PORT`` or ``HOST:PORT``, the host a name, IPv4 or bracketed IPv6): read
+#: here, without importing dask.distributed (most of a second: :func:`tcp_host_port`).
+_TCP = re.compile(r"(?:tcp://)?(?P<host>[A-Za-z0-9][A-Za-z0-9.\-]*|\[[0-9A-Fa-f:.]+\]):(?P<port>[0-9]{1,5})")
+
+
+def tcp_host_port(address: str) -> tuple[str, int] | None:
+    """``(host, port)`` of a plain TCP ``address`` whose port is in 1..65535, None for any other form (which
+    Dask's own parsing reads: :func:`address_problem`)."""
+    match = _TCP.fullmatch(address) if isinstance(address, str) else None
+    if match is None or not 1 <= int(match["port"]) <= 65535:
+        return None
+    return match["host"].strip("[]"), int(match["port"])
+
+
 def address_problem(address: str) -> str | None:
     """What is wrong with the form of a scheduler's ``address`` (Dask's own parsing), None if nothing."""
     if not isinstance(address, str) or not address.strip():
         return "empty"
+    if tcp_host_port(address) is not None:
+        return None
     try:
         from distributed.comm.addressing import parse_address, parse_host_port
         from distributed.comm.registry import backends
@@ -113,6 +136,22 @@ class DaskCluster(Executor):
             self.workers = max(1, sum(w.get("nthreads", 1) for w in info))
         return self._client
 
+    def _reach(self) -> None:
+        """Whether something answers at a plain TCP address (a bare TCP connection within
+        :data:`CONNECT_SECONDS`: dask.distributed is not imported, as a batch kept in this process never
+        needs it); for any other form, Dask's handshake (:meth:`_knock`)."""
+        where = tcp_host_port(self.address)
+        if where is None:
+            import distributed  # noqa: F401 - the knock's import, named missing as the client's is
+            self._knock()
+            return
+        try:
+            socket.create_connection(where, timeout=CONNECT_SECONDS).close()
+        except (ConnectionRefusedError, socket.timeout) as exc:        # nothing listens there: no detail
+            raise self._unreachable(TimeoutError(str(exc))) from None
+        except OSError as exc:                                           # a name that does not resolve, ...
+            raise self._unreachable(exc) from None
+
     def _knock(self) -> None:
         """Whether a scheduler answers at the address within :data:`CONNECT_SECONDS`: a bare connection and
         Dask's handshake, on an event loop of its own (in a thread: the caller's may run one already)."""
@@ -152,8 +191,16 @@ class DaskCluster(Executor):
         self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
 
     def start_on_demand(self, modules: Sequence[str] = ()) -> None:
-        """As :meth:`start`: the cluster's workers run already, and a wrong address fails before any solve."""
-        self.start(modules)
+        """The run's batches go to the cluster only where they repay it (:meth:`_judged_map`), the workers
+        importing ``modules`` and the members' module first; no connection is made before a batch whose rest
+        repays it too (dask.distributed imported and a client connected in this process, ``K`` of
+        :mod:`ngcontact.parallel.dask_payoff`), but an address where nothing answers fails now
+        (:meth:`_reach`), before any solve."""
+        if self._client is None:
+            self._reach()
+            self.workers = max(1, round(dask_payoff.cost_seconds(self.address, "workers", 1.0)))
+        self.judged = True
+        self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
 
     def _map(self, fn, items, names, label, progress, fault) -> list:
         if not self.judged:
@@ -170,21 +217,33 @@ class DaskCluster(Executor):
         the cluster now, sends the rest there or keeps it here (the batch's record says which and why).  Its
         probe is cancelled however the batch ends (:meth:`~ngcontact.parallel.dask_payoff.Probe.cancel`): a
         batch kept here leaves no probe importing on the workers."""
-        probe = dask_payoff.Probe(self.client, label)
-        probe.warm(self._modules + (fn.__module__,))
+        probes: list[dask_payoff.Probe] = []
+        if self._client is not None:        # connected: the workers import while members are solved here
+            probes.append(dask_payoff.Probe(self.client, label))
+            probes[0].warm(self._modules + (fn.__module__,))
         try:
-            return self._probed_map(probe, fn, items, names, label, progress, fault)
+            return self._probed_map(probes, fn, items, names, label, progress, fault)
         finally:
-            probe.cancel()
+            for probe in probes:
+                probe.cancel()
 
-    def _probed_map(self, probe, fn, items, names, label, progress, fault) -> list:
+    def _probed_map(self, probes, fn, items, names, label, progress, fault) -> list:
         clock = self.member_clock
         done: list = []
         while len(done) < len(items):
             k = len(done)
             done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
                                   shifted_progress(progress, k, len(items)), fault)
-            if len(done) < dask_payoff.MEASURED or len(done) == len(items) or not probe.warm_done():
+            if len(done) < dask_payoff.MEASURED or len(done) == len(items):
+                continue
+            if not probes:      # not connected: the connection is part of what the rest must repay
+                ahead = self._ahead(clock.least, len(items) - len(done))
+                if not ahead.repaid:
+                    return self._here(fn, items, names, label, progress, fault, done, ahead.describe(len(done)))
+                probes.append(self._connect(label, fn))
+                probes[0].wait_warm(clock.least)     # a warm cluster's imports: no member's time
+            probe = probes[0]
+            if not probe.warm_done():
                 continue
             try:
                 trip = probe.round_trip(items[len(done)], dask_payoff.result_bytes(done[-1]))
@@ -206,10 +265,30 @@ class DaskCluster(Executor):
             rest = self._cluster_map(fn, items[len(done):], names[len(done):], label,
                                      shifted_progress(progress, len(done)), fault)
             return done + rest
-        importing = not probe.warm_done()
+        importing = bool(probes) and not probes[0].warm_done()
         self._where("serial", f"all {len(done)} members solved here"
                     + (" while the cluster's workers imported their modules" if importing else ""))
         return done
+
+    def _ahead(self, member_seconds: float, rest: int) -> dask_payoff.DaskPayoff:
+        """Condition (4) before the connection: its cost ``K``, the cluster's workers, trip and extra time as
+        this scheduler's record has them (:mod:`ngcontact.parallel.dask_payoff`)."""
+        known = dask_payoff.measured_costs(self.address, "workers")
+        cost = functools.partial(dask_payoff.cost_seconds, self.address)
+        workers = max(1, round(statistics.median(known))) if known else rest
+        return dask_payoff.DaskPayoff(member_seconds, rest, workers, cost("round_trip"),
+                                      cost("member_extra"), cost("connect", dask_payoff.CONNECT_ESTIMATE),
+                                      workers_known=bool(known))
+
+    def _connect(self, label: str, fn) -> dask_payoff.Probe:
+        """Connect now (``K`` timed and recorded, and the cluster's workers) and start the batch's probe."""
+        t0 = time.perf_counter()
+        client = self.client
+        dask_payoff.remember_cost(self.address, "connect", time.perf_counter() - t0)
+        probe = dask_payoff.Probe(client, label)
+        dask_payoff.remember_cost(self.address, "workers", float(len(probe.workers)))
+        probe.warm(self._modules + (fn.__module__,))
+        return probe
 
     def _here(self, fn, items, names, label, progress, fault, done, why) -> list:
         """The rest of a batch in this process, ``why`` recorded with it."""

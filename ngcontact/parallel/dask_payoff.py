@@ -33,21 +33,38 @@ this process's other threads in its CPU time) is not counted on.
 
 The cluster repays its trips when the rest ends sooner there::
 
-    c (r - ceil(r / W))  >  ceil(r / W) (o + e)                                (4)
+    c (r - ceil(r / W))  >  K + ceil(r / W) (o + e)                            (4)
 
 the time the workers save on the rest against the trips and extra time of
-the members each worker solves.  A batch for which (4) fails stays in this
+the members each worker solves, and ``K``, the connection still to make:
+the run's process imports dask.distributed and connects a client to the
+scheduler (most of a second, in this process, so every member waits for
+it) only for a batch whose rest repays that too; a run whose batches all
+stay here never pays it, and so costs the serial run
+(:meth:`~ngcontact.parallel.dask_cluster.DaskCluster.start_on_demand`
+checks the address with a bare TCP connection instead).  ``K`` is the
+connection's wall seconds as last timed for the scheduler
+(:data:`CONNECT_ESTIMATE` before any), and 0 once connected: spent.
+Before the connection, ``W``, ``o`` and ``e`` are the scheduler's record
+(``o`` and ``e`` 0 before any), and ``W`` the rest ``r`` where the record
+has none (every member its own worker: the largest saving, so a batch the
+connection cannot repay even then stays here); once connected, (4) is
+read again with the trip timed on the cluster and ``K = 0``.  A batch for which (4) fails stays in this
 process, its record saying why (as the local rule's does); so does a batch
 whose probe fails (a worker that cannot import the members' module).  A
 batch that stays here cancels its probe, whose tasks import no further
 module once cancelled (:meth:`Probe.cancel`).  Before
 timing the trips, the probe imports the members' modules on every worker
 (each worker's first member would otherwise pay it), while this process goes
-on solving members; (4) is read once that is done and at least
+on solving members (a warm cluster's imports are waited for, up to one
+member's time ``c``); (4) is read once that is done and at least
 :data:`MEASURED` members were solved here, and only then: as members are
 solved here both sides of (4) shrink in proportion (the saving by about
 ``c (1 - 1/W)`` per member, the cost by ``(o + e) / W``), so a later look
-would decide the same.
+would decide the same.  Before the connection, (4) is read once, after
+:data:`MEASURED` members: ``K`` does not shrink as members are solved
+here while the saving does, so a batch it keeps here would be kept by
+every later look too.
 """
 from __future__ import annotations
 
@@ -67,8 +84,13 @@ from ngcontact.parallel.batch_member import in_worker, one_thread
 MEASURED = 2
 
 #: The record of the clusters' costs beside the local workers' (:mod:`ngcontact.parallel.batch_forecast`): by
-#: scheduler address, the last ``round_trip`` seconds measured (``o`` of (4)) and ``member_extra`` (``e``).
-COSTS_FILE, COSTS = "dask_costs.json", ("round_trip", "member_extra")
+#: scheduler address, the last ``round_trip`` seconds measured (``o`` of (4)), ``member_extra`` (``e``),
+#: ``connect`` (``K``) and the cluster's ``workers`` (``W``, as the connection found them).
+COSTS_FILE, COSTS = "dask_costs.json", ("round_trip", "member_extra", "connect", "workers")
+
+#: Wall seconds of the connection to a scheduler (``K``: dask.distributed imported in the run's process, a
+#: client connected) before this scheduler's record has one (an estimate: the import alone is most of it).
+CONNECT_ESTIMATE = 0.5
 
 #: Seconds the probe of a batch may take before the batch is kept in this process.
 PROBE_SECONDS = 30.0
@@ -85,6 +107,8 @@ class DaskPayoff:
     workers: int
     round_trip: float
     member_extra: float
+    connect: float = 0.0
+    workers_known: bool = True
 
     def __post_init__(self):
         object.__setattr__(self, "member_extra", max(self.member_extra, 0.0))     # ``e >= 0``
@@ -101,8 +125,8 @@ class DaskPayoff:
 
     @property
     def cost(self) -> float:
-        """Seconds the busiest worker's members add: ``ceil(r / W) (o + e)``."""
-        return self.per_worker * (self.round_trip + self.member_extra)
+        """Seconds the connection and the busiest worker's members add: ``K + ceil(r / W) (o + e)``."""
+        return self.connect + self.per_worker * (self.round_trip + self.member_extra)
 
     @property
     def repaid(self) -> bool:
@@ -111,13 +135,20 @@ class DaskPayoff:
 
     def describe(self, solved: int) -> str:
         """One line for the report: what was measured and what was decided, after ``solved`` members here."""
-        where = (f"the other {self.rest} on the cluster's {self.workers} workers" if self.repaid
-                 else f"the other {self.rest} in this process")
+        workers = (f"the cluster's {self.workers} worker{'s' if self.workers != 1 else ''}" if self.workers_known
+                   else f"at most {self.workers} workers (the cluster's not known yet)")
+        if self.repaid:
+            where = (f"the other {self.rest} on the cluster" + ("" if self.connect == 0 else ", once connected")
+                     + (f"'s {self.workers} workers" if self.workers_known else ""))
+        else:
+            where = f"the other {self.rest} in this process"
+        connect = "" if self.connect == 0 else (
+            f"the connection to the scheduler ({self.connect:.3g} s: dask.distributed imported and a client "
+            f"connected in this process, as last timed there), ")
         return (f"{solved} member{'s' if solved > 1 else ''} solved here, the cheapest in "
-                f"{self.member_seconds:.3g} s: the cluster's {self.workers} worker"
-                f"{'s' if self.workers != 1 else ''} would save {self.saving:.3g} s on the other {self.rest} "
-                f"against {self.cost:.3g} s of trips ({self.round_trip:.3g} s each: the scheduler's round trip, "
-                f"the member's state and result, timed on the cluster) and of a member's extra time on a "
+                f"{self.member_seconds:.3g} s: {workers} would save {self.saving:.3g} s on the other {self.rest} "
+                f"against {self.cost:.3g} s of {connect}trips ({self.round_trip:.3g} s each: the scheduler's round "
+                f"trip, the member's state and result, timed on the cluster) and of a member's extra time on a "
                 f"worker ({self.member_extra:.3g} s); {where}")
 
 
@@ -204,6 +235,15 @@ class Probe:
 
     def warm_done(self) -> bool:
         return all(f.done() for f in self._warming)
+
+    def wait_warm(self, seconds: float) -> bool:
+        """Wait at most ``seconds`` for the workers' imports (:meth:`warm`); whether they are done."""
+        from distributed import wait
+        try:
+            wait(self._warming, timeout=seconds)
+        except Exception:        # not done in time (or failed: the trip's timing raises the failure)
+            pass
+        return self.warm_done()
 
     def round_trip(self, item: Any, nbytes: int) -> float:
         """``o`` of (4) measured now: the median over the workers of a probe's wall time here, carrying

@@ -66,9 +66,22 @@ READY_MODULE = "ngcontact.parallel.fork_server_ready"
 
 
 class _ForkWorker(ForkServerProcess):
-    """A worker forked by the server's only thread: the kernel's death signal follows the server."""
+    """A worker forked by the server's only thread: the kernel's death signal follows the server.
+
+    :mod:`multiprocessing` starts a new server by itself where the last has
+    died (:func:`multiprocessing.forkserver.ensure_running`, as a worker is
+    asked for), with the environment of the moment: the worker is therefore
+    asked for within the server's one-thread environment, and a server so
+    restarted is the pool's (:meth:`Server.follow`)."""
 
     by_main_thread = True
+
+    def start(self) -> None:
+        server = _SHARED
+        with _single_threaded_environment(server.ready_value() if server is not None else None):
+            super().start()
+        if server is not None:
+            server.follow()
 
 
 class _ForkServer(ForkServerContext):
@@ -100,12 +113,17 @@ def _running_pid() -> int | None:
 
 
 @contextlib.contextmanager
-def _single_threaded_environment(ready: str):
+def _single_threaded_environment(ready: str | None):
     """Within the block, the environment a server is started with: every library on one thread, and
-    :data:`READY_ENV` set to ``ready``; this process's own environment is restored after it."""
-    values = {"NGCONTACT_THREADS": "1", READY_ENV: ready, **{name: "1" for name in BLAS_THREADS_ENV}}
-    saved = {name: os.environ.get(name) for name in values}
+    :data:`READY_ENV` set to ``ready`` (unset for None); this process's own environment is restored after
+    it."""
+    values = {"NGCONTACT_THREADS": "1", **{name: "1" for name in BLAS_THREADS_ENV}}
+    saved = {name: os.environ.get(name) for name in (*values, READY_ENV)}
     os.environ.update(values)
+    if ready is None:
+        os.environ.pop(READY_ENV, None)
+    else:
+        os.environ[READY_ENV] = ready
     try:
         yield
     finally:
@@ -137,14 +155,32 @@ class Server:
         if self.owned:
             worker_lifetime.end_orphans()
             self.record = worker_lifetime.Record()
-            main = threading.current_thread() is threading.main_thread()
             forkserver.set_forkserver_preload(preloaded(modules) + [READY_MODULE])
-            with _single_threaded_environment(f"{self.record.path or ''}:{int(main)}:{os.getpid()}"):
+            with _single_threaded_environment(self.ready_value()):
                 forkserver.ensure_running()
             pid = _running_pid()
         assert pid is not None, "the fork server did not start"
         self.pid = pid
         self._ready = not self.owned or self.record is None or self.record.path is None
+
+    def ready_value(self) -> str | None:
+        """:data:`READY_ENV` for a server started now by this thread: its record, whether the run's main
+        thread starts it, the run's pid (None for a server found running: not this pool's to record)."""
+        if not self.owned or self.record is None:
+            return None
+        main = threading.current_thread() is threading.main_thread()
+        return f"{self.record.path or ''}:{int(main)}:{os.getpid()}"
+
+    def follow(self) -> None:
+        """After a worker's start: where :mod:`multiprocessing` started another server in place of a dead
+        one (in the one-thread environment, :class:`_ForkWorker`), that one is this pool's server now, its
+        start spent."""
+        pid = _running_pid()
+        if pid is None or pid == self.pid or not self.owned:
+            return
+        self.pid = pid
+        self._ready = self.record is None or self.record.path is None
+        self.spawned = time.perf_counter()
 
     def running(self) -> bool:
         """Whether this is still the process's fork server and runs."""

@@ -20,8 +20,14 @@ of the others' use)::
 
     f = C - L_1                                                          (3)
 
-``f`` is held to ``[0, C]``.  Each reading from a window long enough opens
-the next window, so a reading tells what the last seconds left free.
+``f`` is held to ``[0, C]``.  A reading's window ends now and opens at the
+latest earlier sample at least :data:`WINDOW_SECONDS` old (each reading is
+a sample), so a reading tells what the last seconds left free, and a look
+that follows the previous one closely (a member solved in less than
+:data:`WINDOW_SECONDS`) still reads (2) over the samples before, not (3):
+right after another run on the same cores, (3) counts that run for up to a
+minute (its load average decays with a time constant of 60 s) and would
+read a machine that is idle now as busy.
 
 The run's first look (whether its workers start with the run,
 :mod:`ngcontact.parallel.batch_forecast`) comes about a second after the
@@ -128,25 +134,28 @@ class CoreWatch:
     def __init__(self, workers: Callable[[], Iterable[int]] = tuple, opening: bool = False):
         self.cores = affinity()
         self._workers = workers
-        self._mark = self._sample()
-        if opening and OPENING[1] is not None and self._mark[0] - OPENING[0] <= OPENING_SECONDS:
-            self._mark = OPENING
+        self._marks = [self._sample()]      # the samples a window may open at, oldest first
+        if opening and OPENING[1] is not None and self._marks[0][0] - OPENING[0] <= OPENING_SECONDS:
+            self._marks = [OPENING]
 
     def _sample(self) -> tuple[float, float | None, float]:
         own = time.process_time() + sum(process_seconds(pid) for pid in self._workers())
         return time.perf_counter(), core_seconds(self.cores), own
 
     def reading(self) -> Reading:
-        """What the last window left free, (2); the load average, (3), if the window is too short."""
+        """What the last window left free, (2), the window opening at the latest sample at least
+        :data:`WINDOW_SECONDS` old; the load average, (3), where no sample is that old."""
         now = self._sample()
-        (t0, spent0, own0), (t1, spent1, own1) = self._mark, now
+        opening = [m for m in self._marks if now[0] - m[0] >= WINDOW_SECONDS]
+        (t0, spent0, own0), (t1, spent1, own1) = (opening[-1] if opening else self._marks[0]), now
         window = t1 - t0
         if spent0 is None or spent1 is None or window < WINDOW_SECONDS:
             load = load_average()
             if load is None:
                 return Reading(len(self.cores), 0.0, "no load reading on this system: taken as free")
             return Reading(len(self.cores), load, f"one-minute load average {load:.2f}")
-        self._mark = now
+        start = opening[-1] if opening else self._marks[0]
+        self._marks = [m for m in self._marks if m[0] >= start[0]] + [now]   # older ones open no later window
         busy = max((spent1 - spent0) - (own1 - own0), 0.0) / window
         return Reading(len(self.cores), busy, f"{busy:.2g} cores busy with other processes over the last "
                                               f"{window:.2g} s")
@@ -154,4 +163,4 @@ class CoreWatch:
 
 #: The first window's opening sample of the process, taken as the package is imported: (wall, CPU seconds
 #: of every process on this process's cores, CPU seconds of this process), as :meth:`CoreWatch._sample`.
-OPENING = CoreWatch()._mark
+OPENING = CoreWatch()._marks[0]

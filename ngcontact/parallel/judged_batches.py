@@ -185,6 +185,7 @@ class JudgedBatches(Executor, ABC):
                 return done
             first = clock.times[0] - clock.least if len(clock.times) >= 2 else None
             payoff = self.payoff(clock.least, len(items) - len(done), first=first)
+            log.debug("%s: look: %s", label, payoff.describe(len(done)))      # every look's inputs
             if not payoff.repaid:
                 if self._launched() and not self._ready() and payoff.rest > 1:
                     self._abandon_start()   # (a last member here takes one member's time: the start goes on)

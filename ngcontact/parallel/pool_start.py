@@ -26,7 +26,11 @@ class PoolStart(JudgedBatches):
     _pool: Any
 
     def _open_server(self) -> fork_server.Server:
-        """The pool's fork server, started now if it has none (its imports go on beside this process)."""
+        """The pool's fork server, started now if it has none or its server has died (its imports go on
+        beside this process, in the one-thread environment of :mod:`ngcontact.parallel.fork_server`; a
+        server left to :mod:`multiprocessing` would restart with the run's own)."""
+        if self._server is not None and not self._server.running():
+            self._stop_server()
         if self._server is None:
             self._server = fork_server.acquire(self._modules)
             self._forked = 0

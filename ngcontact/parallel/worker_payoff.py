@@ -53,9 +53,25 @@ process's first member took beyond its cheapest, at most
 :data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS` (so the
 first look waits for a second member; without a batch, the estimates
 :data:`~ngcontact.parallel.judged_batches.START_SECONDS` and
-:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS`).  ``R``
+:data:`~ngcontact.parallel.judged_batches.FIRST_MEMBER_SECONDS`).  That
+``F`` holds no import a forked worker is spared: the fork server preloads
+NGSolve, the runner's worker modules and the members' module, all of which
+this process imported before its batch (it made the batch's items with
+them), so its first member's extra is only what a member does once per
+process beyond them (lazy imports, files read, caches filled), which a
+forked worker repeats, plus the spread of the members' own times (the
+first is one draw, the cheapest the least of two): an upper estimate of a
+forked worker's ``F``, until one is timed.  ``R``
 is ``S`` less the time the workers have had since they were spawned: a
 start on busy cores takes longer, which the second condition counts.
+
+``P = min(W, f)`` in the second condition is the share of the cores the
+workers get: other jobs that keep ``C - f`` cores busy keep them while the
+workers run (a fair scheduler gives each runnable thread its turn, and
+their demand is what (2) measured), so ``W`` workers get the ``f`` cores
+left, and at most ``W``.  Where ``f`` is only a little above 1 the saving
+``r c (P - 1)`` is small and the workers' ``W (S + F)`` can outweigh it:
+that batch is faster in this process, which has a core of its own.
 
 (1) is read after every member solved here, and the rest goes to the
 workers only once (1) holds after :data:`MEASURED` members and a worker is

@@ -26,6 +26,26 @@ def test_a_window_reads_the_others_use_of_the_cores_less_the_runs_own(monkeypatc
     assert "busy with other processes over the last" in reading.source
 
 
+def test_a_look_soon_after_the_last_reads_the_window_before_not_the_load_average(monkeypatch):
+    """A member solved in less than ``WINDOW_SECONDS`` after the last look: the window opens at the sample
+    before (still (2)), not at the last look, and never the load average, which right after another run on
+    the same cores counts that run as busy.  (Wall seconds here: the faked ``/proc/stat`` has this process
+    and one other core busy whatever the machine's load.)"""
+    monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
+    monkeypatch.setattr(free_cores, "core_seconds", lambda cores: time.perf_counter() + time.process_time())
+    monkeypatch.setattr(free_cores, "load_average", lambda: 1.9)        # the run just before, on 2 cores
+    watch = CoreWatch()
+    for seconds in (0.3, 0.1, 0.1):
+        t0 = time.perf_counter()
+        while time.perf_counter() - t0 < seconds:
+            pass
+        reading = watch.reading()
+        assert "busy with other processes over the last" in reading.source
+        assert reading.free == pytest.approx(1.0, abs=0.05)
+    window = float(reading.source.split("over the last ")[1].split(" s")[0])
+    assert 0.45 <= window < 0.7         # opened as the watch did: the first look is only 0.2 s old at the third
+
+
 def test_without_a_window_the_load_average_is_read_and_the_free_cores_stay_in_range(monkeypatch):
     monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
     monkeypatch.setattr(free_cores, "core_seconds", lambda cores: None)

@@ -84,6 +84,22 @@ def test_well_formed_addresses_are_taken_without_connecting(address):
     assert time.monotonic() - t0 < 5.0
 
 
+def test_a_plain_tcp_address_is_read_and_reached_without_importing_dask_distributed():
+    """dask.distributed's import is most of a second: a run whose batches stay in its process never pays it
+    (:mod:`ngcontact.parallel.dask_payoff`, ``K``), also not for reading and checking its address."""
+    code = ("import socket, sys\n"
+            "from ngcontact.parallel import executor\n"
+            "with socket.socket() as s:\n"
+            "    s.bind(('127.0.0.1', 0)); s.listen()\n"
+            "    for address in ('tcp://10.0.0.5:8786', 'localhost:8786', 'tcp://[::1]:8786'):\n"
+            "        executor.make(2, address)\n"
+            "    executor.make(2, f'tcp://127.0.0.1:{s.getsockname()[1]}').start_on_demand()\n"
+            "assert 'distributed' not in sys.modules, 'imported'\n")
+    env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+
+
 def test_a_scheduler_that_does_not_answer_ends_the_run_in_seconds_with_exit_2_and_one_line(tmp_path):
     scene = tmp_path / "sweep.toml"
     scene.write_text(SWEEP)

@@ -223,3 +223,59 @@ def test_workers_spawned_by_a_thread_that_ends_live_on_with_their_parent(tmp_pat
             assert pool._server.pid == server and worker_lifetime.process_start(server) is not None
     finally:
         pool.close()
+
+
+def environment(pid: int) -> dict[str, str]:
+    """The environment process ``pid`` was started with (``/proc/PID/environ``)."""
+    with open(f"/proc/{pid}/environ", "rb") as f:
+        entries = f.read().split(b"\0")
+    return dict(e.decode().split("=", 1) for e in entries if b"=" in e)
+
+
+@pytest.mark.parametrize("between", ["pools", "workers"])
+def test_a_fork_server_that_dies_is_restarted_with_one_thread_and_recorded(tmp_path, monkeypatch, between):
+    """A fork server killed while the run goes on: the next batch's workers come from a new server started
+    in the one-thread environment (not the run's: here ``NGCONTACT_THREADS=2``), entered in the pool's
+    record (the orphan guard ends it) and stopped with the pool.  ``pools``: the server dies between two
+    pools (a new pool starts it); ``workers``: it dies while a pool's workers are being asked for, and
+    :mod:`multiprocessing` starts it again by itself."""
+    import operator
+    import signal
+
+    from multiprocessing import forkserver
+
+    from ngcontact.parallel import fork_server, judged_batches, local_pool
+    from ngcontact.parallel.batch_member import BLAS_THREADS_ENV
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
+    monkeypatch.setenv("NGCONTACT_THREADS", "2")
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)          # every batch's rest goes to the workers
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
+    pool = local_pool.LocalPool(2, method="forkserver")
+    try:
+        pool.start()
+        assert pool.wait_ready(120)
+        assert pool.map(operator.neg, [1.0, 2.0, 3.0, 4.0], list("abcd")) == [-1.0, -2.0, -3.0, -4.0]
+        first = pool._server.pid
+        pool._discard()
+        os.kill(first, signal.SIGKILL)
+        assert wait_for(lambda: worker_lifetime.process_start(first) is None, 10)
+        if between == "workers":            # multiprocessing's own restart, as a worker is asked for
+            ctx = fork_server.context()
+            worker = ctx.Process(target=operator.neg, args=(1.0,))
+            worker.start()
+            worker.join(30)
+        # on the workers whatever the payoff rule would say of the new server's start
+        assert pool._pool_map(operator.neg, [1.0, 2.0, 3.0, 4.0], list("abcd"), "after", None, None) == \
+            [-1.0, -2.0, -3.0, -4.0]
+        server = pool._server.pid
+        assert server != first and server == forkserver._forkserver._forkserver_pid
+        env = environment(server)
+        assert env["NGCONTACT_THREADS"] == "1" and all(env[name] == "1" for name in BLAS_THREADS_ENV)
+        assert fork_server.READY_ENV not in os.environ and os.environ["NGCONTACT_THREADS"] == "2"
+        assert wait_for(lambda: pool._server.ready(), 60)
+        _, entries = worker_lifetime.read_record(pool._server.record.path)
+        assert server in [pid for pid, _ in entries]
+    finally:
+        pool.close()
+    assert wait_for(lambda: worker_lifetime.process_start(server) is None, 10)
