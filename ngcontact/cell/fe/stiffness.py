@@ -53,6 +53,12 @@ relative, the Richardson extrapolation from ``k, 2k, 4k`` by ``2e-5``.
 the bodies).  Only the components the caller keeps are computed (a
 frictionless flat interface: the normal one).
 
+The set held closed is that of the closed nodes, which ends a node spacing
+short of each contact edge; in 2D ``S`` is taken at the edges instead, by
+interpolation between that set and the set with the next open node held
+too (:func:`edge_interpolation`), and the change with the set is kept for
+the estimate (:func:`edge_record`).
+
 The inner solves.  Both terms are minima of an energy: ``S_ij = v_i^T K
 v_j`` with ``v_j`` the minimizer of ``v^T K v`` among the ``v`` equal to
 ``e_j`` on the far-face dofs, and ``q^T K_II^-1 q = max_z 2 q^T z - z^T
