@@ -82,7 +82,7 @@ from ngcontact.cell.fe.load_start import starts_afresh
 from ngcontact.cell.cell_solver import Refinement
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.fe.grading_estimate import (LEVELS_PER_STEP, ORDER_RATE, RATIO, edge_cells, edges_miss, merged,
-                                                  order_estimate, out_of_reach, set_move)
+                                                  order_estimate, out_of_reach, set_move, stiffness_edges)
 from ngcontact.cell.fe.observed_rate import DISAGREE
 from ngcontact.errors import ConvergenceError, ModelError, SceneError
 from ngcontact.geometry.cell2d import flat_cell
@@ -266,6 +266,7 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
              "mean_closure": c, "newton_iterations": sol.iterations, "fraction_change": None,
              "closure_change": None, "headline": headline(sol.results), "changes": None,
              "edge_cells": edge_cells(problem, edges), "k_n": float(problem.model.k_n),
+             "stiffness_edges": stiffness_edges(sol.results),
              "length": float(np.sum(ends[:, 1] - ends[:, 0]))}
     if before is not None:
         entry["fraction_change"] = abs(f - before[1]["contact_fraction"])

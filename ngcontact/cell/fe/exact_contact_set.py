@@ -136,8 +136,10 @@ def vertex_area(m: ContactMultiplier, closed: np.ndarray, opening: np.ndarray, e
     return float(np.dot(share, areas))
 
 
-def contact_cuts(problem) -> list[tuple[np.ndarray, list[bool]]]:
-    """Per segment of ``S_C`` (in the order of :attr:`ContactMultiplier.points`): ``(cuts, on)``.
+def contact_cuts(problem, edges: list | None = None) -> list[tuple[np.ndarray, list[bool]]]:
+    """Per segment of ``S_C`` (in the order of :attr:`ContactMultiplier.points`): ``(cuts, on)``; each contact
+    edge also appended to ``edges`` where given, as ``(closed point, open point, fraction)``: the indices of
+    the points on either side and the edge's place between them as a fraction from the closed one.
 
     ``cuts`` are reference coordinates ``0 = c_0 < ... < c_m = 1`` and
     ``on[i]`` says whether ``[c_i, c_(i+1)]`` is in contact: the nodes and
@@ -185,6 +187,8 @@ def contact_cuts(problem) -> list[tuple[np.ndarray, list[bool]]]:
                     root = X[no] - r[no] * (X[n2] - X[no]) / (r[n2] - r[no])
                     f = float(np.clip((root - X[nc]) / (X[no] - X[nc]), 0.0, 1.0))
             tc = t[c] + f * (t[o] - t[c])
+            if edges is not None:
+                edges.append((e * npt + c, e * npt + o, f))
             cuts.append(tc)
             on.append(bool(a))
             cuts.append(t[q + 1])

@@ -229,9 +229,19 @@ def edges_part(orders: list[dict[str, Any]], name: str, fraction_error: float) -
     tail, share = quantity_grading_tail(orders, name, size), set_share(orders[-1], name, fraction_error) / size
     if name == "normal_stiffness" and last.get(COEFFICIENT + "k_n"):
         share = set_share(orders[-1], COEFFICIENT + "k_n", fraction_error) / abs(last[COEFFICIENT + "k_n"])
+    edges = orders[-1].get("stiffness_edges")
+    if name == "normal_stiffness" and edges:
+        share = max(share, (edges["slope"] * fraction_error + edges["spread"]) / size)
     if share >= tail:
         return share, "the contact set's share (the contact fraction's estimate, weighted as eq. 34 weighs it)"
     return tail, "the grading's tail of its own change"
+
+
+def stiffness_edges(results: dict[str, Any]) -> dict[str, float] | None:
+    """The record of exact contact's stiffness at its edges (2D, :func:`~ngcontact.cell.fe.stiffness.edge_record`:
+    its change with the contact fraction and what one interpolation for several edges leaves), or ``None``."""
+    K = results.get("effective_stiffness")
+    return (K.get("edges") or None) if isinstance(K, dict) else None
 
 
 def set_share(entry: dict[str, Any], name: str, fraction_error: float) -> float:

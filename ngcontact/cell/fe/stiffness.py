@@ -53,6 +53,12 @@ relative, the Richardson extrapolation from ``k, 2k, 4k`` by ``2e-5``.
 the bodies).  Only the components the caller keeps are computed (a
 frictionless flat interface: the normal one).
 
+The set held closed is that of the closed nodes, which ends a node spacing
+short of each contact edge; in 2D ``S`` is taken at the edges instead, by
+interpolation between that set and the set with the next open node held
+too (:func:`edge_interpolation`), and the change with the set is kept for
+the estimate (:func:`edge_record`).
+
 The inner solves.  Both terms are minima of an energy: ``S_ij = v_i^T K
 v_j`` with ``v_j`` the minimizer of ``v^T K v`` among the ``v`` equal to
 ``e_j`` on the far-face dofs, and ``q^T K_II^-1 q = max_z 2 q^T z - z^T
@@ -72,7 +78,7 @@ import numpy as np
 from ngcontact.cell.fe.cell_energy import jump
 from ngcontact.cell.fe.contact_multiplier import max_augmentation
 from ngcontact.cell.fe.edge_cuts import element_cuts, piece_rule
-from ngcontact.cell.fe.exact_contact_set import closed_nodes
+from ngcontact.cell.fe.exact_contact_set import closed_nodes, contact_cuts
 from ngcontact.fem import materials as _mat
 from ngcontact.laws import penalty as _contact
 from ngcontact.solvers.linear_solver import LinearSolver, fixed_mask, mask_fixed, match_free_dofs
@@ -86,6 +92,8 @@ SCHUR_RTOL = 1e-7
 #: the augmentation the rigid limit is taken from, in units of the solve's (module docstring), within
 #: :func:`~ngcontact.cell.fe.contact_multiplier.max_augmentation`
 RIGID_SCALE = 64.0
+#: the most contact edges of a 2D exact cell whose stiffness takes one solve per edge (:func:`edge_interpolation`)
+EDGE_SOLVES = 4
 
 
 def schur_complement(form, X, dofs, state_vec, linear: LinearSolver, kept: list[int] | None = None,
@@ -199,11 +207,13 @@ def reference_stiffness(problem) -> np.ndarray:
     return np.linalg.inv(C)
 
 
-def tangent_stiffness(problem, kept: list[int] | None = None) -> np.ndarray:
+def tangent_stiffness(problem, kept: list[int] | None = None, held: list[int] | None = None) -> np.ndarray:
     """``S``: tangent of the mean far-face traction w.r.t. the far-face jump (per ``|T|``), on the components
     ``kept`` (default all), the others held: ``S = C^-1`` (:func:`compliance`).
 
-    Exact enforcement: at ``k -> infinity`` (module docstring).
+    Exact enforcement: at ``k -> infinity`` (module docstring), the closed points held closed and, with
+    ``held`` (indices of points of the multiplier), those points and the other copies of their nodes too
+    (:func:`held_closed`).
     """
     kept = list(range(problem.dim)) if kept is None else list(kept)
     stiff = None
@@ -211,16 +221,105 @@ def tangent_stiffness(problem, kept: list[int] | None = None) -> np.ndarray:
     if k is not None:
         stiff = (problem.augmentation.Set, max(min(RIGID_SCALE * k, max_augmentation(problem)), k))
         problem.augmentation.Set(stiff[1])
+    values = problem.multiplier.point_values() if held and stiff is not None else None
     try:
+        if values is not None and stiff is not None and held:
+            problem.multiplier.set_point_values(held_closed(problem, held, 4.0 * stiff[1]))
         return schur_complement(problem.energy(), problem.X, problem.u_dofs, problem.gfu.vec, problem.linear,
                                 kept, stiff, edge_correction(problem)) / problem.area
     finally:
+        if values is not None:
+            problem.multiplier.set_point_values(values)
         if k is not None:
             problem.augmentation.Set(k)
         if problem.linear.preconditioned(problem.energy()):
             # the whole form was assembled here, on other free dofs: the preconditioner kept by the
             # Newton solve of the next load must be built anew
             problem.energy().renew_preconditioner()
+
+
+def held_closed(problem, held: list[int], k: float) -> np.ndarray:
+    """The multiplier's point values with the nodes of the points ``held`` (every copy of each) raised to
+    ``k`` times their opening (and above 0), so that ``lambda + k' (J_n - g) > 0`` there for every
+    augmentation ``k' < k``: the augmented energy's tangent then holds them closed as it holds the loaded
+    points, and its value there does not enter it (its second derivative is ``k' H(lambda + k' (J_n - g))``)."""
+    m = problem.multiplier
+    values, (_, opening) = m.point_values(), closed_nodes(problem)
+    x = m.at_points(ng.x)
+    tiny = 1e-11 * max(float(np.ptp(x)), 1.0)
+    for q in held:
+        copies = np.abs(x - x[q]) <= tiny
+        values[copies] = k * np.maximum(opening[copies], 0.0) + np.finfo(float).tiny
+    return values
+
+
+def edge_interpolation(problem, kept: list[int], S: np.ndarray) -> tuple[np.ndarray, dict | None]:
+    """``S`` at the contact edges of exact enforcement (2D), from ``S`` (``S_c``) of the closed points and
+    ``S_o`` with the next open node beyond each edge held closed too; and the record of :func:`edge_record`
+    (``None`` where no edge lies between two nodes: nothing moves).
+
+    The tangent of exact contact holds the contact set closed: the set of the closed nodes, which ends at
+    the last closed node ``x_c`` while the edge ``a`` lies between it and the first open node ``x_o``
+    (:func:`~ngcontact.cell.fe.exact_contact_set.contact_cuts`, the fraction ``t = (a - x_c) / (x_o -
+    x_c)``).  The stiffness of a set held closed grows with its extent: the periodic flat punch of
+    half-width ``a``, ``K = pi E* / (2 ln(1 / sin(pi a)))``, the tangent of Westergaard's contact
+    (``docs/benchmarks.md``, "The graded FE cell at a stated tolerance"), has ``d ln K / da = pi cot(pi
+    a) / ln(1 / sin(pi a))``, 14 at ``p/p* = 0.8``, so the closed nodes' set, short by ``a - x_c = 1.1e-5``
+    at each edge on the graded mesh of that load at tolerance ``1e-4``, took ``K`` low by 1.4e-4, beyond
+    its estimate.  Linear in the extent between the two sets,
+
+        S(a) = S_c + t (S_o - S_c) + O((x_o - x_c)^2),
+
+    for each edge with its own ``S_o`` while there are at most :data:`EDGE_SOLVES` (one solve more per
+    edge); beyond, one ``S_o`` holds every edge's next node closed and ``t`` is their mean weighted by the
+    node spacing, ``sum (a_e - x_c) / sum (x_o - x_c)`` (the set's measure added; :func:`edge_record` states
+    what the edges' different ``t_e`` leave).
+    """
+    m = problem.multiplier
+    if m is None or problem.dim != 2:
+        return S, None
+    edges: list = []
+    contact_cuts(problem, edges)
+    if not edges:
+        return S, None
+    x = m.at_points(ng.x)
+    groups = [[e] for e in edges] if len(edges) <= EDGE_SOLVES else [edges]
+    out, record = S.copy(), []
+    for group in groups:
+        S_o = tangent_stiffness(problem, kept, [o for _, o, _ in group])
+        t = np.array([f for *_, f in group])
+        length = np.array([abs(x[o] - x[c]) for c, o, _ in group])
+        share = float(np.dot(t, length) / np.sum(length))
+        out = out + share * (S_o - S)
+        record.append((S_o, float(np.max(np.abs(t - share))), float(np.sum(length)) / float(np.sum(m.element_areas))))
+    return out, {"S_c": S, "groups": record}
+
+
+def edge_record(edge: dict, S0: np.ndarray) -> dict:
+    """What the edges' interpolation (:func:`edge_interpolation`) leaves to the estimate, in the normal
+    stiffness ``K`` (absolute): ``slope``, the largest ``|K_o - K_c| / df`` of the groups of edges (``df`` the
+    contact fraction the group's next open nodes add), whose product with the fraction's error bounds the
+    stiffness's share of the edges' error; and ``spread``, the sum over the groups of ``max_e |t_e - t_g|
+    |K_o - K_c|``, what one ``t_g`` for a group leaves where its edges' ``t_e`` differ (each edge's share
+    of the group's ``K_o - K_c``, all of the same sign, at most all of it): zero where each edge has its own
+    solve."""
+    K_c = _normal(edge["S_c"], S0)
+    slope, spread = 0.0, 0.0
+    for S_o, dt, added in edge["groups"]:
+        K_o = _normal(S_o, S0)
+        if K_c is None or K_o is None or added <= 0.0:
+            return {}
+        slope, spread = max(slope, abs(K_o - K_c) / added), spread + dt * abs(K_o - K_c)
+    return {"slope": slope, "spread": spread}
+
+
+def _normal(S: np.ndarray, S0: np.ndarray) -> float | None:
+    """The normal entry of ``(S^-1 - S_0^-1)^-1``, or ``None`` where it is singular."""
+    compliance = np.linalg.inv(S) - np.linalg.inv(S0)
+    compliance = 0.5 * (compliance + compliance.T)
+    if np.linalg.cond(compliance) > 1e12:
+        return None
+    return float(np.linalg.inv(compliance)[-1, -1])
 
 
 def edge_correction(problem):
@@ -293,6 +392,7 @@ def effective_stiffness(problem) -> dict:
     if problem.multiplier is not None and bool(np.all(closed_nodes(problem)[0])):
         return {"components": [names[i] for i in keep], "matrix": None,
                 "compliance": np.zeros((len(keep), len(keep))).tolist(), "total": S.tolist(), "reference": S0.tolist()}
+    S, edge = edge_interpolation(problem, keep, S)
     if np.linalg.cond(S) > 1e12 * np.linalg.cond(S0):  # (partly) open: S^-1 does not exist
         compliance = None
         A = np.eye(len(keep)) - np.linalg.solve(S0, S)
@@ -303,9 +403,12 @@ def effective_stiffness(problem) -> dict:
         K = None if np.linalg.cond(compliance) > 1e12 else np.linalg.inv(compliance)
     if K is not None:
         K = (0.5 * (K + K.T)).tolist()
-    return {"components": [names[i] for i in keep], "matrix": K,
-            "compliance": None if compliance is None else compliance.tolist(),
-            "total": S.tolist(), "reference": S0.tolist()}
+    out = {"components": [names[i] for i in keep], "matrix": K,
+           "compliance": None if compliance is None else compliance.tolist(),
+           "total": S.tolist(), "reference": S0.tolist()}
+    if edge is not None and K is not None:
+        out["edges"] = edge_record(edge, S0)
+    return out
 
 
 def _acoustic_tensor(law, normal_axis: int) -> np.ndarray:
