@@ -13,6 +13,7 @@ import pytest
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.spectral.contact_edges import KINK, LOCATED_STEP, kink_share, kinks, unresolved_share
+from ngcontact.cell.spectral.grid_measures import edges_fitted, located_edges
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral.refinement import controlled_estimate, sweep_to_tolerance
 from ngcontact.geometry.random_surface import self_affine
@@ -94,3 +95,20 @@ def test_on_the_seed_1_profile_an_edge_pinned_to_a_kink_is_bounded_and_flagged()
         assert refined.forms[0][name] == KINK
         assert "the contact edges of a map with kinks" in refined.flags[0][name]
     assert any("within a step of a kink" in remark for remark in refined.remarks)
+
+
+def test_a_narrow_island_at_a_kink_has_its_edges_located_alike_on_two_grids():
+    """A wedge ``g0 = 0.1 |x - 1/2|`` pressed at p = 0.0005 holds one island about 300 points wide on 16,384 points,
+    the kink at its middle.  The quartic's window once reached 40 to 400 steps beyond each edge, more than the
+    island: its edges moved by a third of a step between 8192 and 16,384 points.  Within half the distance to the
+    kink (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`) both grids locate them by the quartic, to a
+    twentieth of the finer step alike."""
+    located = []
+    for n in (8192, 16384):
+        cell = _cell(lambda m: 0.1 * np.abs(np.arange(m) / m - 0.5), n)
+        assert np.flatnonzero(kinks(cell.g0)).tolist() == [0, n // 2]
+        sol = cell.sweep([cell_load(2, pressure=0.0005)])[0]
+        p, gap = sol.fields["pressure"], sol.fields["gap"]
+        assert edges_fitted(cell, p, gap) and 0.01 < np.mean(p > 0) < 0.03
+        located.append(np.sort([(i + step * t) / n for i, step, t in located_edges(cell, p > 0, gap)]))
+    assert np.abs(located[1] - located[0]).max() < 0.05 / 16384

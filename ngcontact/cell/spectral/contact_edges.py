@@ -51,7 +51,7 @@ still unresolved on the last level keeps its floor; a window of resolved levels 
 there.  Beside such a kink the gap beyond an edge is not ``(x - a)^(3/2)``: the edge's position is set by the
 pressure's balance against a gap whose curvature is concentrated at one point, and it converges only once the
 grid resolves the kink's neighbourhood, not at the first order of a smooth edge.  An edge located within a grid
-step of a kink (:func:`kinks`: points whose second difference of ``g0`` exceeds :data:`KINK_RATIO` times those
+step of a kink (:func:`kinks`: points whose second difference of ``g0`` exceeds its ``KINK_RATIO`` times those
 two points away, a Dirac among the smooth or zero curvature of the segments beside it) may thus stall
 over several grids, pinned to the kink while the differences shrink (random profiles of 64 samples: an edge at a
 sample on 1024 to 8192 points, off it by a fifth of the 4096 grid's step on 65,536; the contact fraction's error
@@ -79,11 +79,12 @@ has no kinks, and in 3D the points are counted, no edge located between them.
 **Every other edge of a map with kinks.**  Away from the kinks the gap beyond an edge is smooth over the few
 steps the line through the first two open points reads, but neither locator converges as on a smooth gap:
 the line is off by a fraction of a step whose size and sign change from grid to grid, as the kinks nearest to
-the edge move between points, and the quartic's window, tens to hundreds of steps wide, reaches across the next
-kink on fine grids and is off by as much (random profiles of 64 samples, seeds 1 to 12, three loads, grids 1024
-to 32,768 against 131,072 points, 141 loads and grids where both have as many edges: the contact fraction's
-error over a load's edges 0.035 of a step per edge in the median, 0.13 in the ninetieth percentile, 0.22 at
-most, and 0.9 of a step at one quartic's edge).  So the edges' error is of the order of the step, with
+the edge move between points, and the quartic reads a window kept within half the way to the nearest kink
+(:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`; a window that reached across it was off by as much)
+(random profiles of 64 samples, seeds 1 to 12, three loads, grids 1024 to 32,768 against 131,072 points, 141
+loads and grids where both have as many edges, measured while the window could reach across a kink: the contact
+fraction's error over a load's edges 0.035 of a step per edge in the median, 0.13 in the ninetieth percentile,
+0.22 at most, and 0.9 of a step at one quartic's edge).  So the edges' error is of the order of the step, with
 a constant erratic from grid to grid: the differences between grids may show its changes of sign and not its
 size (on seed 7 at p = 0.003 the error grows from 0.014 to 0.21 of a step per grid on 2048 to 8192 points
 while the differences contract twofold, and an estimate from them is half the error).  On a map with kinks each
@@ -137,7 +138,7 @@ import numpy as np
 from scipy import ndimage
 
 from ngcontact.cell.cell_solution import COEFFICIENT, scale
-from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset, edge_stiffness
+from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset, edge_stiffness, kinks
 
 #: the fewest collocation points of a resolved 2D contact island (module docstring)
 ISLAND_POINTS = 4
@@ -145,8 +146,6 @@ ISLAND_POINTS = 4
 ISLAND = "island"
 #: the form of an estimate raised to the floor of the edges beside a kink of the map (module docstring)
 KINK = "kink"
-#: a point's second difference of the gap over the smaller of its neighbours' that makes it a kink
-KINK_RATIO = 4.0
 #: the share of a step that bounds the located position of any other edge of a map with kinks (module docstring)
 LOCATED_STEP = 0.25
 #: with a penalty, the share of the stiffness's change with each edge a step out that bounds its error (same)
@@ -260,17 +259,6 @@ def narrow_islands(on: np.ndarray) -> tuple[np.ndarray, int, int]:
     return narrow[labels], int(narrow.sum()), int(np.bincount(labels.ravel())[1:].min())
 
 
-def kinks(g0: np.ndarray) -> np.ndarray:
-    """The points of a periodic 1D gap at a kink of its piecewise-linear interpolant (module docstring): whose
-    second difference ``c_i = |g_(i-1) - 2 g_i + g_(i+1)|`` exceeds :data:`KINK_RATIO` times the larger of
-    ``c_(i-2)`` and ``c_(i+2)``, and rounding.  A Dirac of ``g0''`` falls on the one or two points beside the kink
-    (on a point, or between two), while a smooth curvature varies little over two steps: where it crosses zero
-    linearly, ``c_i = a |x_i|`` lies below ``a (|x_i| + 2 h)``, the larger of the two."""
-    c = np.abs(np.roll(g0, 1) - 2.0 * g0 + np.roll(g0, -1))
-    beside = np.maximum(np.roll(c, 2), np.roll(c, -2))
-    return (c > KINK_RATIO * beside) & (c > 1e3 * np.finfo(float).eps * float(np.abs(g0).max()))
-
-
 def kink_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
     """The share of each quantity on the edges held by the 2D contact edges of a pressure ``p`` (``gap`` the
     deformed gap the edges are located on) that lie within one grid step of a kink of the cell's gap ``g0``
@@ -304,7 +292,7 @@ def edge_steps(cell, p: np.ndarray, gap: np.ndarray) -> tuple[dict[tuple[int, in
     edges = {}                                           # (last contact point, step): (offset, kinked, largest g0)
     for step in (1, -1):
         for i in (int(j) for j in np.flatnonzero(on & ~np.roll(on, -step))):
-            t = edge_offset(root, on, i, step)[0]
+            t = edge_offset(root, on, i, step, at)[0]
             x = i + step * t
             reach = np.arange(int(np.floor(x - 1.0)), int(np.ceil(x + 1.0)) + 1) % n   # the steps it may move across
             edges[i, step] = (t, bool(np.min(np.abs((at - x + n / 2) % n - n / 2)) <= 1.0), float(cell.g0[reach].max()))

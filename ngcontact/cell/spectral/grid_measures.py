@@ -18,15 +18,43 @@ the root of the line through the first two open points is off by a
 fraction of a grid step, that of a quartic fitted to points farther
 away by ten times less).  So each edge is placed at
 the root of the least-squares quartic of ``r`` over the window of open
-points ``EDGE_WINDOW`` (shortened, in proportion, to a quarter of the open
-run when the run is short: the gap must be smooth at the scale of the
-window; at least ``EDGE_MIN_POINTS`` points), when the fit
+points ``EDGE_WINDOW`` (shortened, in proportion, to a sixteenth of the open
+run when the run is short, and to the reach below: the gap must be smooth at
+the scale of the window; at least ``EDGE_MIN_POINTS`` points), when the fit
 explains ``r`` to ``EDGE_FIT_RTOL`` of its size (the root then kept within
 half a grid step of the last contact point and the first open point);
 otherwise (short open runs, rough gaps) at the root of the line through the
 first two open points, kept within the step between them.
 (The other side's ``p^2``, linear for a ``sqrt`` edge, carries the
 collocation error itself: 2e-5 of the fraction at 65,536 points.)
+
+The quartic's reach.  A least-squares quartic on ``[lo, hi]`` steps beyond
+the edge converges to ``r`` at the rate of the largest Bernstein ellipse
+about the window in which ``r`` is analytic: with the nearest singularity
+of ``r`` at a distance ``R`` from the edge, ``rho = z + sqrt(z^2 - 1)``
+with ``z = 2 R / hi - 1`` where it lies ahead of the edge (in the open run)
+and ``z = 2 R / hi + 1`` behind it (in the contact patch), and the fit's
+error goes as ``rho^-5``.  ``r`` has such singularities at the other end of
+the edge's contact patch (on a Hertzian or Westergaard patch of width
+``w`` the gap beyond one edge is singular at the other, ``R = w``), and at
+each kink of a piecewise-linear gap (a height map's interpolant,
+:func:`kinks`): ahead of the edge ``g0`` itself has a slope that jumps
+there; behind it, in contact, ``g0''``'s Dirac makes the pressure
+singular like ``ln|x - x_k|`` (its Hilbert transform), and the gap's
+continuation beyond the edge, an integral of that pressure against the
+logarithmic kernel, carries the singularity with it.  So the window
+reaches at most ``1 / EDGE_REACH_SHARE`` of the distance from the last
+contact point to the nearest of them (its patch's length; the nearest kink,
+on either side): at half that distance ``rho >= 3 + sqrt 8``, ``rho^-5 <=
+1.5e-4`` ahead and ``rho^-5 <= 1e-5`` behind, while a window reaching the
+singularity (``z = 1`` ahead) does not converge at all.  Without that
+reach, the window of a contact island a few hundred steps wide at a sample
+of a random profile spanned up to twice the island, and the island's
+located edges jumped by half a step or more between 2^18, 2^19 and 2^20
+points (random profiles of 64 samples, seeds 2 and 7 at p = 0.001, one
+step worth 1e-4 of the normal stiffness); within it they agree to a
+twentieth of a step.  An edge within a few steps of a kink is left to the
+line (the window holds too few points), as a smooth gap's narrow patch.
 
 The normal stiffness in 2D (exact contact) on the located set.  The tangent
 problem at a fixed contact set is a flat punch: its pressure ``p'`` is
@@ -67,9 +95,14 @@ from ngcontact.solvers.constrained_cg import masked_cg
 EDGE_WINDOW = (40, 400)
 #: fewest points of a (shortened) window: below, the line through the first two open points
 EDGE_MIN_POINTS = 12
+#: the share of the open run ahead of the edge that the window may reach
 EDGE_RUN_SHARE = 16
+#: the window reaches at most this share of the distance to its patch's other end or the nearest kink (docstring)
+EDGE_REACH_SHARE = 2
 #: largest rms misfit of that quartic, relative to the largest ``gap^(2/3)`` in the window
 EDGE_FIT_RTOL = 1e-4
+#: a point's second difference of the gap over the smaller of its neighbours' that makes it a kink
+KINK_RATIO = 4.0
 
 
 def contact_fraction(cell, p: np.ndarray, gap: np.ndarray) -> float:
@@ -98,11 +131,13 @@ def located_edges(cell, on: np.ndarray, gap: np.ndarray) -> list[tuple[int, int,
     if cell.dim == 3 or on.all() or not on.any():
         return []
     root = np.maximum(gap, 0.0) ** (2.0 / 3.0)       # smooth, with a simple root at a smooth contact edge
-    return [(int(i), step, edge_offset(root, on, int(i), step)[0])
+    at = np.flatnonzero(kinks(cell.g0))
+    return [(int(i), step, edge_offset(root, on, int(i), step, at)[0])
             for step in (1, -1) for i in np.flatnonzero(on & ~np.roll(on, -step))]
 
 
-def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int) -> tuple[float, bool]:
+def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int,
+                at: np.ndarray | None = None) -> tuple[float, bool]:
     """Distance in grid steps from the last contact point ``i`` to the edge (module docstring), and whether
     the quartic located it (``False``: the line through the first two open points).
 
@@ -111,7 +146,10 @@ def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int) -> tuple[fl
     few in contact).
 
     ``root = gap^(2/3)`` on the periodic grid, ``step = +1`` (edge to the
-    right of ``i``) or ``-1``.
+    right of ``i``) or ``-1``; ``at`` the points at a kink of the gap
+    (:func:`kinks`; none where not given).  The window reaches at most
+    ``1 / EDGE_REACH_SHARE`` of the way to the other end of the edge's
+    contact patch and to the nearest kink (module docstring).
     """
     n = root.size
     a, b = root[(i + step) % n], root[(i + 2 * step) % n]
@@ -119,7 +157,9 @@ def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int) -> tuple[fl
     offset = 1.0 - min(max(line, 0.0), 1.0)
     ahead = (i + step * np.arange(1, n)) % n
     run = int(np.argmax(on[ahead])) if on[ahead].any() else n - 1     # open points before the next contact
-    hi = min(EDGE_WINDOW[1], run // EDGE_RUN_SHARE)
+    patch = int(np.argmin(on[(i - step * np.arange(n)) % n]))         # contact points back to the patch's end
+    kink = int(np.abs((at - i + n // 2) % n - n // 2).min()) if at is not None and at.size else n
+    hi = min(EDGE_WINDOW[1], run // EDGE_RUN_SHARE, patch // EDGE_REACH_SHARE, kink // EDGE_REACH_SHARE)
     lo = max(EDGE_WINDOW[0] * hi // EDGE_WINDOW[1], 2)
     if hi - lo < EDGE_MIN_POINTS:
         return offset, False
@@ -136,6 +176,18 @@ def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int) -> tuple[fl
     return float(real[np.argmin(np.abs(real - offset))]), True
 
 
+def kinks(g0: np.ndarray) -> np.ndarray:
+    """The points of a periodic 1D gap at a kink of its piecewise-linear interpolant
+    (:mod:`~ngcontact.cell.spectral.contact_edges`): whose
+    second difference ``c_i = |g_(i-1) - 2 g_i + g_(i+1)|`` exceeds :data:`KINK_RATIO` times the larger of
+    ``c_(i-2)`` and ``c_(i+2)``, and rounding.  A Dirac of ``g0''`` falls on the one or two points beside the kink
+    (on a point, or between two), while a smooth curvature varies little over two steps: where it crosses zero
+    linearly, ``c_i = a |x_i|`` lies below ``a (|x_i| + 2 h)``, the larger of the two."""
+    c = np.abs(np.roll(g0, 1) - 2.0 * g0 + np.roll(g0, -1))
+    beside = np.maximum(np.roll(c, 2), np.roll(c, -2))
+    return (c > KINK_RATIO * beside) & (c > 1e3 * np.finfo(float).eps * float(np.abs(g0).max()))
+
+
 def edges_fitted(cell, p: np.ndarray, gap: np.ndarray) -> bool:
     """Whether every contact edge of a 2D cell with contact and an open gap is located by the quartic of
     :func:`edge_offset` (the sharp locator; module docstring); ``False`` in 3D, in full contact or without
@@ -144,7 +196,8 @@ def edges_fitted(cell, p: np.ndarray, gap: np.ndarray) -> bool:
     if cell.dim == 3 or on.all() or not on.any():
         return False
     root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
-    return all(edge_offset(root, on, int(i), step)[1]
+    at = np.flatnonzero(kinks(cell.g0))
+    return all(edge_offset(root, on, int(i), step, at)[1]
                for step in (1, -1) for i in np.flatnonzero(on & ~np.roll(on, -step)))
 
 
