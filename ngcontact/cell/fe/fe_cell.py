@@ -183,7 +183,6 @@ class FECell:
 
     def share_resolution(self) -> None:
         """None: the share is measured on the spectral twin, which resolves it there (:meth:`share_solver`)."""
-        return None
 
     def refiner(self) -> Refiner | None:
         """The discretizations that refine this cell where it cannot be graded

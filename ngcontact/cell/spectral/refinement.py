@@ -11,15 +11,14 @@ it, converge as the grid step ``h`` shrinks.  How they converge decides the esti
 * the mean closure is a mean of the collocated jump: smoother, but its error changes sign as the grid
   crosses the contact edges.
 
-So the sequence ``q_0, q_1, ...`` of a quantity on levels ``k`` has errors ``e_k = q_k - q`` that fall
-like ``rho^k`` on the whole, but level to level by an erratic factor, and that may cross zero.  The
-estimate of the reported (finest) level ``k`` looks at the last ``WINDOW`` differences ``d_j = q_j - q_(j-1)``
-(``j = k, k-1, k-2``) of each headline quantity and each load on its own
-(:func:`ngcontact.cell.cell_solution.headline`: the contact fraction, the mean closure, the normal
-effective stiffness and the coefficients of eq. 34 on the real contact set), in the measure the verdict
-controls (:func:`ngcontact.cell.cell_solution.measure`: the contact fraction absolute, a coefficient
-relative to the largest of its group, every other quantity relative), and takes one of two forms, which
-the report names (:func:`sweep_estimates`):
+So the sequence ``q_0, q_1, ...`` of a quantity on levels ``k`` has errors ``e_k = q_k - q`` that fall like ``rho^k``
+on the whole, but level to level by an erratic factor, and that may cross zero.  The estimate of the reported
+(finest) level ``k`` looks at the last ``WINDOW`` differences ``d_j = q_j - q_(j-1)`` (``j = k, k-1, k-2``) of each
+headline quantity and each load on its own (:func:`ngcontact.cell.cell_solution.headline`: the contact fraction, the
+mean closure, the normal effective stiffness and the coefficients of eq. 34 on the real contact set), in the measure
+the verdict controls (:func:`ngcontact.cell.cell_solution.measure`: the contact fraction absolute, a coefficient
+relative to the largest of its group, every other quantity relative), and takes one of two forms, which the report
+names (:func:`sweep_estimates`):
 
 1. **Richardson with the observed rate**, where the sequence is seen to be geometric: the two successive
    ratios ``|d_(k-1)| / |d_(k-2)|`` and ``|d_k| / |d_(k-1)|`` agree within the factor :data:`AGREE` and
@@ -46,19 +45,18 @@ the report names (:func:`sweep_estimates`):
    count of points whose constant jumps with the edges) is bounded by the ones before it; the tail ``D rho /
    (1 - rho)``, on the levels since where the last ratio is twice as fast (:mod:`.estimate_forms`).
 
-In 2D the contact fraction and the coefficients of eq. 34 rest on edges located between points by one of
-two locators (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`): the quartic fitted to the open
-gap where its window holds enough points and the fit explains the gap, else the line through the first
-two open points, whose root is off by a fraction of a step (first order, with a constant that jumps with
-the edges' position between points; in 3D the fraction counts points, alike).  A window holding such levels
-takes the guarded bound for these quantities: two ratios of such differences agree by chance (an error
-that stalls over two grids, as on a profile with kinks, alternates as if geometric).  On a
-smooth gap the quartic takes over at a grid fixed by its window (every edge of a load:
-:func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`, recorded per level), and the error drops there
-by one to two orders of magnitude.  A difference between a level of the line and one of the quartic is the
-line's error, not a term of the quartic's sequence: the window then bounds the error by the line's, which
-exceeds it by that drop.  So, for these quantities of a load whose edges have been fitted on the last
-``r`` levels (:func:`fitted_run`), after levels of the line:
+In 2D the contact fraction and the coefficients of eq. 34 rest on edges located between points by one of two locators
+(:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`): the quartic fitted to the open gap where its window
+holds enough points and the fit explains the gap, else the line through the first two open points, whose root is off
+by a fraction of a step (first order, with a constant that jumps with the edges' position between points; in 3D the
+fraction counts points, alike).  A window holding such levels takes the guarded bound for these quantities: two
+ratios of such differences agree by chance (an error that stalls over two grids, as on a profile with kinks,
+alternates as if geometric).  On a smooth gap the quartic takes over at a grid fixed by its window (every edge of a
+load: :func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`, recorded per level), and the error drops there by
+one to two orders of magnitude.  A difference between a level of the line and one of the quartic is the line's error,
+not a term of the quartic's sequence: the window then bounds the error by the line's, which exceeds it by that drop.
+So, for these quantities of a load whose edges have been fitted on the last ``r`` levels (:func:`fitted_run`), after
+levels of the line:
 
 * with ``r >= LOCATOR_LEVELS`` (two differences at least, so that one that vanished is seen beside the
   other) the estimate is also taken on those ``r`` levels alone, by the same rule (Richardson needs three
@@ -96,22 +94,21 @@ the guarded bound) neither are theirs, whose errors are the same edges' misplace
 two ratios may agree by chance where the edges' errors change sign, and its Richardson tail then misses an
 error that grows from one grid to the next.
 
-The normal effective stiffness (:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`) is in 3D
-that of the collocated contact set, whose pressure, singular like the inverse square root of the distance to an
-edge, converges at first order with a constant that the edges' position between points makes erratic: estimated
-at first order, doubled (:data:`ERRATIC`).  In 2D (exact contact) it is that of the set with its edges located
-between points: its error is the located edges', and it is estimated as the fraction is.  In 2D it
-is held to the tolerance like the others, within a stated cap (:func:`stiffness_capped`): once every other
-quantity meets the tolerance, refinement goes on for the stiffness alone for at most :data:`STIFFNESS_LEVELS`
-more levels within the largest grid, and only while its estimate, were it to fall by :data:`STIFFNESS_RATE` per
-level (second order: faster than the first order of edges located to a fraction of a step, so that a stiffness
-whose guarded estimate collapses once its differences contract, as on the random profiles of
-``docs/benchmarks.md`` (``random_profile_accuracy``), is not given up early), could meet it within them.  Beyond
-the cap (a tolerance of 1e-4 where a narrow contact island, whose stiffness is sensitive to its width, has an edge
-located to a fraction of a step only) the refinement stops, ``met = False``, the stiffness counted
-in the verdict as not met (one warning line) and the cap named in the remarks; a scene's stated tolerance so missed
-ends its run (:meth:`~ngcontact.cell.spectral.spectral_solver.SpectralCellSolver.refine_to`).  In 3D, whose cost
-bound (points squared) allows a few doublings only, it is reported with its estimate and not held
+The normal effective stiffness (:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`) is in 3D that of
+the collocated contact set, whose pressure, singular like the inverse square root of the distance to an edge,
+converges at first order with a constant that the edges' position between points makes erratic: estimated at first
+order, doubled (:data:`ERRATIC`).  In 2D (exact contact) it is that of the set with its edges located between points:
+its error is the located edges', and it is estimated as the fraction is.  In 2D it is held to the tolerance like the
+others, within a stated cap (:func:`stiffness_capped`): once every other quantity meets the tolerance, refinement
+goes on for the stiffness alone for at most :data:`STIFFNESS_LEVELS` more levels within the largest grid, and only
+while its estimate, were it to fall by :data:`STIFFNESS_RATE` per level (second order: faster than the first order of
+edges located to a fraction of a step, so that a stiffness whose guarded estimate collapses once its differences
+contract, as on the random profiles of ``docs/benchmarks.md`` (``random_profile_accuracy``), is not given up early),
+could meet it within them.  Beyond the cap (a tolerance of 1e-4 where a narrow contact island, whose stiffness is
+sensitive to its width, has an edge located to a fraction of a step only) the refinement stops, ``met = False``, the
+stiffness counted in the verdict as not met (one warning line) and the cap named in the remarks; a scene's stated
+tolerance so missed ends its run (:meth:`~ngcontact.cell.spectral.spectral_solver.SpectralCellSolver.refine_to`).  In
+3D, whose cost bound (points squared) allows a few doublings only, it is reported with its estimate and not held
 (:func:`uncontrolled`: listed in the verdict as not counted).
 
 Two checks end a level's estimate. An island of fewer than :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS`
