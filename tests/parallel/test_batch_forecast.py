@@ -134,7 +134,8 @@ def test_workers_start_with_the_run_only_where_the_last_run_of_the_batch_says_th
         ex.map(burn, [0.01] * members, names, label="ensemble")
     [record] = os.listdir(cache / batch_forecast.FOLDER)
     forecast = batch_forecast.recorded(record[:-len(".json")])
-    assert forecast.members == members and 0.01 <= forecast.member_seconds < 0.05
+    # each member burns 0.01 CPU s by process_time; the record's clock may read a hair less (0.00997 was seen)
+    assert forecast.members == members and 0.009 <= forecast.member_seconds < 0.05
     with runner.batches(scene, workers=2) as ex:            # 30 x 0.01 s do not repay two workers
         assert ex.pools_started == 0
     monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
