@@ -31,14 +31,12 @@ by more than ``1/k_n``: its compression ``p / k_n`` acts on the rigid contact as
 ``p`` growing like the square root of the distance ``s`` from an edge that change has a slope like ``s^(-1/2)``,
 whose weight against the edge's own ``s^(-1/2)`` diverges like ``ln s``; it is cut off at the length ``lambda =
 E*/k_n`` (``1/E* = sum (1 - nu^2)/E`` over the two bodies) below which the layer, not the bodies, carries the
-pressure. So the edge moves by ``lambda (A ln(1/lambda) + B)``, ``A`` and ``B`` set by the geometry: on
-Westergaard's sinusoid (layers of depth 1) at a twentieth of its closing pressure the contact fraction's share per
-edge is ``1.16, 1.52, 1.84 lambda`` at ``k_n = 1e3, 1e4, 1e5`` (on 1,048,576 points), a slope of ``0.15`` per unit
-of ``ln(1/lambda)``. Most of that move lies within a few ``lambda`` of the edge, which a grid whose step is not
+pressure. So the edge moves by ``lambda (A ln(1/lambda) + B)``, ``A`` and ``B`` set by the geometry (on
+Westergaard's sinusoid the share per edge, measured on grids that resolve ``lambda``, grows linearly in
+``ln(1/lambda)``). Most of that move lies within a few ``lambda`` of the edge, which a grid whose step is not
 well below ``lambda`` does not see: its edges are located on points farther away
-(:mod:`ngcontact.cell.spectral.contact_edges`, the penalty zone), and its penalized sweep minus its exact one is
-37 % of the share at ``k_n = 1e5`` and a third at ``1e6`` (``8.7e-7`` on 16,384 points against ``2.44e-6`` of the
-fraction, the latter measured on 4,194,304 points). A share model that says so
+(:mod:`ngcontact.cell.spectral.contact_edges`, the penalty zone), and its penalized sweep minus its exact one
+misses most of the share where ``lambda`` is a fraction of its step. A share model that says so
 (:meth:`~ngcontact.cell.cell_solver.CellSolver.share_resolution`: the 2D spectral cell whose ``lambda`` spans fewer
 than 32 of its steps) is solved again on a grid of at least 32,768 points, exactly and at the two softer penalties
 ``k_1`` and ``k_1 / 2`` whose lengths span 32 and 64 of its steps (``k_1 = k_n`` where ``lambda`` itself does), and
@@ -46,9 +44,8 @@ the two shares ``s_1``, ``s_2`` fix ``A`` and ``B``:
 
     s(k_n) = (k_1 / k_n) [s_1 + (s_1 - s_2 / 2) ln(k_n / k_1) / ln 2].
 
-On the sinusoid from 16,384 points this gives ``2.455e-6`` at ``k_n = 1e6`` (1 % above the measured ``2.44e-6``),
-and at ``1e4`` the three loads' shares within 0.5 % of those measured on 1,048,576 points. The mean closure, an
-integral of the jump that the edges' zone barely moves, keeps the difference of the two sweeps.
+``tests/cell/test_penalty_edges.py`` holds it against the share measured on a grid that resolves ``lambda``.
+The mean closure, an integral of the jump that the edges' zone barely moves, keeps the difference of the two sweeps.
 """
 from __future__ import annotations
 

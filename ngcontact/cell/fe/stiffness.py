@@ -264,9 +264,9 @@ def edge_interpolation(problem, kept: list[int], S: np.ndarray) -> tuple[np.ndar
     x_c)``).  The stiffness of a set held closed grows with its extent: the periodic flat punch of
     half-width ``a``, ``K = pi E* / (2 ln(1 / sin(pi a)))``, the tangent of Westergaard's contact
     (``docs/benchmarks.md``, "The graded FE cell at a stated tolerance"), has ``d ln K / da = pi cot(pi
-    a) / ln(1 / sin(pi a))``, 14 at ``p/p* = 0.8``, so the closed nodes' set, short by ``a - x_c = 1.1e-5``
-    at each edge on the graded mesh of that load at tolerance ``1e-4``, took ``K`` low by 1.4e-4, beyond
-    its estimate.  Linear in the extent between the two sets,
+    a) / ln(1 / sin(pi a))``, large where the contact is wide, so the closed nodes' set, short by ``a - x_c``
+    at each edge, takes ``K`` low by ``(a - x_c) d ln K / da`` relative, which no refinement of the grading
+    shows in time (``tests/cell/test_exact_stiffness_edges.py``).  Linear in the extent between the two sets,
 
         S(a) = S_c + t (S_o - S_c) + O((x_o - x_c)^2),
 
