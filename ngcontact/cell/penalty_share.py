@@ -32,7 +32,7 @@ by more than ``1/k_n``: its compression ``p / k_n`` acts on the rigid contact as
 whose weight against the edge's own ``s^(-1/2)`` diverges like ``ln s``; it is cut off at the length ``lambda =
 E*/k_n`` (``1/E* = sum (1 - nu^2)/E`` over the two bodies) below which the layer, not the bodies, carries the
 pressure. So the edge moves by ``lambda (A ln(1/lambda) + B)``, ``A`` and ``B`` set by the geometry (on
-Westergaard's sinusoid the share per edge, measured on grids that resolve ``lambda``, grows linearly in
+Westergaard's sinusoid the share per edge, on grids that resolve ``lambda``, grows linearly in
 ``ln(1/lambda)``). Most of that move lies within a few ``lambda`` of the edge, which a grid whose step is not
 well below ``lambda`` does not see: its edges are located on points farther away
 (:mod:`ngcontact.cell.spectral.contact_edges`, the penalty zone), and its penalized sweep minus its exact one
@@ -44,7 +44,7 @@ the two shares ``s_1``, ``s_2`` fix ``A`` and ``B``:
 
     s(k_n) = (k_1 / k_n) [s_1 + (s_1 - s_2 / 2) ln(k_n / k_1) / ln 2].
 
-``tests/cell/test_penalty_edges.py`` holds it against the share measured on a grid that resolves ``lambda``.
+``tests/cell/test_penalty_edges.py`` holds it against the share on a grid that resolves ``lambda``.
 The mean closure, an integral of the jump that the edges' zone barely moves, keeps the difference of the two sweeps.
 """
 from __future__ import annotations

@@ -182,7 +182,7 @@ class FECell:
         return self.variant(**changes) if self.variant is not None else None
 
     def share_resolution(self) -> None:
-        """None: the share is measured on the spectral twin, which resolves it there (:meth:`share_solver`)."""
+        """None: the share comes from the spectral twin, which resolves it there (:meth:`share_solver`)."""
 
     def refiner(self) -> Refiner | None:
         """The discretizations that refine this cell where it cannot be graded
