@@ -131,9 +131,9 @@ hide (at ``k_n = 1e4`` refined to 1e-4 the contact fraction's guarded estimate o
 never Richardson's; a stop does not wait for them, :func:`locator_changing`: the whole window's bound stands).
 Every quantity of a load, the mean closure and the stiffness too, changes once more as the step falls below
 ``lambda``: the collocated pressure then resolves the layer's zone at each edge, which coarser grids pass over.
-On Westergaard's sinusoid at ``k_n = 1e4`` the mean closure's differences contract over five grids to 1024 points,
-then turn and stay near one size up to the grid whose step is ``lambda`` (``scripts/penalty_effectivity.py``): a
-sequence seen as geometric before that change says nothing of it.  So on a level whose step exceeds ``lambda``
+On Westergaard's sinusoid the mean closure's differences contract over several grids, then turn and stay near one
+size down to the grid whose step is ``lambda`` (``tests/cell/test_penalty_edges.py``): a sequence seen as geometric
+before that change says nothing of it.  So on a level whose step exceeds ``lambda``
 (:func:`zone_ahead`) no quantity of the load takes Richardson's tail, only the guarded bound, whose envelope
 keeps the earlier, larger differences.
 """
