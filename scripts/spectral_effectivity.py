@@ -76,6 +76,8 @@ class Oracle:
     first: int
     largest: int
     reference: int
+    k_n: float = 1e3              # the Winkler layer's stiffness (eq. 65) where ``enforcement`` is "penalty"
+    enforcement: str = "exact"
 
 
 def westergaard_gap(n: int) -> np.ndarray:
@@ -115,7 +117,8 @@ class Solved:
     def __init__(self, oracle: Oracle, n: int):
         self.oracle, self.n = oracle, n
         self.cell = SpectralCell(dim=oracle.dim, period=1.0, grid=n, rough=Layer(1.0, NU, DEPTH),
-                                 counter=Layer(1.0, NU, DEPTH), gap=oracle.gap(n), k_n=1e3, enforcement="exact",
+                                 counter=Layer(1.0, NU, DEPTH), gap=oracle.gap(n), k_n=oracle.k_n,
+                                 enforcement=oracle.enforcement,
                                  tol=1e-12, max_iter=100000)
         self.points = self.cell.points
 

@@ -12,6 +12,7 @@ from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.penalty_share import penalty_share
 from ngcontact.cell.spectral.contact_edges import PENALTY_ZONE, penalty_length
+from ngcontact.cell.spectral.estimate_forms import RICHARDSON
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral.refinement import sweep_to_tolerance
 from ngcontact.cell.spectral.spectral_solver import SpectralCellSolver
@@ -48,6 +49,21 @@ def test_a_penalty_refined_to_a_tolerance_bounds_the_error_of_its_edges(k_n):
             assert effectivity >= 1.0, (k, name, effectivity)
             if name == "contact_fraction":
                 assert effectivity <= 10.0 and refined.forms[k][name] == PENALTY_ZONE, (k, effectivity)
+
+
+def test_no_richardson_tail_before_the_grid_resolves_the_penalty_zone():
+    """At ``k_n = 1e4`` refined to 1e-2 the heaviest load's mean closure contracts over five grids, then its
+    differences turn as the step nears ``lambda``: a Richardson tail on 4096 points was 0.84 of its error against
+    the same cell on 2^17 points.  On levels whose step exceeds ``lambda`` every estimate is the guarded bound,
+    and bounds that error."""
+    loads = [cell_load(2, pressure=PRESSURES[2])]
+    refined = sweep_to_tolerance(lambda n: _cell(n, 1e4), loads, 1e-2, 64, 2, 2 ** 22)
+    grid = refined.history[-1]["grid"]
+    assert grid * penalty_length(_cell(grid, 1e4)) < 1.0           # the step exceeds lambda
+    head, exact = headline(refined.solutions[0].results), headline(_cell(2 ** 17, 1e4).sweep(loads)[0].results)
+    for name, estimate in refined.estimates[0].items():
+        assert refined.forms[0][name] != RICHARDSON, name
+        assert estimate >= abs(head[name] - exact[name]) / refined.scales[0][name], name
 
 
 def _solver(grid, k_n, enforcement="penalty"):

@@ -129,6 +129,13 @@ hide (at ``k_n = 1e4`` refined to 1e-4 the contact fraction's guarded estimate o
 1.3 times that error).  A run of levels whose edges are all located so is a locator's own, as the quartic's
 (:func:`fitted_run`): a window across the change from the quartic's levels is also taken on them alone (guarded,
 never Richardson's; a stop does not wait for them, :func:`locator_changing`: the whole window's bound stands).
+Every quantity of a load, the mean closure and the stiffness too, changes once more as the step falls below
+``lambda``: the collocated pressure then resolves the layer's zone at each edge, which coarser grids pass over.
+On Westergaard's sinusoid the mean closure's differences contract over several grids, then turn and stay near one
+size down to the grid whose step is ``lambda`` (``tests/cell/test_penalty_edges.py``): a sequence seen as geometric
+before that change says nothing of it.  So on a level whose step exceeds ``lambda``
+(:func:`zone_ahead`) no quantity of the load takes Richardson's tail, only the guarded bound, whose envelope
+keeps the earlier, larger differences.
 """
 from __future__ import annotations
 
@@ -324,6 +331,12 @@ def stiffness_share(cell, p: np.ndarray, gap: np.ndarray) -> float:
                if key in shares)
 
 
+def zone_ahead(entry: dict[str, Any], k: int) -> bool:
+    """Whether a level's step exceeds the penalty's length ``lambda`` at load ``k`` with edges in contact: the
+    change of regime where the grid comes to resolve the penalty's zone lies ahead (module docstring)."""
+    return not entry.get("islands", [{}] * (k + 1))[k].get("penalty", {}).get("resolved", True)
+
+
 def penalty_length(cell) -> float:
     """The length ``lambda = E* / k_n`` over which a 2D penalty's edge departs from a rigid one (module docstring):
     ``E*`` the plane-strain modulus of the two bodies in series, ``1 / E* = sum (1 - nu^2) / E``; 0 for exact
@@ -339,12 +352,12 @@ def penalty_zone_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
     quartic, or by the line on a step above ``lambda``) may be off by ``B = PENALTY_LOG lambda ln(P / lambda)``,
     one located by the line within it by :data:`INSIDE_STEP` of a step ``h``: the contact fraction by that over
     ``P``, ``K0`` ``k_n`` times as much, ``g_n`` that times the largest ``g0`` within it and a step of the edge.
-    ``{"edges": how many beyond, "bound": B, "inside": whether none is, "share": {headline name: absolute
-    share}}``; no share without a penalty's edges."""
+    ``{"edges": how many beyond, "bound": B, "inside": whether none is, "resolved": whether the step is at most
+    lambda (:func:`zone_ahead`), "share": {headline name: absolute share}}``; no share without a penalty's edges."""
     lam, on, n = penalty_length(cell), p > 0, p.size
-    if lam <= 0.0 or on.all() or not on.any():
-        return {"edges": 0, "bound": 0.0, "share": {}, "inside": False}
     step = cell.period / n
+    if lam <= 0.0 or on.all() or not on.any():
+        return {"edges": 0, "bound": 0.0, "share": {}, "inside": False, "resolved": True}
     bound = PENALTY_LOG * lam * max(np.log(cell.period / lam), 1.0)
     root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
     edges, total, heights = 0, 0.0, 0.0
@@ -355,7 +368,7 @@ def penalty_zone_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
             reach = int(np.ceil(off / step)) + 1
             edges, total = edges + beyond, total + off
             heights += off * float(cell.g0[np.arange(i - reach, i + reach + 1) % n].max())
-    return {"edges": edges, "bound": bound, "inside": not edges, "share": {
+    return {"edges": edges, "bound": bound, "inside": not edges, "resolved": step <= lam, "share": {
         "contact_fraction": total / cell.period, COEFFICIENT + "k_n": cell.k_n * total / cell.period,
         COEFFICIENT + "g_n": cell.k_n * heights / cell.period}}
 

@@ -111,28 +111,27 @@ tolerance so missed ends its run (:meth:`~ngcontact.cell.spectral.spectral_solve
 3D, whose cost bound (points squared) allows a few doublings only, it is reported with its estimate and not held
 (:func:`uncontrolled`: listed in the verdict as not counted).
 
-Two checks end a level's estimate. An island of fewer than :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS`
-points (3D: across) has no resolved edges: its error may stall while the differences vanish, so its share of the
-quantities on the edges is a floor under their estimates (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`,
-form ``island``; a 2D edge of a map with kinks, a step within a step of one, else a quarter: ``kink``; a penalty's 2D
-edge located on points beyond its length ``E*/k_n``: ``penalty zone``, whose error no difference shows either); a window
-across the level where the last island came to be resolved is also taken on the resolved levels alone, the smaller
-reported (the same module's docstring). An estimate (not
-Richardson's nor an island's) above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last
-difference leaves at the last contraction, or (any form) at the one before where the last is twice as slow or more,
-may exceed the error by as much: flagged with its reason, per quantity in the report
+Two checks end a level's estimate. An island of fewer than
+:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: its error may
+stall while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
+(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``; a 2D edge of a map with kinks, a step
+within a step of one, else a quarter: ``kink``; a penalty's 2D edge located on points beyond its length ``E*/k_n``:
+``penalty zone``, whose error no difference shows either); a window across the level where the last island came to be
+resolved is also taken on the resolved levels alone, the smaller reported (the same module's docstring). An estimate
+(not Richardson's nor an island's) above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its
+last difference leaves at the last contraction, or (any form) at the one before where the last is twice as slow or
+more, may exceed the error by as much: flagged with its reason, per quantity in the report
 (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
 Levels double the points per direction (:data:`GROWTH`): three differences cost twice the finest level in 2D, 4/3 in 3D.
 
 Its effectivity (estimate over the true error of the reported level) is measured by
-``scripts/spectral_effectivity.py`` on Westergaard's sinusoid, a random 2D profile and a 3D bisinusoid
-against each cell's own value on a much finer grid (``docs/benchmarks.md``).  No estimate from the levels
-up to ``k`` can be sharp where the error of level ``k`` itself is small by chance: where it crosses zero
-between two grids, or where it falls by much more than the differences before it show (a pre-asymptotic
-stretch left for a faster regime that no recorded change of method marks, unlike the 2D edge locator
-above), the differences up to level ``k`` still carry the size of the earlier errors, and the estimate
-exceeds the error by their ratio.
+``scripts/spectral_effectivity.py`` on Westergaard's sinusoid, a random 2D profile and a 3D bisinusoid against each
+cell's own value on a much finer grid (``docs/benchmarks.md``).  No estimate from the levels up to ``k`` can be sharp
+where the error of level ``k`` itself is small by chance: where it crosses zero between two grids, or where it falls
+by much more than the differences before it show (a pre-asymptotic stretch left for a faster regime that no recorded
+change of method marks, unlike the 2D edge locator above), the differences up to level ``k`` still carry the size of
+the earlier errors, and the estimate exceeds the error by their ratio.
 
 A stop needs ``MIN_LEVELS`` levels (three differences: the window) and, to a scene's own tolerance, no load's
 edge locator changing (above).  The levels are known before the first solve (``grid`` times ``GROWTH^k`` up to
@@ -156,7 +155,7 @@ import numpy as np
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
 from ngcontact.cell.spectral.contact_edges import (INSIDE, ISLAND_POINTS, LOCATED_STEP, PENALTY_LOG, fitted_run,
                                                    island_floor, locator_kind, on_edges, resolved_run, unresolved_share,
-                                                   locator_changing as edges_changing)
+                                                   zone_ahead, locator_changing as edges_changing)
 from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, DISAGREE, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP,
                                                     RATE_FLOOR, SAFETY, SPREAD, WINDOW, loose_flags, loose_remarks,
                                                     tail_estimate)
@@ -282,6 +281,7 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
     dim = 2 if history[-1].get("points") == history[-1].get("grid") else 3      # 3D: points = grid^2
     for k, last in enumerate(history[-1]["headline"]):
         out: dict[str, float] = {}
+        ahead = zone_ahead(history[-1], k)      # a penalty's zone not yet resolved (contact_edges)
         form: dict[str, str] = {}
         for name in last:
             values = [h["headline"][k].get(name) for h in history]
@@ -289,9 +289,9 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
                 continue
             size = scale(name, last, history[-1]["whole_surface"])
             located = on_edges(name) or (name == STIFFNESS and dim == 2)       # 2D: the located set's stiffness
-            # not geometric: a coefficient where the fraction is not (its edges), a penalty's line within E*/k_n
+            # not geometric: a coefficient where the fraction is not, a penalty's line within E*/k_n or zone ahead
             geometric = geometric_ok and not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED
-                                              or located and locator_kind(history[-1], k) == INSIDE)
+                                              or located and locator_kind(history[-1], k) == INSIDE or ahead)
             args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size)
             fitted = fitted_run(history, k) if located else len(history)
             run = min(fitted, resolved_run(history, k))        # levels of the quartic and of resolved islands
