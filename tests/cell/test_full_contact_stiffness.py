@@ -13,6 +13,8 @@ import sys
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
 import fe_effectivity  # noqa: E402
 
+from ngcontact.cell.cell_solution import headline  # noqa: E402
+from ngcontact.cell.fe.saturation import estimate_on_scene  # noqa: E402
 from ngcontact.drivers.build import cell_loads, cell_solver  # noqa: E402
 from ngcontact.scene.loader import load_with_contact  # noqa: E402
 
@@ -28,7 +30,23 @@ def test_every_level_of_a_full_contact_gives_k_n_and_the_script_takes_their_spre
     assert all(e["contact_fraction"] > 1.0 - 1e-12 for e in levels)
     errors = [abs(e["headline"]["normal_stiffness"] / k_n - 1.0) for e in levels]
     assert max(errors) < 1e-7, errors                                # exact but for round-off
-    roundoff = fe_effectivity.full_contact_roundoff(refined.per_load[0], "normal_stiffness", k_n, None)
+    got = headline(refined.solutions[0].results)
+    roundoff = fe_effectivity.full_contact_roundoff(refined.per_load[0], got, "normal_stiffness", k_n, None)
     assert abs(roundoff - max(errors)) < 1e-15    # its measure: relative to the reference
     partial = [dict(levels[0], contact_fraction=0.9)] + levels[1:]
-    assert fe_effectivity.full_contact_roundoff({"mesh_history": partial}, "normal_stiffness", k_n, None) == 0.0
+    assert fe_effectivity.full_contact_roundoff({"mesh_history": partial}, got, "normal_stiffness", k_n, None) == 0
+    assert fe_effectivity.full_contact_roundoff(None, got, "normal_stiffness", k_n, None) == 0   # the answer alone
+
+
+def test_the_scene_and_one_order_more_in_full_contact_each_give_k_n():
+    """The default estimate's two sweeps (``next_order``) are exact but for round-off too."""
+    scene = load_with_contact(os.path.join(fe_effectivity.ROOT, "geometries", "cells", "westergaard.toml"), None,
+                              "fe", None)
+    load = cell_loads(scene)[-1]
+    refined = estimate_on_scene(cell_solver(scene), [load])
+    got, more = headline(refined.solutions[0].results), refined.per_load[0]["next_order"]
+    k_n = float(scene.contact.k_n)
+    errors = [abs(h["normal_stiffness"] / k_n - 1.0) for h in (got, more)]
+    assert max(errors) < 1e-7, errors
+    roundoff = fe_effectivity.full_contact_roundoff(refined.per_load[0], got, "normal_stiffness", k_n, None)
+    assert abs(roundoff - max(errors)) < 1e-15
