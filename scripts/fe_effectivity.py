@@ -17,7 +17,13 @@ falling like the grid step, which bounds a 2D coefficient's too).  The quantitie
 a flat frictionless cell estimates (``QUANTITIES``), each in its measure (``ngcontact.cell.cell_solution.measure``).
 For each cell, load and quantity the script writes the value, the estimate, the true error against the oracle
 and their ratio, the effectivity (issue 35 asks for it between 1 and 10); a true error at round-off (below
-``FLOOR``) or within the oracle's resolution has no effectivity.
+``FLOOR``) or within the oracle's resolution has no effectivity.  Nor has the normal stiffness of a load in full
+contact: the tangent problem of a closed flat interface (uniform springs between uniform layers) has a solution
+linear through each layer, in every FE space, so each level of the refinement gives the exact stiffness but for
+round-off, which the difference of nearly equal compliances ``S^-1 - S_0^-1`` amplifies (``k_n = 1e3`` against
+layers of compliance 3: a thousandfold); that round-off is measured as the largest distance from the
+reference of the discretizations the estimate solved (the refinement's levels, or the scene's order and the one
+more of ``next_order``: :func:`full_contact_roundoff`) and counts as the oracle's resolution.
 
     python scripts/fe_effectivity.py [OUT] [--cells NAME ...] [--only HOW ...] [--publish]
 
@@ -61,7 +67,9 @@ NOTE = ("Shipped FE cells at the default tolerance 0.01. Refined (a stated toler
         "one order more on the same mesh. default (what a scene without a tolerance reports): next_order where it "
         "meets 0.01, else the refinement within discretization.budget_dofs. The reference is the same model "
         "(layers, k_n) on the spectral grid; its "
-        "resolution the change from a coarser grid (2D contact fraction: at least its collocation error); no "
+        "resolution the change from a coarser grid (2D contact fraction: at least its collocation error; the "
+        "normal stiffness of a load in full contact: at least the largest distance from it of the discretizations "
+        "the estimate solved, each exact but for round-off); no "
         "effectivity where the true error is within it (a 2D coefficient: at least the fraction's). Contact "
         "fraction absolute, mean closure and normal_stiffness (the effective stiffness) relative, the coefficients "
         "k_n and g_n of eq. 34 on the real contact set relative to their whole-surface values; seconds: "
@@ -77,6 +85,24 @@ def measure(q: str, v: float, r: float, whole: dict | None = None) -> float:
     absolute, a coefficient relative to its group's whole-surface value, the others relative."""
     return abs(v - r) / scale(q, {q: v}, whole) if q.startswith(COEFFICIENT) else \
         abs(v - r) if q == "contact_fraction" else abs(v - r) / abs(r)
+
+
+def full_contact_roundoff(per_load: dict | None, got: dict, q: str, r: float, whole: dict | None) -> float:
+    """The round-off of the normal stiffness ``q`` of a load whose every discretization solved is in full
+    contact: the answer ``got`` (headline quantities) and those ``per_load`` records (the refinement's
+    ``mesh_history``, or the sweep one order more of ``next_order``), each exact in exact arithmetic (module
+    docstring): their largest distance from the reference ``r`` in its measure; 0 for another quantity, a
+    load not in full contact, or a single discretization (nothing measured beside the answer's own error)."""
+    per_load = per_load or {}
+    levels = [dict(e.get("headline", {}), contact_fraction=e.get("contact_fraction", 0.0))
+              for e in per_load.get("mesh_history") or []]
+    levels += [per_load["next_order"]] if per_load.get("next_order") else []
+    levels.append(got)
+    values = [h.get(q) for h in levels]
+    if q != "normal_stiffness" or len(levels) < 2 or None in values or \
+            any(h.get("contact_fraction", 0.0) < 1.0 - 1e-12 for h in levels):
+        return 0.0
+    return max(measure(q, v, r, whole) for v in values)
 
 
 def estimators(scene, loads) -> dict:
@@ -105,6 +131,7 @@ def rows(name: str, grid: int, only: list[str] | None = None) -> list[dict]:
         t0 = time.perf_counter()
         refined = estimate()
         seconds = time.perf_counter() - t0
+        per_load = getattr(refined, "per_load", None) or [None] * len(refined.solutions)
         for k, (sol, e, ref, low) in enumerate(zip(refined.solutions, refined.estimates, reference, coarser)):
             got, head, below = headline(sol.results), headline(ref.results), headline(low.results)
             for q in (q for q in QUANTITIES if q in e and q in got and q in head):
@@ -113,6 +140,7 @@ def rows(name: str, grid: int, only: list[str] | None = None) -> list[dict]:
                 resolution = measure(q, below[q], r, whole)
                 if (q == "contact_fraction" or q.startswith(COEFFICIENT)) and dim == 2:
                     resolution = max(resolution, COLLOCATION * 65536 / grid)
+                resolution = max(resolution, full_contact_roundoff(per_load[k], got, q, r, whole))
                 out.append({"cell": name, "load": k, "quantity": q, "value": v, "reference": r,
                             "resolution": resolution, "estimate": float(e[q]), "true_error": error,
                             "effectivity": float(e[q]) / error if error > max(FLOOR, resolution) else "",
