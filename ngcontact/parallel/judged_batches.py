@@ -279,7 +279,7 @@ class JudgedBatches(Executor, ABC):
                 with threads_asleep():
                     return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
                                                  shifted_progress(progress, len(done), len(items)), fault)
-            if self._start_still(None)[0] <= forecast.member_seconds:
+            if payoff.start_ahead <= forecast.member_seconds:
                 with threads_asleep():
                     if self._await_ready(forecast.member_seconds):
                         continue
