@@ -230,12 +230,14 @@ class JudgedBatches(Executor, ABC):
             if not payoff.repaid:
                 if beside and len(done) < worker_payoff.MEASURED:
                     continue        # a start beside is kept until the look that has timed the batch
+                stopped = beside
                 if self._launched() and not self._ready() and payoff.rest > 1 or beside:
                     self._abandon_start()   # (a last member here takes one member's time: the start goes on)
                     beside = False
                 if len(done) < worker_payoff.MEASURED:
                     continue        # the second member here measures what the first paid once: look again
-                self._where("serial", payoff.describe(len(done)))
+                self._where("serial", payoff.describe(len(done))
+                            + ("; the workers' fork server started beside the batch stopped" if stopped else ""))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
                 return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
                                             shifted_progress(progress, len(done), len(items)), fault)

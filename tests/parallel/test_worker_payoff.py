@@ -307,6 +307,7 @@ def test_a_batch_kept_here_stops_the_fork_server_started_beside_it_and_forks_no_
         assert pool.pools_started == 0 and pool.describe()["workers_started"] == "never"
         batch = pool.describe()["batches"][-1]
         assert batch["executor"] == "serial" and "the other 2 in this process" in batch["decision"]
+        assert batch["decision"].endswith("the workers' fork server started beside the batch stopped")
         assert pool.map(burn, [0.02] * 3, list("abc"), label="three") == [os.getpid()] * 3
         assert opened == [0]          # a batch with no member beyond the two that time it: no server
     finally:
