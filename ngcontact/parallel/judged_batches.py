@@ -170,13 +170,16 @@ class JudgedBatches(Executor, ABC):
 
     def repays(self, forecast) -> bool:
         """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send a batch (its
-        :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: all its members (a
-        batch so forecast goes to them from its first, :meth:`_sent_on_forecast`), of the forecast's
+        :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now, with a margin: the
+        members after the first ``MEASURED`` (the rest a batch without a forecast sends), of the forecast's
         seconds each, against the part of the start that the run's lead before its batch leaves ahead, a
         worker's first member and the starts' CPU time (before this machine has timed a worker: as the last
-        run's process measured them), on the cores free as the run opens."""
-        return self.payoff(forecast.member_seconds, forecast.members, forecast.lead_seconds,
-                           forecast.first_seconds, forecast.start_seconds).repaid
+        run's process measured them), on the cores free as the run opens.  A batch so forecast goes to the
+        workers from its first member (:meth:`_sent_on_forecast`, where (1) holds for all of it, which it
+        then does by ``MEASURED`` members' work): one that (1) would send only without the margin (the
+        measured scan's kind: 8 members of a tenth of a second) starts no worker before its batch."""
+        return self.payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
+                           forecast.lead_seconds, forecast.first_seconds, forecast.start_seconds).repaid
 
     def start_on_demand(self, modules: Sequence[str] = ()) -> None:
         """Start no worker now: only once a batch's rest repays their start (:meth:`_judged_map`), each

@@ -40,16 +40,16 @@ def test_the_forecast_is_condition_1_on_the_cores_free_as_the_run_opens(monkeypa
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 1.0)
     monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
     pool = executor.LocalPool(2, method=method)
-    # all 16 members (a forecast batch goes to the workers from its first), 0.5 s each, on an idle machine
-    # of two cores: 4 s saved against 1 s of a first member and the 2 s start (and a fork: 0.05 s) less the
-    # lead; on the cores, 8 CPU s against 2 x (2 + 1) s of spawned starts and first members, or one
-    # server's 2 s start shared by the two workers: 2 x (1 + 0.05 + 1) = 4.1 s
+    # 14 members after the two solved here, 0.5 s each, on an idle machine of two cores: 3.5 s saved
+    # against 1 s of a first member and the 2 s start (and a fork: 0.05 s) less the lead; on the cores,
+    # 7 CPU s against 2 x (2 + 1) s of spawned starts and first members, or one server's 2 s start shared
+    # by the two workers: 2 x (1 + 0.05 + 1) = 4.1 s
     assert pool.repays(Forecast(16, 0.5, 1.5)) and pool.repays(Forecast(16, 0.5, 0.0))
     if method == "spawn":
-        assert not pool.repays(Forecast(16, 0.35, 10.0))     # 5.6 CPU s do not repay 6 CPU s
+        assert not pool.repays(Forecast(16, 0.4, 10.0))      # 5.6 CPU s do not repay 6 CPU s
     else:
-        assert pool.repays(Forecast(16, 0.35, 10.0))         # 5.6 CPU s repay 4.1 CPU s
-        assert not pool.repays(Forecast(16, 0.25, 10.0))     # 4 CPU s do not
+        assert pool.repays(Forecast(16, 0.4, 10.0))          # 5.6 CPU s repay 4.1 CPU s
+        assert not pool.repays(Forecast(16, 0.25, 10.0))     # 3.5 CPU s do not
     monkeypatch.setattr(free_cores, "load_average", lambda: 1.0)
     assert not pool.repays(Forecast(16, 0.5, 1.5))           # one core left: the workers would gain none
     assert not pool.repays(Forecast(8, 0.15, 10.0))          # the measured scan's kind: never repaid
@@ -87,12 +87,12 @@ def test_the_forecast_reads_the_cores_over_the_runs_opening_not_the_load_average
 @pytest.mark.parametrize("method", ["spawn", "forkserver"])
 def test_before_a_worker_is_timed_the_forecast_takes_the_last_runs_own_start_and_first_member(monkeypatch,
                                                                                                 method):
-    """The 256^2 ensemble's kind: 16 members of 0.25 s, all sent to the workers.  Against the estimates
+    """The 256^2 ensemble's kind: 14 members of 0.25 s after the two solved here.  Against the estimates
     (2 s start, 1 s first member) they would not repay; against what the last run's process measured before
     its batch (0.8 s of CPU, 0.5 s of them ahead of the batch) and its first member (0.03 s beyond the
-    cheapest), they do, as the rule in the batch will find.  The shipped 64^2 ensemble's kind (32 members of
-    0.04 s): 1.28 CPU s do not repay two spawned starts (2 x 0.83 s), and do repay a fork server's start
-    shared by the two workers and their forks (2 x (0.4 + 0.05 + 0.03) = 0.96 s; 0.64 s saved against
+    cheapest), they do, as the rule in the batch will find.  The shipped 64^2 ensemble's kind (30 members of
+    0.04 s): 1.2 CPU s do not repay two spawned starts (2 x 0.83 s), and do repay a fork server's start
+    shared by the two workers and their forks (2 x (0.4 + 0.05 + 0.03) = 0.96 s; 0.6 s saved against
     0.35 s of the start still ahead and 0.03 s)."""
     monkeypatch.setattr(judged_batches, "START_SECONDS", 2.0)
     monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.05)
@@ -104,7 +104,7 @@ def test_before_a_worker_is_timed_the_forecast_takes_the_last_runs_own_start_and
     assert not pool.repays(Forecast(16, 0.25, 0.5, start_seconds=5.0, first_seconds=3.0))   # held to the estimates
     shipped = Forecast(32, 0.04, 0.5, start_seconds=0.8, first_seconds=0.03)
     assert pool.repays(shipped) == (method == "forkserver")
-    assert not pool.repays(Forecast(32, 0.028, 0.5, start_seconds=0.8, first_seconds=0.03))  # 0.9 CPU s: never
+    assert not pool.repays(Forecast(32, 0.03, 0.5, start_seconds=0.8, first_seconds=0.03))  # 0.9 CPU s: never
 
 
 def test_workers_start_with_the_run_after_a_serial_run_of_the_batch_on_an_idle_machine(monkeypatch, cache):
@@ -158,6 +158,20 @@ def test_the_oldest_records_go_beyond_the_kept_number(monkeypatch, cache):
         os.utime(cache / batch_forecast.FOLDER / f"{name}.json", (k, k))
     batch_forecast.remember("d", Forecast(4, 1.0, 0.0))
     assert sorted(os.listdir(cache / batch_forecast.FOLDER)) == ["c.json", "d.json"]
+
+
+def test_a_forecast_starts_workers_early_only_with_two_members_of_margin(monkeypatch):
+    """The measured scan's kind, on a machine that has timed a fork server (0.7 s), a fork (0.05 s) and a
+    first member (0.02 s): all 8 members of 0.112 s would just repay the two workers (0.9 CPU s against
+    2 x (0.35 + 0.05 + 0.02) = 0.84 CPU s), the 6 after the two a batch without a forecast times here do
+    not (0.67 CPU s): no worker starts with the run for it."""
+    monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
+    for kind, seconds in (("server", 0.7), ("fork", 0.05), ("first_member", 0.02)):
+        batch_forecast.remember_cost(kind, seconds)
+    pool = executor.LocalPool(2, method="forkserver")
+    assert pool.payoff(0.112, 8, 10.0).repaid and not pool.payoff(0.112, 6, 10.0).repaid
+    assert not pool.repays(Forecast(8, 0.112, 10.0))
+    assert pool.repays(Forecast(8, 0.2, 10.0))               # 1.2 CPU s after the two: started with the run
 
 
 def spectrum(seed: int) -> tuple[int, float]:
