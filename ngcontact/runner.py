@@ -113,7 +113,8 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
     serial run.  They start with the run (their start overlapping with its
     preparation) where ``start`` says so, or where the last run of the same
     batch on this machine forecasts that the rule sends it to them
-    (:mod:`ngcontact.parallel.batch_forecast`; recorded here after the run).
+    (:mod:`ngcontact.parallel.batch_forecast`; recorded here after the run),
+    and that batch then goes to them from its first member.
     A scheduler address that is malformed, or where no scheduler answers (at
     once, or at the first batch), is a :class:`SceneError` naming
     ``scheduler`` or ``compute.scheduler``.
@@ -135,8 +136,9 @@ def batches(scene, workers: int | None = None, scheduler: str | None = None, pro
             (note or logging.getLogger("ngcontact.parallel.executor").info)(capped)
     try:
         ex = executor.make(workers, scheduler, members)
-        if start or (name is not None and batch_forecast.early(ex, name, members)):
-            ex.start(WORKER_MODULES)
+        forecast = batch_forecast.early(ex, name, members) if name is not None else None
+        if start or forecast is not None:
+            ex.start(WORKER_MODULES, forecast)
         else:  # workers only for a batch whose rest repays their start
             ex.start_on_demand(WORKER_MODULES)
         with executor.use(ex, progress):

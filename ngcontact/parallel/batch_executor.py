@@ -51,12 +51,13 @@ class Executor:
         self.__dict__["_lead_cpu"] = time.process_time()   # this process's CPU seconds before the batch
         t0 = time.perf_counter()
         self.__dict__.pop("_spread", None)
+        self.__dict__.pop("_worker_least", None)
         clock = self.__dict__["_clock"] = MemberClock()
         out = self._map(fn, list(items), list(names), label, progress, fault)
         self.record.append({"label": label, "members": len(items), "seconds": time.perf_counter() - t0,
                             **self.__dict__.pop("_spread", {})})
         self.timings.append({"members": len(items), "began": t0,
-                             "member_seconds": clock.least if clock.times else None,
+                             "member_seconds": clock.least if clock.times else self.__dict__.get("_worker_least"),
                              "lead_cpu": self.__dict__["_lead_cpu"],
                              "first_seconds": clock.times[0] - clock.least if len(clock.times) > 1 else None})
         return out
@@ -65,7 +66,8 @@ class Executor:
     def timings(self) -> list[dict]:
         """The batches this executor ran, as timed in this process: ``members``, when each ``began``
         (``time.perf_counter`` seconds), the least ``min(wall, CPU)`` seconds of its members solved in
-        this process (``member_seconds``; None when none was), this process's CPU seconds as it began
+        this process (``member_seconds``; where none was, the least CPU seconds of a worker's member after
+        its first, None without one), this process's CPU seconds as it began
         (``lead_cpu``) and what its first member here took beyond the least (``first_seconds``; None
         with fewer than two here)."""
         return self.__dict__.setdefault("_timings", [])
@@ -118,10 +120,11 @@ class Executor:
         if failures[k] >= ATTEMPTS:
             raise BatchError(label, name, reason(exc)) from exc
 
-    def start(self, modules: Sequence[str] = ()) -> None:
+    def start(self, modules: Sequence[str] = (), forecast=None) -> None:
         """Get the workers ready now, while this process prepares the batch (nothing to do here).
 
-        ``modules``: what the members will import, imported by each worker as it starts.
+        ``modules``: what the members will import, imported by each worker as it starts; ``forecast``: the
+        record of the run's first batch that said it repays them (:mod:`ngcontact.parallel.batch_forecast`).
         """
 
     def repays(self, forecast) -> bool:

@@ -24,9 +24,15 @@ window is open: it would count the run just before this one, a serial run
 of the same batch, as another job, and no early start would ever pass).
 Nothing is guessed: a batch never run on this machine has no forecast, and
 its workers start on demand.
-The forecast only chooses when the workers start; where each batch runs
-is still decided by (1) on its own members, and workers started early for
-a batch that (1) then keeps in this process are stopped while they start.
+The forecast chooses when the workers start, and it sends the run's first
+batch to them from its first member where (1) still holds for the whole
+batch with the recorded ``c`` on the cores free as the batch opens
+(:meth:`~ngcontact.parallel.judged_batches.JudgedBatches._sent_on_forecast`);
+where it does not, (1) decides on the batch's own members, and workers
+started early for a batch that (1) then keeps in this process are stopped
+while they start.  A batch sent whole to the workers is recorded with
+``c`` as the workers timed it (the least CPU seconds of a member after a
+worker's first).
 
 A record is one small JSON file per batch, named by the SHA-256 of the
 run's description (the scene, the package version), in ``batches`` under
@@ -208,12 +214,14 @@ def remember_cost(kind: str, seconds: float) -> None:
     WORKER_COSTS.remember(kind, seconds)
 
 
-def early(executor, name: str, members: int | None) -> bool:
-    """Whether ``executor`` should start its workers with the run: the last run of the batch recorded under
-    ``name``, of as many ``members``, forecasts that condition (1) sends it to them
-    (:meth:`~ngcontact.parallel.executor.Executor.repays`)."""
+def early(executor, name: str, members: int | None) -> Forecast | None:
+    """The forecast by which ``executor`` should start its workers with the run (None: it should not): the
+    last run of the batch recorded under ``name``, of as many ``members``, where it says that condition (1)
+    sends the batch to them (:meth:`~ngcontact.parallel.executor.Executor.repays`)."""
     forecast = recorded(name)
-    return forecast is not None and forecast.members == members and executor.repays(forecast)
+    if forecast is not None and forecast.members == members and executor.repays(forecast):
+        return forecast
+    return None
 
 
 def remember_run(name: str, executor, opened: float) -> None:

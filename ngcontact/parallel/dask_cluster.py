@@ -182,10 +182,10 @@ class DaskCluster(Executor):
                               f"{CONNECT_SECONDS:g} s{detail}: start one there (dask scheduler) or correct "
                               "the address")
 
-    def start(self, modules: Sequence[str] = ()) -> None:
+    def start(self, modules: Sequence[str] = (), forecast=None) -> None:
         """Connect to the scheduler now (an address that does not answer fails before any solve); the run's
         batches then go to the cluster only where they repay it (:meth:`_judged_map`), the workers importing
-        ``modules`` and the members' module first."""
+        ``modules`` and the members' module first (a local pool's ``forecast`` is not a cluster's)."""
         self.client  # noqa: B018 - the property connects
         self.judged = True
         self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))

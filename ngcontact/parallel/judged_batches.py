@@ -13,6 +13,16 @@ charged for it twice.  A batch kept in this
 process starts no worker; while the workers solve a batch, this process's NGSolve threads sleep
 (:func:`~ngcontact.parallel.batch_member.threads_asleep`).
 
+Two starts overlap the batch's own time.  A run whose first batch the last
+run of it forecast to repay the workers started them with the run; that
+batch goes to them from its first member, none timed here, where (1) still
+holds for all of it with the recorded ``c`` on the cores free now
+(:meth:`JudgedBatches._sent_on_forecast`).  A batch without a forecast
+starts the workers' fork server as it opens, where a core is idle beside
+this process (:meth:`JudgedBatches._start_beside`): its first members are
+timed here while the server imports, and the server is stopped where (1)
+then keeps the batch here.
+
 The rule is a mixin of :class:`~ngcontact.parallel.local_pool.LocalPool`, whose worker processes it starts,
 uses and stops: this module holds the decision, that one the processes.
 """
@@ -49,6 +59,12 @@ FIRST_MEMBER_SECONDS = 1.0
 FORK_SECONDS = 0.05
 
 
+#: The part of a core other processes must leave idle beside this process's own (``f >= 1 +`` this) for a
+#: batch to start the workers' fork server as it opens (:meth:`JudgedBatches._start_beside`): the server's
+#: imports then run on a core this process does not use.
+BESIDE_FREE = 0.75
+
+
 def start_cost(default: float | None = None) -> float:
     """``S``: the CPU seconds of a worker's start as this machine timed it
     (:func:`~ngcontact.parallel.batch_forecast.cost_seconds`), ``default`` (:data:`START_SECONDS`) before
@@ -79,7 +95,9 @@ class JudgedBatches(Executor, ABC):
     processes (:meth:`start`, :meth:`_pool_map`, :meth:`_abandon_start`) are the subclass's."""
 
     workers: int
+    method: str
     judged: bool
+    _forecast: Any
     started: str
     _pool: Any
     _warming: list
@@ -87,8 +105,9 @@ class JudgedBatches(Executor, ABC):
     _modules: tuple[str, ...]
 
     @abstractmethod
-    def start(self, modules: Sequence[str] = ()) -> None:
-        """Spawn the workers now, each importing ``modules``."""
+    def start(self, modules: Sequence[str] = (), forecast: batch_forecast.Forecast | None = None) -> None:
+        """Spawn the workers now, each importing ``modules``; ``forecast``: the record that said the run's
+        first batch repays them (:meth:`_sent_on_forecast`)."""
 
     @abstractmethod
     def _pool_map(self, fn, items, names, label, progress, fault) -> list:
@@ -97,6 +116,14 @@ class JudgedBatches(Executor, ABC):
     @abstractmethod
     def _abandon_start(self) -> None:
         """Stop the workers (or what starts them) still starting."""
+
+    @abstractmethod
+    def _open_server(self, counted: bool = True) -> Any:
+        """Start the workers' fork server now (``counted``: as a pool's start, else once a worker forks)."""
+
+    @abstractmethod
+    def _await_ready(self, seconds: float) -> bool:
+        """Wait at most ``seconds`` until a worker can take a member; whether one can."""
 
     @abstractmethod
     def _launched(self) -> bool:
@@ -142,12 +169,15 @@ class JudgedBatches(Executor, ABC):
                                     cpu, cores)
 
     def repays(self, forecast) -> bool:
-        """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send the rest of a batch
-        (its :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now: the members after
-        the first ``MEASURED`` (solved here), of the forecast's seconds each, against the part of the start
-        that the run's lead before its batch leaves ahead, a worker's first member and the starts' CPU
-        time (before this machine has timed a worker: as the last run's process measured them), on the
-        cores free as the run opens."""
+        """Whether condition (1) of :mod:`ngcontact.parallel.worker_payoff` will send a batch (its
+        :class:`~ngcontact.parallel.batch_forecast.Forecast`) to workers started now, with a margin: the
+        members after the first ``MEASURED`` (the rest a batch without a forecast sends), of the forecast's
+        seconds each, against the part of the start that the run's lead before its batch leaves ahead, a
+        worker's first member and the starts' CPU time (before this machine has timed a worker: as the last
+        run's process measured them), on the cores free as the run opens.  A batch so forecast goes to the
+        workers from its first member (:meth:`_sent_on_forecast`, where (1) holds for all of it, which it
+        then does by ``MEASURED`` members' work): one that (1) would send only without the margin (the
+        measured scan's kind: 8 members of a tenth of a second) starts no worker before its batch."""
         return self.payoff(forecast.member_seconds, forecast.members - worker_payoff.MEASURED,
                            forecast.lead_seconds, forecast.first_seconds, forecast.start_seconds).repaid
 
@@ -171,27 +201,46 @@ class JudgedBatches(Executor, ABC):
         from this process); started ones are kept for the run's next batch.
         A pool not started is started once (1) holds (never for a batch kept
         here), its workers importing the members' module as they start, and
-        this process solves members while they start.
+        this process solves members while they start; or as the batch opens,
+        where a core is idle beside this process (:meth:`_start_beside`).
+        The run's first batch, where a forecast started the workers with the
+        run, goes to them from its first member (:meth:`_sent_on_forecast`).
         """
-        clock = self.member_clock            # each member solved here is timed by Executor._map
+        forecast, self._forecast = self._forecast, None      # the forecast is of the run's first batch
         done: list = []
+        beside = False
+        if forecast is not None and forecast.members == len(items):
+            done = self._sent_on_forecast(fn, items, names, label, progress, fault, forecast)
+            if len(done) == len(items):
+                return done
+        else:
+            beside = self._start_beside(fn, len(items))
+        clock = self.member_clock            # each member solved here is timed by Executor._map
         while True:
             k = len(done)
             done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
                                   shifted_progress(progress, k, len(items)), fault)
             if len(done) == len(items):
-                self._where("serial", f"all {len(done)} members solved here"
-                            + (" while the workers started" if self._launched() else ""))
+                if beside:
+                    self._abandon_start()   # started for this batch only, which ended here
+                self._where("serial", f"all {len(done)} members solved here" + (
+                    " beside the workers' fork server, stopped with the batch" if beside
+                    else " while the workers started" if self._launched() else ""))
                 return done
             first = clock.times[0] - clock.least if len(clock.times) >= 2 else None
             payoff = self.payoff(clock.least, len(items) - len(done), first=first)
             log.debug("%s: look: %s", label, payoff.describe(len(done)))      # every look's inputs
             if not payoff.repaid:
-                if self._launched() and not self._ready() and payoff.rest > 1:
+                if beside and len(done) < worker_payoff.MEASURED:
+                    continue        # a start beside is kept until the look that has timed the batch
+                stopped = beside
+                if self._launched() and not self._ready() and payoff.rest > 1 or beside:
                     self._abandon_start()   # (a last member here takes one member's time: the start goes on)
+                    beside = False
                 if len(done) < worker_payoff.MEASURED:
                     continue        # the second member here measures what the first paid once: look again
-                self._where("serial", payoff.describe(len(done)))
+                self._where("serial", payoff.describe(len(done))
+                            + ("; the workers' fork server started beside the batch stopped" if stopped else ""))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
                 return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
                                             shifted_progress(progress, len(done), len(items)), fault)
@@ -200,11 +249,65 @@ class JudgedBatches(Executor, ABC):
                     self.started = f"during batch '{label}'"
                 self.start((fn.__module__,))
             if self._ready() and len(done) >= worker_payoff.MEASURED:
+                if self.started == "never":
+                    self.started = f"during batch '{label}'"     # a start beside it: the workers start now
                 self._where("local", payoff.describe(len(done)))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
                 with threads_asleep():
                     return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
                                                  shifted_progress(progress, len(done)), fault)
+
+    def _sent_on_forecast(self, fn, items, names, label, progress, fault, forecast) -> list:
+        """The run's first batch, whose workers a forecast started with the run: all of it to the workers
+        from its first member, where (1) holds for the whole batch with the forecast's ``c`` and ``F`` and the
+        cores free now; the members solved here, should (1) fail (the probe of :meth:`_judged_map` then
+        decides, on members timed here), or should the batch end before a worker is ready.
+
+        No member is solved here to time the batch: the last run of it timed
+        its members (:mod:`ngcontact.parallel.batch_forecast`), and two of
+        them here would delay the rest by ``2 c`` while ``ceil(n / W)`` rounds
+        on the workers are no fewer than ``ceil((n - 2) / W) + 1``.  Nor do
+        members go to this process beside the workers: on ``W`` workers over
+        ``W`` cores a member here takes turns with them, not a core of its own.
+        While no worker is ready, this process waits where the start has less
+        than a member's time ``c`` still ahead (its threads asleep: the start
+        has the core), else solves the next member.
+        """
+        done: list = []
+        while len(done) < len(items):
+            payoff = self.payoff(forecast.member_seconds, len(items) - len(done), first=forecast.first_seconds)
+            log.debug("%s: look on the forecast: %s", label, payoff.describe(len(done), recorded=True))
+            if not payoff.repaid:
+                return done
+            if self._ready():
+                self._where("local", payoff.describe(len(done), recorded=True))
+                with threads_asleep():
+                    return done + self._pool_map(fn, items[len(done):], names[len(done):], label,
+                                                 shifted_progress(progress, len(done), len(items)), fault)
+            if payoff.start_ahead <= forecast.member_seconds:
+                with threads_asleep():
+                    if self._await_ready(forecast.member_seconds):
+                        continue
+            k = len(done)
+            done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
+                                  shifted_progress(progress, k, len(items)), fault)
+        self._where("serial", f"all {len(done)} members solved here while the workers started")
+        return done
+
+    def _start_beside(self, fn, members: int) -> bool:
+        """Start the workers' fork server as a batch opens, beside the members this process solves to time
+        it, where that costs this process nothing: the server is one process importing NGSolve and the
+        members' module (spawned workers would be ``W`` of them), the batch has members beyond the
+        ``MEASURED`` to send, and the cores other processes leave free (``f``) hold this process's core and
+        most of another (:data:`BESIDE_FREE`).  Then the start is paid by the time (1) is first read, and the
+        rule counts only what is still ahead (``R``) and the forks; where (1) fails after ``MEASURED``
+        members, or the batch ends here, the server is stopped.  Whether it was started."""
+        if (self.method != "forkserver" or self._launched() or members <= worker_payoff.MEASURED + 1
+                or self.cores.reading().free < 1.0 + BESIDE_FREE):
+            return False
+        self._modules = tuple(dict.fromkeys(self._modules + (fn.__module__,)))
+        self._open_server(counted=False)
+        return True
 
     def _start_ahead(self, start: float) -> float:
         """Seconds of the workers' start still to come (``R`` of :mod:`ngcontact.parallel.worker_payoff`), of

@@ -52,6 +52,7 @@ class LocalPool(PoolStart):
         self.workers = workers
         self._server: fork_server.Server | None = None   # the fork server, started with the pool
         self._forked = 0              # pools of workers forked by the current server
+        self._uncounted = False       # a server started beside a batch, counted once its first pool forks
         self._pool: Any = None        # the ProcessPoolExecutor, started on first use
         self._started: Any = None     # the queue on which workers announce their start
         self._processes: dict = {}      # every worker process of the current pool, by pid
@@ -60,6 +61,7 @@ class LocalPool(PoolStart):
         self._spawned = 0.0           # when the current pool's workers were spawned (perf_counter seconds)
         self._modules: tuple[str, ...] = ()   # what a worker started on demand imports as it starts
         self.judged = False           # the run's batches: the rest of each goes to workers only where repaid
+        self._forecast: Any = None    # the forecast that started the workers with the run, for its first batch
         self.pools_started = 0        # pools of worker processes spawned so far (none for a batch kept here)
         self.started = "never"        # when the workers first started: with the run, or during which batch
 
@@ -73,8 +75,7 @@ class LocalPool(PoolStart):
         self._spawned = time.perf_counter()
         if self.method == "forkserver":
             server = self._open_server()
-            self.pools_started += self._forked > 0      # the first pool of a server was counted with it
-            self._forked += 1
+            self._counted_pool()
             ctx: Any = fork_server.context()
             run = (os.getpid(), worker_lifetime.process_start(os.getpid()))
             args: tuple = (server.pid, self._lifetime.path, run)
@@ -92,8 +93,10 @@ class LocalPool(PoolStart):
         self._discard()
         self._stop_server()
 
-    def start(self, modules: Sequence[str] = ()) -> None:
-        """Spawn every worker now and let it import ``modules`` (what its members will need).
+    def start(self, modules: Sequence[str] = (), forecast: batch_forecast.Forecast | None = None) -> None:
+        """Spawn every worker now and let it import ``modules`` (what its members will need); ``forecast``:
+        the last run's record of the run's first batch, which sends that batch to the workers from its first
+        member where it still repays them (:meth:`_sent_on_forecast`).
 
         A spawned worker is a fresh interpreter: its start and imports take
         about a second, which the batch would otherwise wait for; a fork
@@ -107,6 +110,8 @@ class LocalPool(PoolStart):
         """
         self.judged = True
         self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
+        if forecast is not None:
+            self._forecast = forecast
         if self._launched():
             return
         if self.started == "never":
@@ -162,6 +167,7 @@ class LocalPool(PoolStart):
         unsent: list[int] = []       # members whose submission found the pool already broken
         firsts: list[float] = []     # CPU seconds of the first member of each worker that had one here
         starts: list[float] = []     # CPU seconds of each such worker before its first member (its start)
+        others: list[float] = []     # CPU seconds of the members after a worker's first
         pool = self._pool or self._start()
 
         def submit(k):
@@ -194,6 +200,8 @@ class LocalPool(PoolStart):
                         if start is not None:
                             firsts.append(seconds)
                             starts.append(start)
+                        else:
+                            others.append(seconds)
                         if progress is not None:
                             progress(label, len(results), len(items))
                 if broken or (unsent and not pending):
@@ -217,9 +225,12 @@ class LocalPool(PoolStart):
         except BaseException:
             self._discard()
             raise
-        if firsts and self.member_clock.times:    # ``F``: a first member's CPU beyond the cheapest here
-            batch_forecast.remember_cost("first_member", max(sorted(firsts)[len(firsts) // 2]
-                                                             - self.member_clock.least, 0.0))
+        # ``c`` of a batch with no member solved here: the cheapest member after a worker's first, for the
+        # batch's record (:meth:`Executor.map`, :func:`batch_forecast.remember_run`)
+        self.__dict__["_worker_least"] = min(others, default=None)
+        least = self.member_clock.least if self.member_clock.times else self.__dict__["_worker_least"]
+        if firsts and least is not None:     # ``F``: a first member's CPU beyond the cheapest here (or there)
+            batch_forecast.remember_cost("first_member", max(sorted(firsts)[len(firsts) // 2] - least, 0.0))
         if starts and self.method == "forkserver":          # ``S_fork``: a forked worker's start
             batch_forecast.remember_cost("fork", sorted(starts)[len(starts) // 2])
         return [results[k] for k in range(len(items))]

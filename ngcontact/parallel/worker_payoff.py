@@ -33,8 +33,9 @@ the first with the start's CPU time for its wall time; with ``f <= 1``
 (other jobs keep the cores busy) no batch repays workers, whatever its
 size: it stays here, and its record says why.
 
-``c`` is measured, never guessed: every batch solves its first members in
-this process and times each as ``min(wall, CPU)`` seconds of this process
+``c`` is measured, never guessed: every batch (but one that the last run of
+it on this machine timed, :mod:`ngcontact.parallel.batch_forecast`) solves
+its first members in this process and times each as ``min(wall, CPU)`` seconds of this process
 (CPU seconds are the member's work whatever else runs beside it: other
 processes' load and the workers' own start, which takes cores from this
 process while it runs; wall seconds where NGSolve's threads solve it in
@@ -169,17 +170,23 @@ class Payoff:
         return (self.rest > 0 and self.workers > 1 and not self.busy and self.saving > self.cost
                 and self.core_saving > self.core_cost)
 
-    def describe(self, solved: int) -> str:
-        """One line for the report: what was measured and what was decided, after ``solved`` members here."""
+    def describe(self, solved: int, recorded: bool = False) -> str:
+        """One line for the report: what was measured and what was decided, after ``solved`` members here;
+        ``recorded``: ``c`` is the last run's of the same batch on this machine (a forecast,
+        :mod:`ngcontact.parallel.batch_forecast`), the ``solved`` members here only filled the workers' start."""
         cores = "" if self.cores is None else f"; {self.cores.describe()}"
-        first = (f"{solved} member{'s' if solved > 1 else ''} solved here, the cheapest in "
-                 f"{self.member_seconds:.3g} s{cores}")
+        if recorded:
+            first = (f"the last run of this batch here timed its cheapest member at {self.member_seconds:.3g} s; "
+                     f"{solved or 'none'} solved here while the workers started{cores}")
+        else:
+            first = (f"{solved} member{'s' if solved > 1 else ''} solved here, the cheapest in "
+                     f"{self.member_seconds:.3g} s{cores}")
+        others = f"the other {self.rest}" if solved else f"all {self.rest}"
         if self.busy and self.rest > 0 and self.workers > 1:
             return (f"{first}: the cores are busy with other processes, so {self.workers} workers would only "
-                    f"take turns with them; the other {self.rest} in this process")
-        where = f"the other {self.rest} on {self.workers} workers" if self.repaid else \
-            f"the other {self.rest} in this process"
-        return (f"{first}: {self.workers} workers would save {self.saving:.3g} s on the other {self.rest} "
+                    f"take turns with them; {others} in this process")
+        where = f"{others} on {self.workers} workers" if self.repaid else f"{others} in this process"
+        return (f"{first}: {self.workers} workers would save {self.saving:.3g} s on {others} "
                 f"against {self.start_ahead:.3g} s of their start still ahead and "
                 f"{self.first_member_seconds:.3g} s of a worker's first member, and on {self.parallel:.2g} "
                 f"cores {self.core_saving:.3g} CPU s against {self.core_cost:.3g} CPU s of their starts "

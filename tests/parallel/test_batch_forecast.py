@@ -124,6 +124,11 @@ def test_workers_start_with_the_run_after_a_serial_run_of_the_batch_on_an_idle_m
     idle_since_the_process_opened(monkeypatch, load=1.1)
     with runner.batches(scene, workers=2) as ex:
         assert ex.pools_started == 1 and ex.describe()["workers_started"] == "with the run"
+        assert ex.wait_ready(120)
+        assert os.getpid() not in ex.map(burn, [0.05] * members, names, label="ensemble")   # from the first
+    # the batch's next record: ``c`` as the workers timed it, none solved here
+    again = batch_forecast.recorded(record[:-len(".json")])
+    assert again.members == members and 0.045 <= again.member_seconds < 0.5 and again.first_seconds is None
 
 
 def test_workers_start_with_the_run_only_where_the_last_run_of_the_batch_says_they_take_it(monkeypatch, cache):
@@ -153,3 +158,94 @@ def test_the_oldest_records_go_beyond_the_kept_number(monkeypatch, cache):
         os.utime(cache / batch_forecast.FOLDER / f"{name}.json", (k, k))
     batch_forecast.remember("d", Forecast(4, 1.0, 0.0))
     assert sorted(os.listdir(cache / batch_forecast.FOLDER)) == ["c.json", "d.json"]
+
+
+def test_a_forecast_starts_workers_early_only_with_two_members_of_margin(monkeypatch):
+    """The measured scan's kind, on a machine that has timed a fork server (0.7 s), a fork (0.05 s) and a
+    first member (0.02 s): all 8 members of 0.112 s would just repay the two workers (0.9 CPU s against
+    2 x (0.35 + 0.05 + 0.02) = 0.84 CPU s), the 6 after the two a batch without a forecast times here do
+    not (0.67 CPU s): no worker starts with the run for it."""
+    monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
+    for kind, seconds in (("server", 0.7), ("fork", 0.05), ("first_member", 0.02)):
+        batch_forecast.remember_cost(kind, seconds)
+    pool = executor.LocalPool(2, method="forkserver")
+    assert pool.payoff(0.112, 8, 10.0).repaid and not pool.payoff(0.112, 6, 10.0).repaid
+    assert not pool.repays(Forecast(8, 0.112, 10.0))
+    assert pool.repays(Forecast(8, 0.2, 10.0))               # 1.2 CPU s after the two: started with the run
+
+
+def spectrum(seed: int) -> tuple[int, float]:
+    """A member whose number depends on its item alone (a seeded field's spectrum, 0.05 CPU s): the id of the
+    process that ran it, and the number."""
+    import numpy as np
+    field = np.random.default_rng(seed).standard_normal((128, 128))
+    burn(0.05)
+    return os.getpid(), float(np.abs(np.fft.rfft2(field)).sum())
+
+
+@pytest.fixture
+def forecast_pool(monkeypatch):
+    """A pool of two forked workers started with the run by a forecast of 8 members of 0.05 s (measured
+    costs: no start ahead, a worker's first member 0.01 s), its fork server ready."""
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.01)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
+    pool = executor.LocalPool(2, method="forkserver")
+    pool.start(("ngsolve",), Forecast(8, 0.05, 0.0, start_seconds=0.0, first_seconds=0.0))
+    assert pool.wait_ready(120)
+    yield pool
+    pool.close()
+
+
+def test_a_batch_its_forecast_sends_to_workers_goes_there_from_its_first_member(forecast_pool):
+    """The run's first batch, forecast to repay the workers (8 x 0.05 s: 0.2 s saved against 0.01 s), goes
+    to them whole: no member solved here to time it, the numbers those of the serial run; its record's
+    ``c`` is the workers' (a member's CPU seconds after a worker's first)."""
+    seeds, names = list(range(8)), [f"m{k}" for k in range(8)]
+    out = forecast_pool.map(spectrum, seeds, names, label="forecast")
+    serial = executor.Serial().map(spectrum, seeds, names, label="serial")
+    assert os.getpid() not in [pid for pid, _ in out]
+    assert [v for _, v in out] == [v for _, v in serial]
+    batch = forecast_pool.describe()["batches"][-1]
+    assert batch["executor"] == "local" and "none solved here" in batch["decision"]
+    assert batch["decision"].endswith("all 8 on 2 workers")
+    [timed] = forecast_pool.timings
+    assert 0.045 <= timed["member_seconds"] < 0.5 and timed["first_seconds"] is None
+    # the next batch of the run has no forecast: its first two members time it here
+    again = forecast_pool.map(spectrum, seeds, names, label="second")
+    assert [pid for pid, _ in again[:2]] == [os.getpid()] * 2
+    assert [v for _, v in again] == [v for _, v in serial]
+
+
+def test_a_forecast_of_another_batch_or_on_busy_cores_leaves_the_batch_to_its_own_members(monkeypatch,
+                                                                                          forecast_pool):
+    """A first batch of another size than the forecast's is timed here (its first two members); so is one
+    whose cores other jobs keep busy now, and it stays here."""
+    pids = forecast_pool.map(burn, [0.05] * 6, [f"m{k}" for k in range(6)], label="other size")
+    assert pids[:2] == [os.getpid()] * 2
+    forecast_pool.start((), Forecast(8, 0.05, 0.0, start_seconds=0.0, first_seconds=0.0))
+    monkeypatch.setattr(free_cores, "load_average", lambda: 2.0 * len(free_cores.affinity()))
+    pids = forecast_pool.map(burn, [0.05] * 8, [f"m{k}" for k in range(8)], label="busy")
+    assert pids == [os.getpid()] * 8
+    assert "busy with other processes" in forecast_pool.describe()["batches"][-1]["decision"]
+
+
+def test_a_batch_forecast_to_repay_its_workers_solves_members_here_while_no_worker_is_ready(monkeypatch):
+    """Workers whose start has more than a member's time ahead: the forecast batch solves members here
+    meanwhile (none is lost, none solved twice), and sends the rest once a worker is ready."""
+    monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.01)
+    monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
+    monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
+    pool = executor.LocalPool(2, method="forkserver")
+    try:
+        pool.start(("ngsolve",), Forecast(40, 0.05, 0.0, start_seconds=0.0, first_seconds=0.0))
+        # 0.2 s of the start ahead: more than a member, less than the 1 s the workers save on the batch
+        monkeypatch.setattr(pool._server, "start_still", lambda server, fork: 0.2)
+        pids = pool.map(burn, [0.05] * 40, [f"m{k}" for k in range(40)], label="starting")
+        here = pids.count(os.getpid())
+        assert len(pids) == 40 and here >= 1 and pids[:here] == [os.getpid()] * here
+        batch = pool.describe()["batches"][-1]
+        if here < 40:                   # a worker became ready during the batch: the rest went to the workers
+            assert os.getpid() not in pids[here:] and batch["executor"] == "local"
+            assert f"{here} solved here while the workers started" in batch["decision"]
+    finally:
+        pool.close()
