@@ -94,19 +94,16 @@ class LocalPool(PoolStart):
         self._stop_server()
 
     def start(self, modules: Sequence[str] = (), forecast: batch_forecast.Forecast | None = None) -> None:
-        """Spawn every worker now and let it import ``modules`` (what its members will need); ``forecast``:
-        the last run's record of the run's first batch, which sends that batch to the workers from its first
-        member where it still repays them (:meth:`_sent_on_forecast`).
+        """Spawn every worker now and let it import ``modules`` (what its members will need); ``forecast``: the last
+        run's record of the run's first batch, which sends that batch to the workers from its first member where it
+        still repays them (:meth:`_sent_on_forecast`).
 
-        A spawned worker is a fresh interpreter: its start and imports take
-        about a second, which the batch would otherwise wait for; a fork
-        server makes them once, and its workers fork as a batch needs them.  For a caller that
-        knows its batches will repay the workers (:mod:`ngcontact.parallel.worker_payoff`),
-        this overlaps their start with what the run does before them (its own
-        imports, the scene's meshes, a macro solve).  The pool spawns one
-        process per submitted task while none is idle, so one warm-up task per
-        worker starts them all.  The run's batches then go to the workers only
-        where they repay them (:meth:`_judged_map`).
+        A spawned worker is a fresh interpreter: its start and imports take about a second, which the batch would
+        otherwise wait for; a fork server makes them once, and its workers fork as a batch needs them.  For a caller
+        that knows its batches will repay the workers (:mod:`ngcontact.parallel.worker_payoff`), this overlaps their
+        start with what the run does before them (its own imports, the scene's meshes, a macro solve).  The pool
+        spawns one process per submitted task while none is idle, so one warm-up task per worker starts them all.
+        The run's batches then go to the workers only where they repay them (:meth:`_judged_map`).
         """
         self.judged = True
         self._modules = tuple(dict.fromkeys(self._modules + tuple(modules)))
@@ -197,11 +194,8 @@ class LocalPool(PoolStart):
                             self._failed(label, names[k], failures, k, exc)
                             submit(k)
                             continue
-                        if start is not None:
-                            firsts.append(seconds)
-                            starts.append(start)
-                        else:
-                            others.append(seconds)
+                        (others if start is None else firsts).append(seconds)
+                        starts += [] if start is None else [start]
                         if progress is not None:
                             progress(label, len(results), len(items))
                 if broken or (unsent and not pending):
@@ -225,8 +219,7 @@ class LocalPool(PoolStart):
         except BaseException:
             self._discard()
             raise
-        # ``c`` of a batch with no member solved here: the cheapest member after a worker's first, for the
-        # batch's record (:meth:`Executor.map`, :func:`batch_forecast.remember_run`)
+        # ``c`` of a batch none of whose members ran here: the cheapest after a worker's first (its record)
         self.__dict__["_worker_least"] = min(others, default=None)
         least = self.member_clock.least if self.member_clock.times else self.__dict__["_worker_least"]
         if firsts and least is not None:     # ``F``: a first member's CPU beyond the cheapest here (or there)
@@ -238,8 +231,7 @@ class LocalPool(PoolStart):
     def _running_on_dead_workers(self, names) -> set[str]:
         """Members last started by worker processes that died by themselves (their start records, by pid).
 
-        The pool terminates the other workers when one dies (exit status
-        ``-SIGTERM``): their members are innocent and are not counted.
+        The pool terminates the other workers when one dies (exit status ``-SIGTERM``): their members are innocent.
         """
         import signal
         last: dict[int, str] = {}
