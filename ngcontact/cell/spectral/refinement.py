@@ -154,9 +154,9 @@ from typing import Any, Callable
 import numpy as np
 
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
-from ngcontact.cell.spectral.contact_edges import (INSIDE, ISLAND_POINTS, LOCATED_STEP, PENALTY_LOG, fitted_run,
-                                                   island_floor, locator_kind, on_edges, resolved_run, unresolved_share,
-                                                   locator_changing as edges_changing)
+from ngcontact.cell.spectral.contact_edges import (FITTED_STEP, INSIDE, ISLAND_POINTS, LOCATED_STEP, PENALTY_LOG,
+                                                   QUADRATURE, fitted_run, island_floor, locator_kind, on_edges,
+                                                   resolved_run, unresolved_share, locator_changing as edges_changing)
 from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, DISAGREE, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP,
                                                     RATE_FLOOR, SAFETY, SPREAD, WINDOW, loose_flags, loose_remarks,
                                                     tail_estimate)
@@ -200,8 +200,9 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"would meet it (else not met), times {ERRATIC[STIFFNESS][3]:g} in 3D, reported, not held; at least "
        f"the share of contact islands of fewer than {ISLAND_POINTS} points (3D: across), and after such islands "
        f"also on the resolved levels (at least {LOCATOR_LEVELS}), the smaller; a step per 2D edge within a step of a "
-       f"kink of the map's piecewise-linear surface, {LOCATED_STEP:g} of one per other edge of such a map, "
-       f"{PENALTY_LOG:g} E*/k_n ln(period k_n / E*) per edge of a penalty located on points beyond E*/k_n; above "
+       f"kink of the map's piecewise-linear surface, {LOCATED_STEP:g} of one per other edge of such a map "
+       f"({FITTED_STEP:g} by the quartic; a load's edges {QUADRATURE:g} times their root-sum-square where below their "
+       f"sum), {PENALTY_LOG:g} E*/k_n ln(period k_n / E*) per edge of a penalty located on points beyond E*/k_n; above "
        f"{LOOSE:g} times the error its last difference leaves at the last rate, or the one before where the last is "
        "twice as slow or more: flagged (quantities[].loose)")
 
