@@ -10,7 +10,8 @@ measure: the difference from the same cell's value on a much finer grid (the cel
 half-space formula is not their converged value).  The ratio is the effectivity (issue 35 asks for it
 between 1 and 10 on every oracle); the form of each estimate (Richardson, the guarded bound, or carried from
 a grid where a stop waited, the share of unresolved contact islands, or a step at each 2D edge within a step
-of a kink of the profile's piecewise-linear interpolant, a quarter step at every other edge of such a map, and
+of a kink of the profile's piecewise-linear interpolant, a quarter step at every other edge of such a map (a
+tenth where the quartic located it; a load's edges twice their root-sum-square where below their sum), and
 the 2D stiffness of the located set as many steps of its change with each edge a step out), the true error of
 the grid twice as fine, whether the reported one is small by chance, and the estimator's own flag where it
 states that its estimate may exceed the error by more than ten times (``ngcontact.cell.spectral.estimate_forms``)
@@ -309,9 +310,10 @@ def main(argv=None) -> int:
                               "resolved levels alone, at least three, the smaller; in 2D at least a grid step per "
                               "contact edge within a step of a kink of a profile's piecewise-linear interpolant, "
                               "where the edge may stay pinned over grids, and on such a map a quarter step per "
-                              "other edge, and the normal stiffness (2D: of the located set) as many steps of its "
-                              "change with each edge a step out, whose erratic fraction of a step the differences "
-                              "may not show: `kink`); a "
+                              "other edge (a tenth where the quartic located it), and the normal stiffness (2D: of "
+                              "the located set) as many steps of its change with each edge a step out, whose erratic "
+                              "fraction of a step the differences may not show, a load's edges twice the "
+                              "root-sum-square of their shares where below their sum: `kink`); a "
                               "tolerance not "
                               "met within the study's largest grid reports nothing. The true error of the reported "
                               "grid is against the same cell on a much finer grid; `next_error` is that of the grid "

@@ -11,7 +11,7 @@ import pytest
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.penalty_share import penalty_share
-from ngcontact.cell.spectral.contact_edges import PENALTY_ZONE, penalty_length
+from ngcontact.cell.spectral.penalty_zone import PENALTY_ZONE, penalty_length
 from ngcontact.cell.spectral.estimate_forms import RICHARDSON
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral.refinement import sweep_to_tolerance

@@ -12,7 +12,8 @@ import pytest
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
-from ngcontact.cell.spectral.contact_edges import KINK, LOCATED_STEP, kink_share, kinks, unresolved_share
+from ngcontact.cell.spectral.contact_edges import (FITTED_STEP, KINK, LOCATED_STEP, QUADRATURE, kink_share, kinks,
+                                                   quadrature, unresolved_share)
 from ngcontact.cell.spectral.grid_measures import edges_fitted, located_edges
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral.refinement import controlled_estimate, sweep_to_tolerance
@@ -71,6 +72,35 @@ def test_an_edge_within_a_step_of_a_kink_holds_a_step_of_each_quantity_on_the_ed
     assert share["share"]["contact_fraction"] == pytest.approx((1 + 2 * share_step) / n)
     assert share["share"]["coefficient_g_n"] == pytest.approx(
         k_n * (g0[18:23].max() + share_step * (g0[3:7].max() + g0[24:28].max())) / n)
+
+
+def test_many_edges_are_bounded_together_by_their_root_sum_square_and_a_few_by_their_sum():
+    """A load's edges' shares combine as :data:`QUADRATURE` times their root-sum-square where that is below their
+    sum (module docstring): two edges by their sum, sixteen equal ones by ``QUADRATURE * 4`` shares, not 16; a
+    notch's share, listed on each of its two edges, counts once."""
+    assert quadrature([1.0, LOCATED_STEP], [False, False]) == pytest.approx(1 + LOCATED_STEP)
+    assert quadrature([LOCATED_STEP] * 16, [False] * 16) == pytest.approx(QUADRATURE * 4 * LOCATED_STEP)
+    assert quadrature([1.0] * 2 + [LOCATED_STEP] * 14, [True] * 2 + [False] * 14) == pytest.approx(
+        QUADRATURE * np.sqrt(1 + 14 * LOCATED_STEP ** 2))
+    assert quadrature([], []) == 0.0
+
+
+def test_an_edge_the_quartic_locates_away_from_a_kink_holds_a_smaller_share_of_a_step():
+    """With exact contact an edge away from a kink located by the quartic on its smooth open run holds
+    :data:`FITTED_STEP` of a step, by the line :data:`LOCATED_STEP` (module docstring); with a penalty the quartic's
+    edge is bounded as the line's (its own floor reads the penalty's length)."""
+    n, k_n = 4096, 1e3
+    x = np.arange(n) / n
+    g0 = np.where(x <= 0.75, 0.01 * (x - 0.4) ** 2, 0.01 * 0.35 ** 2 + 0.02 * (x - 0.75))   # a kink at 3/4
+    on = np.abs(x - 0.4) <= 0.1
+    gap = np.maximum(np.abs(x - 0.4) - 0.1, 0.0) ** 1.5           # a smooth edge on each side, far from the kink
+    exact = SimpleNamespace(dim=2, g0=g0, k_n=k_n, enforcement="exact")
+    assert located_edges(exact, on, gap) and edges_fitted(exact, on.astype(float), gap)
+    share = kink_share(exact, on.astype(float), gap)
+    assert (share["edges"], share["located"]) == (0, 2)
+    assert share["share"]["contact_fraction"] == pytest.approx(2 * FITTED_STEP / n)
+    penalty = SimpleNamespace(dim=2, g0=g0, k_n=k_n, enforcement="penalty")
+    assert kink_share(penalty, on.astype(float), gap)["share"]["contact_fraction"] == pytest.approx(2 * LOCATED_STEP / n)
 
 
 def test_on_the_seed_1_profile_an_edge_pinned_to_a_kink_is_bounded_and_flagged():

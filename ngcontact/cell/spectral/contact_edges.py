@@ -59,7 +59,7 @@ stalls at a third of a step while its differences fall tenfold).  Where the edge
 step of the kink, moving the located edge by one step bounds its error: the contact fraction changes by ``h /
 P``, ``K0 = k_n |S| / |T|`` by ``k_n h / P`` and ``g_n = k_n mean(1_S g0)`` by at most ``k_n h / P`` times the
 largest ``g0`` within a step of the edge (the grid points bounding the piecewise-linear ``g0`` there;
-:func:`kink_share`), summed over such edges.
+:func:`kink_share`), combined with the load's other edges (below).
 The refinement takes that share as a floor on the estimate of each quantity on the edges, as an island's
 (:func:`island_floor`, form :data:`KINK`).  The floor rests on the edge lying within a step of the kink, which
 no difference shows (its premise: an edge pinned to a kink lies at it to a fraction of a step on each grid that
@@ -71,71 +71,45 @@ follows) has both edges within a step of its kink: its true width lies between n
 between its two contact points (a wider one would open a point more), so its error is at most ``max(w, s - w)``
 steps, ``w`` its located width (one open point located a step wide, the notch far narrower: on the random
 profile of seed 9 at p = 0.01 the located width halves with the step); one that no grid point sees yet is not
-bounded here (on
-the random profile of seed 6 at p = 0.003 such a notch carries half the 4096 grid's error in the contact
-fraction, within the step of each of its load's two other edges at kinks).  A smooth gap (``g0''`` continuous)
-has no kinks, and in 3D the points are counted, no edge located between them.
+bounded here (on the profile of seed 6 at p = 0.003 such a notch carries half the 4096 grid's error in the
+contact fraction).  A smooth gap (``g0''`` continuous) has no kinks, and in 3D the points are counted.
 
-**Every other edge of a map with kinks.**  Away from the kinks the gap beyond an edge is smooth over the few
-steps the line through the first two open points reads, but neither locator converges as on a smooth gap:
-the line is off by a fraction of a step whose size and sign change from grid to grid, as the kinks nearest to
-the edge move between points, and the quartic reads a window kept within half the way to the nearest kink
+**Every other edge of a map with kinks.**  Away from the kinks the gap beyond an edge is smooth over the few steps
+the line through the first two open points reads, but neither locator converges as on a smooth gap: the line is off
+by a fraction of a step whose size and sign change from grid to grid, as the kinks nearest to the edge move between
+points, and the quartic reads a window kept within half the way to the nearest kink
 (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`; a window that reached across it was off by as much)
-(random profiles of 64 samples, seeds 1 to 12, three loads, grids 1024 to 32,768 against 131,072 points, 141
-loads and grids where both have as many edges, measured while the window could reach across a kink: the contact
-fraction's error over a load's edges 0.035 of a step per edge in the median, 0.13 in the ninetieth percentile,
-0.22 at most, and 0.9 of a step at one quartic's edge).  So the edges' error is of the order of the step, with
-a constant erratic from grid to grid: the differences between grids may show its changes of sign and not its
-size (on seed 7 at p = 0.003 the error grows from 0.014 to 0.21 of a step per grid on 2048 to 8192 points
-while the differences contract twofold, and an estimate from them is half the error).  On a map with kinks each
-edge not at a kink therefore holds :data:`LOCATED_STEP` of a step of each quantity on the edges, summed over the
-edges, as the same floor (form :data:`KINK`): above every one of those errors, about seven times the median
-one (the estimate then exceeds such an error by as much, and says so where it exceeds ten times what the last
-difference leaves), and a tolerance of 1e-4 of the contact fraction is met with six to twelve edges from
-16,384 to 32,768 points (``scripts/random_profile_accuracy.py``).  The 2D normal effective stiffness, of the
-set with its edges located between points (exact contact, :mod:`~ngcontact.cell.spectral.grid_measures`), carries
-the same edges' error: each edge's share is its steps above (a step at a kink, a notch's on each of its edges,
-:data:`LOCATED_STEP` elsewhere) times the stiffness's change with that edge alone a step out
-(:func:`~ngcontact.cell.spectral.grid_measures.edge_stiffness`), summed (:func:`stiffness_share`), the same
-floor under its estimate.  (With a penalty the stiffness is the collocated set's, whose error on the same
-profiles was 0.1 of its change with every edge a step out in the median, 0.53 at most: :data:`STIFFNESS_STEP`
-of each edge's change.)
+(calibration below).  So the edges' error is of the order of the step, with a constant erratic from grid to grid: the
+differences may show its changes of sign, not its size (on seed 7 at p = 0.003 it grows from 0.014 to 0.21 of a step
+on 2048 to 8192 points while they contract twofold: an estimate from them is half the error).  On a map with kinks
+each edge not at a kink therefore holds :data:`LOCATED_STEP` of a step of each quantity on the edges where the line
+located it, :data:`FITTED_STEP` where the quartic did (exact contact: its window reads the smooth gap), as the same
+floor (form :data:`KINK`).  The 2D normal effective stiffness, of the set with its edges located between points
+(exact contact, :mod:`~ngcontact.cell.spectral.grid_measures`), carries the same edges' error: each edge's share is
+its steps above (a step at a kink, a notch's on each of its edges, :data:`FITTED_STEP` or :data:`LOCATED_STEP`
+elsewhere) times the stiffness's change with that edge alone a step out
+(:func:`~ngcontact.cell.spectral.grid_measures.edge_stiffness`; :func:`stiffness_share`), the same floor under its
+estimate.  (With a penalty the stiffness is the collocated set's, whose error on the profiles of seeds 1 to 12 was
+0.1 of its change with every edge a step out in the median, 0.53 at most: :data:`STIFFNESS_STEP` of each edge's
+change, summed; its edges are bounded as the line's, the quartic reading beyond the penalty's length.)
 
-**A penalty's edges.**  With the Winkler layer of eq. 65 (``contact.enforcement = "penalty"``) the gap beyond an
-edge opens like ``(x - a)^(3/2)`` only farther than the length ``lambda = E*/k_n`` from it (:func:`penalty_length`,
-``1/E* = sum (1 - nu^2)/E`` over the two bodies): nearer, the layer carries the pressure, which falls to zero
-smoothly, and the gap opens faster.  The quartic's window (tens to hundreds of steps) and, on a step above
-``lambda``, the line's two points read the gap there, where it looks like that of a rigid edge placed off the
-penalty's own: the located edge converges, as the grid is refined, to that outer edge, and its error stalls
-while the differences between grids vanish (the quartic's window is a fixed share of the open run up to about
-7,500 points per period), then grows as the window shrinks into ``lambda``, before the line, on steps below
-``lambda``, takes over and converges at first order.  On Westergaard's sinusoid (layers of depth 1) refined to
-1e-3 at ``k_n = 1e4`` the contact fraction of each load is off by 0.71 ``lambda`` per edge on 16,384 points
-(8e-5) while the estimate from the differences was 1.6e-5 to 4.6e-6; at ``k_n = 1e3, 1e5, 1e6`` the outer edge
-is off by 0.49, 1.15 and 1.46 ``lambda`` (the penalty's own move of the edge, which it misses in part,
-grows like ``lambda ln(1 / lambda)``: :mod:`ngcontact.cell.penalty_share`).  So each edge of a penalty located on
-points beyond ``lambda`` (by the quartic, or by the line on a step above ``lambda``; :func:`penalty_zone_share`)
-holds ``B = PENALTY_LOG lambda ln(P / lambda)`` (``P`` the period), with ``PENALTY_LOG = 1/4``: 1.9 to 3.6
-``lambda`` from ``k_n = 1e3`` to ``1e6``, two and a half to four times the error above; the contact fraction
-``B / P`` per edge, ``K0 = k_n |S| / |T|`` ``k_n B / P``, ``g_n`` ``k_n B / P`` times the largest ``g0`` within
-``B`` and a step of the edge, summed over such edges, the same floor as an island's (form :data:`PENALTY_ZONE`;
-like an island's stalled share it is not flagged by its last difference, which does not show it).  Within ``lambda``
-the gap opens like ``(x - a)^2`` (the pressure falls to zero linearly), so ``gap^(2/3)`` goes like ``(x - a)^(4/3)``
-and the line through its first two open points, a step apart, is off by up to a third of a step (``1 - 1/(2^(4/3) -
-1)`` where the first lies a step beyond the edge), and by more where the collocated set holds a point too many or
-too few: first order, with a constant that jumps with the edge's position between points, which the differences may
-hide (at ``k_n = 1e4`` refined to 1e-4 the contact fraction's guarded estimate on 524,288 points was half its error,
-0.38 of a step per edge).  Each edge so located holds :data:`INSIDE_STEP` of a step, half, in the same floor (about
-1.3 times that error).  A run of levels whose edges are all located so is a locator's own, as the quartic's
-(:func:`fitted_run`): a window across the change from the quartic's levels is also taken on them alone (guarded,
-never Richardson's; a stop does not wait for them, :func:`locator_changing`: the whole window's bound stands).
-Every quantity of a load, the mean closure and the stiffness too, changes once more as the step falls below
-``lambda``: the collocated pressure then resolves the layer's zone at each edge, which coarser grids pass over.
-On Westergaard's sinusoid the mean closure's differences contract over several grids, then turn and stay near one
-size down to the grid whose step is ``lambda`` (``tests/cell/test_penalty_edges.py``): a sequence seen as geometric
-before that change says nothing of it.  So on a level whose step exceeds ``lambda``
-(:func:`zone_ahead`) no quantity of the load takes Richardson's tail, only the guarded bound, whose envelope
-keeps the earlier, larger differences.
+**A load's edges together.**  Each edge's error is made by its own locator on its own stretch of gap: but for a share
+of one sign (which the differences between grids show) a load's edges' errors are independent and do not add up to
+the sum of their bounds.  The edges hold together :data:`QUADRATURE` times the root-sum-square of their shares
+(:func:`quadrature`), or their sum where smaller: errors of zero mean within ``s_i`` spread by at most ``sqrt(sum
+s_i^2)``, and the factor covers a share of one sign (a load's signed errors summed were 1.1 times their own
+root-sum-square in the median, 3.1 at most, all twelve edges of a load inside by 0.006 to 0.17 of a
+step).  Calibration on random profiles of 64 samples, seeds 13 to 40 (the benchmarks' are 1 to 12), three loads (p =
+0.001, 0.003, 0.01), grids 1024 to 32,768 against 262,144 points, each edge matched to the reference's nearest on
+its side (504 loads and grids, 4,912 edges): an edge's error by the line 0.05 of a step in the median, 0.18 in the
+99th percentile, 0.29 at most (one of 2,920 beyond :data:`LOCATED_STEP`), by the quartic 0.008, 0.044, 0.057, at a
+kink 0.17, 0.65, 1.02 (on 1024 points), a notch's width 0.43 of its bound in the median, 1.4 at most; over its
+load's combined shares the contact fraction's error was 0.13 in the median, 0.34 in the 90th percentile, 0.76 at
+most, ``g_n``'s 0.66 and the stiffness's 0.61 at most, every load within its floor by 1.3 times or more, loads with
+a notch or island no grid point sees yet included (over the sum of the shares: 0.084, 0.24, 0.76).
+
+**A penalty's edges** (``contact.enforcement = "penalty"``) hold the floor of the penalty's zone, argued in
+:mod:`~ngcontact.cell.spectral.penalty_zone`.
 """
 from __future__ import annotations
 
@@ -146,6 +120,7 @@ from scipy import ndimage
 
 from ngcontact.cell.cell_solution import COEFFICIENT, scale
 from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset, edge_stiffness, kinks
+from ngcontact.cell.spectral.penalty_zone import INSIDE, INSIDE_STEP, PENALTY_LOG, PENALTY_ZONE, penalty_zone_share
 
 #: the fewest collocation points of a resolved 2D contact island (module docstring)
 ISLAND_POINTS = 4
@@ -155,16 +130,12 @@ ISLAND = "island"
 KINK = "kink"
 #: the share of a step that bounds the located position of any other edge of a map with kinks (module docstring)
 LOCATED_STEP = 0.25
+#: the share of a step that bounds such an edge located by the quartic, with exact contact (module docstring)
+FITTED_STEP = 0.1
+#: the factor on the root-sum-square of a load's edges' shares that bounds their error together (module docstring)
+QUADRATURE = 2.0
 #: with a penalty, the share of the stiffness's change with each edge a step out that bounds its error (same)
 STIFFNESS_STEP = 0.5
-#: the form of an estimate raised to the floor of a penalty's edges read beyond its length (module docstring)
-PENALTY_ZONE = "penalty zone"
-#: the kind of a level whose penalty's edges are all located by the line on points within its length
-INSIDE = "inside"
-#: the share of a step that bounds a penalty's edge located by the line within its length (module docstring)
-INSIDE_STEP = 0.5
-#: the bound on such an edge's error over ``lambda ln(P / lambda)``, ``lambda = E* / k_n`` (module docstring)
-PENALTY_LOG = 0.25
 
 
 def on_edges(name: str) -> bool:
@@ -271,19 +242,26 @@ def kink_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
     deformed gap the edges are located on) that lie within one grid step of a kink of the cell's gap ``g0``
     (:func:`kinks`): one step per such edge, ``g_n``'s at the largest ``g0`` within a step of the edge; a notch
     (an open run of fewer than :data:`ISLAND_POINTS` points both of whose edges are such) ``max(w, s - w)`` steps,
-    its located width ``w`` against the ``s`` steps between its contact points (module docstring); and
-    :data:`LOCATED_STEP` of a step per other edge of a map with kinks.  ``{"edges": how many at a kink,
+    its located width ``w`` against the ``s`` steps between its contact points (module docstring); :data:`LOCATED_STEP`
+    (:data:`FITTED_STEP` by the quartic) per other edge of a map with kinks; :func:`quadrature`.  ``{"edges": at a kink,
     "notches": how many, "located": how many others, "share": {headline name: absolute share}}``; no share
     without kinks."""
     steps, kinked_edges, notches = edge_steps(cell, p, gap)
     if not steps:
         return {"edges": 0, "notches": 0, "share": {}}
     n = p.size
-    total = sum(s for s, _, _ in steps.values()) - sum(s for s, _, notch in steps.values() if notch) / 2
-    heights = sum(s * h for s, h, notch in steps.values()) - sum(s * h for s, h, notch in steps.values() if notch) / 2
+    total = quadrature([s for s, _, _ in steps.values()], [notch for _, _, notch in steps.values()])
+    heights = quadrature([s * h for s, h, _ in steps.values()], [notch for _, _, notch in steps.values()])
     return {"edges": kinked_edges + 2 * notches, "notches": notches, "located": len(steps) - kinked_edges - 2 * notches,
             "share": {"contact_fraction": total / n, COEFFICIENT + "k_n": cell.k_n * total / n,
                       COEFFICIENT + "g_n": cell.k_n * heights / n}}
+
+
+def quadrature(terms: list[float], notch: list[bool]) -> float:
+    """The bound of a load's edges of shares ``terms`` (module docstring): :data:`QUADRATURE` times their root-sum-
+    square where below their sum; a notch's share, listed on each of its two edges (``notch``), counts once."""
+    weighted = [(t, 0.5 if at_notch else 1.0) for t, at_notch in zip(terms, notch)]
+    return float(min(sum(w * t for t, w in weighted), QUADRATURE * np.sqrt(sum(w * t * t for t, w in weighted))))
 
 
 def edge_steps(cell, p: np.ndarray, gap: np.ndarray) -> tuple[dict[tuple[int, int], tuple[float, float, bool]],
@@ -296,13 +274,14 @@ def edge_steps(cell, p: np.ndarray, gap: np.ndarray) -> tuple[dict[tuple[int, in
     if cell.dim != 2 or on.all() or not on.any() or at.size == 0:
         return {}, 0, 0
     root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
-    edges = {}                                           # (last contact point, step): (offset, kinked, largest g0)
+    edges = {}                          # (last contact point, step): (offset, kinked, largest g0, by the quartic)
     for step in (1, -1):
         for i in (int(j) for j in np.flatnonzero(on & ~np.roll(on, -step))):
-            t = edge_offset(root, on, i, step, at)[0]
+            t, fitted = edge_offset(root, on, i, step, at)
             x = i + step * t
             reach = np.arange(int(np.floor(x - 1.0)), int(np.ceil(x + 1.0)) + 1) % n   # the steps it may move across
-            edges[i, step] = (t, bool(np.min(np.abs((at - x + n / 2) % n - n / 2)) <= 1.0), float(cell.g0[reach].max()))
+            edges[i, step] = (t, bool(np.min(np.abs((at - x + n / 2) % n - n / 2)) <= 1.0), float(cell.g0[reach].max()),
+                              fitted and getattr(cell, "enforcement", "exact") == "exact")
     steps: dict[tuple[int, int], tuple[float, float, bool]] = {}
     notches = 0
     for first, w in islands(~on):                        # a notch: both edges of a short open run at a kink
@@ -313,64 +292,24 @@ def edge_steps(cell, p: np.ndarray, gap: np.ndarray) -> tuple[dict[tuple[int, in
             steps[right] = steps[left] = notch
             del edges[right], edges[left]
             notches += 1
-    steps.update({key: (1.0 if kinked else LOCATED_STEP, height, False) for key, (_, kinked, height) in edges.items()})
-    return steps, sum(1 for _, kinked, _ in edges.values() if kinked), notches
+    steps.update({key: (1.0 if kinked else FITTED_STEP if fitted else LOCATED_STEP, height, False)
+                  for key, (_, kinked, height, fitted) in edges.items()})
+    return steps, sum(1 for _, kinked, _, _ in edges.values() if kinked), notches
 
 
 def stiffness_share(cell, p: np.ndarray, gap: np.ndarray) -> float:
     """The share of the 2D normal effective stiffness held by the located edges of a map with kinks: per edge its
-    steps of :func:`edge_steps` times the stiffness's change with that edge a step out
-    (:func:`~ngcontact.cell.spectral.grid_measures.edge_stiffness`), summed; with a penalty, whose stiffness is the
-    collocated set's, :data:`STIFFNESS_STEP` of a step per edge (module docstring); 0 without kinks."""
+    steps of :func:`edge_steps` times the stiffness's change with that edge a step out (:func:`~ngcontact.cell.
+    spectral.grid_measures.edge_stiffness`), by :func:`quadrature`; with a penalty, whose stiffness is the collocated
+    set's, :data:`STIFFNESS_STEP` of a step per edge, summed (module docstring); 0 without kinks."""
     steps = edge_steps(cell, p, gap)[0]
     if not steps:
         return 0.0
     shares = edge_stiffness(cell, p > 0, gap)["edges"]
-    exact = cell.enforcement == "exact"
-    return sum((s if exact else STIFFNESS_STEP) * abs(shares[key][1]) for key, (s, _, _) in steps.items()
-               if key in shares)
-
-
-def zone_ahead(entry: dict[str, Any], k: int) -> bool:
-    """Whether a level's step exceeds the penalty's length ``lambda`` at load ``k`` with edges in contact: the
-    change of regime where the grid comes to resolve the penalty's zone lies ahead (module docstring)."""
-    return not entry.get("islands", [{}] * (k + 1))[k].get("penalty", {}).get("resolved", True)
-
-
-def penalty_length(cell) -> float:
-    """The length ``lambda = E* / k_n`` over which a 2D penalty's edge departs from a rigid one (module docstring):
-    ``E*`` the plane-strain modulus of the two bodies in series, ``1 / E* = sum (1 - nu^2) / E``; 0 for exact
-    contact and in 3D."""
-    if cell.dim != 2 or cell.enforcement != "penalty":
-        return 0.0
-    return 1.0 / (cell.k_n * sum((1.0 - layer.nu ** 2) / layer.E for layer in (cell.rough, cell.counter)))
-
-
-def penalty_zone_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
-    """The share of each quantity on the edges held by the 2D edges of a penalty's pressure ``p`` (module
-    docstring): an edge located on points farther than its length ``lambda`` (:func:`penalty_length`; by the
-    quartic, or by the line on a step above ``lambda``) may be off by ``B = PENALTY_LOG lambda ln(P / lambda)``,
-    one located by the line within it by :data:`INSIDE_STEP` of a step ``h``: the contact fraction by that over
-    ``P``, ``K0`` ``k_n`` times as much, ``g_n`` that times the largest ``g0`` within it and a step of the edge.
-    ``{"edges": how many beyond, "bound": B, "inside": whether none is, "resolved": whether the step is at most
-    lambda (:func:`zone_ahead`), "share": {headline name: absolute share}}``; no share without a penalty's edges."""
-    lam, on, n = penalty_length(cell), p > 0, p.size
-    step = cell.period / n
-    if lam <= 0.0 or on.all() or not on.any():
-        return {"edges": 0, "bound": 0.0, "share": {}, "inside": False, "resolved": True}
-    bound = PENALTY_LOG * lam * max(np.log(cell.period / lam), 1.0)
-    root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
-    edges, total, heights = 0, 0.0, 0.0
-    for side in (1, -1):
-        for i in (int(j) for j in np.flatnonzero(on & ~np.roll(on, -side))):
-            beyond = edge_offset(root, on, i, side)[1] or step > lam
-            off = bound if beyond else INSIDE_STEP * step
-            reach = int(np.ceil(off / step)) + 1
-            edges, total = edges + beyond, total + off
-            heights += off * float(cell.g0[np.arange(i - reach, i + reach + 1) % n].max())
-    return {"edges": edges, "bound": bound, "inside": not edges, "resolved": step <= lam, "share": {
-        "contact_fraction": total / cell.period, COEFFICIENT + "k_n": cell.k_n * total / cell.period,
-        COEFFICIENT + "g_n": cell.k_n * heights / cell.period}}
+    if cell.enforcement != "exact":
+        return sum(STIFFNESS_STEP * abs(shares[key][1]) for key in steps if key in shares)
+    return quadrature([s * abs(shares[key][1]) for key, (s, _, _) in steps.items() if key in shares],
+                      [False] * len(steps))
 
 
 def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict[str, Any]:
@@ -436,7 +375,7 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                 remarks.append(f"load {k}: {kinked['edges']} contact edge(s) within a step of a kink of the map on "
                                f"grid {last['grid']} ({kinked['notches']} notch(es) of fewer than {ISLAND_POINTS} open "
                                f"points at one) and {kinked.get('located', 0)} other(s): {', '.join(raised)} bounded "
-                               f"by a step at each edge at a kink, {LOCATED_STEP:g} of a step at each other, a notch "
-                               "by its width or the rest of the steps between its contact points, the stiffness by "
-                               "as many steps of its change with each edge a step out")
+                               f"by a step at each edge at a kink, {LOCATED_STEP:g} ({FITTED_STEP:g} by the quartic) "
+                               "of a step at each other, a notch by its width's bound, the stiffness by as many steps "
+                               "of its change with each edge a step out, in quadrature")
     return remarks

@@ -6,7 +6,7 @@ reported grid ``k`` in one of six forms, which the report names: Richardson's ta
 last difference (:data:`CARRIED`), the share of contact islands too narrow for the grid
 (:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), a step at each 2D edge within a step of a kink of
 a map's piecewise-linear surface (:data:`~ngcontact.cell.spectral.contact_edges.KINK`), or a share of a penalty's
-length at each 2D edge located beyond it (:data:`~ngcontact.cell.spectral.contact_edges.PENALTY_ZONE`). Each is a
+length at each 2D edge located beyond it (:data:`~ngcontact.cell.spectral.penalty_zone.PENALTY_ZONE`). Each is a
 bound on its own argument; none is sharp where the error of grid ``k`` is far below the differences that bound it.
 
 The last two differences ``d_(k-1)``, ``d_k`` (``d_k = q_k - q_(k-1)``) say how large that error is in the
@@ -81,7 +81,8 @@ from __future__ import annotations
 from typing import Any
 
 from ngcontact.cell.cell_solution import scale
-from ngcontact.cell.spectral.contact_edges import ISLAND, KINK, PENALTY_ZONE
+from ngcontact.cell.spectral.contact_edges import ISLAND, KINK
+from ngcontact.cell.spectral.penalty_zone import PENALTY_ZONE
 
 #: the forms of the estimate, as the report names them (:data:`CARRIED`: after a deferred stop, module
 #: docstring of :mod:`~ngcontact.cell.spectral.refinement`)

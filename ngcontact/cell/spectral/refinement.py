@@ -20,30 +20,29 @@ the verdict controls (:func:`ngcontact.cell.cell_solution.measure`: the contact 
 relative to the largest of its group, every other quantity relative), and takes one of two forms, which the report
 names (:func:`sweep_estimates`):
 
-1. **Richardson with the observed rate**, where the sequence is seen to be geometric: the two successive
-   ratios ``|d_(k-1)| / |d_(k-2)|`` and ``|d_k| / |d_(k-1)|`` agree within the factor :data:`AGREE` and
-   both contract at least by :data:`RATE_CAP`.  The rate is the larger of the two, but never faster than
-   the quantity's own order in the grid step (:data:`ORDER_RATE`: first order, ``1/2`` per level, for the
-   contact fraction, whose edges are counted or located between points, and for the mean closure too: a
-   mean of the collocated jump, which an edge misplaced by a fraction of a step barely moves (the gap
-   opens like ``(x - a)^(3/2)`` beyond an edge ``a``), but whose error is carried by the collocated
-   pressure at the edges, singular like the inverse square root of the distance to an edge, with a
-   first-order constant that changes sign as the edges cross the grid: two fast ratios just after such a
-   sign change do not show the first-order stretch that follows, as on Westergaard's sinusoid at a fifth
-   of its closing pressure); the estimate is the tail of the geometric series beyond level ``k``,
-   ``|d_k| rho / (1 - rho)``, times :data:`SPREAD`, the scatter of one level's error about the geometric
-   model (the erratic factor above: an edge's position between two points) that two ratios cannot
-   resolve.  Where that exceeds the guarded bound below (which holds without the geometric model), the
-   guarded bound is the estimate: Richardson only ever sharpens it.
-2. **The guarded bound** wherever the two ratios disagree, one difference vanished, or the sequence does
-   not contract ("where two successive differences disagree in rate, the estimate says so and takes the
-   larger"): the rate is the larger of the ratios held to ``[RATE_FLOOR, RATE_CAP]`` (never faster than
-   first order, and a sequence not contracting by ``RATE_CAP`` is taken as contracting by it), and the
-   size of the next differences is the envelope ``D = max_i |d_(k-i)| ENVELOPE^i`` with ``ENVELOPE =
-   1/2``: the last difference, or an earlier one shrunk at first order, whichever is larger, so that a
-   last difference that vanished by coincidence (a symmetric cell gives the same fraction on two grids; a
-   count of points whose constant jumps with the edges) is bounded by the ones before it; the tail ``D rho /
-   (1 - rho)``, on the levels since where the last ratio is twice as fast (:mod:`.estimate_forms`).
+1. **Richardson with the observed rate**, where the sequence is seen to be geometric: the two successive ratios
+   ``|d_(k-1)| / |d_(k-2)|`` and ``|d_k| / |d_(k-1)|`` agree within the factor :data:`AGREE` and both contract at
+   least by :data:`RATE_CAP`. The rate is the larger of the two, but never faster than the quantity's own order in
+   the grid step (:data:`ORDER_RATE`: first order, ``1/2`` per level, for the contact fraction, whose edges are
+   counted or located between points, and for the mean closure too: a mean of the collocated jump, which an edge
+   misplaced by a fraction of a step barely moves (the gap opens like ``(x - a)^(3/2)`` beyond an edge ``a``), but
+   whose error is carried by the collocated pressure at the edges, singular like the inverse square root of the
+   distance to an edge, with a first-order constant that changes sign as the edges cross the grid: two fast ratios
+   just after such a sign change do not show the first-order stretch that follows, as on Westergaard's sinusoid at a
+   fifth of its closing pressure); the estimate is the tail of the geometric series beyond level ``k``,
+   ``|d_k| rho / (1 - rho)``, times :data:`SPREAD`, the scatter of one level's error about the geometric model (the
+   erratic factor above: an edge's position between two points) that two ratios cannot resolve. Where that exceeds
+   the guarded bound below (which holds without the geometric model), the guarded bound is the estimate: Richardson
+   only ever sharpens it.
+2. **The guarded bound** wherever the two ratios disagree, one difference vanished, or the sequence does not contract
+   ("where two successive differences disagree in rate, the estimate says so and takes the larger"): the rate is the
+   larger of the ratios held to ``[RATE_FLOOR, RATE_CAP]`` (never faster than first order, and a sequence not
+   contracting by ``RATE_CAP`` is taken as contracting by it), and the size of the next differences is the envelope
+   ``D = max_i |d_(k-i)| ENVELOPE^i`` with ``ENVELOPE = 1/2``: the last difference, or an earlier one shrunk at first
+   order, whichever is larger, so that a last difference that vanished by coincidence (a symmetric cell gives the
+   same fraction on two grids; a count of points whose constant jumps with the edges) is bounded by the ones before
+   it; the tail ``D rho / (1 - rho)``, on the levels since where the last ratio is twice as fast
+   (:mod:`.estimate_forms`).
 
 In 2D the contact fraction and the coefficients of eq. 34 rest on edges located between points by one of two locators
 (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`): the quartic fitted to the open gap where its window
@@ -133,16 +132,15 @@ by much more than the differences before it show (a pre-asymptotic stretch left 
 change of method marks, unlike the 2D edge locator above), the differences up to level ``k`` still carry the size of
 the earlier errors, and the estimate exceeds the error by their ratio.
 
-A stop needs ``MIN_LEVELS`` levels (three differences: the window) and, to a scene's own tolerance, no load's
-edge locator changing (above).  The levels are known before the first solve (``grid`` times ``GROWTH^k`` up to
+A stop needs ``MIN_LEVELS`` levels (three differences: the window) and, to a scene's own tolerance, no load's edge
+locator changing (above). The levels are known before the first solve (``grid`` times ``GROWTH^k`` up to
 ``max_points``, :func:`levels`; the scene layer bounds ``max_points`` by the cost of a solve,
-:func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest is stated first, and each level prints one
-progress line as it ends.  A tolerance out of reach ends in a :class:`~ngcontact.errors.ConvergenceError` where
-it was required (the scene stated it), else the finest level is the answer, marked as not meeting it.  Each
-level starts its loads from the coarser level's pressures, interpolated onto its grid (:func:`prolong`; the
-coarse points are every other fine point): a start only (it saves the constrained CG's first steps, where the
-contact set shrinks from full contact); the answer is the level's own.
-"""
+:func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest is stated first, and each level prints one progress
+line as it ends. A tolerance out of reach ends in a :class:`~ngcontact.errors.ConvergenceError` where it was required
+(the scene stated it), else the finest level is the answer, marked as not meeting it. Each level starts its loads
+from the coarser level's pressures, interpolated onto its grid (:func:`prolong`; the coarse points are every other
+fine point): a start only (it saves the constrained CG's first steps, where the contact set shrinks from full
+contact); the answer is the level's own."""
 from __future__ import annotations
 
 import logging
@@ -153,13 +151,14 @@ from typing import Any, Callable
 import numpy as np
 
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
-from ngcontact.cell.spectral.contact_edges import (INSIDE, ISLAND_POINTS, LOCATED_STEP, PENALTY_LOG, fitted_run,
+from ngcontact.cell.spectral.contact_edges import (FITTED_STEP, ISLAND_POINTS, LOCATED_STEP, QUADRATURE, fitted_run,
                                                    island_floor, locator_kind, on_edges, resolved_run, unresolved_share,
-                                                   zone_ahead, locator_changing as edges_changing)
+                                                   locator_changing as edges_changing)
 from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, DISAGREE, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP,
                                                     RATE_FLOOR, SAFETY, SPREAD, WINDOW, loose_flags, loose_remarks,
                                                     tail_estimate)
 from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
+from ngcontact.cell.spectral.penalty_zone import INSIDE, PENALTY_LOG, zone_ahead
 from ngcontact.errors import ConvergenceError
 
 #: the run's progress lines (printed as its stage lines, :func:`ngcontact.runner.solve`)
@@ -199,8 +198,9 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"would meet it (else not met), times {ERRATIC[STIFFNESS][3]:g} in 3D, reported, not held; at least "
        f"the share of contact islands of fewer than {ISLAND_POINTS} points (3D: across), and after such islands "
        f"also on the resolved levels (at least {LOCATOR_LEVELS}), the smaller; a step per 2D edge within a step of a "
-       f"kink of the map's piecewise-linear surface, {LOCATED_STEP:g} of one per other edge of such a map, "
-       f"{PENALTY_LOG:g} E*/k_n ln(period k_n / E*) per edge of a penalty located on points beyond E*/k_n; above "
+       f"kink of the map's piecewise-linear surface, {LOCATED_STEP:g} of one per other edge of such a map "
+       f"({FITTED_STEP:g} by the quartic; a load's edges {QUADRATURE:g} times their root-sum-square where below their "
+       f"sum), {PENALTY_LOG:g} E*/k_n ln(period k_n / E*) per edge of a penalty located on points beyond E*/k_n; above "
        f"{LOOSE:g} times the error its last difference leaves at the last rate, or the one before where the last is "
        "twice as slow or more: flagged (quantities[].loose)")
 

@@ -24,7 +24,7 @@ from ngcontact.cell.cell_solution import CellSolution, worst_estimate
 from ngcontact.cell.cell_solver import Refinement, Response, response_of
 from ngcontact.cell.spectral import grid_measures
 from ngcontact.cell.spectral.coarser_grids import HOW as COARSER_HOW, estimate_from_coarser, why_not
-from ngcontact.cell.spectral.contact_edges import penalty_length
+from ngcontact.cell.spectral.penalty_zone import penalty_length
 from ngcontact.cell.spectral.layered_cell import SpectralCell, SpectralSolution
 from ngcontact.cell.spectral.refinement import HOW, sweep_to_tolerance, uncontrolled
 from ngcontact.cell.whole_surface import flat
