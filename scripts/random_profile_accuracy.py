@@ -254,7 +254,8 @@ def verdict(rows: list[dict]) -> str:
                 + (f" ({len(missed)} missed: " + ", ".join(f"seed {r['seed']} load {r['load']} {r['quantity']}"
                                                             for r in missed) + ")" if missed else "")
                 + (f", out of reach on seeds {[r['seed'] for r in lost]}" if lost else "")
-                + (f", {len(unresolved)} rows unresolved (posed grid >= finest grid, no limit, seeds "
+                + (f", {len(unresolved)} rows unresolved (posed on the finest grid, whose differences from the "
+                   "two coarser references do not halve: no limit beyond it; seeds "
                    f"{sorted({r['seed'] for r in unresolved})})" if unresolved else "")
                 + (f"; reported not met (said so): {len(unmet)} quantities of "
                    f"{sorted({q for _, _, q in unmet})} on seeds {sorted({sd for sd, _, _ in unmet})}" if unmet
