@@ -59,7 +59,16 @@ def thread_count() -> int:
 def threads(n: int):
     """Assembly and solves inside NGSolve's task manager with ``n`` threads (NGSolve runs on one core otherwise).
 
-    One thread runs without the task manager: with it a 3D cell solve is markedly slower.  The
+    One thread runs without the task manager: with it a 3D cell solve is markedly slower.  It is told to
+    NGSolve all the same (``SetNumThreads(1)``): a sparse Cholesky factorization (the direct solver of every
+    2D FE cell) runs outside a task manager in a pool of its own on every core, whose partial sums meet in
+    an order that changes from call to call, so that the same matrix factored twice gave solutions
+    differing at round-off, which the exact cell's stiffness (a rigid limit taken from a Schur complement,
+    :mod:`ngcontact.cell.fe.stiffness`) amplified to 1e-9 of itself at the graded Westergaard cell's first
+    level and up to 3e-7 at its finest (p/p* = 0.5): enough to move a stopping decision near the
+    tolerance.  On one thread the factorization, and with it every number of a run, is the same bit for bit
+    from run to run (``tests/test_threads.py``).  With ``n`` threads the factorization's order still varies
+    (inside NGSolve): numbers then agree to that amplified round-off, not bit for bit.  The
     BLAS libraries loaded (NGSolve's OpenBLAS under its direct solvers, NumPy's) run on one thread
     meanwhile: their own threads, which keep spinning after each call, would share the cores with
     NGSolve's, and a solve with both pools on the same cores runs several times slower.  So do those the run
@@ -79,6 +88,8 @@ def threads(n: int):
     try:
         with threadpool_limits(limits=1):
             if n == 1:
+                from pyngcore import SetNumThreads
+                SetNumThreads(1)
                 yield
                 return
             import ngsolve as ng

@@ -36,6 +36,9 @@ below it the true error is not known and no effectivity is reported.  Issue 35 a
     python scripts/graded_effectivity.py [OUT] [--only penalty|exact] [--publish]
 
 Writes ``OUT/graded_effectivity.csv`` and ``.png`` (default ``results/graded_effectivity``).
+It solves on the threads ``NGCONTACT_THREADS`` names (:func:`ngcontact.runner.threads`); on one, a second run
+gives the same figures bit for bit (on more, NGSolve's factorization sums in a varying order: the exact cell's
+stiffness then moves by some 3e-7 of itself from run to run).
 """
 from __future__ import annotations
 
@@ -57,6 +60,7 @@ from ngcontact.cell.fe.edge_grading import contact_edges, graded_vertices  # noq
 from ngcontact.cell.cell_load import cell_load  # noqa: E402
 from ngcontact.drivers.build import cell_loads, fe_cell, spectral_cell  # noqa: E402
 from ngcontact.output.writer import write_csv  # noqa: E402
+from ngcontact.runner import thread_count, threads  # noqa: E402
 from ngcontact.verification.moduli import e_star  # noqa: E402
 from ngcontact.verification.westergaard import westergaard_contact_fraction, westergaard_p_star  # noqa: E402
 
@@ -209,7 +213,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     data = []
     for contact in args.only:
-        new = rows(contact)
+        with threads(thread_count()):      # NGCONTACT_THREADS = 1: the same numbers, bit for bit, run after run
+            new = rows(contact)
         data += new
         for d in new:
             print(", ".join(f"{d[k]:.4g}" if isinstance(d[k], float) else str(d[k]) for k in KEYS), flush=True)

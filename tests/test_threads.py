@@ -62,3 +62,34 @@ def test_blas_runs_on_one_thread_inside_a_run_and_gets_its_threads_back(n):
     after = {i["filepath"]: i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"}
     assert set(inside.values()) == {1}
     assert after == before
+
+
+def test_one_thread_gives_the_same_cell_bit_for_bit():
+    """On one thread the same scene gives the same numbers: the exact graded Westergaard cell's first level
+    (``geometries/cells/westergaard_graded.toml`` with exact contact, p/p* = 0.5) meshed and solved twice gives
+    the same mesh and the same headline numbers, bit for bit (bound 0).  Before ``runner.threads(1)`` told
+    NGSolve one thread, its sparse Cholesky factorization ran in a pool on every core (here two, set first, as
+    a run with more threads before it leaves them), and the stiffness differed by about 1e-9 of itself."""
+    import dataclasses
+
+    import numpy as np
+    import pyngcore
+
+    import ngcontact
+    from ngcontact import runner
+    from ngcontact.cell.cell_solution import headline
+    from ngcontact.drivers.build import cell_loads, fe_cell
+    scene = ngcontact.load(os.path.join(ROOT, "geometries", "cells", "westergaard_graded.toml"))
+    scene = dataclasses.replace(scene, contact=dataclasses.replace(scene.contact, enforcement="exact", k_n=1e3))
+    load = cell_loads(scene)[2]
+    pyngcore.SetNumThreads(2)
+    runs = []
+    with runner.threads(1):
+        for _ in range(2):
+            problem = fe_cell(scene).graded([], scene.discretization.order)
+            points = np.array([p.p for p in problem.mesh.ngmesh.Points()])
+            runs.append((points, headline(problem.solve(load, first=True).results)))
+    (p0, h0), (p1, h1) = runs
+    assert np.array_equal(p0, p1)
+    assert h0 == h1
+    assert 0.49 < h0["contact_fraction"] < 0.51       # the load's own cell (Westergaard: 0.5)
