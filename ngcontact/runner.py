@@ -64,8 +64,7 @@ def threads(n: int):
     2D FE cell) runs outside a task manager in a pool of its own on every core, whose partial sums meet in
     an order that changes from call to call, so that the same matrix factored twice gave solutions
     differing at round-off, which the exact cell's stiffness (a rigid limit taken from a Schur complement,
-    :mod:`ngcontact.cell.fe.stiffness`) amplified to 1e-9 of itself at the graded Westergaard cell's first
-    level and up to 3e-7 at its finest (p/p* = 0.5): enough to move a stopping decision near the
+    :mod:`ngcontact.cell.fe.stiffness`) amplifies many times over: enough to move a stopping decision near the
     tolerance.  On one thread the factorization, and with it every number of a run, is the same bit for bit
     from run to run (``tests/test_threads.py``).  With ``n`` threads the factorization's order still varies
     (inside NGSolve): numbers then agree to that amplified round-off, not bit for bit.  The
