@@ -13,15 +13,14 @@ charged for it twice.  A batch kept in this
 process starts no worker; while the workers solve a batch, this process's NGSolve threads sleep
 (:func:`~ngcontact.parallel.batch_member.threads_asleep`).
 
-Two starts overlap the batch's own time.  A run whose first batch the last
-run of it forecast to repay the workers started them with the run; that
-batch goes to them from its first member, none timed here, where (1) still
-holds for all of it with the recorded ``c`` on the cores free now
-(:meth:`JudgedBatches._sent_on_forecast`).  A batch without a forecast
-starts the workers' fork server as it opens, where a core is idle beside
-this process (:meth:`JudgedBatches._start_beside`): its first members are
-timed here while the server imports, and the server is stopped where (1)
-then keeps the batch here.
+A run whose first batch the last run of it forecast to repay the workers
+started them with the run; that batch goes to them from its first member,
+none timed here, where (1) still holds for all of it with the recorded
+``c`` on the cores free now (:meth:`JudgedBatches._sent_on_forecast`).  A
+batch without a forecast starts no worker before (1) holds: a fork server
+started as such a batch opens, its start then counted as spent, sent the
+shipped measured scan's last members to workers whose first member paid
+imports the record of other batches' first members did not show.
 
 The rule is a mixin of :class:`~ngcontact.parallel.local_pool.LocalPool`, whose worker processes it starts,
 uses and stops: this module holds the decision, that one the processes.
@@ -57,12 +56,6 @@ FIRST_MEMBER_SECONDS = 1.0
 #: fork, unpickling the start's data, the one-thread limits; ``S_fork`` of
 #: :mod:`ngcontact.parallel.fork_server`).
 FORK_SECONDS = 0.05
-
-
-#: The part of a core other processes must leave idle beside this process's own (``f >= 1 +`` this) for a
-#: batch to start the workers' fork server as it opens (:meth:`JudgedBatches._start_beside`): the server's
-#: imports then run on a core this process does not use.
-BESIDE_FREE = 0.75
 
 
 def start_cost(default: float | None = None) -> float:
@@ -118,8 +111,8 @@ class JudgedBatches(Executor, ABC):
         """Stop the workers (or what starts them) still starting."""
 
     @abstractmethod
-    def _open_server(self, counted: bool = True) -> Any:
-        """Start the workers' fork server now (``counted``: as a pool's start, else once a worker forks)."""
+    def _open_server(self) -> Any:
+        """Start the workers' fork server now."""
 
     @abstractmethod
     def _await_ready(self, seconds: float) -> bool:
@@ -201,46 +194,34 @@ class JudgedBatches(Executor, ABC):
         from this process); started ones are kept for the run's next batch.
         A pool not started is started once (1) holds (never for a batch kept
         here), its workers importing the members' module as they start, and
-        this process solves members while they start; or as the batch opens,
-        where a core is idle beside this process (:meth:`_start_beside`).
+        this process solves members while they start.
         The run's first batch, where a forecast started the workers with the
         run, goes to them from its first member (:meth:`_sent_on_forecast`).
         """
         forecast, self._forecast = self._forecast, None      # the forecast is of the run's first batch
         done: list = []
-        beside = False
         if forecast is not None and forecast.members == len(items):
             done = self._sent_on_forecast(fn, items, names, label, progress, fault, forecast)
             if len(done) == len(items):
                 return done
-        else:
-            beside = self._start_beside(fn, len(items))
         clock = self.member_clock            # each member solved here is timed by Executor._map
         while True:
             k = len(done)
             done += Executor._map(self, fn, items[k:k + 1], names[k:k + 1], label,
                                   shifted_progress(progress, k, len(items)), fault)
             if len(done) == len(items):
-                if beside:
-                    self._abandon_start()   # started for this batch only, which ended here
-                self._where("serial", f"all {len(done)} members solved here" + (
-                    " beside the workers' fork server, stopped with the batch" if beside
-                    else " while the workers started" if self._launched() else ""))
+                self._where("serial", f"all {len(done)} members solved here"
+                            + (" while the workers started" if self._launched() else ""))
                 return done
             first = clock.times[0] - clock.least if len(clock.times) >= 2 else None
             payoff = self.payoff(clock.least, len(items) - len(done), first=first)
             log.debug("%s: look: %s", label, payoff.describe(len(done)))      # every look's inputs
             if not payoff.repaid:
-                if beside and len(done) < worker_payoff.MEASURED:
-                    continue        # a start beside is kept until the look that has timed the batch
-                stopped = beside
-                if self._launched() and not self._ready() and payoff.rest > 1 or beside:
+                if self._launched() and not self._ready() and payoff.rest > 1:
                     self._abandon_start()   # (a last member here takes one member's time: the start goes on)
-                    beside = False
                 if len(done) < worker_payoff.MEASURED:
                     continue        # the second member here measures what the first paid once: look again
-                self._where("serial", payoff.describe(len(done))
-                            + ("; the workers' fork server started beside the batch stopped" if stopped else ""))
+                self._where("serial", payoff.describe(len(done)))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
                 return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
                                             shifted_progress(progress, len(done), len(items)), fault)
@@ -249,8 +230,6 @@ class JudgedBatches(Executor, ABC):
                     self.started = f"during batch '{label}'"
                 self.start((fn.__module__,))
             if self._ready() and len(done) >= worker_payoff.MEASURED:
-                if self.started == "never":
-                    self.started = f"during batch '{label}'"     # a start beside it: the workers start now
                 self._where("local", payoff.describe(len(done)))
                 log.debug("%s: %s", label, payoff.describe(len(done)))
                 with threads_asleep():
@@ -293,21 +272,6 @@ class JudgedBatches(Executor, ABC):
                                   shifted_progress(progress, k, len(items)), fault)
         self._where("serial", f"all {len(done)} members solved here while the workers started")
         return done
-
-    def _start_beside(self, fn, members: int) -> bool:
-        """Start the workers' fork server as a batch opens, beside the members this process solves to time
-        it, where that costs this process nothing: the server is one process importing NGSolve and the
-        members' module (spawned workers would be ``W`` of them), the batch has members beyond the
-        ``MEASURED`` to send, and the cores other processes leave free (``f``) hold this process's core and
-        most of another (:data:`BESIDE_FREE`).  Then the start is paid by the time (1) is first read, and the
-        rule counts only what is still ahead (``R``) and the forks; where (1) fails after ``MEASURED``
-        members, or the batch ends here, the server is stopped.  Whether it was started."""
-        if (self.method != "forkserver" or self._launched() or members <= worker_payoff.MEASURED + 1
-                or self.cores.reading().free < 1.0 + BESIDE_FREE):
-            return False
-        self._modules = tuple(dict.fromkeys(self._modules + (fn.__module__,)))
-        self._open_server(counted=False)
-        return True
 
     def _start_ahead(self, start: float) -> float:
         """Seconds of the workers' start still to come (``R`` of :mod:`ngcontact.parallel.worker_payoff`), of

@@ -52,7 +52,6 @@ class LocalPool(PoolStart):
         self.workers = workers
         self._server: fork_server.Server | None = None   # the fork server, started with the pool
         self._forked = 0              # pools of workers forked by the current server
-        self._uncounted = False       # a server started beside a batch, counted once its first pool forks
         self._pool: Any = None        # the ProcessPoolExecutor, started on first use
         self._started: Any = None     # the queue on which workers announce their start
         self._processes: dict = {}      # every worker process of the current pool, by pid

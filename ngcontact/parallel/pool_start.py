@@ -23,29 +23,24 @@ class PoolStart(JudgedBatches):
     pools_started: int
     _server: fork_server.Server | None
     _forked: int
-    _uncounted: bool
     _pool: Any
 
-    def _open_server(self, counted: bool = True) -> fork_server.Server:
+    def _open_server(self) -> fork_server.Server:
         """The pool's fork server, started now if it has none or its server has died (its imports go on
         beside this process, in the one-thread environment of :mod:`ngcontact.parallel.fork_server`; a
-        server left to :mod:`multiprocessing` would restart with the run's own).  ``counted``: the server
-        counts as a pool started (:attr:`pools_started`) now, else once its first workers fork (a server
-        started beside a batch that then stays in this process starts no worker)."""
+        server left to :mod:`multiprocessing` would restart with the run's own)."""
         if self._server is not None and not self._server.running():
             self._stop_server()
         if self._server is None:
             self._server = fork_server.acquire(self._modules)
             self._forked = 0
-            self._uncounted = not counted
-            self.pools_started += counted
+            self.pools_started += 1
         return self._server
 
     def _counted_pool(self) -> None:
         """A pool of workers forks from the server: counted as started (:attr:`pools_started`), the server's
-        first one where the server was (:meth:`_open_server`)."""
-        self.pools_started += self._forked > 0 or self._uncounted
-        self._uncounted = False
+        first one with the server (:meth:`_open_server`)."""
+        self.pools_started += self._forked > 0
         self._forked += 1
 
     def _launched(self) -> bool:

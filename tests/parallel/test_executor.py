@@ -183,7 +183,6 @@ def test_a_pool_started_on_demand_uses_its_workers_only_where_they_repay_their_s
     monkeypatch.setattr(judged_batches, "START_SECONDS", start_seconds)
     monkeypatch.setattr(judged_batches, "FORK_SECONDS", start_seconds)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
-    monkeypatch.setattr(judged_batches, "BESIDE_FREE", float("inf"))     # no server started as the batch opens
     ex = executor.LocalPool(2)
     ex.start_on_demand()
     seen = []

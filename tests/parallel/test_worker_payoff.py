@@ -128,9 +128,7 @@ def test_a_run_with_a_batch_starts_no_worker_before_its_batch_repays_them(monkey
 @pytest.fixture
 def on_demand_pool(monkeypatch):
     """A pool whose workers start on demand, with no start to pay and no first member's extra: a batch of
-    members that take time repays them where the cores are free (not free enough for a fork server started
-    as the batch opens: :data:`~ngcontact.parallel.judged_batches.BESIDE_FREE`)."""
-    monkeypatch.setattr(judged_batches, "BESIDE_FREE", float("inf"))
+    members that take time repays them where the cores are free."""
     monkeypatch.setattr(judged_batches, "START_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
@@ -293,30 +291,26 @@ def opened_after(pool, monkeypatch) -> list[int]:
     return opened
 
 
-def test_a_batch_kept_here_stops_the_fork_server_started_beside_it_and_forks_no_worker(monkeypatch):
-    """An idle core beside this process: the batch opens with the workers' fork server importing there, before
-    its first member.  Four members of 0.02 s do not repay the workers (the estimated 1 s first member): the
-    batch ends here, the server is stopped, no worker forked, and the record says so."""
+def test_a_batch_without_a_forecast_starts_no_server_while_its_members_are_timed(monkeypatch):
+    """Four members of 0.02 s do not repay the workers (the estimated 1 s first member): the batch ends here
+    and no fork server ever started, not even while its first members were timed."""
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 1.0)
     pool = local_pool.LocalPool(2, method="forkserver")
     opened = opened_after(pool, monkeypatch)
     try:
         pool.start_on_demand(("ngsolve",))
         assert pool.map(burn, [0.02] * 4, list("abcd"), label="small") == [os.getpid()] * 4
-        assert opened == [0] and pool._server is None and pool._pool is None
+        assert opened == [] and pool._server is None and pool._pool is None
         assert pool.pools_started == 0 and pool.describe()["workers_started"] == "never"
         batch = pool.describe()["batches"][-1]
         assert batch["executor"] == "serial" and "the other 2 in this process" in batch["decision"]
-        assert batch["decision"].endswith("the workers' fork server started beside the batch stopped")
-        assert pool.map(burn, [0.02] * 3, list("abc"), label="three") == [os.getpid()] * 3
-        assert opened == [0]          # a batch with no member beyond the two that time it: no server
     finally:
         pool.close()
 
 
-def test_a_batch_that_repays_its_workers_forks_them_from_the_server_started_beside_it(monkeypatch):
-    """The fork server starts as the batch opens; the members after the two that time the batch go to the
-    workers once it is ready (how many are solved here meanwhile depends on the machine's load)."""
+def test_a_batch_that_repays_its_workers_starts_them_once_a_timed_member_shows_it(monkeypatch):
+    """The fork server starts once a member timed here shows that the rest repays the workers, never as the
+    batch opens; the members after the two that time the batch go to the workers once it is ready."""
     monkeypatch.setattr(judged_batches, "FIRST_MEMBER_SECONDS", 0.0)
     monkeypatch.setattr(judged_batches, "FORK_SECONDS", 0.0)
     pool = local_pool.LocalPool(2, method="forkserver")
@@ -325,25 +319,10 @@ def test_a_batch_that_repays_its_workers_forks_them_from_the_server_started_besi
         pool.start_on_demand(("ngsolve",))
         pids = pool.map(burn, [0.1] * 60, [f"m{k}" for k in range(60)], label="large")
         here = pids.count(os.getpid())
-        assert opened == [0] and 2 <= here < 60 and pids[:here] == [os.getpid()] * here
+        assert len(opened) == 1 and opened[0] >= 1 and 2 <= here < 60 and pids[:here] == [os.getpid()] * here
         assert pool.pools_started == 1 and pool.describe()["workers_started"] == "during batch 'large'"
         batch = pool.describe()["batches"][-1]
         assert batch["executor"] == "local" and f"the other {60 - here} on 2 workers" in batch["decision"]
     finally:
         pool.close()
 
-
-def test_no_server_starts_beside_a_batch_on_busy_cores_nor_for_spawned_workers(monkeypatch):
-    """A fork server beside the batch only where a core is idle (here 1.5 of 2 free) and only a server (spawned
-    workers would be two interpreters starting beside this process)."""
-    monkeypatch.setattr(free_cores, "affinity", lambda: [0, 1])
-    monkeypatch.setattr(free_cores, "load_average", lambda: 0.5)
-    for method in local_pool.METHODS:
-        pool = local_pool.LocalPool(2, method=method)
-        opened = opened_after(pool, monkeypatch)
-        try:
-            pool.start_on_demand(("ngsolve",))
-            assert pool.map(burn, [0.01] * 6, list("abcdef"), label="small") == [os.getpid()] * 6
-            assert opened == [] and pool.pools_started == 0
-        finally:
-            pool.close()
