@@ -88,7 +88,6 @@ class JudgedBatches(Executor, ABC):
     processes (:meth:`start`, :meth:`_pool_map`, :meth:`_abandon_start`) are the subclass's."""
 
     workers: int
-    method: str
     judged: bool
     _forecast: Any
     started: str
@@ -109,10 +108,6 @@ class JudgedBatches(Executor, ABC):
     @abstractmethod
     def _abandon_start(self) -> None:
         """Stop the workers (or what starts them) still starting."""
-
-    @abstractmethod
-    def _open_server(self) -> Any:
-        """Start the workers' fork server now."""
 
     @abstractmethod
     def _await_ready(self, seconds: float) -> bool:
