@@ -5,10 +5,12 @@ no closed form, so the oracle is the finer solve of ``scripts/graded_effectivity
 towards the answer's edges and then twice towards its own, its own error the largest of its changes from the
 earlier passes and from order 6.  Where the true error exceeds that, the effectivity (estimate / error) is at
 least 1, and for the quantities listed in :data:`WITHIN_TEN` at most 10 (measured: the fraction, k_n and g_n
-8.5 and 6.0 at p/p* = 0.05 and 0.5; the closure 2.5 at 0.05; the stiffness 6.0 at 0.5, where without the
-contact set's share its estimate would be 0.78 times its error).  The rest are bounded only: the stiffness at
-0.05 (its error 2.4e-8 is 440 times below the set's share of the fraction's estimate, which 0.5 needs) and the
-closure at 0.5 (15: the orders' tail of a closure converging faster than geometrically).  At p/p* = 0.8 the
+8.5 and 6.0 at p/p* = 0.05 and 0.5; the closure 2.5 at 0.05; the stiffness 1.2 at 0.5, its orders' tail plus
+its own grading's tail, the larger of the two alone 0.77 times its error).  The rest are bounded only: the
+stiffness at 0.05 (42: its error 2.1e-8 lies 36 times below its own grading's tail, the stiffness converging
+faster over the grading step than the edges whose rate the tail assumes; the contact set's share it took before
+was 490 times its error) and the closure at 0.5 (14: the orders' tail of a closure converging faster than
+geometrically).  At p/p* = 0.8 the
 finer solve's passes may swing between two edge positions 3.3e-7 apart, as far as the answer is from either:
 no verdict there (seen at 0.2 too, once in three runs: :data:`SWING`).
 """

@@ -19,7 +19,8 @@ from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline, scale
 from ngcontact.cell.fe.cell_problem import CellModel, CellProblem
 from ngcontact.cell.fe.edge_grading import graded_flat_cell, solve_to_tolerance
-from ngcontact.cell.fe.grading_estimate import alternating, edges_miss, set_share
+from ngcontact.cell.fe.grading_estimate import (GRADING_RATE, alternating, edges_miss, order_estimate, orders_tail,
+                                                set_share)
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.fem.materials import isotropic
 from ngcontact.verification.moduli import e_star
@@ -100,3 +101,26 @@ def test_a_quantity_missing_by_its_edges_part_is_graded_further_one_missing_by_i
     assert not edges_miss(orders, 1e-6, {"contact_fraction": 1e-6, "coefficient_g_n": 3e-2}, 1e-4)   # 4e-8
     assert edges_miss(orders, 1e-6, {"contact_fraction": 1e-2, "coefficient_g_n": 3e-2}, 1e-4)       # 4e-4
     assert edges_miss(orders, 3e-3, {"contact_fraction": 1e-6, "coefficient_g_n": 1e-6}, 1e-4)       # 3e-3 / 15
+
+
+def test_a_penalty_stiffness_takes_its_orders_and_grading_tails_summed_and_no_set_share():
+    """A penalty's stiffness, the derivative of its discrete response, is estimated by its own sequences: the
+    orders' tail plus the grading tail of its own change (``rho / (1 - rho)`` of it at ``rho = 1/16``), however
+    large the contact fraction's estimate; exact contact's keeps the set's share (module docstring of
+    :mod:`ngcontact.cell.fe.grading_estimate`)."""
+    stiffness, fraction = [2.0, 2.0001, 2.00011], [0.5, 0.50001, 0.500011]
+    orders = [{"headline": {"contact_fraction": f, "mean_closure": 0.01, "normal_stiffness": k,
+                            "coefficient_k_n": K_N * f},
+               "edge_cells": [[1e-3, 0.004]], "k_n": K_N, "set_move": 1e-3, "stiffness_edges": None,
+               "changes": {"normal_stiffness": 1.5e-4}} for k, f in zip(stiffness, fraction)]
+    own = GRADING_RATE / (1.0 - GRADING_RATE) * 1.5e-4 / stiffness[-1]
+    for penalty in (True, False):
+        for entry in orders:
+            entry["penalty"] = penalty
+        estimate, _ = order_estimate(orders)
+        share = estimate["contact_fraction"] / fraction[-1]              # k_n's set share relative to k_n
+        if penalty:
+            assert estimate["normal_stiffness"] == pytest.approx(orders_tail(stiffness, stiffness[-1])[0] + own)
+            assert estimate["normal_stiffness"] < 0.1 * share           # the fraction's 6.7e-5 does not enter
+        else:
+            assert estimate["normal_stiffness"] == pytest.approx(share)

@@ -260,7 +260,7 @@ def _solve_level(make_problem, load, vertices: list[float], p: int, level: int, 
     f, c = sol.results["contact_fraction"], sol.results["mean_closure"]
     entry = {"level": level, "order": p, "ndof": problem.ndof, "edges": [float(e) for e in edges],
              "smallest_element": float(np.min(ends[:, 1] - ends[:, 0])), "edge_offset": edge_offset(edges, ends),
-             "contact_set": contact.tolist(),
+             "contact_set": contact.tolist(), "penalty": problem.multiplier is None,
              "set_move": None if towards is None else set_move(contact, towards[0], towards[1]),
              "contact_fraction": f,
              "mean_closure": c, "newton_iterations": sol.iterations, "fraction_change": None,

@@ -64,9 +64,21 @@ stated tolerance still missed when the steps and orders are spent ends the run w
   shares are ``k_n E_f`` and ``k_n g_e E_f``: the fraction's own error, weighted as eq. 34 weighs the set's
   ends.  At a light load ``g_n`` is small (it grows like the cube of the patch's width) while ``g_e`` is not,
   so on Westergaard's sinusoid its relative share is ``g_e / (h (f - sin(pi f) / pi))`` times the fraction's
-  error, 21 at ``p/p* = 0.05``: the quantity that keeps a light load's grading going.  The stiffness is that
-  of the contact set held closed: it moves with the set's measure as ``k_n`` does, and takes the share of
-  ``k_n`` relative to ``k_n`` as its floor;
+  error, 21 at ``p/p* = 0.05``: the quantity that keeps a light load's grading going.  Exact contact's
+  stiffness is that of the contact set held closed, the set of its closed nodes interpolated to the edges
+  (:func:`~ngcontact.cell.fe.stiffness.edge_interpolation`): it moves with the set's measure as ``k_n`` does,
+  and takes the share of ``k_n`` relative to ``k_n`` as its floor, or the edges' record where larger.  A
+  penalty's stiffness takes none (:func:`penalty_stiffness`): ``[s]_+`` vanishes at its edges, so its tangent
+  is the exact derivative of the discrete response to the load (``S = dp/dU``,
+  :func:`~ngcontact.cell.fe.stiffness.edge_correction`).  The far-face jump is the derivative in the load of
+  the minimum energy, ``U = -dPi*/dp``, so ``1/S_h - 1/S = -d^2 (Pi*_h - Pi*) / dp^2``, the load's second
+  derivative of the energy's error, which is quadratic in the solution's error: the stiffness's error is a
+  product of the solution's error and of its changes with the load, which its own sequences over the orders
+  and the grading show, not first order in the edges' position as the fraction's is (a penalty's edge moves
+  by the penetration's error over the penetration's slope there, ``p' / k_n``, small in its thin zone).
+  Its two parts then add: the orders' tail bounds the answer's distance from the final mesh's limit, the
+  grading's tail of its own change that limit's distance from the model's (the triangle inequality; the
+  other quantities' set share, taken at the fraction's whole estimate, holds both parts already);
 * **its grading's tail** (:func:`quantity_grading_tail`): the quantity's own change over the last grading
   step, at the grading's rate;
 * **an alternating last order** (:func:`alternating`): where the last two changes over the orders alternate
@@ -84,9 +96,9 @@ cell's stiffness of the same layers on 2^16 to 2^18 points (Richardson's limit),
 on the shipped ``westergaard_graded.toml`` at ``1e-4`` (penalty ``k_n = 1e6``) against the same model graded
 three levels and two orders finer (``scripts/graded_effectivity.py``), those of the fraction, ``k_n`` and ``g_n``
 lie between 1 and 10 at ``p/p* = 0.05`` and ``0.5``, the stiffness's at 0.5
-(``tests/cell/test_graded_finer_reference.py``).  At light loads the stiffness's error lies far below the set's
-share its estimate takes; at ``p/p* = 0.5`` the share is what bounds it (its orders' tail and own grading tail
-are below its error there).
+(``tests/cell/test_graded_finer_reference.py``).  Its penalty stiffness, by the sum of its tails, bounds its
+error at both loads, within 10 times at 0.5; at 0.05 its error lies far below the set's share the estimate took
+before, and below its own grading's tail too (the section ``graded_effectivity`` of ``docs/benchmarks.md``).
 """
 from __future__ import annotations
 
@@ -155,6 +167,9 @@ def order_estimate(orders: list[dict[str, Any]], grading_change: float | None = 
         if swing > out[name]:
             out[name] = swing
             notes.append(f"{name}: the last order's change (its changes alternate in sign)")
+        if penalty_stiffness(orders, name) and (tail := quantity_grading_tail(orders, name, scale(name, last))):
+            out[name] += tail                       # the two parts of its error add (module docstring)
+            notes.append(f"{name}: plus the grading's tail of its own change (a penalty's stiffness)")
         own = edges_part(orders, name, out["contact_fraction"])
         if own[0] > out[name]:
             out[name] = own[0]
@@ -222,11 +237,14 @@ def edges_part(orders: list[dict[str, Any]], name: str, fraction_error: float) -
     the orders on one mesh do not reduce, in its measure, and what it is: the larger of its grading's tail
     (:func:`quantity_grading_tail`) and, for a coefficient on the real contact set, the set's share
     (:func:`set_share`) at the contact fraction's estimate ``fraction_error``; for the normal effective
-    stiffness, that of the contact set held closed, the set's share of ``k_n`` relative to ``k_n`` (module
-    docstring)."""
+    stiffness of exact contact, that of the contact set held closed, the set's share of ``k_n`` relative to
+    ``k_n`` or the edges' record; a penalty's stiffness, its grading's tail alone (:func:`penalty_stiffness`,
+    module docstring)."""
     last = orders[-1]["headline"]
     size = scale(name, last)
     tail, share = quantity_grading_tail(orders, name, size), set_share(orders[-1], name, fraction_error) / size
+    if penalty_stiffness(orders, name):
+        return tail, "the grading's tail of its own change (a penalty's stiffness: no set's share)"
     if name == "normal_stiffness" and last.get(COEFFICIENT + "k_n"):
         share = set_share(orders[-1], COEFFICIENT + "k_n", fraction_error) / abs(last[COEFFICIENT + "k_n"])
     edges = orders[-1].get("stiffness_edges")
@@ -235,6 +253,12 @@ def edges_part(orders: list[dict[str, Any]], name: str, fraction_error: float) -
     if share >= tail:
         return share, "the contact set's share (the contact fraction's estimate, weighted as eq. 34 weighs it)"
     return tail, "the grading's tail of its own change"
+
+
+def penalty_stiffness(orders: list[dict[str, Any]], name: str) -> bool:
+    """Whether ``name`` is the normal effective stiffness of a penalty cell, the derivative of its discrete
+    response, which takes no set's share and adds its grading's tail to its orders' (module docstring)."""
+    return name == "normal_stiffness" and bool(orders[-1].get("penalty"))
 
 
 def stiffness_edges(results: dict[str, Any]) -> dict[str, float] | None:
