@@ -25,8 +25,9 @@ Each on the whole period or on its mirror-symmetric quarter (column ``cell``: ``
 sizes, the twin's points folded into the quarter, about a quarter of the unknowns.
 
 The converged value is the spectral cell's contact fraction extrapolated
-from ``1024^2`` and ``2048^2`` (its grid counting errs by one order in the
-spacing; ``512^2`` is left out: its values lie off the line of the grids
+from ``1024^2`` and ``2048^2`` (the stiffness and the closure err by one
+order in the spacing, the contact fraction, its edges located between points,
+by a fraction of a step per edge; ``512^2`` is left out: its values lie off the line of the grids
 around it, the normal stiffness at ``p/p* = 0.05`` 0.07 % above ``1024^2``
 and ``2048^2``, which agree to 0.01 %, and the extrapolation from ``512^2``
 and ``1024^2`` is 0.09 % below that from ``1024^2`` and ``2048^2`` in the

@@ -23,12 +23,13 @@ things the differences cannot show are read off the levels here:
   edges (:func:`island_floor`): the floor falls like ``h`` while islands stay unresolved, and vanishes
   once every island spans :data:`ISLAND_POINTS` points.
 
-In 3D the contact fraction counts points and no edge is located between them: the count of an island is off
-by about one layer of points along its boundary, an error of order ``h`` times its perimeter that is a
-small part of a resolved island's area.  An island fewer than :data:`ISLAND_POINTS` points across in a
+In 3D the contact fraction's edges are located along the grid's rows and columns by the line
+(:func:`~ngcontact.cell.spectral.grid_measures.row_weights`), each to a fraction of a step: an island's area is
+off by an error of order ``h`` times its perimeter with an erratic constant, a small part of a resolved island's
+area.  An island fewer than :data:`ISLAND_POINTS` points across in a
 direction of the grid (no run of that many contact points along it: :func:`narrow_islands`; the islands are
 4-connected across the period, :func:`periodic_labels`) is all boundary: its count may be off by its whole
-size, and two grids may count it alike while its true area differs, as a 2D island's located width may.
+size, and two grids may locate it alike while its true area differs, as a 2D island's located width may.
 Its share is bounded the same way, by its points and one step beyond its boundary (the 4-neighbours of its
 points), eq. 34 on them; the refinement takes it as the same floor.
 
@@ -72,7 +73,9 @@ between its two contact points (a wider one would open a point more), so its err
 steps, ``w`` its located width (one open point located a step wide, the notch far narrower: on the random
 profile of seed 9 at p = 0.01 the located width halves with the step); one that no grid point sees yet is not
 bounded here (on the profile of seed 6 at p = 0.003 such a notch carries half the 4096 grid's error in the
-contact fraction).  A smooth gap (``g0''`` continuous) has no kinks, and in 3D the points are counted.
+contact fraction).  A smooth gap (``g0''`` continuous) has no kinks.  In 3D no kink floor is taken: a map's kinks
+lie on the lines of its samples, which a patch's edge crosses at points, so that only the rows crossing the edge
+within a step of such a point are pinned, and the guarded bound of the differences holds the rest.
 
 **Every other edge of a map with kinks.**  Away from the kinks the gap beyond an edge is smooth over the few steps
 the line through the first two open points reads, but neither locator converges as on a smooth gap: the line is off

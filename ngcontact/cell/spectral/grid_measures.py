@@ -1,8 +1,8 @@
 """Results of a load of the spectral small-slope cell (:mod:`ngcontact.cell.spectral.layered_cell`).
 
 Results use the names of the FE cell (:mod:`ngcontact.cell.fe.measures`):
-``contact_fraction`` (the share of grid points in contact; in 2D the
-contact edges located between grid points, below), ``mean_pressure``,
+``contact_fraction`` (the share of the period in contact, its edges
+located between grid points, below), ``mean_pressure``,
 ``mean_closure`` (the mean of ``J_n``), ``far_face_jump``,
 ``effective_stiffness`` (``d pbar / d Delta_interface`` at the current
 contact set, the FE cell's ``(S^-1 - S_0^-1)^-1``; its normal component
@@ -27,6 +27,16 @@ otherwise (short open runs, rough gaps) at the root of the line through the
 first two open points, kept within the step between them.
 (The other side's ``p^2``, linear for a ``sqrt`` edge, carries the
 collocation error itself: 2e-5 of the fraction at 65,536 points.)
+
+Contact edges in 3D: each row and each column of the grid is a profile that crosses the contact edge at some
+angle ``theta`` to its normal; ``gap^(2/3)`` is linear in the distance normal to a smooth edge, so along the row
+it is linear too (with slope over ``cos theta``), and the line through the first two open points places the
+row's crossing as in 2D (:func:`row_weights`).  The rows' located lengths, summed, are the area by the midpoint
+rule across the rows, and the columns' alike; their mean is the contact fraction.  The quartic is not fitted in
+3D: a row crosses the edge obliquely, runs along it where it is tangent to a patch, and its window would reach
+across the patch's curvature.  Counting the points in contact instead errs by a layer of points along the edges,
+first order in the step with a constant several times the located edges' (``docs/benchmarks.md``, the random
+64 x 64 map; ``tests/cell/test_spectral_cell.py`` on the bisinusoid).
 
 The quartic's reach.  A least-squares quartic on ``[lo, hi]`` steps beyond
 the edge converges to ``r`` at the rate of the largest Bernstein ellipse
@@ -106,17 +116,22 @@ KINK_RATIO = 4.0
 
 
 def contact_fraction(cell, p: np.ndarray, gap: np.ndarray) -> float:
-    """Contact area per period: grid points in 3D; in 2D edges between points (module docstring)."""
+    """Contact area per period: edges located between grid points, in 3D along the rows and the columns
+    (module docstring)."""
     return float(contact_weights(cell, p, gap).sum()) / cell.points
 
 
 def contact_weights(cell, p: np.ndarray, gap: np.ndarray) -> np.ndarray:
-    """Each grid point's share of its step in the real contact set: 1 in contact, 0 open (3D: that is all);
-    in 2D the step an edge cuts is shared (module docstring): the last contact point ``i`` before an edge at
-    ``i + t`` steps keeps ``min(t, 1/2) + 1/2`` of its step and the first open point gains ``max(t - 1/2, 0)``,
-    so that the weights sum to the located contact length, and a smooth function summed with them (eq. 34's
-    integrands) is integrated over the located set."""
+    """Each grid point's share of its step in the real contact set: 1 in contact, 0 open, except beside an edge
+    located between points (module docstring): the last contact point ``i`` before an edge at ``i + t`` steps keeps
+    ``min(t, 1/2) + 1/2`` of its step and the first open point gains ``max(t - 1/2, 0)``, so that the weights sum to
+    the located contact length, and a smooth function summed with them (eq. 34's integrands) is integrated over the
+    located set.  In 3D each row and each column is such a profile, its edges located by the line
+    (:func:`row_weights`), and the two directions' weights are averaged."""
     on = p > 0
+    if cell.dim == 3:
+        root = np.maximum(gap, 0.0) ** (2.0 / 3.0)
+        return (row_weights(on, root, 0) + row_weights(on, root, 1)) / 2.0
     weights = on.astype(float)
     for i, step, t in located_edges(cell, on, gap):
         shift = t - 0.5                             # open share of the step between i and the first open point
@@ -124,10 +139,36 @@ def contact_weights(cell, p: np.ndarray, gap: np.ndarray) -> np.ndarray:
     return weights
 
 
+def row_weights(on: np.ndarray, root: np.ndarray, axis: int) -> np.ndarray:
+    """The weights of :func:`contact_weights` of a 3D contact set ``on`` read as profiles along ``axis``, each
+    edge at the root of the line through the first two open points' ``root = gap^(2/3)`` (:func:`line_offset`)."""
+    weights = on.astype(float)
+    n = on.shape[axis]
+    for step in (1, -1):
+        last = on & ~np.roll(on, -step, axis)                  # last contact point before an edge
+        at = np.nonzero(last)
+        shift = line_offset(np.roll(root, -step, axis)[last], np.roll(root, -2 * step, axis)[last],
+                            ~np.roll(on, -2 * step, axis)[last]) - 0.5
+        ahead = list(at)
+        ahead[axis] = (at[axis] + step) % n
+        np.add.at(weights, tuple(ahead), np.maximum(shift, 0.0))
+        np.add.at(weights, at, np.minimum(shift, 0.0))
+    return weights
+
+
+def line_offset(first, second, beyond_open) -> np.ndarray:
+    """Distance in grid steps, in ``[0, 1]``, from the last contact point to the root of the line through
+    ``gap^(2/3)`` at the first two open points (``first``, ``second``); half a step where that line does not rise
+    or the second point is in contact (``beyond_open`` false).  Arrays of edges, or one edge's numbers."""
+    rising = (second > first) & beyond_open
+    line = np.where(rising, first / np.where(rising, second - first, 1.0), 0.5)
+    return 1.0 - np.clip(line, 0.0, 1.0)
+
+
 def located_edges(cell, on: np.ndarray, gap: np.ndarray) -> list[tuple[int, int, float]]:
     """The 2D contact edges of the contact set ``on`` as ``(last contact point i, step, offset t)``: the edge at
     ``i + step t`` grid steps (:func:`edge_offset` on ``gap^(2/3)``), ``step = +1`` for an edge to the right of
-    its patch, ``-1`` to the left; none in 3D, in full contact or without contact."""
+    its patch, ``-1`` to the left; none in 3D (there :func:`row_weights`), in full contact or without contact."""
     if cell.dim == 3 or on.all() or not on.any():
         return []
     root = np.maximum(gap, 0.0) ** (2.0 / 3.0)       # smooth, with a simple root at a smooth contact edge
@@ -152,9 +193,7 @@ def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int,
     contact patch and to the nearest kink (module docstring).
     """
     n = root.size
-    a, b = root[(i + step) % n], root[(i + 2 * step) % n]
-    line = a / (b - a) if (b > a and not on[(i + 2 * step) % n]) else 0.5
-    offset = 1.0 - min(max(line, 0.0), 1.0)
+    offset = float(line_offset(root[(i + step) % n], root[(i + 2 * step) % n], not on[(i + 2 * step) % n]))
     ahead = (i + step * np.arange(1, n)) % n
     run = int(np.argmax(on[ahead])) if on[ahead].any() else n - 1     # open points before the next contact
     patch = int(np.argmin(on[(i - step * np.arange(n)) % n]))         # contact points back to the patch's end

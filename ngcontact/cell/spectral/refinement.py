@@ -4,10 +4,9 @@ The grid is the spectral cell's only discretization parameter (:mod:`ngcontact.c
 the collocated pressure and gap, and with them the contact set of eq. 57 and the coefficients of eq. 34 on
 it, converge as the grid step ``h`` shrinks.  How they converge decides the estimate:
 
-* the contact fraction is a count of grid points in 3D (one layer of points at the contact edges: an
-  error of order ``h`` whose constant depends on where the edges cross the grid) and in 2D has its edges
-  located between points (:mod:`ngcontact.cell.spectral.grid_measures`): faster once the edge fit holds,
-  but again with a constant that jumps with the edges' position between points;
+* the contact fraction has its edges located between points (:mod:`ngcontact.cell.spectral.grid_measures`; in
+  3D along the rows and columns by the line): an error of order ``h`` whose constant jumps with the edges'
+  position between points, in 2D faster once the edge fit holds;
 * the mean closure is a mean of the collocated jump: smoother, but its error changes sign as the grid
   crosses the contact edges.
 
@@ -24,7 +23,7 @@ names (:func:`sweep_estimates`):
    ``|d_(k-1)| / |d_(k-2)|`` and ``|d_k| / |d_(k-1)|`` agree within the factor :data:`AGREE` and both contract at
    least by :data:`RATE_CAP`. The rate is the larger of the two, but never faster than the quantity's own order in
    the grid step (:data:`ORDER_RATE`: first order, ``1/2`` per level, for the contact fraction, whose edges are
-   counted or located between points, and for the mean closure too: a mean of the collocated jump, which an edge
+   located between points, and for the mean closure too: a mean of the collocated jump, which an edge
    misplaced by a fraction of a step barely moves (the gap opens like ``(x - a)^(3/2)`` beyond an edge ``a``), but
    whose error is carried by the collocated pressure at the edges, singular like the inverse square root of the
    distance to an edge, with a first-order constant that changes sign as the edges cross the grid: two fast ratios
@@ -40,15 +39,15 @@ names (:func:`sweep_estimates`):
    contracting by ``RATE_CAP`` is taken as contracting by it), and the size of the next differences is the envelope
    ``D = max_i |d_(k-i)| ENVELOPE^i`` with ``ENVELOPE = 1/2``: the last difference, or an earlier one shrunk at first
    order, whichever is larger, so that a last difference that vanished by coincidence (a symmetric cell gives the
-   same fraction on two grids; a count of points whose constant jumps with the edges) is bounded by the ones before
+   same fraction on two grids; an edge's offset whose constant jumps between grids) is bounded by the ones before
    it; the tail ``D rho / (1 - rho)``, on the levels since where the last ratio is twice as fast
    (:mod:`.estimate_forms`).
 
 In 2D the contact fraction and the coefficients of eq. 34 rest on edges located between points by one of two locators
 (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`): the quartic fitted to the open gap where its window
 holds enough points and the fit explains the gap, else the line through the first two open points, whose root is off
-by a fraction of a step (first order, with a constant that jumps with the edges' position between points; in 3D the
-fraction counts points, alike).  A window holding such levels takes the guarded bound for these quantities: two
+by a fraction of a step (first order, with a constant that jumps with the edges' position between points; in 3D
+every edge is the line's).  A window holding such levels takes the guarded bound for these quantities: two
 ratios of such differences agree by chance (an error that stalls over two grids, as on a profile with kinks,
 alternates as if geometric).  On a smooth gap the quartic takes over at a grid fixed by its window (every edge of a
 load: :func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`, recorded per level), and the error drops there by
