@@ -75,6 +75,27 @@ within :data:`LOOSE` times both tails may still exceed an error that is small by
 zero on the reported grid, or a level's error that falls several times faster than its differences while
 their two contractions agree), which no difference shows (``docs/benchmarks.md``, the spectral
 effectivity).
+
+**A slowing sequence within Richardson's band.**  Two contractions within :data:`AGREE` of each other take
+Richardson's tail, and the last may still be :data:`DISAGREE` times slower than the one before (``2 c' <= c
+< 3 c'``, :func:`slowed`): the two constants overlap there, and the sequence is slowing.  Its fast contraction
+``c'`` ended at level ``k - 1``, where the difference ``d_(k-1)`` was small for the trend before it (an edge's
+position between points, the scatter :data:`SPREAD` stands for, or a pre-asymptotic stretch ending), and the
+slower one that follows need not stop at ``c``: the error of level ``k`` may stay near that of level ``k - 1``,
+which the last difference then understates (a random profile's mean closure whose differences contracted by
+0.057, then 0.16, had on that last grid an error of twice its last difference, beyond Richardson's first-order
+tail times :data:`SPREAD`, and the next difference grew).  The error of level ``k - 1`` is what ``d_(k-1)``
+leaves at first order, and the estimate takes the larger ("where two successive differences disagree in rate,
+the estimate says so and takes the larger", issue 35): Richardson's tail, or the guarded bound on the levels
+since the fast contraction, ``k - 2`` to ``k`` (:func:`guarded_bound` of ``d_k`` and ``d_(k-1)``:
+``max(|d_k|, ENVELOPE |d_(k-1)|) rho / (1 - rho)``), ``d_(k-1)`` carried to level ``k`` at first order.  That
+exceeds Richardson's ``2 |d_k|`` (at first order) only where ``c < 1/4``, by ``1 / (4 c)`` at most ``1 / (8
+c')``.  ``d_(k-2)`` is left out: it is the difference before the fast contraction, which the two agreeing
+ratios already measured, and carried at first order (``|d_(k-2)| / 4``) it would exceed ``|d_(k-1)| / 2`` by
+``1 / (2 c')``, the whole window's guarded bound, which the estimate takes where the two contractions differ
+by :data:`AGREE` or more.  So a slowing estimate lies between Richardson's and the whole window's guarded
+bound; where it exceeds Richardson's, it is above :data:`LOOSE` times the tail the last difference leaves at
+the faster contraction, and (unless carried lower) the flag above says so, with both contractions.
 """
 from __future__ import annotations
 
@@ -168,7 +189,7 @@ def faster_contraction(values: list[float]) -> tuple[float, float, float] | None
     if len(d) < 3 or d[0] <= 0 or d[1] <= 0:
         return None
     before, last = d[1] / d[0], d[2] / d[1]
-    if last < DISAGREE * before:
+    if not slowed(last, before):
         return None
     rate = min(before, FIRST_ORDER)
     return d[2] * rate / (1.0 - rate), before, last
@@ -198,16 +219,31 @@ def differences(values: list[float], relative: bool, scale: float | None = None)
     return [abs(b - a) / scale for a, b in zip(values[:-1], values[1:])][::-1][:WINDOW]
 
 
-def richardson(d: list[float], order_rate: float) -> tuple[float, float] | None:
-    """Richardson's estimate from the differences ``d`` (newest first) and its rate, where the window's two
-    ratios agree (module docstring of :mod:`~ngcontact.cell.spectral.refinement`); ``None`` where they do not."""
+def richardson(d: list[float], order_rate: float) -> tuple[float, float, str] | None:
+    """Richardson's estimate from the differences ``d`` (newest first), its rate and a remark, where the window's
+    two ratios agree (module docstring of :mod:`~ngcontact.cell.spectral.refinement`); where the last contraction is
+    the slower by :data:`DISAGREE` or more (:func:`slowed`), at least the guarded bound on the last two differences
+    (module docstring); ``None`` where they do not agree."""
     if len(d) < WINDOW or min(d[1:]) <= 0:
         return None
     ratios = [d[i] / d[i + 1] for i in range(WINDOW - 1)]
     if min(ratios) <= 0 or max(ratios) > RATE_CAP or max(ratios) > AGREE * min(ratios):
         return None
     rate = max(max(ratios), order_rate)
-    return SPREAD * d[0] * rate / (1.0 - rate), rate
+    tail = SPREAD * d[0] * rate / (1.0 - rate)
+    if not slowed(*ratios):
+        return tail, rate, ""
+    since = guarded_bound(d[:WINDOW - 1])[0]         # the levels since the fast contraction: the last two differences
+    if since <= tail:
+        return tail, rate, ""
+    return since, rate, (f"; the last contraction {ratios[0]:.2g} at least {DISAGREE:g} times slower than the one "
+                         f"before, {ratios[1]:.2g}: the guarded bound on the levels since")
+
+
+def slowed(last: float, before: float) -> bool:
+    """Whether the contraction ``last`` is at least :data:`DISAGREE` times slower than the one ``before`` it (module
+    docstring)."""
+    return last >= DISAGREE * before
 
 
 def guarded_bound(d: list[float], regime: bool = True) -> tuple[float, str]:
@@ -255,4 +291,4 @@ def tail_estimate(values: list[float], relative: bool, order_rate: float = RATE_
     estimate, remark = guarded_bound(d, regime)
     if fitted is None or fitted[0] >= estimate:
         return estimate, GUARDED, remark
-    return fitted[0], RICHARDSON, f"rate {fitted[1]:.2g}"
+    return fitted[0], RICHARDSON, f"rate {fitted[1]:.2g}{fitted[2]}"

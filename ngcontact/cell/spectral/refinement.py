@@ -30,9 +30,10 @@ names (:func:`sweep_estimates`):
    just after such a sign change do not show the first-order stretch that follows, as on Westergaard's sinusoid at a
    fifth of its closing pressure); the estimate is the tail of the geometric series beyond level ``k``,
    ``|d_k| rho / (1 - rho)``, times :data:`SPREAD`, the scatter of one level's error about the geometric model (the
-   erratic factor above: an edge's position between two points) that two ratios cannot resolve. Where that exceeds
-   the guarded bound below (which holds without the geometric model), the guarded bound is the estimate: Richardson
-   only ever sharpens it.
+   erratic factor above: an edge's position between two points) that two ratios cannot resolve, and where the last
+   ratio is :data:`DISAGREE` times the one before or more (a slowing sequence) at least the guarded bound on the last
+   two differences (:mod:`.estimate_forms`). Where that exceeds the guarded bound below (which holds without the
+   geometric model), the guarded bound is the estimate: Richardson only ever sharpens it.
 2. **The guarded bound** wherever the two ratios disagree, one difference vanished, or the sequence does not contract
    ("where two successive differences disagree in rate, the estimate says so and takes the larger"): the rate is the
    larger of the ratios held to ``[RATE_FLOOR, RATE_CAP]`` (never faster than first order, and a sequence not
@@ -109,20 +110,18 @@ tolerance so missed ends its run (:meth:`~ngcontact.cell.spectral.spectral_solve
 3D, whose cost bound (points squared) allows a few doublings only, it is reported with its estimate and not held
 (:func:`uncontrolled`: listed in the verdict as not counted).
 
-Two checks end a level's estimate. An island of fewer than
-:data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS` points (3D: across) has no resolved edges: its error may
-stall while the differences vanish, so its share of the quantities on the edges is a floor under their estimates
-(:func:`~ngcontact.cell.spectral.contact_edges.island_floor`, form ``island``; a 2D edge of a map with kinks, a step
-within a step of one, else a quarter: ``kink``; a penalty's 2D edge located on points beyond its length ``E*/k_n``:
-``penalty zone``, whose error no difference shows either); a window across the level where the last island came to be
-resolved is also taken on the resolved levels alone, the smaller reported (the same module's docstring). An estimate
-(not Richardson's nor an island's) above :data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its
-last difference leaves at the last contraction, or (any form) at the one before where the last is twice as slow or
-more, may exceed the error by as much: flagged with its reason, per quantity in the report
-(:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
+Two checks end a level's estimate. An island of fewer than :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS`
+points (3D: across) has no resolved edges: its error may stall while the differences vanish, so its share of the
+quantities on the edges is a floor under their estimates (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`,
+form ``island``; a 2D edge of a map with kinks, a step within a step of one, else a quarter: ``kink``; a penalty's 2D
+edge located on points beyond its length ``E*/k_n``: ``penalty zone``, whose error no difference shows either); a window
+across the level where the last island came to be resolved is also taken on the resolved levels alone, the smaller
+reported (the same module's docstring). An estimate (not Richardson's nor an island's) above
+:data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the last
+contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much:
+flagged with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
 Levels double the points per direction (:data:`GROWTH`): three differences cost twice the finest level in 2D, 4/3 in 3D.
-
 Its effectivity (estimate over the true error of the reported level) is measured by
 ``scripts/spectral_effectivity.py`` on Westergaard's sinusoid, a random 2D profile and a 3D bisinusoid against each
 cell's own value on a much finer grid (``docs/benchmarks.md``).  No estimate from the levels up to ``k`` can be sharp
@@ -185,7 +184,8 @@ LOCATOR_LEVELS = 3
 #: how the estimate is made, for the report
 HOW = ("grids of twice the points per direction each; per quantity and load, Richardson with the observed rate "
        f"of the last {WINDOW} differences where their two ratios agree within a factor {AGREE:g} (rate at least "
-       f"{FIRST_ORDER}, the tail times {SPREAD:g}) if that is the smaller, else the guarded geometric tail: "
+       f"{FIRST_ORDER}, the tail times {SPREAD:g}; after a last ratio {DISAGREE:g} times the one before or more, at "
+       "least the guarded tail of the last two differences) if that is the smaller, else the guarded geometric tail: "
        f"rate the larger ratio held to [{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished "
        f"last one (after a last ratio {DISAGREE:g} times below the one before, the last three levels: the difference "
        f"before shrunk by {SAFETY:g} times that ratio, at most 1/2, the rate alike); the contact fraction, "
