@@ -3,11 +3,12 @@
 The shipped scene ``geometries/cells/measured_scan.toml`` (a profilometer's scan in X3P, detrended and
 mirrored into a period of 200 um; spectral cell, exact non-penetration, steel) is solved
 
-* as shipped, the map read from the X3P file through SurfaceTopography on its own 128 x 128 grid;
+* as shipped (the scene refines from 32 points to the default tolerance), but on the map's own 128 x 128 grid
+  alone, the map read from the X3P file through SurfaceTopography;
 * with the same periodic heights given as ``.npy`` in the package's layout (the map the X3P route built,
   saved): the two must agree to round-off;
-* on finer spectral grids (``discretization.grid`` 256 and 512: the bilinear interpolant of the map, the
-  surface the cell stands for), the converged reference of that surface;
+* on finer spectral grids alone (``discretization.grid`` 256 and 512, no estimate: the bilinear interpolant of
+  the map, the surface the cell stands for), towards the converged value of that surface;
 * as the class of surfaces like it (``measured_scan_ensemble.toml``: random surfaces with the scan's
   spectrum), the mean and 95 % half-width of the contact fraction over its members.
 
@@ -38,6 +39,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE = os.path.join(ROOT, "geometries", "cells", "measured_scan.toml")
 ENSEMBLE = os.path.join(ROOT, "geometries", "cells", "measured_scan_ensemble.toml")
 GRIDS = (256, 512)
+#: the periodized map's own grid, on which the X3P and .npy routes are compared
+OWN_GRID = 128
 KEYS = ("pressure", "cf_x3p", "cf_npy", "cf_difference", "closure_relative_difference",
         *(f"cf_grid{n}" for n in GRIDS), "cf_class_mean", "cf_class_half_width")
 
@@ -56,16 +59,21 @@ def _variant(text: str, where: str, name: str) -> str:
     return path
 
 
+def on_grid(text: str, grid: int) -> str:
+    """The scene ``text`` solved on ``grid`` points per direction alone (its refinement's first grid replaced,
+    no estimate)."""
+    return re.sub(r'(?m)^grid = .*$', f'grid = {grid}\nestimate = "off"', text, count=1)
+
+
 def rows() -> list[dict]:
     text = open(SCENE, encoding="utf-8").read()
-    x3p = _loads(SCENE)
     with tempfile.TemporaryDirectory() as tmp:
+        x3p = _loads(_variant(on_grid(text, OWN_GRID), tmp, "x3p.toml"))
         np.save(os.path.join(tmp, "map.npy"), height_map(loader.load(SCENE)))
         npy_text = re.sub(r'(?m)^(file|detrend|periodize) = .*$', "", text).replace(
             'profile = "height_map"', f'profile = "height_map"\nfile = "{tmp}/map.npy"')
-        npy = _loads(_variant(npy_text, tmp, "npy.toml"))
-        finer = {n: _loads(_variant(text.replace('method = "spectral"', f'method = "spectral"\ngrid = {n}'), tmp,
-                                    f"grid{n}.toml")) for n in GRIDS}
+        npy = _loads(_variant(on_grid(npy_text, OWN_GRID), tmp, "npy.toml"))
+        finer = {n: _loads(_variant(on_grid(text, n), tmp, f"grid{n}.toml")) for n in GRIDS}
     report, _ = solve(ENSEMBLE, workers=1)
     band = report["results"]["loads"]
     out = []
