@@ -56,8 +56,9 @@ batch that stays here cancels its probe, whose tasks import no further
 module once cancelled (:meth:`Probe.cancel`).  Before
 timing the trips, the probe imports the members' modules on every worker
 (each worker's first member would otherwise pay it), while this process goes
-on solving members (a warm cluster's imports are waited for, up to one
-member's time ``c``); (4) is read once that is done and at least
+on solving members (a warm cluster's imports, a trip once connected, are
+waited for, up to one member's time ``c``: then the rest is the ``r`` that (4)
+weighed before the connection, not one member less); (4) is read once that is done and at least
 :data:`MEASURED` members were solved here, and only then: as members are
 solved here both sides of (4) shrink in proportion (the saving by about
 ``c (1 - 1/W)`` per member, the cost by ``(o + e) / W``), so a later look
@@ -237,12 +238,18 @@ class Probe:
         return all(f.done() for f in self._warming)
 
     def wait_warm(self, seconds: float) -> bool:
-        """Wait at most ``seconds`` for the workers' imports (:meth:`warm`); whether they are done."""
-        from distributed import wait
-        try:
-            wait(self._warming, timeout=seconds)
-        except Exception:        # not done in time (or failed: the trip's timing raises the failure)
-            pass
+        """Wait at most ``seconds`` for the workers' imports (:meth:`warm`); whether they are done.  Each
+        future is waited for by its own client (``distributed.wait`` looks for a default client, and the
+        run's is none)."""
+        deadline = time.perf_counter() + seconds
+        for fut in self._warming:
+            left = deadline - time.perf_counter()
+            if left <= 0.0:
+                break
+            try:
+                fut.result(timeout=left)
+            except Exception:    # not done in time (or failed: the trip's timing raises the failure)
+                pass
         return self.warm_done()
 
     def round_trip(self, item: Any, nbytes: int) -> float:

@@ -147,6 +147,24 @@ def test_a_cluster_whose_members_were_measured_slower_keeps_the_batch_here(dask)
     assert batch["decision"].endswith(" in this process")    # after two members here (or three: connected)
 
 
+def test_waiting_for_the_workers_imports_needs_no_default_client(cluster, tmp_path):
+    """The probe of a run's client (never Dask's default) waits for the workers' imports: a module whose
+    import takes 0.5 s is imported by every worker when the wait returns."""
+    tag = f"warm_{os.getpid()}_{time.monotonic_ns()}"
+    (tmp_path / f"{tag}.py").write_text(SLOW_MODULE.format(folder=str(tmp_path), seconds=0.5))
+    ex = DaskCluster(cluster)
+    try:
+        ex.client.run(search_path, str(tmp_path), True)
+        probe = dask_payoff.Probe(ex.client, "warm-wait")
+        probe.warm((tag,))
+        assert probe.wait_warm(60.0) and probe.warm_done()
+        assert all(tag in m for m in ex.client.run(lambda: [m for m in sys.modules if m.startswith("warm_")]).values())
+        probe.cancel()
+    finally:
+        ex.client.run(search_path, str(tmp_path), False)
+        ex.close()
+
+
 def test_a_cluster_used_directly_sends_every_member_there(cluster):
     """Without the run's judgement (:func:`ngcontact.parallel.executor.use` of a cluster made by hand) every
     member goes to the workers."""
