@@ -22,7 +22,9 @@ where that record forecasts that the batch goes to them:
 of two one-thread worker processes that this script starts once (the runs
 get the environment this script was started with, not the variables Dask's
 nanny leaks into the process that starts a cluster) and warms
-with one run of each scene (a cluster outlives the runs it serves; a batch
+with one run of each scene (a cluster outlives the runs it serves, and the
+run's record of the cluster's costs, ``ngcontact.parallel.dask_payoff``, with
+it: the warming run writes it where the runs after it read it; a batch
 goes to it only where its rest repays the members' trips,
 ``ngcontact.parallel.dask_payoff``, column ``ran``).  Per
 run: the one-minute load average as it began (the machine is shared; a
@@ -124,6 +126,7 @@ def main() -> None:
         dask = ("--scheduler", cluster.scheduler_address)
         records = os.path.join(tmp, "cache")
         for name, scene in scenes.items():
+            os.environ["NGCONTACT_CACHE"] = records      # as in the runs after it (also the first ensemble's)
             run(scene, os.path.join(tmp, f"warm_{len(rows)}"), *dask)      # the cluster imports the package
             for repeat in range(args.repeats):
                 ref: tuple[float, dict] | None = None
@@ -167,7 +170,8 @@ def main() -> None:
                  "have shown that they repay; `local 2`: after the serial run has recorded the batch, its "
                  "workers start with the run where the record forecasts that the batch goes to them, "
                  "`ngcontact.parallel.batch_forecast`; `started`: when the workers started) "
-                 "and `--scheduler` on a local Dask cluster of two one-thread workers (warmed by one run). "
+                 "and `--scheduler` on a local Dask cluster of two one-thread workers (warmed by one run, which also "
+                 "fills the record of its costs that the Dask runs read). "
                  "`ran`: where the batch ran (a local pool sends a batch to its workers only where its rest "
                  "repays them, `ngcontact.parallel.worker_payoff`, a Dask cluster only where it repays the "
                  "members' trips, `ngcontact.parallel.dask_payoff`; else `serial`, in the run's process). "

@@ -237,11 +237,11 @@ class DaskCluster(Executor):
             if len(done) < dask_payoff.MEASURED or len(done) == len(items):
                 continue
             if not probes:      # not connected: the connection is part of what the rest must repay
-                ahead = self._ahead(clock.least, len(items) - len(done))
+                ahead = self._ahead(clock.least_wall, len(items) - len(done))
                 if not ahead.repaid:
                     return self._here(fn, items, names, label, progress, fault, done, ahead.describe(len(done)))
                 probes.append(self._connect(label, fn))
-                probes[0].wait_warm(clock.least)     # a warm cluster's imports: no member's time
+                probes[0].wait_warm(clock.least_wall)     # a warm cluster's imports: no member's time
             probe = probes[0]
             if not probe.warm_done():
                 continue
@@ -254,9 +254,9 @@ class DaskCluster(Executor):
                 return self._here(fn, items, names, label, progress, fault, done, why)
             dask_payoff.remember_cost(self.address, "round_trip", trip)
             payoff = dask_payoff.DaskPayoff(
-                clock.least, len(items) - len(done), len(probe.workers),
+                clock.least_wall, len(items) - len(done), len(probe.workers),
                 dask_payoff.cost_seconds(self.address, "round_trip", trip),
-                dask_payoff.cost_seconds(self.address, "member_extra"))
+                dask_payoff.member_extra(self.address, clock.least_wall))
             probe.cancel()                 # done with: its results leave the workers
             if not payoff.repaid:
                 return self._here(fn, items, names, label, progress, fault, done, payoff.describe(len(done)))
@@ -271,14 +271,16 @@ class DaskCluster(Executor):
         return done
 
     def _ahead(self, member_seconds: float, rest: int) -> dask_payoff.DaskPayoff:
-        """Condition (4) before the connection: its cost ``K``, the cluster's workers, trip and extra time as
-        this scheduler's record has them (:mod:`ngcontact.parallel.dask_payoff`)."""
+        """Condition (4) before the connection: its cost ``K`` (the connection and the probe's two trips), the
+        cluster's workers, trip and extra time as this scheduler's record has them
+        (:mod:`ngcontact.parallel.dask_payoff`)."""
         known = dask_payoff.measured_costs(self.address, "workers")
         cost = functools.partial(dask_payoff.cost_seconds, self.address)
         workers = max(1, round(statistics.median(known))) if known else rest
         return dask_payoff.DaskPayoff(member_seconds, rest, workers, cost("round_trip"),
-                                      cost("member_extra"), cost("connect", dask_payoff.CONNECT_ESTIMATE),
-                                      workers_known=bool(known))
+                                      dask_payoff.member_extra(self.address, member_seconds),
+                                      cost("connect", dask_payoff.CONNECT_ESTIMATE),
+                                      workers_known=bool(known), probe=2.0 * cost("round_trip"))
 
     def _connect(self, label: str, fn) -> dask_payoff.Probe:
         """Connect now (``K`` timed and recorded, and the cluster's workers) and start the batch's probe."""
@@ -328,9 +330,9 @@ class DaskCluster(Executor):
         except BaseException:
             client.cancel(list(index))
             raise
-        if self.member_clock.times:      # ``e``: a member's time on a worker beyond the cheapest here
-            dask_payoff.remember_cost(self.address, "member_extra",
-                                      statistics.median(seconds) - self.member_clock.least)
+        wall = dask_payoff.member_wall(seconds, self.member_clock.least_wall)
+        if wall is not None:             # ``w``: a member's wall time on a worker over the quickest here
+            dask_payoff.remember_cost(self.address, "member_wall", wall)
         return [results[k] for k in range(len(items))]
 
     def close(self) -> None:
@@ -340,9 +342,10 @@ class DaskCluster(Executor):
 
 
 def _dask_member(fn, item, name, attempt, fault):
-    """One member on a worker: its result and its ``min(wall, CPU)`` seconds there."""
+    """One member on a worker: its result and its wall seconds there (what the batch waits for, whatever
+    share of the worker machine's cores it got: ``w`` of :mod:`ngcontact.parallel.dask_payoff`)."""
     if not in_worker():
         one_thread(ignore_sigint=False)
-    wall, cpu = time.perf_counter(), time.thread_time()
+    wall = time.perf_counter()
     result = run_member(fn, item, name, attempt, fault)
-    return result, min(time.perf_counter() - wall, time.thread_time() - cpu)
+    return result, time.perf_counter() - wall

@@ -4,10 +4,9 @@ A cluster's workers run already: unlike a local pool's
 (:mod:`ngcontact.parallel.worker_payoff`) they have no start to repay, but
 every member sent to them pays a trip, and they may be other machines, whose
 cores the load of this one says nothing about.  With ``r`` members of a
-batch still to solve, ``c`` seconds each in this process (the least
-``min(wall, CPU)`` seconds of the members solved here, as the local rule
-times them), finishing them here takes ``r c``.  On the cluster's ``W``
-workers the rest ends no sooner than::
+batch still to solve, ``c`` seconds each in this process (the least wall
+seconds of the members solved here), finishing them here takes ``r c``.
+On the cluster's ``W`` workers the rest ends no sooner than::
 
     ceil(r / W) (c + e + o)
 
@@ -22,29 +21,45 @@ the cluster at each batch, as the batch's first members are solved here: a
 probe task per worker carrying the next member's item and returning as many
 bytes as the first member's result pickled, ``o`` being its wall time here
 less the time it ran on the worker.  ``e`` is what a member costs on the
-cluster's workers beyond its time here (its ``min(wall, CPU)`` seconds on
-the worker less ``c``: a slower machine, a worker's own overheads), measured
-by every batch the cluster solved.  Both are kept per scheduler address
+cluster's workers beyond its time here: ``e = (w - 1) c``, ``w`` the
+median over a batch the cluster solved of a member's wall seconds on its
+worker over that batch's ``c`` (a median, which each worker's first member,
+reading files or importing what the probe did not, moves little).  Wall
+seconds, not the worker's CPU seconds: the rest waits for the worker's
+wall time, and a worker on a machine whose cores other jobs share (this
+one, for a local cluster, whose workers then also share this process's
+share of the cores) takes several times its CPU seconds to solve a member
+that its CPU time shows as cheap as here; a ratio, not seconds, since
+that slowdown scales with the member while a trip's fixed costs are in
+``o``, so one batch's ``w`` reads for another of other members.  Both are
+kept per scheduler address
 (:data:`COSTS_FILE`, the last :data:`~ngcontact.parallel.batch_forecast.COSTS_KEPT`
 of each) and the rule takes their medians, so one slow probe does not decide
-alone; ``e`` is 0 before the cluster has solved a batch, and never less: a
-cluster whose members measured faster than here (a faster machine, or only
-this process's other threads in its CPU time) is not counted on.
+alone; ``w`` is 1 before the cluster has solved a batch, and ``e`` never less
+than 0: a cluster whose members measured faster than here (a faster
+machine) is not counted on.  Both sides are wall seconds, what the run
+waits for here and there on the machines as other jobs load them now:
+the local rule's ``min(wall, CPU)`` here (:mod:`ngcontact.parallel.worker_payoff`,
+which reads the load from the free cores instead) would set a member's
+CPU time here against its wall time there, and keep here every batch of
+a busy machine whose cluster would still finish it sooner.
 
 The cluster repays its trips when the rest ends sooner there::
 
     c (r - ceil(r / W))  >  K + ceil(r / W) (o + e)                            (4)
 
 the time the workers save on the rest against the trips and extra time of
-the members each worker solves, and ``K``, the connection still to make:
-the run's process imports dask.distributed and connects a client to the
-scheduler (most of a second, in this process, so every member waits for
-it) only for a batch whose rest repays that too; a run whose batches all
-stay here never pays it, and so costs the serial run
+the members each worker solves, and ``K``, the connection and the probe
+still to make: the run's process imports dask.distributed and connects a
+client to the scheduler (most of a second, in this process, so every
+member waits for it) only for a batch whose rest repays that too; a run
+whose batches all stay here never pays it, and so costs the serial run
 (:meth:`~ngcontact.parallel.dask_cluster.DaskCluster.start_on_demand`
 checks the address with a bare TCP connection instead).  ``K`` is the
 connection's wall seconds as last timed for the scheduler
-(:data:`CONNECT_ESTIMATE` before any), and 0 once connected: spent.
+(:data:`CONNECT_ESTIMATE` before any) and two trips ``2 o`` of the probe,
+which this process waits through before the rest leaves (the workers'
+imports confirmed, then the timed trip); 0 once connected: spent.
 Before the connection, ``W``, ``o`` and ``e`` are the scheduler's record
 (``o`` and ``e`` 0 before any), and ``W`` the rest ``r`` where the record
 has none (every member its own worker: the largest saving, so a batch the
@@ -56,8 +71,9 @@ batch that stays here cancels its probe, whose tasks import no further
 module once cancelled (:meth:`Probe.cancel`).  Before
 timing the trips, the probe imports the members' modules on every worker
 (each worker's first member would otherwise pay it), while this process goes
-on solving members (a warm cluster's imports are waited for, up to one
-member's time ``c``); (4) is read once that is done and at least
+on solving members (a warm cluster's imports, a trip once connected, are
+waited for, up to one member's time ``c``: then the rest is the ``r`` that (4)
+weighed before the connection, not one member less); (4) is read once that is done and at least
 :data:`MEASURED` members were solved here, and only then: as members are
 solved here both sides of (4) shrink in proportion (the saving by about
 ``c (1 - 1/W)`` per member, the cost by ``(o + e) / W``), so a later look
@@ -84,9 +100,10 @@ from ngcontact.parallel.batch_member import in_worker, one_thread
 MEASURED = 2
 
 #: The record of the clusters' costs beside the local workers' (:mod:`ngcontact.parallel.batch_forecast`): by
-#: scheduler address, the last ``round_trip`` seconds measured (``o`` of (4)), ``member_extra`` (``e``),
-#: ``connect`` (``K``) and the cluster's ``workers`` (``W``, as the connection found them).
-COSTS_FILE, COSTS = "dask_costs.json", ("round_trip", "member_extra", "connect", "workers")
+#: scheduler address, the last ``round_trip`` seconds measured (``o`` of (4)), ``member_wall`` (``w``, a
+#: ratio), ``connect`` (``K`` less the probe's trips) and the cluster's ``workers`` (``W``, as the
+#: connection found them).
+COSTS_FILE, COSTS = "dask_costs.json", ("round_trip", "member_wall", "connect", "workers")
 
 #: Wall seconds of the connection to a scheduler (``K``: dask.distributed imported in the run's process, a
 #: client connected) before this scheduler's record has one (an estimate: the import alone is most of it).
@@ -100,7 +117,8 @@ PROBE_SECONDS = 30.0
 class DaskPayoff:
     """Condition (4) for the rest of a batch: ``rest`` members of ``member_seconds`` each on ``workers``
     worker processes of a cluster, each member's trip ``round_trip`` seconds (``o``) and its extra time on a
-    worker ``member_extra`` (``e``)."""
+    worker ``member_extra`` (``e``); before the connection, its ``connect`` seconds and the ``probe``'s (``K``
+    is their sum)."""
 
     member_seconds: float
     rest: int
@@ -109,6 +127,7 @@ class DaskPayoff:
     member_extra: float
     connect: float = 0.0
     workers_known: bool = True
+    probe: float = 0.0
 
     def __post_init__(self):
         object.__setattr__(self, "member_extra", max(self.member_extra, 0.0))     # ``e >= 0``
@@ -125,8 +144,8 @@ class DaskPayoff:
 
     @property
     def cost(self) -> float:
-        """Seconds the connection and the busiest worker's members add: ``K + ceil(r / W) (o + e)``."""
-        return self.connect + self.per_worker * (self.round_trip + self.member_extra)
+        """Seconds the connection, the probe and the busiest worker's members add: ``K + ceil(r / W) (o + e)``."""
+        return self.connect + self.probe + self.per_worker * (self.round_trip + self.member_extra)
 
     @property
     def repaid(self) -> bool:
@@ -144,7 +163,7 @@ class DaskPayoff:
             where = f"the other {self.rest} in this process"
         connect = "" if self.connect == 0 else (
             f"the connection to the scheduler ({self.connect:.3g} s: dask.distributed imported and a client "
-            f"connected in this process, as last timed there), ")
+            f"connected in this process, as last timed there), the probe's two trips ({self.probe:.3g} s), ")
         return (f"{solved} member{'s' if solved > 1 else ''} solved here, the cheapest in "
                 f"{self.member_seconds:.3g} s: {workers} would save {self.saving:.3g} s on the other {self.rest} "
                 f"against {self.cost:.3g} s of {connect}trips ({self.round_trip:.3g} s each: the scheduler's round "
@@ -153,8 +172,22 @@ class DaskPayoff:
 
 
 # ------------------------------------------------ the record, per scheduler address
-#: the record of (4)'s costs per scheduler address (``e`` may be measured below 0; it is held at 0 where used)
-RECORD = batch_forecast.CostRecord(COSTS_FILE, COSTS, least=-1e4)
+#: the record of (4)'s costs per scheduler address (``w`` may be measured below 1; ``e`` is held at 0 where used)
+RECORD = batch_forecast.CostRecord(COSTS_FILE, COSTS)
+
+
+def member_extra(address: str, member_seconds: float) -> float:
+    """``e = (w - 1) c`` of (4) for members of ``member_seconds`` (``c``) each, ``w`` the median of the last
+    ``member_wall`` ratios measured at ``address`` (1 before any)."""
+    return (RECORD.median("member_wall", 1.0, address) - 1.0) * member_seconds
+
+
+def member_wall(worker_seconds: Sequence[float], member_seconds: float) -> float | None:
+    """``w`` of (4) as a batch measured it: the median of its members' wall ``worker_seconds`` on the
+    cluster's workers over ``member_seconds`` (``c``, this process's); None without both."""
+    if not worker_seconds or member_seconds <= 0.0:
+        return None
+    return statistics.median(worker_seconds) / member_seconds
 
 
 def measured_costs(address: str, kind: str) -> list[float]:
@@ -237,12 +270,18 @@ class Probe:
         return all(f.done() for f in self._warming)
 
     def wait_warm(self, seconds: float) -> bool:
-        """Wait at most ``seconds`` for the workers' imports (:meth:`warm`); whether they are done."""
-        from distributed import wait
-        try:
-            wait(self._warming, timeout=seconds)
-        except Exception:        # not done in time (or failed: the trip's timing raises the failure)
-            pass
+        """Wait at most ``seconds`` for the workers' imports (:meth:`warm`); whether they are done.  Each
+        future is waited for by its own client (``distributed.wait`` looks for a default client, and the
+        run's is none)."""
+        deadline = time.perf_counter() + seconds
+        for fut in self._warming:
+            left = deadline - time.perf_counter()
+            if left <= 0.0:
+                break
+            try:
+                fut.result(timeout=left)
+            except Exception:    # not done in time (or failed: the trip's timing raises the failure)
+                pass
         return self.warm_done()
 
     def round_trip(self, item: Any, nbytes: int) -> float:

@@ -194,10 +194,12 @@ class Payoff:
 
 
 class MemberClock:
-    """Times members solved in this process: ``min(wall, CPU)`` seconds of each; :attr:`least` of them."""
+    """Times members solved in this process: ``min(wall, CPU)`` seconds of each (:attr:`least` of them) and
+    their wall seconds (:attr:`least_wall`)."""
 
     def __init__(self):
         self.times: list[float] = []
+        self.walls: list[float] = []
         self._wall = self._cpu = 0.0
 
     def __enter__(self) -> "MemberClock":
@@ -206,9 +208,17 @@ class MemberClock:
 
     def __exit__(self, *exc) -> None:
         if exc[0] is None:
-            self.times.append(min(time.perf_counter() - self._wall, time.process_time() - self._cpu))
+            wall = time.perf_counter() - self._wall
+            self.walls.append(wall)
+            self.times.append(min(wall, time.process_time() - self._cpu))
 
     @property
     def least(self) -> float:
         """Seconds of the cheapest member solved here (zero before the first): ``c`` of condition (1)."""
         return min(self.times, default=0.0)
+
+    @property
+    def least_wall(self) -> float:
+        """Wall seconds of the quickest member solved here (zero before the first): ``c`` of condition (4) of
+        :mod:`ngcontact.parallel.dask_payoff`."""
+        return min(self.walls, default=0.0)

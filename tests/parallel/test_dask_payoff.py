@@ -12,9 +12,10 @@ import time
 
 import pytest
 
-from ngcontact.parallel import dask_payoff
+from ngcontact.parallel import batch_executor, dask_payoff
 from ngcontact.parallel.dask_cluster import DaskCluster
 from ngcontact.parallel.dask_payoff import DaskPayoff
+from ngcontact.parallel.worker_payoff import MemberClock
 
 
 def burn(seconds: float) -> int:
@@ -23,6 +24,26 @@ def burn(seconds: float) -> int:
     while time.thread_time() - t0 < seconds:
         pass
     return os.getpid()
+
+
+class NominalClock(MemberClock):
+    """Times every member solved here at ``seconds`` (wall and ``min(wall, CPU)``), its nominal cost: the
+    rule's ``c`` is the test's, not what the machine's load and this process's other threads (the test
+    cluster's scheduler, NGSolve's) made of it."""
+
+    def __init__(self, seconds: float):
+        super().__init__()
+        self.seconds = seconds
+
+    def __exit__(self, *exc) -> None:
+        if exc[0] is None:
+            self.times.append(self.seconds)
+            self.walls.append(self.seconds)
+
+
+def nominal(monkeypatch, seconds: float) -> None:
+    """Each member solved in this process is timed at ``seconds`` (:class:`NominalClock`)."""
+    monkeypatch.setattr(batch_executor, "MemberClock", functools.partial(NominalClock, seconds))
 
 
 @pytest.fixture(scope="module")
@@ -63,6 +84,40 @@ def test_condition_4_weighs_the_saving_on_the_rest_against_the_trips_and_a_worke
     assert "the other 6 in this process" in slow.describe(2)
 
 
+def test_a_members_extra_time_on_a_worker_is_its_wall_time_there_over_its_time_here(tmp_path):
+    """``w``: the median of the members' wall seconds on the workers over ``c`` (each worker's slow first
+    member left out), read as ``e = (w - 1) c`` for the members of another batch; 1, so ``e = 0``, before
+    any; a cluster measured faster is not counted on."""
+    assert dask_payoff.member_wall([0.5, 0.25, 0.26, 0.27, 0.9], 0.25) == pytest.approx(1.08)
+    assert dask_payoff.member_wall([], 0.25) is None and dask_payoff.member_wall([0.3], 0.0) is None
+    address = "tcp://127.0.0.1:1"
+    assert dask_payoff.member_extra(address, 0.1) == 0.0
+    for w in (1.2, 3.0, 1.3):
+        dask_payoff.remember_cost(address, "member_wall", w)
+    assert dask_payoff.member_extra(address, 0.1) == pytest.approx(0.03)      # the median ratio, 1.3
+    assert dask_payoff.member_extra(address, 0.25) == pytest.approx(0.075)
+    dask_payoff.remember_cost("tcp://127.0.0.1:2", "member_wall", 0.5)
+    assert DaskPayoff(0.1, 6, 2, 0.01, dask_payoff.member_extra("tcp://127.0.0.1:2", 0.1)).member_extra == 0.0
+
+
+def test_the_measured_scan_is_not_sent_to_a_cluster_whose_workers_share_the_cores():
+    """The measured scan's batch on a local cluster of two workers, with figures like the benchmark's: members
+    of 0.105 s, a connection timed at 0.2 s, trips of 0.015 s.  With a member's extra time on a worker taken
+    from its CPU time there (0.012 s), the other six would save 0.315 s against 0.281 s: sent, and slower
+    than serial.  The probe's two trips and the members' wall time there (1.25 times their time here, two
+    workers sharing the cores with the run's other jobs) make it 0.354 s: kept here.  The 256^2 ensemble's
+    members of 0.235 s still repay the same cluster many times over."""
+    def scan(extra, probe):
+        return DaskPayoff(0.105, 6, 2, 0.015, extra, connect=0.2, probe=probe)
+
+    assert scan(0.012, 0.0).repaid and scan(0.012, 0.0).cost == pytest.approx(0.281)
+    kept = scan((1.25 - 1) * 0.105, 2 * 0.015)
+    assert kept.saving == pytest.approx(0.315) and kept.cost == pytest.approx(0.35375) and not kept.repaid
+    assert "the probe's two trips (0.03 s)" in kept.describe(2) and kept.describe(2).endswith("in this process")
+    large = DaskPayoff(0.235, 14, 2, 0.015, (1.25 - 1) * 0.235, connect=0.2, probe=2 * 0.015)
+    assert large.saving == pytest.approx(1.645) and large.cost == pytest.approx(0.74625) and large.repaid
+
+
 def test_a_dask_batch_too_small_to_repay_the_trips_runs_serially_and_says_why(dask):
     """Three members of 0.1 s: after two here, the last one alone saves nothing, on any number of workers:
     the run never connects (no dask.distributed client, no trip timed)."""
@@ -75,29 +130,35 @@ def test_a_dask_batch_too_small_to_repay_the_trips_runs_serially_and_says_why(da
     assert dask._client is None and dask_payoff.measured_costs(dask.address, "round_trip") == []
 
 
-def test_a_small_batch_that_cannot_repay_the_connection_stays_here_and_connects_nothing(dask):
-    """The measured scan's batch: eight members of 0.1 s on a cluster of two workers whose connection was
-    timed at 0.45 s.  The other six would save 0.3 s on two workers, less than the connection alone: the
-    batch stays here, connecting nothing.  The same batch in a run already connected (``K`` spent) goes
-    there: the trips of a warm local cluster are milliseconds."""
+def test_a_small_batch_that_cannot_repay_the_connection_stays_here_and_connects_nothing(dask, monkeypatch):
+    """The measured scan's batch: eight members of 0.1 s (timed at that, :class:`NominalClock`: a member
+    timed slower here, on a busy machine, would make the saving the test weighs larger) on a cluster of two
+    workers whose connection was timed at 0.45 s.  The other six would save 0.3 s on two workers, less than
+    the connection alone: the batch stays here, connecting nothing.  The same batch in a run already
+    connected (``K`` spent) goes there: the record's trips are a millisecond (one slow probe among them does
+    not move their median)."""
+    nominal(monkeypatch, 0.1)
     dask_payoff.remember_cost(dask.address, "connect", 0.45)
     dask_payoff.remember_cost(dask.address, "workers", 2.0)
     pids = dask.map(burn, [0.1] * 8, [f"m{k}" for k in range(8)], label="scan")
     assert pids == [os.getpid()] * 8 and dask._client is None
     batch = dask.describe()["batches"][-1]
-    assert batch["executor"] == "serial" and "the cluster's 2 workers would save 0.3" in batch["decision"]
-    assert "the connection to the scheduler (0.45 s" in batch["decision"]
+    assert batch["executor"] == "serial" and "the cluster's 2 workers would save 0.3 s on the other 6" in batch["decision"]
+    assert "against 0.45 s of the connection to the scheduler (0.45 s" in batch["decision"]
     dask.client  # noqa: B018 - connected by an earlier batch: its cost is spent
+    for _ in range(4):
+        dask_payoff.remember_cost(dask.address, "round_trip", 0.001)
     pids = dask.map(burn, [0.1] * 8, [f"m{k}" for k in range(8)], label="connected")
     assert dask.describe()["batches"][-1]["executor"] == "dask" and os.getpid() not in pids[-4:]
 
 
-def test_a_large_dask_batch_goes_to_the_cluster_after_its_first_two_members(dask):
+def test_a_large_dask_batch_goes_to_the_cluster_after_its_first_two_members(dask, monkeypatch):
     """Eight members of 0.3 s: after two here, the connection is made (the other six would save 1.5 s on six
     workers, against the connection's estimate of 0.5 s); at most one more member is solved here while the
     workers' imports are confirmed; then 0.9 s saved on the other six (or 0.6 s on five), against trips of
-    milliseconds; on the workers each member costs what it costs here, so its extra time is measured near
-    zero."""
+    milliseconds.  A member's wall time on a worker is recorded over its time here (0.3 s, as timed:
+    :class:`NominalClock`): at least 1, the member's thread burning 0.3 s there."""
+    nominal(monkeypatch, 0.3)
     seen = []
     pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="large",
                     progress=lambda *a: seen.append(a[1:]))
@@ -106,20 +167,58 @@ def test_a_large_dask_batch_goes_to_the_cluster_after_its_first_two_members(dask
     assert seen == [(k, 8) for k in range(9)]                   # one count per member, wherever it ran
     batch = dask.describe()["batches"][-1]
     assert batch["executor"] == "dask" and f"the other {8 - here} on the cluster's 2 workers" in batch["decision"]
-    (trip,), (extra,), (connect,), (workers,) = (dask_payoff.measured_costs(dask.address, k)
-                                                 for k in dask_payoff.COSTS)
-    assert 0.0 <= trip < 0.3 and abs(extra) < 0.1 and 0.0 < connect < 5.0 and workers == 2.0
+    (trip,), (wall,), (connect,), (workers,) = (dask_payoff.measured_costs(dask.address, k)
+                                                for k in dask_payoff.COSTS)
+    assert 0.0 <= trip < 0.3 and wall >= 1.0 and 0.0 < connect < 5.0 and workers == 2.0
 
 
-def test_a_cluster_whose_members_were_measured_slower_keeps_the_batch_here(dask):
-    """The same eight members, on a cluster whose record says a member costs 1 s more there: the rest stays
-    here, and the decision names that extra time."""
-    dask_payoff.remember_cost(dask.address, "member_extra", 1.0)
+def test_a_cluster_whose_members_were_measured_slower_keeps_the_batch_here(dask, monkeypatch):
+    """The same eight members, on a cluster whose record says a member takes four times its time here (a
+    worker sharing busy cores): 0.9 s more there, so the rest stays here, and the decision names that extra
+    time."""
+    nominal(monkeypatch, 0.3)
+    dask_payoff.remember_cost(dask.address, "member_wall", 4.0)
     pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="large")
     assert pids == [os.getpid()] * 8
     batch = dask.describe()["batches"][-1]
-    assert batch["executor"] == "serial" and "extra time on a worker (1 s)" in batch["decision"]
+    assert batch["executor"] == "serial" and "extra time on a worker (0.9 s)" in batch["decision"]
     assert batch["decision"].endswith(" in this process")    # after two members here (or three: connected)
+
+
+def nap(seconds: float) -> int:
+    """A member that waits ``seconds`` without computing (a worker whose cores are busy with other jobs);
+    the id of the process that ran it."""
+    time.sleep(seconds)
+    return os.getpid()
+
+
+def test_a_worker_member_that_waits_for_its_cores_is_recorded_by_its_wall_time(dask, monkeypatch):
+    """Members that take 0.3 s of wall time and almost no CPU time, as a worker's on cores other jobs keep
+    busy: the record holds their wall time there over their time here (0.3 s, as timed), at least 1 (their
+    CPU time there would make it near 0: a cluster whose members look free)."""
+    nominal(monkeypatch, 0.3)
+    pids = dask.map(nap, [0.3] * 8, [f"m{k}" for k in range(8)], label="waiting")
+    assert dask.describe()["batches"][-1]["executor"] == "dask" and os.getpid() not in pids[-4:]
+    (wall,) = dask_payoff.measured_costs(dask.address, "member_wall")
+    assert wall >= 1.0
+
+
+def test_waiting_for_the_workers_imports_needs_no_default_client(cluster, tmp_path):
+    """The probe of a run's client (never Dask's default) waits for the workers' imports: a module whose
+    import takes 0.5 s is imported by every worker when the wait returns."""
+    tag = f"warm_{os.getpid()}_{time.monotonic_ns()}"
+    (tmp_path / f"{tag}.py").write_text(SLOW_MODULE.format(folder=str(tmp_path), seconds=0.5))
+    ex = DaskCluster(cluster)
+    try:
+        ex.client.run(search_path, str(tmp_path), True)
+        probe = dask_payoff.Probe(ex.client, "warm-wait")
+        probe.warm((tag,))
+        assert probe.wait_warm(60.0) and probe.warm_done()
+        assert all(tag in m for m in ex.client.run(lambda: [m for m in sys.modules if m.startswith("warm_")]).values())
+        probe.cancel()
+    finally:
+        ex.client.run(search_path, str(tmp_path), False)
+        ex.close()
 
 
 def test_a_cluster_used_directly_sends_every_member_there(cluster):

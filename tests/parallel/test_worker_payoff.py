@@ -41,6 +41,8 @@ def test_a_member_is_timed_by_its_cpu_seconds_when_the_process_waits_beside_it()
         burn(0.02)
     assert len(clock.times) == 2 and clock.times[0] < 0.01 <= 0.02 <= clock.times[1] < 0.04
     assert clock.least == clock.times[0]
+    assert clock.walls[0] >= 0.05 and clock.walls[1] >= clock.times[1]       # the wall seconds, kept beside
+    assert clock.least_wall == min(clock.walls) and MemberClock().least_wall == 0.0
 
 
 @pytest.fixture
