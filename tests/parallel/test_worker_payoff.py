@@ -219,7 +219,8 @@ def test_a_workers_start_is_measured_and_kept_for_the_next_runs(method):
     """The workers' start (``S`` of condition (1)) is recorded on this machine: a spawned worker's CPU
     seconds once its imports are done, as each worker's start ends; a fork server's once its imports are
     done (NGSolve among them: more than a tenth of a second, less than a minute) and each forked worker's
-    before its first member (a fork: less than a tenth of the server's)."""
+    before its first member (a fork, which imports nothing again: less than half the server's; its CPU seconds
+    are tens of milliseconds, the server's a few tenths where the imports' files are cached)."""
     pool = local_pool.LocalPool(2, method=method)
     try:
         pool.start(("ngsolve",))
@@ -238,7 +239,7 @@ def test_a_workers_start_is_measured_and_kept_for_the_next_runs(method):
         import operator                   # a member whose module the server has imported (the forks' own cost)
         pool._pool_map(operator.neg, [1.0] * 4, list("abcd"), "forks", None, None)
         [fork] = batch_forecast.measured_costs("fork")
-        assert 0.0 < fork < 0.1 * server and judged_batches.fork_cost() == fork
+        assert 0.0 < fork < 0.5 * server and judged_batches.fork_cost() == fork
     finally:
         pool.close()
 
