@@ -119,6 +119,7 @@ def test_the_sections_rows_are_scored_against_the_converged_bisinusoid():
         0.07 / theirs["contact_fraction"] - 1.0, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_the_published_extrapolations_bound_their_errors():
     """On the kept rows of the section (docs/benchmarks/scaling_3d), scored against the spectral cell
     extrapolated from 1024^2 and 2048^2, every extrapolation's estimate (with the real spectral twin) is at

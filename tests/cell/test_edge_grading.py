@@ -175,6 +175,7 @@ def test_the_twins_edges_lie_within_half_its_spacing_of_westergaards():
     assert twin_edges(twin, full) is None
 
 
+@pytest.mark.slow
 def test_a_load_graded_from_its_twins_edges_takes_fewer_meshes_and_steps_to_the_same_accuracy():
     """The shipped scene's lightest load: seeded with the twin's edges and started from the twin at every level,
     against the uniform first mesh and the carried states of a rigid start (no twin)."""

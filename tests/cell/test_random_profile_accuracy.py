@@ -75,6 +75,7 @@ def test_the_posed_scenes_state_no_discretization_but_the_tolerance(tmp_path):
         assert list(scene.load.pressure) == list(S.PRESSURES)
 
 
+@pytest.mark.slow
 def test_a_random_profile_meets_the_aim_with_the_defaults_and_at_a_tolerance_of_1e_4(tmp_path):
     gap = S.write_gap(str(tmp_path), SEED)
     defaults = _results(tmp_path, "defaults", S.scene_text(SEED, gap, S.RUNS["defaults"]))

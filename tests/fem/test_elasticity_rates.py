@@ -43,9 +43,9 @@ LEVELS = {
 }
 
 FAST = [("plane_strain", 1), ("plane_strain", 2), ("axisymmetric", 1), ("axisymmetric", 2),
-        ("periodic_cell", 1), ("periodic_cell", 2), ("3d", 1)]
+        ("periodic_cell", 1), ("periodic_cell", 2)]
 SLOW = [("plane_strain", 3), ("plane_strain", 4), ("axisymmetric", 3), ("axisymmetric", 4),
-        ("periodic_cell", 3), ("periodic_cell", 4), ("3d", 2), ("3d", 3)]
+        ("periodic_cell", 3), ("periodic_cell", 4), ("3d", 1), ("3d", 2), ("3d", 3)]
 
 
 def observed_rates(setting, order):
