@@ -25,6 +25,7 @@ def _write(path, rows: list[dict]) -> None:
         w.writerows(rows)
 
 
+@pytest.mark.slow
 def test_kept_rows_and_new_ones_make_the_table_their_republication_makes(tmp_path):
     """An earlier run's rows (two edge sizes and their extrapolation) kept above a new size: the measured rows in
     their order, then one extrapolation over all three sizes, the table that republishing its CSV makes again."""

@@ -208,6 +208,7 @@ def test_a_load_graded_from_its_twins_edges_takes_fewer_meshes_and_steps_to_the_
     assert steps[0] < steps[1] / 2, steps
 
 
+@pytest.mark.slow
 def test_a_stated_tolerance_out_of_reach_of_a_counted_quantity_ends_the_run(tmp_path, capsys):
     """The shipped scene's lightest load at a stated 1e-5: the fraction and the closure meet it on the graded
     levels (estimates about 5.6e-7 on the finest), while g_n, the fraction's error weighted by the gap at the

@@ -263,8 +263,9 @@ def test_3d_exact_contact_is_independent_of_k_n_admissible_and_balanced(cell3d_c
         assert res["contact_fraction"] == pytest.approx(westergaard_contact_fraction(r, 1.0), rel=0.08)
 
 
-@pytest.mark.parametrize("friction", [Tresca(G=0.4 * 0.5 * PSTAR, w=1e-8),
-                                      Coulomb(mu=0.4, w=1e-8)], ids=["tresca", "coulomb"])
+@pytest.mark.parametrize("friction", [pytest.param(Tresca(G=0.4 * 0.5 * PSTAR, w=1e-8), id="tresca"),
+                                      pytest.param(Coulomb(mu=0.4, w=1e-8), id="coulomb",
+                                                   marks=pytest.mark.slow)])
 def test_3d_friction_with_exact_contact_is_independent_of_k_n(cell3d_coarse, friction):
     """Pressure 0.5 p*, then a shear of 0.2 times it along x."""
     p, q = 0.5 * PSTAR, 0.1 * PSTAR

@@ -141,6 +141,7 @@ def coarse_block(tmp_path) -> str:
     return str(path)
 
 
+@pytest.mark.slow
 def test_epsilon_study_script_writes_report_csv_and_plot_and_refuses_a_mesh_rate(tmp_path):
     """The study's plumbing on coarse meshes, where the field error's discretization estimate is a large share
     of it: the field rate is refused (it would measure the meshes), the L2 rate is fitted, and the reaction's

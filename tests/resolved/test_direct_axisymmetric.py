@@ -213,6 +213,7 @@ def test_femur_bundle_and_effective_laws_converge_on_finer_levels():
 
 
 # -------------------------------------------------------------- command line
+@pytest.mark.slow
 def test_cli_study_epsilon_writes_the_study_and_uses_the_exit_codes(tmp_path, capsys):
     import json
 
