@@ -58,6 +58,7 @@ import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.m
 
 from ngcontact.cell.cell_load import cell_load  # noqa: E402
 from ngcontact.cell.cell_solution import headline  # noqa: E402
+from ngcontact.cell.spectral.contact_edges import LINE_STEP  # noqa: E402
 from ngcontact.cell.spectral.grid_measures import coefficients, contact_weights  # noqa: E402
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell  # noqa: E402
 from ngcontact.cell.spectral.refinement import sweep_to_tolerance  # noqa: E402
@@ -315,7 +316,7 @@ def main(argv=None) -> int:
                               "difference before the last shrunk by twice the contraction before it, at most a "
                               "half, the first one dropped): column `form`; the contact "
                               "fraction and coefficients guarded on levels whose edges are not all located by the "
-                              "quartic (in 3D: a count of points), and in 2D also estimated on the levels whose "
+                              "quartic (2D; in 3D see `line`), and in 2D also estimated on the levels whose "
                               "edges the quartic located, a stop to the tolerance waiting for four of them; on the "
                               "grid after such a wait the waited grid's estimate plus the last difference where "
                               "smaller: `carried`; at least the share of contact islands of fewer than four "
@@ -327,7 +328,9 @@ def main(argv=None) -> int:
                               "other edge (a tenth where the quartic located it), and the normal stiffness (2D: of "
                               "the located set) as many steps of its change with each edge a step out, whose erratic "
                               "fraction of a step the differences may not show, a load's edges twice the "
-                              "root-sum-square of their shares where below their sum: `kink`); a "
+                              "root-sum-square of their shares where below their sum: `kink`; in 3D at least "
+                              f"{LINE_STEP:g} of a step per crossing of an edge by a row or column, summed, above "
+                              "which the quantities on the edges take Richardson at the observed rate: `line`); a "
                               "tolerance not "
                               "met within the study's largest grid reports nothing. The true error of the reported "
                               "grid is against the same cell on a much finer grid; `next_error` is that of the grid "
