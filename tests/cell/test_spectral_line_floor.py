@@ -65,7 +65,7 @@ def test_the_line_floor_raises_a_vanished_difference_and_is_flagged_where_far_ab
 @pytest.mark.slow
 def test_the_bisinusoid_s_estimate_on_the_edges_bounds_its_error_within_ten_times_where_it_stalls():
     """The bisinusoid refined from 32 to 512 points per direction: its contact fraction's error hardly falls from
-    256 to 512 (at the lightest load 4.5e-5, then 3.8e-5 against 2048) while their difference is a seventh of it,
+    256 to 512 (at the lightest load 4.5e-5, then 3.8e-5 against 2048) while their difference is a sixth of it,
     and the differences-only estimate of 512 was below the error (0.93, 0.82 times the contact fraction's at the
     lightest and heaviest load, 0.62 times ``g_n``'s).  With the line's floor each estimate on the edges lies
     between the error and ten times it, against a 2048 x 2048 reference."""

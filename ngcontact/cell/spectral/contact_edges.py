@@ -123,7 +123,7 @@ and add up rather than cancel: the bound is the sum, ``LINE_STEP N h^2`` for ``|
 LINE_STEP h^2`` times the sum of ``g0`` at the crossings' last contact points).  The offsets' size and sign jump
 between grids, so the differences may vanish while this error stalls (the bisinusoid of ``docs/benchmarks.md``,
 spectral effectivity, whose contact fraction at its lightest load errs by about the same on 256 and 512 points per
-direction while the difference between them is a seventh of it): it is a floor under the estimate of each quantity
+direction while the difference between them is a sixth of it): it is a floor under the estimate of each quantity
 on the edges (:func:`island_floor`, form :data:`LINE`), which then need not hold the differences' tail to first
 order (:mod:`~ngcontact.cell.spectral.refinement`).  :data:`LINE_STEP` is calibrated on that bisinusoid (the
 mean ``|delta|`` its contact fraction's errors on 256 to 1024 points imply, against 4096 points, is at most 0.04
