@@ -27,7 +27,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import benchmark_doc  # noqa: E402  (the sibling module writes docs/benchmarks.md)
-from spectral_effectivity import KEYS, NU, Oracle, oracle_rows, plot, random_profile_gap, westergaard_gap  # noqa: E402
+from spectral_effectivity import (KEYS, NU, Oracle, judged, oracle_rows, plot, random_profile_gap,  # noqa: E402
+                                  westergaard_gap)
 
 from ngcontact.output.writer import write_csv  # noqa: E402
 
@@ -59,11 +60,6 @@ def reference_grid(k_n: float) -> int:
     return max(REFERENCE, 2 ** int(np.ceil(np.log2(1.0 / (REFERENCE_STEP * lam)))))
 
 
-def judged(row: dict) -> bool:
-    """Whether the row's true error exceeds the reference's own change (else its effectivity is the reference's)."""
-    return row["true_error"] > row["reference_change"]
-
-
 def summarize(data: list[dict]) -> str:
     """The study's outcome in words: per penalty the range of the judged rows' effectivity, and every row
     outside [1, 10]."""
@@ -93,11 +89,10 @@ def main(argv=None) -> int:
     for oracle in oracles():
         for row in oracle_rows(oracle, TOLERANCES):
             row["k_n"] = oracle.k_n
-            row["judged"] = judged(row)
             data.append(row)
         print(f"{oracle.name}: {sum(1 for d in data if d['oracle'] == oracle.name)} rows", flush=True)
     os.makedirs(args.out, exist_ok=True)
-    keys = ("k_n",) + KEYS + ("judged",)
+    keys = ("k_n",) + KEYS
     csv_path = os.path.join(args.out, "penalty_effectivity.csv")
     write_csv(csv_path, list(keys), [[d[k] for k in keys] for d in data])
     plot(data, os.path.join(args.out, "penalty_effectivity.png"), oracles())

@@ -111,6 +111,24 @@ load's combined shares the contact fraction's error was 0.13 in the median, 0.34
 most, ``g_n``'s 0.66 and the stiffness's 0.61 at most, every load within its floor by 1.3 times or more, loads with
 a notch or island no grid point sees yet included (over the sum of the shares: 0.084, 0.24, 0.76).
 
+**The 3D line's crossings.**  In 3D each row and each column crossing a contact edge holds its own located edge,
+the root of the line through ``gap^(2/3)`` at its first two open points
+(:func:`~ngcontact.cell.spectral.grid_measures.row_weights`), off by a fraction ``delta_i`` of a step that changes
+with the crossing's position between points from row to row and from grid to grid.  Each such offset moves the
+located set by ``delta_i h`` along a row of width ``h``, so that with ``N`` crossings per direction (the two
+directions' weights are averaged) the contact fraction's error from them is ``sum_i delta_i h^2``.  Neighbouring
+rows cross one edge at nearby positions between points, so their offsets share a sign over stretches of the edge
+and add up rather than cancel: the bound is the sum, ``LINE_STEP N h^2`` for ``|delta_i| <= LINE_STEP``
+(:func:`crossing_share`; ``K0 = k_n |S| / |T|`` by ``k_n`` times that, ``g_n = k_n mean(1_S g0)`` by ``k_n
+LINE_STEP h^2`` times the sum of ``g0`` at the crossings' last contact points).  The offsets' size and sign jump
+between grids, so the differences may vanish while this error stalls (the bisinusoid of ``docs/benchmarks.md``,
+spectral effectivity, whose contact fraction at its lightest load errs by about the same on 256 and 512 points per
+direction while the difference between them is a sixth of it): it is a floor under the estimate of each quantity
+on the edges (:func:`island_floor`, form :data:`LINE`), which then need not hold the differences' tail to first
+order (:mod:`~ngcontact.cell.spectral.refinement`).  :data:`LINE_STEP` is calibrated on that bisinusoid (the
+mean ``|delta|`` its contact fraction's errors on 256 to 1024 points imply, against 4096 points, is at most 0.04
+of a step) and checked on random maps of 64 x 64 samples (``scripts/random_map_accuracy.py``).
+
 **A penalty's edges** (``contact.enforcement = "penalty"``) hold the floor of the penalty's zone, argued in
 :mod:`~ngcontact.cell.spectral.penalty_zone`.
 """
@@ -139,6 +157,10 @@ FITTED_STEP = 0.1
 QUADRATURE = 2.0
 #: with a penalty, the share of the stiffness's change with each edge a step out that bounds its error (same)
 STIFFNESS_STEP = 0.5
+#: the form of an estimate raised to the floor of the 3D line's crossings of the contact edges (module docstring)
+LINE = "line"
+#: the share of a step that bounds the mean offset of the 3D line's located crossings (module docstring)
+LINE_STEP = 0.05
 
 
 def on_edges(name: str) -> bool:
@@ -315,6 +337,25 @@ def stiffness_share(cell, p: np.ndarray, gap: np.ndarray) -> float:
                       [False] * len(steps))
 
 
+def crossing_share(cell, p: np.ndarray) -> dict[str, Any]:
+    """The share of each quantity on the edges held by the 3D line's located crossings of the contact edges of a
+    pressure ``p`` along the grid's rows and columns (module docstring): ``{"crossings": per direction, "share":
+    {headline name: absolute share}}``, ``LINE_STEP`` of a step per crossing, summed; no share in 2D."""
+    on = p > 0
+    if cell.dim != 3 or on.all() or not on.any():
+        return {"crossings": 0, "share": {}}
+    count, heights = 0.0, 0.0
+    for axis in (0, 1):
+        for step in (1, -1):
+            last = on & ~np.roll(on, -step, axis)             # last contact point before an edge
+            count += 0.5 * last.sum()
+            heights += 0.5 * float(cell.g0[last].sum())
+    share = LINE_STEP / p.size
+    return {"crossings": int(round(count)), "share": {"contact_fraction": share * count,
+                                                      COEFFICIENT + "k_n": cell.k_n * share * count,
+                                                      COEFFICIENT + "g_n": cell.k_n * share * heights}}
+
+
 def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict[str, Any]:
     """The share of each quantity on the edges held by the islands of fewer than :data:`ISLAND_POINTS`
     points of a pressure ``p`` (in 3D: points across, :func:`narrow_islands`; module docstring):
@@ -337,6 +378,8 @@ def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict
                            "kinks": kink_share(cell, p, gap) if gap is not None else {"edges": 0, "notches": 0,
                                                                                       "share": {}}}
     out["penalty"] = penalty_zone_share(cell, p, gap) if gap is not None else {"edges": 0, "share": {}, "inside": False}
+    if cell.dim == 3 and getattr(cell, "enforcement", "exact") == "exact":
+        out["line"] = crossing_share(cell, p)
     if out["kinks"]["share"] and gap is not None:
         out["kinks"]["share"]["normal_stiffness"] = stiffness_share(cell, p, gap)
     if count:
@@ -355,7 +398,8 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
     remarks = []
     for k, (per_load, unresolved) in enumerate(zip(estimates, last.get("islands", []))):
         for form, shares in ((ISLAND, unresolved["share"]), (KINK, unresolved.get("kinks", {}).get("share", {})),
-                             (PENALTY_ZONE, unresolved.get("penalty", {}).get("share", {}))):
+                             (PENALTY_ZONE, unresolved.get("penalty", {}).get("share", {})),
+                             (LINE, unresolved.get("line", {}).get("share", {}))):
             raised = []
             for name, share in shares.items():
                 if name in per_load and (floor := share / scale(name, last["headline"][k], last["whole_surface"])
@@ -367,6 +411,10 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                                f"points (in 3D across; the smallest island {unresolved['points']} point(s)) on grid "
                                f"{last['grid']}: {', '.join(raised)} bounded by their share, one step beyond each "
                                "edge")
+            elif raised and form == LINE:
+                remarks.append(f"load {k}: {unresolved['line']['crossings']} crossings of the contact edges per "
+                               f"direction on grid {last['grid']}: {', '.join(raised)} bounded by {LINE_STEP:g} of a "
+                               "step per crossing")
             elif raised and form == PENALTY_ZONE:
                 zone = unresolved["penalty"]
                 remarks.append(f"load {k}: {zone['edges']} contact edge(s) of the penalty located on grid "

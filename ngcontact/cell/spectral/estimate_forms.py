@@ -1,13 +1,15 @@
 """The forms of the spectral refinement's estimate, and the estimates that may be loose by much.
 
 :mod:`~ngcontact.cell.spectral.refinement` estimates the error of each headline quantity of a load on the
-reported grid ``k`` in one of six forms, which the report names: Richardson's tail with the observed rate
+reported grid ``k`` in one of seven forms, which the report names: Richardson's tail with the observed rate
 (:data:`RICHARDSON`), the guarded geometric tail (:data:`GUARDED`), the estimate of a deferred grid plus the
 last difference (:data:`CARRIED`), the share of contact islands too narrow for the grid
 (:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), a step at each 2D edge within a step of a kink of
-a map's piecewise-linear surface (:data:`~ngcontact.cell.spectral.contact_edges.KINK`), or a share of a penalty's
-length at each 2D edge located beyond it (:data:`~ngcontact.cell.spectral.penalty_zone.PENALTY_ZONE`). Each is a
-bound on its own argument; none is sharp where the error of grid ``k`` is far below the differences that bound it.
+a map's piecewise-linear surface (:data:`~ngcontact.cell.spectral.contact_edges.KINK`), a share of a penalty's
+length at each 2D edge located beyond it (:data:`~ngcontact.cell.spectral.penalty_zone.PENALTY_ZONE`), or a share
+of a step at each 3D crossing of an edge by a row or column (:data:`~ngcontact.cell.spectral.contact_edges.LINE`).
+Each is a bound on its own argument; none is sharp where the error of grid ``k`` is far below the differences
+that bound it.
 
 The last two differences ``d_(k-1)``, ``d_k`` (``d_k = q_k - q_(k-1)``) say how large that error is in the
 model every form rests on: where the levels beyond ``k`` contract as the last one did, by ``rho = |d_k| /
@@ -102,7 +104,7 @@ from __future__ import annotations
 from typing import Any
 
 from ngcontact.cell.cell_solution import scale
-from ngcontact.cell.spectral.contact_edges import ISLAND, KINK
+from ngcontact.cell.spectral.contact_edges import ISLAND, KINK, LINE, LINE_STEP
 from ngcontact.cell.spectral.penalty_zone import PENALTY_ZONE
 
 #: the forms of the estimate, as the report names them (:data:`CARRIED`: after a deferred stop, module
@@ -136,7 +138,8 @@ AGREE = 3.0
 SPREAD = 2.0
 #: why, per form of the estimate (module docstring)
 WHY_LOOSE = {GUARDED: "an earlier difference bounds it", CARRIED: "carried from the deferred grid",
-             KINK: "the contact edges of a map with kinks, bounded by a step at a kink, a quarter elsewhere"}
+             KINK: "the contact edges of a map with kinks, bounded by a step at a kink, a quarter elsewhere",
+             LINE: f"the 3D line's crossings of the contact edges, bounded by {LINE_STEP:g} of a step each"}
 
 
 def loose_flags(history: list[dict[str, Any]], estimates: list[dict[str, float]], forms: list[dict[str, str]]

@@ -7,8 +7,7 @@ it, converge as the grid step ``h`` shrinks.  How they converge decides the esti
 * the contact fraction has its edges located between points (:mod:`ngcontact.cell.spectral.grid_measures`; in
   3D along the rows and columns by the line): an error of order ``h`` whose constant jumps with the edges'
   position between points, in 2D faster once the edge fit holds;
-* the mean closure is a mean of the collocated jump: smoother, but its error changes sign as the grid
-  crosses the contact edges.
+* the mean closure is a mean of the collocated jump: smoother, but its error changes sign as the grid crosses the edges.
 
 So the sequence ``q_0, q_1, ...`` of a quantity on levels ``k`` has errors ``e_k = q_k - q`` that fall like ``rho^k``
 on the whole, but level to level by an erratic factor, and that may cross zero.  The estimate of the reported
@@ -41,19 +40,20 @@ names (:func:`sweep_estimates`):
    ``D = max_i |d_(k-i)| ENVELOPE^i`` with ``ENVELOPE = 1/2``: the last difference, or an earlier one shrunk at first
    order, whichever is larger, so that a last difference that vanished by coincidence (a symmetric cell gives the
    same fraction on two grids; an edge's offset whose constant jumps between grids) is bounded by the ones before
-   it; the tail ``D rho / (1 - rho)``, on the levels since where the last ratio is twice as fast
-   (:mod:`.estimate_forms`).
+   it; the tail ``D rho / (1 - rho)``, on the levels since after a ratio twice as fast (:mod:`.estimate_forms`).
 
 In 2D the contact fraction and the coefficients of eq. 34 rest on edges located between points by one of two locators
 (:func:`~ngcontact.cell.spectral.grid_measures.edge_offset`): the quartic fitted to the open gap where its window
 holds enough points and the fit explains the gap, else the line through the first two open points, whose root is off
-by a fraction of a step (first order, with a constant that jumps with the edges' position between points; in 3D
-every edge is the line's).  A window holding such levels takes the guarded bound for these quantities: two
-ratios of such differences agree by chance (an error that stalls over two grids, as on a profile with kinks,
-alternates as if geometric).  On a smooth gap the quartic takes over at a grid fixed by its window (every edge of a
-load: :func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`, recorded per level), and the error drops there by
-one to two orders of magnitude.  A difference between a level of the line and one of the quartic is the line's error,
-not a term of the quartic's sequence: the window then bounds the error by the line's, which exceeds it by that drop.
+by a fraction of a step (first order, with a constant that jumps with the edges' position between points).  A 2D
+window holding such levels takes the guarded bound for these quantities: two ratios of such differences agree by
+chance (an error that stalls over two grids, as on a profile with kinks, alternates as if geometric).  In 3D (exact
+contact) the line's offsets along the rows and columns hold a floor (``contact_edges``, form ``line``), above which
+the differences are read as any other quantity's, Richardson's rate the observed one (not held to first order).  On a
+smooth gap the quartic takes over at a grid fixed by its window (every edge of a load: :func:`~ngcontact.cell.spectral.
+grid_measures.edges_fitted`, recorded per level), and the error drops there by one to two orders of magnitude.  A
+difference between a level of the line and one of the quartic is the line's error, not a term of the quartic's
+sequence: the window then bounds the error by the line's, which exceeds it by that drop.
 So, for these quantities of a load whose edges have been fitted on the last ``r`` levels (:func:`fitted_run`), after
 levels of the line:
 
@@ -87,11 +87,10 @@ levels of the line:
 
 The coefficients of eq. 34 on the real contact set are integrals over it (:mod:`ngcontact.cell.spectral.grid_measures`:
 ``k_n`` times the contact fraction, ``k_n`` times the gap integrated over the set), with the set's 2D edges
-located between points as the contact fraction's: they converge as the fraction does and are estimated at
-its first order, and where the fraction's sequence of a load is not seen to be geometric (its estimate is
-the guarded bound) neither are theirs, whose errors are the same edges' misplacements: a coefficient's own
-two ratios may agree by chance where the edges' errors change sign, and its Richardson tail then misses an
-error that grows from one grid to the next.
+located between points as the contact fraction's: they converge as the fraction does and are estimated at its
+order, and where the fraction's sequence of a load is not seen to be geometric (its estimate is the guarded bound)
+neither are theirs, whose errors are the same edges' misplacements: a coefficient's own two ratios may agree by
+chance where the edges' errors change sign, and its Richardson tail then misses an error that grows between grids.
 
 The normal effective stiffness (:func:`~ngcontact.cell.spectral.grid_measures.effective_stiffness`) is in 3D that of
 the collocated contact set, whose pressure, singular like the inverse square root of the distance to an edge,
@@ -149,9 +148,9 @@ from typing import Any, Callable
 import numpy as np
 
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
-from ngcontact.cell.spectral.contact_edges import (FITTED_STEP, ISLAND_POINTS, LOCATED_STEP, QUADRATURE, fitted_run,
-                                                   island_floor, locator_kind, on_edges, resolved_run, unresolved_share,
-                                                   locator_changing as edges_changing)
+from ngcontact.cell.spectral.contact_edges import (FITTED_STEP, ISLAND_POINTS, LINE_STEP, LOCATED_STEP, QUADRATURE,
+                                                   fitted_run, island_floor, locator_kind, on_edges, resolved_run,
+                                                   unresolved_share, locator_changing as edges_changing)
 from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, DISAGREE, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP,
                                                     RATE_FLOOR, SAFETY, SPREAD, WINDOW, loose_flags, loose_remarks,
                                                     tail_estimate)
@@ -189,8 +188,9 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"rate the larger ratio held to [{RATE_FLOOR}, {RATE_CAP}], an earlier difference bounding a vanished "
        f"last one (after a last ratio {DISAGREE:g} times below the one before, the last three levels: the difference "
        f"before shrunk by {SAFETY:g} times that ratio, at most 1/2, the rate alike); the contact fraction, "
-       "coefficients and 2D stiffness (of the located set) guarded on levels of edges not all fitted by the quartic, "
-       f"and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
+       "coefficients and 2D stiffness (of the located set) guarded on levels of edges not all fitted by the quartic "
+       f"(3D exact: Richardson at the observed rate, at least {LINE_STEP:g} step per edge crossed by a row or column)"
+       f", and also on those fitted (at least {LOCATOR_LEVELS}; a stop waits for {MIN_LEVELS}), the smaller; after "
        "a deferred stop, the deferred grid's estimate plus the last difference where smaller; the effective "
        f"stiffness's estimate times {ERRATIC[STIFFNESS][2]:g} in 2D, held to the tolerance up to {STIFFNESS_LEVELS} "
        f"levels beyond the grid where the others met it while its estimate falling by {STIFFNESS_RATE:g} per level "
@@ -291,8 +291,9 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
             # not geometric: a coefficient where the fraction is not, a penalty's line within E*/k_n or zone ahead
             geometric = geometric_ok and not (name.startswith(COEFFICIENT) and form.get("contact_fraction") == GUARDED
                                               or located and locator_kind(history[-1], k) == INSIDE or ahead)
-            args = (measure(name) == RELATIVE, ORDER_RATE.get(name, FIRST_ORDER), size)
-            fitted = fitted_run(history, k) if located else len(history)
+            lined = located and bool(history[-1].get("islands", [{}] * (k + 1))[k].get("line", {}).get("share"))
+            args = (measure(name) == RELATIVE, 0.0 if lined else ORDER_RATE.get(name, FIRST_ORDER), size)
+            fitted = fitted_run(history, k) if located and not lined else len(history)
             run = min(fitted, resolved_run(history, k))        # levels of the quartic and of resolved islands
             out[name], form[name], note = tail_estimate(values, *args, geometric and fitted == len(history),
                                                          geometric_ok)
