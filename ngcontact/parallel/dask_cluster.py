@@ -253,15 +253,20 @@ class DaskCluster(Executor):
                 probe.cancel()
                 return self._here(fn, items, names, label, progress, fault, done, why)
             dask_payoff.remember_cost(self.address, "round_trip", trip)
-            payoff = dask_payoff.DaskPayoff(
-                clock.least_wall, len(items) - len(done), len(probe.workers),
-                dask_payoff.cost_seconds(self.address, "round_trip", trip),
-                dask_payoff.member_extra(self.address, clock.least_wall))
+            payoff = self._payoff(len(items) - len(done), len(probe.workers))
             probe.cancel()                 # done with: its results leave the workers
+            why = payoff.describe(len(done))
+            if payoff.repaid and not dask_payoff.wall_known(self.address) and payoff.rest > payoff.workers:
+                part = payoff.workers      # no ``w`` yet: one member per worker measures it first
+                done += self._cluster_map(fn, items[len(done):len(done) + part], names[len(done):len(done) + part],
+                                          label, shifted_progress(progress, len(done), len(items)), fault)
+                payoff = self._payoff(len(items) - len(done), payoff.workers)
+                why += (f"; the cluster having solved no member yet, the first {part} there measured a member's "
+                        f"time on a worker; then {payoff.describe(len(done) - part)}")
             if not payoff.repaid:
-                return self._here(fn, items, names, label, progress, fault, done, payoff.describe(len(done)))
-            self._where("dask", payoff.describe(len(done)))
-            log.debug("%s: %s", label, payoff.describe(len(done)))
+                return self._here(fn, items, names, label, progress, fault, done, why)
+            self._where("dask", why)
+            log.debug("%s: %s", label, why)
             rest = self._cluster_map(fn, items[len(done):], names[len(done):], label,
                                      shifted_progress(progress, len(done)), fault)
             return done + rest
@@ -270,12 +275,19 @@ class DaskCluster(Executor):
                     + (" while the cluster's workers imported their modules" if importing else ""))
         return done
 
+    def _payoff(self, rest: int, workers: int) -> dask_payoff.DaskPayoff:
+        """Condition (4) once connected (``K = 0``): the ``rest`` on the cluster's ``workers``, at the largest
+        trip and member's wall ratio this scheduler's record keeps (:mod:`ngcontact.parallel.dask_payoff`)."""
+        c = self.member_clock.least_wall
+        return dask_payoff.DaskPayoff(c, rest, workers, dask_payoff.largest_cost(self.address, "round_trip"),
+                                      dask_payoff.member_extra(self.address, c))
+
     def _ahead(self, member_seconds: float, rest: int) -> dask_payoff.DaskPayoff:
         """Condition (4) before the connection: its cost ``K`` (the connection and the probe's two trips), the
         cluster's workers, trip and extra time as this scheduler's record has them
         (:mod:`ngcontact.parallel.dask_payoff`)."""
         known = dask_payoff.measured_costs(self.address, "workers")
-        cost = functools.partial(dask_payoff.cost_seconds, self.address)
+        cost = functools.partial(dask_payoff.largest_cost, self.address)
         workers = max(1, round(statistics.median(known))) if known else rest
         return dask_payoff.DaskPayoff(member_seconds, rest, workers, cost("round_trip"),
                                       dask_payoff.member_extra(self.address, member_seconds),
