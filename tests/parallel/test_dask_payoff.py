@@ -153,6 +153,24 @@ def test_a_batch_whose_gain_lies_within_the_scatter_of_its_recorded_costs_stays_
     assert large.saving - large.cost == pytest.approx(0.9 - 3 * (0.03 + 0.09)) and large.repaid
 
 
+def test_a_batch_kept_here_by_its_recorded_ratio_alone_retires_the_oldest():
+    """A record whose ``w`` keeps a batch here would keep every later one too (a batch kept here measures
+    none): a batch that would go with ``e = 0`` retires the oldest ratio; one that the connection keeps here
+    (even at ``e = 0``) retires nothing."""
+    address = "tcp://127.0.0.1:5"
+    for w in (1.1, 3.0):
+        dask_payoff.remember_cost(address, "member_wall", w)
+    by_wall = dask_payoff.connected(address, 0.1, 6, 2)
+    assert not by_wall.repaid
+    dask_payoff.kept(address, by_wall)
+    assert dask_payoff.measured_costs(address, "member_wall") == [3.0]
+    by_connection = DaskPayoff(0.1, 6, 2, 0.01, 0.2, connect=0.5)
+    dask_payoff.kept(address, by_connection)
+    assert dask_payoff.measured_costs(address, "member_wall") == [3.0]
+    dask_payoff.kept(address, dask_payoff.connected(address, 0.1, 6, 2))
+    assert not dask_payoff.wall_known(address)          # the next batch measures the cluster afresh
+
+
 def test_a_dask_batch_too_small_to_repay_the_trips_runs_serially_and_says_why(dask):
     """Three members of 0.1 s: after two here, the last one alone saves nothing, on any number of workers:
     the run never connects (no dask.distributed client, no trip timed)."""
@@ -169,9 +187,10 @@ def test_a_small_batch_that_cannot_repay_the_connection_stays_here_and_connects_
     """The measured scan's batch: eight members of 0.1 s (timed at that, :class:`NominalClock`: a member
     timed slower here, on a busy machine, would make the saving the test weighs larger) on a cluster of two
     workers whose connection was timed at 0.45 s.  The other six would save 0.3 s on two workers, less than
-    the connection alone: the batch stays here, connecting nothing.  The same batch in a run already
-    connected (``K`` spent) goes there: the record's trips are a millisecond, its members' wall time there
-    that here."""
+    the connection alone: the batch stays here, connecting nothing.  Eight members of 0.3 s in a run
+    already connected (``K`` spent) go there: 0.9 s saved against three trips (the record's of a
+    millisecond, and the one timed now on the test machine: all count, at their largest), the members' wall
+    time there recorded as that here."""
     nominal(monkeypatch, 0.1)
     dask_payoff.remember_cost(dask.address, "connect", 0.45)
     dask_payoff.remember_cost(dask.address, "workers", 2.0)
@@ -184,7 +203,8 @@ def test_a_small_batch_that_cannot_repay_the_connection_stays_here_and_connects_
     for _ in range(4):
         dask_payoff.remember_cost(dask.address, "round_trip", 0.001)
     dask_payoff.remember_cost(dask.address, "member_wall", 1.0)
-    pids = dask.map(burn, [0.1] * 8, [f"m{k}" for k in range(8)], label="connected")
+    nominal(monkeypatch, 0.3)        # the trip timed now is decisive too (the largest): 0.9 s saved against 3 o
+    pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="connected")
     assert dask.describe()["batches"][-1]["executor"] == "dask" and os.getpid() not in pids[-4:]
 
 
@@ -213,7 +233,8 @@ def test_a_large_dask_batch_goes_to_the_cluster_after_its_first_two_members(dask
 def test_a_batch_whose_recorded_costs_scatter_across_the_break_even_stays_here(dask, monkeypatch):
     """Eight members of 0.1 s in a connected run, the cluster's member ratios recorded at 1.1, 1.2 and 2.0:
     at their median the other six would gain 0.3 - 3 (o + 0.02) s there, at the largest nothing (3 (o + 0.1) s
-    of trips and extra time against 0.3 s saved): the batch stays here."""
+    of trips and extra time against 0.3 s saved): the batch stays here, kept by the recorded ratios alone, and
+    the oldest of them retires."""
     nominal(monkeypatch, 0.1)
     dask.client  # noqa: B018 - connected by an earlier batch
     for w in (1.1, 1.2, 2.0):
@@ -222,7 +243,7 @@ def test_a_batch_whose_recorded_costs_scatter_across_the_break_even_stays_here(d
     assert pids == [os.getpid()] * 8
     batch = dask.describe()["batches"][-1]
     assert batch["executor"] == "serial" and "extra time on a worker (0.1 s)" in batch["decision"]
-    assert dask_payoff.measured_costs(dask.address, "member_wall") == [1.1, 1.2, 2.0]     # nothing sent
+    assert dask_payoff.measured_costs(dask.address, "member_wall") == [1.2, 2.0]     # nothing sent, 1.1 retired
 
 
 def test_a_cluster_that_solved_no_member_gets_one_per_worker_before_the_rest(dask, monkeypatch):
@@ -259,7 +280,7 @@ def test_a_cluster_found_slow_by_its_first_members_keeps_the_rest_here(dask, mon
 def test_a_cluster_whose_members_were_measured_slower_keeps_the_batch_here(dask, monkeypatch):
     """The same eight members, on a cluster whose record says a member takes four times its time here (a
     worker sharing busy cores): 0.9 s more there, so the rest stays here, and the decision names that extra
-    time."""
+    time.  That ratio alone kept it here: it retires, and the next batch measures the cluster afresh."""
     nominal(monkeypatch, 0.3)
     dask_payoff.remember_cost(dask.address, "member_wall", 4.0)
     pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="large")
@@ -267,6 +288,7 @@ def test_a_cluster_whose_members_were_measured_slower_keeps_the_batch_here(dask,
     batch = dask.describe()["batches"][-1]
     assert batch["executor"] == "serial" and "extra time on a worker (0.9 s)" in batch["decision"]
     assert batch["decision"].endswith(" in this process")    # after two members here (or three: connected)
+    assert not dask_payoff.wall_known(dask.address)
 
 
 def nap(seconds: float) -> int:
