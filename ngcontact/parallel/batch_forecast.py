@@ -182,23 +182,16 @@ class CostRecord:
         mid = len(costs) // 2
         return costs[mid] if len(costs) % 2 else 0.5 * (costs[mid - 1] + costs[mid])
 
-    def remember(self, kind: str, seconds: float | None, scope: str | None = None) -> None:
-        """Add a cost of ``kind`` to the record (a scope's entry beside the others'); ``None``: retire the
-        oldest instead."""
+    def remember(self, kind: str, seconds: float, scope: str | None = None) -> None:
+        """Add a cost of ``kind`` to the record (a scope's entry beside the others')."""
         entry = {k: self.measured(k, scope) for k in self.kinds}
-        entry[kind] = entry[kind][1:] if seconds is None else (entry[kind] + [float(seconds)])[-COSTS_KEPT:]
+        entry[kind] = (entry[kind] + [float(seconds)])[-COSTS_KEPT:]
         if scope is None:
             _write(self.file, entry)
         else:
             data = self._data()
             data[scope] = entry
             _write(self.file, data)
-
-
-    def retire(self, kind: str, scope: str | None = None) -> None:
-        """Drop the oldest cost of ``kind`` kept (none kept: nothing)."""
-        if self.measured(kind, scope):
-            self.remember(kind, None, scope)
 
 
 #: this machine's record of a local worker's costs (:data:`COSTS`)

@@ -25,9 +25,11 @@ address is also read without dask.distributed, :func:`tcp_host_port`).  A cluste
 """
 from __future__ import annotations
 
+import functools
 import logging
 import re
 import socket
+import statistics
 import time
 from typing import Any, Sequence
 
@@ -235,9 +237,8 @@ class DaskCluster(Executor):
             if len(done) < dask_payoff.MEASURED or len(done) == len(items):
                 continue
             if not probes:      # not connected: the connection is part of what the rest must repay
-                ahead = dask_payoff.ahead(self.address, clock.least_wall, len(items) - len(done))
+                ahead = self._ahead(clock.least_wall, len(items) - len(done))
                 if not ahead.repaid:
-                    dask_payoff.kept(self.address, ahead)
                     return self._here(fn, items, names, label, progress, fault, done, ahead.describe(len(done)))
                 probes.append(self._connect(label, fn))
                 probes[0].wait_warm(clock.least_wall)     # a warm cluster's imports: no member's time
@@ -259,13 +260,12 @@ class DaskCluster(Executor):
             if payoff.repaid and not dask_payoff.wall_known(self.address) and payoff.rest > payoff.workers:
                 part = payoff.workers      # no ``w`` yet: one member per worker measures it first
                 done += self._cluster_map(fn, items[len(done):len(done) + part], names[len(done):len(done) + part],
-                                          label, shifted_progress(progress, len(done), len(items)), fault)
+                                          label, shifted_progress(progress, len(done), len(items)), fault,
+                                          record=False)
                 payoff = dask_payoff.connected(self.address, clock.least_wall, len(items) - len(done),
-                                               payoff.workers)
+                                               payoff.workers, self.__dict__["_part_wall"])
                 why += (f"; the cluster having solved no member yet, the first {part} there measured a member's "
                         f"time on a worker; then {payoff.describe(len(done) - part)}")
-            elif not payoff.repaid:
-                dask_payoff.kept(self.address, payoff)
             if not payoff.repaid:
                 return self._here(fn, items, names, label, progress, fault, done, why)
             self._where("dask", why)
@@ -277,6 +277,18 @@ class DaskCluster(Executor):
         self._where("serial", f"all {len(done)} members solved here"
                     + (" while the cluster's workers imported their modules" if importing else ""))
         return done
+
+    def _ahead(self, member_seconds: float, rest: int) -> dask_payoff.DaskPayoff:
+        """Condition (4) before the connection: its cost ``K`` (the connection and the probe's two trips), the
+        cluster's workers, trip and extra time as this scheduler's record has them
+        (:mod:`ngcontact.parallel.dask_payoff`)."""
+        known = dask_payoff.measured_costs(self.address, "workers")
+        cost = functools.partial(dask_payoff.largest_cost, self.address)
+        workers = max(1, round(statistics.median(known))) if known else rest
+        return dask_payoff.DaskPayoff(member_seconds, rest, workers, cost("round_trip"),
+                                      dask_payoff.member_extra(self.address, member_seconds),
+                                      cost("connect", dask_payoff.CONNECT_ESTIMATE),
+                                      workers_known=bool(known), probe=2.0 * cost("round_trip"))
 
     def _connect(self, label: str, fn) -> dask_payoff.Probe:
         """Connect now (``K`` timed and recorded, and the cluster's workers) and start the batch's probe."""
@@ -295,7 +307,7 @@ class DaskCluster(Executor):
         return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
                                     shifted_progress(progress, len(done), len(items)), fault)
 
-    def _cluster_map(self, fn, items, names, label, progress, fault) -> list:
+    def _cluster_map(self, fn, items, names, label, progress, fault, record: bool = True) -> list:
         from distributed import as_completed
         client = self.client
         results: dict[int, Any] = {}
@@ -327,7 +339,8 @@ class DaskCluster(Executor):
             client.cancel(list(index))
             raise
         wall = dask_payoff.member_wall(seconds, self.member_clock.least_wall)
-        if wall is not None:             # ``w``: a member's wall time on a worker over the quickest here
+        self.__dict__["_part_wall"] = 1.0 if wall is None else wall
+        if wall is not None and record:  # ``w``: a member's wall time on a worker over the quickest here
             dask_payoff.remember_cost(self.address, "member_wall", wall)
         return [results[k] for k in range(len(items))]
 

@@ -60,29 +60,26 @@ recorded spread above them::
     G(K~, o~, w~)  >  (K+ - K~) + n ((o+ - o~) + (w+ - w~) c)                (5)
 
 (``~`` the medians): a batch whose forecast gain lies within the scatter of
-its own recorded costs stays here.  A bound that one slow batch sets would
-keep every later batch here that does not repay it, and a batch kept here
-measures no ``w``: so a batch kept here by its recorded ``w`` alone (one
-that (4) sends with ``e = 0``) retires the oldest ``w`` kept
-(:func:`kept`).  A slow ``w`` thus keeps at most
-:data:`~ngcontact.parallel.batch_forecast.COSTS_KEPT` batches here, then
-the cluster is measured afresh, as one that solved no member.
+its own recorded costs stays here.  The price is a bound that one slow
+batch sets: a cluster once measured that slow keeps the batches that do
+not repay it here until the last kept ``w`` have all been measured since,
+by batches whose gain exceeds it (a batch kept here measures no ``w``).
 
 Before the cluster has solved a member, no ``w`` is recorded, and none can
 be assumed (its workers may share this machine's busy cores, or be faster
 ones).  A batch whose rest (4) sends there at ``w = 1`` (its largest gain)
 then sends only one member per worker first (``W`` of them)
-and waits for them, its threads asleep: their wall seconds there over
-``c`` are this batch's ``w``, and (4) is read again for the rest with it
-(``K = 0``: spent), and recorded.  Those ``W`` members cost ``w c + o``
-there against ``W c`` here, so the part loses time only on a cluster with
-``w > W - o/c`` (a member more than ``W`` times slower there), and at most
-``(w - W) c + o``.  Each is its worker's first member of the batch and
-carries what a worker does once (imports the probe did not make, files
-read, caches filled): a ``w`` it sets too high keeps the next batch here
-and retires (above), and a warmer part or a rest sent there measures
-again.  A cluster steadily more than ``W`` times slower than here costs
-such a part every other batch, each at most that bound, never a rest.
+and waits for them, its threads asleep: their wall seconds there over ``c``
+are this batch's ``w``,
+and (4) is read again for the rest with it (``K = 0``: spent).  Those
+``W`` members cost ``w c + o`` there against ``W c`` here, so the part
+loses time only on a cluster with ``w > W - o/c`` (a member more than ``W``
+times slower there), and then at most ``(w - W) c + o``, not a batch's
+rest.  Each is its worker's first member of the batch and carries
+what a worker does once (the imports the probe did not make, files read,
+caches filled), so its ``w`` decides this batch's rest only and is not
+recorded: the ``w`` of a rest sent there is, over members most of which
+are not a worker's first; until one is, each batch sends such a part.
 The connection: the run's process imports dask.distributed and connects a
 client to the scheduler (most of a second, in this process, so every
 member waits for it) only for a batch whose rest repays that too; a run
@@ -117,7 +114,6 @@ every later look too.
 """
 from __future__ import annotations
 
-import dataclasses
 import importlib
 import math
 import pickle
@@ -253,31 +249,12 @@ def remember_cost(address: str, kind: str, seconds: float) -> None:
     RECORD.remember(kind, seconds, address)
 
 
-# ------------------------------------------------ (4) as a batch reads it
-def connected(address: str, member_seconds: float, rest: int, workers: int) -> DaskPayoff:
+def connected(address: str, member_seconds: float, rest: int, workers: int,
+              wall: float | None = None) -> DaskPayoff:
     """Condition (4) once connected (``K = 0``): the ``rest`` on the cluster's ``workers``, at the largest trip
-    and member's wall ratio the record of ``address`` keeps."""
-    return DaskPayoff(member_seconds, rest, workers, largest_cost(address, "round_trip"),
-                      member_extra(address, member_seconds))
-
-
-def ahead(address: str, member_seconds: float, rest: int) -> DaskPayoff:
-    """Condition (4) before the connection: its cost ``K`` (the connection and the probe's two trips), the
-    cluster's workers, trip and extra time as the record of ``address`` has them, at their largest; ``W`` the
-    ``rest`` where the record has no workers."""
-    known = measured_costs(address, "workers")
-    workers = max(1, round(statistics.median(known))) if known else rest
-    trip = largest_cost(address, "round_trip")
-    return DaskPayoff(member_seconds, rest, workers, trip, member_extra(address, member_seconds),
-                      largest_cost(address, "connect", CONNECT_ESTIMATE), workers_known=bool(known),
-                      probe=2.0 * trip)
-
-
-def kept(address: str, payoff: DaskPayoff) -> None:
-    """A batch that ``payoff`` keeps here: where its recorded ``w`` alone keeps it (it would go with ``e = 0``),
-    the oldest ``w`` kept for ``address`` retires."""
-    if dataclasses.replace(payoff, member_extra=0.0).repaid:
-        RECORD.retire("member_wall", address)
+    and member's wall ratio the record of ``address`` keeps (at ``wall``, a part's ``w``, where given)."""
+    extra = member_extra(address, member_seconds) if wall is None else (wall - 1.0) * member_seconds
+    return DaskPayoff(member_seconds, rest, workers, largest_cost(address, "round_trip"), extra)
 
 
 # ------------------------------------------------ the probe
