@@ -253,15 +253,23 @@ class DaskCluster(Executor):
                 probe.cancel()
                 return self._here(fn, items, names, label, progress, fault, done, why)
             dask_payoff.remember_cost(self.address, "round_trip", trip)
-            payoff = dask_payoff.DaskPayoff(
-                clock.least_wall, len(items) - len(done), len(probe.workers),
-                dask_payoff.cost_seconds(self.address, "round_trip", trip),
-                dask_payoff.member_extra(self.address, clock.least_wall))
+            payoff = dask_payoff.connected(self.address, clock.least_wall, len(items) - len(done),
+                                           len(probe.workers))
             probe.cancel()                 # done with: its results leave the workers
+            why = payoff.describe(len(done))
+            if payoff.repaid and not dask_payoff.wall_known(self.address) and payoff.rest > payoff.workers:
+                part = payoff.workers      # no ``w`` yet: one member per worker measures it first
+                done += self._cluster_map(fn, items[len(done):len(done) + part], names[len(done):len(done) + part],
+                                          label, shifted_progress(progress, len(done), len(items)), fault,
+                                          record=False)
+                payoff = dask_payoff.connected(self.address, clock.least_wall, len(items) - len(done),
+                                               payoff.workers, self.__dict__["_part_wall"])
+                why += (f"; the cluster having solved no member yet, the first {part} there measured a member's "
+                        f"time on a worker; then {payoff.describe(len(done) - part)}")
             if not payoff.repaid:
-                return self._here(fn, items, names, label, progress, fault, done, payoff.describe(len(done)))
-            self._where("dask", payoff.describe(len(done)))
-            log.debug("%s: %s", label, payoff.describe(len(done)))
+                return self._here(fn, items, names, label, progress, fault, done, why)
+            self._where("dask", why)
+            log.debug("%s: %s", label, why)
             rest = self._cluster_map(fn, items[len(done):], names[len(done):], label,
                                      shifted_progress(progress, len(done)), fault)
             return done + rest
@@ -275,7 +283,7 @@ class DaskCluster(Executor):
         cluster's workers, trip and extra time as this scheduler's record has them
         (:mod:`ngcontact.parallel.dask_payoff`)."""
         known = dask_payoff.measured_costs(self.address, "workers")
-        cost = functools.partial(dask_payoff.cost_seconds, self.address)
+        cost = functools.partial(dask_payoff.largest_cost, self.address)
         workers = max(1, round(statistics.median(known))) if known else rest
         return dask_payoff.DaskPayoff(member_seconds, rest, workers, cost("round_trip"),
                                       dask_payoff.member_extra(self.address, member_seconds),
@@ -299,7 +307,7 @@ class DaskCluster(Executor):
         return done + Executor._map(self, fn, items[len(done):], names[len(done):], label,
                                     shifted_progress(progress, len(done), len(items)), fault)
 
-    def _cluster_map(self, fn, items, names, label, progress, fault) -> list:
+    def _cluster_map(self, fn, items, names, label, progress, fault, record: bool = True) -> list:
         from distributed import as_completed
         client = self.client
         results: dict[int, Any] = {}
@@ -331,7 +339,8 @@ class DaskCluster(Executor):
             client.cancel(list(index))
             raise
         wall = dask_payoff.member_wall(seconds, self.member_clock.least_wall)
-        if wall is not None:             # ``w``: a member's wall time on a worker over the quickest here
+        self.__dict__["_part_wall"] = 1.0 if wall is None else wall
+        if wall is not None and record:  # ``w``: a member's wall time on a worker over the quickest here
             dask_payoff.remember_cost(self.address, "member_wall", wall)
         return [results[k] for k in range(len(items))]
 

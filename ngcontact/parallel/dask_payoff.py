@@ -34,10 +34,8 @@ that slowdown scales with the member while a trip's fixed costs are in
 ``o``, so one batch's ``w`` reads for another of other members.  Both are
 kept per scheduler address
 (:data:`COSTS_FILE`, the last :data:`~ngcontact.parallel.batch_forecast.COSTS_KEPT`
-of each) and the rule takes their medians, so one slow probe does not decide
-alone; ``w`` is 1 before the cluster has solved a batch, and ``e`` never less
-than 0: a cluster whose members measured faster than here (a faster
-machine) is not counted on.  Both sides are wall seconds, what the run
+of each), and ``e`` is never less than 0: a cluster whose members measured
+faster than here (a faster machine) is not counted on.  Both sides are wall seconds, what the run
 waits for here and there on the machines as other jobs load them now:
 the local rule's ``min(wall, CPU)`` here (:mod:`ngcontact.parallel.worker_payoff`,
 which reads the load from the free cores instead) would set a member's
@@ -46,18 +44,50 @@ a busy machine whose cluster would still finish it sooner.
 
 The cluster repays its trips when the rest ends sooner there::
 
-    c (r - ceil(r / W))  >  K + ceil(r / W) (o + e)                            (4)
+    c (r - n)  >  K + n (o + e),    n = ceil(r / W)                           (4)
 
 the time the workers save on the rest against the trips and extra time of
 the members each worker solves, and ``K``, the connection and the probe
-still to make: the run's process imports dask.distributed and connects a
+still to make.  The recorded costs scatter (the machines' other jobs, a
+worker's caches) as much as the gain of a small batch, so (4) is read at
+the largest of the kept ones, ``w+ = max w_i``, ``o+ = max o_i`` and the
+connection's ``K+``, not at their medians: the gain
+``G(K, o, w) = c (r - n) - K - n (o + (w - 1) c)`` falls as each cost grows,
+so ``G(K+, o+, w+) > 0`` holds only where the gain is positive at every
+cost recorded, that is where the gain at the medians exceeds the costs'
+recorded spread above them::
+
+    G(K~, o~, w~)  >  (K+ - K~) + n ((o+ - o~) + (w+ - w~) c)                (5)
+
+(``~`` the medians): a batch whose forecast gain lies within the scatter of
+its own recorded costs stays here.  The price is a bound that one slow
+batch sets: a cluster once measured that slow keeps the batches that do
+not repay it here until the last kept ``w`` have all been measured since,
+by batches whose gain exceeds it (a batch kept here measures no ``w``).
+
+Before the cluster has solved a member, no ``w`` is recorded, and none can
+be assumed (its workers may share this machine's busy cores, or be faster
+ones).  A batch whose rest (4) sends there at ``w = 1`` (its largest gain)
+then sends only one member per worker first (``W`` of them)
+and waits for them, its threads asleep: their wall seconds there over ``c``
+are this batch's ``w``,
+and (4) is read again for the rest with it (``K = 0``: spent).  Those
+``W`` members cost ``w c + o`` there against ``W c`` here, so the part
+loses time only on a cluster with ``w > W - o/c`` (a member more than ``W``
+times slower there), and then at most ``(w - W) c + o``, not a batch's
+rest.  Each is its worker's first member of the batch and carries
+what a worker does once (the imports the probe did not make, files read,
+caches filled), so its ``w`` decides this batch's rest only and is not
+recorded: the ``w`` of a rest sent there is, over members most of which
+are not a worker's first; until one is, each batch sends such a part.
+The connection: the run's process imports dask.distributed and connects a
 client to the scheduler (most of a second, in this process, so every
 member waits for it) only for a batch whose rest repays that too; a run
 whose batches all stay here never pays it, and so costs the serial run
 (:meth:`~ngcontact.parallel.dask_cluster.DaskCluster.start_on_demand`
 checks the address with a bare TCP connection instead).  ``K`` is the
-connection's wall seconds as last timed for the scheduler
-(:data:`CONNECT_ESTIMATE` before any) and two trips ``2 o`` of the probe,
+connection's wall seconds as timed for the scheduler (the largest kept,
+:data:`CONNECT_ESTIMATE` before any) and two trips ``2 o`` of the probe,
 which this process waits through before the rest leaves (the workers'
 imports confirmed, then the timed trip); 0 once connected: spent.
 Before the connection, ``W``, ``o`` and ``e`` are the scheduler's record
@@ -177,9 +207,16 @@ RECORD = batch_forecast.CostRecord(COSTS_FILE, COSTS)
 
 
 def member_extra(address: str, member_seconds: float) -> float:
-    """``e = (w - 1) c`` of (4) for members of ``member_seconds`` (``c``) each, ``w`` the median of the last
-    ``member_wall`` ratios measured at ``address`` (1 before any)."""
-    return (RECORD.median("member_wall", 1.0, address) - 1.0) * member_seconds
+    """``e = (w+ - 1) c`` of (4) for members of ``member_seconds`` (``c``) each, ``w+`` the largest of the last
+    ``member_wall`` ratios measured at ``address`` (1 before any: then the batch sends only a part first,
+    :func:`wall_known`)."""
+    return (largest_cost(address, "member_wall", 1.0) - 1.0) * member_seconds
+
+
+def wall_known(address: str) -> bool:
+    """Whether the cluster at ``address`` has a ``w`` recorded; without one, a batch (4) sends there sends one
+    member per worker first, whose wall seconds there measure it."""
+    return bool(RECORD.measured("member_wall", address))
 
 
 def member_wall(worker_seconds: Sequence[float], member_seconds: float) -> float | None:
@@ -200,10 +237,24 @@ def cost_seconds(address: str, kind: str, default: float = 0.0) -> float:
     return RECORD.median(kind, default, address)
 
 
+def largest_cost(address: str, kind: str, default: float = 0.0) -> float:
+    """The largest of the last costs of ``kind`` measured at ``address`` (``K+``, ``o+``, ``w+`` of (5)),
+    ``default`` before any."""
+    return max(RECORD.measured(kind, address), default=default)
+
+
 def remember_cost(address: str, kind: str, seconds: float) -> None:
     """Add a cost of ``kind`` measured at ``address`` to the record (the last
     :data:`~ngcontact.parallel.batch_forecast.COSTS_KEPT` of each kind are kept)."""
     RECORD.remember(kind, seconds, address)
+
+
+def connected(address: str, member_seconds: float, rest: int, workers: int,
+              wall: float | None = None) -> DaskPayoff:
+    """Condition (4) once connected (``K = 0``): the ``rest`` on the cluster's ``workers``, at the largest trip
+    and member's wall ratio the record of ``address`` keeps (at ``wall``, a part's ``w``, where given)."""
+    extra = member_extra(address, member_seconds) if wall is None else (wall - 1.0) * member_seconds
+    return DaskPayoff(member_seconds, rest, workers, largest_cost(address, "round_trip"), extra)
 
 
 # ------------------------------------------------ the probe

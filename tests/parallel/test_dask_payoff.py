@@ -85,17 +85,20 @@ def test_condition_4_weighs_the_saving_on_the_rest_against_the_trips_and_a_worke
 
 
 def test_a_members_extra_time_on_a_worker_is_its_wall_time_there_over_its_time_here(tmp_path):
-    """``w``: the median of the members' wall seconds on the workers over ``c`` (each worker's slow first
-    member left out), read as ``e = (w - 1) c`` for the members of another batch; 1, so ``e = 0``, before
-    any; a cluster measured faster is not counted on."""
+    """``w``: the median of a batch's members' wall seconds on the workers over ``c`` (each worker's slow first
+    member left out), read as ``e = (w+ - 1) c`` for the members of another batch, ``w+`` the largest kept
+    (the rule's bound, (5)); 1, so ``e = 0``, before any (and no ``w`` known); a cluster measured faster is
+    not counted on."""
     assert dask_payoff.member_wall([0.5, 0.25, 0.26, 0.27, 0.9], 0.25) == pytest.approx(1.08)
     assert dask_payoff.member_wall([], 0.25) is None and dask_payoff.member_wall([0.3], 0.0) is None
     address = "tcp://127.0.0.1:1"
-    assert dask_payoff.member_extra(address, 0.1) == 0.0
+    assert dask_payoff.member_extra(address, 0.1) == 0.0 and not dask_payoff.wall_known(address)
     for w in (1.2, 3.0, 1.3):
         dask_payoff.remember_cost(address, "member_wall", w)
-    assert dask_payoff.member_extra(address, 0.1) == pytest.approx(0.03)      # the median ratio, 1.3
-    assert dask_payoff.member_extra(address, 0.25) == pytest.approx(0.075)
+    assert dask_payoff.wall_known(address)
+    assert dask_payoff.member_extra(address, 0.1) == pytest.approx(0.2)       # the largest ratio, 3.0
+    assert dask_payoff.member_extra(address, 0.25) == pytest.approx(0.5)
+    assert dask_payoff.cost_seconds(address, "member_wall") == pytest.approx(1.3)     # the median, not decisive
     dask_payoff.remember_cost("tcp://127.0.0.1:2", "member_wall", 0.5)
     assert DaskPayoff(0.1, 6, 2, 0.01, dask_payoff.member_extra("tcp://127.0.0.1:2", 0.1)).member_extra == 0.0
 
@@ -118,6 +121,38 @@ def test_the_measured_scan_is_not_sent_to_a_cluster_whose_workers_share_the_core
     assert large.saving == pytest.approx(1.645) and large.cost == pytest.approx(0.74625) and large.repaid
 
 
+def test_a_batch_whose_gain_lies_within_the_scatter_of_its_recorded_costs_stays_here():
+    """(5): eight members of 0.1 s, six of them left on two workers (``n = 3``), connected.  The cluster's
+    member ratios were measured at 1.1, 1.2 and 2.0, its trips at 0.01 and 0.03 s.  At the medians the gain
+    is 0.3 - 3 (0.02 + 0.02) = 0.18 s, less than the recorded costs' spread above them,
+    3 (0.01 + 0.8 x 0.1) = 0.27 s: at the largest costs the cluster saves nothing, and the batch stays.  Members
+    of 0.3 s on a cluster whose ratios scatter from 1.0 to 1.3 gain 0.9 - 3 (0.03 + 0.09) = 0.54 s even at
+    the largest: they go."""
+    walls, trips = (1.1, 1.2, 2.0), (0.01, 0.03)
+    address = "tcp://127.0.0.1:3"
+    for w in walls:
+        dask_payoff.remember_cost(address, "member_wall", w)
+    for o in trips:
+        dask_payoff.remember_cost(address, "round_trip", o)
+
+    def payoff(c, address):
+        return DaskPayoff(c, 6, 2, dask_payoff.largest_cost(address, "round_trip"),
+                          dask_payoff.member_extra(address, c))
+
+    at_medians = DaskPayoff(0.1, 6, 2, 0.02, (1.2 - 1) * 0.1)
+    assert at_medians.repaid and at_medians.saving - at_medians.cost == pytest.approx(0.18)
+    scattered = payoff(0.1, address)
+    assert scattered.cost == pytest.approx(3 * (0.03 + 0.1)) and not scattered.repaid
+    assert at_medians.saving - at_medians.cost < 3 * ((0.03 - 0.02) + (2.0 - 1.2) * 0.1)          # (5) fails
+    clear = "tcp://127.0.0.1:4"
+    for w in (1.0, 1.3, 1.1):
+        dask_payoff.remember_cost(clear, "member_wall", w)
+    for o in trips:
+        dask_payoff.remember_cost(clear, "round_trip", o)
+    large = payoff(0.3, clear)
+    assert large.saving - large.cost == pytest.approx(0.9 - 3 * (0.03 + 0.09)) and large.repaid
+
+
 def test_a_dask_batch_too_small_to_repay_the_trips_runs_serially_and_says_why(dask):
     """Three members of 0.1 s: after two here, the last one alone saves nothing, on any number of workers:
     the run never connects (no dask.distributed client, no trip timed)."""
@@ -134,9 +169,10 @@ def test_a_small_batch_that_cannot_repay_the_connection_stays_here_and_connects_
     """The measured scan's batch: eight members of 0.1 s (timed at that, :class:`NominalClock`: a member
     timed slower here, on a busy machine, would make the saving the test weighs larger) on a cluster of two
     workers whose connection was timed at 0.45 s.  The other six would save 0.3 s on two workers, less than
-    the connection alone: the batch stays here, connecting nothing.  The same batch in a run already
-    connected (``K`` spent) goes there: the record's trips are a millisecond (one slow probe among them does
-    not move their median)."""
+    the connection alone: the batch stays here, connecting nothing.  Eight members of 0.3 s in a run
+    already connected (``K`` spent) go there: 0.9 s saved against three trips (the record's of a
+    millisecond, and the one timed now on the test machine: all count, at their largest), the members' wall
+    time there recorded as that here."""
     nominal(monkeypatch, 0.1)
     dask_payoff.remember_cost(dask.address, "connect", 0.45)
     dask_payoff.remember_cost(dask.address, "workers", 2.0)
@@ -148,17 +184,21 @@ def test_a_small_batch_that_cannot_repay_the_connection_stays_here_and_connects_
     dask.client  # noqa: B018 - connected by an earlier batch: its cost is spent
     for _ in range(4):
         dask_payoff.remember_cost(dask.address, "round_trip", 0.001)
-    pids = dask.map(burn, [0.1] * 8, [f"m{k}" for k in range(8)], label="connected")
+    dask_payoff.remember_cost(dask.address, "member_wall", 1.0)
+    nominal(monkeypatch, 0.3)        # the trip timed now counts too, at the largest: 0.9 s saved against 3 o
+    pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="connected")
     assert dask.describe()["batches"][-1]["executor"] == "dask" and os.getpid() not in pids[-4:]
 
 
 def test_a_large_dask_batch_goes_to_the_cluster_after_its_first_two_members(dask, monkeypatch):
-    """Eight members of 0.3 s: after two here, the connection is made (the other six would save 1.5 s on six
-    workers, against the connection's estimate of 0.5 s); at most one more member is solved here while the
-    workers' imports are confirmed; then 0.9 s saved on the other six (or 0.6 s on five), against trips of
-    milliseconds.  A member's wall time on a worker is recorded over its time here (0.3 s, as timed:
-    :class:`NominalClock`): at least 1, the member's thread burning 0.3 s there."""
+    """Eight members of 0.3 s, on a cluster whose members were measured as fast as here: after two here, the
+    connection is made (the other six would save 1.5 s on six workers, against the connection's estimate of
+    0.5 s); at most one more member is solved here while the workers' imports are confirmed; then 0.9 s saved
+    on the other six (or 0.6 s on five), against trips of milliseconds.  A member's wall time on a worker is
+    recorded over its time here (0.3 s, as timed: :class:`NominalClock`): at least 1, the member's thread
+    burning 0.3 s there."""
     nominal(monkeypatch, 0.3)
+    dask_payoff.remember_cost(dask.address, "member_wall", 1.0)
     seen = []
     pids = dask.map(burn, [0.3] * 8, [f"m{k}" for k in range(8)], label="large",
                     progress=lambda *a: seen.append(a[1:]))
@@ -167,9 +207,55 @@ def test_a_large_dask_batch_goes_to_the_cluster_after_its_first_two_members(dask
     assert seen == [(k, 8) for k in range(9)]                   # one count per member, wherever it ran
     batch = dask.describe()["batches"][-1]
     assert batch["executor"] == "dask" and f"the other {8 - here} on the cluster's 2 workers" in batch["decision"]
-    (trip,), (wall,), (connect,), (workers,) = (dask_payoff.measured_costs(dask.address, k)
-                                                for k in dask_payoff.COSTS)
+    (trip,), (_, wall), (connect,), (workers,) = (dask_payoff.measured_costs(dask.address, k)
+                                                   for k in dask_payoff.COSTS)
     assert 0.0 <= trip < 0.3 and wall >= 1.0 and 0.0 < connect < 5.0 and workers == 2.0
+
+
+def test_a_batch_whose_recorded_costs_scatter_across_the_break_even_stays_here(dask, monkeypatch):
+    """Eight members of 0.1 s in a connected run, the cluster's member ratios recorded at 1.1, 1.2 and 2.0:
+    at their median the other six would gain 0.3 - 3 (o + 0.02) s there, at the largest nothing (3 (o + 0.1) s
+    of trips and extra time against 0.3 s saved): the batch stays here."""
+    nominal(monkeypatch, 0.1)
+    dask.client  # noqa: B018 - connected by an earlier batch
+    for w in (1.1, 1.2, 2.0):
+        dask_payoff.remember_cost(dask.address, "member_wall", w)
+    pids = dask.map(burn, [0.1] * 8, [f"m{k}" for k in range(8)], label="scattered")
+    assert pids == [os.getpid()] * 8
+    batch = dask.describe()["batches"][-1]
+    assert batch["executor"] == "serial" and "extra time on a worker (0.1 s)" in batch["decision"]
+    assert dask_payoff.measured_costs(dask.address, "member_wall") == [1.1, 1.2, 2.0]     # nothing sent
+
+
+def test_a_cluster_that_solved_no_member_gets_one_per_worker_before_the_rest(dask, monkeypatch):
+    """Eight members of 0.3 s (waiting, so that their wall time there is theirs whatever the load) on a
+    cluster with no member's time recorded: after two here (or three), one member per worker measures ``w``
+    (about 1), and then the rest goes there too; only the rest's ``w`` is recorded (each of the part's members
+    was its worker's first)."""
+    nominal(monkeypatch, 0.3)
+    pids = dask.map(nap, [0.3] * 8, [f"m{k}" for k in range(8)], label="first")
+    here = pids.count(os.getpid())
+    assert here <= 3 and os.getpid() not in pids[here:]
+    batch = dask.describe()["batches"][-1]
+    assert batch["executor"] == "dask" and "the first 2 there measured a member's time" in batch["decision"]
+    assert f"the other {8 - here - 2} on the cluster's 2 workers" in batch["decision"]
+    (wall,) = dask_payoff.measured_costs(dask.address, "member_wall")
+    assert wall >= 1.0
+
+
+def test_a_cluster_found_slow_by_its_first_members_keeps_the_rest_here(dask, monkeypatch):
+    """Members timed at 0.1 s here that take 0.4 s on a worker (``w`` = 4), on a connected cluster with no
+    member's time recorded: the first two there measure it, and the rest (four members: 0.2 s saved against
+    2 (o + 0.3) s) stays here.  What the part cost is bounded: two members, not the rest."""
+    nominal(monkeypatch, 0.1)
+    dask.client  # noqa: B018 - connected by an earlier batch
+    pids = dask.map(nap, [0.4] * 8, [f"m{k}" for k in range(8)], label="slow")
+    here = [k for k, pid in enumerate(pids) if pid == os.getpid()]
+    assert len(here) == 6 and len(set(pids) - {os.getpid()}) == 2 and here[-3:] == [5, 6, 7]
+    batch = dask.describe()["batches"][-1]
+    assert batch["executor"] == "serial" and batch["decision"].endswith(" in this process")
+    assert "the first 2 there measured a member's time" in batch["decision"]
+    assert not dask_payoff.wall_known(dask.address)     # the part's ``w`` decides its own batch only
 
 
 def test_a_cluster_whose_members_were_measured_slower_keeps_the_batch_here(dask, monkeypatch):
@@ -199,7 +285,7 @@ def test_a_worker_member_that_waits_for_its_cores_is_recorded_by_its_wall_time(d
     nominal(monkeypatch, 0.3)
     pids = dask.map(nap, [0.3] * 8, [f"m{k}" for k in range(8)], label="waiting")
     assert dask.describe()["batches"][-1]["executor"] == "dask" and os.getpid() not in pids[-4:]
-    (wall,) = dask_payoff.measured_costs(dask.address, "member_wall")
+    (wall,) = dask_payoff.measured_costs(dask.address, "member_wall")       # the rest's, not the part's
     assert wall >= 1.0
 
 
