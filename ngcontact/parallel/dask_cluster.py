@@ -118,6 +118,7 @@ class DaskCluster(Executor):
         self._client: Any = None      # the distributed Client, connected on first use
         self._modules: tuple[str, ...] = ()   # what the workers import before a batch's members
         self.judged = False           # the run's batches: the rest of each goes to the cluster only where repaid
+        self._part_wall = 1.0         # ``w`` of the last members sent (dask_payoff: a fresh cluster's part)
 
     @property
     def client(self):
@@ -263,7 +264,7 @@ class DaskCluster(Executor):
                                           label, shifted_progress(progress, len(done), len(items)), fault,
                                           record=False)
                 payoff = dask_payoff.connected(self.address, clock.least_wall, len(items) - len(done),
-                                               payoff.workers, self.__dict__["_part_wall"])
+                                               payoff.workers, self._part_wall)
                 why += (f"; the cluster having solved no member yet, the first {part} there measured a member's "
                         f"time on a worker; then {payoff.describe(len(done) - part)}")
             if not payoff.repaid:
@@ -339,7 +340,7 @@ class DaskCluster(Executor):
             client.cancel(list(index))
             raise
         wall = dask_payoff.member_wall(seconds, self.member_clock.least_wall)
-        self.__dict__["_part_wall"] = 1.0 if wall is None else wall
+        self._part_wall = 1.0 if wall is None else wall
         if wall is not None and record:  # ``w``: a member's wall time on a worker over the quickest here
             dask_payoff.remember_cost(self.address, "member_wall", wall)
         return [results[k] for k in range(len(items))]
