@@ -99,8 +99,12 @@ process, its record saying why (as the local rule's does); so does a batch
 whose probe fails (a worker that cannot import the members' module).  A
 batch that stays here cancels its probe, whose tasks import no further
 module once cancelled (:meth:`Probe.cancel`).  Before
-timing the trips, the probe imports the members' modules on every worker
-(each worker's first member would otherwise pay it), while this process goes
+timing the trips, the probe imports the members' modules on every worker,
+and then every top-level package loaded in this process (:func:`loaded_packages`):
+a member imports lazily what the scene's load imported here (a measured
+scan's reader and its dependencies cost its first solve on a fresh worker
+several times a member's time), and each worker's first member would otherwise
+pay it, unseen by the ``w`` of other batches; meanwhile this process goes
 on solving members (a warm cluster's imports, a trip once connected, are
 waited for, up to one member's time ``c``: then the rest is the ``r`` that (4)
 weighed before the connection, not one member less); (4) is read once that is done and at least
@@ -118,6 +122,7 @@ import importlib
 import math
 import pickle
 import statistics
+import sys
 import time
 from dataclasses import dataclass
 from typing import Any, Sequence
@@ -258,11 +263,13 @@ def connected(address: str, member_seconds: float, rest: int, workers: int,
 
 
 # ------------------------------------------------ the probe
-def probe_task(modules: Sequence[str], item: Any, nbytes: int) -> tuple[float, bytes]:
-    """On a worker: its start as a member's (one thread), ``modules`` imported, ``item`` received; returns the
-    seconds this took on the worker and ``nbytes`` bytes (a member's result's size).  A probe cancelled while
-    it runs (its batch stayed in the run's process) starts and imports nothing more: Dask cannot stop a
-    running task, so the task looks before each step (:func:`cancelled`)."""
+def probe_task(modules: Sequence[str], item: Any, nbytes: int, loaded: Sequence[str] = ()) -> tuple[float, bytes]:
+    """On a worker: its start as a member's (one thread), ``modules`` imported (a failure fails the probe), then
+    the packages ``loaded`` in the run's process (:func:`loaded_packages`; one that does not import here is
+    passed over), ``item`` received; returns the seconds this took on the worker and ``nbytes`` bytes (a
+    member's result's size).  A probe cancelled while it runs (its batch stayed in the run's process) starts
+    and imports nothing more: Dask cannot stop a running task, so the task looks before each step
+    (:func:`cancelled`)."""
     t0 = time.perf_counter()
     if not in_worker() and not cancelled():
         one_thread(ignore_sigint=False)
@@ -271,7 +278,22 @@ def probe_task(modules: Sequence[str], item: Any, nbytes: int) -> tuple[float, b
             break
         if module != "__main__":
             importlib.import_module(module)
+    for package in loaded:
+        if cancelled():
+            break
+        try:
+            importlib.import_module(package)
+        except Exception:  # a package of the run's process a worker lacks: its members lack it too
+            pass
     return time.perf_counter() - t0, bytes(nbytes)
+
+
+def loaded_packages() -> tuple[str, ...]:
+    """The top-level packages loaded in this process (private ones and ``__main__`` left out): what a member
+    may import lazily (a file format's reader and its dependencies, imported by the scene's load here and by
+    the member's first solve on a worker), which the probe imports on the workers beforehand."""
+    return tuple(sorted({name.partition(".")[0] for name in list(sys.modules)
+                         if not name.startswith("_") and name.partition(".")[0] != "__main__"}))
 
 
 def cancelled() -> bool:
@@ -305,8 +327,8 @@ class Probe:
         self._warming: list = []
         self._sent: list = []         # every probe task submitted, until cancelled
 
-    def _submit(self, modules, item, nbytes) -> list:
-        futures = [self.client.submit(probe_task, tuple(modules), item, nbytes, workers=[w],
+    def _submit(self, modules, item, nbytes, loaded: Sequence[str] = ()) -> list:
+        futures = [self.client.submit(probe_task, tuple(modules), item, nbytes, tuple(loaded), workers=[w],
                                       allow_other_workers=False, pure=False,
                                       key=f"ngcontact-probe-{self.label}-{k}-{time.time_ns()}")
                    for k, w in enumerate(self.workers)]
@@ -314,8 +336,9 @@ class Probe:
         return futures
 
     def warm(self, modules: Sequence[str]) -> None:
-        """Every worker imports ``modules`` now (in the background)."""
-        self._warming = self._submit(modules, None, 0)
+        """Every worker imports ``modules`` now (in the background), then the packages this process has loaded
+        (:func:`loaded_packages`)."""
+        self._warming = self._submit(modules, None, 0, loaded_packages())
 
     def warm_done(self) -> bool:
         return all(f.done() for f in self._warming)

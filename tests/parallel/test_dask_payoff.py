@@ -385,3 +385,29 @@ def kept_probes(dask_worker) -> list:
 
 def test_a_probe_outside_a_dask_task_is_never_cancelled():
     assert dask_payoff.cancelled() is False
+
+
+def test_a_package_this_process_loaded_is_imported_on_the_workers_before_a_member_needs_it(cluster):
+    """A member imports lazily what the scene's load imported in the run's process (a measured scan's reader):
+    the probe's warm-up imports every package loaded here on each worker first."""
+    distributed = pytest.importorskip("distributed")
+
+    def has(name):
+        return name in sys.modules
+
+    with distributed.Client(cluster, set_as_default=False) as client:
+        assert not any(client.run(has, "mailbox").values())      # the workers have not imported it
+        import mailbox  # noqa: F401  (a package of this process only, as a scan's reader in a run)
+        assert "mailbox" in dask_payoff.loaded_packages()
+        probe = dask_payoff.Probe(client, "loaded")
+        probe.warm(())
+        assert probe.wait_warm(60.0)
+        assert all(client.run(has, "mailbox").values())
+        probe.cancel()
+
+
+def test_a_loaded_package_a_worker_cannot_import_does_not_fail_the_probe():
+    seconds, result = dask_payoff.probe_task((), None, 3, ("no_package_of_this_name", "colorsys"))
+    assert result == bytes(3) and seconds >= 0.0 and "colorsys" in sys.modules
+    with pytest.raises(ImportError):                      # the members' own modules still must import
+        dask_payoff.probe_task(("no_package_of_this_name",), None, 0)
