@@ -142,6 +142,7 @@ from scipy import ndimage
 from ngcontact.cell.cell_solution import COEFFICIENT, scale
 from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset, edge_stiffness, kinks
 from ngcontact.cell.spectral.penalty_zone import INSIDE, INSIDE_STEP, PENALTY_LOG, PENALTY_ZONE, penalty_zone_share
+from ngcontact.cell.spectral.quartic_spread import FIT, SPREAD_STEPS, fit_share
 
 #: the fewest collocation points of a resolved 2D contact island (module docstring)
 ISLAND_POINTS = 4
@@ -380,6 +381,8 @@ def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict
     out["penalty"] = penalty_zone_share(cell, p, gap) if gap is not None else {"edges": 0, "share": {}, "inside": False}
     if cell.dim == 3 and getattr(cell, "enforcement", "exact") == "exact":
         out["line"] = crossing_share(cell, p)
+    elif gap is not None:
+        out["fit"] = fit_share(cell, p, gap)
     if out["kinks"]["share"] and gap is not None:
         out["kinks"]["share"]["normal_stiffness"] = stiffness_share(cell, p, gap)
     if count:
@@ -399,7 +402,8 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
     for k, (per_load, unresolved) in enumerate(zip(estimates, last.get("islands", []))):
         for form, shares in ((ISLAND, unresolved["share"]), (KINK, unresolved.get("kinks", {}).get("share", {})),
                              (PENALTY_ZONE, unresolved.get("penalty", {}).get("share", {})),
-                             (LINE, unresolved.get("line", {}).get("share", {}))):
+                             (LINE, unresolved.get("line", {}).get("share", {})),
+                             (FIT, unresolved.get("fit", {}).get("share", {}))):
             raised = []
             for name, share in shares.items():
                 if name in per_load and (floor := share / scale(name, last["headline"][k], last["whole_surface"])
@@ -415,6 +419,10 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                 remarks.append(f"load {k}: {unresolved['line']['crossings']} crossings of the contact edges per "
                                f"direction on grid {last['grid']}: {', '.join(raised)} bounded by {LINE_STEP:g} of a "
                                "step per crossing")
+            elif raised and form == FIT:
+                remarks.append(f"load {k}: {unresolved['fit']['edges']} edge(s) located by the quartic on grid "
+                               f"{last['grid']}, {unresolved['fit']['steps']:.3g} step(s) apart from its half "
+                               f"window's: {', '.join(raised)} bounded by {SPREAD_STEPS:g} times that spread")
             elif raised and form == PENALTY_ZONE:
                 zone = unresolved["penalty"]
                 remarks.append(f"load {k}: {zone['edges']} contact edge(s) of the penalty located on grid "

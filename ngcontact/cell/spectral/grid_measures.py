@@ -192,27 +192,40 @@ def edge_offset(root: np.ndarray, on: np.ndarray, i: int, step: int,
     ``1 / EDGE_REACH_SHARE`` of the way to the other end of the edge's
     contact patch and to the nearest kink (module docstring).
     """
+    offset = float(line_offset(root[(i + step) % root.size], root[(i + 2 * step) % root.size],
+                               not on[(i + 2 * step) % root.size]))
+    lo, hi = edge_window(root, on, i, step, at)
+    fitted = quartic_root(root, i, step, lo, hi, offset) if hi - lo >= EDGE_MIN_POINTS else None
+    return (offset, False) if fitted is None else (fitted, True)
+
+
+def edge_window(root: np.ndarray, on: np.ndarray, i: int, step: int,
+                at: np.ndarray | None = None) -> tuple[int, int]:
+    """The quartic's window ``[lo, hi)`` in steps beyond the last contact point ``i`` (:func:`edge_offset`, module
+    docstring): at most ``EDGE_WINDOW``, a sixteenth of the open run ahead, half the way to the patch's other end
+    and to the nearest kink."""
     n = root.size
-    offset = float(line_offset(root[(i + step) % n], root[(i + 2 * step) % n], not on[(i + 2 * step) % n]))
     ahead = (i + step * np.arange(1, n)) % n
     run = int(np.argmax(on[ahead])) if on[ahead].any() else n - 1     # open points before the next contact
     patch = int(np.argmin(on[(i - step * np.arange(n)) % n]))         # contact points back to the patch's end
     kink = int(np.abs((at - i + n // 2) % n - n // 2).min()) if at is not None and at.size else n
     hi = min(EDGE_WINDOW[1], run // EDGE_RUN_SHARE, patch // EDGE_REACH_SHARE, kink // EDGE_REACH_SHARE)
-    lo = max(EDGE_WINDOW[0] * hi // EDGE_WINDOW[1], 2)
-    if hi - lo < EDGE_MIN_POINTS:
-        return offset, False
+    return max(EDGE_WINDOW[0] * hi // EDGE_WINDOW[1], 2), hi
+
+
+def quartic_root(root: np.ndarray, i: int, step: int, lo: int, hi: int, near: float) -> float | None:
+    """The root nearest ``near`` (in steps beyond ``i``, within half a step of the last contact point and the
+    first open point) of the least-squares quartic of ``root`` on the window ``[lo, hi)``; ``None`` where the fit
+    misses ``root`` by more than ``EDGE_FIT_RTOL`` of its size or has no such root (module docstring)."""
     t = np.arange(lo, hi, dtype=float)
-    r = root[(i + step * np.arange(lo, hi)) % n]
+    r = root[(i + step * np.arange(lo, hi)) % root.size]
     coef, misfit, *_ = np.polyfit(t, r, 4, full=True)
     if not misfit.size or np.sqrt(misfit[0] / t.size) > EDGE_FIT_RTOL * float(r.max()):
-        return offset, False
+        return None
     roots = np.roots(coef)
     real = roots[np.abs(roots.imag) <= 1e-9 * np.abs(roots)].real
     real = real[(real >= -0.5) & (real <= 1.5)]
-    if real.size == 0:
-        return offset, False
-    return float(real[np.argmin(np.abs(real - offset))]), True
+    return float(real[np.argmin(np.abs(real - near))]) if real.size else None
 
 
 def kinks(g0: np.ndarray) -> np.ndarray:

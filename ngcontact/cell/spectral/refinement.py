@@ -54,8 +54,7 @@ smooth gap the quartic takes over at a grid fixed by its window (every edge of a
 grid_measures.edges_fitted`, recorded per level), and the error drops there by one to two orders of magnitude.  A
 difference between a level of the line and one of the quartic is the line's error, not a term of the quartic's
 sequence: the window then bounds the error by the line's, which exceeds it by that drop.
-So, for these quantities of a load whose edges have been fitted on the last ``r`` levels (:func:`fitted_run`), after
-levels of the line:
+So for these quantities of a load whose edges were fitted on the last ``r`` levels (:func:`fitted_run`), after the line:
 
 * with ``r >= LOCATOR_LEVELS`` (two differences at least, so that one that vanished is seen beside the
   other) the estimate is also taken on those ``r`` levels alone, by the same rule (Richardson needs three
@@ -113,12 +112,13 @@ Two checks end a level's estimate. An island of fewer than :data:`~ngcontact.cel
 points (3D: across) has no resolved edges: its error may stall while the differences vanish, so its share of the
 quantities on the edges is a floor under their estimates (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`,
 form ``island``; a 2D edge of a map with kinks, a step within a step of one, else a quarter: ``kink``; a penalty's 2D
-edge located on points beyond its length ``E*/k_n``: ``penalty zone``, whose error no difference shows either); a window
-across the level where the last island came to be resolved is also taken on the resolved levels alone, the smaller
-reported (the same module's docstring). An estimate (not Richardson's nor an island's) above
-:data:`~ngcontact.cell.spectral.estimate_forms.LOOSE` times the error its last difference leaves at the last
-contraction, or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much:
-flagged with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
+edge located on points beyond its length ``E*/k_n``: ``penalty zone``, whose error no difference shows either; a 2D
+edge the quartic located, twice its root's spread from the quartic on half its window, whose error stalls while the
+patch sets the window's length: ``fit``, :mod:`.quartic_spread`); a window across the level where the last island
+was resolved is also taken on the resolved levels alone, the smaller reported. An estimate (not Richardson's nor
+a share of stalled edges) above :data:`.LOOSE` times the error its last difference leaves at the last contraction,
+or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much: flagged
+with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
 Levels double the points per direction (:data:`GROWTH`): three differences cost twice the finest level in 2D, 4/3 in 3D.
 Its effectivity (estimate over the true error of the reported level) is measured by
