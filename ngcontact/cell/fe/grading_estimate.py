@@ -99,6 +99,10 @@ lie between 1 and 10 at ``p/p* = 0.05`` and ``0.5``, the stiffness's at 0.5
 (``tests/cell/test_graded_finer_reference.py``).  Its penalty stiffness, by the sum of its tails, bounds its
 error at both loads, within 10 times at 0.5; at 0.05 its error lies far below the set's share the estimate took
 before, and below its own grading's tail too (the section ``graded_effectivity`` of ``docs/benchmarks.md``).
+Sharper rules tried on that section's recorded levels (the larger of the stiffness's two tails instead of their
+sum, its grading's tail scaled by the orders' contraction, exact contact's set share alone, the orders' tail
+without its safety factor) each take some estimate there below its error
+(``tests/cell/test_graded_recorded_levels.py``).
 """
 from __future__ import annotations
 
