@@ -113,9 +113,9 @@ points (3D: across) has no resolved edges: its error may stall while the differe
 quantities on the edges is a floor under their estimates (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`,
 form ``island``; a 2D edge of a map with kinks, a step within a step of one, else a quarter: ``kink``; a penalty's 2D
 edge located on points beyond its length ``E*/k_n``: ``penalty zone``, whose error no difference shows either; a 2D
-edge the quartic located, twice its root's spread from the quartic on half its window, whose error stalls while the
-patch sets the window's length: ``fit``, :mod:`.quartic_spread`); a window across the level where the last island
-was resolved is also taken on the resolved levels alone, the smaller reported. An estimate (not Richardson's nor
+edge of a map without kinks, its quartic's spread from its half window's or the line's share of a step: ``smooth``,
+:mod:`.smooth_edges`); a window across the level where the last island was resolved is also taken on the resolved
+levels alone, the smaller reported. An estimate (not Richardson's nor
 a share of stalled edges) above :data:`.LOOSE` times the error its last difference leaves at the last contraction,
 or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much: flagged
 with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
@@ -298,7 +298,7 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
             out[name], form[name], note = tail_estimate(values, *args, geometric and fitted == len(history),
                                                          geometric_ok)
             if LOCATOR_LEVELS <= run < len(history):
-                sharp = tail_estimate(values[-run:], *args, geometric, geometric_ok)
+                sharp = tail_estimate(values[-run:], *args, geometric, geometric_ok, run == fitted > WINDOW)
                 if sharp[0] < out[name]:
                     out[name], form[name], note = sharp[0], sharp[1], "; ".join(filter(None, (sharp[2], (
                         "the edge fit's own levels" if run == fitted else "the levels of resolved islands"))))
