@@ -181,6 +181,13 @@ def fitted_run(history: list[dict[str, Any]], k: int) -> int:
     return run
 
 
+def stall_floored(entry: dict[str, Any], k: int) -> bool:
+    """Whether load ``k``'s 2D located edges on the level ``entry`` hold a floor against their stall: a share of a
+    map with kinks' edges or of a smooth map's (:mod:`~ngcontact.cell.spectral.smooth_edges`)."""
+    held = entry.get("islands", [{}] * (k + 1))[k]
+    return bool(held.get("kinks", {}).get("share") or held.get("smooth", {}).get("share"))
+
+
 def locator_kind(entry: dict[str, Any], k: int) -> str | None:
     """How a level located the edges of load ``k``: ``"quartic"``, ``"inside"`` (a penalty's edges, all by the
     line on points within its length) or ``None`` (the line elsewhere)."""

@@ -86,12 +86,13 @@ order: ``d_(k-1)`` may have vanished by coincidence, the error stalling over lev
 levels whose 2D edges the quartic located (``since`` in :func:`tail_estimate`; the located quantities' estimate on
 the quartic's own levels, :mod:`~ngcontact.cell.spectral.refinement`) such a stall of the edges is the quartic's
 own, of a window whose length the patch sets, and the floor of the edges' spread from their half window's bounds it
-(:mod:`~ngcontact.cell.spectral.smooth_edges`; on a map with kinks its steps per edge,
-:mod:`~ngcontact.cell.spectral.contact_edges`).  So there the slowing sequence, the last contraction
-:data:`DISAGREE` times slower than the one before or more and at most :data:`RATE_CAP`, takes the guarded bound on
-the levels since the fast contraction, ``max(|d_k|, ENVELOPE |d_(k-1)|) rho / (1 - rho)``, where smaller: on
-Westergaard's sinusoid at light loads the whole window carried the line's last difference onto the quartic's
-levels, far above their error (``docs/benchmarks.md``, the spectral effectivity).
+(:mod:`~ngcontact.cell.spectral.smooth_edges`, exact contact; on a map with kinks its steps per edge,
+:mod:`~ngcontact.cell.spectral.contact_edges`; a load without either, a penalty's on a smooth map, keeps the whole
+window: :func:`~ngcontact.cell.spectral.contact_edges.stall_floored`).  So there the slowing sequence, the last
+contraction :data:`DISAGREE` times slower than the one before or more and at most :data:`RATE_CAP`, takes the
+guarded bound on the levels since the fast contraction, ``max(|d_k|, ENVELOPE |d_(k-1)|) rho / (1 - rho)``, where
+smaller: on Westergaard's sinusoid at light loads the whole window carried the line's last difference onto the
+quartic's levels, far above their error (``docs/benchmarks.md``, the spectral effectivity).
 
 **A slowing sequence within Richardson's band.**  Two contractions within :data:`AGREE` of each other take
 Richardson's tail, and the last may still be :data:`DISAGREE` times slower than the one before (``2 c' <= c
