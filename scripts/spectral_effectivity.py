@@ -12,7 +12,8 @@ between 1 and 10 on every oracle); the form of each estimate (Richardson, the gu
 a grid where a stop waited, the share of unresolved contact islands, or a step at each 2D edge within a step
 of a kink of the profile's piecewise-linear interpolant, a quarter step at every other edge of such a map (a
 tenth where the quartic located it; a load's edges twice their root-sum-square where below their sum), and
-the 2D stiffness of the located set as many steps of its change with each edge a step out), the true error of
+the 2D stiffness of the located set as many steps of its change with each edge a step out, or on a map without
+kinks the quartic's spread from its half window's, a quarter step where the line located the edge), the true error of
 the grid twice as fine, whether the reported one is small by chance, and the estimator's own flag where it
 states that its estimate may exceed the error by more than ten times (``ngcontact.cell.spectral.estimate_forms``)
 are listed beside it.
@@ -65,6 +66,7 @@ from ngcontact.cell.spectral.contact_edges import LINE_STEP  # noqa: E402
 from ngcontact.cell.spectral.grid_measures import coefficients, contact_weights  # noqa: E402
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell  # noqa: E402
 from ngcontact.cell.spectral.refinement import sweep_to_tolerance  # noqa: E402
+from ngcontact.cell.spectral.smooth_edges import SPREAD_STEPS  # noqa: E402
 from ngcontact.errors import ConvergenceError  # noqa: E402
 from ngcontact.geometry.random_surface import self_affine  # noqa: E402
 from ngcontact.output.writer import write_csv  # noqa: E402
@@ -337,7 +339,10 @@ def main(argv=None) -> int:
                               "half, the first one dropped): column `form`; the contact "
                               "fraction and coefficients guarded on levels whose edges are not all located by the "
                               "quartic (2D; in 3D see `line`), and in 2D also estimated on the levels whose "
-                              "edges the quartic located, a stop to the tolerance waiting for four of them; on the "
+                              "edges the quartic located, a stop to the tolerance waiting for four of them (on "
+                              "those levels a sequence whose last contraction is at least twice as slow as the one "
+                              "before and below 0.7 takes the guarded envelope of its last two differences where "
+                              "smaller, the quartic's stall bounded by `smooth`); on the "
                               "grid after such a wait the waited grid's estimate plus the last difference where "
                               "smaller: `carried`; at least the share of contact islands of fewer than four "
                               "points (3D: across), their points and a step beyond: `island`; a window across the "
@@ -350,7 +355,11 @@ def main(argv=None) -> int:
                               "fraction of a step the differences may not show, a load's edges twice the "
                               "root-sum-square of their shares where below their sum: `kink`; in 3D at least "
                               f"{LINE_STEP:g} of a step per crossing of an edge by a row or column, summed, above "
-                              "which the quantities on the edges take Richardson at the observed rate: `line`); a "
+                              "which the quantities on the edges take Richardson at the observed rate: `line`; in "
+                              f"2D on a map without kinks at least {SPREAD_STEPS:g} times each edge's root spread "
+                              "from the quartic on the first half of its window, where the window's length, set by "
+                              "its patch, does not shrink with the step and its error stalls, and a quarter step "
+                              "per edge the line located: `smooth`); a "
                               "tolerance not "
                               "met within the study's largest grid reports nothing. The true error of the reported "
                               "grid is against the same cell on a much finer grid; `next_error` is that of the grid "

@@ -140,9 +140,10 @@ import numpy as np
 from scipy import ndimage
 
 from ngcontact.cell.cell_solution import COEFFICIENT, scale
-from ngcontact.cell.spectral.grid_measures import coefficients, edge_offset, edge_stiffness, kinks
+from ngcontact.cell.spectral.grid_measures import (FITTED_STEP, LOCATED_STEP, coefficients, edge_offset, edge_stiffness,
+                                                   kinks)
 from ngcontact.cell.spectral.penalty_zone import INSIDE, INSIDE_STEP, PENALTY_LOG, PENALTY_ZONE, penalty_zone_share
-from ngcontact.cell.spectral.quartic_spread import FIT, SPREAD_STEPS, fit_share
+from ngcontact.cell.spectral.smooth_edges import SMOOTH, smooth_share
 
 #: the fewest collocation points of a resolved 2D contact island (module docstring)
 ISLAND_POINTS = 4
@@ -150,10 +151,6 @@ ISLAND_POINTS = 4
 ISLAND = "island"
 #: the form of an estimate raised to the floor of the edges beside a kink of the map (module docstring)
 KINK = "kink"
-#: the share of a step that bounds the located position of any other edge of a map with kinks (module docstring)
-LOCATED_STEP = 0.25
-#: the share of a step that bounds such an edge located by the quartic, with exact contact (module docstring)
-FITTED_STEP = 0.1
 #: the factor on the root-sum-square of a load's edges' shares that bounds their error together (module docstring)
 QUADRATURE = 2.0
 #: with a penalty, the share of the stiffness's change with each edge a step out that bounds its error (same)
@@ -182,6 +179,13 @@ def fitted_run(history: list[dict[str, Any]], k: int) -> int:
             break
         run += 1
     return run
+
+
+def stall_floored(entry: dict[str, Any], k: int) -> bool:
+    """Whether load ``k``'s 2D located edges on the level ``entry`` hold a floor against their stall: a share of a
+    map with kinks' edges or of a smooth map's (:mod:`~ngcontact.cell.spectral.smooth_edges`)."""
+    held = entry.get("islands", [{}] * (k + 1))[k]
+    return bool(held.get("kinks", {}).get("share") or held.get("smooth", {}).get("share"))
 
 
 def locator_kind(entry: dict[str, Any], k: int) -> str | None:
@@ -382,7 +386,7 @@ def unresolved_share(cell, p: np.ndarray, gap: np.ndarray | None = None) -> dict
     if cell.dim == 3 and getattr(cell, "enforcement", "exact") == "exact":
         out["line"] = crossing_share(cell, p)
     elif gap is not None:
-        out["fit"] = fit_share(cell, p, gap)
+        out["smooth"] = smooth_share(cell, p, gap)
     if out["kinks"]["share"] and gap is not None:
         out["kinks"]["share"]["normal_stiffness"] = stiffness_share(cell, p, gap)
     if count:
@@ -403,7 +407,7 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
         for form, shares in ((ISLAND, unresolved["share"]), (KINK, unresolved.get("kinks", {}).get("share", {})),
                              (PENALTY_ZONE, unresolved.get("penalty", {}).get("share", {})),
                              (LINE, unresolved.get("line", {}).get("share", {})),
-                             (FIT, unresolved.get("fit", {}).get("share", {}))):
+                             (SMOOTH, unresolved.get("smooth", {}).get("share", {}))):
             raised = []
             for name, share in shares.items():
                 if name in per_load and (floor := share / scale(name, last["headline"][k], last["whole_surface"])
@@ -419,10 +423,12 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                 remarks.append(f"load {k}: {unresolved['line']['crossings']} crossings of the contact edges per "
                                f"direction on grid {last['grid']}: {', '.join(raised)} bounded by {LINE_STEP:g} of a "
                                "step per crossing")
-            elif raised and form == FIT:
-                remarks.append(f"load {k}: {unresolved['fit']['edges']} edge(s) located by the quartic on grid "
-                               f"{last['grid']}, {unresolved['fit']['steps']:.3g} step(s) apart from its half "
-                               f"window's: {', '.join(raised)} bounded by {SPREAD_STEPS:g} times that spread")
+            elif raised and form == SMOOTH:
+                edges = unresolved["smooth"]
+                remarks.append(f"load {k}: {edges['fitted']} edge(s) located by the quartic on grid {last['grid']}, "
+                               f"{edges['lined']} by the line, {edges['steps']:.3g} step(s) in all: "
+                               f"{', '.join(raised)} bounded by each quartic's spread from its half window's, a share "
+                               "of a step each else")
             elif raised and form == PENALTY_ZONE:
                 zone = unresolved["penalty"]
                 remarks.append(f"load {k}: {zone['edges']} contact edge(s) of the penalty located on grid "

@@ -8,8 +8,8 @@ last difference (:data:`CARRIED`), the share of contact islands too narrow for t
 a map's piecewise-linear surface (:data:`~ngcontact.cell.spectral.contact_edges.KINK`), a share of a penalty's
 length at each 2D edge located beyond it (:data:`~ngcontact.cell.spectral.penalty_zone.PENALTY_ZONE`), a share
 of a step at each 3D crossing of an edge by a row or column (:data:`~ngcontact.cell.spectral.contact_edges.LINE`),
-or twice the spread of each 2D edge's quartic against the quartic on half its window
-(:data:`~ngcontact.cell.spectral.quartic_spread.FIT`).
+or a share of each 2D edge of a map without kinks, the quartic's spread from its half window's or the line's
+share of a step (:data:`~ngcontact.cell.spectral.smooth_edges.SMOOTH`).
 Each is a bound on its own argument; none is sharp where the error of grid ``k`` is far below the differences
 that bound it.
 
@@ -30,7 +30,7 @@ first-order one (on Westergaard's sinusoid at a twentieth of its closing pressur
 about 16 per doubling twice, then by 2), and an earlier difference bounds the error where the last one
 vanished by coincidence (a stall, a symmetric cell). Richardson's form states its rate and holds it to first
 order on purpose (the same sinusoid) and is not flagged by that tail. Nor is an unresolved island's share
-(:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), nor a penalty's zone, nor a quartic's spread (their
+(:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), nor a penalty's zone, nor a smooth map's edges (their
 located edges' errors stall alike): such an island's error stalls while the differences
 vanish (:mod:`~ngcontact.cell.spectral.contact_edges`), so the last difference measures neither its size nor
 how far it lies below the share. The share exceeds that error by more than :data:`LOOSE` times only where the
@@ -80,6 +80,20 @@ zero on the reported grid, or a level's error that falls several times faster th
 their two contractions agree), which no difference shows (``docs/benchmarks.md``, the spectral
 effectivity).
 
+**A slowing sequence on the quartic's own levels.**  Beyond Richardson's band (the two contractions apart by
+:data:`AGREE` or more) a slowing sequence keeps the whole window's guarded bound, ``d_(k-2)`` carried at first
+order: ``d_(k-1)`` may have vanished by coincidence, the error stalling over levels ``k - 2`` to ``k``.  On the
+levels whose 2D edges the quartic located (``since`` in :func:`tail_estimate`; the located quantities' estimate on
+the quartic's own levels, :mod:`~ngcontact.cell.spectral.refinement`) such a stall of the edges is the quartic's
+own, of a window whose length the patch sets, and the floor of the edges' spread from their half window's bounds it
+(:mod:`~ngcontact.cell.spectral.smooth_edges`, exact contact; on a map with kinks its steps per edge,
+:mod:`~ngcontact.cell.spectral.contact_edges`; a load without either, a penalty's on a smooth map, keeps the whole
+window: :func:`~ngcontact.cell.spectral.contact_edges.stall_floored`).  So there the slowing sequence, the last
+contraction :data:`DISAGREE` times slower than the one before or more and at most :data:`RATE_CAP`, takes the
+guarded bound on the levels since the fast contraction, ``max(|d_k|, ENVELOPE |d_(k-1)|) rho / (1 - rho)``, where
+smaller: on Westergaard's sinusoid at light loads the whole window carried the line's last difference onto the
+quartic's levels, far above their error (``docs/benchmarks.md``, the spectral effectivity).
+
 **A slowing sequence within Richardson's band.**  Two contractions within :data:`AGREE` of each other take
 Richardson's tail, and the last may still be :data:`DISAGREE` times slower than the one before (``2 c' <= c
 < 3 c'``, :func:`slowed`): the two constants overlap there, and the sequence is slowing.  Its fast contraction
@@ -108,7 +122,7 @@ from typing import Any
 from ngcontact.cell.cell_solution import scale
 from ngcontact.cell.spectral.contact_edges import ISLAND, KINK, LINE, LINE_STEP
 from ngcontact.cell.spectral.penalty_zone import PENALTY_ZONE
-from ngcontact.cell.spectral.quartic_spread import FIT
+from ngcontact.cell.spectral.smooth_edges import SMOOTH
 
 #: the forms of the estimate, as the report names them (:data:`CARRIED`: after a deferred stop, module
 #: docstring of :mod:`~ngcontact.cell.spectral.refinement`)
@@ -166,11 +180,11 @@ def loose_reason(values: list[float], estimate: float, form: str) -> str:
     """Why ``estimate`` (of the last of ``values``, two to four levels of a quantity in its measure, made in
     ``form``) may exceed its error by more than :data:`LOOSE` times, "" where it may not (module docstring):
     above :data:`LOOSE` times the tail its last difference leaves at the last contraction (:func:`tail_left`;
-    not Richardson's form nor an island's, a penalty zone's or a quartic spread's share), or above :data:`LOOSE`
+    not Richardson's form nor an island's, a penalty zone's or a smooth map's edges' share), or above :data:`LOOSE`
     times the tail it leaves at the contraction before, where the last two disagree, the last slower by
     :data:`DISAGREE` or more (:func:`faster_contraction`; any form)."""
     left, rate = tail_left(values[-3:])
-    if form not in (RICHARDSON, ISLAND, PENALTY_ZONE, FIT) and estimate > LOOSE * left:
+    if form not in (RICHARDSON, ISLAND, PENALTY_ZONE, SMOOTH) and estimate > LOOSE * left:
         return (f"{times(estimate, left)} the tail the last difference leaves at its rate {rate:.2g}: "
                 f"{WHY_LOOSE.get(form, WHY_LOOSE[GUARDED])}")
     faster = faster_contraction(values)
@@ -285,16 +299,23 @@ def regime_changed(d: list[float]) -> bool:
 
 
 def tail_estimate(values: list[float], relative: bool, order_rate: float = RATE_FLOOR,
-                  scale: float | None = None, geometric: bool = True, regime: bool = True
+                  scale: float | None = None, geometric: bool = True, regime: bool = True, since: bool = False
                   ) -> tuple[float, str, str]:
     """The estimated error of the last of ``values`` (a quantity on successive levels; module docstring), its
     form (:data:`RICHARDSON` where that is the smaller, else :data:`GUARDED`) and a remark on it.  Needs two
     values at least; ``order_rate`` is the quantity's :data:`ORDER_RATE`; ``scale``: the size the error is
     divided by (default: 1, or the last value where ``relative``); not ``geometric``: the guarded bound only; not
-    ``regime``: its envelope over the whole window, a change of regime not looked for (:func:`guarded_bound`)."""
+    ``regime``: its envelope over the whole window, a change of regime not looked for (:func:`guarded_bound`);
+    ``since``: levels the 2D quartic located, whose slowing sequence beyond Richardson's band takes the guarded bound
+    on the levels since its fast contraction where smaller (module docstring)."""
     d = differences(values, relative, scale)
     fitted = richardson(d, order_rate) if geometric else None
     estimate, remark = guarded_bound(d, regime)
+    if since and len(d) == WINDOW and min(d) > 0 and slowed(d[0] / d[1], d[1] / d[2]) and d[0] <= RATE_CAP * d[1]:
+        bound = guarded_bound(d[:WINDOW - 1])[0]        # the quartic's levels since its fast contraction
+        if bound < estimate:
+            estimate, remark = bound, (f"the quartic's levels since its contraction {d[1] / d[2]:.2g}, the last "
+                                       f"{d[0] / d[1]:.2g} slower: its edges' stall bounded by their spread")
     if fitted is None or fitted[0] >= estimate:
         return estimate, GUARDED, remark
     return fitted[0], RICHARDSON, f"rate {fitted[1]:.2g}{fitted[2]}"

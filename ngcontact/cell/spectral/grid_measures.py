@@ -113,6 +113,10 @@ EDGE_REACH_SHARE = 2
 EDGE_FIT_RTOL = 1e-4
 #: a point's second difference of the gap over the smaller of its neighbours' that makes it a kink
 KINK_RATIO = 4.0
+#: the share of a step that bounds an edge's located position by the line (calibration: ``contact_edges``)
+LOCATED_STEP = 0.25
+#: the share of a step that bounds an edge's located position by the quartic, with exact contact (the same)
+FITTED_STEP = 0.1
 
 
 def contact_fraction(cell, p: np.ndarray, gap: np.ndarray) -> float:

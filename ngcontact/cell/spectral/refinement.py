@@ -63,26 +63,24 @@ So for these quantities of a load whose edges were fitted on the last ``r`` leve
 * with ``0 < r < MIN_LEVELS`` the fitted levels are too few to see their rate: with ``r < LOCATOR_LEVELS``
   the window compares the two locators, a bound by the line's error; with ``r = LOCATOR_LEVELS`` the two
   fitted differences give the guarded bound, whose envelope ``|d_(k-1)| ENVELOPE`` is still of the size
-  of the switch's drop.  Just after the switch the error may change sign, so that ``|d_k|`` is far below
-  ``|d_(k-1)|`` and neither says how fast the tail falls.  To a scene's own tolerance a stop waits for
-  ``MIN_LEVELS`` fitted levels (:func:`locator_changing`) unless that level is beyond the largest grid
-  (the whole window's estimate then stands): three differences whose two ratios decide between
-  Richardson (they agree and contract) and the guarded bound (they do not: "the estimate says so and
-  takes the larger").  Richardson's rate is held to first order there too, ``E = SPREAD |d_k| rho /
-  (1 - rho)``, ``rho = max(|d_k| / |d_(k-1)|, |d_(k-1)| / |d_(k-2)|, 1/2)``: a contraction much faster
-  than ``1/2`` right after the switch is the error crossing zero, and the next level falls at first order
-  again (on Westergaard's sinusoid at a twentieth of its closing pressure the fitted errors fall by about
-  16 per doubling twice, then by 2: the observed rate would estimate a tenth of the error, the first-order
-  one twice it).  The wait costs at most one 2D level more: the sweep, whose levels sum to about twice its
-  finest, about doubles. On the level after a deferred stop (one whose estimates met the tolerance, the 2D
-  stiffness's aside: a level refined on for the stiffness alone defers too) each estimate is the smaller of
-  its own and the deferred one carried over, ``E_k = min(E_k^own, E_(k-1) + |d_k|)`` (:data:`CARRIED`): by
-  ``|e_k| <= |e_(k-1)| + |q_k - q_(k-1)|`` a bound wherever ``E_(k-1)`` is one, it keeps a quantity whose
-  window now holds a vanished difference (the mean closure at a fifth of Westergaard's closing pressure) at
-  what the deferred level stated. Refined to the default tolerance (``sharpen = False`` in
-  :func:`sweep_to_tolerance`) the first grid whose estimate meets it stops, its estimate a bound but not a
-  sharp one. A load whose edges are never all fitted (a piecewise linear profile's kinks defeat the quartic)
-  is estimated on the whole window.
+  of the switch's drop.  Just after the switch the error may change sign, so that ``|d_k|`` is far below ``|d_(k-1)|``
+  and neither says how fast the tail falls.  To a scene's own tolerance a stop waits for ``MIN_LEVELS`` fitted levels
+  (:func:`locator_changing`) unless that level is beyond the largest grid (the whole window's estimate then stands):
+  three differences whose two ratios decide between Richardson (they agree and contract) and the guarded bound (they
+  do not: "the estimate says so and takes the larger").  Richardson's rate is held to first order there too, ``E =
+  SPREAD |d_k| rho / (1 - rho)``, ``rho = max(|d_k| / |d_(k-1)|, |d_(k-1)| / |d_(k-2)|, 1/2)``: a contraction much
+  faster than ``1/2`` right after the switch is the error crossing zero, and the next level falls at first order again
+  (on Westergaard's sinusoid at a twentieth of its closing pressure the fitted errors fall by about 16 per doubling
+  twice, then by 2: the observed rate would estimate a tenth of the error, the first-order one twice it).  The wait
+  costs at most one 2D level more: the sweep, whose levels sum to about twice its finest, about doubles. On the level
+  after a deferred stop (one whose estimates met the tolerance, the 2D stiffness's aside: a level refined on for the
+  stiffness alone defers too) each estimate is the smaller of its own and the deferred one carried over, ``E_k =
+  min(E_k^own, E_(k-1) + |d_k|)`` (:data:`CARRIED`): by ``|e_k| <= |e_(k-1)| + |q_k - q_(k-1)|`` a bound wherever
+  ``E_(k-1)`` is one, it keeps a quantity whose window now holds a vanished difference (the mean closure at a fifth of
+  Westergaard's closing pressure) at what the deferred level stated. Refined to the default tolerance (``sharpen =
+  False`` in :func:`sweep_to_tolerance`) the first grid whose estimate meets it stops, its estimate a bound but not a
+  sharp one. A load whose edges are never all fitted (a piecewise linear profile's kinks defeat the quartic) is
+  estimated on the whole window.
 
 The coefficients of eq. 34 on the real contact set are integrals over it (:mod:`ngcontact.cell.spectral.grid_measures`:
 ``k_n`` times the contact fraction, ``k_n`` times the gap integrated over the set), with the set's 2D edges
@@ -113,9 +111,9 @@ points (3D: across) has no resolved edges: its error may stall while the differe
 quantities on the edges is a floor under their estimates (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`,
 form ``island``; a 2D edge of a map with kinks, a step within a step of one, else a quarter: ``kink``; a penalty's 2D
 edge located on points beyond its length ``E*/k_n``: ``penalty zone``, whose error no difference shows either; a 2D
-edge the quartic located, twice its root's spread from the quartic on half its window, whose error stalls while the
-patch sets the window's length: ``fit``, :mod:`.quartic_spread`); a window across the level where the last island
-was resolved is also taken on the resolved levels alone, the smaller reported. An estimate (not Richardson's nor
+edge of a map without kinks, its quartic's spread from its half window's or the line's share of a step: ``smooth``,
+:mod:`.smooth_edges`); a window across the level where the last island was resolved is also taken on the resolved
+levels alone, the smaller reported. An estimate (not Richardson's nor
 a share of stalled edges) above :data:`.LOOSE` times the error its last difference leaves at the last contraction,
 or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much: flagged
 with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
@@ -150,7 +148,7 @@ import numpy as np
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
 from ngcontact.cell.spectral.contact_edges import (FITTED_STEP, ISLAND_POINTS, LINE_STEP, LOCATED_STEP, QUADRATURE,
                                                    fitted_run, island_floor, locator_kind, on_edges, resolved_run,
-                                                   unresolved_share, locator_changing as edges_changing)
+                                                   stall_floored, unresolved_share, locator_changing as edges_changing)
 from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, DISAGREE, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP,
                                                     RATE_FLOOR, SAFETY, SPREAD, WINDOW, loose_flags, loose_remarks,
                                                     tail_estimate)
@@ -297,8 +295,9 @@ def sweep_estimates(history: list[dict[str, Any]], geometric_ok: bool = True
             run = min(fitted, resolved_run(history, k))        # levels of the quartic and of resolved islands
             out[name], form[name], note = tail_estimate(values, *args, geometric and fitted == len(history),
                                                          geometric_ok)
+            since = run == fitted > WINDOW and stall_floored(history[-1], k)     # the quartic's levels, stall floored
             if LOCATOR_LEVELS <= run < len(history):
-                sharp = tail_estimate(values[-run:], *args, geometric, geometric_ok)
+                sharp = tail_estimate(values[-run:], *args, geometric, geometric_ok, since)
                 if sharp[0] < out[name]:
                     out[name], form[name], note = sharp[0], sharp[1], "; ".join(filter(None, (sharp[2], (
                         "the edge fit's own levels" if run == fitted else "the levels of resolved islands"))))
