@@ -143,7 +143,7 @@ from ngcontact.cell.cell_solution import COEFFICIENT, scale
 from ngcontact.cell.spectral.grid_measures import (FITTED_STEP, LOCATED_STEP, coefficients, edge_offset, edge_stiffness,
                                                    kinks)
 from ngcontact.cell.spectral.penalty_zone import INSIDE, INSIDE_STEP, PENALTY_LOG, PENALTY_ZONE, penalty_zone_share
-from ngcontact.cell.spectral.smooth_edges import SMOOTH, smooth_share
+from ngcontact.cell.spectral.smooth_edges import SMOOTH, smooth_remark, smooth_share
 
 #: the fewest collocation points of a resolved 2D contact island (module docstring)
 ISLAND_POINTS = 4
@@ -424,11 +424,7 @@ def island_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]
                                f"direction on grid {last['grid']}: {', '.join(raised)} bounded by {LINE_STEP:g} of a "
                                "step per crossing")
             elif raised and form == SMOOTH:
-                edges = unresolved["smooth"]
-                remarks.append(f"load {k}: {edges['fitted']} edge(s) located by the quartic on grid {last['grid']}, "
-                               f"{edges['lined']} by the line, {edges['steps']:.3g} step(s) in all: "
-                               f"{', '.join(raised)} bounded by each quartic's spread from its half window's, a share "
-                               "of a step each else")
+                remarks.append(f"load {k}: " + smooth_remark(unresolved["smooth"], last["grid"], raised))
             elif raised and form == PENALTY_ZONE:
                 zone = unresolved["penalty"]
                 remarks.append(f"load {k}: {zone['edges']} contact edge(s) of the penalty located on grid "

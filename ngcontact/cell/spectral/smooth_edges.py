@@ -95,3 +95,11 @@ def smooth_share(cell, p: np.ndarray, gap: np.ndarray) -> dict[str, Any]:
                       COEFFICIENT + "g_n": cell.k_n * heights / n,
                       "normal_stiffness": sum(s * abs(stiffness[key][1]) for key, s in steps.items()
                                               if key in stiffness)}}
+
+
+def smooth_remark(edges: dict[str, Any], grid: int, raised: list[str]) -> str:
+    """The report's remark on a load whose estimates of ``raised`` the share ``edges`` (:func:`smooth_share`) floors
+    on ``grid`` points."""
+    return (f"{edges['fitted']} edge(s) located by the quartic on grid {grid}, {edges['lined']} by the line, "
+            f"{edges['steps']:.3g} step(s) in all: {', '.join(raised)} bounded by each quartic's spread from its half "
+            "window's, a share of a step each else")
