@@ -25,7 +25,7 @@ surface's samples through the bilinear interpolant that also defines the surface
 (a random surface's cut-off within a few of its points) shows large differences, and the estimate is large:
 the scene's grid is then not shown to be converged, which is what the estimate is for.  The scene's grid is
 solved last and from zero pressure, as without the estimate, so its numbers are those of the plain sweep; a
-coarser grid starts from the one before it, interpolated (:func:`~ngcontact.cell.spectral.refinement.prolong`).
+coarser grid starts from the one before it, interpolated (:func:`~ngcontact.cell.spectral.grid_level.prolong`).
 
 Cost: the three coarser grids hold ``1/4 + 1/16 + 1/64 = 0.33`` of the scene grid's points in 3D and
 ``1/2 + 1/4 + 1/8 = 0.88`` in 2D, each solved in fewer constrained CG steps (their count grows like the
@@ -40,6 +40,7 @@ from typing import Any, Callable
 
 from ngcontact.cell.spectral.contact_edges import island_floor
 from ngcontact.cell.spectral.estimate_forms import loose_flags, loose_remarks
+from ngcontact.cell.spectral.grid_phase import phase_floor
 from ngcontact.cell.spectral.refinement import GROWTH, MIN_LEVELS, RefinedSweep, solve_level, sweep_estimates
 
 #: the fewest points per direction of the coarsest grid
@@ -78,7 +79,7 @@ def estimate_from_coarser(make_cell: Callable[[int], Any], loads: list, grid: in
         cell, sols, entry = solve_level(make_cell, loads, n, None if n == grid else (sols or None))
         history.append(entry)
     estimates, remarks, forms = sweep_estimates(history, geometric_ok=False)
-    remarks += island_floor(history, estimates, forms)
+    remarks += island_floor(history, estimates, forms) + phase_floor(history, estimates, forms)
     flags = loose_flags(history, estimates, forms)
     return RefinedSweep(cell=cell, solutions=sols, estimates=estimates, history=history,
                         remarks=remarks + loose_remarks(flags), forms=forms, flags=flags)

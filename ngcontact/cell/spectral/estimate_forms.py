@@ -1,15 +1,16 @@
 """The forms of the spectral refinement's estimate, and the estimates that may be loose by much.
 
 :mod:`~ngcontact.cell.spectral.refinement` estimates the error of each headline quantity of a load on the
-reported grid ``k`` in one of eight forms, which the report names: Richardson's tail with the observed rate
+reported grid ``k`` in one of nine forms, which the report names: Richardson's tail with the observed rate
 (:data:`RICHARDSON`), the guarded geometric tail (:data:`GUARDED`), the estimate of a deferred grid plus the
 last difference (:data:`CARRIED`), the share of contact islands too narrow for the grid
 (:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), a step at each 2D edge within a step of a kink of
 a map's piecewise-linear surface (:data:`~ngcontact.cell.spectral.contact_edges.KINK`), a share of a penalty's
 length at each 2D edge located beyond it (:data:`~ngcontact.cell.spectral.penalty_zone.PENALTY_ZONE`), a share
 of a step at each 3D crossing of an edge by a row or column (:data:`~ngcontact.cell.spectral.contact_edges.LINE`),
-or a share of each 2D edge of a map without kinks, the quartic's spread from its half window's or the line's
-share of a step (:data:`~ngcontact.cell.spectral.smooth_edges.SMOOTH`).
+a share of each 2D edge of a map without kinks, the quartic's spread from its half window's or the line's
+share of a step (:data:`~ngcontact.cell.spectral.smooth_edges.SMOOTH`), or in 2D the change on the same grid
+sampled half a step over (:data:`~ngcontact.cell.spectral.grid_phase.PHASE`).
 Each is a bound on its own argument; none is sharp where the error of grid ``k`` is far below the differences
 that bound it.
 
@@ -31,7 +32,8 @@ about 16 per doubling twice, then by 2), and an earlier difference bounds the er
 vanished by coincidence (a stall, a symmetric cell). Richardson's form states its rate and holds it to first
 order on purpose (the same sinusoid) and is not flagged by that tail. Nor is an unresolved island's share
 (:data:`~ngcontact.cell.spectral.contact_edges.ISLAND`), nor a penalty's zone, nor a smooth map's edges (their
-located edges' errors stall alike): such an island's error stalls while the differences
+located edges' errors stall alike), nor the grid's phase (the level's own change half a step over, which no
+difference between levels measures): such an island's error stalls while the differences
 vanish (:mod:`~ngcontact.cell.spectral.contact_edges`), so the last difference measures neither its size nor
 how far it lies below the share. The share exceeds that error by more than :data:`LOOSE` times only where the
 island's located width happens to be right to a tenth of its points and one step beyond each edge, which, like
@@ -121,6 +123,7 @@ from typing import Any
 
 from ngcontact.cell.cell_solution import scale
 from ngcontact.cell.spectral.contact_edges import ISLAND, KINK, LINE, LINE_STEP
+from ngcontact.cell.spectral.grid_phase import PHASE
 from ngcontact.cell.spectral.penalty_zone import PENALTY_ZONE
 from ngcontact.cell.spectral.smooth_edges import SMOOTH
 
@@ -180,11 +183,11 @@ def loose_reason(values: list[float], estimate: float, form: str) -> str:
     """Why ``estimate`` (of the last of ``values``, two to four levels of a quantity in its measure, made in
     ``form``) may exceed its error by more than :data:`LOOSE` times, "" where it may not (module docstring):
     above :data:`LOOSE` times the tail its last difference leaves at the last contraction (:func:`tail_left`;
-    not Richardson's form nor an island's, a penalty zone's or a smooth map's edges' share), or above :data:`LOOSE`
-    times the tail it leaves at the contraction before, where the last two disagree, the last slower by
-    :data:`DISAGREE` or more (:func:`faster_contraction`; any form)."""
+    not Richardson's form nor an island's, a penalty zone's, a smooth map's edges' or the phase's floor), or
+    above :data:`LOOSE` times the tail it leaves at the contraction before, where the last two disagree, the last
+    slower by :data:`DISAGREE` or more (:func:`faster_contraction`; any form)."""
     left, rate = tail_left(values[-3:])
-    if form not in (RICHARDSON, ISLAND, PENALTY_ZONE, SMOOTH) and estimate > LOOSE * left:
+    if form not in (RICHARDSON, ISLAND, PENALTY_ZONE, SMOOTH, PHASE) and estimate > LOOSE * left:
         return (f"{times(estimate, left)} the tail the last difference leaves at its rate {rate:.2g}: "
                 f"{WHY_LOOSE.get(form, WHY_LOOSE[GUARDED])}")
     faster = faster_contraction(values)

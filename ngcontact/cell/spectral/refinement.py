@@ -106,26 +106,25 @@ tolerance so missed ends its run (:meth:`~ngcontact.cell.spectral.spectral_solve
 3D, whose cost bound (points squared) allows a few doublings only, it is reported with its estimate and not held
 (:func:`uncontrolled`: listed in the verdict as not counted).
 
-Two checks end a level's estimate. An island of fewer than :data:`~ngcontact.cell.spectral.contact_edges.ISLAND_POINTS`
-points (3D: across) has no resolved edges: its error may stall while the differences vanish, so its share of the
-quantities on the edges is a floor under their estimates (:func:`~ngcontact.cell.spectral.contact_edges.island_floor`,
-form ``island``; a 2D edge of a map with kinks, a step within a step of one, else a quarter: ``kink``; a penalty's 2D
-edge located on points beyond its length ``E*/k_n``: ``penalty zone``, whose error no difference shows either; a 2D
-edge of a map without kinks, its quartic's spread from its half window's or the line's share of a step: ``smooth``,
-:mod:`.smooth_edges`); a window across the level where the last island was resolved is also taken on the resolved
-levels alone, the smaller reported. An estimate (not Richardson's nor
-a share of stalled edges) above :data:`.LOOSE` times the error its last difference leaves at the last contraction,
-or (any form) at the one before where the last is twice as slow or more, may exceed the error by as much: flagged
-with its reason, per quantity in the report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
+Three checks end a level's estimate. An island of fewer than :data:`~ngcontact.cell.spectral.contact_edges.
+ISLAND_POINTS` points (3D: across) has no resolved edges: its error may stall while the differences vanish, so its
+share of the quantities on the edges is a floor under their estimates (:func:`~ngcontact.cell.spectral.contact_edges.
+island_floor`, form ``island``; a 2D edge of a map with kinks, a step within a step of one, else a quarter: ``kink``; a
+penalty's 2D edge located beyond its length ``E*/k_n``: ``penalty zone``; a 2D edge of a map without kinks, its
+quartic's spread from its half window's or the line's share of a step: ``smooth``, :mod:`.smooth_edges`); a window
+across the level where the last island was resolved is also taken on the resolved levels alone, the smaller reported.
+In 2D each estimate is at least the change on the level's twin sampled half a step over (``phase``, :mod:`.grid_phase`):
+the error's part that jumps with the edges' place between points. An estimate (not Richardson's nor a floor) above
+:data:`.LOOSE` times the error its last difference leaves at the last contraction, or (any form) at the one before
+where the last is twice as slow or more, may exceed the error by as much: flagged with its reason, per quantity in the
+report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
-Levels double the points per direction (:data:`GROWTH`): three differences cost twice the finest level in 2D, 4/3 in 3D.
-Its effectivity (estimate over the true error of the reported level) is measured by
-``scripts/spectral_effectivity.py`` on Westergaard's sinusoid, a random 2D profile and a 3D bisinusoid against each
-cell's own value on a much finer grid (``docs/benchmarks.md``).  No estimate from the levels up to ``k`` can be sharp
-where the error of level ``k`` itself is small by chance: where it crosses zero between two grids, or where it falls
-by much more than the differences before it show (a pre-asymptotic stretch left for a faster regime that no recorded
-change of method marks, unlike the 2D edge locator above), the differences up to level ``k`` still carry the size of
-the earlier errors, and the estimate exceeds the error by their ratio.
+Levels double the points per direction (:data:`GROWTH`): the differences cost twice the finest level (2D: four times
+with the twins), 4/3 in 3D. The effectivity (estimate over true error of the reported level) is measured by
+``scripts/spectral_effectivity.py`` against each cell's own value on a much finer grid (``docs/benchmarks.md``).  No
+estimate can be sharp where the error of level ``k`` is small by chance: where it crosses zero, or where it falls by
+much more than the differences before it show (a pre-asymptotic stretch left for a faster regime), the differences
+still carry the size of the earlier errors, and the estimate exceeds the error by their ratio.
 
 A stop needs ``MIN_LEVELS`` levels (three differences: the window) and, to a scene's own tolerance, no load's edge
 locator changing (above). The levels are known before the first solve (``grid`` times ``GROWTH^k`` up to
@@ -133,13 +132,10 @@ locator changing (above). The levels are known before the first solve (``grid`` 
 :func:`ngcontact.scene.spectral_grid.spectral_cost`): the largest is stated first, and each level prints one progress
 line as it ends. A tolerance out of reach ends in a :class:`~ngcontact.errors.ConvergenceError` where it was required
 (the scene stated it), else the finest level is the answer, marked as not meeting it. Each level starts its loads
-from the coarser level's pressures, interpolated onto its grid (:func:`prolong`; the coarse points are every other
-fine point): a start only (it saves the constrained CG's first steps, where the contact set shrinks from full
-contact); the answer is the level's own."""
+from the coarser level's pressures (:mod:`.grid_level`): a start only; the answer is the level's own."""
 from __future__ import annotations
 
 import logging
-import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -148,19 +144,19 @@ import numpy as np
 from ngcontact.cell.cell_solution import COEFFICIENT, RELATIVE, headline, measure, scale, worst_estimate
 from ngcontact.cell.spectral.contact_edges import (FITTED_STEP, ISLAND_POINTS, LINE_STEP, LOCATED_STEP, QUADRATURE,
                                                    fitted_run, island_floor, locator_kind, on_edges, resolved_run,
-                                                   stall_floored, unresolved_share, locator_changing as edges_changing)
+                                                   stall_floored, locator_changing as edges_changing)
 from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, DISAGREE, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP,
                                                     RATE_FLOOR, SAFETY, SPREAD, WINDOW, loose_flags, loose_remarks,
                                                     tail_estimate)
-from ngcontact.cell.spectral.grid_measures import coefficients, edges_fitted
+from ngcontact.cell.spectral.grid_level import GROWTH, solve_level
+from ngcontact.cell.spectral.grid_phase import phase_floor
 from ngcontact.cell.spectral.penalty_zone import INSIDE, PENALTY_LOG, zone_ahead
+from ngcontact.cell.spectral.smooth_edges import SPREAD_STEPS
 from ngcontact.errors import ConvergenceError
 
 #: the run's progress lines (printed as its stage lines, :func:`ngcontact.runner.solve`)
 progress = logging.getLogger("ngcontact.progress")
 
-#: points per direction of a level over those of the previous level
-GROWTH = 2
 #: the fewest levels a stop needs: one more than the differences the estimate looks at
 MIN_LEVELS = WINDOW + 1
 #: the fastest contraction per level Richardson may assume: each quantity's own order in the grid step, first
@@ -197,9 +193,12 @@ HOW = ("grids of twice the points per direction each; per quantity and load, Ric
        f"also on the resolved levels (at least {LOCATOR_LEVELS}), the smaller; a step per 2D edge within a step of a "
        f"kink of the map's piecewise-linear surface, {LOCATED_STEP:g} of one per other edge of such a map "
        f"({FITTED_STEP:g} by the quartic; a load's edges {QUADRATURE:g} times their root-sum-square where below their "
-       f"sum), {PENALTY_LOG:g} E*/k_n ln(period k_n / E*) per edge of a penalty located on points beyond E*/k_n; above "
-       f"{LOOSE:g} times the error its last difference leaves at the last rate, or the one before where the last is "
-       "twice as slow or more: flagged (quantities[].loose)")
+       f"sum), {PENALTY_LOG:g} E*/k_n ln(period k_n / E*) per edge of a penalty located on points beyond E*/k_n, on a "
+       f"2D map without kinks {SPREAD_STEPS:g} times each quartic edge's spread from the quartic on its window's first "
+       f"half ({LOCATED_STEP:g} step per edge the line located); in 2D every quantity at least its change on the same "
+       "grid sampled half a step over (twice the half-difference: the part of the error that changes sign with the "
+       f"edges' place between points); above {LOOSE:g} times the error its last difference leaves at the last rate, "
+       "or the one before where the last is twice as slow or more: flagged (quantities[].loose)")
 
 
 @dataclass
@@ -348,41 +347,6 @@ def levels(grid: int, dim: int, max_points: int) -> list[int]:
     return out
 
 
-def prolong(p: np.ndarray) -> np.ndarray:
-    """A periodic grid field on twice the points per direction: the coarse values at the even points, their
-    (bi)linear interpolation between (non-negative where ``p`` is)."""
-    out = p
-    for axis in range(p.ndim):
-        fine = np.repeat(out, 2, axis=axis)
-        odd = [slice(None)] * p.ndim
-        odd[axis] = slice(1, None, 2)
-        fine[tuple(odd)] = 0.5 * (out + np.roll(out, -1, axis=axis))
-        out = fine
-    return out
-
-
-def solve_level(make_cell: Callable[[int], Any], loads: list, n: int,
-                coarser: list | None = None) -> tuple[Any, list, dict[str, Any]]:
-    """The cell on ``n`` points per direction, its solutions of ``loads`` (from ``coarser``'s pressures,
-    interpolated, where the coarser level's solutions are given) and the history entry of the level."""
-    t0 = time.perf_counter()
-    cell = make_cell(n)
-    starts = None
-    if coarser is not None and all(c.fields["pressure"].shape[0] * GROWTH == n for c in coarser):
-        starts = [prolong(c.fields["pressure"]) for c in coarser]
-    sols = cell.sweep(loads, starts=starts)
-    entry: dict[str, Any] = {
-        "grid": n, "points": cell.points, "seconds": time.perf_counter() - t0,
-        "iterations": [s.iterations for s in sols],
-        "contact_fraction": [s.results["contact_fraction"] for s in sols],
-        "mean_closure": [s.results["mean_closure"] for s in sols],
-        "headline": [headline(s.results) for s in sols],
-        "edges_fitted": [edges_fitted(cell, s.fields["pressure"], s.fields["gap"]) for s in sols],
-        "islands": [unresolved_share(cell, s.fields["pressure"], s.fields["gap"]) for s in sols],
-        "whole_surface": coefficients(cell, np.ones(cell.shape, bool)).as_dict()}
-    return cell, sols, entry
-
-
 def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: float, grid: int, dim: int,
                        max_points: int, required: bool = True, sharpen: bool = True) -> RefinedSweep:
     """Solve ``loads`` on grids from ``grid`` up until the estimate meets ``tolerance`` (module docstring).
@@ -411,7 +375,7 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
                 remarks.append(f"{lowered} estimates carried from the deferred grid {history[-2]['grid']}: its "
                                "estimate plus the last difference")
         if estimates is not None:
-            remarks += island_floor(history, estimates, forms)
+            remarks += island_floor(history, estimates, forms) + phase_floor(history, estimates, forms)
             flags = loose_flags(history, estimates, forms)
             entry["estimate"] = controlled_estimate(estimates, skip)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
