@@ -13,10 +13,10 @@ a grid where a stop waited, the share of unresolved contact islands, or a step a
 of a kink of the profile's piecewise-linear interpolant, a quarter step at every other edge of such a map (a
 tenth where the quartic located it; a load's edges twice their root-sum-square where below their sum), and
 the 2D stiffness of the located set as many steps of its change with each edge a step out, or on a map without
-kinks the quartic's spread from its half window's, a quarter step where the line located the edge), the true error of
-the grid twice as fine, whether the reported one is small by chance, and the estimator's own flag where it
-states that its estimate may exceed the error by more than ten times (``ngcontact.cell.spectral.estimate_forms``)
-are listed beside it.
+kinks the quartic's spread from its half window's, a quarter step where the line located the edge, or in 2D the change
+on the same grid sampled half a step over), the true error of the grid twice as fine, whether the reported one is
+small by chance, and the estimator's own flag where it states that its estimate may exceed the error by more than ten
+times (``ngcontact.cell.spectral.estimate_forms``) are listed beside it.
 Oracles, each with exact contact:
 
 * ``westergaard``: Westergaard's sinusoid ``2h sin^2(pi x)``, layers of depth 1, first grid 64, grids up to
@@ -387,8 +387,10 @@ def main(argv=None) -> int:
                               f"2D on a map without kinks at least {SPREAD_STEPS:g} times each edge's root spread "
                               "from the quartic on the first half of its window, where the window's length, set by "
                               "its patch, does not shrink with the step and its error stalls, and a quarter step "
-                              "per edge the line located: `smooth`); a "
-                              "tolerance not "
+                              "per edge the line located: `smooth`; in 2D every quantity at least its change on "
+                              "the same grid sampled half a step over, twice the half-difference that bounds the "
+                              "part of the error which changes sign with the edges' place between points, where "
+                              "the differences between grids may stall: `phase`); a tolerance not "
                               "met within the study's largest grid reports nothing. The true error of the reported "
                               "grid is against the same cell on a much finer grid; `next_error` is that of the grid "
                               "twice as fine, `reference_change` the reference's own change from the grid of half "
