@@ -40,8 +40,9 @@ from typing import Any, Callable
 
 from ngcontact.cell.spectral.contact_edges import island_floor
 from ngcontact.cell.spectral.estimate_forms import loose_flags, loose_remarks
+from ngcontact.cell.spectral.grid_level import GROWTH, solve_level
 from ngcontact.cell.spectral.grid_phase import phase_floor
-from ngcontact.cell.spectral.refinement import GROWTH, MIN_LEVELS, RefinedSweep, solve_level, sweep_estimates
+from ngcontact.cell.spectral.refinement import MIN_LEVELS, RefinedSweep, sweep_estimates
 
 #: the fewest points per direction of the coarsest grid
 COARSEST = 4

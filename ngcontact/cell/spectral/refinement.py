@@ -106,18 +106,18 @@ tolerance so missed ends its run (:meth:`~ngcontact.cell.spectral.spectral_solve
 3D, whose cost bound (points squared) allows a few doublings only, it is reported with its estimate and not held
 (:func:`uncontrolled`: listed in the verdict as not counted).
 
-Three checks end a level's estimate. An island of fewer than :data:`~ngcontact.cell.spectral.contact_edges.
-ISLAND_POINTS` points (3D: across) has no resolved edges: its error may stall while the differences vanish, so its
-share of the quantities on the edges is a floor under their estimates (:func:`~ngcontact.cell.spectral.contact_edges.
-island_floor`, form ``island``; a 2D edge of a map with kinks, a step within a step of one, else a quarter: ``kink``; a
-penalty's 2D edge located beyond its length ``E*/k_n``: ``penalty zone``; a 2D edge of a map without kinks, its
-quartic's spread from its half window's or the line's share of a step: ``smooth``, :mod:`.smooth_edges`); a window
-across the level where the last island was resolved is also taken on the resolved levels alone, the smaller reported.
-In 2D each estimate is at least the change on the level's twin sampled half a step over (``phase``, :mod:`.grid_phase`):
-the error's part that jumps with the edges' place between points. An estimate (not Richardson's nor a floor) above
-:data:`.LOOSE` times the error its last difference leaves at the last contraction, or (any form) at the one before
-where the last is twice as slow or more, may exceed the error by as much: flagged with its reason, per quantity in the
-report (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
+Three checks end a level's estimate. An island of fewer than :data:`.contact_edges.ISLAND_POINTS` points (3D:
+across) has no resolved edges: its error may stall while the differences vanish, so its share of the quantities on
+the edges is a floor under their estimates (:func:`.contact_edges.island_floor`, form ``island``; a 2D edge of a map
+with kinks, a step within a step of one, else a quarter: ``kink``; a penalty's 2D edge located beyond its length
+``E*/k_n``: ``penalty zone``; a 2D edge of a map without kinks, its quartic's spread from its half window's or the
+line's share of a step: ``smooth``, :mod:`.smooth_edges`); a window across the level where the last island was
+resolved is also taken on the resolved levels alone, the smaller reported. In 2D each estimate is at least the change
+on the level's twin sampled half a step over (``phase``, :mod:`.grid_phase`): the error's part that jumps with the
+edges' place between points. An estimate (not Richardson's nor a floor) above :data:`.LOOSE` times the error its last
+difference leaves at the last contraction, or (any form) at the one before where the last is twice as slow or more,
+may exceed the error by as much: flagged with its reason, per quantity in the report
+(:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
 Levels double the points per direction (:data:`GROWTH`): the differences cost twice the finest level (2D: four times
 with the twins), 4/3 in 3D. The effectivity (estimate over true error of the reported level) is measured by
