@@ -11,7 +11,7 @@ from scipy.optimize import minimize_scalar
 
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline, scale
-from ngcontact.cell.spectral.grid_phase import PHASE, PHASE_SAFETY, phase_floor, twin_headline
+from ngcontact.cell.spectral.grid_phase import PHASE, PHASE_SAFETY, phase_floor, posed_on, twin_headline
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
 from ngcontact.cell.spectral.refinement import sweep_to_tolerance
 
@@ -52,7 +52,7 @@ def test_the_twin_is_the_same_cell_on_the_surface_sampled_half_a_step_over():
     n = 256
     cell = _cell(n)
     cell.friction_method = "projected"
-    twin = cell.with_gap(_smooth(2 * n)[1::2])
+    twin = posed_on(cell, _smooth(2 * n)[1::2])
     s = (np.arange(n) + 0.5) / n
     harmonics = _harmonics(35)
     top, bottom = _extreme(harmonics, 1.0), _extreme(harmonics, -1.0)

@@ -14,11 +14,11 @@ which no rule on differences can tell from convergence (on a smooth profile of t
 error held 2e-7 over 4096 and 8192 points with a difference of 3e-8 between them; ``docs/benchmarks.md``, the
 spectral effectivity's held-out profiles).
 
-**The twin.**  The same cell posed on the gap sampled half a step over, at ``x_j + h / 2``: every second point of
-the grid twice as fine, so the same surface (a formula, a table's or a map's interpolant; ``make_cell(2 n)``'s
-gap).  Its answer ``q'_n = q + s_n + o_n(phi + 1/2)`` shares ``s_n``, and the first harmonic of ``o_n`` in
-``phi`` changes sign half a step over, ``o(phi + 1/2) = -o(phi)``, so that ``|o_n(phi)| = |q_n - q'_n| / 2`` for
-that harmonic.  The floor of a 2D level's estimate is :data:`PHASE_SAFETY` times that,
+**The twin.**  The same cell posed on the gap sampled half a step over (:func:`posed_on`), at ``x_j + h / 2``:
+every second point of the grid twice as fine, so the same surface (a formula, a table's or a map's interpolant;
+``make_cell(2 n)``'s gap).  Its answer ``q'_n = q + s_n + o_n(phi + 1/2)`` shares ``s_n``, and the first harmonic
+of ``o_n`` in ``phi`` changes sign half a step over, ``o(phi + 1/2) = -o(phi)``, so that ``|o_n(phi)| = |q_n -
+q'_n| / 2`` for that harmonic.  The floor of a 2D level's estimate is :data:`PHASE_SAFETY` times that,
 
     ``E_n >= PHASE_SAFETY |q_n - q'_n| / 2 = |q_n - q'_n|``,
 
@@ -33,7 +33,10 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+import numpy as np
+
 from ngcontact.cell.cell_solution import headline, scale
+from ngcontact.cell.spectral.layered_cell import SpectralCell
 
 #: the estimate's form where the grid's phase bounds it (module docstring)
 PHASE = "phase"
@@ -46,8 +49,17 @@ def twin_headline(make_cell: Callable[[int], Any], cell, loads: list, sols: list
     every second point of ``make_cell(2 n)``'s gap), solved from the pressures of ``sols``; ``None`` in 3D."""
     if cell.dim != 2:
         return None
-    twin = cell.with_gap(make_cell(2 * cell.grid).g0[1::2])
+    twin = posed_on(cell, make_cell(2 * cell.grid).g0[1::2])
     return [headline(s.results) for s in twin.sweep(loads, starts=[s.fields["pressure"] for s in sols])]
+
+
+def posed_on(cell: SpectralCell, gap: np.ndarray) -> SpectralCell:
+    """The same cell (layers, grid, interface law, solver) posed on another initial ``gap`` of its grid."""
+    twin = SpectralCell(dim=cell.dim, period=cell.period, grid=cell.grid, rough=cell.rough, counter=cell.counter,
+                        gap=gap, k_n=cell.k_n, enforcement=cell.enforcement, tol=cell.tol, max_iter=cell.max_iter,
+                        friction=cell.friction)
+    twin.preconditioned, twin.friction_method = cell.preconditioned, cell.friction_method
+    return twin
 
 
 def phase_floor(history: list[dict[str, Any]], estimates: list[dict[str, float]], forms: list[dict[str, str]]

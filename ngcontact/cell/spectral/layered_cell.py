@@ -158,15 +158,6 @@ class SpectralCell:
     def points(self) -> int:
         return int(np.prod(self.shape))
 
-    def with_gap(self, gap: np.ndarray) -> SpectralCell:
-        """The same cell (layers, grid, interface law, solver) posed on another initial ``gap`` of its grid, e.g.
-        the surface sampled half a step over (:mod:`~ngcontact.cell.spectral.grid_phase`)."""
-        twin = SpectralCell(dim=self.dim, period=self.period, grid=self.grid, rough=self.rough, counter=self.counter,
-                            gap=gap, k_n=self.k_n, enforcement=self.enforcement, tol=self.tol, max_iter=self.max_iter,
-                            friction=self.friction)
-        twin.preconditioned, twin.friction_method = self.preconditioned, self.friction_method
-        return twin
-
     def convolve(self, p: np.ndarray, symbol: np.ndarray) -> np.ndarray:
         """``IFFT(symbol FFT(p))`` on the grid (real FFTs on the run's threads, :mod:`.fft_threads`), a new
         array."""
