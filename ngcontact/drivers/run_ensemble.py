@@ -9,7 +9,7 @@ FE as the scene says; on its own grid or mesh unless the scene states a
 ``discretization.tolerance``: the members are not refined to the default one,
 but each is estimated there, :meth:`~ngcontact.cell.cell_solver.CellSolver.scene_estimate`:
 the spectral cell from three coarser grids, at most a third of its solve more in
-3D and seven eighths in 2D, the FE cell by one order more on its mesh, about
+3D and seven eighths and its twin half a step over in 2D, the FE cell by one order more on its mesh, about
 ``((p + 1) / p)^d`` times its unknowns; ``discretization.estimate = "off"``
 skips it), in a worker of the run's batch (:mod:`ngcontact.parallel.executor`), and returns per load the contact
 fraction, ``k_n0`` on the real contact set (paper eq. 34), the normal

@@ -12,8 +12,10 @@ from scipy.optimize import minimize_scalar
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline, scale
 from ngcontact.cell.spectral.grid_phase import PHASE, PHASE_SAFETY, phase_floor, posed_on, twin_headline
+from ngcontact.cell.spectral import refinement
+from ngcontact.cell.spectral.grid_level import solve_level, solve_twin
 from ngcontact.cell.spectral.layered_cell import Layer, SpectralCell
-from ngcontact.cell.spectral.refinement import sweep_to_tolerance
+from ngcontact.cell.spectral.refinement import MIN_LEVELS, sweep_to_tolerance
 
 NU, H = 0.3, 0.01
 PRESSURES = (0.0004, 0.0015, 0.004)
@@ -104,3 +106,23 @@ def test_a_stalled_mean_closure_is_bounded_by_its_change_half_a_step_over():
     assert refined.forms[1]["mean_closure"] == PHASE
     assert error <= refined.estimates[1]["mean_closure"] <= 10 * error
     assert any("mean_closure bounded by 2 times half the change" in r for r in refined.remarks)
+
+
+def test_the_twin_is_solved_only_where_its_floor_can_change_a_decision(monkeypatch):
+    """The floor only raises an estimate: a level whose estimate before it misses the tolerance keeps missing it.
+    So the lazy twin (the levels a stop or the report reads) gives the sweep of a twin on every level."""
+    loads = [cell_load(2, pressure=p) for p in PRESSURES]
+    lazy = sweep_to_tolerance(_cell, loads, 1e-4, 64, 2, 2 ** 13)
+    assert [h["phase"] is None for h in lazy.history[:MIN_LEVELS - 1]] == [True] * (MIN_LEVELS - 1)
+    assert lazy.history[-1]["phase"] is not None
+    assert any(h["phase"] is None for h in lazy.history[MIN_LEVELS - 1:-1])      # a level the lazy twin skipped
+
+    def eager(make_cell, loads, n, coarser=None):
+        cell, sols, entry = solve_level(make_cell, loads, n, coarser)
+        solve_twin(make_cell, loads, cell, sols, entry)
+        return cell, sols, entry
+
+    monkeypatch.setattr(refinement, "solve_level", eager)
+    every = sweep_to_tolerance(_cell, loads, 1e-4, 64, 2, 2 ** 13)
+    assert [h["grid"] for h in every.history] == [h["grid"] for h in lazy.history]
+    assert (every.estimates, every.forms, every.met) == (lazy.estimates, lazy.forms, lazy.met)

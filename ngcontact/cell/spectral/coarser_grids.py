@@ -30,8 +30,9 @@ coarser grid starts from the one before it, interpolated (:func:`~ngcontact.cell
 Cost: the three coarser grids hold ``1/4 + 1/16 + 1/64 = 0.33`` of the scene grid's points in 3D and
 ``1/2 + 1/4 + 1/8 = 0.88`` in 2D, each solved in fewer constrained CG steps (their count grows like the
 square root of the points per direction, :func:`ngcontact.scene.spectral_grid.spectral_cost`), so the
-estimate costs at most a third (3D) or seven eighths (2D) of the scene's own solve more.  A grid that does
-not halve three times to at least :data:`COARSEST` points per direction is not estimated (the reason is
+estimate costs at most a third (3D) of the scene's own solve more; in 2D seven eighths, and the scene grid's
+twin half a step over (:mod:`~ngcontact.cell.spectral.grid_phase`), one solve of its size from its own pressures.
+A grid that does not halve three times to at least :data:`COARSEST` points per direction is not estimated (the reason is
 reported).
 """
 from __future__ import annotations
@@ -40,7 +41,7 @@ from typing import Any, Callable
 
 from ngcontact.cell.spectral.contact_edges import island_floor
 from ngcontact.cell.spectral.estimate_forms import loose_flags, loose_remarks
-from ngcontact.cell.spectral.grid_level import GROWTH, solve_level
+from ngcontact.cell.spectral.grid_level import GROWTH, solve_level, solve_twin
 from ngcontact.cell.spectral.grid_phase import phase_floor
 from ngcontact.cell.spectral.refinement import MIN_LEVELS, RefinedSweep, sweep_estimates
 
@@ -48,8 +49,8 @@ from ngcontact.cell.spectral.refinement import MIN_LEVELS, RefinedSweep, sweep_e
 COARSEST = 4
 #: how the estimate is made, for the report
 HOW = (f"the scene's grid and {MIN_LEVELS - 1} coarser ones, each with half the points per direction of the next "
-       "(at most a third of the scene's solve more in 3D, seven eighths in 2D), estimated as the finest of that "
-       "sequence as refinement estimates its finest grid")
+       "(at most a third of the scene's solve more in 3D, in 2D seven eighths and its twin half a step over), "
+       "estimated as the finest of that sequence as refinement estimates its finest grid")
 
 
 def coarser_levels(grid: int) -> list[int] | None:
@@ -79,6 +80,7 @@ def estimate_from_coarser(make_cell: Callable[[int], Any], loads: list, grid: in
     for n in grids:
         cell, sols, entry = solve_level(make_cell, loads, n, None if n == grid else (sols or None))
         history.append(entry)
+    solve_twin(make_cell, loads, cell, sols, entry)         # the scene's grid only: the one reported
     estimates, remarks, forms = sweep_estimates(history, geometric_ok=False)
     remarks += island_floor(history, estimates, forms) + phase_floor(history, estimates, forms)
     flags = loose_flags(history, estimates, forms)

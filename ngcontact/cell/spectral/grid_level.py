@@ -7,9 +7,10 @@ point, the points between take the mean of their neighbours): a start only, whic
 first steps where the contact set shrinks from full contact; the answer is the level's own.  Its record holds per
 load the headline quantities (:func:`~ngcontact.cell.cell_solution.headline`), which edges the quartic located
 (:func:`~ngcontact.cell.spectral.grid_measures.edges_fitted`), the shares of the edges that no difference
-bounds (:func:`~ngcontact.cell.spectral.contact_edges.unresolved_share`), in 2D the twin half a step over
-(:func:`~ngcontact.cell.spectral.grid_phase.twin_headline`), and the coefficients of the whole surface, the
-scale of eq. 34's coefficients on the real contact set.
+bounds (:func:`~ngcontact.cell.spectral.contact_edges.unresolved_share`), and the coefficients of the whole
+surface, the scale of eq. 34's coefficients on the real contact set; in 2D, on the levels whose estimate a stop
+or the report reads, also the twin half a step over (:func:`solve_twin`,
+:func:`~ngcontact.cell.spectral.grid_phase.twin_headline`; ``None`` on the others).
 """
 from __future__ import annotations
 
@@ -43,15 +44,14 @@ def prolong(p: np.ndarray) -> np.ndarray:
 def solve_level(make_cell: Callable[[int], Any], loads: list, n: int,
                 coarser: list | None = None) -> tuple[Any, list, dict[str, Any]]:
     """The cell on ``n`` points per direction, its solutions of ``loads`` (from ``coarser``'s pressures,
-    interpolated, where the coarser level's solutions are given) and the history entry of the level (its time the
-    twin's too, :mod:`~ngcontact.cell.spectral.grid_phase`)."""
+    interpolated, where the coarser level's solutions are given) and the history entry of the level, its twin not
+    yet solved (:func:`solve_twin`)."""
     t0 = time.perf_counter()
     cell = make_cell(n)
     starts = None
     if coarser is not None and all(c.fields["pressure"].shape[0] * GROWTH == n for c in coarser):
         starts = [prolong(c.fields["pressure"]) for c in coarser]
     sols = cell.sweep(loads, starts=starts)
-    twin = twin_headline(make_cell, cell, loads, sols)
     entry: dict[str, Any] = {
         "grid": n, "points": cell.points, "seconds": time.perf_counter() - t0,
         "iterations": [s.iterations for s in sols],
@@ -60,6 +60,15 @@ def solve_level(make_cell: Callable[[int], Any], loads: list, n: int,
         "headline": [headline(s.results) for s in sols],
         "edges_fitted": [edges_fitted(cell, s.fields["pressure"], s.fields["gap"]) for s in sols],
         "islands": [unresolved_share(cell, s.fields["pressure"], s.fields["gap"]) for s in sols],
-        "phase": twin,
+        "phase": None,
         "whole_surface": coefficients(cell, np.ones(cell.shape, bool)).as_dict()}
     return cell, sols, entry
+
+
+def solve_twin(make_cell: Callable[[int], Any], loads: list, cell, sols: list, entry: dict[str, Any]) -> None:
+    """Solve the twin half a step over of the level of ``cell`` and ``sols`` (2D;
+    :func:`~ngcontact.cell.spectral.grid_phase.twin_headline`) into its history ``entry``, whose time then
+    counts the twin's too."""
+    t0 = time.perf_counter()
+    entry["phase"] = twin_headline(make_cell, cell, loads, sols)
+    entry["seconds"] += time.perf_counter() - t0

@@ -25,9 +25,11 @@ q'_n| / 2`` for that harmonic.  The floor of a 2D level's estimate is :data:`PHA
 the harmonics beyond the first within the safety factor 2.  It bounds ``o`` at the reported level itself,
 whichever way the differences stalled; ``s_n``, which the twin does not see, the differences bound.  Each
 estimate is raised to its floor where smaller (form :data:`PHASE`), in the quantity's measure
-(:func:`~ngcontact.cell.cell_solution.scale`).  One more solve per level, of the same size, from the level's own
-pressures.  2D only: a 3D twin would double the cost of the dearest solves, and the 3D line's floor bounds the
-crossings of its edges (:mod:`~ngcontact.cell.spectral.contact_edges`).
+(:func:`~ngcontact.cell.cell_solution.scale`).  One more solve of the level's size, from the level's own
+pressures, on the levels whose estimate a stop or the report reads (:mod:`~ngcontact.cell.spectral.refinement`:
+the floor only raises an estimate, so elsewhere it changes no decision).  2D only: a 3D twin would double the cost
+of the dearest solves, and the 3D line's floor bounds the crossings of its edges
+(:mod:`~ngcontact.cell.spectral.contact_edges`).
 """
 from __future__ import annotations
 

@@ -114,17 +114,22 @@ with kinks, a step within a step of one, else a quarter: ``kink``; a penalty's 2
 line's share of a step: ``smooth``, :mod:`.smooth_edges`); a window across the level where the last island was
 resolved is also taken on the resolved levels alone, the smaller reported. In 2D each estimate is at least the change
 on the level's twin sampled half a step over (``phase``, :mod:`.grid_phase`): the error's part that jumps with the
-edges' place between points. An estimate (not Richardson's nor a floor) above :data:`.LOOSE` times the error its last
+edges' place between points.  The twin is solved only where its floor can matter: on a level whose estimates before
+it let every quantity but the stiffness meet the tolerance (a stop, a deferral or the stiffness's cap reads them) and
+on the largest grid (reported where nothing met the tolerance).  The floor only raises an estimate, so on any other
+level it would leave the tolerance missed and change no decision; those levels' estimates in the history are
+without it. An estimate (not Richardson's nor a floor) above :data:`.LOOSE` times the error its last
 difference leaves at the last contraction, or (any form) at the one before where the last is twice as slow or more,
 may exceed the error by as much: flagged with its reason, per quantity in the report
 (:func:`~ngcontact.cell.spectral.estimate_forms.loose_flags`).
 
-Levels double the points per direction (:data:`GROWTH`): the differences cost twice the finest level (2D: four times
-with the twins), 4/3 in 3D. The effectivity (estimate over true error of the reported level) is measured by
-``scripts/spectral_effectivity.py`` against each cell's own value on a much finer grid (``docs/benchmarks.md``).  No
-estimate can be sharp where the error of level ``k`` is small by chance: where it crosses zero, or where it falls by
-much more than the differences before it show (a pre-asymptotic stretch left for a faster regime), the differences
-still carry the size of the earlier errors, and the estimate exceeds the error by their ratio.
+Levels double the points per direction (:data:`GROWTH`): the differences cost twice the finest level (2D: three times
+with the reported level's twin, a solve more per level that waited), 4/3 in 3D. The effectivity (estimate over true
+error of the reported level) is measured by ``scripts/spectral_effectivity.py`` against each cell's own value on a
+much finer grid (``docs/benchmarks.md``).  No estimate can be sharp where the error of level ``k`` is small by chance:
+where it crosses zero, or where it falls by much more than the differences before it show (a pre-asymptotic stretch
+left for a faster regime), the differences still carry the size of the earlier errors, and the estimate exceeds the
+error by their ratio.
 
 A stop needs ``MIN_LEVELS`` levels (three differences: the window) and, to a scene's own tolerance, no load's edge
 locator changing (above). The levels are known before the first solve (``grid`` times ``GROWTH^k`` up to
@@ -148,7 +153,7 @@ from ngcontact.cell.spectral.contact_edges import (FITTED_STEP, ISLAND_POINTS, L
 from ngcontact.cell.spectral.estimate_forms import (AGREE, CARRIED, DISAGREE, FIRST_ORDER, GUARDED, LOOSE, RATE_CAP,
                                                     RATE_FLOOR, SAFETY, SPREAD, WINDOW, loose_flags, loose_remarks,
                                                     tail_estimate)
-from ngcontact.cell.spectral.grid_level import GROWTH, solve_level
+from ngcontact.cell.spectral.grid_level import GROWTH, solve_level, solve_twin
 from ngcontact.cell.spectral.grid_phase import phase_floor
 from ngcontact.cell.spectral.penalty_zone import INSIDE, PENALTY_LOG, zone_ahead
 from ngcontact.cell.spectral.smooth_edges import SPREAD_STEPS
@@ -375,7 +380,11 @@ def sweep_to_tolerance(make_cell: Callable[[int], Any], loads: list, tolerance: 
                 remarks.append(f"{lowered} estimates carried from the deferred grid {history[-2]['grid']}: its "
                                "estimate plus the last difference")
         if estimates is not None:
-            remarks += island_floor(history, estimates, forms) + phase_floor(history, estimates, forms)
+            remarks += island_floor(history, estimates, forms)
+            if n == grids[-1] or len(history) >= MIN_LEVELS and controlled_estimate(estimates, skip + (STIFFNESS,)
+                                                                                    ) <= tolerance:
+                solve_twin(make_cell, loads, cell, sols, entry)     # a level a stop or the report reads: lazy twin
+            remarks += phase_floor(history, estimates, forms)
             flags = loose_flags(history, estimates, forms)
             entry["estimate"] = controlled_estimate(estimates, skip)
         progress.info("spectral grid %d: %.2f s%s", n, entry["seconds"],
