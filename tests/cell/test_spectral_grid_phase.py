@@ -63,15 +63,18 @@ def test_the_twin_is_the_same_cell_on_the_surface_sampled_half_a_step_over():
         n, cell.k_n, cell.enforcement, cell.tol, cell.max_iter, "projected")
     loads = [cell_load(2, pressure=p) for p in PRESSURES]
     sols = cell.sweep(loads)
-    heads = twin_headline(_cell, cell, loads, sols)
+    heads = twin_headline(_cell, cell, loads, None)
     assert heads == [pytest.approx(headline(s.results), rel=1e-9) for s in twin.sweep(loads)]
+    entry = {"seconds": 0.0}                  # from the level's pressures at the twin's points: the same answer
+    solve_twin(_cell, loads, cell, sols, entry)
+    assert entry["phase"] == [pytest.approx(h, rel=1e-8) for h in heads] and entry["seconds"] > 0
     assert heads[1]["mean_closure"] != pytest.approx(headline(sols[1].results)["mean_closure"], rel=1e-9)
 
 
 def test_no_twin_in_3d():
     cell = SpectralCell(dim=3, period=1.0, grid=8, rough=Layer(1.0, NU, 1.0), counter=Layer(1.0, NU, 1.0),
                         gap=np.zeros((8, 8)), k_n=1e3)
-    assert twin_headline(lambda n: pytest.fail("no finer grid is built in 3D"), cell, [], []) is None
+    assert twin_headline(lambda n: pytest.fail("no finer grid is built in 3D"), cell, [], None) is None
 
 
 def _level(value, twin_value):

@@ -68,7 +68,8 @@ def solve_level(make_cell: Callable[[int], Any], loads: list, n: int,
 def solve_twin(make_cell: Callable[[int], Any], loads: list, cell, sols: list, entry: dict[str, Any]) -> None:
     """Solve the twin half a step over of the level of ``cell`` and ``sols`` (2D;
     :func:`~ngcontact.cell.spectral.grid_phase.twin_headline`) into its history ``entry``, whose time then
-    counts the twin's too."""
+    counts the twin's too.  Its loads start from the level's pressures at the midpoints between its points,
+    which are the twin's (the odd points of :func:`prolong`)."""
     t0 = time.perf_counter()
-    entry["phase"] = twin_headline(make_cell, cell, loads, sols)
+    entry["phase"] = twin_headline(make_cell, cell, loads, [prolong(s.fields["pressure"])[1::2] for s in sols])
     entry["seconds"] += time.perf_counter() - t0

@@ -23,13 +23,13 @@ q'_n| / 2`` for that harmonic.  The floor of a 2D level's estimate is :data:`PHA
     ``E_n >= PHASE_SAFETY |q_n - q'_n| / 2 = |q_n - q'_n|``,
 
 the harmonics beyond the first within the safety factor 2.  It bounds ``o`` at the reported level itself,
-whichever way the differences stalled; ``s_n``, which the twin does not see, the differences bound.  Each
-estimate is raised to its floor where smaller (form :data:`PHASE`), in the quantity's measure
-(:func:`~ngcontact.cell.cell_solution.scale`).  One more solve of the level's size, from the level's own
-pressures, on the levels whose estimate a stop or the report reads (:mod:`~ngcontact.cell.spectral.refinement`:
-the floor only raises an estimate, so elsewhere it changes no decision).  2D only: a 3D twin would double the cost
-of the dearest solves, and the 3D line's floor bounds the crossings of its edges
-(:mod:`~ngcontact.cell.spectral.contact_edges`).
+whichever way the differences stalled; ``s_n``, which the twin does not see, the differences bound.  Each estimate
+is raised to its floor where smaller (form :data:`PHASE`), in the quantity's measure
+(:func:`~ngcontact.cell.cell_solution.scale`).  One more solve of the level's size, from the level's own pressures
+interpolated to the twin's points, on the levels whose estimate a stop or the report reads
+(:mod:`~ngcontact.cell.spectral.refinement`: the floor only raises an estimate, so elsewhere it changes no
+decision).  2D only: a 3D twin would double the cost of the dearest solves, and the 3D line's floor bounds the
+crossings of its edges (:mod:`~ngcontact.cell.spectral.contact_edges`).
 """
 from __future__ import annotations
 
@@ -46,13 +46,15 @@ PHASE = "phase"
 PHASE_SAFETY = 2.0
 
 
-def twin_headline(make_cell: Callable[[int], Any], cell, loads: list, sols: list) -> list[dict[str, float]] | None:
+def twin_headline(make_cell: Callable[[int], Any], cell, loads: list, starts: list | None
+                  ) -> list[dict[str, float]] | None:
     """Per load, the headline quantities of ``cell`` posed on the gap sampled half a step over (module docstring:
-    every second point of ``make_cell(2 n)``'s gap), solved from the pressures of ``sols``; ``None`` in 3D."""
+    every second point of ``make_cell(2 n)``'s gap), solved from the pressures ``starts`` on the twin's points
+    (``None``: from zero); ``None`` in 3D."""
     if cell.dim != 2:
         return None
     twin = posed_on(cell, make_cell(2 * cell.grid).g0[1::2])
-    return [headline(s.results) for s in twin.sweep(loads, starts=[s.fields["pressure"] for s in sols])]
+    return [headline(s.results) for s in twin.sweep(loads, starts=starts)]
 
 
 def posed_on(cell: SpectralCell, gap: np.ndarray) -> SpectralCell:
