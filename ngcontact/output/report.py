@@ -104,13 +104,28 @@ class Clock:
 
 
 def to_plain(obj, path: str = "results"):
-    """Convert NumPy scalars/arrays to JSON types and reject non-finite numbers."""
+    """Convert NumPy scalars/arrays to JSON types and reject non-finite numbers (naming where: ``path``).  The
+    path of an element is spelled out only where it is reported, so that a table of a million rows converts at
+    the cost of its numbers; a float array is checked as a whole."""
     if isinstance(obj, dict):
         return {str(k): to_plain(v, f"{path}.{k}") for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [to_plain(v, f"{path}[{i}]") for i, v in enumerate(obj)]
+        out = []
+        for i, v in enumerate(obj):
+            if isinstance(v, float):                # a Python float, NumPy's float64 too
+                x = float(v)
+                if not math.isfinite(x):
+                    raise ValueError(f"non-finite number {x} at {path}[{i}]")
+                out.append(x)
+            else:
+                out.append(to_plain(v, f"{path}[{i}]"))
+        return out
     if isinstance(obj, np.ndarray):
-        return to_plain(obj.tolist(), path)
+        if obj.dtype.kind == "f" and not np.isfinite(obj).all():
+            where = np.argwhere(~np.isfinite(obj))[0]
+            raise ValueError(f"non-finite number {obj[tuple(where)]} at {path}"
+                             + "".join(f"[{i}]" for i in where))
+        return obj.tolist() if obj.dtype.kind in "fiub" else to_plain(obj.tolist(), path)
     if isinstance(obj, (bool, np.bool_)):
         return bool(obj)
     if isinstance(obj, (int, np.integer)):
@@ -125,9 +140,6 @@ def to_plain(obj, path: str = "results"):
     raise TypeError(f"cannot write {type(obj).__name__} at {path} to JSON")
 
 
-
-
-
 def _error_text(q: dict) -> str:
     """A quantity's error on the terminal line: ``+/- rel``, ``(no estimate)``, or where its value has no
     limit (a stress maximum at a singular corner) ``(mesh dependent: singular at (x, y))``, followed by
@@ -138,6 +150,7 @@ def _error_text(q: dict) -> str:
     if q.get("relative_error") is None:
         return "(no estimate)"
     return f"+/- {q['relative_error']:.2%}" + ("" if q.get("counted", True) else " not counted")
+
 
 def method_line(results: dict) -> str | None:
     """The method that solved a cell and why (``results.accuracy.method``) in one terminal line, with a 3D FE

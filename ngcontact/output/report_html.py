@@ -13,6 +13,7 @@ from __future__ import annotations
 import base64
 import csv
 import html
+import itertools
 import math
 import os
 
@@ -363,15 +364,17 @@ def figure(directory: str, name: str) -> str:
 
 
 def csv_table(directory: str, name: str) -> str:
-    """One CSV table of the run as HTML (the first :data:`MAX_TABLE_ROWS` rows)."""
+    """One CSV table of the run as HTML (the first :data:`MAX_TABLE_ROWS` rows; the others only counted)."""
     with open(os.path.join(directory, name), newline="") as fh:
-        rows = list(csv.reader(fh))
+        reader = csv.reader(fh)
+        rows = list(itertools.islice(reader, MAX_TABLE_ROWS + 1))
+        count = len(rows) - 1 + sum(1 for _ in reader)
     if not rows:
         return ""
     header, body = rows[0], rows[1:]
-    note = (f" (the first {MAX_TABLE_ROWS} of {len(body)} rows; all in "
-            f'<a href="{_e(name)}">{_e(name)}</a>)' if len(body) > MAX_TABLE_ROWS else
-            f' (<a href="{_e(name)}">{_e(name)}</a>, {len(body)} rows)')
+    note = (f" (the first {MAX_TABLE_ROWS} of {count} rows; all in "
+            f'<a href="{_e(name)}">{_e(name)}</a>)' if count > MAX_TABLE_ROWS else
+            f' (<a href="{_e(name)}">{_e(name)}</a>, {count} rows)')
     return (f'<h3 id="table-{_e(name)}">{_e(name)}</h3><p>{note}</p>'
             + html_table(header, [[_cell_text(c) for c in r] for r in body[:MAX_TABLE_ROWS]], "csv"))
 

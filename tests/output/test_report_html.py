@@ -179,3 +179,16 @@ def test_the_femur_report_renders_in_headless_chromium_with_every_image_loaded(t
     assert not [c for c in status["cards"] if NON_FINITE.search(c[1]) or not c[1].strip()], status["cards"]
     assert not NON_FINITE.search(status["text"]), "the rendered page shows a non-finite number"
     assert not NON_FINITE.search(visible_text(page)), "the page's source holds a non-finite number"
+
+
+def test_a_long_csv_table_shows_its_first_rows_and_counts_them_all(tmp_path):
+    from ngcontact.output.report_html import MAX_TABLE_ROWS, csv_table
+    with open(tmp_path / "surface_load0.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["x", "pressure"])
+        w.writerows([i, 0.5 * i] for i in range(MAX_TABLE_ROWS + 123))
+    page = csv_table(str(tmp_path), "surface_load0.csv")
+    assert f"the first {MAX_TABLE_ROWS} of {MAX_TABLE_ROWS + 123} rows" in page
+    assert f"<td>{MAX_TABLE_ROWS - 1}</td>" in page and f"<td>{MAX_TABLE_ROWS}</td>" not in page
+    (tmp_path / "short.csv").write_text("a,b\n1,2\n3,4\n")
+    assert "2 rows" in csv_table(str(tmp_path), "short.csv")
