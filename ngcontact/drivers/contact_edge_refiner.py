@@ -32,7 +32,6 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
-
 from ngcontact.cell.cell_load import cell_load
 from ngcontact.cell.cell_solution import headline
 from ngcontact.cell.fe.cell_model import CellModel
