@@ -51,7 +51,7 @@ from ngcontact.cell.penalty_share import penalty_share
 from ngcontact.errors import ConvergenceError
 from ngcontact.drivers import cell_gap, cell_members
 from ngcontact.drivers.build import cell_facts, cell_loads, cell_solver, with_symmetry
-from ngcontact.output import plots as figures
+from ngcontact.output import cell_plots as figures
 from ngcontact.output.report import Outcome, VtkField
 
 log = logging.getLogger(__name__)

@@ -42,6 +42,7 @@ import numpy as np
 
 from ngcontact.drivers import cell_gap, ensemble_accuracy, run_cell
 from ngcontact.errors import ModelError
+from ngcontact.output import cell_plots
 from ngcontact.output import plots as figures
 from ngcontact.output.report import Clock, Outcome
 from ngcontact.parallel import executor
@@ -140,7 +141,7 @@ def run(scene, clock) -> Outcome:
     if topography is not None:
         results["topography"] = topography
         psd, title = topography["psd"], f"{topography['file']} ({topography['source']})"
-        plots["psd"] = lambda path: figures.topography_psd(path, psd, title)
+        plots["psd"] = lambda path: cell_plots.topography_psd(path, psd, title)
     spread = {q: s for q, s in shrink.items() if s["rate"] is not None}
     if spread and len(sizes) >= 2:
         plots["ensemble_band"] = lambda path: figures.ensemble_band(path, spread)

@@ -1,4 +1,5 @@
-"""Every figure the package draws, from plain data (arrays, dicts, lists).
+"""Every figure the package draws, from plain data (arrays, dicts, lists); the cell's in
+:mod:`ngcontact.output.cell_plots`.
 
 Computation never imports matplotlib: drivers attach plot callables that
 call these functions with the numbers they computed, and the writer of
@@ -11,7 +12,7 @@ import math
 import numpy as np
 
 
-def _pyplot():
+def pyplot():
     """Matplotlib's pyplot on the non-interactive Agg backend."""
     import matplotlib
     matplotlib.use("Agg")
@@ -23,7 +24,7 @@ def epsilon_study(path: str, rows: list, laws) -> None:
     """Error against ``eps`` (field and reaction; thin dotted: the field error's discretization estimate, where
     the rows carry it; the bundle law's L2 error over the whole bodies without and with the first-order
     corrector, where the rows carry it) and cost against ``eps``."""
-    plt = _pyplot()
+    plt = pyplot()
     eps = np.array([r["eps"] for r in rows])
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
     for name, color in zip(laws, ("C0", "C1", "C2")):
@@ -58,7 +59,7 @@ def epsilon_errors(path: str, rows: list, laws, rates: dict, levels: dict) -> No
     discretization estimate (thin dotted) and the fitted line ``C eps^rate`` over the levels it was fitted on
     (dashed; ``rates[law][error]`` and ``levels[law][error]`` as :func:`ngcontact.drivers.study_epsilon.rates`
     returns them), so that each rate can be read against the levels the share rule let in."""
-    plt = _pyplot()
+    plt = pyplot()
     keys = [k for k in dict.fromkeys(k for law in laws for k in rates.get(law, {}))]
     if not keys:
         return
@@ -93,76 +94,6 @@ def epsilon_errors(path: str, rows: list, laws, rates: dict, levels: dict) -> No
     plt.close(fig)
 
 
-# ------------------------------------------------------------------ cell
-#: the most points a line of :func:`cell_surface` is drawn through: far more than the figure's pixels across
-MAX_LINE_POINTS = 4096
-
-
-def line_points(x, y) -> tuple[np.ndarray, np.ndarray]:
-    """The points of a line ``y(x)`` to draw: all of them up to :data:`MAX_LINE_POINTS`, else in each of
-    ``MAX_LINE_POINTS / 2`` runs of consecutive points its lowest and its highest, in their order, so that the
-    line keeps its envelope (a pressure peak, a contact edge) at a cost that does not grow with a fine grid."""
-    x, y = np.asarray(x), np.asarray(y)
-    if len(y) <= MAX_LINE_POINTS:
-        return x, y
-    bounds = np.linspace(0, len(y), MAX_LINE_POINTS // 2 + 1).astype(int)
-    keep = []
-    for a, b in zip(bounds[:-1], bounds[1:]):
-        keep += sorted({a + int(np.argmin(y[a:b])), a + int(np.argmax(y[a:b]))})
-    return x[keep], y[keep]
-
-
-def cell_surface(path: str, surfaces: list) -> None:
-    """Contact pressure and slip along the cell's contact surface, one line per load (a long one through its
-    envelope, :func:`line_points`).
-
-    ``surfaces``: one dict per load with arrays ``x``, ``pressure``, ``slip``.
-    """
-    plt = _pyplot()
-    fig, (a1, a2) = plt.subplots(2, 1, sharex=True, figsize=(6, 5))
-    for k, sf in enumerate(surfaces):
-        a1.plot(*line_points(sf["x"], sf["pressure"]), label=f"load {k}")
-        a2.plot(*line_points(sf["x"], sf["slip"]))
-    a1.set_ylabel("pressure (compression +)")
-    a2.set_ylabel("|slip|")
-    a2.set_xlabel("x")
-    a1.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def cell_contact_curve(path: str, pressure, contact_fraction, mean_closure) -> None:
-    """Contact fraction and mean closure against the transmitted mean pressure."""
-    plt = _pyplot()
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(8, 3.5))
-    a1.plot(pressure, contact_fraction, "o-")
-    a1.set_xlabel("mean pressure")
-    a1.set_ylabel("contact fraction")
-    a2.plot(pressure, mean_closure, "o-")
-    a2.set_xlabel("mean pressure")
-    a2.set_ylabel("mean closure")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
-def pressure_map(path: str, pressures: list, period: float) -> None:
-    """Contact pressure over one period of a 3D cell, one panel per load (in contact: nonzero)."""
-    plt = _pyplot()
-    n = len(pressures)
-    fig, axes = plt.subplots(1, n, figsize=(3.6 * n + 0.6, 3.4), squeeze=False)
-    for k, (ax, p) in enumerate(zip(axes[0], pressures)):
-        im = ax.imshow(p, origin="lower", extent=(0, period, 0, period), cmap="viridis")
-        ax.set_title(f"load {k}: contact {float((p > 0).mean()):.3f}", fontsize=8)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-        fig.colorbar(im, ax=ax, shrink=0.8, label="pressure")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-
-
 # ------------------------------------------------------------------ macro
 STATUS_LEVELS = {"open": 0, "stick": 1, "slip": 2}
 
@@ -182,7 +113,7 @@ def macro_interface(path: str, prof: dict) -> None:
     ``prof``: arrays ``s``, ``pressure``, ``shear``, ``jump_n``, ``jump_t``
     and a list ``status`` of ``"open"``, ``"stick"``, ``"slip"``.
     """
-    plt = _pyplot()
+    plt = pyplot()
     s = np.asarray(prof["s"]) * 1e3
     fig, ax = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
     ax[0].plot(s, np.asarray(prof["pressure"]) / 1e6, label="pressure p (compression > 0)")
@@ -205,7 +136,7 @@ def macro_interface_3d(path: str, surf: dict) -> None:
     ``surf``: arrays ``x, y, z``, ``pressure``, ``shear`` and a list ``status``
     (:func:`ngcontact.macro.macro_measures.interface_surface`).
     """
-    plt = _pyplot()
+    plt = pyplot()
     fig = plt.figure(figsize=(13, 4.2))
     x, y, z = (np.asarray(surf[c]) * 1e3 for c in ("x", "y", "z"))
     for i, (key, label) in enumerate((("pressure", "pressure p [MPa]"), ("shear", "|shear| [MPa]"))):
@@ -236,7 +167,7 @@ def macro_interface_axial(path: str, surf: dict) -> None:
     (on a surface of revolution the points of one height coincide when the
     solution is axisymmetric, and their spread shows where it is not).
     """
-    plt = _pyplot()
+    plt = pyplot()
     z = np.asarray(surf["z"]) * 1e3
     angle = np.degrees(np.arctan2(np.asarray(surf["y"]), np.asarray(surf["x"])))
     fig, ax = plt.subplots(4, 1, figsize=(8, 10), sharex=True, constrained_layout=True)
@@ -257,7 +188,7 @@ def macro_fields(path: str, x, y, triangles, values: dict, axisymmetric: bool) -
     ``x, y``: point coordinates [m]; ``triangles``: ``(n, 3)`` indices into
     them; ``values``: field name -> values at the points (stresses in Pa).
     """
-    plt = _pyplot()
+    plt = pyplot()
     from matplotlib.tri import Triangulation
     tri = Triangulation(np.asarray(x) * 1e3, np.asarray(y) * 1e3, np.asarray(triangles))
     fig, axes = plt.subplots(1, 4, figsize=(11, 7))
@@ -281,7 +212,7 @@ def convergence(path: str, rows: list, rates: dict) -> None:
     ``rows``: dicts with ``order``, ``h``, ``l2``, ``h1``, ``setting``;
     ``rates``: order -> ``{"l2": rate, "h1": rate}``.
     """
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), constrained_layout=True)
     for ax, norm, label in zip(axes, ("l2", "h1"), ("L2 error", "H1-seminorm error")):
         for p in sorted({r["order"] for r in rows}):
@@ -311,7 +242,7 @@ def strength_map(path: str, s, values: dict, sigma_u: dict, criterion: str, pres
     ``s`` [Pa] (3D: the magnitude of the shear).  Points, not lines, for
     samples that do not form a curve.
     """
-    plt = _pyplot()
+    plt = pyplot()
     s = np.asarray(s) * 1e3
     fig, ax = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
     style = {} if xlabel is None else {"ls": "none", "marker": ".", "ms": 2}
@@ -344,7 +275,7 @@ def worst_cell(path: str, points, eq, criterion: str, dim: int, tangents: tuple[
     ``tangents``: the macro directions of the cell's ``x, y`` axes (a 3D
     cell under a 3D macro scene: ``t1, t2``).
     """
-    plt = _pyplot()
+    plt = pyplot()
     pts = np.asarray(points)
     eq = np.asarray(eq) / 1e6
     label = f"{criterion.replace('_', ' ')} [MPa]"
@@ -380,7 +311,7 @@ def worst_cell(path: str, points, eq, criterion: str, dim: int, tangents: tuple[
 
 def ensemble_law(path: str, pressure, bands: dict, labels: dict, members: int) -> None:
     """An ensemble's law against the transmitted pressure: the mean of each quantity and its 95 % band."""
-    plt = _pyplot()
+    plt = pyplot()
     names = list(bands)
     fig, ax = plt.subplots(1, len(names), figsize=(3.6 * len(names), 3.6))
     order = np.argsort(pressure)
@@ -401,7 +332,7 @@ def ensemble_law(path: str, pressure, bands: dict, labels: dict, members: int) -
 
 def ensemble_band(path: str, shrink: dict) -> None:
     """Relative standard error of the ensemble mean against the number of members, with ``M^(-1/2)``."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(5, 4))
     for name, s in shrink.items():
         rate = s["rate"]
@@ -425,7 +356,7 @@ def ensemble_band(path: str, shrink: dict) -> None:
 def work_precision(path: str, quantity: str, measure: str, series: dict, target: float | None = None) -> None:
     """Error of ``quantity`` against wall time, log-log, one line per knob (``series``: knob -> (seconds,
     errors) of its levels; levels with a zero error are left out); the target as a horizontal line."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     drawn = False
     for k, (knob, (seconds, errors)) in enumerate(series.items()):
@@ -444,20 +375,4 @@ def work_precision(path: str, quantity: str, measure: str, series: dict, target:
         ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-def topography_psd(path: str, psd: dict, title: str) -> None:
-    """The radially averaged power spectral density ``C(q)`` of a measured topography, log-log."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(5, 4))
-    q, C = np.asarray(psd["q"], float), np.asarray(psd["C"], float)
-    keep = (q > 0) & (C > 0)
-    ax.loglog(q[keep], C[keep], "o-", ms=3)
-    ax.set_xlabel("wave number q [1/m]")
-    ax.set_ylabel("C(q) [m^4]")
-    ax.set_title(title, fontsize=9)
-    ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
     plt.close(fig)

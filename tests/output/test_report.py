@@ -42,7 +42,7 @@ def test_clock_accumulates_stages():
 
 
 def test_a_long_surface_line_is_drawn_through_its_envelope():
-    from ngcontact.output.plots import MAX_LINE_POINTS, line_points
+    from ngcontact.output.cell_plots import MAX_LINE_POINTS, line_points
     x = np.linspace(0.0, 1.0, 1_000_003)
     y = np.sqrt(np.clip(0.3 - np.abs(x - 0.5), 0.0, None))        # an edge at 0.2 and 0.8, its peak at 0.5
     y[777_777] = 9.0                                               # one spike
