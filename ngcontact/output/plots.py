@@ -1,5 +1,5 @@
-"""Every figure the package draws, from plain data (arrays, dicts, lists); the cell's in
-:mod:`ngcontact.output.cell_plots`.
+"""The figures of the macro, strength, ensemble and study stages, from plain data (arrays, dicts, lists); the
+cell's are in :mod:`ngcontact.output.cell_plots`.
 
 Computation never imports matplotlib: drivers attach plot callables that
 call these functions with the numbers they computed, and the writer of
